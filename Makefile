@@ -1,0 +1,49 @@
+# Two commands set everything up on a fresh machine: `make demo` and `make test`.
+# Each bootstraps .venv (Python >= 3.12) only when pyproject.toml changed.
+SHELL := /bin/bash
+VENV := .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.installed
+BENCH_STAMP := $(VENV)/.installed-bench
+NP ?= 2
+export UCX_TLS ?= self,sm,tcp
+export OMP_NUM_THREADS ?= 1
+export MPLBACKEND ?= Agg
+
+# First interpreter >= 3.12 found: PYTHON=..., then the pyenv-selected `python` (.python-version), then pythonX.Y.
+PYTHON ?= $(shell for p in python python3 python3.12 python3.13 python3.14; do \
+	  if command -v $$p >/dev/null 2>&1 && $$p -c 'import sys; sys.exit(sys.version_info < (3, 12))' 2>/dev/null; then \
+	    command -v $$p; break; fi; done)
+
+.PHONY: venv demo test test-serial test-mpi bench clean
+
+venv: $(STAMP)
+
+$(STAMP): pyproject.toml
+	@test -n "$(PYTHON)" || { echo "error: no Python >= 3.12 found (pyenv install 3.12, or make PYTHON=/path/to/python3.12)"; exit 1; }
+	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install -q --upgrade pip
+	$(BIN)/python -m pip install -q -e '.[fem,test]'
+	@touch $(STAMP)
+
+demo: $(STAMP)
+	$(BIN)/python demos/micro_contact.py
+
+test: test-serial test-mpi
+
+test-serial: $(STAMP)
+	$(BIN)/python -m pytest -q tests
+
+test-mpi: $(STAMP)
+	@if ls tests/mpi/test_*.py >/dev/null 2>&1; then \
+	  $(BIN)/mpiexec -n $(NP) $(BIN)/python -m pytest -q -p no:cacheprovider tests/mpi --override-ini addopts= ; fi
+
+$(BENCH_STAMP): $(STAMP)
+	$(BIN)/python -m pip install -q -e '.[fem,test,bench]'
+	@touch $(BENCH_STAMP)
+
+bench: $(BENCH_STAMP)
+	$(BIN)/python benchmarks/run_all.py
+
+clean:
+	rm -rf $(VENV) .pytest_cache build *.egg-info

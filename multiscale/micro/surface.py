@@ -1,0 +1,246 @@
+"""Rough surfaces: generation, import, statistics and asperity detection (thesis §1.3.1).
+
+Heights ``h[..., ny, nx]`` [m], positive towards the counter-face; pixel sizes dx, dy [m];
+row index ↔ y, column index ↔ x. Generated surfaces are periodic; imported ones are not.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from multiscale.errors import InputError, check_positive
+
+
+@dataclass(frozen=True)
+class Surface:
+    """Topography of one patch or a batch of patches (leading axes)."""
+
+    heights: np.ndarray   # m, (..., ny, nx)
+    dx: float             # m, pixel size along x (columns)
+    dy: float             # m, pixel size along y (rows)
+    periodic: bool = True
+
+    def __post_init__(self):
+        h = np.asarray(self.heights, dtype=float)
+        if h.ndim < 2 or min(h.shape[-2:]) < 4:
+            raise InputError("heights.shape", h.shape, "need a grid of at least 4 x 4 points")
+        if not np.all(np.isfinite(h)):
+            raise InputError("heights", "array with NaN/inf", "all heights must be finite")
+        check_positive("dx", self.dx)
+        check_positive("dy", self.dy)
+        object.__setattr__(self, "heights", h)
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.heights.shape[-2:]
+
+    @property
+    def size(self) -> tuple[float, float]:
+        """(Lx, Ly) [m]."""
+        return self.shape[1] * self.dx, self.shape[0] * self.dy
+
+    def coordinates(self) -> tuple[np.ndarray, np.ndarray]:
+        """Cell-centre coordinates x[nx], y[ny] [m], origin at the patch corner."""
+        ny, nx = self.shape
+        return (np.arange(nx) + 0.5) * self.dx, (np.arange(ny) + 0.5) * self.dy
+
+
+def _pair(name: str, value) -> tuple[float, float]:
+    v = np.broadcast_to(np.asarray(value, dtype=float), (2,))
+    if not np.all(np.isfinite(v)) or np.any(v <= 0):
+        raise InputError(name, value, "must be > 0 (a number, or a pair (x, y))")
+    return float(v[0]), float(v[1])
+
+
+def fractal_surface(n, size, hurst: float, k_min, k_max, rms: float, seed: int = 0,
+                    batch: tuple[int, ...] = ()) -> Surface:
+    """Self-affine random surface with a power-law PSD S(q) ∝ |q|^(−2(H+1)) (Eqs. 1.24–1.25).
+
+    n: grid points (n or (nx, ny)); size: patch size [m] (L or (Lx, Ly)); hurst: H in (0, 1];
+    k_min, k_max: lower and upper cut-offs in wavelengths per patch (thesis Table 1.1 units),
+    a number or a pair (kx, ky) for an anisotropic surface: the PSD is non-zero where
+    (kx/kx_max)² + (ky/ky_max)² <= 1 and (kx/kx_min)² + (ky/ky_min)² >= 1.
+    rms: RMS height [m] (each patch is scaled to it exactly); seed: random seed; batch: leading
+    shape of a batch of independent patches. Random phases uniform in [0, 2π) (Eq. 1.25).
+    """
+    nx, ny = (int(v) for v in np.broadcast_to(np.asarray(n), (2,)))
+    if min(nx, ny) < 4:
+        raise InputError("n", n, "need at least 4 points per side")
+    Lx, Ly = _pair("size", size)
+    if not 0 < hurst <= 1:
+        raise InputError("hurst", hurst, "Hurst exponent must lie in (0, 1]")
+    kx_min, ky_min = _pair("k_min", k_min)
+    kx_max, ky_max = _pair("k_max", k_max)
+    if kx_max <= kx_min or ky_max <= ky_min:
+        raise InputError("k_max", k_max, f"must exceed k_min = {k_min}")
+    if kx_max > nx // 2 or ky_max > ny // 2:
+        raise InputError("k_max", k_max, f"must not exceed the Nyquist index ({nx // 2}, {ny // 2})")
+    check_positive("rms", rms)
+    kx = np.fft.rfftfreq(nx, 1.0 / nx)[None, :]
+    ky = np.fft.fftfreq(ny, 1.0 / ny)[:, None]
+    band = ((kx / kx_max) ** 2 + (ky / ky_max) ** 2 <= 1 + 1e-12) & \
+           ((kx / kx_min) ** 2 + (ky / ky_min) ** 2 >= 1 - 1e-12)
+    q = np.hypot(kx / Lx, ky / Ly)
+    amplitude = np.where(band, np.where(q > 0, q, 1.0) ** (-(hurst + 1.0)), 0.0)
+    rng = np.random.default_rng(seed)
+    phase = rng.uniform(0.0, 2 * np.pi, size=tuple(batch) + amplitude.shape)
+    h = np.fft.irfft2(amplitude * np.exp(1j * phase), s=(ny, nx))
+    h -= h.mean(axis=(-2, -1), keepdims=True)
+    h *= rms / np.sqrt(np.mean(h**2, axis=(-2, -1), keepdims=True))
+    return Surface(h, Lx / nx, Ly / ny, periodic=True)
+
+
+def load_surface(path, dx: float, dy: float | None = None, *, scale: float = 1.0,
+                 detrend: str = "plane") -> Surface:
+    """Measured topography from .npy or a .txt/.csv matrix (rows ↔ y) with pixel size dx (dy) [m].
+
+    ``scale`` converts the file's height unit to metres (1e-6 for µm). ``detrend`` removes the
+    least-squares 'plane', the 'mean', or 'none'. The result is not periodic.
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError("path", str(path), "no such file")
+    suffix = path.suffix.lower()
+    try:
+        if suffix == ".npy":
+            h = np.load(path, allow_pickle=False)
+        elif suffix in (".txt", ".csv", ".dat", ".asc"):
+            delimiter = "," if suffix == ".csv" else None
+            h = np.loadtxt(path, delimiter=delimiter, comments="#", ndmin=2)
+        else:
+            raise InputError("path", str(path), "expected .npy, .txt, .csv, .dat or .asc")
+    except ValueError as exc:
+        if isinstance(exc, InputError):
+            raise
+        raise InputError("path", str(path), f"could not read a height matrix ({exc})") from None
+    h = np.asarray(h, dtype=float) * check_positive("scale", scale)
+    if h.ndim != 2:
+        raise InputError("path", str(path), f"expected a 2-D height matrix, got shape {h.shape}")
+    if not np.all(np.isfinite(h)):
+        raise InputError("path", str(path), "height matrix contains NaN/inf (fill missing points first)")
+    if detrend == "plane":
+        ny, nx = h.shape
+        Y, X = np.mgrid[:ny, :nx]
+        A = np.column_stack([np.ones(h.size), X.ravel(), Y.ravel()])
+        h = h - (A @ np.linalg.lstsq(A, h.ravel(), rcond=None)[0]).reshape(h.shape)
+    elif detrend == "mean":
+        h = h - h.mean()
+    elif detrend != "none":
+        raise InputError("detrend", detrend, "one of 'plane', 'mean', 'none'")
+    return Surface(h, dx, dy if dy is not None else dx, periodic=False)
+
+
+@dataclass(frozen=True)
+class SurfaceStats:
+    """Roughness statistics (per patch for batches). Profile moments are x/y averages."""
+
+    rms_height: np.ndarray  # m, sqrt(m0)
+    rms_slope: np.ndarray   # -, sqrt(<|grad h|²>)
+    m0: np.ndarray          # m², <h²>
+    m2: np.ndarray          # -, (<h_x²> + <h_y²>)/2
+    m4: np.ndarray          # 1/m², (<h_xx²> + <h_yy²>)/2
+    nayak: np.ndarray       # -, m0 m4 / m2²
+
+
+def statistics(surface: Surface) -> SurfaceStats:
+    """RMS height and slope, spectral moments m0, m2, m4 and Nayak's parameter.
+
+    Periodic surfaces: exact spectral derivatives. Others: central finite differences.
+    """
+    h = surface.heights - surface.heights.mean(axis=(-2, -1), keepdims=True)
+    dx, dy = surface.dx, surface.dy
+    m0 = np.mean(h**2, axis=(-2, -1))
+    if surface.periodic:
+        ny, nx = surface.shape
+        H = np.fft.fft2(h) / (nx * ny)
+        P = np.abs(H) ** 2
+        qx = 2 * np.pi * np.fft.fftfreq(nx, dx)[None, :]
+        qy = 2 * np.pi * np.fft.fftfreq(ny, dy)[:, None]
+        m20, m02 = np.sum(P * qx**2, axis=(-2, -1)), np.sum(P * qy**2, axis=(-2, -1))
+        m40, m04 = np.sum(P * qx**4, axis=(-2, -1)), np.sum(P * qy**4, axis=(-2, -1))
+    else:
+        hx = (h[..., :, 2:] - h[..., :, :-2]) / (2 * dx)
+        hy = (h[..., 2:, :] - h[..., :-2, :]) / (2 * dy)
+        hxx = (h[..., :, 2:] - 2 * h[..., :, 1:-1] + h[..., :, :-2]) / dx**2
+        hyy = (h[..., 2:, :] - 2 * h[..., 1:-1, :] + h[..., :-2, :]) / dy**2
+        m20, m02 = np.mean(hx**2, axis=(-2, -1)), np.mean(hy**2, axis=(-2, -1))
+        m40, m04 = np.mean(hxx**2, axis=(-2, -1)), np.mean(hyy**2, axis=(-2, -1))
+    m2, m4 = (m20 + m02) / 2, (m40 + m04) / 2
+    with np.errstate(divide="ignore", invalid="ignore"):
+        nayak = np.where(m2 > 0, m0 * m4 / np.where(m2 > 0, m2, 1) ** 2, np.inf)
+    return SurfaceStats(np.sqrt(m0), np.sqrt(m20 + m02), m0, m2, m4, nayak)
+
+
+@dataclass(frozen=True)
+class AsperityTable:
+    """Summits of one patch, one entry per asperity (arrays of equal length).
+
+    Principal radii R1 >= R2 > 0 [m] of the summit's curvature (R' and R'' of Eq. 1.2),
+    ``angle`` [rad] of the R1 axis (the long semi-axis of the Hertz ellipse) from +x,
+    equivalent radius R = sqrt(R1 R2), eccentricity e = sqrt(1 − (R2/R1)^(4/3)) (Eq. 1.2).
+    """
+
+    x: np.ndarray        # m, cell-centre coordinates of the summit
+    y: np.ndarray        # m
+    height: np.ndarray   # m
+    R1: np.ndarray       # m
+    R2: np.ndarray       # m
+    angle: np.ndarray    # rad
+    row: np.ndarray      # grid indices of the summit
+    col: np.ndarray
+
+    def __len__(self) -> int:
+        return len(self.height)
+
+    @property
+    def radius(self) -> np.ndarray:
+        return np.sqrt(self.R1 * self.R2)
+
+    @property
+    def eccentricity(self) -> np.ndarray:
+        return np.sqrt(np.clip(1.0 - (self.R2 / self.R1) ** (4.0 / 3.0), 0.0, 1.0))
+
+
+def find_asperities(surface: Surface) -> AsperityTable:
+    """Summits as strict 8-neighbour maxima with finite-difference Hessians (thesis §1.3.1).
+
+    Principal radii are the inverse eigenvalues of −Hessian, directions its eigenvectors.
+    Summits whose Hessian is not negative definite (a ridge or saddle-like maximum in the
+    discrete sense) have no finite radii and are left out. Periodic surfaces wrap around;
+    on others the border rows and columns are not candidates.
+    """
+    if surface.heights.ndim != 2:
+        raise InputError("surface.heights", surface.heights.shape, "asperity detection takes one patch (2-D)")
+    h, dx, dy = surface.heights, surface.dx, surface.dy
+    if surface.periodic:
+        def nb(di, dj):
+            return np.roll(h, (-di, -dj), axis=(0, 1))
+    else:
+        hp = np.pad(h, 1, mode="edge")  # border cells are never candidates
+
+        def nb(di, dj):
+            return hp[1 + di:hp.shape[0] - 1 + di, 1 + dj:hp.shape[1] - 1 + dj]
+    peak = np.ones(h.shape, dtype=bool)
+    for di in (-1, 0, 1):
+        for dj in (-1, 0, 1):
+            if di or dj:
+                peak &= h > nb(di, dj)
+    if not surface.periodic:
+        peak[[0, -1], :] = False
+        peak[:, [0, -1]] = False
+    hxx = (nb(0, 1) - 2 * h + nb(0, -1)) / dx**2
+    hyy = (nb(1, 0) - 2 * h + nb(-1, 0)) / dy**2
+    hxy = (nb(1, 1) - nb(1, -1) - nb(-1, 1) + nb(-1, -1)) / (4 * dx * dy)
+    r, c = np.nonzero(peak)
+    a, b, d = -hxx[r, c], -hxy[r, c], -hyy[r, c]          # curvature tensor K = −Hessian
+    mean, dev = (a + d) / 2, np.sqrt(((a - d) / 2) ** 2 + b**2)
+    k_small, k_large = mean - dev, mean + dev               # R1 = 1/k_small >= R2 = 1/k_large
+    keep = k_small > 0
+    r, c, a, b, d = r[keep], c[keep], a[keep], b[keep], d[keep]
+    k_small, k_large = k_small[keep], k_large[keep]
+    angle = 0.5 * np.arctan2(-2 * b, d - a)                 # eigenvector of k_small
+    x, y = surface.coordinates()
+    return AsperityTable(x=x[c], y=y[r], height=h[r, c], R1=1 / k_small, R2=1 / k_large,
+                         angle=np.mod(angle, np.pi), row=r, col=c)

@@ -1,0 +1,115 @@
+"""Rough surfaces: PSD band, determinism, statistics, import, asperity detection (thesis §1.3.1)."""
+import numpy as np
+import pytest
+
+from multiscale.errors import InputError
+from multiscale.micro.surface import Surface, find_asperities, fractal_surface, load_surface, statistics
+
+
+def test_same_seed_same_surface_and_rms():
+    a = fractal_surface(64, 1e-3, 0.95, 2, 10, 2e-6, seed=11)
+    b = fractal_surface(64, 1e-3, 0.95, 2, 10, 2e-6, seed=11)
+    c = fractal_surface(64, 1e-3, 0.95, 2, 10, 2e-6, seed=12)
+    np.testing.assert_array_equal(a.heights, b.heights)
+    assert not np.allclose(a.heights, c.heights)
+    assert np.sqrt(np.mean(a.heights**2)) == pytest.approx(2e-6, rel=1e-12)
+    assert abs(a.heights.mean()) < 1e-20
+
+
+def test_anisotropic_surface_has_requested_cutoffs():
+    s = fractal_surface((128, 96), (1e-3, 0.75e-3), 0.95, 2, (7, 12), 1e-6, seed=3)
+    assert s.heights.shape == (96, 128)
+    P = np.abs(np.fft.rfft2(s.heights)) ** 2
+    kx = np.fft.rfftfreq(128, 1 / 128)[None, :]
+    ky = np.fft.fftfreq(96, 1 / 96)[:, None]
+    on = P > 1e-20 * P.max()
+    inside = ((kx / 7) ** 2 + (ky / 12) ** 2 <= 1 + 1e-12) & ((kx / 2) ** 2 + (ky / 2) ** 2 >= 1 - 1e-12)
+    assert np.all(inside[on]) and np.all(on[inside])                  # exactly the requested band
+    assert kx[0, np.nonzero(on.any(axis=0))[0].max()] == 7
+    assert np.abs(ky[np.nonzero(on.any(axis=1))[0], 0]).max() == 12
+
+
+def test_power_law_slope_of_psd():
+    H = 0.8
+    s = fractal_surface(256, 1e-3, H, 4, 100, 1e-6, seed=5, batch=(8,))
+    P = (np.abs(np.fft.rfft2(s.heights)) ** 2).mean(axis=0)
+    k = np.hypot(np.fft.fftfreq(256, 1 / 256)[:, None], np.fft.rfftfreq(256, 1 / 256)[None, :])
+    band = (k > 6) & (k < 90)
+    slope = np.polyfit(np.log(k[band]), np.log(P[band]), 1)[0]
+    assert slope == pytest.approx(-2 * (H + 1), abs=0.05)
+
+
+def test_statistics_of_a_sinusoid():
+    n, L, A = 64, 1e-3, 1e-6
+    x = (np.arange(n) + 0.5) * L / n
+    q = 2 * np.pi * 3 / L
+    h = A * np.cos(q * x)[None, :] * np.ones((n, 1))
+    st = statistics(Surface(h, L / n, L / n))
+    assert st.m0 == pytest.approx(A**2 / 2, rel=1e-12)
+    assert st.rms_slope == pytest.approx(A * q / np.sqrt(2), rel=1e-12)
+    assert st.m2 == pytest.approx(A**2 * q**2 / 4, rel=1e-12)      # average of x (A²q²/2) and y (0)
+    assert st.m4 == pytest.approx(A**2 * q**4 / 4, rel=1e-12)
+    assert st.nayak == pytest.approx(2.0, rel=1e-12)
+    fd = statistics(Surface(h, L / n, L / n, periodic=False))        # finite differences
+    assert fd.rms_slope == pytest.approx(st.rms_slope, rel=2e-2)
+
+
+@pytest.mark.parametrize("theta", [0.0, 0.4, 1.3, 2.8])
+def test_asperity_radii_and_direction_of_elliptic_paraboloid(theta):
+    n, dx, R1, R2 = 33, 1e-6, 3e-3, 1e-3
+    x = (np.arange(n) - 16) * dx
+    X, Y = np.meshgrid(x, x)
+    xr, yr = X * np.cos(theta) + Y * np.sin(theta), -X * np.sin(theta) + Y * np.cos(theta)
+    h = -xr**2 / (2 * R1) - yr**2 / (2 * R2)
+    t = find_asperities(Surface(h, dx, dx, periodic=False))
+    assert len(t) == 1 and t.row[0] == 16 and t.col[0] == 16
+    assert t.R1[0] == pytest.approx(R1, rel=1e-9) and t.R2[0] == pytest.approx(R2, rel=1e-9)
+    assert t.angle[0] == pytest.approx(theta % np.pi, abs=1e-9)
+    assert t.eccentricity[0] == pytest.approx(np.sqrt(1 - (R2 / R1) ** (4 / 3)), rel=1e-12)
+
+
+def test_summits_are_strict_8_neighbour_maxima():
+    s = fractal_surface(64, 1e-3, 0.9, 2, 20, 1e-6, seed=2)
+    t = find_asperities(s)
+    h = s.heights
+    for r, c in zip(t.row, t.col):
+        window = np.roll(np.roll(h, 1 - r, 0), 1 - c, 1)[:3, :3]
+        assert (window < h[r, c]).sum() == 8
+    brute = sum(1 for r in range(64) for c in range(64)
+                if (np.roll(np.roll(h, 1 - r, 0), 1 - c, 1)[:3, :3] < h[r, c]).sum() == 8)
+    assert len(t) <= brute and len(t) >= 0.9 * brute         # only non-definite Hessians dropped
+    assert np.all(t.R1 >= t.R2) and np.all(t.R2 > 0)
+
+
+def test_import_npy_txt_csv(tmp_path):
+    rng = np.random.default_rng(0)
+    h = rng.normal(size=(10, 12))
+    np.save(tmp_path / "s.npy", h)
+    np.savetxt(tmp_path / "s.txt", h)
+    np.savetxt(tmp_path / "s.csv", h, delimiter=",")
+    for name in ("s.npy", "s.txt", "s.csv"):
+        s = load_surface(tmp_path / name, 2e-6, scale=1e-6, detrend="none")
+        np.testing.assert_allclose(s.heights, h * 1e-6, rtol=1e-12)
+        assert s.dx == s.dy == 2e-6 and not s.periodic
+    tilted = h + 3.0 * np.arange(12)[None, :] - 2.0 * np.arange(10)[:, None]
+    np.save(tmp_path / "t.npy", tilted)
+    flat = load_surface(tmp_path / "t.npy", 1e-6).heights
+    Y, X = np.mgrid[:10, :12]
+    A = np.column_stack([np.ones(120), X.ravel(), Y.ravel()])
+    assert np.abs(A.T @ flat.ravel()).max() < 1e-9          # plane removed
+
+
+def test_bad_surface_input(tmp_path):
+    with pytest.raises(InputError, match="path"):
+        load_surface(tmp_path / "missing.npy", 1e-6)
+    (tmp_path / "bad.csv").write_text("1,2,x\n3,4,5\n")
+    with pytest.raises(InputError, match="path"):
+        load_surface(tmp_path / "bad.csv", 1e-6)
+    with pytest.raises(InputError, match="dx"):
+        Surface(np.zeros((8, 8)), -1.0, 1.0)
+    with pytest.raises(InputError, match="hurst"):
+        fractal_surface(64, 1e-3, 1.5, 2, 10, 1e-6)
+    with pytest.raises(InputError, match="k_max"):
+        fractal_surface(64, 1e-3, 0.8, 2, 40, 1e-6)
+    with pytest.raises(InputError, match="rms"):
+        fractal_surface(64, 1e-3, 0.8, 2, 10, 0.0)
