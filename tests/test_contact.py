@@ -168,3 +168,16 @@ def test_bad_kernel_grid_and_heights():
     h[2, 2] = np.nan
     with pytest.raises(InputError, match="heights"):
         solve_contact(h, 1e-6, E, load=1e6)
+
+
+def test_thermal_half_space_is_the_elastic_one_rescaled():
+    """T = Q/(2 pi kappa r) and u = P/(pi E* r): same shape, ratio E*/(2 kappa)."""
+    from multiscale.micro.kernels import ThermalHalfSpace
+    kappa = 3.0
+    th, el = ThermalHalfSpace(kappa), HalfSpace(1.0)
+    q = np.array([0.0, 1.0, 10.0, 1e4])
+    np.testing.assert_allclose(th.compliance(q), el.compliance(q) / (2 * kappa), rtol=1e-15)
+    np.testing.assert_allclose(th.influence(5, 6, 1e-6, 2e-6), el.influence(5, 6, 1e-6, 2e-6) / (2 * kappa),
+                               rtol=1e-15)
+    # centre temperature of a uniformly heated square of half-width l: 1.1222 q l / kappa (thesis ch. 6)
+    assert love_rectangle(0.0, 0.0, 1.0, 1.0) / (2 * np.pi) == pytest.approx(1.1222, abs=1e-4)

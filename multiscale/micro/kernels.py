@@ -20,24 +20,26 @@ from multiscale.micro.fft import RealFFT2
 
 
 class Kernel(ABC):
-    """Normal surface compliance of a solid loaded by normal surface pressure."""
+    """Linear surface response of a solid to a surface load distribution.
+
+    Elastic kernels: normal displacement [m] per normal pressure [Pa]. Thermal kernels: surface
+    temperature rise [K] per surface heat flux [W/m²]. Responses are axisymmetric (isotropic
+    solids), so the Fourier transfer function depends on |k| only.
+    """
 
     @abstractmethod
     def compliance(self, q: np.ndarray) -> np.ndarray:
-        """Fourier compliance û_z/p̂ [m/Pa · m] at wavenumber modulus ``q`` [rad/m]."""
+        """Fourier transfer function (response/load per unit wavenumber, e.g. û_z/p̂ [m/Pa·m])
+        at wavenumber modulus ``q`` [rad/m]. Where it is infinite (q = 0 on a half-space) it
+        returns 0: a periodic patch then has a zero-mean response."""
 
     @abstractmethod
     def influence(self, ny: int, nx: int, dy: float, dx: float) -> np.ndarray:
-        """Displacement [m] at cell centres per unit pressure [Pa] on the cell at the origin.
+        """Response at cell centres per unit load on the (dx × dy) cell at the origin.
 
         Returns the ``(2 ny, 2 nx)`` array in wrap-around order (offset ``i`` at index ``i``,
         offset ``-i`` at index ``2n - i``), ready for a zero-padded linear convolution.
         """
-
-    @property
-    @abstractmethod
-    def surface_modulus(self) -> float:
-        """Effective plane-strain modulus E* [Pa] seen at short wavelengths (top material)."""
 
     def key(self) -> tuple:
         """Hashable identity (for caches of laws computed with this kernel)."""
@@ -71,10 +73,6 @@ class HalfSpace(Kernel):
             inv += (1 - nu2**2) / E2
         return cls(1.0 / inv)
 
-    @property
-    def surface_modulus(self) -> float:
-        return self.E_star
-
     def compliance(self, q):
         q = np.asarray(q, dtype=float)
         with np.errstate(divide="ignore"):
@@ -84,6 +82,29 @@ class HalfSpace(Kernel):
         ox = _wrap_offsets(nx) * dx
         oy = _wrap_offsets(ny) * dy
         return love_rectangle(ox[None, :], oy[:, None], dx / 2, dy / 2) / (np.pi * self.E_star)
+
+
+@dataclass(frozen=True)
+class ThermalHalfSpace(Kernel):
+    """Steady conduction in a homogeneous half-space of conductivity ``kappa`` [W/(m K)].
+
+    Surface temperature rise per surface heat flux: point source T = Q/(2 pi kappa r), Fourier
+    transfer 1/(kappa q) (thesis §5.3, homogeneous limit of F(rho)).
+    """
+
+    kappa: float
+
+    def __post_init__(self):
+        check_positive("kappa", self.kappa)
+
+    def compliance(self, q):
+        q = np.asarray(q, dtype=float)
+        return np.where(q > 0, 1.0 / (self.kappa * np.where(q > 0, q, 1.0)), 0.0)
+
+    def influence(self, ny, nx, dy, dx):
+        ox = _wrap_offsets(nx) * dx
+        oy = _wrap_offsets(ny) * dy
+        return love_rectangle(ox[None, :], oy[:, None], dx / 2, dy / 2) / (2 * np.pi * self.kappa)
 
 
 def love_rectangle(x, y, a, b):
