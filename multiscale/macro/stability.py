@@ -1,0 +1,532 @@
+"""Complex eigenvalue (squeal) stability analysis of a pre-stressed sliding system (thesis ch. 4).
+
+Linearised about a steady sliding state, the free vibrations obey ``M u'' + C u' + K u = 0`` with
+``K`` the tangent stiffness, non-symmetric because of the friction forces (§4.3.1). With
+``u = phi exp(lambda t)`` the undamped problem is the generalised non-Hermitian eigenproblem (GNHEP)
+
+    K phi = theta M phi,        lambda = sigma + i omega = i sqrt(theta)   (omega >= 0),
+
+solved with SLEPc by shift-and-invert about ``theta_t = (2 pi f_t)^2``. A real ``theta`` gives a
+neutrally stable mode; two modes that coalesce ("lock in") become a conjugate pair theta, conj(theta):
+one mode with sigma > 0 (unstable, growth rate [1/s]) and one with sigma < 0, at the same frequency.
+Damping proportional to the operators (``Damping``: Rayleigh alpha, beta; structural loss factor eta)
+keeps the eigenvectors and maps each theta exactly to lambda; a general damping matrix needs the
+quadratic eigenproblem (SLEPc PEP, ``solve_quadratic``).
+
+Post-processing (§4.4): unstable and potentially unstable modes (Fig. 4.14), MAC between two cases,
+MMAC and its cumulative moving average (Figs. 4.16–4.19), strain-energy shares per component and
+between the two pads (Figs. 4.20–4.21). Vectors are kept as the rank-owned part of the PETSc layout
+(complex numpy arrays); inner products are reduced over the matrix communicator.
+
+Sign conventions: sigma > 0 is growth (unstable), frequency = omega / (2 pi) [Hz] >= 0, modes are
+numbered from 1 in order of increasing frequency (ties: increasing sigma).
+"""
+from __future__ import annotations
+
+import csv
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Mapping, Sequence
+
+import numpy as np
+
+try:  # the PyPI DOLFINx wheel must be imported before petsc4py/slepc4py
+    import dolfinx_solver  # noqa: F401
+except ImportError:
+    pass
+from petsc4py import PETSc
+from slepc4py import SLEPc
+
+from ..errors import ConvergenceError, InputError, check_positive
+
+TWO_PI = 2.0 * math.pi
+
+
+# --------------------------------------------------------------------------------------------
+# Results
+# --------------------------------------------------------------------------------------------
+@dataclass
+class ModalResult:
+    """Complex modes of a linearised system, sorted by frequency.
+
+    ``modes[:, j]`` is mode j (rank-owned entries of the PETSc layout), normalised to
+    ``phi^H M phi = 1`` with the phase that makes ``phi^T phi`` real positive.
+    """
+
+    eigenvalues: np.ndarray     # lambda = sigma + i omega [1/s], omega >= 0
+    theta: np.ndarray           # eigenvalue of K phi = theta M phi [1/s^2] (= -lambda^2 undamped)
+    modes: np.ndarray           # complex (n_owned, n_modes) [m per unit modal mass^(1/2)]
+    errors: np.ndarray          # SLEPc relative residual of each pair [-]
+    band: tuple[float, float]   # requested band (f_min, f_max) [Hz]
+    target: float               # shift-and-invert target frequency [Hz]
+    n_dofs: int                 # global problem size
+    method: str                 # "gnhep" or "pep"
+    iterations: int             # outer iterations of the last SLEPc solve
+    solves: int                 # SLEPc solves (the band search may enlarge the subspace)
+    time: float                 # wall time [s]
+    comm: object = field(default=None, repr=False)   # mpi4py communicator of the modes (None: serial)
+
+    @property
+    def frequency(self) -> np.ndarray:
+        """omega / 2 pi [Hz]."""
+        return self.eigenvalues.imag / TWO_PI
+
+    @property
+    def growth(self) -> np.ndarray:
+        """sigma = Re(lambda) [1/s]; > 0 means unstable."""
+        return self.eigenvalues.real
+
+    @property
+    def damping_ratio(self) -> np.ndarray:
+        """-sigma / |lambda| [-] (negative for an unstable mode)."""
+        return -self.eigenvalues.real / np.maximum(np.abs(self.eigenvalues), np.finfo(float).tiny)
+
+    def unstable(self, rtol: float = 1e-6) -> np.ndarray:
+        """Boolean mask of modes with sigma > rtol |lambda| (round-off guard, default 1e-6)."""
+        return self.eigenvalues.real > rtol * np.abs(self.eigenvalues)
+
+    def __len__(self) -> int:
+        return self.eigenvalues.size
+
+    def write_csv(self, path: str | Path, rtol: float = 1e-6) -> Path:
+        """Mode table: number, frequency [Hz], sigma [1/s], damping ratio, unstable flag, residual."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with path.open("w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["mode", "frequency_Hz", "sigma_1_per_s", "damping_ratio", "unstable", "residual"])
+            for j, (fr, s, z, u, e) in enumerate(zip(self.frequency, self.growth, self.damping_ratio,
+                                                     self.unstable(rtol), self.errors), start=1):
+                w.writerow([j, f"{fr:.6f}", f"{s:.6e}", f"{z:.6e}", int(u), f"{e:.2e}"])
+        return path
+
+
+@dataclass(frozen=True)
+class Damping:
+    """Damping proportional to the operators: C = alpha M + beta K, and K -> K (1 + i eta).
+
+    Each GNHEP eigenvalue theta maps exactly (same eigenvector) to the root with omega >= 0 of
+    lambda^2 + (alpha + beta theta) lambda + theta (1 + i eta) = 0.
+    """
+
+    alpha: float = 0.0   # mass-proportional coefficient [1/s]
+    beta: float = 0.0    # stiffness-proportional coefficient [s]
+    eta: float = 0.0     # structural (hysteretic) loss factor [-]
+
+    def __post_init__(self):
+        for name in ("alpha", "beta", "eta"):
+            check_positive(f"damping.{name}", getattr(self, name), allow_zero=True)
+
+
+@dataclass
+class StabilityReport:
+    """Unstable and potentially unstable modes of one case (thesis Fig. 4.14)."""
+
+    unstable: np.ndarray              # mode numbers (1-based) with sigma > rtol |lambda|
+    potentially_unstable: np.ndarray  # stable modes with a stable neighbour closer than close_tol
+    frequency: np.ndarray             # [Hz] of all modes
+    growth: np.ndarray                # sigma [1/s] of all modes
+    rtol: float                       # instability threshold on sigma / |lambda| [-]
+    close_tol: float                  # relative frequency gap of a potentially unstable pair [-]
+
+
+@dataclass
+class EnergyShares:
+    """Strain-energy share of each component per mode (thesis Figs. 4.20–4.21)."""
+
+    names: list[str]        # component names
+    energy: np.ndarray      # (n_modes, n_components) 1/2 phi^H K_c phi [J per unit modal mass]
+    share: np.ndarray       # energy / sum over components [-]
+
+    def split(self, a: str, b: str) -> np.ndarray:
+        """Share of component ``a`` in the energy of ``a`` and ``b`` (e.g. inner vs outer pad) [-]."""
+        ia, ib = self._index(a), self._index(b)
+        tot = self.energy[:, ia] + self.energy[:, ib]
+        return self.energy[:, ia] / np.where(tot > 0, tot, 1.0)
+
+    def _index(self, name: str) -> int:
+        if name not in self.names:
+            raise InputError("component", name, f"one of {self.names}")
+        return self.names.index(name)
+
+
+# --------------------------------------------------------------------------------------------
+# Eigenvalue solvers
+# --------------------------------------------------------------------------------------------
+def lambda_from_theta(theta, damping: Damping | None = None) -> np.ndarray:
+    """Map eigenvalues theta of K phi = theta M phi to lambda = sigma + i omega (omega >= 0).
+
+    Undamped: lambda = i sqrt(theta). With ``damping``: the root of
+    lambda^2 + (alpha + beta theta) lambda + theta (1 + i eta) = 0 with the larger imaginary part
+    (ties, i.e. real roots from a negative theta, take the larger real part: divergence is unstable).
+    """
+    theta = np.asarray(theta, dtype=complex)
+    d = damping or Damping()
+    b = d.alpha + d.beta * theta
+    disc = np.sqrt(b * b - 4.0 * theta * (1.0 + 1j * d.eta))
+    r1, r2 = (-b + disc) / 2.0, (-b - disc) / 2.0
+    take1 = (r1.imag > r2.imag) | ((r1.imag == r2.imag) & (r1.real >= r2.real))
+    return np.where(take1, r1, r2)
+
+
+def _check_band(f_min, f_max, target, n_modes):
+    f_min = check_positive("f_min", f_min, allow_zero=True)
+    f_max = check_positive("f_max", f_max)
+    if f_max <= f_min:
+        raise InputError("f_max", f_max, f"must exceed f_min = {f_min} Hz")
+    if target is None:
+        target = f_min
+    try:
+        target = float(target)
+    except (TypeError, ValueError):
+        raise InputError("target", target, "must be a frequency in Hz >= 0") from None
+    if not (target >= 0 and math.isfinite(target)):
+        raise InputError("target", target, "must be a finite frequency in Hz >= 0 (a shift below "
+                         "the spectrum is not a frequency)")
+    if n_modes is not None and (int(n_modes) != n_modes or n_modes < 1):
+        raise InputError("n_modes", n_modes, "must be a positive integer")
+    return f_min, f_max, target
+
+
+def _direct_solver(st):
+    st.setType(SLEPc.ST.Type.SINVERT)
+    ksp = st.getKSP()
+    ksp.setType(PETSc.KSP.Type.PREONLY)
+    pc = ksp.getPC()
+    pc.setType(PETSc.PC.Type.LU)
+    if PETSc.Sys.hasExternalPackage("mumps"):
+        pc.setFactorSolverType("mumps")
+
+
+def _pairs(solver, i, vr, vi):
+    val = solver.getEigenpair(i, vr, vi)
+    return complex(val), vr.getArray() + 1j * vi.getArray()
+
+
+def _normalise(phi: np.ndarray, M, comm) -> np.ndarray:
+    """Scale columns to phi^H M phi = 1 and rotate so that phi^T phi is real positive."""
+    mphi = _apply(M, phi)
+    gram = np.array([np.vdot(phi[:, j], mphi[:, j]).real for j in range(phi.shape[1])])
+    sq = np.einsum("ij,ij->j", phi, phi)
+    gram, sq = _allreduce(np.concatenate([gram, sq]), comm).reshape(2, -1)
+    scale = np.exp(-0.5j * np.angle(sq)) / np.sqrt(np.maximum(gram.real, np.finfo(float).tiny))
+    return phi * scale
+
+
+def _allreduce(a: np.ndarray, comm) -> np.ndarray:
+    return a if comm is None else comm.allreduce(a)
+
+
+def _mpi_comm(A):
+    """None in serial; otherwise a duplicate of the matrix communicator (it outlives the matrix)."""
+    comm = A.getComm().tompi4py()
+    return None if comm.size == 1 else comm.Dup()
+
+
+def _apply(A, phi: np.ndarray) -> np.ndarray:
+    """A @ phi for a PETSc matrix and complex columns of owned entries."""
+    x, y = A.createVecs()
+    out = np.empty_like(phi)
+    for j in range(phi.shape[1]):
+        for part, unit in ((phi[:, j].real, 1.0), (phi[:, j].imag, 1j)):
+            x.setArray(part)
+            A.mult(x, y)
+            if unit == 1.0:
+                out[:, j] = y.getArray()
+            else:
+                out[:, j] += 1j * y.getArray()
+    x.destroy(), y.destroy()
+    return out
+
+
+def _sort_and_filter(lam, theta, vecs, errs, f_min, f_max, band_label):
+    f = lam.imag / TWO_PI
+    keep = (f >= f_min) & (f <= f_max)
+    if not keep.any():
+        raise InputError(band_label, (f_min, f_max),
+                         "no eigenvalue in this frequency band [Hz]; widen it (nearest found: "
+                         + (f"{f[np.argmin(np.minimum(abs(f - f_min), abs(f - f_max)))]:.6g} Hz)"
+                            if f.size else "none)"))
+    order = np.lexsort((lam.real[keep], f[keep]))
+    return lam[keep][order], theta[keep][order], vecs[:, keep][:, order], errs[keep][order]
+
+
+def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int | None = None,
+                target: float | None = None, damping: Damping | None = None, tol: float = 1e-10,
+                max_it: int = 300, nev: int = 20, options_prefix: str = "stability_") -> ModalResult:
+    """All modes with f_min <= f <= f_max [Hz] of K phi = theta M phi (GNHEP, shift-and-invert).
+
+    ``K`` (tangent, may be non-symmetric) and ``M`` (mass, diag 0 on Dirichlet rows so that the
+    constrained modes go to infinity) are assembled PETSc matrices. The shift is
+    theta_t = (2 pi target)^2 (default target = f_min); K - theta_t M must be non-singular, so a
+    free-free structure needs target > 0. Eigenvalues converge in order of |theta - theta_t|; the
+    subspace grows until every theta with |theta - theta_t| <= max((2 pi f_max)^2 - theta_t,
+    theta_t - (2 pi f_min)^2) is converged, i.e. the band is complete for modes with
+    |sigma| << omega. With ``n_modes`` the ``n_modes`` eigenvalues nearest the target are computed
+    instead (still filtered to the band). Raises InputError for a bad request or an empty band,
+    ConvergenceError if SLEPc does not converge.
+    """
+    f_min, f_max, target = _check_band(f_min, f_max, target, n_modes)
+    t0 = time.perf_counter()
+    comm = _mpi_comm(K)
+    n = K.getSize()[0]
+    shift = (TWO_PI * target) ** 2
+    radius = max((TWO_PI * f_max) ** 2 - shift, shift - (TWO_PI * f_min) ** 2)
+    if n_modes is not None and n_modes > n:
+        raise InputError("n_modes", n_modes, f"must not exceed the number of dofs ({n})")
+    want = int(n_modes) if n_modes is not None else min(int(nev), n)
+
+    eps = SLEPc.EPS().create(K.getComm())
+    eps.setOperators(K, M)
+    eps.setProblemType(SLEPc.EPS.ProblemType.GNHEP)
+    eps.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
+    eps.setTarget(shift)
+    eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
+    eps.setTolerances(tol, max_it)
+    _direct_solver(eps.getST())
+    eps.setOptionsPrefix(options_prefix)
+    eps.setFromOptions()
+    vr, vi = K.createVecs()
+    solves = 0
+    while True:
+        eps.setDimensions(want, PETSc.DECIDE)
+        try:
+            eps.solve()
+        except PETSc.Error as exc:
+            raise InputError("target", target, f"K - (2 pi target)^2 M could not be factorised "
+                             f"(singular at this shift? choose a target > 0 away from an eigenvalue): "
+                             f"{exc}") from None
+        solves += 1
+        nconv = eps.getConverged()
+        if nconv < min(want, n):
+            raise ConvergenceError(f"SLEPc converged {nconv} of {want} eigenpairs "
+                                   f"(reason {eps.getConvergedReason()})",
+                                   history=[eps.getIterationNumber()])
+        theta = np.array([eps.getEigenvalue(i) for i in range(nconv)], dtype=complex)
+        reached = np.sort(np.abs(theta - shift))[min(want, nconv) - 1]
+        if n_modes is not None or reached > radius or want >= n:
+            break
+        # Weyl: the count of theta below R grows like R^(3/2) in 3D; aim 20 % beyond the band.
+        grow = (1.2 * radius / max(reached, 1e-300)) ** 1.5
+        want = min(n, max(want + 10, int(math.ceil(want * min(grow, 8.0)))))
+
+    vecs = np.empty((vr.getLocalSize(), nconv), dtype=complex)
+    errs = np.empty(nconv)
+    for i in range(nconv):
+        theta[i], vecs[:, i] = _pairs(eps, i, vr, vi)
+        errs[i] = eps.computeError(i, SLEPc.EPS.ErrorType.RELATIVE)
+    iterations = eps.getIterationNumber()
+    eps.destroy(), vr.destroy(), vi.destroy()
+
+    lam = lambda_from_theta(theta, damping)
+    lam, theta, vecs, errs = _sort_and_filter(lam, theta, vecs, errs, f_min, f_max, "f_max")
+    return ModalResult(lam, theta, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
+                       "gnhep", iterations, solves, time.perf_counter() - t0, comm)
+
+
+def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int = 20,
+                    target: float = 0.0, tol: float = 1e-10, max_it: int = 300,
+                    options_prefix: str = "stability_pep_") -> ModalResult:
+    """Damped modes of (lambda^2 M + lambda C + K) phi = 0 with a general damping matrix C (SLEPc PEP).
+
+    Real arithmetic cannot shift at i omega; the shift is the real rate s = 2 pi target [1/s]
+    (K + s C + s^2 M is non-singular for s > 0 even for a free-free structure) and eigenvalues
+    converge in order of |lambda - s|, i.e. by frequency for light damping. ``n_modes`` counts
+    modes with omega >= 0 (conjugate pairs are computed together); the result is filtered to the
+    band. ``theta`` is reported as -lambda^2.
+    """
+    f_min, f_max, target = _check_band(f_min, f_max, target, n_modes)
+    t0 = time.perf_counter()
+    comm = _mpi_comm(K)
+    n = K.getSize()[0]
+    pep = SLEPc.PEP().create(K.getComm())
+    pep.setOperators([K, C, M])
+    pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
+    pep.setType(SLEPc.PEP.Type.TOAR)
+    pep.setTarget(TWO_PI * target)
+    pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
+    pep.setTolerances(tol, max_it)
+    pep.setDimensions(min(2 * int(n_modes), 2 * n), PETSc.DECIDE)
+    _direct_solver(pep.getST())
+    pep.setOptionsPrefix(options_prefix)
+    pep.setFromOptions()
+    try:
+        pep.solve()
+    except PETSc.Error as exc:
+        raise InputError("target", target, f"K + s C + s^2 M could not be factorised: {exc}") from None
+    nconv = pep.getConverged()
+    if nconv < min(2 * int(n_modes), 2 * n):
+        raise ConvergenceError(f"SLEPc PEP converged {nconv} of {2 * n_modes} eigenpairs",
+                               history=[pep.getIterationNumber()])
+    vr, vi = K.createVecs()
+    lam, vecs, errs = [], [], []
+    for i in range(nconv):
+        val, v = _pairs(pep, i, vr, vi)
+        if val.imag < 0 or (val.imag == 0 and any(abs(val - l) == 0 for l in lam)):
+            continue  # the conjugate partner of a kept mode
+        lam.append(val)
+        vecs.append(v)
+        errs.append(pep.computeError(i, SLEPc.PEP.ErrorType.BACKWARD))
+    iterations = pep.getIterationNumber()
+    pep.destroy(), vr.destroy(), vi.destroy()
+    lam = np.array(lam, dtype=complex)
+    vecs = np.column_stack(vecs) if vecs else np.empty((K.getLocalSize()[0], 0), complex)
+    lam, theta, vecs, errs = _sort_and_filter(lam, -lam**2, vecs, np.array(errs), f_min, f_max,
+                                              "f_max")
+    return ModalResult(lam, theta, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
+                       "pep", iterations, 1, time.perf_counter() - t0, comm)
+
+
+def onset_of_instability(build: Callable[[float], tuple], mu_lo: float, mu_hi: float, *,
+                         xtol: float = 1e-9, rtol: float = 1e-6, **solve_kw) -> float:
+    """Smallest friction coefficient in [mu_lo, mu_hi] with an unstable mode, by bisection.
+
+    ``build(mu) -> (K, M)``; ``solve_kw`` go to ``solve_modes``. Stable at mu_lo and unstable at
+    mu_hi are required (InputError otherwise). Returns the onset mu [-] within ``xtol``.
+    """
+    mu_lo = check_positive("mu_lo", mu_lo, allow_zero=True)
+    mu_hi = check_positive("mu_hi", mu_hi)
+    if mu_hi <= mu_lo:
+        raise InputError("mu_hi", mu_hi, f"must exceed mu_lo = {mu_lo}")
+
+    def unstable(mu):
+        return bool(solve_modes(*build(mu), **solve_kw).unstable(rtol).any())
+
+    if unstable(mu_lo):
+        raise InputError("mu_lo", mu_lo, "the system is already unstable there")
+    if not unstable(mu_hi):
+        raise InputError("mu_hi", mu_hi, "the system is still stable there")
+    while mu_hi - mu_lo > xtol:
+        mid = 0.5 * (mu_lo + mu_hi)
+        mu_lo, mu_hi = (mu_lo, mid) if unstable(mid) else (mid, mu_hi)
+    return 0.5 * (mu_lo + mu_hi)
+
+
+def hoffmann_model(mu: float, k11: float = 1.0, k22: float = 1.5, k12: float = 0.3,
+                   k21: float = 0.3, k3: float = 1.0, mass: float = 1.0, comm=None):
+    """(K, M) of the Hoffmann 2-DOF minimal model of mode-coupling instability.
+
+    A mass on a belt held by springs; the normal contact spring k3 and Coulomb friction mu k3 x2
+    add the circulatory term: K = [[k11, k12 - mu k3], [k21, k22]], M = mass I. The two modes
+    coalesce at mu_c = [(k11 - k22)^2 + 4 k12 k21] / (4 k21 k3).
+    """
+    mu = check_positive("mu", mu, allow_zero=True)
+    for name, v in (("k11", k11), ("k22", k22), ("k3", k3), ("mass", mass)):
+        check_positive(name, v)
+    comm = comm or PETSc.COMM_SELF
+    out = []
+    for rows in (((k11, k12 - mu * k3), (k21, k22)), ((mass, 0.0), (0.0, mass))):
+        A = PETSc.Mat().createAIJ([2, 2], nnz=2, comm=comm)
+        A.setUp()
+        for i in range(2):
+            A.setValues(i, [0, 1], rows[i])
+        A.assemble()
+        out.append(A)
+    return tuple(out)
+
+
+# --------------------------------------------------------------------------------------------
+# Post-processing (§4.4)
+# --------------------------------------------------------------------------------------------
+def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float = 1e-3) -> StabilityReport:
+    """Unstable modes (sigma > rtol |lambda|) and potentially unstable ones (Fig. 4.14).
+
+    A stable mode is potentially unstable when a neighbouring stable mode lies within
+    ``close_tol`` relative frequency: the pair is close to coalescence but not yet locked in.
+    """
+    check_positive("rtol", rtol)
+    check_positive("close_tol", close_tol)
+    f = result.frequency
+    bad = result.unstable(rtol)
+    close = np.zeros(f.size, bool)
+    if f.size > 1:
+        gap = np.diff(f) <= close_tol * np.maximum(f[1:], np.finfo(float).tiny)
+        both_stable = ~bad[1:] & ~bad[:-1]
+        pair = gap & both_stable
+        close[1:] |= pair
+        close[:-1] |= pair
+    number = np.arange(1, f.size + 1)
+    return StabilityReport(number[bad], number[close], f.copy(), result.growth.copy(), rtol, close_tol)
+
+
+def mac_matrix(a: ModalResult | np.ndarray, b: ModalResult | np.ndarray, comm=None) -> np.ndarray:
+    """MAC_ij = |y_i^H y_j|^2 / (y_i^H y_i  y_j^H y_j) between modes of two cases (§4.4).
+
+    Both sets must live on the same dof layout (same mesh and spaces). Returns (n_a, n_b) in [0, 1].
+    """
+    comm = comm or getattr(a, "comm", None) or getattr(b, "comm", None)
+    ya = a.modes if isinstance(a, ModalResult) else np.asarray(a)
+    yb = b.modes if isinstance(b, ModalResult) else np.asarray(b)
+    if ya.shape[0] != yb.shape[0]:
+        raise InputError("modes", (ya.shape, yb.shape), "the two cases must share the dof layout")
+    cross = ya.conj().T @ yb
+    na = np.einsum("ij,ij->j", ya.conj(), ya).real
+    nb = np.einsum("ij,ij->j", yb.conj(), yb).real
+    cross, na, nb = _allreduce(cross, comm), _allreduce(na, comm), _allreduce(nb, comm)
+    return np.abs(cross) ** 2 / np.maximum(np.outer(na, nb), np.finfo(float).tiny)
+
+
+def mmac(mac: np.ndarray) -> np.ndarray:
+    """MMAC_i = max_j MAC_ij: best correlation of mode i of the first case (§4.4)."""
+    return np.asarray(mac).max(axis=1)
+
+
+def cumulative_moving_average(x) -> np.ndarray:
+    """xbar_n = (1/n) sum_{k=0}^{n-1} x_{n-k}, n = 1..N (Fig. 4.19)."""
+    x = np.asarray(x, dtype=float)
+    return np.cumsum(x) / np.arange(1, x.size + 1)
+
+
+def strain_energy_shares(result: ModalResult, stiffness: Mapping[str, object]) -> EnergyShares:
+    """Per-mode strain energy 1/2 phi^H K_c phi of each component (Figs. 4.20–4.21).
+
+    ``stiffness`` maps component names to symmetric elastic stiffness matrices assembled over that
+    component only (same layout as the modes).
+    """
+    if not stiffness:
+        raise InputError("stiffness", stiffness, "at least one component matrix")
+    names = list(stiffness)
+    energy = np.empty((len(result), len(names)))
+    for c, name in enumerate(names):
+        kphi = _apply(stiffness[name], result.modes)
+        energy[:, c] = 0.5 * np.einsum("ij,ij->j", result.modes.conj(), kphi).real
+    energy = _allreduce(energy, result.comm)
+    tot = energy.sum(axis=1, keepdims=True)
+    return EnergyShares(names, energy, energy / np.where(tot > 0, tot, 1.0))
+
+
+def write_modes_xdmf(path: str | Path, result: ModalResult, functions: Sequence,
+                     modes: Sequence[int] | None = None) -> list[Path]:
+    """Mode shapes to XDMF, one file per body mesh: real and imaginary parts, "time" = mode number.
+
+    ``functions`` are displacement Functions of the bodies in the block order of the matrices (the
+    owned dofs of body 0, then of body 1, ... on each rank). Returns the written paths.
+    """
+    from dolfinx import fem, io
+
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    sel = range(1, len(result) + 1) if modes is None else modes
+    sizes = [u.function_space.dofmap.bs * u.function_space.dofmap.index_map.size_local
+             for u in functions]
+    if sum(sizes) != result.modes.shape[0]:
+        raise InputError("functions", len(functions), "must span the dof layout of the modes")
+    offsets = np.concatenate([[0], np.cumsum(sizes)])
+    parts = [(fem.Function(u.function_space, name="mode_re"),
+              fem.Function(u.function_space, name="mode_im")) for u in functions]
+    files = []
+    for k, (u, (re, im)) in enumerate(zip(functions, parts)):
+        mesh = u.function_space.mesh
+        out = path.with_name(f"{path.stem}_body{k}.xdmf")
+        with io.XDMFFile(mesh.comm, str(out), "w") as w:
+            w.write_mesh(mesh)
+            for j in sel:
+                block = result.modes[offsets[k]:offsets[k + 1], j - 1]
+                for f, values in ((re, block.real), (im, block.imag)):
+                    f.x.array[:sizes[k]] = values
+                    f.x.scatter_forward()
+                    w.write_function(f, float(j))
+        files.append(out)
+    return files

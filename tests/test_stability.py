@@ -1,0 +1,222 @@
+"""Complex eigenvalue stability core (thesis ch. 4): Hoffmann 2-DOF model, band search, damping, MAC."""
+import csv
+import math
+
+import numpy as np
+import pytest
+
+from multiscale.errors import InputError
+from multiscale.macro import stability as st
+from multiscale.macro.stability import PETSc
+
+K11, K22, K12, K21, K3 = 1.0, 1.5, 0.3, 0.3, 1.0
+MU_C = ((K11 - K22) ** 2 + 4 * K12 * K21) / (4 * K21 * K3)   # 0.508333...
+
+
+def hoffmann_theta(mu):
+    """Exact eigenvalues of K = [[k11, k12 - mu k3], [k21, k22]] (unit mass)."""
+    d = complex(((K11 - K22) / 2) ** 2 + K21 * (K12 - mu * K3))
+    return np.array([(K11 + K22) / 2 - np.sqrt(d), (K11 + K22) / 2 + np.sqrt(d)])
+
+
+def petsc_mat(A):
+    n = A.shape[0]
+    m = PETSc.Mat().createAIJ([n, n], nnz=min(n, 3), comm=PETSc.COMM_SELF)
+    m.setUp()
+    rows, cols = np.nonzero(A)
+    for i, j in zip(rows, cols):
+        m.setValue(i, j, A[i, j])
+    m.assemble()
+    return m
+
+
+def chain(n=200, k=4e6, m=0.01, drift=0.0):
+    """Fixed-fixed spring-mass chain (n masses) with both end dofs as Dirichlet rows.
+
+    Returns dense K, M of size n + 2: rows 0 and n+1 are identity in K and zero in M (constrained
+    modes at infinity). ``drift`` adds a circulatory (follower-like) coupling to make K non-symmetric.
+    """
+    N = n + 2
+    K = np.zeros((N, N))
+    M = np.zeros((N, N))
+    for i in range(1, n + 1):
+        K[i, i] = 2 * k
+        if i > 1:
+            K[i, i - 1] = -k + drift * k
+        if i < n:
+            K[i, i + 1] = -k - drift * k
+        M[i, i] = m
+    K[0, 0] = K[-1, -1] = 1.0
+    return K, M
+
+
+def chain_frequencies(n=200, k=4e6, m=0.01):
+    j = np.arange(1, n + 1)
+    return 2 * np.sqrt(k / m) * np.sin(j * np.pi / (2 * (n + 1))) / (2 * np.pi)
+
+
+def test_hoffmann_coalescence_at_analytic_mu_c():
+    mu = st.onset_of_instability(st.hoffmann_model, 0.0, 1.0, xtol=1e-9, f_max=1.0)
+    assert MU_C == pytest.approx(0.508333333333, abs=1e-9)
+    assert abs(mu - MU_C) < 1e-6
+
+
+@pytest.mark.parametrize("mu", [0.0, 0.3, 0.5])
+def test_hoffmann_stable_below_mu_c(mu):
+    r = st.solve_modes(*st.hoffmann_model(mu), f_max=1.0)
+    assert len(r) == 2 and not r.unstable().any()
+    np.testing.assert_allclose(np.sort(r.theta.real), hoffmann_theta(mu).real, rtol=1e-10)
+    assert np.abs(r.theta.imag).max() <= 1e-10 * np.abs(r.theta).max()
+    np.testing.assert_allclose(r.frequency, np.sqrt(hoffmann_theta(mu).real) / (2 * np.pi), rtol=1e-10)
+
+
+@pytest.mark.parametrize("mu", [0.52, 0.8])
+def test_hoffmann_exactly_one_unstable_mode_above_mu_c(mu):
+    r = st.solve_modes(*st.hoffmann_model(mu), f_max=1.0)
+    assert r.unstable().sum() == 1
+    lam = 1j * np.sqrt(hoffmann_theta(mu))          # both with omega > 0
+    lam = lam[np.lexsort((lam.real, lam.imag))]
+    np.testing.assert_allclose(r.eigenvalues, lam, rtol=1e-10)
+    assert r.growth[r.unstable()][0] == pytest.approx(abs(lam.real[0]), rel=1e-10)
+    rep = st.stability_report(r)
+    assert list(rep.unstable) == [int(np.argmax(r.growth)) + 1]
+
+
+def test_hoffmann_just_below_mu_c_is_potentially_unstable():
+    rep = st.stability_report(st.solve_modes(*st.hoffmann_model(MU_C - 1e-4), f_max=1.0),
+                              close_tol=0.05)
+    assert rep.unstable.size == 0 and list(rep.potentially_unstable) == [1, 2]
+    far = st.stability_report(st.solve_modes(*st.hoffmann_model(0.0), f_max=1.0), close_tol=0.05)
+    assert far.potentially_unstable.size == 0
+
+
+def test_bad_requests_raise_clear_errors():
+    K, M = st.hoffmann_model(0.3)
+    with pytest.raises(InputError, match="mu"):
+        st.hoffmann_model(-0.1)
+    with pytest.raises(InputError, match="target"):
+        st.solve_modes(K, M, target=-5.0)
+    with pytest.raises(InputError, match="no eigenvalue in this frequency band"):
+        st.solve_modes(K, M, f_min=10.0, f_max=20.0, target=15.0)
+    with pytest.raises(InputError, match="f_max"):
+        st.solve_modes(K, M, f_min=2.0, f_max=1.0)
+    with pytest.raises(InputError, match="n_modes"):
+        st.solve_modes(K, M, n_modes=5)
+    with pytest.raises(InputError, match="mu_hi"):
+        st.onset_of_instability(st.hoffmann_model, 0.0, 0.4, f_max=1.0)
+    with pytest.raises(InputError, match="mu_lo"):
+        st.onset_of_instability(st.hoffmann_model, -1.0, 0.4, f_max=1.0)
+
+
+def test_band_search_finds_every_mode_and_skips_dirichlet_rows():
+    K, M = chain()
+    f_exact = chain_frequencies()
+    f_max = 0.5 * f_exact.max()                       # ~66 modes, more than the initial subspace
+    r = st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=f_max, nev=10)
+    inband = f_exact[f_exact <= f_max]
+    assert r.solves > 1 and len(r) == inband.size
+    np.testing.assert_allclose(r.frequency, inband, rtol=1e-8)
+    assert np.abs(r.theta.imag).max() <= 1e-8 * np.abs(r.theta).max()   # symmetric: real
+    assert np.abs(r.modes[[0, -1]]).max() < 1e-9 * np.abs(r.modes).max()  # constrained dofs
+    np.testing.assert_allclose(np.einsum("ij,ij->j", r.modes.conj(), M @ r.modes).real, 1.0,
+                               rtol=1e-10)
+    # a sub-band with a shift inside it gives the same modes
+    sub = st.solve_modes(petsc_mat(K), petsc_mat(M), f_min=0.2 * f_exact.max(), f_max=f_max,
+                         target=0.35 * f_exact.max())
+    np.testing.assert_allclose(sub.frequency, inband[inband >= 0.2 * f_exact.max()], rtol=1e-8)
+
+
+def dense_quadratic(K, C, M):
+    """All lambda of (lambda^2 M + lambda C + K) phi = 0 with omega >= 0 (companion form)."""
+    n = K.shape[0]
+    Minv = np.linalg.inv(M)
+    A = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
+    lam = np.linalg.eigvals(A)
+    lam = lam[lam.imag > 0]
+    return lam[np.lexsort((lam.real, lam.imag))]
+
+
+def test_proportional_damping_mapping_matches_companion_form_and_pep():
+    K, M = chain(n=40, drift=0.05)
+    K, M = K[1:-1, 1:-1], M[1:-1, 1:-1]
+    alpha, beta, eta = 30.0, 2e-7, 0.01
+    f_max = 0.4 * chain_frequencies(40).max()
+    r = st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=f_max, damping=st.Damping(alpha, beta, eta))
+    ref = dense_quadratic(K * (1 + 1j * eta), alpha * M + beta * K, M)
+    ref = ref[ref.imag / (2 * np.pi) <= f_max]
+    np.testing.assert_allclose(r.eigenvalues, ref, rtol=1e-9)
+    assert r.growth.max() < 0                       # damping stabilises this weak drift
+    # the general quadratic solver (SLEPc PEP) agrees for a damping matrix given as such
+    C = alpha * M + beta * K
+    q = st.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_max=f_max, n_modes=len(r) + 4,
+                           target=1.0)
+    ref = dense_quadratic(K, C, M)
+    ref = ref[ref.imag / (2 * np.pi) <= f_max]
+    np.testing.assert_allclose(q.eigenvalues, ref, rtol=1e-7)
+    mac = st.mac_matrix(q, st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=f_max,
+                                          damping=st.Damping(alpha, beta)))
+    np.testing.assert_allclose(np.diag(mac), 1.0, atol=1e-8)
+
+
+def test_friction_like_drift_couples_chain_modes():
+    """A circulatory term makes K non-symmetric; strong enough, neighbouring modes lock in."""
+    K, M = chain(n=40, drift=0.0)
+    K, M = K[1:-1, 1:-1], M[1:-1, 1:-1]
+    f_max = 0.3 * chain_frequencies(40).max()
+    r0 = st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=f_max)
+    assert not r0.unstable().any()
+    Kd = K.copy()
+    Kd[0, 1] -= 2e6                                   # one-sided follower coupling
+    r1 = st.solve_modes(petsc_mat(Kd), petsc_mat(M), f_max=f_max)
+    lam = 1j * np.sqrt(np.linalg.eigvals(np.linalg.solve(M, Kd)).astype(complex))
+    lam = np.where(lam.imag < 0, -lam, lam)
+    lam = lam[lam.imag / (2 * np.pi) <= f_max]
+    np.testing.assert_allclose(np.sort(r1.growth), np.sort(lam.real), atol=1e-8 * np.abs(lam).max())
+
+
+def test_mac_mmac_and_cumulative_average():
+    a = np.array([[1, 0], [0, 1], [0, 0]], complex)
+    b = np.array([[1, 1], [1j, -1j], [0, 0]], complex) * (2 - 3j)
+    mac = st.mac_matrix(a, b)
+    np.testing.assert_allclose(mac, [[0.5, 0.5], [0.5, 0.5]], atol=1e-15)
+    np.testing.assert_allclose(st.mac_matrix(b, b), np.eye(2), atol=1e-15)
+    np.testing.assert_allclose(st.mmac([[0.2, 0.9], [0.4, 0.1]]), [0.9, 0.4])
+    np.testing.assert_allclose(st.cumulative_moving_average([1, 0, 0.5, 0.5]), [1, 0.5, 0.5, 0.5])
+    with pytest.raises(InputError, match="modes"):
+        st.mac_matrix(a, b[:2])
+
+
+def test_strain_energy_shares_sum_to_modal_stiffness(tmp_path):
+    n, k = 60, 4e6
+    K, M = chain(n=n, k=k)
+    K, M = K[1:-1, 1:-1], M[1:-1, 1:-1]
+    Ka, Kb = np.zeros_like(K), np.zeros_like(K)       # springs of the left / right half
+    for s in range(n + 1):                            # spring s joins masses s-1 and s
+        target = Ka if s < n // 2 else Kb
+        for i in (s - 1, s):
+            for j in (s - 1, s):
+                if 0 <= i < n and 0 <= j < n:
+                    target[i, j] += k if i == j else -k
+    np.testing.assert_allclose(Ka + Kb, K)
+    r = st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=0.3 * chain_frequencies(n).max())
+    sh = st.strain_energy_shares(r, {"left": petsc_mat(Ka), "right": petsc_mat(Kb)})
+    np.testing.assert_allclose(sh.energy.sum(axis=1), 0.5 * r.theta.real, rtol=1e-9)
+    np.testing.assert_allclose(sh.share.sum(axis=1), 1.0, rtol=1e-12)
+    np.testing.assert_allclose(sh.split("left", "right"), sh.share[:, 0], rtol=1e-12)
+    # symmetric chain: each half stores half of the energy of every mode
+    np.testing.assert_allclose(sh.share[:, 0], 0.5, atol=0.02)
+    path = r.write_csv(tmp_path / "modes.csv")
+    rows = list(csv.DictReader(path.open()))
+    assert len(rows) == len(r)
+    assert float(rows[3]["frequency_Hz"]) == pytest.approx(r.frequency[3], rel=1e-6)
+    with pytest.raises(InputError, match="component"):
+        sh.split("left", "middle")
+
+
+def test_mu_zero_like_symmetric_problem_gives_real_eigenvalues():
+    K, M = chain(n=120)
+    r = st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=0.2 * chain_frequencies(120).max(),
+                       n_modes=15)
+    assert len(r) == 15 and not r.unstable().any()
+    assert np.abs(r.theta.imag).max() <= 1e-8 * np.abs(r.theta).max()
+    assert math.isfinite(r.time) and r.method == "gnhep"
