@@ -1,0 +1,141 @@
+"""Archard wear of a rough surface (thesis §3.4–3.5, Eq. 3.10; k_w(T) of §7.2.2)."""
+import numpy as np
+import pytest
+
+from multiscale.errors import InputError
+from multiscale.micro.contact import ContactSolver
+from multiscale.micro.kernels import HalfSpace
+from multiscale.micro.surface import Surface, fractal_surface
+from multiscale.micro.wear import WearRate, simulate_wear, wear_step
+
+# Thesis §3.5.1: p = 1 MPa, mu = 0.4, S = 10 mm, k_w = 1e-12 /Pa, E = 4 GPa, nu = 0.15 vs a rigid flat,
+# fractal surface (H = 0.8, cut-offs 2 and 10 per patch, RMS 6 um) on a 1 mm patch.
+P, MU, S, KW = 1e6, 0.4, 10e-3, 1e-12
+KERNEL = HalfSpace.from_materials(4e9, 0.15)
+
+
+def thesis_surface(n, seed=1, batch=()):
+    return fractal_surface(n, 1e-3, 0.8, 2, 10, 6e-6, seed=seed, batch=batch)
+
+
+@pytest.fixture(scope="module")
+def thesis_runs():
+    """N = 300 and N = 600 wear steps on a 128 x 128 grid (7.8 um pixels), one solver reused."""
+    surface = thesis_surface(128)
+    solver = ContactSolver(KERNEL, surface.shape, surface.dx)
+    return {N: simulate_wear(surface, solver, load=P, mu=MU, distance=S, steps=N, k_w=KW) for N in (300, 600)}
+
+
+def test_wear_step_is_archard_per_point_with_tabulated_and_callable_rates():
+    rng = np.random.default_rng(0)
+    surface = Surface(rng.normal(size=(2, 8, 8)) * 1e-6, 2e-6, 3e-6)
+    p = rng.uniform(0, 5e8, size=(2, 8, 8)) * (rng.random((2, 8, 8)) < 0.3)
+    inc = wear_step(surface, p, KW, MU, 1e-5)
+    assert np.allclose(inc.depth, KW * MU * p * 1e-5, rtol=1e-14, atol=0)
+    assert np.allclose(inc.surface.heights, surface.heights - inc.depth, rtol=0, atol=1e-22)
+    assert np.allclose(inc.volume, KW * MU * 1e-5 * p.sum(axis=(1, 2)) * 6e-12, rtol=1e-13)
+    # table: temperatures strictly increasing, linear interpolation, ends held; per-point field
+    table = ([300.0, 473.0, 673.0], [1e-13, 2e-13, 1e-12])
+    T = rng.uniform(250, 750, size=(2, 8, 8))
+    by_table = wear_step(surface, p, table, MU, 1e-5, temperature=T)
+    assert np.allclose(by_table.depth, np.interp(T, *table) * MU * p * 1e-5, rtol=1e-14, atol=0)
+    assert WearRate(table)(200.0) == 1e-13 and WearRate(table)(800.0) == 1e-12
+    assert WearRate(table)(573.0) == pytest.approx(6e-13, rel=1e-14)
+    # per-patch temperature (batch shape) equals the same field spelled out per point
+    per_patch = wear_step(surface, p, table, MU, 1e-5, temperature=np.array([350.0, 600.0]))
+    spelled = wear_step(surface, p, table, MU, 1e-5, temperature=np.array([350.0, 600.0])[:, None, None] + 0 * T)
+    assert np.array_equal(per_patch.depth, spelled.depth)
+    by_call = wear_step(surface, p, lambda t: 1e-12 * np.exp((t - 300) / 100), MU, 1e-5, temperature=T)
+    assert np.allclose(by_call.depth, 1e-12 * np.exp((T - 300) / 100) * MU * p * 1e-5, rtol=1e-14, atol=0)
+
+
+@pytest.mark.parametrize("steps", [1, 3, 17])
+def test_wear_volume_is_kw_mu_P_S_whatever_the_number_of_steps(steps):
+    surface = thesis_surface(32, batch=(3,))
+    loads = np.array([1e6, 0.0, 3e6])   # the unloaded patch neither touches nor wears
+    res = simulate_wear(surface, KERNEL, load=loads, mu=MU, distance=S, steps=steps, k_w=KW)
+    area = 1e-3 * 1e-3
+    assert np.allclose(res.history.volume[-1], KW * MU * loads * area * S, rtol=1e-12, atol=0)
+    assert np.allclose(np.diff(res.history.volume, axis=0), KW * MU * loads * area * S / steps, rtol=1e-10, atol=0)
+    assert np.all(res.depth >= 0) and np.all(res.depth[1] == 0)
+    assert res.history.area_fraction[0, 1] == 0 and np.all(res.history.area_fraction[:, [0, 2]] > 0)
+    assert np.allclose(res.history.mean_depth[-1], KW * MU * loads * S, rtol=1e-12)
+
+
+def test_wear_step_convergence_N300_vs_N600_on_the_thesis_example(thesis_runs):
+    a, b = thesis_runs[300].history, thesis_runs[600].history
+    assert abs(a.area_fraction[-1] / b.area_fraction[-1] - 1) < 0.01
+    assert abs(a.max_depth[-1] / b.max_depth[-1] - 1) < 0.01
+    # same sliding instants (every other step of N = 600) agree along the whole history
+    assert np.allclose(a.max_depth, b.max_depth[::2], rtol=0.01, atol=1e-9)
+
+
+def test_sliding_grows_the_area_flattens_the_pressure_and_smooths_the_surface(thesis_runs):
+    h = thesis_runs[600].history
+    assert h.area_fraction[-1] > 1.3 * h.area_fraction[0]          # Fig. 3.3
+    assert h.max_pressure[-1] < 0.8 * h.max_pressure[0]            # Figs. 3.5–3.6
+    assert np.all(np.diff(h.max_depth) > 0)                        # Fig. 3.4: depth grows …
+    rate = np.diff(h.max_depth)
+    assert rate[-50:].mean() < 0.8 * rate[:50].mean()              # … at a decreasing rate
+    assert h.rms_height[-1] < h.rms_height[0]
+    assert np.all(np.diff(h.mean_gap) < 0)                         # worn peaks: the flat comes closer
+    # warm start: a wear step costs a handful of iterations, not a cold solve
+    assert np.median(h.iterations[1:]) < 0.6 * h.iterations[0]
+
+
+def test_pressure_gap_law_stiffens_with_sliding():
+    surface = thesis_surface(64)
+    loads = np.array([0.5e6, 1e6, 2e6])
+    res = simulate_wear(surface, KERNEL, load=P, mu=MU, distance=S, steps=20, k_w=KW,
+                        law_steps=(0, 20), law_loads=loads)
+    first, last = res.laws
+    assert (first.step, last.step) == (0, 20) and last.sliding == pytest.approx(S)
+    stiff = [np.diff(law.pressure) / -np.diff(law.mean_gap) for law in (first, last)]
+    assert np.all(stiff[1] > stiff[0])                              # Fig. 3.10
+    assert np.all(last.mean_gap < first.mean_gap)
+    # the sampled law at the run's load is the run's own state
+    assert first.mean_gap[1] == pytest.approx(res.history.mean_gap[0], rel=1e-6)
+    assert last.area_fraction[1] == pytest.approx(res.history.area_fraction[-1], rel=1e-6)
+
+
+def test_batched_wear_equals_patch_by_patch():
+    surface = thesis_surface(32, batch=(2,))
+    temps = np.array([350.0, 650.0])
+    table = ([300.0, 500.0, 700.0], [1e-12, 2e-12, 8e-12])
+    both = simulate_wear(surface, KERNEL, load=[1e6, 2e6], mu=MU, distance=S, steps=5, k_w=table,
+                         temperature=temps, tol=1e-10)
+    for i, (load, T) in enumerate(zip([1e6, 2e6], temps)):
+        one = simulate_wear(Surface(surface.heights[i], surface.dx, surface.dy), KERNEL, load=load, mu=MU,
+                            distance=S, steps=5, k_w=table, temperature=T, tol=1e-10)
+        assert np.allclose(both.depth[i], one.depth, rtol=1e-6, atol=1e-6 * one.depth.max())
+        assert both.history.volume[-1, i] == pytest.approx(np.interp(T, *table) * MU * load * 1e-6 * S, rel=1e-12)
+
+
+def test_bad_input_is_named():
+    surface = thesis_surface(32)
+    p = np.zeros(surface.shape)
+    with pytest.raises(InputError, match="distance"):
+        wear_step(surface, p, KW, MU, -1e-3)
+    with pytest.raises(InputError, match="distance"):
+        simulate_wear(surface, KERNEL, load=P, mu=MU, distance=-S, steps=3, k_w=KW)
+    with pytest.raises(InputError, match="temperatures"):
+        WearRate(([300.0, 250.0, 400.0], [1e-13, 2e-13, 3e-13]))      # not increasing in temperature
+    with pytest.raises(InputError, match="rates"):
+        WearRate(([300.0, 400.0], [1e-13, -2e-13]))
+    with pytest.raises(InputError, match="k_w"):
+        WearRate(-1e-12)
+    with pytest.raises(InputError, match="temperature"):
+        wear_step(surface, p, ([300.0, 400.0], [1e-13, 2e-13]), MU, 1e-3)   # table needs a temperature
+    with pytest.raises(InputError, match="mu"):
+        wear_step(surface, p, KW, -0.1, 1e-3)
+    with pytest.raises(InputError, match="pressure"):
+        wear_step(surface, -np.ones(surface.shape), KW, MU, 1e-3)
+    with pytest.raises(InputError, match="steps"):
+        simulate_wear(surface, KERNEL, load=P, mu=MU, distance=S, steps=0, k_w=KW)
+    with pytest.raises(InputError, match="load"):
+        simulate_wear(surface, KERNEL, load=-P, mu=MU, distance=S, steps=2, k_w=KW)
+    with pytest.raises(InputError, match="contact"):
+        simulate_wear(surface, ContactSolver(KERNEL, (16, 16), surface.dx), load=P, mu=MU, distance=S,
+                      steps=2, k_w=KW)
+    with pytest.raises(InputError, match="k_w"):
+        wear_step(surface, p, lambda t: -t, MU, 1e-3, temperature=300.0)
