@@ -1,0 +1,142 @@
+"""Contact, friction and heat on the flat macro interface (thesis §1.4, §7.2.1, Fig. 7.4).
+
+Sign conventions. Body 0 is the "+" side, body 1 the "−" side; n = n("−") points from body 1
+into body 0. The normal gap is g_n = g_0 + (u_0 − u_1)·n [m] (> 0 open); the contact pressure
+p_n = law(g_n) [Pa] is >= 0 in compression. The traction on body 0 is t = p_n n + mu p_n s, on
+body 1 it is −t, where s is the unit tangential velocity of body 1 relative to body 0 (steady
+Coulomb sliding: friction drags body 0 along with body 1). The frictional heat flux is
+q = mu p_n |w_t| [W/m^2]; body 0 receives p_1 q and body 1 (1 − p_1) q; with a conductance
+h_c [W/(m^2 K)] a flux h_c (T_0 − T_1) flows from body 0 to body 1.
+
+The pressure law is the seam of the multiscale coupling: any callable ``law(g_n) -> p_n`` built
+from UFL operations and per-facet DG0 fields (restricted with ("+")). Newton's tangent is the
+exact UFL derivative of the law. ``PenaltyLaw`` is the perfect-contact law p_n = K_n <−g_n>_+.
+"""
+from __future__ import annotations
+
+from typing import Callable
+
+import numpy as np
+import ufl
+from dolfinx import fem
+
+from multiscale.macro.geometry import Rotation, Translation
+from multiscale.macro.mesh import TwoBodyMesh
+
+PressureLaw = Callable[[ufl.core.expr.Expr], ufl.core.expr.Expr]
+VELOCITY_FLOOR = 1e-9    # m/s, regularises the sliding direction at zero speed (s -> 0, no friction)
+
+
+def penetration(g):
+    """<−g>_+ with derivative −1 at g = 0, so a touching start already carries contact stiffness."""
+    return ufl.conditional(ufl.le(g, 0), -g, 0)
+
+
+class PenaltyLaw:
+    """Perfect-contact penalty p_n = K_n <−g_n>_+ (thesis §7.3.1) with K_n a per-facet field [Pa/m]."""
+
+    def __init__(self, stiffness: fem.Function):
+        self.stiffness = stiffness
+
+    def __call__(self, g):
+        return self.stiffness("+") * penetration(g)
+
+
+def rigid_velocity(motion: Rotation | Translation, x, speed: fem.Constant):
+    """Velocity of body 1 [m/s]: omega e x (x − c) for a rotation (speed in rad/s), v e for a translation."""
+    if isinstance(motion, Rotation):
+        axis = ufl.as_vector(np.asarray(motion.axis, float) / np.linalg.norm(motion.axis))
+        return speed * ufl.cross(axis, x - ufl.as_vector(motion.centre))
+    e = np.asarray(motion.direction, float)
+    return speed * ufl.as_vector(e / np.linalg.norm(e))
+
+
+class ContactInterface:
+    """Interface forms between the displacement fields ``u0`` (body 0) and ``u1`` (body 1).
+
+    Per-facet fields (DG0 on the interface, set with ``tm.interface.set_field`` from global
+    per-facet arrays): ``stiffness`` K_n [Pa/m], ``initial_gap`` g_0 [m], ``partition`` p_1 (share
+    of the frictional heat into body 0) and ``conductance`` h_c [W/(m^2 K)]. ``friction`` (mu) and
+    ``speed`` (rad/s or m/s, see ``rigid_velocity``) are Constants. ``law`` defaults to
+    ``PenaltyLaw(stiffness)``; pass ``law=`` a callable to use another pressure–gap law.
+    """
+
+    def __init__(self, tm: TwoBodyMesh, u0: fem.Function, u1: fem.Function, *, stiffness=1e13,
+                 friction: float = 0.0, speed: float = 0.0, law: PressureLaw | None = None,
+                 velocity=None):
+        iface = tm.interface
+        self.tm = tm
+        self.u = (u0, u1)
+        self.stiffness = iface.field("contact_stiffness", stiffness)
+        self.initial_gap = iface.field("initial_gap", 0.0)
+        self.partition = iface.field("heat_partition", 0.5)
+        self.conductance = iface.field("conductance", 0.0)
+        self.law = law if law is not None else PenaltyLaw(self.stiffness)
+        self.friction = fem.Constant(tm.parent, float(friction))
+        self.speed = fem.Constant(tm.parent, float(speed))
+        self.normal = ufl.FacetNormal(tm.parent)("-")
+        x = ufl.SpatialCoordinate(tm.parent)
+        w = velocity if velocity is not None else rigid_velocity(tm.spec.motion, x, self.speed)
+        w = w("-") if _needs_restriction(w) else w
+        self.slip_velocity = w - ufl.dot(w, self.normal) * self.normal          # tangential part
+        self.slip_speed = ufl.sqrt(ufl.dot(self.slip_velocity, self.slip_velocity))
+        self.slip_direction = self.slip_velocity / ufl.sqrt(self.slip_speed**2 + VELOCITY_FLOOR**2)
+        self.gap = self.initial_gap("+") + ufl.dot(u0("+") - u1("-"), self.normal)
+        self.pressure = self.law(self.gap)
+        self.traction = self.pressure * self.normal + self.friction * self.pressure * self.slip_direction
+        self.heat_flux = self.friction * self.pressure * self.slip_speed
+
+    # ---- mechanics -------------------------------------------------------------------------
+    def residuals(self, v0, v1):
+        """Interface terms of the residuals of body 0 and body 1 (virtual work of −t resp. +t)."""
+        dS = self.tm.interface.dS
+        return -ufl.dot(self.traction, v0("+")) * dS, ufl.dot(self.traction, v1("-")) * dS
+
+    def normal_force(self) -> float:
+        """Total normal contact force [N] (integral of p_n, same quadrature as the residual)."""
+        return self.tm.assemble_scalar(self.pressure * self.tm.interface.dS)
+
+    def force(self) -> np.ndarray:
+        """Resultant interface force on body 0 [N] (3-vector: normal pressure plus friction)."""
+        return np.array([self.tm.assemble_scalar(self.traction[i] * self.tm.interface.dS) for i in range(3)])
+
+    def facet_pressure(self) -> np.ndarray:
+        """Mean contact pressure per interface facet [Pa] (global order, every rank)."""
+        return self.tm.interface.facet_mean(self.pressure, self.tm.entity_maps)
+
+    def facet_gap(self) -> np.ndarray:
+        """Mean normal gap per interface facet [m] (negative: interpenetration of the penalty)."""
+        return self.tm.interface.facet_mean(self.gap, self.tm.entity_maps)
+
+    # ---- heat ------------------------------------------------------------------------------
+    def heat_residuals(self, T0, T1, r0, r1, *, conductance: bool):
+        """Interface terms of the heat residuals of both bodies (thesis Fig. 7.4).
+
+        Frictional heat q split by p_1; with ``conductance`` the flux h_c (T_0 − T_1) couples the
+        two temperature fields (otherwise they are disconnected, as in the thesis' perfect model).
+        """
+        dS = self.tm.interface.dS
+        p1 = self.partition("+")
+        F0 = -p1 * self.heat_flux * r0("+") * dS
+        F1 = -(1 - p1) * self.heat_flux * r1("-") * dS
+        if conductance:
+            exchange = self.conductance("+") * (T0("+") - T1("-"))
+            F0 += exchange * r0("+") * dS
+            F1 -= exchange * r1("-") * dS
+        return F0, F1
+
+    def heat_power(self) -> tuple[float, float]:
+        """Frictional heat power into body 0 and body 1 [W] at the current state."""
+        dS = self.tm.interface.dS
+        p1 = self.partition("+")
+        return (self.tm.assemble_scalar(p1 * self.heat_flux * dS),
+                self.tm.assemble_scalar((1 - p1) * self.heat_flux * dS))
+
+    def facet_heat_flux(self) -> np.ndarray:
+        """Mean frictional heat flux per interface facet [W/m^2] (global order)."""
+        return self.tm.interface.facet_mean(self.heat_flux, self.tm.entity_maps)
+
+
+def _needs_restriction(expr) -> bool:
+    """True if ``expr`` contains coefficients that must be restricted on an interior facet."""
+    return any(not isinstance(c, fem.Constant) for c in ufl.algorithms.extract_coefficients(expr))

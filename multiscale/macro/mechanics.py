@@ -1,0 +1,187 @@
+"""Quasi-static elasticity of the two bodies, coupled only through the contact interface.
+
+Small-strain isotropic elasticity per material region, optional thermal strain alpha (T − T_ref) I
+(thesis Fig. 7.4, "contact problem with thermal expansion"), a normal load on the builder's load
+faces, zero-displacement supports, and the penalty/law contact with steady Coulomb sliding friction
+of ``interface.ContactInterface``. Solved monolithically (block Jacobian, MUMPS LU) by SNES Newton
+from rest with load ramping; failures raise ``ConvergenceError`` with the residual history.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Mapping
+
+import numpy as np
+import ufl
+from dolfinx import fem
+from dolfinx.fem import petsc as fpetsc
+from petsc4py import PETSc
+
+from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.macro.interface import ContactInterface, PressureLaw
+from multiscale.macro.mesh import TwoBodyMesh
+
+NEWTON_OPTIONS = {
+    "snes_type": "newtonls", "snes_linesearch_type": "basic",
+    "snes_rtol": 1e-10, "snes_atol": 1e-10, "snes_stol": 0.0, "snes_max_it": 30,
+    "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps",
+}
+
+
+@dataclass
+class SolveResult:
+    """One nonlinear solve."""
+
+    converged: bool
+    reason: int                    # PETSc SNES converged reason
+    iterations: int
+    residuals: list = field(default_factory=list)   # residual norm per Newton iteration
+    normal_force: float = 0.0      # N, total contact force
+    max_pressure: float = 0.0      # Pa, largest per-facet mean pressure
+
+
+def body_fields(tm: TwoBodyMesh, materials: Mapping[str, object], attribute: str, prefix: str = ""):
+    """Per-body DG0 fields of one material property (``attribute`` of each material object)."""
+    out = []
+    for body in tm.bodies:
+        values = {}
+        for r in body.spec.regions:
+            if r.material not in materials:
+                raise InputError(f"materials.{r.material}", None, f"material of region {r.name!r} is missing")
+            value = getattr(materials[r.material], attribute, None)
+            if value is None:
+                raise InputError(f"materials.{r.material}.{attribute}", None, "required by this model")
+            values[r.tag] = float(value)
+        out.append(body.cell_field(f"{prefix}{attribute}_{body.name}", values))
+    return out
+
+
+class Mechanics:
+    """Two-body contact mechanics (see module docstring).
+
+    ``materials`` maps material names (of the geometry's regions) to objects with ``E`` [Pa],
+    ``nu`` and, with ``temperatures`` given, ``alpha`` [1/K]. ``temperatures`` is a pair of P1
+    functions on the body submeshes (thermal expansion relative to ``reference_temperature`` [K]).
+    ``stiffness`` [Pa/m] (scalar or per-facet array), ``friction``, ``speed`` and ``law`` go to
+    ``ContactInterface``. ``load`` is the total force [N] along the spec's load direction on its
+    load faces (``load_kind="force"``) or a traction [Pa] (``load_kind="pressure"``).
+    """
+
+    def __init__(self, tm: TwoBodyMesh, materials: Mapping[str, object], *, stiffness=1e13,
+                 friction: float = 0.0, speed: float = 0.0, law: PressureLaw | None = None,
+                 velocity=None, temperatures=None, reference_temperature: float = 293.15,
+                 load_kind: str = "force", degree: int = 1, prefix: str = "mech_"):
+        if load_kind not in ("force", "pressure"):
+            raise InputError("load_kind", load_kind, "'force' or 'pressure'")
+        self.tm = tm
+        self.spaces = [fem.functionspace(b.mesh, ("Lagrange", degree, (3,))) for b in tm.bodies]
+        self.u = [fem.Function(V, name=f"displacement_{b.name}") for V, b in zip(self.spaces, tm.bodies)]
+        self.E = body_fields(tm, materials, "E")
+        self.nu = body_fields(tm, materials, "nu")
+        self.temperatures = temperatures
+        if temperatures is not None:
+            self.alpha = body_fields(tm, materials, "alpha")
+            self.reference_temperature = fem.Constant(tm.parent, float(reference_temperature))
+        self.contact = ContactInterface(tm, *self.u, stiffness=stiffness, friction=friction, speed=speed,
+                                        law=law, velocity=velocity)
+        self.load = fem.Constant(tm.parent, 0.0)        # N (force) or Pa (pressure), ramped
+        self.load_kind = load_kind
+        v = [ufl.TestFunction(V) for V in self.spaces]
+        F = [ufl.inner(self.stress(i), ufl.sym(ufl.grad(v[i]))) * self.dx(i) for i in range(2)]
+        Fc = self.contact.residuals(*v)
+        F = [F[i] + Fc[i] for i in range(2)]
+        for name in tm.spec.load_faces:
+            i = tm.body_of_face(name)
+            F[i] -= ufl.dot(self.traction(), v[i]) * tm.ds(tm.face(name))
+        self.residuals = F
+        self.bcs = self._supports()
+        self.problem = fpetsc.NonlinearProblem(F, self.u, bcs=self.bcs, petsc_options_prefix=prefix,
+                                               petsc_options=NEWTON_OPTIONS, entity_maps=tm.entity_maps)
+        self._history: list[float] = []
+        self.problem.solver.setMonitor(lambda snes, it, norm: self._history.append(norm))
+
+    # ---- forms -----------------------------------------------------------------------------
+    def dx(self, i: int):
+        """Volume measure over the regions of body i (on the parent mesh)."""
+        return self.tm.dx(tuple(r.tag for r in self.tm.bodies[i].spec.regions))
+
+    def stress(self, i: int):
+        """Cauchy stress of body i [Pa], sigma = C:(eps − alpha dT I)."""
+        E, nu = self.E[i], self.nu[i]
+        lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
+        eps = ufl.sym(ufl.grad(self.u[i]))
+        if self.temperatures is not None:
+            eps = eps - self.alpha[i] * (self.temperatures[i] - self.reference_temperature) * ufl.Identity(3)
+        return lam * ufl.tr(eps) * ufl.Identity(3) + 2 * mu * eps
+
+    def von_mises(self, i: int):
+        s = self.stress(i)
+        dev = s - ufl.tr(s) / 3 * ufl.Identity(3)
+        return ufl.sqrt(1.5 * ufl.inner(dev, dev))
+
+    def traction(self):
+        """Applied traction on the load faces [Pa]."""
+        spec = self.tm.spec
+        direction = ufl.as_vector(np.asarray(spec.load_direction, float) / np.linalg.norm(spec.load_direction))
+        if self.load_kind == "pressure":
+            return self.load * direction
+        area = sum(self.tm.assemble_scalar(1.0 * self.tm.ds(self.tm.face(f))) for f in spec.load_faces)
+        return self.load / area * direction
+
+    def _supports(self) -> list:
+        bcs = []
+        fdim = self.tm.parent.topology.dim - 1
+        for sup in self.tm.spec.supports:
+            tag = self.tm.face(sup.face)
+            for i, body in enumerate(self.tm.bodies):
+                if not body.has_face(tag):
+                    continue
+                facets = body.facet_tags.find(tag)
+                for c in sup.components:
+                    sub = self.spaces[i].sub(c)
+                    dofs = fem.locate_dofs_topological(sub, fdim, facets)
+                    bcs.append(fem.dirichletbc(0.0, dofs, sub))
+        return bcs
+
+    def mass_forms(self, density):
+        """Block-diagonal mass forms [[m_00, None], [None, m_11]] with per-body density fields."""
+        trial = [ufl.TrialFunction(V) for V in self.spaces]
+        test = [ufl.TestFunction(V) for V in self.spaces]
+        m = [density[i] * ufl.dot(trial[i], test[i]) * self.dx(i) for i in range(2)]
+        return [[m[0], None], [None, m[1]]]
+
+    # ---- solution --------------------------------------------------------------------------
+    def solve(self, load: float | None = None) -> SolveResult:
+        """Newton solve at the given load (N or Pa); raises ConvergenceError on failure."""
+        if load is not None:
+            self.load.value = float(load)
+        self._history.clear()
+        self.problem.solve()
+        snes = self.problem.solver
+        reason, its = snes.getConvergedReason(), snes.getIterationNumber()
+        history = list(self._history)
+        finite = all(np.isfinite(history)) and all(np.isfinite(u.x.array).all() for u in self.u)
+        result = SolveResult(reason > 0 and finite, reason, its, history)
+        if not result.converged:
+            raise ConvergenceError(
+                f"contact Newton did not converge at load {float(self.load.value):.6g} "
+                f"(SNES reason {reason}, {its} iterations, residuals {['%.3g' % r for r in history]})",
+                history, result)
+        result.normal_force = self.contact.normal_force()
+        result.max_pressure = float(self.contact.facet_pressure().max(initial=0.0))
+        return result
+
+    def ramp(self, load: float, steps: int = 1) -> SolveResult:
+        """Solve from the current state at loads load/steps, 2 load/steps, ..., load."""
+        steps = int(check_positive("ramp_steps", steps))
+        for k in range(1, steps + 1):
+            result = self.solve(load * k / steps)
+        return result
+
+    def tangent(self) -> PETSc.Mat:
+        """The assembled block Jacobian at the current state (assembled on request)."""
+        A = self.problem.A
+        A.zeroEntries()
+        fpetsc.assemble_matrix(A, self.problem.J, bcs=self.bcs)
+        A.assemble()
+        return A

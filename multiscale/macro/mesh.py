@@ -1,0 +1,313 @@
+"""Two deformable bodies and their conforming interface in one DOLFINx mesh.
+
+One parent mesh (gmsh, shared-facet ghosting) holds both bodies; each body is a codim-0 submesh
+(its function spaces live there), the interface a codim-1 submesh (per-facet DG0 fields live
+there). Every integral is written on the parent: ``dx(tag)`` over material regions, ``ds(tag)`` on
+named faces, and the interface measure ``dS`` whose integration rows are reordered so that "+"
+is always body 0 and "−" body 1 (DOLFINx orders them arbitrarily). Forms get
+``entity_maps=tm.entity_maps``.
+
+Per-facet data are keyed by a global facet index that does not depend on the number of MPI ranks:
+facets sorted lexicographically by their (rounded) midpoints. ``Interface.midpoints`` (global,
+every rank) tells which facet is which.
+"""
+from __future__ import annotations
+
+import importlib
+from dataclasses import dataclass, field
+
+import numpy as np
+
+try:
+    import dolfinx_solver  # noqa: F401  (must precede dolfinx in the PyPI wheel)
+except ImportError:  # pragma: no cover
+    pass
+import dolfinx
+import ufl
+from dolfinx import fem
+from dolfinx import mesh as dmesh
+from mpi4py import MPI
+
+from multiscale.errors import InputError
+from multiscale.macro.geometry import BodySpec, GeometrySpec
+
+BUILDERS = {"block_on_flat": "meshes.block_on_flat", "pin_on_disc": "meshes.pin_on_disc",
+            "disc_brake": "meshes.disc_brake"}
+INTERFACE_QUADRATURE = 2      # exact for P1 displacements times P1 tests on a facet
+
+
+def builder(name: str):
+    """The builder module ``meshes.<name>`` (InputError if unknown)."""
+    if name not in BUILDERS:
+        raise InputError("geometry.builder", name, f"one of {', '.join(BUILDERS)}")
+    return importlib.import_module(BUILDERS[name])
+
+
+@dataclass
+class Body:
+    """One body: its submesh and the maps to the parent mesh."""
+
+    spec: BodySpec
+    mesh: dmesh.Mesh
+    cell_map: dmesh.EntityMap          # submesh cells -> parent cells
+    vertex_map: dmesh.EntityMap
+    facet_tags: dmesh.MeshTags         # parent facet tags moved to the submesh
+    region_tags: np.ndarray            # region (cell) tag of every local submesh cell
+
+    @property
+    def name(self) -> str:
+        return self.spec.name
+
+    @property
+    def region_space(self) -> fem.FunctionSpace:
+        return fem.functionspace(self.mesh, ("DG", 0))
+
+    def cell_field(self, name: str, by_region: dict) -> fem.Function:
+        """DG0 field on the body, constant per region: ``by_region`` maps region tag -> value."""
+        f = fem.Function(self.region_space, name=name)
+        values = np.full(len(self.region_tags), np.nan)
+        for tag, value in by_region.items():
+            values[self.region_tags == tag] = value
+        if np.isnan(values).any():
+            missing = sorted(set(self.region_tags[np.isnan(values)]) - set(by_region))
+            raise InputError(name, by_region, f"a value for every region of {self.name!r} (missing tags {missing})")
+        f.x.array[self.region_space.dofmap.list[:, 0]] = values
+        return f
+
+    def has_face(self, tag: int) -> bool:
+        """True if the face ``tag`` belongs to this body (on any rank)."""
+        return bool(self.mesh.comm.allreduce(len(self.facet_tags.find(tag)), op=MPI.SUM))
+
+
+@dataclass
+class Interface:
+    """The contact interface: a facet submesh, its measure and a rank-independent facet ordering.
+
+    ``dS`` integrates over all interface tags ("+" = body 0); ``dS_tag[name]`` over one tag.
+    ``midpoints`` (n_facets, 3) and ``areas`` (n_facets,) are global and the same on every rank;
+    ``owned_index`` gives the global index of each owned facet of the submesh.
+    """
+
+    mesh: dmesh.Mesh
+    facet_map: dmesh.EntityMap         # submesh cells -> parent facets
+    tags: dict
+    measure: ufl.Measure
+    midpoints: np.ndarray              # m, global
+    owned_index: np.ndarray            # global index of the owned submesh cells 0..n_owned-1
+    areas: np.ndarray = field(default=None)   # m^2, global
+    _dg0: fem.FunctionSpace = field(default=None, repr=False)
+
+    @property
+    def dS(self):
+        return self.measure(tuple(self.tags.values()))
+
+    @property
+    def dS_tag(self) -> dict:
+        return {name: self.measure(tag) for name, tag in self.tags.items()}
+
+    @property
+    def n_facets(self) -> int:
+        return len(self.midpoints)
+
+    @property
+    def comm(self):
+        return self.mesh.comm
+
+    @property
+    def space(self) -> fem.FunctionSpace:
+        """DG0 space of per-facet fields."""
+        if self._dg0 is None:
+            self._dg0 = fem.functionspace(self.mesh, ("DG", 0))
+        return self._dg0
+
+    def _owned_dofs(self) -> np.ndarray:
+        n = len(self.owned_index)
+        return self.space.dofmap.list[:n, 0]
+
+    def field(self, name: str, value=0.0) -> fem.Function:
+        """A new per-facet (DG0) field set to ``value`` (scalar or global per-facet array)."""
+        f = fem.Function(self.space, name=name)
+        self.set_field(f, value)
+        return f
+
+    def set_field(self, f: fem.Function, value) -> None:
+        """Set a DG0 field from a scalar or a global per-facet array (length n_facets)."""
+        value = np.asarray(value, dtype=float)
+        if value.ndim == 0:
+            f.x.array[:] = value
+        else:
+            if value.shape != (self.n_facets,):
+                raise InputError(f.name, value.shape, f"one value per interface facet ({self.n_facets})")
+            f.x.array[self._owned_dofs()] = value[self.owned_index]
+        f.x.scatter_forward()
+
+    def values(self, f: fem.Function) -> np.ndarray:
+        """Global per-facet array of a DG0 field (every rank)."""
+        return self.gather(f.x.array[self._owned_dofs()])
+
+    def gather(self, owned: np.ndarray) -> np.ndarray:
+        """Global per-facet array from the values of the owned facets (every rank)."""
+        parts = self.comm.allgather(np.asarray(owned, dtype=float))
+        index = np.concatenate(self.comm.allgather(self.owned_index))
+        out = np.empty(self.n_facets)
+        out[index] = np.concatenate(parts)
+        return out
+
+    def integrate_per_facet(self, expr, entity_maps) -> np.ndarray:
+        """Global per-facet integrals of the scalar UFL expression ``expr`` over the interface."""
+        q = ufl.TestFunction(self.space)
+        vec = fem.assemble_vector(fem.form(expr * q("+") * self.dS, entity_maps=entity_maps))
+        vec.scatter_reverse(dolfinx.la.InsertMode.add)
+        return self.gather(vec.array[self._owned_dofs()])
+
+    def facet_mean(self, expr, entity_maps) -> np.ndarray:
+        """Global per-facet mean of ``expr`` (integral / facet area)."""
+        return self.integrate_per_facet(expr, entity_maps) / self.areas
+
+
+@dataclass
+class TwoBodyMesh:
+    """Parent mesh, its tags, the two bodies and the interface (see module docstring)."""
+
+    spec: GeometrySpec
+    parent: dmesh.Mesh
+    cell_tags: dmesh.MeshTags
+    facet_tags: dmesh.MeshTags
+    bodies: tuple[Body, Body]
+    interface: Interface
+
+    @property
+    def comm(self):
+        return self.parent.comm
+
+    @property
+    def entity_maps(self) -> list:
+        return [self.bodies[0].cell_map, self.bodies[1].cell_map, self.interface.facet_map]
+
+    @property
+    def dx(self) -> ufl.Measure:
+        return ufl.Measure("dx", domain=self.parent, subdomain_data=self.cell_tags)
+
+    @property
+    def ds(self) -> ufl.Measure:
+        return ufl.Measure("ds", domain=self.parent, subdomain_data=self.facet_tags)
+
+    def face(self, name: str) -> int:
+        """Facet tag of the named face."""
+        if name not in self.spec.faces:
+            raise InputError("face", name, f"one of {', '.join(self.spec.faces)}")
+        return self.spec.faces[name]
+
+    def body_of_face(self, name: str) -> int:
+        """Index of the body that holds the named boundary face."""
+        tag = self.face(name)
+        owners = [i for i, b in enumerate(self.bodies) if b.has_face(tag)]
+        if len(owners) != 1:
+            raise RuntimeError(f"face {name!r} (tag {tag}) belongs to bodies {owners}, expected one")
+        return owners[0]
+
+    def assemble_scalar(self, expr) -> float:
+        """Integral of a scalar form over the whole parent mesh, summed over ranks."""
+        local = fem.assemble_scalar(fem.form(expr, entity_maps=self.entity_maps))
+        return self.comm.allreduce(local, op=MPI.SUM)
+
+
+def build(builder_name: str, params=None, comm=MPI.COMM_WORLD) -> TwoBodyMesh:
+    """Run a gmsh builder on rank 0 and distribute the mesh (shared-facet ghosting)."""
+    mod = builder(builder_name)
+    spec = mod.describe(params)
+    error = None
+    if comm.rank == 0:
+        import gmsh
+        gmsh.initialize(interruptible=False)
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("General.NumThreads", 1)
+        gmsh.model.add(builder_name)
+        try:
+            mod.generate(gmsh.model, params)
+        except Exception as exc:  # re-raised on every rank below
+            error = exc
+    failed = comm.bcast(repr(error) if error is not None else None, root=0)
+    try:
+        if failed:
+            if error is not None:
+                raise error
+            raise RuntimeError(f"mesh builder {builder_name!r} failed on rank 0: {failed}")
+        partitioner = dmesh.create_cell_partitioner(dolfinx.graph.partitioner(),
+                                                    dmesh.GhostMode.shared_facet, 2)
+        model = gmsh.model if comm.rank == 0 else None
+        data = dolfinx.io.gmsh.model_to_mesh(model, comm, 0, gdim=3, partitioner=partitioner)
+    finally:
+        if comm.rank == 0:
+            gmsh.finalize()
+    return from_mesh(spec, data.mesh, data.cell_tags, data.facet_tags)
+
+
+def from_mesh(spec: GeometrySpec, parent: dmesh.Mesh, cell_tags: dmesh.MeshTags,
+              facet_tags: dmesh.MeshTags) -> TwoBodyMesh:
+    """Bodies and interface of a parent mesh tagged according to ``spec``."""
+    tdim = parent.topology.dim
+    parent.topology.create_connectivity(tdim - 1, tdim)
+    parent.topology.create_connectivity(tdim, tdim - 1)
+    bodies = tuple(_body(parent, cell_tags, facet_tags, b) for b in spec.bodies)
+    interface = _interface(parent, facet_tags, spec, bodies)
+    tm = TwoBodyMesh(spec, parent, cell_tags, facet_tags, bodies, interface)
+    q = ufl.TestFunction(interface.space)
+    vec = fem.assemble_vector(fem.form(q("+") * interface.dS, entity_maps=tm.entity_maps))
+    vec.scatter_reverse(dolfinx.la.InsertMode.add)
+    interface.areas = interface.gather(vec.array[interface._owned_dofs()])
+    return tm
+
+
+def _body(parent, cell_tags, facet_tags, spec: BodySpec) -> Body:
+    tdim = parent.topology.dim
+    cells = np.unique(np.concatenate([cell_tags.find(r.tag) for r in spec.regions])).astype(np.int32)
+    sub, cell_map, vertex_map, _ = dmesh.create_submesh(parent, tdim, cells)
+    sub.topology.create_connectivity(tdim - 1, tdim)
+    tags = dmesh.transfer_meshtags_to_submesh(facet_tags, sub, vertex_map, cell_map)
+    tags = tags[0] if isinstance(tags, tuple) else tags
+    n_cells = sub.topology.index_map(tdim).size_local + sub.topology.index_map(tdim).num_ghosts
+    parent_cells = cell_map.sub_topology_to_topology(np.arange(n_cells, dtype=np.int32), inverse=False)
+    tag_of = np.full(parent.topology.index_map(tdim).size_local + parent.topology.index_map(tdim).num_ghosts, -1)
+    tag_of[cell_tags.indices] = cell_tags.values
+    return Body(spec, sub, cell_map, vertex_map, tags, tag_of[parent_cells])
+
+
+def _interface(parent, facet_tags, spec: GeometrySpec, bodies) -> Interface:
+    tdim = parent.topology.dim
+    comm = parent.comm
+    facets = {name: facet_tags.find(tag) for name, tag in spec.interfaces.items()}
+    all_facets = np.unique(np.concatenate(list(facets.values()))).astype(np.int32)
+    sub, facet_map, _, _ = dmesh.create_submesh(parent, tdim - 1, all_facets)
+    data = []
+    for name, tag in spec.interfaces.items():
+        rows = fem.compute_integration_domains(fem.IntegralType.interior_facet, parent.topology,
+                                               facets[name].astype(np.int32))
+        rows = np.asarray(rows, dtype=np.int32).reshape(-1, 4)
+        data.append((tag, _orient(rows, bodies, name).ravel()))
+    measure = ufl.Measure("dS", domain=parent, subdomain_data=data,
+                          metadata={"quadrature_degree": INTERFACE_QUADRATURE})
+    n_owned = sub.topology.index_map(tdim - 1).size_local
+    mid_local = dmesh.compute_midpoints(sub, tdim - 1, np.arange(n_owned, dtype=np.int32))
+    midpoints = np.concatenate(comm.allgather(mid_local)).reshape(-1, 3)
+    counts = comm.allgather(n_owned)
+    key = np.round(midpoints / spec.length_scale, 9)
+    order = np.lexsort(key.T[::-1])                  # sort by x, then y, then z
+    rank_of_sorted = np.empty_like(order)
+    rank_of_sorted[order] = np.arange(len(order))
+    start = int(np.sum(counts[:comm.rank]))
+    owned_index = rank_of_sorted[start:start + n_owned]
+    return Interface(sub, facet_map, dict(spec.interfaces), measure, midpoints[order], owned_index)
+
+
+def _orient(rows: np.ndarray, bodies, name: str) -> np.ndarray:
+    """Swap the two sides of each interior-facet row so that "+" (first pair) lies in body 0."""
+    inside0 = bodies[0].cell_map.sub_topology_to_topology(rows[:, 0], inverse=True) >= 0
+    rows = rows.copy()
+    rows[~inside0] = rows[~inside0][:, [2, 3, 0, 1]]
+    ok0 = bodies[0].cell_map.sub_topology_to_topology(rows[:, 0], inverse=True) >= 0
+    ok1 = bodies[1].cell_map.sub_topology_to_topology(rows[:, 2], inverse=True) >= 0
+    if not (ok0.all() and ok1.all()):
+        raise RuntimeError(f"interface {name!r} has facets that do not separate "
+                           f"{bodies[0].name!r} from {bodies[1].name!r}")
+    return rows
