@@ -27,10 +27,78 @@ def _info(args) -> int:
     return 0
 
 
+def _check(args) -> int:
+    """Validate scene files: a short summary for a good one, every problem of a bad one."""
+    from multiscale.scene import load, summary
+    failed = 0
+    for path in args.scenes:
+        try:
+            scene = load(path)
+        except SceneError as exc:
+            for line in exc.problems:
+                print(f"error: {line}", file=sys.stderr)
+            n = len(exc.problems)
+            print(f"{path}: {n} problem{'s' if n > 1 else ''}", file=sys.stderr)
+            failed += 1
+            continue
+        print("\n".join(summary(scene)))
+        print(f"{path}: OK")
+    return 2 if failed else 0
+
+
+def _rank() -> int:
+    try:
+        from mpi4py import MPI
+    except ImportError:
+        return 0
+    return MPI.COMM_WORLD.rank
+
+
+def _run(args) -> int:
+    """Validate the scene, protect earlier results, then hand over to the macro runner.
+
+    Under ``mpirun`` every rank runs this; user errors are printed by rank 0 only."""
+    from multiscale.scene import load
+    rank = _rank()
+    try:
+        scene = load(args.scene)
+        existing = scene.output.existing_results()
+        if existing and not (args.overwrite or args.resume):
+            shown = ", ".join(p.name for p in existing[:3]) + (", ..." if len(existing) > 3 else "")
+            raise SceneError(f'output.folder = "{scene.output.folder}": already holds results '
+                             f"({len(existing)} entries: {shown}); use --overwrite to replace them, "
+                             f"--resume to continue the run, or choose another folder")
+        try:
+            from multiscale.macro.runner import run
+        except ModuleNotFoundError as exc:
+            if exc.name == "multiscale.macro.runner":
+                raise MultiscaleError("multiscale run: the macro runner (multiscale.macro.runner.run) "
+                                      "is not available in this version yet") from None
+            if exc.name and exc.name.split(".")[0] in ("dolfinx", "dolfinx_solver", "petsc4py", "ufl", "basix"):
+                raise MultiscaleError(f"multiscale run needs DOLFINx ({exc}); install it with "
+                                      "pip install -e '.[fem]'") from None
+            raise
+    except MultiscaleError:
+        if rank == 0:
+            raise
+        return 2
+    result = run(scene, overwrite=args.overwrite, resume=args.resume)
+    return result if isinstance(result, int) else 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="multiscale", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("info", help="versions and settings").set_defaults(func=_info)
+    check = sub.add_parser("check", help="validate scene files: every problem at once, or a summary")
+    check.add_argument("scenes", nargs="+", metavar="SCENE", help="scene TOML file(s)")
+    check.set_defaults(func=_check)
+    run = sub.add_parser("run", help="run a scene (mpirun -n N multiscale run scene.toml)")
+    run.add_argument("scene", metavar="SCENE", help="scene TOML file")
+    again = run.add_mutually_exclusive_group()
+    again.add_argument("--overwrite", action="store_true", help="replace results already in the output folder")
+    again.add_argument("--resume", action="store_true", help="continue from the last checkpoint in the output folder")
+    run.set_defaults(func=_run)
     return parser
 
 

@@ -1,0 +1,494 @@
+"""Declarative validation of TOML tables into frozen dataclasses (scene and study files).
+
+A table is a frozen dataclass whose fields carry a ``key(...)`` spec: how the TOML value is read
+(``Quantity("pressure", gt=0)``, ``Integer(ge=1)``, ``Choice(...)``, ``Section(Cls)`` ...), its
+default, and whether it is required always or only when some effect is on (``needed_by``).
+Class-level ``rules`` (``OneOf``, ``Requires``, ``OnlyWith``) relate keys of one table; an optional
+``problems(self, path)`` method checks the built table's consistency. ``read`` walks a raw table
+and collects EVERY problem as one line naming the path, the value and what is allowed, so a new
+section is added by declaring a dataclass, not by writing a code path.
+Paths are dotted (``materials.pin.E``); list items are numbered from 1 (``layers.layer[2].E``).
+"""
+from __future__ import annotations
+
+import dataclasses
+import difflib
+import json
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from multiscale.units import KINDS, UnitError, to_si
+
+__all__ = ["Bad", "Choice", "Context", "Curve", "Either", "FilePath", "Flag", "Folder", "FrozenMap",
+           "Integer", "ListOf", "Named", "OneOf", "OnlyWith", "Pair", "Quantity", "Requires",
+           "Section", "Tables", "Text", "key", "read", "show", "suggest"]
+
+
+class Bad(ValueError):
+    """A raw value that cannot be read; the message says what is allowed."""
+
+
+@dataclass
+class Context:
+    """What a table is read against: active effects, the scene directory, collected problems."""
+
+    effects: frozenset = frozenset()
+    directory: Path = Path(".")
+    problems: list[str] = field(default_factory=list)
+
+
+class FrozenMap(Mapping):
+    """Read-only, hashable, picklable mapping (named sub-tables such as ``materials``)."""
+
+    def __init__(self, data=()):
+        self._data = dict(data)
+
+    def __getitem__(self, name):
+        return self._data[name]
+
+    def __iter__(self):
+        return iter(self._data)
+
+    def __len__(self):
+        return len(self._data)
+
+    def __hash__(self):
+        return hash(tuple(self._data.items()))
+
+    def __repr__(self):
+        return f"FrozenMap({self._data!r})"
+
+    def __reduce__(self):
+        return FrozenMap, (self._data,)
+
+
+def show(value) -> str:
+    """A raw value as the user wrote it (TOML-like: strings in double quotes)."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, (str, int, float)):
+        return json.dumps(value, ensure_ascii=False) if isinstance(value, str) else repr(value)
+    if isinstance(value, (list, tuple)):
+        items = [show(v) for v in value]
+        text = ", ".join(items)
+        while len(text) > 60 and len(items) > 1:
+            items.pop()
+            text = ", ".join(items) + ", ..."
+        return f"[{text}]"
+    if isinstance(value, dict):
+        return "{" + ", ".join(value)[:60] + "}"
+    return repr(value)
+
+
+def suggest(name: str, options) -> str:
+    """' (did you mean "x"?)' for the closest option (or one that the name starts with), or ''."""
+    options = [str(o) for o in options]
+    near = difflib.get_close_matches(str(name), options, n=1, cutoff=0.6) or [
+        o for o in options if len(o) > 2 and str(name).startswith(o)][:1]
+    return f' (did you mean "{near[0]}"?)' if near else ""
+
+
+def _number(x) -> str:
+    return f"{x:g}"
+
+
+def _a(words: str) -> str:
+    return ("an " if words[0] in "aeiou" else "a ") + words
+
+
+# ---------------------------------------------------------------- value parsers
+class Quantity:
+    """A physical quantity of a units.KINDS kind, converted to SI, with an optional range."""
+
+    def __init__(self, kind: str, *, gt=None, ge=None, lt=None, le=None):
+        self.name, self.kind, self.gt, self.ge, self.lt, self.le = kind, KINDS[kind], gt, ge, lt, le
+
+    def _range(self) -> str:
+        unit = f" {self.kind.si}" if self.kind.si else ""
+        low = f"> {_number(self.gt)}" if self.gt is not None else (
+            f">= {_number(self.ge)}" if self.ge is not None else None)
+        high = f"< {_number(self.lt)}" if self.lt is not None else (
+            f"<= {_number(self.le)}" if self.le is not None else None)
+        if low and high:
+            lb = "(" if self.gt is not None else "["
+            rb = ")" if self.lt is not None else "]"
+            lo, hi = (self.gt if self.gt is not None else self.ge), (self.lt if self.lt is not None else self.le)
+            return f"in {lb}{_number(lo)}, {_number(hi)}{rb}{unit}"
+        return f"{low or high}{unit}" if (low or high) else ""
+
+    def describe(self) -> str:
+        rng = self._range()
+        examples = f" ({self.kind.examples})" if self.kind.examples not in ("", self.kind.si) and self.kind.si else ""
+        return f"{_a(self.kind.name)}{' ' + rng if rng else ''}{examples}"
+
+    def __call__(self, raw, ctx):
+        try:
+            v = to_si(raw, self.name)
+        except UnitError as exc:
+            raise Bad(str(exc)) from None
+        ok = ((self.gt is None or v > self.gt) and (self.ge is None or v >= self.ge)
+              and (self.lt is None or v < self.lt) and (self.le is None or v <= self.le))
+        if not ok:
+            shown = "" if not isinstance(raw, str) else f" (got {v:g} {self.kind.si})".replace(" )", ")")
+            raise Bad(f"must be {self._range()}{shown}")
+        return v
+
+
+class Integer:
+    def __init__(self, *, ge=None, le=None):
+        self.ge, self.le = ge, le
+
+    def describe(self) -> str:
+        rng = [f">= {self.ge}" if self.ge is not None else "", f"<= {self.le}" if self.le is not None else ""]
+        return "an integer " + " and ".join(r for r in rng if r)
+
+    def __call__(self, raw, ctx):
+        if isinstance(raw, bool) or not isinstance(raw, int):
+            raise Bad(f"must be {self.describe()}")
+        if (self.ge is not None and raw < self.ge) or (self.le is not None and raw > self.le):
+            raise Bad(f"must be {self.describe()}")
+        return raw
+
+
+class Flag:
+    def describe(self) -> str:
+        return "true or false"
+
+    def __call__(self, raw, ctx):
+        if not isinstance(raw, bool):
+            raise Bad("must be true or false")
+        return raw
+
+
+class Text:
+    def __init__(self, pattern: str = r".+", what: str = "a non-empty string"):
+        self.pattern, self.what = re.compile(pattern), what
+
+    def describe(self) -> str:
+        return self.what
+
+    def __call__(self, raw, ctx):
+        if not isinstance(raw, str) or not self.pattern.fullmatch(raw):
+            raise Bad(f"must be {self.what}")
+        return raw
+
+
+class Choice:
+    def __init__(self, options, notes: Mapping[str, str] | None = None):
+        self.options, self.notes = tuple(options), dict(notes or {})
+
+    def describe(self) -> str:
+        return "one of " + ", ".join(f'"{o}"' for o in self.options)
+
+    def __call__(self, raw, ctx):
+        if raw not in self.options:
+            hint = suggest(raw, self.options) if isinstance(raw, str) else ""
+            raise Bad(f"unknown{hint}; allowed: {', '.join(self.options)}")
+        if raw in self.notes:
+            raise Bad(self.notes[raw])
+        return raw
+
+
+class Either:
+    """The first of several parsers that accepts the value (e.g. a number or "effusivity")."""
+
+    def __init__(self, *parsers):
+        self.parsers = parsers
+
+    def describe(self) -> str:
+        return " or ".join(p.describe() for p in self.parsers)
+
+    def __call__(self, raw, ctx):
+        for parser in self.parsers:
+            try:
+                return parser(raw, ctx)
+            except Bad:
+                continue
+        raise Bad(f"must be {self.describe()}")
+
+
+class ListOf:
+    """A TOML array of items of one parser, as a tuple."""
+
+    def __init__(self, item, *, unique: bool = False, min_len: int = 0):
+        self.item, self.unique, self.min_len = item, unique, min_len
+
+    def describe(self) -> str:
+        return f"a list of {self.item.describe()}"
+
+    def __call__(self, raw, ctx):
+        if not isinstance(raw, list):
+            raise Bad(f"must be {self.describe()}")
+        if len(raw) < self.min_len:
+            raise Bad(f"needs at least {self.min_len} item(s); allowed: {self.item.describe()}")
+        out, errors = [], []
+        for i, v in enumerate(raw, 1):
+            try:
+                out.append(self.item(v, ctx))
+            except Bad as exc:
+                errors.append(f"item {i} ({show(v)}): {exc}")
+        if self.unique and len(set(out)) != len(out):
+            errors.append("items must not repeat")
+        if errors:
+            raise Bad("; ".join(errors))
+        return tuple(out)
+
+
+class Pair(ListOf):
+    """A pair [a, b] (tuple of two); with ``single`` also one value meaning (v, v)."""
+
+    def __init__(self, item, *, single: bool = True, names: str = "[x, y]"):
+        super().__init__(item)
+        self.single, self.names = single, names
+
+    def describe(self) -> str:
+        pair = f"a pair {self.names} of {self.item.describe()}"
+        return f"{self.item.describe()}, or {pair}" if self.single else pair
+
+    def __call__(self, raw, ctx):
+        if isinstance(raw, list):
+            if len(raw) != 2:
+                raise Bad(f"a pair needs exactly 2 values; allowed: {self.describe()}")
+            return super().__call__(raw, ctx)
+        if not self.single:
+            raise Bad(f"must be {self.describe()}")
+        v = self.item(raw, ctx)
+        return (v, v)
+
+
+class Curve:
+    """A table of [x, y] rows with strictly increasing x, as a tuple of (x, y) tuples."""
+
+    def __init__(self, x, y, x_name: str, y_name: str):
+        self.x, self.y, self.x_name, self.y_name = x, y, x_name, y_name
+
+    def describe(self) -> str:
+        return (f"rows [{self.x_name}, {self.y_name}] with increasing {self.x_name}: "
+                f"{self.x_name} a {self.x.describe()}, {self.y_name} a {self.y.describe()}")
+
+    def __call__(self, raw, ctx):
+        if not isinstance(raw, list) or not raw or not all(isinstance(r, list) and len(r) == 2 for r in raw):
+            raise Bad(f"must be a non-empty list of {self.describe()}")
+        rows, errors = [], []
+        for i, (x, y) in enumerate(raw, 1):
+            try:
+                rows.append((self.x(x, ctx), self.y(y, ctx)))
+            except Bad as exc:
+                errors.append(f"row {i} ({show([x, y])}): {exc}")
+        if not errors and any(b[0] <= a[0] for a, b in zip(rows, rows[1:])):
+            errors.append(f"{self.x_name} must increase strictly from row to row")
+        if errors:
+            raise Bad("; ".join(errors))
+        return tuple(rows)
+
+
+class FilePath:
+    """An existing file; a relative path is taken from the scene file's directory."""
+
+    def describe(self) -> str:
+        return "the path of an existing file (relative to the scene file)"
+
+    def __call__(self, raw, ctx):
+        if not isinstance(raw, str) or not raw:
+            raise Bad(f"must be {self.describe()}")
+        path = (ctx.directory / Path(raw).expanduser()).resolve()
+        if not path.is_file():
+            raise Bad(f"no such file ({path})")
+        return path
+
+
+class Folder:
+    """A folder (need not exist yet); a relative path is taken from the scene file's directory."""
+
+    def describe(self) -> str:
+        return "a folder path (relative to the scene file)"
+
+    def __call__(self, raw, ctx):
+        if not isinstance(raw, str) or not raw:
+            raise Bad(f"must be {self.describe()}")
+        path = (ctx.directory / Path(raw).expanduser()).resolve()
+        if path.exists() and not path.is_dir():
+            raise Bad(f"exists and is not a folder ({path})")
+        return path
+
+
+class Section:
+    """A sub-table read into the dataclass ``cls`` (absent -> defaults when ``always``)."""
+
+    def __init__(self, cls, *, always: bool = False):
+        self.cls, self.always = cls, always
+
+    def describe(self) -> str:
+        return "a table"
+
+    def read(self, raw, path, ctx):
+        return read(self.cls, raw, path, ctx)
+
+
+class Tables(Section):
+    """An array of tables ``[[path]]``, each read into ``cls``; a tuple."""
+
+    def __init__(self, cls, *, min_len: int = 1):
+        super().__init__(cls)
+        self.min_len = min_len
+
+    def describe(self) -> str:
+        return f"an array of tables (at least {self.min_len})"
+
+    def read(self, raw, path, ctx):
+        if not isinstance(raw, list) or not all(isinstance(t, dict) for t in raw) or len(raw) < self.min_len:
+            ctx.problems.append(f"{path}: must be {self.describe()}, written [[{path}]]")
+            return None
+        return tuple(read(self.cls, t, f"{path}[{i}]", ctx) for i, t in enumerate(raw, 1))
+
+
+class Named(Section):
+    """A table of named sub-tables (``[materials.pin]``); a FrozenMap name -> cls."""
+
+    def describe(self) -> str:
+        return "a table of named tables"
+
+    def read(self, raw, path, ctx):
+        if not isinstance(raw, dict):
+            ctx.problems.append(f"{path} = {show(raw)}: must be {self.describe()} ([{path}.<name>])")
+            return None
+        return FrozenMap({name: read(self.cls, t, f"{path}.{name}", ctx) for name, t in raw.items()})
+
+
+# ---------------------------------------------------------------- keys and rules
+@dataclass(frozen=True)
+class Spec:
+    parser: Any
+    required: bool = False
+    needed_by: tuple[str, ...] = ()       # effects that need this key
+    unless: tuple[str, ...] = ()          # ... except when one of these effects is on
+    doc: str = ""
+
+
+def key(parser, *, default=None, required: bool = False, needed_by=(), unless=(), doc: str = ""):
+    """A dataclass field read from the TOML key of the same name."""
+    spec = Spec(parser, required, tuple(needed_by), tuple(unless), doc)
+    return field(default=default, metadata={"spec": spec})
+
+
+def _needing(needed_by, unless, effects) -> str | None:
+    """The first active effect that needs something, or None."""
+    if any(e in effects for e in unless):
+        return None
+    return next((e for e in needed_by if e in effects), None)
+
+
+@dataclass(frozen=True)
+class OneOf:
+    """At most one of ``keys``; exactly one when required or an effect in ``needed_by`` is on."""
+
+    keys: tuple[str, ...]
+    required: bool = False
+    needed_by: tuple[str, ...] = ()
+
+    def check(self, present, path, ctx):
+        given = [k for k in self.keys if k in present]
+        names = " or ".join(f"{path}.{k}" for k in self.keys)
+        if len(given) > 1:
+            return [f"{names}: give only one of them (got {', '.join(given)})"]
+        effect = _needing(self.needed_by, (), ctx.effects)
+        if not given and (self.required or effect):
+            why = f'effect "{effect}" needs it' if effect else "required"
+            return [f"{names}: missing; {why}"]
+        return []
+
+
+@dataclass(frozen=True)
+class Requires:
+    """If ``key`` is given, ``then`` keys are required too (optionally only when an effect is on)."""
+
+    key: str
+    then: tuple[str, ...]
+    needed_by: tuple[str, ...] = ()
+
+    def check(self, present, path, ctx):
+        if self.key not in present:
+            return []
+        effect = _needing(self.needed_by, (), ctx.effects)
+        if self.needed_by and not effect:
+            return []
+        why = f' (effect "{effect}")' if effect else ""
+        return [f"{path}.{k}: missing; needed with {path}.{self.key}{why}"
+                for k in self.then if k not in present]
+
+
+@dataclass(frozen=True)
+class OnlyWith:
+    """``keys`` make sense only together with ``key`` (e.g. a seed only for a generated surface)."""
+
+    key: str
+    keys: tuple[str, ...]
+
+    def check(self, present, path, ctx):
+        if self.key in present:
+            return []
+        return [f"{path}.{k}: only used with {path}.{self.key}" for k in self.keys if k in present]
+
+
+# ---------------------------------------------------------------- the reader
+def unknown_keys(raw, allowed, path: str, ctx: Context, what: str = "key") -> set[str]:
+    """Report keys of ``raw`` not in ``allowed`` (with a "did you mean"); return the suggested
+    names, so that their "missing" problem is not reported a second time."""
+    prefix, typos = f"{path}." if path else "", set()
+    for name in raw:
+        if name not in allowed:
+            hint = suggest(name, allowed)
+            typos.update(hint.split('"')[1:2])
+            ctx.problems.append(f"{prefix}{name}: unknown {what}{hint}; "
+                                f"allowed: {', '.join(allowed) or 'none'}")
+    return typos
+
+
+def fields_of(cls):
+    """(name, Spec) of the TOML keys of a table class."""
+    return [(f.name, f.metadata["spec"]) for f in dataclasses.fields(cls) if "spec" in f.metadata]
+
+
+def read(cls, raw, path: str, ctx: Context):
+    """Validate the raw table ``raw`` against ``cls``, appending one line per problem to
+    ``ctx.problems``. Returns an instance (keys that failed keep their default, so later
+    cross-checks still run: use it only if no problem was added), or None if ``raw`` is no table.
+    The instance's ``problems(path, ctx)`` consistency check runs only on a clean table."""
+    prefix = f"{path}." if path else ""
+    if not isinstance(raw, dict):
+        ctx.problems.append(f"{path} = {show(raw)}: must be a table [{path}]")
+        return None
+    before = len(ctx.problems)
+    specs = dict(fields_of(cls))
+    typos = unknown_keys(raw, specs, path, ctx)
+    values = {}
+    for name, spec in specs.items():
+        where = prefix + name
+        effect = _needing(spec.needed_by, spec.unless, ctx.effects)
+        missing = name not in raw and name not in typos   # a typo was already reported
+        why = f'effect "{effect}" needs it' if effect else "required"
+        if isinstance(spec.parser, Section):
+            if name in raw:
+                values[name] = spec.parser.read(raw[name], where, ctx)
+            elif spec.required or (effect and isinstance(spec.parser, (Tables, Named))):
+                if missing:
+                    ctx.problems.append(f"{where}: missing; {why}: {spec.parser.describe()}")
+            elif spec.parser.always or effect:       # absent: defaults, and name what is missing
+                values[name] = spec.parser.read({}, where, ctx)
+        elif name in raw:
+            try:
+                values[name] = spec.parser(raw[name], ctx)
+            except Bad as exc:
+                ctx.problems.append(f"{where} = {show(raw[name])}: {exc}")
+        elif (spec.required or effect) and missing:
+            ctx.problems.append(f"{where}: missing; {why}: {spec.parser.describe()}")
+    present = {k for k in raw if k in specs}
+    for rule in getattr(cls, "rules", ()):
+        ctx.problems.extend(rule.check(present, path or "scene", ctx))
+    obj = cls(**values)
+    if len(ctx.problems) == before and hasattr(obj, "problems"):
+        ctx.problems.extend(obj.problems(path, ctx))
+    return obj

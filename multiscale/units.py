@@ -1,0 +1,258 @@
+"""Unit strings -> SI numbers, used at the border (scene and study files).
+
+``to_si("200 rpm", "angular_speed") == 20.944`` rad/s. A value is a number (taken as SI) or a
+string "<number> <unit>": units multiply by juxtaposition, space or ``*``, divide with ``/``
+(everything up to the next ``/`` or ``)`` is the denominator: ``W/m K`` = ``W/(m K)``), and take
+integer powers with ``^``, ``**`` or superscripts (``kg/m^3``, ``m²/s``, ``1/K``). SI prefixes
+G M k c m u µ n p apply to m g s N Pa bar W J Hz rad. The angle is its own dimension (so "rpm"
+and "Hz" are not confused): ``rad``, ``deg``, ``rev``; ``rpm`` = rev/min. ``degC`` alone is an
+absolute temperature (+273.15 K); inside a compound unit (``1/degC``) it is a kelvin. ``%`` is
+0.01. Temperatures must carry their unit (a bare 20 would be 20 K).
+"""
+from __future__ import annotations
+
+import difflib
+import math
+import re
+from dataclasses import dataclass
+from fractions import Fraction
+
+__all__ = ["KINDS", "Kind", "UnitError", "parse_unit", "to_si"]
+
+# Dimension exponents over the base units (m, kg, s, K, rad).
+_BASE = ("m", "kg", "s", "K", "rad")
+L, M, T, TH, A = ((1, 0, 0, 0, 0), (0, 1, 0, 0, 0), (0, 0, 1, 0, 0), (0, 0, 0, 1, 0), (0, 0, 0, 0, 1))
+ONE = (0, 0, 0, 0, 0)
+
+
+def _dim(*pairs) -> tuple[int, ...]:
+    """Dimension from (base, power) pairs, e.g. _dim((L, 1), (T, -1)) for a speed."""
+    out = [0] * 5
+    for base, power in pairs:
+        for i, b in enumerate(base):
+            out[i] += b * power
+    return tuple(out)
+
+
+class UnitError(ValueError):
+    """A unit string that cannot be read, or a unit of the wrong dimension (message says which)."""
+
+
+@dataclass(frozen=True)
+class Kind:
+    """A physical quantity kind: its dimension, SI unit and examples for error messages."""
+
+    name: str                 # what the user reads ("pressure or modulus")
+    dim: tuple[int, ...]      # exponents of (m, kg, s, K, rad)
+    si: str                   # SI unit the value is stored in
+    examples: str             # accepted spellings, for messages
+    needs_unit: bool = False  # bare numbers refused (temperatures: 20 would silently be 20 K)
+
+
+KINDS: dict[str, Kind] = {
+    "dimensionless": Kind("dimensionless number", ONE, "", "a plain number, or a percentage like \"14 %\""),
+    "length": Kind("length", L, "m", "m, mm, um"),
+    "area": Kind("area", _dim((L, 2)), "m^2", "m^2, mm^2"),
+    "angle": Kind("angle", A, "rad", "rad, deg"),
+    "time": Kind("time", T, "s", "s, ms, min, h"),
+    "frequency": Kind("frequency", _dim((T, -1)), "Hz", "Hz, kHz"),
+    "speed": Kind("speed", _dim((L, 1), (T, -1)), "m/s", "m/s, mm/s"),
+    "angular_speed": Kind("angular speed", _dim((A, 1), (T, -1)), "rad/s", "rpm, rad/s"),
+    "force": Kind("force", _dim((M, 1), (L, 1), (T, -2)), "N", "N, kN"),
+    "pressure": Kind("pressure or modulus", _dim((M, 1), (L, -1), (T, -2)), "Pa", "Pa, kPa, MPa, GPa, bar"),
+    "stiffness": Kind("stiffness per area", _dim((M, 1), (L, -2), (T, -2)), "Pa/m", "Pa/m, N/mm^3"),
+    "temperature": Kind("temperature", TH, "K", "K, degC", needs_unit=True),
+    "expansion": Kind("thermal expansion coefficient", _dim((TH, -1)), "1/K", "1/K"),
+    "density": Kind("density", _dim((M, 1), (L, -3)), "kg/m^3", "kg/m^3, g/cm^3"),
+    "conductivity": Kind("thermal conductivity", _dim((M, 1), (L, 1), (T, -3), (TH, -1)), "W/(m K)",
+                         "W/(m K)"),
+    "specific_heat": Kind("specific heat capacity", _dim((L, 2), (T, -2), (TH, -1)), "J/(kg K)",
+                          "J/(kg K)"),
+    "diffusivity": Kind("thermal diffusivity", _dim((L, 2), (T, -1)), "m^2/s", "m^2/s, mm^2/s"),
+    "conductance": Kind("thermal conductance per area", _dim((M, 1), (T, -3), (TH, -1)), "W/(m^2 K)",
+                        "W/(m^2 K)"),
+    "wear_rate": Kind("wear rate (Archard, per pressure)", _dim((M, -1), (L, 1), (T, 2)), "1/Pa",
+                      "1/Pa, 1/MPa, m^2/N"),
+}
+
+_FORCE, _PRESSURE = KINDS["force"].dim, KINDS["pressure"].dim
+_ENERGY, _POWER = _dim((M, 1), (L, 2), (T, -2)), _dim((M, 1), (L, 2), (T, -3))
+_OTHER_NAMES = {_ENERGY: "energy", _POWER: "power", M: "mass", _dim((M, 1), (T, -3)): "heat flux"}
+# symbol: (exact factor to SI, dimension, takes SI prefixes); factors are Fractions so that
+# "10 um" is exactly the float 1e-05 (the decimal number times the factor, rounded once).
+_F = Fraction
+_UNITS: dict[str, tuple[Fraction, tuple[int, ...], bool]] = {
+    "m": (_F(1), L, True), "g": (_F(1, 1000), M, True), "s": (_F(1), T, True), "K": (_F(1), TH, False),
+    "N": (_F(1), _FORCE, True), "Pa": (_F(1), _PRESSURE, True), "bar": (_F(10**5), _PRESSURE, True),
+    "J": (_F(1), _ENERGY, True), "W": (_F(1), _POWER, True),
+    "Hz": (_F(1), _dim((T, -1)), True), "rad": (_F(1), A, True),
+    "min": (_F(60), T, False), "h": (_F(3600), T, False),
+    "deg": (_F(math.pi / 180), A, False), "°": (_F(math.pi / 180), A, False),
+    "rev": (_F(2 * math.pi), A, False), "rpm": (_F(2 * math.pi) / 60, _dim((A, 1), (T, -1)), False),
+    "degC": (_F(1), TH, False), "°C": (_F(1), TH, False), "%": (_F(1, 100), ONE, False),
+}
+_ABSOLUTE = {"degC": _F("273.15"), "°C": _F("273.15")}   # offsets of a whole-unit absolute temperature
+_PREFIXES = {"G": _F(10**9), "M": _F(10**6), "k": _F(1000), "c": _F(1, 100), "m": _F(1, 1000),
+             "u": _F(1, 10**6), "µ": _F(1, 10**6), "μ": _F(1, 10**6), "n": _F(1, 10**9),
+             "p": _F(1, 10**12)}
+_SUPERSCRIPT = str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻", "0123456789-")
+_NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
+_VALUE = re.compile(rf"^\s*({_NUMBER})\s*(.*?)\s*$")
+_TOKEN = re.compile(r"\s*(?:(?P<num>\d+\.?\d*(?:[eE][+-]?\d+)?)|(?P<name>°C|[A-Za-zµμ°%]+)"
+                    r"|(?P<sup>[⁰¹²³⁴⁵⁶⁷⁸⁹⁻]+)|(?P<op>\*\*|[/*·^()]|-?\d+))")
+
+
+def _lookup(name: str) -> tuple[Fraction, tuple[int, ...]]:
+    if name in _UNITS:
+        factor, dim, _ = _UNITS[name]
+        return factor, dim
+    if len(name) > 1 and name[0] in _PREFIXES:
+        base = _UNITS.get(name[1:])
+        if base is not None and base[2]:
+            return _PREFIXES[name[0]] * base[0], base[1]
+    known = list(_UNITS) + [p + u for u, (_, _, pre) in _UNITS.items() if pre for p in "GMkmu"]
+    near = difflib.get_close_matches(name, known, n=1, cutoff=0.5)
+    hint = f' (did you mean "{near[0]}"?)' if near else ""
+    raise UnitError(f'unknown unit "{name}"{hint}')
+
+
+class _Parser:
+    """Recursive descent over tokens: expr := product ('/' product)*; product := power+;
+    power := atom [('^' | '**') int | superscript]; atom := NAME | NUMBER | '(' expr ')'."""
+
+    def __init__(self, text: str):
+        self.tokens, pos = [], 0
+        text = text.strip()
+        while pos < len(text):
+            match = _TOKEN.match(text, pos)
+            if not match or match.end() == pos:
+                raise UnitError(f'cannot read unit "{text}" at "{text[pos:].strip()}"')
+            kind = match.lastgroup
+            self.tokens.append((kind, match.group(kind)))
+            pos = match.end()
+        self.i = 0
+
+    def peek(self):
+        return self.tokens[self.i] if self.i < len(self.tokens) else (None, None)
+
+    def take(self):
+        token = self.peek()
+        self.i += 1
+        return token
+
+    def expr(self) -> tuple[Fraction, tuple[int, ...]]:
+        factor, dim = self.product()
+        while self.peek() == ("op", "/"):
+            self.take()
+            f2, d2 = self.product()
+            factor, dim = factor / f2, tuple(a - b for a, b in zip(dim, d2))
+        return factor, dim
+
+    def product(self):
+        factor, dim = self.power()
+        while self.peek()[0] in ("name", "num") or self.peek()[1] in ("(", "*", "·"):
+            if self.peek()[1] in ("*", "·"):
+                self.take()
+            f2, d2 = self.power()
+            factor, dim = factor * f2, tuple(a + b for a, b in zip(dim, d2))
+        return factor, dim
+
+    def power(self):
+        factor, dim = self.atom()
+        kind, tok = self.peek()
+        exponent = None
+        if kind == "op" and tok in ("^", "**"):
+            self.take()
+            kind, tok = self.take()
+            if tok == "(":
+                kind, tok = self.take()
+                if self.take() != ("op", ")"):
+                    raise UnitError("expected ')' after the exponent")
+            exponent = tok
+        elif kind == "sup":
+            self.take()
+            exponent = tok.translate(_SUPERSCRIPT)
+        if exponent is None:
+            return factor, dim
+        try:
+            n = int(exponent)
+        except (TypeError, ValueError):
+            raise UnitError(f'exponent must be an integer, got "{exponent}"') from None
+        return factor**n, tuple(d * n for d in dim)
+
+    def atom(self):
+        kind, tok = self.take()
+        if kind == "name":
+            return _lookup(tok)
+        if kind == "num" or (kind == "op" and tok.isdigit()):
+            return _F(tok), ONE
+        if tok == "(":
+            inner = self.expr()
+            if self.take() != ("op", ")"):
+                raise UnitError("unbalanced parentheses")
+            return inner
+        raise UnitError("unexpected end of unit" if tok is None else f'unexpected "{tok}"')
+
+
+def parse_unit(text: str) -> tuple[Fraction, Fraction, tuple[int, ...]]:
+    """Unit string -> (factor, offset, dimension): SI value = number * factor + offset (exact)."""
+    text = text.strip()
+    if not text:
+        return _F(1), _F(0), ONE
+    if text in _ABSOLUTE:
+        return _F(1), _ABSOLUTE[text], TH
+    parser = _Parser(text)
+    factor, dim = parser.expr()
+    if parser.i != len(parser.tokens):
+        raise UnitError(f'cannot read unit "{text}" at "{parser.peek()[1]}"')
+    return factor, _F(0), dim
+
+
+def describe(dim: tuple[int, ...]) -> str:
+    """A dimension in words: the kind's name if one matches, else base units (kg m^-1 s^-2)."""
+    for kind in KINDS.values():
+        if kind.dim == dim:
+            return kind.name
+    if dim in _OTHER_NAMES:
+        return _OTHER_NAMES[dim]
+    parts = [b if p == 1 else f"{b}^{p}" for b, p in zip(_BASE, dim) if p]
+    return " ".join(parts) or "dimensionless"
+
+
+def to_si(value, kind: str) -> float:
+    """A TOML value (number or "<number> <unit>") as a float in the SI unit of ``kind``.
+
+    Raises UnitError with a one-line reason (what was expected, e.g. "use Pa, MPa, GPa, bar").
+    """
+    spec = KINDS[kind]
+    expect = f"expected {_a(spec.name)} ({spec.examples})"
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        raise UnitError(f"{expect}, got a {type(value).__name__}")
+    if isinstance(value, float) and not math.isfinite(value):
+        raise UnitError("must be a finite number")
+    if isinstance(value, (int, float)):
+        if spec.needs_unit:
+            raise UnitError(f'{_a(spec.name)} needs its unit, e.g. "{value} degC" or "{value} K"')
+        number, (factor, offset, dim) = _F(value), (_F(1), _F(0), spec.dim)
+    else:
+        match = _VALUE.match(value)
+        if not match:
+            raise UnitError(f'{expect}: write a number then a unit, like "{_example(spec)}"')
+        number = _F(match.group(1))
+        if not match.group(2) and spec.needs_unit:
+            raise UnitError(f'{_a(spec.name)} needs its unit, e.g. "{match.group(1)} degC"')
+        factor, offset, dim = parse_unit(match.group(2))
+        if dim != spec.dim:
+            raise UnitError(f"{expect}; the unit \"{match.group(2)}\" is {_a(describe(dim))}")
+    try:
+        return float(number * factor + offset)
+    except OverflowError:
+        raise UnitError("must be a finite number") from None
+
+
+def _a(words: str) -> str:
+    return ("an " if words[0] in "aeiou" else "a ") + words
+
+
+def _example(spec: Kind) -> str:
+    return "1 " + spec.examples.split(",")[0].split(" or ")[0].strip('"') if spec.si else "0.5"

@@ -1,0 +1,146 @@
+"""CLI `multiscale check|run`: clear one-line errors and a non-zero exit for bad input, never a
+traceback; a summary for a good scene; earlier results are not overwritten without --overwrite."""
+import sys
+import types
+from pathlib import Path
+
+import pytest
+
+from multiscale.cli import main
+
+BLOCK = (Path(__file__).resolve().parents[1] / "demos" / "block_on_flat.toml").read_text()
+THERMAL = BLOCK.replace('effects = ["contact"]', 'effects = ["contact", "thermal"]').replace(
+    'E = "4 GPa"', 'E = "4 GPa"\nkappa = "5 W/(m K)"\nchi = "1e-6 m^2/s"').replace(
+    'E = "210 GPa"', 'E = "210 GPa"\nkappa = "45 W/(m K)"\nchi = "1e-5 m^2/s"') + '\n[time]\nend = "1 s"\n'
+
+
+def _write(tmp_path, text, name="scene.toml"):
+    path = tmp_path / name
+    path.write_text(text, encoding="utf-8")
+    return str(path)
+
+
+def test_thermal_variant_is_good(tmp_path, capsys):
+    assert main(["check", _write(tmp_path, THERMAL)]) == 0
+    out = capsys.readouterr().out
+    assert "thermal        transient conduction in block, flat" in out
+
+
+BAD = [  # (name, the demo block scene changed, the one expected message)
+    ("missing field", BLOCK.replace('E = "4 GPa"\n', ""),
+     "materials.block.E: missing; required: a pressure or modulus > 0 Pa"),
+    ("wrong unit", BLOCK.replace('"1 MPa"', '"1 MN"'),
+     'loading.pressure = "1 MN": expected a pressure or modulus (Pa, kPa, MPa, GPa, bar); '
+     'the unit "MN" is a force'),
+    ("negative modulus", BLOCK.replace('"210 GPa"', '"-210 GPa"'),
+     'materials.flat.E = "-210 GPa": must be > 0 Pa (got -2.1e+11 Pa)'),
+    ("unknown effect", BLOCK.replace('["contact"]', '["contact", "thermol"]'),
+     'effects = ["contact", "thermol"]: item 2 ("thermol"): unknown (did you mean "thermal"?); '
+     "allowed: contact, friction, thermal, heat_partition, conductance, expansion, roughness, layers, "
+     "wear, stability"),
+    ("not implemented effect", BLOCK.replace('["contact"]', '["contact", "stability"]'),
+     'item 2 ("stability"): known but not implemented yet (issue 10)'),
+    ("unknown key", BLOCK.replace("penalty =", "penalty_stiffness ="),
+     'interface.penalty_stiffness: unknown key (did you mean "penalty"?); allowed: penalty, partition, '
+     "conductance"),
+    ("effect without inputs", THERMAL.replace('kappa = "5 W/(m K)"\n', ""),
+     'materials.block.kappa: missing; effect "thermal" needs it: a thermal conductivity > 0 W/(m K)'),
+    ("effect without its effect", THERMAL.replace('["contact", "thermal"]', '["thermal", "conductance"]')
+     .replace("[interface]", '[interface]\nconductance = "1e5 W/(m^2 K)"'),
+     'effects: "conductance" needs effect "contact" too (add it to effects)'),
+    ("unknown body material", BLOCK.replace("[materials.flat]", "[materials.flat_]"),
+     'materials.flat_: unknown material of builder "block_on_flat" (did you mean "flat"?)'),
+    ("malformed TOML", BLOCK.replace('E = "4 GPa"', 'E = "4 GPa'), "not valid TOML: "),
+    ("not a table", "loading = 3\n" + BLOCK.replace('[loading]\npressure = "1 MPa"\n', ""),
+     "loading = 3: must be a table [loading]"),
+]
+
+
+@pytest.mark.parametrize("name, text, message", BAD, ids=[b[0] for b in BAD])
+def test_bad_scene_gives_one_clear_line_and_exit_2(tmp_path, capsys, name, text, message):
+    assert text not in (BLOCK, THERMAL)
+    path = _write(tmp_path, text)
+    assert main(["check", path]) == 2
+    err = capsys.readouterr().err
+    assert "Traceback" not in err
+    errors = [line for line in err.splitlines() if line.startswith("error: ")]
+    assert len(errors) == 1, err
+    assert message in errors[0], err
+    assert err.splitlines()[-1] == f"{path}: 1 problem"
+
+
+def test_missing_file_is_a_clear_error(tmp_path, capsys):
+    assert main(["check", str(tmp_path / "nope.toml")]) == 2
+    err = capsys.readouterr().err
+    assert "cannot read the scene file" in err and "Traceback" not in err
+
+
+def test_check_good_scene_prints_summary(tmp_path, capsys):
+    path = _write(tmp_path, BLOCK)
+    assert main(["check", path]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0].startswith("scene block_on_flat")
+    assert any(line.startswith("  bodies    block (block: block) | flat (flat: flat)") for line in out)
+    assert any(line.startswith("  effects   contact") for line in out)
+    assert any("penalty K_n = 1e+13 Pa/m" in line for line in out)
+    assert any(line.startswith("  loading   1 MPa") for line in out)
+    assert out[-1] == f"{path}: OK"
+
+
+def test_check_several_files_fails_if_one_fails(tmp_path, capsys):
+    good, bad = _write(tmp_path, BLOCK, "a.toml"), _write(tmp_path, BLOCK.replace("nu = 0.3", "nu = 0.7"), "b.toml")
+    assert main(["check", good, bad]) == 2
+    captured = capsys.readouterr()
+    assert f"{good}: OK" in captured.out
+    assert "error: materials.flat.nu = 0.7: must be in (-1, 0.5)" in captured.err
+
+
+@pytest.fixture
+def fake_runner(monkeypatch):
+    """A stand-in for multiscale.macro.runner recording its calls (no DOLFINx needed)."""
+    calls = []
+    module = types.ModuleType("multiscale.macro.runner")
+    module.run = lambda scene, overwrite=False, resume=False: calls.append((scene.name, overwrite, resume))
+    monkeypatch.setitem(sys.modules, "multiscale.macro.runner", module)
+    return calls
+
+
+def test_run_hands_the_scene_to_the_runner(tmp_path, fake_runner):
+    path = _write(tmp_path, BLOCK.replace("../results/block_on_flat", "out"))
+    assert main(["run", path]) == 0
+    assert fake_runner == [("block_on_flat", False, False)]
+
+
+def test_run_refuses_to_overwrite_results(tmp_path, capsys, fake_runner):
+    path = _write(tmp_path, BLOCK.replace("../results/block_on_flat", "out"))
+    (tmp_path / "out").mkdir()
+    (tmp_path / "out" / "history.h5").write_bytes(b"")
+    assert main(["run", path]) == 2
+    err = capsys.readouterr().err
+    assert f'error: output.folder = "{tmp_path / "out"}": already holds results (1 entries: history.h5)' in err
+    assert "--overwrite" in err and "Traceback" not in err and fake_runner == []
+    assert main(["run", path, "--overwrite"]) == 0
+    assert main(["run", path, "--resume"]) == 0
+    assert fake_runner == [("block_on_flat", True, False), ("block_on_flat", False, True)]
+    assert (tmp_path / "out" / "history.h5").exists()          # the CLI itself deletes nothing
+
+
+def test_run_bad_scene_does_not_reach_the_runner(tmp_path, capsys, fake_runner):
+    assert main(["run", _write(tmp_path, BLOCK.replace('"4 GPa"', '"4 GPa/m"'))]) == 2
+    assert "materials.block.E" in capsys.readouterr().err and fake_runner == []
+
+
+def test_run_without_runner_says_so(tmp_path, capsys, monkeypatch):
+    monkeypatch.setitem(sys.modules, "multiscale.macro.runner", None)   # import fails as if absent
+    assert main(["run", _write(tmp_path, BLOCK.replace("../results/block_on_flat", "out"))]) == 2
+    err = capsys.readouterr().err
+    assert "multiscale.macro.runner" in err and "Traceback" not in err
+
+
+def test_check_does_not_import_dolfinx(tmp_path):
+    import subprocess
+    code = ("import sys; from multiscale.cli import main; rc = main(['check', sys.argv[1]]); "
+            "assert not any(m.split('.')[0] in ('dolfinx', 'gmsh', 'petsc4py') for m in sys.modules), "
+            "sorted(m for m in sys.modules if 'dolfinx' in m or 'gmsh' in m); sys.exit(rc)")
+    result = subprocess.run([sys.executable, "-c", code, _write(tmp_path, BLOCK)], capture_output=True, text=True)
+    assert result.returncode == 0, result.stderr
