@@ -29,7 +29,11 @@ def _info(args) -> int:
 
 def _check(args) -> int:
     """Validate scene files: a short summary for a good one, every problem of a bad one."""
-    from multiscale.scene import load, summary
+    from multiscale.scene import load, reference, summary
+    if args.keys:
+        print("\n".join(reference()))
+    elif not args.scenes:
+        raise MultiscaleError("multiscale check: give scene file(s), or --keys for the scene format")
     failed = 0
     for path in args.scenes:
         try:
@@ -91,7 +95,8 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", required=True)
     sub.add_parser("info", help="versions and settings").set_defaults(func=_info)
     check = sub.add_parser("check", help="validate scene files: every problem at once, or a summary")
-    check.add_argument("scenes", nargs="+", metavar="SCENE", help="scene TOML file(s)")
+    check.add_argument("scenes", nargs="*", metavar="SCENE", help="scene TOML file(s)")
+    check.add_argument("--keys", action="store_true", help="print the scene format: every section and key")
     check.set_defaults(func=_check)
     run = sub.add_parser("run", help="run a scene (mpirun -n N multiscale run scene.toml)")
     run.add_argument("scene", metavar="SCENE", help="scene TOML file")

@@ -21,11 +21,13 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from multiscale.errors import InputError, SceneError
-from multiscale.schema import (Bad, Choice, Context, Curve, Either, FilePath, Flag, Folder, FrozenMap,
+from multiscale.schema import (Bad, Choice, Context, Curve, Either, FilePath, Flag, FrozenMap,
                                Integer, ListOf, Named, OneOf, OnlyWith, Pair, Quantity, Requires,
-                               Section, Tables, Text, key, read, show, unknown_keys)
+                               Section, Tables, Text, fields_of, key, read, show, unknown_keys)
+from multiscale.schema import reference as schema_reference
 
-__all__ = ["BUILDERS", "EFFECTS", "OUTPUT_FIELDS", "Geometry", "Material", "Scene", "load", "loads", "summary"]
+__all__ = ["BUILDERS", "EFFECTS", "OUTPUT_FIELDS", "Geometry", "Material", "Scene", "load", "loads",
+           "reference", "summary"]
 
 
 # ------------------------------------------------------------------ effects
@@ -124,6 +126,18 @@ class _Geometry(Section):
     def describe(self) -> str:
         return f"a table with builder = {_BUILDER_CHOICE.describe()} and its parameters"
 
+    def reference(self, path) -> list[str]:
+        lines = [f"  {'builder':<20} {_BUILDER_CHOICE.describe()}  [required]"]
+        for builder in BUILDERS:
+            try:
+                module = importlib.import_module(f"meshes.{builder}")
+            except ImportError:
+                lines.append(f"  builder = \"{builder}\": not available")
+                continue
+            lines.append(f"  builder = \"{builder}\" parameters (SI defaults; 0 = the builder's fallback):")
+            lines += [f"    {k:<22} {_parameter_kind(module, k):<8} {v:g}" for k, v in module.DEFAULTS.items()]
+        return lines
+
     def read(self, raw, path, ctx):
         if not isinstance(raw, dict):
             ctx.problems.append(f"{path} = {show(raw)}: must be {self.describe()}")
@@ -173,7 +187,7 @@ class Material:
     kappa: float | None = key(_CONDUCTIVITY, needed_by=("thermal",))         # W/(m K)
     c: float | None = key(Quantity("specific_heat", gt=0))                   # J/(kg K)
     chi: float | None = key(Quantity("diffusivity", gt=0))                   # m^2/s, kappa/(rho c)
-    alpha: float | None = key(Quantity("expansion"), needed_by=("expansion",))   # 1/K
+    alpha: float | None = key(Quantity("expansion"), needed_by=("expansion",), warn_unused=True)  # 1/K
 
     rules = (OneOf(("c", "chi"), needed_by=("thermal",)), Requires("c", ("rho",), needed_by=("thermal",)))
 
@@ -205,9 +219,9 @@ class Interface:
                                 unless=("roughness",))          # Pa/m, normal penalty stiffness K_n
     partition: float | str | None = key(Either(Quantity("dimensionless", ge=0, le=1),
                                                Choice(("effusivity",))),
-                                        needed_by=("heat_partition",))  # share into the first body
-    conductance: float | None = key(Quantity("conductance", gt=0),
-                                    needed_by=("conductance",))  # W/(m^2 K), h_c
+                                        needed_by=("heat_partition",), warn_unused=True)  # into body 0
+    conductance: float | None = key(Quantity("conductance", gt=0), needed_by=("conductance",),
+                                    warn_unused=True)            # W/(m^2 K), h_c
 
 
 # ------------------------------------------------------------------ loading, time, output
@@ -221,7 +235,8 @@ class Loading:
     speed_profile: tuple | None = key(Curve(Quantity("time", ge=0), Quantity("angular_speed", ge=0),
                                             "time", "speed"))                 # ((s, rad/s), ...)
     sliding_speed: float | None = key(Quantity("speed", ge=0))                # m/s (translation builders)
-    friction: float | None = key(Quantity("dimensionless", ge=0), needed_by=("friction",))  # mu
+    friction: float | None = key(Quantity("dimensionless", ge=0), needed_by=("friction",),
+                                 warn_unused=True)                            # mu
     ramp_steps: int = key(Integer(ge=1), default=1)       # load increments of the first mechanical solve
 
     rules = (OneOf(("normal_force", "pressure"), needed_by=("contact",)),
@@ -261,7 +276,7 @@ class Output:
     """Where and what to write. Defaults: folder results/<name> next to the scene file; every
     field the scene's effects produce."""
 
-    folder: Path | None = key(Folder())
+    folder: Path | None = key(FilePath(folder=True))
     every: int = key(Integer(ge=1), default=1)            # write fields every n macro steps
     fields: tuple = key(ListOf(Choice(OUTPUT_FIELDS), unique=True))
 
@@ -481,14 +496,27 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
             missing = [e for e in OUTPUT_FIELDS[f] if e not in effects]
             if missing:
                 problems.append(f'output.fields: "{f}" needs effect "{missing[0]}" (not in effects)')
-    for section, effect in (("roughness", "roughness"), ("micro", "roughness"), ("wear", "wear"),
-                            ("layers", "layers"), ("stability", "stability")):
-        if section in raw and effect not in effects:
-            warnings.append(f'[{section}] is ignored: effect "{effect}" is not in effects')
-    return warnings
+    for section, spec in fields_of(Scene):
+        if section in raw and spec.needed_by and not any(e in effects for e in spec.needed_by):
+            warnings.append(f'[{section}] is ignored: effect "{spec.needed_by[0]}" is not in effects')
+    if {"friction", "thermal"} <= effects and "heat_partition" not in effects:
+        warnings.append('effects "friction" and "thermal" without "heat_partition": no frictional heat '
+                        "enters the bodies")
+    return ctx.warnings + warnings
 
 
-# ------------------------------------------------------------------ summary for `multiscale check`
+# ------------------------------------------------------------------ `multiscale check` output
+def reference() -> list[str]:
+    """The scene format: effects, then every section and key (``multiscale check --keys``)."""
+    effects = [f"  {name:<15} {e.doc}" + (f"  [not implemented yet: issue {e.issue}]" if e.issue else "")
+               + (f"  (needs {', '.join(e.requires)})" if e.requires else "") for name, e in EFFECTS.items()]
+    fields = [f"  {name:<18} needs {', '.join(needs) or 'nothing'}" for name, needs in OUTPUT_FIELDS.items()]
+    return (["Scene file (TOML). Values: SI numbers or unit strings (\"4 GPa\", \"200 rpm\", \"20 degC\").",
+             "", "effects:"] + effects + ["", "output.fields:"] + fields + ["", "top level:"]
+            + schema_reference(Scene))
+
+
+
 def summary(scene: Scene) -> list[str]:
     """A few lines: bodies, effects, loading, time, output — what a run would compute."""
     g, ld, t, o = scene.geometry, scene.loading, scene.time, scene.output

@@ -4,7 +4,7 @@ A table is a frozen dataclass whose fields carry a ``key(...)`` spec: how the TO
 (``Quantity("pressure", gt=0)``, ``Integer(ge=1)``, ``Choice(...)``, ``Section(Cls)`` ...), its
 default, and whether it is required always or only when some effect is on (``needed_by``).
 Class-level ``rules`` (``OneOf``, ``Requires``, ``OnlyWith``) relate keys of one table; an optional
-``problems(self, path)`` method checks the built table's consistency. ``read`` walks a raw table
+``problems(self, path, ctx)`` method checks the built table's consistency. ``read`` walks a raw table
 and collects EVERY problem as one line naming the path, the value and what is allowed, so a new
 section is added by declaring a dataclass, not by writing a code path.
 Paths are dotted (``materials.pin.E``); list items are numbered from 1 (``layers.layer[2].E``).
@@ -22,9 +22,10 @@ from typing import Any
 
 from multiscale.units import KINDS, UnitError, to_si
 
-__all__ = ["Bad", "Choice", "Context", "Curve", "Either", "FilePath", "Flag", "Folder", "FrozenMap",
+__all__ = ["Bad", "Choice", "Context", "Curve", "Either", "FilePath", "Flag", "FrozenMap",
            "Integer", "ListOf", "Named", "OneOf", "OnlyWith", "Pair", "Quantity", "Requires",
-           "Section", "Tables", "Text", "key", "read", "show", "suggest"]
+           "Section", "Tables", "Text", "fields_of", "key", "read", "reference", "show", "suggest",
+           "unknown_keys"]
 
 
 class Bad(ValueError):
@@ -33,11 +34,13 @@ class Bad(ValueError):
 
 @dataclass
 class Context:
-    """What a table is read against: active effects, the scene directory, collected problems."""
+    """What a table is read against: active effects, the scene directory; collected problems and
+    warnings (keys given but unused by the active effects)."""
 
     effects: frozenset = frozenset()
     directory: Path = Path(".")
     problems: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
 
 
 class FrozenMap(Mapping):
@@ -266,8 +269,8 @@ class Curve:
         self.x, self.y, self.x_name, self.y_name = x, y, x_name, y_name
 
     def describe(self) -> str:
-        return (f"rows [{self.x_name}, {self.y_name}] with increasing {self.x_name}: "
-                f"{self.x_name} a {self.x.describe()}, {self.y_name} a {self.y.describe()}")
+        return (f"rows [{self.x_name}, {self.y_name}] with increasing {self.x_name}; "
+                f"{self.x_name}: {self.x.describe()}; {self.y_name}: {self.y.describe()}")
 
     def __call__(self, raw, ctx):
         if not isinstance(raw, list) or not raw or not all(isinstance(r, list) and len(r) == 2 for r in raw):
@@ -286,32 +289,24 @@ class Curve:
 
 
 class FilePath:
-    """An existing file; a relative path is taken from the scene file's directory."""
+    """A path, relative ones taken from the scene file's directory: an existing file, or with
+    ``folder`` a folder that need not exist yet."""
+
+    def __init__(self, *, folder: bool = False):
+        self.folder = folder
 
     def describe(self) -> str:
-        return "the path of an existing file (relative to the scene file)"
+        what = "a folder path" if self.folder else "the path of an existing file"
+        return f"{what} (relative to the scene file)"
 
     def __call__(self, raw, ctx):
         if not isinstance(raw, str) or not raw:
             raise Bad(f"must be {self.describe()}")
         path = (ctx.directory / Path(raw).expanduser()).resolve()
-        if not path.is_file():
-            raise Bad(f"no such file ({path})")
-        return path
-
-
-class Folder:
-    """A folder (need not exist yet); a relative path is taken from the scene file's directory."""
-
-    def describe(self) -> str:
-        return "a folder path (relative to the scene file)"
-
-    def __call__(self, raw, ctx):
-        if not isinstance(raw, str) or not raw:
-            raise Bad(f"must be {self.describe()}")
-        path = (ctx.directory / Path(raw).expanduser()).resolve()
-        if path.exists() and not path.is_dir():
+        if self.folder and path.exists() and not path.is_dir():
             raise Bad(f"exists and is not a folder ({path})")
+        if not self.folder and not path.is_file():
+            raise Bad(f"no such file ({path})")
         return path
 
 
@@ -365,12 +360,12 @@ class Spec:
     required: bool = False
     needed_by: tuple[str, ...] = ()       # effects that need this key
     unless: tuple[str, ...] = ()          # ... except when one of these effects is on
-    doc: str = ""
+    warn_unused: bool = False             # warn when given while none of needed_by is on
 
 
-def key(parser, *, default=None, required: bool = False, needed_by=(), unless=(), doc: str = ""):
+def key(parser, *, default=None, required: bool = False, needed_by=(), unless=(), warn_unused=False):
     """A dataclass field read from the TOML key of the same name."""
-    spec = Spec(parser, required, tuple(needed_by), tuple(unless), doc)
+    spec = Spec(parser, required, tuple(needed_by), tuple(unless), warn_unused)
     return field(default=default, metadata={"spec": spec})
 
 
@@ -388,6 +383,10 @@ class OneOf:
     keys: tuple[str, ...]
     required: bool = False
     needed_by: tuple[str, ...] = ()
+
+    def text(self) -> str:
+        return f"one of {', '.join(self.keys)}" + (" (required)" if self.required else
+                                                     f" (needed by {', '.join(self.needed_by)})" if self.needed_by else "")
 
     def check(self, present, path, ctx):
         given = [k for k in self.keys if k in present]
@@ -409,6 +408,10 @@ class Requires:
     then: tuple[str, ...]
     needed_by: tuple[str, ...] = ()
 
+    def text(self) -> str:
+        return f"{self.key} needs {', '.join(self.then)}" + (
+            f" (with {', '.join(self.needed_by)})" if self.needed_by else "")
+
     def check(self, present, path, ctx):
         if self.key not in present:
             return []
@@ -426,6 +429,9 @@ class OnlyWith:
 
     key: str
     keys: tuple[str, ...]
+
+    def text(self) -> str:
+        return f"{', '.join(self.keys)} only with {self.key}"
 
     def check(self, present, path, ctx):
         if self.key in present:
@@ -483,6 +489,9 @@ def read(cls, raw, path: str, ctx: Context):
                 values[name] = spec.parser(raw[name], ctx)
             except Bad as exc:
                 ctx.problems.append(f"{where} = {show(raw[name])}: {exc}")
+            if spec.warn_unused and not any(e in ctx.effects for e in spec.needed_by):
+                users = " or ".join(f'"{e}"' for e in spec.needed_by)
+                ctx.warnings.append(f"{where} is ignored: effect {users} is not in effects")
         elif (spec.required or effect) and missing:
             ctx.problems.append(f"{where}: missing; {why}: {spec.parser.describe()}")
     present = {k for k in raw if k in specs}
@@ -492,3 +501,27 @@ def read(cls, raw, path: str, ctx: Context):
     if len(ctx.problems) == before and hasattr(obj, "problems"):
         ctx.problems.extend(obj.problems(path, ctx))
     return obj
+
+
+def reference(cls, path: str = "") -> list[str]:
+    """Every key of ``cls`` (recursively) with what it accepts and when it is needed: the scene
+    format reference printed by ``multiscale check --keys``."""
+    lines = []
+    for name, spec in fields_of(cls):
+        where = f"{path}.{name}" if path else name
+        when = ("required" if spec.required else
+                f"needed by {', '.join(spec.needed_by)}" + (f" unless {', '.join(spec.unless)}" if spec.unless else "")
+                if spec.needed_by else "optional")
+        if isinstance(spec.parser, Section):
+            header = {Tables: f"[[{where}]]", Named: f"[{where}.<name>]"}.get(type(spec.parser), f"[{where}]")
+            sub = spec.parser.reference(where) if hasattr(spec.parser, "reference") else \
+                reference(spec.parser.cls, where + (".<name>" if isinstance(spec.parser, Named) else ""))
+            lines += ["", f"{header}  ({when})"] + sub
+            continue
+        default = next(f.default for f in dataclasses.fields(cls) if f.name == name)
+        if default is not None and not spec.required:
+            when = f"default {show(default)}" + ("" if when == "optional" else f"; {when}")
+        lines.append(f"  {name:<20} {spec.parser.describe()}  [{when}]")
+    for rule in getattr(cls, "rules", ()):
+        lines.append(f"  rule: {rule.text()}")
+    return lines

@@ -321,3 +321,23 @@ def test_unimplemented_effect_is_named_with_its_issue(tmp_path):
     assert info.value.problems == [
         'effects = ["contact", "friction", "thermal", "heat_partition", ...]: item 7 ("wear"): '
         "known but not implemented yet (issue 9)"]
+
+
+def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
+    text = (DEMOS / "block_on_flat.toml").read_text().replace(
+        'pressure = "1 MPa"', 'pressure = "1 MPa"\nfriction = 0.4')
+    scene = loads(text, tmp_path)
+    assert scene.warnings == ('loading.friction is ignored: effect "friction" is not in effects',)
+    no_heat = loads(GOOD.replace('"heat_partition", ', "").replace('partition = "effusivity"\n', ""), tmp_path)
+    assert no_heat.warnings == ('effects "friction" and "thermal" without "heat_partition": no frictional '
+                                "heat enters the bodies",)
+
+
+def test_reference_lists_every_section_and_key():
+    from multiscale.scene import Scene, reference
+    from multiscale.schema import fields_of
+    text = "\n".join(reference())
+    for name, spec in fields_of(Scene):
+        assert (f"[{name}" in text) or (f"  {name} " in text), name
+    for key in ("penalty", "k_w_table", "partition_law", "modes", "thickness", "initial_temperature"):
+        assert f"  {key} " in text
