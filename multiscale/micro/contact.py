@@ -89,63 +89,134 @@ class ContactSolver:
         return self._run(z, scale, None, delta[..., None, None], tol, max_iter, initial_pressure, partial)
 
     def _run(self, z, scale, target, delta, tol, max_iter, p0, partial):
-        L, axes = self.operator, (-2, -1)
+        """Polonsky–Keer iterations on (B, N) views of the batch (B patches of N cells).
+
+        The conjugate direction lives on the contact set only, so the scalar products run on
+        gathered contact values; full-grid passes are the FFT convolutions and a few updates.
+        Between exact evaluations u = L p is updated as c (u − τ L t), exact while projection
+        and overlap correction leave p alone; otherwise, every ``_REFRESH`` iterations and
+        before accepting convergence, u is recomputed by FFT.
+        """
+        L = self.operator
+        batch, grid = z.shape[:-2], z.shape[-2:]
+        B, N = int(np.prod(batch, dtype=int)), grid[0] * grid[1]
+        zf = np.ascontiguousarray(z, dtype=float).reshape(B, N)
+        scale = np.asarray(scale, dtype=float).reshape(B)
         load_control = target is not None
+        if load_control:
+            target = np.asarray(target, dtype=float).reshape(B)
+        else:
+            delta = np.asarray(delta, dtype=float).reshape(B)
         if p0 is not None:
-            p = np.array(np.broadcast_to(p0, z.shape), dtype=float)
+            p = np.array(np.broadcast_to(p0, z.shape), dtype=float).reshape(B, N)
             if np.any(p < 0) or not np.all(np.isfinite(p)):
                 raise InputError("initial_pressure", "array", "must be finite and >= 0")
         elif load_control:
-            p = np.empty_like(z)
-            p[...] = target[..., None, None]
+            p = np.repeat(target[:, None], N, axis=1)
         else:
-            p = np.maximum(delta - z, 0.0) / L.self_influence
+            p = np.maximum(delta[:, None] - zf, 0.0) / L.self_influence
         if load_control:
-            p = _rescale(p, target, z)
-        bshape = z.shape[:-2] + (1, 1)
-        t = np.zeros_like(z)
-        G_old = np.ones(bshape)
-        conjugate = np.zeros(bshape, dtype=bool)
-        active = np.ones(bshape, dtype=bool)
-        iterations = np.zeros(z.shape[:-2], dtype=int)
-        history = []
-        u = np.empty_like(z)
-        for it in range(max_iter + 1):
-            L(p, out=u)
-            g = u + z
-            S = p > 0
-            nS = np.maximum(S.sum(axis=axes, keepdims=True), 1)
-            d = np.sum(g * S, axis=axes, keepdims=True) / nS if load_control else delta
-            g -= d
-            res = _residual(g, S, nS, scale)
-            active &= res > tol
+            p = _rescale(p, target, zf)
+
+        def rowsum(rows, values):
+            return np.bincount(rows, values, minlength=B)
+
+        ws = L.workspace((B,))                    # the direction t lives in ws.load
+        t, r = ws.load, ws.response               # (B, ny, nx) views of the FFT buffers
+        u, g = np.zeros((B, N)), np.zeros((B, N))
+        u3 = u.reshape((B,) + grid)
+        pv, uv, zv, gv = p.reshape(-1), u.reshape(-1), zf.reshape(-1), g.reshape(-1)
+        L(p.reshape(u3.shape), out=u3)
+        idx = np.flatnonzero(pv)                  # contact set (p >= 0 always), sorted
+        exact = np.ones(B, dtype=bool)
+        G_old, conjugate = np.ones(B), np.zeros(B, dtype=bool)
+        active = np.ones(B, dtype=bool)
+        iterations, history = np.zeros(B, dtype=int), []
+        prev_at = None
+        since_refresh = 0
+        while True:
+            rows, cell = np.divmod(idx, N)
+            at = (rows,) + np.divmod(cell, grid[1])   # (b, i, j) of the contact cells
+            nS = np.maximum(np.bincount(rows, minlength=B), 1)
+            gS = uv[idx] + zv[idx]
+            d = rowsum(rows, gS) / nS if load_control else delta   # approach (load: unknown)
+            gS -= d[rows]
+            G = rowsum(rows, gS * gS)
+            np.subtract(u, d[:, None], out=g)
+            g += zf
+            res = np.maximum(np.sqrt(G / nS), np.maximum(-g.min(axis=1), 0.0)) / scale
+            done = active & (res <= tol)
+            if np.any(done & ~exact):        # accept convergence only on an exact displacement
+                L(p.reshape(u3.shape), out=u3)
+                exact[:] = True
+                since_refresh = 0
+                continue
+            active &= ~done
             history.append(float(res.max()))
-            if not active.any() or it == max_iter:
+            if not active.any() or iterations.max() >= max_iter:
                 break
-            iterations += active[..., 0, 0]
-            gS = g * S
-            G = np.sum(gS**2, axis=axes, keepdims=True)
-            t = np.where(S, gS + np.where(conjugate, G / G_old, 0.0) * t, 0.0)
+            iterations += active
+            beta = np.where(conjugate, G / G_old, 0.0)
+            t_old = t[at]
+            if prev_at is not None:
+                t[prev_at] = 0.0                  # t is zero off its support
+            tS = gS + beta[rows] * t_old
+            t[at] = tS
+            prev_at = at
             G_old = np.where(G > 0, G, 1.0)
-            r = L(t)
+            ws.apply()
+            rS = r[at]
+            rt = rowsum(rows, rS * tS)
             if load_control:
-                r -= np.sum(r * S, axis=axes, keepdims=True) / nS
-            rt = np.sum(r * t, axis=axes, keepdims=True)
-            tau = np.where(rt > 0, np.sum(gS * t, axis=axes, keepdims=True) / np.where(rt > 0, rt, 1), 0.0)
-            p_new = np.maximum(p - tau * t, 0.0)
-            overlap = (p_new == 0) & (g < 0)
-            p_new = np.where(overlap, -tau * g, p_new)
-            conjugate = ~np.any(overlap, axis=axes, keepdims=True)
+                rt -= rowsum(rows, rS) / nS * rowsum(rows, tS)
+            tau = np.where(active & (rt > 0), rowsum(rows, gS * tS) / np.where(rt > 0, rt, 1.0), 0.0)
+            pS = pv[idx] - tau[rows] * tS
+            touched = rowsum(rows, pS < 0) > 0
+            np.maximum(pS, 0.0, out=pS)
+            # overlap: zero pressure but negative gap -> enters the contact (PK step 8)
+            lift = (pS == 0) & (gS < 0) & active[rows]
+            pS[lift] = -tau[rows[lift]] * gS[lift]
+            enter = np.flatnonzero(g < 0)
+            enter = enter[(pv[enter] == 0) & active[enter // N]]
+            enter_rows = enter // N
+            has_overlap = (rowsum(rows, lift) + np.bincount(enter_rows, minlength=B)) > 0
+            conjugate = ~has_overlap
+            p_enter = -tau[enter_rows] * gv[enter]
             if load_control:
-                p_new = _rescale(p_new, target, z)
-            p = np.where(active, p_new, p)
-        converged = ~active[..., 0, 0]
-        gap = np.maximum(g, 0.0) * (p == 0)
+                total = rowsum(rows, pS) + rowsum(enter_rows, p_enter)
+                lost = active & (total <= 0)               # every point left: restart
+                c = np.where(active, target * N / np.where(total > 0, total, 1.0), 1.0)
+            else:
+                lost, c = np.zeros(B, dtype=bool), np.ones(B)
+            pv[idx] = pS * c[rows]
+            pv[enter] = p_enter * c[enter_rows]
+            if lost.any():
+                p[lost] = _rescale(zf[lost] == 0, target[lost], zf[lost])
+            idx = np.flatnonzero(pv)
+            since_refresh += 1
+            refresh = (touched | has_overlap | lost) & active
+            if since_refresh >= _REFRESH:
+                L(p.reshape(u3.shape), out=u3)
+                exact[:], since_refresh = True, 0
+            elif refresh.any():
+                keep = ~refresh
+                u_inc = c[keep, None, None] * (u3[keep] - tau[keep, None, None] * r[keep])
+                L(p.reshape(u3.shape), out=u3)
+                u3[keep] = u_inc
+                exact = refresh.copy()
+            else:
+                u3 -= tau[:, None, None] * r
+                u *= c[:, None]
+                exact[:] = False
+        converged = ~active
+        gap = np.where(p > 0, 0.0, np.maximum(g, 0.0))
+        shape = batch + grid
         result = ContactResult(
-            pressure=p, displacement=u, gap=gap, contact=p > 0,
-            area_fraction=np.mean(p > 0, axis=axes), mean_pressure=np.mean(p, axis=axes),
-            approach=np.broadcast_to(d, bshape)[..., 0, 0].copy(), mean_gap=np.mean(gap, axis=axes), iterations=iterations,
-            residual=res[..., 0, 0], converged=converged, history=history)
+            pressure=p.reshape(shape), displacement=u.reshape(shape), gap=gap.reshape(shape),
+            contact=(p > 0).reshape(shape), area_fraction=np.mean(p > 0, axis=1).reshape(batch),
+            mean_pressure=p.mean(axis=1).reshape(batch), approach=np.array(d, dtype=float).reshape(batch),
+            mean_gap=gap.mean(axis=1).reshape(batch), iterations=iterations.reshape(batch),
+            residual=res.reshape(batch), converged=converged.reshape(batch), history=history)
         if not np.all(converged) and not partial:
             raise ContactConvergenceError(
                 f"contact solver did not converge in {max_iter} iterations "
@@ -154,20 +225,19 @@ class ContactSolver:
         return result
 
 
+_REFRESH = 25  # iterations between exact recomputations of u = L p (bounds round-off drift)
+
+
 def _rescale(p, target, z):
-    """Scale p so that its mean is the target mean pressure (load balance, exact)."""
-    mean = p.mean(axis=(-2, -1), keepdims=True)
-    if np.any(mean <= 0):  # every point left the contact: restart from the highest ones
-        p = np.where(mean > 0, p, (z == 0).astype(float))
-        mean = p.mean(axis=(-2, -1), keepdims=True)
-    return p * (target[..., None, None] / mean)
+    """Scale each row of p so that its mean is the target mean pressure (load balance, exact).
 
-
-def _residual(g, S, nS, scale):
-    """max(rms gap on the contact, max penetration off it), relative to the RMS height."""
-    on = np.sqrt(np.sum((g * S) ** 2, axis=(-2, -1), keepdims=True) / nS)
-    off = np.max(np.where(S, 0.0, np.maximum(-g, 0.0)), axis=(-2, -1), keepdims=True)
-    return np.maximum(on, off) / scale
+    A row that lost all contact restarts from its highest points (z == 0)."""
+    p = np.asarray(p, dtype=float)
+    mean = p.mean(axis=1)
+    if np.any(mean <= 0):
+        p = np.where((mean > 0)[:, None], p, (z == 0).astype(float))
+        mean = p.mean(axis=1)
+    return p * (target / mean)[:, None]
 
 
 def solve_contact(heights, dx: float, kernel: Kernel, *, dy: float | None = None, periodic: bool = True,

@@ -13,7 +13,6 @@ import numpy as np
 try:  # pragma: no cover - depends on the installation
     import pyfftw
 
-    pyfftw.interfaces.cache.enable()
 except ImportError:  # pragma: no cover
     pyfftw = None
 
@@ -31,49 +30,55 @@ def get_threads() -> int:
 
 
 class RealFFT2:
-    """Forward and inverse real FFT of arrays of one fixed shape ``(..., ny, nx)``.
+    """Real 2-D FFT pair over the last two axes of arrays of one fixed shape ``(..., ny, nx)``.
 
-    ``forward(x)`` and ``inverse(X)`` return views of internal buffers that the next call of the
-    same method overwrites; copy what must outlive it.
+    Three aligned buffers: real ``input``, complex ``spectrum`` (rfft2 of input, overwritten by
+    ``inverse``) and real ``output``; the methods return views of them that the next call
+    overwrites. Plans are built once (FFTW_MEASURE).
     """
 
     def __init__(self, shape: tuple[int, ...]):
         self.shape = tuple(int(s) for s in shape)
         self.spectral_shape = self.shape[:-1] + (self.shape[-1] // 2 + 1,)
+        self.size = self.shape[-1] * self.shape[-2]
         self.threads = _threads
         if pyfftw is not None:
-            rin = pyfftw.empty_aligned(self.shape, dtype="float64")
-            cout = pyfftw.empty_aligned(self.spectral_shape, dtype="complex128")
-            cin = pyfftw.empty_aligned(self.spectral_shape, dtype="complex128")
-            rout = pyfftw.empty_aligned(self.shape, dtype="float64")
+            self.input = pyfftw.empty_aligned(self.shape, dtype="float64")
+            self.spectrum = pyfftw.empty_aligned(self.spectral_shape, dtype="complex128")
+            self.output = pyfftw.empty_aligned(self.shape, dtype="float64")
             flags = ("FFTW_MEASURE",)
-            self._fwd = pyfftw.FFTW(rin, cout, axes=(-2, -1), direction="FFTW_FORWARD",
+            self._fwd = pyfftw.FFTW(self.input, self.spectrum, axes=(-2, -1), direction="FFTW_FORWARD",
                                     flags=flags, threads=self.threads)
-            self._inv = pyfftw.FFTW(cin, rout, axes=(-2, -1), direction="FFTW_BACKWARD",
+            self._inv = pyfftw.FFTW(self.spectrum, self.output, axes=(-2, -1), direction="FFTW_BACKWARD",
                                     flags=flags, threads=self.threads)
-            rin[...] = 0.0
         else:  # pragma: no cover
+            self.input, self.output = np.empty(self.shape), np.empty(self.shape)
+            self.spectrum = np.empty(self.spectral_shape, dtype=complex)
             self._fwd = self._inv = None
-            self._rin = np.zeros(self.shape)
-
-    @property
-    def input(self) -> np.ndarray:
-        """Real input buffer of ``forward`` (write into it, then call ``forward()``)."""
-        return self._fwd.input_array if self._fwd is not None else self._rin
+        self.input[...] = 0.0   # planning scribbles on the buffers
 
     def forward(self, x: np.ndarray | None = None) -> np.ndarray:
-        """rfft2 of ``x`` (or of the current input buffer when ``x`` is None)."""
+        """``spectrum = rfft2(input)`` (after copying ``x`` into ``input`` if given)."""
         if x is not None:
             self.input[...] = x
         if self._fwd is not None:
-            return self._fwd()
-        import scipy.fft  # pragma: no cover
-        return scipy.fft.rfft2(self._rin, workers=self.threads)  # pragma: no cover
+            self._fwd()
+        else:  # pragma: no cover
+            import scipy.fft
+            self.spectrum[...] = scipy.fft.rfft2(self.input, workers=self.threads)
+        return self.spectrum
 
-    def inverse(self, X: np.ndarray) -> np.ndarray:
-        """irfft2 of ``X`` (normalised so that inverse(forward(x)) == x)."""
+    def inverse(self, X: np.ndarray | None = None, normalise: bool = True) -> np.ndarray:
+        """``output = irfft2(spectrum)`` (after copying ``X`` into ``spectrum`` if given).
+
+        ``normalise=False`` skips the 1/(ny nx) factor (fold it into a multiplier instead)."""
+        if X is not None:
+            self.spectrum[...] = X
         if self._inv is not None:
-            self._inv.input_array[...] = X
-            return self._inv(normalise_idft=True)
-        import scipy.fft  # pragma: no cover
-        return scipy.fft.irfft2(X, s=self.shape[-2:], workers=self.threads)  # pragma: no cover
+            self._inv(normalise_idft=normalise)
+        else:  # pragma: no cover
+            import scipy.fft
+            self.output[...] = scipy.fft.irfft2(self.spectrum, s=self.shape[-2:], workers=self.threads)
+            if not normalise:
+                self.output *= self.size
+        return self.output

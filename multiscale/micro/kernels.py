@@ -161,29 +161,45 @@ class InfluenceOperator:
             self.spectrum = np.fft.rfft2(coeffs)
         if not np.all(np.isfinite(self.spectrum)):
             raise InputError("kernel", kernel, "produced non-finite influence coefficients")
-        self._plans: dict[tuple[int, ...], RealFFT2] = {}
+        self._scaled_spectrum = self.spectrum / (self.fft_shape[0] * self.fft_shape[1])
+        self._workspaces: dict[tuple[int, ...], ConvolutionWorkspace] = {}
         self.self_influence = float(np.fft.irfft2(self.spectrum, s=self.fft_shape)[0, 0])
 
-    def _plan(self, batch: tuple[int, ...]) -> RealFFT2:
-        plan = self._plans.get(batch)
-        if plan is None:
-            plan = self._plans[batch] = RealFFT2(batch + self.fft_shape)
-        return plan
+    def workspace(self, batch: tuple[int, ...] = ()) -> "ConvolutionWorkspace":
+        """A new workspace of this operator for a batch shape (buffers owned by the caller)."""
+        return ConvolutionWorkspace(self, tuple(batch))
 
     def __call__(self, p: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Displacement [m] of pressure ``p`` [Pa] of shape (..., ny, nx)."""
-        ny, nx = self.shape
         if p.shape[-2:] != self.shape:
             raise InputError("pressure.shape", p.shape, f"last two axes must be {self.shape}")
-        plan = self._plan(p.shape[:-2])
-        if self.periodic:
-            plan.input[...] = p
-        else:
-            plan.input[..., :ny, :nx] = p  # the padding stays zero: this plan is ours alone
-        spec = plan.forward()
-        spec *= self.spectrum
-        u = plan.inverse(spec)
+        ws = self._workspaces.get(p.shape[:-2])
+        if ws is None:
+            ws = self._workspaces[p.shape[:-2]] = self.workspace(p.shape[:-2])
+        ws.load[...] = p
         if out is None:
             out = np.empty(p.shape)
-        out[...] = u[..., :ny, :nx]
+        out[...] = ws.apply()
         return out
+
+
+class ConvolutionWorkspace:
+    """FFT buffers and plans to apply an ``InfluenceOperator`` repeatedly without copies.
+
+    Write the load into ``load`` (a (..., ny, nx) view of the FFT input; zero padding around it
+    stays zero), call ``apply()``, read ``response`` (a view of the FFT output, overwritten by the
+    next ``apply``).
+    """
+
+    def __init__(self, operator: InfluenceOperator, batch: tuple[int, ...]):
+        ny, nx = operator.shape
+        self._plan = RealFFT2(batch + operator.fft_shape)
+        self._multiplier = operator._scaled_spectrum
+        self.load = self._plan.input[..., :ny, :nx]
+        self.response = self._plan.output[..., :ny, :nx]
+
+    def apply(self) -> np.ndarray:
+        self._plan.forward()
+        self._plan.spectrum *= self._multiplier
+        self._plan.inverse(normalise=False)
+        return self.response
