@@ -14,6 +14,7 @@ exact UFL derivative of the law. ``PenaltyLaw`` is the perfect-contact law p_n =
 """
 from __future__ import annotations
 
+from multiscale.macro import _dolfinx  # noqa: F401,I001  (before DOLFINx)
 from typing import Callable
 
 import numpy as np
@@ -21,7 +22,7 @@ import ufl
 from dolfinx import fem
 
 from multiscale.macro.geometry import Rotation, Translation
-from multiscale.macro.mesh import TwoBodyMesh
+from multiscale.macro.mesh import FormCache, TwoBodyMesh
 
 PressureLaw = Callable[[ufl.core.expr.Expr], ufl.core.expr.Expr]
 VELOCITY_FLOOR = 1e-9    # m/s, regularises the sliding direction at zero speed (s -> 0, no friction)
@@ -85,6 +86,7 @@ class ContactInterface:
         self.pressure = self.law(self.gap)
         self.traction = self.pressure * self.normal + self.friction * self.pressure * self.slip_direction
         self.heat_flux = self.friction * self.pressure * self.slip_speed
+        self.cache = FormCache(tm)
 
     # ---- mechanics -------------------------------------------------------------------------
     def residuals(self, v0, v1):
@@ -94,47 +96,55 @@ class ContactInterface:
 
     def normal_force(self) -> float:
         """Total normal contact force [N] (integral of p_n, same quadrature as the residual)."""
-        return self.tm.assemble_scalar(self.pressure * self.tm.interface.dS)
+        return self.cache.scalar("p", lambda: self.pressure * self.tm.interface.dS)
 
     def force(self) -> np.ndarray:
         """Resultant interface force on body 0 [N] (3-vector: normal pressure plus friction)."""
-        return np.array([self.tm.assemble_scalar(self.traction[i] * self.tm.interface.dS) for i in range(3)])
+        return np.array([self.cache.scalar(("t", i), lambda: self.traction[i] * self.tm.interface.dS)
+                         for i in range(3)])
+
+    def friction_force(self) -> np.ndarray:
+        """Resultant friction force on body 0 [N] (3-vector, mu p_n s integrated)."""
+        f = self.friction * self.pressure * self.slip_direction
+        return np.array([self.cache.scalar(("f", i), lambda: f[i] * self.tm.interface.dS) for i in range(3)])
 
     def facet_pressure(self) -> np.ndarray:
         """Mean contact pressure per interface facet [Pa] (global order, every rank)."""
-        return self.tm.interface.facet_mean(self.pressure, self.tm.entity_maps)
+        return self.cache.facet_mean("p", lambda: self.pressure)
 
     def facet_gap(self) -> np.ndarray:
         """Mean normal gap per interface facet [m] (negative: interpenetration of the penalty)."""
-        return self.tm.interface.facet_mean(self.gap, self.tm.entity_maps)
+        return self.cache.facet_mean("g", lambda: self.gap)
 
     # ---- heat ------------------------------------------------------------------------------
-    def heat_residuals(self, T0, T1, r0, r1, *, conductance: bool):
-        """Interface terms of the heat residuals of both bodies (thesis Fig. 7.4).
+    def heat_residuals(self, T0, T1, r0, r1, *, frictional_heat: bool = True, conductance: bool = False):
+        """Interface terms of the heat residuals of both bodies (thesis Fig. 7.4); None if empty.
 
         Frictional heat q split by p_1; with ``conductance`` the flux h_c (T_0 − T_1) couples the
         two temperature fields (otherwise they are disconnected, as in the thesis' perfect model).
         """
         dS = self.tm.interface.dS
-        p1 = self.partition("+")
-        F0 = -p1 * self.heat_flux * r0("+") * dS
-        F1 = -(1 - p1) * self.heat_flux * r1("-") * dS
+        F0 = F1 = None
+        if frictional_heat:
+            p1 = self.partition("+")
+            F0 = -p1 * self.heat_flux * r0("+") * dS
+            F1 = -(1 - p1) * self.heat_flux * r1("-") * dS
         if conductance:
             exchange = self.conductance("+") * (T0("+") - T1("-"))
-            F0 += exchange * r0("+") * dS
-            F1 -= exchange * r1("-") * dS
+            G0, G1 = exchange * r0("+") * dS, -exchange * r1("-") * dS
+            F0, F1 = (G0, G1) if F0 is None else (F0 + G0, F1 + G1)
         return F0, F1
 
     def heat_power(self) -> tuple[float, float]:
         """Frictional heat power into body 0 and body 1 [W] at the current state."""
         dS = self.tm.interface.dS
         p1 = self.partition("+")
-        return (self.tm.assemble_scalar(p1 * self.heat_flux * dS),
-                self.tm.assemble_scalar((1 - p1) * self.heat_flux * dS))
+        return (self.cache.scalar("q0", lambda: p1 * self.heat_flux * dS),
+                self.cache.scalar("q1", lambda: (1 - p1) * self.heat_flux * dS))
 
     def facet_heat_flux(self) -> np.ndarray:
         """Mean frictional heat flux per interface facet [W/m^2] (global order)."""
-        return self.tm.interface.facet_mean(self.heat_flux, self.tm.entity_maps)
+        return self.cache.facet_mean("q", lambda: self.heat_flux)
 
 
 def _needs_restriction(expr) -> bool:

@@ -8,6 +8,7 @@ from rest with load ramping; failures raise ``ConvergenceError`` with the residu
 """
 from __future__ import annotations
 
+from multiscale.macro import _dolfinx  # noqa: F401,I001  (before DOLFINx)
 from dataclasses import dataclass, field
 from typing import Mapping
 
@@ -40,20 +41,29 @@ class SolveResult:
     max_pressure: float = 0.0      # Pa, largest per-facet mean pressure
 
 
-def body_fields(tm: TwoBodyMesh, materials: Mapping[str, object], attribute: str, prefix: str = ""):
-    """Per-body DG0 fields of one material property (``attribute`` of each material object)."""
-    out = []
-    for body in tm.bodies:
-        values = {}
-        for r in body.spec.regions:
-            if r.material not in materials:
-                raise InputError(f"materials.{r.material}", None, f"material of region {r.name!r} is missing")
-            value = getattr(materials[r.material], attribute, None)
-            if value is None:
-                raise InputError(f"materials.{r.material}.{attribute}", None, "required by this model")
-            values[r.tag] = float(value)
-        out.append(body.cell_field(f"{prefix}{attribute}_{body.name}", values))
+def material_values(tm: TwoBodyMesh, materials: Mapping[str, object], attribute, label: str | None = None) -> dict:
+    """{material name: value} for the materials the geometry uses.
+
+    ``attribute`` is an attribute name of the material objects or a callable(material) -> value;
+    a missing material or value raises InputError naming the scene field.
+    """
+    out = {}
+    for name in tm.spec.materials:
+        if name not in materials:
+            raise InputError(f"materials.{name}", None, "this material is used by the geometry and is missing")
+        value = attribute(materials[name]) if callable(attribute) else getattr(materials[name], attribute, None)
+        if value is None:
+            raise InputError(f"materials.{name}.{label or attribute}", None, "required by this model")
+        out[name] = float(value)
     return out
+
+
+def body_fields(tm: TwoBodyMesh, materials: Mapping[str, object], attribute, name: str | None = None):
+    """Per-body DG0 fields (constant per region) of one material property (see material_values)."""
+    name = name or attribute
+    values = material_values(tm, materials, attribute, name)
+    return [body.cell_field(f"{name}_{body.name}", {r.tag: values[r.material] for r in body.spec.regions})
+            for body in tm.bodies]
 
 
 class Mechanics:
@@ -81,7 +91,7 @@ class Mechanics:
         self.temperatures = temperatures
         if temperatures is not None:
             self.alpha = body_fields(tm, materials, "alpha")
-            self.reference_temperature = fem.Constant(tm.parent, float(reference_temperature))
+        self.reference_temperature = float(reference_temperature)
         self.contact = ContactInterface(tm, *self.u, stiffness=stiffness, friction=friction, speed=speed,
                                         law=law, velocity=velocity)
         self.load = fem.Constant(tm.parent, 0.0)        # N (force) or Pa (pressure), ramped
@@ -115,6 +125,7 @@ class Mechanics:
         return lam * ufl.tr(eps) * ufl.Identity(3) + 2 * mu * eps
 
     def von_mises(self, i: int):
+        """Von Mises equivalent stress of body i [Pa] (UFL, on the body's submesh)."""
         s = self.stress(i)
         dev = s - ufl.tr(s) / 3 * ufl.Identity(3)
         return ufl.sqrt(1.5 * ufl.inner(dev, dev))

@@ -13,15 +13,12 @@ every rank) tells which facet is which.
 """
 from __future__ import annotations
 
+from multiscale.macro import _dolfinx  # noqa: F401,I001  (before DOLFINx)
 import importlib
 from dataclasses import dataclass, field
 
 import numpy as np
 
-try:
-    import dolfinx_solver  # noqa: F401  (must precede dolfinx in the PyPI wheel)
-except ImportError:  # pragma: no cover
-    pass
 import dolfinx
 import ufl
 from dolfinx import fem
@@ -153,16 +150,10 @@ class Interface:
         out[index] = np.concatenate(parts)
         return out
 
-    def integrate_per_facet(self, expr, entity_maps) -> np.ndarray:
-        """Global per-facet integrals of the scalar UFL expression ``expr`` over the interface."""
-        q = ufl.TestFunction(self.space)
-        vec = fem.assemble_vector(fem.form(expr * q("+") * self.dS, entity_maps=entity_maps))
+    def owned_values(self, vec) -> np.ndarray:
+        """Global per-facet array from an assembled DG0 vector (ghost contributions added)."""
         vec.scatter_reverse(dolfinx.la.InsertMode.add)
         return self.gather(vec.array[self._owned_dofs()])
-
-    def facet_mean(self, expr, entity_maps) -> np.ndarray:
-        """Global per-facet mean of ``expr`` (integral / facet area)."""
-        return self.integrate_per_facet(expr, entity_maps) / self.areas
 
 
 @dataclass
@@ -207,9 +198,40 @@ class TwoBodyMesh:
         return owners[0]
 
     def assemble_scalar(self, expr) -> float:
-        """Integral of a scalar form over the whole parent mesh, summed over ranks."""
-        local = fem.assemble_scalar(fem.form(expr, entity_maps=self.entity_maps))
-        return self.comm.allreduce(local, op=MPI.SUM)
+        """Integral of a scalar form over the whole parent mesh, summed over ranks (compiles it)."""
+        return FormCache(self).scalar(None, lambda: expr)
+
+
+class FormCache:
+    """Compiled diagnostic forms of a TwoBodyMesh, built once per key and reassembled on demand."""
+
+    def __init__(self, tm: TwoBodyMesh):
+        self.tm = tm
+        self.forms: dict = {}
+
+    def _form(self, key, make):
+        if key is None or key not in self.forms:
+            compiled = fem.form(make(), entity_maps=self.tm.entity_maps)
+            if key is None:
+                return compiled
+            self.forms[key] = compiled
+        return self.forms[key]
+
+    def scalar(self, key, make) -> float:
+        """Integral of the scalar form ``make()`` (summed over ranks)."""
+        local = fem.assemble_scalar(self._form(key, make))
+        return self.tm.comm.allreduce(local, op=MPI.SUM)
+
+    def facet_integrals(self, key, make) -> np.ndarray:
+        """Global per-facet integrals of the scalar interface expression ``make()``."""
+        iface = self.tm.interface
+        q = ufl.TestFunction(iface.space)
+        form = self._form(None if key is None else ("per facet", key), lambda: make() * q("+") * iface.dS)
+        return iface.owned_values(fem.assemble_vector(form))
+
+    def facet_mean(self, key, make) -> np.ndarray:
+        """Global per-facet means (integral / facet area) of ``make()``."""
+        return self.facet_integrals(key, make) / self.tm.interface.areas
 
 
 def build(builder_name: str, params=None, comm=MPI.COMM_WORLD) -> TwoBodyMesh:
@@ -252,10 +274,7 @@ def from_mesh(spec: GeometrySpec, parent: dmesh.Mesh, cell_tags: dmesh.MeshTags,
     bodies = tuple(_body(parent, cell_tags, facet_tags, b) for b in spec.bodies)
     interface = _interface(parent, facet_tags, spec, bodies)
     tm = TwoBodyMesh(spec, parent, cell_tags, facet_tags, bodies, interface)
-    q = ufl.TestFunction(interface.space)
-    vec = fem.assemble_vector(fem.form(q("+") * interface.dS, entity_maps=tm.entity_maps))
-    vec.scatter_reverse(dolfinx.la.InsertMode.add)
-    interface.areas = interface.gather(vec.array[interface._owned_dofs()])
+    interface.areas = FormCache(tm).facet_integrals(None, lambda: ufl.as_ufl(1.0))
     return tm
 
 
