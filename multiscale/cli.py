@@ -50,23 +50,28 @@ def _check(args) -> int:
     return 2 if failed else 0
 
 
-def _rank() -> int:
+def _world():
+    """MPI.COMM_WORLD, or None without mpi4py."""
     try:
         from mpi4py import MPI
     except ImportError:
-        return 0
-    return MPI.COMM_WORLD.rank
+        return None
+    return MPI.COMM_WORLD
 
 
 def _run(args) -> int:
     """Validate the scene, protect earlier results, then hand over to the macro runner.
 
-    Under ``mpirun`` every rank runs this; user errors are printed by rank 0 only."""
+    Under ``mpirun`` every rank runs this: rank 0 alone looks at the output folder (so a fast rank
+    that starts writing cannot make a slow one refuse), and prints the user errors."""
     from multiscale.scene import load
-    rank = _rank()
+    comm = _world()
+    rank = comm.rank if comm is not None else 0
     try:
-        scene = load(args.scene)
-        existing = scene.output.existing_results()
+        scene = load(args.scene)                 # deterministic: every rank fails or none does
+        existing = scene.output.existing_results() if rank == 0 else None
+        if comm is not None and comm.size > 1:
+            existing = comm.bcast(existing, root=0)
         if existing and not (args.overwrite or args.resume):
             shown = ", ".join(p.name for p in existing[:3]) + (", ..." if len(existing) > 3 else "")
             raise SceneError(f'output.folder = "{scene.output.folder}": already holds results '
