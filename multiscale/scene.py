@@ -423,23 +423,35 @@ class Scene:
         return e0 / (e0 + e1)
 
 
-def load(path) -> Scene:
-    """Read and validate a scene file; raises SceneError listing every problem."""
+def load(path, overrides=None) -> Scene:
+    """Read and validate a scene file; raises SceneError listing every problem.
+
+    ``overrides`` maps dotted key paths to raw values applied before validation (a study's sweep:
+    ``{"loading.friction": 0.2, "geometry.mesh_size": "6 mm"}``); they are validated like the file."""
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise SceneError(f"{path}: cannot read the scene file ({exc.strerror or exc})") from None
-    return loads(text, path.resolve().parent, name=path.stem, source=path.resolve())
+    return loads(text, path.resolve().parent, name=path.stem, source=path.resolve(), overrides=overrides)
 
 
-def loads(text: str, directory=".", *, name: str = "scene", source: Path | None = None) -> Scene:
+def loads(text: str, directory=".", *, name: str = "scene", source: Path | None = None,
+          overrides=None) -> Scene:
     """Validate scene TOML text; relative paths are taken from ``directory``; ``name`` is the
-    default scene name (the file stem for ``load``)."""
+    default scene name (the file stem for ``load``); ``overrides`` as in ``load``."""
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{source or 'scene'}: not valid TOML: {exc}") from None
+    for dotted, value in (overrides or {}).items():
+        *parents, last = dotted.split(".")
+        table = raw
+        for part in parents:
+            table = table.setdefault(part, {})
+            if not isinstance(table, dict):
+                raise SceneError(f"{dotted}: cannot override, {part} is not a table")
+        table[last] = value
     effects = raw.get("effects")
     active = frozenset(e for e in effects if isinstance(e, str) and e in EFFECTS and EFFECTS[e].issue is None) \
         if isinstance(effects, list) else frozenset()      # implemented effects decide what is needed
@@ -541,6 +553,9 @@ def summary(scene: Scene) -> list[str]:
         lines.append(f"  time      {t.end:g} s in {t.steps} step(s) of {t.dt:g} s x {t.substeps} substep(s); "
                      f"T0 = {t.initial_temperature - 273.15:g} degC")
     lines.append(f"  output    {o.folder} every {o.every} step(s): {', '.join(o.fields)}")
+    if o.existing_results():
+        lines.append(f"  note      the output folder already holds {len(o.existing_results())} entries: "
+                     "run needs --overwrite or --resume")
     lines += [f"  warning   {w}" for w in scene.warnings]
     return lines
 

@@ -119,6 +119,8 @@ def test_run_refuses_to_overwrite_results(tmp_path, capsys, fake_runner):
     err = capsys.readouterr().err
     assert f'error: output.folder = "{tmp_path / "out"}": already holds results (1 entries: history.h5)' in err
     assert "--overwrite" in err and "Traceback" not in err and fake_runner == []
+    assert main(["check", path]) == 0
+    assert "the output folder already holds 1 entries: run needs --overwrite or --resume" in capsys.readouterr().out
     assert main(["run", path, "--overwrite"]) == 0
     assert main(["run", path, "--resume"]) == 0
     assert fake_runner == [("block_on_flat", True, False), ("block_on_flat", False, True)]

@@ -341,3 +341,17 @@ def test_reference_lists_every_section_and_key():
         assert (f"[{name}" in text) or (f"  {name} " in text), name
     for key in ("penalty", "k_w_table", "partition_law", "modes", "thickness", "initial_temperature"):
         assert f"  {key} " in text
+
+
+def test_overrides_are_validated_like_the_file(tmp_path):
+    scene = loads(GOOD, tmp_path, overrides={"loading.friction": 0.2, "geometry.mesh_size": "1 mm",
+                                             "materials.block.E": "5 GPa"})
+    assert (scene.loading.friction, scene.geometry.params["mesh_size"], scene.materials["block"].E) == (0.2, 1e-3, 5e9)
+    with pytest.raises(SceneError) as info:
+        loads(GOOD, tmp_path, overrides={"loading.frictoin": 0.2, "time.end": "-1 s"})
+    assert info.value.problems == [
+        'loading.frictoin: unknown key (did you mean "friction"?); allowed: normal_force, pressure, '
+        "rotation_speed, speed_profile, sliding_speed, friction, ramp_steps",
+        'time.end = "-1 s": must be > 0 s (got -1 s)']
+    with pytest.raises(SceneError, match="cannot override, friction is not a table"):
+        loads(GOOD, tmp_path, overrides={"loading.friction.x": 1})
