@@ -431,8 +431,8 @@ def load(path, overrides=None) -> Scene:
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise SceneError(f"{path}: cannot read the scene file ({exc.strerror or exc})") from None
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SceneError(f"{path}: cannot read the scene file ({getattr(exc, 'strerror', None) or exc})") from None
     return loads(text, path.resolve().parent, name=path.stem, source=path.resolve(), overrides=overrides)
 
 

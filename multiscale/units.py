@@ -12,6 +12,7 @@ absolute temperature (+273.15 K); inside a compound unit (``1/degC``) it is a ke
 from __future__ import annotations
 
 import difflib
+import functools
 import math
 import re
 from dataclasses import dataclass
@@ -194,6 +195,7 @@ class _Parser:
         raise UnitError("unexpected end of unit" if tok is None else f'unexpected "{tok}"')
 
 
+@functools.lru_cache(maxsize=256)
 def parse_unit(text: str) -> tuple[Fraction, Fraction, tuple[int, ...]]:
     """Unit string -> (factor, offset, dimension): SI value = number * factor + offset (exact)."""
     text = text.strip()

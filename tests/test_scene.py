@@ -355,3 +355,29 @@ def test_overrides_are_validated_like_the_file(tmp_path):
         'time.end = "-1 s": must be > 0 s (got -1 s)']
     with pytest.raises(SceneError, match="cannot override, friction is not a table"):
         loads(GOOD, tmp_path, overrides={"loading.friction.x": 1})
+
+
+def _paths(table, prefix=""):
+    for k, v in table.items():
+        path = f"{prefix}{k}"
+        yield path
+        if isinstance(v, dict):
+            yield from _paths(v, path + ".")
+
+
+def test_any_wrong_type_anywhere_is_a_scene_error(tmp_path):
+    """Every key of a full scene replaced by values of every TOML type: a SceneError or a valid
+    scene, never another exception (no traceback for bad input)."""
+    import tomllib
+    text = GOOD + LATER
+    raw = tomllib.loads(text)
+    outcomes = {"error": 0, "ok": 0}
+    for path in _paths(raw):
+        for value in (-1.5, "1 m", {"a": 1}, [{"b": 1}]):
+            try:
+                loads(text, tmp_path, overrides={path: value})
+                outcomes["ok"] += 1
+            except SceneError as exc:
+                assert exc.problems and all(isinstance(p, str) and p for p in exc.problems)
+                outcomes["error"] += 1
+    assert outcomes["error"] > 10 * outcomes["ok"] > 0
