@@ -199,7 +199,7 @@ def test_strain_energy_shares_sum_to_modal_stiffness(tmp_path):
                     target[i, j] += k if i == j else -k
     np.testing.assert_allclose(Ka + Kb, K)
     r = st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=0.3 * chain_frequencies(n).max())
-    sh = st.strain_energy_shares(r, {"left": petsc_mat(Ka), "right": petsc_mat(Kb)})
+    sh = st.strain_energy_shares(r, st.MatrixEnergy({"left": petsc_mat(Ka), "right": petsc_mat(Kb)}))
     np.testing.assert_allclose(sh.energy.sum(axis=1), 0.5 * r.theta.real, rtol=1e-9)
     np.testing.assert_allclose(sh.share.sum(axis=1), 1.0, rtol=1e-12)
     np.testing.assert_allclose(sh.split("left", "right"), sh.share[:, 0], rtol=1e-12)

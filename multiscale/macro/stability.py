@@ -36,10 +36,14 @@ try:  # the PyPI DOLFINx wheel must be imported before petsc4py/slepc4py
     import dolfinx_solver  # noqa: F401
 except ImportError:
     pass
+import ufl
+from dolfinx import fem, la
+from dolfinx.fem import petsc as fpetsc
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
 from ..errors import ConvergenceError, InputError, check_positive
+from .mechanics import Mechanics, body_fields
 
 TWO_PI = 2.0 * math.pi
 
@@ -226,47 +230,47 @@ def _mpi_comm(A):
 
 
 def _apply(A, phi: np.ndarray) -> np.ndarray:
-    """A @ phi for a PETSc matrix and complex columns of owned entries."""
+    """A @ phi for a real PETSc matrix and complex columns of owned entries."""
     x, y = A.createVecs()
     out = np.empty_like(phi)
     for j in range(phi.shape[1]):
-        for part, unit in ((phi[:, j].real, 1.0), (phi[:, j].imag, 1j)):
-            x.setArray(part)
+        parts = []
+        for part in (phi[:, j].real, phi[:, j].imag):
+            x.setArray(np.ascontiguousarray(part))
             A.mult(x, y)
-            if unit == 1.0:
-                out[:, j] = y.getArray()
-            else:
-                out[:, j] += 1j * y.getArray()
+            parts.append(y.getArray().copy())
+        out[:, j] = parts[0] + 1j * parts[1]
     x.destroy(), y.destroy()
     return out
 
 
-def _sort_and_filter(lam, theta, vecs, errs, f_min, f_max, band_label):
-    f = lam.imag / TWO_PI
-    keep = (f >= f_min) & (f <= f_max)
-    if not keep.any():
-        raise InputError(band_label, (f_min, f_max),
-                         "no eigenvalue in this frequency band [Hz]; widen it (nearest found: "
-                         + (f"{f[np.argmin(np.minimum(abs(f - f_min), abs(f - f_max)))]:.6g} Hz)"
-                            if f.size else "none)"))
-    order = np.lexsort((lam.real[keep], f[keep]))
-    return lam[keep][order], theta[keep][order], vecs[:, keep][:, order], errs[keep][order]
+def _sorted(lam, theta, vecs, errs, band, seen_f):
+    """Modes sorted by frequency then growth; none (an empty band) is an InputError.
+
+    ``seen_f`` are the frequencies [Hz] of every converged eigenvalue (for the message).
+    """
+    if lam.size == 0:
+        hint = (f"nearest found: {seen_f[np.argmin(np.minimum(abs(seen_f - band[0]), abs(seen_f - band[1])))]:.6g} Hz"
+                if seen_f.size else "none found")
+        raise InputError("f_max", band, f"no eigenvalue in this frequency band [Hz]; widen it ({hint})")
+    order = np.lexsort((lam.real, lam.imag))
+    return lam[order], theta[order], vecs[:, order], errs[order]
 
 
 def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int | None = None,
                 target: float | None = None, damping: Damping | None = None, tol: float = 1e-10,
                 max_it: int = 300, nev: int = 20, options_prefix: str = "stability_") -> ModalResult:
-    """All modes with f_min <= f <= f_max [Hz] of K phi = theta M phi (GNHEP, shift-and-invert).
+    """Modes with f_min <= f <= f_max [Hz] of K phi = theta M phi (GNHEP, shift-and-invert, §4.3.1).
 
     ``K`` (tangent, may be non-symmetric) and ``M`` (mass, diag 0 on Dirichlet rows so that the
     constrained modes go to infinity) are assembled PETSc matrices. The shift is
     theta_t = (2 pi target)^2 (default target = f_min); K - theta_t M must be non-singular, so a
     free-free structure needs target > 0. Eigenvalues converge in order of |theta - theta_t|; the
-    subspace grows until every theta with |theta - theta_t| <= max((2 pi f_max)^2 - theta_t,
-    theta_t - (2 pi f_min)^2) is converged, i.e. the band is complete for modes with
-    |sigma| << omega. With ``n_modes`` the ``n_modes`` eigenvalues nearest the target are computed
-    instead (still filtered to the band). Raises InputError for a bad request or an empty band,
-    ConvergenceError if SLEPc does not converge.
+    subspace grows (from ``nev``) until every theta with |theta - theta_t| <= max((2 pi f_max)^2 -
+    theta_t, theta_t - (2 pi f_min)^2) is converged, i.e. the band is complete for modes with
+    |sigma| << omega, or until ``n_modes`` band modes nearest the target are found (a cap; the
+    conjugate partner of the last one is kept with it). Raises InputError for a bad request or an
+    empty band, ConvergenceError if SLEPc does not converge.
     """
     f_min, f_max, target = _check_band(f_min, f_max, target, n_modes)
     t0 = time.perf_counter()
@@ -276,7 +280,7 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
     radius = max((TWO_PI * f_max) ** 2 - shift, shift - (TWO_PI * f_min) ** 2)
     if n_modes is not None and n_modes > n:
         raise InputError("n_modes", n_modes, f"must not exceed the number of dofs ({n})")
-    want = int(n_modes) if n_modes is not None else min(int(nev), n)
+    want = min(max(int(nev), int(n_modes or 0)), n)
 
     eps = SLEPc.EPS().create(K.getComm())
     eps.setOperators(K, M)
@@ -288,7 +292,6 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
     _direct_solver(eps.getST())
     eps.setOptionsPrefix(options_prefix)
     eps.setFromOptions()
-    vr, vi = K.createVecs()
     solves = 0
     while True:
         eps.setDimensions(want, PETSc.DECIDE)
@@ -300,29 +303,44 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
                              f"{exc}") from None
         solves += 1
         nconv = eps.getConverged()
-        if nconv < min(want, n):
+        if nconv < want:
             raise ConvergenceError(f"SLEPc converged {nconv} of {want} eigenpairs "
                                    f"(reason {eps.getConvergedReason()})",
                                    history=[eps.getIterationNumber()])
         theta = np.array([eps.getEigenvalue(i) for i in range(nconv)], dtype=complex)
-        reached = np.sort(np.abs(theta - shift))[min(want, nconv) - 1]
-        if n_modes is not None or reached > radius or want >= n:
+        order = np.argsort(np.abs(theta - shift), kind="stable")[:want]   # complete up to 'reached'
+        reached = abs(theta[order[-1]] - shift)
+        f = lambda_from_theta(theta[order]).imag / TWO_PI
+        inband = order[(f >= f_min) & (f <= f_max)]
+        if n_modes is not None and inband.size >= n_modes:
+            keep = inband[:n_modes]
+            partner = inband[n_modes:n_modes + 1]
+            if partner.size and np.isclose(theta[partner[0]], theta[keep[-1]].conjugate(), rtol=1e-10):
+                keep = inband[:n_modes + 1]
+            break
+        if reached > radius or want >= n:
+            keep = inband
             break
         # Weyl: the count of theta below R grows like R^(3/2) in 3D; aim 20 % beyond the band.
         grow = (1.2 * radius / max(reached, 1e-300)) ** 1.5
+        if n_modes is not None and inband.size:
+            grow = min(grow, 1.2 * n_modes / inband.size)
         want = min(n, max(want + 10, int(math.ceil(want * min(grow, 8.0)))))
 
-    vecs = np.empty((vr.getLocalSize(), nconv), dtype=complex)
-    errs = np.empty(nconv)
-    for i in range(nconv):
-        theta[i], vecs[:, i] = _pairs(eps, i, vr, vi)
-        errs[i] = eps.computeError(i, SLEPc.EPS.ErrorType.RELATIVE)
+    vr, vi = K.createVecs()
+    vecs = np.empty((vr.getLocalSize(), keep.size), dtype=complex)
+    errs = np.empty(keep.size)
+    vals = np.empty(keep.size, dtype=complex)
+    for j, i in enumerate(keep):
+        vals[j], vecs[:, j] = _pairs(eps, int(i), vr, vi)
+        errs[j] = eps.computeError(int(i), SLEPc.EPS.ErrorType.RELATIVE)
     iterations = eps.getIterationNumber()
     eps.destroy(), vr.destroy(), vi.destroy()
 
-    lam = lambda_from_theta(theta, damping)
-    lam, theta, vecs, errs = _sort_and_filter(lam, theta, vecs, errs, f_min, f_max, "f_max")
-    return ModalResult(lam, theta, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
+    lam = lambda_from_theta(vals, damping)
+    lam, vals, vecs, errs = _sorted(lam, vals, vecs, errs, (f_min, f_max),
+                                    lambda_from_theta(theta).imag / TWO_PI)
+    return ModalResult(lam, vals, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
                        "gnhep", iterations, solves, time.perf_counter() - t0, comm)
 
 
@@ -364,7 +382,7 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     lam, vecs, errs = [], [], []
     for i in range(nconv):
         val, v = _pairs(pep, i, vr, vi)
-        if val.imag < 0 or (val.imag == 0 and any(abs(val - l) == 0 for l in lam)):
+        if val.imag < 0:
             continue  # the conjugate partner of a kept mode
         lam.append(val)
         vecs.append(v)
@@ -373,8 +391,11 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     pep.destroy(), vr.destroy(), vi.destroy()
     lam = np.array(lam, dtype=complex)
     vecs = np.column_stack(vecs) if vecs else np.empty((K.getLocalSize()[0], 0), complex)
-    lam, theta, vecs, errs = _sort_and_filter(lam, -lam**2, vecs, np.array(errs), f_min, f_max,
-                                              "f_max")
+    errs = np.array(errs)
+    seen = lam.imag / TWO_PI
+    inband = (seen >= f_min) & (seen <= f_max)
+    lam, theta, vecs, errs = _sorted(lam[inband], -lam[inband] ** 2, vecs[:, inband], errs[inband],
+                                     (f_min, f_max), seen)
     return ModalResult(lam, theta, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
                        "pep", iterations, 1, time.perf_counter() - t0, comm)
 
@@ -479,22 +500,35 @@ def cumulative_moving_average(x) -> np.ndarray:
     return np.cumsum(x) / np.arange(1, x.size + 1)
 
 
-def strain_energy_shares(result: ModalResult, stiffness: Mapping[str, object]) -> EnergyShares:
-    """Per-mode strain energy 1/2 phi^H K_c phi of each component (Figs. 4.20–4.21).
+def strain_energy_shares(result: ModalResult, meter) -> EnergyShares:
+    """Per-mode strain energy of each component (thesis Figs. 4.20–4.21).
 
-    ``stiffness`` maps component names to symmetric elastic stiffness matrices assembled over that
-    component only (same layout as the modes).
+    ``meter`` has ``names`` and ``meter(x) -> (n_components,)`` global energies 1/2 x^T K_c x of a
+    real vector of owned dofs (``MatrixEnergy`` from matrices, ``RegionEnergy`` from a DOLFINx model).
+    For a complex mode phi = a + i b and symmetric K_c, 1/2 phi^H K_c phi = E_c(a) + E_c(b).
     """
-    if not stiffness:
-        raise InputError("stiffness", stiffness, "at least one component matrix")
-    names = list(stiffness)
-    energy = np.empty((len(result), len(names)))
-    for c, name in enumerate(names):
-        kphi = _apply(stiffness[name], result.modes)
-        energy[:, c] = 0.5 * np.einsum("ij,ij->j", result.modes.conj(), kphi).real
-    energy = _allreduce(energy, result.comm)
+    names = list(meter.names)
+    energy = np.array([meter(np.ascontiguousarray(phi.real)) + meter(np.ascontiguousarray(phi.imag))
+                       for phi in result.modes.T]).reshape(len(result), len(names))
     tot = energy.sum(axis=1, keepdims=True)
     return EnergyShares(names, energy, energy / np.where(tot > 0, tot, 1.0))
+
+
+class MatrixEnergy:
+    """Energy meter from assembled symmetric component stiffness matrices {name: K_c}."""
+
+    def __init__(self, stiffness: Mapping[str, object]):
+        if not stiffness:
+            raise InputError("stiffness", stiffness, "at least one component matrix")
+        self.names = list(stiffness)
+        self._mats = [stiffness[n] for n in self.names]
+        self._comm = _mpi_comm(self._mats[0])
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        out = np.empty(len(self._mats))
+        for c, K in enumerate(self._mats):
+            out[c] = 0.5 * x @ _apply(K, x[:, None].astype(complex))[:, 0].real
+        return _allreduce(out, self._comm)
 
 
 def write_modes_xdmf(path: str | Path, result: ModalResult, functions: Sequence,
@@ -530,3 +564,130 @@ def write_modes_xdmf(path: str | Path, result: ModalResult, functions: Sequence,
                     w.write_function(f, float(j))
         files.append(out)
     return files
+
+
+# --------------------------------------------------------------------------------------------
+# Linearisation of a DOLFINx two-body model at its steady sliding state (§4.3.1)
+# --------------------------------------------------------------------------------------------
+class HydraulicMechanics(Mechanics):
+    """``Mechanics`` loaded by a fluid pressure p = ``load`` [Pa]: traction −p n on each load face.
+
+    n is the outward normal, so two faces that look at each other across the fluid (the brake's
+    piston back and caliper bore, §4.3.1) are pushed apart by the same pressure.
+    """
+
+    def __init__(self, tm, materials, **kwargs):
+        kwargs["load_kind"] = "pressure"
+        super().__init__(tm, materials, **kwargs)
+
+    def traction(self):
+        return -self.load * ufl.FacetNormal(self.tm.parent)
+
+
+@dataclass
+class Preload:
+    """Quasi-static sliding state before the modal analysis (§4.3.1, first step)."""
+
+    pressure: float          # Pa, hydraulic pressure (load of the last step)
+    friction: float          # friction coefficient mu [-]
+    normal_force: dict       # N, per interface name: integral of p_n
+    friction_force: dict     # N, per interface name: resultant of mu p_n s (3-vector)
+    load_force: dict         # N, per load face: p times the face area
+    max_pressure: float      # Pa, largest per-facet mean contact pressure
+    iterations: int          # Newton iterations of the last load step
+    residuals: list          # residual norms of the last load step
+    time: float              # s, wall time
+
+
+def preload(mech: Mechanics, pressure: float, steps: int = 1, reset: bool = True) -> Preload:
+    """Ramp the load to ``pressure`` [Pa] in ``steps`` Newton solves (from rest if ``reset``)."""
+    check_positive("pressure", pressure)
+    t0 = time.perf_counter()
+    if reset:
+        for u in mech.u:
+            u.x.array[:] = 0.0
+    solved = mech.ramp(pressure, steps)
+    tm, c = mech.tm, mech.contact
+    friction_traction = c.friction * c.pressure * c.slip_direction
+    normal, tangential = {}, {}
+    for name, dS in tm.interface.dS_tag.items():
+        normal[name] = tm.assemble_scalar(c.pressure * dS)
+        tangential[name] = np.array([tm.assemble_scalar(friction_traction[i] * dS) for i in range(3)])
+    loads = {f: float(pressure) * tm.assemble_scalar(1.0 * tm.ds(tm.face(f))) for f in tm.spec.load_faces}
+    return Preload(float(pressure), float(c.friction.value), normal, tangential, loads,
+                   solved.max_pressure, solved.iterations, list(solved.residuals),
+                   time.perf_counter() - t0)
+
+
+def linearise(mech: Mechanics, materials: Mapping[str, object]):
+    """(K, M) at the current state: K the consistent tangent (``ufl.derivative`` of the residual,
+    non-symmetric with friction; it is the Newton matrix, overwritten by the next solve), M the
+    block-diagonal mass with density ``rho`` of each material and diag 0 on Dirichlet rows."""
+    rho = body_fields(mech.tm, materials, "rho")
+    form = fem.form(mech.mass_forms(rho), entity_maps=mech.tm.entity_maps)
+    M = fpetsc.assemble_matrix(form, bcs=mech.bcs, diag=0.0)
+    M.assemble()
+    return mech.tangent(), M
+
+
+class RegionEnergy:
+    """Energy meter per material region of a DOLFINx model: 1/2 int sigma(x):eps(x) over each region."""
+
+    def __init__(self, mech: Mechanics):
+        self.mech = mech
+        self.names, self._forms, self._work, self._sizes = [], [], [], []
+        self._regions = []
+        for i, body in enumerate(mech.tm.bodies):
+            w = fem.Function(mech.spaces[i])
+            sigma = ufl.replace(mech.stress(i), {mech.u[i]: w})
+            Q = body.region_space
+            q = ufl.TestFunction(Q)
+            self._forms.append((fem.form(0.5 * ufl.inner(sigma, ufl.sym(ufl.grad(w))) * q * mech.dx(i),
+                                         entity_maps=mech.tm.entity_maps), Q))
+            self._work.append(w)
+            dm = mech.spaces[i].dofmap
+            self._sizes.append(dm.bs * dm.index_map.size_local)
+            n_owned = body.mesh.topology.index_map(body.mesh.topology.dim).size_local
+            cell_dofs = Q.dofmap.list[:n_owned, 0]
+            for r in body.spec.regions:
+                self.names.append(r.name)
+                self._regions.append((i, cell_dofs[body.region_tags[:n_owned] == r.tag]))
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        per_cell, start = [], 0
+        for (form, Q), w, n in zip(self._forms, self._work, self._sizes):
+            w.x.array[:n] = x[start:start + n]
+            w.x.scatter_forward()
+            start += n
+            vec = fem.assemble_vector(form)
+            vec.scatter_reverse(la.InsertMode.add)
+            per_cell.append(vec.array)
+        local = np.array([per_cell[i][dofs].sum() for i, dofs in self._regions])
+        return self.mech.tm.comm.allreduce(local)
+
+
+@dataclass
+class SquealCase:
+    """One case of the squeal study: preload, complex modes and their post-processing (§4.4)."""
+
+    name: str
+    preload: Preload
+    modes: ModalResult
+    report: StabilityReport
+    energy: EnergyShares | None
+    facet_pressure: np.ndarray      # Pa, per interface facet (global order of tm.interface)
+
+
+def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "case", *,
+                pressure: float = 1e6, steps: int = 1, band=(0.0, 16e3), n_modes: int | None = None,
+                target: float | None = None, damping: Damping | None = None, energy: bool = True,
+                rtol: float = 1e-6, close_tol: float = 1e-3) -> SquealCase:
+    """Preload, linearise and extract the complex modes of ``mech`` (§4.3.1, two steps)."""
+    pre = preload(mech, pressure, steps)
+    K, M = linearise(mech, materials)
+    modes = solve_modes(K, M, f_min=band[0], f_max=band[1], n_modes=n_modes, target=target,
+                        damping=damping)
+    M.destroy()
+    shares = strain_energy_shares(modes, RegionEnergy(mech)) if energy else None
+    return SquealCase(name, pre, modes, stability_report(modes, rtol, close_tol), shares,
+                      mech.contact.facet_pressure())

@@ -1,0 +1,203 @@
+"""Disc-brake assembly (thesis §4.3.1): geometry, free-free disc modes, preload and complex modes."""
+from types import SimpleNamespace as NS
+
+import numpy as np
+import pytest
+
+pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+
+import gmsh  # noqa: E402
+import ufl  # noqa: E402
+from dolfinx import fem, io  # noqa: E402
+from dolfinx.fem import petsc as fpetsc  # noqa: E402
+from mpi4py import MPI  # noqa: E402
+from scipy import special, optimize  # noqa: E402
+
+from meshes import disc_brake  # noqa: E402
+from multiscale.errors import InputError  # noqa: E402
+from multiscale.macro import mesh as two_body  # noqa: E402
+from multiscale.macro import stability as st  # noqa: E402
+
+STEEL = NS(E=210e9, nu=0.3, rho=7850.0)
+MATERIALS = {"disc": NS(E=125e9, nu=0.25, rho=7200.0), "pad": NS(E=5e9, nu=0.25, rho=2500.0),
+             "backplate": STEEL, "piston": STEEL, "caliper": STEEL}
+PRESSURE = 1e6            # Pa (10 bar)
+COARSE = {"mesh_size": 0.02}
+
+
+# ---------------------------------------------------------------- geometry
+def test_parameters_are_checked_and_named():
+    with pytest.raises(InputError, match="geometry.piston_radius"):
+        disc_brake.parameters({"piston_radius": 0.05})
+    with pytest.raises(InputError, match="geometry.pad_outer_radius"):
+        disc_brake.parameters({"pad_outer_radius": 0.2})
+    with pytest.raises(InputError, match="geometry.colour"):
+        disc_brake.parameters({"colour": 1.0})
+    spec = disc_brake.describe()
+    assert spec.materials == ("pad", "backplate", "piston", "caliper", "disc")
+    assert set(spec.interfaces) == {"inner_pad", "outer_pad"}
+    assert disc_brake.clamp_force(PRESSURE) == pytest.approx(PRESSURE * np.pi * 0.023**2)
+
+
+def _groups(params):
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        gmsh.model.add("brake")
+        disc_brake.generate(gmsh.model, params)
+        return {gmsh.model.getPhysicalName(d, t): len(gmsh.model.getEntitiesForPhysicalGroup(d, t))
+                for d, t in gmsh.model.getPhysicalGroups()}
+    finally:
+        gmsh.finalize()
+
+
+def test_ventilated_assembly_has_every_tagged_group():
+    groups = _groups({"mesh_size": 0.03, "vanes": 24})
+    assert set(groups) == set(disc_brake.CELL) | set(disc_brake.FACET)
+    assert groups["abutment_inner"] == 2 and groups["guide_pins"] == 2 and groups["inner_pad"] == 1
+
+
+# ---------------------------------------------------------------- free-free disc vs plate theory
+def kirchhoff_annulus(n, beta, nu):
+    """Lowest lambda^2 = omega a^2 sqrt(rho h / D) of a free annular Kirchhoff plate, n nodal diameters.
+
+    w = [A J_n + B Y_n + C I_n + D K_n](k r) cos(n theta); M_r = 0 and V_r = 0 at r = a and r = b.
+    """
+    def rows(lam, rho):
+        x, out = lam * rho, []
+        for f, s in ((special.jvp, -1), (special.yvp, -1), (special.ivp, 1), (special.kvp, 1)):
+            w0, w1, w2 = f(n, x, 0), lam * f(n, x, 1), lam**2 * f(n, x, 2)
+            out.append((w2 + nu * (w1 / rho - n * n * w0 / rho**2),
+                        s * lam**2 * w1 - (1 - nu) * n * n * (w1 / rho**2 - w0 / rho**3)))
+        return np.array(out).T
+
+    def det(lam):
+        A = np.vstack([rows(lam, 1.0), rows(lam, beta)])
+        return np.linalg.det(A / np.linalg.norm(A, axis=0))
+
+    grid = np.linspace(0.5, 8.0, 1500)
+    d = np.array([det(g) for g in grid])
+    i = np.nonzero(np.sign(d[:-1]) != np.sign(d[1:]))[0][0]
+    return optimize.brentq(det, grid[i], grid[i + 1]) ** 2
+
+
+def test_plate_reference_reproduces_leissa_for_a_full_plate():
+    assert kirchhoff_annulus(2, 1e-4, 0.33) == pytest.approx(5.253, rel=3e-3)   # Leissa, free disc
+
+
+def free_disc_frequencies(h, thickness):
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        gmsh.model.add("disc")
+        disc_brake.generate_disc(gmsh.model, {"mesh_size": h, "disc_thickness": thickness}, hat=False)
+        msh = io.gmsh.model_to_mesh(gmsh.model, MPI.COMM_SELF, 0, gdim=3).mesh
+    finally:
+        gmsh.finalize()
+    m = MATERIALS["disc"]
+    V = fem.functionspace(msh, ("Lagrange", 2, (3,)))
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    lam, mu = m.E * m.nu / ((1 + m.nu) * (1 - 2 * m.nu)), m.E / (2 * (1 + m.nu))
+    eps = ufl.sym(ufl.grad(u))
+    K = fpetsc.assemble_matrix(fem.form((lam * ufl.tr(eps) * ufl.div(v)
+                                         + 2 * mu * ufl.inner(eps, ufl.sym(ufl.grad(v)))) * ufl.dx))
+    M = fpetsc.assemble_matrix(fem.form(m.rho * ufl.inner(u, v) * ufl.dx))
+    K.assemble(), M.assemble()
+    # free-free: 6 rigid modes at 0 Hz; a small positive target keeps K - theta_t M regular
+    return st.solve_modes(K, M, f_min=20.0, f_max=2000.0, target=20.0, n_modes=5).frequency
+
+
+def test_free_free_disc_bending_converges_to_plate_theory():
+    t, p = 0.008, disc_brake.parameters()
+    a, b = p["disc_outer_radius"], p["ring_inner_radius"]
+    m = MATERIALS["disc"]
+    D = m.E * t**3 / (12 * (1 - m.nu**2))
+    scale = np.sqrt(D / (m.rho * t)) / (2 * np.pi * a * a)
+    f2, f3 = (kirchhoff_annulus(n, b / a, m.nu) * scale for n in (2, 3))
+    runs = [free_disc_frequencies(h, t) for h in (0.032, 0.02, 0.012)]
+    doublet = np.array([r[:2].mean() for r in runs])          # two nodal diameters
+    assert all(abs(r[1] / r[0] - 1) < 2e-3 for r in runs)      # split only by the mesh
+    steps = np.abs(np.diff(doublet))
+    assert doublet[0] > doublet[1] > doublet[2] and steps[1] < steps[0]   # monotone, converging
+    # thick-plate effects (shear, rotary inertia) lower the 3D values by ~1 % (h/a = 0.06)
+    assert -0.025 < doublet[-1] / f2 - 1 < 0.0
+    assert -0.03 < runs[-1][2:4].mean() / f3 - 1 < 0.0            # three nodal diameters
+
+
+# ---------------------------------------------------------------- preload and complex modes
+@pytest.fixture(scope="module")
+def brake():
+    tm = two_body.build("disc_brake", COARSE)
+    mech = st.HydraulicMechanics(tm, MATERIALS, stiffness=1e13, friction=0.0, speed=5.0,
+                                 prefix="brake_test_")
+    return tm, mech
+
+
+@pytest.fixture(scope="module")
+def no_friction(brake):
+    return st.squeal_case(brake[1], MATERIALS, "mu0", pressure=PRESSURE, n_modes=30)
+
+
+@pytest.fixture(scope="module")
+def friction(brake, no_friction):
+    brake[1].contact.friction.value = 0.4
+    try:
+        return st.squeal_case(brake[1], MATERIALS, "mu0.4", pressure=PRESSURE, n_modes=30)
+    finally:
+        brake[1].contact.friction.value = 0.0
+
+
+@pytest.mark.parametrize("case", ["no_friction", "friction"])
+def test_pad_forces_balance_the_hydraulic_pressure(case, request):
+    pre = request.getfixturevalue(case).preload
+    assert pre.normal_force["inner_pad"] == pytest.approx(pre.load_force["piston_back"], rel=1e-6)
+    assert pre.normal_force["outer_pad"] == pytest.approx(pre.load_force["caliper_bore"], rel=1e-6)
+    assert pre.load_force["piston_back"] == pytest.approx(disc_brake.clamp_force(PRESSURE), rel=0.02)
+    # Coulomb: the friction traction is mu p_n along a unit direction, so its resultant <= mu N
+    for name, force in pre.friction_force.items():
+        assert np.linalg.norm(force) <= pre.friction * pre.normal_force[name] * (1 + 1e-12)
+        assert abs(force[2]) < 1e-9 * pre.normal_force[name]        # tangential to the pad face
+    if pre.friction:
+        assert np.linalg.norm(pre.friction_force["inner_pad"]) > 0.9 * pre.friction * pre.normal_force["inner_pad"]
+
+
+def test_without_friction_every_eigenvalue_is_real(no_friction):
+    modes = no_friction.modes
+    assert len(modes) == 30 and no_friction.report.unstable.size == 0
+    assert np.abs(modes.theta.imag).max() <= 1e-8 * np.abs(modes.theta).max()
+    assert modes.errors.max() < 1e-8
+
+
+def test_friction_locks_in_a_pair_of_modes(no_friction, friction):
+    modes, unstable = friction.modes, friction.report.unstable
+    assert unstable.size >= 1
+    for j in unstable - 1:          # the partner of an unstable mode: same frequency, sigma < 0
+        partner = np.argmin(np.abs(modes.eigenvalues + np.conj(modes.eigenvalues[j])))
+        assert modes.frequency[partner] == pytest.approx(modes.frequency[j], rel=1e-8)
+        assert modes.growth[partner] == pytest.approx(-modes.growth[j], rel=1e-6)
+    # below the lock-in the two modes were distinct, neighbouring real modes
+    f = friction.modes.frequency[unstable[0] - 1]
+    near = np.sort(np.abs(no_friction.modes.frequency - f))[:2]
+    assert near.max() < 0.1 * f
+
+
+def test_strain_energy_per_region_matches_an_assembled_disc_stiffness(brake, no_friction):
+    tm, mech = brake
+    shares = no_friction.energy
+    assert shares.names == ["pad_inner", "pad_outer", "backplate_inner", "backplate_outer", "piston",
+                            "caliper", "disc"]
+    np.testing.assert_allclose(shares.share.sum(axis=1), 1.0, rtol=1e-12)
+    assert 0.0 <= shares.split("pad_inner", "pad_outer").min() <= shares.split("pad_inner", "pad_outer").max() <= 1
+    du, v = ufl.TrialFunction(mech.spaces[1]), ufl.TestFunction(mech.spaces[1])
+    a = ufl.derivative(ufl.inner(mech.stress(1), ufl.sym(ufl.grad(v))) * mech.dx(1), mech.u[1], du)
+    K1 = fpetsc.assemble_matrix(fem.form(a, entity_maps=tm.entity_maps))
+    K1.assemble()
+    n0 = mech.spaces[0].dofmap.index_map.size_local * 3
+    modes = no_friction.modes.modes
+    disc_energy = [0.5 * np.vdot(x, st._apply(K1, x[:, None])[:, 0]).real for x in modes[n0:].T]
+    np.testing.assert_allclose(shares.energy[:, -1], disc_energy, rtol=1e-9)
+
+
+def test_mode_shapes_are_written_to_xdmf(tmp_path, brake, friction):
+    files = st.write_modes_xdmf(tmp_path / "modes.xdmf", friction.modes, brake[1].u, modes=[1, 2])
+    assert len(files) == 2 and all(f.exists() and f.with_suffix(".h5").exists() for f in files)
