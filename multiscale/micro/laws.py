@@ -1,0 +1,566 @@
+"""Homogenized interface laws of the zones of a macro contact interface (thesis §1.4.2, Eqs.
+1.29–1.31; §4.2.1; §7.2).
+
+For each zone (``multiscale.micro.zones.Zone``: a rectangle 2a × 2b or a triangle with its own
+roughness patch) the FFT-BEM contact solver gives the micro mean pressure p_n(δ) at rigid approaches
+δ (displacement control, an isolated non-periodic patch as in the thesis). The macro model sees a
+flat interface: loading the zone by the uniform pressure p_n moves its surface by
+U = L p_n/(π E*) (Love, Eq. 1.29–1.30; Boussinesq on a triangle), so the law is tabulated against
+the *macro gap* left once that elastic part is taken out (Eq. 1.31):
+
+    g_n = (z_top − δ) + L p_n / (π E*)            [m]
+
+where z_top − δ is the height of the rigid flat above the zones' common datum (see zones.py).
+Sign: g_n > 0 is an open macro gap; the zone first touches at g_n = z_top ('g_open') and the
+pressure grows as g_n decreases; the thesis's gap of Eq. 1.31 (an interpenetration) is
+z_top − g_n. Stiffness K_n = −dp_n/dg_n ≥ 0.
+
+Where L is evaluated (``LawSpec.love``): 'average' (default) uses the mean of Love's integral over
+the footprint, i.e. the mean displacement of the uniformly loaded zone: the displacement that is
+work-conjugate to a uniform pressure, hence what a facet law integrated over the facet (a
+Galerkin/penalty form) sees; 'centre' uses its value at the centroid (a collocation macro model);
+'none' drops the correction (for comparison only: the macro model then counts the zone's own
+elastic compliance twice). Either way, a flat macro zone loaded by its law with the same L carries
+exactly the micro force at every node (tests/test_laws.py).
+
+The law p_n(g_n) is C¹ and monotone (``PressureGapLaw``), in log-log variables: with the
+interpenetration d = g_open − g_n, Fritsch–Butland (PCHIP) Hermite cubics of ln p_n in ln d
+between the nodes. A rough contact starts as a power law p ∝ d^m (m = 3/2 for one Hertzian
+asperity, larger as asperities join: a straight line in these variables, exact from the first
+node down to first touch, where K = 0) and ends close to exponential in d (Persson), smooth in
+ln d; PCHIP keeps ln p, hence p, monotone without overshoot and the table spans decades of
+pressure at uniform relative accuracy. Beyond the last node, p_n is linear in g_n with the last
+stiffness (finite, positive, never overflows). Extra laws (real contact area, thermal conductance, heat partition…)
+are tabulated at the same nodes against p_n (``PressureTable``).
+"""
+from __future__ import annotations
+
+import time
+from abc import ABC, abstractmethod
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.micro.contact import ContactResult, ContactSolver
+from multiscale.micro.kernels import Kernel
+from multiscale.micro.zones import Zone
+
+
+# --------------------------------------------------------------------------- specification
+class ExtraLaw(ABC):
+    """A law tabulated at the mechanical nodes against the zone pressure p_n.
+
+    ``values(result, zones)`` receives the contact solution of a batch of zone patches at one
+    node (``ContactResult`` with batch shape (B,)) and returns one value per zone, (B,), or one
+    per point of ``axis`` (e.g. sliding speeds), (B, len(axis)). ``below``: the value below the
+    first node: 'zero' (linear in p_n down to 0 at p_n = 0) or 'hold' (the first node's).
+    Subclasses must be deterministic and define ``key()`` (their parameters, for the caches).
+    """
+
+    name: str = ""
+    below: str = "hold"
+    axis: np.ndarray | None = None
+
+    @abstractmethod
+    def key(self) -> tuple:
+        """Hashable identity of the law and its parameters."""
+
+    @abstractmethod
+    def values(self, result: ContactResult, zones: list[Zone]) -> np.ndarray:
+        """Per-zone values at one node (see the class docstring)."""
+
+
+@dataclass(frozen=True)
+class LawSpec:
+    """What to compute for every zone.
+
+    kernel: the micro solids (e.g. ``HalfSpace``); E_star [Pa]: composite modulus of the macro
+    half-space in Love's correction (default: ``kernel.E_star``); p_max [Pa]: highest tabulated
+    zone pressure (the top node, by a load-controlled solve); n_points: nodes per law (the others
+    at approaches δ_max (k/n)², k = 1 … n−1, which spreads them evenly in ln p from Hertz-like
+    first contacts up to p_max); love: 'average' | 'centre' | 'none'; tol, max_iter: contact
+    solver (relative gap residual); extras: ``ExtraLaw`` objects; batch_cells: cells per batched
+    solve (several equal zones are solved together up to this size).
+    """
+
+    kernel: Kernel
+    p_max: float
+    n_points: int = 20
+    love: str = "average"
+    tol: float = 1e-8
+    max_iter: int = 2000
+    E_star: float | None = None
+    extras: tuple = ()
+    batch_cells: int = 20000
+
+    def __post_init__(self):
+        check_positive("p_max", self.p_max)
+        check_positive("tol", self.tol)
+        if int(self.n_points) != self.n_points or self.n_points < 4:
+            raise InputError("n_points", self.n_points, "an integer >= 4")
+        if self.love not in ("average", "centre", "none"):
+            raise InputError("love", self.love, "one of 'average', 'centre', 'none'")
+        if self.E_star is None:
+            if not hasattr(self.kernel, "E_star"):
+                raise InputError("E_star", None, "give the macro composite modulus for this kernel")
+            object.__setattr__(self, "E_star", float(self.kernel.E_star))
+        check_positive("E_star", self.E_star)
+        extras = tuple(self.extras)
+        names = [getattr(e, "name", None) for e in extras]
+        if not all(isinstance(e, ExtraLaw) and e.name for e in extras) or len(set(names)) != len(names):
+            raise InputError("extras", names, "ExtraLaw objects with distinct, non-empty names")
+        object.__setattr__(self, "extras", extras)
+
+    def key(self) -> tuple:
+        """Everything a zone's law depends on besides its topography (for caches)."""
+        return (self.kernel.key(), self.E_star, self.p_max, self.n_points, self.love, self.tol,
+                self.max_iter, tuple(e.key() for e in self.extras))
+
+    def approach_fractions(self) -> np.ndarray:
+        """δ_k / δ_max of the nodes, k = 1 … n."""
+        k = np.arange(1, self.n_points + 1)
+        return (k / self.n_points) ** 2
+
+
+# --------------------------------------------------------------------------- micro solves
+@dataclass
+class ZoneNodes:
+    """The micro results behind one zone's laws (what caches keep and ranks exchange)."""
+
+    zone_id: int
+    topography_hash: str
+    approach: np.ndarray       # m, rigid approach δ_k from the zone's first touch, (n,)
+    pressure: np.ndarray       # Pa, zone mean pressure p_k = force / zone area, (n,)
+    gap: np.ndarray            # m, macro gap g_k (Eq. 1.31, module docstring), (n,), decreasing
+    area_fraction: np.ndarray  # real contact area / zone area, (n,)
+    iterations: np.ndarray     # contact-solver iterations per node, (n,)
+    top: float                 # m, highest point of the zone above the datum (g at first touch)
+    compliance: float          # m/Pa, L/(π E*) used for the gap (0 for love='none')
+    extras: dict = field(default_factory=dict)   # name -> (n,) or (n, m) values
+    seconds: float = 0.0       # wall time of this zone's share of its batched solves
+    cells: int = 0             # grid cells of the zone's patch
+
+
+@dataclass
+class ZoneFailure:
+    """A zone whose laws could not be computed."""
+
+    zone_id: int
+    kind: str       # exception class name
+    message: str
+
+
+class LawError(ConvergenceError):
+    """Laws of some zones could not be computed; ``failures`` lists them (zone ids, reasons) and
+    ``result`` holds the ``ZoneLaws`` of the others (or None)."""
+
+    def __init__(self, failures: list[ZoneFailure], result=None):
+        self.failures = list(failures)
+        lines = [f"zone {f.zone_id}: {f.kind}: {f.message}" for f in self.failures[:10]]
+        more = len(self.failures) - len(lines)
+        text = f"laws failed for {len(self.failures)} zone(s):\n  " + "\n  ".join(lines) \
+            + (f"\n  ... and {more} more" if more > 0 else "")
+        super().__init__(text, history=None, result=result)
+
+
+_SOLVERS: dict[tuple, ContactSolver] = {}
+
+
+def _solver(kernel: Kernel, shape, dx, dy) -> ContactSolver:
+    """One solver (FFT plans) per kernel and grid, reused across calls and time steps."""
+    key = (kernel.key(), tuple(shape), float(dx), float(dy))
+    if key not in _SOLVERS:
+        if len(_SOLVERS) >= 16:
+            _SOLVERS.pop(next(iter(_SOLVERS)))
+        _SOLVERS[key] = ContactSolver(kernel, shape, dx, dy, periodic=False)
+    return _SOLVERS[key]
+
+
+def zone_nodes(zones: list[Zone], spec: LawSpec) -> tuple[list[ZoneNodes], list[ZoneFailure]]:
+    """Micro solves of the zones' nodes; equal patches are batched ``spec.batch_cells`` at a time.
+
+    Returns the nodes of the zones that succeeded and the failures (non-convergence, a gap that
+    is not monotone below p_max, any other exception), each with its zone id. Results do not
+    depend on how zones are grouped beyond FFT round-off.
+    """
+    nodes, failures = [], []
+    for group in batches([batch_signature(z) for z in zones], spec.batch_cells):
+        group = [zones[i] for i in group]
+        try:
+            n, f = _batch_nodes(group, spec)
+        except Exception as exc:  # an unexpected error fails the batch, never the caller's peers
+            n, f = [], [ZoneFailure(z.id, type(exc).__name__, str(exc)) for z in group]
+        nodes += n
+        failures += f
+    return nodes, failures
+
+
+def batch_signature(zone: Zone) -> tuple:
+    """Zones with equal signatures share a solver grid and can be solved in one batch."""
+    return (zone.shape, zone.surface.dx, zone.surface.dy, zone.triangle is None)
+
+
+def batches(signatures: list[tuple], batch_cells: int, max_zones: int | None = None) -> list[list[int]]:
+    """Indices of consecutive runs of equal signatures, each of at most ``batch_cells`` grid cells
+    and ``max_zones`` zones (at least one zone)."""
+    limit = max_zones or len(signatures)
+    out: list[list[int]] = []
+    for i, sig in enumerate(signatures):
+        cells = sig[0][0] * sig[0][1]
+        if out and signatures[out[-1][-1]] == sig and len(out[-1]) < limit \
+                and (len(out[-1]) + 1) * cells <= batch_cells:
+            out[-1].append(i)
+        else:
+            out.append([i])
+    return out
+
+
+def _batch_nodes(zones: list[Zone], spec: LawSpec) -> tuple[list[ZoneNodes], list[ZoneFailure]]:
+    """Nodes of equal-grid zones in one batch: a load-controlled solve at p_max fixes δ_max, then
+    displacement-controlled solves at δ_max (k/n)², each warm-started from the previous one."""
+    t0 = time.perf_counter()
+    s = zones[0].surface
+    solver = _solver(spec.kernel, s.shape, s.dx, s.dy)
+    box_area = s.size[0] * s.size[1]
+    masks = np.stack([z.mask for z in zones])
+    area = np.array([z.area for z in zones])
+    heights, tol = _masked_heights(zones, masks, spec)
+    n, B = spec.n_points, len(zones)
+    failures: dict[int, ZoneFailure] = {}
+    alive = np.ones(B, dtype=bool)
+    approach, pressure, fraction = (np.full((B, n), np.nan) for _ in range(3))
+    iterations = np.zeros((B, n), dtype=int)
+    extras: dict[str, np.ndarray] = {}
+
+    def run(k, idx, **control):
+        r = solver.solve(heights[idx], tol=tol[idx].min(), max_iter=spec.max_iter, partial=True, **control)
+        for j, b in enumerate(idx):
+            if not r.converged[j]:
+                failures[b] = ZoneFailure(zones[b].id, "ContactConvergenceError",
+                                          f"no convergence in {spec.max_iter} iterations at node {k + 1} "
+                                          f"(residual {r.residual[j]:.2e} > {tol[b]:.1e})")
+            elif np.any(r.pressure[j][~masks[b]] > 0):
+                failures[b] = ZoneFailure(zones[b].id, "InputError", "cells outside the triangle touched")
+        alive[list(failures)] = False
+        approach[idx, k] = r.approach
+        pressure[idx, k] = r.mean_pressure * box_area / area[idx]
+        fraction[idx, k] = r.area_fraction * box_area / area[idx]
+        iterations[idx, k] = r.iterations
+        for e in spec.extras:
+            v = np.asarray(e.values(r, [zones[b] for b in idx]), dtype=float)
+            if e.name not in extras:
+                extras[e.name] = np.full((B, n) + v.shape[1:], np.nan)
+            extras[e.name][idx, k] = v
+        return r
+
+    idx = np.arange(B)
+    last = run(n - 1, idx, load=spec.p_max * area / box_area)
+    delta_max = last.approach.copy()
+    previous = None
+    for k, frac in enumerate(spec.approach_fractions()[:-1]):
+        keep = alive[idx]
+        idx = idx[keep]
+        if not len(idx):
+            break
+        warm = None if previous is None else previous.pressure[keep]
+        previous = run(k, idx, approach=delta_max[idx] * frac, initial_pressure=warm)
+
+    seconds = (time.perf_counter() - t0) / B
+    nodes = []
+    for b, z in enumerate(zones):
+        if not alive[b]:
+            continue
+        extra = {name: values[b] for name, values in extras.items()}
+        c = 0.0 if spec.love == "none" else z.love(spec.love) / (np.pi * spec.E_star)
+        gap = z.top - approach[b] + c * pressure[b]
+        problem = _monotone_problem(gap, pressure[b])
+        if problem:
+            failures[b] = ZoneFailure(z.id, "InputError", problem + f"; lower p_max (now {spec.p_max:.3g} Pa)")
+            continue
+        nodes.append(ZoneNodes(z.id, z.topography_hash, approach[b], pressure[b], gap, fraction[b],
+                               iterations[b], z.top, c, extra, seconds, z.shape[0] * z.shape[1]))
+    return nodes, [failures[b] for b in sorted(failures)]
+
+
+def _masked_heights(zones, masks, spec):
+    """Heights of the batch with cells outside triangular zones sunk far below reach, and the
+    solver tolerance per zone rescaled so the residual stays relative to the zone's own RMS."""
+    h = np.stack([z.surface.heights for z in zones])
+    tol = np.full(len(zones), spec.tol)
+    if masks.all():
+        return h, tol
+    h = h.copy()
+    for b, z in enumerate(zones):
+        inside = h[b][masks[b]]
+        reach = (inside.max() - inside.min()) + spec.p_max * z.love("centre") / (np.pi * spec.E_star)
+        h[b][~masks[b]] = inside.min() - 4 * reach - 1e-12
+        rms_in = inside.std() or 1.0
+        tol[b] = spec.tol * rms_in / (h[b].std() or 1.0)
+    return h, tol
+
+
+def _monotone_problem(gap, pressure) -> str:
+    if not np.all(np.isfinite(gap)) or not np.all(np.isfinite(pressure)):
+        return "non-finite node values"
+    if not np.all(np.diff(pressure) > 0) or pressure[0] <= 0:
+        return "the zone pressure does not grow with the approach"
+    if not np.all(np.diff(gap) < 0):
+        k = int(np.argmax(np.diff(gap) >= 0))
+        return (f"the Love-corrected gap stops decreasing above p = {pressure[k]:.3g} Pa "
+                "(the zone is close to full contact)")
+    return ""
+
+
+# --------------------------------------------------------------------------- tables
+def _pchip_slopes(x, y):
+    """Fritsch–Butland (PCHIP) node slopes of y(x) along the last axis; x ascending.
+
+    x: (..., n), y: (..., n) or (..., n, m) (columns interpolated independently)."""
+    if y.ndim == x.ndim + 1:
+        return np.stack([_pchip_slopes(x, y[..., j]) for j in range(y.shape[-1])], axis=-1)
+    h = np.diff(x, axis=-1)
+    delta = np.diff(y, axis=-1) / h
+    d = np.zeros_like(y)
+    h0, h1, d0, d1 = h[..., :-1], h[..., 1:], delta[..., :-1], delta[..., 1:]
+    w1, w2 = 2 * h1 + h0, h1 + 2 * h0
+    same = d0 * d1 > 0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        d[..., 1:-1] = np.where(same, (w1 + w2) / (w1 / np.where(same, d0, 1) + w2 / np.where(same, d1, 1)), 0.0)
+    d[..., 0] = _edge_slope(h[..., 0], h[..., 1], delta[..., 0], delta[..., 1])
+    d[..., -1] = _edge_slope(h[..., -1], h[..., -2], delta[..., -1], delta[..., -2])
+    return d
+
+
+def _edge_slope(h0, h1, d0, d1):
+    """Shape-preserving three-point end slope (the end interval has width h0, secant d0)."""
+    d = ((2 * h0 + h1) * d0 - h0 * d1) / (h0 + h1)
+    d = np.where(np.sign(d) != np.sign(d0), 0.0, d)
+    return np.where((np.sign(d0) != np.sign(d1)) & (np.abs(d) > 3 * np.abs(d0)), 3 * d0, d)
+
+
+def _hermite(y0, y1, d0, d1, h, t):
+    """Cubic Hermite value and x-derivative on an interval of width h at t = (x − x0)/h."""
+    t2, t3 = t * t, t * t * t
+    value = y0 * (2 * t3 - 3 * t2 + 1) + h * d0 * (t3 - 2 * t2 + t) + y1 * (3 * t2 - 2 * t3) + h * d1 * (t3 - t2)
+    slope = (y0 * (6 * t2 - 6 * t) + y1 * (6 * t - 6 * t2)) / h + d0 * (3 * t2 - 4 * t + 1) + d1 * (3 * t2 - 2 * t)
+    return value, slope
+
+
+@dataclass(frozen=True)
+class LawValue:
+    """A law evaluated at many points."""
+
+    pressure: np.ndarray   # Pa, p_n >= 0
+    stiffness: np.ndarray  # Pa/m, K_n = −dp_n/dg_n >= 0
+
+
+class PressureGapLaw:
+    """A batch of C¹ monotone laws p_n(g_n), one row per zone (module docstring).
+
+    Rows are built from node gaps ``gap`` (Z, n), strictly decreasing, node pressures
+    ``pressure`` (Z, n) > 0, strictly increasing, and the first-touch gaps ``g_open`` (Z,) above
+    the first node. With the interpenetration d = g_open − g_n: PCHIP Hermite cubics of ln p in
+    ln d between nodes; below the first node the power law p_1 (d/d_1)^m that continues them
+    (m their slope there; where m < 3/2, a cubic in p with K = 0 at first touch: K always
+    vanishes at first touch, at least as fast as Hertz's √d); above the last, p linear in g with the last node's stiffness.
+    """
+
+    def __init__(self, gap, pressure, g_open):
+        g = np.atleast_2d(np.asarray(gap, dtype=float))
+        p = np.atleast_2d(np.asarray(pressure, dtype=float))
+        g_open = np.atleast_1d(np.asarray(g_open, dtype=float))
+        if g.shape != p.shape or g.shape[1] < 3 or g_open.shape != g.shape[:1]:
+            raise InputError("gap/pressure", (g.shape, p.shape), "(zones, n >= 3) tables and one g_open per zone")
+        if not (np.all(np.diff(g, axis=1) < 0) and np.all(np.diff(p, axis=1) > 0) and np.all(p > 0)
+                and np.all(g_open > g[:, 0]) and np.all(np.isfinite(g)) and np.all(np.isfinite(p))):
+            raise InputError("gap/pressure", "tables", "need g decreasing below g_open and p > 0 increasing")
+        x, y = np.log(g_open[:, None] - g), np.log(p)       # ln d ascending, ln p ascending
+        slope = _pchip_slopes(x, y)                           # d ln p / d ln d at the nodes
+        secant = np.diff(y, axis=1) / np.diff(x, axis=1)
+        slope[:, -1] = np.clip(slope[:, -1], secant[:, -1] / 3, 3 * secant[:, -1])   # K beyond > 0
+        self.gap, self.pressure, self.g_open = g, p, g_open
+        self._x, self._y, self._slope = x, y, slope
+
+    @property
+    def n_zones(self) -> int:
+        return self.gap.shape[0]
+
+    def __call__(self, gap, rows=None) -> LawValue:
+        """p_n and K_n at gaps ``gap`` [m]; ``rows`` picks each point's law (default: point i
+        uses row i, or row 0 for a single law). Vectorised; never NaN for finite gaps."""
+        g, rows, shape = _points(gap, rows, self.n_zones)
+        if not np.all(np.isfinite(g)):
+            raise InputError("gap", "array with NaN/inf", "gaps must be finite")
+        n = self.gap.shape[1]
+        d = self.g_open[rows] - g                              # interpenetration, > 0 in contact
+        x = np.log(np.where(d > 0, d, 1.0))
+        k = np.sum(self.gap[rows] > g[:, None], axis=1)       # nodes with a larger gap (lower p)
+        j = np.clip(k - 1, 0, n - 2)
+        x0, x1 = self._x[rows, j], self._x[rows, j + 1]
+        y, dy = _hermite(self._y[rows, j], self._y[rows, j + 1], self._slope[rows, j], self._slope[rows, j + 1],
+                         x1 - x0, np.clip((x - x0) / (x1 - x0), 0.0, 1.0))
+        inner = (k >= 1) & (k < n)
+        p = np.where(inner, np.exp(np.where(inner, y, 0.0)), 0.0)
+        K = p * dy / np.where(d > 0, d, 1.0)
+        # onset: power law p1 (d/d1)^m, or a cubic in p with K = 0 at first touch
+        p1, d1, m = self.pressure[rows, 0], np.exp(self._x[rows, 0]), self._slope[rows, 0]
+        u = np.clip(d / d1, 0.0, 1.0)
+        power = m >= 1.5
+        p_cubic, K_cubic = _hermite(0.0, p1, 0.0, m * p1 / d1, d1, u)
+        u_m1 = u ** np.where(power, m - 1, 1.0)
+        onset = (k == 0) & (d > 0)
+        p = np.where(onset, np.where(power, p1 * u_m1 * u, p_cubic), p)
+        K = np.where(onset, np.where(power, m * p1 * u_m1 / d1, K_cubic), K)
+        # beyond the last node: constant stiffness
+        beyond = k == n
+        pn = self.pressure[rows, -1]
+        Kn = pn * self._slope[rows, -1] / np.exp(self._x[rows, -1])
+        p = np.where(beyond, pn + Kn * (self.gap[rows, -1] - g), p)
+        K = np.where(beyond, Kn, K)
+        return LawValue(p.reshape(shape), K.reshape(shape))
+
+
+def _points(values, rows, n_rows):
+    """Flattened evaluation points and their rows (default: one point per row, or row 0)."""
+    v = np.asarray(values, dtype=float)
+    if rows is None:
+        rows = np.zeros(v.shape, dtype=int) if n_rows == 1 else np.arange(n_rows)
+    v, rows = np.broadcast_arrays(v, np.asarray(rows, dtype=int))
+    if rows.size and (rows.min() < 0 or rows.max() >= n_rows):
+        raise InputError("rows", "indices", f"must lie in [0, {n_rows})")
+    return v.ravel(), rows.ravel(), v.shape
+
+
+class PressureTable:
+    """A batch of tables y(p_n) (one row per zone), PCHIP in ln p_n between the nodes.
+
+    values (Z, n) or (Z, n, m) with ``axis`` (m,) ascending (e.g. sliding speeds: linear in
+    between, clamped). Above the last node the last value holds; below the first, 'zero' scales
+    linearly to 0 at p_n = 0, 'hold' keeps the first value.
+    """
+
+    def __init__(self, pressure, values, below: str = "hold", axis=None):
+        p = np.atleast_2d(np.asarray(pressure, dtype=float))
+        v = np.asarray(values, dtype=float)
+        if v.shape[:2] != p.shape:                              # a single zone's (n,) or (n, m)
+            v = v.reshape(p.shape + v.shape[1:])
+        if below not in ("zero", "hold"):
+            raise InputError("below", below, "one of 'zero', 'hold'")
+        if v.ndim == 3:
+            axis = np.asarray(axis, dtype=float)
+            if axis.shape != (v.shape[2],) or np.any(np.diff(axis) <= 0):
+                raise InputError("axis", axis, f"{v.shape[2]} ascending values")
+        elif axis is not None:
+            raise InputError("axis", axis, "only for (zones, n, m) values")
+        if not np.all(np.isfinite(v)) or not np.all(np.diff(p, axis=1) > 0) or np.any(p <= 0):
+            raise InputError("values", "table", "finite values at increasing pressures > 0")
+        self.pressure, self.values, self.below, self.axis = p, v, below, axis
+        self._x = np.log(p)
+        self._v = v if v.ndim == 3 else v[..., None]          # (Z, n, m)
+        self._slope = _pchip_slopes(self._x, self._v)
+
+    def __call__(self, pressure, rows=None, at=None) -> np.ndarray:
+        """Values at zone pressures ``pressure`` [Pa] (and axis points ``at``), rows as for
+        ``PressureGapLaw``."""
+        p, rows, shape = _points(pressure, rows, self.pressure.shape[0])
+        n = self._x.shape[1]
+        x = np.log(np.maximum(p, np.finfo(float).tiny))
+        j = np.clip(np.sum(self._x[rows] <= x[:, None], axis=1) - 1, 0, n - 2)
+        x0, x1 = self._x[rows, j], self._x[rows, j + 1]
+        t = np.clip((x - x0) / (x1 - x0), 0.0, 1.0)[:, None]
+        value, _ = _hermite(self._v[rows, j], self._v[rows, j + 1], self._slope[rows, j],
+                            self._slope[rows, j + 1], (x1 - x0)[:, None], t)
+        p_first, first = self.pressure[rows, 0][:, None], self._v[rows, 0]
+        below = first * np.maximum(p[:, None], 0.0) / p_first if self.below == "zero" else first
+        value = np.where(p[:, None] <= p_first, below, value)
+        if self.axis is None:
+            return value[:, 0].reshape(shape)
+        if at is None:
+            raise InputError("at", None, f"this table also depends on {len(self.axis)} axis values")
+        at = np.broadcast_to(np.asarray(at, dtype=float), shape).ravel()
+        i = np.clip(np.searchsorted(self.axis, at) - 1, 0, len(self.axis) - 2)
+        w = np.clip((at - self.axis[i]) / (self.axis[i + 1] - self.axis[i]), 0.0, 1.0)
+        r = np.arange(len(at))
+        return ((1 - w) * value[r, i] + w * value[r, i + 1]).reshape(shape)
+
+
+# --------------------------------------------------------------------------- container
+class ZoneLaws:
+    """The laws of a set of zones, evaluated per point from zone ids (e.g. one per facet).
+
+    ``pressure(gap, zone_ids)`` -> ``LawValue`` (p_n, K_n); ``area_fraction(p, zone_ids)``;
+    ``extra(name, p, zone_ids, at=None)``. ``nodes`` keeps the micro results, in ``ids`` order.
+    """
+
+    def __init__(self, nodes: list[ZoneNodes], spec: LawSpec | None = None):
+        self.nodes = list(nodes)
+        self.ids = np.array([nd.zone_id for nd in nodes], dtype=int)
+        order = np.argsort(self.ids, kind="stable")
+        if np.any(np.diff(self.ids[order]) == 0):
+            raise InputError("nodes", "zone ids", "each zone once")
+        self._sorted_ids, self._order = self.ids[order], order
+        self.mechanical = self._area = None
+        self.extras: dict[str, PressureTable] = {}
+        if not nodes:                      # e.g. a rank without interface facets
+            return
+        self.mechanical = PressureGapLaw(np.stack([nd.gap for nd in nodes]),
+                                         np.stack([nd.pressure for nd in nodes]),
+                                         np.array([nd.top for nd in nodes]))
+        pressure = self.mechanical.pressure
+        self._area = PressureTable(pressure, np.stack([nd.area_fraction for nd in nodes]), below="zero")
+        for e in (spec.extras if spec is not None else ()):
+            self.extras[e.name] = PressureTable(pressure, np.stack([nd.extras[e.name] for nd in nodes]),
+                                                below=e.below, axis=e.axis)
+
+    def __len__(self) -> int:
+        return len(self.ids)
+
+    def rows(self, zone_ids) -> np.ndarray:
+        """Row of each zone id (raises for an unknown id)."""
+        z = np.asarray(zone_ids, dtype=int)
+        if not len(self.ids):
+            if z.size:
+                raise InputError("zone_ids", np.unique(z)[:5].tolist(), "no law for these zones")
+            return z
+        i = np.clip(np.searchsorted(self._sorted_ids, z), 0, len(self._sorted_ids) - 1)
+        if np.any(self._sorted_ids[i] != z):
+            missing = np.unique(z[self._sorted_ids[i] != z])[:5]
+            raise InputError("zone_ids", missing.tolist(), "no law for these zones")
+        return self._order[i]
+
+    def _evaluate(self, table, values, zone_ids, *args):
+        rows = self.rows(zone_ids)
+        if table is None:                  # no zones: only empty requests get here
+            return np.zeros(np.broadcast(np.asarray(values), rows).shape)
+        return table(values, rows, *args)
+
+    def pressure(self, gap, zone_ids) -> LawValue:
+        """Zone pressure p_n [Pa] and stiffness K_n [Pa/m] at macro gaps ``gap`` [m]."""
+        if self.mechanical is None:
+            empty = self._evaluate(None, gap, zone_ids)
+            return LawValue(empty, empty.copy())
+        return self.mechanical(gap, self.rows(zone_ids))
+
+    def area_fraction(self, pressure, zone_ids) -> np.ndarray:
+        """Real contact area / nominal area at zone pressures ``pressure`` [Pa]."""
+        return self._evaluate(self._area, pressure, zone_ids)
+
+    def extra(self, name: str, pressure, zone_ids, at=None) -> np.ndarray:
+        """Extra law ``name`` at zone pressures [Pa] (and axis points ``at``)."""
+        if name not in self.extras and self.mechanical is not None:
+            raise InputError("name", name, f"one of {sorted(self.extras)}")
+        return self._evaluate(self.extras.get(name), pressure, zone_ids, at)
+
+
+def compute_laws(zones: list[Zone], spec: LawSpec) -> ZoneLaws:
+    """Laws of the zones in this process (see ``multiscale.pool.MicroPool`` for MPI).
+
+    Raises ``LawError`` naming every failed zone (its ``result`` holds the others' laws)."""
+    ids = [z.id for z in zones]
+    if len(set(ids)) != len(ids):
+        raise InputError("zones", "ids", "zone ids must be unique")
+    nodes, failures = zone_nodes(list(zones), spec)
+    if failures:
+        raise LawError(failures, ZoneLaws(nodes, spec) if nodes else None)
+    return ZoneLaws(nodes, spec)
