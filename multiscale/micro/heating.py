@@ -1,0 +1,536 @@
+"""Frictional heating of a rough sliding contact: heat partition and flash temperatures (thesis ch. 6).
+
+Body 1 moves (``Motion``: a rotating disc or a translation), body 2 is fixed; the grid is a
+window of body 2's surface. The frictional heat phi = mu p_n V (W/m², contact cells only) splits
+into phi_1 + phi_2 so that the surface temperatures match on the contact (perfect contact, §6.3.6)
+or differ by the temperature jump of an interface layer (§6.3.3).
+
+Transient (§6.3, ``TransientHeating``): fluxes are constant over each time step dt (§6.3.2); at step N
+the increment psi = phi_1(t_N) − phi_1(t_{N−1}) on the contact solves A^N psi = Phi^N − Lambda^N
+(Eqs. 6.9–6.18) with A^N = (T_1 + T_2)(one step) + interface diagonal (Eq. 6.16) applied by FFT
+convolution (Eq. 6.22), by conjugate gradients on the non-symmetric least-squares objective
+(Eqs. 6.19–6.20) restricted to the contacting cells (Eq. 6.21). Energy is conserved exactly:
+phi_2 = phi − phi_1.
+Steady (§6.5, ``SteadyHeating``): the same with steady kernels and remote temperatures (Eqs. 6.23–6.25).
+``partition_law`` gives the steady p_1(p_mean, V) that the macro model needs.
+
+Temperatures are rises [K] above the initial (or remote) temperature. Sign: phi_i > 0 flows into
+body i. Heat rates Phi [W] are over the patch window.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from tqdm import tqdm
+
+from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.micro.contact import ContactResult, ContactSolver
+from multiscale.micro.fft import RealFFT2
+from multiscale.micro.heat_kernels import Motion, ThermalMaterial, Translation, pulse_tables
+from multiscale.micro.kernels import Kernel
+from multiscale.micro.surface import Surface
+
+
+class HeatingConvergenceError(ConvergenceError):
+    """The least-squares solve of a thermal contact step reached ``max_iter`` before ``tol``."""
+
+
+@dataclass(frozen=True)
+class InterfaceLayer:
+    """Thin interface layer of n components in series (§6.3.3, Fig. 6.19).
+
+    Component m (1 … n, from body 1 to body 2) is a resistance ``resistance[m]`` [K m²/W] in
+    parallel with a capacitance ``capacitance[m]`` [J/(m² K)] (step response R (1 − e^{−t/RC})).
+    The heat is generated at the n + 1 nodes (node 0 on body 1, node n on body 2) with the
+    ``generation`` profile of Fig. 6.42: "plane" (all at node round(plane · n)), "uniform", "linear"
+    (weights n+1 … 1, largest next to the sliding body 1), or explicit weights (n + 1 values).
+    Scalars apply to every component. R = 0 everywhere is the perfect contact of §6.3.6.
+    """
+
+    resistance: float | tuple = 0.0
+    capacitance: float | tuple = 0.0
+    n: int = 1
+    generation: str | tuple = "plane"
+    plane: float = 0.5
+
+    def __post_init__(self):
+        if int(self.n) < 1:
+            raise InputError("n", self.n, "number of interface components must be >= 1")
+        for name in ("resistance", "capacitance"):
+            v = np.broadcast_to(np.asarray(getattr(self, name), dtype=float), (int(self.n),))
+            if not np.all(np.isfinite(v)) or np.any(v < 0):
+                raise InputError(name, getattr(self, name), f"{self.n} finite values >= 0 (or one)")
+            object.__setattr__(self, name, tuple(v.tolist()))
+        if not 0.0 <= self.plane <= 1.0:
+            raise InputError("plane", self.plane, "position of the heating plane in [0, 1]")
+        self.weights  # validates the profile
+
+    @property
+    def weights(self) -> np.ndarray:
+        """Fraction of the heat generated at each node 0 … n (sums to 1)."""
+        n = int(self.n)
+        if isinstance(self.generation, str):
+            if self.generation == "plane":
+                w = np.zeros(n + 1)
+                w[int(round(self.plane * n))] = 1.0
+            elif self.generation == "uniform":
+                w = np.ones(n + 1)
+            elif self.generation == "linear":
+                w = np.arange(n + 1, 0, -1, dtype=float)
+            else:
+                raise InputError("generation", self.generation, "'plane', 'uniform', 'linear' or n+1 weights")
+        else:
+            w = np.asarray(self.generation, dtype=float)
+            if w.shape != (n + 1,) or np.any(w < 0) or not np.all(np.isfinite(w)) or w.sum() <= 0:
+                raise InputError("generation", self.generation, f"{n + 1} finite weights >= 0, not all 0")
+        return w / w.sum()
+
+    def terms(self, dt: float):
+        """(R, e, c) per component: resistance, exp(−dt/RC) (0 when C = 0), and the fraction c_m of
+        the heat generated between body 1 and component m (flux through m: phi_1 − c_m phi)."""
+        R, C = np.asarray(self.resistance), np.asarray(self.capacitance)
+        tau = R * C
+        with np.errstate(divide="ignore", over="ignore"):
+            e = np.where(tau > 0, np.exp(-dt / np.where(tau > 0, tau, 1.0)), 0.0)
+        return R, e, np.cumsum(self.weights)[:-1]
+
+
+class _Layer:
+    """Jump theta_2 − theta_1 = diagonal · phi_1 + offset at the end of a step across an interface
+    layer (§6.3.3): Σ_m Σ_k (1 − exp(−(t_{N+1} − t_k)/(R^m C^m))) R^m Δ(phi_1 − c_m phi)_k, the
+    memory of each component carried by one exponential sum (no history is stored).
+    dt = inf gives the steady jump Σ_m R^m (phi_1 − c_m phi)."""
+
+    def __init__(self, interface: InterfaceLayer | None, dt: float, shape):
+        self.R, self.e, self.c = (interface or InterfaceLayer()).terms(dt)
+        self.diagonal = float(np.sum(self.R * (1 - self.e)))
+        self.active = bool(np.any(self.R > 0))                   # R = 0: perfect contact (§6.3.6)
+        size = (self.R.size,) + tuple(shape) if self.active else (self.R.size,)
+        self._sum = np.zeros(size)                               # Σ_k e^{−(t_{N+1}−t_k)/RC} Δvarphi_k
+        self._last = np.zeros(size)                              # varphi_{N−1} = phi_1 − c_m phi
+
+    def offset(self, phi):
+        if not self.active:
+            return 0.0
+        memory = np.tensordot(self.R * self.e, self._last - self._sum, axes=1)
+        return memory - float(np.sum(self.R * (1 - self.e) * self.c)) * phi
+
+    def advance(self, phi_1, phi):
+        if not self.active:
+            return
+        varphi = phi_1 - self.c.reshape((-1,) + (1,) * phi.ndim) * phi
+        self._sum = self.e.reshape(self._sum.shape[:1] + (1,) * phi.ndim) * (self._sum + varphi - self._last)
+        self._last = varphi
+
+
+@dataclass
+class HeatingResult:
+    """Transient frictional heating (§6.3). Per-step arrays: (n_steps, *batch)."""
+
+    times: np.ndarray              # s, end t_{N+1} of each step (the matching instant)
+    heat: np.ndarray               # W, Phi: frictional heat rate during each step (mu F_n V)
+    heat_1: np.ndarray             # W, Phi_1 into body 1 (moving)
+    heat_2: np.ndarray             # W, Phi_2 into body 2 (fixed)
+    partition_1: np.ndarray        # p_1 = Phi_1/Phi; NaN where Phi = 0 (no heat: undefined)
+    partition_2: np.ndarray        # p_2 = Phi_2/Phi = 1 − p_1
+    max_temperature_1: np.ndarray  # K, max surface temperature rise of body 1 on the window
+    max_temperature_2: np.ndarray  # K, same for body 2
+    field_times: np.ndarray        # s, step ends at which fields were stored
+    temperature_1: np.ndarray      # K, (n_fields, *batch, ny, nx) surface temperature rise of body 1
+    temperature_2: np.ndarray      # K, same for body 2
+    flux_1: np.ndarray             # W/m², (n_fields, *batch, ny, nx) phi_1 (phi_2 = flux − flux_1)
+    flux: np.ndarray               # W/m², (n_fields, *batch, ny, nx) generated phi
+    iterations: np.ndarray         # conjugate-gradient iterations per step
+    residual: np.ndarray           # relative temperature mismatch on the contact per step
+    converged: np.ndarray          # bool per step
+
+
+@dataclass
+class SteadyHeatingResult:
+    """Steady sliding with remote temperatures (§6.5). Per-patch arrays have the batch shape."""
+
+    heat: np.ndarray               # W, Phi = mu F_n V
+    heat_1: np.ndarray             # W, into body 1 (includes conduction from the remote temperatures)
+    heat_2: np.ndarray             # W, into body 2
+    partition_1: np.ndarray        # Phi_1/Phi (NaN where Phi = 0)
+    partition_2: np.ndarray
+    max_temperature_1: np.ndarray  # K, including the remote temperature theta_1^0
+    max_temperature_2: np.ndarray  # K
+    temperature_1: np.ndarray      # K, (*batch, ny, nx), Eq. 6.24
+    temperature_2: np.ndarray      # K
+    flux_1: np.ndarray             # W/m², (*batch, ny, nx)
+    flux: np.ndarray               # W/m², generated
+    iterations: np.ndarray
+    residual: np.ndarray
+    converged: np.ndarray
+    history: list = field(default_factory=list, repr=False)
+
+
+class _Padded:
+    """Real FFTs of (..., ny, nx) fields zero-padded to (2ny, 2nx): products of spectra with the
+    wrap-around influence tables are exact linear convolutions. Plans are reused per batch shape."""
+
+    def __init__(self, shape):
+        self.shape = shape
+        self._plans: dict[tuple, RealFFT2] = {}
+
+    def _plan(self, batch):
+        plan = self._plans.get(batch)
+        if plan is None:
+            ny, nx = self.shape
+            plan = self._plans[batch] = RealFFT2(batch + (2 * ny, 2 * nx))
+        return plan
+
+    def spectrum(self, x):
+        ny, nx = self.shape
+        plan = self._plan(x.shape[:-2])
+        plan.input[..., :ny, :nx] = x
+        return plan.forward().copy()
+
+    def field(self, spec):
+        ny, nx = self.shape
+        return self._plan(spec.shape[:-2]).inverse(spec)[..., :ny, :nx].copy()
+
+    def convolve(self, kernel_spec, x):
+        ny, nx = self.shape
+        plan = self._plan(x.shape[:-2])
+        plan.input[..., :ny, :nx] = x
+        spec = plan.forward()
+        spec *= kernel_spec
+        return plan.inverse(spec)[..., :ny, :nx].copy()
+
+
+def _cgls(apply, apply_t, b, mask, scale, tol, max_iter, x0=None):
+    """Minimise ½|A x − b|² over x supported on ``mask`` (Eqs. 6.19–6.21) by conjugate gradients on
+    the normal equations (gradient Aᵀ(Ax − b), Eq. 6.20) from ``x0`` (default 0). Batched over
+    leading axes; stops per patch when |Ax − b| <= tol · scale."""
+    axes = (-2, -1)
+    x = np.zeros_like(b) if x0 is None else np.where(mask, x0, 0.0)
+    r = np.where(mask, b - (apply(x) if x0 is not None else 0.0), 0.0)
+    s = np.where(mask, apply_t(r), 0.0)
+    p = s.copy()
+    gamma = np.sum(s * s, axis=axes, keepdims=True)
+    res = np.sqrt(np.sum(r * r, axis=axes, keepdims=True)) / scale
+    iterations = np.zeros(res.shape, dtype=int)
+    history = [float(res.max())]
+    for _ in range(max_iter):
+        active = res > tol
+        if not active.any():
+            break
+        q = np.where(mask, apply(p), 0.0)
+        qq = np.sum(q * q, axis=axes, keepdims=True)
+        alpha = np.where(active & (qq > 0), gamma / np.where(qq > 0, qq, 1.0), 0.0)
+        x += alpha * p
+        r -= alpha * q
+        res = np.sqrt(np.sum(r * r, axis=axes, keepdims=True)) / scale
+        s = np.where(mask, apply_t(r), 0.0)
+        gamma_new = np.sum(s * s, axis=axes, keepdims=True)
+        p = s + np.where(gamma > 0, gamma_new / np.where(gamma > 0, gamma, 1.0), 0.0) * p
+        gamma = gamma_new
+        iterations += active
+        history.append(float(res.max()))
+    return x, iterations[..., 0, 0], res[..., 0, 0], history
+
+
+def _extrapolate(last, before):
+    """Initial increment psi_N = r psi_{N−1} with r = <psi_{N−1}, psi_{N−2}>/|psi_{N−2}|² per patch
+    (the increments of a heating transient decay nearly geometrically)."""
+    axes = (-2, -1)
+    bb = np.sum(before * before, axis=axes, keepdims=True)
+    ratio = np.sum(last * before, axis=axes, keepdims=True) / np.where(bb > 0, bb, 1.0)
+    return np.where(bb > 0, ratio, 0.0) * last
+
+
+def _check_grid(shape, dx, dy):
+    ny, nx = (int(s) for s in shape)
+    if ny < 1 or nx < 1:
+        raise InputError("shape", shape, "grid needs at least one cell per side")
+    dx = check_positive("dx", dx)
+    return (ny, nx), dx, check_positive("dy", dy if dy is not None else dx)
+
+
+def _check_pressure(pressure, shape):
+    p = np.asarray(pressure, dtype=float)
+    if p.ndim < 2 or p.shape[-2:] != shape:
+        raise InputError("pressure.shape", p.shape, f"last two axes must be {shape}")
+    if not np.all(np.isfinite(p)) or np.any(p < 0):
+        raise InputError("pressure", "array", "contact pressure must be finite and >= 0")
+    return p
+
+
+def _partition(part, total):
+    with np.errstate(divide="ignore", invalid="ignore"):
+        return np.where(total != 0, part / np.where(total != 0, total, 1.0), np.nan)
+
+
+class TransientHeating:
+    """Transient thermal contact (§6.3) on one grid and time step; kernels tabulated once.
+
+    shape (ny, nx) and pixel dx (dy) [m] of the patch window; body1 (moving with ``motion``) and
+    body2 (fixed) materials; time step dt [s]; n_steps: the longest run. For a constant speed the
+    kernel tables are Toeplitz in time and built here; for a varying speed (e.g. Eq. 6.6) body 1's
+    tables depend on the absolute time and are rebuilt each step (A^N changes with N).
+    ``run`` can be called many times (pressures, friction, interface layers) with the same tables.
+    """
+
+    def __init__(self, shape, dx: float, body1: ThermalMaterial, body2: ThermalMaterial, motion: Motion,
+                 dt: float, n_steps: int, dy: float | None = None):
+        self.shape, self.dx, self.dy = _check_grid(shape, dx, dy)
+        self.dt = check_positive("dt", dt)
+        self.n_steps = int(n_steps)
+        if self.n_steps < 1:
+            raise InputError("n_steps", n_steps, "at least one time step")
+        self.body1, self.body2, self.motion = body1, body2, motion
+        self._pad = _Padded(self.shape)
+        self._tables2 = self._spectra(pulse_tables(self.shape, self.dx, self.dy, body2, self.dt, self.n_steps))
+        self.toeplitz = motion.profile.is_constant
+        self._tables1 = self._spectra(pulse_tables(self.shape, self.dx, self.dy, body1, self.dt, self.n_steps,
+                                                   motion)) if self.toeplitz else None
+
+    @staticmethod
+    def _spectra(tables):
+        return tables.ages, np.fft.rfft2(tables.coeffs)
+
+    def _body1_tables(self, N):
+        if self.toeplitz:
+            return self._tables1
+        return self._spectra(pulse_tables(self.shape, self.dx, self.dy, self.body1, self.dt, N + 1,
+                                          self.motion, t=(N + 1) * self.dt))
+
+    @staticmethod
+    def _history(tables, F, N, nb):
+        """Σ_{age k >= 1} S_k · F[N − k]: temperature spectra at t_{N+1} of the fluxes of past steps."""
+        ages, S = tables
+        i0, i1 = np.searchsorted(ages, [1, N + 1])
+        if i1 <= i0:
+            return np.zeros(F.shape[1:], dtype=complex)
+        ag, S = ages[i0:i1], S[i0:i1].reshape((i1 - i0,) + (1,) * nb + S.shape[-2:])
+        if ag[-1] - ag[0] == ag.size - 1:
+            Fk = F[N - ag[-1]: N - ag[0] + 1][::-1]
+        else:
+            Fk = F[N - ag]
+        return np.einsum("k...,k...->...", S, Fk)
+
+    def run(self, pressure, mu: float, *, interface: InterfaceLayer | None = None, n_steps: int | None = None,
+            field_times=(), tol: float = 1e-8, max_iter: int = 2000, partial: bool = False,
+            progress: bool = False) -> HeatingResult:
+        """Heat the contact of ``pressure`` [Pa] ((..., ny, nx), p > 0 on the contact, e.g.
+        ``ContactResult.pressure``) with friction coefficient ``mu`` for ``n_steps`` steps.
+
+        ``field_times`` [s]: store the surface temperature and flux fields at the step ends nearest
+        to these times. Raises ``HeatingConvergenceError`` if a step does not reach ``tol`` in
+        ``max_iter`` iterations, unless ``partial`` (then the step is flagged not converged).
+        """
+        p = _check_pressure(pressure, self.shape)
+        mu = check_positive("mu", mu)
+        n_steps = self.n_steps if n_steps is None else int(n_steps)
+        if not 1 <= n_steps <= self.n_steps:
+            raise InputError("n_steps", n_steps, f"between 1 and the tabulated {self.n_steps}")
+        check_positive("tol", tol)
+        batch, nb = p.shape[:-2], p.ndim - 2
+        mask = p > 0
+        area = self.dx * self.dy
+        edges = self.dt * np.arange(n_steps + 1)
+        speed = self.motion.mean_speed(edges[:-1], edges[1:])               # m/s over each step
+        keep = np.unique(np.clip(np.rint(np.asarray(field_times, dtype=float) / self.dt).astype(int) - 1,
+                                 0, n_steps - 1))
+        layer = _Layer(interface, self.dt, p.shape)
+        spec_shape = (n_steps,) + batch + (2 * self.shape[0], self.shape[1] + 1)
+        F1, F2 = np.zeros(spec_shape, complex), np.zeros(spec_shape, complex)
+        out = {k: np.zeros((n_steps,) + batch) for k in ("heat", "heat_1", "max_1", "max_2", "res")}
+        its = np.zeros((n_steps,) + batch, dtype=int)
+        fields = {k: np.zeros((keep.size,) + p.shape) for k in ("T1", "T2", "f", "phi")}
+        f_prev = psi_prev = psi_prev2 = np.zeros(p.shape)
+        A2 = self._tables2[1][0]
+        for N in tqdm(range(n_steps), disable=not progress, desc="heating", unit="step"):
+            tables1 = self._body1_tables(N)
+            A1 = tables1[1][0]                          # age 0 (the current step) is never empty
+            A = A1 + A2
+            phi = mu * p * speed[N]
+            phi_hat = self._pad.spectrum(phi)
+            H1, H2 = self._history(tables1, F1, N, nb), self._history(self._tables2, F2, N, nb)
+            free1 = self._pad.field(H1)
+            free2 = self._pad.field(H2 + A2 * phi_hat)
+            # Phi^N - Lambda^N (Eqs. 6.17-6.18): body-2 temperature of all the heat minus the
+            # temperatures of phi_1 frozen at its last value, with the layer's jump
+            rhs = free2 - free1 - layer.diagonal * f_prev - layer.offset(phi)
+            if N:
+                rhs -= self._pad.field(A * F1[N - 1])
+            scale = np.sqrt(np.sum(mask * (free1**2 + free2**2), axis=(-2, -1), keepdims=True))
+            scale = np.where(scale > 0, scale, np.inf)
+            psi, it, res, hist = _cgls(lambda x: self._pad.convolve(A, x) + layer.diagonal * x,
+                                       lambda x: self._pad.convolve(np.conj(A), x) + layer.diagonal * x,
+                                       rhs, mask, scale, tol, max_iter, _extrapolate(psi_prev, psi_prev2))
+            psi_prev2, psi_prev = psi_prev, psi
+            f = f_prev + psi
+            F1[N] = self._pad.spectrum(f)
+            F2[N] = phi_hat - F1[N]
+            T1 = self._pad.field(H1 + A1 * F1[N])
+            T2 = self._pad.field(H2 + A2 * F2[N])
+            layer.advance(f, phi)
+            out["heat"][N] = np.sum(phi, axis=(-2, -1)) * area
+            out["heat_1"][N] = np.sum(f, axis=(-2, -1)) * area
+            out["max_1"][N], out["max_2"][N] = T1.max(axis=(-2, -1)), T2.max(axis=(-2, -1))
+            out["res"][N], its[N] = res, it
+            if N in keep:
+                i = int(np.searchsorted(keep, N))
+                fields["T1"][i], fields["T2"][i], fields["f"][i], fields["phi"][i] = T1, T2, f, phi
+            f_prev = f
+            if np.any(res > tol) and not partial:
+                raise HeatingConvergenceError(
+                    f"thermal contact step {N} did not converge in {max_iter} iterations "
+                    f"(residual {res.max():.3e} > tol {tol:.1e})", hist,
+                    self._result(out, its, fields, keep, edges, N + 1, tol))
+        return self._result(out, its, fields, keep, edges, n_steps, tol)
+
+    @staticmethod
+    def _result(out, its, fields, keep, edges, n, tol):
+        heat, heat_1 = out["heat"][:n], out["heat_1"][:n]
+        heat_2 = heat - heat_1
+        sel = keep < n
+        return HeatingResult(
+            times=edges[1:n + 1], heat=heat, heat_1=heat_1, heat_2=heat_2,
+            partition_1=_partition(heat_1, heat), partition_2=_partition(heat_2, heat),
+            max_temperature_1=out["max_1"][:n], max_temperature_2=out["max_2"][:n],
+            field_times=edges[keep[sel] + 1], temperature_1=fields["T1"][sel], temperature_2=fields["T2"][sel],
+            flux_1=fields["f"][sel], flux=fields["phi"][sel], iterations=its[:n], residual=out["res"][:n],
+            converged=out["res"][:n] <= tol)
+
+
+class SteadyHeating:
+    """Steady sliding contact with remote temperatures (§6.5), tables built once per (grid, speed).
+
+    Body 1 slides at constant ``speed`` [m/s] along ``angle`` [rad from +x] (a ``Rotation`` is
+    replaced by the translation of its patch centre: far axis); body 2 is fixed.
+    """
+
+    def __init__(self, shape, dx: float, body1: ThermalMaterial, body2: ThermalMaterial, speed: float,
+                 dy: float | None = None, angle: float = 0.0):
+        self.shape, self.dx, self.dy = _check_grid(shape, dx, dy)
+        self.speed = check_positive("speed", speed, allow_zero=True)
+        self.body1, self.body2 = body1, body2
+        self._pad = _Padded(self.shape)
+        motion = Translation.steady(self.speed, angle)
+        k1 = pulse_tables(self.shape, self.dx, self.dy, body1, np.inf, 1, motion).coeffs[0]
+        k2 = pulse_tables(self.shape, self.dx, self.dy, body2, np.inf, 1).coeffs[0]
+        self._S1, self._S2 = np.fft.rfft2(k1), np.fft.rfft2(k2)
+
+    def solve(self, pressure, mu: float, *, interface: InterfaceLayer | None = None,
+              remote_temperatures=(0.0, 0.0), tol: float = 1e-8, max_iter: int = 2000,
+              partial: bool = False) -> SteadyHeatingResult:
+        """Steady partition of phi = mu p V on the contact of ``pressure`` [Pa] (..., ny, nx).
+
+        (F1 + F2 + Σ R^m) phi_1 = F2 phi + Σ R^m c_m phi + theta_2^0 − theta_1^0 on the contact
+        (Eq. 6.23 with the steady interface jump), by the least-squares CG of Eq. 6.25.
+        ``remote_temperatures`` = (theta_1^0, theta_2^0) [K], temperatures far inside each body.
+        """
+        p = _check_pressure(pressure, self.shape)
+        mu = check_positive("mu", mu)
+        th1, th2 = (float(v) for v in remote_temperatures)
+        if not (np.isfinite(th1) and np.isfinite(th2)):
+            raise InputError("remote_temperatures", remote_temperatures, "two finite temperatures [K]")
+        check_positive("tol", tol)
+        layer = _Layer(interface, np.inf, p.shape)
+        mask = p > 0
+        phi = mu * p * self.speed
+        phi_hat = self._pad.spectrum(phi)
+        free2 = self._pad.field(self._S2 * phi_hat)
+        rhs = free2 - layer.offset(phi) + (th2 - th1)
+        A = self._S1 + self._S2
+        scale = np.sqrt(np.sum(mask * (free2**2 + (th2 - th1) ** 2), axis=(-2, -1), keepdims=True))
+        scale = np.where(scale > 0, scale, np.inf)
+        f, it, res, hist = _cgls(lambda x: self._pad.convolve(A, x) + layer.diagonal * x,
+                                 lambda x: self._pad.convolve(np.conj(A), x) + layer.diagonal * x,
+                                 rhs, mask, scale, tol, max_iter)
+        f_hat = self._pad.spectrum(f)
+        T1 = self._pad.field(self._S1 * f_hat) + th1
+        T2 = self._pad.field(self._S2 * (phi_hat - f_hat)) + th2
+        area = self.dx * self.dy
+        heat, heat_1 = phi.sum(axis=(-2, -1)) * area, f.sum(axis=(-2, -1)) * area
+        result = SteadyHeatingResult(
+            heat=heat, heat_1=heat_1, heat_2=heat - heat_1, partition_1=_partition(heat_1, heat),
+            partition_2=_partition(heat - heat_1, heat), max_temperature_1=T1.max(axis=(-2, -1)),
+            max_temperature_2=T2.max(axis=(-2, -1)), temperature_1=T1, temperature_2=T2, flux_1=f, flux=phi,
+            iterations=it, residual=res, converged=res <= tol, history=hist)
+        if np.any(res > tol) and not partial:
+            raise HeatingConvergenceError(f"steady thermal contact did not converge in {max_iter} iterations "
+                                          f"(residual {res.max():.3e} > tol {tol:.1e})", hist, result)
+        return result
+
+
+@dataclass
+class PartitionLaw:
+    """Steady heat partition of a rough patch over a pressure sweep (and speeds): the law p_1(p, V)
+    the macro model applies per interface facet. Arrays are (n_speeds, n_pressures)."""
+
+    mean_pressure: np.ndarray      # Pa, (n_p,), ascending
+    speed: np.ndarray              # m/s, (n_v,), ascending
+    partition_1: np.ndarray        # steady p_1 = Phi_1/Phi into the moving body 1
+    area_fraction: np.ndarray      # (n_p,), real contact area / nominal area
+    max_temperature_1: np.ndarray  # K, steady flash temperature rise of body 1 (with this mu)
+    max_temperature_2: np.ndarray  # K, same for body 2
+    mu: float                      # friction coefficient used for the temperatures
+
+    def __call__(self, pressure, speed=None) -> np.ndarray:
+        """p_1 at mean pressure(s) [Pa] (and speed(s) [m/s], needed when several were sampled):
+        linear in log p and in V, clamped to the sampled ranges."""
+        logp = np.log(np.clip(np.asarray(pressure, dtype=float), self.mean_pressure[0], self.mean_pressure[-1]))
+        rows = np.array([np.interp(logp, np.log(self.mean_pressure), row) for row in self.partition_1])
+        if self.speed.size == 1:
+            return rows[0]
+        if speed is None:
+            raise InputError("speed", speed, f"the law was sampled at {self.speed.size} speeds: give one")
+        v = np.clip(np.broadcast_to(np.asarray(speed, dtype=float), logp.shape), self.speed[0], self.speed[-1])
+        i = np.clip(np.searchsorted(self.speed, v, side="right") - 1, 0, self.speed.size - 2)
+        w = (v - self.speed[i]) / (self.speed[i + 1] - self.speed[i])
+        lo = np.take_along_axis(rows, i[None], 0)[0]
+        hi = np.take_along_axis(rows, (i + 1)[None], 0)[0]
+        return (1 - w) * lo + w * hi
+
+
+def partition_law(source, body1: ThermalMaterial, body2: ThermalMaterial, speed, pressures=None, *,
+                  mu: float, elastic: Kernel | None = None, dx: float | None = None, dy: float | None = None,
+                  angle: float = 0.0, interface: InterfaceLayer | None = None, tol: float = 1e-8) -> PartitionLaw:
+    """Steady partition law p_1(p_mean, V) of one patch (§6.4.2, Fig. 6.26; steady solver of §6.5).
+
+    source: a ``Surface`` (then ``elastic`` kernel and ``pressures`` [Pa] are needed: the patch is
+    pressed by ``ContactSolver`` at each mean pressure, batched) or a batched ``ContactResult``
+    (pressure fields (n_p, ny, nx); give ``dx``). speed: sliding speed(s) V [m/s] > 0 of body 1
+    along ``angle``; body 2 is fixed. The thermal problem is an isolated patch (heat-source kernels).
+    """
+    if isinstance(source, Surface):
+        if elastic is None or pressures is None:
+            raise InputError("elastic/pressures", (elastic, pressures), "a Surface needs an elastic kernel and pressures")
+        if source.heights.ndim != 2:
+            raise InputError("source", source.heights.shape, "one patch (a 2-D height map)")
+        loads = np.sort(np.atleast_1d(np.asarray(pressures, dtype=float)))
+        if loads.ndim != 1 or not np.all(np.isfinite(loads)) or np.any(loads <= 0):
+            raise InputError("pressures", pressures, "mean pressures must be finite and > 0")
+        h = np.broadcast_to(source.heights, loads.shape + source.shape)
+        contact = ContactSolver(elastic, source.shape, source.dx, source.dy, source.periodic).solve(
+            h, load=loads, tol=tol)
+        dx, dy = source.dx, source.dy
+    elif isinstance(source, ContactResult):
+        if dx is None:
+            raise InputError("dx", dx, "a ContactResult needs the pixel size dx [m]")
+        if pressures is not None:
+            raise InputError("pressures", pressures, "taken from the ContactResult: leave it None")
+        contact = source
+    else:
+        raise InputError("source", type(source).__name__, "a Surface or a ContactResult")
+    p = np.asarray(contact.pressure, dtype=float).reshape((-1,) + contact.pressure.shape[-2:])
+    order = np.argsort(np.asarray(contact.mean_pressure).reshape(-1))
+    p = p[order]
+    mean = np.asarray(contact.mean_pressure, dtype=float).reshape(-1)[order]
+    if np.any(mean <= 0) or np.any(np.diff(mean) <= 0):
+        raise InputError("pressures", mean, "distinct mean pressures > 0")
+    speeds = np.sort(np.atleast_1d(np.asarray(speed, dtype=float)))
+    if speeds.ndim != 1 or not np.all(np.isfinite(speeds)) or np.any(speeds <= 0):
+        raise InputError("speed", speed, "sliding speeds must be finite and > 0 (no heat at rest)")
+    rows = [SteadyHeating(p.shape[-2:], dx, body1, body2, v, dy, angle).solve(p, mu, interface=interface, tol=tol)
+            for v in speeds]
+    return PartitionLaw(
+        mean_pressure=mean, speed=speeds, partition_1=np.array([r.partition_1 for r in rows]),
+        area_fraction=np.mean(p > 0, axis=(-2, -1)), max_temperature_1=np.array([r.max_temperature_1 for r in rows]),
+        max_temperature_2=np.array([r.max_temperature_2 for r in rows]), mu=float(mu))
