@@ -186,11 +186,23 @@ def zone_nodes(zones: list[Zone], spec: LawSpec) -> tuple[list[ZoneNodes], list[
     """
     nodes, failures = [], []
     for group in batches([batch_signature(z) for z in zones], spec.batch_cells):
-        group = [zones[i] for i in group]
-        try:
-            n, f = _batch_nodes(group, spec)
-        except Exception as exc:  # an unexpected error fails the batch, never the caller's peers
-            n, f = [], [ZoneFailure(z.id, type(exc).__name__, str(exc)) for z in group]
+        n, f = _isolated([zones[i] for i in group], spec)
+        nodes += n
+        failures += f
+    return nodes, failures
+
+
+def _isolated(group: list[Zone], spec: LawSpec):
+    """A batch's nodes; an unexpected exception in a batch is retried zone by zone, so that it is
+    reported against the zone(s) that raise it, and never reaches the caller (or its MPI peers)."""
+    try:
+        return _batch_nodes(group, spec)
+    except Exception as exc:
+        if len(group) == 1:
+            return [], [ZoneFailure(group[0].id, type(exc).__name__, str(exc))]
+    nodes, failures = [], []
+    for z in group:
+        n, f = _isolated([z], spec)
         nodes += n
         failures += f
     return nodes, failures

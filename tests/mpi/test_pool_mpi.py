@@ -1,0 +1,94 @@
+"""The zone-law pool under MPI (run by ``mpiexec -n 2 python -m pytest tests/mpi``; also passes on
+one process): same laws as one process, each distinct zone solved once, failures reported on every
+rank without deadlock."""
+import numpy as np
+import pytest
+from mpi4py import MPI
+
+from multiscale.errors import InputError
+from multiscale.micro.kernels import HalfSpace
+from multiscale.micro.laws import ExtraLaw, LawSpec, compute_laws
+from multiscale.micro.surface import Surface, fractal_surface
+from multiscale.micro.zones import Zone, cut_zones
+from multiscale.pool import MicroPool, PoolError
+
+comm = MPI.COMM_WORLD
+E = HalfSpace(1e9)
+SPEC = LawSpec(E, p_max=3e6, n_points=8)
+
+
+@pytest.fixture(scope="module")
+def zones():
+    s = fractal_surface(96, 1e-3, 0.8, 12, 24, 1e-6, seed=3)
+    return cut_zones(s, (4, 4))[1]
+
+
+def flat_zone(zid, like):
+    return Zone(zid, Surface(np.zeros(like.shape), like.surface.dx, like.surface.dy, periodic=False))
+
+
+def test_laws_equal_one_process_and_are_shared_out(zones):
+    pool = MicroPool(SPEC)
+    mine = zones[comm.rank::comm.size]
+    laws = pool.laws(mine, gather="all")
+    assert sorted(laws.ids.tolist()) == list(range(16))
+    assert pool.stats.computed == 16 and pool.stats.failed == 0
+    assert len(pool.stats.compute_seconds) == comm.size and min(pool.stats.compute_seconds) > 0
+    serial = compute_laws(zones, SPEC)           # this process alone
+    rows = serial.rows(laws.ids)
+    np.testing.assert_allclose(laws.mechanical.pressure, serial.mechanical.pressure[rows], rtol=1e-9)
+    np.testing.assert_allclose(laws.mechanical.gap, serial.mechanical.gap[rows], rtol=1e-9)
+    g = np.linspace(laws.mechanical.gap.min() - 1e-7, laws.mechanical.g_open.max(), 200)
+    for zid in (0, 9):
+        np.testing.assert_allclose(laws.pressure(g, np.full(200, zid)).pressure,
+                                   serial.pressure(g, np.full(200, zid)).pressure, rtol=1e-8, atol=1e-6)
+    own = pool.laws(mine)                        # nothing changed: all from the caches
+    assert own.ids.tolist() == [z.id for z in mine]
+    assert pool.stats.computed == 0 and pool.stats.cached == 16
+
+
+def test_shared_zones_are_solved_once(zones):
+    pool = MicroPool(SPEC)
+    laws = pool.laws(zones[:3] + zones[3 + comm.rank:4 + comm.rank])
+    assert pool.stats.computed == 3 + comm.size
+    assert laws.ids.tolist() == [0, 1, 2, 3 + comm.rank]
+
+
+class Fragile(ExtraLaw):
+    """Raises for one zone (an unexpected exception inside a batch)."""
+
+    name = "fragile"
+
+    def key(self):
+        return ("fragile",)
+
+    def values(self, result, zones):
+        if any(z.id == 5 for z in zones):
+            raise RuntimeError("boom in zone 5")
+        return result.area_fraction
+
+
+def test_a_failing_zone_is_reported_on_every_rank_without_deadlock(zones):
+    pool = MicroPool(SPEC)
+    last = comm.size - 1
+    request = zones[comm.rank::comm.size] + ([flat_zone(99, zones[0])] if comm.rank == last else [])
+    with pytest.raises(PoolError) as info:
+        pool.laws(request)
+    assert [f.zone_id for f in info.value.failures] == [99]          # the same on every rank
+    assert "full contact" in info.value.failures[0].message
+    assert info.value.result.ids.tolist() == [z.id for z in zones[comm.rank::comm.size]]
+    fragile = LawSpec(E, p_max=3e6, n_points=6, extras=(Fragile(),))
+    with pytest.raises(PoolError) as info:
+        pool.laws(zones[comm.rank::comm.size], spec=fragile, gather="all")
+    assert [(f.zone_id, f.kind) for f in info.value.failures] == [(5, "RuntimeError")]
+    assert len(info.value.result) == 15
+    comm.barrier()                                                   # everyone got here
+    assert len(pool.laws(zones[:2])) == 2                            # and the pool still works
+
+
+def test_ranks_must_agree_on_the_spec(zones):
+    spec = SPEC if comm.rank == 0 else LawSpec(E, p_max=4e6, n_points=8)
+    if comm.size == 1:
+        pytest.skip("needs two ranks")
+    with pytest.raises(InputError, match="same LawSpec"):
+        MicroPool(SPEC).laws(zones[:1], spec=spec)
