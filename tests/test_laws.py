@@ -11,7 +11,8 @@ from scipy import integrate
 from multiscale.errors import InputError
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import HalfSpace, love_rectangle
-from multiscale.micro.laws import (ExtraLaw, LawError, LawSpec, PressureGapLaw, PressureTable, compute_laws)
+from multiscale.micro.laws import (Conductance, ExtraLaw, HeatPartition, LawError, LawSpec, PressureGapLaw,
+                                   PressureTable, compute_laws)
 from multiscale.micro.surface import Surface, fractal_surface
 from multiscale.micro.zones import (Zone, ZoneGrid, cut_triangles, cut_zones, generate_zones, love_rectangle_mean,
                                     love_triangle, love_triangle_mean, triangle_area)
@@ -281,13 +282,13 @@ def test_law_accuracy_on_a_known_power_law():
 class PeakPressure(ExtraLaw):
     """Test extra law: the highest local pressure at speeds (1, 2, 4) times a speed factor."""
 
-    name, below, axis = "peak", "hold", np.array([1.0, 2.0, 4.0])
+    tables, axis = {"peak": "hold"}, np.array([1.0, 2.0, 4.0])
 
     def key(self):
         return ("peak", 1)
 
     def values(self, result, zones):
-        return result.pressure.max(axis=(-2, -1))[:, None] * self.axis[None, :]
+        return {"peak": result.pressure.max(axis=(-2, -1))[:, None] * self.axis[None, :]}
 
 
 def test_area_fraction_and_extra_laws_are_tabulated_at_the_nodes(tiled):
@@ -308,6 +309,44 @@ def test_area_fraction_and_extra_laws_are_tabulated_at_the_nodes(tiled):
     table = PressureTable(nd.pressure, nd.area_fraction, below="zero")
     p = np.geomspace(nd.pressure[0], nd.pressure[-1], 300)
     assert np.all(np.diff(table(p)) >= -1e-15)                                 # no overshoot (PCHIP)
+
+
+def test_conductance_law_plugs_in_with_the_zone_scale_correction(tiled):
+    """h_c(p): K_t of the zone from conduction.py (thesis ch. 5), minus the zone-scale spreading
+    resistance of a uniform flux (the thermal analogue of Eq. 1.31)."""
+    from multiscale.micro.conduction import conductance_law
+    from multiscale.micro.kernels import ThermalHalfSpace
+    _, grid, zones = tiled
+    k1, k2 = ThermalHalfSpace(50.0), ThermalHalfSpace(35.0)
+    laws = compute_laws(zones[:2], LawSpec(E, p_max=3e6, n_points=6, extras=(Conductance(k1, k2),)))
+    nd = laws.nodes[1]
+    K, h = nd.extras["patch_conductance"], nd.extras["conductance"]
+    ref = conductance_law(zones[1].surface, E, (k1, k2), [nd.pressure[3]], tol=1e-10, thermal_tol=1e-10)
+    assert K[3] == pytest.approx(ref.conductance[0], rel=1e-4)        # load vs displacement control
+    R = love_rectangle_mean(grid.size[0] / 2, grid.size[1] / 2) * (1 / 50.0 + 1 / 35.0) / (2 * np.pi)
+    np.testing.assert_allclose(1 / K - 1 / h, R, rtol=5e-3)           # discrete vs Love's mean
+    assert np.all(np.diff(h) > 0) and np.all(h > K)
+    assert laws.extra("conductance", nd.pressure[3], 1) == pytest.approx(h[3], rel=1e-13)
+    assert laws.extra("conductance", 0.0, 1) == 0.0
+
+
+def test_heat_partition_law_plugs_in_and_matches_heating_module(tiled):
+    from multiscale.micro.heat_kernels import ThermalMaterial
+    from multiscale.micro.heating import partition_law
+    _, _, zones = tiled
+    z = zones[2]
+    disc, pad = ThermalMaterial(50.0, 1e-5), ThermalMaterial(35.0, 8.3e-6)
+    law = HeatPartition(disc, pad, [1.0, 10.0], mu=0.4)
+    laws = compute_laws([z], LawSpec(E, p_max=3e6, n_points=5, extras=(law,)))
+    nd = laws.nodes[0]
+    r = ContactSolver(E, z.shape, z.surface.dx, periodic=False).solve(
+        np.repeat(z.surface.heights[None], 2, 0), approach=nd.approach[2:4], tol=1e-10)
+    ref = partition_law(r, disc, pad, [1.0, 10.0], mu=0.4, dx=z.surface.dx)
+    np.testing.assert_allclose(nd.extras["partition_1"][2:4].T, ref.partition_1, rtol=1e-4)
+    np.testing.assert_allclose(nd.extras["max_temperature_1"][2:4].T, ref.max_temperature_1, rtol=1e-4)
+    p1 = laws.extra("partition_1", nd.pressure[2], z.id, at=[1.0, 5.5, 10.0])
+    assert np.all((0 < p1) & (p1 < 1))
+    assert p1[1] == pytest.approx((p1[0] + p1[2]) / 2, rel=1e-12)       # linear between speeds
 
 
 def test_triangular_zones_carry_the_micro_force(tiled):

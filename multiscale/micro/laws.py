@@ -42,24 +42,27 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.micro.conduction import ConductionSolver
 from multiscale.micro.contact import ContactResult, ContactSolver
+from multiscale.micro.heat_kernels import ThermalMaterial
+from multiscale.micro.heating import InterfaceLayer, SteadyHeating
 from multiscale.micro.kernels import Kernel
 from multiscale.micro.zones import Zone
 
 
 # --------------------------------------------------------------------------- specification
 class ExtraLaw(ABC):
-    """A law tabulated at the mechanical nodes against the zone pressure p_n.
+    """Laws tabulated at the mechanical nodes against the zone pressure p_n (thermal laws…).
 
-    ``values(result, zones)`` receives the contact solution of a batch of zone patches at one
-    node (``ContactResult`` with batch shape (B,)) and returns one value per zone, (B,), or one
-    per point of ``axis`` (e.g. sliding speeds), (B, len(axis)). ``below``: the value below the
-    first node: 'zero' (linear in p_n down to 0 at p_n = 0) or 'hold' (the first node's).
-    Subclasses must be deterministic and define ``key()`` (their parameters, for the caches).
+    ``tables``: the names of the tables it fills and, for each, its value below the first node:
+    'zero' (linear in p_n down to 0 at p_n = 0) or 'hold' (the first node's). ``values(result,
+    zones)`` receives the contact solution of a batch of zone patches at one node (a
+    ``ContactResult`` of batch shape (B,)) and returns {table: (B,) values}, or (B, len(axis))
+    values with one per point of ``axis`` (e.g. sliding speeds). Subclasses are deterministic
+    and define ``key()`` (their parameters, for the caches).
     """
 
-    name: str = ""
-    below: str = "hold"
+    tables: dict = {}
     axis: np.ndarray | None = None
 
     @abstractmethod
@@ -67,8 +70,8 @@ class ExtraLaw(ABC):
         """Hashable identity of the law and its parameters."""
 
     @abstractmethod
-    def values(self, result: ContactResult, zones: list[Zone]) -> np.ndarray:
-        """Per-zone values at one node (see the class docstring)."""
+    def values(self, result: ContactResult, zones: list[Zone]) -> dict:
+        """Per-zone values of each table at one node (see the class docstring)."""
 
 
 @dataclass(frozen=True)
@@ -107,9 +110,11 @@ class LawSpec:
             object.__setattr__(self, "E_star", float(self.kernel.E_star))
         check_positive("E_star", self.E_star)
         extras = tuple(self.extras)
-        names = [getattr(e, "name", None) for e in extras]
-        if not all(isinstance(e, ExtraLaw) and e.name for e in extras) or len(set(names)) != len(names):
-            raise InputError("extras", names, "ExtraLaw objects with distinct, non-empty names")
+        if not all(isinstance(e, ExtraLaw) and e.tables for e in extras):
+            raise InputError("extras", extras, "ExtraLaw objects, each filling at least one table")
+        names = [name for e in extras for name in e.tables]
+        if len(set(names)) != len(names) or any(b not in ("zero", "hold") for e in extras for b in e.tables.values()):
+            raise InputError("extras", names, "distinct table names, each 'zero' or 'hold' below the table")
         object.__setattr__(self, "extras", extras)
 
     def key(self) -> tuple:
@@ -137,7 +142,7 @@ class ZoneNodes:
     iterations: np.ndarray     # contact-solver iterations per node, (n,)
     top: float                 # m, highest point of the zone above the datum (g at first touch)
     compliance: float          # m/Pa, L/(π E*) used for the gap (0 for love='none')
-    extras: dict = field(default_factory=dict)   # name -> (n,) or (n, m) values
+    extras: dict = field(default_factory=dict)   # table name -> (n,) or (n, m) values
     seconds: float = 0.0       # wall time of this zone's share of its batched solves
     cells: int = 0             # grid cells of the zone's patch
 
@@ -260,10 +265,12 @@ def _batch_nodes(zones: list[Zone], spec: LawSpec) -> tuple[list[ZoneNodes], lis
         fraction[idx, k] = r.area_fraction * box_area / area[idx]
         iterations[idx, k] = r.iterations
         for e in spec.extras:
-            v = np.asarray(e.values(r, [zones[b] for b in idx]), dtype=float)
-            if e.name not in extras:
-                extras[e.name] = np.full((B, n) + v.shape[1:], np.nan)
-            extras[e.name][idx, k] = v
+            values = e.values(r, [zones[b] for b in idx])
+            for name in e.tables:
+                v = np.asarray(values[name], dtype=float)
+                if name not in extras:
+                    extras[name] = np.full((B, n) + v.shape[1:], np.nan)
+                extras[name][idx, k] = v
         return r
 
     idx = np.arange(B)
@@ -475,6 +482,12 @@ class PressureTable:
     def __call__(self, pressure, rows=None, at=None) -> np.ndarray:
         """Values at zone pressures ``pressure`` [Pa] (and axis points ``at``), rows as for
         ``PressureGapLaw``."""
+        if self.axis is not None:
+            if at is None:
+                raise InputError("at", None, f"this table also depends on {len(self.axis)} axis values")
+            pressure, at = np.broadcast_arrays(np.asarray(pressure, dtype=float), np.asarray(at, dtype=float))
+            if rows is not None:
+                rows, pressure, at = np.broadcast_arrays(np.asarray(rows, dtype=int), pressure, at)
         p, rows, shape = _points(pressure, rows, self.pressure.shape[0])
         n = self._x.shape[1]
         x = np.log(np.maximum(p, np.finfo(float).tiny))
@@ -488,9 +501,7 @@ class PressureTable:
         value = np.where(p[:, None] <= p_first, below, value)
         if self.axis is None:
             return value[:, 0].reshape(shape)
-        if at is None:
-            raise InputError("at", None, f"this table also depends on {len(self.axis)} axis values")
-        at = np.broadcast_to(np.asarray(at, dtype=float), shape).ravel()
+        at = np.broadcast_to(at, shape).ravel()
         i = np.clip(np.searchsorted(self.axis, at) - 1, 0, len(self.axis) - 2)
         w = np.clip((at - self.axis[i]) / (self.axis[i + 1] - self.axis[i]), 0.0, 1.0)
         r = np.arange(len(at))
@@ -522,8 +533,9 @@ class ZoneLaws:
         pressure = self.mechanical.pressure
         self._area = PressureTable(pressure, np.stack([nd.area_fraction for nd in nodes]), below="zero")
         for e in (spec.extras if spec is not None else ()):
-            self.extras[e.name] = PressureTable(pressure, np.stack([nd.extras[e.name] for nd in nodes]),
-                                                below=e.below, axis=e.axis)
+            for name, below in e.tables.items():
+                self.extras[name] = PressureTable(pressure, np.stack([nd.extras[name] for nd in nodes]),
+                                                  below=below, axis=e.axis)
 
     def __len__(self) -> int:
         return len(self.ids)
@@ -563,6 +575,87 @@ class ZoneLaws:
         if name not in self.extras and self.mechanical is not None:
             raise InputError("name", name, f"one of {sorted(self.extras)}")
         return self._evaluate(self.extras.get(name), pressure, zone_ids, at)
+
+
+# --------------------------------------------------------------------------- thermal laws
+class Conductance(ExtraLaw):
+    """Thermal contact conductance h_c(p_n) of a zone for the macro interface (thesis ch. 5).
+
+    At each node, steady conduction through the zone's real contact area between two solids
+    (thermal kernels ``kernel_1``, ``kernel_2``, local resistance ``resistance`` [m² K/W];
+    ``ConductionSolver`` on the isolated patch) gives K_t = heat flow / (zone area ΔT) (Eq. 5.9):
+    table 'patch_conductance' [W/(m² K)]. As for the mechanical gap (Eq. 1.31), the macro model
+    spreads the zone's heat through its own bulk: a uniform flux q on the zone raises the mean
+    surface temperature difference by q R_zone (R_zone: mean over the zone of the series kernels'
+    response to a uniform unit flux on it), so the interface conductance is
+    h_c = 1/(1/K_t − R_zone): table 'conductance'. Both vanish with p_n ('zero' below the table).
+    """
+
+    tables = {"conductance": "zero", "patch_conductance": "zero"}
+
+    def __init__(self, kernel_1: Kernel, kernel_2: Kernel, resistance: float = 0.0, tol: float = 1e-10):
+        self.kernels = (kernel_1, kernel_2)
+        self.resistance = check_positive("resistance", resistance, allow_zero=True)
+        self.tol = check_positive("tol", tol)
+        self._solvers: dict[tuple, ConductionSolver] = {}
+
+    def key(self) -> tuple:
+        return ("Conductance", self.kernels[0].key(), self.kernels[1].key(), self.resistance, self.tol)
+
+    def values(self, result: ContactResult, zones: list[Zone]) -> dict:
+        s = zones[0].surface
+        grid = (s.shape, s.dx, s.dy)
+        if grid not in self._solvers:
+            self._solvers[grid] = ConductionSolver(*self.kernels, s.shape, s.dx, s.dy, periodic=False)
+        solver = self._solvers[grid]
+        heat = solver.solve(result.contact, resistance=self.resistance, theta_1=0.0, theta_2=1.0, tol=self.tol)
+        area = np.array([z.area for z in zones])
+        K_t = heat.conductance * (s.size[0] * s.size[1]) / area
+        masks = np.stack([z.mask for z in zones]).astype(float)
+        R_zone = np.sum(solver.series(masks) * masks, axis=(-2, -1)) / masks.sum(axis=(-2, -1))
+        excess = 1.0 / K_t - R_zone
+        if np.any(excess <= 0):
+            raise InputError("p_max", result.mean_pressure.max(), "the zone's conductance exceeds its "
+                             "uniform-flux bulk conductance (close to full contact): lower p_max")
+        return {"conductance": 1.0 / excess, "patch_conductance": K_t}
+
+
+class HeatPartition(ExtraLaw):
+    """Steady frictional heat partition p_1(p_n, V) and flash temperatures of a zone (thesis ch. 6,
+    §7.2; ``SteadyHeating``).
+
+    Body 1 (``body1``, the counter-face) slides at each of ``speeds`` [m/s] along ``angle`` over
+    the zone (body 2, ``body2``), friction ``mu``, optional ``interface`` layer. Tables over the
+    speed axis: 'partition_1' (share of the heat into body 1; held below the table) and
+    'max_temperature_1', 'max_temperature_2' [K] (steady maximum surface temperature rise of the
+    isolated patch, zone-scale rise included; zero below the table).
+    """
+
+    tables = {"partition_1": "hold", "max_temperature_1": "zero", "max_temperature_2": "zero"}
+
+    def __init__(self, body1: ThermalMaterial, body2: ThermalMaterial, speeds, mu: float, *,
+                 angle: float = 0.0, interface: InterfaceLayer | None = None, tol: float = 1e-8):
+        v = np.atleast_1d(np.asarray(speeds, dtype=float))
+        if v.ndim != 1 or len(v) < 2 or not np.all(np.isfinite(v)) or np.any(v <= 0) or np.any(np.diff(v) <= 0):
+            raise InputError("speeds", speeds, "at least two increasing sliding speeds > 0 [m/s]")
+        self.body1, self.body2, self.axis = body1, body2, v
+        self.mu, self.angle = check_positive("mu", mu), float(angle)
+        self.interface, self.tol = interface, check_positive("tol", tol)
+        self._solvers: dict[tuple, SteadyHeating] = {}
+
+    def key(self) -> tuple:
+        return ("HeatPartition", repr(self.body1), repr(self.body2), tuple(self.axis), self.mu, self.angle,
+                repr(self.interface), self.tol)
+
+    def values(self, result: ContactResult, zones: list[Zone]) -> dict:
+        s = zones[0].surface
+        rows = []
+        for v in self.axis:
+            key = (s.shape, s.dx, s.dy, v)
+            if key not in self._solvers:
+                self._solvers[key] = SteadyHeating(s.shape, s.dx, self.body1, self.body2, v, s.dy, self.angle)
+            rows.append(self._solvers[key].solve(result.pressure, self.mu, interface=self.interface, tol=self.tol))
+        return {name: np.stack([getattr(r, name) for r in rows], axis=-1) for name in self.tables}
 
 
 def compute_laws(zones: list[Zone], spec: LawSpec) -> ZoneLaws:

@@ -57,7 +57,7 @@ def test_shared_zones_are_solved_once(zones):
 class Fragile(ExtraLaw):
     """Raises for one zone (an unexpected exception inside a batch)."""
 
-    name = "fragile"
+    tables = {"fragile": "hold"}
 
     def key(self):
         return ("fragile",)
@@ -65,7 +65,7 @@ class Fragile(ExtraLaw):
     def values(self, result, zones):
         if any(z.id == 5 for z in zones):
             raise RuntimeError("boom in zone 5")
-        return result.area_fraction
+        return {"fragile": result.area_fraction}
 
 
 def test_a_failing_zone_is_reported_on_every_rank_without_deadlock(zones):
