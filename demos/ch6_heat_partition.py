@@ -117,7 +117,7 @@ def study_profile(surface, contact, out):
         axes[1, 0].plot(t, r.partition_1, style, label=f"omega1 = {omega1:g}")
         axes[1, 1].plot(t, np.maximum(r.max_temperature_1, r.max_temperature_2), style, label=f"omega1 = {omega1:g}")
         after = r.times > 0.1
-        print(f"  omega1 = {omega1:g}: after the stop of the ramp Phi1 in [{r.heat_1[after].min():.3g}, "
+        print(f"  omega1 = {omega1:g}: after the ramp (t > 100 ms) Phi1 in [{r.heat_1[after].min():.3g}, "
               f"{r.heat_1[after].max():.3g}] W, Phi2 in [{r.heat_2[after].min():.3g}, {r.heat_2[after].max():.3g}] W")
     titles = ("Fig. 6.30: heat generated Phi [W]", "Fig. 6.31: Phi1, Phi2 [W]",
               "Fig. 6.32: p1 (undefined once Phi = 0)", "Fig. 6.33: T_max [K]")
@@ -132,7 +132,10 @@ def study_interface(surface, contact, out):
     dt, steps = 25e-6, 80
     sol = TransientHeating(surface.shape, surface.dx, DISC, PIN, rotation(100.0), dt, steps)
     cases = {
-        "profile": [(g, InterfaceLayer(1e-8, 1e4, n=10, generation=g)) for g in ("plane", "uniform", "linear")],
+        # plane: all heat generated next to the sliding S1 (the thesis' reading of Fig. 6.42a; a mid-plane
+        # source is equivalent to uniform generation when all components are equal)
+        "profile": [(g, InterfaceLayer(1e-8, 1e4, n=10, generation=g, plane=0.0))
+                    for g in ("plane", "uniform", "linear")],
         "resistance": [(f"R = {R:g}", InterfaceLayer(R, 1e4, n=10, generation="uniform")) for R in (1e-10, 1e-9, 1e-8)],
         "capacitance": [(f"C = {C:g}", InterfaceLayer(1e-8, C, n=10, generation="uniform")) for C in (1e3, 1e4, 1e5)],
     }
@@ -193,7 +196,7 @@ def main():
     study_velocity(surface, contact, out)
     print("contact-area study (steady partition law):")
     law = study_area(surface, out)
-    print(f"  p1 at 3 MPa: " + ", ".join(f"{v:.1f} m/s: {law(3e6, v):.4f}" for v in law.speed))
+    print("  p1 at 3 MPa: " + ", ".join(f"{v:.1f} m/s: {law(3e6, v):.4f}" for v in law.speed))
     print("velocity-profile study (200 ms, dt = 2 ms):")
     study_profile(surface, contact, out)
     print("interface-layer study (2 ms, dt = 25 us, omega = 100 rad/s):")

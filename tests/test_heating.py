@@ -103,8 +103,8 @@ def test_far_axis_table_matches_the_exact_rotating_kernel():
 def rosenthal_square(pe, m=72):
     """Steady moving square source by the spatial integral of Rosenthal's point source,
     T = q/(2 pi kappa) ∫∫ exp(-V (r - dx)/(2 chi))/r (Love closed form for the 1/r part)."""
-    l, chi, kappa = 0.5e-3, DISC.diffusivity, DISC.kappa
-    k = pe / l                                                       # V/(2 chi)
+    l, kappa = 0.5e-3, DISC.kappa
+    k = pe / l                                                       # V/(2 chi), Pe = V l/(2 chi)
     h = 2 * l / m
     c = (np.arange(m) + 0.5) * h - l
     off = (np.arange(2 * m - 1) - (m - 1)) * h

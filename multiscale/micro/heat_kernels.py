@@ -340,8 +340,14 @@ def pulse_tables(shape, dx: float, dy: float, material: ThermalMaterial, dt: flo
                  motion: Motion | None = None, t: float | None = None, refine: float = 1.0) -> PulseTables:
     """Pulse tables of ages 0 … n_ages−1 for a fixed body (motion None: Eq. 6.3 route) or for
     body 1 moving with ``motion`` observed at time ``t`` (default n_ages·dt, which is all that
-    matters for a constant speed). dt = np.inf with n_ages = 1 gives the steady tables."""
+    matters for a constant speed). dt = np.inf with n_ages = 1 gives the steady tables. ``refine``
+    (> 1) refines the moving-body quadrature panels (used to check its convergence)."""
     ny, nx = (int(s) for s in shape)
+    if ny < 1 or nx < 1:
+        raise InputError("shape", shape, "at least one cell per side")
+    if not (dt > 0 and int(n_ages) >= 1 and (np.isfinite(dt) or n_ages == 1)):
+        raise InputError("dt/n_ages", (dt, n_ages), "dt > 0 and n_ages >= 1 (np.inf only with n_ages = 1)")
+    check_positive("refine", refine)
     a, b = 0.5 * dx, 0.5 * dy
     X, Y = _wrap_offsets(nx) * dx, _wrap_offsets(ny) * dy
     reach = float(np.hypot(nx * dx, ny * dy)) + 1.5 * max(a, b)
@@ -368,7 +374,7 @@ def pulse_tables(shape, dx: float, dy: float, material: ThermalMaterial, dt: flo
             return pulse_tables(shape, dx, dy, material, dt, 1)
         motion = Translation.steady(float(motion.speed(0.0)), motion.direction)
         k = motion.profile.values[0] / (4 * material.diffusivity)
-        v_end = 2.0 * (9 + np.sqrt(81 + 4 * k * reach)) / (2 * k)
+        v_end = 2.0 * (9 + np.sqrt(81 + 4 * k * reach)) / (2 * k)   # twice where V v²/4χ = reach + 9v
         t = lag_max = v_end * v_end / (4 * material.diffusivity)
         breaks = np.empty(0)
     else:

@@ -501,7 +501,8 @@ def partition_law(source, body1: ThermalMaterial, body2: ThermalMaterial, speed,
     """
     if isinstance(source, Surface):
         if elastic is None or pressures is None:
-            raise InputError("elastic/pressures", (elastic, pressures), "a Surface needs an elastic kernel and pressures")
+            raise InputError("elastic/pressures", (elastic, pressures),
+                             "a Surface needs an elastic kernel and mean pressures")
         if source.heights.ndim != 2:
             raise InputError("source", source.heights.shape, "one patch (a 2-D height map)")
         loads = np.sort(np.atleast_1d(np.asarray(pressures, dtype=float)))
