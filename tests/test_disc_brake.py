@@ -201,3 +201,46 @@ def test_strain_energy_per_region_matches_an_assembled_disc_stiffness(brake, no_
 def test_mode_shapes_are_written_to_xdmf(tmp_path, brake, friction):
     files = st.write_modes_xdmf(tmp_path / "modes.xdmf", friction.modes, brake[1].u, modes=[1, 2])
     assert len(files) == 2 and all(f.exists() and f.with_suffix(".h5").exists() for f in files)
+
+
+# ---------------------------------------------------------------- rough pad interfaces
+@pytest.fixture(scope="module")
+def smooth_rough(brake):
+    """A very smooth rough case (R_q = 0.05 um): embedded zone laws on both pads, mu = 0.4."""
+    from multiscale.micro.kernels import HalfSpace
+    LawSpec = pytest.importorskip("multiscale.micro.laws", reason="interface laws (issue 7) not installed").LawSpec
+
+    tm = brake[0]
+    pad, disc = MATERIALS["pad"], MATERIALS["disc"]
+    spec = LawSpec(HalfSpace.from_materials(pad.E, pad.nu, disc.E, disc.nu), p_max=3e4, n_points=10)
+    laws = st.rough_pad_laws(tm, st.PadRoughness(5e-8, zones=(4, 2), grid=32, k_max=(16, 16)), spec)
+    law = st.LinearisedFacetLaw(tm, laws)
+    mech = st.HydraulicMechanics(tm, MATERIALS, friction=0.4, speed=5.0, law=law, prefix="brake_rough_")
+    masks = st.interface_facets(tm)
+    nominal = {k: disc_brake.clamp_force(PRESSURE) / tm.interface.areas[m].sum() for k, m in masks.items()}
+    pre = st.settle(mech, law, PRESSURE, initial_gap=st.datum_gap(laws, tm.interface.areas, masks, nominal))
+    K, M = st.linearise(mech, MATERIALS)
+    return pre, laws, mech, st.solve_modes(K, M, n_modes=30)
+
+
+def test_embedded_laws_hold_on_every_facet_and_balance_the_pads(smooth_rough):
+    pre, laws, mech, _ = smooth_rough
+    assert pre.law_residuals[-1] <= 1e-6 * pre.normal_force["inner_pad"] / 4.8e-3
+    assert pre.normal_force["inner_pad"] == pytest.approx(pre.load_force["piston_back"], rel=1e-6)
+    assert pre.normal_force["outer_pad"] == pytest.approx(pre.load_force["caliper_bore"], rel=1e-6)
+    gap = mech.contact.facet_gap()
+    p_law, K_law = laws(gap)
+    # facets well inside the contact (no quadrature point clipped): mean pressure = law(mean gap)
+    inside = p_law > 0.5 * p_law.mean()
+    assert inside.sum() > 0.5 * len(p_law)
+    np.testing.assert_allclose(mech.contact.facet_pressure()[inside], p_law[inside], rtol=1e-6)
+    # the Newton matrix holds the law's stiffness on the closed facets (consistent tangent)
+    iface = mech.tm.interface
+    closed = p_law > 0
+    np.testing.assert_allclose(iface.values(mech.contact.law.k_star)[closed], K_law[closed], rtol=1e-12)
+
+
+def test_perfect_contact_and_a_very_smooth_rough_case_share_their_modes(friction, smooth_rough):
+    mac = st.mac_matrix(friction.modes, smooth_rough[3])
+    assert np.diag(mac)[:20].min() > 0.9
+    assert st.cumulative_moving_average(st.mmac(mac))[19] > 0.95

@@ -26,7 +26,7 @@ from __future__ import annotations
 import csv
 import math
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Callable, Mapping, Sequence
 
@@ -691,3 +691,207 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
     shares = strain_energy_shares(modes, RegionEnergy(mech)) if energy else None
     return SquealCase(name, pre, modes, stability_report(modes, rtol, close_tol), shares,
                       mech.contact.facet_pressure())
+
+
+# --------------------------------------------------------------------------------------------
+# Rough pad interfaces: per-zone homogenized laws embedded per facet (§4.2, §4.3.2, Table 4.1)
+# --------------------------------------------------------------------------------------------
+class LinearisedFacetLaw:
+    """A per-facet pressure–gap law in the UFL contact form, by successive linearisation.
+
+    The contact pressure is p_n = <p* + K* (g* − g_n)>_+ with per-facet DG0 fields (p*, K*, g*)
+    [Pa, Pa/m, m]; ``linearise_at`` re-linearises each facet's true law (``law(g) -> (p_n, K_n)``
+    and ``law.onset() -> (g_open, K_open)``, numpy over the global facets, e.g. ``FacetZoneLaws``)
+    at its current mean gap. Repeated to convergence (``settle``) this is Newton's method on the
+    facet laws: the state satisfies every law at its facet-mean gap and the Newton matrix holds
+    the law's stiffness K_n = −dp_n/dg_n, the consistent tangent of the embedded interface
+    (§4.2.1). An open facet (p_n = 0) is linearised at its first touch g_open with the secant
+    stiffness of its first law node, so that it resists closing in the next solve instead of
+    being pushed through (which would make the iteration cycle).
+    Pass the object as ``law=`` to ``Mechanics``; gaps follow interface.py (g_n > 0 open).
+    """
+
+    def __init__(self, tm, law):
+        self.tm, self.law = tm, law
+        iface = tm.interface
+        self.p_star = iface.field("law_pressure", 0.0)
+        self.k_star = iface.field("law_stiffness", 0.0)
+        self.g_star = iface.field("law_gap", 0.0)
+
+    def __call__(self, g):
+        lin = self.p_star("+") + self.k_star("+") * (self.g_star("+") - g)
+        return ufl.conditional(ufl.gt(lin, 0), lin, 0)
+
+    def mismatch(self, gap: np.ndarray) -> float:
+        """Largest |p_affine − p_law| over the facets at the per-facet ``gap`` [m], in Pa."""
+        iface = self.tm.interface
+        gap = np.asarray(gap, dtype=float)
+        affine = iface.values(self.p_star) + iface.values(self.k_star) * (iface.values(self.g_star) - gap)
+        return float(np.abs(np.maximum(affine, 0.0) - self.law(gap)[0]).max(initial=0.0))
+
+    def linearise_at(self, gap: np.ndarray) -> None:
+        """Set (p*, K*, g*) from the laws at the per-facet ``gap`` [m]."""
+        iface = self.tm.interface
+        gap = np.asarray(gap, dtype=float)
+        p, K = self.law(gap)
+        g_open, K_open = self.law.onset()
+        is_open = p <= 0
+        star = (p, np.where(is_open, K_open, K), np.where(is_open, g_open, gap))
+        for f, value in zip((self.p_star, self.k_star, self.g_star), star):
+            iface.set_field(f, value)
+
+
+@dataclass
+class LawPreload(Preload):
+    """``Preload`` of an interface with embedded laws: plus the linearisation history."""
+
+    law_iterations: int = 0            # re-linearisations until the laws held
+    law_residuals: list = field(default_factory=list)   # Pa, max |p_affine − p_law| per iteration
+
+
+def settle(mech: Mechanics, law: LinearisedFacetLaw, pressure: float, *, initial_gap: np.ndarray,
+           steps: int = 1, rtol: float = 1e-6, max_iter: int = 40) -> LawPreload:
+    """Preload with embedded facet laws: solve, re-linearise, until every law holds within
+    ``rtol`` of the mean interface pressure. ``initial_gap`` [m] per facet: where the laws are
+    first linearised (the macro gap field g_0 of the interface is set to it, u starts at rest).
+
+    Newton on the facet laws; when the mismatch stops decreasing (a stiffening law makes facets
+    overshoot back and forth) the next linearisation point is relaxed towards the previous one
+    (factor halved, down to 1/32) and restored once the mismatch decreases again.
+    """
+    iface = mech.tm.interface
+    g_lin = np.asarray(initial_gap, dtype=float)
+    iface.set_field(mech.contact.initial_gap, g_lin)
+    law.linearise_at(g_lin)
+    pre = preload(mech, pressure, steps)
+    scale = max(sum(pre.normal_force.values()) / iface.areas.sum(), np.finfo(float).tiny)
+    history, omega = [], 1.0
+    for it in range(1, max_iter + 1):
+        gap = mech.contact.facet_gap()
+        history.append(law.mismatch(gap))
+        if history[-1] <= rtol * scale:
+            # re-linearising at the solution moves no facet pressure by more than the tolerance;
+            # the Newton matrix assembled next then holds the laws' stiffness
+            law.linearise_at(gap)
+            return LawPreload(**vars(pre), law_iterations=it, law_residuals=history)
+        if len(history) > 1:
+            omega = min(1.0, 2 * omega) if history[-1] < 0.7 * history[-2] else max(omega / 2, 1 / 32)
+        g_lin = g_lin + omega * (gap - g_lin)
+        law.linearise_at(g_lin)
+        pre = preload(mech, pressure, 1, reset=False)
+    raise ConvergenceError(f"embedded interface laws did not settle in {max_iter} linearisations "
+                           f"(max pressure mismatch {history[-1]:.3g} Pa)", history)
+
+
+class FacetZoneLaws:
+    """Per-facet view of zone laws: facet i follows the law of zone ``zone_ids[i]`` (§4.2.1).
+
+    ``laws`` is a ``multiscale.micro.laws.ZoneLaws``; calling with per-facet gaps [m] returns
+    (p_n [Pa], K_n [Pa/m]).
+    """
+
+    def __init__(self, laws, zone_ids: np.ndarray):
+        self.laws, self.zone_ids = laws, np.asarray(zone_ids, dtype=int)
+
+    def __call__(self, gap: np.ndarray):
+        v = self.laws.pressure(np.asarray(gap, dtype=float), self.zone_ids)
+        return v.pressure, v.stiffness
+
+    def onset(self):
+        """Per facet: first-touch gap g_open [m] and the secant stiffness to the first node [Pa/m]."""
+        law = self.laws.mechanical
+        rows = self.laws.rows(self.zone_ids)
+        g_open = law.g_open[rows]
+        return g_open, law.pressure[rows, 0] / (g_open - law.gap[rows, 0])
+
+
+# R_q and sigma [m] of the pad surfaces of thesis Table 4.1 (case 0 roughest, case 5 smoothest)
+TABLE_4_1 = {0: (11.8e-6, 5.5e-6), 1: (5.7e-6, 2.7e-6), 2: (4.9e-6, 2.3e-6), 3: (4.3e-6, 2.0e-6),
+             4: (3.9e-6, 1.8e-6), 5: (3.5e-6, 1.6e-6)}
+
+
+@dataclass(frozen=True)
+class PadRoughness:
+    """Rough pad faces of one case (§4.3.2): every interface gets its own fractal surface with the
+    same statistics, cut into a grid of zones over its footprint in the (x, y) plane, one patch of
+    ``grid`` x ``grid`` cells per zone (``zones.generate_zones``; cut-offs in wavelengths per zone).
+    The counter-face (disc) is flat.
+    """
+
+    rms: float                       # m, R_q of each pad surface
+    hurst: float = 0.8
+    k_min: tuple = (1.0, 1.0)        # wavelengths per zone, (x, y)
+    k_max: tuple = (8.0, 8.0)
+    zones: tuple = (6, 3)            # zones over each pad's bounding box, (nx, ny)
+    grid: int = 32                   # cells per zone side
+    seed: int = 0
+
+    def __post_init__(self):
+        check_positive("rms", self.rms)
+
+
+def interface_facets(tm) -> dict:
+    """{interface name: boolean mask over the global interface facets}."""
+    iface = tm.interface
+    q = ufl.TestFunction(iface.space)
+    out = {}
+    for name, dS in iface.dS_tag.items():
+        vec = fem.assemble_vector(fem.form(q("+") * dS, entity_maps=tm.entity_maps))
+        vec.scatter_reverse(la.InsertMode.add)
+        out[name] = iface.gather(vec.array[iface._owned_dofs()]) > 0
+    return out
+
+
+def rough_pad_laws(tm, roughness: PadRoughness, spec, pool=None) -> FacetZoneLaws:
+    """Zone laws of every interface (pad) and the facet -> zone map (thesis §4.2, Table 4.1).
+
+    ``spec``: ``multiscale.micro.laws.LawSpec`` (kernel of the pad on the flat disc, p_max,
+    nodes); ``pool``: a ``multiscale.pool.MicroPool`` (default: one over the mesh communicator).
+    Only zones that hold a facet midpoint are solved. Zone ids: 100000 k + grid id for pad k.
+    """
+    from multiscale.micro.zones import ZoneGrid, generate_zones
+    from multiscale.pool import MicroPool
+
+    pool = pool or MicroPool(spec, tm.comm)
+    mid = tm.interface.midpoints
+    zone_ids = np.full(len(mid), -1)
+    zones = []
+    for k, (name, mask) in enumerate(interface_facets(tm).items()):
+        lo, hi = mid[mask, :2].min(axis=0), mid[mask, :2].max(axis=0)
+        pad = 1e-9 + 1e-6 * (hi - lo).max()
+        counts = tuple(int(c) for c in roughness.zones)
+        grid = ZoneGrid(tuple(lo - pad), counts, tuple((hi - lo + 2 * pad) / np.array(counts)))
+        local = grid.zone_of(mid[mask, 0], mid[mask, 1])
+        zone_ids[mask] = 100000 * k + local
+        used = set(local.tolist())
+        for z in generate_zones(grid, roughness.grid, roughness.hurst, roughness.k_min, roughness.k_max,
+                                roughness.rms, seed=roughness.seed + 7919 * k):
+            if z.id in used:
+                zones.append(replace(z, id=100000 * k + z.id))
+    if np.any(zone_ids < 0):
+        raise InputError("interface", "facets", "every interface facet must belong to an interface tag")
+    return FacetZoneLaws(pool.laws(zones, spec, gather="own"), zone_ids)
+
+
+def datum_gap(law: Callable, areas: np.ndarray, masks: Mapping[str, np.ndarray],
+              mean_pressure: Mapping[str, float]) -> np.ndarray:
+    """Per-facet initial gap: on each interface the constant gap G at which the area-weighted mean
+    of the facet laws equals ``mean_pressure[name]`` [Pa] (a rigid pad's equilibrium; bisection)."""
+    out = np.zeros(len(areas))
+    for name, mask in masks.items():
+        target = check_positive(f"mean_pressure[{name}]", mean_pressure[name])
+        a = areas[mask] / areas[mask].sum()
+        mean_p = lambda G: float(a @ law(np.full(len(areas), G))[0][mask])  # noqa: E731
+        hi = 1e-3
+        while mean_p(hi) > 0:
+            hi *= 2
+        lo = hi - 1e-6
+        while mean_p(lo) < target:
+            lo -= 2 * (hi - lo)
+        for _ in range(200):
+            mid = 0.5 * (lo + hi)
+            lo, hi = (mid, hi) if mean_p(mid) > target else (lo, mid)
+            if hi - lo <= 1e-12 * max(abs(hi), 1e-9):
+                break
+        out[mask] = 0.5 * (lo + hi)
+    return out
