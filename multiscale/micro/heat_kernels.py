@@ -363,10 +363,10 @@ def pulse_tables(shape, dx: float, dy: float, material: ThermalMaterial, dt: flo
         # w-panel between 1/v_breaks[k+1] and 1/v_breaks[k] = heat of age k (k >= 1); beyond = age n
         seg = np.searchsorted(1.0 / v_breaks[::-1], w, side="right")          # 0 … n_ages
         age = n_ages - seg                                                      # n_ages … 0 (0 unused)
-        coeffs = _segment_sums(erf_window(Y[None, :], b, v[:, None]) * (v * v)[:, None],
-                               erf_window(X[None, :], a, v[:, None]), wt, age, n_ages + 1) * norm
-        coeffs[0] = full - coeffs[1:].sum(axis=0)       # steady minus the whole tail (Eq. 6.3)
-        return PulseTables(np.arange(n_ages), coeffs[:n_ages])
+        ages, tail = _segment_sums(erf_window(Y[None, :], b, v[:, None]) * (v * v)[:, None],
+                                   erf_window(X[None, :], a, v[:, None]), wt, age)     # ages 1 … n_ages
+        first = full - norm * tail.sum(axis=0)          # steady minus the whole tail (Eq. 6.3)
+        return PulseTables(np.arange(n_ages), np.concatenate((first[None], norm * tail[:n_ages - 1])))
     if steady:
         if not motion.profile.is_constant:
             raise InputError("motion", motion, "a steady state needs a constant speed")
@@ -384,21 +384,18 @@ def pulse_tables(shape, dx: float, dy: float, material: ThermalMaterial, dt: flo
     v, w, lag = _moving_nodes(motion, t, lag_max, material.diffusivity, min(a, b), reach, breaks, refine)
     dxs, dys = motion.back_displacement(t, lag)
     age = np.searchsorted(breaks, lag, side="right")
-    coeffs = _segment_sums(erf_window(Y[None, :] + dys[:, None], b, v[:, None]),
-                           erf_window(X[None, :] + dxs[:, None], a, v[:, None]), w, age,
-                           1 if steady else n_ages) * norm
-    nonzero = np.flatnonzero(np.bincount(age, minlength=coeffs.shape[0]))
-    return PulseTables(nonzero, coeffs[nonzero])
+    ages, coeffs = _segment_sums(erf_window(Y[None, :] + dys[:, None], b, v[:, None]),
+                                 erf_window(X[None, :] + dxs[:, None], a, v[:, None]), w, age)
+    return PulseTables(ages, coeffs * norm)
 
 
-def _segment_sums(ey, ex, w, seg, n_seg):
-    """Σ over the nodes of each segment of w · outer(ey, ex): one matrix product per segment."""
-    out = np.zeros((n_seg, ey.shape[1], ex.shape[1]))
+def _segment_sums(ey, ex, w, seg):
+    """(segments present, Σ over each one's nodes of w · outer(ey, ex)): one matrix product each."""
     order = np.argsort(seg, kind="stable")
     seg, ey, ex, w = seg[order], ey[order], ex[order], w[order]
-    bounds = np.searchsorted(seg, np.arange(n_seg + 1))
-    for k in range(n_seg):
-        i, j = bounds[k], bounds[k + 1]
-        if j > i:
-            out[k] = (ey[i:j] * w[i:j, None]).T @ ex[i:j]
-    return out
+    present, starts = np.unique(seg, return_index=True)
+    ends = np.append(starts[1:], seg.size)
+    out = np.empty((present.size, ey.shape[1], ex.shape[1]))
+    for k, (i, j) in enumerate(zip(starts, ends)):
+        out[k] = (ey[i:j] * w[i:j, None]).T @ ex[i:j]
+    return present, out
