@@ -10,7 +10,9 @@ the increment psi = phi_1(t_N) − phi_1(t_{N−1}) on the contact solves A^N ps
 (Eqs. 6.9–6.18) with A^N = (T_1 + T_2)(one step) + interface diagonal (Eq. 6.16) applied by FFT
 convolution (Eq. 6.22), by conjugate gradients on the non-symmetric least-squares objective
 (Eqs. 6.19–6.20) restricted to the contacting cells (Eq. 6.21). Energy is conserved exactly:
-phi_2 = phi − phi_1.
+phi_2 = phi − phi_1. The history terms are summed in Fourier space as Σ_k S_k · (flux of step N−k)
+with the pulse tables S_k of ``heat_kernels`` (the thesis' step increments, summed by parts);
+matching at the end of each step makes the scheme first order in dt.
 Steady (§6.5, ``SteadyHeating``): the same with steady kernels and remote temperatures (Eqs. 6.23–6.25).
 ``partition_law`` gives the steady p_1(p_mean, V) that the macro model needs.
 
