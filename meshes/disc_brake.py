@@ -36,6 +36,8 @@ from multiscale.macro.geometry import (BodySpec, GeometrySpec, Region, Rotation,
                                        entities_in_box, entities_where, resolve_parameters)
 
 NAME = "disc_brake"
+FLUID_PRESSURE = True              # the load is the hydraulic pressure on its load faces (−p n)
+PARAMETER_KINDS = {"vanes": "dimensionless"}
 DEFAULTS: dict[str, float] = {
     "disc_outer_radius": 0.140,      # m
     "ring_inner_radius": 0.085,      # m, inner radius of the friction ring (= hat wall outer radius)

@@ -676,6 +676,7 @@ class SquealCase:
     report: StabilityReport
     energy: EnergyShares | None
     facet_pressure: np.ndarray      # Pa, per interface facet (global order of tm.interface)
+    mech: Mechanics | None = field(default=None, repr=False)   # the model (spaces of the modes)
 
 
 def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "case", *,
@@ -690,7 +691,7 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
     M.destroy()
     shares = strain_energy_shares(modes, RegionEnergy(mech)) if energy else None
     return SquealCase(name, pre, modes, stability_report(modes, rtol, close_tol), shares,
-                      mech.contact.facet_pressure())
+                      mech.contact.facet_pressure(), mech)
 
 
 # --------------------------------------------------------------------------------------------
@@ -895,3 +896,206 @@ def datum_gap(law: Callable, areas: np.ndarray, masks: Mapping[str, np.ndarray],
                 break
         out[mask] = 0.5 * (lo + hi)
     return out
+
+
+# --------------------------------------------------------------------------------------------
+# Scene-driven workflow (effects include "stability")
+# --------------------------------------------------------------------------------------------
+SQUEAL_DEGREE = 2     # quadratic tetrahedra: linear ones are far too stiff in bending (tests)
+
+
+def mechanics_from_scene(scene, tm, *, law=None, degree: int = SQUEAL_DEGREE,
+                         prefix: str = "squeal_") -> Mechanics:
+    """The quasi-static sliding model of a scene: a fluid-pressure load for builders that declare
+    ``FLUID_PRESSURE`` (the disc brake), the scene's force or pressure otherwise."""
+    ld = scene.loading
+    prefix = "".join(ch if ch.isalnum() else "_" for ch in prefix)
+    kwargs = dict(friction=ld.friction if scene.has("friction") else 0.0, speed=ld.angular_speed(0.0),
+                  stiffness=scene.interface.penalty or 0.0, law=law, degree=degree, prefix=prefix)
+    if getattr(scene.geometry.module(), "FLUID_PRESSURE", False):
+        if ld.pressure is None:
+            raise InputError("loading.pressure", None, f'builder "{scene.geometry.builder}" is loaded by '
+                             "the hydraulic pressure on its piston and caliper")
+        return HydraulicMechanics(tm, dict(scene.materials), **kwargs)
+    kind = "force" if ld.normal_force is not None else "pressure"
+    return Mechanics(tm, dict(scene.materials), load_kind=kind, **kwargs)
+
+
+def scene_roughness(scene) -> PadRoughness | None:
+    """``PadRoughness`` of a scene with effect "roughness" ([roughness], [micro]); else None."""
+    if not scene.has("roughness"):
+        return None
+    r, m = scene.roughness, scene.micro
+    if r.rms is None:
+        raise InputError("roughness.file", r.file, "the squeal analysis generates its zone patches "
+                         "(give roughness.rms, hurst, k_min, k_max)")
+    return PadRoughness(r.rms, r.hurst, tuple(r.k_min), tuple(r.k_max), tuple(m.zones), int(m.grid[0]),
+                        r.seed)
+
+
+def law_spec_for(materials, spec_p_max: float, n_points: int = 20):
+    """``LawSpec`` of pads on a flat disc: E* of the pad and disc materials (§4.3.2: only the pads
+    are rough), top node at ``spec_p_max`` [Pa]."""
+    from multiscale.micro.kernels import HalfSpace
+    from multiscale.micro.laws import LawSpec
+
+    pad, disc = materials["pad"], materials["disc"]
+    return LawSpec(HalfSpace.from_materials(pad.E, pad.nu, disc.E, disc.nu), p_max=spec_p_max,
+                   n_points=n_points)
+
+
+def analyse(scene, tm, *, name: str | None = None, roughness: PadRoughness | None = None,
+            law_spec=None, energy: bool = True, degree: int = SQUEAL_DEGREE) -> SquealCase:
+    """One squeal case of a scene on the mesh ``tm``: perfect penalty contact, or the embedded
+    rough laws of ``roughness`` (default: the scene's [roughness]/[micro]) with ``law_spec``
+    (default ``law_spec_for``: nodes per law from [micro], p_max 5 x the mean pad pressure)."""
+    st_ = scene.stability
+    materials = dict(scene.materials)
+    roughness = roughness or scene_roughness(scene)
+    pressure = scene.loading.pressure
+    band = tuple(st_.band)
+    damping = Damping(eta=st_.damping) if st_.damping else None
+    name = name or scene.name
+    if roughness is None:
+        mech = mechanics_from_scene(scene, tm, degree=degree, prefix=f"squeal_{name}_")
+        return squeal_case(mech, materials, name, pressure=pressure, steps=scene.loading.ramp_steps,
+                           band=band, n_modes=st_.modes, target=st_.target, damping=damping, energy=energy)
+    masks = interface_facets(tm)
+    areas = tm.interface.areas
+    load_area = {f: tm.assemble_scalar(1.0 * tm.ds(tm.face(f))) for f in tm.spec.load_faces}
+    clamp = pressure * max(load_area.values())
+    nominal = {k: clamp / areas[m].sum() for k, m in masks.items()}
+    if law_spec is None:
+        n_points = scene.micro.law_points if scene.micro is not None else 20
+        law_spec = law_spec_for(materials, 5 * max(nominal.values()), n_points)
+    laws = rough_pad_laws(tm, roughness, law_spec)
+    law = LinearisedFacetLaw(tm, laws)
+    mech = mechanics_from_scene(scene, tm, law=law, degree=degree, prefix=f"squeal_{name}_")
+    pre = settle(mech, law, pressure, initial_gap=datum_gap(laws, areas, masks, nominal),
+                 steps=scene.loading.ramp_steps)
+    K, M = linearise(mech, materials)
+    modes = solve_modes(K, M, f_min=band[0], f_max=band[1], n_modes=st_.modes, target=st_.target,
+                        damping=damping)
+    M.destroy()
+    shares = strain_energy_shares(modes, RegionEnergy(mech)) if energy else None
+    return SquealCase(name, pre, modes, stability_report(modes), shares, mech.contact.facet_pressure(), mech)
+
+
+@dataclass
+class SquealRun:
+    """Where a scene's squeal analysis wrote its results."""
+
+    folder: Path
+    case: SquealCase
+    files: list          # written paths
+    wall_time: float     # s
+
+
+def run_scene(scene, *, comm=None, overwrite: bool = False, verbose: bool = True,
+              degree: int = SQUEAL_DEGREE) -> SquealRun:
+    """``multiscale run`` for a scene whose effects include "stability" (thesis §4.3–4.4).
+
+    Preload, complex modes and, in ``scene.output.folder``: ``modes.csv``, mode shapes
+    (``modes_body*.xdmf``), ``pressure.png`` (Fig. 4.12), ``re_im.png`` (Fig. 4.13) and
+    ``energy.png`` (Figs. 4.20–4.21).
+    """
+    from mpi4py import MPI
+
+    from multiscale import io
+    from multiscale.macro import mesh as two_body
+
+    comm = comm or MPI.COMM_WORLD
+    t0 = time.perf_counter()
+    if not scene.has("stability"):
+        raise InputError("effects", sorted(scene.effects), 'the squeal analysis needs effect "stability"')
+    folder = Path(scene.output.folder)
+    existing = comm.bcast(sorted(p.name for p in folder.iterdir()) if comm.rank == 0 and folder.is_dir()
+                          else [], root=0)
+    if existing and not overwrite:
+        raise InputError("output.folder", str(folder),
+                         f"already holds results ({', '.join(existing[:3])}...); pass --overwrite to replace them")
+    io.abort_on_exception(comm)
+    if comm.rank == 0:
+        folder.mkdir(parents=True, exist_ok=True)
+    tm = two_body.build(scene.geometry.builder, dict(scene.geometry.params), comm)
+    case = analyse(scene, tm, degree=degree)
+    files = [case.modes.write_csv(folder / "modes.csv")] if comm.rank == 0 else []
+    files += write_modes_xdmf(folder / "modes.xdmf", case.modes, case.mech.u)
+    if comm.rank == 0:
+        files += [plot_pressure(tm, case, folder / "pressure.png"),
+                  plot_re_im([case], folder / "re_im.png"),
+                  plot_energy(case, folder / "energy.png")]
+    comm.barrier()
+    run = SquealRun(folder, case, files, time.perf_counter() - t0)
+    if verbose and comm.rank == 0:
+        rep = case.report
+        print(f"{scene.name}: {len(case.modes)} modes up to {case.modes.frequency.max():.0f} Hz, "
+              f"{rep.unstable.size} unstable ({', '.join(f'{f:.0f} Hz' for f in rep.frequency[rep.unstable - 1])}), "
+              f"{rep.potentially_unstable.size} potentially unstable; {run.wall_time:.1f} s on {comm.size} rank(s)")
+        print(f"  results: {folder}")
+    return run
+
+
+# --------------------------------------------------------------------------------------------
+# Figures of §4.4 (rank 0; matplotlib with the Agg backend)
+# --------------------------------------------------------------------------------------------
+def _figure(*args, **kwargs):
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    return plt, plt.subplots(*args, **kwargs)
+
+
+def _save(plt, fig, path) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    plt.close(fig)
+    return path
+
+
+def plot_pressure(tm, case: SquealCase, path) -> Path:
+    """Contact pressure on each pad at the preloaded state (thesis Fig. 4.12) [MPa]."""
+    masks = interface_facets(tm)
+    plt, (fig, axes) = _figure(1, len(masks), figsize=(5 * len(masks), 3.6), squeeze=False)
+    mid, p = tm.interface.midpoints, case.facet_pressure / 1e6
+    for ax, (name, mask) in zip(axes[0], masks.items()):
+        art = ax.tricontourf(mid[mask, 0] * 1e3, mid[mask, 1] * 1e3, p[mask], levels=20, cmap="jet")
+        fig.colorbar(art, ax=ax, label="contact pressure [MPa]")
+        ax.set(title=f"{case.name}: {name}", xlabel="x [mm]", ylabel="y [mm]", aspect="equal")
+    return _save(plt, fig, path)
+
+
+def plot_re_im(cases: Sequence[SquealCase], path) -> Path:
+    """Real part against imaginary part of the eigenvalues, one marker set per case (Fig. 4.13)."""
+    plt, (fig, ax) = _figure(figsize=(8, 4.5))
+    for c in cases:
+        ax.plot(c.modes.frequency, c.modes.growth, "o", ms=3, label=c.name)
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set(xlabel="imaginary part: frequency [Hz]", ylabel="real part sigma [1/s]",
+           title="complex eigenvalues (sigma > 0: unstable)")
+    ax.legend(fontsize=7)
+    return _save(plt, fig, path)
+
+
+def plot_energy(case: SquealCase, path) -> Path:
+    """Strain-energy share of each component per mode (Fig. 4.20) and the pad split (Fig. 4.21)."""
+    sh = case.energy
+    plt, (fig, (a, b)) = _figure(2, 1, figsize=(9, 6), sharex=True)
+    n = np.arange(1, len(case.modes) + 1)
+    bottom = np.zeros(len(n))
+    for j, name in enumerate(sh.names):
+        a.bar(n, sh.share[:, j], bottom=bottom, label=name, width=0.9)
+        bottom += sh.share[:, j]
+    a.set(ylabel="strain-energy share [-]", title=f"{case.name}: strain energy per component")
+    a.legend(fontsize=7, ncol=4)
+    pads = [x for x in sh.names if x.startswith("pad")]
+    if len(pads) == 2:
+        b.bar(n, sh.split(*pads), width=0.9, label=f"{pads[0]} / ({pads[0]} + {pads[1]})")
+        b.axhline(0.5, color="k", lw=0.5)
+        b.legend(fontsize=7)
+    for j in case.report.unstable:
+        b.axvline(j, color="r", lw=0.8, ls=":")
+    b.set(xlabel="mode number (red: unstable)", ylabel="share of the pads' energy [-]")
+    return _save(plt, fig, path)
