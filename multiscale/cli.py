@@ -95,6 +95,20 @@ def _run(args) -> int:
     return result if isinstance(result, int) else 0
 
 
+def _study(args) -> int:
+    """Run parametric studies; every problem of every study file is reported before anything runs."""
+    from multiscale.studies import problems_text, run_studies
+    if args.problems:
+        print(problems_text())
+        return 0
+    if not args.studies:
+        raise MultiscaleError("multiscale study: give study file(s), or --problems for the problems and their keys")
+    command = " ".join(["multiscale study", *args.studies] + (["--report", args.report] if args.report else []))
+    failed = run_studies(args.studies, rerun_failed=args.rerun_failed, report_folder=args.report,
+                         processes=args.processes, command=command)
+    return 1 if failed else 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="multiscale", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -109,6 +123,14 @@ def build_parser() -> argparse.ArgumentParser:
     again.add_argument("--overwrite", action="store_true", help="replace results already in the output folder")
     again.add_argument("--resume", action="store_true", help="continue from the last checkpoint in the output folder")
     run.set_defaults(func=_run)
+    study = sub.add_parser("study", help="parametric study: sweep, resumable runs, accuracy-vs-time report "
+                                         "(mpiexec -n N multiscale study study.toml)")
+    study.add_argument("studies", nargs="*", metavar="STUDY", help="study TOML file(s)")
+    study.add_argument("--rerun-failed", action="store_true", help="run the failed runs again")
+    study.add_argument("--report", metavar="DIR", help="write every report into DIR, with an index README.md")
+    study.add_argument("--processes", type=int, metavar="N", help="runs at a time (overrides [run] processes)")
+    study.add_argument("--problems", action="store_true", help="list the problems, their parameters and metrics")
+    study.set_defaults(func=_study)
     return parser
 
 

@@ -1,0 +1,264 @@
+"""Parametric studies (`multiscale study`): sweep expansion, resumable runs in fresh processes, errors
+against independent computations, failed and timed-out runs, clear errors for bad study files."""
+import csv
+import json
+import math
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+from multiscale.cli import main
+from multiscale.errors import SceneError
+from multiscale.micro.contact import ContactSolver
+from multiscale.micro.kernels import HalfSpace
+from multiscale.studies import load_study, pareto, relative_error
+
+ROOT = Path(__file__).resolve().parents[1]
+GRIDS = (12, 16, 24, 32)
+
+HERTZ = """
+name = "hertz"
+problem = "hertz"
+metrics = ["contact_radius", "max_pressure", "approach"]
+[fixed]
+load = "10 N"
+radius = "10 mm"
+[sweep]
+grid = [12, 16, 24, 32]
+[reference]
+kind = "analytic"
+[run]
+processes = 2
+[report]
+errors = ["1 %", "5 %"]
+"""
+
+
+def write(folder, text, name="study.toml"):
+    path = folder / name
+    path.write_text(text, encoding="utf-8")
+    return path
+
+
+def table(path):
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def hertz_independent(grid, load=10.0, R=10e-3, E=210e9, nu=0.3, window=4.0):
+    """Hertz errors computed here: the closed form (Johnson §4.2) and a direct FFT-BEM solve."""
+    E_star = E / (1 - nu**2)
+    a = (3 * load * R / (4 * E_star)) ** (1 / 3)
+    exact = {"contact_radius": a, "max_pressure": 3 * load / (2 * np.pi * a * a), "approach": a * a / R}
+    side = window * a
+    dx = side / grid
+    x = (np.arange(grid) + 0.5) * dx - side / 2
+    h = -(x[None, :] ** 2 + x[:, None] ** 2) / (2 * R)
+    r = ContactSolver(HalfSpace(E_star), h.shape, dx, periodic=False).solve(h, load=load / side**2)
+    got = {"contact_radius": math.sqrt(r.contact.sum() * dx * dx / math.pi), "max_pressure": r.pressure.max(),
+           "approach": float(r.approach)}
+    return {m: abs(got[m] - exact[m]) / exact[m] for m in exact}
+
+
+@pytest.fixture(scope="module")
+def hertz_study(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("hertz")
+    path = write(folder, HERTZ)
+    assert main(["study", str(path)]) == 0
+    return path, folder / "results" / "hertz"
+
+
+def test_hertz_study_errors_match_an_independent_computation(hertz_study):
+    path, out = hertz_study
+    rows = table(out / "results.csv")
+    assert [int(r["grid"]) for r in rows] == list(GRIDS)
+    for row in rows:
+        assert row["status"] == "ok" and row["converged"] == "True"
+        assert float(row["wall_time"]) > 0 and float(row["peak_memory_mb"]) > 10 and int(row["iterations"]) > 0
+        mine = hertz_independent(int(row["grid"]))
+        for m, err in mine.items():
+            assert float(row[f"{m}_error"]) == pytest.approx(err, rel=1e-6, abs=1e-12)
+        assert float(row["max_error"]) == pytest.approx(max(mine.values()), rel=1e-6)
+    # the same table in HDF5, one row per run
+    with h5py.File(out / "results.h5", "r") as h5:
+        np.testing.assert_allclose(h5["max_pressure_error"][...], [float(r["max_pressure_error"]) for r in rows])
+        assert list(h5["grid"][...]) == list(GRIDS)
+    # the report names the cheapest grid meeting each error, from the same errors
+    worst = {int(r["grid"]): float(r["max_error"]) for r in rows}
+    time = {int(r["grid"]): float(r["wall_time"]) for r in rows}
+    text = (out / "hertz.md").read_text()
+    for tol, shown in ((0.01, "| 1 % |"), (0.05, "| 5 % |")):
+        good = [g for g in GRIDS if worst[g] <= tol]
+        line = next(line for line in text.splitlines() if line.startswith(shown))
+        if good:
+            best = min(good, key=time.get)
+            assert line.split("|")[2].strip() == str(best)
+        else:
+            assert "none of the runs" in line
+    for png in ("hertz_error_vs_time.png", "hertz_grid.png"):
+        assert (out / png).stat().st_size > 5000
+
+
+def test_rerun_skips_finished_runs_and_runs_only_new_points(hertz_study, capsys):
+    path, out = hertz_study
+    before = {p.name: p.read_text() for p in (out / "runs").glob("*.json")}
+    path.write_text(HERTZ + "plots = false\n")
+    assert main(["study", str(path)]) == 0
+    assert "4 recorded before, 0 run now" in capsys.readouterr().out
+    assert {p.name: p.read_text() for p in (out / "runs").glob("*.json")} == before
+    # a fifth grid: only that run is computed; a range giving the same points names the same runs
+    path.write_text(HERTZ.replace("grid = [12, 16, 24, 32]", "grid = [12, 16, 24, 32, 20]") + "plots = false\n")
+    assert main(["study", str(path)]) == 0
+    assert "4 recorded before, 1 run now" in capsys.readouterr().out
+    path.write_text(HERTZ.replace("grid = [12, 16, 24, 32]", "grid = {start = 12, stop = 24, step = 4}")
+                    + "plots = false\n")
+    assert main(["study", str(path)]) == 0
+    assert "4 recorded before, 0 run now" in capsys.readouterr().out
+
+
+def test_failing_and_timed_out_runs_are_recorded_and_the_rest_completes(tmp_path, capsys):
+    text = HERTZ.replace("[sweep]\ngrid = [12, 16, 24, 32]",
+                         '[sweep]\ncombine = "zip"\ngrid = [12, 16, 24]\nmax_iter = [5000, 1, 5000]') + "plots = false\n"
+    path = write(tmp_path, text)
+    assert main(["study", str(path)]) == 1          # runs failed: exit 1, not a user error
+    rows = table(tmp_path / "results" / "hertz" / "results.csv")
+    assert [r["status"] for r in rows] == ["ok", "failed", "ok"]
+    assert rows[1]["message"].startswith("ContactConvergenceError: ") and "1 iterations" in rows[1]["message"]
+    assert float(rows[0]["max_error"]) < 0.1 and math.isnan(float(rows[1]["max_error"]))
+    report = (tmp_path / "results" / "hertz" / "hertz.md").read_text()
+    assert "grid = 16, max_iter = 1: ContactConvergenceError" in report
+    # --rerun-failed runs only the failed one again
+    capsys.readouterr()
+    assert main(["study", str(path), "--rerun-failed"]) == 1
+    assert "2 recorded before, 1 run now, 1 failed" in capsys.readouterr().out
+    # a run over its time limit is killed and recorded as failed
+    slow = write(tmp_path, text.replace("[run]", '[run]\ntimeout = "0.05 s"').replace('name = "hertz"', 'name = "slow"'),
+                 "slow.toml")
+    assert main(["study", str(slow)]) == 1
+    rows = table(tmp_path / "results" / "slow" / "results.csv")
+    assert all(r["status"] == "failed" and r["message"] == "timed out after 0.05 s (run.timeout)" for r in rows)
+
+
+def test_sweep_expansion_products_zips_and_ranges(tmp_path):
+    path = write(tmp_path, """
+problem = "heat_partition"
+metrics = ["partition_1"]
+[[sweep]]
+dt = {start = "50 us", stop = "450 us", num = 3, log = true}
+[[sweep]]
+combine = "zip"
+n = [32, 48]
+seed = {start = 3, stop = 4, num = 2}
+[reference]
+kind = "run"
+run = {dt = "50 us"}
+""")
+    study = load_study(path)
+    assert study.knobs == ("dt", "n", "seed")
+    labels = [r.label for r in study.runs]
+    assert len(labels) == 6 and len({r.key for r in study.runs}) == 6
+    assert [x["dt"] for x in labels[::2]] == pytest.approx([50e-6, 150e-6, 450e-6])
+    assert [(x["n"], x["seed"]) for x in labels[:2]] == [(32, 3), (48, 4)]
+    assert study.folder == tmp_path / "results" / "study"
+
+
+def test_pareto_front():
+    times = [1.0, 2.0, 3.0, 4.0, 2.5, 5.0]
+    errors = [0.1, 0.2, 0.05, 0.01, 0.05, 0.0]       # the 0 (the reference itself) is left out
+    assert pareto(times, errors) == [0, 4, 3]
+    assert relative_error(1.1, 1.0) == pytest.approx(0.1) and relative_error(0.2, 0.0) == 0.2
+
+
+BAD = [   # (what, replacement applied to HERTZ, the message expected on stderr)
+    ("unknown parameter", ("grid = [12", "gird = [12"),
+     'sweep.gird: unknown parameter of problem "hertz" (did you mean "grid"?)'),
+    ("empty sweep", ("grid = [12, 16, 24, 32]", "grid = []"), "sweep.grid = []: empty sweep: give at least one value"),
+    ("reference not in the sweep", ('kind = "analytic"', 'kind = "run"\nrun = {grid = 64}'),
+     "reference.run = {grid = 64}: not in the sweep (swept grid: 12, 16, 24, 32)"),
+    ("reference of an unswept parameter", ('kind = "analytic"', 'kind = "run"\nrun = {load = "1 N"}'),
+     "reference.run.load: not a swept parameter; swept: grid"),
+    ("unknown problem", ('problem = "hertz"', 'problem = "herz"'),
+     'problem = "herz": unknown problem (did you mean "hertz"?)'),
+    ("unknown metric", ('"approach"]', '"aproach"]'),
+     'metrics item 3 ("aproach"): unknown metric of problem "hertz" (did you mean "approach"?)'),
+    ("bad value", ("grid = [12, 16, 24, 32]", "grid = [12, 4]"),
+     "sweep.grid = [12, 4]: item 2 (4): must be an integer >= 8"),
+    ("unequal zip", ("grid = [12, 16, 24, 32]", 'combine = "zip"\ngrid = [12, 16]\nwindow = [3]'),
+     'sweep: combine = "zip" needs lists of equal length (grid: 2, window: 1)'),
+    ("swept and fixed", ("grid = [12, 16, 24, 32]", "load = [1, 2]"), "sweep.load: also given in fixed; give it once"),
+    ("bad range", ("grid = [12, 16, 24, 32]", "grid = {start = 8, stop = 64}"),
+     "sweep.grid = {start = 8, stop = 64}: a range needs start, stop and one of num, step"),
+    ("analytic without one", ('problem = "hertz"\nmetrics = ["contact_radius", "max_pressure", "approach"]',
+                              'problem = "rough_contact"\nmetrics = ["mean_pressure"]', "grid = [12, 16, 24, 32]",
+                              "n = [32, 64]", 'load = "10 N"\nradius = "10 mm"', ""),
+     'reference.kind = "analytic": problem "rough_contact" has no analytic reference; use kind = "run"'),
+    ("wrong unit", ('load = "10 N"', 'load = "10 mm"'),
+     'fixed.load = "10 mm": expected a force (N, kN); the unit "mm" is a length'),
+    ("no sweep", ("[sweep]\ngrid = [12, 16, 24, 32]", ""), "sweep: missing; required"),
+]
+
+
+@pytest.mark.parametrize("what, change, message", BAD, ids=[b[0] for b in BAD])
+def test_bad_study_files_give_clear_errors(tmp_path, capsys, what, change, message):
+    text = HERTZ
+    for old, new in zip(change[::2], change[1::2]):
+        text = text.replace(old, new)
+    path = write(tmp_path, text)
+    assert main(["study", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert message in err, err
+    assert "Traceback" not in err and not (tmp_path / "results").exists()
+
+
+def test_bad_scene_study_names_the_scene_path(tmp_path, capsys):
+    scene = (ROOT / "demos" / "block_on_flat.toml").resolve()
+    path = write(tmp_path, f"""
+problem = "scene"
+scene = "{scene}"
+metrics = ["interface_force:last", "max_pressure:sum"]
+[sweep]
+geometry.mesh_siz = ["2 mm", "3 mm"]
+""")
+    assert main(["study", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert 'geometry.mesh_siz: unknown parameter of builder "block_on_flat" (did you mean "mesh_size"?)' in err
+    assert 'metrics item 2 ("max_pressure:sum"): a history column, optionally with :last|:first' in err
+
+
+def test_shipped_study_files_are_valid():
+    files = sorted((ROOT / "studies").glob("*/*.toml"))
+    assert len(files) >= 8
+    for f in files:
+        study = load_study(f)
+        assert study.runs and all(k in study.knobs for k in study.report.cases)
+
+
+def test_scene_problem_errors_are_user_errors(tmp_path):
+    with pytest.raises(SceneError, match='scene: missing; problem "scene" needs the base scene file'):
+        load_study(write(tmp_path, 'problem = "scene"\nmetrics = ["time"]\n[sweep]\n"time.steps" = [1, 2]\n'))
+
+
+def test_scene_study_runs_the_macro_scene_with_overrides(tmp_path):
+    """A macro scene swept through its keys: the block-on-flat force is pressure x face area."""
+    scene = (ROOT / "demos" / "block_on_flat.toml").resolve()
+    path = write(tmp_path, f"""
+problem = "scene"
+scene = "{scene}"
+metrics = ["interface_force:last", "max_pressure:max"]
+[fixed]
+geometry.mesh_size = "5 mm"
+geometry.width = "6 mm"
+[sweep]
+loading.pressure = ["3 MPa"]
+[report]
+plots = false
+""")
+    assert main(["study", str(path)]) == 0
+    out = tmp_path / "results" / "study"
+    row = table(out / "results.csv")[0]
+    assert float(row["loading.pressure"]) == 3e6
+    assert float(row["interface_force:last"]) == pytest.approx(3e6 * 10e-3 * 6e-3, rel=1e-6)
+    assert float(row["max_pressure:max"]) == pytest.approx(3e6, rel=1e-3)
+    assert (out / "runs" / row["run"] / "output" / "history.h5").is_file()
