@@ -71,30 +71,30 @@ def run_cases(args, comm):
     return scene, tm, cases
 
 
-def figures(tm, cases: dict, out: Path) -> list[Path]:
-    """Figures 4.12–4.21 (rank 0)."""
+def correlations(cases: dict) -> dict:
+    """MAC of every rough case against the perfect contact (collective: every rank calls it)."""
+    ref = cases.get("perfect")
+    return {} if ref is None else {name: st.mac_matrix(ref.modes, c.modes)
+                                   for name, c in cases.items() if c is not ref}
+
+
+def figures(tm, masks: dict, cases: dict, macs: dict, out: Path) -> list[Path]:
+    """Figures 4.12–4.21 and the tables (rank 0; the collective parts are computed before)."""
     files = []
     for name, case in cases.items():
         slug = name.replace(" ", "")
         files.append(case.modes.write_csv(out / f"modes_{slug}.csv"))
-        files.append(st.plot_pressure(tm, case, out / f"fig4_12_pressure_{slug}.png"))
+        files.append(st.plot_pressure(tm.interface.midpoints, masks, case, out / f"fig4_12_pressure_{slug}.png"))
         files.append(st.plot_energy(case, out / f"fig4_20_energy_{slug}.png"))
     files.append(st.plot_re_im(list(cases.values()), out / "fig4_13_re_im.png"))
     files.append(plot_unstable_bars(cases, out / "fig4_14_unstable.png"))
-    if "perfect" in cases:
-        ref = cases["perfect"]
-        mmacs = {}
-        for name, case in cases.items():
-            if name == "perfect":
-                continue
-            mac = st.mac_matrix(ref.modes, case.modes)
-            mmacs[name] = st.mmac(mac)
-            if name in ("case 5", "case 0"):
-                fig = "fig4_16" if name == "case 5" else "fig4_17"
-                files.append(plot_mac(mac, f"perfect contact vs {name}", out / f"{fig}_mac_{name.replace(' ', '')}.png"))
-        if mmacs:
-            files += plot_mmac(mmacs, out / "fig4_18_mmac.png", out / "fig4_19_cumulative.png")
-    files.append(write_summary(cases, out / "summary.csv"))
+    for name, fig in (("case 5", "fig4_16"), ("case 0", "fig4_17")):
+        if name in macs:
+            files.append(plot_mac(macs[name], f"perfect contact vs {name}", out / f"{fig}_mac_{name.replace(' ', '')}.png"))
+    if macs:
+        files += plot_mmac({name: st.mmac(mac) for name, mac in macs.items()},
+                           out / "fig4_18_mmac.png", out / "fig4_19_cumulative.png")
+    files.append(write_summary(cases, macs, out / "summary.csv"))
     return files
 
 
@@ -136,15 +136,14 @@ def plot_mmac(mmacs: dict, path, cumulative_path) -> list[Path]:
     return out
 
 
-def write_summary(cases: dict, path) -> Path:
-    ref = cases.get("perfect")
+def write_summary(cases: dict, macs: dict, path) -> Path:
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["case", "R_q_um", "modes", "f_max_Hz", "unstable", "unstable_Hz", "potentially_unstable",
                     "max_pressure_MPa", "mean_MMAC_first20"])
         for name, c in cases.items():
             rq = "" if name == "perfect" else f"{st.TABLE_4_1[int(name.split()[1])][0] * 1e6:g}"
-            mm = "" if ref is None or c is ref else f"{st.mmac(st.mac_matrix(ref.modes, c.modes))[:20].mean():.3f}"
+            mm = f"{st.mmac(macs[name])[:20].mean():.3f}" if name in macs else ""
             w.writerow([name, rq, len(c.modes), f"{c.modes.frequency.max():.0f}", c.report.unstable.size,
                         " ".join(f"{f:.0f}" for f in c.report.frequency[c.report.unstable - 1]),
                         c.report.potentially_unstable.size, f"{c.facet_pressure.max() / 1e6:.3f}", mm])
@@ -157,9 +156,10 @@ def main(argv=None) -> int:
     io.abort_on_exception(comm)
     out = Path(args.out)
     _, tm, cases = run_cases(args, comm)
+    masks, macs = st.interface_facets(tm), correlations(cases)
     if comm.rank == 0:
         out.mkdir(parents=True, exist_ok=True)
-        files = figures(tm, cases, out)
+        files = figures(tm, masks, cases, macs, out)
         for name, c in cases.items():
             print(f"{name:>8}: {len(c.modes)} modes, unstable at "
                   f"{', '.join(f'{f:.0f}' for f in c.report.frequency[c.report.unstable - 1]) or '-'} Hz")

@@ -1021,8 +1021,9 @@ def run_scene(scene, *, comm=None, overwrite: bool = False, verbose: bool = True
     case = analyse(scene, tm, degree=degree)
     files = [case.modes.write_csv(folder / "modes.csv")] if comm.rank == 0 else []
     files += write_modes_xdmf(folder / "modes.xdmf", case.modes, case.mech.u)
+    masks = interface_facets(tm)
     if comm.rank == 0:
-        files += [plot_pressure(tm, case, folder / "pressure.png"),
+        files += [plot_pressure(tm.interface.midpoints, masks, case, folder / "pressure.png"),
                   plot_re_im([case], folder / "re_im.png"),
                   plot_energy(case, folder / "energy.png")]
     comm.barrier()
@@ -1055,11 +1056,13 @@ def _save(plt, fig, path) -> Path:
     return path
 
 
-def plot_pressure(tm, case: SquealCase, path) -> Path:
-    """Contact pressure on each pad at the preloaded state (thesis Fig. 4.12) [MPa]."""
-    masks = interface_facets(tm)
+def plot_pressure(midpoints: np.ndarray, masks: Mapping[str, np.ndarray], case: SquealCase, path) -> Path:
+    """Contact pressure on each pad at the preloaded state (thesis Fig. 4.12) [MPa].
+
+    ``midpoints`` (global interface facets) and ``masks`` (``interface_facets``, collective) are
+    gathered beforehand, so that rank 0 alone can draw."""
     plt, (fig, axes) = _figure(1, len(masks), figsize=(5 * len(masks), 3.6), squeeze=False)
-    mid, p = tm.interface.midpoints, case.facet_pressure / 1e6
+    mid, p = midpoints, case.facet_pressure / 1e6
     for ax, (name, mask) in zip(axes[0], masks.items()):
         art = ax.tricontourf(mid[mask, 0] * 1e3, mid[mask, 1] * 1e3, p[mask], levels=20, cmap="jet")
         fig.colorbar(art, ax=ax, label="contact pressure [MPa]")
