@@ -292,8 +292,11 @@ def test_interaction_truncation_is_within_its_bound():
     t, law = model.table, model.law
     on = np.nonzero(r.contact)[0]
     a = r.semi_axes[on, 0]
-    full = _Interactions(law, t.x[on], t.y[on], on, a, cutoff=1e9).evaluate(a).u
-    cut = _Interactions(law, t.x[on], t.y[on], on, a, cutoff=model.cutoff).evaluate(a).u
+    inter = _Interactions(law, t.x[on], t.y[on], on)
+    inter.set_near(a, 1e9)
+    full = inter.evaluate(a).u
+    inter.set_near(a, model.cutoff)
+    cut = inter.evaluate(a).u
     assert r.truncation == pytest.approx(1e-2)
     err = np.abs(cut - full) / full
     assert err.max() <= r.truncation and err.max() > 1e-2 * r.truncation

@@ -37,8 +37,9 @@ solutions differ only by the non-reciprocity of that approximation, O((a/r)²) o
 Interaction sums (vectorised, no loop over pairs): every contact acts on every other through the
 point-force response ``g(r)`` of the solid (``P_l g(r)``, a dense matrix–vector product among the
 candidate summits: double precision up to ~4500 candidates, single (1e-6 relative) up to ~6300,
-recomputed blockwise beyond), and pairs closer than ``cutoff · a_max,l``
-(found with a ``scipy.spatial.cKDTree``; a_max is the non-interacting size, an upper bound) add the
+recomputed blockwise beyond), and pairs closer than ``cutoff · a_ref,l`` (found with a
+``scipy.spatial.cKDTree``; a_ref >= a is a bound on the final contact size, from the warm start or a
+screening pass with point forces only, enlarged and re-solved if a contact outgrows it) add the
 near-field correction ``u_l − P_l g``. For a Hertz contact of semi-axes a >= b the correction is
 the quadrupole term, |u − P g| <= (2a² − b²)/(10 r²) · P g <= 0.2 (a/r)² P g (circular:
 (a/r)²/10), so the neglected part of every interaction sum is at most
@@ -91,8 +92,9 @@ from multiscale.micro.surface import AsperityTable, Surface, find_asperities, st
 
 _GL_X, _GL_V = np.polynomial.legendre.leggauss(16)
 _GL_T, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_V          # Gauss–Legendre on (0, 1)
-_FLOOR = 1e-10          # smallest relative size a/a_max used where derivatives are divided by a
+_FLOOR = 1e-10          # smallest relative size a/a_ref used where derivatives are divided by a
 _DENSE_BYTES = 160e6    # far-field matrix kept in memory up to this size (float64, then float32)
+_SCREEN = 400           # more active candidates than this: screening pass with point forces only
 
 
 # ----------------------------------------------------------------------------- laws
@@ -439,8 +441,7 @@ class AsperityModel:
             absorbed = self._absorbed(cand, a_free)
             active = dk > 0
             active[absorbed] = False
-            inter = self._interactions(cand, dk[cand])
-            a, stats = _minimise(inter, dk, active, a_free, route, method, tol, max_iter, initial)
+            a, stats = self._interacting(dk, active, a_free, route, method, tol, max_iter, initial)
             if not stats["converged"] and not partial:
                 res = self._result(delta, a, stats, t0, raster, absorbed)
                 raise AsperityConvergenceError(
@@ -476,7 +477,7 @@ class AsperityModel:
         dk = d[-1] - (self.z_max - self.table.height)
         cand = np.nonzero(dk > 0)[0]
         if self.interaction and len(cand) > 1:
-            self._interactions(cand, dk[cand])       # one neighbour structure for the whole curve
+            self._interactions(cand)                 # one far-field matrix for the whole curve
         steps = d
         if progress:
             from tqdm import tqdm
@@ -498,14 +499,62 @@ class AsperityModel:
             results=results)
 
     # -- internals ------------------------------------------------------------------------
-    def _interactions(self, cand, dk) -> "_Interactions":
+    def _interactions(self, cand) -> "_Interactions":
         c = self._cache
-        if c is not None and np.all(np.isin(cand, c.idx)):
-            return c
-        t = self.table
-        a_max = self.law.size_at(dk, cand)
-        self._cache = _Interactions(self.law, t.x[cand], t.y[cand], cand, a_max, self.cutoff)
-        return self._cache
+        if c is None or not np.all(np.isin(cand, c.idx)):
+            t = self.table
+            c = self._cache = _Interactions(self.law, t.x[cand], t.y[cand], cand)
+        return c
+
+    def _interacting(self, dk, active, a_free, route, method, tol, max_iter, initial):
+        """Minimise with a near-field list sized by a_ref >= a (from the initial sizes or, for many
+        candidates, from a screening pass with point-force interactions only), on the summits in
+        contact at the start or within 5 % of delta of touching; a_ref grows, and excluded summits
+        that penetrate join, until the solution is verified on every candidate."""
+        full = self._interactions(np.nonzero(dk > 0)[0])
+        totals = dict(iterations=0, evaluations=0)
+        ref = float(dk.max())
+
+        def run(inter, a_ref, start, tol_, route=route, method=method):
+            inter.set_near(a_ref[inter.idx], self.cutoff)
+            a, st = _minimise(inter, dk, active, a_free, route, method, tol_, max_iter, start)
+            totals["iterations"] += st["iterations"]
+            totals["evaluations"] += st["evaluations"]
+            return a, st
+
+        many = active.sum() > _SCREEN
+        if initial is None and many:
+            initial, _ = run(full, np.zeros_like(a_free), None, 1e-3, "energy", "l-bfgs-b")
+        if initial is None:
+            a_ref = a_free
+        else:
+            initial = np.minimum(np.maximum(np.asarray(initial, dtype=float), 0.0), a_free)
+            a_ref = np.minimum(a_free, 1.3 * initial + 0.1 * a_free)
+        keep = active.copy()
+        if many:
+            keep &= (initial > 0) | (self._gaps(full, initial, a_ref, dk) < 0.05 * ref)
+        for _ in range(10):
+            inter = full if keep.sum() == active.sum() else full.subset(keep[full.idx])
+            a, st = run(inter, a_ref, initial, tol)
+            over = a > a_ref
+            bad = np.zeros_like(keep)
+            if inter is not full:
+                bad = ~keep & active & (self._gaps(full, a, a_ref, dk) < -tol * ref)
+            if not over.any() and not bad.any():
+                break
+            a_ref = np.where(over, np.minimum(a_free, 1.5 * a), a_ref)
+            keep |= bad
+            initial = a
+        st.update(totals)
+        return a, st
+
+    def _gaps(self, inter, a, a_ref, dk):
+        """Gap of every summit of ``inter`` (a = 0 there) under the contacts ``a`` (full index)."""
+        inter.set_near(a_ref[inter.idx], self.cutoff)
+        st = inter.evaluate(a[inter.idx])
+        gap = np.full(len(dk), np.inf)
+        gap[inter.idx] = st.w + st.u - dk[inter.idx]
+        return gap
 
     def _result(self, delta, a, stats, t0, raster, absorbed) -> AsperityResult:
         law, on = self.law, np.nonzero(a > 0)[0]
@@ -566,35 +615,59 @@ class AsperityModel:
 
 # ----------------------------------------------------------------------------- interaction sums
 class _Interactions:
-    """Interaction sums among candidate summits ``idx`` (positions x, y; upper-bound sizes a_max).
+    """Interaction sums among candidate summits ``idx`` (positions x, y).
 
     u_int = G P + N(a): G the point-response matrix (zero diagonal), N the near-field correction
-    u_l − P_l g over pairs with r < cutoff · a_max[source]."""
+    u_l − P_l g over pairs with r < cutoff · a_ref[source] (``set_near``), a_ref >= a."""
 
-    def __init__(self, law: AsperityLaw, x, y, idx, a_max, cutoff):
-        self.law, self.idx, self.a_max = law, np.asarray(idx), np.asarray(a_max, dtype=float)
+    def __init__(self, law: AsperityLaw, x, y, idx):
+        self.law, self.idx = law, np.asarray(idx)
         n = self.n = len(self.idx)
-        xy = np.column_stack([x, y])
-        reach = cutoff * self.a_max
-        pairs = cKDTree(xy).query_pairs(float(reach.max()), output_type="ndarray")
-        src = np.concatenate([pairs[:, 0], pairs[:, 1]])
-        dst = np.concatenate([pairs[:, 1], pairs[:, 0]])
-        d = xy[dst] - xy[src]
-        r = np.hypot(d[:, 0], d[:, 1])
-        keep = r < reach[src]
-        self.src, self.dst, self.ddx, self.ddy = src[keep], dst[keep], d[keep, 0], d[keep, 1]
-        self.g_near = law.point_response(r[keep])
-        self.xy = xy
+        self.xy = np.column_stack([x, y])
+        self.tree = cKDTree(self.xy)
         self.G = None
         if n * n * 8 <= _DENSE_BYTES:
             self.G = self._block(0, n)
         elif n * n * 4 <= _DENSE_BYTES:             # single precision: 1e-6 relative, << truncation
             self.G = np.vstack([self._block(i, min(i + 1024, n)).astype(np.float32) for i in range(0, n, 1024)])
         self.evaluations = 0
+        self.set_near(np.zeros(n), 1.0)
+
+    def subset(self, sel) -> "_Interactions":
+        """The same sums restricted to the summits ``sel`` (bool over ``idx``)."""
+        sub = object.__new__(_Interactions)
+        sub.law, sub.idx = self.law, self.idx[sel]
+        sub.n, sub.xy = len(sub.idx), self.xy[sel]
+        sub.tree = cKDTree(sub.xy)
+        sub.G = None if self.G is None else self.G[np.ix_(sel, sel)]
+        sub.evaluations = 0
+        sub.set_near(np.zeros(sub.n), 1.0)
+        return sub
+
+    def set_near(self, a_ref, cutoff):
+        """Near-field pairs (source, receiver) closer than cutoff · a_ref[source]."""
+        self.a_ref = np.asarray(a_ref, dtype=float)
+        reach = cutoff * self.a_ref
+        src = np.nonzero(reach > 0)[0]
+        lists = self.tree.query_ball_point(self.xy[src], reach[src], return_sorted=False)
+        counts = np.fromiter((len(v) for v in lists), dtype=int, count=len(lists))
+        dst = np.fromiter((j for v in lists for j in v), dtype=int, count=int(counts.sum()))
+        src = np.repeat(src, counts)
+        keep = dst != src
+        src, dst = src[keep], dst[keep]
+        d = self.xy[dst] - self.xy[src]
+        self.src, self.dst, self.ddx, self.ddy = src, dst, d[:, 0], d[:, 1]
+        self.g_near = self.law.point_response(np.hypot(d[:, 0], d[:, 1]))
 
     def _block(self, i0, i1):
-        d = self.xy[i0:i1, None, :] - self.xy[None, :, :]
-        r = np.hypot(d[..., 0], d[..., 1])
+        """Rows i0:i1 of G."""
+        x, y = self.xy[:, 0], self.xy[:, 1]
+        r = np.subtract.outer(x[i0:i1], x)
+        r *= r
+        t = np.subtract.outer(y[i0:i1], y)
+        t *= t
+        r += t
+        np.sqrt(r, out=r)
         diag = np.arange(i0, i1)
         r[diag - i0, diag] = 1.0
         g = self.law.point_response(r)
@@ -602,24 +675,31 @@ class _Interactions:
         return g
 
     def far(self, f):
-        """G f (blockwise when G is not stored)."""
+        """G f (only the rows of non-zero sources: G is symmetric; blockwise when not stored)."""
         if self.G is not None:
-            return self.G @ f.astype(self.G.dtype) if self.G.dtype != f.dtype else self.G @ f
+            nz = np.nonzero(f)[0]
+            if len(nz) < 0.6 * self.n:
+                return (f[nz].astype(self.G.dtype) @ self.G[nz]).astype(float)
+            return (self.G @ f.astype(self.G.dtype)).astype(float)
         out = np.empty(self.n)
         step = max(1, int(_DENSE_BYTES / (8 * self.n)))
         for i0 in range(0, self.n, step):
             out[i0:i0 + step] = self._block(i0, min(i0 + step, self.n)) @ f
         return out
 
-    def evaluate(self, a):
-        """Interaction state at sizes ``a`` (>= 0, one per candidate)."""
+    def evaluate(self, a, a_low=None):
+        """Interaction state at sizes ``a`` (>= 0, one per candidate); derivatives are taken at
+        max(a, a_low) (their limits for contacts about to open)."""
         self.evaluations += 1
         law, idx = self.law, self.idx
+        ad = a if a_low is None else np.maximum(a, a_low)
         P, dP = law.force(a, idx)
         w, dw = law.approach(a, idx)
-        live = a[self.src] > _FLOOR * self.a_max[self.src]
+        if a_low is not None:
+            dP, dw = law.force(ad, idx)[1], law.approach(ad, idx)[1]
+        live = a[self.src] > 0
         src, dst, g = self.src[live], self.dst[live], self.g_near[live]
-        u, du = law.displacement(a[src], idx[src], self.ddx[live], self.ddy[live], self.a_max[src])
+        u, du = law.displacement(a[src], idx[src], self.ddx[live], self.ddy[live], self.a_ref[src])
         corr, dcorr = u - P[src] * g, du - dP[src] * g
         far = self.far(P)
         near = np.bincount(dst, corr, minlength=self.n)
@@ -653,7 +733,7 @@ def _minimise(inter: _Interactions, dk_all, active_all, a_free, route, method, t
     cand = active_all[idx]                          # the structure may hold a superset of candidates
     a0 = a_free[idx] if initial is None else np.minimum(
         np.maximum(np.asarray(initial, dtype=float)[idx], 0.0), a_free[idx])
-    a0 = np.where(cand, np.where(a0 > 0, a0, 0.5 * a_free[idx]), 0.0)
+    a0 = np.where(cand, a0, 0.0)
     ev0 = inter.evaluations
     if route == "energy":
         a, its, res = _energy_route(inter, dk, cand, a_free[idx], a0, method, tol, max_iter)
@@ -689,16 +769,17 @@ class _Stop:
 
 
 def _energy_route(inter, dk, cand, a_top, a_init, method, tol, max_iter):
-    """Minimise the complementary energy over z = (P_top/P_u)(a/a_top)³ >= 0 (a_top, P_top the
-    non-interacting size and force, P_u their mean: z is exactly the force in units P_u for Hertz),
-    U in units P_u max(delta_k): then dU/dz_k is the energy-route gap of summit k over delta, and
-    the projected-gradient tolerance is the gap tolerance."""
+    """Minimise the complementary energy over z = c (P_top/P_u)(a/a_top)³ >= 0 (a_top, P_top the
+    non-interacting size and force, P_u their mean: z ∝ force for Hertz), U in units P_u max(delta_k);
+    c_k makes d²U/dz_k² = 1 at the non-interacting state. dU/dz_k is the gap of summit k (energy
+    route) over delta, divided by c_k; the minimiser stops on the complementarity residual."""
     law, idx = inter.law, inter.idx
     am = np.where(cand, a_top, 1.0)
     Pm = law.force(am, idx)[0]
     ref = float(dk.max())
     Pu = float(np.mean(Pm[cand]))
-    s = Pm / Pu
+    dPm, dwm = law.force(am, idx)[1], law.approach(am, idx)[1]
+    s = Pm / Pu * np.sqrt(dwm / dPm * Pu / ref)        # unit curvature at the non-interacting state
     t_floor = _FLOOR**3
     last = {}
 
@@ -709,12 +790,12 @@ def _energy_route(inter, dk, cand, a_top, a_init, method, tol, max_iter):
 
     def fun(z):
         a, dadz = sizes(z)
-        st = inter.evaluate(np.where(cand, np.maximum(a, _FLOOR * am), 0.0))
-        W, dW = law.energy(st.a, idx)
+        st = inter.evaluate(a, np.where(cand, _FLOOR * am, 0.0))
+        W, dW = law.energy(a, idx)
         U = np.sum(W - st.P * dk + 0.5 * st.P * st.u)
         grad = _energy_gradient(st, dW, dk, inter.n)
         gap = np.divide(grad, st.dP, out=np.zeros_like(grad), where=st.dP > 0)
-        last.update(z=z.copy(), a=a, P=np.where(a > 0, st.P, 0.0), gap=gap)
+        last.update(z=z.copy(), a=a, P=st.P, gap=gap)
         return U / (Pu * ref), np.where(cand, grad * dadz / (Pu * ref), 0.0)
 
     def measure(z):
