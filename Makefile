@@ -15,7 +15,7 @@ PYTHON ?= $(shell for p in python python3 python3.12 python3.13 python3.14; do \
 	  if command -v $$p >/dev/null 2>&1 && $$p -c 'import sys; sys.exit(sys.version_info < (3, 12))' 2>/dev/null; then \
 	    command -v $$p; break; fi; done)
 
-.PHONY: venv demo test test-serial test-mpi bench clean
+.PHONY: venv demo test test-serial test-mpi bench report clean
 
 venv: $(STAMP)
 
@@ -44,6 +44,11 @@ $(BENCH_STAMP): $(STAMP)
 
 bench: $(BENCH_STAMP)
 	$(BIN)/python benchmarks/run_all.py
+
+# Accuracy-vs-time report of the micro models (docs/accuracy); finished runs are reused
+# (studies/accuracy/results/): delete that folder to recompute everything.
+report: $(STAMP)
+	$(BIN)/multiscale study studies/accuracy/*.toml --report docs/accuracy
 
 clean:
 	rm -rf $(VENV) .pytest_cache build *.egg-info

@@ -159,8 +159,9 @@ class StudyRun:
     """One point of the sweep."""
 
     key: str          # hash of the problem and its validated parameters (the record's name)
-    label: dict       # swept knob -> value (SI number, string or tuple), in sweep order
+    label: dict       # swept knob -> value (SI number, string or list), in sweep order
     raw: dict         # fixed and swept raw values, as the problem parses them
+    shown: dict       # swept knob -> the value as the study file wrote it (for tables and plots)
 
 
 @dataclass(frozen=True)
@@ -444,7 +445,7 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple:
         label = {k: _norm(swept[k], _parser_of(problem, k)) for k in knobs}
         local = Context(directory=ctx.directory)
         params = problem.parse(raw, "", local, **extra)
-        where = ", ".join(f"{k} = {_text(v)}" for k, v in label.items())
+        where = ", ".join(f"{k} = {_text(swept[k])}" for k in knobs)
         ctx.problems.extend(f"{line} (run {where})" for line in local.problems)
         if local.problems:
             continue
@@ -454,7 +455,7 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple:
             ctx.problems.append(f"runs ({seen[digest]}) and ({where}) have the same parameters")
             continue
         seen[digest] = where
-        runs.append(StudyRun(digest, label, raw))
+        runs.append(StudyRun(digest, label, raw, {k: _text(swept[k]) for k in knobs}))
     return tuple(runs)
 
 
@@ -487,8 +488,8 @@ def _check_reference(f: StudyFile, problem, knobs, axes, runs, ctx):
         want = {k: _norm(v, _parser_of(problem, k)) for k, v in ref.run.items()}
         for r in runs:
             if reference_run(runs, r.label, want, axes) is None:
-                swept = "; ".join(f"{k}: {', '.join(sorted({_text(x.label[k]) for x in runs}))}" for k in ref.run)
-                ctx.problems.append(f"reference.run = {{{', '.join(f'{k} = {_text(v)}' for k, v in want.items())}}}: "
+                swept = "; ".join(f"{k}: {', '.join(dict.fromkeys(x.shown[k] for x in runs))}" for k in ref.run)
+                ctx.problems.append(f"reference.run = {{{', '.join(f'{k} = {_text(v)}' for k, v in ref.run.items())}}}: "
                                     f"not in the sweep (swept {swept})")
                 return
     else:
@@ -593,7 +594,7 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
         while queue or running:
             while queue and len(running) < study.options.processes:
                 run = queue.pop(0)
-                running[_spawn(study, run)] = (run, time.monotonic())
+                running[_spawn(study, run, rank)] = (run, time.monotonic())
             time.sleep(0.05)
             for proc, (run, t0) in list(running.items()):
                 timeout = study.options.timeout
@@ -606,6 +607,9 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
                     _failed_record(study, run, _crash_message(study, run, proc.returncode))
                 del running[proc]
                 failed += json.loads(_record_path(study, run).read_text()).get("status") == _FAILED
+                log = study.folder / "runs" / f"{run.key}.log"
+                if log.is_file() and not log.stat().st_size:
+                    log.unlink()
                 if bar is not None:
                     bar.update()
     finally:
@@ -618,15 +622,16 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     return ExecStats(len(study.runs), len(study.runs) - len(todo), len(mine), failed, time.perf_counter() - start)
 
 
-def _spawn(study: Study, run: StudyRun) -> subprocess.Popen:
+def _spawn(study: Study, run: StudyRun, rank: int) -> subprocess.Popen:
     workdir = study.folder / "runs" / run.key
     task = {"problem": study.problem, "raw": run.raw, "label": run.label, "key": run.key,
             "metrics": list(study.metrics), "repeat": study.options.repeat,
             "exact": study.reference is not None and study.reference.kind == "analytic",
             "record": str(_record_path(study, run)), "workdir": str(workdir),
-            "references": str(study.folder / "references"), "directory": str(study.source.parent)}
+            "references": str(study.folder / "references"), "directory": str(study.source.parent), "rank": rank}
     if study.problem == "scene":
         task.update(scene=str(study.scene), ranks=study.options.ranks)
+    _record_path(study, run).unlink(missing_ok=True)          # a failed run being retried
     log = open(study.folder / "runs" / f"{run.key}.log", "w")
     try:
         return subprocess.Popen([sys.executable, "-m", "multiscale.studies", json.dumps(task, default=_json_default)],
@@ -685,7 +690,7 @@ def _worker(task: dict) -> int:
     from multiscale.study_problems import problem as get_problem
     record = {"key": task["key"], "problem": task["problem"], "label": task["label"], "status": _FAILED,
               "metrics": {}, "started": _now(), "repeat": task["repeat"], "python": platform.python_version(),
-              "multiscale": multiscale.__version__, "cpus": os.cpu_count()}
+              "multiscale": multiscale.__version__, "cpus": os.cpu_count(), "rank": task["rank"]}
     try:
         problem = get_problem(task["problem"])
         ctx = Context(directory=Path(task["directory"]))
@@ -695,7 +700,7 @@ def _worker(task: dict) -> int:
             raise SceneError(ctx.problems)
         record["params"] = problem.key(params)
         workdir = Path(task["workdir"])
-        workdir.mkdir(parents=True, exist_ok=True)
+        problem.prepare()
         record["base_memory_mb"] = _peak_mb()
         times, cpu0 = [], _cpu()
         for _ in range(task["repeat"]):
@@ -867,7 +872,7 @@ def _reference_text(study: Study) -> str:
 
 
 def _case_key(study: Study, row: Row) -> tuple:
-    return tuple(_text(row.run.label[k]) for k in study.cases)
+    return tuple(row.run.shown[k] for k in study.cases)
 
 
 def cheapest(study: Study, rows: list[Row]) -> list[dict]:
@@ -916,7 +921,7 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
               f"- Runs: {len(ok)} ok, {len(failed)} failed; {sum(r.record.get('wall_time', 0) for r in ok):.1f} s "
               f"of run wall time in all. Wall time: best of {study.options.repeat} repetition(s) in a fresh "
               "process (one thread); peak memory: the run process's maximum resident set (interpreter and "
-              "libraries included).",
+              "libraries included; in brackets what the run added to the process's baseline).",
               f"- Generated {_now()} on a {os.cpu_count()}-core machine by `{command or 'multiscale study ' + study.source.name}`.",
               ""]
     if study.reference is not None and ok:
@@ -933,8 +938,14 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
     return path
 
 
+def _memory(record: dict) -> str:
+    """Peak memory [MB] and, in brackets, what the run added to its process's baseline."""
+    peak, base = record.get("peak_memory_mb", math.nan), record.get("base_memory_mb", math.nan)
+    return "n/a" if not math.isfinite(peak) else f"{peak:.0f}" + (f" (+{peak - base:.0f})" if math.isfinite(base) else "")
+
+
 def _label_text(row: Row) -> str:
-    return ", ".join(f"{k} = {_text(v)}" for k, v in row.run.label.items())
+    return ", ".join(f"{k} = {v}" for k, v in row.run.shown.items())
 
 
 def _cheapest_table(study, rows) -> list[str]:
@@ -951,8 +962,7 @@ def _cheapest_table(study, rows) -> list[str]:
             cells = ["none of the runs"] + [""] * (len(knobs) + 3)
         else:
             speed = r.record["wall_time"] / base.record["wall_time"] if base else math.nan
-            cells = [_text(r.run.label[k]) for k in knobs] + [f"{r.record['wall_time']:.3g}",
-                                                                f"{r.record.get('peak_memory_mb', math.nan):.0f}",
+            cells = [r.run.shown[k] for k in knobs] + [f"{r.record['wall_time']:.3g}", _memory(r.record),
                                                                 _pct(r.max_error), f"{speed:.2g}"]
             if r.is_reference:
                 cells[-1] += " (only the reference)"
@@ -965,7 +975,7 @@ def _average_table(study, rows) -> list[str]:
     keep = [k for k in study.knobs if k not in study.averaged]
     groups = {}
     for r in rows:
-        groups.setdefault(tuple(_text(r.run.label[k]) for k in keep), []).append(r)
+        groups.setdefault(tuple(r.run.shown[k] for k in keep), []).append(r)
     head = keep + [f"{m} mean ± std (min … max)" for m in study.metrics] + ["samples"]
     lines = [f"## Averaged over {', '.join(study.averaged)}", "",
              "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
@@ -985,7 +995,7 @@ def _runs_table(study, rows) -> list[str]:
     head += ["wall time [s]", "peak memory [MB]", "iterations", "status"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
-        cells = [_text(r.run.label[k]) for k in study.knobs]
+        cells = [r.run.shown[k] for k in study.knobs]
         for m in study.metrics:
             cells.append(_num(r.record.get("metrics", {}).get(m, math.nan)))
             if study.reference:
@@ -996,7 +1006,7 @@ def _runs_table(study, rows) -> list[str]:
             status += " (not converged)"
         if r.note:
             status += f" ({r.note})"
-        cells += [_num(float(rec.get("wall_time", math.nan))), _num(float(rec.get("peak_memory_mb", math.nan))),
+        cells += [_num(float(rec.get("wall_time", math.nan))), _memory(rec),
                   str(rec.get("iterations", "")), status]
         lines.append("| " + " | ".join(cells) + " |")
     return lines
@@ -1037,8 +1047,8 @@ def plot(study: Study, rows: list[Row], folder: Path) -> list[Path]:
     return [p for p in out if p is not None]
 
 
-def _short(label: dict, skip=()) -> str:
-    return ", ".join(_text(v) for k, v in label.items() if k not in skip)
+def _short(run: StudyRun, skip=()) -> str:
+    return ", ".join(v for k, v in run.shown.items() if k not in skip)
 
 
 def _plot_pareto(plt, study, ok, folder):
@@ -1054,8 +1064,12 @@ def _plot_pareto(plt, study, ok, folder):
             ax.scatter([t[i] for i in idx], [e[i] for i in idx], color=f"C{c}", s=28, zorder=3,
                        label=", ".join(f"{k} = {v}" for k, v in zip(study.cases, case)) or None)
             for i in idx:
-                ax.annotate(_short(ok[i].run.label, study.cases), (t[i], e[i]), fontsize=6,
+                ax.annotate(_short(ok[i].run, study.cases), (t[i], e[i]), fontsize=6,
                             xytext=(3, 3), textcoords="offset points")
+        refs = sorted(r.record["wall_time"] for r in ok if r.is_reference)
+        if refs:
+            ax.axvspan(refs[0], refs[-1], color="green", alpha=0.15, lw=0)
+            ax.axvline(refs[len(refs) // 2], color="green", ls=":", label="reference run" + "s" * (len(refs) > 1))
         front = pareto(t, e)
         if front:
             drawn = True
@@ -1093,10 +1107,10 @@ def _plot_axis(plt, study, ok, axis, folder):
     averaged = set(study.averaged)
     others = [k for k in study.knobs if k not in axis and k not in averaged]
     if not numeric:      # categorical: name every zipped value at its tick
-        ticks = {json.dumps(r.run.label[knob]): ", ".join(_text(r.run.label[k]) for k in axis) for r in ok}
+        ticks = {json.dumps(r.run.label[knob]): ", ".join(r.run.shown[k] for k in axis) for r in ok}
     lines = {}
     for r in ok:
-        lines.setdefault(tuple(_text(r.run.label[k]) for k in others), []).append(r)
+        lines.setdefault(tuple(r.run.shown[k] for k in others), []).append(r)
     with_ref = study.reference is not None
     panels = ([("error", m) for m in study.metrics] if with_ref else [("value", m) for m in study.metrics]) \
         + [("time", None)]
@@ -1105,7 +1119,7 @@ def _plot_axis(plt, study, ok, axis, folder):
         for c, (other, group) in enumerate(lines.items()):
             pts = {}
             for r in group:
-                y = (r.errors.get(m, math.nan) if kind == "error" else
+                y = (r.errors.get(m, math.nan) or math.nan if kind == "error" else     # 0: the reference
                      r.record["metrics"][m] if kind == "value" else r.record["wall_time"])
                 pts.setdefault(xs[json.dumps(r.run.label[knob])], []).append(y)
             x = sorted(pts)
@@ -1209,14 +1223,21 @@ def _index(summaries, folder: Path, command: str) -> Path:
         if study.reference is None:
             lines += ["Parametric study (no reference).", ""]
             continue
-        lines += [f"Reference: {_reference_text(study)}.", ""]
-        for c in cheapest(study, rows):
-            r = c["row"]
-            case = f" ({', '.join(f'{k} = {v}' for k, v in zip(study.cases, c['case']))})" if study.cases else ""
-            what = "no run meets it" if r is None else (
-                ", ".join(f"{k} = {_text(r.run.label[k])}" for k in study.knobs if k not in study.cases)
-                + f": {r.record['wall_time']:.3g} s, worst error {_pct(r.max_error)}")
-            lines.append(f"- error ≤ {_pct(c['error'])}{case}: {what}")
+        lines += [f"Reference: {_reference_text(study)}. Cheapest setting meeting each error "
+                  "(wall time, worst error):", ""]
+        found = cheapest(study, rows)
+        cases = list(dict.fromkeys(c["case"] for c in found))
+        head = ["error ≤"] + ([", ".join(f"{k} = {v}" for k, v in zip(study.cases, case)) for case in cases]
+                             if study.cases else ["setting"])
+        lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        for tol in study.report.errors:
+            cells = [_pct(tol)]
+            for c in (c for c in found if c["error"] == tol):
+                r = c["row"]
+                cells.append("none" if r is None else ", ".join(
+                    f"{k} = {r.run.shown[k]}" for k in study.knobs if k not in study.cases)
+                    + f" ({r.record['wall_time']:.3g} s, {_pct(r.max_error)})" + (" (the reference)" * r.is_reference))
+            lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
     path = folder / "README.md"
     path.write_text("\n".join(lines) + "\n")

@@ -15,6 +15,7 @@ discretisation alone. Physics lives in ``multiscale.micro``; this module only se
 """
 from __future__ import annotations
 
+import importlib
 import json
 import os
 import subprocess
@@ -62,6 +63,9 @@ class Problem:
         """JSON-able identity of a run's parameters (hashed to name the run's record)."""
         raise NotImplementedError
 
+    def prepare(self) -> None:
+        """Load what every run needs before its clock starts."""
+
     def run(self, params, workdir: Path) -> Outcome:
         raise NotImplementedError
 
@@ -77,8 +81,10 @@ class MicroProblem(Problem):
     """A micro problem: ``params`` dataclass, ``function(params) -> Outcome``, optional
     ``exact(params) -> dict`` depending only on ``exact_params`` (None: all parameters)."""
 
-    def __init__(self, name, params, metrics, function, exact=None, exact_metrics=(), exact_params=None):
+    def __init__(self, name, params, metrics, function, exact=None, exact_metrics=(), exact_params=None,
+                 imports=()):
         self.name, self.params, self.metrics, self.function = name, params, dict(metrics), function
+        self.imports = ("surface", "kernels", "contact") + tuple(imports)
         self.doc = (function.__doc__ or "").strip().split("\n\n")[0].replace("\n", " ")
         self.exact, self.exact_metrics, self.exact_params = exact, tuple(exact_metrics), exact_params
 
@@ -92,6 +98,12 @@ class MicroProblem(Problem):
         values = self.key(params)
         return values if self.exact_params is None else {k: values[k] for k in self.exact_params}
 
+    def prepare(self) -> None:
+        """Import the micro modules the problem uses, so that a run's wall time and memory do not
+        include loading them."""
+        for name in self.imports:
+            importlib.import_module(f"multiscale.micro.{name}")
+
     def run(self, params, workdir):
         return self.function(params)
 
@@ -99,10 +111,10 @@ class MicroProblem(Problem):
 PROBLEMS: dict[str, Problem] = {}
 
 
-def _register(params, metrics, exact=None, exact_metrics=(), exact_params=None):
+def _register(params, metrics, exact=None, exact_metrics=(), exact_params=None, imports=()):
     def wrap(function):
         name = function.__name__.lstrip("_")
-        PROBLEMS[name] = MicroProblem(name, params, metrics, function, exact, exact_metrics, exact_params)
+        PROBLEMS[name] = MicroProblem(name, params, metrics, function, exact, exact_metrics, exact_params, imports)
         return function
     return wrap
 
@@ -232,7 +244,7 @@ class RoughContactParams(SurfaceParams):
 
 
 @_register(RoughContactParams, {"mean_pressure": "force / nominal area [Pa]",
-                                "area_fraction": "real contact area / nominal area [-]"})
+                                "area_fraction": "real contact area / nominal area [-]"}, imports=("asperity",))
 def _rough_contact(p: RoughContactParams) -> Outcome:
     """Rough contact at one rigid approach: FFT-BEM or an asperity model (thesis §1.2.2, Fig. 1.14)."""
     from multiscale.micro.kernels import HalfSpace
@@ -277,7 +289,7 @@ class WearParams(SurfaceParams):
                         "max_pressure": "final peak contact pressure [Pa]",
                         "mean_gap": "final mean gap at the load [m]",
                         "rms_height": "final RMS height [m]",
-                        "volume": "worn volume [m^3]"})
+                        "volume": "worn volume [m^3]"}, imports=("wear",))
 def _wear_steps(p: WearParams) -> Outcome:
     """Wear of a rough patch in N steps (thesis §3.5.1: N = 200…600): final state."""
     from multiscale.micro.kernels import HalfSpace
@@ -322,7 +334,8 @@ class ConductanceParams(SurfaceParams):
 @_register(ConductanceParams, {"conductance": "total thermal contact conductance K_t [W/(m^2 K)]",
                                "interface_conductance": "K_i = 1/(1/K_t - 1/K_p) [W/(m^2 K)]",
                                "contact_temperature": "T_s, mean temperature of solid 1 on the contact [K]",
-                               "area_fraction": "real contact area / nominal area [-]"})
+                               "area_fraction": "real contact area / nominal area [-]"},
+           imports=("conduction", "layered"))
 def _conductance(p: ConductanceParams) -> Outcome:
     """Thermal contact conductance of a rough (layered) contact at one pressure (thesis §5.5)."""
     from multiscale.micro.conduction import ConductionSolver, SeriesKernel
@@ -388,7 +401,8 @@ class HeatPartitionParams(SurfaceParams):
                                  "partition_1_mean": "time average of partition_1 over the run [-]",
                                  "max_temperature": "largest surface temperature rise at the end [K]",
                                  "area_fraction": "real contact area / nominal area [-]",
-                                 "mean_pressure": "mean contact pressure [Pa]"})
+                                 "mean_pressure": "mean contact pressure [Pa]"},
+           imports=("heat_kernels", "heating"))
 def _heat_partition(p: HeatPartitionParams) -> Outcome:
     """Heat partition and flash temperature of a rough pin on a rotating disc (thesis §6.4)."""
     from multiscale.micro.contact import ContactSolver
@@ -507,7 +521,7 @@ def _flat_interface(laws, ids, C, flat, tol=1e-12, max_iter=100):
                            "area_fraction": "real contact area / nominal area from the zone laws [-]"},
            exact=_zone_reference, exact_metrics=("mean_pressure", "area_fraction"),
            exact_params=("size", "hurst", "k_min", "k_max", "rms", "seed", "source_n", "E", "nu", "approach",
-                         "reference_n", "tol"))
+                         "reference_n", "tol"), imports=("laws", "zones"))
 def _zone_laws(p: ZoneLawParams) -> Outcome:
     """Zone laws on a flat macro interface vs the micro solve of the whole surface (thesis Fig. 1.14)."""
     from multiscale.micro.kernels import HalfSpace
@@ -574,6 +588,7 @@ class SceneProblem(Problem):
         """Run the scene in a subprocess (``mpiexec -n ranks`` when ranks > 1) into workdir/output."""
         from multiscale.io import History
         out = Path(workdir) / "output"
+        Path(workdir).mkdir(parents=True, exist_ok=True)
         task = json.dumps({"scene": str(params.scene), "overrides": {**params.overrides, "output.folder": str(out)}})
         command = [sys.executable, "-m", "multiscale.study_problems", task]
         if params.ranks > 1:

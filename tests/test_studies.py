@@ -262,3 +262,22 @@ plots = false
     assert float(row["interface_force:last"]) == pytest.approx(3e6 * 10e-3 * 6e-3, rel=1e-6)
     assert float(row["max_pressure:max"]) == pytest.approx(3e6, rel=1e-3)
     assert (out / "runs" / row["run"] / "output" / "history.h5").is_file()
+
+
+def test_runs_are_shared_out_over_mpi_ranks(tmp_path):
+    """`mpiexec -n 2 multiscale study`: each rank runs its share, rank 0 writes the table."""
+    import os
+    import subprocess
+    import sys
+    path = write(tmp_path, HERTZ.replace("processes = 2", "processes = 1").replace("[12, 16, 24, 32]", "[12, 16]")
+                 + "plots = false\n")
+    mpiexec = Path(sys.executable).with_name("mpiexec")
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    done = subprocess.run([str(mpiexec), "-n", "2", sys.executable, "-m", "multiscale.cli", "study", str(path)],
+                          capture_output=True, text=True, env=env, timeout=300)
+    assert done.returncode == 0, done.stderr
+    out = tmp_path / "results" / "hertz"
+    assert done.stdout.count("hertz: 2 runs") == 1                  # rank 0 reports
+    ranks = sorted(json.loads(p.read_text())["rank"] for p in (out / "runs").glob("*.json"))
+    assert ranks == [0, 1]
+    assert [r["status"] for r in table(out / "results.csv")] == ["ok"] * 2
