@@ -1,6 +1,4 @@
 """Block pressed on a flat through the penalty interface (thesis §1.4, §7.3.1): exact checks."""
-from types import SimpleNamespace as NS
-
 import numpy as np
 import pytest
 
@@ -9,8 +7,9 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 from multiscale.errors import ConvergenceError, InputError  # noqa: E402
 from multiscale.macro import mesh  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
+from multiscale.scene import Material  # noqa: E402
 
-MATERIALS = {"block": NS(E=4e9, nu=0.15, alpha=1e-5), "flat": NS(E=210e9, nu=0.3, alpha=1.2e-5)}
+MATERIALS = {"block": Material(E=4e9, nu=0.15, alpha=1e-5), "flat": Material(E=210e9, nu=0.3, alpha=1.2e-5)}
 K_N = 1e13          # Pa/m
 
 

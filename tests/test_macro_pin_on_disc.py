@@ -1,6 +1,4 @@
 """Pin-on-disc of thesis §7.3 with perfect contact: force balance, friction, frictional heat."""
-from types import SimpleNamespace as NS
-
 import numpy as np
 import pytest
 
@@ -9,11 +7,12 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 from multiscale.macro import mesh  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
 from multiscale.macro.thermal import Thermal  # noqa: E402
+from multiscale.scene import Material  # noqa: E402
 
 COARSE = {"mesh_size": 15e-3, "holder_mesh_size": 6e-3, "interface_mesh_size": 2.5e-3}
 MATERIALS = {   # Table 7.2 (chi given, so rho c = kappa / chi)
-    "pin": NS(E=5e9, nu=0.3, kappa=35.0, chi=8.3e-6, alpha=5e-6),
-    "disc": NS(E=220e9, nu=0.3, kappa=50.0, chi=1e-5, alpha=1e-5),
+    "pin": Material(E=5e9, nu=0.3, kappa=35.0, chi=8.3e-6, alpha=5e-6),
+    "disc": Material(E=220e9, nu=0.3, kappa=50.0, chi=1e-5, alpha=1e-5),
 }
 F, OMEGA, MU, HALF = 200.0, 200 * 2 * np.pi / 60, 0.4, 10e-3     # N, rad/s, -, m (half pin size)
 

@@ -29,16 +29,6 @@ LINEAR_OPTIONS = {"snes_type": "ksponly", "ksp_type": "preonly", "pc_type": "lu"
                   "pc_factor_mat_solver_type": "mumps"}
 
 
-def heat_capacity(material) -> float | None:
-    """Volumetric heat capacity rho c [J/(m^3 K)]: from rho and c, else from kappa / chi."""
-    rho, c, chi = (getattr(material, k, None) for k in ("rho", "c", "chi"))
-    if rho is not None and c is not None:
-        return float(rho) * float(c)
-    if chi is not None and getattr(material, "kappa", None) is not None:
-        return float(material.kappa) / float(chi)
-    return None
-
-
 def temperature_functions(tm, degree: int = 1) -> list:
     """P1 temperature functions [K] on the two body submeshes."""
     return [fem.Function(fem.functionspace(b.mesh, ("Lagrange", degree)), name=f"temperature_{b.name}")
@@ -57,8 +47,8 @@ class ThermalStep:
 class Thermal:
     """Heat problem of both bodies driven by the contact's frictional heat (see module docstring).
 
-    ``materials`` maps material names to objects with ``kappa`` [W/(m K)] and either ``rho``
-    [kg/m^3] and ``c`` [J/(kg K)] or ``chi`` [m^2/s]. ``initial_temperature`` [K] is also the
+    ``materials`` maps material names to ``multiscale.scene.Material`` (``kappa`` [W/(m K)],
+    ``heat_capacity`` rho c [J/(m^3 K)]). ``initial_temperature`` [K] is also the
     reference of the stored-heat balance.
     """
 
@@ -74,7 +64,7 @@ class Thermal:
         for f in self.T + self.T_old:
             f.x.array[:] = self.T_ref
         self.kappa = body_fields(tm, materials, "kappa")
-        self.rho_c = body_fields(tm, materials, heat_capacity, "rho_c")
+        self.rho_c = body_fields(tm, materials, "heat_capacity", "rho_c")
         self.dt = fem.Constant(tm.parent, check_positive("dt", dt))
         self.time = 0.0
         self.cache = FormCache(tm)

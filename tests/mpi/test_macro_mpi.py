@@ -1,0 +1,61 @@
+"""Two MPI ranks give the same pin-on-disc history as one (run: mpiexec -n 2 python -m pytest tests/mpi)."""
+import numpy as np
+import pytest
+
+pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+
+from mpi4py import MPI  # noqa: E402
+
+from multiscale.macro.runner import run  # noqa: E402
+from multiscale.scene import loads  # noqa: E402
+
+SCENE = """
+name = "pod_mpi"
+effects = ["contact", "friction", "thermal", "heat_partition", "expansion"]
+[geometry]
+builder = "pin_on_disc"
+mesh_size = "15 mm"
+holder_mesh_size = "6 mm"
+interface_mesh_size = "2.5 mm"
+[materials.disc]
+E = "220 GPa"
+nu = 0.3
+kappa = "50 W/(m K)"
+chi = "1e-5 m^2/s"
+alpha = "1e-5 1/K"
+[materials.pin]
+E = "5 GPa"
+nu = 0.3
+kappa = "35 W/(m K)"
+chi = "8.3e-6 m^2/s"
+alpha = "5e-6 1/K"
+[interface]
+penalty = "1e13 Pa/m"
+partition = 0.14
+[loading]
+normal_force = "200 N"
+rotation_speed = "200 rpm"
+friction = 0.4
+ramp_steps = 2
+[time]
+end = "1.2 s"
+steps = 2
+initial_temperature = "20 degC"
+[output]
+folder = "{folder}"
+"""
+
+
+def test_two_ranks_give_the_serial_history(tmp_path):
+    world = MPI.COMM_WORLD
+    assert world.size == 2, "run under mpiexec -n 2"
+    base = world.bcast(str(tmp_path), root=0)
+    parallel = run(loads(SCENE.format(folder=f"{base}/parallel")), comm=world, verbose=False).history
+    serial = None
+    if world.rank == 0:
+        serial = run(loads(SCENE.format(folder=f"{base}/serial")), comm=MPI.COMM_SELF, verbose=False).history
+    serial = world.bcast(serial.columns if serial is not None else None, root=0)
+    assert set(serial) == set(parallel.columns)
+    assert parallel["interface_force"] == pytest.approx(200.0, rel=1e-6)
+    for key, values in serial.items():
+        np.testing.assert_allclose(parallel[key], values, rtol=1e-8, atol=1e-8, err_msg=key)

@@ -1,0 +1,112 @@
+"""Scenes through the macro runner: only the requested effects are built; files a run writes."""
+import numpy as np
+import pytest
+
+pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+
+from multiscale.errors import InputError  # noqa: E402
+from multiscale.io import History  # noqa: E402
+from multiscale.macro.runner import build_model, run  # noqa: E402
+from multiscale.scene import loads  # noqa: E402
+
+BLOCK = """
+name = "block"
+effects = [{effects}]
+[geometry]
+builder = "block_on_flat"
+mesh_size = "2.5 mm"
+[materials.block]
+E = "4 GPa"
+nu = 0.15
+kappa = "5 W/(m K)"
+chi = "1e-6 m^2/s"
+[materials.flat]
+E = "210 GPa"
+nu = 0.3
+kappa = "45 W/(m K)"
+chi = "1e-5 m^2/s"
+[interface]
+penalty = "1e13 Pa/m"
+[loading]
+pressure = "1 MPa"
+[time]
+end = "1 s"
+[output]
+folder = "{folder}"
+"""
+
+PIN = """
+name = "pod"
+effects = ["contact", "friction", "thermal", "heat_partition", "expansion"]
+[geometry]
+builder = "pin_on_disc"
+mesh_size = "15 mm"
+holder_mesh_size = "6 mm"
+interface_mesh_size = "2.5 mm"
+[materials.disc]
+E = "220 GPa"
+nu = 0.3
+kappa = "50 W/(m K)"
+chi = "1e-5 m^2/s"
+alpha = "1e-5 1/K"
+[materials.pin]
+E = "5 GPa"
+nu = 0.3
+kappa = "35 W/(m K)"
+chi = "8.3e-6 m^2/s"
+alpha = "5e-6 1/K"
+[interface]
+penalty = "1e13 Pa/m"
+partition = "effusivity"
+[loading]
+normal_force = "200 N"
+rotation_speed = "200 rpm"
+friction = 0.4
+[time]
+end = "1.2 s"
+steps = 2
+substeps = 2
+initial_temperature = "20 degC"
+[output]
+folder = "{folder}"
+"""
+
+
+def test_scene_without_thermal_builds_no_heat_problem(tmp_path):
+    scene = loads(BLOCK.format(effects='"contact"', folder=tmp_path / "out"))
+    model = build_model(scene)
+    assert model.problems == ("mechanics",) and model.thermal is None
+    assert model.mechanics.temperatures is None             # no thermal strain either
+    result = run(scene, verbose=False)
+    assert set(result.history.columns) == {"time", "interface_force", "friction_force", "max_pressure",
+                                           "newton_iterations"}
+    assert result.history["max_pressure"][-1] == pytest.approx(1e6, rel=1e-6)
+    assert [f.name for f in result.field_files] == ["block.xdmf", "flat.xdmf", "interface.xdmf"]
+
+
+def test_thermal_on_a_translating_flat_is_refused(tmp_path):
+    scene = loads(BLOCK.format(effects='"contact", "thermal"', folder=tmp_path / "out"))
+    with pytest.raises(InputError, match="rotating body"):
+        build_model(scene)
+
+
+def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
+    scene = loads(PIN.format(folder=tmp_path / "pod"))
+    result = run(scene, verbose=False)
+    h = History.read(result.history_file)
+    assert len(h) == 3 and h["time"][-1] == pytest.approx(1.2)
+    np.testing.assert_allclose(h["interface_force"], 200.0, rtol=1e-6)
+    # the effusivity partition (Material.effusivity of pin and disc) goes to the pin
+    e_pin, e_disc = (scene.materials[m].effusivity for m in ("pin", "disc"))
+    share = h["heat_total_pin"][-1] / (h["heat_total_pin"][-1] + h["heat_total_disc"][-1])
+    assert share == pytest.approx(e_pin / (e_pin + e_disc), rel=1e-9)
+    # energy: what the fields store equals the frictional heat put in (adiabatic bodies)
+    assert h["stored_heat_pin"][-1] == pytest.approx(h["heat_total_pin"][-1], rel=1e-6)
+    assert h["stored_heat_disc"][-1] == pytest.approx(h["heat_total_disc"][-1], rel=1e-2)
+    assert np.all(np.diff(h["max_temperature_pin"]) > 0)
+    for f in result.field_files + [result.plot_file]:
+        assert f.exists() and f.stat().st_size > 0
+    with pytest.raises(InputError, match="--overwrite"):
+        run(scene, verbose=False)
+    with pytest.raises(InputError, match="resume"):
+        run(scene, resume=True, verbose=False)
