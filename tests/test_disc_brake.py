@@ -199,8 +199,16 @@ def test_strain_energy_per_region_matches_an_assembled_disc_stiffness(brake, no_
 
 
 def test_mode_shapes_are_written_to_xdmf(tmp_path, brake, friction):
+    import h5py
+
     files = st.write_modes_xdmf(tmp_path / "modes.xdmf", friction.modes, brake[1].u, modes=[1, 2])
     assert len(files) == 2 and all(f.exists() and f.with_suffix(".h5").exists() for f in files)
+    n0 = brake[1].spaces[0].dofmap.index_map.size_local * 3
+    disc = friction.modes.modes[n0:, 1]                     # mode 2 on the disc (P1: vertex values)
+    with h5py.File(files[1].with_suffix(".h5"), "r") as f:
+        assert sorted(f["Function/mode_re"]) == ["1", "2"]
+        for part, values in (("mode_re", disc.real), ("mode_im", disc.imag)):
+            assert np.abs(f[f"Function/{part}/2"][...]).max() == pytest.approx(np.abs(values).max(), rel=1e-12)
 
 
 # ---------------------------------------------------------------- rough pad interfaces

@@ -536,9 +536,10 @@ def write_modes_xdmf(path: str | Path, result: ModalResult, functions: Sequence,
     """Mode shapes to XDMF, one file per body mesh: real and imaginary parts, "time" = mode number.
 
     ``functions`` are displacement Functions of the bodies in the block order of the matrices (the
-    owned dofs of body 0, then of body 1, ... on each rank). Returns the written paths.
+    owned dofs of body 0, then of body 1, ... on each rank). Shapes are interpolated to linear
+    vertex values (XDMF stores the mesh's own degree). Returns the written paths.
     """
-    from dolfinx import fem, io
+    from dolfinx import io
 
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
@@ -548,19 +549,21 @@ def write_modes_xdmf(path: str | Path, result: ModalResult, functions: Sequence,
     if sum(sizes) != result.modes.shape[0]:
         raise InputError("functions", len(functions), "must span the dof layout of the modes")
     offsets = np.concatenate([[0], np.cumsum(sizes)])
-    parts = [(fem.Function(u.function_space, name="mode_re"),
-              fem.Function(u.function_space, name="mode_im")) for u in functions]
     files = []
-    for k, (u, (re, im)) in enumerate(zip(functions, parts)):
+    for k, u in enumerate(functions):
         mesh = u.function_space.mesh
+        work = fem.Function(u.function_space)
+        W = fem.functionspace(mesh, ("Lagrange", 1, (mesh.geometry.dim,)))
+        parts = (fem.Function(W, name="mode_re"), fem.Function(W, name="mode_im"))
         out = path.with_name(f"{path.stem}_body{k}.xdmf")
         with io.XDMFFile(mesh.comm, str(out), "w") as w:
             w.write_mesh(mesh)
             for j in sel:
                 block = result.modes[offsets[k]:offsets[k + 1], j - 1]
-                for f, values in ((re, block.real), (im, block.imag)):
-                    f.x.array[:sizes[k]] = values
-                    f.x.scatter_forward()
+                for f, values in zip(parts, (block.real, block.imag)):
+                    work.x.array[:sizes[k]] = values
+                    work.x.scatter_forward()
+                    f.interpolate(work)
                     w.write_function(f, float(j))
         files.append(out)
     return files
