@@ -36,8 +36,7 @@ solutions differ only by the non-reciprocity of that approximation, O((a/r)²) o
 
 Interaction sums (vectorised, no loop over pairs): every contact acts on every other through the
 point-force response ``g(r)`` of the solid (``P_l g(r)``, a dense matrix–vector product among the
-candidate summits: double precision up to ~4500 candidates, single (1e-6 relative) up to ~6300,
-recomputed blockwise beyond), and pairs closer than ``cutoff · a_ref,l`` (found with a
+candidate summits: stored up to ~5600 candidates, rows recomputed blockwise beyond), and pairs closer than ``cutoff · a_ref,l`` (found with a
 ``scipy.spatial.cKDTree``; a_ref >= a is a bound on the final contact size, from the warm start or a
 screening pass with point forces only, enlarged and re-solved if a contact outgrows it) add the
 near-field correction ``u_l − P_l g``. For a Hertz contact of semi-axes a >= b the correction is
@@ -93,7 +92,7 @@ from multiscale.micro.surface import AsperityTable, Surface, find_asperities, st
 _GL_X, _GL_V = np.polynomial.legendre.leggauss(16)
 _GL_T, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_V          # Gauss–Legendre on (0, 1)
 _FLOOR = 1e-10          # smallest relative size a/a_ref used where derivatives are divided by a
-_DENSE_BYTES = 160e6    # far-field matrix kept in memory up to this size (float64, then float32)
+_DENSE_BYTES = 256e6    # far-field matrix kept in memory up to this size (~5600 candidates)
 _SCREEN = 400           # more active candidates than this: screening pass with point forces only
 
 
@@ -627,9 +626,7 @@ class _Interactions:
         self.tree = cKDTree(self.xy)
         self.G = None
         if n * n * 8 <= _DENSE_BYTES:
-            self.G = self._block(0, n)
-        elif n * n * 4 <= _DENSE_BYTES:             # single precision: 1e-6 relative, << truncation
-            self.G = np.vstack([self._block(i, min(i + 1024, n)).astype(np.float32) for i in range(0, n, 1024)])
+            self.G = self._rows(np.arange(n))
         self.evaluations = 0
         self.set_near(np.zeros(n), 1.0)
 
@@ -659,33 +656,35 @@ class _Interactions:
         self.src, self.dst, self.ddx, self.ddy = src, dst, d[:, 0], d[:, 1]
         self.g_near = self.law.point_response(np.hypot(d[:, 0], d[:, 1]))
 
-    def _block(self, i0, i1):
-        """Rows i0:i1 of G."""
+    def _rows(self, rows):
+        """Rows ``rows`` of G, computed."""
         x, y = self.xy[:, 0], self.xy[:, 1]
-        r = np.subtract.outer(x[i0:i1], x)
+        r = np.subtract.outer(x[rows], x)
         r *= r
-        t = np.subtract.outer(y[i0:i1], y)
+        t = np.subtract.outer(y[rows], y)
         t *= t
         r += t
         np.sqrt(r, out=r)
-        diag = np.arange(i0, i1)
-        r[diag - i0, diag] = 1.0
+        i = np.arange(len(rows))
+        r[i, rows] = 1.0
         g = self.law.point_response(r)
-        g[diag - i0, diag] = 0.0
+        g[i, rows] = 0.0
         return g
 
     def far(self, f):
-        """G f (only the rows of non-zero sources: G is symmetric; blockwise when not stored)."""
-        if self.G is not None:
-            nz = np.nonzero(f)[0]
-            if len(nz) < 0.6 * self.n:
-                return (f[nz].astype(self.G.dtype) @ self.G[nz]).astype(float)
-            return (self.G @ f.astype(self.G.dtype)).astype(float)
-        out = np.empty(self.n)
-        step = max(1, int(_DENSE_BYTES / (8 * self.n)))
-        for i0 in range(0, self.n, step):
-            out[i0:i0 + step] = self._block(i0, min(i0 + step, self.n)) @ f
-        return out
+        """G f over the non-zero sources only (G is symmetric); rows computed in blocks when G is
+        not stored."""
+        nz = np.nonzero(f)[0]
+        if self.G is None:
+            out = np.zeros(self.n)
+            step = max(1, int(_DENSE_BYTES / (8 * self.n)))
+            for i0 in range(0, len(nz), step):
+                rows = nz[i0:i0 + step]
+                out += f[rows] @ self._rows(rows)
+            return out
+        if len(nz) < 0.6 * self.n:
+            return f[nz] @ self.G[nz]
+        return self.G @ f
 
     def evaluate(self, a, a_low=None):
         """Interaction state at sizes ``a`` (>= 0, one per candidate); derivatives are taken at
