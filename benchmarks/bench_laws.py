@@ -9,7 +9,9 @@ from an empty cache; then a call with nothing changed and one with one worn zone
 Run on one and on two ranks (each run prints its table and, once both exist, the speed-up):
     python benchmarks/bench_laws.py
     mpiexec -n 2 python benchmarks/bench_laws.py
-Targets: under 60 s on 2 ranks; 1 -> 2 rank speed-up >= 1.7.
+Targets: under 60 s on 2 ranks; 1 -> 2 rank speed-up >= 1.7. 'CPU/rank' is the process time of
+the busiest rank: what the wall time would be on otherwise idle cores ('load avg' says how idle
+they were).
 """
 import argparse
 import json
@@ -43,12 +45,13 @@ def main():
     spec = LawSpec(HalfSpace.from_materials(5e9, 0.3, 220e9, 0.3), p_max=10e6, n_points=20)
     mine = zones[comm.rank::comm.size]        # e.g. the zones of this rank's interface facets
 
-    walls, balance, laws = [], [], None
+    walls, cpus, balance, laws = [], [], [], None
     for _ in range(args.repeats):
         pool = MicroPool(spec, progress=comm.rank == 0)
         comm.barrier()
-        t0 = time.perf_counter()
+        t0, c0 = time.perf_counter(), time.process_time()
         laws = pool.laws(mine, gather="all")
+        cpus.append(comm.allreduce(time.process_time() - c0, op=MPI.MAX))
         comm.barrier()
         walls.append(time.perf_counter() - t0)
         balance.append(max(pool.stats.compute_seconds) / max(np.mean(pool.stats.compute_seconds), 1e-12))
@@ -66,16 +69,18 @@ def main():
     if comm.rank:
         return
     iters = np.array([nd.iterations.sum() for nd in laws.nodes])
-    row = dict(ranks=comm.size, zones=len(zones), wall=stats.median(walls), walls=walls,
+    row = dict(ranks=comm.size, zones=len(zones), wall=stats.median(walls), walls=walls, cpu=stats.median(cpus),
+               load=os.getloadavg()[0],
                imbalance=stats.median(balance), cached=cached, one_worn=one,
                iterations_per_node=float(iters.mean() / spec.n_points),
                area_fraction_at_pmax=float(np.median([nd.area_fraction[-1] for nd in laws.nodes])),
                date=time.strftime("%Y-%m-%d"))
-    print(f"\n{'ranks':>5} {'zones':>5} {'laws [s] (median)':>18} {'repeats':>24} {'max/mean rank':>13} "
-          f"{'cached [s]':>10} {'1 worn [s]':>10} {'iters/node':>10} {'A/A0 @ p_max':>12}")
+    print(f"\n{'ranks':>5} {'zones':>5} {'laws [s] (median)':>18} {'repeats':>24} {'CPU/rank [s]':>12} "
+          f"{'max/mean rank':>13} {'cached [s]':>10} {'1 worn [s]':>10} {'iters/node':>10} {'A/A0 @ p_max':>12} "
+          f"{'load avg':>8}")
     print(f"{row['ranks']:>5} {row['zones']:>5} {row['wall']:>18.1f} {str([round(w, 1) for w in walls]):>24} "
-          f"{row['imbalance']:>13.3f} {cached:>10.3f} {one:>10.2f} {row['iterations_per_node']:>10.1f} "
-          f"{row['area_fraction_at_pmax']:>12.3f}")
+          f"{row['cpu']:>12.1f} {row['imbalance']:>13.3f} {cached:>10.3f} {one:>10.2f} "
+          f"{row['iterations_per_node']:>10.1f} {row['area_fraction_at_pmax']:>12.3f} {row['load']:>8.1f}")
     RESULTS.parent.mkdir(exist_ok=True)
     table = json.loads(RESULTS.read_text()) if RESULTS.exists() else {}
     table[f"{len(zones)}:{comm.size}"] = row

@@ -11,11 +11,12 @@ every rank back the laws it asked for. Collective: every rank of ``comm`` must c
   same partition without a master; zones change slowly between steps (wear), so the last
   measured times predict the next ones well — a static partition then balances as well as a
   dynamic queue (mpi4py.futures) would, without a scheduler rank or a process spawn.
-- Results do not depend on the number of ranks or on the partition beyond FFT round-off: a
-  zone's solve does not depend on its batch-mates (the batched solver iterates each patch on
-  its own), only the rounding of the batched FFTs does, and FFTW plans are measured per process
-  anyway (agreement ~1e-13, not bitwise). Batches hold at most a quarter of a rank's share, so
-  that the partition can balance.
+- Results do not depend on the number of ranks or on the partition beyond round-off: a zone's
+  solve does not depend on its batch-mates (the batched solver iterates each patch on its own),
+  only the rounding of the batched FFTs does, and FFTW plans are measured per process anyway.
+  Laws agree to ~1e-13, not bitwise (to the solver tolerance in the rare case where round-off
+  moves a residual across it and an iteration count changes). Batches hold at most a quarter
+  of a rank's share, so that the partition can balance.
 - Cache: every rank keeps the laws it received (LRU, ``cache_size`` zones), keyed by
   (topography hash, ``LawSpec.key()``: kernel, E*, p_max, nodes, Love variant, tolerances,
   extra laws); a zone whose topography did not change is not recomputed.
@@ -23,7 +24,11 @@ every rank back the laws it asked for. Collective: every rank of ``comm`` must c
   batch, gathered with their zone ids, and raised as ``PoolError`` on every rank after the
   collective exchange: no rank is left waiting.
 
-The pool imports numpy, mpi4py and ``multiscale.micro`` only, never DOLFINx.
+The pool imports numpy, mpi4py and ``multiscale.micro`` only, never DOLFINx. Use, each step::
+
+    pool = MicroPool(LawSpec(HalfSpace.from_materials(5e9, 0.3, 220e9, 0.3), p_max=10e6))
+    laws = pool.laws(my_zones)                   # collective; unchanged zones come from the cache
+    value = laws.pressure(gap, zone_of_facet)    # p_n and K_n per facet (ZoneGrid.zone_of)
 """
 from __future__ import annotations
 

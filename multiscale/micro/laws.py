@@ -13,7 +13,9 @@ the *macro gap* left once that elastic part is taken out (Eq. 1.31):
 where z_top − δ is the height of the rigid flat above the zones' common datum (see zones.py).
 Sign: g_n > 0 is an open macro gap; the zone first touches at g_n = z_top ('g_open') and the
 pressure grows as g_n decreases; the thesis's gap of Eq. 1.31 (an interpenetration) is
-z_top − g_n. Stiffness K_n = −dp_n/dg_n ≥ 0.
+z_top − g_n. Stiffness K_n = −dp_n/dg_n ≥ 0. A macro model whose interface meshes start
+conforming (mesh gap 0) passes g_n = g_mesh + g_ref, with g_ref the height above the datum of
+its initial contact plane (e.g. the highest zone top: the first zone then touches at once).
 
 Where L is evaluated (``LawSpec.love``): 'average' (default) uses the mean of Love's integral over
 the footprint, i.e. the mean displacement of the uniformly loaded zone: the displacement that is
@@ -81,8 +83,8 @@ class LawSpec:
     kernel: the micro solids (e.g. ``HalfSpace``); E_star [Pa]: composite modulus of the macro
     half-space in Love's correction (default: ``kernel.E_star``); p_max [Pa]: highest tabulated
     zone pressure (the top node, by a load-controlled solve); n_points: nodes per law (the others
-    at approaches δ_max (k/n)², k = 1 … n−1, which spreads them evenly in ln p from Hertz-like
-    first contacts up to p_max); love: 'average' | 'centre' | 'none'; tol, max_iter: contact
+    at approaches δ_max (k/n)², k = 1 … n−1: dense near first touch, where ln p changes fastest,
+    so that 20 nodes span about four decades of pressure); love: 'average' | 'centre' | 'none'; tol, max_iter: contact
     solver (relative gap residual); extras: ``ExtraLaw`` objects; batch_cells: cells per batched
     solve (several equal zones are solved together up to this size).
     """
