@@ -6,6 +6,7 @@ from multiscale.errors import InputError
 from multiscale.micro.contact import ContactSolver, solve_contact
 from multiscale.micro.conduction import ConductionSolver, SeriesKernel, conductance_law
 from multiscale.micro.kernels import HalfSpace, Kernel, ThermalHalfSpace
+from multiscale.micro.layered import LayeredElastic, LayeredThermal
 from multiscale.micro.surface import fractal_surface
 
 K1, K2 = ThermalHalfSpace(10.0), ThermalHalfSpace(50.0)
@@ -140,6 +141,50 @@ def test_conductance_law_is_monotone_and_matches_single_solves():
     cold = solve_contact(surface.heights[1], surface.dx, elastic, load=2e6)
     single = ConductionSolver(*thermal, surface.shape, surface.dx).solve(cold.contact)
     assert law.conductance[1, 1] == pytest.approx(single.conductance, rel=1e-6)
+
+
+L = 1e-3
+SOLID_2 = (LayeredElastic((L,), (220e9,), (0.33,)), LayeredThermal((L,), (50.0,)))
+
+
+def thesis_case(surface, E1, kappa1, h, pressure=3e6):
+    """Thesis §5.5 cubes: solid 1 one or two layers to 1 mm on an isothermal rigid base, solid 2 kappa 50."""
+    if h is None:
+        e1, t1 = LayeredElastic((L,), (E1,), (0.15,)), LayeredThermal((L,), (kappa1,))
+    else:
+        e1 = LayeredElastic((h, L - h), (E1, 4e9), (0.15, 0.15))
+        t1 = LayeredThermal((h, L - h), (kappa1, 10.0))
+    law = conductance_law(surface, SeriesKernel(e1, SOLID_2[0]), (t1, SOLID_2[1]), [pressure])
+    return law.conductance[0], law.perfect_conductance, law.contact_temperature[0]
+
+
+@pytest.fixture(scope="module")
+def thesis_surface_150():
+    return fractal_surface(150, L, 0.8, 2, 10, 6e-6, seed=1)      # the thesis grid: 6.67 um cells
+
+
+def test_table_5_4_perfect_conductance_exact_and_ratio_falls_with_kappa1(thesis_surface_150):
+    cases = [(4e9, 10.0, None), (4e9, 5.0, 5e-4), (4e9, 2.5, 5e-4)]           # Table 5.3
+    K_p_thesis = [1 / (1e-3 / 10 + 2e-5), 1 / (5e-4 / 5 + 5e-4 / 10 + 2e-5), 1 / (5e-4 / 2.5 + 5e-4 / 10 + 2e-5)]
+    out = [thesis_case(thesis_surface_150, *c) for c in cases]
+    ratio = [K_t / K_p for K_t, K_p, _ in out]
+    for (K_t, K_p, T_s), exact in zip(out, K_p_thesis):
+        assert K_p == pytest.approx(exact, rel=1e-12)                         # 8.33, 5.88, 3.70 e3
+    assert ratio[0] > ratio[1] > ratio[2]                                      # Table 5.4: 0.45, 0.38, 0.33
+    assert np.allclose(ratio, [0.45, 0.38, 0.33], rtol=0.1)                    # another random surface
+    assert [T_s for *_, T_s in out] == sorted(T_s for *_, T_s in out)          # T_s rises: 0.83, 0.88, 0.93
+
+
+def test_tables_5_6_and_5_8_trends(thesis_surface_150):
+    """Softer and less conductive top layer (kappa1/kappa2 = E1/E2): K_t falls but K_t/K_p rises
+    (Table 5.6); thicker such layer: K_t falls, K_t/K_p rises (Table 5.8)."""
+    for cases in ([(4e9, 10.0, None), (2e9, 5.0, 5e-4), (1e9, 2.5, 5e-4)],
+                  [(1e9, 2.5, 1e-4), (1e9, 2.5, 2e-4), (1e9, 2.5, 5e-4)]):
+        out = [thesis_case(thesis_surface_150, *c) for c in cases]
+        K_t = [o[0] for o in out]
+        ratio = [o[0] / o[1] for o in out]
+        assert K_t[0] > K_t[1] > K_t[2]
+        assert ratio[0] < ratio[1] < ratio[2]
 
 
 def test_series_kernel_keeps_an_infinite_q0_infinite():

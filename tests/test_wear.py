@@ -5,6 +5,7 @@ import pytest
 from multiscale.errors import InputError
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import HalfSpace
+from multiscale.micro.layered import LayeredElastic
 from multiscale.micro.surface import Surface, fractal_surface
 from multiscale.micro.wear import WearRate, simulate_wear, wear_step
 
@@ -96,6 +97,26 @@ def test_pressure_gap_law_stiffens_with_sliding():
     # the sampled law at the run's load is the run's own state
     assert first.mean_gap[1] == pytest.approx(res.history.mean_gap[0], rel=1e-6)
     assert last.area_fraction[1] == pytest.approx(res.history.area_fraction[-1], rel=1e-6)
+
+
+def test_compliant_top_layer_lowers_pressure_and_wear_depth_and_raises_area():
+    """§3.5.2: a 200 um top layer of E1 = 1 GPa on a 4 GPa half-space vs the homogeneous 4 GPa solid."""
+    surface = thesis_surface(64)
+    runs = {}
+    for E1 in (4e9, 1e9):
+        kernel = LayeredElastic((200e-6,), (E1,), (0.15,), substrate_E=4e9, substrate_nu=0.15)
+        runs[E1] = simulate_wear(surface, kernel, load=P, mu=MU, distance=S, steps=40, k_w=KW).history
+    stiff, soft = runs[4e9], runs[1e9]
+    assert np.allclose(stiff.max_pressure[0], thesis_homogeneous_max_pressure(surface), rtol=1e-6)
+    assert np.all(soft.max_pressure < 0.7 * stiff.max_pressure)          # lower local pressure …
+    assert np.all(soft.max_depth[1:] < 0.7 * stiff.max_depth[1:])        # … less wear depth (Fig. 3.8)
+    assert np.all(soft.area_fraction > 1.5 * stiff.area_fraction)        # larger area (Fig. 3.7)
+    assert soft.volume[-1] == pytest.approx(stiff.volume[-1], rel=1e-12)  # same volume (Fig. 3.9)
+
+
+def thesis_homogeneous_max_pressure(surface):
+    """Identical layer on an identical half-space = the homogeneous solid (Boussinesq kernel)."""
+    return ContactSolver(KERNEL, surface.shape, surface.dx).solve(surface.heights, load=P).pressure.max()
 
 
 def test_batched_wear_equals_patch_by_patch():
