@@ -96,6 +96,8 @@ class MicroPool:
         for z, (_, key) in zip(zones, requested):
             if key not in self._cache:
                 misses.setdefault(key, z)
+        known = dict(self._cache) if gather == "all" else {k: self._cache[k] for _, k in requested
+                                                             if k in self._cache}
         # every rank learns every request: its misses (zone id, key, batch signature, expected cost)
         mine = [(z.id, key, batch_signature(z), self._expected_cost(z, spec)) for key, z in misses.items()]
         shared = comm.allgather((spec_key, mine, len(zones) - sum(k in misses for _, k in requested),
@@ -128,6 +130,7 @@ class MicroPool:
         for ns, _, _ in gathered:
             for nd, key in ns:
                 self._remember(key, nd)
+                known[key] = nd
         self.stats = PoolStats(
             requested=sum(len(m) for _, m, _, _ in shared) + sum(h for _, _, h, _ in shared),
             cached=sum(h for _, _, h, _ in shared), computed=len(work), failed=len(all_failures),
@@ -136,8 +139,7 @@ class MicroPool:
         if gather == "all":
             requested = sorted({item for _, _, _, req in shared for item in req})
         failed = {f.zone_id for f in all_failures}
-        found = [replace(self._cache[key], zone_id=zid) for zid, key in requested
-                 if zid not in failed and key in self._cache]
+        found = [replace(known[key], zone_id=zid) for zid, key in requested if zid not in failed and key in known]
         result = ZoneLaws(found, spec)
         if all_failures:
             raise PoolError(all_failures, result)

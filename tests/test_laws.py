@@ -465,6 +465,8 @@ def test_pool_caches_unchanged_zones_and_matches_compute_laws(tiled):
     with pytest.raises(PoolError) as info:
         pool.laws(zones[:2] + [flat])
     assert [f.zone_id for f in info.value.failures] == [99] and len(info.value.result) == 2
+    small = MicroPool(spec, comm=MPI.COMM_SELF, cache_size=2)        # a call returns all it computed
+    assert small.laws(zones[:4]).ids.tolist() == [0, 1, 2, 3] and len(small._cache) == 2
 
 
 def test_pool_worker_never_imports_dolfinx():
