@@ -96,17 +96,16 @@ class ContactInterface:
 
     def normal_force(self) -> float:
         """Total normal contact force [N] (integral of p_n, same quadrature as the residual)."""
-        return self.cache.scalar("p", lambda: self.pressure * self.tm.interface.dS)
+        return float(self.cache.facet_integrals("p", lambda: self.pressure).sum())
 
     def force(self) -> np.ndarray:
         """Resultant interface force on body 0 [N] (3-vector: normal pressure plus friction)."""
-        return np.array([self.cache.scalar(("t", i), lambda: self.traction[i] * self.tm.interface.dS)
-                         for i in range(3)])
+        return self.cache.facet_integrals("t", lambda: self.traction, vector=True).sum(axis=0)
 
     def friction_force(self) -> np.ndarray:
         """Resultant friction force on body 0 [N] (3-vector, mu p_n s integrated)."""
-        f = self.friction * self.pressure * self.slip_direction
-        return np.array([self.cache.scalar(("f", i), lambda: f[i] * self.tm.interface.dS) for i in range(3)])
+        return self.cache.facet_integrals(
+            "f", lambda: self.friction * self.pressure * self.slip_direction, vector=True).sum(axis=0)
 
     def facet_pressure(self) -> np.ndarray:
         """Mean contact pressure per interface facet [Pa] (global order, every rank)."""
@@ -137,10 +136,9 @@ class ContactInterface:
 
     def heat_power(self) -> tuple[float, float]:
         """Frictional heat power into body 0 and body 1 [W] at the current state."""
-        dS = self.tm.interface.dS
-        p1 = self.partition("+")
-        return (self.cache.scalar("q0", lambda: p1 * self.heat_flux * dS),
-                self.cache.scalar("q1", lambda: (1 - p1) * self.heat_flux * dS))
+        Q = self.cache.facet_integrals("q", lambda: self.heat_flux)     # W per facet
+        p1 = self.tm.interface.values(self.partition)                    # constant per facet
+        return float((p1 * Q).sum()), float(((1 - p1) * Q).sum())
 
     def facet_heat_flux(self) -> np.ndarray:
         """Mean frictional heat flux per interface facet [W/m^2] (global order)."""

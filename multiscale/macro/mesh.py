@@ -93,6 +93,7 @@ class Interface:
     owned_index: np.ndarray            # global index of the owned submesh cells 0..n_owned-1
     areas: np.ndarray = field(default=None)   # m^2, global
     _dg0: fem.FunctionSpace = field(default=None, repr=False)
+    _dg0_vector: fem.FunctionSpace = field(default=None, repr=False)
 
     @property
     def dS(self):
@@ -117,9 +118,16 @@ class Interface:
             self._dg0 = fem.functionspace(self.mesh, ("DG", 0))
         return self._dg0
 
-    def _owned_dofs(self) -> np.ndarray:
+    @property
+    def vector_space(self) -> fem.FunctionSpace:
+        """Vector DG0 space (3 components) of per-facet vectors."""
+        if self._dg0_vector is None:
+            self._dg0_vector = fem.functionspace(self.mesh, ("DG", 0, (3,)))
+        return self._dg0_vector
+
+    def _owned_dofs(self, space=None) -> np.ndarray:
         n = len(self.owned_index)
-        return self.space.dofmap.list[:n, 0]
+        return (space or self.space).dofmap.list[:n, 0]
 
     def field(self, name: str, value=0.0) -> fem.Function:
         """A new per-facet (DG0) field set to ``value`` (scalar or global per-facet array)."""
@@ -143,17 +151,20 @@ class Interface:
         return self.gather(f.x.array[self._owned_dofs()])
 
     def gather(self, owned: np.ndarray) -> np.ndarray:
-        """Global per-facet array from the values of the owned facets (every rank)."""
-        parts = self.comm.allgather(np.asarray(owned, dtype=float))
+        """Global per-facet array (n_facets, ...) from the values of the owned facets (every rank)."""
+        owned = np.asarray(owned, dtype=float)
+        parts = self.comm.allgather(owned)
         index = np.concatenate(self.comm.allgather(self.owned_index))
-        out = np.empty(self.n_facets)
+        out = np.empty((self.n_facets,) + owned.shape[1:])
         out[index] = np.concatenate(parts)
         return out
 
-    def owned_values(self, vec) -> np.ndarray:
-        """Global per-facet array from an assembled DG0 vector (ghost contributions added)."""
+    def owned_values(self, vec, space=None) -> np.ndarray:
+        """Global per-facet array from a vector assembled on ``space`` (DG0 scalar or vector)."""
+        space = space or self.space
         vec.scatter_reverse(dolfinx.la.InsertMode.add)
-        return self.gather(vec.array[self._owned_dofs()])
+        values = vec.array.reshape(-1, space.dofmap.bs)[self._owned_dofs(space)]
+        return self.gather(values if space.dofmap.bs > 1 else values[:, 0])
 
 
 @dataclass
@@ -222,12 +233,15 @@ class FormCache:
         local = fem.assemble_scalar(self._form(key, make))
         return self.tm.comm.allreduce(local, op=MPI.SUM)
 
-    def facet_integrals(self, key, make) -> np.ndarray:
-        """Global per-facet integrals of the scalar interface expression ``make()``."""
+    def facet_integrals(self, key, make, vector: bool = False) -> np.ndarray:
+        """Global per-facet integrals of the interface expression ``make()``: (n_facets,) for a
+        scalar, (n_facets, 3) with ``vector`` for a 3-vector."""
         iface = self.tm.interface
-        q = ufl.TestFunction(iface.space)
-        form = self._form(None if key is None else ("per facet", key), lambda: make() * q("+") * iface.dS)
-        return iface.owned_values(fem.assemble_vector(form))
+        space = iface.vector_space if vector else iface.space
+        q = ufl.TestFunction(space)
+        form = self._form(None if key is None else ("per facet", key),
+                          lambda: ufl.inner(make(), q("+")) * iface.dS)
+        return iface.owned_values(fem.assemble_vector(form), space)
 
     def facet_mean(self, key, make) -> np.ndarray:
         """Global per-facet means (integral / facet area) of ``make()``."""
