@@ -158,42 +158,59 @@ class ConductionSolver:
         return result
 
     def _cg(self, mask, R, dtheta, tol, max_iter, phi0):
-        """Conjugate gradients for (T + R) phi = Δθ on the mask, phi = 0 off it; batched, each patch
-        frozen once converged. Returns phi, iterations, relative residual, converged."""
-        axes = (-2, -1)
-        A = lambda x: (self.series(x) + R * x) * mask            # noqa: E731  (restricted operator)
-        b = dtheta * mask
-        bnorm = np.sqrt(np.sum(b * b, axis=axes, keepdims=True))
+        """Conjugate gradients for (T + R) phi = Δθ on the mask, phi = 0 off it; batched on (B, N)
+        views, in place, each patch frozen once converged. Returns phi, iterations, relative
+        residual, converged."""
+        shape, batch = mask.shape, mask.shape[:-2]
+        B, N = int(np.prod(batch, dtype=int)), shape[-2] * shape[-1]
+        m = mask.reshape(B, N).astype(float)
+        Rf = np.ascontiguousarray(R).reshape(B, N) if np.any(R) else None
+
+        def A(x, out):                                   # restricted operator (T + R) on the mask
+            self.series(x.reshape(shape), out=out.reshape(shape))
+            if Rf is not None:
+                out += Rf * x
+            out *= m
+            return out
+
+        def dot(x, y):
+            return np.einsum("ij,ij->i", x, y)
+
+        b = dtheta * m
+        bnorm = np.sqrt(dot(b, b))
         if phi0 is not None:
-            phi = np.array(np.broadcast_to(np.asarray(phi0, dtype=float), mask.shape)) * mask
+            phi = np.array(np.broadcast_to(np.asarray(phi0, dtype=float), shape)).reshape(B, N) * m
             if not np.all(np.isfinite(phi)):
                 raise InputError("initial_flux", "array", "must be finite")
         else:   # uniform flux of the 1-D (bulk + self-influence) estimate
-            phi = b / (self.series.self_influence + R + (sum(self.bulk) if self.bulk else 0.0))
-        r = b - A(phi)
+            diag = self.series.self_influence + (sum(self.bulk) if self.bulk else 0.0)
+            phi = b / (diag + (Rf if Rf is not None else 0.0))
+        Ad, tmp = np.empty((B, N)), np.empty((B, N))
+        r = b - A(phi, Ad)
         d = r.copy()
-        rr = np.sum(r * r, axis=axes, keepdims=True)
+        rr = dot(r, r)
         safe = np.where(bnorm > 0, bnorm, 1.0)
         active = np.sqrt(rr) / safe > tol
-        its = np.zeros(mask.shape[:-2], dtype=int)
+        its = np.zeros(B, dtype=int)
         for _ in range(max_iter):
             if not active.any():
                 break
-            Ad = A(d)
-            dAd = np.sum(d * Ad, axis=axes, keepdims=True)
-            alpha = np.where(active & (dAd > 0), rr / np.where(dAd > 0, dAd, 1.0), 0.0)
-            phi += alpha * d
-            r -= alpha * Ad
-            rr_new = np.sum(r * r, axis=axes, keepdims=True)
-            d = r + np.where(active, rr_new / np.where(rr > 0, rr, 1.0), 0.0) * d
+            A(d, Ad)
+            dAd = dot(d, Ad)
+            alpha = np.where(active & (dAd > 0), rr / np.where(dAd > 0, dAd, 1.0), 0.0)[:, None]
+            phi += np.multiply(d, alpha, out=tmp)
+            r -= np.multiply(Ad, alpha, out=tmp)
+            rr_new = dot(r, r)
+            d *= np.where(active, rr_new / np.where(rr > 0, rr, 1.0), 0.0)[:, None]
+            d += r
             rr = np.where(active, rr_new, rr)
-            its += active[..., 0, 0]
+            its += active
             active &= np.sqrt(rr) / safe > tol
-        true = b - A(phi)
-        res = (np.sqrt(np.sum(true * true, axis=axes, keepdims=True)) / safe)[..., 0, 0]
+        true = b - A(phi, Ad)
+        res = np.sqrt(dot(true, true)) / safe
         if not np.all(np.isfinite(phi)):
             raise ConductionConvergenceError("conduction CG produced non-finite fluxes", [], None)
-        return phi, its, res, ~active[..., 0, 0]
+        return phi.reshape(shape), its.reshape(batch), res.reshape(batch), ~active.reshape(batch)
 
 
 @dataclass
