@@ -18,6 +18,14 @@ MMAC and its cumulative moving average (Figs. 4.16–4.19), strain-energy shares
 between the two pads (Figs. 4.20–4.21). Vectors are kept as the rank-owned part of the PETSc layout
 (complex numpy arrays); inner products are reduced over the matrix communicator.
 
+The brake (§4.3): ``HydraulicMechanics`` (pressure −p n on piston and caliper), ``preload``
+(quasi-static steady sliding, Coulomb friction along the disc's rotation) and ``linearise``
+(K = the consistent Newton matrix of the ``mechanics``/``interface`` forms, M = mass with diag 0 on
+Dirichlet rows), ``RegionEnergy`` (strain energy per material region), ``squeal_case``. Rough pads
+(§4.2, §4.3.2, Table 4.1): per-zone laws of ``multiscale.micro.laws`` (computed by the micro pool)
+embedded per facet by ``LinearisedFacetLaw``/``settle``. Scenes: ``analyse``, ``run_scene``;
+figures of §4.4: ``plot_*`` (rank 0).
+
 Sign conventions: sigma > 0 is growth (unstable), frequency = omega / (2 pi) [Hz] >= 0, modes are
 numbered from 1 in order of increasing frequency (ties: increasing sigma).
 """
@@ -595,28 +603,39 @@ class Preload:
     friction: float          # friction coefficient mu [-]
     normal_force: dict       # N, per interface name: integral of p_n
     friction_force: dict     # N, per interface name: resultant of mu p_n s (3-vector)
-    load_force: dict         # N, per load face: p times the face area
+    load_force: dict         # N, per load face: p times the face area (its share of a force load)
     max_pressure: float      # Pa, largest per-facet mean contact pressure
     iterations: int          # Newton iterations of the last load step
     residuals: list          # residual norms of the last load step
     time: float              # s, wall time
 
 
+NEWTON_FORCE_TOL = 1e-11    # absolute Newton tolerance relative to the applied force [-]
+
+
 def preload(mech: Mechanics, pressure: float, steps: int = 1, reset: bool = True) -> Preload:
-    """Ramp the load to ``pressure`` [Pa] in ``steps`` Newton solves (from rest if ``reset``)."""
+    """Ramp the load to ``pressure`` [Pa] (a force [N] for ``load_kind="force"``) in ``steps``
+    Newton solves, from rest if ``reset``. The absolute residual tolerance is NEWTON_FORCE_TOL
+    times the applied force: a re-solve from a nearly balanced state (``settle``) otherwise asks
+    for a relative reduction below the round-off floor of the penalty-stiff system."""
     check_positive("pressure", pressure)
     t0 = time.perf_counter()
+    tm, c = mech.tm, mech.contact
+    area = {f: tm.assemble_scalar(1.0 * tm.ds(tm.face(f))) for f in tm.spec.load_faces}
+    total = sum(area.values())
+    loads = {f: float(pressure) * (a if mech.load_kind == "pressure" else a / total) for f, a in area.items()}
+    snes = mech.problem.solver
+    rtol, atol, stol, max_it = snes.getTolerances()
+    snes.setTolerances(atol=max(atol, NEWTON_FORCE_TOL * sum(loads.values())))
     if reset:
         for u in mech.u:
             u.x.array[:] = 0.0
     solved = mech.ramp(pressure, steps)
-    tm, c = mech.tm, mech.contact
     friction_traction = c.friction * c.pressure * c.slip_direction
     normal, tangential = {}, {}
     for name, dS in tm.interface.dS_tag.items():
         normal[name] = tm.assemble_scalar(c.pressure * dS)
         tangential[name] = np.array([tm.assemble_scalar(friction_traction[i] * dS) for i in range(3)])
-    loads = {f: float(pressure) * tm.assemble_scalar(1.0 * tm.ds(tm.face(f))) for f in tm.spec.load_faces}
     return Preload(float(pressure), float(c.friction.value), normal, tangential, loads,
                    solved.max_pressure, solved.iterations, list(solved.residuals),
                    time.perf_counter() - t0)
