@@ -158,59 +158,61 @@ class ConductionSolver:
         return result
 
     def _cg(self, mask, R, dtheta, tol, max_iter, phi0):
-        """Conjugate gradients for (T + R) phi = Δθ on the mask, phi = 0 off it; batched on (B, N)
-        views, in place, each patch frozen once converged. Returns phi, iterations, relative
+        """Conjugate gradients for (T + R) phi = Δθ on the mask, phi = 0 off it (Eqs. 5.10–5.12).
+
+        Vectors hold the contact points of all patches only (gathered); per-patch dot products
+        are segment sums, each patch is frozen once converged. Returns phi, iterations, relative
         residual, converged."""
         shape, batch = mask.shape, mask.shape[:-2]
         B, N = int(np.prod(batch, dtype=int)), shape[-2] * shape[-1]
-        m = mask.reshape(B, N).astype(float)
-        Rf = np.ascontiguousarray(R).reshape(B, N) if np.any(R) else None
+        idx = np.flatnonzero(mask)
+        seg = idx // N                                   # patch of each contact point
+        Rc = np.ascontiguousarray(R).ravel()[idx]
+        work = np.zeros(shape)
 
-        def A(x, out):                                   # restricted operator (T + R) on the mask
-            self.series(x.reshape(shape), out=out.reshape(shape))
-            if Rf is not None:
-                out += Rf * x
-            out *= m
-            return out
+        def A(x):                                        # (T + R) x restricted to the contact
+            work.ravel()[idx] = x
+            out = self.series(work).ravel()[idx]
+            work.ravel()[idx] = 0.0
+            return out + Rc * x
 
         def dot(x, y):
-            return np.einsum("ij,ij->i", x, y)
+            return np.bincount(seg, weights=x * y, minlength=B)
 
-        b = dtheta * m
-        bnorm = np.sqrt(dot(b, b))
+        b = np.full(idx.size, dtheta)
         if phi0 is not None:
-            phi = np.array(np.broadcast_to(np.asarray(phi0, dtype=float), shape)).reshape(B, N) * m
+            phi = np.broadcast_to(np.asarray(phi0, dtype=float), shape).ravel()[idx].copy()
             if not np.all(np.isfinite(phi)):
                 raise InputError("initial_flux", "array", "must be finite")
         else:   # uniform flux of the 1-D (bulk + self-influence) estimate
-            diag = self.series.self_influence + (sum(self.bulk) if self.bulk else 0.0)
-            phi = b / (diag + (Rf if Rf is not None else 0.0))
-        Ad, tmp = np.empty((B, N)), np.empty((B, N))
-        r = b - A(phi, Ad)
+            phi = b / (self.series.self_influence + (sum(self.bulk) if self.bulk else 0.0) + Rc)
+        bnorm = np.sqrt(dot(b, b))
+        safe = np.where(bnorm > 0, bnorm, 1.0)
+        r = b - A(phi)
         d = r.copy()
         rr = dot(r, r)
-        safe = np.where(bnorm > 0, bnorm, 1.0)
         active = np.sqrt(rr) / safe > tol
         its = np.zeros(B, dtype=int)
         for _ in range(max_iter):
             if not active.any():
                 break
-            A(d, Ad)
+            Ad = A(d)
             dAd = dot(d, Ad)
-            alpha = np.where(active & (dAd > 0), rr / np.where(dAd > 0, dAd, 1.0), 0.0)[:, None]
-            phi += np.multiply(d, alpha, out=tmp)
-            r -= np.multiply(Ad, alpha, out=tmp)
+            alpha = np.where(active & (dAd > 0), rr / np.where(dAd > 0, dAd, 1.0), 0.0)[seg]
+            phi += alpha * d
+            r -= alpha * Ad
             rr_new = dot(r, r)
-            d *= np.where(active, rr_new / np.where(rr > 0, rr, 1.0), 0.0)[:, None]
-            d += r
+            d = r + np.where(active, rr_new / np.where(rr > 0, rr, 1.0), 0.0)[seg] * d
             rr = np.where(active, rr_new, rr)
             its += active
             active &= np.sqrt(rr) / safe > tol
-        true = b - A(phi, Ad)
+        true = b - A(phi)
         res = np.sqrt(dot(true, true)) / safe
         if not np.all(np.isfinite(phi)):
             raise ConductionConvergenceError("conduction CG produced non-finite fluxes", [], None)
-        return phi.reshape(shape), its.reshape(batch), res.reshape(batch), ~active.reshape(batch)
+        out = np.zeros(shape)
+        out.ravel()[idx] = phi
+        return out, its.reshape(batch), res.reshape(batch), ~active.reshape(batch)
 
 
 @dataclass
