@@ -52,7 +52,8 @@ def run_set(name, k_max, size_mm, seed, n_steps=14):
     print(f"{name}: {size_mm:g} mm patch, {len(table)} summits, mean eccentricity "
           f"{table.eccentricity.mean():.2f}, rms slope {st.rms_slope:.3f}, Nayak {st.nayak:.2f}")
     for label, (c, t) in curves.items():
-        print(f"  {label:30s} {t:7.3f} s   F(top) = {c.force[-1]:8.3f} N   A/A0(top) = {c.area_fraction[-1]:.4f}")
+        print(f"  {label:30s} {t:7.3f} s   F(top) = {c.force[-1]:8.3f} N   "
+              f"A/A0(top) = {c.area_fraction[-1]:.4f}")
     F_bem = bem.mean_pressure * A0
     print(f"  {'FFT-BEM (isolated patch)':30s} {t_bem:7.3f} s   F(top) = {F_bem[-1]:8.3f} N   "
           f"A/A0(top) = {bem.area_fraction[-1]:.4f}")
@@ -83,7 +84,8 @@ def plot(sets, path):
         row[0].set(title=f"{name} (i)", xlabel="approach delta [um]", ylabel="mean pressure [MPa]")
         row[1].set(title="(ii)", xlabel="separation g_n [um]", ylabel="mean pressure [MPa]")
         row[2].set(title="(iii)", xlabel="mean pressure [MPa]", ylabel="A/A0 [%]")
-        row[3].set(title="(iv) kappa = (A/A0) E* |grad h| / p", xlabel="A/A0 [%]", ylabel="kappa", ylim=(0, 5))
+        row[3].set(title="(iv) kappa = (A/A0) E* |grad h| / p", xlabel="A/A0 [%]", ylabel="kappa",
+                   ylim=(0, 5))
         row[3].axvspan(1.5, 5, color="0.9")
         row[4].set(title=f"wall time of the {len(d['deltas'])}-step curve", ylabel="s")
         row[0].legend(fontsize=8)

@@ -66,7 +66,8 @@ def test_thesis_F1_A1_equal_the_carlson_closed_forms():
     delta = 2e-7
     a = law.size_at(np.full(e.size, delta), idx)
     R = np.sqrt(R1 * R2)
-    np.testing.assert_allclose(law.force(a, idx)[0], 4 / 3 * ES * np.sqrt(R) * hertz_F1(e) * delta**1.5, rtol=1e-9)
+    np.testing.assert_allclose(law.force(a, idx)[0], 4 / 3 * ES * np.sqrt(R) * hertz_F1(e) * delta**1.5,
+                               rtol=1e-9)
     np.testing.assert_allclose(law.area(a, idx), np.pi * hertz_A1(e) * R * delta, rtol=1e-9)
     assert hertz_F1(0.99) == pytest.approx(1.18835, abs=1e-5)   # thesis Fig. 1.3: F1 grows, A1 falls
     assert hertz_A1(0.99) == pytest.approx(0.90966, abs=1e-5)

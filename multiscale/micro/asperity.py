@@ -12,38 +12,46 @@ the highest summit. Summit k (height z_k) is asked to move ``delta_k = delta −
 
 With interaction the summit's displacement is its own Hertz approach plus the surface
 displacement caused at its centre by every other contact (Eqs. 1.10, 1.23, 2.19):
-``w_k = w_self(a_k) + sum_l u_l(a_l; x_k − x_l)``. Two solution routes (unknown: contact size
-a >= 0 per asperity):
+``w_k = w_self(a_k) + sum_l u_l(a_l; x_k − x_l)``; contact requires w_k >= delta_k, with equality
+where a_k > 0 (Eq. 1.11). Two solution routes (unknown: contact size a >= 0 per asperity):
 
-* ``route="kinematic"`` — the least-squares objective of Eq. 1.12, O = ½ sum_{k in S} (w_k − delta_k)²
-  over the set S of asperities supposed in contact, minimised with a >= 0 by scipy's bounded
-  trust-region-reflective Gauss–Newton (``least_squares``, LSMR inner solves: a truncated Newton
-  method whose Hessian-vector products J^T J v are analytic), or by ``tnc`` / ``l-bfgs-b`` on O with
-  the analytic gradient J^T r. An active-set loop updates S (drop summits pushed to a = 0, add
-  summits that penetrate the flat) until the kinematic conditions (Eq. 1.11) hold everywhere.
+* ``route="kinematic"`` — the least-squares objective of Eq. 1.12, O = ½ sum_k (w_k − delta_k)²,
+  minimised by scipy's trust-region Gauss–Newton (``least_squares`` "trf" with LSMR inner solves: a
+  truncated Newton method whose Hessian-vector products J^T J v are analytic), or by ``tnc`` /
+  ``l-bfgs-b`` on O with the analytic gradient J^T r. One signed variable per summit carries both
+  a >= 0 (x > 0) and the gap of a summit out of contact (x < 0), so O vanishes exactly at the
+  solution of Eq. 1.11 and no active-set loop is needed (the literal form, O summed over the
+  summits "supposed in contact" with a >= 0 bounds, needs one and cycles on summits at the edge).
 * ``route="energy"`` — the total complementary energy (§4.2.2, Eqs. 2.21–2.23, 4.1)
   U = sum_j [W_j(a_j) − P_j(a_j) delta_j + ½ P_j sum_{l≠j} u_l(a_l; x_j − x_l)], where
   W = ∫ P'(a) w_self(a) da is the self energy (Hertz: W = 3/5 P w_self, i.e. the 6/5 of §4.2.2;
-  Eq. 2.23's 2/5 is a misprint, it does not reproduce Hertz), minimised over a >= 0 by scipy's
-  truncated Newton ``tnc`` (Nash, the thesis' algorithm; Hessian-vector products by gradient
-  differences) or ``l-bfgs-b``, both with the analytic gradient. U is minimised in the force-like
-  variable ∝ a³, in which it is convex (two contacts: for spacing > 2a/π) and its gradient is the
-  gap of each summit.
+  Eq. 2.23's 2/5 is a misprint, it does not reproduce Hertz), minimised over a >= 0 (bounds) by
+  scipy's ``l-bfgs-b`` or the truncated Newton ``tnc`` (Nash, the thesis' algorithm; its
+  Hessian-vector products are gradient differences), both with the analytic gradient. U is
+  minimised in a force-like variable ∝ a³, in which it is convex (two contacts: spacing > 2a/π)
+  and its gradient is the gap of each summit.
 
-Both routes evaluate the interaction at the receiving summit's centre as the thesis does, so their
-solutions differ only by the non-reciprocity of that approximation, O((a/r)²) of the interaction
-(measured in tests: well below 1 % of force and area).
+Both routes stop on the complementarity residual max_k |min(P_k/P̄, gap_k/delta)|. They evaluate
+the interaction at the receiving summit's centre as the thesis does, so their solutions differ by
+the non-reciprocity of that approximation, O((a/r)²) of the interaction (tests: < 0.5 % of force
+and area on a fractal surface). A summit lying inside the (non-interacting) contact ellipse of a
+higher summit — twin peaks, ~1 % of the summits of a fractal surface — would make both problems
+ill-posed (two energy minima, a singular Jacobian); it is absorbed by the higher summit
+(``AsperityResult.absorbed``).
 
 Interaction sums (vectorised, no loop over pairs): every contact acts on every other through the
-point-force response ``g(r)`` of the solid (``P_l g(r)``, a dense matrix–vector product among the
-candidate summits: stored up to ~5600 candidates, rows recomputed blockwise beyond), and pairs closer than ``cutoff · a_ref,l`` (found with a
-``scipy.spatial.cKDTree``; a_ref >= a is a bound on the final contact size, from the warm start or a
-screening pass with point forces only, enlarged and re-solved if a contact outgrows it) add the
-near-field correction ``u_l − P_l g``. For a Hertz contact of semi-axes a >= b the correction is
-the quadrupole term, |u − P g| <= (2a² − b²)/(10 r²) · P g <= 0.2 (a/r)² P g (circular:
-(a/r)²/10), so the neglected part of every interaction sum is at most
+point-force response ``g(r)`` of the solid (``P_l g(r)``, a dense matrix–vector product over the
+candidate summits, stored up to ~5600 candidates, rows recomputed beyond), and pairs closer than
+``cutoff · a_ref,l`` (``scipy.spatial.cKDTree``) add the near-field correction ``u_l − P_l g``.
+a_ref >= a bounds the final contact size: it comes from the warm start or from a screening pass
+with point forces only, and is enlarged (and the solve repeated) if a contact outgrows it. For a
+Hertz contact of semi-axes a >= b the correction is the quadrupole term,
+|u − P g| <= (2a² − b²)/(10 r²) · P g (circular: (a/r)²/10), with the higher orders < 0.21 (a/r)²
+P g for r >= 3a, so the neglected part of every interaction sum is at most
 ``far_field_coefficient / cutoff²`` of it: ``interaction_tol`` (default 1e-3) sets
-cutoff = sqrt(0.2 / interaction_tol) ≈ 14 and results report the bound.
+cutoff = sqrt(0.21 / interaction_tol) ≈ 14.5, and results report the bound. With many candidates
+the minimisation runs on the summits in contact after screening or within 5 % of delta of
+touching; the final state is checked on every candidate (those that penetrate join, re-solve).
 
 Per-asperity law API (``AsperityLaw``, for Hertz and for layered solids, §2.4.2)
 ------------------------------------------------------------------------------
@@ -67,7 +75,7 @@ and ``idx`` the matching asperity indices (table order). Sizes may be tiny but n
 * ``point_response(r) -> g``  surface displacement [m] at distance r per unit normal point force
   [N] (half-space: 1/(π E* r)); the far-field kernel of the interaction sum.
 * attributes ``n`` (number of asperities), ``E_star`` [Pa] (modulus used in kappa),
-  ``far_field_coefficient`` (bound c on |u − P g| <= c (a/r)² P g beyond the cut-off; Hertz 0.2).
+  ``far_field_coefficient`` (bound c on |u − P g| <= c (a/r)² P g for r >= 3a; Hertz 0.21).
 
 ``AsperityModel(table, law, interaction=...)`` solves any such law; ``HertzCircular`` and
 ``HertzElliptic`` are the homogeneous half-space implementations (``hertz_law`` builds them from
@@ -75,6 +83,7 @@ an ``AsperityTable``).
 """
 from __future__ import annotations
 
+import inspect
 import time
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
@@ -93,6 +102,7 @@ _GL_X, _GL_V = np.polynomial.legendre.leggauss(16)
 _GL_T, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_V          # Gauss–Legendre on (0, 1)
 _FLOOR = 1e-10          # smallest relative size a/a_ref used where derivatives are divided by a
 _DENSE_BYTES = 256e6    # far-field matrix kept in memory up to this size (~5600 candidates)
+_LS_CALLBACK = "callback" in inspect.signature(optimize.least_squares).parameters   # scipy >= 1.16
 _SCREEN = 400           # more active candidates than this: screening pass with point forces only
 
 
@@ -102,7 +112,7 @@ class AsperityLaw(ABC):
 
     n: int
     E_star: float
-    far_field_coefficient: float = 0.2
+    far_field_coefficient: float = 0.21
 
     @abstractmethod
     def approach(self, a, idx):
@@ -204,7 +214,8 @@ class HertzCircular(_HalfSpaceLaw):
         return np.sqrt(self.R[idx] * np.maximum(w, 0.0))
 
     def displacement(self, a, src, dx, dy, a_ref=None):
-        """Eq. 1.10: (2a² − r²)/2R inside, [(2a² − r²) asin(a/r) + a sqrt(r² − a²)]/πR outside."""
+        """Eq. 1.10: (2a² − r²)/2R inside, [(2a² − r²) asin(a/r) + a sqrt(r² − a²)]/πR outside.
+        (Closed form: ``a_ref`` is not needed.)"""
         R = self.R[src]
         r2 = dx * dx + dy * dy
         inside = r2 <= a * a
@@ -237,7 +248,8 @@ class HertzElliptic(_HalfSpaceLaw):
         R1, R2 = _positive_array("R1", R1), _positive_array("R2", R2)
         angle = np.asarray(angle, dtype=float).ravel()
         if R1.shape != R2.shape or angle.shape != R1.shape or not np.all(np.isfinite(angle)):
-            raise InputError("R1/R2/angle", (R1.shape, R2.shape, angle.shape), "finite arrays of equal length")
+            raise InputError("R1/R2/angle", (R1.shape, R2.shape, angle.shape),
+                             "finite arrays of equal length")
         if np.any(R2 > R1 * (1 + 1e-12)):
             raise InputError("R2", R2, "principal radii must be ordered R1 >= R2")
         super().__init__(E_star, len(R1))
@@ -271,8 +283,8 @@ class HertzElliptic(_HalfSpaceLaw):
     def displacement(self, a, src, dx, dy, a_ref=None):
         """Eq. 1.17 in Carlson form, du/da = 2 k a I0(λ) (the λ-derivative terms vanish by Eq. 1.18),
         within ``exact_range`` · a_ref (default a) of the centre; beyond, the multipole series to the
-        quadrupole, u = P/(π E* r) [1 + (3(a² X̂² + b² Ŷ²) − a² − b²)/(10 r²)] (X̂, Ŷ direction
-        cosines in the principal axes), relative error < 1e-4 there (tested)."""
+        quadrupole, u = P/(π E* r) [1 + (3(a² X̂² + b² Ŷ²) − a² − b²)/(10 r²)] (X̂, Ŷ
+        direction cosines in the principal axes), relative error < 1e-4 there (tested)."""
         X, Y = self._local(a, src, dx, dy)
         bb = self.bb[src]
         X2, Y2 = X * X, Y * Y
@@ -370,7 +382,8 @@ class AsperityModel:
     ``surface`` (optional) gives the nominal area A0, the RMS slope for kappa, the mean plane z̄
     of Eq. 1.9 and the grid of the pressure map; without it give ``nominal_area`` (and
     ``rms_slope``); z̄ is then the mean summit height (Eq. 1.9 literally).
-    ``interaction_tol``: bound on the relative truncation error of the interaction sums.
+    ``interaction_tol``: bound on the relative truncation error of the interaction sums (the
+    cut-off is never below 3 contact sizes; ``truncation`` reports the bound in force).
     """
 
     def __init__(self, table: AsperityTable, law: AsperityLaw, *, interaction: bool = True,
@@ -394,13 +407,10 @@ class AsperityModel:
             rms_slope = float(statistics(surface).rms_slope)
         self.rms_slope = None if rms_slope is None else check_positive("rms_slope", rms_slope)
         tol = check_positive("interaction_tol", interaction_tol)
-        if tol >= 0.2:
-            raise InputError("interaction_tol", interaction_tol, "must be < 0.2")
         self.cutoff = max(np.sqrt(law.far_field_coefficient / tol), 3.0)
         self.truncation = law.far_field_coefficient / self.cutoff**2
         self.z_max = float(table.height.max())
         self.mean_height = float(surface.heights.mean() if surface is not None else table.height.mean())
-        self._all = np.arange(len(table))
         self._cache: _Interactions | None = None
 
     @classmethod
@@ -597,8 +607,8 @@ class AsperityModel:
             oy, ox = (v.ravel() for v in np.meshgrid(o, o, indexing="ij"))
             rows, cols = t.row[sel][:, None] + oy[None, :], t.col[sel][:, None] + ox[None, :]
             src = np.repeat(sel, len(o) ** 2)
-            p = law.pressure(np.repeat(a[sel], len(o) ** 2), src, (ox * s.dx)[None, :].repeat(len(sel), 0).ravel(),
-                             (oy * s.dy)[None, :].repeat(len(sel), 0).ravel()).reshape(len(sel), -1)
+            p = law.pressure(np.repeat(a[sel], len(o) ** 2), src, np.tile(ox * s.dx, len(sel)),
+                             np.tile(oy * s.dy, len(sel))).reshape(len(sel), -1)
             if s.periodic:
                 rows, cols = rows % ny, cols % nx
             else:
@@ -824,12 +834,12 @@ def _energy_gradient(st: _State, dW, dk, n):
 def _kinematic_route(inter, dk, cand, a_top, a_init, method, tol, max_iter):
     """Eq. 1.12 as a square least-squares problem in one signed variable per candidate summit.
 
-    x >= 0: in contact, a = a_top sqrt(x/s) (a_top the non-interacting size) with s = delta_k/max(delta_k) (Hertz: x = self approach /
-    max delta_k); x < 0: out of contact, a = 0 and x · max(delta_k) is minus its gap. The residual
-    r_k = w_k − delta_k (w_k = self approach, or x · max(delta_k) out of contact, plus interactions)
-    vanishes exactly at the solution of Eq. 1.11 with a >= 0, so no active-set loop is needed (the
-    literal bound-constrained form needs one and cycles on summits at the edge of contact).
-    """
+    x >= 0: in contact, a = a_top sqrt(x/s) (a_top the non-interacting size, s = delta_k/max(delta_k);
+    Hertz: x = self approach / max delta_k); x < 0: out of contact, a = 0 and x · max(delta_k) is
+    minus its gap. The residual r_k = w_k − delta_k (w_k = self approach, or x · max(delta_k) out of
+    contact, plus interactions) vanishes exactly at the solution of Eq. 1.11 with a >= 0, so no
+    active-set loop is needed (the literal bound-constrained form needs one and cycles on summits
+    at the edge of contact)."""
     law, idx, n = inter.law, inter.idx, inter.n
     C = np.nonzero(cand)[0]
     am = np.where(cand, a_top, 1.0)
@@ -883,9 +893,9 @@ def _kinematic_route(inter, dk, cand, a_top, a_init, method, tol, max_iter):
     stop = _Stop(measure, tol)
     x0 = s[C] * (a_init[C] / am[C]) ** 2
     if method == "trf":
+        early = {"callback": lambda intermediate_result: stop(intermediate_result.x)} if _LS_CALLBACK else {}
         r = optimize.least_squares(resid, x0, jac=jac, method="trf", tr_solver="lsmr", x_scale=1.0,
-                                   ftol=None, xtol=1e-3 * tol, gtol=None, max_nfev=max_iter,
-                                   callback=lambda intermediate_result: stop(intermediate_result.x))
+                                   ftol=None, xtol=1e-3 * tol, gtol=None, max_nfev=max_iter, **early)
         x, its = r.x, r.nfev
     else:
         def obj(x):
