@@ -362,5 +362,7 @@ def test_bad_input_raises_named_errors():
         AsperityModel(table, HertzCircular([1e-3, 1e-3], ES), surface=surf)
     with pytest.raises(InputError, match="deltas"):
         model.curve([2e-8, 1e-8])
+    with pytest.raises(InputError, match="initial"):
+        model.solve(1e-8, initial=[1e-6, 1e-6])
     with pytest.raises(InputError, match="E_star"):
         HertzCircular([1e-3], -1.0)

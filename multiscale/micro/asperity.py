@@ -437,6 +437,10 @@ class AsperityModel:
         delta = _check_delta(delta)
         check_positive("tol", tol)
         route, method = _check_route(route, method)
+        if initial is not None:
+            initial = np.asarray(initial, dtype=float)
+            if initial.shape != (len(self.table),) or not np.all(np.isfinite(initial)):
+                raise InputError("initial", initial, f"{len(self.table)} finite contact sizes [m]")
         t0 = time.perf_counter()
         dk = delta - (self.z_max - self.table.height)
         a = np.zeros(len(self.table))
