@@ -140,13 +140,14 @@ def write_summary(cases: dict, macs: dict, path) -> Path:
     with open(path, "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(["case", "R_q_um", "modes", "f_max_Hz", "unstable", "unstable_Hz", "potentially_unstable",
-                    "max_pressure_MPa", "mean_MMAC_first20"])
+                    "max_pressure_MPa", "mean_MMAC_first20", "law_linearisations", "preload_s", "modes_s"])
         for name, c in cases.items():
             rq = "" if name == "perfect" else f"{st.TABLE_4_1[int(name.split()[1])][0] * 1e6:g}"
             mm = f"{st.mmac(macs[name])[:20].mean():.3f}" if name in macs else ""
             w.writerow([name, rq, len(c.modes), f"{c.modes.frequency.max():.0f}", c.report.unstable.size,
                         " ".join(f"{f:.0f}" for f in c.report.frequency[c.report.unstable - 1]),
-                        c.report.potentially_unstable.size, f"{c.facet_pressure.max() / 1e6:.3f}", mm])
+                        c.report.potentially_unstable.size, f"{c.facet_pressure.max() / 1e6:.3f}", mm,
+                        getattr(c.preload, "law_iterations", ""), f"{c.preload.time:.1f}", f"{c.modes.time:.1f}"])
     return Path(path)
 
 

@@ -766,7 +766,8 @@ class LinearisedFacetLaw:
 
 @dataclass
 class LawPreload(Preload):
-    """``Preload`` of an interface with embedded laws: plus the linearisation history."""
+    """``Preload`` of an interface with embedded laws (``time``: the whole settling), plus the
+    linearisation history; the other fields are those of the last Newton solve."""
 
     law_iterations: int = 0            # re-linearisations until the laws held
     law_residuals: list = field(default_factory=list)   # Pa, max |p_affine − p_law| per iteration
@@ -782,6 +783,7 @@ def settle(mech: Mechanics, law: LinearisedFacetLaw, pressure: float, *, initial
     overshoot back and forth) the next linearisation point is relaxed towards the previous one
     (factor halved, down to 1/32) and restored once the mismatch decreases again.
     """
+    t0 = time.perf_counter()
     iface = mech.tm.interface
     g_lin = np.asarray(initial_gap, dtype=float)
     iface.set_field(mech.contact.initial_gap, g_lin)
@@ -796,7 +798,8 @@ def settle(mech: Mechanics, law: LinearisedFacetLaw, pressure: float, *, initial
             # re-linearising at the solution moves no facet pressure by more than the tolerance;
             # the Newton matrix assembled next then holds the laws' stiffness
             law.linearise_at(gap)
-            return LawPreload(**vars(pre), law_iterations=it, law_residuals=history)
+            return LawPreload(**{**vars(pre), "time": time.perf_counter() - t0}, law_iterations=it,
+                              law_residuals=history)
         if len(history) > 1:
             omega = min(1.0, 2 * omega) if history[-1] < 0.7 * history[-2] else max(omega / 2, 1 / 32)
         g_lin = g_lin + omega * (gap - g_lin)
