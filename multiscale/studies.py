@@ -582,7 +582,7 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     if comm is not None:
         comm.barrier()
     records = read_records(study)
-    todo = [r for r in study.runs if r.key not in records or (rerun_failed and records[r.key].get("status") == _FAILED)]
+    todo = [r for r in study.runs if not _done(records.get(r.key), study.metrics, rerun_failed)]
     mine = todo[rank::size]
     bar = None
     if progress and rank == 0 and mine:
@@ -620,6 +620,16 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     if comm is not None:
         comm.barrier()
     return ExecStats(len(study.runs), len(study.runs) - len(todo), len(mine), failed, time.perf_counter() - start)
+
+
+def _done(record, metrics, rerun_failed: bool) -> bool:
+    """A run is done if it failed (unless retried) or recorded every metric the study asks for
+    (a study may ask for a new metric of a scene history after its runs were made)."""
+    if record is None:
+        return False
+    if record.get("status") == _FAILED:
+        return not rerun_failed
+    return all(m in record.get("metrics", {}) for m in metrics)
 
 
 def _spawn(study: Study, run: StudyRun, rank: int) -> subprocess.Popen:
@@ -1030,8 +1040,8 @@ def pareto(times, errors) -> list[int]:
 
 
 def plot(study: Study, rows: list[Row], folder: Path) -> list[Path]:
-    """PNGs: error vs wall time per metric (Pareto front), and per knob: error (or metric) and
-    wall time vs the knob."""
+    """PNGs: error vs wall time per metric (Pareto front; with many runs only the front is
+    labelled), and per knob: error (or metric) and wall time vs the knob."""
     import matplotlib
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
@@ -1063,7 +1073,7 @@ def _plot_pareto(plt, study, ok, folder):
             idx = [i for i, r in enumerate(ok) if _case_key(study, r) == case and math.isfinite(e[i]) and e[i] > 0]
             ax.scatter([t[i] for i in idx], [e[i] for i in idx], color=f"C{c}", s=28, zorder=3,
                        label=", ".join(f"{k} = {v}" for k, v in zip(study.cases, case)) or None)
-            for i in idx:
+            for i in (idx if len(ok) <= 16 else [i for i in idx if i in pareto(t, e)]):
                 ax.annotate(_short(ok[i].run, study.cases), (t[i], e[i]), fontsize=6,
                             xytext=(3, 3), textcoords="offset points")
         refs = sorted(r.record["wall_time"] for r in ok if r.is_reference)
@@ -1098,16 +1108,16 @@ def _plot_axis(plt, study, ok, axis, folder):
     """Errors (or metric values) and wall time against one axis (a knob, or zipped knobs plotted
     against the first), one line per setting of the other knobs (mean ± std over averaged ones)."""
     import numpy as np
-    knob = axis[0]
-    values = list(dict.fromkeys(json.dumps(r.run.label[knob]) for r in ok))
-    raw = [json.loads(v) for v in values]
-    numeric = _numeric(raw)
-    xs = {v: (json.loads(v) if numeric else i) for i, v in enumerate(values)}
+    def point(r):
+        return json.dumps([r.run.label[k] for k in axis])
+    values = list(dict.fromkeys(point(r) for r in ok))
+    raw = [json.loads(v)[0] for v in values]
+    numeric = _numeric(raw) and len(set(raw)) == len(raw)    # else categorical, one tick per setting
+    xs = {v: (x if numeric else i) for i, (v, x) in enumerate(zip(values, raw))}
+    ticks = {point(r): ", ".join(r.run.shown[k] for k in axis) for r in ok}
     log_x = numeric and min(raw) > 0 and max(raw) / min(raw) > 5
     averaged = set(study.averaged)
     others = [k for k in study.knobs if k not in axis and k not in averaged]
-    if not numeric:      # categorical: name every zipped value at its tick
-        ticks = {json.dumps(r.run.label[knob]): ", ".join(r.run.shown[k] for k in axis) for r in ok}
     lines = {}
     for r in ok:
         lines.setdefault(tuple(r.run.shown[k] for k in others), []).append(r)
@@ -1121,7 +1131,7 @@ def _plot_axis(plt, study, ok, axis, folder):
             for r in group:
                 y = (r.errors.get(m, math.nan) or math.nan if kind == "error" else     # 0: the reference
                      r.record["metrics"][m] if kind == "value" else r.record["wall_time"])
-                pts.setdefault(xs[json.dumps(r.run.label[knob])], []).append(y)
+                pts.setdefault(xs[point(r)], []).append(y)
             x = sorted(pts)
             mean = np.array([np.mean(pts[v]) for v in x])
             label = ", ".join(f"{k} = {v}" for k, v in zip(others, other)) if others else None
@@ -1147,7 +1157,7 @@ def _plot_axis(plt, study, ok, axis, folder):
             ax.legend(fontsize=6)
     fig.suptitle(f"{study.name}: {' / '.join(axis)}" + (f" (mean ± std over {', '.join(averaged)})" if averaged else ""))
     fig.tight_layout()
-    path = folder / f"{study.name}_{knob.replace('.', '_')}.png"
+    path = folder / f"{study.name}_{axis[0].replace('.', '_')}.png"
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path

@@ -541,7 +541,8 @@ def _zone_laws(p: ZoneLawParams) -> Outcome:
 
 
 # ----------------------------------------------------------------------------- macro scenes
-_REDUCERS = {"last": lambda v: v[-1], "first": lambda v: v[0], "max": np.max, "min": np.min, "mean": np.mean}
+_REDUCERS = {"last": lambda v: v[-1], "first": lambda v: v[0], "max": np.max, "min": np.min, "mean": np.mean,
+             "rise": lambda v: v[-1] - v[0]}
 
 
 @dataclass(frozen=True)
@@ -555,11 +556,12 @@ class SceneRun:
 
 class SceneProblem(Problem):
     """Any macro scene (``multiscale run``) with overrides; metrics are history columns reduced
-    over time: ``column`` (last value) or ``column:last|first|max|min|mean``."""
+    over time: ``column`` (last value) or ``column:last|first|max|min|mean|rise`` (rise = last −
+    first: a temperature rise, whose relative error means more than that of a temperature in K)."""
 
     name = "scene"
     doc = ("a macro scene run by the macro runner with overrides; metrics: HDF5 history columns, "
-           "column[:last|first|max|min|mean]")
+           "column[:last|first|max|min|mean|rise]")
     metrics = {}
 
     def parse(self, raw, path, ctx, scene=None, ranks=1):

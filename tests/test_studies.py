@@ -118,6 +118,27 @@ def test_rerun_skips_finished_runs_and_runs_only_new_points(hertz_study, capsys)
     assert "4 recorded before, 0 run now" in capsys.readouterr().out
 
 
+def test_reference_from_a_stored_file_and_records_shared_by_studies(hertz_study, tmp_path, capsys):
+    """kind = "file": the stored exact values give the analytic errors; a second study pointing at
+    the same run folder reuses the first one's runs (records are keyed by parameters)."""
+    path, out = hertz_study
+    E_star = 210e9 / (1 - 0.3**2)
+    a = (3 * 10.0 * 10e-3 / (4 * E_star)) ** (1 / 3)
+    (tmp_path / "hertz.json").write_text(json.dumps({"contact_radius": a, "max_pressure": 3 * 10.0 / (2 * np.pi * a * a),
+                                                    "approach": a * a / 10e-3}))
+    other = write(tmp_path, HERTZ.replace('kind = "analytic"', 'kind = "file"\nfile = "hertz.json"')
+                  .replace("[run]", f'[run]\nfolder = "{out}"').replace('name = "hertz"', 'name = "stored"')
+                  + f'plots = false\nfolder = "{tmp_path}"\n')
+    capsys.readouterr()
+    assert main(["study", str(other)]) == 0
+    assert "4 recorded before, 0 run now" in capsys.readouterr().out
+    rows = table(out / "results.csv")          # rewritten by the "stored" study
+    for row in rows:
+        for m, err in hertz_independent(int(row["grid"])).items():
+            assert float(row[f"{m}_error"]) == pytest.approx(err, rel=1e-6)
+    assert "stored result hertz.json" in (tmp_path / "stored.md").read_text()
+
+
 def test_failing_and_timed_out_runs_are_recorded_and_the_rest_completes(tmp_path, capsys):
     text = HERTZ.replace("[sweep]\ngrid = [12, 16, 24, 32]",
                          '[sweep]\ncombine = "zip"\ngrid = [12, 16, 24]\nmax_iter = [5000, 1, 5000]') + "plots = false\n"
