@@ -14,10 +14,12 @@ a base scene whose keys it overrides), the parameters to sweep, the metrics and 
     grid = [16, 32, 64, 128]          # a list, or a range {start, stop, num | step, log = true}
     [reference]
     kind = "analytic"                 # the problem's exact values; "run" with run = {grid = 128}
-                                      # (per run: the run with these values, others unchanged);
+                                      # (per run: the run with these values, others unchanged,
+                                      # zip partners following);
                                       # "file" with file = "ref.json" ({metric: value})
     [run]                             # processes, timeout, repeat (best-of wall time), folder
-    [report]                          # errors = ["1 %", "5 %"], cases, average_over, folder, title
+    [report]                          # errors = ["1 %", "5 %"], cases (physical parameters, not
+                                      # knobs), average_over (e.g. seeds), folder, title, plots
 
 Runs: each run is a fresh worker process (``python -m multiscale.studies``), so its peak memory
 (``ru_maxrss``, children included) is its own; ``[run] processes`` of them at a time, or under
