@@ -12,7 +12,8 @@ from pathlib import Path
 
 import numpy as np
 
-UNITS = {"time": "s", "force": "N", "pressure": "Pa", "temperature": "K", "heat": "J", "iterations": "-"}
+UNITS = {"time": "s", "force": "N", "pressure": "Pa", "temperature": "K", "heat": "J", "iterations": "-",
+         "volume": "m^3", "depth": "m", "rms": "m", "work": "J"}
 
 
 def unit_of(name: str) -> str:
@@ -77,7 +78,10 @@ class History:
             ax.set_xlabel("time [s]")
             ax.set_ylabel(label)
             ax.grid(alpha=0.3)
-            ax.ticklabel_format(axis="y", useOffset=False)
+            values = np.concatenate([self[k] * scale + shift for k in keys])
+            if np.ptp(values) <= 1e-6 * np.abs(values).max(initial=0.0):     # constant to round-off
+                centre = values.mean()
+                ax.set_ylim(centre - 0.05 * abs(centre) - 1e-30, centre + 0.05 * abs(centre) + 1e-30)
             if len(keys) > 1:
                 ax.legend()
         fig.suptitle(title)
@@ -88,30 +92,36 @@ class History:
 
 
 class FieldWriter:
-    """XDMF time series: ``<folder>/<body>.xdmf`` per body and ``<folder>/interface.xdmf``."""
+    """XDMF time series: ``<folder>/<body>.xdmf`` per body and ``<folder>/interface.xdmf``.
 
-    def __init__(self, folder: Path, tm, body_functions, interface_functions):
+    The files are closed after every write, so that a run killed between two writes leaves them
+    readable; ``append`` continues existing files (a resumed run: no new mesh)."""
+
+    def __init__(self, folder: Path, tm, body_functions, interface_functions, append: bool = False):
         from dolfinx.io import XDMFFile
         self.files = []
         self.groups = []
+        self.append = append
+        self._XDMFFile, self._comm = XDMFFile, tm.comm
         for body, functions in zip(tm.bodies, body_functions):
-            self._open(XDMFFile, Path(folder) / f"{body.name}.xdmf", body.mesh, functions, tm.comm)
-        self._open(XDMFFile, Path(folder) / "interface.xdmf", tm.interface.mesh, interface_functions, tm.comm)
+            self._open(Path(folder) / f"{body.name}.xdmf", body.mesh, functions)
+        self._open(Path(folder) / "interface.xdmf", tm.interface.mesh, interface_functions)
 
-    def _open(self, XDMFFile, path, mesh, functions, comm):
-        f = XDMFFile(comm, str(path), "w")
-        f.write_mesh(mesh)
+    def _open(self, path, mesh, functions):
+        if not self.append:
+            f = self._XDMFFile(self._comm, str(path), "w")
+            f.write_mesh(mesh)
+            f.close()
         self.files.append(path)
-        self.groups.append((f, list(functions)))
+        self.groups.append((path, list(functions)))
 
     def write(self, time: float) -> None:
-        for f, functions in self.groups:
-            for u in functions:
-                f.write_function(u, time)
+        for path, functions in self.groups:
+            with self._XDMFFile(self._comm, str(path), "a") as f:
+                for u in functions:
+                    f.write_function(u, time)
 
     def close(self) -> None:
-        for f, _ in self.groups:
-            f.close()
         self.groups = []
 
 

@@ -8,8 +8,8 @@ Values are numbers (SI) or unit strings ("200 rpm", "4 GPa", "20 degC"; ``multis
 relative paths are taken from the scene file's directory. Code asks ``scene.has("thermal")``.
 
 Sections: geometry (builder + its parameters), materials (one table per body of the builder),
-interface, loading, time, output; and, for effects landing with later issues, roughness, micro,
-wear, layers, stability (validated now, used by no code yet).
+interface, loading, time, output; roughness, micro, wear and layers (the multiscale loop,
+``multiscale.coupling``); stability (the squeal analysis).
 """
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ from multiscale.schema import (Bad, Choice, Context, Curve, Either, FilePath, Fl
                                Section, Tables, Text, fields_of, key, read, show, unknown_keys)
 from multiscale.schema import reference as schema_reference
 
-__all__ = ["BUILDERS", "EFFECTS", "OUTPUT_FIELDS", "Geometry", "Material", "Scene", "load", "loads",
+__all__ = ["BUILDERS", "EFFECTS", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Geometry", "Material", "Scene", "load", "loads",
            "reference", "summary"]
 
 
@@ -49,10 +49,10 @@ EFFECTS: dict[str, Effect] = {
                           ("thermal", "contact")),
     "expansion": Effect("thermal expansion alpha (T - T0) in the mechanics", ("thermal",)),
     "roughness": Effect("rough interface: per-zone homogenized laws from micro patches "
-                        "([roughness], [micro])", ("contact",), issue=9),
-    "layers": Effect("layered near-surface material in the micro models ([layers])", ("roughness",), issue=9),
+                        "([roughness], [micro])", ("contact",)),
+    "layers": Effect("layered near-surface material in the micro models ([layers])", ("roughness",)),
     "wear": Effect("Archard wear of the rough zones between macro steps ([wear])",
-                   ("roughness", "friction"), issue=9),
+                   ("roughness", "friction")),
     "stability": Effect("complex eigenvalue (squeal) analysis at the sliding state ([stability])",
                         ("contact",), issue=10),
 }
@@ -316,13 +316,17 @@ class Roughness:
 @dataclass(frozen=True)
 class Micro:
     """How the rough interface is solved (issue 7): zone grid on the interface, grid per zone,
-    micro model, points of each p_n(g_n) law, micro partition law (ch. 6) or the constant one."""
+    micro model, points of each p_n(g_n) law (top node at ``p_max``, default 20 x the nominal
+    interface pressure; contact solver tolerance ``tol``), micro partition law (ch. 6) or the
+    constant one."""
 
     zones: tuple | None = key(Pair(Integer(ge=1)), required=True)             # (nx, ny) zones
     grid: tuple = key(Pair(Integer(ge=8)), default=(50, 50))                  # (nx, ny) per zone
     model: str = key(Choice(("fft-bem", "asperity", "asperity-interacting")), default="fft-bem")
-    law_points: int = key(Integer(ge=3), default=20)
+    law_points: int = key(Integer(ge=4), default=20)
     partition_law: bool = key(Flag(), default=False)
+    p_max: float | None = key(Quantity("pressure", gt=0))                     # Pa, top node of the laws
+    tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)     # micro contact solves
 
     def problems(self, path, ctx):
         if self.partition_law and "heat_partition" not in ctx.effects:
@@ -330,16 +334,33 @@ class Micro:
         return []
 
 
+# Default k_w(T) [(K, 1/Pa)]: the shape of thesis Fig. 7.9 (sintered pad material, [Mann 2017]):
+# slowly rising up to 200 degC, steeply above. The figure's numbers are not in the text; the level
+# at 20-100 degC (~8e-15 1/Pa) is what reproduces the worn volume of §7.3.2 (3.8e7 um^3 in 30 s
+# of 200 N at 1.9 m/s with mu = 0.4: V / (mu F s) = 8.4e-15 1/Pa).
+FIG_7_9_WEAR_RATE = ((293.15, 6e-15), (373.15, 8e-15), (473.15, 1.5e-14), (573.15, 6e-14), (673.15, 2e-13))
+
+
 @dataclass(frozen=True)
 class Wear:
-    """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (Fig. 7.9)."""
+    """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (default: the
+    shape of thesis Fig. 7.9, ``FIG_7_9_WEAR_RATE``). Every ``update_every`` macro steps the zones
+    wear over the sliding of those steps in ``substeps`` load-controlled increments."""
 
     k_w: float | None = key(Quantity("wear_rate", gt=0))                      # 1/Pa
     k_w_table: tuple | None = key(Curve(Quantity("temperature", gt=0), Quantity("wear_rate", ge=0),
                                         "temperature", "k_w"))                # ((K, 1/Pa), ...)
     update_every: int = key(Integer(ge=1), default=1)                         # macro steps per update
+    substeps: int = key(Integer(ge=1), default=1)                             # wear increments per update
 
-    rules = (OneOf(("k_w", "k_w_table"), required=True),)
+    rules = (OneOf(("k_w", "k_w_table")),)
+
+    @property
+    def rate(self):
+        """k_w [1/Pa]: the constant, else the table ((temperatures [K]), (rates [1/Pa]))."""
+        if self.k_w is not None:
+            return self.k_w
+        return tuple(zip(*(self.k_w_table or FIG_7_9_WEAR_RATE)))
 
 
 @dataclass(frozen=True)
@@ -572,5 +593,15 @@ def _effect_line(scene: Scene, effect: str) -> str:
         share = f"{scene.partition:.3g}" + (" (effusivity)" if i.partition == "effusivity" else "")
         return f"share {share} of mu p |v| into the {scene.bodies[0]}"
     if effect == "conductance":
-        return f"h_c = {i.conductance:g} W/(m^2 K)"
+        return f"h_c = {i.conductance:g} W/(m^2 K)" if not scene.has("roughness") else "h_c(p) per zone (micro)"
+    if effect == "roughness":
+        r, m = scene.roughness, scene.micro
+        surface = f"RMS {r.rms * 1e6:g} um, H {r.hurst:g}" if r.rms is not None else f"file {r.file.name}"
+        return (f"{r.body}: {surface}; {m.zones[0]} x {m.zones[1]} zones of {m.grid[0]} x {m.grid[1]} cells, "
+                f"{m.law_points}-point laws")
+    if effect == "wear":
+        w = scene.wear
+        rate = f"k_w = {w.k_w:g} 1/Pa" if w.k_w is not None else (
+            "k_w(T) table" if w.k_w_table is not None else "k_w(T) of thesis Fig. 7.9 (default)")
+        return f"Archard, {rate}, every {w.update_every} step(s) in {w.substeps} increment(s)"
     return EFFECTS[effect].doc

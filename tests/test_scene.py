@@ -316,11 +316,15 @@ def test_later_sections_report_clear_problems(tmp_path, old, new, fragment):
 
 
 def test_unimplemented_effect_is_named_with_its_issue(tmp_path):
+    pending = [name for name, e in EFFECTS.items() if e.issue]
+    if not pending:
+        pytest.skip("every effect is implemented")
+    name = pending[0]
     with pytest.raises(SceneError) as info:
-        loads(GOOD.replace('"expansion"]', '"expansion", "wear"]') + LATER, tmp_path)
+        loads(GOOD.replace('"expansion"]', f'"expansion", "{name}"]') + LATER, tmp_path)
     assert info.value.problems == [
-        'effects = ["contact", "friction", "thermal", "heat_partition", ...]: item 7 ("wear"): '
-        "known but not implemented yet (issue 9)"]
+        f'effects = ["contact", "friction", "thermal", "heat_partition", ...]: item 7 ("{name}"): '
+        f"known but not implemented yet (issue {EFFECTS[name].issue})"]
 
 
 def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):

@@ -99,14 +99,15 @@ class MacroModel:
         return row
 
 
-def build_model(scene, comm=MPI.COMM_WORLD, law=None) -> MacroModel:
+def build_model(scene, comm=MPI.COMM_WORLD, law=None, tm=None) -> MacroModel:
     """Mesh and the problems the scene's effects ask for (no heat problem without ``thermal``).
 
-    ``law`` optionally replaces the perfect-contact penalty law (see ``interface.PressureLaw``).
+    ``law`` optionally replaces the perfect-contact penalty law (see ``interface.PressureLaw``);
+    ``tm``: an already built mesh of the scene (e.g. the one the law's per-facet fields live on).
     """
     if not scene.has("contact"):
         raise InputError("effects", sorted(scene.effects), 'the macro model needs effect "contact"')
-    tm = _mesh.build(scene.geometry.builder, dict(scene.geometry.params), comm)
+    tm = tm or _mesh.build(scene.geometry.builder, dict(scene.geometry.params), comm)
     materials = dict(scene.materials)
     thermal = scene.has("thermal")
     T = temperature_functions(tm) if thermal else None
@@ -144,23 +145,34 @@ class RunResult:
     wall_time: float                 # s
 
 
-def run(scene, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_WORLD,
-        verbose: bool = True) -> RunResult:
-    """Run a scene (``multiscale run``): see module docstring."""
-    start = _time.perf_counter()
-    io.abort_on_exception(comm)
-    if resume:
-        raise InputError("--resume", True, "this scene has no checkpoints to resume from "
-                         "(checkpointing arrives with the multiscale loop)")
+def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
+    """The scene's output folder, created; refuses to overwrite results without ``overwrite``
+    (or ``resume``, which continues them). Rank 0 decides for every rank."""
     folder = Path(scene.output.folder)
     existing = comm.bcast(sorted(p.name for p in folder.iterdir()) if comm.rank == 0 and folder.is_dir() else [],
                           root=0)
-    if existing and not overwrite:
+    if existing and not (overwrite or resume):
         raise InputError("output.folder", str(folder),
                          f"already holds results ({', '.join(existing[:3])}...); pass --overwrite to replace them")
     if comm.rank == 0:
         folder.mkdir(parents=True, exist_ok=True)
     comm.barrier()
+    return folder
+
+
+def run(scene, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_WORLD,
+        verbose: bool = True) -> RunResult:
+    """Run a scene (``multiscale run``): see module docstring. Scenes with effect ``roughness``
+    run the multiscale loop (``multiscale.coupling.run``, checkpointed, resumable)."""
+    if scene.has("roughness"):
+        from multiscale.coupling import run as run_multiscale
+        return run_multiscale(scene, overwrite=overwrite, resume=resume, comm=comm, verbose=verbose)
+    start = _time.perf_counter()
+    io.abort_on_exception(comm)
+    if resume:
+        raise InputError("--resume", True, "this scene has no checkpoints to resume from "
+                         "(only the multiscale loop, effect \"roughness\", writes checkpoints)")
+    folder = prepare_folder(scene, overwrite, False, comm)
     model = build_model(scene, comm)
     model.start()
     writer = _FieldOutput(model, folder, scene.output.fields)
@@ -188,9 +200,12 @@ def run(scene, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_WORL
 
 
 class _FieldOutput:
-    """The scene's output fields, refreshed and written at each output time."""
+    """The scene's output fields, refreshed and written at each output time.
 
-    def __init__(self, model: MacroModel, folder: Path, fields):
+    ``extra``: {interface field name: callable returning its global per-facet array}, written when
+    the name is among ``fields``; ``append``: continue existing XDMF files (a resumed run)."""
+
+    def __init__(self, model: MacroModel, folder: Path, fields, extra=None, append: bool = False):
         self.model = model
         tm, mech, th = model.tm, model.mechanics, model.thermal
         fields = set(fields)
@@ -209,8 +224,9 @@ class _FieldOutput:
         iface = []
         self.pressure = tm.interface.field("contact_pressure") if "contact_pressure" in fields else None
         self.flux = tm.interface.field("heat_flux") if "heat_flux" in fields and th is not None else None
-        iface = [f for f in (self.pressure, self.flux) if f is not None]
-        self.writer = io.FieldWriter(folder, tm, body, iface)
+        self.extra = [(tm.interface.field(name), make) for name, make in (extra or {}).items() if name in fields]
+        iface = [f for f in (self.pressure, self.flux) if f is not None] + [f for f, _ in self.extra]
+        self.writer = io.FieldWriter(folder, tm, body, iface, append=append)
         self.files = self.writer.files
 
     def write(self) -> None:
@@ -221,6 +237,8 @@ class _FieldOutput:
             m.tm.interface.set_field(self.pressure, m.contact.facet_pressure())
         if self.flux is not None:
             m.tm.interface.set_field(self.flux, m.contact.facet_heat_flux())
+        for f, make in self.extra:
+            m.tm.interface.set_field(f, make())
         self.writer.write(m.time)
 
     def close(self) -> None:

@@ -1,0 +1,309 @@
+"""The multiscale loop (thesis §1.4–1.5, ch. 7): facet laws in UFL, the ch. 1 block verification,
+the seam against perfect contact, wear bookkeeping, checkpoints and resume."""
+import dataclasses
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+
+import ufl  # noqa: E402
+
+from multiscale.errors import InputError  # noqa: E402
+from multiscale.io import History  # noqa: E402
+from multiscale.macro import mesh  # noqa: E402
+from multiscale.macro.geometry import Support  # noqa: E402
+from multiscale.macro.laws_ufl import FacetLaw  # noqa: E402
+from multiscale.macro.mechanics import Mechanics  # noqa: E402
+from multiscale.micro.contact import ContactSolver  # noqa: E402
+from multiscale.micro.heat_kernels import ThermalMaterial  # noqa: E402
+from multiscale.micro.kernels import HalfSpace  # noqa: E402
+from multiscale.micro.laws import LawSpec, ZoneLaws, ZoneNodes, compute_laws  # noqa: E402
+from multiscale.micro.post_analysis import Heating, PostAnalysis  # noqa: E402
+from multiscale.micro.surface import Surface, fractal_surface  # noqa: E402
+from multiscale.micro.zones import cut_zones, love_rectangle_mean  # noqa: E402
+from multiscale.scene import loads  # noqa: E402
+
+N_POINTS = 8          # nodes per law in every test here: the compiled forms are shared
+
+
+@pytest.fixture(scope="module")
+def block():
+    """Coarse block on a flat (10 x 10 mm, 2.5 mm elements)."""
+    return mesh.build("block_on_flat", {"mesh_size": 2.5e-3})
+
+
+def _synthetic_law(zone_id, top, d1, exponent, n=N_POINTS):
+    """A law p = 1 MPa (d/d1)^m on nodes d1 ... 6 d1 (its onset below the first node is that power)."""
+    d = d1 * np.geomspace(1, 6, n)
+    p = 1e6 * (d / d1) ** exponent
+    return ZoneNodes(zone_id, f"synthetic{zone_id}", d, p, top - d, np.full(n, 0.1), np.zeros(n, int), top, 0.0)
+
+
+def test_facet_law_is_the_zone_law_and_its_tangent(block):
+    """UFL p_n(g) per facet equals the numpy PressureGapLaw (every branch: open, onset power law
+    and cubic, PCHIP nodes, beyond the table) and UFL's derivative equals its stiffness K_n."""
+    s = fractal_surface(64, 2e-3, 0.8, 1, 8, 1e-6, seed=1)
+    _, zones = cut_zones(Surface(s.heights, s.dx, s.dy, periodic=False), (2, 1))
+    rough = compute_laws(zones, LawSpec(HalfSpace.from_materials(5e9, 0.3, 220e9, 0.3), p_max=5e6,
+                                        n_points=N_POINTS))
+    laws = ZoneLaws(rough.nodes + [_synthetic_law(7, 2e-6, 1e-7, 2.0), _synthetic_law(9, 1e-6, 2e-7, 1.2)])
+    assert laws.mechanical._slope[2, 0] >= 1.5 > laws.mechanical._slope[3, 0]     # both onset branches
+    iface = block.interface
+    ids = np.array([0, 1, 7, 9])[np.arange(iface.n_facets) % 4]
+    law = FacetLaw(block, N_POINTS)
+    law.set_laws(laws, ids)
+    rows = laws.rows(ids)
+    g_open, g_last = laws.mechanical.g_open[rows], laws.mechanical.gap[rows, -1]
+    d_first, d_last = np.exp(laws.mechanical._x[rows, 0]), g_open - g_last
+    u = np.random.default_rng(0).uniform(0.05, 0.95, iface.n_facets)
+    branch = (np.arange(iface.n_facets) // 4) % 4            # open, onset, between nodes, beyond
+    d = np.choose(branch, [-u * d_last, u * d_first, d_first + u * (d_last - d_first), d_last * (1 + u)])
+    gap = g_open - d
+    g0 = iface.field("g0", gap)
+    g = ufl.variable(g0("+"))
+    p = law(g)
+    cache = mesh.FormCache(block)
+    p_ufl = cache.facet_mean("p", lambda: p)
+    K_ufl = cache.facet_mean("K", lambda: -ufl.diff(p, g))
+    p_np, K_np = law.evaluate(gap)
+    assert np.all(np.bincount(branch, minlength=4) >= 4)
+    np.testing.assert_allclose(p_ufl, p_np, rtol=1e-11, atol=1e-12 * p_np.max())
+    np.testing.assert_allclose(K_ufl, K_np, rtol=1e-9, atol=1e-12 * K_np.max())
+
+
+def test_block_on_rigid_flat_force_matches_the_micro_solution():
+    """Thesis §1.5 (Fig. 1.14): a block pressed by a rigid flat moved by delta, its interface
+    embedded with the Love-corrected laws of 5 x 5, 15 x 15 and 15 x 25 zones: total force within
+    3 % of the FFT-BEM solution of the whole rough surface. The block's bulk is not a half-space:
+    the micro curve is moved by F/A (C_block - C_halfspace), C_block from the same FE model with
+    perfect contact, C_halfspace = Love's mean over the face / (pi E*) (without it: within 5 %)."""
+    Lx, Ly, E = 15e-3, 22.5e-3, 10e9
+    area = Lx * Ly
+    tm = mesh.build("block_on_flat", {"length": Lx, "width": Ly, "height": 15e-3, "flat_thickness": 5e-3,
+                                      "mesh_size": 5e-3, "interface_mesh_size": 0.8e-3})
+    spec = dataclasses.replace(tm.spec, supports=tm.spec.supports + (Support("block_top", (2,)),), load_faces=())
+    tm = dataclasses.replace(tm, spec=spec)              # top held: the flat's motion is the initial gap
+    materials = {"block": SimpleNamespace(E=E, nu=0.3), "flat": SimpleNamespace(E=1e6 * E, nu=0.3)}
+    kernel = HalfSpace.from_materials(E, 0.3, 1e6 * E, 0.3)
+    perfect = Mechanics(tm, materials, stiffness=1e20, load_kind="pressure", prefix="ch1_perfect_")
+    tm.interface.set_field(perfect.contact.initial_gap, -1e-6)
+    perfect.solve(0.0)
+    c_block = 1e-6 * area / perfect.contact.normal_force()
+    c_half = love_rectangle_mean(Lx / 2, Ly / 2) / (np.pi * kernel.E_star)
+
+    rms = 5e-6
+    s = fractal_surface((300, 450), (Lx, Ly), 0.8, 30, 75, rms, seed=11)
+    surface = Surface(s.heights, s.dx, s.dy, periodic=False)
+    solver = ContactSolver(kernel, surface.shape, surface.dx, surface.dy, periodic=False)
+    approach = rms * np.linspace(1.5, 4.0, 6)
+    force = np.array([solver.solve(surface.heights, approach=a).mean_pressure * area for a in approach])
+    moved = approach + force / area * (c_block - c_half)
+    deltas = rms * np.array([2.0, 2.75, 3.5])
+    reference = np.interp(deltas, moved, force)
+    raw = np.interp(deltas, approach, force)
+
+    law = FacetLaw(tm, N_POINTS)
+    mech = Mechanics(tm, materials, law=law, load_kind="pressure", prefix="ch1_rough_")
+    mid = tm.interface.midpoints
+    for counts in [(5, 5), (15, 15), (15, 25)]:
+        grid, zones = cut_zones(surface, counts)
+        laws = compute_laws(zones, LawSpec(kernel, p_max=2 * force.max() / area, n_points=N_POINTS,
+                                           max_iter=20000))
+        law.set_laws(laws, grid.zone_of(mid[:, 0], mid[:, 1]), [z.area for z in zones])
+        for u in mech.u:
+            u.x.array[:] = 0.0
+        embedded = []
+        for d in deltas:
+            tm.interface.set_field(mech.contact.initial_gap, surface.heights.max() - d)
+            mech.solve(0.0)
+            embedded.append(mech.contact.normal_force())
+        assert np.abs(np.array(embedded) / reference - 1).max() < 0.03, (counts, embedded, reference)
+        assert np.abs(np.array(embedded) / raw - 1).max() < 0.05, (counts, embedded, raw)
+
+
+BLOCK = """
+name = "rough_block"
+effects = ["contact", "roughness"{extra}]
+[geometry]
+builder = "block_on_flat"
+mesh_size = "2.5 mm"
+[materials.block]
+E = "4 GPa"
+nu = 0.15
+[materials.flat]
+E = "210 GPa"
+nu = 0.3
+[loading]
+pressure = "1 MPa"
+{loading}
+[roughness]
+body = "block"
+file = "{file}"
+pixel_size = "{pixel}"
+[micro]
+zones = [4, 4]
+law_points = {n}
+[output]
+folder = "{folder}"
+"""
+
+
+def test_identical_zones_equal_perfect_contact_with_the_secant_stiffness(tmp_path, block):
+    """Wear off, every zone the same patch: the embedded block (uniform stress) equals the
+    penalty model with K_n = p / (g_open - g) and the gap shifted by g_open (to solver tolerance)."""
+    from multiscale.coupling import Multiscale
+    patch = fractal_surface(16, 2.5e-3, 0.8, 1, 6, 2e-6, seed=5).heights
+    patch = patch + patch[::-1] + patch[:, ::-1] + patch[::-1, ::-1]     # even: the file's plane fit is flat
+    np.save(tmp_path / "tiled.npy", np.tile(patch, (4, 4)))
+    scene = loads(BLOCK.format(extra="", loading="", file=tmp_path / "tiled.npy", pixel="156.25 um",
+                               n=N_POINTS, folder=tmp_path / "out"), tmp_path)
+    ms = Multiscale(scene)
+    ms.start()
+    heights = np.stack([z.surface.heights for z in ms.zones])
+    assert np.abs(heights - heights[0]).max() < 1e-12 * np.abs(heights).max()   # the file's plane fit is ~0
+    emb = ms.model
+    p = emb.contact.facet_pressure()
+    np.testing.assert_allclose(p, 1e6, rtol=1e-6)
+    gap = emb.contact.facet_gap()
+    g_open = ms.law.laws.mechanical.g_open.mean()
+    secant = 1e6 / (g_open - gap.mean())
+    assert np.ptp(gap) < 1e-9 * (g_open - gap.mean())
+    perfect = Mechanics(ms.tm, dict(scene.materials), stiffness=secant, load_kind="pressure", prefix="seam_")
+    ms.tm.interface.set_field(perfect.contact.initial_gap, ms.datum_gap - g_open)
+    perfect.solve(1e6)
+    for ue, up in zip(emb.mechanics.u, perfect.u):
+        assert np.abs(ue.x.array - up.x.array).max() < 1e-8 * np.abs(up.x.array).max()
+
+
+def test_post_analysis_wears_exactly_archard_volume():
+    """Constant k_w: a zone's worn volume is k_w mu P A s to round-off, whatever the substeps; the
+    partition into the rough body lies in [0, 1] and matches the steady solver alone."""
+    s = fractal_surface(24, 1e-3, 0.8, 1, 6, 2e-6, seed=2)
+    _, zones = cut_zones(Surface(s.heights, s.dx, s.dy, periodic=False), (2, 1))
+    kernel = HalfSpace.from_materials(5e9, 0.3, 220e9, 0.3)
+    heating = Heating(ThermalMaterial(50, 1e-5), ThermalMaterial(35, 8.3e-6))
+    P, v, dt, k_w, mu = np.array([1e6, 3e6]), np.array([1.9, 1.7]), 0.6, 1e-14, 0.4
+    for substeps in (1, 3):
+        post = PostAnalysis(kernel, zones[0].shape, s.dx, s.dy, mu=mu, heating=heating, wear_rate=k_w,
+                            substeps=substeps)
+        r = post.run(zones, P, speed=v, angle=np.pi / 2, remote=[[300.0, 310.0], [300.0, 300.0]],
+                     sliding=v * dt)
+        area = np.array([z.area for z in zones])
+        np.testing.assert_allclose(r.volume, k_w * mu * P * area * v * dt, rtol=1e-10)
+        assert np.all(r.depth >= 0) and np.all((0 <= r.partition) & (r.partition <= 1))
+        np.testing.assert_allclose(r.heights, np.stack([z.surface.heights for z in zones]) - r.depth)
+    assert r.partition[0] < r.partition[1]           # a hotter rough body takes less of the heat
+    assert np.all(r.max_temperature > 300.0)
+    with pytest.raises(InputError, match="load"):
+        post.run(zones, [1e6, 0.0], speed=v, remote=[[300.0, 300.0]] * 2)
+
+
+POD = """
+name = "pod_rough"
+effects = ["contact", "friction", "thermal", "heat_partition", "expansion", "roughness", "wear"]
+[geometry]
+builder = "pin_on_disc"
+mesh_size = "15 mm"
+holder_mesh_size = "6 mm"
+interface_mesh_size = "2.5 mm"
+track_mesh_size = "8 mm"
+[materials.disc]
+E = "220 GPa"
+nu = 0.3
+kappa = "50 W/(m K)"
+chi = "1e-5 m^2/s"
+alpha = "1e-5 1/K"
+[materials.pin]
+E = "5 GPa"
+nu = 0.3
+kappa = "35 W/(m K)"
+chi = "8.3e-6 m^2/s"
+alpha = "5e-6 1/K"
+[interface]
+partition = 0.14
+[loading]
+normal_force = "200 N"
+rotation_speed = "200 rpm"
+friction = 0.4
+[time]
+end = "1.2 s"
+steps = 2
+initial_temperature = "20 degC"
+[roughness]
+body = "pin"
+rms = "10 um"
+hurst = 0.6
+k_min = 1
+k_max = 8
+seed = 3
+[micro]
+zones = [5, 5]
+grid = [16, 16]
+law_points = 8
+partition_law = true
+[wear]
+k_w = "1e-14 1/Pa"
+substeps = 2
+[output]
+folder = "{folder}"
+"""
+
+
+@pytest.fixture(scope="module")
+def straight(tmp_path_factory):
+    from multiscale.macro.runner import run
+    folder = tmp_path_factory.mktemp("pod") / "straight"
+    scene = loads(POD.format(folder=folder))
+    return scene, run(scene, verbose=False)
+
+
+def test_rough_pin_on_disc_bookkeeping_and_outputs(straight):
+    """Worn volume summed over the zones = k_w x (time integral of mu p |v| over the interface)
+    within 1 %; the load is carried; partitions in [0, 1]; every result file written."""
+    scene, result = straight
+    h = History.read(result.history_file)
+    assert len(h) == 3 and h["time"][-1] == pytest.approx(1.2)
+    np.testing.assert_allclose(h["interface_force"], 200.0, rtol=1e-6)
+    assert h["frictional_work"][-1] == pytest.approx(0.4 * 200 * 2 * np.pi * 200 / 60 * 0.09 * 1.2, rel=0.03)
+    assert h["wear_volume"][-1] == pytest.approx(1e-14 * h["frictional_work"][-1], rel=0.01)
+    assert np.all(np.diff(h["wear_volume"]) > 0) and np.all(np.diff(h["rms_height"]) < 0)
+    assert np.all((h["partition_min"] >= 0) & (h["partition_max"] <= 1))
+    assert np.all(h["micro_max_pressure"] > h["max_pressure"])
+    assert h["laws_computed"][0] == 25 and 0 < h["laws_computed"][1] <= h["zones_in_contact"][1]
+    for f in result.field_files + [result.plot_file, result.multiscale_plot, result.wear_map, result.zones_file]:
+        assert f.exists() and f.stat().st_size > 0
+    text = (result.folder / "interface.xdmf").read_text()
+    assert all(name in text for name in ("contact_stiffness", "partition", "wear_depth"))
+
+
+def test_resume_after_an_interrupted_run_gives_the_straight_history(straight, tmp_path):
+    """Stopped after step 1 (its checkpoint and fields on disk, nothing else), then resumed in a
+    fresh model: the same history as the straight run (to solver tolerance)."""
+    from multiscale.coupling import run
+    scene, reference = straight
+    scene = loads(POD.format(folder=tmp_path / "killed"))
+    first = run(scene, verbose=False, stop_after=1)
+    assert first.steps_done == 1 and len(first.history) == 2
+    with pytest.raises(InputError, match="--overwrite"):
+        run(scene, verbose=False)
+    resumed = run(scene, resume=True, verbose=False)
+    assert resumed.steps_done == 2
+    h, ref = History.read(resumed.history_file), reference.history
+    assert set(h.columns) == set(ref.columns)
+    for key in ref.columns:
+        if not key.startswith("time_"):
+            np.testing.assert_allclose(h[key], ref[key], rtol=1e-7, atol=1e-12, err_msg=key)
+    assert (tmp_path / "killed" / "interface.xdmf").read_text().count("<Time ") == \
+        (reference.folder / "interface.xdmf").read_text().count("<Time ")
+
+
+def test_scene_errors_of_the_loop(tmp_path):
+    from multiscale.coupling import run
+    scene = loads(POD.format(folder=tmp_path / "none"))
+    with pytest.raises(InputError, match="checkpoint"):
+        run(scene, resume=True, verbose=False)
+    disc_rough = loads(POD.format(folder=tmp_path / "x").replace('body = "pin"', 'body = "disc"'))
+    with pytest.raises(InputError, match="stationary"):
+        run(disc_rough, verbose=False)
