@@ -21,12 +21,12 @@ ROOT = Path(__file__).resolve().parents[1]
 BIN = Path(sys.executable).parent
 
 
-def once(ranks: int, env: dict) -> tuple[float, float, float]:
+def once(ranks: int, env: dict, scene: str = "demos/pin_on_disc.toml") -> tuple[float, float, float]:
     """(wall s, CPU s of the children, 1-min load average at the end) of one demo run."""
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     start = time.perf_counter()
     subprocess.run([str(BIN / "mpiexec"), "-n", str(ranks), str(BIN / "multiscale"), "run",
-                    "demos/pin_on_disc.toml", "--overwrite"], cwd=ROOT, env=env, check=True,
+                    scene, "--overwrite"], cwd=ROOT, env=env, check=True,
                    stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     wall = time.perf_counter() - start
     after = resource.getrusage(resource.RUSAGE_CHILDREN)
@@ -38,11 +38,13 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--ranks", type=int, default=2)
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--scene", default="demos/pin_on_disc.toml",
+                    help="scene to time (default: make demo's; demos/pin_on_disc_perfect.toml: perfect contact)")
     args = ap.parse_args()
     env = dict(os.environ, UCX_TLS="self,sm,tcp", OMP_NUM_THREADS="1", MPLBACKEND="Agg")
     with tempfile.TemporaryDirectory() as cache:
-        cold = once(args.ranks, dict(env, XDG_CACHE_HOME=cache))
-        warm = [once(args.ranks, dict(env, XDG_CACHE_HOME=cache)) for _ in range(args.repeats)]
+        cold = once(args.ranks, dict(env, XDG_CACHE_HOME=cache), args.scene)
+        warm = [once(args.ranks, dict(env, XDG_CACHE_HOME=cache), args.scene) for _ in range(args.repeats)]
     walls = [w[0] for w in warm]
     print("| ranks | cold JIT wall [s] | cold CPU [s] | warm wall median [s] | warm walls [s] | "
           "warm CPU median [s] | load avg |")

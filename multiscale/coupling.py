@@ -19,8 +19,11 @@ One macro step Δt (Fig. 7.2) runs:
    zone's facets) / (zone area) — so that the micro patch carries the macro force —, the facet
    temperatures of both bodies, the sliding speed and direction at the zone centre;
 3. the micro post-analysis of the loaded zones (Fig. 7.5, ``micro.post_analysis``): local pressure
-   under P, local surface temperature and partition (steady heating with the macro temperatures as
-   remote temperatures), and with ``wear`` every ``wear.update_every`` steps the Archard wear of the
+   under P, local surface temperature and partition (steady sliding heating, both bodies' remote
+   temperatures at the rough body's macro surface temperature: the macro field already holds the
+   zone-scale heating, and feeding the macro temperature difference of the two surfaces back into
+   the micro partition double counts it and makes the explicit coupling oscillate), and with
+   ``wear`` every ``wear.update_every`` steps the Archard wear of the
    patch over the sliding of those steps with k_w(T) (default table: the shape of thesis Fig. 7.9);
    the zones are spread over the MPI ranks and the worn topographies shared;
 4. the laws of the zones whose topography changed are recomputed (``pool.MicroPool``: the others
@@ -43,6 +46,7 @@ from __future__ import annotations
 
 from multiscale.macro import _dolfinx  # noqa: F401,I001  (before DOLFINx)
 import dataclasses
+import gc
 import time as _time
 from dataclasses import dataclass
 from pathlib import Path
@@ -77,8 +81,9 @@ def interface_box(tm) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper corners (x, y) [m] of the interface; it must lie in a plane z = const."""
     x = tm.interface.mesh.geometry.x
     comm = tm.comm
-    lo = comm.allreduce(x.min(axis=0) if len(x) else np.full(3, np.inf), op=MPI.MIN)
-    hi = comm.allreduce(x.max(axis=0) if len(x) else np.full(3, -np.inf), op=MPI.MAX)
+    lo, hi = np.empty(3), np.empty(3)
+    comm.Allreduce(x.min(axis=0) if len(x) else np.full(3, np.inf), lo, op=MPI.MIN)
+    comm.Allreduce(x.max(axis=0) if len(x) else np.full(3, -np.inf), hi, op=MPI.MAX)
     if hi[2] - lo[2] > 1e-9 * max(hi[0] - lo[0], hi[1] - lo[1]):
         raise InputError("geometry.builder", tm.spec, "the rough interface must lie in a plane z = const")
     return lo[:2], hi[:2]
@@ -156,6 +161,7 @@ class MicroStep:
     """What one post-analysis did (scalars for the history)."""
 
     loaded: int                # zones in contact
+    zone_pressure: float       # Pa, largest zone pressure of the macro model
     max_pressure: float        # Pa, largest local pressure (before wear)
     max_temperature: float     # K, largest local surface temperature of the rough body (NaN without)
     partition: tuple           # (min, mean, max) share into the rough body over the loaded zones
@@ -304,8 +310,9 @@ class Multiscale:
         loaded = np.flatnonzero(load.pressure > LOADED * self.nominal)
         mine = loaded[comm.rank::comm.size]
         sliding = load.speed[mine] * duration if wear else None
+        rough = load.temperature[mine, 1]
         res = self.post.run([self.zones[i] for i in mine], load.pressure[mine], speed=load.speed[mine],
-                            angle=load.angle[mine], remote=load.temperature[mine], sliding=sliding,
+                            angle=load.angle[mine], remote=np.column_stack([rough, rough]), sliding=sliding,
                             warm=self.warm[mine])
         parts = comm.allgather((mine, res.worn_pressure, res.heights if wear else None, res.max_pressure,
                                 res.max_temperature, res.partition, res.conductance))
@@ -327,7 +334,7 @@ class Multiscale:
         self.work += work
         max_p, max_T = np.concatenate(max_p), np.concatenate(max_T)
         used = self.partition[loaded] if len(loaded) else np.full(1, np.nan)
-        return MicroStep(len(loaded), float(max_p.max(initial=0.0)),
+        return MicroStep(len(loaded), float(load.pressure.max()), float(max_p.max(initial=0.0)),
                          float(max_T.max()) if len(max_T) and np.isfinite(max_T).any() else np.nan,
                          (float(used.min()), float(used.mean()), float(used.max())), work,
                          _time.perf_counter() - t0)
@@ -390,7 +397,7 @@ class Multiscale:
         """One history row (units: ``io.UNITS``)."""
         row = self.model.record(heat)
         row.update(zones_in_contact=micro.loaded, laws_computed=self.laws_computed,
-                   micro_max_pressure=micro.max_pressure)
+                   max_zone_pressure=micro.zone_pressure, micro_max_pressure=micro.max_pressure)
         if self.post.heating is not None:
             row.update(micro_max_temperature=micro.max_temperature, partition_min=micro.partition[0],
                        partition_mean=micro.partition[1], partition_max=micro.partition[2])
@@ -514,10 +521,12 @@ def run(scene, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_WORL
     result = MultiscaleResult(folder, history, files["history"], files["plot"], writer.files,
                               _time.perf_counter() - start, files["multiscale"], files["wear_map"],
                               files["zones"], done)
+    del ms, writer            # the model holds reference cycles of PETSc objects: free them on every
+    gc.collect()              # rank at the same point (collected later, ranks could hang at exit)
     if verbose and comm.rank == 0:
         print(f"{scene.name}: {len(history)} records ({done}/{steps} steps) in {result.wall_time:.1f} s "
               f"on {comm.size} rank(s)")
-        print(f"  ParaView: {', '.join(str(f) for f in writer.files)}")
+        print(f"  ParaView: {', '.join(str(f) for f in result.field_files)}")
         print(f"  history:  {files['history']}  plots: {files['plot']}, {files['multiscale']}"
               + (f", {files['wear_map']}" if files["wear_map"] else ""))
     return result

@@ -1,6 +1,6 @@
 """Figures of a multiscale run (thesis ch. 7): the history at both scales and the wear map.
 
-``history_figure``: max contact pressure macro vs micro (Fig. 7.14), max temperature macro vs micro
+``history_figure``: max contact pressure macro (facets, zones) vs micro (Fig. 7.14; log scale), max temperature macro vs micro
 (Fig. 7.15), heat partition min/mean/max (Fig. 7.12), wear volume (Fig. 7.16), max wear depth
 (Fig. 7.17) and RMS of the worn surface (Fig. 7.18) — the panels whose columns the history has.
 ``wear_map``: the mean wear depth of every zone over the interface (Fig. 7.13) beside the micro
@@ -25,7 +25,8 @@ def history_figure(history, path: Path, title: str = "") -> Path:
     plt = _pyplot()
     cols = history.columns
     hot = [k for k in cols if k.startswith("max_temperature")]
-    panels = [("max contact pressure [MPa]", [("max_pressure", "macro"), ("micro_max_pressure", "micro")], 1e-6, 0),
+    panels = [("max contact pressure [MPa]", [("max_pressure", "macro facet"), ("max_zone_pressure", "macro zone"),
+                                               ("micro_max_pressure", "micro")], 1e-6, 0),
               ("max temperature [°C]", [(k, "macro " + k.split("_")[-1]) for k in hot]
                + [("micro_max_temperature", "micro")], 1.0, -273.15),
               ("heat into the rough body [%]", [("partition_max", "max"), ("partition_mean", "mean"),
@@ -42,10 +43,13 @@ def history_figure(history, path: Path, title: str = "") -> Path:
     for ax, (label, keys, scale, shift) in zip(axes.ravel(), panels):
         for key, name in keys:
             ax.plot(t, history[key] * scale + shift, "o-", ms=3, label=name)
+        if label.startswith("max contact pressure"):
+            ax.set_yscale("log")
         ax.set_xlabel("time [s]")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
-        ax.ticklabel_format(axis="y", useOffset=False)
+        if ax.get_yscale() == "linear":
+            ax.ticklabel_format(axis="y", useOffset=False)
         if any(name for _, name in keys):
             ax.legend(fontsize=8)
     for ax in axes.ravel()[len(panels):]:

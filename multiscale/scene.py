@@ -221,7 +221,7 @@ class Interface:
                                                Choice(("effusivity",))),
                                         needed_by=("heat_partition",), warn_unused=True)  # into body 0
     conductance: float | None = key(Quantity("conductance", gt=0), needed_by=("conductance",),
-                                    warn_unused=True)            # W/(m^2 K), h_c
+                                    unless=("roughness",), warn_unused=True)   # W/(m^2 K), h_c
 
 
 # ------------------------------------------------------------------ loading, time, output

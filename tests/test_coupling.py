@@ -18,8 +18,8 @@ from multiscale.macro.laws_ufl import FacetLaw  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
 from multiscale.micro.contact import ContactSolver  # noqa: E402
 from multiscale.micro.heat_kernels import ThermalMaterial  # noqa: E402
-from multiscale.micro.kernels import HalfSpace  # noqa: E402
-from multiscale.micro.laws import LawSpec, ZoneLaws, ZoneNodes, compute_laws  # noqa: E402
+from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace  # noqa: E402
+from multiscale.micro.laws import Conductance, LawSpec, ZoneLaws, ZoneNodes, compute_laws  # noqa: E402
 from multiscale.micro.post_analysis import Heating, PostAnalysis  # noqa: E402
 from multiscale.micro.surface import Surface, fractal_surface  # noqa: E402
 from multiscale.micro.zones import cut_zones, love_rectangle_mean  # noqa: E402
@@ -196,6 +196,14 @@ def test_post_analysis_wears_exactly_archard_volume():
         np.testing.assert_allclose(r.heights, np.stack([z.surface.heights for z in zones]) - r.depth)
     assert r.partition[0] < r.partition[1]           # a hotter rough body takes less of the heat
     assert np.all(r.max_temperature > 300.0)
+    # the zone conductance is the conduction law's at the local contact (laws.Conductance)
+    conductance = Conductance(ThermalHalfSpace(35.0), ThermalHalfSpace(50.0))
+    post = PostAnalysis(kernel, zones[0].shape, s.dx, s.dy, mu=mu, conductance=conductance)
+    r = post.run(zones, P, speed=v)
+    local = ContactSolver(kernel, zones[0].shape, s.dx, s.dy, periodic=False).solve(
+        np.stack([z.surface.heights for z in zones]), load=P)
+    np.testing.assert_allclose(r.conductance, conductance.values(local, zones)["conductance"], rtol=1e-6)
+    assert r.conductance[1] > r.conductance[0] > 0 and np.all(r.volume == 0)
     with pytest.raises(InputError, match="load"):
         post.run(zones, [1e6, 0.0], speed=v, remote=[[300.0, 300.0]] * 2)
 
@@ -307,3 +315,34 @@ def test_scene_errors_of_the_loop(tmp_path):
     disc_rough = loads(POD.format(folder=tmp_path / "x").replace('body = "pin"', 'body = "disc"'))
     with pytest.raises(InputError, match="stationary"):
         run(disc_rough, verbose=False)
+
+
+def test_layers_make_the_micro_solid_layered():
+    """Effect "layers": the rough body's micro kernel is its layer stack (on its own material or a
+    rigid base) in series with the counter-face; E* of Love's correction stays the macro bodies'."""
+    layered = pytest.importorskip("multiscale.micro.layered")
+    from multiscale.coupling import contact_kernel, thermal_kernels
+    text = POD.format(folder="out").replace('"wear"]', '"wear", "conductance", "layers"]') + """
+[layers]
+body = "pin"
+base = "half-space"
+[[layers.layer]]
+thickness = "20 um"
+E = "1 GPa"
+nu = 0.3
+kappa = "5 W/(m K)"
+"""
+    scene = loads(text)
+    kernel, E_star = contact_kernel(scene)
+    assert E_star == pytest.approx(HalfSpace.from_materials(5e9, 0.3, 220e9, 0.3).E_star, rel=1e-14)
+    q = np.array([10.0, 1e8])                     # wavelengths far above and far below the layer
+    pin, disc = HalfSpace.from_materials(5e9, 0.3), HalfSpace.from_materials(220e9, 0.3)
+    coating = HalfSpace.from_materials(1e9, 0.3)
+    expected = [pin.compliance(q[:1])[0] + disc.compliance(q[:1])[0],
+                coating.compliance(q[1:])[0] + disc.compliance(q[1:])[0]]
+    np.testing.assert_allclose(kernel.compliance(q), expected, rtol=1e-3)
+    first, second = thermal_kernels(scene)
+    assert isinstance(first, layered.LayeredThermal) and first.kappa == (5.0,)
+    with pytest.raises(InputError, match="layers.body"):
+        from multiscale.coupling import Multiscale
+        Multiscale(loads(text.replace('body = "pin"\nbase', 'body = "disc"\nbase')))

@@ -154,7 +154,7 @@ def test_speed_profile_interpolates(tmp_path):
 
 def test_pin_on_disc_speed_profile(tmp_path):
     pytest.importorskip("meshes.pin_on_disc")
-    text = (DEMOS / "pin_on_disc.toml").read_text().replace(
+    text = (DEMOS / "pin_on_disc_perfect.toml").read_text().replace(
         'rotation_speed = "200 rpm"', 'speed_profile = [[0, "60 rpm"], ["10 s", "0 rpm"]]')
     loading = loads(text, tmp_path).loading
     w0 = 2 * math.pi
@@ -163,13 +163,17 @@ def test_pin_on_disc_speed_profile(tmp_path):
 
 def test_demo_scenes_validate():
     pytest.importorskip("meshes.pin_on_disc")
-    pod = load(DEMOS / "pin_on_disc.toml")
+    pod = load(DEMOS / "pin_on_disc_perfect.toml")
     assert pod.effects == {"contact", "friction", "thermal", "heat_partition", "expansion"}
     assert pod.bodies == ("pin", "disc") and set(pod.materials) == {"pin", "disc"}
     assert pod.loading.rotation_speed == pytest.approx(200 * math.pi / 30, rel=1e-15)
     assert (pod.loading.normal_force, pod.loading.friction, pod.partition) == (200.0, 0.4, 0.14)
-    assert pod.output.folder == (DEMOS.parent / "results" / "pin_on_disc").resolve()
+    assert pod.output.folder == (DEMOS.parent / "results" / "pin_on_disc_perfect").resolve()
     assert pod.warnings == ()
+    for name in ("pin_on_disc", "pin_on_disc_thesis"):               # the multiscale versions
+        rough = load(DEMOS / f"{name}.toml")
+        assert {"roughness", "wear"} <= rough.effects and rough.warnings == ()
+        assert rough.roughness.body == "pin" and rough.micro.partition_law
 
 
 def test_block_demo_validates():

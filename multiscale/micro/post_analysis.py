@@ -6,11 +6,12 @@ area, sliding speed V and direction, macro surface temperatures of both bodies):
 1. local pressure: the zone's patch pressed by a rigid flat to the mean pressure P (FFT-BEM,
    isolated patch, warm-started from the zone's previous local pressure);
 2. local surface temperature and heat partition: steady sliding heating of that contact (§6.5,
-   ``SteadyHeating``) at speed V along the sliding direction, with the macro surface temperatures as
-   the remote temperatures of the two bodies (thesis §7.2.2: "remote temperatures are also
-   considered as boundary conditions"); the share of the frictional heat into the rough body
-   (``partition``) is what the macro heat split uses next. Speeds and directions are rounded to a
-   relative step (``Heating``) so that the kernel tables are shared between zones;
+   ``SteadyHeating``) at speed V along the sliding direction, with given remote temperatures of the
+   two bodies (thesis §7.2.2: "remote temperatures are also considered as boundary conditions";
+   the caller chooses them from the macro temperatures); the share of the frictional heat into
+   the rough body (``partition``, clipped to [0, 1]) is what the macro heat split uses next.
+   Speeds and directions are rounded to a relative step (``Heating``) so that the kernel tables
+   are shared between zones;
 3. optionally the thermal contact conductance h_c of the zone at that contact
    (``laws.Conductance``, the zone-scale spreading resistance taken out);
 4. Archard wear over the sliding distance s = V Δt (Eq. 3.10, dh = k_w(T) mu p ds, T the local
@@ -29,7 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from multiscale.errors import InputError, check_positive
-from multiscale.micro.contact import ContactSolver
+from multiscale.micro.contact import ContactConvergenceError, ContactSolver
 from multiscale.micro.heat_kernels import ThermalMaterial
 from multiscale.micro.heating import SteadyHeating
 from multiscale.micro.kernels import Kernel
@@ -37,6 +38,9 @@ from multiscale.micro.laws import Conductance
 from multiscale.micro.surface import Surface
 from multiscale.micro.wear import WearRate, wear_step
 from multiscale.micro.zones import Zone
+
+
+WARM_ITERATIONS = 300     # a warm-started local solve that needs more starts again from uniform
 
 
 @dataclass(frozen=True)
@@ -102,8 +106,8 @@ class PostAnalysis:
         """Post-analysis of ``zones`` at zone mean pressures ``load`` [Pa] > 0 (B,).
 
         speed [m/s] and angle [rad from +x] of the counter-face over each zone (B,); remote (B, 2)
-        [K]: macro surface temperatures (counter-face, rough body) — needed with heating or a
-        temperature-dependent k_w; sliding (B,) [m]: distance worn over (None: no wear this call);
+        [K]: remote temperatures (counter-face, rough body) — needed with heating or a
+        temperature-dependent k_w (without heating, k_w is taken at the rough body's); sliding (B,) [m]: distance worn over (None: no wear this call);
         warm (B, ny, nx): previous local pressures (warm start; rows summing to 0 start cold).
         """
         B = len(zones)
@@ -120,13 +124,12 @@ class PostAnalysis:
             empty = np.zeros((0,) + self.shape)
             return ZoneResult(empty, empty, empty, empty, np.zeros(0), *(np.zeros(0) for _ in range(6)),
                               np.zeros(0, dtype=int))
-        r = self.solver.solve(H, load=load, initial_pressure=_warm(warm, H.shape), tol=self.tol,
-                              max_iter=self.max_iter)
+        r = self._solve(zones, H, load, _warm(warm, H.shape))
         iterations = np.asarray(r.iterations).copy()
         T, max_T, partition = None, nan.copy(), nan.copy()
         if self.heating is not None:
             if remote is None:
-                raise InputError("remote", None, "heating needs the macro surface temperatures of both bodies")
+                raise InputError("remote", None, "heating needs the remote temperatures of both bodies")
             T = np.empty(H.shape)
             for b in range(B):
                 heat = self._heater(speed[b], angle[b]).solve(r.pressure[b], self.mu, tol=self.tol,
@@ -149,13 +152,34 @@ class PostAnalysis:
                 worn = wear_step(Surface(heights, self.dx, self.dy, periodic=False),
                                  self.mu * p * ds[:, None, None], self.rate, 1.0, 1.0, T)
                 heights, depth = worn.surface.heights, depth + worn.depth
-                again = self.solver.solve(heights, load=load, initial_pressure=p, tol=self.tol,
-                                          max_iter=self.max_iter)
+                again = self._solve(zones, heights, load, p)
                 p = again.pressure
                 iterations += np.asarray(again.iterations)
         return ZoneResult(r.pressure, p, heights, depth, depth.sum(axis=(-2, -1)) * self.dx * self.dy,
                           r.pressure.max(axis=(-2, -1)), np.asarray(r.area_fraction, dtype=float),
                           max_T, partition, h_c, iterations)
+
+    def _solve(self, zones, heights, load, warm):
+        """Load-controlled contact of the batch; patches that do not converge within
+        ``WARM_ITERATIONS`` from the warm start (warm starts converge in tens of iterations; one
+        supported by a single cell was seen to stall for ever) are solved again from a uniform
+        start with 4 x max_iter; ``ContactConvergenceError`` names those that still fail."""
+        r = self.solver.solve(heights, load=load, initial_pressure=warm, tol=self.tol,
+                              max_iter=min(self.max_iter, WARM_ITERATIONS), partial=True)
+        bad = np.flatnonzero(~np.asarray(r.converged))
+        if len(bad):
+            again = self.solver.solve(heights[bad], load=load[bad], tol=self.tol, max_iter=4 * self.max_iter,
+                                      partial=True)
+            for name in ("pressure", "displacement", "gap", "contact", "area_fraction", "mean_pressure", "approach",
+                         "mean_gap", "residual", "converged"):
+                getattr(r, name)[bad] = getattr(again, name)
+            r.iterations[bad] += again.iterations
+            if not np.all(again.converged):
+                failed = [zones[b].id for b in bad[~np.asarray(again.converged)]]
+                raise ContactConvergenceError(f"local contact of zone(s) {failed} did not converge "
+                                              f"(residual {np.max(again.residual):.3e} > {self.tol:.1e})",
+                                              again.history, r)
+        return r
 
     def _heater(self, speed: float, angle: float) -> SteadyHeating:
         v, a = self.heating.rounded(speed, angle)
