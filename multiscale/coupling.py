@@ -420,7 +420,10 @@ class Multiscale:
         return out
 
     def fingerprint(self) -> str:
-        s = dataclasses.replace(self.scene, output=None, source=None, warnings=())
+        """Hash of what the results depend on (not the output section; effects sorted: a set's
+        order changes between processes)."""
+        s = dataclasses.replace(self.scene, output=None, source=None, warnings=(),
+                                effects=tuple(sorted(self.scene.effects)))
         return checkpoint.fingerprint(repr(s))
 
     def save(self, path: Path, step: int, history: io.History) -> None:

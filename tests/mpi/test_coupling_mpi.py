@@ -30,4 +30,4 @@ def test_two_ranks_give_the_serial_multiscale_history(tmp_path):
     np.testing.assert_allclose(parallel["interface_force"], 200.0, rtol=1e-6)
     assert parallel["wear_volume"][-1] > 0 and parallel["zones_in_contact"][-1] >= 2
     for key in (k for k in serial if not k.startswith("time_")):
-        np.testing.assert_allclose(parallel[key], serial[key], rtol=1e-7, atol=1e-12, err_msg=key)
+        np.testing.assert_allclose(parallel[key], serial[key], rtol=1e-6, atol=1e-12, err_msg=key)
