@@ -181,6 +181,9 @@ class Multiscale:
         if scene.roughness.body != bodies[0]:
             raise InputError("roughness.body", scene.roughness.body,
                              f'the rough body must be the stationary one, "{bodies[0]}" (zones do not move)')
+        if scene.micro.model != "fft-bem":
+            raise InputError("micro.model", scene.micro.model, 'the multiscale loop computes its zone laws by '
+                             'FFT-BEM: "fft-bem"')
         if scene.has("layers") and scene.layers.body != bodies[0]:
             raise InputError("layers.body", scene.layers.body, f'the layers belong to the rough body "{bodies[0]}"')
         tm = _mesh.build(scene.geometry.builder, dict(scene.geometry.params), comm)

@@ -128,7 +128,7 @@ def build_model(scene, comm=MPI.COMM_WORLD, law=None, tm=None) -> MacroModel:
                        temperatures=T)
         if scene.has("heat_partition"):
             tm.interface.set_field(mech.contact.partition, scene.partition)
-        if scene.has("conductance"):
+        if scene.has("conductance") and scene.interface.conductance is not None:   # else per facet later
             tm.interface.set_field(mech.contact.conductance, scene.interface.conductance)
     return MacroModel(scene, tm, mech, heat)
 
