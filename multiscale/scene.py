@@ -35,7 +35,6 @@ __all__ = ["BUILDERS", "EFFECTS", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Geometr
 class Effect:
     doc: str
     requires: tuple[str, ...] = ()   # other effects it builds on
-    issue: int | None = None         # None: implemented; else the issue that brings it
 
 
 EFFECTS: dict[str, Effect] = {
@@ -54,10 +53,9 @@ EFFECTS: dict[str, Effect] = {
     "wear": Effect("Archard wear of the rough zones between macro steps ([wear])",
                    ("roughness", "friction")),
     "stability": Effect("complex eigenvalue (squeal) analysis at the sliding state ([stability])",
-                        ("contact",), issue=10),
+                        ("contact",)),
 }
-_EFFECT_CHOICE = Choice(EFFECTS, notes={name: f"known but not implemented yet (issue {e.issue})"
-                                        for name, e in EFFECTS.items() if e.issue})
+_EFFECT_CHOICE = Choice(EFFECTS)
 
 # output field -> effects it needs
 OUTPUT_FIELDS: dict[str, tuple[str, ...]] = {
@@ -388,7 +386,7 @@ class Stability:
     band: tuple = key(Pair(Quantity("frequency", ge=0), single=False, names="[low, high]"),
                       default=(0.0, 16e3))                                    # Hz
     modes: int | None = key(Integer(ge=1), required=True)
-    target: float | None = key(Quantity("frequency", ge=0))                   # Hz; default band centre
+    target: float | None = key(Quantity("frequency", ge=0))                   # Hz; default: the band's lower edge
     damping: float = key(Quantity("dimensionless", ge=0), default=0.0)        # structural loss factor
 
     def problems(self, path, ctx):
@@ -474,8 +472,8 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
                 raise SceneError(f"{dotted}: cannot override, {part} is not a table")
         table[last] = value
     effects = raw.get("effects")
-    active = frozenset(e for e in effects if isinstance(e, str) and e in EFFECTS and EFFECTS[e].issue is None) \
-        if isinstance(effects, list) else frozenset()      # implemented effects decide what is needed
+    active = frozenset(e for e in effects if isinstance(e, str) and e in EFFECTS) \
+        if isinstance(effects, list) else frozenset()      # the known effects decide what is needed
     ctx = Context(effects=active, directory=Path(directory).resolve())
     scene = read(Scene, raw, "", ctx)
     warnings = _cross_checks(scene, raw, ctx)
@@ -541,8 +539,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
 # ------------------------------------------------------------------ `multiscale check` output
 def reference() -> list[str]:
     """The scene format: effects, then every section and key (``multiscale check --keys``)."""
-    effects = [f"  {name:<15} {e.doc}" + (f"  [not implemented yet: issue {e.issue}]" if e.issue else "")
-               + (f"  (needs {', '.join(e.requires)})" if e.requires else "") for name, e in EFFECTS.items()]
+    effects = [f"  {name:<15} {e.doc}" + (f"  (needs {', '.join(e.requires)})" if e.requires else "") for name, e in EFFECTS.items()]
     fields = [f"  {name:<18} needs {', '.join(needs) or 'nothing'}" for name, needs in OUTPUT_FIELDS.items()]
     return (["Scene file (TOML). Values: SI numbers or unit strings (\"4 GPa\", \"200 rpm\", \"20 degC\").",
              "", "effects:"] + effects + ["", "output.fields:"] + fields + ["", "top level:"]

@@ -180,8 +180,8 @@ class Text:
 
 
 class Choice:
-    def __init__(self, options, notes: Mapping[str, str] | None = None):
-        self.options, self.notes = tuple(options), dict(notes or {})
+    def __init__(self, options):
+        self.options = tuple(options)
 
     def describe(self) -> str:
         return "one of " + ", ".join(f'"{o}"' for o in self.options)
@@ -190,8 +190,6 @@ class Choice:
         if raw not in self.options:
             hint = suggest(raw, self.options) if isinstance(raw, str) else ""
             raise Bad(f"unknown{hint}; allowed: {', '.join(self.options)}")
-        if raw in self.notes:
-            raise Bad(self.notes[raw])
         return raw
 
 

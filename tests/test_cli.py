@@ -38,8 +38,6 @@ BAD = [  # (name, the demo block scene changed, the one expected message)
      'effects = ["contact", "thermol"]: item 2 ("thermol"): unknown (did you mean "thermal"?); '
      "allowed: contact, friction, thermal, heat_partition, conductance, expansion, roughness, layers, "
      "wear, stability"),
-    ("not implemented effect", BLOCK.replace('["contact"]', '["contact", "stability"]'),
-     'item 2 ("stability"): known but not implemented yet (issue 10)'),
     ("unknown key", BLOCK.replace("penalty =", "penalty_stiffness ="),
      'interface.penalty_stiffness: unknown key (did you mean "penalty"?); allowed: penalty, partition, '
      "conductance"),

@@ -256,17 +256,13 @@ def test_perfect_contact_and_a_very_smooth_rough_case_share_their_modes(friction
 
 # ---------------------------------------------------------------- scene-driven run
 def test_scene_run_writes_results_and_matches_the_direct_analysis(tmp_path, friction):
-    import dataclasses
     from pathlib import Path
 
     from multiscale import scene as scenes
 
     demo = Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml"
     overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 20, "output.folder": str(tmp_path / "out")}
-    if scenes.EFFECTS["stability"].issue is not None:      # effect not yet enabled in scene.py
-        overrides["effects"] = ["contact", "friction"]
     scene = scenes.load(demo, overrides)
-    scene = dataclasses.replace(scene, effects=scene.effects | {"stability"})
     run = st.run_scene(scene, degree=1, verbose=False)
     names = {p.name for p in run.files}
     assert {"modes.csv", "modes_body0.xdmf", "modes_body1.xdmf", "pressure.png", "re_im.png",
@@ -275,3 +271,19 @@ def test_scene_run_writes_results_and_matches_the_direct_analysis(tmp_path, fric
     np.testing.assert_allclose(run.case.modes.frequency, friction.modes.frequency[:20], rtol=1e-6)
     with pytest.raises(InputError, match="output.folder"):
         st.run_scene(scene, degree=1, verbose=False)
+
+
+def test_multiscale_run_hands_stability_scenes_to_the_squeal_analysis(tmp_path, monkeypatch):
+    from pathlib import Path
+
+    from multiscale import scene as scenes
+    from multiscale.macro import runner
+
+    demo = Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml"
+    scene = scenes.load(demo, {"output.folder": str(tmp_path / "out")})
+    seen = []
+    monkeypatch.setattr(st, "run_scene", lambda sc, **kw: seen.append((sc, kw)) or "squeal")
+    assert runner.run(scene, overwrite=True, verbose=False) == "squeal"
+    assert seen[0][0] is scene and seen[0][1]["overwrite"] is True
+    with pytest.raises(InputError, match="no checkpoints"):
+        runner.run(scene, resume=True)

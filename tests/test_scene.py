@@ -319,18 +319,6 @@ def test_later_sections_report_clear_problems(tmp_path, old, new, fragment):
     assert any(fragment in p for p in info.value.problems), info.value.problems
 
 
-def test_unimplemented_effect_is_named_with_its_issue(tmp_path):
-    pending = [name for name, e in EFFECTS.items() if e.issue]
-    if not pending:
-        pytest.skip("every effect is implemented")
-    name = pending[0]
-    with pytest.raises(SceneError) as info:
-        loads(GOOD.replace('"expansion"]', f'"expansion", "{name}"]') + LATER, tmp_path)
-    assert info.value.problems == [
-        f'effects = ["contact", "friction", "thermal", "heat_partition", ...]: item 7 ("{name}"): '
-        f"known but not implemented yet (issue {EFFECTS[name].issue})"]
-
-
 def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
     text = (DEMOS / "block_on_flat.toml").read_text().replace(
         'pressure = "1 MPa"', 'pressure = "1 MPa"\nfriction = 0.4')

@@ -163,7 +163,13 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
 def run(scene, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_WORLD,
         verbose: bool = True) -> RunResult:
     """Run a scene (``multiscale run``): see module docstring. Scenes with effect ``roughness``
-    run the multiscale loop (``multiscale.coupling.run``, checkpointed, resumable)."""
+    run the multiscale loop (``multiscale.coupling.run``, checkpointed, resumable); scenes with
+    effect ``stability`` the squeal analysis (``multiscale.macro.stability.run_scene``)."""
+    if scene.has("stability"):
+        if resume:
+            raise InputError("--resume", True, "the squeal analysis has no checkpoints to resume from")
+        from multiscale.macro.stability import run_scene
+        return run_scene(scene, comm=comm, overwrite=overwrite, verbose=verbose)
     if scene.has("roughness"):
         from multiscale.coupling import run as run_multiscale
         return run_multiscale(scene, overwrite=overwrite, resume=resume, comm=comm, verbose=verbose)
