@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.micro import _pk_steps as _pk
 from multiscale.micro.kernels import InfluenceOperator, Kernel
 
 
@@ -53,6 +54,7 @@ class ContactSolver:
     def __init__(self, kernel: Kernel, shape, dx: float, dy: float | None = None, periodic: bool = True):
         self.operator = InfluenceOperator(kernel, shape, dx, dy, periodic)
         self.kernel, self.shape, self.periodic = kernel, self.operator.shape, periodic
+        self._workspaces = {}                     # batch size -> FFT buffers of the direction
 
     def solve(self, heights, *, load=None, approach=None, tol: float = 1e-8, max_iter: int = 5000,
               initial_pressure=None, partial: bool = False) -> ContactResult:
@@ -66,6 +68,8 @@ class ContactSolver:
         h = np.asarray(heights, dtype=float)
         if h.ndim < 2 or h.shape[-2:] != self.shape:
             raise InputError("heights.shape", h.shape, f"last two axes must be {self.shape}")
+        if h.size == 0:
+            raise InputError("heights.shape", h.shape, "the batch holds no patch")
         if not np.all(np.isfinite(h)):
             raise InputError("heights", "array with NaN/inf", "all heights must be finite")
         check_positive("tol", tol)
@@ -74,81 +78,109 @@ class ContactSolver:
         batch = h.shape[:-2]
         z = h.max(axis=(-2, -1), keepdims=True) - h            # depth below the highest point, >= 0
         scale = np.sqrt(np.mean((h - h.mean(axis=(-2, -1), keepdims=True)) ** 2, axis=(-2, -1)))
-        scale = np.where(scale > 0, scale, 1.0)[..., None, None]
+        scale = np.where(scale > 0, scale, 1.0)
         if load is not None:
             target = np.broadcast_to(np.asarray(load, dtype=float), batch)
             if not np.all(np.isfinite(target)) or np.any(target <= 0):
                 raise InputError("load", load, "mean pressure must be finite and > 0")
-            return self._run(z, scale, target, None, tol, max_iter, initial_pressure, partial)
-        delta = np.broadcast_to(np.asarray(approach, dtype=float), batch)
-        if not np.all(np.isfinite(delta)) or np.any(delta < 0):
-            raise InputError("approach", approach, "rigid approach must be finite and >= 0")
-        if self.periodic and np.any(delta >= z.mean(axis=(-2, -1))):
-            raise InputError("approach", approach, "a periodic patch under displacement control needs "
-                             "approach < max(h) - mean(h) (full contact has no finite load)")
-        return self._run(z, scale, None, delta[..., None, None], tol, max_iter, initial_pressure, partial)
-
-    def _run(self, z, scale, target, delta, tol, max_iter, p0, partial):
-        """Polonsky–Keer iterations on (B, N) views of the batch (B patches of N cells).
-
-        The conjugate direction lives on the contact set only, so the scalar products run on
-        gathered contact values; full-grid passes are the FFT convolutions and a few updates.
-        Between exact evaluations u = L p is updated as c (u − τ L t), exact while projection
-        and overlap correction leave p alone; otherwise, every ``_REFRESH`` iterations and
-        before accepting convergence, u is recomputed by FFT.
-        """
-        L = self.operator
-        batch, grid = z.shape[:-2], z.shape[-2:]
-        B, N = int(np.prod(batch, dtype=int)), grid[0] * grid[1]
-        zf = np.ascontiguousarray(z, dtype=float).reshape(B, N)
-        scale = np.asarray(scale, dtype=float).reshape(B)
-        load_control = target is not None
-        if load_control:
-            target = np.asarray(target, dtype=float).reshape(B)
+            delta = None
         else:
-            delta = np.asarray(delta, dtype=float).reshape(B)
-        if p0 is not None:
-            p = np.array(np.broadcast_to(p0, z.shape), dtype=float).reshape(B, N)
-            if np.any(p < 0) or not np.all(np.isfinite(p)):
+            target = None
+            delta = np.broadcast_to(np.asarray(approach, dtype=float), batch)
+            if not np.all(np.isfinite(delta)) or np.any(delta < 0):
+                raise InputError("approach", approach, "rigid approach must be finite and >= 0")
+            if self.periodic and np.any(delta >= z.mean(axis=(-2, -1))):
+                raise InputError("approach", approach, "a periodic patch under displacement control needs "
+                                 "approach < max(h) - mean(h) (full contact has no finite load)")
+        p0 = None
+        if initial_pressure is not None:
+            p0 = np.broadcast_to(np.asarray(initial_pressure, dtype=float), h.shape)
+            if np.any(p0 < 0) or not np.all(np.isfinite(p0)):
                 raise InputError("initial_pressure", "array", "must be finite and >= 0")
+        return self._run_chunks(z, scale, target, delta, tol, max_iter, p0, partial)
+
+    def _run_chunks(self, z, scale, target, delta, tol, max_iter, p0, partial):
+        """Run the iterations on chunks of the batch small enough for the CPU cache (the full-grid
+        passes are memory bound: 400 patches of 64² in one block run ~2x slower than in chunks
+        of 8), then assemble the batch result."""
+        batch, grid = z.shape[:-2], z.shape[-2:]
+        B = int(np.prod(batch, dtype=int))
+        size = max(1, _CHUNK_CELLS // (grid[0] * grid[1]))
+
+        def flat(a, cells=False):
+            return None if a is None else np.reshape(a, (B,) + (grid if cells else ()))
+
+        z, scale, target, delta, p0 = flat(z, True), flat(scale), flat(target), flat(delta), flat(p0, True)
+        parts = [self._run(z[i:i + size], scale[i:i + size],
+                           None if target is None else target[i:i + size],
+                           None if delta is None else delta[i:i + size], tol, max_iter,
+                           None if p0 is None else p0[i:i + size]) for i in range(0, B, size)]
+        length = max(len(r.history) for r in parts)
+        history = [max(r.history[k] for r in parts if k < len(r.history)) for k in range(length)]
+        fields = {f: np.concatenate([getattr(r, f) for r in parts]).reshape(batch + np.shape(getattr(parts[0], f))[1:])
+                  for f in ContactResult.__dataclass_fields__ if f != "history"}
+        result = ContactResult(**fields, history=history)
+        if not np.all(result.converged) and not partial:
+            raise ContactConvergenceError(
+                f"contact solver did not converge in {max_iter} iterations "
+                f"(residual {result.residual.max():.3e} > tol {tol:.1e} on "
+                f"{int(np.sum(~result.converged))} patch(es))", history, result)
+        return result
+
+    def _run(self, z, scale, target, delta, tol, max_iter, p0):
+        """Polonsky–Keer iterations on B patches (z: (B, ny, nx); scale, target or delta: (B,));
+        returns the partial result of shape (B, ...) when not converged.
+
+        The cell loops of each iteration are compiled (``_pk_steps``); the FFT convolution of the
+        direction runs on the whole chunk. Between exact evaluations u = L p is updated as
+        c (u − τ L t), exact while projection and overlap correction leave p alone; otherwise,
+        every ``_REFRESH`` iterations and before accepting convergence, u is recomputed by FFT.
+        """
+        L, grid = self.operator, z.shape[-2:]
+        B, N = z.shape[0], grid[0] * grid[1]
+        zf = np.ascontiguousarray(z, dtype=float).reshape(B, N)
+        load_control = target is not None
+        if p0 is not None:
+            p = np.array(p0, dtype=float).reshape(B, N)
         elif load_control:
             p = np.repeat(target[:, None], N, axis=1)
         else:
             p = np.maximum(delta[:, None] - zf, 0.0) / L.self_influence
         if load_control:
             p = _rescale(p, target, zf)
-
-        def rowsum(rows, values):
-            return np.bincount(rows, values, minlength=B)
-
-        ws = L.workspace((B,))                    # the direction t lives in ws.load
-        t, r = ws.load, ws.response               # (B, ny, nx) views of the FFT buffers
-        u, g = np.zeros((B, N)), np.zeros((B, N))
-        u3 = u.reshape((B,) + grid)
-        pv, uv, zv, gv = p.reshape(-1), u.reshape(-1), zf.reshape(-1), g.reshape(-1)
-        L(p.reshape(u3.shape), out=u3)
-        idx = np.flatnonzero(pv)                  # contact set (p >= 0 always), sorted
+        target, delta = (np.ascontiguousarray(np.zeros(B) if a is None else a, dtype=float)
+                         for a in (target, delta))          # the compiled loops take arrays
+        ws = self._workspaces.get(B)
+        if ws is None:
+            ws = self._workspaces[B] = L.workspace((B,))
+        t, r = ws.load_buffer.reshape((B,) + L.fft_shape), ws.response_buffer.reshape((B,) + L.fft_shape)
+        p3 = p.reshape((B,) + grid)
+        u = np.zeros((B, N))
+        u3, z3 = u.reshape(p3.shape), zf.reshape(p3.shape)
         exact = np.ones(B, dtype=bool)
-        G_old, conjugate = np.ones(B), np.zeros(B, dtype=bool)
-        active = np.ones(B, dtype=bool)
+
+        def recompute(which):                     # u = L p exactly on the patches ``which``
+            if 2 * np.count_nonzero(which) > B:
+                L(p3, out=u3)
+                exact[:] = True
+            else:
+                for b in np.flatnonzero(which):
+                    L(p3[b], out=u3[b])
+                exact[which] = True
+
+        recompute(exact)
+        d, G, gmin, count = np.zeros(B), np.zeros(B), np.zeros(B), np.zeros(B, dtype=np.int64)
+        corrected, lost, conjugate = (np.zeros(B, dtype=bool) for _ in range(3))
+        pending = np.ones(B)                      # load-balance factor of p and u, see _pk.step
+        G_old, active = np.ones(B), np.ones(B, dtype=bool)
         iterations, history = np.zeros(B, dtype=int), []
-        prev_at = None
         since_refresh = 0
         while True:
-            rows, cell = np.divmod(idx, N)
-            at = (rows,) + np.divmod(cell, grid[1])   # (b, i, j) of the contact cells
-            nS = np.maximum(np.bincount(rows, minlength=B), 1)
-            gS = uv[idx] + zv[idx]
-            d = rowsum(rows, gS) / nS if load_control else delta   # approach (load: unknown)
-            gS -= d[rows]
-            G = rowsum(rows, gS * gS)
-            np.subtract(u, d[:, None], out=g)
-            g += zf
-            res = np.maximum(np.sqrt(G / nS), np.maximum(-g.min(axis=1), 0.0)) / scale
+            _pk.gap_statistics(p3, u3, z3, delta, load_control, pending, d, G, count, gmin)
+            res = np.maximum(np.sqrt(G / np.maximum(count, 1)), np.maximum(-gmin, 0.0)) / scale
             done = active & (res <= tol)
             if np.any(done & ~exact):        # accept convergence only on an exact displacement
-                L(p.reshape(u3.shape), out=u3)
-                exact[:] = True
+                recompute(done & ~exact)
                 since_refresh = 0
                 continue
             active &= ~done
@@ -157,75 +189,32 @@ class ContactSolver:
                 break
             iterations += active
             beta = np.where(conjugate, G / G_old, 0.0)
-            t_old = t[at]
-            if prev_at is not None:
-                t[prev_at] = 0.0                  # t is zero off its support
-            tS = gS + beta[rows] * t_old
-            t[at] = tS
-            prev_at = at
             G_old = np.where(G > 0, G, 1.0)
+            _pk.direction(p3, u3, z3, d, active, beta, t)                  # t: the direction
             ws.apply()
-            rS = r[at]
-            rt = rowsum(rows, rS * tS)
-            if load_control:
-                rt -= rowsum(rows, rS) / nS * rowsum(rows, tS)
-            tau = np.where(active & (rt > 0), rowsum(rows, gS * tS) / np.where(rt > 0, rt, 1.0), 0.0)
-            pS = pv[idx] - tau[rows] * tS
-            touched = rowsum(rows, pS < 0) > 0
-            np.maximum(pS, 0.0, out=pS)
-            # overlap: zero pressure but negative gap -> enters the contact (PK step 8)
-            lift = (pS == 0) & (gS < 0) & active[rows]
-            pS[lift] = -tau[rows[lift]] * gS[lift]
-            enter = np.flatnonzero(g < 0)
-            enter = enter[(pv[enter] == 0) & active[enter // N]]
-            enter_rows = enter // N
-            has_overlap = (rowsum(rows, lift) + np.bincount(enter_rows, minlength=B)) > 0
-            conjugate = ~has_overlap
-            p_enter = -tau[enter_rows] * gv[enter]
-            if load_control:
-                total = rowsum(rows, pS) + rowsum(enter_rows, p_enter)
-                lost = active & (total <= 0)               # every point left: restart
-                c = np.where(active, target * N / np.where(total > 0, total, 1.0), 1.0)
-            else:
-                lost, c = np.zeros(B, dtype=bool), np.ones(B)
-            pv[idx] = pS * c[rows]
-            pv[enter] = p_enter * c[enter_rows]
-            if lost.any():
+            _pk.step(p3, u3, z3, d, count, target, load_control, active, t, r, pending, corrected, lost,
+                     conjugate)                                             # r = L t
+            if lost.any():                   # every point left the contact: restart from the top
                 p[lost] = _rescale(zf[lost] == 0, target[lost], zf[lost])
-            idx = np.flatnonzero(pv)
             since_refresh += 1
-            refresh = (touched | has_overlap | lost) & active
+            exact[:] = False
             if since_refresh >= _REFRESH:
-                L(p.reshape(u3.shape), out=u3)
-                exact[:], since_refresh = True, 0
-            elif refresh.any():
-                keep = ~refresh
-                u_inc = c[keep, None, None] * (u3[keep] - tau[keep, None, None] * r[keep])
-                L(p.reshape(u3.shape), out=u3)
-                u3[keep] = u_inc
-                exact = refresh.copy()
+                recompute(active)
+                since_refresh = 0
             else:
-                u3 -= tau[:, None, None] * r
-                u *= c[:, None]
-                exact[:] = False
-        converged = ~active
+                recompute(corrected & active)
+        g = u + zf - d[:, None]
         gap = np.where(p > 0, 0.0, np.maximum(g, 0.0))
-        shape = batch + grid
-        result = ContactResult(
+        shape = (B,) + grid
+        return ContactResult(
             pressure=p.reshape(shape), displacement=u.reshape(shape), gap=gap.reshape(shape),
-            contact=(p > 0).reshape(shape), area_fraction=np.mean(p > 0, axis=1).reshape(batch),
-            mean_pressure=p.mean(axis=1).reshape(batch), approach=np.array(d, dtype=float).reshape(batch),
-            mean_gap=gap.mean(axis=1).reshape(batch), iterations=iterations.reshape(batch),
-            residual=res.reshape(batch), converged=converged.reshape(batch), history=history)
-        if not np.all(converged) and not partial:
-            raise ContactConvergenceError(
-                f"contact solver did not converge in {max_iter} iterations "
-                f"(residual {res.max():.3e} > tol {tol:.1e} on {int(np.sum(~converged))} patch(es))",
-                history, result)
-        return result
+            contact=(p > 0).reshape(shape), area_fraction=np.mean(p > 0, axis=1),
+            mean_pressure=p.mean(axis=1), approach=np.array(d, dtype=float), mean_gap=gap.mean(axis=1),
+            iterations=iterations, residual=res, converged=~active, history=history)
 
 
 _REFRESH = 25  # iterations between exact recomputations of u = L p (bounds round-off drift)
+_CHUNK_CELLS = 32768  # cells per chunk of the batch (a few such float arrays fit in L2)
 
 
 def _rescale(p, target, z):

@@ -188,7 +188,8 @@ class ConvolutionWorkspace:
 
     Write the load into ``load`` (a (..., ny, nx) view of the FFT input; zero padding around it
     stays zero), call ``apply()``, read ``response`` (a view of the FFT output, overwritten by the
-    next ``apply``).
+    next ``apply``). ``load_buffer``/``response_buffer`` are the whole (contiguous) buffers,
+    padding included, for compiled loops.
     """
 
     def __init__(self, operator: InfluenceOperator, batch: tuple[int, ...]):
@@ -197,6 +198,7 @@ class ConvolutionWorkspace:
         self._multiplier = operator._scaled_spectrum
         self.load = self._plan.input[..., :ny, :nx]
         self.response = self._plan.output[..., :ny, :nx]
+        self.load_buffer, self.response_buffer = self._plan.input, self._plan.output
 
     def apply(self) -> np.ndarray:
         self._plan.forward()
