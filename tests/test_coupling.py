@@ -3,6 +3,8 @@ the seam against perfect contact, wear bookkeeping, checkpoints and resume."""
 import dataclasses
 from types import SimpleNamespace
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -208,6 +210,8 @@ def test_post_analysis_wears_exactly_archard_volume():
         post.run(zones, [1e6, 0.0], speed=v, remote=[[300.0, 300.0]] * 2)
 
 
+# disc and pin of the pin-on-disc test scenes
+MATERIALS = (Path(__file__).resolve().parent / "data" / "pin_on_disc_materials.toml").read_text()
 POD = """
 name = "pod_rough"
 effects = ["contact", "friction", "thermal", "heat_partition", "expansion", "roughness", "wear"]
@@ -217,18 +221,7 @@ mesh_size = "15 mm"
 holder_mesh_size = "6 mm"
 interface_mesh_size = "2.5 mm"
 track_mesh_size = "8 mm"
-[materials.disc]
-E = "220 GPa"
-nu = 0.3
-kappa = "50 W/(m K)"
-chi = "1e-5 m^2/s"
-alpha = "1e-5 1/K"
-[materials.pin]
-E = "5 GPa"
-nu = 0.3
-kappa = "35 W/(m K)"
-chi = "8.3e-6 m^2/s"
-alpha = "5e-6 1/K"
+{materials}
 [interface]
 partition = 0.14
 [loading]
@@ -256,7 +249,7 @@ k_w = "1e-14 1/Pa"
 substeps = 2
 [output]
 folder = "{folder}"
-"""
+""".replace("{materials}", MATERIALS)
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,6 @@
 """Scenes through the macro runner: only the requested effects are built; files a run writes."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -35,6 +37,8 @@ end = "1 s"
 folder = "{folder}"
 """
 
+# disc and pin of the pin-on-disc test scenes
+MATERIALS = (Path(__file__).resolve().parent / "data" / "pin_on_disc_materials.toml").read_text()
 PIN = """
 name = "pod"
 effects = ["contact", "friction", "thermal", "heat_partition", "expansion"]
@@ -43,18 +47,7 @@ builder = "pin_on_disc"
 mesh_size = "15 mm"
 holder_mesh_size = "6 mm"
 interface_mesh_size = "2.5 mm"
-[materials.disc]
-E = "220 GPa"
-nu = 0.3
-kappa = "50 W/(m K)"
-chi = "1e-5 m^2/s"
-alpha = "1e-5 1/K"
-[materials.pin]
-E = "5 GPa"
-nu = 0.3
-kappa = "35 W/(m K)"
-chi = "8.3e-6 m^2/s"
-alpha = "5e-6 1/K"
+{materials}
 [interface]
 penalty = "1e13 Pa/m"
 partition = "effusivity"
@@ -69,7 +62,7 @@ substeps = 2
 initial_temperature = "20 degC"
 [output]
 folder = "{folder}"
-"""
+""".replace("{materials}", MATERIALS)
 
 
 def test_scene_without_thermal_builds_no_heat_problem(tmp_path):

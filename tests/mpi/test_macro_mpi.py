@@ -1,4 +1,6 @@
 """Two MPI ranks give the same pin-on-disc history as one (run: mpiexec -n 2 python -m pytest tests/mpi)."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -9,6 +11,8 @@ from mpi4py import MPI  # noqa: E402
 from multiscale.macro.runner import run  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 
+# disc and pin of the pin-on-disc test scenes
+MATERIALS = (Path(__file__).resolve().parents[1] / "data" / "pin_on_disc_materials.toml").read_text()
 SCENE = """
 name = "pod_mpi"
 effects = ["contact", "friction", "thermal", "heat_partition", "expansion"]
@@ -17,18 +21,7 @@ builder = "pin_on_disc"
 mesh_size = "15 mm"
 holder_mesh_size = "6 mm"
 interface_mesh_size = "2.5 mm"
-[materials.disc]
-E = "220 GPa"
-nu = 0.3
-kappa = "50 W/(m K)"
-chi = "1e-5 m^2/s"
-alpha = "1e-5 1/K"
-[materials.pin]
-E = "5 GPa"
-nu = 0.3
-kappa = "35 W/(m K)"
-chi = "8.3e-6 m^2/s"
-alpha = "5e-6 1/K"
+{materials}
 [interface]
 penalty = "1e13 Pa/m"
 partition = 0.14
@@ -43,7 +36,7 @@ steps = 2
 initial_temperature = "20 degC"
 [output]
 folder = "{folder}"
-"""
+""".replace("{materials}", MATERIALS)
 
 
 def test_two_ranks_give_the_serial_history(tmp_path):
