@@ -33,7 +33,7 @@ import numpy as np
 from scipy.special import erf, erfc
 
 from multiscale.errors import InputError, check_positive
-from multiscale.micro.kernels import ThermalHalfSpace, _wrap_offsets, love_rectangle
+from multiscale.micro.kernels import ThermalHalfSpace, wrap_offsets, love_rectangle
 
 _GL6 = np.polynomial.legendre.leggauss(6)
 _GL8 = np.polynomial.legendre.leggauss(8)
@@ -349,7 +349,7 @@ def pulse_tables(shape, dx: float, dy: float, material: ThermalMaterial, dt: flo
         raise InputError("dt/n_ages", (dt, n_ages), "dt > 0 and n_ages >= 1 (np.inf only with n_ages = 1)")
     check_positive("refine", refine)
     a, b = 0.5 * dx, 0.5 * dy
-    X, Y = _wrap_offsets(nx) * dx, _wrap_offsets(ny) * dy
+    X, Y = wrap_offsets(nx) * dx, wrap_offsets(ny) * dy
     reach = float(np.hypot(nx * dx, ny * dy)) + 1.5 * max(a, b)
     norm = 1.0 / (4 * material.kappa * np.sqrt(np.pi))
     steady = np.isinf(dt)

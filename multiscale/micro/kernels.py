@@ -79,8 +79,8 @@ class HalfSpace(Kernel):
             return np.where(q > 0, 2.0 / (self.E_star * np.where(q > 0, q, 1.0)), 0.0)
 
     def influence(self, ny, nx, dy, dx):
-        ox = _wrap_offsets(nx) * dx
-        oy = _wrap_offsets(ny) * dy
+        ox = wrap_offsets(nx) * dx
+        oy = wrap_offsets(ny) * dy
         return love_rectangle(ox[None, :], oy[:, None], dx / 2, dy / 2) / (np.pi * self.E_star)
 
 
@@ -102,8 +102,8 @@ class ThermalHalfSpace(Kernel):
         return np.where(q > 0, 1.0 / (self.kappa * np.where(q > 0, q, 1.0)), 0.0)
 
     def influence(self, ny, nx, dy, dx):
-        ox = _wrap_offsets(nx) * dx
-        oy = _wrap_offsets(ny) * dy
+        ox = wrap_offsets(nx) * dx
+        oy = wrap_offsets(ny) * dy
         return love_rectangle(ox[None, :], oy[:, None], dx / 2, dy / 2) / (2 * np.pi * self.kappa)
 
 
@@ -123,7 +123,7 @@ def love_rectangle(x, y, a, b):
     return corner(x + a, y + b) - corner(x + a, y - b) - corner(x - a, y + b) + corner(x - a, y - b)
 
 
-def _wrap_offsets(n: int) -> np.ndarray:
+def wrap_offsets(n: int) -> np.ndarray:
     """Cell offsets 0, 1, …, n-1, -n, …, -1 of a 2n zero-padded circular grid."""
     i = np.arange(2 * n)
     return np.where(i < n, i, i - 2 * n).astype(float)

@@ -34,7 +34,7 @@ from scipy.interpolate import CubicSpline
 from scipy.special import j0, j1
 
 from multiscale.errors import InputError, check_positive
-from multiscale.micro.kernels import Kernel, _wrap_offsets, love_rectangle
+from multiscale.micro.kernels import Kernel, wrap_offsets, love_rectangle
 
 _NEAR = 4        # cells |i|, |j| <= _NEAR around the loaded cell use the exact corner formula
 _GAUSS = 4       # Gauss points per direction on the other cells
@@ -99,8 +99,8 @@ class LayeredKernel(Kernel):
         """
         ny, nx = int(ny), int(nx)
         dx, dy = check_positive("dx", dx), check_positive("dy", dy)
-        ox = _wrap_offsets(nx) * dx
-        oy = _wrap_offsets(ny) * dy
+        ox = wrap_offsets(nx) * dx
+        oy = wrap_offsets(ny) * dy
         coeffs = love_rectangle(ox[None, :], oy[:, None], dx / 2, dy / 2) * (self.top_coefficient / (2 * np.pi))
         q_cut = self._cutoff()
         if q_cut > 0:
@@ -156,8 +156,8 @@ def _corner(M, X, Y, nodes: int = 48):
 
 def _remainder_influence(kernel, q_cut, ny, nx, dy, dx):
     """Cell integrals of g(r) (see ``LayeredKernel.influence``) in wrap-around order."""
-    ix = _wrap_offsets(nx)
-    iy = _wrap_offsets(ny)
+    ix = wrap_offsets(nx)
+    iy = wrap_offsets(ny)
     out = np.zeros((2 * ny, 2 * nx))
     h_min = min(kernel.thickness)
     # near zone: exact corner function
