@@ -4,7 +4,9 @@ The complementary energy U = ½ pᵀ L p − pᵀ δ (Eqs. 3.4, 3.9) is minimise
 constrained conjugate gradient of Polonsky & Keer (1999), with ``L`` applied by FFT
 (``InfluenceOperator``). Load control fixes the mean pressure, displacement control the rigid
 approach. Batches of patches (leading axes) are solved in one call, each patch iterating on its
-own until it converges (then it is frozen), so batched and looped answers agree.
+own until it converges (then it is frozen), so batched and looped answers agree. The cell loops
+of an iteration are compiled (``_pk_steps``, numba); a batch runs in chunks of ``_CHUNK_CELLS``
+cells that keep the working set in the CPU cache.
 
 Conventions: heights ``h`` [m] point towards the rigid flat. The flat first touches the highest
 point; the approach ``delta`` [m] moves it into the solid. Gap
@@ -48,7 +50,8 @@ class ContactSolver:
     """Reusable FFT-BEM contact solver on one grid (plans and kernel spectrum built once).
 
     Parameters: kernel (e.g. ``HalfSpace``), grid ``shape`` (ny, nx), pixel ``dx`` (and ``dy``) [m],
-    ``periodic`` (repeating patch) or not (isolated patch, zero-padded DC-FFT).
+    ``periodic`` (repeating patch) or not (isolated patch, zero-padded DC-FFT). A solver keeps
+    its FFT buffers between calls: use one solver per thread.
     """
 
     def __init__(self, kernel: Kernel, shape, dx: float, dy: float | None = None, periodic: bool = True):
