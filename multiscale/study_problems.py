@@ -6,7 +6,7 @@ returns (name -> description [unit]) and, where one exists, an exact or independ
 (``exact``): the study's ``reference.kind = "analytic"``. ``run(params, workdir)`` returns an
 ``Outcome``. Micro problems import ``multiscale.micro`` only (a worker never loads DOLFINx); the
 ``scene`` problem runs a macro scene with overrides in a subprocess (``multiscale run``'s runner)
-and reads its metrics from the HDF5 history.
+and reads its metrics from the HDF5 history (squeal scenes: from their table of modes).
 
 Surfaces: the random fractal patch is drawn on a fixed generator grid (``source_n``) and resampled
 to the study's grid ``n`` by Fourier interpolation, which is exact for a band-limited surface
@@ -545,6 +545,27 @@ _REDUCERS = {"last": lambda v: v[-1], "first": lambda v: v[0], "max": np.max, "m
              "rise": lambda v: v[-1] - v[0]}
 
 
+SQUEAL_METRICS = {
+    "modes": "number of complex modes found in the band",
+    "unstable_modes": "modes with a positive real part (growth rate) [-]",
+    "max_growth": "largest real part sigma of the eigenvalues [1/s]",
+    "max_growth_frequency": "frequency of the mode with the largest real part [Hz]",
+    "lowest_unstable_frequency": "frequency of the lowest unstable mode, 0 if none [Hz]",
+    "min_damping_ratio": "smallest damping ratio (negative: unstable) [-]",
+}
+
+
+def squeal_metrics(modes_csv) -> dict:
+    """``SQUEAL_METRICS`` of a squeal run's mode table (``ModalResult.write_csv``)."""
+    table = np.genfromtxt(modes_csv, delimiter=",", names=True, ndmin=1)
+    f, sigma, unstable = table["frequency_Hz"], table["sigma_1_per_s"], table["unstable"] > 0
+    k = int(np.argmax(sigma))
+    return {"modes": float(f.size), "unstable_modes": float(unstable.sum()), "max_growth": float(sigma[k]),
+            "max_growth_frequency": float(f[k]),
+            "lowest_unstable_frequency": float(f[unstable].min()) if unstable.any() else 0.0,
+            "min_damping_ratio": float(table["damping_ratio"].min())}
+
+
 @dataclass(frozen=True)
 class SceneRun:
     """A macro scene with overrides (dotted scene paths -> raw values) and MPI ranks per run."""
@@ -557,11 +578,13 @@ class SceneRun:
 class SceneProblem(Problem):
     """Any macro scene (``multiscale run``) with overrides; metrics are history columns reduced
     over time: ``column`` (last value) or ``column:last|first|max|min|mean|rise`` (rise = last −
-    first: a temperature rise, whose relative error means more than that of a temperature in K)."""
+    first: a temperature rise, whose relative error means more than that of a temperature in K).
+    A squeal scene (effect ``stability``) has no history; its metrics come from ``modes.csv``
+    (``squeal_metrics``)."""
 
     name = "scene"
     doc = ("a macro scene run by the macro runner with overrides; metrics: HDF5 history columns, "
-           "column[:last|first|max|min|mean|rise]")
+           "column[:last|first|max|min|mean|rise]; squeal scenes: " + ", ".join(SQUEAL_METRICS))
     metrics = {}
 
     def parse(self, raw, path, ctx, scene=None, ranks=1):
@@ -601,6 +624,8 @@ class SceneProblem(Problem):
         if done.returncode != 0:
             last = [line for line in (done.stderr or done.stdout).strip().splitlines() if line.strip()]
             raise RuntimeError(f"scene run failed (exit {done.returncode}): {last[-1] if last else 'no output'}")
+        if (out / "modes.csv").exists():
+            return Outcome(squeal_metrics(out / "modes.csv"), 0, True)
         history = History.read(out / "history.h5")
         metrics = {}
         for column in history.columns:

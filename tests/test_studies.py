@@ -302,3 +302,20 @@ def test_runs_are_shared_out_over_mpi_ranks(tmp_path):
     ranks = sorted(json.loads(p.read_text())["rank"] for p in (out / "runs").glob("*.json"))
     assert ranks == [0, 1]
     assert [r["status"] for r in table(out / "results.csv")] == ["ok"] * 2
+
+
+def test_squeal_scene_metrics_from_the_mode_table(tmp_path):
+    """A squeal scene's study metrics, read back from modes.csv, equal those of the eigenvalues."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+    from multiscale.macro.stability import ModalResult
+    from multiscale.study_problems import squeal_metrics
+    lam = np.array([-3.0 + 2j * np.pi * 900.0, 40.0 + 2j * np.pi * 2500.0, 0.0 + 2j * np.pi * 4000.0,
+                    12.0 + 2j * np.pi * 7100.0])
+    modes = ModalResult(lam, -lam**2, np.zeros((1, 4), complex), np.full(4, 1e-12), (0.0, 16e3), 0.0, 10,
+                        "gnhep", 1, 1, 0.0)
+    got = squeal_metrics(modes.write_csv(tmp_path / "modes.csv"))
+    assert got["modes"] == 4 and got["unstable_modes"] == 2
+    assert got["max_growth"] == pytest.approx(40.0, rel=1e-6)
+    assert got["max_growth_frequency"] == pytest.approx(2500.0, rel=1e-9)
+    assert got["lowest_unstable_frequency"] == pytest.approx(2500.0, rel=1e-9)
+    assert got["min_damping_ratio"] == pytest.approx(-40.0 / abs(lam[1]), rel=1e-6)
