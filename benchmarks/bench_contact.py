@@ -38,6 +38,16 @@ def tamaas_solve(h, load):
     return np.array(model.traction).reshape(n, n)
 
 
+def timed(fn, repeats):
+    """Median wall time of ``repeats`` calls of ``fn`` and its last result."""
+    times, out = [], None
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn()
+        times.append(time.perf_counter() - t0)
+    return stats.median(times), out
+
+
 def side_by_side(peer, ours, repeats):
     """Median peer time, median our time, median per-repeat ratio, our last result, peer's."""
     t_peer, t_ours, ratio = [], [], []
