@@ -8,13 +8,14 @@ from multiscale.errors import MultiscaleError, SceneError
 
 
 def _info(args) -> int:
+    import numba
     import numpy
     import scipy
 
     import multiscale
     from multiscale.micro.fft import get_threads, pyfftw
     print(f"multiscale {multiscale.__version__}  numpy {numpy.__version__}  scipy {scipy.__version__}  "
-          f"fft {'pyfftw' if pyfftw else 'scipy'} ({get_threads()} thread(s))")
+          f"numba {numba.__version__}  fft {'pyfftw' if pyfftw else 'scipy'} ({get_threads()} thread(s))")
     try:
         import dolfinx_solver  # noqa: F401  (must precede dolfinx in the PyPI wheel)
     except ImportError:
