@@ -210,8 +210,8 @@ def test_post_analysis_wears_exactly_archard_volume():
         post.run(zones, [1e6, 0.0], speed=v, remote=[[300.0, 300.0]] * 2)
 
 
-# disc and pin of the pin-on-disc test scenes
-MATERIALS = (Path(__file__).resolve().parent / "data" / "pin_on_disc_materials.toml").read_text()
+# materials, loading and time shared by the pin-on-disc test scenes
+BASE = (Path(__file__).resolve().parent / "data" / "pin_on_disc_base.toml").read_text()
 POD = """
 name = "pod_rough"
 effects = ["contact", "friction", "thermal", "heat_partition", "expansion", "roughness", "wear"]
@@ -221,17 +221,9 @@ mesh_size = "15 mm"
 holder_mesh_size = "6 mm"
 interface_mesh_size = "2.5 mm"
 track_mesh_size = "8 mm"
-{materials}
+{base}
 [interface]
 partition = 0.14
-[loading]
-normal_force = "200 N"
-rotation_speed = "200 rpm"
-friction = 0.4
-[time]
-end = "1.2 s"
-steps = 2
-initial_temperature = "20 degC"
 [roughness]
 body = "pin"
 rms = "10 um"
@@ -249,7 +241,7 @@ k_w = "1e-14 1/Pa"
 substeps = 2
 [output]
 folder = "{folder}"
-""".replace("{materials}", MATERIALS)
+""".replace("{base}", BASE)
 
 
 @pytest.fixture(scope="module")

@@ -37,8 +37,8 @@ end = "1 s"
 folder = "{folder}"
 """
 
-# disc and pin of the pin-on-disc test scenes
-MATERIALS = (Path(__file__).resolve().parent / "data" / "pin_on_disc_materials.toml").read_text()
+# materials, loading and time shared by the pin-on-disc test scenes
+BASE = (Path(__file__).resolve().parent / "data" / "pin_on_disc_base.toml").read_text()
 PIN = """
 name = "pod"
 effects = ["contact", "friction", "thermal", "heat_partition", "expansion"]
@@ -47,22 +47,13 @@ builder = "pin_on_disc"
 mesh_size = "15 mm"
 holder_mesh_size = "6 mm"
 interface_mesh_size = "2.5 mm"
-{materials}
+{base}
 [interface]
 penalty = "1e13 Pa/m"
 partition = "effusivity"
-[loading]
-normal_force = "200 N"
-rotation_speed = "200 rpm"
-friction = 0.4
-[time]
-end = "1.2 s"
-steps = 2
-substeps = 2
-initial_temperature = "20 degC"
 [output]
 folder = "{folder}"
-""".replace("{materials}", MATERIALS)
+""".replace("{base}", BASE)
 
 
 def test_scene_without_thermal_builds_no_heat_problem(tmp_path):
@@ -84,7 +75,7 @@ def test_thermal_on_a_translating_flat_is_refused(tmp_path):
 
 
 def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
-    scene = loads(PIN.format(folder=tmp_path / "pod"))
+    scene = loads(PIN.format(folder=tmp_path / "pod"), overrides={"time.substeps": 2})
     result = run(scene, verbose=False)
     h = History.read(result.history_file)
     assert len(h) == 3 and h["time"][-1] == pytest.approx(1.2)

@@ -11,8 +11,8 @@ from mpi4py import MPI  # noqa: E402
 from multiscale.macro.runner import run  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 
-# disc and pin of the pin-on-disc test scenes
-MATERIALS = (Path(__file__).resolve().parents[1] / "data" / "pin_on_disc_materials.toml").read_text()
+# materials, loading and time shared by the pin-on-disc test scenes
+BASE = (Path(__file__).resolve().parents[1] / "data" / "pin_on_disc_base.toml").read_text()
 SCENE = """
 name = "pod_mpi"
 effects = ["contact", "friction", "thermal", "heat_partition", "expansion"]
@@ -21,32 +21,27 @@ builder = "pin_on_disc"
 mesh_size = "15 mm"
 holder_mesh_size = "6 mm"
 interface_mesh_size = "2.5 mm"
-{materials}
+{base}
 [interface]
 penalty = "1e13 Pa/m"
 partition = 0.14
-[loading]
-normal_force = "200 N"
-rotation_speed = "200 rpm"
-friction = 0.4
-ramp_steps = 2
-[time]
-end = "1.2 s"
-steps = 2
-initial_temperature = "20 degC"
 [output]
 folder = "{folder}"
-""".replace("{materials}", MATERIALS)
+""".replace("{base}", BASE)
+
+
+def scene(folder):
+    return loads(SCENE.format(folder=folder), overrides={"loading.ramp_steps": 2})
 
 
 def test_two_ranks_give_the_serial_history(tmp_path):
     world = MPI.COMM_WORLD
     assert world.size == 2, "run under mpiexec -n 2"
     base = world.bcast(str(tmp_path), root=0)
-    parallel = run(loads(SCENE.format(folder=f"{base}/parallel")), comm=world, verbose=False).history
+    parallel = run(scene(f"{base}/parallel"), comm=world, verbose=False).history
     serial = None
     if world.rank == 0:
-        serial = run(loads(SCENE.format(folder=f"{base}/serial")), comm=MPI.COMM_SELF, verbose=False).history
+        serial = run(scene(f"{base}/serial"), comm=MPI.COMM_SELF, verbose=False).history
     serial = world.bcast(serial.columns if serial is not None else None, root=0)
     assert set(serial) == set(parallel.columns)
     assert parallel["interface_force"] == pytest.approx(200.0, rel=1e-6)
