@@ -350,9 +350,18 @@ class Multiscale:
         if self.post.conductance is not None:
             iface.set_field(contact.conductance, self.conductance[self.zone_of_facet])
 
+    def heights(self) -> np.ndarray:
+        """Current zone topographies (Z, ny, nx) [m]."""
+        return np.stack([z.surface.heights for z in self.zones])
+
     def wear_depth(self) -> np.ndarray:
         """Accumulated wear depth fields (Z, ny, nx) [m]."""
-        return self.initial - np.stack([z.surface.heights for z in self.zones])
+        return self.initial - self.heights()
+
+    def zone_wear_volume(self, depth: np.ndarray) -> np.ndarray:
+        """Worn volume of each zone [m^3] from its depth field (Z, ny, nx) [m]."""
+        s = self.zones[0].surface
+        return depth.sum(axis=(-2, -1)) * s.dx * s.dy
 
     def facet_fields(self) -> dict:
         """Interface output fields of the multiscale loop: name -> per-facet array maker."""
@@ -405,10 +414,9 @@ class Multiscale:
             row.update(micro_max_temperature=micro.max_temperature, partition_min=micro.partition[0],
                        partition_mean=micro.partition[1], partition_max=micro.partition[2])
         if self.scene.has("wear"):
-            depth = self.wear_depth()
-            heights = np.stack([z.surface.heights for z in self.zones])
-            s = self.zones[0].surface
-            row.update(wear_volume=float(depth.sum() * s.dx * s.dy), wear_max_depth=float(depth.max()),
+            heights = self.heights()
+            depth = self.initial - heights
+            row.update(wear_volume=float(self.zone_wear_volume(depth).sum()), wear_max_depth=float(depth.max()),
                        rms_height=float(np.sqrt(np.mean((heights - heights.mean()) ** 2))),
                        frictional_work=self.work)
         row.update(timing)
@@ -431,7 +439,7 @@ class Multiscale:
 
     def save(self, path: Path, step: int, history: io.History) -> None:
         m, last = self.model, self.model.last_solve
-        arrays = {"heights": np.stack([z.surface.heights for z in self.zones]), "warm": self.warm,
+        arrays = {"heights": self.heights(), "warm": self.warm,
                   "partition": self.partition, "conductance": self.conductance, "levels": self.levels,
                   "heat_total": m.heat_total, **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
         attrs = {"step": step, "time": m.time, "work": self.work, "datum_gap": self.datum_gap,
@@ -550,12 +558,11 @@ def _write_results(ms: Multiscale, folder: Path, history: io.History, comm) -> d
         history.write(files["history"], {"scene": ms.scene.name, "ranks": comm.size})
         history.plot(files["plot"], title=ms.scene.name)
         coupling_plots.history_figure(history, files["multiscale"], ms.scene.name)
-        s = ms.zones[0].surface
         with h5py.File(files["zones"], "w") as h5:
             h5.create_dataset("centre", data=np.array([z.centre for z in ms.zones])).attrs["unit"] = "m"
             h5.create_dataset("mean_wear_depth", data=depth.mean(axis=(-2, -1))).attrs["unit"] = "m"
             h5.create_dataset("max_wear_depth", data=depth.max(axis=(-2, -1))).attrs["unit"] = "m"
-            h5.create_dataset("wear_volume", data=depth.sum(axis=(-2, -1)) * s.dx * s.dy).attrs["unit"] = "m^3"
+            h5.create_dataset("wear_volume", data=ms.zone_wear_volume(depth)).attrs["unit"] = "m^3"
             h5.create_dataset("partition", data=ms.partition)
             h5.create_dataset("conductance", data=ms.conductance).attrs["unit"] = "W/(m^2 K)"
             h5.attrs["counts"] = ms.grid.counts

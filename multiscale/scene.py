@@ -26,8 +26,8 @@ from multiscale.schema import (Bad, Choice, Context, Curve, Either, FilePath, Fl
                                Section, Tables, Text, fields_of, key, read, show, unknown_keys)
 from multiscale.schema import reference as schema_reference
 
-__all__ = ["BUILDERS", "EFFECTS", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Geometry", "Material", "Scene", "load", "loads",
-           "reference", "summary"]
+__all__ = ["BUILDERS", "EFFECTS", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Geometry", "Material", "Scene", "load",
+           "loads", "reference", "summary"]
 
 
 # ------------------------------------------------------------------ effects
@@ -539,7 +539,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
 # ------------------------------------------------------------------ `multiscale check` output
 def reference() -> list[str]:
     """The scene format: effects, then every section and key (``multiscale check --keys``)."""
-    effects = [f"  {name:<15} {e.doc}" + (f"  (needs {', '.join(e.requires)})" if e.requires else "") for name, e in EFFECTS.items()]
+    effects = [f"  {name:<15} {e.doc}" + (f"  (needs {', '.join(e.requires)})" if e.requires else "")
+               for name, e in EFFECTS.items()]
     fields = [f"  {name:<18} needs {', '.join(needs) or 'nothing'}" for name, needs in OUTPUT_FIELDS.items()]
     return (["Scene file (TOML). Values: SI numbers or unit strings (\"4 GPa\", \"200 rpm\", \"20 degC\").",
              "", "effects:"] + effects + ["", "output.fields:"] + fields + ["", "top level:"]

@@ -1071,18 +1071,19 @@ def _plot_pareto(plt, study, ok, folder):
     for ax, m in zip(axes[0], study.metrics):
         t = [r.record["wall_time"] for r in ok]
         e = [r.errors.get(m, math.nan) for r in ok]
+        front = pareto(t, e)
+        labelled = set(range(len(ok))) if len(ok) <= 16 else set(front)
         for c, case in enumerate(cases):
             idx = [i for i, r in enumerate(ok) if _case_key(study, r) == case and math.isfinite(e[i]) and e[i] > 0]
             ax.scatter([t[i] for i in idx], [e[i] for i in idx], color=f"C{c}", s=28, zorder=3,
                        label=", ".join(f"{k} = {v}" for k, v in zip(study.cases, case)) or None)
-            for i in (idx if len(ok) <= 16 else [i for i in idx if i in pareto(t, e)]):
+            for i in (i for i in idx if i in labelled):
                 ax.annotate(_short(ok[i].run, study.cases), (t[i], e[i]), fontsize=6,
                             xytext=(3, 3), textcoords="offset points")
         refs = sorted(r.record["wall_time"] for r in ok if r.is_reference)
         if refs:
             ax.axvspan(refs[0], refs[-1], color="green", alpha=0.15, lw=0)
             ax.axvline(refs[len(refs) // 2], color="green", ls=":", label="reference run" + "s" * (len(refs) > 1))
-        front = pareto(t, e)
         if front:
             drawn = True
             ax.step([t[i] for i in front], [e[i] for i in front], where="post", color="red", lw=2, alpha=0.6,

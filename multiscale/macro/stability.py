@@ -1028,20 +1028,14 @@ def run_scene(scene, *, comm=None, overwrite: bool = False, verbose: bool = True
 
     from multiscale import io
     from multiscale.macro import mesh as two_body
+    from multiscale.macro.runner import prepare_folder
 
     comm = comm or MPI.COMM_WORLD
     t0 = time.perf_counter()
     if not scene.has("stability"):
         raise InputError("effects", sorted(scene.effects), 'the squeal analysis needs effect "stability"')
-    folder = Path(scene.output.folder)
-    existing = comm.bcast(sorted(p.name for p in folder.iterdir()) if comm.rank == 0 and folder.is_dir()
-                          else [], root=0)
-    if existing and not overwrite:
-        raise InputError("output.folder", str(folder),
-                         f"already holds results ({', '.join(existing[:3])}...); pass --overwrite to replace them")
+    folder = prepare_folder(scene, overwrite, False, comm)
     io.abort_on_exception(comm)
-    if comm.rank == 0:
-        folder.mkdir(parents=True, exist_ok=True)
     tm = two_body.build(scene.geometry.builder, dict(scene.geometry.params), comm)
     case = analyse(scene, tm, degree=degree)
     files = [case.modes.write_csv(folder / "modes.csv")] if comm.rank == 0 else []

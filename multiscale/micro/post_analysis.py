@@ -25,7 +25,7 @@ k_w mu P A s.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 
@@ -170,9 +170,9 @@ class PostAnalysis:
         if len(bad):
             again = self.solver.solve(heights[bad], load=load[bad], tol=self.tol, max_iter=4 * self.max_iter,
                                       partial=True)
-            for name in ("pressure", "displacement", "gap", "contact", "area_fraction", "mean_pressure", "approach",
-                         "mean_gap", "residual", "converged"):
-                getattr(r, name)[bad] = getattr(again, name)
+            for f in fields(r):
+                if f.name not in ("history", "iterations"):
+                    getattr(r, f.name)[bad] = getattr(again, f.name)
             r.iterations[bad] += again.iterations
             if not np.all(again.converged):
                 failed = [zones[b].id for b in bad[~np.asarray(again.converged)]]
