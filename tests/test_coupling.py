@@ -329,7 +329,7 @@ def test_scene_errors_of_the_loop(tmp_path):
 def test_layers_make_the_micro_solid_layered():
     """Effect "layers": the rough body's micro kernel is its layer stack (on its own material or a
     rigid base) in series with the counter-face; E* of Love's correction stays the macro bodies'."""
-    layered = pytest.importorskip("multiscale.micro.layered")
+    from multiscale.micro import layered
     from multiscale.coupling import contact_kernel, thermal_kernels
     text = POD.format(folder="out").replace('"wear"]', '"wear", "conductance", "layers"]') + """
 [layers]
