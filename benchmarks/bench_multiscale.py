@@ -21,7 +21,7 @@ import numpy as np  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 
 from multiscale.io import History  # noqa: E402
-from multiscale.macro.runner import run  # noqa: E402
+from multiscale.workflows import run  # noqa: E402
 from multiscale.scene import load  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]

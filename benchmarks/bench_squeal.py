@@ -12,17 +12,16 @@ from __future__ import annotations
 import argparse
 import resource
 import statistics
-import sys
 import time
-from pathlib import Path
 from types import SimpleNamespace as NS
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from mpi4py import MPI
 
-from mpi4py import MPI  # noqa: E402
-
-from multiscale.macro import mesh as two_body  # noqa: E402
-from multiscale.macro import stability as st  # noqa: E402
+from multiscale.geometry import builder
+from multiscale.macro import mesh as two_body
+from multiscale.macro.eigen import solve_modes
+from multiscale.macro.mechanics import Mechanics
+from multiscale.macro.preload import linearise, preload
 
 # Thesis §4.3.1 materials: cast-iron disc, composite pads, steel parts (values: ours, typical).
 STEEL = NS(E=210e9, nu=0.3, rho=7850.0)
@@ -33,19 +32,19 @@ MATERIALS = {"disc": NS(E=125e9, nu=0.25, rho=7200.0), "pad": NS(E=5e9, nu=0.25,
 def run_once(args, comm):
     t = {}
     t0 = time.perf_counter()
-    tm = two_body.build("disc_brake", {"mesh_size": args.mesh_size}, comm)
+    tm = two_body.build(builder("disc_brake"), {"mesh_size": args.mesh_size}, comm)
     t["mesh"] = time.perf_counter() - t0
     t0 = time.perf_counter()
-    mech = st.HydraulicMechanics(tm, MATERIALS, stiffness=args.penalty, friction=args.friction,
-                                 speed=5.0, degree=args.degree, prefix="bench_squeal_")
+    mech = Mechanics(tm, MATERIALS, stiffness=args.penalty, friction=args.friction, speed=5.0,
+                     load_kind="fluid", degree=args.degree, prefix="bench_squeal_")
     ndofs = sum(V.dofmap.index_map.size_global * 3 for V in mech.spaces)
     t["setup"] = time.perf_counter() - t0
-    pre = st.preload(mech, args.pressure, args.ramp)
+    pre = preload(mech, args.pressure, args.ramp)
     t["preload"] = pre.time
     t0 = time.perf_counter()
-    K, M = st.linearise(mech, MATERIALS)
+    K, M = linearise(mech, MATERIALS)
     t["linearise"] = time.perf_counter() - t0
-    modes = st.solve_modes(K, M, f_max=args.f_max, n_modes=args.modes)
+    modes = solve_modes(K, M, f_max=args.f_max, n_modes=args.modes)
     t["modes"] = modes.time
     t["total"] = sum(t.values())
     return t, ndofs, pre, modes

@@ -10,7 +10,7 @@ uniform: the first check of the penalty interface.
 from __future__ import annotations
 
 from multiscale.errors import InputError
-from multiscale.macro.geometry import (BodySpec, GeometrySpec, Region, Support, Translation,
+from multiscale.geometry import (BodySpec, GeometrySpec, Region, Support, Translation,
                                        add_group, entities_in_box, entities_where, resolve_parameters)
 
 DEFAULTS: dict[str, float] = {

@@ -32,11 +32,10 @@ from __future__ import annotations
 import math
 
 from multiscale.errors import InputError
-from multiscale.macro.geometry import (BodySpec, GeometrySpec, Region, Rotation, Support, add_group,
+from multiscale.geometry import (BodySpec, GeometrySpec, Region, Rotation, Support, add_group,
                                        entities_in_box, entities_where, resolve_parameters)
 
 NAME = "disc_brake"
-FLUID_PRESSURE = True              # the load is the hydraulic pressure on its load faces (−p n)
 PARAMETER_KINDS = {"vanes": "dimensionless"}
 DEFAULTS: dict[str, float] = {
     "disc_outer_radius": 0.140,      # m
@@ -137,6 +136,7 @@ def describe(params=None) -> GeometrySpec:
         load_direction=(0.0, 0.0, 1.0),           # piston face; the bore face is loaded opposite (−p n)
         motion=Rotation((0.0, 0.0, 1.0), (0.0, 0.0, 0.0)),
         length_scale=p["disc_outer_radius"],
+        fluid_load=True,                          # the hydraulic pressure on piston and caliper bore
     )
 
 

@@ -16,7 +16,7 @@ enters the contact) is its y = −pin_size/2 edge.
 from __future__ import annotations
 
 from multiscale.errors import InputError
-from multiscale.macro.geometry import (BodySpec, GeometrySpec, Region, Rotation, Support, add_group,
+from multiscale.geometry import (BodySpec, GeometrySpec, Region, Rotation, Support, add_group,
                                        entities_in_box, entities_where, resolve_parameters)
 
 DEFAULTS: dict[str, float] = {

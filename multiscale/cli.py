@@ -4,23 +4,22 @@ from __future__ import annotations
 import argparse
 import sys
 
+from multiscale import __version__
 from multiscale.errors import MultiscaleError, SceneError
+from multiscale.scene import load, reference, summary
 
 
 def _info(args) -> int:
+    # versions only: numba, scipy and pyfftw take seconds to load, which `check` must not pay
     import numba
     import numpy
     import scipy
 
-    import multiscale
     from multiscale.micro.fft import get_threads, pyfftw
-    print(f"multiscale {multiscale.__version__}  numpy {numpy.__version__}  scipy {scipy.__version__}  "
+    print(f"multiscale {__version__}  numpy {numpy.__version__}  scipy {scipy.__version__}  "
           f"numba {numba.__version__}  fft {'pyfftw' if pyfftw else 'scipy'} ({get_threads()} thread(s))")
     try:
-        import dolfinx_solver  # noqa: F401  (must precede dolfinx in the PyPI wheel)
-    except ImportError:
-        pass
-    try:
+        import multiscale.macro  # noqa: F401  (DOLFINx is optional; this loads its prerequisites first)
         import dolfinx
         print(f"dolfinx {dolfinx.__version__}")
     except ImportError:
@@ -30,7 +29,6 @@ def _info(args) -> int:
 
 def _check(args) -> int:
     """Validate scene files: a short summary for a good one, every problem of a bad one."""
-    from multiscale.scene import load, reference, summary
     if args.keys:
         print("\n".join(reference()))
     elif not args.scenes:
@@ -54,46 +52,32 @@ def _check(args) -> int:
 def _world():
     """MPI.COMM_WORLD, or None without mpi4py."""
     try:
-        from mpi4py import MPI
+        from mpi4py import MPI   # initialises MPI: only `run` needs it
     except ImportError:
         return None
     return MPI.COMM_WORLD
 
 
 def _run(args) -> int:
-    """Validate the scene, protect earlier results, then hand over to the macro runner.
+    """Validate the scene and hand it to its workflow (``multiscale.workflows.run``).
 
-    Under ``mpirun`` every rank runs this: rank 0 alone looks at the output folder (so a fast rank
-    that starts writing cannot make a slow one refuse), and prints the user errors."""
-    from multiscale.scene import load
+    Under ``mpiexec`` every rank runs this; user errors are raised on every rank (scene validation
+    is deterministic, the output folder is judged by rank 0 for all) and printed by rank 0."""
     comm = _world()
     rank = comm.rank if comm is not None else 0
     try:
-        scene = load(args.scene)                 # deterministic: every rank fails or none does
-        existing = scene.output.existing_results() if rank == 0 else None
-        if comm is not None and comm.size > 1:
-            existing = comm.bcast(existing, root=0)
-        if existing and not (args.overwrite or args.resume):
-            shown = ", ".join(p.name for p in existing[:3]) + (", ..." if len(existing) > 3 else "")
-            raise SceneError(f'output.folder = "{scene.output.folder}": already holds results '
-                             f"({len(existing)} entries: {shown}); use --overwrite to replace them, "
-                             f"--resume to continue the run, or choose another folder")
+        scene = load(args.scene)
         try:
-            from multiscale.macro.runner import run
+            from multiscale.workflows import run   # DOLFINx: optional ([fem] extra), slow to import
         except ModuleNotFoundError as exc:
-            if exc.name == "multiscale.macro.runner":
-                raise MultiscaleError("multiscale run: the macro runner (multiscale.macro.runner.run) "
-                                      "is not available in this version yet") from None
-            if exc.name and exc.name.split(".")[0] in ("dolfinx", "dolfinx_solver", "petsc4py", "ufl", "basix"):
-                raise MultiscaleError(f"multiscale run needs DOLFINx ({exc}); install it with "
-                                      "pip install -e '.[fem]'") from None
-            raise
+            raise MultiscaleError(f"multiscale run needs DOLFINx and the macro workflows ({exc}); install "
+                                  "them with pip install -e '.[fem]'") from None
+        run(scene, overwrite=args.overwrite, resume=args.resume)
     except MultiscaleError:
         if rank == 0:
             raise
         return 2
-    result = run(scene, overwrite=args.overwrite, resume=args.resume)
-    return result if isinstance(result, int) else 0
+    return 0
 
 
 def _study(args) -> int:

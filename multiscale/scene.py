@@ -14,19 +14,19 @@ interface, loading, time, output; roughness, micro, wear and layers (the multisc
 from __future__ import annotations
 
 import dataclasses
-import importlib
 import math
 import tomllib
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from multiscale.errors import InputError, SceneError
+from multiscale.geometry import GeometrySpec, Rotation, builder, builder_names
 from multiscale.schema import (Bad, Choice, Context, Curve, Either, FilePath, Flag, FrozenMap,
                                Integer, ListOf, Named, OneOf, OnlyWith, Pair, Quantity, Requires,
                                Section, Tables, Text, fields_of, key, read, show, unknown_keys)
 from multiscale.schema import reference as schema_reference
 
-__all__ = ["BUILDERS", "EFFECTS", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Geometry", "Material", "Scene", "load",
+__all__ = ["EFFECTS", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Geometry", "Material", "Scene", "load",
            "loads", "reference", "summary"]
 
 
@@ -72,23 +72,23 @@ _LENGTH = Quantity("length", gt=0)
 
 
 # ------------------------------------------------------------------ geometry builders
-BUILDERS = ("block_on_flat", "pin_on_disc", "disc_brake")   # modules meshes.<name>
-_BUILDER_CHOICE = Choice(BUILDERS)
+_BUILDER_CHOICE = Choice(builder_names())      # the registry: entry points multiscale.builders
 
 
 @dataclass(frozen=True)
 class Geometry:
-    """[geometry]: a builder of ``meshes/`` and the parameters the scene sets (SI; the builder's
-    ``DEFAULTS`` fill the rest). ``spec`` (``meshes.<builder>.describe``) names the bodies (body 0
-    the stationary "+" side: pin, pads, block; body 1 the sliding side), material regions and motion."""
+    """[geometry]: a registered mesh builder (``multiscale.geometry.builder``) and the parameters
+    the scene sets (SI; the builder's ``DEFAULTS`` fill the rest). ``spec`` (the builder's
+    ``describe``) names the bodies (body 0 the stationary "+" side, body 1 the sliding side),
+    material regions and motion."""
 
     builder: str
     params: FrozenMap
-    spec: object                      # multiscale.macro.geometry.GeometrySpec
+    spec: GeometrySpec
 
     def module(self):
-        """The builder module ``meshes.<builder>`` (DEFAULTS, parameters, describe, generate)."""
-        return importlib.import_module(f"meshes.{self.builder}")
+        """The builder module (DEFAULTS, parameters, describe, generate)."""
+        return builder(self.builder)
 
     def resolved(self) -> dict:
         """Every builder parameter [SI]: DEFAULTS updated by the scene's values."""
@@ -106,7 +106,7 @@ class Geometry:
     @property
     def motion(self) -> str:
         """"rotation" (of body 1 about an axis) or "translation"."""
-        return "rotation" if type(self.spec.motion).__name__ == "Rotation" else "translation"
+        return "rotation" if isinstance(self.spec.motion, Rotation) else "translation"
 
 
 def _parameter_kind(module, name: str) -> str:
@@ -116,7 +116,7 @@ def _parameter_kind(module, name: str) -> str:
 
 
 class _Geometry(Section):
-    """[geometry]: ``builder`` picks meshes.<builder>, whose DEFAULTS are the allowed keys."""
+    """[geometry]: ``builder`` picks a registered builder, whose DEFAULTS are the allowed keys."""
 
     def __init__(self):
         super().__init__(Geometry)
@@ -126,13 +126,13 @@ class _Geometry(Section):
 
     def reference(self, path) -> list[str]:
         lines = [f"  {'builder':<20} {_BUILDER_CHOICE.describe()}  [required]"]
-        for builder in BUILDERS:
+        for name in builder_names():
             try:
-                module = importlib.import_module(f"meshes.{builder}")
+                module = builder(name)
             except ImportError:
-                lines.append(f"  builder = \"{builder}\": not available")
+                lines.append(f"  builder = \"{name}\": not available")
                 continue
-            lines.append(f"  builder = \"{builder}\" parameters (SI defaults; 0 = the builder's fallback):")
+            lines.append(f"  builder = \"{name}\" parameters (SI defaults; 0 = the builder's fallback):")
             lines += [f"    {k:<22} {_parameter_kind(module, k):<8} {v:g}" for k, v in module.DEFAULTS.items()]
         return lines
 
@@ -144,8 +144,8 @@ class _Geometry(Section):
             ctx.problems.append(f"{path}.builder: missing; required: {_BUILDER_CHOICE.describe()}")
             return None
         try:
-            builder = _BUILDER_CHOICE(raw["builder"], ctx)
-            module = importlib.import_module(f"meshes.{builder}")
+            name = _BUILDER_CHOICE(raw["builder"], ctx)
+            module = builder(name)
         except Bad as exc:
             ctx.problems.append(f"{path}.builder = {show(raw['builder'])}: {exc}")
             return None
@@ -154,16 +154,16 @@ class _Geometry(Section):
             return None
         before = len(ctx.problems)
         given = {k: v for k, v in raw.items() if k != "builder"}
-        unknown_keys(given, module.DEFAULTS, path, ctx, f'parameter of builder "{builder}"')
+        unknown_keys(given, module.DEFAULTS, path, ctx, f'parameter of builder "{name}"')
         params = {}
-        for name, value in given.items():
-            if name in module.DEFAULTS:
-                zero_ok = float(module.DEFAULTS[name]) == 0.0    # 0 means "builder's fallback"
-                parser = Quantity(_parameter_kind(module, name), **({"ge": 0} if zero_ok else {"gt": 0}))
+        for param, value in given.items():
+            if param in module.DEFAULTS:
+                zero_ok = float(module.DEFAULTS[param]) == 0.0    # 0 means "builder's fallback"
+                parser = Quantity(_parameter_kind(module, param), **({"ge": 0} if zero_ok else {"gt": 0}))
                 try:
-                    params[name] = parser(value, ctx)
+                    params[param] = parser(value, ctx)
                 except Bad as exc:
-                    ctx.problems.append(f"{path}.{name} = {show(value)}: {exc}")
+                    ctx.problems.append(f"{path}.{param} = {show(value)}: {exc}")
         if len(ctx.problems) > before:
             return None
         try:
@@ -171,7 +171,7 @@ class _Geometry(Section):
         except InputError as exc:
             ctx.problems.append(str(exc))
             return None
-        return Geometry(builder, FrozenMap(params), spec)
+        return Geometry(name, FrozenMap(params), spec)
 
 
 # ------------------------------------------------------------------ materials and interface

@@ -644,7 +644,7 @@ def _scene_main(task: str) -> int:
     spec = json.loads(task)
     from multiscale.scene import load
     scene = load(spec["scene"], overrides=spec["overrides"])
-    from multiscale.macro.runner import run
+    from multiscale.workflows import run
     run(scene, overwrite=True, verbose=False)
     return 0
 

@@ -14,8 +14,8 @@ import ufl  # noqa: E402
 
 from multiscale.errors import InputError  # noqa: E402
 from multiscale.io import History  # noqa: E402
+from multiscale.geometry import Support, builder  # noqa: E402
 from multiscale.macro import mesh  # noqa: E402
-from multiscale.macro.geometry import Support  # noqa: E402
 from multiscale.macro.laws_ufl import FacetLaw  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
 from multiscale.micro.contact import ContactSolver  # noqa: E402
@@ -33,7 +33,7 @@ N_POINTS = 8          # nodes per law in every test here: the compiled forms are
 @pytest.fixture(scope="module")
 def block():
     """Coarse block on a flat (10 x 10 mm, 2.5 mm elements)."""
-    return mesh.build("block_on_flat", {"mesh_size": 2.5e-3})
+    return mesh.build(builder("block_on_flat"), {"mesh_size": 2.5e-3})
 
 
 def _synthetic_law(zone_id, top, d1, exponent, n=N_POINTS):
@@ -83,7 +83,7 @@ def test_block_on_rigid_flat_force_matches_the_micro_solution():
     perfect contact, C_halfspace = Love's mean over the face / (pi E*) (without it: within 5 %)."""
     Lx, Ly, E = 15e-3, 22.5e-3, 10e9
     area = Lx * Ly
-    tm = mesh.build("block_on_flat", {"length": Lx, "width": Ly, "height": 15e-3, "flat_thickness": 5e-3,
+    tm = mesh.build(builder("block_on_flat"), {"length": Lx, "width": Ly, "height": 15e-3, "flat_thickness": 5e-3,
                                       "mesh_size": 5e-3, "interface_mesh_size": 0.8e-3})
     spec = dataclasses.replace(tm.spec, supports=tm.spec.supports + (Support("block_top", (2,)),), load_faces=())
     tm = dataclasses.replace(tm, spec=spec)              # top held: the flat's motion is the initial gap
@@ -155,21 +155,21 @@ folder = "{folder}"
 def test_identical_zones_equal_perfect_contact_with_the_secant_stiffness(tmp_path, block):
     """Wear off, every zone the same patch: the embedded block (uniform stress) equals the
     penalty model with K_n = p / (g_open - g) and the gap shifted by g_open (to solver tolerance)."""
-    from multiscale.coupling import Multiscale
+    from multiscale.workflows.multiscale import build
     patch = fractal_surface(16, 2.5e-3, 0.8, 1, 6, 2e-6, seed=5).heights
     patch = patch + patch[::-1] + patch[:, ::-1] + patch[::-1, ::-1]     # even: the file's plane fit is flat
     np.save(tmp_path / "tiled.npy", np.tile(patch, (4, 4)))
     scene = loads(BLOCK.format(extra="", loading="", file=tmp_path / "tiled.npy", pixel="156.25 um",
                                n=N_POINTS, folder=tmp_path / "out"), tmp_path)
-    ms = Multiscale(scene)
+    ms = build(scene)
     ms.start()
-    heights = np.stack([z.surface.heights for z in ms.zones])
+    heights = ms.rough.heights()
     assert np.abs(heights - heights[0]).max() < 1e-12 * np.abs(heights).max()   # the file's plane fit is ~0
     emb = ms.model
     p = emb.contact.facet_pressure()
     np.testing.assert_allclose(p, 1e6, rtol=1e-6)
     gap = emb.contact.facet_gap()
-    g_open = ms.law.laws.mechanical.g_open.mean()
+    g_open = ms.rough.law.laws.mechanical.g_open.mean()
     secant = 1e6 / (g_open - gap.mean())
     assert np.ptp(gap) < 1e-9 * (g_open - gap.mean())
     perfect = Mechanics(ms.tm, dict(scene.materials), stiffness=secant, load_kind="pressure", prefix="seam_")
@@ -246,7 +246,7 @@ folder = "{folder}"
 
 @pytest.fixture(scope="module")
 def straight(tmp_path_factory):
-    from multiscale.macro.runner import run
+    from multiscale.workflows import run
     folder = tmp_path_factory.mktemp("pod") / "straight"
     scene = loads(POD.format(folder=folder))
     return scene, run(scene, verbose=False)
@@ -265,7 +265,7 @@ def test_rough_pin_on_disc_bookkeeping_and_outputs(straight):
     assert np.all((h["partition_min"] >= 0) & (h["partition_max"] <= 1))
     assert np.all(h["micro_max_pressure"] > h["max_pressure"])
     assert h["laws_computed"][0] == 25 and 0 < h["laws_computed"][1] <= h["zones_in_contact"][1]
-    for f in result.field_files + [result.plot_file, result.multiscale_plot, result.wear_map, result.zones_file]:
+    for f in result.field_files + [result.plot_file, result.multiscale_plot, *result.wear_maps, result.zones_file]:
         assert f.exists() and f.stat().st_size > 0
     text = (result.folder / "interface.xdmf").read_text()
     assert all(name in text for name in ("contact_stiffness", "partition", "wear_depth"))
@@ -277,7 +277,7 @@ def test_resume_after_an_interrupted_run_gives_the_straight_history(straight, tm
     recomputes its zone laws: FFT round-off, then the micro heating's CG tolerance 1e-8 on the
     partition). A real SIGKILL of `mpiexec -n 2 multiscale run` followed by --resume was checked
     by hand the same way (max relative difference 8e-8)."""
-    from multiscale.coupling import run
+    from multiscale.workflows.multiscale import run
     scene, reference = straight
     scene = loads(POD.format(folder=tmp_path / "killed"))
     first = run(scene, verbose=False, stop_after=1)
@@ -298,23 +298,23 @@ def test_resume_after_an_interrupted_run_gives_the_straight_history(straight, tm
 def test_micro_conductance_couples_the_temperature_fields(tmp_path):
     """Effect "conductance" with roughness: h_c of each loaded zone (micro conduction) on its
     facets, 0 on the others; the exchange conserves the heat of the two bodies."""
-    from multiscale.coupling import Multiscale
+    from multiscale.workflows.multiscale import build
     text = POD.format(folder=tmp_path / "hc").replace('"wear"]', '"wear", "conductance"]')
-    ms = Multiscale(loads(text.replace("steps = 2", "steps = 1")))
+    ms = build(loads(text.replace("steps = 2", "steps = 1")))
     ms.start()
     heat = ms.model.macro_step(0.6)
     iface, contact = ms.tm.interface, ms.model.contact
     h_c = iface.values(contact.conductance)
-    loaded = np.isin(ms.zone_of_facet, np.flatnonzero(ms.conductance > 0))
+    loaded = np.isin(ms.rough.zone_of_facet, np.flatnonzero(ms.conductance > 0))
     assert loaded.any() and np.all(h_c[loaded] > 0) and np.all(h_c[~loaded] == 0)
-    np.testing.assert_array_equal(h_c, ms.conductance[ms.zone_of_facet])
+    np.testing.assert_array_equal(h_c, ms.conductance[ms.rough.zone_of_facet])
     # stored = frictional heat in (the exchange moves heat, it creates none); the disc's advection
     # through its faceted rim loses a little (~3e-4 of its heat without exchange, test_macro_run)
     assert sum(ms.model.thermal.stored_heat()) == pytest.approx(sum(heat), rel=5e-3)
 
 
 def test_scene_errors_of_the_loop(tmp_path):
-    from multiscale.coupling import run
+    from multiscale.workflows.multiscale import run
     scene = loads(POD.format(folder=tmp_path / "none"))
     with pytest.raises(InputError, match="checkpoint"):
         run(scene, resume=True, verbose=False)
@@ -330,7 +330,7 @@ def test_layers_make_the_micro_solid_layered():
     """Effect "layers": the rough body's micro kernel is its layer stack (on its own material or a
     rigid base) in series with the counter-face; E* of Love's correction stays the macro bodies'."""
     from multiscale.micro import layered
-    from multiscale.coupling import contact_kernel, thermal_kernels
+    from multiscale.workflows.rough import contact_kernel, thermal_kernels
     text = POD.format(folder="out").replace('"wear"]', '"wear", "conductance", "layers"]') + """
 [layers]
 body = "pin"
@@ -353,5 +353,5 @@ kappa = "5 W/(m K)"
     first, second = thermal_kernels(scene)
     assert isinstance(first, layered.LayeredThermal) and first.kappa == (5.0,)
     with pytest.raises(InputError, match="layers.body"):
-        from multiscale.coupling import Multiscale
-        Multiscale(loads(text.replace('body = "pin"\nbase', 'body = "disc"\nbase')))
+        from multiscale.workflows.multiscale import build
+        build(loads(text.replace('body = "pin"\nbase', 'body = "disc"\nbase')))

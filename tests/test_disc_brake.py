@@ -1,4 +1,5 @@
 """Disc-brake assembly (thesis §4.3.1): geometry, free-free disc modes, preload and complex modes."""
+from pathlib import Path
 from types import SimpleNamespace as NS
 
 import numpy as np
@@ -15,8 +16,13 @@ from scipy import special, optimize  # noqa: E402
 
 from meshes import disc_brake  # noqa: E402
 from multiscale.errors import InputError  # noqa: E402
+from multiscale.geometry import builder  # noqa: E402
+from multiscale.macro import eigen, modal  # noqa: E402
 from multiscale.macro import mesh as two_body  # noqa: E402
-from multiscale.macro import stability as st  # noqa: E402
+from multiscale.macro.mechanics import Mechanics  # noqa: E402
+from multiscale.macro.output import write_modes_xdmf  # noqa: E402
+from multiscale import scene as scenes  # noqa: E402
+from multiscale.workflows import squeal  # noqa: E402
 
 STEEL = NS(E=210e9, nu=0.3, rho=7850.0)
 MATERIALS = {"disc": NS(E=125e9, nu=0.25, rho=7200.0), "pad": NS(E=5e9, nu=0.25, rho=2500.0),
@@ -104,7 +110,7 @@ def free_disc_frequencies(h, thickness):
     M = fpetsc.assemble_matrix(fem.form(m.rho * ufl.inner(u, v) * ufl.dx))
     K.assemble(), M.assemble()
     # free-free: 6 rigid modes at 0 Hz; a small positive target keeps K - theta_t M regular
-    return st.solve_modes(K, M, f_min=20.0, f_max=2000.0, target=20.0, n_modes=5).frequency
+    return eigen.solve_modes(K, M, f_min=20.0, f_max=2000.0, target=20.0, n_modes=5).frequency
 
 
 def test_free_free_disc_bending_converges_to_plate_theory():
@@ -127,22 +133,22 @@ def test_free_free_disc_bending_converges_to_plate_theory():
 # ---------------------------------------------------------------- preload and complex modes
 @pytest.fixture(scope="module")
 def brake():
-    tm = two_body.build("disc_brake", COARSE)
-    mech = st.HydraulicMechanics(tm, MATERIALS, stiffness=1e13, friction=0.0, speed=5.0,
-                                 prefix="brake_test_")
+    tm = two_body.build(builder("disc_brake"), COARSE)
+    mech = Mechanics(tm, MATERIALS, stiffness=1e13, friction=0.0, speed=5.0, load_kind="fluid",
+                     prefix="brake_test_")
     return tm, mech
 
 
 @pytest.fixture(scope="module")
 def no_friction(brake):
-    return st.squeal_case(brake[1], MATERIALS, "mu0", pressure=PRESSURE, n_modes=30)
+    return squeal.squeal_case(brake[1], MATERIALS, "mu0", load=PRESSURE, n_modes=30)
 
 
 @pytest.fixture(scope="module")
 def friction(brake, no_friction):
     brake[1].contact.friction.value = 0.4
     try:
-        return st.squeal_case(brake[1], MATERIALS, "mu0.4", pressure=PRESSURE, n_modes=30)
+        return squeal.squeal_case(brake[1], MATERIALS, "mu0.4", load=PRESSURE, n_modes=30)
     finally:
         brake[1].contact.friction.value = 0.0
 
@@ -194,14 +200,14 @@ def test_strain_energy_per_region_matches_an_assembled_disc_stiffness(brake, no_
     K1.assemble()
     n0 = mech.spaces[0].dofmap.index_map.size_local * 3
     modes = no_friction.modes.modes
-    disc_energy = [0.5 * np.vdot(x, st._apply(K1, x[:, None])[:, 0]).real for x in modes[n0:].T]
+    disc_energy = [0.5 * np.vdot(x, eigen.mat_apply(K1, x[:, None])[:, 0]).real for x in modes[n0:].T]
     np.testing.assert_allclose(shares.energy[:, -1], disc_energy, rtol=1e-9)
 
 
 def test_mode_shapes_are_written_to_xdmf(tmp_path, brake, friction):
     import h5py
 
-    files = st.write_modes_xdmf(tmp_path / "modes.xdmf", friction.modes, brake[1].u, modes=[1, 2])
+    files = write_modes_xdmf(tmp_path / "modes.xdmf", friction.modes, brake[1].u, modes=[1, 2])
     assert len(files) == 2 and all(f.exists() and f.with_suffix(".h5").exists() for f in files)
     n0 = brake[1].spaces[0].dofmap.index_map.size_local * 3
     disc = friction.modes.modes[n0:, 1]                     # mode 2 on the disc (P1: vertex values)
@@ -212,78 +218,74 @@ def test_mode_shapes_are_written_to_xdmf(tmp_path, brake, friction):
 
 
 # ---------------------------------------------------------------- rough pad interfaces
+DEMO = Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml"
+SMOOTH_ROUGH = {"effects": ["contact", "friction", "stability", "roughness"], "roughness.body": "brake",
+                "roughness.rms": "0.05 um", "roughness.hurst": 0.8, "roughness.k_min": 1, "roughness.k_max": 16,
+                "roughness.patch": "zone", "micro.zones": [4, 2], "micro.grid": [32, 32], "micro.law_points": 10,
+                "micro.p_max": "30 kPa", "stability.modes": 30}
+
+
 @pytest.fixture(scope="module")
 def smooth_rough(brake):
-    """A very smooth rough case (R_q = 0.05 um): embedded zone laws on both pads, mu = 0.4."""
-    from multiscale.micro.kernels import HalfSpace
-    LawSpec = pytest.importorskip("multiscale.micro.laws", reason="interface laws (issue 7) not installed").LawSpec
-
-    tm = brake[0]
-    pad, disc = MATERIALS["pad"], MATERIALS["disc"]
-    spec = LawSpec(HalfSpace.from_materials(pad.E, pad.nu, disc.E, disc.nu), p_max=3e4, n_points=10)
-    laws = st.rough_pad_laws(tm, st.PadRoughness(5e-8, zones=(4, 2), grid=32, k_max=(16, 16)), spec)
-    law = st.LinearisedFacetLaw(tm, laws)
-    mech = st.HydraulicMechanics(tm, MATERIALS, friction=0.4, speed=5.0, law=law, prefix="brake_rough_")
-    masks = st.interface_facets(tm)
-    nominal = {k: disc_brake.clamp_force(PRESSURE) / tm.interface.areas[m].sum() for k, m in masks.items()}
-    pre = st.settle(mech, law, PRESSURE, initial_gap=st.datum_gap(laws, tm.interface.areas, masks, nominal))
-    K, M = st.linearise(mech, MATERIALS)
-    return pre, laws, mech, st.solve_modes(K, M, n_modes=30)
+    """A very smooth rough case (R_q = 0.05 um) of the scene on the mesh of the perfect-contact
+    fixtures: embedded zone laws on both pads, mu = 0.4."""
+    scene = scenes.load(DEMO, SMOOTH_ROUGH)
+    return squeal.analyse(scene, brake[0], name="smooth", degree=1, energy=False)
 
 
-def test_embedded_laws_hold_on_every_facet_and_balance_the_pads(smooth_rough):
-    pre, laws, mech, _ = smooth_rough
-    assert pre.law_residuals[-1] <= 1e-6 * pre.normal_force["inner_pad"] / 4.8e-3
+def test_embedded_laws_balance_the_pads_with_their_consistent_tangent(smooth_rough):
+    """The laws are embedded pointwise (their UFL form equals the numpy law: test_coupling); here:
+    both pads carry the clamp force, most facets are closed, and the Newton matrix at the preload
+    is the exact tangent of the laws (what the modal analysis linearises)."""
+    pre, mech = smooth_rough.preload, smooth_rough.mech
     assert pre.normal_force["inner_pad"] == pytest.approx(pre.load_force["piston_back"], rel=1e-6)
     assert pre.normal_force["outer_pad"] == pytest.approx(pre.load_force["caliper_bore"], rel=1e-6)
-    gap = mech.contact.facet_gap()
-    p_law, K_law = laws(gap)
-    # facets well inside the contact (no quadrature point clipped): mean pressure = law(mean gap)
-    inside = p_law > 0.5 * p_law.mean()
-    assert inside.sum() > 0.5 * len(p_law)
-    np.testing.assert_allclose(mech.contact.facet_pressure()[inside], p_law[inside], rtol=1e-6)
-    # the Newton matrix holds the law's stiffness on the closed facets (consistent tangent)
-    iface = mech.tm.interface
-    closed = p_law > 0
-    np.testing.assert_allclose(iface.values(mech.contact.law.k_star)[closed], K_law[closed], rtol=1e-12)
+    p_law, _ = mech.contact.law.evaluate(mech.contact.facet_gap())
+    assert (p_law > 0.5 * p_law.mean()).sum() > 0.5 * len(p_law)
+    # the Newton matrix is the consistent tangent of the embedded laws: K v = dF/du v (central differences)
+    snes, x = mech.problem.solver, mech.problem.x
+    K = mech.tangent()
+    v = x.duplicate()
+    v.setArray(np.random.default_rng(0).standard_normal(v.getLocalSize()))
+    eps = 1e-9 * x.norm() / v.norm()
+    Kv, fp, fm, x0 = x.duplicate(), x.duplicate(), x.duplicate(), x.copy()
+    K.mult(v, Kv)
+    for sign, f in ((1, fp), (-1, fm)):
+        x0.copy(x)
+        x.axpy(sign * eps, v)
+        snes.computeFunction(x, f)
+    x0.copy(x)
+    fd = (fp - fm) / (2 * eps)
+    assert (fd - Kv).norm() <= 1e-6 * Kv.norm()          # measured 6e-8
 
 
 def test_perfect_contact_and_a_very_smooth_rough_case_share_their_modes(friction, smooth_rough):
-    mac = st.mac_matrix(friction.modes, smooth_rough[3])
+    mac = modal.mac_matrix(friction.modes, smooth_rough.modes)
     assert np.diag(mac)[:20].min() > 0.9
-    assert st.cumulative_moving_average(st.mmac(mac))[19] > 0.95
+    assert modal.cumulative_moving_average(modal.mmac(mac))[19] > 0.95
 
 
 # ---------------------------------------------------------------- scene-driven run
 def test_scene_run_writes_results_and_matches_the_direct_analysis(tmp_path, friction):
-    from pathlib import Path
-
-    from multiscale import scene as scenes
-
-    demo = Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml"
     overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 20, "output.folder": str(tmp_path / "out")}
-    scene = scenes.load(demo, overrides)
-    run = st.run_scene(scene, degree=1, verbose=False)
+    scene = scenes.load(DEMO, overrides)
+    run = squeal.run(scene, degree=1, verbose=False)
     names = {p.name for p in run.files}
     assert {"modes.csv", "modes_body0.xdmf", "modes_body1.xdmf", "pressure.png", "re_im.png",
             "energy.png"} <= names and all(p.exists() for p in run.files)
     # same mesh, materials, 10 bar, mu = 0.4 as the direct analysis of the fixtures
     np.testing.assert_allclose(run.case.modes.frequency, friction.modes.frequency[:20], rtol=1e-6)
     with pytest.raises(InputError, match="output.folder"):
-        st.run_scene(scene, degree=1, verbose=False)
+        squeal.run(scene, degree=1, verbose=False)
 
 
 def test_multiscale_run_hands_stability_scenes_to_the_squeal_analysis(tmp_path, monkeypatch):
-    from pathlib import Path
+    from multiscale import workflows
 
-    from multiscale import scene as scenes
-    from multiscale.macro import runner
-
-    demo = Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml"
-    scene = scenes.load(demo, {"output.folder": str(tmp_path / "out")})
+    scene = scenes.load(DEMO, {"output.folder": str(tmp_path / "out")})
     seen = []
-    monkeypatch.setattr(st, "run_scene", lambda sc, **kw: seen.append((sc, kw)) or "squeal")
-    assert runner.run(scene, overwrite=True, verbose=False) == "squeal"
+    monkeypatch.setattr(squeal, "run", lambda sc, **kw: seen.append((sc, kw)) or "squeal")
+    assert workflows.run(scene, overwrite=True, verbose=False) == "squeal"
     assert seen[0][0] is scene and seen[0][1]["overwrite"] is True
     with pytest.raises(InputError, match="no checkpoints"):
-        runner.run(scene, resume=True)
+        workflows.run(scene, resume=True)

@@ -5,6 +5,7 @@ import pytest
 pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from multiscale.errors import ConvergenceError, InputError  # noqa: E402
+from multiscale.geometry import builder  # noqa: E402
 from multiscale.macro import mesh  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
 from multiscale.scene import Material  # noqa: E402
@@ -15,7 +16,7 @@ K_N = 1e13          # Pa/m
 
 @pytest.fixture(scope="module")
 def tm():
-    return mesh.build("block_on_flat", {"mesh_size": 2.5e-3})
+    return mesh.build(builder("block_on_flat"), {"mesh_size": 2.5e-3})
 
 
 def test_uniform_load_gives_uniform_pressure_and_penalty_gap(tm):
@@ -59,6 +60,6 @@ def test_missing_material_and_unknown_builder_are_input_errors(tm):
     with pytest.raises(InputError, match="materials.flat"):
         Mechanics(tm, {"block": MATERIALS["block"]}, prefix="block_e_")
     with pytest.raises(InputError, match="geometry.builder"):
-        mesh.builder("teapot")
+        builder("teapot")
     with pytest.raises(InputError, match="geometry.height"):
-        mesh.builder("block_on_flat").describe({"height": -1.0})
+        builder("block_on_flat").describe({"height": -1.0})

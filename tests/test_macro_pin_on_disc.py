@@ -4,6 +4,7 @@ import pytest
 
 pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
+from multiscale.geometry import builder  # noqa: E402
 from multiscale.macro import mesh  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
 from multiscale.macro.thermal import Thermal  # noqa: E402
@@ -19,7 +20,7 @@ F, OMEGA, MU, HALF = 200.0, 200 * 2 * np.pi / 60, 0.4, 10e-3     # N, rad/s, -, 
 
 @pytest.fixture(scope="module")
 def tm():
-    return mesh.build("pin_on_disc", COARSE)
+    return mesh.build(builder("pin_on_disc"), COARSE)
 
 
 @pytest.fixture(scope="module")

@@ -1,4 +1,4 @@
-"""Scenes through the macro runner: only the requested effects are built; files a run writes."""
+"""Scenes through the workflows: only the requested effects are built; files a run writes."""
 from pathlib import Path
 
 import numpy as np
@@ -8,7 +8,8 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from multiscale.errors import InputError  # noqa: E402
 from multiscale.io import History  # noqa: E402
-from multiscale.macro.runner import build_model, run  # noqa: E402
+from multiscale.workflows import run  # noqa: E402
+from multiscale.workflows.model import build_model  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 
 BLOCK = """

@@ -5,9 +5,12 @@ import math
 import numpy as np
 import pytest
 
+import multiscale.macro  # noqa: F401,I001  (DOLFINx's prerequisites before petsc4py)
+from petsc4py import PETSc
+
 from multiscale.errors import InputError
-from multiscale.macro import stability as st
-from multiscale.macro.stability import PETSc
+from multiscale.macro import eigen, modal
+from multiscale.references.stability import hoffmann_matrices
 
 K11, K22, K12, K21, K3 = 1.0, 1.5, 0.3, 0.3, 1.0
 MU_C = ((K11 - K22) ** 2 + 4 * K12 * K21) / (4 * K21 * K3)   # 0.508333...
@@ -17,6 +20,11 @@ def hoffmann_theta(mu):
     """Exact eigenvalues of K = [[k11, k12 - mu k3], [k21, k22]] (unit mass)."""
     d = complex(((K11 - K22) / 2) ** 2 + K21 * (K12 - mu * K3))
     return np.array([(K11 + K22) / 2 - np.sqrt(d), (K11 + K22) / 2 + np.sqrt(d)])
+
+
+def hoffmann_model(mu, **k):
+    """(K, M) of the Hoffmann 2-DOF model as PETSc matrices."""
+    return tuple(petsc_mat(A) for A in hoffmann_matrices(mu, **k))
 
 
 def petsc_mat(A):
@@ -56,14 +64,14 @@ def chain_frequencies(n=200, k=4e6, m=0.01):
 
 
 def test_hoffmann_coalescence_at_analytic_mu_c():
-    mu = st.onset_of_instability(st.hoffmann_model, 0.0, 1.0, xtol=1e-9, f_max=1.0)
+    mu = eigen.onset_of_instability(hoffmann_model, 0.0, 1.0, xtol=1e-9, f_max=1.0)
     assert MU_C == pytest.approx(0.508333333333, abs=1e-9)
     assert abs(mu - MU_C) < 1e-6
 
 
 @pytest.mark.parametrize("mu", [0.0, 0.3, 0.5])
 def test_hoffmann_stable_below_mu_c(mu):
-    r = st.solve_modes(*st.hoffmann_model(mu), f_max=1.0)
+    r = eigen.solve_modes(*hoffmann_model(mu), f_max=1.0)
     assert len(r) == 2 and not r.unstable().any()
     np.testing.assert_allclose(np.sort(r.theta.real), hoffmann_theta(mu).real, rtol=1e-10)
     assert np.abs(r.theta.imag).max() <= 1e-10 * np.abs(r.theta).max()
@@ -72,47 +80,47 @@ def test_hoffmann_stable_below_mu_c(mu):
 
 @pytest.mark.parametrize("mu", [0.52, 0.8])
 def test_hoffmann_exactly_one_unstable_mode_above_mu_c(mu):
-    r = st.solve_modes(*st.hoffmann_model(mu), f_max=1.0)
+    r = eigen.solve_modes(*hoffmann_model(mu), f_max=1.0)
     assert r.unstable().sum() == 1
     lam = 1j * np.sqrt(hoffmann_theta(mu))          # both with omega > 0
     lam = lam[np.lexsort((lam.real, lam.imag))]
     np.testing.assert_allclose(r.eigenvalues, lam, rtol=1e-10)
     assert r.growth[r.unstable()][0] == pytest.approx(abs(lam.real[0]), rel=1e-10)
-    rep = st.stability_report(r)
+    rep = modal.stability_report(r)
     assert list(rep.unstable) == [int(np.argmax(r.growth)) + 1]
 
 
 def test_hoffmann_just_below_mu_c_is_potentially_unstable():
-    rep = st.stability_report(st.solve_modes(*st.hoffmann_model(MU_C - 1e-4), f_max=1.0),
+    rep = modal.stability_report(eigen.solve_modes(*hoffmann_model(MU_C - 1e-4), f_max=1.0),
                               close_tol=0.05)
     assert rep.unstable.size == 0 and list(rep.potentially_unstable) == [1, 2]
-    far = st.stability_report(st.solve_modes(*st.hoffmann_model(0.0), f_max=1.0), close_tol=0.05)
+    far = modal.stability_report(eigen.solve_modes(*hoffmann_model(0.0), f_max=1.0), close_tol=0.05)
     assert far.potentially_unstable.size == 0
 
 
 def test_bad_requests_raise_clear_errors():
-    K, M = st.hoffmann_model(0.3)
+    K, M = hoffmann_model(0.3)
     with pytest.raises(InputError, match="mu"):
-        st.hoffmann_model(-0.1)
+        hoffmann_model(-0.1)
     with pytest.raises(InputError, match="target"):
-        st.solve_modes(K, M, target=-5.0)
+        eigen.solve_modes(K, M, target=-5.0)
     with pytest.raises(InputError, match="no eigenvalue in this frequency band"):
-        st.solve_modes(K, M, f_min=10.0, f_max=20.0, target=15.0)
+        eigen.solve_modes(K, M, f_min=10.0, f_max=20.0, target=15.0)
     with pytest.raises(InputError, match="f_max"):
-        st.solve_modes(K, M, f_min=2.0, f_max=1.0)
+        eigen.solve_modes(K, M, f_min=2.0, f_max=1.0)
     with pytest.raises(InputError, match="n_modes"):
-        st.solve_modes(K, M, n_modes=5)
+        eigen.solve_modes(K, M, n_modes=5)
     with pytest.raises(InputError, match="mu_hi"):
-        st.onset_of_instability(st.hoffmann_model, 0.0, 0.4, f_max=1.0)
+        eigen.onset_of_instability(hoffmann_model, 0.0, 0.4, f_max=1.0)
     with pytest.raises(InputError, match="mu_lo"):
-        st.onset_of_instability(st.hoffmann_model, -1.0, 0.4, f_max=1.0)
+        eigen.onset_of_instability(hoffmann_model, -1.0, 0.4, f_max=1.0)
 
 
 def test_band_search_finds_every_mode_and_skips_dirichlet_rows():
     K, M = chain()
     f_exact = chain_frequencies()
     f_max = 0.5 * f_exact.max()                       # ~66 modes, more than the initial subspace
-    r = st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=f_max, nev=10)
+    r = eigen.solve_modes(petsc_mat(K), petsc_mat(M), f_max=f_max, nev=10)
     inband = f_exact[f_exact <= f_max]
     assert r.solves > 1 and len(r) == inband.size
     np.testing.assert_allclose(r.frequency, inband, rtol=1e-8)
@@ -121,7 +129,7 @@ def test_band_search_finds_every_mode_and_skips_dirichlet_rows():
     np.testing.assert_allclose(np.einsum("ij,ij->j", r.modes.conj(), M @ r.modes).real, 1.0,
                                rtol=1e-10)
     # a sub-band with a shift inside it gives the same modes
-    sub = st.solve_modes(petsc_mat(K), petsc_mat(M), f_min=0.2 * f_exact.max(), f_max=f_max,
+    sub = eigen.solve_modes(petsc_mat(K), petsc_mat(M), f_min=0.2 * f_exact.max(), f_max=f_max,
                          target=0.35 * f_exact.max())
     np.testing.assert_allclose(sub.frequency, inband[inband >= 0.2 * f_exact.max()], rtol=1e-8)
 
@@ -141,20 +149,20 @@ def test_proportional_damping_mapping_matches_companion_form_and_pep():
     K, M = K[1:-1, 1:-1], M[1:-1, 1:-1]
     alpha, beta, eta = 30.0, 2e-7, 0.01
     f_max = 0.4 * chain_frequencies(40).max()
-    r = st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=f_max, damping=st.Damping(alpha, beta, eta))
+    r = eigen.solve_modes(petsc_mat(K), petsc_mat(M), f_max=f_max, damping=eigen.Damping(alpha, beta, eta))
     ref = dense_quadratic(K * (1 + 1j * eta), alpha * M + beta * K, M)
     ref = ref[ref.imag / (2 * np.pi) <= f_max]
     np.testing.assert_allclose(r.eigenvalues, ref, rtol=1e-9)
     assert r.growth.max() < 0                       # damping stabilises this weak drift
     # the general quadratic solver (SLEPc PEP) agrees for a damping matrix given as such
     C = alpha * M + beta * K
-    q = st.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_max=f_max, n_modes=len(r) + 4,
+    q = eigen.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_max=f_max, n_modes=len(r) + 4,
                            target=1.0)
     ref = dense_quadratic(K, C, M)
     ref = ref[ref.imag / (2 * np.pi) <= f_max]
     np.testing.assert_allclose(q.eigenvalues, ref, rtol=1e-7)
-    mac = st.mac_matrix(q, st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=f_max,
-                                          damping=st.Damping(alpha, beta)))
+    mac = modal.mac_matrix(q, eigen.solve_modes(petsc_mat(K), petsc_mat(M), f_max=f_max,
+                                          damping=eigen.Damping(alpha, beta)))
     np.testing.assert_allclose(np.diag(mac), 1.0, atol=1e-8)
 
 
@@ -163,11 +171,11 @@ def test_friction_like_drift_couples_chain_modes():
     K, M = chain(n=40, drift=0.0)
     K, M = K[1:-1, 1:-1], M[1:-1, 1:-1]
     f_max = 0.3 * chain_frequencies(40).max()
-    r0 = st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=f_max)
+    r0 = eigen.solve_modes(petsc_mat(K), petsc_mat(M), f_max=f_max)
     assert not r0.unstable().any()
     Kd = K.copy()
     Kd[0, 1] -= 2e6                                   # one-sided follower coupling
-    r1 = st.solve_modes(petsc_mat(Kd), petsc_mat(M), f_max=f_max)
+    r1 = eigen.solve_modes(petsc_mat(Kd), petsc_mat(M), f_max=f_max)
     lam = 1j * np.sqrt(np.linalg.eigvals(np.linalg.solve(M, Kd)).astype(complex))
     lam = np.where(lam.imag < 0, -lam, lam)
     lam = lam[lam.imag / (2 * np.pi) <= f_max]
@@ -177,13 +185,13 @@ def test_friction_like_drift_couples_chain_modes():
 def test_mac_mmac_and_cumulative_average():
     a = np.array([[1, 0], [0, 1], [0, 0]], complex)
     b = np.array([[1, 1], [1j, -1j], [0, 0]], complex) * (2 - 3j)
-    mac = st.mac_matrix(a, b)
+    mac = modal.mac_matrix(a, b)
     np.testing.assert_allclose(mac, [[0.5, 0.5], [0.5, 0.5]], atol=1e-15)
-    np.testing.assert_allclose(st.mac_matrix(b, b), np.eye(2), atol=1e-15)
-    np.testing.assert_allclose(st.mmac([[0.2, 0.9], [0.4, 0.1]]), [0.9, 0.4])
-    np.testing.assert_allclose(st.cumulative_moving_average([1, 0, 0.5, 0.5]), [1, 0.5, 0.5, 0.5])
+    np.testing.assert_allclose(modal.mac_matrix(b, b), np.eye(2), atol=1e-15)
+    np.testing.assert_allclose(modal.mmac([[0.2, 0.9], [0.4, 0.1]]), [0.9, 0.4])
+    np.testing.assert_allclose(modal.cumulative_moving_average([1, 0, 0.5, 0.5]), [1, 0.5, 0.5, 0.5])
     with pytest.raises(InputError, match="modes"):
-        st.mac_matrix(a, b[:2])
+        modal.mac_matrix(a, b[:2])
 
 
 def test_strain_energy_shares_sum_to_modal_stiffness(tmp_path):
@@ -198,8 +206,8 @@ def test_strain_energy_shares_sum_to_modal_stiffness(tmp_path):
                 if 0 <= i < n and 0 <= j < n:
                     target[i, j] += k if i == j else -k
     np.testing.assert_allclose(Ka + Kb, K)
-    r = st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=0.3 * chain_frequencies(n).max())
-    sh = st.strain_energy_shares(r, st.MatrixEnergy({"left": petsc_mat(Ka), "right": petsc_mat(Kb)}))
+    r = eigen.solve_modes(petsc_mat(K), petsc_mat(M), f_max=0.3 * chain_frequencies(n).max())
+    sh = modal.strain_energy_shares(r, modal.MatrixEnergy({"left": petsc_mat(Ka), "right": petsc_mat(Kb)}))
     np.testing.assert_allclose(sh.energy.sum(axis=1), 0.5 * r.theta.real, rtol=1e-9)
     np.testing.assert_allclose(sh.share.sum(axis=1), 1.0, rtol=1e-12)
     np.testing.assert_allclose(sh.split("left", "right"), sh.share[:, 0], rtol=1e-12)
@@ -215,7 +223,7 @@ def test_strain_energy_shares_sum_to_modal_stiffness(tmp_path):
 
 def test_mu_zero_like_symmetric_problem_gives_real_eigenvalues():
     K, M = chain(n=120)
-    r = st.solve_modes(petsc_mat(K), petsc_mat(M), f_max=0.2 * chain_frequencies(120).max(),
+    r = eigen.solve_modes(petsc_mat(K), petsc_mat(M), f_max=0.2 * chain_frequencies(120).max(),
                        n_modes=15)
     assert len(r) == 15 and not r.unstable().any()
     assert np.abs(r.theta.imag).max() <= 1e-8 * np.abs(r.theta).max()

@@ -14,14 +14,13 @@ exact UFL derivative of the law. ``PenaltyLaw`` is the perfect-contact law p_n =
 """
 from __future__ import annotations
 
-from multiscale.macro import _dolfinx  # noqa: F401,I001  (before DOLFINx)
 from typing import Callable
 
 import numpy as np
 import ufl
 from dolfinx import fem
 
-from multiscale.macro.geometry import Rotation, Translation
+from multiscale.geometry import Rotation, Translation
 from multiscale.macro.mesh import FormCache, TwoBodyMesh
 
 PressureLaw = Callable[[ufl.core.expr.Expr], ufl.core.expr.Expr]

@@ -22,7 +22,6 @@ Sign conventions follow ``interface.py``: g_n > 0 open, p_n >= 0 in compression.
 """
 from __future__ import annotations
 
-from multiscale.macro import _dolfinx  # noqa: F401,I001  (before DOLFINx)
 import numpy as np
 import ufl
 from dolfinx import fem

@@ -8,7 +8,6 @@ from rest with load ramping; failures raise ``ConvergenceError`` with the residu
 """
 from __future__ import annotations
 
-from multiscale.macro import _dolfinx  # noqa: F401,I001  (before DOLFINx)
 from dataclasses import dataclass, field
 from typing import Mapping
 
@@ -66,6 +65,14 @@ def body_fields(tm: TwoBodyMesh, materials: Mapping[str, object], attribute, nam
             for body in tm.bodies]
 
 
+def load_face_forces(tm: TwoBodyMesh, load: float, load_kind: str) -> dict:
+    """Resultant [N] of the load on each load face: its area's share of a force ``load`` [N]
+    (``load_kind="force"``), or the (fluid) pressure ``load`` [Pa] times the face area."""
+    area = {f: tm.assemble_scalar(1.0 * tm.ds(tm.face(f))) for f in tm.spec.load_faces}
+    total = sum(area.values())
+    return {f: float(load) * (a / total if load_kind == "force" else a) for f, a in area.items()}
+
+
 class Mechanics:
     """Two-body contact mechanics (see module docstring).
 
@@ -74,15 +81,20 @@ class Mechanics:
     functions on the body submeshes (thermal expansion relative to ``reference_temperature`` [K]).
     ``stiffness`` [Pa/m] (scalar or per-facet array), ``friction``, ``speed`` and ``law`` go to
     ``ContactInterface``. ``load`` is the total force [N] along the spec's load direction on its
-    load faces (``load_kind="force"``) or a traction [Pa] (``load_kind="pressure"``).
+    load faces (``load_kind="force"``), a traction [Pa] along it (``load_kind="pressure"``), or a
+    fluid pressure p [Pa] (``load_kind="fluid"``: traction −p n with n the outward normal, so two
+    faces that look at each other across the fluid, e.g. a brake's piston back and caliper bore,
+    are pushed apart by the same pressure).
     """
+
+    LOAD_KINDS = ("force", "pressure", "fluid")
 
     def __init__(self, tm: TwoBodyMesh, materials: Mapping[str, object], *, stiffness=1e13,
                  friction: float = 0.0, speed: float = 0.0, law: PressureLaw | None = None,
                  velocity=None, temperatures=None, reference_temperature: float = 293.15,
                  load_kind: str = "force", degree: int = 1, prefix: str = "mech_"):
-        if load_kind not in ("force", "pressure"):
-            raise InputError("load_kind", load_kind, "'force' or 'pressure'")
+        if load_kind not in self.LOAD_KINDS:
+            raise InputError("load_kind", load_kind, f"one of {', '.join(self.LOAD_KINDS)}")
         self.tm = tm
         self.spaces = [fem.functionspace(b.mesh, ("Lagrange", degree, (3,))) for b in tm.bodies]
         self.u = [fem.Function(V, name=f"displacement_{b.name}") for V, b in zip(self.spaces, tm.bodies)]
@@ -132,6 +144,8 @@ class Mechanics:
 
     def traction(self):
         """Applied traction on the load faces [Pa]."""
+        if self.load_kind == "fluid":
+            return -self.load * ufl.FacetNormal(self.tm.parent)
         spec = self.tm.spec
         direction = ufl.as_vector(np.asarray(spec.load_direction, float) / np.linalg.norm(spec.load_direction))
         if self.load_kind == "pressure":

@@ -13,9 +13,8 @@ every rank) tells which facet is which.
 """
 from __future__ import annotations
 
-from multiscale.macro import _dolfinx  # noqa: F401,I001  (before DOLFINx)
-import importlib
 from dataclasses import dataclass, field
+from types import ModuleType
 
 import numpy as np
 
@@ -26,18 +25,9 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from multiscale.errors import InputError
-from multiscale.macro.geometry import BodySpec, GeometrySpec
+from multiscale.geometry import BodySpec, GeometrySpec
 
-BUILDERS = {"block_on_flat": "meshes.block_on_flat", "pin_on_disc": "meshes.pin_on_disc",
-            "disc_brake": "meshes.disc_brake"}
 INTERFACE_QUADRATURE = 2      # exact for P1 displacements times P1 tests on a facet
-
-
-def builder(name: str):
-    """The builder module ``meshes.<name>`` (InputError if unknown)."""
-    if name not in BUILDERS:
-        raise InputError("geometry.builder", name, f"one of {', '.join(BUILDERS)}")
-    return importlib.import_module(BUILDERS[name])
 
 
 @dataclass
@@ -81,8 +71,9 @@ class Interface:
     """The contact interface: a facet submesh, its measure and a rank-independent facet ordering.
 
     ``dS`` integrates over all interface tags ("+" = body 0); ``dS_tag[name]`` over one tag.
-    ``midpoints`` (n_facets, 3) and ``areas`` (n_facets,) are global and the same on every rank;
-    ``owned_index`` gives the global index of each owned facet of the submesh.
+    ``midpoints`` (n_facets, 3), ``areas`` (n_facets,) and ``tag_index`` (n_facets,: position of
+    each facet's tag in ``tags``) are global and the same on every rank; ``owned_index`` gives the
+    global index of each owned facet of the submesh.
     """
 
     mesh: dmesh.Mesh
@@ -91,6 +82,8 @@ class Interface:
     measure: ufl.Measure
     midpoints: np.ndarray              # m, global
     owned_index: np.ndarray            # global index of the owned submesh cells 0..n_owned-1
+    tag_index: np.ndarray              # global: index into ``tags`` of every facet
+    plus_regions: dict                 # interface name -> region (cell) tags of body 0 along it
     areas: np.ndarray = field(default=None)   # m^2, global
     _dg0: fem.FunctionSpace = field(default=None, repr=False)
     _dg0_vector: fem.FunctionSpace = field(default=None, repr=False)
@@ -124,6 +117,20 @@ class Interface:
         if self._dg0_vector is None:
             self._dg0_vector = fem.functionspace(self.mesh, ("DG", 0, (3,)))
         return self._dg0_vector
+
+    def masks(self) -> dict:
+        """{interface name: boolean mask over the global facets}."""
+        return {name: self.tag_index == k for k, name in enumerate(self.tags)}
+
+    def box(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper corners (3-vectors) [m] of the vertices of interface ``name`` (collective)."""
+        k = list(self.tags).index(name)
+        owned = self.tag_index[self.owned_index] == k
+        x = self.mesh.geometry.x[self.mesh.geometry.dofmaps[0][:len(self.owned_index)][owned]].reshape(-1, 3)
+        lo, hi = np.empty(3), np.empty(3)
+        self.comm.Allreduce(x.min(axis=0) if len(x) else np.full(3, np.inf), lo, op=MPI.MIN)
+        self.comm.Allreduce(x.max(axis=0) if len(x) else np.full(3, -np.inf), hi, op=MPI.MAX)
+        return lo, hi
 
     def _owned_dofs(self, space=None) -> np.ndarray:
         n = len(self.owned_index)
@@ -248,19 +255,20 @@ class FormCache:
         return self.facet_integrals(key, make) / self.tm.interface.areas
 
 
-def build(builder_name: str, params=None, comm=MPI.COMM_WORLD) -> TwoBodyMesh:
-    """Run a gmsh builder on rank 0 and distribute the mesh (shared-facet ghosting)."""
-    mod = builder(builder_name)
-    spec = mod.describe(params)
+def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD) -> TwoBodyMesh:
+    """Run a gmsh builder (``multiscale.geometry``) on rank 0 and distribute the mesh (shared-facet
+    ghosting)."""
+    spec = builder.describe(params)
+    name = getattr(builder, "NAME", builder.__name__)
     error = None
     if comm.rank == 0:
         import gmsh
         gmsh.initialize(interruptible=False)
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.model.add(builder_name)
+        gmsh.model.add(name)
         try:
-            mod.generate(gmsh.model, params)
+            builder.generate(gmsh.model, params)
         except Exception as exc:  # re-raised on every rank below
             error = exc
     failed = comm.bcast(repr(error) if error is not None else None, root=0)
@@ -268,7 +276,7 @@ def build(builder_name: str, params=None, comm=MPI.COMM_WORLD) -> TwoBodyMesh:
         if failed:
             if error is not None:
                 raise error
-            raise RuntimeError(f"mesh builder {builder_name!r} failed on rank 0: {failed}")
+            raise RuntimeError(f"mesh builder {name!r} failed on rank 0: {failed}")
         partitioner = dmesh.create_cell_partitioner(dolfinx.graph.partitioner(),
                                                     dmesh.GhostMode.shared_facet, 2)
         model = gmsh.model if comm.rank == 0 else None
@@ -286,7 +294,7 @@ def from_mesh(spec: GeometrySpec, parent: dmesh.Mesh, cell_tags: dmesh.MeshTags,
     parent.topology.create_connectivity(tdim - 1, tdim)
     parent.topology.create_connectivity(tdim, tdim - 1)
     bodies = tuple(_body(parent, cell_tags, facet_tags, b) for b in spec.bodies)
-    interface = _interface(parent, facet_tags, spec, bodies)
+    interface = _interface(parent, cell_tags, facet_tags, spec, bodies)
     tm = TwoBodyMesh(spec, parent, cell_tags, facet_tags, bodies, interface)
     interface.areas = FormCache(tm).facet_integrals(None, lambda: ufl.as_ufl(1.0))
     return tm
@@ -306,21 +314,28 @@ def _body(parent, cell_tags, facet_tags, spec: BodySpec) -> Body:
     return Body(spec, sub, cell_map, vertex_map, tags, tag_of[parent_cells])
 
 
-def _interface(parent, facet_tags, spec: GeometrySpec, bodies) -> Interface:
+def _interface(parent, cell_tags, facet_tags, spec: GeometrySpec, bodies) -> Interface:
     tdim = parent.topology.dim
     comm = parent.comm
     facets = {name: facet_tags.find(tag) for name, tag in spec.interfaces.items()}
     all_facets = np.unique(np.concatenate(list(facets.values()))).astype(np.int32)
     sub, facet_map, _, _ = dmesh.create_submesh(parent, tdim - 1, all_facets)
-    data = []
-    for name, tag in spec.interfaces.items():
+    data, plus = [], {}
+    n_owned = sub.topology.index_map(tdim - 1).size_local
+    tag_of_cell = np.full(n_owned, -1)
+    region_of = np.full(parent.topology.index_map(tdim).size_local + parent.topology.index_map(tdim).num_ghosts, -1)
+    region_of[cell_tags.indices] = cell_tags.values
+    for k, (name, tag) in enumerate(spec.interfaces.items()):
+        cells = facet_map.sub_topology_to_topology(facets[name].astype(np.int32), inverse=True)
+        cells = cells[(cells >= 0) & (cells < n_owned)]
+        tag_of_cell[cells] = k
         rows = fem.compute_integration_domains(fem.IntegralType.interior_facet, parent.topology,
                                                facets[name].astype(np.int32))
-        rows = np.asarray(rows, dtype=np.int32).reshape(-1, 4)
-        data.append((tag, _orient(rows, bodies, name).ravel()))
+        rows = _orient(np.asarray(rows, dtype=np.int32).reshape(-1, 4), bodies, name)
+        data.append((tag, rows.ravel()))
+        plus[name] = tuple(sorted(set().union(*comm.allgather(set(region_of[rows[:, 0]].tolist())))))
     measure = ufl.Measure("dS", domain=parent, subdomain_data=data,
                           metadata={"quadrature_degree": INTERFACE_QUADRATURE})
-    n_owned = sub.topology.index_map(tdim - 1).size_local
     mid_local = dmesh.compute_midpoints(sub, tdim - 1, np.arange(n_owned, dtype=np.int32))
     midpoints = np.concatenate(comm.allgather(mid_local)).reshape(-1, 3)
     counts = comm.allgather(n_owned)
@@ -330,7 +345,9 @@ def _interface(parent, facet_tags, spec: GeometrySpec, bodies) -> Interface:
     rank_of_sorted[order] = np.arange(len(order))
     start = int(np.sum(counts[:comm.rank]))
     owned_index = rank_of_sorted[start:start + n_owned]
-    return Interface(sub, facet_map, dict(spec.interfaces), measure, midpoints[order], owned_index)
+    tag_index = np.empty(len(order), dtype=int)
+    tag_index[np.concatenate(comm.allgather(owned_index))] = np.concatenate(comm.allgather(tag_of_cell))
+    return Interface(sub, facet_map, dict(spec.interfaces), measure, midpoints[order], owned_index, tag_index, plus)
 
 
 def _orient(rows: np.ndarray, bodies, name: str) -> np.ndarray:

@@ -10,7 +10,6 @@ equals the frictional energy dissipated.
 """
 from __future__ import annotations
 
-from multiscale.macro import _dolfinx  # noqa: F401,I001  (before DOLFINx)
 from dataclasses import dataclass
 from typing import Mapping
 
@@ -18,9 +17,10 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc as fpetsc
+from mpi4py import MPI
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
-from multiscale.macro.geometry import Rotation
+from multiscale.geometry import Rotation
 from multiscale.macro.interface import ContactInterface, rigid_velocity
 from multiscale.macro.mechanics import body_fields
 from multiscale.macro.mesh import FormCache
@@ -117,7 +117,7 @@ class Thermal:
     def max_temperature(self) -> tuple:
         """Largest nodal temperature of each body [K]."""
         comm = self.tm.comm
-        return tuple(comm.allreduce(T.x.array.max(initial=-np.inf), op=_max()) for T in self.T)
+        return tuple(comm.allreduce(T.x.array.max(initial=-np.inf), op=MPI.MAX) for T in self.T)
 
     def stored_heat(self) -> tuple:
         """Heat stored in each body since the start, integral of rho c (T − T_0) [J]."""
@@ -130,8 +130,3 @@ class Thermal:
         """Mean temperature per interface facet [K] of body 0 ("+") or body 1 ("−")."""
         T = self.T[0]("+") if side == 0 else self.T[1]("-")
         return self.cache.facet_mean(("T", side), lambda: T)
-
-
-def _max():
-    from mpi4py import MPI
-    return MPI.MAX

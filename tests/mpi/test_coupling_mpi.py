@@ -10,7 +10,7 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from mpi4py import MPI  # noqa: E402
 
-from multiscale.coupling import run  # noqa: E402
+from multiscale.workflows.multiscale import run  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))

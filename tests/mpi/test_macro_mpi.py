@@ -8,7 +8,7 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from mpi4py import MPI  # noqa: E402
 
-from multiscale.macro.runner import run  # noqa: E402
+from multiscale.workflows import run  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 
 # materials, loading and time shared by the pin-on-disc test scenes

@@ -8,8 +8,11 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from mpi4py import MPI  # noqa: E402
 
+from multiscale.geometry import builder  # noqa: E402
 from multiscale.macro import mesh as two_body  # noqa: E402
-from multiscale.macro import stability as st  # noqa: E402
+from multiscale.macro import modal  # noqa: E402
+from multiscale.macro.mechanics import Mechanics  # noqa: E402
+from multiscale.workflows.squeal import squeal_case  # noqa: E402
 
 STEEL = NS(E=210e9, nu=0.3, rho=7850.0)
 MATERIALS = {"disc": NS(E=125e9, nu=0.25, rho=7200.0), "pad": NS(E=5e9, nu=0.25, rho=2500.0),
@@ -17,9 +20,9 @@ MATERIALS = {"disc": NS(E=125e9, nu=0.25, rho=7200.0), "pad": NS(E=5e9, nu=0.25,
 
 
 def case(comm, prefix):
-    tm = two_body.build("disc_brake", {"mesh_size": 0.02}, comm)
-    mech = st.HydraulicMechanics(tm, MATERIALS, stiffness=1e13, friction=0.4, speed=5.0, prefix=prefix)
-    return st.squeal_case(mech, MATERIALS, "mpi", pressure=1e6, n_modes=20)
+    tm = two_body.build(builder("disc_brake"), {"mesh_size": 0.02}, comm)
+    mech = Mechanics(tm, MATERIALS, stiffness=1e13, friction=0.4, speed=5.0, load_kind="fluid", prefix=prefix)
+    return squeal_case(mech, MATERIALS, "mpi", load=1e6, n_modes=20)
 
 
 def test_two_ranks_reproduce_the_serial_squeal_analysis():
@@ -32,7 +35,7 @@ def test_two_ranks_reproduce_the_serial_squeal_analysis():
     np.testing.assert_allclose(got["forces"], ref["forces"], rtol=1e-10)
     np.testing.assert_allclose(got["energy"], ref["energy"], atol=1e-6)
     assert got["unstable"] == ref["unstable"]
-    np.testing.assert_allclose(np.diag(st.mac_matrix(par.modes, par.modes)), 1.0, rtol=1e-12)
+    np.testing.assert_allclose(np.diag(modal.mac_matrix(par.modes, par.modes)), 1.0, rtol=1e-12)
 
 
 def _summary(c):

@@ -1,28 +1,51 @@
-"""Figures of a multiscale run (thesis ch. 7): the history at both scales and the wear map.
+"""Figures of a run's history (``history.h5``): the macro quantities, both scales of the multiscale
+loop (thesis ch. 7) and the wear map.
 
-``history_figure``: max contact pressure macro (facets, zones) vs micro (Fig. 7.14; log scale), max temperature macro vs micro
-(Fig. 7.15), heat partition min/mean/max (Fig. 7.12), wear volume (Fig. 7.16), max wear depth
-(Fig. 7.17) and RMS of the worn surface (Fig. 7.18) — the panels whose columns the history has.
-``wear_map``: the mean wear depth of every zone over the interface (Fig. 7.13) beside the micro
-wear depth field of the whole face.
+``history_figure``: interface force, max contact pressure, max temperatures and heat into each body
+against time. ``multiscale_figure``: max contact pressure macro (facets, zones) vs micro (Fig. 7.14;
+log scale), max temperature macro vs micro (Fig. 7.15), heat partition min/mean/max (Fig. 7.12),
+wear volume (Fig. 7.16), max wear depth (Fig. 7.17) and RMS of the worn surface (Fig. 7.18) — the
+panels whose columns the history has. ``wear_map``: the mean wear depth of every zone over the
+interface (Fig. 7.13) beside the micro wear depth field of the whole face.
 """
 from __future__ import annotations
 
 from pathlib import Path
 
 import numpy as np
-
-
-def _pyplot():
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    return plt
+from matplotlib.figure import Figure
 
 
 def history_figure(history, path: Path, title: str = "") -> Path:
-    """PNG of the multiscale history columns (see module docstring)."""
-    plt = _pyplot()
+    """PNG of the history: force, max pressure, max temperatures, heat per body vs time."""
+    t = history["time"]
+    groups = [("interface force [N]", ["interface_force"], 1.0, 0.0),
+              ("max contact pressure [MPa]", ["max_pressure"], 1e-6, 0.0),
+              ("max temperature [°C]", [k for k in history.columns if k.startswith("max_temperature")], 1.0, -273.15),
+              ("heat into body [J]", [k for k in history.columns if k.startswith("heat_total")], 1.0, 0.0)]
+    groups = [g for g in groups if g[1] and all(k in history.columns for k in g[1])]
+    fig = Figure(figsize=(4.2 * len(groups), 3.4))
+    axes = fig.subplots(1, len(groups), squeeze=False)
+    for ax, (label, keys, scale, shift) in zip(axes[0], groups):
+        for key in keys:
+            ax.plot(t, history[key] * scale + shift, "o-", ms=3, label=key.split("_")[-1] if len(keys) > 1 else None)
+        ax.set_xlabel("time [s]")
+        ax.set_ylabel(label)
+        ax.grid(alpha=0.3)
+        values = np.concatenate([history[k] * scale + shift for k in keys])
+        if np.ptp(values) <= 1e-6 * np.abs(values).max(initial=0.0):     # constant to round-off
+            centre = values.mean()
+            ax.set_ylim(centre - 0.05 * abs(centre) - 1e-30, centre + 0.05 * abs(centre) + 1e-30)
+        if len(keys) > 1:
+            ax.legend()
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    return path
+
+
+def multiscale_figure(history, path: Path, title: str = "") -> Path:
+    """PNG of the multiscale history columns at both scales (see module docstring)."""
     cols = history.columns
     hot = [k for k in cols if k.startswith("max_temperature")]
     panels = [("max contact pressure [MPa]", [("max_pressure", "macro facet"), ("max_zone_pressure", "macro zone"),
@@ -38,7 +61,8 @@ def history_figure(history, path: Path, title: str = "") -> Path:
     panels = [p for p in panels if p[1]]
     ncol = min(3, len(panels))
     nrow = -(-len(panels) // ncol)
-    fig, axes = plt.subplots(nrow, ncol, figsize=(4.3 * ncol, 3.3 * nrow), squeeze=False)
+    fig = Figure(figsize=(4.3 * ncol, 3.3 * nrow))
+    axes = fig.subplots(nrow, ncol, squeeze=False)
     t = history["time"]
     for ax, (label, keys, scale, shift) in zip(axes.ravel(), panels):
         for key, name in keys:
@@ -57,20 +81,19 @@ def history_figure(history, path: Path, title: str = "") -> Path:
     fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path
 
 
 def wear_map(grid, depth: np.ndarray, path: Path, title: str = "") -> Path:
     """PNG of the zone-mean wear depth (zone grid) and of the micro wear depth field [µm]."""
-    plt = _pyplot()
     nx, ny = grid.counts
     _, my, mx = depth.shape
     x0, y0 = grid.origin
     extent = [1e3 * x0, 1e3 * (x0 + nx * grid.size[0]), 1e3 * y0, 1e3 * (y0 + ny * grid.size[1])]
     zone_mean = depth.mean(axis=(-2, -1)).reshape(ny, nx)
     field = depth.reshape(ny, nx, my, mx).transpose(0, 2, 1, 3).reshape(ny * my, nx * mx)
-    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
+    fig = Figure(figsize=(10, 4.2))
+    axes = fig.subplots(1, 2)
     for ax, data, label in ((axes[0], zone_mean, "mean wear depth per zone [µm]"),
                             (axes[1], field, "micro wear depth [µm]")):
         im = ax.imshow(1e6 * data, origin="lower", extent=extent, cmap="inferno", interpolation="nearest")
@@ -80,5 +103,4 @@ def wear_map(grid, depth: np.ndarray, path: Path, title: str = "") -> Path:
     fig.suptitle(title)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
-    plt.close(fig)
     return path

@@ -1,10 +1,15 @@
-"""What a mesh builder tells the macro model: bodies, material regions, tagged faces, motion.
+"""What a mesh builder tells the macro model (bodies, material regions, tagged faces, motion), and
+the registry of builders.
 
-A builder in ``meshes/`` (``block_on_flat``, ``pin_on_disc``, ``disc_brake``) provides
-``DEFAULTS`` (its parameters in SI units), ``describe(params) -> GeometrySpec`` (pure Python:
-tags, bodies, supports) and ``generate(model, params)`` (builds and meshes the gmsh model on one
-rank). This module holds the spec dataclasses and small gmsh helpers; it imports neither DOLFINx
-nor gmsh at module level, so scenes and builders can use it without them.
+A builder (the modules of ``meshes/``: ``block_on_flat``, ``pin_on_disc``, ``disc_brake``, or a
+user's own) is a module providing ``DEFAULTS`` (its parameters in SI units), optionally
+``PARAMETER_KINDS`` (unit kind of a parameter, default "length", or "angle" when the name says so),
+``parameters(params) -> dict`` (defaults updated and checked), ``describe(params) ->
+GeometrySpec`` (pure Python: tags, bodies, supports) and ``generate(model, params)`` (builds and
+meshes the gmsh model on one rank). Builders are found by name in the ``multiscale.builders``
+entry-point group (``pyproject.toml``: the registry is package metadata, so a scene never imports
+``meshes`` and a user's package can add builders). This module holds the spec dataclasses, the
+registry lookup and small gmsh helpers; it imports neither DOLFINx nor gmsh.
 
 Conventions: body 0 is the "+" side of the interface (the stationary body: pin, pads, block),
 body 1 the "−" side (the sliding body: disc, flat). The interface normal n points from body 1
@@ -13,6 +18,9 @@ into body 0; the gap g_n = g_0 + (u_0 − u_1)·n is positive when open (thesis 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from importlib import import_module
+from importlib.metadata import entry_points
+from types import ModuleType
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -67,7 +75,8 @@ class GeometrySpec:
     ``bodies[0]`` is the "+" (stationary) side, ``bodies[1]`` the "−" (sliding) side.
     ``interfaces`` maps interface names to facet tags (all between body 0 and body 1);
     ``faces`` maps named boundary faces to facet tags; the normal load acts on ``load_faces``
-    as a uniform traction along ``load_direction`` whose resultant is the scene's normal force.
+    as a uniform traction along ``load_direction`` whose resultant is the scene's normal force,
+    or, with ``fluid_load``, as a fluid pressure p: traction −p n on every load face (n outward).
     """
 
     bodies: tuple[BodySpec, BodySpec]
@@ -78,12 +87,29 @@ class GeometrySpec:
     load_direction: tuple[float, float, float] = (0.0, 0.0, -1.0)
     motion: Rotation | Translation = field(default_factory=Rotation)
     length_scale: float = 1.0          # m, a typical size (tolerances for facet keys)
+    fluid_load: bool = False           # load faces loaded by a fluid pressure (−p n)
 
     @property
     def materials(self) -> tuple[str, ...]:
         """Names of the material tables the geometry needs, in first-use order."""
         names = [r.material for b in self.bodies for r in b.regions]
         return tuple(dict.fromkeys(names))
+
+
+BUILDER_GROUP = "multiscale.builders"
+
+
+def builder_names() -> tuple[str, ...]:
+    """Names of the registered mesh builders (entry-point group ``multiscale.builders``)."""
+    return tuple(sorted(ep.name for ep in entry_points(group=BUILDER_GROUP)))
+
+
+def builder(name: str) -> ModuleType:
+    """The builder module registered as ``name`` (InputError naming the known builders)."""
+    found = [ep for ep in entry_points(group=BUILDER_GROUP) if ep.name == name]
+    if not found:
+        raise InputError("geometry.builder", name, f"one of {', '.join(builder_names())}")
+    return import_module(found[0].value)
 
 
 def resolve_parameters(defaults: Mapping[str, object], params: Mapping[str, object] | None,

@@ -1,0 +1,377 @@
+"""Complex eigenvalues of a linearised sliding system with SLEPc (thesis §4.3.1).
+
+Linearised about a steady sliding state, the free vibrations obey ``M u'' + C u' + K u = 0`` with
+``K`` the tangent stiffness, non-symmetric because of the friction forces (§4.3.1). With
+``u = phi exp(lambda t)`` the undamped problem is the generalised non-Hermitian eigenproblem (GNHEP)
+
+    K phi = theta M phi,        lambda = sigma + i omega = i sqrt(theta)   (omega >= 0),
+
+solved by shift-and-invert about ``theta_t = (2 pi f_t)^2`` (``solve_modes``). A real ``theta``
+gives a neutrally stable mode; two modes that coalesce ("lock in") become a conjugate pair theta,
+conj(theta): one mode with sigma > 0 (unstable, growth rate [1/s]) and one with sigma < 0, at the
+same frequency. Damping proportional to the operators (``Damping``: Rayleigh alpha, beta;
+structural loss factor eta) keeps the eigenvectors and maps each theta exactly to lambda; a general
+damping matrix needs the quadratic eigenproblem (SLEPc PEP, ``solve_quadratic``).
+``onset_of_instability`` bisects the friction coefficient at which a mode first goes unstable.
+
+Vectors are kept as the rank-owned part of the PETSc layout (complex numpy arrays); inner products
+are reduced over the matrix communicator (``reduce_sum``). Sign conventions: sigma > 0 is growth
+(unstable), frequency = omega / (2 pi) [Hz] >= 0, modes are numbered from 1 in order of increasing
+frequency (ties: increasing sigma).
+"""
+from __future__ import annotations
+
+import csv
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable
+
+import numpy as np
+from petsc4py import PETSc
+from slepc4py import SLEPc
+
+from multiscale.errors import ConvergenceError, InputError, check_positive
+
+TWO_PI = 2.0 * math.pi
+
+
+@dataclass
+class ModalResult:
+    """Complex modes of a linearised system, sorted by frequency.
+
+    ``modes[:, j]`` is mode j (rank-owned entries of the PETSc layout), normalised to
+    ``phi^H M phi = 1`` with the phase that makes ``phi^T phi`` real positive.
+    """
+
+    eigenvalues: np.ndarray     # lambda = sigma + i omega [1/s], omega >= 0
+    theta: np.ndarray           # eigenvalue of K phi = theta M phi [1/s^2] (= -lambda^2 undamped)
+    modes: np.ndarray           # complex (n_owned, n_modes) [m per unit modal mass^(1/2)]
+    errors: np.ndarray          # SLEPc relative residual of each pair [-]
+    band: tuple[float, float]   # requested band (f_min, f_max) [Hz]
+    target: float               # shift-and-invert target frequency [Hz]
+    n_dofs: int                 # global problem size
+    method: str                 # "gnhep" or "pep"
+    iterations: int             # outer iterations of the last SLEPc solve
+    solves: int                 # SLEPc solves (the band search may enlarge the subspace)
+    time: float                 # wall time [s]
+    comm: object = field(default=None, repr=False)   # mpi4py communicator of the modes (None: serial)
+
+    @property
+    def frequency(self) -> np.ndarray:
+        """omega / 2 pi [Hz]."""
+        return self.eigenvalues.imag / TWO_PI
+
+    @property
+    def growth(self) -> np.ndarray:
+        """sigma = Re(lambda) [1/s]; > 0 means unstable."""
+        return self.eigenvalues.real
+
+    @property
+    def damping_ratio(self) -> np.ndarray:
+        """-sigma / |lambda| [-] (negative for an unstable mode)."""
+        return -self.eigenvalues.real / np.maximum(np.abs(self.eigenvalues), np.finfo(float).tiny)
+
+    def unstable(self, rtol: float = 1e-6) -> np.ndarray:
+        """Boolean mask of modes with sigma > rtol |lambda| (round-off guard, default 1e-6)."""
+        return self.eigenvalues.real > rtol * np.abs(self.eigenvalues)
+
+    def __len__(self) -> int:
+        return self.eigenvalues.size
+
+    def write_csv(self, path: str | Path, rtol: float = 1e-6) -> Path:
+        """Mode table: number, frequency [Hz], sigma [1/s], damping ratio, unstable flag, residual."""
+        path = Path(path)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        with path.open("w", newline="") as f:
+            w = csv.writer(f)
+            w.writerow(["mode", "frequency_Hz", "sigma_1_per_s", "damping_ratio", "unstable", "residual"])
+            for j, (fr, s, z, u, e) in enumerate(zip(self.frequency, self.growth, self.damping_ratio,
+                                                     self.unstable(rtol), self.errors), start=1):
+                w.writerow([j, f"{fr:.6f}", f"{s:.6e}", f"{z:.6e}", int(u), f"{e:.2e}"])
+        return path
+
+
+@dataclass(frozen=True)
+class Damping:
+    """Damping proportional to the operators: C = alpha M + beta K, and K -> K (1 + i eta).
+
+    Each GNHEP eigenvalue theta maps exactly (same eigenvector) to the root with omega >= 0 of
+    lambda^2 + (alpha + beta theta) lambda + theta (1 + i eta) = 0.
+    """
+
+    alpha: float = 0.0   # mass-proportional coefficient [1/s]
+    beta: float = 0.0    # stiffness-proportional coefficient [s]
+    eta: float = 0.0     # structural (hysteretic) loss factor [-]
+
+    def __post_init__(self):
+        for name in ("alpha", "beta", "eta"):
+            check_positive(f"damping.{name}", getattr(self, name), allow_zero=True)
+
+
+
+def lambda_from_theta(theta, damping: Damping | None = None) -> np.ndarray:
+    """Map eigenvalues theta of K phi = theta M phi to lambda = sigma + i omega (omega >= 0).
+
+    Undamped: lambda = i sqrt(theta). With ``damping``: the root of
+    lambda^2 + (alpha + beta theta) lambda + theta (1 + i eta) = 0 with the larger imaginary part
+    (ties, i.e. real roots from a negative theta, take the larger real part: divergence is unstable).
+    """
+    theta = np.asarray(theta, dtype=complex)
+    d = damping or Damping()
+    b = d.alpha + d.beta * theta
+    disc = np.sqrt(b * b - 4.0 * theta * (1.0 + 1j * d.eta))
+    r1, r2 = (-b + disc) / 2.0, (-b - disc) / 2.0
+    take1 = (r1.imag > r2.imag) | ((r1.imag == r2.imag) & (r1.real >= r2.real))
+    return np.where(take1, r1, r2)
+
+
+def _check_band(f_min, f_max, target, n_modes):
+    f_min = check_positive("f_min", f_min, allow_zero=True)
+    f_max = check_positive("f_max", f_max)
+    if f_max <= f_min:
+        raise InputError("f_max", f_max, f"must exceed f_min = {f_min} Hz")
+    if target is None:
+        target = f_min
+    try:
+        target = float(target)
+    except (TypeError, ValueError):
+        raise InputError("target", target, "must be a frequency in Hz >= 0") from None
+    if not (target >= 0 and math.isfinite(target)):
+        raise InputError("target", target, "must be a finite frequency in Hz >= 0 (a shift below "
+                         "the spectrum is not a frequency)")
+    if n_modes is not None and (int(n_modes) != n_modes or n_modes < 1):
+        raise InputError("n_modes", n_modes, "must be a positive integer")
+    return f_min, f_max, target
+
+
+def _direct_solver(st):
+    st.setType(SLEPc.ST.Type.SINVERT)
+    ksp = st.getKSP()
+    ksp.setType(PETSc.KSP.Type.PREONLY)
+    pc = ksp.getPC()
+    pc.setType(PETSc.PC.Type.LU)
+    if PETSc.Sys.hasExternalPackage("mumps"):
+        pc.setFactorSolverType("mumps")
+
+
+def _pairs(solver, i, vr, vi):
+    val = solver.getEigenpair(i, vr, vi)
+    return complex(val), vr.getArray() + 1j * vi.getArray()
+
+
+def _normalise(phi: np.ndarray, M, comm) -> np.ndarray:
+    """Scale columns to phi^H M phi = 1 and rotate so that phi^T phi is real positive."""
+    mphi = mat_apply(M, phi)
+    gram = np.array([np.vdot(phi[:, j], mphi[:, j]).real for j in range(phi.shape[1])])
+    sq = np.einsum("ij,ij->j", phi, phi)
+    gram, sq = reduce_sum(np.concatenate([gram, sq]), comm).reshape(2, -1)
+    scale = np.exp(-0.5j * np.angle(sq)) / np.sqrt(np.maximum(gram.real, np.finfo(float).tiny))
+    return phi * scale
+
+
+def reduce_sum(a: np.ndarray, comm) -> np.ndarray:
+    return a if comm is None else comm.allreduce(a)
+
+
+def matrix_comm(A):
+    """None in serial; otherwise a duplicate of the matrix communicator (it outlives the matrix)."""
+    comm = A.getComm().tompi4py()
+    return None if comm.size == 1 else comm.Dup()
+
+
+def mat_apply(A, phi: np.ndarray) -> np.ndarray:
+    """A @ phi for a real PETSc matrix and complex columns of owned entries."""
+    x, y = A.createVecs()
+    out = np.empty_like(phi)
+    for j in range(phi.shape[1]):
+        parts = []
+        for part in (phi[:, j].real, phi[:, j].imag):
+            x.setArray(np.ascontiguousarray(part))
+            A.mult(x, y)
+            parts.append(y.getArray().copy())
+        out[:, j] = parts[0] + 1j * parts[1]
+    x.destroy(), y.destroy()
+    return out
+
+
+def _sorted(lam, theta, vecs, errs, band, seen_f):
+    """Modes sorted by frequency then growth; none (an empty band) is an InputError.
+
+    ``seen_f`` are the frequencies [Hz] of every converged eigenvalue (for the message).
+    """
+    if lam.size == 0:
+        hint = (f"nearest found: {seen_f[np.argmin(np.minimum(abs(seen_f - band[0]), abs(seen_f - band[1])))]:.6g} Hz"
+                if seen_f.size else "none found")
+        raise InputError("f_max", band, f"no eigenvalue in this frequency band [Hz]; widen it ({hint})")
+    order = np.lexsort((lam.real, lam.imag))
+    return lam[order], theta[order], vecs[:, order], errs[order]
+
+
+def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int | None = None,
+                target: float | None = None, damping: Damping | None = None, tol: float = 1e-10,
+                max_it: int = 300, nev: int = 20, options_prefix: str = "stability_") -> ModalResult:
+    """Modes with f_min <= f <= f_max [Hz] of K phi = theta M phi (GNHEP, shift-and-invert, §4.3.1).
+
+    ``K`` (tangent, may be non-symmetric) and ``M`` (mass, diag 0 on Dirichlet rows so that the
+    constrained modes go to infinity) are assembled PETSc matrices. The shift is
+    theta_t = (2 pi target)^2 (default target = f_min); K - theta_t M must be non-singular, so a
+    free-free structure needs target > 0. Eigenvalues converge in order of |theta - theta_t|; the
+    subspace grows (from ``nev``) until every theta with |theta - theta_t| <= max((2 pi f_max)^2 -
+    theta_t, theta_t - (2 pi f_min)^2) is converged, i.e. the band is complete for modes with
+    |sigma| << omega, or until ``n_modes`` band modes nearest the target are found (a cap; the
+    conjugate partner of the last one is kept with it). Raises InputError for a bad request or an
+    empty band, ConvergenceError if SLEPc does not converge.
+    """
+    f_min, f_max, target = _check_band(f_min, f_max, target, n_modes)
+    t0 = time.perf_counter()
+    comm = matrix_comm(K)
+    n = K.getSize()[0]
+    shift = (TWO_PI * target) ** 2
+    radius = max((TWO_PI * f_max) ** 2 - shift, shift - (TWO_PI * f_min) ** 2)
+    if n_modes is not None and n_modes > n:
+        raise InputError("n_modes", n_modes, f"must not exceed the number of dofs ({n})")
+    want = min(max(int(nev), int(n_modes or 0)), n)
+
+    eps = SLEPc.EPS().create(K.getComm())
+    eps.setOperators(K, M)
+    eps.setProblemType(SLEPc.EPS.ProblemType.GNHEP)
+    eps.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
+    eps.setTarget(shift)
+    eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
+    eps.setTolerances(tol, max_it)
+    _direct_solver(eps.getST())
+    eps.setOptionsPrefix(options_prefix)
+    eps.setFromOptions()
+    solves = 0
+    while True:
+        eps.setDimensions(want, PETSc.DECIDE)
+        try:
+            eps.solve()
+        except PETSc.Error as exc:
+            raise InputError("target", target, f"K - (2 pi target)^2 M could not be factorised "
+                             f"(singular at this shift? choose a target > 0 away from an eigenvalue): "
+                             f"{exc}") from None
+        solves += 1
+        nconv = eps.getConverged()
+        if nconv < want:
+            raise ConvergenceError(f"SLEPc converged {nconv} of {want} eigenpairs "
+                                   f"(reason {eps.getConvergedReason()})",
+                                   history=[eps.getIterationNumber()])
+        theta = np.array([eps.getEigenvalue(i) for i in range(nconv)], dtype=complex)
+        order = np.argsort(np.abs(theta - shift), kind="stable")[:want]   # complete up to 'reached'
+        reached = abs(theta[order[-1]] - shift)
+        f = lambda_from_theta(theta[order]).imag / TWO_PI
+        inband = order[(f >= f_min) & (f <= f_max)]
+        if n_modes is not None and inband.size >= n_modes:
+            keep = inband[:n_modes]
+            partner = inband[n_modes:n_modes + 1]
+            if partner.size and np.isclose(theta[partner[0]], theta[keep[-1]].conjugate(), rtol=1e-10):
+                keep = inband[:n_modes + 1]
+            break
+        if reached > radius or want >= n:
+            keep = inband
+            break
+        # Weyl: the count of theta below R grows like R^(3/2) in 3D; aim 20 % beyond the band.
+        grow = (1.2 * radius / max(reached, 1e-300)) ** 1.5
+        if n_modes is not None and inband.size:
+            grow = min(grow, 1.2 * n_modes / inband.size)
+        want = min(n, max(want + 10, int(math.ceil(want * min(grow, 8.0)))))
+
+    vr, vi = K.createVecs()
+    vecs = np.empty((vr.getLocalSize(), keep.size), dtype=complex)
+    errs = np.empty(keep.size)
+    vals = np.empty(keep.size, dtype=complex)
+    for j, i in enumerate(keep):
+        vals[j], vecs[:, j] = _pairs(eps, int(i), vr, vi)
+        errs[j] = eps.computeError(int(i), SLEPc.EPS.ErrorType.RELATIVE)
+    iterations = eps.getIterationNumber()
+    eps.destroy(), vr.destroy(), vi.destroy()
+
+    lam = lambda_from_theta(vals, damping)
+    lam, vals, vecs, errs = _sorted(lam, vals, vecs, errs, (f_min, f_max),
+                                    lambda_from_theta(theta).imag / TWO_PI)
+    return ModalResult(lam, vals, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
+                       "gnhep", iterations, solves, time.perf_counter() - t0, comm)
+
+
+def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int = 20,
+                    target: float = 0.0, tol: float = 1e-10, max_it: int = 300,
+                    options_prefix: str = "stability_pep_") -> ModalResult:
+    """Damped modes of (lambda^2 M + lambda C + K) phi = 0 with a general damping matrix C (SLEPc PEP).
+
+    Real arithmetic cannot shift at i omega; the shift is the real rate s = 2 pi target [1/s]
+    (K + s C + s^2 M is non-singular for s > 0 even for a free-free structure) and eigenvalues
+    converge in order of |lambda - s|, i.e. by frequency for light damping. ``n_modes`` counts
+    modes with omega >= 0 (conjugate pairs are computed together); the result is filtered to the
+    band. ``theta`` is reported as -lambda^2.
+    """
+    f_min, f_max, target = _check_band(f_min, f_max, target, n_modes)
+    t0 = time.perf_counter()
+    comm = matrix_comm(K)
+    n = K.getSize()[0]
+    pep = SLEPc.PEP().create(K.getComm())
+    pep.setOperators([K, C, M])
+    pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
+    pep.setType(SLEPc.PEP.Type.TOAR)
+    pep.setTarget(TWO_PI * target)
+    pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
+    pep.setTolerances(tol, max_it)
+    pep.setDimensions(min(2 * int(n_modes), 2 * n), PETSc.DECIDE)
+    _direct_solver(pep.getST())
+    pep.setOptionsPrefix(options_prefix)
+    pep.setFromOptions()
+    try:
+        pep.solve()
+    except PETSc.Error as exc:
+        raise InputError("target", target, f"K + s C + s^2 M could not be factorised: {exc}") from None
+    nconv = pep.getConverged()
+    if nconv < min(2 * int(n_modes), 2 * n):
+        raise ConvergenceError(f"SLEPc PEP converged {nconv} of {2 * n_modes} eigenpairs",
+                               history=[pep.getIterationNumber()])
+    vr, vi = K.createVecs()
+    lam, vecs, errs = [], [], []
+    for i in range(nconv):
+        val, v = _pairs(pep, i, vr, vi)
+        if val.imag < 0:
+            continue  # the conjugate partner of a kept mode
+        lam.append(val)
+        vecs.append(v)
+        errs.append(pep.computeError(i, SLEPc.PEP.ErrorType.BACKWARD))
+    iterations = pep.getIterationNumber()
+    pep.destroy(), vr.destroy(), vi.destroy()
+    lam = np.array(lam, dtype=complex)
+    vecs = np.column_stack(vecs) if vecs else np.empty((K.getLocalSize()[0], 0), complex)
+    errs = np.array(errs)
+    seen = lam.imag / TWO_PI
+    inband = (seen >= f_min) & (seen <= f_max)
+    lam, theta, vecs, errs = _sorted(lam[inband], -lam[inband] ** 2, vecs[:, inband], errs[inband],
+                                     (f_min, f_max), seen)
+    return ModalResult(lam, theta, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
+                       "pep", iterations, 1, time.perf_counter() - t0, comm)
+
+
+def onset_of_instability(build: Callable[[float], tuple], mu_lo: float, mu_hi: float, *,
+                         xtol: float = 1e-9, rtol: float = 1e-6, **solve_kw) -> float:
+    """Smallest friction coefficient in [mu_lo, mu_hi] with an unstable mode, by bisection.
+
+    ``build(mu) -> (K, M)``; ``solve_kw`` go to ``solve_modes``. Stable at mu_lo and unstable at
+    mu_hi are required (InputError otherwise). Returns the onset mu [-] within ``xtol``.
+    """
+    mu_lo = check_positive("mu_lo", mu_lo, allow_zero=True)
+    mu_hi = check_positive("mu_hi", mu_hi)
+    if mu_hi <= mu_lo:
+        raise InputError("mu_hi", mu_hi, f"must exceed mu_lo = {mu_lo}")
+
+    def unstable(mu):
+        return bool(solve_modes(*build(mu), **solve_kw).unstable(rtol).any())
+
+    if unstable(mu_lo):
+        raise InputError("mu_lo", mu_lo, "the system is already unstable there")
+    if not unstable(mu_hi):
+        raise InputError("mu_hi", mu_hi, "the system is still stable there")
+    while mu_hi - mu_lo > xtol:
+        mid = 0.5 * (mu_lo + mu_hi)
+        mu_lo, mu_hi = (mu_lo, mid) if unstable(mid) else (mid, mu_hi)
+    return 0.5 * (mu_lo + mu_hi)

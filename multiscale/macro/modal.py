@@ -1,0 +1,168 @@
+"""Post-processing of complex modes (thesis §4.4): unstable and potentially unstable modes
+(Fig. 4.14), MAC between two cases, MMAC and its cumulative moving average (Figs. 4.16–4.19),
+strain-energy shares per component (Figs. 4.20–4.21), from matrices (``MatrixEnergy``) or per
+material region of a DOLFINx model (``RegionEnergy``).
+
+Modes are ``multiscale.macro.eigen.ModalResult`` (rank-owned entries of the PETSc layout); inner
+products are reduced over the modes' communicator.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Mapping
+
+import numpy as np
+import ufl
+from dolfinx import fem, la
+
+from multiscale.errors import InputError, check_positive
+from multiscale.macro.eigen import ModalResult, mat_apply, matrix_comm, reduce_sum
+
+
+@dataclass
+class StabilityReport:
+    """Unstable and potentially unstable modes of one case (thesis Fig. 4.14)."""
+
+    unstable: np.ndarray              # mode numbers (1-based) with sigma > rtol |lambda|
+    potentially_unstable: np.ndarray  # stable modes with a stable neighbour closer than close_tol
+    frequency: np.ndarray             # [Hz] of all modes
+    growth: np.ndarray                # sigma [1/s] of all modes
+    rtol: float                       # instability threshold on sigma / |lambda| [-]
+    close_tol: float                  # relative frequency gap of a potentially unstable pair [-]
+
+
+@dataclass
+class EnergyShares:
+    """Strain-energy share of each component per mode (thesis Figs. 4.20–4.21)."""
+
+    names: list[str]        # component names
+    energy: np.ndarray      # (n_modes, n_components) 1/2 phi^H K_c phi [J per unit modal mass]
+    share: np.ndarray       # energy / sum over components [-]
+
+    def split(self, a: str, b: str) -> np.ndarray:
+        """Share of component ``a`` in the energy of ``a`` and ``b`` (e.g. inner vs outer pad) [-]."""
+        ia, ib = self._index(a), self._index(b)
+        tot = self.energy[:, ia] + self.energy[:, ib]
+        return self.energy[:, ia] / np.where(tot > 0, tot, 1.0)
+
+    def _index(self, name: str) -> int:
+        if name not in self.names:
+            raise InputError("component", name, f"one of {self.names}")
+        return self.names.index(name)
+
+
+def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float = 1e-3) -> StabilityReport:
+    """Unstable modes (sigma > rtol |lambda|) and potentially unstable ones (Fig. 4.14).
+
+    A stable mode is potentially unstable when a neighbouring stable mode lies within
+    ``close_tol`` relative frequency: the pair is close to coalescence but not yet locked in.
+    """
+    check_positive("rtol", rtol)
+    check_positive("close_tol", close_tol)
+    f = result.frequency
+    bad = result.unstable(rtol)
+    close = np.zeros(f.size, bool)
+    if f.size > 1:
+        gap = np.diff(f) <= close_tol * np.maximum(f[1:], np.finfo(float).tiny)
+        both_stable = ~bad[1:] & ~bad[:-1]
+        pair = gap & both_stable
+        close[1:] |= pair
+        close[:-1] |= pair
+    number = np.arange(1, f.size + 1)
+    return StabilityReport(number[bad], number[close], f.copy(), result.growth.copy(), rtol, close_tol)
+
+
+def mac_matrix(a: ModalResult | np.ndarray, b: ModalResult | np.ndarray, comm=None) -> np.ndarray:
+    """MAC_ij = |y_i^H y_j|^2 / (y_i^H y_i  y_j^H y_j) between modes of two cases (§4.4).
+
+    Both sets must live on the same dof layout (same mesh and spaces). Returns (n_a, n_b) in [0, 1].
+    """
+    comm = comm or getattr(a, "comm", None) or getattr(b, "comm", None)
+    ya = a.modes if isinstance(a, ModalResult) else np.asarray(a)
+    yb = b.modes if isinstance(b, ModalResult) else np.asarray(b)
+    if ya.shape[0] != yb.shape[0]:
+        raise InputError("modes", (ya.shape, yb.shape), "the two cases must share the dof layout")
+    cross = ya.conj().T @ yb
+    na = np.einsum("ij,ij->j", ya.conj(), ya).real
+    nb = np.einsum("ij,ij->j", yb.conj(), yb).real
+    cross, na, nb = reduce_sum(cross, comm), reduce_sum(na, comm), reduce_sum(nb, comm)
+    return np.abs(cross) ** 2 / np.maximum(np.outer(na, nb), np.finfo(float).tiny)
+
+
+def mmac(mac: np.ndarray) -> np.ndarray:
+    """MMAC_i = max_j MAC_ij: best correlation of mode i of the first case (§4.4)."""
+    return np.asarray(mac).max(axis=1)
+
+
+def cumulative_moving_average(x) -> np.ndarray:
+    """xbar_n = (1/n) sum_{k=0}^{n-1} x_{n-k}, n = 1..N (Fig. 4.19)."""
+    x = np.asarray(x, dtype=float)
+    return np.cumsum(x) / np.arange(1, x.size + 1)
+
+
+def strain_energy_shares(result: ModalResult, meter) -> EnergyShares:
+    """Per-mode strain energy of each component (thesis Figs. 4.20–4.21).
+
+    ``meter`` has ``names`` and ``meter(x) -> (n_components,)`` global energies 1/2 x^T K_c x of a
+    real vector of owned dofs (``MatrixEnergy`` from matrices, ``RegionEnergy`` from a DOLFINx model).
+    For a complex mode phi = a + i b and symmetric K_c, 1/2 phi^H K_c phi = E_c(a) + E_c(b).
+    """
+    names = list(meter.names)
+    energy = np.array([meter(np.ascontiguousarray(phi.real)) + meter(np.ascontiguousarray(phi.imag))
+                       for phi in result.modes.T]).reshape(len(result), len(names))
+    tot = energy.sum(axis=1, keepdims=True)
+    return EnergyShares(names, energy, energy / np.where(tot > 0, tot, 1.0))
+
+
+class MatrixEnergy:
+    """Energy meter from assembled symmetric component stiffness matrices {name: K_c}."""
+
+    def __init__(self, stiffness: Mapping[str, object]):
+        if not stiffness:
+            raise InputError("stiffness", stiffness, "at least one component matrix")
+        self.names = list(stiffness)
+        self._mats = [stiffness[n] for n in self.names]
+        self._comm = matrix_comm(self._mats[0])
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        out = np.empty(len(self._mats))
+        for c, K in enumerate(self._mats):
+            out[c] = 0.5 * x @ mat_apply(K, x[:, None].astype(complex))[:, 0].real
+        return reduce_sum(out, self._comm)
+
+
+class RegionEnergy:
+    """Energy meter per material region of a DOLFINx model: 1/2 int sigma(x):eps(x) over each region."""
+
+    def __init__(self, mech):
+        """``mech``: a ``multiscale.macro.mechanics.Mechanics`` (its spaces, stress and regions)."""
+        self.mech = mech
+        self.names, self._forms, self._work, self._sizes = [], [], [], []
+        self._regions = []
+        for i, body in enumerate(mech.tm.bodies):
+            w = fem.Function(mech.spaces[i])
+            sigma = ufl.replace(mech.stress(i), {mech.u[i]: w})
+            Q = body.region_space
+            q = ufl.TestFunction(Q)
+            self._forms.append((fem.form(0.5 * ufl.inner(sigma, ufl.sym(ufl.grad(w))) * q * mech.dx(i),
+                                         entity_maps=mech.tm.entity_maps), Q))
+            self._work.append(w)
+            dm = mech.spaces[i].dofmap
+            self._sizes.append(dm.bs * dm.index_map.size_local)
+            n_owned = body.mesh.topology.index_map(body.mesh.topology.dim).size_local
+            cell_dofs = Q.dofmap.list[:n_owned, 0]
+            for r in body.spec.regions:
+                self.names.append(r.name)
+                self._regions.append((i, cell_dofs[body.region_tags[:n_owned] == r.tag]))
+
+    def __call__(self, x: np.ndarray) -> np.ndarray:
+        per_cell, start = [], 0
+        for (form, Q), w, n in zip(self._forms, self._work, self._sizes):
+            w.x.array[:n] = x[start:start + n]
+            w.x.scatter_forward()
+            start += n
+            vec = fem.assemble_vector(form)
+            vec.scatter_reverse(la.InsertMode.add)
+            per_cell.append(vec.array)
+        local = np.array([per_cell[i][dofs].sum() for i, dofs in self._regions])
+        return self.mech.tm.comm.allreduce(local)

@@ -1,0 +1,114 @@
+"""Figures of the squeal analysis (thesis §4.4): contact pressure at the preload (Fig. 4.12),
+complex eigenvalues (Fig. 4.13), unstable modes per case (Fig. 4.14), MAC matrices (Figs. 4.16–4.17),
+per-mode curves such as the MMAC and its cumulative mean (Figs. 4.18–4.19), strain-energy shares per component (Figs. 4.20–4.21).
+
+Every function takes results already gathered (the collective parts are computed before), so that
+rank 0 alone can draw.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Mapping, Sequence
+
+import numpy as np
+from matplotlib.figure import Figure
+
+
+def _save(fig: Figure, path) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.tight_layout()
+    fig.savefig(path, dpi=120)
+    return path
+
+
+def plot_pressure(midpoints: np.ndarray, masks: Mapping[str, np.ndarray], facet_pressure: np.ndarray,
+                  name: str, path) -> Path:
+    """Contact pressure [MPa] on each interface at the preloaded state (Fig. 4.12).
+
+    ``midpoints`` and ``facet_pressure`` are global per interface facet; ``masks`` select each
+    interface's facets."""
+    fig = Figure(figsize=(5 * len(masks), 3.6))
+    axes = fig.subplots(1, len(masks), squeeze=False)
+    mid, p = midpoints, facet_pressure / 1e6
+    for ax, (iface, mask) in zip(axes[0], masks.items()):
+        art = ax.tricontourf(mid[mask, 0] * 1e3, mid[mask, 1] * 1e3, p[mask], levels=20, cmap="jet")
+        fig.colorbar(art, ax=ax, label="contact pressure [MPa]")
+        ax.set(title=f"{name}: {iface}", xlabel="x [mm]", ylabel="y [mm]", aspect="equal")
+    return _save(fig, path)
+
+
+def plot_re_im(cases: Sequence, path) -> Path:
+    """Real part against imaginary part of the eigenvalues, one marker set per case (Fig. 4.13);
+    ``cases`` have ``name`` and ``modes`` (``ModalResult``)."""
+    fig = Figure(figsize=(8, 4.5))
+    ax = fig.subplots()
+    for c in cases:
+        ax.plot(c.modes.frequency, c.modes.growth, "o", ms=3, label=c.name)
+    ax.axhline(0.0, color="k", lw=0.5)
+    ax.set(xlabel="imaginary part: frequency [Hz]", ylabel="real part sigma [1/s]",
+           title="complex eigenvalues (sigma > 0: unstable)")
+    ax.legend(fontsize=7)
+    return _save(fig, path)
+
+
+def plot_energy(case, path, split: tuple[str, str] | None = None) -> Path:
+    """Strain-energy share of each component per mode (Fig. 4.20) and, with ``split`` = (a, b), the
+    share of component a in the energy of a and b (Fig. 4.21: inner vs outer pad); unstable modes
+    marked. ``case`` has ``name``, ``modes``, ``energy`` (``EnergyShares``) and ``report``."""
+    sh = case.energy
+    fig = Figure(figsize=(9, 6))
+    a, b = fig.subplots(2, 1, sharex=True)
+    n = np.arange(1, len(case.modes) + 1)
+    bottom = np.zeros(len(n))
+    for j, name in enumerate(sh.names):
+        a.bar(n, sh.share[:, j], bottom=bottom, label=name, width=0.9)
+        bottom += sh.share[:, j]
+    a.set(ylabel="strain-energy share [-]", title=f"{case.name}: strain energy per component")
+    a.legend(fontsize=7, ncol=4)
+    if split is not None:
+        b.bar(n, sh.split(*split), width=0.9, label=f"{split[0]} / ({split[0]} + {split[1]})")
+        b.axhline(0.5, color="k", lw=0.5)
+        b.legend(fontsize=7)
+    for j in case.report.unstable:
+        b.axvline(j, color="r", lw=0.8, ls=":")
+    b.set(xlabel="mode number (red: unstable)", ylabel="energy share [-]")
+    return _save(fig, path)
+
+
+def plot_unstable_bars(cases: Mapping, path) -> Path:
+    """Unstable (full) and potentially unstable (hatched) modes per case against mode number (Fig. 4.14)."""
+    fig = Figure(figsize=(9, 0.6 * len(cases) + 1.5))
+    ax = fig.subplots()
+    for row, (name, case) in enumerate(cases.items()):
+        rep = case.report
+        ax.bar(rep.unstable, 0.8, bottom=row - 0.4, width=0.8, color=f"C{row}")
+        ax.bar(rep.potentially_unstable, 0.8, bottom=row - 0.4, width=0.8, fill=False, hatch="///",
+               edgecolor=f"C{row}")
+    ax.set_yticks(range(len(cases)), list(cases))
+    ax.set_xlim(0.5, max(len(c.modes) for c in cases.values()) + 0.5)
+    ax.set(xlabel="mode number", title="unstable (full) and potentially unstable (hatched) modes")
+    return _save(fig, path)
+
+
+def plot_mac(mac: np.ndarray, title: str, path) -> Path:
+    """MAC matrix between two cases (Figs. 4.16–4.17)."""
+    fig = Figure(figsize=(5.5, 4.8))
+    ax = fig.subplots()
+    art = ax.imshow(mac, origin="lower", vmin=0, vmax=1, cmap="viridis",
+                    extent=(0.5, mac.shape[1] + 0.5, 0.5, mac.shape[0] + 0.5))
+    fig.colorbar(art, ax=ax, label="MAC")
+    ax.set(title=title, xlabel="mode (rough case)", ylabel="mode (perfect contact)")
+    return _save(fig, path)
+
+
+def plot_mode_curves(curves: Mapping[str, np.ndarray], ylabel: str, path) -> Path:
+    """One value per mode of the perfect-contact model for each case, e.g. the MMAC (Fig. 4.18) or
+    its cumulative mean (Fig. 4.19)."""
+    fig = Figure(figsize=(8, 4))
+    ax = fig.subplots()
+    for name, m in curves.items():
+        ax.plot(np.arange(1, len(m) + 1), m, "-o", ms=2.5, label=name)
+    ax.set(xlabel="mode of the perfect-contact model", ylabel=ylabel, ylim=(0, 1.02))
+    ax.legend(fontsize=7)
+    return _save(fig, path)

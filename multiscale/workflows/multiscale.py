@@ -1,0 +1,170 @@
+"""The multiscale loop of a scene with effect ``roughness`` (thesis ch. 7): build, run, checkpoint,
+resume, write.
+
+The scene gives the macro model (``workflows.model``), the rough interface (``workflows.rough``:
+[roughness], [micro], [layers]) and the micro post-analysis: steady sliding heating with effects
+``thermal`` + ``heat_partition`` (the micro partition law with ``micro.partition_law``), the zone
+conductance with ``conductance``, Archard wear with ``wear`` (k_w or k_w(T), ``wear.update_every``,
+``wear.substeps``). ``multiscale.coupling.Multiscale`` runs the loop.
+
+Every step writes a checkpoint (``checkpoint.h5``: macro fields, zone topographies, per-zone state,
+history), so that ``multiscale run --resume`` continues a killed run and ends with the same history
+as an uninterrupted one (to solver tolerance); then the fields of output steps. Results:
+``history.h5`` and ``history.png`` (macro), ``multiscale.png`` (both scales: Figs. 7.12, 7.14–7.18),
+``wear_map.png`` (Fig. 7.13), ``zones.h5`` (final per-zone state) and XDMF fields (the interface adds
+per-facet stiffness, partition and wear depth).
+"""
+from __future__ import annotations
+
+import dataclasses
+import gc
+import time as _time
+from dataclasses import dataclass
+from pathlib import Path
+
+import h5py
+import numpy as np
+from mpi4py import MPI
+
+from multiscale import checkpoint, io
+from multiscale.coupling import LoopSettings, Multiscale
+from multiscale.errors import InputError
+from multiscale.macro.output import FieldOutput
+from multiscale.micro.heat_kernels import ThermalMaterial
+from multiscale.micro.laws import Conductance
+from multiscale.micro.post_analysis import Heating, PostAnalysis
+from multiscale.plots.history import multiscale_figure, wear_map
+from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, interface_forces, \
+    interface_materials
+from multiscale.workflows.output import prepare_folder
+from multiscale.workflows.rough import build_rough_interface, check_rough_scene, contact_kernel, thermal_kernels
+from multiscale.workflows.transient import TransientResult, write_history
+
+CHECKPOINT = "checkpoint.h5"
+
+
+@dataclass
+class MultiscaleResult(TransientResult):
+    """``TransientResult`` plus the multiscale plots and the final per-zone state."""
+
+    multiscale_plot: Path
+    wear_maps: list             # one per interface (none without wear)
+    zones_file: Path
+    steps_done: int
+
+
+def post_analysis(scene, zone) -> PostAnalysis:
+    """The micro post-analysis of the scene's zones (``zone``: one of them, for the grid)."""
+    rough, counter = interface_materials(scene)
+    heating = None
+    if scene.has("thermal") and scene.has("heat_partition"):
+        heating = Heating(ThermalMaterial(counter.kappa, counter.diffusivity),
+                          ThermalMaterial(rough.kappa, rough.diffusivity))
+    wear = scene.has("wear")
+    s = zone.surface
+    return PostAnalysis(contact_kernel(scene)[0], s.shape, s.dx, s.dy, mu=friction_coefficient(scene),
+                        heating=heating,
+                        conductance=Conductance(*thermal_kernels(scene)) if scene.has("conductance") else None,
+                        wear_rate=scene.wear.rate if wear else None, substeps=scene.wear.substeps if wear else 1,
+                        tol=scene.micro.tol)
+
+
+def fingerprint(scene) -> str:
+    """Hash of what the results depend on (not the output section; effects sorted: a set's order
+    changes between processes)."""
+    s = dataclasses.replace(scene, output=None, source=None, warnings=(), effects=tuple(sorted(scene.effects)))
+    return checkpoint.fingerprint(repr(s))
+
+
+def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
+    """The loop of a scene with effect ``roughness`` (collective)."""
+    if not scene.has("roughness"):
+        raise InputError("effects", sorted(scene.effects), 'the multiscale loop needs effect "roughness"')
+    check_rough_scene(scene)              # before meshing
+    tm = build_mesh(scene, comm)
+    rough = build_rough_interface(scene, tm, progress=progress)
+    model = build_model(scene, comm, law=rough.law, tm=tm)
+    t, wear = scene.time, scene.has("wear")
+    settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature,
+                            partition=float(scene.partition) if scene.has("heat_partition") else np.nan,
+                            partition_law=scene.micro.partition_law, wear=wear,
+                            wear_every=scene.wear.update_every if wear else 1,
+                            forces=tuple(interface_forces(scene, tm)))
+    return Multiscale(model, rough, post_analysis(scene, rough.zones[0]), settings, fingerprint(scene))
+
+
+def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_WORLD, verbose: bool = True,
+        stop_after: int | None = None) -> MultiscaleResult:
+    """Run a scene with effect ``roughness`` (see module docstring).
+
+    ``resume`` continues from ``checkpoint.h5`` in the output folder; ``stop_after`` ends the run
+    after that macro step's checkpoint (as if it had been killed then; for tests).
+    """
+    start = _time.perf_counter()
+    io.abort_on_exception(comm)
+    folder = prepare_folder(scene, overwrite, resume, comm)
+    ckpt = folder / CHECKPOINT
+    if resume and not comm.bcast(ckpt.is_file() if comm.rank == 0 else None, root=0):
+        raise InputError("--resume", str(folder), f"no {CHECKPOINT} in the output folder to resume from")
+    ms = build(scene, comm, progress=verbose and comm.rank == 0)
+    steps = scene.time.steps if (ms.model.thermal is not None or scene.has("wear")) else 0
+    every = scene.output.every
+    if resume:
+        done, history, written = dataclasses.astuple(ms.restore(ckpt))
+    else:
+        first = ms.start()
+        done, history, written = 0, io.History(), -1
+        history.append(**ms.record(first))
+        ms.save(ckpt, 0, history)
+    ms.rough.pool.progress = False
+    writer = FieldOutput(ms.model, folder, scene.output.fields, extra=ms.facet_fields(), append=resume)
+    if written < done and (done % every == 0 or done == steps):
+        writer.write()
+        ms.mark_fields(ckpt, done, comm)
+    last = steps if stop_after is None else min(steps, stop_after)
+    for n in io.progress(range(done + 1, last + 1), comm, desc=scene.name, unit="step", initial=done, total=steps):
+        history.append(**ms.record(ms.step(n)))
+        ms.save(ckpt, n, history)
+        if n % every == 0 or n == steps:
+            writer.write()
+            ms.mark_fields(ckpt, n, comm)
+        done = n
+    h5, png = write_history(history, folder, scene.name, comm)
+    plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
+    result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones] + maps, _time.perf_counter() - start,
+                              history, h5, png, writer.files, plot, maps, zones, done)
+    del ms, writer            # the model holds reference cycles of PETSc objects: free them on every
+    gc.collect()              # rank at the same point (collected later, ranks could hang at exit)
+    if verbose and comm.rank == 0:
+        print(f"{scene.name}: {len(history)} records ({done}/{steps} steps) in {result.wall_time:.1f} s "
+              f"on {comm.size} rank(s)")
+        print(f"  ParaView: {', '.join(str(f) for f in result.field_files)}")
+        print(f"  history:  {h5}  plots: {', '.join(str(p) for p in [png, plot] + maps)}")
+    return result
+
+
+def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: str, comm) -> tuple:
+    """multiscale.png, the wear maps (with wear: ``wear_map.png``, or ``wear_map_<interface>.png``
+    for several interfaces) and zones.h5 (rank 0 writes; collective)."""
+    rough = ms.rough
+    plot, zones = folder / "multiscale.png", folder / "zones.h5"
+    names = list(ms.tm.interface.tags)
+    maps = [] if not ms.settings.wear else [folder / "wear_map.png"] if len(names) == 1 else \
+        [folder / f"wear_map_{n}.png" for n in names]
+    depth = rough.wear_depth()
+    if comm.rank == 0:
+        multiscale_figure(history, plot, name)
+        with h5py.File(zones, "w") as h5:
+            h5.create_dataset("centre", data=np.array([z.centre for z in rough.zones])).attrs["unit"] = "m"
+            h5.create_dataset("mean_wear_depth", data=depth.mean(axis=(-2, -1))).attrs["unit"] = "m"
+            h5.create_dataset("max_wear_depth", data=depth.max(axis=(-2, -1))).attrs["unit"] = "m"
+            h5.create_dataset("wear_volume", data=rough.zone_wear_volume(depth)).attrs["unit"] = "m^3"
+            h5.create_dataset("partition", data=ms.partition)
+            h5.create_dataset("conductance", data=ms.conductance).attrs["unit"] = "W/(m^2 K)"
+            h5.attrs["counts"] = np.array([g.counts for g in rough.grids])     # (interfaces, 2)
+        offset = 0
+        for grid, path, interface in zip(rough.grids, maps, names):
+            wear_map(grid, depth[offset:offset + grid.n_zones], path, f"{name}: {interface}")
+            offset += grid.n_zones
+    comm.barrier()
+    return plot, maps, zones

@@ -1,0 +1,111 @@
+"""The one rough-interface builder: a scene's [roughness], [micro] and [layers] -> zones -> patches
+-> laws through the pool -> facet laws (``multiscale.rough.RoughInterface``), with the same rules for
+the multiscale loop and the squeal analysis:
+
+- the rough body is the stationary body 0 (zones do not move); the counter-face is flat;
+- every interface of the mesh is rough and covered by ``micro.zones`` = (nx, ny) zones over the
+  bounding box of its facets, each zone a patch of ``micro.grid`` = (nx, ny) cells: one measured
+  surface (``roughness.file``) or one generated fractal surface per interface cut into zones
+  (``patch = "face"``; cut-offs in wavelengths per face), or one generated patch per zone
+  (``patch = "zone"``; per zone); interface k > 0 draws with seed ``seed + 7919 k``;
+- laws by FFT-BEM (``micro.model = "fft-bem"``; the asperity models are refused), ``micro.law_points``
+  nodes up to ``micro.p_max`` (default ``P_MAX_FACTOR`` x the nominal interface pressure), contact
+  tolerance ``micro.tol``; the micro solid is layered with effect ``layers``.
+"""
+from __future__ import annotations
+
+from dataclasses import replace
+
+import numpy as np
+
+from multiscale.errors import InputError
+from multiscale.micro.conduction import SeriesKernel
+from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace
+from multiscale.micro.layered import LayeredElastic, LayeredThermal
+from multiscale.micro.laws import LawSpec
+from multiscale.micro.surface import Surface, fractal_surface, load_surface
+from multiscale.micro.zones import ZoneGrid, cut_zones, generate_zones
+from multiscale.pool import MicroPool
+from multiscale.rough import RoughInterface, interface_plane
+from multiscale.workflows.model import interface_forces, interface_materials
+
+P_MAX_FACTOR = 20.0        # default top node of the laws: 20 x the nominal interface pressure
+SEED_STRIDE = 7919         # interface k draws its surfaces with seed + SEED_STRIDE k
+
+
+def check_rough_scene(scene) -> None:
+    """The rules every rough analysis shares (InputError naming the field)."""
+    bodies = scene.geometry.bodies
+    if scene.roughness.body != bodies[0]:
+        raise InputError("roughness.body", scene.roughness.body,
+                         f'the rough body must be the stationary one, "{bodies[0]}" (zones do not move)')
+    if scene.micro.model != "fft-bem":
+        raise InputError("micro.model", scene.micro.model, 'the zone laws are computed by FFT-BEM: "fft-bem"')
+    if scene.has("layers") and scene.layers.body != bodies[0]:
+        raise InputError("layers.body", scene.layers.body, f'the layers belong to the rough body "{bodies[0]}"')
+
+
+def make_zones(scene, lo, hi, seed: int) -> tuple[ZoneGrid, list]:
+    """The zone grid over the box [lo, hi] (x, y) [m] of one interface and each zone's initial
+    patch (see module docstring; ids from 0)."""
+    r, m = scene.roughness, scene.micro
+    counts = tuple(int(c) for c in m.zones)
+    size = np.asarray(hi, float) - np.asarray(lo, float)
+    if r.file is not None:
+        surface = load_surface(r.file, *r.pixel_size, scale=r.height_unit)
+        if np.any(np.array(surface.size) < size * (1 - 1e-6)):
+            raise InputError("roughness.pixel_size", r.pixel_size, f"the surface ({surface.size[0]:.4g} x "
+                             f"{surface.size[1]:.4g} m) must cover the interface ({size[0]:.4g} x {size[1]:.4g} m)")
+        return cut_zones(surface, counts, origin=tuple(lo))
+    if r.patch == "face":
+        cells = (counts[0] * m.grid[0], counts[1] * m.grid[1])
+        s = fractal_surface(cells, tuple(size), r.hurst, r.k_min, r.k_max, r.rms, seed=seed)
+        return cut_zones(Surface(s.heights, s.dx, s.dy, periodic=False), counts, origin=tuple(lo))
+    grid = ZoneGrid(tuple(lo), counts, tuple(size / np.array(counts)))
+    return grid, generate_zones(grid, tuple(m.grid), r.hurst, r.k_min, r.k_max, r.rms, seed=seed)
+
+
+def contact_kernel(scene):
+    """Elastic micro kernel of the rough body against the counter-face (layered with ``layers``)
+    and the composite modulus E* of the macro bodies for Love's correction (Eq. 1.31)."""
+    rough, counter = interface_materials(scene)
+    E_star = HalfSpace.from_materials(rough.E, rough.nu, counter.E, counter.nu).E_star
+    if not scene.has("layers"):
+        return HalfSpace(E_star), E_star
+    L = scene.layers
+    substrate = rough.E if L.base == "half-space" else np.inf
+    layered = LayeredElastic(tuple(x.thickness for x in L.layer), tuple(x.E for x in L.layer),
+                             tuple(x.nu for x in L.layer), substrate, rough.nu)
+    return SeriesKernel(layered, HalfSpace.from_materials(counter.E, counter.nu)), E_star
+
+
+def thermal_kernels(scene):
+    """Steady thermal kernels (rough body, counter-face) for the zone conductance (layered with
+    ``layers``: each layer's kappa on the rough body, or on an isothermal base)."""
+    rough, counter = interface_materials(scene)
+    first = ThermalHalfSpace(rough.kappa)
+    if scene.has("layers"):
+        L = scene.layers
+        if any(x.kappa is None for x in L.layer):
+            raise InputError("layers.layer.kappa", None, 'every layer needs kappa with effect "conductance"')
+        first = LayeredThermal(tuple(x.thickness for x in L.layer), tuple(x.kappa for x in L.layer),
+                               rough.kappa if L.base == "half-space" else np.inf)
+    return first, ThermalHalfSpace(counter.kappa)
+
+
+def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterface:
+    """Zones of every interface of ``tm``, the law spec and the pool (collective; laws not yet
+    computed: ``RoughInterface.update_laws``)."""
+    check_rough_scene(scene)
+    grids, zones = [], []
+    for k, name in enumerate(tm.interface.tags):
+        lo, hi = interface_plane(tm, name)
+        grid, patches = make_zones(scene, lo, hi, scene.roughness.seed + SEED_STRIDE * k)
+        offset = len(zones)
+        grids.append(grid)
+        zones += [replace(z, id=offset + z.id) for z in patches]
+    m = scene.micro
+    kernel, E_star = contact_kernel(scene)
+    nominal = interface_forces(scene, tm).sum() / tm.interface.areas.sum()
+    spec = LawSpec(kernel, m.p_max or P_MAX_FACTOR * nominal, n_points=m.law_points, tol=m.tol, E_star=E_star)
+    return RoughInterface(tm, grids, zones, spec, MicroPool(spec, tm.comm, progress=progress))

@@ -1,0 +1,67 @@
+"""Transient thermo-mechanics with perfect contact (thesis §7.3.1, Fig. 7.4): the workflow of a scene
+without ``roughness`` or ``stability``.
+
+Builds the model (``workflows.model``), ramps the load, marches ``time.steps`` macro steps of
+``time.substeps`` sub-steps (only with effect ``thermal``; otherwise the one contact solve), and
+writes ``history.h5``, ``history.png`` and the XDMF fields into ``output.folder``.
+"""
+from __future__ import annotations
+
+import time as _time
+from dataclasses import dataclass
+from pathlib import Path
+
+from mpi4py import MPI
+
+from multiscale import io
+from multiscale.macro.output import FieldOutput
+from multiscale.plots.history import history_figure
+from multiscale.workflows.model import build_model
+from multiscale.workflows.output import RunResult, prepare_folder
+
+
+@dataclass
+class TransientResult(RunResult):
+    """``RunResult`` of a macro run with a history."""
+
+    history: io.History
+    history_file: Path          # history.h5
+    plot_file: Path             # history.png
+    field_files: list           # XDMF files
+
+
+def write_history(history: io.History, folder: Path, name: str, comm) -> tuple[Path, Path]:
+    """``history.h5`` and ``history.png`` (rank 0 writes; collective)."""
+    h5, png = folder / "history.h5", folder / "history.png"
+    if comm.rank == 0:
+        history.write(h5, {"scene": name, "ranks": comm.size})
+        history_figure(history, png, title=name)
+    comm.barrier()
+    return h5, png
+
+
+def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = True) -> TransientResult:
+    """Run a perfect-contact scene (see module docstring)."""
+    start = _time.perf_counter()
+    io.abort_on_exception(comm)
+    folder = prepare_folder(scene, overwrite, False, comm)
+    model = build_model(scene, comm)
+    model.start()
+    writer = FieldOutput(model, folder, scene.output.fields)
+    history = io.History()
+    history.append(**model.record())
+    writer.write()
+    steps = scene.time.steps if model.thermal is not None else 0
+    for n in io.progress(range(1, steps + 1), comm, desc=f"{scene.name}", unit="step"):
+        heat = model.macro_step(scene.time.dt, scene.time.substeps)
+        history.append(**model.record(heat))
+        if n % scene.output.every == 0 or n == steps:
+            writer.write()
+    h5, png = write_history(history, folder, scene.name, comm)
+    result = TransientResult(folder, writer.files + [h5, png], _time.perf_counter() - start, history, h5, png,
+                             writer.files)
+    if verbose and comm.rank == 0:
+        print(f"{scene.name}: {len(history)} records in {result.wall_time:.1f} s on {comm.size} rank(s)")
+        print(f"  ParaView: {', '.join(str(f) for f in writer.files)}")
+        print(f"  history:  {h5}  plot: {png}")
+    return result
