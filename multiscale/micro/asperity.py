@@ -94,9 +94,9 @@ from scipy.sparse.linalg import LinearOperator
 from scipy.spatial import cKDTree
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
-from multiscale.micro.elliptic import axis_ratio_squared, exterior_lambda, potential_integrals
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.surface import AsperityTable, Surface, find_asperities, statistics
+from multiscale.references.hertz import axis_ratio_squared, exterior_lambda, potential_integrals
 
 _GL_X, _GL_V = np.polynomial.legendre.leggauss(16)
 _GL_T, _GL_W = 0.5 * (_GL_X + 1.0), 0.5 * _GL_V          # Gauss–Legendre on (0, 1)
@@ -237,8 +237,8 @@ class HertzElliptic(_HalfSpaceLaw):
 
     The major semi-axis a lies along the R1 axis at ``angle`` [rad] from +x; b = a sqrt(1 − e²).
     ``exact=True`` takes e from the exact Hertz relation between R2/R1 and b/a (see
-    ``elliptic.axis_ratio_squared``); ``exact=False`` uses the approximation of Eq. 1.2. All
-    relations are closed forms in Carlson integrals (``elliptic.potential_integrals``) and equal
+    ``references.hertz.axis_ratio_squared``); ``exact=False`` uses the approximation of Eq. 1.2.
+    All relations are closed forms in Carlson integrals (``references.hertz.potential_integrals``) and equal
     P = 4/3 E* R^½ F1(e) w^(3/2), A = π A1(e) R w of Eqs. 1.1, 1.3 with R = sqrt(R1 R2).
     """
 

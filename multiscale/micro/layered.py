@@ -34,7 +34,8 @@ from scipy.interpolate import CubicSpline
 from scipy.special import j0, j1
 
 from multiscale.errors import InputError, check_positive
-from multiscale.micro.kernels import Kernel, wrap_offsets, love_rectangle
+from multiscale.micro.kernels import Kernel, wrap_offsets
+from multiscale.references.love import love_rectangle
 
 _NEAR = 4        # cells |i|, |j| <= _NEAR around the loaded cell use the exact corner formula
 _GAUSS = 4       # Gauss points per direction on the other cells
