@@ -59,7 +59,7 @@ def propagator_reference(q, thickness, E, nu, substrate_E=None, substrate_nu=0.3
 def brute_influence(kernel, offsets, dx, dy, ng=8):
     """Cell integrals of the remainder g(r) = (1/2pi) ∫ excess(q)/q J0(q r) q dq: uniform-panel
     Gauss quadrature in q (250 panels) and ng x ng Gauss points on the cell, no splines."""
-    q_cut = kernel._cutoff()
+    q_cut = kernel.cutoff()
     x, w = np.polynomial.legendre.leggauss(24)
     edges = np.linspace(0, q_cut, 251)
     q = ((edges[:-1, None] + edges[1:, None]) / 2 + np.diff(edges)[:, None] / 2 * x).ravel()

@@ -92,6 +92,7 @@ import numpy as np
 from scipy import optimize, sparse
 from scipy.sparse.linalg import LinearOperator
 from scipy.spatial import cKDTree
+from tqdm import tqdm
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.micro.kernels import HalfSpace
@@ -493,7 +494,6 @@ class AsperityModel:
             self._interactions(cand)                 # one far-field matrix for the whole curve
         steps = d
         if progress:
-            from tqdm import tqdm
             steps = tqdm(d, desc="asperity model", unit="step")
         results, prev = [], None
         for delta in steps:
