@@ -8,8 +8,9 @@ import pytest
 from scipy import integrate
 
 from multiscale.errors import InputError
-from multiscale.micro.asperity import (AsperityLaw, AsperityModel, HertzCircular, HertzElliptic,
-                                       _Interactions, hertz_law)
+from multiscale.micro.asperity import AsperityModel
+from multiscale.micro.asperity_interaction import Interactions
+from multiscale.micro.asperity_laws import AsperityLaw, HertzCircular, HertzElliptic, hertz_law
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.surface import AsperityTable, Surface, find_asperities, fractal_surface
@@ -293,7 +294,7 @@ def test_interaction_truncation_is_within_its_bound():
     t, law = model.table, model.law
     on = np.nonzero(r.contact)[0]
     a = r.semi_axes[on, 0]
-    inter = _Interactions(law, t.x[on], t.y[on], on)
+    inter = Interactions(law, t.x[on], t.y[on], on)
     inter.set_near(a, 1e9)
     full = inter.evaluate(a).u
     inter.set_near(a, model.cutoff)
@@ -305,7 +306,7 @@ def test_interaction_truncation_is_within_its_bound():
 
 def test_far_field_stored_and_recomputed_agree(monkeypatch):
     """Stored and recomputed-blockwise far-field sums give one solution."""
-    import multiscale.micro.asperity as asp
+    import multiscale.micro.asperity_interaction as asp
     surf = thesis_surface("set1", 2, seed=5)
     delta = 0.5 * (surf.heights.max() - surf.heights.mean())
     forces = []

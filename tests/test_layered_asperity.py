@@ -4,7 +4,8 @@ import numpy as np
 import pytest
 
 from multiscale.errors import InputError
-from multiscale.micro.asperity import AsperityModel, HertzCircular
+from multiscale.micro.asperity import AsperityModel
+from multiscale.micro.asperity_laws import HertzCircular
 from multiscale.micro.contact import solve_contact
 from multiscale.micro.layered import LayeredElastic
 from multiscale.micro.layered_asperity import LayeredAsperity, layered_law

@@ -29,7 +29,7 @@ from scipy.interpolate import CubicSpline, RectBivariateSpline
 from scipy.special import j0
 
 from multiscale.errors import InputError, check_positive
-from multiscale.micro.asperity import AsperityLaw
+from multiscale.micro.asperity_laws import AsperityLaw
 from multiscale.micro.layered import LayeredElastic, hankel_nodes, radial_table
 from multiscale.micro.surface import AsperityTable
 from multiscale.references.hertz import sphere_load
