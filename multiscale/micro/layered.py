@@ -109,7 +109,7 @@ class LayeredKernel(Kernel):
         return coeffs
 
     def cutoff(self) -> float:
-        """Wavenumber beyond which |excess| < 1e-15 A (0 if the excess vanishes everywhere)."""
+        """Wavenumber [rad/m] beyond which |excess| < 1e-15 A (0 if the excess vanishes everywhere)."""
         h1 = self.thickness[0]
         q = np.arange(1, 801) * (0.25 / h1)
         big = np.nonzero(np.abs(self._excess(q)) > _EXCESS_TOL * self.top_coefficient)[0]
