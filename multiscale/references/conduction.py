@@ -14,7 +14,7 @@ from multiscale.errors import check_positive
 def holm_conductance(radius: float, kappa_1: float, kappa_2: float) -> float:
     """Conductance [W/K] of an isothermal circular spot of radius a [m] between two half-spaces:
     4 a κ1 κ2 / (κ1 + κ2), each body's constriction resistance being 1/(4 κ a) (Holm 1967,
-    Electric Contacts, §4)."""
+    Electric Contacts)."""
     a = check_positive("radius", radius)
     k1, k2 = check_positive("kappa_1", kappa_1), check_positive("kappa_2", kappa_2)
     return 4 * a * k1 * k2 / (k1 + k2)

@@ -19,7 +19,7 @@ from multiscale.errors import check_positive
 
 def uniform_flux_temperature(time, kappa: float, diffusivity: float, flux: float = 1.0):
     """T = 2 q sqrt(χ t/π) / κ [K]: surface rise of a half-space under a uniform flux switched on at
-    t = 0 (1-D heating; Carslaw & Jaeger 1959, §2.9). ``time`` [s] >= 0."""
+    t = 0 (1-D heating; Carslaw & Jaeger 1959, ch. 2). ``time`` [s] >= 0."""
     t = np.asarray(time, dtype=float)
     return 2 * flux * np.sqrt(diffusivity * t / np.pi) / kappa
 
@@ -27,7 +27,7 @@ def uniform_flux_temperature(time, kappa: float, diffusivity: float, flux: float
 def point_source_deficit(time, power: float, kappa: float, diffusivity: float):
     """T_steady − T(t) [K] at a continuous surface point source Q switched on at t = 0:
     Q / (2 π^(3/2) κ sqrt(χ t)), the limit r → 0 of Q/(2π κ r) erf(r/sqrt(4 χ t)) (Carslaw & Jaeger
-    1959, §10.3; thesis Eq. 6.1 integrated in time). Also the far-field (t → ∞) deficit of any
+    1959, ch. 10; thesis Eq. 6.1 integrated in time). Also the far-field (t → ∞) deficit of any
     compact source of total power Q."""
     t = np.asarray(time, dtype=float)
     return power / (2 * np.pi**1.5 * kappa * np.sqrt(diffusivity * t))

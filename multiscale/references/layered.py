@@ -46,7 +46,8 @@ class ThinLayerContact:
 
 def thin_layer_sphere(approach: float, radius: float, thickness: float, E: float, nu: float) -> ThinLayerContact:
     """Winkler limit of a sphere (radius R [m]) pressed by δ [m] into a thin layer on a rigid base:
-    p = (M/h)(δ − r²/2R), a² = 2Rδ, P = π M R δ²/h (Johnson 1985, §5.9)."""
+    p = (M/h)(δ − r²/2R), a² = 2Rδ, P = π M R δ²/h (elastic foundation model; Johnson 1985,
+    Contact Mechanics, ch. 5)."""
     d, R = check_positive("approach", approach), check_positive("radius", radius)
     h = check_positive("thickness", thickness)
     return ThinLayerContact(np.pi * oedometric_modulus(E, nu) * R * d * d / h, np.sqrt(2 * R * d))
