@@ -8,12 +8,14 @@ import pytest
 from scipy import integrate
 
 from multiscale.errors import InputError
-from multiscale.micro.asperity import (AsperityLaw, AsperityModel, HertzCircular, HertzElliptic,
-                                       _Interactions, hertz_law)
+from multiscale.micro.asperity import AsperityModel
+from multiscale.micro.asperity_interaction import Interactions
+from multiscale.micro.asperity_laws import AsperityLaw, HertzCircular, HertzElliptic, hertz_law
 from multiscale.micro.contact import ContactSolver
-from multiscale.micro.elliptic import axis_ratio_squared, curvature_ratio, hertz_A1, hertz_F1
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.surface import AsperityTable, Surface, find_asperities, fractal_surface
+from multiscale.references.hertz import (axis_ratio_squared, curvature_ratio, hertz_A1, hertz_F1, sphere_load,
+                                         sphere_on_flat)
 
 SOLID = HalfSpace.from_materials(4e9, 0.15)          # thesis §1.3.1: E = 4 GPa, nu = 0.15, rigid flat
 ES = SOLID.E_star
@@ -41,15 +43,14 @@ def test_single_circular_asperity_is_hertz(shape, interaction):
     assert len(model.table) == 1 and model.table.R1[0] == pytest.approx(R, rel=1e-9)
     for delta in (1e-8, 4e-8, 1.5e-7):
         r = model.solve(delta)
-        assert r.force == pytest.approx(4 / 3 * ES * np.sqrt(R) * delta**1.5, rel=1e-9)
+        assert r.force == pytest.approx(sphere_load(delta, R, ES), rel=1e-9)
         assert r.area == pytest.approx(np.pi * R * delta, rel=1e-9)
         assert r.semi_axes[0] == pytest.approx(np.sqrt(R * delta), rel=1e-9)
         assert r.pressure.sum() * dx * dx == pytest.approx(r.force, rel=1e-12)
     # the map is Eq. 1.5 sampled at pixel centres (rescaled to the force by less than 2 %)
-    a = r.semi_axes[0, 0]
     x = (np.arange(n) + 0.5) * dx
     rr2 = (x[None, :] - 32.5 * dx) ** 2 + (x[:, None] - 31.5 * dx) ** 2
-    exact = 2 * ES / (np.pi * R) * np.sqrt(np.maximum(a * a - rr2, 0))
+    exact = sphere_on_flat(r.force, R, ES).pressure(np.sqrt(rr2))
     assert np.abs(r.pressure - exact).max() < 0.02 * exact.max()
     assert r.mean_gap == pytest.approx(surf.heights.max() - surf.heights.mean() - delta, rel=1e-12)
 
@@ -293,7 +294,7 @@ def test_interaction_truncation_is_within_its_bound():
     t, law = model.table, model.law
     on = np.nonzero(r.contact)[0]
     a = r.semi_axes[on, 0]
-    inter = _Interactions(law, t.x[on], t.y[on], on)
+    inter = Interactions(law, t.x[on], t.y[on], on)
     inter.set_near(a, 1e9)
     full = inter.evaluate(a).u
     inter.set_near(a, model.cutoff)
@@ -305,7 +306,7 @@ def test_interaction_truncation_is_within_its_bound():
 
 def test_far_field_stored_and_recomputed_agree(monkeypatch):
     """Stored and recomputed-blockwise far-field sums give one solution."""
-    import multiscale.micro.asperity as asp
+    import multiscale.micro.asperity_interaction as asp
     surf = thesis_surface("set1", 2, seed=5)
     delta = 0.5 * (surf.heights.max() - surf.heights.mean())
     forces = []

@@ -4,8 +4,12 @@ import pytest
 
 from multiscale.errors import InputError
 from multiscale.micro.contact import ContactConvergenceError, ContactSolver, solve_contact
-from multiscale.micro.kernels import HalfSpace, InfluenceOperator, love_rectangle
+from multiscale.micro.kernels import HalfSpace, InfluenceOperator
 from multiscale.micro.surface import fractal_surface
+from multiscale.references.hertz import sphere_on_flat_at_radius
+from multiscale.references.love import love_rectangle
+from multiscale.references.westergaard import (complete_contact_pressure, full_contact_pressure,
+                                               partial_contact_mean_pressure)
 
 E = HalfSpace.from_materials(4e9, 0.15)
 
@@ -16,8 +20,8 @@ def hertz_case(cells_per_radius, R=0.01, a=0.5e-3):
     x = (np.arange(n) - n / 2 + 0.5) * dx
     X, Y = np.meshgrid(x, x)
     h = -(X**2 + Y**2) / (2 * R)
-    P = 4 * E.E_star * a**3 / (3 * R)
-    return h, dx, P, a, a * a / R, 3 * P / (2 * np.pi * a * a)
+    hertz = sphere_on_flat_at_radius(a, R, E.E_star)
+    return h, dx, hertz.load, hertz.contact_radius, hertz.approach, hertz.max_pressure
 
 
 def hertz_errors(cells_per_radius):
@@ -50,14 +54,14 @@ def test_westergaard_full_and_partial_contact():
     dx = lam / n
     x = (np.arange(n) + 0.5) * dx
     h = np.tile(Delta * np.cos(2 * np.pi * x / lam), (8, 1))
-    p_star = np.pi * E.E_star * Delta / lam
+    p_star = complete_contact_pressure(Delta, lam, E.E_star)
     solver = ContactSolver(E, h.shape, dx, periodic=True)
     full = solver.solve(h, load=1.5 * p_star, tol=1e-12)
     assert full.area_fraction == 1.0
-    expected = 1.5 * p_star + p_star * np.cos(2 * np.pi * x / lam)   # heights up => pressure up
+    expected = full_contact_pressure(x, 1.5 * p_star, Delta, lam, E.E_star)   # heights up => pressure up
     assert np.max(np.abs(full.pressure[0] - expected)) < 1e-8 * p_star
     for frac in (0.2, 0.5):
-        pbar = p_star * np.sin(np.pi * frac / 2) ** 2   # contact width 2a = frac * lambda
+        pbar = partial_contact_mean_pressure(frac, Delta, lam, E.E_star)   # contact width 2a = frac * lambda
         part = solver.solve(h, load=pbar, tol=1e-10)
         assert abs(part.area_fraction - frac) <= 2.0 / n + 1e-12
 

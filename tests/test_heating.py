@@ -11,8 +11,12 @@ from multiscale.micro.heat_kernels import (Rotation, SpeedProfile, ThermalMateri
                                            pulse_tables)
 from multiscale.micro.heating import (HeatingConvergenceError, InterfaceLayer, SteadyHeating,
                                       TransientHeating, partition_law)
-from multiscale.micro.kernels import HalfSpace, love_rectangle
+from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.surface import Surface, fractal_surface
+from multiscale.references.conduction import holm_conductance
+from multiscale.references.heat import (fast_square_source, fixed_square_source, point_source_deficit,
+                                        uniform_flux_temperature)
+from multiscale.references.love import love_rectangle
 
 DISC = ThermalMaterial(50.0, 1e-5)       # thesis Table 6.3, solid S1 (moving)
 PIN = ThermalMaterial(5.0, 3.5e-6)       # solid S2 (fixed)
@@ -37,8 +41,8 @@ def rough_contact(n, seed=3, approach=10e-6):
 def test_fixed_square_source_centre_and_mean_within_half_percent():
     T, l = steady_square(21, PIN)
     q_l_k = l / PIN.kappa
-    centre = 4 * np.log(1 + np.sqrt(2)) / np.pi                                  # 1.1222
-    mean = 2 / np.pi * (2 * np.log(1 + np.sqrt(2)) - 2 / 3 * (np.sqrt(2) - 1))    # 0.9464
+    ref = fixed_square_source(l, PIN.kappa)
+    centre, mean = ref.centre / q_l_k, ref.mean / q_l_k
     assert centre == pytest.approx(1.1222, abs=1e-4) and mean == pytest.approx(0.9464, abs=1e-4)
     assert T[10, 10] / q_l_k == pytest.approx(centre, rel=1e-10)   # union of the cells = the square
     assert T.mean() / q_l_k == pytest.approx(mean, rel=5e-3)
@@ -50,11 +54,11 @@ def test_fixed_transient_tends_to_steady_with_the_point_source_deficit():
     steady = fixed_rectangle_temperature(0.0, 0.0, np.inf, l, l, PIN)
     short = 1e-3 * l * l / chi                                      # sqrt(chi t) << l: 1-D heating
     assert fixed_rectangle_temperature(0.0, 0.0, short, l, l, PIN) == pytest.approx(
-        2 * np.sqrt(chi * short / np.pi) / k, rel=1e-6)
+        uniform_flux_temperature(short, k, chi), rel=1e-6)
     deficits = []
     for tau in (1e2 * l * l / chi, 1e4 * l * l / chi):
         T = fixed_rectangle_temperature(0.0, 0.0, tau, l, l, PIN)
-        point = 4 * l * l / (2 * np.pi**1.5 * k * np.sqrt(chi * tau))  # (T_ss - T) of a point source
+        point = point_source_deficit(tau, 4 * l * l, k, chi)          # (T_ss - T) of a point source
         deficits.append(abs((steady - T) / point - 1))
         assert T < steady
     assert deficits[1] < 1e-3 and deficits[1] < deficits[0] / 10
@@ -136,11 +140,11 @@ def test_moving_square_source_high_peclet_mean_approaches_jaeger():
     for pe in (10.0, 100.0, 1000.0):
         speed = 2 * DISC.diffusivity * pe / l
         T, _ = steady_square(n, DISC, Rotation((0.0, -10.0), SpeedProfile.constant(speed / 10.0)))
-        ratios.append(T.mean() * DISC.kappa / l * np.sqrt(pe) / 0.752)
+        ratios.append(T.mean() / fast_square_source(l, pe, DISC.kappa).mean)
     errors = np.abs(np.array(ratios) - 1)
     assert errors[-1] < 0.01 and errors[0] > errors[1] > errors[2]
     # maximum (trailing edge, 1-D heating during 2l/V): 2/sqrt(pi) q l/(kappa sqrt(Pe))
-    assert T.max() * DISC.kappa / l * np.sqrt(pe) == pytest.approx(2 / np.sqrt(np.pi), rel=0.02)
+    assert T.max() == pytest.approx(fast_square_source(l, pe, DISC.kappa).maximum, rel=0.02)
 
 
 # --- transient thermal contact (§6.3) --------------------------------------------------------------
@@ -327,7 +331,7 @@ def test_remote_temperatures_conduct_through_a_circular_spot_like_two_constricti
     a = np.sqrt(np.count_nonzero(p) / np.pi) * dx
     sol = SteadyHeating((n, n), dx, DISC, PIN, 0.0)
     r = sol.solve(p, 0.4, remote_temperatures=(1.0, 0.0))
-    conductance = 1 / (1 / (4 * DISC.kappa * a) + 1 / (4 * PIN.kappa * a))      # isothermal circles
+    conductance = holm_conductance(a, DISC.kappa, PIN.kappa)                    # isothermal circles
     assert -r.heat_1 == pytest.approx(conductance * 1.0, rel=0.02)
     assert r.heat == 0 and r.heat_2 == pytest.approx(-r.heat_1, rel=1e-12)
 

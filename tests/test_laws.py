@@ -10,12 +10,13 @@ from scipy import integrate
 
 from multiscale.errors import InputError
 from multiscale.micro.contact import ContactSolver
-from multiscale.micro.kernels import HalfSpace, love_rectangle
-from multiscale.micro.laws import (Conductance, ExtraLaw, HeatPartition, LawError, LawSpec, PressureGapLaw,
-                                   PressureTable, compute_laws)
+from multiscale.micro.kernels import HalfSpace
+from multiscale.micro.law_tables import PressureGapLaw, PressureTable
+from multiscale.micro.laws import Conductance, ExtraLaw, HeatPartition, LawError, LawSpec, compute_laws
 from multiscale.micro.surface import Surface, fractal_surface
-from multiscale.micro.zones import (Zone, ZoneGrid, cut_triangles, cut_zones, generate_zones, love_rectangle_mean,
-                                    love_triangle, love_triangle_mean, triangle_area)
+from multiscale.micro.zones import Zone, ZoneGrid, cut_triangles, cut_zones, generate_zones
+from multiscale.references.love import (love_rectangle, love_rectangle_mean, love_triangle, love_triangle_mean,
+                                        triangle_area)
 
 E = HalfSpace(1e9)
 

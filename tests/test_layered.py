@@ -7,19 +7,14 @@ import pytest
 from scipy.special import j0
 
 from multiscale.errors import InputError
-from multiscale.micro.kernels import HalfSpace, InfluenceOperator, ThermalHalfSpace, love_rectangle
+from multiscale.micro.kernels import HalfSpace, InfluenceOperator, ThermalHalfSpace
 from multiscale.micro.layered import LayeredElastic, LayeredThermal, layer_boundaries, layer_means
+from multiscale.references.conduction import exponential_graded_compliance, thermal_layer_compliance
+from multiscale.references.layered import layer_on_rigid_base_compliance, oedometric_compliance
+from multiscale.references.love import love_rectangle
 
 
 # ----------------------------------------------------------------------------- references
-def carbone_mangialardi(q, h, E, nu):
-    """Compliance of one layer bonded to a rigid base (Carbone & Mangialardi 2008, eq. A.30)."""
-    k, t = 3 - 4 * nu, q * h
-    stiffness = (E / (1 - nu**2) * q / 2) * (k * np.cosh(2 * t) + 2 * t * t + 8 * nu**2 - 12 * nu + 5) \
-        / (k * np.sinh(2 * t) - 2 * t)
-    return 1 / stiffness
-
-
 def propagator_reference(q, thickness, E, nu, substrate_E=None, substrate_nu=0.3):
     """F(q) from the product of layer propagators exp(-A q h) (thesis Eq. 2.4, App. B), 60 digits."""
     D = Decimal
@@ -64,7 +59,7 @@ def propagator_reference(q, thickness, E, nu, substrate_E=None, substrate_nu=0.3
 def brute_influence(kernel, offsets, dx, dy, ng=8):
     """Cell integrals of the remainder g(r) = (1/2pi) ∫ excess(q)/q J0(q r) q dq: uniform-panel
     Gauss quadrature in q (250 panels) and ng x ng Gauss points on the cell, no splines."""
-    q_cut = kernel._cutoff()
+    q_cut = kernel.cutoff()
     x, w = np.polynomial.legendre.leggauss(24)
     edges = np.linspace(0, q_cut, 251)
     q = ((edges[:-1, None] + edges[1:, None]) / 2 + np.diff(edges)[:, None] / 2 * x).ravel()
@@ -98,8 +93,8 @@ def test_layer_on_rigid_base_matches_carbone_mangialardi_and_oedometric_limit(nu
     lay = LayeredElastic([h], [E], [nu])
     t = np.geomspace(1e-6, 300, 200)
     F = lay.compliance(t / h)
-    assert np.max(np.abs(F / carbone_mangialardi(t / h, h, E, nu) - 1)) < 1e-8
-    oedometric = h * (1 + nu) * (1 - 2 * nu) / (E * (1 - nu))
+    assert np.max(np.abs(F / layer_on_rigid_base_compliance(t / h, h, E, nu) - 1)) < 1e-8
+    oedometric = oedometric_compliance(h, E, nu)
     assert lay.static_compliance == pytest.approx(oedometric, rel=1e-14)
     assert lay.compliance(np.array([0.0]))[0] == lay.static_compliance
     assert F[0] == pytest.approx(oedometric, rel=1e-12)          # k h = 1e-6
@@ -166,12 +161,10 @@ def test_elastic_trends_stiffer_substrate_and_thinner_layer_lower_compliance():
 def test_thermal_layer_on_half_space_closed_form():
     k1, k2, h = 10.0, 50.0, 2e-4
     q = np.geomspace(1.0, 1e8, 200)
-    c = (k1 - k2) / (k1 + k2)
-    ref = (1 / (k1 * q)) * (1 + c * np.exp(-2 * q * h)) / (1 - c * np.exp(-2 * q * h))
     F = LayeredThermal([h], [k1], k2).compliance(q)
-    assert np.max(np.abs(F / ref - 1)) < 1e-12
+    assert np.max(np.abs(F / thermal_layer_compliance(q, h, k1, k2) - 1)) < 1e-12
     iso = LayeredThermal([h], [k1]).compliance(q)                    # fixed temperature below
-    assert np.max(np.abs(iso / (np.tanh(q * h) / (k1 * q)) - 1)) < 1e-12
+    assert np.max(np.abs(iso / thermal_layer_compliance(q, h, k1) - 1)) < 1e-12
 
 
 @pytest.mark.parametrize("ratio, Kp", [(1.0, 8.33e3), (0.5, 5.88e3), (0.25, 3.70e3)])
@@ -185,15 +178,13 @@ def test_series_limit_gives_table_5_4_perfect_contact_conductance(ratio, Kp):
 def test_graded_exponential_conductivity_converges_to_exact_at_second_order():
     k0, beta, H = 10.0, 3e3, 1e-3                      # kappa = k0 exp(beta z): e^3 contrast over 1 mm
     q = np.geomspace(1e2, 1e4, 7)
-    mp, mm = (-beta + np.sqrt(beta**2 + 4 * q**2)) / 2, (-beta - np.sqrt(beta**2 + 4 * q**2)) / 2
-    T0 = np.exp(-mp * H) - np.exp(-mm * H)             # T = e^{m+(z-H)} - e^{m-(z-H)}, T(H) = 0
-    exact = T0 / (-k0 * (mp * np.exp(-mp * H) - mm * np.exp(-mm * H)))
+    exact = exponential_graded_compliance(q, k0, beta, H)
     errors = [np.max(np.abs(LayeredThermal.graded(lambda z: k0 * np.exp(beta * z), H, n).compliance(q) / exact - 1))
               for n in (10, 20, 40)]
     assert errors[2] < 5e-3
     assert errors[0] / errors[1] > 3.5 and errors[1] / errors[2] > 3.5
     static = LayeredThermal.graded(lambda z: k0 * np.exp(beta * z), H, 7).static_compliance
-    assert static == pytest.approx((1 - np.exp(-beta * H)) / (k0 * beta), rel=1e-8)
+    assert static == pytest.approx(exponential_graded_compliance(0.0, k0, beta, H), rel=1e-8)   # 1-D series
 
 
 def test_graded_elastic_profile_converges():

@@ -4,11 +4,14 @@ import numpy as np
 import pytest
 
 from multiscale.errors import InputError
-from multiscale.micro.asperity import AsperityModel, HertzCircular
+from multiscale.micro.asperity import AsperityModel
+from multiscale.micro.asperity_laws import HertzCircular
 from multiscale.micro.contact import solve_contact
 from multiscale.micro.layered import LayeredElastic
 from multiscale.micro.layered_asperity import LayeredAsperity, layered_law
 from multiscale.micro.surface import Surface, find_asperities
+from multiscale.references.hertz import sphere_load, sphere_on_flat_at_radius
+from multiscale.references.layered import thin_layer_sphere
 
 E1, NU, R = 4e9, 0.15, 100e-6                       # thesis §2.3.2: E1 = 4 GPa, nu = 0.15, H = 1 mm
 
@@ -24,10 +27,10 @@ def test_homogeneous_solid_is_hertz():
     sol = asp.exact(a, R)
     Es = E1 / (1 - NU**2)
     assert np.allclose(sol.chi, 1, atol=1e-12) and np.allclose(sol.zeta, 1, atol=1e-12)
-    assert np.allclose(sol.force, 4 * Es * a**3 / (3 * R), rtol=1e-12)
+    assert np.allclose(sol.force, sphere_load(a * a / R, R, Es), rtol=1e-12)
     assert np.allclose(asp.approximate(a), 1, atol=1e-12)
     r = np.linspace(0, 30e-6, 7)
-    hertz = 2 * Es * np.sqrt(30e-6**2 - r**2) / (np.pi * R)
+    hertz = sphere_on_flat_at_radius(30e-6, R, Es).pressure(r)
     assert np.allclose(asp.pressure(30e-6, R, r), hertz, rtol=1e-9, atol=1e-9 * hertz[0])
 
 
@@ -56,12 +59,12 @@ def test_nystrom_converges():
 def test_thin_layer_on_rigid_base_tends_to_winkler():
     """a >> h: p = (M/h)(delta - r²/2R), a² = 2 R delta, P = pi M R delta²/h (M oedometric)."""
     E, nu, delta = 4e9, 0.3, 0.5e-6
-    M = E * (1 - nu) / ((1 + nu) * (1 - 2 * nu))
     a_w = np.sqrt(2 * R * delta)
     err = []
     for h in (a_w / 2.5, a_w / 5):
         curve = LayeredAsperity(LayeredElastic([h], [E], [nu]), 1.3 * a_w).force_curve([delta], R)
-        err.append((abs(curve.force[0] / (np.pi * M * R * delta**2 / h) - 1), abs(curve.radius[0] / a_w - 1)))
+        winkler = thin_layer_sphere(delta, R, h, E, nu)
+        err.append((abs(curve.force[0] / winkler.load - 1), abs(curve.radius[0] / winkler.contact_radius - 1)))
     assert err[1][0] < 0.01 and err[1][1] < 0.03
     assert err[1][0] < err[0][0] and err[1][1] < err[0][1]
 

@@ -5,7 +5,7 @@ constrained conjugate gradient of Polonsky & Keer (1999), with ``L`` applied by 
 (``InfluenceOperator``). Load control fixes the mean pressure, displacement control the rigid
 approach. Batches of patches (leading axes) are solved in one call, each patch iterating on its
 own until it converges (then it is frozen), so batched and looped answers agree. The cell loops
-of an iteration are compiled (``_pk_steps``, numba); a batch runs in chunks of ``_CHUNK_CELLS``
+of an iteration are compiled (``pk_steps``, numba); a batch runs in chunks of ``_CHUNK_CELLS``
 cells that keep the working set in the CPU cache.
 
 Conventions: heights ``h`` [m] point towards the rigid flat. The flat first touches the highest
@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
-from multiscale.micro import _pk_steps as _pk
+from multiscale.micro import pk_steps
 from multiscale.micro.kernels import InfluenceOperator, Kernel
 
 
@@ -134,7 +134,7 @@ class ContactSolver:
         """Polonsky–Keer iterations on B patches (z: (B, ny, nx); scale, target or delta: (B,));
         returns the partial result of shape (B, ...) when not converged.
 
-        The cell loops of each iteration are compiled (``_pk_steps``); the FFT convolution of the
+        The cell loops of each iteration are compiled (``pk_steps``); the FFT convolution of the
         direction runs on the whole chunk. Between exact evaluations u = L p is updated as
         c (u − τ L t), exact while projection and overlap correction leave p alone; otherwise,
         every ``_REFRESH`` iterations and before accepting convergence, u is recomputed by FFT.
@@ -174,12 +174,12 @@ class ContactSolver:
         recompute(exact)
         d, G, gmin, count = np.zeros(B), np.zeros(B), np.zeros(B), np.zeros(B, dtype=np.int64)
         corrected, lost, conjugate = (np.zeros(B, dtype=bool) for _ in range(3))
-        pending = np.ones(B)                      # load-balance factor of p and u, see _pk.step
+        pending = np.ones(B)                      # load-balance factor of p and u, see pk_steps.step
         G_old, active = np.ones(B), np.ones(B, dtype=bool)
         iterations, history = np.zeros(B, dtype=int), []
         since_refresh = 0
         while True:
-            _pk.gap_statistics(p3, u3, z3, delta, load_control, pending, d, G, count, gmin)
+            pk_steps.gap_statistics(p3, u3, z3, delta, load_control, pending, d, G, count, gmin)
             res = np.maximum(np.sqrt(G / np.maximum(count, 1)), np.maximum(-gmin, 0.0)) / scale
             done = active & (res <= tol)
             if np.any(done & ~exact):        # accept convergence only on an exact displacement
@@ -193,9 +193,9 @@ class ContactSolver:
             iterations += active
             beta = np.where(conjugate, G / G_old, 0.0)
             G_old = np.where(G > 0, G, 1.0)
-            _pk.direction(p3, u3, z3, d, active, beta, t)                  # t: the direction
+            pk_steps.direction(p3, u3, z3, d, active, beta, t)                  # t: the direction
             ws.apply()
-            _pk.step(p3, u3, z3, d, count, target, load_control, active, t, r, pending, corrected, lost,
+            pk_steps.step(p3, u3, z3, d, count, target, load_control, active, t, r, pending, corrected, lost,
                      conjugate)                                             # r = L t
             if lost.any():                   # every point left the contact: restart from the top
                 p[lost] = _rescale(zf[lost] == 0, target[lost], zf[lost])

@@ -9,6 +9,7 @@ from __future__ import annotations
 import os
 
 import numpy as np
+import scipy.fft
 
 try:  # pragma: no cover - depends on the installation
     import pyfftw
@@ -64,7 +65,6 @@ class RealFFT2:
         if self._fwd is not None:
             self._fwd()
         else:  # pragma: no cover
-            import scipy.fft
             self.spectrum[...] = scipy.fft.rfft2(self.input, workers=self.threads)
         return self.spectrum
 
@@ -77,7 +77,6 @@ class RealFFT2:
         if self._inv is not None:
             self._inv(normalise_idft=normalise)
         else:  # pragma: no cover
-            import scipy.fft
             self.output[...] = scipy.fft.irfft2(self.spectrum, s=self.shape[-2:], workers=self.threads)
             if not normalise:
                 self.output *= self.size

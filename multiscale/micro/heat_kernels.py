@@ -33,7 +33,8 @@ import numpy as np
 from scipy.special import erf, erfc
 
 from multiscale.errors import InputError, check_positive
-from multiscale.micro.kernels import ThermalHalfSpace, wrap_offsets, love_rectangle
+from multiscale.micro.kernels import ThermalHalfSpace, wrap_offsets
+from multiscale.references.love import love_rectangle
 
 _GL6 = np.polynomial.legendre.leggauss(6)
 _GL8 = np.polynomial.legendre.leggauss(8)

@@ -17,6 +17,7 @@ import numpy as np
 
 from multiscale.errors import InputError, check_positive
 from multiscale.micro.fft import RealFFT2
+from multiscale.references.love import love_rectangle
 
 
 class Kernel(ABC):
@@ -105,22 +106,6 @@ class ThermalHalfSpace(Kernel):
         ox = wrap_offsets(nx) * dx
         oy = wrap_offsets(ny) * dy
         return love_rectangle(ox[None, :], oy[:, None], dx / 2, dy / 2) / (2 * np.pi * self.kappa)
-
-
-def love_rectangle(x, y, a, b):
-    """∫∫ dξ dη / r over the rectangle |ξ| < a, |η| < b seen from (x, y) [m].
-
-    Love's solution: the surface displacement under a uniform pressure p on that rectangle is
-    ``p / (pi E*)`` times this (thesis §3.3.2). Written with asinh so that it is accurate far from
-    the rectangle; (x ± a, y ± b) must not vanish (true at cell centres).
-    """
-    def corner(X, Y):
-        with np.errstate(divide="ignore", invalid="ignore"):
-            fx = np.where(X != 0, X * np.arcsinh(Y / np.abs(np.where(X != 0, X, 1))), 0.0)
-            fy = np.where(Y != 0, Y * np.arcsinh(X / np.abs(np.where(Y != 0, Y, 1))), 0.0)
-        return fx + fy
-
-    return corner(x + a, y + b) - corner(x + a, y - b) - corner(x - a, y + b) + corner(x - a, y - b)
 
 
 def wrap_offsets(n: int) -> np.ndarray:

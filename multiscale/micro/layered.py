@@ -34,7 +34,8 @@ from scipy.interpolate import CubicSpline
 from scipy.special import j0, j1
 
 from multiscale.errors import InputError, check_positive
-from multiscale.micro.kernels import Kernel, wrap_offsets, love_rectangle
+from multiscale.micro.kernels import Kernel, wrap_offsets
+from multiscale.references.love import love_rectangle
 
 _NEAR = 4        # cells |i|, |j| <= _NEAR around the loaded cell use the exact corner formula
 _GAUSS = 4       # Gauss points per direction on the other cells
@@ -76,8 +77,8 @@ class LayeredKernel(Kernel):
         return self._chunked(qu)[1][inverse].reshape(q.shape)
 
     def _chunked(self, q, size: int = 16384):
-        """``_response`` over a 1-D array in cache-sized chunks: (q F, excess)."""
-        parts = [self._response(q[i:i + size]) for i in range(0, q.size, size)]
+        """``_response`` over a 1-D array (possibly empty) in cache-sized chunks: (q F, excess)."""
+        parts = [self._response(q[i:i + size]) for i in range(0, max(q.size, 1), size)]
         return np.concatenate([p[0] for p in parts]), np.concatenate([p[1] for p in parts])
 
     def _excess(self, q):
@@ -102,20 +103,20 @@ class LayeredKernel(Kernel):
         ox = wrap_offsets(nx) * dx
         oy = wrap_offsets(ny) * dy
         coeffs = love_rectangle(ox[None, :], oy[:, None], dx / 2, dy / 2) * (self.top_coefficient / (2 * np.pi))
-        q_cut = self._cutoff()
+        q_cut = self.cutoff()
         if q_cut > 0:
             coeffs += _remainder_influence(self, q_cut, ny, nx, dy, dx)
         return coeffs
 
-    def _cutoff(self) -> float:
-        """Wavenumber beyond which |excess| < 1e-15 A (0 if the excess vanishes everywhere)."""
+    def cutoff(self) -> float:
+        """Wavenumber [rad/m] beyond which |excess| < 1e-15 A (0 if the excess vanishes everywhere)."""
         h1 = self.thickness[0]
         q = np.arange(1, 801) * (0.25 / h1)
         big = np.nonzero(np.abs(self._excess(q)) > _EXCESS_TOL * self.top_coefficient)[0]
         return 0.0 if big.size == 0 else float(q[min(big[-1] + 1, q.size - 1)])
 
 
-def _q_nodes(q_cut: float, r_max: float, depth: float, per_panel: int = 6):
+def hankel_nodes(q_cut: float, r_max: float, depth: float, per_panel: int = 6):
     """Composite Gauss-Legendre nodes and weights on [0, q_cut]: panels no wider than pi/r_max
     (Bessel oscillations) and max(1/(20 depth), q/20) (variation of the layered transfer function)."""
     edges = [0.0]
@@ -129,9 +130,9 @@ def _q_nodes(q_cut: float, r_max: float, depth: float, per_panel: int = 6):
     return (mid[:, None] + half[:, None] * x).ravel(), (half[:, None] * w).ravel()
 
 
-def _radial_table(kernel, q_cut, r_lo, r_hi, moment: bool):
+def radial_table(kernel, q_cut, r_lo, r_hi, moment: bool):
     """Cubic spline of g(r) (moment=False) or M(r) = ∫_0^r g r' dr' (moment=True), r in [r_lo, r_hi]."""
-    q, w = _q_nodes(q_cut, r_hi, sum(kernel.thickness))
+    q, w = hankel_nodes(q_cut, r_hi, sum(kernel.thickness))
     R = kernel._excess(q) / q
     n = int(np.ceil(np.log(r_hi / r_lo) / np.log(1.02))) + 1
     r = r_lo * np.exp(np.linspace(0.0, np.log(r_hi / r_lo), n))
@@ -163,7 +164,7 @@ def _remainder_influence(kernel, q_cut, ny, nx, dy, dx):
     # near zone: exact corner function
     K = _NEAR
     r_near = np.hypot((K + 1) * dx, (K + 1) * dy)
-    M = _radial_table(kernel, q_cut, min(h_min, dx, dy) / 100, r_near, moment=True)
+    M = radial_table(kernel, q_cut, min(h_min, dx, dy) / 100, r_near, moment=True)
     cx = (np.arange(K + 1) + 0.5) * dx
     cy = (np.arange(K + 1) + 0.5) * dy
     Phi = _corner(M, cx[None, :] + 0 * cy[:, None], cy[:, None] + 0 * cx[None, :])
@@ -181,7 +182,7 @@ def _remainder_influence(kernel, q_cut, ny, nx, dy, dx):
     far = ~(near_y[:, None] & near_x[None, :])
     if far.any():
         r_hi = np.hypot((nx + 0.5) * dx, (ny + 0.5) * dy) * 1.001
-        g = _radial_table(kernel, q_cut, (K + 0.5) * min(dx, dy) * 0.999, r_hi, moment=False)
+        g = radial_table(kernel, q_cut, (K + 0.5) * min(dx, dy) * 0.999, r_hi, moment=False)
         x, w = np.polynomial.legendre.leggauss(_GAUSS)
         X = ix[None, :] * dx
         Y = iy[:, None] * dy

@@ -29,9 +29,10 @@ from scipy.interpolate import CubicSpline, RectBivariateSpline
 from scipy.special import j0
 
 from multiscale.errors import InputError, check_positive
-from multiscale.micro.asperity import AsperityLaw
-from multiscale.micro.layered import LayeredElastic, _q_nodes, _radial_table
+from multiscale.micro.asperity_laws import AsperityLaw
+from multiscale.micro.layered import LayeredElastic, hankel_nodes, radial_table
 from multiscale.micro.surface import AsperityTable
+from multiscale.references.hertz import sphere_load
 
 
 @dataclass
@@ -168,7 +169,7 @@ class LayeredAsperity:
         rb = CubicSpline(d_app, a)(d)
         P = CubicSpline(a, full.chi)(ra) * 4 * self.E_star * ra**3 / (3 * R)
         Pa = CubicSpline(a, chi)(rb) * 4 * self.E_star * rb**3 / (3 * R)
-        return ForceCurve(d, P, ra, Pa, rb, 4 * self.E_star * np.sqrt(R) * d**1.5 / 3)
+        return ForceCurve(d, P, ra, Pa, rb, sphere_load(d, R, self.E_star))
 
     # -- interaction terms -----------------------------------------------------------------
     def interaction_table(self, r_max: float, n_a: int = 48, r_points: int = 240):
@@ -176,8 +177,8 @@ class LayeredAsperity:
         as a spline over a in [0, a_max] and r in [r_min, r_max] (r_min = a_max / 100)."""
         kernel = self.kernel
         r_max = check_positive("r_max", r_max)
-        q, wq = _q_nodes(kernel._cutoff(), max(r_max, self.a_max), sum(kernel.thickness))
-        k = kernel._excess(q) / kernel.top_coefficient
+        q, wq = hankel_nodes(kernel.cutoff(), max(r_max, self.a_max), sum(kernel.thickness))
+        k = kernel.excess(q) / kernel.top_coefficient
         a = np.linspace(0, self.a_max, n_a)
         x = np.outer(q, a)
         small = x < 1e-2                                              # series of sin x − x cos x
@@ -190,12 +191,12 @@ class LayeredAsperity:
 
 class _CosineTransform:
     """c(y) = ∫_0^∞ k(u) cos(u y) du on [0, Y], k = excess / A: composite Gauss–Legendre in u
-    (``_q_nodes``), tabulated every h1/48 in y and interpolated by a cubic spline (c varies on the
+    (``hankel_nodes``), tabulated every h1/48 in y and interpolated by a cubic spline (c varies on the
     scale h1: relative interpolation error ~1e-9)."""
 
     def __init__(self, kernel: LayeredElastic, Y: float):
-        u, w = _q_nodes(kernel._cutoff(), Y, sum(kernel.thickness))
-        kw = kernel._excess(u) / kernel.top_coefficient * w
+        u, w = hankel_nodes(kernel.cutoff(), Y, sum(kernel.thickness))
+        kw = kernel.excess(u) / kernel.top_coefficient * w
         n = int(min(200000, 64 + 48 * np.ceil(Y / kernel.thickness[0])))
         y = np.linspace(0.0, Y, n)
         values = np.concatenate([np.cos(np.outer(y[i:i + 512], u)) @ kw for i in range(0, n, 512)])
@@ -235,7 +236,7 @@ class LayeredCircular(AsperityLaw):
         self._r_min = asperity.a_max / 100
         kernel = asperity.kernel
         A = kernel.top_coefficient
-        self._G = _radial_table(kernel, kernel._cutoff(), self._r_min, self.r_max, moment=False)
+        self._G = radial_table(kernel, kernel.cutoff(), self._r_min, self.r_max, moment=False)
         self._top = A / (2 * np.pi)
         E_s, nu_s = kernel.substrate_E, kernel.substrate_nu
         self._far = 0.0 if np.isinf(E_s) else (1 - nu_s**2) / (np.pi * E_s)
@@ -245,8 +246,8 @@ class LayeredCircular(AsperityLaw):
         """max over r of (r²/10) |lap G(r)| / G_1(r) (G_1 = top layer as a half-space)."""
         kernel = self.asperity.kernel
         r = np.geomspace(self._r_min, self.r_max, 200)
-        q, w = _q_nodes(kernel._cutoff(), self.r_max, sum(kernel.thickness))
-        lap = -(j0(np.outer(r, q)) @ (kernel._excess(q) * q * q * w)) / (2 * np.pi)
+        q, w = hankel_nodes(kernel.cutoff(), self.r_max, sum(kernel.thickness))
+        lap = -(j0(np.outer(r, q)) @ (kernel.excess(q) * q * q * w)) / (2 * np.pi)
         lap += self._top / r**3                                      # lap (1/r) = 1/r³ on the surface
         return float(np.max(r**3 * np.abs(lap) / (10 * self._top)) * 2)
 

@@ -107,7 +107,8 @@ class PostAnalysis:
 
         speed [m/s] and angle [rad from +x] of the counter-face over each zone (B,); remote (B, 2)
         [K]: remote temperatures (counter-face, rough body) — needed with heating or a
-        temperature-dependent k_w (without heating, k_w is taken at the rough body's); sliding (B,) [m]: distance worn over (None: no wear this call);
+        temperature-dependent k_w (without heating, k_w is taken at the rough body's); sliding
+        (B,) [m]: distance worn over (None: no wear this call);
         warm (B, ny, nx): previous local pressures (warm start; rows summing to 0 start cold).
         """
         B = len(zones)

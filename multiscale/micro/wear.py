@@ -19,6 +19,7 @@ import time
 from dataclasses import dataclass, field
 
 import numpy as np
+from tqdm import tqdm
 
 from multiscale.errors import InputError, check_positive
 from multiscale.micro.contact import ContactSolver
@@ -203,7 +204,6 @@ def simulate_wear(surface: Surface, contact: Kernel | ContactSolver, *, load, mu
     p = _solve_at_load(solver, current.heights, loads, initial_pressure, rows, 0, options)
     steps_iter = range(1, steps + 1)
     if progress:
-        from tqdm import tqdm
         steps_iter = tqdm(steps_iter, desc="wear steps", unit="step")
     for j in [0, *steps_iter]:
         if j > 0:

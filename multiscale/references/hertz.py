@@ -1,7 +1,15 @@
-"""Elliptic Hertz contact in closed form (thesis §1.2.1 and §1.2.2.3, Eqs. 1.1–1.4, 1.17–1.22).
+"""Hertz contact of a sphere or an ellipsoid on an elastic flat (Hertz 1882; Johnson 1985, ch. 4).
 
-Everything is written for a contact ellipse of semi-axes ``a = 1`` (along X) and ``b = sqrt(bb)``
-(along Y), ``bb = b²/a² = 1 − e²``; lengths scale with ``a``. The potential integrals of Eq. 1.17,
+Frictionless, small strains; ``E_star`` [Pa] is the composite modulus
+1/E* = (1 − ν1²)/E1 + (1 − ν2²)/E2. Pressure positive in compression, approach δ [m] positive as
+the bodies close.
+
+Sphere (thesis Eqs. 1.1, 1.3, 1.5 with e = 0): P = 4/3 E* R^½ δ^(3/2), a = (3 P R / 4 E*)^(1/3),
+δ = a²/R, p0 = 3P/(2π a²), p(r) = p0 √(1 − r²/a²).
+
+Ellipse (thesis §1.2.1 and §1.2.2.3, Eqs. 1.1–1.4, 1.17–1.22): written for a contact ellipse of
+semi-axes ``a = 1`` (along X) and ``b = sqrt(bb)`` (along Y), ``bb = b²/a² = 1 − e²``; lengths
+scale with ``a``. The potential integrals of Eq. 1.17,
 
     I0(λ) = ∫_λ^∞ dw / sqrt((1+w)(bb+w) w)
     Ia(λ) = ∫_λ^∞ dw / sqrt((1+w)³(bb+w) w),   Ib(λ) = ∫_λ^∞ dw / sqrt((1+w)(bb+w)³ w),
@@ -17,12 +25,55 @@ e → 1. The surface displacement of the Hertz pressure p0 sqrt(1 − X² − Y�
 """
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 from scipy import special
 
-from multiscale.errors import InputError
+from multiscale.errors import InputError, check_positive
 
 
+# ----------------------------------------------------------------------------- sphere on a flat
+@dataclass(frozen=True)
+class HertzContact:
+    """Hertz contact of a sphere on a flat under one load."""
+
+    load: float            # N, P
+    contact_radius: float  # m, a
+    max_pressure: float    # Pa, p0 = 3P/(2π a²), at the centre
+    approach: float        # m, δ = a²/R
+
+    def pressure(self, r) -> np.ndarray:
+        """p(r) = p0 √(1 − r²/a²) [Pa] at radii ``r`` [m] (0 outside the contact; thesis Eq. 1.5)."""
+        r = np.asarray(r, dtype=float)
+        return self.max_pressure * np.sqrt(np.maximum(1.0 - (r / self.contact_radius) ** 2, 0.0))
+
+
+def sphere_on_flat(load: float, radius: float, E_star: float) -> HertzContact:
+    """Contact of a sphere of radius ``radius`` [m] pressed by ``load`` [N] > 0 on a flat (E* [Pa])."""
+    P = check_positive("load", load)
+    R = check_positive("radius", radius)
+    a = (3 * P * R / (4 * check_positive("E_star", E_star))) ** (1 / 3)
+    return HertzContact(P, a, 3 * P / (2 * np.pi * a * a), a * a / R)
+
+
+def sphere_on_flat_at_radius(contact_radius: float, radius: float, E_star: float) -> HertzContact:
+    """The same contact given its radius a [m] > 0: P = 4 E* a³/(3R), p0 = 2 E* a/(π R), δ = a²/R."""
+    a = check_positive("contact_radius", contact_radius)
+    R = check_positive("radius", radius)
+    E = check_positive("E_star", E_star)
+    return HertzContact(4 * E * a**3 / (3 * R), a, 2 * E * a / (np.pi * R), a * a / R)
+
+
+def sphere_load(approach, radius: float, E_star: float):
+    """Load P = 4/3 E* R^½ δ^(3/2) [N] of a sphere (radius R [m]) at approaches δ [m] >= 0 (Eq. 1.1, e = 0)."""
+    d = np.asarray(approach, dtype=float)
+    if np.any(d < 0):
+        raise InputError("approach", approach, "must be >= 0")
+    return 4 / 3 * E_star * np.sqrt(radius) * d**1.5
+
+
+# ----------------------------------------------------------------------------- ellipsoid on a flat
 def potential_integrals(lam, bb):
     """(I0, Ia, Ib) of Eq. 1.17 at λ >= 0 for the ellipse (1, sqrt(bb)), 0 < bb <= 1."""
     lam = np.asarray(lam, dtype=float)
@@ -79,7 +130,7 @@ def axis_ratio_squared(R2_over_R1, *, exact: bool = True):
 
 
 def hertz_F1(e):
-    """F1(e) of Eq. 1.1 (Legendre form, for reference): P = 4/3 E* R^½ F1 δ^(3/2); F1(0) = 1."""
+    """F1(e) of Eq. 1.1 (Legendre form): P = 4/3 E* R^½ F1 δ^(3/2), R = sqrt(R' R''); F1(0) = 1."""
     e = np.asarray(e, dtype=float)
     m = e * e
     K, E = special.ellipk(m), special.ellipe(m)
@@ -89,7 +140,7 @@ def hertz_F1(e):
 
 
 def hertz_A1(e):
-    """A1(e) of Eq. 1.3 (Legendre form, for reference): A = π A1 R δ; A1(0) = 1."""
+    """A1(e) of Eq. 1.3 (Legendre form): contact area A = π a b = π A1 R δ; A1(0) = 1."""
     e = np.asarray(e, dtype=float)
     K = special.ellipk(e * e)
     return np.sqrt(1.0 - e * e) * (2.0 * K * hertz_F1(e) / np.pi) ** 2
