@@ -55,7 +55,7 @@ from pathlib import Path
 from multiscale.errors import MultiscaleError, SceneError
 from multiscale.schema import (Bad, Choice, Context, FilePath, Flag, FrozenMap, Integer, ListOf, Quantity,
                                Section, Text, fields_of, key, read, show, suggest)
-from multiscale.units import _VALUE, UnitError, parse_unit
+from multiscale.units import VALUE, UnitError, parse_unit
 
 __all__ = ["Study", "StudyRun", "load_study", "execute", "collect", "report", "run_studies"]
 
@@ -410,7 +410,7 @@ def _si(value, parser=None):
     if isinstance(value, bool) or not isinstance(value, (int, float, str)):
         raise Bad("range bounds must be numbers or \"<number> <unit>\" strings")
     if isinstance(value, str):
-        match = _VALUE.match(value)
+        match = VALUE.match(value)
         if not match:
             raise Bad(f"cannot read {show(value)} as a number with a unit")
         factor, offset, _ = parse_unit(match.group(2))
