@@ -1,0 +1,1 @@
+"""Figures (matplotlib): imported only where figures are drawn."""
