@@ -20,7 +20,8 @@ import time
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
-from multiscale.micro.asperity import AsperityModel, hertz_law  # noqa: E402
+from multiscale.micro.asperity import AsperityModel  # noqa: E402
+from multiscale.micro.asperity_laws import hertz_law  # noqa: E402
 from multiscale.micro.contact import ContactSolver  # noqa: E402
 from multiscale.micro.kernels import HalfSpace  # noqa: E402
 from multiscale.micro.surface import find_asperities, fractal_surface  # noqa: E402

@@ -82,7 +82,7 @@ def _run(args) -> int:
 
 def _study(args) -> int:
     """Run parametric studies; every problem of every study file is reported before anything runs."""
-    from multiscale.studies import problems_text, run_studies
+    from multiscale.studies import problems_text, run_studies  # local: loads the numba micro modules
     if args.problems:
         print(problems_text())
         return 0

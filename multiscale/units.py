@@ -18,7 +18,7 @@ import re
 from dataclasses import dataclass
 from fractions import Fraction
 
-__all__ = ["KINDS", "Kind", "UnitError", "parse_unit", "to_si"]
+__all__ = ["KINDS", "VALUE", "Kind", "UnitError", "parse_unit", "to_si"]
 
 # Dimension exponents over the base units (m, kg, s, K, rad).
 _BASE = ("m", "kg", "s", "K", "rad")
@@ -98,7 +98,7 @@ _PREFIXES = {"G": _F(10**9), "M": _F(10**6), "k": _F(1000), "c": _F(1, 100), "m"
              "p": _F(1, 10**12)}
 _SUPERSCRIPT = str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻", "0123456789-")
 _NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
-_VALUE = re.compile(rf"^\s*({_NUMBER})\s*(.*?)\s*$")
+VALUE = re.compile(rf"^\s*({_NUMBER})\s*(.*?)\s*$")       # "<number> <unit>": groups number, unit
 _TOKEN = re.compile(r"\s*(?:(?P<num>\d+\.?\d*(?:[eE][+-]?\d+)?)|(?P<name>°C|[A-Za-zµμ°%]+)"
                     r"|(?P<sup>[⁰¹²³⁴⁵⁶⁷⁸⁹⁻]+)|(?P<op>\*\*|[/*·^()]|-?\d+))")
 
@@ -237,7 +237,7 @@ def to_si(value, kind: str) -> float:
             raise UnitError(f'{_a(spec.name)} needs its unit, e.g. "{value} degC" or "{value} K"')
         number, (factor, offset, dim) = _F(value), (_F(1), _F(0), spec.dim)
     else:
-        match = _VALUE.match(value)
+        match = VALUE.match(value)
         if not match:
             raise UnitError(f'{expect}: write a number then a unit, like "{_example(spec)}"')
         number = _F(match.group(1))

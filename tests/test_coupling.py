@@ -24,7 +24,8 @@ from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace  # noqa: E402
 from multiscale.micro.laws import Conductance, LawSpec, ZoneLaws, ZoneNodes, compute_laws  # noqa: E402
 from multiscale.micro.post_analysis import Heating, PostAnalysis  # noqa: E402
 from multiscale.micro.surface import Surface, fractal_surface  # noqa: E402
-from multiscale.micro.zones import cut_zones, love_rectangle_mean  # noqa: E402
+from multiscale.micro.zones import cut_zones  # noqa: E402
+from multiscale.references.love import love_rectangle_mean  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 
 N_POINTS = 8          # nodes per law in every test here: the compiled forms are shared

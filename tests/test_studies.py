@@ -307,8 +307,8 @@ def test_runs_are_shared_out_over_mpi_ranks(tmp_path):
 def test_squeal_scene_metrics_from_the_mode_table(tmp_path):
     """A squeal scene's study metrics, read back from modes.csv, equal those of the eigenvalues."""
     pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
-    from multiscale.macro.stability import ModalResult
-    from multiscale.study_problems import squeal_metrics
+    from multiscale.macro.eigen import ModalResult
+    from multiscale.studies.scene_problem import squeal_metrics
     lam = np.array([-3.0 + 2j * np.pi * 900.0, 40.0 + 2j * np.pi * 2500.0, 0.0 + 2j * np.pi * 4000.0,
                     12.0 + 2j * np.pi * 7100.0])
     modes = ModalResult(lam, -lam**2, np.zeros((1, 4), complex), np.full(4, 1e-12), (0.0, 16e3), 0.0, 10,

@@ -27,7 +27,8 @@ import ufl
 from dolfinx import fem
 
 from multiscale.errors import InputError
-from multiscale.micro.laws import PressureGapLaw, ZoneLaws
+from multiscale.micro.law_tables import PressureGapLaw
+from multiscale.micro.laws import ZoneLaws
 
 # layout of a law's coefficient vector (n = nodes of the law): scalars, then 3 (n − 2) knot terms;
 # _SCALE multiplies the pressure (set per facet by FacetLaw, 1 in law_coefficients)

@@ -1,2 +1,2 @@
-"""Figures of the package, one module per results family (matplotlib, Agg backend); solver and
-workflow modules never draw. Only rank 0 calls these."""
+"""Figures of the package, one module per results family (matplotlib ``Figure`` objects, no pyplot
+state); solver, workflow and study modules never draw. Only rank 0 calls these."""

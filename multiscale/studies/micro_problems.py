@@ -1,12 +1,12 @@
-"""Named problems for parametric studies (``multiscale study``): parameters -> scalar metrics.
+"""The micro problems of parametric studies: parameters -> scalar metrics, with ``multiscale.micro``.
 
 A problem declares its parameters as a frozen dataclass of ``multiscale.schema`` keys (unit kind,
 range, default: study files are validated like scenes, with did-you-mean), the scalar metrics it
 returns (name -> description [unit]) and, where one exists, an exact or independent reference
 (``exact``): the study's ``reference.kind = "analytic"``. ``run(params, workdir)`` returns an
-``Outcome``. Micro problems import ``multiscale.micro`` only (a worker never loads DOLFINx); the
-``scene`` problem runs a macro scene with overrides in a subprocess (``multiscale run``'s runner)
-and reads its metrics from the HDF5 history (squeal scenes: from their table of modes).
+``Outcome``. Only ``multiscale.micro`` is used (a worker never loads DOLFINx); its modules are
+imported here, with the worker, so a run's wall time and memory baseline never include loading
+them.
 
 Surfaces: the random fractal patch is drawn on a fixed generator grid (``source_n``) and resampled
 to the study's grid ``n`` by Fourier interpolation, which is exact for a band-limited surface
@@ -15,20 +15,27 @@ discretisation alone. Physics lives in ``multiscale.micro``; this module only se
 """
 from __future__ import annotations
 
-import importlib
-import json
-import os
-import subprocess
-import sys
-from dataclasses import asdict, dataclass, field
-from pathlib import Path
+from dataclasses import asdict, dataclass, replace
 
 import numpy as np
 
-from multiscale.errors import InputError, SceneError
-from multiscale.schema import Choice, Context, Flag, Integer, Pair, Quantity, key, read, suggest
+from multiscale.micro.asperity import AsperityModel
+from multiscale.micro.conduction import ConductionSolver, SeriesKernel
+from multiscale.micro.contact import ContactSolver
+from multiscale.micro.heat_kernels import Rotation, SpeedProfile, ThermalMaterial
+from multiscale.micro.heating import SteadyHeating, TransientHeating
+from multiscale.micro.kernels import HalfSpace
+from multiscale.micro.laws import LawSpec, compute_laws
+from multiscale.micro.layered import LayeredElastic, LayeredThermal
+from multiscale.micro.surface import Surface, fractal_surface
+from multiscale.micro.wear import simulate_wear
+from multiscale.micro.zones import cut_zones
+from multiscale.references.hertz import sphere_on_flat
+from multiscale.references.love import love_rectangle, love_rectangle_mean
+from multiscale.schema import Choice, Flag, Integer, Pair, Quantity, key, read
+from multiscale.studies.base import Outcome, Problem, jsonable
 
-__all__ = ["Outcome", "PROBLEMS", "Problem", "MicroProblem", "SceneProblem", "rough_surface"]
+__all__ = ["MICRO_PROBLEMS", "MicroProblem", "SurfaceParams", "rough_surface"]
 
 _LENGTH = Quantity("length", gt=0)
 _MODULUS = Quantity("pressure", gt=0)
@@ -36,55 +43,12 @@ _POISSON = Quantity("dimensionless", gt=-1, lt=0.5)
 _POSITIVE = Quantity("dimensionless", gt=0)
 
 
-@dataclass
-class Outcome:
-    """What one run of a problem produced."""
-
-    metrics: dict                 # name -> float (SI units, see the problem's ``metrics``)
-    iterations: int = 0           # solver iterations, summed over the run's solves
-    converged: bool = True        # every solve reached its tolerance
-
-
-# ----------------------------------------------------------------------------- registry
-class Problem:
-    """A named problem: ``parse`` validates raw parameters, ``run`` computes the metrics."""
-
-    name: str
-    doc: str
-    metrics: dict                 # name -> description with unit
-    exact_metrics: tuple = ()     # metrics the analytic reference provides
-
-    def parse(self, raw: dict, path: str, ctx: Context, **options):
-        """Validated parameters (problems appended to ``ctx``); ``options``: the scene problem's
-        base scene and ranks."""
-        raise NotImplementedError
-
-    def key(self, params) -> dict:
-        """JSON-able identity of a run's parameters (hashed to name the run's record)."""
-        raise NotImplementedError
-
-    def prepare(self) -> None:
-        """Load what every run needs before its clock starts."""
-
-    def run(self, params, workdir: Path) -> Outcome:
-        raise NotImplementedError
-
-    def check_metric(self, name: str) -> str | None:
-        """None if ``name`` is a metric of this problem, else the problem (one line)."""
-        if name in self.metrics:
-            return None
-        return f'unknown metric of problem "{self.name}"{suggest(name, self.metrics)}; allowed: ' \
-               f'{", ".join(self.metrics)}'
-
-
 class MicroProblem(Problem):
     """A micro problem: ``params`` dataclass, ``function(params) -> Outcome``, optional
     ``exact(params) -> dict`` depending only on ``exact_params`` (None: all parameters)."""
 
-    def __init__(self, name, params, metrics, function, exact=None, exact_metrics=(), exact_params=None,
-                 imports=()):
+    def __init__(self, name, params, metrics, function, exact=None, exact_metrics=(), exact_params=None):
         self.name, self.params, self.metrics, self.function = name, params, dict(metrics), function
-        self.imports = ("surface", "kernels", "contact") + tuple(imports)
         self.doc = (function.__doc__ or "").strip().split("\n\n")[0].replace("\n", " ")
         self.exact, self.exact_metrics, self.exact_params = exact, tuple(exact_metrics), exact_params
 
@@ -92,43 +56,26 @@ class MicroProblem(Problem):
         return read(self.params, raw, path, ctx)
 
     def key(self, params) -> dict:
-        return _jsonable(asdict(params))
+        return jsonable(asdict(params))
 
     def exact_key(self, params) -> dict:
         values = self.key(params)
         return values if self.exact_params is None else {k: values[k] for k in self.exact_params}
 
-    def prepare(self) -> None:
-        """Import the micro modules the problem uses, so that a run's wall time and memory do not
-        include loading them."""
-        for name in self.imports:
-            importlib.import_module(f"multiscale.micro.{name}")
-
     def run(self, params, workdir):
         return self.function(params)
 
 
-PROBLEMS: dict[str, Problem] = {}
+MICRO_PROBLEMS: dict[str, Problem] = {}     # name -> problem, in registration order
 
 
-def _register(params, metrics, exact=None, exact_metrics=(), exact_params=None, imports=()):
+def _register(params, metrics, exact=None, exact_metrics=(), exact_params=None):
+    """Decorator: register ``function(params) -> Outcome`` as the problem named after it."""
     def wrap(function):
         name = function.__name__.lstrip("_")
-        PROBLEMS[name] = MicroProblem(name, params, metrics, function, exact, exact_metrics, exact_params, imports)
+        MICRO_PROBLEMS[name] = MicroProblem(name, params, metrics, function, exact, exact_metrics, exact_params)
         return function
     return wrap
-
-
-def _jsonable(value):
-    if isinstance(value, dict):
-        return {k: _jsonable(v) for k, v in value.items()}
-    if isinstance(value, (list, tuple)):
-        return [_jsonable(v) for v in value]
-    if isinstance(value, Path):
-        return str(value)
-    if isinstance(value, float) and not np.isfinite(value):
-        return str(value)
-    return value
 
 
 # ----------------------------------------------------------------------------- shared parameters
@@ -159,7 +106,6 @@ class SurfaceParams:
 
 def rough_surface(p: SurfaceParams, periodic: bool = True):
     """The patch of ``p`` on an n x n grid: drawn on ``source_n`` (seeded), Fourier-resampled."""
-    from multiscale.micro.surface import Surface, fractal_surface
     h = fractal_surface(p.source_n, p.size, p.hurst, p.k_min, p.k_max, p.rms, seed=p.seed).heights
     if p.n != p.source_n:
         h = _fourier_resample(h, p.n)
@@ -193,24 +139,20 @@ class HertzParams:
     max_iter: int = key(Integer(ge=1), default=5000)
 
 
-def _hertz_exact(p: HertzParams) -> dict:
-    """Hertz: a = (3 F R / 4 E*)^(1/3), p0 = 3 F / (2 pi a^2), delta = a^2 / R."""
-    from multiscale.micro.kernels import HalfSpace
-    E_star = HalfSpace.from_materials(p.E, p.nu).E_star
-    a = (3 * p.load * p.radius / (4 * E_star)) ** (1 / 3)
-    return {"contact_radius": a, "max_pressure": 3 * p.load / (2 * np.pi * a * a), "approach": a * a / p.radius}
+def _hertz_closed_form(p: HertzParams) -> dict:
+    """The exact values of ``references.hertz.sphere_on_flat``."""
+    h = sphere_on_flat(p.load, p.radius, HalfSpace.from_materials(p.E, p.nu).E_star)
+    return {"contact_radius": h.contact_radius, "max_pressure": h.max_pressure, "approach": h.approach}
 
 
 @_register(HertzParams, {"contact_radius": "radius of the contact area sqrt(A/pi) [m]",
                          "max_pressure": "peak contact pressure [Pa]",
                          "approach": "rigid approach from first touch [m]"},
-           exact=_hertz_exact, exact_metrics=("contact_radius", "max_pressure", "approach"))
+           exact=_hertz_closed_form, exact_metrics=("contact_radius", "max_pressure", "approach"))
 def _hertz(p: HertzParams) -> Outcome:
     """FFT-BEM Hertz contact (sphere on a half-space under a force) against the closed form."""
-    from multiscale.micro.contact import ContactSolver
-    from multiscale.micro.kernels import HalfSpace
     kernel = HalfSpace.from_materials(p.E, p.nu)
-    side = p.window * _hertz_exact(p)["contact_radius"]
+    side = p.window * _hertz_closed_form(p)["contact_radius"]
     dx = side / p.grid
     x = (np.arange(p.grid) + 0.5) * dx - side / 2
     heights = -(x[None, :] ** 2 + x[:, None] ** 2) / (2 * p.radius)
@@ -244,19 +186,16 @@ class RoughContactParams(SurfaceParams):
 
 
 @_register(RoughContactParams, {"mean_pressure": "force / nominal area [Pa]",
-                                "area_fraction": "real contact area / nominal area [-]"}, imports=("asperity",))
+                                "area_fraction": "real contact area / nominal area [-]"})
 def _rough_contact(p: RoughContactParams) -> Outcome:
     """Rough contact at one rigid approach: FFT-BEM or an asperity model (thesis §1.2.2, Fig. 1.14)."""
-    from multiscale.micro.kernels import HalfSpace
     kernel = HalfSpace.from_materials(p.E, p.nu)
     surface = rough_surface(p, periodic=p.periodic)
     if p.model == "fft-bem":
-        from multiscale.micro.contact import ContactSolver
         r = ContactSolver(kernel, surface.shape, surface.dx, periodic=p.periodic).solve(
             surface.heights, approach=p.approach, **({"tol": p.tol} if p.tol else {}))
         return Outcome({"mean_pressure": float(r.mean_pressure), "area_fraction": float(r.area_fraction)},
                        int(r.iterations), bool(r.converged))
-    from multiscale.micro.asperity import AsperityModel
     shape, interaction = _MODELS[p.model]
     model = AsperityModel.from_surface(surface, kernel, shape, interaction=interaction)
     # the same flat position: the asperity approach counts from the highest summit
@@ -289,11 +228,9 @@ class WearParams(SurfaceParams):
                         "max_pressure": "final peak contact pressure [Pa]",
                         "mean_gap": "final mean gap at the load [m]",
                         "rms_height": "final RMS height [m]",
-                        "volume": "worn volume [m^3]"}, imports=("wear",))
+                        "volume": "worn volume [m^3]"})
 def _wear_steps(p: WearParams) -> Outcome:
     """Wear of a rough patch in N steps (thesis §3.5.1: N = 200…600): final state."""
-    from multiscale.micro.kernels import HalfSpace
-    from multiscale.micro.wear import simulate_wear
     r = simulate_wear(rough_surface(p), HalfSpace.from_materials(p.E, p.nu, p.E2, p.nu2), load=p.pressure,
                       mu=p.mu, distance=p.distance, steps=p.steps, k_w=p.k_w, tol=p.tol)
     h = r.history
@@ -334,13 +271,9 @@ class ConductanceParams(SurfaceParams):
 @_register(ConductanceParams, {"conductance": "total thermal contact conductance K_t [W/(m^2 K)]",
                                "interface_conductance": "K_i = 1/(1/K_t - 1/K_p) [W/(m^2 K)]",
                                "contact_temperature": "T_s, mean temperature of solid 1 on the contact [K]",
-                               "area_fraction": "real contact area / nominal area [-]"},
-           imports=("conduction", "layered"))
+                               "area_fraction": "real contact area / nominal area [-]"})
 def _conductance(p: ConductanceParams) -> Outcome:
     """Thermal contact conductance of a rough (layered) contact at one pressure (thesis §5.5)."""
-    from multiscale.micro.conduction import ConductionSolver, SeriesKernel
-    from multiscale.micro.contact import ContactSolver
-    from multiscale.micro.layered import LayeredElastic, LayeredThermal
     L = p.thickness
     if p.h > 0:
         el1 = LayeredElastic((p.h, L - p.h), (p.E1, p.E2), (p.nu1, p.nu1))
@@ -401,14 +334,9 @@ class HeatPartitionParams(SurfaceParams):
                                  "partition_1_mean": "time average of partition_1 over the run [-]",
                                  "max_temperature": "largest surface temperature rise at the end [K]",
                                  "area_fraction": "real contact area / nominal area [-]",
-                                 "mean_pressure": "mean contact pressure [Pa]"},
-           imports=("heat_kernels", "heating"))
+                                 "mean_pressure": "mean contact pressure [Pa]"})
 def _heat_partition(p: HeatPartitionParams) -> Outcome:
     """Heat partition and flash temperature of a rough pin on a rotating disc (thesis §6.4)."""
-    from multiscale.micro.contact import ContactSolver
-    from multiscale.micro.heat_kernels import Rotation, SpeedProfile, ThermalMaterial
-    from multiscale.micro.heating import SteadyHeating, TransientHeating
-    from multiscale.micro.kernels import HalfSpace
     surface = rough_surface(p, periodic=False)
     control = {"load": p.pressure} if p.pressure else {"approach": p.approach}
     contact = ContactSolver(HalfSpace.from_materials(p.E, p.nu, p.E1, p.nu1), surface.shape, surface.dx,
@@ -465,10 +393,6 @@ class ZoneLawParams(SurfaceParams):
 
 def _zone_reference(p: ZoneLawParams) -> dict:
     """FFT-BEM of the whole (isolated) surface at the same approach on ``reference_n``."""
-    from dataclasses import replace
-
-    from multiscale.micro.contact import ContactSolver
-    from multiscale.micro.kernels import HalfSpace
     surface = rough_surface(replace(p, n=p.reference_n or p.n), periodic=False)
     r = ContactSolver(HalfSpace.from_materials(p.E, p.nu), surface.shape, surface.dx, periodic=False).solve(
         surface.heights, approach=p.approach, tol=p.tol)
@@ -478,8 +402,6 @@ def _zone_reference(p: ZoneLawParams) -> dict:
 def _zone_coupling(zones, grid, love: str) -> np.ndarray:
     """C_ij [m per Pa·π E*]: Love displacement of zone i (its mean, or at its centre) under a unit
     uniform pressure on zone j (Eq. 1.30), the flat macro half-space between the zones."""
-    from multiscale.micro.kernels import love_rectangle
-    from multiscale.micro.zones import love_rectangle_mean
     a, b = grid.size[0] / 2, grid.size[1] / 2
     c = np.array([z.centre for z in zones])
     if love == "centre":
@@ -521,12 +443,9 @@ def _flat_interface(laws, ids, C, flat, tol=1e-12, max_iter=100):
                            "area_fraction": "real contact area / nominal area from the zone laws [-]"},
            exact=_zone_reference, exact_metrics=("mean_pressure", "area_fraction"),
            exact_params=("size", "hurst", "k_min", "k_max", "rms", "seed", "source_n", "E", "nu", "approach",
-                         "reference_n", "tol"), imports=("laws", "zones"))
+                         "reference_n", "tol"))
 def _zone_laws(p: ZoneLawParams) -> Outcome:
     """Zone laws on a flat macro interface vs the micro solve of the whole surface (thesis Fig. 1.14)."""
-    from multiscale.micro.kernels import HalfSpace
-    from multiscale.micro.laws import LawSpec, compute_laws
-    from multiscale.micro.zones import cut_zones
     kernel = HalfSpace.from_materials(p.E, p.nu)
     surface = rough_surface(p, periodic=False)
     grid, zones = cut_zones(surface, p.zones)
@@ -538,124 +457,3 @@ def _zone_laws(p: ZoneLawParams) -> Outcome:
     area = laws.area_fraction(pressure, ids)
     micro = int(sum(nd.iterations.sum() for nd in laws.nodes))
     return Outcome({"mean_pressure": float(pressure.mean()), "area_fraction": float(area.mean())}, micro + its, ok)
-
-
-# ----------------------------------------------------------------------------- macro scenes
-_REDUCERS = {"last": lambda v: v[-1], "first": lambda v: v[0], "max": np.max, "min": np.min, "mean": np.mean,
-             "rise": lambda v: v[-1] - v[0]}
-
-
-SQUEAL_METRICS = {
-    "modes": "number of complex modes found in the band",
-    "unstable_modes": "modes with a positive real part (growth rate) [-]",
-    "max_growth": "largest real part sigma of the eigenvalues [1/s]",
-    "max_growth_frequency": "frequency of the mode with the largest real part [Hz]",
-    "lowest_unstable_frequency": "frequency of the lowest unstable mode, 0 if none [Hz]",
-    "min_damping_ratio": "smallest damping ratio (negative: unstable) [-]",
-}
-
-
-def squeal_metrics(modes_csv) -> dict:
-    """``SQUEAL_METRICS`` of a squeal run's mode table (``ModalResult.write_csv``)."""
-    table = np.genfromtxt(modes_csv, delimiter=",", names=True, ndmin=1)
-    f, sigma, unstable = table["frequency_Hz"], table["sigma_1_per_s"], table["unstable"] > 0
-    k = int(np.argmax(sigma))
-    return {"modes": float(f.size), "unstable_modes": float(unstable.sum()), "max_growth": float(sigma[k]),
-            "max_growth_frequency": float(f[k]),
-            "lowest_unstable_frequency": float(f[unstable].min()) if unstable.any() else 0.0,
-            "min_damping_ratio": float(table["damping_ratio"].min())}
-
-
-@dataclass(frozen=True)
-class SceneRun:
-    """A macro scene with overrides (dotted scene paths -> raw values) and MPI ranks per run."""
-
-    scene: Path
-    overrides: dict = field(default_factory=dict)
-    ranks: int = 1
-
-
-class SceneProblem(Problem):
-    """Any macro scene (``multiscale run``) with overrides; metrics are history columns reduced
-    over time: ``column`` (last value) or ``column:last|first|max|min|mean|rise`` (rise = last −
-    first: a temperature rise, whose relative error means more than that of a temperature in K).
-    A squeal scene (effect ``stability``) has no history; its metrics come from ``modes.csv``
-    (``squeal_metrics``)."""
-
-    name = "scene"
-    doc = ("a macro scene run by the macro runner with overrides; metrics: HDF5 history columns, "
-           "column[:last|first|max|min|mean|rise]; squeal scenes: " + ", ".join(SQUEAL_METRICS))
-    metrics = {}
-
-    def parse(self, raw, path, ctx, scene=None, ranks=1):
-        from multiscale.scene import load
-        try:
-            load(scene, overrides=raw)
-        except SceneError as exc:
-            ctx.problems.extend(f"{path}: {line}" if path else line for line in exc.problems)
-            return None
-        return SceneRun(Path(scene), dict(raw), ranks)
-
-    def key(self, params: SceneRun) -> dict:
-        text = params.scene.read_bytes()
-        import hashlib
-        return {"scene": str(params.scene), "scene_sha256": hashlib.sha256(text).hexdigest(),
-                "overrides": _jsonable(params.overrides)}
-
-    def check_metric(self, name):
-        column, _, reducer = name.partition(":")
-        if not column or (reducer and reducer not in _REDUCERS):
-            return (f"a history column, optionally with :{'|:'.join(_REDUCERS)} "
-                    f"(e.g. max_temperature_pin:max)")
-        return None
-
-    def run(self, params: SceneRun, workdir: Path) -> Outcome:
-        """Run the scene in a subprocess (``mpiexec -n ranks`` when ranks > 1) into workdir/output."""
-        from multiscale.io import History
-        out = Path(workdir) / "output"
-        Path(workdir).mkdir(parents=True, exist_ok=True)
-        task = json.dumps({"scene": str(params.scene), "overrides": {**params.overrides, "output.folder": str(out)}})
-        command = [sys.executable, "-m", "multiscale.study_problems", task]
-        if params.ranks > 1:
-            mpiexec = Path(sys.executable).with_name("mpiexec")
-            command = [str(mpiexec) if mpiexec.exists() else "mpiexec", "-n", str(params.ranks)] + command
-        done = subprocess.run(command, capture_output=True, text=True)
-        (Path(workdir) / "scene_run.log").write_text(done.stdout + done.stderr)
-        if done.returncode != 0:
-            last = [line for line in (done.stderr or done.stdout).strip().splitlines() if line.strip()]
-            raise RuntimeError(f"scene run failed (exit {done.returncode}): {last[-1] if last else 'no output'}")
-        if (out / "modes.csv").exists():
-            return Outcome(squeal_metrics(out / "modes.csv"), 0, True)
-        history = History.read(out / "history.h5")
-        metrics = {}
-        for column in history.columns:
-            values = history[column]
-            metrics[column] = float(values[-1])
-            metrics.update({f"{column}:{r}": float(f(values)) for r, f in _REDUCERS.items()})
-        iterations = int(history["newton_iterations"].sum()) if "newton_iterations" in history.columns else 0
-        return Outcome(metrics, iterations, True)
-
-
-PROBLEMS["scene"] = SceneProblem()
-
-
-def _scene_main(task: str) -> int:
-    """``python -m multiscale.study_problems TASK``: load the scene with overrides, run it."""
-    spec = json.loads(task)
-    from multiscale.scene import load
-    scene = load(spec["scene"], overrides=spec["overrides"])
-    from multiscale.workflows import run
-    run(scene, overwrite=True, verbose=False)
-    return 0
-
-
-def problem(name: str) -> Problem:
-    """The registered problem ``name`` (InputError with did-you-mean otherwise)."""
-    if name not in PROBLEMS:
-        raise InputError("problem", name, f"unknown{suggest(name, PROBLEMS)}; known: {', '.join(PROBLEMS)}")
-    return PROBLEMS[name]
-
-
-if __name__ == "__main__":  # pragma: no cover  (the scene problem's subprocess)
-    os.environ.setdefault("OMP_NUM_THREADS", "1")
-    sys.exit(_scene_main(sys.argv[1]))

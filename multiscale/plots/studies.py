@@ -1,0 +1,146 @@
+"""Figures of a parametric study (``multiscale.studies``), written as PNGs beside its report:
+each metric's relative error against wall time (Pareto front), and error (or metric value) and
+wall time against each swept knob."""
+from __future__ import annotations
+
+import json
+import math
+from pathlib import Path
+
+import matplotlib
+import matplotlib.pyplot as plt
+import numpy as np
+
+from multiscale.studies.expand import Study, StudyRun
+from multiscale.studies.formatting import percent
+from multiscale.studies.results import Row, case_key, pareto
+
+__all__ = ["plot"]
+
+matplotlib.use("Agg")          # PNG files only, no display
+
+
+def plot(study: Study, rows: list[Row], folder: Path) -> list[Path]:
+    """PNGs: error vs wall time per metric (Pareto front; with many runs only the front is
+    labelled), and per knob: error (or metric) and wall time vs the knob."""
+    ok = [r for r in rows if r.ok]
+    if not ok or not study.report.plots:
+        return []
+    out = []
+    if study.reference is not None:
+        out.append(_plot_pareto(study, ok, folder))
+    for axis in study.axes:
+        if axis[0] not in study.averaged:
+            out.append(_plot_axis(study, ok, axis, folder))
+    return [p for p in out if p is not None]
+
+
+def _numeric(values) -> bool:
+    return all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values)
+
+
+def _short(run: StudyRun, skip=()) -> str:
+    return ", ".join(v for k, v in run.shown.items() if k not in skip)
+
+
+def _plot_pareto(study, ok, folder):
+    """Relative error vs wall time, one panel per metric (None if no error is positive)."""
+    n = len(study.metrics)
+    fig, axes = plt.subplots(1, n, figsize=(5.2 * n, 4.3), squeeze=False)
+    cases = list(dict.fromkeys(case_key(study, r) for r in ok))
+    drawn = False
+    for ax, m in zip(axes[0], study.metrics):
+        t = [r.record["wall_time"] for r in ok]
+        e = [r.errors.get(m, math.nan) for r in ok]
+        front = pareto(t, e)
+        labelled = set(range(len(ok))) if len(ok) <= 16 else set(front)
+        for c, case in enumerate(cases):
+            idx = [i for i, r in enumerate(ok) if case_key(study, r) == case and math.isfinite(e[i]) and e[i] > 0]
+            ax.scatter([t[i] for i in idx], [e[i] for i in idx], color=f"C{c}", s=28, zorder=3,
+                       label=", ".join(f"{k} = {v}" for k, v in zip(study.cases, case)) or None)
+            for i in (i for i in idx if i in labelled):
+                ax.annotate(_short(ok[i].run, study.cases), (t[i], e[i]), fontsize=6,
+                            xytext=(3, 3), textcoords="offset points")
+        refs = sorted(r.record["wall_time"] for r in ok if r.is_reference)
+        if refs:
+            ax.axvspan(refs[0], refs[-1], color="green", alpha=0.15, lw=0)
+            ax.axvline(refs[len(refs) // 2], color="green", ls=":", label="reference run" + "s" * (len(refs) > 1))
+        if front:
+            drawn = True
+            ax.step([t[i] for i in front], [e[i] for i in front], where="post", color="red", lw=2, alpha=0.6,
+                    zorder=2, label="Pareto front")
+            ax.set(xscale="log", yscale="log")
+        for tol in study.report.errors:
+            ax.axhline(tol, color="gray", ls="--", lw=0.8)
+            ax.annotate(percent(tol), (1, tol), xycoords=("axes fraction", "data"), fontsize=7, ha="right",
+                        va="bottom", color="gray")
+        ax.set(xlabel="wall time [s]", ylabel=f"relative error of {m}", title=m)
+        ax.grid(True, which="both", alpha=0.25)
+        ax.legend(fontsize=7)
+    if not drawn:
+        plt.close(fig)
+        return None
+    fig.suptitle(f"{study.name}: error vs wall time")
+    fig.tight_layout()
+    path = folder / f"{study.name}_error_vs_time.png"
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path
+
+
+def _plot_axis(study, ok, axis, folder):
+    """Errors (or metric values) and wall time against one axis (a knob, or zipped knobs plotted
+    against the first), one line per setting of the other knobs (mean ± std over averaged ones)."""
+    def point(r):
+        return json.dumps([r.run.label[k] for k in axis])
+    values = list(dict.fromkeys(point(r) for r in ok))
+    raw = [json.loads(v)[0] for v in values]
+    numeric = _numeric(raw) and len(set(raw)) == len(raw)    # else categorical, one tick per setting
+    xs = {v: (x if numeric else i) for i, (v, x) in enumerate(zip(values, raw))}
+    ticks = {point(r): ", ".join(r.run.shown[k] for k in axis) for r in ok}
+    log_x = numeric and min(raw) > 0 and max(raw) / min(raw) > 5
+    averaged = set(study.averaged)
+    others = [k for k in study.knobs if k not in axis and k not in averaged]
+    lines = {}
+    for r in ok:
+        lines.setdefault(tuple(r.run.shown[k] for k in others), []).append(r)
+    with_ref = study.reference is not None
+    panels = ([("error", m) for m in study.metrics] if with_ref else [("value", m) for m in study.metrics]) \
+        + [("time", None)]
+    fig, axes = plt.subplots(1, len(panels), figsize=(4.4 * len(panels), 3.9), squeeze=False)
+    for ax, (kind, m) in zip(axes[0], panels):
+        for c, (other, group) in enumerate(lines.items()):
+            pts = {}
+            for r in group:
+                y = (r.errors.get(m, math.nan) or math.nan if kind == "error" else     # 0: the reference
+                     r.record["metrics"][m] if kind == "value" else r.record["wall_time"])
+                pts.setdefault(xs[point(r)], []).append(y)
+            x = sorted(pts)
+            mean = np.array([np.mean(pts[v]) for v in x])
+            label = ", ".join(f"{k} = {v}" for k, v in zip(others, other)) if others else None
+            if averaged and kind != "error":
+                std = np.array([np.std(pts[v]) for v in x])
+                ax.errorbar(x, mean, yerr=std, marker="o", ms=4, color=f"C{c % 10}", capsize=3, label=label)
+            else:
+                ax.plot(x, mean, "o-", ms=4, color=f"C{c % 10}", label=label)
+        if kind == "error":
+            for tol in study.report.errors:
+                ax.axhline(tol, color="gray", ls="--", lw=0.8)
+            ax.set_yscale("log")
+        if kind == "time":
+            ax.set_yscale("log")
+        ax.set(xlabel=" / ".join(axis), ylabel={"error": f"relative error of {m}", "value": m, "time": "wall time [s]"}[kind],
+               title=m or "cost")
+        if log_x:
+            ax.set_xscale("log")
+        if not numeric:
+            ax.set_xticks(range(len(values)), [ticks[v] for v in values], rotation=30, ha="right", fontsize=7)
+        ax.grid(True, which="both", alpha=0.25)
+        if others and len(lines) <= 8:
+            ax.legend(fontsize=6)
+    fig.suptitle(f"{study.name}: {' / '.join(axis)}" + (f" (mean ± std over {', '.join(averaged)})" if averaged else ""))
+    fig.tight_layout()
+    path = folder / f"{study.name}_{axis[0].replace('.', '_')}.png"
+    fig.savefig(path, dpi=100)
+    plt.close(fig)
+    return path

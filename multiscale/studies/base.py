@@ -1,0 +1,63 @@
+"""What a study problem is: ``Problem`` (parameters -> ``Outcome``, the scalar metrics of a run)
+and ``jsonable`` (a run's identity for its record key). The registry is ``problems``."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from multiscale.schema import Context, suggest
+
+__all__ = ["Outcome", "Problem", "jsonable"]
+
+
+@dataclass
+class Outcome:
+    """What one run of a problem produced."""
+
+    metrics: dict                 # name -> float (SI units, see the problem's ``metrics``)
+    iterations: int = 0           # solver iterations, summed over the run's solves
+    converged: bool = True        # every solve reached its tolerance
+
+
+class Problem:
+    """A named problem: ``parse`` validates raw parameters, ``run`` computes the metrics."""
+
+    name: str
+    doc: str
+    metrics: dict                 # name -> description with unit
+    exact_metrics: tuple = ()     # metrics the analytic reference provides
+
+    def parse(self, raw: dict, path: str, ctx: Context, **options):
+        """Validated parameters (problems appended to ``ctx``); ``options``: the scene problem's
+        base scene and ranks."""
+        raise NotImplementedError
+
+    def key(self, params) -> dict:
+        """JSON-able identity of a run's parameters (hashed to name the run's record)."""
+        raise NotImplementedError
+
+    def run(self, params, workdir: Path) -> Outcome:
+        """One run of validated ``params``; files it writes go under ``workdir``."""
+        raise NotImplementedError
+
+    def check_metric(self, name: str) -> str | None:
+        """None if ``name`` is a metric of this problem, else the problem (one line)."""
+        if name in self.metrics:
+            return None
+        return f'unknown metric of problem "{self.name}"{suggest(name, self.metrics)}; allowed: ' \
+               f'{", ".join(self.metrics)}'
+
+
+def jsonable(value):
+    """``value`` with tuples as lists, paths as strings and non-finite floats as strings."""
+    if isinstance(value, dict):
+        return {k: jsonable(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [jsonable(v) for v in value]
+    if isinstance(value, Path):
+        return str(value)
+    if isinstance(value, float) and not np.isfinite(value):
+        return str(value)
+    return value

@@ -1,0 +1,51 @@
+"""``multiscale study``: several studies end to end (load all, run, tables, reports, index)."""
+from __future__ import annotations
+
+import dataclasses
+from pathlib import Path
+
+from multiscale.errors import SceneError
+from multiscale.studies.expand import load_study
+from multiscale.studies.reporting import report, write_index
+from multiscale.studies.results import collect, write_tables
+from multiscale.studies.running import execute, world
+
+__all__ = ["run_studies"]
+
+
+def run_studies(paths, *, rerun_failed: bool = False, report_folder=None, processes: int | None = None,
+                progress: bool = True, command: str = "") -> int:
+    """Load every study first (all problems reported at once), run them, write tables and reports;
+    with ``report_folder`` every report goes there, with an index README.md. Returns the number of
+    failed runs."""
+    comm = world()
+    studies, problems = [], []
+    for path in paths:
+        try:
+            studies.append(load_study(path))
+        except SceneError as exc:
+            problems += [f"{path}: {line}" for line in exc.problems] if len(paths) > 1 else exc.problems
+    if problems:
+        raise SceneError(problems if comm is None or comm.rank == 0 else [])   # one rank speaks
+    if report_folder is not None:
+        studies = [dataclasses.replace(s, report_folder=Path(report_folder).resolve()) for s in studies]
+    if processes is not None:
+        studies = [dataclasses.replace(s, options=dataclasses.replace(s.options, processes=processes)) for s in studies]
+    rank = comm.rank if comm is not None else 0
+    failed, summaries = 0, []
+    for study in studies:
+        stats = execute(study, rerun_failed=rerun_failed, progress=progress, comm=comm)
+        if rank != 0:
+            continue
+        rows = collect(study)
+        write_tables(study, rows)
+        md = report(study, rows, command)
+        bad = sum(not r.ok for r in rows)
+        failed += bad
+        summaries.append((study, rows, md))
+        print(f"{study.name}: {len(rows)} runs ({stats.done} recorded before, {stats.started} run now, "
+              f"{bad} failed); table {study.folder / 'results.csv'}; report {md}")
+    if rank == 0 and report_folder is not None:
+        index = write_index(summaries, Path(report_folder).resolve(), command)
+        print(f"index {index}")
+    return failed

@@ -1,0 +1,371 @@
+"""A validated study: the study file checked against its problem (every problem at once) and the
+sweep expanded into runs, each named by the hash of its validated parameters."""
+from __future__ import annotations
+
+import hashlib
+import itertools
+import json
+import math
+import tomllib
+from dataclasses import dataclass
+from pathlib import Path
+
+from multiscale.errors import SceneError
+from multiscale.schema import Bad, Context, Integer, Quantity, fields_of, read, show, suggest
+from multiscale.studies.formatting import value_text
+from multiscale.studies.problems import PROBLEMS
+from multiscale.studies.spec import RANGE_KEYS, ReportOptions, Reference, RunOptions, StudyFile, is_range
+from multiscale.units import VALUE, UnitError, parse_unit
+
+__all__ = ["Study", "StudyRun", "load_study", "normalise", "parser_of", "reference_run"]
+
+
+@dataclass(frozen=True)
+class StudyRun:
+    """One point of the sweep."""
+
+    key: str          # hash of the problem and its validated parameters (the record's name)
+    label: dict       # swept knob -> value (SI number, string or list), in sweep order
+    raw: dict         # fixed and swept raw values, as the problem parses them
+    shown: dict       # swept knob -> the value as the study file wrote it (for tables and plots)
+
+
+@dataclass(frozen=True)
+class Study:
+    """A study file validated against its problem and expanded into runs (values in SI)."""
+
+    name: str
+    description: str
+    source: Path
+    problem: str
+    scene: Path | None
+    metrics: tuple
+    knobs: tuple                      # swept parameters, in file order
+    axes: tuple                       # knobs varied together: a zip group, or one knob of a product
+    fixed: dict
+    sweep_text: tuple                 # one line per sweep group, for the report
+    runs: tuple                       # StudyRun
+    reference: Reference | None
+    options: RunOptions
+    report: ReportOptions
+    folder: Path
+    report_folder: Path
+
+    def _with_partners(self, names) -> tuple:
+        return tuple(k for axis in self.axes if any(n in axis for n in names) for k in axis)
+
+    @property
+    def cases(self) -> tuple:
+        """Swept physical parameters (``report.cases`` and their zip partners): not accuracy knobs."""
+        return self._with_partners(self.report.cases)
+
+    @property
+    def averaged(self) -> tuple:
+        """Knobs averaged over in tables and plots (``report.average_over`` and partners)."""
+        return self._with_partners(self.report.average_over)
+
+
+def load_study(path) -> Study:
+    """Read, validate and expand a study file; raises SceneError listing every problem."""
+    path = Path(path)
+    try:
+        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise SceneError(f"{path}: cannot read the study file ({getattr(exc, 'strerror', None) or exc})") from None
+    except tomllib.TOMLDecodeError as exc:
+        raise SceneError(f"{path}: not valid TOML: {exc}") from None
+    ctx = Context(directory=path.resolve().parent)
+    f = read(StudyFile, raw, "", ctx)
+    if f.problem is not None and f.problem not in PROBLEMS:
+        ctx.problems.append(f"problem = {show(f.problem)}: unknown problem{suggest(f.problem, PROBLEMS)}; "
+                            f"known: {', '.join(PROBLEMS)}")
+    if ctx.problems:
+        raise SceneError(ctx.problems)
+    problem = PROBLEMS[f.problem]
+    scene_problem = f.problem == "scene"
+    if scene_problem != (f.scene is not None):
+        raise SceneError("scene: missing; problem \"scene\" needs the base scene file" if scene_problem else
+                         f"scene: only used with problem = \"scene\" (problem is \"{f.problem}\")")
+    for i, name in enumerate(f.metrics, 1):
+        why = problem.check_metric(name)
+        if why:
+            ctx.problems.append(f"metrics item {i} ({show(name)}): {why}")
+    before = len(ctx.problems)
+    knobs, values, lines, axes = _expand_groups(f, problem, ctx)
+    name = f.name or path.stem
+    extra = {"scene": f.scene, "ranks": f.run.ranks} if scene_problem else {}
+    runs = _runs(f, problem, knobs, values, extra, ctx) if len(ctx.problems) == before else ()
+    if f.reference is not None and runs:
+        _check_reference(f, problem, knobs, axes, runs, ctx)
+    for option in ("cases", "average_over"):
+        for k in getattr(f.report, option):
+            if k not in knobs:
+                ctx.problems.append(f"report.{option}: \"{k}\" is not a swept parameter{suggest(k, knobs)}; "
+                                    f"swept: {', '.join(knobs)}")
+    if ctx.problems:
+        raise SceneError(list(dict.fromkeys(ctx.problems)))
+    folder = f.run.folder or ctx.directory / "results" / name
+    return Study(name=name, description=f.description, source=path.resolve(), problem=f.problem, scene=f.scene,
+                 metrics=f.metrics, knobs=knobs, axes=axes, fixed=dict(f.fixed), sweep_text=tuple(lines), runs=runs,
+                 reference=f.reference, options=f.run, report=f.report, folder=folder,
+                 report_folder=f.report.folder or folder)
+
+
+def parser_of(problem, name):
+    """The schema parser of a micro problem's parameter (None: unknown kind, e.g. scene keys)."""
+    params = getattr(problem, "params", None)
+    return dict(fields_of(params)).get(name) if params is not None else None
+
+
+def _names(problem) -> list | None:
+    """A micro problem's parameter names (None: any, e.g. scene keys)."""
+    params = getattr(problem, "params", None)
+    return [n for n, _ in fields_of(params)] if params is not None else None
+
+
+def _expand_groups(f: StudyFile, problem, ctx):
+    """Swept knobs (file order), one list of value-tuples per group, a text per group, the axes."""
+    names = _names(problem)
+    where_of = {}
+    for name, value in f.fixed.items():
+        where_of[name] = "fixed"
+        if names is not None and name not in names:
+            ctx.problems.append(f"fixed.{name}: unknown parameter of problem \"{f.problem}\"{suggest(name, names)}; "
+                                f"allowed: {', '.join(names)}")
+        elif names is not None:
+            try:
+                parser_of(problem, name).parser(value, ctx)
+            except Bad as exc:
+                ctx.problems.append(f"fixed.{name} = {show(value)}: {exc}")
+    knobs, groups, lines, axes = [], [], [], []
+    single = len(f.sweep) == 1
+    for i, group in enumerate(f.sweep, 1):
+        path = "sweep" if single else f"sweep[{i}]"
+        combine = group.get("combine", "product")
+        if combine not in ("product", "zip"):
+            ctx.problems.append(f"{path}.combine = {show(combine)}: unknown{suggest(str(combine), ('product', 'zip'))}; "
+                                "allowed: product, zip")
+            continue
+        params = {k: v for k, v in group.items() if k != "combine"}
+        if not params:
+            ctx.problems.append(f"{path}: empty sweep: give at least one parameter = [values]")
+            continue
+        lists = {}
+        for name, value in params.items():
+            where = f"{path}.{name}"
+            if names is not None and name not in names:
+                ctx.problems.append(f"{where}: unknown parameter of problem \"{f.problem}\"{suggest(name, names)}; "
+                                    f"allowed: {', '.join(names)}")
+                continue
+            if name in where_of:
+                ctx.problems.append(f"{where}: also given in {where_of[name]}; give it once")
+                continue
+            where_of[name] = path
+            items = _values(value, where, parser_of(problem, name), ctx, unique=combine == "product")
+            if items is not None:
+                lists[name] = items
+                knobs.append(name)
+        if len(lists) != len(params):
+            continue
+        if combine == "zip":
+            sizes = {k: len(v) for k, v in lists.items()}
+            if len(set(sizes.values())) > 1:
+                ctx.problems.append(f"{path}: combine = \"zip\" needs lists of equal length "
+                                    f"({', '.join(f'{k}: {n}' for k, n in sizes.items())})")
+                continue
+            groups.append([dict(zip(lists, combo)) for combo in zip(*lists.values())])
+            axes.append(tuple(lists))
+        else:
+            groups.append([dict(zip(lists, combo)) for combo in itertools.product(*lists.values())])
+            axes += [(k,) for k in lists]
+        lines.append(f"{' x '.join(lists) if combine == 'product' else ' with '.join(lists)} "
+                     f"({combine}): " + "; ".join(f"{k} = {', '.join(value_text(v) for v in vals)}"
+                                                  for k, vals in lists.items()))
+    return tuple(knobs), groups, lines, tuple(axes)
+
+
+def _values(value, where, parser, ctx, unique: bool = True) -> list | None:
+    """The values of one swept parameter: a list, or a range table (SI numbers)."""
+    if isinstance(value, list):
+        if not value:
+            ctx.problems.append(f"{where} = []: empty sweep: give at least one value")
+            return None
+        items = value
+    elif is_range(value):
+        items = _range(value, where, parser, ctx)
+        if items is None:
+            return None
+    else:
+        ctx.problems.append(f"{where} = {show(value)}: must be a list of values or a range "
+                            "{start, stop, num | step, log}; a single value goes in [fixed]")
+        return None
+    if parser is not None:
+        bad = []
+        for i, item in enumerate(items, 1):
+            try:
+                parser.parser(item, ctx)
+            except Bad as exc:
+                bad.append(f"item {i} ({show(item)}): {exc}")
+        if bad:
+            ctx.problems.append(f"{where} = {show(value)}: " + "; ".join(bad))
+            return None
+    if unique and len({json.dumps(normalise(v, parser)) for v in items}) != len(items):
+        ctx.problems.append(f"{where} = {show(value)}: values must not repeat")
+        return None
+    return list(items)
+
+
+def _range(spec: dict, where, parser, ctx) -> list | None:
+    """The values of a range table (SI; integers when the parameter or the bounds are)."""
+    unknown = [k for k in spec if k not in RANGE_KEYS]
+    if unknown:
+        ctx.problems.append(f"{where}.{unknown[0]}: unknown key of a range{suggest(unknown[0], RANGE_KEYS)}; "
+                            f"allowed: {', '.join(RANGE_KEYS)}")
+        return None
+    text = f"{where} = {{{', '.join(f'{k} = {show(v)}' for k, v in spec.items())}}}"
+    if "start" not in spec or "stop" not in spec or ("num" in spec) == ("step" in spec):
+        ctx.problems.append(f"{text}: a range needs start, stop and one of num, step")
+        return None
+    log = spec.get("log", False)
+    if not isinstance(log, bool):
+        ctx.problems.append(f"{text}: log must be true or false")
+        return None
+    try:
+        start, stop = (_si(spec[k], parser) for k in ("start", "stop"))
+        step = _si(spec["step"], parser) if "step" in spec else None
+    except (Bad, UnitError) as exc:
+        ctx.problems.append(f"{text}: {exc}")
+        return None
+    integer = (parser is not None and isinstance(parser.parser, Integer)) or \
+        all(isinstance(spec[k], int) and not isinstance(spec[k], bool) for k in ("start", "stop", "step") if k in spec)
+    num = spec.get("num")
+    if num is not None and (isinstance(num, bool) or not isinstance(num, int) or num < 1):
+        ctx.problems.append(f"{text}: num must be an integer >= 1")
+        return None
+    if log and (start <= 0 or stop <= 0):
+        ctx.problems.append(f"{text}: a log range needs start and stop > 0")
+        return None
+    if step is not None:
+        if log:
+            ctx.problems.append(f"{text}: a log range takes num, not step")
+            return None
+        if step == 0 or (stop - start) * step < 0:
+            ctx.problems.append(f"{text}: step must be non-zero and go from start towards stop")
+            return None
+        count = int(math.floor((stop - start) / step * (1 + 1e-12) + 1e-9)) + 1
+        values = [start + i * step for i in range(count)]
+    elif num == 1:
+        values = [start]
+    elif log:
+        values = [start * (stop / start) ** (i / (num - 1)) for i in range(num)]
+    else:
+        values = [start + (stop - start) * i / (num - 1) for i in range(num)]
+    if integer:
+        values = list(dict.fromkeys(int(round(v)) for v in values))
+    else:
+        values = [float(f"{v:.12g}") for v in values]
+    if len(values) > 10000:
+        ctx.problems.append(f"{text}: more than 10000 values")
+        return None
+    return values
+
+
+def _si(value, parser=None):
+    """A number or "<number> <unit>" in SI (by the parameter's kind when known)."""
+    if parser is not None and isinstance(parser.parser, Quantity):
+        return parser.parser(value, Context())
+    if isinstance(value, bool) or not isinstance(value, (int, float, str)):
+        raise Bad("range bounds must be numbers or \"<number> <unit>\" strings")
+    if isinstance(value, str):
+        match = VALUE.match(value)
+        if not match:
+            raise Bad(f"cannot read {show(value)} as a number with a unit")
+        factor, offset, _ = parse_unit(match.group(2))
+        return float(float(match.group(1)) * factor + offset)
+    return value
+
+
+def normalise(value, parser=None):
+    """A value in comparable form: SI number, string, or list of these."""
+    if isinstance(value, list):
+        return [normalise(v) for v in value]
+    if isinstance(value, (int, float)) and not isinstance(value, bool):
+        return value
+    try:
+        v = _si(value, parser)
+    except (Bad, UnitError):
+        return value
+    return list(v) if isinstance(v, tuple) else v
+
+
+def _runs(f, problem, knobs, groups, extra, ctx) -> tuple:
+    """The runs of the product of the groups, each parsed by the problem and named by its hash."""
+    runs, seen = [], {}
+    for combo in itertools.product(*groups):
+        swept = {k: v for part in combo for k, v in part.items()}
+        raw = {**dict(f.fixed), **swept}
+        label = {k: normalise(swept[k], parser_of(problem, k)) for k in knobs}
+        local = Context(directory=ctx.directory)
+        params = problem.parse(raw, "", local, **extra)
+        where = ", ".join(f"{k} = {value_text(swept[k])}" for k in knobs)
+        ctx.problems.extend(f"{line} (run {where})" for line in local.problems)
+        if local.problems:
+            continue
+        ident = json.dumps({"problem": f.problem, "params": problem.key(params)}, sort_keys=True)
+        digest = hashlib.sha256(ident.encode()).hexdigest()[:16]
+        if digest in seen:
+            ctx.problems.append(f"runs ({seen[digest]}) and ({where}) have the same parameters")
+            continue
+        seen[digest] = where
+        runs.append(StudyRun(digest, label, raw, {k: value_text(swept[k]) for k in knobs}))
+    return tuple(runs)
+
+
+def reference_run(runs, label: dict, want: dict, axes) -> StudyRun | None:
+    """The run with the values ``want`` and, for the other knobs, those of ``label`` (zip partners
+    of a wanted knob follow it)."""
+    free = {k for axis in axes if any(w in axis for w in want) for k in axis}
+    hits = [r for r in runs if all(r.label[k] == v for k, v in want.items())
+            and all(r.label[k] == label[k] for k in label if k not in free)]
+    return hits[0] if len(hits) == 1 else None
+
+
+def _check_reference(f: StudyFile, problem, knobs, axes, runs, ctx):
+    ref = f.reference
+    if ref.kind == "analytic":
+        if not getattr(problem, "exact", None):
+            ctx.problems.append(f'reference.kind = "analytic": problem "{f.problem}" has no analytic reference; '
+                                'use kind = "run" (a run of the sweep) or "file"')
+            return
+        missing = [m for m in f.metrics if m not in problem.exact_metrics]
+        if missing:
+            ctx.problems.append(f'reference.kind = "analytic": no analytic value of {", ".join(missing)} '
+                                f'(the problem gives {", ".join(problem.exact_metrics)})')
+    elif ref.kind == "run":
+        bad = [k for k in ref.run if k not in knobs]
+        for k in bad:
+            ctx.problems.append(f"reference.run.{k}: not a swept parameter{suggest(k, knobs)}; swept: {', '.join(knobs)}")
+        if bad:
+            return
+        want = {k: normalise(v, parser_of(problem, k)) for k, v in ref.run.items()}
+        for r in runs:
+            if reference_run(runs, r.label, want, axes) is None:
+                swept = "; ".join(f"{k}: {', '.join(dict.fromkeys(x.shown[k] for x in runs))}" for k in ref.run)
+                ctx.problems.append(f"reference.run = {{{', '.join(f'{k} = {value_text(v)}' for k, v in ref.run.items())}}}: "
+                                    f"not in the sweep (swept {swept})")
+                return
+    else:
+        try:
+            values = json.loads(ref.file.read_text())
+        except (OSError, ValueError) as exc:
+            ctx.problems.append(f"reference.file = \"{ref.file}\": cannot read a JSON object ({exc})")
+            return
+        if not isinstance(values, dict):
+            ctx.problems.append(f"reference.file = \"{ref.file}\": must hold a JSON object {{metric: value}}")
+            return
+        for m in f.metrics:
+            if not isinstance(values.get(m), (int, float)) or isinstance(values.get(m), bool):
+                ctx.problems.append(f"reference.file = \"{ref.file}\": no number for metric \"{m}\""
+                                    f"{suggest(m, values)}")
+
+

@@ -1,0 +1,163 @@
+"""The Markdown report of a study (tables of the cheapest settings, averages, every run; links
+to the figures of ``multiscale.plots.studies``) and the index of a report folder."""
+from __future__ import annotations
+
+import math
+import os
+from pathlib import Path
+
+import numpy as np
+
+from multiscale.studies.expand import Study
+from multiscale.studies.formatting import now, number_text, percent, value_text
+from multiscale.studies.problems import PROBLEMS
+from multiscale.studies.results import Row, cheapest, reference_text
+
+__all__ = ["report", "write_index"]
+
+
+def report(study: Study, rows: list[Row], command: str = "") -> Path:
+    """Markdown report and PNGs in ``study.report_folder``; returns the Markdown path."""
+    folder = study.report_folder
+    folder.mkdir(parents=True, exist_ok=True)
+    from multiscale.plots.studies import plot  # local: matplotlib only when reporting; it imports this package
+    pngs = plot(study, rows, folder)
+    problem = PROBLEMS[study.problem]
+    ok = [r for r in rows if r.ok]
+    failed = [r for r in rows if not r.ok]
+    lines = [f"# {study.report.title or study.name}", ""]
+    if study.description:
+        lines += [study.description, ""]
+    metric_doc = problem.metrics
+    lines += [f"- Problem: `{study.problem}` — {problem.doc}",
+              *[f"- Swept: {text}" for text in study.sweep_text],
+              f"- Fixed: {', '.join(f'{k} = {value_text(v)}' for k, v in study.fixed.items()) or 'problem defaults'}",
+              "- Metrics: " + "; ".join(f"`{m}`" + (f" ({metric_doc[m]})" if m in metric_doc else "")
+                                         for m in study.metrics),
+              f"- Reference: {reference_text(study)}"
+              + ("; error = |m − m_ref| / |m_ref|" if study.reference else ""),
+              f"- Runs: {len(ok)} ok, {len(failed)} failed; {sum(r.record.get('wall_time', 0) for r in ok):.1f} s "
+              f"of run wall time in all. Wall time: best of {study.options.repeat} repetition(s) in a fresh "
+              "process (one thread); peak memory: the run process's maximum resident set (interpreter and "
+              "libraries included; in brackets what the run added to the process's baseline).",
+              f"- Generated {now()} on a {os.cpu_count()}-core machine by `{command or 'multiscale study ' + study.source.name}`.",
+              ""]
+    if study.reference is not None and ok:
+        lines += _cheapest_table(study, rows)
+    if study.averaged and ok:
+        lines += _average_table(study, ok)
+    lines += ["## Runs", ""] + _runs_table(study, rows)
+    if failed:
+        lines += ["", "Failed runs:", ""] + [f"- {_label_text(r)}: {r.record.get('error', '')}" for r in failed]
+    if pngs:
+        lines += ["", "## Plots", ""] + [f"![{p.stem}]({p.name})" for p in pngs]
+    path = folder / f"{study.name}.md"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def _memory(record: dict) -> str:
+    """Peak memory [MB] and, in brackets, what the run added to its process's baseline."""
+    peak, base = record.get("peak_memory_mb", math.nan), record.get("base_memory_mb", math.nan)
+    return "n/a" if not math.isfinite(peak) else f"{peak:.0f}" + (f" (+{peak - base:.0f})" if math.isfinite(base) else "")
+
+
+def _label_text(row: Row) -> str:
+    return ", ".join(f"{k} = {v}" for k, v in row.run.shown.items())
+
+
+def _cheapest_table(study, rows) -> list[str]:
+    knobs = [k for k in study.knobs if k not in study.cases]
+    head = ["error ≤"] + list(study.cases) + knobs + ["wall time [s]", "peak memory [MB]", "worst error", "time / base"]
+    lines = ["## What accuracy costs", "",
+             "The cheapest run (least wall time) whose worst error over the metrics meets each stated error; "
+             "'time / base' compares it with " + ("the reference run" if study.reference.kind == "run"
+                                                  else "the most expensive run") + ".", "",
+             "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for c in cheapest(study, rows):
+        r, base = c["row"], c["base"]
+        if r is None:
+            cells = ["none of the runs"] + [""] * (len(knobs) + 3)
+        else:
+            speed = r.record["wall_time"] / base.record["wall_time"] if base else math.nan
+            cells = [r.run.shown[k] for k in knobs] + [f"{r.record['wall_time']:.3g}", _memory(r.record),
+                                                                percent(r.max_error), f"{speed:.2g}"]
+            if r.is_reference:
+                cells[-1] += " (only the reference)"
+        lines.append("| " + " | ".join([percent(c["error"]), *c["case"], *cells]) + " |")
+    return lines + [""]
+
+
+def _average_table(study, rows) -> list[str]:
+    keep = [k for k in study.knobs if k not in study.averaged]
+    groups = {}
+    for r in rows:
+        groups.setdefault(tuple(r.run.shown[k] for k in keep), []).append(r)
+    head = keep + [f"{m} mean ± std (min … max)" for m in study.metrics] + ["samples"]
+    lines = [f"## Averaged over {', '.join(study.averaged)}", "",
+             "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for label, group in groups.items():
+        cells = list(label)
+        for m in study.metrics:
+            v = np.array([r.record["metrics"][m] for r in group])
+            cells.append(f"{v.mean():.4g} ± {v.std():.2g} ({v.min():.4g} … {v.max():.4g})")
+        lines.append("| " + " | ".join(cells + [str(len(group))]) + " |")
+    return lines + [""]
+
+
+def _runs_table(study, rows) -> list[str]:
+    head = list(study.knobs)
+    for m in study.metrics:
+        head += [m] + (["error"] if study.reference else [])
+    head += ["wall time [s]", "peak memory [MB]", "iterations", "status"]
+    lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+    for r in rows:
+        cells = [r.run.shown[k] for k in study.knobs]
+        for m in study.metrics:
+            cells.append(number_text(r.record.get("metrics", {}).get(m, math.nan)))
+            if study.reference:
+                cells.append(percent(r.errors.get(m, math.nan)))
+        rec = r.record
+        status = rec.get("status", "")
+        if r.ok and not rec.get("converged", True):
+            status += " (not converged)"
+        if r.note:
+            status += f" ({r.note})"
+        cells += [number_text(float(rec.get("wall_time", math.nan))), _memory(rec),
+                  str(rec.get("iterations", "")), status]
+        lines.append("| " + " | ".join(cells) + " |")
+    return lines
+
+
+def write_index(summaries, folder: Path, command: str) -> Path:
+    """README.md of a report folder: per study, its cheapest settings at each stated error."""
+    lines = ["# What accuracy costs", "",
+             f"Generated {now()} on a {os.cpu_count()}-core machine by `{command}`. Each study has its own "
+             "page (tables of every run, plots of error against wall time with the Pareto front, and against "
+             "each knob).", ""]
+    for study, rows, md in summaries:
+        lines += [f"## [{study.report.title or study.name}]({md.name})", ""]
+        if study.description:
+            lines += [study.description, ""]
+        if study.reference is None:
+            lines += ["Parametric study (no reference).", ""]
+            continue
+        lines += [f"Reference: {reference_text(study)}. Cheapest setting meeting each error "
+                  "(wall time, worst error):", ""]
+        found = cheapest(study, rows)
+        cases = list(dict.fromkeys(c["case"] for c in found))
+        head = ["error ≤"] + ([", ".join(f"{k} = {v}" for k, v in zip(study.cases, case)) for case in cases]
+                             if study.cases else ["setting"])
+        lines += ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+        for tol in study.report.errors:
+            cells = [percent(tol)]
+            for c in (c for c in found if c["error"] == tol):
+                r = c["row"]
+                cells.append("none" if r is None else ", ".join(
+                    f"{k} = {r.run.shown[k]}" for k in study.knobs if k not in study.cases)
+                    + f" ({r.record['wall_time']:.3g} s, {percent(r.max_error)})" + (" (the reference)" * r.is_reference))
+            lines.append("| " + " | ".join(cells) + " |")
+        lines.append("")
+    path = folder / "README.md"
+    path.write_text("\n".join(lines) + "\n")
+    return path

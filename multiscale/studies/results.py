@@ -1,0 +1,174 @@
+"""Results of a study: its records as rows with reference values and relative errors, the tables
+(``results.csv``, ``results.h5``), the cheapest run meeting each stated error, the Pareto front."""
+from __future__ import annotations
+
+import csv
+import json
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import h5py
+import numpy as np
+
+from multiscale.studies.expand import Study, StudyRun, normalise, parser_of, reference_run
+from multiscale.studies.formatting import value_text
+from multiscale.studies.problems import PROBLEMS
+from multiscale.studies.records import read_records
+
+__all__ = ["Row", "case_key", "cheapest", "collect", "pareto", "reference_text", "relative_error", "write_tables"]
+
+
+@dataclass
+class Row:
+    """One run in the results table."""
+
+    run: StudyRun
+    record: dict
+    reference: dict = field(default_factory=dict)    # metric -> reference value (may be missing)
+    errors: dict = field(default_factory=dict)       # metric -> relative error (NaN if unknown)
+    note: str = ""                                   # why an error is missing
+    is_reference: bool = False                       # the reference run of its own errors
+
+    @property
+    def ok(self) -> bool:
+        return self.record.get("status") == "ok"
+
+    @property
+    def max_error(self) -> float:
+        values = list(self.errors.values())
+        return max(values) if values and all(math.isfinite(v) for v in values) else math.nan
+
+
+def relative_error(value: float, ref: float) -> float:
+    """|value − ref| / |ref| (|value − ref| when ref = 0)."""
+    return abs(value - ref) / abs(ref) if ref != 0 else abs(value - ref)
+
+
+def collect(study: Study) -> list[Row]:
+    """Rows of the recorded runs, with reference values and relative errors."""
+    records = read_records(study)
+    rows = [Row(r, records.get(r.key, {"status": "missing", "error": "not run", "metrics": {}})) for r in study.runs]
+    ref = study.reference
+    if ref is None:
+        return rows
+    by_key = {row.run.key: row for row in rows}
+    fixed = json.loads(ref.file.read_text()) if ref.kind == "file" else None
+    want = {k: normalise(v, parser_of(PROBLEMS[study.problem], k)) for k, v in (ref.run or {}).items()}
+    for row in rows:
+        if not row.ok:
+            continue
+        if ref.kind == "analytic":
+            values = row.record.get("reference") or {}
+        elif ref.kind == "file":
+            values = fixed
+        else:
+            target = by_key[reference_run(study.runs, row.run.label, want, study.axes).key]
+            values = target.record["metrics"] if target.ok else {}
+            if not target.ok:
+                row.note = "reference run failed"
+            elif target is row:
+                row.note, row.is_reference = "reference run", True
+        for m in study.metrics:
+            if m in values:
+                row.reference[m] = float(values[m])
+                row.errors[m] = relative_error(row.record["metrics"][m], float(values[m]))
+            else:
+                row.errors[m] = math.nan
+                row.note = row.note or "no reference value"
+    return rows
+
+
+def _columns(study: Study, rows: list[Row]) -> dict:
+    """The tidy table, column -> list (one entry per run)."""
+    cols = {"run": [r.run.key for r in rows], "status": [r.record.get("status", "") for r in rows]}
+    for k in study.knobs:
+        cols[k] = [_cell(r.run.label[k]) for r in rows]
+    for m in study.metrics:
+        cols[m] = [r.record.get("metrics", {}).get(m, math.nan) for r in rows]
+        if study.reference is not None:
+            cols[f"{m}_reference"] = [r.reference.get(m, math.nan) for r in rows]
+            cols[f"{m}_error"] = [r.errors.get(m, math.nan) for r in rows]
+    if study.reference is not None:
+        cols["max_error"] = [r.max_error for r in rows]
+    for name in ("wall_time", "cpu_time", "peak_memory_mb"):
+        cols[name] = [float(r.record.get(name, math.nan)) for r in rows]
+    cols["iterations"] = [int(r.record.get("iterations", -1)) for r in rows]
+    cols["converged"] = [bool(r.record.get("converged", False)) for r in rows]
+    cols["message"] = [r.record.get("error", "") or r.note for r in rows]
+    return cols
+
+
+def _cell(value):
+    return json.dumps(value) if isinstance(value, list) else value
+
+
+def write_tables(study: Study, rows: list[Row]) -> tuple[Path, Path]:
+    """results.csv and results.h5 (one dataset per column, one row per run)."""
+    cols = _columns(study, rows)
+    study.folder.mkdir(parents=True, exist_ok=True)
+    csv_path, h5_path = study.folder / "results.csv", study.folder / "results.h5"
+    with open(csv_path, "w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(cols)
+        for i in range(len(rows)):
+            w.writerow([_csv(cols[c][i]) for c in cols])
+    with h5py.File(h5_path, "w") as h5:
+        for name, values in cols.items():
+            if all(isinstance(v, (int, float, bool)) for v in values):
+                h5.create_dataset(name, data=np.asarray(values))
+            else:
+                h5.create_dataset(name, data=[str(v) for v in values], dtype=h5py.string_dtype())
+        h5.attrs.update(study=study.name, problem=study.problem, source=str(study.source),
+                        reference=reference_text(study), metrics=list(study.metrics), knobs=list(study.knobs))
+    return csv_path, h5_path
+
+
+def _csv(value):
+    return f"{value:.10g}" if isinstance(value, float) else value
+
+
+def reference_text(study: Study) -> str:
+    """What the errors are measured against, in words."""
+    ref = study.reference
+    if ref is None:
+        return "none (a parametric study)"
+    if ref.kind == "analytic":
+        doc = (PROBLEMS[study.problem].exact.__doc__ or "").strip().splitlines()
+        return "the problem's own reference" + (f": {doc[0].rstrip('.')}" if doc else "")
+    if ref.kind == "file":
+        return f"stored result {ref.file.name}"
+    return "the run with " + ", ".join(f"{k} = {value_text(v)}" for k, v in ref.run.items()) + \
+        (" (other parameters unchanged)" if len(ref.run) < len(study.knobs) else "")
+
+
+def case_key(study: Study, row: Row) -> tuple:
+    """The row's values of the study's cases (physical parameters), as shown."""
+    return tuple(row.run.shown[k] for k in study.cases)
+
+
+def cheapest(study: Study, rows: list[Row]) -> list[dict]:
+    """Per stated error and case: the run of least wall time whose worst error meets it."""
+    out = []
+    cases = list(dict.fromkeys(case_key(study, r) for r in rows))
+    for tol in study.report.errors:
+        for case in cases:
+            pool = [r for r in rows if r.ok and case_key(study, r) == case]
+            good = [r for r in pool if math.isfinite(r.max_error) and r.max_error <= tol]
+            best = min(good, key=lambda r: r.record["wall_time"]) if good else None
+            refs = [r for r in pool if r.is_reference]
+            base = refs[0] if refs else (max(pool, key=lambda r: r.record["wall_time"]) if pool else None)
+            out.append({"error": tol, "case": case, "row": best, "base": base})
+    return out
+
+
+def pareto(times, errors) -> list[int]:
+    """Indices of the runs not beaten in both wall time and error, by increasing time."""
+    order = sorted((i for i in range(len(times)) if math.isfinite(errors[i]) and errors[i] > 0),
+                   key=lambda i: (times[i], errors[i]))
+    front, best = [], math.inf
+    for i in order:
+        if errors[i] < best:
+            front.append(i)
+            best = errors[i]
+    return front

@@ -1,0 +1,154 @@
+"""Running a study: each run without a record in a fresh worker process (``python -m
+multiscale.studies.worker``), ``[run] processes`` at a time, with timeouts; under ``mpiexec`` the
+runs are shared out over the ranks. A crash or timeout becomes a failed record."""
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from dataclasses import dataclass
+
+from tqdm import tqdm
+
+from multiscale.studies.expand import Study, StudyRun
+from multiscale.studies.formatting import now
+from multiscale.studies.records import FAILED, json_default, read_records, record_path, write_json
+
+__all__ = ["ExecStats", "execute", "world"]
+
+
+@dataclass
+class ExecStats:
+    """What ``execute`` did on this process (rank)."""
+
+    total: int            # runs in the study
+    done: int             # already recorded, skipped
+    started: int          # run now
+    failed: int           # of those, failed
+    wall_time: float      # s
+
+
+def _child_env() -> dict:
+    """The worker's environment: an MPI singleton (no launcher variables), one thread."""
+    env = {k: v for k, v in os.environ.items()
+           if not k.startswith(("PMI_", "PMIX_", "HYDRA_", "OMPI_", "MPI_LOCAL", "MPIR_"))}
+    env.setdefault("OMP_NUM_THREADS", "1")
+    env.setdefault("MPLBACKEND", "Agg")
+    return env
+
+
+def world():
+    """MPI.COMM_WORLD when launched by mpiexec with several ranks, else None (no MPI init)."""
+    if not any(k in os.environ for k in ("PMI_SIZE", "PMI_RANK", "OMPI_COMM_WORLD_SIZE", "PMIX_RANK")):
+        return None
+    try:
+        from mpi4py import MPI       # local: importing it initialises MPI, wanted only under mpiexec
+    except ImportError:
+        return None
+    return MPI.COMM_WORLD if MPI.COMM_WORLD.size > 1 else None
+
+
+def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, comm=None) -> ExecStats:
+    """Run the study's runs that have no record (and failed ones with ``rerun_failed``), each in a
+    fresh worker process, ``options.processes`` at a time; with ``comm``, runs are shared out
+    round-robin over its ranks (collective)."""
+    start = time.perf_counter()
+    rank, size = (comm.rank, comm.size) if comm is not None else (0, 1)
+    if rank == 0:
+        (study.folder / "runs").mkdir(parents=True, exist_ok=True)
+    if comm is not None:
+        comm.barrier()
+    records = read_records(study)
+    todo = [r for r in study.runs if not _done(records.get(r.key), study.metrics, rerun_failed)]
+    mine = todo[rank::size]
+    bar = None
+    if progress and rank == 0 and mine:
+        bar = tqdm(total=len(mine), desc=study.name, unit="run")
+    failed = 0
+    queue, running = list(mine), {}
+    try:
+        while queue or running:
+            while queue and len(running) < study.options.processes:
+                run = queue.pop(0)
+                running[_spawn(study, run, rank)] = (run, time.monotonic())
+            time.sleep(0.05)
+            for proc, (run, t0) in list(running.items()):
+                timeout = study.options.timeout
+                if proc.poll() is None and not (timeout and time.monotonic() - t0 > timeout):
+                    continue
+                if proc.poll() is None:
+                    _kill(proc)
+                    _failed_record(study, run, f"timed out after {timeout:g} s (run.timeout)")
+                elif proc.returncode != 0 or not record_path(study, run).is_file():
+                    _failed_record(study, run, _crash_message(study, run, proc.returncode))
+                del running[proc]
+                failed += json.loads(record_path(study, run).read_text()).get("status") == FAILED
+                log = study.folder / "runs" / f"{run.key}.log"
+                if log.is_file() and not log.stat().st_size:
+                    log.unlink()
+                if bar is not None:
+                    bar.update()
+    finally:
+        for proc in running:
+            _kill(proc)
+        if bar is not None:
+            bar.close()
+    if comm is not None:
+        comm.barrier()
+    return ExecStats(len(study.runs), len(study.runs) - len(todo), len(mine), failed, time.perf_counter() - start)
+
+
+def _done(record, metrics, rerun_failed: bool) -> bool:
+    """A run is done if it failed (unless retried) or recorded every metric the study asks for
+    (a study may ask for a new metric of a scene history after its runs were made)."""
+    if record is None:
+        return False
+    if record.get("status") == FAILED:
+        return not rerun_failed
+    return all(m in record.get("metrics", {}) for m in metrics)
+
+
+def _spawn(study: Study, run: StudyRun, rank: int) -> subprocess.Popen:
+    workdir = study.folder / "runs" / run.key
+    task = {"problem": study.problem, "raw": run.raw, "label": run.label, "key": run.key,
+            "metrics": list(study.metrics), "repeat": study.options.repeat,
+            "exact": study.reference is not None and study.reference.kind == "analytic",
+            "record": str(record_path(study, run)), "workdir": str(workdir),
+            "references": str(study.folder / "references"), "directory": str(study.source.parent), "rank": rank}
+    if study.problem == "scene":
+        task.update(scene=str(study.scene), ranks=study.options.ranks)
+    record_path(study, run).unlink(missing_ok=True)          # a failed run being retried
+    log = open(study.folder / "runs" / f"{run.key}.log", "w")
+    try:
+        return subprocess.Popen([sys.executable, "-m", "multiscale.studies.worker",
+                                 json.dumps(task, default=json_default)],
+                                stdout=log, stderr=subprocess.STDOUT, env=_child_env(), start_new_session=True)
+    finally:
+        log.close()
+
+
+def _kill(proc: subprocess.Popen) -> None:
+    try:
+        os.killpg(proc.pid, signal.SIGKILL)
+    except (ProcessLookupError, PermissionError):
+        pass
+    proc.wait()
+
+
+def _crash_message(study, run, code) -> str:
+    log = study.folder / "runs" / f"{run.key}.log"
+    lines = [line for line in (log.read_text(errors="replace").splitlines() if log.is_file() else []) if line.strip()]
+    if code is not None and code < 0:
+        name = signal.Signals(-code).name if -code in signal.Signals._value2member_map_ else str(-code)
+        why = f"worker killed by {name}" + (" (out of memory?)" if -code == signal.SIGKILL else "")
+    else:
+        why = f"worker exited with code {code} without a record"
+    return why + (f": {lines[-1].strip()}" if lines else "")
+
+
+def _failed_record(study, run, message) -> None:
+    write_json(record_path(study, run), {"key": run.key, "problem": study.problem, "label": run.label,
+                                         "status": FAILED, "error": message, "metrics": {}, "finished": now()})

@@ -1,0 +1,111 @@
+"""The ``scene`` problem: any macro scene with overrides (dotted scene paths -> raw values), run
+in a subprocess (``python -m multiscale.studies.scene_run``, under ``mpiexec -n ranks`` when
+ranks > 1); metrics from its HDF5 history, or for a squeal scene from its table of modes."""
+from __future__ import annotations
+
+import hashlib
+import json
+import subprocess
+import sys
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from multiscale.errors import SceneError
+from multiscale.io import History
+from multiscale.scene import load
+from multiscale.studies.base import Outcome, Problem, jsonable
+
+__all__ = ["SQUEAL_METRICS", "SceneProblem", "SceneRun", "squeal_metrics"]
+
+_REDUCERS = {"last": lambda v: v[-1], "first": lambda v: v[0], "max": np.max, "min": np.min, "mean": np.mean,
+             "rise": lambda v: v[-1] - v[0]}
+
+
+SQUEAL_METRICS = {
+    "modes": "number of complex modes found in the band",
+    "unstable_modes": "modes with a positive real part (growth rate) [-]",
+    "max_growth": "largest real part sigma of the eigenvalues [1/s]",
+    "max_growth_frequency": "frequency of the mode with the largest real part [Hz]",
+    "lowest_unstable_frequency": "frequency of the lowest unstable mode, 0 if none [Hz]",
+    "min_damping_ratio": "smallest damping ratio (negative: unstable) [-]",
+}
+
+
+def squeal_metrics(modes_csv) -> dict:
+    """``SQUEAL_METRICS`` of a squeal run's mode table (``ModalResult.write_csv``)."""
+    table = np.genfromtxt(modes_csv, delimiter=",", names=True, ndmin=1)
+    f, sigma, unstable = table["frequency_Hz"], table["sigma_1_per_s"], table["unstable"] > 0
+    k = int(np.argmax(sigma))
+    return {"modes": float(f.size), "unstable_modes": float(unstable.sum()), "max_growth": float(sigma[k]),
+            "max_growth_frequency": float(f[k]),
+            "lowest_unstable_frequency": float(f[unstable].min()) if unstable.any() else 0.0,
+            "min_damping_ratio": float(table["damping_ratio"].min())}
+
+
+@dataclass(frozen=True)
+class SceneRun:
+    """A macro scene with overrides (dotted scene paths -> raw values) and MPI ranks per run."""
+
+    scene: Path
+    overrides: dict = field(default_factory=dict)
+    ranks: int = 1
+
+
+class SceneProblem(Problem):
+    """Any macro scene (``multiscale run``) with overrides; metrics are history columns reduced
+    over time: ``column`` (last value) or ``column:last|first|max|min|mean|rise`` (rise = last −
+    first: a temperature rise, whose relative error means more than that of a temperature in K).
+    A squeal scene (effect ``stability``) has no history; its metrics come from ``modes.csv``
+    (``squeal_metrics``)."""
+
+    name = "scene"
+    doc = ("a macro scene run by the macro runner with overrides; metrics: HDF5 history columns, "
+           "column[:last|first|max|min|mean|rise]; squeal scenes: " + ", ".join(SQUEAL_METRICS))
+    metrics = {}
+
+    def parse(self, raw, path, ctx, scene=None, ranks=1):
+        try:
+            load(scene, overrides=raw)
+        except SceneError as exc:
+            ctx.problems.extend(f"{path}: {line}" if path else line for line in exc.problems)
+            return None
+        return SceneRun(Path(scene), dict(raw), ranks)
+
+    def key(self, params: SceneRun) -> dict:
+        text = params.scene.read_bytes()
+        return {"scene": str(params.scene), "scene_sha256": hashlib.sha256(text).hexdigest(),
+                "overrides": jsonable(params.overrides)}
+
+    def check_metric(self, name):
+        column, _, reducer = name.partition(":")
+        if not column or (reducer and reducer not in _REDUCERS):
+            return (f"a history column, optionally with :{'|:'.join(_REDUCERS)} "
+                    f"(e.g. max_temperature_pin:max)")
+        return None
+
+    def run(self, params: SceneRun, workdir: Path) -> Outcome:
+        """Run the scene in a subprocess (``mpiexec -n ranks`` when ranks > 1) into workdir/output."""
+        out = Path(workdir) / "output"
+        Path(workdir).mkdir(parents=True, exist_ok=True)
+        task = json.dumps({"scene": str(params.scene), "overrides": {**params.overrides, "output.folder": str(out)}})
+        command = [sys.executable, "-m", "multiscale.studies.scene_run", task]
+        if params.ranks > 1:
+            mpiexec = Path(sys.executable).with_name("mpiexec")
+            command = [str(mpiexec) if mpiexec.exists() else "mpiexec", "-n", str(params.ranks)] + command
+        done = subprocess.run(command, capture_output=True, text=True)
+        (Path(workdir) / "scene_run.log").write_text(done.stdout + done.stderr)
+        if done.returncode != 0:
+            last = [line for line in (done.stderr or done.stdout).strip().splitlines() if line.strip()]
+            raise RuntimeError(f"scene run failed (exit {done.returncode}): {last[-1] if last else 'no output'}")
+        if (out / "modes.csv").exists():
+            return Outcome(squeal_metrics(out / "modes.csv"), 0, True)
+        history = History.read(out / "history.h5")
+        metrics = {}
+        for column in history.columns:
+            values = history[column]
+            metrics[column] = float(values[-1])
+            metrics.update({f"{column}:{r}": float(f(values)) for r, f in _REDUCERS.items()})
+        iterations = int(history["newton_iterations"].sum()) if "newton_iterations" in history.columns else 0
+        return Outcome(metrics, iterations, True)

@@ -1,0 +1,101 @@
+"""One study run in this fresh process: ``python -m multiscale.studies.worker TASK_JSON``, spawned
+by ``running.execute``. Parses the run's parameters, runs it ``repeat`` times and writes its
+record; a failure is recorded, never raised. The problem modules (and the numba-compiled micro
+modules they import) are loaded with this module, before the run's clock and memory baseline."""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import platform
+import resource
+import sys
+import time
+import traceback
+from pathlib import Path
+
+import multiscale
+from multiscale.errors import MultiscaleError, SceneError
+from multiscale.schema import Context, suggest
+from multiscale.studies.formatting import now
+from multiscale.studies.problems import problem as get_problem
+from multiscale.studies.records import FAILED, write_json
+
+__all__ = ["run_task"]
+
+
+def _peak_mb() -> float:
+    """Peak resident memory [MB] of this process and of its finished children (ru_maxrss)."""
+    own = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss
+    kids = resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss
+    return max(own, kids) / 1024.0
+
+
+def _cpu() -> float:
+    """CPU time [s], user + system, of this process and of its finished children."""
+    total = 0.0
+    for who in (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN):
+        u = resource.getrusage(who)
+        total += u.ru_utime + u.ru_stime
+    return total
+
+
+def run_task(task: dict) -> int:
+    """One run in this (fresh) process: parse, run ``repeat`` times, write the record."""
+    record = {"key": task["key"], "problem": task["problem"], "label": task["label"], "status": FAILED,
+              "metrics": {}, "started": now(), "repeat": task["repeat"], "python": platform.python_version(),
+              "multiscale": multiscale.__version__, "cpus": os.cpu_count(), "rank": task["rank"]}
+    try:
+        problem = get_problem(task["problem"])
+        ctx = Context(directory=Path(task["directory"]))
+        extra = {"scene": task["scene"], "ranks": task["ranks"]} if "scene" in task else {}
+        params = problem.parse(task["raw"], "", ctx, **extra)
+        if ctx.problems:
+            raise SceneError(ctx.problems)
+        record["params"] = problem.key(params)
+        workdir = Path(task["workdir"])
+        record["base_memory_mb"] = _peak_mb()
+        times, cpu0 = [], _cpu()
+        for _ in range(task["repeat"]):
+            t0 = time.perf_counter()
+            outcome = problem.run(params, workdir)
+            times.append(time.perf_counter() - t0)
+        record.update(wall_time=min(times), wall_times=times, cpu_time=(_cpu() - cpu0) / len(times),
+                      peak_memory_mb=_peak_mb(), iterations=int(outcome.iterations),
+                      converged=bool(outcome.converged))
+        metrics = {k: float(v) for k, v in outcome.metrics.items()}
+        record["metrics"] = metrics
+        for name in task["metrics"]:
+            if name not in metrics:
+                raise MultiscaleError(f"metric \"{name}\" not produced{suggest(name, metrics)}; "
+                                      f"available: {', '.join(sorted(metrics))}")
+            if not math.isfinite(metrics[name]):
+                raise MultiscaleError(f"metric \"{name}\" is {metrics[name]} (not finite)")
+        record.update(status="ok", error="")
+        if task["exact"]:
+            record["reference"] = _exact(problem, params, Path(task["references"]))
+    except Exception as exc:       # recorded, never raised: the study goes on
+        text = str(exc).strip().splitlines()
+        record.update(status=FAILED, error=f"{type(exc).__name__}: {text[0] if text else ''}".strip(),
+                      traceback=traceback.format_exc())
+    record["finished"] = now()
+    record.setdefault("peak_memory_mb", _peak_mb())
+    write_json(Path(task["record"]), record)
+    return 0
+
+
+def _exact(problem, params, folder: Path) -> dict:
+    """The problem's analytic reference, cached on disk by the parameters it depends on."""
+    ident = json.dumps(problem.exact_key(params), sort_keys=True)
+    path = folder / f"{problem.name}-{hashlib.sha256(ident.encode()).hexdigest()[:16]}.json"
+    if path.is_file():
+        return json.loads(path.read_text())["values"]
+    values = {k: float(v) for k, v in problem.exact(params).items()}
+    folder.mkdir(parents=True, exist_ok=True)
+    write_json(path, {"params": json.loads(ident), "values": values})
+    return values
+
+
+if __name__ == "__main__":
+    sys.exit(run_task(json.loads(sys.argv[1])))
