@@ -298,7 +298,7 @@ def generate_disc(model, params=None, hat: bool = True) -> int:
 
 def gmsh_size(model, size: float) -> None:
     """Uniform target element size [m] (curvature-refined on circles)."""
-    import gmsh
+    import gmsh   # only when meshing: scenes read this builder's parameters without gmsh
 
     gmsh.option.setNumber("Mesh.MeshSizeMax", size)
     gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 24)

@@ -13,6 +13,7 @@ import hashlib
 import os
 from pathlib import Path
 
+import h5py
 import numpy as np
 
 from multiscale.errors import InputError
@@ -35,7 +36,6 @@ def _dof_table(f, scale: float):
 def save(path, comm, *, attrs: dict, arrays: dict, functions: dict, scale: float = 1.0) -> Path:
     """Write a checkpoint (collective). ``arrays``: name -> numpy array (same on every rank);
     ``functions``: name -> dolfinx Function (gathered by dof coordinates)."""
-    import h5py
     path = Path(path)
     tables = {name: comm.gather(_dof_table(f, scale), root=0) for name, f in functions.items()}
     if comm.rank == 0:
@@ -57,7 +57,6 @@ def save(path, comm, *, attrs: dict, arrays: dict, functions: dict, scale: float
 def load(path, comm, functions: dict) -> tuple[dict, dict]:
     """Read a checkpoint: sets ``functions`` (name -> Function, matched by dof coordinates) and
     returns (attrs, arrays). Raises InputError if a function's dofs are not in the file."""
-    import h5py
     with h5py.File(path, "r") as h5:
         attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in h5.attrs.items()}
         arrays = {}

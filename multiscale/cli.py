@@ -6,7 +6,8 @@ import sys
 
 from multiscale import __version__
 from multiscale.errors import MultiscaleError, SceneError
-from multiscale.scene import load, reference, summary
+from multiscale.scene import load
+from multiscale.scene_summary import reference, summary
 
 
 def _info(args) -> int:
@@ -14,12 +15,12 @@ def _info(args) -> int:
     import numba
     import numpy
     import scipy
-
     from multiscale.micro.fft import get_threads, pyfftw
     print(f"multiscale {__version__}  numpy {numpy.__version__}  scipy {scipy.__version__}  "
           f"numba {numba.__version__}  fft {'pyfftw' if pyfftw else 'scipy'} ({get_threads()} thread(s))")
     try:
-        import multiscale.macro  # noqa: F401  (DOLFINx is optional; this loads its prerequisites first)
+        # DOLFINx is optional; multiscale.macro loads its prerequisites first
+        import multiscale.macro  # noqa: F401
         import dolfinx
         print(f"dolfinx {dolfinx.__version__}")
     except ImportError:

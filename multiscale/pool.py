@@ -39,6 +39,7 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from mpi4py import MPI
+from tqdm import tqdm
 
 from multiscale.errors import InputError
 from multiscale.micro.laws import (LawError, LawSpec, ZoneFailure, ZoneLaws, ZoneNodes, batch_signature,
@@ -192,7 +193,4 @@ class MicroPool:
 
 
 def _progress(items, show: bool):
-    if not show:
-        return items
-    from tqdm import tqdm
-    return tqdm(items, desc="zone laws", unit="batch")
+    return tqdm(items, desc="zone laws", unit="batch") if show else items

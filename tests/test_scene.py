@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from multiscale.errors import InputError, SceneError
-from multiscale.scene import EFFECTS, load, loads, summary
+from multiscale.scene import EFFECTS, load, loads
+from multiscale.scene_summary import summary
 from multiscale.units import UnitError, to_si
 
 DEMOS = Path(__file__).resolve().parents[1] / "demos"
@@ -330,7 +331,8 @@ def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
 
 
 def test_reference_lists_every_section_and_key():
-    from multiscale.scene import Scene, reference
+    from multiscale.scene import Scene
+    from multiscale.scene_summary import reference
     from multiscale.schema import fields_of
     text = "\n".join(reference())
     for name, spec in fields_of(Scene):

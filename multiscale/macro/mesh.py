@@ -262,7 +262,7 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD) -> TwoBodyMesh:
     name = getattr(builder, "NAME", builder.__name__)
     error = None
     if comm.rank == 0:
-        import gmsh
+        import gmsh   # rank 0 alone builds the geometry
         gmsh.initialize(interruptible=False)
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.NumThreads", 1)

@@ -1,0 +1,75 @@
+"""What ``multiscale check`` prints: the scene format (``--keys``) and a scene's summary."""
+from __future__ import annotations
+
+import math
+
+from multiscale.scene import EFFECTS, OUTPUT_FIELDS, Scene
+from multiscale.schema import reference as schema_reference
+
+
+def reference() -> list[str]:
+    """The scene format: effects, then every section and key (``multiscale check --keys``)."""
+    effects = [f"  {name:<15} {e.doc}" + (f"  (needs {', '.join(e.requires)})" if e.requires else "")
+               for name, e in EFFECTS.items()]
+    fields = [f"  {name:<18} needs {', '.join(needs) or 'nothing'}" for name, needs in OUTPUT_FIELDS.items()]
+    return (["Scene file (TOML). Values: SI numbers or unit strings (\"4 GPa\", \"200 rpm\", \"20 degC\").",
+             "", "effects:"] + effects + ["", "output.fields:"] + fields + ["", "top level:"]
+            + schema_reference(Scene))
+
+
+
+def summary(scene: Scene) -> list[str]:
+    """A few lines: bodies, effects, loading, time, output — what a run would compute."""
+    g, ld, t, o = scene.geometry, scene.loading, scene.time, scene.output
+    params = g.resolved()
+    bodies = " | ".join(f"{b.name} ({', '.join(f'{r.name}: {r.material}' for r in b.regions)})"
+                        for b in g.spec.bodies)
+    sizes = ", ".join(f"{k} {params[k] * 1e3:g} mm" for k in params if k.endswith("mesh_size"))
+    lines = [f"scene {scene.name}" + (f" ({scene.source})" if scene.source else ""),
+             f"  geometry  {g.builder}, {g.motion} of {g.bodies[1]}; {sizes}",
+             f"  bodies    {bodies}",
+             f"  effects   {', '.join(e for e in EFFECTS if e in scene.effects)}"]
+    for effect in EFFECTS:
+        if scene.has(effect):
+            lines.append(f"    {effect:<15}{_effect_line(scene, effect)}")
+    load_text = (f"{ld.normal_force:g} N" if ld.normal_force is not None else
+                 f"{ld.pressure / 1e6:g} MPa" if ld.pressure is not None else "none")
+    motion = (f"{ld.rotation_speed * 30 / math.pi:g} rpm" if ld.rotation_speed is not None else
+              f"speed profile of {len(ld.speed_profile)} points" if ld.speed_profile is not None else
+              f"{ld.sliding_speed:g} m/s" if ld.sliding_speed is not None else "no sliding")
+    lines.append(f"  loading   {load_text}, {motion}, {ld.ramp_steps} ramp step(s)")
+    if t.end is not None:
+        lines.append(f"  time      {t.end:g} s in {t.steps} step(s) of {t.dt:g} s x {t.substeps} substep(s); "
+                     f"T0 = {t.initial_temperature - 273.15:g} degC")
+    lines.append(f"  output    {o.folder} every {o.every} step(s): {', '.join(o.fields)}")
+    if o.existing_results():
+        lines.append(f"  note      the output folder already holds {len(o.existing_results())} entries: "
+                     "run needs --overwrite or --resume")
+    lines += [f"  warning   {w}" for w in scene.warnings]
+    return lines
+
+
+def _effect_line(scene: Scene, effect: str) -> str:
+    i, ld = scene.interface, scene.loading
+    if effect == "contact":
+        return f"penalty K_n = {i.penalty:g} Pa/m" if not scene.has("roughness") else "rough per-zone laws"
+    if effect == "friction":
+        return f"Coulomb, mu = {ld.friction:g}"
+    if effect == "thermal":
+        return f"transient conduction in {', '.join(scene.bodies)}"
+    if effect == "heat_partition":
+        share = f"{scene.partition:.3g}" + (" (effusivity)" if i.partition == "effusivity" else "")
+        return f"share {share} of mu p |v| into the {scene.bodies[0]}"
+    if effect == "conductance":
+        return f"h_c = {i.conductance:g} W/(m^2 K)" if not scene.has("roughness") else "h_c(p) per zone (micro)"
+    if effect == "roughness":
+        r, m = scene.roughness, scene.micro
+        surface = f"RMS {r.rms * 1e6:g} um, H {r.hurst:g}" if r.rms is not None else f"file {r.file.name}"
+        return (f"{r.body}: {surface}; {m.zones[0]} x {m.zones[1]} zones of {m.grid[0]} x {m.grid[1]} cells, "
+                f"{m.law_points}-point laws")
+    if effect == "wear":
+        w = scene.wear
+        rate = f"k_w = {w.k_w:g} 1/Pa" if w.k_w is not None else (
+            "k_w(T) table" if w.k_w_table is not None else "k_w(T) of thesis Fig. 7.9 (default)")
+        return f"Archard, {rate}, every {w.update_every} step(s) in {w.substeps} increment(s)"
+    return EFFECTS[effect].doc
