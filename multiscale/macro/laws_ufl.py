@@ -45,7 +45,7 @@ def coefficient_size(n_points: int) -> int:
 
 def law_coefficients(law: PressureGapLaw) -> np.ndarray:
     """(zones, coefficient_size(n)) vectors of the batch of laws ``law`` (module docstring)."""
-    x, y, slope = law._x, law._y, law._slope        # ln d, ln p and d ln p/d ln d at the nodes
+    x, y, slope = law.hermite_nodes               # ln d, ln p and d ln p/d ln d at the nodes
     n = x.shape[1]
     h = np.diff(x, axis=1)
     secant = np.diff(y, axis=1) / h

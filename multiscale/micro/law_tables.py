@@ -94,6 +94,12 @@ class PressureGapLaw:
     def n_zones(self) -> int:
         return self.gap.shape[0]
 
+    @property
+    def hermite_nodes(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(ln d, ln p, d ln p / d ln d) at the nodes, each (Z, n): the Hermite data of the laws
+        (d = g_open − g_n [m], p [Pa])."""
+        return self._x, self._y, self._slope
+
     def __call__(self, gap, rows=None) -> LawValue:
         """p_n and K_n at gaps ``gap`` [m]; ``rows`` picks each point's law (default: point i
         uses row i, or row 0 for a single law). Vectorised; never NaN for finite gaps."""

@@ -142,7 +142,7 @@ def _crash_message(study, run, code) -> str:
     log = study.folder / "runs" / f"{run.key}.log"
     lines = [line for line in (log.read_text(errors="replace").splitlines() if log.is_file() else []) if line.strip()]
     if code is not None and code < 0:
-        name = signal.Signals(-code).name if -code in signal.Signals._value2member_map_ else str(-code)
+        name = signal.Signals(-code).name if -code in {s.value for s in signal.Signals} else str(-code)
         why = f"worker killed by {name}" + (" (out of memory?)" if -code == signal.SIGKILL else "")
     else:
         why = f"worker exited with code {code} without a record"
