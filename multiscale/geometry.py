@@ -88,6 +88,9 @@ class GeometrySpec:
     motion: Rotation | Translation = field(default_factory=Rotation)
     length_scale: float = 1.0          # m, a typical size (tolerances for facet keys)
     fluid_load: bool = False           # load faces loaded by a fluid pressure (−p n)
+    interface_normals: Mapping[str, tuple | None] = field(default_factory=dict)   # unit normal of a
+    #                                    planar interface (None: not planar; absent: not inspected)
+    report: tuple[str, ...] = ()       # what the builder found (bodies, volumes, interfaces), for check
 
     @property
     def materials(self) -> tuple[str, ...]:

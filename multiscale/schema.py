@@ -24,8 +24,8 @@ from multiscale.units import KINDS, UnitError, to_si
 
 __all__ = ["Bad", "Choice", "Context", "Curve", "Either", "FilePath", "Flag", "FrozenMap",
            "Integer", "ListOf", "Named", "OneOf", "OnlyWith", "Pair", "Quantity", "Requires",
-           "Section", "Tables", "Text", "fields_of", "key", "read", "reference", "show", "suggest",
-           "unknown_keys"]
+           "Section", "TableOr", "Tables", "Text", "Vector", "fields_of", "key", "read", "reference", "show",
+           "suggest", "unknown_keys"]
 
 
 class Bad(ValueError):
@@ -39,6 +39,7 @@ class Context:
 
     effects: frozenset = frozenset()
     directory: Path = Path(".")
+    root: dict = field(default_factory=dict)        # the whole raw file (tables that merge others)
     problems: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
 
@@ -261,18 +262,22 @@ class Pair(ListOf):
 
 
 class Curve:
-    """A table of [x, y] rows with strictly increasing x, as a tuple of (x, y) tuples."""
+    """A table of [x, y] rows with strictly increasing x (at least ``min_rows``), as a tuple of
+    (x, y) tuples."""
 
-    def __init__(self, x, y, x_name: str, y_name: str):
-        self.x, self.y, self.x_name, self.y_name = x, y, x_name, y_name
+    def __init__(self, x, y, x_name: str, y_name: str, *, min_rows: int = 1):
+        self.x, self.y, self.x_name, self.y_name, self.min_rows = x, y, x_name, y_name, min_rows
 
     def describe(self) -> str:
-        return (f"rows [{self.x_name}, {self.y_name}] with increasing {self.x_name}; "
+        rows = "rows" if self.min_rows < 2 else f"at least {self.min_rows} rows"
+        return (f"{rows} [{self.x_name}, {self.y_name}] with increasing {self.x_name}; "
                 f"{self.x_name}: {self.x.describe()}; {self.y_name}: {self.y.describe()}")
 
     def __call__(self, raw, ctx):
         if not isinstance(raw, list) or not raw or not all(isinstance(r, list) and len(r) == 2 for r in raw):
             raise Bad(f"must be a non-empty list of {self.describe()}")
+        if len(raw) < self.min_rows:
+            raise Bad(f"needs {self.describe()} (got {len(raw)} row)")
         rows, errors = [], []
         for i, (x, y) in enumerate(raw, 1):
             try:
@@ -284,6 +289,35 @@ class Curve:
         if errors:
             raise Bad("; ".join(errors))
         return tuple(rows)
+
+
+class TableOr:
+    """A constant, or a table of [x, y] rows (``Curve``) when the value is a list."""
+
+    def __init__(self, value, table: Curve):
+        self.value, self.table = value, table
+
+    def describe(self) -> str:
+        return f"{self.value.describe()}, or a table of {self.table.describe()}"
+
+    def __call__(self, raw, ctx):
+        return self.table(raw, ctx) if isinstance(raw, list) else self.value(raw, ctx)
+
+
+class Vector(ListOf):
+    """Exactly ``n`` items of one parser (a point or a direction), as a tuple."""
+
+    def __init__(self, item, n: int = 3, names: str = "[x, y, z]"):
+        super().__init__(item)
+        self.n, self.names = n, names
+
+    def describe(self) -> str:
+        return f"{self.names}, each {self.item.describe()}"
+
+    def __call__(self, raw, ctx):
+        if not isinstance(raw, list) or len(raw) != self.n:
+            raise Bad(f"must be {self.describe()}")
+        return super().__call__(raw, ctx)
 
 
 class FilePath:
