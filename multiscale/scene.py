@@ -239,6 +239,10 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
     for section, spec in fields_of(Scene):
         if section in raw and spec.needed_by and not any(e in effects for e in spec.needed_by):
             warnings.append(f'[{section}] is ignored: effect "{spec.needed_by[0]}" is not in effects')
+    for i, b in enumerate(scene.boundary or (), 1):
+        given = [k for k in Boundary.THERMAL if b is not None and getattr(b, k) is not None]
+        if given and "thermal" not in effects:
+            warnings.append(f'boundary[{i}].{given[0]} is ignored: effect "thermal" is not in effects')
     if {"friction", "thermal"} <= effects and "heat_partition" not in effects:
         warnings.append('effects "friction" and "thermal" without "heat_partition": no frictional heat '
                         "enters the bodies")
@@ -250,7 +254,7 @@ def _surface_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]
     interfaces are planar; a file's load faces are given."""
     problems, known = [], g.surfaces
     for i, b in enumerate(scene.boundary or (), 1):
-        for s in (b.surfaces if b is not None else ()):
+        for s in ((b.surfaces or ()) if b is not None else ()):
             if s not in known:
                 problems.append(f'boundary[{i}].surfaces: "{s}" is not a surface of {where}; known: {", ".join(known)}')
     faces = scene.loading.faces if scene.loading is not None else None

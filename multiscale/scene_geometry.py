@@ -30,6 +30,18 @@ FILE_TYPES = {".msh": "mesh", ".geo": "script", ".step": "cad", ".stp": "cad", "
               ".brep": "cad"}
 
 
+class Points:
+    """One point [x, y, z] or a list of points, as a tuple of points."""
+
+    def describe(self) -> str:
+        return f"a point {_POINT.describe()}, or a list of such points"
+
+    def __call__(self, raw, ctx):
+        if isinstance(raw, list) and raw and all(isinstance(r, list) for r in raw):
+            return tuple(_POINT(r, ctx) for r in raw)
+        return (_POINT(raw, ctx),)
+
+
 class LengthUnit:
     """The name of a length unit ("mm", "m", "in"), as its size in metres."""
 
@@ -49,7 +61,7 @@ class BodySelection:
 
     volumes: tuple | None = key(ListOf(Text(), unique=True, min_len=1))   # physical names or CAD labels
     index: tuple | None = key(ListOf(Integer(ge=1), unique=True, min_len=1))   # volume numbers of the file
-    contains: tuple | None = key(_POINT)                                  # m, a point inside the volume
+    contains: tuple | None = key(Points())                                # m, points inside its volumes
     material: str | None = key(Text(), required=True)
 
     rules = (OneOf(("volumes", "index", "contains"), required=True),)
@@ -59,12 +71,12 @@ class BodySelection:
 class SurfaceSelection:
     """[geometry.surfaces.<name>]: a named surface: a physical surface ``group`` of the file, or the
     faces of ``body`` whose outward ``normal`` is the given direction (within 5 degrees), or the
-    face(s) through the point ``contains`` (of ``body`` if given)."""
+    faces through the points ``contains`` (of ``body`` if given)."""
 
     group: str | None = key(Text())
     body: str | None = key(Text())
     normal: tuple | None = key(_DIRECTION)
-    contains: tuple | None = key(_POINT)
+    contains: tuple | None = key(Points())                 # m, a point on each face
 
     rules = (OneOf(("group", "normal", "contains"), required=True),)
 

@@ -14,7 +14,7 @@ from pathlib import Path
 
 from multiscale.errors import InputError
 from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, ListOf, OneOf, OnlyWith, Pair,
-                               Quantity, Requires, Section, TableOr, Tables, Text, key)
+                               Quantity, Requires, Section, TableOr, Tables, Text, Vector, key)
 
 _MODULUS = Quantity("pressure", gt=0)
 _POISSON = Quantity("dimensionless", gt=-1, lt=0.5)
@@ -144,11 +144,12 @@ class Boundary:
     surfaces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), required=True)
     fix: tuple | None = key(ListOf(Choice(_COMPONENTS), unique=True, min_len=1))
     convection: float | tuple | None = key(TableOr(Quantity("conductance", ge=0), Curve(
-        Quantity("angular_speed", ge=0), Quantity("conductance", ge=0), "speed", "h", min_rows=2)),
-        needed_by=("thermal",), warn_unused=True)
-    emissivity: float | None = key(Quantity("dimensionless", gt=0, le=1), needed_by=("thermal",), warn_unused=True)
+        Quantity("angular_speed", ge=0), Quantity("conductance", ge=0), "speed", "h", min_rows=2)))
+    emissivity: float | None = key(Quantity("dimensionless", gt=0, le=1))
     ambient: float | None = key(_TEMPERATURE)                        # K, default time.initial_temperature
-    temperature: float | None = key(_TEMPERATURE, needed_by=("thermal",), warn_unused=True)   # K, fixed
+    temperature: float | None = key(_TEMPERATURE)                    # K, fixed
+
+    THERMAL = ("convection", "emissivity", "temperature")
 
     rules = (OneOf(("temperature", "convection")), OneOf(("temperature", "emissivity")))
 
@@ -225,7 +226,8 @@ class Loading:
     """Normal load (force or pressure on the load faces), sliding speed, friction, duty cycle.
 
     The load acts on ``faces`` (default: the builder's load faces; required for geometry files,
-    where it is a pressure normal to each face, -p n, and a force is spread as a uniform pressure),
+    where it is a pressure normal to each face, -p n, and a force is spread as a uniform pressure;
+    with ``direction`` a traction along it whose resultant is the force, or the pressure itself),
     scaled in time by ``load_profile`` (factor, 0 = released: no contact, no frictional heat). The
     speed of the rotating body: ``rotation_speed``, a ``speed_profile`` against time, or a
     ``vehicle`` stop or drag; a translating body slides at ``sliding_speed``."""
@@ -233,6 +235,7 @@ class Loading:
     normal_force: float | None = key(Quantity("force", gt=0))                 # N
     pressure: float | None = key(Quantity("pressure", gt=0))                  # Pa
     faces: tuple | None = key(ListOf(Text(), unique=True, min_len=1))         # where the load acts
+    direction: tuple | None = key(Vector(Quantity("dimensionless")))         # traction direction (else -n)
     load_profile: tuple | None = key(Curve(Quantity("time", ge=0), Quantity("dimensionless", ge=0),
                                            "time", "factor"))                 # ((s, -), ...)
     rotation_speed: float | None = key(Quantity("angular_speed", ge=0))       # rad/s (rotation builders)

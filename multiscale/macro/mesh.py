@@ -277,10 +277,10 @@ class FormCache:
         return self.facet_integrals(key, make) / self.tm.interface.areas
 
 
-def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD) -> TwoBodyMesh:
+def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometrySpec | None = None) -> TwoBodyMesh:
     """Run a gmsh builder (``multiscale.geometry``) on rank 0 and distribute the mesh (shared-facet
-    ghosting)."""
-    spec = builder.describe(params)
+    ghosting); ``spec`` (default: the builder's ``describe``) tags bodies, faces and interfaces."""
+    spec = spec or builder.describe(params)
     name = getattr(builder, "NAME", builder.__name__)
     error = None
     if comm.rank == 0:

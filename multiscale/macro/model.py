@@ -3,9 +3,12 @@ Fig. 7.4.
 
 ``MacroModel.macro_step`` advances one macro step Δt in ``substeps`` times {heat step over δt with
 the current contact state; contact solve with the new temperatures (thermal expansion) or the new
-speed}. ``start`` makes the first (ramped) contact solve; ``record`` gives one history row. The
-model is built from plain objects (``multiscale.workflows.model.build_model`` makes one from a
-scene).
+load}. The drive gives the load and the speed of the sliding body against time: while the load
+factor is 0 the contact is released (no solve, no frictional heat, no interface conductance) and
+the bodies only exchange heat with their surroundings. The sliding direction does not depend on the
+speed's magnitude, so a changing speed needs no contact solve (only its heat changes). ``start``
+makes the first (ramped) contact solve; ``record`` gives one history row. The model is built from
+plain objects (``multiscale.workflows.model.build_model`` makes one from a scene).
 """
 from __future__ import annotations
 
@@ -24,14 +27,14 @@ class Drive:
     """What drives the sliding contact: the normal load and the sliding speed of body 1.
 
     ``load``: N (mechanics ``load_kind="force"``) or Pa (pressure or fluid pressure), reached in
-    ``ramp_steps`` increments by the first solve; ``speed(t)``: rad/s (rotation) or m/s
-    (translation) at time t [s]; ``steady``: True when the speed never changes (no re-solve for it).
+    ``ramp_steps`` increments by the first solve, times ``factor(t)`` (0: released); ``speed(t)``:
+    rad/s (rotation) or m/s (translation) at time t [s].
     """
 
     load: float
     speed: Callable[[float], float]
     ramp_steps: int = 1
-    steady: bool = True
+    factor: Callable[[float], float] = lambda t: 1.0
 
 
 @dataclass
@@ -58,10 +61,17 @@ class MacroModel:
         """Sliding speed of body 1 at time t: rad/s (rotation) or m/s (translation)."""
         return self.drive.speed(t)
 
+    @property
+    def released(self) -> bool:
+        """True while the load factor is 0 (no contact)."""
+        return self.contact.engaged.value == 0.0
+
     def start(self) -> SolveResult:
-        """First contact solve from rest with the drive's load ramp."""
+        """First contact solve from rest with the drive's load ramp (at the initial load factor;
+        a start in a released phase solves at the first engaged load, then releases)."""
         self.contact.speed.value = self.speed(0.0)
-        self.last_solve = self.mechanics.ramp(self.drive.load, self.drive.ramp_steps)
+        self.last_solve = self.mechanics.ramp(self.drive.load * (self.drive.factor(0.0) or 1.0), self.drive.ramp_steps)
+        self.contact.engaged.value = float(self.drive.factor(0.0) > 0)
         return self.last_solve
 
     def macro_step(self, dt: float, substeps: int = 1) -> np.ndarray:
@@ -74,19 +84,29 @@ class MacroModel:
                 self.contact.speed.value = self.speed(self.time)
                 heat += self.thermal.step(delta).heat_in
             self.time += delta
-            speed_changed = not self.drive.steady and self.speed(self.time) != self.speed(self.time - delta)
-            if self.mechanics.temperatures is not None or speed_changed:
-                self.contact.speed.value = self.speed(self.time)
-                self.last_solve = self.mechanics.solve()
+            self.contact.speed.value = self.speed(self.time)
+            factor = self.drive.factor(self.time)
+            self.contact.engaged.value = float(factor > 0)
+            load = self.drive.load * factor
+            if factor > 0 and (self.mechanics.temperatures is not None or load != self.mechanics.load.value):
+                self.last_solve = self.mechanics.solve(load)
         self.heat_total += heat
         return heat
 
     def record(self, heat_step=(0.0, 0.0)) -> dict:
         """One history row at the current state (units: see ``multiscale.io.UNITS``)."""
-        row = {"time": self.time, "interface_force": self.last_solve.normal_force,
-               "friction_force": float(np.linalg.norm(self.contact.friction_force())),
-               "max_pressure": self.last_solve.max_pressure,
+        on = not self.released
+        row = {"time": self.time, "interface_force": self.last_solve.normal_force * on,
+               "friction_force": float(np.linalg.norm(self.contact.friction_force())) * on,
+               "max_pressure": self.last_solve.max_pressure * on,
                "newton_iterations": self.last_solve.iterations}
+        masks = self.tm.interface.masks()
+        if len(masks) > 1:                        # per interface (a brake's pads, a disc's pucks)
+            p, friction = self.contact.facet_pressure() * on, self.contact.facet_friction() * on
+            for name, m in masks.items():
+                row[f"interface_force_{name}"] = float(p[m] @ self.tm.interface.areas[m])
+                row[f"friction_force_{name}"] = float(np.linalg.norm(friction[m].sum(axis=0)))
+                row[f"max_pressure_{name}"] = float(p[m].max(initial=0.0))
         if self.thermal is not None:
             stored, hottest = self.thermal.stored_heat(), self.thermal.max_temperature()
             for i, body in enumerate(self.tm.bodies):

@@ -3,11 +3,15 @@
 the multiscale loop and the squeal analysis:
 
 - the rough body is the stationary body 0 (zones do not move); the counter-face is flat;
-- every interface of the mesh is rough and covered by ``micro.zones`` = (nx, ny) zones over the
-  bounding box of its facets, each zone a patch of ``micro.grid`` = (nx, ny) cells: one measured
-  surface (``roughness.file``) or one generated fractal surface per interface cut into zones
-  (``patch = "face"``; cut-offs in wavelengths per face), or one generated patch per zone
-  (``patch = "zone"``; per zone); interface k > 0 draws with seed ``seed + 7919 k``;
+- the rough interfaces are ``scene.rough_interfaces`` (all, unless [interfaces.<name>] says
+  ``rough = false``: those keep the perfect-contact penalty), each planar and covered by
+  ``micro.zones`` = (nx, ny) zones over the bounding box of its facets in its plane, each zone a
+  patch of ``micro.grid`` = (nx, ny) cells: one measured surface (``roughness.file``) or one
+  generated fractal surface per interface cut into zones (``patch = "face"``; cut-offs in
+  wavelengths per face), or one generated patch per zone (``patch = "zone"``; per zone); the k-th
+  interface of the geometry draws with seed ``seed + 7919 k``; [interfaces.<name>.roughness] and
+  [interfaces.<name>.micro] change these per interface (the grid per zone and the law settings
+  must be the same on every interface: one law table, one post-analysis grid);
 - laws by FFT-BEM (``micro.model = "fft-bem"``; the asperity models are refused), ``micro.law_points``
   nodes up to ``micro.p_max`` (default ``P_MAX_FACTOR`` x the nominal interface pressure), contact
   tolerance ``micro.tol``; the micro solid is layered with effect ``layers``.
@@ -36,19 +40,27 @@ SEED_STRIDE = 7919         # interface k draws its surfaces with seed + SEED_STR
 def check_rough_scene(scene) -> None:
     """The rules every rough analysis shares (InputError naming the field)."""
     bodies = scene.geometry.bodies
-    if scene.roughness.body != bodies[0]:
+    if scene.roughness.body not in (None, bodies[0]):
         raise InputError("roughness.body", scene.roughness.body,
                          f'the rough body must be the stationary one, "{bodies[0]}" (zones do not move)')
     if scene.micro.model != "fft-bem":
         raise InputError("micro.model", scene.micro.model, 'the zone laws are computed by FFT-BEM: "fft-bem"')
-    if scene.has("layers") and scene.layers.body != bodies[0]:
+    if scene.has("layers") and scene.layers.body not in (None, bodies[0]):
         raise InputError("layers.body", scene.layers.body, f'the layers belong to the rough body "{bodies[0]}"')
+    if not scene.rough_interfaces:
+        raise InputError("interfaces", "rough = false", 'effect "roughness" needs at least one rough interface')
+    shared = ("grid", "law_points", "model", "p_max", "tol", "partition_law")
+    for name in scene.rough_interfaces:
+        m = scene.interface_settings(name).micro
+        for key in shared:
+            if getattr(m, key) != getattr(scene.micro, key):
+                raise InputError(f"interfaces.{name}.micro.{key}", getattr(m, key), f"must be the same on every "
+                                 f"interface (micro.{key} = {getattr(scene.micro, key)}); only zones may differ")
 
 
-def make_zones(scene, lo, hi, seed: int) -> tuple[ZoneGrid, list]:
-    """The zone grid over the box [lo, hi] (x, y) [m] of one interface and each zone's initial
-    patch (see module docstring; ids from 0)."""
-    r, m = scene.roughness, scene.micro
+def make_zones(r, m, lo, hi, seed: int) -> tuple[ZoneGrid, list]:
+    """The zone grid over the box [lo, hi] (u, v) [m] of one interface and each zone's initial
+    patch (``r``: its [roughness], ``m``: its [micro]; see module docstring; ids from 0)."""
     counts = tuple(int(c) for c in m.zones)
     size = np.asarray(hi, float) - np.asarray(lo, float)
     if r.file is not None:
@@ -94,18 +106,22 @@ def thermal_kernels(scene):
 
 
 def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterface:
-    """Zones of every interface of ``tm``, the law spec and the pool (collective; laws not yet
-    computed: ``RoughInterface.update_laws``)."""
+    """Zones of every rough interface of ``tm``, the law spec and the pool (collective; laws not
+    yet computed: ``RoughInterface.update_laws``)."""
     check_rough_scene(scene)
-    grids, zones = [], []
-    for k, name in enumerate(tm.interface.tags):
-        lo, hi = interface_plane(tm, name)
-        grid, patches = make_zones(scene, lo, hi, scene.roughness.seed + SEED_STRIDE * k)
+    names, planes, grids, zones = list(scene.rough_interfaces), [], [], []
+    for name in names:
+        settings = scene.interface_settings(name)
+        k = list(tm.interface.tags).index(name)
+        plane, lo, hi = interface_plane(tm, name)
+        grid, patches = make_zones(settings.roughness, settings.micro, lo, hi,
+                                   settings.roughness.seed + SEED_STRIDE * k)
         offset = len(zones)
+        planes.append(plane)
         grids.append(grid)
         zones += [replace(z, id=offset + z.id) for z in patches]
     m = scene.micro
     kernel, E_star = contact_kernel(scene)
-    nominal = interface_forces(scene, tm).sum() / tm.interface.areas.sum()
+    nominal = sum(interface_forces(scene, tm).values()) / tm.interface.areas.sum()
     spec = LawSpec(kernel, m.p_max or P_MAX_FACTOR * nominal, n_points=m.law_points, tol=m.tol, E_star=E_star)
-    return RoughInterface(tm, grids, zones, spec, MicroPool(spec, tm.comm, progress=progress))
+    return RoughInterface(tm, names, planes, grids, zones, spec, MicroPool(spec, tm.comm, progress=progress))
