@@ -137,6 +137,7 @@ def describe(params=None) -> GeometrySpec:
         motion=Rotation((0.0, 0.0, 1.0), (0.0, 0.0, 0.0)),
         length_scale=p["disc_outer_radius"],
         fluid_load=True,                          # the hydraulic pressure on piston and caliper bore
+        interface_regions={"inner_pad": "pad_inner", "outer_pad": "pad_outer"},
     )
 
 

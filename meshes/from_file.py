@@ -263,20 +263,31 @@ def _nodes(model, faces: list[int]) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(tris)
 
 
+def _flat(model, face: int):
+    """(unit normal, a point) of a flat face, or None: normals and points sampled over the face's
+    parameter range (a scaled CAD face is a B-spline surface, so its type says nothing)."""
+    lo, hi = (np.asarray(b, dtype=float) for b in model.getParametrizationBounds(2, face))
+    t = np.linspace(0.1, 0.9, 4)
+    uv = np.array([[a, b] for a in lo[0] + t * (hi[0] - lo[0]) for b in lo[1] + t * (hi[1] - lo[1])]).ravel()
+    n = np.reshape(model.getNormal(face, uv), (-1, 3))
+    x = np.reshape(model.getValue(2, face, uv), (-1, 3))
+    n0 = n[0] / np.linalg.norm(n[0])
+    size = max(np.ptp(x, axis=0).max(), np.finfo(float).tiny)
+    if np.all(np.abs(n @ n0) / np.linalg.norm(n, axis=1) > 1 - 1e-9) and np.abs((x - x[0]) @ n0).max() <= 1e-9 * size:
+        return n0, x[0]
+    return None
+
+
 def _plane(model, faces: list[int], fixed: list[int], occ: bool):
     """Area [m^2] and unit normal (from the fixed body outwards) of a face set; normal None if
     the faces are not one plane."""
     if occ:
         area = sum(model.occ.getMass(2, f) for f in faces)
-        normals, points = [], []
-        for f in faces:
-            if model.getType(2, f) != "Plane":
-                return area, None
-            lo, hi = model.getParametrizationBounds(2, f)
-            uv = 0.5 * (np.asarray(lo) + np.asarray(hi))
-            normals.append(np.asarray(model.getNormal(f, uv)))
-            points.append(np.asarray(model.getValue(2, f, uv)))
-        n = normals[0] / np.linalg.norm(normals[0])
+        flat = [_flat(model, f) for f in faces]
+        if any(f is None for f in flat):
+            return area, None
+        normals, points = [n for n, _ in flat], [p for _, p in flat]
+        n = normals[0]
         planar = all(abs(abs(m @ n) - 1) < 1e-9 for m in normals) and \
             all(abs((p - points[0]) @ n) < 1e-9 * max(1.0, np.abs(points[0]).max()) for p in points)
         centre = np.asarray(model.occ.getCenterOfMass(3, fixed[0]))
@@ -316,7 +327,7 @@ def _surfaces(model, g, found: Found) -> None:
             faces = []
             for point in sel.contains:
                 near = [f for f in candidates if np.linalg.norm(
-                    np.asarray(model.getClosestPoint(2, f, list(point))[0]) - np.asarray(point)) <= 1e-6 * found.extent]
+                    np.asarray(model.getClosestPoint(2, f, list(point))[0]) - np.asarray(point)) <= 1e-4 * found.extent]
                 if not near:
                     raise InputError(f"{where}.contains", list(point), f"no face of {g.file.name} passes through "
                                      "this point [m]")
@@ -332,11 +343,10 @@ def _faces_of(model, volumes: list[int]) -> list[int]:
 
 def _outward(model, face: int, volumes: list[int], direction: np.ndarray) -> bool:
     """True if ``face`` is planar with its outward normal (from ``volumes``) along ``direction``."""
-    if model.getType(2, face) != "Plane":
+    flat = _flat(model, face)
+    if flat is None:
         return False
-    lo, hi = model.getParametrizationBounds(2, face)
-    uv = 0.5 * (np.asarray(lo) + np.asarray(hi))
-    n, p = np.asarray(model.getNormal(face, uv)), np.asarray(model.getValue(2, face, uv))
+    n, p = flat
     inside = [v for v in volumes if face in model.getAdjacencies(3, v)[1]]
     centre = np.asarray(model.occ.getCenterOfMass(3, inside[0]))
     if (p - centre) @ n < 0:
@@ -384,4 +394,5 @@ def _spec(g, found: Found) -> GeometrySpec:
         faces={n: 2001 + k for k, n in enumerate(found.surfaces)},
         supports=(), load_faces=(), motion=Rotation(tuple(g.axis), tuple(g.centre)),
         length_scale=found.extent, fluid_load=True,
-        interface_normals=dict(found.normals), report=tuple(report))
+        interface_normals=dict(found.normals), report=tuple(report),
+        interface_regions={name: fixed for name, (fixed, _) in found.pairs.items()})

@@ -271,7 +271,7 @@ class Multiscale:
                   "conductance": self.conductance, "levels": self.rough.levels, "heat_total": m.heat_total,
                   "datum_gap": self.datum_gap,
                   **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
-        attrs = {"step": step, "time": m.time, "work": self.work, "scene": self.fingerprint,
+        attrs = {"step": step, "time": m.time, "work": self.work, "scene": self.fingerprint, "load": m.load,
                  "ranks": self.comm.size, "fields_written": -1,
                  "solve": [last.reason, last.iterations, last.normal_force, last.max_pressure]}
         checkpoint.save(path, self.comm, attrs=attrs, arrays=arrays, functions=self._functions(),
@@ -296,7 +296,8 @@ class Multiscale:
         m.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
         self.tm.interface.set_field(m.contact.initial_gap, self.datum_gap)
         m.contact.speed.value = m.speed(m.time)
-        m.mechanics.load.value = m.drive.load
+        m.load = float(attrs["load"])
+        m.mechanics.load.value = m.load * m.drive.factor(m.time)
         self.rough.update_laws()
         self.apply_zone_fields()
         history = io.History()

@@ -125,14 +125,19 @@ class Scene:
 
     @property
     def partition(self) -> float | None:
-        """Share of frictional heat into body 0 (pin, pads, block): the constant, or the effusivity
-        ratio e_0/(e_0 + e_1), e = sqrt(kappa rho c), of each body's first material region (the
-        one at the interface) at the initial temperature. None if unset."""
+        """Share of frictional heat into body 0 (pin, pads, block) at the first interface (see
+        ``partition_at``)."""
+        return self.partition_at(None)
+
+    def partition_at(self, interface: str | None) -> float | None:
+        """Share of frictional heat into body 0 at an interface: the constant, or the effusivity
+        ratio e_0/(e_0 + e_1), e = sqrt(kappa rho c), of the materials on both sides of it at the
+        initial temperature. None if unset."""
         value = self.interface.partition
         if value != "effusivity":
             return value
         T0 = self.time.initial_temperature
-        e0, e1 = (self.materials[b.regions[0].material].at(T0).effusivity for b in self.geometry.spec.bodies)
+        e0, e1 = (self.materials[m].at(T0).effusivity for m in self.geometry.spec.interface_materials(interface))
         return e0 / (e0 + e1)
 
     def interface_settings(self, name: str) -> InterfaceSettings:

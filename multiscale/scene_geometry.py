@@ -71,7 +71,7 @@ class BodySelection:
 class SurfaceSelection:
     """[geometry.surfaces.<name>]: a named surface: a physical surface ``group`` of the file, or the
     faces of ``body`` whose outward ``normal`` is the given direction (within 5 degrees), or the
-    faces through the points ``contains`` (of ``body`` if given)."""
+    faces through the points ``contains`` (of ``body`` if given; within 1e-4 of the model's size)."""
 
     group: str | None = key(Text())
     body: str | None = key(Text())

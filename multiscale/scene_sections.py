@@ -29,6 +29,15 @@ def _property(value: Quantity, name: str) -> TableOr:
     return TableOr(value, Curve(_TEMPERATURE, value, "temperature", name, min_rows=2))
 
 
+def mean(table, x0: float, x1: float) -> float:
+    """Mean over [x0, x1] of the piecewise-linear ``interpolate(table, .)`` (exact)."""
+    if x1 <= x0:
+        return interpolate(table, x0)
+    xs = sorted({x0, x1, *(x for x, _ in table if x0 < x < x1)})
+    ys = [interpolate(table, x) for x in xs]
+    return sum(0.5 * (a + b) * (x1_ - x0_) for a, b, x0_, x1_ in zip(ys, ys[1:], xs, xs[1:])) / (x1 - x0)
+
+
 def interpolate(table, x: float) -> float:
     """Piecewise-linear interpolation of ((x, y), ...) rows at ``x``, held constant beyond the ends."""
     xs, ys = zip(*table)
@@ -276,6 +285,10 @@ class Loading:
     def factor(self, t: float) -> float:
         """Load factor at t [s] (1 without a load profile; 0: released)."""
         return 1.0 if self.load_profile is None else interpolate(self.load_profile, t)
+
+    def mean_factor(self, t0: float, t1: float) -> float:
+        """Mean load factor over [t0, t1] [s]."""
+        return 1.0 if self.load_profile is None else mean(self.load_profile, t0, t1)
 
 
 @dataclass(frozen=True)

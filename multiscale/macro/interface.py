@@ -121,6 +121,15 @@ class ContactInterface:
         """Resultant friction force on body 0 [N] (3-vector, mu p_n s integrated)."""
         return self.facet_friction().sum(axis=0)
 
+    def friction_moment(self) -> float:
+        """Moment [N m] about the rotation axis of the friction on body 0 (the same integrand and
+        quadrature as the frictional heat: heat power = moment x angular speed)."""
+        motion = self.tm.spec.motion
+        axis = ufl.as_vector(np.asarray(motion.axis, float) / np.linalg.norm(motion.axis))
+        arm = ufl.SpatialCoordinate(self.tm.parent) - ufl.as_vector(motion.centre)
+        return float(self.cache.facet_integrals(
+            "m", lambda: ufl.dot(ufl.cross(arm, self.friction_traction), axis)).sum())
+
     def facet_friction(self) -> np.ndarray:
         """Friction force on body 0 per interface facet [N] (n_facets, 3), global order."""
         return self.cache.facet_integrals("f", lambda: self.friction_traction, vector=True)

@@ -13,9 +13,10 @@ The rules that more than one analysis follows live here once:
 - load: a fluid pressure -p n for builders that declare ``fluid_load`` and for geometry files (a
   normal force spread as the uniform pressure F / A of the load faces; with ``loading.direction``
   a traction along it), else the scene's normal force [N] or pressure [Pa] on the load faces; with
-  ``loading.vehicle.mass`` the normal force that brakes the vehicle's mass share (every interface
-  the same clamp force N, with sum_k mu_k N r_k = braking force x wheel radius, r_k the interface's
-  mean radius about the axis);
+  ``loading.vehicle.mass`` the load whose friction moment about the axis is the braking torque
+  (braking force x wheel radius): first guessed with every interface carrying the same clamp
+  force N, sum_k mu_k N r_k = torque (r_k the interface's mean radius), then scaled by the model
+  after its first solve to the friction moment of the real pressure distribution;
 - interface forces: every interface carries its area's share of the resultant of the load on the
   load faces (``interface_forces``; what the rigid datum gap and the law range start from);
 - materials at an interface: the first region of each body at the initial temperature
@@ -80,7 +81,7 @@ def drive(scene, tm) -> Drive:
     """Load [N or Pa] (``load_kind``), ramp, load factor and speed of body 1 (rad/s for a
     rotation, m/s for a translation) against time."""
     ld, kind = scene.loading, load_kind(scene)
-    force = ld.normal_force
+    force, torque = ld.normal_force, None
     vehicle = ld.vehicle
     if vehicle is not None and vehicle.mass is not None:
         radius = interface_radii(scene, tm)
@@ -88,22 +89,24 @@ def drive(scene, tm) -> Drive:
         if moment <= 0:
             raise InputError("loading.vehicle.mass", vehicle.mass, 'braking needs friction (effect "friction" and '
                              "loading.friction > 0)")
-        force = len(radius) * vehicle.braking_force * vehicle.wheel_radius / moment
+        torque = vehicle.braking_force * vehicle.wheel_radius
+        force = len(radius) * torque / moment          # a first guess: the model scales it to the torque
     if force is not None and kind != "force":          # a force as a uniform pressure on the load faces
         area = sum(tm.assemble_scalar(1.0 * tm.ds(tm.face(f))) for f in tm.spec.load_faces)
         load = force / area
     else:
         load = force if force is not None else ld.pressure
     if scene.geometry.motion == "rotation":
-        return Drive(load, ld.angular_speed, ld.ramp_steps, ld.factor)
+        return Drive(load, ld.angular_speed, ld.ramp_steps, ld.factor, ld.mean_factor, ld.steady_speed, torque)
     speed = ld.sliding_speed or 0.0
-    return Drive(load, lambda t: speed, ld.ramp_steps, ld.factor)
+    return Drive(load, lambda t: speed, ld.ramp_steps, ld.factor, ld.mean_factor)
 
 
-def interface_materials(scene) -> tuple:
-    """Materials at the interface at the initial temperature: (body 0, body 1), each body's first region."""
+def interface_materials(scene, interface: str | None = None) -> tuple:
+    """Materials on both sides of an interface (default: the first) at the initial temperature:
+    (body 0's region along it, body 1)."""
     T0 = scene.time.initial_temperature
-    return tuple(scene.materials[b.regions[0].material].at(T0) for b in scene.geometry.spec.bodies)
+    return tuple(scene.materials[m].at(T0) for m in scene.geometry.spec.interface_materials(interface))
 
 
 def build_mesh(scene, comm=MPI.COMM_WORLD) -> two_body.TwoBodyMesh:
@@ -157,7 +160,10 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None) -> MacroModel:
                        dt=t.dt / t.substeps, frictional_heat=scene.has("heat_partition"),
                        conductance=scene.has("conductance"), temperatures=T)
         if scene.has("heat_partition"):
-            tm.interface.set_field(mech.contact.partition, scene.partition)
+            share = np.zeros(tm.interface.n_facets)
+            for name, m in tm.interface.masks().items():
+                share[m] = scene.partition_at(name)
+            tm.interface.set_field(mech.contact.partition, share)
         if scene.has("conductance") and scene.interface.conductance is not None:   # else per facet later
             tm.interface.set_field(mech.contact.conductance, scene.interface.conductance)
     return MacroModel(tm, mech, heat, drive(scene, tm))

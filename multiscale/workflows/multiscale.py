@@ -55,7 +55,7 @@ class MultiscaleResult(TransientResult):
 
 def post_analysis(scene, zone) -> PostAnalysis:
     """The micro post-analysis of the scene's zones (``zone``: one of them, for the grid)."""
-    rough, counter = interface_materials(scene)
+    rough, counter = interface_materials(scene, scene.rough_interfaces[0])
     heating = None
     if scene.has("thermal") and scene.has("heat_partition"):
         heating = Heating(ThermalMaterial(counter.kappa, counter.diffusivity),

@@ -49,6 +49,10 @@ def check_rough_scene(scene) -> None:
         raise InputError("layers.body", scene.layers.body, f'the layers belong to the rough body "{bodies[0]}"')
     if not scene.rough_interfaces:
         raise InputError("interfaces", "rough = false", 'effect "roughness" needs at least one rough interface')
+    pairs = {scene.geometry.spec.interface_materials(n) for n in scene.rough_interfaces}
+    if len(pairs) > 1:
+        raise InputError("interfaces", sorted(scene.rough_interfaces), "the rough interfaces must have the same "
+                         f"materials on both sides (one micro solid); found {sorted(pairs)}")
     shared = ("grid", "law_points", "model", "p_max", "tol", "partition_law")
     for name in scene.rough_interfaces:
         m = scene.interface_settings(name).micro
@@ -80,7 +84,7 @@ def make_zones(r, m, lo, hi, seed: int) -> tuple[ZoneGrid, list]:
 def contact_kernel(scene):
     """Elastic micro kernel of the rough body against the counter-face (layered with ``layers``)
     and the composite modulus E* of the macro bodies for Love's correction (Eq. 1.31)."""
-    rough, counter = interface_materials(scene)
+    rough, counter = interface_materials(scene, scene.rough_interfaces[0])
     E_star = HalfSpace.from_materials(rough.E, rough.nu, counter.E, counter.nu).E_star
     if not scene.has("layers"):
         return HalfSpace(E_star), E_star
@@ -94,7 +98,7 @@ def contact_kernel(scene):
 def thermal_kernels(scene):
     """Steady thermal kernels (rough body, counter-face) for the zone conductance (layered with
     ``layers``: each layer's kappa on the rough body, or on an isothermal base)."""
-    rough, counter = interface_materials(scene)
+    rough, counter = interface_materials(scene, scene.rough_interfaces[0])
     first = ThermalHalfSpace(rough.kappa)
     if scene.has("layers"):
         L = scene.layers
