@@ -43,7 +43,6 @@ parser.add_argument("--seed", type=int, default=1)
 parser.add_argument("--out", default="results/ch1_asperity_models", help="output folder")
 args = parser.parse_args()
 out = Path(args.out)
-out.mkdir(parents=True, exist_ok=True)
 
 # ## The surfaces (thesis §1.3.1, Table 1.1)
 # Upper cut-off k_max in wavelengths per mm: the same in both directions for Set 1; for Set 2,
@@ -99,6 +98,7 @@ for name, surface in surfaces.items():
 
 # ## Figure: one row per set, the four panels of Figs. 1.7 / 1.9 and the wall times
 # The grey band of (iv) is the range 1.5–5 % of area fraction where the thesis reads κ.
+out.mkdir(parents=True, exist_ok=True)
 fig, axes = plt.subplots(len(sets), 5, figsize=(22, 4.4 * len(sets)), squeeze=False)
 for row, (name, d) in zip(axes, sets.items()):
     bem = d["bem"]

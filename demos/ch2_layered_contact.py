@@ -38,7 +38,6 @@ parser.add_argument("--n", type=int, default=128, help="grid points per side of 
 parser.add_argument("--out", default="results/ch2_layered_contact", help="output folder")
 args = parser.parse_args()
 out = Path(args.out)
-out.mkdir(parents=True, exist_ok=True)
 
 # ## The solids
 # Top layer E1 = 4 GPa, ν = 0.15 over a total height H = 1 mm on a rigid base (Fig. 2.3, 2.11);
@@ -135,6 +134,7 @@ def save(fig, png, t0, title):
     return wall
 
 
+out.mkdir(parents=True, exist_ok=True)
 wall = save(fig, out / "ch2_single_asperity.png", t0,
             "Asperity on a two-layered solid (E1 = 4 GPa, ν = 0.15, H = 1 mm, rigid base)")
 print(f"single asperity: {len(worst)} curves in {wall:.1f} s; max |chi/zeta force error| per curve:")

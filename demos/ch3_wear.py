@@ -42,7 +42,6 @@ parser.add_argument("--kw", type=float, default=KW, help="wear rate k_w [1/Pa] (
 parser.add_argument("--out", default="results/ch3_wear", help="output folder")
 args = parser.parse_args()
 out = Path(args.out)
-out.mkdir(parents=True, exist_ok=True)
 t0 = time.perf_counter()
 
 # ## The surface and the solid
@@ -78,6 +77,7 @@ main_run = runs[args.steps]
 # ## Figure: the wear history
 # Real area (Fig. 3.3) and largest wear depth (Fig. 3.4) for each N; worn volume per unit area
 # against Archard's k_w μ p S (Fig. 3.9) and the pressure–gap laws (Fig. 3.10) of the last run.
+out.mkdir(parents=True, exist_ok=True)
 fig, axes = plt.subplots(2, 2, figsize=(11, 8))
 for N, run in runs.items():
     s_mm = run.history.sliding * 1e3

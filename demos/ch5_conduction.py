@@ -35,7 +35,6 @@ parser.add_argument("--n", type=int, default=150, help="grid points per side (th
 parser.add_argument("--out", default="results/ch5_conduction", help="output folder")
 args = parser.parse_args()
 out = Path(args.out)
-out.mkdir(parents=True, exist_ok=True)
 t0 = time.perf_counter()
 
 # ## The two solids (Fig. 5.10, Table 5.1)
@@ -117,6 +116,7 @@ ax.set(xlabel="mean pressure [MPa]", ylabel="K_t [10³ W/(m² K)]", title="Fig. 
 ax.grid(True, alpha=0.3)
 ax.legend(fontsize=8)
 fig.tight_layout()
+out.mkdir(parents=True, exist_ok=True)
 png = out / "conductance_vs_pressure.png"
 fig.savefig(png, dpi=110)
 plt.close(fig)

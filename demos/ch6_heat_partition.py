@@ -46,7 +46,6 @@ parser.add_argument("--n", type=int, default=75, choices=(30, 50, 75, 150),
 parser.add_argument("--out", default="results/ch6_heat_partition", help="output folder")
 args = parser.parse_args()
 out = Path(args.out)
-out.mkdir(parents=True, exist_ok=True)
 start = time.perf_counter()
 
 # ## The two solids and the motion (Tables 6.2–6.3)
@@ -85,6 +84,7 @@ print(f"grid {args.n} x {args.n} ({surface.dx * 1e6:.2f} µm cells), rms 6.49 µ
       f"A/A0 = {contact.area_fraction * 100:.2f} % (thesis: 1.48 %), mean pressure "
       f"{contact.mean_pressure / 1e6:.2f} MPa")
 
+out.mkdir(parents=True, exist_ok=True)
 fig, ax = plt.subplots(figsize=(5.2, 4.4))
 im = ax.imshow(contact.pressure / 1e6, origin="lower", extent=(0, 1, 0, 1), cmap="inferno")
 ax.set(title=f"contact pressure, δ = 10 µm, A/A0 = {contact.area_fraction * 100:.2f} %",

@@ -31,7 +31,6 @@ parser.add_argument("--n", type=int, default=256, help="grid points per side")
 parser.add_argument("--out", default="results/micro_contact", help="output folder")
 args = parser.parse_args()
 out = Path(args.out)
-out.mkdir(parents=True, exist_ok=True)
 
 # ## The surface
 # A 1 mm x 1 mm periodic patch generated from its power spectrum S(k) = S0 |k|^-2(H+1) (thesis
@@ -64,6 +63,7 @@ kappa = area / (loads / (kernel.E_star * stats.rms_slope))
 
 # ## Figure
 # The pressure field at the highest load and the real area against the load.
+out.mkdir(parents=True, exist_ok=True)
 fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.5))
 L = surface.size[0] * 1e3
 im = ax1.imshow(results[-1].pressure / 1e6, extent=(0, L, 0, L), origin="lower", cmap="inferno")
