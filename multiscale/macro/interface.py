@@ -33,7 +33,8 @@ def penetration(g):
 
 
 class PenaltyLaw:
-    """Perfect-contact penalty p_n = K_n <−g_n>_+ (thesis §7.3.1) with K_n a per-facet field [Pa/m]."""
+    """Perfect-contact penalty p_n = K_n <−g_n>_+ (thesis Eq. 1.28, §1.4.1; the perfect-contact model of
+    §7.3.1) with K_n a per-facet field [Pa/m]."""
 
     def __init__(self, stiffness: fem.Function):
         self.stiffness = stiffness
