@@ -76,6 +76,7 @@ stages["20 steps: heat solves"] = sum(heat_times)
 stages["20 steps: contact solves and the rest"] = sum(step_times) - sum(heat_times)
 stages["output (XDMF)"] = output
 total = sum(stages.values())
+hottest = model.thermal.max_temperature()[1]          # collective: every rank
 if comm.rank == 0:
     load1 = os.getloadavg()[0]
     print(f"car-brake stop: {dofs} displacement dofs, {temperature_dofs} temperature dofs, {comm.size} rank(s), "
@@ -85,5 +86,5 @@ if comm.rank == 0:
         print(f"| {k} | {v:.1f} |")
     print(f"| total | {total:.1f} |")
     print(f"per step: median {statistics.median(step_times):.2f} s, max {max(step_times):.2f} s; "
-          f"max disc temperature {model.thermal.max_temperature()[1] - 273.15:.1f} degC; "
+          f"max disc temperature {hottest - 273.15:.1f} degC; "
           f"heat {sum(model.heat_total) / 1e3:.1f} kJ")
