@@ -17,7 +17,8 @@ from dolfinx import fem
 from dolfinx.fem import petsc as fpetsc
 
 from multiscale.errors import check_positive
-from multiscale.macro.mechanics import Mechanics, body_fields, load_face_forces
+from multiscale.macro.materials import body_fields
+from multiscale.macro.mechanics import Mechanics, load_face_forces
 
 
 @dataclass
@@ -69,7 +70,7 @@ def linearise(mech: Mechanics, materials: Mapping[str, object]):
     """(K, M) at the current state: K the consistent tangent (``ufl.derivative`` of the residual,
     non-symmetric with friction; it is the Newton matrix, overwritten by the next solve), M the
     block-diagonal mass with density ``rho`` of each material and diag 0 on Dirichlet rows."""
-    rho = body_fields(mech.tm, materials, "rho")
+    rho = body_fields(mech.tm, materials, "rho", mech.reference_temperature)
     form = fem.form(mech.mass_forms(rho), entity_maps=mech.tm.entity_maps)
     M = fpetsc.assemble_matrix(form, bcs=mech.bcs, diag=0.0)
     M.assemble()
