@@ -54,6 +54,7 @@ class MacroModel:
     drive: Drive
     time: float = 0.0                                  # s
     heat_total: np.ndarray = field(default_factory=lambda: np.zeros(2))   # J, frictional heat in
+    heat_lost_recorded: np.ndarray = field(default_factory=lambda: np.zeros(2))   # J, lost at the last record
     last_solve: SolveResult | None = None
     load: float | None = None                          # N or Pa at factor 1 (the drive's, or scaled to its torque)
 
@@ -118,7 +119,8 @@ class MacroModel:
         return heat
 
     def record(self, heat_step=(0.0, 0.0)) -> dict:
-        """One history row at the current state (units: see ``multiscale.io.UNITS``)."""
+        """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal
+        boundary conditions, ``heat_lost_step_<body>`` is the heat lost since the previous record."""
         on = not self.released
         row = {"time": self.time, "interface_force": self.last_solve.normal_force * on,
                "friction_force": float(np.linalg.norm(self.contact.friction_force())) * on,
@@ -138,4 +140,10 @@ class MacroModel:
                 row[f"heat_step_{body.name}"] = heat_step[i]
                 row[f"heat_total_{body.name}"] = self.heat_total[i]
                 row[f"stored_heat_{body.name}"] = stored[i]
+            if self.thermal.boundaries:       # heat lost through convection, radiation, fixed temperatures
+                lost = self.thermal.heat_lost
+                for i, body in enumerate(self.tm.bodies):
+                    row[f"heat_lost_step_{body.name}"] = lost[i] - self.heat_lost_recorded[i]
+                    row[f"heat_lost_total_{body.name}"] = lost[i]
+                self.heat_lost_recorded = lost.copy()
         return row

@@ -35,7 +35,7 @@ from multiscale.macro import mesh as two_body
 from multiscale.macro.interface import PenaltyLaw, SumLaw
 from multiscale.macro.mechanics import Mechanics, load_face_forces
 from multiscale.macro.model import Drive, MacroModel
-from multiscale.macro.thermal import Thermal, temperature_functions
+from multiscale.macro.thermal import Thermal, ThermalBoundary, temperature_functions
 
 
 def friction_coefficient(scene, interface: str | None = None) -> float:
@@ -138,6 +138,21 @@ def build_mechanics(scene, tm, *, law=None, temperatures=None, degree: int = 1,
                      load_kind=load_kind(scene), degree=degree, prefix=prefix)
 
 
+def thermal_conditions(scene) -> tuple[ThermalBoundary, ...]:
+    """The thermal conditions of [[boundary]] for the heat problem (none without effect "thermal"):
+    convection h [W/(m^2 K)], constant or against the rotating body's speed [rad/s]; radiation with
+    an emissivity; both towards ``ambient`` (default ``time.initial_temperature``); or a fixed
+    temperature. Surfaces without one are insulated; ``fix`` is a mechanical support."""
+    if not scene.has("thermal"):
+        return ()
+    T0 = scene.time.initial_temperature
+    return tuple(ThermalBoundary(tuple(b.surfaces), convection=b.h if b.convection is not None else None,
+                                 emissivity=b.emissivity, ambient=b.ambient if b.ambient is not None else T0,
+                                 temperature=b.temperature)
+                 for b in scene.boundary
+                 if any(v is not None for v in (b.convection, b.emissivity, b.temperature)))
+
+
 def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None) -> MacroModel:
     """Mesh and the problems the scene's effects ask for (no heat problem without ``thermal``).
 
@@ -158,7 +173,8 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None) -> MacroModel:
     if T is not None:
         heat = Thermal(mech.contact, dict(scene.materials), initial_temperature=t.initial_temperature,
                        dt=t.dt / t.substeps, frictional_heat=scene.has("heat_partition"),
-                       conductance=scene.has("conductance"), temperatures=T)
+                       conductance=scene.has("conductance"), temperatures=T,
+                       boundaries=thermal_conditions(scene))
         if scene.has("heat_partition"):
             share = np.zeros(tm.interface.n_facets)
             for name, m in tm.interface.masks().items():
