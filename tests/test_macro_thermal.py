@@ -1,5 +1,7 @@
 """Thermal boundary conditions and temperature-dependent materials of the macro heat problem, through
 scenes (``multiscale.workflows``), against closed forms (``multiscale.references.thermal``)."""
+import dataclasses
+
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
@@ -39,6 +41,7 @@ def test_kirchhoff_slab_of_constant_conductivity_is_linear():
 pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from multiscale.io import History  # noqa: E402
+from multiscale.macro.materials import body_fields  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 from multiscale.workflows.model import build_model  # noqa: E402
@@ -89,7 +92,7 @@ def march(scene, steps=None):
 def test_newton_cooling_of_a_block_with_small_biot_number():
     """Convection h = 20 W/(m^2 K) on every free face (Bi = h V/(A kappa) = 7e-4) from 400 K to 300 K:
     the mean temperature (from the stored heat) follows T_a + (T_i - T_a) exp(-h A t/(rho c V))
-    within 0.15 % of T - T_a at t = tau (1000 backward-Euler steps: 0.05 %; Biot: 0.06 %)."""
+    within 0.2 % of T - T_a at t = tau (measured 0.11 %: 1000 backward-Euler steps and Biot)."""
     tau = 5e6 * VOLUME / (20 * AREA)
     scene = block_scene(end=tau, steps=1000, boundary='[[boundary]]\nsurfaces = ["free:block"]\n'
                         'convection = "20 W/(m^2 K)"\nambient = "300 K"')
@@ -99,7 +102,7 @@ def test_newton_cooling_of_a_block_with_small_biot_number():
     stored, lost = th.stored_heat(), th.heat_lost
     mean = 400 + stored[0] / (5e6 * VOLUME)
     expected = lumped_convective_cooling(tau, 400, 300, 20, AREA, 5e6 * VOLUME)
-    assert (mean - 300) == pytest.approx(expected - 300, rel=1.5e-3)
+    assert (mean - 300) == pytest.approx(expected - 300, rel=2e-3)
     assert stored[0] + lost[0] == pytest.approx(0.0, abs=1e-10 * lost[0])     # what is lost left the store
     assert stored[1] == lost[1] == 0.0                                          # the flat is insulated
 
@@ -107,7 +110,7 @@ def test_newton_cooling_of_a_block_with_small_biot_number():
 def test_slab_with_convection_on_one_face_against_the_series():
     """A 20 mm column insulated on its sides and bottom, h = 500 W/(m^2 K) on its top (Bi = 1):
     nodal temperatures against Carslaw & Jaeger's series within 0.1 % of T_i - T_a at Fo = 0.125
-    and 0.5 (measured 0.04 %)."""
+    and 0.5 (measured 0.05 % and 0.02 %)."""
     scene = block_scene(geometry='length = "1 mm"\nwidth = "1 mm"\nheight = "20 mm"\nflat_thickness = "1 mm"\n'
                         'mesh_size = "0.5 mm"', block=STEEL.replace('"50 W', '"10 W'), end=20.0, steps=400,
                         boundary='[[boundary]]\nsurfaces = ["block_top"]\nconvection = "500 W/(m^2 K)"\n'
@@ -127,7 +130,8 @@ def test_slab_with_convection_on_one_face_against_the_series():
 def test_radiation_against_the_lumped_solution():
     """A black block (eps = 1) at 800 K radiating to 300 K surroundings (radiative Biot 4e-3):
     dT/dt = -eps sigma A/(rho c V) (T^4 - T_a^4) (Incropera Eq. 5.18); the mean temperature after
-    100 s within 0.1 % of T_i - T_a; Newton's method converges in a few iterations a step."""
+    100 s within 0.1 % of T_i - T_a (measured 0.06 %); Newton's method converges in a few iterations
+    a step."""
     scene = block_scene(T0=800.0, end=100.0, steps=1000, boundary='[[boundary]]\nsurfaces = ["free:block"]\n'
                         'emissivity = 1.0\nambient = "300 K"')
     model = march(scene)
@@ -211,6 +215,10 @@ def test_temperature_dependent_elastic_constants_and_expansion():
     E, nu, thermal = 150e9, 0.25, 1.5e-5 * 200                                        # block at 500 K
     assert strains(0) == pytest.approx((nu * p / E + thermal, -p / E + thermal), rel=1e-9)
     assert strains(1) == pytest.approx((0.3 * p / 200e9 + 2.4e-3, -p / 200e9 + 2.4e-3), rel=1e-9)
+    # a table without a temperature field (the squeal mass matrix): DG0 at the given temperature
+    materials = {n: dataclasses.replace(m, rho=((300.0, 8000.0), (700.0, 7600.0))) for n, m in scene.materials.items()}
+    rho = body_fields(model.tm, materials, "rho", 500.0)
+    assert np.all(rho[0].x.array == 7800.0) and np.all(rho[1].x.array == 7800.0)
 
 
 STOP = """
@@ -262,7 +270,7 @@ def test_energy_balance_of_a_stop(tmp_path):
     the disc rising with its speed, radiation, a pin with kappa(T) and c(T)): frictional work = heat
     stored in both bodies + heat lost by convection and radiation, within 1 % over the run (the
     disc's faceted-rim advection loss is 1e-4 of it); the pin, not advected, balances to round-off."""
-    result = run(loads(STOP.format(folder=tmp_path / "stop")), verbose=False)
+    result = run(loads(STOP.replace("{folder}", str(tmp_path / "stop"))), verbose=False)
     h = History.read(result.history_file)
     final = {k: v[-1] for k, v in h.columns.items()}
     work = final["heat_total_pin"] + final["heat_total_disc"]
