@@ -269,6 +269,8 @@ class Multiscale:
         m, last = self.model, self.model.last_solve
         arrays = {"heights": self.rough.heights(), "warm": self.warm, "partition": self.partition,
                   "conductance": self.conductance, "levels": self.rough.levels, "heat_total": m.heat_total,
+                  "heat_lost_recorded": m.heat_lost_recorded,
+                  **({"lost_total": m.thermal.lost_total} if m.thermal is not None else {}),
                   "datum_gap": self.datum_gap,
                   **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
         attrs = {"step": step, "time": m.time, "work": self.work, "scene": self.fingerprint, "load": m.load,
@@ -289,6 +291,9 @@ class Multiscale:
         self.conductance, self.rough.levels = arrays["conductance"], arrays["levels"]
         self.datum_gap = arrays["datum_gap"]
         m.heat_total = arrays["heat_total"].copy()
+        m.heat_lost_recorded = arrays["heat_lost_recorded"].copy()
+        if m.thermal is not None:
+            m.thermal.lost_total = arrays["lost_total"].copy()
         m.time, self.work = float(attrs["time"]), float(attrs["work"])
         if m.thermal is not None:
             m.thermal.time = m.time
