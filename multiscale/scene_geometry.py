@@ -192,7 +192,8 @@ class Geometry:
 
 
 def _parameter_kind(module, name: str) -> str:
-    """Unit kind of a builder parameter: the module's PARAMETER_KINDS, else angle/length by name."""
+    """Unit kind of a builder parameter: the module's PARAMETER_KINDS ("count": a whole number),
+    else angle/length by name."""
     kinds = getattr(module, "PARAMETER_KINDS", {})
     return kinds.get(name, "angle" if "angle" in name else "length")
 
@@ -239,7 +240,9 @@ class GeometrySection(Section):
         for param, value in given.items():
             if param in module.DEFAULTS:
                 zero_ok = float(module.DEFAULTS[param]) == 0.0    # 0 means "builder's fallback"
-                parser = Quantity(_parameter_kind(module, param), **({"ge": 0} if zero_ok else {"gt": 0}))
+                kind = _parameter_kind(module, param)
+                parser = Integer(ge=0 if zero_ok else 1) if kind == "count" else \
+                    Quantity(kind, **({"ge": 0} if zero_ok else {"gt": 0}))
                 try:
                     params[param] = parser(value, ctx)
                 except Bad as exc:

@@ -334,6 +334,8 @@ class FilePath:
     def __call__(self, raw, ctx):
         if not isinstance(raw, str) or not raw:
             raise Bad(f"must be {self.describe()}")
+        if "\x00" in raw:
+            raise Bad("holds a NUL character; a path cannot")
         path = (ctx.directory / Path(raw).expanduser()).resolve()
         if self.folder and path.exists() and not path.is_dir():
             raise Bad(f"exists and is not a folder ({path})")

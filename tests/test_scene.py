@@ -379,3 +379,21 @@ def test_any_wrong_type_anywhere_is_a_scene_error(tmp_path):
                 assert exc.problems and all(isinstance(p, str) and p for p in exc.problems)
                 outcomes["error"] += 1
     assert outcomes["error"] > 10 * outcomes["ok"] > 0
+
+
+@pytest.mark.parametrize("old, new, fragment", [
+    ("friction = 0.4", 'friction = "0.4 5"', 'a number ("5") inside a unit'),       # was read as 2.0
+    ('mesh_size = "2 mm"', 'mesh_size = "2 mm 2"', 'a number ("2") inside a unit'),
+    ('folder = "out/run1"', 'folder = "out/\\u0000run"', "NUL character"),       # a TOML escape
+])
+def test_typos_that_used_to_pass_are_problems(tmp_path, old, new, fragment):
+    assert old in GOOD
+    with pytest.raises(SceneError) as info:
+        loads(GOOD.replace(old, new, 1), tmp_path)
+    assert len(info.value.problems) == 1 and fragment in info.value.problems[0], info.value.problems
+
+
+def test_a_fractional_number_of_vanes_is_a_problem():
+    brake = (Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml")
+    with pytest.raises(SceneError, match="geometry.vanes = 2.5: must be an integer >= 0"):
+        load(brake, {"geometry.vanes": 2.5})
