@@ -6,6 +6,7 @@ import sys
 
 from multiscale import __version__
 from multiscale.errors import MultiscaleError, SceneError
+from multiscale.io import ended_together
 from multiscale.scene import load
 from multiscale.scene_summary import reference, summary
 
@@ -63,7 +64,10 @@ def _run(args) -> int:
     """Validate the scene and hand it to its workflow (``multiscale.workflows.run``).
 
     Under ``mpiexec`` every rank runs this; user errors are raised on every rank (scene validation
-    is deterministic, the output folder is judged by rank 0 for all) and printed by rank 0."""
+    is deterministic, the output folder is judged by rank 0 for all, solver failures are decided
+    collectively) and printed by rank 0. An error met by some ranks only (the others wait in a
+    collective operation) is printed by the rank that met it, which then aborts the job: nothing
+    hangs."""
     comm = _world()
     rank = comm.rank if comm is not None else 0
     try:
@@ -74,7 +78,10 @@ def _run(args) -> int:
             raise MultiscaleError(f"multiscale run needs DOLFINx and the macro workflows ({exc}); install "
                                   "them with pip install -e '.[fem]'") from None
         run(scene, overwrite=args.overwrite, resume=args.resume)
-    except MultiscaleError:
+    except MultiscaleError as exc:
+        if comm is not None and not ended_together(comm):
+            print(f"error (rank {rank} of {comm.size}): {exc}", file=sys.stderr, flush=True)
+            comm.Abort(2)
         if rank == 0:
             raise
         return 2

@@ -7,6 +7,7 @@ Fields for ParaView are written by ``multiscale.macro.output``.
 from __future__ import annotations
 
 import sys
+import time
 from pathlib import Path
 
 import h5py
@@ -59,6 +60,20 @@ class History:
         with h5py.File(path, "r") as f:
             h.columns = {key: list(f[key][...]) for key in f.keys()}
         return h
+
+
+def ended_together(comm, timeout: float = 10.0) -> bool:
+    """Called by a rank that met an error: True if every rank of ``comm`` reaches this call within
+    ``timeout`` [s] (the error was collective: each can end cleanly), False if not (another rank is
+    waiting in a collective operation that will never complete: the caller must abort the job)."""
+    if comm.size == 1:
+        return True
+    request, start = comm.Ibarrier(), time.monotonic()
+    while not request.Test():
+        if time.monotonic() - start > timeout:
+            return False
+        time.sleep(0.01)
+    return True
 
 
 def abort_on_exception(comm=None) -> None:
