@@ -88,3 +88,87 @@ def test_a_nan_on_one_rank_fails_on_every_rank_with_one_message(tmp_path):
     assert done.returncode == 2 and seconds < 120, done.stderr[-2000:]
     errors = [line for line in done.stderr.splitlines() if line.startswith("error")]
     assert len(errors) == 1 and "heat step at t = 2 s failed" in errors[0]
+
+
+# ---------------------------------------------------------------- checkpoints and full disks
+@pytest.fixture(scope="module")
+def stopped(tmp_path_factory):
+    """A rough pin-on-disc run stopped after its first step: the checkpoint to resume from."""
+    from test_coupling import POD
+
+    from multiscale.scene import loads
+    from multiscale.workflows.multiscale import run
+    folder = tmp_path_factory.mktemp("stopped") / "out"
+    scene = loads(POD.format(folder=folder))
+    run(scene, verbose=False, stop_after=1)
+    return scene, folder / "checkpoint.h5"
+
+
+@pytest.mark.parametrize("damage, message", [
+    (lambda b: b[: len(b) // 2], "cannot be read"),             # truncated
+    (lambda b: b"", "cannot be read"),                           # empty
+    (lambda b: b[:-4096] + bytes(x ^ 0x5A for x in b[-4096:]), "corrupted"),   # damaged data
+])
+def test_a_damaged_checkpoint_is_one_clear_error(stopped, tmp_path, damage, message):
+    import shutil
+
+    from multiscale.errors import InputError
+    from multiscale.workflows.multiscale import run
+    scene, checkpoint = stopped
+    folder = tmp_path / "copy"
+    shutil.copytree(checkpoint.parent, folder)
+    path = folder / "checkpoint.h5"
+    path.write_bytes(damage(path.read_bytes()))
+    with pytest.raises(InputError, match=message):
+        run(_with_folder(scene, folder), resume=True, verbose=False)
+
+
+def _with_folder(scene, folder):
+    import dataclasses
+    return dataclasses.replace(scene, output=dataclasses.replace(scene.output, folder=folder))
+
+
+def test_a_full_disk_keeps_the_previous_checkpoint(stopped, tmp_path, monkeypatch):
+    """No space left while the next checkpoint is written (simulated ENOSPC at its rename): an
+    OutputError naming the file and the cause; the step's previous checkpoint is intact."""
+    import errno
+    import os
+    import shutil
+
+    from multiscale import checkpoint as ckpt
+    from multiscale.errors import OutputError
+    from multiscale.workflows.multiscale import run
+    scene, checkpoint = stopped
+    folder = tmp_path / "copy"
+    shutil.copytree(checkpoint.parent, folder)
+    before = (folder / "checkpoint.h5").read_bytes()
+
+    def full(*args):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    monkeypatch.setattr(ckpt.os, "replace", full)
+    with pytest.raises(OutputError, match="cannot write the checkpoint .*No space left on device"):
+        run(_with_folder(scene, folder), resume=True, verbose=False)
+    assert (folder / "checkpoint.h5").read_bytes() == before
+    assert not (folder / "checkpoint.h5.tmp").exists()
+
+
+def test_a_read_only_output_folder_is_one_clear_error(tmp_path, monkeypatch):
+    """A folder the run cannot write into (simulated: root may write anywhere) is an OutputError
+    before any work."""
+    import errno
+    import os
+    from pathlib import Path
+
+    from multiscale.errors import OutputError
+    from multiscale.scene import loads
+    from multiscale.workflows import run
+    write_bytes = Path.write_bytes
+
+    def read_only(self, data):
+        if "locked" in str(self):
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(self))
+        return write_bytes(self, data)
+    monkeypatch.setattr(Path, "write_bytes", read_only)
+    scene = loads(SCENE.format(folder=tmp_path / "locked"))
+    with pytest.raises(OutputError, match="cannot write into the output folder .*Permission denied"):
+        run(scene, verbose=False)
