@@ -3,15 +3,16 @@ areal roughness parameters (ISO 25178-2), computed through SurfaceTopography whe
 
 Conventions (Jacobs, Junge & Pastewka, Surf. Topogr. Metrol. Prop. 5 (2017) 013001): wavevector q
 [rad/m]; the two-dimensional PSD C(q) = |h̃(q)|²/A with h̃ = Δx Δy Σ h e^(−i q·x), so that
-<h²> = (2π)⁻² ∫ C(q) d²q; ``Spectrum`` holds its radial average C_iso(q) [m⁴] in logarithmic bins.
-Measured (non-periodic) surfaces are windowed (radial Hann window, <w²> = 1) before the FFT,
-periodic ones are not: SurfaceTopography's ``power_spectrum_from_area``.
+<h²> = (2π)⁻² ∫ C(q) d²q; ``Spectrum`` holds the map C(q) and its radial average C_iso(q) [m⁴] in
+logarithmic bins, from SurfaceTopography's ``power_spectrum_from_area``: of the patch itself if it
+is periodic, of its mirror-stitched double if it is measured (no window needed, Parseval exact: see
+``power_spectrum``; SurfaceTopography's Hann window on request).
 
 A self-affine surface has C(q) ∝ q^(−2−2H) between a long-wavelength roll-off q_r (below it C is
 flat, or zero for a band-limited surface) and a short-wavelength cut-off q_s (thesis Eqs. 1.24–1.25);
-``fit_power_law`` finds H, q_r and q_s of a measured spectrum (SurfaceTopography fits no
-cut-offs). ``equivalent_surface`` draws a random surface with the measured PSD itself (not only its
-fit) on any grid; ``surface_statistics`` gives Sq, Sdq, Ssk, Sku, Nayak's parameter, the summit
+``fit_power_law`` finds H, q_r and q_s of a measured spectrum (SurfaceTopography fits none).
+``equivalent_surface`` draws a random surface with the measured PSD itself (not only its fit, and
+with its anisotropy) on any grid; ``surface_statistics`` gives Sq, Sdq, Ssk, Sku, Nayak's parameter, the summit
 density and both of the above.
 
 SurfaceTopography stores heights as [x, y]; here they are [y, x] (``multiscale.micro.surface``):
