@@ -105,7 +105,11 @@ def _length(option: str, text: str | None) -> float | None:
     if text is None:
         return None
     try:
-        return to_si(text if not text.replace(".", "", 1).replace("e-", "", 1).isdigit() else float(text), "length")
+        value = float(text)
+    except ValueError:
+        value = text
+    try:
+        return to_si(value, "length")
     except UnitError as exc:
         raise InputError(option, text, str(exc)) from None
 
@@ -117,9 +121,14 @@ def _surface(args) -> int:
         return 0
     if not args.file:
         raise MultiscaleError("multiscale surface: give a topography file, or --formats for the formats it reads")
-    measurement = read_topography(args.file, args.channel, pixel_size=_length("--pixel-size", args.pixel_size),
-                                  height_unit=_length("--height-unit", args.height_unit), prefix="--")
-    done = condition(measurement, args.detrend, _length("--cutoff", args.cutoff), args.max_undefined, prefix="--")
+    pixel, unit, cutoff = (_length(o, v) for o, v in (("--pixel-size", args.pixel_size),
+                                                       ("--height-unit", args.height_unit), ("--cutoff", args.cutoff)))
+    try:
+        measurement = read_topography(args.file, args.channel, pixel_size=pixel, height_unit=unit)
+        done = condition(measurement, args.detrend, cutoff, args.max_undefined)
+    except InputError as exc:     # the micro fields by their command-line names
+        name = "FILE" if exc.name == "file" else "--" + exc.name.replace("_", "-")
+        raise InputError(name, exc.value, exc.allowed) from None
     stats = surface_statistics(done.surface)
     print("\n".join(done.report))
     print(f"statistics of the {'roughness' if done.waviness is not None else 'surface'}:")

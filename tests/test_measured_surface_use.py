@@ -51,7 +51,7 @@ def test_surface_command_prints_the_steps_and_surfacetopographys_sq(tmp_path, ca
 @pytest.mark.parametrize("args, message", [
     (["--channel", "2"], 'error: --channel = 2: top-1.top has the channels 0 "Default" (2-D)'),
     (["--cutoff", "3 kg"], 'error: --cutoff = \'3 kg\': expected a length'),
-    (["--cutoff", "1 nm"], "error: --cutoff = 1e-09: λc must span at least 2 pixels of top-1.top"),
+    (["--cutoff", "1 nm"], "error: --cutoff = 1e-09: λc must span at least 2 pixels (4.69e-09 m): top-1.top's pixels"),
 ])
 def test_surface_command_bad_options_are_one_line(capsys, args, message):
     assert main(["surface", str(TOP), "--figure", "none", *args]) == 2

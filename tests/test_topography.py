@@ -202,6 +202,9 @@ def test_covering_an_interface():
     with pytest.warns(TopographyWarning, match="3 x 2 copies"):
         tiled, _ = cover(s, (100, 60), (100e-6, 60e-6), "tile")
     assert tiled.shape == (60, 100) and not tiled.periodic
+    with pytest.warns(TopographyWarning, match="13 x 7 mirror-stitched copies"):     # coarsened before copying
+        coarse, lines = cover(s, (100, 50), (1e-3, 0.5e-3), "mirror")
+    assert coarse.shape == (50, 100) and lines[0].startswith("resampled 80 x 80 points of 1 um to 8 x 8 of 10 x 10 um")
     a, _ = cover(s, (64, 48), (128e-6, 96e-6), "equivalent", seed=5)
     b, _ = cover(s, (64, 48), (128e-6, 96e-6), "equivalent", seed=5)
     c, _ = cover(s, (64, 48), (128e-6, 96e-6), "equivalent", seed=6)

@@ -266,9 +266,8 @@ def equivalent_surface(spectrum: Spectrum, n, size, seed=0, *, amplitudes: str =
     (the map itself, with its anisotropy, not a power-law fit).
 
     q-space is cut into cells: the spectrum's logarithmic bins (continued to the corners of the
-    grids) split into angular
-    sectors of [0, π) centred on the axes (as many as the ring's measured modes allow, at least
-    ``modes_per_sector`` each, a power of 2 up to 32). Each cell keeps the measured power
+    grids) split into angular sectors of [0, π) centred on the axes (as many as the ring's measured
+    modes allow, at least ``modes_per_sector`` each, a power of 2 up to 32). Each cell keeps the measured power
     (2π)⁻² Σ C Δq² of its modes, spread over the new grid's modes in it along the shape of the
     ring-averaged C(|q|) (log-log interpolated): so the new surface has the measured power in every
     ring and direction on any grid, whatever its mode spacing, and within a ring the measured
@@ -339,8 +338,8 @@ class Statistics:
     """Areal roughness parameters of one patch (ISO 25178-2 names) and its spectrum.
 
     Sq, Sdq: SurfaceTopography's ``Sq`` and ``rms_gradient`` (upwind finite
-    differences, what its users compare with). Ssk = <h³>/Sq³ and Sku = <h⁴>/Sq⁴ (ISO 25178-2
-    §4.1.3–4.1.4; SurfaceTopography has neither). m0, m2, m4 and Nayak's α = m0 m4/m2² (Nayak,
+    differences, what its users compare with). Ssk = <h³>/Sq³ and Sku = <h⁴>/Sq⁴ (ISO 25178-2;
+    SurfaceTopography has neither). m0, m2, m4 and Nayak's α = m0 m4/m2² (Nayak,
     ASME J. Lubr. Technol. 93 (1971) 398): profile moments averaged over x and y,
     ``multiscale.micro.surface.statistics`` (what the asperity models use). Summit density: strict
     8-neighbour maxima with a curvature (``find_asperities``) per unit area, and Nayak's value for

@@ -184,15 +184,16 @@ def probe_topography(path, channel: int | None = None, *, pixel_size=None, heigh
             m = read_topography(path, channel, pixel_size=pixel_size, height_unit=height_unit, prefix=prefix)
     except InputError as exc:
         return [str(exc)], []
-    problem = _undefined_problem(m, max_undefined, prefix)
-    return ([] if problem is None else [problem]), list(m.notes)
+    too_many = _too_many_undefined(m, max_undefined, prefix)
+    return ([] if too_many is None else [str(InputError(f"{prefix}file", m.path.name, too_many))]), list(m.notes)
 
 
-def _undefined_problem(m: Measurement, max_undefined: float, prefix: str) -> str | None:
+def _too_many_undefined(m: Measurement, max_undefined: float, prefix: str) -> str | None:
+    """Why the measurement has too many undefined points to fill, or None."""
     share = m.undefined / m.heights.size
     if share > max_undefined:
-        return (f"{prefix}file = '{m.path.name}': {share:.1%} of its points are undefined, more than "
-                f"{prefix}max_undefined = {max_undefined:.1%} (too much to fill by interpolation)")
+        return (f"{share:.1%} of its points are undefined, more than {prefix}max_undefined = {max_undefined:.1%} "
+                "(too much to fill by interpolation)")
     return None
 
 
@@ -216,15 +217,16 @@ def gaussian_transmission(wavelength, cutoff: float) -> np.ndarray:
 
 def gaussian_filter(surface: Surface, cutoff: float) -> Surface:
     """The Gaussian mean surface (waviness) of ISO 16610-61 at the cut-off wavelength λc [m]:
-    convolution with s(x, y) = exp(−π (x² + y²)/(α λc)²)/(α λc)², truncated at ±λc (ISO 16610-21), so
-    that a sinusoid of wavelength λ keeps ``gaussian_transmission(λ, λc)`` of its amplitude. Edges:
+    convolution with s(x, y) = exp(−π (x² + y²)/(α λc)²)/(α λc)², truncated at ±λc (where it has
+    fallen to 7e-7 of its peak), so that a sinusoid of wavelength λ keeps
+    ``gaussian_transmission(λ, λc)`` of its amplitude. Edges:
     periodic surfaces wrap, others are mirrored (one of the end-effect treatments of ISO 16610-28).
     SurfaceTopography filters periodic topographies in Fourier space only, hence this one."""
     import scipy.ndimage  # ~0.4 s to import: only when a surface is filtered
     check_positive("cutoff", cutoff)
-    sigma = ALPHA * cutoff / np.sqrt(2 * np.pi)              # exp(-π x²/(αλc)²) = exp(-x²/(2σ²))
     if cutoff < 2 * max(surface.dx, surface.dy):
         raise InputError("cutoff", cutoff, f"λc must span at least 2 pixels ({2 * max(surface.dx, surface.dy):.3g} m)")
+    sigma = ALPHA * cutoff / np.sqrt(2 * np.pi)              # exp(-π x²/(αλc)²) = exp(-x²/(2σ²))
     h = surface.heights
     axes = (h.ndim - 2, h.ndim - 1)
     w = scipy.ndimage.gaussian_filter(h, sigma=(sigma / surface.dy, sigma / surface.dx), axes=axes,
@@ -241,9 +243,11 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
         raise InputError(f"{prefix}detrend", detrend, f"one of {', '.join(DETREND)}")
     if cutoff is not None:
         check_positive(f"{prefix}cutoff", cutoff)
-    problem = _undefined_problem(m, max_undefined, prefix)
-    if problem is not None:
-        raise InputError(f"{prefix}file", m.path.name, problem.split(": ", 1)[1])
+    if not 0 <= max_undefined <= 1:
+        raise InputError(f"{prefix}max_undefined", max_undefined, "a fraction of the points, in [0, 1]")
+    too_many = _too_many_undefined(m, max_undefined, prefix)
+    if too_many is not None:
+        raise InputError(f"{prefix}file", m.path.name, too_many)
     report = [f"read {m.path.name}, channel {m.channel} (\"{m.channel_name}\"): {m.shape[1]} x {m.shape[0]} points "
               f"of {m.dx * 1e6:.4g} x {m.dy * 1e6:.4g} um ({m.size[0] * 1e3:.4g} x {m.size[1] * 1e3:.4g} mm)"
               + (f", heights in {m.unit}" if m.unit else "")] + [f"warning: {n}" for n in m.notes]
@@ -265,10 +269,10 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
     surface = Surface(h - h.mean(), m.dx, m.dy, periodic=False)
     waviness = None
     if cutoff is not None:
-        if cutoff < 2 * max(m.dx, m.dy):
-            raise InputError(f"{prefix}cutoff", cutoff, f"λc must span at least 2 pixels of {m.path.name} "
-                             f"({2 * max(m.dx, m.dy):.3g} m)")
-        waviness = gaussian_filter(surface, cutoff)
+        try:
+            waviness = gaussian_filter(surface, cutoff)
+        except InputError as exc:
+            raise InputError(f"{prefix}cutoff", cutoff, f"{exc.allowed}: {m.path.name}'s pixels") from None
         rough = surface.heights - waviness.heights
         surface = Surface(rough - rough.mean(), m.dx, m.dy, periodic=False)
         longer = " (longer than the measurement: little is removed)" if cutoff > min(m.size) else ""
@@ -351,8 +355,12 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
         if method == "mirror":
             t = as_topography(surface).mirror_stitch()
             base = Surface(np.asarray(t.heights()).T, surface.dx, surface.dy, periodic=True)
+        cell = (Lx / nx, Ly / ny)
+        if base.dx < cell[0] * (1 - 1e-9) or base.dy < cell[1] * (1 - 1e-9):     # coarsen once, then copy
+            base, note = resample(base, tuple(max(4, round(b / c)) for b, c in zip(base.size, cell)))
+            lines.append(note)
         reps = (int(np.ceil(Ly / base.size[1])), int(np.ceil(Lx / base.size[0])))
-        surface = Surface(np.tile(base.heights, reps), surface.dx, surface.dy, periodic=False)
+        surface = Surface(np.tile(base.heights, reps), base.dx, base.dy, periodic=False)
         message = (f"{prefix}cover = \"{method}\": {wide} is smaller than {target}: {reps[1]} x {reps[0]} "
                    f"{'mirror-stitched ' if method == 'mirror' else ''}copies; wavelengths longer than "
                    f"{max(base.size) * 1e3:.4g} mm are missing and the pattern repeats")
