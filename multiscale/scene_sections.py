@@ -13,6 +13,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from multiscale.errors import InputError
+from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_topography
 from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, ListOf, OneOf, OnlyWith, Pair,
                                Quantity, Requires, Section, TableOr, Tables, Text, Vector, key)
 
@@ -325,7 +326,16 @@ class Output:
 class Roughness:
     """Rough face of one body (§7.3.1: only the pin is rough): generated (fractal, Eqs. 1.24–1.25)
     or measured. Cut-offs are wavelengths per generated patch; ``patch`` says whether one surface
-    is generated for the whole face and cut into zones, or one per zone (per-zone seeds)."""
+    is generated for the whole face and cut into zones, or one per zone (per-zone seeds).
+
+    A measured ``file`` (issue 17; ``multiscale.micro.topography``): any format SurfaceTopography
+    reads (x3p, sur, plu, opd, ...) with its own units and pixel sizes (``pixel_size`` and
+    ``height_unit`` override them, with a warning), or a plain height matrix (.npy, .txt, .csv,
+    .asc: ``pixel_size`` needed, ``height_unit`` default 1 m). It is conditioned (``detrend``,
+    undefined points filled up to ``max_undefined``, Gaussian filter at ``cutoff``), then
+    ``cover``s the face: the measurement itself ("measured": it must cover the face), copies
+    ("mirror", "tile": warned) or a statistically equivalent surface from its PSD ("equivalent",
+    drawn with ``seed``). ``multiscale check`` reads the file's header and heights, nothing more."""
 
     body: str | None = key(Text())               # the stationary (rough) side; default: that side
     rms: float | None = key(_LENGTH)                                          # m
@@ -334,29 +344,41 @@ class Roughness:
     k_max: tuple | None = key(Pair(Quantity("dimensionless", gt=0)))
     seed: int = key(Integer(ge=0), default=0)
     patch: str = key(Choice(("face", "zone")), default="face")
-    file: Path | None = key(FilePath())                                       # .npy / .txt / .csv heights
-    pixel_size: tuple | None = key(Pair(_LENGTH))                             # m, (dx, dy) of the file
-    height_unit: float = key(_LENGTH, default=1.0)                            # m per file height unit
+    file: Path | None = key(FilePath())                                       # measured topography
+    channel: int | None = key(Integer(ge=0))                                  # default: the file's default
+    pixel_size: tuple | None = key(Pair(_LENGTH))                             # m, (dx, dy): overrides the file's
+    height_unit: float | None = key(_LENGTH)                                  # m per file height unit
+    detrend: str = key(Choice(tuple(DETREND)), default="plane")               # form removal
+    cutoff: float | None = key(_LENGTH)                                       # m, Gaussian filter λc
+    max_undefined: float = key(Quantity("dimensionless", ge=0, le=1), default=MAX_UNDEFINED)
+    cover: str = key(Choice(COVER), default="measured")
 
     rules = (OneOf(("rms", "file"), required=True), Requires("rms", ("hurst", "k_min", "k_max")),
-             Requires("file", ("pixel_size",)), OnlyWith("rms", ("hurst", "k_min", "k_max", "seed", "patch")),
-             OnlyWith("file", ("pixel_size", "height_unit")))
+             OnlyWith("rms", ("hurst", "k_min", "k_max", "patch")),
+             OnlyWith("file", ("channel", "pixel_size", "height_unit", "detrend", "cutoff", "max_undefined", "cover")))
 
     def problems(self, path, ctx):
         if self.rms is not None and any(hi <= lo for lo, hi in zip(self.k_min, self.k_max)):
             return [f"{path}.k_max = {list(self.k_max)}: must exceed k_min = {list(self.k_min)}"]
-        return []
+        if self.file is None:
+            return []
+        problems, notes = probe_topography(self.file, self.channel, pixel_size=self.pixel_size,
+                                           height_unit=self.height_unit, max_undefined=self.max_undefined,
+                                           prefix=f"{path}.")
+        ctx.warnings.extend(notes)
+        return problems
 
 
 @dataclass(frozen=True)
 class Micro:
-    """How the rough interface is solved (issue 7): zone grid on the interface, grid per zone,
-    micro model, points of each p_n(g_n) law (top node at ``p_max``, default 20 x the nominal
+    """How the rough interface is solved (issue 7): zone grid on the interface, grid per zone
+    (default 50 x 50; a measured surface's own pixel size, rounded, unless it is replaced by a
+    statistically equivalent one), micro model, points of each p_n(g_n) law (top node at ``p_max``, default 20 x the nominal
     interface pressure; contact solver tolerance ``tol``), micro partition law (ch. 6) or the
     constant one."""
 
     zones: tuple | None = key(Pair(Integer(ge=1)), required=True)             # (nx, ny) zones
-    grid: tuple = key(Pair(Integer(ge=8)), default=(50, 50))                  # (nx, ny) per zone
+    grid: tuple | None = key(Pair(Integer(ge=8)))                             # (nx, ny) per zone
     model: str = key(Choice(("fft-bem", "asperity", "asperity-interacting")), default="fft-bem")
     law_points: int = key(Integer(ge=4), default=20)
     partition_law: bool = key(Flag(), default=False)

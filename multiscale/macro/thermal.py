@@ -40,7 +40,7 @@ exact circle and is small on the faceted rim of the mesh (chords: w·n changes s
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
