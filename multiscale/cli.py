@@ -76,6 +76,8 @@ def _run(args) -> int:
     rank = comm.rank if comm is not None else 0
     try:
         scene = load(args.scene)
+        for line in scene.warnings if rank == 0 else ():
+            print(f"warning: {line}", file=sys.stderr, flush=True)
         try:
             from multiscale.workflows import run   # DOLFINx: optional ([fem] extra), slow to import
         except ModuleNotFoundError as exc:

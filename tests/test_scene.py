@@ -330,6 +330,31 @@ def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
                                 "heat enters the bodies",)
 
 
+@pytest.mark.parametrize("old, new, warning", [
+    ('initial_temperature = "20 degC"', 'initial_temperature = "1e-300 K"',
+     'time.initial_temperature = "1e-300 K": 1e-300 K is outside the plausible range 20 to 2500 K'),
+    ('pressure = "10 bar"', 'pressure = "1e9 MPa"', 'loading.pressure = "1e9 MPa": 1e+15 Pa is outside'),
+    ('E = "4 GPa"', 'E = "4 Pa"', "materials.block.E = \"4 Pa\": 4 Pa is outside the plausible range 100000"),
+    ("friction = 0.4", "friction = 40", "loading.friction = 40: 40 is outside the plausible range 0 to 2"),
+    ('mesh_size = "2 mm"', 'mesh_size = "20 m"', 'geometry.mesh_size = "20 m": 20 m is outside'),
+    ('kappa = "5 W/(m K)"', 'kappa = [["20 degC", "5 W/(m K)"], ["3000 degC", "6 W/(m K)"]]',
+     'materials.block.kappa = [["20 degC", "5 W/(m K)"], ["3000 degC", "6 W/(m K)"]]: 3273.15 K is outside'),
+])
+def test_implausible_values_are_warned_with_their_path(tmp_path, old, new, warning):
+    """A value outside its documented plausible range (check --keys) runs, with one warning naming the
+    key, the value in SI and the range; plausible values give none."""
+    assert loads(GOOD, tmp_path).warnings == ()
+    assert old in GOOD
+    scene = loads(GOOD.replace(old, new, 1), tmp_path)
+    assert len(scene.warnings) == 1 and scene.warnings[0].startswith(warning), scene.warnings
+    assert scene.warnings[0].endswith("check the value and its unit")
+
+
+def test_no_shipped_scene_is_implausible():
+    for path in sorted(DEMOS.glob("*.toml")):
+        assert not [w for w in load(path).warnings if "plausible" in w], path
+
+
 def test_reference_lists_every_section_and_key():
     from multiscale.scene import Scene
     from multiscale.scene_summary import reference
