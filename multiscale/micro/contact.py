@@ -34,7 +34,7 @@ from multiscale.micro.fft import get_threads
 from multiscale.micro.kernels import InfluenceOperator, Kernel, positive_number, real_number
 
 METHODS = ("bccg", "pk")
-CHUNK_CELLS = 32768  # cells per chunk of the batch (a few such float arrays fit in L2)
+CHUNK_CELLS = {"bccg": 65536, "pk": 32768}   # cells per chunk of a batch (the working set stays in L2)
 COARSE_MIN = 32      # smallest side of the grids of the nested start of "bccg"
 COARSE_TOL = 1e-1    # tolerance of the coarse solves of the nested start
 
@@ -142,23 +142,30 @@ class ContactSolver:
                 raise InputError("initial_pressure", "array", "must be finite and >= 0")
         return self._run_chunks(method, z, target, delta, tol, max_iter, p0, partial)
 
-    def _run_chunks(self, method, z, target, delta, tol, max_iter, p0, partial):
+    def _run_chunks(self, method, z, target, delta, tol, max_iter, p0, partial, fields=True):
         """Run the iterations on chunks of the batch small enough for the CPU cache (the full-grid
         passes are memory bound: 400 patches of 64² in one block run ~2x slower than in chunks
-        of 8), on ``get_threads()`` threads when there are several chunks, then assemble."""
+        of 8), on ``get_threads()`` threads when there are several chunks; each chunk makes its
+        start (its nested coarse solve) and fills its part of the result (``fields``: the gap and
+        the means, not needed by a nested start)."""
         batch, grid = z.shape[:-2], z.shape[-2:]
         B = int(np.prod(batch, dtype=int))
-        size = max(1, CHUNK_CELLS // (grid[0] * grid[1]))
+        size = max(1, CHUNK_CELLS[method] // (grid[0] * grid[1]))
         z = np.ascontiguousarray(np.reshape(z, (B,) + grid))
-        p = self._initial_pressure(method, z, None if target is None else np.reshape(target, B),
-                                   None if delta is None else np.reshape(delta, B),
-                                   None if p0 is None else np.reshape(p0, (B,) + grid), max_iter)
         target = None if target is None else np.ascontiguousarray(np.reshape(target, B), dtype=float)
         delta = None if delta is None else np.ascontiguousarray(np.reshape(delta, B), dtype=float)
+        p0 = None if p0 is None else np.reshape(p0, (B,) + grid)
         chunks = [slice(i, min(i + size, B)) for i in range(0, B, size)]
         threads = min(get_threads(), len(chunks))
+        p, u = np.empty_like(z), np.empty_like(z)
+        out = {k: np.zeros(B, dtype=t) for k, t in (("d", float), ("iterations", int), ("residual", float),
+                                                    ("converged", bool), ("area_fraction", float),
+                                                    ("mean_pressure", float), ("mean_gap", float))}
+        gap = np.empty_like(p) if fields else None
+        histories = [None] * len(chunks)
 
-        def one(c):
+        def one(k):
+            c = chunks[k]
             key = (method, c.stop - c.start, 1 if threads > 1 else get_threads())
             free = self._scratch.setdefault(key, queue.SimpleQueue())
             try:
@@ -166,15 +173,16 @@ class ContactSolver:
             except queue.Empty:
                 work = self._new_scratch(method, *key[1:])
             history: list = []
-            args = (z[c], p[c], None if target is None else target[c], None if delta is None else delta[c],
-                    tol, max_iter, history)
+            tc, dc = (None if a is None else a[c] for a in (target, delta))
+            p[c] = self._initial_pressure(method, z[c], tc, dc, None if p0 is None else p0[c], max_iter)
+            args = (z[c], p[c], u[c], tc, dc, tol, max_iter, history)
             try:
                 with np.errstate(all="ignore"):
                     if method == "bccg":
-                        out = bccg_solver.run(self.operator, work, *args)
+                        part = bccg_solver.run(self.operator, work, *args)
                     else:
-                        out = pk_solver.run(self.operator, work[0], work[1], *args)
-                    finite = all(np.all(np.isfinite(out[k])) for k in ("u", "d")) and np.all(np.isfinite(p[c]))
+                        part = pk_solver.run(self.operator, work[0], work[1], *args)
+                    finite = np.all(np.isfinite(part["d"])) and np.all(np.isfinite(u[c])) and np.all(np.isfinite(p[c]))
             except FloatingPointError:
                 finite = False
             if not finite:
@@ -184,16 +192,32 @@ class ContactSolver:
                 raise ContactNonFiniteError("the contact iteration overflowed float64 (non-finite pressure or "
                                             "displacement): rescale the problem (heights, load, modulus)")
             free.put(work)
-            out["history"] = history
-            return out
+            for name, values in part.items():
+                out[name][c] = values
+            histories[k] = history
+            out["mean_pressure"][c] = p[c].mean(axis=(1, 2))
+            if fields:
+                np.add(u[c], z[c], out=gap[c])
+                gap[c] -= part["d"][:, None, None]
+                np.maximum(gap[c], 0.0, out=gap[c])
+                gap[c][p[c] > 0] = 0.0
+                out["area_fraction"][c] = np.mean(p[c] > 0, axis=(1, 2))
+                out["mean_gap"][c] = gap[c].mean(axis=(1, 2))
 
         if threads > 1:
             if self._pool is None or self._pool_threads != threads:
                 self._pool, self._pool_threads = ThreadPoolExecutor(threads), threads
-            parts = list(self._pool.map(one, chunks))
+            list(self._pool.map(one, range(len(chunks))))
         else:
-            parts = [one(c) for c in chunks]
-        result = self._assemble(z, p, parts, batch)
+            for k in range(len(chunks)):
+                one(k)
+        length = max(len(h) for h in histories)
+        history = [max(h[k] for h in histories if k < len(h)) for k in range(length)]
+        cells = batch + grid
+        result = ContactResult(
+            pressure=p.reshape(cells), displacement=u.reshape(cells),
+            gap=gap.reshape(cells) if fields else None, contact=(p > 0).reshape(cells) if fields else None,
+            approach=out.pop("d").reshape(batch), history=history, **{k: v.reshape(batch) for k, v in out.items()})
         if not np.all(result.converged) and not partial:
             raise ContactConvergenceError(
                 f"contact solver did not converge in {max_iter} iterations "
@@ -238,31 +262,13 @@ class ContactSolver:
             self._coarse = ContactSolver(self.kernel, (ny // 2, nx // 2), 2 * op.dx, 2 * op.dy, self.periodic)
         zc = z.reshape(B, ny // 2, 2, nx // 2, 2).mean(axis=(2, 4))
         low = zc.min(axis=(1, 2))                        # the coarse top lies this far below the fine one
-        options = dict(tol=COARSE_TOL, max_iter=max_iter, partial=True)
-        if target is not None:
-            r = self._coarse.solve(-zc, load=target, **options)
-        else:
-            dc = delta - low
-            if np.any(dc <= 0) or (self.periodic and np.any(dc >= (zc - low[:, None, None]).mean(axis=(1, 2)))):
+        zc -= low[:, None, None]
+        if target is None:
+            delta = delta - low
+            if np.any(delta <= 0) or (self.periodic and np.any(delta >= zc.mean(axis=(1, 2)))):
                 return None
-            r = self._coarse.solve(-zc, approach=dc, **options)
-        return np.repeat(np.repeat(r.pressure.reshape(B, ny // 2, nx // 2), 2, axis=1), 2, axis=2)
-
-    @staticmethod
-    def _assemble(z, p, parts, batch) -> ContactResult:
-        u = np.concatenate([o["u"] for o in parts])
-        d = np.concatenate([o["d"] for o in parts])
-        length = max(len(o["history"]) for o in parts)
-        history = [max(o["history"][k] for o in parts if k < len(o["history"])) for k in range(length)]
-        g = u + z - d[:, None, None]
-        gap = np.where(p > 0, 0.0, np.maximum(g, 0.0))
-        cells = batch + z.shape[1:]
-        per = {k: np.concatenate([o[k] for o in parts]).reshape(batch) for k in ("iterations", "residual", "converged")}
-        return ContactResult(
-            pressure=p.reshape(cells), displacement=u.reshape(cells), gap=gap.reshape(cells),
-            contact=(p > 0).reshape(cells), area_fraction=np.mean(p > 0, axis=(1, 2)).reshape(batch),
-            mean_pressure=p.mean(axis=(1, 2)).reshape(batch), approach=d.reshape(batch),
-            mean_gap=gap.mean(axis=(1, 2)).reshape(batch), history=history, **per)
+        r = self._coarse._run_chunks("bccg", zc, target, delta, COARSE_TOL, max_iter, None, True, fields=False)
+        return np.repeat(np.repeat(r.pressure, 2, axis=1), 2, axis=2)
 
 
 def _method(method) -> str:

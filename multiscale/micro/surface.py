@@ -62,12 +62,17 @@ def fractal_surface(n, size, hurst: float, k_min, k_max, rms: float, seed: int =
     k_min, k_max: lower and upper cut-offs in wavelengths per patch (thesis Table 1.1 units),
     a number or a pair (kx, ky) for an anisotropic surface: the PSD is non-zero where
     (kx/kx_max)² + (ky/ky_max)² <= 1 and (kx/kx_min)² + (ky/ky_min)² >= 1.
-    rms: RMS height [m] (each patch is scaled to it exactly); seed: random seed; batch: leading
-    shape of a batch of independent patches. Random phases uniform in [0, 2π) (Eq. 1.25).
+    rms: RMS height [m] (each patch is scaled to it exactly); seed: random seed (a whole number
+    >= 0 or a numpy SeedSequence); batch: leading shape of a batch of independent patches. Random
+    phases uniform in [0, 2π) (Eq. 1.25).
     """
-    nx, ny = (int(v) for v in np.broadcast_to(np.asarray(n), (2,)))
+    nx, ny = _whole("n", n, 2)
     if min(nx, ny) < 4:
         raise InputError("n", n, "need at least 4 points per side")
+    batch = _whole("batch", batch, max(np.size(batch), 1)) if np.size(batch) or np.ndim(batch) == 0 else ()
+    seeded = isinstance(seed, (np.random.SeedSequence, np.random.BitGenerator, np.random.Generator))
+    if not seeded and (isinstance(seed, (bool, np.bool_)) or not isinstance(seed, (int, np.integer)) or seed < 0):
+        raise InputError("seed", seed, "must be a whole number >= 0 (or a numpy SeedSequence)")
     Lx, Ly = _pair("size", size)
     if not 0 < hurst <= 1:
         raise InputError("hurst", hurst, "Hurst exponent must lie in (0, 1]")
@@ -90,6 +95,20 @@ def fractal_surface(n, size, hurst: float, k_min, k_max, rms: float, seed: int =
     h -= h.mean(axis=(-2, -1), keepdims=True)
     h *= rms / np.sqrt(np.mean(h**2, axis=(-2, -1), keepdims=True))
     return Surface(h, Lx / nx, Ly / ny, periodic=True)
+
+
+def _whole(name: str, value, count: int) -> tuple[int, ...]:
+    """``value`` (a number or ``count`` numbers) as whole numbers >= 1, else ``InputError`` (a float
+    grid size used to be truncated)."""
+    try:
+        a = np.broadcast_to(np.asarray(value), (count,))
+        ints = tuple(int(v) for v in a)
+        exact = a.dtype.kind in "iuf" and all(float(v) == i for v, i in zip(a, ints))
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(name, value, "must be whole numbers") from None
+    if not exact or min(ints, default=1) < 1:
+        raise InputError(name, value, "must be whole numbers >= 1")
+    return ints
 
 
 def load_surface(path, dx: float, dy: float | None = None, *, scale: float = 1.0,
