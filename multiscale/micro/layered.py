@@ -354,7 +354,8 @@ class LayeredElastic(LayeredKernel):
     """N bonded elastic layers (top first) on an elastic half-space or a rigid base (§2.2, App. A/B).
 
     ``thickness`` [m], ``E`` [Pa], ``nu`` per layer; ``substrate_E`` = inf (default) is a rigid
-    base. Normal surface compliance w_z / p against a rigid flat, frictionless (F11 of Eq. 3.8).
+    base. Normal surface compliance w_z / p against a rigid flat, frictionless (F11 of Eq. 3.8 with
+    the 1/rho of Eq. 3.7, which the printed Eq. 3.8 drops).
     """
 
     thickness: tuple
