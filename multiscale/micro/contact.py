@@ -28,10 +28,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from multiscale.errors import ConvergenceError, InputError
+from multiscale.errors import ConvergenceError, InputError, check_count, check_flag, check_positive
 from multiscale.micro import bccg_solver, pk_solver
 from multiscale.micro.fft import get_threads
-from multiscale.micro.kernels import InfluenceOperator, Kernel, positive_number, real_number
+from multiscale.micro.kernels import InfluenceOperator, Kernel
 
 METHODS = ("bccg", "pk")
 CHUNK_CELLS = {"bccg": 65536, "pk": 32768}   # cells per chunk of a batch (the working set stays in L2)
@@ -109,12 +109,11 @@ class ContactSolver:
             raise InputError("heights.shape", h.shape, "the batch holds no patch")
         if not np.all(np.isfinite(h)):
             raise InputError("heights", "array with NaN/inf", "all heights must be finite")
-        tol = positive_number("tol", tol)
+        tol = check_positive("tol", tol)
         if tol >= 1:
             raise InputError("tol", tol, "relative tolerance must lie in (0, 1)")
-        max_iter = _count("max_iter", max_iter)
-        if not isinstance(partial, (bool, np.bool_)):
-            raise InputError("partial", partial, "must be True or False")
+        max_iter = check_count("max_iter", max_iter)
+        check_flag("partial", partial)
         if (load is None) == (approach is None):
             raise InputError("load/approach", (load, approach), "give exactly one of them")
         batch = h.shape[:-2]
@@ -275,14 +274,6 @@ def _method(method) -> str:
     if not isinstance(method, str) or method not in METHODS:
         raise InputError("method", method, f"choose one of {', '.join(METHODS)}")
     return method
-
-
-def _count(name: str, value) -> int:
-    """A whole number >= 1 (no NaN, no silent truncation), else ``InputError``."""
-    v = real_number(name, value)
-    if not (np.isfinite(v) and v == int(v) and v >= 1):
-        raise InputError(name, value, "must be a whole number >= 1")
-    return int(v)
 
 
 def _batch_values(name: str, value, shape) -> np.ndarray:
