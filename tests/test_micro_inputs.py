@@ -13,6 +13,7 @@ from multiscale.micro.heat_kernels import Rotation, SpeedProfile, ThermalMateria
 from multiscale.micro.heating import InterfaceLayer, SteadyHeating, TransientHeating, partition_law
 from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
+from multiscale.micro.laws import LawSpec
 from multiscale.micro.layered_asperity import LayeredAsperity, layered_law
 from multiscale.micro.surface import Surface, find_asperities, fractal_surface, load_surface, statistics
 from multiscale.micro.wear import simulate_wear, wear_step
@@ -152,6 +153,12 @@ CASES = [
     (lambda **k: generate_zones(**{**dict(grid=cut_zones(S, (2, 2))[0], n=8, hurst=0.8, k_min=1, k_max=3,
                                           rms=1e-6), **k}), dict(grid=(2, 2)), "grid"),
     (lambda **k: fft.set_threads(**k), dict(n="2"), "n"),
+    # zone laws
+    (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(kernel="steel"), "kernel"),
+    (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(n_points=4.5), "n_points"),
+    (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(max_iter=np.nan), "max_iter"),
+    (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(batch_cells="many"), "batch_cells"),
+    (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(love=["average"]), "love"),
 ]
 
 
