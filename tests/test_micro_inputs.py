@@ -15,6 +15,7 @@ from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
 from multiscale.micro.laws import LawSpec
 from multiscale.micro.layered_asperity import LayeredAsperity, layered_law
+from multiscale.micro.post_analysis import Heating, PostAnalysis
 from multiscale.micro.surface import Surface, find_asperities, fractal_surface, load_surface, statistics
 from multiscale.micro.wear import simulate_wear, wear_step
 from multiscale.micro.zones import cut_zones, generate_zones
@@ -159,6 +160,15 @@ CASES = [
     (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(max_iter=np.nan), "max_iter"),
     (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(batch_cells="many"), "batch_cells"),
     (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(love=["average"]), "love"),
+    # post-analysis
+    (lambda **k: Heating(**{**dict(moving=DISC, fixed=PIN), **k}), dict(moving=50.0), "moving"),
+    (lambda **k: Heating(**{**dict(moving=DISC, fixed=PIN), **k}), dict(speed_step=np.nan), "speed_step"),
+    (lambda **k: PostAnalysis(**{**dict(kernel=E, shape=(8, 8), dx=1e-5, dy=1e-5, mu=0.4), **k}), dict(heating="hot"),
+     "heating"),
+    (lambda **k: PostAnalysis(**{**dict(kernel=E, shape=(8, 8), dx=1e-5, dy=1e-5, mu=0.4), **k}), dict(max_iter=np.nan),
+     "max_iter"),
+    (lambda **k: PostAnalysis(**{**dict(kernel=E, shape=(8, 8), dx=1e-5, dy=1e-5, mu=0.4), **k}), dict(substeps="2"),
+     "substeps"),
 ]
 
 
