@@ -363,7 +363,9 @@ class Roughness:
 
 
 # Default coupling of partitions and temperatures for each choice of remote temperatures, chosen by
-# measurement (docs/accuracy/coupling_bulk.md, coupling_rough.md).
+# measurement (docs/accuracy/coupling.md: with "bulk" the explicit and fixed-point schemes put
+# spurious heat jumps into the pin, the implicit one does not). With "rough" the partition does not
+# depend on the temperatures: nothing to iterate.
 COUPLING_DEFAULT = {"rough": "explicit", "bulk": "implicit"}
 
 
@@ -375,7 +377,8 @@ class Micro:
     constant one. The micro heating of the loop (issue 19): ``heating`` "steady" (§6.5) or
     "transient" over each macro step in ``heating_steps`` = N_t steps (§6.3, Table 7.1: 10);
     ``remote_temperatures`` "rough" (both bodies' at the rough body's macro surface temperature)
-    or "bulk" (each body's own: §7.2.2, §6.5); ``coupling`` of partitions and temperatures
+    or "bulk" (each body's own: §7.2.2, §6.5; the default, "rough" with effect "conductance",
+    whose h_c conducts between the bodies already); ``coupling`` of partitions and temperatures
     "explicit" (from the previous step), "fixed-point" (iterated within the step to
     ``coupling_tol`` in at most ``coupling_iterations`` passes) or "implicit" (bulk only: the
     partition at equal temperatures and the zone's exchange G as an interface conductance);
@@ -390,7 +393,7 @@ class Micro:
     tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)     # micro contact solves
     heating: str = key(Choice(("steady", "transient")), default="steady")
     heating_steps: int = key(Integer(ge=1), default=10)                       # N_t per macro step (transient)
-    remote_temperatures: str = key(Choice(("rough", "bulk")), default="rough")
+    remote_temperatures: str | None = key(Choice(("rough", "bulk")))             # default: ``remote``
     coupling: str | None = key(Choice(("explicit", "fixed-point", "implicit")))   # default: COUPLING_DEFAULT
     coupling_tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-3)   # max |dp| per pass
     coupling_iterations: int = key(Integer(ge=1), default=30)
@@ -398,18 +401,22 @@ class Micro:
     def problems(self, path, ctx):
         if self.partition_law and "heat_partition" not in ctx.effects:
             return [f'{path}.partition_law = true: needs effect "heat_partition"']
-        if self.coupling == "implicit" and self.remote_temperatures != "bulk":
+        if self.coupling == "implicit" and self.remote(ctx.effects) != "bulk":
             return [f'{path}.coupling = "implicit": conducts between the bulk temperatures; needs '
-                    f'{path}.remote_temperatures = "bulk"']
+                    f'{path}.remote_temperatures = "bulk" (and no effect "conductance")']
         if self.remote_temperatures == "bulk" and "conductance" in ctx.effects:
             return [f'{path}.remote_temperatures = "bulk": the micro heating conducts between the two bodies '
                     f'already; effect "conductance" would conduct twice (drop one)']
         return []
 
-    @property
-    def coupling_scheme(self) -> str:
+    def remote(self, effects) -> str:
+        """``remote_temperatures``, or its default for the scene's ``effects``: "bulk" (thesis
+        §7.2.2), "rough" with effect "conductance"."""
+        return self.remote_temperatures or ("rough" if "conductance" in effects else "bulk")
+
+    def coupling_scheme(self, effects) -> str:
         """``coupling``, or its default for the remote temperatures (``COUPLING_DEFAULT``)."""
-        return self.coupling or COUPLING_DEFAULT[self.remote_temperatures]
+        return self.coupling or COUPLING_DEFAULT[self.remote(effects)]
 
 
 # Default k_w(T) [(K, 1/Pa)]: the shape of thesis Fig. 7.9 (sintered pad material, [Mann 2017]):

@@ -81,8 +81,8 @@ def _effect_line(scene: Scene, effect: str) -> str:
     if effect == "heat_partition" and scene.has("roughness") and scene.micro.partition_law:
         m = scene.micro
         heating = f"transient, N_t = {m.heating_steps}" if m.heating == "transient" else "steady"
-        return (f"micro partition per zone ({heating} heating, remote temperatures: {m.remote_temperatures}, "
-                f"{m.coupling_scheme} coupling; {scene.partition:.3g} before the first)")
+        return (f"micro partition per zone ({heating} heating, remote temperatures: {m.remote(scene.effects)}, "
+                f"{m.coupling_scheme(scene.effects)} coupling; {scene.partition:.3g} before the first)")
     if effect == "heat_partition":
         share = f"{scene.partition:.3g}" + (" (effusivity)" if i.partition == "effusivity" else "")
         return f"share {share} of mu p |v| into the {scene.bodies[0]}"

@@ -280,7 +280,7 @@ def test_track_spread_conserves_the_volume():
 def test_scene_rules_of_the_thermal_coupling(tmp_path):
     text = scene_text(tmp_path / "x")
     with pytest.raises(SceneError, match="implicit"):
-        loads(text.replace("partition_law = true", 'partition_law = true\ncoupling = "implicit"'))
+        loads(text.replace("partition_law = true", 'partition_law = true\ncoupling = "implicit"\nremote_temperatures = "rough"'))
     with pytest.raises(SceneError, match="conduct twice"):
         loads(scene_text(tmp_path, micro='remote_temperatures = "bulk"', effects=', "conductance"'))
     wear = text.replace('"roughness"]', '"roughness", "wear"]') + '[wear]\nk_w = "1e-14 1/Pa"\n'
@@ -290,7 +290,12 @@ def test_scene_rules_of_the_thermal_coupling(tmp_path):
     assert any("k_w is ignored" in w for w in scene.warnings)
     assert scene.materials["pin"].wear_rate == ((293.15, 473.15), (1e-14, 2e-14))
     bulk = loads(scene_text(tmp_path, micro='remote_temperatures = "bulk"'))
-    assert bulk.micro.coupling_scheme == "implicit" and loads(text).micro.coupling_scheme == "explicit"
+    e = bulk.effects
+    assert bulk.micro.coupling_scheme(e) == "implicit" and loads(text).micro.coupling_scheme(e) == "implicit"
+    rough = loads(scene_text(tmp_path, micro='remote_temperatures = "rough"'))
+    assert rough.micro.coupling_scheme(e) == "explicit"
+    hc = loads(scene_text(tmp_path, effects=', "conductance"'))      # h_c conducts: equal remote temperatures
+    assert hc.micro.remote(hc.effects) == "rough" and hc.micro.coupling_scheme(hc.effects) == "explicit"
     from multiscale.scene_summary import summary
     assert any("calibrated" in line or "level set so that" in line
                for line in summary(loads(wear.replace('k_w = "1e-14 1/Pa"', "substeps = 1"))))

@@ -66,7 +66,8 @@ def post_analysis(scene, zone) -> PostAnalysis:
         heating = Heating(ThermalMaterial(counter.kappa, counter.diffusivity),
                           ThermalMaterial(rough.kappa, rough.diffusivity),
                           transient_steps=m.heating_steps if m.heating == "transient" else 0,
-                          bounded=m.remote_temperatures == "rough", conduction=m.coupling_scheme == "implicit")
+                          bounded=m.remote(scene.effects) == "rough",
+                          conduction=m.coupling_scheme(scene.effects) == "implicit")
     wear = scene.has("wear")
     rate = (rough.wear_rate if rough.k_w is not None else scene.wear.rate) if wear else None
     counter_rate = counter.wear_rate if wear and counter.k_w is not None else None
@@ -95,7 +96,8 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
     check_rough_scene(scene)              # before meshing
     tm = build_mesh(scene, comm)
     rough = build_rough_interface(scene, tm, progress=progress)
-    exchange = scene.has("heat_partition") and scene.micro.partition_law and scene.micro.coupling_scheme == "implicit"
+    exchange = (scene.has("heat_partition") and scene.micro.partition_law
+                and scene.micro.coupling_scheme(scene.effects) == "implicit")
     model = build_model(scene, comm, law=rough.law, tm=tm, conductance=scene.has("conductance") or exchange)
     t, wear = scene.time, scene.has("wear")
     mu = np.concatenate([np.full(g.n_zones, friction_coefficient(scene, n)) for n, g in zip(rough.names, rough.grids)])
@@ -104,7 +106,7 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
                             partition_law=scene.micro.partition_law, wear=wear,
                             wear_every=scene.wear.update_every if wear else 1,
                             forces=interface_forces(scene, tm), friction=mu,
-                            remote=scene.micro.remote_temperatures, coupling=scene.micro.coupling_scheme,
+                            remote=scene.micro.remote(scene.effects), coupling=scene.micro.coupling_scheme(scene.effects),
                             coupling_tol=scene.micro.coupling_tol, coupling_iterations=scene.micro.coupling_iterations)
     return Multiscale(model, rough, post_analysis(scene, rough.zones[0]), settings, fingerprint(scene))
 
