@@ -298,7 +298,8 @@ class Thermal:
             old.x.array[:] = new.x.array
         self.problem.solve()
         snes = self.problem.solver
-        ok = snes.getConvergedReason() > 0 and all(np.isfinite(T.x.array).all() for T in self.T)
+        finite = bool(self.tm.comm.allreduce(all(np.isfinite(T.x.array).all() for T in self.T), op=MPI.LAND))
+        ok = snes.getConvergedReason() > 0 and finite             # the same answer on every rank
         if not ok:
             raise ConvergenceError(f"heat step at t = {self.time + dt:.6g} s failed "
                                    f"(SNES reason {snes.getConvergedReason()}, "
