@@ -44,8 +44,8 @@ def main():
             rows[name].append((wall, float(np.median(h["time_micro"][1:])), float(np.max(h["micro_max_temperature"])),
                                float(np.mean(h["partition_mean"])), os.getloadavg()[0]))
     if comm.rank == 0:
-        print(f"| micro heating | wall median [s] | walls [s] | post-analysis per step, median [s] | "
-              f"micro max T [degC] | mean partition | load avg |")
+        print("| micro heating | wall median [s] | walls [s] | post-analysis per step, median [s] | "
+              "micro max T [degC] | mean partition | load avg |")
         print("|---|---|---|---|---|---|---|")
         for name, r in rows.items():
             print(f"| {name} | {statistics.median(x[0] for x in r):.1f} | {', '.join(f'{x[0]:.1f}' for x in r)} | "

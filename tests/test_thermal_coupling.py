@@ -243,8 +243,8 @@ def test_wear_sheds_load_from_the_most_loaded_zones(tmp_path):
 
 
 def test_counter_face_wears_along_its_track_with_its_own_rate_and_outputs(tmp_path):
-    """The disc's material k_w: its worn volume = k_w x frictional work (constant k_w, exactly as
-    the pin's), spread along the track (the gap of the pin's facets opens by the disc's depth);
+    """The disc's material k_w: its worn volume = k_w x frictional work (constant k_w, as the
+    pin's), spread along the track (the gap of the pin's facets opens by the disc's depth);
     transient micro heating (N_t = 3): flash temperature per zone in the history (NaN where
     unloaded, its max the micro max) and as an interface field; a zone-less rank is fine."""
     from multiscale.workflows.multiscale import run
@@ -255,7 +255,11 @@ def test_counter_face_wears_along_its_track_with_its_own_rate_and_outputs(tmp_pa
     result = run(loads(text), verbose=False)
     h = result.history
     work = h["frictional_work"][-1]
-    assert h["counter_wear_volume"][-1] == pytest.approx(4e-15 * work, rel=1e-9)
+    # both volumes are k_w x the micro frictional work (the same increments): exactly in ratio; the
+    # macro work differs by the speed's variation over a zone (its patch slides at its centre's
+    # speed: measured 0.4 %)
+    assert h["counter_wear_volume"][-1] == pytest.approx(0.4 * h["wear_volume"][-1], rel=1e-9)
+    assert h["counter_wear_volume"][-1] == pytest.approx(4e-15 * work, rel=1e-2)
     assert h["wear_volume"][-1] == pytest.approx(1e-14 * work, rel=1e-2)
     assert 0 < h["counter_wear_max_depth"][-1] < h["wear_max_depth"][-1]
     flash = h["zone_flash_temperature"]
