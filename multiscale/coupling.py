@@ -22,11 +22,11 @@ Remote temperatures of the micro heating (``LoopSettings.remote``). "bulk": each
 surface temperature at the zone (thesis §7.2.2, §6.5: the heat conducted from the hotter body
 through the contact spots is part of the heat into the rough body, whose share of the frictional
 heat may then leave [0, 1]). "rough": both at the rough body's (the partition then depends on the
-contact and the speed only); a departure from the thesis kept as an option (and the default, so
-that scenes keep their results) because the explicit coupling oscillates with the bulk
-temperatures: a hotter rough body sends its heat back through the partition of the next step,
-more than it received (the micro model's zone-scale heating comes on top of the macro field's,
-which holds it already), and the partition swings from step to step.
+contact and the speed only); a departure from the thesis, the loop's behaviour before issue 19,
+kept as an option (and the scenes' default with an interface conductance, which conducts between
+the bulk temperatures itself): with the bulk temperatures the explicit coupling swings, a hotter
+rough body sending its heat back through the partition of the next step. The scenes' default is
+"bulk" with the implicit coupling (below).
 
 Coupling of partitions and temperatures (``LoopSettings.coupling``); residual of a step: max over
 the loaded zones of |heat into the rough body by the post-analysis at the end of the step − the
