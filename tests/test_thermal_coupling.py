@@ -2,7 +2,6 @@
 remote temperatures, converged by the fixed point or the implicit exchange; the loop's micro
 result against the standalone solvers (§6.5); energy bookkeeping; wear that sheds load; wear of
 the counter-face along its track; transient micro heating and flash temperatures in the outputs."""
-from pathlib import Path
 
 import numpy as np
 import pytest
@@ -19,36 +18,20 @@ from multiscale.micro.surface import Surface, fractal_surface  # noqa: E402
 from multiscale.micro.zones import cut_zones  # noqa: E402
 from multiscale.rough import track_spread  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
+from test_coupling import POD  # noqa: E402
 
-BASE = (Path(__file__).resolve().parent / "data" / "pin_on_disc_base.toml").read_text()
-SCENE = """
-name = "pod_thermal"
-effects = ["contact", "friction", "thermal", "heat_partition", "roughness"{effects}]
-[geometry]
-builder = "pin_on_disc"
-mesh_size = "15 mm"
-holder_mesh_size = "6 mm"
-interface_mesh_size = "2.5 mm"
-track_mesh_size = "8 mm"
-{base}
-[interface]
-partition = 0.14
-[roughness]
-body = "pin"
-rms = "10 um"
-hurst = 0.6
-k_min = 1
-k_max = 8
-seed = 3
-[micro]
-zones = {zones}
-grid = [16, 16]
-law_points = 8
-partition_law = true
-{micro}
-[output]
-folder = "{folder}"
-""".replace("{base}", BASE)
+def _edit(text: str, *pairs: tuple[str, str]) -> str:
+    for old, new in pairs:
+        assert old in text, old
+        text = text.replace(old, new)
+    return text
+
+
+# test_coupling's rough pin-on-disc without expansion and wear, zones, [micro] and effects to fill in
+SCENE = _edit(POD, ('name = "pod_rough"', 'name = "pod_thermal"'),
+              ('"heat_partition", "expansion", "roughness", "wear"]', '"heat_partition", "roughness"{effects}]'),
+              ("zones = [5, 5]", "zones = {zones}"),
+              ('partition_law = true\n[wear]\nk_w = "1e-14 1/Pa"\nsubsteps = 2\n', "partition_law = true\n{micro}\n"))
 DISC, PIN = ThermalMaterial(50.0, 1e-5), ThermalMaterial(35.0, 8.3e-6)      # the base scene's materials
 
 
