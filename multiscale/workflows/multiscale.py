@@ -26,7 +26,7 @@ import h5py
 import numpy as np
 from mpi4py import MPI
 
-from multiscale import checkpoint, io
+from multiscale import checkpoint, io, outputs
 from multiscale.coupling import LoopSettings, Multiscale
 from multiscale.errors import InputError
 from multiscale.macro.output import FieldOutput
@@ -81,9 +81,11 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
     if not scene.has("roughness"):
         raise InputError("effects", sorted(scene.effects), 'the multiscale loop needs effect "roughness"')
     check_rough_scene(scene)              # before meshing
-    tm = build_mesh(scene, comm)
-    rough = build_rough_interface(scene, tm, progress=progress)
-    model = build_model(scene, comm, law=rough.law, tm=tm)
+    with io.stage("meshing"):
+        tm = build_mesh(scene, comm)
+    with io.stage("model set-up"):
+        rough = build_rough_interface(scene, tm, progress=progress)
+        model = build_model(scene, comm, law=rough.law, tm=tm)
     t, wear = scene.time, scene.has("wear")
     mu = np.concatenate([np.full(g.n_zones, friction_coefficient(scene, n)) for n, g in zip(rough.names, rough.grids)])
     settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature,
@@ -111,28 +113,34 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     steps = scene.time.steps if (ms.model.thermal is not None or scene.has("wear")) else 0
     every = scene.output.every
     if resume:
-        done, history, written = dataclasses.astuple(ms.restore(ckpt))
+        with io.stage("restoring the checkpoint"):
+            done, history, written = dataclasses.astuple(ms.restore(ckpt))
     else:
-        first = ms.start()
+        with io.stage("zone laws and first solve"):
+            first = ms.start()
         done, history, written = 0, io.History(), -1
         history.append(**ms.record(first))
         ms.save(ckpt, 0, history)
     ms.rough.pool.progress = False
-    writer = FieldOutput(ms.model, folder, scene.output.fields, extra=ms.facet_fields(), append=resume)
+    plan = outputs.plan(scene)
+    writer = FieldOutput(ms.model, folder, plan.body_fields + plan.interface_fields, extra=ms.facet_fields(),
+                         append=resume)
     if written < done and (done % every == 0 or done == steps):
         writer.write()
         ms.mark_fields(ckpt, done, comm)
     last = steps if stop_after is None else min(steps, stop_after)
-    for n in io.progress(range(done + 1, last + 1), comm, desc=scene.name, unit="step", initial=done, total=steps):
-        history.append(**ms.record(ms.step(n)))
-        ms.save(ckpt, n, history)
-        if n % every == 0 or n == steps:
-            writer.write()
-            ms.mark_fields(ckpt, n, comm)
-        done = n
-    h5, png = write_history(history, folder, scene.name, comm)
-    plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
-    result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones] + maps, _time.perf_counter() - start,
+    with io.stage("macro steps"):
+        for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
+            history.append(**ms.record(ms.step(n)))
+            ms.save(ckpt, n, history)
+            if n % every == 0 or n == steps:
+                writer.write()
+                ms.mark_fields(ckpt, n, comm)
+            done = n
+    with io.stage("writing history and plots"):
+        h5, png = write_history(history, folder, scene.name, comm)
+        plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
+    result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones, ckpt] + maps, _time.perf_counter() - start,
                               history, h5, png, writer.files, plot, maps, zones, done)
     del ms, writer            # the model holds reference cycles of PETSc objects: free them on every
     gc.collect()              # rank at the same point (collected later, ranks could hang at exit)

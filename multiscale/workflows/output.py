@@ -4,6 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from multiscale import io
 from multiscale.errors import SceneError
 
 
@@ -29,4 +30,5 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
     if comm.rank == 0:
         folder.mkdir(parents=True, exist_ok=True)
     comm.barrier()
+    io.reporter().folder = folder         # where a failed run leaves its provenance
     return folder
