@@ -28,6 +28,10 @@ class SceneError(InputError):
         self.name, self.value, self.allowed = "scene", None, self.problems[0] if self.problems else ""
 
 
+class OutputError(MultiscaleError, OSError):
+    """A result could not be written (disk full, read-only folder, ...); raised on every rank."""
+
+
 class ConvergenceError(MultiscaleError, RuntimeError):
     """An iterative solver stopped before reaching its tolerance.
 

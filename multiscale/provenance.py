@@ -18,7 +18,7 @@ from importlib import metadata
 from pathlib import Path
 
 from multiscale import __version__
-from multiscale.schema import (Choice, Curve, Either, FilePath, FrozenMap, ListOf, Named, OnlyWith, Quantity, Section, TableOr,
+from multiscale.schema import (Choice, Curve, Either, FilePath, ListOf, Named, OnlyWith, Quantity, Section, TableOr,
                                Tables, fields_of)
 from multiscale.scene import EFFECTS, Scene
 from multiscale.scene_geometry import FileGeometry, LengthUnit, Points

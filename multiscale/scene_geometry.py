@@ -19,13 +19,15 @@ from pathlib import Path
 from multiscale.errors import InputError
 from multiscale.geometry import GeometrySpec, Rotation, builder, builder_names
 from multiscale.schema import (Bad, Choice, FilePath, FrozenMap, Integer, ListOf, Named, OneOf, Quantity,
-                               Section, Text, Vector, key, read, show, unknown_keys)
+                               Section, Text, Vector, key, parse, read, show, unknown_keys)
 from multiscale.schema import reference as schema_reference
 from multiscale.units import UnitError, to_si
 
 _LENGTH = Quantity("length", gt=0)
 _POINT = Vector(Quantity("length"))
 _DIRECTION = Vector(Quantity("dimensionless"))
+# plausible builder parameters by kind (SI; warned outside): lengths of a tribometer or brake part
+_PLAUSIBLE = {"length": (1e-5, 10.0), "angle": (0.0, 6.2832)}
 FILE_TYPES = {".msh": "mesh", ".geo": "script", ".step": "cad", ".stp": "cad", ".iges": "cad", ".igs": "cad",
               ".brep": "cad"}
 
@@ -192,7 +194,8 @@ class Geometry:
 
 
 def _parameter_kind(module, name: str) -> str:
-    """Unit kind of a builder parameter: the module's PARAMETER_KINDS, else angle/length by name."""
+    """Unit kind of a builder parameter: the module's PARAMETER_KINDS ("count": a whole number),
+    else angle/length by name."""
     kinds = getattr(module, "PARAMETER_KINDS", {})
     return kinds.get(name, "angle" if "angle" in name else "length")
 
@@ -239,11 +242,10 @@ class GeometrySection(Section):
         for param, value in given.items():
             if param in module.DEFAULTS:
                 zero_ok = float(module.DEFAULTS[param]) == 0.0    # 0 means "builder's fallback"
-                parser = Quantity(_parameter_kind(module, param), **({"ge": 0} if zero_ok else {"gt": 0}))
-                try:
-                    params[param] = parser(value, ctx)
-                except Bad as exc:
-                    ctx.problems.append(f"{path}.{param} = {show(value)}: {exc}")
+                kind = _parameter_kind(module, param)
+                parser = Integer(ge=0 if zero_ok else 1) if kind == "count" else \
+                    Quantity(kind, **({"ge": 0} if zero_ok else {"gt": 0}), plausible=_PLAUSIBLE.get(kind))
+                params[param] = parse(parser, value, f"{path}.{param}", ctx)
         if len(ctx.problems) > before:
             return None
         return self._describe(name, module, FrozenMap(params), params, ctx)

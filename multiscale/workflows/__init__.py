@@ -53,14 +53,15 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                                  status=f"failed: {type(exc).__name__}: {exc}")
             raise
     result.files += [f.with_suffix(".h5") for f in result.files if f.suffix == ".xdmf"]   # their data
-    if comm.rank == 0:
-        result.files += provenance.write(result.folder, scene, ranks=comm.size, started=started,
-                                         stages=reporter.times, wall_time=time.perf_counter() - start,
-                                         analysis=kind, status="resumed and finished" if resume else "finished")
-        script = result.folder / "paraview.py"
+    script = result.folder / "paraview.py"
+
+    def write():
+        files = provenance.write(result.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
+                                 wall_time=time.perf_counter() - start, analysis=kind,
+                                 status="resumed and finished" if resume else "finished")
         script.write_text(outputs.paraview_script(outputs.plan(scene)))
-        result.files.append(script)
-    comm.barrier()
+        return files + [script]
+    result.files += comm.bcast(io.on_root(comm, write, f"the provenance into {result.folder}"), root=0)
     return result
 
 
