@@ -98,7 +98,7 @@ def _section(name, parser, v) -> dict:
     if name == "geometry":
         if isinstance(v.params, FileGeometry):
             return _table(FileGeometry, v.params)
-        return {"builder": (v.builder, ""), **{k: (float(x), "") for k, x in v.resolved().items()}}
+        return {"builder": (v.builder, ""), **{k: (x if isinstance(x, int) else float(x), "") for k, x in v.resolved().items()}}
     if name == "interfaces":
         out = {}
         for n, s in v.items():

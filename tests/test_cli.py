@@ -184,7 +184,16 @@ def test_version_prints_the_package_version(capsys):
     assert stop.value.code == 0 and capsys.readouterr().out.strip() == f"multiscale {__version__}"
 
 
-@pytest.mark.parametrize("command", [[], ["info"], ["check"], ["run"], ["study"]])
+def _commands():
+    """[] (the top level) and every subcommand the parser knows."""
+    import argparse
+
+    from multiscale.cli import build_parser
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    return [[]] + [[name] for name in sub.choices]
+
+
+@pytest.mark.parametrize("command", _commands(), ids=lambda c: " ".join(c) or "multiscale")
 def test_help_is_plain_text_and_names_the_environments_mpiexec(command, capsys):
     import re
     with pytest.raises(SystemExit):

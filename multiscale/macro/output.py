@@ -12,7 +12,8 @@ writes every function as its own grid (coincident unnamed blocks in ParaView).
 - ``FieldWriter``: the series of a set of meshes; the mesh is gathered to rank 0 once in a
   rank-independent order (nodes sorted by coordinates, cells by their nodes), so that a run
   resumed on another number of ranks appends to the same files. Files are closed after every
-  write: a run killed between two writes leaves them readable.
+  write: a run killed between two writes leaves them readable; the resumed run drops the times
+  the killed one wrote after its checkpoint, and replaces a time written again: no time twice.
 - ``FieldOutput``: a model's requested fields (``output.fields``) refreshed and written at each
   output time; ``write_state`` writes one state (the squeal analysis' preload).
 - ``write_modes``: complex mode shapes, one VTX (ADIOS2, ``.bp``) file per body holding the real and
@@ -30,7 +31,8 @@ import numpy as np
 from dolfinx import fem
 from dolfinx.io import VTXMeshPolicy, VTXWriter
 
-from multiscale.errors import InputError
+from multiscale import io
+from multiscale.errors import InputError, OutputError
 from multiscale.outputs import FIELDS, array_name
 
 # DOLFINx cell name -> (XDMF topology type, DOLFINx vertex order -> XDMF/VTK order)
@@ -110,20 +112,28 @@ def is_cell_field(f: fem.Function) -> bool:
 class SeriesFile:
     """One XDMF/HDF5 time series of one mesh (rank 0 writes; see module docstring)."""
 
-    def __init__(self, path: Path, layout: MeshLayout, append: bool = False):
+    def __init__(self, path: Path, layout: MeshLayout):
         self.path, self.h5, self.layout = Path(path), Path(path).with_suffix(".h5"), layout
-        if layout.comm.rank != 0:
-            return
-        if append and self.h5.is_file():
-            with h5py.File(self.h5, "r") as f:
-                if f["mesh/geometry"].shape != layout.geometry.shape:
-                    raise InputError("output", str(self.h5), "holds another mesh than this run's (resume with "
-                                     "the same scene)")
-            return
-        with h5py.File(self.h5, "w") as f:
-            f.create_dataset("mesh/geometry", data=layout.geometry).attrs["unit"] = "m"
-            f.create_dataset("mesh/topology", data=layout.topology).attrs["cell_type"] = layout.cell_type
-            f.create_dataset("times", data=np.zeros(0), maxshape=(None,)).attrs["unit"] = "s"
+
+    def start(self, resume_at: float | None = None) -> None:
+        """Create the files (rank 0), or with ``resume_at`` [s] continue those of a run resumed from
+        a checkpoint at that time: the times after it, written by the run that was killed, are dropped
+        (the resumed run writes them again, once)."""
+        if resume_at is None or not self.h5.is_file():
+            with h5py.File(self.h5, "w") as f:
+                f.create_dataset("mesh/geometry", data=self.layout.geometry).attrs["unit"] = "m"
+                f.create_dataset("mesh/topology", data=self.layout.topology).attrs["cell_type"] = self.layout.cell_type
+                f.create_dataset("times", data=np.zeros(0), maxshape=(None,)).attrs["unit"] = "s"
+        else:
+            with h5py.File(self.h5, "a") as f:
+                if f["mesh/geometry"].shape != self.layout.geometry.shape:
+                    raise OutputError(f"{self.h5} holds another mesh than this run's (resume with the same scene)")
+                times = f["times"][...]
+                keep = int(np.count_nonzero(times <= resume_at))
+                for k in range(keep, len(times)):
+                    if f"data/{k}" in f:
+                        del f[f"data/{k}"]
+                f["times"].resize((keep,))
         self._write_xml()
 
     def write(self, time: float, arrays: Mapping[str, tuple]) -> None:
@@ -177,17 +187,17 @@ class SeriesFile:
 
 class FieldWriter:
     """Time series ``<folder>/<name>.xdmf`` (+ ``.h5``) of named meshes, each with its fields
-    (``{field: Function}``, the keys among ``io.FIELDS``); ``append`` continues existing files (a
-    resumed run). Collective."""
+    (``{field: Function}``, the keys among ``io.FIELDS``); ``resume_at`` [s]: continue the existing
+    files of a run resumed from a checkpoint at that time (``SeriesFile.start``). Collective: a file
+    that cannot be written or continued is an ``OutputError`` on every rank."""
 
-    def __init__(self, folder: Path, groups: Sequence[tuple], append: bool = False):
-        self.groups = []
-        for name, mesh, functions in groups:
-            if not functions:
-                continue
-            layout = MeshLayout(mesh)
-            self.groups.append((SeriesFile(Path(folder) / f"{name}.xdmf", layout, append), dict(functions)))
+    def __init__(self, folder: Path, groups: Sequence[tuple], resume_at: float | None = None):
+        self.groups = [(SeriesFile(Path(folder) / f"{name}.xdmf", MeshLayout(mesh)), dict(functions))
+                       for name, mesh, functions in groups if functions]
         self.files = [s.path for s, _ in self.groups]
+        if self.groups:
+            io.on_root(self.groups[0][0].layout.comm, lambda: [s.start(resume_at) for s, _ in self.groups],
+                       f"the field files in {folder}")
 
     def write(self, time: float) -> None:
         for series, functions in self.groups:
@@ -206,10 +216,11 @@ class FieldOutput:
 
     ``extra``: {interface field name: callable returning its global per-facet array}, written when
     the name is among ``fields`` (they replace the built-in ones of the same name: the frictional
-    ``heat_flux`` and ``partition``); ``append``: continue existing files (a resumed run)."""
+    ``heat_flux`` and ``partition``); ``resume_at`` [s]: continue the files of a run resumed at that
+    time (``FieldWriter``)."""
 
     def __init__(self, model, folder: Path, fields, extra: Mapping[str, Callable] | None = None,
-                 append: bool = False, mechanics=None, thermal=None):
+                 resume_at: float | None = None, mechanics=None, thermal=None):
         self.model = model
         tm = model.tm if model is not None else mechanics.tm
         mech = model.mechanics if model is not None else mechanics
@@ -236,7 +247,7 @@ class FieldOutput:
         self.interface = [(tm.interface.field(name), make) for name, make in makers.items() if name in fields]
         groups = [(b.name, b.mesh, body[i]) for i, b in enumerate(tm.bodies)]
         groups.append(("interface", tm.interface.mesh, {f.name: f for f, _ in self.interface}))
-        self.writer = FieldWriter(folder, groups, append=append)
+        self.writer = FieldWriter(folder, groups, resume_at=resume_at)
         self.files = self.writer.files
 
     def write(self, time: float | None = None) -> None:

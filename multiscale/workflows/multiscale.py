@@ -127,7 +127,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     ms.rough.pool.progress = False
     plan = outputs.plan(scene)
     writer = FieldOutput(ms.model, folder, plan.body_fields + plan.interface_fields, extra=ms.facet_fields(),
-                         append=resume)
+                         resume_at=ms.model.time if resume else None)
     if written < done and (done % every == 0 or done == steps):
         writer.write()
         ms.mark_fields(ckpt, done, comm)

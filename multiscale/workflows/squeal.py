@@ -80,7 +80,8 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     if rough is not None:
         with io.stage("zone laws"):
             rough.update_laws()
-    mech = build_mechanics(scene, tm, law=rough.law if rough else None, degree=degree, prefix=prefix)
+    with io.stage("model set-up"):       # function spaces, forms compiled (cached after the first run)
+        mech = build_mechanics(scene, tm, law=rough.law if rough else None, degree=degree, prefix=prefix)
     if rough is not None:            # Newton starts at rest from the rigid datum gap
         tm.interface.set_field(mech.contact.initial_gap, rough.datum_gap(interface_forces(scene, tm)))
     return squeal_case(mech, dict(scene.materials), name, load=drive(scene, tm).load, steps=scene.loading.ramp_steps,
