@@ -124,17 +124,20 @@ class SeriesFile:
                 f.create_dataset("mesh/geometry", data=self.layout.geometry).attrs["unit"] = "m"
                 f.create_dataset("mesh/topology", data=self.layout.topology).attrs["cell_type"] = self.layout.cell_type
                 f.create_dataset("times", data=np.zeros(0), maxshape=(None,)).attrs["unit"] = "s"
-        else:
+            self._write_xml()
+            return
+        with h5py.File(self.h5, "r") as f:
+            if f["mesh/geometry"].shape != self.layout.geometry.shape:
+                raise OutputError(f"{self.h5} holds another mesh than this run's (resume with the same scene)")
+            times = f["times"][...]
+        keep = int(np.count_nonzero(times <= resume_at))
+        if keep < len(times):
             with h5py.File(self.h5, "a") as f:
-                if f["mesh/geometry"].shape != self.layout.geometry.shape:
-                    raise OutputError(f"{self.h5} holds another mesh than this run's (resume with the same scene)")
-                times = f["times"][...]
-                keep = int(np.count_nonzero(times <= resume_at))
                 for k in range(keep, len(times)):
                     if f"data/{k}" in f:
                         del f[f"data/{k}"]
                 f["times"].resize((keep,))
-        self._write_xml()
+            self._write_xml()
 
     def write(self, time: float, arrays: Mapping[str, tuple]) -> None:
         """Write ``arrays`` {field: (values, "Node" or "Cell")} at ``time`` (an existing time is
@@ -200,14 +203,15 @@ class FieldWriter:
                        f"the field files in {folder}")
 
     def write(self, time: float) -> None:
+        """Every group's fields at ``time`` [s] (collective; a failed write is an OutputError on every rank)."""
+        written = []
         for series, functions in self.groups:
             lay = series.layout
-            arrays = {k: (lay.cell_values(f), "Cell") if is_cell_field(f) else (lay.point_values(f), "Node")
-                      for k, f in functions.items()}
-            if lay.comm.rank == 0:
-                series.write(float(time), arrays)
-        for series, _ in self.groups[:1]:
-            series.layout.comm.barrier()
+            written.append((series, {k: (lay.cell_values(f), "Cell") if is_cell_field(f) else
+                                     (lay.point_values(f), "Node") for k, f in functions.items()}))
+        if self.groups:
+            io.on_root(self.groups[0][0].layout.comm, lambda: [s.write(float(time), a) for s, a in written],
+                       f"the fields at t = {time:g} s")
 
 
 class FieldOutput:
