@@ -1,18 +1,21 @@
 """A run killed and resumed writes what the uninterrupted run writes (issues 21 and 22).
 
-A rough pin-on-disc (4 macro steps, fields at every step) is run once uninterrupted. The same scene
-is started by ``multiscale run`` in a subprocess, killed with SIGKILL while it computes step 3
-(after the checkpoint and the fields of step 2), and continued with ``multiscale run --resume``:
-the history equals the uninterrupted one (to the solver tolerance of the recomputed zone laws, as
-in test_coupling), every field file holds each output time exactly once, the same times, and
-nothing printed an HDF5 error. A second test leaves the field files AHEAD of the checkpoint (the
-state of a run killed after writing fields but before its next checkpoint was complete): the
-resumed run drops those ghost times (they are gone when it stops again) and writes them again, once."""
+A rough pin-on-disc (4 macro steps, fields at every step) is started by ``multiscale run`` in a
+subprocess (alone, and under ``mpiexec -n 2``); one process is killed with SIGKILL while it
+computes step 3 (after the checkpoint and the fields of step 2), and the run is continued with
+``multiscale run --resume``: the history equals that of the uninterrupted run on as many processes
+(to the solver tolerance of the recomputed zone laws, as in test_coupling), every field file holds
+each output time exactly once, the same times, and nothing printed an HDF5 error. A second test
+leaves the field files AHEAD of the checkpoint (the state of a run killed after writing fields but
+before its next checkpoint was complete): the resumed run drops those ghost times (they are gone
+when it stops again) and writes them again, once."""
+import os
 import shutil
 import signal
 import subprocess
 import sys
 import time
+from io import BytesIO
 from pathlib import Path
 
 import h5py
@@ -28,6 +31,7 @@ from multiscale.outputs import plan  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 
 MULTISCALE = Path(sys.executable).with_name("multiscale")
+MPIEXEC = Path(sys.executable).with_name("mpiexec")
 
 
 def scene_text(folder: Path) -> str:
@@ -40,12 +44,8 @@ def scene_text(folder: Path) -> str:
 
 
 @pytest.fixture(scope="module")
-def uninterrupted(tmp_path_factory):
-    from multiscale.workflows import run
-    folder = tmp_path_factory.mktemp("straight") / "out"
-    scene = loads(scene_text(folder))
-    assert scene.time.steps == 4 and scene.output.every == 1
-    return scene, run(scene, verbose=False)
+def base(tmp_path_factory):
+    return tmp_path_factory.mktemp("killed")
 
 
 def field_times(folder: Path) -> dict:
@@ -61,50 +61,98 @@ def field_times(folder: Path) -> dict:
     return out
 
 
-def same_results(folder: Path, reference) -> None:
-    scene, ref = reference
-    h, r = History.read(folder / "history.h5"), ref.history
+def uninterrupted_run(base: Path, ranks: int) -> Path:
+    """The results folder of the scene run without interruption on ``ranks`` processes."""
+    folder = base / f"straight{ranks}" / "out"
+    if not folder.is_dir():
+        folder.parent.mkdir(parents=True)
+        path = folder.parent / "scene.toml"
+        path.write_text(scene_text(folder))
+        launcher = [str(MPIEXEC), "-n", str(ranks)] if ranks > 1 else []
+        done = subprocess.run(launcher + [str(MULTISCALE), "run", str(path), "--quiet"], capture_output=True,
+                              text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+    return folder
+
+
+def same_results(folder: Path, reference: Path) -> None:
+    """History (to the solver tolerance) and field times (exactly) of ``folder`` as in ``reference``."""
+    scene = loads(scene_text(folder))
+    h, r = History.read(folder / "history.h5"), History.read(reference / "history.h5")
     assert set(h.columns) == set(r.columns) and len(h) == len(r) == scene.time.steps + 1
     for key in r.columns:
         if not key.startswith("time_"):                # wall times differ
             np.testing.assert_allclose(h[key], r[key], rtol=1e-6, atol=1e-12, err_msg=key)
     times = field_times(folder)
-    assert times == field_times(ref.folder)
+    assert times == field_times(reference)
     assert all(t == list(plan(scene).times) for t in times.values())   # each time once, exact
 
 
-def test_killed_mid_run_and_resumed_writes_the_uninterrupted_results(uninterrupted, tmp_path):
+def ranks_of(pid: int) -> list[int]:
+    """The processes below ``pid`` that run multiscale (the ranks under mpiexec), from /proc."""
+    children = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        children.setdefault(int(fields[1]), []).append(int(stat.parent.name))
+    out, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            todo.append(child)
+            try:
+                command = (Path("/proc") / str(child) / "cmdline").read_bytes().split(b"\0")
+            except OSError:
+                continue
+            if any(part.endswith(b"multiscale") for part in command) and b"mpiexec" not in command[0]:
+                out.append(child)
+    return out
+
+
+def fields_written(ckpt: Path) -> int:
+    """The last step whose fields the running job wrote (-1: none yet); read from a copy of the
+    checkpoint's bytes, so that no HDF5 lock is taken on the file the job rewrites."""
+    try:
+        with h5py.File(BytesIO(ckpt.read_bytes()), "r") as f:
+            return int(f.attrs["fields_written"])
+    except (OSError, KeyError, ValueError):
+        return -1
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_killed_mid_run_and_resumed_writes_the_uninterrupted_results(base, tmp_path, ranks):
+    """``ranks`` 2: one rank of ``mpiexec -n 2`` is killed (mpiexec ends the other), the run resumed
+    under ``mpiexec -n 2``."""
     folder = tmp_path / "out"
     path = tmp_path / "scene.toml"
     path.write_text(scene_text(folder))
     ckpt = folder / "checkpoint.h5"
-    job = subprocess.Popen([str(MULTISCALE), "run", str(path), "--quiet"], stdout=subprocess.PIPE,
-                           stderr=subprocess.PIPE, text=True)
+    launcher = [str(MPIEXEC), "-n", str(ranks)] if ranks > 1 else []
+    job = subprocess.Popen(launcher + [str(MULTISCALE), "run", str(path), "--quiet"], stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True, start_new_session=True)
     try:
         deadline = time.monotonic() + 300
-        while time.monotonic() < deadline and job.poll() is None:
-            try:                                    # the checkpoint is replaced atomically
-                with h5py.File(ckpt, "r") as f:
-                    if int(f.attrs["fields_written"]) >= 2:     # step 2 done: now computing step 3
-                        break
-            except (OSError, KeyError):
-                pass
-            time.sleep(0.05)
-        job.send_signal(signal.SIGKILL)
+        while time.monotonic() < deadline and job.poll() is None and fields_written(ckpt) < 2:
+            time.sleep(0.05)                    # after step 2's checkpoint and fields: computing step 3
+        victims = ranks_of(job.pid)[-1:] if ranks > 1 else [job.pid]
+        assert victims and job.poll() is None, "the run was to be killed mid-run; it ended"
+        os.kill(victims[0], signal.SIGKILL)
         _, err = job.communicate(timeout=60)
     finally:
-        job.kill()
-    assert job.returncode == -signal.SIGKILL, f"the run was to be killed mid-run; it ended: {err}"
+        if job.poll() is None:
+            os.killpg(job.pid, signal.SIGKILL)
+    assert job.returncode != 0, err
     with h5py.File(ckpt, "r") as f:
         assert 2 <= int(f.attrs["step"]) < 4 and "finished" not in f.attrs
-    resumed = subprocess.run([str(MULTISCALE), "run", str(path), "--resume", "--quiet"], capture_output=True,
-                             text=True, timeout=300)
+    resumed = subprocess.run(launcher + [str(MULTISCALE), "run", str(path), "--resume", "--quiet"],
+                             capture_output=True, text=True, timeout=300)
     assert resumed.returncode == 0, resumed.stderr
     assert "HDF5" not in resumed.stderr + resumed.stdout
-    same_results(folder, uninterrupted)
+    same_results(folder, uninterrupted_run(base, ranks))
 
 
-def test_field_times_after_the_checkpoint_are_dropped_and_written_once(uninterrupted, tmp_path):
+def test_field_times_after_the_checkpoint_are_dropped_and_written_once(base, tmp_path):
     from multiscale.workflows.multiscale import run
     folder = tmp_path / "out"
     scene = loads(scene_text(folder))
@@ -117,4 +165,4 @@ def test_field_times_after_the_checkpoint_are_dropped_and_written_once(uninterru
     run(scene, resume=True, verbose=False, stop_after=2)   # the ghosts of steps 3 and 4 are gone
     assert all(t == list(plan(scene).times[:3]) for t in field_times(folder).values())
     run(scene, resume=True, verbose=False)
-    same_results(folder, uninterrupted)
+    same_results(folder, uninterrupted_run(base, 1))
