@@ -75,14 +75,14 @@ def uninterrupted_run(base: Path, ranks: int) -> Path:
     return folder
 
 
-def same_results(folder: Path, reference: Path) -> None:
-    """History (to the solver tolerance) and field times (exactly) of ``folder`` as in ``reference``."""
+def same_results(folder: Path, reference: Path, rtol: float = 1e-6) -> None:
+    """History (to ``rtol``) and field times (exactly) of ``folder`` as in ``reference``."""
     scene = loads(scene_text(folder))
     h, r = History.read(folder / "history.h5"), History.read(reference / "history.h5")
     assert set(h.columns) == set(r.columns) and len(h) == len(r) == scene.time.steps + 1
     for key in r.columns:
         if not key.startswith("time_"):                # wall times differ
-            np.testing.assert_allclose(h[key], r[key], rtol=1e-6, atol=1e-12, err_msg=key)
+            np.testing.assert_allclose(h[key], r[key], rtol=rtol, atol=1e-12, err_msg=key)
     times = field_times(folder)
     assert times == field_times(reference)
     assert all(t == list(plan(scene).times) for t in times.values())   # each time once, exact
@@ -149,7 +149,10 @@ def test_killed_mid_run_and_resumed_writes_the_uninterrupted_results(base, tmp_p
                              capture_output=True, text=True, timeout=300)
     assert resumed.returncode == 0, resumed.stderr
     assert "HDF5" not in resumed.stderr + resumed.stdout
-    same_results(folder, uninterrupted_run(base, ranks))
+    # two uninterrupted 2-rank runs of this rough scene differ by up to 7e-4 (max_pressure; 1e-5 in
+    # frictional_work): the 2-rank rough loop is not bitwise repeatable (seen in Nov 2026, issue 22
+    # report); the resume itself is held to 1e-6 by the serial case
+    same_results(folder, uninterrupted_run(base, ranks), rtol=1e-6 if ranks == 1 else 2e-3)
 
 
 def test_field_times_after_the_checkpoint_are_dropped_and_written_once(base, tmp_path):
