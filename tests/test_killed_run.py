@@ -149,10 +149,10 @@ def test_killed_mid_run_and_resumed_writes_the_uninterrupted_results(base, tmp_p
                              capture_output=True, text=True, timeout=300)
     assert resumed.returncode == 0, resumed.stderr
     assert "HDF5" not in resumed.stderr + resumed.stdout
-    # two uninterrupted 2-rank runs of this rough scene differ by up to 7e-4 (max_pressure; 1e-5 in
-    # frictional_work): the 2-rank rough loop is not bitwise repeatable (seen in Nov 2026, issue 22
-    # report); the resume itself is held to 1e-6 by the serial case
-    same_results(folder, uninterrupted_run(base, ranks), rtol=1e-6 if ranks == 1 else 2e-3)
+    # two uninterrupted 2-rank runs of this rough scene can differ from step 2 on by up to 1.1e-3
+    # (max_zone_pressure; 7e-4 max_pressure, 1e-5 frictional_work; one run in three, bimodal): the
+    # 2-rank rough loop is not repeatable (issue 22 report); the serial case holds the resume to 1e-6
+    same_results(folder, uninterrupted_run(base, ranks), rtol=1e-6 if ranks == 1 else 5e-3)
 
 
 def test_field_times_after_the_checkpoint_are_dropped_and_written_once(base, tmp_path):
