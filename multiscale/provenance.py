@@ -159,8 +159,12 @@ def versions() -> dict:
         out["dolfinx"] = loaded["dolfinx"].__version__
     if "petsc4py" in loaded:
         out["petsc"] = ".".join(map(str, loaded["petsc4py"].PETSc.Sys.getVersion()))
-    if "slepc4py" in loaded:
-        out["slepc"] = ".".join(map(str, loaded["slepc4py"].SLEPc.Sys.getVersion()))
+        try:
+            from slepc4py import SLEPc   # optional (fem extra); loaded with PETSc, versioned in every run
+        except ImportError:
+            pass
+        else:
+            out["slepc"] = ".".join(map(str, SLEPc.Sys.getVersion()))
     if "mpi4py.MPI" in loaded:
         out["mpi"] = loaded["mpi4py.MPI"].Get_library_version().strip().splitlines()[0]
     out["platform"] = platform.platform()
