@@ -96,9 +96,11 @@ def _table(cls, obj) -> dict:
 
 def _section(name, parser, v) -> dict:
     if name == "geometry":
+        limit = {"max_cells": (v.max_cells, "")}
         if isinstance(v.params, FileGeometry):
-            return _table(FileGeometry, v.params)
-        return {"builder": (v.builder, ""), **{k: (x if isinstance(x, int) else float(x), "") for k, x in v.resolved().items()}}
+            return {**_table(FileGeometry, v.params), **limit}
+        params = {k: (x if isinstance(x, int) else float(x), "") for k, x in v.resolved().items()}
+        return {"builder": (v.builder, ""), **params, **limit}
     if name == "interfaces":
         out = {}
         for n, s in v.items():
