@@ -23,6 +23,7 @@ from multiscale.macro.mechanics import Mechanics  # noqa: E402
 from multiscale.macro.output import write_modes  # noqa: E402
 from multiscale import scene as scenes  # noqa: E402
 from multiscale.workflows import squeal  # noqa: E402
+from multiscale.workflows.output import RunResult  # noqa: E402
 
 STEEL = NS(E=210e9, nu=0.3, rho=7850.0)
 MATERIALS = {"disc": NS(E=125e9, nu=0.25, rho=7200.0), "pad": NS(E=5e9, nu=0.25, rho=2500.0),
@@ -282,9 +283,13 @@ def test_multiscale_run_hands_stability_scenes_to_the_squeal_analysis(tmp_path, 
     from multiscale import workflows
 
     scene = scenes.load(DEMO, {"output.folder": str(tmp_path / "out")})
-    seen = []
-    monkeypatch.setattr(squeal, "run", lambda sc, **kw: seen.append((sc, kw)) or "squeal")
-    assert workflows.run(scene, overwrite=True, verbose=False) == "squeal"
+    seen, folder = [], tmp_path / "out"
+    folder.mkdir()
+    done = RunResult(folder, [], 0.0)
+    monkeypatch.setattr(squeal, "run", lambda sc, **kw: seen.append((sc, kw)) or done)
+    assert workflows.run(scene, overwrite=True, verbose=False) is done
     assert seen[0][0] is scene and seen[0][1]["overwrite"] is True
+    assert sorted(f.name for f in done.files) == ["paraview.py", "provenance.json", "scene.toml",
+                                                  "scene_resolved.toml"]      # the provenance beside
     with pytest.raises(InputError, match="no checkpoints"):
         workflows.run(scene, resume=True)

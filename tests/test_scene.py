@@ -350,9 +350,15 @@ def test_implausible_values_are_warned_with_their_path(tmp_path, old, new, warni
     assert scene.warnings[0].endswith("check the value and its unit")
 
 
-def test_no_shipped_scene_is_implausible():
-    for path in sorted(DEMOS.glob("*.toml")):
-        assert not [w for w in load(path).warnings if "plausible" in w], path
+@pytest.mark.parametrize("path", sorted(DEMOS.glob("*.toml")), ids=lambda p: p.stem)
+def test_no_shipped_scene_is_implausible(path):
+    try:
+        scene = load(path)
+    except SceneError as exc:          # the STEP demos need demos/cad_models.py first; the measured
+        if "no such file" not in str(exc):    # topography lies in the shared data beside the repository
+            raise
+        pytest.skip(f"{path.name}: {exc}")
+    assert not [w for w in scene.warnings if "plausible" in w], path
 
 
 def test_reference_lists_every_section_and_key():
