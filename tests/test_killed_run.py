@@ -8,7 +8,7 @@ computes step 3 (after the checkpoint and the fields of step 2), and the run is 
 each output time exactly once, the same times, and nothing printed an HDF5 error. A second test
 leaves the field files AHEAD of the checkpoint (the state of a run killed after writing fields but
 before its next checkpoint was complete): the resumed run drops those ghost times (they are gone
-when it stops again) and writes them again, once."""
+when it stops again) and writes them again, once; a --resume after the end writes nothing."""
 import os
 import shutil
 import signal
@@ -156,6 +156,7 @@ def test_killed_mid_run_and_resumed_writes_the_uninterrupted_results(base, tmp_p
 
 
 def test_field_times_after_the_checkpoint_are_dropped_and_written_once(base, tmp_path):
+    from multiscale import workflows
     from multiscale.workflows.multiscale import run
     folder = tmp_path / "out"
     scene = loads(scene_text(folder))
@@ -167,5 +168,10 @@ def test_field_times_after_the_checkpoint_are_dropped_and_written_once(base, tmp
     assert all(len(t) == 5 for t in field_times(folder).values())
     run(scene, resume=True, verbose=False, stop_after=2)   # the ghosts of steps 3 and 4 are gone
     assert all(t == list(plan(scene).times[:3]) for t in field_times(folder).values())
-    run(scene, resume=True, verbose=False)
+    result = workflows.run(scene, resume=True, verbose=False)
     same_results(folder, uninterrupted_run(base, 1))
+    # --resume once more: nothing to do, nothing written, the provenance of the run stays as it was
+    before = {f.name: f.read_bytes() for f in folder.iterdir()}
+    again = workflows.run(scene, resume=True, verbose=False)
+    assert {f.name: f.read_bytes() for f in folder.iterdir()} == before
+    assert sorted(f.name for f in again.files) == sorted(f.name for f in result.files) == sorted(plan(scene).files)

@@ -10,10 +10,11 @@ provenance (``multiscale.provenance``) and a pvpython script (``multiscale.outpu
 from __future__ import annotations
 
 import time
+from pathlib import Path
 
 from mpi4py import MPI
 
-from multiscale import io, outputs, provenance
+from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.output import RunResult
@@ -38,6 +39,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                'this scene has no checkpoints to resume from (only the multiscale loop, effect "roughness", '
                "writes checkpoints)")
         raise InputError("--resume", True, why)
+    ended = resume and checkpoint.peek(Path(scene.output.folder) / multiscale.CHECKPOINT, comm).get("finished")
     started, start = provenance.now(), time.perf_counter()
     with io.Reporter(comm, quiet=not verbose) as reporter:
         try:
@@ -53,6 +55,9 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                                  status=f"failed: {type(exc).__name__}: {exc}")
             raise
     result.files += [f.with_suffix(".h5") for f in result.files if f.suffix == ".xdmf"]   # their data
+    if ended:                 # --resume of a finished run: nothing to do, its provenance stays as it was
+        result.files += [result.folder / name for name in outputs.PROVENANCE]
+        return result
     script = result.folder / "paraview.py"
 
     def write():
