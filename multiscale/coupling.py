@@ -371,7 +371,7 @@ class Multiscale:
                                                  rough.wear_depth().mean(axis=(-2, -1))[rough.zone_of_facet], 0.0)}
         if self.post.heating is not None:
             fields["flash_temperature"] = self.facet_flash
-        if self.post.counter_rate is not None:
+        if self.settings.wear:      # zero where body 1 does not wear (no k_w of its material)
             fields["counter_wear_depth"] = lambda: self.counter_depth.copy()
         return fields
 

@@ -18,6 +18,7 @@ from typing import Callable
 
 import numpy as np
 
+from multiscale.outputs import step_time
 from multiscale.errors import InputError
 from multiscale.macro.mechanics import Mechanics, SolveResult
 from multiscale.macro.mesh import TwoBodyMesh
@@ -97,10 +98,11 @@ class MacroModel:
 
     def macro_step(self, dt: float, substeps: int = 1) -> np.ndarray:
         """Advance by one macro step dt [s] in ``substeps`` (Fig. 7.4); returns the heat [J] put
-        into each body during the step."""
+        into each body during the step. The time after the step is rounded to 12 significant
+        digits (``outputs.step_time``): output times are exact decimals, not sums of rounded steps."""
         heat, self.heat_exchanged = np.zeros(2), 0.0
-        delta = dt / substeps
-        for _ in range(substeps):
+        delta, start = dt / substeps, self.time
+        for k in range(substeps):
             if self.thermal is not None:            # the mean speed of the step for a changing speed
                 self.contact.speed.value = self.speed(self.time) if self.drive.steady else \
                     0.5 * (self.speed(self.time) + self.speed(self.time + delta))
@@ -112,7 +114,7 @@ class MacroModel:
                 done = self.thermal.step(delta)
                 heat += done.heat_in
                 self.heat_exchanged += done.heat_exchanged
-            self.time += delta
+            self.time = step_time(start, dt) if k == substeps - 1 else start + (k + 1) * delta
             self.contact.speed.value = self.speed(self.time)
             factor = self.drive.factor(self.time)
             self.contact.engaged.value = float(factor > 0)

@@ -29,7 +29,7 @@ import h5py
 import numpy as np
 from mpi4py import MPI
 
-from multiscale import checkpoint, io
+from multiscale import checkpoint, io, outputs
 from multiscale.coupling import LoopSettings, Multiscale
 from multiscale.errors import InputError
 from multiscale.geometry import Rotation
@@ -94,11 +94,13 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
     if not scene.has("roughness"):
         raise InputError("effects", sorted(scene.effects), 'the multiscale loop needs effect "roughness"')
     check_rough_scene(scene)              # before meshing
-    tm = build_mesh(scene, comm)
-    rough = build_rough_interface(scene, tm, progress=progress)
-    exchange = (scene.has("heat_partition") and scene.micro.partition_law
-                and scene.micro.coupling_scheme(scene.effects) == "implicit")
-    model = build_model(scene, comm, law=rough.law, tm=tm, conductance=scene.has("conductance") or exchange)
+    with io.stage("meshing"):
+        tm = build_mesh(scene, comm)
+    with io.stage("model set-up"):
+        rough = build_rough_interface(scene, tm, progress=progress)
+        exchange = (scene.has("heat_partition") and scene.micro.partition_law
+                    and scene.micro.coupling_scheme(scene.effects) == "implicit")
+        model = build_model(scene, comm, law=rough.law, tm=tm, conductance=scene.has("conductance") or exchange)
     t, wear = scene.time, scene.has("wear")
     mu = np.concatenate([np.full(g.n_zones, friction_coefficient(scene, n)) for n, g in zip(rough.names, rough.grids)])
     settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature,
@@ -131,30 +133,36 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     steps = scene.time.steps if (ms.model.thermal is not None or scene.has("wear")) else 0
     every = scene.output.every
     if resume:
-        done, history, written = dataclasses.astuple(ms.restore(ckpt))
+        with io.stage("restoring the checkpoint"):
+            done, history, written = dataclasses.astuple(ms.restore(ckpt))
     else:
-        first = ms.start()
+        with io.stage("zone laws and first solve"):
+            first = ms.start()
         done, history, written = 0, io.History(), -1
         history.append(**ms.record(first))
         ms.save(ckpt, 0, history)
     ms.rough.pool.progress = False
-    writer = FieldOutput(ms.model, folder, scene.output.fields, extra=ms.facet_fields(), append=resume)
+    plan = outputs.plan(scene)
+    writer = FieldOutput(ms.model, folder, plan.body_fields + plan.interface_fields, extra=ms.facet_fields(),
+                         resume_at=ms.model.time if resume else None)
     if written < done and (done % every == 0 or done == steps):
         writer.write()
         ms.mark_fields(ckpt, done, comm)
     last = steps if stop_after is None else min(steps, stop_after)
-    for n in io.progress(range(done + 1, last + 1), comm, desc=scene.name, unit="step", initial=done, total=steps):
-        history.append(**ms.record(ms.step(n)))
-        ms.save(ckpt, n, history)
-        if n % every == 0 or n == steps:
-            writer.write()
-            ms.mark_fields(ckpt, n, comm)
-        done = n
-    h5, png = write_history(history, folder, scene.name, comm)
-    plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
+    with io.stage("macro steps"):
+        for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
+            history.append(**ms.record(ms.step(n)))
+            ms.save(ckpt, n, history)
+            if n % every == 0 or n == steps:
+                writer.write()
+                ms.mark_fields(ckpt, n, comm)
+            done = n
+    with io.stage("writing history and plots"):
+        h5, png = write_history(history, folder, scene.name, comm)
+        plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
     if done == steps:
         checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
-    result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones] + maps, _time.perf_counter() - start,
+    result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones, ckpt] + maps, _time.perf_counter() - start,
                               history, h5, png, writer.files, plot, maps, zones, done)
     del ms, writer            # the model holds reference cycles of PETSc objects: free them on every
     gc.collect()              # rank at the same point (collected later, ranks could hang at exit)
@@ -171,7 +179,7 @@ def finished(folder: Path, name: str, steps: int, comm, verbose: bool) -> Multis
     history = io.History.read(folder / "history.h5")
     fields = sorted(folder.glob("*.xdmf"))
     maps = sorted(folder.glob("wear_map*.png"))
-    files = fields + [folder / n for n in ("history.h5", "history.png", "multiscale.png", "zones.h5")] + maps
+    files = fields + [folder / n for n in ("history.h5", "history.png", "multiscale.png", "zones.h5", CHECKPOINT)] + maps
     if verbose and comm.rank == 0:
         print(f"{name}: nothing to do, the run in {folder} has ended after {steps} step(s); "
               "use --overwrite to run it again")

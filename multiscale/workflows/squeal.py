@@ -10,8 +10,9 @@ of the multiscale loop (``workflows.rough``, same scene rules) gives every inter
 embedded exactly in the contact form, and the rigid datum gap where Newton starts; the Newton
 matrix at the preload then holds the laws' consistent tangent.
 
-``run`` writes into ``output.folder``: ``modes.csv``, mode shapes (``modes_body*.xdmf``),
-``pressure.png`` (Fig. 4.12), ``re_im.png`` (Fig. 4.13) and ``energy.png`` (Figs. 4.20–4.21).
+``run`` writes into ``output.folder``: ``modes.csv``, mode shapes (``modes_<body>.bp``, VTX), the
+preloaded state's fields (``<body>.xdmf``, ``interface.xdmf``), ``pressure.png`` (Fig. 4.12),
+``re_im.png`` (Fig. 4.13) and ``energy.png`` (Figs. 4.20–4.21); ``multiscale.outputs.plan``.
 """
 from __future__ import annotations
 
@@ -22,13 +23,13 @@ from typing import Mapping
 import numpy as np
 from mpi4py import MPI
 
-from multiscale import io
+from multiscale import io, outputs
 from multiscale.errors import InputError
 from multiscale.macro.eigen import Damping, ModalResult, solve_modes
 from multiscale.macro.mechanics import Mechanics
 from multiscale.macro.modal import EnergyShares, RegionEnergy, StabilityReport, stability_report, \
     strain_energy_shares
-from multiscale.macro.output import write_modes_xdmf
+from multiscale.macro.output import write_modes, write_state
 from multiscale.macro.preload import Preload, linearise, preload
 from multiscale.plots.squeal import plot_energy, plot_pressure, plot_re_im
 from multiscale.workflows.model import build_mechanics, build_mesh, drive, interface_forces
@@ -57,11 +58,14 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
                 rtol: float = 1e-6, close_tol: float = 1e-3) -> SquealCase:
     """Preload ``mech`` from rest to ``load`` [Pa or N] in ``steps``, linearise and extract the
     complex modes in ``band`` [Hz] (§4.3.1, two steps)."""
-    pre = preload(mech, load, steps)
-    K, M = linearise(mech, materials)
-    modes = solve_modes(K, M, f_min=band[0], f_max=band[1], n_modes=n_modes, target=target, damping=damping)
-    M.destroy()
-    shares = strain_energy_shares(modes, RegionEnergy(mech)) if energy else None
+    with io.stage("preload"):
+        pre = preload(mech, load, steps)
+    with io.stage("eigen solve"):
+        K, M = linearise(mech, materials)
+        modes = solve_modes(K, M, f_min=band[0], f_max=band[1], n_modes=n_modes, target=target, damping=damping)
+        M.destroy()
+    with io.stage("strain energy per component"):
+        shares = strain_energy_shares(modes, RegionEnergy(mech)) if energy else None
     return SquealCase(name, pre, modes, stability_report(modes, rtol, close_tol), shares,
                       mech.contact.facet_pressure(), mech)
 
@@ -74,8 +78,10 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     prefix = "squeal_" + "".join(ch if ch.isalnum() else "_" for ch in name) + "_"
     rough = build_rough_interface(scene, tm) if scene.has("roughness") else None
     if rough is not None:
-        rough.update_laws()
-    mech = build_mechanics(scene, tm, law=rough.law if rough else None, degree=degree, prefix=prefix)
+        with io.stage("zone laws"):
+            rough.update_laws()
+    with io.stage("model set-up"):       # function spaces, forms compiled (cached after the first run)
+        mech = build_mechanics(scene, tm, law=rough.law if rough else None, degree=degree, prefix=prefix)
     if rough is not None:            # Newton starts at rest from the rigid datum gap
         tm.interface.set_field(mech.contact.initial_gap, rough.datum_gap(interface_forces(scene, tm)))
     return squeal_case(mech, dict(scene.materials), name, load=drive(scene, tm).load, steps=scene.loading.ramp_steps,
@@ -105,17 +111,21 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         raise InputError("effects", sorted(scene.effects), 'the squeal analysis needs effect "stability"')
     io.abort_on_exception(comm)
     folder = prepare_folder(scene, overwrite, False, comm)
-    tm = build_mesh(scene, comm)
+    with io.stage("meshing"):
+        tm = build_mesh(scene, comm)
     case = analyse(scene, tm, degree=degree)
-    files = [case.modes.write_csv(folder / "modes.csv")] if comm.rank == 0 else []
-    files += write_modes_xdmf(folder / "modes.xdmf", case.modes, case.mech.u)
-    split = energy_split(tm)
-    if comm.rank == 0:
-        files += [plot_pressure(tm.interface.midpoints, tm.interface.masks(), case.facet_pressure, case.name,
-                                folder / "pressure.png"),
-                  plot_re_im([case], folder / "re_im.png"),
-                  plot_energy(case, folder / "energy.png", split)]
-    comm.barrier()
+    with io.stage("writing results"):
+        plan = outputs.plan(scene)
+        files = [case.modes.write_csv(folder / "modes.csv")] if comm.rank == 0 else []
+        files += write_state(folder, case.mech, plan.body_fields + plan.interface_fields)
+        files += write_modes(folder, case.modes, case.mech.u, [b.name for b in tm.bodies])
+        split = energy_split(tm)
+        if comm.rank == 0:
+            files += [plot_pressure(tm.interface.midpoints, tm.interface.masks(), case.facet_pressure, case.name,
+                                    folder / "pressure.png"),
+                      plot_re_im([case], folder / "re_im.png"),
+                      plot_energy(case, folder / "energy.png", split)]
+        comm.barrier()
     result = SquealResult(folder, files, time.perf_counter() - t0, case)
     if verbose and comm.rank == 0:
         rep = case.report
