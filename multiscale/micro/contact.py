@@ -10,7 +10,11 @@ control the rigid approach. Two methods give the same discrete answer:
 - ``"pk"``: the constrained CG of Polonsky & Keer (1999) (``pk_solver``): iterations growing like
   the square root of the grid size, ~2 FFT pairs each. Slower from 128² up, as fast below.
 
-Both stop on the same unit-free criterion (see ``ContactSolver.solve``). Batches of patches
+Both stop on the same unit-free criterion (see ``ContactSolver.solve``). With a ``hardness`` H
+(``"bccg"`` only) the surface is elastic-perfectly plastic: 0 <= p <= H, the cells at H flow
+plastically and their interpenetration is the permanent deformation (the bounded problem of
+Almqvist et al. 2007, Tribol. Int. 40, 574–579; Weber et al. 2018, Nat. Commun. 9, 888; ContactMechanics'
+hardness cut-off and tamaas' saturated solvers solve the same discrete problem). Batches of patches
 (leading axes) are solved in one call, each patch iterating on its own until it converges (then
 it is frozen), so batched and looped answers agree; a batch runs in chunks of ``CHUNK_CELLS``
 cells that keep the working set in the CPU cache, spread over ``multiscale.micro.fft``'s threads.
@@ -51,6 +55,8 @@ class ContactResult:
     mean_pressure: np.ndarray  # Pa, total force / nominal area
     approach: np.ndarray       # m, rigid approach delta from first touch
     mean_gap: np.ndarray       # m, mean separation between the flat and the deformed surface
+    plastic_area_fraction: np.ndarray  # cells at p = H (plastic flow) / all cells; 0 without a hardness
+    plastic: np.ndarray        # m, permanent (plastic) deformation, >= 0 into the solid: u + z - d < 0 at p = H
     iterations: np.ndarray     # per patch
     residual: np.ndarray       # per patch, see ContactSolver.solve
     converged: np.ndarray      # bool per patch
@@ -86,9 +92,13 @@ class ContactSolver:
         self._pool_threads = 0
 
     def solve(self, heights, *, load=None, approach=None, tol: float = 1e-8, max_iter: int = 5000,
-              initial_pressure=None, partial: bool = False, method: str | None = None) -> ContactResult:
+              initial_pressure=None, partial: bool = False, method: str | None = None,
+              hardness=None) -> ContactResult:
         """Solve under load control (``load`` = mean pressure [Pa]) or displacement control
-        (``approach`` = delta [m]); scalars or arrays of the batch shape.
+        (``approach`` = delta [m]); scalars or arrays of the batch shape. ``hardness`` H [Pa]
+        (scalar or per patch, > 0; inf or None: elastic) bounds the pressure (p <= H, load < H):
+        the result's ``plastic`` field is then the permanent deformation d - z - u on the cells at
+        H (``plastic_area_fraction``); H = inf computes bit for bit what None computes.
 
         Stopping criterion (both methods): eps = ||s||₂ / ||p||₂ <= ``tol`` per patch, where s is
         the preconditioned residual over the free set (contact cells, and cells with a negative
@@ -135,14 +145,26 @@ class ContactSolver:
             if self.periodic and np.any(delta >= z.mean(axis=(-2, -1))):
                 raise InputError("approach", approach, "a periodic patch under displacement control needs "
                                  "approach < max(h) - mean(h) (full contact has no finite load)")
+        upper = None
+        if hardness is not None:
+            upper = _batch_values("hardness", hardness, batch)
+            if np.any(np.isnan(upper)) or np.any(upper <= 0):
+                raise InputError("hardness", hardness, "must be > 0 (inf: no bound)")
+            if np.all(upper == np.inf):
+                upper = None
+            elif method != "bccg":
+                raise InputError("hardness", hardness, f"method {method!r} has no pressure bound: use 'bccg'")
+            elif target is not None and np.any(target >= upper):
+                raise InputError("load", load, "mean pressure must be below the hardness (a fully plastic "
+                                 "patch carries at most H)")
         p0 = None
         if initial_pressure is not None:
             p0 = _batch_values("initial_pressure", initial_pressure, h.shape)
             if np.any(p0 < 0) or not np.all(np.isfinite(p0)):
                 raise InputError("initial_pressure", "array", "must be finite and >= 0")
-        return self._run_chunks(method, z, target, delta, tol, max_iter, p0, partial)
+        return self._run_chunks(method, z, target, delta, tol, max_iter, p0, partial, upper)
 
-    def _run_chunks(self, method, z, target, delta, tol, max_iter, p0, partial):
+    def _run_chunks(self, method, z, target, delta, tol, max_iter, p0, partial, upper=None):
         """Run the iterations on chunks of the batch small enough for the CPU cache (the full-grid
         passes are memory bound: 400 patches of 64² in one block run ~2x slower than in chunks
         of 8), on ``get_threads()`` threads when there are several chunks, then assemble."""
@@ -152,7 +174,9 @@ class ContactSolver:
         z = np.ascontiguousarray(np.reshape(z, (B,) + grid))
         p = self._initial_pressure(method, z, None if target is None else np.reshape(target, B),
                                    None if delta is None else np.reshape(delta, B),
-                                   None if p0 is None else np.reshape(p0, (B,) + grid), max_iter)
+                                   None if p0 is None else np.reshape(p0, (B,) + grid), max_iter,
+                                   None if upper is None else np.reshape(upper, B))
+        upper = None if upper is None else np.ascontiguousarray(np.reshape(upper, B), dtype=float)
         target = None if target is None else np.ascontiguousarray(np.reshape(target, B), dtype=float)
         delta = None if delta is None else np.ascontiguousarray(np.reshape(delta, B), dtype=float)
         chunks = [slice(i, min(i + size, B)) for i in range(0, B, size)]
@@ -171,7 +195,7 @@ class ContactSolver:
             try:
                 with np.errstate(all="ignore"):
                     if method == "bccg":
-                        out = bccg_solver.run(self.operator, work, *args)
+                        out = bccg_solver.run(self.operator, work, *args, None if upper is None else upper[c])
                     else:
                         out = pk_solver.run(self.operator, work[0], work[1], *args)
                     finite = all(np.all(np.isfinite(out[k])) for k in ("u", "d")) and np.all(np.isfinite(p[c]))
@@ -193,7 +217,7 @@ class ContactSolver:
             parts = list(self._pool.map(one, chunks))
         else:
             parts = [one(c) for c in chunks]
-        result = self._assemble(z, p, parts, batch)
+        result = self._assemble(z, p, parts, batch, upper)
         if not np.all(result.converged) and not partial:
             raise ContactConvergenceError(
                 f"contact solver did not converge in {max_iter} iterations "
@@ -206,24 +230,26 @@ class ContactSolver:
             return bccg_solver.Scratch(self.operator, chunk, threads)
         return self.operator.workspace((chunk,), threads), bccg_solver.Scratch(self.operator, chunk, threads)
 
-    def _initial_pressure(self, method, z, target, delta, p0, max_iter):
+    def _initial_pressure(self, method, z, target, delta, p0, max_iter, upper=None):
         """A feasible start: the warm start; else for "bccg" the nested start (the solution on the
         grid of half the resolution, ``coarse_start``) when the grid allows it; else uniform
         (load control) or the local solution max(delta - z, 0) / L_00 (displacement control).
-        Balanced under load control."""
+        Balanced under load control; within the bounds ``upper`` (``bounded_start``)."""
         B, N = z.shape[0], z.shape[1] * z.shape[2]
         p = None if p0 is None else np.array(p0, dtype=float)
         if p is None and method == "bccg":
-            p = self.coarse_start(z, target, delta, max_iter)
+            p = self.coarse_start(z, target, delta, max_iter, upper)
         if p is None and target is not None:
             p = np.repeat(target, N).reshape(z.shape)
         elif p is None:
             p = np.maximum(delta[:, None, None] - z, 0.0) / self.operator.self_influence
         if target is not None:
             p = pk_solver.rescale(p.reshape(B, N), target, z.reshape(B, N)).reshape(z.shape)
+        if upper is not None:
+            p = bounded_start(p.reshape(B, N), upper, None if target is None else target * N).reshape(z.shape)
         return np.ascontiguousarray(p)
 
-    def coarse_start(self, z, target, delta, max_iter):
+    def coarse_start(self, z, target, delta, max_iter, upper=None):
         """Nested iteration (as in full multigrid; for contact: the cascade multi-resolution start
         of Bemporad & Paggi 2015, Int. J. Solids Struct. 69–70, 94–105): solve the patches with
         2 x 2 cells merged (heights averaged, same kernel, recursively down to ``COARSE_MIN``
@@ -238,7 +264,7 @@ class ContactSolver:
             self._coarse = ContactSolver(self.kernel, (ny // 2, nx // 2), 2 * op.dx, 2 * op.dy, self.periodic)
         zc = z.reshape(B, ny // 2, 2, nx // 2, 2).mean(axis=(2, 4))
         low = zc.min(axis=(1, 2))                        # the coarse top lies this far below the fine one
-        options = dict(tol=COARSE_TOL, max_iter=max_iter, partial=True)
+        options = dict(tol=COARSE_TOL, max_iter=max_iter, partial=True, hardness=upper)
         if target is not None:
             r = self._coarse.solve(-zc, load=target, **options)
         else:
@@ -249,20 +275,51 @@ class ContactSolver:
         return np.repeat(np.repeat(r.pressure.reshape(B, ny // 2, nx // 2), 2, axis=1), 2, axis=2)
 
     @staticmethod
-    def _assemble(z, p, parts, batch) -> ContactResult:
+    def _assemble(z, p, parts, batch, upper) -> ContactResult:
         u = np.concatenate([o["u"] for o in parts])
         d = np.concatenate([o["d"] for o in parts])
         length = max(len(o["history"]) for o in parts)
         history = [max(o["history"][k] for o in parts if k < len(o["history"])) for k in range(length)]
         g = u + z - d[:, None, None]
         gap = np.where(p > 0, 0.0, np.maximum(g, 0.0))
+        if upper is None:
+            flow, plastic = np.zeros(p.shape, dtype=bool), np.zeros(p.shape)
+        else:
+            flow = p >= upper[:, None, None]
+            plastic = np.where(flow, np.maximum(-g, 0.0), 0.0)
         cells = batch + z.shape[1:]
         per = {k: np.concatenate([o[k] for o in parts]).reshape(batch) for k in ("iterations", "residual", "converged")}
         return ContactResult(
             pressure=p.reshape(cells), displacement=u.reshape(cells), gap=gap.reshape(cells),
             contact=(p > 0).reshape(cells), area_fraction=np.mean(p > 0, axis=(1, 2)).reshape(batch),
             mean_pressure=p.mean(axis=(1, 2)).reshape(batch), approach=d.reshape(batch),
-            mean_gap=gap.mean(axis=(1, 2)).reshape(batch), history=history, **per)
+            mean_gap=gap.mean(axis=(1, 2)).reshape(batch), plastic_area_fraction=flow.mean(axis=(1, 2)).reshape(batch),
+            plastic=plastic.reshape(cells), history=history, **per)
+
+
+def bounded_start(p, upper, total=None):
+    """p (B, N) >= 0 made feasible for the bounds ``upper`` (B,): min(c p, H) per patch, with c
+    (>= 0) such that Σ min(c p, H) = ``total`` (B,) under load control (exact on the sorted
+    values: the k largest cells saturate, c v_k <= H <= c v_(k-1)), else c = 1."""
+    p = np.maximum(np.asarray(p, dtype=float), 0.0)
+    H = upper[:, None]
+    if total is None:
+        return np.minimum(p, H)
+    bounded = np.isfinite(upper)
+    if not bounded.all():                                          # elastic patches keep p
+        p[bounded] = bounded_start(p[bounded], upper[bounded], total[bounded])
+        return p
+    v = -np.sort(-p, axis=1)                                       # descending
+    k = np.arange(p.shape[1] + 1)
+    tail = np.concatenate([np.cumsum(v[:, ::-1], axis=1)[:, ::-1], np.zeros((p.shape[0], 1))], axis=1)
+    nxt = np.concatenate([v, np.zeros((p.shape[0], 1))], axis=1)   # the largest cell not saturated
+    prev = np.concatenate([np.full((p.shape[0], 1), np.inf), v], axis=1)  # the smallest saturated one
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = (total[:, None] - k * H) / tail                        # scale if the k largest saturate
+        ok = (c >= 0) & (c * nxt <= H) & (c * prev >= H) & (tail > 0)
+    first = np.argmax(ok, axis=1)
+    scale = c[np.arange(p.shape[0]), first]
+    return np.minimum(p * scale[:, None], H)
 
 
 def _method(method) -> str:
