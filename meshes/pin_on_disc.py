@@ -20,7 +20,7 @@ from multiscale.geometry import (BodySpec, GeometrySpec, Region, Rotation, Suppo
                                        entities_in_box, entities_where, resolve_parameters)
 
 DEFAULTS: dict[str, float] = {
-    "inner_radius": 12.5e-3,        # m, disc bore (Table 7.1 / §7.3.1)
+    "inner_radius": 12.5e-3,        # m, disc bore (§7.3.1)
     "outer_radius": 107.5e-3,       # m
     "disc_thickness": 10e-3,        # m
     "track_radius": 90e-3,          # m, pin centre: middle of the 80-100 mm track (Table 7.1)

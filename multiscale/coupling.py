@@ -28,7 +28,7 @@ zone laws). This module reads no scene: ``multiscale.workflows.multiscale`` buil
 from __future__ import annotations
 
 import time as _time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import h5py
@@ -56,7 +56,8 @@ class LoopSettings:
     partition_law: bool = False   # micro partition per zone (ch. 6) instead of the constant
     wear: bool = False            # Archard wear of the zones
     wear_every: int = 1           # macro steps per wear update
-    forces: tuple = (1.0,)        # N, the load each interface nominally carries (datum gap, unloaded zones)
+    forces: dict = field(default_factory=dict)   # N, per interface: the load it nominally carries
+    friction: np.ndarray | None = None            # mu of every zone (its interface's; None: the post-analysis')
 
 
 @dataclass
@@ -112,7 +113,7 @@ class Multiscale:
         self.model, self.rough, self.post, self.settings = model, rough, post, settings
         self.tm, self.comm = model.tm, model.tm.comm
         self.fingerprint = fingerprint
-        self.nominal = sum(settings.forces) / self.tm.interface.areas.sum()
+        self.nominal = sum(settings.forces.values()) / self.tm.interface.areas.sum()
         Z = len(rough.zones)
         self.partition = np.full(Z, float(settings.partition))
         self.conductance = np.zeros(Z)
@@ -128,25 +129,25 @@ class Multiscale:
     def loading(self) -> ZoneLoading:
         """Per-zone macro loading at the current state (every rank gets the same arrays)."""
         iface, model, Z = self.tm.interface, self.model, len(self.rough.zones)
-        zone_of = self.rough.zone_of_facet
-        facet_force = model.contact.facet_pressure() * iface.areas
-        force = np.bincount(zone_of, facet_force, minlength=Z)
-        area = np.bincount(zone_of, iface.areas, minlength=Z)
+        rough = self.rough.zone_of_facet >= 0
+        zone_of, areas = self.rough.zone_of_facet[rough], iface.areas[rough]
+        force = np.bincount(zone_of, (model.contact.facet_pressure() * iface.areas)[rough], minlength=Z)
+        area = np.bincount(zone_of, areas, minlength=Z)
         T = np.full((Z, 2), self.settings.initial_temperature)
         if model.thermal is not None:
             for col, side in ((0, 1), (1, 0)):
-                total = np.bincount(zone_of, model.thermal.facet_temperature(side) * iface.areas, minlength=Z)
+                total = np.bincount(zone_of, model.thermal.facet_temperature(side)[rough] * areas, minlength=Z)
                 T[:, col] = np.where(area > 0, total / np.where(area > 0, area, 1.0), T[:, col])
-        centres = np.array([z.centre for z in self.rough.zones])
+        centres, axes = self.rough.zone_frames()
         motion = self.tm.spec.motion
         speed = model.speed(model.time)
         if isinstance(motion, Rotation):
             axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
-            r = np.column_stack([centres, np.zeros(Z)]) - np.asarray(motion.centre, float)
-            w = speed * np.cross(axis, r)[:, :2]
+            w = speed * np.cross(axis, centres - np.asarray(motion.centre, float))
         else:
             e = np.asarray(motion.direction, float) / np.linalg.norm(motion.direction)
-            w = np.tile(speed * e[:2], (Z, 1))
+            w = np.tile(speed * e, (Z, 1))
+        w = np.einsum("zij,zj->zi", axes, w)             # in each zone's plane coordinates
         return ZoneLoading(force, force / self.rough.zone_area, np.hypot(w[:, 0], w[:, 1]),
                            np.arctan2(w[:, 1], w[:, 0]), T)
 
@@ -159,9 +160,10 @@ class Multiscale:
         mine = loaded[comm.rank::comm.size]
         sliding = load.speed[mine] * duration if wear else None
         rough = load.temperature[mine, 1]
+        mu = None if self.settings.friction is None else self.settings.friction[mine]
         res = self.post.run([zones[i] for i in mine], load.pressure[mine], speed=load.speed[mine],
                             angle=load.angle[mine], remote=np.column_stack([rough, rough]), sliding=sliding,
-                            warm=self.warm[mine])
+                            warm=self.warm[mine], mu=mu)
         parts = comm.allgather((mine, res.worn_pressure, res.heights if wear else None, res.max_pressure,
                                 res.max_temperature, res.partition, res.conductance))
         max_p, max_T = [], []
@@ -189,17 +191,20 @@ class Multiscale:
     def apply_zone_fields(self) -> None:
         """Per-facet partition (micro partition law) and conductance from the zones."""
         contact, iface, zone_of = self.model.contact, self.tm.interface, self.rough.zone_of_facet
+        rough = zone_of >= 0                       # the other interfaces keep their scene values
         if self.partition_law:
-            iface.set_field(contact.partition, self.partition[zone_of])
+            iface.set_field(contact.partition, np.where(rough, self.partition[zone_of], iface.values(contact.partition)))
         if self.post.conductance is not None:
-            iface.set_field(contact.conductance, self.conductance[zone_of])
+            iface.set_field(contact.conductance,
+                            np.where(rough, self.conductance[zone_of], iface.values(contact.conductance)))
 
     def facet_fields(self) -> dict:
         """Interface output fields of the loop: name -> per-facet array maker."""
         iface, contact, rough = self.tm.interface, self.model.contact, self.rough
         return {"contact_stiffness": lambda: rough.law.evaluate(contact.facet_gap())[1],
                 "partition": lambda: iface.values(contact.partition),
-                "wear_depth": lambda: rough.wear_depth().mean(axis=(-2, -1))[rough.zone_of_facet]}
+                "wear_depth": lambda: np.where(rough.zone_of_facet >= 0,
+                                               rough.wear_depth().mean(axis=(-2, -1))[rough.zone_of_facet], 0.0)}
 
     # ---- the run ---------------------------------------------------------------------------
     def start(self) -> StepResult:
@@ -264,9 +269,11 @@ class Multiscale:
         m, last = self.model, self.model.last_solve
         arrays = {"heights": self.rough.heights(), "warm": self.warm, "partition": self.partition,
                   "conductance": self.conductance, "levels": self.rough.levels, "heat_total": m.heat_total,
+                  "heat_lost_recorded": m.heat_lost_recorded,
+                  **({"lost_total": m.thermal.lost_total} if m.thermal is not None else {}),
                   "datum_gap": self.datum_gap,
                   **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
-        attrs = {"step": step, "time": m.time, "work": self.work, "scene": self.fingerprint,
+        attrs = {"step": step, "time": m.time, "work": self.work, "scene": self.fingerprint, "load": m.load,
                  "ranks": self.comm.size, "fields_written": -1,
                  "solve": [last.reason, last.iterations, last.normal_force, last.max_pressure]}
         checkpoint.save(path, self.comm, attrs=attrs, arrays=arrays, functions=self._functions(),
@@ -284,6 +291,9 @@ class Multiscale:
         self.conductance, self.rough.levels = arrays["conductance"], arrays["levels"]
         self.datum_gap = arrays["datum_gap"]
         m.heat_total = arrays["heat_total"].copy()
+        m.heat_lost_recorded = arrays["heat_lost_recorded"].copy()
+        if m.thermal is not None:
+            m.thermal.lost_total = arrays["lost_total"].copy()
         m.time, self.work = float(attrs["time"]), float(attrs["work"])
         if m.thermal is not None:
             m.thermal.time = m.time
@@ -291,7 +301,8 @@ class Multiscale:
         m.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
         self.tm.interface.set_field(m.contact.initial_gap, self.datum_gap)
         m.contact.speed.value = m.speed(m.time)
-        m.mechanics.load.value = m.drive.load
+        m.load = float(attrs["load"])
+        m.mechanics.load.value = m.load * m.drive.factor(m.time)
         self.rough.update_laws()
         self.apply_zone_fields()
         history = io.History()

@@ -88,12 +88,25 @@ class GeometrySpec:
     motion: Rotation | Translation = field(default_factory=Rotation)
     length_scale: float = 1.0          # m, a typical size (tolerances for facet keys)
     fluid_load: bool = False           # load faces loaded by a fluid pressure (−p n)
+    interface_normals: Mapping[str, tuple | None] = field(default_factory=dict)   # unit normal of a
+    #                                    planar interface (None: not planar; absent: not inspected)
+    report: tuple[str, ...] = ()       # what the builder found (bodies, volumes, interfaces), for check
+    interface_regions: Mapping[str, str] = field(default_factory=dict)   # interface -> region of
+    #                                    body 0 along it (default: body 0's first region)
 
     @property
     def materials(self) -> tuple[str, ...]:
         """Names of the material tables the geometry needs, in first-use order."""
         names = [r.material for b in self.bodies for r in b.regions]
         return tuple(dict.fromkeys(names))
+
+    def interface_materials(self, interface: str | None = None) -> tuple[str, str]:
+        """Names of the materials on both sides of an interface (default: the first one): body 0's
+        region along it, and body 1's first region."""
+        interface = interface if interface is not None else next(iter(self.interfaces))
+        name = self.interface_regions.get(interface, self.bodies[0].regions[0].name)
+        region = next(r for r in self.bodies[0].regions if r.name == name)
+        return region.material, self.bodies[1].regions[0].material
 
 
 BUILDER_GROUP = "multiscale.builders"

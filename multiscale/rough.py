@@ -1,12 +1,15 @@
 """A rough contact interface of a macro model: zones of micro patches -> laws through the pool ->
 per-facet laws, and the rigid datum gap (thesis §1.4.2, §4.2, §7.2.1).
 
-Each interface of the mesh (one face of the stationary body 0, in a plane z = const) is covered by
-a grid of zones, each carrying its own micro patch. A facet follows the law p_n(g_n) of the zone
+Each rough interface of the mesh (a planar face of the stationary body 0) is covered by a grid of
+zones in its plane, each carrying its own micro patch. A facet follows the law p_n(g_n) of the zone
 holding its midpoint, embedded exactly in the UFL contact form (``macro.laws_ufl.FacetLaw``: the
 Newton matrix holds the laws' consistent tangent, for the multiscale loop and the squeal analysis
-alike). Only zones that hold a facet get a law. Zone ids run over the interfaces in order (those
-of interface k follow those of interface k − 1), so per-zone arrays are indexed by id.
+alike); facets of the other interfaces have no law (their perfect-contact penalty law is added by
+the caller). Only zones that hold a facet get a law. Zone ids run over the rough interfaces in
+order (those of interface k follow those of interface k − 1), so per-zone arrays are indexed by
+id. Zone coordinates (u, v) are those of the interface plane's frame (``interface_plane``): for a
+plane z = const, (u, v) = (x, y).
 
 ``update_laws`` computes the laws of the zones whose topography changed (the pool's cache keeps
 the others) and loads them into the facet law; a zone whose law fails (close to full contact
@@ -33,29 +36,67 @@ from multiscale.pool import MicroPool
 P_MAX_HALVINGS = 4         # a zone whose law fails is retried with p_max / 2, ... / 16
 
 
-def interface_plane(tm: TwoBodyMesh, name: str) -> tuple[np.ndarray, np.ndarray]:
-    """Lower and upper corners (x, y) [m] of interface ``name``, which must lie in a plane z = const."""
-    lo, hi = tm.interface.box(name)
-    if hi[2] - lo[2] > 1e-9 * max(hi[0] - lo[0], hi[1] - lo[1]):
-        raise InputError("geometry", name, "a rough interface must lie in a plane z = const")
-    return lo[:2], hi[:2]
+@dataclass(frozen=True)
+class Plane:
+    """The plane of an interface: ``origin`` [m] and the orthonormal frame (e_u, e_v, normal)."""
+
+    origin: np.ndarray
+    frame: np.ndarray          # (3, 3): rows e_u, e_v, normal
+
+    def uv(self, x) -> np.ndarray:
+        """Plane coordinates (..., 2) [m] of points x (..., 3)."""
+        return (np.asarray(x, dtype=float) - self.origin) @ self.frame[:2].T
+
+    def to_plane(self, vectors) -> np.ndarray:
+        """Components (..., 2) of 3-vectors along (e_u, e_v)."""
+        return np.asarray(vectors, dtype=float) @ self.frame[:2].T
+
+
+def interface_plane(tm: TwoBodyMesh, name: str) -> tuple[Plane, np.ndarray, np.ndarray]:
+    """The plane of interface ``name`` and the lower and upper corners (u, v) [m] of its facets'
+    vertices in it; InputError if the interface is not planar. For a normal along z the frame is
+    (x, y, z) itself; otherwise e_u is the direction of x projected on the plane (or y)."""
+    iface = tm.interface
+    mask = iface.masks()[name]
+    mid, areas = iface.midpoints[mask], iface.areas[mask]
+    centre = (areas[:, None] * mid).sum(axis=0) / areas.sum()
+    _, _, vt = np.linalg.svd((mid - centre) * np.sqrt(areas)[:, None], full_matrices=False)
+    n = vt[-1] / np.linalg.norm(vt[-1])
+    lo3, hi3 = iface.box(name)
+    size = max(float((hi3 - lo3).max()), np.finfo(float).tiny)
+    if np.abs((mid - centre) @ n).max() > 1e-9 * size:
+        raise InputError("geometry", name, "a rough interface must be planar")
+    if abs(n[2]) > 1 - 1e-12:
+        frame = np.eye(3)
+    else:
+        e_u = np.array([1.0, 0.0, 0.0]) - n[0] * n
+        e_u = e_u if np.linalg.norm(e_u) > 1e-6 else np.array([0.0, 1.0, 0.0]) - n[1] * n
+        e_u /= np.linalg.norm(e_u)
+        frame = np.array([e_u, np.cross(n, e_u), n])
+    plane = Plane(np.zeros(3) if abs(n[2]) > 1 - 1e-12 else centre, frame)
+    corners = plane.uv(np.array([[a, b, c] for a in (lo3[0], hi3[0]) for b in (lo3[1], hi3[1])
+                                 for c in (lo3[2], hi3[2])]))
+    return plane, corners.min(axis=0), corners.max(axis=0)
 
 
 @dataclass
 class RoughInterface:
     """Zones, laws and facet law of the rough interfaces of ``tm`` (see module docstring).
 
-    ``grids[k]``: the zone grid of interface k, whose zones have ids ``offsets[k] + local id``;
-    ``zones[i]`` has id i. ``spec``: the laws' ``LawSpec`` (p_max of level 0).
+    ``names[k]``: the k-th rough interface, ``planes[k]`` its plane, ``grids[k]`` its zone grid (in
+    plane coordinates), whose zones have ids ``offsets[k] + local id``; ``zones[i]`` has id i.
+    ``spec``: the laws' ``LawSpec`` (p_max of level 0).
     """
 
     tm: TwoBodyMesh
+    names: list[str]
+    planes: list[Plane]
     grids: list[ZoneGrid]
     zones: list[Zone]
     spec: LawSpec
     pool: MicroPool
     law: FacetLaw = field(init=False)
-    zone_of_facet: np.ndarray = field(init=False)       # zone id of every global facet
+    zone_of_facet: np.ndarray = field(init=False)       # zone id of every global facet (-1: not rough)
     initial: np.ndarray = field(init=False)              # (Z, ny, nx) initial topographies [m]
     levels: np.ndarray = field(init=False)               # p_max halvings of each zone's law
     used: np.ndarray = field(init=False)                 # ids of the zones holding a facet
@@ -66,11 +107,12 @@ class RoughInterface:
         offsets = np.cumsum([0] + [g.n_zones for g in self.grids])
         if [z.id for z in self.zones] != list(range(offsets[-1])):
             raise InputError("zones", len(self.zones), "one zone per grid cell, ids in grid order")
-        mid = iface.midpoints
-        self.zone_of_facet = np.empty(iface.n_facets, dtype=int)
-        for k, mask in enumerate(iface.masks().values()):
-            self.zone_of_facet[mask] = offsets[k] + self.grids[k].zone_of(mid[mask, 0], mid[mask, 1])
-        self.used = np.unique(self.zone_of_facet)
+        masks = iface.masks()
+        self.zone_of_facet = np.full(iface.n_facets, -1)
+        for k, name in enumerate(self.names):
+            uv = self.planes[k].uv(iface.midpoints[masks[name]])
+            self.zone_of_facet[masks[name]] = offsets[k] + self.grids[k].zone_of(uv[:, 0], uv[:, 1])
+        self.used = np.unique(self.zone_of_facet[self.zone_of_facet >= 0])
         self.initial = np.stack([z.surface.heights for z in self.zones])
         self.levels = np.zeros(len(self.zones), dtype=int)
         self.law = FacetLaw(self.tm, self.spec.n_points)
@@ -79,6 +121,17 @@ class RoughInterface:
     def zone_area(self) -> np.ndarray:
         """Nominal area of every zone [m^2]."""
         return np.array([z.area for z in self.zones])
+
+    def zone_frames(self) -> tuple[np.ndarray, np.ndarray]:
+        """Centre (Z, 3) [m] of every zone in space and the (Z, 2, 3) in-plane directions (e_u, e_v)
+        of its interface (zone coordinates and sliding directions are along these)."""
+        centres, axes = [], []
+        for plane, grid in zip(self.planes, self.grids):
+            for zid in range(grid.n_zones):
+                u, v = self.zones[len(centres)].centre
+                centres.append(plane.origin + u * plane.frame[0] + v * plane.frame[1])
+                axes.append(plane.frame[:2])
+        return np.array(centres), np.array(axes)
 
     def heights(self) -> np.ndarray:
         """Current zone topographies (Z, ny, nx) [m]."""
@@ -120,12 +173,20 @@ class RoughInterface:
         self.laws_computed = computed
         return computed
 
+    def zone_of(self, name: str) -> np.ndarray:
+        """Zone ids of rough interface ``name``."""
+        k = self.names.index(name)
+        start = sum(g.n_zones for g in self.grids[:k])
+        return np.arange(start, start + self.grids[k].n_zones)
+
     def datum_gap(self, forces) -> np.ndarray:
-        """Per-facet uniform gap g_0 [m] of each interface at which its rigid rough body carries
-        ``forces[k]`` [N] (interface k, in the order of ``tm.interface.tags``; bisection)."""
+        """Per-facet uniform gap g_0 [m] of each rough interface at which its rigid rough body
+        carries ``forces[name]`` [N] (bisection); 0 on the other facets."""
         areas, laws = self.tm.interface.areas, self.law.laws
         out = np.zeros(len(areas))
-        for mask, target in zip(self.tm.interface.masks().values(), forces):
+        masks = self.tm.interface.masks()
+        for name in self.names:
+            mask, target = masks[name], forces[name]
             rows = laws.rows(self.zone_of_facet[mask])
             g_open = laws.mechanical.g_open[rows]
 

@@ -25,19 +25,40 @@ def summary(scene: Scene) -> list[str]:
     bodies = " | ".join(f"{b.name} ({', '.join(f'{r.name}: {r.material}' for r in b.regions)})"
                         for b in g.spec.bodies)
     sizes = ", ".join(f"{k} {params[k] * 1e3:g} mm" for k in params if k.endswith("mesh_size"))
+    source = f"file {g.params.file.name}" if g.builder == "file" else g.builder
     lines = [f"scene {scene.name}" + (f" ({scene.source})" if scene.source else ""),
-             f"  geometry  {g.builder}, {g.motion} of {g.bodies[1]}; {sizes}",
+             f"  geometry  {source}, {g.motion} of {g.bodies[1]}" + (f"; {sizes}" if sizes else ""),
+             *(f"            {line}" for line in g.spec.report),
              f"  bodies    {bodies}",
              f"  effects   {', '.join(e for e in EFFECTS if e in scene.effects)}"]
     for effect in EFFECTS:
         if scene.has(effect):
             lines.append(f"    {effect:<15}{_effect_line(scene, effect)}")
+    v = ld.vehicle
     load_text = (f"{ld.normal_force:g} N" if ld.normal_force is not None else
-                 f"{ld.pressure / 1e6:g} MPa" if ld.pressure is not None else "none")
+                 f"{ld.pressure / 1e6:g} MPa" if ld.pressure is not None else
+                 f"braking {v.mass:g} kg" if v is not None and v.mass is not None else "none")
     motion = (f"{ld.rotation_speed * 30 / math.pi:g} rpm" if ld.rotation_speed is not None else
               f"speed profile of {len(ld.speed_profile)} points" if ld.speed_profile is not None else
-              f"{ld.sliding_speed:g} m/s" if ld.sliding_speed is not None else "no sliding")
-    lines.append(f"  loading   {load_text}, {motion}, {ld.ramp_steps} ramp step(s)")
+              (f"a stop from {v.speed * 3.6:g} km/h in {v.stop_time:.3g} s" if v.deceleration else
+               f"a drag at {v.speed * 3.6:g} km/h") + f" (wheel radius {v.wheel_radius * 1e3:g} mm)"
+              if v is not None else f"{ld.sliding_speed:g} m/s" if ld.sliding_speed is not None else "no sliding")
+    where = f" on {', '.join(ld.faces)}" if ld.faces else ""
+    profile = f", load profile of {len(ld.load_profile)} points" if ld.load_profile else ""
+    lines.append(f"  loading   {load_text}{where}, {motion}{profile}, {ld.ramp_steps} ramp step(s)")
+    for name in g.spec.interfaces:
+        if name in scene.interfaces or len(g.spec.interfaces) > 1:
+            s = scene.interface_settings(name)
+            kind = "rough" if name in (scene.rough_interfaces if scene.has("roughness") else ()) else "perfect contact"
+            mu = f", mu = {s.friction:g}" if scene.has("friction") and s.friction is not None else ""
+            lines.append(f"  interface {name}: {kind}{mu}")
+    for b in scene.boundary:
+        what = [f"fix {''.join(b.fix)}" if b.fix else "",
+                "convection h(speed)" if isinstance(b.convection, tuple) else
+                f"convection h = {b.convection:g} W/(m^2 K)" if b.convection is not None else "",
+                f"radiation eps = {b.emissivity:g}" if b.emissivity is not None else "",
+                f"T = {b.temperature - 273.15:g} degC" if b.temperature is not None else ""]
+        lines.append(f"  boundary  {', '.join(b.surfaces)}: {'; '.join(w for w in what if w)}")
     if t.end is not None:
         lines.append(f"  time      {t.end:g} s in {t.steps} step(s) of {t.dt:g} s x {t.substeps} substep(s); "
                      f"T0 = {t.initial_temperature - 273.15:g} degC")
@@ -64,9 +85,12 @@ def _effect_line(scene: Scene, effect: str) -> str:
         return f"h_c = {i.conductance:g} W/(m^2 K)" if not scene.has("roughness") else "h_c(p) per zone (micro)"
     if effect == "roughness":
         r, m = scene.roughness, scene.micro
-        surface = f"RMS {r.rms * 1e6:g} um, H {r.hurst:g}" if r.rms is not None else f"file {r.file.name}"
-        return (f"{r.body}: {surface}; {m.zones[0]} x {m.zones[1]} zones of {m.grid[0]} x {m.grid[1]} cells, "
-                f"{m.law_points}-point laws")
+        surface = f"RMS {r.rms * 1e6:g} um, H {r.hurst:g}" if r.rms is not None else \
+            f"file {r.file.name} ({r.cover}" + (f", seed {r.seed})" if r.cover == "equivalent" else ")")
+        measured_pixels = r.file is not None and r.cover != "equivalent"
+        cells = f"{m.grid[0]} x {m.grid[1]} cells" if m.grid else \
+            "the measurement's pixel size" if measured_pixels else "50 x 50 cells"
+        return f"{r.body or scene.bodies[0]}: {surface}; {m.zones[0]} x {m.zones[1]} zones of {cells}, {m.law_points}-point laws"
     if effect == "wear":
         w = scene.wear
         rate = f"k_w = {w.k_w:g} 1/Pa" if w.k_w is not None else (

@@ -24,8 +24,8 @@ from multiscale.units import KINDS, UnitError, to_si
 
 __all__ = ["Bad", "Choice", "Context", "Curve", "Either", "FilePath", "Flag", "FrozenMap",
            "Integer", "ListOf", "Named", "OneOf", "OnlyWith", "Pair", "Quantity", "Requires",
-           "Section", "Tables", "Text", "fields_of", "key", "read", "reference", "show", "suggest",
-           "unknown_keys"]
+           "Section", "TableOr", "Tables", "Text", "Vector", "fields_of", "key", "parse", "read", "reference", "show",
+           "suggest", "unknown_keys"]
 
 
 class Bad(ValueError):
@@ -35,12 +35,14 @@ class Bad(ValueError):
 @dataclass
 class Context:
     """What a table is read against: active effects, the scene directory; collected problems and
-    warnings (keys given but unused by the active effects)."""
+    warnings (keys given but unused by the active effects, values outside their plausible range)."""
 
     effects: frozenset = frozenset()
     directory: Path = Path(".")
+    root: dict = field(default_factory=dict)        # the whole raw file (tables that merge others)
     problems: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    implausible: list[str] = field(default_factory=list)   # of the value being read: warnings with its path
 
 
 class FrozenMap(Mapping):
@@ -104,10 +106,13 @@ def _a(words: str) -> str:
 
 # ---------------------------------------------------------------- value parsers
 class Quantity:
-    """A physical quantity of a units.KINDS kind, converted to SI, with an optional range."""
+    """A physical quantity of a units.KINDS kind, converted to SI, with an optional range (outside
+    it: a problem) and an optional ``plausible`` range (lo, hi) in SI (outside it: a warning, e.g. a
+    load of 1e9 N on a pin; the value is still used)."""
 
-    def __init__(self, kind: str, *, gt=None, ge=None, lt=None, le=None):
+    def __init__(self, kind: str, *, gt=None, ge=None, lt=None, le=None, plausible=None):
         self.name, self.kind, self.gt, self.ge, self.lt, self.le = kind, KINDS[kind], gt, ge, lt, le
+        self.plausible = plausible
 
     def _range(self) -> str:
         unit = f" {self.kind.si}" if self.kind.si else ""
@@ -125,7 +130,13 @@ class Quantity:
     def describe(self) -> str:
         rng = self._range()
         examples = f" ({self.kind.examples})" if self.kind.examples not in ("", self.kind.si) and self.kind.si else ""
-        return f"{_a(self.kind.name)}{' ' + rng if rng else ''}{examples}"
+        return f"{_a(self.kind.name)}{' ' + rng if rng else ''}{examples}{self._plausible()}"
+
+    def _plausible(self) -> str:
+        if self.plausible is None:
+            return ""
+        unit = f" {self.kind.si}" if self.kind.si else ""
+        return f", plausibly {_number(self.plausible[0])} to {_number(self.plausible[1])}{unit}"
 
     def __call__(self, raw, ctx):
         try:
@@ -137,6 +148,10 @@ class Quantity:
         if not ok:
             shown = "" if not isinstance(raw, str) else f" (got {v:g} {self.kind.si})".replace(" )", ")")
             raise Bad(f"must be {self._range()}{shown}")
+        if self.plausible is not None and not self.plausible[0] <= v <= self.plausible[1]:
+            unit = f" {self.kind.si}" if self.kind.si else ""
+            ctx.implausible.append(f"{v:g}{unit} is outside the plausible range {_number(self.plausible[0])} to "
+                                   f"{_number(self.plausible[1])}{unit}: check the value and its unit")
         return v
 
 
@@ -261,18 +276,22 @@ class Pair(ListOf):
 
 
 class Curve:
-    """A table of [x, y] rows with strictly increasing x, as a tuple of (x, y) tuples."""
+    """A table of [x, y] rows with strictly increasing x (at least ``min_rows``), as a tuple of
+    (x, y) tuples."""
 
-    def __init__(self, x, y, x_name: str, y_name: str):
-        self.x, self.y, self.x_name, self.y_name = x, y, x_name, y_name
+    def __init__(self, x, y, x_name: str, y_name: str, *, min_rows: int = 1):
+        self.x, self.y, self.x_name, self.y_name, self.min_rows = x, y, x_name, y_name, min_rows
 
     def describe(self) -> str:
-        return (f"rows [{self.x_name}, {self.y_name}] with increasing {self.x_name}; "
+        rows = "rows" if self.min_rows < 2 else f"at least {self.min_rows} rows"
+        return (f"{rows} [{self.x_name}, {self.y_name}] with increasing {self.x_name}; "
                 f"{self.x_name}: {self.x.describe()}; {self.y_name}: {self.y.describe()}")
 
     def __call__(self, raw, ctx):
         if not isinstance(raw, list) or not raw or not all(isinstance(r, list) and len(r) == 2 for r in raw):
             raise Bad(f"must be a non-empty list of {self.describe()}")
+        if len(raw) < self.min_rows:
+            raise Bad(f"needs {self.describe()} (got {len(raw)} row)")
         rows, errors = [], []
         for i, (x, y) in enumerate(raw, 1):
             try:
@@ -284,6 +303,35 @@ class Curve:
         if errors:
             raise Bad("; ".join(errors))
         return tuple(rows)
+
+
+class TableOr:
+    """A constant, or a table of [x, y] rows (``Curve``) when the value is a list."""
+
+    def __init__(self, value, table: Curve):
+        self.value, self.table = value, table
+
+    def describe(self) -> str:
+        return f"{self.value.describe()}, or a table of {self.table.describe()}"
+
+    def __call__(self, raw, ctx):
+        return self.table(raw, ctx) if isinstance(raw, list) else self.value(raw, ctx)
+
+
+class Vector(ListOf):
+    """Exactly ``n`` items of one parser (a point or a direction), as a tuple."""
+
+    def __init__(self, item, n: int = 3, names: str = "[x, y, z]"):
+        super().__init__(item)
+        self.n, self.names = n, names
+
+    def describe(self) -> str:
+        return f"{self.names}, each {self.item.describe()}"
+
+    def __call__(self, raw, ctx):
+        if not isinstance(raw, list) or len(raw) != self.n:
+            raise Bad(f"must be {self.describe()}")
+        return super().__call__(raw, ctx)
 
 
 class FilePath:
@@ -300,6 +348,8 @@ class FilePath:
     def __call__(self, raw, ctx):
         if not isinstance(raw, str) or not raw:
             raise Bad(f"must be {self.describe()}")
+        if "\x00" in raw:
+            raise Bad("holds a NUL character; a path cannot")
         path = (ctx.directory / Path(raw).expanduser()).resolve()
         if self.folder and path.exists() and not path.is_dir():
             raise Bad(f"exists and is not a folder ({path})")
@@ -451,6 +501,19 @@ def unknown_keys(raw, allowed, path: str, ctx: Context, what: str = "key") -> se
     return typos
 
 
+def parse(parser, raw, where: str, ctx: Context):
+    """``raw`` read by ``parser``: the value, or None with a problem naming ``where``; values outside
+    their plausible range become warnings naming ``where``."""
+    try:
+        return parser(raw, ctx)
+    except Bad as exc:
+        ctx.problems.append(f"{where} = {show(raw)}: {exc}")
+        return None
+    finally:
+        ctx.warnings.extend(f"{where} = {show(raw)}: {note}" for note in dict.fromkeys(ctx.implausible))
+        ctx.implausible.clear()
+
+
 def fields_of(cls):
     """(name, Spec) of the TOML keys of a table class."""
     return [(f.name, f.metadata["spec"]) for f in dataclasses.fields(cls) if "spec" in f.metadata]
@@ -483,10 +546,10 @@ def read(cls, raw, path: str, ctx: Context):
             elif spec.parser.always or effect:       # absent: defaults, and name what is missing
                 values[name] = spec.parser.read({}, where, ctx)
         elif name in raw:
-            try:
-                values[name] = spec.parser(raw[name], ctx)
-            except Bad as exc:
-                ctx.problems.append(f"{where} = {show(raw[name])}: {exc}")
+            n = len(ctx.problems)
+            value = parse(spec.parser, raw[name], where, ctx)
+            if len(ctx.problems) == n:
+                values[name] = value
             if spec.warn_unused and not any(e in ctx.effects for e in spec.needed_by):
                 users = " or ".join(f'"{e}"' for e in spec.needed_by)
                 ctx.warnings.append(f"{where} is ignored: effect {users} is not in effects")

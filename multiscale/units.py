@@ -4,7 +4,8 @@
 string "<number> <unit>": units multiply by juxtaposition, space or ``*``, divide with ``/``
 (everything up to the next ``/`` or ``)`` is the denominator: ``W/m K`` = ``W/(m K)``), and take
 integer powers with ``^``, ``**`` or superscripts (``kg/m^3``, ``m²/s``, ``1/K``). SI prefixes
-G M k c m u µ n p apply to m g s N Pa bar W J Hz rad. The angle is its own dimension (so "rpm"
+G M k c m u µ n p apply to m g s N Pa bar W J Hz rad; ``gn`` is the standard gravity
+(9.80665 m/s²), ``t`` the tonne, ``in`` the inch. The angle is its own dimension (so "rpm"
 and "Hz" are not confused): ``rad``, ``deg``, ``rev``; ``rpm`` = rev/min. ``degC`` alone is an
 absolute temperature (+273.15 K); inside a compound unit (``1/degC``) it is a kelvin. ``%`` is
 0.01. Temperatures must carry their unit (a bare 20 would be 20 K).
@@ -58,6 +59,8 @@ KINDS: dict[str, Kind] = {
     "time": Kind("time", T, "s", "s, ms, min, h"),
     "frequency": Kind("frequency", _dim((T, -1)), "Hz", "Hz, kHz"),
     "speed": Kind("speed", _dim((L, 1), (T, -1)), "m/s", "m/s, mm/s"),
+    "acceleration": Kind("acceleration", _dim((L, 1), (T, -2)), "m/s^2", "m/s^2, gn"),
+    "mass": Kind("mass", M, "kg", "kg, t"),
     "angular_speed": Kind("angular speed", _dim((A, 1), (T, -1)), "rad/s", "rpm, rad/s"),
     "force": Kind("force", _dim((M, 1), (L, 1), (T, -2)), "N", "N, kN"),
     "pressure": Kind("pressure or modulus", _dim((M, 1), (L, -1), (T, -2)), "Pa", "Pa, kPa, MPa, GPa, bar"),
@@ -91,6 +94,8 @@ _UNITS: dict[str, tuple[Fraction, tuple[int, ...], bool]] = {
     "deg": (_F(math.pi / 180), A, False), "°": (_F(math.pi / 180), A, False),
     "rev": (_F(2 * math.pi), A, False), "rpm": (_F(2 * math.pi) / 60, _dim((A, 1), (T, -1)), False),
     "degC": (_F(1), TH, False), "°C": (_F(1), TH, False), "%": (_F(1, 100), ONE, False),
+    "gn": (_F("9.80665"), _dim((L, 1), (T, -2)), False), "t": (_F(1000), M, False),
+    "in": (_F("0.0254"), L, False),
 }
 _ABSOLUTE = {"degC": _F("273.15"), "°C": _F("273.15")}   # offsets of a whole-unit absolute temperature
 _PREFIXES = {"G": _F(10**9), "M": _F(10**6), "k": _F(1000), "c": _F(1, 100), "m": _F(1, 1000),
@@ -186,6 +191,8 @@ class _Parser:
         if kind == "name":
             return _lookup(tok)
         if kind == "num" or (kind == "op" and tok.isdigit()):
+            if self.i != 1 or _F(tok) != 1:      # only the 1 of "1/K": "0.4 5" is a typo, not 2.0
+                raise UnitError(f'a number ("{tok}") inside a unit: only "1/<unit>" may start with one')
             return _F(tok), ONE
         if tok == "(":
             inner = self.expr()

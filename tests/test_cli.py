@@ -12,6 +12,7 @@ BLOCK = (Path(__file__).resolve().parents[1] / "demos" / "block_on_flat.toml").r
 THERMAL = BLOCK.replace('effects = ["contact"]', 'effects = ["contact", "thermal"]').replace(
     'E = "4 GPa"', 'E = "4 GPa"\nkappa = "5 W/(m K)"\nchi = "1e-6 m^2/s"').replace(
     'E = "210 GPa"', 'E = "210 GPa"\nkappa = "45 W/(m K)"\nchi = "1e-5 m^2/s"') + '\n[time]\nend = "1 s"\n'
+COOLED = THERMAL + '[[boundary]]\nsurfaces = ["free:block"]\nconvection = "10 W/(m^2 K)"\nambient = "20 degC"\n'
 
 
 def _write(tmp_path, text, name="scene.toml"):
@@ -24,6 +25,7 @@ def test_thermal_variant_is_good(tmp_path, capsys):
     assert main(["check", _write(tmp_path, THERMAL)]) == 0
     out = capsys.readouterr().out
     assert "thermal        transient conduction in block, flat" in out
+    assert main(["check", _write(tmp_path, COOLED)]) == 0
 
 
 BAD = [  # (name, the demo block scene changed, the one expected message)
@@ -51,12 +53,26 @@ BAD = [  # (name, the demo block scene changed, the one expected message)
     ("malformed TOML", BLOCK.replace('E = "4 GPa"', 'E = "4 GPa'), "not valid TOML: "),
     ("not a table", "loading = 3\n" + BLOCK.replace('[loading]\npressure = "1 MPa"\n', ""),
      "loading = 3: must be a table [loading]"),
+    ("unknown thermal surface", COOLED.replace('"free:block"', '"block_topp"'),
+     'boundary[1].surfaces: "block_topp" is not a surface of builder "block_on_flat"; known: block_top, '
+     "flat_bottom, symmetry_x, symmetry_y, free:block, free:flat"),
+    ("unknown free: body", COOLED.replace('"free:block"', '"free:blok"'),
+     'boundary[1].surfaces: "free:blok" is not a surface of builder "block_on_flat"'),
+    ("ambient without convection or emissivity", COOLED.replace('convection = "10 W/(m^2 K)"', 'temperature = "300 K"'),
+     "boundary[1].ambient: only used with boundary[1].convection or boundary[1].emissivity"),
+    ("convection table of one row", COOLED.replace('"10 W/(m^2 K)"', '[["0 rad/s", 10]]'),
+     'boundary[1].convection = [["0 rad/s", 10]]: needs at least 2 rows [speed, h] with increasing speed'),
+    ("material table of one row", THERMAL.replace('kappa = "5 W/(m K)"', 'kappa = [["300 K", 5]]'),
+     'materials.block.kappa = [["300 K", 5]]: needs at least 2 rows [temperature, kappa] with increasing '
+     "temperature"),
+    ("material table out of order", THERMAL.replace('kappa = "5 W/(m K)"', 'kappa = [["400 K", 5], ["300 K", 6]]'),
+     'materials.block.kappa = [["400 K", 5], ["300 K", 6]]: temperature must increase strictly from row to row'),
 ]
 
 
 @pytest.mark.parametrize("name, text, message", BAD, ids=[b[0] for b in BAD])
 def test_bad_scene_gives_one_clear_line_and_exit_2(tmp_path, capsys, name, text, message):
-    assert text not in (BLOCK, THERMAL)
+    assert text not in (BLOCK, THERMAL, COOLED)
     path = _write(tmp_path, text)
     assert main(["check", path]) == 2
     err = capsys.readouterr().err
@@ -128,6 +144,15 @@ def test_run_refuses_to_overwrite_results(tmp_path, capsys, monkeypatch):
     assert main(["run", path, "--resume"]) == 0
     assert fake_runner == [("block_on_flat", True, False), ("block_on_flat", False, True)]
     assert (tmp_path / "out" / "history.h5").exists()          # the CLI itself deletes nothing
+
+
+def test_run_refuses_heat_in_a_sliding_translating_body(tmp_path, capsys):
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")   # the real workflow
+    path = _write(tmp_path, COOLED.replace("../results/block_on_flat", "out")
+                  .replace('pressure = "1 MPa"', 'pressure = "1 MPa"\nsliding_speed = "0.1 m/s"'))
+    assert main(["run", path]) == 2
+    errors = [line for line in capsys.readouterr().err.splitlines() if line.startswith("error: ")]
+    assert len(errors) == 1 and "loading.sliding_speed = 0.1: heat transport needs a rotating body" in errors[0]
 
 
 def test_run_bad_scene_does_not_reach_the_runner(tmp_path, capsys, fake_runner):

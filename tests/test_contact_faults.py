@@ -143,3 +143,19 @@ def test_bad_heights_are_named(heights, name):
         with pytest.raises(InputError) as info:
             solve_contact(heights, 1e-6, E, load=1e6)
         assert info.value.name == "heights"
+
+
+@pytest.mark.parametrize("kwargs, name", [
+    (dict(n=64.5), "n"), (dict(n="64"), "n"), (dict(n=(64, 32.5)), "n"), (dict(seed=1.5), "seed"),
+    (dict(seed="a"), "seed"), (dict(seed=-1), "seed"), (dict(seed=True), "seed"), (dict(seed=None), "seed"),
+    (dict(batch=(2.5,)), "batch"), (dict(batch="3"), "batch"), (dict(batch=(0,)), "batch"),
+])
+def test_the_surfaces_fed_to_the_solver_check_sizes_and_seeds(kwargs, name):
+    """Float grid sizes were truncated, wrong seeds and batches raised numpy's errors."""
+    args = dict(n=16, size=1e-3, hurst=0.8, k_min=2, k_max=4, rms=1e-6)
+    args.update(kwargs)
+    with pytest.raises(InputError) as info:
+        fractal_surface(**args)
+    assert info.value.name == name
+    assert fractal_surface(16, 1e-3, 0.8, 2, 4, 1e-6, seed=np.int64(3), batch=3).heights.shape == (3, 16, 16)
+    assert fractal_surface(16, 1e-3, 0.8, 2, 4, 1e-6, seed=np.random.SeedSequence([3, 1])).heights.shape == (16, 16)

@@ -40,7 +40,7 @@ def test_force_balance_symmetry_and_leading_edge(tm, mech):
     # frictionless: the geometry is symmetric about y = 0, so is the pressure, up to the asymmetry
     # of the unstructured mesh (1.4 % of the half width measured on this mesh)
     assert abs(pressure_centre(tm, p0)[1]) < 0.03 * HALF
-    mech.contact.friction.value = MU
+    tm.interface.set_field(mech.contact.friction, MU)
     r = mech.solve()
     assert r.normal_force == pytest.approx(F, rel=1e-6)
     assert mech.contact.force()[2] == pytest.approx(F, rel=1e-6)
@@ -53,7 +53,7 @@ def test_force_balance_symmetry_and_leading_edge(tm, mech):
 
 
 def test_heat_into_both_bodies_is_mu_F_v_t(tm, mech):
-    mech.contact.friction.value = MU
+    tm.interface.set_field(mech.contact.friction, MU)
     mech.solve(F)
     tm.interface.set_field(mech.contact.partition, 0.14)
     heat = Thermal(mech.contact, MATERIALS, initial_temperature=293.15, dt=0.6, prefix="pod_heat_")

@@ -69,10 +69,13 @@ def test_scene_without_thermal_builds_no_heat_problem(tmp_path):
     assert [f.name for f in result.field_files] == ["block.xdmf", "flat.xdmf", "interface.xdmf"]
 
 
-def test_thermal_on_a_translating_flat_is_refused(tmp_path):
-    scene = loads(BLOCK.format(effects='"contact", "thermal"', folder=tmp_path / "out"))
+def test_thermal_on_a_sliding_translating_flat_is_refused(tmp_path):
+    scene = loads(BLOCK.format(effects='"contact", "thermal"', folder=tmp_path / "out"),
+                  overrides={"loading.sliding_speed": "0.1 m/s"})
     with pytest.raises(InputError, match="rotating body"):
         build_model(scene)
+    at_rest = build_model(loads(BLOCK.format(effects='"contact", "thermal"', folder=tmp_path / "out")))
+    assert at_rest.problems == ("mechanics", "heat")           # no transport at rest: allowed
 
 
 def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
@@ -89,6 +92,7 @@ def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
     assert h["stored_heat_pin"][-1] == pytest.approx(h["heat_total_pin"][-1], rel=1e-6)
     assert h["stored_heat_disc"][-1] == pytest.approx(h["heat_total_disc"][-1], rel=1e-2)
     assert np.all(np.diff(h["max_temperature_pin"]) > 0)
+    assert not any(k.startswith("heat_lost") for k in h.columns)      # insulated: no loss columns
     for f in result.field_files + [result.plot_file]:
         assert f.exists() and f.stat().st_size > 0
     with pytest.raises(InputError, match="--overwrite"):

@@ -33,13 +33,25 @@ def penetration(g):
 
 
 class PenaltyLaw:
-    """Perfect-contact penalty p_n = K_n <−g_n>_+ (thesis §7.3.1) with K_n a per-facet field [Pa/m]."""
+    """Perfect-contact penalty p_n = K_n <−g_n>_+ (thesis Eq. 1.28, §1.4.1; the perfect-contact model of
+    §7.3.1) with K_n a per-facet field [Pa/m]."""
 
     def __init__(self, stiffness: fem.Function):
         self.stiffness = stiffness
 
     def __call__(self, g):
         return self.stiffness("+") * penetration(g)
+
+
+class SumLaw:
+    """The sum of pressure laws (e.g. zone laws on the rough interfaces, each zero elsewhere, plus
+    a penalty law whose stiffness is zero on them)."""
+
+    def __init__(self, *laws):
+        self.laws = laws
+
+    def __call__(self, g):
+        return sum((law(g) for law in self.laws[1:]), self.laws[0](g))
 
 
 def rigid_velocity(motion: Rotation | Translation, x, speed: fem.Constant):
@@ -54,11 +66,13 @@ def rigid_velocity(motion: Rotation | Translation, x, speed: fem.Constant):
 class ContactInterface:
     """Interface forms between the displacement fields ``u0`` (body 0) and ``u1`` (body 1).
 
-    Per-facet fields (DG0 on the interface, set with ``tm.interface.set_field`` from global
-    per-facet arrays): ``stiffness`` K_n [Pa/m], ``initial_gap`` g_0 [m], ``partition`` p_1 (share
-    of the frictional heat into body 0) and ``conductance`` h_c [W/(m^2 K)]. ``friction`` (mu) and
-    ``speed`` (rad/s or m/s, see ``rigid_velocity``) are Constants. ``law`` defaults to
-    ``PenaltyLaw(stiffness)``; pass ``law=`` a callable to use another pressure–gap law.
+    Per-facet fields (DG0 on the interface, set with ``tm.interface.set_field`` from a scalar or
+    global per-facet arrays): ``stiffness`` K_n [Pa/m], ``initial_gap`` g_0 [m], ``friction`` mu
+    (one value per interface, or per facet), ``partition`` p_1 (share of the frictional heat into
+    body 0) and ``conductance`` h_c [W/(m^2 K)]. ``speed`` (rad/s or m/s, see ``rigid_velocity``)
+    and ``engaged`` (1: in contact; 0: released, no frictional heat and no conductance) are
+    Constants. ``law`` defaults to ``PenaltyLaw(stiffness)``; pass ``law=`` a callable to use another
+    pressure–gap law.
     """
 
     def __init__(self, tm: TwoBodyMesh, u0: fem.Function, u1: fem.Function, *, stiffness=1e13,
@@ -72,8 +86,9 @@ class ContactInterface:
         self.partition = iface.field("heat_partition", 0.5)
         self.conductance = iface.field("conductance", 0.0)
         self.law = law if law is not None else PenaltyLaw(self.stiffness)
-        self.friction = fem.Constant(tm.parent, float(friction))
+        self.friction = iface.field("friction", friction)
         self.speed = fem.Constant(tm.parent, float(speed))
+        self.engaged = fem.Constant(tm.parent, 1.0)
         self.normal = ufl.FacetNormal(tm.parent)("-")
         x = ufl.SpatialCoordinate(tm.parent)
         w = velocity if velocity is not None else rigid_velocity(tm.spec.motion, x, self.speed)
@@ -83,8 +98,10 @@ class ContactInterface:
         self.slip_direction = self.slip_velocity / ufl.sqrt(self.slip_speed**2 + VELOCITY_FLOOR**2)
         self.gap = self.initial_gap("+") + ufl.dot(u0("+") - u1("-"), self.normal)
         self.pressure = self.law(self.gap)
-        self.traction = self.pressure * self.normal + self.friction * self.pressure * self.slip_direction
-        self.heat_flux = self.friction * self.pressure * self.slip_speed
+        mu = self.friction("+")
+        self.traction = self.pressure * self.normal + mu * self.pressure * self.slip_direction
+        self.friction_traction = mu * self.pressure * self.slip_direction
+        self.heat_flux = self.engaged * mu * self.pressure * self.slip_speed
         self.cache = FormCache(tm)
 
     # ---- mechanics -------------------------------------------------------------------------
@@ -103,8 +120,20 @@ class ContactInterface:
 
     def friction_force(self) -> np.ndarray:
         """Resultant friction force on body 0 [N] (3-vector, mu p_n s integrated)."""
-        return self.cache.facet_integrals(
-            "f", lambda: self.friction * self.pressure * self.slip_direction, vector=True).sum(axis=0)
+        return self.facet_friction().sum(axis=0)
+
+    def friction_moment(self) -> float:
+        """Moment [N m] about the rotation axis of the friction on body 0 (the same integrand and
+        quadrature as the frictional heat: heat power = moment x angular speed)."""
+        motion = self.tm.spec.motion
+        axis = ufl.as_vector(np.asarray(motion.axis, float) / np.linalg.norm(motion.axis))
+        arm = ufl.SpatialCoordinate(self.tm.parent) - ufl.as_vector(motion.centre)
+        return float(self.cache.facet_integrals(
+            "m", lambda: ufl.dot(ufl.cross(arm, self.friction_traction), axis)).sum())
+
+    def facet_friction(self) -> np.ndarray:
+        """Friction force on body 0 per interface facet [N] (n_facets, 3), global order."""
+        return self.cache.facet_integrals("f", lambda: self.friction_traction, vector=True)
 
     def facet_pressure(self) -> np.ndarray:
         """Mean contact pressure per interface facet [Pa] (global order, every rank)."""
@@ -128,7 +157,7 @@ class ContactInterface:
             F0 = -p1 * self.heat_flux * r0("+") * dS
             F1 = -(1 - p1) * self.heat_flux * r1("-") * dS
         if conductance:
-            exchange = self.conductance("+") * (T0("+") - T1("-"))
+            exchange = self.engaged * self.conductance("+") * (T0("+") - T1("-"))
             G0, G1 = exchange * r0("+") * dS, -exchange * r1("-") * dS
             F0, F1 = (G0, G1) if F0 is None else (F0 + G0, F1 + G1)
         return F0, F1

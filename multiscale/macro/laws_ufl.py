@@ -97,11 +97,13 @@ class FacetLaw:
     """Per-facet nonlinear pressure–gap laws p_n(g_n) for ``ContactInterface(law=...)``.
 
     ``FacetLaw(tm, n_points)``; ``set_laws(laws, zone_of_facet, zone_area)`` gives facet i the
-    law of zone ``zone_of_facet[i]`` (a ``ZoneLaws``, global facet order); calling the object with
-    the UFL gap returns p_n. With ``zone_area`` (one per zone id) each facet's law is scaled by
-    A_zone / (area of the facets assigned to the zone), so that a zone carries exactly its micro
-    force at a uniform gap even when facets do not tile the zones exactly (scale 1 when they do).
-    ``laws``, ``zone_of_facet`` and ``scale`` are kept for numpy evaluations (``evaluate``).
+    law of zone ``zone_of_facet[i]`` (a ``ZoneLaws``, global facet order; -1: no law, p_n = 0 on
+    that facet, e.g. an interface in perfect contact whose penalty law is added separately);
+    calling the object with the UFL gap returns p_n. With ``zone_area`` (one per zone id) each
+    facet's law is scaled by A_zone / (area of the facets assigned to the zone), so that a zone
+    carries exactly its micro force at a uniform gap even when facets do not tile the zones
+    exactly (scale 1 when they do). ``laws``, ``zone_of_facet`` and ``scale`` are kept for numpy
+    evaluations (``evaluate``).
     """
 
     def __init__(self, tm, n_points: int):
@@ -124,13 +126,15 @@ class FacetLaw:
             raise InputError("zone_of_facet", zones.shape, f"one zone id per interface facet ({iface.n_facets})")
         if laws.mechanical is None or laws.mechanical.gap.shape[1] != self.n_points:
             raise InputError("laws", getattr(laws.mechanical, "gap", None), f"laws of {self.n_points} nodes")
-        self.scale = np.ones(iface.n_facets)
+        lawless = zones < 0
+        self.scale = np.where(lawless, 0.0, 1.0)
         if zone_area is not None:
-            covered = np.bincount(zones, iface.areas, minlength=len(zone_area))
-            self.scale = np.asarray(zone_area, dtype=float)[zones] / covered[zones]
+            covered = np.bincount(zones[~lawless], iface.areas[~lawless], minlength=len(zone_area))
+            self.scale[~lawless] = np.asarray(zone_area, dtype=float)[zones[~lawless]] / covered[zones[~lawless]]
         table = law_coefficients(laws.mechanical)
         owned = iface.owned_index
-        values = table[laws.rows(zones[owned])]
+        some = laws.ids[0] if len(laws.ids) else 0            # any law: scaled by 0 where lawless
+        values = table[laws.rows(np.where(lawless, some, zones)[owned])]
         values[:, _SCALE] = self.scale[owned]
         blocks = self.space.dofmap.list[:len(owned), 0]
         self.coefficients.x.array.reshape(-1, self.size)[blocks] = values
@@ -138,6 +142,8 @@ class FacetLaw:
         self.laws, self.zone_of_facet = laws, zones
 
     def evaluate(self, gap) -> tuple[np.ndarray, np.ndarray]:
-        """Per-facet (p_n [Pa], K_n [Pa/m]) of the numpy laws (scaled) at per-facet gaps [m]."""
-        v = self.laws.pressure(np.asarray(gap, dtype=float), self.zone_of_facet)
+        """Per-facet (p_n [Pa], K_n [Pa/m]) of the numpy laws (scaled) at per-facet gaps [m]
+        (0 on facets without a law)."""
+        zones = np.where(self.zone_of_facet < 0, self.laws.ids[0], self.zone_of_facet)
+        v = self.laws.pressure(np.asarray(gap, dtype=float), zones)
         return self.scale * v.pressure, self.scale * v.stiffness

@@ -1,10 +1,14 @@
 """Quasi-static elasticity of the two bodies, coupled only through the contact interface.
 
 Small-strain isotropic elasticity per material region, optional thermal strain alpha (T − T_ref) I
-(thesis Fig. 7.4, "contact problem with thermal expansion"), a normal load on the builder's load
-faces, zero-displacement supports, and the penalty/law contact with steady Coulomb sliding friction
-of ``interface.ContactInterface``. Solved monolithically (block Jacobian, MUMPS LU) by SNES Newton
-from rest with load ramping; failures raise ``ConvergenceError`` with the residual history.
+(thesis Fig. 7.4, "contact problem with thermal expansion"; alpha the mean, secant coefficient from
+T_ref), a normal load on the builder's load faces, zero-displacement supports, and the penalty/law
+contact with steady Coulomb sliding friction of ``interface.ContactInterface``. Solved
+monolithically (block Jacobian, MUMPS LU) by SNES Newton from rest with load ramping; failures
+raise ``ConvergenceError`` with the residual history.
+
+E, nu and alpha are constants per region (DG0) or, with a temperature field, piecewise-linear
+functions of T (``macro.materials``); without a temperature field, tables are taken at T_ref.
 """
 from __future__ import annotations
 
@@ -15,10 +19,12 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc as fpetsc
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.macro.interface import ContactInterface, PressureLaw
+from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
 NEWTON_OPTIONS = {
@@ -40,31 +46,6 @@ class SolveResult:
     max_pressure: float = 0.0      # Pa, largest per-facet mean pressure
 
 
-def material_values(tm: TwoBodyMesh, materials: Mapping[str, object], attribute, label: str | None = None) -> dict:
-    """{material name: value} for the materials the geometry uses.
-
-    ``attribute`` is an attribute name of the material objects or a callable(material) -> value;
-    a missing material or value raises InputError naming the scene field.
-    """
-    out = {}
-    for name in tm.spec.materials:
-        if name not in materials:
-            raise InputError(f"materials.{name}", None, "this material is used by the geometry and is missing")
-        value = attribute(materials[name]) if callable(attribute) else getattr(materials[name], attribute, None)
-        if value is None:
-            raise InputError(f"materials.{name}.{label or attribute}", None, "required by this model")
-        out[name] = float(value)
-    return out
-
-
-def body_fields(tm: TwoBodyMesh, materials: Mapping[str, object], attribute, name: str | None = None):
-    """Per-body DG0 fields (constant per region) of one material property (see material_values)."""
-    name = name or attribute
-    values = material_values(tm, materials, attribute, name)
-    return [body.cell_field(f"{name}_{body.name}", {r.tag: values[r.material] for r in body.spec.regions})
-            for body in tm.bodies]
-
-
 def load_face_forces(tm: TwoBodyMesh, load: float, load_kind: str) -> dict:
     """Resultant [N] of the load on each load face: its area's share of a force ``load`` [N]
     (``load_kind="force"``), or the (fluid) pressure ``load`` [Pa] times the face area."""
@@ -77,8 +58,9 @@ class Mechanics:
     """Two-body contact mechanics (see module docstring).
 
     ``materials`` maps material names (of the geometry's regions) to objects with ``E`` [Pa],
-    ``nu`` and, with ``temperatures`` given, ``alpha`` [1/K]. ``temperatures`` is a pair of P1
-    functions on the body submeshes (thermal expansion relative to ``reference_temperature`` [K]).
+    ``nu`` and, with ``temperatures`` given, ``alpha`` [1/K], each a constant or a temperature table
+    ((K, value), ...). ``temperatures`` is a pair of P1 functions on the body submeshes (thermal
+    expansion relative to ``reference_temperature`` [K], the temperature of tables without them).
     ``stiffness`` [Pa/m] (scalar or per-facet array), ``friction``, ``speed`` and ``law`` go to
     ``ContactInterface``. ``load`` is the total force [N] along the spec's load direction on its
     load faces (``load_kind="force"``), a traction [Pa] along it (``load_kind="pressure"``), or a
@@ -98,12 +80,13 @@ class Mechanics:
         self.tm = tm
         self.spaces = [fem.functionspace(b.mesh, ("Lagrange", degree, (3,))) for b in tm.bodies]
         self.u = [fem.Function(V, name=f"displacement_{b.name}") for V, b in zip(self.spaces, tm.bodies)]
-        self.E = body_fields(tm, materials, "E")
-        self.nu = body_fields(tm, materials, "nu")
         self.temperatures = temperatures
-        if temperatures is not None:
-            self.alpha = body_fields(tm, materials, "alpha")
         self.reference_temperature = float(reference_temperature)
+        T, T_ref = temperatures, self.reference_temperature
+        self.E = body_expressions(tm, materials, "E", T, T_ref)        # DG0, or UFL of T with tables
+        self.nu = body_expressions(tm, materials, "nu", T, T_ref)
+        if temperatures is not None:
+            self.alpha = body_expressions(tm, materials, "alpha", T, T_ref)
         self.contact = ContactInterface(tm, *self.u, stiffness=stiffness, friction=friction, speed=speed,
                                         law=law, velocity=velocity)
         self.load = fem.Constant(tm.parent, 0.0)        # N (force) or Pa (pressure), ramped
@@ -128,7 +111,7 @@ class Mechanics:
         return self.tm.dx(tuple(r.tag for r in self.tm.bodies[i].spec.regions))
 
     def stress(self, i: int):
-        """Cauchy stress of body i [Pa], sigma = C:(eps − alpha dT I)."""
+        """Cauchy stress of body i [Pa], sigma = C(T):(eps − alpha(T) (T − T_ref) I)."""
         E, nu = self.E[i], self.nu[i]
         lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
         eps = ufl.sym(ufl.grad(self.u[i]))
@@ -186,6 +169,7 @@ class Mechanics:
         reason, its = snes.getConvergedReason(), snes.getIterationNumber()
         history = list(self._history)
         finite = all(np.isfinite(history)) and all(np.isfinite(u.x.array).all() for u in self.u)
+        finite = bool(self.tm.comm.allreduce(finite, op=MPI.LAND))     # every rank decides alike
         result = SolveResult(reason > 0 and finite, reason, its, history)
         if not result.converged:
             raise ConvergenceError(

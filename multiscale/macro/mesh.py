@@ -207,6 +207,28 @@ class TwoBodyMesh:
             raise InputError("face", name, f"one of {', '.join(self.spec.faces)}")
         return self.spec.faces[name]
 
+    def surface(self, name: str) -> ufl.Measure:
+        """Boundary measure of a named surface: a named face (``ds(tag)``), or "free:<body or
+        region>", every exterior facet of the parent mesh that bounds that body's cells (the faces
+        that touch nothing else: not the interfaces, not the faces bonded to another part)."""
+        if not name.startswith("free:"):
+            return self.ds(self.face(name))
+        who = name[len("free:"):]
+        tags = [r.tag for b in self.bodies for r in b.spec.regions if who in (b.name, r.name)]
+        if not tags:
+            known = [b.name for b in self.bodies] + [r.name for b in self.bodies for r in b.spec.regions]
+            raise InputError("surfaces", name, f"free:<body or region>, one of {', '.join(dict.fromkeys(known))}")
+        tdim = self.parent.topology.dim
+        facets = dmesh.exterior_facet_indices(self.parent.topology)
+        f2c = self.parent.topology.connectivity(tdim - 1, tdim)
+        cells = np.array([f2c.links(f)[0] for f in facets], dtype=np.int32)
+        region = np.full(self.parent.topology.index_map(tdim).size_local
+                         + self.parent.topology.index_map(tdim).num_ghosts, -1)
+        region[self.cell_tags.indices] = self.cell_tags.values
+        chosen = facets[np.isin(region[cells], tags)].astype(np.int32)
+        rows = fem.compute_integration_domains(fem.IntegralType.exterior_facet, self.parent.topology, chosen)
+        return ufl.Measure("ds", domain=self.parent, subdomain_data=[(1, np.asarray(rows, dtype=np.int32))])(1)
+
     def body_of_face(self, name: str) -> int:
         """Index of the body that holds the named boundary face."""
         tag = self.face(name)
@@ -255,10 +277,10 @@ class FormCache:
         return self.facet_integrals(key, make) / self.tm.interface.areas
 
 
-def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD) -> TwoBodyMesh:
+def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometrySpec | None = None) -> TwoBodyMesh:
     """Run a gmsh builder (``multiscale.geometry``) on rank 0 and distribute the mesh (shared-facet
-    ghosting)."""
-    spec = builder.describe(params)
+    ghosting); ``spec`` (default: the builder's ``describe``) tags bodies, faces and interfaces."""
+    spec = spec or builder.describe(params)
     name = getattr(builder, "NAME", builder.__name__)
     error = None
     if comm.rank == 0:

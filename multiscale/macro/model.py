@@ -3,9 +3,13 @@ Fig. 7.4.
 
 ``MacroModel.macro_step`` advances one macro step Δt in ``substeps`` times {heat step over δt with
 the current contact state; contact solve with the new temperatures (thermal expansion) or the new
-speed}. ``start`` makes the first (ramped) contact solve; ``record`` gives one history row. The
-model is built from plain objects (``multiscale.workflows.model.build_model`` makes one from a
-scene).
+load}. The drive gives the load and the speed of the sliding body against time: while the load
+factor is 0 the contact is released (no solve, no frictional heat, no interface conductance) and
+the bodies only exchange heat with their surroundings. The sliding direction does not depend on the
+speed's magnitude, so a changing speed needs no contact solve (only its heat changes: a heat step
+takes the mean of the speeds at its ends, exact for a speed linear in time). ``start``
+makes the first (ramped) contact solve; ``record`` gives one history row. The model is built from
+plain objects (``multiscale.workflows.model.build_model`` makes one from a scene).
 """
 from __future__ import annotations
 
@@ -14,6 +18,7 @@ from typing import Callable
 
 import numpy as np
 
+from multiscale.errors import InputError
 from multiscale.macro.mechanics import Mechanics, SolveResult
 from multiscale.macro.mesh import TwoBodyMesh
 from multiscale.macro.thermal import Thermal
@@ -24,14 +29,19 @@ class Drive:
     """What drives the sliding contact: the normal load and the sliding speed of body 1.
 
     ``load``: N (mechanics ``load_kind="force"``) or Pa (pressure or fluid pressure), reached in
-    ``ramp_steps`` increments by the first solve; ``speed(t)``: rad/s (rotation) or m/s
-    (translation) at time t [s]; ``steady``: True when the speed never changes (no re-solve for it).
+    ``ramp_steps`` increments by the first solve, times ``factor(t)`` (0: released); ``speed(t)``:
+    rad/s (rotation) or m/s (translation) at time t [s]. With ``torque`` [N m] the load is a first
+    guess: after the first solve it is scaled so that the friction moment about the rotation axis
+    is the torque (the brake delivers what the vehicle needs, whatever the pressure distribution).
     """
 
     load: float
     speed: Callable[[float], float]
     ramp_steps: int = 1
-    steady: bool = True
+    factor: Callable[[float], float] = lambda t: 1.0
+    mean_factor: Callable[[float, float], float] = lambda t0, t1: 1.0   # mean of factor over [t0, t1]
+    steady: bool = True              # the speed never changes
+    torque: float | None = None      # N m, braking torque the friction must give
 
 
 @dataclass
@@ -44,7 +54,9 @@ class MacroModel:
     drive: Drive
     time: float = 0.0                                  # s
     heat_total: np.ndarray = field(default_factory=lambda: np.zeros(2))   # J, frictional heat in
+    heat_lost_recorded: np.ndarray = field(default_factory=lambda: np.zeros(2))   # J, lost at the last record
     last_solve: SolveResult | None = None
+    load: float | None = None                          # N or Pa at factor 1 (the drive's, or scaled to its torque)
 
     @property
     def contact(self):
@@ -58,10 +70,27 @@ class MacroModel:
         """Sliding speed of body 1 at time t: rad/s (rotation) or m/s (translation)."""
         return self.drive.speed(t)
 
+    @property
+    def released(self) -> bool:
+        """True while the load factor is 0 (no contact)."""
+        return self.contact.engaged.value == 0.0
+
     def start(self) -> SolveResult:
-        """First contact solve from rest with the drive's load ramp."""
+        """First contact solve from rest with the drive's load ramp (at the initial load factor;
+        a start in a released phase solves at the first engaged load, then releases); with a
+        torque, the load is scaled to it and solved again."""
         self.contact.speed.value = self.speed(0.0)
-        self.last_solve = self.mechanics.ramp(self.drive.load, self.drive.ramp_steps)
+        self.load = self.drive.load
+        factor = self.drive.factor(0.0) or 1.0
+        self.last_solve = self.mechanics.ramp(self.load * factor, self.drive.ramp_steps)
+        if self.drive.torque is not None:
+            moment = abs(self.contact.friction_moment())
+            if not moment > 0:
+                raise InputError("loading.vehicle", self.drive.torque, "braking needs a friction moment: give "
+                                 "friction and a speed at the start of the stop")
+            self.load *= self.drive.torque / moment
+            self.last_solve = self.mechanics.solve(self.load * factor)
+        self.contact.engaged.value = float(self.drive.factor(0.0) > 0)
         return self.last_solve
 
     def macro_step(self, dt: float, substeps: int = 1) -> np.ndarray:
@@ -70,23 +99,40 @@ class MacroModel:
         heat = np.zeros(2)
         delta = dt / substeps
         for _ in range(substeps):
-            if self.thermal is not None:
-                self.contact.speed.value = self.speed(self.time)
+            if self.thermal is not None:            # the mean speed of the step for a changing speed
+                self.contact.speed.value = self.speed(self.time) if self.drive.steady else \
+                    0.5 * (self.speed(self.time) + self.speed(self.time + delta))
+                # the pressure was solved at the load factor of the step's start: its heat scales
+                # with the mean factor over the step (a release inside the step, a load ramp)
+                solved = float(self.mechanics.load.value)
+                self.contact.engaged.value = self.drive.mean_factor(self.time, self.time + delta) * self.load / solved \
+                    if solved > 0 else 0.0
                 heat += self.thermal.step(delta).heat_in
             self.time += delta
-            speed_changed = not self.drive.steady and self.speed(self.time) != self.speed(self.time - delta)
-            if self.mechanics.temperatures is not None or speed_changed:
-                self.contact.speed.value = self.speed(self.time)
-                self.last_solve = self.mechanics.solve()
+            self.contact.speed.value = self.speed(self.time)
+            factor = self.drive.factor(self.time)
+            self.contact.engaged.value = float(factor > 0)
+            load = self.load * factor
+            if factor > 0 and (self.mechanics.temperatures is not None or load != self.mechanics.load.value):
+                self.last_solve = self.mechanics.solve(load)
         self.heat_total += heat
         return heat
 
     def record(self, heat_step=(0.0, 0.0)) -> dict:
-        """One history row at the current state (units: see ``multiscale.io.UNITS``)."""
-        row = {"time": self.time, "interface_force": self.last_solve.normal_force,
-               "friction_force": float(np.linalg.norm(self.contact.friction_force())),
-               "max_pressure": self.last_solve.max_pressure,
+        """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal
+        boundary conditions, ``heat_lost_step_<body>`` is the heat lost since the previous record."""
+        on = not self.released
+        row = {"time": self.time, "interface_force": self.last_solve.normal_force * on,
+               "friction_force": float(np.linalg.norm(self.contact.friction_force())) * on,
+               "max_pressure": self.last_solve.max_pressure * on,
                "newton_iterations": self.last_solve.iterations}
+        masks = self.tm.interface.masks()
+        if len(masks) > 1:                        # per interface (a brake's pads, a disc's pucks)
+            p, friction = self.contact.facet_pressure() * on, self.contact.facet_friction() * on
+            for name, m in masks.items():
+                row[f"interface_force_{name}"] = float(p[m] @ self.tm.interface.areas[m])
+                row[f"friction_force_{name}"] = float(np.linalg.norm(friction[m].sum(axis=0)))
+                row[f"max_pressure_{name}"] = float(p[m].max(initial=0.0))
         if self.thermal is not None:
             stored, hottest = self.thermal.stored_heat(), self.thermal.max_temperature()
             for i, body in enumerate(self.tm.bodies):
@@ -94,4 +140,10 @@ class MacroModel:
                 row[f"heat_step_{body.name}"] = heat_step[i]
                 row[f"heat_total_{body.name}"] = self.heat_total[i]
                 row[f"stored_heat_{body.name}"] = stored[i]
+            if self.thermal.boundaries:       # heat lost through convection, radiation, fixed temperatures
+                lost = self.thermal.heat_lost
+                for i, body in enumerate(self.tm.bodies):
+                    row[f"heat_lost_step_{body.name}"] = lost[i] - self.heat_lost_recorded[i]
+                    row[f"heat_lost_total_{body.name}"] = lost[i]
+                self.heat_lost_recorded = lost.copy()
         return row

@@ -17,7 +17,8 @@ from dolfinx import fem
 from dolfinx.fem import petsc as fpetsc
 
 from multiscale.errors import check_positive
-from multiscale.macro.mechanics import Mechanics, body_fields, load_face_forces
+from multiscale.macro.materials import body_fields
+from multiscale.macro.mechanics import Mechanics, load_face_forces
 
 
 @dataclass
@@ -25,7 +26,7 @@ class Preload:
     """Quasi-static sliding state before the modal analysis (§4.3.1, first step)."""
 
     pressure: float          # Pa or N, the load of the last step (a force for load_kind "force")
-    friction: float          # friction coefficient mu [-]
+    friction: dict           # friction coefficient mu [-] per interface name (its facets' mean)
     normal_force: dict       # N, per interface name: integral of p_n
     friction_force: dict     # N, per interface name: resultant of mu p_n s (3-vector)
     load_force: dict         # N, per load face: pressure times the face area (its share of a force load)
@@ -54,12 +55,13 @@ def preload(mech: Mechanics, pressure: float, steps: int = 1, reset: bool = True
         for u in mech.u:
             u.x.array[:] = 0.0
     solved = mech.ramp(pressure, steps)
-    friction_traction = c.friction * c.pressure * c.slip_direction
     normal, tangential = {}, {}
+    mu, masks = tm.interface.values(c.friction), tm.interface.masks()
     for name, dS in tm.interface.dS_tag.items():
         normal[name] = tm.assemble_scalar(c.pressure * dS)
-        tangential[name] = np.array([tm.assemble_scalar(friction_traction[i] * dS) for i in range(3)])
-    return Preload(float(pressure), float(c.friction.value), normal, tangential, loads,
+        tangential[name] = np.array([tm.assemble_scalar(c.friction_traction[i] * dS) for i in range(3)])
+    friction = {name: float(mu[m].mean()) for name, m in masks.items()}
+    return Preload(float(pressure), friction, normal, tangential, loads,
                    solved.max_pressure, solved.iterations, list(solved.residuals),
                    time.perf_counter() - t0)
 
@@ -68,7 +70,7 @@ def linearise(mech: Mechanics, materials: Mapping[str, object]):
     """(K, M) at the current state: K the consistent tangent (``ufl.derivative`` of the residual,
     non-symmetric with friction; it is the Newton matrix, overwritten by the next solve), M the
     block-diagonal mass with density ``rho`` of each material and diag 0 on Dirichlet rows."""
-    rho = body_fields(mech.tm, materials, "rho")
+    rho = body_fields(mech.tm, materials, "rho", mech.reference_temperature)
     form = fem.form(mech.mass_forms(rho), entity_maps=mech.tm.entity_maps)
     M = fpetsc.assemble_matrix(form, bcs=mech.bcs, diag=0.0)
     M.assemble()

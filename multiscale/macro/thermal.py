@@ -1,38 +1,118 @@
-"""Transient heat conduction in both bodies, the rotating disc in an Eulerian frame (thesis Fig. 7.4).
+"""Transient heat conduction in both bodies, the rotating disc in an Eulerian frame (thesis Fig. 7.4),
+with convection, radiation and fixed temperatures on named surfaces and temperature-dependent
+materials.
 
-Backward Euler in time, P1 in space. Body 1 (the disc) is advected by its rigid velocity
-w = omega e_z x r (steady sliding seen from the lab frame), stabilised by SUPG with
-tau = [(2/dt)^2 + (2|w|/h)^2 + 9 (4 chi/h^2)^2]^(-1/2). The interface heat sources come from
-``ContactInterface.heat_residuals``: the frictional flux mu p_n |w| split by the per-facet partition
-p_1, and with ``conductance`` an exchange h_c (T_0 − T_1). All other boundaries are adiabatic
-(§7.3.1: convection is neglected during the heating sequence), so the heat stored in the bodies
-equals the frictional energy dissipated.
+Equations (SI: T [K], t [s], lengths [m]). In each body, with the enthalpy per unit volume
+e(T) = ∫_{T_0}^{T} rho c(s) ds [J/m^3] (``macro.materials``; e = rho c (T − T_0) for a constant
+rho c) and the conductivity kappa(T) [W/(m K)],
+
+    de/dt + w·∇e = ∇·(kappa ∇T),
+
+w = 0 in body 0 and w = omega e × (x − c) in the rotating body 1 (steady sliding seen from the lab
+frame; a translating body is accepted only at rest, w = 0). Backward Euler in time, P1 in space,
+SUPG on body 1 with tau = [(2/dt)^2 + (2|w|/h)^2 + 9 (4 chi/h^2)^2]^(-1/2), chi = kappa/(rho c):
+find T^{n+1} such that for every test function r
+
+    ∫ [(e(T^{n+1}) − e(T^n))/dt r + kappa ∇T^{n+1}·∇r + rho c (w·∇T^{n+1}) r] dx + SUPG
+      − ∫_interface q_i r dS + ∫_convection h (T − T_a) r ds + ∫_radiation eps sigma (T^4 − T_a^4) r ds = 0
+
+with T = T_fix on fixed-temperature surfaces and ∂T/∂n = 0 (insulated) on every other surface
+(today's default, §7.3.1: convection neglected during the heating sequence). The interface sources
+q_i come from ``ContactInterface.heat_residuals``: the frictional flux mu p_n |w| split by the
+per-facet partition p_1, and with ``conductance`` an exchange h_c (T_0 − T_1). Boundary fluxes are
+positive out of the body: convection h [W/(m^2 K)] towards the ambient T_a (Newton's law of cooling,
+h constant or a function of the rotating body's speed, taken at the start of each step), grey-body
+radiation to surroundings at T_a with emissivity eps and sigma = 5.670374419e-8 W/(m^2 K^4)
+(Incropera & DeWitt, Fundamentals of Heat and Mass Transfer, §1.2.3). With constant materials and
+no radiation the step is one linear solve (LU); radiation or a temperature table makes it Newton's
+method (SNES, exact tangent of T^4, kappa(T) and e(T); LU).
+
+Energy balance. P1 test functions sum to one, so the residual summed over every dof of a body is
+its heat balance over the step. The heat lost [J] during a step, consistent with it, is
+dt ∫ h (T^{n+1} − T_a) ds through a convection surface, dt ∫ eps sigma ((T^{n+1})^4 − T_a^4) ds through
+a radiating one (same quadrature as the residual, exact for P1), and minus dt times the residual
+summed over the Dirichlet dofs of a fixed-temperature surface (its reaction flux). Hence
+
+    stored heat ∫ (e(T^{n+1}) − e(T_0)) dx = frictional heat in − heat lost − rim loss,
+
+exactly up to the solver tolerance; the rim loss dt ∮ e w·n ds of the advection term vanishes on an
+exact circle and is small on the faceted rim of the mesh (chords: w·n changes sign along each facet).
 """
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Mapping
+from typing import Callable, Mapping, Sequence
 
 import numpy as np
 import ufl
-from dolfinx import fem
+from dolfinx import fem, la
+from dolfinx import mesh as dmesh
 from dolfinx.fem import petsc as fpetsc
 from mpi4py import MPI
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.geometry import Rotation
 from multiscale.macro.interface import ContactInterface, rigid_velocity
-from multiscale.macro.mechanics import body_fields
-from multiscale.macro.mesh import FormCache
+from multiscale.macro.materials import body_properties, heat_capacity
+from multiscale.macro.mesh import FormCache, TwoBodyMesh
 
 LINEAR_OPTIONS = {"snes_type": "ksponly", "ksp_type": "preonly", "pc_type": "lu",
                   "pc_factor_mat_solver_type": "mumps"}
+NEWTON_OPTIONS = {"snes_type": "newtonls", "snes_linesearch_type": "basic", "snes_rtol": 1e-10,
+                  "snes_atol": 1e-12, "snes_stol": 1e-12, "snes_max_it": 30,
+                  "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+STEFAN_BOLTZMANN = 5.670374419e-8      # W/(m^2 K^4), CODATA 2018 (exact)
+CONVECTION_QUADRATURE = 2              # exact for h (T − T_a) r, P1 on flat facets
+RADIATION_QUADRATURE = 5               # exact for (T^4 − T_a^4) r, P1
+ENTHALPY_QUADRATURE = 3                # e(T) r with a tabulated rho c (same rule for the stored heat)
 
 
 def temperature_functions(tm, degree: int = 1) -> list:
     """P1 temperature functions [K] on the two body submeshes."""
     return [fem.Function(fem.functionspace(b.mesh, ("Lagrange", degree)), name=f"temperature_{b.name}")
             for b in tm.bodies]
+
+
+@dataclass(frozen=True)
+class ThermalBoundary:
+    """A thermal condition on named surfaces (``TwoBodyMesh.surface`` names: a face, or
+    "free:<body or region>"), on every body that holds some of their exterior facets.
+
+    ``convection``: h [W/(m^2 K)], a constant or a callable h(speed) of the rotating body's speed
+    [rad/s]; ``emissivity``: eps in (0, 1], radiation eps sigma (T^4 − T_a^4); ``ambient``: T_a [K]
+    of both (default: the initial temperature); ``temperature``: a fixed temperature [K] (not
+    combined with the others). Fluxes are positive out of the body."""
+
+    surfaces: tuple
+    convection: float | Callable[[float], float] | None = None
+    emissivity: float | None = None
+    ambient: float | None = None
+    temperature: float | None = None
+
+    def __post_init__(self):
+        if self.temperature is not None and (self.convection is not None or self.emissivity is not None):
+            raise InputError("temperature", self.temperature, "a fixed temperature excludes convection and radiation")
+        if self.temperature is None and self.convection is None and self.emissivity is None:
+            raise InputError("surfaces", self.surfaces, "give convection, emissivity or temperature")
+
+    def h(self, speed: float) -> float:
+        """Convection coefficient [W/(m^2 K)] at the speed [rad/s] (0 without convection)."""
+        if self.convection is None:
+            return 0.0
+        value = self.convection(speed) if callable(self.convection) else self.convection
+        return check_positive("convection", value, allow_zero=True)
+
+
+def surface_rows(tm: TwoBodyMesh, name: str) -> np.ndarray:
+    """(cell, local facet) rows (n, 2) on the parent mesh of the exterior facets of a named surface
+    owned by this rank."""
+    if name.startswith("free:"):
+        (_, rows), = tm.surface(name).subdomain_data()
+        return np.asarray(rows, dtype=np.int32).reshape(-1, 2)
+    facets = np.intersect1d(tm.facet_tags.find(tm.face(name)), dmesh.exterior_facet_indices(tm.parent.topology))
+    rows = fem.compute_integration_domains(fem.IntegralType.exterior_facet, tm.parent.topology,
+                                           facets.astype(np.int32))
+    return np.asarray(rows, dtype=np.int32).reshape(-1, 2)
 
 
 @dataclass
@@ -42,19 +122,35 @@ class ThermalStep:
     time: float                    # s, at the end of the step
     heat_in: tuple                 # J, frictional heat put into body 0 and body 1 during the step
     max_temperature: tuple         # K, per body
+    heat_lost: tuple = (0.0, 0.0)  # J, heat lost through the boundary conditions of each body
+
+
+@dataclass
+class AppliedBoundary:
+    """A ``ThermalBoundary`` on one body: its measure id and, for a fixed temperature, its BC."""
+
+    index: int                     # position in Thermal.boundaries
+    body: int
+    condition: ThermalBoundary
+    ambient: float                 # K
+    facets: np.ndarray             # facets of the body's submesh (this rank)
+    h: fem.Constant | None = None
+    bc: fem.DirichletBC | None = None
 
 
 class Thermal:
     """Heat problem of both bodies driven by the contact's frictional heat (see module docstring).
 
-    ``materials`` maps material names to ``multiscale.scene.Material`` (``kappa`` [W/(m K)],
-    ``heat_capacity`` rho c [J/(m^3 K)]). ``initial_temperature`` [K] is also the
-    reference of the stored-heat balance.
+    ``materials`` maps material names to ``multiscale.scene.Material``-like objects (``kappa``
+    [W/(m K)], ``rho`` and ``c`` or ``chi``; constants or temperature tables). ``initial_temperature``
+    [K] is also the reference of the stored heat. ``boundaries``: ``ThermalBoundary`` conditions
+    (none: every outer surface insulated).
     """
 
     def __init__(self, contact: ContactInterface, materials: Mapping[str, object], *,
                  initial_temperature: float = 293.15, dt: float = 1.0, frictional_heat: bool = True,
-                 conductance: bool = False, temperatures=None, prefix: str = "heat_"):
+                 conductance: bool = False, temperatures=None, boundaries: Sequence[ThermalBoundary] = (),
+                 prefix: str = "heat_"):
         tm = contact.tm
         self.tm, self.contact = tm, contact
         self.T = list(temperatures) if temperatures is not None else temperature_functions(tm)
@@ -63,56 +159,194 @@ class Thermal:
         self.T_ref = float(initial_temperature)
         for f in self.T + self.T_old:
             f.x.array[:] = self.T_ref
-        self.kappa = body_fields(tm, materials, "kappa")
-        self.rho_c = body_fields(tm, materials, "heat_capacity", "rho_c")
+        conductivity = body_properties(tm, materials, "kappa")
+        self.capacity = body_properties(tm, materials, "rho_c", of=heat_capacity)
+        self.kappa = [p.expression(T, self.T_ref) for p, T in zip(conductivity, self.T)]
+        self.kappa_constant = [p.constant for p in conductivity]
+        self.rho_c = [p.expression(T, self.T_ref) for p, T in zip(self.capacity, self.T)]
         self.dt = fem.Constant(tm.parent, check_positive("dt", dt))
         self.time = 0.0
         self.cache = FormCache(tm)
+        self.transport = isinstance(tm.spec.motion, Rotation)
+        self._check_motion()
         r = [ufl.TestFunction(V) for V in self.spaces]
         F = []
         for i in range(2):
-            dx = tm.dx(tuple(reg.tag for reg in tm.bodies[i].spec.regions))
-            rate = self.rho_c[i] * (self.T[i] - self.T_old[i]) / self.dt
-            F.append((rate * r[i] + self.kappa[i] * ufl.dot(ufl.grad(self.T[i]), ufl.grad(r[i]))) * dx)
-        F[1] += self._advection(r[1])
+            conduction = self.kappa[i] * ufl.dot(ufl.grad(self.T[i]), ufl.grad(r[i]))
+            if self.capacity[i].constant:
+                F.append((self._rate(i) * r[i] + conduction) * self._dx(i))
+            else:
+                F.append(self._rate(i) * r[i] * self._dx(i, ENTHALPY_QUADRATURE) + conduction * self._dx(i))
+        if self.transport:
+            F[1] += self._advection(r[1])
         Fi = contact.heat_residuals(self.T[0], self.T[1], r[0], r[1], frictional_heat=frictional_heat,
                                     conductance=conductance)
         self.residuals = [F[i] + Fi[i] if Fi[i] is not None else F[i] for i in range(2)]
         self.frictional_heat = frictional_heat
-        self.problem = fpetsc.NonlinearProblem(self.residuals, self.T, petsc_options_prefix=prefix,
-                                               petsc_options=LINEAR_OPTIONS, entity_maps=tm.entity_maps)
+        self.boundaries = tuple(boundaries)
+        self.applied = self._apply_boundaries(r)
+        self.bcs = [a.bc for a in self.applied if a.bc is not None]
+        self.lost_step = np.zeros((len(self.boundaries), 2))      # J, per condition and body, last step
+        self.lost_total = np.zeros((len(self.boundaries), 2))     # J, since the start
+        self.nonlinear = (any(b.emissivity is not None for b in self.boundaries)
+                          or not all(p.constant for p in conductivity + self.capacity))
+        self.problem = fpetsc.NonlinearProblem(self.residuals, self.T, bcs=self.bcs, petsc_options_prefix=prefix,
+                                               petsc_options=NEWTON_OPTIONS if self.nonlinear else LINEAR_OPTIONS,
+                                               entity_maps=tm.entity_maps)
+        self._residual_forms: dict = {}
+
+    # ---- forms -----------------------------------------------------------------------------
+    def _dx(self, i: int, degree: int | None = None):
+        """Volume measure of body i on the parent mesh (optionally a fixed quadrature degree)."""
+        tags = tuple(reg.tag for reg in self.tm.bodies[i].spec.regions)
+        return self.tm.dx(tags) if degree is None else self.tm.dx(tags, degree=degree)
+
+    def _rate(self, i: int):
+        """(e(T) − e(T_old))/dt [W/m^3]: rho c (T − T_old)/dt for a constant rho c."""
+        T, T_old = self.T[i], self.T_old[i]
+        if self.capacity[i].constant:
+            return self.rho_c[i] * (T - T_old) / self.dt
+        p = self.capacity[i]
+        return (p.integral(T, self.T_ref) - p.integral(T_old, self.T_ref)) / self.dt
+
+    def _check_motion(self) -> None:
+        """A translating body has no steady Eulerian frame: heat only at rest (no transport)."""
+        speed = float(self.contact.speed.value)
+        if not self.transport and speed != 0.0:
+            raise InputError("loading.sliding_speed", speed,
+                             "heat transport needs a rotating body: a translating finite body has no steady "
+                             "Eulerian frame (the heat problem runs with a translating body only at rest, "
+                             "sliding_speed = 0)")
 
     def _advection(self, r):
         """Eulerian transport of the rotating body 1 with SUPG (Brooks–Hughes)."""
         tm = self.tm
-        if not isinstance(tm.spec.motion, Rotation):
-            raise InputError("geometry.builder", type(tm.spec.motion).__name__,
-                             "heat transport needs a rotating body (a translating finite body has no "
-                             "steady Eulerian frame)")
         x = ufl.SpatialCoordinate(tm.parent)
         w = rigid_velocity(tm.spec.motion, x, self.contact.speed)
         T, rho_c, kappa = self.T[1], self.rho_c[1], self.kappa[1]
         h = ufl.CellDiameter(tm.parent)
         chi = kappa / rho_c
         tau = 1 / ufl.sqrt((2 / self.dt) ** 2 + 4 * ufl.dot(w, w) / h**2 + 9 * (4 * chi / h**2) ** 2)
-        residual = rho_c * ((T - self.T_old[1]) / self.dt + ufl.dot(w, ufl.grad(T)))
-        dx = tm.dx(tuple(reg.tag for reg in tm.bodies[1].spec.regions))
+        if self.capacity[1].constant:
+            residual = rho_c * ((T - self.T_old[1]) / self.dt + ufl.dot(w, ufl.grad(T)))
+        else:
+            residual = self._rate(1) + rho_c * ufl.dot(w, ufl.grad(T))
+        # a tabulated disc makes rho_c and tau high-degree expressions (UFL estimates 9): integrate
+        # with the enthalpy's rule, exact for the Galerkin part with P1 (constant materials: unchanged)
+        dx = self._dx(1) if self.capacity[1].constant and self.kappa_constant[1] else self._dx(1, ENTHALPY_QUADRATURE)
         return (rho_c * ufl.dot(w, ufl.grad(T)) * r + tau * ufl.dot(w, ufl.grad(r)) * residual) * dx
 
+    def _apply_boundaries(self, r) -> list[AppliedBoundary]:
+        """Measures, residual terms and Dirichlet conditions of the boundary conditions."""
+        tm, tdim = self.tm, self.tm.parent.topology.dim
+        rows = {}               # (condition, body) -> rows of the body's exterior facets
+        for k, cond in enumerate(self.boundaries):
+            for name in cond.surfaces:
+                found = surface_rows(tm, name)
+                if tm.comm.allreduce(len(found), op=MPI.SUM) == 0:
+                    raise InputError("boundary.surfaces", name, "has no exterior facet (an interface or a "
+                                     "face between two parts cannot carry a thermal condition)")
+                for i, body in enumerate(tm.bodies):
+                    inside = body.cell_map.sub_topology_to_topology(found[:, 0], inverse=True) >= 0
+                    rows.setdefault((k, i), []).append(found[inside])
+        applied, data = [], ([], [])
+        for (k, i), parts in rows.items():
+            found = np.unique(np.concatenate(parts), axis=0)
+            if tm.comm.allreduce(len(found), op=MPI.SUM) == 0:
+                continue
+            body = tm.bodies[i]
+            sub_cells = body.cell_map.sub_topology_to_topology(found[:, 0], inverse=True)
+            body.mesh.topology.create_connectivity(tdim, tdim - 1)
+            c2f = body.mesh.topology.connectivity(tdim, tdim - 1)       # same local facets as the parent's cell
+            facets = np.unique(c2f.array[c2f.offsets[sub_cells] + found[:, 1]]).astype(np.int32)
+            cond = self.boundaries[k]
+            ambient = self.T_ref if cond.ambient is None else float(cond.ambient)
+            applied.append(AppliedBoundary(k, i, cond, ambient, facets))
+            data[i].append((k + 1, found.astype(np.int32).ravel()))
+        self.ds = [ufl.Measure("ds", domain=tm.parent, subdomain_data=d) if d else None for d in data]
+        for a in applied:
+            T, ds = self.T[a.body], self.ds[a.body]
+            c = a.condition
+            if c.temperature is not None:
+                dofs = fem.locate_dofs_topological(self.spaces[a.body], tdim - 1, a.facets)
+                a.bc = fem.dirichletbc(float(c.temperature), dofs, self.spaces[a.body])
+            if c.convection is not None:
+                a.h = fem.Constant(tm.parent, c.h(float(self.contact.speed.value)))
+                self.residuals[a.body] += a.h * (T - a.ambient) * r[a.body] * ds(a.index + 1,
+                                                                                  degree=CONVECTION_QUADRATURE)
+            if c.emissivity is not None:
+                self.residuals[a.body] += self._radiation(a) * r[a.body] * ds(a.index + 1,
+                                                                              degree=RADIATION_QUADRATURE)
+        return applied
+
+    def _radiation(self, a: AppliedBoundary):
+        """eps sigma (T^4 − T_a^4) [W/m^2], out of the body."""
+        return a.condition.emissivity * STEFAN_BOLTZMANN * (self.T[a.body] ** 4 - a.ambient**4)
+
+    # ---- solution --------------------------------------------------------------------------
     def step(self, dt: float) -> ThermalStep:
         """Advance by dt [s] with the current contact state (pressure, speed) as heat source."""
         self.dt.value = check_positive("dt", dt)
+        self._check_motion()
+        speed = float(self.contact.speed.value)
+        for a in self.applied:
+            if a.h is not None:
+                a.h.value = a.condition.h(speed)
         power = self.contact.heat_power() if self.frictional_heat else (0.0, 0.0)
         for new, old in zip(self.T, self.T_old):
             old.x.array[:] = new.x.array
         self.problem.solve()
         snes = self.problem.solver
-        ok = snes.getConvergedReason() > 0 and all(np.isfinite(T.x.array).all() for T in self.T)
+        finite = bool(self.tm.comm.allreduce(all(np.isfinite(T.x.array).all() for T in self.T), op=MPI.LAND))
+        ok = snes.getConvergedReason() > 0 and finite             # the same answer on every rank
         if not ok:
             raise ConvergenceError(f"heat step at t = {self.time + dt:.6g} s failed "
-                                   f"(SNES reason {snes.getConvergedReason()})")
+                                   f"(SNES reason {snes.getConvergedReason()}, "
+                                   f"{snes.getIterationNumber()} iterations)")
         self.time += dt
-        return ThermalStep(self.time, (power[0] * dt, power[1] * dt), self.max_temperature())
+        self.lost_step = self._losses(dt)
+        self.lost_total += self.lost_step
+        lost = self.lost_step.sum(axis=0)
+        return ThermalStep(self.time, (power[0] * dt, power[1] * dt), self.max_temperature(),
+                           (float(lost[0]), float(lost[1])))
+
+    def _losses(self, dt: float) -> np.ndarray:
+        """Heat lost [J] through each condition and body during the step just solved (see module
+        docstring): boundary integrals, and the reaction of the fixed-temperature dofs."""
+        out = np.zeros((len(self.boundaries), 2))
+        claimed = [np.empty(0, np.int32), np.empty(0, np.int32)]
+        residual = {}
+        for a in self.applied:
+            T, ds = self.T[a.body], self.ds[a.body]
+            key = (a.index, a.body)
+            if a.h is not None:
+                out[key] += dt * self.cache.scalar(("convection",) + key, lambda: a.h * (T - a.ambient) * ds(
+                    a.index + 1, degree=CONVECTION_QUADRATURE))
+            if a.condition.emissivity is not None:
+                out[key] += dt * self.cache.scalar(("radiation",) + key, lambda: self._radiation(a) * ds(
+                    a.index + 1, degree=RADIATION_QUADRATURE))
+            if a.bc is not None:
+                if a.body not in residual:
+                    residual[a.body] = self._residual_vector(a.body)
+                dofs, owned = a.bc.dof_indices()
+                dofs = np.setdiff1d(dofs[:owned], claimed[a.body])      # a dof counts once
+                claimed[a.body] = np.union1d(claimed[a.body], dofs)
+                out[key] -= dt * self.tm.comm.allreduce(residual[a.body][dofs].sum(), op=MPI.SUM)
+        return out
+
+    def _residual_vector(self, i: int) -> np.ndarray:
+        """The heat residual of body i [W] at the current temperatures, assembled without boundary
+        conditions (owned and ghost dofs, ghost contributions added to their owners)."""
+        if i not in self._residual_forms:
+            self._residual_forms[i] = fem.form(self.residuals[i], entity_maps=self.tm.entity_maps)
+        vec = fem.assemble_vector(self._residual_forms[i])
+        vec.scatter_reverse(la.InsertMode.add)
+        return vec.array
+
+    @property
+    def heat_lost(self) -> np.ndarray:
+        """Heat lost [J] through the boundary conditions since the start, per body."""
+        return self.lost_total.sum(axis=0)
 
     def max_temperature(self) -> tuple:
         """Largest nodal temperature of each body [K]."""
@@ -120,13 +354,19 @@ class Thermal:
         return tuple(comm.allreduce(T.x.array.max(initial=-np.inf), op=MPI.MAX) for T in self.T)
 
     def stored_heat(self) -> tuple:
-        """Heat stored in each body since the start, integral of rho c (T − T_0) [J]."""
+        """Heat stored in each body since the start [J], ∫ (e(T) − e(T_0)) dx (rho c (T − T_0) for
+        a constant rho c)."""
         def energy(i):
-            dx = self.tm.dx(tuple(reg.tag for reg in self.tm.bodies[i].spec.regions))
-            return self.rho_c[i] * (self.T[i] - self.T_ref) * dx
+            p = self.capacity[i]
+            if p.constant:
+                return self.rho_c[i] * (self.T[i] - self.T_ref) * self._dx(i)
+            return p.integral(self.T[i], self.T_ref) * self._dx(i, ENTHALPY_QUADRATURE)
         return tuple(self.cache.scalar(("stored", i), lambda: energy(i)) for i in range(2))
 
     def facet_temperature(self, side: int = 0) -> np.ndarray:
         """Mean temperature per interface facet [K] of body 0 ("+") or body 1 ("−")."""
         T = self.T[0]("+") if side == 0 else self.T[1]("-")
         return self.cache.facet_mean(("T", side), lambda: T)
+
+
+__all__ = ["STEFAN_BOLTZMANN", "Thermal", "ThermalBoundary", "ThermalStep", "temperature_functions"]

@@ -101,12 +101,12 @@ def estimate(operator: InfluenceOperator, work: Scratch, z, p, u, target, delta,
     return eps, d
 
 
-def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray, target, delta, tol: float,
-        max_iter: int, history: list, upper=None) -> dict:
-    """Iterate on the chunk (z, p: (B, ny, nx) contiguous; p the feasible start, balanced under
+def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray, u: np.ndarray, target, delta,
+        tol: float, max_iter: int, history: list, upper=None) -> dict:
+    """Iterate on the chunk (z, p, u: (B, ny, nx) contiguous; p the feasible start, balanced under
     load control: ``target`` the mean pressures, else ``delta`` the approaches; ``upper`` the
-    pressure bounds H (B,), None: elastic). p is updated in place; returns u, d, iterations,
-    residual (eps), converged; ``history`` gets the largest eps per iteration."""
+    pressure bounds H (B,), None: elastic). p and u (= L p) are updated in place; returns d,
+    iterations, residual (eps), converged; ``history`` gets the largest eps per iteration."""
     B, ny, nx = z.shape
     N, Fx = ny * nx, operator.fft_shape[1]
     ws = work.ws
@@ -115,7 +115,6 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
     load_control = target is not None
     target = np.ascontiguousarray(np.zeros(B) if target is None else target, dtype=float)
     delta = np.ascontiguousarray(np.zeros(B) if delta is None else delta, dtype=float)
-    u = np.zeros((B, ny, nx))
     z2, p2, u2 = z.reshape(B, N), p.reshape(B, N), u.reshape(B, N)    # views
     active = np.ones(B, dtype=bool)
     d, pending, pnorm, eps, rt, tau, rho_old, csum, factor = (np.zeros(B) for _ in range(9))
@@ -181,4 +180,4 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
             exact(active)
             since = 0
     converged = eps <= tol
-    return dict(u=u, d=d, iterations=iterations, residual=eps, converged=converged)
+    return dict(d=d, iterations=iterations, residual=eps, converged=converged)

@@ -13,9 +13,9 @@ control the rigid approach. Two methods give the same discrete answer:
 Both stop on the same unit-free criterion (see ``ContactSolver.solve``). With a ``hardness`` H
 (``"bccg"`` only) the surface is elastic-perfectly plastic: 0 <= p <= H, the cells at H flow
 plastically and their interpenetration is the permanent deformation (the bounded problem of
-Almqvist et al. 2007, Tribol. Int. 40, 574–579; Weber et al. 2018, Nat. Commun. 9, 888; ContactMechanics'
-hardness cut-off and tamaas' saturated solvers solve the same discrete problem). Batches of patches
-(leading axes) are solved in one call, each patch iterating on its own until it converges (then
+Almqvist et al. 2007, Tribol. Int. 40, 574–579; Weber et al. 2018, Nat. Commun. 9, 888;
+ContactMechanics' hardness cut-off and tamaas' saturated solvers solve the same discrete
+problem). Batches of patches (leading axes) are solved in one call, each patch iterating on its own until it converges (then
 it is frozen), so batched and looped answers agree; a batch runs in chunks of ``CHUNK_CELLS``
 cells that keep the working set in the CPU cache, spread over ``multiscale.micro.fft``'s threads.
 
@@ -32,13 +32,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from multiscale.errors import ConvergenceError, InputError
+from multiscale.errors import ConvergenceError, InputError, check_count, check_flag, check_positive
 from multiscale.micro import bccg_solver, pk_solver
 from multiscale.micro.fft import get_threads
-from multiscale.micro.kernels import InfluenceOperator, Kernel, positive_number, real_number
+from multiscale.micro.kernels import InfluenceOperator, Kernel
 
 METHODS = ("bccg", "pk")
-CHUNK_CELLS = 32768  # cells per chunk of the batch (a few such float arrays fit in L2)
+CHUNK_CELLS = {"bccg": 65536, "pk": 32768}   # cells per chunk of a batch (the working set stays in L2)
 COARSE_MIN = 32      # smallest side of the grids of the nested start of "bccg"
 COARSE_TOL = 1e-1    # tolerance of the coarse solves of the nested start
 
@@ -56,7 +56,7 @@ class ContactResult:
     approach: np.ndarray       # m, rigid approach delta from first touch
     mean_gap: np.ndarray       # m, mean separation between the flat and the deformed surface
     plastic_area_fraction: np.ndarray  # cells at p = H (plastic flow) / all cells; 0 without a hardness
-    plastic: np.ndarray        # m, permanent (plastic) deformation, >= 0 into the solid: u + z - d < 0 at p = H
+    plastic: np.ndarray | None  # m, permanent (plastic) deformation, >= 0 into the solid: d - z - u at p = H
     iterations: np.ndarray     # per patch
     residual: np.ndarray       # per patch, see ContactSolver.solve
     converged: np.ndarray      # bool per patch
@@ -119,12 +119,11 @@ class ContactSolver:
             raise InputError("heights.shape", h.shape, "the batch holds no patch")
         if not np.all(np.isfinite(h)):
             raise InputError("heights", "array with NaN/inf", "all heights must be finite")
-        tol = positive_number("tol", tol)
+        tol = check_positive("tol", tol)
         if tol >= 1:
             raise InputError("tol", tol, "relative tolerance must lie in (0, 1)")
-        max_iter = _count("max_iter", max_iter)
-        if not isinstance(partial, (bool, np.bool_)):
-            raise InputError("partial", partial, "must be True or False")
+        max_iter = check_count("max_iter", max_iter)
+        check_flag("partial", partial)
         if (load is None) == (approach is None):
             raise InputError("load/approach", (load, approach), "give exactly one of them")
         batch = h.shape[:-2]
@@ -162,27 +161,35 @@ class ContactSolver:
             p0 = _batch_values("initial_pressure", initial_pressure, h.shape)
             if np.any(p0 < 0) or not np.all(np.isfinite(p0)):
                 raise InputError("initial_pressure", "array", "must be finite and >= 0")
-        return self._run_chunks(method, z, target, delta, tol, max_iter, p0, partial, upper)
+        return self._run_chunks(method, z, target, delta, tol, max_iter, p0, partial, upper=upper)
 
-    def _run_chunks(self, method, z, target, delta, tol, max_iter, p0, partial, upper=None):
+    def _run_chunks(self, method, z, target, delta, tol, max_iter, p0, partial, fields=True, upper=None):
         """Run the iterations on chunks of the batch small enough for the CPU cache (the full-grid
         passes are memory bound: 400 patches of 64² in one block run ~2x slower than in chunks
-        of 8), on ``get_threads()`` threads when there are several chunks, then assemble."""
+        of 8), on ``get_threads()`` threads when there are several chunks; each chunk makes its
+        start (its nested coarse solve) and fills its part of the result (``fields``: the gap and
+        the means, not needed by a nested start; ``upper``: the hardness per patch or None)."""
         batch, grid = z.shape[:-2], z.shape[-2:]
         B = int(np.prod(batch, dtype=int))
-        size = max(1, CHUNK_CELLS // (grid[0] * grid[1]))
+        size = max(1, CHUNK_CELLS[method] // (grid[0] * grid[1]))
         z = np.ascontiguousarray(np.reshape(z, (B,) + grid))
-        p = self._initial_pressure(method, z, None if target is None else np.reshape(target, B),
-                                   None if delta is None else np.reshape(delta, B),
-                                   None if p0 is None else np.reshape(p0, (B,) + grid), max_iter,
-                                   None if upper is None else np.reshape(upper, B))
-        upper = None if upper is None else np.ascontiguousarray(np.reshape(upper, B), dtype=float)
         target = None if target is None else np.ascontiguousarray(np.reshape(target, B), dtype=float)
         delta = None if delta is None else np.ascontiguousarray(np.reshape(delta, B), dtype=float)
+        p0 = None if p0 is None else np.reshape(p0, (B,) + grid)
+        upper = None if upper is None else np.ascontiguousarray(np.reshape(upper, B), dtype=float)
         chunks = [slice(i, min(i + size, B)) for i in range(0, B, size)]
         threads = min(get_threads(), len(chunks))
+        p, u = np.empty_like(z), np.empty_like(z)
+        out = {k: np.zeros(B, dtype=t) for k, t in (("d", float), ("iterations", int), ("residual", float),
+                                                    ("converged", bool), ("area_fraction", float),
+                                                    ("mean_pressure", float), ("mean_gap", float))}
+        gap = np.empty_like(p) if fields else None
+        plastic = np.zeros_like(p) if fields and upper is not None else None
+        out["plastic_area_fraction"] = np.zeros(B)
+        histories = [None] * len(chunks)
 
-        def one(c):
+        def one(k):
+            c = chunks[k]
             key = (method, c.stop - c.start, 1 if threads > 1 else get_threads())
             free = self._scratch.setdefault(key, queue.SimpleQueue())
             try:
@@ -190,15 +197,17 @@ class ContactSolver:
             except queue.Empty:
                 work = self._new_scratch(method, *key[1:])
             history: list = []
-            args = (z[c], p[c], None if target is None else target[c], None if delta is None else delta[c],
-                    tol, max_iter, history)
+            tc, dc = (None if a is None else a[c] for a in (target, delta))
+            uc = None if upper is None else upper[c]
+            p[c] = self._initial_pressure(method, z[c], tc, dc, None if p0 is None else p0[c], max_iter, uc)
+            args = (z[c], p[c], u[c], tc, dc, tol, max_iter, history)
             try:
                 with np.errstate(all="ignore"):
                     if method == "bccg":
-                        out = bccg_solver.run(self.operator, work, *args, None if upper is None else upper[c])
+                        part = bccg_solver.run(self.operator, work, *args, uc)
                     else:
-                        out = pk_solver.run(self.operator, work[0], work[1], *args)
-                    finite = all(np.all(np.isfinite(out[k])) for k in ("u", "d")) and np.all(np.isfinite(p[c]))
+                        part = pk_solver.run(self.operator, work[0], work[1], *args)
+                    finite = np.all(np.isfinite(part["d"])) and np.all(np.isfinite(u[c])) and np.all(np.isfinite(p[c]))
             except FloatingPointError:
                 finite = False
             if not finite:
@@ -208,16 +217,38 @@ class ContactSolver:
                 raise ContactNonFiniteError("the contact iteration overflowed float64 (non-finite pressure or "
                                             "displacement): rescale the problem (heights, load, modulus)")
             free.put(work)
-            out["history"] = history
-            return out
+            for name, values in part.items():
+                out[name][c] = values
+            histories[k] = history
+            out["mean_pressure"][c] = p[c].mean(axis=(1, 2))
+            if fields:
+                np.add(u[c], z[c], out=gap[c])
+                gap[c] -= part["d"][:, None, None]
+                if plastic is not None:                      # the interpenetration at p = H
+                    flow = p[c] >= uc[:, None, None]
+                    np.copyto(plastic[c], -gap[c], where=flow)
+                    np.maximum(plastic[c], 0.0, out=plastic[c])
+                    out["plastic_area_fraction"][c] = flow.mean(axis=(1, 2))
+                np.maximum(gap[c], 0.0, out=gap[c])
+                gap[c][p[c] > 0] = 0.0
+                out["area_fraction"][c] = np.mean(p[c] > 0, axis=(1, 2))
+                out["mean_gap"][c] = gap[c].mean(axis=(1, 2))
 
         if threads > 1:
             if self._pool is None or self._pool_threads != threads:
                 self._pool, self._pool_threads = ThreadPoolExecutor(threads), threads
-            parts = list(self._pool.map(one, chunks))
+            list(self._pool.map(one, range(len(chunks))))
         else:
-            parts = [one(c) for c in chunks]
-        result = self._assemble(z, p, parts, batch, upper)
+            for k in range(len(chunks)):
+                one(k)
+        length = max(len(h) for h in histories)
+        history = [max(h[k] for h in histories if k < len(h)) for k in range(length)]
+        cells = batch + grid
+        result = ContactResult(
+            pressure=p.reshape(cells), displacement=u.reshape(cells),
+            gap=gap.reshape(cells) if fields else None, contact=(p > 0).reshape(cells) if fields else None,
+            plastic=(np.zeros(cells) if plastic is None else plastic.reshape(cells)) if fields else None,
+            approach=out.pop("d").reshape(batch), history=history, **{k: v.reshape(batch) for k, v in out.items()})
         if not np.all(result.converged) and not partial:
             raise ContactConvergenceError(
                 f"contact solver did not converge in {max_iter} iterations "
@@ -264,37 +295,14 @@ class ContactSolver:
             self._coarse = ContactSolver(self.kernel, (ny // 2, nx // 2), 2 * op.dx, 2 * op.dy, self.periodic)
         zc = z.reshape(B, ny // 2, 2, nx // 2, 2).mean(axis=(2, 4))
         low = zc.min(axis=(1, 2))                        # the coarse top lies this far below the fine one
-        options = dict(tol=COARSE_TOL, max_iter=max_iter, partial=True, hardness=upper)
-        if target is not None:
-            r = self._coarse.solve(-zc, load=target, **options)
-        else:
-            dc = delta - low
-            if np.any(dc <= 0) or (self.periodic and np.any(dc >= (zc - low[:, None, None]).mean(axis=(1, 2)))):
+        zc -= low[:, None, None]
+        if target is None:
+            delta = delta - low
+            if np.any(delta <= 0) or (self.periodic and np.any(delta >= zc.mean(axis=(1, 2)))):
                 return None
-            r = self._coarse.solve(-zc, approach=dc, **options)
-        return np.repeat(np.repeat(r.pressure.reshape(B, ny // 2, nx // 2), 2, axis=1), 2, axis=2)
-
-    @staticmethod
-    def _assemble(z, p, parts, batch, upper) -> ContactResult:
-        u = np.concatenate([o["u"] for o in parts])
-        d = np.concatenate([o["d"] for o in parts])
-        length = max(len(o["history"]) for o in parts)
-        history = [max(o["history"][k] for o in parts if k < len(o["history"])) for k in range(length)]
-        g = u + z - d[:, None, None]
-        gap = np.where(p > 0, 0.0, np.maximum(g, 0.0))
-        if upper is None:
-            flow, plastic = np.zeros(p.shape, dtype=bool), np.zeros(p.shape)
-        else:
-            flow = p >= upper[:, None, None]
-            plastic = np.where(flow, np.maximum(-g, 0.0), 0.0)
-        cells = batch + z.shape[1:]
-        per = {k: np.concatenate([o[k] for o in parts]).reshape(batch) for k in ("iterations", "residual", "converged")}
-        return ContactResult(
-            pressure=p.reshape(cells), displacement=u.reshape(cells), gap=gap.reshape(cells),
-            contact=(p > 0).reshape(cells), area_fraction=np.mean(p > 0, axis=(1, 2)).reshape(batch),
-            mean_pressure=p.mean(axis=(1, 2)).reshape(batch), approach=d.reshape(batch),
-            mean_gap=gap.mean(axis=(1, 2)).reshape(batch), plastic_area_fraction=flow.mean(axis=(1, 2)).reshape(batch),
-            plastic=plastic.reshape(cells), history=history, **per)
+        r = self._coarse._run_chunks("bccg", zc, target, delta, COARSE_TOL, max_iter, None, True, fields=False,
+                                     upper=upper)
+        return np.repeat(np.repeat(r.pressure, 2, axis=1), 2, axis=2)
 
 
 def bounded_start(p, upper, total=None):
@@ -326,14 +334,6 @@ def _method(method) -> str:
     if not isinstance(method, str) or method not in METHODS:
         raise InputError("method", method, f"choose one of {', '.join(METHODS)}")
     return method
-
-
-def _count(name: str, value) -> int:
-    """A whole number >= 1 (no NaN, no silent truncation), else ``InputError``."""
-    v = real_number(name, value)
-    if not (np.isfinite(v) and v == int(v) and v >= 1):
-        raise InputError(name, value, "must be a whole number >= 1")
-    return int(v)
 
 
 def _batch_values(name: str, value, shape) -> np.ndarray:

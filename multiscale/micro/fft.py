@@ -15,6 +15,8 @@ import weakref
 import numpy as np
 import scipy.fft
 
+from multiscale.errors import check_count
+
 try:  # pragma: no cover - depends on the installation
     import pyfftw
 
@@ -29,7 +31,7 @@ _retired: dict = {}                            # grid -> [forward, inverse] of t
 def set_threads(n: int) -> None:
     """Threads used by FFT plans created from now on."""
     global _threads
-    _threads = max(1, int(n))
+    _threads = check_count("n", n)
 
 
 def get_threads() -> int:

@@ -26,11 +26,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from tqdm import tqdm
 
-from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.errors import (ConvergenceError, InputError, check_count, check_field, check_flag, check_instance,
+                               check_positive, check_real)
 from multiscale.micro.contact import ContactResult, ContactSolver
 from multiscale.micro.fft import RealFFT2
 from multiscale.micro.heat_kernels import Motion, ThermalMaterial, Translation, pulse_tables
-from multiscale.micro.kernels import Kernel
+from multiscale.micro.kernels import Kernel, grid_shape
 from multiscale.micro.surface import Surface
 
 
@@ -57,14 +58,14 @@ class InterfaceLayer:
     plane: float = 0.5
 
     def __post_init__(self):
-        if int(self.n) < 1:
-            raise InputError("n", self.n, "number of interface components must be >= 1")
+        n = check_count("n", self.n)
+        object.__setattr__(self, "n", n)
         for name in ("resistance", "capacitance"):
-            v = np.broadcast_to(np.asarray(getattr(self, name), dtype=float), (int(self.n),))
-            if not np.all(np.isfinite(v)) or np.any(v < 0):
-                raise InputError(name, getattr(self, name), f"{self.n} finite values >= 0 (or one)")
-            object.__setattr__(self, name, tuple(v.tolist()))
-        if not 0.0 <= self.plane <= 1.0:
+            v = check_field(name, getattr(self, name), nonnegative=True)
+            if v.size not in (1, n) or v.ndim > 1:
+                raise InputError(name, getattr(self, name), f"{n} finite values >= 0 (or one)")
+            object.__setattr__(self, name, tuple(np.broadcast_to(v, (n,)).tolist()))
+        if not 0.0 <= check_real("plane", self.plane) <= 1.0:
             raise InputError("plane", self.plane, "position of the heating plane in [0, 1]")
         self.weights  # validates the profile
 
@@ -83,7 +84,7 @@ class InterfaceLayer:
             else:
                 raise InputError("generation", self.generation, "'plane', 'uniform', 'linear' or n+1 weights")
         else:
-            w = np.asarray(self.generation, dtype=float)
+            w = check_field("generation", self.generation)
             if w.shape != (n + 1,) or np.any(w < 0) or not np.all(np.isfinite(w)) or w.sum() <= 0:
                 raise InputError("generation", self.generation, f"{n + 1} finite weights >= 0, not all 0")
         return w / w.sum()
@@ -105,6 +106,8 @@ class _Layer:
     dt = inf gives the steady jump Σ_m R^m (phi_1 − c_m phi)."""
 
     def __init__(self, interface: InterfaceLayer | None, dt: float, shape):
+        if interface is not None:
+            check_instance("interface", interface, InterfaceLayer, "an InterfaceLayer or None")
         self.R, self.e, self.c = (interface or InterfaceLayer()).terms(dt)
         self.diagonal = float(np.sum(self.R * (1 - self.e)))
         self.active = bool(np.any(self.R > 0))                   # R = 0: perfect contact (§6.3.6)
@@ -245,20 +248,28 @@ def _extrapolate(last, before):
 
 
 def _check_grid(shape, dx, dy):
-    ny, nx = (int(s) for s in shape)
-    if ny < 1 or nx < 1:
-        raise InputError("shape", shape, "grid needs at least one cell per side")
+    ny, nx = grid_shape("shape", shape, minimum=1)
     dx = check_positive("dx", dx)
     return (ny, nx), dx, check_positive("dy", dy if dy is not None else dx)
 
 
 def _check_pressure(pressure, shape):
-    p = np.asarray(pressure, dtype=float)
-    if p.ndim < 2 or p.shape[-2:] != shape:
+    p = check_field("pressure", pressure, min_ndim=2, nonnegative=True)
+    if p.shape[-2:] != shape:
         raise InputError("pressure.shape", p.shape, f"last two axes must be {shape}")
-    if not np.all(np.isfinite(p)) or np.any(p < 0):
-        raise InputError("pressure", "array", "contact pressure must be finite and >= 0")
     return p
+
+
+def _check_bodies(body1, body2):
+    for name, body in (("body1", body1), ("body2", body2)):
+        check_instance(name, body, ThermalMaterial, "a ThermalMaterial(kappa, diffusivity)")
+
+
+def _check_iteration(tol, max_iter, partial):
+    """The CG options of both heating solvers."""
+    check_positive("tol", tol)
+    check_flag("partial", partial)
+    return check_count("max_iter", max_iter)
 
 
 def _partition(part, total):
@@ -280,9 +291,9 @@ class TransientHeating:
                  dt: float, n_steps: int, dy: float | None = None):
         self.shape, self.dx, self.dy = _check_grid(shape, dx, dy)
         self.dt = check_positive("dt", dt)
-        self.n_steps = int(n_steps)
-        if self.n_steps < 1:
-            raise InputError("n_steps", n_steps, "at least one time step")
+        self.n_steps = check_count("n_steps", n_steps)
+        _check_bodies(body1, body2)
+        check_instance("motion", motion, Motion, "a Motion (Rotation or Translation)")
         self.body1, self.body2, self.motion = body1, body2, motion
         self._pad = _Padded(self.shape)
         self._tables2 = self._spectra(pulse_tables(self.shape, self.dx, self.dy, body2, self.dt, self.n_steps))
@@ -326,16 +337,18 @@ class TransientHeating:
         """
         p = _check_pressure(pressure, self.shape)
         mu = check_positive("mu", mu)
-        n_steps = self.n_steps if n_steps is None else int(n_steps)
-        if not 1 <= n_steps <= self.n_steps:
+        n_steps = self.n_steps if n_steps is None else check_count("n_steps", n_steps)
+        if not n_steps <= self.n_steps:
             raise InputError("n_steps", n_steps, f"between 1 and the tabulated {self.n_steps}")
-        check_positive("tol", tol)
+        max_iter = _check_iteration(tol, max_iter, partial)
+        check_flag("progress", progress)
+        field_times = check_field("field_times", field_times, nonnegative=True)
         batch, nb = p.shape[:-2], p.ndim - 2
         mask = p > 0
         area = self.dx * self.dy
         edges = self.dt * np.arange(n_steps + 1)
         speed = self.motion.mean_speed(edges[:-1], edges[1:])               # m/s over each step
-        keep = np.unique(np.clip(np.rint(np.asarray(field_times, dtype=float) / self.dt).astype(int) - 1,
+        keep = np.unique(np.clip(np.rint(field_times / self.dt).astype(int) - 1,
                                  0, n_steps - 1))
         layer = _Layer(interface, self.dt, p.shape)
         spec_shape = (n_steps,) + batch + (2 * self.shape[0], self.shape[1] + 1)
@@ -411,6 +424,9 @@ class SteadyHeating:
                  dy: float | None = None, angle: float = 0.0):
         self.shape, self.dx, self.dy = _check_grid(shape, dx, dy)
         self.speed = check_positive("speed", speed, allow_zero=True)
+        _check_bodies(body1, body2)
+        if not np.isfinite(check_real("angle", angle)):
+            raise InputError("angle", angle, "must be finite [rad]")
         self.body1, self.body2 = body1, body2
         self._pad = _Padded(self.shape)
         motion = Translation.steady(self.speed, angle)
@@ -429,10 +445,11 @@ class SteadyHeating:
         """
         p = _check_pressure(pressure, self.shape)
         mu = check_positive("mu", mu)
-        th1, th2 = (float(v) for v in remote_temperatures)
-        if not (np.isfinite(th1) and np.isfinite(th2)):
+        th = check_field("remote_temperatures", remote_temperatures)
+        if th.shape != (2,):
             raise InputError("remote_temperatures", remote_temperatures, "two finite temperatures [K]")
-        check_positive("tol", tol)
+        th1, th2 = th
+        max_iter = _check_iteration(tol, max_iter, partial)
         layer = _Layer(interface, np.inf, p.shape)
         mask = p > 0
         phi = mu * p * self.speed
@@ -505,9 +522,10 @@ def partition_law(source, body1: ThermalMaterial, body2: ThermalMaterial, speed,
         if elastic is None or pressures is None:
             raise InputError("elastic/pressures", (elastic, pressures),
                              "a Surface needs an elastic kernel and mean pressures")
+        check_instance("elastic", elastic, Kernel, "an elastic Kernel")
         if source.heights.ndim != 2:
             raise InputError("source", source.heights.shape, "one patch (a 2-D height map)")
-        loads = np.sort(np.atleast_1d(np.asarray(pressures, dtype=float)))
+        loads = np.sort(np.atleast_1d(check_field("pressures", pressures)))
         if loads.ndim != 1 or not np.all(np.isfinite(loads)) or np.any(loads <= 0):
             raise InputError("pressures", pressures, "mean pressures must be finite and > 0")
         h = np.broadcast_to(source.heights, loads.shape + source.shape)
@@ -528,7 +546,7 @@ def partition_law(source, body1: ThermalMaterial, body2: ThermalMaterial, speed,
     mean = np.asarray(contact.mean_pressure, dtype=float).reshape(-1)[order]
     if np.any(mean <= 0) or np.any(np.diff(mean) <= 0):
         raise InputError("pressures", mean, "distinct mean pressures > 0")
-    speeds = np.sort(np.atleast_1d(np.asarray(speed, dtype=float)))
+    speeds = np.sort(np.atleast_1d(check_field("speed", speed)))
     if speeds.ndim != 1 or not np.all(np.isfinite(speeds)) or np.any(speeds <= 0):
         raise InputError("speed", speed, "sliding speeds must be finite and > 0 (no heat at rest)")
     rows = [SteadyHeating(p.shape[-2:], dx, body1, body2, v, dy, angle).solve(p, mu, interface=interface, tol=tol)

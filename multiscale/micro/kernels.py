@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multiscale.errors import InputError, check_positive
+from multiscale.errors import InputError, check_positive, check_real
 from multiscale.micro.fft import RealFFT2
 from multiscale.references.love import love_rectangle
 
@@ -60,16 +60,16 @@ class HalfSpace(Kernel):
     E_star: float
 
     def __post_init__(self):
-        object.__setattr__(self, "E_star", positive_number("E_star", self.E_star))
+        object.__setattr__(self, "E_star", check_positive("E_star", self.E_star))
 
     @classmethod
     def from_materials(cls, E: float, nu: float, E2: float = np.inf, nu2: float = 0.0) -> "HalfSpace":
         """Composite modulus of a solid (E, nu) against a second one (E2, nu2; default: rigid,
         E2 = inf). Poisson ratios in (-1, 0.5]."""
-        inv = (1 - poisson_ratio("nu", nu) ** 2) / positive_number("E", E)
+        inv = (1 - poisson_ratio("nu", nu) ** 2) / check_positive("E", E)
         nu2 = poisson_ratio("nu2", nu2)
-        if real_number("E2", E2) != np.inf:       # +inf: a rigid counter-face; nan, -inf, <= 0 refused
-            inv += (1 - nu2**2) / positive_number("E2", E2)
+        if check_real("E2", E2) != np.inf:       # +inf: a rigid counter-face; nan, -inf, <= 0 refused
+            inv += (1 - nu2**2) / check_positive("E2", E2)
         return cls(1.0 / inv)
 
     def compliance(self, q):
@@ -94,7 +94,7 @@ class ThermalHalfSpace(Kernel):
     kappa: float
 
     def __post_init__(self):
-        object.__setattr__(self, "kappa", positive_number("kappa", self.kappa))
+        object.__setattr__(self, "kappa", check_positive("kappa", self.kappa))
 
     def compliance(self, q):
         q = np.asarray(q, dtype=float)
@@ -106,24 +106,8 @@ class ThermalHalfSpace(Kernel):
         return love_rectangle(ox[None, :], oy[:, None], dx / 2, dy / 2) / (2 * np.pi * self.kappa)
 
 
-def real_number(name: str, value) -> float:
-    """``value`` as a float if it is a real number (not a string, a bool or an array), else
-    ``InputError`` naming ``name``; NaN and inf pass (callers check ranges)."""
-    if isinstance(value, (str, bytes, bool, np.bool_)) or np.ndim(value) != 0:
-        raise InputError(name, value, "must be a real number")
-    try:
-        return float(value)
-    except (TypeError, ValueError):
-        raise InputError(name, value, "must be a real number") from None
-
-
-def positive_number(name: str, value) -> float:
-    """A real number that is finite and > 0, else ``InputError``."""
-    return check_positive(name, real_number(name, value))
-
-
 def poisson_ratio(name: str, value) -> float:
-    nu = real_number(name, value)
+    nu = check_real(name, value)
     if not -1.0 < nu <= 0.5:
         raise InputError(name, value, "Poisson ratio must lie in (-1, 0.5]")
     return nu
@@ -183,8 +167,8 @@ class InfluenceOperator:
             raise InputError("periodic", periodic, "must be True or False")
         ny, nx = grid_shape("shape", shape)
         self.kernel, self.shape, self.periodic = kernel, (ny, nx), bool(periodic)
-        self.dx = positive_number("dx", dx)
-        self.dy = positive_number("dy", dy if dy is not None else dx)
+        self.dx = check_positive("dx", dx)
+        self.dy = check_positive("dy", dy if dy is not None else dx)
         if self.periodic:
             self.fft_shape = (ny, nx)
             spectrum = np.asarray(kernel.compliance(wavenumbers(ny, nx, self.dy, self.dx)), float)

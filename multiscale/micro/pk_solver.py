@@ -34,11 +34,12 @@ def rescale(p, target, z):
     return p * (target / mean)[:, None]
 
 
-def run(operator: InfluenceOperator, ws: ConvolutionWorkspace, estimator: bccg_solver.Scratch, z, p, target, delta,
-        tol: float, max_iter: int, history: list) -> dict:
-    """Polonsky–Keer iterations on B patches (z, p: (B, ny, nx), p feasible and balanced under
-    load control; ``target`` mean pressures or ``delta`` approaches: (B,)). p is updated in place;
-    returns u, d, iterations, residual, converged. ``estimator``: buffers of the stopping test."""
+def run(operator: InfluenceOperator, ws: ConvolutionWorkspace, estimator: bccg_solver.Scratch, z, p, u, target,
+        delta, tol: float, max_iter: int, history: list) -> dict:
+    """Polonsky–Keer iterations on B patches (z, p, u: (B, ny, nx), p feasible and balanced under
+    load control; ``target`` mean pressures or ``delta`` approaches: (B,)). p and u (= L p) are
+    updated in place; returns d, iterations, residual, converged. ``estimator``: buffers of the
+    stopping test."""
     L, grid = operator, z.shape[-2:]
     B, N = z.shape[0], grid[0] * grid[1]
     load_control = target is not None
@@ -48,7 +49,7 @@ def run(operator: InfluenceOperator, ws: ConvolutionWorkspace, estimator: bccg_s
     t[...] = 0.0
     p3, z3 = p, np.ascontiguousarray(z)
     pf = p.reshape(B, N)
-    u3 = np.zeros(p.shape)
+    u3 = u
     exact = np.ones(B, dtype=bool)
 
     def recompute(which):                     # u = L p exactly on the patches ``which`` (the
@@ -101,4 +102,4 @@ def run(operator: InfluenceOperator, ws: ConvolutionWorkspace, estimator: bccg_s
             since_refresh = 0
         else:
             recompute(corrected & active)
-    return dict(u=u3, d=d, iterations=iterations, residual=res, converged=res <= tol)
+    return dict(d=d, iterations=iterations, residual=res, converged=res <= tol)

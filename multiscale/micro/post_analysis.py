@@ -102,14 +102,15 @@ class PostAnalysis:
         self._heaters: dict[tuple, SteadyHeating] = {}
 
     def run(self, zones: list[Zone], load, *, speed, angle=0.0, remote=None, sliding=None,
-            warm=None) -> ZoneResult:
+            warm=None, mu=None) -> ZoneResult:
         """Post-analysis of ``zones`` at zone mean pressures ``load`` [Pa] > 0 (B,).
 
         speed [m/s] and angle [rad from +x] of the counter-face over each zone (B,); remote (B, 2)
         [K]: remote temperatures (counter-face, rough body) — needed with heating or a
         temperature-dependent k_w (without heating, k_w is taken at the rough body's); sliding
         (B,) [m]: distance worn over (None: no wear this call);
-        warm (B, ny, nx): previous local pressures (warm start; rows summing to 0 start cold).
+        warm (B, ny, nx): previous local pressures (warm start; rows summing to 0 start cold);
+        mu (B,): friction coefficient of each zone (default: the post-analysis' ``mu``).
         """
         B = len(zones)
         H = np.stack([z.surface.heights for z in zones]) if B else np.zeros((0,) + self.shape)
@@ -119,6 +120,7 @@ class PostAnalysis:
         if np.any(load <= 0):
             raise InputError("load", load, "zone pressures must be > 0 (skip unloaded zones)")
         speed, angle = _per_zone("speed", speed, B), _per_zone("angle", angle, B)
+        mu = np.full(B, self.mu) if mu is None else _per_zone("mu", mu, B)
         remote = None if remote is None else np.broadcast_to(np.asarray(remote, dtype=float), (B, 2))
         nan = np.full(B, np.nan)
         if B == 0:
@@ -133,7 +135,7 @@ class PostAnalysis:
                 raise InputError("remote", None, "heating needs the remote temperatures of both bodies")
             T = np.empty(H.shape)
             for b in range(B):
-                heat = self._heater(speed[b], angle[b]).solve(r.pressure[b], self.mu, tol=self.tol,
+                heat = self._heater(speed[b], angle[b]).solve(r.pressure[b], mu[b], tol=self.tol,
                                                               remote_temperatures=tuple(remote[b]))
                 T[b] = heat.temperature_2
                 max_T[b] = T[b].max()
@@ -151,7 +153,7 @@ class PostAnalysis:
             for _ in range(self.substeps):
                 # Archard with the per-zone sliding folded into the work density mu p ds [J/m^2]
                 worn = wear_step(Surface(heights, self.dx, self.dy, periodic=False),
-                                 self.mu * p * ds[:, None, None], self.rate, 1.0, 1.0, T)
+                                 mu[:, None, None] * p * ds[:, None, None], self.rate, 1.0, 1.0, T)
                 heights, depth = worn.surface.heights, depth + worn.depth
                 again = self._solve(zones, heights, load, p)
                 p = again.pressure

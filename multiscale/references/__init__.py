@@ -5,5 +5,6 @@ The solvers of ``multiscale.micro`` and ``multiscale.macro`` may import them; th
 nothing from the solvers. Modules: ``hertz`` (sphere and ellipsoid on a flat), ``love`` (uniform
 pressure on a rectangle or triangle), ``westergaard`` (sinusoidal contact), ``layered`` (one elastic
 layer), ``conduction`` (constriction and layered steady conduction), ``heat`` (heat sources),
-``stability`` (Hoffmann's 2-DOF mode-coupling model).
+``thermal`` (cooling by convection and radiation, a slab with convection, conduction with kappa(T))
+and ``stability`` (Hoffmann's 2-DOF mode-coupling model).
 """

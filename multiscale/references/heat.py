@@ -27,7 +27,7 @@ def uniform_flux_temperature(time, kappa: float, diffusivity: float, flux: float
 def point_source_deficit(time, power: float, kappa: float, diffusivity: float):
     """T_steady − T(t) [K] at a continuous surface point source Q switched on at t = 0:
     Q / (2 π^(3/2) κ sqrt(χ t)), the limit r → 0 of Q/(2π κ r) erf(r/sqrt(4 χ t)) (Carslaw & Jaeger
-    1959, ch. 10; thesis Eq. 6.1 integrated in time). Also the far-field (t → ∞) deficit of any
+    1959, ch. 10; thesis Eq. 6.1 with its area shrunk to a point). Also the far-field (t → ∞) deficit of any
     compact source of total power Q."""
     t = np.asarray(time, dtype=float)
     return power / (2 * np.pi**1.5 * kappa * np.sqrt(diffusivity * t))

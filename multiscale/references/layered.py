@@ -3,7 +3,7 @@
 
 Layer of thickness h [m], Young's modulus E [Pa] and Poisson ratio ν; frictionless normal load,
 displacement positive into the solid. F(q) = w_z/p [m/Pa per unit area] is the Fourier transfer
-function of the surface (thesis Eq. 3.8, F11 = −q F).
+function of the surface (thesis Eqs. 2.5 and 3.7: F11 = −q F; the printed Eq. 3.8 drops the 1/rho).
 """
 from __future__ import annotations
 

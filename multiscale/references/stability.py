@@ -11,7 +11,7 @@ coalesce (lock-in) where the root vanishes, at mu_c = [(k11 − k22)² + 4 k12 k
 and one of them grows beyond.
 
 Hoffmann, N., Fischer, M., Allgaier, R., Gaul, L. (2002), Mech. Res. Commun. 29, 197–205
-(thesis ch. 4, the analytic check of the complex eigenvalue analysis).
+(not in the thesis: the closed-form check of the package's ch. 4 complex eigenvalue analysis).
 """
 from __future__ import annotations
 

@@ -1,80 +1,164 @@
 """The scene-to-model factory: the only code that reads a scene's sections for the macro side.
 
-From a validated scene (``multiscale.scene``) it builds the mesh (the registered builder), the
-mechanics (materials per body, the interface law, the friction rule, the load), the heat problem
-(only with effect ``thermal``) and the drive (load, ramp, speed program), as plain objects for
-``multiscale.macro``. The rules that more than one analysis follows live here once:
+From a validated scene (``multiscale.scene``) it builds the mesh (the registered builder or the
+user's file), the mechanics (materials per body, the interface law, the friction of every
+interface, the supports and the load), the heat problem (only with effect ``thermal``) and the
+drive (load, ramp, load factor and speed against time), as plain objects for ``multiscale.macro``.
+The rules that more than one analysis follows live here once:
 
-- friction coefficient: ``loading.friction`` with effect ``friction``, else 0;
-- load: a fluid pressure for builders that declare ``fluid_load`` (the disc brake), else the
-  scene's normal force [N] or pressure [Pa] on the builder's load faces;
+- supports: the builder's, plus every [[boundary]] ``fix``; load faces and direction: [loading]
+  ``faces``/``direction``, else the builder's;
+- friction coefficient of an interface: its [interfaces.<name>] ``friction``, else
+  ``loading.friction``, with effect ``friction``; else 0;
+- load: a fluid pressure -p n for builders that declare ``fluid_load`` and for geometry files (a
+  normal force spread as the uniform pressure F / A of the load faces; with ``loading.direction``
+  a traction along it), else the scene's normal force [N] or pressure [Pa] on the load faces; with
+  ``loading.vehicle.mass`` the load whose friction moment about the axis is the braking torque
+  (braking force x wheel radius): first guessed with every interface carrying the same clamp
+  force N, sum_k mu_k N r_k = torque (r_k the interface's mean radius), then scaled by the model
+  after its first solve to the friction moment of the real pressure distribution;
 - interface forces: every interface carries its area's share of the resultant of the load on the
   load faces (``interface_forces``; what the rigid datum gap and the law range start from);
-- materials at an interface: the first region of each body (``interface_materials``).
+- materials at an interface: the first region of each body at the initial temperature
+  (``interface_materials``).
 """
 from __future__ import annotations
+
+import dataclasses
 
 import numpy as np
 from mpi4py import MPI
 
 from multiscale.errors import InputError
+from multiscale.geometry import GeometrySpec, Support
 from multiscale.macro import mesh as two_body
+from multiscale.macro.interface import PenaltyLaw, SumLaw
 from multiscale.macro.mechanics import Mechanics, load_face_forces
 from multiscale.macro.model import Drive, MacroModel
-from multiscale.macro.thermal import Thermal, temperature_functions
+from multiscale.macro.thermal import Thermal, ThermalBoundary, temperature_functions
 
 
-def friction_coefficient(scene) -> float:
-    """mu [-] of the sliding contact: ``loading.friction`` with effect "friction", else 0."""
-    return scene.loading.friction if scene.has("friction") else 0.0
+def friction_coefficient(scene, interface: str | None = None) -> float:
+    """mu [-] of an interface (default: ``loading.friction``) with effect "friction", else 0."""
+    if not scene.has("friction"):
+        return 0.0
+    return scene.interface_settings(interface).friction if interface is not None else scene.loading.friction
+
+
+def scene_spec(scene) -> GeometrySpec:
+    """The geometry's spec with the scene's supports, load faces and load direction."""
+    spec, ld = scene.geometry.spec, scene.loading
+    supports = spec.supports + tuple(Support(s, b.components) for b in scene.boundary if b.fix for s in b.surfaces)
+    changes = {"supports": supports}
+    if ld.faces:
+        changes["load_faces"] = tuple(ld.faces)
+    if ld.direction is not None:
+        changes.update(load_direction=tuple(ld.direction), fluid_load=False)
+    return dataclasses.replace(spec, **changes)
 
 
 def load_kind(scene) -> str:
-    """How the load acts: "fluid" (builders with ``fluid_load``), "force" or "pressure"."""
+    """How the load acts: "fluid" (-p n: builders with ``fluid_load``, files), "force" or "pressure"."""
     ld = scene.loading
-    if scene.geometry.spec.fluid_load:
-        if ld.pressure is None:
+    if scene_spec(scene).fluid_load:
+        if ld.pressure is None and scene.geometry.builder != "file" and (ld.vehicle is None or ld.vehicle.mass is None):
             raise InputError("loading.pressure", None, f'builder "{scene.geometry.builder}" is loaded by a '
                              "fluid pressure on its load faces (give loading.pressure)")
         return "fluid"
-    return "force" if ld.normal_force is not None else "pressure"
+    return "force" if ld.pressure is None else "pressure"
 
 
-def drive(scene) -> Drive:
-    """Load [N or Pa], ramp and speed program of body 1 (rad/s for a rotation, m/s for a translation)."""
-    ld = scene.loading
-    load = ld.normal_force if ld.normal_force is not None else ld.pressure
+def interface_radii(scene, tm) -> dict:
+    """Mean distance [m] of every interface from the rotation axis (area-weighted)."""
+    motion, iface = tm.spec.motion, tm.interface
+    axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
+    r = iface.midpoints - np.asarray(motion.centre, float)
+    r = np.linalg.norm(r - np.outer(r @ axis, axis), axis=1)
+    return {n: float(r[m] @ iface.areas[m] / iface.areas[m].sum()) for n, m in iface.masks().items()}
+
+
+def drive(scene, tm) -> Drive:
+    """Load [N or Pa] (``load_kind``), ramp, load factor and speed of body 1 (rad/s for a
+    rotation, m/s for a translation) against time."""
+    ld, kind = scene.loading, load_kind(scene)
+    force, torque = ld.normal_force, None
+    vehicle = ld.vehicle
+    if vehicle is not None and vehicle.mass is not None:
+        radius = interface_radii(scene, tm)
+        moment = sum(friction_coefficient(scene, n) * radius[n] for n in tm.interface.tags)
+        if moment <= 0:
+            raise InputError("loading.vehicle.mass", vehicle.mass, 'braking needs friction (effect "friction" and '
+                             "loading.friction > 0)")
+        torque = vehicle.braking_force * vehicle.wheel_radius
+        force = len(radius) * torque / moment          # a first guess: the model scales it to the torque
+    if force is not None and kind != "force":          # a force as a uniform pressure on the load faces
+        area = sum(tm.assemble_scalar(1.0 * tm.ds(tm.face(f))) for f in tm.spec.load_faces)
+        load = force / area
+    else:
+        load = force if force is not None else ld.pressure
     if scene.geometry.motion == "rotation":
-        return Drive(load, ld.angular_speed, ld.ramp_steps, steady=ld.speed_profile is None)
+        return Drive(load, ld.angular_speed, ld.ramp_steps, ld.factor, ld.mean_factor, ld.steady_speed, torque)
     speed = ld.sliding_speed or 0.0
-    return Drive(load, lambda t: speed, ld.ramp_steps)
+    return Drive(load, lambda t: speed, ld.ramp_steps, ld.factor, ld.mean_factor)
 
 
-def interface_materials(scene) -> tuple:
-    """Materials at the interface: (body 0, body 1), each body's first region."""
-    return tuple(scene.materials[b.regions[0].material] for b in scene.geometry.spec.bodies)
+def interface_materials(scene, interface: str | None = None) -> tuple:
+    """Materials on both sides of an interface (default: the first) at the initial temperature:
+    (body 0's region along it, body 1)."""
+    T0 = scene.time.initial_temperature
+    return tuple(scene.materials[m].at(T0) for m in scene.geometry.spec.interface_materials(interface))
 
 
 def build_mesh(scene, comm=MPI.COMM_WORLD) -> two_body.TwoBodyMesh:
-    """The scene's mesh (gmsh builder on rank 0, distributed)."""
-    return two_body.build(scene.geometry.module(), dict(scene.geometry.params), comm)
+    """The scene's mesh (gmsh on rank 0, distributed), with the scene's supports and loads."""
+    g = scene.geometry
+    params = g.params if g.builder == "file" else dict(g.params)
+    return two_body.build(g.module(), params, comm, spec=scene_spec(scene))
 
 
 def build_mechanics(scene, tm, *, law=None, temperatures=None, degree: int = 1,
                     prefix: str = "mech_") -> Mechanics:
-    """Quasi-static sliding mechanics of the scene on ``tm`` (perfect-contact penalty unless ``law``;
-    thermal expansion with ``temperatures``; Lagrange ``degree``)."""
-    return Mechanics(tm, dict(scene.materials), stiffness=scene.interface.penalty or 0.0,
-                     friction=friction_coefficient(scene), speed=drive(scene).speed(0.0), law=law,
+    """Quasi-static sliding mechanics of the scene on ``tm``: perfect-contact penalty, or ``law``
+    on the rough interfaces (``scene.rough_interfaces``) and the penalty on the others; thermal
+    expansion with ``temperatures``; Lagrange ``degree``; every interface's friction."""
+    penalty = scene.interface.penalty or 0.0
+    masks = tm.interface.masks()
+    if law is not None and len(scene.rough_interfaces) < len(masks):     # some interfaces in perfect contact
+        perfect = np.zeros(tm.interface.n_facets)
+        for name, m in masks.items():
+            if name not in scene.rough_interfaces:
+                perfect[m] = penalty
+        law = SumLaw(law, PenaltyLaw(tm.interface.field("perfect_stiffness", perfect)))
+    mu = np.zeros(tm.interface.n_facets)
+    for name, m in masks.items():
+        mu[m] = friction_coefficient(scene, name)
+    d = drive(scene, tm)
+    return Mechanics(tm, dict(scene.materials), stiffness=penalty, friction=mu, speed=d.speed(0.0), law=law,
                      temperatures=temperatures, reference_temperature=scene.time.initial_temperature,
                      load_kind=load_kind(scene), degree=degree, prefix=prefix)
+
+
+def thermal_conditions(scene) -> tuple[ThermalBoundary, ...]:
+    """The thermal conditions of [[boundary]] for the heat problem (none without effect "thermal"):
+    convection h [W/(m^2 K)], constant or against the rotating body's speed [rad/s]; radiation with
+    an emissivity; both towards ``ambient`` (default ``time.initial_temperature``); or a fixed
+    temperature. Surfaces without one are insulated; ``fix`` is a mechanical support."""
+    if not scene.has("thermal"):
+        return ()
+    T0 = scene.time.initial_temperature
+    return tuple(ThermalBoundary(tuple(b.surfaces), convection=b.h if b.convection is not None else None,
+                                 emissivity=b.emissivity, ambient=b.ambient if b.ambient is not None else T0,
+                                 temperature=b.temperature)
+                 for b in scene.boundary
+                 if any(v is not None for v in (b.convection, b.emissivity, b.temperature)))
 
 
 def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None) -> MacroModel:
     """Mesh and the problems the scene's effects ask for (no heat problem without ``thermal``).
 
-    ``law`` optionally replaces the perfect-contact penalty law (``macro.interface.PressureLaw``);
-    ``tm``: an already built mesh of the scene (e.g. the one the law's per-facet fields live on).
+    ``law`` optionally replaces the perfect-contact penalty law on the rough interfaces
+    (``macro.interface.PressureLaw``); ``tm``: an already built mesh of the scene (e.g. the one
+    the law's per-facet fields live on).
     """
     if not scene.has("contact"):
         raise InputError("effects", sorted(scene.effects), 'the macro model needs effect "contact"')
@@ -89,18 +173,22 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None) -> MacroModel:
     if T is not None:
         heat = Thermal(mech.contact, dict(scene.materials), initial_temperature=t.initial_temperature,
                        dt=t.dt / t.substeps, frictional_heat=scene.has("heat_partition"),
-                       conductance=scene.has("conductance"), temperatures=T)
+                       conductance=scene.has("conductance"), temperatures=T,
+                       boundaries=thermal_conditions(scene))
         if scene.has("heat_partition"):
-            tm.interface.set_field(mech.contact.partition, scene.partition)
+            share = np.zeros(tm.interface.n_facets)
+            for name, m in tm.interface.masks().items():
+                share[m] = scene.partition_at(name)
+            tm.interface.set_field(mech.contact.partition, share)
         if scene.has("conductance") and scene.interface.conductance is not None:   # else per facet later
             tm.interface.set_field(mech.contact.conductance, scene.interface.conductance)
-    return MacroModel(tm, mech, heat, drive(scene))
+    return MacroModel(tm, mech, heat, drive(scene, tm))
 
 
-def interface_forces(scene, tm) -> np.ndarray:
-    """Normal force [N] each interface (order of ``tm.interface.tags``) nominally carries: its
-    area's share of the load on the load faces (a pin carries the whole load; each pad of a brake
-    the clamp force of its piston)."""
-    total = sum(load_face_forces(tm, drive(scene).load, load_kind(scene)).values())
-    areas = np.array([tm.interface.areas[m].sum() for m in tm.interface.masks().values()])
-    return total * areas / areas.sum()
+def interface_forces(scene, tm) -> dict:
+    """Normal force [N] every interface nominally carries: its area's share of the load on the
+    load faces (a pin carries the whole load; each pad of a brake the clamp force of its piston)."""
+    d = drive(scene, tm)
+    total = sum(load_face_forces(tm, d.load, load_kind(scene)).values())
+    areas = {n: tm.interface.areas[m].sum() for n, m in tm.interface.masks().items()}
+    return {n: total * a / sum(areas.values()) for n, a in areas.items()}

@@ -55,7 +55,7 @@ class MultiscaleResult(TransientResult):
 
 def post_analysis(scene, zone) -> PostAnalysis:
     """The micro post-analysis of the scene's zones (``zone``: one of them, for the grid)."""
-    rough, counter = interface_materials(scene)
+    rough, counter = interface_materials(scene, scene.rough_interfaces[0])
     heating = None
     if scene.has("thermal") and scene.has("heat_partition"):
         heating = Heating(ThermalMaterial(counter.kappa, counter.diffusivity),
@@ -85,11 +85,12 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
     rough = build_rough_interface(scene, tm, progress=progress)
     model = build_model(scene, comm, law=rough.law, tm=tm)
     t, wear = scene.time, scene.has("wear")
+    mu = np.concatenate([np.full(g.n_zones, friction_coefficient(scene, n)) for n, g in zip(rough.names, rough.grids)])
     settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature,
                             partition=float(scene.partition) if scene.has("heat_partition") else np.nan,
                             partition_law=scene.micro.partition_law, wear=wear,
                             wear_every=scene.wear.update_every if wear else 1,
-                            forces=tuple(interface_forces(scene, tm)))
+                            forces=interface_forces(scene, tm), friction=mu)
     return Multiscale(model, rough, post_analysis(scene, rough.zones[0]), settings, fingerprint(scene))
 
 
@@ -148,7 +149,7 @@ def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: 
     for several interfaces) and zones.h5 (rank 0 writes; collective)."""
     rough = ms.rough
     plot, zones = folder / "multiscale.png", folder / "zones.h5"
-    names = list(ms.tm.interface.tags)
+    names = list(rough.names)
     maps = [] if not ms.settings.wear else [folder / "wear_map.png"] if len(names) == 1 else \
         [folder / f"wear_map_{n}.png" for n in names]
     depth = rough.wear_depth()

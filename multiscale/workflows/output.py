@@ -5,6 +5,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from multiscale.errors import SceneError
+from multiscale.io import on_root
 
 
 @dataclass
@@ -26,7 +27,11 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
         shown = ", ".join(existing[:3]) + (", ..." if len(existing) > 3 else "")
         raise SceneError(f'output.folder = "{folder}": already holds results ({len(existing)} entries: {shown}); '
                          "use --overwrite to replace them, --resume to continue the run, or choose another folder")
-    if comm.rank == 0:
+
+    def create():
         folder.mkdir(parents=True, exist_ok=True)
-    comm.barrier()
+        probe = folder / ".multiscale_write_test"
+        probe.write_bytes(b"")              # a read-only folder fails here, before any work
+        probe.unlink()
+    on_root(comm, create, f"into the output folder {folder}")
     return folder

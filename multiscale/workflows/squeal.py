@@ -78,7 +78,7 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     mech = build_mechanics(scene, tm, law=rough.law if rough else None, degree=degree, prefix=prefix)
     if rough is not None:            # Newton starts at rest from the rigid datum gap
         tm.interface.set_field(mech.contact.initial_gap, rough.datum_gap(interface_forces(scene, tm)))
-    return squeal_case(mech, dict(scene.materials), name, load=drive(scene).load, steps=scene.loading.ramp_steps,
+    return squeal_case(mech, dict(scene.materials), name, load=drive(scene, tm).load, steps=scene.loading.ramp_steps,
                        band=tuple(st.band), n_modes=st.modes, target=st.target,
                        damping=Damping(eta=st.damping) if st.damping else None, energy=energy)
 

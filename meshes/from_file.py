@@ -1,0 +1,398 @@
+"""Geometry from the user's file, read through gmsh: a mesh (``.msh``), a gmsh script (``.geo``) or
+CAD through OpenCASCADE (``.step``/``.stp``, ``.iges``/``.igs``, ``.brep``). Registered as the
+builder "file"; its parameters are a ``multiscale.scene_geometry.FileGeometry`` ([geometry] of a
+scene).
+
+Reading (``describe``, run when the scene is read, so that ``multiscale check`` reports what it
+found; and ``generate``, on the meshing rank):
+
+1. load the file into a gmsh model and scale it to metres (``unit``); CAD and OpenCASCADE scripts
+   are fragmented (``occ.fragment``) so that faces where two volumes touch become one shared face
+   and the mesh is conforming there (a ``.msh`` must be conforming already: gmsh writes shared
+   faces as one entity);
+2. assign every volume to one body: by physical-group name or CAD label (``volumes``), by the
+   file's volume number (``index``), or as the volume containing a point (``contains``);
+3. find the contact interfaces: faces shared by a fixed body and the rotating one (given pairs,
+   or every such pair, one interface per fixed body named after it), with their area, and their
+   normal when planar;
+4. find the named surfaces: the file's physical surface groups and [geometry.surfaces].
+
+The macro model's body 0 ("fixed") holds every fixed body as a material region (bodies that touch
+are bonded: one conforming mesh), body 1 the rotating body. Tags: body k -> cell tag 1 + k,
+interface k -> facet tag 1001 + k, surface k -> facet tag 2001 + k.
+"""
+from __future__ import annotations
+
+from contextlib import contextmanager
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from multiscale.errors import InputError
+from multiscale.geometry import BodySpec, GeometrySpec, Region, Rotation, add_group
+
+NAME = "file"
+DEFAULTS: dict = {}          # no numeric parameters: [geometry] of the scene is a FileGeometry
+FIXED = "fixed"              # name of body 0 (the fixed bodies), body 1 is the rotating body
+PLAUSIBLE = (1e-3, 10.0)     # m, smallest and largest extent of a brake or tribometer model
+NORMAL_TOLERANCE = np.cos(np.radians(5.0))
+
+
+@dataclass
+class Found:
+    """What a file holds, in metres (see module docstring)."""
+
+    bodies: dict                              # body name -> volume tags
+    labels: dict                              # volume tag -> label (physical names or CAD label)
+    volume: dict                              # volume tag -> m^3
+    interfaces: dict = field(default_factory=dict)   # name -> face tags
+    pairs: dict = field(default_factory=dict)        # name -> (fixed body, rotating body)
+    areas: dict = field(default_factory=dict)        # name -> m^2
+    normals: dict = field(default_factory=dict)      # name -> unit normal (fixed towards rotating), None if not planar
+    surfaces: dict = field(default_factory=dict)     # name -> face tags
+    extent: float = 0.0                              # m, largest side of the bounding box
+
+
+def parameters(params) -> dict:
+    """The file's mesh sizes [m] (for the scene summary)."""
+    return {k: getattr(params, k) for k in ("mesh_size", "interface_mesh_size") if getattr(params, k) is not None}
+
+
+@contextmanager
+def _model():
+    """A gmsh model of its own (gmsh initialised here if it is not already)."""
+    import gmsh   # only when a file is read: scenes with a builder never load gmsh
+    started = not gmsh.isInitialized()
+    if started:
+        gmsh.initialize(interruptible=False)
+        gmsh.option.setNumber("General.Terminal", 0)
+    previous = gmsh.model.getCurrent() if not started else None
+    gmsh.model.add("multiscale_file_inspection")
+    try:
+        yield gmsh.model
+    finally:
+        gmsh.model.remove()
+        if started:
+            gmsh.finalize()
+        elif previous:
+            gmsh.model.setCurrent(previous)
+
+
+def describe(params) -> GeometrySpec:
+    """Inspect the file (see module docstring) and describe the macro model."""
+    with _model() as model:
+        found = _load(model, params)
+    return _spec(params, found)
+
+
+def generate(model, params) -> None:
+    """Load, tag and (CAD, scripts) mesh the file in the gmsh ``model`` (on one rank)."""
+    found = _load(model, params)
+    model.removePhysicalGroups()
+    for k, name in enumerate(params.bodies):
+        add_group(model, 3, found.bodies[name], 1 + k, name)
+    for k, (name, faces) in enumerate(found.interfaces.items()):
+        add_group(model, 2, faces, 1001 + k, name)
+    for k, (name, faces) in enumerate(found.surfaces.items()):
+        add_group(model, 2, faces, 2001 + k, name)
+    if params.kind != "mesh":
+        _sizes(model, params, [f for faces in found.interfaces.values() for f in faces])
+        model.mesh.generate(3)
+
+
+# ---------------------------------------------------------------- reading
+def _load(model, g) -> Found:
+    import gmsh   # the module-level functions (merge, option) of the model's gmsh
+    path = str(g.file)
+    if g.kind == "cad":
+        shapes = model.occ.importShapes(path)
+        model.occ.synchronize()
+        order = [t for d, t in shapes if d == 3]
+    else:
+        try:
+            gmsh.merge(path)
+        except Exception as exc:
+            raise InputError("geometry.file", g.file.name, f"gmsh cannot read it ({exc})") from None
+        order = [t for _, t in model.getEntities(3)]
+    if not order:
+        raise InputError("geometry.file", g.file.name, "holds no volume (3-D solid)")
+    occ = bool(model.occ.getEntities(3))
+    if g.unit != 1.0:
+        if g.kind == "mesh":
+            s = g.unit
+            model.mesh.affineTransform([s, 0, 0, 0, 0, s, 0, 0, 0, 0, s, 0])
+        elif occ:
+            model.occ.dilate(model.occ.getEntities(), 0, 0, 0, g.unit, g.unit, g.unit)
+        else:
+            model.geo.dilate(model.getEntities(), 0, 0, 0, g.unit, g.unit, g.unit)
+            model.geo.synchronize()
+    if occ and g.kind != "mesh":
+        volumes = model.occ.getEntities(3)
+        _, mapping = model.occ.fragment(volumes, [])
+        model.occ.synchronize()
+        after = {t: [b for d, b in m if d == 3] for (_, t), m in zip(volumes, mapping)}
+        order = [t for old in order for t in after.get(old, [old])]
+    extent = _extent(model, g)
+    labels = {t: _label(model, t) for _, t in model.getEntities(3)}
+    found = Found(_bodies(model, g, order, labels), labels, {t: _volume(model, t, occ) for t in labels},
+                  extent=extent)
+    _interfaces(model, g, found, occ)
+    _surfaces(model, g, found)
+    return found
+
+
+def _extent(model, g) -> float:
+    box = np.array(model.getBoundingBox(-1, -1))
+    extent = float((box[3:] - box[:3]).max())
+    if not PLAUSIBLE[0] <= extent <= PLAUSIBLE[1]:
+        raise InputError("geometry.unit", g.unit, f"the geometry of {g.file.name} spans {extent:.4g} m, implausible for "
+                         f"a brake or tribometer ({PLAUSIBLE[0]:g}..{PLAUSIBLE[1]:g} m): is the file's length unit "
+                         f"right? (unit = {g.unit:g} m per file unit)")
+    return extent
+
+
+def _label(model, tag: int) -> str:
+    names = [model.getPhysicalName(3, p) for p in model.getPhysicalGroupsForEntity(3, tag)]
+    return ", ".join([n for n in names if n] + ([model.getEntityName(3, tag)] if model.getEntityName(3, tag) else []))
+
+
+def _volume(model, tag: int, occ: bool) -> float:
+    if occ:
+        return float(model.occ.getMass(3, tag))
+    node_tags, coords, _ = model.mesh.getNodes(3, tag, includeBoundary=True, returnParametricCoord=False)
+    x = dict(zip(node_tags, np.reshape(coords, (-1, 3))))
+    types, _, conn = model.mesh.getElements(3, tag)
+    total = 0.0
+    for etype, c in zip(types, conn):
+        if model.mesh.getElementProperties(etype)[0] != "Tetrahedron 4":
+            raise InputError("geometry.file", "elements", "a .msh of linear tetrahedra")
+        tets = np.array([x[n] for n in c]).reshape(-1, 4, 3)
+        total += np.abs(np.einsum("ij,ij->i", tets[:, 1] - tets[:, 0],
+                                  np.cross(tets[:, 2] - tets[:, 0], tets[:, 3] - tets[:, 0]))).sum() / 6
+    return total
+
+
+def _bodies(model, g, order: list[int], labels: dict) -> dict:
+    """Body name -> volume tags; every volume in exactly one body."""
+    groups = {model.getPhysicalName(3, t): list(model.getEntitiesForPhysicalGroup(3, t))
+              for _, t in model.getPhysicalGroups(3)}
+    out, owner = {}, {}
+    for name, sel in g.bodies.items():
+        where = f"geometry.bodies.{name}"
+        if sel.volumes is not None:
+            tags = []
+            for v in sel.volumes:
+                hit = groups.get(v) or [t for t, label in labels.items()
+                                        if v in (label, label.rsplit("/", 1)[-1]) or label.endswith("/" + v)]
+                if not hit:
+                    known = sorted(set(groups) | {lab for lab in labels.values() if lab})
+                    raise InputError(f"{where}.volumes", v, f"no volume of {g.file.name} has this name; known: "
+                                     f"{', '.join(known) or 'none (use index or contains)'}")
+                tags += hit
+        elif sel.index is not None:
+            bad = [i for i in sel.index if i > len(order)]
+            if bad:
+                raise InputError(f"{where}.index", bad, f"{g.file.name} has {len(order)} volumes (1..{len(order)})")
+            tags = [order[i - 1] for i in sel.index]
+        else:
+            tags = []
+            for point in sel.contains:
+                inside = [t for t in labels if model.isInside(3, t, list(point))]
+                if not inside:
+                    raise InputError(f"{where}.contains", list(point), f"no volume of {g.file.name} contains "
+                                     "this point [m]")
+                tags += inside
+        for t in tags:
+            if t in owner and owner[t] != name:
+                raise InputError(f"{where}", name, f"volume {t} ({labels[t] or 'no label'}) also belongs to body "
+                                 f"\"{owner[t]}\"")
+            owner[t] = name
+        out[name] = sorted(set(tags))
+    left = [t for t in labels if t not in owner]
+    if left:
+        centres = [np.round(model.occ.getCenterOfMass(3, t), 4).tolist() if model.occ.getEntities(3) else "" for t in left]
+        raise InputError("geometry.bodies", sorted(g.bodies), "every volume must belong to a body; not assigned: "
+                         + "; ".join(f"volume {t} ({labels[t] or 'no label'}) at {c} m" for t, c in zip(left, centres)))
+    return out
+
+
+def _shared_faces(model, a: list[int], b: list[int]) -> list[int]:
+    """Faces bounding a volume of ``a`` and a volume of ``b``."""
+    faces = []
+    for _, f in model.getEntities(2):
+        up = set(model.getAdjacencies(2, f)[0].tolist())
+        if up & set(a) and up & set(b):
+            faces.append(f)
+    return faces
+
+
+def _interfaces(model, g, found: Found, occ: bool) -> None:
+    rotating = found.bodies[g.rotating]
+    pairs = {n: tuple(p.between) for n, p in g.interfaces.items()} or \
+        {name: (name, g.rotating) for name in g.bodies if name != g.rotating}
+    for name, (a, b) in pairs.items():
+        fixed = a if b == g.rotating else b
+        faces = _shared_faces(model, found.bodies[fixed], rotating)
+        if not faces:
+            if g.interfaces:
+                gap = _gap(model, found.bodies[fixed], rotating, occ)
+                raise InputError(f"geometry.interfaces.{name}", [a, b], f"these bodies do not touch (gap {gap})")
+            continue
+        found.interfaces[name], found.pairs[name] = faces, (fixed, g.rotating)
+        found.areas[name], found.normals[name] = _plane(model, faces, found.bodies[fixed], occ)
+    if not found.interfaces:
+        raise InputError("geometry.rotating", g.rotating, f"no fixed body of {g.file.name} touches it: no contact "
+                         "interface (bodies must share a face; give [geometry.interfaces] to see the gaps)")
+
+
+def _gap(model, a: list[int], b: list[int], occ: bool) -> str:
+    if not occ:
+        return "unknown for a mesh file: the bodies share no face entity"
+    d = min(model.occ.getDistance(3, s, 3, t)[0] for s in a for t in b)
+    return f"{d:.4g} m" if d > 0 else "0 m: they overlap or touch at an edge, not along a shared face"
+
+
+def _nodes(model, faces: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """Triangles (n, 3, 3) [m] of the meshed faces (a .msh)."""
+    tris = []
+    for f in faces:
+        tags, coords, _ = model.mesh.getNodes(2, f, includeBoundary=True)
+        x = dict(zip(tags, np.reshape(coords, (-1, 3))))
+        for etype, conn in zip(*model.mesh.getElements(2, f)[::2]):
+            tris.append(np.array([x[n] for n in conn]).reshape(-1, 3, 3)[:, :3])
+    return np.concatenate(tris)
+
+
+def _flat(model, face: int):
+    """(unit normal, a point) of a flat face, or None: normals and points sampled over the face's
+    parameter range (a scaled CAD face is a B-spline surface, so its type says nothing)."""
+    lo, hi = (np.asarray(b, dtype=float) for b in model.getParametrizationBounds(2, face))
+    t = np.linspace(0.1, 0.9, 4)
+    uv = np.array([[a, b] for a in lo[0] + t * (hi[0] - lo[0]) for b in lo[1] + t * (hi[1] - lo[1])]).ravel()
+    n = np.reshape(model.getNormal(face, uv), (-1, 3))
+    x = np.reshape(model.getValue(2, face, uv), (-1, 3))
+    n0 = n[0] / np.linalg.norm(n[0])
+    size = max(np.ptp(x, axis=0).max(), np.finfo(float).tiny)
+    if np.all(np.abs(n @ n0) / np.linalg.norm(n, axis=1) > 1 - 1e-9) and np.abs((x - x[0]) @ n0).max() <= 1e-9 * size:
+        return n0, x[0]
+    return None
+
+
+def _plane(model, faces: list[int], fixed: list[int], occ: bool):
+    """Area [m^2] and unit normal (from the fixed body outwards) of a face set; normal None if
+    the faces are not one plane."""
+    if occ:
+        area = sum(model.occ.getMass(2, f) for f in faces)
+        flat = [_flat(model, f) for f in faces]
+        if any(f is None for f in flat):
+            return area, None
+        normals, points = [n for n, _ in flat], [p for _, p in flat]
+        n = normals[0]
+        planar = all(abs(abs(m @ n) - 1) < 1e-9 for m in normals) and \
+            all(abs((p - points[0]) @ n) < 1e-9 * max(1.0, np.abs(points[0]).max()) for p in points)
+        centre = np.asarray(model.occ.getCenterOfMass(3, fixed[0]))
+    else:
+        tri = _nodes(model, faces)
+        cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+        area = 0.5 * np.linalg.norm(cross, axis=1).sum()
+        pts = tri.reshape(-1, 3)
+        mean = pts.mean(axis=0)
+        _, sv, vt = np.linalg.svd(pts - mean)
+        n = vt[-1]
+        size = np.ptp(pts, axis=0).max()
+        planar = np.abs((pts - mean) @ n).max() <= 1e-6 * size
+        points = [mean]
+        centre = np.asarray(model.getBoundingBox(3, fixed[0])).reshape(2, 3).mean(axis=0)
+    if (centre - points[0]) @ n > 0:      # point from the fixed body towards the rotating one
+        n = -n
+    return float(area), (tuple(float(c) for c in n) if planar else None)
+
+
+def _surfaces(model, g, found: Found) -> None:
+    groups = {model.getPhysicalName(2, t): list(model.getEntitiesForPhysicalGroup(2, t))
+              for _, t in model.getPhysicalGroups(2)}
+    found.surfaces.update({n: f for n, f in groups.items() if n and n not in found.interfaces})
+    for name, sel in g.surfaces.items():
+        where = f"geometry.surfaces.{name}"
+        if sel.group is not None:
+            if sel.group not in groups:
+                raise InputError(f"{where}.group", sel.group, f"no physical surface of {g.file.name} has this name; "
+                                 f"known: {', '.join(n for n in groups if n) or 'none'}")
+            found.surfaces[name] = groups[sel.group]
+            continue
+        candidates = _faces_of(model, found.bodies[sel.body]) if sel.body else [t for _, t in model.getEntities(2)]
+        if sel.normal is not None:
+            faces = [f for f in candidates if _outward(model, f, found.bodies[sel.body], np.asarray(sel.normal))]
+        else:
+            faces = []
+            for point in sel.contains:
+                near = [f for f in candidates if np.linalg.norm(
+                    np.asarray(model.getClosestPoint(2, f, list(point))[0]) - np.asarray(point)) <= 1e-4 * found.extent]
+                if not near:
+                    raise InputError(f"{where}.contains", list(point), f"no face of {g.file.name} passes through "
+                                     "this point [m]")
+                faces += [f for f in near if f not in faces]
+        if not faces:
+            raise InputError(where, name, f"selects no face of {g.file.name}")
+        found.surfaces[name] = faces
+
+
+def _faces_of(model, volumes: list[int]) -> list[int]:
+    return sorted({int(f) for v in volumes for f in model.getAdjacencies(3, v)[1]})
+
+
+def _outward(model, face: int, volumes: list[int], direction: np.ndarray) -> bool:
+    """True if ``face`` is planar with its outward normal (from ``volumes``) along ``direction``."""
+    flat = _flat(model, face)
+    if flat is None:
+        return False
+    n, p = flat
+    inside = [v for v in volumes if face in model.getAdjacencies(3, v)[1]]
+    centre = np.asarray(model.occ.getCenterOfMass(3, inside[0]))
+    if (p - centre) @ n < 0:
+        n = -n
+    return float(n @ direction) / (np.linalg.norm(n) * np.linalg.norm(direction)) >= NORMAL_TOLERANCE
+
+
+def _sizes(model, g, interface_faces: list[int]) -> None:
+    """Element size ``mesh_size``, refined to ``interface_mesh_size`` on the interfaces."""
+    model.mesh.setSize(model.getEntities(0), g.mesh_size)
+    import gmsh   # mesh options are global in gmsh
+    gmsh.option.setNumber("Mesh.MeshSizeMax", g.mesh_size)
+    fine = g.interface_mesh_size
+    if fine is None or fine >= g.mesh_size or not interface_faces:
+        return
+    field = model.mesh.field
+    dist = field.add("Distance")
+    field.setNumbers(dist, "SurfacesList", interface_faces)
+    near = field.add("Threshold")
+    for key, value in (("InField", dist), ("SizeMin", fine), ("SizeMax", g.mesh_size),
+                       ("DistMin", fine), ("DistMax", 4 * g.mesh_size)):
+        field.setNumber(near, key, value)
+    field.setAsBackgroundMesh(near)
+    model.mesh.setSize(model.getBoundary([(2, f) for f in interface_faces], combined=False, recursive=True), fine)
+
+
+# ---------------------------------------------------------------- the spec
+def _spec(g, found: Found) -> GeometrySpec:
+    fixed = [n for n in g.bodies if n != g.rotating]
+    tag = {n: 1 + k for k, n in enumerate(g.bodies)}
+    regions = tuple(Region(n, tag[n], g.bodies[n].material) for n in fixed)
+    report = [f"file {g.file.name}: {len(found.labels)} volume(s), extent {found.extent:.4g} m"]
+    report += [f"body {n}: {len(found.bodies[n])} volume(s), {sum(found.volume[t] for t in found.bodies[n]) * 1e6:.4g} cm^3, "
+               f"material {g.bodies[n].material}" + (" (rotating)" if n == g.rotating else "") for n in g.bodies]
+    for name, faces in found.interfaces.items():
+        n = found.normals[name]
+        normal = f"normal ({', '.join(f'{round(c, 3) + 0.0:.3f}' for c in n)})" if n is not None else "not planar"
+        report.append(f"interface {name}: {found.pairs[name][0]} on {g.rotating}, {len(faces)} face(s), "
+                      f"{found.areas[name] * 1e6:.4g} mm^2, {normal}")
+    report += [f"surface {n}: {len(f)} face(s)" for n, f in found.surfaces.items()]
+    return GeometrySpec(
+        bodies=(BodySpec(FIXED, regions), BodySpec(g.rotating, (Region(g.rotating, tag[g.rotating],
+                                                                       g.bodies[g.rotating].material),))),
+        interfaces={n: 1001 + k for k, n in enumerate(found.interfaces)},
+        faces={n: 2001 + k for k, n in enumerate(found.surfaces)},
+        supports=(), load_faces=(), motion=Rotation(tuple(g.axis), tuple(g.centre)),
+        length_scale=found.extent, fluid_load=True,
+        interface_normals=dict(found.normals), report=tuple(report),
+        interface_regions={name: fixed for name, (fixed, _) in found.pairs.items()})

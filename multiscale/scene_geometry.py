@@ -1,0 +1,269 @@
+"""[geometry] of a scene: a registered mesh builder with its parameters, or the user's own file.
+
+A builder (``builder = "pin_on_disc"``; the registry of ``multiscale.geometry``) takes its
+parameters as keys of [geometry]. A file (``file = "brake.step"``: a gmsh mesh ``.msh``, a gmsh
+script ``.geo``, or CAD through OpenCASCADE: ``.step``/``.stp``, ``.iges``/``.igs``, ``.brep``) names
+its bodies in [geometry.bodies.<name>] (volumes chosen by physical-group name or CAD label, by
+index, or as "the volume containing a point"; each with its material), the rotating body and its
+axis, named surfaces for boundary conditions and loads in [geometry.surfaces.<name>], and
+optionally the contact interfaces in [geometry.interfaces.<name>] (default: every face where a
+fixed body touches the rotating one, one interface per fixed body, named after it). The file
+builder (``meshes.from_file``, registered as "file") inspects the file when the scene is read, so
+that ``multiscale check`` reports bodies, volumes, interfaces, areas and normals before meshing.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+from multiscale.errors import InputError
+from multiscale.geometry import GeometrySpec, Rotation, builder, builder_names
+from multiscale.schema import (Bad, Choice, FilePath, FrozenMap, Integer, ListOf, Named, OneOf, Quantity,
+                               Section, Text, Vector, key, parse, read, show, unknown_keys)
+from multiscale.schema import reference as schema_reference
+from multiscale.units import UnitError, to_si
+
+_LENGTH = Quantity("length", gt=0)
+_POINT = Vector(Quantity("length"))
+_DIRECTION = Vector(Quantity("dimensionless"))
+# plausible builder parameters by kind (SI; warned outside): lengths of a tribometer or brake part
+_PLAUSIBLE = {"length": (1e-5, 10.0), "angle": (0.0, 6.2832)}
+FILE_TYPES = {".msh": "mesh", ".geo": "script", ".step": "cad", ".stp": "cad", ".iges": "cad", ".igs": "cad",
+              ".brep": "cad"}
+
+
+class Points:
+    """One point [x, y, z] or a list of points, as a tuple of points."""
+
+    def describe(self) -> str:
+        return f"a point {_POINT.describe()}, or a list of such points"
+
+    def __call__(self, raw, ctx):
+        if isinstance(raw, list) and raw and all(isinstance(r, list) for r in raw):
+            return tuple(_POINT(r, ctx) for r in raw)
+        return (_POINT(raw, ctx),)
+
+
+class LengthUnit:
+    """The name of a length unit ("mm", "m", "in"), as its size in metres."""
+
+    def describe(self) -> str:
+        return 'a length unit such as "m", "mm", "in"'
+
+    def __call__(self, raw, ctx):
+        try:
+            return to_si(f"1 {raw}", "length") if isinstance(raw, str) else None
+        except UnitError as exc:
+            raise Bad(str(exc)) from None
+
+
+@dataclass(frozen=True)
+class BodySelection:
+    """[geometry.bodies.<name>]: the volumes of one body and its material."""
+
+    volumes: tuple | None = key(ListOf(Text(), unique=True, min_len=1))   # physical names or CAD labels
+    index: tuple | None = key(ListOf(Integer(ge=1), unique=True, min_len=1))   # volume numbers of the file
+    contains: tuple | None = key(Points())                                # m, points inside its volumes
+    material: str | None = key(Text(), required=True)
+
+    rules = (OneOf(("volumes", "index", "contains"), required=True),)
+
+
+@dataclass(frozen=True)
+class SurfaceSelection:
+    """[geometry.surfaces.<name>]: a named surface: a physical surface ``group`` of the file, or the
+    faces of ``body`` whose outward ``normal`` is the given direction (within 5 degrees), or the
+    faces through the points ``contains`` (of ``body`` if given; within 1e-4 of the model's size)."""
+
+    group: str | None = key(Text())
+    body: str | None = key(Text())
+    normal: tuple | None = key(_DIRECTION)
+    contains: tuple | None = key(Points())                 # m, a point on each face
+
+    rules = (OneOf(("group", "normal", "contains"), required=True),)
+
+    def problems(self, path, ctx):
+        if self.normal is not None and self.body is None:
+            return [f"{path}.body: missing; needed with {path}.normal"]
+        if self.group is not None and self.body is not None:
+            return [f"{path}.body: not used with {path}.group"]
+        return []
+
+
+@dataclass(frozen=True)
+class ContactPair:
+    """[geometry.interfaces.<name>]: a contact interface between a fixed body and the rotating one."""
+
+    between: tuple | None = key(ListOf(Text(), unique=True, min_len=2), required=True)
+
+    def problems(self, path, ctx):
+        return [] if len(self.between) == 2 else [f"{path}.between: give two bodies"]
+
+
+@dataclass(frozen=True)
+class FileGeometry:
+    """[geometry] from the user's file (see module docstring). Lengths of the file are in ``unit``;
+    every length of the scene is in SI (or a unit string)."""
+
+    file: Path | None = key(FilePath(), required=True)
+    unit: float = key(LengthUnit(), default=1.0)              # m per length unit of the file
+    mesh_size: float | None = key(_LENGTH)                     # m, global element size (CAD, .geo)
+    interface_mesh_size: float | None = key(_LENGTH)           # m, element size on the interfaces
+    rotating: str | None = key(Text(), required=True)          # the body that rotates
+    axis: tuple = key(_DIRECTION, default=(0.0, 0.0, 1.0))
+    centre: tuple = key(_POINT, default=(0.0, 0.0, 0.0))       # m, a point on the axis
+    bodies: FrozenMap | None = key(Named(BodySelection), required=True)
+    surfaces: FrozenMap = key(Named(SurfaceSelection), default=FrozenMap())
+    interfaces: FrozenMap = key(Named(ContactPair), default=FrozenMap())
+
+    @property
+    def kind(self) -> str:
+        """"mesh", "script" or "cad"."""
+        return FILE_TYPES[self.file.suffix.lower()]
+
+    def problems(self, path, ctx):
+        out = []
+        if self.file.suffix.lower() not in FILE_TYPES:
+            out.append(f"{path}.file = \"{self.file.name}\": unknown type; allowed: {', '.join(FILE_TYPES)}")
+        elif self.kind != "mesh" and self.mesh_size is None:
+            out.append(f"{path}.mesh_size: missing; needed to mesh a {self.file.suffix} file")
+        if self.rotating not in self.bodies:
+            out.append(f"{path}.rotating = \"{self.rotating}\": not a body; bodies: {', '.join(self.bodies)}")
+        if len(self.bodies) < 2:
+            out.append(f"{path}.bodies: give at least two bodies (a fixed one and the rotating one)")
+        if sum(a * a for a in self.axis) == 0:
+            out.append(f"{path}.axis = {list(self.axis)}: must not be zero")
+        for name, pair in self.interfaces.items():
+            for b in pair.between:
+                if b not in self.bodies:
+                    out.append(f"{path}.interfaces.{name}.between: \"{b}\" is not a body; bodies: "
+                               f"{', '.join(self.bodies)}")
+            if self.rotating not in pair.between:
+                out.append(f"{path}.interfaces.{name}.between: one of the two must be the rotating body "
+                           f"\"{self.rotating}\"")
+        for name, s in self.surfaces.items():
+            if s.body is not None and s.body not in self.bodies:
+                out.append(f"{path}.surfaces.{name}.body = \"{s.body}\": not a body; bodies: {', '.join(self.bodies)}")
+        return out
+
+
+@dataclass(frozen=True)
+class Geometry:
+    """[geometry]: a registered builder and its parameters (SI; the builder's ``DEFAULTS`` fill the
+    rest), or a ``FileGeometry`` (``builder == "file"``). ``spec`` names the bodies (body 0 the
+    stationary "+" side, body 1 the sliding side), material regions, faces, interfaces and motion."""
+
+    builder: str
+    params: object                    # FrozenMap of builder parameters, or a FileGeometry
+    spec: GeometrySpec
+
+    def module(self):
+        """The builder module (parameters, describe, generate)."""
+        return builder(self.builder)
+
+    def resolved(self) -> dict:
+        """Every builder parameter [SI] (the mesh sizes of a file)."""
+        if isinstance(self.params, FileGeometry):
+            return {k: getattr(self.params, k) for k in ("mesh_size", "interface_mesh_size")
+                    if getattr(self.params, k) is not None}
+        return self.module().parameters(dict(self.params))
+
+    @property
+    def bodies(self) -> tuple[str, str]:
+        return tuple(b.name for b in self.spec.bodies)
+
+    @property
+    def regions(self) -> tuple[str, ...]:
+        """Names of the material regions of both bodies."""
+        return tuple(r.name for b in self.spec.bodies for r in b.regions)
+
+    @property
+    def materials(self) -> tuple[str, ...]:
+        """Names of the [materials.<name>] tables the geometry needs."""
+        return self.spec.materials
+
+    @property
+    def motion(self) -> str:
+        """"rotation" (of body 1 about an axis) or "translation"."""
+        return "rotation" if isinstance(self.spec.motion, Rotation) else "translation"
+
+    @property
+    def surfaces(self) -> tuple[str, ...]:
+        """Names a boundary condition or a load can use: the named faces and "free:<body or region>"."""
+        return tuple(self.spec.faces) + tuple(f"free:{n}" for n in dict.fromkeys(self.bodies + self.regions))
+
+
+def _parameter_kind(module, name: str) -> str:
+    """Unit kind of a builder parameter: the module's PARAMETER_KINDS ("count": a whole number),
+    else angle/length by name."""
+    kinds = getattr(module, "PARAMETER_KINDS", {})
+    return kinds.get(name, "angle" if "angle" in name else "length")
+
+
+class GeometrySection(Section):
+    """[geometry]: ``builder`` picks a registered builder, whose DEFAULTS are the allowed keys; or
+    ``file`` gives the user's geometry (``FileGeometry``)."""
+
+    def __init__(self):
+        super().__init__(Geometry)
+        self.builders = Choice(tuple(n for n in builder_names() if n != "file"))
+
+    def describe(self) -> str:
+        return f"a table with builder = {self.builders.describe()} and its parameters, or file = \"...\""
+
+    def reference(self, path) -> list[str]:
+        lines = [f"  {'builder':<20} {self.builders.describe()}  [or file]"]
+        for name in self.builders.options:
+            module = builder(name)
+            lines.append(f"  builder = \"{name}\" parameters (SI defaults; 0 = the builder's fallback):")
+            lines += [f"    {k:<22} {_parameter_kind(module, k):<8} {v:g}" for k, v in module.DEFAULTS.items()]
+        lines.append("  file = \"...\" (.msh, .geo, .step/.stp, .iges/.igs, .brep) with:")
+        return lines + ["  " + line for line in schema_reference(FileGeometry, path)]
+
+    def read(self, raw, path, ctx):
+        if not isinstance(raw, dict):
+            ctx.problems.append(f"{path} = {show(raw)}: must be {self.describe()}")
+            return None
+        if "file" in raw:
+            return self._read_file(raw, path, ctx)
+        if "builder" not in raw:
+            ctx.problems.append(f"{path}.builder: missing; required: {self.builders.describe()} (or file)")
+            return None
+        try:
+            name = self.builders(raw["builder"], ctx)
+            module = builder(name)
+        except Bad as exc:
+            ctx.problems.append(f"{path}.builder = {show(raw['builder'])}: {exc}")
+            return None
+        before = len(ctx.problems)
+        given = {k: v for k, v in raw.items() if k != "builder"}
+        unknown_keys(given, module.DEFAULTS, path, ctx, f'parameter of builder "{name}"')
+        params = {}
+        for param, value in given.items():
+            if param in module.DEFAULTS:
+                zero_ok = float(module.DEFAULTS[param]) == 0.0    # 0 means "builder's fallback"
+                kind = _parameter_kind(module, param)
+                parser = Integer(ge=0 if zero_ok else 1) if kind == "count" else \
+                    Quantity(kind, **({"ge": 0} if zero_ok else {"gt": 0}), plausible=_PLAUSIBLE.get(kind))
+                params[param] = parse(parser, value, f"{path}.{param}", ctx)
+        if len(ctx.problems) > before:
+            return None
+        return self._describe(name, module, FrozenMap(params), params, ctx)
+
+    def _read_file(self, raw, path, ctx):
+        before = len(ctx.problems)
+        if "builder" in raw:
+            ctx.problems.append(f"{path}.builder: give either builder or file")
+        params = read(FileGeometry, {k: v for k, v in raw.items() if k != "builder"}, path, ctx)
+        if len(ctx.problems) > before:
+            return None
+        return self._describe("file", builder("file"), params, params, ctx)
+
+    @staticmethod
+    def _describe(name, module, params, arguments, ctx):
+        try:
+            spec = module.describe(arguments)        # the builder's consistency checks; a file is inspected
+        except InputError as exc:
+            ctx.problems.append(str(exc))
+            return None
+        return Geometry(name, params, spec)

@@ -1,0 +1,470 @@
+"""The tables of a scene (``multiscale.scene``): frozen dataclasses read by ``multiscale.schema``.
+
+Materials (constants or temperature tables), the interface defaults and per-interface settings,
+boundary conditions (supports, convection, radiation, fixed temperatures), the loading and its duty
+cycle (load and speed against time, a vehicle stop or drag), time, output, and the sections of the
+multiscale loop (roughness, micro, wear, layers) and of the squeal analysis (stability). Values are
+SI numbers or unit strings (``multiscale.units``).
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from multiscale.errors import InputError
+from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_topography
+from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, ListOf, OneOf, OnlyWith, Pair,
+                               Quantity, Requires, Section, TableOr, Tables, Text, Vector, key)
+
+# Plausible ranges (SI) are documented per key (``multiscale check --keys``); a value outside its
+# range is warned, not refused: foams, diamond, cryogenic tests exist, but 1e9 N on a pin is a typo.
+_MODULUS = Quantity("pressure", gt=0, plausible=(1e5, 1.2e12))           # rubber to diamond
+_POISSON = Quantity("dimensionless", gt=-1, lt=0.5, plausible=(0.0, 0.5))
+_CONDUCTIVITY = Quantity("conductivity", gt=0, plausible=(0.01, 2500.0))  # foam to diamond
+_LENGTH = Quantity("length", gt=0)
+_TEMPERATURE = Quantity("temperature", gt=0, plausible=(20.0, 2500.0))    # cryogenic to molten iron
+_DENSITY = Quantity("density", gt=0, plausible=(100.0, 23e3))            # cork to osmium
+_SPECIFIC_HEAT = Quantity("specific_heat", gt=0, plausible=(50.0, 5e3))
+_DIFFUSIVITY = Quantity("diffusivity", gt=0, plausible=(1e-8, 1.2e-3))
+_EXPANSION = Quantity("expansion", plausible=(-1e-5, 5e-4))
+_FRICTION = Quantity("dimensionless", ge=0, plausible=(0.0, 2.0))
+_ROUGHNESS = Quantity("length", gt=0, plausible=(1e-10, 1e-3))            # RMS height
+_CONVECTION = Quantity("conductance", ge=0, plausible=(0.0, 1e4))         # still air to boiling water
+_ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0))  # up to ~24 000 rpm
+_WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # Archard k/H
+GRAVITY = 9.80665                  # m/s^2, standard gravity
+
+
+def _property(value: Quantity, name: str) -> TableOr:
+    """A material property: a constant, or a table [[temperature, value], ...] (>= 2 rows)."""
+    return TableOr(value, Curve(_TEMPERATURE, value, "temperature", name, min_rows=2))
+
+
+def mean(table, x0: float, x1: float) -> float:
+    """Mean over [x0, x1] of the piecewise-linear ``interpolate(table, .)`` (exact)."""
+    if x1 <= x0:
+        return interpolate(table, x0)
+    xs = sorted({x0, x1, *(x for x, _ in table if x0 < x < x1)})
+    ys = [interpolate(table, x) for x in xs]
+    return sum(0.5 * (a + b) * (x1_ - x0_) for a, b, x0_, x1_ in zip(ys, ys[1:], xs, xs[1:])) / (x1 - x0)
+
+
+def interpolate(table, x: float) -> float:
+    """Piecewise-linear interpolation of ((x, y), ...) rows at ``x``, held constant beyond the ends."""
+    xs, ys = zip(*table)
+    if x <= xs[0]:
+        return ys[0]
+    for (x0, y0), (x1, y1) in zip(table, table[1:]):
+        if x <= x1:
+            return y0 + (y1 - y0) * (x - x0) / (x1 - x0)
+    return ys[-1]
+
+
+# ------------------------------------------------------------------ materials and interfaces
+@dataclass(frozen=True)
+class Material:
+    """One body's material (Table 7.2). Every property is a constant or a table against the
+    temperature ((K, value), ...), interpolated linearly and held constant beyond its ends; ``alpha``
+    is the mean (secant) expansion coefficient from the initial temperature. Thermal needs kappa and
+    c (with rho) or chi."""
+
+    E: float | tuple = key(_property(_MODULUS, "E"), required=True)                          # Pa
+    nu: float | tuple = key(_property(_POISSON, "nu"), required=True)
+    rho: float | tuple | None = key(_property(_DENSITY, "rho"), needed_by=("stability",))  # kg/m^3
+    kappa: float | tuple | None = key(_property(_CONDUCTIVITY, "kappa"), needed_by=("thermal",))  # W/(m K)
+    c: float | tuple | None = key(_property(_SPECIFIC_HEAT, "c"))           # J/(kg K)
+    chi: float | tuple | None = key(_property(_DIFFUSIVITY, "chi"))         # m^2/s
+    alpha: float | tuple | None = key(_property(_EXPANSION, "alpha"), needed_by=("expansion",),
+                                      warn_unused=True)                                      # 1/K
+
+    rules = (OneOf(("c", "chi"), needed_by=("thermal",)), Requires("c", ("rho",), needed_by=("thermal",)))
+
+    PROPERTIES = ("E", "nu", "rho", "kappa", "c", "chi", "alpha")
+
+    def tabulated(self, name: str) -> bool:
+        """True if property ``name`` is a temperature table."""
+        return isinstance(getattr(self, name), tuple)
+
+    @property
+    def constant(self) -> bool:
+        """True if no property depends on the temperature."""
+        return not any(self.tabulated(n) for n in self.PROPERTIES)
+
+    def value(self, name: str, T: float) -> float | None:
+        """Property ``name`` at the temperature T [K] (None if not given)."""
+        v = getattr(self, name)
+        return interpolate(v, T) if isinstance(v, tuple) else v
+
+    def at(self, T: float) -> "Material":
+        """The material with every property taken at T [K] (constants)."""
+        return replace(self, **{n: self.value(n, T) for n in self.PROPERTIES})
+
+    def _constant(self, what: str) -> None:
+        if not self.constant:
+            raise InputError("material", what, "a temperature-dependent material: take .at(T) first")
+
+    @property
+    def heat_capacity(self) -> float:
+        """Volumetric heat capacity rho c [J/(m^3 K)] (= kappa/chi when chi is given)."""
+        self._constant("heat_capacity")
+        if self.c is not None and self.rho is not None:
+            return self.rho * self.c
+        if self.chi is not None and self.kappa is not None:
+            return self.kappa / self.chi
+        raise InputError("material", self, "needs rho and c, or kappa and chi")
+
+    @property
+    def diffusivity(self) -> float:
+        """Thermal diffusivity chi = kappa/(rho c) [m^2/s]."""
+        self._constant("diffusivity")
+        return self.chi if self.chi is not None else self.kappa / self.heat_capacity
+
+    @property
+    def effusivity(self) -> float:
+        """Thermal effusivity e = kappa/sqrt(chi) = sqrt(kappa rho c) [W s^0.5/(m^2 K)]."""
+        return self.kappa / math.sqrt(self.diffusivity)
+
+@dataclass(frozen=True)
+class Interface:
+    """[interface]: the defaults of every contact interface (perfect-contact baseline, §7.3.1)."""
+
+    penalty: float | None = key(Quantity("stiffness", gt=0, plausible=(1e8, 1e19)), needed_by=("contact",),
+                                unless=("roughness",))          # Pa/m, normal penalty stiffness K_n
+    partition: float | str | None = key(Either(Quantity("dimensionless", ge=0, le=1),
+                                               Choice(("effusivity",))),
+                                        needed_by=("heat_partition",), warn_unused=True)  # into body 0
+    conductance: float | None = key(Quantity("conductance", gt=0, plausible=(1.0, 1e8)), needed_by=("conductance",),
+                                    unless=("roughness",), warn_unused=True)   # W/(m^2 K), h_c
+
+@dataclass(frozen=True)
+class InterfaceSettings:
+    """[interfaces.<name>]: one contact interface's own settings (names: the geometry's interfaces).
+    ``roughness`` and ``micro`` override keys of the [roughness] and [micro] tables for this
+    interface (its own surface, zones, laws); ``rough = false`` keeps it in perfect contact when
+    the scene has effect "roughness"."""
+
+    friction: float | None = key(_FRICTION)     # mu of this interface (default loading.friction)
+    rough: bool = key(Flag(), default=True)                           # with effect "roughness"
+    roughness: object = None          # Roughness of this interface (the merged [roughness] table)
+    micro: object = None              # Micro of this interface (the merged [micro] table)
+
+
+_COMPONENTS = {"x": 0, "y": 1, "z": 2}
+
+
+@dataclass(frozen=True)
+class Boundary:
+    """[[boundary]]: conditions on named surfaces of the geometry (a builder's faces, the file's
+    physical surfaces or [geometry.surfaces]; "free:<body>" is every surface of a body that touches
+    nothing else). ``fix``: displacement components held at zero; ``convection`` h [W/(m^2 K)],
+    constant or a table against the rotating body's speed [rad/s], towards ``ambient``;
+    ``emissivity``: radiation eps sigma (T^4 - T_ambient^4); ``temperature``: a fixed temperature.
+    Surfaces without a thermal condition are insulated."""
+
+    surfaces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), required=True)
+    fix: tuple | None = key(ListOf(Choice(_COMPONENTS), unique=True, min_len=1))
+    convection: float | tuple | None = key(TableOr(_CONVECTION, Curve(
+        Quantity("angular_speed", ge=0), _CONVECTION, "speed", "h", min_rows=2)))
+    emissivity: float | None = key(Quantity("dimensionless", gt=0, le=1))
+    ambient: float | None = key(_TEMPERATURE)                        # K, default time.initial_temperature
+    temperature: float | None = key(_TEMPERATURE)                    # K, fixed
+
+    THERMAL = ("convection", "emissivity", "temperature")
+
+    rules = (OneOf(("temperature", "convection")), OneOf(("temperature", "emissivity")))
+
+    @property
+    def components(self) -> tuple[int, ...]:
+        """The fixed components as indices (0 = x, 1 = y, 2 = z)."""
+        return tuple(_COMPONENTS[c] for c in self.fix or ())
+
+    def problems(self, path, ctx):
+        if not any(getattr(self, k) is not None for k in ("fix", "convection", "emissivity", "temperature")):
+            return [f"{path}: give a condition: fix, convection, emissivity or temperature"]
+        if self.ambient is not None and self.convection is None and self.emissivity is None:
+            return [f"{path}.ambient: only used with {path}.convection or {path}.emissivity"]
+        return []
+
+    def h(self, speed: float) -> float:
+        """Convection coefficient [W/(m^2 K)] at the rotating body's speed [rad/s] (0 without)."""
+        if self.convection is None:
+            return 0.0
+        return interpolate(self.convection, speed) if isinstance(self.convection, tuple) else self.convection
+
+# ------------------------------------------------------------------ loading, time, output
+# output field -> effects it needs
+OUTPUT_FIELDS: dict[str, tuple[str, ...]] = {
+    "displacement": (), "von_mises": (), "contact_pressure": ("contact",),
+    "temperature": ("thermal",), "heat_flux": ("thermal",),
+    "contact_stiffness": ("roughness",), "partition": ("heat_partition",), "wear_depth": ("wear",),
+}
+
+
+@dataclass(frozen=True)
+class Vehicle:
+    """[loading.vehicle]: the brake of a vehicle: a stop from ``speed`` at ``deceleration`` (or a
+    drag at constant ``speed`` down a ``slope``), the rotating body turning with the wheel
+    (omega = v / wheel_radius). With ``mass`` (the vehicle mass braked by this brake) the brake
+    load follows from the braking force at the tyre (m a for a stop, m g sin(atan(slope)) for a
+    drag): the friction power is then mu F v = that force times the vehicle speed."""
+
+    speed: float | None = key(Quantity("speed", gt=0, plausible=(0.1, 150.0)), required=True)  # m/s, initial
+    wheel_radius: float | None = key(Quantity("length", gt=0, plausible=(0.05, 2.0)), required=True)  # m
+    deceleration: float | None = key(Quantity("acceleration", gt=0, plausible=(0.01, 15.0)))  # m/s^2: a stop
+    slope: float | None = key(Quantity("dimensionless", gt=0, plausible=(0.0, 0.5)))  # grade (rise/run): a drag
+    mass: float | None = key(Quantity("mass", gt=0, plausible=(1.0, 1e7)))                               # kg
+
+    rules = (OneOf(("deceleration", "slope")),)
+
+    def problems(self, path, ctx):
+        if self.mass is not None and self.deceleration is None and self.slope is None:
+            return [f"{path}.mass: needs {path}.deceleration (a stop) or {path}.slope (a drag) for the braking force"]
+        return []
+
+    @property
+    def stop_time(self) -> float | None:
+        """Duration of the stop [s] (None for a drag)."""
+        return None if self.deceleration is None else self.speed / self.deceleration
+
+    def angular_speed(self, t: float) -> float:
+        """omega(t) [rad/s] of the wheel (and the rotating body)."""
+        v = self.speed if self.deceleration is None else max(self.speed - self.deceleration * t, 0.0)
+        return v / self.wheel_radius
+
+    @property
+    def braking_force(self) -> float | None:
+        """Force at the tyre contact [N] that the brake must give (None without a mass)."""
+        if self.mass is None:
+            return None
+        if self.deceleration is not None:
+            return self.mass * self.deceleration
+        return self.mass * GRAVITY * math.sin(math.atan(self.slope))
+
+
+@dataclass(frozen=True)
+class Loading:
+    """Normal load (force or pressure on the load faces), sliding speed, friction, duty cycle.
+
+    The load acts on ``faces`` (default: the builder's load faces; required for geometry files,
+    where it is a pressure normal to each face, -p n, and a force is spread as a uniform pressure;
+    with ``direction`` a traction along it whose resultant is the force, or the pressure itself),
+    scaled in time by ``load_profile`` (factor, 0 = released: no contact, no frictional heat). The
+    speed of the rotating body: ``rotation_speed``, a ``speed_profile`` against time, or a
+    ``vehicle`` stop or drag; a translating body slides at ``sliding_speed``."""
+
+    normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)))                 # N
+    pressure: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e9)))  # Pa
+    faces: tuple | None = key(ListOf(Text(), unique=True, min_len=1))         # where the load acts
+    direction: tuple | None = key(Vector(Quantity("dimensionless")))         # traction direction (else -n)
+    load_profile: tuple | None = key(Curve(Quantity("time", ge=0), Quantity("dimensionless", ge=0),
+                                           "time", "factor"))                 # ((s, -), ...)
+    rotation_speed: float | None = key(_ANGULAR_SPEED)       # rad/s (rotation builders)
+    speed_profile: tuple | None = key(Curve(Quantity("time", ge=0), _ANGULAR_SPEED,
+                                            "time", "speed"))                 # ((s, rad/s), ...)
+    vehicle: Vehicle | None = key(Section(Vehicle))
+    sliding_speed: float | None = key(Quantity("speed", ge=0, plausible=(0.0, 200.0)))  # m/s (translation builders)
+    friction: float | None = key(_FRICTION, needed_by=("friction",),
+                                 warn_unused=True)                            # mu
+    ramp_steps: int = key(Integer(ge=1), default=1)       # load increments of the first mechanical solve
+
+    rules = (OneOf(("normal_force", "pressure")), OneOf(("rotation_speed", "speed_profile", "vehicle")))
+
+    def problems(self, path, ctx):
+        given = [k for k in ("normal_force", "pressure") if getattr(self, k) is not None]
+        by_mass = self.vehicle is not None and self.vehicle.mass is not None
+        if given and by_mass:
+            return [f"{path}.{given[0]}: give the load or {path}.vehicle.mass, not both"]
+        if not given and not by_mass and "contact" in ctx.effects:
+            return [f"{path}.normal_force or {path}.pressure: missing; effect \"contact\" needs it "
+                    f"(or {path}.vehicle.mass)"]
+        return []
+
+    def angular_speed(self, t: float) -> float:
+        """omega(t) [rad/s]: constant, the speed profile (linear in time, held constant beyond its
+        ends) or the vehicle's; 0 without rotation."""
+        if self.vehicle is not None:
+            return self.vehicle.angular_speed(t)
+        if self.speed_profile is not None:
+            return interpolate(self.speed_profile, t)
+        return self.rotation_speed or 0.0
+
+    @property
+    def steady_speed(self) -> bool:
+        """True if the speed never changes."""
+        return self.speed_profile is None and (self.vehicle is None or self.vehicle.deceleration is None)
+
+    def factor(self, t: float) -> float:
+        """Load factor at t [s] (1 without a load profile; 0: released)."""
+        return 1.0 if self.load_profile is None else interpolate(self.load_profile, t)
+
+    def mean_factor(self, t0: float, t1: float) -> float:
+        """Mean load factor over [t0, t1] [s]."""
+        return 1.0 if self.load_profile is None else mean(self.load_profile, t0, t1)
+
+
+@dataclass(frozen=True)
+class Time:
+    """Staggered time loop (Fig. 7.4): ``steps`` macro steps Δt over ``end``, each in ``substeps``."""
+
+    end: float | None = key(Quantity("time", gt=0, plausible=(1e-6, 1e6)), needed_by=("thermal", "wear"))  # s
+    steps: int = key(Integer(ge=1), default=1)
+    substeps: int = key(Integer(ge=1), default=1)
+    initial_temperature: float = key(_TEMPERATURE, default=293.15)  # K
+
+    @property
+    def dt(self) -> float | None:
+        """Macro time step Δt [s] (None without an end time)."""
+        return None if self.end is None else self.end / self.steps
+
+
+@dataclass(frozen=True)
+class Output:
+    """Where and what to write. Defaults: folder results/<name> next to the scene file; every
+    field the scene's effects produce."""
+
+    folder: Path | None = key(FilePath(folder=True))
+    every: int = key(Integer(ge=1), default=1)            # write fields every n macro steps
+    fields: tuple = key(ListOf(Choice(OUTPUT_FIELDS), unique=True))
+
+    def existing_results(self) -> list[Path]:
+        """Entries already in the output folder (what ``run`` must not overwrite silently)."""
+        return sorted(self.folder.iterdir()) if self.folder is not None and self.folder.is_dir() else []
+
+
+# ------------------------------------------------------------------ later effects (validated only)
+@dataclass(frozen=True)
+class Roughness:
+    """Rough face of one body (§7.3.1: only the pin is rough): generated (fractal, Eqs. 1.24–1.25)
+    or measured. Cut-offs are wavelengths per generated patch; ``patch`` says whether one surface
+    is generated for the whole face and cut into zones, or one per zone (per-zone seeds).
+
+    A measured ``file`` (issue 17; ``multiscale.micro.topography``): any format SurfaceTopography
+    reads (x3p, sur, plu, opd, ...) with its own units and pixel sizes (``pixel_size`` and
+    ``height_unit`` override them, with a warning), or a plain height matrix (.npy, .txt, .csv,
+    .asc: ``pixel_size`` needed, ``height_unit`` default 1 m). It is conditioned (``detrend``,
+    undefined points filled up to ``max_undefined``, Gaussian filter at ``cutoff``), then
+    ``cover``s the face: the measurement itself ("measured": it must cover the face), copies
+    ("mirror", "tile": warned) or a statistically equivalent surface from its PSD ("equivalent",
+    drawn with ``seed``). ``multiscale check`` reads the file's header and heights, nothing more."""
+
+    body: str | None = key(Text())               # the stationary (rough) side; default: that side
+    rms: float | None = key(_ROUGHNESS)                                        # m
+    hurst: float | None = key(Quantity("dimensionless", gt=0, le=1, plausible=(0.1, 1.0)))
+    k_min: tuple | None = key(Pair(Quantity("dimensionless", gt=0)))          # wavelengths, (x, y)
+    k_max: tuple | None = key(Pair(Quantity("dimensionless", gt=0)))
+    seed: int = key(Integer(ge=0), default=0)
+    patch: str = key(Choice(("face", "zone")), default="face")
+    file: Path | None = key(FilePath())                                       # measured topography
+    channel: int | None = key(Integer(ge=0))                                  # default: the file's default
+    pixel_size: tuple | None = key(Pair(_LENGTH))                             # m, (dx, dy): overrides the file's
+    height_unit: float | None = key(_LENGTH)                                  # m per file height unit
+    detrend: str = key(Choice(tuple(DETREND)), default="plane")               # form removal
+    cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)))  # m, Gaussian filter λc
+    max_undefined: float = key(Quantity("dimensionless", ge=0, le=1), default=MAX_UNDEFINED)
+    cover: str = key(Choice(COVER), default="measured")
+
+    rules = (OneOf(("rms", "file"), required=True), Requires("rms", ("hurst", "k_min", "k_max")),
+             OnlyWith("rms", ("hurst", "k_min", "k_max", "patch")),
+             OnlyWith("file", ("channel", "pixel_size", "height_unit", "detrend", "cutoff", "max_undefined", "cover")))
+
+    def problems(self, path, ctx):
+        if self.rms is not None and any(hi <= lo for lo, hi in zip(self.k_min, self.k_max)):
+            return [f"{path}.k_max = {list(self.k_max)}: must exceed k_min = {list(self.k_min)}"]
+        if self.file is None:
+            return []
+        problems, notes = probe_topography(self.file, self.channel, pixel_size=self.pixel_size,
+                                           height_unit=self.height_unit, max_undefined=self.max_undefined,
+                                           prefix=f"{path}.")
+        ctx.warnings.extend(notes)
+        return problems
+
+
+@dataclass(frozen=True)
+class Micro:
+    """How the rough interface is solved (issue 7): zone grid on the interface, grid per zone
+    (default 50 x 50; a measured surface's own pixel size, rounded, unless it is replaced by a
+    statistically equivalent one), micro model, points of each p_n(g_n) law (top node at ``p_max``, default 20 x the nominal
+    interface pressure; contact solver tolerance ``tol``), micro partition law (ch. 6) or the
+    constant one."""
+
+    zones: tuple | None = key(Pair(Integer(ge=1)), required=True)             # (nx, ny) zones
+    grid: tuple | None = key(Pair(Integer(ge=8)))                             # (nx, ny) per zone
+    model: str = key(Choice(("fft-bem", "asperity", "asperity-interacting")), default="fft-bem")
+    law_points: int = key(Integer(ge=4), default=20)
+    partition_law: bool = key(Flag(), default=False)
+    p_max: float | None = key(Quantity("pressure", gt=0))                     # Pa, top node of the laws
+    tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)     # micro contact solves
+
+    def problems(self, path, ctx):
+        if self.partition_law and "heat_partition" not in ctx.effects:
+            return [f'{path}.partition_law = true: needs effect "heat_partition"']
+        return []
+
+
+# Default k_w(T) [(K, 1/Pa)]: the shape of thesis Fig. 7.9 (sintered pad material, [Mann 2017]):
+# slowly rising up to 200 degC, steeply above. The figure's numbers are not in the text; the level
+# at 20-100 degC (~8e-15 1/Pa) is what reproduces the worn volume of §7.3.2 (3.8e7 um^3 in 30 s
+# of 200 N at 1.9 m/s with mu = 0.4: V / (mu F s) = 8.4e-15 1/Pa).
+FIG_7_9_WEAR_RATE = ((293.15, 6e-15), (373.15, 8e-15), (473.15, 1.5e-14), (573.15, 6e-14), (673.15, 2e-13))
+
+
+@dataclass(frozen=True)
+class Wear:
+    """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (default: the
+    shape of thesis Fig. 7.9, ``FIG_7_9_WEAR_RATE``). Every ``update_every`` macro steps the zones
+    wear over the sliding of those steps in ``substeps`` load-controlled increments."""
+
+    k_w: float | None = key(_WEAR_RATE)                      # 1/Pa
+    k_w_table: tuple | None = key(Curve(_TEMPERATURE, Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)),
+                                        "temperature", "k_w"))                # ((K, 1/Pa), ...)
+    update_every: int = key(Integer(ge=1), default=1)                         # macro steps per update
+    substeps: int = key(Integer(ge=1), default=1)                             # wear increments per update
+
+    rules = (OneOf(("k_w", "k_w_table")),)
+
+    @property
+    def rate(self):
+        """k_w [1/Pa]: the constant, else the table ((temperatures [K]), (rates [1/Pa]))."""
+        if self.k_w is not None:
+            return self.k_w
+        return tuple(zip(*(self.k_w_table or FIG_7_9_WEAR_RATE)))
+
+
+@dataclass(frozen=True)
+class Layer:
+    thickness: float = key(Quantity("length", gt=0, plausible=(1e-9, 0.1)), required=True)  # m
+    E: float = key(_MODULUS, required=True)                                   # Pa
+    nu: float = key(_POISSON, required=True)
+    kappa: float | None = key(_CONDUCTIVITY, needed_by=("thermal",))          # W/(m K)
+
+
+@dataclass(frozen=True)
+class Layers:
+    """Layers on one body's face, top first ([[layers.layer]]), on the body's material as a
+    half-space or on a rigid base (ch. 2, §5.3)."""
+
+    body: str | None = key(Text())               # the stationary (rough) side; default: that side
+    base: str = key(Choice(("half-space", "rigid")), default="half-space")
+    layer: tuple | None = key(Tables(Layer), required=True)
+
+
+@dataclass(frozen=True)
+class Stability:
+    """Complex eigenvalue analysis (§4.3): modes in a frequency band, shift target, damping."""
+
+    band: tuple = key(Pair(Quantity("frequency", ge=0), single=False, names="[low, high]"),
+                      default=(0.0, 16e3))                                    # Hz
+    modes: int | None = key(Integer(ge=1), required=True)
+    target: float | None = key(Quantity("frequency", ge=0))                   # Hz; default: the band's lower edge
+    damping: float = key(Quantity("dimensionless", ge=0, plausible=(0.0, 0.5)), default=0.0)  # structural loss factor
+
+    def problems(self, path, ctx):
+        low, high = self.band
+        if high <= low:
+            return [f"{path}.band = [{low:g}, {high:g}] Hz: the upper bound must exceed the lower"]
+        if self.target is not None and not low <= self.target <= high:
+            return [f"{path}.target = {self.target:g} Hz: must lie in the band [{low:g}, {high:g}] Hz"]
+        return []
+
+

@@ -1,0 +1,70 @@
+"""Thermal boundary conditions on two MPI ranks give the serial history (convection, radiation, a fixed
+temperature and its reaction, kappa(T) and c(T); run: mpiexec -n 2 python -m pytest tests/mpi)."""
+import numpy as np
+import pytest
+
+pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+
+from mpi4py import MPI  # noqa: E402
+
+from multiscale.scene import loads  # noqa: E402
+from multiscale.workflows import run  # noqa: E402
+
+SCENE = """
+name = "stack_mpi"
+effects = ["contact", "thermal", "conductance", "expansion"]
+[geometry]
+builder = "block_on_flat"
+mesh_size = "2 mm"
+[materials.block]
+E = [["300 K", "200 GPa"], ["700 K", "150 GPa"]]
+nu = 0.3
+alpha = "1e-5 1/K"
+kappa = [["300 K", 50], ["700 K", 30]]
+rho = "7800 kg/m^3"
+c = [["300 K", 450], ["700 K", 600]]
+[materials.flat]
+E = "200 GPa"
+nu = 0.3
+alpha = "1.2e-5 1/K"
+kappa = "40 W/(m K)"
+chi = "1e-5 m^2/s"
+[interface]
+penalty = "1e13 Pa/m"
+conductance = "1e5 W/(m^2 K)"
+[loading]
+pressure = "1 MPa"
+[time]
+end = "20 s"
+steps = 4
+initial_temperature = "500 K"
+[[boundary]]
+surfaces = ["free:block"]
+convection = "100 W/(m^2 K)"
+emissivity = 0.8
+ambient = "300 K"
+[[boundary]]
+surfaces = ["flat_bottom"]
+temperature = "350 K"
+[output]
+folder = "{folder}"
+fields = []
+"""
+
+
+def test_two_ranks_give_the_serial_thermal_history(tmp_path):
+    world = MPI.COMM_WORLD
+    assert world.size == 2, "run under mpiexec -n 2"
+    base = world.bcast(str(tmp_path), root=0)
+    parallel = run(loads(SCENE.format(folder=f"{base}/parallel")), comm=world, verbose=False).history
+    serial = None
+    if world.rank == 0:
+        serial = run(loads(SCENE.format(folder=f"{base}/serial")), comm=MPI.COMM_SELF, verbose=False).history
+    serial = world.bcast(serial.columns if serial is not None else None, root=0)
+    assert set(serial) == set(parallel.columns) and "heat_lost_total_flat" in serial
+    for key, values in serial.items():
+        np.testing.assert_allclose(parallel[key], values, rtol=1e-8, atol=1e-8, err_msg=key)
+    # energy: stored + lost = 0 in the stack (no frictional heat), to round-off
+    stored = parallel["stored_heat_block"][-1] + parallel["stored_heat_flat"][-1]
+    lost = parallel["heat_lost_total_block"][-1] + parallel["heat_lost_total_flat"][-1]
+    assert stored + lost == pytest.approx(0.0, abs=1e-9 * abs(lost))
