@@ -33,6 +33,7 @@ _ROUGHNESS = Quantity("length", gt=0, plausible=(1e-10, 1e-3))            # RMS 
 _CONVECTION = Quantity("conductance", ge=0, plausible=(0.0, 1e4))         # still air to boiling water
 _ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0))  # up to ~24 000 rpm
 _WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # Archard k/H
+_HARDNESS = Quantity("pressure", gt=0, plausible=(1e6, 1e11))            # soft polymer to diamond
 GRAVITY = 9.80665                  # m/s^2, standard gravity
 
 
@@ -77,10 +78,11 @@ class Material:
     chi: float | tuple | None = key(_property(_DIFFUSIVITY, "chi"))         # m^2/s
     alpha: float | tuple | None = key(_property(_EXPANSION, "alpha"), needed_by=("expansion",),
                                       warn_unused=True)                                      # 1/K
+    hardness: float | tuple | None = key(_property(_HARDNESS, "hardness"))   # Pa, plastic flow pressure of asperities
 
     rules = (OneOf(("c", "chi"), needed_by=("thermal",)), Requires("c", ("rho",), needed_by=("thermal",)))
 
-    PROPERTIES = ("E", "nu", "rho", "kappa", "c", "chi", "alpha")
+    PROPERTIES = ("E", "nu", "rho", "kappa", "c", "chi", "alpha", "hardness")
 
     def tabulated(self, name: str) -> bool:
         """True if property ``name`` is a temperature table."""
