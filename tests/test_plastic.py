@@ -1,16 +1,20 @@
 """Elastic-perfectly-plastic FFT-BEM contact (0 <= p <= H): the elastic limit bit for bit, the
 fully plastic limit, a dense independent solve, Hertz below yield and H far above it, the
 permanent deformation as an elastic reload, batches, layered kernels and bad input."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 from scipy.optimize import minimize
 
-from multiscale.errors import InputError
+from multiscale.errors import InputError, SceneError
 from multiscale.micro.contact import ContactSolver, solve_contact
 from multiscale.micro.kernels import HalfSpace, InfluenceOperator
 from multiscale.micro.layered import LayeredElastic
+from multiscale.micro.plasticity import Hardness, load_path
 from multiscale.micro.surface import fractal_surface
 from multiscale.references.hertz import sphere_on_flat_at_radius
+from multiscale.scene import loads
 
 E = HalfSpace.from_materials(4e9, 0.15)
 
@@ -146,3 +150,55 @@ def test_pk_method_has_no_bound():
     with pytest.raises(InputError) as e:
         solve_contact(s.heights, s.dx, E, load=2e6, hardness=1e8, method="pk")
     assert e.value.name == "hardness"
+
+
+def test_load_unload_reload_of_a_fractal_patch():
+    """Loading yields; unloading is elastic and stiffer, keeps the residual deformation;
+    reloading meets the loading curve at the previous maximum; loading on is the monotonic path."""
+    s = rough(64, seed=5)
+    solver = ContactSolver(E, s.shape, s.dx)
+    loads = [1e6, 2e6, 4e6, 2e6, 1e6, 2e6, 4e6, 6e6]
+    steps, deformed = load_path(solver, s.heights, loads, 3e7, tol=1e-11)
+    flat = np.array([float(x.flat) for x in steps])
+    assert [str(x.branch) for x in steps] == ["loading"] * 3 + ["reloading"] * 4 + ["loading"]
+    assert all(steps[k].plastic_area_fraction == 0 for k in (3, 4, 5))          # elastic unloading
+    assert steps[3].result.plastic.max() == 0 and steps[4].result.plastic.max() == 0
+    assert flat[3] - flat[2] < 0.1 * (flat[1] - flat[2])                         # stiffer than loading
+    assert flat[3] < flat[1] and flat[4] < flat[0]                               # the residual deformation
+    assert flat[5] == pytest.approx(flat[3], rel=1e-9)                           # reloading = unloading
+    assert flat[6] == pytest.approx(flat[2], rel=1e-9)                           # meets loading at the max
+    assert steps[6].result.plastic.max() < 1e-9 * steps[2].result.plastic.max()
+    direct = load_path(solver, s.heights, [6e6], 3e7, tol=1e-11)[0][0]
+    assert float(steps[7].flat) == pytest.approx(float(direct.flat), rel=1e-9)
+    assert np.all(deformed <= s.heights) and np.any(deformed < s.heights)
+
+
+def test_hardness_constant_or_table():
+    assert Hardness(3e8)(500.0) == 3e8
+    table = Hardness(([300.0, 600.0], [3e8, 1e8]))
+    assert table(450.0) == pytest.approx(2e8) and table(900.0) == pytest.approx(1e8)
+    for bad, field in [(0.0, "hardness"), (-1.0, "hardness"), (([300.0, 300.0], [1e8, 2e8]), "hardness.temperatures"),
+                       (([600.0, 300.0], [1e8, 2e8]), "hardness.temperatures"),
+                       (([300.0, 600.0], [1e8, -2e8]), "hardness.values")]:
+        with pytest.raises(InputError) as e:
+            Hardness(bad)
+        assert e.value.name == field
+
+
+def test_scene_plasticity_needs_a_hardness_and_checks_its_table():
+    text = (Path(__file__).parents[1] / "demos" / "pin_on_disc.toml").read_text()
+    text = text.replace('"roughness", "wear"]', '"roughness", "wear", "plasticity"]')
+    assert '"plasticity"]' in text
+    with pytest.raises(SceneError) as e:
+        loads(text, "demos")
+    assert len(e.value.problems) == 1 and e.value.problems[0].startswith("materials.pin.hardness: missing")
+    table = 'hardness = [["400 K", "300 MPa"], ["300 K", "200 MPa"]]\n'
+    with pytest.raises(SceneError) as e:
+        loads(text.replace("[materials.pin]", "[materials.pin]\n" + table, 1), "demos")
+    assert len(e.value.problems) == 1 and "materials.pin.hardness" in e.value.problems[0] \
+        and "increase" in e.value.problems[0]
+    with pytest.raises(SceneError) as e:
+        loads(text.replace("[materials.pin]", "[materials.pin]\nhardness = 0\n", 1), "demos")
+    assert len(e.value.problems) == 1 and e.value.problems[0].startswith("materials.pin.hardness = 0")
+    scene = loads(text.replace("[materials.pin]", '[materials.pin]\nhardness = "300 MPa"\n', 1), "demos")
+    assert scene.has("plasticity") and scene.materials["pin"].hardness == 3e8
