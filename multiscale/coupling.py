@@ -164,7 +164,8 @@ class Multiscale:
         res = self.post.run([zones[i] for i in mine], load.pressure[mine], speed=load.speed[mine],
                             angle=load.angle[mine], remote=np.column_stack([rough, rough]), sliding=sliding,
                             warm=self.warm[mine], mu=mu)
-        parts = comm.allgather((mine, res.worn_pressure, res.heights if wear else None, res.max_pressure,
+        changed = wear or self.post.hardness is not None          # worn or plastically deformed
+        parts = comm.allgather((mine, res.worn_pressure, res.heights if changed else None, res.max_pressure,
                                 res.max_temperature, res.partition, res.conductance))
         max_p, max_T = [], []
         for ids, warm, heights, mp, mT, part, h_c in parts:
@@ -231,10 +232,11 @@ class Multiscale:
         self.apply_zone_fields()
         t2 = _time.perf_counter()
         self.rough.laws_computed = 0
-        if wear:
+        changed = wear or self.post.hardness is not None   # new topographies: their laws (cached if unchanged)
+        if changed:
             self.rough.update_laws()
         t3 = _time.perf_counter()
-        if wear:
+        if changed:
             self.model.last_solve = self.model.mechanics.solve()
         return StepResult(n, heat, micro, t1 - t0 + _time.perf_counter() - t3, t2 - t1, t3 - t2)
 

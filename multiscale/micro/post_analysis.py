@@ -35,6 +35,7 @@ from multiscale.micro.heat_kernels import ThermalMaterial
 from multiscale.micro.heating import SteadyHeating
 from multiscale.micro.kernels import Kernel
 from multiscale.micro.laws import Conductance
+from multiscale.micro.plasticity import Hardness
 from multiscale.micro.surface import Surface
 from multiscale.micro.wear import WearRate, wear_step
 from multiscale.micro.zones import Zone
@@ -75,6 +76,7 @@ class ZoneResult:
     partition: np.ndarray         # (B,): share of the frictional heat into the rough body (NaN without)
     conductance: np.ndarray       # W/(m^2 K), (B,): zone conductance h_c (NaN without)
     iterations: np.ndarray        # (B,): contact-solver iterations of the step
+    plastic_area_fraction: np.ndarray  # (B,): cells at the hardness / zone cells at the macro load (0 if elastic)
 
 
 class PostAnalysis:
@@ -85,12 +87,15 @@ class PostAnalysis:
     periodic); ``mu``: friction coefficient; ``heating``: a ``Heating`` or None (no local
     temperature: k_w is then taken at the macro temperature of the rough body); ``conductance``: a
     ``laws.Conductance`` or None; ``wear_rate``: anything ``WearRate`` accepts (temperatures in K),
-    or None for no wear; ``substeps``: wear increments per step; ``tol``: contact tolerance.
+    or None for no wear; ``substeps``: wear increments per step; ``tol``: contact tolerance;
+    ``hardness``: a ``plasticity.Hardness`` (H, or H(T) at the rough body's remote temperature of
+    each zone) for elastic-perfectly-plastic asperities, whose permanent deformation goes into the
+    returned heights (before wear; the wear re-solves are bounded too), or None (elastic).
     """
 
     def __init__(self, kernel: Kernel, shape, dx: float, dy: float, *, mu: float, heating: Heating | None = None,
                  conductance: Conductance | None = None, wear_rate=None, substeps: int = 1,
-                 tol: float = 1e-8, max_iter: int = 5000):
+                 tol: float = 1e-8, max_iter: int = 5000, hardness: Hardness | None = None):
         self.solver = ContactSolver(kernel, shape, dx, dy, periodic=False)
         self.shape, self.dx, self.dy = tuple(shape), float(dx), float(dy)
         self.mu = check_positive("mu", mu, allow_zero=True)
@@ -100,6 +105,7 @@ class PostAnalysis:
             raise InputError("substeps", substeps, "an integer >= 1")
         self.substeps, self.tol, self.max_iter = int(substeps), check_positive("tol", tol), int(max_iter)
         self._heaters: dict[tuple, SteadyHeating] = {}
+        self.hardness = hardness
 
     def run(self, zones: list[Zone], load, *, speed, angle=0.0, remote=None, sliding=None,
             warm=None, mu=None) -> ZoneResult:
@@ -126,8 +132,13 @@ class PostAnalysis:
         if B == 0:
             empty = np.zeros((0,) + self.shape)
             return ZoneResult(empty, empty, empty, empty, np.zeros(0), *(np.zeros(0) for _ in range(6)),
-                              np.zeros(0, dtype=int))
-        r = self._solve(zones, H, load, _warm(warm, H.shape))
+                              np.zeros(0, dtype=int), np.zeros(0))
+        hard = None
+        if self.hardness is not None:
+            if self.hardness.depends_on_temperature and remote is None:
+                raise InputError("remote", None, "a temperature-dependent hardness needs temperatures")
+            hard = np.broadcast_to(self.hardness(None if remote is None else remote[:, 1]), (B,))
+        r = self._solve(zones, H, load, _warm(warm, H.shape), hard)
         iterations = np.asarray(r.iterations).copy()
         T, max_T, partition = None, nan.copy(), nan.copy()
         if self.heating is not None:
@@ -143,7 +154,7 @@ class PostAnalysis:
         h_c = nan.copy()
         if self.conductance is not None:
             h_c = np.asarray(self.conductance.values(r, zones)["conductance"], dtype=float)
-        heights, depth, p = H, np.zeros(H.shape), r.pressure
+        heights, depth, p = H - r.plastic, np.zeros(H.shape), r.pressure
         if self.rate is not None and sliding is not None:
             if self.rate.depends_on_temperature and T is None:
                 if remote is None:
@@ -155,24 +166,24 @@ class PostAnalysis:
                 worn = wear_step(Surface(heights, self.dx, self.dy, periodic=False),
                                  mu[:, None, None] * p * ds[:, None, None], self.rate, 1.0, 1.0, T)
                 heights, depth = worn.surface.heights, depth + worn.depth
-                again = self._solve(zones, heights, load, p)
-                p = again.pressure
+                again = self._solve(zones, heights, load, p, hard)
+                p, heights = again.pressure, heights - again.plastic
                 iterations += np.asarray(again.iterations)
         return ZoneResult(r.pressure, p, heights, depth, depth.sum(axis=(-2, -1)) * self.dx * self.dy,
                           r.pressure.max(axis=(-2, -1)), np.asarray(r.area_fraction, dtype=float),
-                          max_T, partition, h_c, iterations)
+                          max_T, partition, h_c, iterations, np.asarray(r.plastic_area_fraction, dtype=float))
 
-    def _solve(self, zones, heights, load, warm):
+    def _solve(self, zones, heights, load, warm, hardness=None):
         """Load-controlled contact of the batch; patches that do not converge within
         ``WARM_ITERATIONS`` from the warm start (warm starts converge in tens of iterations; one
         supported by a single cell was seen to stall for ever) are solved again from a uniform
         start with 4 x max_iter; ``ContactConvergenceError`` names those that still fail."""
         r = self.solver.solve(heights, load=load, initial_pressure=warm, tol=self.tol,
-                              max_iter=min(self.max_iter, WARM_ITERATIONS), partial=True)
+                              max_iter=min(self.max_iter, WARM_ITERATIONS), partial=True, hardness=hardness)
         bad = np.flatnonzero(~np.asarray(r.converged))
         if len(bad):
             again = self.solver.solve(heights[bad], load=load[bad], tol=self.tol, max_iter=4 * self.max_iter,
-                                      partial=True)
+                                      partial=True, hardness=None if hardness is None else hardness[bad])
             for f in fields(r):
                 if f.name not in ("history", "iterations"):
                     getattr(r, f.name)[bad] = getattr(again, f.name)

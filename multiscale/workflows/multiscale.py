@@ -37,7 +37,8 @@ from multiscale.plots.history import multiscale_figure, wear_map
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, interface_forces, \
     interface_materials
 from multiscale.workflows.output import prepare_folder
-from multiscale.workflows.rough import build_rough_interface, check_rough_scene, contact_kernel, thermal_kernels
+from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
+                                        thermal_kernels)
 from multiscale.workflows.transient import TransientResult, write_history
 
 CHECKPOINT = "checkpoint.h5"
@@ -66,7 +67,7 @@ def post_analysis(scene, zone) -> PostAnalysis:
                         heating=heating,
                         conductance=Conductance(*thermal_kernels(scene)) if scene.has("conductance") else None,
                         wear_rate=scene.wear.rate if wear else None, substeps=scene.wear.substeps if wear else 1,
-                        tol=scene.micro.tol)
+                        tol=scene.micro.tol, hardness=interface_hardness(scene) if scene.has("plasticity") else None)
 
 
 def fingerprint(scene) -> str:
