@@ -82,6 +82,7 @@ class MicroStep:
     partition: tuple           # (min, mean, max) share into the rough body over the loaded zones
     work: float                # J, mu ∫ p |v| dA over the wear interval (0 without wear)
     seconds: float
+    plastic_fraction: float = 0.0  # largest share of a zone's cells at the hardness (0 without plasticity)
 
 
 @dataclass
@@ -165,19 +166,24 @@ class Multiscale:
                             angle=load.angle[mine], remote=np.column_stack([rough, rough]), sliding=sliding,
                             warm=self.warm[mine], mu=mu)
         changed = wear or self.post.hardness is not None          # worn or plastically deformed
+        plastic = self.post.hardness is not None
         parts = comm.allgather((mine, res.worn_pressure, res.heights if changed else None, res.max_pressure,
-                                res.max_temperature, res.partition, res.conductance))
-        max_p, max_T = [], []
-        for ids, warm, heights, mp, mT, part, h_c in parts:
+                                res.max_temperature, res.partition, res.conductance,
+                                res.plastic if plastic else None, res.plastic_area_fraction))
+        max_p, max_T, flow = [], [], []
+        for ids, warm, heights, mp, mT, part, h_c, w, fraction in parts:
             self.warm[ids] = warm
             if heights is not None:
                 self.rough.set_heights(ids, heights)
+            if w is not None:
+                self.rough.plastic[ids] += w
             if self.partition_law:
                 self.partition[ids] = part
             if self.post.conductance is not None:
                 self.conductance[ids] = h_c
             max_p.append(mp)
             max_T.append(mT)
+            flow.append(fraction)
         if self.post.conductance is not None:
             self.conductance[np.setdiff1d(np.arange(len(zones)), loaded)] = 0.0
         work = sum(self.model.contact.heat_power()) * duration if wear else 0.0   # mu ∫ p |w| dA Δt
@@ -187,7 +193,7 @@ class Multiscale:
         return MicroStep(len(loaded), float(load.pressure.max()), float(max_p.max(initial=0.0)),
                          float(max_T.max()) if len(max_T) and np.isfinite(max_T).any() else np.nan,
                          (float(used.min()), float(used.mean()), float(used.max())), work,
-                         _time.perf_counter() - t0)
+                         _time.perf_counter() - t0, float(np.concatenate(flow).max(initial=0.0)))
 
     def apply_zone_fields(self) -> None:
         """Per-facet partition (micro partition law) and conductance from the zones."""
@@ -249,9 +255,12 @@ class Multiscale:
         if self.post.heating is not None:
             row.update(micro_max_temperature=micro.max_temperature, partition_min=micro.partition[0],
                        partition_mean=micro.partition[1], partition_max=micro.partition[2])
+        if self.post.hardness is not None:
+            row.update(micro_plastic_fraction=micro.plastic_fraction,
+                       plastic_max_depth=float(self.rough.plastic.max(initial=0.0)))
         if self.settings.wear:
             heights = self.rough.heights()
-            depth = self.rough.initial - heights
+            depth = self.rough.wear_depth()
             row.update(wear_volume=float(self.rough.zone_wear_volume(depth).sum()), wear_max_depth=float(depth.max()),
                        rms_height=float(np.sqrt(np.mean((heights - heights.mean()) ** 2))),
                        frictional_work=self.work)
@@ -269,7 +278,8 @@ class Multiscale:
     def save(self, path: Path, step: int, history: io.History) -> None:
         """Checkpoint after macro step ``step`` (collective)."""
         m, last = self.model, self.model.last_solve
-        arrays = {"heights": self.rough.heights(), "warm": self.warm, "partition": self.partition,
+        arrays = {"heights": self.rough.heights(), "plastic": self.rough.plastic, "warm": self.warm,
+                  "partition": self.partition,
                   "conductance": self.conductance, "levels": self.rough.levels, "heat_total": m.heat_total,
                   "heat_lost_recorded": m.heat_lost_recorded,
                   **({"lost_total": m.thermal.lost_total} if m.thermal is not None else {}),
@@ -289,6 +299,7 @@ class Multiscale:
                              "run it with --overwrite")
         m = self.model
         self.rough.set_heights(range(len(arrays["heights"])), arrays["heights"])
+        self.rough.plastic = arrays["plastic"].copy()
         self.warm, self.partition = arrays["warm"], arrays["partition"]
         self.conductance, self.rough.levels = arrays["conductance"], arrays["levels"]
         self.datum_gap = arrays["datum_gap"]

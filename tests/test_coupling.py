@@ -356,3 +356,17 @@ kappa = "5 W/(m K)"
     with pytest.raises(InputError, match="layers.body"):
         from multiscale.workflows.multiscale import build
         build(loads(text.replace('body = "pin"\nbase', 'body = "disc"\nbase')))
+
+
+def test_plastic_pin_on_disc_caps_the_micro_pressure_and_keeps_archard(tmp_path):
+    """Effect "plasticity" with the pin's hardness: every micro pressure <= H, zones yield and keep
+    their permanent deformation, the load is carried, and the worn volume is still k_w x the
+    frictional work (the permanent deformation is not counted as wear)."""
+    from multiscale.workflows import run
+    text = POD.format(folder=tmp_path / "plastic").replace('"roughness", "wear"]', '"roughness", "wear", "plasticity"]')
+    scene = loads(text.replace("[materials.pin]", '[materials.pin]\nhardness = "60 MPa"', 1))
+    h = History.read(run(scene, verbose=False).history_file)
+    assert np.all(h["micro_max_pressure"] <= 60e6 * (1 + 1e-12)) and np.all(h["micro_plastic_fraction"] > 0)
+    assert np.all(np.diff(h["plastic_max_depth"]) >= 0) and h["plastic_max_depth"][-1] > 0
+    np.testing.assert_allclose(h["interface_force"], 200.0, rtol=1e-6)
+    assert h["wear_volume"][-1] == pytest.approx(1e-14 * h["frictional_work"][-1], rel=0.01)

@@ -177,7 +177,7 @@ def test_hardness_constant_or_table():
     assert Hardness(3e8)(500.0) == 3e8
     table = Hardness(([300.0, 600.0], [3e8, 1e8]))
     assert table(450.0) == pytest.approx(2e8) and table(900.0) == pytest.approx(1e8)
-    for bad, field in [(0.0, "hardness"), (-1.0, "hardness"), (([300.0, 300.0], [1e8, 2e8]), "hardness.temperatures"),
+    for bad, field in [(0.0, "hardness"), (-1.0, "hardness"), ("hard", "hardness"), (np.inf, "hardness"), (([300.0, 300.0], [1e8, 2e8]), "hardness.temperatures"),
                        (([600.0, 300.0], [1e8, 2e8]), "hardness.temperatures"),
                        (([300.0, 600.0], [1e8, -2e8]), "hardness.values")]:
         with pytest.raises(InputError) as e:

@@ -59,14 +59,14 @@ class Hardness:
 
 
 def _positive(name, value):
-    v = np.asarray(value, dtype=float) if np.ndim(value) else value
+    """``value`` (a number or an array) finite and > 0, else ``InputError`` naming it."""
     try:
-        ok = np.all(np.isfinite(v)) and np.all(np.asarray(v, dtype=float) > 0)
+        v = np.asarray(value, dtype=float)
     except (TypeError, ValueError):
-        ok = False
-    if not ok:
+        v = np.asarray(np.nan)
+    if not (np.all(np.isfinite(v)) and np.all(v > 0)):
         raise InputError(name, value, "hardness must be finite and > 0 [Pa]")
-    return float(v) if np.ndim(v) == 0 else v
+    return float(v) if v.ndim == 0 else v
 
 
 @dataclass

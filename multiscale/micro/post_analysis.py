@@ -67,7 +67,7 @@ class ZoneResult:
 
     pressure: np.ndarray          # Pa, (B, ny, nx): local pressure at the macro load, before wear
     worn_pressure: np.ndarray     # Pa, (B, ny, nx): local pressure on the worn patch (next warm start)
-    heights: np.ndarray           # m, (B, ny, nx): worn topography
+    heights: np.ndarray           # m, (B, ny, nx): worn (and plastically deformed) topography
     depth: np.ndarray             # m, (B, ny, nx): wear depth of this step, >= 0
     volume: np.ndarray            # m^3, (B,): worn volume of this step
     max_pressure: np.ndarray      # Pa, (B,): largest local pressure before wear
@@ -77,6 +77,7 @@ class ZoneResult:
     conductance: np.ndarray       # W/(m^2 K), (B,): zone conductance h_c (NaN without)
     iterations: np.ndarray        # (B,): contact-solver iterations of the step
     plastic_area_fraction: np.ndarray  # (B,): cells at the hardness / zone cells at the macro load (0 if elastic)
+    plastic: np.ndarray           # m, (B, ny, nx): permanent deformation of this step, >= 0 (0 if elastic)
 
 
 class PostAnalysis:
@@ -132,7 +133,7 @@ class PostAnalysis:
         if B == 0:
             empty = np.zeros((0,) + self.shape)
             return ZoneResult(empty, empty, empty, empty, np.zeros(0), *(np.zeros(0) for _ in range(6)),
-                              np.zeros(0, dtype=int), np.zeros(0))
+                              np.zeros(0, dtype=int), np.zeros(0), empty)
         hard = None
         if self.hardness is not None:
             if self.hardness.depends_on_temperature and remote is None:
@@ -154,7 +155,8 @@ class PostAnalysis:
         h_c = nan.copy()
         if self.conductance is not None:
             h_c = np.asarray(self.conductance.values(r, zones)["conductance"], dtype=float)
-        heights, depth, p = H - r.plastic, np.zeros(H.shape), r.pressure
+        plastic = r.plastic.copy()
+        heights, depth, p = H - plastic, np.zeros(H.shape), r.pressure
         if self.rate is not None and sliding is not None:
             if self.rate.depends_on_temperature and T is None:
                 if remote is None:
@@ -168,10 +170,12 @@ class PostAnalysis:
                 heights, depth = worn.surface.heights, depth + worn.depth
                 again = self._solve(zones, heights, load, p, hard)
                 p, heights = again.pressure, heights - again.plastic
+                plastic += again.plastic
                 iterations += np.asarray(again.iterations)
         return ZoneResult(r.pressure, p, heights, depth, depth.sum(axis=(-2, -1)) * self.dx * self.dy,
                           r.pressure.max(axis=(-2, -1)), np.asarray(r.area_fraction, dtype=float),
-                          max_T, partition, h_c, iterations, np.asarray(r.plastic_area_fraction, dtype=float))
+                          max_T, partition, h_c, iterations, np.asarray(r.plastic_area_fraction, dtype=float),
+                          plastic)
 
     def _solve(self, zones, heights, load, warm, hardness=None):
         """Load-controlled contact of the batch; patches that do not converge within
