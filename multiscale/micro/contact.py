@@ -41,6 +41,7 @@ METHODS = ("bccg", "pk")
 CHUNK_CELLS = {"bccg": 65536, "pk": 32768}   # cells per chunk of a batch (the working set stays in L2)
 COARSE_MIN = 32      # smallest side of the grids of the nested start of "bccg"
 COARSE_TOL = 1e-1    # tolerance of the coarse solves of the nested start
+SNAP = 1e-12         # a start within this relative distance below the hardness is at the hardness
 
 
 @dataclass
@@ -308,7 +309,9 @@ class ContactSolver:
 def bounded_start(p, upper, total=None):
     """p (B, N) >= 0 made feasible for the bounds ``upper`` (B,): min(c p, H) per patch, with c
     (>= 0) such that Σ min(c p, H) = ``total`` (B,) under load control (exact on the sorted
-    values: the k largest cells saturate, c v_k <= H <= c v_(k-1)), else c = 1."""
+    values: the k largest cells saturate, c v_k <= H <= c v_(k-1)), else c = 1. Values within
+    ``SNAP`` of H are set to H: a warm start from a bounded solution (its cells at H rescaled by
+    1 ± 1e-16) keeps its saturated set (the first iteration's projection restores the balance)."""
     p = np.maximum(np.asarray(p, dtype=float), 0.0)
     H = upper[:, None]
     if total is None:
@@ -327,7 +330,9 @@ def bounded_start(p, upper, total=None):
         ok = (c >= 0) & (c * nxt <= H) & (c * prev >= H) & (tail > 0)
     first = np.argmax(ok, axis=1)
     scale = c[np.arange(p.shape[0]), first]
-    return np.minimum(p * scale[:, None], H)
+    p = np.minimum(p * scale[:, None], H)
+    p[p >= H * (1 - SNAP)] = np.broadcast_to(H, p.shape)[p >= H * (1 - SNAP)]   # ties at H stay saturated
+    return p
 
 
 def _method(method) -> str:
