@@ -106,6 +106,28 @@ def load(path, comm, functions: dict) -> tuple[dict, dict]:
     return attrs, arrays
 
 
+def mark(path, comm, **attrs) -> None:
+    """Set scalar attributes of the checkpoint ``path`` (e.g. the last step whose fields are
+    written, or that the run finished); outside the checksum, which covers the data (collective)."""
+    def write():
+        with h5py.File(path, "r+") as h5:
+            for key, value in attrs.items():
+                h5.attrs[key] = value
+    on_root(comm, write, f"the checkpoint {path}")
+
+
+def peek(path, comm) -> dict:
+    """The scalar attributes of a checkpoint, read by rank 0 for every rank without loading its
+    data ({} if there is none or it cannot be read: ``load`` then says why)."""
+    def read():
+        try:
+            with h5py.File(path, "r") as h5:
+                return {k: (v.decode() if isinstance(v, bytes) else v) for k, v in h5.attrs.items()}
+        except (OSError, KeyError, ValueError):
+            return {}
+    return comm.bcast(read() if comm.rank == 0 else None, root=0)
+
+
 def _match(stored: np.ndarray, wanted: np.ndarray) -> np.ndarray:
     """Row of ``stored`` equal to each row of ``wanted`` (-1 where none)."""
     both = np.concatenate([stored, wanted])

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
 from pathlib import Path
 
@@ -11,7 +12,7 @@ from multiscale.io import ended_together
 from multiscale.micro.spectrum import surface_statistics
 from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition, formats, read_topography
 from multiscale.scene import load
-from multiscale.scene_summary import reference, summary
+from multiscale.scene_summary import cells_line, reference, summary
 from multiscale.units import UnitError, to_si
 
 
@@ -51,6 +52,8 @@ def _check(args) -> int:
             failed += 1
             continue
         print("\n".join(summary(scene)))
+        if args.cells:
+            print(cells_line(scene))
         print(f"{path}: OK")
     return 2 if failed else 0
 
@@ -76,6 +79,8 @@ def _run(args) -> int:
     rank = comm.rank if comm is not None else 0
     try:
         scene = load(args.scene)
+        if args.max_cells is not None:
+            scene = dataclasses.replace(scene, geometry=dataclasses.replace(scene.geometry, max_cells=args.max_cells))
         for line in scene.warnings if rank == 0 else ():
             print(f"warning: {line}", file=sys.stderr, flush=True)
         try:
@@ -106,6 +111,17 @@ def _study(args) -> int:
     failed = run_studies(args.studies, rerun_failed=args.rerun_failed, report_folder=args.report,
                          processes=args.processes, command=command)
     return 1 if failed else 0
+
+
+def _count(text: str) -> int:
+    """A positive whole number of the command line ("2000000" or "2e6")."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (value >= 1 and value == int(value)):
+        raise argparse.ArgumentTypeError(f"{text!r}: a whole number >= 1")
+    return int(value)
 
 
 def _length(option: str, text: str | None) -> float | None:
@@ -157,12 +173,15 @@ def build_parser() -> argparse.ArgumentParser:
     check = sub.add_parser("check", help="validate scene files: every problem at once, or a summary")
     check.add_argument("scenes", nargs="*", metavar="SCENE", help="scene TOML file(s)")
     check.add_argument("--keys", action="store_true", help="print the scene format: every section and key")
+    check.add_argument("--cells", action="store_true", help="estimate the mesh's cell count (trial meshes, seconds)")
     check.set_defaults(func=_check)
     run = sub.add_parser("run", help="run a scene (mpirun -n N multiscale run scene.toml)")
     run.add_argument("scene", metavar="SCENE", help="scene TOML file")
     again = run.add_mutually_exclusive_group()
     again.add_argument("--overwrite", action="store_true", help="replace results already in the output folder")
     again.add_argument("--resume", action="store_true", help="continue from the last checkpoint in the output folder")
+    run.add_argument("--max-cells", type=_count, metavar="N", help="largest mesh (cells) the run may build; "
+                                                                   "overrides geometry.max_cells (default 1e6)")
     run.set_defaults(func=_run)
     study = sub.add_parser("study", help="parametric study: sweep, resumable runs, accuracy-vs-time report "
                                          "(mpiexec -n N multiscale study study.toml)")

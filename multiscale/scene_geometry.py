@@ -13,11 +13,12 @@ that ``multiscale check`` reports bodies, volumes, interfaces, areas and normals
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
 from multiscale.errors import InputError
-from multiscale.geometry import GeometrySpec, Rotation, builder, builder_names
+from multiscale.geometry import MAX_CELLS, GeometrySpec, Rotation, builder, builder_names
 from multiscale.schema import (Bad, Choice, FilePath, FrozenMap, Integer, ListOf, Named, OneOf, Quantity,
                                Section, Text, Vector, key, parse, read, show, unknown_keys)
 from multiscale.schema import reference as schema_reference
@@ -156,6 +157,7 @@ class Geometry:
     builder: str
     params: object                    # FrozenMap of builder parameters, or a FileGeometry
     spec: GeometrySpec
+    max_cells: int = MAX_CELLS        # a mesh estimated larger is refused before meshing
 
     def module(self):
         """The builder module (parameters, describe, generate)."""
@@ -212,7 +214,9 @@ class GeometrySection(Section):
         return f"a table with builder = {self.builders.describe()} and its parameters, or file = \"...\""
 
     def reference(self, path) -> list[str]:
-        lines = [f"  {'builder':<20} {self.builders.describe()}  [or file]"]
+        lines = [f"  {'builder':<20} {self.builders.describe()}  [or file]",
+                 f"  {'max_cells':<20} integer >= 1, default {MAX_CELLS}: a mesh estimated larger (trial meshes "
+                 "before meshing) is refused; multiscale run --max-cells overrides it"]
         for name in self.builders.options:
             module = builder(name)
             lines.append(f"  builder = \"{name}\" parameters (SI defaults; 0 = the builder's fallback):")
@@ -224,6 +228,12 @@ class GeometrySection(Section):
         if not isinstance(raw, dict):
             ctx.problems.append(f"{path} = {show(raw)}: must be {self.describe()}")
             return None
+        limit = parse(Integer(ge=1), raw["max_cells"], f"{path}.max_cells", ctx) if "max_cells" in raw else MAX_CELLS
+        raw = {k: v for k, v in raw.items() if k != "max_cells"}
+        geometry = self._read(raw, path, ctx)
+        return None if geometry is None else dataclasses.replace(geometry, max_cells=limit)
+
+    def _read(self, raw, path, ctx):
         if "file" in raw:
             return self._read_file(raw, path, ctx)
         if "builder" not in raw:

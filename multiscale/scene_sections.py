@@ -382,6 +382,9 @@ class Roughness:
         return problems
 
 
+DEFAULT_GRID = (50, 50)    # cells per zone without micro.grid (generated surfaces)
+
+
 @dataclass(frozen=True)
 class Micro:
     """How the rough interface is solved (issue 7): zone grid on the interface, grid per zone
@@ -395,7 +398,7 @@ class Micro:
     model: str = key(Choice(("fft-bem", "asperity", "asperity-interacting")), default="fft-bem")
     law_points: int = key(Integer(ge=4), default=20)
     partition_law: bool = key(Flag(), default=False)
-    p_max: float | None = key(Quantity("pressure", gt=0))                     # Pa, top node of the laws
+    p_max: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e10)))  # Pa, top node of the laws
     tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)     # micro contact solves
 
     def problems(self, path, ctx):

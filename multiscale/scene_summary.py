@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 
+from multiscale.geometry import estimate_cells
 from multiscale.scene import EFFECTS, OUTPUT_FIELDS, Scene
 from multiscale.schema import reference as schema_reference
 
@@ -97,3 +98,12 @@ def _effect_line(scene: Scene, effect: str) -> str:
             "k_w(T) table" if w.k_w_table is not None else "k_w(T) of thesis Fig. 7.9 (default)")
         return f"Archard, {rate}, every {w.update_every} step(s) in {w.substeps} increment(s)"
     return EFFECTS[effect].doc
+
+
+def cells_line(scene: Scene) -> str:
+    """The mesh's estimated cell count against its limit (``check --cells``; runs gmsh trials)."""
+    g = scene.geometry
+    e = estimate_cells(g.module(), g.params if g.builder == "file" else dict(g.params))
+    how = "exact" if e.exact else f"from a trial mesh {e.factor:.3g}x coarser with {e.trial} cells"
+    verdict = "refused by run" if e.cells > g.max_cells else "within"
+    return f"  mesh      about {e.cells:,} cells ({how}); {verdict} geometry.max_cells = {g.max_cells:,}"

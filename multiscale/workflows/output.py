@@ -4,7 +4,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from multiscale.errors import SceneError
+from multiscale.errors import InputError, SceneError
 from multiscale.io import on_root
 
 
@@ -19,8 +19,12 @@ class RunResult:
 
 def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
     """The scene's output folder, created; refuses to touch earlier results unless ``overwrite``
-    (replace them) or ``resume`` (continue them). Rank 0 decides for every rank (collective)."""
+    (replace them) or ``resume`` (continue them; a missing folder is then an error and is not
+    created). Rank 0 decides for every rank (collective)."""
     folder = Path(scene.output.folder)
+    if resume and not comm.bcast(folder.is_dir() if comm.rank == 0 else None, root=0):
+        raise InputError("--resume", str(folder), "the output folder does not exist: there is nothing to resume "
+                         "(run without --resume)")
     existing = comm.bcast(sorted(p.name for p in folder.iterdir()) if comm.rank == 0 and folder.is_dir() else [],
                           root=0)
     if existing and not (overwrite or resume):

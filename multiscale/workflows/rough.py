@@ -41,11 +41,11 @@ from multiscale.micro.topography import TopographyWarning, condition, cover, rea
 from multiscale.micro.zones import ZoneGrid, cut_zones, generate_zones
 from multiscale.pool import MicroPool
 from multiscale.rough import RoughInterface, interface_plane
+from multiscale.scene_sections import DEFAULT_GRID
 from multiscale.workflows.model import interface_forces, interface_materials
 
 P_MAX_FACTOR = 20.0        # default top node of the laws: 20 x the nominal interface pressure
 SEED_STRIDE = 7919         # interface k draws its surfaces with seed + SEED_STRIDE k
-DEFAULT_GRID = (50, 50)    # cells per zone without micro.grid (generated surfaces)
 MAX_CELLS = 1024           # cells per zone side taken from a measurement's own pixel size
 P_MAX_PLASTIC = 0.9        # with plasticity, the top node of the laws is at most this x the hardness
 
