@@ -16,9 +16,10 @@ Both stop on the same unit-free criterion (see ``ContactSolver.solve``). With a 
 plastically and their interpenetration is the permanent deformation (the bounded problem of
 Almqvist et al. 2007, Tribol. Int. 40, 574–579; Weber et al. 2018, Nat. Commun. 9, 888;
 ContactMechanics' hardness cut-off and tamaas' saturated solvers solve the same discrete
-problem). Batches of patches (leading axes) are solved in one call, each patch iterating on its own until it converges (then
-it is frozen), so batched and looped answers agree; a batch runs in chunks of ``CHUNK_CELLS``
-cells that keep the working set in the CPU cache, spread over ``multiscale.micro.fft``'s threads.
+problem). Batches of patches (leading axes) are solved in one call, each patch iterating on its
+own until it converges (then it is frozen), so batched and looped answers agree; a batch runs in
+chunks of ``CHUNK_CELLS`` cells that keep the working set in the CPU cache, spread over
+``multiscale.micro.fft``'s threads.
 
 Conventions: heights ``h`` [m] point towards the rigid flat. The flat first touches the highest
 point; the approach ``delta`` [m] moves it into the solid. Gap
