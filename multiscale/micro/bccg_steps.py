@@ -333,8 +333,9 @@ def update_pressure(p, t, fi, fj, nf, tau, X, active, load_control, target, pend
         if not active[b]:
             continue
         if upper[b] < np.inf:
-            rest = target[b] * N - upper[b] * fixed[b] if load_control else -1.0
-            clipped[b] = bounded_update(p[b], t[b], fi[b], fj[b], nf[b], tau[b], X[b], upper[b], rest, nx, Fx)
+            rest = max(target[b] * N - upper[b] * fixed[b], 0.0)
+            clipped[b] = bounded_update(p[b], t[b], fi[b], fj[b], nf[b], tau[b], X[b], upper[b], load_control, rest,
+                                        nx, Fx)
             nclip += clipped[b]
             continue
         tb, total = tau[b], 0.0
@@ -361,21 +362,21 @@ def update_pressure(p, t, fi, fj, nf, tau, X, active, load_control, target, pend
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
-def bounded_update(p, t, fi, fj, n, tau, X, H, rest, nx, Fx):
+def bounded_update(p, t, fi, fj, n, tau, X, H, load_control, rest, nx, Fx):
     """One patch (flat arrays) with the bound H: p <- P(p - tau t) on F, P the Euclidean
-    projection on {0 <= p <= H; Σ_F p = ``rest``} under load control (``rest`` >= 0: the load
-    less what the cells held at H carry), i.e. p = clip(q + a, 0, H) with the shift a found by a
-    safeguarded Newton search on the piecewise-linear Σ clip(q + a) (exact on the final
-    linear piece); the box alone under displacement control (``rest`` < 0). This bounded
-    projection is that of Almqvist et al. (2007, Tribol. Int. 40, 574-579) and of ContactMechanics'
-    ``constrained_conjugate_gradients(hardness=...)``, with the load kept by the shift instead of
-    a rescaling (which would push saturated cells above H). X = p_new - (p - tau t) on F, as in
-    ``update_pressure``. Returns whether any X is nonzero."""
+    projection on {0 <= p <= H; Σ_F p = ``rest``} under load control (``rest``: the load less
+    what the cells held at H carry), i.e. p = clip(q + a, 0, H) with the shift a found by a
+    safeguarded Newton search on the piecewise-linear Σ clip(q + a) (exact on the final linear
+    piece); the box alone under displacement control. The bound is the hardness cut-off of
+    Almqvist et al. (2007, Tribol. Int. 40, 574-579), also ContactMechanics'
+    ``constrained_conjugate_gradients(hardness=...)``; the load is kept by the shift (the exact
+    projection) instead of a rescaling, which would push saturated cells above H.
+    X = p_new - (p - tau t) on F, as in ``update_pressure``. Returns whether any X is nonzero."""
     for m in range(n):                          # X <- q = p - tau t (unbounded step)
         i, j = fi[m], fj[m]
         X[i * Fx + j] = p[i * nx + j] - tau * t[i * nx + j]
     a = 0.0
-    if rest >= 0.0:
+    if load_control:
         qmin, qmax = np.inf, -np.inf
         for m in range(n):
             v = X[fi[m] * Fx + fj[m]]
