@@ -56,6 +56,7 @@ class LoopSettings:
     partition_law: bool = False   # micro partition per zone (ch. 6) instead of the constant
     wear: bool = False            # Archard wear of the zones
     wear_every: int = 1           # macro steps per wear update
+    flash_softening: bool = False  # H(T) of each zone at its last micro flash temperature (plasticity)
     forces: dict = field(default_factory=dict)   # N, per interface: the load it nominally carries
     friction: np.ndarray | None = None            # mu of every zone (its interface's; None: the post-analysis')
 
@@ -119,6 +120,7 @@ class Multiscale:
         self.partition = np.full(Z, float(settings.partition))
         self.conductance = np.zeros(Z)
         self.warm = np.zeros(rough.initial.shape)     # previous local pressures (warm starts)
+        self.flash = np.full(len(rough.zones), np.nan)  # K, last micro max temperature of each zone
         self.work = 0.0                               # J, frictional work over the wear intervals
         self.datum_gap = np.zeros(self.tm.interface.n_facets)   # m, uniform initial gap g_0 per facet
 
@@ -164,7 +166,7 @@ class Multiscale:
         mu = None if self.settings.friction is None else self.settings.friction[mine]
         res = self.post.run([zones[i] for i in mine], load.pressure[mine], speed=load.speed[mine],
                             angle=load.angle[mine], remote=np.column_stack([rough, rough]), sliding=sliding,
-                            warm=self.warm[mine], mu=mu)
+                            warm=self.warm[mine], mu=mu, hardness_temperature=self._hardness_temperature(mine, rough))
         changed = wear or self.post.hardness is not None          # worn or plastically deformed
         plastic = self.post.hardness is not None
         parts = comm.allgather((mine, res.worn_pressure, res.heights if changed else None, res.max_pressure,
@@ -173,6 +175,7 @@ class Multiscale:
         max_p, max_T, flow = [], [], []
         for ids, warm, heights, mp, mT, part, h_c, w, fraction in parts:
             self.warm[ids] = warm
+            self.flash[ids] = mT
             if heights is not None:
                 self.rough.set_heights(ids, heights)
             if w is not None:
@@ -194,6 +197,15 @@ class Multiscale:
                          float(max_T.max()) if len(max_T) and np.isfinite(max_T).any() else np.nan,
                          (float(used.min()), float(used.mean()), float(used.max())), work,
                          _time.perf_counter() - t0, float(np.concatenate(flow).max(initial=0.0)))
+
+    def _hardness_temperature(self, ids, rough_temperature) -> np.ndarray | None:
+        """Where the zones ``ids`` take H(T): with ``settings.flash_softening``, their flash
+        temperature of the previous post-analysis (the rough body's macro temperature before the
+        first, or if higher): the fixed point H = H(T_flash(H)) is reached explicitly over the macro
+        steps, lagged by one step like the micro partition; else None (the macro temperature)."""
+        if not self.settings.flash_softening:
+            return None
+        return np.fmax(self.flash[ids], rough_temperature)
 
     def apply_zone_fields(self) -> None:
         """Per-facet partition (micro partition law) and conductance from the zones."""
@@ -278,7 +290,7 @@ class Multiscale:
     def save(self, path: Path, step: int, history: io.History) -> None:
         """Checkpoint after macro step ``step`` (collective)."""
         m, last = self.model, self.model.last_solve
-        arrays = {"heights": self.rough.heights(), "plastic": self.rough.plastic, "warm": self.warm,
+        arrays = {"heights": self.rough.heights(), "plastic": self.rough.plastic, "flash": self.flash, "warm": self.warm,
                   "partition": self.partition,
                   "conductance": self.conductance, "levels": self.rough.levels, "heat_total": m.heat_total,
                   "heat_lost_recorded": m.heat_lost_recorded,
@@ -299,7 +311,7 @@ class Multiscale:
                              "run it with --overwrite")
         m = self.model
         self.rough.set_heights(range(len(arrays["heights"])), arrays["heights"])
-        self.rough.plastic = arrays["plastic"].copy()
+        self.rough.plastic, self.flash = arrays["plastic"].copy(), arrays["flash"].copy()
         self.warm, self.partition = arrays["warm"], arrays["partition"]
         self.conductance, self.rough.levels = arrays["conductance"], arrays["levels"]
         self.datum_gap = arrays["datum_gap"]

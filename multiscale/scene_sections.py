@@ -400,10 +400,14 @@ class Micro:
     partition_law: bool = key(Flag(), default=False)
     p_max: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e10)))  # Pa, top node of the laws
     tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)     # micro contact solves
+    flash_softening: bool = key(Flag(), default=False)   # H(T) of each zone at its last flash temperature
 
     def problems(self, path, ctx):
         if self.partition_law and "heat_partition" not in ctx.effects:
             return [f'{path}.partition_law = true: needs effect "heat_partition"']
+        if self.flash_softening and not {"plasticity", "heat_partition"} <= ctx.effects:
+            return [f'{path}.flash_softening = true: needs effects "plasticity" and "heat_partition" (the micro '
+                    "heating gives the flash temperature)"]
         return []
 
 

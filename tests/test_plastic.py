@@ -202,3 +202,11 @@ def test_scene_plasticity_needs_a_hardness_and_checks_its_table():
     assert len(e.value.problems) == 1 and e.value.problems[0].startswith("materials.pin.hardness = 0")
     scene = loads(text.replace("[materials.pin]", '[materials.pin]\nhardness = "300 MPa"\n', 1), "demos")
     assert scene.has("plasticity") and scene.materials["pin"].hardness == 3e8
+
+
+def test_flash_softening_needs_plasticity_and_heating():
+    text = (Path(__file__).parents[1] / "demos" / "pin_on_disc.toml").read_text()
+    assert "[micro]" in text
+    with pytest.raises(SceneError) as e:
+        loads(text.replace("[micro]", "[micro]\nflash_softening = true", 1), "demos")
+    assert len(e.value.problems) == 1 and e.value.problems[0].startswith("micro.flash_softening = true: needs")

@@ -44,6 +44,8 @@ def test_post_analysis_keeps_the_permanent_deformation(zones):
     hot = soft.run([zones[0]] * 2, [3e6] * 2, speed=1.0, remote=[[300.0, 300.0], [300.0, 500.0]])
     assert hot.plastic_area_fraction[1] > hot.plastic_area_fraction[0]
     assert hot.max_pressure[0] == pytest.approx(H) and hot.max_pressure[1] == pytest.approx(H * (1 - 1 / 3))
+    same = soft.run([zones[0]] * 2, [3e6] * 2, speed=1.0, hardness_temperature=[300.0, 500.0])
+    np.testing.assert_array_equal(same.pressure, hot.pressure)
     with pytest.raises(InputError, match="remote"):
         soft.run(zones, P, speed=1.0)
 

@@ -109,7 +109,7 @@ class PostAnalysis:
         self.hardness = hardness
 
     def run(self, zones: list[Zone], load, *, speed, angle=0.0, remote=None, sliding=None,
-            warm=None, mu=None) -> ZoneResult:
+            warm=None, mu=None, hardness_temperature=None) -> ZoneResult:
         """Post-analysis of ``zones`` at zone mean pressures ``load`` [Pa] > 0 (B,).
 
         speed [m/s] and angle [rad from +x] of the counter-face over each zone (B,); remote (B, 2)
@@ -117,7 +117,9 @@ class PostAnalysis:
         temperature-dependent k_w (without heating, k_w is taken at the rough body's); sliding
         (B,) [m]: distance worn over (None: no wear this call);
         warm (B, ny, nx): previous local pressures (warm start; rows summing to 0 start cold);
-        mu (B,): friction coefficient of each zone (default: the post-analysis' ``mu``).
+        mu (B,): friction coefficient of each zone (default: the post-analysis' ``mu``);
+        hardness_temperature (B,) [K]: where H(T) is taken (default: the rough body's remote
+        temperature; the loop's flash softening passes each zone's last flash temperature).
         """
         B = len(zones)
         H = np.stack([z.surface.heights for z in zones]) if B else np.zeros((0,) + self.shape)
@@ -136,9 +138,10 @@ class PostAnalysis:
                               np.zeros(0, dtype=int), np.zeros(0), empty)
         hard = None
         if self.hardness is not None:
-            if self.hardness.depends_on_temperature and remote is None:
+            if self.hardness.depends_on_temperature and remote is None and hardness_temperature is None:
                 raise InputError("remote", None, "a temperature-dependent hardness needs temperatures")
-            hard = np.broadcast_to(self.hardness(None if remote is None else remote[:, 1]), (B,))
+            at = remote[:, 1] if hardness_temperature is None and remote is not None else hardness_temperature
+            hard = np.broadcast_to(self.hardness(at), (B,))
         r = self._solve(zones, H, load, _warm(warm, H.shape), hard)
         iterations = np.asarray(r.iterations).copy()
         T, max_T, partition = None, nan.copy(), nan.copy()

@@ -91,6 +91,7 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
                             partition=float(scene.partition) if scene.has("heat_partition") else np.nan,
                             partition_law=scene.micro.partition_law, wear=wear,
                             wear_every=scene.wear.update_every if wear else 1,
+                            flash_softening=scene.micro.flash_softening,
                             forces=interface_forces(scene, tm), friction=mu)
     return Multiscale(model, rough, post_analysis(scene, rough.zones[0]), settings, fingerprint(scene))
 
