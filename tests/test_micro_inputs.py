@@ -13,7 +13,9 @@ from multiscale.micro.heat_kernels import Rotation, SpeedProfile, ThermalMateria
 from multiscale.micro.heating import InterfaceLayer, SteadyHeating, TransientHeating, partition_law
 from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
+from multiscale.micro.laws import LawSpec
 from multiscale.micro.layered_asperity import LayeredAsperity, layered_law
+from multiscale.micro.post_analysis import Heating, PostAnalysis
 from multiscale.micro.surface import Surface, find_asperities, fractal_surface, load_surface, statistics
 from multiscale.micro.wear import simulate_wear, wear_step
 from multiscale.micro.zones import cut_zones, generate_zones
@@ -152,6 +154,21 @@ CASES = [
     (lambda **k: generate_zones(**{**dict(grid=cut_zones(S, (2, 2))[0], n=8, hurst=0.8, k_min=1, k_max=3,
                                           rms=1e-6), **k}), dict(grid=(2, 2)), "grid"),
     (lambda **k: fft.set_threads(**k), dict(n="2"), "n"),
+    # zone laws
+    (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(kernel="steel"), "kernel"),
+    (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(n_points=4.5), "n_points"),
+    (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(max_iter=np.nan), "max_iter"),
+    (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(batch_cells="many"), "batch_cells"),
+    (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(love=["average"]), "love"),
+    # post-analysis
+    (lambda **k: Heating(**{**dict(moving=DISC, fixed=PIN), **k}), dict(moving=50.0), "moving"),
+    (lambda **k: Heating(**{**dict(moving=DISC, fixed=PIN), **k}), dict(speed_step=np.nan), "speed_step"),
+    (lambda **k: PostAnalysis(**{**dict(kernel=E, shape=(8, 8), dx=1e-5, dy=1e-5, mu=0.4), **k}), dict(heating="hot"),
+     "heating"),
+    (lambda **k: PostAnalysis(**{**dict(kernel=E, shape=(8, 8), dx=1e-5, dy=1e-5, mu=0.4), **k}), dict(max_iter=np.nan),
+     "max_iter"),
+    (lambda **k: PostAnalysis(**{**dict(kernel=E, shape=(8, 8), dx=1e-5, dy=1e-5, mu=0.4), **k}), dict(substeps="2"),
+     "substeps"),
 ]
 
 

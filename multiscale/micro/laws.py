@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.errors import ConvergenceError, InputError, check_count, check_instance, check_positive
 from multiscale.micro.conduction import ConductionSolver
 from multiscale.micro.contact import ContactResult, ContactSolver
 from multiscale.micro.heat_kernels import ThermalMaterial
@@ -104,13 +104,15 @@ class LawSpec:
     hardness: float | None = None
 
     def __post_init__(self):
+        check_instance("kernel", self.kernel, Kernel, "the micro solids' Kernel (e.g. HalfSpace)")
         check_positive("p_max", self.p_max)
         if self.hardness is not None and not check_positive("hardness", self.hardness) > self.p_max:
             raise InputError("p_max", self.p_max, f"the top node must lie below the hardness {self.hardness:.3g} Pa")
         check_positive("tol", self.tol)
-        if int(self.n_points) != self.n_points or self.n_points < 4:
-            raise InputError("n_points", self.n_points, "an integer >= 4")
-        if self.love not in ("average", "centre", "none"):
+        object.__setattr__(self, "n_points", check_count("n_points", self.n_points, minimum=4))
+        object.__setattr__(self, "max_iter", check_count("max_iter", self.max_iter))
+        object.__setattr__(self, "batch_cells", check_count("batch_cells", self.batch_cells))
+        if not isinstance(self.love, str) or self.love not in ("average", "centre", "none"):
             raise InputError("love", self.love, "one of 'average', 'centre', 'none'")
         if self.E_star is None:
             if not hasattr(self.kernel, "E_star"):

@@ -29,7 +29,7 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 
-from multiscale.errors import InputError, check_positive
+from multiscale.errors import InputError, check_count, check_instance, check_positive
 from multiscale.micro.contact import ContactConvergenceError, ContactSolver
 from multiscale.micro.heat_kernels import ThermalMaterial
 from multiscale.micro.heating import SteadyHeating
@@ -54,6 +54,12 @@ class Heating:
     fixed: ThermalMaterial
     speed_step: float = 0.01
     angle_step: float = np.radians(2.0)
+
+    def __post_init__(self):
+        for name in ("moving", "fixed"):
+            check_instance(name, getattr(self, name), ThermalMaterial, "a ThermalMaterial(kappa, diffusivity)")
+        for name in ("speed_step", "angle_step"):
+            object.__setattr__(self, name, check_positive(name, getattr(self, name)))
 
     def rounded(self, speed, angle) -> tuple[np.ndarray, np.ndarray]:
         """Speeds [m/s] and angles [rad] rounded to the table grid."""
@@ -100,11 +106,14 @@ class PostAnalysis:
         self.solver = ContactSolver(kernel, shape, dx, dy, periodic=False)
         self.shape, self.dx, self.dy = tuple(shape), float(dx), float(dy)
         self.mu = check_positive("mu", mu, allow_zero=True)
+        if heating is not None:
+            check_instance("heating", heating, Heating, "a Heating or None")
+        if conductance is not None:
+            check_instance("conductance", conductance, Conductance, "a laws.Conductance or None")
         self.heating, self.conductance = heating, conductance
         self.rate = WearRate(wear_rate) if wear_rate is not None else None
-        if int(substeps) != substeps or substeps < 1:
-            raise InputError("substeps", substeps, "an integer >= 1")
-        self.substeps, self.tol, self.max_iter = int(substeps), check_positive("tol", tol), int(max_iter)
+        self.substeps, self.tol = check_count("substeps", substeps), check_positive("tol", tol)
+        self.max_iter = check_count("max_iter", max_iter)
         self._heaters: dict[tuple, SteadyHeating] = {}
         self.hardness = hardness
 
