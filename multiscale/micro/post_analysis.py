@@ -110,6 +110,8 @@ class PostAnalysis:
             check_instance("heating", heating, Heating, "a Heating or None")
         if conductance is not None:
             check_instance("conductance", conductance, Conductance, "a laws.Conductance or None")
+        if hardness is not None:
+            check_instance("hardness", hardness, Hardness, "a plasticity.Hardness or None")
         self.heating, self.conductance = heating, conductance
         self.rate = WearRate(wear_rate) if wear_rate is not None else None
         self.substeps, self.tol = check_count("substeps", substeps), check_positive("tol", tol)
