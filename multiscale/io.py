@@ -30,7 +30,8 @@ def unit_of(name: str) -> str:
 
 
 class History:
-    """Scalar time series: ``append(time=..., interface_force=..., ...)``, same keys every row."""
+    """Time series: ``append(time=..., interface_force=..., ...)``, same keys every row; a value is a
+    scalar, or a 1-D array of fixed length (a per-zone quantity: its column is (rows, length))."""
 
     def __init__(self):
         self.columns: dict[str, list[float]] = {}
@@ -39,7 +40,8 @@ class History:
         if self.columns and set(row) != set(self.columns):
             raise KeyError(f"history row keys {sorted(row)} differ from {sorted(self.columns)}")
         for key, value in row.items():
-            self.columns.setdefault(key, []).append(float(value))
+            self.columns.setdefault(key, []).append(float(value) if np.ndim(value) == 0
+                                                    else np.array(value, dtype=float))
 
     def __getitem__(self, key: str) -> np.ndarray:
         return np.asarray(self.columns[key])

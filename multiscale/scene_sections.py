@@ -68,7 +68,9 @@ class Material:
     """One body's material (Table 7.2). Every property is a constant or a table against the
     temperature ((K, value), ...), interpolated linearly and held constant beyond its ends; ``alpha``
     is the mean (secant) expansion coefficient from the initial temperature. Thermal needs kappa and
-    c (with rho) or chi."""
+    c (with rho) or chi. ``k_w``: the Archard wear rate of this material (effect "wear"), taken at
+    the local surface temperature: the rough body's (instead of [wear]'s), or the counter-face's
+    (only a counter-face with k_w wears)."""
 
     E: float | tuple = key(_property(_MODULUS, "E"), required=True)                          # Pa
     nu: float | tuple = key(_property(_POISSON, "nu"), required=True)
@@ -78,11 +80,22 @@ class Material:
     chi: float | tuple | None = key(_property(_DIFFUSIVITY, "chi"))         # m^2/s
     alpha: float | tuple | None = key(_property(_EXPANSION, "alpha"), needed_by=("expansion",),
                                       warn_unused=True)                                      # 1/K
+    k_w: float | tuple | None = key(_property(Quantity("wear_rate", ge=0), "k_w"))          # 1/Pa, Archard
     hardness: float | tuple | None = key(_property(_HARDNESS, "hardness"))   # Pa, plastic flow pressure of asperities
 
     rules = (OneOf(("c", "chi"), needed_by=("thermal",)), Requires("c", ("rho",), needed_by=("thermal",)))
 
     PROPERTIES = ("E", "nu", "rho", "kappa", "c", "chi", "alpha", "hardness")
+
+    def problems(self, path, ctx):
+        if self.k_w is not None and "wear" not in ctx.effects:
+            ctx.warnings.append(f'{path}.k_w is ignored: effect "wear" is not in effects')
+        return []
+
+    @property
+    def wear_rate(self):
+        """k_w [1/Pa] for ``micro.wear.WearRate``: the constant, or ((temperatures [K]), (rates))."""
+        return self.k_w if not isinstance(self.k_w, tuple) else tuple(zip(*self.k_w))
 
     def tabulated(self, name: str) -> bool:
         """True if property ``name`` is a temperature table."""
@@ -200,6 +213,7 @@ OUTPUT_FIELDS: dict[str, tuple[str, ...]] = {
     "displacement": (), "von_mises": (), "contact_pressure": ("contact",),
     "temperature": ("thermal",), "heat_flux": ("thermal",),
     "contact_stiffness": ("roughness",), "partition": ("heat_partition",), "wear_depth": ("wear",),
+    "flash_temperature": ("roughness", "heat_partition"), "counter_wear_depth": ("wear",),
 }
 
 
@@ -385,13 +399,28 @@ class Roughness:
 DEFAULT_GRID = (50, 50)    # cells per zone without micro.grid (generated surfaces)
 
 
+# Default coupling of partitions and temperatures for each choice of remote temperatures, chosen by
+# measurement (docs/accuracy/coupling.md: with "bulk" the explicit and fixed-point schemes put
+# spurious heat jumps into the pin, the implicit one does not). With "rough" the partition does not
+# depend on the temperatures: nothing to iterate.
+COUPLING_DEFAULT = {"rough": "explicit", "bulk": "implicit"}
+
+
 @dataclass(frozen=True)
 class Micro:
     """How the rough interface is solved (issue 7): zone grid on the interface, grid per zone
     (default 50 x 50; a measured surface's own pixel size, rounded, unless it is replaced by a
     statistically equivalent one), micro model, points of each p_n(g_n) law (top node at ``p_max``, default 20 x the nominal
     interface pressure; contact solver tolerance ``tol``), micro partition law (ch. 6) or the
-    constant one."""
+    constant one. The micro heating of the loop (issue 19): ``heating`` "steady" (§6.5) or
+    "transient" over each macro step in ``heating_steps`` = N_t steps (§6.3, Table 7.1: 10);
+    ``remote_temperatures`` "rough" (both bodies' at the rough body's macro surface temperature)
+    or "bulk" (each body's own: §7.2.2, §6.5; the default, "rough" with effect "conductance",
+    whose h_c conducts between the bodies already); ``coupling`` of partitions and temperatures
+    "explicit" (from the previous step), "fixed-point" (iterated within the step to
+    ``coupling_tol`` in at most ``coupling_iterations`` passes) or "implicit" (bulk only: the
+    partition at equal temperatures and the zone's exchange G as an interface conductance);
+    default ``COUPLING_DEFAULT`` (see ``multiscale.coupling``)."""
 
     zones: tuple | None = key(Pair(Integer(ge=1)), required=True)             # (nx, ny) zones
     grid: tuple | None = key(Pair(Integer(ge=8)))                             # (nx, ny) per zone
@@ -401,6 +430,12 @@ class Micro:
     p_max: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e10)))  # Pa, top node of the laws
     tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)     # micro contact solves
     flash_softening: bool = key(Flag(), default=False)   # H(T) of each zone at its last flash temperature
+    heating: str = key(Choice(("steady", "transient")), default="steady")
+    heating_steps: int = key(Integer(ge=1), default=10)                       # N_t per macro step (transient)
+    remote_temperatures: str | None = key(Choice(("rough", "bulk")))             # default: ``remote``
+    coupling: str | None = key(Choice(("explicit", "fixed-point", "implicit")))   # default: COUPLING_DEFAULT
+    coupling_tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-3)   # max |dp| per pass
+    coupling_iterations: int = key(Integer(ge=1), default=30)
 
     def problems(self, path, ctx):
         if self.partition_law and "heat_partition" not in ctx.effects:
@@ -408,21 +443,43 @@ class Micro:
         if self.flash_softening and not {"plasticity", "heat_partition"} <= ctx.effects:
             return [f'{path}.flash_softening = true: needs effects "plasticity" and "heat_partition" (the micro '
                     "heating gives the flash temperature)"]
+        if self.coupling == "implicit" and self.remote(ctx.effects) != "bulk":
+            return [f'{path}.coupling = "implicit": conducts between the bulk temperatures; needs '
+                    f'{path}.remote_temperatures = "bulk" (and no effect "conductance")']
+        if self.remote_temperatures == "bulk" and "conductance" in ctx.effects:
+            return [f'{path}.remote_temperatures = "bulk": the micro heating conducts between the two bodies '
+                    f'already; effect "conductance" would conduct twice (drop one)']
         return []
+
+    def remote(self, effects) -> str:
+        """``remote_temperatures``, or its default for the scene's ``effects``: "bulk" (thesis
+        §7.2.2), "rough" with effect "conductance"."""
+        return self.remote_temperatures or ("rough" if "conductance" in effects else "bulk")
+
+    def coupling_scheme(self, effects) -> str:
+        """``coupling``, or its default for the remote temperatures (``COUPLING_DEFAULT``)."""
+        return self.coupling or COUPLING_DEFAULT[self.remote(effects)]
 
 
 # Default k_w(T) [(K, 1/Pa)]: the shape of thesis Fig. 7.9 (sintered pad material, [Mann 2017]):
 # slowly rising up to 200 degC, steeply above. The figure's numbers are not in the text; the level
 # at 20-100 degC (~8e-15 1/Pa) is what reproduces the worn volume of §7.3.2 (3.8e7 um^3 in 30 s
-# of 200 N at 1.9 m/s with mu = 0.4: V / (mu F s) = 8.4e-15 1/Pa).
+# of 200 N at 1.9 m/s with mu = 0.4: V / (mu F s) = 8.4e-15 1/Pa). Calibrated on that one volume
+# of a pin below 100 degC: below 100 degC it is nearly flat (the worn volume then grows linearly
+# with the sliding), above it is the figure's shape only. ``multiscale check`` says so.
+FIG_7_9_CALIBRATION = ("shape of thesis Fig. 7.9 (its numbers are not in the text); level set so that "
+                       "k_w mu F s gives the thesis' ch. 7 worn volume (3.8e7 um^3 in 30 s at 200 N, "
+                       "1.9 m/s, mu 0.4: 8.4e-15 1/Pa near 20-100 degC); give your material's k_w")
 FIG_7_9_WEAR_RATE = ((293.15, 6e-15), (373.15, 8e-15), (473.15, 1.5e-14), (573.15, 6e-14), (673.15, 2e-13))
 
 
 @dataclass(frozen=True)
 class Wear:
     """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (default: the
-    shape of thesis Fig. 7.9, ``FIG_7_9_WEAR_RATE``). Every ``update_every`` macro steps the zones
-    wear over the sliding of those steps in ``substeps`` load-controlled increments."""
+    rough body's material k_w, else the shape of thesis Fig. 7.9, ``FIG_7_9_WEAR_RATE``, whose
+    level is calibrated on the thesis' ch. 7 worn volume: ``FIG_7_9_CALIBRATION``). Every
+    ``update_every`` macro steps the zones wear over the sliding of those steps in ``substeps``
+    load-controlled increments; a counter-face whose material gives ``k_w`` wears too."""
 
     k_w: float | None = key(_WEAR_RATE)                      # 1/Pa
     k_w_table: tuple | None = key(Curve(_TEMPERATURE, Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)),

@@ -13,11 +13,14 @@ convolution (Eq. 6.22), by conjugate gradients on the non-symmetric least-square
 phi_2 = phi − phi_1. The history terms are summed in Fourier space as Σ_k S_k · (flux of step N−k)
 with the pulse tables S_k of ``heat_kernels`` (the thesis' step increments, summed by parts);
 matching at the end of each step makes the scheme first order in dt.
-Steady (§6.5, ``SteadyHeating``): the same with steady kernels and remote temperatures (Eqs. 6.23–6.25).
-``partition_law`` gives the steady p_1(p_mean, V) that the macro model needs.
+Steady (§6.5, ``SteadyHeating``): the same with steady kernels and remote temperatures (Eqs. 6.23–6.25);
+the transient problem takes remote temperatures too (an extension: the thesis gives them to the
+steady problem only). ``partition_law`` gives the steady p_1(p_mean, V) that the macro model needs.
 
-Temperatures are rises [K] above the initial (or remote) temperature. Sign: phi_i > 0 flows into
-body i. Heat rates Phi [W] are over the patch window.
+Temperatures are rises [K] above the initial temperature, or remote temperature + rise when remote
+temperatures are given. Sign: phi_i > 0 flows into body i. Heat rates Phi [W] are over the patch
+window; with remote temperatures Phi_1 includes the conduction between them, so that a share
+Phi_i/Phi may leave [0, 1].
 """
 from __future__ import annotations
 
@@ -139,10 +142,10 @@ class HeatingResult:
     heat_2: np.ndarray             # W, Phi_2 into body 2 (fixed)
     partition_1: np.ndarray        # p_1 = Phi_1/Phi; NaN where Phi = 0 (no heat: undefined)
     partition_2: np.ndarray        # p_2 = Phi_2/Phi = 1 − p_1
-    max_temperature_1: np.ndarray  # K, max surface temperature rise of body 1 on the window
+    max_temperature_1: np.ndarray  # K, max surface temperature rise of body 1 on the window (+ theta_1^0)
     max_temperature_2: np.ndarray  # K, same for body 2
     field_times: np.ndarray        # s, step ends at which fields were stored
-    temperature_1: np.ndarray      # K, (n_fields, *batch, ny, nx) surface temperature rise of body 1
+    temperature_1: np.ndarray      # K, (n_fields, *batch, ny, nx) surface temperature rise of body 1 (+ theta_1^0)
     temperature_2: np.ndarray      # K, same for body 2
     flux_1: np.ndarray             # W/m², (n_fields, *batch, ny, nx) phi_1 (phi_2 = flux − flux_1)
     flux: np.ndarray               # W/m², (n_fields, *batch, ny, nx) generated phi
@@ -327,16 +330,24 @@ class TransientHeating:
 
     def run(self, pressure, mu: float, *, interface: InterfaceLayer | None = None, n_steps: int | None = None,
             field_times=(), tol: float = 1e-8, max_iter: int = 2000, partial: bool = False,
-            progress: bool = False) -> HeatingResult:
+            progress: bool = False, remote_temperatures=(0.0, 0.0)) -> HeatingResult:
         """Heat the contact of ``pressure`` [Pa] ((..., ny, nx), p > 0 on the contact, e.g.
         ``ContactResult.pressure``) with friction coefficient ``mu`` for ``n_steps`` steps.
 
         ``field_times`` [s]: store the surface temperature and flux fields at the step ends nearest
         to these times. Raises ``HeatingConvergenceError`` if a step does not reach ``tol`` in
         ``max_iter`` iterations, unless ``partial`` (then the step is flagged not converged).
+        ``remote_temperatures`` = (theta_1^0, theta_2^0) [K]: both bodies start uniform at their
+        own temperature, held far inside each body; the matching of every step gets theta_2^0 −
+        theta_1^0 on its right-hand side as Eq. 6.23 does in the steady problem (the thesis
+        gives remote temperatures to the steady problem only, §6.5; this extends them to §6.3),
+        and the temperatures returned are theta^0 + rise. Default (0, 0): rises, as in §6.3.
         """
         p = _check_pressure(pressure, self.shape)
         mu = check_positive("mu", mu)
+        th1, th2 = (float(v) for v in remote_temperatures)
+        if not (np.isfinite(th1) and np.isfinite(th2)):
+            raise InputError("remote_temperatures", remote_temperatures, "two finite temperatures [K]")
         n_steps = self.n_steps if n_steps is None else check_count("n_steps", n_steps)
         if not n_steps <= self.n_steps:
             raise InputError("n_steps", n_steps, f"between 1 and the tabulated {self.n_steps}")
@@ -369,10 +380,10 @@ class TransientHeating:
             free2 = self._pad.field(H2 + A2 * phi_hat)
             # Phi^N - Lambda^N (Eqs. 6.17-6.18): body-2 temperature of all the heat minus the
             # temperatures of phi_1 frozen at its last value, with the layer's jump
-            rhs = free2 - free1 - layer.diagonal * f_prev - layer.offset(phi)
+            rhs = free2 - free1 - layer.diagonal * f_prev - layer.offset(phi) + (th2 - th1)
             if N:
                 rhs -= self._pad.field(A * F1[N - 1])
-            scale = np.sqrt(np.sum(mask * (free1**2 + free2**2), axis=(-2, -1), keepdims=True))
+            scale = np.sqrt(np.sum(mask * (free1**2 + free2**2 + (th2 - th1) ** 2), axis=(-2, -1), keepdims=True))
             scale = np.where(scale > 0, scale, np.inf)
             psi, it, res, hist = _cgls(lambda x: self._pad.convolve(A, x) + layer.diagonal * x,
                                        lambda x: self._pad.convolve(np.conj(A), x) + layer.diagonal * x,
@@ -381,8 +392,8 @@ class TransientHeating:
             f = f_prev + psi
             F1[N] = self._pad.spectrum(f)
             F2[N] = phi_hat - F1[N]
-            T1 = self._pad.field(H1 + A1 * F1[N])
-            T2 = self._pad.field(H2 + A2 * F2[N])
+            T1 = self._pad.field(H1 + A1 * F1[N]) + th1
+            T2 = self._pad.field(H2 + A2 * F2[N]) + th2
             layer.advance(f, phi)
             out["heat"][N] = np.sum(phi, axis=(-2, -1)) * area
             out["heat_1"][N] = np.sum(f, axis=(-2, -1)) * area

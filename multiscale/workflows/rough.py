@@ -66,7 +66,8 @@ def check_rough_scene(scene) -> None:
     if len(pairs) > 1:
         raise InputError("interfaces", sorted(scene.rough_interfaces), "the rough interfaces must have the same "
                          f"materials on both sides (one micro solid); found {sorted(pairs)}")
-    shared = ("grid", "law_points", "model", "p_max", "tol", "partition_law")
+    shared = ("grid", "law_points", "model", "p_max", "tol", "partition_law", "heating", "heating_steps",
+              "remote_temperatures", "coupling", "coupling_tol", "coupling_iterations")
     for name in scene.rough_interfaces:
         m = scene.interface_settings(name).micro
         for key in shared:
