@@ -100,6 +100,7 @@ class LoopSettings:
     partition_law: bool = False   # micro partition per zone (ch. 6) instead of the constant
     wear: bool = False            # Archard wear of the zones
     wear_every: int = 1           # macro steps per wear update
+    flash_softening: bool = False  # H(T) of each zone at its last micro flash temperature (plasticity)
     forces: dict = field(default_factory=dict)   # N, per interface: the load it nominally carries
     friction: np.ndarray | None = None            # mu of every zone (its interface's; None: the post-analysis')
     remote: str = "rough"         # remote temperatures of the micro heating: "rough" or "bulk" (module docstring)
@@ -142,6 +143,7 @@ class MicroStep:
     partition: tuple           # (min, mean, max) share into the rough body over the loaded zones
     work: float                # J, mu ∫ p |v| dA over the wear interval (0 without wear)
     seconds: float
+    plastic_fraction: float = 0.0  # largest share of a zone's cells at the hardness (0 without plasticity)
 
 
 @dataclass
@@ -256,17 +258,18 @@ class Multiscale:
         mu = None if self.settings.friction is None else self.settings.friction[mine]
         res = self.post.run([zones[i] for i in mine], load.pressure[mine], speed=load.speed[mine],
                             angle=load.angle[mine], remote=remote, warm=self.warm[mine], mu=mu,
-                            duration=self.settings.dt)
+                            duration=self.settings.dt, hardness_temperature=self._hardness_temperature(mine, T[:, 1]))
         self._last = (mine, res, load, remote, loaded)
         implicit = self.settings.coupling == "implicit"
         parts = comm.allgather((mine, res.pressure, res.max_pressure, res.max_temperature,
                                 res.partition_equal if implicit else res.partition, res.conductance, res.heat,
-                                res.heat_rough, res.exchange, remote[:, 1] - remote[:, 0]))
+                                res.heat_rough, res.exchange, remote[:, 1] - remote[:, 0], res.plastic_area_fraction))
         for a in (self.proposed, self.flash, self.micro_heat, self.micro_heat_rough):
             a[:] = np.nan
         self.proposed_exchange[:] = 0.0
-        max_p = []
-        for ids, warm, mp, mT, part, h_c, heat, rough, exchange, diff in parts:
+        max_p, flow = [], [np.zeros(0)]
+        for ids, warm, mp, mT, part, h_c, heat, rough, exchange, diff, fraction in parts:
+            flow.append(fraction)
             self.warm[ids], self.proposed[ids], self.flash[ids] = warm, part, mT
             self.micro_heat[ids], self.micro_heat_rough[ids], self.remote_difference[ids] = heat, rough, diff
             if implicit:
@@ -280,7 +283,29 @@ class Multiscale:
         max_p = np.concatenate(max_p)
         return MicroStep(len(loaded), float(load.pressure.max()), float(max_p.max(initial=0.0)),
                          float(np.nanmax(hot)) if np.isfinite(hot).any() else np.nan, (np.nan,) * 3, 0.0,
-                         _time.perf_counter() - t0)
+                         _time.perf_counter() - t0, float(np.concatenate(flow).max(initial=0.0)))
+
+    def _hardness_temperature(self, ids, rough_temperature) -> np.ndarray | None:
+        """Where the zones ``ids`` take H(T): with ``settings.flash_softening``, their flash
+        temperature of the previous post-analysis (the rough body's macro temperature before the
+        first, or if higher): the fixed point H = H(T_flash(H)) is reached explicitly over the macro
+        steps (and the passes of the fixed-point coupling); else None (the macro temperature)."""
+        if not self.settings.flash_softening:
+            return None
+        return np.fmax(self.flash[ids], rough_temperature)
+
+    @property
+    def plastic(self) -> bool:
+        """True if the zones are elastic-perfectly plastic (their topographies change when they yield)."""
+        return self.post.hardness is not None
+
+    def deform(self) -> None:
+        """The zones of the last ``analyse`` keep their permanent deformation (without wear; ``wear``
+        keeps it with the worn topographies)."""
+        mine, res = self._last[:2]
+        for ids, heights, w in self.comm.allgather((mine, res.heights, res.plastic)):
+            self.rough.set_heights(ids, heights)
+            self.rough.plastic[ids] += w
 
     def wear(self, duration: float) -> float:
         """Wear of the zones of the last ``analyse`` over ``duration`` [s] of sliding (their
@@ -290,11 +315,13 @@ class Multiscale:
         zones = self.rough.zones
         res = self.post.wear([zones[i] for i in mine], res, load.speed[mine] * duration, remote)
         volume = np.zeros(len(zones))
-        for ids, warm, heights, lost in self.comm.allgather((mine, res.worn_pressure, res.heights,
-                                                              res.counter_volume)):
+        for ids, warm, heights, lost, w in self.comm.allgather((mine, res.worn_pressure, res.heights,
+                                                                 res.counter_volume, res.plastic)):
             self.warm[ids] = warm
             self.rough.set_heights(ids, heights)
             volume[ids] = lost
+            if self.plastic:
+                self.rough.plastic[ids] += w
         if self.post.counter_rate is not None:
             contact, iface = self.model.contact, self.tm.interface
             self.counter_depth += self.rough.track_depth(volume, contact.facet_heat_flux() * iface.areas)
@@ -325,6 +352,8 @@ class Multiscale:
             t0 = _time.perf_counter()
             micro.work = self.wear(duration)
             micro.seconds += _time.perf_counter() - t0
+        elif self.plastic:
+            self.deform()
         return self.accept(micro)
 
     def residual(self) -> np.ndarray:
@@ -454,14 +483,17 @@ class Multiscale:
         t2 = _time.perf_counter()
         if wear:
             micro.work = self.wear(s.dt * s.wear_every)
+        elif self.plastic:
+            self.deform()
         self.accept(micro)
         self.apply_zone_fields()
         t3 = _time.perf_counter()
         self.rough.laws_computed = 0
-        if wear:
+        changed = wear or self.plastic           # new topographies: their laws (cached if unchanged)
+        if changed:
             self.rough.update_laws()
         t4 = _time.perf_counter()
-        if wear:
+        if changed:
             self.model.last_solve = self.model.mechanics.solve()
         return StepResult(n, heat, micro, time_macro + _time.perf_counter() - t4, time_micro + t3 - t2, t4 - t3,
                           residuals)
@@ -479,9 +511,12 @@ class Multiscale:
         if self.partition_law:
             row.update(coupling_residual=result.residuals[-1] if result.residuals else np.nan,
                        coupling_iterations=len(result.residuals))
+        if self.plastic:
+            row.update(micro_plastic_fraction=micro.plastic_fraction,
+                       plastic_max_depth=float(self.rough.plastic.max(initial=0.0)))
         if self.settings.wear:
             heights = self.rough.heights()
-            depth = self.rough.initial - heights
+            depth = self.rough.wear_depth()
             row.update(wear_volume=float(self.rough.zone_wear_volume(depth).sum()), wear_max_depth=float(depth.max()),
                        rms_height=float(np.sqrt(np.mean((heights - heights.mean()) ** 2))),
                        frictional_work=self.work)
@@ -502,7 +537,8 @@ class Multiscale:
     def save(self, path: Path, step: int, history: io.History) -> None:
         """Checkpoint after macro step ``step`` (collective)."""
         m, last = self.model, self.model.last_solve
-        arrays = {"heights": self.rough.heights(), "warm": self.warm, "partition": self.partition,
+        arrays = {"heights": self.rough.heights(), "plastic": self.rough.plastic, "warm": self.warm,
+                  "partition": self.partition,
                   "conductance": self.conductance, "flash": self.flash, "counter_depth": self.counter_depth,
                   "exchange": self.exchange, "levels": self.rough.levels, "heat_total": m.heat_total,
                   "heat_lost_recorded": m.heat_lost_recorded,
@@ -524,6 +560,7 @@ class Multiscale:
                              "run it with --overwrite")
         m = self.model
         self.rough.set_heights(range(len(arrays["heights"])), arrays["heights"])
+        self.rough.plastic = arrays["plastic"].copy()
         self.warm, self.partition = arrays["warm"], arrays["partition"]
         self.conductance, self.rough.levels = arrays["conductance"], arrays["levels"]
         self.datum_gap, self.flash, self.counter_depth = arrays["datum_gap"], arrays["flash"], arrays["counter_depth"]

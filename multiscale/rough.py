@@ -116,6 +116,7 @@ class RoughInterface:
     law: FacetLaw = field(init=False)
     zone_of_facet: np.ndarray = field(init=False)       # zone id of every global facet (-1: not rough)
     initial: np.ndarray = field(init=False)              # (Z, ny, nx) initial topographies [m]
+    plastic: np.ndarray = field(init=False)              # (Z, ny, nx) accumulated permanent deformation [m]
     levels: np.ndarray = field(init=False)               # p_max halvings of each zone's law
     used: np.ndarray = field(init=False)                 # ids of the zones holding a facet
     laws_computed: int = 0                               # laws computed by the last update
@@ -132,6 +133,7 @@ class RoughInterface:
             self.zone_of_facet[masks[name]] = offsets[k] + self.grids[k].zone_of(uv[:, 0], uv[:, 1])
         self.used = np.unique(self.zone_of_facet[self.zone_of_facet >= 0])
         self.initial = np.stack([z.surface.heights for z in self.zones])
+        self.plastic = np.zeros_like(self.initial)
         self.levels = np.zeros(len(self.zones), dtype=int)
         self.law = FacetLaw(self.tm, self.spec.n_points)
 
@@ -161,8 +163,8 @@ class RoughInterface:
             self.zones[zid] = self.zones[zid].with_heights(h)
 
     def wear_depth(self) -> np.ndarray:
-        """Accumulated wear depth fields (Z, ny, nx) [m]."""
-        return self.initial - self.heights()
+        """Accumulated wear depth fields (Z, ny, nx) [m] (the permanent deformation taken out)."""
+        return self.initial - self.heights() - self.plastic
 
     def zone_wear_volume(self, depth: np.ndarray) -> np.ndarray:
         """Worn volume of each zone [m^3] from its depth field (Z, ny, nx) [m]."""

@@ -33,6 +33,7 @@ _ROUGHNESS = Quantity("length", gt=0, plausible=(1e-10, 1e-3))            # RMS 
 _CONVECTION = Quantity("conductance", ge=0, plausible=(0.0, 1e4))         # still air to boiling water
 _ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0))  # up to ~24 000 rpm
 _WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # Archard k/H
+_HARDNESS = Quantity("pressure", gt=0, plausible=(1e6, 1e11))            # soft polymer to diamond
 GRAVITY = 9.80665                  # m/s^2, standard gravity
 
 
@@ -80,10 +81,11 @@ class Material:
     alpha: float | tuple | None = key(_property(_EXPANSION, "alpha"), needed_by=("expansion",),
                                       warn_unused=True)                                      # 1/K
     k_w: float | tuple | None = key(_property(Quantity("wear_rate", ge=0), "k_w"))          # 1/Pa, Archard
+    hardness: float | tuple | None = key(_property(_HARDNESS, "hardness"))   # Pa, plastic flow pressure of asperities
 
     rules = (OneOf(("c", "chi"), needed_by=("thermal",)), Requires("c", ("rho",), needed_by=("thermal",)))
 
-    PROPERTIES = ("E", "nu", "rho", "kappa", "c", "chi", "alpha")
+    PROPERTIES = ("E", "nu", "rho", "kappa", "c", "chi", "alpha", "hardness")
 
     def problems(self, path, ctx):
         if self.k_w is not None and "wear" not in ctx.effects:
@@ -427,6 +429,7 @@ class Micro:
     partition_law: bool = key(Flag(), default=False)
     p_max: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e10)))  # Pa, top node of the laws
     tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)     # micro contact solves
+    flash_softening: bool = key(Flag(), default=False)   # H(T) of each zone at its last flash temperature
     heating: str = key(Choice(("steady", "transient")), default="steady")
     heating_steps: int = key(Integer(ge=1), default=10)                       # N_t per macro step (transient)
     remote_temperatures: str | None = key(Choice(("rough", "bulk")))             # default: ``remote``
@@ -437,6 +440,9 @@ class Micro:
     def problems(self, path, ctx):
         if self.partition_law and "heat_partition" not in ctx.effects:
             return [f'{path}.partition_law = true: needs effect "heat_partition"']
+        if self.flash_softening and not {"plasticity", "heat_partition"} <= ctx.effects:
+            return [f'{path}.flash_softening = true: needs effects "plasticity" and "heat_partition" (the micro '
+                    "heating gives the flash temperature)"]
         if self.coupling == "implicit" and self.remote(ctx.effects) != "bulk":
             return [f'{path}.coupling = "implicit": conducts between the bulk temperatures; needs '
                     f'{path}.remote_temperatures = "bulk" (and no effect "conductance")']

@@ -39,7 +39,7 @@ BAD = [  # (name, the demo block scene changed, the one expected message)
     ("unknown effect", BLOCK.replace('["contact"]', '["contact", "thermol"]'),
      'effects = ["contact", "thermol"]: item 2 ("thermol"): unknown (did you mean "thermal"?); '
      "allowed: contact, friction, thermal, heat_partition, conductance, expansion, roughness, layers, "
-     "wear, stability"),
+     "wear, plasticity, stability"),
     ("unknown key", BLOCK.replace("penalty =", "penalty_stiffness ="),
      'interface.penalty_stiffness: unknown key (did you mean "penalty"?); allowed: penalty, partition, '
      "conductance"),

@@ -114,7 +114,7 @@ def test_unit_errors_say_what_is_expected(text, kind, fragment):
 
 def test_good_scene_in_si(tmp_path):
     scene = loads(GOOD, tmp_path)
-    assert scene.effects == frozenset(EFFECTS) - {"roughness", "layers", "wear", "stability"}
+    assert scene.effects == frozenset(EFFECTS) - {"roughness", "layers", "wear", "stability", "plasticity"}
     assert scene.has("thermal") and not scene.has("wear")
     assert scene.bodies == ("block", "flat") and scene.geometry.motion == "translation"
     assert scene.geometry.params["mesh_size"] == 2e-3

@@ -79,18 +79,19 @@ def exact_displacement(operator: InfluenceOperator, ws: ConvolutionWorkspace, p:
 
 def estimate(operator: InfluenceOperator, work: Scratch, z, p, u, target, delta, which) -> tuple:
     """The stopping criterion of ``run`` for a state (p, u = L p; (B, ny, nx)) of the patches
-    ``which``: (eps, d) per patch (one FFT pair; eps = inf elsewhere)."""
+    ``which``, without a pressure bound: (eps, d) per patch (one FFT pair; eps = inf elsewhere)."""
     B, ny, nx = z.shape
     Fx = operator.fft_shape[1]
     z2, p2, u2 = (np.ascontiguousarray(a).reshape(B, ny * nx) for a in (z, p, u))
     load_control = target is not None
     delta = np.ascontiguousarray(np.zeros(B) if delta is None else delta, dtype=float)
     d, pnorm, eps, csum = np.zeros(B), np.zeros(B), np.full(B, np.inf), np.zeros(B)
-    nf, ccount = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.int64)
+    nf, ccount, fixed = (np.zeros(B, dtype=np.int64) for _ in range(3))
+    upper = np.full(B, np.inf)
     work.X[...] = 0.0
-    bccg_steps.contact_sums(p2, u2, z2, which, ccount, csum, pnorm)
+    bccg_steps.contact_sums(p2, u2, z2, upper, which, ccount, csum, pnorm)
     bccg_steps.free_set(u2, z2, p2, delta, load_control, which, ccount, csum, d, work.label, work.fi, work.fj, nf,
-                        work.r, work.s_old, work.t, work.X, nx, Fx)
+                        work.r, work.s_old, work.t, work.X, upper, fixed, nx, Fx)
     bccg_steps.extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, work.X, GAMMAS,
                       operator.periodic, which, ny, nx, Fx)
     work.ws.apply(operator.inverse_multiplier)
@@ -101,11 +102,11 @@ def estimate(operator: InfluenceOperator, work: Scratch, z, p, u, target, delta,
 
 
 def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray, u: np.ndarray, target, delta,
-        tol: float, max_iter: int, history: list) -> dict:
+        tol: float, max_iter: int, history: list, upper=None) -> dict:
     """Iterate on the chunk (z, p, u: (B, ny, nx) contiguous; p the feasible start, balanced under
-    load control: ``target`` the mean pressures, else ``delta`` the approaches). p and u (= L p)
-    are updated in place; returns d, iterations, residual (eps), converged; ``history`` gets the
-    largest eps per iteration."""
+    load control: ``target`` the mean pressures, else ``delta`` the approaches; ``upper`` the
+    pressure bounds H (B,), None: elastic). p and u (= L p) are updated in place; returns d,
+    iterations, residual (eps), converged; ``history`` gets the largest eps per iteration."""
     B, ny, nx = z.shape
     N, Fx = ny * nx, operator.fft_shape[1]
     ws = work.ws
@@ -119,7 +120,8 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
     d, pending, pnorm, eps, rt, tau, rho_old, csum, factor = (np.zeros(B) for _ in range(9))
     pending[:] = 1.0
     eps[:] = np.inf
-    nf, ccount = np.zeros(B, dtype=np.int64), np.zeros(B, dtype=np.int64)
+    nf, ccount, fixed = (np.zeros(B, dtype=np.int64) for _ in range(3))
+    upper = np.ascontiguousarray(np.full(B, np.inf) if upper is None else upper, dtype=float)
     conj, clipped, lost = (np.zeros(B, dtype=bool) for _ in range(3))
     iterations = np.zeros(B, dtype=int)
     periodic = operator.periodic
@@ -129,13 +131,13 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
 
     def exact(which):                        # u = L p and the contact sums on the patches ``which``
         exact_displacement(operator, ws, p, u, which)
-        bccg_steps.contact_sums(p2, u2, z2, which, ccount, csum, pnorm)
+        bccg_steps.contact_sums(p2, u2, z2, upper, which, ccount, csum, pnorm)
 
     exact(active)
     since = 0
     while True:
         bccg_steps.free_set(u2, z2, p2, delta, load_control, active, ccount, csum, d, work.label, work.fi, work.fj,
-                            nf, work.r, work.s_old, work.t, X, nx, Fx)
+                            nf, work.r, work.s_old, work.t, X, upper, fixed, nx, Fx)
         bccg_steps.extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, X, GAMMAS,
                           periodic, active, ny, nx, Fx)
         ws.fft.forward()
@@ -155,7 +157,8 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
         if not bccg_steps.step_length(S, lmul, Fx, rt, active, tau):          # S <- L T
             raise FloatingPointError("non-finite step length")
         clipped_any, lost_any = bccg_steps.update_pressure(p2, work.t, work.fi, work.fj, nf, tau, X, active,
-                                                           load_control, target, pending, clipped, lost, nx, Fx)
+                                                           load_control, target, pending, clipped, lost, upper,
+                                                           fixed, nx, Fx)
         if clipped_any:                      # u += L(-tau t + clipped amounts): one more forward FFT
             np.copyto(W, S)
             ws.fft.forward()
@@ -165,7 +168,7 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
             np.negative(tau, out=factor)
         ws.fft.inverse(normalise=False)
         bccg_steps.add_response(u2, Y, factor, p2, z2, work.fi, work.fj, nf, pending, active, ccount, csum, pnorm,
-                                nx, Fx)
+                                upper, fixed, nx, Fx)
         since += 1
         if lost_any:                         # every cell left the contact: restart from the top
             for b in np.flatnonzero(lost):

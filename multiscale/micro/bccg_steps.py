@@ -8,6 +8,12 @@ p = 0 and a negative gap (they may enter). ``label`` marks F (0), the rings 1..R
 around it into which the residual is extended (k), and the other cells (-1); ``fi``/``fj`` and
 ``bi``/``bj`` list the rows and columns of the cells of F and of the rings (ring by ring,
 ``ring_end``), so that the sweeps over them need no integer division.
+
+Bounded pressure 0 <= p <= H (``upper``, H per patch; +inf: elastic, then every loop computes
+exactly what it computes without the bound): the contact cells are then the elastic ones (0 < p
+< H) and the saturated ones (p = H, plastic flow, gap <= 0). F adds the saturated cells with a
+gap >= 0 (they may leave the bound); the other saturated cells are held at H (``fixed`` counts
+them) like the cells with p = 0 and a gap >= 0 are held at 0. See ``bounded_update``.
 """
 from __future__ import annotations
 
@@ -18,26 +24,28 @@ _FAST = {"reassoc", "contract", "nsz"}   # reductions may be reordered (vectoris
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
-def contact_sums(p, u, z, active, ccount, csum, pnorm):
-    """Per active patch: contact cells (p > 0), Σ_contact (u + z) and ||p||²."""
+def contact_sums(p, u, z, upper, active, ccount, csum, pnorm):
+    """Per active patch: elastic contact cells (0 < p < H), their Σ (u + z), and ||p||²."""
     B, N = p.shape
     for b in range(B):
         if not active[b]:
             continue
-        n, sc, pp = 0, 0.0, 0.0
+        n, sc, pp, H = 0, 0.0, 0.0, upper[b]
         for f in range(N):
             q = p[b, f]
             pp += q * q
-            if q > 0.0:
+            if q > 0.0 and q < H:
                 n += 1
                 sc += u[b, f] + z[b, f]
         ccount[b], csum[b], pnorm[b] = n, sc, pp
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
-def free_set(u, z, p, delta, load_control, active, ccount, csum, d, label, fi, fj, nf, r, s_old, t, X, nx, Fx):
-    """Per active patch: the approach ``d`` (load control: mean of u + z on the contact, from
-    ``contact_sums``; else ``delta``), the free set F (``label`` 0, listed in ``fi``/``fj``/``nf``),
+def free_set(u, z, p, delta, load_control, active, ccount, csum, d, label, fi, fj, nf, r, s_old, t, X, upper, fixed,
+             nx, Fx):
+    """Per active patch: the approach ``d`` (load control: mean of u + z on the elastic contact,
+    from ``contact_sums``; with none but saturated cells, their largest u + z; else ``delta``),
+    the free set F (``label`` 0, listed in ``fi``/``fj``/``nf``; ``fixed`` the cells held at H),
     the residual r = g = u + z - d on F (mean-free on F under load control: the gradient
     projected on Σ p = const) and X = r on F. X, ``s_old`` and ``t`` are zeroed on the cells that
     left F (a cell entering F starts without history); elsewhere X is zero already (it held the
@@ -48,14 +56,20 @@ def free_set(u, z, p, delta, load_control, active, ccount, csum, d, label, fi, f
     for b in range(B):
         if not active[b]:
             continue
+        H = upper[b]
         db = (csum[b] / ccount[b] if ccount[b] > 0 else 0.0) if load_control else delta[b]
+        if load_control and ccount[b] == 0 and H < np.inf:
+            db = saturated_top(u[b], z[b], p[b], H)
         d[b] = db
-        k, sf = 0, 0.0
+        k, sf, nfix = 0, 0.0, 0
         for i in range(ny):
             for j in range(nx):
                 f = i * nx + j
                 g = u[b, f] + z[b, f] - db
-                if p[b, f] > 0.0 or g < 0.0:
+                q = p[b, f]
+                held = q >= H and g < 0.0
+                nfix += held
+                if (q > 0.0 or g < 0.0) and not held:
                     label[b, f] = 0
                     fi[b, k], fj[b, k] = i, j
                     k += 1
@@ -69,12 +83,26 @@ def free_set(u, z, p, delta, load_control, active, ccount, csum, d, label, fi, f
                         t[b, f] = 0.0
                     label[b, f] = -1
         nf[b] = k
+        fixed[b] = nfix
         if load_control and k > 0:
             mean = sf / k
             for m in range(k):
                 i, j = fi[b, m], fj[b, m]
                 r[b, i * nx + j] -= mean
                 X[b, i * Fx + j] -= mean
+
+
+@njit(cache=True, nogil=True)
+def saturated_top(u, z, p, H):
+    """Largest u + z over the saturated cells (p >= H) of one patch (flat arrays), 0 if none:
+    the approach under load control when no cell is in elastic contact (fully plastic)."""
+    top, found = 0.0, False
+    for f in range(p.shape[0]):
+        if p[f] >= H:
+            v = u[f] + z[f]
+            if not found or v > top:
+                top, found = v, True
+    return top
 
 
 @njit(cache=True, inline="always")
@@ -291,16 +319,24 @@ def step_length(S, lmul, Fx, rt, active, tau):
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
-def update_pressure(p, t, fi, fj, nf, tau, X, active, load_control, target, pending, clipped, lost, nx, Fx):
+def update_pressure(p, t, fi, fj, nf, tau, X, active, load_control, target, pending, clipped, lost, upper, fixed,
+                    nx, Fx):
     """p <- max(p - tau t, 0) on F (cells outside F keep p = 0); X = the clipped amount
     (p_new - (p - tau t) >= 0) on F, so that L(p_new - p) = L(-tau t + X); under load control
     the factor restoring the mean pressure goes to ``pending`` (applied to p and u next).
+    Patches with a finite bound H take ``bounded_update`` instead.
     Returns the numbers of patches with clipped cells and of patches that lost every contact."""
     B, N = p.shape
     nclip, nlost = 0, 0
     for b in range(B):
         clipped[b], lost[b] = False, False
         if not active[b]:
+            continue
+        if upper[b] < np.inf:
+            rest = max(target[b] * N - upper[b] * fixed[b], 0.0)
+            clipped[b] = bounded_update(p[b], t[b], fi[b], fj[b], nf[b], tau[b], X[b], upper[b], load_control, rest,
+                                        nx, Fx)
+            nclip += clipped[b]
             continue
         tb, total = tau[b], 0.0
         for m in range(nf[b]):
@@ -326,6 +362,56 @@ def update_pressure(p, t, fi, fj, nf, tau, X, active, load_control, target, pend
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
+def bounded_update(p, t, fi, fj, n, tau, X, H, load_control, rest, nx, Fx):
+    """One patch (flat arrays) with the bound H: p <- P(p - tau t) on F, P the Euclidean
+    projection on {0 <= p <= H; Σ_F p = ``rest``} under load control (``rest``: the load less
+    what the cells held at H carry), i.e. p = clip(q + a, 0, H) with the shift a found by a
+    safeguarded Newton search on the piecewise-linear Σ clip(q + a) (exact on the final linear
+    piece); the box alone under displacement control. The bound is the hardness cut-off of
+    Almqvist et al. (2007, Tribol. Int. 40, 574-579), also ContactMechanics'
+    ``constrained_conjugate_gradients(hardness=...)``; the load is kept by the shift (the exact
+    projection) instead of a rescaling, which would push saturated cells above H.
+    X = p_new - (p - tau t) on F, as in ``update_pressure``. Returns whether any X is nonzero."""
+    for m in range(n):                          # X <- q = p - tau t (unbounded step)
+        i, j = fi[m], fj[m]
+        X[i * Fx + j] = p[i * nx + j] - tau * t[i * nx + j]
+    a = 0.0
+    if load_control:
+        qmin, qmax = np.inf, -np.inf
+        for m in range(n):
+            v = X[fi[m] * Fx + fj[m]]
+            qmin, qmax = min(qmin, v), max(qmax, v)
+        lo, hi = -qmax, H - qmin                # phi(lo) = -rest <= 0 <= phi(hi) = n H - rest
+        for _ in range(200):
+            phi, slope = -rest, 0
+            for m in range(n):
+                v = X[fi[m] * Fx + fj[m]] + a
+                if v >= H:
+                    phi += H
+                elif v > 0.0:
+                    phi += v
+                    slope += 1
+            if abs(phi) <= 1e-14 * max(rest, H) or hi - lo <= 1e-15 * H:
+                break
+            if phi < 0.0:
+                lo = a
+            else:
+                hi = a
+            a = a - phi / slope if slope > 0 else 0.5 * (lo + hi)
+            if not lo < a < hi:
+                a = 0.5 * (lo + hi)
+    moved = False
+    for m in range(n):
+        i, j = fi[m], fj[m]
+        q = X[i * Fx + j]
+        v = min(max(q + a, 0.0), H)
+        p[i * nx + j] = v
+        X[i * Fx + j] = v - q
+        moved = moved or v != q
+    return moved
+
+
+@njit(cache=True, fastmath=_FAST, nogil=True)
 def combine_spectrum(S, W, lmul, tau, active):
     """S = -tau W + L S: W holds L T, S the rfft2 of the clipped amounts; the result is the
     spectrum of L(p_new - p) = L(-tau t + clipped)."""
@@ -338,9 +424,10 @@ def combine_spectrum(S, W, lmul, tau, active):
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
-def add_response(u, Y, factor, p, z, fi, fj, nf, pending, active, ccount, csum, pnorm, nx, Fx):
-    """u <- c (u + factor Y) and p <- c p (p is zero off F) with c the pending load-balance
-    factor (then reset to 1), and the ``contact_sums`` of the new state, on active patches."""
+def add_response(u, Y, factor, p, z, fi, fj, nf, pending, active, ccount, csum, pnorm, upper, fixed, nx, Fx):
+    """u <- c (u + factor Y) and p <- c p (p is zero off F, or H on the ``fixed`` cells, where
+    c = 1) with c the pending load-balance factor (then reset to 1), and the ``contact_sums`` of
+    the new state, on active patches."""
     B, N = u.shape
     ny = N // nx
     for b in range(B):
@@ -352,13 +439,15 @@ def add_response(u, Y, factor, p, z, fi, fj, nf, pending, active, ccount, csum, 
         for i in range(ny):
             for j in range(nx):
                 u[b, i * nx + j] = c * u[b, i * nx + j] + cf * Y[b, i * Fx + j]
-        n, sc, pp = 0, 0.0, 0.0
+        n, sc, pp, H = 0, 0.0, 0.0, upper[b]
         for m in range(nf[b]):
             g = fi[b, m] * nx + fj[b, m]
             q = c * p[b, g]
             p[b, g] = q
             pp += q * q
-            if q > 0.0:
+            if q > 0.0 and q < H:
                 n += 1
                 sc += u[b, g] + z[b, g]
+        if fixed[b] > 0:
+            pp += fixed[b] * H * H
         ccount[b], csum[b], pnorm[b] = n, sc, pp

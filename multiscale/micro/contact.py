@@ -11,10 +11,15 @@ control the rigid approach. Two methods give the same discrete answer:
 - ``"pk"``: the constrained CG of Polonsky & Keer (1999) (``pk_solver``): iterations growing like
   the square root of the grid size, ~2 FFT pairs each. Slower from 128² up, as fast below.
 
-Both stop on the same unit-free criterion (see ``ContactSolver.solve``). Batches of patches
-(leading axes) are solved in one call, each patch iterating on its own until it converges (then
-it is frozen), so batched and looped answers agree; a batch runs in chunks of ``CHUNK_CELLS``
-cells that keep the working set in the CPU cache, spread over ``multiscale.micro.fft``'s threads.
+Both stop on the same unit-free criterion (see ``ContactSolver.solve``). With a ``hardness`` H
+(``"bccg"`` only) the surface is elastic-perfectly plastic: 0 <= p <= H, the cells at H flow
+plastically and their interpenetration is the permanent deformation (the bounded problem of
+Almqvist et al. 2007, Tribol. Int. 40, 574–579; Weber et al. 2018, Nat. Commun. 9, 888;
+ContactMechanics' hardness cut-off and tamaas' saturated solvers solve the same discrete
+problem). Batches of patches (leading axes) are solved in one call, each patch iterating on its
+own until it converges (then it is frozen), so batched and looped answers agree; a batch runs in
+chunks of ``CHUNK_CELLS`` cells that keep the working set in the CPU cache, spread over
+``multiscale.micro.fft``'s threads.
 
 Conventions: heights ``h`` [m] point towards the rigid flat. The flat first touches the highest
 point; the approach ``delta`` [m] moves it into the solid. Gap
@@ -38,6 +43,7 @@ METHODS = ("bccg", "pk")
 CHUNK_CELLS = {"bccg": 65536, "pk": 32768}   # cells per chunk of a batch (the working set stays in L2)
 COARSE_MIN = 32      # smallest side of the grids of the nested start of "bccg"
 COARSE_TOL = 1e-1    # tolerance of the coarse solves of the nested start
+SNAP = 1e-12         # a start within this relative distance below the hardness is at the hardness
 
 
 @dataclass
@@ -52,6 +58,8 @@ class ContactResult:
     mean_pressure: np.ndarray  # Pa, total force / nominal area
     approach: np.ndarray       # m, rigid approach delta from first touch
     mean_gap: np.ndarray       # m, mean separation between the flat and the deformed surface
+    plastic_area_fraction: np.ndarray  # cells at p = H (plastic flow) / all cells; 0 without a hardness
+    plastic: np.ndarray | None  # m, permanent (plastic) deformation, >= 0 into the solid: d - z - u at p = H
     iterations: np.ndarray     # per patch
     residual: np.ndarray       # per patch, see ContactSolver.solve
     converged: np.ndarray      # bool per patch
@@ -87,9 +95,13 @@ class ContactSolver:
         self._pool_threads = 0
 
     def solve(self, heights, *, load=None, approach=None, tol: float = 1e-8, max_iter: int = 5000,
-              initial_pressure=None, partial: bool = False, method: str | None = None) -> ContactResult:
+              initial_pressure=None, partial: bool = False, method: str | None = None,
+              hardness=None) -> ContactResult:
         """Solve under load control (``load`` = mean pressure [Pa]) or displacement control
-        (``approach`` = delta [m]); scalars or arrays of the batch shape.
+        (``approach`` = delta [m]); scalars or arrays of the batch shape. ``hardness`` H [Pa]
+        (scalar or per patch, > 0; inf or None: elastic) bounds the pressure (p <= H, load < H):
+        the result's ``plastic`` field is then the permanent deformation d - z - u on the cells at
+        H (``plastic_area_fraction``); H = inf computes bit for bit what None computes.
 
         Stopping criterion (both methods): eps = ||s||₂ / ||p||₂ <= ``tol`` per patch, where s is
         the preconditioned residual over the free set (contact cells, and cells with a negative
@@ -135,19 +147,31 @@ class ContactSolver:
             if self.periodic and np.any(delta >= z.mean(axis=(-2, -1))):
                 raise InputError("approach", approach, "a periodic patch under displacement control needs "
                                  "approach < max(h) - mean(h) (full contact has no finite load)")
+        upper = None
+        if hardness is not None:
+            upper = _batch_values("hardness", hardness, batch)
+            if np.any(np.isnan(upper)) or np.any(upper <= 0):
+                raise InputError("hardness", hardness, "must be > 0 (inf: no bound)")
+            if np.all(upper == np.inf):
+                upper = None
+            elif method != "bccg":
+                raise InputError("hardness", hardness, f"method {method!r} has no pressure bound: use 'bccg'")
+            elif target is not None and np.any(target >= upper):
+                raise InputError("load", load, "mean pressure must be below the hardness (a fully plastic "
+                                 "patch carries at most H)")
         p0 = None
         if initial_pressure is not None:
             p0 = _batch_values("initial_pressure", initial_pressure, h.shape)
             if np.any(p0 < 0) or not np.all(np.isfinite(p0)):
                 raise InputError("initial_pressure", "array", "must be finite and >= 0")
-        return self._run_chunks(method, z, target, delta, tol, max_iter, p0, partial)
+        return self._run_chunks(method, z, target, delta, tol, max_iter, p0, partial, upper=upper)
 
-    def _run_chunks(self, method, z, target, delta, tol, max_iter, p0, partial, fields=True):
+    def _run_chunks(self, method, z, target, delta, tol, max_iter, p0, partial, fields=True, upper=None):
         """Run the iterations on chunks of the batch small enough for the CPU cache (the full-grid
         passes are memory bound: 400 patches of 64² in one block run ~2x slower than in chunks
         of 8), on ``get_threads()`` threads when there are several chunks; each chunk makes its
         start (its nested coarse solve) and fills its part of the result (``fields``: the gap and
-        the means, not needed by a nested start)."""
+        the means, not needed by a nested start; ``upper``: the hardness per patch or None)."""
         batch, grid = z.shape[:-2], z.shape[-2:]
         B = int(np.prod(batch, dtype=int))
         size = max(1, CHUNK_CELLS[method] // (grid[0] * grid[1]))
@@ -155,6 +179,7 @@ class ContactSolver:
         target = None if target is None else np.ascontiguousarray(np.reshape(target, B), dtype=float)
         delta = None if delta is None else np.ascontiguousarray(np.reshape(delta, B), dtype=float)
         p0 = None if p0 is None else np.reshape(p0, (B,) + grid)
+        upper = None if upper is None else np.ascontiguousarray(np.reshape(upper, B), dtype=float)
         chunks = [slice(i, min(i + size, B)) for i in range(0, B, size)]
         threads = min(get_threads(), len(chunks))
         p, u = np.empty_like(z), np.empty_like(z)
@@ -162,6 +187,8 @@ class ContactSolver:
                                                     ("converged", bool), ("area_fraction", float),
                                                     ("mean_pressure", float), ("mean_gap", float))}
         gap = np.empty_like(p) if fields else None
+        plastic = np.zeros_like(p) if fields and upper is not None else None
+        out["plastic_area_fraction"] = np.zeros(B)
         histories = [None] * len(chunks)
 
         def one(k):
@@ -174,12 +201,13 @@ class ContactSolver:
                 work = self._new_scratch(method, *key[1:])
             history: list = []
             tc, dc = (None if a is None else a[c] for a in (target, delta))
-            p[c] = self._initial_pressure(method, z[c], tc, dc, None if p0 is None else p0[c], max_iter)
+            uc = None if upper is None else upper[c]
+            p[c] = self._initial_pressure(method, z[c], tc, dc, None if p0 is None else p0[c], max_iter, uc)
             args = (z[c], p[c], u[c], tc, dc, tol, max_iter, history)
             try:
                 with np.errstate(all="ignore"):
                     if method == "bccg":
-                        part = bccg_solver.run(self.operator, work, *args)
+                        part = bccg_solver.run(self.operator, work, *args, uc)
                     else:
                         part = pk_solver.run(self.operator, work[0], work[1], *args)
                     finite = np.all(np.isfinite(part["d"])) and np.all(np.isfinite(u[c])) and np.all(np.isfinite(p[c]))
@@ -199,6 +227,11 @@ class ContactSolver:
             if fields:
                 np.add(u[c], z[c], out=gap[c])
                 gap[c] -= part["d"][:, None, None]
+                if plastic is not None:                      # the interpenetration at p = H
+                    flow = p[c] >= uc[:, None, None]
+                    np.copyto(plastic[c], -gap[c], where=flow)
+                    np.maximum(plastic[c], 0.0, out=plastic[c])
+                    out["plastic_area_fraction"][c] = flow.mean(axis=(1, 2))
                 np.maximum(gap[c], 0.0, out=gap[c])
                 gap[c][p[c] > 0] = 0.0
                 out["area_fraction"][c] = np.mean(p[c] > 0, axis=(1, 2))
@@ -217,6 +250,7 @@ class ContactSolver:
         result = ContactResult(
             pressure=p.reshape(cells), displacement=u.reshape(cells),
             gap=gap.reshape(cells) if fields else None, contact=(p > 0).reshape(cells) if fields else None,
+            plastic=(np.zeros(cells) if plastic is None else plastic.reshape(cells)) if fields else None,
             approach=out.pop("d").reshape(batch), history=history, **{k: v.reshape(batch) for k, v in out.items()})
         if not np.all(result.converged) and not partial:
             raise ContactConvergenceError(
@@ -230,24 +264,26 @@ class ContactSolver:
             return bccg_solver.Scratch(self.operator, chunk, threads)
         return self.operator.workspace((chunk,), threads), bccg_solver.Scratch(self.operator, chunk, threads)
 
-    def _initial_pressure(self, method, z, target, delta, p0, max_iter):
+    def _initial_pressure(self, method, z, target, delta, p0, max_iter, upper=None):
         """A feasible start: the warm start; else for "bccg" the nested start (the solution on the
         grid of half the resolution, ``coarse_start``) when the grid allows it; else uniform
         (load control) or the local solution max(delta - z, 0) / L_00 (displacement control).
-        Balanced under load control."""
+        Balanced under load control; within the bounds ``upper`` (``bounded_start``)."""
         B, N = z.shape[0], z.shape[1] * z.shape[2]
         p = None if p0 is None else np.array(p0, dtype=float)
         if p is None and method == "bccg":
-            p = self.coarse_start(z, target, delta, max_iter)
+            p = self.coarse_start(z, target, delta, max_iter, upper)
         if p is None and target is not None:
             p = np.repeat(target, N).reshape(z.shape)
         elif p is None:
             p = np.maximum(delta[:, None, None] - z, 0.0) / self.operator.self_influence
         if target is not None:
             p = pk_solver.rescale(p.reshape(B, N), target, z.reshape(B, N)).reshape(z.shape)
+        if upper is not None:
+            p = bounded_start(p.reshape(B, N), upper, None if target is None else target * N).reshape(z.shape)
         return np.ascontiguousarray(p)
 
-    def coarse_start(self, z, target, delta, max_iter):
+    def coarse_start(self, z, target, delta, max_iter, upper=None):
         """Nested iteration (as in full multigrid; for contact: the cascade multi-resolution start
         of Bemporad & Paggi 2015, Int. J. Solids Struct. 69–70, 94–105): solve the patches with
         2 x 2 cells merged (heights averaged, same kernel, recursively down to ``COARSE_MIN``
@@ -267,8 +303,38 @@ class ContactSolver:
             delta = delta - low
             if np.any(delta <= 0) or (self.periodic and np.any(delta >= zc.mean(axis=(1, 2)))):
                 return None
-        r = self._coarse._run_chunks("bccg", zc, target, delta, COARSE_TOL, max_iter, None, True, fields=False)
+        r = self._coarse._run_chunks("bccg", zc, target, delta, COARSE_TOL, max_iter, None, True, fields=False,
+                                     upper=upper)
         return np.repeat(np.repeat(r.pressure, 2, axis=1), 2, axis=2)
+
+
+def bounded_start(p, upper, total=None):
+    """p (B, N) >= 0 made feasible for the bounds ``upper`` (B,): min(c p, H) per patch, with c
+    (>= 0) such that Σ min(c p, H) = ``total`` (B,) under load control (exact on the sorted
+    values: the k largest cells saturate, c v_k <= H <= c v_(k-1)), else c = 1. Values within
+    ``SNAP`` of H are set to H: a warm start from a bounded solution (its cells at H rescaled by
+    1 ± 1e-16) keeps its saturated set (the first iteration's projection restores the balance)."""
+    p = np.maximum(np.asarray(p, dtype=float), 0.0)
+    H = upper[:, None]
+    if total is None:
+        return np.minimum(p, H)
+    bounded = np.isfinite(upper)
+    if not bounded.all():                                          # elastic patches keep p
+        p[bounded] = bounded_start(p[bounded], upper[bounded], total[bounded])
+        return p
+    v = -np.sort(-p, axis=1)                                       # descending
+    k = np.arange(p.shape[1] + 1)
+    tail = np.concatenate([np.cumsum(v[:, ::-1], axis=1)[:, ::-1], np.zeros((p.shape[0], 1))], axis=1)
+    nxt = np.concatenate([v, np.zeros((p.shape[0], 1))], axis=1)   # the largest cell not saturated
+    prev = np.concatenate([np.full((p.shape[0], 1), np.inf), v], axis=1)  # the smallest saturated one
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = (total[:, None] - k * H) / tail                        # scale if the k largest saturate
+        ok = (c >= 0) & (c * nxt <= H) & (c * prev >= H) & (tail > 0)
+    first = np.argmax(ok, axis=1)
+    scale = c[np.arange(p.shape[0]), first]
+    p = np.minimum(p * scale[:, None], H)
+    p[p >= H * (1 - SNAP)] = np.broadcast_to(H, p.shape)[p >= H * (1 - SNAP)]   # ties at H stay saturated
+    return p
 
 
 def _method(method) -> str:

@@ -45,6 +45,7 @@ from multiscale.micro.heat_kernels import ThermalMaterial, Translation
 from multiscale.micro.heating import SteadyHeating, TransientHeating
 from multiscale.micro.kernels import Kernel
 from multiscale.micro.laws import Conductance
+from multiscale.micro.plasticity import Hardness
 from multiscale.micro.surface import Surface
 from multiscale.micro.wear import WearRate, wear_step
 from multiscale.micro.zones import Zone
@@ -111,6 +112,9 @@ class ZoneResult:
     heat_rough: np.ndarray = None           # W, (B,): heat rate into the rough body (Phi_2, with the conduction)
     exchange: np.ndarray = None             # W/K, (B,): G of ``Heating.conduction`` (NaN without)
     partition_equal: np.ndarray = None      # (B,): share into the rough body at equal remote temperatures (NaN without)
+    plastic_area_fraction: np.ndarray = None  # (B,): cells at the hardness / zone cells at the macro load (0 if elastic)
+    plastic: np.ndarray = None              # m, (B, ny, nx): permanent deformation of this step, >= 0 (0 if elastic)
+    hardness: np.ndarray | None = None      # Pa, (B,): the hardness of each zone's solves (None: elastic)
 
 
 class PostAnalysis:
@@ -122,12 +126,15 @@ class PostAnalysis:
     temperature: k_w is then taken at the macro temperature of the rough body); ``conductance``: a
     ``laws.Conductance`` or None; ``wear_rate``: anything ``WearRate`` accepts (temperatures in K),
     or None for no wear; ``counter_rate``: the same for the counter-face (None: it does not wear);
-    ``substeps``: wear increments per step; ``tol``: contact tolerance.
+    ``substeps``: wear increments per step; ``tol``: contact tolerance; ``hardness``: a
+    ``plasticity.Hardness`` (H, or H(T) at the rough body's remote temperature of each zone) for
+    elastic-perfectly-plastic asperities, whose permanent deformation goes into the returned
+    heights (before wear; the wear re-solves are bounded too), or None (elastic).
     """
 
     def __init__(self, kernel: Kernel, shape, dx: float, dy: float, *, mu: float, heating: Heating | None = None,
                  conductance: Conductance | None = None, wear_rate=None, counter_rate=None, substeps: int = 1,
-                 tol: float = 1e-8, max_iter: int = 5000):
+                 tol: float = 1e-8, max_iter: int = 5000, hardness: Hardness | None = None):
         self.solver = ContactSolver(kernel, shape, dx, dy, periodic=False)
         self.shape, self.dx, self.dy = tuple(shape), float(dx), float(dy)
         self.mu = check_positive("mu", mu, allow_zero=True)
@@ -135,6 +142,9 @@ class PostAnalysis:
             check_instance("heating", heating, Heating, "a Heating or None")
         if conductance is not None:
             check_instance("conductance", conductance, Conductance, "a laws.Conductance or None")
+        if hardness is not None:
+            check_instance("hardness", hardness, Hardness, "a plasticity.Hardness or None")
+        self.hardness = hardness
         self.heating, self.conductance = heating, conductance
         if heating is not None and (int(heating.transient_steps) != heating.transient_steps
                                     or heating.transient_steps < 0):
@@ -151,7 +161,7 @@ class PostAnalysis:
         return self.rate is not None or self.counter_rate is not None
 
     def run(self, zones: list[Zone], load, *, speed, angle=0.0, remote=None, sliding=None,
-            warm=None, mu=None, duration: float | None = None) -> ZoneResult:
+            warm=None, mu=None, duration: float | None = None, hardness_temperature=None) -> ZoneResult:
         """Post-analysis of ``zones`` at zone mean pressures ``load`` [Pa] > 0 (B,).
 
         speed [m/s] and angle [rad from +x] of the counter-face over each zone (B,); remote (B, 2)
@@ -160,7 +170,9 @@ class PostAnalysis:
         (B,) [m]: distance worn over (None: no wear this call; see ``wear``);
         warm (B, ny, nx): previous local pressures (warm start; rows summing to 0 start cold);
         mu (B,): friction coefficient of each zone (default: the post-analysis' ``mu``);
-        duration [s]: the macro step, heated over by the transient heating.
+        duration [s]: the macro step, heated over by the transient heating; hardness_temperature
+        (B,) [K]: where H(T) is taken (default: the rough body's remote temperature; the loop's
+        flash softening passes each zone's last flash temperature).
         """
         B = len(zones)
         H = np.stack([z.surface.heights for z in zones]) if B else np.zeros((0,) + self.shape)
@@ -178,8 +190,14 @@ class PostAnalysis:
             arrays = {f.name: np.zeros(0) for f in fields(ZoneResult)}
             return ZoneResult(**{**arrays, **dict.fromkeys(("pressure", "worn_pressure", "heights", "depth"), empty),
                                  "iterations": np.zeros(0, dtype=int), "temperature": None,
-                                 "counter_temperature": None})
-        r = self._solve(zones, H, load, _warm(warm, H.shape))
+                                 "counter_temperature": None, "plastic": empty, "hardness": None})
+        hard = None
+        if self.hardness is not None:
+            if self.hardness.depends_on_temperature and remote is None and hardness_temperature is None:
+                raise InputError("remote", None, "a temperature-dependent hardness needs temperatures")
+            at = remote[:, 1] if hardness_temperature is None and remote is not None else hardness_temperature
+            hard = np.broadcast_to(self.hardness(at), (B,))
+        r = self._solve(zones, H, load, _warm(warm, H.shape), hard)
         T = T1 = None
         max_T, partition, heat, heat_rough, exchange, equal = (nan.copy() for _ in range(6))
         if self.heating is not None:
@@ -202,10 +220,10 @@ class PostAnalysis:
         h_c = nan.copy()
         if self.conductance is not None:
             h_c = np.asarray(self.conductance.values(r, zones)["conductance"], dtype=float)
-        result = ZoneResult(r.pressure, r.pressure, H, np.zeros(H.shape), np.zeros(B), r.pressure.max(axis=(-2, -1)),
-                            np.asarray(r.area_fraction, dtype=float), max_T, partition, h_c,
-                            np.asarray(r.iterations).copy(), load, mu, T, T1, np.zeros(B), heat, heat_rough,
-                            exchange, equal)
+        result = ZoneResult(r.pressure, r.pressure, H - r.plastic, np.zeros(H.shape), np.zeros(B),
+                            r.pressure.max(axis=(-2, -1)), np.asarray(r.area_fraction, dtype=float), max_T, partition,
+                            h_c, np.asarray(r.iterations).copy(), load, mu, T, T1, np.zeros(B), heat, heat_rough,
+                            exchange, equal, np.asarray(r.plastic_area_fraction, dtype=float), r.plastic.copy(), hard)
         if sliding is not None and self.wears:
             result = self.wear(zones, result, sliding, remote)
         return result
@@ -226,6 +244,7 @@ class PostAnalysis:
                 T, T1 = (value, T1) if field == "T" else (T, value)
         ds = _per_zone("sliding", sliding, B) / self.substeps
         depth, counter, iterations = np.zeros(heights.shape), np.zeros(B), result.iterations.copy()
+        plastic = result.plastic
         for _ in range(self.substeps):
             work = mu[:, None, None] * p * ds[:, None, None]      # mu p ds [J/m^2], per-zone sliding folded in
             if self.counter_rate is not None:
@@ -236,12 +255,13 @@ class PostAnalysis:
             # Archard with the per-zone sliding folded into the work density mu p ds [J/m^2]
             worn = wear_step(Surface(heights, self.dx, self.dy, periodic=False), work, self.rate, 1.0, 1.0, T)
             heights, depth = worn.surface.heights, depth + worn.depth
-            again = self._solve(zones, heights, load, p)
-            p = again.pressure
+            again = self._solve(zones, heights, load, p, result.hardness)
+            p, heights = again.pressure, heights - again.plastic
+            plastic = plastic + again.plastic
             iterations += np.asarray(again.iterations)
         return replace(result, worn_pressure=p, heights=heights, depth=depth,
                        volume=depth.sum(axis=(-2, -1)) * self.dx * self.dy, iterations=iterations,
-                       counter_volume=counter)
+                       counter_volume=counter, plastic=plastic)
 
     def _heat(self, pressure, speed, angle, mu, remote, duration):
         """(counter-face field, rough-body field, flash temperature, Phi, Phi_2) of one zone: the
@@ -256,17 +276,17 @@ class PostAnalysis:
         return (h.temperature_1[-1], h.temperature_2[-1], h.max_temperature_2.max(), float(h.heat.mean()),
                 float(h.heat_2.mean()))
 
-    def _solve(self, zones, heights, load, warm):
+    def _solve(self, zones, heights, load, warm, hardness=None):
         """Load-controlled contact of the batch; patches that do not converge within
         ``WARM_ITERATIONS`` from the warm start (warm starts converge in tens of iterations; one
         supported by a single cell was seen to stall for ever) are solved again from a uniform
         start with 4 x max_iter; ``ContactConvergenceError`` names those that still fail."""
         r = self.solver.solve(heights, load=load, initial_pressure=warm, tol=self.tol,
-                              max_iter=min(self.max_iter, WARM_ITERATIONS), partial=True)
+                              max_iter=min(self.max_iter, WARM_ITERATIONS), partial=True, hardness=hardness)
         bad = np.flatnonzero(~np.asarray(r.converged))
         if len(bad):
             again = self.solver.solve(heights[bad], load=load[bad], tol=self.tol, max_iter=4 * self.max_iter,
-                                      partial=True)
+                                      partial=True, hardness=None if hardness is None else hardness[bad])
             for f in fields(r):
                 if f.name not in ("history", "iterations"):
                     getattr(r, f.name)[bad] = getattr(again, f.name)

@@ -41,7 +41,8 @@ from multiscale.plots.history import multiscale_figure, wear_map
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, interface_forces, \
     interface_materials
 from multiscale.workflows.output import prepare_folder
-from multiscale.workflows.rough import build_rough_interface, check_rough_scene, contact_kernel, thermal_kernels
+from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
+                                        thermal_kernels)
 from multiscale.workflows.transient import TransientResult, write_history
 
 CHECKPOINT = "checkpoint.h5"
@@ -79,7 +80,7 @@ def post_analysis(scene, zone) -> PostAnalysis:
                         heating=heating,
                         conductance=Conductance(*thermal_kernels(scene)) if scene.has("conductance") else None,
                         wear_rate=rate, counter_rate=counter_rate, substeps=scene.wear.substeps if wear else 1,
-                        tol=m.tol)
+                        tol=m.tol, hardness=interface_hardness(scene) if scene.has("plasticity") else None)
 
 
 def fingerprint(scene) -> str:
@@ -107,6 +108,7 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
                             partition=float(scene.partition) if scene.has("heat_partition") else np.nan,
                             partition_law=scene.micro.partition_law, wear=wear,
                             wear_every=scene.wear.update_every if wear else 1,
+                            flash_softening=scene.micro.flash_softening,
                             forces=interface_forces(scene, tm), friction=mu,
                             remote=scene.micro.remote(scene.effects), coupling=scene.micro.coupling_scheme(scene.effects),
                             coupling_tol=scene.micro.coupling_tol, coupling_iterations=scene.micro.coupling_iterations)
