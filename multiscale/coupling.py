@@ -72,7 +72,6 @@ import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import h5py
 import numpy as np
 
 from multiscale import checkpoint, io
@@ -589,7 +588,4 @@ class Multiscale:
     @staticmethod
     def mark_fields(path: Path, step: int, comm) -> None:
         """Record in the checkpoint that the fields of ``step`` are written (collective)."""
-        if comm.rank == 0:
-            with h5py.File(path, "r+") as h5:
-                h5.attrs["fields_written"] = step
-        comm.barrier()
+        checkpoint.mark(path, comm, fields_written=step)

@@ -172,3 +172,21 @@ def test_a_read_only_output_folder_is_one_clear_error(tmp_path, monkeypatch):
     scene = loads(SCENE.format(folder=tmp_path / "locked"))
     with pytest.raises(OutputError, match="cannot write into the output folder .*Permission denied"):
         run(scene, verbose=False)
+
+
+def test_a_full_disk_at_the_history_is_one_clear_error(tmp_path, monkeypatch):
+    """The history (rank 0 writes it) on a full disk: an OutputError naming the file and the cause
+    (collective: on 2 ranks the other rank raises it too, through io.on_root)."""
+    import errno
+    import os
+
+    from multiscale import io
+    from multiscale.errors import OutputError
+    from multiscale.scene import loads
+    from multiscale.workflows import run
+
+    def full(self, path, attrs=None):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    monkeypatch.setattr(io.History, "write", full)
+    with pytest.raises(OutputError, match="cannot write the history .*history.h5: No space left on device"):
+        run(loads(SCENE.format(folder=tmp_path / "out")), verbose=False)

@@ -191,14 +191,15 @@ def finished(folder: Path, name: str, steps: int, comm, verbose: bool) -> Multis
 
 def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: str, comm) -> tuple:
     """multiscale.png, the wear maps (with wear: ``wear_map.png``, or ``wear_map_<interface>.png``
-    for several interfaces) and zones.h5 (rank 0 writes; collective)."""
+    for several interfaces) and zones.h5 (rank 0 writes; a failure is an OutputError on every rank)."""
     rough = ms.rough
     plot, zones = folder / "multiscale.png", folder / "zones.h5"
     names = list(rough.names)
     maps = [] if not ms.settings.wear else [folder / "wear_map.png"] if len(names) == 1 else \
         [folder / f"wear_map_{n}.png" for n in names]
     depth = rough.wear_depth()
-    if comm.rank == 0:
+
+    def write():
         multiscale_figure(history, plot, name)
         with h5py.File(zones, "w") as h5:
             h5.create_dataset("centre", data=np.array([z.centre for z in rough.zones])).attrs["unit"] = "m"
@@ -214,5 +215,5 @@ def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: 
         for grid, path, interface in zip(rough.grids, maps, names):
             wear_map(grid, depth[offset:offset + grid.n_zones], path, f"{name}: {interface}")
             offset += grid.n_zones
-    comm.barrier()
+    io.on_root(comm, write, f"the zone results in {folder}")
     return plot, maps, zones

@@ -116,16 +116,15 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     case = analyse(scene, tm, degree=degree)
     with io.stage("writing results"):
         plan = outputs.plan(scene)
-        files = [case.modes.write_csv(folder / "modes.csv")] if comm.rank == 0 else []
+        files = io.on_root(comm, lambda: [case.modes.write_csv(folder / "modes.csv")], f"{folder / 'modes.csv'}") or []
         files += write_state(folder, case.mech, plan.body_fields + plan.interface_fields)
         files += write_modes(folder, case.modes, case.mech.u, [b.name for b in tm.bodies])
         split = energy_split(tm)
-        if comm.rank == 0:
-            files += [plot_pressure(tm.interface.midpoints, tm.interface.masks(), case.facet_pressure, case.name,
-                                    folder / "pressure.png"),
-                      plot_re_im([case], folder / "re_im.png"),
-                      plot_energy(case, folder / "energy.png", split)]
-        comm.barrier()
+        masks = tm.interface.masks()
+        files += io.on_root(comm, lambda: [
+            plot_pressure(tm.interface.midpoints, masks, case.facet_pressure, case.name, folder / "pressure.png"),
+            plot_re_im([case], folder / "re_im.png"), plot_energy(case, folder / "energy.png", split)],
+            f"the figures in {folder}") or []
     result = SquealResult(folder, files, time.perf_counter() - t0, case)
     if verbose and comm.rank == 0:
         rep = case.report

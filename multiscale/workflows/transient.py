@@ -32,12 +32,13 @@ class TransientResult(RunResult):
 
 
 def write_history(history: io.History, folder: Path, name: str, comm) -> tuple[Path, Path]:
-    """``history.h5`` and ``history.png`` (rank 0 writes; collective)."""
+    """``history.h5`` and ``history.png`` (rank 0 writes; a failure is an OutputError on every rank)."""
     h5, png = folder / "history.h5", folder / "history.png"
-    if comm.rank == 0:
+
+    def write():
         history.write(h5, {"scene": name, "ranks": comm.size})
         history_figure(history, png, title=name)
-    comm.barrier()
+    io.on_root(comm, write, f"the history {h5}")
     return h5, png
 
 
