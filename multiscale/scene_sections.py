@@ -55,7 +55,9 @@ class Material:
     """One body's material (Table 7.2). Every property is a constant or a table against the
     temperature ((K, value), ...), interpolated linearly and held constant beyond its ends; ``alpha``
     is the mean (secant) expansion coefficient from the initial temperature. Thermal needs kappa and
-    c (with rho) or chi."""
+    c (with rho) or chi. The squeal analysis reads the material damping: a structural loss factor
+    eta (complex stiffness E (1 + i eta)) and Rayleigh coefficients (alpha M + beta K of this
+    material's mass and stiffness)."""
 
     E: float | tuple = key(_property(_MODULUS, "E"), required=True)                          # Pa
     nu: float | tuple = key(_property(_POISSON, "nu"), required=True)
@@ -65,10 +67,20 @@ class Material:
     chi: float | tuple | None = key(_property(Quantity("diffusivity", gt=0), "chi"))         # m^2/s
     alpha: float | tuple | None = key(_property(Quantity("expansion"), "alpha"), needed_by=("expansion",),
                                       warn_unused=True)                                      # 1/K
+    loss_factor: float | None = key(Quantity("dimensionless", ge=0))      # structural damping eta (squeal)
+    damping_alpha: float | None = key(Quantity("frequency", ge=0))        # 1/s, Rayleigh: alpha M (squeal)
+    damping_beta: float | None = key(Quantity("time", ge=0))              # s, Rayleigh: beta K (squeal)
 
     rules = (OneOf(("c", "chi"), needed_by=("thermal",)), Requires("c", ("rho",), needed_by=("thermal",)))
 
     PROPERTIES = ("E", "nu", "rho", "kappa", "c", "chi", "alpha")
+    DAMPING = ("loss_factor", "damping_alpha", "damping_beta")
+
+    def problems(self, path, ctx):
+        given = [k for k in self.DAMPING if getattr(self, k) is not None]
+        if given and "stability" not in ctx.effects:
+            ctx.warnings.append(f'{path}.{given[0]} is ignored: effect "stability" is not in effects')
+        return []
 
     def tabulated(self, name: str) -> bool:
         """True if property ``name`` is a temperature table."""
@@ -231,6 +243,17 @@ class Vehicle:
 
 
 @dataclass(frozen=True)
+class Stribeck:
+    """[loading.stribeck]: friction falling with the slip speed v, mu(v) = kinetic + (static -
+    kinetic) exp(-(v / speed)^exponent) (exponent 1: the exponential static-to-kinetic decay law)."""
+
+    static: float | None = key(Quantity("dimensionless", ge=0), required=True)
+    kinetic: float | None = key(Quantity("dimensionless", ge=0), required=True)
+    speed: float | None = key(Quantity("speed", gt=0), required=True)            # m/s, Stribeck speed
+    exponent: float = key(Quantity("dimensionless", gt=0), default=1.0)
+
+
+@dataclass(frozen=True)
 class Loading:
     """Normal load (force or pressure on the load faces), sliding speed, friction, duty cycle.
 
@@ -239,7 +262,10 @@ class Loading:
     with ``direction`` a traction along it whose resultant is the force, or the pressure itself),
     scaled in time by ``load_profile`` (factor, 0 = released: no contact, no frictional heat). The
     speed of the rotating body: ``rotation_speed``, a ``speed_profile`` against time, or a
-    ``vehicle`` stop or drag; a translating body slides at ``sliding_speed``."""
+    ``vehicle`` stop or drag; a translating body slides at ``sliding_speed``. Friction: a
+    constant ``friction``, or (squeal analysis only) mu against the slip speed: a table
+    ``friction_curve`` or a ``stribeck`` law, taken per interface facet at its steady slip speed;
+    its slope enters the modal analysis as damping."""
 
     normal_force: float | None = key(Quantity("force", gt=0))                 # N
     pressure: float | None = key(Quantity("pressure", gt=0))                  # Pa
@@ -252,13 +278,23 @@ class Loading:
                                             "time", "speed"))                 # ((s, rad/s), ...)
     vehicle: Vehicle | None = key(Section(Vehicle))
     sliding_speed: float | None = key(Quantity("speed", ge=0))                # m/s (translation builders)
-    friction: float | None = key(Quantity("dimensionless", ge=0), needed_by=("friction",),
-                                 warn_unused=True)                            # mu
+    friction: float | None = key(Quantity("dimensionless", ge=0))             # mu
     ramp_steps: int = key(Integer(ge=1), default=1)       # load increments of the first mechanical solve
+    friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), Quantity("dimensionless", ge=0),
+                                             "slip speed", "mu", min_rows=2))  # ((m/s, -), ...)
+    stribeck: Stribeck | None = key(Section(Stribeck))
 
-    rules = (OneOf(("normal_force", "pressure")), OneOf(("rotation_speed", "speed_profile", "vehicle")))
+    FRICTION = ("friction", "friction_curve", "stribeck")
+    rules = (OneOf(("normal_force", "pressure")), OneOf(("rotation_speed", "speed_profile", "vehicle")),
+             OneOf(FRICTION, needed_by=("friction",)))
 
     def problems(self, path, ctx):
+        law = [k for k in self.FRICTION if getattr(self, k) is not None]
+        if law and "friction" not in ctx.effects:
+            ctx.warnings.append(f'{path}.{law[0]} is ignored: effect "friction" is not in effects')
+        elif law and law[0] != "friction" and "stability" not in ctx.effects:
+            return [f"{path}.{law[0]}: a speed-dependent friction is read by the squeal analysis only "
+                    f'(effect "stability"); give {path}.friction']
         given = [k for k in ("normal_force", "pressure") if getattr(self, k) is not None]
         by_mass = self.vehicle is not None and self.vehicle.mass is not None
         if given and by_mass:
@@ -416,15 +452,101 @@ class Layers:
     layer: tuple | None = key(Tables(Layer), required=True)
 
 
+SWEEP_PARAMETERS = {"friction": "-", "pressure": "Pa", "speed": "rad/s", "rms": "m"}
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """[stability.sweep]: a stability map over one parameter: the friction coefficient of every
+    interface, the brake pressure, the speed of the rotating body or the R_q of the rough surfaces
+    (effect "roughness"). The listed values, or with ``points`` that many from the first to the
+    last. ``preload = "once"`` (default for friction and speed) keeps the sliding state of the
+    nominal analysis and projects every point on the undamped modes of the first and last points;
+    ``"each"`` (pressure, roughness) preloads and solves every point. The modes are tracked by MAC
+    (``mac``: the lowest MAC of a pair) and the onset of every unstable mode is bisected
+    (``onsets``); see ``multiscale.workflows.squeal_map``."""
+
+    friction: tuple | None = key(ListOf(Quantity("dimensionless", ge=0), min_len=2))
+    pressure: tuple | None = key(ListOf(Quantity("pressure", gt=0), min_len=2))          # Pa
+    speed: tuple | None = key(ListOf(Quantity("angular_speed", ge=0), min_len=2))       # rad/s
+    rms: tuple | None = key(ListOf(Quantity("length", gt=0), min_len=2))                # m
+    points: int | None = key(Integer(ge=2))
+    preload: str | None = key(Choice(("each", "once")))      # default: once for friction and speed
+    mac: float = key(Quantity("dimensionless", gt=0, le=1), default=0.5)
+    onsets: bool = key(Flag(), default=True)
+
+    rules = (OneOf(tuple(SWEEP_PARAMETERS), required=True),)
+
+    @property
+    def parameter(self) -> str:
+        return next(k for k in SWEEP_PARAMETERS if getattr(self, k) is not None)
+
+    @property
+    def preload_mode(self) -> str:
+        """"once" (keep the nominal sliding state) or "each" (preload every point)."""
+        return self.preload or ("once" if self.parameter in ("friction", "speed") else "each")
+
+    @property
+    def values(self) -> tuple:
+        """The swept values (SI), increasing."""
+        given = getattr(self, self.parameter)
+        if self.points is None:
+            return tuple(given)
+        lo, hi = given
+        return tuple(lo + (hi - lo) * k / (self.points - 1) for k in range(self.points))
+
+    def problems(self, path, ctx):
+        name = self.parameter
+        given = getattr(self, name)
+        where = f"{path}.{name}"
+        if self.points is not None and len(given) != 2:
+            return [f"{where}: with {path}.points give the range [first, last] (2 values, got {len(given)})"]
+        if any(b <= a for a, b in zip(given, given[1:])):
+            return [f"{where}: the values must increase"]
+        loading = ctx.root.get("loading") if isinstance(ctx.root.get("loading"), dict) else {}
+        if name == "rms" and "roughness" not in ctx.effects:
+            return [f'{where}: sweeps the rough surfaces: needs effect "roughness"']
+        if name == "rms" and "rms" not in (ctx.root.get("roughness") or {}):
+            return [f"{where}: sweeps roughness.rms of a generated surface; the scene gives no roughness.rms"]
+        if self.preload == "once" and name in ("pressure", "rms"):
+            return [f'{path}.preload = "once": a {name} sweep changes the preloaded state; use "each"']
+        if name == "friction" and ("friction_curve" in loading or "stribeck" in loading):
+            return [f"{where}: sets a constant friction; remove loading.friction_curve / loading.stribeck"]
+        if name == "pressure" and "pressure" not in loading:
+            return [f"{where}: sweeps loading.pressure; the scene gives no loading.pressure"]
+        if name == "speed" and "sliding_speed" in loading:
+            return [f"{where}: an angular speed of the rotating body; this geometry translates"]
+        return []
+
+
 @dataclass(frozen=True)
 class Stability:
-    """Complex eigenvalue analysis (§4.3): modes in a frequency band, shift target, damping."""
+    """Complex eigenvalue analysis (§4.3): modes in a frequency band, shift target, damping.
+
+    Damping: ``damping`` (a structural loss factor eta of the whole system), ``rayleigh_alpha`` /
+    ``rayleigh_beta`` (alpha M + beta K of the whole linearised system): proportional, mapped
+    exactly from the undamped modes; per-material damping ([materials] loss_factor,
+    damping_alpha, damping_beta), the friction slope of a mu(v) law (``friction_damping``) and the
+    gyroscopic terms are not: the damped problem is then solved as a full quadratic eigenproblem
+    (``method = "quadratic"``, exact, viscous damping only: the default for it) or by projection
+    on the undamped modes up to ``basis`` x the band's top (``"projection"``, the default with loss
+    factors; approximate for damping localised at the interface: see ``multiscale.macro.damped``). ``prestress`` adds the initial-stress
+    stiffness of the preloaded state (and reports its effect on every frequency); ``gyroscopic``
+    the Coriolis and centrifugal terms of the rotating body at the loading speed."""
 
     band: tuple = key(Pair(Quantity("frequency", ge=0), single=False, names="[low, high]"),
                       default=(0.0, 16e3))                                    # Hz
     modes: int | None = key(Integer(ge=1), required=True)
     target: float | None = key(Quantity("frequency", ge=0))                   # Hz; default: the band's lower edge
     damping: float = key(Quantity("dimensionless", ge=0), default=0.0)        # structural loss factor
+    rayleigh_alpha: float = key(Quantity("frequency", ge=0), default=0.0)     # 1/s
+    rayleigh_beta: float = key(Quantity("time", ge=0), default=0.0)           # s
+    prestress: bool = key(Flag(), default=False)
+    gyroscopic: bool = key(Flag(), default=False)
+    friction_damping: bool = key(Flag(), default=True)
+    method: str = key(Choice(("auto", "projection", "quadratic")), default="auto")
+    basis: float = key(Quantity("dimensionless", ge=1), default=1.5)
+    sweep: Sweep | None = key(Section(Sweep))
 
     def problems(self, path, ctx):
         low, high = self.band
@@ -432,6 +554,13 @@ class Stability:
             return [f"{path}.band = [{low:g}, {high:g}] Hz: the upper bound must exceed the lower"]
         if self.target is not None and not low <= self.target <= high:
             return [f"{path}.target = {self.target:g} Hz: must lie in the band [{low:g}, {high:g}] Hz"]
+        materials = ctx.root.get("materials") if isinstance(ctx.root.get("materials"), dict) else {}
+        lossy = [m for m, t in materials.items() if isinstance(t, dict) and t.get("loss_factor")]
+        if self.method == "quadratic" and (self.damping or lossy):
+            what = f"{path}.damping" if self.damping else f"materials.{lossy[0]}.loss_factor"
+            return [f'{path}.method = "quadratic": takes viscous damping only; {what} (complex stiffness) '
+                    'needs method = "projection"']
+        loading = ctx.root.get("loading") if isinstance(ctx.root.get("loading"), dict) else {}
+        if self.gyroscopic and "sliding_speed" in loading:
+            return [f"{path}.gyroscopic = true: needs a rotating body; this geometry translates"]
         return []
-
-

@@ -308,7 +308,8 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     Real arithmetic cannot shift at i omega; the shift is the real rate s = 2 pi target [1/s]
     (K + s C + s^2 M is non-singular for s > 0 even for a free-free structure) and eigenvalues
     converge in order of |lambda - s|, i.e. by frequency for light damping. ``n_modes`` counts
-    modes with omega >= 0 (conjugate pairs are computed together); ``n_modes=None`` asks for the
+    modes with omega >= 0 (conjugate pairs are computed together; at most ``n_modes`` in the band,
+    the nearest s, are returned); ``n_modes=None`` asks for the
     whole band: the subspace grows until a converged |lambda - s| exceeds |i 2 pi f_max - s|.
     The result is filtered to the band. ``theta`` is reported as -lambda^2.
     """
@@ -361,7 +362,9 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     vecs = np.column_stack(vecs) if vecs else np.empty((K.getLocalSize()[0], 0), complex)
     errs = np.array(errs)
     seen = lam.imag / TWO_PI
-    inband = (seen >= f_min) & (seen <= f_max)
+    inband = np.nonzero((seen >= f_min) & (seen <= f_max))[0]
+    if n_modes is not None:             # the n_modes nearest the shift, as they converge
+        inband = inband[np.argsort(np.abs(lam[inband] - s), kind="stable")[:int(n_modes)]]
     lam, theta, vecs, errs = _sorted(lam[inband], -lam[inband] ** 2, vecs[:, inband], errs[inband],
                                      (f_min, f_max), seen)
     return ModalResult(lam, theta, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
