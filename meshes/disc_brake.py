@@ -36,7 +36,7 @@ from multiscale.geometry import (BodySpec, GeometrySpec, Region, Rotation, Suppo
                                        entities_in_box, entities_where, resolve_parameters)
 
 NAME = "disc_brake"
-PARAMETER_KINDS = {"vanes": "dimensionless"}
+PARAMETER_KINDS = {"vanes": "count"}
 DEFAULTS: dict[str, float] = {
     "disc_outer_radius": 0.140,      # m
     "ring_inner_radius": 0.085,      # m, inner radius of the friction ring (= hat wall outer radius)
@@ -80,7 +80,9 @@ def parameters(params=None) -> dict:
     """DEFAULTS updated by ``params`` (SI); checks that the parts fit together."""
     p = resolve_parameters(DEFAULTS, params, NAME)
     p["pad_mesh_size"] = p["pad_mesh_size"] or p["mesh_size"] / 2
-    p["vanes"] = int(round(p["vanes"]))
+    if p["vanes"] != int(p["vanes"]):
+        raise InputError("geometry.vanes", p["vanes"], "a whole number of vanes (0: solid disc)")
+    p["vanes"] = int(p["vanes"])
     checks = [
         ("ring_inner_radius", p["ring_inner_radius"] - p["hat_wall"] > p["hub_radius"],
          "ring_inner_radius - hat_wall must exceed hub_radius"),

@@ -5,7 +5,7 @@ conduction, frictional heating. Macro scale (``multiscale.macro``, DOLFINx): pin
 disc-brake models whose flat interfaces carry homogenized per-facet laws.
 SI units everywhere (m, Pa, W, K, s).
 """
-from multiscale.errors import ConvergenceError, InputError, MultiscaleError, SceneError
+from multiscale.errors import ConvergenceError, InputError, MultiscaleError, OutputError, SceneError
 
 __version__ = "0.1.0"
-__all__ = ["ConvergenceError", "InputError", "MultiscaleError", "SceneError", "__version__"]
+__all__ = ["ConvergenceError", "InputError", "MultiscaleError", "OutputError", "SceneError", "__version__"]

@@ -17,6 +17,7 @@ import h5py
 import numpy as np
 
 from multiscale.errors import InputError
+from multiscale.io import on_root
 
 
 def fingerprint(text: str) -> str:
@@ -33,39 +34,65 @@ def _dof_table(f, scale: float):
     return keys, f.x.array.reshape(-1, bs)[:n]
 
 
+def _digest(datasets: dict) -> str:
+    """SHA-256 of the datasets (name -> array) in name order: a checkpoint's checksum."""
+    h = hashlib.sha256()
+    for name in sorted(datasets):
+        value = np.ascontiguousarray(datasets[name])
+        h.update(name.encode())
+        h.update(str(value.dtype).encode())
+        h.update(value.tobytes())
+    return h.hexdigest()
+
+
 def save(path, comm, *, attrs: dict, arrays: dict, functions: dict, scale: float = 1.0) -> Path:
     """Write a checkpoint (collective). ``arrays``: name -> numpy array (same on every rank);
-    ``functions``: name -> dolfinx Function (gathered by dof coordinates)."""
+    ``functions``: name -> dolfinx Function (gathered by dof coordinates). A failure to write
+    (disk full, ...) is an ``OutputError`` on every rank; the previous checkpoint stays."""
     path = Path(path)
     tables = {name: comm.gather(_dof_table(f, scale), root=0) for name, f in functions.items()}
-    if comm.rank == 0:
+
+    def write():
         tmp = path.with_name(path.name + ".tmp")
-        with h5py.File(tmp, "w") as h5:
-            for key, value in attrs.items():
-                h5.attrs[key] = value
-            h5.attrs["length_scale"] = scale
-            for name, value in arrays.items():
-                h5.create_dataset(f"arrays/{name}", data=np.asarray(value))
-            for name, parts in tables.items():
-                h5.create_dataset(f"functions/{name}/keys", data=np.concatenate([k for k, _ in parts]))
-                h5.create_dataset(f"functions/{name}/values", data=np.concatenate([v for _, v in parts]))
-        os.replace(tmp, path)
-    comm.barrier()
+        data = {f"arrays/{name}": np.asarray(value) for name, value in arrays.items()}
+        for name, parts in tables.items():
+            data[f"functions/{name}/keys"] = np.concatenate([k for k, _ in parts])
+            data[f"functions/{name}/values"] = np.concatenate([v for _, v in parts])
+        try:
+            with h5py.File(tmp, "w") as h5:
+                for key, value in attrs.items():
+                    h5.attrs[key] = value
+                h5.attrs["length_scale"] = scale
+                h5.attrs["checksum"] = _digest(data)
+                for name, value in data.items():
+                    h5.create_dataset(name, data=value)
+            os.replace(tmp, path)
+        except OSError:
+            tmp.unlink(missing_ok=True)
+            raise
+    on_root(comm, write, f"the checkpoint {path}")
     return path
 
 
 def load(path, comm, functions: dict) -> tuple[dict, dict]:
     """Read a checkpoint: sets ``functions`` (name -> Function, matched by dof coordinates) and
-    returns (attrs, arrays). Raises InputError if a function's dofs are not in the file."""
-    with h5py.File(path, "r") as h5:
-        attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in h5.attrs.items()}
-        arrays = {}
-        if "arrays" in h5:
-            h5["arrays"].visititems(lambda name, item: arrays.__setitem__(name, item[...])
-                                    if isinstance(item, h5py.Dataset) else None)
-        stored = {name: (h5[f"functions/{name}/keys"][...], h5[f"functions/{name}/values"][...])
-                  for name in functions}
-    scale = float(attrs["length_scale"])
+    returns (attrs, arrays). Raises InputError (on every rank: each reads the whole file) if the
+    file is unreadable, truncated or corrupted (its checksum), or a function's dofs are not in it."""
+    data = {}
+    try:
+        with h5py.File(path, "r") as h5:
+            attrs = {k: (v.decode() if isinstance(v, bytes) else v) for k, v in h5.attrs.items()}
+            h5.visititems(lambda name, item: data.__setitem__(name, item[...]) if isinstance(item, h5py.Dataset)
+                          else None)
+        scale, checksum = float(attrs["length_scale"]), attrs["checksum"]
+        stored = {name: (data[f"functions/{name}/keys"], data[f"functions/{name}/values"]) for name in functions}
+    except (OSError, KeyError, ValueError) as exc:
+        raise InputError("--resume", str(path), f"the checkpoint cannot be read ({exc}): the file is truncated "
+                         "or damaged; start again with --overwrite") from None
+    if _digest(data) != checksum:
+        raise InputError("--resume", str(path), "the checkpoint is corrupted (its checksum does not match its "
+                         "data); start again with --overwrite")
+    arrays = {name[len("arrays/"):]: value for name, value in data.items() if name.startswith("arrays/")}
     for name, f in functions.items():
         keys, values = _dof_table(f, scale)
         index = _match(stored[name][0], keys)
@@ -77,6 +104,28 @@ def load(path, comm, functions: dict) -> tuple[dict, dict]:
         f.x.array.reshape(-1, bs)[:len(keys)] = owned
         f.x.scatter_forward()
     return attrs, arrays
+
+
+def mark(path, comm, **attrs) -> None:
+    """Set scalar attributes of the checkpoint ``path`` (e.g. the last step whose fields are
+    written, or that the run finished); outside the checksum, which covers the data (collective)."""
+    def write():
+        with h5py.File(path, "r+") as h5:
+            for key, value in attrs.items():
+                h5.attrs[key] = value
+    on_root(comm, write, f"the checkpoint {path}")
+
+
+def peek(path, comm) -> dict:
+    """The scalar attributes of a checkpoint, read by rank 0 for every rank without loading its
+    data ({} if there is none or it cannot be read: ``load`` then says why)."""
+    def read():
+        try:
+            with h5py.File(path, "r") as h5:
+                return {k: (v.decode() if isinstance(v, bytes) else v) for k, v in h5.attrs.items()}
+        except (OSError, KeyError, ValueError):
+            return {}
+    return comm.bcast(read() if comm.rank == 0 else None, root=0)
 
 
 def _match(stored: np.ndarray, wanted: np.ndarray) -> np.ndarray:

@@ -2,12 +2,18 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import sys
+from pathlib import Path
 
 from multiscale import __version__
-from multiscale.errors import MultiscaleError, SceneError
+from multiscale.errors import InputError, MultiscaleError, SceneError
+from multiscale.io import ended_together
+from multiscale.micro.spectrum import surface_statistics
+from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition, formats, read_topography
 from multiscale.scene import load
-from multiscale.scene_summary import reference, summary
+from multiscale.scene_summary import cells_line, reference, summary
+from multiscale.units import UnitError, to_si
 
 
 def _info(args) -> int:
@@ -46,6 +52,8 @@ def _check(args) -> int:
             failed += 1
             continue
         print("\n".join(summary(scene)))
+        if args.cells:
+            print(cells_line(scene))
         print(f"{path}: OK")
     return 2 if failed else 0
 
@@ -63,18 +71,28 @@ def _run(args) -> int:
     """Validate the scene and hand it to its workflow (``multiscale.workflows.run``).
 
     Under ``mpiexec`` every rank runs this; user errors are raised on every rank (scene validation
-    is deterministic, the output folder is judged by rank 0 for all) and printed by rank 0."""
+    is deterministic, the output folder is judged by rank 0 for all, solver failures are decided
+    collectively) and printed by rank 0. An error met by some ranks only (the others wait in a
+    collective operation) is printed by the rank that met it, which then aborts the job: nothing
+    hangs."""
     comm = _world()
     rank = comm.rank if comm is not None else 0
     try:
         scene = load(args.scene)
+        if args.max_cells is not None:
+            scene = dataclasses.replace(scene, geometry=dataclasses.replace(scene.geometry, max_cells=args.max_cells))
+        for line in scene.warnings if rank == 0 else ():
+            print(f"warning: {line}", file=sys.stderr, flush=True)
         try:
             from multiscale.workflows import run   # DOLFINx: optional ([fem] extra), slow to import
         except ModuleNotFoundError as exc:
             raise MultiscaleError(f"multiscale run needs DOLFINx and the macro workflows ({exc}); install "
                                   "them with pip install -e '.[fem]'") from None
         run(scene, overwrite=args.overwrite, resume=args.resume)
-    except MultiscaleError:
+    except MultiscaleError as exc:
+        if comm is not None and not ended_together(comm):
+            print(f"error (rank {rank} of {comm.size}): {exc}", file=sys.stderr, flush=True)
+            comm.Abort(2)
         if rank == 0:
             raise
         return 2
@@ -95,6 +113,59 @@ def _study(args) -> int:
     return 1 if failed else 0
 
 
+def _count(text: str) -> int:
+    """A positive whole number of the command line ("2000000" or "2e6")."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not (value >= 1 and value == int(value)):
+        raise argparse.ArgumentTypeError(f"{text!r}: a whole number >= 1")
+    return int(value)
+
+
+def _length(option: str, text: str | None) -> float | None:
+    """A length option ("0.8 mm", or a number in metres) in metres."""
+    if text is None:
+        return None
+    try:
+        value = float(text)
+    except ValueError:
+        value = text
+    try:
+        return to_si(value, "length")
+    except UnitError as exc:
+        raise InputError(option, text, str(exc)) from None
+
+
+def _surface(args) -> int:
+    """Read, condition and analyse a measured topography: the steps, the statistics, a figure."""
+    if args.formats:
+        print("\n".join(formats()))
+        return 0
+    if not args.file:
+        raise MultiscaleError("multiscale surface: give a topography file, or --formats for the formats it reads")
+    pixel, unit, cutoff = (_length(o, v) for o, v in (("--pixel-size", args.pixel_size),
+                                                       ("--height-unit", args.height_unit), ("--cutoff", args.cutoff)))
+    try:
+        measurement = read_topography(args.file, args.channel, pixel_size=pixel, height_unit=unit)
+        done = condition(measurement, args.detrend, cutoff, args.max_undefined)
+    except InputError as exc:     # the micro fields by their command-line names
+        name = "FILE" if exc.name == "file" else "--" + exc.name.replace("_", "-")
+        raise InputError(name, exc.value, exc.allowed) from None
+    stats = surface_statistics(done.surface)
+    print("\n".join(done.report))
+    print(f"statistics of the {'roughness' if done.waviness is not None else 'surface'}:")
+    print("\n".join(stats.table()))
+    if args.figure != "none":
+        from multiscale.plots.surface import surface_figure   # matplotlib: only when a figure is drawn
+        path = Path(args.figure or f"{Path(args.file).stem}_surface.png")
+        surface_figure(done.surface, stats, path, f"{Path(args.file).name}, channel {measurement.channel}",
+                       waviness=done.waviness)
+        print(f"figure: {path}")
+    return 0
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="multiscale", description=__doc__)
     sub = parser.add_subparsers(dest="command", required=True)
@@ -102,12 +173,15 @@ def build_parser() -> argparse.ArgumentParser:
     check = sub.add_parser("check", help="validate scene files: every problem at once, or a summary")
     check.add_argument("scenes", nargs="*", metavar="SCENE", help="scene TOML file(s)")
     check.add_argument("--keys", action="store_true", help="print the scene format: every section and key")
+    check.add_argument("--cells", action="store_true", help="estimate the mesh's cell count (trial meshes, seconds)")
     check.set_defaults(func=_check)
     run = sub.add_parser("run", help="run a scene (mpirun -n N multiscale run scene.toml)")
     run.add_argument("scene", metavar="SCENE", help="scene TOML file")
     again = run.add_mutually_exclusive_group()
     again.add_argument("--overwrite", action="store_true", help="replace results already in the output folder")
     again.add_argument("--resume", action="store_true", help="continue from the last checkpoint in the output folder")
+    run.add_argument("--max-cells", type=_count, metavar="N", help="largest mesh (cells) the run may build; "
+                                                                   "overrides geometry.max_cells (default 1e6)")
     run.set_defaults(func=_run)
     study = sub.add_parser("study", help="parametric study: sweep, resumable runs, accuracy-vs-time report "
                                          "(mpiexec -n N multiscale study study.toml)")
@@ -117,6 +191,21 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("--processes", type=int, metavar="N", help="runs at a time (overrides [run] processes)")
     study.add_argument("--problems", action="store_true", help="list the problems, their parameters and metrics")
     study.set_defaults(func=_study)
+    surface = sub.add_parser("surface", help="measured topography: conditioning, statistics (Sq, Sdq, Ssk, Sku, "
+                                             "Nayak, summits, PSD fit) and a figure")
+    surface.add_argument("file", nargs="?", metavar="FILE", help="topography file (x3p, sur, plu, opd, ...; "
+                                                                 "--formats lists them)")
+    surface.add_argument("--channel", type=int, metavar="N", help="channel index (default: the file's default)")
+    surface.add_argument("--detrend", choices=list(DETREND), default="plane", help="form removal (default plane)")
+    surface.add_argument("--cutoff", metavar="LENGTH", help='Gaussian filter cut-off λc, e.g. "0.8 mm": '
+                                                            "keep the roughness, report the waviness")
+    surface.add_argument("--max-undefined", type=float, default=MAX_UNDEFINED, metavar="FRACTION",
+                         help=f"largest share of undefined points that is filled (default {MAX_UNDEFINED})")
+    surface.add_argument("--pixel-size", metavar="LENGTH", help="override the file's pixel size")
+    surface.add_argument("--height-unit", metavar="LENGTH", help='override the file\'s height unit, e.g. "1 um"')
+    surface.add_argument("--figure", metavar="PNG", help="figure path (default FILE-stem_surface.png; none: no figure)")
+    surface.add_argument("--formats", action="store_true", help="list the file formats")
+    surface.set_defaults(func=_surface)
     return parser
 
 

@@ -18,6 +18,9 @@ class InputError(MultiscaleError, ValueError):
         self.name, self.value, self.allowed = name, value, allowed
         super().__init__(f"{name} = {_short(value)}: {allowed}")
 
+    def __reduce__(self):      # pickled as given (MPI broadcasts of an error met by one rank)
+        return type(self), (self.name, self.value, self.allowed)
+
 
 class SceneError(InputError):
     """Bad scene or study file; ``problems`` lists every problem found (one line each)."""
@@ -26,6 +29,13 @@ class SceneError(InputError):
         self.problems = [problems] if isinstance(problems, str) else list(problems)
         MultiscaleError.__init__(self, "\n".join(self.problems))
         self.name, self.value, self.allowed = "scene", None, self.problems[0] if self.problems else ""
+
+    def __reduce__(self):
+        return type(self), (self.problems,)
+
+
+class OutputError(MultiscaleError, OSError):
+    """A result could not be written (disk full, read-only folder, ...); raised on every rank."""
 
 
 class ConvergenceError(MultiscaleError, RuntimeError):

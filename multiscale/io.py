@@ -7,12 +7,15 @@ Fields for ParaView are written by ``multiscale.macro.output``.
 from __future__ import annotations
 
 import sys
+import time
 from pathlib import Path
 
 import h5py
 import numpy as np
 from mpi4py import MPI
 from tqdm import tqdm
+
+from multiscale.errors import OutputError
 
 UNITS = {"time": "s", "force": "N", "pressure": "Pa", "temperature": "K", "heat": "J", "iterations": "-",
          "volume": "m^3", "depth": "m", "rms": "m", "work": "J"}
@@ -59,6 +62,37 @@ class History:
         with h5py.File(path, "r") as f:
             h.columns = {key: list(f[key][...]) for key in f.keys()}
         return h
+
+
+def on_root(comm, write, what: str):
+    """Run ``write()`` on rank 0 only (a file every rank needs written once) and make its failure
+    collective: an ``OSError`` there (disk full, read-only folder) raises ``OutputError`` naming
+    ``what`` on every rank, instead of leaving the others waiting. Returns ``write()``'s value on
+    rank 0, None elsewhere."""
+    value, failure = None, None
+    if comm.rank == 0:
+        try:
+            value = write()
+        except OSError as exc:
+            failure = f"cannot write {what}: {exc.strerror or exc}"
+    failure = comm.bcast(failure, root=0)
+    if failure:
+        raise OutputError(failure)
+    return value
+
+
+def ended_together(comm, timeout: float = 10.0) -> bool:
+    """Called by a rank that met an error: True if every rank of ``comm`` reaches this call within
+    ``timeout`` [s] (the error was collective: each can end cleanly), False if not (another rank is
+    waiting in a collective operation that will never complete: the caller must abort the job)."""
+    if comm.size == 1:
+        return True
+    request, start = comm.Ibarrier(), time.monotonic()
+    while not request.Test():
+        if time.monotonic() - start > timeout:
+            return False
+        time.sleep(0.01)
+    return True
 
 
 def abort_on_exception(comm=None) -> None:

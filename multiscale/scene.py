@@ -24,7 +24,7 @@ from multiscale.errors import InputError, SceneError
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, show, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
-from multiscale.scene_sections import (FIG_7_9_WEAR_RATE, OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings,
+from multiscale.scene_sections import (DEFAULT_GRID, FIG_7_9_WEAR_RATE, OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings,
                                        Layers, Loading, Material, Micro, Output, Roughness, Stability, Time, Vehicle,
                                        Wear)
 
@@ -236,6 +236,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                 problems.append(f'{section}.body = "{table.body}": not a body of {where}; allowed: '
                                 f'{", ".join(g.bodies)}')
         problems += _surface_checks(scene, g, where, effects)
+        if not problems:
+            problems += _nyquist(scene)
     if scene.output is not None and scene.output.fields is not None:
         for f in scene.output.fields:
             missing = [e for e in OUTPUT_FIELDS[f] if e not in effects]
@@ -252,6 +254,24 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         warnings.append('effects "friction" and "thermal" without "heat_partition": no frictional heat '
                         "enters the bodies")
     return ctx.warnings + warnings
+
+
+def _nyquist(scene: Scene) -> list[str]:
+    """A generated surface's k_max within the Nyquist index of the cells it is drawn on (the zone's
+    micro grid, or zones x grid for patch = "face")."""
+    out = []
+    for name in scene.rough_interfaces:
+        own = scene.interfaces.get(name)
+        s = scene.interface_settings(name)
+        r, m = s.roughness, s.micro
+        if r is None or r.rms is None or m is None or m.zones is None:
+            continue
+        cells = [g * (z if r.patch == "face" else 1) for g, z in zip(m.grid or DEFAULT_GRID, m.zones)]
+        if any(k > c // 2 for k, c in zip(r.k_max, cells)):
+            where = f"interfaces.{name}.roughness" if own is not None and own.roughness is not None else "roughness"
+            out.append(f"{where}.k_max = {list(r.k_max)}: must not exceed the Nyquist index {[c // 2 for c in cells]} "
+                       f"of the {'face' if r.patch == 'face' else 'zone'}'s micro grid of {cells} cells")
+    return sorted(set(out))
 
 
 def _surface_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]:

@@ -13,19 +13,22 @@ that ``multiscale check`` reports bodies, volumes, interfaces, areas and normals
 """
 from __future__ import annotations
 
+import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
 from multiscale.errors import InputError
-from multiscale.geometry import GeometrySpec, Rotation, builder, builder_names
+from multiscale.geometry import MAX_CELLS, GeometrySpec, Rotation, builder, builder_names
 from multiscale.schema import (Bad, Choice, FilePath, FrozenMap, Integer, ListOf, Named, OneOf, Quantity,
-                               Section, Text, Vector, key, read, show, unknown_keys)
+                               Section, Text, Vector, key, parse, read, show, unknown_keys)
 from multiscale.schema import reference as schema_reference
 from multiscale.units import UnitError, to_si
 
 _LENGTH = Quantity("length", gt=0)
 _POINT = Vector(Quantity("length"))
 _DIRECTION = Vector(Quantity("dimensionless"))
+# plausible builder parameters by kind (SI; warned outside): lengths of a tribometer or brake part
+_PLAUSIBLE = {"length": (1e-5, 10.0), "angle": (0.0, 6.2832)}
 FILE_TYPES = {".msh": "mesh", ".geo": "script", ".step": "cad", ".stp": "cad", ".iges": "cad", ".igs": "cad",
               ".brep": "cad"}
 
@@ -154,6 +157,7 @@ class Geometry:
     builder: str
     params: object                    # FrozenMap of builder parameters, or a FileGeometry
     spec: GeometrySpec
+    max_cells: int = MAX_CELLS        # a mesh estimated larger is refused before meshing
 
     def module(self):
         """The builder module (parameters, describe, generate)."""
@@ -192,7 +196,8 @@ class Geometry:
 
 
 def _parameter_kind(module, name: str) -> str:
-    """Unit kind of a builder parameter: the module's PARAMETER_KINDS, else angle/length by name."""
+    """Unit kind of a builder parameter: the module's PARAMETER_KINDS ("count": a whole number),
+    else angle/length by name."""
     kinds = getattr(module, "PARAMETER_KINDS", {})
     return kinds.get(name, "angle" if "angle" in name else "length")
 
@@ -209,7 +214,9 @@ class GeometrySection(Section):
         return f"a table with builder = {self.builders.describe()} and its parameters, or file = \"...\""
 
     def reference(self, path) -> list[str]:
-        lines = [f"  {'builder':<20} {self.builders.describe()}  [or file]"]
+        lines = [f"  {'builder':<20} {self.builders.describe()}  [or file]",
+                 f"  {'max_cells':<20} integer >= 1, default {MAX_CELLS}: a mesh estimated larger (trial meshes "
+                 "before meshing) is refused; multiscale run --max-cells overrides it"]
         for name in self.builders.options:
             module = builder(name)
             lines.append(f"  builder = \"{name}\" parameters (SI defaults; 0 = the builder's fallback):")
@@ -221,6 +228,12 @@ class GeometrySection(Section):
         if not isinstance(raw, dict):
             ctx.problems.append(f"{path} = {show(raw)}: must be {self.describe()}")
             return None
+        limit = parse(Integer(ge=1), raw["max_cells"], f"{path}.max_cells", ctx) if "max_cells" in raw else MAX_CELLS
+        raw = {k: v for k, v in raw.items() if k != "max_cells"}
+        geometry = self._read(raw, path, ctx)
+        return None if geometry is None else dataclasses.replace(geometry, max_cells=limit)
+
+    def _read(self, raw, path, ctx):
         if "file" in raw:
             return self._read_file(raw, path, ctx)
         if "builder" not in raw:
@@ -239,11 +252,10 @@ class GeometrySection(Section):
         for param, value in given.items():
             if param in module.DEFAULTS:
                 zero_ok = float(module.DEFAULTS[param]) == 0.0    # 0 means "builder's fallback"
-                parser = Quantity(_parameter_kind(module, param), **({"ge": 0} if zero_ok else {"gt": 0}))
-                try:
-                    params[param] = parser(value, ctx)
-                except Bad as exc:
-                    ctx.problems.append(f"{path}.{param} = {show(value)}: {exc}")
+                kind = _parameter_kind(module, param)
+                parser = Integer(ge=0 if zero_ok else 1) if kind == "count" else \
+                    Quantity(kind, **({"ge": 0} if zero_ok else {"gt": 0}), plausible=_PLAUSIBLE.get(kind))
+                params[param] = parse(parser, value, f"{path}.{param}", ctx)
         if len(ctx.problems) > before:
             return None
         return self._describe(name, module, FrozenMap(params), params, ctx)

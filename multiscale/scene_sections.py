@@ -13,14 +13,26 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from multiscale.errors import InputError
+from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_topography
 from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, ListOf, OneOf, OnlyWith, Pair,
                                Quantity, Requires, Section, TableOr, Tables, Text, Vector, key)
 
-_MODULUS = Quantity("pressure", gt=0)
-_POISSON = Quantity("dimensionless", gt=-1, lt=0.5)
-_CONDUCTIVITY = Quantity("conductivity", gt=0)
+# Plausible ranges (SI) are documented per key (``multiscale check --keys``); a value outside its
+# range is warned, not refused: foams, diamond, cryogenic tests exist, but 1e9 N on a pin is a typo.
+_MODULUS = Quantity("pressure", gt=0, plausible=(1e5, 1.2e12))           # rubber to diamond
+_POISSON = Quantity("dimensionless", gt=-1, lt=0.5, plausible=(0.0, 0.5))
+_CONDUCTIVITY = Quantity("conductivity", gt=0, plausible=(0.01, 2500.0))  # foam to diamond
 _LENGTH = Quantity("length", gt=0)
-_TEMPERATURE = Quantity("temperature", gt=0)
+_TEMPERATURE = Quantity("temperature", gt=0, plausible=(20.0, 2500.0))    # cryogenic to molten iron
+_DENSITY = Quantity("density", gt=0, plausible=(100.0, 23e3))            # cork to osmium
+_SPECIFIC_HEAT = Quantity("specific_heat", gt=0, plausible=(50.0, 5e3))
+_DIFFUSIVITY = Quantity("diffusivity", gt=0, plausible=(1e-8, 1.2e-3))
+_EXPANSION = Quantity("expansion", plausible=(-1e-5, 5e-4))
+_FRICTION = Quantity("dimensionless", ge=0, plausible=(0.0, 2.0))
+_ROUGHNESS = Quantity("length", gt=0, plausible=(1e-10, 1e-3))            # RMS height
+_CONVECTION = Quantity("conductance", ge=0, plausible=(0.0, 1e4))         # still air to boiling water
+_ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0))  # up to ~24 000 rpm
+_WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # Archard k/H
 GRAVITY = 9.80665                  # m/s^2, standard gravity
 
 
@@ -61,11 +73,11 @@ class Material:
 
     E: float | tuple = key(_property(_MODULUS, "E"), required=True)                          # Pa
     nu: float | tuple = key(_property(_POISSON, "nu"), required=True)
-    rho: float | tuple | None = key(_property(Quantity("density", gt=0), "rho"), needed_by=("stability",))  # kg/m^3
+    rho: float | tuple | None = key(_property(_DENSITY, "rho"), needed_by=("stability",))  # kg/m^3
     kappa: float | tuple | None = key(_property(_CONDUCTIVITY, "kappa"), needed_by=("thermal",))  # W/(m K)
-    c: float | tuple | None = key(_property(Quantity("specific_heat", gt=0), "c"))           # J/(kg K)
-    chi: float | tuple | None = key(_property(Quantity("diffusivity", gt=0), "chi"))         # m^2/s
-    alpha: float | tuple | None = key(_property(Quantity("expansion"), "alpha"), needed_by=("expansion",),
+    c: float | tuple | None = key(_property(_SPECIFIC_HEAT, "c"))           # J/(kg K)
+    chi: float | tuple | None = key(_property(_DIFFUSIVITY, "chi"))         # m^2/s
+    alpha: float | tuple | None = key(_property(_EXPANSION, "alpha"), needed_by=("expansion",),
                                       warn_unused=True)                                      # 1/K
     loss_factor: float | None = key(Quantity("dimensionless", ge=0))      # structural damping eta (squeal)
     damping_alpha: float | None = key(Quantity("frequency", ge=0))        # 1/s, Rayleigh: alpha M (squeal)
@@ -129,12 +141,12 @@ class Material:
 class Interface:
     """[interface]: the defaults of every contact interface (perfect-contact baseline, §7.3.1)."""
 
-    penalty: float | None = key(Quantity("stiffness", gt=0), needed_by=("contact",),
+    penalty: float | None = key(Quantity("stiffness", gt=0, plausible=(1e8, 1e19)), needed_by=("contact",),
                                 unless=("roughness",))          # Pa/m, normal penalty stiffness K_n
     partition: float | str | None = key(Either(Quantity("dimensionless", ge=0, le=1),
                                                Choice(("effusivity",))),
                                         needed_by=("heat_partition",), warn_unused=True)  # into body 0
-    conductance: float | None = key(Quantity("conductance", gt=0), needed_by=("conductance",),
+    conductance: float | None = key(Quantity("conductance", gt=0, plausible=(1.0, 1e8)), needed_by=("conductance",),
                                     unless=("roughness",), warn_unused=True)   # W/(m^2 K), h_c
 
 @dataclass(frozen=True)
@@ -144,7 +156,7 @@ class InterfaceSettings:
     interface (its own surface, zones, laws); ``rough = false`` keeps it in perfect contact when
     the scene has effect "roughness"."""
 
-    friction: float | None = key(Quantity("dimensionless", ge=0))     # mu of this interface (default loading.friction)
+    friction: float | None = key(_FRICTION)     # mu of this interface (default loading.friction)
     rough: bool = key(Flag(), default=True)                           # with effect "roughness"
     roughness: object = None          # Roughness of this interface (the merged [roughness] table)
     micro: object = None              # Micro of this interface (the merged [micro] table)
@@ -164,8 +176,8 @@ class Boundary:
 
     surfaces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), required=True)
     fix: tuple | None = key(ListOf(Choice(_COMPONENTS), unique=True, min_len=1))
-    convection: float | tuple | None = key(TableOr(Quantity("conductance", ge=0), Curve(
-        Quantity("angular_speed", ge=0), Quantity("conductance", ge=0), "speed", "h", min_rows=2)))
+    convection: float | tuple | None = key(TableOr(_CONVECTION, Curve(
+        Quantity("angular_speed", ge=0), _CONVECTION, "speed", "h", min_rows=2)))
     emissivity: float | None = key(Quantity("dimensionless", gt=0, le=1))
     ambient: float | None = key(_TEMPERATURE)                        # K, default time.initial_temperature
     temperature: float | None = key(_TEMPERATURE)                    # K, fixed
@@ -209,11 +221,11 @@ class Vehicle:
     load follows from the braking force at the tyre (m a for a stop, m g sin(atan(slope)) for a
     drag): the friction power is then mu F v = that force times the vehicle speed."""
 
-    speed: float | None = key(Quantity("speed", gt=0), required=True)              # m/s, initial
-    wheel_radius: float | None = key(_LENGTH, required=True)                       # m
-    deceleration: float | None = key(Quantity("acceleration", gt=0))               # m/s^2: a stop
-    slope: float | None = key(Quantity("dimensionless", gt=0))                     # grade (rise/run): a drag
-    mass: float | None = key(Quantity("mass", gt=0))                               # kg
+    speed: float | None = key(Quantity("speed", gt=0, plausible=(0.1, 150.0)), required=True)  # m/s, initial
+    wheel_radius: float | None = key(Quantity("length", gt=0, plausible=(0.05, 2.0)), required=True)  # m
+    deceleration: float | None = key(Quantity("acceleration", gt=0, plausible=(0.01, 15.0)))  # m/s^2: a stop
+    slope: float | None = key(Quantity("dimensionless", gt=0, plausible=(0.0, 0.5)))  # grade (rise/run): a drag
+    mass: float | None = key(Quantity("mass", gt=0, plausible=(1.0, 1e7)))                               # kg
 
     rules = (OneOf(("deceleration", "slope")),)
 
@@ -267,18 +279,18 @@ class Loading:
     ``friction_curve`` or a ``stribeck`` law, taken per interface facet at its steady slip speed;
     its slope enters the modal analysis as damping."""
 
-    normal_force: float | None = key(Quantity("force", gt=0))                 # N
-    pressure: float | None = key(Quantity("pressure", gt=0))                  # Pa
+    normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)))                 # N
+    pressure: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e9)))  # Pa
     faces: tuple | None = key(ListOf(Text(), unique=True, min_len=1))         # where the load acts
     direction: tuple | None = key(Vector(Quantity("dimensionless")))         # traction direction (else -n)
     load_profile: tuple | None = key(Curve(Quantity("time", ge=0), Quantity("dimensionless", ge=0),
                                            "time", "factor"))                 # ((s, -), ...)
-    rotation_speed: float | None = key(Quantity("angular_speed", ge=0))       # rad/s (rotation builders)
-    speed_profile: tuple | None = key(Curve(Quantity("time", ge=0), Quantity("angular_speed", ge=0),
+    rotation_speed: float | None = key(_ANGULAR_SPEED)       # rad/s (rotation builders)
+    speed_profile: tuple | None = key(Curve(Quantity("time", ge=0), _ANGULAR_SPEED,
                                             "time", "speed"))                 # ((s, rad/s), ...)
     vehicle: Vehicle | None = key(Section(Vehicle))
-    sliding_speed: float | None = key(Quantity("speed", ge=0))                # m/s (translation builders)
-    friction: float | None = key(Quantity("dimensionless", ge=0))             # mu
+    sliding_speed: float | None = key(Quantity("speed", ge=0, plausible=(0.0, 200.0)))  # m/s (translation builders)
+    friction: float | None = key(_FRICTION)                                   # mu
     ramp_steps: int = key(Integer(ge=1), default=1)       # load increments of the first mechanical solve
     friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), Quantity("dimensionless", ge=0),
                                              "slip speed", "mu", min_rows=2))  # ((m/s, -), ...)
@@ -331,10 +343,10 @@ class Loading:
 class Time:
     """Staggered time loop (Fig. 7.4): ``steps`` macro steps Δt over ``end``, each in ``substeps``."""
 
-    end: float | None = key(Quantity("time", gt=0), needed_by=("thermal", "wear"))  # s
+    end: float | None = key(Quantity("time", gt=0, plausible=(1e-6, 1e6)), needed_by=("thermal", "wear"))  # s
     steps: int = key(Integer(ge=1), default=1)
     substeps: int = key(Integer(ge=1), default=1)
-    initial_temperature: float = key(Quantity("temperature", gt=0), default=293.15)  # K
+    initial_temperature: float = key(_TEMPERATURE, default=293.15)  # K
 
     @property
     def dt(self) -> float | None:
@@ -361,42 +373,66 @@ class Output:
 class Roughness:
     """Rough face of one body (§7.3.1: only the pin is rough): generated (fractal, Eqs. 1.24–1.25)
     or measured. Cut-offs are wavelengths per generated patch; ``patch`` says whether one surface
-    is generated for the whole face and cut into zones, or one per zone (per-zone seeds)."""
+    is generated for the whole face and cut into zones, or one per zone (per-zone seeds).
+
+    A measured ``file`` (issue 17; ``multiscale.micro.topography``): any format SurfaceTopography
+    reads (x3p, sur, plu, opd, ...) with its own units and pixel sizes (``pixel_size`` and
+    ``height_unit`` override them, with a warning), or a plain height matrix (.npy, .txt, .csv,
+    .asc: ``pixel_size`` needed, ``height_unit`` default 1 m). It is conditioned (``detrend``,
+    undefined points filled up to ``max_undefined``, Gaussian filter at ``cutoff``), then
+    ``cover``s the face: the measurement itself ("measured": it must cover the face), copies
+    ("mirror", "tile": warned) or a statistically equivalent surface from its PSD ("equivalent",
+    drawn with ``seed``). ``multiscale check`` reads the file's header and heights, nothing more."""
 
     body: str | None = key(Text())               # the stationary (rough) side; default: that side
-    rms: float | None = key(_LENGTH)                                          # m
-    hurst: float | None = key(Quantity("dimensionless", gt=0, le=1))
+    rms: float | None = key(_ROUGHNESS)                                        # m
+    hurst: float | None = key(Quantity("dimensionless", gt=0, le=1, plausible=(0.1, 1.0)))
     k_min: tuple | None = key(Pair(Quantity("dimensionless", gt=0)))          # wavelengths, (x, y)
     k_max: tuple | None = key(Pair(Quantity("dimensionless", gt=0)))
     seed: int = key(Integer(ge=0), default=0)
     patch: str = key(Choice(("face", "zone")), default="face")
-    file: Path | None = key(FilePath())                                       # .npy / .txt / .csv heights
-    pixel_size: tuple | None = key(Pair(_LENGTH))                             # m, (dx, dy) of the file
-    height_unit: float = key(_LENGTH, default=1.0)                            # m per file height unit
+    file: Path | None = key(FilePath())                                       # measured topography
+    channel: int | None = key(Integer(ge=0))                                  # default: the file's default
+    pixel_size: tuple | None = key(Pair(_LENGTH))                             # m, (dx, dy): overrides the file's
+    height_unit: float | None = key(_LENGTH)                                  # m per file height unit
+    detrend: str = key(Choice(tuple(DETREND)), default="plane")               # form removal
+    cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)))  # m, Gaussian filter λc
+    max_undefined: float = key(Quantity("dimensionless", ge=0, le=1), default=MAX_UNDEFINED)
+    cover: str = key(Choice(COVER), default="measured")
 
     rules = (OneOf(("rms", "file"), required=True), Requires("rms", ("hurst", "k_min", "k_max")),
-             Requires("file", ("pixel_size",)), OnlyWith("rms", ("hurst", "k_min", "k_max", "seed", "patch")),
-             OnlyWith("file", ("pixel_size", "height_unit")))
+             OnlyWith("rms", ("hurst", "k_min", "k_max", "patch")),
+             OnlyWith("file", ("channel", "pixel_size", "height_unit", "detrend", "cutoff", "max_undefined", "cover")))
 
     def problems(self, path, ctx):
         if self.rms is not None and any(hi <= lo for lo, hi in zip(self.k_min, self.k_max)):
             return [f"{path}.k_max = {list(self.k_max)}: must exceed k_min = {list(self.k_min)}"]
-        return []
+        if self.file is None:
+            return []
+        problems, notes = probe_topography(self.file, self.channel, pixel_size=self.pixel_size,
+                                           height_unit=self.height_unit, max_undefined=self.max_undefined,
+                                           prefix=f"{path}.")
+        ctx.warnings.extend(notes)
+        return problems
+
+
+DEFAULT_GRID = (50, 50)    # cells per zone without micro.grid (generated surfaces)
 
 
 @dataclass(frozen=True)
 class Micro:
-    """How the rough interface is solved (issue 7): zone grid on the interface, grid per zone,
-    micro model, points of each p_n(g_n) law (top node at ``p_max``, default 20 x the nominal
+    """How the rough interface is solved (issue 7): zone grid on the interface, grid per zone
+    (default 50 x 50; a measured surface's own pixel size, rounded, unless it is replaced by a
+    statistically equivalent one), micro model, points of each p_n(g_n) law (top node at ``p_max``, default 20 x the nominal
     interface pressure; contact solver tolerance ``tol``), micro partition law (ch. 6) or the
     constant one."""
 
     zones: tuple | None = key(Pair(Integer(ge=1)), required=True)             # (nx, ny) zones
-    grid: tuple = key(Pair(Integer(ge=8)), default=(50, 50))                  # (nx, ny) per zone
+    grid: tuple | None = key(Pair(Integer(ge=8)))                             # (nx, ny) per zone
     model: str = key(Choice(("fft-bem", "asperity", "asperity-interacting")), default="fft-bem")
     law_points: int = key(Integer(ge=4), default=20)
     partition_law: bool = key(Flag(), default=False)
-    p_max: float | None = key(Quantity("pressure", gt=0))                     # Pa, top node of the laws
+    p_max: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e10)))  # Pa, top node of the laws
     tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)     # micro contact solves
 
     def problems(self, path, ctx):
@@ -418,8 +454,8 @@ class Wear:
     shape of thesis Fig. 7.9, ``FIG_7_9_WEAR_RATE``). Every ``update_every`` macro steps the zones
     wear over the sliding of those steps in ``substeps`` load-controlled increments."""
 
-    k_w: float | None = key(Quantity("wear_rate", gt=0))                      # 1/Pa
-    k_w_table: tuple | None = key(Curve(Quantity("temperature", gt=0), Quantity("wear_rate", ge=0),
+    k_w: float | None = key(_WEAR_RATE)                      # 1/Pa
+    k_w_table: tuple | None = key(Curve(_TEMPERATURE, Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)),
                                         "temperature", "k_w"))                # ((K, 1/Pa), ...)
     update_every: int = key(Integer(ge=1), default=1)                         # macro steps per update
     substeps: int = key(Integer(ge=1), default=1)                             # wear increments per update
@@ -436,7 +472,7 @@ class Wear:
 
 @dataclass(frozen=True)
 class Layer:
-    thickness: float = key(_LENGTH, required=True)                            # m
+    thickness: float = key(Quantity("length", gt=0, plausible=(1e-9, 0.1)), required=True)  # m
     E: float = key(_MODULUS, required=True)                                   # Pa
     nu: float = key(_POISSON, required=True)
     kappa: float | None = key(_CONDUCTIVITY, needed_by=("thermal",))          # W/(m K)
@@ -530,15 +566,16 @@ class Stability:
     gyroscopic terms are not: the damped problem is then solved as a full quadratic eigenproblem
     (``method = "quadratic"``, exact, viscous damping only: the default for it) or by projection
     on the undamped modes up to ``basis`` x the band's top (``"projection"``, the default with loss
-    factors; approximate for damping localised at the interface: see ``multiscale.macro.damped``). ``prestress`` adds the initial-stress
-    stiffness of the preloaded state (and reports its effect on every frequency); ``gyroscopic``
-    the Coriolis and centrifugal terms of the rotating body at the loading speed."""
+    factors; approximate for damping localised at the interface: see ``multiscale.macro.damped``).
+    ``prestress`` adds the initial-stress stiffness of the preloaded state (and reports its effect
+    on every frequency); ``gyroscopic`` the Coriolis and centrifugal terms of the rotating body at
+    the loading speed."""
 
     band: tuple = key(Pair(Quantity("frequency", ge=0), single=False, names="[low, high]"),
                       default=(0.0, 16e3))                                    # Hz
     modes: int | None = key(Integer(ge=1), required=True)
     target: float | None = key(Quantity("frequency", ge=0))                   # Hz; default: the band's lower edge
-    damping: float = key(Quantity("dimensionless", ge=0), default=0.0)        # structural loss factor
+    damping: float = key(Quantity("dimensionless", ge=0, plausible=(0.0, 0.5)), default=0.0)  # structural loss factor
     rayleigh_alpha: float = key(Quantity("frequency", ge=0), default=0.0)     # 1/s
     rayleigh_beta: float = key(Quantity("time", ge=0), default=0.0)           # s
     prestress: bool = key(Flag(), default=False)

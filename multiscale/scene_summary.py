@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import math
 
+from multiscale.geometry import estimate_cells
 from multiscale.scene import EFFECTS, OUTPUT_FIELDS, Scene
 from multiscale.schema import reference as schema_reference
 
@@ -85,12 +86,24 @@ def _effect_line(scene: Scene, effect: str) -> str:
         return f"h_c = {i.conductance:g} W/(m^2 K)" if not scene.has("roughness") else "h_c(p) per zone (micro)"
     if effect == "roughness":
         r, m = scene.roughness, scene.micro
-        surface = f"RMS {r.rms * 1e6:g} um, H {r.hurst:g}" if r.rms is not None else f"file {r.file.name}"
-        return (f"{r.body or scene.bodies[0]}: {surface}; {m.zones[0]} x {m.zones[1]} zones of {m.grid[0]} x {m.grid[1]} cells, "
-                f"{m.law_points}-point laws")
+        surface = f"RMS {r.rms * 1e6:g} um, H {r.hurst:g}" if r.rms is not None else \
+            f"file {r.file.name} ({r.cover}" + (f", seed {r.seed})" if r.cover == "equivalent" else ")")
+        measured_pixels = r.file is not None and r.cover != "equivalent"
+        cells = f"{m.grid[0]} x {m.grid[1]} cells" if m.grid else \
+            "the measurement's pixel size" if measured_pixels else "50 x 50 cells"
+        return f"{r.body or scene.bodies[0]}: {surface}; {m.zones[0]} x {m.zones[1]} zones of {cells}, {m.law_points}-point laws"
     if effect == "wear":
         w = scene.wear
         rate = f"k_w = {w.k_w:g} 1/Pa" if w.k_w is not None else (
             "k_w(T) table" if w.k_w_table is not None else "k_w(T) of thesis Fig. 7.9 (default)")
         return f"Archard, {rate}, every {w.update_every} step(s) in {w.substeps} increment(s)"
     return EFFECTS[effect].doc
+
+
+def cells_line(scene: Scene) -> str:
+    """The mesh's estimated cell count against its limit (``check --cells``; runs gmsh trials)."""
+    g = scene.geometry
+    e = estimate_cells(g.module(), g.params if g.builder == "file" else dict(g.params))
+    how = "exact" if e.exact else f"from a trial mesh {e.factor:.3g}x coarser with {e.trial} cells"
+    verdict = "refused by run" if e.cells > g.max_cells else "within"
+    return f"  mesh      about {e.cells:,} cells ({how}); {verdict} geometry.max_cells = {g.max_cells:,}"

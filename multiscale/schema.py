@@ -24,7 +24,7 @@ from multiscale.units import KINDS, UnitError, to_si
 
 __all__ = ["Bad", "Choice", "Context", "Curve", "Either", "FilePath", "Flag", "FrozenMap",
            "Integer", "ListOf", "Named", "OneOf", "OnlyWith", "Pair", "Quantity", "Requires",
-           "Section", "TableOr", "Tables", "Text", "Vector", "fields_of", "key", "read", "reference", "show",
+           "Section", "TableOr", "Tables", "Text", "Vector", "fields_of", "key", "parse", "read", "reference", "show",
            "suggest", "unknown_keys"]
 
 
@@ -35,13 +35,14 @@ class Bad(ValueError):
 @dataclass
 class Context:
     """What a table is read against: active effects, the scene directory; collected problems and
-    warnings (keys given but unused by the active effects)."""
+    warnings (keys given but unused by the active effects, values outside their plausible range)."""
 
     effects: frozenset = frozenset()
     directory: Path = Path(".")
     root: dict = field(default_factory=dict)        # the whole raw file (tables that merge others)
     problems: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    implausible: list[str] = field(default_factory=list)   # of the value being read: warnings with its path
 
 
 class FrozenMap(Mapping):
@@ -105,10 +106,13 @@ def _a(words: str) -> str:
 
 # ---------------------------------------------------------------- value parsers
 class Quantity:
-    """A physical quantity of a units.KINDS kind, converted to SI, with an optional range."""
+    """A physical quantity of a units.KINDS kind, converted to SI, with an optional range (outside
+    it: a problem) and an optional ``plausible`` range (lo, hi) in SI (outside it: a warning, e.g. a
+    load of 1e9 N on a pin; the value is still used)."""
 
-    def __init__(self, kind: str, *, gt=None, ge=None, lt=None, le=None):
+    def __init__(self, kind: str, *, gt=None, ge=None, lt=None, le=None, plausible=None):
         self.name, self.kind, self.gt, self.ge, self.lt, self.le = kind, KINDS[kind], gt, ge, lt, le
+        self.plausible = plausible
 
     def _range(self) -> str:
         unit = f" {self.kind.si}" if self.kind.si else ""
@@ -126,7 +130,13 @@ class Quantity:
     def describe(self) -> str:
         rng = self._range()
         examples = f" ({self.kind.examples})" if self.kind.examples not in ("", self.kind.si) and self.kind.si else ""
-        return f"{_a(self.kind.name)}{' ' + rng if rng else ''}{examples}"
+        return f"{_a(self.kind.name)}{' ' + rng if rng else ''}{examples}{self._plausible()}"
+
+    def _plausible(self) -> str:
+        if self.plausible is None:
+            return ""
+        unit = f" {self.kind.si}" if self.kind.si else ""
+        return f", plausibly {_number(self.plausible[0])} to {_number(self.plausible[1])}{unit}"
 
     def __call__(self, raw, ctx):
         try:
@@ -138,6 +148,10 @@ class Quantity:
         if not ok:
             shown = "" if not isinstance(raw, str) else f" (got {v:g} {self.kind.si})".replace(" )", ")")
             raise Bad(f"must be {self._range()}{shown}")
+        if self.plausible is not None and not self.plausible[0] <= v <= self.plausible[1]:
+            unit = f" {self.kind.si}" if self.kind.si else ""
+            ctx.implausible.append(f"{v:g}{unit} is outside the plausible range {_number(self.plausible[0])} to "
+                                   f"{_number(self.plausible[1])}{unit}: check the value and its unit")
         return v
 
 
@@ -334,6 +348,8 @@ class FilePath:
     def __call__(self, raw, ctx):
         if not isinstance(raw, str) or not raw:
             raise Bad(f"must be {self.describe()}")
+        if "\x00" in raw:
+            raise Bad("holds a NUL character; a path cannot")
         path = (ctx.directory / Path(raw).expanduser()).resolve()
         if self.folder and path.exists() and not path.is_dir():
             raise Bad(f"exists and is not a folder ({path})")
@@ -485,6 +501,19 @@ def unknown_keys(raw, allowed, path: str, ctx: Context, what: str = "key") -> se
     return typos
 
 
+def parse(parser, raw, where: str, ctx: Context):
+    """``raw`` read by ``parser``: the value, or None with a problem naming ``where``; values outside
+    their plausible range become warnings naming ``where``."""
+    try:
+        return parser(raw, ctx)
+    except Bad as exc:
+        ctx.problems.append(f"{where} = {show(raw)}: {exc}")
+        return None
+    finally:
+        ctx.warnings.extend(f"{where} = {show(raw)}: {note}" for note in dict.fromkeys(ctx.implausible))
+        ctx.implausible.clear()
+
+
 def fields_of(cls):
     """(name, Spec) of the TOML keys of a table class."""
     return [(f.name, f.metadata["spec"]) for f in dataclasses.fields(cls) if "spec" in f.metadata]
@@ -517,10 +546,10 @@ def read(cls, raw, path: str, ctx: Context):
             elif spec.parser.always or effect:       # absent: defaults, and name what is missing
                 values[name] = spec.parser.read({}, where, ctx)
         elif name in raw:
-            try:
-                values[name] = spec.parser(raw[name], ctx)
-            except Bad as exc:
-                ctx.problems.append(f"{where} = {show(raw[name])}: {exc}")
+            n = len(ctx.problems)
+            value = parse(spec.parser, raw[name], where, ctx)
+            if len(ctx.problems) == n:
+                values[name] = value
             if spec.warn_unused and not any(e in ctx.effects for e in spec.needed_by):
                 users = " or ".join(f'"{e}"' for e in spec.needed_by)
                 ctx.warnings.append(f"{where} is ignored: effect {users} is not in effects")

@@ -191,6 +191,8 @@ class _Parser:
         if kind == "name":
             return _lookup(tok)
         if kind == "num" or (kind == "op" and tok.isdigit()):
+            if self.i != 1 or _F(tok) != 1:      # only the 1 of "1/K": "0.4 5" is a typo, not 2.0
+                raise UnitError(f'a number ("{tok}") inside a unit: only "1/<unit>" may start with one')
             return _F(tok), ONE
         if tok == "(":
             inner = self.expr()

@@ -296,6 +296,21 @@ def test_resume_after_an_interrupted_run_gives_the_straight_history(straight, tm
         (reference.folder / "interface.xdmf").read_text().count("<Time ")
 
 
+def test_resume_of_a_finished_run_has_nothing_to_do(straight, capsys):
+    """--resume of a run that ended reads its results and says so: no model is built, nothing is
+    written (the checkpoint and the history keep their bytes)."""
+    from multiscale.workflows.multiscale import run
+    scene, reference = straight
+    ckpt, h5 = reference.folder / "checkpoint.h5", reference.history_file
+    before = ckpt.read_bytes(), h5.read_bytes()
+    again = run(scene, resume=True)
+    assert "nothing to do" in capsys.readouterr().out
+    assert again.steps_done == 2 and again.wall_time == 0.0
+    assert (ckpt.read_bytes(), h5.read_bytes()) == before
+    np.testing.assert_array_equal(again.history["time"], reference.history["time"])
+    assert sorted(again.field_files) == sorted(reference.field_files)
+
+
 def test_micro_conductance_couples_the_temperature_fields(tmp_path):
     """Effect "conductance" with roughness: h_c of each loaded zone (micro conduction) on its
     facets, 0 on the others; the exchange conserves the heat of the two bodies."""
@@ -317,7 +332,11 @@ def test_micro_conductance_couples_the_temperature_fields(tmp_path):
 def test_scene_errors_of_the_loop(tmp_path):
     from multiscale.workflows.multiscale import run
     scene = loads(POD.format(folder=tmp_path / "none"))
-    with pytest.raises(InputError, match="checkpoint"):
+    with pytest.raises(InputError, match="does not exist: there is nothing to resume"):
+        run(scene, resume=True, verbose=False)
+    assert not (tmp_path / "none").exists()        # refused, not created
+    (tmp_path / "none").mkdir()
+    with pytest.raises(InputError, match="no checkpoint.h5"):
         run(scene, resume=True, verbose=False)
     disc_rough = loads(POD.format(folder=tmp_path / "x").replace('body = "pin"', 'body = "disc"'))
     with pytest.raises(InputError, match="stationary"):

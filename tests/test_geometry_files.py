@@ -1,7 +1,6 @@
 """Geometry from the user's files (issue 16): the pin-on-disc of the built-in builder described as a
 gmsh mesh (.msh), a gmsh script (.geo, in mm) and CAD (.step) gives the builder's results, and bad
 input is one clear line with exit code 2, nothing written."""
-from pathlib import Path
 
 import numpy as np
 import pytest

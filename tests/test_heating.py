@@ -72,7 +72,8 @@ def test_pulse_tables_sum_to_the_pointwise_step_response():
     for m in (1, 6):
         ref = fixed_rectangle_temperature(X, Y, m * dt, dx / 2, dx / 2, PIN)
         got = step[m - 1][(Y / dx).round().astype(int) % (2 * n), (X / dx).round().astype(int) % (2 * n)]
-        assert got == pytest.approx(ref, rel=1e-12)
+        # round-off of the summed tables is relative to the largest value (the far point is 1e-4 of it)
+        np.testing.assert_allclose(got, ref, rtol=0, atol=1e-12 * ref.max())
 
 
 def test_fixed_closed_form_route_equals_direct_quadrature_at_rest():
@@ -101,7 +102,9 @@ def test_far_axis_table_matches_the_exact_rotating_kernel():
     off = np.where(np.arange(2 * n) < n, np.arange(2 * n), np.arange(2 * n) - 2 * n) * dx
     exact = moving_rectangle_temperature(off[None, :], off[:, None], 1e-3, dx / 2, dx / 2, DISC, motion)
     assert np.max(np.abs(exact - table)) < 2e-3 * table.max()
-    assert np.unravel_index(np.argmax(table), table.shape) != (0, 0) or table[0, 0] > 0
+    # the disc moves along (-1, 1)/sqrt(2) there: the heat is carried downstream, (dx, dy) = (-1, +1)
+    # cells, not upstream (+1, -1) (rows are y offsets, columns x; -1 is index 2n - 1)
+    assert table[1, 2 * n - 1] > 100 * table[2 * n - 1, 1]
 
 
 def rosenthal_square(pe, m=72):
@@ -357,7 +360,8 @@ def test_partition_law_from_surface_and_from_contact_result_agree():
     assert np.all((law.partition_1 > 0.5) & (law.partition_1 < 1))
     assert np.all(law.partition_1[1] > law.partition_1[0])               # faster: more into the disc
     assert law(4e6, 10.0) == pytest.approx(law.partition_1[1, 1], rel=1e-12)
-    assert law(2e6, 5.5) == pytest.approx(law.partition_1[:, :2].mean(axis=0).mean(), rel=0.02)
+    # linear in log p and in V: 2 MPa and 5.5 m/s are the midpoints of (1, 4) MPa and (1, 10) m/s
+    assert law(2e6, 5.5) == pytest.approx(law.partition_1[:, :2].mean(axis=0).mean(), rel=1e-12)
     contact = ContactSolver(ELASTIC, s.shape, s.dx, periodic=True).solve(
         np.broadcast_to(s.heights, (3,) + s.shape), load=loads)
     again = partition_law(contact, DISC, PIN, 10.0, mu=0.4, dx=s.dx)

@@ -97,7 +97,9 @@ def test_layer_on_rigid_base_matches_carbone_mangialardi_and_oedometric_limit(nu
     oedometric = oedometric_compliance(h, E, nu)
     assert lay.static_compliance == pytest.approx(oedometric, rel=1e-14)
     assert lay.compliance(np.array([0.0]))[0] == lay.static_compliance
-    assert F[0] == pytest.approx(oedometric, rel=1e-12)          # k h = 1e-6
+    # k h = 1e-6: the limit is approached more slowly as the layer becomes incompressible
+    # (measured 1.7e-10 at nu = 0.499, below 1e-12 otherwise)
+    assert F[0] == pytest.approx(oedometric, rel=1e-12 / (1 - 2 * nu))
 
 
 def test_stacks_match_60_digit_propagator():

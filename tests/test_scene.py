@@ -330,6 +330,31 @@ def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
                                 "heat enters the bodies",)
 
 
+@pytest.mark.parametrize("old, new, warning", [
+    ('initial_temperature = "20 degC"', 'initial_temperature = "1e-300 K"',
+     'time.initial_temperature = "1e-300 K": 1e-300 K is outside the plausible range 20 to 2500 K'),
+    ('pressure = "10 bar"', 'pressure = "1e9 MPa"', 'loading.pressure = "1e9 MPa": 1e+15 Pa is outside'),
+    ('E = "4 GPa"', 'E = "4 Pa"', "materials.block.E = \"4 Pa\": 4 Pa is outside the plausible range 100000"),
+    ("friction = 0.4", "friction = 40", "loading.friction = 40: 40 is outside the plausible range 0 to 2"),
+    ('mesh_size = "2 mm"', 'mesh_size = "20 m"', 'geometry.mesh_size = "20 m": 20 m is outside'),
+    ('kappa = "5 W/(m K)"', 'kappa = [["20 degC", "5 W/(m K)"], ["3000 degC", "6 W/(m K)"]]',
+     'materials.block.kappa = [["20 degC", "5 W/(m K)"], ["3000 degC", "6 W/(m K)"]]: 3273.15 K is outside'),
+])
+def test_implausible_values_are_warned_with_their_path(tmp_path, old, new, warning):
+    """A value outside its documented plausible range (check --keys) runs, with one warning naming the
+    key, the value in SI and the range; plausible values give none."""
+    assert loads(GOOD, tmp_path).warnings == ()
+    assert old in GOOD
+    scene = loads(GOOD.replace(old, new, 1), tmp_path)
+    assert len(scene.warnings) == 1 and scene.warnings[0].startswith(warning), scene.warnings
+    assert scene.warnings[0].endswith("check the value and its unit")
+
+
+def test_no_shipped_scene_is_implausible():
+    for path in sorted(DEMOS.glob("*.toml")):
+        assert not [w for w in load(path).warnings if "plausible" in w], path
+
+
 def test_reference_lists_every_section_and_key():
     from multiscale.scene import Scene
     from multiscale.scene_summary import reference
@@ -379,3 +404,21 @@ def test_any_wrong_type_anywhere_is_a_scene_error(tmp_path):
                 assert exc.problems and all(isinstance(p, str) and p for p in exc.problems)
                 outcomes["error"] += 1
     assert outcomes["error"] > 10 * outcomes["ok"] > 0
+
+
+@pytest.mark.parametrize("old, new, fragment", [
+    ("friction = 0.4", 'friction = "0.4 5"', 'a number ("5") inside a unit'),       # was read as 2.0
+    ('mesh_size = "2 mm"', 'mesh_size = "2 mm 2"', 'a number ("2") inside a unit'),
+    ('folder = "out/run1"', 'folder = "out/\\u0000run"', "NUL character"),       # a TOML escape
+])
+def test_typos_that_used_to_pass_are_problems(tmp_path, old, new, fragment):
+    assert old in GOOD
+    with pytest.raises(SceneError) as info:
+        loads(GOOD.replace(old, new, 1), tmp_path)
+    assert len(info.value.problems) == 1 and fragment in info.value.problems[0], info.value.problems
+
+
+def test_a_fractional_number_of_vanes_is_a_problem():
+    brake = (Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml")
+    with pytest.raises(SceneError, match="geometry.vanes = 2.5: must be an integer >= 0"):
+        load(brake, {"geometry.vanes": 2.5})

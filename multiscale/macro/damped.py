@@ -13,8 +13,8 @@ H += eta K. ``solve_system`` picks the method:
 - ``"quadratic"`` (``"auto"`` with viscous damping only): SLEPc PEP on (K, C + alpha M + beta K,
   M) over the whole model, exact;
 - ``"projection"`` (``"auto"`` with hysteretic terms, which the real PEP cannot take): the
-  complex modes of the undamped, friction-coupled system (K, M) up to ``basis`` x f_max span a real M-orthonormal basis V (``Subspace``); the
-  reduced quadratic problem (lambda^2 V'MV + lambda V'CV + V'(K + iH)V) q = 0 is solved densely
+  complex modes of the undamped, friction-coupled system (K, M) up to ``basis`` x f_max span a
+  real M-orthonormal basis V (``Subspace``); the reduced quadratic problem (lambda^2 V'MV + lambda V'CV + V'(K + iH)V) q = 0 is solved densely
   (companion form), phi = V q. This is the subspace projection of commercial complex-eigenvalue
   solvers (Abaqus projects on the undamped modes of the symmetrised stiffness; here the basis
   already holds the friction coupling). Its accuracy is reported per mode: the relative residual

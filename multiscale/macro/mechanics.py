@@ -19,6 +19,7 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc as fpetsc
+from mpi4py import MPI
 from petsc4py import PETSc
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
@@ -168,6 +169,7 @@ class Mechanics:
         reason, its = snes.getConvergedReason(), snes.getIterationNumber()
         history = list(self._history)
         finite = all(np.isfinite(history)) and all(np.isfinite(u.x.array).all() for u in self.u)
+        finite = bool(self.tm.comm.allreduce(finite, op=MPI.LAND))     # every rank decides alike
         result = SolveResult(reason > 0 and finite, reason, its, history)
         if not result.converged:
             raise ConvergenceError(

@@ -24,8 +24,8 @@ from dolfinx import fem
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
-from multiscale.errors import InputError
-from multiscale.geometry import BodySpec, GeometrySpec
+from multiscale.errors import InputError, MultiscaleError
+from multiscale.geometry import BodySpec, GeometrySpec, check_cells
 
 INTERFACE_QUADRATURE = 2      # exact for P1 displacements times P1 tests on a facet
 
@@ -277,24 +277,36 @@ class FormCache:
         return self.facet_integrals(key, make) / self.tm.interface.areas
 
 
-def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometrySpec | None = None) -> TwoBodyMesh:
+def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometrySpec | None = None,
+          max_cells: int | None = None) -> TwoBodyMesh:
     """Run a gmsh builder (``multiscale.geometry``) on rank 0 and distribute the mesh (shared-facet
-    ghosting); ``spec`` (default: the builder's ``describe``) tags bodies, faces and interfaces."""
+    ghosting); ``spec`` (default: the builder's ``describe``) tags bodies, faces and interfaces.
+    With ``max_cells``, a mesh estimated larger is refused before meshing (``check_cells``: an
+    InputError on every rank)."""
     spec = spec or builder.describe(params)
     name = getattr(builder, "NAME", builder.__name__)
     error = None
     if comm.rank == 0:
         import gmsh   # rank 0 alone builds the geometry
+        try:
+            if max_cells is not None:
+                check_cells(builder, params, max_cells)      # gmsh sessions of its own, before ours
+        except MultiscaleError as exc:
+            error = exc
         gmsh.initialize(interruptible=False)
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.option.setNumber("General.NumThreads", 1)
         gmsh.model.add(name)
         try:
-            builder.generate(gmsh.model, params)
+            if error is None:
+                builder.generate(gmsh.model, params)
         except Exception as exc:  # re-raised on every rank below
             error = exc
-    failed = comm.bcast(repr(error) if error is not None else None, root=0)
+    failed = comm.bcast(error if isinstance(error, MultiscaleError) else repr(error) if error is not None else None,
+                        root=0)
     try:
+        if isinstance(failed, MultiscaleError):
+            raise failed
         if failed:
             if error is not None:
                 raise error

@@ -40,7 +40,7 @@ exact circle and is small on the faceted rim of the mesh (chords: w·n changes s
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
@@ -297,7 +297,8 @@ class Thermal:
             old.x.array[:] = new.x.array
         self.problem.solve()
         snes = self.problem.solver
-        ok = snes.getConvergedReason() > 0 and all(np.isfinite(T.x.array).all() for T in self.T)
+        finite = bool(self.tm.comm.allreduce(all(np.isfinite(T.x.array).all() for T in self.T), op=MPI.LAND))
+        ok = snes.getConvergedReason() > 0 and finite             # the same answer on every rank
         if not ok:
             raise ConvergenceError(f"heat step at t = {self.time + dt:.6g} s failed "
                                    f"(SNES reason {snes.getConvergedReason()}, "

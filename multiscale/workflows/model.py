@@ -113,7 +113,7 @@ def build_mesh(scene, comm=MPI.COMM_WORLD) -> two_body.TwoBodyMesh:
     """The scene's mesh (gmsh on rank 0, distributed), with the scene's supports and loads."""
     g = scene.geometry
     params = g.params if g.builder == "file" else dict(g.params)
-    return two_body.build(g.module(), params, comm, spec=scene_spec(scene))
+    return two_body.build(g.module(), params, comm, spec=scene_spec(scene), max_cells=g.max_cells)
 
 
 def build_mechanics(scene, tm, *, law=None, temperatures=None, degree: int = 1,

@@ -107,6 +107,9 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     ckpt = folder / CHECKPOINT
     if resume and not comm.bcast(ckpt.is_file() if comm.rank == 0 else None, root=0):
         raise InputError("--resume", str(folder), f"no {CHECKPOINT} in the output folder to resume from")
+    stored = checkpoint.peek(ckpt, comm) if resume else {}
+    if stored.get("finished"):
+        return finished(folder, scene.name, int(stored["step"]), comm, verbose)
     ms = build(scene, comm, progress=verbose and comm.rank == 0)
     steps = scene.time.steps if (ms.model.thermal is not None or scene.has("wear")) else 0
     every = scene.output.every
@@ -132,6 +135,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         done = n
     h5, png = write_history(history, folder, scene.name, comm)
     plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
+    if done == steps:
+        checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
     result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones] + maps, _time.perf_counter() - start,
                               history, h5, png, writer.files, plot, maps, zones, done)
     del ms, writer            # the model holds reference cycles of PETSc objects: free them on every
@@ -142,6 +147,19 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         print(f"  ParaView: {', '.join(str(f) for f in result.field_files)}")
         print(f"  history:  {h5}  plots: {', '.join(str(p) for p in [png, plot] + maps)}")
     return result
+
+
+def finished(folder: Path, name: str, steps: int, comm, verbose: bool) -> MultiscaleResult:
+    """The results of a run that ended (``--resume`` of a finished run: nothing to do), from its files."""
+    history = io.History.read(folder / "history.h5")
+    fields = sorted(folder.glob("*.xdmf"))
+    maps = sorted(folder.glob("wear_map*.png"))
+    files = fields + [folder / n for n in ("history.h5", "history.png", "multiscale.png", "zones.h5")] + maps
+    if verbose and comm.rank == 0:
+        print(f"{name}: nothing to do, the run in {folder} has ended after {steps} step(s); "
+              "use --overwrite to run it again")
+    return MultiscaleResult(folder, files, 0.0, history, folder / "history.h5", folder / "history.png", fields,
+                            folder / "multiscale.png", maps, folder / "zones.h5", steps)
 
 
 def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: str, comm) -> tuple:

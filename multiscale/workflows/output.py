@@ -4,7 +4,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
-from multiscale.errors import SceneError
+from multiscale.errors import InputError, SceneError
+from multiscale.io import on_root
 
 
 @dataclass
@@ -18,15 +19,23 @@ class RunResult:
 
 def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
     """The scene's output folder, created; refuses to touch earlier results unless ``overwrite``
-    (replace them) or ``resume`` (continue them). Rank 0 decides for every rank (collective)."""
+    (replace them) or ``resume`` (continue them; a missing folder is then an error and is not
+    created). Rank 0 decides for every rank (collective)."""
     folder = Path(scene.output.folder)
+    if resume and not comm.bcast(folder.is_dir() if comm.rank == 0 else None, root=0):
+        raise InputError("--resume", str(folder), "the output folder does not exist: there is nothing to resume "
+                         "(run without --resume)")
     existing = comm.bcast(sorted(p.name for p in folder.iterdir()) if comm.rank == 0 and folder.is_dir() else [],
                           root=0)
     if existing and not (overwrite or resume):
         shown = ", ".join(existing[:3]) + (", ..." if len(existing) > 3 else "")
         raise SceneError(f'output.folder = "{folder}": already holds results ({len(existing)} entries: {shown}); '
                          "use --overwrite to replace them, --resume to continue the run, or choose another folder")
-    if comm.rank == 0:
+
+    def create():
         folder.mkdir(parents=True, exist_ok=True)
-    comm.barrier()
+        probe = folder / ".multiscale_write_test"
+        probe.write_bytes(b"")              # a read-only folder fails here, before any work
+        probe.unlink()
+    on_root(comm, create, f"into the output folder {folder}")
     return folder

@@ -6,18 +6,23 @@ the multiscale loop and the squeal analysis:
 - the rough interfaces are ``scene.rough_interfaces`` (all, unless [interfaces.<name>] says
   ``rough = false``: those keep the perfect-contact penalty), each planar and covered by
   ``micro.zones`` = (nx, ny) zones over the bounding box of its facets in its plane, each zone a
-  patch of ``micro.grid`` = (nx, ny) cells: one measured surface (``roughness.file``) or one
-  generated fractal surface per interface cut into zones (``patch = "face"``; cut-offs in
-  wavelengths per face), or one generated patch per zone (``patch = "zone"``; per zone); the k-th
-  interface of the geometry draws with seed ``seed + 7919 k``; [interfaces.<name>.roughness] and
-  [interfaces.<name>.micro] change these per interface (the grid per zone and the law settings
-  must be the same on every interface: one law table, one post-analysis grid);
+  patch of ``micro.grid`` = (nx, ny) cells (default ``DEFAULT_GRID``): one measured surface per
+  interface (``roughness.file``: read, conditioned and made to cover the face by
+  ``multiscale.micro.topography``, each step printed by rank 0; without ``micro.grid`` a
+  measurement used as it is keeps its own pixel size) or one generated fractal surface per
+  interface cut into zones (``patch = "face"``; cut-offs in wavelengths per face), or one
+  generated patch per zone (``patch = "zone"``; per zone); the k-th interface of the geometry
+  draws with seed ``seed + 7919 k`` (fractal and statistically equivalent surfaces);
+  [interfaces.<name>.roughness] and [interfaces.<name>.micro] change these per interface (the
+  grid per zone and the law settings must be the same on every interface: one law table, one
+  post-analysis grid);
 - laws by FFT-BEM (``micro.model = "fft-bem"``; the asperity models are refused), ``micro.law_points``
   nodes up to ``micro.p_max`` (default ``P_MAX_FACTOR`` x the nominal interface pressure), contact
   tolerance ``micro.tol``; the micro solid is layered with effect ``layers``.
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import replace
 
 import numpy as np
@@ -27,14 +32,17 @@ from multiscale.micro.conduction import SeriesKernel
 from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
 from multiscale.micro.laws import LawSpec
-from multiscale.micro.surface import Surface, fractal_surface, load_surface
+from multiscale.micro.surface import Surface, fractal_surface
+from multiscale.micro.topography import TopographyWarning, condition, cover, read_topography
 from multiscale.micro.zones import ZoneGrid, cut_zones, generate_zones
 from multiscale.pool import MicroPool
 from multiscale.rough import RoughInterface, interface_plane
+from multiscale.scene_sections import DEFAULT_GRID
 from multiscale.workflows.model import interface_forces, interface_materials
 
 P_MAX_FACTOR = 20.0        # default top node of the laws: 20 x the nominal interface pressure
 SEED_STRIDE = 7919         # interface k draws its surfaces with seed + SEED_STRIDE k
+MAX_CELLS = 1024           # cells per zone side taken from a measurement's own pixel size
 
 
 def check_rough_scene(scene) -> None:
@@ -62,23 +70,47 @@ def check_rough_scene(scene) -> None:
                                  f"interface (micro.{key} = {getattr(scene.micro, key)}); only zones may differ")
 
 
-def make_zones(r, m, lo, hi, seed: int) -> tuple[ZoneGrid, list]:
+def make_zones(r, m, lo, hi, seed: int, log=None) -> tuple[ZoneGrid, list]:
     """The zone grid over the box [lo, hi] (u, v) [m] of one interface and each zone's initial
-    patch (``r``: its [roughness], ``m``: its [micro]; see module docstring; ids from 0)."""
+    patch (``r``: its [roughness], ``m``: its [micro]; see module docstring; ids from 0).
+    ``log(line)`` receives the steps that made a measured surface (the warnings among them too,
+    instead of Python warnings on every rank)."""
     counts = tuple(int(c) for c in m.zones)
     size = np.asarray(hi, float) - np.asarray(lo, float)
     if r.file is not None:
-        surface = load_surface(r.file, *r.pixel_size, scale=r.height_unit)
-        if np.any(np.array(surface.size) < size * (1 - 1e-6)):
-            raise InputError("roughness.pixel_size", r.pixel_size, f"the surface ({surface.size[0]:.4g} x "
-                             f"{surface.size[1]:.4g} m) must cover the interface ({size[0]:.4g} x {size[1]:.4g} m)")
-        return cut_zones(surface, counts, origin=tuple(lo))
+        return cut_zones(measured_face(r, m, counts, size, seed, log), counts, origin=tuple(lo))
+    cells_per_zone = m.grid or DEFAULT_GRID
     if r.patch == "face":
-        cells = (counts[0] * m.grid[0], counts[1] * m.grid[1])
+        cells = (counts[0] * cells_per_zone[0], counts[1] * cells_per_zone[1])
         s = fractal_surface(cells, tuple(size), r.hurst, r.k_min, r.k_max, r.rms, seed=seed)
         return cut_zones(Surface(s.heights, s.dx, s.dy, periodic=False), counts, origin=tuple(lo))
     grid = ZoneGrid(tuple(lo), counts, tuple(size / np.array(counts)))
-    return grid, generate_zones(grid, tuple(m.grid), r.hurst, r.k_min, r.k_max, r.rms, seed=seed)
+    return grid, generate_zones(grid, tuple(cells_per_zone), r.hurst, r.k_min, r.k_max, r.rms, seed=seed)
+
+
+def measured_face(r, m, counts, size, seed: int, log=None) -> Surface:
+    """The face of ``size`` [m] from ``roughness.file``: read, conditioned (``roughness.detrend``,
+    ``cutoff``, ``max_undefined``) and covering the face (``roughness.cover``), on counts x
+    ``micro.grid`` cells (without ``micro.grid``: 50 x 50 per zone for an equivalent surface, else
+    the measurement's pixel size rounded to whole cells per zone)."""
+    with warnings.catch_warnings():      # the warnings are lines of the report: printed once, not per rank
+        warnings.simplefilter("ignore", TopographyWarning)
+        measured = read_topography(r.file, r.channel, pixel_size=r.pixel_size, height_unit=r.height_unit,
+                                   prefix="roughness.")
+        done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix="roughness.")
+        cells = m.grid
+        if cells is None and r.cover == "equivalent":
+            cells = DEFAULT_GRID
+        elif cells is None:
+            cells = tuple(max(4, int(round(s / c / d))) for s, c, d in zip(size, counts, (measured.dx, measured.dy)))
+            if max(cells) > MAX_CELLS:
+                raise InputError("micro.grid", None, f"{r.file.name}'s pixels give {cells[0]} x {cells[1]} cells "
+                                 f"per zone: set micro.grid (at most {MAX_CELLS} without it)")
+        surface, lines = cover(done.surface, (counts[0] * cells[0], counts[1] * cells[1]), tuple(size), r.cover,
+                               seed, prefix="roughness.")
+    for line in (*done.report, *lines) if log is not None else ():
+        log(f"roughness: {line}")
+    return surface
 
 
 def contact_kernel(scene):
@@ -114,12 +146,13 @@ def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterfac
     yet computed: ``RoughInterface.update_laws``)."""
     check_rough_scene(scene)
     names, planes, grids, zones = list(scene.rough_interfaces), [], [], []
+    log = print if tm.comm.rank == 0 else None
     for name in names:
         settings = scene.interface_settings(name)
         k = list(tm.interface.tags).index(name)
         plane, lo, hi = interface_plane(tm, name)
         grid, patches = make_zones(settings.roughness, settings.micro, lo, hi,
-                                   settings.roughness.seed + SEED_STRIDE * k)
+                                   settings.roughness.seed + SEED_STRIDE * k, log=log)
         offset = len(zones)
         planes.append(plane)
         grids.append(grid)

@@ -17,7 +17,8 @@ coefficients), a friction coefficient falling with the slip speed (``loading.fri
 centrifugal terms of the rotating body (``stability.gyroscopic``) and the prestress stiffness
 (``stability.prestress``, with the shift of every frequency it causes). A damped system that the
 undamped modes do not map exactly is solved as a quadratic eigenproblem (viscous damping) or by
-projection on the undamped modes (loss factors; ``macro.damped``). ``[stability.sweep]`` adds a stability map (``workflows.squeal_map``).
+projection on the undamped modes (loss factors; ``macro.damped``). ``[stability.sweep]`` adds a
+stability map (``workflows.squeal_map``).
 
 ``run`` writes into ``output.folder``: ``modes.csv``, mode shapes (``modes_body*.xdmf``),
 ``pressure.png`` (Fig. 4.12), ``re_im.png`` (Fig. 4.13) and ``energy.png`` (Figs. 4.20–4.21);

@@ -1,0 +1,378 @@
+"""Measured topographies: instrument files read through SurfaceTopography, conditioned step by step,
+and spread over an interface larger than the measurement.
+
+Reading (``read_topography``): every format SurfaceTopography reads (x3p, Digital Surf .sur, Sensofar
+.plu, Wyko .opd, Zygo .dat/.datx, Alicona .al3d, AFM files, ...; ``formats()``), a chosen channel,
+the file's own units and pixel sizes (a caller may override them: noted in the result). Plain height
+matrices without units (.npy, .txt, .csv, .asc) go through ``multiscale.micro.surface.load_surface``
+and need a pixel size. Undefined points (no value from the instrument) are NaN.
+
+Conditioning (``condition``), in the order of ISO 25178-3 and each step reported: form removal (the
+F-operator: least-squares mean, plane or polynomial fitted on the defined points), undefined points
+filled (harmonic interpolation; refused above a stated fraction), waviness and roughness separated by
+the areal Gaussian filter of ISO 16610-61 (the L-filter, cut-off wavelength λc: the roughness is the
+S-L surface). ``resample`` puts a surface on another grid (the micro grid) with an anti-aliasing
+S-filter when it coarsens.
+
+Covering an interface (``cover``): the measurement itself (it must cover the interface), mirrored or
+tiled copies (with a warning: wavelengths longer than the measurement are missing and the pattern
+repeats), or a statistically equivalent surface drawn from the measured PSD
+(``multiscale.micro.spectrum.equivalent_surface``).
+"""
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from multiscale.errors import InputError, check_positive
+from multiscale.micro.spectrum import as_topography, equivalent_surface, power_spectrum, surface_topography
+from multiscale.micro.surface import Surface, load_surface
+
+MATRIX_SUFFIXES = (".npy", ".txt", ".csv", ".asc")    # plain height matrices (no units in the file)
+MAX_UNDEFINED = 0.1       # default largest fraction of undefined points that is filled
+DETREND = {"none": None, "mean": "mean", "plane": "height", "poly2": "curvature"}   # -> SurfaceTopography
+COVER = ("measured", "mirror", "tile", "equivalent")
+ALPHA = np.sqrt(np.log(2) / np.pi)     # ISO 16610-21/-61 Gaussian: 50 % transmission at the cut-off
+S_FILTER_PIXELS = 3.0     # anti-aliasing before coarsening: λs = 3 new pixels (21 % at the new Nyquist)
+
+
+class TopographyWarning(UserWarning):
+    """Something the file said was overridden, or an interface covered by copies of a measurement."""
+
+
+def formats() -> list[str]:
+    """Name (extensions) of every format SurfaceTopography reads."""
+    return [f"{r.name()} (.{', .'.join(r.file_extensions())})" for r in surface_topography().IO.readers
+            if r.format() not in ("npy", "asc", "xyz")] + [
+        "plain height matrices .npy, .txt, .csv, .asc (with a pixel size)"]
+
+
+# --------------------------------------------------------------------------- reading
+@dataclass(frozen=True)
+class Measurement:
+    """One channel of a measured topography, as read: heights [m] (ny, nx), NaN where undefined;
+    pixel sizes [m]; where it came from; ``notes``: what overrode the file (one line each)."""
+
+    heights: np.ndarray
+    dx: float
+    dy: float
+    path: Path
+    channel: int = 0
+    channel_name: str = ""
+    unit: str | None = None       # the file's length unit (None: none in the file)
+    notes: tuple[str, ...] = ()
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.heights.shape
+
+    @property
+    def size(self) -> tuple[float, float]:
+        """(Lx, Ly) [m]."""
+        return self.shape[1] * self.dx, self.shape[0] * self.dy
+
+    @property
+    def undefined(self) -> int:
+        """Number of undefined points."""
+        return int(np.isnan(self.heights).sum())
+
+
+def _reader(path: Path, name: str):
+    ST = surface_topography()
+    try:
+        return ST.open_topography(str(path))
+    except (ST.Exceptions.UnknownFileFormat, ST.Exceptions.CannotDetectFileFormat):
+        raise InputError(name, path.name, "cannot read it as a topography: not a format SurfaceTopography "
+                         "recognises (`multiscale surface --formats` lists them)") from None
+    except Exception as exc:    # any other parser failure on a user's file: one error naming it
+        raise InputError(name, path.name, f"cannot read it as a topography ({_first_line(exc)})") from None
+
+
+def _first_line(exc: Exception) -> str:
+    text = str(exc).strip().splitlines()
+    return f"{type(exc).__name__}: {text[0][:160] if text else ''}"
+
+
+def _channel(reader, path: Path, channel, prefix: str):
+    channels = reader.channels
+    listing = ", ".join(f"{c.index} \"{c.name}\" ({c.dim}-D)" for c in channels)
+    if channel is None:
+        ch = reader.default_channel
+    elif not isinstance(channel, (int, np.integer)) or not 0 <= channel < len(channels):
+        raise InputError(f"{prefix}channel", channel, f"{path.name} has the channels {listing}")
+    else:
+        ch = channels[int(channel)]
+    if ch.dim != 2:
+        raise InputError(f"{prefix}file", path.name, f"channel {ch.index} (\"{ch.name}\") is a {ch.dim}-D profile "
+                         f"(line scan): a height map (2-D) is needed; channels: {listing}")
+    return ch
+
+
+def read_topography(path, channel: int | None = None, *, pixel_size=None, height_unit: float | None = None,
+                    prefix: str = "") -> Measurement:
+    """One channel of a measured topography (see module docstring) in SI units.
+
+    ``channel``: its index (default: the file's default channel). ``pixel_size`` (dx or (dx, dy)
+    [m]) and ``height_unit`` [m per height unit of the file] override the file's (noted in
+    ``Measurement.notes``); a plain matrix needs ``pixel_size`` (``height_unit`` default 1).
+    Errors (``InputError``) name the file and the field ``prefix + "file"``, ``"channel"``, ...
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(f"{prefix}file", path.name, f"no such file ({path})")
+    pair = None if pixel_size is None else tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size), (2,)))
+    if pair is not None:
+        for v in pair:
+            check_positive(f"{prefix}pixel_size", v)
+    if height_unit is not None:
+        check_positive(f"{prefix}height_unit", height_unit)
+    if path.suffix.lower() in MATRIX_SUFFIXES:
+        if pair is None:
+            raise InputError(f"{prefix}pixel_size", None, f"{path.name} is a plain height matrix without units: "
+                             "give its pixel size")
+        try:
+            s = load_surface(path, *pair, scale=1.0 if height_unit is None else height_unit, detrend="none")
+        except InputError as exc:
+            raise InputError(f"{prefix}file", path.name, exc.allowed) from None
+        return Measurement(s.heights, s.dx, s.dy, path, 0, "matrix", None)
+    ch = _channel(_reader(path, f"{prefix}file"), path, channel, prefix)
+    unit = ch.unit if isinstance(ch.unit, str) else None
+    notes = []
+    try:
+        t = ch.topography(**({} if ch.physical_sizes is not None else {"physical_sizes": ch.nb_grid_pts}))
+        raw = t.heights()
+    except Exception as exc:    # the header was fine, the data is not: still one error naming the file
+        raise InputError(f"{prefix}file", path.name, f"cannot read channel {ch.index} ({_first_line(exc)})") from None
+    factor = None if unit is None else surface_topography().Support.UnitConversion.get_unit_conversion_factor(unit, "m")
+    if ch.physical_sizes is None or factor is None:
+        if pair is None:
+            raise InputError(f"{prefix}pixel_size", None, f"{path.name} gives no lateral "
+                             f"{'size' if ch.physical_sizes is None else 'unit'}: give the pixel size")
+        dx, dy = pair
+    else:
+        dx, dy = (float(v) * factor for v in t.pixel_size)
+        if pair is not None:
+            notes.append(f"{prefix}pixel_size = {pair[0]:.4g} x {pair[1]:.4g} m overrides the file's "
+                         f"{dx:.4g} x {dy:.4g} m")
+            dx, dy = pair
+    if height_unit is not None:
+        if factor is not None:
+            notes.append(f"{prefix}height_unit = {height_unit:.4g} m overrides the file's unit "
+                         f"({unit} = {factor:.4g} m)")
+        factor = height_unit
+    elif factor is None:
+        raise InputError(f"{prefix}height_unit", None, f"{path.name} gives no height unit: give it (m per unit)")
+    h = np.ma.filled(np.ma.masked_invalid(np.ma.asarray(raw, dtype=float)), np.nan).T * factor
+    if not np.isfinite(h).any():
+        raise InputError(f"{prefix}file", path.name, f"channel {ch.index} (\"{ch.name}\") holds no defined height")
+    for note in notes:
+        warnings.warn(note, TopographyWarning, stacklevel=2)
+    return Measurement(h, dx, dy, path, ch.index, str(ch.name), unit, tuple(notes))
+
+
+def probe_topography(path, channel: int | None = None, *, pixel_size=None, height_unit=None,
+                     max_undefined: float = MAX_UNDEFINED, prefix: str = "") -> tuple[list[str], list[str]]:
+    """What ``read_topography`` and ``condition`` would refuse in a file, without conditioning it
+    (``multiscale check``): (problems, notes), one line each; no problems for a usable file, the
+    notes say what overrides the file."""
+    try:
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", TopographyWarning)      # returned as notes
+            m = read_topography(path, channel, pixel_size=pixel_size, height_unit=height_unit, prefix=prefix)
+    except InputError as exc:
+        return [str(exc)], []
+    too_many = _too_many_undefined(m, max_undefined, prefix)
+    return ([] if too_many is None else [str(InputError(f"{prefix}file", m.path.name, too_many))]), list(m.notes)
+
+
+def _too_many_undefined(m: Measurement, max_undefined: float, prefix: str) -> str | None:
+    """Why the measurement has too many undefined points to fill, or None."""
+    share = m.undefined / m.heights.size
+    if share > max_undefined:
+        return (f"{share:.1%} of its points are undefined, more than {prefix}max_undefined = {max_undefined:.1%} "
+                "(too much to fill by interpolation)")
+    return None
+
+
+# --------------------------------------------------------------------------- conditioning
+@dataclass(frozen=True)
+class Conditioned:
+    """A conditioned measurement: ``surface`` (the roughness, non-periodic, mean zero), ``waviness``
+    (what the Gaussian filter took out; None without a cut-off) and ``report`` (one line per step)."""
+
+    surface: Surface
+    waviness: Surface | None
+    report: tuple[str, ...]
+
+
+def gaussian_transmission(wavelength, cutoff: float) -> np.ndarray:
+    """Amplitude transmission of the ISO 16610-61 areal Gaussian filter's mean surface (waviness)
+    at a wavelength: exp(−π (α λc/λ)²), α = sqrt(ln 2/π) (50 % at λ = λc); the roughness keeps the
+    rest, 1 − that."""
+    return np.exp(-np.pi * (ALPHA * cutoff / np.asarray(wavelength, dtype=float)) ** 2)
+
+
+def gaussian_filter(surface: Surface, cutoff: float) -> Surface:
+    """The Gaussian mean surface (waviness) of ISO 16610-61 at the cut-off wavelength λc [m]:
+    convolution with s(x, y) = exp(−π (x² + y²)/(α λc)²)/(α λc)², truncated at ±λc (where it has
+    fallen to 7e-7 of its peak), so that a sinusoid of wavelength λ keeps
+    ``gaussian_transmission(λ, λc)`` of its amplitude. Edges:
+    periodic surfaces wrap, others are mirrored (one of the end-effect treatments of ISO 16610-28).
+    SurfaceTopography filters periodic topographies in Fourier space only, hence this one."""
+    import scipy.ndimage  # ~0.4 s to import: only when a surface is filtered
+    check_positive("cutoff", cutoff)
+    if cutoff < 2 * max(surface.dx, surface.dy):
+        raise InputError("cutoff", cutoff, f"λc must span at least 2 pixels ({2 * max(surface.dx, surface.dy):.3g} m)")
+    sigma = ALPHA * cutoff / np.sqrt(2 * np.pi)              # exp(-π x²/(αλc)²) = exp(-x²/(2σ²))
+    h = surface.heights
+    axes = (h.ndim - 2, h.ndim - 1)
+    w = scipy.ndimage.gaussian_filter(h, sigma=(sigma / surface.dy, sigma / surface.dx), axes=axes,
+                                      mode="wrap" if surface.periodic else "mirror", truncate=cutoff / sigma)
+    return Surface(w, surface.dx, surface.dy, periodic=surface.periodic)
+
+
+def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = None,
+              max_undefined: float = MAX_UNDEFINED, prefix: str = "") -> Conditioned:
+    """Form removal, filling of undefined points, waviness/roughness separation (see module
+    docstring); ``detrend`` one of ``DETREND`` (SurfaceTopography's detrend modes: mean, least-squares
+    plane, second-order polynomial), ``cutoff`` λc [m] of the Gaussian filter (None: no filter)."""
+    if detrend not in DETREND:
+        raise InputError(f"{prefix}detrend", detrend, f"one of {', '.join(DETREND)}")
+    if cutoff is not None:
+        check_positive(f"{prefix}cutoff", cutoff)
+    if not 0 <= max_undefined <= 1:
+        raise InputError(f"{prefix}max_undefined", max_undefined, "a fraction of the points, in [0, 1]")
+    too_many = _too_many_undefined(m, max_undefined, prefix)
+    if too_many is not None:
+        raise InputError(f"{prefix}file", m.path.name, too_many)
+    report = [f"read {m.path.name}, channel {m.channel} (\"{m.channel_name}\"): {m.shape[1]} x {m.shape[0]} points "
+              f"of {m.dx * 1e6:.4g} x {m.dy * 1e6:.4g} um ({m.size[0] * 1e3:.4g} x {m.size[1] * 1e3:.4g} mm)"
+              + (f", heights in {m.unit}" if m.unit else "")] + [f"warning: {n}" for n in m.notes]
+    frame = Surface(np.zeros(m.shape), m.dx, m.dy, periodic=False)
+    masked = np.ma.masked_invalid(m.heights)
+    t = as_topography(frame, masked)
+    before = float(masked.std())
+    if DETREND[detrend] is not None:
+        t = t.detrend(detrend_mode=DETREND[detrend])
+        names = {"mean": "mean height", "plane": "least-squares plane", "poly2": "least-squares polynomial of degree 2"}
+        h = np.ma.masked_invalid(np.ma.filled(t.heights(), np.nan).T)
+        report.append(f"form removed: {names[detrend]} (SurfaceTopography detrend \"{DETREND[detrend]}\"): "
+                      f"Sq {_um(before)} -> {_um(float(h.std()))} um")
+    if m.undefined:
+        t = t.interpolate_undefined_data("harmonic")
+        report.append(f"filled {m.undefined} undefined points ({m.undefined / m.heights.size:.2%}) by harmonic "
+                      "interpolation (SurfaceTopography interpolate_undefined_data)")
+    h = np.asarray(t.heights(), dtype=float).T
+    surface = Surface(h - h.mean(), m.dx, m.dy, periodic=False)
+    waviness = None
+    if cutoff is not None:
+        try:
+            waviness = gaussian_filter(surface, cutoff)
+        except InputError as exc:
+            raise InputError(f"{prefix}cutoff", cutoff, f"{exc.allowed}: {m.path.name}'s pixels") from None
+        rough = surface.heights - waviness.heights
+        surface = Surface(rough - rough.mean(), m.dx, m.dy, periodic=False)
+        longer = " (longer than the measurement: little is removed)" if cutoff > min(m.size) else ""
+        report.append(f"waviness removed: Gaussian filter (ISO 16610-61) at λc = {cutoff * 1e3:.4g} mm{longer}: "
+                      f"Sq waviness {_um(float(waviness.heights.std()))} um, roughness "
+                      f"{_um(float(surface.heights.std()))} um")
+    return Conditioned(surface, waviness, tuple(report))
+
+
+def _um(value: float) -> str:
+    return f"{value * 1e6:.4g}"
+
+
+# --------------------------------------------------------------------------- grids
+def resample(surface: Surface, n, size=None) -> tuple[Surface, str]:
+    """The surface on a grid of n = (nx, ny) cells over size (Lx, Ly) [m] (default: its own size),
+    cell centres at ((i + ½) Lx/nx, (j + ½) Ly/ny) from its corner, by cubic splines; a coarser grid
+    first low-passes with the Gaussian S-filter at λs = ``S_FILTER_PIXELS`` new pixels (against
+    aliasing). Returns the surface and one report line."""
+    import scipy.ndimage  # ~0.4 s to import: only when a surface is resampled
+    nx, ny = (int(v) for v in np.broadcast_to(np.asarray(n), (2,)))
+    Lx, Ly = surface.size if size is None else (float(v) for v in np.broadcast_to(np.asarray(size, float), (2,)))
+    dx, dy = Lx / nx, Ly / ny
+    if (ny, nx) == surface.shape and np.isclose(dx, surface.dx, rtol=1e-9) and np.isclose(dy, surface.dy, rtol=1e-9):
+        return surface, "on the micro grid already"
+    source, filtered = surface, ""
+    if dx > surface.dx * (1 + 1e-9) or dy > surface.dy * (1 + 1e-9):
+        cut = S_FILTER_PIXELS * max(dx, dy)
+        source = gaussian_filter(surface, cut)
+        filtered = f" after an S-filter at λs = {cut * 1e6:.4g} um against aliasing"
+    rows = (np.arange(ny) + 0.5) * dy / surface.dy - 0.5
+    cols = (np.arange(nx) + 0.5) * dx / surface.dx - 0.5
+    R, Cc = np.meshgrid(rows, cols, indexing="ij")
+    h = scipy.ndimage.map_coordinates(source.heights, [R, Cc], order=3,
+                                      mode="grid-wrap" if surface.periodic else "mirror")
+    same = np.isclose(Lx, surface.size[0], rtol=1e-9) and np.isclose(Ly, surface.size[1], rtol=1e-9)
+    out = Surface(h, dx, dy, periodic=surface.periodic and same)
+    return out, (f"resampled {surface.shape[1]} x {surface.shape[0]} points of {surface.dx * 1e6:.4g} um to "
+                 f"{nx} x {ny} of {dx * 1e6:.4g} x {dy * 1e6:.4g} um (cubic splines){filtered}: Sq "
+                 f"{_um(float(surface.heights.std()))} -> {_um(float(out.heights.std()))} um")
+
+
+def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: str = "") -> tuple[Surface, list[str]]:
+    """A surface of n = (nx, ny) cells over size (Lx, Ly) [m] made from a conditioned measurement
+    (at its own pixel size) by ``method`` (one of ``COVER``):
+
+    - ``"measured"``: the measurement itself, cropped at its centre and resampled; it must cover
+      the size;
+    - ``"mirror"`` / ``"tile"``: copies of it (mirror-stitched by SurfaceTopography, so without
+      steps at the seams, or repeated as they are), a ``TopographyWarning`` if more than one copy is
+      needed: wavelengths longer than the measurement are missing and the pattern repeats;
+    - ``"equivalent"``: a statistically equivalent surface from its PSD
+      (``spectrum.equivalent_surface``, ``seed``) over the whole size.
+
+    Returns the (non-periodic) surface and report lines.
+    """
+    if method not in COVER:
+        raise InputError(f"{prefix}cover", method, f"one of {', '.join(COVER)}")
+    nx, ny = (int(v) for v in np.broadcast_to(np.asarray(n), (2,)))
+    Lx, Ly = (float(v) for v in np.broadcast_to(np.asarray(size, float), (2,)))
+    mx, my = surface.size
+    wide = f"the measurement ({mx * 1e3:.4g} x {my * 1e3:.4g} mm)"
+    target = f"the interface ({Lx * 1e3:.4g} x {Ly * 1e3:.4g} mm)"
+    if method == "equivalent":
+        spectrum = power_spectrum(surface)
+        s = equivalent_surface(spectrum, (nx, ny), (Lx, Ly), seed)
+        s = Surface(s.heights, s.dx, s.dy, periodic=False)
+        return s, [f"statistically equivalent surface over {target} from the measured PSD (seed {seed}): "
+                   f"{nx} x {ny} cells of {Lx / nx * 1e6:.4g} x {Ly / ny * 1e6:.4g} um, Sq {_um(float(s.heights.std()))} "
+                   f"um (measured {_um(float(surface.heights.std()))} um; the grid resolves wavelengths down to "
+                   f"{2 * max(Lx / nx, Ly / ny) * 1e6:.4g} um, the measurement "
+                   f"{2 * max(surface.dx, surface.dy) * 1e6:.4g} um)"]
+    lines = []
+    short = mx < Lx * (1 - 1e-6) or my < Ly * (1 - 1e-6)
+    if short and method == "measured":
+        raise InputError(f"{prefix}cover", method, f"{wide} does not cover {target}: use \"equivalent\" (a "
+                         "statistically equivalent surface) or \"mirror\"/\"tile\" (copies)")
+    if short:
+        base = surface
+        if method == "mirror":
+            t = as_topography(surface).mirror_stitch()
+            base = Surface(np.asarray(t.heights()).T, surface.dx, surface.dy, periodic=True)
+        cell = (Lx / nx, Ly / ny)
+        if base.dx < cell[0] * (1 - 1e-9) or base.dy < cell[1] * (1 - 1e-9):     # coarsen once, then copy
+            base, note = resample(base, tuple(max(4, round(b / c)) for b, c in zip(base.size, cell)))
+            lines.append(note)
+        reps = (int(np.ceil(Ly / base.size[1])), int(np.ceil(Lx / base.size[0])))
+        surface = Surface(np.tile(base.heights, reps), base.dx, base.dy, periodic=False)
+        message = (f"{prefix}cover = \"{method}\": {wide} is smaller than {target}: {reps[1]} x {reps[0]} "
+                   f"{'mirror-stitched ' if method == 'mirror' else ''}copies; wavelengths longer than "
+                   f"{max(base.size) * 1e3:.4g} mm are missing and the pattern repeats")
+        warnings.warn(message, TopographyWarning, stacklevel=2)
+        lines.append(f"warning: {message}")
+    # the central Lx x Ly of it, on the target grid
+    cx, cy = (surface.size[0] - Lx) / 2, (surface.size[1] - Ly) / 2
+    c0, r0 = int(np.floor(cx / surface.dx + 1e-9)), int(np.floor(cy / surface.dy + 1e-9))
+    c1, r1 = int(np.ceil((cx + Lx) / surface.dx - 1e-9)), int(np.ceil((cy + Ly) / surface.dy - 1e-9))
+    crop = Surface(surface.heights[r0:r1, c0:c1], surface.dx, surface.dy, periodic=False)
+    if crop.shape != surface.shape:
+        lines.append(f"cropped the central {Lx * 1e3:.4g} x {Ly * 1e3:.4g} mm")
+    out, note = resample(crop, (nx, ny), (Lx, Ly))
+    lines.append(note)
+    return Surface(out.heights - out.heights.mean(), out.dx, out.dy, periodic=False), lines

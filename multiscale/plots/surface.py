@@ -1,0 +1,47 @@
+"""Figure of a measured or generated surface (``multiscale surface``): the height map beside its
+radially averaged PSD with the self-affine fit and its cut-offs (``multiscale.micro.spectrum``)."""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+from matplotlib.figure import Figure
+
+
+def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -> Path:
+    """PNG: height map [µm] (and the waviness taken out, if given), then C(q) [m⁴] against q [1/m]
+    (complete bins as points, partial ones hollow) with the power-law fit between its cut-offs."""
+    maps = [("roughness" if waviness is not None else "heights", surface)] + (
+        [("waviness", waviness)] if waviness is not None else [])
+    fig = Figure(figsize=(4.6 * (len(maps) + 1), 4.0))
+    axes = fig.subplots(1, len(maps) + 1, squeeze=False)[0]
+    for ax, (label, s) in zip(axes, maps):
+        Lx, Ly = s.size
+        image = ax.imshow(s.heights * 1e6, origin="lower", extent=(0, Lx * 1e3, 0, Ly * 1e3), cmap="viridis",
+                          interpolation="nearest")
+        ax.set_xlabel("x [mm]")
+        ax.set_ylabel("y [mm]")
+        ax.set_title(label)
+        fig.colorbar(image, ax=ax, label="height [µm]", shrink=0.85)
+    ax = axes[-1]
+    sp = stats.spectrum
+    ax.loglog(sp.q[sp.complete], sp.C[sp.complete], "o", ms=3, label="PSD (radial average)")
+    if (~sp.complete).any():
+        ax.loglog(sp.q[~sp.complete], sp.C[~sp.complete], "o", ms=3, mfc="none", color="C0", label="partial bins")
+    fit = stats.power_law
+    if fit is not None:
+        q = np.geomspace(sp.q[0], sp.q[-1], 200)
+        inside = q <= fit.q_s
+        ax.loglog(q[inside], fit(q[inside]), "-", color="C1", label=f"fit: H = {fit.hurst:.2f}")
+        for value, resolved, name in ((fit.q_r, fit.resolved[0], "q_r"), (fit.q_s, fit.resolved[1], "q_s")):
+            ax.axvline(value, color="C1", ls="--" if resolved else ":", lw=1,
+                       label=f"{name} = {value:.3g} 1/m" + ("" if resolved else " (end of data)"))
+    ax.set_xlabel("wavevector q [1/m]")
+    ax.set_ylabel("PSD C(q) [m⁴]")
+    ax.grid(True, which="both", alpha=0.25)
+    ax.legend(fontsize=8)
+    ax.set_title(f"Sq = {stats.Sq * 1e6:.3g} µm, Sdq = {stats.Sdq:.3g}")
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    return path

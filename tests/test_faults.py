@@ -1,0 +1,174 @@
+"""Faults that used to hang a parallel job (issue 21): an error met by one rank only, and a NaN on
+one rank. Each runs ``multiscale run`` under ``mpiexec -n 2`` in a subprocess and asserts that the
+job ends within seconds, with one clear message and a non-zero exit code."""
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+
+MPIEXEC = Path(sys.executable).with_name("mpiexec")
+SCENE = """
+name = "cooling_block"
+effects = ["contact", "thermal"]
+[geometry]
+builder = "block_on_flat"
+mesh_size = "5 mm"
+[materials.block]
+E = "4 GPa"
+nu = 0.15
+kappa = "5 W/(m K)"
+chi = "1e-6 m^2/s"
+[materials.flat]
+E = "210 GPa"
+nu = 0.3
+kappa = "45 W/(m K)"
+chi = "1e-5 m^2/s"
+[interface]
+penalty = "1e13 Pa/m"
+[loading]
+pressure = "1 MPa"
+[time]
+end = "3 s"
+steps = 3
+[[boundary]]
+surfaces = ["block_top"]
+temperature = "80 degC"
+[output]
+folder = "{folder}"
+"""
+# the fault, injected on rank 1 only at the second heat step, then the ordinary CLI run
+DRIVER = """
+import sys
+from mpi4py import MPI
+from multiscale.cli import main
+from multiscale.errors import ConvergenceError
+from multiscale.macro import thermal
+step, calls = thermal.Thermal.step, []
+
+def faulty(self, dt):
+    calls.append(dt)
+    if MPI.COMM_WORLD.rank == 1 and len(calls) == 2:
+        if sys.argv[2] == "raise":
+            raise ConvergenceError("injected failure on rank 1")
+        self.T[0].x.array[:] = float("nan")           # a NaN in this rank's temperatures only
+    return step(self, dt)
+
+thermal.Thermal.step = faulty
+sys.exit(main(["run", sys.argv[1], "--overwrite"]))
+"""
+
+
+def run_faulty(tmp_path, mode):
+    scene = tmp_path / "scene.toml"
+    scene.write_text(SCENE.format(folder=tmp_path / "out"))
+    driver = tmp_path / "driver.py"
+    driver.write_text(DRIVER)
+    start = time.monotonic()
+    done = subprocess.run([str(MPIEXEC), "-n", "2", sys.executable, str(driver), str(scene), mode],
+                          capture_output=True, text=True, timeout=300)
+    return done, time.monotonic() - start
+
+
+def test_an_error_on_one_rank_ends_the_job(tmp_path):
+    """Rank 1 raises while rank 0 goes on into the next collective: rank 1 says so and aborts."""
+    done, seconds = run_faulty(tmp_path, "raise")
+    assert done.returncode != 0 and seconds < 120
+    assert done.stderr.count("injected failure on rank 1") == 1
+    assert "error (rank 1 of 2)" in done.stderr
+
+
+def test_a_nan_on_one_rank_fails_on_every_rank_with_one_message(tmp_path):
+    """The finiteness of a heat step is decided by every rank together: both raise, rank 0 prints
+    one line, the job exits with code 2 (no abort needed)."""
+    done, seconds = run_faulty(tmp_path, "nan")
+    assert done.returncode == 2 and seconds < 120, done.stderr[-2000:]
+    errors = [line for line in done.stderr.splitlines() if line.startswith("error")]
+    assert len(errors) == 1 and "heat step at t = 2 s failed" in errors[0]
+
+
+# ---------------------------------------------------------------- checkpoints and full disks
+@pytest.fixture(scope="module")
+def stopped(tmp_path_factory):
+    """A rough pin-on-disc run stopped after its first step: the checkpoint to resume from."""
+    from test_coupling import POD
+
+    from multiscale.scene import loads
+    from multiscale.workflows.multiscale import run
+    folder = tmp_path_factory.mktemp("stopped") / "out"
+    scene = loads(POD.format(folder=folder))
+    run(scene, verbose=False, stop_after=1)
+    return scene, folder / "checkpoint.h5"
+
+
+@pytest.mark.parametrize("damage, message", [
+    (lambda b: b[: len(b) // 2], "cannot be read"),             # truncated
+    (lambda b: b"", "cannot be read"),                           # empty
+    (lambda b: b[:-4096] + bytes(x ^ 0x5A for x in b[-4096:]), "corrupted"),   # damaged data
+])
+def test_a_damaged_checkpoint_is_one_clear_error(stopped, tmp_path, damage, message):
+    import shutil
+
+    from multiscale.errors import InputError
+    from multiscale.workflows.multiscale import run
+    scene, checkpoint = stopped
+    folder = tmp_path / "copy"
+    shutil.copytree(checkpoint.parent, folder)
+    path = folder / "checkpoint.h5"
+    path.write_bytes(damage(path.read_bytes()))
+    with pytest.raises(InputError, match=message):
+        run(_with_folder(scene, folder), resume=True, verbose=False)
+
+
+def _with_folder(scene, folder):
+    import dataclasses
+    return dataclasses.replace(scene, output=dataclasses.replace(scene.output, folder=folder))
+
+
+def test_a_full_disk_keeps_the_previous_checkpoint(stopped, tmp_path, monkeypatch):
+    """No space left while the next checkpoint is written (simulated ENOSPC at its rename): an
+    OutputError naming the file and the cause; the step's previous checkpoint is intact."""
+    import errno
+    import os
+    import shutil
+
+    from multiscale import checkpoint as ckpt
+    from multiscale.errors import OutputError
+    from multiscale.workflows.multiscale import run
+    scene, checkpoint = stopped
+    folder = tmp_path / "copy"
+    shutil.copytree(checkpoint.parent, folder)
+    before = (folder / "checkpoint.h5").read_bytes()
+
+    def full(*args):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    monkeypatch.setattr(ckpt.os, "replace", full)
+    with pytest.raises(OutputError, match="cannot write the checkpoint .*No space left on device"):
+        run(_with_folder(scene, folder), resume=True, verbose=False)
+    assert (folder / "checkpoint.h5").read_bytes() == before
+    assert not (folder / "checkpoint.h5.tmp").exists()
+
+
+def test_a_read_only_output_folder_is_one_clear_error(tmp_path, monkeypatch):
+    """A folder the run cannot write into (simulated: root may write anywhere) is an OutputError
+    before any work."""
+    import errno
+    import os
+    from pathlib import Path
+
+    from multiscale.errors import OutputError
+    from multiscale.scene import loads
+    from multiscale.workflows import run
+    write_bytes = Path.write_bytes
+
+    def read_only(self, data):
+        if "locked" in str(self):
+            raise PermissionError(errno.EACCES, os.strerror(errno.EACCES), str(self))
+        return write_bytes(self, data)
+    monkeypatch.setattr(Path, "write_bytes", read_only)
+    scene = loads(SCENE.format(folder=tmp_path / "locked"))
+    with pytest.raises(OutputError, match="cannot write into the output folder .*Permission denied"):
+        run(scene, verbose=False)

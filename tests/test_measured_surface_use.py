@@ -1,0 +1,132 @@
+"""Measured surfaces in use (issue 17): `multiscale surface FILE` (steps, statistics, figure),
+scenes with `[roughness] file = ...` (validated by `multiscale check` from the file itself), and the
+zones the one rough-interface builder makes from them."""
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pytest
+import SurfaceTopography as ST
+
+from multiscale.cli import main
+from multiscale.errors import InputError, SceneError
+from multiscale.scene import loads
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "tests" / "data"
+TOP = DATA / "top-1.top"
+SCENE = (ROOT / "demos" / "block_on_flat.toml").read_text().replace(
+    'effects = ["contact"]', 'effects = ["contact", "roughness"]') + """
+[roughness]
+body = "block"
+{roughness}
+[micro]
+zones = [2, 2]
+{micro}
+"""
+
+
+def scene(tmp_path, roughness, micro=""):
+    return loads(SCENE.format(roughness=roughness, micro=micro), tmp_path)
+
+
+def test_surface_command_prints_the_steps_and_surfacetopographys_sq(tmp_path, capsys):
+    figure = tmp_path / "top.png"
+    assert main(["surface", str(TOP), "--figure", str(figure)]) == 0
+    out = capsys.readouterr().out
+    sq = ST.open_topography(str(TOP)).topography().detrend("height").Sq()      # nm
+    assert f"Sq   RMS height              {sq:.4g} nm" in out
+    assert "read top-1.top, channel 0 (\"Default\"): 256 x 256 points" in out and "form removed" in out
+    for row in ("Sdq  RMS gradient", "Ssk  skewness", "Sku  kurtosis", "Nayak parameter", "summit density",
+                "Hurst exponent H (PSD fit)", "long cut-off", "short cut-off"):
+        assert row in out
+    assert figure.stat().st_size > 10_000 and f"figure: {figure}" in out
+    assert main(["surface", str(TOP), "--cutoff", "0.1 um", "--detrend", "poly2", "--figure", "none"]) == 0
+    out = capsys.readouterr().out
+    assert "Gaussian filter (ISO 16610-61) at λc = 0.0001 mm" in out and "statistics of the roughness" in out
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--channel", "2"], 'error: --channel = 2: top-1.top has the channels 0 "Default" (2-D)'),
+    (["--cutoff", "3 kg"], 'error: --cutoff = \'3 kg\': expected a length'),
+    (["--cutoff", "1 nm"], "error: --cutoff = 1e-09: λc must span at least 2 pixels (4.69e-09 m): top-1.top's pixels"),
+])
+def test_surface_command_bad_options_are_one_line(capsys, args, message):
+    assert main(["surface", str(TOP), "--figure", "none", *args]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith(message) and "Traceback" not in err and len(err.strip().splitlines()) == 1
+
+
+def test_surface_command_lists_the_formats(capsys):
+    assert main(["surface", "--formats"]) == 0
+    assert "XML 3D surface profile (X3P) (.x3p)" in capsys.readouterr().out
+
+
+def test_scene_reads_a_measured_file_with_its_options(tmp_path):
+    s = scene(tmp_path, f'file = "{TOP}"\nchannel = 0\ndetrend = "poly2"\ncutoff = "0.2 um"\ncover = "equivalent"\n'
+                        'seed = 4\nmax_undefined = 0.2')
+    r = s.roughness
+    assert (r.file, r.channel, r.detrend, r.cutoff, r.cover, r.seed, r.max_undefined) == (
+        TOP, 0, "poly2", pytest.approx(2e-7), "equivalent", 4, 0.2)
+    assert r.pixel_size is None and r.height_unit is None and s.warnings == ()
+    over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"')
+    assert over.warnings == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",)
+
+
+@pytest.mark.parametrize("roughness, fragment", [
+    ('file = "pad.x3p"', "roughness.file = 'pad.x3p': cannot read it as a topography: not a format"),
+    (f'file = "{TOP}"\nchannel = 4', 'roughness.channel = 4: top-1.top has the channels 0 "Default" (2-D)'),
+    (f'file = "{DATA / "opdx-3.opdx"}"', "is a 1-D profile (line scan): a height map (2-D) is needed"),
+    ('file = "pad.npy"', "roughness.pixel_size = None: pad.npy is a plain height matrix without units"),
+    (f'file = "{TOP}"\ncover = "stretch"', 'roughness.cover = "stretch": unknown'),
+    (f'file = "{TOP}"\nhurst = 0.5', "roughness.hurst: only used with roughness.rms"),
+])
+def test_check_reports_a_bad_measured_file_from_the_file_itself(tmp_path, roughness, fragment):
+    (tmp_path / "pad.x3p").write_bytes(b"\x00garbage" * 50)
+    np.save(tmp_path / "pad.npy", np.zeros((8, 8)))
+    with pytest.raises(SceneError) as info:
+        scene(tmp_path, roughness)
+    assert any(fragment in p for p in info.value.problems), info.value.problems
+
+
+def test_check_of_a_bad_file_runs_nothing_heavy(tmp_path):
+    (tmp_path / "pad.x3p").write_bytes(b"\x00garbage" * 50)
+    path = tmp_path / "scene.toml"
+    path.write_text(SCENE.format(roughness='file = "pad.x3p"', micro=""))
+    code = ("import sys; from multiscale.cli import main; rc = main(['check', sys.argv[1]]); "
+            "heavy = sorted(m for m in sys.modules if m.split('.')[0] in ('dolfinx', 'gmsh', 'numba', 'pyfftw')); "
+            "assert not heavy, heavy; sys.exit(rc)")
+    result = subprocess.run([sys.executable, "-c", code, str(path)], capture_output=True, text=True)
+    assert result.returncode == 2, result.stderr
+    assert "error: roughness.file = 'pad.x3p': cannot read it as a topography" in result.stderr
+
+
+def test_zones_from_a_measured_file_for_every_cover(tmp_path):
+    from multiscale.workflows import rough
+
+    def make_zones(s, *args, **kwargs):
+        return rough.make_zones(s.roughness, s.micro, *args, **kwargs)
+
+    lo = (0.0, 0.0)
+    lines = []
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")             # the warnings come as report lines, not per rank
+        grid, zones = make_zones(scene(tmp_path, f'file = "{TOP}"\ncover = "mirror"', "grid = [64, 32]"),
+                                 lo, (2e-6, 1e-6), seed=0, log=lines.append)
+    assert len(zones) == 4 and zones[0].shape == (32, 64) and grid.size == pytest.approx((1e-6, 0.5e-6))
+    assert any(line.startswith("roughness: warning: roughness.cover = \"mirror\"") for line in lines)
+    # the measurement as it is: its own pixels, rounded to whole cells per zone
+    grid, zones = make_zones(scene(tmp_path, f'file = "{TOP}"'), lo, (0.3e-6, 0.3e-6), seed=0)
+    assert zones[0].shape == (64, 64) and zones[0].surface.dx == pytest.approx(0.15e-6 / 64)
+    with pytest.raises(InputError, match=r'roughness\.cover = .measured.: the measurement \(0\.0006 x 0\.0006 mm\) '
+                                         r'does not cover the interface'):
+        make_zones(scene(tmp_path, f'file = "{TOP}"'), lo, (1e-6, 1e-6), seed=0)
+    # a statistically equivalent face: 50 x 50 cells per zone unless micro.grid says otherwise, seeded
+    eq = scene(tmp_path, f'file = "{TOP}"\ncover = "equivalent"\nseed = 3')
+    lines = []
+    _, a = make_zones(eq, lo, (4e-6, 4e-6), seed=10, log=lines.append)
+    _, b = make_zones(eq, lo, (4e-6, 4e-6), seed=10)
+    assert a[0].shape == (50, 50) and np.array_equal(a[3].surface.heights, b[3].surface.heights)
+    assert any("statistically equivalent surface" in line for line in lines)

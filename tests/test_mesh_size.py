@@ -1,0 +1,112 @@
+"""The cell count of a mesh, estimated before meshing (issue 21: a 0.05 mm mesh size used to start
+meshing without end): trial meshes with every element size scaled up, extrapolated as a volume
+mesh (``multiscale.geometry.estimate_cells``); a mesh estimated above ``geometry.max_cells`` is
+refused before meshing, on every rank, with one message."""
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+gmsh = pytest.importorskip("gmsh")
+
+from multiscale.errors import InputError  # noqa: E402
+from multiscale.geometry import MAX_CELLS, builder, check_cells, estimate_cells  # noqa: E402
+
+TINY = {"mesh_size": 5e-5, "holder_mesh_size": 5e-5, "interface_mesh_size": 5e-5}
+
+
+def cells(name: str, params: dict) -> int:
+    """Tetrahedra of the builder's real mesh."""
+    gmsh.initialize(interruptible=False)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.add("real")
+        builder(name).generate(gmsh.model, params)
+        return sum(len(t) for t in gmsh.model.mesh.getElements(3)[1])
+    finally:
+        gmsh.finalize()
+
+
+@pytest.mark.parametrize("name, params", [
+    ("pin_on_disc", {"interface_mesh_size": 1e-3, "mesh_size": 6e-3}),
+    ("block_on_flat", {"mesh_size": 0.4e-3}),
+    ("disc_brake", {}),                         # its coarsest trials fail in the CAD kernel: skipped
+    ("disc_brake", {"mesh_size": 6e-3}),
+])
+def test_the_estimate_is_within_a_factor_two_and_a_half(name, params):
+    """From trial meshes of >= 5000 cells (coarser than the mesh: factor > 1), the estimate lies
+    between 0.9x (mesh-to-mesh noise of gmsh) and 2.5x the real count (measured: 1.0-2.1x; the
+    disc brake's circles keep their curvature-based cells in coarse trials; 1.0-1.3x from the
+    default 20 000-cell trials)."""
+    estimate = estimate_cells(builder(name), params, target=5000)
+    real = cells(name, params)
+    assert estimate.factor > 1 and estimate.trial >= 5000 and not estimate.exact
+    assert 0.9 * real <= estimate.cells <= 2.5 * real, (estimate, real)
+
+
+def test_the_estimate_of_a_small_mesh_is_its_count():
+    """A mesh smaller than the trial target is meshed at its size: the exact count."""
+    estimate = estimate_cells(builder("block_on_flat"), {})
+    assert estimate.exact and estimate.cells == cells("block_on_flat", {})
+
+
+def test_an_absurd_mesh_size_is_refused_before_meshing():
+    """0.05 mm everywhere on the pin-on-disc: ~1e10 cells, refused from one trial mesh 64x coarser;
+    the message names the limit and what to change."""
+    with pytest.raises(InputError, match=r"geometry.max_cells = 1000000: the mesh would have about 1\.\d+e\+10 "
+                                         r"cells .*geometry.mesh_size.*--max-cells") as info:
+        check_cells(builder("pin_on_disc"), TINY, MAX_CELLS)
+    assert "64x coarser" in str(info.value)
+
+
+def test_a_mesh_below_the_limit_is_settled_by_a_coarse_trial():
+    """The estimate over-estimates, so a coarse trial below the limit settles it: the mesh itself
+    is not built twice."""
+    estimate = check_cells(builder("pin_on_disc"), {}, MAX_CELLS)
+    assert estimate.factor > 2 and 0.9 * cells("pin_on_disc", {}) <= estimate.cells <= MAX_CELLS
+
+
+def test_gmsh_is_left_as_found():
+    """Each trial is a gmsh session of its own; a caller's session is refused, not disturbed."""
+    estimate_cells(builder("block_on_flat"), {})
+    assert not gmsh.isInitialized()
+    gmsh.initialize(interruptible=False)
+    try:
+        with pytest.raises(RuntimeError, match="before gmsh.initialize"):
+            estimate_cells(builder("block_on_flat"), {})
+    finally:
+        gmsh.finalize()
+
+
+def test_the_limit_of_a_run_two_ranks(tmp_path):
+    """multiscale run on 2 ranks of a scene whose mesh exceeds --max-cells: both ranks end with
+    exit code 2 and one error line, before meshing."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+    from test_faults import MPIEXEC, SCENE
+    scene = tmp_path / "scene.toml"
+    scene.write_text(SCENE.format(folder=tmp_path / "out"))
+    done = subprocess.run([str(MPIEXEC), "-n", "2", str(Path(sys.executable).with_name("multiscale")), "run",
+                           str(scene), "--max-cells", "50"], capture_output=True, text=True, timeout=300)
+    errors = [line for line in done.stderr.splitlines() if line.startswith("error")]
+    assert done.returncode == 2, done.stderr[-2000:]
+    assert len(errors) == 1 and "geometry.max_cells = 50: the mesh would have about" in errors[0]
+
+
+def test_max_cells_in_the_scene_and_on_the_command_line(tmp_path, capsys):
+    from multiscale.cli import main
+    from multiscale.scene import loads
+    from test_faults import SCENE
+    text = SCENE.format(folder=tmp_path / "out")
+    assert loads(text).geometry.max_cells == MAX_CELLS
+    assert loads(text.replace('mesh_size = "5 mm"', 'mesh_size = "5 mm"\nmax_cells = 2_000_000')).geometry.max_cells \
+        == 2_000_000
+    with pytest.raises(InputError, match="geometry.max_cells"):
+        loads(text.replace('mesh_size = "5 mm"', 'mesh_size = "5 mm"\nmax_cells = 0'))
+    path = tmp_path / "scene.toml"
+    path.write_text(text)
+    assert main(["check", str(path), "--cells"]) == 0
+    assert "cells (exact); within geometry.max_cells = 1,000,000" in capsys.readouterr().out
+    with pytest.raises(SystemExit):
+        main(["run", str(path), "--max-cells", "2.5"])
+    assert "a whole number" in capsys.readouterr().err

@@ -1,0 +1,212 @@
+"""Measured topographies (issue 17): instrument files read through SurfaceTopography (heights, pixel
+sizes and RMS values equal its own), channels and overrides, one clear error per bad input, and the
+conditioning steps checked against exact answers: harmonic filling of a plane, form removal, the
+ISO 16610-61 Gaussian filter's transmission, resampling and covering an interface."""
+import os
+from pathlib import Path
+
+import numpy as np
+import pytest
+import SurfaceTopography as ST
+from SurfaceTopography.Support.UnitConversion import get_unit_conversion_factor
+
+from multiscale.errors import InputError
+from multiscale.micro.spectrum import surface_statistics
+from multiscale.micro.surface import Surface, fractal_surface, load_surface
+from multiscale.micro.topography import (Measurement, TopographyWarning, condition, cover, formats,
+                                         gaussian_filter, gaussian_transmission, probe_topography,
+                                         read_topography, resample)
+
+ROOT = Path(__file__).resolve().parents[1]
+DATA = ROOT / "tests" / "data"
+# the shared measurements beside the repository (../shared; ../../shared from a worktree)
+SHARED = next((p for p in (Path(os.environ.get("MULTISCALE_TOPOGRAPHIES", "/nonexistent")),
+                           ROOT.parent / "shared/data/topographies", ROOT.parent.parent / "shared/data/topographies")
+               if p.is_dir()), None)
+FOUR = ["x3p-2.x3p", "plu-1.plu", "sur-2.sur", "opd-1.opd"]
+FILES = [DATA / "top-1.top", DATA / "sdf-1.sdf"] + [
+    pytest.param(SHARED / name if SHARED else Path(name), id=name,
+                 marks=pytest.mark.skipif(SHARED is None, reason="../shared/data/topographies not here"))
+    for name in FOUR]
+
+
+def write_nc(path, heights, dx, dy):
+    """A NetCDF topography file written by SurfaceTopography: heights [y, x] in m, NaN undefined."""
+    h = np.ma.masked_invalid(np.asarray(heights, dtype=float).T)
+    ST.Topography(h, (h.shape[0] * dx, h.shape[1] * dy), unit="m").to_netcdf(str(path))
+    return path
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")      # SurfaceTopography's NetCDF reader, on close
+@pytest.mark.parametrize("path", FILES)
+def test_heights_pixel_sizes_and_rms_equal_surfacetopography(path):
+    m = read_topography(path)
+    t = ST.open_topography(str(path)).topography()
+    f = get_unit_conversion_factor(t.unit, "m")
+    ref = np.ma.masked_invalid(np.ma.asarray(t.heights(), dtype=float))         # [x, y], file unit
+    mine = m.heights.T / f
+    undefined = np.ma.getmaskarray(ref)
+    np.testing.assert_array_equal(np.isnan(mine), undefined)
+    np.testing.assert_allclose(mine[~undefined], ref.data[~undefined], rtol=1e-9, atol=0)
+    assert (m.dx, m.dy) == pytest.approx((t.pixel_size[0] * f, t.pixel_size[1] * f), rel=1e-9)
+    assert m.size == pytest.approx(tuple(s * f for s in t.physical_sizes), rel=1e-9)
+    # RMS height and gradient as read (undefined points filled alike): SurfaceTopography's own values
+    stats = surface_statistics(condition(m, detrend="none").surface)
+    filled = t.interpolate_undefined_data() if t.has_undefined_data else t
+    assert stats.Sq == pytest.approx(filled.Sq() * f, rel=1e-9)
+    assert stats.Sdq == pytest.approx(filled.rms_gradient(), rel=1e-9)
+
+
+def test_channel_selection_and_overrides_with_a_warning():
+    t = ST.open_topography(str(DATA / "top-1.top")).topography()
+    assert read_topography(DATA / "top-1.top", 0).channel_name == "Default"
+    with pytest.warns(TopographyWarning, match="overrides the file's") as caught:
+        m = read_topography(DATA / "top-1.top", pixel_size=(1e-8, 2e-8), height_unit=1e-6)
+    assert len(caught) == 2 and len(m.notes) == 2
+    assert (m.dx, m.dy) == (1e-8, 2e-8)
+    np.testing.assert_allclose(m.heights, np.asarray(t.heights()).T * 1e-6, rtol=1e-12)
+
+
+def test_plain_matrices_still_read_as_before(tmp_path):
+    h = fractal_surface(16, 1e-3, 0.8, 1, 4, 1.0, seed=3).heights
+    np.save(tmp_path / "pad.npy", h)
+    m = read_topography(tmp_path / "pad.npy", pixel_size=2e-6, height_unit=1e-6)
+    np.testing.assert_array_equal(m.heights, load_surface(tmp_path / "pad.npy", 2e-6, scale=1e-6,
+                                                          detrend="none").heights)
+    assert (m.dx, m.dy) == (2e-6, 2e-6)
+    with pytest.raises(InputError, match=r"roughness\.pixel_size = None: pad\.npy is a plain height matrix"):
+        read_topography(tmp_path / "pad.npy", prefix="roughness.")
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+@pytest.mark.parametrize("case, message", [
+    ("unreadable", r"roughness\.file = '.*pad\.x3p': cannot read it as a topography"),
+    ("garbage sur", r"roughness\.file = '.*pad\.sur': cannot read it as a topography"),
+    ("missing", r"roughness\.file = '.*nowhere\.x3p': no such file"),
+    ("unknown channel", r"roughness\.channel = 3: top-1\.top has the channels 0 \"Default\" \(2-D\)"),
+    ("all undefined", r"roughness\.file = '.*empty\.nc': channel 0 \(\"[^\"]*\"\) holds no defined height"),
+    ("profile", r"roughness\.file = '.*opdx-3\.opdx': channel 0 \(\"Height\"\) is a 1-D profile \(line scan\): "
+                r"a height map \(2-D\) is needed"),
+])
+def test_bad_input_is_one_clear_error_naming_the_file_and_the_field(tmp_path, case, message):
+    path, channel = {"unreadable": (tmp_path / "pad.x3p", None), "garbage sur": (tmp_path / "pad.sur", None),
+                     "missing": (tmp_path / "nowhere.x3p", None), "unknown channel": (DATA / "top-1.top", 3),
+                     "all undefined": (tmp_path / "empty.nc", None), "profile": (DATA / "opdx-3.opdx", None)}[case]
+    if case in ("unreadable", "garbage sur"):
+        path.write_bytes(b"this is no topography\n" * 40)
+    if case == "all undefined":
+        write_nc(path, np.full((6, 8), np.nan), 1e-6, 1e-6)
+    with pytest.raises(InputError, match=message):
+        read_topography(path, channel, prefix="roughness.")
+    problems, _ = probe_topography(path, channel, prefix="roughness.")      # what `multiscale check` says
+    assert len(problems) == 1 and problems[0].startswith("roughness.")
+
+
+def test_formats_are_surfacetopographys():
+    names = " ".join(formats())
+    for fmt in (".x3p", ".sur", ".plu", ".opd", ".datx", ".al3d", ".ibw", ".npy"):
+        assert fmt in names
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+def test_undefined_points_of_a_plane_are_filled_exactly_and_too_many_refused(tmp_path):
+    n, d = 40, 1e-6
+    y, x = np.mgrid[:n, :n] * d
+    plane = 2e-3 * x - 1e-3 * y + 1e-7
+    holes = plane.copy()
+    holes[10:14, 5:9] = holes[30, 30] = holes[17, 21:23] = np.nan        # 19 points inside
+    m = read_topography(write_nc(tmp_path / "holes.nc", holes, d, d))
+    assert m.undefined == 19
+    done = condition(m, detrend="none")
+    np.testing.assert_allclose(done.surface.heights, plane - plane.mean(), atol=1e-12 * np.abs(plane).max())
+    assert "filled 19 undefined points (1.19%) by harmonic interpolation" in " ".join(done.report)
+    with pytest.raises(InputError, match=r"roughness\.file = '.*holes\.nc': 1\.2% of its points are undefined, "
+                                         r"more than roughness\.max_undefined = 1\.0%"):
+        condition(m, max_undefined=0.01, prefix="roughness.")
+    assert probe_topography(m.path, max_undefined=0.01)[0]
+
+
+def test_form_removal_plane_and_polynomial():
+    n, d = 32, 1e-6
+    y, x = np.mgrid[:n, :n] * d
+    rough = 1e-8 * np.sin(2 * np.pi * x / (8 * d)) * np.sin(2 * np.pi * y / (8 * d))   # no plane, no curvature
+
+    def conditioned(h, mode):
+        return condition(Measurement(h, d, d, Path("synthetic.x3p")), detrend=mode).surface.heights
+
+    tilt, bowl = 3e-3 * x + 1e-3 * y, 2e2 * ((x - 16e-6) ** 2 + (y - 10e-6) ** 2)
+    assert np.abs(conditioned(tilt, "plane")).max() < 1e-12 * np.abs(tilt).max()
+    assert np.abs(conditioned(bowl, "poly2")).max() < 1e-12 * np.abs(bowl).max()
+    assert np.abs(conditioned(bowl, "plane")).max() > 1e-2 * np.abs(bowl).max()   # a plane leaves the bowl
+    np.testing.assert_allclose(conditioned(tilt + rough, "plane"), conditioned(rough, "plane"), atol=1e-20)
+    with pytest.raises(InputError, match=r"detrend = 'cubic': one of none, mean, plane, poly2"):
+        conditioned(tilt, "cubic")
+
+
+def test_gaussian_filter_splits_two_sinusoids_as_its_transmission_says():
+    """ISO 16610-61: the mean surface keeps exp(-π (α λc/λ)²) of a sinusoid, 50 % at λ = λc."""
+    n, d, cutoff = 256, 1e-6, 32e-6
+    y, x = np.mgrid[:n, :n] * d
+    long_wave, short_wave = 128e-6, n * d / (16 * np.sqrt(2))       # 4 λc along x; λc/2.8 diagonally
+    a, b = 2e-6, 0.5e-6
+    wave = a * np.cos(2 * np.pi * x / long_wave)
+    ripple = b * np.sin(2 * np.pi * 16 * (x + y) / (n * d))
+    expected = gaussian_transmission(long_wave, cutoff) * wave + gaussian_transmission(short_wave, cutoff) * ripple
+    assert gaussian_transmission(cutoff, cutoff) == pytest.approx(0.5, rel=1e-15)
+    periodic = gaussian_filter(Surface(wave + ripple, d, d, periodic=True), cutoff).heights
+    np.testing.assert_allclose(periodic, expected, atol=1e-6 * a)
+    # a measurement (mirrored at its edges): exact one cut-off away from the edges (the kernel's reach)
+    done = condition(Measurement(wave + ripple, d, d, Path("waves.sur")), detrend="none", cutoff=cutoff)
+
+    def inner(h):
+        h = h[32:-32, 32:-32]
+        return h - h.mean()
+
+    np.testing.assert_allclose(inner(done.waviness.heights), inner(expected), atol=1e-6 * a)
+    np.testing.assert_allclose(inner(done.surface.heights), inner(wave + ripple - expected), atol=1e-6 * a)
+    assert "Gaussian filter (ISO 16610-61) at λc = 0.032 mm" in done.report[-1]
+
+
+def test_resampling_keeps_a_smooth_surface_and_filters_before_coarsening():
+    n, d = 64, 1e-6
+    wave = 32e-6                                         # two periods over the patch
+
+    def sampled(m, dx):
+        x = (np.arange(m) + 0.5) * dx
+        return 1e-6 * np.cos(2 * np.pi * x / wave)[None, :] * np.cos(2 * np.pi * x / wave)[:, None]
+
+    s = Surface(sampled(n, d), d, d, periodic=True)
+    fine, note = resample(s, (2 * n, 2 * n))
+    np.testing.assert_allclose(fine.heights, sampled(2 * n, d / 2), atol=1e-3 * 1e-6)
+    assert fine.dx == d / 2 and "cubic splines" in note and "S-filter" not in note
+    coarse, note = resample(s, (n // 4, n // 4))
+    assert "S-filter at λs = 12 um against aliasing" in note
+    keep = gaussian_transmission(wave, 12e-6) ** 2          # the S-filter's, in x and in y
+    np.testing.assert_allclose(coarse.heights, keep * sampled(n // 4, 4 * d), atol=2e-2 * 1e-6)
+
+
+def test_covering_an_interface():
+    d = 1e-6
+    s = Surface(fractal_surface(40, 40e-6, 0.8, 1, 10, 1e-7, seed=4).heights, d, d, periodic=False)
+    inside, lines = cover(s, (20, 20), (20e-6, 20e-6))                    # the measured centre, as it is
+    np.testing.assert_allclose(inside.heights, s.heights[10:30, 10:30] - s.heights[10:30, 10:30].mean(), atol=1e-20)
+    with pytest.raises(InputError, match=r'roughness\.cover = .measured.: the measurement \(0\.04 x 0\.04 mm\) does '
+                                         r'not cover the interface \(0\.1 x 0\.08 mm\): use "equivalent"'):
+        cover(s, (100, 80), (100e-6, 80e-6), prefix="roughness.")
+    with pytest.warns(TopographyWarning, match=r"3 x 2 mirror-stitched copies; wavelengths longer than 0\.08 mm "
+                                               r"are missing and the pattern repeats"):
+        mirrored, lines = cover(s, (200, 100), (200e-6, 100e-6), "mirror")
+    twice = np.block([[s.heights, s.heights[:, ::-1]], [s.heights[::-1], s.heights[::-1, ::-1]]])
+    tiles = np.tile(twice, (2, 3))[30:130, 20:220]                          # the central 200 x 100 cells
+    np.testing.assert_allclose(mirrored.heights, tiles - tiles.mean(), atol=1e-20)
+    with pytest.warns(TopographyWarning, match="3 x 2 copies"):
+        tiled, _ = cover(s, (100, 60), (100e-6, 60e-6), "tile")
+    assert tiled.shape == (60, 100) and not tiled.periodic
+    with pytest.warns(TopographyWarning, match="13 x 7 mirror-stitched copies"):     # coarsened before copying
+        coarse, lines = cover(s, (100, 50), (1e-3, 0.5e-3), "mirror")
+    assert coarse.shape == (50, 100) and lines[0].startswith("resampled 80 x 80 points of 1 um to 8 x 8 of 10 x 10 um")
+    a, _ = cover(s, (64, 48), (128e-6, 96e-6), "equivalent", seed=5)
+    b, _ = cover(s, (64, 48), (128e-6, 96e-6), "equivalent", seed=5)
+    c, _ = cover(s, (64, 48), (128e-6, 96e-6), "equivalent", seed=6)
+    np.testing.assert_array_equal(a.heights, b.heights)
+    assert a.shape == (48, 64) and a.dx == 2e-6 and not np.allclose(a.heights, c.heights)
