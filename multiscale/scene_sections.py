@@ -559,17 +559,13 @@ class Sweep:
 class Stability:
     """Complex eigenvalue analysis (§4.3): modes in a frequency band, shift target, damping.
 
-    Damping: ``damping`` (a structural loss factor eta of the whole system), ``rayleigh_alpha`` /
-    ``rayleigh_beta`` (alpha M + beta K of the whole linearised system): proportional, mapped
-    exactly from the undamped modes; per-material damping ([materials] loss_factor,
-    damping_alpha, damping_beta), the friction slope of a mu(v) law (``friction_damping``) and the
-    gyroscopic terms are not: the damped problem is then solved as a full quadratic eigenproblem
-    (``method = "quadratic"``, exact, viscous damping only: the default for it) or by projection
-    on the undamped modes up to ``basis`` x the band's top (``"projection"``, the default with loss
-    factors; approximate for damping localised at the interface: see ``multiscale.macro.damped``).
-    ``prestress`` adds the initial-stress stiffness of the preloaded state (and reports its effect
-    on every frequency); ``gyroscopic`` the Coriolis and centrifugal terms of the rotating body at
-    the loading speed."""
+    ``damping`` (loss factor eta), ``rayleigh_alpha`` / ``rayleigh_beta`` (alpha M + beta K) act on
+    the whole system, mapped exactly from the undamped modes. Per-material damping, the friction
+    slope (``friction_damping``) and the gyroscopic terms are solved as a full quadratic
+    eigenproblem (``method = "quadratic"``, viscous only) or by projection on the undamped modes up
+    to ``basis`` x the band's top (``"projection"``, needed for loss factors); ``"auto"`` picks.
+    ``prestress``: the initial-stress stiffness of the preload, its effect on every frequency
+    reported; ``gyroscopic``: the rotating body's Coriolis and centrifugal terms (docs/squeal.md)."""
 
     band: tuple = key(Pair(Quantity("frequency", ge=0), single=False, names="[low, high]"),
                       default=(0.0, 16e3))                                    # Hz

@@ -40,8 +40,9 @@ from multiscale.macro.preload import linearise_system, preload
 from multiscale.macro.stability_map import MapBuilder, StabilityMap
 from multiscale.plots.squeal import plot_map, plot_tracks
 from multiscale.schema import FrozenMap
+from multiscale.scene_sections import SWEEP_PARAMETERS
 
-UNITS = {"friction": "-", "pressure": "Pa", "speed": "rad/s", "rms": "m"}
+UNITS = SWEEP_PARAMETERS          # swept parameter -> unit
 
 
 class MapModel:
