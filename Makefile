@@ -1,5 +1,5 @@
-# Two commands set everything up on a fresh machine: `make demo` and `make test`.
-# Each bootstraps .venv (Python >= 3.12) only when pyproject.toml changed.
+# Two commands set everything up on a fresh machine: `make demo` and `make test` (which also builds
+# the user guide, `make docs`). Each bootstraps .venv (Python >= 3.12) only when pyproject.toml changed.
 SHELL := /bin/bash
 VENV := .venv
 BIN := $(VENV)/bin
@@ -15,7 +15,7 @@ PYTHON ?= $(shell for p in python python3 python3.12 python3.13 python3.14; do \
 	  if command -v $$p >/dev/null 2>&1 && $$p -c 'import sys; sys.exit(sys.version_info < (3, 12))' 2>/dev/null; then \
 	    command -v $$p; break; fi; done)
 
-.PHONY: venv demo test test-serial test-mpi bench report clean
+.PHONY: venv demo test test-serial test-mpi docs bench report clean
 
 venv: $(STAMP)
 
@@ -23,13 +23,17 @@ $(STAMP): pyproject.toml
 	@test -n "$(PYTHON)" || { echo "error: no Python >= 3.12 found (pyenv install 3.12, or make PYTHON=/path/to/python3.12)"; exit 1; }
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -e '.[fem,test]'
+	$(BIN)/python -m pip install -q -e '.[fem,test,docs]'
 	@touch $(STAMP)
 
 demo: $(STAMP)
 	$(BIN)/mpiexec -n $(NP) $(BIN)/multiscale run demos/pin_on_disc.toml --overwrite
 
-test: test-serial test-mpi
+test: docs test-serial test-mpi
+
+# The user guide (docs/_build/html): any warning, a broken cross-reference among them, fails it.
+docs: $(STAMP)
+	$(BIN)/python -m sphinx -b html -E -W --keep-going -n -q docs docs/_build/html
 
 test-serial: $(STAMP)
 	$(BIN)/python -m pytest -q tests
@@ -51,4 +55,4 @@ report: $(STAMP)
 	$(BIN)/multiscale study studies/accuracy/*.toml --report docs/accuracy
 
 clean:
-	rm -rf $(VENV) .pytest_cache build *.egg-info
+	rm -rf $(VENV) .pytest_cache build *.egg-info docs/_build

@@ -1,95 +1,247 @@
-"""FFT-BEM contact speed and agreement against tamaas (issue 2).
+"""FFT-BEM normal contact: the targets of issue 23 side by side with tamaas (issues 2, 23).
 
-Same surfaces, same material, periodic kernel, pressure control, p/E* ~ 0.01 * rms slope,
-same relative tolerance (1e-8), one thread each (OMP_NUM_THREADS=1, MULTISCALE_THREADS=1).
-Each repeat times tamaas then ours back to back (the VM's speed drifts between minutes); reports
-median times, the median of the per-repeat ratios, iterations, contact area and the relative L2
-difference of the pressure fields. Run: python benchmarks/bench_contact.py [--quick]
+Solvers: ours with the preconditioned constrained CG (``method="bccg"``, the default), ours with
+Polonsky–Keer (``method="pk"``) and tamaas 2.9 ``PolonskyKeerRey`` (``basic_2d``), one thread
+each (OMP_NUM_THREADS=1, MULTISCALE_THREADS=1 unless said), the same relative tolerance 1e-8.
+Each repeat runs tamaas, then bccg, then pk back to back (the VM's speed drifts between
+minutes); times are medians over repeats, ratios medians of the per-repeat ratios.
+
+Surfaces the issue prescribes: self-affine, Hurst 0.8, cut-offs 4 and N/4 wavelengths over the
+patch, RMS slope 1, E* = 1, mean pressure 0.01 (A/A0 ~ 2 %), N = 256 ... 2048; then at N = 512
+an anisotropic one (cut-offs 4 x 16 and N/4 x N/16), H = 0.3, 30 % contact, and an isolated patch
+(zero-padded; tamaas has none: pk is the reference there); batches of 100 patches of 128².
+
+Columns: iterations (tamaas counted from its log in an untimed run); "pairs/it": FFT pairs per
+iteration counted by the FFT wrapper (``multiscale.micro.fft.fft_pairs``: every transform of the
+solve, the nested coarse solves included, weighted by its cells, in pairs of the FFT grid: N² for
+a periodic patch, (2N)² zero-padded for an isolated one); "t/it [pairs]": time per iteration over
+the time of one rfft2 + irfft2 pair of that grid (measured here); "to ref": relative
+L2 distance of the pressure to a tol = 1e-12 reference (bccg; pk at 1e-12 agrees with it to
+~1e-11); "vs pk": relative L2 between bccg and pk at tol 1e-8 (the discrete answer).
+
+Run: python benchmarks/bench_contact.py [--quick] [--sizes 256,512] [--skip-tamaas-above N]
 """
 import argparse
+import contextlib
 import os
+import platform
+import re
 import statistics as stats
+import subprocess
+import sys
+import tempfile
 import time
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
+os.environ.setdefault("MULTISCALE_THREADS", "1")
 import numpy as np  # noqa: E402
 
+from multiscale.micro import fft  # noqa: E402
 from multiscale.micro.contact import ContactSolver  # noqa: E402
 from multiscale.micro.kernels import HalfSpace  # noqa: E402
 from multiscale.micro.surface import fractal_surface, statistics  # noqa: E402
 
 TOL = 1e-8
-E = HalfSpace.from_materials(1.0, 0.0)   # E* = 1: tamaas' model.E = 1, nu = 0
+E = HalfSpace(1.0)                    # E* = 1: tamaas' model.E = 1, nu = 0
+LOAD = 0.01                           # mean pressure / E*
 
 
-def case(n, batch=(), seed=1):
-    s = fractal_surface(n, 1.0, 0.8, 4, min(64, n // 4), 1e-2, seed=seed, batch=batch)
-    load = 0.01 * E.E_star * np.asarray(statistics(s).rms_slope)
-    return s, load
+def surface(n, hurst=0.8, k_min=4, k_max=None, seed=1, batch=()):
+    s = fractal_surface(n, 1.0, hurst, k_min, k_max or n // 4, 1.0, seed=seed, batch=batch)
+    slope = np.asarray(statistics(s).rms_slope)
+    return s.heights / (slope[..., None, None] if batch else slope), s.dx
 
 
-def tamaas_solve(h, load):
+def tamaas_solve(h, load, tol=TOL, log=False):
     import tamaas as tm
     n = h.shape[-1]
     model = tm.ModelFactory.createModel(tm.model_type.basic_2d, [1.0, 1.0], [n, n])
     model.E, model.nu = 1.0, 0.0
-    solver = tm.PolonskyKeerRey(model, np.ascontiguousarray(h), TOL)
+    solver = tm.PolonskyKeerRey(model, np.ascontiguousarray(h), tol)
+    solver.max_iter = 100000
+    if log:
+        solver.dump_freq = 1
     solver.solve(float(load))
     return np.array(model.traction).reshape(n, n)
 
 
-def timed(fn, repeats):
-    """Median wall time of ``repeats`` calls of ``fn`` and its last result."""
-    times, out = [], None
+def tamaas_iterations(h, load):
+    """Iterations of tamaas' solve, read from its log: an untimed run in a subprocess (tamaas
+    prints through C++ streams) that logs every iteration."""
+    with tempfile.TemporaryDirectory() as tmp:
+        path = os.path.join(tmp, "h.npy")
+        np.save(path, h)
+        code = ("import sys, numpy as np, tamaas as tm\n"
+                f"sys.path.insert(0, {os.path.dirname(os.path.abspath(__file__))!r})\n"
+                "from bench_contact import tamaas_solve\n"
+                "tm.set_log_level(tm.LogLevel.info)\n"
+                f"tamaas_solve(np.load({path!r}), {float(load)!r}, log=True)\n")
+        done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+        out = done.stdout + done.stderr                   # tamaas logs to stderr
+    numbers = [int(m.group(1)) for m in re.finditer(r"^\s*(\d+)\s+\S+\s+\S+\s*$", out, re.M)]
+    return max(numbers) if numbers else -1
+
+
+def pair_time(shape, repeats=30):
+    """Median time of one rfft2 + irfft2 pair of ``shape`` (our wrapper, FFTW_MEASURE plans)."""
+    plan = fft.RealFFT2(shape)
+    plan.input[...] = np.random.default_rng(0).random(shape)
+    times = []
     for _ in range(repeats):
         t0 = time.perf_counter()
-        out = fn()
+        plan.forward()
+        plan.inverse(normalise=False)
         times.append(time.perf_counter() - t0)
-    return stats.median(times), out
+    return stats.median(times)
 
 
-def side_by_side(peer, ours, repeats):
-    """Median peer time, median our time, median per-repeat ratio, our last result, peer's."""
-    t_peer, t_ours, ratio = [], [], []
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out_peer = peer()
-        t1 = time.perf_counter()
-        out = ours()
-        t2 = time.perf_counter()
-        t_peer.append(t1 - t0)
-        t_ours.append(t2 - t1)
-        ratio.append(t_ours[-1] / t_peer[-1])
-    return stats.median(t_peer), stats.median(t_ours), stats.median(ratio), out, out_peer
+def rel(a, b):
+    return float(np.linalg.norm(a - b) / np.linalg.norm(b))
+
+
+def ours(solver, h, load, method):
+    fft.reset_fft_counts()
+    t0 = time.perf_counter()
+    r = solver.solve(h, load=load, tol=TOL, method=method)
+    return time.perf_counter() - t0, r, fft.fft_pairs(solver.operator.fft_shape)
+
+
+def machine():
+    model = "?"
+    with contextlib.suppress(OSError):
+        for line in open("/proc/cpuinfo"):
+            if line.startswith("model name"):
+                model = line.split(":", 1)[1].strip()
+                break
+    return f"{platform.node()}, {os.cpu_count()} cores, {model}"
+
+
+def compare(name, h, dx, load, reps, with_tamaas=True, periodic=True):
+    """One row per solver: time, ratio to tamaas, iterations, pairs/it, t/it in pairs, to ref, vs pk."""
+    solver = ContactSolver(E, h.shape, dx, periodic=periodic)
+    solver.solve(h, load=load, tol=1e-4)                  # plans and compiled loops outside the timing
+    solver.solve(h, load=load, tol=1e-4, method="pk")
+    ref = solver.solve(h, load=load, tol=1e-12, max_iter=100000).pressure
+    times = {"tamaas": [], "bccg": [], "pk": []}
+    out = {}
+    for _ in range(reps):
+        if with_tamaas:
+            t0 = time.perf_counter()
+            out["tamaas"] = tamaas_solve(h, load)
+            times["tamaas"].append(time.perf_counter() - t0)
+        for m in ("bccg", "pk"):
+            t, r, pairs = ours(solver, h, load, m)
+            times[m].append(t)
+            out[m] = (r, pairs)
+    tp = pair_time(solver.operator.fft_shape)
+    rows = []
+    for m in ("tamaas", "bccg", "pk"):
+        if not times[m]:
+            continue
+        t = stats.median(times[m])
+        ratio = stats.median([a / b for a, b in zip(times[m], times["tamaas"])]) if times["tamaas"] else float("nan")
+        if m == "tamaas":
+            its = tamaas_iterations(h, load)
+            p, pairs, area = out[m], float("nan"), float(np.mean(out[m] > 0))
+        else:
+            r, pairs = out[m]
+            its, p, area = int(r.iterations), r.pressure, float(r.area_fraction)
+            pairs /= its
+        per_it = t / its / tp if its > 0 else float("nan")
+        vs_pk = rel(p, out["pk"][0].pressure) if m != "pk" else 0.0
+        rows.append((name, m, t, ratio, its, pairs, per_it, rel(p, ref), vs_pk, area))
+    return rows
+
+
+def print_rows(rows):
+    print(f"{'case':>24} {'solver':>7} {'time [s]':>9} {'/tamaas':>8} {'its':>5} {'pairs/it':>8} "
+          f"{'t/it [pairs]':>12} {'to ref':>9} {'vs pk':>9} {'A/A0':>7}")
+    for name, m, t, ratio, its, pairs, per_it, to_ref, vs_pk, area in rows:
+        print(f"{name:>24} {m:>7} {t:9.3f} {ratio:8.3f} {its:5d} {pairs:8.2f} {per_it:12.2f} "
+              f"{to_ref:9.1e} {vs_pk:9.1e} {area:7.4f}", flush=True)
+
+
+def stopping_rule(n, tols=(1e-6, 1e-8, 1e-10)):
+    """Distance to the 1e-12 reference at the same nominal tolerance: ours (both) and tamaas."""
+    h, dx = surface(n, seed=7)
+    solver = ContactSolver(E, h.shape, dx)
+    ref = solver.solve(h, load=LOAD, tol=1e-12).pressure
+    print(f"\nstopping rule, N = {n}: relative L2 distance of the pressure to the tol 1e-12 reference")
+    print(f"{'tol':>8} {'bccg':>9} {'pk':>9} {'tamaas':>9}")
+    for tol in tols:
+        b = rel(solver.solve(h, load=LOAD, tol=tol).pressure, ref)
+        k = rel(solver.solve(h, load=LOAD, tol=tol, method="pk").pressure, ref)
+        t = rel(tamaas_solve(h, LOAD, tol), ref)
+        print(f"{tol:8.0e} {b:9.2e} {k:9.2e} {t:9.2e}", flush=True)
+
+
+def batch(n_patches, n, reps, threads):
+    """One call with the batch against a loop over its patches, the same solver, both methods."""
+    fft.set_threads(threads)
+    h, dx = surface(n, seed=2, batch=(n_patches,))
+    print(f"\nbatch of {n_patches} patches of {n}², MULTISCALE_THREADS={threads}")
+    print(f"{'method':>7} {'one call [s]':>12} {'loop [s]':>9} {'speed-up':>8} {'its (max)':>9} {'max rel diff':>12}")
+    for m in ("bccg", "pk"):
+        solver = ContactSolver(E, (n, n), dx, method=m)
+        solver.solve(h, load=LOAD)
+        solver.solve(h[0], load=LOAD)
+        tb, tl, ratio = [], [], []
+        for _ in range(reps):
+            t0 = time.perf_counter()
+            rb = solver.solve(h, load=LOAD)
+            t1 = time.perf_counter()
+            rl = [solver.solve(h[k], load=LOAD) for k in range(n_patches)]
+            t2 = time.perf_counter()
+            tb.append(t1 - t0)
+            tl.append(t2 - t1)
+            ratio.append((t2 - t1) / (t1 - t0))
+        diff = max(rel(rb.pressure[k], rl[k].pressure) for k in range(n_patches))
+        print(f"{m:>7} {stats.median(tb):12.3f} {stats.median(tl):9.3f} {stats.median(ratio):8.2f} "
+              f"{int(rb.iterations.max()):9d} {diff:12.1e}", flush=True)
+    fft.set_threads(1)
 
 
 def main():
-    ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--quick", action="store_true", help="fewer repeats, smaller batch")
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--quick", action="store_true", help="N = 256, 512, one repeat, smaller batches")
+    ap.add_argument("--sizes", default="", help="grid sizes of the scaling rows (default 256,512,1024,2048)")
+    ap.add_argument("--skip-tamaas-above", type=int, default=1 << 30, help="no tamaas above this N")
+    ap.add_argument("--only", default="scaling,surfaces,stopping,batch", help="parts to run")
     args = ap.parse_args()
     import tamaas as tm
     tm.set_log_level(tm.LogLevel.error)
-    reps = 1 if args.quick else 5
-    print(f"{'case':>16} {'tamaas [s]':>11} {'ours [s]':>9} {'ratio':>6} {'iters':>6} {'A/A0':>8} {'rel L2(p)':>10}")
-    for n in (256, 512, 1024):
-        s, load = case(n)
-        solver = ContactSolver(E, s.shape, s.dx)
-        solver.solve(s.heights, load=load, tol=TOL)           # plans built outside the timing
-        t_tm, t_us, ratio, r, p_tm = side_by_side(lambda: tamaas_solve(s.heights, load),
-                                                  lambda: solver.solve(s.heights, load=load, tol=TOL), reps)
-        err = np.linalg.norm(r.pressure - p_tm) / np.linalg.norm(p_tm)
-        print(f"{f'{n}x{n}':>16} {t_tm:11.3f} {t_us:9.3f} {ratio:6.2f} {int(r.iterations):6d} "
-              f"{float(r.area_fraction):8.4f} {err:10.2e}")
-    nb = 100 if args.quick else 400
-    s, load = case(64, batch=(nb,), seed=2)
-    solver = ContactSolver(E, s.shape, s.dx)
-    solver.solve(s.heights, load=load, tol=TOL)
-    t_tm, t_us, ratio, r, p_tm = side_by_side(
-        lambda: np.stack([tamaas_solve(h, l) for h, l in zip(s.heights, load)]),
-        lambda: solver.solve(s.heights, load=load, tol=TOL), reps)
-    err = np.max(np.linalg.norm(r.pressure - p_tm, axis=(1, 2)) / np.linalg.norm(p_tm, axis=(1, 2)))
-    print(f"{f'{nb}x(64x64)':>16} {t_tm:11.3f} {t_us:9.3f} {ratio:6.2f} {int(r.iterations.max()):6d} "
-          f"{float(r.area_fraction.mean()):8.4f} {err:10.2e}")
+    parts = set(args.only.split(","))
+    sizes = [int(s) for s in args.sizes.split(",") if s] or ([256, 512] if args.quick else [256, 512, 1024, 2048])
+    load0 = os.getloadavg()
+    print(f"{time.strftime('%Y-%m-%d %H:%M %Z')}; {machine()}; load average {load0[0]:.2f} {load0[1]:.2f}")
+    print(f"command: {' '.join(sys.argv)}; tamaas {tm.__version__}; numpy {np.__version__}")
+    if "scaling" in parts:
+        rows = []
+        for n in sizes:
+            reps = 1 if args.quick else {256: 5, 512: 5, 1024: 3}.get(n, 2)
+            h, dx = surface(n)
+            rows += compare(f"{n}² slope 1", h, dx, LOAD, reps, n <= args.skip_tamaas_above)
+        print_rows(rows)
+    if "surfaces" in parts:
+        n, reps = 512, (1 if args.quick else 3)
+        rows = []
+        h, dx = surface(n, k_min=(4, 16), k_max=(n // 4, n // 16))
+        rows += compare(f"{n}² anisotropic 4x", h, dx, LOAD, reps)
+        h, dx = surface(n, hurst=0.3)
+        rows += compare(f"{n}² H = 0.3", h, dx, LOAD, reps)
+        h, dx = surface(n)
+        rows += compare(f"{n}² 30 % contact", h, dx, 0.2, reps)
+        h, dx = surface(n)
+        rows += compare(f"{n}² isolated", h, dx, LOAD, reps, with_tamaas=False, periodic=False)
+        print()
+        print_rows(rows)
+    if "stopping" in parts:
+        stopping_rule(256 if args.quick else 512)
+    if "batch" in parts:
+        for threads in (1, 2):
+            batch(100, 128, 1 if args.quick else 3, threads)
+    load1 = os.getloadavg()
+    print(f"\nload average at the end {load1[0]:.2f} {load1[1]:.2f}")
 
 
 if __name__ == "__main__":

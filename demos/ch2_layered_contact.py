@@ -118,7 +118,7 @@ for col, (runs, title) in enumerate([([(100e-6, E2, f"E2/E1 = {E2 / E1:g}") for 
         ax[1, col].plot(a * 1e6, zeta, "--", color=f"C{i}", label=f"ζ, {label}")
     ax[1, col].set(title=title, xlabel="contact radius a [µm]", ylabel="χ (solid), ζ (dashed) [-]")
     ax[1, col].legend(fontsize=7, ncol=2)
-ax[1, 2].set(title="Fig. 2.9: χ/ζ force error vs full solution", xlabel="approach δ [µm]",
+ax[1, 2].set(title="force error of the χ/ζ approximation", xlabel="approach δ [µm]",
              ylabel="P_approx / P_full - 1 [%]")
 ax[1, 2].legend(fontsize=6, ncol=2)
 
@@ -198,10 +198,10 @@ for i, (E2, (curves, bem)) in enumerate(results.items()):
     ax[1, 1].plot(m_n.mean_pressure / E1_STAR * 1e3, m_n.area_fraction * 100, "--", color=colour, label=f"N, {label}")
 pg = dict(xlabel="separation g_n [µm]", ylabel="p_n / E1* [-]")
 ap = dict(xlabel="p_n / E1* [1e-3]", ylabel="A / A0 [%]")
-ax[0, 0].set(title="Fig. 2.13: model I (lines) vs FFT-BEM (circles)", **pg)
-ax[0, 1].set(title="Fig. 2.14: real area, model I vs FFT-BEM", **ap)
-ax[1, 0].set(title="Fig. 2.15: with (I) and without (N) interaction", **pg)
-ax[1, 1].set(title="Fig. 2.16: real area, I vs N", **ap)
+ax[0, 0].set(title="pressure-gap: model I (lines) vs FFT-BEM (circles)", **pg)
+ax[0, 1].set(title="real contact area: model I vs FFT-BEM", **ap)
+ax[1, 0].set(title="pressure-gap with (I) and without (N) interaction", **pg)
+ax[1, 1].set(title="real contact area with (I) and without (N) interaction", **ap)
 for axis in ax.ravel():
     axis.legend(fontsize=7)
     axis.grid(True, which="both", alpha=0.3)

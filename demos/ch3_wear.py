@@ -83,15 +83,15 @@ for N, run in runs.items():
     s_mm = run.history.sliding * 1e3
     axes[0, 0].plot(s_mm, run.history.area_fraction * 100, label=f"N = {N}")
     axes[0, 1].plot(s_mm, run.history.max_depth * 1e6, label=f"N = {N}")
-axes[0, 0].set(xlabel="sliding distance [mm]", ylabel="real contact area A/A0 [%]", title="Fig. 3.3")
-axes[0, 1].set(xlabel="sliding distance [mm]", ylabel="max wear depth [µm]", title="Fig. 3.4")
+axes[0, 0].set(xlabel="sliding distance [mm]", ylabel="real contact area A/A0 [%]", title="real contact area against sliding distance")
+axes[0, 1].set(xlabel="sliding distance [mm]", ylabel="max wear depth [µm]", title="max wear depth against sliding distance")
 h = main_run.history
 axes[1, 0].plot(h.sliding * 1e3, h.volume / area * 1e9, label="wear volume")
 axes[1, 0].plot(h.sliding * 1e3, args.kw * MU * P * h.sliding * 1e9, "k--", label="k_w μ p S")
-axes[1, 0].set(xlabel="sliding distance [mm]", ylabel="wear volume per area [nm]", title="Fig. 3.9")
+axes[1, 0].set(xlabel="sliding distance [mm]", ylabel="wear volume per area [nm]", title="wear volume against sliding distance")
 for law in main_run.laws:
     axes[1, 1].plot(law.mean_gap * 1e6, law.pressure / 1e6, "o-", label=f"S = {law.sliding * 1e3:.1f} mm")
-axes[1, 1].set(xlabel="mean gap g_n [µm]", ylabel="mean pressure p_n [MPa]", title="Fig. 3.10")
+axes[1, 1].set(xlabel="mean gap g_n [µm]", ylabel="mean pressure p_n [MPa]", title="pressure-gap law of the worn surface")
 for ax in axes.flat:
     ax.grid(True, alpha=0.3)
     ax.legend()
@@ -109,10 +109,10 @@ L = surface.size[0] * 1e3
 ext = (0, L, 0, L)
 im = axes[0, 0].imshow(surface.heights * 1e6, extent=ext, origin="lower", cmap="terrain")
 fig.colorbar(im, ax=axes[0, 0], label="height [µm]")
-axes[0, 0].set(title="initial surface (Fig. 3.5)")
+axes[0, 0].set(title="initial surface heights")
 im = axes[0, 1].imshow(main_run.depth * 1e6, extent=ext, origin="lower", cmap="viridis")
 fig.colorbar(im, ax=axes[0, 1], label="wear depth [µm]")
-axes[0, 1].set(title=f"wear depth after S = {S * 1e3:.0f} mm (Fig. 3.6)")
+axes[0, 1].set(title=f"wear depth after S = {S * 1e3:.0f} mm")
 for ax, title, pressure in ((axes[1, 0], "initial", initial.pressure),
                             (axes[1, 1], f"after S = {S * 1e3:.0f} mm", main_run.pressure)):
     im = ax.imshow(pressure / 1e6, extent=ext, origin="lower", cmap="inferno")

@@ -112,7 +112,7 @@ for R in (0.0, 1e-7, 3e-7, 1e-6):
     law = conductance_law(surface, mech, heat, pressures, resistance=R)
     ax.plot(pressures / 1e6, law.conductance / 1e3, "o-", label=f"R = {R:.0e} m² K/W")
     print(f"  R = {R:.0e}: K_t = {law.conductance[i3]:.0f}, K_i = {law.interface_conductance[i3]:.0f} W/(m² K)")
-ax.set(xlabel="mean pressure [MPa]", ylabel="K_t [10³ W/(m² K)]", title="Fig. 5.25: local resistance")
+ax.set(xlabel="mean pressure [MPa]", ylabel="K_t [10³ W/(m² K)]", title="conductance with a local interface resistance")
 ax.grid(True, alpha=0.3)
 ax.legend(fontsize=8)
 fig.tight_layout()

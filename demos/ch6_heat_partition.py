@@ -110,7 +110,7 @@ for omega in (1.0, 10.0, 50.0, 100.0):
     print(f"  omega = {omega:5.0f} rad/s: p1(4.5 ms) = {r.partition_1[-1]:.4f}, "
           f"T_max = {r.max_temperature_1[-1]:.1f} K, {r.iterations.sum()} CG iterations")
     hot = r
-a1.set(xlabel="t [ms]", ylabel="heat partition [-]", title="Fig. 6.24: p1(t), p2(t)")
+a1.set(xlabel="t [ms]", ylabel="heat partition [-]", title="heat partition p1 (disc), p2 (pin) against time")
 a2.set(xlabel="t [ms]", ylabel="max surface temperature rise [K]", title="T_max(t)", yscale="log")
 for a in (a1, a2):
     a.grid(alpha=0.3)
@@ -123,7 +123,7 @@ fig, axes = plt.subplots(1, 2, figsize=(11, 4.4))
 for ax, T, name in zip(axes, (hot.temperature_1[0], hot.temperature_2[0]), ("S1 (mobile)", "S2 (static)")):
     im = ax.imshow(T, origin="lower", extent=(0, 1, 0, 1), cmap="inferno")
     ax.set(title=f"{name} at 4.5 ms, ω = 100 rad/s", xlabel="x [mm]", ylabel="y [mm]")
-    fig.colorbar(im, ax=ax, label="T [K]")
+    fig.colorbar(im, ax=ax, label="temperature rise [K]")
 save(fig, "temperatures")
 
 # ## Influence of the contact area (§6.4.2.1, Figs. 6.26–6.27)
@@ -137,8 +137,8 @@ fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
 for v, p1, t1, t2 in zip(law.speed, law.partition_1, law.max_temperature_1, law.max_temperature_2):
     a1.plot(law.area_fraction * 100, p1, "o-", label=f"V = {v:.1f} m/s")
     a2.plot(law.area_fraction * 100, np.maximum(t1, t2), "o-", label=f"V = {v:.1f} m/s")
-a1.set(xlabel="real contact area [%]", ylabel="steady p1 [-]", title="Fig. 6.26: p1 versus contact area")
-a2.set(xlabel="real contact area [%]", ylabel="steady T_max [K]", title="Fig. 6.27", yscale="log")
+a1.set(xlabel="real contact area [%]", ylabel="steady p1 [-]", title="steady partition p1 against the real contact area")
+a2.set(xlabel="real contact area [%]", ylabel="steady max temperature rise [K]", title="steady flash temperature rise", yscale="log")
 for a in (a1, a2):
     a.grid(alpha=0.3)
     a.legend(fontsize=8)
@@ -165,9 +165,9 @@ for omega1, style in ((5.0, "-"), (1.0, "--"), (0.0, ":")):
     after = r.times > 0.1
     print(f"  omega1 = {omega1:g}: after the ramp (t > 100 ms) Phi1 in [{r.heat_1[after].min():.3g}, "
           f"{r.heat_1[after].max():.3g}] W, Phi2 in [{r.heat_2[after].min():.3g}, {r.heat_2[after].max():.3g}] W")
-titles = ("Fig. 6.30: heat generated Φ", "Fig. 6.31: Φ1, Φ2",
-          "Fig. 6.32: p1 (undefined once Φ = 0)", "Fig. 6.33: T_max")
-ylabels = ("Φ [W]", "Φ1, Φ2 [W]", "p1 [-]", "T_max [K]")
+titles = ("heat generated Φ", "heat into each body Φ1, Φ2",
+          "partition p1 (undefined once Φ = 0)", "max temperature rise")
+ylabels = ("Φ [W]", "Φ1, Φ2 [W]", "p1 [-]", "max temperature rise [K]")
 for ax, title, ylabel in zip(axes.flat, titles, ylabels):
     ax.set(xlabel="t [ms]", ylabel=ylabel, title=title)
     ax.grid(alpha=0.3)
@@ -200,7 +200,7 @@ for col, (study, layers) in enumerate(cases.items()):
         axes[1, col].plot(t, r.max_temperature_1, color=f"C{i}", label=f"S1, {label}")
         axes[1, col].plot(t, r.max_temperature_2, "--", color=f"C{i}", label=f"S2, {label}")
     axes[0, col].set(title=f"{study}: heat partition", xlabel="t [ms]", ylabel="p1, p2 [-]")
-    axes[1, col].set(title=f"{study}: T_max", xlabel="t [ms]", ylabel="T_max [K]")
+    axes[1, col].set(title=f"{study}: max temperature rise", xlabel="t [ms]", ylabel="max temperature rise [K]")
 for ax in axes.flat:
     ax.grid(alpha=0.3)
     ax.legend(fontsize=6, ncol=2)
@@ -223,7 +223,7 @@ for ax, omega in zip(axes, (10.0, 100.0)):
     for name, temps in remote.items():
         ax.plot(area, steady.solve(swept.pressure, MU, remote_temperatures=temps).partition_1, "o-",
                 label=f"{name}: θ1⁰ = {temps[0]}, θ2⁰ = {temps[1]}")
-    ax.set(xlabel="real contact area [%]", ylabel="steady p1 [-]", title=f"ω = {omega:g} rad/s (Figs 6.49-6.50)")
+    ax.set(xlabel="real contact area [%]", ylabel="steady p1 [-]", title=f"steady partition p1 against the real contact area, ω = {omega:g} rad/s")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
 save(fig, "remote")

@@ -1,8 +1,14 @@
-"""Command line: ``multiscale <command>``. User errors print one line each and exit 2."""
+"""Command line: ``multiscale <command>``. User errors print one line each and exit 2.
+
+Help texts are plain text (no reST markup); parallel runs name the ``mpiexec`` of the environment
+that holds multiscale (``.venv/bin/mpiexec``), and a run started by another MPI's launcher is
+stopped with a message saying so (``launcher_problem``).
+"""
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import os
 import sys
 from pathlib import Path
 
@@ -11,9 +17,18 @@ from multiscale.errors import InputError, MultiscaleError, SceneError
 from multiscale.io import ended_together
 from multiscale.micro.spectrum import surface_statistics
 from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition, formats, read_topography
+from multiscale.outputs import plan
+from multiscale.outputs import summary as plan_summary
 from multiscale.scene import load
 from multiscale.scene_summary import cells_line, reference, summary
 from multiscale.units import UnitError, to_si
+
+DESCRIPTION = """Multi-scale thermo-mechanical simulation of frictional sliding contacts (disc brakes,
+pin-on-disc): validate a scene file (check), run it (run), sweep parameters (study)."""
+MPIEXEC = f"{Path(sys.executable).parent / 'mpiexec'}"
+EPILOG = f"""Parallel runs: {MPIEXEC} -n N multiscale run scene.toml
+Use the mpiexec of this environment: the launcher of another MPI (a system mpirun or mpiexec)
+starts N separate serial runs, or stops with a PMI error."""
 
 
 def _info(args) -> int:
@@ -51,11 +66,40 @@ def _check(args) -> int:
             print(f"{path}: {n} problem{'s' if n > 1 else ''}", file=sys.stderr)
             failed += 1
             continue
-        print("\n".join(summary(scene)))
+        print("\n".join(summary(scene) + plan_summary(plan(scene))))
         if args.cells:
             print(cells_line(scene))
         print(f"{path}: OK")
     return 2 if failed else 0
+
+
+# environment variables that MPI launchers set: (size, rank)
+LAUNCHERS = {"Open MPI": ("OMPI_COMM_WORLD_SIZE", "OMPI_COMM_WORLD_RANK"),
+             "MPICH/Intel MPI (PMI)": ("PMI_SIZE", "PMI_RANK"), "PMIx": ("PMIX_SIZE", "PMIX_RANK"),
+             "MVAPICH": ("MV2_COMM_WORLD_SIZE", "MV2_COMM_WORLD_RANK"),
+             "Slurm srun": ("SLURM_STEP_NUM_TASKS", "SLURM_PROCID")}
+
+
+def launcher_problem(comm, environ=None) -> tuple[str, bool] | None:
+    """(message, print it) when a launcher started several processes that all see an MPI world
+    of size 1: ``mpiexec``/``mpirun`` of another MPI than the one mpi4py was built with. ``print
+    it`` is true on the launcher's rank 0 only (every process thinks it is rank 0 of 1)."""
+    environ = os.environ if environ is None else environ
+    if comm.size != 1:
+        return None
+    for name, (size_var, rank_var) in LAUNCHERS.items():
+        try:
+            size = int(environ.get(size_var, "1"))
+        except ValueError:
+            continue
+        if size > 1:
+            mpiexec = Path(sys.executable).parent / "mpiexec"
+            message = (f"started by a {name} launcher for {size} processes ({size_var}={size}), but every process "
+                       f"sees an MPI world of 1: that launcher belongs to another MPI than the one multiscale "
+                       f"uses. Start parallel runs with the mpiexec of this environment: {mpiexec} -n {size} "
+                       f"multiscale ...")
+            return message, environ.get(rank_var, "0") == "0"
+    return None
 
 
 def _world():
@@ -77,6 +121,12 @@ def _run(args) -> int:
     hangs."""
     comm = _world()
     rank = comm.rank if comm is not None else 0
+    foreign = launcher_problem(comm) if comm is not None else None
+    if foreign is not None:
+        message, shown = foreign
+        if shown:
+            print(f"error: {message}", file=sys.stderr)
+        return 2
     try:
         scene = load(args.scene)
         if args.max_cells is not None:
@@ -88,7 +138,7 @@ def _run(args) -> int:
         except ModuleNotFoundError as exc:
             raise MultiscaleError(f"multiscale run needs DOLFINx and the macro workflows ({exc}); install "
                                   "them with pip install -e '.[fem]'") from None
-        run(scene, overwrite=args.overwrite, resume=args.resume)
+        run(scene, overwrite=args.overwrite, resume=args.resume, verbose=not args.quiet)
     except MultiscaleError as exc:
         if comm is not None and not ended_together(comm):
             print(f"error (rank {rank} of {comm.size}): {exc}", file=sys.stderr, flush=True)
@@ -107,6 +157,12 @@ def _study(args) -> int:
         return 0
     if not args.studies:
         raise MultiscaleError("multiscale study: give study file(s), or --problems for the problems and their keys")
+    comm = _world()
+    foreign = launcher_problem(comm) if comm is not None else None
+    if foreign is not None:
+        if foreign[1]:
+            print(f"error: {foreign[0]}", file=sys.stderr)
+        return 2
     command = " ".join(["multiscale study", *args.studies] + (["--report", args.report] if args.report else []))
     failed = run_studies(args.studies, rerun_failed=args.rerun_failed, report_folder=args.report,
                          processes=args.processes, command=command)
@@ -167,24 +223,37 @@ def _surface(args) -> int:
 
 
 def build_parser() -> argparse.ArgumentParser:
-    parser = argparse.ArgumentParser(prog="multiscale", description=__doc__)
-    sub = parser.add_subparsers(dest="command", required=True)
-    sub.add_parser("info", help="versions and settings").set_defaults(func=_info)
-    check = sub.add_parser("check", help="validate scene files: every problem at once, or a summary")
+    parser = argparse.ArgumentParser(prog="multiscale", description=DESCRIPTION, epilog=EPILOG,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser.add_argument("--version", action="version", version=f"multiscale {__version__}")
+    sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    sub.add_parser("info", help="versions and settings", description="Print the versions of multiscale and "
+                   "of the libraries it uses.").set_defaults(func=_info)
+    check = sub.add_parser("check", help="validate scene files: every problem at once, or a summary",
+                           description="Validate scene files without running them: every problem at once, "
+                           "or a summary of what a run computes and the files it writes.")
     check.add_argument("scenes", nargs="*", metavar="SCENE", help="scene TOML file(s)")
     check.add_argument("--keys", action="store_true", help="print the scene format: every section and key")
     check.add_argument("--cells", action="store_true", help="estimate the mesh's cell count (trial meshes, seconds)")
     check.set_defaults(func=_check)
-    run = sub.add_parser("run", help="run a scene (mpirun -n N multiscale run scene.toml)")
+    run = sub.add_parser("run", help=f"run a scene (in parallel: {MPIEXEC} -n N multiscale run SCENE)",
+                         description="Run a scene: its effects decide the analysis (transient, multiscale loop "
+                         "or squeal); the results, their provenance and a ParaView script go to output.folder. "
+                         "One line per stage on the terminal.", epilog=EPILOG,
+                         formatter_class=argparse.RawDescriptionHelpFormatter)
     run.add_argument("scene", metavar="SCENE", help="scene TOML file")
     again = run.add_mutually_exclusive_group()
     again.add_argument("--overwrite", action="store_true", help="replace results already in the output folder")
     again.add_argument("--resume", action="store_true", help="continue from the last checkpoint in the output folder")
+    run.add_argument("--quiet", action="store_true", help="no stage lines or summary (errors only)")
     run.add_argument("--max-cells", type=_count, metavar="N", help="largest mesh (cells) the run may build; "
                                                                    "overrides geometry.max_cells (default 1e6)")
     run.set_defaults(func=_run)
-    study = sub.add_parser("study", help="parametric study: sweep, resumable runs, accuracy-vs-time report "
-                                         "(mpiexec -n N multiscale study study.toml)")
+    study = sub.add_parser("study", help=f"parametric study: sweep, resumable runs, accuracy-vs-time report "
+                                         f"(in parallel: {MPIEXEC} -n N multiscale study STUDY)",
+                           description="Sweep the knobs of a problem, run what is missing (resumable) and "
+                           "write tables, plots and a Markdown report.", epilog=EPILOG,
+                           formatter_class=argparse.RawDescriptionHelpFormatter)
     study.add_argument("studies", nargs="*", metavar="STUDY", help="study TOML file(s)")
     study.add_argument("--rerun-failed", action="store_true", help="run the failed runs again")
     study.add_argument("--report", metavar="DIR", help="write every report into DIR, with an index README.md")

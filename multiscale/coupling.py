@@ -9,21 +9,62 @@ One macro step Δt (Fig. 7.2) runs:
    force on the zone's facets) / (zone area) — so that the micro patch carries the macro force —,
    the facet temperatures of both bodies, the sliding speed and direction at the zone centre;
 3. the micro post-analysis of the loaded zones (Fig. 7.5, ``micro.post_analysis``): local pressure
-   under P, local surface temperature and partition (steady sliding heating, both bodies' remote
-   temperatures at the rough body's macro surface temperature: the macro field already holds the
-   zone-scale heating, and feeding the macro temperature difference of the two surfaces back into
-   the micro partition double counts it and makes the explicit coupling oscillate), and, every
-   ``wear_every`` steps, the Archard wear of the patch over the sliding of those steps with k_w(T);
-   the zones are spread over the MPI ranks and the worn topographies shared;
+   under P, local surface temperatures, flash temperature and partition (steady sliding heating,
+   or with ``PostAnalysis.heating.transient_steps`` the transient heating over Δt, Table 7.1),
+   and, every ``wear_every`` steps, the Archard wear of the patch over the sliding of those steps
+   with k_w(T) (and the counter-face's, spread over its wear track: ``rough.track_depth``); the
+   zones are spread over the MPI ranks and the worn topographies shared;
 4. the laws of the zones whose topography changed are recomputed (``rough.RoughInterface``: the
    others come from the pool's cache), the facet laws updated and the mechanics re-solved at the
    same time: the macro temperature field carries over to the next step unchanged.
 
+Remote temperatures of the micro heating (``LoopSettings.remote``). "bulk": each body's own macro
+surface temperature at the zone (thesis §7.2.2, §6.5: the heat conducted from the hotter body
+through the contact spots is part of the heat into the rough body, whose share of the frictional
+heat may then leave [0, 1]). "rough": both at the rough body's (the partition then depends on the
+contact and the speed only); a departure from the thesis, the loop's behaviour before issue 19,
+kept as an option (and the scenes' default with an interface conductance, which conducts between
+the bulk temperatures itself): with the bulk temperatures the explicit coupling swings, a hotter
+rough body sending its heat back through the partition of the next step. The scenes' default is
+"bulk" with the implicit coupling (below).
+
+Coupling of partitions and temperatures (``LoopSettings.coupling``); residual of a step: max over
+the loaded zones of |heat into the rough body by the post-analysis at the end of the step − the
+heat the macro model puts into it at that state| / mean zone frictional heat (``heat_residual``;
+a light zone's partition counts for the heat it moves). Schemes:
+
+- "explicit": the partitions of step n + 1 come from the post-analysis of step n (thesis Fig. 7.2).
+- "fixed-point" (thesis form, converged): the partitions p of step n solve p = G(p), G = the
+  post-analysis' partitions at the end of a macro step run with p: the step is restarted from its
+  initial state (``snapshot``/``restore_state``) with the next p of Anderson's acceleration
+  (``anderson``: a multisecant quasi-Newton on the per-zone partitions, residuals weighted by the
+  zones' heat, first step p + ``relaxation`` (G(p) − p)) until the residual is <= ``coupling_tol``;
+  wear is then done once, at the converged state. A scalar relaxation (Aitken's Δ²) does not do:
+  the zones' gains differ by orders of magnitude (a heavily loaded zone over-reacts, a light one
+  hardly) and one factor that tames the first stalls the others (measured on the coarse demo:
+  30 passes without reaching 1e-3).
+- "implicit" (bulk temperatures only): the micro problem is linear in the frictional heat and the
+  remote temperatures, so the post-analysis returns, per zone, the partition at equal remote
+  temperatures and the exchange G [W/K] (``PostAnalysis`` with ``Heating.conduction``); the macro
+  model splits the frictional heat with the first and conducts G (T_rough − T_counter) through the
+  interface conductance h_c = G / (facet area of the zone), inside its own backward-Euler heat
+  solve. This is a Newton step on the per-zone heat with the micro model's exact derivative, the
+  macro heat solve doing the rest: the micro heat at the end of the step is the macro one up to
+  the change of the contact during the step, in one pass. It departs from the thesis' form (which
+  keeps the thermal fields of the two bodies disconnected, Fig. 7.4, the conduction hidden in the
+  partition) to reach the same balance without its failure: in the thesis' form the conduction is
+  a multiple of the zone's frictional heat, so that a zone which barely touches at the
+  post-analysis (a partition of −2.3e4 measured at 1e-6 N on the coarse demo) and is pressed
+  harder at the next macro step (after the worn laws' re-solve) receives that multiple of a much
+  larger frictional heat (−74 W, the pin's whole share turned negative).
+
+The default (``scene_sections.COUPLING_DEFAULT``) was chosen by measurement
+(``docs/accuracy/coupling.md``).
+
 The initial laws are computed before the first solve; the rigid datum gap starts Newton close to
-equilibrium. The partitions of step n + 1 come from the heating of step n's post-analysis
-(explicit coupling). ``save``/``restore`` write and read the whole state (``checkpoint``), so that
-a killed run continues to the same history (to solver tolerance: a resumed run recomputes its
-zone laws). This module reads no scene: ``multiscale.workflows.multiscale`` builds and runs it.
+equilibrium. ``save``/``restore`` write and read the whole state (``checkpoint``), so that a killed
+run continues to the same history (to solver tolerance: a resumed run recomputes its zone laws).
+This module reads no scene: ``multiscale.workflows.multiscale`` builds and runs it.
 """
 from __future__ import annotations
 
@@ -35,7 +76,7 @@ import h5py
 import numpy as np
 
 from multiscale import checkpoint, io
-from multiscale.errors import InputError
+from multiscale.errors import ConvergenceError, InputError
 from multiscale.geometry import Rotation
 from multiscale.macro.mechanics import SolveResult
 from multiscale.macro.model import MacroModel
@@ -43,6 +84,9 @@ from multiscale.micro.post_analysis import PostAnalysis
 from multiscale.rough import RoughInterface
 
 LOADED = 1e-9              # zones below this fraction of the nominal pressure are unloaded
+REMOTE = ("rough", "bulk")
+ANDERSON_MEMORY = 8        # past passes the fixed point's acceleration uses
+COUPLING = ("explicit", "fixed-point", "implicit")
 
 
 @dataclass(frozen=True)
@@ -56,8 +100,25 @@ class LoopSettings:
     partition_law: bool = False   # micro partition per zone (ch. 6) instead of the constant
     wear: bool = False            # Archard wear of the zones
     wear_every: int = 1           # macro steps per wear update
+    flash_softening: bool = False  # H(T) of each zone at its last micro flash temperature (plasticity)
     forces: dict = field(default_factory=dict)   # N, per interface: the load it nominally carries
     friction: np.ndarray | None = None            # mu of every zone (its interface's; None: the post-analysis')
+    remote: str = "rough"         # remote temperatures of the micro heating: "rough" or "bulk" (module docstring)
+    coupling: str = "explicit"    # "explicit", "fixed-point" or "implicit" (module docstring)
+    coupling_tol: float = 1e-3    # fixed point: max |G(p) - p| over the loaded zones
+    coupling_iterations: int = 30  # fixed point: passes before ConvergenceError
+    relaxation: float = 0.5       # fixed point: first relaxation factor
+
+    def __post_init__(self):
+        for name, allowed in (("remote", REMOTE), ("coupling", COUPLING)):
+            if getattr(self, name) not in allowed:
+                raise InputError(name, getattr(self, name), f"one of {', '.join(allowed)}")
+        if self.coupling == "implicit" and self.remote != "bulk":
+            raise InputError("coupling", self.coupling, 'the implicit coupling conducts between the bulk temperatures: '
+                             'remote = "bulk"')
+        if not (self.coupling_tol > 0 and self.coupling_iterations >= 1 and 0 < self.relaxation <= 1):
+            raise InputError("coupling", (self.coupling_tol, self.coupling_iterations, self.relaxation),
+                             "tolerance > 0, iterations >= 1, relaxation in (0, 1]")
 
 
 @dataclass
@@ -82,6 +143,7 @@ class MicroStep:
     partition: tuple           # (min, mean, max) share into the rough body over the loaded zones
     work: float                # J, mu ∫ p |v| dA over the wear interval (0 without wear)
     seconds: float
+    plastic_fraction: float = 0.0  # largest share of a zone's cells at the hardness (0 without plasticity)
 
 
 @dataclass
@@ -94,6 +156,7 @@ class StepResult:
     time_macro: float          # s, wall time of the macro solves
     time_micro: float          # s, of the post-analysis
     time_laws: float           # s, of the law updates
+    residuals: list = field(default_factory=list)   # max |G(p) - p| of each pass (empty: no partition law)
 
 
 @dataclass
@@ -103,6 +166,20 @@ class Restored:
     step: int                  # last macro step done
     history: io.History
     fields_written: int        # last step whose fields were written (-1: none)
+
+
+def anderson(passes, weight, mixing: float) -> np.ndarray:
+    """The next partitions of Anderson's acceleration (Walker & Ni 2011, type II) of the fixed point
+    p = G(p): ``passes`` [(p_j, r_j = G(p_j) − p_j), ...], the last one current; the residuals
+    are compared weighted by ``weight`` (the zones' heat): p + m r − (ΔP + m ΔR) γ, γ minimising
+    |W (r − ΔR γ)|; with one pass, the relaxed step p + m r."""
+    p, r = passes[-1]
+    if len(passes) == 1:
+        return p + mixing * r
+    dP = np.column_stack([b[0] - a[0] for a, b in zip(passes, passes[1:])])
+    dR = np.column_stack([b[1] - a[1] for a, b in zip(passes, passes[1:])])
+    gamma = np.linalg.lstsq(weight[:, None] * dR, weight * r, rcond=None)[0]
+    return p + mixing * r - (dP + mixing * dR) @ gamma
 
 
 class Multiscale:
@@ -116,14 +193,31 @@ class Multiscale:
         self.nominal = sum(settings.forces.values()) / self.tm.interface.areas.sum()
         Z = len(rough.zones)
         self.partition = np.full(Z, float(settings.partition))
+        self.proposed = np.full(Z, np.nan)            # partitions of the last post-analysis (NaN: unloaded)
+        self.flash = np.full(Z, np.nan)               # K, flash temperature of each zone (NaN: unloaded)
         self.conductance = np.zeros(Z)
         self.warm = np.zeros(rough.initial.shape)     # previous local pressures (warm starts)
         self.work = 0.0                               # J, frictional work over the wear intervals
         self.datum_gap = np.zeros(self.tm.interface.n_facets)   # m, uniform initial gap g_0 per facet
+        self.counter_depth = np.zeros(self.tm.interface.n_facets)   # m, counter-face worn along its track
+        self.counter_volume = 0.0                     # m^3, lost by the counter-face
+        self.exchange = np.zeros(Z)                   # W/K, conduction rough body -> counter-face (implicit)
+        self.proposed_exchange = np.zeros(Z)
+        self.micro_heat = np.full(Z, np.nan)          # W, Phi of the last post-analysis
+        self.micro_heat_rough = np.full(Z, np.nan)    # W, heat into the rough body by it
+        self.remote_difference = np.zeros(Z)          # K, T_rough − T_counter of the macro surfaces
+        self.facet_area = np.bincount(rough.zone_of_facet[rough.zone_of_facet >= 0],
+                                      self.tm.interface.areas[rough.zone_of_facet >= 0], minlength=Z)
+        self._last = None                             # this rank's zones, their post-analysis, loading, remote
 
     @property
     def partition_law(self) -> bool:
         return self.settings.partition_law and self.post.heating is not None
+
+    @property
+    def iterating(self) -> bool:
+        """True if the partitions are iterated within each step (fixed point)."""
+        return self.settings.coupling == "fixed-point" and self.partition_law and self.model.thermal is not None
 
     # ---- macro <-> micro -------------------------------------------------------------------
     def loading(self) -> ZoneLoading:
@@ -151,42 +245,139 @@ class Multiscale:
         return ZoneLoading(force, force / self.rough.zone_area, np.hypot(w[:, 0], w[:, 1]),
                            np.arctan2(w[:, 1], w[:, 0]), T)
 
-    def micro_step(self, wear: bool, duration: float = 0.0) -> MicroStep:
-        """Post-analysis of the loaded zones at the current macro state; with ``wear`` the zones
-        wear over ``duration`` [s] of sliding (their topographies change)."""
+    def analyse(self) -> MicroStep:
+        """Post-analysis (local contact, heating, conductance) of the loaded zones at the current
+        macro state, spread over the ranks; the partitions (and exchanges) it finds are
+        ``proposed`` (made the zones' by ``accept``)."""
         t0 = _time.perf_counter()
         comm, load, zones = self.comm, self.loading(), self.rough.zones
         loaded = np.flatnonzero(load.pressure > LOADED * self.nominal)
         mine = loaded[comm.rank::comm.size]
-        sliding = load.speed[mine] * duration if wear else None
-        rough = load.temperature[mine, 1]
+        T = load.temperature[mine]
+        remote = np.column_stack([T[:, 0] if self.settings.remote == "bulk" else T[:, 1], T[:, 1]])
         mu = None if self.settings.friction is None else self.settings.friction[mine]
         res = self.post.run([zones[i] for i in mine], load.pressure[mine], speed=load.speed[mine],
-                            angle=load.angle[mine], remote=np.column_stack([rough, rough]), sliding=sliding,
-                            warm=self.warm[mine], mu=mu)
-        parts = comm.allgather((mine, res.worn_pressure, res.heights if wear else None, res.max_pressure,
-                                res.max_temperature, res.partition, res.conductance))
-        max_p, max_T = [], []
-        for ids, warm, heights, mp, mT, part, h_c in parts:
-            self.warm[ids] = warm
-            if heights is not None:
-                self.rough.set_heights(ids, heights)
-            if self.partition_law:
-                self.partition[ids] = part
+                            angle=load.angle[mine], remote=remote, warm=self.warm[mine], mu=mu,
+                            duration=self.settings.dt, hardness_temperature=self._hardness_temperature(mine, T[:, 1]))
+        self._last = (mine, res, load, remote, loaded)
+        implicit = self.settings.coupling == "implicit"
+        parts = comm.allgather((mine, res.pressure, res.max_pressure, res.max_temperature,
+                                res.partition_equal if implicit else res.partition, res.conductance, res.heat,
+                                res.heat_rough, res.exchange, remote[:, 1] - remote[:, 0], res.plastic_area_fraction))
+        for a in (self.proposed, self.flash, self.micro_heat, self.micro_heat_rough):
+            a[:] = np.nan
+        self.proposed_exchange[:] = 0.0
+        max_p, flow = [], [np.zeros(0)]
+        for ids, warm, mp, mT, part, h_c, heat, rough, exchange, diff, fraction in parts:
+            flow.append(fraction)
+            self.warm[ids], self.proposed[ids], self.flash[ids] = warm, part, mT
+            self.micro_heat[ids], self.micro_heat_rough[ids], self.remote_difference[ids] = heat, rough, diff
+            if implicit:
+                self.proposed_exchange[ids] = exchange
             if self.post.conductance is not None:
                 self.conductance[ids] = h_c
             max_p.append(mp)
-            max_T.append(mT)
         if self.post.conductance is not None:
             self.conductance[np.setdiff1d(np.arange(len(zones)), loaded)] = 0.0
-        work = sum(self.model.contact.heat_power()) * duration if wear else 0.0   # mu ∫ p |w| dA Δt
-        self.work += work
-        max_p, max_T = np.concatenate(max_p), np.concatenate(max_T)
-        used = self.partition[loaded] if len(loaded) else np.full(1, np.nan)
+        hot = self.flash[loaded]
+        max_p = np.concatenate(max_p)
         return MicroStep(len(loaded), float(load.pressure.max()), float(max_p.max(initial=0.0)),
-                         float(max_T.max()) if len(max_T) and np.isfinite(max_T).any() else np.nan,
-                         (float(used.min()), float(used.mean()), float(used.max())), work,
-                         _time.perf_counter() - t0)
+                         float(np.nanmax(hot)) if np.isfinite(hot).any() else np.nan, (np.nan,) * 3, 0.0,
+                         _time.perf_counter() - t0, float(np.concatenate(flow).max(initial=0.0)))
+
+    def _hardness_temperature(self, ids, rough_temperature) -> np.ndarray | None:
+        """Where the zones ``ids`` take H(T): with ``settings.flash_softening``, their flash
+        temperature of the previous post-analysis (the rough body's macro temperature before the
+        first, or if higher): the fixed point H = H(T_flash(H)) is reached explicitly over the macro
+        steps (and the passes of the fixed-point coupling); else None (the macro temperature)."""
+        if not self.settings.flash_softening:
+            return None
+        return np.fmax(self.flash[ids], rough_temperature)
+
+    @property
+    def plastic(self) -> bool:
+        """True if the zones are elastic-perfectly plastic (their topographies change when they yield)."""
+        return self.post.hardness is not None
+
+    def deform(self) -> None:
+        """The zones of the last ``analyse`` keep their permanent deformation (without wear; ``wear``
+        keeps it with the worn topographies)."""
+        mine, res = self._last[:2]
+        for ids, heights, w in self.comm.allgather((mine, res.heights, res.plastic)):
+            self.rough.set_heights(ids, heights)
+            self.rough.plastic[ids] += w
+
+    def wear(self, duration: float) -> float:
+        """Wear of the zones of the last ``analyse`` over ``duration`` [s] of sliding (their
+        topographies change; a wearing counter-face recedes along its track); returns the
+        frictional work [J] of the interval."""
+        mine, res, load, remote, _ = self._last
+        zones = self.rough.zones
+        res = self.post.wear([zones[i] for i in mine], res, load.speed[mine] * duration, remote)
+        volume = np.zeros(len(zones))
+        for ids, warm, heights, lost, w in self.comm.allgather((mine, res.worn_pressure, res.heights,
+                                                                 res.counter_volume, res.plastic)):
+            self.warm[ids] = warm
+            self.rough.set_heights(ids, heights)
+            volume[ids] = lost
+            if self.plastic:
+                self.rough.plastic[ids] += w
+        if self.post.counter_rate is not None:
+            contact, iface = self.model.contact, self.tm.interface
+            self.counter_depth += self.rough.track_depth(volume, contact.facet_heat_flux() * iface.areas)
+            self.counter_volume += volume.sum()
+            iface.set_field(contact.initial_gap, self.datum_gap + self.counter_depth)
+        work = sum(self.model.contact.heat_power()) * duration            # mu ∫ p |w| dA Δt
+        self.work += work
+        return work
+
+    def accept(self, micro: MicroStep) -> MicroStep:
+        """The partitions (and exchanges) of the last ``analyse`` become the zones' (partition law);
+        ``micro`` with their (min, mean, max) over the loaded zones."""
+        loaded = self._last[-1]
+        if self.partition_law:
+            self.partition[loaded] = self.proposed[loaded]
+        if self.settings.coupling == "implicit":
+            self.exchange[:] = 0.0
+            self.exchange[loaded] = self.proposed_exchange[loaded]
+        used = self.partition[loaded] if len(loaded) else np.full(1, np.nan)
+        micro.partition = (float(used.min()), float(used.mean()), float(used.max()))
+        return micro
+
+    def micro_step(self, wear: bool, duration: float = 0.0) -> MicroStep:
+        """Post-analysis of the loaded zones at the current macro state, its partitions accepted;
+        with ``wear`` the zones wear over ``duration`` [s] of sliding."""
+        micro = self.analyse()
+        if wear:
+            t0 = _time.perf_counter()
+            micro.work = self.wear(duration)
+            micro.seconds += _time.perf_counter() - t0
+        elif self.plastic:
+            self.deform()
+        return self.accept(micro)
+
+    def residual(self) -> np.ndarray:
+        """G(p) − p per zone: the last post-analysis' partitions minus those used (0 where unloaded)."""
+        return np.where(np.isfinite(self.proposed), self.proposed - self.partition, 0.0)
+
+    def heat_residual(self) -> float:
+        """The coupling residual: max over the loaded zones of |heat into the rough body by the last
+        post-analysis − heat the macro model put into it at the same state (its partition of Phi,
+        minus the exchange G (T_rough − T_counter))| / the zones' mean Phi."""
+        loaded = self._last[-1]
+        if not len(loaded):
+            return 0.0
+        Q = self.micro_heat[loaded]
+        given = self.partition[loaded] * Q - self.exchange[loaded] * self.remote_difference[loaded]
+        return float(np.abs(self.micro_heat_rough[loaded] - given).max() / Q.mean())
+
+    def zone_heat(self) -> np.ndarray:
+        """Frictional heat rate Phi of each zone loaded in the last ``analyse`` over their mean (0 on
+        the others): the weights of the partitions in the fixed point (a change of partition
+        counts as the heat it moves)."""
+        loaded, Q = self._last[-1], np.zeros(len(self.rough.zones))
+        Q[loaded] = self.micro_heat[loaded]
+        return Q / Q[loaded].mean() if len(loaded) and Q[loaded].mean() > 0 else Q
 
     def apply_zone_fields(self) -> None:
         """Per-facet partition (micro partition law) and conductance from the zones."""
@@ -194,17 +385,62 @@ class Multiscale:
         rough = zone_of >= 0                       # the other interfaces keep their scene values
         if self.partition_law:
             iface.set_field(contact.partition, np.where(rough, self.partition[zone_of], iface.values(contact.partition)))
-        if self.post.conductance is not None:
+        if self.settings.coupling == "implicit":   # the exchange G of each zone over its facets
+            self.conductance = self.exchange / np.where(self.facet_area > 0, self.facet_area, 1.0)
+        if self.post.conductance is not None or self.settings.coupling == "implicit":
             iface.set_field(contact.conductance,
                             np.where(rough, self.conductance[zone_of], iface.values(contact.conductance)))
 
     def facet_fields(self) -> dict:
         """Interface output fields of the loop: name -> per-facet array maker."""
         iface, contact, rough = self.tm.interface, self.model.contact, self.rough
-        return {"contact_stiffness": lambda: rough.law.evaluate(contact.facet_gap())[1],
-                "partition": lambda: iface.values(contact.partition),
-                "wear_depth": lambda: np.where(rough.zone_of_facet >= 0,
-                                               rough.wear_depth().mean(axis=(-2, -1))[rough.zone_of_facet], 0.0)}
+        fields = {"contact_stiffness": lambda: rough.law.evaluate(contact.facet_gap())[1],
+                  "partition": lambda: iface.values(contact.partition),
+                  "wear_depth": lambda: np.where(rough.zone_of_facet >= 0,
+                                                 rough.wear_depth().mean(axis=(-2, -1))[rough.zone_of_facet], 0.0)}
+        if self.post.heating is not None:
+            fields["flash_temperature"] = self.facet_flash
+        if self.settings.wear:      # zero where body 1 does not wear (no k_w of its material)
+            fields["counter_wear_depth"] = lambda: self.counter_depth.copy()
+        return fields
+
+    def facet_flash(self) -> np.ndarray:
+        """Flash temperature [K] per facet: its zone's, or the rough body's macro surface
+        temperature where the zone is not loaded (or off the rough interfaces)."""
+        zone_of = self.rough.zone_of_facet
+        macro = self.model.thermal.facet_temperature(0) if self.model.thermal is not None else \
+            np.full(self.tm.interface.n_facets, self.settings.initial_temperature)
+        flash = np.where(zone_of >= 0, self.flash[zone_of], np.nan)
+        return np.where(np.isfinite(flash), flash, macro)
+
+    # ---- state of a macro step (the fixed point restarts it) -------------------------------
+    def snapshot(self) -> dict:
+        """The macro state a step starts from (fields, time, heat counters, drive constants)."""
+        m = self.model
+        state = {"arrays": [f.x.array.copy() for f in self._functions().values()], "time": m.time,
+                 "heat_total": m.heat_total.copy(), "exchanged": m.heat_exchanged_total, "last_solve": m.last_solve,
+                 "constants": [float(c.value) for c in self._constants()]}
+        if m.thermal is not None:
+            state.update(thermal_time=m.thermal.time, lost_total=m.thermal.lost_total.copy(),
+                         lost_step=m.thermal.lost_step.copy())
+        return state
+
+    def restore_state(self, state: dict) -> None:
+        """Back to a ``snapshot``."""
+        m = self.model
+        for f, values in zip(self._functions().values(), state["arrays"]):
+            f.x.array[:] = values
+        for c, value in zip(self._constants(), state["constants"]):
+            c.value = value
+        m.time, m.heat_total, m.last_solve = state["time"], state["heat_total"].copy(), state["last_solve"]
+        m.heat_exchanged_total = state["exchanged"]
+        if m.thermal is not None:
+            m.thermal.time = state["thermal_time"]
+            m.thermal.lost_total, m.thermal.lost_step = state["lost_total"].copy(), state["lost_step"].copy()
+
+    def _constants(self) -> list:
+        m = self.model
+        return [m.contact.speed, m.contact.engaged, m.mechanics.load]
 
     # ---- the run ---------------------------------------------------------------------------
     def start(self) -> StepResult:
@@ -213,7 +449,7 @@ class Multiscale:
         self.rough.update_laws()
         t1 = _time.perf_counter()
         self.datum_gap = self.rough.datum_gap(self.settings.forces)
-        self.tm.interface.set_field(self.model.contact.initial_gap, self.datum_gap)
+        self.tm.interface.set_field(self.model.contact.initial_gap, self.datum_gap + self.counter_depth)
         self.model.start()
         t2 = _time.perf_counter()
         micro = self.micro_step(wear=False)
@@ -221,22 +457,46 @@ class Multiscale:
         return StepResult(0, np.zeros(2), micro, t2 - t1, micro.seconds, t1 - t0)
 
     def step(self, n: int) -> StepResult:
-        """Macro step n (1, 2, ...): the macro transient, the post-analysis, the new laws."""
+        """Macro step n (1, 2, ...): the macro transient and the post-analysis (iterated to the
+        fixed point of the partitions with ``coupling = "fixed-point"``), wear, the new laws."""
         s = self.settings
-        t0 = _time.perf_counter()
-        heat = self.model.macro_step(s.dt, s.substeps)
-        t1 = _time.perf_counter()
-        wear = s.wear and n % s.wear_every == 0
-        micro = self.micro_step(wear, s.dt * s.wear_every if wear else 0.0)
-        self.apply_zone_fields()
+        wear = s.wear and n % s.wear_every == 0 and self.post.wears
+        state = self.snapshot() if self.iterating else None
+        residuals, passes, time_macro, time_micro = [], [], 0.0, 0.0
+        while True:
+            t0 = _time.perf_counter()
+            heat = self.model.macro_step(s.dt, s.substeps)
+            t1 = _time.perf_counter()
+            micro = self.analyse()
+            time_macro, time_micro = time_macro + t1 - t0, time_micro + _time.perf_counter() - t1
+            if self.partition_law:
+                residuals.append(self.heat_residual())
+            if state is None or residuals[-1] <= s.coupling_tol:
+                break
+            if len(residuals) >= s.coupling_iterations:
+                raise ConvergenceError(f"step {n}: the partitions did not converge in {len(residuals)} passes "
+                                       f"(residual {residuals[-1]:.3g} > {s.coupling_tol:g})", residuals)
+            passes.append((self.partition.copy(), self.residual()))
+            self.restore_state(state)
+            self.partition = anderson(passes[-ANDERSON_MEMORY - 1:], self.zone_heat(), s.relaxation)
+            self.apply_zone_fields()
         t2 = _time.perf_counter()
-        self.rough.laws_computed = 0
         if wear:
-            self.rough.update_laws()
+            micro.work = self.wear(s.dt * s.wear_every)
+        elif self.plastic:
+            self.deform()
+        self.accept(micro)
+        self.apply_zone_fields()
         t3 = _time.perf_counter()
-        if wear:
+        self.rough.laws_computed = 0
+        changed = wear or self.plastic           # new topographies: their laws (cached if unchanged)
+        if changed:
+            self.rough.update_laws()
+        t4 = _time.perf_counter()
+        if changed:
             self.model.last_solve = self.model.mechanics.solve()
-        return StepResult(n, heat, micro, t1 - t0 + _time.perf_counter() - t3, t2 - t1, t3 - t2)
+        return StepResult(n, heat, micro, time_macro + _time.perf_counter() - t4, time_micro + t3 - t2, t4 - t3,
+                          residuals)
 
     def record(self, result: StepResult) -> dict:
         """One history row (units: ``io.UNITS``)."""
@@ -246,13 +506,23 @@ class Multiscale:
                    max_zone_pressure=micro.zone_pressure, micro_max_pressure=micro.max_pressure)
         if self.post.heating is not None:
             row.update(micro_max_temperature=micro.max_temperature, partition_min=micro.partition[0],
-                       partition_mean=micro.partition[1], partition_max=micro.partition[2])
+                       partition_mean=micro.partition[1], partition_max=micro.partition[2],
+                       zone_flash_temperature=self.flash.copy())
+        if self.partition_law:
+            row.update(coupling_residual=result.residuals[-1] if result.residuals else np.nan,
+                       coupling_iterations=len(result.residuals))
+        if self.plastic:
+            row.update(micro_plastic_fraction=micro.plastic_fraction,
+                       plastic_max_depth=float(self.rough.plastic.max(initial=0.0)))
         if self.settings.wear:
             heights = self.rough.heights()
-            depth = self.rough.initial - heights
+            depth = self.rough.wear_depth()
             row.update(wear_volume=float(self.rough.zone_wear_volume(depth).sum()), wear_max_depth=float(depth.max()),
                        rms_height=float(np.sqrt(np.mean((heights - heights.mean()) ** 2))),
                        frictional_work=self.work)
+            if self.post.counter_rate is not None:
+                row.update(counter_wear_volume=self.counter_volume,
+                           counter_wear_max_depth=float(self.counter_depth.max(initial=0.0)))
         row.update(time_macro=result.time_macro, time_micro=result.time_micro, time_laws=result.time_laws)
         return row
 
@@ -267,13 +537,16 @@ class Multiscale:
     def save(self, path: Path, step: int, history: io.History) -> None:
         """Checkpoint after macro step ``step`` (collective)."""
         m, last = self.model, self.model.last_solve
-        arrays = {"heights": self.rough.heights(), "warm": self.warm, "partition": self.partition,
-                  "conductance": self.conductance, "levels": self.rough.levels, "heat_total": m.heat_total,
+        arrays = {"heights": self.rough.heights(), "plastic": self.rough.plastic, "warm": self.warm,
+                  "partition": self.partition,
+                  "conductance": self.conductance, "flash": self.flash, "counter_depth": self.counter_depth,
+                  "exchange": self.exchange, "levels": self.rough.levels, "heat_total": m.heat_total,
                   "heat_lost_recorded": m.heat_lost_recorded,
                   **({"lost_total": m.thermal.lost_total} if m.thermal is not None else {}),
                   "datum_gap": self.datum_gap,
                   **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
-        attrs = {"step": step, "time": m.time, "work": self.work, "scene": self.fingerprint, "load": m.load,
+        attrs = {"step": step, "time": m.time, "work": self.work, "counter_volume": self.counter_volume,
+                 "heat_exchanged": [m.heat_exchanged, m.heat_exchanged_total], "scene": self.fingerprint, "load": m.load,
                  "ranks": self.comm.size, "fields_written": -1,
                  "solve": [last.reason, last.iterations, last.normal_force, last.max_pressure]}
         checkpoint.save(path, self.comm, attrs=attrs, arrays=arrays, functions=self._functions(),
@@ -287,9 +560,13 @@ class Multiscale:
                              "run it with --overwrite")
         m = self.model
         self.rough.set_heights(range(len(arrays["heights"])), arrays["heights"])
+        self.rough.plastic = arrays["plastic"].copy()
         self.warm, self.partition = arrays["warm"], arrays["partition"]
         self.conductance, self.rough.levels = arrays["conductance"], arrays["levels"]
-        self.datum_gap = arrays["datum_gap"]
+        self.datum_gap, self.flash, self.counter_depth = arrays["datum_gap"], arrays["flash"], arrays["counter_depth"]
+        self.counter_volume = float(attrs["counter_volume"])
+        m.heat_exchanged, m.heat_exchanged_total = (float(v) for v in attrs["heat_exchanged"])
+        self.exchange = arrays["exchange"]
         m.heat_total = arrays["heat_total"].copy()
         m.heat_lost_recorded = arrays["heat_lost_recorded"].copy()
         if m.thermal is not None:
@@ -299,7 +576,7 @@ class Multiscale:
             m.thermal.time = m.time
         reason, its, force, max_p = attrs["solve"]
         m.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
-        self.tm.interface.set_field(m.contact.initial_gap, self.datum_gap)
+        self.tm.interface.set_field(m.contact.initial_gap, self.datum_gap + self.counter_depth)
         m.contact.speed.value = m.speed(m.time)
         m.load = float(attrs["load"])
         m.mechanics.load.value = m.load * m.drive.factor(m.time)

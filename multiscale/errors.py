@@ -6,6 +6,10 @@ where one exists, the partial result.
 """
 from __future__ import annotations
 
+import numbers
+
+import numpy as np
+
 
 class MultiscaleError(Exception):
     """Base class of every error raised on purpose by multiscale."""
@@ -55,13 +59,70 @@ def _short(value, limit: int = 60) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
+def check_real(name: str, value) -> float:
+    """``value`` as a float if it is a real number (not a string, a bool or an array), else
+    ``InputError`` naming ``name``; NaN and inf pass (callers check ranges)."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real) and not _scalar_array(value):
+        raise InputError(name, value, "must be a real number")
+    return float(value)
+
+
 def check_positive(name: str, value, *, allow_zero: bool = False) -> float:
-    """Return ``value`` as float, or raise InputError if it is not finite and > 0 (>= 0)."""
-    try:
-        v = float(value)
-    except (TypeError, ValueError):
-        raise InputError(name, value, "must be a real number") from None
+    """Return ``value`` as float, or raise InputError if it is not a real number, finite and > 0
+    (>= 0). Strings, bools and arrays are refused (``"1e9"`` used to pass as a number)."""
+    v = check_real(name, value)
     ok = v >= 0 if allow_zero else v > 0
     if not (ok and v == v and v != float("inf")):
         raise InputError(name, value, "must be finite and " + (">= 0" if allow_zero else "> 0"))
     return v
+
+
+def check_count(name: str, value, minimum: int = 1) -> int:
+    """A whole number >= ``minimum`` (an integral float such as 3.0 too; no NaN, no silent
+    truncation of 2.5, no bool), else ``InputError``."""
+    v = check_real(name, value)
+    if not (v == v and abs(v) != float("inf") and v == int(v) and v >= minimum):
+        raise InputError(name, value, f"must be a whole number >= {minimum}")
+    return int(v)
+
+
+def check_flag(name: str, value) -> bool:
+    """True or False (numpy bools too), else ``InputError`` (``"no"`` is not False)."""
+    if type(value).__name__ not in ("bool", "bool_"):
+        raise InputError(name, value, "must be True or False")
+    return bool(value)
+
+
+def check_field(name: str, value, *, min_ndim: int = 0, nonnegative: bool = False):
+    """``value`` as a finite float numpy array with at least ``min_ndim`` axes (>= 0 if
+    ``nonnegative``), else ``InputError`` naming ``name``."""
+    a = np.asarray(value) if not isinstance(value, (str, bytes)) else np.asarray(None)
+    if a.dtype.kind not in "biuf" or a.dtype.kind == "b" and a.ndim == 0:
+        raise InputError(name, _summary(value), "must be a number or an array of numbers")
+    a = a.astype(float)
+    if a.ndim < min_ndim:
+        raise InputError(name + ".shape", a.shape, f"needs at least {min_ndim} axes")
+    if not np.all(np.isfinite(a)):
+        raise InputError(name, _summary(value), "must be finite (no NaN or inf)")
+    if nonnegative and np.any(a < 0):
+        raise InputError(name, _summary(value), "must be >= 0")
+    return a
+
+
+def check_instance(name: str, value, kind: type | tuple, what: str):
+    """``value`` if it is a ``kind``, else ``InputError`` saying ``what`` is expected."""
+    if not isinstance(value, kind):
+        raise InputError(name, value, f"must be {what}")
+    return value
+
+
+def _scalar_array(value) -> bool:
+    """A 0-d numpy array or numpy scalar of a real (non-bool) number."""
+    dtype, shape = getattr(value, "dtype", None), getattr(value, "shape", None)
+    return dtype is not None and shape == () and dtype.kind in "iuf"
+
+
+def _summary(value):
+    """What an error message shows of an array: its shape, else the value."""
+    shape = getattr(value, "shape", None)
+    return f"array of shape {shape}" if shape else value

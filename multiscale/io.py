@@ -1,13 +1,15 @@
-"""Scalar histories on disk, MPI-safe entry points and progress bars (no DOLFINx).
+"""Scalar histories on disk, MPI-safe entry points, stage messages and progress bars (no DOLFINx).
 
 ``History`` collects one row of scalars per recorded step (units in ``UNITS``) and writes them as
 datasets of ``history.h5`` (only rank 0 writes; its figure is ``multiscale.plots.history``).
-Fields for ParaView are written by ``multiscale.macro.output``.
+Fields for ParaView are written by ``multiscale.macro.output``. ``Reporter`` prints one line per
+stage of a run on rank 0 (``stage``, ``bar``) and keeps the wall time of every stage.
 """
 from __future__ import annotations
 
 import sys
-import time
+import time as _time
+from contextlib import contextmanager
 from pathlib import Path
 
 import h5py
@@ -30,7 +32,8 @@ def unit_of(name: str) -> str:
 
 
 class History:
-    """Scalar time series: ``append(time=..., interface_force=..., ...)``, same keys every row."""
+    """Time series: ``append(time=..., interface_force=..., ...)``, same keys every row; a value is a
+    scalar, or a 1-D array of fixed length (a per-zone quantity: its column is (rows, length))."""
 
     def __init__(self):
         self.columns: dict[str, list[float]] = {}
@@ -39,7 +42,8 @@ class History:
         if self.columns and set(row) != set(self.columns):
             raise KeyError(f"history row keys {sorted(row)} differ from {sorted(self.columns)}")
         for key, value in row.items():
-            self.columns.setdefault(key, []).append(float(value))
+            self.columns.setdefault(key, []).append(float(value) if np.ndim(value) == 0
+                                                    else np.array(value, dtype=float))
 
     def __getitem__(self, key: str) -> np.ndarray:
         return np.asarray(self.columns[key])
@@ -87,11 +91,11 @@ def ended_together(comm, timeout: float = 10.0) -> bool:
     waiting in a collective operation that will never complete: the caller must abort the job)."""
     if comm.size == 1:
         return True
-    request, start = comm.Ibarrier(), time.monotonic()
+    request, start = comm.Ibarrier(), _time.monotonic()
     while not request.Test():
-        if time.monotonic() - start > timeout:
+        if _time.monotonic() - start > timeout:
             return False
-        time.sleep(0.01)
+        _time.sleep(0.01)
     return True
 
 
@@ -116,3 +120,98 @@ def progress(iterable, comm, **kwargs):
     if comm.rank != 0:
         return iterable
     return tqdm(iterable, **kwargs)
+
+
+# ------------------------------------------------------------------ stages and progress
+_ACTIVE: list["Reporter"] = []
+
+
+class Reporter:
+    """Stage messages of a run: one line per stage on rank 0 (under a terminal the line shows the
+    running stage, its progress bar, then its wall time), nothing with ``quiet``. ``times`` holds
+    the wall time [s] of every stage (summed over repeats), for the provenance of the results.
+    Used as a context manager, it is the one that ``stage`` and ``bar`` report to."""
+
+    def __init__(self, comm=None, quiet: bool = False, stream=None):
+        self.comm = comm or MPI.COMM_WORLD
+        self.stream = stream or sys.stdout
+        self.show = not quiet and self.comm.rank == 0
+        self.tty = self.show and hasattr(self.stream, "isatty") and self.stream.isatty()
+        self.times: dict[str, float] = {}
+        self.depth = 0            # nested stages are timed, not printed
+        self.folder = None        # the results folder, once prepared
+        self.barred = False       # a bar is showing: inner bars stay silent
+
+    def __enter__(self):
+        _ACTIVE.append(self)
+        return self
+
+    def __exit__(self, *exc):
+        _ACTIVE.remove(self)
+        return False
+
+    def say(self, text: str) -> None:
+        """A message line on rank 0 (not with ``quiet``)."""
+        if self.show:
+            print(text, file=self.stream, flush=True)
+
+    @contextmanager
+    def stage(self, name: str):
+        top = self.depth == 0
+        if top and self.tty:
+            self.stream.write(f"{name} ...")
+            self.stream.flush()
+        self.depth += 1
+        start = _time.perf_counter()
+        try:
+            yield self
+        finally:
+            seconds = _time.perf_counter() - start
+            self.depth -= 1
+            self.times[name] = self.times.get(name, 0.0) + seconds
+            if top and self.show:
+                clear = "\r\033[K" if self.tty else ""
+                self.stream.write(f"{clear}{name}: {seconds:.1f} s\n")
+                self.stream.flush()
+
+    def bar(self, iterable, name: str, total: int | None = None, initial: int = 0, unit: str = "step"):
+        """``iterable`` with a progress bar under a terminal (a line per tenth otherwise) on rank 0."""
+        if not self.show or self.barred:
+            yield from iterable
+            return
+        total = total if total is not None else (len(iterable) if hasattr(iterable, "__len__") else None)
+        self.barred = True
+        try:
+            if self.tty:
+                with tqdm(iterable, desc=name, total=total, initial=initial, unit=unit, leave=False,
+                          file=self.stream, dynamic_ncols=True) as items:
+                    yield from items
+                return
+            start, done, every = _time.perf_counter(), initial, max(1, (total or 10) // 10)
+            for item in iterable:
+                yield item
+                done += 1
+                if done % every == 0 or done == total:
+                    self.stream.write(f"  {name}: {done}/{total if total else '?'} {unit}s, "
+                                      f"{_time.perf_counter() - start:.1f} s\n")
+                    self.stream.flush()
+        finally:
+            self.barred = False
+
+
+_SILENT = Reporter(MPI.COMM_SELF, quiet=True)
+
+
+def reporter() -> Reporter:
+    """The active ``Reporter`` (innermost ``with Reporter(...)``), else a silent one."""
+    return _ACTIVE[-1] if _ACTIVE else _SILENT
+
+
+def stage(name: str):
+    """``with stage("meshing"): ...``: a stage of the active reporter (timed; one line on rank 0)."""
+    return reporter().stage(name)
+
+
+def bar(iterable, name: str, **kwargs):
+    """``iterable`` with the active reporter's progress bar (see ``Reporter.bar``)."""
+    return reporter().bar(iterable, name, **kwargs)

@@ -39,8 +39,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 from mpi4py import MPI
-from tqdm import tqdm
 
+from multiscale import io
 from multiscale.errors import InputError
 from multiscale.micro.laws import (LawError, LawSpec, ZoneFailure, ZoneLaws, ZoneNodes, batch_signature,
                                    batches, zone_nodes)
@@ -193,4 +193,5 @@ class MicroPool:
 
 
 def _progress(items, show: bool):
-    return tqdm(items, desc="zone laws", unit="batch") if show else items
+    """The active reporter's bar (one line under a terminal, inside the running stage's line)."""
+    return io.bar(items, "zone laws", unit="batch") if show else items

@@ -17,6 +17,11 @@ below p_max) is retried with p_max halved, up to ``P_MAX_HALVINGS`` times (remem
 later laws). ``datum_gap`` is the per-facet uniform initial gap at which the rigid rough bodies
 carry given forces, one bisection per interface: it starts Newton close to equilibrium.
 
+``track_depth`` spreads the volume the counter-face (a rotating body 1) loses in each zone over its
+circular wear track: the counter-face stays flat at the zone scale and its surface recedes by a
+depth that depends on the radius only (every point of the track passes under the zones many times
+per macro step), which widens the macro gap of the facets at that radius.
+
 This module reads no scene: ``multiscale.workflows.rough`` builds a ``RoughInterface`` from one.
 """
 from __future__ import annotations
@@ -27,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from multiscale.errors import InputError
+from multiscale.geometry import Rotation
 from multiscale.macro.laws_ufl import FacetLaw
 from multiscale.macro.mesh import TwoBodyMesh
 from multiscale.micro.laws import LawError, LawSpec, ZoneLaws
@@ -79,6 +85,18 @@ def interface_plane(tm: TwoBodyMesh, name: str) -> tuple[Plane, np.ndarray, np.n
     return plane, corners.min(axis=0), corners.max(axis=0)
 
 
+def track_spread(radius, source_radius, volume, half: float) -> np.ndarray:
+    """Depth [m] at ``radius`` [m] of the volumes ``volume`` [m^3] lost at ``source_radius`` spread
+    around their circles: Σ_f V_f K(r − r_f) / (2 π r), K the hat of half-width ``half`` [m] and unit
+    integral (the depth integrated over the track, ∫ depth 2 π r dr, is Σ V_f)."""
+    r, src, v = (np.asarray(a, dtype=float) for a in (radius, source_radius, volume))
+    out = np.empty(r.size)
+    for i in range(0, r.size, 256):                                    # rows in blocks: memory O(256 n)
+        hat = np.clip(1.0 - np.abs(r[i:i + 256, None] - src[None, :]) / half, 0.0, None) / half
+        out[i:i + 256] = hat @ v / (2 * np.pi * r[i:i + 256])
+    return out
+
+
 @dataclass
 class RoughInterface:
     """Zones, laws and facet law of the rough interfaces of ``tm`` (see module docstring).
@@ -98,6 +116,7 @@ class RoughInterface:
     law: FacetLaw = field(init=False)
     zone_of_facet: np.ndarray = field(init=False)       # zone id of every global facet (-1: not rough)
     initial: np.ndarray = field(init=False)              # (Z, ny, nx) initial topographies [m]
+    plastic: np.ndarray = field(init=False)              # (Z, ny, nx) accumulated permanent deformation [m]
     levels: np.ndarray = field(init=False)               # p_max halvings of each zone's law
     used: np.ndarray = field(init=False)                 # ids of the zones holding a facet
     laws_computed: int = 0                               # laws computed by the last update
@@ -114,6 +133,7 @@ class RoughInterface:
             self.zone_of_facet[masks[name]] = offsets[k] + self.grids[k].zone_of(uv[:, 0], uv[:, 1])
         self.used = np.unique(self.zone_of_facet[self.zone_of_facet >= 0])
         self.initial = np.stack([z.surface.heights for z in self.zones])
+        self.plastic = np.zeros_like(self.initial)
         self.levels = np.zeros(len(self.zones), dtype=int)
         self.law = FacetLaw(self.tm, self.spec.n_points)
 
@@ -143,8 +163,8 @@ class RoughInterface:
             self.zones[zid] = self.zones[zid].with_heights(h)
 
     def wear_depth(self) -> np.ndarray:
-        """Accumulated wear depth fields (Z, ny, nx) [m]."""
-        return self.initial - self.heights()
+        """Accumulated wear depth fields (Z, ny, nx) [m] (the permanent deformation taken out)."""
+        return self.initial - self.heights() - self.plastic
 
     def zone_wear_volume(self, depth: np.ndarray) -> np.ndarray:
         """Worn volume of each zone [m^3] from its depth field (Z, ny, nx) [m]."""
@@ -208,3 +228,52 @@ class RoughInterface:
                     break
             out[mask] = 0.5 * (lo + hi)
         return out
+
+    def track_depth(self, volume, weight) -> np.ndarray:
+        """Per-facet depth [m] by which a rotating counter-face recedes when it loses ``volume``
+        [m^3] in each zone (Z,): a zone's volume is shared among its facets in proportion to
+        ``weight`` (per facet, e.g. the frictional power mu p |w| dA; the facet areas where a zone's
+        weights sum to 0), then spread along the circle of each facet's radius r about the rotation
+        axis over the counter-face (the rough interfaces in one plane share it): depth(r) =
+        Σ_f V_f K(r − r_f) / (2 π r), K a hat of unit integral and half-width one interface
+        element, so that the depth integrated over the track is the volume lost. 0 off the rough
+        interfaces."""
+        motion, iface = self.tm.spec.motion, self.tm.interface
+        if not isinstance(motion, Rotation):
+            raise InputError("counter-face wear", type(motion).__name__, "needs a rotating counter-face (its "
+                             "wear spreads over a circular track)")
+        zone_of, areas = self.zone_of_facet, iface.areas
+        rough = zone_of >= 0
+        w = np.where(rough, np.asarray(weight, dtype=float), 0.0)
+        total = np.bincount(zone_of[rough], w[rough], minlength=len(self.zones))
+        area = np.bincount(zone_of[rough], areas[rough], minlength=len(self.zones))
+        share = np.where(total[zone_of] > 0, w / np.where(total[zone_of] > 0, total[zone_of], 1.0),
+                         areas / np.where(area[zone_of] > 0, area[zone_of], 1.0))
+        lost = np.where(rough, np.asarray(volume, dtype=float)[zone_of] * share, 0.0)        # m^3 per facet
+        axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
+        arm = iface.midpoints - np.asarray(motion.centre, float)
+        radius = np.linalg.norm(arm - np.outer(arm @ axis, axis), axis=1)
+        half = np.sqrt(2.0 * np.median(areas[rough]))                  # the side of a typical facet
+        depth = np.zeros(len(areas))
+        masks = iface.masks()
+        for group in self._planes():
+            on = np.any([masks[name] for name in group], axis=0)
+            depth[on] = track_spread(radius[on], radius[on], lost[on], half)
+        return depth
+
+    def _planes(self) -> list[list[str]]:
+        """The rough interfaces grouped by the plane they lie in (one face of the counter-face)."""
+        iface, masks, groups = self.tm.interface, self.tm.interface.masks(), []
+        size = self.tm.spec.length_scale
+        keys = []
+        for name, plane in zip(self.names, self.planes):
+            n = plane.frame[2]
+            offset = float(np.mean(iface.midpoints[masks[name]] @ n))
+            for k, (m, c) in enumerate(keys):
+                if abs(abs(n @ m) - 1) < 1e-9 and abs(offset * np.sign(n @ m) - c) < 1e-9 * size:
+                    groups[k].append(name)
+                    break
+            else:
+                keys.append((n, offset))
+                groups.append([name])
+        return groups

@@ -24,12 +24,13 @@ from multiscale.errors import InputError, SceneError
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, show, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
-from multiscale.scene_sections import (DEFAULT_GRID, FIG_7_9_WEAR_RATE, OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings,
-                                       Layers, Loading, Material, Micro, Output, Roughness, Stability, Time, Vehicle,
-                                       Wear)
+from multiscale.scene_sections import (COUPLING_DEFAULT, DEFAULT_GRID, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
+                                       OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
+                                       Micro, Output, Roughness, Time, Vehicle, Wear)
+from multiscale.scene_stability import Stability
 
-__all__ = ["EFFECTS", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Boundary", "Geometry", "Interface", "InterfaceSettings",
-           "Loading", "Material", "Scene", "Vehicle", "load", "loads"]
+__all__ = ["COUPLING_DEFAULT", "EFFECTS", "FIG_7_9_CALIBRATION", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Boundary",
+           "Geometry", "Interface", "InterfaceSettings", "Loading", "Material", "Scene", "Vehicle", "load", "loads"]
 
 
 # ------------------------------------------------------------------ effects
@@ -53,8 +54,11 @@ EFFECTS: dict[str, Effect] = {
     "roughness": Effect("rough interface: per-zone homogenized laws from micro patches "
                         "([roughness], [micro])", ("contact",)),
     "layers": Effect("layered near-surface material in the micro models ([layers])", ("roughness",)),
-    "wear": Effect("Archard wear of the rough zones between macro steps ([wear])",
-                   ("roughness", "friction")),
+    "wear": Effect("Archard wear of the rough zones between macro steps ([wear]), and of a counter-face "
+                   "whose material gives k_w", ("roughness", "friction")),
+    "plasticity": Effect("elastic-perfectly-plastic asperities: micro pressures bounded by the hardness of the "
+                         "softer body of each rough interface (materials.<name>.hardness, constant or H(T)); "
+                         "yielded zones keep their permanent deformation", ("roughness",)),
     "stability": Effect("complex eigenvalue (squeal) analysis at the sliding state ([stability])",
                         ("contact",)),
 }
@@ -236,6 +240,14 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                 problems.append(f'{section}.body = "{table.body}": not a body of {where}; allowed: '
                                 f'{", ".join(g.bodies)}')
         problems += _surface_checks(scene, g, where, effects)
+        problems += _hardness_checks(scene, g, raw, effects)
+        if "wear" in effects and scene.wear is not None and scene.materials is not None and not problems:
+            rough = {scene.geometry.spec.interface_materials(n)[0] for n in scene.geometry.spec.interfaces}
+            given = [k for k in ("k_w", "k_w_table") if getattr(scene.wear, k) is not None]
+            for name in sorted(rough):
+                if given and name in scene.materials and scene.materials[name].k_w is not None:
+                    problems.append(f"wear.{given[0]}: the rough body's material gives k_w "
+                                    f"(materials.{name}.k_w): give one of them")
         if not problems:
             problems += _nyquist(scene)
     if scene.output is not None and scene.output.fields is not None:
@@ -254,6 +266,26 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         warnings.append('effects "friction" and "thermal" without "heat_partition": no frictional heat '
                         "enters the bodies")
     return ctx.warnings + warnings
+
+
+def _hardness_checks(scene: Scene, g: Geometry, raw: dict, effects) -> list[str]:
+    """Effect "plasticity" needs a hardness on one side (at least) of every rough interface (a
+    hardness given but refused is reported by the material's table itself)."""
+    tables = raw.get("materials") if isinstance(raw.get("materials"), dict) else {}
+    if scene.materials is None or "plasticity" not in effects:
+        return []
+    problems = []
+    for name in g.spec.interfaces:
+        try:
+            rough = scene.interface_settings(name).rough
+            sides = [m for m in g.spec.interface_materials(name) if m in scene.materials]
+        except (AttributeError, KeyError, StopIteration, TypeError):   # a partial scene: reported elsewhere
+            continue
+        given = [m for m in sides if isinstance(tables.get(m), dict) and "hardness" in tables[m]]
+        if rough and sides and not given:
+            problems.append(f'materials.{sides[0]}.hardness: missing; effect "plasticity" needs the hardness of '
+                            f'the softer body of interface "{name}" ({" or ".join(sides)})')
+    return problems
 
 
 def _nyquist(scene: Scene) -> list[str]:

@@ -3,7 +3,7 @@
 Materials (constants or temperature tables), the interface defaults and per-interface settings,
 boundary conditions (supports, convection, radiation, fixed temperatures), the loading and its duty
 cycle (load and speed against time, a vehicle stop or drag), time, output, and the sections of the
-multiscale loop (roughness, micro, wear, layers) and of the squeal analysis (stability). Values are
+multiscale loop (roughness, micro, wear, layers); the squeal analysis' in ``scene_stability``. Values are
 SI numbers or unit strings (``multiscale.units``).
 """
 from __future__ import annotations
@@ -14,6 +14,7 @@ from pathlib import Path
 
 from multiscale.errors import InputError
 from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_topography
+from multiscale.scene_stability import Stribeck
 from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, ListOf, OneOf, OnlyWith, Pair,
                                Quantity, Requires, Section, TableOr, Tables, Text, Vector, key)
 
@@ -33,6 +34,7 @@ _ROUGHNESS = Quantity("length", gt=0, plausible=(1e-10, 1e-3))            # RMS 
 _CONVECTION = Quantity("conductance", ge=0, plausible=(0.0, 1e4))         # still air to boiling water
 _ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0))  # up to ~24 000 rpm
 _WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # Archard k/H
+_HARDNESS = Quantity("pressure", gt=0, plausible=(1e6, 1e11))            # soft polymer to diamond
 GRAVITY = 9.80665                  # m/s^2, standard gravity
 
 
@@ -67,9 +69,11 @@ class Material:
     """One body's material (Table 7.2). Every property is a constant or a table against the
     temperature ((K, value), ...), interpolated linearly and held constant beyond its ends; ``alpha``
     is the mean (secant) expansion coefficient from the initial temperature. Thermal needs kappa and
-    c (with rho) or chi. The squeal analysis reads the material damping: a structural loss factor
-    eta (complex stiffness E (1 + i eta)) and Rayleigh coefficients (alpha M + beta K of this
-    material's mass and stiffness)."""
+    c (with rho) or chi. ``k_w``: the Archard wear rate of this material (effect "wear"), taken at
+    the local surface temperature: the rough body's (instead of [wear]'s), or the counter-face's
+    (only a counter-face with k_w wears). The squeal analysis reads the material damping: a
+    structural loss factor eta (complex stiffness E (1 + i eta)) and Rayleigh coefficients (alpha M
+    + beta K of this material's mass and stiffness)."""
 
     E: float | tuple = key(_property(_MODULUS, "E"), required=True)                          # Pa
     nu: float | tuple = key(_property(_POISSON, "nu"), required=True)
@@ -79,20 +83,29 @@ class Material:
     chi: float | tuple | None = key(_property(_DIFFUSIVITY, "chi"))         # m^2/s
     alpha: float | tuple | None = key(_property(_EXPANSION, "alpha"), needed_by=("expansion",),
                                       warn_unused=True)                                      # 1/K
+    k_w: float | tuple | None = key(_property(Quantity("wear_rate", ge=0), "k_w"))          # 1/Pa, Archard
+    hardness: float | tuple | None = key(_property(_HARDNESS, "hardness"))   # Pa, plastic flow pressure of asperities
     loss_factor: float | None = key(Quantity("dimensionless", ge=0))      # structural damping eta (squeal)
     damping_alpha: float | None = key(Quantity("frequency", ge=0))        # 1/s, Rayleigh: alpha M (squeal)
     damping_beta: float | None = key(Quantity("time", ge=0))              # s, Rayleigh: beta K (squeal)
 
     rules = (OneOf(("c", "chi"), needed_by=("thermal",)), Requires("c", ("rho",), needed_by=("thermal",)))
 
-    PROPERTIES = ("E", "nu", "rho", "kappa", "c", "chi", "alpha")
+    PROPERTIES = ("E", "nu", "rho", "kappa", "c", "chi", "alpha", "hardness")
     DAMPING = ("loss_factor", "damping_alpha", "damping_beta")
 
     def problems(self, path, ctx):
+        if self.k_w is not None and "wear" not in ctx.effects:
+            ctx.warnings.append(f'{path}.k_w is ignored: effect "wear" is not in effects')
         given = [k for k in self.DAMPING if getattr(self, k) is not None]
         if given and "stability" not in ctx.effects:
             ctx.warnings.append(f'{path}.{given[0]} is ignored: effect "stability" is not in effects')
         return []
+
+    @property
+    def wear_rate(self):
+        """k_w [1/Pa] for ``micro.wear.WearRate``: the constant, or ((temperatures [K]), (rates))."""
+        return self.k_w if not isinstance(self.k_w, tuple) else tuple(zip(*self.k_w))
 
     def tabulated(self, name: str) -> bool:
         """True if property ``name`` is a temperature table."""
@@ -210,6 +223,7 @@ OUTPUT_FIELDS: dict[str, tuple[str, ...]] = {
     "displacement": (), "von_mises": (), "contact_pressure": ("contact",),
     "temperature": ("thermal",), "heat_flux": ("thermal",),
     "contact_stiffness": ("roughness",), "partition": ("heat_partition",), "wear_depth": ("wear",),
+    "flash_temperature": ("roughness", "heat_partition"), "counter_wear_depth": ("wear",),
 }
 
 
@@ -252,17 +266,6 @@ class Vehicle:
         if self.deceleration is not None:
             return self.mass * self.deceleration
         return self.mass * GRAVITY * math.sin(math.atan(self.slope))
-
-
-@dataclass(frozen=True)
-class Stribeck:
-    """[loading.stribeck]: friction falling with the slip speed v, mu(v) = kinetic + (static -
-    kinetic) exp(-(v / speed)^exponent) (exponent 1: the exponential static-to-kinetic decay law)."""
-
-    static: float | None = key(Quantity("dimensionless", ge=0), required=True)
-    kinetic: float | None = key(Quantity("dimensionless", ge=0), required=True)
-    speed: float | None = key(Quantity("speed", gt=0), required=True)            # m/s, Stribeck speed
-    exponent: float = key(Quantity("dimensionless", gt=0), default=1.0)
 
 
 @dataclass(frozen=True)
@@ -419,13 +422,28 @@ class Roughness:
 DEFAULT_GRID = (50, 50)    # cells per zone without micro.grid (generated surfaces)
 
 
+# Default coupling of partitions and temperatures for each choice of remote temperatures, chosen by
+# measurement (docs/accuracy/coupling.md: with "bulk" the explicit and fixed-point schemes put
+# spurious heat jumps into the pin, the implicit one does not). With "rough" the partition does not
+# depend on the temperatures: nothing to iterate.
+COUPLING_DEFAULT = {"rough": "explicit", "bulk": "implicit"}
+
+
 @dataclass(frozen=True)
 class Micro:
     """How the rough interface is solved (issue 7): zone grid on the interface, grid per zone
     (default 50 x 50; a measured surface's own pixel size, rounded, unless it is replaced by a
     statistically equivalent one), micro model, points of each p_n(g_n) law (top node at ``p_max``, default 20 x the nominal
     interface pressure; contact solver tolerance ``tol``), micro partition law (ch. 6) or the
-    constant one."""
+    constant one. The micro heating of the loop (issue 19): ``heating`` "steady" (§6.5) or
+    "transient" over each macro step in ``heating_steps`` = N_t steps (§6.3, Table 7.1: 10);
+    ``remote_temperatures`` "rough" (both bodies' at the rough body's macro surface temperature)
+    or "bulk" (each body's own: §7.2.2, §6.5; the default, "rough" with effect "conductance",
+    whose h_c conducts between the bodies already); ``coupling`` of partitions and temperatures
+    "explicit" (from the previous step), "fixed-point" (iterated within the step to
+    ``coupling_tol`` in at most ``coupling_iterations`` passes) or "implicit" (bulk only: the
+    partition at equal temperatures and the zone's exchange G as an interface conductance);
+    default ``COUPLING_DEFAULT`` (see ``multiscale.coupling``)."""
 
     zones: tuple | None = key(Pair(Integer(ge=1)), required=True)             # (nx, ny) zones
     grid: tuple | None = key(Pair(Integer(ge=8)))                             # (nx, ny) per zone
@@ -434,25 +452,57 @@ class Micro:
     partition_law: bool = key(Flag(), default=False)
     p_max: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e10)))  # Pa, top node of the laws
     tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)     # micro contact solves
+    flash_softening: bool = key(Flag(), default=False)   # H(T) of each zone at its last flash temperature
+    heating: str = key(Choice(("steady", "transient")), default="steady")
+    heating_steps: int = key(Integer(ge=1), default=10)                       # N_t per macro step (transient)
+    remote_temperatures: str | None = key(Choice(("rough", "bulk")))             # default: ``remote``
+    coupling: str | None = key(Choice(("explicit", "fixed-point", "implicit")))   # default: COUPLING_DEFAULT
+    coupling_tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-3)   # max |dp| per pass
+    coupling_iterations: int = key(Integer(ge=1), default=30)
 
     def problems(self, path, ctx):
         if self.partition_law and "heat_partition" not in ctx.effects:
             return [f'{path}.partition_law = true: needs effect "heat_partition"']
+        if self.flash_softening and not {"plasticity", "heat_partition"} <= ctx.effects:
+            return [f'{path}.flash_softening = true: needs effects "plasticity" and "heat_partition" (the micro '
+                    "heating gives the flash temperature)"]
+        if self.coupling == "implicit" and self.remote(ctx.effects) != "bulk":
+            return [f'{path}.coupling = "implicit": conducts between the bulk temperatures; needs '
+                    f'{path}.remote_temperatures = "bulk" (and no effect "conductance")']
+        if self.remote_temperatures == "bulk" and "conductance" in ctx.effects:
+            return [f'{path}.remote_temperatures = "bulk": the micro heating conducts between the two bodies '
+                    f'already; effect "conductance" would conduct twice (drop one)']
         return []
+
+    def remote(self, effects) -> str:
+        """``remote_temperatures``, or its default for the scene's ``effects``: "bulk" (thesis
+        §7.2.2), "rough" with effect "conductance"."""
+        return self.remote_temperatures or ("rough" if "conductance" in effects else "bulk")
+
+    def coupling_scheme(self, effects) -> str:
+        """``coupling``, or its default for the remote temperatures (``COUPLING_DEFAULT``)."""
+        return self.coupling or COUPLING_DEFAULT[self.remote(effects)]
 
 
 # Default k_w(T) [(K, 1/Pa)]: the shape of thesis Fig. 7.9 (sintered pad material, [Mann 2017]):
 # slowly rising up to 200 degC, steeply above. The figure's numbers are not in the text; the level
 # at 20-100 degC (~8e-15 1/Pa) is what reproduces the worn volume of §7.3.2 (3.8e7 um^3 in 30 s
-# of 200 N at 1.9 m/s with mu = 0.4: V / (mu F s) = 8.4e-15 1/Pa).
+# of 200 N at 1.9 m/s with mu = 0.4: V / (mu F s) = 8.4e-15 1/Pa). Calibrated on that one volume
+# of a pin below 100 degC: below 100 degC it is nearly flat (the worn volume then grows linearly
+# with the sliding), above it is the figure's shape only. ``multiscale check`` says so.
+FIG_7_9_CALIBRATION = ("shape of thesis Fig. 7.9 (its numbers are not in the text); level set so that "
+                       "k_w mu F s gives the thesis' ch. 7 worn volume (3.8e7 um^3 in 30 s at 200 N, "
+                       "1.9 m/s, mu 0.4: 8.4e-15 1/Pa near 20-100 degC); give your material's k_w")
 FIG_7_9_WEAR_RATE = ((293.15, 6e-15), (373.15, 8e-15), (473.15, 1.5e-14), (573.15, 6e-14), (673.15, 2e-13))
 
 
 @dataclass(frozen=True)
 class Wear:
     """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (default: the
-    shape of thesis Fig. 7.9, ``FIG_7_9_WEAR_RATE``). Every ``update_every`` macro steps the zones
-    wear over the sliding of those steps in ``substeps`` load-controlled increments."""
+    rough body's material k_w, else the shape of thesis Fig. 7.9, ``FIG_7_9_WEAR_RATE``, whose
+    level is calibrated on the thesis' ch. 7 worn volume: ``FIG_7_9_CALIBRATION``). Every
+    ``update_every`` macro steps the zones wear over the sliding of those steps in ``substeps``
+    load-controlled increments; a counter-face whose material gives ``k_w`` wears too."""
 
     k_w: float | None = key(_WEAR_RATE)                      # 1/Pa
     k_w_table: tuple | None = key(Curve(_TEMPERATURE, Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)),
@@ -486,114 +536,3 @@ class Layers:
     body: str | None = key(Text())               # the stationary (rough) side; default: that side
     base: str = key(Choice(("half-space", "rigid")), default="half-space")
     layer: tuple | None = key(Tables(Layer), required=True)
-
-
-SWEEP_PARAMETERS = {"friction": "-", "pressure": "Pa", "speed": "rad/s", "rms": "m"}
-
-
-@dataclass(frozen=True)
-class Sweep:
-    """[stability.sweep]: a stability map over one parameter: the friction coefficient of every
-    interface, the brake pressure, the speed of the rotating body or the R_q of the rough surfaces
-    (effect "roughness"). The listed values, or with ``points`` that many from the first to the
-    last. ``preload = "once"`` (default for friction and speed) keeps the sliding state of the
-    nominal analysis and projects every point on the undamped modes of the first and last points;
-    ``"each"`` (pressure, roughness) preloads and solves every point. The modes are tracked by MAC
-    (``mac``: the lowest MAC of a pair) and the onset of every unstable mode is bisected
-    (``onsets``); see ``multiscale.workflows.squeal_map``."""
-
-    friction: tuple | None = key(ListOf(Quantity("dimensionless", ge=0), min_len=2))
-    pressure: tuple | None = key(ListOf(Quantity("pressure", gt=0), min_len=2))          # Pa
-    speed: tuple | None = key(ListOf(Quantity("angular_speed", ge=0), min_len=2))       # rad/s
-    rms: tuple | None = key(ListOf(Quantity("length", gt=0), min_len=2))                # m
-    points: int | None = key(Integer(ge=2))
-    preload: str | None = key(Choice(("each", "once")))      # default: once for friction and speed
-    mac: float = key(Quantity("dimensionless", gt=0, le=1), default=0.5)
-    onsets: bool = key(Flag(), default=True)
-
-    rules = (OneOf(tuple(SWEEP_PARAMETERS), required=True),)
-
-    @property
-    def parameter(self) -> str:
-        return next(k for k in SWEEP_PARAMETERS if getattr(self, k) is not None)
-
-    @property
-    def preload_mode(self) -> str:
-        """"once" (keep the nominal sliding state) or "each" (preload every point)."""
-        return self.preload or ("once" if self.parameter in ("friction", "speed") else "each")
-
-    @property
-    def values(self) -> tuple:
-        """The swept values (SI), increasing."""
-        given = getattr(self, self.parameter)
-        if self.points is None:
-            return tuple(given)
-        lo, hi = given
-        return tuple(lo + (hi - lo) * k / (self.points - 1) for k in range(self.points))
-
-    def problems(self, path, ctx):
-        name = self.parameter
-        given = getattr(self, name)
-        where = f"{path}.{name}"
-        if self.points is not None and len(given) != 2:
-            return [f"{where}: with {path}.points give the range [first, last] (2 values, got {len(given)})"]
-        if any(b <= a for a, b in zip(given, given[1:])):
-            return [f"{where}: the values must increase"]
-        loading = ctx.root.get("loading") if isinstance(ctx.root.get("loading"), dict) else {}
-        if name == "rms" and "roughness" not in ctx.effects:
-            return [f'{where}: sweeps the rough surfaces: needs effect "roughness"']
-        if name == "rms" and "rms" not in (ctx.root.get("roughness") or {}):
-            return [f"{where}: sweeps roughness.rms of a generated surface; the scene gives no roughness.rms"]
-        if self.preload == "once" and name in ("pressure", "rms"):
-            return [f'{path}.preload = "once": a {name} sweep changes the preloaded state; use "each"']
-        if name == "friction" and ("friction_curve" in loading or "stribeck" in loading):
-            return [f"{where}: sets a constant friction; remove loading.friction_curve / loading.stribeck"]
-        if name == "pressure" and "pressure" not in loading:
-            return [f"{where}: sweeps loading.pressure; the scene gives no loading.pressure"]
-        if name == "speed" and "sliding_speed" in loading:
-            return [f"{where}: an angular speed of the rotating body; this geometry translates"]
-        return []
-
-
-@dataclass(frozen=True)
-class Stability:
-    """Complex eigenvalue analysis (§4.3): modes in a frequency band, shift target, damping.
-
-    ``damping`` (loss factor eta), ``rayleigh_alpha`` / ``rayleigh_beta`` (alpha M + beta K) act on
-    the whole system, mapped exactly from the undamped modes. Per-material damping, the friction
-    slope (``friction_damping``) and the gyroscopic terms are solved as a full quadratic
-    eigenproblem (``method = "quadratic"``, viscous only) or by projection on the undamped modes up
-    to ``basis`` x the band's top (``"projection"``, needed for loss factors); ``"auto"`` picks.
-    ``prestress``: the initial-stress stiffness of the preload, its effect on every frequency
-    reported; ``gyroscopic``: the rotating body's Coriolis and centrifugal terms (docs/squeal.md)."""
-
-    band: tuple = key(Pair(Quantity("frequency", ge=0), single=False, names="[low, high]"),
-                      default=(0.0, 16e3))                                    # Hz
-    modes: int | None = key(Integer(ge=1), required=True)
-    target: float | None = key(Quantity("frequency", ge=0))                   # Hz; default: the band's lower edge
-    damping: float = key(Quantity("dimensionless", ge=0, plausible=(0.0, 0.5)), default=0.0)  # structural loss factor
-    rayleigh_alpha: float = key(Quantity("frequency", ge=0), default=0.0)     # 1/s
-    rayleigh_beta: float = key(Quantity("time", ge=0), default=0.0)           # s
-    prestress: bool = key(Flag(), default=False)
-    gyroscopic: bool = key(Flag(), default=False)
-    friction_damping: bool = key(Flag(), default=True)
-    method: str = key(Choice(("auto", "projection", "quadratic")), default="auto")
-    basis: float = key(Quantity("dimensionless", ge=1), default=1.5)
-    sweep: Sweep | None = key(Section(Sweep))
-
-    def problems(self, path, ctx):
-        low, high = self.band
-        if high <= low:
-            return [f"{path}.band = [{low:g}, {high:g}] Hz: the upper bound must exceed the lower"]
-        if self.target is not None and not low <= self.target <= high:
-            return [f"{path}.target = {self.target:g} Hz: must lie in the band [{low:g}, {high:g}] Hz"]
-        materials = ctx.root.get("materials") if isinstance(ctx.root.get("materials"), dict) else {}
-        lossy = [m for m, t in materials.items() if isinstance(t, dict) and t.get("loss_factor")]
-        if self.method == "quadratic" and (self.damping or lossy):
-            what = f"{path}.damping" if self.damping else f"materials.{lossy[0]}.loss_factor"
-            return [f'{path}.method = "quadratic": takes viscous damping only; {what} (complex stiffness) '
-                    'needs method = "projection"']
-        loading = ctx.root.get("loading") if isinstance(ctx.root.get("loading"), dict) else {}
-        if self.gyroscopic and "sliding_speed" in loading:
-            return [f"{path}.gyroscopic = true: needs a rotating body; this geometry translates"]
-        return []

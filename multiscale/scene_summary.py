@@ -4,7 +4,7 @@ from __future__ import annotations
 import math
 
 from multiscale.geometry import estimate_cells
-from multiscale.scene import EFFECTS, OUTPUT_FIELDS, Scene
+from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
 from multiscale.schema import reference as schema_reference
 
 
@@ -79,6 +79,11 @@ def _effect_line(scene: Scene, effect: str) -> str:
         return f"Coulomb, mu = {ld.friction:g}"
     if effect == "thermal":
         return f"transient conduction in {', '.join(scene.bodies)}"
+    if effect == "heat_partition" and scene.has("roughness") and scene.micro.partition_law:
+        m = scene.micro
+        heating = f"transient, N_t = {m.heating_steps}" if m.heating == "transient" else "steady"
+        return (f"micro partition per zone ({heating} heating, remote temperatures: {m.remote(scene.effects)}, "
+                f"{m.coupling_scheme(scene.effects)} coupling; {scene.partition:.3g} before the first)")
     if effect == "heat_partition":
         share = f"{scene.partition:.3g}" + (" (effusivity)" if i.partition == "effusivity" else "")
         return f"share {share} of mu p |v| into the {scene.bodies[0]}"
@@ -94,9 +99,14 @@ def _effect_line(scene: Scene, effect: str) -> str:
         return f"{r.body or scene.bodies[0]}: {surface}; {m.zones[0]} x {m.zones[1]} zones of {cells}, {m.law_points}-point laws"
     if effect == "wear":
         w = scene.wear
+        rough, counter = (scene.materials[m] for m in scene.geometry.spec.interface_materials(
+            scene.rough_interfaces[0] if scene.rough_interfaces else None))
         rate = f"k_w = {w.k_w:g} 1/Pa" if w.k_w is not None else (
-            "k_w(T) table" if w.k_w_table is not None else "k_w(T) of thesis Fig. 7.9 (default)")
-        return f"Archard, {rate}, every {w.update_every} step(s) in {w.substeps} increment(s)"
+            "k_w(T) table" if w.k_w_table is not None else "k_w of its material" if rough.k_w is not None else
+            f"k_w(T) default table: {FIG_7_9_CALIBRATION}")
+        both = f"; the {scene.bodies[1]} wears too (k_w of its material)" if counter.k_w is not None else ""
+        return f"Archard every {w.update_every} step(s) in {w.substeps} increment(s){both}; {rate}"
+
     return EFFECTS[effect].doc
 
 

@@ -127,6 +127,10 @@ class Quantity:
             return f"in {lb}{_number(lo)}, {_number(hi)}{rb}{unit}"
         return f"{low or high}{unit}" if (low or high) else ""
 
+    def range_text(self) -> str:
+        """The allowed range with its unit (">= 0 Pa", "in (0, 1]"), or ""."""
+        return self._range()
+
     def describe(self) -> str:
         rng = self._range()
         examples = f" ({self.kind.examples})" if self.kind.examples not in ("", self.kind.si) and self.kind.si else ""

@@ -39,7 +39,7 @@ BAD = [  # (name, the demo block scene changed, the one expected message)
     ("unknown effect", BLOCK.replace('["contact"]', '["contact", "thermol"]'),
      'effects = ["contact", "thermol"]: item 2 ("thermol"): unknown (did you mean "thermal"?); '
      "allowed: contact, friction, thermal, heat_partition, conductance, expansion, roughness, layers, "
-     "wear, stability"),
+     "wear, plasticity, stability"),
     ("unknown key", BLOCK.replace("penalty =", "penalty_stiffness ="),
      'interface.penalty_stiffness: unknown key (did you mean "penalty"?); allowed: penalty, partition, '
      "conductance"),
@@ -114,7 +114,7 @@ def fake_runner(monkeypatch):
     """A stand-in for multiscale.workflows recording its calls (no DOLFINx needed)."""
     calls = []
     module = types.ModuleType("multiscale.workflows")
-    module.run = lambda scene, overwrite=False, resume=False: calls.append((scene.name, overwrite, resume))
+    module.run = lambda scene, overwrite=False, resume=False, **kw: calls.append((scene.name, overwrite, resume))
     monkeypatch.setitem(sys.modules, "multiscale.workflows", module)
     return calls
 
@@ -136,7 +136,7 @@ def test_run_refuses_to_overwrite_results(tmp_path, capsys, monkeypatch):
     assert "--overwrite" in err and "Traceback" not in err
     fake_runner = []
     module = types.ModuleType("multiscale.workflows")
-    module.run = lambda scene, overwrite=False, resume=False: fake_runner.append((scene.name, overwrite, resume))
+    module.run = lambda scene, overwrite=False, resume=False, **kw: fake_runner.append((scene.name, overwrite, resume))
     monkeypatch.setitem(sys.modules, "multiscale.workflows", module)
     assert main(["check", path]) == 0
     assert "the output folder already holds 1 entries: run needs --overwrite or --resume" in capsys.readouterr().out
@@ -174,3 +174,81 @@ def test_check_does_not_import_dolfinx(tmp_path):
             "sorted(m for m in sys.modules if 'dolfinx' in m or 'gmsh' in m); sys.exit(rc)")
     result = subprocess.run([sys.executable, "-c", code, _write(tmp_path, BLOCK)], capture_output=True, text=True)
     assert result.returncode == 0, result.stderr
+
+
+# ---------------------------------------------------------------- issue 22: version, help, launcher, stages
+def test_version_prints_the_package_version(capsys):
+    from multiscale import __version__
+    with pytest.raises(SystemExit) as stop:
+        main(["--version"])
+    assert stop.value.code == 0 and capsys.readouterr().out.strip() == f"multiscale {__version__}"
+
+
+def _commands():
+    """[] (the top level) and every subcommand the parser knows."""
+    import argparse
+
+    from multiscale.cli import build_parser
+    sub = next(a for a in build_parser()._actions if isinstance(a, argparse._SubParsersAction))
+    return [[]] + [[name] for name in sub.choices]
+
+
+@pytest.mark.parametrize("command", _commands(), ids=lambda c: " ".join(c) or "multiscale")
+def test_help_is_plain_text_and_names_the_environments_mpiexec(command, capsys):
+    import re
+    with pytest.raises(SystemExit):
+        main(command + ["--help"])
+    text = capsys.readouterr().out
+    assert not re.search(r"``|:(func|class|mod|meth|ref|doc):|\*\*|^\s*\.\. ", text, re.M), text
+    assert "mpirun -n" not in text
+    if command in ([], ["run"], ["study"]):
+        assert f"{Path(sys.executable).parent / 'mpiexec'} -n N multiscale" in text
+
+
+def test_a_foreign_mpi_launcher_is_detected(tmp_path, capsys, monkeypatch, fake_runner):
+    from multiscale.cli import launcher_problem
+    path = _write(tmp_path, BLOCK.replace("../results/block_on_flat", "out"))
+    monkeypatch.setenv("OMPI_COMM_WORLD_SIZE", "2")
+    monkeypatch.setenv("OMPI_COMM_WORLD_RANK", "0")
+    assert main(["run", path]) == 2
+    err = capsys.readouterr().err
+    assert "Open MPI launcher for 2 processes" in err and f"{Path(sys.executable).parent / 'mpiexec'} -n 2" in err
+    assert fake_runner == []
+    monkeypatch.setenv("OMPI_COMM_WORLD_RANK", "1")             # the other processes stay silent
+    assert main(["run", path]) == 2 and capsys.readouterr().err == ""
+
+    class World:
+        size = 2
+    assert launcher_problem(World(), {"PMI_SIZE": "2"}) is None   # the right launcher: a world of 2
+    assert launcher_problem(types.SimpleNamespace(size=1), {}) is None
+
+
+def test_stage_lines_one_per_stage_quiet_and_timed():
+    import io as stdio
+
+    from mpi4py import MPI
+
+    from multiscale import io
+    out = stdio.StringIO()
+    with io.Reporter(MPI.COMM_SELF, stream=out) as rep:
+        with io.stage("meshing"):
+            with io.stage("inner"):
+                pass
+        with io.stage("macro steps"):
+            assert list(io.bar(range(3), "macro steps")) == [0, 1, 2]
+    lines = out.getvalue().splitlines()
+    assert lines[0].startswith("meshing: ") and lines[-1].startswith("macro steps: ") and len(lines) == 5
+    assert set(rep.times) == {"meshing", "inner", "macro steps"}
+    quiet = stdio.StringIO()
+    with io.Reporter(MPI.COMM_SELF, quiet=True, stream=quiet):
+        with io.stage("meshing"):
+            list(io.bar(range(3), "steps"))
+    assert quiet.getvalue() == ""
+
+
+def test_output_times_are_exact_decimals():
+    from multiscale.outputs import step_time
+    t = 0.0
+    for _ in range(30):
+        t = step_time(t, 0.4)
+    assert t == 12.0 and repr(t) == "12.0"

@@ -375,3 +375,23 @@ kappa = "5 W/(m K)"
     with pytest.raises(InputError, match="layers.body"):
         from multiscale.workflows.multiscale import build
         build(loads(text.replace('body = "pin"\nbase', 'body = "disc"\nbase')))
+
+
+def test_plastic_pin_on_disc_caps_the_micro_pressure_and_keeps_archard(tmp_path):
+    """Effect "plasticity" with the pin's hardness H(T) and flash softening: every micro pressure
+    <= H at the zone's last flash temperature (60 MPa at 20 degC first), zones yield and keep their
+    permanent deformation, the load is carried, and the worn volume is still k_w x the frictional
+    work (the permanent deformation is not counted as wear)."""
+    from multiscale.workflows import run
+    text = POD.format(folder=tmp_path / "plastic").replace('"roughness", "wear"]', '"roughness", "wear", "plasticity"]')
+    text = text.replace("[materials.pin]", '[materials.pin]\nhardness = [["20 degC", "60 MPa"], ["120 degC", "30 MPa"]]', 1)
+    scene = loads(text.replace("partition_law = true", "partition_law = true\nflash_softening = true"))
+    h = History.read(run(scene, verbose=False).history_file)
+    assert h["micro_plastic_fraction"][0] > 0 and h["micro_max_pressure"][0] == pytest.approx(60e6)
+    # softened at the flash temperatures of step 0 (> 27 degC), the zones yield again (without
+    # flash softening they reload elastically below 60 MPa: plastic fraction 0 after step 0)
+    assert h["micro_max_temperature"][0] > 300.0 and np.all(h["micro_max_pressure"][1:] < 60e6)
+    assert h["micro_plastic_fraction"][1:].max() > 0
+    assert np.all(np.diff(h["plastic_max_depth"]) >= 0) and h["plastic_max_depth"][-1] > 0
+    np.testing.assert_allclose(h["interface_force"], 200.0, rtol=1e-6)
+    assert h["wear_volume"][-1] == pytest.approx(1e-14 * h["frictional_work"][-1], rel=0.01)

@@ -20,9 +20,10 @@ from multiscale.geometry import builder  # noqa: E402
 from multiscale.macro import eigen, modal  # noqa: E402
 from multiscale.macro import mesh as two_body  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
-from multiscale.macro.output import write_modes_xdmf  # noqa: E402
+from multiscale.macro.output import write_modes  # noqa: E402
 from multiscale import scene as scenes  # noqa: E402
 from multiscale.workflows import squeal  # noqa: E402
+from multiscale.workflows.output import RunResult  # noqa: E402
 
 STEEL = NS(E=210e9, nu=0.3, rho=7850.0)
 MATERIALS = {"disc": NS(E=125e9, nu=0.25, rho=7200.0), "pad": NS(E=5e9, nu=0.25, rho=2500.0),
@@ -204,17 +205,16 @@ def test_strain_energy_per_region_matches_an_assembled_disc_stiffness(brake, no_
     np.testing.assert_allclose(shares.energy[:, -1], disc_energy, rtol=1e-9)
 
 
-def test_mode_shapes_are_written_to_xdmf(tmp_path, brake, friction):
-    import h5py
-
-    files = write_modes_xdmf(tmp_path / "modes.xdmf", friction.modes, brake[1].u, modes=[1, 2])
-    assert len(files) == 2 and all(f.exists() and f.with_suffix(".h5").exists() for f in files)
+def test_mode_shapes_are_written_to_vtx(tmp_path, brake, friction):
+    adios2 = pytest.importorskip("adios2")
+    files = write_modes(tmp_path, friction.modes, brake[1].u, ["pads", "disc"], modes=[1, 2])
+    assert [f.name for f in files] == ["modes_pads.bp", "modes_disc.bp"] and all(f.is_dir() for f in files)
     n0 = brake[1].spaces[0].dofmap.index_map.size_local * 3
-    disc = friction.modes.modes[n0:, 1]                     # mode 2 on the disc (P1: vertex values)
-    with h5py.File(files[1].with_suffix(".h5"), "r") as f:
-        assert sorted(f["Function/mode_re"]) == ["1", "2"]
-        for part, values in (("mode_re", disc.real), ("mode_im", disc.imag)):
-            assert np.abs(f[f"Function/{part}/2"][...]).max() == pytest.approx(np.abs(values).max(), rel=1e-12)
+    disc = friction.modes.modes[n0:, 1]                     # mode 2 on the disc (its dofs, serial)
+    with adios2.FileReader(str(files[1])) as reader:
+        for part, values in (("real", disc.real), ("imaginary", disc.imag)):
+            stored = reader.read(f"mode shape {part} part [m/kg^0.5]", step_selection=[1, 1])
+            assert np.abs(stored).max() == pytest.approx(np.abs(values).max(), rel=1e-12)
 
 
 # ---------------------------------------------------------------- rough pad interfaces
@@ -271,8 +271,8 @@ def test_scene_run_writes_results_and_matches_the_direct_analysis(tmp_path, fric
     scene = scenes.load(DEMO, overrides)
     run = squeal.run(scene, degree=1, verbose=False)
     names = {p.name for p in run.files}
-    assert {"modes.csv", "modes_body0.xdmf", "modes_body1.xdmf", "pressure.png", "re_im.png",
-            "energy.png"} <= names and all(p.exists() for p in run.files)
+    assert {"modes.csv", "modes_brake.bp", "modes_disc.bp", "pressure.png", "re_im.png",
+            "energy.png", "brake.xdmf", "disc.xdmf", "interface.xdmf"} <= names and all(p.exists() for p in run.files)
     # same mesh, materials, 10 bar, mu = 0.4 as the direct analysis of the fixtures
     np.testing.assert_allclose(run.case.modes.frequency, friction.modes.frequency[:20], rtol=1e-6)
     with pytest.raises(InputError, match="output.folder"):
@@ -283,9 +283,13 @@ def test_multiscale_run_hands_stability_scenes_to_the_squeal_analysis(tmp_path, 
     from multiscale import workflows
 
     scene = scenes.load(DEMO, {"output.folder": str(tmp_path / "out")})
-    seen = []
-    monkeypatch.setattr(squeal, "run", lambda sc, **kw: seen.append((sc, kw)) or "squeal")
-    assert workflows.run(scene, overwrite=True, verbose=False) == "squeal"
+    seen, folder = [], tmp_path / "out"
+    folder.mkdir()
+    done = RunResult(folder, [], 0.0)
+    monkeypatch.setattr(squeal, "run", lambda sc, **kw: seen.append((sc, kw)) or done)
+    assert workflows.run(scene, overwrite=True, verbose=False) is done
     assert seen[0][0] is scene and seen[0][1]["overwrite"] is True
+    assert sorted(f.name for f in done.files) == ["paraview.py", "provenance.json", "scene.toml",
+                                                  "scene_resolved.toml"]      # the provenance beside
     with pytest.raises(InputError, match="no checkpoints"):
         workflows.run(scene, resume=True)

@@ -50,6 +50,43 @@ def test_friction_resultant_is_mu_times_normal_force(tm):
     np.testing.assert_allclose(f, [0.3 * 100.0, 0.0, 100.0], rtol=0, atol=1e-8)
 
 
+def test_reused_factorisations_give_the_fresh_newton_answer(tm):
+    """LU factors kept for 5 Newton iterations and across solves (the default) as GMRES
+    preconditioner: the same displacements as a fresh factorisation every iteration, to the
+    Newton tolerance (1e-9 of the largest displacement), over a friction load sequence."""
+    kept = Mechanics(tm, MATERIALS, stiffness=K_N, friction=0.3, speed=0.5, load_kind="pressure", prefix="block_k_")
+    fresh = Mechanics(tm, MATERIALS, stiffness=K_N, friction=0.3, speed=0.5, load_kind="pressure", prefix="block_l_",
+                      lag=1)
+    for p in (0.5e6, 1e6, 2e6, 1.5e6):
+        a, b = kept.solve(p), fresh.solve(p)
+        assert a.converged and b.converged
+        for u, v in zip(kept.u, fresh.u):
+            scale = np.abs(v.x.array).max()
+            np.testing.assert_allclose(u.x.array, v.x.array, rtol=0, atol=1e-9 * scale)
+
+
+def test_a_solve_that_fails_with_old_factors_is_repeated_with_fresh_ones(tm):
+    """A Newton solve that went astray (NaN state, not converged) is restarted from the state
+    before it with a fresh factorisation every iteration: the answer of an undisturbed solve."""
+    from multiscale.macro.mechanics import SolveResult
+    reference = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_m_")
+    reference.solve(1e6)
+    m = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_n_")
+    real, calls = m._newton, []
+
+    def astray():
+        calls.append(1)
+        if len(calls) == 1:
+            for u in m.u:
+                u.x.array[:] = np.nan
+            return SolveResult(False, -3, 1, [1.0])
+        return real()
+    m._newton = astray
+    assert m.solve(1e6).converged and len(calls) == 2
+    for u, v in zip(m.u, reference.u):
+        np.testing.assert_allclose(u.x.array, v.x.array, rtol=0, atol=1e-9 * np.abs(v.x.array).max())
+
+
 def test_pulling_the_block_off_raises_convergence_error(tm):
     m = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_d_")
     with pytest.raises(ConvergenceError, match="did not converge"):

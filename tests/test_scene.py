@@ -2,6 +2,7 @@
 import dataclasses
 import math
 import pickle
+import tomllib
 from pathlib import Path
 
 import numpy as np
@@ -113,7 +114,7 @@ def test_unit_errors_say_what_is_expected(text, kind, fragment):
 
 def test_good_scene_in_si(tmp_path):
     scene = loads(GOOD, tmp_path)
-    assert scene.effects == frozenset(EFFECTS) - {"roughness", "layers", "wear", "stability"}
+    assert scene.effects == frozenset(EFFECTS) - {"roughness", "layers", "wear", "stability", "plasticity"}
     assert scene.has("thermal") and not scene.has("wear")
     assert scene.bodies == ("block", "flat") and scene.geometry.motion == "translation"
     assert scene.geometry.params["mesh_size"] == 2e-3
@@ -351,8 +352,19 @@ def test_implausible_values_are_warned_with_their_path(tmp_path, old, new, warni
 
 
 def test_no_shipped_scene_is_implausible():
+    """Every demo scene (the CAD demos' STEP files written by demos/cad_models.py first, as their
+    README says); a measured surface from the shared data beside the repository is replaced by a
+    test file where that folder is absent (a clone elsewhere, CI)."""
+    import subprocess
+    import sys
+    if not (DEMOS / "cad" / "car_brake.step").exists():
+        subprocess.run([sys.executable, str(DEMOS / "cad_models.py")], check=True, capture_output=True, cwd=DEMOS)
+    top = Path(__file__).parent / "data" / "top-1.top"
     for path in sorted(DEMOS.glob("*.toml")):
-        assert not [w for w in load(path).warnings if "plausible" in w], path
+        raw = tomllib.loads(path.read_text())
+        file = raw.get("roughness", {}).get("file")
+        overrides = {"roughness.file": str(top)} if file and not (path.parent / file).exists() else None
+        assert not [w for w in load(path, overrides=overrides).warnings if "plausible" in w], path
 
 
 def test_reference_lists_every_section_and_key():

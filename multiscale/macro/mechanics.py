@@ -27,10 +27,19 @@ from multiscale.macro.interface import ContactInterface, PressureLaw
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
+# Newton on the assembled tangent; each linear solve is GMRES on the current tangent, preconditioned
+# by an LU factorisation (MUMPS) that is refreshed every LAG Newton iterations and kept across
+# solves (time steps): the directions are exact Newton directions to ksp_rtol, the factorisations
+# (most of a step's time) a fraction (issue 23). A solve that fails with old factors is repeated
+# from its start with fresh ones every iteration (``Mechanics.solve``).
+LAG = 5
 NEWTON_OPTIONS = {
     "snes_type": "newtonls", "snes_linesearch_type": "basic",
     "snes_rtol": 1e-10, "snes_atol": 1e-10, "snes_stol": 0.0, "snes_max_it": 30,
-    "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps",
+    "ksp_type": "gmres", "ksp_pc_side": "right", "ksp_rtol": 1e-10, "ksp_atol": 0.0, "ksp_max_it": 50,
+    "ksp_gmres_restart": 50,
+    "pc_type": "lu", "pc_factor_mat_solver_type": "mumps",
+    "snes_lag_preconditioner": LAG, "snes_lag_preconditioner_persists": True,
 }
 
 
@@ -66,7 +75,8 @@ class Mechanics:
     load faces (``load_kind="force"``), a traction [Pa] along it (``load_kind="pressure"``), or a
     fluid pressure p [Pa] (``load_kind="fluid"``: traction −p n with n the outward normal, so two
     faces that look at each other across the fluid, e.g. a brake's piston back and caliper bore,
-    are pushed apart by the same pressure).
+    are pushed apart by the same pressure). ``lag``: Newton iterations per LU factorisation of the
+    tangent (``NEWTON_OPTIONS``; 1 = a fresh one every iteration).
     """
 
     LOAD_KINDS = ("force", "pressure", "fluid")
@@ -74,7 +84,7 @@ class Mechanics:
     def __init__(self, tm: TwoBodyMesh, materials: Mapping[str, object], *, stiffness=1e13,
                  friction: float = 0.0, speed: float = 0.0, law: PressureLaw | None = None,
                  velocity=None, temperatures=None, reference_temperature: float = 293.15,
-                 load_kind: str = "force", degree: int = 1, prefix: str = "mech_"):
+                 load_kind: str = "force", degree: int = 1, prefix: str = "mech_", lag: int = LAG):
         if load_kind not in self.LOAD_KINDS:
             raise InputError("load_kind", load_kind, f"one of {', '.join(self.LOAD_KINDS)}")
         self.tm = tm
@@ -101,7 +111,9 @@ class Mechanics:
         self.residuals = F
         self.bcs = self._supports()
         self.problem = fpetsc.NonlinearProblem(F, self.u, bcs=self.bcs, petsc_options_prefix=prefix,
-                                               petsc_options=NEWTON_OPTIONS, entity_maps=tm.entity_maps)
+                                               petsc_options=dict(NEWTON_OPTIONS, snes_lag_preconditioner=lag),
+                                               entity_maps=tm.entity_maps)
+        self.lag = lag
         self._history: list[float] = []
         self.problem.solver.setMonitor(lambda snes, it, norm: self._history.append(norm))
 
@@ -163,6 +175,35 @@ class Mechanics:
         """Newton solve at the given load (N or Pa); raises ConvergenceError on failure."""
         if load is not None:
             self.load.value = float(load)
+        start = [u.x.array.copy() for u in self.u]
+        result = self._newton()
+        if not result.converged:           # old factors can mislead: again from the start, fresh ones
+            for u, x in zip(self.u, start):
+                u.x.array[:] = x
+            self._lag(1)
+            try:
+                result = self._newton()
+            finally:
+                self._lag(self.lag)
+        if not result.converged:
+            raise ConvergenceError(
+                f"contact Newton did not converge at load {float(self.load.value):.6g} "
+                f"(SNES reason {result.reason}, {result.iterations} iterations, residuals "
+                f"{['%.3g' % r for r in result.residuals]})", result.residuals, result)
+        result.normal_force = self.contact.normal_force()
+        result.max_pressure = float(self.contact.facet_pressure().max(initial=0.0))
+        return result
+
+    def _lag(self, n: int) -> None:
+        """Refresh the LU preconditioner every ``n`` Newton iterations (petsc4py has no setter)."""
+        snes, options = self.problem.solver, PETSc.Options()
+        key = f"{snes.getOptionsPrefix()}snes_lag_preconditioner"
+        options[key] = n
+        snes.setFromOptions()
+        del options[key]
+
+    def _newton(self) -> SolveResult:
+        """One SNES solve from the current state; converged only if finite on every rank."""
         self._history.clear()
         self.problem.solve()
         snes = self.problem.solver
@@ -170,15 +211,7 @@ class Mechanics:
         history = list(self._history)
         finite = all(np.isfinite(history)) and all(np.isfinite(u.x.array).all() for u in self.u)
         finite = bool(self.tm.comm.allreduce(finite, op=MPI.LAND))     # every rank decides alike
-        result = SolveResult(reason > 0 and finite, reason, its, history)
-        if not result.converged:
-            raise ConvergenceError(
-                f"contact Newton did not converge at load {float(self.load.value):.6g} "
-                f"(SNES reason {reason}, {its} iterations, residuals {['%.3g' % r for r in history]})",
-                history, result)
-        result.normal_force = self.contact.normal_force()
-        result.max_pressure = float(self.contact.facet_pressure().max(initial=0.0))
-        return result
+        return SolveResult(reason > 0 and finite, reason, its, history)
 
     def ramp(self, load: float, steps: int = 1) -> SolveResult:
         """Solve from the current state at loads load/steps, 2 load/steps, ..., load."""

@@ -18,6 +18,7 @@ from typing import Callable
 
 import numpy as np
 
+from multiscale.outputs import step_time
 from multiscale.errors import InputError
 from multiscale.macro.mechanics import Mechanics, SolveResult
 from multiscale.macro.mesh import TwoBodyMesh
@@ -55,6 +56,8 @@ class MacroModel:
     time: float = 0.0                                  # s
     heat_total: np.ndarray = field(default_factory=lambda: np.zeros(2))   # J, frictional heat in
     heat_lost_recorded: np.ndarray = field(default_factory=lambda: np.zeros(2))   # J, lost at the last record
+    heat_exchanged: float = 0.0                        # J, body 0 -> body 1 through the conductance, last step
+    heat_exchanged_total: float = 0.0                  # J, since the start
     last_solve: SolveResult | None = None
     load: float | None = None                          # N or Pa at factor 1 (the drive's, or scaled to its torque)
 
@@ -95,10 +98,11 @@ class MacroModel:
 
     def macro_step(self, dt: float, substeps: int = 1) -> np.ndarray:
         """Advance by one macro step dt [s] in ``substeps`` (Fig. 7.4); returns the heat [J] put
-        into each body during the step."""
-        heat = np.zeros(2)
-        delta = dt / substeps
-        for _ in range(substeps):
+        into each body during the step. The time after the step is rounded to 12 significant
+        digits (``outputs.step_time``): output times are exact decimals, not sums of rounded steps."""
+        heat, self.heat_exchanged = np.zeros(2), 0.0
+        delta, start = dt / substeps, self.time
+        for k in range(substeps):
             if self.thermal is not None:            # the mean speed of the step for a changing speed
                 self.contact.speed.value = self.speed(self.time) if self.drive.steady else \
                     0.5 * (self.speed(self.time) + self.speed(self.time + delta))
@@ -107,8 +111,10 @@ class MacroModel:
                 solved = float(self.mechanics.load.value)
                 self.contact.engaged.value = self.drive.mean_factor(self.time, self.time + delta) * self.load / solved \
                     if solved > 0 else 0.0
-                heat += self.thermal.step(delta).heat_in
-            self.time += delta
+                done = self.thermal.step(delta)
+                heat += done.heat_in
+                self.heat_exchanged += done.heat_exchanged
+            self.time = step_time(start, dt) if k == substeps - 1 else start + (k + 1) * delta
             self.contact.speed.value = self.speed(self.time)
             factor = self.drive.factor(self.time)
             self.contact.engaged.value = float(factor > 0)
@@ -116,6 +122,7 @@ class MacroModel:
             if factor > 0 and (self.mechanics.temperatures is not None or load != self.mechanics.load.value):
                 self.last_solve = self.mechanics.solve(load)
         self.heat_total += heat
+        self.heat_exchanged_total += self.heat_exchanged
         return heat
 
     def record(self, heat_step=(0.0, 0.0)) -> dict:
@@ -140,6 +147,8 @@ class MacroModel:
                 row[f"heat_step_{body.name}"] = heat_step[i]
                 row[f"heat_total_{body.name}"] = self.heat_total[i]
                 row[f"stored_heat_{body.name}"] = stored[i]
+            if self.thermal.conductance:      # conducted through the interface conductance (body 0 -> 1)
+                row.update(heat_exchanged_step=self.heat_exchanged, heat_exchanged_total=self.heat_exchanged_total)
             if self.thermal.boundaries:       # heat lost through convection, radiation, fixed temperatures
                 lost = self.thermal.heat_lost
                 for i, body in enumerate(self.tm.bodies):

@@ -1,125 +1,301 @@
-"""Fields for ParaView: XDMF time series of the bodies and of the interface.
+"""Fields for ParaView: one XDMF time series per body and one for the interface; mode shapes in VTX.
 
-``FieldWriter`` writes ``<body>.xdmf`` per body and ``interface.xdmf`` (per-facet cell data);
-``FieldOutput`` picks a model's requested fields (displacement, temperature, von Mises stress,
-contact pressure, frictional heat flux, and per-facet extras such as the zone laws' stiffness),
-refreshes the derived ones and writes them at each output time; ``write_modes_xdmf`` writes complex
-mode shapes. XDMF writes are collective.
+Every field file holds ONE mesh and, at each output time, ONE grid carrying every field as a named
+point array (nodal fields: displacement, temperature) or cell array (von Mises stress per cell,
+the interface's per-facet values), named with its unit ("temperature [K]", ``outputs.FIELDS``):
+ParaView's XDMF reader shows one block per file whose arrays colour it directly, and meshio's
+``TimeSeriesReader`` or h5py read it back. The times are the model's exact output times.
+``<name>.xdmf`` is the index and ``<name>.h5`` the data (``/mesh/geometry``, ``/mesh/topology``,
+``/times``, ``/data/<k>/<field>``); the writer is ours, not DOLFINx's ``XDMFFile``, because that one
+writes every function as its own grid (coincident unnamed blocks in ParaView).
+
+- ``FieldWriter``: the series of a set of meshes; the mesh is gathered to rank 0 once in a
+  rank-independent order (nodes sorted by coordinates, cells by their nodes), so that a run
+  resumed on another number of ranks appends to the same files. Files are closed after every
+  write: a run killed between two writes leaves them readable; the resumed run drops the times
+  the killed one wrote after its checkpoint, and replaces a time written again: no time twice.
+- ``FieldOutput``: a model's requested fields (``output.fields``) refreshed and written at each
+  output time; ``write_state`` writes one state (the squeal analysis' preload).
+- ``write_modes``: complex mode shapes, one VTX (ADIOS2, ``.bp``) file per body holding the real and
+  imaginary parts on the mesh of the displacement (quadratic shapes exactly), "time" = mode number.
+  ParaView opens it with its ADIOS2 VTX reader.
 """
 from __future__ import annotations
 
 from pathlib import Path
 from typing import Callable, Mapping, Sequence
+from xml.sax.saxutils import quoteattr
 
+import h5py
 import numpy as np
 from dolfinx import fem
-from dolfinx.io import XDMFFile
+from dolfinx.io import VTXMeshPolicy, VTXWriter
 
-from multiscale.errors import InputError
+from multiscale import io
+from multiscale.errors import InputError, OutputError
+from multiscale.outputs import FIELDS, array_name
+
+# DOLFINx cell name -> (XDMF topology type, DOLFINx vertex order -> XDMF/VTK order)
+CELLS = {"tetrahedron": ("Tetrahedron", [0, 1, 2, 3]), "triangle": ("Triangle", [0, 1, 2]),
+         "hexahedron": ("Hexahedron", [0, 1, 3, 2, 4, 5, 7, 6]), "quadrilateral": ("Quadrilateral", [0, 1, 3, 2])}
+MODE_UNIT = "m/kg^0.5"     # mode shapes normalised to unit modal mass
+
+
+class MeshLayout:
+    """A linear mesh gathered on rank 0 in a rank-independent order, and the maps that gather
+    point values (at the mesh nodes) and cell values into that order (collective)."""
+
+    def __init__(self, mesh):
+        if mesh.geometry.cmaps[0].degree != 1:
+            raise InputError("mesh", mesh.geometry.cmaps[0].degree, "field files need a linear mesh geometry")
+        tdim, cell = mesh.topology.dim, mesh.topology.cell_name()
+        if cell not in CELLS:
+            raise InputError("mesh", cell, f"field files support {', '.join(CELLS)} cells")
+        self.mesh, self.comm, self.cell_type = mesh, mesh.comm, CELLS[cell][0]
+        self.n_nodes = mesh.geometry.index_map().size_local
+        self.n_cells = mesh.topology.index_map(tdim).size_local
+        self.xdofs = mesh.geometry.dofmaps[0]
+        x = mesh.geometry.x
+        parts = self.comm.gather((x[:self.n_nodes], x[self.xdofs[:self.n_cells]]), root=0)
+        self._p1 = {}
+        if self.comm.rank != 0:
+            return
+        nodes = np.concatenate([p[0] for p in parts])
+        corners = np.concatenate([p[1] for p in parts])
+        unique, inverse = np.unique(np.vstack([nodes, corners.reshape(-1, 3)]), axis=0, return_inverse=True)
+        inverse = inverse.ravel()
+        if len(unique) != len(nodes):
+            raise InputError("mesh", len(nodes), "nodes of the field mesh must have distinct coordinates")
+        self.node_position = inverse[:len(nodes)]
+        topology = inverse[len(nodes):].reshape(len(corners), -1)
+        order = np.lexsort(np.sort(topology, axis=1).T[::-1])
+        self.cell_position = np.empty(len(order), dtype=np.int64)
+        self.cell_position[order] = np.arange(len(order))
+        self.geometry = unique
+        self.topology = topology[order][:, CELLS[cell][1]].astype(np.int64)
+
+    def _gather(self, owned: np.ndarray, position_name: str):
+        parts = self.comm.gather(owned, root=0)
+        if self.comm.rank != 0:
+            return None
+        values = np.concatenate(parts)
+        out = np.empty_like(values)
+        out[getattr(self, position_name)] = values
+        return out
+
+    def point_values(self, f: fem.Function) -> np.ndarray | None:
+        """Values of a Lagrange function at the mesh nodes (interpolated to degree 1), on rank 0:
+        (nodes,) or (nodes, components)."""
+        shape = f.function_space.value_shape
+        if shape not in self._p1:
+            V = fem.functionspace(self.mesh, ("Lagrange", 1, shape))
+            node_dof = np.empty(self.mesh.geometry.x.shape[0], dtype=np.int64)
+            node_dof[self.xdofs] = V.dofmap.list
+            self._p1[shape] = (fem.Function(V), node_dof[:self.n_nodes])
+        work, node_dof = self._p1[shape]
+        work.interpolate(f)
+        bs = work.function_space.dofmap.bs
+        return self._gather(work.x.array.reshape(-1, bs)[node_dof].squeeze(), "node_position")
+
+    def cell_values(self, f: fem.Function) -> np.ndarray | None:
+        """Values of a DG0 function per cell, on rank 0."""
+        bs = f.function_space.dofmap.bs
+        dofs = f.function_space.dofmap.list[:self.n_cells, 0]
+        return self._gather(f.x.array.reshape(-1, bs)[dofs].squeeze(), "cell_position")
+
+
+def is_cell_field(f: fem.Function) -> bool:
+    """True for a DG0 function (written as cell data)."""
+    return f.function_space.element.basix_element.degree == 0
+
+
+class SeriesFile:
+    """One XDMF/HDF5 time series of one mesh (rank 0 writes; see module docstring)."""
+
+    def __init__(self, path: Path, layout: MeshLayout):
+        self.path, self.h5, self.layout = Path(path), Path(path).with_suffix(".h5"), layout
+
+    def start(self, resume_at: float | None = None) -> None:
+        """Create the files (rank 0), or with ``resume_at`` [s] continue those of a run resumed from
+        a checkpoint at that time: the times after it, written by the run that was killed, are dropped
+        (the resumed run writes them again, once)."""
+        if resume_at is None or not self.h5.is_file():
+            with h5py.File(self.h5, "w") as f:
+                f.create_dataset("mesh/geometry", data=self.layout.geometry).attrs["unit"] = "m"
+                f.create_dataset("mesh/topology", data=self.layout.topology).attrs["cell_type"] = self.layout.cell_type
+                f.create_dataset("times", data=np.zeros(0), maxshape=(None,)).attrs["unit"] = "s"
+            self._write_xml()
+            return
+        with h5py.File(self.h5, "r") as f:
+            if f["mesh/geometry"].shape != self.layout.geometry.shape:
+                raise OutputError(f"{self.h5} holds another mesh than this run's (resume with the same scene)")
+            times = f["times"][...]
+        keep = int(np.count_nonzero(times <= resume_at))
+        if keep < len(times):
+            with h5py.File(self.h5, "a") as f:
+                for k in range(keep, len(times)):
+                    if f"data/{k}" in f:
+                        del f[f"data/{k}"]
+                f["times"].resize((keep,))
+            self._write_xml()
+
+    def write(self, time: float, arrays: Mapping[str, tuple]) -> None:
+        """Write ``arrays`` {field: (values, "Node" or "Cell")} at ``time`` (an existing time is
+        replaced); rank 0 only."""
+        with h5py.File(self.h5, "a") as f:
+            times = list(f["times"][...])
+            k = times.index(time) if time in times else len(times)
+            if k == len(times):
+                f["times"].resize((k + 1,))
+                f["times"][k] = time
+            group = f.require_group(f"data/{k}")
+            for field, (values, centre) in arrays.items():
+                if field in group:
+                    del group[field]
+                d = group.create_dataset(field, data=values)
+                d.attrs.update(name=array_name(field), unit=FIELDS[field][1], centre=centre)
+        self._write_xml()
+
+    def _write_xml(self) -> None:
+        lay, h5 = self.layout, self.h5.name
+        with h5py.File(self.h5, "r") as f:
+            times = f["times"][...]
+            steps = [(t, [(name, d) for name, d in f[f"data/{k}"].items()] if f"data/{k}" in f else [])
+                     for k, t in enumerate(times)]
+            nodes, cells = f["mesh/geometry"].shape[0], f["mesh/topology"].shape
+
+            def item(path, shape, kind="Float"):
+                dims = " ".join(str(s) for s in shape)
+                return (f'<DataItem Dimensions="{dims}" NumberType="{kind}" Precision="8" Format="HDF">'
+                        f"{h5}:{path}</DataItem>")
+            mesh = (f'<Topology TopologyType="{lay.cell_type}" NumberOfElements="{cells[0]}" '
+                    f'NodesPerElement="{cells[1]}">{item("/mesh/topology", cells, "Int")}</Topology>'
+                    f'<Geometry GeometryType="XYZ">{item("/mesh/geometry", (nodes, 3))}</Geometry>')
+            grids = []
+            for k, (t, arrays) in enumerate(steps):
+                attrs = []
+                for field, d in arrays:
+                    kind = "Scalar" if d.ndim == 1 else "Vector" if d.shape[1] == 3 else "Matrix"
+                    attrs.append(f'<Attribute Name={quoteattr(array_name(field))} AttributeType="{kind}" '
+                                 f'Center="{d.attrs["centre"]}">{item(f"/data/{k}/{field}", d.shape)}</Attribute>')
+                grids.append(f'<Grid Name="{self.path.stem}" GridType="Uniform"><Time Value="{float(t)!r}"/>'
+                             + mesh + "".join(attrs) + "</Grid>")
+        text = ('<?xml version="1.0"?>\n<Xdmf Version="3.0">\n<Domain>\n'
+                f'<Grid Name="{self.path.stem}" GridType="Collection" CollectionType="Temporal">\n'
+                + "\n".join(grids) + "\n</Grid>\n</Domain>\n</Xdmf>\n")
+        tmp = self.path.with_name(self.path.name + ".tmp")
+        tmp.write_text(text)
+        tmp.replace(self.path)
 
 
 class FieldWriter:
-    """XDMF time series: ``<folder>/<body>.xdmf`` per body and ``<folder>/interface.xdmf``.
+    """Time series ``<folder>/<name>.xdmf`` (+ ``.h5``) of named meshes, each with its fields
+    (``{field: Function}``, the keys among ``io.FIELDS``); ``resume_at`` [s]: continue the existing
+    files of a run resumed from a checkpoint at that time (``SeriesFile.start``). Collective: a file
+    that cannot be written or continued is an ``OutputError`` on every rank."""
 
-    The files are closed after every write, so that a run killed between two writes leaves them
-    readable; ``append`` continues existing files (a resumed run: no new mesh)."""
-
-    def __init__(self, folder: Path, tm, body_functions, interface_functions, append: bool = False):
-        self.files, self.groups = [], []
-        self.append, self.comm = append, tm.comm
-        for body, functions in zip(tm.bodies, body_functions):
-            self._open(Path(folder) / f"{body.name}.xdmf", body.mesh, functions)
-        self._open(Path(folder) / "interface.xdmf", tm.interface.mesh, interface_functions)
-
-    def _open(self, path, mesh, functions):
-        if not self.append:
-            with XDMFFile(self.comm, str(path), "w") as f:
-                f.write_mesh(mesh)
-        self.files.append(path)
-        self.groups.append((path, list(functions)))
+    def __init__(self, folder: Path, groups: Sequence[tuple], resume_at: float | None = None):
+        self.groups = [(SeriesFile(Path(folder) / f"{name}.xdmf", MeshLayout(mesh)), dict(functions))
+                       for name, mesh, functions in groups if functions]
+        self.files = [s.path for s, _ in self.groups]
+        if self.groups:
+            io.on_root(self.groups[0][0].layout.comm, lambda: [s.start(resume_at) for s, _ in self.groups],
+                       f"the field files in {folder}")
 
     def write(self, time: float) -> None:
-        for path, functions in self.groups:
-            with XDMFFile(self.comm, str(path), "a") as f:
-                for u in functions:
-                    f.write_function(u, time)
+        """Every group's fields at ``time`` [s] (collective; a failed write is an OutputError on every rank)."""
+        written = []
+        for series, functions in self.groups:
+            lay = series.layout
+            written.append((series, {k: (lay.cell_values(f), "Cell") if is_cell_field(f) else
+                                     (lay.point_values(f), "Node") for k, f in functions.items()}))
+        if self.groups:
+            io.on_root(self.groups[0][0].layout.comm, lambda: [s.write(float(time), a) for s, a in written],
+                       f"the fields at t = {time:g} s")
 
 
 class FieldOutput:
-    """The requested ``fields`` of a ``MacroModel``, refreshed and written at each output time.
+    """The requested ``fields`` of a model (``tm``, ``mechanics``, optional ``thermal``), refreshed
+    and written at each output time.
 
     ``extra``: {interface field name: callable returning its global per-facet array}, written when
-    the name is among ``fields``; ``append``: continue existing XDMF files (a resumed run)."""
+    the name is among ``fields`` (they replace the built-in ones of the same name: the frictional
+    ``heat_flux`` and ``partition``); ``resume_at`` [s]: continue the files of a run resumed at that
+    time (``FieldWriter``)."""
 
     def __init__(self, model, folder: Path, fields, extra: Mapping[str, Callable] | None = None,
-                 append: bool = False):
+                 resume_at: float | None = None, mechanics=None, thermal=None):
         self.model = model
-        tm, mech, th = model.tm, model.mechanics, model.thermal
-        fields = set(fields)
-        body = [[], []]
+        tm = model.tm if model is not None else mechanics.tm
+        mech = model.mechanics if model is not None else mechanics
+        th = model.thermal if model is not None else thermal
+        self.tm, self.mech, fields = tm, mech, list(fields)
+        body = [{} for _ in tm.bodies]
         self.von_mises = []
         for i, b in enumerate(tm.bodies):
             if "displacement" in fields:
-                body[i].append(mech.u[i])
+                body[i]["displacement"] = mech.u[i]
             if "temperature" in fields and th is not None:
-                body[i].append(th.T[i])
+                body[i]["temperature"] = th.T[i]
             if "von_mises" in fields:
                 V = b.region_space
                 f = fem.Function(V, name=f"von_mises_{b.name}")
                 self.von_mises.append((f, fem.Expression(mech.von_mises(i), V.element.interpolation_points)))
-                body[i].append(f)
-        self.pressure = tm.interface.field("contact_pressure") if "contact_pressure" in fields else None
-        self.flux = tm.interface.field("heat_flux") if "heat_flux" in fields and th is not None else None
-        self.extra = [(tm.interface.field(name), make) for name, make in (extra or {}).items() if name in fields]
-        iface = [f for f in (self.pressure, self.flux) if f is not None] + [f for f, _ in self.extra]
-        self.writer = FieldWriter(folder, tm, body, iface, append=append)
+                body[i]["von_mises"] = f
+        contact = mech.contact
+        makers = {"contact_pressure": contact.facet_pressure}
+        if th is not None:
+            makers["heat_flux"] = contact.facet_heat_flux
+            makers["partition"] = lambda: tm.interface.values(contact.partition)
+        makers.update(extra or {})
+        self.interface = [(tm.interface.field(name), make) for name, make in makers.items() if name in fields]
+        groups = [(b.name, b.mesh, body[i]) for i, b in enumerate(tm.bodies)]
+        groups.append(("interface", tm.interface.mesh, {f.name: f for f, _ in self.interface}))
+        self.writer = FieldWriter(folder, groups, resume_at=resume_at)
         self.files = self.writer.files
 
-    def write(self) -> None:
-        m = self.model
+    def write(self, time: float | None = None) -> None:
+        """Refresh the derived fields and write them at ``time`` (default: the model's time)."""
         for f, expr in self.von_mises:
             f.interpolate(expr)
-        if self.pressure is not None:
-            m.tm.interface.set_field(self.pressure, m.contact.facet_pressure())
-        if self.flux is not None:
-            m.tm.interface.set_field(self.flux, m.contact.facet_heat_flux())
-        for f, make in self.extra:
-            m.tm.interface.set_field(f, make())
-        self.writer.write(m.time)
+        for f, make in self.interface:
+            self.tm.interface.set_field(f, make())
+        self.writer.write(self.model.time if time is None else time)
 
 
-def write_modes_xdmf(path: str | Path, result, functions: Sequence,
-                     modes: Sequence[int] | None = None) -> list[Path]:
-    """Mode shapes of ``result`` (``eigen.ModalResult``) to XDMF, one file per body mesh: real and
-    imaginary parts, "time" = mode number.
+def write_state(folder: Path, mechanics, fields, time: float = 0.0) -> list[Path]:
+    """The ``fields`` of one mechanical state (e.g. the squeal preload) at ``time``; the files."""
+    out = FieldOutput(None, folder, fields, mechanics=mechanics)
+    out.write(time)
+    return out.files
+
+
+def write_modes(folder: str | Path, result, functions: Sequence, names: Sequence[str],
+                modes: Sequence[int] | None = None) -> list[Path]:
+    """Mode shapes of ``result`` (``eigen.ModalResult``) to ``<folder>/modes_<name>.bp`` (VTX, one
+    per body): arrays "mode shape real part" and "... imaginary part" [m/kg^0.5] on the space of
+    the displacement, "time" = mode number (1, 2, ...). Collective; returns the written paths.
 
     ``functions`` are displacement Functions of the bodies in the block order of the matrices (the
-    owned dofs of body 0, then of body 1, ... on each rank). Shapes are interpolated to linear
-    vertex values (XDMF stores the mesh's own degree). Returns the written paths.
-    """
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
+    owned dofs of body 0, then of body 1, ... on each rank)."""
+    folder = Path(folder)
     sel = range(1, len(result) + 1) if modes is None else modes
-    sizes = [u.function_space.dofmap.bs * u.function_space.dofmap.index_map.size_local
-             for u in functions]
+    sizes = [u.function_space.dofmap.bs * u.function_space.dofmap.index_map.size_local for u in functions]
     if sum(sizes) != result.modes.shape[0]:
         raise InputError("functions", len(functions), "must span the dof layout of the modes")
     offsets = np.concatenate([[0], np.cumsum(sizes)])
     files = []
-    for k, u in enumerate(functions):
-        mesh = u.function_space.mesh
-        work = fem.Function(u.function_space)
-        W = fem.functionspace(mesh, ("Lagrange", 1, (mesh.geometry.dim,)))
-        parts = (fem.Function(W, name="mode_re"), fem.Function(W, name="mode_im"))
-        out = path.with_name(f"{path.stem}_body{k}.xdmf")
-        with XDMFFile(mesh.comm, str(out), "w") as w:
-            w.write_mesh(mesh)
+    for k, (u, name) in enumerate(zip(functions, names)):
+        V = u.function_space
+        parts = (fem.Function(V, name=f"mode shape real part [{MODE_UNIT}]"),
+                 fem.Function(V, name=f"mode shape imaginary part [{MODE_UNIT}]"))
+        out = folder / f"modes_{name}.bp"
+        with VTXWriter(V.mesh.comm, out, list(parts), engine="BP4", mesh_policy=VTXMeshPolicy.reuse) as w:
             for j in sel:
                 block = result.modes[offsets[k]:offsets[k + 1], j - 1]
                 for f, values in zip(parts, (block.real, block.imag)):
-                    work.x.array[:sizes[k]] = values
-                    work.x.scatter_forward()
-                    f.interpolate(work)
-                    w.write_function(f, float(j))
+                    f.x.array[:sizes[k]] = values
+                    f.x.scatter_forward()
+                w.write(float(j))
         files.append(out)
     return files

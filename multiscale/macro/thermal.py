@@ -123,6 +123,7 @@ class ThermalStep:
     heat_in: tuple                 # J, frictional heat put into body 0 and body 1 during the step
     max_temperature: tuple         # K, per body
     heat_lost: tuple = (0.0, 0.0)  # J, heat lost through the boundary conditions of each body
+    heat_exchanged: float = 0.0    # J, conducted from body 0 to body 1 through the interface conductance
 
 
 @dataclass
@@ -182,7 +183,7 @@ class Thermal:
         Fi = contact.heat_residuals(self.T[0], self.T[1], r[0], r[1], frictional_heat=frictional_heat,
                                     conductance=conductance)
         self.residuals = [F[i] + Fi[i] if Fi[i] is not None else F[i] for i in range(2)]
-        self.frictional_heat = frictional_heat
+        self.frictional_heat, self.conductance = frictional_heat, conductance
         self.boundaries = tuple(boundaries)
         self.applied = self._apply_boundaries(r)
         self.bcs = [a.bc for a in self.applied if a.bc is not None]
@@ -308,7 +309,14 @@ class Thermal:
         self.lost_total += self.lost_step
         lost = self.lost_step.sum(axis=0)
         return ThermalStep(self.time, (power[0] * dt, power[1] * dt), self.max_temperature(),
-                           (float(lost[0]), float(lost[1])))
+                           (float(lost[0]), float(lost[1])), dt * self.exchange_power() if self.conductance else 0.0)
+
+    def exchange_power(self) -> float:
+        """Heat [W] conducted from body 0 to body 1 through the interface conductance at the current
+        temperatures (the residual's own term: for the step just solved, backward Euler's flux)."""
+        c = self.contact
+        return self.cache.scalar("exchange", lambda: c.engaged * c.conductance("+") * (self.T[0]("+") - self.T[1]("-"))
+                                 * self.tm.interface.dS)
 
     def _losses(self, dt: float) -> np.ndarray:
         """Heat lost [J] through each condition and body during the step just solved (see module

@@ -27,7 +27,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 from tqdm import tqdm
 
-from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.errors import (ConvergenceError, InputError, check_count, check_field, check_flag, check_positive,
+                               check_real)
 from multiscale.micro.asperity_interaction import Interactions, minimise
 from multiscale.micro.asperity_laws import AsperityLaw, check_table, hertz_law
 from multiscale.micro.surface import AsperityTable, Surface, find_asperities, statistics
@@ -108,7 +109,8 @@ class AsperityModel:
             raise InputError("law", law.n, f"law has {law.n} asperities, the table {len(table)}")
         if surface is not None and not isinstance(surface, Surface):
             raise InputError("surface", surface, "a multiscale.micro.surface.Surface")
-        self.table, self.law, self.interaction, self.surface = table, law, bool(interaction), surface
+        self.table, self.law, self.surface = table, law, surface
+        self.interaction = check_flag("interaction", interaction)
         if nominal_area is None:
             if surface is None:
                 raise InputError("nominal_area", None, "give the nominal area A0 [m²] or the surface")
@@ -148,10 +150,13 @@ class AsperityModel:
         """
         delta = _check_delta(delta)
         check_positive("tol", tol)
+        max_iter = check_count("max_iter", max_iter)
+        for name, flag in (("partial", partial), ("raster", raster)):
+            check_flag(name, flag)
         route, method = _check_route(route, method)
         if initial is not None:
-            initial = np.asarray(initial, dtype=float)
-            if initial.shape != (len(self.table),) or not np.all(np.isfinite(initial)):
+            initial = check_field("initial", initial)
+            if initial.shape != (len(self.table),):
                 raise InputError("initial", initial, f"{len(self.table)} finite contact sizes [m]")
         t0 = time.perf_counter()
         dk = delta - (self.z_max - self.table.height)
@@ -195,8 +200,9 @@ class AsperityModel:
     def curve(self, deltas, *, route: str = "energy", method: str | None = None, tol: float = 1e-6,
               raster: bool = False, progress: bool = False) -> AsperityCurve:
         """Solve at increasing approaches ``deltas`` [m], each step warm-started from the last."""
-        d = np.asarray(deltas, dtype=float).ravel()
-        if d.size == 0 or not np.all(np.isfinite(d)) or np.any(d < 0) or np.any(np.diff(d) < 0):
+        d = check_field("deltas", deltas).ravel()
+        check_flag("progress", progress)
+        if d.size == 0 or np.any(d < 0) or np.any(np.diff(d) < 0):
             raise InputError("deltas", deltas, "a non-empty increasing sequence of approaches >= 0")
         t0 = time.perf_counter()
         dk = d[-1] - (self.z_max - self.table.height)
@@ -339,10 +345,7 @@ class AsperityModel:
 
 # ----------------------------------------------------------------------------- checks
 def _check_delta(delta) -> float:
-    try:
-        d = float(delta)
-    except (TypeError, ValueError):
-        raise InputError("delta", delta, "approach must be a real number [m]") from None
+    d = check_real("delta", delta)
     if not np.isfinite(d) or d < 0:
         raise InputError("delta", delta, "approach must be finite and >= 0")
     return d
@@ -352,9 +355,9 @@ _METHODS = {"energy": ("l-bfgs-b", "tnc"), "kinematic": ("trf", "tnc", "l-bfgs-b
 
 
 def _check_route(route, method):
-    if route not in _METHODS:
+    if not isinstance(route, str) or route not in _METHODS:
         raise InputError("route", route, "'energy' or 'kinematic'")
-    method = _METHODS[route][0] if method is None else str(method).lower()
+    method = _METHODS[route][0] if method is None else (method.lower() if isinstance(method, str) else method)
     if method not in _METHODS[route]:
         raise InputError("method", method, f"one of {_METHODS[route]} for the {route} route")
     return route, method

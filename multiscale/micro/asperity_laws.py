@@ -35,7 +35,7 @@ from abc import ABC, abstractmethod
 
 import numpy as np
 
-from multiscale.errors import InputError, check_positive
+from multiscale.errors import InputError, check_flag, check_positive
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.surface import AsperityTable
 from multiscale.references.hertz import axis_ratio_squared, exterior_lambda, potential_integrals
@@ -252,12 +252,12 @@ def hertz_law(table: AsperityTable, solid, shape: str = "elliptic", *, exact: bo
     ``shape="circular"``: radius R = sqrt(R1 R2) (models 1 and 3); ``"elliptic"``: models 2 and 4.
     """
     check_table(table)
-    E_star = solid.E_star if isinstance(solid, HalfSpace) else solid
+    E_star = solid.E_star if isinstance(solid, HalfSpace) else check_positive("solid", solid)
+    if not isinstance(shape, str) or shape not in ("circular", "elliptic"):
+        raise InputError("shape", shape, "'circular' or 'elliptic'")
     if shape == "circular":
         return HertzCircular(table.radius, E_star)
-    if shape == "elliptic":
-        return HertzElliptic(table.R1, table.R2, table.angle, E_star, exact=exact)
-    raise InputError("shape", shape, "'circular' or 'elliptic'")
+    return HertzElliptic(table.R1, table.R2, table.angle, E_star, exact=check_flag("exact", exact))
 
 
 def check_table(table) -> None:

@@ -26,10 +26,11 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.errors import (ConvergenceError, InputError, check_count, check_field, check_flag, check_instance,
+                               check_positive, check_real)
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import InfluenceOperator, Kernel
-from multiscale.micro.surface import Surface
+from multiscale.micro.surface import Surface, check_surface
 
 
 class SeriesKernel(Kernel):
@@ -85,6 +86,8 @@ class ConductionSolver:
 
     def __init__(self, kernel_1: Kernel, kernel_2: Kernel, shape, dx: float, dy: float | None = None,
                  periodic: bool = True):
+        for name, kernel in (("kernel_1", kernel_1), ("kernel_2", kernel_2)):
+            check_instance(name, kernel, Kernel, "a thermal Kernel (e.g. ThermalHalfSpace(kappa))")
         self.kernels = (kernel_1, kernel_2)
         self.series = InfluenceOperator(SeriesKernel(kernel_1, kernel_2), shape, dx, dy, periodic)
         self.body_1 = InfluenceOperator(kernel_1, shape, dx, dy, periodic)
@@ -110,21 +113,23 @@ class ConductionSolver:
         initial_flux: warm start (W/m², restricted to the contact). Raises
         ``ConductionConvergenceError`` if not converged, unless ``partial``.
         """
-        mask = np.asarray(contact)
-        if mask.ndim < 2 or mask.shape[-2:] != self.shape:
+        mask = check_field("contact", contact, min_ndim=2) != 0
+        if mask.shape[-2:] != self.shape:
             raise InputError("contact.shape", mask.shape, f"last two axes must be {self.shape}")
-        mask = mask.astype(bool)
-        R = np.asarray(resistance, dtype=float)
-        if not np.all(np.isfinite(R)) or np.any(R < 0):
-            raise InputError("resistance", resistance, "local thermal resistance R must be finite and >= 0 [m² K/W]")
+        R = check_field("resistance", resistance, nonnegative=True)
         try:
             R = np.broadcast_to(R, mask.shape)
         except ValueError:
             raise InputError("resistance.shape", R.shape, f"must broadcast to {mask.shape}") from None
-        dtheta = float(theta_2) - float(theta_1)
+        if not np.isfinite(check_real("theta_1", theta_1)):
+            raise InputError("theta_1", theta_1, "must be finite [K]")
+        dtheta = check_real("theta_2", theta_2) - float(theta_1)
         if not np.isfinite(dtheta) or dtheta == 0:
             raise InputError("theta_2", theta_2, f"must be finite and differ from theta_1 = {theta_1}")
         check_positive("tol", tol)
+        check_flag("partial", partial)
+        if initial_flux is not None:
+            initial_flux = check_field("initial_flux", initial_flux)
         axes = (-2, -1)
         full = mask.all(axis=axes)
         if self.periodic and self.bulk is None and np.any(full & np.all(R == 0, axis=axes)):
@@ -133,6 +138,7 @@ class ConductionSolver:
         n_contact = mask.sum(axis=axes)
         if max_iter is None:
             max_iter = int(20 * np.sqrt(max(int(n_contact.max()), 1))) + 100
+        max_iter = check_count("max_iter", max_iter)
         phi, its, res, ok = self._cg(mask, R, dtheta, tol, max_iter, initial_flux)
         T1phi = self.body_1(phi)
         Tphi = self.series(phi)
@@ -181,9 +187,10 @@ class ConductionSolver:
 
         b = np.full(idx.size, dtheta)
         if phi0 is not None:
-            phi = np.broadcast_to(np.asarray(phi0, dtype=float), shape).ravel()[idx].copy()
-            if not np.all(np.isfinite(phi)):
-                raise InputError("initial_flux", "array", "must be finite")
+            try:
+                phi = np.broadcast_to(phi0, shape).ravel()[idx].copy()
+            except ValueError:
+                raise InputError("initial_flux.shape", phi0.shape, f"must broadcast to {shape}") from None
         else:   # uniform flux of the 1-D (bulk + self-influence) estimate
             phi = b / (self.series.self_influence + (sum(self.bulk) if self.bulk else 0.0) + Rc)
         bnorm = np.sqrt(dot(b, b))
@@ -238,8 +245,11 @@ def conductance_law(surface: Surface, elastic: Kernel | ContactSolver, thermal, 
     ``(kernel_1, kernel_2)`` or a ``ConductionSolver``. Each pressure: FFT-BEM contact solve (area),
     then Eq. 5.8 on that area; both warm-started from the previous pressure.
     """
-    p = np.asarray(pressures, dtype=float)
-    if p.ndim != 1 or p.size == 0 or not np.all(np.isfinite(p)) or np.any(p <= 0):
+    check_surface(surface)
+    check_instance("elastic", elastic, (Kernel, ContactSolver), "an elastic Kernel or a ContactSolver")
+    check_positive("thermal_tol", thermal_tol)
+    p = check_field("pressures", pressures)
+    if p.ndim != 1 or p.size == 0 or np.any(p <= 0):
         raise InputError("pressures", pressures, "a 1-D array of mean pressures > 0 [Pa]")
     p = np.sort(p)
     mech = elastic if isinstance(elastic, ContactSolver) else ContactSolver(

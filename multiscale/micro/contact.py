@@ -1,12 +1,25 @@
 """FFT-BEM frictionless normal contact of a rough elastic solid and a rigid flat (thesis §3.3).
 
-The complementary energy U = ½ pᵀ L p − pᵀ δ (Eqs. 3.4, 3.9) is minimised over p ≥ 0 by the
-constrained conjugate gradient of Polonsky & Keer (1999), with ``L`` applied by FFT
-(``InfluenceOperator``). Load control fixes the mean pressure, displacement control the rigid
-approach. Batches of patches (leading axes) are solved in one call, each patch iterating on its
-own until it converges (then it is frozen), so batched and looped answers agree. The cell loops
-of an iteration are compiled (``pk_steps``, numba); a batch runs in chunks of ``_CHUNK_CELLS``
-cells that keep the working set in the CPU cache.
+The complementary energy U = ½ pᵀ L p − pᵀ δ (Eqs. 3.4, 3.9) is minimised over p ≥ 0 with
+``L`` applied by FFT (``InfluenceOperator``). Load control fixes the mean pressure, displacement
+control the rigid approach. Two methods give the same discrete answer:
+
+- ``"bccg"`` (default): the preconditioned constrained CG of Vollebregt (2014, J. Comput. Phys.
+  257, 333–351) with an FFT-based preconditioner (``bccg_solver``) and a nested start: iteration
+  counts that grow slowly with the grid (like log² N: 13, 14, 18, 25 at N = 256 … 2048 on the
+  self-affine benchmark surfaces, Polonsky–Keer 48 … 225), 2–2.5 FFT pairs each;
+- ``"pk"``: the constrained CG of Polonsky & Keer (1999) (``pk_solver``): iterations growing like
+  the square root of the grid size, ~2 FFT pairs each. Slower from 128² up, as fast below.
+
+Both stop on the same unit-free criterion (see ``ContactSolver.solve``). With a ``hardness`` H
+(``"bccg"`` only) the surface is elastic-perfectly plastic: 0 <= p <= H, the cells at H flow
+plastically and their interpenetration is the permanent deformation (the bounded problem of
+Almqvist et al. 2007, Tribol. Int. 40, 574–579; Weber et al. 2018, Nat. Commun. 9, 888;
+ContactMechanics' hardness cut-off and tamaas' saturated solvers solve the same discrete
+problem). Batches of patches (leading axes) are solved in one call, each patch iterating on its
+own until it converges (then it is frozen), so batched and looped answers agree; a batch runs in
+chunks of ``CHUNK_CELLS`` cells that keep the working set in the CPU cache, spread over
+``multiscale.micro.fft``'s threads.
 
 Conventions: heights ``h`` [m] point towards the rigid flat. The flat first touches the highest
 point; the approach ``delta`` [m] moves it into the solid. Gap
@@ -15,13 +28,22 @@ solid; pressure [Pa] positive in compression.
 """
 from __future__ import annotations
 
+import queue
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from multiscale.errors import ConvergenceError, InputError, check_positive
-from multiscale.micro import pk_steps
+from multiscale.errors import ConvergenceError, InputError, check_count, check_flag, check_positive
+from multiscale.micro import bccg_solver, pk_solver
+from multiscale.micro.fft import get_threads
 from multiscale.micro.kernels import InfluenceOperator, Kernel
+
+METHODS = ("bccg", "pk")
+CHUNK_CELLS = {"bccg": 65536, "pk": 32768}   # cells per chunk of a batch (the working set stays in L2)
+COARSE_MIN = 32      # smallest side of the grids of the nested start of "bccg"
+COARSE_TOL = 1e-1    # tolerance of the coarse solves of the nested start
+SNAP = 1e-12         # a start within this relative distance below the hardness is at the hardness
 
 
 @dataclass
@@ -36,6 +58,8 @@ class ContactResult:
     mean_pressure: np.ndarray  # Pa, total force / nominal area
     approach: np.ndarray       # m, rigid approach delta from first touch
     mean_gap: np.ndarray       # m, mean separation between the flat and the deformed surface
+    plastic_area_fraction: np.ndarray  # cells at p = H (plastic flow) / all cells; 0 without a hardness
+    plastic: np.ndarray | None  # m, permanent (plastic) deformation, >= 0 into the solid: d - z - u at p = H
     iterations: np.ndarray     # per patch
     residual: np.ndarray       # per patch, see ContactSolver.solve
     converged: np.ndarray      # bool per patch
@@ -46,196 +70,297 @@ class ContactConvergenceError(ConvergenceError):
     """The contact solver reached ``max_iter`` before ``tol``."""
 
 
+class ContactNonFiniteError(ContactConvergenceError):
+    """The iteration produced non-finite numbers (the problem's scales overflow float64); the
+    solver's buffers are cleared, so the next solve starts clean."""
+
+
 class ContactSolver:
     """Reusable FFT-BEM contact solver on one grid (plans and kernel spectrum built once).
 
     Parameters: kernel (e.g. ``HalfSpace``), grid ``shape`` (ny, nx), pixel ``dx`` (and ``dy``) [m],
-    ``periodic`` (repeating patch) or not (isolated patch, zero-padded DC-FFT). A solver keeps
-    its FFT buffers between calls: use one solver per thread.
+    ``periodic`` (repeating patch) or not (isolated patch, zero-padded DC-FFT), ``method``
+    ("bccg" or "pk", see the module). A solver keeps its FFT buffers between calls: use one
+    solver per thread (it runs the chunks of a batch on ``get_threads()`` threads itself).
     """
 
-    def __init__(self, kernel: Kernel, shape, dx: float, dy: float | None = None, periodic: bool = True):
+    def __init__(self, kernel: Kernel, shape, dx: float, dy: float | None = None, periodic: bool = True,
+                 method: str = "bccg"):
         self.operator = InfluenceOperator(kernel, shape, dx, dy, periodic)
-        self.kernel, self.shape, self.periodic = kernel, self.operator.shape, periodic
-        self._workspaces = {}                     # batch size -> FFT buffers of the direction
+        self.kernel, self.shape, self.periodic = kernel, self.operator.shape, self.operator.periodic
+        self.method = _method(method)
+        self._scratch: dict[tuple, queue.SimpleQueue] = {}   # (method, chunk, threads) -> free buffers
+        self._coarse: ContactSolver | None = None             # the half-resolution solver of the nested start
+        self._pool: ThreadPoolExecutor | None = None
+        self._pool_threads = 0
 
     def solve(self, heights, *, load=None, approach=None, tol: float = 1e-8, max_iter: int = 5000,
-              initial_pressure=None, partial: bool = False) -> ContactResult:
+              initial_pressure=None, partial: bool = False, method: str | None = None,
+              hardness=None) -> ContactResult:
         """Solve under load control (``load`` = mean pressure [Pa]) or displacement control
-        (``approach`` = delta [m]); scalars or arrays of the batch shape.
+        (``approach`` = delta [m]); scalars or arrays of the batch shape. ``hardness`` H [Pa]
+        (scalar or per patch, > 0; inf or None: elastic) bounds the pressure (p <= H, load < H):
+        the result's ``plastic`` field is then the permanent deformation d - z - u on the cells at
+        H (``plastic_area_fraction``); H = inf computes bit for bit what None computes.
 
-        Stops when the residual ``max(rms(g on contact), max(−g off contact)) / rms(h)`` is below
-        ``tol`` (the pressure then balances the load exactly). Raises ``ContactConvergenceError``
-        after ``max_iter`` iterations unless ``partial`` is True.
+        Stopping criterion (both methods): eps = ||s||₂ / ||p||₂ <= ``tol`` per patch, where s is
+        the preconditioned residual over the free set (contact cells, and cells with a negative
+        gap), i.e. the pressure correction predicted by the FFT preconditioner M ≈ L⁻¹ from the
+        gap residual: an estimate of the relative L2 error of the pressure, free of units
+        (``result.residual``). Under load control the pressure balances the load exactly.
+        Raises ``ContactConvergenceError`` after ``max_iter`` iterations unless ``partial`` is True,
+        ``ContactNonFiniteError`` if the numbers overflow (never a non-finite result).
         """
-        h = np.asarray(heights, dtype=float)
+        method = self.method if method is None else _method(method)
+        try:
+            h = np.asarray(heights, dtype=float)
+        except (TypeError, ValueError):
+            raise InputError("heights", heights, "must be an array of numbers") from None
         if h.ndim < 2 or h.shape[-2:] != self.shape:
             raise InputError("heights.shape", h.shape, f"last two axes must be {self.shape}")
         if h.size == 0:
             raise InputError("heights.shape", h.shape, "the batch holds no patch")
         if not np.all(np.isfinite(h)):
             raise InputError("heights", "array with NaN/inf", "all heights must be finite")
-        check_positive("tol", tol)
+        tol = check_positive("tol", tol)
+        if tol >= 1:
+            raise InputError("tol", tol, "relative tolerance must lie in (0, 1)")
+        max_iter = check_count("max_iter", max_iter)
+        check_flag("partial", partial)
         if (load is None) == (approach is None):
             raise InputError("load/approach", (load, approach), "give exactly one of them")
         batch = h.shape[:-2]
-        z = h.max(axis=(-2, -1), keepdims=True) - h            # depth below the highest point, >= 0
-        scale = np.sqrt(np.mean((h - h.mean(axis=(-2, -1), keepdims=True)) ** 2, axis=(-2, -1)))
-        scale = np.where(scale > 0, scale, 1.0)
+        with np.errstate(over="ignore", invalid="ignore"):
+            z = h.max(axis=(-2, -1), keepdims=True) - h        # depth below the highest point, >= 0
+        if not np.all(np.isfinite(z)):
+            raise InputError("heights", "array", "the height range overflows float64")
         if load is not None:
-            target = np.broadcast_to(np.asarray(load, dtype=float), batch)
+            target = _batch_values("load", load, batch)
             if not np.all(np.isfinite(target)) or np.any(target <= 0):
                 raise InputError("load", load, "mean pressure must be finite and > 0")
             delta = None
         else:
             target = None
-            delta = np.broadcast_to(np.asarray(approach, dtype=float), batch)
+            delta = _batch_values("approach", approach, batch)
             if not np.all(np.isfinite(delta)) or np.any(delta < 0):
                 raise InputError("approach", approach, "rigid approach must be finite and >= 0")
             if self.periodic and np.any(delta >= z.mean(axis=(-2, -1))):
                 raise InputError("approach", approach, "a periodic patch under displacement control needs "
                                  "approach < max(h) - mean(h) (full contact has no finite load)")
+        upper = None
+        if hardness is not None:
+            upper = _batch_values("hardness", hardness, batch)
+            if np.any(np.isnan(upper)) or np.any(upper <= 0):
+                raise InputError("hardness", hardness, "must be > 0 (inf: no bound)")
+            if np.all(upper == np.inf):
+                upper = None
+            elif method != "bccg":
+                raise InputError("hardness", hardness, f"method {method!r} has no pressure bound: use 'bccg'")
+            elif target is not None and np.any(target >= upper):
+                raise InputError("load", load, "mean pressure must be below the hardness (a fully plastic "
+                                 "patch carries at most H)")
         p0 = None
         if initial_pressure is not None:
-            p0 = np.broadcast_to(np.asarray(initial_pressure, dtype=float), h.shape)
+            p0 = _batch_values("initial_pressure", initial_pressure, h.shape)
             if np.any(p0 < 0) or not np.all(np.isfinite(p0)):
                 raise InputError("initial_pressure", "array", "must be finite and >= 0")
-        return self._run_chunks(z, scale, target, delta, tol, max_iter, p0, partial)
+        return self._run_chunks(method, z, target, delta, tol, max_iter, p0, partial, upper=upper)
 
-    def _run_chunks(self, z, scale, target, delta, tol, max_iter, p0, partial):
+    def _run_chunks(self, method, z, target, delta, tol, max_iter, p0, partial, fields=True, upper=None):
         """Run the iterations on chunks of the batch small enough for the CPU cache (the full-grid
         passes are memory bound: 400 patches of 64² in one block run ~2x slower than in chunks
-        of 8), then assemble the batch result."""
+        of 8), on ``get_threads()`` threads when there are several chunks; each chunk makes its
+        start (its nested coarse solve) and fills its part of the result (``fields``: the gap and
+        the means, not needed by a nested start; ``upper``: the hardness per patch or None)."""
         batch, grid = z.shape[:-2], z.shape[-2:]
         B = int(np.prod(batch, dtype=int))
-        size = max(1, _CHUNK_CELLS // (grid[0] * grid[1]))
+        size = max(1, CHUNK_CELLS[method] // (grid[0] * grid[1]))
+        z = np.ascontiguousarray(np.reshape(z, (B,) + grid))
+        target = None if target is None else np.ascontiguousarray(np.reshape(target, B), dtype=float)
+        delta = None if delta is None else np.ascontiguousarray(np.reshape(delta, B), dtype=float)
+        p0 = None if p0 is None else np.reshape(p0, (B,) + grid)
+        upper = None if upper is None else np.ascontiguousarray(np.reshape(upper, B), dtype=float)
+        chunks = [slice(i, min(i + size, B)) for i in range(0, B, size)]
+        threads = min(get_threads(), len(chunks))
+        p, u = np.empty_like(z), np.empty_like(z)
+        out = {k: np.zeros(B, dtype=t) for k, t in (("d", float), ("iterations", int), ("residual", float),
+                                                    ("converged", bool), ("area_fraction", float),
+                                                    ("mean_pressure", float), ("mean_gap", float))}
+        gap = np.empty_like(p) if fields else None
+        plastic = np.zeros_like(p) if fields and upper is not None else None
+        out["plastic_area_fraction"] = np.zeros(B)
+        histories = [None] * len(chunks)
 
-        def flat(a, cells=False):
-            return None if a is None else np.reshape(a, (B,) + (grid if cells else ()))
+        def one(k):
+            c = chunks[k]
+            key = (method, c.stop - c.start, 1 if threads > 1 else get_threads())
+            free = self._scratch.setdefault(key, queue.SimpleQueue())
+            try:
+                work = free.get_nowait()
+            except queue.Empty:
+                work = self._new_scratch(method, *key[1:])
+            history: list = []
+            tc, dc = (None if a is None else a[c] for a in (target, delta))
+            uc = None if upper is None else upper[c]
+            p[c] = self._initial_pressure(method, z[c], tc, dc, None if p0 is None else p0[c], max_iter, uc)
+            args = (z[c], p[c], u[c], tc, dc, tol, max_iter, history)
+            try:
+                with np.errstate(all="ignore"):
+                    if method == "bccg":
+                        part = bccg_solver.run(self.operator, work, *args, uc)
+                    else:
+                        part = pk_solver.run(self.operator, work[0], work[1], *args)
+                    finite = np.all(np.isfinite(part["d"])) and np.all(np.isfinite(u[c])) and np.all(np.isfinite(p[c]))
+            except FloatingPointError:
+                finite = False
+            if not finite:
+                for w in (work if isinstance(work, tuple) else (work,)):
+                    w.clear()
+                free.put(work)
+                raise ContactNonFiniteError("the contact iteration overflowed float64 (non-finite pressure or "
+                                            "displacement): rescale the problem (heights, load, modulus)")
+            free.put(work)
+            for name, values in part.items():
+                out[name][c] = values
+            histories[k] = history
+            out["mean_pressure"][c] = p[c].mean(axis=(1, 2))
+            if fields:
+                np.add(u[c], z[c], out=gap[c])
+                gap[c] -= part["d"][:, None, None]
+                if plastic is not None:                      # the interpenetration at p = H
+                    flow = p[c] >= uc[:, None, None]
+                    np.copyto(plastic[c], -gap[c], where=flow)
+                    np.maximum(plastic[c], 0.0, out=plastic[c])
+                    out["plastic_area_fraction"][c] = flow.mean(axis=(1, 2))
+                np.maximum(gap[c], 0.0, out=gap[c])
+                gap[c][p[c] > 0] = 0.0
+                out["area_fraction"][c] = np.mean(p[c] > 0, axis=(1, 2))
+                out["mean_gap"][c] = gap[c].mean(axis=(1, 2))
 
-        z, scale, target, delta, p0 = flat(z, True), flat(scale), flat(target), flat(delta), flat(p0, True)
-        parts = [self._run(z[i:i + size], scale[i:i + size],
-                           None if target is None else target[i:i + size],
-                           None if delta is None else delta[i:i + size], tol, max_iter,
-                           None if p0 is None else p0[i:i + size]) for i in range(0, B, size)]
-        length = max(len(r.history) for r in parts)
-        history = [max(r.history[k] for r in parts if k < len(r.history)) for k in range(length)]
-        fields = {f: np.concatenate([getattr(r, f) for r in parts]).reshape(batch + np.shape(getattr(parts[0], f))[1:])
-                  for f in ContactResult.__dataclass_fields__ if f != "history"}
-        result = ContactResult(**fields, history=history)
+        if threads > 1:
+            if self._pool is None or self._pool_threads != threads:
+                self._pool, self._pool_threads = ThreadPoolExecutor(threads), threads
+            list(self._pool.map(one, range(len(chunks))))
+        else:
+            for k in range(len(chunks)):
+                one(k)
+        length = max(len(h) for h in histories)
+        history = [max(h[k] for h in histories if k < len(h)) for k in range(length)]
+        cells = batch + grid
+        result = ContactResult(
+            pressure=p.reshape(cells), displacement=u.reshape(cells),
+            gap=gap.reshape(cells) if fields else None, contact=(p > 0).reshape(cells) if fields else None,
+            plastic=(np.zeros(cells) if plastic is None else plastic.reshape(cells)) if fields else None,
+            approach=out.pop("d").reshape(batch), history=history, **{k: v.reshape(batch) for k, v in out.items()})
         if not np.all(result.converged) and not partial:
             raise ContactConvergenceError(
                 f"contact solver did not converge in {max_iter} iterations "
                 f"(residual {result.residual.max():.3e} > tol {tol:.1e} on "
-                f"{int(np.sum(~result.converged))} patch(es))", history, result)
+                f"{int(np.sum(~result.converged))} patch(es))", result.history, result)
         return result
 
-    def _run(self, z, scale, target, delta, tol, max_iter, p0):
-        """Polonsky–Keer iterations on B patches (z: (B, ny, nx); scale, target or delta: (B,));
-        returns the partial result of shape (B, ...) when not converged.
+    def _new_scratch(self, method, chunk, threads):
+        if method == "bccg":
+            return bccg_solver.Scratch(self.operator, chunk, threads)
+        return self.operator.workspace((chunk,), threads), bccg_solver.Scratch(self.operator, chunk, threads)
 
-        The cell loops of each iteration are compiled (``pk_steps``); the FFT convolution of the
-        direction runs on the whole chunk. Between exact evaluations u = L p is updated as
-        c (u − τ L t), exact while projection and overlap correction leave p alone; otherwise,
-        every ``_REFRESH`` iterations and before accepting convergence, u is recomputed by FFT.
-        """
-        L, grid = self.operator, z.shape[-2:]
-        B, N = z.shape[0], grid[0] * grid[1]
-        zf = np.ascontiguousarray(z, dtype=float).reshape(B, N)
-        load_control = target is not None
-        if p0 is not None:
-            p = np.array(p0, dtype=float).reshape(B, N)
-        elif load_control:
-            p = np.repeat(target[:, None], N, axis=1)
-        else:
-            p = np.maximum(delta[:, None] - zf, 0.0) / L.self_influence
-        if load_control:
-            p = _rescale(p, target, zf)
-        target, delta = (np.ascontiguousarray(np.zeros(B) if a is None else a, dtype=float)
-                         for a in (target, delta))          # the compiled loops take arrays
-        ws = self._workspaces.get(B)
-        if ws is None:
-            ws = self._workspaces[B] = L.workspace((B,))
-        t, r = ws.load_buffer.reshape((B,) + L.fft_shape), ws.response_buffer.reshape((B,) + L.fft_shape)
-        p3 = p.reshape((B,) + grid)
-        u = np.zeros((B, N))
-        u3, z3 = u.reshape(p3.shape), zf.reshape(p3.shape)
-        exact = np.ones(B, dtype=bool)
+    def _initial_pressure(self, method, z, target, delta, p0, max_iter, upper=None):
+        """A feasible start: the warm start; else for "bccg" the nested start (the solution on the
+        grid of half the resolution, ``coarse_start``) when the grid allows it; else uniform
+        (load control) or the local solution max(delta - z, 0) / L_00 (displacement control).
+        Balanced under load control; within the bounds ``upper`` (``bounded_start``)."""
+        B, N = z.shape[0], z.shape[1] * z.shape[2]
+        p = None if p0 is None else np.array(p0, dtype=float)
+        if p is None and method == "bccg":
+            p = self.coarse_start(z, target, delta, max_iter, upper)
+        if p is None and target is not None:
+            p = np.repeat(target, N).reshape(z.shape)
+        elif p is None:
+            p = np.maximum(delta[:, None, None] - z, 0.0) / self.operator.self_influence
+        if target is not None:
+            p = pk_solver.rescale(p.reshape(B, N), target, z.reshape(B, N)).reshape(z.shape)
+        if upper is not None:
+            p = bounded_start(p.reshape(B, N), upper, None if target is None else target * N).reshape(z.shape)
+        return np.ascontiguousarray(p)
 
-        def recompute(which):                     # u = L p exactly on the patches ``which``
-            if 2 * np.count_nonzero(which) > B:
-                L(p3, out=u3)
-                exact[:] = True
-            else:
-                for b in np.flatnonzero(which):
-                    L(p3[b], out=u3[b])
-                exact[which] = True
-
-        recompute(exact)
-        d, G, gmin, count = np.zeros(B), np.zeros(B), np.zeros(B), np.zeros(B, dtype=np.int64)
-        corrected, lost, conjugate = (np.zeros(B, dtype=bool) for _ in range(3))
-        pending = np.ones(B)                      # load-balance factor of p and u, see pk_steps.step
-        G_old, active = np.ones(B), np.ones(B, dtype=bool)
-        iterations, history = np.zeros(B, dtype=int), []
-        since_refresh = 0
-        while True:
-            pk_steps.gap_statistics(p3, u3, z3, delta, load_control, pending, d, G, count, gmin)
-            res = np.maximum(np.sqrt(G / np.maximum(count, 1)), np.maximum(-gmin, 0.0)) / scale
-            done = active & (res <= tol)
-            if np.any(done & ~exact):        # accept convergence only on an exact displacement
-                recompute(done & ~exact)
-                since_refresh = 0
-                continue
-            active &= ~done
-            history.append(float(res.max()))
-            if not active.any() or iterations.max() >= max_iter:
-                break
-            iterations += active
-            beta = np.where(conjugate, G / G_old, 0.0)
-            G_old = np.where(G > 0, G, 1.0)
-            pk_steps.direction(p3, u3, z3, d, active, beta, t)                  # t: the direction
-            ws.apply()
-            pk_steps.step(p3, u3, z3, d, count, target, load_control, active, t, r, pending, corrected, lost,
-                     conjugate)                                             # r = L t
-            if lost.any():                   # every point left the contact: restart from the top
-                p[lost] = _rescale(zf[lost] == 0, target[lost], zf[lost])
-            since_refresh += 1
-            exact[:] = False
-            if since_refresh >= _REFRESH:
-                recompute(active)
-                since_refresh = 0
-            else:
-                recompute(corrected & active)
-        g = u + zf - d[:, None]
-        gap = np.where(p > 0, 0.0, np.maximum(g, 0.0))
-        shape = (B,) + grid
-        return ContactResult(
-            pressure=p.reshape(shape), displacement=u.reshape(shape), gap=gap.reshape(shape),
-            contact=(p > 0).reshape(shape), area_fraction=np.mean(p > 0, axis=1),
-            mean_pressure=p.mean(axis=1), approach=np.array(d, dtype=float), mean_gap=gap.mean(axis=1),
-            iterations=iterations, residual=res, converged=~active, history=history)
+    def coarse_start(self, z, target, delta, max_iter, upper=None):
+        """Nested iteration (as in full multigrid; for contact: the cascade multi-resolution start
+        of Bemporad & Paggi 2015, Int. J. Solids Struct. 69–70, 94–105): solve the patches with
+        2 x 2 cells merged (heights averaged, same kernel, recursively down to ``COARSE_MIN``
+        cells) to ``COARSE_TOL`` and prolong the pressure piecewise constant. It gives the fine
+        iteration a nearly right contact set: on the self-affine benchmark surfaces a third fewer
+        fine iterations for a quarter of the work. None where the grid is odd or small."""
+        (ny, nx), B = self.shape, z.shape[0]
+        if ny % 2 or nx % 2 or min(ny, nx) < 2 * COARSE_MIN:
+            return None
+        if self._coarse is None:
+            op = self.operator
+            self._coarse = ContactSolver(self.kernel, (ny // 2, nx // 2), 2 * op.dx, 2 * op.dy, self.periodic)
+        zc = z.reshape(B, ny // 2, 2, nx // 2, 2).mean(axis=(2, 4))
+        low = zc.min(axis=(1, 2))                        # the coarse top lies this far below the fine one
+        zc -= low[:, None, None]
+        if target is None:
+            delta = delta - low
+            if np.any(delta <= 0) or (self.periodic and np.any(delta >= zc.mean(axis=(1, 2)))):
+                return None
+        r = self._coarse._run_chunks("bccg", zc, target, delta, COARSE_TOL, max_iter, None, True, fields=False,
+                                     upper=upper)
+        return np.repeat(np.repeat(r.pressure, 2, axis=1), 2, axis=2)
 
 
-_REFRESH = 25  # iterations between exact recomputations of u = L p (bounds round-off drift)
-_CHUNK_CELLS = 32768  # cells per chunk of the batch (a few such float arrays fit in L2)
+def bounded_start(p, upper, total=None):
+    """p (B, N) >= 0 made feasible for the bounds ``upper`` (B,): min(c p, H) per patch, with c
+    (>= 0) such that Σ min(c p, H) = ``total`` (B,) under load control (exact on the sorted
+    values: the k largest cells saturate, c v_k <= H <= c v_(k-1)), else c = 1. Values within
+    ``SNAP`` of H are set to H: a warm start from a bounded solution (its cells at H rescaled by
+    1 ± 1e-16) keeps its saturated set (the first iteration's projection restores the balance)."""
+    p = np.maximum(np.asarray(p, dtype=float), 0.0)
+    H = upper[:, None]
+    if total is None:
+        return np.minimum(p, H)
+    bounded = np.isfinite(upper)
+    if not bounded.all():                                          # elastic patches keep p
+        p[bounded] = bounded_start(p[bounded], upper[bounded], total[bounded])
+        return p
+    v = -np.sort(-p, axis=1)                                       # descending
+    k = np.arange(p.shape[1] + 1)
+    tail = np.concatenate([np.cumsum(v[:, ::-1], axis=1)[:, ::-1], np.zeros((p.shape[0], 1))], axis=1)
+    nxt = np.concatenate([v, np.zeros((p.shape[0], 1))], axis=1)   # the largest cell not saturated
+    prev = np.concatenate([np.full((p.shape[0], 1), np.inf), v], axis=1)  # the smallest saturated one
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = (total[:, None] - k * H) / tail                        # scale if the k largest saturate
+        ok = (c >= 0) & (c * nxt <= H) & (c * prev >= H) & (tail > 0)
+    first = np.argmax(ok, axis=1)
+    scale = c[np.arange(p.shape[0]), first]
+    p = np.minimum(p * scale[:, None], H)
+    p[p >= H * (1 - SNAP)] = np.broadcast_to(H, p.shape)[p >= H * (1 - SNAP)]   # ties at H stay saturated
+    return p
 
 
-def _rescale(p, target, z):
-    """Scale each row of p so that its mean is the target mean pressure (load balance, exact).
+def _method(method) -> str:
+    if not isinstance(method, str) or method not in METHODS:
+        raise InputError("method", method, f"choose one of {', '.join(METHODS)}")
+    return method
 
-    A row that lost all contact restarts from its highest points (z == 0)."""
-    p = np.asarray(p, dtype=float)
-    mean = p.mean(axis=1)
-    if np.any(mean <= 0):
-        p = np.where((mean > 0)[:, None], p, (z == 0).astype(float))
-        mean = p.mean(axis=1)
-    return p * (target / mean)[:, None]
+
+def _batch_values(name: str, value, shape) -> np.ndarray:
+    """``value`` as a float array broadcast to ``shape``, else ``InputError`` naming it."""
+    a = np.asarray(value)
+    if a.dtype.kind not in "iuf":
+        raise InputError(name, value, "must be a number or an array of numbers")
+    try:
+        return np.broadcast_to(a.astype(float), shape)
+    except ValueError:
+        raise InputError(name, a.shape, f"must broadcast to {shape}") from None
 
 
 def solve_contact(heights, dx: float, kernel: Kernel, *, dy: float | None = None, periodic: bool = True,
                   **options) -> ContactResult:
     """One-call form of ``ContactSolver(kernel, heights.shape[-2:], dx, dy, periodic).solve(...)``."""
-    h = np.asarray(heights)
+    try:
+        h = np.asarray(heights, dtype=float)
+    except (TypeError, ValueError):
+        raise InputError("heights", heights, "must be an array of numbers") from None
     if h.ndim < 2:
         raise InputError("heights", h.shape, "must be at least 2-D (..., ny, nx)")
     return ContactSolver(kernel, h.shape[-2:], dx, dy, periodic).solve(h, **options)

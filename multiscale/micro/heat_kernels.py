@@ -32,7 +32,7 @@ from dataclasses import dataclass
 import numpy as np
 from scipy.special import erf, erfc
 
-from multiscale.errors import InputError, check_positive
+from multiscale.errors import InputError, check_field, check_instance, check_positive, check_real
 from multiscale.micro.kernels import ThermalHalfSpace, wrap_offsets
 from multiscale.references.love import love_rectangle
 
@@ -69,8 +69,8 @@ class SpeedProfile:
     values: tuple[float, ...]  # rad/s or m/s, >= 0
 
     def __post_init__(self):
-        t = np.asarray(self.times, dtype=float)
-        v = np.asarray(self.values, dtype=float)
+        t = check_field("times", self.times)
+        v = check_field("values", self.values)
         if t.ndim != 1 or t.shape != v.shape or t.size < 1:
             raise InputError("times/values", (self.times, self.values), "two 1-D sequences of equal length")
         if t[0] != 0.0 or np.any(np.diff(t) <= 0) or not np.all(np.isfinite(t)):
@@ -82,13 +82,14 @@ class SpeedProfile:
 
     @classmethod
     def constant(cls, value: float) -> "SpeedProfile":
-        return cls((0.0,), (float(value),))
+        return cls((0.0,), (check_positive("value", value, allow_zero=True),))
 
     @classmethod
     def ramp(cls, start: float, end: float, duration: float) -> "SpeedProfile":
         """Linear change from ``start`` to ``end`` over [0, duration], then constant (Eq. 6.6)."""
         check_positive("duration", duration)
-        return cls((0.0, float(duration)), (float(start), float(end)))
+        speeds = (check_positive("start", start, allow_zero=True), check_positive("end", end, allow_zero=True))
+        return cls((0.0, float(duration)), speeds)
 
     @property
     def is_constant(self) -> bool:
@@ -145,6 +146,10 @@ class Motion(ABC):
         """Sliding speed [m/s] at the patch centre."""
 
 
+def _check_profile(profile) -> None:
+    check_instance("profile", profile, SpeedProfile, "a SpeedProfile (e.g. SpeedProfile.constant(v))")
+
+
 @dataclass(frozen=True)
 class Translation(Motion):
     """Body 1 translates at speed ``profile`` [m/s] along the direction ``angle`` [rad from +x]."""
@@ -152,9 +157,15 @@ class Translation(Motion):
     profile: SpeedProfile
     angle: float = 0.0
 
+    def __post_init__(self):
+        _check_profile(self.profile)
+        if not np.isfinite(check_real("angle", self.angle)):
+            raise InputError("angle", self.angle, "must be finite [rad]")
+        object.__setattr__(self, "angle", float(self.angle))
+
     @classmethod
     def steady(cls, speed: float, angle: float = 0.0) -> "Translation":
-        return cls(SpeedProfile.constant(speed), angle)
+        return cls(SpeedProfile.constant(check_positive("speed", speed, allow_zero=True)), angle)
 
     def path(self, t):
         return self.profile.integral(t)
@@ -180,8 +191,9 @@ class Rotation(Motion):
     profile: SpeedProfile
 
     def __post_init__(self):
-        c = np.asarray(self.centre, dtype=float)
-        if c.shape != (2,) or not np.all(np.isfinite(c)):
+        _check_profile(self.profile)
+        c = check_field("centre", self.centre)
+        if c.shape != (2,):
             raise InputError("centre", self.centre, "a pair (x_c, y_c) of finite numbers [m]")
         object.__setattr__(self, "centre", (float(c[0]), float(c[1])))
 

@@ -13,11 +13,14 @@ convolution (Eq. 6.22), by conjugate gradients on the non-symmetric least-square
 phi_2 = phi − phi_1. The history terms are summed in Fourier space as Σ_k S_k · (flux of step N−k)
 with the pulse tables S_k of ``heat_kernels`` (the thesis' step increments, summed by parts);
 matching at the end of each step makes the scheme first order in dt.
-Steady (§6.5, ``SteadyHeating``): the same with steady kernels and remote temperatures (Eqs. 6.23–6.25).
-``partition_law`` gives the steady p_1(p_mean, V) that the macro model needs.
+Steady (§6.5, ``SteadyHeating``): the same with steady kernels and remote temperatures (Eqs. 6.23–6.25);
+the transient problem takes remote temperatures too (an extension: the thesis gives them to the
+steady problem only). ``partition_law`` gives the steady p_1(p_mean, V) that the macro model needs.
 
-Temperatures are rises [K] above the initial (or remote) temperature. Sign: phi_i > 0 flows into
-body i. Heat rates Phi [W] are over the patch window.
+Temperatures are rises [K] above the initial temperature, or remote temperature + rise when remote
+temperatures are given. Sign: phi_i > 0 flows into body i. Heat rates Phi [W] are over the patch
+window; with remote temperatures Phi_1 includes the conduction between them, so that a share
+Phi_i/Phi may leave [0, 1].
 """
 from __future__ import annotations
 
@@ -26,11 +29,12 @@ from dataclasses import dataclass, field
 import numpy as np
 from tqdm import tqdm
 
-from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.errors import (ConvergenceError, InputError, check_count, check_field, check_flag, check_instance,
+                               check_positive, check_real)
 from multiscale.micro.contact import ContactResult, ContactSolver
 from multiscale.micro.fft import RealFFT2
 from multiscale.micro.heat_kernels import Motion, ThermalMaterial, Translation, pulse_tables
-from multiscale.micro.kernels import Kernel
+from multiscale.micro.kernels import Kernel, grid_shape
 from multiscale.micro.surface import Surface
 
 
@@ -57,14 +61,14 @@ class InterfaceLayer:
     plane: float = 0.5
 
     def __post_init__(self):
-        if int(self.n) < 1:
-            raise InputError("n", self.n, "number of interface components must be >= 1")
+        n = check_count("n", self.n)
+        object.__setattr__(self, "n", n)
         for name in ("resistance", "capacitance"):
-            v = np.broadcast_to(np.asarray(getattr(self, name), dtype=float), (int(self.n),))
-            if not np.all(np.isfinite(v)) or np.any(v < 0):
-                raise InputError(name, getattr(self, name), f"{self.n} finite values >= 0 (or one)")
-            object.__setattr__(self, name, tuple(v.tolist()))
-        if not 0.0 <= self.plane <= 1.0:
+            v = check_field(name, getattr(self, name), nonnegative=True)
+            if v.size not in (1, n) or v.ndim > 1:
+                raise InputError(name, getattr(self, name), f"{n} finite values >= 0 (or one)")
+            object.__setattr__(self, name, tuple(np.broadcast_to(v, (n,)).tolist()))
+        if not 0.0 <= check_real("plane", self.plane) <= 1.0:
             raise InputError("plane", self.plane, "position of the heating plane in [0, 1]")
         self.weights  # validates the profile
 
@@ -83,7 +87,7 @@ class InterfaceLayer:
             else:
                 raise InputError("generation", self.generation, "'plane', 'uniform', 'linear' or n+1 weights")
         else:
-            w = np.asarray(self.generation, dtype=float)
+            w = check_field("generation", self.generation)
             if w.shape != (n + 1,) or np.any(w < 0) or not np.all(np.isfinite(w)) or w.sum() <= 0:
                 raise InputError("generation", self.generation, f"{n + 1} finite weights >= 0, not all 0")
         return w / w.sum()
@@ -105,6 +109,8 @@ class _Layer:
     dt = inf gives the steady jump Σ_m R^m (phi_1 − c_m phi)."""
 
     def __init__(self, interface: InterfaceLayer | None, dt: float, shape):
+        if interface is not None:
+            check_instance("interface", interface, InterfaceLayer, "an InterfaceLayer or None")
         self.R, self.e, self.c = (interface or InterfaceLayer()).terms(dt)
         self.diagonal = float(np.sum(self.R * (1 - self.e)))
         self.active = bool(np.any(self.R > 0))                   # R = 0: perfect contact (§6.3.6)
@@ -136,10 +142,10 @@ class HeatingResult:
     heat_2: np.ndarray             # W, Phi_2 into body 2 (fixed)
     partition_1: np.ndarray        # p_1 = Phi_1/Phi; NaN where Phi = 0 (no heat: undefined)
     partition_2: np.ndarray        # p_2 = Phi_2/Phi = 1 − p_1
-    max_temperature_1: np.ndarray  # K, max surface temperature rise of body 1 on the window
+    max_temperature_1: np.ndarray  # K, max surface temperature rise of body 1 on the window (+ theta_1^0)
     max_temperature_2: np.ndarray  # K, same for body 2
     field_times: np.ndarray        # s, step ends at which fields were stored
-    temperature_1: np.ndarray      # K, (n_fields, *batch, ny, nx) surface temperature rise of body 1
+    temperature_1: np.ndarray      # K, (n_fields, *batch, ny, nx) surface temperature rise of body 1 (+ theta_1^0)
     temperature_2: np.ndarray      # K, same for body 2
     flux_1: np.ndarray             # W/m², (n_fields, *batch, ny, nx) phi_1 (phi_2 = flux − flux_1)
     flux: np.ndarray               # W/m², (n_fields, *batch, ny, nx) generated phi
@@ -245,20 +251,28 @@ def _extrapolate(last, before):
 
 
 def _check_grid(shape, dx, dy):
-    ny, nx = (int(s) for s in shape)
-    if ny < 1 or nx < 1:
-        raise InputError("shape", shape, "grid needs at least one cell per side")
+    ny, nx = grid_shape("shape", shape, minimum=1)
     dx = check_positive("dx", dx)
     return (ny, nx), dx, check_positive("dy", dy if dy is not None else dx)
 
 
 def _check_pressure(pressure, shape):
-    p = np.asarray(pressure, dtype=float)
-    if p.ndim < 2 or p.shape[-2:] != shape:
+    p = check_field("pressure", pressure, min_ndim=2, nonnegative=True)
+    if p.shape[-2:] != shape:
         raise InputError("pressure.shape", p.shape, f"last two axes must be {shape}")
-    if not np.all(np.isfinite(p)) or np.any(p < 0):
-        raise InputError("pressure", "array", "contact pressure must be finite and >= 0")
     return p
+
+
+def _check_bodies(body1, body2):
+    for name, body in (("body1", body1), ("body2", body2)):
+        check_instance(name, body, ThermalMaterial, "a ThermalMaterial(kappa, diffusivity)")
+
+
+def _check_iteration(tol, max_iter, partial):
+    """The CG options of both heating solvers."""
+    check_positive("tol", tol)
+    check_flag("partial", partial)
+    return check_count("max_iter", max_iter)
 
 
 def _partition(part, total):
@@ -280,9 +294,9 @@ class TransientHeating:
                  dt: float, n_steps: int, dy: float | None = None):
         self.shape, self.dx, self.dy = _check_grid(shape, dx, dy)
         self.dt = check_positive("dt", dt)
-        self.n_steps = int(n_steps)
-        if self.n_steps < 1:
-            raise InputError("n_steps", n_steps, "at least one time step")
+        self.n_steps = check_count("n_steps", n_steps)
+        _check_bodies(body1, body2)
+        check_instance("motion", motion, Motion, "a Motion (Rotation or Translation)")
         self.body1, self.body2, self.motion = body1, body2, motion
         self._pad = _Padded(self.shape)
         self._tables2 = self._spectra(pulse_tables(self.shape, self.dx, self.dy, body2, self.dt, self.n_steps))
@@ -316,26 +330,36 @@ class TransientHeating:
 
     def run(self, pressure, mu: float, *, interface: InterfaceLayer | None = None, n_steps: int | None = None,
             field_times=(), tol: float = 1e-8, max_iter: int = 2000, partial: bool = False,
-            progress: bool = False) -> HeatingResult:
+            progress: bool = False, remote_temperatures=(0.0, 0.0)) -> HeatingResult:
         """Heat the contact of ``pressure`` [Pa] ((..., ny, nx), p > 0 on the contact, e.g.
         ``ContactResult.pressure``) with friction coefficient ``mu`` for ``n_steps`` steps.
 
         ``field_times`` [s]: store the surface temperature and flux fields at the step ends nearest
         to these times. Raises ``HeatingConvergenceError`` if a step does not reach ``tol`` in
         ``max_iter`` iterations, unless ``partial`` (then the step is flagged not converged).
+        ``remote_temperatures`` = (theta_1^0, theta_2^0) [K]: both bodies start uniform at their
+        own temperature, held far inside each body; the matching of every step gets theta_2^0 −
+        theta_1^0 on its right-hand side as Eq. 6.23 does in the steady problem (the thesis
+        gives remote temperatures to the steady problem only, §6.5; this extends them to §6.3),
+        and the temperatures returned are theta^0 + rise. Default (0, 0): rises, as in §6.3.
         """
         p = _check_pressure(pressure, self.shape)
         mu = check_positive("mu", mu)
-        n_steps = self.n_steps if n_steps is None else int(n_steps)
-        if not 1 <= n_steps <= self.n_steps:
+        th1, th2 = (float(v) for v in remote_temperatures)
+        if not (np.isfinite(th1) and np.isfinite(th2)):
+            raise InputError("remote_temperatures", remote_temperatures, "two finite temperatures [K]")
+        n_steps = self.n_steps if n_steps is None else check_count("n_steps", n_steps)
+        if not n_steps <= self.n_steps:
             raise InputError("n_steps", n_steps, f"between 1 and the tabulated {self.n_steps}")
-        check_positive("tol", tol)
+        max_iter = _check_iteration(tol, max_iter, partial)
+        check_flag("progress", progress)
+        field_times = check_field("field_times", field_times, nonnegative=True)
         batch, nb = p.shape[:-2], p.ndim - 2
         mask = p > 0
         area = self.dx * self.dy
         edges = self.dt * np.arange(n_steps + 1)
         speed = self.motion.mean_speed(edges[:-1], edges[1:])               # m/s over each step
-        keep = np.unique(np.clip(np.rint(np.asarray(field_times, dtype=float) / self.dt).astype(int) - 1,
+        keep = np.unique(np.clip(np.rint(field_times / self.dt).astype(int) - 1,
                                  0, n_steps - 1))
         layer = _Layer(interface, self.dt, p.shape)
         spec_shape = (n_steps,) + batch + (2 * self.shape[0], self.shape[1] + 1)
@@ -356,10 +380,10 @@ class TransientHeating:
             free2 = self._pad.field(H2 + A2 * phi_hat)
             # Phi^N - Lambda^N (Eqs. 6.17-6.18): body-2 temperature of all the heat minus the
             # temperatures of phi_1 frozen at its last value, with the layer's jump
-            rhs = free2 - free1 - layer.diagonal * f_prev - layer.offset(phi)
+            rhs = free2 - free1 - layer.diagonal * f_prev - layer.offset(phi) + (th2 - th1)
             if N:
                 rhs -= self._pad.field(A * F1[N - 1])
-            scale = np.sqrt(np.sum(mask * (free1**2 + free2**2), axis=(-2, -1), keepdims=True))
+            scale = np.sqrt(np.sum(mask * (free1**2 + free2**2 + (th2 - th1) ** 2), axis=(-2, -1), keepdims=True))
             scale = np.where(scale > 0, scale, np.inf)
             psi, it, res, hist = _cgls(lambda x: self._pad.convolve(A, x) + layer.diagonal * x,
                                        lambda x: self._pad.convolve(np.conj(A), x) + layer.diagonal * x,
@@ -368,8 +392,8 @@ class TransientHeating:
             f = f_prev + psi
             F1[N] = self._pad.spectrum(f)
             F2[N] = phi_hat - F1[N]
-            T1 = self._pad.field(H1 + A1 * F1[N])
-            T2 = self._pad.field(H2 + A2 * F2[N])
+            T1 = self._pad.field(H1 + A1 * F1[N]) + th1
+            T2 = self._pad.field(H2 + A2 * F2[N]) + th2
             layer.advance(f, phi)
             out["heat"][N] = np.sum(phi, axis=(-2, -1)) * area
             out["heat_1"][N] = np.sum(f, axis=(-2, -1)) * area
@@ -411,6 +435,9 @@ class SteadyHeating:
                  dy: float | None = None, angle: float = 0.0):
         self.shape, self.dx, self.dy = _check_grid(shape, dx, dy)
         self.speed = check_positive("speed", speed, allow_zero=True)
+        _check_bodies(body1, body2)
+        if not np.isfinite(check_real("angle", angle)):
+            raise InputError("angle", angle, "must be finite [rad]")
         self.body1, self.body2 = body1, body2
         self._pad = _Padded(self.shape)
         motion = Translation.steady(self.speed, angle)
@@ -429,10 +456,11 @@ class SteadyHeating:
         """
         p = _check_pressure(pressure, self.shape)
         mu = check_positive("mu", mu)
-        th1, th2 = (float(v) for v in remote_temperatures)
-        if not (np.isfinite(th1) and np.isfinite(th2)):
+        th = check_field("remote_temperatures", remote_temperatures)
+        if th.shape != (2,):
             raise InputError("remote_temperatures", remote_temperatures, "two finite temperatures [K]")
-        check_positive("tol", tol)
+        th1, th2 = th
+        max_iter = _check_iteration(tol, max_iter, partial)
         layer = _Layer(interface, np.inf, p.shape)
         mask = p > 0
         phi = mu * p * self.speed
@@ -505,9 +533,10 @@ def partition_law(source, body1: ThermalMaterial, body2: ThermalMaterial, speed,
         if elastic is None or pressures is None:
             raise InputError("elastic/pressures", (elastic, pressures),
                              "a Surface needs an elastic kernel and mean pressures")
+        check_instance("elastic", elastic, Kernel, "an elastic Kernel")
         if source.heights.ndim != 2:
             raise InputError("source", source.heights.shape, "one patch (a 2-D height map)")
-        loads = np.sort(np.atleast_1d(np.asarray(pressures, dtype=float)))
+        loads = np.sort(np.atleast_1d(check_field("pressures", pressures)))
         if loads.ndim != 1 or not np.all(np.isfinite(loads)) or np.any(loads <= 0):
             raise InputError("pressures", pressures, "mean pressures must be finite and > 0")
         h = np.broadcast_to(source.heights, loads.shape + source.shape)
@@ -528,7 +557,7 @@ def partition_law(source, body1: ThermalMaterial, body2: ThermalMaterial, speed,
     mean = np.asarray(contact.mean_pressure, dtype=float).reshape(-1)[order]
     if np.any(mean <= 0) or np.any(np.diff(mean) <= 0):
         raise InputError("pressures", mean, "distinct mean pressures > 0")
-    speeds = np.sort(np.atleast_1d(np.asarray(speed, dtype=float)))
+    speeds = np.sort(np.atleast_1d(check_field("speed", speed)))
     if speeds.ndim != 1 or not np.all(np.isfinite(speeds)) or np.any(speeds <= 0):
         raise InputError("speed", speed, "sliding speeds must be finite and > 0 (no heat at rest)")
     rows = [SteadyHeating(p.shape[-2:], dx, body1, body2, v, dy, angle).solve(p, mu, interface=interface, tol=tol)

@@ -15,7 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multiscale.errors import InputError, check_positive
+from multiscale.errors import InputError, check_positive, check_real
 from multiscale.micro.fft import RealFFT2
 from multiscale.references.love import love_rectangle
 
@@ -60,18 +60,16 @@ class HalfSpace(Kernel):
     E_star: float
 
     def __post_init__(self):
-        check_positive("E_star", self.E_star)
+        object.__setattr__(self, "E_star", check_positive("E_star", self.E_star))
 
     @classmethod
     def from_materials(cls, E: float, nu: float, E2: float = np.inf, nu2: float = 0.0) -> "HalfSpace":
-        """Composite modulus of a solid (E, nu) against a second one (default: rigid)."""
-        check_positive("E", E)
-        if not -1.0 < nu < 0.5:
-            raise InputError("nu", nu, "Poisson ratio must lie in (-1, 0.5)")
-        inv = (1 - nu**2) / E
-        if np.isfinite(E2):
-            check_positive("E2", E2)
-            inv += (1 - nu2**2) / E2
+        """Composite modulus of a solid (E, nu) against a second one (E2, nu2; default: rigid,
+        E2 = inf). Poisson ratios in (-1, 0.5]."""
+        inv = (1 - poisson_ratio("nu", nu) ** 2) / check_positive("E", E)
+        nu2 = poisson_ratio("nu2", nu2)
+        if check_real("E2", E2) != np.inf:       # +inf: a rigid counter-face; nan, -inf, <= 0 refused
+            inv += (1 - nu2**2) / check_positive("E2", E2)
         return cls(1.0 / inv)
 
     def compliance(self, q):
@@ -96,7 +94,7 @@ class ThermalHalfSpace(Kernel):
     kappa: float
 
     def __post_init__(self):
-        check_positive("kappa", self.kappa)
+        object.__setattr__(self, "kappa", check_positive("kappa", self.kappa))
 
     def compliance(self, q):
         q = np.asarray(q, dtype=float)
@@ -106,6 +104,33 @@ class ThermalHalfSpace(Kernel):
         ox = wrap_offsets(nx) * dx
         oy = wrap_offsets(ny) * dy
         return love_rectangle(ox[None, :], oy[:, None], dx / 2, dy / 2) / (2 * np.pi * self.kappa)
+
+
+def poisson_ratio(name: str, value) -> float:
+    nu = check_real(name, value)
+    if not -1.0 < nu <= 0.5:
+        raise InputError(name, value, "Poisson ratio must lie in (-1, 0.5]")
+    return nu
+
+
+def grid_shape(name: str, shape, minimum: int = 4) -> tuple[int, int]:
+    """(ny, nx) of whole numbers >= ``minimum``, else ``InputError`` (no silent truncation)."""
+    try:
+        values = [v for v in shape]
+    except TypeError:
+        raise InputError(name, shape, "must be a pair (ny, nx) of whole numbers") from None
+    if len(values) != 2 or any(isinstance(v, (str, bytes, bool, np.bool_)) or np.ndim(v) != 0 for v in values):
+        raise InputError(name, shape, "must be a pair (ny, nx) of whole numbers")
+    try:
+        ints = [int(v) for v in values]
+        exact = all(float(v) == i for v, i in zip(values, ints))
+    except (TypeError, ValueError, OverflowError):
+        raise InputError(name, shape, "must be a pair (ny, nx) of whole numbers") from None
+    if not exact:
+        raise InputError(name, shape, "grid sizes must be whole numbers")
+    if min(ints) < minimum:
+        raise InputError(name, shape, f"the grid needs at least {minimum} x {minimum} cells")
+    return ints[0], ints[1]
 
 
 def wrap_offsets(n: int) -> np.ndarray:
@@ -127,35 +152,54 @@ class InfluenceOperator:
     periodic=True: the patch repeats (spectral kernel, the mean displacement is the kernel's
     q = 0 value, zero for a half-space). periodic=False: an isolated patch (zero-padded DC-FFT
     with the kernel's influence coefficients). FFT plans are built once per batch shape.
+
+    ``spectrum`` (real: the kernels are even) is the transfer function on the FFT grid
+    ``fft_shape``; ``inverse_spectrum`` its inverse where it is positive (0 elsewhere, e.g. at
+    q = 0 of a periodic half-space): the FFT-based preconditioner M ≈ L⁻¹ of the contact solver.
+    ``multiplier`` and ``inverse_multiplier`` include the 1/(Fy Fx) of the inverse FFT.
     """
 
     def __init__(self, kernel: Kernel, shape: tuple[int, int], dx: float, dy: float | None = None,
                  periodic: bool = True):
-        ny, nx = (int(s) for s in shape)
-        if ny < 4 or nx < 4:
-            raise InputError("shape", shape, "the grid needs at least 4 x 4 cells")
+        if not isinstance(kernel, Kernel):
+            raise InputError("kernel", kernel, "must be a Kernel (e.g. HalfSpace)")
+        if not isinstance(periodic, (bool, np.bool_)):
+            raise InputError("periodic", periodic, "must be True or False")
+        ny, nx = grid_shape("shape", shape)
         self.kernel, self.shape, self.periodic = kernel, (ny, nx), bool(periodic)
         self.dx = check_positive("dx", dx)
         self.dy = check_positive("dy", dy if dy is not None else dx)
         if self.periodic:
             self.fft_shape = (ny, nx)
-            self.spectrum = np.asarray(kernel.compliance(wavenumbers(ny, nx, self.dy, self.dx)), float)
+            spectrum = np.asarray(kernel.compliance(wavenumbers(ny, nx, self.dy, self.dx)), float)
         else:
             self.fft_shape = (2 * ny, 2 * nx)
             coeffs = np.asarray(kernel.influence(ny, nx, self.dy, self.dx), float)
-            self.spectrum = np.fft.rfft2(coeffs)
-        if not np.all(np.isfinite(self.spectrum)):
+            if coeffs.shape != self.fft_shape:
+                raise InputError("kernel", kernel, f"influence() returned shape {coeffs.shape}, not {self.fft_shape}")
+            spectrum = np.fft.rfft2(coeffs)
+        if not np.all(np.isfinite(spectrum)):
             raise InputError("kernel", kernel, "produced non-finite influence coefficients")
-        self._scaled_spectrum = self.spectrum / (self.fft_shape[0] * self.fft_shape[1])
+        if np.iscomplexobj(spectrum):     # even coefficients: imaginary parts are round-off
+            if np.max(np.abs(spectrum.imag), initial=0.0) <= 1e-9 * np.max(np.abs(spectrum), initial=0.0):
+                spectrum = np.ascontiguousarray(spectrum.real)
+        self.spectrum = spectrum
+        size = self.fft_shape[0] * self.fft_shape[1]
+        self.multiplier = self.spectrum / size
+        real = np.real(self.spectrum)
+        positive = real > 1e-12 * np.max(real, initial=0.0)
+        self.inverse_spectrum = np.where(positive, 1.0 / np.where(positive, real, 1.0), 0.0)
+        self.inverse_multiplier = self.inverse_spectrum / size
         self._workspaces: dict[tuple[int, ...], ConvolutionWorkspace] = {}
         self.self_influence = float(np.fft.irfft2(self.spectrum, s=self.fft_shape)[0, 0])
 
-    def workspace(self, batch: tuple[int, ...] = ()) -> "ConvolutionWorkspace":
+    def workspace(self, batch: tuple[int, ...] = (), threads: int | None = None) -> "ConvolutionWorkspace":
         """A new workspace of this operator for a batch shape (buffers owned by the caller)."""
-        return ConvolutionWorkspace(self, tuple(batch))
+        return ConvolutionWorkspace(self, tuple(batch), threads)
 
     def __call__(self, p: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Displacement [m] of pressure ``p`` [Pa] of shape (..., ny, nx)."""
+        p = np.asarray(p)
         if p.shape[-2:] != self.shape:
             raise InputError("pressure.shape", p.shape, f"last two axes must be {self.shape}")
         ws = self._workspaces.get(p.shape[:-2])
@@ -174,19 +218,25 @@ class ConvolutionWorkspace:
     Write the load into ``load`` (a (..., ny, nx) view of the FFT input; zero padding around it
     stays zero), call ``apply()``, read ``response`` (a view of the FFT output, overwritten by the
     next ``apply``). ``load_buffer``/``response_buffer`` are the whole (contiguous) buffers,
-    padding included, for compiled loops.
+    padding included, and ``fft`` the plan (its ``spectrum`` buffer), for compiled loops.
     """
 
-    def __init__(self, operator: InfluenceOperator, batch: tuple[int, ...]):
+    def __init__(self, operator: InfluenceOperator, batch: tuple[int, ...], threads: int | None = None):
         ny, nx = operator.shape
-        self._plan = RealFFT2(batch + operator.fft_shape)
-        self._multiplier = operator._scaled_spectrum
-        self.load = self._plan.input[..., :ny, :nx]
-        self.response = self._plan.output[..., :ny, :nx]
-        self.load_buffer, self.response_buffer = self._plan.input, self._plan.output
+        self.fft = RealFFT2(batch + operator.fft_shape, threads)
+        self.multiplier = operator.multiplier
+        self.load = self.fft.input[..., :ny, :nx]
+        self.response = self.fft.output[..., :ny, :nx]
+        self.load_buffer, self.response_buffer = self.fft.input, self.fft.output
 
-    def apply(self) -> np.ndarray:
-        self._plan.forward()
-        self._plan.spectrum *= self._multiplier
-        self._plan.inverse(normalise=False)
+    def apply(self, multiplier: np.ndarray | None = None) -> np.ndarray:
+        """response = irfft2(multiplier * rfft2(load)); default multiplier: the operator's."""
+        self.fft.forward()
+        self.fft.spectrum *= self.multiplier if multiplier is None else multiplier
+        self.fft.inverse(normalise=False)
         return self.response
+
+    def clear(self) -> None:
+        """Zero every buffer (after a failed solve, so that nothing of it leaks into the next)."""
+        for a in (self.fft.input, self.fft.spectrum, self.fft.output):
+            a[...] = 0.0

@@ -42,7 +42,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.errors import ConvergenceError, InputError, check_count, check_instance, check_positive
 from multiscale.micro.conduction import ConductionSolver
 from multiscale.micro.contact import ContactResult, ContactSolver
 from multiscale.micro.heat_kernels import ThermalMaterial
@@ -86,7 +86,10 @@ class LawSpec:
     at approaches δ_max (k/n)², k = 1 … n−1: dense near first touch, where ln p changes fastest,
     so that 20 nodes span about four decades of pressure); love: 'average' | 'centre' | 'none'; tol, max_iter: contact
     solver (relative gap residual); extras: ``ExtraLaw`` objects; batch_cells: cells per batched
-    solve (several equal zones are solved together up to this size).
+    solve (several equal zones are solved together up to this size); hardness [Pa]: the
+    elastic-perfectly-plastic micro solve (p <= H, ``ContactSolver.solve``; None: elastic), so
+    that the law of a zone's current (deformed) topography is its elastic reloading curve up to
+    its previous maximum pressure and the plastic loading curve beyond (p_max < H).
     """
 
     kernel: Kernel
@@ -98,13 +101,18 @@ class LawSpec:
     E_star: float | None = None
     extras: tuple = ()
     batch_cells: int = 20000
+    hardness: float | None = None
 
     def __post_init__(self):
+        check_instance("kernel", self.kernel, Kernel, "the micro solids' Kernel (e.g. HalfSpace)")
         check_positive("p_max", self.p_max)
+        if self.hardness is not None and not check_positive("hardness", self.hardness) > self.p_max:
+            raise InputError("p_max", self.p_max, f"the top node must lie below the hardness {self.hardness:.3g} Pa")
         check_positive("tol", self.tol)
-        if int(self.n_points) != self.n_points or self.n_points < 4:
-            raise InputError("n_points", self.n_points, "an integer >= 4")
-        if self.love not in ("average", "centre", "none"):
+        object.__setattr__(self, "n_points", check_count("n_points", self.n_points, minimum=4))
+        object.__setattr__(self, "max_iter", check_count("max_iter", self.max_iter))
+        object.__setattr__(self, "batch_cells", check_count("batch_cells", self.batch_cells))
+        if not isinstance(self.love, str) or self.love not in ("average", "centre", "none"):
             raise InputError("love", self.love, "one of 'average', 'centre', 'none'")
         if self.E_star is None:
             if not hasattr(self.kernel, "E_star"):
@@ -122,7 +130,7 @@ class LawSpec:
     def key(self) -> tuple:
         """Everything a zone's law depends on besides its topography (for caches)."""
         return (self.kernel.key(), self.E_star, self.p_max, self.n_points, self.love, self.tol,
-                self.max_iter, tuple(e.key() for e in self.extras))
+                self.max_iter, tuple(e.key() for e in self.extras)) + (() if self.hardness is None else (self.hardness,))
 
     def approach_fractions(self) -> np.ndarray:
         """δ_k / δ_max of the nodes, k = 1 … n."""
@@ -254,7 +262,8 @@ def _batch_nodes(zones: list[Zone], spec: LawSpec) -> tuple[list[ZoneNodes], lis
     extras: dict[str, np.ndarray] = {}
 
     def run(k, idx, **control):
-        r = solver.solve(heights[idx], tol=tol[idx].min(), max_iter=spec.max_iter, partial=True, **control)
+        r = solver.solve(heights[idx], tol=tol[idx].min(), max_iter=spec.max_iter, partial=True,
+                         hardness=spec.hardness, **control)
         for j, b in enumerate(idx):
             if not r.converged[j]:
                 failures[b] = ZoneFailure(zones[b].id, "ContactConvergenceError",

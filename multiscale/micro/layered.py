@@ -33,8 +33,8 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.special import j0, j1
 
-from multiscale.errors import InputError, check_positive
-from multiscale.micro.kernels import Kernel, wrap_offsets
+from multiscale.errors import InputError, check_field, check_positive, check_real
+from multiscale.micro.kernels import Kernel, poisson_ratio, wrap_offsets
 from multiscale.references.love import love_rectangle
 
 _NEAR = 4        # cells |i|, |j| <= _NEAR around the loaded cell use the exact corner formula
@@ -341,11 +341,9 @@ def _thermal_response(q, h, kappa, sub_kappa):
 
 
 def _as_tuple(name, values, n=None):
-    arr = np.atleast_1d(np.asarray(values, dtype=float))
+    arr = np.atleast_1d(check_field(name, values))
     if arr.ndim != 1 or arr.size == 0 or (n is not None and arr.size != n):
         raise InputError(name, values, f"one value per layer ({n if n else '>= 1'} values)")
-    if not np.all(np.isfinite(arr)):
-        raise InputError(name, values, "must be finite")
     return tuple(float(v) for v in arr)
 
 
@@ -373,13 +371,12 @@ class LayeredElastic(LayeredKernel):
         for name, vals in (("thickness", h), ("E", self.E)):
             if min(vals) <= 0:
                 raise InputError(name, vals, "must be > 0")
-        for nu in self.nu + (self.substrate_nu,):
-            if not -1.0 < nu <= 0.5:
-                raise InputError("nu", nu, "Poisson ratio must lie in (-1, 0.5]")
-        if not (self.substrate_E > 0):
+        for nu in self.nu:
+            poisson_ratio("nu", nu)
+        if not (check_real("substrate_E", self.substrate_E) > 0):
             raise InputError("substrate_E", self.substrate_E, "must be > 0 (inf for a rigid base)")
         set_(self, "substrate_E", float(self.substrate_E))
-        set_(self, "substrate_nu", float(self.substrate_nu))
+        set_(self, "substrate_nu", poisson_ratio("substrate_nu", self.substrate_nu))
 
     @property
     def mu(self) -> np.ndarray:
@@ -433,7 +430,7 @@ class LayeredThermal(LayeredKernel):
         for name, vals in (("thickness", h), ("kappa", self.kappa)):
             if min(vals) <= 0:
                 raise InputError(name, vals, "must be > 0")
-        if not (self.substrate_kappa > 0):
+        if not (check_real("substrate_kappa", self.substrate_kappa) > 0):
             raise InputError("substrate_kappa", self.substrate_kappa, "must be > 0 (inf: fixed temperature)")
         object.__setattr__(self, "substrate_kappa", float(self.substrate_kappa))
 

@@ -28,8 +28,8 @@ import numpy as np
 from scipy.interpolate import CubicSpline, RectBivariateSpline
 from scipy.special import j0
 
-from multiscale.errors import InputError, check_positive
-from multiscale.micro.asperity_laws import AsperityLaw
+from multiscale.errors import InputError, check_count, check_positive
+from multiscale.micro.asperity_laws import AsperityLaw, check_table
 from multiscale.micro.layered import LayeredElastic, hankel_nodes, radial_table
 from multiscale.micro.surface import AsperityTable
 from multiscale.references.hertz import sphere_load
@@ -78,7 +78,7 @@ class LayeredAsperity:
         self.kernel, self.a_max = kernel, check_positive("a_max", a_max)
         self.E_star = 2.0 / kernel.top_coefficient            # E1* = -2 alpha
         h1 = kernel.thickness[0]
-        n = int(nodes) if nodes is not None else int(min(400, 32 + 8 * np.ceil(self.a_max / h1)))
+        n = check_count("nodes", nodes) if nodes is not None else int(min(400, 32 + 8 * np.ceil(self.a_max / h1)))
         if n < 4:
             raise InputError("nodes", nodes, "at least 4 Gauss nodes")
         x, w = np.polynomial.legendre.leggauss(n)
@@ -322,6 +322,5 @@ def layered_law(table: AsperityTable, kernel: LayeredElastic, a_max: float, r_ma
     """``LayeredCircular`` law of the summits of ``table`` (radius sqrt(R1 R2)) on ``kernel``:
     contact radii up to ``a_max`` [m], interactions tabulated up to ``r_max`` [m] (the patch
     diagonal)."""
-    if len(table) == 0:
-        raise InputError("table", table, "needs at least one asperity")
+    check_table(table)
     return LayeredCircular(table.radius, LayeredAsperity(kernel, a_max), r_max)

@@ -14,12 +14,12 @@ from numba import njit
 _FAST = {"reassoc", "contract", "nsz"}   # reductions may be reordered (vectorised); no NaN/inf tricks
 
 
-@njit(cache=True, fastmath=_FAST)
-def gap_statistics(p, u, z, delta, load_control, scale, d, G, count, gmin):
+@njit(cache=True, fastmath=_FAST, nogil=True)
+def gap_statistics(p, u, z, delta, load_control, scale, d, G, count, gmin, Gneg, pnorm):
     """Per patch b: first p and u times the pending load-balance factor ``scale[b]`` (left by
     ``step``; reset to 1), then the contact cell count, approach ``d`` (load control: mean of
-    u + z on the contact, else ``delta``), G = Σ_contact g² and the minimum over all cells of
-    g = u + z − d."""
+    u + z on the contact, else ``delta``), G = Σ_contact g², the minimum over all cells of
+    g = u + z − d, Gneg = Σ g² over the cells off the contact with g < 0 and pnorm = Σ p²."""
     B, ny, nx = p.shape
     for b in range(B):
         c = scale[b]
@@ -29,26 +29,33 @@ def gap_statistics(p, u, z, delta, load_control, scale, d, G, count, gmin):
                 for j in range(nx):
                     p[b, i, j] *= c
                     u[b, i, j] *= c
-        n, s = 0, 0.0
+        n, s, pp = 0, 0.0, 0.0
         for i in range(ny):
             for j in range(nx):
-                on = p[b, i, j] > 0.0
+                q = p[b, i, j]
+                on = q > 0.0
                 n += on
                 s += u[b, i, j] + z[b, i, j] if on else 0.0
+                pp += q * q
         count[b] = n
+        pnorm[b] = pp
         db = s / max(n, 1) if load_control else delta[b]
         d[b] = db
-        ss, low = 0.0, np.inf
+        ss, sn, low = 0.0, 0.0, np.inf
         for i in range(ny):
             for j in range(nx):
                 g = u[b, i, j] + z[b, i, j] - db
                 low = min(low, g)
-                ss += g * g if p[b, i, j] > 0.0 else 0.0
+                if p[b, i, j] > 0.0:
+                    ss += g * g
+                elif g < 0.0:
+                    sn += g * g
         G[b] = ss
+        Gneg[b] = sn
         gmin[b] = low
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, nogil=True)
 def direction(p, u, z, d, active, beta, t):
     """New conjugate direction t = g + beta t_old on the contact of active patches, 0 elsewhere."""
     B, ny, nx = p.shape
@@ -63,7 +70,7 @@ def direction(p, u, z, d, active, beta, t):
                 t[b, i, j] = new if p[b, i, j] > 0.0 else 0.0
 
 
-@njit(cache=True, fastmath=_FAST)
+@njit(cache=True, fastmath=_FAST, nogil=True)
 def step(p, u, z, d, count, target, load_control, active, t, r, scale, corrected, lost, conjugate):
     """Step p -= tau t with tau = (g, t) / (t, L t) (load control: L t made mean-free on the
     contact), projection p >= 0, overlapping cells (zero pressure, negative gap) entering with

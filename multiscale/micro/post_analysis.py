@@ -5,36 +5,47 @@ area, sliding speed V and direction, macro surface temperatures of both bodies):
 
 1. local pressure: the zone's patch pressed by a rigid flat to the mean pressure P (FFT-BEM,
    isolated patch, warm-started from the zone's previous local pressure);
-2. local surface temperature and heat partition: steady sliding heating of that contact (§6.5,
-   ``SteadyHeating``) at speed V along the sliding direction, with given remote temperatures of the
-   two bodies (thesis §7.2.2: "remote temperatures are also considered as boundary conditions";
-   the caller chooses them from the macro temperatures); the share of the frictional heat into
-   the rough body (``partition``, clipped to [0, 1]) is what the macro heat split uses next.
-   Speeds and directions are rounded to a relative step (``Heating``) so that the kernel tables
-   are shared between zones;
+2. local surface temperatures and heat partition, with given remote temperatures of the two bodies
+   (thesis §7.2.2: "remote temperatures are also considered as boundary conditions"; the caller
+   chooses them from the macro temperatures): steady sliding heating of that contact (§6.5,
+   ``SteadyHeating``) at speed V along the sliding direction, or (``Heating.transient_steps`` =
+   N_t > 0, thesis Table 7.1) the transient heating of §6.3 (``TransientHeating``) over the macro
+   step in N_t steps, both bodies starting uniform at their remote temperatures; its partition is
+   the share of the step's heat, its temperatures those at the end of the step, its flash
+   temperature the largest of the step. The share of the frictional heat into the rough body
+   (``partition``) is what the macro heat split uses next; with equal remote temperatures it lies
+   in [0, 1] and is clipped there (``Heating.bounded``); with different ones the heat conducted
+   from the hotter body is part of it and it may leave [0, 1]. Speeds and directions are rounded
+   to a relative step (``Heating``) so that the kernel tables are shared between zones;
 3. optionally the thermal contact conductance h_c of the zone at that contact
    (``laws.Conductance``, the zone-scale spreading resistance taken out);
 4. Archard wear over the sliding distance s = V Δt (Eq. 3.10, dh = k_w(T) mu p ds, T the local
    surface temperature of step 2): ``substeps`` increments, each followed by a load-controlled
-   re-solve of the worn patch warm-started from the previous pressure (§3.5.1).
+   re-solve of the worn patch warm-started from the previous pressure (§3.5.1). ``run`` does it
+   when given the sliding; ``wear`` does it later on a ``run`` made without (the coupled loop
+   iterates steps 1–3 and wears once, at the converged state).
 
-Only the rough body wears; the counter-face is the rigid flat of ``contact.py``. Heights point to
-the counter-face (wear lowers them), pressures are positive in compression, temperatures in K.
-The worn volume of a zone is exactly ∫ k_w mu p ds over its patch: for constant k_w it equals
-k_w mu P A s.
+The rough body's topography wears; with ``counter_rate`` the counter-face (the rigid flat of
+``contact.py``, the sliding body 1) loses the volume ∫ k_w,c(T_1) mu p ds dA of the same contact,
+T_1 its own surface temperature (returned per zone: the caller spreads it over the counter-face's
+track; it stays flat at the micro scale). The thesis wears one surface only (§7.2.1). Heights
+point to the counter-face (wear lowers them), pressures are positive in compression,
+temperatures in K. The worn volume of a zone is exactly ∫ k_w mu p ds over its patch: for
+constant k_w it equals k_w mu P A s.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from multiscale.errors import InputError, check_positive
+from multiscale.errors import InputError, check_count, check_instance, check_positive
 from multiscale.micro.contact import ContactConvergenceError, ContactSolver
-from multiscale.micro.heat_kernels import ThermalMaterial
-from multiscale.micro.heating import SteadyHeating
+from multiscale.micro.heat_kernels import ThermalMaterial, Translation
+from multiscale.micro.heating import SteadyHeating, TransientHeating
 from multiscale.micro.kernels import Kernel
 from multiscale.micro.laws import Conductance
+from multiscale.micro.plasticity import Hardness
 from multiscale.micro.surface import Surface
 from multiscale.micro.wear import WearRate, wear_step
 from multiscale.micro.zones import Zone
@@ -47,12 +58,29 @@ WARM_ITERATIONS = 300     # a warm-started local solve that needs more starts ag
 class Heating:
     """Thermal set-up: ``moving`` (the sliding counter-face) and ``fixed`` (the rough body)
     materials; sliding speeds are rounded to a relative step ``speed_step`` and directions to
-    ``angle_step`` [rad] (steady kernel tables are built once per rounded pair)."""
+    ``angle_step`` [rad] (kernel tables are built once per rounded pair); ``transient_steps``: 0
+    for steady sliding heating (§6.5), N_t > 0 for the transient heating over the macro step in
+    N_t steps (§6.3, Table 7.1); ``bounded``: clip the partition to [0, 1] (for equal remote
+    temperatures, where it lies there up to the solver tolerance); ``conduction``: also the
+    zone's exchange G [W/K], the heat the contact conducts from the rough body to the counter-face
+    per kelvin of remote difference, and the partition at equal remote temperatures (a second
+    solve with the rough body's remote temperature 1 K higher: the problem is linear in the
+    frictional heat and the remote temperatures, so that heat into the rough body =
+    partition_equal Phi − G (theta_rough − theta_counter) exactly)."""
 
     moving: ThermalMaterial
     fixed: ThermalMaterial
     speed_step: float = 0.01
     angle_step: float = np.radians(2.0)
+    transient_steps: int = 0
+    bounded: bool = True
+    conduction: bool = False
+
+    def __post_init__(self):
+        for name in ("moving", "fixed"):
+            check_instance(name, getattr(self, name), ThermalMaterial, "a ThermalMaterial(kappa, diffusivity)")
+        for name in ("speed_step", "angle_step"):
+            object.__setattr__(self, name, check_positive(name, getattr(self, name)))
 
     def rounded(self, speed, angle) -> tuple[np.ndarray, np.ndarray]:
         """Speeds [m/s] and angles [rad] rounded to the table grid."""
@@ -75,6 +103,18 @@ class ZoneResult:
     partition: np.ndarray         # (B,): share of the frictional heat into the rough body (NaN without)
     conductance: np.ndarray       # W/(m^2 K), (B,): zone conductance h_c (NaN without)
     iterations: np.ndarray        # (B,): contact-solver iterations of the step
+    load: np.ndarray = None       # Pa, (B,): the zone mean pressures
+    mu: np.ndarray = None         # (B,): friction coefficients
+    temperature: np.ndarray = None          # K, (B, ny, nx): rough body's surface temperature (None without heating)
+    counter_temperature: np.ndarray = None  # K, (B, ny, nx): the counter-face's (None without heating)
+    counter_volume: np.ndarray = None       # m^3, (B,): volume the counter-face lost (0 without its wear)
+    heat: np.ndarray = None                 # W, (B,): frictional heat rate Phi of the zone (NaN without heating)
+    heat_rough: np.ndarray = None           # W, (B,): heat rate into the rough body (Phi_2, with the conduction)
+    exchange: np.ndarray = None             # W/K, (B,): G of ``Heating.conduction`` (NaN without)
+    partition_equal: np.ndarray = None      # (B,): share into the rough body at equal remote temperatures (NaN without)
+    plastic_area_fraction: np.ndarray = None  # (B,): cells at the hardness / zone cells at the macro load (0 if elastic)
+    plastic: np.ndarray = None              # m, (B, ny, nx): permanent deformation of this step, >= 0 (0 if elastic)
+    hardness: np.ndarray | None = None      # Pa, (B,): the hardness of each zone's solves (None: elastic)
 
 
 class PostAnalysis:
@@ -85,32 +125,54 @@ class PostAnalysis:
     periodic); ``mu``: friction coefficient; ``heating``: a ``Heating`` or None (no local
     temperature: k_w is then taken at the macro temperature of the rough body); ``conductance``: a
     ``laws.Conductance`` or None; ``wear_rate``: anything ``WearRate`` accepts (temperatures in K),
-    or None for no wear; ``substeps``: wear increments per step; ``tol``: contact tolerance.
+    or None for no wear; ``counter_rate``: the same for the counter-face (None: it does not wear);
+    ``substeps``: wear increments per step; ``tol``: contact tolerance; ``hardness``: a
+    ``plasticity.Hardness`` (H, or H(T) at the rough body's remote temperature of each zone) for
+    elastic-perfectly-plastic asperities, whose permanent deformation goes into the returned
+    heights (before wear; the wear re-solves are bounded too), or None (elastic).
     """
 
     def __init__(self, kernel: Kernel, shape, dx: float, dy: float, *, mu: float, heating: Heating | None = None,
-                 conductance: Conductance | None = None, wear_rate=None, substeps: int = 1,
-                 tol: float = 1e-8, max_iter: int = 5000):
+                 conductance: Conductance | None = None, wear_rate=None, counter_rate=None, substeps: int = 1,
+                 tol: float = 1e-8, max_iter: int = 5000, hardness: Hardness | None = None):
         self.solver = ContactSolver(kernel, shape, dx, dy, periodic=False)
         self.shape, self.dx, self.dy = tuple(shape), float(dx), float(dy)
         self.mu = check_positive("mu", mu, allow_zero=True)
+        if heating is not None:
+            check_instance("heating", heating, Heating, "a Heating or None")
+        if conductance is not None:
+            check_instance("conductance", conductance, Conductance, "a laws.Conductance or None")
+        if hardness is not None:
+            check_instance("hardness", hardness, Hardness, "a plasticity.Hardness or None")
+        self.hardness = hardness
         self.heating, self.conductance = heating, conductance
+        if heating is not None and (int(heating.transient_steps) != heating.transient_steps
+                                    or heating.transient_steps < 0):
+            raise InputError("transient_steps", heating.transient_steps, "0 (steady) or an integer >= 1")
         self.rate = WearRate(wear_rate) if wear_rate is not None else None
-        if int(substeps) != substeps or substeps < 1:
-            raise InputError("substeps", substeps, "an integer >= 1")
-        self.substeps, self.tol, self.max_iter = int(substeps), check_positive("tol", tol), int(max_iter)
-        self._heaters: dict[tuple, SteadyHeating] = {}
+        self.counter_rate = WearRate(counter_rate) if counter_rate is not None else None
+        self.substeps, self.tol = check_count("substeps", substeps), check_positive("tol", tol)
+        self.max_iter = check_count("max_iter", max_iter)
+        self._heaters: dict[tuple, SteadyHeating | TransientHeating] = {}
+
+    @property
+    def wears(self) -> bool:
+        """True if a body wears (the rough one or the counter-face)."""
+        return self.rate is not None or self.counter_rate is not None
 
     def run(self, zones: list[Zone], load, *, speed, angle=0.0, remote=None, sliding=None,
-            warm=None, mu=None) -> ZoneResult:
+            warm=None, mu=None, duration: float | None = None, hardness_temperature=None) -> ZoneResult:
         """Post-analysis of ``zones`` at zone mean pressures ``load`` [Pa] > 0 (B,).
 
         speed [m/s] and angle [rad from +x] of the counter-face over each zone (B,); remote (B, 2)
         [K]: remote temperatures (counter-face, rough body) — needed with heating or a
-        temperature-dependent k_w (without heating, k_w is taken at the rough body's); sliding
-        (B,) [m]: distance worn over (None: no wear this call);
+        temperature-dependent k_w (without heating, k_w is taken at each body's own); sliding
+        (B,) [m]: distance worn over (None: no wear this call; see ``wear``);
         warm (B, ny, nx): previous local pressures (warm start; rows summing to 0 start cold);
-        mu (B,): friction coefficient of each zone (default: the post-analysis' ``mu``).
+        mu (B,): friction coefficient of each zone (default: the post-analysis' ``mu``);
+        duration [s]: the macro step, heated over by the transient heating; hardness_temperature
+        (B,) [K]: where H(T) is taken (default: the rough body's remote temperature; the loop's
+        flash softening passes each zone's last flash temperature).
         """
         B = len(zones)
         H = np.stack([z.surface.heights for z in zones]) if B else np.zeros((0,) + self.shape)
@@ -125,54 +187,106 @@ class PostAnalysis:
         nan = np.full(B, np.nan)
         if B == 0:
             empty = np.zeros((0,) + self.shape)
-            return ZoneResult(empty, empty, empty, empty, np.zeros(0), *(np.zeros(0) for _ in range(6)),
-                              np.zeros(0, dtype=int))
-        r = self._solve(zones, H, load, _warm(warm, H.shape))
-        iterations = np.asarray(r.iterations).copy()
-        T, max_T, partition = None, nan.copy(), nan.copy()
+            arrays = {f.name: np.zeros(0) for f in fields(ZoneResult)}
+            return ZoneResult(**{**arrays, **dict.fromkeys(("pressure", "worn_pressure", "heights", "depth"), empty),
+                                 "iterations": np.zeros(0, dtype=int), "temperature": None,
+                                 "counter_temperature": None, "plastic": empty, "hardness": None})
+        hard = None
+        if self.hardness is not None:
+            if self.hardness.depends_on_temperature and remote is None and hardness_temperature is None:
+                raise InputError("remote", None, "a temperature-dependent hardness needs temperatures")
+            at = remote[:, 1] if hardness_temperature is None and remote is not None else hardness_temperature
+            hard = np.broadcast_to(self.hardness(at), (B,))
+        r = self._solve(zones, H, load, _warm(warm, H.shape), hard)
+        T = T1 = None
+        max_T, partition, heat, heat_rough, exchange, equal = (nan.copy() for _ in range(6))
         if self.heating is not None:
             if remote is None:
                 raise InputError("remote", None, "heating needs the remote temperatures of both bodies")
-            T = np.empty(H.shape)
+            T, T1 = np.empty(H.shape), np.empty(H.shape)
             for b in range(B):
-                heat = self._heater(speed[b], angle[b]).solve(r.pressure[b], mu[b], tol=self.tol,
-                                                              remote_temperatures=tuple(remote[b]))
-                T[b] = heat.temperature_2
-                max_T[b] = T[b].max()
-                partition[b] = np.clip(heat.partition_2, 0.0, 1.0)
+                T1[b], T[b], max_T[b], heat[b], heat_rough[b] = self._heat(r.pressure[b], speed[b], angle[b],
+                                                                           mu[b], remote[b], duration)
+                if self.heating.conduction:
+                    warmer = remote[b] + np.array([0.0, 1.0])      # the rough body 1 K warmer
+                    exchange[b] = heat_rough[b] - self._heat(r.pressure[b], speed[b], angle[b], mu[b], warmer,
+                                                             duration)[-1]
+            with np.errstate(divide="ignore", invalid="ignore"):
+                partition = heat_rough / heat
+                if self.heating.conduction:
+                    equal = np.clip((heat_rough + exchange * (remote[:, 1] - remote[:, 0])) / heat, 0.0, 1.0)
+            if self.heating.bounded:
+                partition = np.clip(partition, 0.0, 1.0)
         h_c = nan.copy()
         if self.conductance is not None:
             h_c = np.asarray(self.conductance.values(r, zones)["conductance"], dtype=float)
-        heights, depth, p = H, np.zeros(H.shape), r.pressure
-        if self.rate is not None and sliding is not None:
-            if self.rate.depends_on_temperature and T is None:
+        result = ZoneResult(r.pressure, r.pressure, H - r.plastic, np.zeros(H.shape), np.zeros(B),
+                            r.pressure.max(axis=(-2, -1)), np.asarray(r.area_fraction, dtype=float), max_T, partition,
+                            h_c, np.asarray(r.iterations).copy(), load, mu, T, T1, np.zeros(B), heat, heat_rough,
+                            exchange, equal, np.asarray(r.plastic_area_fraction, dtype=float), r.plastic.copy(), hard)
+        if sliding is not None and self.wears:
+            result = self.wear(zones, result, sliding, remote)
+        return result
+
+    def wear(self, zones: list[Zone], result: ZoneResult, sliding, remote=None) -> ZoneResult:
+        """Archard wear of the zones of ``result`` (``run`` of these zones without sliding) over
+        ``sliding`` [m] (B,) in ``substeps`` increments; remote (B, 2) [K] gives k_w's temperatures
+        without heating. Returns ``result`` with the worn heights, depth, volumes, pressures."""
+        heights, p, load, mu = result.heights, result.pressure, result.load, result.mu
+        B = len(zones)
+        T, T1 = result.temperature, result.counter_temperature
+        for rate, field, col in ((self.rate, "T", 1), (self.counter_rate, "T1", 0)):
+            if rate is not None and rate.depends_on_temperature and (T if field == "T" else T1) is None:
                 if remote is None:
                     raise InputError("remote", None, "a temperature-dependent wear rate needs temperatures")
-                T = np.broadcast_to(remote[:, 1, None, None], H.shape)
-            ds = _per_zone("sliding", sliding, B) / self.substeps
-            for _ in range(self.substeps):
-                # Archard with the per-zone sliding folded into the work density mu p ds [J/m^2]
-                worn = wear_step(Surface(heights, self.dx, self.dy, periodic=False),
-                                 mu[:, None, None] * p * ds[:, None, None], self.rate, 1.0, 1.0, T)
-                heights, depth = worn.surface.heights, depth + worn.depth
-                again = self._solve(zones, heights, load, p)
-                p = again.pressure
-                iterations += np.asarray(again.iterations)
-        return ZoneResult(r.pressure, p, heights, depth, depth.sum(axis=(-2, -1)) * self.dx * self.dy,
-                          r.pressure.max(axis=(-2, -1)), np.asarray(r.area_fraction, dtype=float),
-                          max_T, partition, h_c, iterations)
+                value = np.broadcast_to(np.broadcast_to(np.asarray(remote, float), (B, 2))[:, col, None, None],
+                                        heights.shape)
+                T, T1 = (value, T1) if field == "T" else (T, value)
+        ds = _per_zone("sliding", sliding, B) / self.substeps
+        depth, counter, iterations = np.zeros(heights.shape), np.zeros(B), result.iterations.copy()
+        plastic = result.plastic
+        for _ in range(self.substeps):
+            work = mu[:, None, None] * p * ds[:, None, None]      # mu p ds [J/m^2], per-zone sliding folded in
+            if self.counter_rate is not None:
+                counter += wear_step(Surface(heights, self.dx, self.dy, periodic=False), work,
+                                     self.counter_rate, 1.0, 1.0, T1).volume
+            if self.rate is None:
+                continue
+            # Archard with the per-zone sliding folded into the work density mu p ds [J/m^2]
+            worn = wear_step(Surface(heights, self.dx, self.dy, periodic=False), work, self.rate, 1.0, 1.0, T)
+            heights, depth = worn.surface.heights, depth + worn.depth
+            again = self._solve(zones, heights, load, p, result.hardness)
+            p, heights = again.pressure, heights - again.plastic
+            plastic = plastic + again.plastic
+            iterations += np.asarray(again.iterations)
+        return replace(result, worn_pressure=p, heights=heights, depth=depth,
+                       volume=depth.sum(axis=(-2, -1)) * self.dx * self.dy, iterations=iterations,
+                       counter_volume=counter, plastic=plastic)
 
-    def _solve(self, zones, heights, load, warm):
+    def _heat(self, pressure, speed, angle, mu, remote, duration):
+        """(counter-face field, rough-body field, flash temperature, Phi, Phi_2) of one zone: the
+        transient heating's fields at the end of the step, its flash temperature the largest of
+        the step, its heat rates the means over the step."""
+        heater = self._heater(speed, angle, duration)
+        remote = tuple(float(v) for v in remote)
+        if isinstance(heater, SteadyHeating):
+            h = heater.solve(pressure, mu, tol=self.tol, remote_temperatures=remote)
+            return h.temperature_1, h.temperature_2, h.temperature_2.max(), float(h.heat), float(h.heat_2)
+        h = heater.run(pressure, mu, tol=self.tol, remote_temperatures=remote, field_times=[duration])
+        return (h.temperature_1[-1], h.temperature_2[-1], h.max_temperature_2.max(), float(h.heat.mean()),
+                float(h.heat_2.mean()))
+
+    def _solve(self, zones, heights, load, warm, hardness=None):
         """Load-controlled contact of the batch; patches that do not converge within
         ``WARM_ITERATIONS`` from the warm start (warm starts converge in tens of iterations; one
         supported by a single cell was seen to stall for ever) are solved again from a uniform
         start with 4 x max_iter; ``ContactConvergenceError`` names those that still fail."""
         r = self.solver.solve(heights, load=load, initial_pressure=warm, tol=self.tol,
-                              max_iter=min(self.max_iter, WARM_ITERATIONS), partial=True)
+                              max_iter=min(self.max_iter, WARM_ITERATIONS), partial=True, hardness=hardness)
         bad = np.flatnonzero(~np.asarray(r.converged))
         if len(bad):
             again = self.solver.solve(heights[bad], load=load[bad], tol=self.tol, max_iter=4 * self.max_iter,
-                                      partial=True)
+                                      partial=True, hardness=None if hardness is None else hardness[bad])
             for f in fields(r):
                 if f.name not in ("history", "iterations"):
                     getattr(r, f.name)[bad] = getattr(again, f.name)
@@ -184,14 +298,19 @@ class PostAnalysis:
                                               again.history, r)
         return r
 
-    def _heater(self, speed: float, angle: float) -> SteadyHeating:
+    def _heater(self, speed: float, angle: float, duration: float | None):
         v, a = self.heating.rounded(speed, angle)
-        key = (float(v), float(a))
+        n = int(self.heating.transient_steps)
+        if n and (duration is None or not duration > 0):
+            raise InputError("duration", duration, "the transient heating needs the macro step [s] > 0")
+        key = (float(v), float(a)) + ((float(duration),) if n else ())
         if key not in self._heaters:
             if len(self._heaters) >= 256:
                 self._heaters.pop(next(iter(self._heaters)))
-            self._heaters[key] = SteadyHeating(self.shape, self.dx, self.heating.moving, self.heating.fixed,
-                                               key[0], self.dy, key[1])
+            h = self.heating
+            self._heaters[key] = SteadyHeating(self.shape, self.dx, h.moving, h.fixed, key[0], self.dy, key[1]) \
+                if not n else TransientHeating(self.shape, self.dx, h.moving, h.fixed, Translation.steady(*key[:2]),
+                                               key[2] / n, n, self.dy)
         return self._heaters[key]
 
 

@@ -5,12 +5,14 @@ row index ↔ y, column index ↔ x. Generated surfaces are periodic; imported o
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 
-from multiscale.errors import InputError, check_positive
+from multiscale.errors import (InputError, check_count, check_field, check_flag, check_instance, check_positive,
+                               check_real)
 
 
 @dataclass(frozen=True)
@@ -23,14 +25,13 @@ class Surface:
     periodic: bool = True
 
     def __post_init__(self):
-        h = np.asarray(self.heights, dtype=float)
-        if h.ndim < 2 or min(h.shape[-2:]) < 4:
+        h = check_field("heights", self.heights, min_ndim=2)
+        if min(h.shape[-2:]) < 4:
             raise InputError("heights.shape", h.shape, "need a grid of at least 4 x 4 points")
-        if not np.all(np.isfinite(h)):
-            raise InputError("heights", "array with NaN/inf", "all heights must be finite")
-        check_positive("dx", self.dx)
-        check_positive("dy", self.dy)
         object.__setattr__(self, "heights", h)
+        object.__setattr__(self, "dx", check_positive("dx", self.dx))
+        object.__setattr__(self, "dy", check_positive("dy", self.dy))
+        object.__setattr__(self, "periodic", check_flag("periodic", self.periodic))
 
     @property
     def shape(self) -> tuple[int, int]:
@@ -48,9 +49,10 @@ class Surface:
 
 
 def _pair(name: str, value) -> tuple[float, float]:
-    v = np.broadcast_to(np.asarray(value, dtype=float), (2,))
-    if not np.all(np.isfinite(v)) or np.any(v <= 0):
+    v = check_field(name, value)
+    if v.shape not in ((), (1,), (2,)) or np.any(v <= 0):
         raise InputError(name, value, "must be > 0 (a number, or a pair (x, y))")
+    v = np.broadcast_to(v, (2,))
     return float(v[0]), float(v[1])
 
 
@@ -62,14 +64,17 @@ def fractal_surface(n, size, hurst: float, k_min, k_max, rms: float, seed: int =
     k_min, k_max: lower and upper cut-offs in wavelengths per patch (thesis Table 1.1 units),
     a number or a pair (kx, ky) for an anisotropic surface: the PSD is non-zero where
     (kx/kx_max)² + (ky/ky_max)² <= 1 and (kx/kx_min)² + (ky/ky_min)² >= 1.
-    rms: RMS height [m] (each patch is scaled to it exactly); seed: random seed; batch: leading
-    shape of a batch of independent patches. Random phases uniform in [0, 2π) (Eq. 1.25).
+    rms: RMS height [m] (each patch is scaled to it exactly); seed: random seed (a whole number
+    >= 0 or a numpy SeedSequence); batch: leading shape of a batch of independent patches. Random
+    phases uniform in [0, 2π) (Eq. 1.25).
     """
-    nx, ny = (int(v) for v in np.broadcast_to(np.asarray(n), (2,)))
+    nx, ny = whole_numbers("n", n, 2)
     if min(nx, ny) < 4:
         raise InputError("n", n, "need at least 4 points per side")
+    batch = whole_numbers("batch", batch, max(np.size(batch), 1)) if np.size(batch) or np.ndim(batch) == 0 else ()
+    seed = check_seed(seed)
     Lx, Ly = _pair("size", size)
-    if not 0 < hurst <= 1:
+    if not 0 < check_real("hurst", hurst) <= 1:
         raise InputError("hurst", hurst, "Hurst exponent must lie in (0, 1]")
     kx_min, ky_min = _pair("k_min", k_min)
     kx_max, ky_max = _pair("k_max", k_max)
@@ -92,6 +97,23 @@ def fractal_surface(n, size, hurst: float, k_min, k_max, rms: float, seed: int =
     return Surface(h, Lx / nx, Ly / ny, periodic=True)
 
 
+def whole_numbers(name: str, value, count: int) -> tuple[int, ...]:
+    """``value`` (a number or ``count`` numbers) as whole numbers >= 1, else ``InputError`` (a float
+    grid size used to be truncated)."""
+    a = np.asarray(value, dtype=object) if not isinstance(value, (str, bytes)) else np.asarray([value], dtype=object)
+    if a.ndim > 1 or a.size not in (1, count):
+        raise InputError(name, value, f"must be one or {count} whole numbers")
+    return tuple(check_count(name, v) for v in np.broadcast_to(a, (count,)))
+
+
+def check_seed(seed):
+    """A random seed: a whole number >= 0 (returned as int) or a numpy SeedSequence,
+    BitGenerator or Generator (returned as is), else ``InputError``."""
+    if isinstance(seed, (np.random.SeedSequence, np.random.BitGenerator, np.random.Generator)):
+        return seed
+    return check_count("seed", seed, minimum=0)
+
+
 def load_surface(path, dx: float, dy: float | None = None, *, scale: float = 1.0,
                  detrend: str = "plane") -> Surface:
     """Measured topography from .npy or a .txt/.csv matrix (rows ↔ y) with pixel size dx (dy) [m].
@@ -99,6 +121,10 @@ def load_surface(path, dx: float, dy: float | None = None, *, scale: float = 1.0
     ``scale`` converts the file's height unit to metres (1e-6 for µm). ``detrend`` removes the
     least-squares 'plane', the 'mean', or 'none'. The result is not periodic.
     """
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError("path", path, "a file name (str or Path)")
+    if not isinstance(detrend, str):
+        raise InputError("detrend", detrend, "one of 'plane', 'mean', 'none'")
     path = Path(path)
     if not path.is_file():
         raise InputError("path", str(path), "no such file")
@@ -111,7 +137,7 @@ def load_surface(path, dx: float, dy: float | None = None, *, scale: float = 1.0
             h = np.loadtxt(path, delimiter=delimiter, comments="#", ndmin=2)
         else:
             raise InputError("path", str(path), "expected .npy, .txt, .csv, .dat or .asc")
-    except ValueError as exc:
+    except (ValueError, OSError) as exc:
         if isinstance(exc, InputError):
             raise
         raise InputError("path", str(path), f"could not read a height matrix ({exc})") from None
@@ -149,6 +175,7 @@ def statistics(surface: Surface) -> SurfaceStats:
 
     Periodic surfaces: exact spectral derivatives. Others: central finite differences.
     """
+    check_surface(surface)
     h = surface.heights - surface.heights.mean(axis=(-2, -1), keepdims=True)
     dx, dy = surface.dx, surface.dy
     m0 = np.mean(h**2, axis=(-2, -1))
@@ -203,6 +230,11 @@ class AsperityTable:
         return np.sqrt(np.clip(1.0 - (self.R2 / self.R1) ** (4.0 / 3.0), 0.0, 1.0))
 
 
+def check_surface(surface) -> Surface:
+    """``surface`` if it is a ``Surface``, else ``InputError`` naming it."""
+    return check_instance("surface", surface, Surface, "a multiscale.micro.surface.Surface")
+
+
 def find_asperities(surface: Surface) -> AsperityTable:
     """Summits as strict 8-neighbour maxima with finite-difference Hessians (thesis §1.3.1).
 
@@ -211,6 +243,7 @@ def find_asperities(surface: Surface) -> AsperityTable:
     discrete sense) have no finite radii and are left out. Periodic surfaces wrap around;
     on others the border rows and columns are not candidates.
     """
+    check_surface(surface)
     if surface.heights.ndim != 2:
         raise InputError("surface.heights", surface.heights.shape, "asperity detection takes one patch (2-D)")
     h, dx, dy = surface.heights, surface.dx, surface.dy

@@ -21,10 +21,10 @@ from dataclasses import dataclass, field
 import numpy as np
 from tqdm import tqdm
 
-from multiscale.errors import InputError, check_positive
+from multiscale.errors import InputError, check_count, check_field, check_flag, check_instance, check_positive
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import Kernel
-from multiscale.micro.surface import Surface
+from multiscale.micro.surface import Surface, check_surface
 
 
 class WearRate:
@@ -96,17 +96,16 @@ def wear_step(surface: Surface, pressure, k_w, mu: float, distance: float,
     it accepts; mu the friction coefficient; temperature: a scalar, one value per patch (batch
     shape) or a field (..., ny, nx), in the unit of the k_w table (needed only when k_w depends on it).
     """
+    check_surface(surface)
     rate = WearRate(k_w)
     h = surface.heights
     mu = check_positive("mu", mu, allow_zero=True)
     distance = check_positive("distance", distance, allow_zero=True)
-    p = np.asarray(pressure, dtype=float)
+    p = check_field("pressure", pressure, nonnegative=True)
     try:
         p = np.broadcast_to(p, h.shape)
     except ValueError:
         raise InputError("pressure.shape", p.shape, f"must broadcast to the heights {h.shape}") from None
-    if not np.all(np.isfinite(p)) or np.any(p < 0):
-        raise InputError("pressure", "array", "contact pressure must be finite and >= 0")
     T = _per_point("temperature", temperature, h.shape) if rate.depends_on_temperature else None
     depth = rate(T) * (mu * distance) * p
     worn = Surface(h - depth, surface.dx, surface.dy, surface.periodic)
@@ -169,6 +168,9 @@ def simulate_wear(surface: Surface, contact: Kernel | ContactSolver, *, load, mu
     ``pressure``).
     """
     t0 = time.perf_counter()
+    check_surface(surface)
+    check_instance("contact", contact, (Kernel, ContactSolver), "an elastic Kernel or a ContactSolver")
+    check_flag("progress", progress)
     solver = contact if isinstance(contact, ContactSolver) else ContactSolver(
         contact, surface.shape, surface.dx, surface.dy, surface.periodic)
     if tuple(solver.shape) != tuple(surface.shape) or solver.periodic != surface.periodic:
@@ -176,22 +178,23 @@ def simulate_wear(surface: Surface, contact: Kernel | ContactSolver, *, load, mu
                          f"periodic={surface.periodic})")
     distance = check_positive("distance", distance, allow_zero=True)
     mu = check_positive("mu", mu, allow_zero=True)
-    if int(steps) != steps or steps < 1:
-        raise InputError("steps", steps, "number of wear steps must be an integer >= 1")
-    steps = int(steps)
+    steps = check_count("steps", steps)
     rate = WearRate(k_w)
     h0 = surface.heights
     batch = h0.shape[:-2]
-    loads = np.broadcast_to(np.asarray(load, dtype=float), batch)
-    if not np.all(np.isfinite(loads)) or np.any(loads < 0):
-        raise InputError("load", load, "mean pressure must be finite and >= 0")
+    loads = check_field("load", load, nonnegative=True)
+    try:
+        loads = np.broadcast_to(loads, batch)
+    except ValueError:
+        raise InputError("load.shape", loads.shape, f"a scalar or the batch shape {batch}") from None
     T = _per_point("temperature", temperature, h0.shape) if rate.depends_on_temperature else None
-    law_steps = sorted({int(s) for s in law_steps})
+    law_steps = sorted({check_count("law_steps", s, minimum=0)
+                        for s in np.atleast_1d(check_field("law_steps", law_steps))})
     if law_steps and (law_steps[0] < 0 or law_steps[-1] > steps):
         raise InputError("law_steps", law_steps, f"steps must lie in 0…{steps}")
     if law_steps:
-        law_loads = np.sort(np.atleast_1d(np.asarray(law_loads, dtype=float)))
-        if law_loads.ndim != 1 or not np.all(np.isfinite(law_loads)) or np.any(law_loads <= 0):
+        law_loads = np.sort(np.atleast_1d(check_field("law_loads", law_loads)))
+        if law_loads.ndim != 1 or np.any(law_loads <= 0):
             raise InputError("law_loads", law_loads, "a 1-D array of mean pressures > 0 [Pa]")
 
     dS = distance / steps
@@ -264,7 +267,7 @@ def _per_point(name: str, value, shape) -> np.ndarray:
     """A scalar, per-patch (batch shape) or per-point (full shape) value broadcast to ``shape``."""
     if value is None:
         raise InputError(name, None, "is required here")
-    v = np.asarray(value, dtype=float)
+    v = check_field(name, value)
     batch = shape[:-2]
     if v.ndim == len(shape):
         target = v

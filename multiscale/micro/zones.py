@@ -21,8 +21,8 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from multiscale.errors import InputError, check_positive
-from multiscale.micro.surface import Surface, fractal_surface
+from multiscale.errors import InputError, check_count, check_field, check_instance
+from multiscale.micro.surface import Surface, check_surface, fractal_surface, whole_numbers
 from multiscale.references.love import (love_rectangle, love_rectangle_mean, love_triangle, love_triangle_mean,
                                         triangle_area, triangle_vertices)
 
@@ -156,13 +156,15 @@ class ZoneGrid:
     size: tuple[float, float]
 
     def __post_init__(self):
-        nx, ny = (int(v) for v in self.counts)
-        if nx < 1 or ny < 1:
-            raise InputError("counts", self.counts, "need at least one zone per direction")
-        object.__setattr__(self, "counts", (nx, ny))
-        object.__setattr__(self, "size", (check_positive("size[0]", self.size[0]),
-                                          check_positive("size[1]", self.size[1])))
-        object.__setattr__(self, "origin", tuple(float(v) for v in self.origin))
+        object.__setattr__(self, "counts", whole_numbers("counts", self.counts, 2))
+        size = check_field("size", self.size)
+        if size.shape != (2,) or np.any(size <= 0):
+            raise InputError("size", self.size, "a pair (Lx, Ly) of sizes > 0 [m]")
+        origin = check_field("origin", self.origin)
+        if origin.shape != (2,):
+            raise InputError("origin", self.origin, "a pair (x, y) of finite numbers [m]")
+        object.__setattr__(self, "size", (float(size[0]), float(size[1])))
+        object.__setattr__(self, "origin", (float(origin[0]), float(origin[1])))
 
     @property
     def n_zones(self) -> int:
@@ -192,10 +194,10 @@ def cut_zones(surface: Surface, counts, origin=(0.0, 0.0)) -> tuple[ZoneGrid, li
     The surface's grid must divide evenly (equal zones share one FFT grid and batch together).
     Heights keep the surface's datum. Returns the grid and the zones, ids row by row.
     """
-    h = surface.heights
+    h = check_surface(surface).heights
     if h.ndim != 2:
         raise InputError("surface", h.shape, "cut one 2-D surface at a time")
-    nx, ny = (int(v) for v in np.broadcast_to(np.asarray(counts), (2,)))
+    nx, ny = whole_numbers("counts", counts, 2)
     Ny, Nx = h.shape
     if nx < 1 or ny < 1 or Nx % nx or Ny % ny:
         raise InputError("counts", counts, f"must divide the surface grid {Nx} x {Ny} (columns x rows)")
@@ -217,9 +219,11 @@ def generate_zones(grid: ZoneGrid, n: int, hurst: float, k_min, k_max, rms: floa
     """One independent fractal patch of n x n cells per zone of ``grid`` (``fractal_surface``
     parameters; cut-offs in wavelengths per zone). Zone i gets the seed spawned from (seed, i),
     so a zone's patch does not depend on how many zones there are or who generates it."""
+    check_instance("grid", grid, ZoneGrid, "a ZoneGrid")
+    seed = check_count("seed", seed, minimum=0)
     zones = []
     for zid in range(grid.n_zones):
-        zone_seed = np.random.SeedSequence([int(seed), zid])
+        zone_seed = np.random.SeedSequence([seed, zid])
         s = fractal_surface(n, grid.size, hurst, k_min, k_max, rms, seed=zone_seed)
         zones.append(Zone(zid, Surface(s.heights, s.dx, s.dy, periodic=False), grid.zone_origin(zid)))
     return zones

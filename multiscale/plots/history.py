@@ -38,7 +38,8 @@ def history_figure(history, path: Path, title: str = "") -> Path:
             ax.set_ylim(centre - 0.05 * abs(centre) - 1e-30, centre + 0.05 * abs(centre) + 1e-30)
         if len(keys) > 1:
             ax.legend()
-    fig.suptitle(title)
+    fig.suptitle(f"{title}: interface force, contact pressure, temperatures and heat against time" if title else
+                 "interface force, contact pressure, temperatures and heat against time")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     return path
@@ -78,7 +79,8 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
             ax.legend(fontsize=8)
     for ax in axes.ravel()[len(panels):]:
         ax.axis("off")
-    fig.suptitle(title)
+    fig.suptitle(f"{title}: both scales of the multiscale loop against time" if title else
+                 "both scales of the multiscale loop against time")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     return path
@@ -100,7 +102,7 @@ def wear_map(grid, depth: np.ndarray, path: Path, title: str = "") -> Path:
         ax.set_xlabel("x [mm]")
         ax.set_ylabel("y [mm]")
         fig.colorbar(im, ax=ax, label=label, shrink=0.85)
-    fig.suptitle(title)
+    fig.suptitle(f"wear depth over the interface ({title})" if title else "wear depth over the interface")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     return path

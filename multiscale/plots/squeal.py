@@ -34,7 +34,8 @@ def plot_pressure(midpoints: np.ndarray, masks: Mapping[str, np.ndarray], facet_
     for ax, (iface, mask) in zip(axes[0], masks.items()):
         art = ax.tricontourf(mid[mask, 0] * 1e3, mid[mask, 1] * 1e3, p[mask], levels=20, cmap="jet")
         fig.colorbar(art, ax=ax, label="contact pressure [MPa]")
-        ax.set(title=f"{name}: {iface}", xlabel="x [mm]", ylabel="y [mm]", aspect="equal")
+        ax.set(title=f"contact pressure at the preload: {iface}", xlabel="x [mm]", ylabel="y [mm]", aspect="equal")
+    fig.suptitle(name)
     return _save(fig, path)
 
 
@@ -64,7 +65,7 @@ def plot_energy(case, path, split: tuple[str, str] | None = None) -> Path:
     for j, name in enumerate(sh.names):
         a.bar(n, sh.share[:, j], bottom=bottom, label=name, width=0.9)
         bottom += sh.share[:, j]
-    a.set(ylabel="strain-energy share [-]", title=f"{case.name}: strain energy per component")
+    a.set(ylabel="strain-energy share [-]", title=f"{case.name}: share of the strain energy of each mode per component")
     a.legend(fontsize=7, ncol=4)
     if split is not None:
         b.bar(n, sh.split(*split), width=0.9, label=f"{split[0]} / ({split[0]} + {split[1]})")

@@ -10,9 +10,10 @@ from pathlib import Path
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
+from matplotlib.ticker import NullFormatter
 
 from multiscale.studies.expand import Study, StudyRun
-from multiscale.studies.formatting import percent
+from multiscale.studies.formatting import percent, value_text
 from multiscale.studies.results import Row, case_key, pareto
 
 __all__ = ["plot"]
@@ -74,13 +75,13 @@ def _plot_pareto(study, ok, folder):
             ax.axhline(tol, color="gray", ls="--", lw=0.8)
             ax.annotate(percent(tol), (1, tol), xycoords=("axes fraction", "data"), fontsize=7, ha="right",
                         va="bottom", color="gray")
-        ax.set(xlabel="wall time [s]", ylabel=f"relative error of {m}", title=m)
+        ax.set(xlabel="wall time [s]", ylabel=f"relative error of {m}", title=f"error of {m} against cost")
         ax.grid(True, which="both", alpha=0.25)
         ax.legend(fontsize=7)
     if not drawn:
         plt.close(fig)
         return None
-    fig.suptitle(f"{study.name}: error vs wall time")
+    fig.suptitle(f"{study.name}: relative error against wall time (lower left is better)")
     fig.tight_layout()
     path = folder / f"{study.name}_error_vs_time.png"
     fig.savefig(path, dpi=100)
@@ -130,15 +131,20 @@ def _plot_axis(study, ok, axis, folder):
         if kind == "time":
             ax.set_yscale("log")
         ax.set(xlabel=" / ".join(axis), ylabel={"error": f"relative error of {m}", "value": m, "time": "wall time [s]"}[kind],
-               title=m or "cost")
-        if log_x:
+               title={"error": f"error of {m}", "value": m, "time": "wall time of a run"}[kind])
+        if log_x:             # ticks at the swept values, no minor labels (they overlap on short decades)
             ax.set_xscale("log")
-        if not numeric:
+            ax.xaxis.set_minor_formatter(NullFormatter())
+        if numeric:
+            ticks_at = sorted(set(raw))
+            ax.set_xticks(ticks_at, [value_text(v) for v in ticks_at], rotation=30 if len(ticks_at) > 5 else 0)
+        else:
             ax.set_xticks(range(len(values)), [ticks[v] for v in values], rotation=30, ha="right", fontsize=7)
         ax.grid(True, which="both", alpha=0.25)
         if others and len(lines) <= 8:
             ax.legend(fontsize=6)
-    fig.suptitle(f"{study.name}: {' / '.join(axis)}" + (f" (mean ± std over {', '.join(averaged)})" if averaged else ""))
+    fig.suptitle(f"{study.name}: {' and '.join(study.metrics)} and wall time against {' / '.join(axis)}"
+                 + (f" (mean ± std over {', '.join(averaged)})" if averaged else ""))
     fig.tight_layout()
     path = folder / f"{study.name}_{axis[0].replace('.', '_')}.png"
     fig.savefig(path, dpi=100)

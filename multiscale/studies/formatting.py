@@ -2,13 +2,24 @@
 from __future__ import annotations
 
 import math
+import re
 import time
 
 __all__ = ["now", "number_text", "percent", "value_text"]
 
 
+# unit spellings of the study files -> their symbols in tables and plots
+SYMBOLS = ((re.compile(r"(?<=[\d\s])um\b"), "µm"), (re.compile(r"(?<=[\d\s])us\b"), "µs"),
+           (re.compile(r"\bdegC\b"), "°C"))
+
+
 def value_text(value) -> str:
-    """A parameter value: floats to 4 significant digits, lists in brackets."""
+    """A parameter value: floats to 4 significant digits, lists in brackets, unit strings with
+    their symbols ("2 um" is shown "2 µm")."""
+    if isinstance(value, str):
+        for pattern, symbol in SYMBOLS:
+            value = pattern.sub(symbol, value)
+        return value
     if isinstance(value, float):
         return f"{value:.4g}"
     if isinstance(value, (list, tuple)):

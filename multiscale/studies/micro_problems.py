@@ -183,17 +183,25 @@ class RoughContactParams(SurfaceParams):
     route: str = key(Choice(("energy", "kinematic")), default="energy")       # interacting models
     periodic: bool = key(Flag(), default=False)                                # FFT-BEM kernel
     tol: float | None = key(Quantity("dimensionless", gt=0, lt=1))            # default: the solver's
+    hardness: float | None = key(Quantity("pressure", gt=0))                  # Pa, elastic-plastic FFT-BEM
+
+    def problems(self, path, ctx):
+        out = super().problems(path, ctx)
+        if self.hardness is not None and self.model != "fft-bem":
+            out.append(f'{path + "." if path else ""}hardness: only with model = "fft-bem" (the asperity models '
+                       "are elastic)")
+        return out
 
 
 @_register(RoughContactParams, {"mean_pressure": "force / nominal area [Pa]",
                                 "area_fraction": "real contact area / nominal area [-]"})
 def _rough_contact(p: RoughContactParams) -> Outcome:
-    """Rough contact at one rigid approach: FFT-BEM or an asperity model (thesis §1.2.2, Fig. 1.14)."""
+    """Rough contact at one rigid approach: FFT-BEM (optionally with a hardness) or an asperity model (§1.2.2)."""
     kernel = HalfSpace.from_materials(p.E, p.nu)
     surface = rough_surface(p, periodic=p.periodic)
     if p.model == "fft-bem":
         r = ContactSolver(kernel, surface.shape, surface.dx, periodic=p.periodic).solve(
-            surface.heights, approach=p.approach, **({"tol": p.tol} if p.tol else {}))
+            surface.heights, approach=p.approach, hardness=p.hardness, **({"tol": p.tol} if p.tol else {}))
         return Outcome({"mean_pressure": float(r.mean_pressure), "area_fraction": float(r.area_fraction)},
                        int(r.iterations), bool(r.converged))
     shape, interaction = _MODELS[p.model]

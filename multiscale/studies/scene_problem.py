@@ -55,7 +55,7 @@ class SceneRun:
 
 class SceneProblem(Problem):
     """Any macro scene (``multiscale run``) with overrides; metrics are history columns reduced
-    over time: ``column`` (last value) or ``column:last|first|max|min|mean|rise`` (rise = last −
+    over time (scalar columns: per-zone ones are skipped): ``column`` (last value) or ``column:last|first|max|min|mean|rise`` (rise = last −
     first: a temperature rise, whose relative error means more than that of a temperature in K).
     A squeal scene (effect ``stability``) has no history; its metrics come from ``modes.csv``
     (``squeal_metrics``)."""
@@ -105,6 +105,8 @@ class SceneProblem(Problem):
         metrics = {}
         for column in history.columns:
             values = history[column]
+            if values.ndim != 1:              # a per-zone column (rows, zones): no scalar metric
+                continue
             metrics[column] = float(values[-1])
             metrics.update({f"{column}:{r}": float(f(values)) for r, f in _REDUCERS.items()})
         iterations = int(history["newton_iterations"].sum()) if "newton_iterations" in history.columns else 0

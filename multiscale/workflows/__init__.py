@@ -3,12 +3,18 @@
 ``model`` (the scene-to-model factory), ``rough`` (the one rough-interface builder), ``output`` (the
 output-folder check, ``RunResult``) and one workflow per analysis: ``transient`` (thermo-mechanics
 with perfect contact), ``multiscale`` (the multiscale loop, effect ``roughness``) and ``squeal``
-(complex eigenvalues, effect ``stability``). ``run`` dispatches a scene to its workflow.
+(complex eigenvalues, effect ``stability``). ``run`` dispatches a scene to its workflow, prints one
+line per stage on rank 0 (``multiscale.io.Reporter``) and completes the results folder with its
+provenance (``multiscale.provenance``) and a pvpython script (``multiscale.outputs``).
 """
 from __future__ import annotations
 
+import time
+from pathlib import Path
+
 from mpi4py import MPI
 
+from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.output import RunResult
@@ -16,23 +22,52 @@ from multiscale.workflows.output import RunResult
 
 def workflow(scene) -> str:
     """Which analysis a scene runs: "squeal" (effect stability), "multiscale" (effect roughness)
-    or "transient"."""
-    return "squeal" if scene.has("stability") else "multiscale" if scene.has("roughness") else "transient"
+    or "transient" (``multiscale.outputs.analysis``)."""
+    return outputs.analysis(scene)
 
 
 def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_WORLD,
         verbose: bool = True) -> RunResult:
-    """Run a scene (``multiscale run``) with its workflow; only the multiscale loop resumes."""
+    """Run a scene (``multiscale run``) with its workflow; only the multiscale loop resumes.
+
+    Besides the analysis' results, the folder receives ``scene.toml``, ``scene_resolved.toml``,
+    ``provenance.json`` (also after a failure, once the folder was prepared) and ``paraview.py``.
+    ``verbose``: stage lines and the summary on rank 0."""
     kind = workflow(scene)
-    if kind == "multiscale":
-        return multiscale.run(scene, overwrite=overwrite, resume=resume, comm=comm, verbose=verbose)
-    if resume:
+    if resume and kind != "multiscale":
         why = ("the squeal analysis has no checkpoints to resume from" if kind == "squeal" else
                'this scene has no checkpoints to resume from (only the multiscale loop, effect "roughness", '
                "writes checkpoints)")
         raise InputError("--resume", True, why)
-    module = squeal if kind == "squeal" else transient
-    return module.run(scene, overwrite=overwrite, comm=comm, verbose=verbose)
+    ended = resume and checkpoint.peek(Path(scene.output.folder) / multiscale.CHECKPOINT, comm).get("finished")
+    started, start = provenance.now(), time.perf_counter()
+    with io.Reporter(comm, quiet=not verbose) as reporter:
+        try:
+            if kind == "multiscale":
+                result = multiscale.run(scene, overwrite=overwrite, resume=resume, comm=comm, verbose=verbose)
+            else:
+                module = squeal if kind == "squeal" else transient
+                result = module.run(scene, overwrite=overwrite, comm=comm, verbose=verbose)
+        except BaseException as exc:
+            if reporter.folder is not None and comm.rank == 0:
+                provenance.write(reporter.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
+                                 wall_time=time.perf_counter() - start, analysis=kind,
+                                 status=f"failed: {type(exc).__name__}: {exc}")
+            raise
+    result.files += [f.with_suffix(".h5") for f in result.files if f.suffix == ".xdmf"]   # their data
+    if ended:                 # --resume of a finished run: nothing to do, its provenance stays as it was
+        result.files += [result.folder / name for name in outputs.PROVENANCE]
+        return result
+    script = result.folder / "paraview.py"
+
+    def write():
+        files = provenance.write(result.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
+                                 wall_time=time.perf_counter() - start, analysis=kind,
+                                 status="resumed and finished" if resume else "finished")
+        script.write_text(outputs.paraview_script(outputs.plan(scene)))
+        return files + [script]
+    result.files += comm.bcast(io.on_root(comm, write, f"the provenance into {result.folder}"), root=0)
+    return result
 
 
 __all__ = ["RunResult", "run", "workflow"]

@@ -153,12 +153,13 @@ def thermal_conditions(scene) -> tuple[ThermalBoundary, ...]:
                  if any(v is not None for v in (b.convection, b.emissivity, b.temperature)))
 
 
-def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None) -> MacroModel:
+def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: bool | None = None) -> MacroModel:
     """Mesh and the problems the scene's effects ask for (no heat problem without ``thermal``).
 
     ``law`` optionally replaces the perfect-contact penalty law on the rough interfaces
     (``macro.interface.PressureLaw``); ``tm``: an already built mesh of the scene (e.g. the one
-    the law's per-facet fields live on).
+    the law's per-facet fields live on); ``conductance``: the heat problem's interface conductance
+    term (default: with effect "conductance"; the multiscale loop's implicit coupling sets it).
     """
     if not scene.has("contact"):
         raise InputError("effects", sorted(scene.effects), 'the macro model needs effect "contact"')
@@ -173,7 +174,7 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None) -> MacroModel:
     if T is not None:
         heat = Thermal(mech.contact, dict(scene.materials), initial_temperature=t.initial_temperature,
                        dt=t.dt / t.substeps, frictional_heat=scene.has("heat_partition"),
-                       conductance=scene.has("conductance"), temperatures=T,
+                       conductance=scene.has("conductance") if conductance is None else conductance, temperatures=T,
                        boundaries=thermal_conditions(scene))
         if scene.has("heat_partition"):
             share = np.zeros(tm.interface.n_facets)

@@ -2,17 +2,20 @@
 resume, write.
 
 The scene gives the macro model (``workflows.model``), the rough interface (``workflows.rough``:
-[roughness], [micro], [layers]) and the micro post-analysis: steady sliding heating with effects
-``thermal`` + ``heat_partition`` (the micro partition law with ``micro.partition_law``), the zone
-conductance with ``conductance``, Archard wear with ``wear`` (k_w or k_w(T), ``wear.update_every``,
-``wear.substeps``). ``multiscale.coupling.Multiscale`` runs the loop.
+[roughness], [micro], [layers]) and the micro post-analysis: micro heating with effects
+``thermal`` + ``heat_partition`` (``micro.heating`` steady or transient in ``micro.heating_steps``;
+the micro partition law with ``micro.partition_law``, its remote temperatures and coupling
+``micro.remote_temperatures``, ``micro.coupling``), the zone conductance with ``conductance``,
+Archard wear with ``wear`` (the rough body's k_w or k_w(T): its material's ``k_w``, else [wear]'s,
+else the default table; the counter-face wears when its material gives ``k_w``;
+``wear.update_every``, ``wear.substeps``). ``multiscale.coupling.Multiscale`` runs the loop.
 
 Every step writes a checkpoint (``checkpoint.h5``: macro fields, zone topographies, per-zone state,
 history), so that ``multiscale run --resume`` continues a killed run and ends with the same history
 as an uninterrupted one (to solver tolerance); then the fields of output steps. Results:
 ``history.h5`` and ``history.png`` (macro), ``multiscale.png`` (both scales: Figs. 7.12, 7.14–7.18),
 ``wear_map.png`` (Fig. 7.13), ``zones.h5`` (final per-zone state) and XDMF fields (the interface adds
-per-facet stiffness, partition and wear depth).
+per-facet stiffness, partition, wear depth, flash temperature and the counter-face's wear depth).
 """
 from __future__ import annotations
 
@@ -26,9 +29,10 @@ import h5py
 import numpy as np
 from mpi4py import MPI
 
-from multiscale import checkpoint, io
+from multiscale import checkpoint, io, outputs
 from multiscale.coupling import LoopSettings, Multiscale
 from multiscale.errors import InputError
+from multiscale.geometry import Rotation
 from multiscale.macro.output import FieldOutput
 from multiscale.micro.heat_kernels import ThermalMaterial
 from multiscale.micro.laws import Conductance
@@ -37,7 +41,8 @@ from multiscale.plots.history import multiscale_figure, wear_map
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, interface_forces, \
     interface_materials
 from multiscale.workflows.output import prepare_folder
-from multiscale.workflows.rough import build_rough_interface, check_rough_scene, contact_kernel, thermal_kernels
+from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
+                                        thermal_kernels)
 from multiscale.workflows.transient import TransientResult, write_history
 
 CHECKPOINT = "checkpoint.h5"
@@ -56,17 +61,26 @@ class MultiscaleResult(TransientResult):
 def post_analysis(scene, zone) -> PostAnalysis:
     """The micro post-analysis of the scene's zones (``zone``: one of them, for the grid)."""
     rough, counter = interface_materials(scene, scene.rough_interfaces[0])
+    m = scene.micro
     heating = None
     if scene.has("thermal") and scene.has("heat_partition"):
         heating = Heating(ThermalMaterial(counter.kappa, counter.diffusivity),
-                          ThermalMaterial(rough.kappa, rough.diffusivity))
+                          ThermalMaterial(rough.kappa, rough.diffusivity),
+                          transient_steps=m.heating_steps if m.heating == "transient" else 0,
+                          bounded=m.remote(scene.effects) == "rough",
+                          conduction=m.coupling_scheme(scene.effects) == "implicit")
     wear = scene.has("wear")
+    rate = (rough.wear_rate if rough.k_w is not None else scene.wear.rate) if wear else None
+    counter_rate = counter.wear_rate if wear and counter.k_w is not None else None
+    if counter_rate is not None and not isinstance(scene.geometry.spec.motion, Rotation):
+        raise InputError("materials.k_w", counter.k_w, "the counter-face wears along a circular track: it must "
+                         "rotate (give k_w to a rotating counter-face only)")
     s = zone.surface
     return PostAnalysis(contact_kernel(scene)[0], s.shape, s.dx, s.dy, mu=friction_coefficient(scene),
                         heating=heating,
                         conductance=Conductance(*thermal_kernels(scene)) if scene.has("conductance") else None,
-                        wear_rate=scene.wear.rate if wear else None, substeps=scene.wear.substeps if wear else 1,
-                        tol=scene.micro.tol)
+                        wear_rate=rate, counter_rate=counter_rate, substeps=scene.wear.substeps if wear else 1,
+                        tol=m.tol, hardness=interface_hardness(scene) if scene.has("plasticity") else None)
 
 
 def fingerprint(scene) -> str:
@@ -81,16 +95,23 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
     if not scene.has("roughness"):
         raise InputError("effects", sorted(scene.effects), 'the multiscale loop needs effect "roughness"')
     check_rough_scene(scene)              # before meshing
-    tm = build_mesh(scene, comm)
-    rough = build_rough_interface(scene, tm, progress=progress)
-    model = build_model(scene, comm, law=rough.law, tm=tm)
+    with io.stage("meshing"):
+        tm = build_mesh(scene, comm)
+    with io.stage("model set-up"):
+        rough = build_rough_interface(scene, tm, progress=progress)
+        exchange = (scene.has("heat_partition") and scene.micro.partition_law
+                    and scene.micro.coupling_scheme(scene.effects) == "implicit")
+        model = build_model(scene, comm, law=rough.law, tm=tm, conductance=scene.has("conductance") or exchange)
     t, wear = scene.time, scene.has("wear")
     mu = np.concatenate([np.full(g.n_zones, friction_coefficient(scene, n)) for n, g in zip(rough.names, rough.grids)])
     settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature,
                             partition=float(scene.partition) if scene.has("heat_partition") else np.nan,
                             partition_law=scene.micro.partition_law, wear=wear,
                             wear_every=scene.wear.update_every if wear else 1,
-                            forces=interface_forces(scene, tm), friction=mu)
+                            flash_softening=scene.micro.flash_softening,
+                            forces=interface_forces(scene, tm), friction=mu,
+                            remote=scene.micro.remote(scene.effects), coupling=scene.micro.coupling_scheme(scene.effects),
+                            coupling_tol=scene.micro.coupling_tol, coupling_iterations=scene.micro.coupling_iterations)
     return Multiscale(model, rough, post_analysis(scene, rough.zones[0]), settings, fingerprint(scene))
 
 
@@ -114,30 +135,36 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     steps = scene.time.steps if (ms.model.thermal is not None or scene.has("wear")) else 0
     every = scene.output.every
     if resume:
-        done, history, written = dataclasses.astuple(ms.restore(ckpt))
+        with io.stage("restoring the checkpoint"):
+            done, history, written = dataclasses.astuple(ms.restore(ckpt))
     else:
-        first = ms.start()
+        with io.stage("zone laws and first solve"):
+            first = ms.start()
         done, history, written = 0, io.History(), -1
         history.append(**ms.record(first))
         ms.save(ckpt, 0, history)
     ms.rough.pool.progress = False
-    writer = FieldOutput(ms.model, folder, scene.output.fields, extra=ms.facet_fields(), append=resume)
+    plan = outputs.plan(scene)
+    writer = FieldOutput(ms.model, folder, plan.body_fields + plan.interface_fields, extra=ms.facet_fields(),
+                         resume_at=ms.model.time if resume else None)
     if written < done and (done % every == 0 or done == steps):
         writer.write()
         ms.mark_fields(ckpt, done, comm)
     last = steps if stop_after is None else min(steps, stop_after)
-    for n in io.progress(range(done + 1, last + 1), comm, desc=scene.name, unit="step", initial=done, total=steps):
-        history.append(**ms.record(ms.step(n)))
-        ms.save(ckpt, n, history)
-        if n % every == 0 or n == steps:
-            writer.write()
-            ms.mark_fields(ckpt, n, comm)
-        done = n
-    h5, png = write_history(history, folder, scene.name, comm)
-    plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
+    with io.stage("macro steps"):
+        for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
+            history.append(**ms.record(ms.step(n)))
+            ms.save(ckpt, n, history)
+            if n % every == 0 or n == steps:
+                writer.write()
+                ms.mark_fields(ckpt, n, comm)
+            done = n
+    with io.stage("writing history and plots"):
+        h5, png = write_history(history, folder, scene.name, comm)
+        plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
     if done == steps:
         checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
-    result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones] + maps, _time.perf_counter() - start,
+    result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones, ckpt] + maps, _time.perf_counter() - start,
                               history, h5, png, writer.files, plot, maps, zones, done)
     del ms, writer            # the model holds reference cycles of PETSc objects: free them on every
     gc.collect()              # rank at the same point (collected later, ranks could hang at exit)
@@ -154,7 +181,7 @@ def finished(folder: Path, name: str, steps: int, comm, verbose: bool) -> Multis
     history = io.History.read(folder / "history.h5")
     fields = sorted(folder.glob("*.xdmf"))
     maps = sorted(folder.glob("wear_map*.png"))
-    files = fields + [folder / n for n in ("history.h5", "history.png", "multiscale.png", "zones.h5")] + maps
+    files = fields + [folder / n for n in ("history.h5", "history.png", "multiscale.png", "zones.h5", CHECKPOINT)] + maps
     if verbose and comm.rank == 0:
         print(f"{name}: nothing to do, the run in {folder} has ended after {steps} step(s); "
               "use --overwrite to run it again")
@@ -179,6 +206,8 @@ def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: 
             h5.create_dataset("max_wear_depth", data=depth.max(axis=(-2, -1))).attrs["unit"] = "m"
             h5.create_dataset("wear_volume", data=rough.zone_wear_volume(depth)).attrs["unit"] = "m^3"
             h5.create_dataset("partition", data=ms.partition)
+            h5.create_dataset("flash_temperature", data=ms.flash).attrs["unit"] = "K"
+            h5.create_dataset("counter_wear_depth", data=ms.counter_depth).attrs["unit"] = "m"   # per facet
             h5.create_dataset("conductance", data=ms.conductance).attrs["unit"] = "W/(m^2 K)"
             h5.attrs["counts"] = np.array([g.counts for g in rough.grids])     # (interfaces, 2)
         offset = 0

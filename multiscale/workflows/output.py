@@ -4,8 +4,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 from pathlib import Path
 
+from multiscale import io
 from multiscale.errors import InputError, SceneError
-from multiscale.io import on_root
 
 
 @dataclass
@@ -37,5 +37,6 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
         probe = folder / ".multiscale_write_test"
         probe.write_bytes(b"")              # a read-only folder fails here, before any work
         probe.unlink()
-    on_root(comm, create, f"into the output folder {folder}")
+    io.on_root(comm, create, f"into the output folder {folder}")
+    io.reporter().folder = folder         # where a failed run leaves its provenance
     return folder

@@ -18,7 +18,10 @@ the multiscale loop and the squeal analysis:
   post-analysis grid);
 - laws by FFT-BEM (``micro.model = "fft-bem"``; the asperity models are refused), ``micro.law_points``
   nodes up to ``micro.p_max`` (default ``P_MAX_FACTOR`` x the nominal interface pressure), contact
-  tolerance ``micro.tol``; the micro solid is layered with effect ``layers``.
+  tolerance ``micro.tol``; the micro solid is layered with effect ``layers``;
+- with effect ``plasticity`` the micro solves are elastic-perfectly plastic with the hardness of
+  the softer body of the interface (``interface_hardness``): the laws at H(T0), the top node at
+  most ``P_MAX_PLASTIC`` x H (no zone carries more than H).
 """
 from __future__ import annotations
 
@@ -32,6 +35,7 @@ from multiscale.micro.conduction import SeriesKernel
 from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
 from multiscale.micro.laws import LawSpec
+from multiscale.micro.plasticity import Hardness
 from multiscale.micro.surface import Surface, fractal_surface
 from multiscale.micro.topography import TopographyWarning, condition, cover, read_topography
 from multiscale.micro.zones import ZoneGrid, cut_zones, generate_zones
@@ -43,6 +47,7 @@ from multiscale.workflows.model import interface_forces, interface_materials
 P_MAX_FACTOR = 20.0        # default top node of the laws: 20 x the nominal interface pressure
 SEED_STRIDE = 7919         # interface k draws its surfaces with seed + SEED_STRIDE k
 MAX_CELLS = 1024           # cells per zone side taken from a measurement's own pixel size
+P_MAX_PLASTIC = 0.9        # with plasticity, the top node of the laws is at most this x the hardness
 
 
 def check_rough_scene(scene) -> None:
@@ -61,7 +66,8 @@ def check_rough_scene(scene) -> None:
     if len(pairs) > 1:
         raise InputError("interfaces", sorted(scene.rough_interfaces), "the rough interfaces must have the same "
                          f"materials on both sides (one micro solid); found {sorted(pairs)}")
-    shared = ("grid", "law_points", "model", "p_max", "tol", "partition_law")
+    shared = ("grid", "law_points", "model", "p_max", "tol", "partition_law", "heating", "heating_steps",
+              "remote_temperatures", "coupling", "coupling_tol", "coupling_iterations")
     for name in scene.rough_interfaces:
         m = scene.interface_settings(name).micro
         for key in shared:
@@ -141,6 +147,24 @@ def thermal_kernels(scene):
     return first, ThermalHalfSpace(counter.kappa)
 
 
+def interface_hardness(scene) -> Hardness:
+    """The hardness of the softer body of the rough interfaces (one material pair, see
+    ``check_rough_scene``): of the side(s) with materials.<name>.hardness, the one with the lower
+    value at the initial temperature (constant or its H(T) table, in K)."""
+    T0 = scene.time.initial_temperature
+    sides = [scene.materials[m] for m in scene.geometry.spec.interface_materials(scene.rough_interfaces[0])]
+    given = [m.hardness for m in sides if m.hardness is not None]
+    if not given:
+        raise InputError("hardness", None, 'effect "plasticity" needs materials.<name>.hardness on the rough interface')
+    softest = min(given, key=lambda h: Hardness(_table(h))(T0))
+    return Hardness(_table(softest))
+
+
+def _table(value):
+    """A scene property (a number, or rows ((K, value), ...)) as ``Hardness`` takes it."""
+    return value if not isinstance(value, tuple) else tuple(zip(*value))
+
+
 def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterface:
     """Zones of every rough interface of ``tm``, the law spec and the pool (collective; laws not
     yet computed: ``RoughInterface.update_laws``)."""
@@ -160,5 +184,9 @@ def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterfac
     m = scene.micro
     kernel, E_star = contact_kernel(scene)
     nominal = sum(interface_forces(scene, tm).values()) / tm.interface.areas.sum()
-    spec = LawSpec(kernel, m.p_max or P_MAX_FACTOR * nominal, n_points=m.law_points, tol=m.tol, E_star=E_star)
+    p_max, hardness = m.p_max or P_MAX_FACTOR * nominal, None
+    if scene.has("plasticity"):
+        hardness = float(interface_hardness(scene)(scene.time.initial_temperature))
+        p_max = min(p_max, P_MAX_PLASTIC * hardness)
+    spec = LawSpec(kernel, p_max, n_points=m.law_points, tol=m.tol, E_star=E_star, hardness=hardness)
     return RoughInterface(tm, names, planes, grids, zones, spec, MicroPool(spec, tm.comm, progress=progress))

@@ -20,9 +20,10 @@ undamped modes do not map exactly is solved as a quadratic eigenproblem (viscous
 projection on the undamped modes (loss factors; ``macro.damped``). ``[stability.sweep]`` adds a
 stability map (``workflows.squeal_map``).
 
-``run`` writes into ``output.folder``: ``modes.csv``, mode shapes (``modes_body*.xdmf``),
-``pressure.png`` (Fig. 4.12), ``re_im.png`` (Fig. 4.13) and ``energy.png`` (Figs. 4.20–4.21);
-with prestress ``prestress.csv``; with a sweep the map's files (``workflows.squeal_map.write``).
+``run`` writes into ``output.folder``: ``modes.csv``, mode shapes (``modes_<body>.bp``, VTX), the
+preloaded state's fields (``<body>.xdmf``, ``interface.xdmf``), ``pressure.png`` (Fig. 4.12),
+``re_im.png`` (Fig. 4.13) and ``energy.png`` (Figs. 4.20–4.21); ``multiscale.outputs.plan``.
+With prestress also ``prestress.csv``; with a sweep the map's files (``workflows.squeal_map.write``).
 """
 from __future__ import annotations
 
@@ -36,7 +37,7 @@ from typing import Mapping
 import numpy as np
 from mpi4py import MPI
 
-from multiscale import io
+from multiscale import io, outputs
 from multiscale.errors import InputError
 from multiscale.macro.damped import PrestressEffect, prestress_effect, solve_system
 from multiscale.macro.eigen import Damping, ModalResult
@@ -44,7 +45,7 @@ from multiscale.macro.friction import ConstantFriction, StribeckFriction, TableF
 from multiscale.macro.mechanics import Mechanics
 from multiscale.macro.modal import EnergyShares, RegionEnergy, StabilityReport, stability_report, \
     strain_energy_shares
-from multiscale.macro.output import write_modes_xdmf
+from multiscale.macro.output import write_modes, write_state
 from multiscale.macro.preload import Preload, linearise_system, preload
 from multiscale.macro.stability_map import StabilityMap
 from multiscale.plots.squeal import plot_energy, plot_pressure, plot_re_im
@@ -95,17 +96,20 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
     ``options.damping``) is the proportional part, ``options`` the rest (``SquealOptions``)."""
     opt = options or SquealOptions()
     slope = set_friction(mech, opt.friction_laws)[1] if opt.friction_laws else None
-    pre = preload(mech, load, steps, reset=reset)
-    lin = linearise_system(mech, materials, damping=damping or opt.damping,
-                           slope=slope if opt.friction_damping else None, prestress=opt.prestress,
-                           gyroscopic=opt.gyroscopic, material=opt.material_damping)
-    modes = solve_system(lin.system, f_min=band[0], f_max=band[1], n_modes=n_modes, target=target,
-                         method=opt.method, basis=opt.basis)
-    effect = prestress_effect(modes, lin.system, lin.K_sigma) if lin.K_sigma is not None else None
-    for A in (lin.system.M, lin.system.C, lin.system.H, lin.K_sigma):
-        if A is not None:
-            A.destroy()
-    shares = strain_energy_shares(modes, RegionEnergy(mech)) if energy else None
+    with io.stage("preload"):
+        pre = preload(mech, load, steps, reset=reset)
+    with io.stage("eigen solve"):
+        lin = linearise_system(mech, materials, damping=damping or opt.damping,
+                               slope=slope if opt.friction_damping else None, prestress=opt.prestress,
+                               gyroscopic=opt.gyroscopic, material=opt.material_damping)
+        modes = solve_system(lin.system, f_min=band[0], f_max=band[1], n_modes=n_modes, target=target,
+                             method=opt.method, basis=opt.basis)
+        effect = prestress_effect(modes, lin.system, lin.K_sigma) if lin.K_sigma is not None else None
+        for A in (lin.system.M, lin.system.C, lin.system.H, lin.K_sigma):
+            if A is not None:
+                A.destroy()
+    with io.stage("strain energy per component"):
+        shares = strain_energy_shares(modes, RegionEnergy(mech)) if energy else None
     return SquealCase(name, pre, modes, stability_report(modes, rtol, close_tol), shares,
                       mech.contact.facet_pressure(), mech, effect, lin.terms)
 
@@ -144,8 +148,10 @@ def build_squeal_mechanics(scene, tm, *, degree: int = SQUEAL_DEGREE, prefix: st
     model = model_scene(scene)
     rough = build_rough_interface(model, tm) if scene.has("roughness") else None
     if rough is not None:
-        rough.update_laws()
-    mech = build_mechanics(model, tm, law=rough.law if rough else None, degree=degree, prefix=prefix)
+        with io.stage("zone laws"):
+            rough.update_laws()
+    with io.stage("model set-up"):       # function spaces, forms compiled (cached after the first run)
+        mech = build_mechanics(model, tm, law=rough.law if rough else None, degree=degree, prefix=prefix)
     if rough is not None:            # Newton starts at rest from the rigid datum gap
         tm.interface.set_field(mech.contact.initial_gap, rough.datum_gap(interface_forces(model, tm)))
     return mech
@@ -200,26 +206,32 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         raise InputError("effects", sorted(scene.effects), 'the squeal analysis needs effect "stability"')
     io.abort_on_exception(comm)
     folder = prepare_folder(scene, overwrite, False, comm)
-    tm = build_mesh(scene, comm)
+    with io.stage("meshing"):
+        tm = build_mesh(scene, comm)
     case = analyse(scene, tm, degree=degree)
-    files = [case.modes.write_csv(folder / "modes.csv")] if comm.rank == 0 else []
-    files += write_modes_xdmf(folder / "modes.xdmf", case.modes, case.mech.u)
-    split = energy_split(tm)
-    if comm.rank == 0:
-        files += [plot_pressure(tm.interface.midpoints, tm.interface.masks(), case.facet_pressure, case.name,
-                                folder / "pressure.png"),
-                  plot_re_im([case], folder / "re_im.png"),
-                  plot_energy(case, folder / "energy.png", split)]
-        if case.prestress is not None:
-            files.append(write_prestress_csv(case.prestress, folder / "prestress.csv"))
+    with io.stage("writing results"):
+        plan = outputs.plan(scene)
+        files = [case.modes.write_csv(folder / "modes.csv")] if comm.rank == 0 else []
+        files += write_state(folder, case.mech, plan.body_fields + plan.interface_fields)
+        files += write_modes(folder, case.modes, case.mech.u, [b.name for b in tm.bodies])
+        split = energy_split(tm)
+        if comm.rank == 0:
+            files += [plot_pressure(tm.interface.midpoints, tm.interface.masks(), case.facet_pressure, case.name,
+                                    folder / "pressure.png"),
+                      plot_re_im([case], folder / "re_im.png"),
+                      plot_energy(case, folder / "energy.png", split)]
+            if case.prestress is not None:
+                files.append(write_prestress_csv(case.prestress, folder / "prestress.csv"))
+        comm.barrier()
     smap = None
     if scene.stability.sweep is not None:
-        smap = squeal_map.stability_map(scene, tm, case.mech, squeal_options(scene, tm),
-                                        drive(model_scene(scene), tm).load,
-                                        lambda changed: build_squeal_mechanics(changed, tm, degree=degree,
-                                                                               prefix="squeal_map_"))
-        files += squeal_map.write(smap, folder, comm)
-    comm.barrier()
+        with io.stage("stability map"):
+            smap = squeal_map.stability_map(scene, tm, case.mech, squeal_options(scene, tm),
+                                            drive(model_scene(scene), tm).load,
+                                            lambda changed: build_squeal_mechanics(changed, tm, degree=degree,
+                                                                                   prefix="squeal_map_"))
+            files += squeal_map.write(smap, folder, comm)
+        comm.barrier()
     result = SquealResult(folder, files, time.perf_counter() - t0, case, smap)
     if verbose and comm.rank == 0:
         rep = case.report

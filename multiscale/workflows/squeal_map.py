@@ -40,7 +40,7 @@ from multiscale.macro.preload import linearise_system, preload
 from multiscale.macro.stability_map import MapBuilder, StabilityMap
 from multiscale.plots.squeal import plot_map, plot_tracks
 from multiscale.schema import FrozenMap
-from multiscale.scene_sections import SWEEP_PARAMETERS
+from multiscale.scene_stability import SWEEP_PARAMETERS
 
 UNITS = SWEEP_PARAMETERS          # swept parameter -> unit
 

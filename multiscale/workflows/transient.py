@@ -3,7 +3,8 @@ without ``roughness`` or ``stability``.
 
 Builds the model (``workflows.model``), ramps the load, marches ``time.steps`` macro steps of
 ``time.substeps`` sub-steps (only with effect ``thermal``; otherwise the one contact solve), and
-writes ``history.h5``, ``history.png`` and the XDMF fields into ``output.folder``.
+writes ``history.h5``, ``history.png`` and the field files (``multiscale.outputs.plan``) into
+``output.folder``.
 """
 from __future__ import annotations
 
@@ -13,10 +14,10 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from multiscale import io
+from multiscale import io, outputs
 from multiscale.macro.output import FieldOutput
 from multiscale.plots.history import history_figure
-from multiscale.workflows.model import build_model
+from multiscale.workflows.model import build_mesh, build_model
 from multiscale.workflows.output import RunResult, prepare_folder
 
 
@@ -45,19 +46,25 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     start = _time.perf_counter()
     io.abort_on_exception(comm)
     folder = prepare_folder(scene, overwrite, False, comm)
-    model = build_model(scene, comm)
-    model.start()
-    writer = FieldOutput(model, folder, scene.output.fields)
+    with io.stage("meshing"):
+        tm = build_mesh(scene, comm)
+    with io.stage("first contact solve"):
+        model = build_model(scene, comm, tm=tm)
+        model.start()
+    plan = outputs.plan(scene)
+    writer = FieldOutput(model, folder, plan.body_fields + plan.interface_fields)
     history = io.History()
     history.append(**model.record())
     writer.write()
     steps = scene.time.steps if model.thermal is not None else 0
-    for n in io.progress(range(1, steps + 1), comm, desc=f"{scene.name}", unit="step"):
-        heat = model.macro_step(scene.time.dt, scene.time.substeps)
-        history.append(**model.record(heat))
-        if n % scene.output.every == 0 or n == steps:
-            writer.write()
-    h5, png = write_history(history, folder, scene.name, comm)
+    with io.stage("macro steps"):
+        for n in io.bar(range(1, steps + 1), "macro steps"):
+            heat = model.macro_step(scene.time.dt, scene.time.substeps)
+            history.append(**model.record(heat))
+            if n % scene.output.every == 0 or n == steps:
+                writer.write()
+    with io.stage("writing history and plots"):
+        h5, png = write_history(history, folder, scene.name, comm)
     result = TransientResult(folder, writer.files + [h5, png], _time.perf_counter() - start, history, h5, png,
                              writer.files)
     if verbose and comm.rank == 0:

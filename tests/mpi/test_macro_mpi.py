@@ -1,4 +1,5 @@
 """Two MPI ranks give the same pin-on-disc history as one (run: mpiexec -n 2 python -m pytest tests/mpi)."""
+import json
 from pathlib import Path
 
 import numpy as np
@@ -6,8 +7,10 @@ import pytest
 
 pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
+import h5py  # noqa: E402
 from mpi4py import MPI  # noqa: E402
 
+from multiscale.outputs import plan  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 
@@ -47,3 +50,17 @@ def test_two_ranks_give_the_serial_history(tmp_path):
     assert parallel["interface_force"] == pytest.approx(200.0, rel=1e-6)
     for key, values in serial.items():
         np.testing.assert_allclose(parallel[key], values, rtol=1e-8, atol=1e-8, err_msg=key)
+    # the field files: the same mesh (rank-independent order), values and times; exactly the plan
+    if world.rank == 0:
+        p = plan(scene(f"{base}/parallel"))
+        assert sorted(f.name for f in Path(f"{base}/parallel").iterdir()) == sorted(p.files)
+        for name in p.field_files:
+            h5 = Path(name).with_suffix(".h5").name
+            with h5py.File(f"{base}/parallel/{h5}", "r") as a, h5py.File(f"{base}/serial/{h5}", "r") as b:
+                assert list(a["times"][...]) == list(b["times"][...]) == list(p.times)
+                np.testing.assert_array_equal(a["mesh/geometry"][...], b["mesh/geometry"][...])
+                for k in a["data"]:
+                    for field in a[f"data/{k}"]:
+                        x, y = a[f"data/{k}/{field}"][...], b[f"data/{k}/{field}"][...]
+                        np.testing.assert_allclose(x, y, rtol=1e-7, atol=1e-9 * np.abs(y).max(), err_msg=field)
+        assert json.loads(Path(f"{base}/parallel/provenance.json").read_text())["ranks"] == 2

@@ -1,0 +1,183 @@
+"""Preconditioned constrained conjugate gradients for FFT-BEM normal contact (a chunk of patches).
+
+The method is the bound-constrained CG (BCCG) of Vollebregt (2014), "A new solver for the
+elastic normal contact problem using conjugate gradients, deflation, and an FFT-based
+preconditioner", J. Comput. Phys. 257, 333–351: the Polonsky–Keer (1999) iteration on the free
+set with an FFT-based preconditioner M = L⁻¹ (the inverse of the influence operator on the FFT
+grid, ``InfluenceOperator.inverse_spectrum``) and the force balance kept by projecting the
+gradient and the directions on Σ p = const over the free set (the deflation of the total force).
+The details here:
+
+- free set F = contact cells (p > 0) and cells with p = 0 and a negative gap; cells leave by the
+  projection p <- max(p - tau t, 0) and enter along the preconditioned direction;
+- preconditioner Eᵀ M E: the residual r on F is extended by E into two rings of gap cells around
+  F (each ring gamma_k times the mean of its neighbours in the ring inside) before M and folded
+  back by Eᵀ. M restricted to F (zero extension) over-estimates the stiffness of contact spots
+  next to narrow gaps and of their edges: the exact inverse (L_FF)⁻¹ is the Schur complement
+  E*ᵀ M E* with E* the displacement of the gap cells, which E imitates. On the self-affine
+  benchmark surfaces at N = 1024 the condition number on the final contact set drops from 8.1
+  to 4.1 (it grows like log² N either way, as for operator preconditioning on screens). Any E
+  keeps Eᵀ M E symmetric positive definite, so the discrete answer is that of Polonsky–Keer;
+- Polak–Ribière(+) factors (conjugacy survives small changes of F), restart when t is not a
+  descent direction;
+- two FFT pairs per iteration: Y = M E r, and L t, whose inverse transform is also the update of
+  u = L p: (t, L t) comes from Parseval, the clipped amounts X of the projection are transformed
+  forward only when there are some (then 2.5 pairs), and u <- u + L(-tau t + X) stays exact.
+
+The start is nested (``ContactSolver.coarse_start``). Stopping criterion: eps = ||s|| / ||p|| <=
+tol, with s = Eᵀ M E r the preconditioned residual over F, i.e. the pressure correction that M
+predicts: an estimate of the relative L2 error of the pressure (it was 0.3-0.7 times the true
+error on the benchmark surfaces), free of units (a flat punch stops where a rough patch does).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from multiscale.micro import bccg_steps
+from multiscale.micro.kernels import ConvolutionWorkspace, InfluenceOperator
+
+GAMMAS = np.array([0.6, 0.3])   # extension factors of the rings 1, 2 around the free set
+REFRESH = 50                           # iterations between exact recomputations of u = L p
+
+
+class Scratch:
+    """Buffers of one chunk of B patches (reused between solves of the same chunk size); the
+    per-cell ones flattened to (B, ny * nx), see ``bccg_steps``."""
+
+    def __init__(self, operator: InfluenceOperator, B: int, threads: int | None = None):
+        ny, nx = operator.shape
+        N = ny * nx
+        self.ws: ConvolutionWorkspace = operator.workspace((B,), threads)
+        self.W = np.zeros_like(self.ws.fft.spectrum)
+        self.X = self.ws.load_buffer.reshape(B, -1)            # flat views of the FFT buffers
+        self.Y = self.ws.response_buffer.reshape(B, -1)
+        self.label = np.full((B, N), -1, dtype=np.int8)
+        self.count = np.zeros((B, N), dtype=np.int8)
+        self.fi, self.fj, self.bi, self.bj = (np.zeros((B, N), dtype=np.int32) for _ in range(4))
+        self.ring_end = np.zeros((B, len(GAMMAS)), dtype=np.int64)
+        self.r, self.s, self.s_old, self.t = (np.zeros((B, N)) for _ in range(4))
+
+    def clear(self) -> None:
+        """Zero every buffer (after a failed solve)."""
+        self.ws.clear()
+        for a in (self.W, self.r, self.s, self.s_old, self.t):
+            a[...] = 0.0
+        self.label[...] = -1
+
+
+def exact_displacement(operator: InfluenceOperator, ws: ConvolutionWorkspace, p: np.ndarray, u: np.ndarray,
+                       which: np.ndarray) -> None:
+    """u = L p on the patches ``which`` (p, u: (B, ny, nx); one batched FFT pair); the FFT input
+    is left zeroed."""
+    ny, nx = operator.shape
+    ws.load_buffer[...] = 0.0
+    ws.load_buffer[which, :ny, :nx] = p[which]
+    ws.apply()
+    u[which] = ws.response_buffer[which, :ny, :nx]
+    ws.load_buffer[...] = 0.0
+
+
+def estimate(operator: InfluenceOperator, work: Scratch, z, p, u, target, delta, which) -> tuple:
+    """The stopping criterion of ``run`` for a state (p, u = L p; (B, ny, nx)) of the patches
+    ``which``, without a pressure bound: (eps, d) per patch (one FFT pair; eps = inf elsewhere)."""
+    B, ny, nx = z.shape
+    Fx = operator.fft_shape[1]
+    z2, p2, u2 = (np.ascontiguousarray(a).reshape(B, ny * nx) for a in (z, p, u))
+    load_control = target is not None
+    delta = np.ascontiguousarray(np.zeros(B) if delta is None else delta, dtype=float)
+    d, pnorm, eps, csum = np.zeros(B), np.zeros(B), np.full(B, np.inf), np.zeros(B)
+    nf, ccount, fixed = (np.zeros(B, dtype=np.int64) for _ in range(3))
+    upper = np.full(B, np.inf)
+    work.X[...] = 0.0
+    bccg_steps.contact_sums(p2, u2, z2, upper, which, ccount, csum, pnorm)
+    bccg_steps.free_set(u2, z2, p2, delta, load_control, which, ccount, csum, d, work.label, work.fi, work.fj, nf,
+                        work.r, work.s_old, work.t, work.X, upper, fixed, nx, Fx)
+    bccg_steps.extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, work.X, GAMMAS,
+                      operator.periodic, which, ny, nx, Fx)
+    work.ws.apply(operator.inverse_multiplier)
+    bccg_steps.back_extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, work.Y,
+                           work.s, GAMMAS, operator.periodic, work.X, load_control, which, pnorm, eps, ny, nx, Fx)
+    work.X[...] = 0.0
+    return eps, d
+
+
+def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray, u: np.ndarray, target, delta,
+        tol: float, max_iter: int, history: list, upper=None) -> dict:
+    """Iterate on the chunk (z, p, u: (B, ny, nx) contiguous; p the feasible start, balanced under
+    load control: ``target`` the mean pressures, else ``delta`` the approaches; ``upper`` the
+    pressure bounds H (B,), None: elastic). p and u (= L p) are updated in place; returns d,
+    iterations, residual (eps), converged; ``history`` gets the largest eps per iteration."""
+    B, ny, nx = z.shape
+    N, Fx = ny * nx, operator.fft_shape[1]
+    ws = work.ws
+    X, Y, S, W = work.X, work.Y, ws.fft.spectrum, work.W
+    lmul, mmul = operator.multiplier, operator.inverse_multiplier
+    load_control = target is not None
+    target = np.ascontiguousarray(np.zeros(B) if target is None else target, dtype=float)
+    delta = np.ascontiguousarray(np.zeros(B) if delta is None else delta, dtype=float)
+    z2, p2, u2 = z.reshape(B, N), p.reshape(B, N), u.reshape(B, N)    # views
+    active = np.ones(B, dtype=bool)
+    d, pending, pnorm, eps, rt, tau, rho_old, csum, factor = (np.zeros(B) for _ in range(9))
+    pending[:] = 1.0
+    eps[:] = np.inf
+    nf, ccount, fixed = (np.zeros(B, dtype=np.int64) for _ in range(3))
+    upper = np.ascontiguousarray(np.full(B, np.inf) if upper is None else upper, dtype=float)
+    conj, clipped, lost = (np.zeros(B, dtype=bool) for _ in range(3))
+    iterations = np.zeros(B, dtype=int)
+    periodic = operator.periodic
+    work.label[...] = -1                     # no free set and no history yet
+    work.s_old[...] = 0.0
+    work.t[...] = 0.0
+
+    def exact(which):                        # u = L p and the contact sums on the patches ``which``
+        exact_displacement(operator, ws, p, u, which)
+        bccg_steps.contact_sums(p2, u2, z2, upper, which, ccount, csum, pnorm)
+
+    exact(active)
+    since = 0
+    while True:
+        bccg_steps.free_set(u2, z2, p2, delta, load_control, active, ccount, csum, d, work.label, work.fi, work.fj,
+                            nf, work.r, work.s_old, work.t, X, upper, fixed, nx, Fx)
+        bccg_steps.extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, X, GAMMAS,
+                          periodic, active, ny, nx, Fx)
+        ws.fft.forward()
+        bccg_steps.precondition(S, mmul)
+        ws.fft.inverse(normalise=False)
+        bccg_steps.back_extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, Y,
+                               work.s, GAMMAS, periodic, X, load_control, active, pnorm, eps, ny, nx, Fx)
+        top, left, bad = bccg_steps.check(eps, tol, iterations, max_iter, active, X)
+        if bad:
+            raise FloatingPointError("non-finite residual")
+        history.append(top)
+        if not left:
+            break
+        bccg_steps.direction(work.fi, work.fj, nf, work.r, work.s, work.s_old, work.t, X, load_control, active, conj,
+                             rho_old, rt, iterations, nx, Fx)
+        ws.fft.forward()
+        if not bccg_steps.step_length(S, lmul, Fx, rt, active, tau):          # S <- L T
+            raise FloatingPointError("non-finite step length")
+        clipped_any, lost_any = bccg_steps.update_pressure(p2, work.t, work.fi, work.fj, nf, tau, X, active,
+                                                           load_control, target, pending, clipped, lost, upper,
+                                                           fixed, nx, Fx)
+        if clipped_any:                      # u += L(-tau t + clipped amounts): one more forward FFT
+            np.copyto(W, S)
+            ws.fft.forward()
+            bccg_steps.combine_spectrum(S, W, lmul, tau, active)
+            factor.fill(1.0)
+        else:                                # u += -tau L t
+            np.negative(tau, out=factor)
+        ws.fft.inverse(normalise=False)
+        bccg_steps.add_response(u2, Y, factor, p2, z2, work.fi, work.fj, nf, pending, active, ccount, csum, pnorm,
+                                upper, fixed, nx, Fx)
+        since += 1
+        if lost_any:                         # every cell left the contact: restart from the top
+            for b in np.flatnonzero(lost):
+                top = (z[b] == 0).astype(float)
+                p[b] = top * (target[b] / top.mean())
+            conj[lost] = False
+            exact(lost)
+        elif since >= REFRESH:               # bound the round-off drift of the updates of u
+            exact(active)
+            since = 0
+    converged = eps <= tol
+    return dict(d=d, iterations=iterations, residual=eps, converged=converged)

@@ -1,0 +1,453 @@
+"""Compiled (numba) loops of one preconditioned constrained CG iteration (``bccg_solver``).
+
+Arrays of a chunk of B patches on a grid (ny, nx), flattened to (B, ny * nx): ``p``, ``u``, ``z``
+[Pa, m, m], ``label`` and the work vectors; the FFT buffers ``X`` (input), ``Y`` (output) are
+(B, Fy * Fx) with Fy, Fx >= ny, nx (cell (i, j) at i * Fx + j, zero padding beyond); the
+spectra ``S``, ``W`` (B, Fy, Fx // 2 + 1). Free set F: contact cells (p > 0) and cells with
+p = 0 and a negative gap (they may enter). ``label`` marks F (0), the rings 1..R of gap cells
+around it into which the residual is extended (k), and the other cells (-1); ``fi``/``fj`` and
+``bi``/``bj`` list the rows and columns of the cells of F and of the rings (ring by ring,
+``ring_end``), so that the sweeps over them need no integer division.
+
+Bounded pressure 0 <= p <= H (``upper``, H per patch; +inf: elastic, then every loop computes
+exactly what it computes without the bound): the contact cells are then the elastic ones (0 < p
+< H) and the saturated ones (p = H, plastic flow, gap <= 0). F adds the saturated cells with a
+gap >= 0 (they may leave the bound); the other saturated cells are held at H (``fixed`` counts
+them) like the cells with p = 0 and a gap >= 0 are held at 0. See ``bounded_update``.
+"""
+from __future__ import annotations
+
+import numpy as np
+from numba import njit
+
+_FAST = {"reassoc", "contract", "nsz"}   # reductions may be reordered (vectorised); no NaN/inf tricks
+
+
+@njit(cache=True, fastmath=_FAST, nogil=True)
+def contact_sums(p, u, z, upper, active, ccount, csum, pnorm):
+    """Per active patch: elastic contact cells (0 < p < H), their Σ (u + z), and ||p||²."""
+    B, N = p.shape
+    for b in range(B):
+        if not active[b]:
+            continue
+        n, sc, pp, H = 0, 0.0, 0.0, upper[b]
+        for f in range(N):
+            q = p[b, f]
+            pp += q * q
+            if q > 0.0 and q < H:
+                n += 1
+                sc += u[b, f] + z[b, f]
+        ccount[b], csum[b], pnorm[b] = n, sc, pp
+
+
+@njit(cache=True, fastmath=_FAST, nogil=True)
+def free_set(u, z, p, delta, load_control, active, ccount, csum, d, label, fi, fj, nf, r, s_old, t, X, upper, fixed,
+             nx, Fx):
+    """Per active patch: the approach ``d`` (load control: mean of u + z on the elastic contact,
+    from ``contact_sums``; with none but saturated cells, their largest u + z; else ``delta``),
+    the free set F (``label`` 0, listed in ``fi``/``fj``/``nf``; ``fixed`` the cells held at H),
+    the residual r = g = u + z - d on F (mean-free on F under load control: the gradient
+    projected on Σ p = const) and X = r on F. X, ``s_old`` and ``t`` are zeroed on the cells that
+    left F (a cell entering F starts without history); elsewhere X is zero already (it held the
+    clipped amounts, on F, since ``update_pressure``; ``back_extend`` cleared the rings) and r
+    is never read."""
+    B, N = p.shape
+    ny = N // nx
+    for b in range(B):
+        if not active[b]:
+            continue
+        H = upper[b]
+        db = (csum[b] / ccount[b] if ccount[b] > 0 else 0.0) if load_control else delta[b]
+        if load_control and ccount[b] == 0 and H < np.inf:
+            db = saturated_top(u[b], z[b], p[b], H)
+        d[b] = db
+        k, sf, nfix = 0, 0.0, 0
+        for i in range(ny):
+            for j in range(nx):
+                f = i * nx + j
+                g = u[b, f] + z[b, f] - db
+                q = p[b, f]
+                held = q >= H and g < 0.0
+                nfix += held
+                if (q > 0.0 or g < 0.0) and not held:
+                    label[b, f] = 0
+                    fi[b, k], fj[b, k] = i, j
+                    k += 1
+                    r[b, f] = g
+                    X[b, i * Fx + j] = g
+                    sf += g
+                elif label[b, f] != -1:
+                    if label[b, f] == 0:
+                        X[b, i * Fx + j] = 0.0
+                        s_old[b, f] = 0.0
+                        t[b, f] = 0.0
+                    label[b, f] = -1
+        nf[b] = k
+        fixed[b] = nfix
+        if load_control and k > 0:
+            mean = sf / k
+            for m in range(k):
+                i, j = fi[b, m], fj[b, m]
+                r[b, i * nx + j] -= mean
+                X[b, i * Fx + j] -= mean
+
+
+@njit(cache=True, nogil=True)
+def saturated_top(u, z, p, H):
+    """Largest u + z over the saturated cells (p >= H) of one patch (flat arrays), 0 if none:
+    the approach under load control when no cell is in elastic contact (fully plastic)."""
+    top, found = 0.0, False
+    for f in range(p.shape[0]):
+        if p[f] >= H:
+            v = u[f] + z[f]
+            if not found or v > top:
+                top, found = v, True
+    return top
+
+
+@njit(cache=True, inline="always")
+def _wrap(i, n, periodic):
+    """Index i along an axis of n cells: wrapped around (periodic) or -1 outside."""
+    if 0 <= i < n:
+        return i
+    if not periodic:
+        return -1
+    return i + n if i < 0 else i - n
+
+
+@njit(cache=True, inline="always")
+def _neighbours(i0, j0, ny, nx, periodic, out):
+    """Flat indices (i * nx + j) of the cells of the 3 x 3 block around (i0, j0), itself included,
+    into ``out``; returns how many (wrapped around a periodic grid, cut at a non-periodic edge)."""
+    n = 0
+    for di in range(-1, 2):
+        i = _wrap(i0 + di, ny, periodic)
+        for dj in range(-1, 2):
+            j = _wrap(j0 + dj, nx, periodic)
+            if i >= 0 and j >= 0:
+                out[n] = i * nx + j
+                n += 1
+    return n
+
+
+@njit(cache=True, nogil=True)
+def extend(label, fi, fj, nf, bi, bj, ring_end, count, X, gammas, periodic, active, ny, nx, Fx):
+    """X = E r on the physical grid (X holds r on F from ``free_set``): ring by ring
+    (8-neighbourhood), gamma_k times the mean of the values of the neighbouring cells of ring
+    k - 1. Builds the rings (``label`` k, ``bi``/``bj``/``ring_end``) and ``count``, the
+    neighbours of each ring cell in the ring inside it."""
+    B = label.shape[0]
+    R = gammas.shape[0]
+    near = np.empty(9, dtype=np.int64)
+    for b in range(B):
+        if not active[b]:
+            continue
+        k = 0
+        for ring in range(1, R + 1):
+            lo = 0 if ring <= 2 else ring_end[b, ring - 3]
+            hi = nf[b] if ring == 1 else ring_end[b, ring - 2]
+            new = k
+            for m in range(lo, hi):            # scatter the values of ring - 1 to their neighbours
+                i0, j0 = (fi[b, m], fj[b, m]) if ring == 1 else (bi[b, m], bj[b, m])
+                v = X[b, i0 * Fx + j0]
+                for e in range(_neighbours(i0, j0, ny, nx, periodic, near)):
+                    g = near[e]
+                    lg = label[b, g]
+                    if lg == -1 or lg == ring:
+                        i, j = g // nx, g - (g // nx) * nx
+                        if lg == -1:
+                            label[b, g] = ring
+                            bi[b, k], bj[b, k] = i, j
+                            k += 1
+                            count[b, g] = 1
+                            X[b, i * Fx + j] = v
+                        else:
+                            count[b, g] += 1
+                            X[b, i * Fx + j] += v
+            ring_end[b, ring - 1] = k
+            gam = gammas[ring - 1]
+            for m in range(new, k):
+                i, j = bi[b, m], bj[b, m]
+                X[b, i * Fx + j] *= gam / count[b, i * nx + j]
+
+
+@njit(cache=True, fastmath=_FAST, nogil=True)
+def back_extend(label, fi, fj, nf, bi, bj, ring_end, count, Y, s, gammas, periodic, X, load_control, active, pnorm,
+                eps, ny, nx, Fx):
+    """From Y = M E r: the preconditioned residual s = E^T Y on F (mean-free on F under load
+    control; ``s`` is scratch on the rings, whose cells are cleared from X), and the error
+    estimate ``eps`` = ||s|| / ||p||, the relative L2 error of the pressure when the
+    preconditioner is exact (0 when s = 0)."""
+    B = label.shape[0]
+    R = gammas.shape[0]
+    near = np.empty(9, dtype=np.int64)
+    for b in range(B):
+        if not active[b]:
+            continue
+        k = ring_end[b, R - 1]
+        n = nf[b]
+        total = 0.0                            # Σ_F s, for the mean
+        for m in range(k):
+            i, j = bi[b, m], bj[b, m]
+            s[b, i * nx + j] = Y[b, i * Fx + j]
+            X[b, i * Fx + j] = 0.0
+        for m in range(n):
+            i, j = fi[b, m], fj[b, m]
+            v = Y[b, i * Fx + j]
+            s[b, i * nx + j] = v
+            total += v
+        for ring in range(R, 0, -1):           # adjoint of ``extend``: outermost ring first
+            first = 0 if ring == 1 else ring_end[b, ring - 2]
+            gam = gammas[ring - 1]
+            for m in range(first, ring_end[b, ring - 1]):
+                i0, j0 = bi[b, m], bj[b, m]
+                g0 = i0 * nx + j0
+                v = s[b, g0] * gam / count[b, g0]
+                for e in range(_neighbours(i0, j0, ny, nx, periodic, near)):
+                    g = near[e]
+                    if label[b, g] == ring - 1:
+                        s[b, g] += v
+                        if ring == 1:
+                            total += v
+        mean = total / n if load_control and n > 0 else 0.0
+        ss = 0.0
+        for m in range(n):
+            g = fi[b, m] * nx + fj[b, m]
+            v = s[b, g] - mean
+            s[b, g] = v
+            ss += v * v
+        eps[b] = np.sqrt(ss / pnorm[b]) if pnorm[b] > 0.0 else (0.0 if ss == 0.0 else np.inf)
+
+
+@njit(cache=True, nogil=True)
+def check(eps, tol, iterations, max_iter, active, X):
+    """Stopping test after ``back_extend``: patches with eps <= tol, or at ``max_iter``, leave
+    ``active`` (their FFT input is zeroed). Returns (largest eps of the patches that were
+    active, patches still active, non-finite eps found)."""
+    B = eps.shape[0]
+    top, left, bad = 0.0, 0, False
+    for b in range(B):
+        if not active[b]:
+            continue
+        e = eps[b]
+        if not np.isfinite(e):
+            bad = True
+        top = max(top, e)
+        if e <= tol or iterations[b] >= max_iter:
+            active[b] = False
+            X[b] = 0.0
+        else:
+            left += 1
+    return top, left, bad
+
+
+@njit(cache=True, fastmath=_FAST, nogil=True)
+def direction(fi, fj, nf, r, s, s_old, t, X, load_control, active, conj, rho_old, rt, iterations, nx, Fx):
+    """New direction t = s + beta t on F with the Polak–Ribière(+) factor (beta = 0 when
+    ``conj`` is False, then set; restart from s when t is not a descent direction), mean-free on F
+    under load control; (r, t) in ``rt``; X = t on F (zero elsewhere after ``back_extend``);
+    s_old = s; one more iteration counted."""
+    B = r.shape[0]
+    for b in range(B):
+        if not active[b]:
+            continue
+        n = nf[b]
+        rho, mixed = 0.0, 0.0
+        for m in range(n):
+            g = fi[b, m] * nx + fj[b, m]
+            rho += r[b, g] * s[b, g]
+            mixed += r[b, g] * s_old[b, g]
+        beta = max(0.0, (rho - mixed) / rho_old[b]) if conj[b] and rho_old[b] > 0.0 else 0.0
+        rho_old[b] = rho
+        tm = 0.0
+        for m in range(n):
+            g = fi[b, m] * nx + fj[b, m]
+            v = s[b, g]
+            s_old[b, g] = v
+            w = v + beta * t[b, g]
+            t[b, g] = w
+            tm += w
+        tm = tm / n if load_control and n > 0 else 0.0
+        dot = 0.0
+        for m in range(n):
+            i, j = fi[b, m], fj[b, m]
+            g = i * nx + j
+            w = t[b, g] - tm
+            t[b, g] = w
+            X[b, i * Fx + j] = w
+            dot += r[b, g] * w
+        if beta > 0.0 and not dot > 0.0:      # not a descent direction: restart from s
+            dot = 0.0
+            for m in range(n):
+                i, j = fi[b, m], fj[b, m]
+                g = i * nx + j
+                w = s_old[b, g]
+                t[b, g] = w
+                X[b, i * Fx + j] = w
+                dot += r[b, g] * w
+        rt[b] = dot
+        conj[b] = True
+        iterations[b] += 1
+
+
+@njit(cache=True, fastmath=_FAST, nogil=True)
+def precondition(S, mmul):
+    """S *= M (the preconditioner's transfer function / (Fy Fx)) on every patch."""
+    B, Fy, Fh = S.shape
+    for b in range(B):
+        for i in range(Fy):
+            for j in range(Fh):
+                S[b, i, j] *= mmul[i, j]
+
+
+@njit(cache=True, fastmath=_FAST, nogil=True)
+def step_length(S, lmul, Fx, rt, active, tau):
+    """S (the rfft2 of t on a real grid of width Fx) <- L T, and tau = (r, t) / (t, L t) per
+    patch with (t, L t) = Σ_k lmul_k |T_k|² over the full spectrum (Parseval; lmul is the real
+    transfer function / (Fy Fx)). Returns whether every tau is finite."""
+    B, Fy, Fh = S.shape
+    for b in range(B):
+        acc = 0.0
+        for i in range(Fy):
+            for j in range(Fh):
+                w = 1.0 if j == 0 or 2 * j == Fx else 2.0
+                v = S[b, i, j]
+                acc += w * lmul[i, j] * (v.real * v.real + v.imag * v.imag)
+                S[b, i, j] = lmul[i, j] * v
+        tau[b] = rt[b] / acc if active[b] and acc > 0.0 else 0.0
+    return np.all(np.isfinite(tau))
+
+
+@njit(cache=True, fastmath=_FAST, nogil=True)
+def update_pressure(p, t, fi, fj, nf, tau, X, active, load_control, target, pending, clipped, lost, upper, fixed,
+                    nx, Fx):
+    """p <- max(p - tau t, 0) on F (cells outside F keep p = 0); X = the clipped amount
+    (p_new - (p - tau t) >= 0) on F, so that L(p_new - p) = L(-tau t + X); under load control
+    the factor restoring the mean pressure goes to ``pending`` (applied to p and u next).
+    Patches with a finite bound H take ``bounded_update`` instead.
+    Returns the numbers of patches with clipped cells and of patches that lost every contact."""
+    B, N = p.shape
+    nclip, nlost = 0, 0
+    for b in range(B):
+        clipped[b], lost[b] = False, False
+        if not active[b]:
+            continue
+        if upper[b] < np.inf:
+            rest = max(target[b] * N - upper[b] * fixed[b], 0.0)
+            clipped[b] = bounded_update(p[b], t[b], fi[b], fj[b], nf[b], tau[b], X[b], upper[b], load_control, rest,
+                                        nx, Fx)
+            nclip += clipped[b]
+            continue
+        tb, total = tau[b], 0.0
+        for m in range(nf[b]):
+            i, j = fi[b, m], fj[b, m]
+            g = i * nx + j
+            q = p[b, g] - tb * t[b, g]
+            if q < 0.0:
+                X[b, i * Fx + j] = -q
+                clipped[b] = True
+                q = 0.0
+            else:
+                X[b, i * Fx + j] = 0.0
+            p[b, g] = q
+            total += q
+        if load_control:
+            if total > 0.0:
+                pending[b] = target[b] * N / total
+            else:
+                lost[b] = True
+        nclip += clipped[b]
+        nlost += lost[b]
+    return nclip, nlost
+
+
+@njit(cache=True, fastmath=_FAST, nogil=True)
+def bounded_update(p, t, fi, fj, n, tau, X, H, load_control, rest, nx, Fx):
+    """One patch (flat arrays) with the bound H: p <- P(p - tau t) on F, P the Euclidean
+    projection on {0 <= p <= H; Σ_F p = ``rest``} under load control (``rest``: the load less
+    what the cells held at H carry), i.e. p = clip(q + a, 0, H) with the shift a found by a
+    safeguarded Newton search on the piecewise-linear Σ clip(q + a) (exact on the final linear
+    piece); the box alone under displacement control. The bound is the hardness cut-off of
+    Almqvist et al. (2007, Tribol. Int. 40, 574-579), also ContactMechanics'
+    ``constrained_conjugate_gradients(hardness=...)``; the load is kept by the shift (the exact
+    projection) instead of a rescaling, which would push saturated cells above H.
+    X = p_new - (p - tau t) on F, as in ``update_pressure``. Returns whether any X is nonzero."""
+    for m in range(n):                          # X <- q = p - tau t (unbounded step)
+        i, j = fi[m], fj[m]
+        X[i * Fx + j] = p[i * nx + j] - tau * t[i * nx + j]
+    a = 0.0
+    if load_control:
+        qmin, qmax = np.inf, -np.inf
+        for m in range(n):
+            v = X[fi[m] * Fx + fj[m]]
+            qmin, qmax = min(qmin, v), max(qmax, v)
+        lo, hi = -qmax, H - qmin                # phi(lo) = -rest <= 0 <= phi(hi) = n H - rest
+        for _ in range(200):
+            phi, slope = -rest, 0
+            for m in range(n):
+                v = X[fi[m] * Fx + fj[m]] + a
+                if v >= H:
+                    phi += H
+                elif v > 0.0:
+                    phi += v
+                    slope += 1
+            if abs(phi) <= 1e-14 * max(rest, H) or hi - lo <= 1e-15 * H:
+                break
+            if phi < 0.0:
+                lo = a
+            else:
+                hi = a
+            a = a - phi / slope if slope > 0 else 0.5 * (lo + hi)
+            if not lo < a < hi:
+                a = 0.5 * (lo + hi)
+    moved = False
+    for m in range(n):
+        i, j = fi[m], fj[m]
+        q = X[i * Fx + j]
+        v = min(max(q + a, 0.0), H)
+        p[i * nx + j] = v
+        X[i * Fx + j] = v - q
+        moved = moved or v != q
+    return moved
+
+
+@njit(cache=True, fastmath=_FAST, nogil=True)
+def combine_spectrum(S, W, lmul, tau, active):
+    """S = -tau W + L S: W holds L T, S the rfft2 of the clipped amounts; the result is the
+    spectrum of L(p_new - p) = L(-tau t + clipped)."""
+    B, Fy, Fh = S.shape
+    for b in range(B):
+        c = -tau[b]
+        for i in range(Fy):
+            for j in range(Fh):
+                S[b, i, j] = c * W[b, i, j] + lmul[i, j] * S[b, i, j] if active[b] else 0.0
+
+
+@njit(cache=True, fastmath=_FAST, nogil=True)
+def add_response(u, Y, factor, p, z, fi, fj, nf, pending, active, ccount, csum, pnorm, upper, fixed, nx, Fx):
+    """u <- c (u + factor Y) and p <- c p (p is zero off F, or H on the ``fixed`` cells, where
+    c = 1) with c the pending load-balance factor (then reset to 1), and the ``contact_sums`` of
+    the new state, on active patches."""
+    B, N = u.shape
+    ny = N // nx
+    for b in range(B):
+        if not active[b]:
+            continue
+        c, f = pending[b], factor[b]
+        pending[b] = 1.0
+        cf = c * f
+        for i in range(ny):
+            for j in range(nx):
+                u[b, i * nx + j] = c * u[b, i * nx + j] + cf * Y[b, i * Fx + j]
+        n, sc, pp, H = 0, 0.0, 0.0, upper[b]
+        for m in range(nf[b]):
+            g = fi[b, m] * nx + fj[b, m]
+            q = c * p[b, g]
+            p[b, g] = q
+            pp += q * q
+            if q > 0.0 and q < H:
+                n += 1
+                sc += u[b, g] + z[b, g]
+        if fixed[b] > 0:
+            pp += fixed[b] * H * H
+        ccount[b], csum[b], pnorm[b] = n, sc, pp

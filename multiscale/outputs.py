@@ -1,0 +1,169 @@
+"""What a run writes, known before it runs (no DOLFINx): the analysis of a scene, every file of its
+results folder with what it holds, the fields of each field file and the output times.
+
+``multiscale check`` prints this plan and the workflows write exactly it (a test runs every kind
+of analysis and compares the folder with the plan). ``FIELDS`` says what each output field is
+called in the field files and its unit; ``step_time`` keeps output times free of the drift of
+summed steps; ``paraview_script`` is the pvpython script written beside the results. Imports
+nothing heavy (``multiscale check`` uses it; so does ``multiscale.macro``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+
+# output field (scene key output.fields) -> (array name in the field files, unit)
+FIELDS = {"displacement": ("displacement", "m"), "temperature": ("temperature", "K"),
+          "von_mises": ("von Mises stress", "Pa"), "contact_pressure": ("contact pressure", "Pa"),
+          "heat_flux": ("frictional heat flux", "W/m^2"), "contact_stiffness": ("contact stiffness", "Pa/m"),
+          "partition": ("heat partition into body 0", "-"), "wear_depth": ("wear depth", "m"),
+          "flash_temperature": ("flash temperature", "K"), "counter_wear_depth": ("wear depth of body 1", "m")}
+
+
+def array_name(field: str) -> str:
+    """Name of an output field's array in the files, with its unit: "temperature [K]"."""
+    label, unit = FIELDS[field]
+    return f"{label} [{unit}]"
+
+
+def step_time(t: float, dt: float) -> float:
+    """t + dt rounded to 12 significant digits: output times stay exact decimals (12.0, not
+    11.999999999999998 after 30 steps of 0.4 s)."""
+    return float(f"{t + dt:.12g}")
+
+
+BODY_FIELDS = ("displacement", "temperature", "von_mises")
+# output fields each analysis writes (when the scene asks for them)
+WRITES = {"transient": ("displacement", "temperature", "von_mises", "contact_pressure", "heat_flux", "partition"),
+          "multiscale": tuple(FIELDS),
+          "squeal": ("displacement", "von_mises", "contact_pressure")}
+PROVENANCE = {"scene.toml": "the scene file as given",
+              "scene_resolved.toml": "the scene with every default filled in, SI units",
+              "provenance.json": "versions, command line, ranks, start and end time, wall time per stage",
+              "paraview.py": "pvpython script that opens the fields (pvpython paraview.py, or ParaView's "
+                             "Python shell)"}
+
+
+def analysis(scene) -> str:
+    """Which analysis a scene runs: "squeal" (effect stability), "multiscale" (effect roughness)
+    or "transient"."""
+    return "squeal" if scene.has("stability") else "multiscale" if scene.has("roughness") else "transient"
+
+
+def output_times(scene) -> tuple[float, ...]:
+    """Times [s] at which the fields are written: 0, then every ``output.every`` macro step and the
+    last (squeal: the preload, 0)."""
+    kind, t = analysis(scene), scene.time
+    marching = scene.has("thermal") or (kind == "multiscale" and scene.has("wear"))
+    steps = t.steps if kind != "squeal" and marching else 0
+    times, now = [0.0], 0.0
+    for n in range(1, steps + 1):
+        now = step_time(now, t.dt)
+        if n % scene.output.every == 0 or n == steps:
+            times.append(now)
+    return tuple(times)
+
+
+@dataclass(frozen=True)
+class Plan:
+    """What ``multiscale run`` writes into ``folder`` (see module docstring)."""
+
+    analysis: str
+    folder: object                  # Path
+    bodies: tuple[str, ...]
+    body_fields: tuple[str, ...]    # output fields in every <body>.xdmf
+    interface_fields: tuple[str, ...]
+    times: tuple[float, ...]        # s, of the field files
+    files: dict                     # file name -> what it holds
+    ignored: tuple[str, ...]        # requested fields this analysis does not write
+
+    @property
+    def field_files(self) -> dict:
+        """{<name>.xdmf: output fields} of the field files."""
+        out = {f"{b}.xdmf": self.body_fields for b in self.bodies} if self.body_fields else {}
+        if self.interface_fields:
+            out["interface.xdmf"] = self.interface_fields
+        return out
+
+
+def plan(scene) -> Plan:
+    """The results of a run of ``scene`` (see module docstring)."""
+    kind = analysis(scene)
+    fields = [f for f in scene.output.fields if f in WRITES[kind]]
+    body = tuple(f for f in fields if f in BODY_FIELDS)
+    iface = tuple(f for f in fields if f not in BODY_FIELDS)
+    times = output_times(scene)
+    when = "the preload" if kind == "squeal" else f"{len(times)} output time(s)"
+    files = {}
+    for name, held in [(b, body) for b in scene.bodies] + [("interface", iface)]:
+        if held:
+            files[f"{name}.xdmf"] = f"fields of {name} at {when}: {', '.join(array_name(f) for f in held)}"
+            files[f"{name}.h5"] = f"data of {name}.xdmf"
+    if kind == "squeal":
+        files["modes.csv"] = "frequency, growth rate, damping ratio and SLEPc error of every mode"
+        files.update({f"modes_{b}.bp": f"mode shapes of {b} (VTX): real and imaginary parts, time = mode number"
+                      for b in scene.bodies})
+        files["pressure.png"] = "contact pressure on each interface at the preload"
+        files["re_im.png"] = "complex eigenvalues: growth rate against frequency"
+        files["energy.png"] = "strain-energy share of each component per mode"
+    else:
+        files["history.h5"] = "scalar history per step (forces, pressures, temperatures, heat), unit per dataset"
+        files["history.png"] = "the history against time"
+    if kind == "multiscale":
+        files["checkpoint.h5"] = "the last macro step's state (multiscale run --resume)"
+        files["multiscale.png"] = "both scales of the loop against time: pressures, temperatures, partition, wear"
+        files["zones.h5"] = "final state of every zone: centre, wear depth and volume, partition, conductance"
+        if scene.has("wear"):
+            rough = scene.rough_interfaces
+            files.update({("wear_map.png" if len(rough) == 1 else f"wear_map_{n}.png"):
+                          f"wear depth over the interface {n}: per zone and the micro field" for n in rough})
+    files.update(PROVENANCE)
+    return Plan(kind, scene.output.folder, tuple(scene.bodies), body, iface, times, files,
+                tuple(f for f in scene.output.fields if f not in WRITES[kind]))
+
+
+def summary(p: Plan) -> list[str]:
+    """Lines of ``multiscale check``: the analysis, every file and the output times."""
+    times = ", ".join(f"{t:g}" for t in p.times[:6]) + (f", ... {p.times[-1]:g}" if len(p.times) > 6 else "")
+    lines = [f"  analysis  {p.analysis}", f"  writes    into {p.folder}:"]
+    lines += [f"    {name:<22}{what}" for name, what in p.files.items()]
+    if p.analysis != "squeal":
+        lines.append(f"  fields at t = {times} s")
+    if p.ignored:
+        lines.append(f"  note      output.fields {', '.join(p.ignored)}: not written by the {p.analysis} analysis")
+    return lines
+
+
+def paraview_script(p: Plan) -> str:
+    """A pvpython script that opens the results of ``p`` beside it: the bodies coloured by
+    temperature (else displacement or von Mises stress), the interface by contact pressure; for
+    the squeal analysis the mode shapes, warped."""
+    files = p.field_files
+    lines = ['"""Open these results in ParaView: pvpython paraview.py (a window), or paste into',
+             "View > Python Shell. Each .xdmf holds one mesh with every field as a named array",
+             "(unit in the name); the time slider steps through the output times.",
+             '"""', "import os", "from paraview.simple import *  # noqa: F401,F403", "",
+             "# the folder of this script (the results folder where it was written, if run without a file)",
+             f"here = os.path.dirname(os.path.abspath(__file__)) if '__file__' in globals() else {str(p.folder)!r}",
+             "view = GetActiveViewOrCreate('RenderView')", ""]
+    for name, fields in files.items():
+        var = name.split(".")[0].replace("-", "_")
+        shown = next((f for f in ("temperature", "contact_pressure", "von_mises", "displacement") if f in fields),
+                     fields[0])
+        centre = "CELLS" if shown not in ("temperature", "displacement") else "POINTS"
+        lines += [f"{var} = Xdmf3ReaderS(registrationName={name!r}, FileName=[os.path.join(here, {name!r})])",
+                  f"{var}_view = Show({var}, view)",
+                  f"ColorBy({var}_view, ({centre!r}, {array_name(shown)!r}))",
+                  f"{var}_view.SetScalarBarVisibility(view, True)", ""]
+    if p.analysis == "squeal":
+        lines += ["# mode shapes (VTX, ADIOS2 reader): time = mode number, see modes.csv for the frequencies"]
+        for b in p.bodies:
+            var = f"modes_{b}".replace("-", "_")
+            lines += [f"{var} = ADIOS2VTXReader(registrationName='modes_{b}.bp', "
+                      f"FileName=os.path.join(here, 'modes_{b}.bp'))",
+                      f"{var}_warp = WarpByVector(Input={var}, Vectors=['POINTS', "
+                      f"'mode shape real part [m/kg^0.5]'], ScaleFactor=0.01)",
+                      f"{var}_view = Show({var}_warp, view)",
+                      f"ColorBy({var}_view, ('POINTS', 'mode shape real part [m/kg^0.5]', 'Magnitude'))", ""]
+    lines += ["view.ResetCamera()", "Render()", "if __name__ == '__main__':", "    Interact()", ""]
+    return "\n".join(lines)

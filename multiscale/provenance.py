@@ -1,0 +1,200 @@
+"""Provenance of a results folder: the scene as given, the scene resolved with every default, and a
+record of the run (versions, command line, ranks, start and end, wall time per stage).
+
+``resolved_toml(scene)`` writes a validated scene back as TOML, every key the schema knows with its
+value (defaults filled in, SI numbers, the unit as a comment; temperatures as "... K" strings,
+since the scene format refuses bare temperatures): loading it gives the same scene. ``versions()``
+lists the software of the process (DOLFINx, PETSc and SLEPc when they are loaded). ``write`` puts
+``scene.toml``, ``scene_resolved.toml`` and ``provenance.json`` into a folder (rank 0).
+"""
+from __future__ import annotations
+
+import datetime
+import json
+import math
+import platform
+import sys
+from importlib import metadata
+from pathlib import Path
+
+from multiscale import __version__
+from multiscale.schema import (Choice, Curve, Either, FilePath, ListOf, Named, OnlyWith, Quantity, Section, TableOr,
+                               Tables, fields_of)
+from multiscale.scene import EFFECTS, Scene
+from multiscale.scene_geometry import FileGeometry, LengthUnit, Points
+
+LENGTH_UNITS = {1.0: "m", 1e-3: "mm", 1e-2: "cm", 1e-6: "um", 0.0254: "in", 0.3048: "ft"}
+
+
+# ------------------------------------------------------------------ the resolved scene
+def _scalar(v) -> str:
+    if isinstance(v, bool):
+        return "true" if v else "false"
+    if isinstance(v, int):
+        return str(v)
+    if isinstance(v, float):
+        return "inf" if v == math.inf else "-inf" if v == -math.inf else "nan" if math.isnan(v) else repr(v)
+    if isinstance(v, (list, tuple)):
+        return "[" + ", ".join(_scalar(x) for x in v) + "]"
+    return json.dumps(str(v), ensure_ascii=False)
+
+
+def _value(parser, v):
+    """(TOML-ready value, unit comment) of a parsed value."""
+    if isinstance(v, frozenset):
+        return [e for e in EFFECTS if e in v], ""
+    if isinstance(parser, Quantity):
+        if parser.kind.needs_unit:
+            return f"{v!r} {parser.kind.si}", ""
+        return float(v), parser.kind.si
+    if isinstance(parser, Either):
+        for p in parser.parsers:
+            if isinstance(p, Choice) and v in p.options or isinstance(p, Quantity) and not isinstance(v, str):
+                return _value(p, v)
+    if isinstance(parser, TableOr):
+        return _value(parser.table if isinstance(v, tuple) else parser.value, v)
+    if isinstance(parser, Curve):
+        rows = [[_value(parser.x, x)[0], _value(parser.y, y)[0]] for x, y in v]
+        return rows, f"[{parser.x_name}, {parser.y_name}] in [{_value(parser.x, v[0][0])[1] or '-'}, " \
+                     f"{_value(parser.y, v[0][1])[1] or '-'}]"
+    if isinstance(parser, Points):
+        return [[float(c) for c in point] for point in v], "m"
+    if isinstance(parser, ListOf):           # also Pair, Vector
+        items = [_value(parser.item, x) for x in v]
+        return [x for x, _ in items], (items[0][1] if items else "")
+    if isinstance(parser, FilePath):
+        return str(v), ""
+    if isinstance(parser, LengthUnit):
+        return next((n for size, n in LENGTH_UNITS.items() if math.isclose(size, v)), f"{v!r} m"), ""
+    return v, ""
+
+
+def _table(cls, obj) -> dict:
+    """{key: (value, comment) or sub-table dict or list of sub-table dicts} of a schema dataclass."""
+    out = {}
+    unused = {k for rule in getattr(cls, "rules", ()) if isinstance(rule, OnlyWith) and getattr(obj, rule.key) is None
+              for k in rule.keys}            # defaults of keys allowed only with an absent one
+    for name, spec in fields_of(cls):
+        v = getattr(obj, name)
+        if v is None or name in unused:
+            continue
+        parser = spec.parser
+        if isinstance(parser, Named):
+            if v:
+                out[name] = {n: _table(parser.cls, t) for n, t in v.items()}
+        elif isinstance(parser, Tables):
+            if v:
+                out[name] = [_table(parser.cls, t) for t in v]
+        elif isinstance(parser, Section):
+            table = _section(name, parser, v)
+            if table or name != "interfaces":
+                out[name] = table
+        else:
+            out[name] = _value(parser, v)
+    return out
+
+
+def _section(name, parser, v) -> dict:
+    if name == "geometry":
+        limit = {"max_cells": (v.max_cells, "")}
+        if isinstance(v.params, FileGeometry):
+            return {**_table(FileGeometry, v.params), **limit}
+        params = {k: (x if isinstance(x, int) else float(x), "") for k, x in v.resolved().items()}
+        return {"builder": (v.builder, ""), **params, **limit}
+    if name == "interfaces":
+        out = {}
+        for n, s in v.items():
+            table = _table(type(s), s)
+            for sub in ("roughness", "micro"):
+                if getattr(s, sub) is not None:
+                    table[sub] = _table(type(getattr(s, sub)), getattr(s, sub))
+            out[n] = table
+        return out
+    return _table(parser.cls, v)
+
+
+def _emit(table: dict, path: tuple = ()) -> list[str]:
+    lines, subs = [], []
+    for k, v in table.items():
+        if isinstance(v, tuple):
+            value, unit = v
+            text = f"{_key(k)} = {_scalar(value)}"
+            lines.append(text + (f"   # {unit}" if unit else ""))
+        else:
+            subs.append((k, v))
+    for k, v in subs:
+        where = path + (k,)
+        if isinstance(v, list):
+            for item in v:
+                lines += ["", f"[[{'.'.join(map(_key, where))}]]"] + _emit(item, where)
+        elif v and all(isinstance(x, dict) for x in v.values()) and not any(isinstance(x, tuple) for x in v.values()):
+            for n, item in v.items():                       # named tables ([materials.pin])
+                lines += ["", f"[{'.'.join(map(_key, where + (n,)))}]"] + _emit(item, where + (n,))
+        else:
+            lines += ["", f"[{'.'.join(map(_key, where))}]"] + _emit(v, where)
+    return lines
+
+
+def _key(k: str) -> str:
+    return k if k.replace("_", "").replace("-", "").isalnum() else json.dumps(k)
+
+
+def resolved_toml(scene: Scene) -> str:
+    """The scene as TOML with every key the schema knows (see module docstring)."""
+    head = ["# The scene as multiscale read it: every default filled in, SI units (unit in the comment).",
+            f"# Read from {scene.source}" if scene.source else "# Read from text (no file)."]
+    head += [f"# warning: {w}" for w in scene.warnings]
+    return "\n".join(head + [""] + _emit(_table(Scene, scene))) + "\n"
+
+
+# ------------------------------------------------------------------ versions and the record
+def versions() -> dict:
+    """Versions of Python, multiscale and the libraries of this process."""
+    out = {"python": platform.python_version(), "multiscale": __version__}
+    for name in ("numpy", "scipy", "h5py", "mpi4py", "numba", "matplotlib", "gmsh"):
+        try:
+            out[name] = metadata.version(name)
+        except metadata.PackageNotFoundError:
+            pass
+    loaded = sys.modules
+    if "dolfinx" in loaded:
+        out["dolfinx"] = loaded["dolfinx"].__version__
+    if "petsc4py" in loaded:
+        out["petsc"] = ".".join(map(str, loaded["petsc4py"].PETSc.Sys.getVersion()))
+        try:
+            from slepc4py import SLEPc   # optional (fem extra); loaded with PETSc, versioned in every run
+        except ImportError:
+            pass
+        else:
+            out["slepc"] = ".".join(map(str, SLEPc.Sys.getVersion()))
+    if "mpi4py.MPI" in loaded:
+        out["mpi"] = loaded["mpi4py.MPI"].Get_library_version().strip().splitlines()[0]
+    out["platform"] = platform.platform()
+    return out
+
+
+def now() -> str:
+    """The local time, ISO 8601 with its offset."""
+    return datetime.datetime.now().astimezone().isoformat(timespec="seconds")
+
+
+def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict, wall_time: float,
+          status: str = "finished", command: list[str] | None = None, analysis: str = "") -> list[Path]:
+    """``scene.toml`` (the file as given; the resolved scene when it came from text),
+    ``scene_resolved.toml`` and ``provenance.json`` in ``folder``; call on rank 0."""
+    folder = Path(folder)
+    given = scene.source.read_text(encoding="utf-8") if scene.source and scene.source.is_file() else \
+        "# The scene came from text, not a file: here it is as resolved.\n" + resolved_toml(scene)
+    paths = [folder / "scene.toml", folder / "scene_resolved.toml", folder / "provenance.json"]
+    paths[0].write_text(given, encoding="utf-8")
+    paths[1].write_text(resolved_toml(scene), encoding="utf-8")
+    record = {"status": status, "analysis": analysis, "scene": str(scene.source or scene.name),
+              "command": list(sys.argv if command is None else command), "ranks": ranks,
+              "start": started, "end": now(),
+              "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()},
+              "total_wall_time_s": round(wall_time, 3), "versions": versions()}
+    paths[2].write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
+    return paths
+
+
+__all__ = ["now", "resolved_toml", "versions", "write"]

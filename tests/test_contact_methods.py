@@ -1,0 +1,100 @@
+"""The two contact methods (issue 23): the preconditioned constrained CG ("bccg", default) and
+Polonsky–Keer ("pk") give the same discrete answer; the stopping rule ends within the tolerance
+of a tight reference; iterations that do not grow like sqrt(N); batches over threads; FFT pairs per iteration."""
+import numpy as np
+import pytest
+
+from multiscale.micro import fft
+from multiscale.micro.contact import ContactSolver
+from multiscale.micro.kernels import HalfSpace
+from multiscale.micro.surface import fractal_surface, statistics
+
+E = HalfSpace(1.0)
+
+
+def slope_one(n, seed=1, batch=(), hurst=0.8):
+    """Self-affine surface (cut-offs 4 and n/4 wavelengths), RMS slope 1 (the issue-23 family)."""
+    s = fractal_surface(n, 1.0, hurst, 4, n // 4, 1.0, seed=seed, batch=batch)
+    slope = np.asarray(statistics(s).rms_slope)
+    return s.heights / (slope[..., None, None] if batch else slope), s.dx
+
+
+def rel(a, b):
+    return np.linalg.norm(a - b) / np.linalg.norm(b)
+
+
+@pytest.mark.parametrize("periodic", (True, False))
+def test_methods_give_the_same_discrete_answer(periodic):
+    """Load and displacement control, periodic and isolated, a batch: relative L2 of the pressure
+    between the methods far below 1e-7 at tol 1e-11 (both converge to the one KKT point)."""
+    h, dx = slope_one(64, seed=3, batch=(2,))
+    load = np.array([0.01, 0.05])
+    out = {}
+    for m in ("bccg", "pk"):
+        solver = ContactSolver(E, h.shape[-2:], dx, periodic=periodic, method=m)
+        lc = solver.solve(h, load=load, tol=1e-11)
+        dc = solver.solve(h, approach=lc.approach * 0.8, tol=1e-11)
+        out[m] = (lc, dc)
+    for k in range(2):
+        for c in range(2):
+            assert rel(out["bccg"][c].pressure[k], out["pk"][c].pressure[k]) < 1e-9
+            assert np.array_equal(out["bccg"][c].contact[k], out["pk"][c].contact[k])
+    np.testing.assert_allclose(out["bccg"][0].approach, out["pk"][0].approach, rtol=1e-9)
+    np.testing.assert_allclose(out["bccg"][0].mean_pressure, load, rtol=1e-13)
+
+
+@pytest.mark.parametrize("method", ("bccg", "pk"))
+@pytest.mark.parametrize("tol", (1e-6, 1e-8))
+def test_the_stopping_rule_bounds_the_error_of_the_pressure(method, tol):
+    """The criterion estimates the relative L2 error of the pressure: at tol the distance to a
+    1e-12 reference is below tol (tamaas' rule ends at about tol, 0.8–1.2x, see benchmarks)."""
+    h, dx = slope_one(128, seed=4)
+    ref = ContactSolver(E, h.shape, dx).solve(h, load=0.01, tol=1e-12)
+    r = ContactSolver(E, h.shape, dx, method=method).solve(h, load=0.01, tol=tol)
+    assert r.residual <= tol
+    assert rel(r.pressure, ref.pressure) < tol
+
+
+def test_iterations_grow_little_with_the_grid():
+    """Same surface family at 64² and 256² (its cut-off follows the grid): the preconditioned
+    method's iterations grow by at most 1.5x and stay under half of Polonsky–Keer's at 256²
+    (PK grows like sqrt(N); benchmarks/README.md has the counts up to 2048²)."""
+    its = {}
+    for n in (64, 256):
+        h, dx = slope_one(n, seed=2)
+        for m in ("bccg", "pk"):
+            its[m, n] = int(ContactSolver(E, h.shape, dx, method=m).solve(h, load=0.01).iterations)
+    assert its["bccg", 256] <= 1.5 * its["bccg", 64]
+    assert its["bccg", 256] < 0.5 * its["pk", 256]
+    assert its["pk", 256] > 1.3 * its["pk", 64]
+
+
+def test_batch_on_two_threads_equals_the_loop():
+    h, dx = slope_one(64, seed=5, batch=(6,))
+    load = np.linspace(0.005, 0.03, 6)
+    solver = ContactSolver(E, (64, 64), dx)
+    before = fft.get_threads()
+    try:
+        fft.set_threads(2)
+        batched = solver.solve(h, load=load)
+    finally:
+        fft.set_threads(before)
+    for k in range(6):
+        one = solver.solve(h[k], load=load[k])
+        assert batched.iterations[k] == one.iterations
+        np.testing.assert_allclose(batched.pressure[k], one.pressure, rtol=0, atol=1e-12 * one.pressure.max())
+
+
+def test_bccg_iteration_costs_at_most_two_and_a_half_fft_pairs():
+    """Two pairs per iteration (preconditioner, direction); the clipped cells of a projection cost
+    one more forward transform; plus the nested start on the coarser grids (counted too)."""
+    h, dx = slope_one(128, seed=6)
+    solver = ContactSolver(E, h.shape, dx)
+    solver.solve(h, load=0.01)
+    fft.reset_fft_counts()
+    r = solver.solve(h, load=0.01)
+    counts = fft.fft_counts()
+    forward, inverse = counts[(128, 128)]
+    assert inverse == 2 * r.iterations + 1 + 1           # + the start's u = L p, + the last check
+    assert forward <= 2.5 * r.iterations + 2
+    assert fft.fft_pairs((128, 128)) <= 3.0 * r.iterations

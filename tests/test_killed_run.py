@@ -1,0 +1,177 @@
+"""A run killed and resumed writes what the uninterrupted run writes (issues 21 and 22).
+
+A rough pin-on-disc (4 macro steps, fields at every step) is started by ``multiscale run`` in a
+subprocess (alone, and under ``mpiexec -n 2``); one process is killed with SIGKILL while it
+computes step 3 (after the checkpoint and the fields of step 2), and the run is continued with
+``multiscale run --resume``: the history equals that of the uninterrupted run on as many processes
+(to the solver tolerance of the recomputed zone laws, as in test_coupling), every field file holds
+each output time exactly once, the same times, and nothing printed an HDF5 error. A second test
+leaves the field files AHEAD of the checkpoint (the state of a run killed after writing fields but
+before its next checkpoint was complete): the resumed run drops those ghost times (they are gone
+when it stops again) and writes them again, once; a --resume after the end writes nothing."""
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+from io import BytesIO
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+
+pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+
+from test_coupling import POD  # noqa: E402
+
+from multiscale.io import History  # noqa: E402
+from multiscale.outputs import plan  # noqa: E402
+from multiscale.scene import loads  # noqa: E402
+
+MULTISCALE = Path(sys.executable).with_name("multiscale")
+MPIEXEC = Path(sys.executable).with_name("mpiexec")
+
+
+def scene_text(folder: Path) -> str:
+    """test_coupling's rough pin-on-disc with 4 steps of 0.6 s and 3 x 3 zones."""
+    text = POD.format(folder=folder)
+    for old, new in (('end = "1.2 s"\nsteps = 2', 'end = "2.4 s"\nsteps = 4'), ("zones = [5, 5]", "zones = [3, 3]")):
+        assert old in text
+        text = text.replace(old, new)
+    return text
+
+
+@pytest.fixture(scope="module")
+def base(tmp_path_factory):
+    return tmp_path_factory.mktemp("killed")
+
+
+def field_times(folder: Path) -> dict:
+    """{field file: its times, from the .h5 and from the .xdmf index} of a results folder."""
+    out = {}
+    for xdmf in sorted(folder.glob("*.xdmf")):
+        with h5py.File(xdmf.with_suffix(".h5"), "r") as f:
+            times = list(f["times"][...])
+            assert sorted(f["data"], key=int) == [str(k) for k in range(len(times))], xdmf.name
+        shown = [float(t.split('"')[1]) for t in xdmf.read_text().split("<Time Value=")[1:]]
+        assert shown == times, xdmf.name
+        out[xdmf.name] = times
+    return out
+
+
+def uninterrupted_run(base: Path, ranks: int) -> Path:
+    """The results folder of the scene run without interruption on ``ranks`` processes."""
+    folder = base / f"straight{ranks}" / "out"
+    if not folder.is_dir():
+        folder.parent.mkdir(parents=True)
+        path = folder.parent / "scene.toml"
+        path.write_text(scene_text(folder))
+        launcher = [str(MPIEXEC), "-n", str(ranks)] if ranks > 1 else []
+        done = subprocess.run(launcher + [str(MULTISCALE), "run", str(path), "--quiet"], capture_output=True,
+                              text=True, timeout=300)
+        assert done.returncode == 0, done.stderr
+    return folder
+
+
+def same_results(folder: Path, reference: Path, rtol: float = 1e-6) -> None:
+    """History (to ``rtol``) and field times (exactly) of ``folder`` as in ``reference``."""
+    scene = loads(scene_text(folder))
+    h, r = History.read(folder / "history.h5"), History.read(reference / "history.h5")
+    assert set(h.columns) == set(r.columns) and len(h) == len(r) == scene.time.steps + 1
+    for key in r.columns:
+        if not key.startswith("time_"):                # wall times differ
+            np.testing.assert_allclose(h[key], r[key], rtol=rtol, atol=1e-12, err_msg=key)
+    times = field_times(folder)
+    assert times == field_times(reference)
+    assert all(t == list(plan(scene).times) for t in times.values())   # each time once, exact
+
+
+def ranks_of(pid: int) -> list[int]:
+    """The processes below ``pid`` that run multiscale (the ranks under mpiexec), from /proc."""
+    children = {}
+    for stat in Path("/proc").glob("[0-9]*/stat"):
+        try:
+            fields = stat.read_text().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        children.setdefault(int(fields[1]), []).append(int(stat.parent.name))
+    out, todo = [], [pid]
+    while todo:
+        for child in children.get(todo.pop(), []):
+            todo.append(child)
+            try:
+                command = (Path("/proc") / str(child) / "cmdline").read_bytes().split(b"\0")
+            except OSError:
+                continue
+            if any(part.endswith(b"multiscale") for part in command) and b"mpiexec" not in command[0]:
+                out.append(child)
+    return out
+
+
+def fields_written(ckpt: Path) -> int:
+    """The last step whose fields the running job wrote (-1: none yet); read from a copy of the
+    checkpoint's bytes, so that no HDF5 lock is taken on the file the job rewrites."""
+    try:
+        with h5py.File(BytesIO(ckpt.read_bytes()), "r") as f:
+            return int(f.attrs["fields_written"])
+    except (OSError, KeyError, ValueError):
+        return -1
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_killed_mid_run_and_resumed_writes_the_uninterrupted_results(base, tmp_path, ranks):
+    """``ranks`` 2: one rank of ``mpiexec -n 2`` is killed (mpiexec ends the other), the run resumed
+    under ``mpiexec -n 2``."""
+    folder = tmp_path / "out"
+    path = tmp_path / "scene.toml"
+    path.write_text(scene_text(folder))
+    ckpt = folder / "checkpoint.h5"
+    launcher = [str(MPIEXEC), "-n", str(ranks)] if ranks > 1 else []
+    job = subprocess.Popen(launcher + [str(MULTISCALE), "run", str(path), "--quiet"], stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        deadline = time.monotonic() + 300
+        while time.monotonic() < deadline and job.poll() is None and fields_written(ckpt) < 2:
+            time.sleep(0.05)                    # after step 2's checkpoint and fields: computing step 3
+        victims = ranks_of(job.pid)[-1:] if ranks > 1 else [job.pid]
+        assert victims and job.poll() is None, "the run was to be killed mid-run; it ended"
+        os.kill(victims[0], signal.SIGKILL)
+        _, err = job.communicate(timeout=60)
+    finally:
+        if job.poll() is None:
+            os.killpg(job.pid, signal.SIGKILL)
+    assert job.returncode != 0, err
+    with h5py.File(ckpt, "r") as f:
+        assert 2 <= int(f.attrs["step"]) < 4 and "finished" not in f.attrs
+    resumed = subprocess.run(launcher + [str(MULTISCALE), "run", str(path), "--resume", "--quiet"],
+                             capture_output=True, text=True, timeout=300)
+    assert resumed.returncode == 0, resumed.stderr
+    assert "HDF5" not in resumed.stderr + resumed.stdout
+    # two uninterrupted 2-rank runs of this rough scene can differ from step 2 on by up to 1.1e-3
+    # (max_zone_pressure; 7e-4 max_pressure, 1e-5 frictional_work; one run in three, bimodal): the
+    # 2-rank rough loop is not repeatable (issue 22 report); the serial case holds the resume to 1e-6
+    same_results(folder, uninterrupted_run(base, ranks), rtol=1e-6 if ranks == 1 else 5e-3)
+
+
+def test_field_times_after_the_checkpoint_are_dropped_and_written_once(base, tmp_path):
+    from multiscale import workflows
+    from multiscale.workflows.multiscale import run
+    folder = tmp_path / "out"
+    scene = loads(scene_text(folder))
+    run(scene, verbose=False, stop_after=1)
+    early = tmp_path / "checkpoint_step1.h5"
+    shutil.copy(folder / "checkpoint.h5", early)
+    run(scene, resume=True, verbose=False)              # fields at every time, then the step-1 checkpoint
+    shutil.copy(early, folder / "checkpoint.h5")
+    assert all(len(t) == 5 for t in field_times(folder).values())
+    run(scene, resume=True, verbose=False, stop_after=2)   # the ghosts of steps 3 and 4 are gone
+    assert all(t == list(plan(scene).times[:3]) for t in field_times(folder).values())
+    result = workflows.run(scene, resume=True, verbose=False)
+    same_results(folder, uninterrupted_run(base, 1))
+    # --resume once more: nothing to do, nothing written, the provenance of the run stays as it was
+    before = {f.name: f.read_bytes() for f in folder.iterdir()}
+    again = workflows.run(scene, resume=True, verbose=False)
+    assert {f.name: f.read_bytes() for f in folder.iterdir()} == before
+    assert sorted(f.name for f in again.files) == sorted(f.name for f in result.files) == sorted(plan(scene).files)
