@@ -3,7 +3,7 @@
 Materials (constants or temperature tables), the interface defaults and per-interface settings,
 boundary conditions (supports, convection, radiation, fixed temperatures), the loading and its duty
 cycle (load and speed against time, a vehicle stop or drag), time, output, and the sections of the
-multiscale loop (roughness, micro, wear, layers) and of the squeal analysis (stability). Values are
+multiscale loop (roughness, micro, wear, layers); the squeal analysis' in ``scene_stability``. Values are
 SI numbers or unit strings (``multiscale.units``).
 """
 from __future__ import annotations
@@ -14,6 +14,7 @@ from pathlib import Path
 
 from multiscale.errors import InputError
 from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_topography
+from multiscale.scene_stability import Stribeck
 from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, ListOf, OneOf, OnlyWith, Pair,
                                Quantity, Requires, Section, TableOr, Tables, Text, Vector, key)
 
@@ -70,7 +71,9 @@ class Material:
     is the mean (secant) expansion coefficient from the initial temperature. Thermal needs kappa and
     c (with rho) or chi. ``k_w``: the Archard wear rate of this material (effect "wear"), taken at
     the local surface temperature: the rough body's (instead of [wear]'s), or the counter-face's
-    (only a counter-face with k_w wears)."""
+    (only a counter-face with k_w wears). The squeal analysis reads the material damping: a
+    structural loss factor eta (complex stiffness E (1 + i eta)) and Rayleigh coefficients (alpha M
+    + beta K of this material's mass and stiffness)."""
 
     E: float | tuple = key(_property(_MODULUS, "E"), required=True)                          # Pa
     nu: float | tuple = key(_property(_POISSON, "nu"), required=True)
@@ -82,14 +85,21 @@ class Material:
                                       warn_unused=True)                                      # 1/K
     k_w: float | tuple | None = key(_property(Quantity("wear_rate", ge=0), "k_w"))          # 1/Pa, Archard
     hardness: float | tuple | None = key(_property(_HARDNESS, "hardness"))   # Pa, plastic flow pressure of asperities
+    loss_factor: float | None = key(Quantity("dimensionless", ge=0))      # structural damping eta (squeal)
+    damping_alpha: float | None = key(Quantity("frequency", ge=0))        # 1/s, Rayleigh: alpha M (squeal)
+    damping_beta: float | None = key(Quantity("time", ge=0))              # s, Rayleigh: beta K (squeal)
 
     rules = (OneOf(("c", "chi"), needed_by=("thermal",)), Requires("c", ("rho",), needed_by=("thermal",)))
 
     PROPERTIES = ("E", "nu", "rho", "kappa", "c", "chi", "alpha", "hardness")
+    DAMPING = ("loss_factor", "damping_alpha", "damping_beta")
 
     def problems(self, path, ctx):
         if self.k_w is not None and "wear" not in ctx.effects:
             ctx.warnings.append(f'{path}.k_w is ignored: effect "wear" is not in effects')
+        given = [k for k in self.DAMPING if getattr(self, k) is not None]
+        if given and "stability" not in ctx.effects:
+            ctx.warnings.append(f'{path}.{given[0]} is ignored: effect "stability" is not in effects')
         return []
 
     @property
@@ -267,7 +277,10 @@ class Loading:
     with ``direction`` a traction along it whose resultant is the force, or the pressure itself),
     scaled in time by ``load_profile`` (factor, 0 = released: no contact, no frictional heat). The
     speed of the rotating body: ``rotation_speed``, a ``speed_profile`` against time, or a
-    ``vehicle`` stop or drag; a translating body slides at ``sliding_speed``."""
+    ``vehicle`` stop or drag; a translating body slides at ``sliding_speed``. Friction: a
+    constant ``friction``, or (squeal analysis only) mu against the slip speed: a table
+    ``friction_curve`` or a ``stribeck`` law, taken per interface facet at its steady slip speed;
+    its slope enters the modal analysis as damping."""
 
     normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)))                 # N
     pressure: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e9)))  # Pa
@@ -280,13 +293,23 @@ class Loading:
                                             "time", "speed"))                 # ((s, rad/s), ...)
     vehicle: Vehicle | None = key(Section(Vehicle))
     sliding_speed: float | None = key(Quantity("speed", ge=0, plausible=(0.0, 200.0)))  # m/s (translation builders)
-    friction: float | None = key(_FRICTION, needed_by=("friction",),
-                                 warn_unused=True)                            # mu
+    friction: float | None = key(_FRICTION)                                   # mu
     ramp_steps: int = key(Integer(ge=1), default=1)       # load increments of the first mechanical solve
+    friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), Quantity("dimensionless", ge=0),
+                                             "slip speed", "mu", min_rows=2))  # ((m/s, -), ...)
+    stribeck: Stribeck | None = key(Section(Stribeck))
 
-    rules = (OneOf(("normal_force", "pressure")), OneOf(("rotation_speed", "speed_profile", "vehicle")))
+    FRICTION = ("friction", "friction_curve", "stribeck")
+    rules = (OneOf(("normal_force", "pressure")), OneOf(("rotation_speed", "speed_profile", "vehicle")),
+             OneOf(FRICTION, needed_by=("friction",)))
 
     def problems(self, path, ctx):
+        law = [k for k in self.FRICTION if getattr(self, k) is not None]
+        if law and "friction" not in ctx.effects:
+            ctx.warnings.append(f'{path}.{law[0]} is ignored: effect "friction" is not in effects')
+        elif law and law[0] != "friction" and "stability" not in ctx.effects:
+            return [f"{path}.{law[0]}: a speed-dependent friction is read by the squeal analysis only "
+                    f'(effect "stability"); give {path}.friction']
         given = [k for k in ("normal_force", "pressure") if getattr(self, k) is not None]
         by_mass = self.vehicle is not None and self.vehicle.mass is not None
         if given and by_mass:
@@ -513,24 +536,3 @@ class Layers:
     body: str | None = key(Text())               # the stationary (rough) side; default: that side
     base: str = key(Choice(("half-space", "rigid")), default="half-space")
     layer: tuple | None = key(Tables(Layer), required=True)
-
-
-@dataclass(frozen=True)
-class Stability:
-    """Complex eigenvalue analysis (§4.3): modes in a frequency band, shift target, damping."""
-
-    band: tuple = key(Pair(Quantity("frequency", ge=0), single=False, names="[low, high]"),
-                      default=(0.0, 16e3))                                    # Hz
-    modes: int | None = key(Integer(ge=1), required=True)
-    target: float | None = key(Quantity("frequency", ge=0))                   # Hz; default: the band's lower edge
-    damping: float = key(Quantity("dimensionless", ge=0, plausible=(0.0, 0.5)), default=0.0)  # structural loss factor
-
-    def problems(self, path, ctx):
-        low, high = self.band
-        if high <= low:
-            return [f"{path}.band = [{low:g}, {high:g}] Hz: the upper bound must exceed the lower"]
-        if self.target is not None and not low <= self.target <= high:
-            return [f"{path}.target = {self.target:g} Hz: must lie in the band [{low:g}, {high:g}] Hz"]
-        return []
-
-

@@ -386,7 +386,8 @@ def test_overrides_are_validated_like_the_file(tmp_path):
         loads(GOOD, tmp_path, overrides={"loading.frictoin": 0.2, "time.end": "-1 s"})
     assert info.value.problems == [
         'loading.frictoin: unknown key (did you mean "friction"?); allowed: normal_force, pressure, faces, direction, '
-        "load_profile, rotation_speed, speed_profile, vehicle, sliding_speed, friction, ramp_steps",
+        "load_profile, rotation_speed, speed_profile, vehicle, sliding_speed, friction, ramp_steps, friction_curve, "
+        "stribeck",
         'time.end = "-1 s": must be > 0 s (got -1 s)']
     with pytest.raises(SceneError, match="cannot override, friction is not a table"):
         loads(GOOD, tmp_path, overrides={"loading.friction.x": 1})

@@ -42,7 +42,9 @@ class ModalResult:
     """Complex modes of a linearised system, sorted by frequency.
 
     ``modes[:, j]`` is mode j (rank-owned entries of the PETSc layout), normalised to
-    ``phi^H M phi = 1`` with the phase that makes ``phi^T phi`` real positive.
+    ``phi^H M phi = 1`` with the phase that makes ``phi^T phi`` real positive; with ``gram`` set,
+    the reduced coordinates q of phi = V q in an M-orthonormal basis V instead (same on every rank).
+    ``method``: "gnhep", "pep" or "projection".
     """
 
     eigenvalues: np.ndarray     # lambda = sigma + i omega [1/s], omega >= 0
@@ -52,11 +54,13 @@ class ModalResult:
     band: tuple[float, float]   # requested band (f_min, f_max) [Hz]
     target: float               # shift-and-invert target frequency [Hz]
     n_dofs: int                 # global problem size
-    method: str                 # "gnhep" or "pep"
+    method: str                 # "gnhep", "pep" or "projection"
     iterations: int             # outer iterations of the last SLEPc solve
     solves: int                 # SLEPc solves (the band search may enlarge the subspace)
     time: float                 # wall time [s]
     comm: object = field(default=None, repr=False)   # mpi4py communicator of the modes (None: serial)
+    gram: np.ndarray | None = field(default=None, repr=False)   # modes in reduced coordinates q of a
+    #                                 basis V (``macro.damped.Subspace``): V^T V, for the MAC
 
     @property
     def frequency(self) -> np.ndarray:
@@ -296,40 +300,53 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
                        "gnhep", iterations, solves, time.perf_counter() - t0, comm)
 
 
-def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int = 20,
-                    target: float = 0.0, tol: float = 1e-10, max_it: int = 300,
+def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int | None = 20,
+                    target: float = 0.0, tol: float = 1e-10, max_it: int = 300, nev: int = 20,
                     options_prefix: str = "stability_pep_") -> ModalResult:
     """Damped modes of (lambda^2 M + lambda C + K) phi = 0 with a general damping matrix C (SLEPc PEP).
 
     Real arithmetic cannot shift at i omega; the shift is the real rate s = 2 pi target [1/s]
     (K + s C + s^2 M is non-singular for s > 0 even for a free-free structure) and eigenvalues
     converge in order of |lambda - s|, i.e. by frequency for light damping. ``n_modes`` counts
-    modes with omega >= 0 (conjugate pairs are computed together); the result is filtered to the
-    band. ``theta`` is reported as -lambda^2.
+    modes with omega >= 0 (conjugate pairs are computed together; at most ``n_modes`` in the band,
+    the nearest s, are returned); ``n_modes=None`` asks for the
+    whole band: the subspace grows until a converged |lambda - s| exceeds |i 2 pi f_max - s|.
+    The result is filtered to the band. ``theta`` is reported as -lambda^2.
     """
     f_min, f_max, target = _check_band(f_min, f_max, target, n_modes)
     t0 = time.perf_counter()
     comm = matrix_comm(K)
     n = K.getSize()[0]
+    s = TWO_PI * target
+    radius = abs(complex(-s, TWO_PI * f_max))
     pep = SLEPc.PEP().create(K.getComm())
     pep.setOperators([K, C, M])
     pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
     pep.setType(SLEPc.PEP.Type.TOAR)
-    pep.setTarget(TWO_PI * target)
+    pep.setTarget(s)
     pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
     pep.setTolerances(tol, max_it)
-    pep.setDimensions(min(2 * int(n_modes), 2 * n), PETSc.DECIDE)
     _direct_solver(pep.getST())
     pep.setOptionsPrefix(options_prefix)
     pep.setFromOptions()
-    try:
-        pep.solve()
-    except PETSc.Error as exc:
-        raise InputError("target", target, f"K + s C + s^2 M could not be factorised: {exc}") from None
-    nconv = pep.getConverged()
-    if nconv < min(2 * int(n_modes), 2 * n):
-        raise ConvergenceError(f"SLEPc PEP converged {nconv} of {2 * n_modes} eigenpairs",
-                               history=[pep.getIterationNumber()])
+    want = min(2 * int(n_modes if n_modes is not None else max(nev, 1)), 2 * n)
+    solves = 0
+    while True:
+        pep.setDimensions(want, PETSc.DECIDE)
+        try:
+            pep.solve()
+        except PETSc.Error as exc:
+            raise InputError("target", target, f"K + s C + s^2 M could not be factorised: {exc}") from None
+        solves += 1
+        nconv = pep.getConverged()
+        if nconv < want:
+            raise ConvergenceError(f"SLEPc PEP converged {nconv} of {want} eigenpairs",
+                                   history=[pep.getIterationNumber()])
+        reached = max(abs(pep.getEigenpair(i) - s) for i in range(nconv))
+        if n_modes is not None or reached > radius or want >= 2 * n:
+            break
+        grow = (1.2 * radius / max(reached, 1e-300)) ** 3      # eigenvalue count ~ omega^3 in 3D
+        want = min(2 * n, max(want + 20, int(math.ceil(want * min(grow, 8.0)))))
     vr, vi = K.createVecs()
     lam, vecs, errs = [], [], []
     for i in range(nconv):
@@ -345,19 +362,24 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     vecs = np.column_stack(vecs) if vecs else np.empty((K.getLocalSize()[0], 0), complex)
     errs = np.array(errs)
     seen = lam.imag / TWO_PI
-    inband = (seen >= f_min) & (seen <= f_max)
+    inband = np.nonzero((seen >= f_min) & (seen <= f_max))[0]
+    if n_modes is not None:             # the n_modes nearest the shift, as they converge
+        inband = inband[np.argsort(np.abs(lam[inband] - s), kind="stable")[:int(n_modes)]]
     lam, theta, vecs, errs = _sorted(lam[inband], -lam[inband] ** 2, vecs[:, inband], errs[inband],
                                      (f_min, f_max), seen)
     return ModalResult(lam, theta, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
-                       "pep", iterations, 1, time.perf_counter() - t0, comm)
+                       "pep", iterations, solves, time.perf_counter() - t0, comm)
 
 
 def onset_of_instability(build: Callable[[float], tuple], mu_lo: float, mu_hi: float, *,
-                         xtol: float = 1e-9, rtol: float = 1e-6, **solve_kw) -> float:
+                         xtol: float = 1e-9, rtol: float = 1e-6, solve: Callable | None = None,
+                         **solve_kw) -> float:
     """Smallest friction coefficient in [mu_lo, mu_hi] with an unstable mode, by bisection.
 
-    ``build(mu) -> (K, M)``; ``solve_kw`` go to ``solve_modes``. Stable at mu_lo and unstable at
-    mu_hi are required (InputError otherwise). Returns the onset mu [-] within ``xtol``.
+    ``build(mu) -> (K, M)`` solved by ``solve_modes``, or any system that ``solve(system,
+    **solve_kw) -> ModalResult`` takes (e.g. ``macro.damped.solve_system`` for damped systems);
+    ``solve_kw`` go to the solver. Stable at mu_lo and unstable at mu_hi are required (InputError
+    otherwise). Returns the onset mu [-] within ``xtol``.
     """
     mu_lo = check_positive("mu_lo", mu_lo, allow_zero=True)
     mu_hi = check_positive("mu_hi", mu_hi)
@@ -365,7 +387,9 @@ def onset_of_instability(build: Callable[[float], tuple], mu_lo: float, mu_hi: f
         raise InputError("mu_hi", mu_hi, f"must exceed mu_lo = {mu_lo}")
 
     def unstable(mu):
-        return bool(solve_modes(*build(mu), **solve_kw).unstable(rtol).any())
+        system = build(mu)
+        result = solve(system, **solve_kw) if solve is not None else solve_modes(*system, **solve_kw)
+        return bool(result.unstable(rtol).any())
 
     if unstable(mu_lo):
         raise InputError("mu_lo", mu_lo, "the system is already unstable there")

@@ -14,6 +14,7 @@ from typing import Mapping
 import numpy as np
 import ufl
 from dolfinx import fem, la
+from scipy.optimize import linear_sum_assignment
 
 from multiscale.errors import InputError, check_positive
 from multiscale.macro.eigen import ModalResult, mat_apply, matrix_comm, reduce_sum
@@ -72,21 +73,37 @@ def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float =
     return StabilityReport(number[bad], number[close], f.copy(), result.growth.copy(), rtol, close_tol)
 
 
-def mac_matrix(a: ModalResult | np.ndarray, b: ModalResult | np.ndarray, comm=None) -> np.ndarray:
+def mac_matrix(a: ModalResult | np.ndarray, b: ModalResult | np.ndarray, comm=None, gram=None) -> np.ndarray:
     """MAC_ij = |y_i^H y_j|^2 / (y_i^H y_i  y_j^H y_j) between modes of two cases (§4.4).
 
-    Both sets must live on the same dof layout (same mesh and spaces). Returns (n_a, n_b) in [0, 1].
+    Both sets must live on the same dof layout (same mesh and spaces), or be reduced coordinates q
+    of one basis V (``ModalResult.gram`` = V^T V, or ``gram``): y^H y = q^H (V^T V) q. Returns
+    (n_a, n_b) in [0, 1].
     """
-    comm = comm or getattr(a, "comm", None) or getattr(b, "comm", None)
+    gram = gram if gram is not None else getattr(a, "gram", None)
+    comm = None if gram is not None else comm or getattr(a, "comm", None) or getattr(b, "comm", None)
     ya = a.modes if isinstance(a, ModalResult) else np.asarray(a)
     yb = b.modes if isinstance(b, ModalResult) else np.asarray(b)
     if ya.shape[0] != yb.shape[0]:
         raise InputError("modes", (ya.shape, yb.shape), "the two cases must share the dof layout")
-    cross = ya.conj().T @ yb
-    na = np.einsum("ij,ij->j", ya.conj(), ya).real
-    nb = np.einsum("ij,ij->j", yb.conj(), yb).real
+    gb = yb if gram is None else gram @ yb
+    cross = ya.conj().T @ gb
+    na = np.einsum("ij,ij->j", ya.conj(), ya if gram is None else gram @ ya).real
+    nb = np.einsum("ij,ij->j", yb.conj(), gb).real
     cross, na, nb = reduce_sum(cross, comm), reduce_sum(na, comm), reduce_sum(nb, comm)
     return np.abs(cross) ** 2 / np.maximum(np.outer(na, nb), np.finfo(float).tiny)
+
+
+def pair_modes(mac: np.ndarray, lam_a: np.ndarray, lam_b: np.ndarray, mac_min: float = 0.5) -> list[tuple[int, int]]:
+    """One-to-one pairs (i, j) of modes of two neighbouring cases that maximise the sum of
+    MAC_ij - |lambda_j - lambda_i| / |lambda_i| (the eigenvalue distance tells apart the two
+    members of a locked-in pair, whose shapes are complex conjugates); pairs with MAC < ``mac_min``
+    are dropped."""
+    if mac.size == 0:
+        return []
+    dist = np.abs(lam_b[None, :] - lam_a[:, None]) / np.maximum(np.abs(lam_a)[:, None], np.finfo(float).tiny)
+    rows, cols = linear_sum_assignment(-(mac - np.minimum(dist, 1.0)))
+    return [(int(i), int(j)) for i, j in zip(rows, cols) if mac[i, j] >= mac_min]
 
 
 def mmac(mac: np.ndarray) -> np.ndarray:

@@ -4,7 +4,10 @@
 the rotation of body 1) and reports the interface forces; ``linearise`` returns (K, M) at that
 state: K the consistent Newton matrix of the mechanics and interface forms (non-symmetric with
 friction, including the exact tangent of embedded rough laws), M the block-diagonal mass with
-diag 0 on Dirichlet rows (so constrained modes go to infinity).
+diag 0 on Dirichlet rows (so constrained modes go to infinity). ``linearise_system`` adds the
+optional parts of issue 20 (``macro.operators``, ``macro.friction``): material damping, the
+friction-slope damping, the gyroscopic and centrifugal terms of the rotating body and the prestress
+(geometric) stiffness, as a ``macro.damped.LinearSystem``.
 """
 from __future__ import annotations
 
@@ -15,10 +18,16 @@ from typing import Mapping
 import numpy as np
 from dolfinx import fem
 from dolfinx.fem import petsc as fpetsc
+from petsc4py import PETSc
 
 from multiscale.errors import check_positive
+from multiscale.macro.damped import LinearSystem
+from multiscale.macro.eigen import Damping
+from multiscale.macro.friction import friction_damping
 from multiscale.macro.materials import body_fields
 from multiscale.macro.mechanics import Mechanics, load_face_forces
+from multiscale.macro.operators import (centrifugal_displacement, geometric_stiffness, material_damping,
+                                        rotation_matrices)
 
 
 @dataclass
@@ -75,3 +84,55 @@ def linearise(mech: Mechanics, materials: Mapping[str, object]):
     M = fpetsc.assemble_matrix(form, bcs=mech.bcs, diag=0.0)
     M.assemble()
     return mech.tangent(), M
+
+
+@dataclass
+class Linearised:
+    """The linearised system and the parts it holds."""
+
+    system: LinearSystem
+    K_sigma: object = None        # PETSc.Mat, the geometric stiffness included in K (prestress)
+    terms: tuple = ()             # names of the parts beyond K and M
+
+
+def _add(total, A):
+    if total is None:
+        return A
+    total.axpy(1.0, A, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    A.destroy()
+    return total
+
+
+def linearise_system(mech: Mechanics, materials: Mapping[str, object], *, damping: Damping | None = None,
+                     slope: np.ndarray | None = None, prestress: bool = False, gyroscopic: bool = False,
+                     material: bool = True) -> Linearised:
+    """(K, M) of ``linearise`` plus: per-material damping (``material``: the loss factors and
+    Rayleigh coefficients the materials give), the damping of the per-facet friction slope
+    mu'(V) [s/m] (``slope``), the gyroscopic matrix and centrifugal stiffness of the rotating body
+    at the contact's speed (``gyroscopic``), the geometric stiffness of the preloaded stress
+    (``prestress``; with ``gyroscopic`` also of the centrifugal stress, solved with the tangent);
+    ``damping``: the proportional part over the whole system."""
+    K, M = linearise(mech, materials)
+    C, H = material_damping(mech, materials) if material else (None, None)
+    terms = [n for n, A in (("material viscous damping", C), ("material loss factors", H)) if A is not None]
+    if slope is not None and np.any(slope):
+        C = _add(C, friction_damping(mech, slope))
+        terms.append("friction slope")
+    omega = float(mech.contact.speed.value)
+    extra = None
+    if gyroscopic:
+        if prestress and omega:
+            extra = centrifugal_displacement(mech, materials, omega, K)
+        G, Kw = rotation_matrices(mech, materials, omega)
+        C = _add(C, G)
+        K.axpy(1.0, Kw, PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        Kw.destroy()
+        terms.append("gyroscopic and centrifugal")
+    Ks = None
+    if prestress:
+        Ks = geometric_stiffness(mech, extra)
+        K.axpy(1.0, Ks, PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        terms.append("prestress" + (" (with centrifugal stress)" if extra is not None else ""))
+    if damping is not None and (damping.alpha or damping.beta or damping.eta):
+        terms.append("proportional damping")
+    return Linearised(LinearSystem(K, M, C, H, damping), Ks, tuple(terms))

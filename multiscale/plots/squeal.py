@@ -113,3 +113,42 @@ def plot_mode_curves(curves: Mapping[str, np.ndarray], ylabel: str, path) -> Pat
     ax.set(xlabel="mode of the perfect-contact model", ylabel=ylabel, ylim=(0, 1.02))
     ax.legend(fontsize=7)
     return _save(fig, path)
+
+
+def plot_map(smap, path) -> Path:
+    """Stability map: growth rate against frequency of every mode at every point of a sweep,
+    coloured by the swept value; unstable modes above the line (``smap``: a
+    ``macro.stability_map.StabilityMap``)."""
+    fig = Figure(figsize=(8, 4.8))
+    ax = fig.subplots()
+    values = np.broadcast_to(smap.values[:, None], smap.frequency.shape)
+    ok = ~np.isnan(smap.frequency)
+    art = ax.scatter(smap.frequency[ok], smap.growth[ok], c=values[ok], s=8, cmap="viridis")
+    fig.colorbar(art, ax=ax, label=f"{smap.parameter} [{smap.unit}]")
+    ax.axhline(0.0, color="k", lw=0.5)
+    for o in smap.onsets:
+        ax.plot(o.frequency, 0.0, "rx", ms=7)
+    ax.set(xlabel="frequency [Hz]", ylabel="growth rate sigma [1/s]",
+           title=f"stability map over {smap.parameter} (x: onsets)")
+    return _save(fig, path)
+
+
+def plot_tracks(smap, path) -> Path:
+    """Frequency and growth rate of every tracked mode against the swept value; unstable
+    tracks coloured, the others grey; onsets marked."""
+    fig = Figure(figsize=(8, 7))
+    a, b = fig.subplots(2, 1, sharex=True)
+    bad = smap.unstable().any(axis=0)
+    for t in range(smap.n_tracks):
+        style = dict(lw=1.2, label=f"track {t + 1}") if bad[t] else dict(color="0.75", lw=0.6)
+        line = a.plot(smap.values, smap.frequency[:, t], **style)[0]
+        b.plot(smap.values, smap.growth[:, t], color=line.get_color(), lw=style["lw"])
+    for o in smap.onsets:
+        a.plot(o.value, o.frequency, "kx", ms=6)
+        b.plot(o.value, 0.0, "kx", ms=6)
+    b.axhline(0.0, color="k", lw=0.5)
+    a.set(ylabel="frequency [Hz]", title="tracked modes (coloured: unstable somewhere; x: onsets)")
+    b.set(xlabel=f"{smap.parameter} [{smap.unit}]", ylabel="growth rate sigma [1/s]")
+    if bad.any() and bad.sum() <= 12:
+        a.legend(fontsize=7, ncol=2)
+    return _save(fig, path)

@@ -10,14 +10,28 @@ of the multiscale loop (``workflows.rough``, same scene rules) gives every inter
 embedded exactly in the contact form, and the rigid datum gap where Newton starts; the Newton
 matrix at the preload then holds the laws' consistent tangent.
 
+Beyond the thesis (issue 20, ``squeal_options``): damping (``stability.damping``,
+``rayleigh_alpha``/``rayleigh_beta`` over the whole system; per-material loss factors and Rayleigh
+coefficients), a friction coefficient falling with the slip speed (``loading.friction_curve`` or
+``loading.stribeck``: mu(V) per facet at the preload, its slope as damping), the gyroscopic and
+centrifugal terms of the rotating body (``stability.gyroscopic``) and the prestress stiffness
+(``stability.prestress``, with the shift of every frequency it causes). A damped system that the
+undamped modes do not map exactly is solved as a quadratic eigenproblem (viscous damping) or by
+projection on the undamped modes (loss factors; ``macro.damped``). ``[stability.sweep]`` adds a
+stability map (``workflows.squeal_map``).
+
 ``run`` writes into ``output.folder``: ``modes.csv``, mode shapes (``modes_<body>.bp``, VTX), the
 preloaded state's fields (``<body>.xdmf``, ``interface.xdmf``), ``pressure.png`` (Fig. 4.12),
 ``re_im.png`` (Fig. 4.13) and ``energy.png`` (Figs. 4.20–4.21); ``multiscale.outputs.plan``.
+With prestress also ``prestress.csv``; with a sweep the map's files (``workflows.squeal_map.write``).
 """
 from __future__ import annotations
 
+import csv
+import dataclasses
 import time
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Mapping
 
 import numpy as np
@@ -25,18 +39,36 @@ from mpi4py import MPI
 
 from multiscale import io, outputs
 from multiscale.errors import InputError
-from multiscale.macro.eigen import Damping, ModalResult, solve_modes
+from multiscale.macro.damped import PrestressEffect, prestress_effect, solve_system
+from multiscale.macro.eigen import Damping, ModalResult
+from multiscale.macro.friction import ConstantFriction, StribeckFriction, TableFriction, set_friction
 from multiscale.macro.mechanics import Mechanics
 from multiscale.macro.modal import EnergyShares, RegionEnergy, StabilityReport, stability_report, \
     strain_energy_shares
 from multiscale.macro.output import write_modes, write_state
-from multiscale.macro.preload import Preload, linearise, preload
+from multiscale.macro.preload import Preload, linearise_system, preload
+from multiscale.macro.stability_map import StabilityMap
 from multiscale.plots.squeal import plot_energy, plot_pressure, plot_re_im
+from multiscale.workflows import squeal_map
 from multiscale.workflows.model import build_mechanics, build_mesh, drive, interface_forces
 from multiscale.workflows.output import RunResult, prepare_folder
 from multiscale.workflows.rough import build_rough_interface
 
 SQUEAL_DEGREE = 2     # quadratic tetrahedra: linear ones are far too stiff in bending (tests)
+
+
+@dataclass(frozen=True)
+class SquealOptions:
+    """What the linearised system holds beyond the tangent K and the mass M (issue 20)."""
+
+    damping: Damping | None = None         # proportional: alpha M + beta K, eta K of the whole system
+    material_damping: bool = True          # the materials' loss factors and Rayleigh coefficients
+    friction_laws: dict | None = None      # interface -> mu(v) law (None: the friction field as set)
+    friction_damping: bool = True          # the slope of the laws as damping
+    prestress: bool = False
+    gyroscopic: bool = False
+    method: str = "auto"                   # macro.damped.solve_system
+    basis: float = 1.5
 
 
 @dataclass
@@ -50,24 +82,79 @@ class SquealCase:
     energy: EnergyShares | None
     facet_pressure: np.ndarray      # Pa, per interface facet (global order of tm.interface)
     mech: Mechanics | None = field(default=None, repr=False)   # the model (spaces of the modes)
+    prestress: PrestressEffect | None = None    # the frequencies without the prestress stiffness
+    terms: tuple = ()                           # parts of the linearised system beyond K and M
 
 
 def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "case", *, load: float = 1e6,
                 steps: int = 1, band=(0.0, 16e3), n_modes: int | None = None,
                 target: float | None = None, damping: Damping | None = None, energy: bool = True,
-                rtol: float = 1e-6, close_tol: float = 1e-3) -> SquealCase:
-    """Preload ``mech`` from rest to ``load`` [Pa or N] in ``steps``, linearise and extract the
-    complex modes in ``band`` [Hz] (§4.3.1, two steps)."""
+                rtol: float = 1e-6, close_tol: float = 1e-3, options: SquealOptions | None = None,
+                reset: bool = True) -> SquealCase:
+    """Preload ``mech`` from rest (``reset``) to ``load`` [Pa or N] in ``steps``, linearise and
+    extract the complex modes in ``band`` [Hz] (§4.3.1, two steps); ``damping`` (or
+    ``options.damping``) is the proportional part, ``options`` the rest (``SquealOptions``)."""
+    opt = options or SquealOptions()
+    slope = set_friction(mech, opt.friction_laws)[1] if opt.friction_laws else None
     with io.stage("preload"):
-        pre = preload(mech, load, steps)
+        pre = preload(mech, load, steps, reset=reset)
     with io.stage("eigen solve"):
-        K, M = linearise(mech, materials)
-        modes = solve_modes(K, M, f_min=band[0], f_max=band[1], n_modes=n_modes, target=target, damping=damping)
-        M.destroy()
+        lin = linearise_system(mech, materials, damping=damping or opt.damping,
+                               slope=slope if opt.friction_damping else None, prestress=opt.prestress,
+                               gyroscopic=opt.gyroscopic, material=opt.material_damping)
+        modes = solve_system(lin.system, f_min=band[0], f_max=band[1], n_modes=n_modes, target=target,
+                             method=opt.method, basis=opt.basis)
+        effect = prestress_effect(modes, lin.system, lin.K_sigma) if lin.K_sigma is not None else None
+        for A in (lin.system.M, lin.system.C, lin.system.H, lin.K_sigma):
+            if A is not None:
+                A.destroy()
     with io.stage("strain energy per component"):
         shares = strain_energy_shares(modes, RegionEnergy(mech)) if energy else None
     return SquealCase(name, pre, modes, stability_report(modes, rtol, close_tol), shares,
-                      mech.contact.facet_pressure(), mech)
+                      mech.contact.facet_pressure(), mech, effect, lin.terms)
+
+
+def friction_laws(scene, tm) -> dict | None:
+    """mu(v) law of every interface when [loading] gives a ``friction_curve`` or ``stribeck``
+    (an interface's own constant ``friction`` stays constant); None with a constant friction."""
+    ld = scene.loading
+    if not scene.has("friction") or (ld.friction_curve is None and ld.stribeck is None):
+        return None
+    law = TableFriction(ld.friction_curve) if ld.friction_curve is not None else \
+        StribeckFriction(ld.stribeck.static, ld.stribeck.kinetic, ld.stribeck.speed, ld.stribeck.exponent)
+    own = {n: scene.interfaces[n].friction for n in scene.interfaces if scene.interfaces[n] is not None}
+    return {n: ConstantFriction(own[n]) if own.get(n) is not None else law for n in tm.interface.tags}
+
+
+def squeal_options(scene, tm) -> SquealOptions:
+    """The ``SquealOptions`` of a scene's [stability], [materials] and [loading]."""
+    st = scene.stability
+    proportional = (st.rayleigh_alpha, st.rayleigh_beta, st.damping)
+    return SquealOptions(Damping(*proportional) if any(proportional) else None, True, friction_laws(scene, tm),
+                         st.friction_damping, st.prestress, st.gyroscopic, st.method, st.basis)
+
+
+def model_scene(scene):
+    """The scene the model factory reads: with a mu(v) law, a placeholder constant friction
+    (the law sets the per-facet mu before the preload)."""
+    if scene.loading.friction is None and scene.has("friction"):
+        return dataclasses.replace(scene, loading=dataclasses.replace(scene.loading, friction=0.0))
+    return scene
+
+
+def build_squeal_mechanics(scene, tm, *, degree: int = SQUEAL_DEGREE, prefix: str = "squeal_") -> Mechanics:
+    """The mechanics of a scene's squeal analysis on ``tm`` (rough laws with effect roughness;
+    the datum gap as Newton's start)."""
+    model = model_scene(scene)
+    rough = build_rough_interface(model, tm) if scene.has("roughness") else None
+    if rough is not None:
+        with io.stage("zone laws"):
+            rough.update_laws()
+    with io.stage("model set-up"):       # function spaces, forms compiled (cached after the first run)
+        mech = build_mechanics(model, tm, law=rough.law if rough else None, degree=degree, prefix=prefix)
+    if rough is not None:            # Newton starts at rest from the rigid datum gap
+        tm.interface.set_field(mech.contact.initial_gap, rough.datum_gap(interface_forces(model, tm)))
+    return mech
 
 
 def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: int = SQUEAL_DEGREE) -> SquealCase:
@@ -76,17 +163,24 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     st = scene.stability
     name = name or scene.name
     prefix = "squeal_" + "".join(ch if ch.isalnum() else "_" for ch in name) + "_"
-    rough = build_rough_interface(scene, tm) if scene.has("roughness") else None
-    if rough is not None:
-        with io.stage("zone laws"):
-            rough.update_laws()
-    with io.stage("model set-up"):       # function spaces, forms compiled (cached after the first run)
-        mech = build_mechanics(scene, tm, law=rough.law if rough else None, degree=degree, prefix=prefix)
-    if rough is not None:            # Newton starts at rest from the rigid datum gap
-        tm.interface.set_field(mech.contact.initial_gap, rough.datum_gap(interface_forces(scene, tm)))
-    return squeal_case(mech, dict(scene.materials), name, load=drive(scene, tm).load, steps=scene.loading.ramp_steps,
-                       band=tuple(st.band), n_modes=st.modes, target=st.target,
-                       damping=Damping(eta=st.damping) if st.damping else None, energy=energy)
+    mech = build_squeal_mechanics(scene, tm, degree=degree, prefix=prefix)
+    return squeal_case(mech, dict(scene.materials), name, load=drive(model_scene(scene), tm).load,
+                       steps=scene.loading.ramp_steps, band=tuple(st.band), n_modes=st.modes, target=st.target,
+                       energy=energy, options=squeal_options(scene, tm))
+
+
+def write_prestress_csv(effect: PrestressEffect, path) -> Path:
+    """Frequency of every mode with and without the prestress stiffness, and the shift."""
+    path = Path(path)
+    with path.open("w", newline="") as f:
+        w = csv.writer(f)
+        w.writerow(["mode", "frequency_Hz", "frequency_without_prestress_Hz", "shift_Hz", "sigma_1_per_s",
+                    "sigma_without_prestress_1_per_s", "mac", "residual_without"])
+        for j in range(effect.frequency.size):
+            w.writerow([j + 1, f"{effect.frequency[j]:.6f}", f"{effect.frequency_without[j]:.6f}",
+                        f"{effect.shift[j]:.6f}", f"{effect.growth[j]:.6e}", f"{effect.growth_without[j]:.6e}",
+                        f"{effect.mac[j]:.4f}", f"{effect.residual[j]:.2e}"])
+    return path
 
 
 def energy_split(tm) -> tuple[str, str] | None:
@@ -101,6 +195,7 @@ class SquealResult(RunResult):
     """``RunResult`` of the squeal analysis, with its case."""
 
     case: SquealCase
+    map: StabilityMap | None = None  # with [stability.sweep]
 
 
 def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = True,
@@ -121,15 +216,32 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         files += write_modes(folder, case.modes, case.mech.u, [b.name for b in tm.bodies])
         split = energy_split(tm)
         masks = tm.interface.masks()
-        files += io.on_root(comm, lambda: [
-            plot_pressure(tm.interface.midpoints, masks, case.facet_pressure, case.name, folder / "pressure.png"),
-            plot_re_im([case], folder / "re_im.png"), plot_energy(case, folder / "energy.png", split)],
-            f"the figures in {folder}") or []
-    result = SquealResult(folder, files, time.perf_counter() - t0, case)
+
+        def figures():
+            out = [plot_pressure(tm.interface.midpoints, masks, case.facet_pressure, case.name, folder / "pressure.png"),
+                   plot_re_im([case], folder / "re_im.png"), plot_energy(case, folder / "energy.png", split)]
+            if case.prestress is not None:
+                out.append(write_prestress_csv(case.prestress, folder / "prestress.csv"))
+            return out
+        files += io.on_root(comm, figures, f"the figures in {folder}") or []
+    smap = None
+    if scene.stability.sweep is not None:
+        with io.stage("stability map"):
+            smap = squeal_map.stability_map(scene, tm, case.mech, squeal_options(scene, tm),
+                                            drive(model_scene(scene), tm).load,
+                                            lambda changed: build_squeal_mechanics(changed, tm, degree=degree,
+                                                                                   prefix="squeal_map_"))
+            files += squeal_map.write(smap, folder, comm)
+    result = SquealResult(folder, files, time.perf_counter() - t0, case, smap)
     if verbose and comm.rank == 0:
         rep = case.report
         print(f"{scene.name}: {len(case.modes)} modes up to {case.modes.frequency.max():.0f} Hz, "
               f"{rep.unstable.size} unstable ({', '.join(f'{f:.0f} Hz' for f in rep.frequency[rep.unstable - 1])}), "
               f"{rep.potentially_unstable.size} potentially unstable; {result.wall_time:.1f} s on {comm.size} rank(s)")
+        if case.prestress is not None:
+            shift = case.prestress.shift
+            print(f"  prestress shifts the frequencies by {np.nanmin(shift):+.2f} to {np.nanmax(shift):+.2f} Hz")
+        if smap is not None:
+            print(smap.summary())
         print(f"  results: {folder}")
     return result

@@ -1,0 +1,132 @@
+"""The squeal-analysis tables of a scene (``multiscale.scene``): [stability], [stability.sweep] and the
+speed-dependent friction law [loading.stribeck] (issue 20; docs/squeal.md). Values are SI numbers or
+unit strings (``multiscale.units``).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from multiscale.schema import Choice, Flag, Integer, ListOf, OneOf, Pair, Quantity, Section, key
+
+
+@dataclass(frozen=True)
+class Stribeck:
+    """[loading.stribeck]: friction falling with the slip speed v, mu(v) = kinetic + (static -
+    kinetic) exp(-(v / speed)^exponent) (exponent 1: the exponential static-to-kinetic decay law)."""
+
+    static: float | None = key(Quantity("dimensionless", ge=0), required=True)
+    kinetic: float | None = key(Quantity("dimensionless", ge=0), required=True)
+    speed: float | None = key(Quantity("speed", gt=0), required=True)            # m/s, Stribeck speed
+    exponent: float = key(Quantity("dimensionless", gt=0), default=1.0)
+
+
+
+SWEEP_PARAMETERS = {"friction": "-", "pressure": "Pa", "speed": "rad/s", "rms": "m"}
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """[stability.sweep]: a stability map over one parameter: the friction coefficient of every
+    interface, the brake pressure, the speed of the rotating body or the R_q of the rough surfaces
+    (effect "roughness"). The listed values, or with ``points`` that many from the first to the
+    last. ``preload = "once"`` (default for friction and speed) keeps the sliding state of the
+    nominal analysis and projects every point on the undamped modes of the first and last points;
+    ``"each"`` (pressure, roughness) preloads and solves every point. The modes are tracked by MAC
+    (``mac``: the lowest MAC of a pair) and the onset of every unstable mode is bisected
+    (``onsets``); see ``multiscale.workflows.squeal_map``."""
+
+    friction: tuple | None = key(ListOf(Quantity("dimensionless", ge=0), min_len=2))
+    pressure: tuple | None = key(ListOf(Quantity("pressure", gt=0), min_len=2))          # Pa
+    speed: tuple | None = key(ListOf(Quantity("angular_speed", ge=0), min_len=2))       # rad/s
+    rms: tuple | None = key(ListOf(Quantity("length", gt=0), min_len=2))                # m
+    points: int | None = key(Integer(ge=2))
+    preload: str | None = key(Choice(("each", "once")))      # default: once for friction and speed
+    mac: float = key(Quantity("dimensionless", gt=0, le=1), default=0.5)
+    onsets: bool = key(Flag(), default=True)
+
+    rules = (OneOf(tuple(SWEEP_PARAMETERS), required=True),)
+
+    @property
+    def parameter(self) -> str:
+        return next(k for k in SWEEP_PARAMETERS if getattr(self, k) is not None)
+
+    @property
+    def preload_mode(self) -> str:
+        """"once" (keep the nominal sliding state) or "each" (preload every point)."""
+        return self.preload or ("once" if self.parameter in ("friction", "speed") else "each")
+
+    @property
+    def values(self) -> tuple:
+        """The swept values (SI), increasing."""
+        given = getattr(self, self.parameter)
+        if self.points is None:
+            return tuple(given)
+        lo, hi = given
+        return tuple(lo + (hi - lo) * k / (self.points - 1) for k in range(self.points))
+
+    def problems(self, path, ctx):
+        name = self.parameter
+        given = getattr(self, name)
+        where = f"{path}.{name}"
+        if self.points is not None and len(given) != 2:
+            return [f"{where}: with {path}.points give the range [first, last] (2 values, got {len(given)})"]
+        if any(b <= a for a, b in zip(given, given[1:])):
+            return [f"{where}: the values must increase"]
+        loading = ctx.root.get("loading") if isinstance(ctx.root.get("loading"), dict) else {}
+        if name == "rms" and "roughness" not in ctx.effects:
+            return [f'{where}: sweeps the rough surfaces: needs effect "roughness"']
+        if name == "rms" and "rms" not in (ctx.root.get("roughness") or {}):
+            return [f"{where}: sweeps roughness.rms of a generated surface; the scene gives no roughness.rms"]
+        if self.preload == "once" and name in ("pressure", "rms"):
+            return [f'{path}.preload = "once": a {name} sweep changes the preloaded state; use "each"']
+        if name == "friction" and ("friction_curve" in loading or "stribeck" in loading):
+            return [f"{where}: sets a constant friction; remove loading.friction_curve / loading.stribeck"]
+        if name == "pressure" and "pressure" not in loading:
+            return [f"{where}: sweeps loading.pressure; the scene gives no loading.pressure"]
+        if name == "speed" and "sliding_speed" in loading:
+            return [f"{where}: an angular speed of the rotating body; this geometry translates"]
+        return []
+
+
+@dataclass(frozen=True)
+class Stability:
+    """Complex eigenvalue analysis (§4.3): modes in a frequency band, shift target, damping.
+
+    ``damping`` (loss factor eta), ``rayleigh_alpha`` / ``rayleigh_beta`` (alpha M + beta K) act on
+    the whole system, mapped exactly from the undamped modes. Per-material damping, the friction
+    slope (``friction_damping``) and the gyroscopic terms are solved as a full quadratic
+    eigenproblem (``method = "quadratic"``, viscous only) or by projection on the undamped modes up
+    to ``basis`` x the band's top (``"projection"``, needed for loss factors); ``"auto"`` picks.
+    ``prestress``: the initial-stress stiffness of the preload, its effect on every frequency
+    reported; ``gyroscopic``: the rotating body's Coriolis and centrifugal terms (docs/squeal.md)."""
+
+    band: tuple = key(Pair(Quantity("frequency", ge=0), single=False, names="[low, high]"),
+                      default=(0.0, 16e3))                                    # Hz
+    modes: int | None = key(Integer(ge=1), required=True)
+    target: float | None = key(Quantity("frequency", ge=0))                   # Hz; default: the band's lower edge
+    damping: float = key(Quantity("dimensionless", ge=0, plausible=(0.0, 0.5)), default=0.0)  # structural loss factor
+    rayleigh_alpha: float = key(Quantity("frequency", ge=0), default=0.0)     # 1/s
+    rayleigh_beta: float = key(Quantity("time", ge=0), default=0.0)           # s
+    prestress: bool = key(Flag(), default=False)
+    gyroscopic: bool = key(Flag(), default=False)
+    friction_damping: bool = key(Flag(), default=True)
+    method: str = key(Choice(("auto", "projection", "quadratic")), default="auto")
+    basis: float = key(Quantity("dimensionless", ge=1), default=1.5)
+    sweep: Sweep | None = key(Section(Sweep))
+
+    def problems(self, path, ctx):
+        low, high = self.band
+        if high <= low:
+            return [f"{path}.band = [{low:g}, {high:g}] Hz: the upper bound must exceed the lower"]
+        if self.target is not None and not low <= self.target <= high:
+            return [f"{path}.target = {self.target:g} Hz: must lie in the band [{low:g}, {high:g}] Hz"]
+        materials = ctx.root.get("materials") if isinstance(ctx.root.get("materials"), dict) else {}
+        lossy = [m for m, t in materials.items() if isinstance(t, dict) and t.get("loss_factor")]
+        if self.method == "quadratic" and (self.damping or lossy):
+            what = f"{path}.damping" if self.damping else f"materials.{lossy[0]}.loss_factor"
+            return [f'{path}.method = "quadratic": takes viscous damping only; {what} (complex stiffness) '
+                    'needs method = "projection"']
+        loading = ctx.root.get("loading") if isinstance(ctx.root.get("loading"), dict) else {}
+        if self.gyroscopic and "sliding_speed" in loading:
+            return [f"{path}.gyroscopic = true: needs a rotating body; this geometry translates"]
+        return []

@@ -1,0 +1,186 @@
+"""Damped linearised systems of the squeal analysis (issue 20): Hoffmann 2-DOF with damping,
+Rayleigh damping ratios, the 1-DOF oscillator on a belt with a falling mu(v), stability maps."""
+import numpy as np
+import pytest
+
+import multiscale.macro  # noqa: F401,I001  (DOLFINx's prerequisites before petsc4py)
+from petsc4py import PETSc
+
+from multiscale.errors import InputError
+from multiscale.macro import damped, eigen
+from multiscale.macro.friction import StribeckFriction, TableFriction
+from multiscale.macro.stability_map import build_map
+from multiscale.references.stability import (belt_onset_speed, damped_hoffmann_onset, hoffmann_matrices,
+                                              hoffmann_onset, rayleigh_damping_ratio, stribeck,
+                                              vanishing_damping_onset)
+
+HOFFMANN = dict(k11=1.0, k22=1.5, k12=0.3, k21=0.3, k3=1.0)
+MU_C = hoffmann_onset(**HOFFMANN)          # 0.508333...
+
+
+def petsc_mat(A):
+    A = np.atleast_2d(A)
+    n = A.shape[0]
+    m = PETSc.Mat().createAIJ([n, n], nnz=n, comm=PETSc.COMM_SELF)
+    m.setUp()
+    for i, j in zip(*np.nonzero(A)):
+        m.setValue(i, j, A[i, j])
+    m.assemble()
+    return m
+
+
+def hoffmann_system(mu, c1=0.0, c2=0.0):
+    K, M = hoffmann_matrices(mu, **HOFFMANN)
+    C = petsc_mat(np.diag([c1, c2])) if c1 or c2 else None
+    return damped.LinearSystem(petsc_mat(K), petsc_mat(M), C)
+
+
+def companion_eigenvalues(K, C, M):
+    """lambda (omega >= 0) of det(lambda^2 M + lambda C + K) = 0 by numpy's dense eigvals."""
+    n = K.shape[0]
+    Minv = np.linalg.inv(M)
+    lam = np.linalg.eigvals(np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]]))
+    lam = lam[lam.imag > 0]
+    return lam[np.lexsort((lam.real, lam.imag))]
+
+
+# ---------------------------------------------------------------- Hoffmann 2-DOF with damping
+@pytest.mark.parametrize("c", [(0.05, 0.05), (0.02, 0.08), (0.1, 0.0)])
+def test_routh_hurwitz_onset_is_where_the_companion_form_turns_unstable(c):
+    mu_c = damped_hoffmann_onset(*c, **HOFFMANN)
+    for mu, sign in ((mu_c * (1 - 1e-6), -1), (mu_c * (1 + 1e-6), 1)):
+        lam = companion_eigenvalues(hoffmann_matrices(mu, **HOFFMANN)[0], np.diag(c), np.eye(2))
+        assert np.sign(lam.real.max()) == sign
+
+
+def test_equal_damping_raises_and_unequal_damping_can_lower_the_critical_friction():
+    c = 0.05
+    assert damped_hoffmann_onset(c, c, **HOFFMANN) == pytest.approx(MU_C + 2.5 * c**2 / (2 * 0.3), rel=1e-12)
+    assert damped_hoffmann_onset(0.0, 0.0, **HOFFMANN) == MU_C
+    # destabilisation paradox: vanishing unequal damping gives a lower onset than the undamped one
+    for w in (0.2, 0.5, 1.0):
+        small = damped_hoffmann_onset(1e-7 * w, 1e-7 * (1 - w), **HOFFMANN)
+        assert small == pytest.approx(vanishing_damping_onset(w, **HOFFMANN), rel=1e-6)
+    assert vanishing_damping_onset(0.5, **HOFFMANN) == pytest.approx(MU_C, rel=1e-12)
+    assert vanishing_damping_onset(0.2, **HOFFMANN) < MU_C
+    assert damped_hoffmann_onset(0.01, 0.04, **HOFFMANN) < MU_C     # smoothing effect lost
+
+
+@pytest.mark.parametrize("method", ["projection", "quadratic"])
+@pytest.mark.parametrize("c", [(0.05, 0.05), (0.02, 0.08)])
+def test_damped_hoffmann_onset_by_bisection_matches_the_closed_form(method, c):
+    onset = eigen.onset_of_instability(lambda mu: hoffmann_system(mu, *c), 0.0, 2.0, xtol=1e-8,
+                                       solve=damped.solve_system, f_max=1.0, method=method)
+    # the "unstable" test sigma > 1e-6 |lambda| moves the onset by ~1e-6 |lambda| / (d sigma / d mu)
+    assert onset == pytest.approx(damped_hoffmann_onset(*c, **HOFFMANN), rel=1e-4)
+
+
+def test_undamped_system_takes_the_gnhep_path_bit_for_bit():
+    K, M = hoffmann_matrices(0.7, **HOFFMANN)
+    a = damped.solve_system(damped.LinearSystem(petsc_mat(K), petsc_mat(M)), f_max=1.0)
+    b = eigen.solve_modes(petsc_mat(K), petsc_mat(M), f_max=1.0)
+    assert a.method == "gnhep"
+    np.testing.assert_array_equal(a.eigenvalues, b.eigenvalues)
+    np.testing.assert_array_equal(a.modes, b.modes)
+
+
+# ---------------------------------------------------------------- Rayleigh damping
+def chain(n=30, k=4e6, m=0.01):
+    K = 2 * k * np.eye(n) - k * (np.eye(n, k=1) + np.eye(n, k=-1))
+    return K, m * np.eye(n)
+
+
+@pytest.mark.parametrize("method", ["proportional", "projection", "quadratic"])
+def test_rayleigh_damping_ratio_of_every_mode(method):
+    """zeta = -sigma / |lambda| = alpha / (2 omega) + beta omega / 2 with omega = |lambda| the
+    undamped angular frequency: the exact map, the projection and the full quadratic solver."""
+    K, M = chain()
+    alpha, beta = 200.0, 2e-6
+    if method == "proportional":
+        system = damped.LinearSystem(petsc_mat(K), petsc_mat(M), damping=eigen.Damping(alpha, beta))
+    else:
+        system = damped.LinearSystem(petsc_mat(K), petsc_mat(M), petsc_mat(alpha * M + beta * K))
+    r = damped.solve_system(system, f_max=4e3, method="auto" if method == "proportional" else method)
+    undamped = 2 * np.sqrt(4e6 / 0.01) * np.sin(np.arange(1, 31) * np.pi / 62)
+    undamped = undamped[undamped <= 2 * np.pi * 4e3]
+    assert len(r) == undamped.size == 13
+    assert r.method == {"proportional": "gnhep", "quadratic": "pep"}.get(method, method)
+    omega = np.abs(r.eigenvalues)
+    np.testing.assert_allclose(-r.growth / omega, rayleigh_damping_ratio(omega, alpha, beta), rtol=1e-8)
+    np.testing.assert_allclose(omega, undamped, rtol=1e-8)      # SLEPc PEP tol 1e-10
+    if method == "projection":
+        assert r.errors.max() < 1e-10                 # exact: the basis holds the damped modes
+
+
+def test_hysteretic_damping_needs_the_projection():
+    K, M = chain(8)
+    system = damped.LinearSystem(petsc_mat(K), petsc_mat(M), H=petsc_mat(0.02 * K))
+    with pytest.raises(InputError, match="stability.method"):
+        damped.solve_system(system, f_max=2e4, method="quadratic")
+    r = damped.solve_system(system, f_max=2e4, basis=5.0)
+    ref = companion_eigenvalues(K * (1 + 0.02j), np.zeros_like(K), M)     # loss factor: zeta ~ eta / 2
+    np.testing.assert_allclose(r.eigenvalues, ref[ref.imag / (2 * np.pi) <= 2e4], rtol=1e-10)
+
+
+# ---------------------------------------------------------------- mu(v) slope: a 1-DOF oscillator on a belt
+def test_friction_laws_values_and_slopes():
+    law = StribeckFriction(0.6, 0.4, 0.1)
+    v = np.array([0.0, 0.05, 0.1, 1.0])
+    mu, slope = stribeck(v, 0.6, 0.4, 0.1)
+    np.testing.assert_allclose(law.value(v), mu, rtol=1e-14)
+    np.testing.assert_allclose(law.slope(v), slope, rtol=1e-14)
+    h = 1e-7                                         # central difference of the law itself
+    np.testing.assert_allclose(law.slope(v[1:]), (law.value(v[1:] + h) - law.value(v[1:] - h)) / (2 * h), rtol=1e-6)
+    table = TableFriction(((0.0, 0.5), (1.0, 0.4), (2.0, 0.4)))
+    np.testing.assert_allclose(table.value([0.5, 3.0]), [0.45, 0.4])
+    np.testing.assert_allclose(table.slope([0.5, 1.5, 3.0]), [-0.1, 0.0, 0.0])
+    with pytest.raises(InputError, match="friction_curve"):
+        TableFriction(((1.0, 0.5), (0.5, 0.4)))
+
+
+def test_belt_oscillator_negative_damping_onset():
+    """m x'' + (c + N mu'(V)) x' + k x = 0: unstable below the belt speed where N mu'(V) = -c."""
+    m, k, c, N = 1.0, 1e4, 0.5, 100.0
+    law = StribeckFriction(0.6, 0.4, 0.1)
+
+    def system(v):
+        return damped.LinearSystem(petsc_mat(k), petsc_mat(m), petsc_mat(c + N * law.slope(v)))
+
+    def unstable(v):
+        return damped.solve_system(system(v), f_max=100.0, method="quadratic").unstable().any()
+
+    v_star = belt_onset_speed(c, N, 0.6, 0.4, 0.1)
+    assert v_star == pytest.approx(0.1 * np.log(400.0), rel=1e-12)
+    assert unstable(0.5 * v_star) and not unstable(1.5 * v_star)
+    lo, hi = 0.5 * v_star, 1.5 * v_star
+    while hi - lo > 1e-6 * v_star:
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if unstable(mid) else (lo, mid)
+    assert 0.5 * (lo + hi) == pytest.approx(v_star, rel=1e-4)
+    r = damped.solve_system(system(0.2), f_max=100.0, method="projection")
+    assert r.growth[0] == pytest.approx(-(c + N * law.slope(0.2)) / (2 * m), rel=1e-9)
+
+
+# ---------------------------------------------------------------- stability map of the Hoffmann model
+def test_map_tracks_the_hoffmann_pair_and_bisects_its_lock_in(tmp_path):
+    values = np.linspace(0.0, 1.0, 6)
+    sub = damped.Subspace([np.eye(2)], petsc_mat(np.eye(2)))
+    results, reduced = [], []
+    for mu in values:
+        r, red = damped.solve_projected(hoffmann_system(mu), sub, band=(0.0, 1.0), expand=False)
+        results.append(r), reduced.append(red)
+    smap = build_map("friction", "-", values, results, reduced, (0.0, 1.0), xtol=1e-9)
+    assert smap.n_tracks == 2 and (smap.mode >= 0).all()
+    assert len(smap.onsets) == 1
+    onset = smap.onsets[0]
+    assert onset.value == pytest.approx(MU_C, rel=1e-6) and onset.kind == "lock-in"
+    theta = (1.0 + 1.5) / 2                           # coalescence at the mean theta
+    assert onset.frequency == pytest.approx(np.sqrt(theta) / (2 * np.pi), rel=1e-3)
+    smap.write_csv(tmp_path / "map.csv"), smap.write_onsets_csv(tmp_path / "onsets.csv")
+    smap.write_h5(tmp_path / "map.h5")
+    rows = (tmp_path / "map.csv").read_text().splitlines()
+    assert len(rows) == 1 + 2 * values.size
+    import h5py
+    with h5py.File(tmp_path / "map.h5") as f:
+        np.testing.assert_allclose(f["onsets/value"][:], [onset.value])
+        assert f["growth"].shape == (6, 2)

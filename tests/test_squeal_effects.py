@@ -1,0 +1,210 @@
+"""Squeal-analysis options on finite-element models (issue 20): prestress (pre-tensioned beam),
+gyroscopic terms (spinning disc), per-material damping, friction-slope damping, scene sweeps."""
+from pathlib import Path
+from types import SimpleNamespace as NS
+
+import numpy as np
+import pytest
+
+pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+
+import gmsh  # noqa: E402
+import ufl  # noqa: E402
+from dolfinx import fem, io, mesh as dmesh  # noqa: E402
+from dolfinx.fem import petsc as fpetsc  # noqa: E402
+from mpi4py import MPI  # noqa: E402
+
+from meshes import disc_brake  # noqa: E402
+from multiscale import scene as scenes  # noqa: E402
+from multiscale.errors import InputError  # noqa: E402
+from multiscale.geometry import Rotation, builder  # noqa: E402
+from multiscale.macro import damped, eigen  # noqa: E402
+from multiscale.macro import mesh as two_body  # noqa: E402
+from multiscale.macro.friction import StribeckFriction, facet_slip_speed, friction_damping  # noqa: E402
+from multiscale.macro.mechanics import Mechanics  # noqa: E402
+from multiscale.macro.operators import geometric_form, rotation_forms, rotation_velocity  # noqa: E402
+from multiscale.macro.preload import linearise, preload  # noqa: E402
+from multiscale.references.stability import spinning_disc_split, tensioned_beam_frequency  # noqa: E402
+from multiscale.workflows import squeal  # noqa: E402
+
+DEMO = Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml"
+STEEL = NS(E=210e9, nu=0.3, rho=7850.0)
+MATERIALS = {"disc": NS(E=125e9, nu=0.25, rho=7200.0), "pad": NS(E=5e9, nu=0.25, rho=2500.0),
+             "backplate": STEEL, "piston": STEEL, "caliper": STEEL}
+PRESSURE = 1e6
+
+
+def elasticity(V, m):
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    lam, mu = m.E * m.nu / ((1 + m.nu) * (1 - 2 * m.nu)), m.E / (2 * (1 + m.nu))
+    eps = ufl.sym(ufl.grad(u))
+    k = (lam * ufl.tr(eps) * ufl.div(v) + 2 * mu * ufl.inner(eps, ufl.sym(ufl.grad(v)))) * ufl.dx
+    return u, v, k, m.rho * ufl.inner(u, v) * ufl.dx
+
+
+def assemble(form, bcs=(), diag=1.0):
+    A = fpetsc.assemble_matrix(fem.form(form), bcs=list(bcs), diag=diag)
+    A.assemble()
+    return A
+
+
+# ---------------------------------------------------------------- prestress
+def test_pre_tensioned_beam_frequency_shift_matches_the_closed_form():
+    """Pinned-pinned beam (transverse displacements fixed on the end faces) under an axial stress
+    sigma_0 = T / A: omega^2 rises by T k^2 / (rho A), k = n pi / L, whatever the bending stiffness."""
+    L, h, m = 1.0, 0.04, STEEL
+    msh = dmesh.create_box(MPI.COMM_SELF, [[0, 0, 0], [L, h, h]], [24, 2, 2], dmesh.CellType.hexahedron)
+    V = fem.functionspace(msh, ("Lagrange", 2, (3,)))
+    u, v, k, mass = elasticity(V, m)
+    ends = dmesh.locate_entities_boundary(msh, 2, lambda x: np.isclose(x[0], 0) | np.isclose(x[0], L))
+    bcs = [fem.dirichletbc(0.0, fem.locate_dofs_topological(V.sub(i), 2, ends), V.sub(i)) for i in (1, 2)]
+    stress0 = 20e6                                   # Pa, T = 32 kN (3 % of the Euler load of mode 1)
+    sigma = ufl.as_matrix([[stress0, 0, 0], [0, 0, 0], [0, 0, 0]])
+    K, M = assemble(k, bcs), assemble(mass, bcs, diag=0.0)
+    Ks = assemble(geometric_form(sigma, u, v, ufl.dx), bcs, diag=0.0)
+    f0 = eigen.solve_modes(K, M, f_min=5.0, f_max=200.0, target=5.0).frequency
+    K.axpy(1.0, Ks)
+    f1 = eigen.solve_modes(K, M, f_min=5.0, f_max=200.0, target=5.0).frequency
+    # first bending doublet (y and z): the shift of omega^2 against the closed form
+    A, inertia = h * h, h**4 / 12
+    ref = tensioned_beam_frequency(1, L, m.E, inertia, m.rho, A, stress0 * A) ** 2 \
+        - tensioned_beam_frequency(1, L, m.E, inertia, m.rho, A) ** 2
+    shift = (2 * np.pi) ** 2 * (f1[:2] ** 2 - f0[:2] ** 2)
+    np.testing.assert_allclose(shift, ref, rtol=1e-5)              # measured 4e-7
+    assert f0[0] == pytest.approx(tensioned_beam_frequency(1, L, m.E, inertia, m.rho, A) / (2 * np.pi), rel=5e-3)   # 2.5e-3: shear, h/L = 0.04
+
+
+# ---------------------------------------------------------------- rotating disc
+@pytest.mark.parametrize("method", ["quadratic", "projection"])
+def test_spinning_disc_splits_two_nodal_diameter_doublet_by_n_omega(method):
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        gmsh.model.add("disc")
+        disc_brake.generate_disc(gmsh.model, {"mesh_size": 0.032, "disc_thickness": 0.008}, hat=False)
+        msh = io.gmsh.model_to_mesh(gmsh.model, MPI.COMM_SELF, 0, gdim=3).mesh
+    finally:
+        gmsh.finalize()
+    m = MATERIALS["disc"]
+    V = fem.functionspace(msh, ("Lagrange", 2, (3,)))
+    u, v, k, mass = elasticity(V, m)
+    K, M = assemble(k), assemble(mass)
+    base = eigen.solve_modes(K, M, f_min=20.0, f_max=2000.0, target=20.0, n_modes=2)
+    f_r = base.frequency.mean()
+    omega = 2 * np.pi * 0.02 * f_r / 2               # split n Omega / pi = 4 % of f_r
+    w = rotation_velocity(Rotation((0.0, 0.0, 1.0), (0.0, 0.0, 0.0)), ufl.SpatialCoordinate(msh), omega)
+    g, kw = rotation_forms(m.rho, w, u, v, ufl.dx)
+    Kt = assemble(k)
+    Kt.axpy(1.0, assemble(kw, diag=0.0))
+    system = damped.LinearSystem(Kt, M, assemble(g, diag=0.0))
+    r = damped.solve_system(system, f_min=20.0, f_max=1.3 * f_r, target=20.0, basis=2.0, method=method)
+    pair = r.frequency[np.argsort(np.abs(r.frequency - f_r))[:2]]
+    low, high = np.sort(pair)
+    b, f = spinning_disc_split(f_r, 2, omega)
+    assert high - low == pytest.approx(f - b, rel=0.01)          # measured 1.1e-3 (in-plane motion)
+    assert 0.5 * (low + high) == pytest.approx(f_r, rel=1e-5)     # measured 1e-7
+    assert np.abs(r.growth).max() < 1e-6 * np.abs(r.eigenvalues).max()   # gyroscopic: conservative
+    assert r.errors.max() < 1e-3                                     # projection: measured 6e-4
+
+
+# ---------------------------------------------------------------- the brake model
+@pytest.fixture(scope="module")
+def brake():
+    tm = two_body.build(builder("disc_brake"), {"mesh_size": 0.02})
+    mech = Mechanics(tm, MATERIALS, stiffness=1e13, friction=0.4, speed=5.0, load_kind="fluid",
+                     prefix="brake_effects_")
+    return tm, mech
+
+
+def test_default_options_give_the_undamped_analysis_bit_for_bit(brake):
+    tm, mech = brake
+    case = squeal.squeal_case(mech, MATERIALS, "mu0.4", load=PRESSURE, n_modes=12, energy=False)
+    preload(mech, PRESSURE, 1)
+    ref = eigen.solve_modes(*linearise(mech, MATERIALS), n_modes=12, f_max=16e3)
+    assert case.terms == () and case.modes.method == "gnhep"
+    np.testing.assert_array_equal(case.modes.eigenvalues, ref.eigenvalues)
+
+
+def test_material_mass_damping_shifts_every_eigenvalue_exactly(brake):
+    """alpha_b = alpha on every body: C = alpha M, so lambda^2 + alpha lambda + theta = 0 maps
+    the undamped theta exactly; the full quadratic solver must reproduce it."""
+    tm, mech = brake
+    alpha = 40.0
+    lossy = {n: NS(**vars(m), damping_alpha=alpha) for n, m in MATERIALS.items()}
+    plain = squeal.squeal_case(mech, MATERIALS, "plain", load=PRESSURE, n_modes=12, energy=False)
+    case = squeal.squeal_case(mech, lossy, "alpha", load=PRESSURE, n_modes=12, energy=False)
+    assert case.terms == ("material viscous damping",) and case.modes.method == "pep"
+    ref = eigen.lambda_from_theta(plain.modes.theta, eigen.Damping(alpha=alpha))
+    np.testing.assert_allclose(case.modes.eigenvalues, ref, rtol=1e-6)        # measured 1.1e-7 (PEP)
+
+
+def test_friction_slope_damping_of_a_rigid_disc_rotation(brake):
+    """C_f of a uniform slope k [s/m] on the disc's rigid rotation (unit rad/s) is int p k r^2 dS."""
+    tm, mech = brake
+    preload(mech, PRESSURE, 1)
+    k = -0.05
+    C = friction_damping(mech, np.full(tm.interface.n_facets, k))
+    rot = fem.Function(mech.spaces[1])
+    rot.interpolate(lambda x: np.vstack([-x[1], x[0], 0 * x[2]]))
+    x, y = C.createVecs()
+    x.set(0.0)
+    off = mech.spaces[0].dofmap.index_map.size_local * 3
+    n1 = mech.spaces[1].dofmap.index_map.size_local * 3
+    x.array[off:off + n1] = rot.x.array[:n1]
+    C.mult(x, y)
+    xs = ufl.SpatialCoordinate(tm.parent)
+    ref = fem.assemble_scalar(fem.form(k * mech.contact.pressure * (xs[0] ** 2 + xs[1] ** 2) * tm.interface.dS,
+                                       entity_maps=tm.entity_maps))
+    assert x.dot(y) == pytest.approx(ref, rel=1e-10)
+    assert ref < 0
+
+
+# ---------------------------------------------------------------- scene options and sweeps
+def test_scene_friction_sweep_writes_the_map(tmp_path):
+    overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 30, "output.folder": str(tmp_path / "out"),
+                 "stability.sweep.friction": [0.0, 0.6], "stability.sweep.points": 4}
+    scene = scenes.load(DEMO, overrides)
+    run = squeal.run(scene, degree=1, verbose=False)
+    names = {p.name for p in run.files}
+    assert {"map.csv", "onsets.csv", "map.h5", "map.png", "map_tracks.png"} <= names
+    smap = run.map
+    np.testing.assert_allclose(smap.values, [0.0, 0.2, 0.4, 0.6])
+    assert not smap.unstable()[0].any()                       # no friction: stable
+    assert smap.unstable()[-1].any() and smap.onsets
+    assert np.nanmax(smap.residual) < 0.05                    # measured 0.023
+    # mu = 0.4 in the map against the nominal analysis (same preload, projected)
+    f_map = np.sort(smap.frequency[2][~np.isnan(smap.frequency[2])])
+    assert f_map[:8] == pytest.approx(run.case.modes.frequency[:8], rel=1e-4)    # measured 8e-6
+
+
+def test_scene_damping_and_stribeck_options(tmp_path):
+    overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 10, "output.folder": str(tmp_path / "out"),
+                 "stability.rayleigh_alpha": "20 1/s", "stability.prestress": True,
+                 "materials.pad.loss_factor": 0.05}
+    run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
+    assert {"material loss factors", "prestress", "proportional damping"} <= set(run.case.terms)
+    assert (tmp_path / "out" / "prestress.csv").exists()
+    assert np.all(np.abs(run.case.prestress.shift) < 0.01 * run.case.prestress.frequency)
+    with pytest.raises(InputError, match="quadratic"):
+        scenes.load(DEMO, dict(overrides, **{"stability.method": "quadratic"}))
+
+
+def test_scene_stribeck_friction_sets_mu_per_facet_and_its_slope_damping(tmp_path):
+    text = DEMO.read_text().replace("friction = 0.4\n", "") + (
+        '\n[loading.stribeck]\nstatic = 0.5\nkinetic = 0.35\nspeed = "1 m/s"\n')
+    overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 20, "output.folder": str(tmp_path / "out")}
+    scene = scenes.loads(text, DEMO.parent, overrides=overrides)
+    run = squeal.run(scene, degree=1, verbose=False)
+    case, law = run.case, StribeckFriction(0.5, 0.35, 1.0)
+    assert case.terms == ("friction slope",) and case.modes.method == "pep"
+    tm = case.mech.tm
+    V = facet_slip_speed(case.mech)
+    assert 0.2 < V.min() and V.max() < 1.0                      # 5 rad/s at the pad radii
+    np.testing.assert_allclose(tm.interface.values(case.mech.contact.friction), law.value(V), rtol=1e-12)
+    assert case.modes.errors.max() < 1e-6                      # measured 1.8e-8
+    steady = scenes.loads(text, DEMO.parent, overrides=dict(overrides, **{"stability.friction_damping": False,
+                                                                          "output.folder": str(tmp_path / "o2")}))
+    plain = squeal.run(steady, degree=1, verbose=False).case
+    assert plain.terms == () and plain.modes.method == "gnhep"
+    # the falling mu(v) damps negatively: on average the growth rates rise
+    assert np.mean(case.modes.growth - plain.modes.growth) > 0
