@@ -69,7 +69,7 @@ def run_faulty(tmp_path, mode):
     driver.write_text(DRIVER)
     start = time.monotonic()
     done = subprocess.run([str(MPIEXEC), "-n", "2", sys.executable, str(driver), str(scene), mode],
-                          capture_output=True, text=True, timeout=300)
+                          capture_output=True, text=True, timeout=300, start_new_session=True)
     return done, time.monotonic() - start
 
 

@@ -87,7 +87,8 @@ def test_the_limit_of_a_run_two_ranks(tmp_path):
     scene = tmp_path / "scene.toml"
     scene.write_text(SCENE.format(folder=tmp_path / "out"))
     done = subprocess.run([str(MPIEXEC), "-n", "2", str(Path(sys.executable).with_name("multiscale")), "run",
-                           str(scene), "--max-cells", "50"], capture_output=True, text=True, timeout=300)
+                           str(scene), "--max-cells", "50"], capture_output=True, text=True, timeout=300,
+                          start_new_session=True)
     errors = [line for line in done.stderr.splitlines() if line.startswith("error")]
     assert done.returncode == 2, done.stderr[-2000:]
     assert len(errors) == 1 and "geometry.max_cells = 50: the mesh would have about" in errors[0]

@@ -295,7 +295,7 @@ def test_runs_are_shared_out_over_mpi_ranks(tmp_path):
     mpiexec = Path(sys.executable).with_name("mpiexec")
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
     done = subprocess.run([str(mpiexec), "-n", "2", sys.executable, "-m", "multiscale.cli", "study", str(path)],
-                          capture_output=True, text=True, env=env, timeout=300)
+                          capture_output=True, text=True, env=env, timeout=300, start_new_session=True)
     assert done.returncode == 0, done.stderr
     out = tmp_path / "results" / "hertz"
     assert done.stdout.count("hertz: 2 runs") == 1                  # rank 0 reports
