@@ -109,6 +109,20 @@ def check_field(name: str, value, *, min_ndim: int = 0, nonnegative: bool = Fals
     return a
 
 
+def check_table(name: str, value, what: str) -> tuple[np.ndarray, np.ndarray]:
+    """(temperatures [K], values) of a table given as two 1-D sequences of equal length >= 2 with
+    finite, strictly increasing temperatures; InputError naming ``name`` (``what``: the allowed forms)."""
+    try:
+        temps, values = (np.asarray(v, dtype=float) for v in value)
+    except (TypeError, ValueError):
+        raise InputError(name, value, what) from None
+    if temps.ndim != 1 or temps.shape != values.shape or temps.size < 2:
+        raise InputError(name, value, "a table needs two 1-D arrays of equal length >= 2")
+    if not (np.all(np.isfinite(temps)) and np.all(np.diff(temps) > 0)):
+        raise InputError(f"{name}.temperatures", temps, "must be finite and strictly increasing")
+    return temps, values
+
+
 def check_instance(name: str, value, kind: type | tuple, what: str):
     """``value`` if it is a ``kind``, else ``InputError`` saying ``what`` is expected."""
     if not isinstance(value, kind):

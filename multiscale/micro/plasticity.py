@@ -22,7 +22,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multiscale.errors import InputError
+from multiscale.errors import InputError, check_table
 from multiscale.micro.contact import ContactResult, ContactSolver
 
 
@@ -34,14 +34,7 @@ class Hardness:
         if np.ndim(value) == 0:
             self.value, self.table = _positive("hardness", value), None
             return
-        try:
-            temps, values = (np.asarray(v, dtype=float) for v in value)
-        except (TypeError, ValueError):
-            raise InputError("hardness", value, "a number [Pa] or a (temperatures [K], values [Pa]) table") from None
-        if temps.ndim != 1 or temps.shape != values.shape or temps.size < 2:
-            raise InputError("hardness", value, "a table needs two 1-D arrays of equal length >= 2")
-        if not (np.all(np.isfinite(temps)) and np.all(np.diff(temps) > 0)):
-            raise InputError("hardness.temperatures", temps, "must be finite and strictly increasing")
+        temps, values = check_table("hardness", value, "a number [Pa] or a (temperatures [K], values [Pa]) table")
         _positive("hardness.values", values)
         self.value, self.table = None, (temps, values)
 

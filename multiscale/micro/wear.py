@@ -21,7 +21,8 @@ from dataclasses import dataclass, field
 import numpy as np
 from tqdm import tqdm
 
-from multiscale.errors import InputError, check_count, check_field, check_flag, check_instance, check_positive
+from multiscale.errors import InputError, check_count, check_field, check_flag, check_instance, check_positive, \
+    check_table
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import Kernel
 from multiscale.micro.surface import Surface, check_surface
@@ -46,14 +47,7 @@ class WearRate:
         elif np.ndim(k_w) == 0:
             self.value = check_positive("k_w", k_w, allow_zero=True)
         else:
-            try:
-                temps, rates = (np.asarray(v, dtype=float) for v in k_w)
-            except (TypeError, ValueError):
-                raise InputError("k_w", k_w, "a number, a (temperatures, rates) table or a callable") from None
-            if temps.ndim != 1 or temps.shape != rates.shape or temps.size < 2:
-                raise InputError("k_w", k_w, "table needs two 1-D arrays of equal length >= 2")
-            if not (np.all(np.isfinite(temps)) and np.all(np.diff(temps) > 0)):
-                raise InputError("k_w.temperatures", temps, "must be finite and strictly increasing")
+            temps, rates = check_table("k_w", k_w, "a number, a (temperatures, rates) table or a callable")
             if not np.all(np.isfinite(rates)) or np.any(rates < 0):
                 raise InputError("k_w.rates", rates, "wear rates must be finite and >= 0 [1/Pa]")
             self.table = (temps, rates)
