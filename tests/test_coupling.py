@@ -291,7 +291,9 @@ def test_resume_after_an_interrupted_run_gives_the_straight_history(straight, tm
     assert set(h.columns) == set(ref.columns)
     for key in ref.columns:
         if not key.startswith("time_"):
-            np.testing.assert_allclose(h[key], ref[key], rtol=1e-6, atol=1e-12, err_msg=key)
+            # the coupling residual (a difference of partitions) shows the recomputed laws first
+            rtol = 1e-4 if key == "coupling_residual" else 1e-6
+            np.testing.assert_allclose(h[key], ref[key], rtol=rtol, atol=1e-12, err_msg=key)
     assert (tmp_path / "killed" / "interface.xdmf").read_text().count("<Time ") == \
         (reference.folder / "interface.xdmf").read_text().count("<Time ")
 
