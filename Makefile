@@ -35,8 +35,13 @@ test: docs test-serial test-mpi
 docs: $(STAMP)
 	$(BIN)/python -m sphinx -b html -E -W --keep-going -n -q docs docs/_build/html
 
+# one pytest process per test module: in one process for the whole suite, a SIGTERM (turned into
+# exit code 15 by PETSc's signal handler) ended the run after ~4 minutes, at a SLEPc test; cause not
+# found (docs/architecture.md, "Known problems")
 test-serial: $(STAMP)
-	$(BIN)/python -m pytest -q tests
+	@failed=""; for f in tests/test_*.py; do \
+	  $(BIN)/python -m pytest -q -p no:cacheprovider $$f || failed="$$failed $$f"; done; \
+	  if [ -n "$$failed" ]; then echo "failed:$$failed"; exit 1; fi
 
 test-mpi: $(STAMP)
 	@if ls tests/mpi/test_*.py >/dev/null 2>&1; then \
