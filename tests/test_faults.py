@@ -10,36 +10,14 @@ import pytest
 
 pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
+from test_macro_run import BLOCK  # noqa: E402
+
 MPIEXEC = Path(sys.executable).with_name("mpiexec")
-SCENE = """
-name = "cooling_block"
-effects = ["contact", "thermal"]
-[geometry]
-builder = "block_on_flat"
-mesh_size = "5 mm"
-[materials.block]
-E = "4 GPa"
-nu = 0.15
-kappa = "5 W/(m K)"
-chi = "1e-6 m^2/s"
-[materials.flat]
-E = "210 GPa"
-nu = 0.3
-kappa = "45 W/(m K)"
-chi = "1e-5 m^2/s"
-[interface]
-penalty = "1e13 Pa/m"
-[loading]
-pressure = "1 MPa"
-[time]
-end = "3 s"
-steps = 3
-[[boundary]]
-surfaces = ["block_top"]
-temperature = "80 degC"
-[output]
-folder = "{folder}"
-"""
+# test_macro_run's block, cooling 3 s from a hot top face
+SCENE = (BLOCK.replace("{effects}", '"contact", "thermal"').replace('name = "block"', 'name = "cooling_block"')
+         .replace('mesh_size = "2.5 mm"', 'mesh_size = "5 mm"')
+         .replace('end = "1 s"\n', 'end = "3 s"\nsteps = 3\n[[boundary]]\nsurfaces = ["block_top"]\n'
+                  'temperature = "80 degC"\n'))
 # the fault, injected on rank 1 only at the second heat step, then the ordinary CLI run
 DRIVER = """
 import sys
