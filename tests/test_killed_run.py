@@ -180,16 +180,3 @@ def test_field_times_after_the_checkpoint_are_dropped_and_written_once(base, tmp
     assert {f.name: f.read_bytes() for f in folder.iterdir()} == before
     assert sorted(f.name for f in again.files) == sorted(f.name for f in result.files) == sorted(plan(scene).files)
 
-
-def test_a_serial_run_repeats_bit_for_bit(base, tmp_path):
-    """Two uninterrupted serial runs, each in a fresh process, write the same history bit for bit:
-    nothing depends on timing (with FFTW_MEASURE plans, one pair of runs in three differed by 1.7e-7;
-    this test saw that in none of two tries, so it guards against steady sources, not that one). A
-    second run in the same process is not bitwise equal to the first (up to 2.8e-7 of a column's
-    largest value, the coupling residual; cause not isolated, probably vectorised reductions
-    rounding by the alignment of their arrays, which differs once the process has run)."""
-    h = History.read(uninterrupted_run(tmp_path, 1) / "history.h5")
-    r = History.read(uninterrupted_run(base, 1) / "history.h5")
-    for key in r.columns:
-        if not key.startswith("time_"):
-            np.testing.assert_array_equal(h[key], r[key], err_msg=key)
