@@ -53,6 +53,8 @@ def run_once(args, comm):
     t["setup"] = time.perf_counter() - t0
     pre = preload(mech, args.pressure, args.ramp)
     t["preload"] = pre.time
+    if comm.rank == 0:
+        print(f"# {ndofs} dofs, preload {pre.time:.1f} s", flush=True)      # progress of a long run
     linear = mech.problem.solver.getLinearSolveIterations()
     memory = {"preload": peak_gib(comm)}
     t0 = time.perf_counter()

@@ -47,8 +47,10 @@ NEWTON_OPTIONS = {
 # converges in one iteration with fresh factors); "cholesky", a MUMPS LDL^T (sym=2) of the
 # frictionless tangent J_0 (J with mu = 0: symmetric, the friction part J - J_0 = mu s (x) dp/du
 # lives on the sliding interface only). The LDL^T takes about half the memory of the LU (0.58 vs
-# 1.00 GB on the 106k-dof brake) and GMRES needs ~10 iterations (measured on the 49k-dof brake at
-# the preload; the symmetric part (J + J^T)/2 instead stalls: 200 iterations, 5e-5).
+# 1.00 GB on the 106k-dof brake) and GMRES needs ~11 iterations per Newton step with fresh factors
+# (measured on the 49k-dof brake at the preload; the symmetric part (J + J^T)/2 instead stalls: 200
+# iterations, 5e-5). Factors lagged over the contact-status changes of the first Newton steps cost
+# ~90 iterations per step (lag 5: 445 in all, 25 s, against 87 and 14.5 s fresh), hence lag 1.
 PRECONDITIONERS = ("lu", "cholesky")
 
 
@@ -85,8 +87,8 @@ class Mechanics:
     fluid pressure p [Pa] (``load_kind="fluid"``: traction −p n with n the outward normal, so two
     faces that look at each other across the fluid, e.g. a brake's piston back and caliper bore,
     are pushed apart by the same pressure). ``lag``: Newton iterations per LU factorisation of the
-    tangent (``NEWTON_OPTIONS``; 1 = a fresh one every iteration); ``preconditioner``: one of
-    ``PRECONDITIONERS`` (see there).
+    tangent (``NEWTON_OPTIONS``; 1 = a fresh one every iteration; default LAG with "lu", 1 with
+    "cholesky"); ``preconditioner``: one of ``PRECONDITIONERS`` (see there).
     """
 
     LOAD_KINDS = ("force", "pressure", "fluid")
@@ -94,7 +96,7 @@ class Mechanics:
     def __init__(self, tm: TwoBodyMesh, materials: Mapping[str, object], *, stiffness=1e13,
                  friction: float = 0.0, speed: float = 0.0, law: PressureLaw | None = None,
                  velocity=None, temperatures=None, reference_temperature: float = 293.15,
-                 load_kind: str = "force", degree: int = 1, prefix: str = "mech_", lag: int = LAG,
+                 load_kind: str = "force", degree: int = 1, prefix: str = "mech_", lag: int | None = None,
                  preconditioner: str = "lu"):
         if load_kind not in self.LOAD_KINDS:
             raise InputError("load_kind", load_kind, f"one of {', '.join(self.LOAD_KINDS)}")
@@ -123,6 +125,7 @@ class Mechanics:
             F[i] -= ufl.dot(self.traction(), v[i]) * tm.ds(tm.face(name))
         self.residuals = F
         self.bcs = self._supports()
+        lag = (LAG if preconditioner == "lu" else 1) if lag is None else lag
         options = dict(NEWTON_OPTIONS, snes_lag_preconditioner=lag)
         P = None
         if preconditioner == "cholesky":
