@@ -8,6 +8,9 @@ wear, penalty 1e13 Pa/m, the thesis' constant 14 % partition), then prints the w
     mpiexec -n 2 python benchmarks/bench_multiscale.py              # both runs (target < 1 h)
     mpiexec -n 2 python benchmarks/bench_multiscale.py --reuse      # tabulate finished runs
     mpiexec -n 2 python benchmarks/bench_multiscale.py --steps 5    # a quick partial check
+    mpiexec -n 2 python benchmarks/bench_multiscale.py --hardness "176 MPa"   # + elastic-plastic pin
+With ``--hardness`` a third run adds the effect ``plasticity`` with that pin hardness (issue 18)
+and the table gets a column for it.
 (``python benchmarks/bench_pin_on_disc.py`` times ``make demo``: the coarse multiscale demo.)
 """
 import argparse
@@ -52,6 +55,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--steps", type=int, help="only the first N macro steps (0.6 s each)")
     ap.add_argument("--reuse", action="store_true", help="tabulate runs already in their output folders")
+    ap.add_argument("--hardness", help='pin hardness of a third, elastic-plastic run, e.g. "176 MPa"')
     args = ap.parse_args()
     over = {} if args.steps is None else {"time.steps": args.steps, "time.end": 0.6 * args.steps}
     rough_scene = load(SCENE, overrides=over)
@@ -59,10 +63,28 @@ def main():
                                  "interface.penalty": "1e13 Pa/m", "name": "pin_on_disc_thesis_perfect",
                                  "output.folder": str(ROOT / "results" / "pin_on_disc_thesis_perfect")})
     perfect_scene = load(SCENE, overrides=perfect_over)
-    rough, rough_wall = _run(rough_scene, args.reuse)
+    runs = {"ours": _run(rough_scene, args.reuse)}
     perfect, perfect_wall = _run(perfect_scene, args.reuse)
+    if args.hardness:
+        plastic_over = dict(over, **{"effects": [*rough_scene.effects, "plasticity"],
+                                     "materials.pin.hardness": args.hardness, "name": "pin_on_disc_thesis_plastic",
+                                     "output.folder": str(ROOT / "results" / "pin_on_disc_thesis_plastic")})
+        runs[f"plastic, H = {args.hardness}"] = _run(load(SCENE, overrides=plastic_over), args.reuse)
     if MPI.COMM_WORLD.rank:
         return
+    columns = {name: _quantities(rough, wall, perfect, perfect_wall) for name, (rough, wall) in runs.items()}
+    names = list(columns)
+    print(f"\n| quantity | thesis | {' | '.join(f'{n} ({len(runs[n][0]) - 1} steps)' for n in names)} |")
+    print("|---|---|" + "---|" * len(names))
+    for key in dict.fromkeys(k for n in names for k in columns[n]):
+        print(f"| {key} | {THESIS.get(key, '')} | {' | '.join(columns[n].get(key, '') for n in names)} |")
+    RESULTS.parent.mkdir(exist_ok=True)
+    RESULTS.write_text(json.dumps({"date": time.strftime("%Y-%m-%d"), "ranks": MPI.COMM_WORLD.size,
+                                   "columns": columns, "thesis": THESIS}, indent=1))
+
+
+def _quantities(rough: History, rough_wall, perfect: History, perfect_wall) -> dict:
+    """The §7.3.2 quantities of a rough run (and the perfect-contact run), as table cells."""
     c = lambda T: T - 273.15  # noqa: E731
     loaded = rough["time"] > 0
     ours = {
@@ -89,15 +111,14 @@ def main():
              "time per step: macro / micro / laws [s]": " / ".join(
                  f"{np.median(rough[k][1:]):.1f}" for k in ("time_macro", "time_micro", "time_laws")),
              "initial laws [s]": f"{rough['time_laws'][0]:.1f}"}
-    print(f"\n| quantity | thesis | ours ({len(rough) - 1} steps) |\n|---|---|---|")
-    for key in THESIS:
-        print(f"| {key} | {THESIS[key]} | {ours[key]} |")
-    for key, value in extra.items():
-        print(f"| {key} | | {value} |")
-    RESULTS.parent.mkdir(exist_ok=True)
-    RESULTS.write_text(json.dumps({"date": time.strftime("%Y-%m-%d"), "ranks": MPI.COMM_WORLD.size,
-                                   "steps": len(rough) - 1, "ours": ours, "extra": extra, "thesis": THESIS},
-                                  indent=1))
+    if "real_contact_area" in rough.columns:
+        area = rough["real_contact_area"]
+        extra["real contact area first -> last [mm^2]"] = f"{area[0] * 1e6:.3g} -> {area[-1] * 1e6:.3g}"
+    if "micro_plastic_fraction" in rough.columns:
+        extra["largest plastic share of a zone first -> last"] = (f"{rough['micro_plastic_fraction'][0]:.3g} -> "
+                                                                  f"{rough['micro_plastic_fraction'][-1]:.3g}")
+        extra["largest permanent deformation [um]"] = f"{rough['plastic_max_depth'][-1] * 1e6:.3g}"
+    return ours | extra
 
 
 if __name__ == "__main__":

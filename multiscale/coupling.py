@@ -143,6 +143,7 @@ class MicroStep:
     work: float                # J, mu ∫ p |v| dA over the wear interval (0 without wear)
     seconds: float
     plastic_fraction: float = 0.0  # largest share of a zone's cells at the hardness (0 without plasticity)
+    real_area: float = 0.0     # m^2, real contact area summed over the loaded zones (before wear)
 
 
 @dataclass
@@ -262,13 +263,15 @@ class Multiscale:
         implicit = self.settings.coupling == "implicit"
         parts = comm.allgather((mine, res.pressure, res.max_pressure, res.max_temperature,
                                 res.partition_equal if implicit else res.partition, res.conductance, res.heat,
-                                res.heat_rough, res.exchange, remote[:, 1] - remote[:, 0], res.plastic_area_fraction))
+                                res.heat_rough, res.exchange, remote[:, 1] - remote[:, 0], res.plastic_area_fraction,
+                                res.area_fraction * self.rough.zone_area[mine]))
         for a in (self.proposed, self.flash, self.micro_heat, self.micro_heat_rough):
             a[:] = np.nan
         self.proposed_exchange[:] = 0.0
-        max_p, flow = [], [np.zeros(0)]
-        for ids, warm, mp, mT, part, h_c, heat, rough, exchange, diff, fraction in parts:
+        max_p, flow, real = [], [np.zeros(0)], 0.0
+        for ids, warm, mp, mT, part, h_c, heat, rough, exchange, diff, fraction, area in parts:
             flow.append(fraction)
+            real += float(np.sum(area))
             self.warm[ids], self.proposed[ids], self.flash[ids] = warm, part, mT
             self.micro_heat[ids], self.micro_heat_rough[ids], self.remote_difference[ids] = heat, rough, diff
             if implicit:
@@ -282,7 +285,7 @@ class Multiscale:
         max_p = np.concatenate(max_p)
         return MicroStep(len(loaded), float(load.pressure.max()), float(max_p.max(initial=0.0)),
                          float(np.nanmax(hot)) if np.isfinite(hot).any() else np.nan, (np.nan,) * 3, 0.0,
-                         _time.perf_counter() - t0, float(np.concatenate(flow).max(initial=0.0)))
+                         _time.perf_counter() - t0, float(np.concatenate(flow).max(initial=0.0)), real)
 
     def _hardness_temperature(self, ids, rough_temperature) -> np.ndarray | None:
         """Where the zones ``ids`` take H(T): with ``settings.flash_softening``, their flash
@@ -502,7 +505,8 @@ class Multiscale:
         micro = result.micro
         row = self.model.record(result.heat)
         row.update(zones_in_contact=micro.loaded, laws_computed=self.rough.laws_computed,
-                   max_zone_pressure=micro.zone_pressure, micro_max_pressure=micro.max_pressure)
+                   max_zone_pressure=micro.zone_pressure, micro_max_pressure=micro.max_pressure,
+                   real_contact_area=micro.real_area)
         if self.post.heating is not None:
             row.update(micro_max_temperature=micro.max_temperature, partition_min=micro.partition[0],
                        partition_mean=micro.partition[1], partition_max=micro.partition[2],

@@ -20,7 +20,7 @@ from tqdm import tqdm
 from multiscale.errors import OutputError
 
 UNITS = {"time": "s", "force": "N", "pressure": "Pa", "temperature": "K", "heat": "J", "iterations": "-",
-         "volume": "m^3", "depth": "m", "rms": "m", "work": "J"}
+         "volume": "m^3", "depth": "m", "rms": "m", "work": "J", "area": "m^2"}
 
 
 def unit_of(name: str) -> str:

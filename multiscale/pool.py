@@ -13,9 +13,10 @@ every rank back the laws it asked for. Collective: every rank of ``comm`` must c
   dynamic queue (mpi4py.futures) would, without a scheduler rank or a process spawn.
 - Results do not depend on the number of ranks or on the partition beyond round-off: a zone's
   solve does not depend on its batch-mates (the batched solver iterates each patch on its own),
-  only the rounding of the batched FFTs does, and FFTW plans are measured per process anyway.
-  Laws agree to ~1e-13, not bitwise (to the solver tolerance in the rare case where round-off
-  moves a residual across it and an iteration count changes). Batches hold at most a quarter
+  only the rounding of the batched FFTs does (the FFT plans are the same in every process:
+  ``micro.fft``). Laws agree to ~1e-13, not bitwise (to the solver tolerance in the rare case
+  where round-off moves a residual across it and an iteration count changes); on a given number
+  of ranks the batches, hence the laws, are the same in every run. Batches hold at most a quarter
   of a rank's share, so that the partition can balance.
 - Cache: every rank keeps the laws it received (LRU, ``cache_size`` zones), keyed by
   (topography hash, ``LawSpec.key()``: kernel, E*, p_max, nodes, Love variant, tolerances,

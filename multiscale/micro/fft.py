@@ -73,7 +73,11 @@ class RealFFT2:
 
     Three aligned buffers: real ``input``, complex ``spectrum`` (rfft2 of input, overwritten by
     ``inverse``) and real ``output``; the methods return views of them that the next call
-    overwrites. Plans are built once (FFTW_MEASURE) with ``threads`` (default: ``get_threads()``).
+    overwrites. Plans are built once with ``threads`` (default: ``get_threads()``), by FFTW_ESTIMATE:
+    the same plan, hence the same rounding, in every process and every run (FFTW_MEASURE times
+    candidate plans, so two runs could round differently and a solve near its tolerance take another
+    iteration; measured on this machine, the estimated plans are as fast for 16^2 to 2048^2 and
+    batches of 100 x 128^2, within +-10 %, and cost no planning time: 0.3-0.8 s per measured plan).
     """
 
     def __init__(self, shape: tuple[int, ...], threads: int | None = None):
@@ -89,7 +93,7 @@ class RealFFT2:
             self.input = pyfftw.empty_aligned(self.shape, dtype="float64")
             self.spectrum = pyfftw.empty_aligned(self.spectral_shape, dtype="complex128")
             self.output = pyfftw.empty_aligned(self.shape, dtype="float64")
-            flags = ("FFTW_MEASURE",)
+            flags = ("FFTW_ESTIMATE",)
             self._fwd = pyfftw.FFTW(self.input, self.spectrum, axes=(-2, -1), direction="FFTW_FORWARD",
                                     flags=flags, threads=self.threads)
             self._inv = pyfftw.FFTW(self.spectrum, self.output, axes=(-2, -1), direction="FFTW_BACKWARD",
