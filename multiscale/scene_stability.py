@@ -128,6 +128,8 @@ class Stability:
             what = f"{path}.damping" if self.damping else f"materials.{lossy[0]}.loss_factor"
             return [f'{path}.method = "quadratic": takes viscous damping only; {what} (complex stiffness) '
                     'needs method = "projection"']
+        if self.method == "subspace" and self.sweep is not None:
+            return [f'{path}.method = "subspace": one big analysis, not a sweep (use "auto" with [{path}.sweep])']
         loading = ctx.root.get("loading") if isinstance(ctx.root.get("loading"), dict) else {}
         if self.gyroscopic and "sliding_speed" in loading:
             return [f"{path}.gyroscopic = true: needs a rotating body; this geometry translates"]

@@ -2,6 +2,7 @@
 the frictionless tangent, and the complex modes by projection on the real modes of that tangent
 plus their static corrections (``macro.damped`` method "subspace"), against the direct LU path."""
 from dataclasses import replace
+from pathlib import Path
 from types import SimpleNamespace as NS
 
 import numpy as np
@@ -11,17 +12,20 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from petsc4py import PETSc  # noqa: E402
 
+from multiscale import scene as scenes  # noqa: E402
 from multiscale.errors import InputError  # noqa: E402
 from multiscale.geometry import builder  # noqa: E402
 from multiscale.macro import damped, eigen  # noqa: E402
 from multiscale.macro import mesh as two_body  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
 from multiscale.macro.preload import linearise, preload  # noqa: E402
+from multiscale.workflows import squeal  # noqa: E402
 
 STEEL = NS(E=210e9, nu=0.3, rho=7850.0)
 MATERIALS = {"disc": NS(E=125e9, nu=0.25, rho=7200.0), "pad": NS(E=5e9, nu=0.25, rho=2500.0),
              "backplate": STEEL, "piston": STEEL, "caliper": STEEL}
 PRESSURE = 1e6
+DEMO = Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml"
 F_MAX = 50e3
 
 
@@ -110,3 +114,20 @@ def test_subspace_needs_the_frictionless_tangent(models):
         damped.solve_system(damped.LinearSystem(K, M), n_modes=10, f_max=F_MAX, method="subspace")
     with pytest.raises(InputError, match="preconditioner"):
         Mechanics(mech.tm, MATERIALS, preconditioner="ilu")
+
+
+def test_scene_subspace_method_against_the_default_analysis(tmp_path):
+    """The demo brake through `multiscale run`'s workflow: [stability] method = "subspace" gives
+    the default (direct GNHEP) modes to the projection's accuracy; a sweep with it is refused."""
+    overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 10}
+    runs = {m: squeal.run(scenes.load(DEMO, dict(overrides, **{"stability.method": m,
+                                                                "output.folder": str(tmp_path / m)})),
+                          degree=1, verbose=False)
+            for m in ("auto", "subspace")}
+    ref, sub = runs["auto"].case.modes, runs["subspace"].case.modes
+    assert ref.method == "gnhep" and sub.method == "projection" and len(sub) == len(ref)
+    np.testing.assert_allclose(sub.frequency, ref.frequency, rtol=1e-3)
+    assert sub.errors.max() < 0.1
+    with pytest.raises(InputError, match="subspace"):
+        scenes.load(DEMO, dict(overrides, **{"stability.method": "subspace", "stability.sweep.friction": [0.1, 0.5],
+                                              "stability.sweep.points": 3}))
