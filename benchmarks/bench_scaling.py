@@ -47,6 +47,21 @@ class Timed:
             self.seconds += time.perf_counter() - t0
 
 
+class PoolBusy:
+    """Wraps ``MicroPool.laws`` and adds every call's solve time of each rank to ``seconds``."""
+
+    def __init__(self, pool):
+        self.pool, self.call = pool, pool.laws
+        self.seconds = np.zeros(pool.comm.size)
+
+    def __call__(self, *args, **kwargs):
+        try:
+            return self.call(*args, **kwargs)
+        finally:
+            if self.pool.stats is not None:
+                self.seconds += self.pool.stats.compute_seconds
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--scene", default=str(ROOT / "demos" / "pin_on_disc_thesis.toml"))
@@ -59,17 +74,16 @@ def main():
     with io.Reporter(comm, quiet=True):
         ms = build(scene, comm)
         post = ms.post.run = Timed(ms.post.run)
-        pool = ms.rough.pool
+        pool = ms.rough.pool.laws = PoolBusy(ms.rough.pool)
         rows, history = [], io.History()
         for n in range(args.steps + 1):
-            post.seconds = 0.0
+            post.seconds, pool.seconds = 0.0, np.zeros(comm.size)
             t0 = time.perf_counter()
             result = ms.start() if n == 0 else ms.step(n)
             wall = time.perf_counter() - t0
             history.append(**ms.record(result))
-            laws = comm.allgather(pool.stats.compute_seconds if pool.stats else (0.0,) * comm.size)
             rows.append(dict(wall=wall, macro=result.time_macro, micro=result.time_micro, laws=result.time_laws,
-                             laws_busy=np.array(laws[0]), post_busy=np.array(comm.allgather(post.seconds)),
+                             laws_busy=pool.seconds.copy(), post_busy=np.array(comm.allgather(post.seconds)),
                              zones=result.micro.loaded))
     if comm.rank:
         return
