@@ -97,6 +97,8 @@ class Stability:
     slope (``friction_damping``) and the gyroscopic terms are solved as a full quadratic
     eigenproblem (``method = "quadratic"``, viscous only) or by projection on the undamped modes up
     to ``basis`` x the band's top (``"projection"``, needed for loss factors); ``"auto"`` picks.
+    ``"subspace"``: projection on the real modes of the frictionless tangent and their static
+    corrections, for models whose LU does not fit in memory (docs/squeal.md).
     ``prestress``: the initial-stress stiffness of the preload, its effect on every frequency
     reported; ``gyroscopic``: the rotating body's Coriolis and centrifugal terms (docs/squeal.md)."""
 
@@ -110,7 +112,7 @@ class Stability:
     prestress: bool = key(Flag(), default=False)
     gyroscopic: bool = key(Flag(), default=False)
     friction_damping: bool = key(Flag(), default=True)
-    method: str = key(Choice(("auto", "projection", "quadratic")), default="auto")
+    method: str = key(Choice(("auto", "projection", "quadratic", "subspace")), default="auto")
     basis: float = key(Quantity("dimensionless", ge=1), default=1.5)
     sweep: Sweep | None = key(Section(Sweep))
 
@@ -126,6 +128,8 @@ class Stability:
             what = f"{path}.damping" if self.damping else f"materials.{lossy[0]}.loss_factor"
             return [f'{path}.method = "quadratic": takes viscous damping only; {what} (complex stiffness) '
                     'needs method = "projection"']
+        if self.method == "subspace" and self.sweep is not None:
+            return [f'{path}.method = "subspace": one big analysis, not a sweep (use "auto" with [{path}.sweep])']
         loading = ctx.root.get("loading") if isinstance(ctx.root.get("loading"), dict) else {}
         if self.gyroscopic and "sliding_speed" in loading:
             return [f"{path}.gyroscopic = true: needs a rotating body; this geometry translates"]

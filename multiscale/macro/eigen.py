@@ -150,12 +150,12 @@ def _check_band(f_min, f_max, target, n_modes):
     return f_min, f_max, target
 
 
-def _direct_solver(st):
+def _direct_solver(st, factor=PETSc.PC.Type.LU):
     st.setType(SLEPc.ST.Type.SINVERT)
     ksp = st.getKSP()
     ksp.setType(PETSc.KSP.Type.PREONLY)
     pc = ksp.getPC()
-    pc.setType(PETSc.PC.Type.LU)
+    pc.setType(factor)
     if PETSc.Sys.hasExternalPackage("mumps"):
         pc.setFactorSolverType("mumps")
 
@@ -215,7 +215,8 @@ def _sorted(lam, theta, vecs, errs, band, seen_f):
 
 def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int | None = None,
                 target: float | None = None, damping: Damping | None = None, tol: float = 1e-10,
-                max_it: int = 300, nev: int = 20, options_prefix: str = "stability_") -> ModalResult:
+                max_it: int = 300, nev: int = 20, options_prefix: str = "stability_",
+                symmetric: bool = False, inverse: list | None = None) -> ModalResult:
     """Modes with f_min <= f <= f_max [Hz] of K phi = theta M phi (GNHEP, shift-and-invert, §4.3.1).
 
     ``K`` (tangent, may be non-symmetric) and ``M`` (mass, diag 0 on Dirichlet rows so that the
@@ -225,8 +226,12 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
     subspace grows (from ``nev``) until every theta with |theta - theta_t| <= max((2 pi f_max)^2 -
     theta_t, theta_t - (2 pi f_min)^2) is converged, i.e. the band is complete for modes with
     |sigma| << omega, or until ``n_modes`` band modes nearest the target are found (a cap; the
-    conjugate partner of the last one is kept with it). Raises InputError for a bad request or an
-    empty band, ConvergenceError if SLEPc does not converge.
+    conjugate partner of the last one is kept with it). ``symmetric``: K is symmetric (and M
+    positive semi-definite): the GHEP, shift-and-invert through a MUMPS LDL^T factorisation (about
+    half the memory of the LU), real modes. ``inverse``: a list that receives the SLEPc
+    solver, kept with its factors (``getST().getKSP()`` solves with K - theta_t M; the caller
+    destroys it). Raises InputError for a bad request or an empty band, ConvergenceError if SLEPc
+    does not converge.
     """
     f_min, f_max, target = _check_band(f_min, f_max, target, n_modes)
     t0 = time.perf_counter()
@@ -240,12 +245,12 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
 
     eps = SLEPc.EPS().create(K.getComm())
     eps.setOperators(K, M)
-    eps.setProblemType(SLEPc.EPS.ProblemType.GNHEP)
+    eps.setProblemType(SLEPc.EPS.ProblemType.GHEP if symmetric else SLEPc.EPS.ProblemType.GNHEP)
     eps.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
     eps.setTarget(shift)
     eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
     eps.setTolerances(tol, max_it)
-    _direct_solver(eps.getST())
+    _direct_solver(eps.getST(), PETSc.PC.Type.CHOLESKY if symmetric else PETSc.PC.Type.LU)
     eps.setOptionsPrefix(options_prefix)
     eps.setFromOptions()
     solves = 0
@@ -291,7 +296,11 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
         vals[j], vecs[:, j] = _pairs(eps, int(i), vr, vi)
         errs[j] = eps.computeError(int(i), SLEPc.EPS.ErrorType.RELATIVE)
     iterations = eps.getIterationNumber()
-    eps.destroy(), vr.destroy(), vi.destroy()
+    if inverse is None:
+        eps.destroy()
+    else:
+        inverse.append(eps)
+    vr.destroy(), vi.destroy()
 
     lam = lambda_from_theta(vals, damping)
     lam, vals, vecs, errs = _sorted(lam, vals, vecs, errs, (f_min, f_max),

@@ -102,6 +102,9 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
         lin = linearise_system(mech, materials, damping=damping or opt.damping,
                                slope=slope if opt.friction_damping else None, prestress=opt.prestress,
                                gyroscopic=opt.gyroscopic, material=opt.material_damping)
+        if opt.method == "subspace":       # the memory-lean path: no Newton factors next to the modes'
+            mech.release()
+            lin.system.K0 = mech.frictionless_tangent()
         modes = solve_system(lin.system, f_min=band[0], f_max=band[1], n_modes=n_modes, target=target,
                              method=opt.method, basis=opt.basis)
         effect = prestress_effect(modes, lin.system, lin.K_sigma) if lin.K_sigma is not None else None
