@@ -1,0 +1,50 @@
+"""FFTW_ESTIMATE against FFTW_MEASURE plans: planning time and time per rfft2 + irfft2 pair.
+
+``multiscale.micro.fft`` builds its plans with FFTW_ESTIMATE (the same plan in every process,
+hence repeatable runs); this script checks that it costs no speed. Medians of 5 repeats per size,
+the two flags side by side, one thread.
+
+    python benchmarks/bench_fft_plans.py
+"""
+import os
+import time
+
+import numpy as np
+import pyfftw
+
+SHAPES = [(16, 16), (100, 16, 16), (64, 64), (100, 128, 128), (512, 512), (1024, 1024), (2048, 2048)]
+
+
+def pair_time(shape, flag):
+    """(planning time, median time of one forward + inverse transform) [s] for ``shape``."""
+    a = pyfftw.empty_aligned(shape, "float64")
+    s = pyfftw.empty_aligned(shape[:-1] + (shape[-1] // 2 + 1,), "complex128")
+    o = pyfftw.empty_aligned(shape, "float64")
+    t0 = time.perf_counter()
+    fwd = pyfftw.FFTW(a, s, axes=(-2, -1), flags=(flag,))
+    inv = pyfftw.FFTW(s, o, axes=(-2, -1), direction="FFTW_BACKWARD", flags=(flag,))
+    planning = time.perf_counter() - t0
+    a[:] = np.random.default_rng(0).random(shape)
+    n = max(3, int(2e7 / np.prod(shape)))
+    times = []
+    for _ in range(5):
+        t0 = time.perf_counter()
+        for _ in range(n):
+            fwd()
+            inv()
+        times.append((time.perf_counter() - t0) / n)
+    return planning, float(np.median(times))
+
+
+def main():
+    print(f"load average {os.getloadavg()[0]:.2f}")
+    print("| shape | plan MEASURE [s] | plan ESTIMATE [s] | pair MEASURE [ms] | pair ESTIMATE [ms] | ESTIMATE / MEASURE |")
+    print("|---|---|---|---|---|---|")
+    for shape in SHAPES:
+        pm, m = pair_time(shape, "FFTW_MEASURE")
+        pe, e = pair_time(shape, "FFTW_ESTIMATE")
+        print(f"| {shape} | {pm:.3f} | {pe:.4f} | {m * 1e3:.3f} | {e * 1e3:.3f} | {e / m:.2f} |")
+
+
+if __name__ == "__main__":
+    main()
