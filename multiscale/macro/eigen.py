@@ -150,7 +150,13 @@ def _check_band(f_min, f_max, target, n_modes):
     return f_min, f_max, target
 
 
-def _direct_solver(st, factor=PETSc.PC.Type.LU):
+def _shift_invert(solver, target, tol, max_it, prefix, factor=PETSc.PC.Type.LU):
+    """Configure a SLEPc EPS or PEP: the eigenvalues nearest ``target`` by shift-and-invert through a
+    direct factorisation (``factor``, MUMPS when available), then the options under ``prefix``."""
+    solver.setTarget(target)
+    solver.setWhichEigenpairs(type(solver).Which.TARGET_MAGNITUDE)
+    solver.setTolerances(tol, max_it)
+    st = solver.getST()
     st.setType(SLEPc.ST.Type.SINVERT)
     ksp = st.getKSP()
     ksp.setType(PETSc.KSP.Type.PREONLY)
@@ -158,6 +164,8 @@ def _direct_solver(st, factor=PETSc.PC.Type.LU):
     pc.setType(factor)
     if PETSc.Sys.hasExternalPackage("mumps"):
         pc.setFactorSolverType("mumps")
+    solver.setOptionsPrefix(prefix)
+    solver.setFromOptions()
 
 
 def _pairs(solver, i, vr, vi):
@@ -247,12 +255,7 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
     eps.setOperators(K, M)
     eps.setProblemType(SLEPc.EPS.ProblemType.GHEP if symmetric else SLEPc.EPS.ProblemType.GNHEP)
     eps.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
-    eps.setTarget(shift)
-    eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_MAGNITUDE)
-    eps.setTolerances(tol, max_it)
-    _direct_solver(eps.getST(), PETSc.PC.Type.CHOLESKY if symmetric else PETSc.PC.Type.LU)
-    eps.setOptionsPrefix(options_prefix)
-    eps.setFromOptions()
+    _shift_invert(eps, shift, tol, max_it, options_prefix, PETSc.PC.Type.CHOLESKY if symmetric else PETSc.PC.Type.LU)
     solves = 0
     while True:
         eps.setDimensions(want, PETSc.DECIDE)
@@ -332,12 +335,7 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     pep.setOperators([K, C, M])
     pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
     pep.setType(SLEPc.PEP.Type.TOAR)
-    pep.setTarget(s)
-    pep.setWhichEigenpairs(SLEPc.PEP.Which.TARGET_MAGNITUDE)
-    pep.setTolerances(tol, max_it)
-    _direct_solver(pep.getST())
-    pep.setOptionsPrefix(options_prefix)
-    pep.setFromOptions()
+    _shift_invert(pep, s, tol, max_it, options_prefix)
     want = min(2 * int(n_modes if n_modes is not None else max(nev, 1)), 2 * n)
     solves = 0
     while True:
