@@ -289,3 +289,17 @@ def test_scene_rules_of_the_thermal_coupling(tmp_path):
     from multiscale.coupling import LoopSettings
     with pytest.raises(InputError, match="bulk"):
         LoopSettings(1.0, 1, 293.15, 0.5, coupling="implicit")
+
+
+def test_real_contact_area_is_that_of_the_direct_micro_solves(two_zones):
+    """The history's real contact area: the cells in contact of each loaded zone's micro problem,
+    solved directly from the macro state (FFT-BEM, tol 1e-10), times the cell area, summed."""
+    ms, result, _, _ = two_zones["fixed-point"]
+    loaded = np.flatnonzero(np.isfinite(ms.proposed))
+    direct = 0.0
+    for z in loaded:
+        _, p, _ = direct_micro(ms, z)
+        s = ms.rough.zones[z].surface
+        direct += np.count_nonzero(p > 0) * s.dx * s.dy
+    assert direct > 0
+    assert ms.record(result)["real_contact_area"] == pytest.approx(direct, rel=1e-9)
