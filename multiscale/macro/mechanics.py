@@ -266,16 +266,16 @@ class Mechanics:
                 form = fem.form(self._frictionless_jacobian(), entity_maps=self.tm.entity_maps)
                 self._frictionless = (fpetsc.create_matrix(form), form)
             P, form = self._frictionless
-        P.zeroEntries()
-        fpetsc.assemble_matrix(P, form, bcs=self.bcs)
-        P.assemble()
-        P.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        self._assemble(P, form).setOption(PETSc.Mat.Option.SYMMETRIC, True)
         return P
 
     def tangent(self) -> PETSc.Mat:
         """The assembled block Jacobian at the current state (assembled on request)."""
-        A = self.problem.A
+        return self._assemble(self.problem.A, self.problem.J)
+
+    def _assemble(self, A: PETSc.Mat, form) -> PETSc.Mat:
+        """``A`` overwritten by the block matrix of ``form`` at the current state, with the supports."""
         A.zeroEntries()
-        fpetsc.assemble_matrix(A, self.problem.J, bcs=self.bcs)
+        fpetsc.assemble_matrix(A, form, bcs=self.bcs)
         A.assemble()
         return A
