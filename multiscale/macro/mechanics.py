@@ -29,19 +29,25 @@ from multiscale.macro.interface import ContactInterface, PressureLaw
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
-# Newton on the assembled tangent; each linear solve is GMRES on the current tangent, preconditioned
-# by an LU factorisation (MUMPS) that is refreshed every LAG Newton iterations and kept across
-# solves (time steps): the directions are exact Newton directions to ksp_rtol, the factorisations
-# (most of a step's time) a fraction (issue 23). A solve that fails with old factors is repeated
-# from its start with fresh ones every iteration (``Mechanics.solve``).
-LAG = 5
+# Inexact Newton on the assembled tangent (Eisenstat-Walker forcing terms, their choice 3 in PETSc:
+# each linear solve only as accurate as the Newton step needs; the Newton tolerance is unchanged;
+# on the thesis ch. 7 configuration 6-7 Newton iterations where choice 2 took 8-10).
+# Each linear solve is GMRES on the current tangent, preconditioned by a factorisation (MUMPS) kept
+# across Newton iterations and solves (time steps) until the GMRES iterations it costs beyond one per
+# linear solve add up to ``refresh`` (``Mechanics``), about the price of a factorisation in
+# triangular solves: REFRESH is the 39k-dof thesis ch. 7 mesh's ratio (1.2 s / 0.03 s on one rank),
+# where factors of a loaded state keep GMRES at a few iterations for steps on end (issue 23). A solve
+# that fails with old factors is repeated from its start with fresh ones every iteration
+# (``Mechanics.solve``). The preconditioner is built from a matrix of its own, written only at a
+# refresh: PETSc refactorises when that matrix changed, and only then.
+REFRESH = 40
 NEWTON_OPTIONS = {
     "snes_type": "newtonls", "snes_linesearch_type": "basic",
     "snes_rtol": 1e-10, "snes_atol": 1e-10, "snes_stol": 0.0, "snes_max_it": 30,
+    "snes_ksp_ew": True, "snes_ksp_ew_version": 3,
     "ksp_type": "gmres", "ksp_pc_side": "right", "ksp_rtol": 1e-10, "ksp_atol": 0.0, "ksp_max_it": 50,
     "ksp_gmres_restart": 50,
     "pc_type": "lu", "pc_factor_mat_solver_type": "mumps",
-    "snes_lag_preconditioner": LAG, "snes_lag_preconditioner_persists": True,
 }
 # What the Newton GMRES is preconditioned by: "lu", a MUMPS LU of the tangent J itself (GMRES
 # converges in one iteration with fresh factors); "cholesky", a MUMPS LDL^T (sym=2) of the
@@ -50,7 +56,8 @@ NEWTON_OPTIONS = {
 # 1.00 GB on the 106k-dof brake) and GMRES needs ~11 iterations per Newton step with fresh factors
 # (measured on the 49k-dof brake at the preload; the symmetric part (J + J^T)/2 instead stalls: 200
 # iterations, 5e-5). Factors lagged over the contact-status changes of the first Newton steps cost
-# ~90 iterations per step (lag 5: 445 in all, 25 s, against 87 and 14.5 s fresh), hence lag 1.
+# ~90 iterations per step (lag 5: 445 in all, 25 s, against 87 and 14.5 s fresh), hence refresh 0
+# (a fresh factorisation every Newton iteration) by default.
 PRECONDITIONERS = ("lu", "cholesky")
 
 
@@ -86,9 +93,10 @@ class Mechanics:
     load faces (``load_kind="force"``), a traction [Pa] along it (``load_kind="pressure"``), or a
     fluid pressure p [Pa] (``load_kind="fluid"``: traction −p n with n the outward normal, so two
     faces that look at each other across the fluid, e.g. a brake's piston back and caliper bore,
-    are pushed apart by the same pressure). ``lag``: Newton iterations per LU factorisation of the
-    tangent (``NEWTON_OPTIONS``; 1 = a fresh one every iteration; default LAG with "lu", 1 with
-    "cholesky"); ``preconditioner``: one of ``PRECONDITIONERS`` (see there).
+    are pushed apart by the same pressure). ``refresh``: GMRES iterations beyond one per linear
+    solve, summed since the last factorisation, after which the next Newton iteration factorises
+    afresh (``NEWTON_OPTIONS``; 0 = a fresh factorisation every iteration; default REFRESH with
+    "lu", 0 with "cholesky"); ``preconditioner``: one of ``PRECONDITIONERS`` (see there).
     """
 
     LOAD_KINDS = ("force", "pressure", "fluid")
@@ -96,7 +104,7 @@ class Mechanics:
     def __init__(self, tm: TwoBodyMesh, materials: Mapping[str, object], *, stiffness=1e13,
                  friction: float = 0.0, speed: float = 0.0, law: PressureLaw | None = None,
                  velocity=None, temperatures=None, reference_temperature: float = 293.15,
-                 load_kind: str = "force", degree: int = 1, prefix: str = "mech_", lag: int | None = None,
+                 load_kind: str = "force", degree: int = 1, prefix: str = "mech_", refresh: int | None = None,
                  preconditioner: str = "lu"):
         if load_kind not in self.LOAD_KINDS:
             raise InputError("load_kind", load_kind, f"one of {', '.join(self.LOAD_KINDS)}")
@@ -125,8 +133,8 @@ class Mechanics:
             F[i] -= ufl.dot(self.traction(), v[i]) * tm.ds(tm.face(name))
         self.residuals = F
         self.bcs = self._supports()
-        lag = (LAG if preconditioner == "lu" else 1) if lag is None else lag
-        options = dict(NEWTON_OPTIONS, snes_lag_preconditioner=lag)
+        self.refresh = (REFRESH if preconditioner == "lu" else 0) if refresh is None else int(refresh)
+        options = dict(NEWTON_OPTIONS)
         P = None
         if preconditioner == "cholesky":
             P = self._frictionless_jacobian()
@@ -136,7 +144,19 @@ class Mechanics:
         if P is not None:
             self.problem.P_mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             self.problem.P_mat.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
-        self.lag = lag
+        # the tangent's cell integrals (small-strain elasticity: E, nu constant or of T, not of u)
+        # are assembled once (once per solve with E(T), nu(T)), its facet integrals every iteration
+        self._split = [self._split_forms(self.problem.A, self.problem.J, derivative_block(F, self.u))]
+        if P is not None:
+            self._split.append(self._split_forms(self.problem.P_mat, self.problem.preconditioner, P))
+        self._bulk_of_T = temperatures is not None and not all(isinstance(e, fem.Function)
+                                                                for e in (*self.E, *self.nu))
+        self._bulk_stale = True
+        self._fresh = False                # a fresh factorisation every Newton iteration (retry)
+        self._pc_stale = True              # the preconditioner matrix is to be rewritten
+        self._excess = 0                   # GMRES iterations beyond one per linear solve since then
+        self._pc_mat = self.problem.P_mat if P is not None else self.problem.A.duplicate()
+        self.problem.solver.setJacobian(self._jacobian, self.problem.A, self._pc_mat)
         self._frictionless = None          # (matrix, form) of ``frictionless_tangent`` without P
         self._history: list[float] = []
         self.problem.solver.setMonitor(lambda snes, it, norm: self._history.append(norm))
@@ -145,6 +165,7 @@ class Mechanics:
         """Free the factors of the Newton preconditioner (the next solve factorises afresh): a modal
         analysis after the preload then does not hold two factorisations at once."""
         self.problem.solver.getKSP().getPC().reset()
+        self._pc_stale = True
 
     # ---- forms -----------------------------------------------------------------------------
     def _frictionless_jacobian(self) -> list:
@@ -152,6 +173,51 @@ class Mechanics:
         zero = fem.Constant(self.tm.parent, 0.0)
         J = derivative_block(self.residuals, self.u)
         return [[None if f is None else ufl.replace(f, {self.contact.friction: zero}) for f in row] for row in J]
+
+    def _split_forms(self, A: PETSc.Mat, compiled, form: list) -> tuple:
+        """(matrix, compiled cell part, compiled facet part) of the block form ``form`` (UFL; of
+        ``A``, ``compiled``): the matrix, of A's sparsity, holds the cell part with the supports."""
+        parts = []
+        for cells in (True, False):
+            block = [[None if f is None else ufl.Form([i for i in f.integrals()
+                                                       if (i.integral_type() == "cell") == cells]) for f in row]
+                     for row in form]
+            block = [[None if f is None or f.empty() else f for f in row] for row in block]
+            parts.append(fem.form(block, entity_maps=self.tm.entity_maps))
+        self._assemble(A, compiled)             # fixes A's sparsity (an empty assembly would drop it)
+        return (A.duplicate(), *parts)
+
+    def _jacobian(self, snes, x, J, P) -> None:
+        """SNES Jacobian callback: J = cell part (kept) + facet part at x; the preconditioner
+        matrix P is rewritten (J itself, or J_0 with "cholesky") only at a refresh: the first
+        call, after ``release``, on a retry, after a failed linear solve, or once the linear solves
+        since the last refresh took more than ``refresh`` GMRES iterations beyond one each."""
+        ksp = snes.getKSP()
+        self._excess += max(ksp.getIterationNumber() - 1, 0)       # the last linear solve's
+        refresh = self._pc_stale or self._fresh or self._excess > self.refresh or ksp.getConvergedReason() < 0
+        if refresh:
+            self._excess = 0
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        fpetsc.assign(x, self.u)
+        self._compose(J, 0)
+        if refresh and len(self._split) == 2:
+            self._compose(P, 1)                                     # J_0 ("cholesky")
+        elif refresh:
+            J.copy(P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        self._pc_stale = False
+
+    def _compose(self, A: PETSc.Mat, k: int) -> PETSc.Mat:
+        """``A`` overwritten by split form k (0: the tangent, 1: J_0) at the current state: its cell
+        part (reassembled if stale) plus its facet part, with the supports."""
+        if self._bulk_stale:
+            for bulk, cells, _ in self._split:
+                self._assemble(bulk, cells)
+            self._bulk_stale = False
+        bulk, _, facets = self._split[k]
+        bulk.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        fpetsc.assemble_matrix(A, facets, bcs=self.bcs)
+        A.assemble()
+        return A
 
     def dx(self, i: int):
         """Volume measure over the regions of body i (on the parent mesh)."""
@@ -215,11 +281,11 @@ class Mechanics:
         if not result.converged:           # old factors can mislead: again from the start, fresh ones
             for u, x in zip(self.u, start):
                 u.x.array[:] = x
-            self._lag(1)
+            self._fresh = True
             try:
                 result = self._newton()
             finally:
-                self._lag(self.lag)
+                self._fresh = False
         if not result.converged:
             raise ConvergenceError(
                 f"contact Newton did not converge at load {float(self.load.value):.6g} "
@@ -229,17 +295,10 @@ class Mechanics:
         result.max_pressure = float(self.contact.facet_pressure().max(initial=0.0))
         return result
 
-    def _lag(self, n: int) -> None:
-        """Refresh the LU preconditioner every ``n`` Newton iterations (petsc4py has no setter)."""
-        snes, options = self.problem.solver, PETSc.Options()
-        key = f"{snes.getOptionsPrefix()}snes_lag_preconditioner"
-        options[key] = n
-        snes.setFromOptions()
-        del options[key]
-
     def _newton(self) -> SolveResult:
         """One SNES solve from the current state; converged only if finite on every rank."""
         self._history.clear()
+        self._bulk_stale = self._bulk_stale or self._bulk_of_T      # the temperatures may have changed
         self.problem.solve()
         snes = self.problem.solver
         reason, its = snes.getConvergedReason(), snes.getIterationNumber()
@@ -271,7 +330,8 @@ class Mechanics:
 
     def tangent(self) -> PETSc.Mat:
         """The assembled block Jacobian at the current state (assembled on request)."""
-        return self._assemble(self.problem.A, self.problem.J)
+        self._bulk_stale = self._bulk_stale or self._bulk_of_T
+        return self._compose(self.problem.A, 0)
 
     def _assemble(self, A: PETSc.Mat, form) -> PETSc.Mat:
         """``A`` overwritten by the block matrix of ``form`` at the current state, with the supports."""
