@@ -48,7 +48,7 @@ def run_once(args, comm):
     t0 = time.perf_counter()
     mech = Mechanics(tm, MATERIALS, stiffness=args.penalty, friction=args.friction, speed=5.0,
                      load_kind="fluid", degree=args.degree, prefix="bench_squeal_",
-                     preconditioner="cholesky" if args.method == "subspace" else "lu")
+                     preconditioner="cholesky" if args.method == "subspace" else "lu", refresh=args.refresh)
     ndofs = sum(V.dofmap.index_map.size_global * 3 for V in mech.spaces)
     t["setup"] = time.perf_counter() - t0
     pre = preload(mech, args.pressure, args.ramp)
@@ -57,6 +57,12 @@ def run_once(args, comm):
         print(f"# {ndofs} dofs, preload {pre.time:.1f} s", flush=True)      # progress of a long run
     linear = mech.problem.solver.getLinearSolveIterations()
     memory = {"preload": peak_gib(comm)}
+    if args.preload_only:
+        if comm.rank == 0:
+            print(f"# preload: last load step {pre.iterations} Newton iterations, {linear} GMRES iterations, "
+                  f"{mech.factorisations} factorisations, "
+                  f"peak memory {', '.join(f'{g:.2f}' for g in memory['preload'])} GiB", flush=True)
+        return None
     t0 = time.perf_counter()
     if args.method == "subspace":
         mech.release()
@@ -86,10 +92,13 @@ def main(argv=None):
     ap.add_argument("--repeats", type=int, default=1)
     ap.add_argument("--method", choices=("gnhep", "subspace"), default="gnhep")
     ap.add_argument("--basis", type=float, default=1.5, help="subspace: real modes up to basis x the band")
+    ap.add_argument("--refresh", type=int, help="Newton: GMRES iterations that trigger a new factorisation "
+                    "(Mechanics; default: its own)")
+    ap.add_argument("--preload-only", action="store_true", help="stop after the preload")
     args = ap.parse_args(argv)
     comm = MPI.COMM_WORLD
     runs = [run_once(args, comm) for _ in range(args.repeats)]
-    if comm.rank:
+    if comm.rank or args.preload_only:
         return
     t = {k: statistics.median(r[0][k] for r in runs) for k in runs[0][0]}
     _, ndofs, pre, modes, linear, memory = runs[-1]

@@ -13,6 +13,7 @@ functions of T (``macro.materials``); without a temperature field, tables are ta
 """
 from __future__ import annotations
 
+import time
 from dataclasses import dataclass, field
 from typing import Mapping
 
@@ -33,14 +34,13 @@ from multiscale.macro.mesh import TwoBodyMesh
 # each linear solve only as accurate as the Newton step needs; the Newton tolerance is unchanged;
 # on the thesis ch. 7 configuration 6-7 Newton iterations where choice 2 took 8-10).
 # Each linear solve is GMRES on the current tangent, preconditioned by a factorisation (MUMPS) kept
-# across Newton iterations and solves (time steps) until the GMRES iterations it costs beyond one per
-# linear solve add up to ``refresh`` (``Mechanics``), about the price of a factorisation in
-# triangular solves: REFRESH is the 39k-dof thesis ch. 7 mesh's ratio (1.2 s / 0.03 s on one rank),
-# where factors of a loaded state keep GMRES at a few iterations for steps on end (issue 23). A solve
-# that fails with old factors is repeated from its start with fresh ones every iteration
-# (``Mechanics.solve``). The preconditioner is built from a matrix of its own, written only at a
-# refresh: PETSc refactorises when that matrix changed, and only then.
-REFRESH = 40
+# across Newton iterations and solves (time steps) until the time of the GMRES iterations it costs
+# beyond one per linear solve exceeds the time of a factorisation, both measured on the run (the
+# "ski rental" rule: never more than twice the better of the two choices in hindsight). Factors of a
+# loaded state keep GMRES at a few iterations for steps on end on the thesis ch. 7 configuration
+# (issue 23). A solve that fails with old factors is repeated from its start with fresh ones every
+# iteration (``Mechanics.solve``). The preconditioner is built from a matrix of its own, written only
+# at a refresh: PETSc refactorises when that matrix changed, and only then.
 NEWTON_OPTIONS = {
     "snes_type": "newtonls", "snes_linesearch_type": "basic",
     "snes_rtol": 1e-10, "snes_atol": 1e-10, "snes_stol": 0.0, "snes_max_it": 30,
@@ -55,9 +55,9 @@ NEWTON_OPTIONS = {
 # lives on the sliding interface only). The LDL^T takes about half the memory of the LU (0.58 vs
 # 1.00 GB on the 106k-dof brake) and GMRES needs ~11 iterations per Newton step with fresh factors
 # (measured on the 49k-dof brake at the preload; the symmetric part (J + J^T)/2 instead stalls: 200
-# iterations, 5e-5). Factors lagged over the contact-status changes of the first Newton steps cost
-# ~90 iterations per step (lag 5: 445 in all, 25 s, against 87 and 14.5 s fresh), hence refresh 0
-# (a fresh factorisation every Newton iteration) by default.
+# iterations, 5e-5). Factors kept over the contact-status changes of the first Newton steps cost
+# more GMRES iterations (~90 per step at 49k dofs with a fixed lag of 5), which the timed rule
+# weighs against the factorisations they save.
 PRECONDITIONERS = ("lu", "cholesky")
 
 
@@ -93,10 +93,11 @@ class Mechanics:
     load faces (``load_kind="force"``), a traction [Pa] along it (``load_kind="pressure"``), or a
     fluid pressure p [Pa] (``load_kind="fluid"``: traction −p n with n the outward normal, so two
     faces that look at each other across the fluid, e.g. a brake's piston back and caliper bore,
-    are pushed apart by the same pressure). ``refresh``: GMRES iterations beyond one per linear
-    solve, summed since the last factorisation, after which the next Newton iteration factorises
-    afresh (``NEWTON_OPTIONS``; 0 = a fresh factorisation every iteration; default REFRESH with
-    "lu", 0 with "cholesky"); ``preconditioner``: one of ``PRECONDITIONERS`` (see there).
+    are pushed apart by the same pressure). ``refresh``: None (default) to refactorise by the timed
+    rule of ``NEWTON_OPTIONS``, or a number of GMRES iterations beyond one per linear solve, summed
+    since the last factorisation, from which on the next Newton iteration factorises afresh (0: a
+    fresh factorisation every iteration); ``preconditioner``: one of ``PRECONDITIONERS`` (see
+    there). ``factorisations`` counts the preconditioner's factorisations so far.
     """
 
     LOAD_KINDS = ("force", "pressure", "fluid")
@@ -133,7 +134,7 @@ class Mechanics:
             F[i] -= ufl.dot(self.traction(), v[i]) * tm.ds(tm.face(name))
         self.residuals = F
         self.bcs = self._supports()
-        self.refresh = (REFRESH if preconditioner == "lu" else 0) if refresh is None else int(refresh)
+        self.refresh = None if refresh is None else int(refresh)
         options = dict(NEWTON_OPTIONS)
         P = None
         if preconditioner == "cholesky":
@@ -155,6 +156,9 @@ class Mechanics:
         self._fresh = False                # a fresh factorisation every Newton iteration (retry)
         self._pc_stale = True              # the preconditioner matrix is to be rewritten
         self._excess = 0                   # GMRES iterations beyond one per linear solve since then
+        self.factorisations = 0
+        self._clock = {"mark": 0.0, "factor": 0.0, "iteration": 0.0, "refreshing": False}   # s
+        self.problem.solver.getKSP().setMonitor(self._tick)
         self._pc_mat = self.problem.P_mat if P is not None else self.problem.A.duplicate()
         self.problem.solver.setJacobian(self._jacobian, self.problem.A, self._pc_mat)
         self._frictionless = None          # (matrix, form) of ``frictionless_tangent`` without P
@@ -190,13 +194,19 @@ class Mechanics:
     def _jacobian(self, snes, x, J, P) -> None:
         """SNES Jacobian callback: J = cell part (kept) + facet part at x; the preconditioner
         matrix P is rewritten (J itself, or J_0 with "cholesky") only at a refresh: the first
-        call, after ``release``, on a retry, after a failed linear solve, or once the linear solves
-        since the last refresh took more than ``refresh`` GMRES iterations beyond one each."""
-        ksp = snes.getKSP()
+        call, after ``release``, on a retry, after a failed linear solve, or once the GMRES
+        iterations beyond one per linear solve since the last refresh cost more than it (timed),
+        or number ``refresh`` or more."""
+        ksp, clock = snes.getKSP(), self._clock
         self._excess += max(ksp.getIterationNumber() - 1, 0)       # the last linear solve's
-        refresh = self._pc_stale or self._fresh or self._excess > self.refresh or ksp.getConvergedReason() < 0
+        if self.refresh is None:                 # timings differ between ranks: decide together
+            due = self.tm.comm.allreduce(self._excess * clock["iteration"] > clock["factor"], op=MPI.LOR)
+        else:
+            due = self._excess >= self.refresh
+        refresh = self._pc_stale or self._fresh or due or ksp.getConvergedReason() < 0
         if refresh:
             self._excess = 0
+            self.factorisations += 1
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         fpetsc.assign(x, self.u)
         self._compose(J, 0)
@@ -205,6 +215,18 @@ class Mechanics:
         elif refresh:
             J.copy(P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         self._pc_stale = False
+        clock["refreshing"], clock["mark"] = refresh, time.perf_counter()
+
+    def _tick(self, ksp, it: int, rnorm: float) -> None:
+        """KSP monitor: the time to GMRES's first call after a refresh is the factorisation's, the
+        time between later calls one iteration's (a running mean)."""
+        clock, now = self._clock, time.perf_counter()
+        if it == 0 and clock["refreshing"]:
+            clock["factor"] = now - clock["mark"]
+        elif it > 0:
+            step = now - clock["mark"]
+            clock["iteration"] = step if clock["iteration"] == 0.0 else 0.8 * clock["iteration"] + 0.2 * step
+        clock["mark"] = now
 
     def _compose(self, A: PETSc.Mat, k: int) -> PETSc.Mat:
         """``A`` overwritten by split form k (0: the tangent, 1: J_0) at the current state: its cell
