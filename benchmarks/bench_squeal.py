@@ -55,12 +55,12 @@ def run_once(args, comm):
     t["preload"] = pre.time
     if comm.rank == 0:
         print(f"# {ndofs} dofs, preload {pre.time:.1f} s", flush=True)      # progress of a long run
-    linear = mech.problem.solver.getLinearSolveIterations()
+    linear, factorisations = mech.problem.solver.getLinearSolveIterations(), mech.factorisations
     memory = {"preload": peak_gib(comm)}
     if args.preload_only:
         if comm.rank == 0:
             print(f"# preload: last load step {pre.iterations} Newton iterations, {linear} GMRES iterations, "
-                  f"{mech.factorisations} factorisations, "
+                  f"{factorisations} factorisations, "
                   f"peak memory {', '.join(f'{g:.2f}' for g in memory['preload'])} GiB", flush=True)
         return None
     t0 = time.perf_counter()
@@ -76,7 +76,7 @@ def run_once(args, comm):
     t["modes"] = modes.time
     memory["modes"] = peak_gib(comm)
     t["total"] = sum(t.values())
-    return t, ndofs, pre, modes, linear, memory
+    return t, ndofs, pre, modes, (linear, factorisations), memory
 
 
 def main(argv=None):
@@ -101,7 +101,7 @@ def main(argv=None):
     if comm.rank or args.preload_only:
         return
     t = {k: statistics.median(r[0][k] for r in runs) for k in runs[0][0]}
-    _, ndofs, pre, modes, linear, memory = runs[-1]
+    _, ndofs, pre, modes, (linear, factorisations), memory = runs[-1]
     print(f"brake squeal benchmark ({args.method}): {ndofs} dofs (P{args.degree}, mesh {args.mesh_size * 1e3:g} mm), "
           f"{comm.size} rank(s), median of {args.repeats}")
     print("| stage | wall time [s] |\n|---|---|")
@@ -109,7 +109,7 @@ def main(argv=None):
         print(f"| {k} | {v:.1f} |")
     for k, v in memory.items():
         print(f"| peak memory per rank after {k} | {', '.join(f'{g:.2f}' for g in v)} GiB |")
-    print(f"Newton iterations {pre.iterations} (GMRES iterations {linear}); pad forces "
+    print(f"Newton iterations {pre.iterations} (GMRES iterations {linear}, {factorisations} factorisations); pad forces "
           f"{', '.join(f'{k} {v:.1f} N' for k, v in pre.normal_force.items())}; "
           f"{len(modes)} modes up to {modes.frequency.max():.0f} Hz, {len(modes.unstable().nonzero()[0])} "
           f"unstable; max residual {modes.errors.max():.1e}, median {statistics.median(modes.errors):.1e}; "
