@@ -31,6 +31,14 @@ def unit_of(name: str) -> str:
     return "-"
 
 
+def solver_statistic(name: str) -> bool:
+    """Whether a history column describes the solver's path, not the state: wall times
+    (``time_*``) and Newton iteration counts, which follow the factorisations a run kept (timed
+    decisions, ``macro.mechanics``). Repeated or resumed runs agree on every other column to the
+    solver tolerances (docs/architecture.md, "Repeatability")."""
+    return name.startswith("time_") or name == "newton_iterations"
+
+
 class History:
     """Time series: ``append(time=..., interface_force=..., ...)``, same keys every row; a value is a
     scalar, or a 1-D array of fixed length (a per-zone quantity: its column is (rows, length))."""

@@ -7,6 +7,7 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from mpi4py import MPI  # noqa: E402
 
+from multiscale.io import solver_statistic  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 
@@ -62,8 +63,8 @@ def test_two_ranks_give_the_serial_thermal_history(tmp_path):
         serial = run(loads(SCENE.format(folder=f"{base}/serial")), comm=MPI.COMM_SELF, verbose=False).history
     serial = world.bcast(serial.columns if serial is not None else None, root=0)
     assert set(serial) == set(parallel.columns) and "heat_lost_total_flat" in serial
-    for key, values in serial.items():
-        np.testing.assert_allclose(parallel[key], values, rtol=1e-8, atol=1e-8, err_msg=key)
+    for key in (k for k in serial if not solver_statistic(k)):
+        np.testing.assert_allclose(parallel[key], serial[key], rtol=1e-8, atol=1e-8, err_msg=key)
     # energy: stored + lost = 0 in the stack (no frictional heat), to round-off
     stored = parallel["stored_heat_block"][-1] + parallel["stored_heat_flat"][-1]
     lost = parallel["heat_lost_total_block"][-1] + parallel["heat_lost_total_flat"][-1]
