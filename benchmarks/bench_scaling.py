@@ -105,7 +105,7 @@ def main():
     if args.compare:
         other = io.History.read(Path(args.compare))
         worst = {k: float(np.nanmax(np.abs(history[k] - other[k])) / max(np.nanmax(np.abs(other[k])), 1e-300))
-                 for k in other.columns if not k.startswith("time_") and np.isfinite(other[k]).any()}
+                 for k in other.columns if not io.solver_statistic(k) and np.isfinite(other[k]).any()}
         top = sorted(worst.items(), key=lambda kv: -kv[1])[:5]
         print("largest differences to", args.compare, "(of each column's largest value):",
               ", ".join(f"{k} {v:.1e}" for k, v in top))
