@@ -320,7 +320,7 @@ class Mechanics:
     def _newton(self) -> SolveResult:
         """One SNES solve from the current state; converged only if finite on every rank."""
         self._history.clear()
-        self._bulk_stale = self._bulk_stale or self._bulk_of_T      # the temperatures may have changed
+        self._temperatures_may_have_changed()
         self.problem.solve()
         snes = self.problem.solver
         reason, its = snes.getConvergedReason(), snes.getIterationNumber()
@@ -340,20 +340,26 @@ class Mechanics:
         """The assembled block Jacobian with mu = 0 at the current state (symmetric, flagged so).
         Owned by the model (with ``preconditioner="cholesky"`` the preconditioner matrix) and
         overwritten by the next call or solve, as ``tangent``."""
-        if self.problem.P_mat is not None:
-            P, form = self.problem.P_mat, self.problem.preconditioner
+        if self.problem.P_mat is not None:       # the preconditioner's matrix: refactorise next time
+            self._temperatures_may_have_changed()
+            P = self._compose(self.problem.P_mat, 1)
+            self._pc_stale = True
         else:
             if self._frictionless is None:
                 form = fem.form(self._frictionless_jacobian(), entity_maps=self.tm.entity_maps)
                 self._frictionless = (fpetsc.create_matrix(form), form)
-            P, form = self._frictionless
-        self._assemble(P, form).setOption(PETSc.Mat.Option.SYMMETRIC, True)
+            P = self._assemble(*self._frictionless)
+        P.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         return P
 
     def tangent(self) -> PETSc.Mat:
         """The assembled block Jacobian at the current state (assembled on request)."""
-        self._bulk_stale = self._bulk_stale or self._bulk_of_T
+        self._temperatures_may_have_changed()
         return self._compose(self.problem.A, 0)
+
+    def _temperatures_may_have_changed(self) -> None:
+        """With E(T) or nu(T), the kept cell parts are reassembled at their next use."""
+        self._bulk_stale = self._bulk_stale or self._bulk_of_T
 
     def _assemble(self, A: PETSc.Mat, form) -> PETSc.Mat:
         """``A`` overwritten by the block matrix of ``form`` at the current state, with the supports."""
