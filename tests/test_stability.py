@@ -10,7 +10,8 @@ from petsc4py import PETSc
 
 from multiscale.errors import InputError
 from multiscale.macro import eigen, modal
-from multiscale.references.stability import hoffmann_matrices
+from multiscale.references.stability import hoffmann_matrices, spring_chain as chain
+from multiscale.references.stability import spring_chain_frequencies as chain_frequencies
 
 K11, K22, K12, K21, K3 = 1.0, 1.5, 0.3, 0.3, 1.0
 MU_C = ((K11 - K22) ** 2 + 4 * K12 * K21) / (4 * K21 * K3)   # 0.508333...
@@ -36,31 +37,6 @@ def petsc_mat(A):
         m.setValue(i, j, A[i, j])
     m.assemble()
     return m
-
-
-def chain(n=200, k=4e6, m=0.01, drift=0.0):
-    """Fixed-fixed spring-mass chain (n masses) with both end dofs as Dirichlet rows.
-
-    Returns dense K, M of size n + 2: rows 0 and n+1 are identity in K and zero in M (constrained
-    modes at infinity). ``drift`` adds a circulatory (follower-like) coupling to make K non-symmetric.
-    """
-    N = n + 2
-    K = np.zeros((N, N))
-    M = np.zeros((N, N))
-    for i in range(1, n + 1):
-        K[i, i] = 2 * k
-        if i > 1:
-            K[i, i - 1] = -k + drift * k
-        if i < n:
-            K[i, i + 1] = -k - drift * k
-        M[i, i] = m
-    K[0, 0] = K[-1, -1] = 1.0
-    return K, M
-
-
-def chain_frequencies(n=200, k=4e6, m=0.01):
-    j = np.arange(1, n + 1)
-    return 2 * np.sqrt(k / m) * np.sin(j * np.pi / (2 * (n + 1))) / (2 * np.pi)
 
 
 def test_hoffmann_coalescence_at_analytic_mu_c():

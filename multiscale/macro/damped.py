@@ -46,6 +46,8 @@ import scipy.linalg
 from petsc4py import PETSc
 
 from multiscale.errors import InputError
+from multiscale.macro.block_lanczos import ShiftInvert, m_orthonormalise, symmetric_modes
+from multiscale.macro.dense import mat_mult
 from multiscale.macro.eigen import (TWO_PI, Damping, ModalResult, lambda_from_theta, matrix_comm, reduce_sum,
                                     solve_modes, solve_quadratic)
 from multiscale.macro.modal import mac_matrix, pair_modes
@@ -74,18 +76,6 @@ class LinearSystem:
         return self.H is not None or bool(self.damping and self.damping.eta)
 
 
-def apply_real(A, V: np.ndarray) -> np.ndarray:
-    """A @ V for a PETSc matrix and real columns of owned entries."""
-    x, y = A.createVecs()
-    out = np.empty_like(V)
-    for j in range(V.shape[1]):
-        x.setArray(np.ascontiguousarray(V[:, j]))
-        A.mult(x, y)
-        out[:, j] = y.getArray()
-    x.destroy(), y.destroy()
-    return out
-
-
 class Subspace:
     """Real M-orthonormal basis V of the span of the real and imaginary parts of complex vectors
     (e.g. ``ModalResult.modes`` of several cases), with its Gram matrix V^T V (for the MAC)."""
@@ -93,20 +83,15 @@ class Subspace:
     def __init__(self, vectors, M, comm=None, drop: float = 1e-10):
         X = np.hstack([np.column_stack([np.real(v), np.imag(v)]) if np.iscomplexobj(v) else v for v in vectors])
         self.comm = comm
-        for _ in range(2):                   # twice: orthonormal to round-off after the rank cut
-            G = reduce_sum(X.T @ apply_real(M, X), comm)
-            w, U = np.linalg.eigh(0.5 * (G + G.T))
-            keep = w > drop * w.max()
-            X = X @ (U[:, keep] / np.sqrt(w[keep]))
-        self.V = X
-        self.gram = reduce_sum(X.T @ X, comm)
+        self.V = m_orthonormalise(X, [], [], M, comm, drop)[0]
+        self.gram = reduce_sum(self.V.T @ self.V, comm)
 
     @property
     def size(self) -> int:
         return self.V.shape[1]
 
     def apply(self, A) -> np.ndarray:
-        return apply_real(A, self.V)
+        return mat_mult(A, self.V)
 
     def reduce(self, AV: np.ndarray) -> np.ndarray:
         """V^T A V from the product A V."""
@@ -228,41 +213,38 @@ def solve_projected(system: LinearSystem, sub: Subspace, *, band=(0.0, 16e3), n_
                         base=base, expand=expand), red
 
 
-def basis_modes(system: LinearSystem, *, band, n_modes, target, basis: float, **kw) -> ModalResult:
-    """Undamped modes of (K, M) spanning the projection basis: up to ``basis`` x the band's top
-    (and ``basis`` x ``n_modes`` modes when capped)."""
+def basis_band(band, n_modes, target, basis: float) -> dict:
+    """The band of the projection basis: up to ``basis`` x the band's top (and ``basis`` x
+    ``n_modes`` modes when capped); keywords of the modal solvers."""
     if not basis >= 1:
         raise InputError("stability.basis", basis, "must be >= 1 (the basis reaches basis x f_max)")
     f_min, f_max = band
-    cap = None if n_modes is None else int(math.ceil(basis * n_modes))
-    return solve_modes(system.K, system.M, f_min=f_min / basis, f_max=basis * f_max, n_modes=cap,
-                       target=target if target is not None else f_min / basis, **kw)
+    return dict(f_min=f_min / basis, f_max=basis * f_max, target=f_min / basis if target is None else target,
+                n_modes=None if n_modes is None else int(math.ceil(basis * n_modes)))
+
+
+def basis_modes(system: LinearSystem, *, band, n_modes, target, basis: float, **kw) -> ModalResult:
+    """Undamped modes of (K, M) spanning the projection basis (``basis_band``)."""
+    return solve_modes(system.K, system.M, **basis_band(band, n_modes, target, basis), **kw)
 
 
 def subspace_basis(system: LinearSystem, *, band, n_modes, target, basis: float,
                    **kw) -> tuple[ModalResult, Subspace]:
-    """The ``"subspace"`` basis (module docstring): real modes of (K0, M) up to ``basis`` x the
-    band's top (and ``basis`` x ``n_modes`` modes when capped) and their static corrections."""
+    """The ``"subspace"`` basis (module docstring): real modes of (K0, M) in ``basis_band`` by the
+    shifted block Lanczos method, and their static corrections with the same factors. ``kw``:
+    ``tol`` of the modes."""
     if system.K0 is None:
         raise InputError("stability.method", "subspace", "needs the frictionless tangent K0 of the system")
-    inverse = []
-    base = basis_modes(replace(system, K=system.K0), band=band, n_modes=n_modes, target=target, basis=basis,
-                       symmetric=True, inverse=inverse, **kw)
-    V = np.ascontiguousarray(base.modes.real)     # real modes (normalised with a real phase)
-    base = replace(base, modes=None)
-    eps = inverse[0]
+    wanted = basis_band(band, n_modes, target, basis)
+    factors = ShiftInvert(system.K0, system.M, (TWO_PI * wanted["target"]) ** 2)
     try:
-        ksp = eps.getST().getKSP()
-        W = apply_real(system.K, V) - apply_real(system.K0, V)
-        x, b = system.K0.createVecs()
-        for j in range(W.shape[1]):
-            b.setArray(np.ascontiguousarray(W[:, j]))
-            ksp.solve(b, x)
-            W[:, j] = x.getArray()
-        x.destroy(), b.destroy()
+        base = symmetric_modes(system.K0, system.M, **wanted, solver=factors,
+                               **{k: v for k, v in kw.items() if k == "tol"})
+        V = base.modes
+        W = factors.solve(mat_mult(system.K, V) - mat_mult(system.K0, V))
     finally:
-        eps.destroy()
-    return base, Subspace([V, W], system.M, matrix_comm(system.K))
+        factors.destroy()
+    return replace(base, modes=None), Subspace([V, W], system.M, matrix_comm(system.K))
 
 
 def solve_system(system: LinearSystem, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int | None = None,

@@ -33,6 +33,7 @@ from petsc4py import PETSc
 from slepc4py import SLEPc
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.macro.dense import mat_mult
 
 TWO_PI = 2.0 * math.pi
 
@@ -131,7 +132,8 @@ def lambda_from_theta(theta, damping: Damping | None = None) -> np.ndarray:
     return np.where(take1, r1, r2)
 
 
-def _check_band(f_min, f_max, target, n_modes):
+def check_band(f_min, f_max, target, n_modes):
+    """(f_min, f_max, target) [Hz] checked (InputError), target None -> f_min."""
     f_min = check_positive("f_min", f_min, allow_zero=True)
     f_max = check_positive("f_max", f_max)
     if f_max <= f_min:
@@ -150,9 +152,9 @@ def _check_band(f_min, f_max, target, n_modes):
     return f_min, f_max, target
 
 
-def _shift_invert(solver, target, tol, max_it, prefix, factor=PETSc.PC.Type.LU):
-    """Configure a SLEPc EPS or PEP: the eigenvalues nearest ``target`` by shift-and-invert through a
-    direct factorisation (``factor``, MUMPS when available), then the options under ``prefix``."""
+def _shift_invert(solver, target, tol, max_it, prefix):
+    """Configure a SLEPc EPS or PEP: the eigenvalues nearest ``target`` by shift-and-invert through an
+    LU factorisation (MUMPS when available), then the options under ``prefix``."""
     solver.setTarget(target)
     solver.setWhichEigenpairs(type(solver).Which.TARGET_MAGNITUDE)
     solver.setTolerances(tol, max_it)
@@ -161,7 +163,7 @@ def _shift_invert(solver, target, tol, max_it, prefix, factor=PETSc.PC.Type.LU):
     ksp = st.getKSP()
     ksp.setType(PETSc.KSP.Type.PREONLY)
     pc = ksp.getPC()
-    pc.setType(factor)
+    pc.setType(PETSc.PC.Type.LU)
     if PETSc.Sys.hasExternalPackage("mumps"):
         pc.setFactorSolverType("mumps")
     solver.setOptionsPrefix(prefix)
@@ -195,17 +197,9 @@ def matrix_comm(A):
 
 def mat_apply(A, phi: np.ndarray) -> np.ndarray:
     """A @ phi for a real PETSc matrix and complex columns of owned entries."""
-    x, y = A.createVecs()
-    out = np.empty_like(phi)
-    for j in range(phi.shape[1]):
-        parts = []
-        for part in (phi[:, j].real, phi[:, j].imag):
-            x.setArray(np.ascontiguousarray(part))
-            A.mult(x, y)
-            parts.append(y.getArray().copy())
-        out[:, j] = parts[0] + 1j * parts[1]
-    x.destroy(), y.destroy()
-    return out
+    k = phi.shape[1]
+    out = mat_mult(A, np.hstack([phi.real, phi.imag]))
+    return out[:, :k] + 1j * out[:, k:]
 
 
 def _sorted(lam, theta, vecs, errs, band, seen_f):
@@ -223,8 +217,7 @@ def _sorted(lam, theta, vecs, errs, band, seen_f):
 
 def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int | None = None,
                 target: float | None = None, damping: Damping | None = None, tol: float = 1e-10,
-                max_it: int = 300, nev: int = 20, options_prefix: str = "stability_",
-                symmetric: bool = False, inverse: list | None = None) -> ModalResult:
+                max_it: int = 300, nev: int = 20, options_prefix: str = "stability_") -> ModalResult:
     """Modes with f_min <= f <= f_max [Hz] of K phi = theta M phi (GNHEP, shift-and-invert, §4.3.1).
 
     ``K`` (tangent, may be non-symmetric) and ``M`` (mass, diag 0 on Dirichlet rows so that the
@@ -234,14 +227,10 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
     subspace grows (from ``nev``) until every theta with |theta - theta_t| <= max((2 pi f_max)^2 -
     theta_t, theta_t - (2 pi f_min)^2) is converged, i.e. the band is complete for modes with
     |sigma| << omega, or until ``n_modes`` band modes nearest the target are found (a cap; the
-    conjugate partner of the last one is kept with it). ``symmetric``: K is symmetric (and M
-    positive semi-definite): the GHEP, shift-and-invert through a MUMPS LDL^T factorisation (about
-    half the memory of the LU), real modes. ``inverse``: a list that receives the SLEPc
-    solver, kept with its factors (``getST().getKSP()`` solves with K - theta_t M; the caller
-    destroys it). Raises InputError for a bad request or an empty band, ConvergenceError if SLEPc
+    conjugate partner of the last one is kept with it). Raises InputError for a bad request or an empty band, ConvergenceError if SLEPc
     does not converge.
     """
-    f_min, f_max, target = _check_band(f_min, f_max, target, n_modes)
+    f_min, f_max, target = check_band(f_min, f_max, target, n_modes)
     t0 = time.perf_counter()
     comm = matrix_comm(K)
     n = K.getSize()[0]
@@ -253,9 +242,9 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
 
     eps = SLEPc.EPS().create(K.getComm())
     eps.setOperators(K, M)
-    eps.setProblemType(SLEPc.EPS.ProblemType.GHEP if symmetric else SLEPc.EPS.ProblemType.GNHEP)
+    eps.setProblemType(SLEPc.EPS.ProblemType.GNHEP)
     eps.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
-    _shift_invert(eps, shift, tol, max_it, options_prefix, PETSc.PC.Type.CHOLESKY if symmetric else PETSc.PC.Type.LU)
+    _shift_invert(eps, shift, tol, max_it, options_prefix)
     solves = 0
     while True:
         eps.setDimensions(want, PETSc.DECIDE)
@@ -299,11 +288,7 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
         vals[j], vecs[:, j] = _pairs(eps, int(i), vr, vi)
         errs[j] = eps.computeError(int(i), SLEPc.EPS.ErrorType.RELATIVE)
     iterations = eps.getIterationNumber()
-    if inverse is None:
-        eps.destroy()
-    else:
-        inverse.append(eps)
-    vr.destroy(), vi.destroy()
+    eps.destroy(), vr.destroy(), vi.destroy()
 
     lam = lambda_from_theta(vals, damping)
     lam, vals, vecs, errs = _sorted(lam, vals, vecs, errs, (f_min, f_max),
@@ -325,7 +310,7 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     whole band: the subspace grows until a converged |lambda - s| exceeds |i 2 pi f_max - s|.
     The result is filtered to the band. ``theta`` is reported as -lambda^2.
     """
-    f_min, f_max, target = _check_band(f_min, f_max, target, n_modes)
+    f_min, f_max, target = check_band(f_min, f_max, target, n_modes)
     t0 = time.perf_counter()
     comm = matrix_comm(K)
     n = K.getSize()[0]

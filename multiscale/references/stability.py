@@ -132,3 +132,24 @@ def belt_onset_speed(damping: float, normal_force: float, static: float, kinetic
     check_positive("damping", damping)
     drop = normal_force * (static - kinetic) / (damping * speed)
     return float(speed * np.log(drop)) if drop > 1 else 0.0
+
+
+def spring_chain(n: int = 200, k: float = 4e6, m: float = 0.01, drift: float = 0.0) -> tuple:
+    """Dense (K, M) of a fixed-fixed chain of n masses m [kg] joined by springs k [N/m], with both
+    end dofs as Dirichlet rows (size n + 2: rows 0 and n + 1 identity in K, zero in M: constrained
+    modes at infinity). ``drift`` adds a circulatory (follower-like) coupling: K non-symmetric."""
+    N = n + 2
+    K, M = np.zeros((N, N)), np.zeros((N, N))
+    i = np.arange(1, n + 1)
+    K[i, i], M[i, i] = 2 * k, m
+    K[i[1:], i[1:] - 1] = -k + drift * k
+    K[i[:-1], i[:-1] + 1] = -k - drift * k
+    K[0, 0] = K[-1, -1] = 1.0
+    return K, M
+
+
+def spring_chain_frequencies(n: int = 200, k: float = 4e6, m: float = 0.01) -> np.ndarray:
+    """Natural frequencies [Hz] of ``spring_chain`` without drift, ascending:
+    f_j = sqrt(k/m) sin(j pi / (2 (n + 1))) / pi, j = 1..n."""
+    j = np.arange(1, n + 1)
+    return 2 * np.sqrt(k / m) * np.sin(j * np.pi / (2 * (n + 1))) / (2 * np.pi)
