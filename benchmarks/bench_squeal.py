@@ -113,7 +113,8 @@ def main(argv=None):
           f"{', '.join(f'{k} {v:.1f} N' for k, v in pre.normal_force.items())}; "
           f"{len(modes)} modes up to {modes.frequency.max():.0f} Hz, {len(modes.unstable().nonzero()[0])} "
           f"unstable; max residual {modes.errors.max():.1e}, median {statistics.median(modes.errors):.1e}; "
-          f"SLEPc solves {modes.solves}")
+          + (f"real modes: {modes.iterations} block Lanczos blocks" if args.method == "subspace"
+             else f"SLEPc solves {modes.solves}"))
 
 
 if __name__ == "__main__":
