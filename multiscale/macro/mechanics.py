@@ -161,6 +161,17 @@ class Mechanics:
         self.problem.solver.getKSP().setMonitor(self._tick)
         self._pc_mat = self.problem.P_mat if P is not None else self.problem.A.duplicate()
         self.problem.solver.setJacobian(self._jacobian, self.problem.A, self._pc_mat)
+        # the residual's cell part is affine in u: the kept cell matrix times u plus an offset
+        # (thermal expansion) assembled once per solve; its facet part every evaluation
+        self._cell_residual, self._facet_residual = (
+            fem.form([ufl.Form([i for i in f.integrals() if (i.integral_type() == "cell") == cells]) for f in F],
+                     entity_maps=tm.entity_maps) for cells in (True, False))
+        self._blocks = self.problem.b.getAttr("_blocks")          # DOLFINx's block layout of the vectors
+        self._offset, self._product = self.problem.b.duplicate(), self.problem.b.duplicate()
+        self._offset.setAttr("_blocks", self._blocks)
+        self._offset_stale = True
+        self._bcs_by_body = fem.bcs_by_block(fem.extract_function_spaces(self._cell_residual), self.bcs)
+        self.problem.solver.setFunction(self._residual, self.problem.b)
         self._frictionless = None          # (matrix, form) of ``frictionless_tangent`` without P
         self._history: list[float] = []
         self.problem.solver.setMonitor(lambda snes, it, norm: self._history.append(norm))
@@ -231,15 +242,48 @@ class Mechanics:
     def _compose(self, A: PETSc.Mat, k: int) -> PETSc.Mat:
         """``A`` overwritten by split form k (0: the tangent, 1: J_0) at the current state: its cell
         part (reassembled if stale) plus its facet part, with the supports."""
-        if self._bulk_stale:
-            for bulk, cells, _ in self._split:
-                self._assemble(bulk, cells)
-            self._bulk_stale = False
+        self._refresh_cell_parts()
         bulk, _, facets = self._split[k]
         bulk.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         fpetsc.assemble_matrix(A, facets, bcs=self.bcs)
         A.assemble()
         return A
+
+    def _refresh_cell_parts(self) -> None:
+        if self._bulk_stale:
+            for bulk, cells, _ in self._split:
+                self._assemble(bulk, cells)
+            self._bulk_stale = False
+
+    def _residual(self, snes, x, b) -> None:
+        """SNES residual callback: F(x) = K_cell x + offset + facet part at x (contact, load faces),
+        with the supports (x - 0 on their rows; the supports are homogeneous and x meets them, so
+        there is nothing to lift). K_cell is the tangent's kept cell part; the offset, the cell
+        residual minus K_cell x (the thermal expansion term), is assembled at a solve's first call."""
+        b.setAttr("_blocks", self._blocks)
+        x.setAttr("_blocks", self._blocks)
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        fpetsc.assign(x, self.u)
+        bulk = self._split[0][0]
+        if self._offset_stale:
+            self._refresh_cell_parts()
+            self._assemble_vector(self._offset, self._cell_residual)
+            bulk.mult(x, self._product)
+            self._offset.axpy(-1.0, self._product)
+            self._offset_stale = False
+        self._assemble_vector(b, self._facet_residual)
+        bulk.multAdd(x, b, b)
+        b.axpy(1.0, self._offset)
+        fpetsc.set_bc(b, self._bcs_by_body, x0=x, alpha=-1.0)
+        b.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+
+    @staticmethod
+    def _assemble_vector(b, forms) -> None:
+        """``b`` overwritten by the block vector of ``forms`` (owned entries summed over ranks)."""
+        with b.localForm() as local:
+            local.set(0.0)
+        fpetsc.assemble_vector(b, forms)
+        b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
 
     def dx(self, i: int):
         """Volume measure over the regions of body i (on the parent mesh)."""
@@ -321,6 +365,7 @@ class Mechanics:
         """One SNES solve from the current state; converged only if finite on every rank."""
         self._history.clear()
         self._temperatures_may_have_changed()
+        self._offset_stale = True
         self.problem.solve()
         snes = self.problem.solver
         reason, its = snes.getConvergedReason(), snes.getIterationNumber()
