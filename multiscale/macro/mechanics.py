@@ -161,13 +161,13 @@ class Mechanics:
         self.problem.solver.getKSP().setMonitor(self._tick)
         self._pc_mat = self.problem.P_mat if P is not None else self.problem.A.duplicate()
         self.problem.solver.setJacobian(self._jacobian, self.problem.A, self._pc_mat)
-        # the residual's cell part is affine in u: the kept cell matrix times u plus an offset
-        # (thermal expansion) assembled once per solve; its facet part every evaluation
+        # the residual's cell part is affine in u: assembled at a solve's start x_0, then updated by
+        # the kept cell matrix times x - x_0; its facet part every evaluation
         self._cell_residual, self._facet_residual = (
             fem.form([ufl.Form([i for i in f.integrals() if (i.integral_type() == "cell") == cells]) for f in F],
                      entity_maps=tm.entity_maps) for cells in (True, False))
         self._blocks = self.problem.b.getAttr("_blocks")          # DOLFINx's block layout of the vectors
-        self._offset, self._product = self.problem.b.duplicate(), self.problem.b.duplicate()
+        self._offset, self._start, self._step = (self.problem.b.duplicate() for _ in range(3))
         self._offset.setAttr("_blocks", self._blocks)
         self._offset_stale = True
         self._bcs_by_body = fem.bcs_by_block(fem.extract_function_spaces(self._cell_residual), self.bcs)
@@ -256,23 +256,25 @@ class Mechanics:
             self._bulk_stale = False
 
     def _residual(self, snes, x, b) -> None:
-        """SNES residual callback: F(x) = K_cell x + offset + facet part at x (contact, load faces),
-        with the supports (x - 0 on their rows; the supports are homogeneous and x meets them, so
-        there is nothing to lift). K_cell is the tangent's kept cell part; the offset, the cell
-        residual minus K_cell x (the thermal expansion term), is assembled at a solve's first call."""
+        """SNES residual callback: F(x) = r_cell(x_0) + K_cell (x - x_0) + facet part at x (contact,
+        load faces), with the supports (x - 0 on their rows; the supports are homogeneous and x
+        meets them, so there is nothing to lift). The cell part is affine in x (linear elasticity,
+        thermal expansion at the solve's temperatures): r_cell is assembled at x_0, a solve's first
+        call, and K_cell is the tangent's kept cell part. Only the increment goes through K_cell:
+        K_cell x itself would cancel against the thermal expansion term in round-off (a floor near
+        the Newton tolerance where the thermal strains dominate)."""
         b.setAttr("_blocks", self._blocks)
         x.setAttr("_blocks", self._blocks)
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         fpetsc.assign(x, self.u)
-        bulk = self._split[0][0]
         if self._offset_stale:
             self._refresh_cell_parts()
             self._assemble_vector(self._offset, self._cell_residual)
-            bulk.mult(x, self._product)
-            self._offset.axpy(-1.0, self._product)
+            x.copy(self._start)
             self._offset_stale = False
         self._assemble_vector(b, self._facet_residual)
-        bulk.multAdd(x, b, b)
+        self._step.waxpy(-1.0, self._start, x)                     # x - x_0
+        self._split[0][0].multAdd(self._step, b, b)
         b.axpy(1.0, self._offset)
         fpetsc.set_bc(b, self._bcs_by_body, x0=x, alpha=-1.0)
         b.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
