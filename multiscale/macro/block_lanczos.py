@@ -170,7 +170,7 @@ def wanted(nu, residual, shift, radius, band, n_modes, tol, final):
     need = int(need[0]) + 1 if need.size else order.size
     if n_modes is not None and inband.sum() >= n_modes:
         need = min(need, int(np.nonzero(np.cumsum(inband) == n_modes)[0][0]) + 1)
-    if not (need <= order.size and ok[:need].all()) or (need == order.size and not final):
+    if not ok[:need].all() or (need == order.size and not final):
         return None
     keep = order[:need][inband[:need]]
     if keep.size == 0:

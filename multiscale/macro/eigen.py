@@ -227,8 +227,8 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
     subspace grows (from ``nev``) until every theta with |theta - theta_t| <= max((2 pi f_max)^2 -
     theta_t, theta_t - (2 pi f_min)^2) is converged, i.e. the band is complete for modes with
     |sigma| << omega, or until ``n_modes`` band modes nearest the target are found (a cap; the
-    conjugate partner of the last one is kept with it). Raises InputError for a bad request or an empty band, ConvergenceError if SLEPc
-    does not converge.
+    conjugate partner of the last one is kept with it). Raises InputError for a bad request or an
+    empty band, ConvergenceError if SLEPc does not converge.
     """
     f_min, f_max, target = check_band(f_min, f_max, target, n_modes)
     t0 = time.perf_counter()

@@ -81,6 +81,14 @@ def load_face_forces(tm: TwoBodyMesh, load: float, load_kind: str) -> dict:
     return {f: float(load) * (a / total if load_kind == "force" else a) for f, a in area.items()}
 
 
+def integrals(form, cells: bool):
+    """The cell integrals (``cells``) or all the others of a UFL form; None if there are none."""
+    if form is None:
+        return None
+    part = ufl.Form([i for i in form.integrals() if (i.integral_type() == "cell") == cells])
+    return None if part.empty() else part
+
+
 class Mechanics:
     """Two-body contact mechanics (see module docstring).
 
@@ -164,8 +172,7 @@ class Mechanics:
         # the residual's cell part is affine in u: assembled at a solve's start x_0, then updated by
         # the kept cell matrix times x - x_0; its facet part every evaluation
         self._cell_residual, self._facet_residual = (
-            fem.form([ufl.Form([i for i in f.integrals() if (i.integral_type() == "cell") == cells]) for f in F],
-                     entity_maps=tm.entity_maps) for cells in (True, False))
+            fem.form([integrals(f, cells) for f in F], entity_maps=tm.entity_maps) for cells in (True, False))
         self._blocks = self.problem.b.getAttr("_blocks")          # DOLFINx's block layout of the vectors
         self._offset, self._start, self._step = (self.problem.b.duplicate() for _ in range(3))
         self._offset.setAttr("_blocks", self._blocks)
@@ -192,13 +199,8 @@ class Mechanics:
     def _split_forms(self, A: PETSc.Mat, compiled, form: list) -> tuple:
         """(matrix, compiled cell part, compiled facet part) of the block form ``form`` (UFL; of
         ``A``, ``compiled``): the matrix, of A's sparsity, holds the cell part with the supports."""
-        parts = []
-        for cells in (True, False):
-            block = [[None if f is None else ufl.Form([i for i in f.integrals()
-                                                       if (i.integral_type() == "cell") == cells]) for f in row]
-                     for row in form]
-            block = [[None if f is None or f.empty() else f for f in row] for row in block]
-            parts.append(fem.form(block, entity_maps=self.tm.entity_maps))
+        parts = [fem.form([[integrals(f, cells) for f in row] for row in form], entity_maps=self.tm.entity_maps)
+                 for cells in (True, False)]
         self._assemble(A, compiled)             # fixes A's sparsity (an empty assembly would drop it)
         return (A.duplicate(), *parts)
 
