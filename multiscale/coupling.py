@@ -16,7 +16,10 @@ One macro step Δt (Fig. 7.2) runs:
    zones are spread over the MPI ranks and the worn topographies shared;
 4. the laws of the zones whose topography changed are recomputed (``rough.RoughInterface``: the
    others come from the pool's cache), the facet laws updated and the mechanics re-solved at the
-   same time: the macro temperature field carries over to the next step unchanged.
+   same time: the macro temperature field carries over to the next step unchanged. This solve
+   starts from the previous step's displacement change of the same solve where that lowers the
+   residual (``law_increment``: the laws change alike from step to step; Newton from the state
+   before overshoots into the stiff laws).
 
 Remote temperatures of the micro heating (``LoopSettings.remote``). "bulk": each body's own macro
 surface temperature at the zone (thesis §7.2.2, §6.5: the heat conducted from the hotter body
@@ -209,6 +212,7 @@ class Multiscale:
         self.facet_area = np.bincount(rough.zone_of_facet[rough.zone_of_facet >= 0],
                                       self.tm.interface.areas[rough.zone_of_facet >= 0], minlength=Z)
         self._last = None                             # this rank's zones, their post-analysis, loading, remote
+        self.law_increment = None                     # m, displacement change of the last solve after new laws
 
     @property
     def partition_law(self) -> bool:
@@ -496,7 +500,10 @@ class Multiscale:
             self.rough.update_laws()
         t4 = _time.perf_counter()
         if changed:
-            self.model.last_solve = self.model.mechanics.solve()
+            mech = self.model.mechanics
+            before = [u.x.array.copy() for u in mech.u]
+            self.model.last_solve = mech.solve(guess=self.law_increment)
+            self.law_increment = [u.x.array - x for u, x in zip(mech.u, before)]
         return StepResult(n, heat, micro, time_macro + _time.perf_counter() - t4, time_micro + t3 - t2, t4 - t3,
                           residuals)
 
