@@ -148,3 +148,13 @@ def test_resolved_scene_loads_back_to_itself(path):
     again = loads(text, path.parent, name=scene.name)
     assert resolved_toml(again).splitlines()[2:] == text.splitlines()[2:]
     assert again.effects == scene.effects and again.output == scene.output and again.time == scene.time
+
+
+def test_a_rank_owning_one_node_or_cell_keeps_its_axis():
+    """``output.components``: the gathered per-rank arrays keep their first axis (a rank owning one
+    interface cell of the perfect-contact demo on 2 ranks stopped the run with squeeze's 0-d array)."""
+    from multiscale.macro.output import components
+    assert components(np.array([2.0]), 1).shape == (1,)
+    assert components(np.arange(3.0), 3).shape == (1, 3)
+    assert np.array_equal(components(np.arange(6.0), 3)[1], [3.0, 4.0, 5.0])
+    assert components(np.zeros(0), 3).shape == (0, 3)

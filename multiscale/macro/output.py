@@ -95,13 +95,20 @@ class MeshLayout:
         work, node_dof = self._p1[shape]
         work.interpolate(f)
         bs = work.function_space.dofmap.bs
-        return self._gather(work.x.array.reshape(-1, bs)[node_dof].squeeze(), "node_position")
+        return self._gather(components(work.x.array, bs)[node_dof], "node_position")
 
     def cell_values(self, f: fem.Function) -> np.ndarray | None:
         """Values of a DG0 function per cell, on rank 0."""
         bs = f.function_space.dofmap.bs
         dofs = f.function_space.dofmap.list[:self.n_cells, 0]
-        return self._gather(f.x.array.reshape(-1, bs)[dofs].squeeze(), "cell_position")
+        return self._gather(components(f.x.array, bs)[dofs], "cell_position")
+
+
+def components(values: np.ndarray, bs: int) -> np.ndarray:
+    """A function's dof array as (dofs,) for a scalar, (dofs, bs) otherwise (``squeeze`` would also
+    drop the first axis where a rank owns one node or cell)."""
+    values = values.reshape(-1, bs)
+    return values[:, 0] if bs == 1 else values
 
 
 def is_cell_field(f: fem.Function) -> bool:
