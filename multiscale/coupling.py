@@ -16,10 +16,8 @@ One macro step Δt (Fig. 7.2) runs:
    zones are spread over the MPI ranks and the worn topographies shared;
 4. the laws of the zones whose topography changed are recomputed (``rough.RoughInterface``: the
    others come from the pool's cache), the facet laws updated and the mechanics re-solved at the
-   same time: the macro temperature field carries over to the next step unchanged. This solve
-   starts from the previous step's displacement change of the same solve where that lowers the
-   residual (``law_increment``: the laws change alike from step to step; Newton from the state
-   before overshoots into the stiff laws).
+   same time (from the state plus the previous step's change by this solve, ``law_increment``,
+   if its residual is lower): the macro temperature field carries over to the next step unchanged.
 
 Remote temperatures of the micro heating (``LoopSettings.remote``). "bulk": each body's own macro
 surface temperature at the zone (thesis §7.2.2, §6.5: the heat conducted from the hotter body

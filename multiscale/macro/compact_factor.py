@@ -33,6 +33,7 @@ class CompactFactor:
         self.matrix: PETSc.Mat | None = None
         self.keys: np.ndarray | None = None       # row * columns + column of the kept entries (sorted)
         self.analyses = 0
+        self._local_rows = 0
 
     @property
     def entries(self) -> int:
