@@ -1,10 +1,12 @@
 """The two contact methods (issue 23): the preconditioned constrained CG ("bccg", default) and
 Polonsky–Keer ("pk") give the same discrete answer; the stopping rule ends within the tolerance
 of a tight reference; iterations that do not grow like sqrt(N); batches over threads; FFT pairs per iteration."""
+import threading
+
 import numpy as np
 import pytest
 
-from multiscale.micro import fft
+from multiscale.micro import bccg_solver, contact, fft, pk_solver
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.surface import fractal_surface, statistics
@@ -69,17 +71,33 @@ def test_iterations_grow_little_with_the_grid():
     assert its["pk", 256] > 1.3 * its["pk", 64]
 
 
-def test_batch_on_two_threads_equals_the_loop():
-    h, dx = slope_one(64, seed=5, batch=(6,))
-    load = np.linspace(0.005, 0.03, 6)
-    solver = ContactSolver(E, (64, 64), dx)
+@pytest.mark.parametrize("method", ["bccg", "pk"])
+def test_batch_on_two_threads_equals_the_loop(method, monkeypatch):
+    """7 patches, chunks of at most 2: two threads, each with its part (4 and 3 patches: chunks of
+    2 + 2 and 2 + 1) and its nested start."""
+    monkeypatch.setitem(contact.CHUNK_CELLS, method, 2 * 64 * 64)
+    module = bccg_solver if method == "bccg" else pk_solver
+    run, chunks = module.run, []
+
+    def recorded(*args):
+        z = args[2] if method == "bccg" else args[3]
+        if z.shape[-1] == 64:                       # not a chunk of the nested start
+            chunks.append((threading.get_ident(), z.shape[0]))
+        return run(*args)
+
+    monkeypatch.setattr(module, "run", recorded)
+    h, dx = slope_one(64, seed=5, batch=(7,))
+    load = np.linspace(0.005, 0.03, 7)
+    solver = ContactSolver(E, (64, 64), dx, method=method)
     before = fft.get_threads()
     try:
         fft.set_threads(2)
         batched = solver.solve(h, load=load)
     finally:
         fft.set_threads(before)
-    for k in range(6):
+    assert len({ident for ident, _ in chunks}) == 2
+    assert sorted(n for _, n in chunks) == [1, 2, 2, 2]
+    for k in range(7):
         one = solver.solve(h[k], load=load[k])
         assert batched.iterations[k] == one.iterations
         np.testing.assert_allclose(batched.pressure[k], one.pressure, rtol=0, atol=1e-12 * one.pressure.max())
