@@ -322,7 +322,9 @@ class ContactSolver:
                 return None
         r = self._coarse._run_chunks("bccg", zc, target, delta, COARSE_TOL, max_iter, None, True, fields=False,
                                      upper=upper, threads=threads)
-        return np.repeat(np.repeat(r.pressure, 2, axis=1), 2, axis=2)
+        p = np.empty(z.shape)                            # piecewise constant (a broadcast copy: np.repeat holds the GIL)
+        p.reshape(B, ny // 2, 2, nx // 2, 2)[...] = r.pressure[:, :, None, :, None]
+        return p
 
 
 def bounded_start(p, upper, total=None):
