@@ -14,7 +14,7 @@ from pathlib import Path
 
 from multiscale import __version__
 from multiscale.errors import InputError, MultiscaleError, SceneError
-from multiscale.io import ended_together
+from multiscale.io import abort, ended_together
 from multiscale.micro.spectrum import surface_statistics
 from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition, formats, read_topography
 from multiscale.outputs import plan
@@ -141,8 +141,8 @@ def _run(args) -> int:
         run(scene, overwrite=args.overwrite, resume=args.resume, verbose=not args.quiet)
     except MultiscaleError as exc:
         if comm is not None and not ended_together(comm):
-            print(f"error (rank {rank} of {comm.size}): {exc}", file=sys.stderr, flush=True)
-            comm.Abort(2)
+            print(f"error (rank {rank} of {comm.size}): {exc}", file=sys.stderr)
+            abort(comm, 2)
         if rank == 0:
             raise
         return 2
