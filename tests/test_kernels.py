@@ -1,6 +1,11 @@
 """Kernels and their FFT operator: every argument checked (issue 21), two mutants the suite used
 to miss (kx built with dy; E* of two bodies with nu1 for both), the preconditioner spectrum of
-the contact solver, and the transform counter of the FFT wrapper (issue 23)."""
+the contact solver, and the transform counter and the shared measured plans of the FFT wrapper
+(issue 23)."""
+import os
+import subprocess
+import sys
+
 import numpy as np
 import pytest
 
@@ -124,3 +129,37 @@ def test_fft_counter_counts_transforms_per_grid():
     assert fft.fft_counts()[(8, 8)] == (6, 3)           # plans collected keep their counts
     fft.reset_fft_counts()
     assert fft.fft_counts() == {}
+
+
+PLAN = """
+import numpy as np
+from multiscale.micro import fft
+x = np.random.default_rng(1).random((3, 24, 40))
+X = fft.RealFFT2(x.shape).forward(x)
+assert np.abs(X - np.fft.rfft2(x)).max() < 1e-12
+print(X.tobytes().hex())
+"""
+
+
+def plan_in_a_process(wisdom):
+    env = {**os.environ, "MULTISCALE_FFTW_WISDOM": str(wisdom)}
+    done = subprocess.run([sys.executable, "-c", PLAN], env=env, capture_output=True, text=True)
+    assert done.returncode == 0, done.stderr
+    return done.stdout
+
+
+def test_fft_plans_are_measured_once_and_shared_by_later_processes(tmp_path):
+    """The first process measures a shape's plans and stores the wisdom; a later process plans from
+    it (measures nothing, so it rewrites nothing) and rounds bit for bit alike."""
+    wisdom = tmp_path / "cache" / "fftw-wisdom"
+    first = plan_in_a_process(wisdom)
+    assert wisdom.read_bytes().startswith(b"(fftw-3")
+    stored = wisdom.stat().st_ino
+    assert plan_in_a_process(wisdom) == first
+    assert wisdom.stat().st_ino == stored                # nothing new measured, nothing rewritten
+
+
+def test_fft_plans_without_a_usable_wisdom_file_are_measured_in_the_process(tmp_path):
+    (tmp_path / "file").write_text("")                  # a file where the folder should be
+    plan_in_a_process(tmp_path / "file" / "fftw-wisdom")
+    plan_in_a_process("")                               # no wisdom file wanted

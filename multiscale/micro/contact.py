@@ -313,7 +313,9 @@ class ContactSolver:
         if self._coarse is None:
             op = self.operator
             self._coarse = ContactSolver(self.kernel, (ny // 2, nx // 2), 2 * op.dx, 2 * op.dy, self.periodic)
-        zc = z.reshape(B, ny // 2, 2, nx // 2, 2).mean(axis=(2, 4))
+        zc = z[:, 0::2] + z[:, 1::2]                     # the 2 x 2 means: pairs of rows, then of columns
+        zc = zc[:, :, 0::2] + zc[:, :, 1::2]             # (a strided mean(axis=(2, 4)) took 14x longer)
+        zc *= 0.25
         low = zc.min(axis=(1, 2))                        # the coarse top lies this far below the fine one
         zc -= low[:, None, None]
         if target is None:

@@ -6,11 +6,20 @@ what you want under MPI with one rank per core); a plan may also be given its ow
 
 Every transform is counted (``fft_counts``, ``reset_fft_counts``): benchmarks report the cost of
 an iteration in FFT pairs measured, not guessed.
+
+Plans are measured (FFTW_MEASURE: 1.2-1.65x faster transforms than FFTW_ESTIMATE's on this
+machine, benchmarks/README) and their wisdom is kept in a file (``wisdom_file``) that every
+process reads: a shape is measured once per machine, under a file lock, and every later process,
+MPI rank and run uses the same plan, hence rounds alike (measured anew in each process, two runs
+could differ by 1e-7 when a solve near its tolerance took one iteration more).
 """
 from __future__ import annotations
 
 import os
+import threading
 import weakref
+from contextlib import contextmanager
+from pathlib import Path
 
 import numpy as np
 import scipy.fft
@@ -26,6 +35,7 @@ except ImportError:  # pragma: no cover
 _threads = max(1, int(os.environ.get("MULTISCALE_THREADS", "1")))
 _plans: weakref.WeakSet = weakref.WeakSet()   # every RealFFT2 alive: they count their transforms
 _retired: dict = {}                            # grid -> [forward, inverse] of the plans collected since
+_planning = threading.Lock()                   # FFTW's planner is not thread-safe
 
 
 def set_threads(n: int) -> None:
@@ -62,6 +72,66 @@ def fft_pairs(grid: tuple[int, int]) -> float:
     return sum((f + i) / 2 * (g[0] * g[1]) / cells for g, (f, i) in fft_counts().items())
 
 
+def wisdom_file() -> Path | None:
+    """Where FFTW wisdom is kept: ``$MULTISCALE_FFTW_WISDOM`` (empty: nowhere, plans are measured
+    in every process), else ``$XDG_CACHE_HOME`` or ``~/.cache``, ``multiscale/fftw-wisdom``."""
+    value = os.environ.get("MULTISCALE_FFTW_WISDOM")
+    if value is not None:
+        return Path(value).expanduser() if value else None
+    return Path(os.environ.get("XDG_CACHE_HOME") or Path.home() / ".cache") / "multiscale" / "fftw-wisdom"
+
+
+@contextmanager
+def _locked_wisdom():
+    """Hold the wisdom file's lock with its wisdom imported; yield the file, or None when it cannot
+    be used (no such place, unwritable, no fcntl): then the plans are measured in this process."""
+    path, lock = wisdom_file(), None
+    if path is not None:
+        try:
+            import fcntl                             # POSIX only
+            path.parent.mkdir(parents=True, exist_ok=True)
+            lock = open(path.with_name(path.name + ".lock"), "a")
+        except (ImportError, OSError):
+            pass
+    if lock is None:
+        yield None
+        return
+    with lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            pyfftw.import_wisdom((path.read_bytes(), b"", b""))
+        except OSError:
+            pass
+        yield path
+
+
+def _measured_pair(real, spectrum, output, threads):
+    """Forward and backward plans of one shape from wisdom, measured (and stored) if there is none."""
+    def pair(flags):
+        return (pyfftw.FFTW(real, spectrum, axes=(-2, -1), direction="FFTW_FORWARD", flags=flags, threads=threads),
+                pyfftw.FFTW(spectrum, output, axes=(-2, -1), direction="FFTW_BACKWARD", flags=flags, threads=threads))
+
+    with _planning:
+        try:
+            return pair(("FFTW_MEASURE", "FFTW_WISDOM_ONLY"))
+        except RuntimeError:                             # new here: wait for, or measure, the shared plan
+            pass
+        with _locked_wisdom() as path:
+            try:
+                return pair(("FFTW_MEASURE", "FFTW_WISDOM_ONLY"))
+            except RuntimeError:
+                pass
+            plans = pair(("FFTW_MEASURE",))
+            if path is not None:
+                try:
+                    part = path.with_name(f"{path.name}.{os.getpid()}")
+                    part.write_bytes(pyfftw.export_wisdom()[0])
+                    os.replace(part, path)
+                except OSError:
+                    pass
+            return plans
+
+
 def _retire(grid, batch, counts) -> None:
     t = _retired.setdefault(grid, [0, 0])
     t[0] += counts[0] * batch
@@ -73,11 +143,8 @@ class RealFFT2:
 
     Three aligned buffers: real ``input``, complex ``spectrum`` (rfft2 of input, overwritten by
     ``inverse``) and real ``output``; the methods return views of them that the next call
-    overwrites. Plans are built once with ``threads`` (default: ``get_threads()``), by FFTW_ESTIMATE:
-    the same plan in every process and every run (FFTW_MEASURE times candidate plans, so two
-    runs could round differently and a solve near its tolerance take another iteration). Measured
-    on this machine, the estimated plans are as fast for 16^2 to 2048^2 and batches of
-    100 x 128^2, within +-10 %, and cost no planning time (0.3-0.8 s per measured plan).
+    overwrites. Plans are built once with ``threads`` (default: ``get_threads()``), measured or
+    from the shared wisdom (module docstring).
     """
 
     def __init__(self, shape: tuple[int, ...], threads: int | None = None):
@@ -93,11 +160,7 @@ class RealFFT2:
             self.input = pyfftw.empty_aligned(self.shape, dtype="float64")
             self.spectrum = pyfftw.empty_aligned(self.spectral_shape, dtype="complex128")
             self.output = pyfftw.empty_aligned(self.shape, dtype="float64")
-            flags = ("FFTW_ESTIMATE",)
-            self._fwd = pyfftw.FFTW(self.input, self.spectrum, axes=(-2, -1), direction="FFTW_FORWARD",
-                                    flags=flags, threads=self.threads)
-            self._inv = pyfftw.FFTW(self.spectrum, self.output, axes=(-2, -1), direction="FFTW_BACKWARD",
-                                    flags=flags, threads=self.threads)
+            self._fwd, self._inv = _measured_pair(self.input, self.spectrum, self.output, self.threads)
         else:  # pragma: no cover
             self.input, self.output = np.empty(self.shape), np.empty(self.shape)
             self.spectrum = np.empty(self.spectral_shape, dtype=complex)
