@@ -178,7 +178,7 @@ class ContactSolver:
         (``fields``: the gap and the means, not needed by a nested start; ``upper``: the hardness
         per patch or None). Threads on parts rather than on chunks, and no FFT threads inside a
         part: 100 patches of 128² on 2 threads ran 1.6–1.8x faster than on one thread before,
-        1.9x now (benchmarks/README)."""
+        2.1x now (benchmarks/README)."""
         batch, grid = z.shape[:-2], z.shape[-2:]
         B = int(np.prod(batch, dtype=int))
         size = max(1, CHUNK_CELLS[method] // (grid[0] * grid[1]))
