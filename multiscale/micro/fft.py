@@ -26,6 +26,10 @@ import scipy.fft
 
 from multiscale.errors import check_count
 
+try:  # pragma: no cover - POSIX only: without it, plans are measured in every process
+    import fcntl
+except ImportError:  # pragma: no cover
+    fcntl = None
 try:  # pragma: no cover - depends on the installation
     import pyfftw
 
@@ -86,12 +90,11 @@ def _locked_wisdom():
     """Hold the wisdom file's lock with its wisdom imported; yield the file, or None when it cannot
     be used (no such place, unwritable, no fcntl): then the plans are measured in this process."""
     path, lock = wisdom_file(), None
-    if path is not None:
+    if path is not None and fcntl is not None:
         try:
-            import fcntl                             # POSIX only
             path.parent.mkdir(parents=True, exist_ok=True)
             lock = open(path.with_name(path.name + ".lock"), "a")
-        except (ImportError, OSError):
+        except OSError:
             pass
     if lock is None:
         yield None
