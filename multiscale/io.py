@@ -110,8 +110,8 @@ def ended_together(comm, timeout: float = 10.0) -> bool:
 def abort(comm, code: int, grace: float = 1.0) -> None:
     """End every rank of the job from this one, ``grace`` [s] after flushing its output: mpiexec
     (MPICH's hydra) forwards a rank's stdout/stderr asynchronously and an immediate abort can kill
-    the forwarder first, losing the rank's last message (seen once in 15 runs on a loaded 2-core
-    machine, tests/test_faults.py)."""
+    the forwarder first, losing the rank's last message (1 in 6 and 1 in 20 runs of
+    tests/test_faults.py on a loaded 2-core machine)."""
     sys.stdout.flush()
     sys.stderr.flush()
     _time.sleep(grace)

@@ -7,7 +7,7 @@ what you want under MPI with one rank per core); a plan may also be given its ow
 Every transform is counted (``fft_counts``, ``reset_fft_counts``): benchmarks report the cost of
 an iteration in FFT pairs measured, not guessed.
 
-Plans are measured (FFTW_MEASURE: 1.2-1.65x faster transforms than FFTW_ESTIMATE's on this
+Plans are measured (FFTW_MEASURE: 1.15-1.57x faster transforms than FFTW_ESTIMATE's on this
 machine, benchmarks/README) and their wisdom is kept in a file (``wisdom_file``) that every
 process reads: a shape is measured once per machine, under a file lock, and every later process,
 MPI rank and run uses the same plan, hence rounds alike (measured anew in each process, two runs
@@ -114,16 +114,20 @@ def _measured_pair(real, spectrum, output, threads):
         return (pyfftw.FFTW(real, spectrum, axes=(-2, -1), direction="FFTW_FORWARD", flags=flags, threads=threads),
                 pyfftw.FFTW(spectrum, output, axes=(-2, -1), direction="FFTW_BACKWARD", flags=flags, threads=threads))
 
-    with _planning:
+    def known():
         try:
             return pair(("FFTW_MEASURE", "FFTW_WISDOM_ONLY"))
-        except RuntimeError:                             # new here: wait for, or measure, the shared plan
-            pass
-        with _locked_wisdom() as path:
-            try:
-                return pair(("FFTW_MEASURE", "FFTW_WISDOM_ONLY"))
-            except RuntimeError:
-                pass
+        except RuntimeError:
+            return None
+
+    with _planning:
+        plans = known()
+        if plans is not None:
+            return plans
+        with _locked_wisdom() as path:                   # new here: another process's, or measure it
+            plans = known()
+            if plans is not None:
+                return plans
             plans = pair(("FFTW_MEASURE",))
             if path is not None:
                 try:
