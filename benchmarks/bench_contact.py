@@ -14,8 +14,9 @@ an anisotropic one (cut-offs 4 x 16 and N/4 x N/16), H = 0.3, 30 % contact, and 
 Columns: iterations (tamaas counted from its log in an untimed run); "pairs/it": FFT pairs per
 iteration counted by the FFT wrapper (``multiscale.micro.fft.fft_pairs``: every transform of the
 solve, the nested coarse solves included, weighted by its cells, in pairs of the FFT grid: N² for
-a periodic patch, (2N)² zero-padded for an isolated one); "t/it [pairs]": time per iteration over
-the time of one rfft2 + irfft2 pair of that grid (measured here); "to ref": relative
+a periodic patch, (2N)² zero-padded for an isolated one; "single": of which in single precision,
+bccg's preconditioner from 512²); "t/it [pairs]": time per iteration over the time of one
+(double) rfft2 + irfft2 pair of that grid (measured here); "to ref": relative
 L2 distance of the pressure to a tol = 1e-12 reference (bccg; pk at 1e-12 agrees with it to
 ~1e-11); "vs pk": relative L2 between bccg and pk at tol 1e-8 (the discrete answer).
 
@@ -103,7 +104,8 @@ def ours(solver, h, load, method):
     fft.reset_fft_counts()
     t0 = time.perf_counter()
     r = solver.solve(h, load=load, tol=TOL, method=method)
-    return time.perf_counter() - t0, r, fft.fft_pairs(solver.operator.fft_shape)
+    grid = solver.operator.fft_shape
+    return time.perf_counter() - t0, r, (fft.fft_pairs(grid), fft.fft_pairs(grid, single=True))
 
 
 def machine():
@@ -117,7 +119,8 @@ def machine():
 
 
 def compare(name, h, dx, load, reps, with_tamaas=True, periodic=True):
-    """One row per solver: time, ratio to tamaas, iterations, pairs/it, t/it in pairs, to ref, vs pk."""
+    """One row per solver: time, ratio to tamaas, iterations, pairs/it (all, single), t/it in pairs,
+    to ref, vs pk."""
     solver = ContactSolver(E, h.shape, dx, periodic=periodic)
     solver.solve(h, load=load, tol=1e-4)                  # plans and compiled loops outside the timing
     solver.solve(h, load=load, tol=1e-4, method="pk")
@@ -142,22 +145,22 @@ def compare(name, h, dx, load, reps, with_tamaas=True, periodic=True):
         ratio = stats.median([a / b for a, b in zip(times[m], times["tamaas"])]) if times["tamaas"] else float("nan")
         if m == "tamaas":
             its = tamaas_iterations(h, load)
-            p, pairs, area = out[m], float("nan"), float(np.mean(out[m] > 0))
+            p, pairs, single, area = out[m], float("nan"), float("nan"), float(np.mean(out[m] > 0))
         else:
-            r, pairs = out[m]
+            r, (double, single) = out[m]
             its, p, area = int(r.iterations), r.pressure, float(r.area_fraction)
-            pairs /= its
+            pairs, single = (double + single) / its, single / its
         per_it = t / its / tp if its > 0 else float("nan")
         vs_pk = rel(p, out["pk"][0].pressure) if m != "pk" else 0.0
-        rows.append((name, m, t, ratio, its, pairs, per_it, rel(p, ref), vs_pk, area))
+        rows.append((name, m, t, ratio, its, pairs, single, per_it, rel(p, ref), vs_pk, area))
     return rows
 
 
 def print_rows(rows):
-    print(f"{'case':>24} {'solver':>7} {'time [s]':>9} {'/tamaas':>8} {'its':>5} {'pairs/it':>8} "
+    print(f"{'case':>24} {'solver':>7} {'time [s]':>9} {'/tamaas':>8} {'its':>5} {'pairs/it':>8} {'single':>6} "
           f"{'t/it [pairs]':>12} {'to ref':>9} {'vs pk':>9} {'A/A0':>7}")
-    for name, m, t, ratio, its, pairs, per_it, to_ref, vs_pk, area in rows:
-        print(f"{name:>24} {m:>7} {t:9.3f} {ratio:8.3f} {its:5d} {pairs:8.2f} {per_it:12.2f} "
+    for name, m, t, ratio, its, pairs, single, per_it, to_ref, vs_pk, area in rows:
+        print(f"{name:>24} {m:>7} {t:9.3f} {ratio:8.3f} {its:5d} {pairs:8.2f} {single:6.2f} {per_it:12.2f} "
               f"{to_ref:9.1e} {vs_pk:9.1e} {area:7.4f}", flush=True)
 
 

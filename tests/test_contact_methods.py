@@ -116,3 +116,23 @@ def test_bccg_iteration_costs_at_most_two_and_a_half_fft_pairs():
     assert inverse == 2 * r.iterations + 1 + 1           # + the start's u = L p, + the last check
     assert forward <= 2.5 * r.iterations + 2
     assert fft.fft_pairs((128, 128)) <= 3.0 * r.iterations
+
+
+def test_bccg_preconditions_in_single_precision_on_large_grids_with_the_same_answer():
+    """From 512² (``bccg_solver.SINGLE_FROM``) the preconditioner's pair is float32: one single
+    pair per pass, the double transforms only for L (start, direction, clipped increments); the
+    answer stays the discrete one (relative L2 to Polonsky–Keer < 1e-7 at tol 1e-8, as the
+    issue-23 check) and the stopping estimate still bounds the distance to a tight solution."""
+    h, dx = slope_one(512, seed=7)
+    solver = ContactSolver(E, h.shape, dx)
+    solver.solve(h, load=0.01)                          # plans and compilation
+    fft.reset_fft_counts()
+    r = solver.solve(h, load=0.01)
+    assert fft.fft_counts(single=True)[(512, 512)] == (r.iterations + 1, r.iterations + 1)
+    forward, inverse = fft.fft_counts()[(512, 512)]
+    assert inverse == r.iterations + 1 and r.iterations + 1 <= forward <= 2 * r.iterations + 1
+    pk = ContactSolver(E, h.shape, dx, method="pk").solve(h, load=0.01)
+    tight = solver.solve(h, load=0.01, tol=1e-12)
+    assert tight.converged and tight.residual <= 1e-12
+    assert rel(r.pressure, pk.pressure) < 1e-7
+    assert rel(r.pressure, tight.pressure) < 1e-8

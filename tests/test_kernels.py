@@ -131,6 +131,24 @@ def test_fft_counter_counts_transforms_per_grid():
     assert fft.fft_counts() == {}
 
 
+def test_single_precision_plan_transforms_to_float32_rounding_and_is_counted_apart():
+    """RealFFT2(single=True): float32 buffers, rfft2/irfft2 within 1e-5 of numpy's (double) relative
+    to the largest magnitude (float32 rounding, 6e-8, times the log of the size), counted under
+    ``single=True`` only."""
+    fft.reset_fft_counts()
+    x = np.random.default_rng(4).normal(size=(2, 32, 24))
+    plan = fft.RealFFT2(x.shape, single=True)
+    assert plan.input.dtype == np.float32 and plan.spectrum.dtype == np.complex64
+    spectrum = plan.forward(x)
+    exact = np.fft.rfft2(x)
+    assert np.abs(spectrum - exact).max() <= 1e-5 * np.abs(exact).max()
+    assert np.abs(spectrum - exact).max() > 0              # it is not double precision
+    back = plan.inverse()
+    assert np.abs(back - x).max() <= 1e-5 * np.abs(x).max()
+    assert fft.fft_counts(single=True) == {(32, 24): (2, 2)} and fft.fft_counts() == {}
+    assert fft.fft_pairs((32, 24), single=True) == 2.0
+
+
 PLAN = """
 import numpy as np
 from multiscale.micro import fft

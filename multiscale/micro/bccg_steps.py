@@ -3,7 +3,8 @@
 Arrays of a chunk of B patches on a grid (ny, nx), flattened to (B, ny * nx): ``p``, ``u``, ``z``
 [Pa, m, m], ``label`` and the work vectors; the FFT buffers ``X`` (input), ``Y`` (output) are
 (B, Fy * Fx) with Fy, Fx >= ny, nx (cell (i, j) at i * Fx + j, zero padding beyond); the
-spectra ``S``, ``W`` (B, Fy, Fx // 2 + 1). Free set F: contact cells (p > 0) and cells with
+spectrum ``S`` (B, Fy, Fx // 2 + 1). The preconditioner has its own buffers ``XP``, ``YP``
+(of the same layout, possibly float32) and spectrum. Free set F: contact cells (p > 0) and cells with
 p = 0 and a negative gap (they may enter). ``label`` marks F (0), the rings 1..R of gap cells
 around it into which the residual is extended (k), and the other cells (-1); ``fi``/``fj`` and
 ``bi``/``bj`` list the rows and columns of the cells of F and of the rings (ring by ring,
@@ -41,16 +42,16 @@ def contact_sums(p, u, z, upper, active, ccount, csum, pnorm):
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
-def free_set(u, z, p, delta, load_control, active, ccount, csum, d, label, fi, fj, nf, r, s_old, t, X, upper, fixed,
-             nx, Fx):
+def free_set(u, z, p, delta, load_control, active, ccount, csum, d, label, fi, fj, nf, r, s_old, t, XP, X, upper,
+             fixed, nx, Fx):
     """Per active patch: the approach ``d`` (load control: mean of u + z on the elastic contact,
     from ``contact_sums``; with none but saturated cells, their largest u + z; else ``delta``),
     the free set F (``label`` 0, listed in ``fi``/``fj``/``nf``; ``fixed`` the cells held at H),
     the residual r = g = u + z - d on F (mean-free on F under load control: the gradient
-    projected on Σ p = const) and X = r on F. X, ``s_old`` and ``t`` are zeroed on the cells that
-    left F (a cell entering F starts without history); elsewhere X is zero already (it held the
-    clipped amounts, on F, since ``update_pressure``; ``back_extend`` cleared the rings) and r
-    is never read."""
+    projected on Σ p = const) and XP = r on F. XP, X, ``s_old`` and ``t`` are zeroed on the cells
+    that left F (a cell entering F starts without history); elsewhere XP and X are zero already
+    (X holds the clipped amounts on F since ``update_pressure``, XP held r on F; ``back_extend``
+    cleared the rings) and r is never read."""
     B, N = p.shape
     ny = N // nx
     for b in range(B):
@@ -74,10 +75,11 @@ def free_set(u, z, p, delta, load_control, active, ccount, csum, d, label, fi, f
                     fi[b, k], fj[b, k] = i, j
                     k += 1
                     r[b, f] = g
-                    X[b, i * Fx + j] = g
+                    XP[b, i * Fx + j] = g
                     sf += g
                 elif label[b, f] != -1:
                     if label[b, f] == 0:
+                        XP[b, i * Fx + j] = 0.0
                         X[b, i * Fx + j] = 0.0
                         s_old[b, f] = 0.0
                         t[b, f] = 0.0
@@ -89,7 +91,7 @@ def free_set(u, z, p, delta, load_control, active, ccount, csum, d, label, fi, f
             for m in range(k):
                 i, j = fi[b, m], fj[b, m]
                 r[b, i * nx + j] -= mean
-                X[b, i * Fx + j] -= mean
+                XP[b, i * Fx + j] -= mean
 
 
 @njit(cache=True, nogil=True)
@@ -115,21 +117,6 @@ def _wrap(i, n, periodic):
     return i + n if i < 0 else i - n
 
 
-@njit(cache=True, inline="always")
-def _neighbours(i0, j0, ny, nx, periodic, out):
-    """Flat indices (i * nx + j) of the cells of the 3 x 3 block around (i0, j0), itself included,
-    into ``out``; returns how many (wrapped around a periodic grid, cut at a non-periodic edge)."""
-    n = 0
-    for di in range(-1, 2):
-        i = _wrap(i0 + di, ny, periodic)
-        for dj in range(-1, 2):
-            j = _wrap(j0 + dj, nx, periodic)
-            if i >= 0 and j >= 0:
-                out[n] = i * nx + j
-                n += 1
-    return n
-
-
 @njit(cache=True, nogil=True)
 def extend(label, fi, fj, nf, bi, bj, ring_end, count, X, gammas, periodic, active, ny, nx, Fx):
     """X = E r on the physical grid (X holds r on F from ``free_set``): ring by ring
@@ -138,7 +125,6 @@ def extend(label, fi, fj, nf, bi, bj, ring_end, count, X, gammas, periodic, acti
     neighbours of each ring cell in the ring inside it."""
     B = label.shape[0]
     R = gammas.shape[0]
-    near = np.empty(9, dtype=np.int64)
     for b in range(B):
         if not active[b]:
             continue
@@ -150,18 +136,23 @@ def extend(label, fi, fj, nf, bi, bj, ring_end, count, X, gammas, periodic, acti
             for m in range(lo, hi):            # scatter the values of ring - 1 to their neighbours
                 i0, j0 = (fi[b, m], fj[b, m]) if ring == 1 else (bi[b, m], bj[b, m])
                 v = X[b, i0 * Fx + j0]
-                for e in range(_neighbours(i0, j0, ny, nx, periodic, near)):
-                    g = near[e]
-                    lg = label[b, g]
-                    if lg == -1 or lg == ring:
-                        i, j = g // nx, g - (g // nx) * nx
+                for di in range(-1, 2):        # the 8-neighbourhood (wrapped, or cut at the edge)
+                    i = _wrap(i0 + di, ny, periodic)
+                    if i < 0:
+                        continue
+                    for dj in range(-1, 2):
+                        j = _wrap(j0 + dj, nx, periodic)
+                        if j < 0:
+                            continue
+                        g = i * nx + j
+                        lg = label[b, g]
                         if lg == -1:
                             label[b, g] = ring
                             bi[b, k], bj[b, k] = i, j
                             k += 1
                             count[b, g] = 1
                             X[b, i * Fx + j] = v
-                        else:
+                        elif lg == ring:
                             count[b, g] += 1
                             X[b, i * Fx + j] += v
             ring_end[b, ring - 1] = k
@@ -180,7 +171,6 @@ def back_extend(label, fi, fj, nf, bi, bj, ring_end, count, Y, s, gammas, period
     preconditioner is exact (0 when s = 0)."""
     B = label.shape[0]
     R = gammas.shape[0]
-    near = np.empty(9, dtype=np.int64)
     for b in range(B):
         if not active[b]:
             continue
@@ -203,12 +193,16 @@ def back_extend(label, fi, fj, nf, bi, bj, ring_end, count, Y, s, gammas, period
                 i0, j0 = bi[b, m], bj[b, m]
                 g0 = i0 * nx + j0
                 v = s[b, g0] * gam / count[b, g0]
-                for e in range(_neighbours(i0, j0, ny, nx, periodic, near)):
-                    g = near[e]
-                    if label[b, g] == ring - 1:
-                        s[b, g] += v
-                        if ring == 1:
-                            total += v
+                for di in range(-1, 2):
+                    i = _wrap(i0 + di, ny, periodic)
+                    if i < 0:
+                        continue
+                    for dj in range(-1, 2):
+                        j = _wrap(j0 + dj, nx, periodic)
+                        if j >= 0 and label[b, i * nx + j] == ring - 1:
+                            s[b, i * nx + j] += v
+                            if ring == 1:
+                                total += v
         mean = total / n if load_control and n > 0 else 0.0
         ss = 0.0
         for m in range(n):
@@ -220,9 +214,9 @@ def back_extend(label, fi, fj, nf, bi, bj, ring_end, count, Y, s, gammas, period
 
 
 @njit(cache=True, nogil=True)
-def check(eps, tol, iterations, max_iter, active, X):
+def check(eps, tol, iterations, max_iter, active, XP, X):
     """Stopping test after ``back_extend``: patches with eps <= tol, or at ``max_iter``, leave
-    ``active`` (their FFT input is zeroed). Returns (largest eps of the patches that were
+    ``active`` (their FFT inputs are zeroed). Returns (largest eps of the patches that were
     active, patches still active, non-finite eps found)."""
     B = eps.shape[0]
     top, left, bad = 0.0, 0, False
@@ -235,6 +229,7 @@ def check(eps, tol, iterations, max_iter, active, X):
         top = max(top, e)
         if e <= tol or iterations[b] >= max_iter:
             active[b] = False
+            XP[b] = 0.0
             X[b] = 0.0
         else:
             left += 1
@@ -291,20 +286,20 @@ def direction(fi, fj, nf, r, s, s_old, t, X, load_control, active, conj, rho_old
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
-def precondition(S, mmul):
-    """S *= M (the preconditioner's transfer function / (Fy Fx)) on every patch."""
+def multiply(S, m):
+    """S *= m (a real transfer function / (Fy Fx): the preconditioner's or L's) on every patch."""
     B, Fy, Fh = S.shape
     for b in range(B):
         for i in range(Fy):
             for j in range(Fh):
-                S[b, i, j] *= mmul[i, j]
+                S[b, i, j] *= m[i, j]
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
 def step_length(S, lmul, Fx, rt, active, tau):
-    """S (the rfft2 of t on a real grid of width Fx) <- L T, and tau = (r, t) / (t, L t) per
-    patch with (t, L t) = Σ_k lmul_k |T_k|² over the full spectrum (Parseval; lmul is the real
-    transfer function / (Fy Fx)). Returns whether every tau is finite."""
+    """tau = (r, t) / (t, L t) per patch from S, the rfft2 of t on a real grid of width Fx:
+    (t, L t) = Σ_k lmul_k |T_k|² over the full spectrum (Parseval; lmul is the real transfer
+    function / (Fy Fx)). Returns whether every tau is finite."""
     B, Fy, Fh = S.shape
     for b in range(B):
         acc = 0.0
@@ -313,7 +308,6 @@ def step_length(S, lmul, Fx, rt, active, tau):
                 w = 1.0 if j == 0 or 2 * j == Fx else 2.0
                 v = S[b, i, j]
                 acc += w * lmul[i, j] * (v.real * v.real + v.imag * v.imag)
-                S[b, i, j] = lmul[i, j] * v
         tau[b] = rt[b] / acc if active[b] and acc > 0.0 else 0.0
     return np.all(np.isfinite(tau))
 
@@ -321,10 +315,10 @@ def step_length(S, lmul, Fx, rt, active, tau):
 @njit(cache=True, fastmath=_FAST, nogil=True)
 def update_pressure(p, t, fi, fj, nf, tau, X, active, load_control, target, pending, clipped, lost, upper, fixed,
                     nx, Fx):
-    """p <- max(p - tau t, 0) on F (cells outside F keep p = 0); X = the clipped amount
-    (p_new - (p - tau t) >= 0) on F, so that L(p_new - p) = L(-tau t + X); under load control
-    the factor restoring the mean pressure goes to ``pending`` (applied to p and u next).
-    Patches with a finite bound H take ``bounded_update`` instead.
+    """p <- max(p - tau t, 0) on F (cells outside F keep p = 0) and X = p_new - p on F, the
+    increment whose L updates u (it is -tau t where nothing was clipped); under load control the
+    factor restoring the mean pressure goes to ``pending`` (applied to p and u next). Patches
+    with a finite bound H take ``bounded_update`` instead.
     Returns the numbers of patches with clipped cells and of patches that lost every contact."""
     B, N = p.shape
     nclip, nlost = 0, 0
@@ -344,11 +338,9 @@ def update_pressure(p, t, fi, fj, nf, tau, X, active, load_control, target, pend
             g = i * nx + j
             q = p[b, g] - tb * t[b, g]
             if q < 0.0:
-                X[b, i * Fx + j] = -q
                 clipped[b] = True
                 q = 0.0
-            else:
-                X[b, i * Fx + j] = 0.0
+            X[b, i * Fx + j] = q - p[b, g]
             p[b, g] = q
             total += q
         if load_control:
@@ -371,7 +363,8 @@ def bounded_update(p, t, fi, fj, n, tau, X, H, load_control, rest, nx, Fx):
     Almqvist et al. (2007, Tribol. Int. 40, 574-579), also ContactMechanics'
     ``constrained_conjugate_gradients(hardness=...)``; the load is kept by the shift (the exact
     projection) instead of a rescaling, which would push saturated cells above H.
-    X = p_new - (p - tau t) on F, as in ``update_pressure``. Returns whether any X is nonzero."""
+    X = p_new - p on F, as in ``update_pressure``. Returns whether any cell moved off the
+    unbounded step p - tau t."""
     for m in range(n):                          # X <- q = p - tau t (unbounded step)
         i, j = fi[m], fj[m]
         X[i * Fx + j] = p[i * nx + j] - tau * t[i * nx + j]
@@ -406,21 +399,9 @@ def bounded_update(p, t, fi, fj, n, tau, X, H, load_control, rest, nx, Fx):
         q = X[i * Fx + j]
         v = min(max(q + a, 0.0), H)
         p[i * nx + j] = v
-        X[i * Fx + j] = v - q
+        X[i * Fx + j] = v - q - tau * t[i * nx + j]
         moved = moved or v != q
     return moved
-
-
-@njit(cache=True, fastmath=_FAST, nogil=True)
-def combine_spectrum(S, W, lmul, tau, active):
-    """S = -tau W + L S: W holds L T, S the rfft2 of the clipped amounts; the result is the
-    spectrum of L(p_new - p) = L(-tau t + clipped)."""
-    B, Fy, Fh = S.shape
-    for b in range(B):
-        c = -tau[b]
-        for i in range(Fy):
-            for j in range(Fh):
-                S[b, i, j] = c * W[b, i, j] + lmul[i, j] * S[b, i, j] if active[b] else 0.0
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)

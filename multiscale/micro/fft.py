@@ -5,7 +5,10 @@ pyfftw (FFTW) is used when importable, scipy.fft otherwise. The thread count is 
 what you want under MPI with one rank per core); a plan may also be given its own count.
 
 Every transform is counted (``fft_counts``, ``reset_fft_counts``): benchmarks report the cost of
-an iteration in FFT pairs measured, not guessed.
+an iteration in FFT pairs measured, not guessed. Plans are double precision unless made with
+``single=True`` (float32/complex64 buffers, counted apart): 0.42-0.6x the time of a double pair
+at 512²-2048² on this machine (no gain at 256² and below), for work whose rounding does not
+reach the result, such as applying a preconditioner.
 
 Plans are measured (FFTW_MEASURE: 1.15-1.57x faster transforms than FFTW_ESTIMATE's on this
 machine, benchmarks/README) and their wisdom is kept in a file (``wisdom_file``) that every
@@ -38,7 +41,7 @@ except ImportError:  # pragma: no cover
 
 _threads = max(1, int(os.environ.get("MULTISCALE_THREADS", "1")))
 _plans: weakref.WeakSet = weakref.WeakSet()   # every RealFFT2 alive: they count their transforms
-_retired: dict = {}                            # grid -> [forward, inverse] of the plans collected since
+_retired: dict = {}                            # (grid, single) -> [forward, inverse] of the plans collected since
 _planning = threading.Lock()                   # FFTW's planner is not thread-safe
 
 
@@ -52,14 +55,15 @@ def get_threads() -> int:
     return _threads
 
 
-def fft_counts() -> dict[tuple[int, int], tuple[int, int]]:
-    """Transforms done since the last reset: {(ny, nx): (forward, inverse)}, one per 2-D grid
-    (a batch of B patches counts B)."""
-    totals = {g: list(v) for g, v in _retired.items()}
+def fft_counts(single: bool = False) -> dict[tuple[int, int], tuple[int, int]]:
+    """Transforms of one precision done since the last reset: {(ny, nx): (forward, inverse)},
+    one per 2-D grid (a batch of B patches counts B)."""
+    totals = {g: list(v) for (g, one), v in _retired.items() if one == single}
     for plan in list(_plans):
-        t = totals.setdefault(plan.shape[-2:], [0, 0])
-        t[0] += plan.counts[0] * plan.batch
-        t[1] += plan.counts[1] * plan.batch
+        if plan.single == single:
+            t = totals.setdefault(plan.shape[-2:], [0, 0])
+            t[0] += plan.counts[0] * plan.batch
+            t[1] += plan.counts[1] * plan.batch
     return {g: (f, i) for g, (f, i) in sorted(totals.items()) if f or i}
 
 
@@ -69,11 +73,12 @@ def reset_fft_counts() -> None:
         plan.counts[:] = [0, 0]
 
 
-def fft_pairs(grid: tuple[int, int]) -> float:
-    """Transforms since the last reset in pairs (one forward + one inverse) of an rfft2 on
-    ``grid``, each transform weighted by its number of cells (a zero-padded 2N x 2N pair counts 4)."""
+def fft_pairs(grid: tuple[int, int], single: bool = False) -> float:
+    """Transforms of one precision since the last reset in pairs (one forward + one inverse) of
+    an rfft2 on ``grid``, each transform weighted by its number of cells (a zero-padded 2N x 2N
+    pair counts 4)."""
     cells = grid[0] * grid[1]
-    return sum((f + i) / 2 * (g[0] * g[1]) / cells for g, (f, i) in fft_counts().items())
+    return sum((f + i) / 2 * (g[0] * g[1]) / cells for g, (f, i) in fft_counts(single).items())
 
 
 def wisdom_file() -> Path | None:
@@ -139,8 +144,8 @@ def _measured_pair(real, spectrum, output, threads):
             return plans
 
 
-def _retire(grid, batch, counts) -> None:
-    t = _retired.setdefault(grid, [0, 0])
+def _retire(key, batch, counts) -> None:
+    t = _retired.setdefault(key, [0, 0])
     t[0] += counts[0] * batch
     t[1] += counts[1] * batch
 
@@ -151,26 +156,28 @@ class RealFFT2:
     Three aligned buffers: real ``input``, complex ``spectrum`` (rfft2 of input, overwritten by
     ``inverse``) and real ``output``; the methods return views of them that the next call
     overwrites. Plans are built once with ``threads`` (default: ``get_threads()``), measured or
-    from the shared wisdom (module docstring).
+    from the shared wisdom (module docstring); ``single``: float32/complex64 buffers and plans.
     """
 
-    def __init__(self, shape: tuple[int, ...], threads: int | None = None):
+    def __init__(self, shape: tuple[int, ...], threads: int | None = None, single: bool = False):
         self.shape = tuple(int(s) for s in shape)
         self.spectral_shape = self.shape[:-1] + (self.shape[-1] // 2 + 1,)
         self.size = self.shape[-1] * self.shape[-2]
         self.threads = _threads if threads is None else max(1, int(threads))
         self.batch = int(np.prod(self.shape[:-2], dtype=int))
+        self.single = bool(single)
         self.counts = [0, 0]                   # forward, inverse transforms since ``reset_fft_counts``
         _plans.add(self)
-        weakref.finalize(self, _retire, self.shape[-2:], self.batch, self.counts)
+        weakref.finalize(self, _retire, (self.shape[-2:], self.single), self.batch, self.counts)
+        real, complex_ = (np.float32, np.complex64) if self.single else (np.float64, np.complex128)
         if pyfftw is not None:
-            self.input = pyfftw.empty_aligned(self.shape, dtype="float64")
-            self.spectrum = pyfftw.empty_aligned(self.spectral_shape, dtype="complex128")
-            self.output = pyfftw.empty_aligned(self.shape, dtype="float64")
+            self.input = pyfftw.empty_aligned(self.shape, dtype=real)
+            self.spectrum = pyfftw.empty_aligned(self.spectral_shape, dtype=complex_)
+            self.output = pyfftw.empty_aligned(self.shape, dtype=real)
             self._fwd, self._inv = _measured_pair(self.input, self.spectrum, self.output, self.threads)
         else:  # pragma: no cover
-            self.input, self.output = np.empty(self.shape), np.empty(self.shape)
-            self.spectrum = np.empty(self.spectral_shape, dtype=complex)
+            self.input, self.output = np.empty(self.shape, dtype=real), np.empty(self.shape, dtype=real)
+            self.spectrum = np.empty(self.spectral_shape, dtype=complex_)
             self._fwd = self._inv = None
         self.input[...] = 0.0   # planning scribbles on the buffers
 

@@ -193,9 +193,11 @@ class InfluenceOperator:
         self._workspaces: dict[tuple[int, ...], ConvolutionWorkspace] = {}
         self.self_influence = float(np.fft.irfft2(self.spectrum, s=self.fft_shape)[0, 0])
 
-    def workspace(self, batch: tuple[int, ...] = (), threads: int | None = None) -> "ConvolutionWorkspace":
-        """A new workspace of this operator for a batch shape (buffers owned by the caller)."""
-        return ConvolutionWorkspace(self, tuple(batch), threads)
+    def workspace(self, batch: tuple[int, ...] = (), threads: int | None = None,
+                  single: bool = False) -> "ConvolutionWorkspace":
+        """A new workspace of this operator for a batch shape (buffers owned by the caller;
+        ``single``: in single precision, see ``RealFFT2``)."""
+        return ConvolutionWorkspace(self, tuple(batch), threads, single)
 
     def __call__(self, p: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
         """Displacement [m] of pressure ``p`` [Pa] of shape (..., ny, nx)."""
@@ -221,9 +223,10 @@ class ConvolutionWorkspace:
     padding included, and ``fft`` the plan (its ``spectrum`` buffer), for compiled loops.
     """
 
-    def __init__(self, operator: InfluenceOperator, batch: tuple[int, ...], threads: int | None = None):
+    def __init__(self, operator: InfluenceOperator, batch: tuple[int, ...], threads: int | None = None,
+                 single: bool = False):
         ny, nx = operator.shape
-        self.fft = RealFFT2(batch + operator.fft_shape, threads)
+        self.fft = RealFFT2(batch + operator.fft_shape, threads, single)
         self.multiplier = operator.multiplier
         self.load = self.fft.input[..., :ny, :nx]
         self.response = self.fft.output[..., :ny, :nx]
