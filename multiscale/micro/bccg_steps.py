@@ -50,8 +50,8 @@ def free_set(u, z, p, delta, load_control, active, ccount, csum, d, label, fi, f
     the residual r = g = u + z - d on F (mean-free on F under load control: the gradient
     projected on Σ p = const) and XP = r on F. XP, X, ``s_old`` and ``t`` are zeroed on the cells
     that left F (a cell entering F starts without history); elsewhere XP and X are zero already
-    (X holds the clipped amounts on F since ``update_pressure``, XP held r on F; ``back_extend``
-    cleared the rings) and r is never read."""
+    (X holds the increments p_new - p on F since ``update_pressure``, XP held r on F;
+    ``back_extend`` cleared the rings) and r is never read."""
     B, N = p.shape
     ny = N // nx
     for b in range(B):
