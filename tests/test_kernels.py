@@ -156,6 +156,7 @@ x = np.random.default_rng(1).random((3, 24, 40))
 X = fft.RealFFT2(x.shape).forward(x)
 assert np.abs(X - np.fft.rfft2(x)).max() < 1e-12
 print(X.tobytes().hex())
+print(fft.RealFFT2(x.shape, single=True).forward(x).tobytes().hex())
 """
 
 
@@ -167,11 +168,12 @@ def plan_in_a_process(wisdom):
 
 
 def test_fft_plans_are_measured_once_and_shared_by_later_processes(tmp_path):
-    """The first process measures a shape's plans and stores the wisdom; a later process plans from
-    it (measures nothing, so it rewrites nothing) and rounds bit for bit alike."""
+    """The first process measures a shape's plans, double and single precision, and stores the
+    wisdom; a later process plans from it (measures nothing, so it rewrites nothing) and rounds bit
+    for bit alike."""
     wisdom = tmp_path / "cache" / "fftw-wisdom"
     first = plan_in_a_process(wisdom)
-    assert wisdom.read_bytes().startswith(b"(fftw-3")
+    assert wisdom.read_bytes().startswith(b"(fftw-3") and b"fftwf_wisdom" in wisdom.read_bytes()
     stored = wisdom.stat().st_ino
     assert plan_in_a_process(wisdom) == first
     assert wisdom.stat().st_ino == stored                # nothing new measured, nothing rewritten

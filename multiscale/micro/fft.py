@@ -107,10 +107,17 @@ def _locked_wisdom():
     with lock:
         fcntl.flock(lock, fcntl.LOCK_EX)
         try:
-            pyfftw.import_wisdom((path.read_bytes(), b"", b""))
+            pyfftw.import_wisdom(_wisdom_parts(path.read_bytes()))
         except OSError:
             pass
         yield path
+
+
+def _wisdom_parts(data: bytes) -> tuple[bytes, bytes, bytes]:
+    """The double, single and long double wisdom in a wisdom file's bytes (NUL-separated, as
+    written by ``_measured_pair``; FFTW's wisdom is text; a file of double wisdom only is read too)."""
+    parts = data.split(b"\0")[:3]
+    return tuple(parts + [b""] * (3 - len(parts)))
 
 
 def _measured_pair(real, spectrum, output, threads):
@@ -137,7 +144,7 @@ def _measured_pair(real, spectrum, output, threads):
             if path is not None:
                 try:
                     part = path.with_name(f"{path.name}.{os.getpid()}")
-                    part.write_bytes(pyfftw.export_wisdom()[0])
+                    part.write_bytes(b"\0".join(pyfftw.export_wisdom()))
                     os.replace(part, path)
                 except OSError:
                     pass
