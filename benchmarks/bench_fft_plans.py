@@ -1,7 +1,9 @@
-"""FFTW_ESTIMATE against FFTW_MEASURE plans: planning time and time per rfft2 + irfft2 pair.
+"""FFTW_ESTIMATE against FFTW_MEASURE plans, and single against double precision: planning time
+and time per rfft2 + irfft2 pair.
 
 ``multiscale.micro.fft`` measures its plans (FFTW_MEASURE) once per machine and shares the wisdom
-through a file; this script shows what that buys over FFTW_ESTIMATE. Medians of 5 repeats per
+through a file; this script shows what that buys over FFTW_ESTIMATE, and what a float32 pair (the
+contact solver's preconditioner from 512², ``bccg_solver.SINGLE_FROM``) costs against a double one. Medians of 5 repeats per
 size, the two flags side by side, one thread. FFTW's wisdom is forgotten before every planning: an
 estimated plan made after a measured one of the same shape reuses the measured plan (the first
 version of this script planned MEASURE first and found the two equally fast).
@@ -18,11 +20,12 @@ SHAPES = [(16, 16), (100, 16, 16), (64, 64), (128, 128), (4, 128, 128), (100, 12
           (1024, 1024), (2048, 2048)]
 
 
-def pair_time(shape, flag):
+def pair_time(shape, flag, single=False):
     """(planning time, median time of one forward + inverse transform) [s] for ``shape``."""
-    a = pyfftw.empty_aligned(shape, "float64")
-    s = pyfftw.empty_aligned(shape[:-1] + (shape[-1] // 2 + 1,), "complex128")
-    o = pyfftw.empty_aligned(shape, "float64")
+    real, cplx = ("float32", "complex64") if single else ("float64", "complex128")
+    a = pyfftw.empty_aligned(shape, real)
+    s = pyfftw.empty_aligned(shape[:-1] + (shape[-1] // 2 + 1,), cplx)
+    o = pyfftw.empty_aligned(shape, real)
     pyfftw.forget_wisdom()
     t0 = time.perf_counter()
     fwd = pyfftw.FFTW(a, s, axes=(-2, -1), flags=(flag,))
@@ -42,12 +45,15 @@ def pair_time(shape, flag):
 
 def main():
     print(f"load average {os.getloadavg()[0]:.2f}")
-    print("| shape | plan MEASURE [s] | plan ESTIMATE [s] | pair MEASURE [ms] | pair ESTIMATE [ms] | ESTIMATE / MEASURE |")
-    print("|---|---|---|---|---|---|")
+    print("| shape | plan MEASURE [s] | plan ESTIMATE [s] | pair MEASURE [ms] | pair ESTIMATE [ms] | ESTIMATE / MEASURE "
+          "| pair single, MEASURE [ms] | single / double |")
+    print("|---|---|---|---|---|---|---|---|")
     for shape in SHAPES:
         pm, m = pair_time(shape, "FFTW_MEASURE")
         pe, e = pair_time(shape, "FFTW_ESTIMATE")
-        print(f"| {shape} | {pm:.3f} | {pe:.4f} | {m * 1e3:.3f} | {e * 1e3:.3f} | {e / m:.2f} |")
+        _, f = pair_time(shape, "FFTW_MEASURE", single=True)
+        print(f"| {shape} | {pm:.3f} | {pe:.4f} | {m * 1e3:.3f} | {e * 1e3:.3f} | {e / m:.2f} | {f * 1e3:.3f} "
+              f"| {f / m:.2f} |")
 
 
 if __name__ == "__main__":

@@ -23,7 +23,7 @@ The details here:
 - two FFT pairs per iteration: Y = M E r, and L t, whose inverse transform is also the update of
   u = L p: (t, L t) comes from Parseval, and u <- u + L(p_new - p) stays exact; when the
   projection clipped cells, p_new - p (no longer -tau t) is transformed forward (2.5 pairs);
-- the preconditioner's pair in single precision (on grids of 512² and more, where it is 0.42-0.6x
+- the preconditioner's pair in single precision (on grids of 512² and more, where it is 0.42-0.79x
   the time of a double pair; ``SINGLE_FROM``), a mixed-precision preconditioner in the sense of
   Higham & Mary (2022, Acta Numerica 31, 347–414): its rounding (relative 1e-7) perturbs the
   direction, not the equations, so the answer is the same discrete one and the stopping

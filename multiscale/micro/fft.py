@@ -6,7 +6,7 @@ what you want under MPI with one rank per core); a plan may also be given its ow
 
 Every transform is counted (``fft_counts``, ``reset_fft_counts``): benchmarks report the cost of
 an iteration in FFT pairs measured, not guessed. Plans are double precision unless made with
-``single=True`` (float32/complex64 buffers, counted apart): 0.42-0.6x the time of a double pair
+``single=True`` (float32/complex64 buffers, counted apart): 0.42-0.79x the time of a double pair
 at 512²-2048² on this machine (no gain at 256² and below), for work whose rounding does not
 reach the result, such as applying a preconditioner.
 
