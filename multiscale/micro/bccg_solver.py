@@ -40,7 +40,7 @@ from __future__ import annotations
 import numpy as np
 
 from multiscale.micro import bccg_steps
-from multiscale.micro.kernels import ConvolutionWorkspace, InfluenceOperator
+from multiscale.micro.kernels import ConvolutionWorkspace, InfluenceOperator, multiply
 
 GAMMAS = np.array([0.6, 0.3])   # extension factors of the rings 1, 2 around the free set
 REFRESH = 50                           # iterations between exact recomputations of u = L p
@@ -90,11 +90,26 @@ def exact_displacement(operator: InfluenceOperator, ws: ConvolutionWorkspace, p:
     ws.load_buffer[...] = 0.0
 
 
+def preconditioned_residual(operator: InfluenceOperator, work: Scratch, z2, p2, u2, delta, load_control, which,
+                            ccount, csum, d, nf, upper, fixed, pnorm, eps) -> None:
+    """The free set, the residual r on it and s = Eᵀ M E r with eps = ||s|| / ||p|| (``work.r``,
+    ``work.s``, ``eps``) of the patches ``which`` (flat (B, ny * nx) states, ``contact_sums``
+    done): ``bccg_steps.free_set``, ``extend``, the preconditioner's FFT pair, ``back_extend``."""
+    ny, nx = operator.shape
+    Fx = operator.fft_shape[1]
+    bccg_steps.free_set(u2, z2, p2, delta, load_control, which, ccount, csum, d, work.label, work.fi, work.fj, nf,
+                        work.r, work.s_old, work.t, work.XP, work.X, upper, fixed, nx, Fx)
+    bccg_steps.extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, work.XP, GAMMAS,
+                      operator.periodic, which, ny, nx, Fx)
+    work.pre.apply(work.mmul)
+    bccg_steps.back_extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, work.YP,
+                           work.s, GAMMAS, operator.periodic, work.XP, load_control, which, pnorm, eps, ny, nx, Fx)
+
+
 def estimate(operator: InfluenceOperator, work: Scratch, z, p, u, target, delta, which) -> tuple:
     """The stopping criterion of ``run`` for a state (p, u = L p; (B, ny, nx)) of the patches
     ``which``, without a pressure bound: (eps, d) per patch (one FFT pair; eps = inf elsewhere)."""
     B, ny, nx = z.shape
-    Fx = operator.fft_shape[1]
     z2, p2, u2 = (np.ascontiguousarray(a).reshape(B, ny * nx) for a in (z, p, u))
     load_control = target is not None
     delta = np.ascontiguousarray(np.zeros(B) if delta is None else delta, dtype=float)
@@ -104,13 +119,8 @@ def estimate(operator: InfluenceOperator, work: Scratch, z, p, u, target, delta,
     work.X[...] = 0.0
     work.XP[...] = 0.0
     bccg_steps.contact_sums(p2, u2, z2, upper, which, ccount, csum, pnorm)
-    bccg_steps.free_set(u2, z2, p2, delta, load_control, which, ccount, csum, d, work.label, work.fi, work.fj, nf,
-                        work.r, work.s_old, work.t, work.XP, work.X, upper, fixed, nx, Fx)
-    bccg_steps.extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, work.XP, GAMMAS,
-                      operator.periodic, which, ny, nx, Fx)
-    work.pre.apply(work.mmul)
-    bccg_steps.back_extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, work.YP,
-                           work.s, GAMMAS, operator.periodic, work.XP, load_control, which, pnorm, eps, ny, nx, Fx)
+    preconditioned_residual(operator, work, z2, p2, u2, delta, load_control, which, ccount, csum, d, nf, upper, fixed,
+                            pnorm, eps)
     work.XP[...] = 0.0
     return eps, d
 
@@ -123,10 +133,9 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
     iterations, residual (eps), converged; ``history`` gets the largest eps per iteration."""
     B, ny, nx = z.shape
     N, Fx = ny * nx, operator.fft_shape[1]
-    ws, pre = work.ws, work.pre
+    ws = work.ws
     X, Y, S = work.X, work.Y, ws.fft.spectrum
-    XP, YP, SP = work.XP, work.YP, pre.fft.spectrum
-    lmul, mmul = operator.multiplier, work.mmul
+    lmul = operator.multiplier
     load_control = target is not None
     target = np.ascontiguousarray(np.zeros(B) if target is None else target, dtype=float)
     delta = np.ascontiguousarray(np.zeros(B) if delta is None else delta, dtype=float)
@@ -139,9 +148,8 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
     upper = np.ascontiguousarray(np.full(B, np.inf) if upper is None else upper, dtype=float)
     conj, clipped, lost = (np.zeros(B, dtype=bool) for _ in range(3))
     iterations = np.zeros(B, dtype=int)
-    periodic = operator.periodic
     work.label[...] = -1                     # no free set and no history yet
-    XP[...] = 0.0
+    work.XP[...] = 0.0
     work.s_old[...] = 0.0
     work.t[...] = 0.0
 
@@ -152,16 +160,9 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
     exact(active)
     since = 0
     while True:
-        bccg_steps.free_set(u2, z2, p2, delta, load_control, active, ccount, csum, d, work.label, work.fi, work.fj,
-                            nf, work.r, work.s_old, work.t, XP, X, upper, fixed, nx, Fx)
-        bccg_steps.extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, XP, GAMMAS,
-                          periodic, active, ny, nx, Fx)
-        pre.fft.forward()
-        bccg_steps.multiply(SP, mmul)
-        pre.fft.inverse(normalise=False)
-        bccg_steps.back_extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, YP,
-                               work.s, GAMMAS, periodic, XP, load_control, active, pnorm, eps, ny, nx, Fx)
-        top, left, bad = bccg_steps.check(eps, tol, iterations, max_iter, active, XP, X)
+        preconditioned_residual(operator, work, z2, p2, u2, delta, load_control, active, ccount, csum, d, nf, upper,
+                                fixed, pnorm, eps)
+        top, left, bad = bccg_steps.check(eps, tol, iterations, max_iter, active, work.XP, X)
         if bad:
             raise FloatingPointError("non-finite residual")
         history.append(top)
@@ -180,7 +181,7 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
             factor.fill(1.0)
         else:                                # u += -tau L t
             np.negative(tau, out=factor)
-        bccg_steps.multiply(S, lmul)
+        multiply(S, lmul)
         ws.fft.inverse(normalise=False)
         bccg_steps.add_response(u2, Y, factor, p2, z2, work.fi, work.fj, nf, pending, active, ccount, csum, pnorm,
                                 upper, fixed, nx, Fx)

@@ -287,16 +287,6 @@ def direction(fi, fj, nf, r, s, s_old, t, X, load_control, active, conj, rho_old
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
-def multiply(S, m):
-    """S *= m (a real transfer function / (Fy Fx): the preconditioner's or L's) on every patch."""
-    B, Fy, Fh = S.shape
-    for b in range(B):
-        for i in range(Fy):
-            for j in range(Fh):
-                S[b, i, j] *= m[i, j]
-
-
-@njit(cache=True, fastmath=_FAST, nogil=True)
 def step_length(S, lmul, Fx, rt, active, tau):
     """tau = (r, t) / (t, L t) per patch from S, the rfft2 of t on a real grid of width Fx:
     (t, L t) = Σ_k lmul_k |T_k|² over the full spectrum (Parseval; lmul is the real transfer

@@ -10,7 +10,7 @@ an iteration in FFT pairs measured, not guessed. Plans are double precision unle
 at 512²-2048² on this machine (no gain at 256² and below), for work whose rounding does not
 reach the result, such as applying a preconditioner.
 
-Plans are measured (FFTW_MEASURE: 1.15-1.57x faster transforms than FFTW_ESTIMATE's on this
+Plans are measured (FFTW_MEASURE: 1.15-1.63x faster transforms than FFTW_ESTIMATE's on this
 machine, benchmarks/README) and their wisdom is kept in a file (``wisdom_file``) that every
 process reads: a shape is measured once per machine, under a file lock, and every later process,
 MPI rank and run uses the same plan, hence rounds alike (measured anew in each process, two runs

@@ -14,6 +14,7 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 import numpy as np
+from numba import njit
 
 from multiscale.errors import InputError, check_positive, check_real
 from multiscale.micro.fft import RealFFT2
@@ -234,8 +235,8 @@ class ConvolutionWorkspace:
 
     def apply(self, multiplier: np.ndarray | None = None) -> np.ndarray:
         """response = irfft2(multiplier * rfft2(load)); default multiplier: the operator's."""
-        self.fft.forward()
-        self.fft.spectrum *= self.multiplier if multiplier is None else multiplier
+        spectrum = self.fft.forward()
+        multiply(spectrum.reshape((-1,) + spectrum.shape[-2:]), self.multiplier if multiplier is None else multiplier)
         self.fft.inverse(normalise=False)
         return self.response
 
@@ -243,3 +244,14 @@ class ConvolutionWorkspace:
         """Zero every buffer (after a failed solve, so that nothing of it leaks into the next)."""
         for a in (self.fft.input, self.fft.spectrum, self.fft.output):
             a[...] = 0.0
+
+
+@njit(cache=True, nogil=True)
+def multiply(S, m):
+    """S *= m in place: spectra S (B, Fy, Fh) times a real transfer function m (Fy, Fh) (2-3x
+    faster than numpy's broadcast ``*=``, which converts m to complex on the way)."""
+    B, Fy, Fh = S.shape
+    for b in range(B):
+        for i in range(Fy):
+            for j in range(Fh):
+                S[b, i, j] *= m[i, j]
