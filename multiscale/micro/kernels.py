@@ -248,7 +248,7 @@ class ConvolutionWorkspace:
 
 @njit(cache=True, nogil=True)
 def multiply(S, m):
-    """S *= m in place: spectra S (B, Fy, Fh) times a real transfer function m (Fy, Fh) (2-3x
+    """``S *= m`` in place: spectra S (B, Fy, Fh) times a real transfer function m (Fy, Fh) (2-3x
     faster than numpy's broadcast ``*=``, which converts m to complex on the way)."""
     B, Fy, Fh = S.shape
     for b in range(B):
