@@ -319,3 +319,21 @@ def test_squeal_scene_metrics_from_the_mode_table(tmp_path):
     assert got["max_growth_frequency"] == pytest.approx(2500.0, rel=1e-9)
     assert got["lowest_unstable_frequency"] == pytest.approx(2500.0, rel=1e-9)
     assert got["min_damping_ratio"] == pytest.approx(-40.0 / abs(lam[1]), rel=1e-6)
+
+
+def test_failed_scene_run_reports_its_exception_not_the_launchers_abort():
+    """A scene run that fails under mpiexec is reported by its exception line, which the other
+    ranks' abort lines follow; output without one gives its last line."""
+    from multiscale.studies.scene_problem import failure_line
+    log = """Traceback (most recent call last):
+  File "coupling.py", line 481, in step
+    raise ConvergenceError(f"step {n}: ...")
+multiscale.errors.ConvergenceError: step 18: the partitions did not converge in 30 passes (residual 0.000359 > 1e-05)
+Abort(1) on node 1 (rank 1 in comm 0): application called MPI_Abort(MPI_COMM_WORLD, 1) - process 1
+
+"""
+    assert failure_line(log) == ("multiscale.errors.ConvergenceError: step 18: the partitions did not converge "
+                                 "in 30 passes (residual 0.000359 > 1e-05)")
+    assert failure_line("KeyboardInterrupt\nnothing\n") == "KeyboardInterrupt"
+    assert failure_line("segfault in rank 0\n  \n") == "segfault in rank 0"
+    assert failure_line("") == "no output"

@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import hashlib
 import json
+import re
 import subprocess
 import sys
 from dataclasses import dataclass, field
@@ -17,10 +18,20 @@ from multiscale.io import History
 from multiscale.scene import load
 from multiscale.studies.base import Outcome, Problem, jsonable
 
-__all__ = ["SQUEAL_METRICS", "SceneProblem", "SceneRun", "squeal_metrics"]
+__all__ = ["SQUEAL_METRICS", "SceneProblem", "SceneRun", "failure_line", "squeal_metrics"]
 
 _REDUCERS = {"last": lambda v: v[-1], "first": lambda v: v[0], "max": np.max, "min": np.min, "mean": np.mean,
              "rise": lambda v: v[-1] - v[0]}
+
+_EXCEPTION = re.compile(r"^[A-Za-z_][\w.]*(Error|Exception|Interrupt)\b")
+
+
+def failure_line(output: str) -> str:
+    """What a failed run says of its failure: the last line naming an exception (``ConvergenceError:
+    ...``; the launcher's abort lines of the other ranks come after it), else the last line."""
+    lines = [line.strip() for line in output.splitlines() if line.strip()]
+    named = [line for line in lines if _EXCEPTION.match(line)]
+    return (named or lines or ["no output"])[-1]
 
 
 SQUEAL_METRICS = {
@@ -97,8 +108,7 @@ class SceneProblem(Problem):
         done = subprocess.run(command, capture_output=True, text=True)
         (Path(workdir) / "scene_run.log").write_text(done.stdout + done.stderr)
         if done.returncode != 0:
-            last = [line for line in (done.stderr or done.stdout).strip().splitlines() if line.strip()]
-            raise RuntimeError(f"scene run failed (exit {done.returncode}): {last[-1] if last else 'no output'}")
+            raise RuntimeError(f"scene run failed (exit {done.returncode}): {failure_line(done.stderr or done.stdout)}")
         if (out / "modes.csv").exists():
             return Outcome(squeal_metrics(out / "modes.csv"), 0, True)
         history = History.read(out / "history.h5")
