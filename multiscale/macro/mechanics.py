@@ -103,10 +103,12 @@ class Mechanics:
     fluid pressure p [Pa] (``load_kind="fluid"``: traction −p n with n the outward normal, so two
     faces that look at each other across the fluid, e.g. a brake's piston back and caliper bore,
     are pushed apart by the same pressure). ``refresh``: None (default) to refactorise by the timed
-    rule of ``NEWTON_OPTIONS``, or a number of GMRES iterations beyond one per linear solve, summed
-    since the last factorisation, from which on the next Newton iteration factorises afresh (0: a
-    fresh factorisation every iteration); ``preconditioner``: one of ``PRECONDITIONERS`` (see
-    there). ``factorisations`` counts the preconditioner's factorisations so far.
+    rule of ``NEWTON_OPTIONS`` (runs then repeat within the Newton tolerance, not bit for bit), or a
+    number of GMRES iterations beyond one per linear solve, summed since the last factorisation,
+    from which on the next Newton iteration factorises afresh (0: a fresh factorisation every
+    iteration; fresh serial processes then repeat bit for bit, docs/architecture.md "Known
+    problems"); ``preconditioner``: one of ``PRECONDITIONERS`` (see there). ``factorisations``
+    counts the preconditioner's factorisations so far.
     """
 
     LOAD_KINDS = ("force", "pressure", "fluid")
