@@ -121,3 +121,27 @@ def test_singular_matrix_is_a_failed_preconditioner():
     x = b.duplicate()
     ksp.solve(b, x)
     assert ksp.getConvergedReason() == PETSc.KSP.ConvergedReason.DIVERGED_PCSETUP_FAILED
+
+
+def test_mumps_workspace_too_small_is_retried_with_more():
+    """A symmetric indefinite matrix (random couplings, a diagonal of 1e-6) whose delayed pivots
+    overflow MUMPS' workspace with its default margin (ICNTL(14) = 20: INFOG(1) = -9, measured) is
+    factorised on a retry with a larger one; the LDL^T then solves it to round-off."""
+    import scipy.sparse as sp
+    n = 2000
+    R = sp.random(n, n, density=4 / n, random_state=3)
+    A = (R + R.T).toarray()
+    A[np.diag_indices(n)] = 1e-6 * np.random.default_rng(3).standard_normal(n)
+    M = with_zeros(A, A != 0)
+    M.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    ksp, context = solver(M, "cholesky")
+    b = M.createVecLeft()
+    b.set(1.0)
+    x = b.duplicate()
+    ksp.solve(b, x)
+    assert ksp.getConvergedReason() > 0 and context.status == 0
+    assert context.workspace == 40 and context.analyses == 2                # one retry, twice the margin
+    r = b.duplicate()
+    M.mult(x, r)
+    r.axpy(-1.0, b)
+    assert r.norm() <= 1e-8 * b.norm()

@@ -97,6 +97,19 @@ def test_pulling_the_block_off_raises_convergence_error(tm):
         m.solve(-1e6)
 
 
+def test_a_failed_factorisation_is_named_in_the_error(tm):
+    """MUMPS refusing the factors (here its working memory capped at 1 MB: INFOG(1) = -19) ends the
+    solve with a ConvergenceError that names MUMPS' status, not only the SNES reason."""
+    from petsc4py import PETSc
+    PETSc.Options()["block_f_factor_mat_mumps_icntl_23"] = 1
+    try:
+        m = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_f_")
+        with pytest.raises(ConvergenceError, match=r"MUMPS INFOG\(1\) = -\d+"):
+            m.solve(1e6)
+    finally:
+        PETSc.Options().delValue("block_f_factor_mat_mumps_icntl_23")
+
+
 def test_missing_material_and_unknown_builder_are_input_errors(tm):
     with pytest.raises(InputError, match="materials.flat"):
         Mechanics(tm, {"block": MATERIALS["block"]}, prefix="block_e_")

@@ -12,6 +12,15 @@ entries exact zeros) the LU of the matrix as assembled holds 34.5M entries, the 
 seen, so that the symbolic analysis is redone only when a new entry appears (a facet comes into
 contact), and the same Mat is refactorised otherwise. The factors are those of the matrix itself:
 the dropped entries are zero.
+
+MUMPS sizes its workspace from the analysis' estimate plus ICNTL(14) percent (default 20); pivots
+delayed by the numerical pivoting of an indefinite matrix (the LDL^T of the brake's frictionless
+tangent) can need more, and the factorisation then stops with INFOG(1) = -9 (at 249k dofs, 2
+ranks: 1.57M reals short). As the MUMPS user guide advises, the factorisation is then repeated with
+ICNTL(14) doubled, up to ``WORKSPACE_RETRIES`` times (INFOG is global: every rank retries alike),
+and the larger margin kept for later factorisations. PETSc does not refactorise after a failed
+MUMPS factorisation (its numeric phase returns at once while INFOG(1) < 0), so each retry analyses
+afresh; an explicit ``<prefix>mat_mumps_icntl_14`` option overrides the retries' margin.
 """
 from __future__ import annotations
 
@@ -20,12 +29,18 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 
+WORKSPACE_ERRORS = (-8, -9, -11, -14, -15, -17, -20)   # MUMPS INFOG(1): a workspace or buffer too small
+WORKSPACE_RETRIES = 4
+
+
 class CompactFactor:
     """Python context of a PETSc PC (``pc.setType("python"); pc.setPythonContext(...)``): the
     ``factor`` ("lu" or "cholesky", symmetric matrices) by ``solver`` of the preconditioner matrix
     with its zero entries dropped (the diagonal kept). ``prefix``: options prefix of the inner PC
     (e.g. MUMPS controls ``<prefix>mat_mumps_icntl_14``). ``analyses`` counts the symbolic
-    analyses (pattern changes), ``entries`` the factorised matrix's nonzeros (this rank's rows)."""
+    analyses (pattern changes and workspace retries), ``entries`` the factorised matrix's nonzeros
+    (this rank's rows), ``status`` MUMPS' INFOG(1) of the last factorisation (0: none, or another
+    solver), ``workspace`` the ICNTL(14) margin [%] the retries raised (None: MUMPS' default)."""
 
     def __init__(self, factor: str = "lu", solver: str = "mumps", prefix: str = ""):
         self.factor, self.solver, self.prefix = factor, solver, prefix
@@ -33,6 +48,7 @@ class CompactFactor:
         self.matrix: PETSc.Mat | None = None
         self.keys: np.ndarray | None = None       # row * columns + column of the kept entries (sorted)
         self.analyses = 0
+        self.workspace: int | None = None
         self._csr: tuple = ()                     # (row pointers, columns) of the kept pattern, this rank's rows
 
     @property
@@ -59,7 +75,20 @@ class CompactFactor:
         self.matrix.setValuesCSR(*self._csr, full)
         self.matrix.assemble()
         self.inner.setUp()
+        for _ in range(WORKSPACE_RETRIES):
+            if self.status not in WORKSPACE_ERRORS:
+                break
+            self.workspace = 2 * max(self.inner.getFactorMatrix().getMumpsIcntl(14), 20)
+            self.inner.destroy()
+            self._new_inner()
+            self.inner.setUp()
         pc.setFailedReason(self.inner.getFailedReason())
+
+    @property
+    def status(self) -> int:
+        if self.inner is None or self.solver != "mumps" or self.inner.getFactorMatrix() is None:
+            return 0
+        return self.inner.getFactorMatrix().getMumpsInfog(1)
 
     def _build(self, P: PETSc.Mat) -> None:
         """A new matrix of the kept pattern and a new inner PC on it (a new symbolic analysis)."""
@@ -71,13 +100,21 @@ class CompactFactor:
         if self.factor == "cholesky":
             M.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             M.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
-        inner = PETSc.PC().create(P.getComm())
+        self.matrix = M
+        self._new_inner()
+
+    def _new_inner(self) -> None:
+        """A new inner PC on ``matrix`` (its set-up analyses), with the ``workspace`` margin."""
+        inner = PETSc.PC().create(self.matrix.getComm())
         inner.setOptionsPrefix(self.prefix)
         inner.setType(self.factor)
         inner.setFactorSolverType(self.solver)
-        inner.setOperators(M, M)
+        inner.setOperators(self.matrix, self.matrix)
         inner.setFromOptions()
-        self.matrix, self.inner = M, inner
+        if self.workspace is not None:
+            inner.setFactorSetUpSolverType()
+            inner.getFactorMatrix().setMumpsIcntl(14, self.workspace)
+        self.inner = inner
         self.analyses += 1
 
     def apply(self, pc, x, y) -> None:
