@@ -62,6 +62,9 @@ def test_two_ranks_give_the_serial_history(tmp_path):
                 np.testing.assert_array_equal(a["mesh/geometry"][...], b["mesh/geometry"][...])
                 for k in a["data"]:
                     for field in a[f"data/{k}"]:
+                        # the two runs' Newton paths differ (timed refactorisation, MUMPS' round-off
+                        # on 2 ranks): a small heat flux once differed by 1.4e-9 of the field's
+                        # largest value (CI 2026-11-24), hence 1e-8 of it
                         x, y = a[f"data/{k}/{field}"][...], b[f"data/{k}/{field}"][...]
-                        np.testing.assert_allclose(x, y, rtol=1e-7, atol=1e-9 * np.abs(y).max(), err_msg=field)
+                        np.testing.assert_allclose(x, y, rtol=1e-7, atol=1e-8 * np.abs(y).max(), err_msg=field)
         assert json.loads(Path(f"{base}/parallel/provenance.json").read_text())["ranks"] == 2
