@@ -272,6 +272,18 @@ def test_rough_pin_on_disc_bookkeeping_and_outputs(straight):
     assert all(name in text for name in ("contact_stiffness", "partition", "wear_depth"))
 
 
+def resumed_rtol(key: str, rtol: float = 1e-6) -> float:
+    """Relative tolerance of history column ``key`` between a resumed run and the straight one
+    (``rtol`` for the state columns): the coupling residual, a difference of partitions, shows the
+    recomputed laws first (1e-4); the heat exchanged, G (T_rough - T_counter) dt, carries the
+    temperatures' error times T / dT (1e-5; measured 1.05e-6 on a fresh CI clone, 2026-11-24: the
+    Newton's timed refactorisation makes the path differ between runs, docs/architecture.md
+    "Repeatability")."""
+    if key == "coupling_residual":
+        return max(rtol, 1e-4)
+    return max(rtol, 1e-5) if key.startswith("heat_exchanged") else rtol
+
+
 def test_resume_after_an_interrupted_run_gives_the_straight_history(straight, tmp_path):
     """Stopped after step 1 (its checkpoint and fields on disk, nothing else), then resumed in a
     fresh model: the same history as the straight run to solver tolerance (the resumed run
@@ -291,12 +303,7 @@ def test_resume_after_an_interrupted_run_gives_the_straight_history(straight, tm
     assert set(h.columns) == set(ref.columns)
     for key in ref.columns:
         if not solver_statistic(key):
-            # the coupling residual (a difference of partitions) shows the recomputed laws first; the
-            # heat exchanged, G (T_rough - T_counter) dt, carries the temperatures' error times T / dT
-            # (measured 1.05e-6 on a fresh CI clone, 2026-11-24: the Newton's timed refactorisation
-            # makes the path differ between runs, docs/architecture.md "Repeatability")
-            rtol = 1e-4 if key == "coupling_residual" else 1e-5 if key.startswith("heat_exchanged") else 1e-6
-            np.testing.assert_allclose(h[key], ref[key], rtol=rtol, atol=1e-12, err_msg=key)
+            np.testing.assert_allclose(h[key], ref[key], rtol=resumed_rtol(key), atol=1e-12, err_msg=key)
     assert (tmp_path / "killed" / "interface.xdmf").read_text().count("<Time ") == \
         (reference.folder / "interface.xdmf").read_text().count("<Time ")
 

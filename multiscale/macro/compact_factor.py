@@ -86,9 +86,8 @@ class CompactFactor:
 
     @property
     def status(self) -> int:
-        if self.inner is None or self.solver != "mumps" or self.inner.getFactorMatrix() is None:
-            return 0
-        return self.inner.getFactorMatrix().getMumpsInfog(1)
+        factors = None if self.inner is None or self.solver != "mumps" else self.inner.getFactorMatrix()
+        return 0 if factors is None else factors.getMumpsInfog(1)
 
     def _build(self, P: PETSc.Mat) -> None:
         """A new matrix of the kept pattern and a new inner PC on it (a new symbolic analysis)."""

@@ -368,12 +368,12 @@ class Mechanics:
                 self._fresh = False
         if not result.converged:
             status = self.factors.status     # MUMPS' INFOG(1), the same on every rank
-            factors = (f"; the preconditioner's factorisation failed: MUMPS INFOG(1) = {status} (the codes: "
-                       f"MUMPS user guide; -13: not enough memory)" if status < 0 else "")
+            cause = (f"; the preconditioner's factorisation failed: MUMPS INFOG(1) = {status} (the codes: "
+                     f"MUMPS user guide; -13: not enough memory)" if status < 0 else "")
             raise ConvergenceError(
                 f"contact Newton did not converge at load {float(self.load.value):.6g} "
                 f"(SNES reason {result.reason}, {result.iterations} iterations, residuals "
-                f"{['%.3g' % r for r in result.residuals]}{factors})", result.residuals, result)
+                f"{['%.3g' % r for r in result.residuals]}{cause})", result.residuals, result)
         result.normal_force = self.contact.normal_force()
         result.max_pressure = float(self.contact.facet_pressure().max(initial=0.0))
         return result
