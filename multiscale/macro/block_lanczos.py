@@ -30,13 +30,15 @@ import numpy as np
 from petsc4py import PETSc
 
 from multiscale.errors import ConvergenceError, InputError
+from multiscale.macro import mumps
 from multiscale.macro.dense import block_solve, mat_mult
 from multiscale.macro.eigen import TWO_PI, ModalResult, check_band, lambda_from_theta, matrix_comm, reduce_sum
 
 
 class ShiftInvert:
-    """MUMPS LDL^T factors of K - theta_t M (K symmetric) that solve blocks of right-hand sides;
-    raises InputError if K - theta_t M cannot be factorised (singular). ``destroy`` frees them."""
+    """MUMPS LDL^T factors of K - theta_t M (K symmetric) that solve blocks of right-hand sides
+    (a too-small workspace retried, ``macro.mumps``); raises InputError if K - theta_t M cannot be
+    factorised (singular). ``destroy`` frees them."""
 
     def __init__(self, K: PETSc.Mat, M: PETSc.Mat, shift: float = 0.0, prefix: str = "modes_"):
         self.shift = float(shift)
@@ -55,9 +57,9 @@ class ShiftInvert:
         self.ksp.setOptionsPrefix(prefix)
         self.ksp.setFromOptions()
         try:
-            self.ksp.setUp()
-            reason = pc.getFailedReason()                 # MUMPS' status: the same on every rank
-            failed = f"PC failed reason {reason}" if reason != PETSc.PC.FailedReason.NOERROR else ""
+            self.ksp.setUp()                              # the operators reach the PC
+            mumps.factorise(pc)
+            failed = mumps.describe(pc)                   # MUMPS' status: the same on every rank
         except PETSc.Error as exc:
             failed = str(exc).strip()
         if failed:

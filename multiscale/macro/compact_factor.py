@@ -13,14 +13,8 @@ seen, so that the symbolic analysis is redone only when a new entry appears (a f
 contact), and the same Mat is refactorised otherwise. The factors are those of the matrix itself:
 the dropped entries are zero.
 
-MUMPS sizes its workspace from the analysis' estimate plus ICNTL(14) percent (default 20); pivots
-delayed by the numerical pivoting of an indefinite matrix (the LDL^T of the brake's frictionless
-tangent) can need more, and the factorisation then stops with INFOG(1) = -9 (at 249k dofs, 2
-ranks: 1.57M reals short). As the MUMPS user guide advises, the factorisation is then repeated with
-ICNTL(14) doubled, up to ``WORKSPACE_RETRIES`` times (INFOG is global: every rank retries alike),
-and the larger margin kept for later factorisations. PETSc does not refactorise after a failed
-MUMPS factorisation (its numeric phase returns at once while INFOG(1) < 0), so each retry analyses
-afresh; an explicit ``<prefix>mat_mumps_icntl_14`` option overrides the retries' margin.
+A MUMPS workspace error is retried with a larger margin (``macro.mumps.factorise``), and the
+larger margin kept for later factorisations.
 """
 from __future__ import annotations
 
@@ -28,9 +22,7 @@ import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
-
-WORKSPACE_ERRORS = (-8, -9, -11, -14, -15, -17, -20)   # MUMPS INFOG(1): a workspace or buffer too small
-WORKSPACE_RETRIES = 4
+from multiscale.macro import mumps
 
 
 class CompactFactor:
@@ -74,20 +66,13 @@ class CompactFactor:
         full[np.searchsorted(self.keys, keys)] = values[keep]
         self.matrix.setValuesCSR(*self._csr, full)
         self.matrix.assemble()
-        self.inner.setUp()
-        for _ in range(WORKSPACE_RETRIES):
-            if self.status not in WORKSPACE_ERRORS:
-                break
-            self.workspace = 2 * max(self.inner.getFactorMatrix().getMumpsIcntl(14), 20)
-            self.inner.destroy()
-            self._new_inner()
-            self.inner.setUp()
+        self.workspace, retries = mumps.factorise(self.inner, self.workspace)
+        self.analyses += retries
         pc.setFailedReason(self.inner.getFailedReason())
 
     @property
     def status(self) -> int:
-        factors = None if self.inner is None or self.solver != "mumps" else self.inner.getFactorMatrix()
-        return 0 if factors is None else factors.getMumpsInfog(1)
+        return 0 if self.inner is None else mumps.status(self.inner)
 
     def _build(self, P: PETSc.Mat) -> None:
         """A new matrix of the kept pattern and a new inner PC on it (a new symbolic analysis)."""
@@ -103,16 +88,13 @@ class CompactFactor:
         self._new_inner()
 
     def _new_inner(self) -> None:
-        """A new inner PC on ``matrix`` (its set-up analyses), with the ``workspace`` margin."""
+        """A new inner PC on ``matrix`` (its set-up analyses)."""
         inner = PETSc.PC().create(self.matrix.getComm())
         inner.setOptionsPrefix(self.prefix)
         inner.setType(self.factor)
         inner.setFactorSolverType(self.solver)
         inner.setOperators(self.matrix, self.matrix)
         inner.setFromOptions()
-        if self.workspace is not None:
-            inner.setFactorSetUpSolverType()
-            inner.getFactorMatrix().setMumpsIcntl(14, self.workspace)
         self.inner = inner
         self.analyses += 1
 

@@ -33,6 +33,7 @@ from petsc4py import PETSc
 from slepc4py import SLEPc
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.macro import mumps
 from multiscale.macro.dense import mat_mult
 
 TWO_PI = 2.0 * math.pi
@@ -170,6 +171,28 @@ def _shift_invert(solver, target, tol, max_it, prefix):
     solver.setFromOptions()
 
 
+def _set_up(solver, want: int, failure: tuple) -> None:
+    """Set a configured EPS or PEP up for ``want`` eigenpairs, its factorisation with a too-small
+    MUMPS workspace retried (``macro.mumps``). ``failure``: (name, value, text) of the InputError
+    raised when the shifted operator cannot be factorised."""
+    solver.setDimensions(want, PETSc.DECIDE)
+    pc = solver.getST().getKSP().getPC()
+    try:
+        try:
+            solver.setUp()                     # the ST factorises (once); a failure raises
+        except (PETSc.Error, SystemError):     # (slepc4py passes PETSc's error on as a SystemError)
+            if mumps.status(pc) not in mumps.WORKSPACE_ERRORS:
+                raise
+            mumps.factorise(pc)
+            solver.setUp()                     # the rest of the set-up, on the new factors
+        failed = mumps.describe(pc)
+    except (PETSc.Error, SystemError) as exc:
+        failed = mumps.describe(pc) or str(exc.__cause__ or exc).strip()
+    if failed:
+        name, value, text = failure
+        raise InputError(name, value, f"{text} [{failed}]")
+
+
 def _pairs(solver, i, vr, vi):
     val = solver.getEigenpair(i, vr, vi)
     return complex(val), vr.getArray() + 1j * vi.getArray()
@@ -245,15 +268,12 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
     eps.setProblemType(SLEPc.EPS.ProblemType.GNHEP)
     eps.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
     _shift_invert(eps, shift, tol, max_it, options_prefix)
+    failure = ("target", target, "K - (2 pi target)^2 M could not be factorised (singular at this shift? "
+                                 "choose a target > 0 away from an eigenvalue)")
     solves = 0
     while True:
-        eps.setDimensions(want, PETSc.DECIDE)
-        try:
-            eps.solve()
-        except PETSc.Error as exc:
-            raise InputError("target", target, f"K - (2 pi target)^2 M could not be factorised "
-                             f"(singular at this shift? choose a target > 0 away from an eigenvalue): "
-                             f"{exc}") from None
+        _set_up(eps, want, failure)
+        eps.solve()
         solves += 1
         nconv = eps.getConverged()
         if nconv < want:
@@ -324,11 +344,8 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     want = min(2 * int(n_modes if n_modes is not None else max(nev, 1)), 2 * n)
     solves = 0
     while True:
-        pep.setDimensions(want, PETSc.DECIDE)
-        try:
-            pep.solve()
-        except PETSc.Error as exc:
-            raise InputError("target", target, f"K + s C + s^2 M could not be factorised: {exc}") from None
+        _set_up(pep, want, ("target", target, "K + s C + s^2 M could not be factorised"))
+        pep.solve()
         solves += 1
         nconv = pep.getConverged()
         if nconv < want:
