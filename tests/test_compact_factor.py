@@ -8,6 +8,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from multiscale.macro.compact_factor import CompactFactor
+from test_mumps import indefinite, petsc
 
 COMM = MPI.COMM_WORLD
 
@@ -124,16 +125,10 @@ def test_singular_matrix_is_a_failed_preconditioner():
 
 
 def test_mumps_workspace_too_small_is_retried_with_more():
-    """A symmetric indefinite matrix (random couplings, a diagonal of 1e-6) whose delayed pivots
-    overflow MUMPS' workspace with its default margin (ICNTL(14) = 20: INFOG(1) = -9, measured) is
-    factorised on a retry with a larger one; the LDL^T then solves it to round-off."""
-    import scipy.sparse as sp
-    n = 2000
-    R = sp.random(n, n, density=4 / n, random_state=3)
-    A = (R + R.T).toarray()
-    A[np.diag_indices(n)] = 1e-6 * np.random.default_rng(3).standard_normal(n)
-    M = with_zeros(A, A != 0)
-    M.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+    """The symmetric indefinite matrix of tests/test_mumps.py, whose delayed pivots overflow MUMPS'
+    workspace with its default margin (ICNTL(14) = 20: INFOG(1) = -9, measured), is factorised on a
+    retry with a larger one; the LDL^T then solves it to round-off."""
+    M = petsc(indefinite())
     ksp, context = solver(M, "cholesky")
     b = M.createVecLeft()
     b.set(1.0)
