@@ -1,11 +1,12 @@
 """Thermal boundary conditions and temperature-dependent materials of the macro heat problem, through
-scenes (``multiscale.workflows``), against closed forms (``multiscale.references.thermal``)."""
+scenes (``multiscale.workflows``), against closed forms (``multiscale.references.thermal``); a failed factorisation named."""
 import dataclasses
 
 import numpy as np
 import pytest
 from scipy.integrate import solve_ivp
 
+from multiscale.errors import ConvergenceError
 from multiscale.references.thermal import (STEFAN_BOLTZMANN, kirchhoff_slab, kirchhoff_transform,
                                            lumped_convective_cooling, lumped_cooling_linear_capacity,
                                            radiative_cooling, slab_convection)
@@ -282,3 +283,15 @@ def test_energy_balance_of_a_stop(tmp_path):
     for body in ("pin", "disc"):                               # per-step losses add up to the totals
         assert sum(h[f"heat_lost_step_{body}"]) == pytest.approx(final[f"heat_lost_total_{body}"], rel=1e-12)
     assert h["heat_step_disc"][-1] < 0.25 * h["heat_step_disc"][1]         # the frictional power falls
+
+
+def test_a_failed_heat_factorisation_is_named_in_the_error():
+    """MUMPS refusing the heat system's factors (its working memory capped at 1 MB: INFOG(1) = -19)
+    ends the step with a ConvergenceError that names MUMPS' status, not only the SNES reason."""
+    from petsc4py import PETSc
+    PETSc.Options()["heat_mat_mumps_icntl_23"] = 1
+    try:
+        with pytest.raises(ConvergenceError, match=r"MUMPS INFOG\(1\) = -19 \(more memory than ICNTL\(23\)"):
+            march(block_scene(geometry='mesh_size = "1 mm"'))
+    finally:
+        PETSc.Options().delValue("heat_mat_mumps_icntl_23")

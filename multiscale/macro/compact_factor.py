@@ -31,8 +31,8 @@ class CompactFactor:
     with its zero entries dropped (the diagonal kept). ``prefix``: options prefix of the inner PC
     (e.g. MUMPS controls ``<prefix>mat_mumps_icntl_14``). ``analyses`` counts the symbolic
     analyses (pattern changes and workspace retries), ``entries`` the factorised matrix's nonzeros
-    (this rank's rows), ``status`` MUMPS' INFOG(1) of the last factorisation (0: none, or another
-    solver), ``workspace`` the ICNTL(14) margin [%] the retries raised (None: MUMPS' default)."""
+    (this rank's rows), ``inner`` the PC that holds the factors (``macro.mumps.describe`` names its
+    failure), ``workspace`` the ICNTL(14) margin [%] the retries raised (None: MUMPS' default)."""
 
     def __init__(self, factor: str = "lu", solver: str = "mumps", prefix: str = ""):
         self.factor, self.solver, self.prefix = factor, solver, prefix
@@ -69,10 +69,6 @@ class CompactFactor:
         self.workspace, retries = mumps.factorise(self.inner, self.workspace)
         self.analyses += retries
         pc.setFailedReason(self.inner.getFailedReason())
-
-    @property
-    def status(self) -> int:
-        return 0 if self.inner is None else mumps.status(self.inner)
 
     def _build(self, P: PETSc.Mat) -> None:
         """A new matrix of the kept pattern and a new inner PC on it (a new symbolic analysis)."""

@@ -26,6 +26,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
+from multiscale.macro import mumps
 from multiscale.macro.compact_factor import CompactFactor
 from multiscale.macro.interface import ContactInterface, PressureLaw
 from multiscale.macro.materials import body_expressions
@@ -367,9 +368,8 @@ class Mechanics:
             finally:
                 self._fresh = False
         if not result.converged:
-            status = self.factors.status     # MUMPS' INFOG(1), the same on every rank
-            cause = (f"; the preconditioner's factorisation failed: MUMPS INFOG(1) = {status} (the codes: "
-                     f"MUMPS user guide; -13: not enough memory)" if status < 0 else "")
+            failed = "" if self.factors.inner is None else mumps.describe(self.factors.inner)  # same on every rank
+            cause = f"; the preconditioner's factorisation failed: {failed}" if failed else ""
             raise ConvergenceError(
                 f"contact Newton did not converge at load {float(self.load.value):.6g} "
                 f"(SNES reason {result.reason}, {result.iterations} iterations, residuals "

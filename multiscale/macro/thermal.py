@@ -52,6 +52,7 @@ from mpi4py import MPI
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.geometry import Rotation
+from multiscale.macro import mumps
 from multiscale.macro.interface import ContactInterface, rigid_velocity
 from multiscale.macro.materials import body_properties, heat_capacity
 from multiscale.macro.mesh import FormCache, TwoBodyMesh
@@ -301,9 +302,10 @@ class Thermal:
         finite = bool(self.tm.comm.allreduce(all(np.isfinite(T.x.array).all() for T in self.T), op=MPI.LAND))
         ok = snes.getConvergedReason() > 0 and finite             # the same answer on every rank
         if not ok:
+            failed = mumps.describe(snes.getKSP().getPC())        # the factorisation's failure, if any
             raise ConvergenceError(f"heat step at t = {self.time + dt:.6g} s failed "
                                    f"(SNES reason {snes.getConvergedReason()}, "
-                                   f"{snes.getIterationNumber()} iterations)")
+                                   f"{snes.getIterationNumber()} iterations{'; ' + failed if failed else ''})")
         self.time += dt
         self.lost_step = self._losses(dt)
         self.lost_total += self.lost_step
