@@ -7,7 +7,8 @@ stops with INFOG(1) = -9 (at 249k dofs, 2 ranks: 1.57M reals short). As the MUMP
 advises, ``factorise`` repeats it with ICNTL(14) doubled, up to ``WORKSPACE_RETRIES`` times (INFOG is
 global: every rank retries alike). PETSc's numeric phase returns at once while INFOG(1) < 0, so a
 retry resets the PC (a new analysis); an explicit ``<prefix>mat_mumps_icntl_14`` option overrides
-the retries' margin. A PC that failed otherwise applies NaN: ``check`` names the failure.
+the retries' margin. A PC that failed otherwise applies NaN: ``describe`` names the failure for
+the caller's error.
 """
 from __future__ import annotations
 
