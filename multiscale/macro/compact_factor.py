@@ -80,18 +80,13 @@ class CompactFactor:
         if self.factor == "cholesky":
             M.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             M.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
-        self.matrix = M
-        self._new_inner()
-
-    def _new_inner(self) -> None:
-        """A new inner PC on ``matrix`` (its set-up analyses)."""
-        inner = PETSc.PC().create(self.matrix.getComm())
+        inner = PETSc.PC().create(P.getComm())
         inner.setOptionsPrefix(self.prefix)
         inner.setType(self.factor)
         inner.setFactorSolverType(self.solver)
-        inner.setOperators(self.matrix, self.matrix)
+        inner.setOperators(M, M)
         inner.setFromOptions()
-        self.inner = inner
+        self.matrix, self.inner = M, inner
         self.analyses += 1
 
     def apply(self, pc, x, y) -> None:

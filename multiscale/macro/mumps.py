@@ -63,8 +63,8 @@ def describe(pc: PETSc.PC) -> str:
     if reason == PETSc.PC.FailedReason.NOERROR and code >= 0:
         return ""
     meaning = MEANINGS.get(code, "workspace too small after retries" if code in WORKSPACE_ERRORS else "")
-    mumps = f", MUMPS INFOG(1) = {code}" + (f" ({meaning})" if meaning else "") if code < 0 else ""
-    return f"PC failed reason {reason}{mumps}"
+    detail = f", MUMPS INFOG(1) = {code}" + (f" ({meaning})" if meaning else "") if code < 0 else ""
+    return f"PC failed reason {reason}{detail}"
 
 
 def _set_margin(pc: PETSc.PC, workspace: int) -> None:
