@@ -50,8 +50,9 @@ def test_methods_give_the_same_discrete_answer(periodic):
 def test_the_two_ways_of_extending_the_residual_agree(periodic, fraction):
     """The preconditioner's extension E into two rings around the free set F, by scattering from
     listed cells (small F) and by row sweeps (large F, ``bccg_steps.DENSE_FROM``): same rings,
-    counts and values (to 1e-15), and E^T of each is the adjoint of its E (<E r, y> = <r, E^T y>
-    to 1e-13), on a random F of a 37 x 29 patch (its FFT grid zero-padded when isolated)."""
+    counts and values (to 1e-15), E^T of each the adjoint of its E (<E r, y> = <r, E^T y> to
+    1e-13) and Σ_F E^T y returned (for the mean under load control), on a random F of a 37 x 29
+    patch (its FFT grid zero-padded when isolated)."""
     rng = np.random.default_rng(7)
     ny, nx = 37, 29
     Fy, Fx = (ny, nx) if periodic else (2 * ny, 2 * nx)
@@ -71,16 +72,17 @@ def test_the_two_ways_of_extending_the_residual_agree(periodic, fraction):
         if rows:
             bccg_steps.extend_rows(label, X, count, bccg_solver.GAMMAS, periodic, ny, nx, Fx)
             Er = X.copy()
-            bccg_steps.back_rows(label, count, y, s, X, bccg_solver.GAMMAS, periodic, ny, nx, Fx)
+            total = bccg_steps.back_rows(label, count, y, s, X, bccg_solver.GAMMAS, periodic, ny, nx, Fx)
         else:
             bccg_steps.extend_cells(label, fi, fj, free.size, bi, bj, ring_end, count, X, bccg_solver.GAMMAS,
                                     periodic, ny, nx, Fx)
             Er = X.copy()
-            bccg_steps.back_cells(label, fi, fj, free.size, bi, bj, ring_end, count, y, s, X, bccg_solver.GAMMAS,
-                                  periodic, ny, nx, Fx)
+            total = bccg_steps.back_cells(label, fi, fj, free.size, bi, bj, ring_end, count, y, s, X,
+                                          bccg_solver.GAMMAS, periodic, ny, nx, Fx)
         ring = np.flatnonzero(label > 0)
         assert not X[ring // nx * Fx + ring % nx].any()                # the rings cleared from X
         assert abs(Er @ y - r @ s[free]) <= 1e-13 * np.abs(Er).sum() * np.abs(y).max()
+        assert total == pytest.approx(s[free].sum(), rel=0, abs=1e-13 * np.abs(s[free]).sum())   # for the mean
         out.append((label, count[label > 0], Er, s[free]))
     (l0, c0, e0, s0), (l1, c1, e1, s1) = out
     assert np.array_equal(l0, l1) and (l0 == 1).any() and ((l0 == 2).any() or fraction > 0.5)

@@ -227,13 +227,10 @@ def back_extend(label, fi, fj, nf, bi, bj, ring_end, count, Y, s, gammas, period
             continue
         n = nf[b]
         if n >= DENSE_FROM * ny * nx:
-            back_rows(label[b], count[b], Y[b], s[b], X[b], gammas, periodic, ny, nx, Fx)
+            total = back_rows(label[b], count[b], Y[b], s[b], X[b], gammas, periodic, ny, nx, Fx)
         else:
-            back_cells(label[b], fi[b], fj[b], n, bi[b], bj[b], ring_end[b], count[b], Y[b], s[b], X[b], gammas,
-                        periodic, ny, nx, Fx)
-        total = 0.0
-        for m in range(n):
-            total += s[b, fi[b, m] * nx + fj[b, m]]
+            total = back_cells(label[b], fi[b], fj[b], n, bi[b], bj[b], ring_end[b], count[b], Y[b], s[b], X[b],
+                               gammas, periodic, ny, nx, Fx)
         mean = total / n if load_control and n > 0 else 0.0
         ss = 0.0
         for m in range(n):
@@ -246,15 +243,18 @@ def back_extend(label, fi, fj, nf, bi, bj, ring_end, count, Y, s, gammas, period
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
 def back_cells(label, fi, fj, n, bi, bj, ring_end, count, Y, s, X, gammas, periodic, ny, nx, Fx):
-    """s = E^T Y of one patch (flat arrays) over the listed cells of F and of the rings."""
+    """s = E^T Y of one patch (flat arrays) over the listed cells of F and of the rings; returns Σ_F s."""
     R = gammas.shape[0]
+    total = 0.0
     for m in range(ring_end[R - 1]):
         i, j = bi[m], bj[m]
         s[i * nx + j] = Y[i * Fx + j]
         X[i * Fx + j] = 0.0
     for m in range(n):
         i, j = fi[m], fj[m]
-        s[i * nx + j] = Y[i * Fx + j]
+        v = Y[i * Fx + j]
+        s[i * nx + j] = v
+        total += v
     for ring in range(R, 0, -1):               # adjoint of ``extend``: outermost ring first
         first = 0 if ring == 1 else ring_end[ring - 2]
         gam = gammas[ring - 1]
@@ -270,38 +270,47 @@ def back_cells(label, fi, fj, n, bi, bj, ring_end, count, Y, s, X, gammas, perio
                     j = _wrap(j0 + dj, nx, periodic)
                     if j >= 0:                             # no branch on the label: 18-20 % faster
                         g = i * nx + j
-                        s[g] += v if label[g] == ring - 1 else 0.0
+                        w = v if label[g] == ring - 1 else 0.0
+                        s[g] += w
+                        total += w if ring == 1 else 0.0
+    return total
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
 def back_rows(label, count, Y, s, X, gammas, periodic, ny, nx, Fx):
     """s = E^T Y of one patch (flat arrays) by row sweeps: for each ring, outermost first, its
-    weighted values gamma s / count summed over the 3 x 3 neighbourhoods of the cells of ring - 1."""
-    for i in range(ny):                        # s = Y on F and the rings; the rings cleared from X
+    weighted values gamma s / count summed over the 3 x 3 neighbourhoods of the cells of ring - 1.
+    s is scratch off F and the rings: the sweeps write it everywhere (selects, no branches: 2x
+    faster). Returns Σ_F s."""
+    for i in range(ny):                        # s = Y; the rings cleared from X
         base, xb = i * nx, i * Fx
         for j in range(nx):
-            lg = label[base + j]
-            if lg >= 0:
-                s[base + j] = Y[xb + j]
-            if lg > 0:
-                X[xb + j] = 0.0
-    W = np.zeros((3, nx + 2))
+            s[base + j] = Y[xb + j]
+            X[xb + j] = 0.0 if label[base + j] > 0 else X[xb + j]
+    W = np.zeros((3, nx + 2))                  # rows r - 1, r, r + 1 in slots (row + 1) % 3
     cw = np.zeros(nx + 2)
+    total = 0.0
     for ring in range(gammas.shape[0], 0, -1):
         gam = gammas[ring - 1]
-        for r in range(-2, ny):
+        for r in range(-2, ny):                # row r + 1 loaded, then row r swept
             ii = _wrap(r + 1, ny, periodic)
-            slot = (r + 2) % 3
-            for j in range(nx):
-                g = ii * nx + j
-                W[slot, j + 1] = gam * s[g] / count[g] if ii >= 0 and label[g] == ring else 0.0
+            w = W[(r + 2) % 3]
+            if ii < 0:
+                w[:] = 0.0
+            else:
+                base = ii * nx
+                for j in range(nx):
+                    w[j + 1] = gam * s[base + j] / max(count[base + j], 1) if label[base + j] == ring else 0.0
             if r < 0:
                 continue
             _row_sums(W, cw, periodic, nx)
             base = r * nx
             for j in range(nx):
-                if label[base + j] == ring - 1:
-                    s[base + j] += cw[j] + cw[j + 1] + cw[j + 2]
+                on = label[base + j] == ring - 1
+                v = s[base + j] + (cw[j] + cw[j + 1] + cw[j + 2] if on else 0.0)
+                s[base + j] = v
+                total += v if on and ring == 1 else 0.0
+    return total
 
 
 @njit(cache=True, nogil=True)
