@@ -180,7 +180,7 @@ def extend_cells(label, fi, fj, n, bi, bj, ring_end, count, X, gammas, periodic,
 def extend_rows(label, X, count, gammas, periodic, ny, nx, Fx):
     """``extend`` of one patch (flat arrays) by row sweeps: for each ring, the 3 x 3 sums of the
     indicator of ring - 1 and of X on it, from the column sums of three rows (``_row_sums``)."""
-    A = np.zeros((3, nx + 2))                  # rows i - 1, i, i + 1 in slots (row + 1) % 3
+    A = np.zeros((3, nx + 2))                  # rows r - 1, r, r + 1 in slots (row + 1) % 3
     V = np.zeros((3, nx + 2))
     ca, cv = np.zeros(nx + 2), np.zeros(nx + 2)
     for ring in range(1, gammas.shape[0] + 1):
