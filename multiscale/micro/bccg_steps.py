@@ -121,6 +121,14 @@ def _wrap(i, n, periodic):
     return i + n if i < 0 else i - n
 
 
+@njit(cache=True, inline="always")
+def by_rows(n, ny, nx):
+    """Whether a free set of n cells of an (ny, nx) grid takes the row sweeps (``extend_rows``,
+    ``back_rows``: F covers ``DENSE_FROM`` of the grid or more) or the listed cells; ``extend`` and
+    ``back_extend`` must choose alike (the listed rings exist only after ``extend_cells``)."""
+    return n >= DENSE_FROM * ny * nx
+
+
 @njit(cache=True, nogil=True)
 def extend(label, fi, fj, nf, bi, bj, ring_end, count, X, gammas, periodic, active, ny, nx, Fx):
     """X = E r on the physical grid (X holds r on F from ``free_set``): ring by ring
@@ -132,7 +140,7 @@ def extend(label, fi, fj, nf, bi, bj, ring_end, count, X, gammas, periodic, acti
     for b in range(label.shape[0]):
         if not active[b]:
             continue
-        if nf[b] >= DENSE_FROM * ny * nx:
+        if by_rows(nf[b], ny, nx):
             extend_rows(label[b], X[b], count[b], gammas, periodic, ny, nx, Fx)
         else:
             extend_cells(label[b], fi[b], fj[b], nf[b], bi[b], bj[b], ring_end[b], count[b], X[b], gammas, periodic,
@@ -226,7 +234,7 @@ def back_extend(label, fi, fj, nf, bi, bj, ring_end, count, Y, s, gammas, period
         if not active[b]:
             continue
         n = nf[b]
-        if n >= DENSE_FROM * ny * nx:
+        if by_rows(n, ny, nx):
             total = back_rows(label[b], count[b], Y[b], s[b], X[b], gammas, periodic, ny, nx, Fx)
         else:
             total = back_cells(label[b], fi[b], fj[b], n, bi[b], bj[b], ring_end[b], count[b], Y[b], s[b], X[b],
