@@ -10,6 +10,8 @@ Surfaces the issue prescribes: self-affine, Hurst 0.8, cut-offs 4 and N/4 wavele
 patch, RMS slope 1, E* = 1, mean pressure 0.01 (A/A0 ~ 2 %), N = 256 ... 2048; then at N = 512
 an anisotropic one (cut-offs 4 x 16 and N/4 x N/16), H = 0.3, 30 % contact, and an isolated patch
 (zero-padded; tamaas has none: pk is the reference there); batches of 100 patches of 128².
+The scaling surfaces refine the grid and add roughness (cut-off N/4) at once; the refinement part
+separates the two: one surface resampled on finer grids, then finer roughness on one grid.
 
 Columns: iterations (tamaas counted from its log in an untimed run); "pairs/it": FFT pairs per
 iteration counted by the FFT wrapper (``multiscale.micro.fft.fft_pairs``: every transform of the
@@ -178,6 +180,39 @@ def stopping_rule(n, tols=(1e-6, 1e-8, 1e-10)):
         print(f"{tol:8.0e} {b:9.2e} {k:9.2e} {t:9.2e}", flush=True)
 
 
+def resampled(h, n):
+    """The band-limited periodic surface h (n0², no content at n0/2) on an n² grid: its spectrum
+    zero-padded (the same surface, sampled finer)."""
+    n0, given = h.shape[0], np.fft.rfft2(h)
+    spectrum = np.zeros((n, n // 2 + 1), complex)
+    spectrum[:n0 // 2, :n0 // 2 + 1] = given[:n0 // 2]
+    spectrum[-(n0 // 2):, :n0 // 2 + 1] = given[-(n0 // 2):]
+    return np.fft.irfft2(spectrum, s=(n, n)) * (n / n0) ** 2
+
+
+def refinement(sizes, k_max=64):
+    """Iterations (tol 1e-8) of bccg and pk as the grid is refined under one surface (cut-offs 4 and
+    ``k_max``, drawn at the smallest size and resampled), then at the largest size as the surface's
+    upper cut-off grows to N/4 (the scaling rows' surfaces refine the grid and add roughness at once)."""
+    def its(h):
+        solver = ContactSolver(E, h.shape, 1.0 / h.shape[0])
+        b, k = (solver.solve(h, load=LOAD, tol=TOL, method=m, max_iter=100000) for m in ("bccg", "pk"))
+        return f"{int(b.iterations):5d} {int(k.iterations):5d} {float(b.area_fraction):7.4f}"
+
+    print(f"\niterations under refinement: one surface with cut-offs 4 and {k_max}, resampled")
+    print(f"{'N':>5} {'bccg':>5} {'pk':>5} {'A/A0':>7}")
+    h0, _ = surface(sizes[0], k_max=k_max)
+    for n in sizes:
+        print(f"{n:5d} {its(resampled(h0, n))}", flush=True)
+    n = sizes[-1]
+    print(f"\niterations at N = {n} as the upper cut-off grows (a new surface each)")
+    print(f"{'k_max':>5} {'bccg':>5} {'pk':>5} {'A/A0':>7}")
+    k = k_max
+    while k <= n // 4:
+        print(f"{k:5d} {its(surface(n, k_max=k)[0])}", flush=True)
+        k *= 2
+
+
 def batch(n_patches, n, reps, threads):
     """One call with the batch against a loop over its patches, the same solver, both methods; with
     several threads also against the loop on one thread (a 128² patch gains nothing from FFT threads)."""
@@ -218,7 +253,7 @@ def main():
     ap.add_argument("--quick", action="store_true", help="N = 256, 512, one repeat, smaller batches")
     ap.add_argument("--sizes", default="", help="grid sizes of the scaling rows (default 256,512,1024,2048)")
     ap.add_argument("--skip-tamaas-above", type=int, default=1 << 30, help="no tamaas above this N")
-    ap.add_argument("--only", default="scaling,surfaces,stopping,batch", help="parts to run")
+    ap.add_argument("--only", default="scaling,surfaces,refinement,stopping,batch", help="parts to run")
     args = ap.parse_args()
     import tamaas as tm
     tm.set_log_level(tm.LogLevel.error)
@@ -247,6 +282,8 @@ def main():
         rows += compare(f"{n}² isolated", h, dx, LOAD, reps, with_tamaas=False, periodic=False)
         print()
         print_rows(rows)
+    if "refinement" in parts:
+        refinement(sizes)
     if "stopping" in parts:
         stopping_rule(256 if args.quick else 512)
     if "batch" in parts:
