@@ -3,7 +3,7 @@ import numpy as np
 import pytest
 
 from multiscale.errors import InputError
-from multiscale.micro.surface import Surface, find_asperities, fractal_surface, load_surface, statistics
+from multiscale.micro.surface import Surface, find_asperities, fractal_surface, load_surface, refine, statistics
 
 
 def test_same_seed_same_surface_and_rms():
@@ -113,3 +113,39 @@ def test_bad_surface_input(tmp_path):
         fractal_surface(64, 1e-3, 0.8, 2, 40, 1e-6)
     with pytest.raises(InputError, match="rms"):
         fractal_surface(64, 1e-3, 0.8, 2, 10, 0.0)
+
+
+def sines(nx, ny, size=(1.0, 0.75)):
+    """A band-limited field with content at the Nyquist wavenumbers of a 16 x 12 grid, sampled at
+    the cell centres of an nx x ny grid."""
+    x = (np.arange(nx) + 0.5) * size[0] / nx
+    y = (np.arange(ny) + 0.5) * size[1] / ny
+    X, Y = np.meshgrid(2 * np.pi * x / size[0], 2 * np.pi * y / size[1])
+    return 0.3 + np.sin(8 * X) + np.sin(6 * Y) + np.sin(8 * X) * np.sin(6 * Y) + np.cos(3 * X + 5 * Y)
+
+
+@pytest.mark.parametrize("n", [(40, 30), (16, 30), (40, 12), (33, 17), (16, 12)])
+def test_refine_is_the_trigonometric_interpolant(n):
+    """A sum of sines up to the Nyquist wavenumbers of a 16 x 12 grid, refined to n (odd, even, one
+    direction, none): the same sines at the new cell centres, to round-off."""
+    coarse = Surface(sines(16, 12), 1.0 / 16, 0.75 / 12)
+    fine = refine(coarse, n)
+    assert fine.dx == pytest.approx(1.0 / n[0], rel=1e-14) and fine.dy == pytest.approx(0.75 / n[1], rel=1e-14)
+    assert np.abs(fine.heights - sines(*n)).max() < 1e-12
+
+
+def test_refine_keeps_the_samples_and_batches():
+    """Refined 3x, every third new cell centre is an old one: the samples are kept (a batch of two
+    anisotropic patches)."""
+    s = fractal_surface((64, 48), (1.0, 0.75), 0.8, 2, 24, 1.0, seed=3, batch=(2,))
+    fine = refine(s, (192, 144))
+    assert fine.heights.shape == (2, 144, 192)
+    assert np.abs(fine.heights[..., 1::3, 1::3] - s.heights).max() < 1e-12
+
+
+def test_refine_rejects_measured_and_coarser_grids():
+    s = fractal_surface(32, 1.0, 0.8, 2, 8, 1.0)
+    with pytest.raises(InputError, match="resample"):
+        refine(Surface(s.heights, s.dx, s.dy, periodic=False), 64)
+    with pytest.raises(InputError, match="at least"):
+        refine(s, (64, 16))
