@@ -11,7 +11,7 @@ patch, RMS slope 1, E* = 1, mean pressure 0.01 (A/A0 ~ 2 %), N = 256 ... 2048; t
 an anisotropic one (cut-offs 4 x 16 and N/4 x N/16), H = 0.3, 30 % contact, and an isolated patch
 (zero-padded; tamaas has none: pk is the reference there); batches of 100 patches of 128².
 The scaling surfaces refine the grid and add roughness (cut-off N/4) at once; the refinement part
-separates the two: one surface resampled on finer grids, then finer roughness on one grid.
+separates the two: one surface refined onto finer grids, then finer roughness on one grid.
 
 Columns: iterations (tamaas counted from its log in an untimed run); "pairs/it": FFT pairs per
 iteration counted by the FFT wrapper (``multiscale.micro.fft.fft_pairs``: every transform of the
@@ -42,7 +42,7 @@ import numpy as np  # noqa: E402
 from multiscale.micro import fft  # noqa: E402
 from multiscale.micro.contact import ContactSolver  # noqa: E402
 from multiscale.micro.kernels import HalfSpace  # noqa: E402
-from multiscale.micro.surface import fractal_surface, statistics  # noqa: E402
+from multiscale.micro.surface import Surface, fractal_surface, refine, statistics  # noqa: E402
 
 TOL = 1e-8
 E = HalfSpace(1.0)                    # E* = 1: tamaas' model.E = 1, nu = 0
@@ -180,30 +180,20 @@ def stopping_rule(n, tols=(1e-6, 1e-8, 1e-10)):
         print(f"{tol:8.0e} {b:9.2e} {k:9.2e} {t:9.2e}", flush=True)
 
 
-def resampled(h, n):
-    """The band-limited periodic surface h (n0², no content at n0/2) on an n² grid: its spectrum
-    zero-padded (the same surface, sampled finer)."""
-    n0, given = h.shape[0], np.fft.rfft2(h)
-    spectrum = np.zeros((n, n // 2 + 1), complex)
-    spectrum[:n0 // 2, :n0 // 2 + 1] = given[:n0 // 2]
-    spectrum[-(n0 // 2):, :n0 // 2 + 1] = given[-(n0 // 2):]
-    return np.fft.irfft2(spectrum, s=(n, n)) * (n / n0) ** 2
-
-
 def refinement(sizes, k_max=64):
     """Iterations (tol 1e-8) of bccg and pk as the grid is refined under one surface (cut-offs 4 and
-    ``k_max``, drawn at the smallest size and resampled), then at the largest size as the surface's
+    ``k_max``, drawn at the smallest size, ``surface.refine``), then at the largest size as the surface's
     upper cut-off grows to N/4 (the scaling rows' surfaces refine the grid and add roughness at once)."""
     def its(h):
         solver = ContactSolver(E, h.shape, 1.0 / h.shape[0])
         b, k = (solver.solve(h, load=LOAD, tol=TOL, method=m, max_iter=100000) for m in ("bccg", "pk"))
         return f"{int(b.iterations):5d} {int(k.iterations):5d} {float(b.area_fraction):7.4f}"
 
-    print(f"\niterations under refinement: one surface with cut-offs 4 and {k_max}, resampled")
+    print(f"\niterations under refinement: one surface with cut-offs 4 and {k_max}, refined")
     print(f"{'N':>5} {'bccg':>5} {'pk':>5} {'A/A0':>7}")
-    h0, _ = surface(sizes[0], k_max=k_max)
+    h0, dx0 = surface(sizes[0], k_max=k_max)
     for n in sizes:
-        print(f"{n:5d} {its(resampled(h0, n))}", flush=True)
+        print(f"{n:5d} {its(refine(Surface(h0, dx0, dx0), n).heights)}", flush=True)
     n = sizes[-1]
     print(f"\niterations at N = {n} as the upper cut-off grows (a new surface each)")
     print(f"{'k_max':>5} {'bccg':>5} {'pk':>5} {'A/A0':>7}")

@@ -16,7 +16,8 @@ The details here:
   next to narrow gaps and of their edges: the exact inverse (L_FF)⁻¹ is the Schur complement
   E*ᵀ M E* with E* the displacement of the gap cells, which E imitates. On the self-affine
   benchmark surfaces at N = 1024 the condition number on the final contact set drops from 8.1
-  to 4.1 (it grows like log² N either way, as for operator preconditioning on screens). Any E
+  to 4.1 (either way it grows with the roughness the grid resolves: more, smaller, more ragged
+  spots; one surface on finer grids keeps its iterations, benchmarks/README). Any E
   keeps Eᵀ M E symmetric positive definite, so the discrete answer is that of Polonsky–Keer;
 - Polak–Ribière(+) factors (conjugacy survives small changes of F), restart when t is not a
   descent direction;
