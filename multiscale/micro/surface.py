@@ -99,8 +99,8 @@ def fractal_surface(n, size, hurst: float, k_min, k_max, rms: float, seed: int =
 
 def refine(surface: Surface, n) -> Surface:
     """The periodic ``surface`` on a finer grid of n (or (nx, ny)) >= its own points per side, the
-    same size: its trigonometric interpolant (the Fourier series of its samples, a content at the
-    Nyquist wavenumber split evenly between +-k) sampled at the new cell centres. Exact for a
+    same size: its trigonometric interpolant (the Fourier series of its samples, a Nyquist term
+    split evenly between +k and -k) sampled at the new cell centres. Exact for a
     band-limited surface such as ``fractal_surface``'s: the same surface sampled finer, e.g. for a
     grid-convergence study of a contact patch. Measured (non-periodic) surfaces: see
     ``topography.resample``."""
