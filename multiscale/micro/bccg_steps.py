@@ -195,11 +195,16 @@ def extend_rows(label, X, count, gammas, periodic, ny, nx, Fx):
         gam = gammas[ring - 1]
         for r in range(-2, ny):                # row r + 1 loaded, then row r swept
             ii = _wrap(r + 1, ny, periodic)
-            slot = (r + 2) % 3
-            for j in range(nx):                # the indicator of ring - 1 and X on it, row r + 1
-                on = ii >= 0 and label[ii * nx + j] == ring - 1
-                A[slot, j + 1] = 1.0 if on else 0.0
-                V[slot, j + 1] = X[ii * Fx + j] if on else 0.0
+            a, v = A[(r + 2) % 3], V[(r + 2) % 3]
+            if ii < 0:                         # beyond the edge of an isolated patch
+                a[:] = 0.0
+                v[:] = 0.0
+            else:                              # the indicator of ring - 1 and X on it, row r + 1
+                base, xb = ii * nx, ii * Fx
+                for j in range(nx):
+                    on = label[base + j] == ring - 1
+                    a[j + 1] = 1.0 if on else 0.0
+                    v[j + 1] = X[xb + j] if on else 0.0
             if r < 0:
                 continue
             _row_sums(A, ca, periodic, nx)
