@@ -17,8 +17,11 @@ The details here:
   E*ᵀ M E* with E* the displacement of the gap cells, which E imitates. On the self-affine
   benchmark surfaces at N = 1024 the condition number on the final contact set drops from 8.1
   to 4.1 (either way it grows with the roughness the grid resolves: more, smaller, more ragged
-  spots; one surface on finer grids keeps its iterations, benchmarks/README). Any E
-  keeps Eᵀ M E symmetric positive definite, so the discrete answer is that of Polonsky–Keer;
+  spots; one surface on finer grids keeps its iterations, benchmarks/README). The growth sits in
+  coarse modes, nearly constant over aggregates of F of 64–128 cells: a two-level (balancing)
+  coarse correction on 16 x 16 aggregates removed it in a scratch study, not built for its cost
+  (benchmarks/README). Any E keeps Eᵀ M E symmetric positive definite, so the discrete answer
+  is that of Polonsky–Keer;
 - Polak–Ribière(+) factors (conjugacy survives small changes of F), restart when t is not a
   descent direction;
 - two FFT pairs per iteration: Y = M E r, and L t, whose inverse transform is also the update of
