@@ -43,12 +43,13 @@ from __future__ import annotations
 
 import numpy as np
 
-from multiscale.micro import bccg_steps
+from multiscale.micro import bccg_coarse, bccg_steps
 from multiscale.micro.kernels import ConvolutionWorkspace, InfluenceOperator, multiply
 
 GAMMAS = np.array([0.6, 0.3])   # extension factors of the rings 1, 2 around the free set
 REFRESH = 50                           # iterations between exact recomputations of u = L p
 SINGLE_FROM = 512 * 512                # FFT grids of this many cells and more: preconditioner in float32
+COARSE_FROM = 1024 * 1024              # grids of this many cells and more: two-level preconditioner (bccg_coarse)
 
 
 class Scratch:
@@ -56,7 +57,7 @@ class Scratch:
     per-cell ones flattened to (B, ny * nx), see ``bccg_steps``. ``ws`` applies L, ``pre`` the
     preconditioner M (in single precision on large grids, ``SINGLE_FROM``)."""
 
-    def __init__(self, operator: InfluenceOperator, B: int, threads: int | None = None):
+    def __init__(self, operator: InfluenceOperator, B: int, threads: int | None = None, coarse: bool = False):
         ny, nx = operator.shape
         N = ny * nx
         single = operator.fft_shape[0] * operator.fft_shape[1] >= SINGLE_FROM
@@ -72,6 +73,10 @@ class Scratch:
         self.fi, self.fj, self.bi, self.bj = (np.zeros((B, N), dtype=np.int32) for _ in range(4))
         self.ring_end = np.zeros((B, len(GAMMAS)), dtype=np.int64)
         self.r, self.s, self.s_old, self.t = (np.zeros((B, N)) for _ in range(4))
+        self.coarse = None
+        if coarse and N >= COARSE_FROM and bccg_coarse.CoarseGrid.fits(operator):
+            grid = bccg_coarse.CoarseGrid(operator)
+            self.coarse = [bccg_coarse.CoarseCorrection(grid) for _ in range(B)]
 
     def clear(self) -> None:
         """Zero every buffer (after a failed solve)."""
@@ -80,6 +85,8 @@ class Scratch:
         for a in (self.r, self.s, self.s_old, self.t):
             a[...] = 0.0
         self.label[...] = -1
+        for c in self.coarse or ():
+            c.reset()
 
 
 def exact_displacement(operator: InfluenceOperator, ws: ConvolutionWorkspace, p: np.ndarray, u: np.ndarray,
@@ -103,11 +110,20 @@ def preconditioned_residual(operator: InfluenceOperator, work: Scratch, z2, p2, 
     Fx = operator.fft_shape[1]
     bccg_steps.free_set(u2, z2, p2, delta, load_control, which, ccount, csum, d, work.label, work.fi, work.fj, nf,
                         work.r, work.s_old, work.t, work.XP, work.X, upper, fixed, nx, Fx)
+    coarse = [] if work.coarse is None else [(b, work.coarse[b]) for b in np.flatnonzero(which)]
+    for b, c in coarse:
+        c.prepare(work.fi[b], work.fj[b], nf[b])
+        if c.active:
+            c.balance(work.fi[b], work.fj[b], nf[b], work.r[b], work.XP[b], Fx)
     bccg_steps.extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, work.XP, GAMMAS,
                       operator.periodic, which, ny, nx, Fx)
     work.pre.apply(work.mmul)
     bccg_steps.back_extend(work.label, work.fi, work.fj, nf, work.bi, work.bj, work.ring_end, work.count, work.YP,
                            work.s, GAMMAS, operator.periodic, work.XP, load_control, which, pnorm, eps, ny, nx, Fx)
+    for b, c in coarse:
+        if c.active:
+            ss = c.complete(work.fi[b], work.fj[b], nf[b], work.s[b], load_control)
+            eps[b] = np.sqrt(ss / pnorm[b]) if pnorm[b] > 0.0 else (0.0 if ss == 0.0 else np.inf)
 
 
 def estimate(operator: InfluenceOperator, work: Scratch, z, p, u, target, delta, which) -> tuple:
@@ -153,6 +169,8 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
     conj, clipped, lost = (np.zeros(B, dtype=bool) for _ in range(3))
     iterations = np.zeros(B, dtype=int)
     work.label[...] = -1                     # no free set and no history yet
+    for c in work.coarse or ():
+        c.reset()
     work.XP[...] = 0.0
     work.s_old[...] = 0.0
     work.t[...] = 0.0

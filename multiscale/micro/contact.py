@@ -279,7 +279,7 @@ class ContactSolver:
 
     def _new_scratch(self, method, chunk, threads):
         if method == "bccg":
-            return bccg_solver.Scratch(self.operator, chunk, threads)
+            return bccg_solver.Scratch(self.operator, chunk, threads, coarse=True)
         return self.operator.workspace((chunk,), threads), bccg_solver.Scratch(self.operator, chunk, threads)
 
     def _initial_pressure(self, method, z, target, delta, p0, max_iter, upper, threads):
