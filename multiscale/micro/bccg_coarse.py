@@ -33,6 +33,8 @@ CELLS = 32             # coarse grid cells per side (fewer on grids of fewer tha
 SUB = 8                # sub-blocks of SUB x SUB cells: exact influence between neighbouring ones
 SPARSE_TO = 0.10       # free sets of more than this fraction of the grid: no coarse correction (one-level)
 REBUILD = 0.005        # rebuild the coarse operator when F changed by more than this fraction of its cells
+FORWARD_Y = np.array([0, 0, 1, 1, 1])  # the sub-block itself and 4 of its 8 neighbours: each pair once
+FORWARD_X = np.array([0, 1, -1, 0, 1])
 FAST = {"reassoc", "contract", "nsz"}  # reductions may be reordered (vectorised); no NaN/inf tricks
 
 
@@ -78,8 +80,8 @@ def near_coefficients(fi, fj, n, S, sy, sx, agg_y, agg_x, cy, cx, table, hy, hx,
     s = 3 (dy + 1) + dx + 1 around its own, under A: exact coefficients (``table``, offsets -hy..hy,
     -hx..hx) from the cells of the 3 x 3 sub-blocks (S x S cells) around its own, the coefficient of
     the sub-block centres times the cell count from the farther sub-blocks of those coarse cells.
-    Wrapped across the edges of a periodic grid, none beyond an isolated one. Returns C and the
-    sub-block of each cell."""
+    Wrapped across the edges of a periodic grid, none beyond an isolated one; the kernel is even
+    (each pair of cells is visited once)."""
     nsub = sy * sx
     sub = np.empty(n, dtype=np.int64)
     start = np.zeros(nsub + 1, dtype=np.int64)
@@ -95,23 +97,29 @@ def near_coefficients(fi, fj, n, S, sy, sx, agg_y, agg_x, cy, cx, table, hy, hx,
         order[fill[sub[m]]] = m
         fill[sub[m]] += 1
     C = np.zeros((n, 9))
-    for m in range(n):                                 # exact: the 3 x 3 sub-blocks around
-        py, px = fi[m] // S, fj[m] // S
-        i0, j0 = fi[m] + hy, fj[m] + hx
-        for dy in range(-1, 2):
-            qy, wy, ay = _neighbour(py, dy, sy, agg_y, cy, periodic)
-            if qy < 0:
+    for py in range(sy):                               # exact: each pair of neighbouring sub-blocks once
+        for px in range(sx):
+            k = py * sx + px
+            if start[k] == start[k + 1]:
                 continue
-            for dx in range(-1, 2):
-                qx, wx, ax = _neighbour(px, dx, sx, agg_x, cx, periodic)
-                if qx < 0:
+            for e in range(5):
+                qy, wy, ay = _neighbour(py, FORWARD_Y[e], sy, agg_y, cy, periodic)
+                qx, wx, ax = _neighbour(px, FORWARD_X[e], sx, agg_x, cx, periodic)
+                if qy < 0 or qx < 0:
                     continue
-                k = qy * sx + qx
-                acc = 0.0
-                for q in range(start[k], start[k + 1]):
-                    o = order[q]
-                    acc += table[i0 - fi[o] + wy * ny, j0 - fj[o] + wx * nx]
-                C[m, ay * 3 + ax] += acc
+                q = qy * sx + qx
+                s = ay * 3 + ax                        # slot of q around k; of k around q: 8 - s
+                for a in range(start[k], start[k + 1]):
+                    m = order[a]
+                    i0, j0 = fi[m] + hy + wy * ny, fj[m] + hx + wx * nx
+                    acc = 0.0
+                    for b in range(a if q == k else start[q], start[q + 1]):
+                        o = order[b]
+                        v = table[i0 - fi[o], j0 - fj[o]]     # the kernel is even
+                        acc += v
+                        if o != m:
+                            C[o, 8 - s] += v
+                    C[m, s] += acc
     M = np.zeros((nsub, 9))                            # monopoles of the farther sub-blocks
     reach_y, reach_x = 2 * (sy // cy + 1), 2 * (sx // cx + 1)
     for py in range(sy):

@@ -18,10 +18,10 @@ The details here:
   benchmark surfaces at N = 1024 the condition number on the final contact set drops from 8.1
   to 4.1 (either way it grows with the roughness the grid resolves: more, smaller, more ragged
   spots; one surface on finer grids keeps its iterations, benchmarks/README). The growth sits in
-  coarse modes, nearly constant over aggregates of F of 64–128 cells: a two-level (balancing)
-  coarse correction on 16 x 16 aggregates removed it in a scratch study, not built for its cost
-  (benchmarks/README). Any E keeps Eᵀ M E symmetric positive definite, so the discrete answer
-  is that of Polonsky–Keer;
+  coarse modes, nearly constant over aggregates of F: on grids of ``COARSE_FROM`` cells and more
+  a balancing two-level coarse correction takes them out (``bccg_coarse``; one-level on free sets
+  of more than a tenth of the grid). Any E keeps Eᵀ M E symmetric positive definite, and so is
+  the two-level preconditioner, so the discrete answer is that of Polonsky–Keer;
 - Polak–Ribière(+) factors (conjugacy survives small changes of F), restart when t is not a
   descent direction;
 - two FFT pairs per iteration: Y = M E r, and L t, whose inverse transform is also the update of
@@ -35,8 +35,8 @@ The details here:
   tol 1e-8 and 1e-12: the same iterations, pressures within 2.5e-14 of those of a double one.
 
 The start is nested (``ContactSolver.coarse_start``). Stopping criterion: eps = ||s|| / ||p|| <=
-tol, with s = Eᵀ M E r the preconditioned residual over F, i.e. the pressure correction that M
-predicts: an estimate of the relative L2 error of the pressure (it was 0.3-0.7 times the true
+tol, with s = Eᵀ M E r (two-level: ``bccg_coarse``'s P r) the preconditioned residual over F, i.e.
+the pressure correction that the preconditioner predicts: an estimate of the relative L2 error of the pressure (it was 0.3-0.7 times the true
 error on the benchmark surfaces), free of units (a flat punch stops where a rough patch does).
 """
 from __future__ import annotations
@@ -55,7 +55,9 @@ COARSE_FROM = 1024 * 1024              # grids of this many cells and more: two-
 class Scratch:
     """Buffers of one chunk of B patches (reused between solves of the same chunk size); the
     per-cell ones flattened to (B, ny * nx), see ``bccg_steps``. ``ws`` applies L, ``pre`` the
-    preconditioner M (in single precision on large grids, ``SINGLE_FROM``)."""
+    preconditioner M (in single precision on large grids, ``SINGLE_FROM``); ``coarse``: the
+    two-level correction of each patch (when asked for and the grid has ``COARSE_FROM`` cells or
+    more, else None)."""
 
     def __init__(self, operator: InfluenceOperator, B: int, threads: int | None = None, coarse: bool = False):
         ny, nx = operator.shape
@@ -105,7 +107,9 @@ def preconditioned_residual(operator: InfluenceOperator, work: Scratch, z2, p2, 
                             ccount, csum, d, nf, upper, fixed, pnorm, eps) -> None:
     """The free set, the residual r on it and s = Eᵀ M E r with eps = ||s|| / ||p|| (``work.r``,
     ``work.s``, ``eps``) of the patches ``which`` (flat (B, ny * nx) states, ``contact_sums``
-    done): ``bccg_steps.free_set``, ``extend``, the preconditioner's FFT pair, ``back_extend``."""
+    done): ``bccg_steps.free_set``, ``extend``, the preconditioner's FFT pair, ``back_extend``;
+    with a coarse correction, r - K y1 is extended instead of r and s completed after
+    (``bccg_coarse.CoarseCorrection``: s = P r of the two-level preconditioner)."""
     ny, nx = operator.shape
     Fx = operator.fft_shape[1]
     bccg_steps.free_set(u2, z2, p2, delta, load_control, which, ccount, csum, d, work.label, work.fi, work.fj, nf,
