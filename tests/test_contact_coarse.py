@@ -59,8 +59,7 @@ def test_near_coefficients_are_those_of_the_approximate_stiffness(periodic):
     operator = InfluenceOperator(E, shape, 1e-6, periodic=periodic)
     grid = bccg_coarse.CoarseGrid(operator)
     fi, fj = random_free_set(shape, 0.06, 1)
-    C = bccg_coarse.near_coefficients(fi, fj, fi.size, grid.S, grid.sy, grid.sx, grid.agg_y, grid.agg_x, grid.cy,
-                                      grid.cx, grid.table, grid.hy, grid.hx, grid.periodic, *shape)
+    C = grid.near_coefficients(fi, fj, fi.size)
     kernel = np.fft.irfft2(operator.spectrum, s=operator.fft_shape)
     A, cell = approximate_stiffness(grid, fi, fj, kernel)
     reference = np.zeros_like(C)

@@ -75,7 +75,7 @@ def _neighbour(p, d, n, agg, cn, periodic):
 
 
 @njit(cache=True, nogil=True)
-def near_coefficients(fi, fj, n, S, sy, sx, agg_y, agg_x, cy, cx, table, hy, hx, periodic, ny, nx):
+def near_coefficients(fi, fj, n, S, sy, sx, agg_y, agg_x, cy, cx, slots, table, hy, hx, periodic, ny, nx):
     """C[m, s]: the influence on cell m of F of the cells of F in coarse cell slot
     s = 3 (dy + 1) + dx + 1 around its own, under A: exact coefficients (``table``, offsets -hy..hy,
     -hx..hx) from the cells of the 3 x 3 sub-blocks (S x S cells) around its own, the coefficient of
@@ -96,7 +96,8 @@ def near_coefficients(fi, fj, n, S, sy, sx, agg_y, agg_x, cy, cx, table, hy, hx,
     for m in range(n):
         order[fill[sub[m]]] = m
         fill[sub[m]] += 1
-    C = np.zeros((n, 9))
+    si, sj = fi[order], fj[order]                      # the cells sorted by sub-block
+    T = np.zeros((9, n))                               # T[s, a]: C of the a-th sorted cell
     for py in range(sy):                               # exact: each pair of neighbouring sub-blocks once
         for px in range(sx):
             k = py * sx + px
@@ -110,40 +111,64 @@ def near_coefficients(fi, fj, n, S, sy, sx, agg_y, agg_x, cy, cx, table, hy, hx,
                 q = qy * sx + qx
                 s = ay * 3 + ax                        # slot of q around k; of k around q: 8 - s
                 for a in range(start[k], start[k + 1]):
-                    m = order[a]
-                    i0, j0 = fi[m] + hy + wy * ny, fj[m] + hx + wx * nx
+                    i0, j0 = si[a] + hy + wy * ny, sj[a] + hx + wx * nx
                     acc = 0.0
-                    for b in range(a if q == k else start[q], start[q + 1]):
-                        o = order[b]
-                        v = table[i0 - fi[o], j0 - fj[o]]     # the kernel is even
+                    if q == k:
+                        acc = table[hy, hx]
+                    for b in range(a + 1 if q == k else start[q], start[q + 1]):
+                        v = table[i0 - si[b], j0 - sj[b]]     # the kernel is even
                         acc += v
-                        if o != m:
-                            C[o, 8 - s] += v
-                    C[m, s] += acc
-    M = np.zeros((nsub, 9))                            # monopoles of the farther sub-blocks
-    reach_y, reach_x = 2 * (sy // cy + 1), 2 * (sx // cx + 1)
-    for py in range(sy):
-        for px in range(sx):
-            k = py * sx + px
-            if start[k] == start[k + 1]:
-                continue
-            for dy in range(-reach_y, reach_y + 1):
-                qy, _, ay = _neighbour(py, dy, sy, agg_y, cy, periodic)
-                if qy < 0:
-                    continue
-                for dx in range(-reach_x, reach_x + 1):
-                    qx, _, ax = _neighbour(px, dx, sx, agg_x, cx, periodic)
-                    if qx < 0 or (abs(dy) <= 1 and abs(dx) <= 1):
-                        continue
-                    q = qy * sx + qx
-                    c = start[q + 1] - start[q]
-                    if c:
-                        M[k, ay * 3 + ax] += c * table[hy - dy * S, hx - dx * S]
-    for m in range(n):
-        k = sub[m]
+                        T[8 - s, b] += v
+                    T[s, a] += acc
+    M = monopoles(start, S, sy, sx, agg_y, agg_x, cx, slots, table, hy, hx, periodic)
+    C = np.empty((n, 9))
+    for a in range(n):
+        m = order[a]
         for s in range(9):
-            C[m, s] += M[k, s]
+            C[m, s] = T[s, a] + M[sub[m], s]
     return C
+
+
+@njit(cache=True, nogil=True)
+def monopoles(start, S, sy, sx, agg_y, agg_x, cx, slots, table, hy, hx, periodic):
+    """M[k, s]: the influence on a cell of sub-block k of the cells of F in the sub-blocks q of
+    coarse slot s around k's coarse cell that are not next to k, each taken at q's centre
+    (``start``: cumulative cell counts of the sub-blocks; ``slots``: the coarse cells around each,
+    -1 beyond an isolated grid). Only the non-empty sub-blocks are visited, listed by coarse cell."""
+    nsub, ncoarse = sy * sx, slots.shape[0]
+    first = np.zeros(ncoarse + 1, dtype=np.int64)      # the non-empty sub-blocks by coarse cell
+    for k in range(nsub):
+        if start[k + 1] > start[k]:
+            first[agg_y[k // sx] * cx + agg_x[k % sx] + 1] += 1
+    for c in range(ncoarse):
+        first[c + 1] += first[c]
+    fill = first[:-1].copy()
+    listed = np.empty(first[-1], dtype=np.int64)
+    for k in range(nsub):
+        if start[k + 1] > start[k]:
+            c = agg_y[k // sx] * cx + agg_x[k % sx]
+            listed[fill[c]] = k
+            fill[c] += 1
+    M = np.zeros((nsub, 9))
+    for a in range(first[-1]):
+        k = listed[a]
+        py, px = k // sx, k % sx
+        around = slots[agg_y[py] * cx + agg_x[px]]
+        for e in range(9):
+            c = around[e]
+            if c < 0:
+                continue
+            acc = 0.0
+            for b in range(first[c], first[c + 1]):
+                q = listed[b]
+                dy, dx = q // sx - py, q % sx - px
+                if periodic:                            # the image in the neighbouring coarse cell
+                    dy = (dy + sy // 2) % sy - sy // 2
+                    dx = (dx + sx // 2) % sx - sx // 2
+                if abs(dy) > 1 or abs(dx) > 1:
+                    acc += (start[q + 1] - start[q]) * table[hy - dy * S, hx - dx * S]
+            M[k, e] = acc
+    return M
 
 
 @njit(cache=True, nogil=True)
@@ -280,6 +305,11 @@ class CoarseGrid:
             slots[inside, s] = (by * self.cx + bx)[inside]
         self.slots = slots
 
+    def near_coefficients(self, fi, fj, n):
+        """``near_coefficients`` of the free set F = (fi, fj)[:n] on this grid: (n, 9)."""
+        return near_coefficients(fi, fj, n, self.S, self.sy, self.sx, self.agg_y, self.agg_x, self.cy, self.cx,
+                                 self.slots, self.table, self.hy, self.hx, self.periodic, *self.shape)
+
     @staticmethod
     def fits(operator) -> bool:
         """Whether the grid has at least 8 coarse cells per side (each of 2 x 2 sub-blocks or more)."""
@@ -326,8 +356,7 @@ class CoarseCorrection:
             self.built, self.active = 0, False
             return
         cell, start = coarse_cells(fi, fj, n, g.row_of, g.col_of, g.cx, g.cy * g.cx)
-        C = near_coefficients(fi, fj, n, g.S, g.sy, g.sx, g.agg_y, g.agg_x, g.cy, g.cx, g.table, g.hy, g.hx, g.periodic,
-                              ny, nx)
+        C = g.near_coefficients(fi, fj, n)
         counts = np.diff(start)
         ids = np.flatnonzero(counts)
         aggregate = np.full(g.cy * g.cx, -1, dtype=np.int32)
