@@ -11,7 +11,8 @@ patch, RMS slope 1, E* = 1, mean pressure 0.01 (A/A0 ~ 2 %), N = 256 ... 2048; t
 an anisotropic one (cut-offs 4 x 16 and N/4 x N/16), H = 0.3, 30 % contact, and an isolated patch
 (zero-padded; tamaas has none: pk is the reference there); batches of 100 patches of 128².
 The scaling surfaces refine the grid and add roughness (cut-off N/4) at once; the refinement part
-separates the two: one surface refined onto finer grids, then finer roughness on one grid.
+separates the two: one surface refined onto finer grids, then finer roughness on one grid. The
+levels part sets the two-level preconditioner of large grids against the one-level one.
 
 Columns: iterations (tamaas counted from its log in an untimed run); "pairs/it": FFT pairs per
 iteration counted by the FFT wrapper (``multiscale.micro.fft.fft_pairs``: every transform of the
@@ -39,7 +40,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("MULTISCALE_THREADS", "1")
 import numpy as np  # noqa: E402
 
-from multiscale.micro import fft  # noqa: E402
+from multiscale.micro import bccg_solver, fft  # noqa: E402
 from multiscale.micro.contact import ContactSolver  # noqa: E402
 from multiscale.micro.kernels import HalfSpace  # noqa: E402
 from multiscale.micro.surface import Surface, fractal_surface, refine, statistics  # noqa: E402
@@ -203,6 +204,36 @@ def refinement(sizes, k_max=64):
         k *= 2
 
 
+def levels(sizes, reps):
+    """The two-level preconditioner (``bccg_coarse``, the default from ``bccg_solver.COARSE_FROM``
+    cells) against the one-level one, side by side: two solvers on each surface, one built with
+    the coarse correction switched off, their solves alternated; two realisations per N, and an
+    isolated patch of the smallest N."""
+    default = bccg_solver.COARSE_FROM
+    cases = [(n, seed, True) for n in sizes for seed in (1, 2)] + [(sizes[0], 1, False)]
+    print("\ntwo-level against one-level preconditioner (bccg, tol 1e-8): medians; ratio = median of two / one")
+    print(f"{'case':>24} {'one [s]':>8} {'its':>4} {'two [s]':>8} {'its':>4} {'ratio':>6} {'rel diff':>9}")
+    for n, seed, periodic in cases:
+        h, dx = surface(n, seed=seed)
+        solvers = {}
+        for name, threshold in (("one", 1 << 62), ("two", default)):
+            bccg_solver.COARSE_FROM = threshold           # read when the solver makes its buffers
+            solvers[name] = ContactSolver(E, h.shape, dx, periodic=periodic)
+            solvers[name].solve(h, load=LOAD, tol=1e-4)
+        bccg_solver.COARSE_FROM = default
+        times, out = {"one": [], "two": []}, {}
+        for _ in range(reps.get(n, 2)):
+            for name, solver in solvers.items():
+                t0 = time.perf_counter()
+                out[name] = solver.solve(h, load=LOAD, tol=TOL)
+                times[name].append(time.perf_counter() - t0)
+        ratio = stats.median([b / a for a, b in zip(times["one"], times["two"])])
+        case = f"{n}² seed {seed}" + ("" if periodic else " isolated")
+        print(f"{case:>24} {stats.median(times['one']):8.3f} {int(out['one'].iterations):4d} "
+              f"{stats.median(times['two']):8.3f} {int(out['two'].iterations):4d} {ratio:6.3f} "
+              f"{rel(out['two'].pressure, out['one'].pressure):9.1e}", flush=True)
+
+
 def batch(n_patches, n, reps, threads):
     """One call with the batch against a loop over its patches, the same solver, both methods; with
     several threads also against the loop on one thread (a 128² patch gains nothing from FFT threads)."""
@@ -243,7 +274,7 @@ def main():
     ap.add_argument("--quick", action="store_true", help="N = 256, 512, one repeat, smaller batches")
     ap.add_argument("--sizes", default="", help="grid sizes of the scaling rows (default 256,512,1024,2048)")
     ap.add_argument("--skip-tamaas-above", type=int, default=1 << 30, help="no tamaas above this N")
-    ap.add_argument("--only", default="scaling,surfaces,refinement,stopping,batch", help="parts to run")
+    ap.add_argument("--only", default="scaling,surfaces,refinement,levels,stopping,batch", help="parts to run")
     args = ap.parse_args()
     import tamaas as tm
     tm.set_log_level(tm.LogLevel.error)
@@ -274,6 +305,9 @@ def main():
         print_rows(rows)
     if "refinement" in parts:
         refinement(sizes)
+    if "levels" in parts:
+        big = [n for n in sizes if n * n >= bccg_solver.COARSE_FROM] or [1024]
+        levels(big, {1024: 5, 2048: 3})
     if "stopping" in parts:
         stopping_rule(256 if args.quick else 512)
     if "batch" in parts:
