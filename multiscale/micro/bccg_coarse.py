@@ -20,8 +20,10 @@ times their cell counts (monopoles). K y costs 9 products per cell of F and a de
 (m <= CELLS² non-empty aggregates), Ẽ a Cholesky factorisation. Built for one F, the operator is
 reused while F differs from it by at most ``REBUILD`` of its cells (new cells then have no near
 coefficients, cells of aggregates empty at the build no coarse component): still a symmetric
-positive definite P, slightly weaker. On the benchmark surfaces (scratch study, benchmarks/README)
-the iterations become 13, 13, 14, 15 at N = 256 ... 2048 with 5 builds at 2048².
+positive definite P, slightly weaker. On the benchmark surfaces the iterations become 14 and 14
+(16 for another realisation) at N = 1024 and 2048, against 18 and 25 (23) one-level, with 6-11
+builds of 0.7-0.8 of an FFT pair each; the solve takes 0.69-0.88x the one-level time at 2048²,
+0.95-0.98x at 1024² (benchmarks/README, ``bench_contact.py --only levels``).
 """
 from __future__ import annotations
 

@@ -35,9 +35,10 @@ The details here:
   tol 1e-8 and 1e-12: the same iterations, pressures within 2.5e-14 of those of a double one.
 
 The start is nested (``ContactSolver.coarse_start``). Stopping criterion: eps = ||s|| / ||p|| <=
-tol, with s = Eᵀ M E r (two-level: ``bccg_coarse``'s P r) the preconditioned residual over F, i.e.
-the pressure correction that the preconditioner predicts: an estimate of the relative L2 error of the pressure (it was 0.3-0.7 times the true
-error on the benchmark surfaces), free of units (a flat punch stops where a rough patch does).
+tol, with s = Eᵀ M E r (two-level: ``bccg_coarse``'s P r) the preconditioned residual over F,
+i.e. the pressure correction that the preconditioner predicts: an estimate of the relative L2
+error of the pressure (it was 0.3-0.7 times the true error on the benchmark surfaces), free of
+units (a flat punch stops where a rough patch does).
 """
 from __future__ import annotations
 

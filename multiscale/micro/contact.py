@@ -6,9 +6,10 @@ control the rigid approach. Two methods give the same discrete answer:
 
 - ``"bccg"`` (default): the preconditioned constrained CG of Vollebregt (2014, J. Comput. Phys.
   257, 333–351) with an FFT-based preconditioner (``bccg_solver``) and a nested start: iteration
-  counts that barely grow with the grid (one surface refined from 256² to 2048²: 13 to 15,
-  Polonsky–Keer 48 to 162) and slowly with the roughness resolved (13, 14, 18, 25 at N = 256 …
-  2048 on self-affine surfaces with cut-off N/4, Polonsky–Keer 48 … 225), 2–2.5 FFT pairs each;
+  counts that do not grow with the grid (one surface refined from 256² to 2048²: 13, 13, 11,
+  13, Polonsky–Keer 48 to 162) nor with the roughness resolved (13, 14, 14, 14 at N = 256 … 2048 on
+  self-affine surfaces with cut-off N/4, Polonsky–Keer 48 … 225; from 1024² with a two-level
+  coarse correction, ``bccg_coarse``), 2–2.5 FFT pairs each;
 - ``"pk"``: the constrained CG of Polonsky & Keer (1999) (``pk_solver``): iterations growing like
   the square root of the grid size, ~2 FFT pairs each. Slower from 128² up, as fast below.
 
