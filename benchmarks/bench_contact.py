@@ -216,11 +216,13 @@ def levels(sizes, reps):
     for n, seed, periodic in cases:
         h, dx = surface(n, seed=seed)
         solvers = {}
-        for name, threshold in (("one", 1 << 62), ("two", default)):
-            bccg_solver.COARSE_FROM = threshold           # read when the solver makes its buffers
-            solvers[name] = ContactSolver(E, h.shape, dx, periodic=periodic)
-            solvers[name].solve(h, load=LOAD, tol=1e-4)
-        bccg_solver.COARSE_FROM = default
+        try:
+            for name, threshold in (("one", 1 << 62), ("two", default)):
+                bccg_solver.COARSE_FROM = threshold       # read when the solver makes its buffers
+                solvers[name] = ContactSolver(E, h.shape, dx, periodic=periodic)
+                solvers[name].solve(h, load=LOAD, tol=1e-4)
+        finally:
+            bccg_solver.COARSE_FROM = default
         times, out = {"one": [], "two": []}, {}
         for _ in range(reps.get(n, 2)):
             for name, solver in solvers.items():

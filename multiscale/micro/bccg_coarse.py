@@ -54,6 +54,23 @@ def coarse_cells(fi, fj, n, row_of, col_of, cx, ncoarse):
     return cell, start
 
 
+@njit(cache=True, nogil=True)
+def buckets(key, nb):
+    """Counting sort of ``key`` (values 0..nb-1): the cumulative counts ``start`` (nb + 1) and the
+    indices ``order`` sorted by key (stable), so bucket k holds order[start[k]:start[k + 1]]."""
+    start = np.zeros(nb + 1, dtype=np.int64)
+    for m in range(key.shape[0]):
+        start[key[m] + 1] += 1
+    for k in range(nb):
+        start[k + 1] += start[k]
+    fill = start[:-1].copy()
+    order = np.empty(key.shape[0], dtype=np.int64)
+    for m in range(key.shape[0]):
+        order[fill[key[m]]] = m
+        fill[key[m]] += 1
+    return start, order
+
+
 @njit(cache=True, inline="always")
 def _neighbour(p, d, n, agg, cn, periodic):
     """Sub-block p + d along an axis of n sub-blocks (``agg`` the coarse cell of each, cn of
@@ -84,20 +101,10 @@ def near_coefficients(fi, fj, n, S, sy, sx, agg_y, agg_x, cy, cx, slots, table, 
     the sub-block centres times the cell count from the farther sub-blocks of those coarse cells.
     Wrapped across the edges of a periodic grid, none beyond an isolated one; the kernel is even
     (each pair of cells is visited once)."""
-    nsub = sy * sx
     sub = np.empty(n, dtype=np.int64)
-    start = np.zeros(nsub + 1, dtype=np.int64)
     for m in range(n):
-        k = (fi[m] // S) * sx + fj[m] // S
-        sub[m] = k
-        start[k + 1] += 1
-    for k in range(nsub):
-        start[k + 1] += start[k]
-    fill = start[:-1].copy()
-    order = np.empty(n, dtype=np.int64)
-    for m in range(n):
-        order[fill[sub[m]]] = m
-        fill[sub[m]] += 1
+        sub[m] = (fi[m] // S) * sx + fj[m] // S
+    start, order = buckets(sub, sy * sx)
     si, sj = fi[order], fj[order]                      # the cells sorted by sub-block
     T = np.zeros((9, n))                               # T[s, a]: C of the a-th sorted cell
     for py in range(sy):                               # exact: each pair of neighbouring sub-blocks once
@@ -137,20 +144,10 @@ def monopoles(start, S, sy, sx, agg_y, agg_x, cx, slots, table, hy, hx, periodic
     coarse slot s around k's coarse cell that are not next to k, each taken at q's centre
     (``start``: cumulative cell counts of the sub-blocks; ``slots``: the coarse cells around each,
     -1 beyond an isolated grid). Only the non-empty sub-blocks are visited, listed by coarse cell."""
-    nsub, ncoarse = sy * sx, slots.shape[0]
-    first = np.zeros(ncoarse + 1, dtype=np.int64)      # the non-empty sub-blocks by coarse cell
-    for k in range(nsub):
-        if start[k + 1] > start[k]:
-            first[agg_y[k // sx] * cx + agg_x[k % sx] + 1] += 1
-    for c in range(ncoarse):
-        first[c + 1] += first[c]
-    fill = first[:-1].copy()
-    listed = np.empty(first[-1], dtype=np.int64)
-    for k in range(nsub):
-        if start[k + 1] > start[k]:
-            c = agg_y[k // sx] * cx + agg_x[k % sx]
-            listed[fill[c]] = k
-            fill[c] += 1
+    nsub = sy * sx
+    filled = np.flatnonzero(start[1:] > start[:-1])    # the non-empty sub-blocks, by coarse cell
+    first, by_cell = buckets(agg_y[filled // sx] * cx + agg_x[filled % sx], slots.shape[0])
+    listed = filled[by_cell]
     M = np.zeros((nsub, 9))
     for a in range(first[-1]):
         k = listed[a]
