@@ -12,7 +12,9 @@ an anisotropic one (cut-offs 4 x 16 and N/4 x N/16), H = 0.3, 30 % contact, and 
 (zero-padded; tamaas has none: pk is the reference there); batches of 100 patches of 128².
 The scaling surfaces refine the grid and add roughness (cut-off N/4) at once; the refinement part
 separates the two: one surface refined onto finer grids, then finer roughness on one grid. The
-levels part sets the two-level preconditioner of large grids against the one-level one.
+levels part sets the two-level preconditioner of large grids against the one-level one, the
+padding part isolated patches of sides 257, 511, 1030 on FFT grids padded to 5-smooth lengths
+against exactly 2N.
 
 Columns: iterations (tamaas counted from its log in an untimed run); "pairs/it": FFT pairs per
 iteration counted by the FFT wrapper (``multiscale.micro.fft.fft_pairs``: every transform of the
@@ -40,7 +42,7 @@ os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("MULTISCALE_THREADS", "1")
 import numpy as np  # noqa: E402
 
-from multiscale.micro import bccg_solver, fft  # noqa: E402
+from multiscale.micro import bccg_solver, fft, kernels  # noqa: E402
 from multiscale.micro.contact import ContactSolver  # noqa: E402
 from multiscale.micro.kernels import HalfSpace  # noqa: E402
 from multiscale.micro.surface import Surface, fractal_surface, refine, statistics  # noqa: E402
@@ -271,12 +273,45 @@ def batch(n_patches, n, reps, threads):
               f"{ratio1:>8} {int(rb.iterations.max()):9d} {diff:12.1e}", flush=True)
 
 
+def padding(sizes, reps):
+    """Isolated patches whose 2N has large prime factors: the FFT grid padded to 5-smooth lengths
+    (``kernels.padded_size``, the default) against exactly 2N, side by side: two solvers per
+    surface, the second built with the padding switched off, their solves alternated."""
+    default = kernels.padded_size
+    print("\nisolated patches, FFT grid 2N against padded to 5-smooth (bccg, tol 1e-8): medians; ratio = median of "
+          "padded / 2N")
+    print(f"{'N':>5} {'2N grid':>11} {'[s]':>7} {'its':>4} {'padded grid':>11} {'[s]':>7} {'its':>4} {'ratio':>6} "
+          f"{'rel diff':>9}")
+    for n in sizes:
+        h, dx = surface(n)
+        solvers = {}
+        try:
+            for name, pad in (("2N", int), ("padded", default)):
+                kernels.padded_size = pad                # read when an operator is built (the nested start's too)
+                solvers[name] = ContactSolver(E, h.shape, dx, periodic=False)
+                solvers[name].solve(h, load=LOAD, tol=1e-4)
+        finally:
+            kernels.padded_size = default
+        times, out = {"2N": [], "padded": []}, {}
+        for _ in range(reps):
+            for name, solver in solvers.items():
+                t0 = time.perf_counter()
+                out[name] = solver.solve(h, load=LOAD, tol=TOL)
+                times[name].append(time.perf_counter() - t0)
+        ratio = stats.median([b / a for a, b in zip(times["2N"], times["padded"])])
+        shape = {k: "x".join(map(str, s.operator.fft_shape)) for k, s in solvers.items()}
+        print(f"{n:5d} {shape['2N']:>11} {stats.median(times['2N']):7.3f} {int(out['2N'].iterations):4d} "
+              f"{shape['padded']:>11} {stats.median(times['padded']):7.3f} {int(out['padded'].iterations):4d} "
+              f"{ratio:6.3f} {rel(out['padded'].pressure, out['2N'].pressure):9.1e}", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="N = 256, 512, one repeat, smaller batches")
     ap.add_argument("--sizes", default="", help="grid sizes of the scaling rows (default 256,512,1024,2048)")
     ap.add_argument("--skip-tamaas-above", type=int, default=1 << 30, help="no tamaas above this N")
-    ap.add_argument("--only", default="scaling,surfaces,refinement,levels,stopping,batch", help="parts to run")
+    ap.add_argument("--only", default="scaling,surfaces,refinement,levels,padding,stopping,batch",
+                    help="parts to run")
     args = ap.parse_args()
     import tamaas as tm
     tm.set_log_level(tm.LogLevel.error)
@@ -310,6 +345,8 @@ def main():
     if "levels" in parts:
         big = [n for n in sizes if n * n >= bccg_solver.COARSE_FROM] or [1024]
         levels(big, {1024: 5, 2048: 3})
+    if "padding" in parts:
+        padding([257] if args.quick else [257, 511, 1030], 1 if args.quick else 3)
     if "stopping" in parts:
         stopping_rule(256 if args.quick else 512)
     if "batch" in parts:

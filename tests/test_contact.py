@@ -79,10 +79,14 @@ def test_love_square_displacements():
     assert u.mean() / a == pytest.approx(1.8928, rel=2e-3)
 
 
-def test_dcfft_equals_dense_convolution():
+@pytest.mark.parametrize("ny, nx, fft_shape", [(6, 7, (12, 16)), (17, 9, (36, 18)), (8, 10, (16, 20))])
+def test_dcfft_equals_dense_convolution(ny, nx, fft_shape):
+    """The isolated patch's operator is the linear convolution with Love's coefficients, also on
+    FFT grids padded beyond 2n to 5-smooth lengths (7 -> 8, 17 -> 18; 5-smooth sides keep 2n)."""
     rng = np.random.default_rng(3)
-    ny, nx, dx, dy = 6, 7, 1e-6, 2e-6
+    dx, dy = 1e-6, 2e-6
     op = InfluenceOperator(E, (ny, nx), dx, dy, periodic=False)
+    assert op.fft_shape == fft_shape
     p = rng.random((ny, nx))
     yy, xx = np.mgrid[:ny, :nx]
     dense = np.zeros((ny, nx))

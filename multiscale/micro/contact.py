@@ -82,9 +82,12 @@ class ContactSolver:
     """Reusable FFT-BEM contact solver on one grid (plans and kernel spectrum built once).
 
     Parameters: kernel (e.g. ``HalfSpace``), grid ``shape`` (ny, nx), pixel ``dx`` (and ``dy``) [m],
-    ``periodic`` (repeating patch) or not (isolated patch, zero-padded DC-FFT), ``method``
-    ("bccg" or "pk", see the module). A solver keeps its FFT buffers between calls: use one
-    solver per thread (it runs the chunks of a batch on ``get_threads()`` threads itself).
+    ``periodic`` (repeating patch) or not (isolated patch, zero-padded DC-FFT on a grid padded to
+    5-smooth lengths: fast at any size), ``method`` ("bccg" or "pk", see the module). A periodic
+    patch's FFT grid is the patch: sides with large prime factors are slow (a 1022² FFT pair takes
+    4x a 1024² one); choose 5-smooth sides (2^a 3^b 5^c). A solver keeps its FFT buffers between
+    calls: use one solver per thread (it runs the chunks of a batch on ``get_threads()`` threads
+    itself).
     """
 
     def __init__(self, kernel: Kernel, shape, dx: float, dy: float | None = None, periodic: bool = True,

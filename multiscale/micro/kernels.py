@@ -14,6 +14,7 @@ from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.fft
 from numba import njit
 
 from multiscale.errors import InputError, check_positive, check_real
@@ -140,6 +141,15 @@ def wrap_offsets(n: int) -> np.ndarray:
     return np.where(i < n, i, i - 2 * n).astype(float)
 
 
+def padded_size(n: int) -> int:
+    """Half the FFT length along an axis of n cells of an isolated patch: the smallest 5-smooth
+    m >= n (``scipy.fft.next_fast_len``). Any length >= 2n - 1 gives the same linear convolution
+    on the patch (the kernel on (2m, 2m) wrap-around offsets, zero load beyond the patch), and
+    FFTW's pair is 2-4x faster on 5-smooth lengths: 511² cells 8.2 ms on 1024² against 33.6 ms
+    on 1022², 1017² 50.6 against 181.5 ms (benchmarks/README)."""
+    return int(scipy.fft.next_fast_len(int(n), real=True))
+
+
 def wavenumbers(ny: int, nx: int, dy: float, dx: float) -> np.ndarray:
     """|k| [rad/m] on the rfft2 grid of an (ny, nx) periodic patch with pixel (dy, dx)."""
     kx = 2 * np.pi * np.fft.rfftfreq(nx, dx)
@@ -152,7 +162,8 @@ class InfluenceOperator:
 
     periodic=True: the patch repeats (spectral kernel, the mean displacement is the kernel's
     q = 0 value, zero for a half-space). periodic=False: an isolated patch (zero-padded DC-FFT
-    with the kernel's influence coefficients). FFT plans are built once per batch shape.
+    with the kernel's influence coefficients) on the FFT grid (2 my, 2 mx), my >= ny and mx >= nx
+    the next 5-smooth sizes (``padded_size``). FFT plans are built once per batch shape.
 
     ``spectrum`` (real: the kernels are even) is the transfer function on the FFT grid
     ``fft_shape``; ``inverse_spectrum`` its inverse where it is positive (0 elsewhere, e.g. at
@@ -174,8 +185,9 @@ class InfluenceOperator:
             self.fft_shape = (ny, nx)
             spectrum = np.asarray(kernel.compliance(wavenumbers(ny, nx, self.dy, self.dx)), float)
         else:
-            self.fft_shape = (2 * ny, 2 * nx)
-            coeffs = np.asarray(kernel.influence(ny, nx, self.dy, self.dx), float)
+            my, mx = padded_size(ny), padded_size(nx)
+            self.fft_shape = (2 * my, 2 * mx)
+            coeffs = np.asarray(kernel.influence(my, mx, self.dy, self.dx), float)
             if coeffs.shape != self.fft_shape:
                 raise InputError("kernel", kernel, f"influence() returned shape {coeffs.shape}, not {self.fft_shape}")
             spectrum = np.fft.rfft2(coeffs)
