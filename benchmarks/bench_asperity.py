@@ -15,7 +15,6 @@ accuracy–time reference. Run: python benchmarks/bench_asperity.py [--quick]
 import argparse
 import os
 import statistics as stats
-import time
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
@@ -25,6 +24,8 @@ from multiscale.micro.asperity_laws import hertz_law  # noqa: E402
 from multiscale.micro.contact import ContactSolver  # noqa: E402
 from multiscale.micro.kernels import HalfSpace  # noqa: E402
 from multiscale.micro.surface import find_asperities, fractal_surface  # noqa: E402
+
+from timing import timed  # noqa: E402
 
 SOLID = HalfSpace.from_materials(4e9, 0.15)
 RUNS = [("elliptic", "energy", "l-bfgs-b"), ("elliptic", "kinematic", "trf"),
@@ -49,15 +50,6 @@ def approach_for(surface, table, n_contacts):
         else:
             hi = mid
     return hi
-
-
-def timed(fn, repeats):
-    times, out = [], None
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return stats.median(times), out
 
 
 def main():

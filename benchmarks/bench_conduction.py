@@ -12,8 +12,6 @@ Medians of repeats, one thread. Run: python benchmarks/bench_conduction.py [--qu
 """
 import argparse
 import os
-import statistics as stats
-import time
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
@@ -23,6 +21,8 @@ from multiscale.micro.conduction import ConductionSolver, SeriesKernel, conducta
 from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace  # noqa: E402
 from multiscale.micro.layered import LayeredElastic, LayeredThermal  # noqa: E402
 from multiscale.micro.surface import fractal_surface  # noqa: E402
+
+from timing import timed  # noqa: E402
 
 PRESSURES = np.linspace(0.5e6, 5e6, 10)
 ELASTIC = HalfSpace.from_materials(4e9, 0.15, 220e9, 0.33)
@@ -64,15 +64,6 @@ def scipy_sweep(solver, masks):
         assert info == 0
         K.append(phi.sum() / mask.size)
     return np.array(K)
-
-
-def timed(fn, repeats):
-    times, out = [], None
-    for _ in range(repeats):
-        t0 = time.perf_counter()
-        out = fn()
-        times.append(time.perf_counter() - t0)
-    return stats.median(times), out
 
 
 def main():

@@ -21,7 +21,7 @@ from multiscale.micro.heating import TransientHeating  # noqa: E402
 from multiscale.micro.kernels import HalfSpace  # noqa: E402
 from multiscale.micro.surface import fractal_surface  # noqa: E402
 
-from bench_contact import timed  # noqa: E402  (median of repeats, shared with the contact benchmark)
+from timing import timed  # noqa: E402
 
 DISC, PIN = ThermalMaterial(50.0, 1e-5), ThermalMaterial(5.0, 3.5e-6)
 ELASTIC = HalfSpace.from_materials(4e9, 0.15, 220e9, 0.33)
