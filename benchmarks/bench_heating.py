@@ -5,16 +5,19 @@ R = 100 mm, 4.5 ms transient. Reports (medians over repeats, one thread): kernel
 run time, CG iterations per step and time per step for omega = 1 and 100 rad/s with dt = 50 us;
 then p_1 and T_max at 4.5 ms versus dt (accuracy for the cost); and, as an independent check of
 the FFT + least-squares CG step, a dense direct solve (LAPACK) of the first step's restricted
-system A^0 psi = b on the contacting cells.
+system A^0 psi = b on the contacting cells; last, isolated windows of 127² and 257² on FFT grids
+padded to 5-smooth lengths against exactly 2N.
 Run: python benchmarks/bench_heating.py [--quick] [--repeats 3]
 """
 import argparse
 import os
+import statistics as stats
 import time
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
 
+from multiscale.micro import heating  # noqa: E402
 from multiscale.micro.contact import ContactSolver  # noqa: E402
 from multiscale.micro.heat_kernels import Rotation, SpeedProfile, ThermalMaterial, pulse_tables  # noqa: E402
 from multiscale.micro.heating import TransientHeating  # noqa: E402
@@ -94,6 +97,38 @@ def main():
     err = np.linalg.norm(r.flux_1[0][iy, ix] - psi) / np.linalg.norm(psi)
     print(f"\nfirst step, omega = 100: FFT + CG {t_fft * 1e3:.1f} ms ({int(r.iterations[0])} its) vs dense "
           f"LAPACK solve {t_dense * 1e3:.1f} ms on {psi.size} contact cells; relative difference {err:.2e}")
+    padding([127] if args.quick else [127, 257], repeats)
+
+
+def padding(sizes, repeats):
+    """Isolated windows whose 2N has large prime factors: the FFT grid padded to 5-smooth lengths
+    (``kernels.padded_size``, the default) against exactly 2N, side by side (two solvers, the
+    second built with the padding switched off, runs alternated): 10 steps of 100 us, omega = 50."""
+    default = heating.padded_size
+    print("\ntransient heating of isolated windows, FFT grid 2N against padded to 5-smooth: medians; ratio = "
+          "median of padded / 2N")
+    print(f"{'N':>5} {'2N [s]':>8} {'padded [s]':>10} {'ratio':>6} {'max diff p1':>11}")
+    for n in sizes:
+        s = fractal_surface(n, 1e-3, 0.8, 2, n // 4, 6.49e-6, seed=3)
+        c = ContactSolver(ELASTIC, s.shape, s.dx, periodic=False).solve(s.heights, approach=10e-6)
+        solvers = {}
+        try:
+            for name, pad in (("2N", int), ("padded", default)):
+                heating.padded_size = pad                    # read when the solver builds its tables and plans
+                solvers[name] = TransientHeating(s.shape, s.dx, DISC, PIN, rotation(50.0), 1e-4, 10)
+                solvers[name].run(c.pressure, MU)
+        finally:
+            heating.padded_size = default
+        times, out = {k: [] for k in solvers}, {}
+        for _ in range(repeats):
+            for name, sol in solvers.items():
+                t0 = time.perf_counter()
+                out[name] = sol.run(c.pressure, MU)
+                times[name].append(time.perf_counter() - t0)
+        ratio = stats.median([b / a for a, b in zip(times["2N"], times["padded"])])
+        diff = np.max(np.abs(out["padded"].partition_1 - out["2N"].partition_1))
+        print(f"{n:5d} {stats.median(times['2N']):8.3f} {stats.median(times['padded']):10.3f} {ratio:6.3f} "
+              f"{diff:11.1e}", flush=True)
 
 
 if __name__ == "__main__":

@@ -5,13 +5,14 @@ import numpy as np
 import pytest
 
 from multiscale.errors import InputError
+from multiscale.micro import fft, heating
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.heat_kernels import (Rotation, SpeedProfile, ThermalMaterial, Translation,
                                            fixed_rectangle_temperature, moving_rectangle_temperature,
                                            pulse_tables)
 from multiscale.micro.heating import (HeatingConvergenceError, InterfaceLayer, SteadyHeating,
                                       TransientHeating, partition_law)
-from multiscale.micro.kernels import HalfSpace
+from multiscale.micro.kernels import HalfSpace, padded_size
 from multiscale.micro.surface import Surface, fractal_surface
 from multiscale.references.conduction import holm_conductance
 from multiscale.references.heat import (fast_square_source, fixed_square_source, point_source_deficit,
@@ -174,6 +175,32 @@ def test_batched_patches_match_single_runs():
         one = sol.run(p, 0.4, field_times=[3e-4])
         assert np.allclose(both.partition_1[:, i], one.partition_1, rtol=1e-9)
         assert np.allclose(both.temperature_1[:, i], one.temperature_1, rtol=1e-7, atol=1e-9 * one.temperature_1.max())
+
+
+def test_fft_grids_padded_to_5_smooth_lengths_give_the_same_heating(monkeypatch):
+    """A 22² window is transformed on 48² (``kernels.padded_size``: 22 -> 24), not 44²: the same
+    linear convolutions, so the same temperatures (the steady moving tables' quadrature reaches
+    the larger table's corners: 3e-11)."""
+    assert padded_size(22) == 24 and padded_size(24) == 24
+    s, c = rough_contact(22)
+    motion = Rotation((70.7e-3, 70.7e-3), SpeedProfile.constant(50.0))
+    runs, grids = [], []
+    for exact in (True, False):
+        if exact:
+            monkeypatch.setattr(heating, "padded_size", int)   # the FFT grid exactly 2N
+        else:
+            monkeypatch.undo()
+        fft.reset_fft_counts()
+        runs.append((TransientHeating(s.shape, s.dx, DISC, PIN, motion, 1e-4, 6).run(c.pressure, 0.4,
+                                                                                      field_times=[6e-4]),
+                     SteadyHeating(s.shape, s.dx, DISC, PIN, 3.0).solve(c.pressure, 0.4)))
+        grids.append({g for g, counts in fft.fft_counts().items() if any(counts)})
+    assert grids == [{(44, 44)}, {(48, 48)}]
+    (t_2n, s_2n), (t_pad, s_pad) = runs
+    assert np.allclose(t_pad.temperature_1, t_2n.temperature_1, rtol=0, atol=1e-12 * t_2n.temperature_1.max())
+    assert np.allclose(t_pad.partition_1, t_2n.partition_1, rtol=1e-12)
+    assert np.allclose(s_pad.temperature_1, s_2n.temperature_1, rtol=0, atol=1e-9 * s_2n.temperature_1.max())
+    assert s_pad.partition_1 == pytest.approx(s_2n.partition_1, rel=1e-9)
 
 
 def test_two_stationary_bodies_share_heat_by_effusivity_then_by_conductivity():

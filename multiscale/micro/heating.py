@@ -34,7 +34,7 @@ from multiscale.errors import (ConvergenceError, InputError, check_count, check_
 from multiscale.micro.contact import ContactResult, ContactSolver
 from multiscale.micro.fft import RealFFT2
 from multiscale.micro.heat_kernels import Motion, ThermalMaterial, Translation, pulse_tables
-from multiscale.micro.kernels import Kernel, grid_shape
+from multiscale.micro.kernels import Kernel, grid_shape, padded_size
 from multiscale.micro.surface import Surface
 
 
@@ -176,18 +176,20 @@ class SteadyHeatingResult:
 
 
 class _Padded:
-    """Real FFTs of (..., ny, nx) fields zero-padded to (2ny, 2nx): products of spectra with the
-    wrap-around influence tables are exact linear convolutions. Plans are reused per batch shape."""
+    """Real FFTs of (..., ny, nx) fields zero-padded to (2 my, 2 mx), ``half`` = (my, mx) the next
+    5-smooth sizes (``kernels.padded_size``): products of spectra with the wrap-around influence
+    tables of ``half`` are exact linear convolutions. Plans are reused per batch shape."""
 
     def __init__(self, shape):
         self.shape = shape
+        self.half = (padded_size(shape[0]), padded_size(shape[1]))
         self._plans: dict[tuple, RealFFT2] = {}
 
     def _plan(self, batch):
         plan = self._plans.get(batch)
         if plan is None:
-            ny, nx = self.shape
-            plan = self._plans[batch] = RealFFT2(batch + (2 * ny, 2 * nx))
+            my, mx = self.half
+            plan = self._plans[batch] = RealFFT2(batch + (2 * my, 2 * mx))
         return plan
 
     def spectrum(self, x):
@@ -299,9 +301,9 @@ class TransientHeating:
         check_instance("motion", motion, Motion, "a Motion (Rotation or Translation)")
         self.body1, self.body2, self.motion = body1, body2, motion
         self._pad = _Padded(self.shape)
-        self._tables2 = self._spectra(pulse_tables(self.shape, self.dx, self.dy, body2, self.dt, self.n_steps))
+        self._tables2 = self._spectra(pulse_tables(self._pad.half, self.dx, self.dy, body2, self.dt, self.n_steps))
         self.toeplitz = motion.profile.is_constant
-        self._tables1 = self._spectra(pulse_tables(self.shape, self.dx, self.dy, body1, self.dt, self.n_steps,
+        self._tables1 = self._spectra(pulse_tables(self._pad.half, self.dx, self.dy, body1, self.dt, self.n_steps,
                                                    motion)) if self.toeplitz else None
 
     @staticmethod
@@ -311,7 +313,7 @@ class TransientHeating:
     def _body1_tables(self, N):
         if self.toeplitz:
             return self._tables1
-        return self._spectra(pulse_tables(self.shape, self.dx, self.dy, self.body1, self.dt, N + 1,
+        return self._spectra(pulse_tables(self._pad.half, self.dx, self.dy, self.body1, self.dt, N + 1,
                                           self.motion, t=(N + 1) * self.dt))
 
     @staticmethod
@@ -362,7 +364,7 @@ class TransientHeating:
         keep = np.unique(np.clip(np.rint(field_times / self.dt).astype(int) - 1,
                                  0, n_steps - 1))
         layer = _Layer(interface, self.dt, p.shape)
-        spec_shape = (n_steps,) + batch + (2 * self.shape[0], self.shape[1] + 1)
+        spec_shape = (n_steps,) + batch + (2 * self._pad.half[0], self._pad.half[1] + 1)
         F1, F2 = np.zeros(spec_shape, complex), np.zeros(spec_shape, complex)
         out = {k: np.zeros((n_steps,) + batch) for k in ("heat", "heat_1", "max_1", "max_2", "res")}
         its = np.zeros((n_steps,) + batch, dtype=int)
@@ -441,8 +443,8 @@ class SteadyHeating:
         self.body1, self.body2 = body1, body2
         self._pad = _Padded(self.shape)
         motion = Translation.steady(self.speed, angle)
-        k1 = pulse_tables(self.shape, self.dx, self.dy, body1, np.inf, 1, motion).coeffs[0]
-        k2 = pulse_tables(self.shape, self.dx, self.dy, body2, np.inf, 1).coeffs[0]
+        k1 = pulse_tables(self._pad.half, self.dx, self.dy, body1, np.inf, 1, motion).coeffs[0]
+        k2 = pulse_tables(self._pad.half, self.dx, self.dy, body2, np.inf, 1).coeffs[0]
         self._S1, self._S2 = np.fft.rfft2(k1), np.fft.rfft2(k2)
 
     def solve(self, pressure, mu: float, *, interface: InterfaceLayer | None = None,
