@@ -10,6 +10,7 @@ version of this script planned MEASURE first and found the two equally fast).
 
     python benchmarks/bench_fft_plans.py
 """
+import argparse
 import os
 import time
 
@@ -44,6 +45,7 @@ def pair_time(shape, flag, single=False):
 
 
 def main():
+    argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter).parse_args()
     print(f"load average {os.getloadavg()[0]:.2f}")
     print("| shape | plan MEASURE [s] | plan ESTIMATE [s] | pair MEASURE [ms] | pair ESTIMATE [ms] | ESTIMATE / MEASURE "
           "| pair single, MEASURE [ms] | single / double |")
