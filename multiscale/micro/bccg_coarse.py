@@ -44,14 +44,9 @@ FAST = {"reassoc", "contract", "nsz"}  # reductions may be reordered (vectorised
 def coarse_cells(fi, fj, n, row_of, col_of, cx, ncoarse):
     """Coarse cell of each cell of F, and the cumulative cell counts of the coarse cells."""
     cell = np.empty(n, dtype=np.int32)
-    start = np.zeros(ncoarse + 1, dtype=np.int64)
     for m in range(n):
-        c = row_of[fi[m]] * cx + col_of[fj[m]]
-        cell[m] = c
-        start[c + 1] += 1
-    for c in range(ncoarse):
-        start[c + 1] += start[c]
-    return cell, start
+        cell[m] = row_of[fi[m]] * cx + col_of[fj[m]]
+    return cell, buckets(cell, ncoarse)[0]
 
 
 @njit(cache=True, nogil=True)
