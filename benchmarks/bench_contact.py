@@ -37,6 +37,8 @@ import subprocess
 import sys
 import tempfile
 import time
+from functools import partial
+from unittest import mock
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("MULTISCALE_THREADS", "1")
@@ -46,6 +48,8 @@ from multiscale.micro import bccg_solver, fft, kernels  # noqa: E402
 from multiscale.micro.contact import ContactSolver  # noqa: E402
 from multiscale.micro.kernels import HalfSpace  # noqa: E402
 from multiscale.micro.surface import Surface, fractal_surface, refine, statistics  # noqa: E402
+
+from timing import alternated  # noqa: E402
 
 TOL = 1e-8
 E = HalfSpace(1.0)                    # E* = 1: tamaas' model.E = 1, nu = 0
@@ -211,31 +215,22 @@ def levels(sizes, reps):
     cells) against the one-level one, side by side: two solvers on each surface, one built with
     the coarse correction switched off, their solves alternated; two realisations per N, and an
     isolated patch of the smallest N."""
-    default = bccg_solver.COARSE_FROM
     cases = [(n, seed, True) for n in sizes for seed in (1, 2)] + [(sizes[0], 1, False)]
     print("\ntwo-level against one-level preconditioner (bccg, tol 1e-8): medians; ratio = median of two / one")
     print(f"{'case':>24} {'one [s]':>8} {'its':>4} {'two [s]':>8} {'its':>4} {'ratio':>6} {'rel diff':>9}")
     for n, seed, periodic in cases:
         h, dx = surface(n, seed=seed)
         solvers = {}
-        try:
-            for name, threshold in (("one", 1 << 62), ("two", default)):
-                bccg_solver.COARSE_FROM = threshold       # read when the solver makes its buffers
+        for name, threshold in (("one", 1 << 62), ("two", bccg_solver.COARSE_FROM)):
+            with mock.patch.object(bccg_solver, "COARSE_FROM", threshold):   # read when a solver makes its buffers
                 solvers[name] = ContactSolver(E, h.shape, dx, periodic=periodic)
                 solvers[name].solve(h, load=LOAD, tol=1e-4)
-        finally:
-            bccg_solver.COARSE_FROM = default
-        times, out = {"one": [], "two": []}, {}
-        for _ in range(reps.get(n, 2)):
-            for name, solver in solvers.items():
-                t0 = time.perf_counter()
-                out[name] = solver.solve(h, load=LOAD, tol=TOL)
-                times[name].append(time.perf_counter() - t0)
-        ratio = stats.median([b / a for a, b in zip(times["one"], times["two"])])
+        t, out, ratio = alternated({k: partial(s.solve, h, load=LOAD, tol=TOL) for k, s in solvers.items()},
+                                   reps.get(n, 2))
         case = f"{n}² seed {seed}" + ("" if periodic else " isolated")
-        print(f"{case:>24} {stats.median(times['one']):8.3f} {int(out['one'].iterations):4d} "
-              f"{stats.median(times['two']):8.3f} {int(out['two'].iterations):4d} {ratio:6.3f} "
-              f"{rel(out['two'].pressure, out['one'].pressure):9.1e}", flush=True)
+        print(f"{case:>24} {t['one']:8.3f} {int(out['one'].iterations):4d} {t['two']:8.3f} "
+              f"{int(out['two'].iterations):4d} {ratio:6.3f} {rel(out['two'].pressure, out['one'].pressure):9.1e}",
+              flush=True)
 
 
 def batch(n_patches, n, reps, threads):
@@ -277,7 +272,6 @@ def padding(sizes, reps):
     """Isolated patches whose 2N has large prime factors: the FFT grid padded to 5-smooth lengths
     (``kernels.padded_size``, the default) against exactly 2N, side by side: two solvers per
     surface, the second built with the padding switched off, their solves alternated."""
-    default = kernels.padded_size
     print("\nisolated patches, FFT grid 2N against padded to 5-smooth (bccg, tol 1e-8): medians; ratio = median of "
           "padded / 2N")
     print(f"{'N':>5} {'2N grid':>11} {'[s]':>7} {'its':>4} {'padded grid':>11} {'[s]':>7} {'its':>4} {'ratio':>6} "
@@ -285,24 +279,15 @@ def padding(sizes, reps):
     for n in sizes:
         h, dx = surface(n)
         solvers = {}
-        try:
-            for name, pad in (("2N", int), ("padded", default)):
-                kernels.padded_size = pad                # read when an operator is built (the nested start's too)
+        for name, pad in (("2N", int), ("padded", kernels.padded_size)):
+            with mock.patch.object(kernels, "padded_size", pad):   # read when an operator is built (nested start's too)
                 solvers[name] = ContactSolver(E, h.shape, dx, periodic=False)
                 solvers[name].solve(h, load=LOAD, tol=1e-4)
-        finally:
-            kernels.padded_size = default
-        times, out = {"2N": [], "padded": []}, {}
-        for _ in range(reps):
-            for name, solver in solvers.items():
-                t0 = time.perf_counter()
-                out[name] = solver.solve(h, load=LOAD, tol=TOL)
-                times[name].append(time.perf_counter() - t0)
-        ratio = stats.median([b / a for a, b in zip(times["2N"], times["padded"])])
+        t, out, ratio = alternated({k: partial(s.solve, h, load=LOAD, tol=TOL) for k, s in solvers.items()}, reps)
         shape = {k: "x".join(map(str, s.operator.fft_shape)) for k, s in solvers.items()}
-        print(f"{n:5d} {shape['2N']:>11} {stats.median(times['2N']):7.3f} {int(out['2N'].iterations):4d} "
-              f"{shape['padded']:>11} {stats.median(times['padded']):7.3f} {int(out['padded'].iterations):4d} "
-              f"{ratio:6.3f} {rel(out['padded'].pressure, out['2N'].pressure):9.1e}", flush=True)
+        print(f"{n:5d} {shape['2N']:>11} {t['2N']:7.3f} {int(out['2N'].iterations):4d} {shape['padded']:>11} "
+              f"{t['padded']:7.3f} {int(out['padded'].iterations):4d} {ratio:6.3f} "
+              f"{rel(out['padded'].pressure, out['2N'].pressure):9.1e}", flush=True)
 
 
 def main():

@@ -11,8 +11,9 @@ Run: python benchmarks/bench_heating.py [--quick] [--repeats 3]
 """
 import argparse
 import os
-import statistics as stats
 import time
+from functools import partial
+from unittest import mock
 
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 import numpy as np  # noqa: E402
@@ -24,7 +25,7 @@ from multiscale.micro.heating import TransientHeating  # noqa: E402
 from multiscale.micro.kernels import HalfSpace  # noqa: E402
 from multiscale.micro.surface import fractal_surface  # noqa: E402
 
-from timing import timed  # noqa: E402
+from timing import alternated, timed  # noqa: E402
 
 DISC, PIN = ThermalMaterial(50.0, 1e-5), ThermalMaterial(5.0, 3.5e-6)
 ELASTIC = HalfSpace.from_materials(4e9, 0.15, 220e9, 0.33)
@@ -104,7 +105,6 @@ def padding(sizes, repeats):
     """Isolated windows whose 2N has large prime factors: the FFT grid padded to 5-smooth lengths
     (``kernels.padded_size``, the default) against exactly 2N, side by side (two solvers, the
     second built with the padding switched off, runs alternated): 10 steps of 100 us, omega = 50."""
-    default = heating.padded_size
     print("\ntransient heating of isolated windows, FFT grid 2N against padded to 5-smooth: medians; ratio = "
           "median of padded / 2N")
     print(f"{'N':>5} {'2N [s]':>8} {'padded [s]':>10} {'ratio':>6} {'max diff p1':>11}")
@@ -112,23 +112,13 @@ def padding(sizes, repeats):
         s = fractal_surface(n, 1e-3, 0.8, 2, n // 4, 6.49e-6, seed=3)
         c = ContactSolver(ELASTIC, s.shape, s.dx, periodic=False).solve(s.heights, approach=10e-6)
         solvers = {}
-        try:
-            for name, pad in (("2N", int), ("padded", default)):
-                heating.padded_size = pad                    # read when the solver builds its tables and plans
+        for name, pad in (("2N", int), ("padded", heating.padded_size)):
+            with mock.patch.object(heating, "padded_size", pad):   # read when a solver builds its tables and plans
                 solvers[name] = TransientHeating(s.shape, s.dx, DISC, PIN, rotation(50.0), 1e-4, 10)
                 solvers[name].run(c.pressure, MU)
-        finally:
-            heating.padded_size = default
-        times, out = {k: [] for k in solvers}, {}
-        for _ in range(repeats):
-            for name, sol in solvers.items():
-                t0 = time.perf_counter()
-                out[name] = sol.run(c.pressure, MU)
-                times[name].append(time.perf_counter() - t0)
-        ratio = stats.median([b / a for a, b in zip(times["2N"], times["padded"])])
+        t, out, ratio = alternated({k: partial(sol.run, c.pressure, MU) for k, sol in solvers.items()}, repeats)
         diff = np.max(np.abs(out["padded"].partition_1 - out["2N"].partition_1))
-        print(f"{n:5d} {stats.median(times['2N']):8.3f} {stats.median(times['padded']):10.3f} {ratio:6.3f} "
-              f"{diff:11.1e}", flush=True)
+        print(f"{n:5d} {t['2N']:8.3f} {t['padded']:10.3f} {ratio:6.3f} {diff:11.1e}", flush=True)
 
 
 if __name__ == "__main__":
