@@ -25,14 +25,21 @@ The details here:
 - Polak–Ribière(+) factors (conjugacy survives small changes of F), restart when t is not a
   descent direction;
 - two FFT pairs per iteration: Y = M E r, and L t, whose inverse transform is also the update of
-  u = L p: (t, L t) comes from Parseval, and u <- u + L(p_new - p) stays exact; when the
-  projection clipped cells, p_new - p (no longer -tau t) is transformed forward (2.5 pairs);
-- the preconditioner's pair in single precision (on grids of 512² and more, where it is 0.42-0.79x
-  the time of a double pair; ``SINGLE_FROM``), a mixed-precision preconditioner in the sense of
-  Higham & Mary (2022, Acta Numerica 31, 347–414): its rounding (relative 1e-7) perturbs the
-  direction, not the equations, so the answer is the same discrete one and the stopping
-  criterion below is read to 1e-6 of itself. On the benchmark surfaces at N = 1024 and 2048,
-  tol 1e-8 and 1e-12: the same iterations, pressures within 2.5e-14 of those of a double one.
+  u = L p: (t, L t) comes from Parseval, and u <- u + L(p_new - p); when the projection clipped
+  cells, p_new - p (no longer -tau t) is transformed forward (2.5 pairs);
+- on grids of 512² and more (``SINGLE_FROM``; there a float32 pair takes 0.42-0.79x the time of a
+  double one) both pairs are in single precision, in the sense of Higham & Mary (2022, Acta
+  Numerica 31, 347–414). The preconditioner's rounding (relative 1e-7) perturbs the direction,
+  not the equations. The rounding of the updates of u stays in u instead: about ``DRIFT`` times
+  ||p_new - p|| / ||p|| per step (measured 0.2-0.4 of that), summed in ``drift``. So u = L p is
+  recomputed in double (the residual replacement of van der Vorst & Ye 2000, SIAM J. Sci.
+  Comput. 22, 835–852) once that sum exceeds 1 % of the tolerance and either reaches ``ROOT`` =
+  √DRIFT times eps (the iteration would soon stall on it) or eps comes within 100x of the
+  tolerance (the last chance before the stop). The drift left at the end is below 1 % of the tolerance, so
+  the answer is the discrete one and the stopping criterion below holds for the true residual.
+  On the benchmark surfaces at N = 512 ... 2048, tol 1e-4 ... 1e-12: the same iterations as in
+  double, 0-2 replacements, drift below 7e-4 tol; the solves take 0.84-0.87x the time of the
+  double steps at 2048², 0.90-0.93x at 1024².
 
 The start is nested (``ContactSolver.coarse_start``). Stopping criterion: eps = ||s|| / ||p|| <=
 tol, with s = Eᵀ M E r (two-level: ``bccg_coarse``'s P r) the preconditioned residual over F,
@@ -49,14 +56,18 @@ from multiscale.micro.kernels import ConvolutionWorkspace, InfluenceOperator, mu
 
 GAMMAS = np.array([0.6, 0.3])   # extension factors of the rings 1, 2 around the free set
 REFRESH = 50                           # iterations between exact recomputations of u = L p
-SINGLE_FROM = 512 * 512                # FFT grids of this many cells and more: preconditioner in float32
+SINGLE_FROM = 512 * 512                # FFT grids of this many cells and more: the iteration's pairs in float32
+DRIFT = float(np.finfo(np.float32).eps)   # drift of u per relative pressure step in float32 (measured: 0.2-0.4 of it)
+ROOT = float(np.sqrt(DRIFT))           # u = L p recomputed when the drift reaches this fraction of eps
 COARSE_FROM = 1024 * 1024              # grids of this many cells and more: two-level preconditioner (bccg_coarse)
 
 
 class Scratch:
     """Buffers of one chunk of B patches (reused between solves of the same chunk size); the
-    per-cell ones flattened to (B, ny * nx), see ``bccg_steps``. ``ws`` applies L, ``pre`` the
-    preconditioner M (in single precision on large grids, ``SINGLE_FROM``); ``coarse``: the
+    per-cell ones flattened to (B, ny * nx), see ``bccg_steps``. ``ws`` applies L in double (u =
+    L p), ``step`` applies L to the directions and increments (``X``, ``Y``: its flat buffers) and
+    ``pre`` the preconditioner M: both in single precision on large grids (``SINGLE_FROM``), else
+    ``step`` is ``ws`` and ``pre`` double; ``coarse``: the
     two-level correction of each patch (when asked for and the grid has ``COARSE_FROM`` cells or
     more, else None)."""
 
@@ -65,10 +76,11 @@ class Scratch:
         N = ny * nx
         single = operator.fft_shape[0] * operator.fft_shape[1] >= SINGLE_FROM
         self.ws: ConvolutionWorkspace = operator.workspace((B,), threads)
+        self.step: ConvolutionWorkspace = operator.workspace((B,), threads, True) if single else self.ws
         self.pre: ConvolutionWorkspace = operator.workspace((B,), threads, single)
         self.mmul = operator.inverse_multiplier.astype(self.pre.fft.input.dtype)
-        self.X = self.ws.load_buffer.reshape(B, -1)            # flat views of the FFT buffers
-        self.Y = self.ws.response_buffer.reshape(B, -1)
+        self.X = self.step.load_buffer.reshape(B, -1)          # flat views of the FFT buffers
+        self.Y = self.step.response_buffer.reshape(B, -1)
         self.XP = self.pre.load_buffer.reshape(B, -1)
         self.YP = self.pre.response_buffer.reshape(B, -1)
         self.label = np.full((B, N), -1, dtype=np.int8)
@@ -83,8 +95,8 @@ class Scratch:
 
     def clear(self) -> None:
         """Zero every buffer (after a failed solve)."""
-        self.ws.clear()
-        self.pre.clear()
+        for w in {self.ws, self.step, self.pre}:
+            w.clear()
         for a in (self.r, self.s, self.s_old, self.t):
             a[...] = 0.0
         self.label[...] = -1
@@ -158,15 +170,15 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
     iterations, residual (eps), converged; ``history`` gets the largest eps per iteration."""
     B, ny, nx = z.shape
     N, Fx = ny * nx, operator.fft_shape[1]
-    ws = work.ws
-    X, Y, S = work.X, work.Y, ws.fft.spectrum
+    ws, step = work.ws, work.step
+    X, Y, S = work.X, work.Y, step.fft.spectrum
     lmul = operator.multiplier
     load_control = target is not None
     target = np.ascontiguousarray(np.zeros(B) if target is None else target, dtype=float)
     delta = np.ascontiguousarray(np.zeros(B) if delta is None else delta, dtype=float)
     z2, p2, u2 = z.reshape(B, N), p.reshape(B, N), u.reshape(B, N)    # views
     active = np.ones(B, dtype=bool)
-    d, pending, pnorm, eps, rt, tau, rho_old, csum, factor = (np.zeros(B) for _ in range(9))
+    d, pending, pnorm, eps, rt, tau, rho_old, csum, factor, steps, drift = (np.zeros(B) for _ in range(11))
     pending[:] = 1.0
     eps[:] = np.inf
     nf, ccount, fixed = (np.zeros(B, dtype=np.int64) for _ in range(3))
@@ -185,7 +197,7 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
         bccg_steps.contact_sums(p2, u2, z2, upper, which, ccount, csum, pnorm)
 
     exact(active)
-    since = 0
+    since = 0                                # iterations since the last exact u
     while True:
         preconditioned_residual(operator, work, z2, p2, u2, delta, load_control, active, ccount, csum, d, nf, upper,
                                 fixed, pnorm, eps)
@@ -197,19 +209,19 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
             break
         bccg_steps.direction(work.fi, work.fj, nf, work.r, work.s, work.s_old, work.t, X, load_control, active, conj,
                              rho_old, rt, iterations, nx, Fx)
-        ws.fft.forward()
+        step.fft.forward()
         if not bccg_steps.step_length(S, lmul, Fx, rt, active, tau):
             raise FloatingPointError("non-finite step length")
         clipped_any, lost_any = bccg_steps.update_pressure(p2, work.t, work.fi, work.fj, nf, tau, X, active,
                                                            load_control, target, pending, clipped, lost, upper,
-                                                           fixed, nx, Fx)
+                                                           fixed, steps, work.s, nx, Fx)
         if clipped_any:                      # u += L(p_new - p): one more forward FFT
-            ws.fft.forward()
+            step.fft.forward()
             factor.fill(1.0)
         else:                                # u += -tau L t
             np.negative(tau, out=factor)
         multiply(S, lmul)
-        ws.fft.inverse(normalise=False)
+        step.fft.inverse(normalise=False)
         bccg_steps.add_response(u2, Y, factor, p2, z2, work.fi, work.fj, nf, pending, active, ccount, csum, pnorm,
                                 upper, fixed, nx, Fx)
         since += 1
@@ -219,8 +231,16 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
                 p[b] = top * (target[b] / top.mean())
             conj[lost] = False
             exact(lost)
-        elif since >= REFRESH:               # bound the round-off drift of the updates of u
-            exact(active)
-            since = 0
+            drift[lost] = 0.0
+        if since >= REFRESH:                 # bound the round-off drift of the updates of u
+            stale, since = active & ~lost, 0
+        elif step is not ws:                 # float32 steps: their rounding (DRIFT of each) stays in u
+            drift += DRIFT * np.sqrt(np.divide(steps, pnorm, out=np.zeros(B), where=pnorm > 0.0))
+            stale = active & ~lost & (drift > 0.01 * tol) & ((drift > ROOT * eps) | (eps < 100.0 * tol))
+        else:
+            continue
+        if stale.any():
+            exact(stale)
+            drift[stale] = 0.0
     converged = eps <= tol
     return dict(d=d, iterations=iterations, residual=eps, converged=converged)

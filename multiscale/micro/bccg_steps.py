@@ -417,25 +417,26 @@ def step_length(S, lmul, Fx, rt, active, tau):
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
 def update_pressure(p, t, fi, fj, nf, tau, X, active, load_control, target, pending, clipped, lost, upper, fixed,
-                    nx, Fx):
+                    steps, scratch, nx, Fx):
     """p <- max(p - tau t, 0) on F (cells outside F keep p = 0) and X = p_new - p on F, the
-    increment whose L updates u (it is -tau t where nothing was clipped); under load control the
-    factor restoring the mean pressure goes to ``pending`` (applied to p and u next). Patches
-    with a finite bound H take ``bounded_update`` instead.
+    increment whose L updates u (it is -tau t where nothing was clipped), ||X||² in ``steps``;
+    under load control the factor restoring the mean pressure goes to ``pending`` (applied to p
+    and u next). Patches with a finite bound H take ``bounded_update`` instead (``scratch``: its
+    (B, ny * nx) float64 work array; X may be float32).
     Returns the numbers of patches with clipped cells and of patches that lost every contact."""
     B, N = p.shape
     nclip, nlost = 0, 0
     for b in range(B):
-        clipped[b], lost[b] = False, False
+        clipped[b], lost[b], steps[b] = False, False, 0.0
         if not active[b]:
             continue
         if upper[b] < np.inf:
             rest = max(target[b] * N - upper[b] * fixed[b], 0.0)
-            clipped[b] = bounded_update(p[b], t[b], fi[b], fj[b], nf[b], tau[b], X[b], upper[b], load_control, rest,
-                                        nx, Fx)
+            clipped[b], steps[b] = bounded_update(p[b], t[b], fi[b], fj[b], nf[b], tau[b], X[b], scratch[b], upper[b],
+                                                  load_control, rest, nx, Fx)
             nclip += clipped[b]
             continue
-        tb, total = tau[b], 0.0
+        tb, total, ss = tau[b], 0.0, 0.0
         for m in range(nf[b]):
             i, j = fi[b, m], fj[b, m]
             g = i * nx + j
@@ -443,9 +444,12 @@ def update_pressure(p, t, fi, fj, nf, tau, X, active, load_control, target, pend
             if q < 0.0:
                 clipped[b] = True
                 q = 0.0
-            X[b, i * Fx + j] = q - p[b, g]
+            dq = q - p[b, g]
+            X[b, i * Fx + j] = dq
+            ss += dq * dq
             p[b, g] = q
             total += q
+        steps[b] = ss
         if load_control:
             if total > 0.0:
                 pending[b] = target[b] * N / total
@@ -457,7 +461,7 @@ def update_pressure(p, t, fi, fj, nf, tau, X, active, load_control, target, pend
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
-def bounded_update(p, t, fi, fj, n, tau, X, H, load_control, rest, nx, Fx):
+def bounded_update(p, t, fi, fj, n, tau, X, q, H, load_control, rest, nx, Fx):
     """One patch (flat arrays) with the bound H: p <- P(p - tau t) on F, P the Euclidean
     projection on {0 <= p <= H; Σ_F p = ``rest``} under load control (``rest``: the load less
     what the cells held at H carry), i.e. p = clip(q + a, 0, H) with the shift a found by a
@@ -466,22 +470,22 @@ def bounded_update(p, t, fi, fj, n, tau, X, H, load_control, rest, nx, Fx):
     Almqvist et al. (2007, Tribol. Int. 40, 574-579), also ContactMechanics'
     ``constrained_conjugate_gradients(hardness=...)``; the load is kept by the shift (the exact
     projection) instead of a rescaling, which would push saturated cells above H.
-    X = p_new - p on F, as in ``update_pressure``. Returns whether any cell moved off the
-    unbounded step p - tau t."""
-    for m in range(n):                          # X <- q = p - tau t (unbounded step)
-        i, j = fi[m], fj[m]
-        X[i * Fx + j] = p[i * nx + j] - tau * t[i * nx + j]
+    X = p_new - p on F, as in ``update_pressure``; ``q`` (flat, of p's layout) holds the
+    unbounded step p - tau t on F. Returns whether any cell moved off it, and ||p_new - p||²."""
+    for m in range(n):
+        g = fi[m] * nx + fj[m]
+        q[g] = p[g] - tau * t[g]
     a = 0.0
     if load_control:
         qmin, qmax = np.inf, -np.inf
         for m in range(n):
-            v = X[fi[m] * Fx + fj[m]]
+            v = q[fi[m] * nx + fj[m]]
             qmin, qmax = min(qmin, v), max(qmax, v)
         lo, hi = -qmax, H - qmin                # phi(lo) = -rest <= 0 <= phi(hi) = n H - rest
         for _ in range(200):
             phi, slope = -rest, 0
             for m in range(n):
-                v = X[fi[m] * Fx + fj[m]] + a
+                v = q[fi[m] * nx + fj[m]] + a
                 if v >= H:
                     phi += H
                 elif v > 0.0:
@@ -496,15 +500,17 @@ def bounded_update(p, t, fi, fj, n, tau, X, H, load_control, rest, nx, Fx):
             a = a - phi / slope if slope > 0 else 0.5 * (lo + hi)
             if not lo < a < hi:
                 a = 0.5 * (lo + hi)
-    moved = False
+    moved, ss = False, 0.0
     for m in range(n):
         i, j = fi[m], fj[m]
-        q = X[i * Fx + j]
-        v = min(max(q + a, 0.0), H)
-        p[i * nx + j] = v
-        X[i * Fx + j] = v - q - tau * t[i * nx + j]
-        moved = moved or v != q
-    return moved
+        g = i * nx + j
+        v = min(max(q[g] + a, 0.0), H)
+        dv = v - p[g]
+        moved = moved or v != q[g]
+        p[g] = v
+        X[i * Fx + j] = dv
+        ss += dv * dv
+    return moved, ss
 
 
 @njit(cache=True, fastmath=_FAST, nogil=True)
