@@ -227,19 +227,18 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
         since += 1
         if lost_any:                         # every cell left the contact: restart from the top
             for b in np.flatnonzero(lost):
-                top = (z[b] == 0).astype(float)
-                p[b] = top * (target[b] / top.mean())
+                summit = (z[b] == 0).astype(float)
+                p[b] = summit * (target[b] / summit.mean())
             conj[lost] = False
             exact(lost)
             drift[lost] = 0.0
+        stale = None                         # patches whose u = L p is recomputed
         if since >= REFRESH:                 # bound the round-off drift of the updates of u
             stale, since = active & ~lost, 0
         elif step is not ws:                 # float32 steps: their rounding (DRIFT of each) stays in u
             drift += DRIFT * np.sqrt(np.divide(steps, pnorm, out=np.zeros(B), where=pnorm > 0.0))
             stale = active & ~lost & (drift > 0.01 * tol) & ((drift > ROOT * eps) | (eps < 100.0 * tol))
-        else:
-            continue
-        if stale.any():
+        if stale is not None and stale.any():
             exact(stale)
             drift[stale] = 0.0
     converged = eps <= tol
