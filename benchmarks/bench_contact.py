@@ -20,7 +20,7 @@ Columns: iterations (tamaas counted from its log in an untimed run); "pairs/it":
 iteration counted by the FFT wrapper (``multiscale.micro.fft.fft_pairs``: every transform of the
 solve, the nested coarse solves included, weighted by its cells, in pairs of the FFT grid: N² for
 a periodic patch, (2N)² zero-padded for an isolated one; "single": of which in single precision,
-bccg's preconditioner from 512²); "t/it [pairs]": time per iteration over the time of one
+bccg's two pairs from 512²); "t/it [pairs]": time per iteration over the time of one
 (double) rfft2 + irfft2 pair of that grid (measured here); "to ref": relative
 L2 distance of the pressure to a tol = 1e-12 reference (bccg; pk at 1e-12 agrees with it to
 ~1e-11); "vs pk": relative L2 between bccg and pk at tol 1e-8 (the discrete answer).

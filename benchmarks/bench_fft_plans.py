@@ -3,7 +3,7 @@ and time per rfft2 + irfft2 pair.
 
 ``multiscale.micro.fft`` measures its plans (FFTW_MEASURE) once per machine and shares the wisdom
 through a file; this script shows what that buys over FFTW_ESTIMATE, and what a float32 pair (the
-contact solver's preconditioner from 512², ``bccg_solver.SINGLE_FROM``) costs against a double one. Medians of 5 repeats per
+contact solver's two pairs from 512², ``bccg_solver.SINGLE_FROM``) costs against a double one. Medians of 5 repeats per
 size, the two flags side by side, one thread. FFTW's wisdom is forgotten before every planning: an
 estimated plan made after a measured one of the same shape reuses the measured plan (the first
 version of this script planned MEASURE first and found the two equally fast).
