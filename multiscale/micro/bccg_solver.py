@@ -214,7 +214,7 @@ def run(operator: InfluenceOperator, work: Scratch, z: np.ndarray, p: np.ndarray
             raise FloatingPointError("non-finite step length")
         clipped_any, lost_any = bccg_steps.update_pressure(p2, work.t, work.fi, work.fj, nf, tau, X, active,
                                                            load_control, target, pending, clipped, lost, upper,
-                                                           fixed, steps, work.s, nx, Fx)
+                                                           fixed, steps, work.s, nx, Fx)   # s: free until back_extend
         if clipped_any:                      # u += L(p_new - p): one more forward FFT
             step.fft.forward()
             factor.fill(1.0)
