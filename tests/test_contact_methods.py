@@ -184,7 +184,7 @@ def test_bccg_iteration_costs_at_most_two_and_a_half_fft_pairs():
 def test_bccg_iterates_in_single_precision_on_large_grids_with_the_same_answer():
     """From 512² (``bccg_solver.SINGLE_FROM``) the iteration's pairs are float32 (preconditioner,
     direction, clipped increments) and u = L p is recomputed in double only at the start and at
-    the residual replacements (``bccg_solver.REPLACE``); the answer stays the discrete one
+    the residual replacements (``bccg_solver.DRIFT``, ``ROOT``); the answer stays the discrete one
     (relative L2 to Polonsky–Keer < 1e-7 at tol 1e-8, as the issue-23 check), the drift left in
     u is below 1 % of the tolerance, and the stopping estimate still bounds the distance to a
     tight solution."""

@@ -35,8 +35,9 @@ The details here:
   recomputed in double (the residual replacement of van der Vorst & Ye 2000, SIAM J. Sci.
   Comput. 22, 835–852) once that sum exceeds 1 % of the tolerance and either reaches ``ROOT`` =
   √DRIFT times eps (the iteration would soon stall on it) or eps comes within 100x of the
-  tolerance (the last chance before the stop). The drift left at the end is below 1 % of the tolerance, so
-  the answer is the discrete one and the stopping criterion below holds for the true residual.
+  tolerance (the last chance before the stop). The drift left at the end is below 1 % of the
+  tolerance, so the answer is the discrete one and the stopping criterion below holds for the true
+  residual.
   On the benchmark surfaces at N = 512 ... 2048, tol 1e-4 ... 1e-12: the same iterations as in
   double, 0-2 replacements, drift below 7e-4 tol; the solves take 0.84-0.87x the time of the
   double steps at 2048², 0.90-0.93x at 1024².
@@ -67,16 +68,17 @@ class Scratch:
     per-cell ones flattened to (B, ny * nx), see ``bccg_steps``. ``ws`` applies L in double (u =
     L p), ``step`` applies L to the directions and increments (``X``, ``Y``: its flat buffers) and
     ``pre`` the preconditioner M: both in single precision on large grids (``SINGLE_FROM``), else
-    ``step`` is ``ws`` and ``pre`` double; ``coarse``: the
-    two-level correction of each patch (when asked for and the grid has ``COARSE_FROM`` cells or
-    more, else None)."""
+    ``step`` is ``ws`` and ``pre`` double (``step`` is ``ws`` too when ``steps`` is False: buffers
+    for ``estimate`` only, which takes no step); ``coarse``: the two-level correction of each
+    patch (when asked for and the grid has ``COARSE_FROM`` cells or more, else None)."""
 
-    def __init__(self, operator: InfluenceOperator, B: int, threads: int | None = None, coarse: bool = False):
+    def __init__(self, operator: InfluenceOperator, B: int, threads: int | None = None, coarse: bool = False,
+                 steps: bool = True):
         ny, nx = operator.shape
         N = ny * nx
         single = operator.fft_shape[0] * operator.fft_shape[1] >= SINGLE_FROM
         self.ws: ConvolutionWorkspace = operator.workspace((B,), threads)
-        self.step: ConvolutionWorkspace = operator.workspace((B,), threads, True) if single else self.ws
+        self.step: ConvolutionWorkspace = operator.workspace((B,), threads, True) if single and steps else self.ws
         self.pre: ConvolutionWorkspace = operator.workspace((B,), threads, single)
         self.mmul = operator.inverse_multiplier.astype(self.pre.fft.input.dtype)
         self.X = self.step.load_buffer.reshape(B, -1)          # flat views of the FFT buffers

@@ -284,7 +284,8 @@ class ContactSolver:
     def _new_scratch(self, method, chunk, threads):
         if method == "bccg":
             return bccg_solver.Scratch(self.operator, chunk, threads, coarse=True)
-        return self.operator.workspace((chunk,), threads), bccg_solver.Scratch(self.operator, chunk, threads)
+        return self.operator.workspace((chunk,), threads), bccg_solver.Scratch(self.operator, chunk, threads,
+                                                                                steps=False)
 
     def _initial_pressure(self, method, z, target, delta, p0, max_iter, upper, threads):
         """A feasible start: the warm start; else for "bccg" the nested start (the solution on the
