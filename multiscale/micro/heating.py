@@ -189,7 +189,7 @@ class _Padded:
         plan = self._plans.get(batch)
         if plan is None:
             my, mx = self.half
-            plan = self._plans[batch] = RealFFT2(batch + (2 * my, 2 * mx))
+            plan = self._plans[batch] = RealFFT2(batch + (2 * my, 2 * mx), rows=self.shape[0])
         return plan
 
     def spectrum(self, x):

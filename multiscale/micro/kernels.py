@@ -233,13 +233,15 @@ class ConvolutionWorkspace:
     Write the load into ``load`` (a (..., ny, nx) view of the FFT input; zero padding around it
     stays zero), call ``apply()``, read ``response`` (a view of the FFT output, overwritten by the
     next ``apply``). ``load_buffer``/``response_buffer`` are the whole (contiguous) buffers,
-    padding included, and ``fft`` the plan (its ``spectrum`` buffer), for compiled loops.
+    padding included, and ``fft`` the plan (its ``spectrum`` buffer), for compiled loops. On a
+    zero-padded grid the transforms skip the padding rows (``RealFFT2``'s ``rows``): the rows of
+    ``load_buffer`` below the patch are not read, those of ``response_buffer`` not written.
     """
 
     def __init__(self, operator: InfluenceOperator, batch: tuple[int, ...], threads: int | None = None,
                  single: bool = False):
         ny, nx = operator.shape
-        self.fft = RealFFT2(batch + operator.fft_shape, threads, single)
+        self.fft = RealFFT2(batch + operator.fft_shape, threads, single, rows=ny)   # zero padding: rows skipped
         self.multiplier = operator.multiplier
         self.load = self.fft.input[..., :ny, :nx]
         self.response = self.fft.output[..., :ny, :nx]
