@@ -14,7 +14,8 @@ The scaling surfaces refine the grid and add roughness (cut-off N/4) at once; th
 separates the two: one surface refined onto finer grids, then finer roughness on one grid. The
 levels part sets the two-level preconditioner of large grids against the one-level one, the
 padding part isolated patches of sides 257, 511, 1030 on FFT grids padded to 5-smooth lengths
-against exactly 2N.
+against exactly 2N, the rows part isolated patches whose FFT pairs skip the padding rows against
+full 2-D pairs.
 
 Columns: iterations (tamaas counted from its log in an untimed run); "pairs/it": FFT pairs per
 iteration counted by the FFT wrapper (``multiscale.micro.fft.fft_pairs``: every transform of the
@@ -290,12 +291,37 @@ def padding(sizes, reps):
               f"{rel(out['padded'].pressure, out['2N'].pressure):9.1e}", flush=True)
 
 
+def skipped_rows(sizes, reps):
+    """Isolated patches: the FFT pairs of the zero-padded grid skipping the zero rows (``RealFFT2``'s
+    ``rows``, the default) against the full 2-D pairs, side by side: two solvers per surface, the
+    second built with the rows' passes switched off, their solves alternated; a batch of 100 x 128²
+    too (chunks of 4 patches on 256² grids)."""
+    print("\nisolated patches, FFT pairs skipping the padding rows against full pairs (bccg, tol 1e-8): medians; "
+          "ratio = median of skipped / full")
+    print(f"{'case':>12} {'full [s]':>9} {'its':>4} {'skipped [s]':>11} {'its':>4} {'ratio':>6} {'rel diff':>9}")
+
+    def whole(*args, rows=None, **kwargs):                   # the full pairs: ``rows`` dropped
+        return fft.RealFFT2(*args, **kwargs)
+
+    cases = [(f"{n}²", surface(n), ()) for n in sizes] + [("100 x 128²", surface(128, seed=2, batch=(100,)), (100,))]
+    for case, (h, dx), batch in cases:
+        solvers = {}
+        for name, plan in (("full", whole), ("skipped", fft.RealFFT2)):
+            with mock.patch.object(kernels, "RealFFT2", plan):   # read when a workspace is built
+                solvers[name] = ContactSolver(E, h.shape[-2:], dx, periodic=False)
+                solvers[name].solve(h, load=LOAD, tol=1e-4)
+        t, out, ratio = alternated({k: partial(s.solve, h, load=LOAD, tol=TOL) for k, s in solvers.items()}, reps)
+        its = {k: int(np.max(r.iterations)) for k, r in out.items()}
+        print(f"{case:>12} {t['full']:9.3f} {its['full']:4d} {t['skipped']:11.3f} {its['skipped']:4d} {ratio:6.3f} "
+              f"{rel(out['skipped'].pressure, out['full'].pressure):9.1e}", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="N = 256, 512, one repeat, smaller batches")
     ap.add_argument("--sizes", default="", help="grid sizes of the scaling rows (default 256,512,1024,2048)")
     ap.add_argument("--skip-tamaas-above", type=int, default=1 << 30, help="no tamaas above this N")
-    ap.add_argument("--only", default="scaling,surfaces,refinement,levels,padding,stopping,batch",
+    ap.add_argument("--only", default="scaling,surfaces,refinement,levels,padding,rows,stopping,batch",
                     help="parts to run")
     args = ap.parse_args()
     import tamaas as tm
@@ -332,6 +358,8 @@ def main():
         levels(big, {1024: 5, 2048: 3})
     if "padding" in parts:
         padding([257] if args.quick else [257, 511, 1030], 1 if args.quick else 3)
+    if "rows" in parts:
+        skipped_rows([256] if args.quick else [256, 512, 1024], 1 if args.quick else 5)
     if "stopping" in parts:
         stopping_rule(256 if args.quick else 512)
     if "batch" in parts:
