@@ -171,7 +171,8 @@ class RealFFT2:
     ``rows`` rows of ``input`` (the others count as zero) and ``inverse`` writes only those of
     ``output`` (the others keep what they held). The pair is then split into passes over rows and
     columns and skips the row transforms of the zero rows: 0.55-0.8x the time of the full pair for
-    ``rows`` = Fy / 2 (benchmarks/README), and the same result to round-off.
+    ``rows`` = Fy / 2 (benchmarks/README), and the same result to round-off (the scipy fallback
+    transforms the whole grid).
     """
 
     def __init__(self, shape: tuple[int, ...], threads: int | None = None, single: bool = False,
