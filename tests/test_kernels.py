@@ -180,6 +180,9 @@ X = fft.RealFFT2(x.shape).forward(x)
 assert np.abs(X - np.fft.rfft2(x)).max() < 1e-12
 print(X.tobytes().hex())
 print(fft.RealFFT2(x.shape, single=True).forward(x).tobytes().hex())
+padded = fft.RealFFT2(x.shape, rows=12)                 # the passes of a zero-padded field
+padded.input[...] = x
+print(padded.inverse(padded.forward()).tobytes().hex())     # its other rows: zero, never written
 """
 
 
@@ -191,9 +194,9 @@ def plan_in_a_process(wisdom):
 
 
 def test_fft_plans_are_measured_once_and_shared_by_later_processes(tmp_path):
-    """The first process measures a shape's plans, double and single precision, and stores the
-    wisdom; a later process plans from it (measures nothing, so it rewrites nothing) and rounds bit
-    for bit alike."""
+    """The first process measures a shape's plans, double and single precision, and the passes of
+    a zero-padded field (``rows``), and stores the wisdom; a later process plans from it (measures
+    nothing, so it rewrites nothing) and rounds bit for bit alike."""
     wisdom = tmp_path / "cache" / "fftw-wisdom"
     first = plan_in_a_process(wisdom)
     assert wisdom.read_bytes().startswith(b"(fftw-3") and b"fftwf_wisdom" in wisdom.read_bytes()

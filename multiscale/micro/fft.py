@@ -169,10 +169,10 @@ class RealFFT2:
 
     ``rows`` (zero-padded fields, e.g. a patch of ny < Fy rows): ``forward`` reads only the first
     ``rows`` rows of ``input`` (the others count as zero) and ``inverse`` writes only those of
-    ``output`` (the others keep what they held). The pair is then split into passes over rows and
-    columns and skips the row transforms of the zero rows: 0.55-0.8x the time of the full pair for
-    ``rows`` = Fy / 2 (benchmarks/README), and the same result to round-off (the scipy fallback
-    transforms the whole grid).
+    ``output`` (the others keep what they held: zero from the start). The pair is then split into
+    passes over rows and columns and skips the row transforms of the zero rows: 0.69-0.83x the
+    time of the full pair for ``rows`` = Fy / 2 (benchmarks/README), and the same result to
+    round-off (the scipy fallback transforms the whole grid).
     """
 
     def __init__(self, shape: tuple[int, ...], threads: int | None = None, single: bool = False,
@@ -202,6 +202,7 @@ class RealFFT2:
             self.spectrum = np.empty(self.spectral_shape, dtype=complex_)
             self._fwd = self._inv = None
         self.input[...] = 0.0   # planning scribbles on the buffers
+        self.output[...] = 0.0  # (with ``rows``, the other rows of the output are never written)
 
     def _split(self):
         """The pair in passes (``rows``): forward the r2c of the first rows, zero spectra for the
