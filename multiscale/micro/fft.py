@@ -208,18 +208,18 @@ class RealFFT2:
         """The pair in passes (``rows``): forward the r2c of the first rows, zero spectra for the
         others, the c2c of the columns in place; back the columns' c2c in place, the rows' c2r."""
         n, S = self.rows, self.spectrum
-        rows, columns, columns_back, rows_back = _measured(
+        row_pass, column_pass, column_back, row_back = _measured(
             [(self.input[..., :n, :], S[..., :n, :], (-1,), "FORWARD"), (S, S, (-2,), "FORWARD"),
              (S, S, (-2,), "BACKWARD"), (S[..., :n, :], self.output[..., :n, :], (-1,), "BACKWARD")], self.threads)
 
         def forward():
-            rows()
+            row_pass()
             S[..., n:, :] = 0.0
-            columns()
+            column_pass()
 
         def inverse(normalise_idft=True):
-            columns_back(normalise_idft=normalise_idft)
-            rows_back(normalise_idft=normalise_idft)
+            column_back(normalise_idft=normalise_idft)
+            row_back(normalise_idft=normalise_idft)
         return forward, inverse
 
     def forward(self, x: np.ndarray | None = None) -> np.ndarray:
