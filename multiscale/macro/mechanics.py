@@ -204,6 +204,9 @@ class Mechanics:
         parts = [fem.form([[integrals(f, cells) for f in row] for row in form], entity_maps=self.tm.entity_maps)
                  for cells in (True, False)]
         self._assemble(A, compiled)             # fixes A's sparsity (an empty assembly would drop it)
+        # from now on exact zeros of the element matrices are not added (the same matrix): most
+        # entries of the facet blocks are, and each add searches its row (docs/architecture.md §5, the macro Newton)
+        A.setOption(PETSc.Mat.Option.IGNORE_ZERO_ENTRIES, True)
         return (A.duplicate(), *parts)
 
     def _jacobian(self, snes, x, J, P) -> None:
