@@ -285,6 +285,33 @@ def test_energy_balance_of_a_stop(tmp_path):
     assert h["heat_step_disc"][-1] < 0.25 * h["heat_step_disc"][1]         # the frictional power falls
 
 
+def test_the_heat_tangent_of_a_kept_cell_part_is_the_full_assembly(tmp_path):
+    """With constant materials the heat Jacobian's cell part (storage, conduction, the disc's
+    transport with SUPG) is kept and reassembled only when dt or the speed changed: after steps of
+    a decelerating disc, the last with a shorter dt, the Jacobian of each step equals a direct
+    assembly of the whole Jacobian to 1e-12 of its largest entry."""
+    from dolfinx.fem import petsc as fpetsc
+    from petsc4py import PETSc
+    text = (STOP.replace("{folder}", str(tmp_path / "linear"))
+            .replace('kappa = [["20 degC", 35], ["400 degC", 30]]', 'kappa = "35 W/(m K)"')
+            .replace('c = [["20 degC", 800], ["400 degC", 1000]]', 'c = "800 J/(kg K)"')
+            .replace("emissivity = 0.6\n", "").replace("emissivity = 0.3\n", ""))
+    model = build_model(loads(text))
+    model.start()
+    th = model.thermal
+    assert not th.nonlinear and th.transport
+    snes, x = th.problem.solver, th.problem.x
+    for dt in (1.0, 1.0, 0.5):
+        model.macro_step(dt, 1)
+        snes.computeJacobian(x, th.problem.A)              # at the state after the step (T, dt, speed)
+        direct = fpetsc.assemble_matrix(th.problem.J, bcs=th.bcs)
+        direct.assemble()
+        difference = th.problem.A.copy()
+        difference.axpy(-1.0, direct)
+        scale = direct.norm(PETSc.NormType.NORM_INFINITY)
+        assert difference.norm(PETSc.NormType.NORM_INFINITY) <= 1e-12 * scale
+
+
 def test_a_failed_heat_factorisation_is_named_in_the_error():
     """MUMPS refusing the heat system's factors (its working memory capped at 1 MB: INFOG(1) = -19)
     ends the step with a ConvergenceError that names MUMPS' status, not only the SNES reason."""

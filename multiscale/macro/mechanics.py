@@ -29,6 +29,7 @@ from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.macro import mumps
 from multiscale.macro.compact_factor import CompactFactor
 from multiscale.macro.interface import ContactInterface, PressureLaw
+from multiscale.macro.kept_cells import KeptCells, assemble, integrals
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
@@ -81,14 +82,6 @@ def load_face_forces(tm: TwoBodyMesh, load: float, load_kind: str) -> dict:
     area = {f: tm.assemble_scalar(1.0 * tm.ds(tm.face(f))) for f in tm.spec.load_faces}
     total = sum(area.values())
     return {f: float(load) * (a / total if load_kind == "force" else a) for f, a in area.items()}
-
-
-def integrals(form, cells: bool):
-    """The cell integrals (``cells``) or all the others of a UFL form; None if there are none."""
-    if form is None:
-        return None
-    part = ufl.Form([i for i in form.integrals() if (i.integral_type() == "cell") == cells])
-    return None if part.empty() else part
 
 
 class Mechanics:
@@ -157,9 +150,11 @@ class Mechanics:
             self.problem.P_mat.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
         # the tangent's cell integrals (small-strain elasticity: E, nu constant or of T, not of u)
         # are assembled once (once per solve with E(T), nu(T)), its facet integrals every iteration
-        self._split = [self._split_forms(self.problem.A, self.problem.J, derivative_block(F, self.u))]
+        self._split = [KeptCells(self.problem.A, self.problem.J, derivative_block(F, self.u), tm.entity_maps,
+                                 self.bcs)]
         if P is not None:
-            self._split.append(self._split_forms(self.problem.P_mat, self.problem.preconditioner, P))
+            self._split.append(KeptCells(self.problem.P_mat, self.problem.preconditioner, P, tm.entity_maps,
+                                         self.bcs))
         self._bulk_of_T = temperatures is not None and not all(isinstance(e, fem.Function)
                                                                 for e in (*self.E, *self.nu))
         self._bulk_stale = True
@@ -197,17 +192,6 @@ class Mechanics:
         zero = fem.Constant(self.tm.parent, 0.0)
         J = derivative_block(self.residuals, self.u)
         return [[None if f is None else ufl.replace(f, {self.contact.friction: zero}) for f in row] for row in J]
-
-    def _split_forms(self, A: PETSc.Mat, compiled, form: list) -> tuple:
-        """(matrix, compiled cell part, compiled facet part) of the block form ``form`` (UFL; of
-        ``A``, ``compiled``): the matrix, of A's sparsity, holds the cell part with the supports."""
-        parts = [fem.form([[integrals(f, cells) for f in row] for row in form], entity_maps=self.tm.entity_maps)
-                 for cells in (True, False)]
-        self._assemble(A, compiled)             # fixes A's sparsity (an empty assembly would drop it)
-        # from now on exact zeros of the element matrices are not added (the same matrix): most
-        # entries of the facet blocks are, and each add searches its row (docs/architecture.md §5, the macro Newton)
-        A.setOption(PETSc.Mat.Option.IGNORE_ZERO_ENTRIES, True)
-        return (A.duplicate(), *parts)
 
     def _jacobian(self, snes, x, J, P) -> None:
         """SNES Jacobian callback: J = cell part (kept) + facet part at x; the preconditioner
@@ -250,16 +234,12 @@ class Mechanics:
         """``A`` overwritten by split form k (0: the tangent, 1: J_0) at the current state: its cell
         part (reassembled if stale) plus its facet part, with the supports."""
         self._refresh_cell_parts()
-        bulk, _, facets = self._split[k]
-        bulk.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
-        fpetsc.assemble_matrix(A, facets, bcs=self.bcs)
-        A.assemble()
-        return A
+        return self._split[k].compose(A)
 
     def _refresh_cell_parts(self) -> None:
         if self._bulk_stale:
-            for bulk, cells, _ in self._split:
-                self._assemble(bulk, cells)
+            for split in self._split:
+                split.refresh()
             self._bulk_stale = False
 
     def _residual(self, snes, x, b) -> None:
@@ -281,7 +261,7 @@ class Mechanics:
             self._offset_stale = False
         self._assemble_vector(b, self._facet_residual)
         self._step.waxpy(-1.0, self._start, x)                     # x - x_0
-        self._split[0][0].multAdd(self._step, b, b)
+        self._split[0].bulk.multAdd(self._step, b, b)
         b.axpy(1.0, self._offset)
         fpetsc.set_bc(b, self._bcs_by_body, x0=x, alpha=-1.0)
         b.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
@@ -421,7 +401,7 @@ class Mechanics:
             if self._frictionless is None:
                 form = fem.form(self._frictionless_jacobian(), entity_maps=self.tm.entity_maps)
                 self._frictionless = (fpetsc.create_matrix(form), form)
-            P = self._assemble(*self._frictionless)
+            P = assemble(*self._frictionless, self.bcs)
         P.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         return P
 
@@ -433,10 +413,3 @@ class Mechanics:
     def _temperatures_may_have_changed(self) -> None:
         """With E(T) or nu(T), the kept cell parts are reassembled at their next use."""
         self._bulk_stale = self._bulk_stale or self._bulk_of_T
-
-    def _assemble(self, A: PETSc.Mat, form) -> PETSc.Mat:
-        """``A`` overwritten by the block matrix of ``form`` at the current state, with the supports."""
-        A.zeroEntries()
-        fpetsc.assemble_matrix(A, form, bcs=self.bcs)
-        A.assemble()
-        return A

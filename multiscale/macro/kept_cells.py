@@ -1,0 +1,70 @@
+"""A block Jacobian assembled as a kept cell part plus its other integrals (issue 23).
+
+The cell integrals of the two bodies (linear elasticity, heat conduction and transport with
+constant materials) change only with a few parameters, while the interface and boundary integrals
+(contact, friction, conductance) change at every call. ``KeptCells`` assembles the cell part into
+a matrix of its own when its owner says so (``refresh``) and composes the Jacobian from a copy of
+it and a fresh assembly of the other integrals (``compose``): equal to the assembly of the whole
+form (tests/test_macro_block.py, tests/test_macro_thermal.py) at a fraction of its cost.
+
+The Jacobian's matrix ignores exact zeros of the element matrices once its pattern is fixed
+(``MAT_IGNORE_ZERO_ENTRIES``; the values are the same): most entries of the facet blocks of a
+vector field are zeros, and every add searches its row (docs/architecture.md §5, the macro Newton).
+"""
+from __future__ import annotations
+
+import ufl
+from dolfinx import fem
+from dolfinx.fem import petsc as fpetsc
+from petsc4py import PETSc
+
+
+def integrals(form, cells: bool):
+    """The cell integrals (``cells``) or all the others of a UFL form; None if there are none."""
+    if form is None:
+        return None
+    part = ufl.Form([i for i in form.integrals() if (i.integral_type() == "cell") == cells])
+    return None if part.empty() else part
+
+
+def assemble(A: PETSc.Mat, form, bcs) -> PETSc.Mat:
+    """``A`` overwritten by the block matrix of the compiled ``form``, with the Dirichlet rows of
+    ``bcs`` (unit diagonal)."""
+    A.zeroEntries()
+    fpetsc.assemble_matrix(A, form, bcs=bcs)
+    A.assemble()
+    return A
+
+
+class KeptCells:
+    """The block Jacobian ``form`` (UFL, a list of lists) of the matrix ``A`` (compiled:
+    ``compiled``) split into its cell part, kept in ``bulk`` (of A's sparsity), and the rest.
+    ``refresh`` reassembles ``bulk`` at the current state; ``compose`` overwrites a matrix of A's
+    sparsity by bulk plus the rest at the current state, with the Dirichlet rows of ``bcs``.
+    Where the rest leaves a body's row or column of blocks empty (a body without interface or
+    boundary terms: DOLFINx cannot assemble such a block form), ``split`` is False and
+    ``compose`` assembles the whole form (``bulk`` is still the cell part)."""
+
+    def __init__(self, A: PETSc.Mat, compiled, form: list, entity_maps, bcs):
+        others = [[integrals(f, False) for f in row] for row in form]
+        self.split = (all(any(f is not None for f in row) for row in others)
+                      and all(any(f is not None for f in column) for column in zip(*others)))
+        self.compiled, self.bcs = compiled, bcs
+        self.cells = fem.form([[integrals(f, True) for f in row] for row in form], entity_maps=entity_maps)
+        self.others = fem.form(others, entity_maps=entity_maps) if self.split else None
+        assemble(A, compiled, bcs)              # fixes A's sparsity (an empty assembly would drop it)
+        A.setOption(PETSc.Mat.Option.IGNORE_ZERO_ENTRIES, True)
+        self.bulk = A.duplicate()
+
+    def refresh(self) -> None:
+        """The cell part assembled anew at the current state."""
+        assemble(self.bulk, self.cells, self.bcs)
+
+    def compose(self, A: PETSc.Mat) -> PETSc.Mat:
+        """``A`` = the kept cell part + the other integrals at the current state."""
+        if not self.split:
+            return assemble(A, self.compiled, self.bcs)
+        self.bulk.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
+        fpetsc.assemble_matrix(A, self.others, bcs=self.bcs)
+        A.assemble()
+        return A
