@@ -545,8 +545,8 @@ class Multiscale:
     def save(self, path: Path, step: int, history: io.History) -> None:
         """Checkpoint after macro step ``step`` (collective)."""
         m, last = self.model, self.model.last_solve
-        arrays = {"heights": self.rough.heights(), "plastic": self.rough.plastic, "warm": self.warm,
-                  "partition": self.partition,
+        arrays = {"heights": self.rough.heights(), "warm": self.warm, "partition": self.partition,
+                  **({"plastic": self.rough.plastic} if self.plastic else {}),    # else zero: not stored
                   "conductance": self.conductance, "flash": self.flash, "counter_depth": self.counter_depth,
                   "exchange": self.exchange, "levels": self.rough.levels, "heat_total": m.heat_total,
                   "heat_lost_recorded": m.heat_lost_recorded,
@@ -568,7 +568,8 @@ class Multiscale:
                              "run it with --overwrite")
         m = self.model
         self.rough.set_heights(range(len(arrays["heights"])), arrays["heights"])
-        self.rough.plastic = arrays["plastic"].copy()
+        if self.plastic:
+            self.rough.plastic = arrays["plastic"].copy()
         self.warm, self.partition = arrays["warm"], arrays["partition"]
         self.conductance, self.rough.levels = arrays["conductance"], arrays["levels"]
         self.datum_gap, self.flash, self.counter_depth = arrays["datum_gap"], arrays["flash"], arrays["counter_depth"]
