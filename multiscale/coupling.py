@@ -549,9 +549,8 @@ class Multiscale:
                   **({"plastic": self.rough.plastic} if self.plastic else {}),    # else zero: not stored
                   "conductance": self.conductance, "flash": self.flash, "counter_depth": self.counter_depth,
                   "exchange": self.exchange, "levels": self.rough.levels, "heat_total": m.heat_total,
-                  "heat_lost_recorded": m.heat_lost_recorded,
+                  "heat_lost_recorded": m.heat_lost_recorded, "datum_gap": self.datum_gap,
                   **({"lost_total": m.thermal.lost_total} if m.thermal is not None else {}),
-                  "datum_gap": self.datum_gap,
                   **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
         attrs = {"step": step, "time": m.time, "work": self.work, "counter_volume": self.counter_volume,
                  "heat_exchanged": [m.heat_exchanged, m.heat_exchanged_total], "scene": self.fingerprint, "load": m.load,
