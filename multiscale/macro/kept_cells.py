@@ -13,10 +13,14 @@ vector field are zeros, and every add searches its row (docs/architecture.md §5
 """
 from __future__ import annotations
 
+import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc as fpetsc
+from mpi4py import MPI
 from petsc4py import PETSc
+from ufl.algorithms import expand_derivatives
+from ufl.algorithms.analysis import extract_coefficients, extract_constants
 
 
 def integrals(form, cells: bool):
@@ -39,8 +43,10 @@ def assemble(A: PETSc.Mat, form, bcs) -> PETSc.Mat:
 class KeptCells:
     """The block Jacobian ``form`` (UFL, a list of lists) of the matrix ``A`` (compiled:
     ``compiled``) split into its cell part, kept in ``bulk`` (of A's sparsity), and the rest.
-    ``refresh`` reassembles ``bulk`` at the current state; ``compose`` overwrites a matrix of A's
-    sparsity by bulk plus the rest at the current state, with the Dirichlet rows of ``bcs``.
+    ``refresh`` reassembles ``bulk`` at the current state (``update``: only if a constant or
+    coefficient of the cell integrals changed since, e.g. dt or a speed); ``compose`` overwrites a
+    matrix of A's sparsity by bulk plus the rest at the current state, with the Dirichlet rows of
+    ``bcs``.
     Where the rest leaves a body's row or column of blocks empty (a body without interface or
     boundary terms: DOLFINx cannot assemble such a block form), ``split`` is False and
     ``compose`` assembles the whole form (``bulk`` is still the cell part)."""
@@ -50,7 +56,11 @@ class KeptCells:
         self.split = (all(any(f is not None for f in row) for row in others)
                       and all(any(f is not None for f in column) for column in zip(*others)))
         self.compiled, self.bcs = compiled, bcs
-        self.cells = fem.form([[integrals(f, True) for f in row] for row in form], entity_maps=entity_maps)
+        cells = [[integrals(f, True) for f in row] for row in form]
+        self.cells = fem.form(cells, entity_maps=entity_maps)
+        expanded = [expand_derivatives(f) for row in cells for f in row if f is not None]
+        self.inputs = sorted({c for f in expanded for c in extract_constants(f) + extract_coefficients(f)}, key=str)
+        self._state = None                  # the inputs' values at the last refresh
         self.others = fem.form(others, entity_maps=entity_maps) if self.split else None
         assemble(A, compiled, bcs)              # fixes A's sparsity (an empty assembly would drop it)
         A.setOption(PETSc.Mat.Option.IGNORE_ZERO_ENTRIES, True)
@@ -59,6 +69,18 @@ class KeptCells:
     def refresh(self) -> None:
         """The cell part assembled anew at the current state."""
         assemble(self.bulk, self.cells, self.bcs)
+        self._state = self._values()
+
+    def update(self) -> None:
+        """``refresh`` if an input of the cell part changed since the last one (decided on all
+        ranks together: the assembly is collective)."""
+        values = self._values()
+        changed = self._state is None or any(not np.array_equal(a, b) for a, b in zip(values, self._state))
+        if self.bulk.getComm().tompi4py().allreduce(changed, op=MPI.LOR):
+            self.refresh()
+
+    def _values(self) -> list:
+        return [np.array(c.value if isinstance(c, fem.Constant) else c.x.array) for c in self.inputs]
 
     def compose(self, A: PETSc.Mat) -> PETSc.Mat:
         """``A`` = the kept cell part + the other integrals at the current state."""

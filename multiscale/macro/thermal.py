@@ -52,14 +52,12 @@ from dolfinx.fem import petsc as fpetsc
 from dolfinx.fem.forms import derivative_block
 from mpi4py import MPI
 from petsc4py import PETSc
-from ufl.algorithms import expand_derivatives
-from ufl.algorithms.analysis import extract_coefficients, extract_constants
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.geometry import Rotation
 from multiscale.macro import mumps
 from multiscale.macro.interface import ContactInterface, rigid_velocity
-from multiscale.macro.kept_cells import KeptCells, integrals
+from multiscale.macro.kept_cells import KeptCells
 from multiscale.macro.materials import body_properties, heat_capacity
 from multiscale.macro.mesh import FormCache, TwoBodyMesh
 
@@ -209,10 +207,6 @@ class Thermal:
             J = derivative_block(self.residuals, self.T)
             tangent = KeptCells(self.problem.A, self.problem.J, J, tm.entity_maps, self.bcs)
             if tangent.split:
-                parts = [integrals(expand_derivatives(f), True) for row in J for f in row if f is not None]
-                self._cell_inputs = sorted({c for f in parts if f is not None
-                                            for c in extract_constants(f) + extract_coefficients(f)}, key=str)
-                self._cell_state = None
                 self._tangent = tangent
                 self.problem.solver.setJacobian(self._jacobian, self.problem.A, self.problem.P_mat)
 
@@ -310,11 +304,7 @@ class Thermal:
         constant or coefficient of it changed) plus the interface and boundary terms at x."""
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         fpetsc.assign(x, self.T)
-        state = [np.array(c.value if isinstance(c, fem.Constant) else c.x.array) for c in self._cell_inputs]
-        changed = self._cell_state is None or any(not np.array_equal(a, b) for a, b in zip(state, self._cell_state))
-        if self.tm.comm.allreduce(changed, op=MPI.LOR):             # the assembly is collective
-            self._tangent.refresh()
-            self._cell_state = state
+        self._tangent.update()
         self._tangent.compose(J)
 
     def step(self, dt: float) -> ThermalStep:
