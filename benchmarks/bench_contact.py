@@ -15,7 +15,7 @@ separates the two: one surface refined onto finer grids, then finer roughness on
 levels part sets the two-level preconditioner of large grids against the one-level one, the
 padding part isolated patches of sides 257, 511, 1030 on FFT grids padded to 5-smooth lengths
 against exactly 2N, the rows part isolated patches whose FFT pairs skip the padding rows against
-full 2-D pairs.
+full 2-D pairs, the floor part the least an iteration of bccg's form can cost (``floor``).
 
 Columns: iterations (tamaas counted from its log in an untimed run); "pairs/it": FFT pairs per
 iteration counted by the FFT wrapper (``multiscale.micro.fft.fft_pairs``: every transform of the
@@ -44,8 +44,9 @@ from unittest import mock
 os.environ.setdefault("OMP_NUM_THREADS", "1")
 os.environ.setdefault("MULTISCALE_THREADS", "1")
 import numpy as np  # noqa: E402
+from numba import njit  # noqa: E402
 
-from multiscale.micro import bccg_solver, fft, kernels  # noqa: E402
+from multiscale.micro import bccg_solver, bccg_steps, fft, kernels  # noqa: E402
 from multiscale.micro.contact import ContactSolver  # noqa: E402
 from multiscale.micro.kernels import HalfSpace  # noqa: E402
 from multiscale.micro.surface import Surface, fractal_surface, refine, statistics  # noqa: E402
@@ -316,12 +317,83 @@ def skipped_rows(sizes, reps):
               f"{rel(out['skipped'].pressure, out['full'].pressure):9.1e}", flush=True)
 
 
+@njit(cache=True, fastmath=True, nogil=True)
+def floor_pass(u, Y, z, p, label, factor, d):
+    """The full-grid pass no iteration avoids, fused: u += factor Y (the step's response) and the
+    gap test of every cell (the free set: contact, or a negative gap). Returns the free cells."""
+    n = 0
+    for k in range(u.size):
+        v = u[k] + factor * Y[k]
+        u[k] = v
+        free = p[k] > 0.0 or v + z[k] - d < 0.0
+        label[k] = 0 if free else -1
+        n += free
+    return n
+
+
+def floor(sizes, reps):
+    """The least an iteration of bccg's form costs, in pairs of its grid: its two single-precision
+    FFT pairs (the preconditioner's with its product, the step's L t with Parseval,
+    ``bccg_steps.step_length``, and its product) and one fused full-grid pass (``floor_pass``), at
+    the solved state of the scaling surface. Everything else an iteration does (the free set's
+    lists, the ring passes, the coarse correction, the CG vectors, the clipped increments) comes on
+    top. The floor and a double pair alternated, medians; "bccg t/it": a whole solve (the nested
+    start included) per iteration, alternated with the pair."""
+    print("\nfloor of an iteration: two float32 pairs + one fused full-grid pass, against a double pair")
+    print(f"{'N':>6} {'pair [ms]':>9} {'float32 pair [ms]':>17} {'pass [ms]':>9} {'floor [ms]':>10} "
+          f"{'floor [pairs]':>13} {'its':>4} {'bccg t/it [pairs]':>17}")
+    for n in sizes:
+        h, dx = surface(n)
+        solver = ContactSolver(E, (n, n), dx)
+        r = solver.solve(h, load=LOAD)
+        op = solver.operator
+        u, p = r.displacement.ravel().copy(), r.pressure.ravel()
+        z, d = (h.max() - h).ravel(), float(r.approach)
+        label = np.empty(n * n, dtype=np.int8)
+        pre, step = op.workspace((1,), 1, True), op.workspace((1,), 1, True)
+        mmul, lmul = op.inverse_multiplier.astype(np.float32), op.multiplier
+        pre.load_buffer[...] = np.random.default_rng(0).random(pre.load_buffer.shape)
+        step.load_buffer[...] = pre.load_buffer
+        rt, active, tau = np.ones(1), np.ones(1, dtype=bool), np.zeros(1)
+        unit = fft.RealFFT2((n, n))
+        unit.input[...] = pre.load_buffer[0]
+        Y = step.response_buffer.reshape(-1)
+
+        def double_pair():
+            unit.forward()
+            unit.inverse(normalise=False)
+
+        def single_pair():
+            pre.fft.forward()
+            pre.fft.inverse(normalise=False)
+
+        def one_pass():
+            floor_pass(u, Y, z, p, label, 0.0, d)
+
+        def least():
+            pre.apply(mmul)
+            S = step.fft.forward()
+            bccg_steps.step_length(S, lmul, n, rt, active, tau)
+            kernels.multiply(S, lmul)
+            step.fft.inverse(normalise=False)
+            floor_pass(u, Y, z, p, label, 0.0, d)
+
+        for f in (double_pair, single_pair, one_pass, least):
+            f()                                      # compiled and planned before timing
+        t, _, ratio = alternated({"pair": double_pair, "floor": least}, reps)
+        t1, _, _ = alternated({"single": single_pair, "pass": one_pass}, reps)
+        t2, _, solve = alternated({"pair": double_pair, "solve": partial(solver.solve, h, load=LOAD)}, 3)
+        its = int(r.iterations)
+        print(f"{n:>6} {1e3 * t['pair']:9.2f} {1e3 * t1['single']:17.2f} {1e3 * t1['pass']:9.2f} "
+              f"{1e3 * t['floor']:10.2f} {ratio:13.2f} {its:4d} {solve / its:17.2f}", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="N = 256, 512, one repeat, smaller batches")
     ap.add_argument("--sizes", default="", help="grid sizes of the scaling rows (default 256,512,1024,2048)")
     ap.add_argument("--skip-tamaas-above", type=int, default=1 << 30, help="no tamaas above this N")
-    ap.add_argument("--only", default="scaling,surfaces,refinement,levels,padding,rows,stopping,batch",
+    ap.add_argument("--only", default="scaling,surfaces,refinement,levels,padding,rows,stopping,batch,floor",
                     help="parts to run")
     args = ap.parse_args()
     import tamaas as tm
@@ -365,6 +437,8 @@ def main():
     if "batch" in parts:
         for threads in (1, 2):
             batch(100, 128, 1 if args.quick else 9, threads)
+    if "floor" in parts:
+        floor([n for n in sizes if n >= 512] or [512], 3 if args.quick else 15)
     load1 = os.getloadavg()
     print(f"\nload average at the end {load1[0]:.2f} {load1[1]:.2f}")
 
