@@ -52,12 +52,18 @@ def test_friction_resultant_is_mu_times_normal_force(tm):
 
 def test_reused_factorisations_give_the_fresh_newton_answer(tm):
     """LU factors kept across Newton iterations and solves (the default) as GMRES preconditioner,
-    with inexact Newton: the same displacements as a fresh factorisation every iteration, to the
-    Newton tolerance (1e-9 of the largest displacement), over a friction load sequence, with fewer
-    factorisations."""
+    with inexact Newton, in single precision (the default): the same displacements as a fresh
+    factorisation in double precision every iteration, to the Newton tolerance (1e-9 of the
+    largest displacement), over a friction load sequence, with fewer factorisations."""
+    from petsc4py import PETSc
     kept = Mechanics(tm, MATERIALS, stiffness=K_N, friction=0.3, speed=0.5, load_kind="pressure", prefix="block_k_")
-    fresh = Mechanics(tm, MATERIALS, stiffness=K_N, friction=0.3, speed=0.5, load_kind="pressure", prefix="block_l_",
-                      refresh=0)
+    PETSc.Options()["block_l_factor_pc_precision"] = "double"
+    try:
+        fresh = Mechanics(tm, MATERIALS, stiffness=K_N, friction=0.3, speed=0.5, load_kind="pressure",
+                          prefix="block_l_", refresh=0)
+    finally:
+        PETSc.Options().delValue("block_l_factor_pc_precision")
+    assert (kept.factors.precision, fresh.factors.precision) == ("single", "double")
     newton = 0
     for p in (0.5e6, 1e6, 2e6, 1.5e6):
         a, b = kept.solve(p), fresh.solve(p)
@@ -71,7 +77,8 @@ def test_reused_factorisations_give_the_fresh_newton_answer(tm):
 
 def test_a_solve_that_fails_with_old_factors_is_repeated_with_fresh_ones(tm):
     """A Newton solve that went astray (NaN state, not converged) is restarted from the state
-    before it with a fresh factorisation every iteration: the answer of an undisturbed solve."""
+    before it with a fresh factorisation every iteration, in double precision from then on: the
+    answer of an undisturbed solve."""
     from multiscale.macro.mechanics import SolveResult
     reference = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_m_")
     reference.solve(1e6)
@@ -86,7 +93,8 @@ def test_a_solve_that_fails_with_old_factors_is_repeated_with_fresh_ones(tm):
             return SolveResult(False, -3, 1, [1.0])
         return real()
     m._newton = astray
-    assert m.solve(1e6).converged and len(calls) == 2
+    assert m.factors.precision == "single"
+    assert m.solve(1e6).converged and len(calls) == 2 and m.factors.precision == "double"
     for u, v in zip(m.u, reference.u):
         np.testing.assert_allclose(u.x.array, v.x.array, rtol=0, atol=1e-9 * np.abs(v.x.array).max())
 
@@ -99,15 +107,20 @@ def test_pulling_the_block_off_raises_convergence_error(tm):
 
 def test_a_failed_factorisation_is_named_in_the_error(tm):
     """MUMPS refusing the factors (here its working memory capped at 1 MB: INFOG(1) = -19) ends the
-    solve with a ConvergenceError that names MUMPS' status, not only the SNES reason."""
+    solve with a ConvergenceError that names MUMPS' status, not only the SNES reason. The user's
+    precision option fixes double factors (single ones of this small mesh fit in 1 MB)."""
     from petsc4py import PETSc
-    PETSc.Options()["block_f_factor_mat_mumps_icntl_23"] = 1
+    options = {"block_f_factor_mat_mumps_icntl_23": 1, "block_f_factor_pc_precision": "double"}
+    for k, v in options.items():
+        PETSc.Options()[k] = v
     try:
         m = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_f_")
+        assert m.factors.precision == "double"
         with pytest.raises(ConvergenceError, match=r"MUMPS INFOG\(1\) = -19 \(more memory than ICNTL\(23\) allows\)"):
             m.solve(1e6)
     finally:
-        PETSc.Options().delValue("block_f_factor_mat_mumps_icntl_23")
+        for k in options:
+            PETSc.Options().delValue(k)
 
 
 def test_missing_material_and_unknown_builder_are_input_errors(tm):

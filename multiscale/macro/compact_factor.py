@@ -15,13 +15,22 @@ the dropped entries are zero.
 
 A MUMPS workspace error is retried with a larger margin (``macro.mumps.factorise``), and the
 larger margin kept for later factorisations.
+
+Factors in single precision (``precision="single"``: MUMPS' SMUMPS on the double matrix, PETSc's
+``<prefix>pc_precision``) take half the memory and bandwidth of double ones, for a preconditioner
+whose rounding a Krylov method on the double operator takes out (Higham & Mary 2022, Acta
+Numerica 31, 347-414, §7: mixed-precision preconditioning; the residual and the answer stay in
+double). A user's own ``<prefix>pc_precision`` option overrides ``precision``.
 """
 from __future__ import annotations
+
+from contextlib import contextmanager
 
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from multiscale.errors import InputError
 from multiscale.macro import mumps
 
 
@@ -32,10 +41,18 @@ class CompactFactor:
     (e.g. MUMPS controls ``<prefix>mat_mumps_icntl_14``). ``analyses`` counts the symbolic
     analyses (pattern changes and workspace retries), ``entries`` the factorised matrix's nonzeros
     (this rank's rows), ``inner`` the PC that holds the factors (``macro.mumps.describe`` names its
-    failure), ``workspace`` the ICNTL(14) margin [%] the retries raised (None: MUMPS' default)."""
+    failure), ``workspace`` the ICNTL(14) margin [%] the retries raised (None: MUMPS' default).
+    ``precision``: "double" or "single" factors (module docstring), changed by ``set_precision``."""
 
-    def __init__(self, factor: str = "lu", solver: str = "mumps", prefix: str = ""):
+    PRECISIONS = ("double", "single")
+
+    def __init__(self, factor: str = "lu", solver: str = "mumps", prefix: str = "", precision: str = "double"):
+        if precision not in self.PRECISIONS:
+            raise InputError("precision", precision, f"one of {', '.join(self.PRECISIONS)}")
         self.factor, self.solver, self.prefix = factor, solver, prefix
+        options = PETSc.Options(prefix)
+        self.user_precision = options.getString("pc_precision") if options.hasName("pc_precision") else None
+        self.precision = self.user_precision or precision
         self.inner: PETSc.PC | None = None
         self.matrix: PETSc.Mat | None = None
         self.keys: np.ndarray | None = None       # row * columns + column of the kept entries (sorted)
@@ -62,11 +79,14 @@ class CompactFactor:
             # two sorted runs: the stable sort merges them in linear time (np.union1d: 0.8 s)
             self.keys = np.sort(np.concatenate([known, new]), kind="stable")
             self._build(P)
+        elif self.inner is None:                  # the same on every rank: after ``set_precision``
+            self._build(P)
         full = np.zeros(len(self.keys))
         full[np.searchsorted(self.keys, keys)] = values[keep]
         self.matrix.setValuesCSR(*self._csr, full)
         self.matrix.assemble()
-        self.workspace, retries = mumps.factorise(self.inner, self.workspace)
+        with self._precision_option():
+            self.workspace, retries = mumps.factorise(self.inner, self.workspace)
         self.analyses += retries
         pc.setFailedReason(self.inner.getFailedReason())
 
@@ -89,7 +109,33 @@ class CompactFactor:
         self.matrix, self.inner = M, inner
         self.analyses += 1
 
+    def set_precision(self, precision: str) -> None:
+        """Factors in ``precision`` from the next set-up on (a change drops the current ones: a new
+        analysis); ignored when the user's option fixes it. Collective in effect: call it on every
+        rank alike."""
+        if precision not in self.PRECISIONS:
+            raise InputError("precision", precision, f"one of {', '.join(self.PRECISIONS)}")
+        if self.user_precision is None and precision != self.precision:
+            self.precision = precision
+            self.reset(None, keep_pattern=True)
+
+    @contextmanager
+    def _precision_option(self):
+        """``<prefix>pc_precision`` in PETSc's options while MUMPS analyses (it reads it there; a
+        numeric refactorisation keeps the precision of its analysis), unless the user set it."""
+        if self.user_precision is not None:
+            yield
+            return
+        options = PETSc.Options(self.prefix)
+        options["pc_precision"] = self.precision
+        try:
+            yield
+        finally:
+            options.delValue("pc_precision")
+
     def apply(self, pc, x, y) -> None:
+        if self.inner is None:                    # ``set_precision`` dropped the factors of an unchanged matrix
+            self.setUp(pc)
         self.inner.apply(x, y)
 
     def reset(self, pc, keep_pattern: bool = False) -> None:

@@ -43,25 +43,34 @@ from multiscale.macro.mesh import TwoBodyMesh
 # loaded state keep GMRES at a few iterations for steps on end on the thesis ch. 7 configuration
 # (issue 23). A solve that fails with old factors is repeated from its start with fresh ones every
 # iteration (``Mechanics.solve``). The preconditioner is built from a matrix of its own, written only
-# at a refresh: PETSc refactorises when that matrix changed, and only then.
+# at a refresh: PETSc refactorises when that matrix changed, and only then. The factors are in
+# single precision (``FACTOR_PRECISION``; GMRES on the double tangent takes their rounding out, the
+# Newton's residual and answer are double): half the memory, and triangular solves and
+# factorisations ~1.3-1.4x faster on the thesis ch. 7 mesh for ~5 % more GMRES iterations
+# (benchmarks/README). A retry factorises in double, and the Mechanics keeps double from then on.
+# Flexible GMRES (the preconditioned directions kept): right-preconditioned GMRES forms its answer
+# by one more application of the preconditioner, whose rounding in single precision then leaves a
+# true residual of ~1e-7 where GMRES reports convergence (tests/test_compact_factor.py).
 NEWTON_OPTIONS = {
     "snes_type": "newtonls", "snes_linesearch_type": "basic",
     "snes_rtol": 1e-10, "snes_atol": 1e-10, "snes_stol": 0.0, "snes_max_it": 30,
     "snes_ksp_ew": True, "snes_ksp_ew_version": 3,
-    "ksp_type": "gmres", "ksp_pc_side": "right", "ksp_rtol": 1e-10, "ksp_atol": 0.0, "ksp_max_it": 50,
+    "ksp_type": "fgmres", "ksp_pc_side": "right", "ksp_rtol": 1e-10, "ksp_atol": 0.0, "ksp_max_it": 50,
     "ksp_gmres_restart": 50, "pc_type": "python",
 }
 # What the Newton GMRES is preconditioned by, MUMPS factors of a matrix without its zero entries
 # (``compact_factor.CompactFactor``, options under <prefix>factor_): "lu", an LU of the tangent J
-# itself (GMRES converges in one iteration with fresh factors); "cholesky", an LDL^T (sym=2) of the
-# frictionless tangent J_0 (J with mu = 0: symmetric, the friction part J - J_0 = mu s (x) dp/du
-# lives on the sliding interface only). The LDL^T takes about half the memory of the LU (0.58 vs
-# 1.00 GB on the 106k-dof brake) and GMRES needs ~11 iterations per Newton step with fresh factors
-# (measured on the 49k-dof brake at the preload; the symmetric part (J + J^T)/2 instead stalls: 200
+# itself (with fresh factors GMRES converges in one iteration in double precision, in a few in
+# single); "cholesky", an LDL^T (sym=2) of the frictionless tangent J_0 (J with mu = 0:
+# symmetric, the friction part J - J_0 = mu s (x) dp/du lives on the sliding interface only). The
+# LDL^T takes about half the memory of the LU (0.58 vs 1.00 GB on the 106k-dof brake, double) and
+# GMRES needs ~11 iterations per Newton step with fresh factors (measured on the 49k-dof brake at
+# the preload, double; the symmetric part (J + J^T)/2 instead stalls: 200
 # iterations, 5e-5). Factors kept over the contact-status changes of the first Newton steps cost
 # more GMRES iterations (~90 per step at 49k dofs with a fixed lag of 5), which the timed rule
 # weighs against the factorisations they save.
 PRECONDITIONERS = ("lu", "cholesky")
+FACTOR_PRECISION = "single"
 
 
 @dataclass
@@ -143,7 +152,7 @@ class Mechanics:
         P = self._frictionless_jacobian() if preconditioner == "cholesky" else None
         self.problem = fpetsc.NonlinearProblem(F, self.u, bcs=self.bcs, petsc_options_prefix=prefix,
                                                petsc_options=NEWTON_OPTIONS, P=P, entity_maps=tm.entity_maps)
-        self.factors = CompactFactor(preconditioner, prefix=prefix + "factor_")
+        self.factors = CompactFactor(preconditioner, prefix=prefix + "factor_", precision=FACTOR_PRECISION)
         self.problem.solver.getKSP().getPC().setPythonContext(self.factors)
         if P is not None:
             self.problem.P_mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
@@ -342,10 +351,11 @@ class Mechanics:
                 for u, x in zip(self.u, start):
                     u.x.array[:] = x
         result = self._newton()
-        if not result.converged:           # old factors can mislead: again from the start, fresh ones
+        if not result.converged:           # old or single-precision factors can mislead: again, fresh double ones
             for u, x in zip(self.u, start):
                 u.x.array[:] = x
             self._fresh = True
+            self.factors.set_precision("double")
             try:
                 result = self._newton()
             finally:
