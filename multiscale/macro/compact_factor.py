@@ -20,7 +20,12 @@ Factors in single precision (``precision="single"``: MUMPS' SMUMPS on the double
 ``<prefix>pc_precision``) take half the memory and bandwidth of double ones, for a preconditioner
 whose rounding a Krylov method on the double operator takes out (Higham & Mary 2022, Acta
 Numerica 31, 347-414, §7: mixed-precision preconditioning; the residual and the answer stay in
-double). A user's own ``<prefix>pc_precision`` option overrides ``precision``.
+double). A user's own ``<prefix>pc_precision`` option overrides ``precision``. Single factors
+need a PETSc whose MUMPS interface runs in mixed precision (3.25 built so, as the dolfinx-solver
+wheel's is); elsewhere PETSc raises at the analysis ("MUMPS does not support single precision"),
+and ``PETSC_OPTIONS="-mech_factor_pc_precision double"`` (the Newton's prefix) runs double
+factors. That error cannot be caught and recovered from in-process: destroying the PC whose MUMPS
+analysis failed so segfaults (PETSc 3.25, checked with an unsupported "half").
 """
 from __future__ import annotations
 
