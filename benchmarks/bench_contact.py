@@ -382,7 +382,7 @@ def floor(sizes, reps):
             f()                                      # compiled and planned before timing
         t, _, ratio = alternated({"pair": double_pair, "floor": least}, reps)
         t1, _, _ = alternated({"single": single_pair, "pass": one_pass}, reps)
-        t2, _, solve = alternated({"pair": double_pair, "solve": partial(solver.solve, h, load=LOAD)}, 3)
+        _, _, solve = alternated({"pair": double_pair, "solve": partial(solver.solve, h, load=LOAD)}, 3)
         its = int(r.iterations)
         print(f"{n:>6} {1e3 * t['pair']:9.2f} {1e3 * t1['single']:17.2f} {1e3 * t1['pass']:9.2f} "
               f"{1e3 * t['floor']:10.2f} {ratio:13.2f} {its:4d} {solve / its:17.2f}", flush=True)

@@ -52,18 +52,17 @@ class CompactFactor:
     PRECISIONS = ("double", "single")
 
     def __init__(self, factor: str = "lu", solver: str = "mumps", prefix: str = "", precision: str = "double"):
-        if precision not in self.PRECISIONS:
-            raise InputError("precision", precision, f"one of {', '.join(self.PRECISIONS)}")
         self.factor, self.solver, self.prefix = factor, solver, prefix
         options = PETSc.Options(prefix)
         self.user_precision = options.getString("pc_precision") if options.hasName("pc_precision") else None
-        self.precision = self.user_precision or precision
+        self.precision = self.user_precision or "double"
         self.inner: PETSc.PC | None = None
         self.matrix: PETSc.Mat | None = None
         self.keys: np.ndarray | None = None       # row * columns + column of the kept entries (sorted)
         self.analyses = 0
         self.workspace: int | None = None
         self._csr: tuple = ()                     # (row pointers, columns) of the kept pattern, this rank's rows
+        self.set_precision(precision)
 
     @property
     def entries(self) -> int:

@@ -45,9 +45,10 @@ from multiscale.macro.mesh import TwoBodyMesh
 # iteration (``Mechanics.solve``). The preconditioner is built from a matrix of its own, written only
 # at a refresh: PETSc refactorises when that matrix changed, and only then. The factors are in
 # single precision (``FACTOR_PRECISION``; GMRES on the double tangent takes their rounding out, the
-# Newton's residual and answer are double): half the memory, and triangular solves and
-# factorisations ~1.3-1.4x faster on the thesis ch. 7 mesh for ~5 % more GMRES iterations
-# (benchmarks/README). A retry factorises in double, and the Mechanics keeps double from then on.
+# Newton's residual and answer are double): half the factors' memory; on the thesis ch. 7 run (2
+# ranks) a triangular solve takes 0.65x, a factorisation ~0.55x the time, and the Newton solves
+# 0.64x (benchmarks/README). A retry factorises in double, and the Mechanics keeps double from
+# then on.
 # Flexible GMRES (the preconditioned directions kept): right-preconditioned GMRES forms its answer
 # by one more application of the preconditioner, whose rounding in single precision then leaves a
 # true residual of ~1e-7 where GMRES reports convergence (tests/test_compact_factor.py).
@@ -65,8 +66,7 @@ NEWTON_OPTIONS = {
 # symmetric, the friction part J - J_0 = mu s (x) dp/du lives on the sliding interface only). The
 # LDL^T takes about half the memory of the LU (0.58 vs 1.00 GB on the 106k-dof brake, double) and
 # GMRES needs ~11 iterations per Newton step with fresh factors (measured on the 49k-dof brake at
-# the preload, double; the symmetric part (J + J^T)/2 instead stalls: 200
-# iterations, 5e-5). Factors kept over the contact-status changes of the first Newton steps cost
+# the preload, double; the symmetric part (J + J^T)/2 instead stalls: 200 iterations, 5e-5). Factors kept over the contact-status changes of the first Newton steps cost
 # more GMRES iterations (~90 per step at 49k dofs with a fixed lag of 5), which the timed rule
 # weighs against the factorisations they save.
 PRECONDITIONERS = ("lu", "cholesky")
