@@ -66,9 +66,10 @@ NEWTON_OPTIONS = {
 # symmetric, the friction part J - J_0 = mu s (x) dp/du lives on the sliding interface only). The
 # LDL^T takes about half the memory of the LU (0.58 vs 1.00 GB on the 106k-dof brake, double) and
 # GMRES needs ~11 iterations per Newton step with fresh factors (measured on the 49k-dof brake at
-# the preload, double; the symmetric part (J + J^T)/2 instead stalls: 200 iterations, 5e-5). Factors kept over the contact-status changes of the first Newton steps cost
-# more GMRES iterations (~90 per step at 49k dofs with a fixed lag of 5), which the timed rule
-# weighs against the factorisations they save.
+# the preload, double; the symmetric part (J + J^T)/2 instead stalls: 200 iterations, 5e-5).
+# Factors kept over the contact-status changes of the first Newton steps cost more GMRES
+# iterations (~90 per step at 49k dofs with a fixed lag of 5), which the timed rule weighs against
+# the factorisations they save.
 PRECONDITIONERS = ("lu", "cholesky")
 FACTOR_PRECISION = "single"
 
@@ -158,15 +159,13 @@ class Mechanics:
             self.problem.P_mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             self.problem.P_mat.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
         # the tangent's cell integrals (small-strain elasticity: E, nu constant or of T, not of u)
-        # are assembled once (once per solve with E(T), nu(T)), its facet integrals every iteration
+        # are kept until an input of theirs changes (T with E(T), nu(T)), its facet integrals are
+        # assembled every iteration
         self._split = [KeptCells(self.problem.A, self.problem.J, derivative_block(F, self.u), tm.entity_maps,
                                  self.bcs)]
         if P is not None:
             self._split.append(KeptCells(self.problem.P_mat, self.problem.preconditioner, P, tm.entity_maps,
                                          self.bcs))
-        self._bulk_of_T = temperatures is not None and not all(isinstance(e, fem.Function)
-                                                                for e in (*self.E, *self.nu))
-        self._bulk_stale = True
         self._fresh = False                # a fresh factorisation every Newton iteration (retry)
         self._pc_stale = True              # the preconditioner matrix is to be rewritten
         self._excess = 0                   # GMRES iterations beyond one per linear solve since then
@@ -241,15 +240,9 @@ class Mechanics:
 
     def _compose(self, A: PETSc.Mat, k: int) -> PETSc.Mat:
         """``A`` overwritten by split form k (0: the tangent, 1: J_0) at the current state: its cell
-        part (reassembled if stale) plus its facet part, with the supports."""
-        self._refresh_cell_parts()
+        part (reassembled if an input of it changed) plus its facet part, with the supports."""
+        self._split[k].update()
         return self._split[k].compose(A)
-
-    def _refresh_cell_parts(self) -> None:
-        if self._bulk_stale:
-            for split in self._split:
-                split.refresh()
-            self._bulk_stale = False
 
     def _residual(self, snes, x, b) -> None:
         """SNES residual callback: F(x) = r_cell(x_0) + K_cell (x - x_0) + facet part at x (contact,
@@ -264,7 +257,7 @@ class Mechanics:
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
         fpetsc.assign(x, self.u)
         if self._offset_stale:
-            self._refresh_cell_parts()
+            self._split[0].update()
             self._assemble_vector(self._offset, self._cell_residual)
             x.copy(self._start)
             self._offset_stale = False
@@ -382,7 +375,6 @@ class Mechanics:
     def _newton(self) -> SolveResult:
         """One SNES solve from the current state; converged only if finite on every rank."""
         self._history.clear()
-        self._temperatures_may_have_changed()
         self._offset_stale = True
         self.problem.solve()
         snes = self.problem.solver
@@ -404,7 +396,6 @@ class Mechanics:
         Owned by the model (with ``preconditioner="cholesky"`` the preconditioner matrix) and
         overwritten by the next call or solve, as ``tangent``."""
         if self.problem.P_mat is not None:       # the preconditioner's matrix: refactorise next time
-            self._temperatures_may_have_changed()
             P = self._compose(self.problem.P_mat, 1)
             self._pc_stale = True
         else:
@@ -417,9 +408,4 @@ class Mechanics:
 
     def tangent(self) -> PETSc.Mat:
         """The assembled block Jacobian at the current state (assembled on request)."""
-        self._temperatures_may_have_changed()
         return self._compose(self.problem.A, 0)
-
-    def _temperatures_may_have_changed(self) -> None:
-        """With E(T) or nu(T), the kept cell parts are reassembled at their next use."""
-        self._bulk_stale = self._bulk_stale or self._bulk_of_T
