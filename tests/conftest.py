@@ -20,3 +20,19 @@ def _relative_approx(expected, rel=None, abs=None, nan_ok=False):
 
 
 pytest.approx = _relative_approx
+
+
+@pytest.fixture
+def petsc_options():
+    """``petsc_options(name=value, ...)`` puts options into PETSc's database for one test; they are
+    removed after it (petsc4py imported on use: after h5py, as above)."""
+    from petsc4py import PETSc
+    names = []
+
+    def put(**options):
+        for name, value in options.items():
+            PETSc.Options()[name] = value
+            names.append(name)
+    yield put
+    for name in names:
+        PETSc.Options().delValue(name)

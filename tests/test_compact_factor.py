@@ -148,7 +148,7 @@ def test_mumps_workspace_too_small_is_retried_with_more():
     assert r.norm() <= 1e-8 * b.norm()
 
 
-def test_single_precision_factors_precondition_gmres_to_double_accuracy():
+def test_single_precision_factors_precondition_gmres_to_double_accuracy(petsc_options):
     """Single-precision factors (MUMPS' SMUMPS on the double matrix): applied alone they solve to
     float32 round-off times the condition (relative error between 1e-9 and 1e-4; double factors:
     1e-12), under flexible GMRES on the double operator to 1e-11 within 4 iterations (right-
@@ -167,10 +167,7 @@ def test_single_precision_factors_precondition_gmres_to_double_accuracy():
     context.set_precision("double")
     ksp.setType("preonly")
     assert error(ksp, A) < 1e-12 and context.analyses == 2
-    PETSc.Options()["fixed_pc_precision"] = "double"
-    try:
-        fixed = CompactFactor(prefix="fixed_", precision="single")
-        fixed.set_precision("single")
-        assert fixed.precision == "double"
-    finally:
-        PETSc.Options().delValue("fixed_pc_precision")
+    petsc_options(fixed_pc_precision="double")
+    fixed = CompactFactor(prefix="fixed_", precision="single")
+    fixed.set_precision("single")
+    assert fixed.precision == "double"

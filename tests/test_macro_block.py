@@ -50,19 +50,15 @@ def test_friction_resultant_is_mu_times_normal_force(tm):
     np.testing.assert_allclose(f, [0.3 * 100.0, 0.0, 100.0], rtol=0, atol=1e-8)
 
 
-def test_reused_factorisations_give_the_fresh_newton_answer(tm):
+def test_reused_factorisations_give_the_fresh_newton_answer(tm, petsc_options):
     """LU factors kept across Newton iterations and solves (the default) as GMRES preconditioner,
     with inexact Newton, in single precision (the default): the same displacements as a fresh
     factorisation in double precision every iteration, to the Newton tolerance (1e-9 of the
     largest displacement), over a friction load sequence, with fewer factorisations."""
-    from petsc4py import PETSc
     kept = Mechanics(tm, MATERIALS, stiffness=K_N, friction=0.3, speed=0.5, load_kind="pressure", prefix="block_k_")
-    PETSc.Options()["block_l_factor_pc_precision"] = "double"
-    try:
-        fresh = Mechanics(tm, MATERIALS, stiffness=K_N, friction=0.3, speed=0.5, load_kind="pressure",
-                          prefix="block_l_", refresh=0)
-    finally:
-        PETSc.Options().delValue("block_l_factor_pc_precision")
+    petsc_options(block_l_factor_pc_precision="double")
+    fresh = Mechanics(tm, MATERIALS, stiffness=K_N, friction=0.3, speed=0.5, load_kind="pressure", prefix="block_l_",
+                      refresh=0)
     assert (kept.factors.precision, fresh.factors.precision) == ("single", "double")
     newton = 0
     for p in (0.5e6, 1e6, 2e6, 1.5e6):
@@ -105,22 +101,15 @@ def test_pulling_the_block_off_raises_convergence_error(tm):
         m.solve(-1e6)
 
 
-def test_a_failed_factorisation_is_named_in_the_error(tm):
+def test_a_failed_factorisation_is_named_in_the_error(tm, petsc_options):
     """MUMPS refusing the factors (here its working memory capped at 1 MB: INFOG(1) = -19) ends the
     solve with a ConvergenceError that names MUMPS' status, not only the SNES reason. The user's
     precision option fixes double factors (single ones of this small mesh fit in 1 MB)."""
-    from petsc4py import PETSc
-    options = {"block_f_factor_mat_mumps_icntl_23": 1, "block_f_factor_pc_precision": "double"}
-    for k, v in options.items():
-        PETSc.Options()[k] = v
-    try:
-        m = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_f_")
-        assert m.factors.precision == "double"
-        with pytest.raises(ConvergenceError, match=r"MUMPS INFOG\(1\) = -19 \(more memory than ICNTL\(23\) allows\)"):
-            m.solve(1e6)
-    finally:
-        for k in options:
-            PETSc.Options().delValue(k)
+    petsc_options(block_f_factor_mat_mumps_icntl_23=1, block_f_factor_pc_precision="double")
+    m = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_f_")
+    assert m.factors.precision == "double"
+    with pytest.raises(ConvergenceError, match=r"MUMPS INFOG\(1\) = -19 \(more memory than ICNTL\(23\) allows\)"):
+        m.solve(1e6)
 
 
 def test_missing_material_and_unknown_builder_are_input_errors(tm):

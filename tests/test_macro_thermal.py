@@ -312,13 +312,9 @@ def test_the_heat_tangent_of_a_kept_cell_part_is_the_full_assembly(tmp_path):
         assert difference.norm(PETSc.NormType.NORM_INFINITY) <= 1e-12 * scale
 
 
-def test_a_failed_heat_factorisation_is_named_in_the_error():
+def test_a_failed_heat_factorisation_is_named_in_the_error(petsc_options):
     """MUMPS refusing the heat system's factors (its working memory capped at 1 MB: INFOG(1) = -19)
     ends the step with a ConvergenceError that names MUMPS' status, not only the SNES reason."""
-    from petsc4py import PETSc
-    PETSc.Options()["heat_mat_mumps_icntl_23"] = 1
-    try:
-        with pytest.raises(ConvergenceError, match=r"MUMPS INFOG\(1\) = -19 \(more memory than ICNTL\(23\)"):
-            march(block_scene(geometry='mesh_size = "1 mm"'))
-    finally:
-        PETSc.Options().delValue("heat_mat_mumps_icntl_23")
+    petsc_options(heat_mat_mumps_icntl_23=1)
+    with pytest.raises(ConvergenceError, match=r"MUMPS INFOG\(1\) = -19 \(more memory than ICNTL\(23\)"):
+        march(block_scene(geometry='mesh_size = "1 mm"'))
