@@ -26,7 +26,14 @@ radiation to surroundings at T_a with emissivity eps and sigma = 5.670374419e-8 
 (Incropera & DeWitt, Fundamentals of Heat and Mass Transfer, §1.2.3). With constant materials and
 no radiation the step is one linear solve (LU), its matrix's cell part (storage, conduction,
 transport) kept between steps while dt and the speed stay (``kept_cells.KeptCells``); radiation or
-a temperature table makes it Newton's method (SNES, exact tangent of T^4, kappa(T) and e(T); LU).
+a temperature table makes it Newton's method (SNES, exact tangent of T^4, kappa(T) and e(T); LU)
+in its chord form (Kelley 1995, Iterative Methods for Linear and Nonlinear Equations, SIAM, ch. 5):
+the tangent and its LU factors are kept across iterations and steps of the same dt while each
+iteration brings the residual norm down to at most ``CHORD_CONTRACTION`` times the previous one
+(else the next iteration assembles and factorises afresh). Such an iteration costs a residual and
+the triangular solves, not also an assembly and a factorisation; the stopping test is on the true
+residual, so the answer is Newton's to the same tolerance. A solve that fails with kept factors is
+redone from the step's start with fresh ones (``redone`` counts them).
 
 Energy balance. P1 test functions sum to one, so the residual summed over every dof of a body is
 its heat balance over the step. The heat lost [J] during a step, consistent with it, is
@@ -57,7 +64,7 @@ from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.geometry import Rotation
 from multiscale.macro import mumps
 from multiscale.macro.interface import ContactInterface, rigid_velocity
-from multiscale.macro.kept_cells import KeptCells
+from multiscale.macro.kept_cells import KeptCells, assemble
 from multiscale.macro.materials import body_properties, heat_capacity
 from multiscale.macro.mesh import FormCache, TwoBodyMesh
 
@@ -70,6 +77,7 @@ STEFAN_BOLTZMANN = 5.670374419e-8      # W/(m^2 K^4), CODATA 2018 (exact)
 CONVECTION_QUADRATURE = 2              # exact for h (T − T_a) r, P1 on flat facets
 RADIATION_QUADRATURE = 5               # exact for (T^4 − T_a^4) r, P1
 ENTHALPY_QUADRATURE = 3                # e(T) r with a tabulated rho c (same rule for the stored heat)
+CHORD_CONTRACTION = 0.01               # keep the Newton tangent while ||F_k|| <= this times ||F_k-1||
 
 
 def temperature_functions(tm, degree: int = 1) -> list:
@@ -150,7 +158,8 @@ class Thermal:
     ``materials`` maps material names to ``multiscale.scene.Material``-like objects (``kappa``
     [W/(m K)], ``rho`` and ``c`` or ``chi``; constants or temperature tables). ``initial_temperature``
     [K] is also the reference of the stored heat. ``boundaries``: ``ThermalBoundary`` conditions
-    (none: every outer surface insulated).
+    (none: every outer surface insulated). With Newton's method, ``jacobians`` counts the tangents
+    assembled and factorised so far, ``redone`` the steps redone with fresh tangents.
     """
 
     def __init__(self, contact: ContactInterface, materials: Mapping[str, object], *,
@@ -209,6 +218,15 @@ class Thermal:
             if tangent.split:
                 self._tangent = tangent
                 self.problem.solver.setJacobian(self._jacobian, self.problem.A, self.problem.P_mat)
+        self.jacobians = 0                     # Newton: tangents assembled (and factorised) so far
+        self._norms: list = []                 # Newton: residual norms of the current solve
+        self._chords = 0                       # Newton: iterations of the current solve on a kept tangent
+        self._tangent_dt = None                # Newton: the step of the kept tangent [s]
+        self.redone = 0                        # Newton: steps redone with fresh tangents
+        self._contraction = CHORD_CONTRACTION  # 0 while a step is redone with fresh tangents
+        if self.nonlinear:
+            self.problem.solver.setJacobian(self._chord_jacobian, self.problem.A, self.problem.P_mat)
+            self.problem.solver.setMonitor(self._watch)
 
     # ---- forms -----------------------------------------------------------------------------
     def _dx(self, i: int, degree: int | None = None):
@@ -307,6 +325,35 @@ class Thermal:
         self._tangent.update()
         self._tangent.compose(J)
 
+    def _watch(self, snes, it: int, norm: float) -> None:
+        """SNES monitor: the residual norms of the current solve."""
+        if it == 0:
+            self._norms.clear()
+            self._chords = 0
+        self._norms.append(norm)
+
+    def _chord_jacobian(self, snes, x, J, P) -> None:
+        """SNES Jacobian callback of the Newton steps (module docstring): J is left as it is, and
+        so are its LU factors (PETSc refactorises only a changed matrix), while a tangent of the
+        same dt is kept and the last iteration brought the residual norm down to
+        ``CHORD_CONTRACTION`` times the one before or less (the norms are global: every rank
+        decides alike); else the tangent is assembled at x."""
+        f, dt = self._norms, float(self.dt.value)
+        if (self.jacobians and self._contraction > 0 and dt == self._tangent_dt
+                and (len(f) < 2 or f[-1] <= self._contraction * f[-2])):
+            self._chords += 1
+            return
+        x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
+        fpetsc.assign(x, self.T)
+        assemble(J, self.problem.J, self.bcs)
+        self.jacobians, self._tangent_dt = self.jacobians + 1, dt
+
+    def _solve(self) -> bool:
+        """One solve from the current T; True if it converged to finite values on every rank."""
+        self.problem.solve()
+        finite = bool(self.tm.comm.allreduce(all(np.isfinite(T.x.array).all() for T in self.T), op=MPI.LAND))
+        return self.problem.solver.getConvergedReason() > 0 and finite
+
     def step(self, dt: float) -> ThermalStep:
         """Advance by dt [s] with the current contact state (pressure, speed) as heat source."""
         self.dt.value = check_positive("dt", dt)
@@ -318,10 +365,16 @@ class Thermal:
         power = self.contact.heat_power() if self.frictional_heat else (0.0, 0.0)
         for new, old in zip(self.T, self.T_old):
             old.x.array[:] = new.x.array
-        self.problem.solve()
+        ok = self._solve()                                        # the same answer on every rank
+        if not ok and self._chords:                               # kept tangents: redo with fresh ones
+            for new, old in zip(self.T, self.T_old):
+                new.x.array[:] = old.x.array
+            self._contraction, self.redone = 0.0, self.redone + 1
+            try:
+                ok = self._solve()
+            finally:
+                self._contraction = CHORD_CONTRACTION
         snes = self.problem.solver
-        finite = bool(self.tm.comm.allreduce(all(np.isfinite(T.x.array).all() for T in self.T), op=MPI.LAND))
-        ok = snes.getConvergedReason() > 0 and finite             # the same answer on every rank
         if not ok:
             failed = mumps.describe(snes.getKSP().getPC())        # the factorisation's failure, if any
             raise ConvergenceError(f"heat step at t = {self.time + dt:.6g} s failed "
