@@ -77,7 +77,7 @@ STEFAN_BOLTZMANN = 5.670374419e-8      # W/(m^2 K^4), CODATA 2018 (exact)
 CONVECTION_QUADRATURE = 2              # exact for h (T − T_a) r, P1 on flat facets
 RADIATION_QUADRATURE = 5               # exact for (T^4 − T_a^4) r, P1
 ENTHALPY_QUADRATURE = 3                # e(T) r with a tabulated rho c (same rule for the stored heat)
-CHORD_CONTRACTION = 0.01               # keep the Newton tangent while ||F_k|| <= this times ||F_k-1||
+CHORD_CONTRACTION = 0.01               # keep the Newton tangent while ||F_k|| <= this times ||F_k-1|| (0: never)
 
 
 def temperature_functions(tm, degree: int = 1) -> list:
@@ -223,7 +223,7 @@ class Thermal:
         self._chords = 0                       # Newton: iterations of the current solve on a kept tangent
         self._tangent_dt = None                # Newton: the step of the kept tangent [s]
         self.redone = 0                        # Newton: steps redone with fresh tangents
-        self._contraction = CHORD_CONTRACTION  # 0 while a step is redone with fresh tangents
+        self._fresh = False                    # Newton: a fresh tangent every iteration (a step redone)
         if self.nonlinear:
             self.problem.solver.setJacobian(self._chord_jacobian, self.problem.A, self.problem.P_mat)
             self.problem.solver.setMonitor(self._watch)
@@ -339,8 +339,8 @@ class Thermal:
         ``CHORD_CONTRACTION`` times the one before or less (the norms are global: every rank
         decides alike); else the tangent is assembled at x."""
         f, dt = self._norms, float(self.dt.value)
-        if (self.jacobians and self._contraction > 0 and dt == self._tangent_dt
-                and (len(f) < 2 or f[-1] <= self._contraction * f[-2])):
+        if (self.jacobians and not self._fresh and CHORD_CONTRACTION > 0 and dt == self._tangent_dt
+                and (len(f) < 2 or f[-1] <= CHORD_CONTRACTION * f[-2])):
             self._chords += 1
             return
         x.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
@@ -369,11 +369,11 @@ class Thermal:
         if not ok and self._chords:                               # kept tangents: redo with fresh ones
             for new, old in zip(self.T, self.T_old):
                 new.x.array[:] = old.x.array
-            self._contraction, self.redone = 0.0, self.redone + 1
+            self._fresh, self.redone = True, self.redone + 1
             try:
                 ok = self._solve()
             finally:
-                self._contraction = CHORD_CONTRACTION
+                self._fresh = False
         snes = self.problem.solver
         if not ok:
             failed = mumps.describe(snes.getKSP().getPC())        # the factorisation's failure, if any
