@@ -164,43 +164,85 @@ class CellEstimate:
         return self.factor == 1.0
 
 
+def gmsh_session(module: ModuleType) -> None:
+    """Start gmsh for a run of the builder ``module`` on the calling rank: quiet, one thread (the
+    same mesh on every run), an empty model; the caller ends it with ``gmsh.finalize()``."""
+    import gmsh   # local: this module stays importable without gmsh's library (scene reading)
+    gmsh.initialize(interruptible=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.option.setNumber("General.NumThreads", 1)
+    gmsh.model.add(f"multiscale_{getattr(module, 'NAME', module.__name__)}")
+
+
 def estimate_cells(module: ModuleType, params, target: int = 20_000, start: float = 64.0,
-                   enough: int = 0) -> CellEstimate:
+                   enough: int = 0, keep: bool = False) -> CellEstimate:
     """Estimate the cell count of ``module.generate(params)`` without meshing it at its size: trial
     meshes from ``start`` times coarser, refined until one has ``target`` cells or is the real mesh
     (a trial the CAD kernel cannot mesh that coarse is skipped), or until the estimate is at most
-    ``enough`` (an over-estimate below a limit settles the question). Each trial is a gmsh session of
-    its own on the calling rank (a failed 3-D meshing leaves gmsh unable to mesh again), so gmsh
-    must not be initialised by the caller; the builder's errors at factor 1 propagate."""
-    import gmsh   # local: this module stays importable without gmsh's library (scene reading)
+    ``enough`` (an over-estimate below a limit settles the question). The trials share one gmsh
+    session on the calling rank: the builder runs once and later trials remesh its model (the same
+    mesh as a fresh run's, tested), so a CAD file is read and fragmented once; a failed meshing
+    ends the session (gmsh cannot mesh again after a failed 3-D meshing) and the next trial runs
+    the builder anew. A mesh read from a file is counted as it is. gmsh must not be initialised by
+    the caller; the builder's errors at factor 1 propagate. With ``keep`` and an estimate of at
+    most ``enough``, the session is left open holding the real mesh (factor 1) for the caller to
+    read and end with ``gmsh.finalize()``; otherwise it is ended."""
+    import gmsh   # local, as in gmsh_session
     if gmsh.isInitialized():
         raise RuntimeError("estimate_cells runs gmsh sessions of its own: call it before gmsh.initialize")
     factor = float(start)
-    while True:
-        gmsh.initialize(interruptible=False)
-        try:
-            gmsh.option.setNumber("General.Terminal", 0)
-            gmsh.option.setNumber("Mesh.MeshSizeFactor", factor)
-            gmsh.model.add("multiscale_cell_estimate")
-            module.generate(gmsh.model, params)
-            trial = sum(len(t) for t in gmsh.model.mesh.getElements(3)[1])
-        except Exception:        # e.g. "PLC Error": too coarse for the geometry's features
-            if factor == 1.0:
-                raise
-            trial = 0
-        finally:
+    try:
+        while True:
+            trial = _trial(module, params, factor)
+            if trial and all(gmsh.model.getType(3, t) == "Discrete volume" for _, t in gmsh.model.getEntities(3)):
+                factor = 1.0           # a mesh read from a file: no size factor changes it
+            if factor == 1.0 or trial >= target or 0 < trial * factor ** 3 <= enough:
+                estimate = CellEstimate(int(round(trial * factor ** 3)), trial, factor)
+                break
+            grow = (target / trial) ** (1 / 3) if trial else 2.0
+            factor = factor / max(2.0, min(grow, 8.0))
+            factor = 1.0 if factor < 1.25 else factor      # nearly the mesh: mesh it
+        if keep and estimate.cells <= enough:
+            if not estimate.exact:
+                _trial(module, params, 1.0)
+            return estimate
+    except BaseException:
+        if gmsh.isInitialized():
             gmsh.finalize()
-        if factor == 1.0 or trial >= target or 0 < trial * factor ** 3 <= enough:
-            return CellEstimate(int(round(trial * factor ** 3)), trial, factor)
-        grow = (target / trial) ** (1 / 3) if trial else 2.0
-        factor = factor / max(2.0, min(grow, 8.0))
-        factor = 1.0 if factor < 1.25 else factor      # nearly the mesh: mesh it
+        raise
+    gmsh.finalize()
+    return estimate
 
 
-def check_cells(module: ModuleType, params, max_cells: int) -> CellEstimate:
+def _trial(module: ModuleType, params, factor: float) -> int:
+    """Tetrahedra of the builder's mesh with every size times ``factor``: the open session's model
+    remeshed, or the builder run in a new session; 0 for a failed trial above factor 1 (its
+    session ended), the builder's error at factor 1."""
+    import gmsh   # local, as in gmsh_session
+    built = gmsh.isInitialized()
+    try:
+        if built:
+            gmsh.model.mesh.clear()
+        else:
+            gmsh_session(module)
+        gmsh.option.setNumber("Mesh.MeshSizeFactor", factor)
+        if built:
+            gmsh.model.mesh.generate(3)
+        else:
+            module.generate(gmsh.model, params)
+    except Exception:        # e.g. "PLC Error": too coarse for the geometry's features
+        gmsh.finalize()
+        if factor == 1.0:
+            raise
+        return 0
+    return sum(len(t) for t in gmsh.model.mesh.getElements(3)[1])
+
+
+def check_cells(module: ModuleType, params, max_cells: int, keep: bool = False) -> CellEstimate:
     """``estimate_cells`` against a limit: InputError (naming geometry.max_cells, the estimate and
-    what to change) if the mesh would have more than ``max_cells`` cells."""
-    estimate = estimate_cells(module, params, enough=max_cells)
+    what to change) if the mesh would have more than ``max_cells`` cells. With ``keep``, a mesh
+    within the limit is left meshed in the open gmsh session (``estimate_cells``)."""
+    estimate = estimate_cells(module, params, enough=max_cells, keep=keep)
     if estimate.cells > max_cells:
         raise InputError("geometry.max_cells", max_cells,
                          f"the mesh would have about {estimate.cells:.3g} cells (a trial mesh {estimate.factor:.3g}x "

@@ -11,6 +11,7 @@ import gmsh  # noqa: E402
 
 from meshes import pin_on_disc  # noqa: E402
 from multiscale.cli import main  # noqa: E402
+from multiscale.geometry import estimate_cells  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 
@@ -151,6 +152,19 @@ def test_cad_and_script_files_give_the_builtin_results_to_discretisation_toleran
     rise, ref = h["max_temperature_fixed"] - 293.15, builtin["max_temperature_pin"] - 293.15
     np.testing.assert_allclose(rise[1:], ref[1:], rtol=0.05)
     np.testing.assert_allclose(h["heat_total_fixed"], builtin["heat_total_pin"], rtol=0.01)
+
+
+def test_a_mesh_file_is_counted_as_it_is(files, tmp_path):
+    """A mesh read from a file is what it is: its count, exact, from one reading."""
+    g = scene_for(files, "msh", tmp_path).geometry
+    estimate = estimate_cells(g.module(), g.params)
+    gmsh.initialize()
+    try:
+        gmsh.open(str(files / "pod.msh"))
+        count = sum(len(t) for t in gmsh.model.mesh.getElements(3)[1])
+    finally:
+        gmsh.finalize()
+    assert estimate.exact and estimate.cells == count > 1000
 
 
 def check(tmp_path, capsys, text) -> str:

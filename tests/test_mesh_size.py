@@ -6,6 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 gmsh = pytest.importorskip("gmsh")
@@ -16,16 +17,27 @@ from multiscale.geometry import MAX_CELLS, builder, check_cells, estimate_cells 
 TINY = {"mesh_size": 5e-5, "holder_mesh_size": 5e-5, "interface_mesh_size": 5e-5}
 
 
-def cells(name: str, params: dict) -> int:
-    """Tetrahedra of the builder's real mesh."""
+def mesh() -> tuple[np.ndarray, np.ndarray]:
+    """Node coordinates and tetrahedra (node tags) of gmsh's current model."""
+    _, x, _ = gmsh.model.mesh.getNodes()
+    return x, np.concatenate(gmsh.model.mesh.getElements(3)[2])
+
+
+def real(name: str, params: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The builder's real mesh, built in a session of its own."""
     gmsh.initialize(interruptible=False)
     try:
         gmsh.option.setNumber("General.Terminal", 0)
         gmsh.model.add("real")
         builder(name).generate(gmsh.model, params)
-        return sum(len(t) for t in gmsh.model.mesh.getElements(3)[1])
+        return mesh()
     finally:
         gmsh.finalize()
+
+
+def cells(name: str, params: dict) -> int:
+    """Tetrahedra of the builder's real mesh."""
+    return len(real(name, params)[1]) // 4
 
 
 @pytest.mark.parametrize("name, params", [
@@ -65,6 +77,27 @@ def test_a_mesh_below_the_limit_is_settled_by_a_coarse_trial():
     is not built twice."""
     estimate = check_cells(builder("pin_on_disc"), {}, MAX_CELLS)
     assert estimate.factor > 2 and 0.9 * cells("pin_on_disc", {}) <= estimate.cells <= MAX_CELLS
+
+
+@pytest.mark.parametrize("name", ["pin_on_disc", "disc_brake"])
+def test_a_kept_session_holds_the_builders_own_mesh(name):
+    """With keep, the trials' model is remeshed at the builder's sizes in their session (one
+    reading of a CAD file): node for node and tetrahedron for tetrahedron the mesh of a fresh
+    run of the builder. The disc brake's coarsest trials fail, so its session is begun anew."""
+    estimate = check_cells(builder(name), {}, MAX_CELLS, keep=True)
+    try:
+        assert gmsh.isInitialized() and not estimate.exact
+        x, tets = mesh()
+    finally:
+        gmsh.finalize()
+    x_ref, tets_ref = real(name, {})
+    assert np.array_equal(x, x_ref) and np.array_equal(tets, tets_ref)
+
+
+def test_a_refused_mesh_leaves_no_session():
+    with pytest.raises(InputError, match="geometry.max_cells"):
+        check_cells(builder("pin_on_disc"), TINY, MAX_CELLS, keep=True)
+    assert not gmsh.isInitialized()
 
 
 def test_gmsh_is_left_as_found():

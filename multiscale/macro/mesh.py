@@ -25,7 +25,7 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from multiscale.errors import InputError, MultiscaleError
-from multiscale.geometry import BodySpec, GeometrySpec, check_cells
+from multiscale.geometry import BodySpec, GeometrySpec, check_cells, gmsh_session
 
 INTERFACE_QUADRATURE = 2      # exact for P1 displacements times P1 tests on a facet
 
@@ -282,7 +282,8 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
     """Run a gmsh builder (``multiscale.geometry``) on rank 0 and distribute the mesh (shared-facet
     ghosting); ``spec`` (default: the builder's ``describe``) tags bodies, faces and interfaces.
     With ``max_cells``, a mesh estimated larger is refused before meshing (``check_cells``: an
-    InputError on every rank)."""
+    InputError on every rank); the trial meshes and the mesh share one gmsh session (a CAD file is
+    read once)."""
     spec = spec or builder.describe(params)
     name = getattr(builder, "NAME", builder.__name__)
     error = None
@@ -290,15 +291,9 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
         import gmsh   # rank 0 alone builds the geometry
         try:
             if max_cells is not None:
-                check_cells(builder, params, max_cells)      # gmsh sessions of its own, before ours
-        except MultiscaleError as exc:
-            error = exc
-        gmsh.initialize(interruptible=False)
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("General.NumThreads", 1)
-        gmsh.model.add(name)
-        try:
-            if error is None:
+                check_cells(builder, params, max_cells, keep=True)   # its trials' session holds the mesh
+            else:
+                gmsh_session(builder)
                 builder.generate(gmsh.model, params)
         except Exception as exc:  # re-raised on every rank below
             error = exc
@@ -316,7 +311,7 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
         model = gmsh.model if comm.rank == 0 else None
         data = dolfinx.io.gmsh.model_to_mesh(model, comm, 0, gdim=3, partitioner=partitioner)
     finally:
-        if comm.rank == 0:
+        if comm.rank == 0 and gmsh.isInitialized():
             gmsh.finalize()
     return from_mesh(spec, data.mesh, data.cell_tags, data.facet_tags)
 
