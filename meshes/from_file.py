@@ -17,6 +17,9 @@ found; and ``generate``, on the meshing rank):
    normal when planar;
 4. find the named surfaces: the file's physical surface groups and [geometry.surfaces].
 
+CAD is meshed with gmsh's HXT unless ``mesh_algorithm`` says "delaunay"; a ``.geo`` script keeps
+its own choice unless told. A failed 3-D meshing is an InputError naming the other algorithm.
+
 The macro model's body 0 ("fixed") holds every fixed body as a material region (bodies that touch
 are bonded: one conforming mesh), body 1 the rotating body. Tags: body k -> cell tag 1 + k,
 interface k -> facet tag 1001 + k, surface k -> facet tag 2001 + k.
@@ -36,10 +39,10 @@ DEFAULTS: dict = {}          # no numeric parameters: [geometry] of the scene is
 FIXED = "fixed"              # name of body 0 (the fixed bodies), body 1 is the rotating body
 PLAUSIBLE = (1e-3, 10.0)     # m, smallest and largest extent of a brake or tribometer model
 NORMAL_TOLERANCE = np.cos(np.radians(5.0))
-HXT = 10                     # gmsh's Mesh.Algorithm3D for CAD: HXT (Marot, Pellerin & Remacle 2019,
-#                              Int. J. Numer. Methods Eng. 117, 967-990), on one thread 6x faster than
-#                              gmsh's default Delaunay on the car brake, of better worst quality
-#                              (benchmarks/README, car brake)
+ALGORITHM_3D = {"delaunay": 1, "hxt": 10}   # gmsh's Mesh.Algorithm3D by mesh_algorithm; CAD takes HXT
+#   (Marot, Pellerin & Remacle 2019, Int. J. Numer. Methods Eng. 117, 967-990) unless told: on one
+#   thread 6x faster than gmsh's default Delaunay on the car brake, of better worst quality
+#   (benchmarks/README, car brake)
 
 
 @dataclass
@@ -101,10 +104,17 @@ def generate(model, params) -> None:
         add_group(model, 2, faces, 2001 + k, name)
     if params.kind != "mesh":
         _sizes(model, params, [f for faces in found.interfaces.values() for f in faces])
-        if params.kind == "cad":          # a script's own choice of algorithm stands
+        algorithm = params.mesh_algorithm or ("hxt" if params.kind == "cad" else None)   # else the script's
+        if algorithm is not None:
             import gmsh   # mesh options are global in gmsh
-            gmsh.option.setNumber("Mesh.Algorithm3D", HXT)
-        model.mesh.generate(3)
+            gmsh.option.setNumber("Mesh.Algorithm3D", ALGORITHM_3D[algorithm])
+        try:
+            model.mesh.generate(3)
+        except Exception as exc:
+            other = " or ".join(f'"{a}"' for a in ALGORITHM_3D if a != algorithm)
+            raise InputError("geometry.mesh_algorithm", algorithm or "the script's choice",
+                             f"gmsh could not mesh {params.file.name} ({exc}): try mesh_algorithm = {other}, "
+                             "or other mesh sizes") from None
 
 
 # ---------------------------------------------------------------- reading

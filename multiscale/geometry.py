@@ -217,7 +217,7 @@ def estimate_cells(module: ModuleType, params, target: int = 20_000, start: floa
 def _trial(module: ModuleType, params, factor: float) -> int:
     """Tetrahedra of the builder's mesh with every size times ``factor``: the open session's model
     remeshed, or the builder run in a new session; 0 for a failed trial above factor 1 (its
-    session ended), the builder's error at factor 1."""
+    session ended); at factor 1, the error of the builder's own run."""
     import gmsh   # local, as in gmsh_session
     built = gmsh.isInitialized()
     try:
@@ -233,6 +233,8 @@ def _trial(module: ModuleType, params, factor: float) -> int:
     except Exception:        # e.g. "PLC Error": too coarse for the geometry's features
         gmsh.finalize()
         if factor == 1.0:
+            if built:            # the builder's own run, whose error says what to change
+                return _trial(module, params, factor)
             raise
         return 0
     return sum(len(t) for t in gmsh.model.mesh.getElements(3)[1])

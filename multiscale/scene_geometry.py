@@ -29,6 +29,7 @@ _POINT = Vector(Quantity("length"))
 _DIRECTION = Vector(Quantity("dimensionless"))
 # plausible builder parameters by kind (SI; warned outside): lengths of a tribometer or brake part
 _PLAUSIBLE = {"length": (1e-5, 10.0), "angle": (0.0, 6.2832)}
+MESH_ALGORITHMS = ("hxt", "delaunay")     # gmsh's 3-D algorithms a file can be meshed with
 FILE_TYPES = {".msh": "mesh", ".geo": "script", ".step": "cad", ".stp": "cad", ".iges": "cad", ".igs": "cad",
               ".brep": "cad"}
 
@@ -110,6 +111,7 @@ class FileGeometry:
     unit: float = key(LengthUnit(), default=1.0)              # m per length unit of the file
     mesh_size: float | None = key(_LENGTH)                     # m, global element size (CAD, .geo)
     interface_mesh_size: float | None = key(_LENGTH)           # m, element size on the interfaces
+    mesh_algorithm: str | None = key(Choice(MESH_ALGORITHMS))  # gmsh's 3-D mesher (CAD: "hxt"; .geo: the script's)
     rotating: str | None = key(Text(), required=True)          # the body that rotates
     axis: tuple = key(_DIRECTION, default=(0.0, 0.0, 1.0))
     centre: tuple = key(_POINT, default=(0.0, 0.0, 0.0))       # m, a point on the axis
@@ -128,6 +130,8 @@ class FileGeometry:
             out.append(f"{path}.file = \"{self.file.name}\": unknown type; allowed: {', '.join(FILE_TYPES)}")
         elif self.kind != "mesh" and self.mesh_size is None:
             out.append(f"{path}.mesh_size: missing; needed to mesh a {self.file.suffix} file")
+        elif self.kind == "mesh" and self.mesh_algorithm is not None:
+            out.append(f"{path}.mesh_algorithm: not used with a {self.file.suffix} file (it is meshed already)")
         if self.rotating not in self.bodies:
             out.append(f"{path}.rotating = \"{self.rotating}\": not a body; bodies: {', '.join(self.bodies)}")
         if len(self.bodies) < 2:

@@ -11,7 +11,8 @@ import gmsh  # noqa: E402
 
 from meshes import pin_on_disc  # noqa: E402
 from multiscale.cli import main  # noqa: E402
-from multiscale.geometry import estimate_cells  # noqa: E402
+from multiscale.errors import InputError  # noqa: E402
+from multiscale.geometry import MAX_CELLS, check_cells, estimate_cells  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 
@@ -116,11 +117,11 @@ def files(tmp_path_factory):
     return folder
 
 
-def scene_for(files, kind, tmp_path):
+def scene_for(files, kind, tmp_path, more=""):
     by_name = {b: f'volumes = ["{b}"]' for b in INSIDE}
     by_point = {b: f"contains = {p}" for b, p in INSIDE.items()}
     extra = {"msh": "", "step": 'mesh_size = "15 mm"\ninterface_mesh_size = "2.5 mm"',
-             "geo": 'unit = "mm"\nmesh_size = "15 mm"\ninterface_mesh_size = "2.5 mm"'}[kind]
+             "geo": 'unit = "mm"\nmesh_size = "15 mm"\ninterface_mesh_size = "2.5 mm"'}[kind] + "\n" + more
     text = FILE.format(name=kind, file=files / f"pod.{kind}", extra=extra, folder=tmp_path / kind,
                        surfaces="" if kind == "msh" else CAD_SURFACES, **(by_name if kind == "msh" else by_point))
     return loads(text, files)
@@ -167,6 +168,40 @@ def test_a_mesh_file_is_counted_as_it_is(files, tmp_path):
     assert estimate.exact and estimate.cells == count > 1000
 
 
+def test_cad_is_meshed_by_the_chosen_algorithm_and_a_failure_says_what_to_change(files, tmp_path, monkeypatch):
+    """CAD takes HXT unless mesh_algorithm says otherwise. Were HXT to fail on a file at its mesh
+    size (simulated: gmsh's 3-D meshing raises under HXT at size factor 1, after coarse trials
+    that succeed), the mesh is refused with one InputError naming geometry.mesh_algorithm and the
+    other algorithm, raised by the builder's own run after the kept session's remesh failed; with
+    mesh_algorithm = "delaunay" the same file meshes."""
+    mesh3d = gmsh.model.mesh.generate
+
+    def no_hxt(dim=3):
+        if dim == 3 and gmsh.option.getNumber("Mesh.Algorithm3D") == 10 and \
+                gmsh.option.getNumber("Mesh.MeshSizeFactor") == 1.0:
+            raise Exception("HXT failed (simulated)")
+        mesh3d(dim)
+
+    g = scene_for(files, "step", tmp_path).geometry
+    used = []
+    monkeypatch.setattr(gmsh.model.mesh, "generate", lambda dim=3: used.append(
+        gmsh.option.getNumber("Mesh.Algorithm3D")) or mesh3d(dim))
+    check_cells(g.module(), g.params, MAX_CELLS)
+    assert used and set(used) == {10}
+    monkeypatch.setattr(gmsh.model.mesh, "generate", no_hxt)
+    with pytest.raises(InputError, match=r"geometry.mesh_algorithm = 'hxt': gmsh could not mesh pod.step \(HXT failed "
+                                         r"\(simulated\)\): try mesh_algorithm = \"delaunay\""):
+        check_cells(g.module(), g.params, MAX_CELLS, keep=True)
+    assert not gmsh.isInitialized()
+    delaunay = scene_for(files, "step", tmp_path, 'mesh_algorithm = "delaunay"').geometry
+    estimate = check_cells(delaunay.module(), delaunay.params, MAX_CELLS, keep=True)
+    try:
+        assert gmsh.option.getNumber("Mesh.Algorithm3D") == 1
+        assert 1000 < sum(len(t) for t in gmsh.model.mesh.getElements(3)[1]) <= estimate.cells
+    finally:
+        gmsh.finalize()
+
+
 def check(tmp_path, capsys, text) -> str:
     """``multiscale check`` of a scene: exit code 2, exactly one error line, which is returned."""
     path = tmp_path / "bad.toml"
@@ -195,6 +230,10 @@ def test_bad_geometry_files_are_one_clear_line(files, tmp_path, capsys):
     assert "materials.pin.E" in err and "temperature must increase strictly" in err
     err = check(tmp_path, capsys, good.replace('E = "5 GPa"', 'E = [["100 degC", "5 GPa"]]'))
     assert "materials.pin.E" in err and "at least 2 rows" in err
+    err = check(tmp_path, capsys, good.replace('rotating = "disc"', 'rotating = "disc"\nmesh_algorithm = "hxt"'))
+    assert "geometry.mesh_algorithm: not used with a .msh file" in err
+    err = check(tmp_path, capsys, good.replace('rotating = "disc"', 'rotating = "disc"\nmesh_algorithm = "tetgen"'))
+    assert "geometry.mesh_algorithm" in err and "allowed: hxt, delaunay" in err
     err = check(tmp_path, capsys, good.replace('surfaces = ["disc_bore"]', 'surfaces = ["bore"]'))
     assert 'boundary[2].surfaces: "bore" is not a surface' in err and "disc_bore" in err
 
