@@ -199,7 +199,7 @@ def estimate_cells(module: ModuleType, params, target: int = 20_000, start: floa
             if factor == 1.0 or trial >= target or 0 < trial * factor ** 3 <= enough:
                 estimate = CellEstimate(int(round(trial * factor ** 3)), trial, factor)
                 break
-            grow = (target / trial) ** (1 / 3) if trial else 2.0
+            grow = (target / trial) ** (1 / 3) if trial else 4.0     # a failed trial: its session is gone, skip ahead
             factor = factor / max(2.0, min(grow, 8.0))
             factor = 1.0 if factor < 1.25 else factor      # nearly the mesh: mesh it
         if keep and estimate.cells <= enough:
