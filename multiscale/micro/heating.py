@@ -8,8 +8,9 @@ or differ by the temperature jump of an interface layer (§6.3.3).
 Transient (§6.3, ``TransientHeating``): fluxes are constant over each time step dt (§6.3.2); at step N
 the increment psi = phi_1(t_N) − phi_1(t_{N−1}) on the contact solves A^N psi = Phi^N − Lambda^N
 (Eqs. 6.9–6.18) with A^N = (T_1 + T_2)(one step) + interface diagonal (Eq. 6.16) applied by FFT
-convolution (Eq. 6.22), by conjugate gradients on the non-symmetric least-squares objective
-(Eqs. 6.19–6.20) restricted to the contacting cells (Eq. 6.21). Energy is conserved exactly:
+convolution (Eq. 6.22), restricted to the contacting cells (Eq. 6.21): by BiCGSTAB on the
+non-symmetric system, and by the thesis' conjugate gradients on the least-squares objective
+(Eqs. 6.19–6.20) for the patches where BiCGSTAB breaks down or stalls (``masked_krylov``). Energy is conserved exactly:
 phi_2 = phi − phi_1. The history terms are summed in Fourier space as Σ_k S_k · (flux of step N−k)
 with the pulse tables S_k of ``heat_kernels`` (the thesis' step increments, summed by parts);
 matching at the end of each step makes the scheme first order in dt.
@@ -35,11 +36,12 @@ from multiscale.micro.contact import ContactResult, ContactSolver
 from multiscale.micro.fft import RealFFT2
 from multiscale.micro.heat_kernels import Motion, ThermalMaterial, Translation, pulse_tables
 from multiscale.micro.kernels import Kernel, grid_shape, padded_size
+from multiscale.micro.masked_krylov import masked_solve
 from multiscale.micro.surface import Surface
 
 
 class HeatingConvergenceError(ConvergenceError):
-    """The least-squares solve of a thermal contact step reached ``max_iter`` before ``tol``."""
+    """The solve of a thermal contact step reached ``max_iter`` before ``tol``."""
 
 
 @dataclass(frozen=True)
@@ -211,38 +213,6 @@ class _Padded:
         return plan.inverse(spec)[..., :ny, :nx].copy()
 
 
-def _cgls(apply, apply_t, b, mask, scale, tol, max_iter, x0=None):
-    """Minimise ½|A x − b|² over x supported on ``mask`` (Eqs. 6.19–6.21) by conjugate gradients on
-    the normal equations (gradient Aᵀ(Ax − b), Eq. 6.20) from ``x0`` (default 0). Batched over
-    leading axes; stops per patch when |Ax − b| <= tol · scale."""
-    axes = (-2, -1)
-    x = np.zeros_like(b) if x0 is None else np.where(mask, x0, 0.0)
-    r = np.where(mask, b - (apply(x) if x0 is not None else 0.0), 0.0)
-    s = np.where(mask, apply_t(r), 0.0)
-    p = s.copy()
-    gamma = np.sum(s * s, axis=axes, keepdims=True)
-    res = np.sqrt(np.sum(r * r, axis=axes, keepdims=True)) / scale
-    iterations = np.zeros(res.shape, dtype=int)
-    history = [float(res.max())]
-    for _ in range(max_iter):
-        active = res > tol
-        if not active.any():
-            break
-        q = np.where(mask, apply(p), 0.0)
-        qq = np.sum(q * q, axis=axes, keepdims=True)
-        alpha = np.where(active & (qq > 0), gamma / np.where(qq > 0, qq, 1.0), 0.0)
-        x += alpha * p
-        r -= alpha * q
-        res = np.sqrt(np.sum(r * r, axis=axes, keepdims=True)) / scale
-        s = np.where(mask, apply_t(r), 0.0)
-        gamma_new = np.sum(s * s, axis=axes, keepdims=True)
-        p = s + np.where(gamma > 0, gamma_new / np.where(gamma > 0, gamma, 1.0), 0.0) * p
-        gamma = gamma_new
-        iterations += active
-        history.append(float(res.max()))
-    return x, iterations[..., 0, 0], res[..., 0, 0], history
-
-
 def _extrapolate(last, before):
     """Initial increment psi_N = r psi_{N−1} with r = <psi_{N−1}, psi_{N−2}>/|psi_{N−2}|² per patch
     (the increments of a heating transient decay nearly geometrically)."""
@@ -387,7 +357,7 @@ class TransientHeating:
                 rhs -= self._pad.field(A * F1[N - 1])
             scale = np.sqrt(np.sum(mask * (free1**2 + free2**2 + (th2 - th1) ** 2), axis=(-2, -1), keepdims=True))
             scale = np.where(scale > 0, scale, np.inf)
-            psi, it, res, hist = _cgls(lambda x: self._pad.convolve(A, x) + layer.diagonal * x,
+            psi, it, res, hist = masked_solve(lambda x: self._pad.convolve(A, x) + layer.diagonal * x,
                                        lambda x: self._pad.convolve(np.conj(A), x) + layer.diagonal * x,
                                        rhs, mask, scale, tol, max_iter, _extrapolate(psi_prev, psi_prev2))
             psi_prev2, psi_prev = psi_prev, psi
@@ -453,7 +423,8 @@ class SteadyHeating:
         """Steady partition of phi = mu p V on the contact of ``pressure`` [Pa] (..., ny, nx).
 
         (F1 + F2 + Σ R^m) phi_1 = F2 phi + Σ R^m c_m phi + theta_2^0 − theta_1^0 on the contact
-        (Eq. 6.23 with the steady interface jump), by the least-squares CG of Eq. 6.25.
+        (Eq. 6.23 with the steady interface jump), by ``masked_krylov.masked_solve`` (BiCGSTAB,
+        the least-squares CG of Eq. 6.25 where it fails).
         ``remote_temperatures`` = (theta_1^0, theta_2^0) [K], temperatures far inside each body.
         """
         p = _check_pressure(pressure, self.shape)
@@ -472,7 +443,7 @@ class SteadyHeating:
         A = self._S1 + self._S2
         scale = np.sqrt(np.sum(mask * (free2**2 + (th2 - th1) ** 2), axis=(-2, -1), keepdims=True))
         scale = np.where(scale > 0, scale, np.inf)
-        f, it, res, hist = _cgls(lambda x: self._pad.convolve(A, x) + layer.diagonal * x,
+        f, it, res, hist = masked_solve(lambda x: self._pad.convolve(A, x) + layer.diagonal * x,
                                  lambda x: self._pad.convolve(np.conj(A), x) + layer.diagonal * x,
                                  rhs, mask, scale, tol, max_iter)
         f_hat = self._pad.spectrum(f)
