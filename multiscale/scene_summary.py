@@ -116,4 +116,5 @@ def cells_line(scene: Scene) -> str:
     e = estimate_cells(g.module(), g.params if g.builder == "file" else dict(g.params))
     how = "exact" if e.exact else f"from a trial mesh {e.factor:.3g}x coarser with {e.trial} cells"
     verdict = "refused by run" if e.cells > g.max_cells else "within"
-    return f"  mesh      about {e.cells:,} cells ({how}); {verdict} geometry.max_cells = {g.max_cells:,}"
+    return f"  mesh      {'' if e.exact else 'about '}{e.cells:,} cells ({how}); {verdict} geometry.max_cells = " \
+           f"{g.max_cells:,}"
