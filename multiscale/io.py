@@ -93,6 +93,22 @@ def on_root(comm, write, what: str):
     return value
 
 
+def on_ranks(comm, jobs, what: str) -> None:
+    """Run the callables ``jobs`` spread over the ranks (job k on rank k mod size: files any rank
+    can write alone, e.g. figures from data every rank holds) and make a failure collective: an
+    ``OSError`` on any rank raises ``OutputError`` naming ``what`` on every rank (``on_root``)."""
+    failure = None
+    for job in jobs[comm.rank::comm.size]:
+        try:
+            job()
+        except OSError as exc:
+            failure = f"cannot write {what}: {exc.strerror or exc}"
+            break
+    failures = [f for f in comm.allgather(failure) if f]
+    if failures:
+        raise OutputError(failures[0])
+
+
 def ended_together(comm, timeout: float = 10.0) -> bool:
     """Called by a rank that met an error: True if every rank of ``comm`` reaches this call within
     ``timeout`` [s] (the error was collective: each can end cleanly), False if not (another rank is

@@ -23,6 +23,7 @@ import dataclasses
 import gc
 import time as _time
 from dataclasses import dataclass
+from functools import partial
 from pathlib import Path
 
 import h5py
@@ -191,7 +192,9 @@ def finished(folder: Path, name: str, steps: int, comm, verbose: bool) -> Multis
 
 def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: str, comm) -> tuple:
     """multiscale.png, the wear maps (with wear: ``wear_map.png``, or ``wear_map_<interface>.png``
-    for several interfaces) and zones.h5 (rank 0 writes; a failure is an OutputError on every rank)."""
+    for several interfaces) and zones.h5: rank 0 writes multiscale.png and zones.h5, the wear maps
+    are spread over the ranks (every rank holds the wear depths); a failure is an OutputError on
+    every rank."""
     rough = ms.rough
     plot, zones = folder / "multiscale.png", folder / "zones.h5"
     names = list(rough.names)
@@ -211,9 +214,8 @@ def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: 
             h5.create_dataset("counter_wear_depth", data=ms.counter_depth).attrs["unit"] = "m"   # per facet
             h5.create_dataset("conductance", data=ms.conductance).attrs["unit"] = "W/(m^2 K)"
             h5.attrs["counts"] = np.array([g.counts for g in rough.grids])     # (interfaces, 2)
-        offset = 0
-        for grid, path, interface in zip(rough.grids, maps, names):
-            wear_map(grid, depth[offset:offset + grid.n_zones], path, f"{name}: {interface}")
-            offset += grid.n_zones
-    io.on_root(comm, write, f"the zone results in {folder}")
+    offsets = np.cumsum([0] + [g.n_zones for g in rough.grids])
+    jobs = [write] + [partial(wear_map, grid, depth[offsets[k]:offsets[k + 1]], path, f"{name}: {interface}")
+                      for k, (grid, path, interface) in enumerate(zip(rough.grids, maps, names))]
+    io.on_ranks(comm, jobs, f"the zone results in {folder}")        # the wear maps spread over the ranks
     return plot, maps, zones

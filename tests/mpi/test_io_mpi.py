@@ -1,0 +1,29 @@
+"""Files written by several ranks (run by ``mpiexec -n 2 python -m pytest tests/mpi``; also passes
+on one process): ``io.on_ranks`` spreads the jobs over the ranks, each run once, and a failure on
+one rank is an OutputError on every rank, without deadlock."""
+import errno
+import os
+
+import pytest
+from mpi4py import MPI
+
+from multiscale import io
+from multiscale.errors import OutputError
+
+comm = MPI.COMM_WORLD
+
+
+def test_jobs_are_spread_over_the_ranks_and_each_runs_once():
+    ran = []
+    io.on_ranks(comm, [lambda k=k: ran.append(k) for k in range(5)], "five files")
+    assert ran == list(range(comm.rank, 5, comm.size))
+    assert sorted(k for done in comm.allgather(ran) for k in done) == list(range(5))
+
+
+def test_a_failure_on_one_rank_is_an_output_error_on_every_rank():
+    """Job 1 (rank 1 on two ranks, rank 0 alone) meets a full disk: every rank raises."""
+    def full():
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    with pytest.raises(OutputError, match="cannot write the wear maps: No space left on device"):
+        io.on_ranks(comm, [lambda: None, full, lambda: None], "the wear maps")
+    comm.Barrier()                      # both ranks got here: no rank is left waiting
