@@ -7,9 +7,10 @@ user's own) is a module providing ``DEFAULTS`` (its parameters in SI units), opt
 ``parameters(params) -> dict`` (defaults updated and checked), ``describe(params) ->
 GeometrySpec`` (pure Python: tags, bodies, supports) and ``generate(model, params)`` (builds the
 gmsh model on one rank and ends by meshing it with ``model.mesh.generate(3)``: ``estimate_cells``
-remeshes that model at other sizes, and ``macro.mesh.build`` takes the real mesh from it). Builders are found by name in the ``multiscale.builders``
-entry-point group (``pyproject.toml``: the registry is package metadata, so a scene never imports
-``meshes`` and a user's package can add builders). This module holds the spec dataclasses, the
+remeshes that model at other sizes, and ``macro.mesh.build`` takes the real mesh from it).
+Builders are found by name in the ``multiscale.builders`` entry-point group (``pyproject.toml``:
+the registry is package metadata, so a scene never imports ``meshes`` and a user's package can add
+builders). This module holds the spec dataclasses, the
 registry lookup and small gmsh helpers; it imports neither DOLFINx nor gmsh.
 
 Conventions: body 0 is the "+" side of the interface (the stationary body: pin, pads, block),

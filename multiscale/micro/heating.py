@@ -10,10 +10,10 @@ the increment psi = phi_1(t_N) − phi_1(t_{N−1}) on the contact solves A^N ps
 (Eqs. 6.9–6.18) with A^N = (T_1 + T_2)(one step) + interface diagonal (Eq. 6.16) applied by FFT
 convolution (Eq. 6.22), restricted to the contacting cells (Eq. 6.21): by BiCGSTAB on the
 non-symmetric system, and by the thesis' conjugate gradients on the least-squares objective
-(Eqs. 6.19–6.20) for the patches where BiCGSTAB breaks down or stalls (``masked_krylov``). Energy is conserved exactly:
-phi_2 = phi − phi_1. The history terms are summed in Fourier space as Σ_k S_k · (flux of step N−k)
-with the pulse tables S_k of ``heat_kernels`` (the thesis' step increments, summed by parts);
-matching at the end of each step makes the scheme first order in dt.
+(Eqs. 6.19–6.20) for the patches where BiCGSTAB breaks down or stalls (``masked_krylov``).
+Energy is conserved exactly: phi_2 = phi − phi_1. The history terms are summed in Fourier space
+as Σ_k S_k · (flux of step N−k) with the pulse tables S_k of ``heat_kernels`` (the thesis' step
+increments, summed by parts); matching at the end of each step makes the scheme first order in dt.
 Steady (§6.5, ``SteadyHeating``): the same with steady kernels and remote temperatures (Eqs. 6.23–6.25);
 the transient problem takes remote temperatures too (an extension: the thesis gives them to the
 steady problem only). ``partition_law`` gives the steady p_1(p_mean, V) that the macro model needs.
@@ -358,8 +358,8 @@ class TransientHeating:
             scale = np.sqrt(np.sum(mask * (free1**2 + free2**2 + (th2 - th1) ** 2), axis=(-2, -1), keepdims=True))
             scale = np.where(scale > 0, scale, np.inf)
             psi, it, res, hist = masked_solve(lambda x: self._pad.convolve(A, x) + layer.diagonal * x,
-                                       lambda x: self._pad.convolve(np.conj(A), x) + layer.diagonal * x,
-                                       rhs, mask, scale, tol, max_iter, _extrapolate(psi_prev, psi_prev2))
+                                              lambda x: self._pad.convolve(np.conj(A), x) + layer.diagonal * x,
+                                              rhs, mask, scale, tol, max_iter, _extrapolate(psi_prev, psi_prev2))
             psi_prev2, psi_prev = psi_prev, psi
             f = f_prev + psi
             F1[N] = self._pad.spectrum(f)
@@ -444,8 +444,8 @@ class SteadyHeating:
         scale = np.sqrt(np.sum(mask * (free2**2 + (th2 - th1) ** 2), axis=(-2, -1), keepdims=True))
         scale = np.where(scale > 0, scale, np.inf)
         f, it, res, hist = masked_solve(lambda x: self._pad.convolve(A, x) + layer.diagonal * x,
-                                 lambda x: self._pad.convolve(np.conj(A), x) + layer.diagonal * x,
-                                 rhs, mask, scale, tol, max_iter)
+                                        lambda x: self._pad.convolve(np.conj(A), x) + layer.diagonal * x,
+                                        rhs, mask, scale, tol, max_iter)
         f_hat = self._pad.spectrum(f)
         T1 = self._pad.field(self._S1 * f_hat) + th1
         T2 = self._pad.field(self._S2 * (phi_hat - f_hat)) + th2
