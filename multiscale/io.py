@@ -79,24 +79,17 @@ class History:
 def on_root(comm, write, what: str):
     """Run ``write()`` on rank 0 only (a file every rank needs written once) and make its failure
     collective: an ``OSError`` there (disk full, read-only folder) raises ``OutputError`` naming
-    ``what`` on every rank, instead of leaving the others waiting. Returns ``write()``'s value on
-    rank 0, None elsewhere."""
-    value, failure = None, None
-    if comm.rank == 0:
-        try:
-            value = write()
-        except OSError as exc:
-            failure = f"cannot write {what}: {exc.strerror or exc}"
-    failure = comm.bcast(failure, root=0)
-    if failure:
-        raise OutputError(failure)
-    return value
+    ``what`` on every rank, instead of leaving the others waiting (``on_ranks`` with one job).
+    Returns ``write()``'s value on rank 0, None elsewhere."""
+    value = []
+    on_ranks(comm, [lambda: value.append(write())], what)
+    return value[0] if value else None
 
 
 def on_ranks(comm, jobs, what: str) -> None:
     """Run the callables ``jobs`` spread over the ranks (job k on rank k mod size: files any rank
     can write alone, e.g. figures from data every rank holds) and make a failure collective: an
-    ``OSError`` on any rank raises ``OutputError`` naming ``what`` on every rank (``on_root``)."""
+    ``OSError`` on any rank raises ``OutputError`` naming ``what`` on every rank."""
     failure = None
     for job in jobs[comm.rank::comm.size]:
         try:
