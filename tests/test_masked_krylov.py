@@ -5,9 +5,8 @@ import numpy as np
 
 from multiscale.micro import masked_krylov
 from multiscale.micro.contact import ContactSolver
-from multiscale.micro.heat_kernels import ThermalMaterial
-from multiscale.micro.heating import SteadyHeating
-from multiscale.micro.kernels import HalfSpace
+from multiscale.micro.heat_kernels import ThermalMaterial, Translation, pulse_tables
+from multiscale.micro.kernels import HalfSpace, padded_size
 from multiscale.micro.surface import fractal_surface
 
 DISC = ThermalMaterial(50.0, 1e-5)       # thesis Table 6.3, solid S1 (moving)
@@ -18,19 +17,25 @@ TOL = 1e-8
 
 def steady_system(n=32, batch=4):
     """A batch of steady sliding-contact systems (Eq. 6.23, V = 2 m/s: non-symmetric) on rough
-    contacts: operator, adjoint, right-hand side, contact mask, residual scale, convolution count."""
+    contacts, built here from the pulse tables with numpy's FFT: operator, adjoint, right-hand side,
+    contact mask, residual scale, convolution count."""
     s = fractal_surface(n, 1e-3, 0.8, 2, 8, 6.49e-6, seed=11, batch=(batch,))
     p = ContactSolver(ELASTIC, s.shape, s.dx, periodic=False).solve(s.heights, load=np.full(batch, 8e6)).pressure
-    sol = SteadyHeating(s.shape, s.dx, DISC, PIN, 2.0)
-    A, pad, count = sol._S1 + sol._S2, sol._pad, [0]
+    half = (padded_size(n), padded_size(n))
+    tables = [pulse_tables(half, s.dx, s.dx, DISC, np.inf, 1, Translation.steady(2.0)).coeffs[0],
+              pulse_tables(half, s.dx, s.dx, PIN, np.inf, 1).coeffs[0]]
+    full = tables[0].shape
+    S1, S2 = (np.fft.rfft2(k) for k in tables)
+    count = [0]
 
-    def conv(k, x):
+    def conv(S, x):                   # linear convolution with a wrap-around table, cropped to the patch
         count[0] += 1
-        return pad.convolve(k, x)
-    b = pad.field(sol._S2 * pad.spectrum(0.4 * p * 2.0)) + 5.0        # remote temperatures 0 and 5 K
+        return np.fft.irfft2(np.fft.rfft2(x, s=full) * S, s=full)[..., :n, :n]
+    b = conv(S2, 0.4 * p * 2.0) + 5.0                       # remote temperatures 0 and 5 K
     mask = p > 0
     scale = np.sqrt(np.sum(mask * b**2, axis=(-2, -1), keepdims=True))
-    return (lambda x: conv(A, x)), (lambda x: conv(np.conj(A), x)), b, mask, scale, count
+    count[0] = 0
+    return (lambda x: conv(S1 + S2, x)), (lambda x: conv(np.conj(S1 + S2), x)), b, mask, scale, count
 
 
 def dense(apply, b, mask):
