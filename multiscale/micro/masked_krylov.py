@@ -72,7 +72,8 @@ def bicgstab(apply, b, mask, scale, tol, max_iter, x0=None):
         t = op(h)
         tt = dot(t, t)
         omega = dot(t, h) / np.where(tt != 0, tt, 1.0)
-        broken = active & ((rho_new == 0) | (sv == 0) | (omega == 0))
+        half = tt == 0                         # h = 0 (one or two cells): x + alpha d solves it, omega = 0
+        broken = active & ((rho_new == 0) | (sv == 0) | ((omega == 0) & ~half))
         step = active & ~broken
         x = np.where(step, x + alpha * d + omega * h, x)
         r = np.where(step, h - omega * t, r)
