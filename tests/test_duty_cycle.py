@@ -10,24 +10,16 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 from multiscale.scene import load, loads  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 from multiscale.workflows.multiscale import run as run_multiscale  # noqa: E402
+from test_macro_run import pin_on_disc  # noqa: E402  (tests/ is on sys.path: pytest's rootdir)
 
 ROOT = Path(__file__).resolve().parents[1]
-BASE = (Path(__file__).resolve().parent / "data" / "pin_on_disc_base.toml").read_text()
-POD = """
-name = "pod"
-effects = ["contact", "friction", "thermal", "heat_partition"]
-[geometry]
-builder = "pin_on_disc"
-mesh_size = "15 mm"
-holder_mesh_size = "6 mm"
-interface_mesh_size = "2.5 mm"
-{base}
-[interface]
-penalty = "1e13 Pa/m"
-partition = 0.14
-[output]
-folder = "{folder}"
-""".replace("{base}", BASE)
+
+
+def pod(folder) -> str:
+    """The coarse pin-on-disc test scene without thermal expansion, partition 0.14."""
+    return pin_on_disc(folder, effects=("contact", "friction", "thermal", "heat_partition"), partition="0.14")
+
+
 MASS, V0, DECEL, WHEEL = 20.0, 10.0, 5.0, 0.3      # kg, m/s, m/s^2, m: a 2 s stop
 
 
@@ -43,7 +35,7 @@ def test_a_vehicle_stop_brakes_the_mass_and_turns_its_energy_into_heat(tmp_path)
     pressure inwards, 2.5 % here, so it exceeds the guess from the pin's area-weighted radius);
     the speed falls linearly to 0 at v0/a; the frictional heat of the stop is the kinetic energy
     1/2 m v0^2 (a heat step takes the mean of the speeds at its ends: exact for the linear stop)."""
-    text = POD.format(folder=tmp_path / "stop").replace('rotation_speed = "200 rpm"\n', "")
+    text = pod(tmp_path / "stop").replace('rotation_speed = "200 rpm"\n', "")
     scene = loads(text.replace("normal_force = \"200 N\"\n", ""), overrides={
         "loading.vehicle": {"speed": f"{V0} m/s", "deceleration": f"{DECEL} m/s^2", "wheel_radius": f"{WHEEL} m",
                             "mass": f"{MASS} kg"}, "time.end": "2.4 s", "time.steps": 12})
@@ -62,7 +54,7 @@ def test_a_release_phase_has_no_contact_and_no_frictional_heat(tmp_path):
     release gets the frictional heat of its loaded part only (1/60 of a full 0.3 s step); no heat
     after, the stored heat of the insulated bodies constant while the pin's hot face cools by
     conduction."""
-    scene = loads(POD.format(folder=tmp_path / "release"), overrides={
+    scene = loads(pod(tmp_path / "release"), overrides={
         "loading.load_profile": [["0 s", 1.0], ["0.6 s", 1.0], ["0.61 s", 0.0]], "time.end": "1.8 s",
         "time.steps": 6})
     h = run(scene, verbose=False).history

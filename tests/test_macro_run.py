@@ -1,4 +1,5 @@
 """Scenes through the workflows: only the requested effects are built; files a run writes."""
+import json
 from pathlib import Path
 
 import numpy as np
@@ -40,21 +41,28 @@ folder = "{folder}"
 
 # materials, loading and time shared by the pin-on-disc test scenes
 BASE = (Path(__file__).resolve().parent / "data" / "pin_on_disc_base.toml").read_text()
-PIN = """
-name = "pod"
-effects = ["contact", "friction", "thermal", "heat_partition", "expansion"]
+THERMAL = ("contact", "friction", "thermal", "heat_partition", "expansion")
+
+
+def pin_on_disc(folder, name: str = "pod", effects: tuple = THERMAL, partition: str = '"effusivity"') -> str:
+    """The coarse pin-on-disc test scene (15 mm mesh, 2.5 mm at the interface, penalty 1e13 Pa/m)
+    writing to ``folder``; ``partition`` is TOML (a number or a quoted rule). Shared by the
+    macro-run, duty-cycle and MPI tests."""
+    return f"""
+name = "{name}"
+effects = {json.dumps(list(effects))}
 [geometry]
 builder = "pin_on_disc"
 mesh_size = "15 mm"
 holder_mesh_size = "6 mm"
 interface_mesh_size = "2.5 mm"
-{base}
+{BASE}
 [interface]
 penalty = "1e13 Pa/m"
-partition = "effusivity"
+partition = {partition}
 [output]
 folder = "{folder}"
-""".replace("{base}", BASE)
+"""
 
 
 def test_scene_without_thermal_builds_no_heat_problem(tmp_path):
@@ -79,7 +87,7 @@ def test_thermal_on_a_sliding_translating_flat_is_refused(tmp_path):
 
 
 def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
-    scene = loads(PIN.format(folder=tmp_path / "pod"), overrides={"time.substeps": 2})
+    scene = loads(pin_on_disc(tmp_path / "pod"), overrides={"time.substeps": 2})
     result = run(scene, verbose=False)
     h = History.read(result.history_file)
     assert len(h) == 3 and h["time"][-1] == pytest.approx(1.2)

@@ -1,5 +1,6 @@
 """Two MPI ranks give the same pin-on-disc history as one (run: mpiexec -n 2 python -m pytest tests/mpi)."""
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -15,27 +16,12 @@ from multiscale.outputs import plan  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 
-# materials, loading and time shared by the pin-on-disc test scenes
-BASE = (Path(__file__).resolve().parents[1] / "data" / "pin_on_disc_base.toml").read_text()
-SCENE = """
-name = "pod_mpi"
-effects = ["contact", "friction", "thermal", "heat_partition", "expansion"]
-[geometry]
-builder = "pin_on_disc"
-mesh_size = "15 mm"
-holder_mesh_size = "6 mm"
-interface_mesh_size = "2.5 mm"
-{base}
-[interface]
-penalty = "1e13 Pa/m"
-partition = 0.14
-[output]
-folder = "{folder}"
-""".replace("{base}", BASE)
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from test_macro_run import pin_on_disc  # noqa: E402
 
 
 def scene(folder):
-    return loads(SCENE.format(folder=folder), overrides={"loading.ramp_steps": 2})
+    return loads(pin_on_disc(folder, name="pod_mpi", partition="0.14"), overrides={"loading.ramp_steps": 2})
 
 
 def test_two_ranks_give_the_serial_history(tmp_path):
