@@ -202,7 +202,8 @@ class Reporter:
                 self.stream.flush()
 
     def bar(self, iterable, name: str, total: int | None = None, initial: int = 0, unit: str = "step"):
-        """``iterable`` with a progress bar under a terminal (a line per tenth otherwise) on rank 0."""
+        """``iterable`` with a progress bar under a terminal (a line per tenth otherwise, counting
+        ``unit``s: "3/25 batches") on rank 0."""
         if not self.show or self.barred:
             yield from iterable
             return
@@ -215,11 +216,12 @@ class Reporter:
                     yield from items
                 return
             start, done, every = _time.perf_counter(), initial, max(1, (total or 10) // 10)
+            units = unit + ("es" if unit.endswith(("s", "x", "ch", "sh")) else "s")
             for item in iterable:
                 yield item
                 done += 1
                 if done % every == 0 or done == total:
-                    self.stream.write(f"  {name}: {done}/{total if total else '?'} {unit}s, "
+                    self.stream.write(f"  {name}: {done}/{total if total else '?'} {units}, "
                                       f"{_time.perf_counter() - start:.1f} s\n")
                     self.stream.flush()
         finally:

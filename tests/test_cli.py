@@ -236,8 +236,10 @@ def test_stage_lines_one_per_stage_quiet_and_timed():
                 pass
         with io.stage("macro steps"):
             assert list(io.bar(range(3), "macro steps")) == [0, 1, 2]
+            assert list(io.bar(range(2), "zone laws", unit="batch")) == [0, 1]
     lines = out.getvalue().splitlines()
-    assert lines[0].startswith("meshing: ") and lines[-1].startswith("macro steps: ") and len(lines) == 5
+    assert lines[0].startswith("meshing: ") and lines[-1].startswith("macro steps: ") and len(lines) == 7
+    assert lines[1].startswith("  macro steps: 1/3 steps, ") and lines[5].startswith("  zone laws: 2/2 batches, ")
     assert set(rep.times) == {"meshing", "inner", "macro steps"}
     quiet = stdio.StringIO()
     with io.Reporter(MPI.COMM_SELF, quiet=True, stream=quiet):
