@@ -240,12 +240,19 @@ def test_stage_lines_one_per_stage_quiet_and_timed():
     lines = out.getvalue().splitlines()
     assert lines[0].startswith("meshing: ") and lines[-1].startswith("macro steps: ") and len(lines) == 7
     assert lines[1].startswith("  macro steps: 1/3 steps, ") and lines[5].startswith("  zone laws: 2/2 batches, ")
+    assert lines[1].endswith(" s left") and not lines[3].endswith(" s left")     # the time left, until the end
     assert set(rep.times) == {"meshing", "inner", "macro steps"}
     quiet = stdio.StringIO()
     with io.Reporter(MPI.COMM_SELF, quiet=True, stream=quiet):
         with io.stage("meshing"):
             list(io.bar(range(3), "steps"))
     assert quiet.getvalue() == ""
+
+
+def test_times_left_read_as_durations():
+    from multiscale.io import duration
+    assert [duration(t) for t in (0.04, 9.94, 35.4, 250.0, 7500.0)] == ["0.0 s", "9.9 s", "35 s", "4 min 10 s",
+                                                                        "2 h 05 min"]
 
 
 def test_output_times_are_exact_decimals():
