@@ -39,6 +39,10 @@ DEFAULTS: dict = {}          # no numeric parameters: [geometry] of the scene is
 FIXED = "fixed"              # name of body 0 (the fixed bodies), body 1 is the rotating body
 PLAUSIBLE = (1e-3, 10.0)     # m, smallest and largest extent of a brake or tribometer model
 NORMAL_TOLERANCE = np.cos(np.radians(5.0))
+# CAD is scaled to metres by gmsh's Geometry.OCCScaling at import, a similarity that keeps planes
+# and cylinders analytic; occ.dilate (a general affine map) turns every surface into a B-spline:
+# the fragment then took 1.1 s instead of 0.03 s on the railway disc and HXT meshed 1.4-1.8x slower
+# (benchmarks/README, car brake). Scripts and meshes are still scaled after reading.
 ALGORITHM_3D = {"delaunay": 1, "hxt": 10}   # gmsh's Mesh.Algorithm3D by mesh_algorithm; CAD takes HXT
 #   (Marot, Pellerin & Remacle 2019, Int. J. Numer. Methods Eng. 117, 967-990) unless told: on one
 #   thread 6x faster than gmsh's default Delaunay on the car brake, of better worst quality
@@ -121,8 +125,12 @@ def generate(model, params) -> None:
 def _load(model, g) -> Found:
     import gmsh   # the module-level functions (merge, option) of the model's gmsh
     path = str(g.file)
-    if g.kind == "cad":
-        shapes = model.occ.importShapes(path)
+    if g.kind == "cad":          # scaled to metres as it is imported (the note above ALGORITHM_3D)
+        gmsh.option.setNumber("Geometry.OCCScaling", g.unit)
+        try:
+            shapes = model.occ.importShapes(path)
+        finally:
+            gmsh.option.setNumber("Geometry.OCCScaling", 1.0)
         model.occ.synchronize()
         order = [t for d, t in shapes if d == 3]
     else:
@@ -134,7 +142,7 @@ def _load(model, g) -> Found:
     if not order:
         raise InputError("geometry.file", g.file.name, "holds no volume (3-D solid)")
     occ = bool(model.occ.getEntities(3))
-    if g.unit != 1.0:
+    if g.unit != 1.0 and g.kind != "cad":
         if g.kind == "mesh":
             s = g.unit
             model.mesh.affineTransform([s, 0, 0, 0, 0, s, 0, 0, 0, 0, s, 0])

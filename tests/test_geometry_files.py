@@ -12,7 +12,7 @@ import gmsh  # noqa: E402
 from meshes import pin_on_disc  # noqa: E402
 from multiscale.cli import main  # noqa: E402
 from multiscale.errors import InputError  # noqa: E402
-from multiscale.geometry import MAX_CELLS, check_cells, estimate_cells  # noqa: E402
+from multiscale.geometry import MAX_CELLS, check_cells, estimate_cells, gmsh_session  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 
@@ -200,6 +200,42 @@ def test_cad_is_meshed_by_the_chosen_algorithm_and_a_failure_says_what_to_change
         assert 1000 < sum(len(t) for t in gmsh.model.mesh.getElements(3)[1]) <= estimate.cells
     finally:
         gmsh.finalize()
+
+
+def test_cad_in_millimetres_is_scaled_as_it_is_read(files, tmp_path):
+    """A STEP file in mm (unit = "mm") gives the geometry of the same file in m: the same bounding
+    box to 1e-12 m and the same volumes to 1e-9, its planes and cylinders still analytic (scaled
+    by a similarity at import: occ.dilate would have made every face a B-spline, whose fragment and
+    meshing are much slower, benchmarks/README), and gmsh's import scaling reset afterwards."""
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("Geometry.OCCScaling", 1000.0)      # the metre file written in mm
+        gmsh.model.occ.importShapes(str(files / "pod.step"))
+        gmsh.model.occ.synchronize()
+        gmsh.write(str(tmp_path / "pod_mm.step"))
+    finally:
+        gmsh.finalize()
+
+    def read(more, file):
+        g = loads(FILE.format(name="step", file=file, extra='mesh_size = "15 mm"\ninterface_mesh_size = "2.5 mm"\n'
+                              + more, folder=tmp_path / "out", surfaces=CAD_SURFACES, **{
+                                  b: f"contains = {p}" for b, p in INSIDE.items()}), files).geometry
+        gmsh_session(g.module())
+        try:
+            g.module().generate(gmsh.model, g.params)
+            box = np.array(gmsh.model.getBoundingBox(-1, -1))
+            volumes = sorted(gmsh.model.occ.getMass(3, t) for _, t in gmsh.model.getEntities(3))
+            types = {gmsh.model.getType(2, t) for _, t in gmsh.model.getEntities(2)}
+            return box, np.array(volumes), types, gmsh.option.getNumber("Geometry.OCCScaling")
+        finally:
+            gmsh.finalize()
+
+    box, volumes, types, _ = read("", files / "pod.step")
+    box_mm, volumes_mm, types_mm, scaling = read('unit = "mm"', tmp_path / "pod_mm.step")
+    np.testing.assert_allclose(box_mm, box, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(volumes_mm, volumes, rtol=1e-9)
+    assert types_mm == types and types <= {"Plane", "Cylinder"} and scaling == 1.0
 
 
 def check(tmp_path, capsys, text) -> str:
