@@ -42,7 +42,8 @@ NORMAL_TOLERANCE = np.cos(np.radians(5.0))
 # CAD is scaled to metres by gmsh's Geometry.OCCScaling at import, a similarity that keeps planes
 # and cylinders analytic; occ.dilate (a general affine map) turns every surface into a B-spline:
 # the fragment then took 1.1 s instead of 0.03 s on the railway disc and HXT meshed 1.4-1.8x slower
-# (benchmarks/README, car brake). Scripts and meshes are still scaled after reading.
+# (benchmarks/README, car brake). Scripts and meshes are scaled after reading, an OpenCASCADE script
+# after its fragment (0.26 -> 0.02 s for the pin-on-disc script of tests/test_geometry_files.py).
 ALGORITHM_3D = {"delaunay": 1, "hxt": 10}   # gmsh's Mesh.Algorithm3D by mesh_algorithm; CAD takes HXT
 #   (Marot, Pellerin & Remacle 2019, Int. J. Numer. Methods Eng. 117, 967-990) unless told: on one
 #   thread 6x faster than gmsh's default Delaunay on the car brake, of better worst quality
@@ -142,21 +143,22 @@ def _load(model, g) -> Found:
     if not order:
         raise InputError("geometry.file", g.file.name, "holds no volume (3-D solid)")
     occ = bool(model.occ.getEntities(3))
+    if occ and g.kind != "mesh":  # before a script's scaling: fast on its analytic faces
+        volumes = model.occ.getEntities(3)
+        _, mapping = model.occ.fragment(volumes, [])
+        model.occ.synchronize()
+        after = {t: [b for d, b in m if d == 3] for (_, t), m in zip(volumes, mapping)}
+        order = [t for old in order for t in after.get(old, [old])]
     if g.unit != 1.0 and g.kind != "cad":
         if g.kind == "mesh":
             s = g.unit
             model.mesh.affineTransform([s, 0, 0, 0, 0, s, 0, 0, 0, 0, s, 0])
         elif occ:
             model.occ.dilate(model.occ.getEntities(), 0, 0, 0, g.unit, g.unit, g.unit)
+            model.occ.synchronize()
         else:
             model.geo.dilate(model.getEntities(), 0, 0, 0, g.unit, g.unit, g.unit)
             model.geo.synchronize()
-    if occ and g.kind != "mesh":
-        volumes = model.occ.getEntities(3)
-        _, mapping = model.occ.fragment(volumes, [])
-        model.occ.synchronize()
-        after = {t: [b for d, b in m if d == 3] for (_, t), m in zip(volumes, mapping)}
-        order = [t for old in order for t in after.get(old, [old])]
     extent = _extent(model, g)
     labels = {t: _label(model, t) for _, t in model.getEntities(3)}
     found = Found(_bodies(model, g, order, labels), labels, {t: _volume(model, t, occ) for t in labels},
