@@ -109,17 +109,31 @@ def generate(model, params) -> None:
         add_group(model, 2, faces, 2001 + k, name)
     if params.kind != "mesh":
         _sizes(model, params, [f for faces in found.interfaces.values() for f in faces])
-        algorithm = params.mesh_algorithm or ("hxt" if params.kind == "cad" else None)   # else the script's
-        if algorithm is not None:
-            import gmsh   # mesh options are global in gmsh
-            gmsh.option.setNumber("Mesh.Algorithm3D", ALGORITHM_3D[algorithm])
-        try:
-            model.mesh.generate(3)
-        except Exception as exc:
-            other = " or ".join(f'"{a}"' for a in ALGORITHM_3D if a != algorithm)
-            raise InputError("geometry.mesh_algorithm", algorithm or "the script's choice",
-                             f"gmsh could not mesh {params.file.name} ({exc}): try mesh_algorithm = {other}, "
-                             "or other mesh sizes") from None
+        remesh(model, params)
+
+
+def remesh(model, params) -> None:
+    """Mesh the loaded file's model in 3-D (again, after ``model.mesh.clear()``): CAD with HXT
+    unless ``mesh_algorithm`` says otherwise, a script by its own choice unless told. Trial meshes
+    coarser than the mesh (``Mesh.MeshSizeFactor`` > 1, ``geometry.estimate_cells``) take Delaunay
+    instead of HXT: on thin parts HXT fails on coarse meshes or takes seconds (the railway disc's
+    coarse trials: 0.6-1.2 s each against 0.1 s; benchmarks/README), and the count they estimate
+    does not depend on the algorithm. A failed meshing at the mesh's own size is an InputError
+    naming the other algorithm."""
+    import gmsh   # mesh options are global in gmsh
+    algorithm = params.mesh_algorithm or ("hxt" if params.kind == "cad" else None)   # else the script's
+    trial = gmsh.option.getNumber("Mesh.MeshSizeFactor") > 1.0
+    if algorithm is not None:
+        gmsh.option.setNumber("Mesh.Algorithm3D", ALGORITHM_3D["delaunay" if trial else algorithm])
+    try:
+        model.mesh.generate(3)
+    except Exception as exc:
+        if trial:
+            raise
+        other = " or ".join(f'"{a}"' for a in ALGORITHM_3D if a != algorithm)
+        raise InputError("geometry.mesh_algorithm", algorithm or "the script's choice",
+                         f"gmsh could not mesh {params.file.name} ({exc}): try mesh_algorithm = {other}, "
+                         "or other mesh sizes") from None
 
 
 # ---------------------------------------------------------------- reading

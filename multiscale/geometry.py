@@ -7,7 +7,10 @@ user's own) is a module providing ``DEFAULTS`` (its parameters in SI units), opt
 ``parameters(params) -> dict`` (defaults updated and checked), ``describe(params) ->
 GeometrySpec`` (pure Python: tags, bodies, supports) and ``generate(model, params)`` (builds the
 gmsh model on one rank and ends by meshing it with ``model.mesh.generate(3)``: ``estimate_cells``
-remeshes that model at other sizes, and ``macro.mesh.build`` takes the real mesh from it).
+remeshes that model at other sizes, and ``macro.mesh.build`` takes the real mesh from it), and
+optionally ``remesh(model, params)`` (meshes the built model again in 3-D, after
+``model.mesh.clear()``, with the options the builder chooses for the current
+``Mesh.MeshSizeFactor``; default ``model.mesh.generate(3)``).
 Builders are found by name in the ``multiscale.builders`` entry-point group (``pyproject.toml``:
 the registry is package metadata, so a scene never imports ``meshes`` and a user's package can add
 builders). This module holds the spec dataclasses, the
@@ -229,7 +232,7 @@ def _trial(module: ModuleType, params, factor: float) -> int:
             gmsh_session(module)
         gmsh.option.setNumber("Mesh.MeshSizeFactor", factor)
         if built:
-            gmsh.model.mesh.generate(3)
+            getattr(module, "remesh", lambda model, params: model.mesh.generate(3))(gmsh.model, params)
         else:
             module.generate(gmsh.model, params)
     except Exception:        # e.g. "PLC Error": too coarse for the geometry's features

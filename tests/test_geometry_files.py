@@ -169,12 +169,16 @@ def test_a_mesh_file_is_counted_as_it_is(files, tmp_path):
 
 
 def test_cad_is_meshed_by_the_chosen_algorithm_and_a_failure_says_what_to_change(files, tmp_path, monkeypatch):
-    """CAD takes HXT unless mesh_algorithm says otherwise. Were HXT to fail on a file at its mesh
-    size (simulated: gmsh's 3-D meshing raises under HXT at size factor 1, after coarse trials
-    that succeed), the mesh is refused with one InputError naming geometry.mesh_algorithm and the
-    other algorithm, raised by the builder's own run after the kept session's remesh failed; with
-    mesh_algorithm = "delaunay" the same file meshes."""
+    """CAD takes HXT unless mesh_algorithm says otherwise; its coarse trial meshes take Delaunay,
+    and the kept session's mesh is node for node that of the builder's own run. Were HXT to fail
+    on a file at its mesh size (simulated: gmsh's 3-D meshing raises under HXT at size factor 1,
+    after coarse trials that succeed), the mesh is refused with one InputError naming
+    geometry.mesh_algorithm and the other algorithm, raised by the builder's own run after the
+    kept session's remesh failed; with mesh_algorithm = "delaunay" the same file meshes."""
     mesh3d = gmsh.model.mesh.generate
+
+    def nodes_and_tets():
+        return gmsh.model.mesh.getNodes()[1], np.concatenate(gmsh.model.mesh.getElements(3)[2])
 
     def no_hxt(dim=3):
         if dim == 3 and gmsh.option.getNumber("Mesh.Algorithm3D") == 10 and \
@@ -185,9 +189,21 @@ def test_cad_is_meshed_by_the_chosen_algorithm_and_a_failure_says_what_to_change
     g = scene_for(files, "step", tmp_path).geometry
     used = []
     monkeypatch.setattr(gmsh.model.mesh, "generate", lambda dim=3: used.append(
-        gmsh.option.getNumber("Mesh.Algorithm3D")) or mesh3d(dim))
-    check_cells(g.module(), g.params, MAX_CELLS)
-    assert used and set(used) == {10}
+        (gmsh.option.getNumber("Mesh.MeshSizeFactor"), gmsh.option.getNumber("Mesh.Algorithm3D"))) or mesh3d(dim))
+    estimate = check_cells(g.module(), g.params, MAX_CELLS, keep=True)
+    try:
+        kept = nodes_and_tets()
+    finally:
+        gmsh.finalize()
+    assert not estimate.exact and used[-1] == (1.0, 10) and {a for f, a in used[:-1]} == {1} and \
+        all(f > 1 for f, _ in used[:-1])
+    gmsh_session(g.module())
+    try:
+        g.module().generate(gmsh.model, g.params)
+        fresh = nodes_and_tets()
+    finally:
+        gmsh.finalize()
+    assert all(np.array_equal(a, b) for a, b in zip(kept, fresh))
     monkeypatch.setattr(gmsh.model.mesh, "generate", no_hxt)
     with pytest.raises(InputError, match=r"geometry.mesh_algorithm = 'hxt': gmsh could not mesh pod.step \(HXT failed "
                                          r"\(simulated\)\): try mesh_algorithm = \"delaunay\""):
