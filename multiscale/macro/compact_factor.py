@@ -29,8 +29,6 @@ analysis failed so segfaults (PETSc 3.25, checked with an unsupported "half").
 """
 from __future__ import annotations
 
-from contextlib import contextmanager
-
 import numpy as np
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -89,7 +87,7 @@ class CompactFactor:
         full[np.searchsorted(self.keys, keys)] = values[keep]
         self.matrix.setValuesCSR(*self._csr, full)
         self.matrix.assemble()
-        with self._precision_option():
+        with mumps.precision(self.prefix, self.precision):
             self.workspace, retries = mumps.factorise(self.inner, self.workspace)
         self.analyses += retries
         pc.setFailedReason(self.inner.getFailedReason())
@@ -122,20 +120,6 @@ class CompactFactor:
         if self.user_precision is None and precision != self.precision:
             self.precision = precision
             self.reset(None, keep_pattern=True)
-
-    @contextmanager
-    def _precision_option(self):
-        """``<prefix>pc_precision`` in PETSc's options while MUMPS analyses (it reads it there; a
-        numeric refactorisation keeps the precision of its analysis), unless the user set it."""
-        if self.user_precision is not None:
-            yield
-            return
-        options = PETSc.Options(self.prefix)
-        options["pc_precision"] = self.precision
-        try:
-            yield
-        finally:
-            options.delValue("pc_precision")
 
     def apply(self, pc, x, y) -> None:
         if self.inner is None:                    # ``set_precision`` dropped the factors of an unchanged matrix

@@ -12,6 +12,8 @@ the caller's error.
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
+
 from petsc4py import PETSc
 
 WORKSPACE_ERRORS = (-8, -9, -11, -14, -15, -17, -20)   # MUMPS INFOG(1): a workspace or buffer too small
@@ -55,6 +57,23 @@ def _set_up(pc: PETSc.PC) -> None:
     except PETSc.Error:
         if status(pc) >= 0:
             raise
+
+
+@contextmanager
+def precision(prefix: str, value: str):
+    """``<prefix>pc_precision`` = ``value`` ("single": MUMPS' SMUMPS on the double matrix, PETSc
+    3.25) in PETSc's options database for the block: MUMPS reads it there when it analyses, after
+    DOLFINx has removed the options it was given, and a numeric refactorisation keeps the
+    precision of its analysis. An option the user set already wins (left as it is)."""
+    options = PETSc.Options(prefix)
+    if options.hasName("pc_precision"):
+        yield
+        return
+    options["pc_precision"] = value
+    try:
+        yield
+    finally:
+        options.delValue("pc_precision")
 
 
 def describe(pc: PETSc.PC) -> str:
