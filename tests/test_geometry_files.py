@@ -117,14 +117,25 @@ def files(tmp_path_factory):
     return folder
 
 
-def scene_for(files, kind, tmp_path, more=""):
+def scene_for(files, kind, tmp_path, more="", file=None):
     by_name = {b: f'volumes = ["{b}"]' for b in INSIDE}
     by_point = {b: f"contains = {p}" for b, p in INSIDE.items()}
     extra = {"msh": "", "step": 'mesh_size = "15 mm"\ninterface_mesh_size = "2.5 mm"',
              "geo": 'unit = "mm"\nmesh_size = "15 mm"\ninterface_mesh_size = "2.5 mm"'}[kind] + "\n" + more
-    text = FILE.format(name=kind, file=files / f"pod.{kind}", extra=extra, folder=tmp_path / kind,
+    text = FILE.format(name=kind, file=file or files / f"pod.{kind}", extra=extra, folder=tmp_path / kind,
                        surfaces="" if kind == "msh" else CAD_SURFACES, **(by_name if kind == "msh" else by_point))
     return loads(text, files)
+
+
+def built(g, read):
+    """``read()`` of gmsh's model after the builder of the scene geometry ``g`` ran in a session of
+    its own."""
+    gmsh_session(g.module())
+    try:
+        g.module().generate(gmsh.model, g.params)
+        return read()
+    finally:
+        gmsh.finalize()
 
 
 @pytest.fixture(scope="module")
@@ -197,13 +208,7 @@ def test_cad_is_meshed_by_the_chosen_algorithm_and_a_failure_says_what_to_change
         gmsh.finalize()
     assert not estimate.exact and used[-1] == (1.0, 10) and {a for f, a in used[:-1]} == {1} and \
         all(f > 1 for f, _ in used[:-1])
-    gmsh_session(g.module())
-    try:
-        g.module().generate(gmsh.model, g.params)
-        fresh = nodes_and_tets()
-    finally:
-        gmsh.finalize()
-    assert all(np.array_equal(a, b) for a, b in zip(kept, fresh))
+    assert all(np.array_equal(a, b) for a, b in zip(kept, built(g, nodes_and_tets)))
     monkeypatch.setattr(gmsh.model.mesh, "generate", no_hxt)
     with pytest.raises(InputError, match=r"geometry.mesh_algorithm = 'hxt': gmsh could not mesh pod.step \(HXT failed "
                                          r"\(simulated\)\): try mesh_algorithm = \"delaunay\""):
@@ -233,22 +238,15 @@ def test_cad_in_millimetres_is_scaled_as_it_is_read(files, tmp_path):
     finally:
         gmsh.finalize()
 
-    def read(more, file):
-        g = loads(FILE.format(name="step", file=file, extra='mesh_size = "15 mm"\ninterface_mesh_size = "2.5 mm"\n'
-                              + more, folder=tmp_path / "out", surfaces=CAD_SURFACES, **{
-                                  b: f"contains = {p}" for b, p in INSIDE.items()}), files).geometry
-        gmsh_session(g.module())
-        try:
-            g.module().generate(gmsh.model, g.params)
-            box = np.array(gmsh.model.getBoundingBox(-1, -1))
-            volumes = sorted(gmsh.model.occ.getMass(3, t) for _, t in gmsh.model.getEntities(3))
-            types = {gmsh.model.getType(2, t) for _, t in gmsh.model.getEntities(2)}
-            return box, np.array(volumes), types, gmsh.option.getNumber("Geometry.OCCScaling")
-        finally:
-            gmsh.finalize()
+    def read():
+        box = np.array(gmsh.model.getBoundingBox(-1, -1))
+        volumes = sorted(gmsh.model.occ.getMass(3, t) for _, t in gmsh.model.getEntities(3))
+        types = {gmsh.model.getType(2, t) for _, t in gmsh.model.getEntities(2)}
+        return box, np.array(volumes), types, gmsh.option.getNumber("Geometry.OCCScaling")
 
-    box, volumes, types, _ = read("", files / "pod.step")
-    box_mm, volumes_mm, types_mm, scaling = read('unit = "mm"', tmp_path / "pod_mm.step")
+    box, volumes, types, _ = built(scene_for(files, "step", tmp_path).geometry, read)
+    box_mm, volumes_mm, types_mm, scaling = built(
+        scene_for(files, "step", tmp_path, 'unit = "mm"', tmp_path / "pod_mm.step").geometry, read)
     np.testing.assert_allclose(box_mm, box, rtol=0, atol=1e-12)
     np.testing.assert_allclose(volumes_mm, volumes, rtol=1e-9)
     assert types_mm == types and types <= {"Plane", "Cylinder"} and scaling == 1.0
