@@ -36,7 +36,7 @@ residual, so the answer is Newton's to the same tolerance. The Newton's LU facto
 precision (``FACTOR_PRECISION``; MUMPS on the double matrix): they solve each correction to float32
 round-off times the condition, which the next iteration's double residual takes out like the
 chord's own error (Higham & Mary 2022, Acta Numerica 31, 347–414, §7), at 0.6x the factorisation's
-time (car-brake stop: heat solves 8.6-8.9 → 7.5-7.7 s). A linear step, one solve, keeps double
+time (car-brake stop: heat solves 8.3-9.1 → 7.7-8.1 s, benchmarks/README). A linear step, one solve, keeps double
 factors. A solve that fails with kept or single factors is redone from the step's start with
 fresh double ones, which then stay (``redone`` counts the redone steps).
 
@@ -165,7 +165,8 @@ class Thermal:
     [W/(m K)], ``rho`` and ``c`` or ``chi``; constants or temperature tables). ``initial_temperature``
     [K] is also the reference of the stored heat. ``boundaries``: ``ThermalBoundary`` conditions
     (none: every outer surface insulated). With Newton's method, ``jacobians`` counts the tangents
-    assembled and factorised so far, ``redone`` the steps redone with fresh tangents.
+    assembled and factorised so far, ``redone`` the steps redone with fresh tangents (and double
+    factors), ``precision`` that of the LU factors ("single", or "double" after a redone step).
     """
 
     def __init__(self, contact: ContactInterface, materials: Mapping[str, object], *,
