@@ -44,6 +44,12 @@ NORMAL_TOLERANCE = np.cos(np.radians(5.0))
 # the fragment then took 1.1 s instead of 0.03 s on the railway disc and HXT meshed 1.4-1.8x slower
 # (benchmarks/README, car brake). Scripts and meshes are scaled after reading, an OpenCASCADE script
 # after its fragment (0.26 -> 0.02 s for the pin-on-disc script of tests/test_geometry_files.py).
+# A script's own Mesh.MeshSizeFactor (or its alias CharacteristicLengthFactor) scales every element
+# size of its mesh, as gmsh does. Options are global in gmsh and a script sets them when it is read,
+# so the factor is read from the script and kept on the model, and the option stays the caller's:
+# geometry.estimate_cells meshes its trials at its factor times the script's, and a kept session
+# remeshed at factor 1 gives the script's mesh.
+SIZE_FACTOR = "Mesh.MeshSizeFactor"
 ALGORITHM_3D = {"delaunay": 1, "hxt": 10}   # gmsh's Mesh.Algorithm3D by mesh_algorithm; CAD takes HXT
 #   (Marot, Pellerin & Remacle 2019, Int. J. Numer. Methods Eng. 117, 967-990) unless told: on one
 #   thread 6x faster than gmsh's default Delaunay on the car brake, of better worst quality
@@ -63,6 +69,7 @@ class Found:
     normals: dict = field(default_factory=dict)      # name -> unit normal (fixed towards rotating), None if not planar
     surfaces: dict = field(default_factory=dict)     # name -> face tags
     extent: float = 0.0                              # m, largest side of the bounding box
+    size_factor: float = 1.0                         # a script's own Mesh.MeshSizeFactor (SIZE_FACTOR)
 
 
 def parameters(params) -> dict:
@@ -113,18 +120,20 @@ def generate(model, params) -> None:
 
 
 def remesh(model, params) -> None:
-    """Mesh the loaded file's model in 3-D (again, after ``model.mesh.clear()``): CAD with HXT
-    unless ``mesh_algorithm`` says otherwise, a script by its own choice unless told. Trial meshes
-    coarser than the mesh (``Mesh.MeshSizeFactor`` > 1, ``geometry.estimate_cells``) take Delaunay
-    instead of HXT: on thin parts HXT fails on coarse meshes or takes seconds (the railway disc's
-    coarse trials: 0.6-1.2 s each against 0.1 s; benchmarks/README), and the count they estimate
-    does not depend on the algorithm. A failed meshing at the mesh's own size is an InputError
-    naming the other algorithm."""
+    """Mesh the loaded file's model in 3-D (again, after ``model.mesh.clear()``): CAD with HXT unless
+    ``mesh_algorithm`` says otherwise, a script by its own choice unless told. Trial meshes coarser
+    than the mesh (``Mesh.MeshSizeFactor`` > 1, ``geometry.estimate_cells``; a script's own factor
+    multiplies it, ``SIZE_FACTOR``) take Delaunay instead of HXT: on thin parts HXT fails on coarse
+    meshes or takes seconds (the railway disc's coarse trials: 0.6-1.2 s each against 0.1 s;
+    benchmarks/README), and the count they estimate does not depend on the algorithm. A failed
+    meshing at the mesh's own size is an InputError naming the other algorithm."""
     import gmsh   # mesh options are global in gmsh
     algorithm = params.mesh_algorithm or ("hxt" if params.kind == "cad" else None)   # else the script's
-    trial = gmsh.option.getNumber("Mesh.MeshSizeFactor") > 1.0
+    factor = gmsh.option.getNumber(SIZE_FACTOR)
+    trial = factor > 1.0
     if algorithm is not None:
         gmsh.option.setNumber("Mesh.Algorithm3D", ALGORITHM_3D["delaunay" if trial else algorithm])
+    gmsh.option.setNumber(SIZE_FACTOR, factor * _script_factor(model))
     try:
         model.mesh.generate(3)
     except Exception as exc:
@@ -134,6 +143,13 @@ def remesh(model, params) -> None:
         raise InputError("geometry.mesh_algorithm", algorithm or "the script's choice",
                          f"gmsh could not mesh {params.file.name} ({exc}): try mesh_algorithm = {other}, "
                          "or other mesh sizes") from None
+    finally:
+        gmsh.option.setNumber(SIZE_FACTOR, factor)
+
+
+def _script_factor(model) -> float:
+    """The ``Mesh.MeshSizeFactor`` the loaded script set for its mesh (1: none, or not a script)."""
+    return float(model.getAttribute(SIZE_FACTOR)[0]) if SIZE_FACTOR in model.getAttributeNames() else 1.0
 
 
 # ---------------------------------------------------------------- reading
@@ -149,10 +165,16 @@ def _load(model, g) -> Found:
         model.occ.synchronize()
         order = [t for d, t in shapes if d == 3]
     else:
+        factor = gmsh.option.getNumber(SIZE_FACTOR)   # a trial's (geometry.estimate_cells), else 1
+        gmsh.option.setNumber(SIZE_FACTOR, 1.0)
         try:
             gmsh.merge(path)
         except Exception as exc:
             raise InputError("geometry.file", g.file.name, f"gmsh cannot read it ({exc})") from None
+        finally:
+            own = gmsh.option.getNumber(SIZE_FACTOR)  # set by the script, or 1
+            gmsh.option.setNumber(SIZE_FACTOR, factor)
+        model.setAttribute(SIZE_FACTOR, [repr(own)])
         order = [t for _, t in model.getEntities(3)]
     if not order:
         raise InputError("geometry.file", g.file.name, "holds no volume (3-D solid)")
@@ -176,7 +198,7 @@ def _load(model, g) -> Found:
     extent = _extent(model, g)
     labels = {t: _label(model, t) for _, t in model.getEntities(3)}
     found = Found(_bodies(model, g, order, labels), labels, {t: _volume(model, t, occ) for t in labels},
-                  extent=extent)
+                  extent=extent, size_factor=_script_factor(model))
     _interfaces(model, g, found, occ)
     _surfaces(model, g, found)
     return found
@@ -420,6 +442,8 @@ def _spec(g, found: Found) -> GeometrySpec:
     tag = {n: 1 + k for k, n in enumerate(g.bodies)}
     regions = tuple(Region(n, tag[n], g.bodies[n].material) for n in fixed)
     report = [f"file {g.file.name}: {len(found.labels)} volume(s), extent {found.extent:.4g} m"]
+    if found.size_factor != 1.0:
+        report.append(f"the script's Mesh.MeshSizeFactor {found.size_factor:g} scales every element size")
     report += [f"body {n}: {len(found.bodies[n])} volume(s), {sum(found.volume[t] for t in found.bodies[n]) * 1e6:.4g} cm^3, "
                f"material {g.bodies[n].material}" + (" (rotating)" if n == g.rotating else "") for n in g.bodies]
     for name, faces in found.interfaces.items():

@@ -223,6 +223,45 @@ def test_cad_is_meshed_by_the_chosen_algorithm_and_a_failure_says_what_to_change
         gmsh.finalize()
 
 
+def test_a_scripts_own_size_factor_scales_its_mesh_its_trials_and_the_kept_session(files, tmp_path, monkeypatch):
+    """A .geo script that sets Mesh.MeshSizeFactor (here 2) gets its coarser mesh: the trial meshes
+    are meshed at the trials' factors times the script's, the kept session's mesh at the script's,
+    node for node the builder's own run, and the count refined to the mesh is exact. Reading the script leaves gmsh's
+    option as it was, and the scene's summary says the factor. (Before: the script's value replaced
+    the trials' factor when it was read and was lost in a remesh: a count of the unscaled mesh,
+    7289 cells instead of 1802, and that mesh run; a factor 0.5 was estimated at 1e10 cells.)"""
+    (tmp_path / "pod.geo").write_text(GEO + "Mesh.MeshSizeFactor = 2;\n")
+    g = scene_for(files, "geo", tmp_path, file=tmp_path / "pod.geo").geometry
+    plain = scene_for(files, "geo", tmp_path).geometry
+
+    def nodes_and_tets():
+        return gmsh.model.mesh.getNodes()[1], np.concatenate(gmsh.model.mesh.getElements(3)[2])
+
+    own = built(g, nodes_and_tets)
+    assert len(own[1]) < 0.5 * len(built(plain, nodes_and_tets)[1])
+    mesh3d, used = gmsh.model.mesh.generate, []
+    monkeypatch.setattr(gmsh.model.mesh, "generate", lambda dim=3: used.append(
+        gmsh.option.getNumber("Mesh.MeshSizeFactor")) or mesh3d(dim))
+    estimate = check_cells(g.module(), g.params, MAX_CELLS, keep=True)
+    try:
+        kept = nodes_and_tets()
+        after = gmsh.option.getNumber("Mesh.MeshSizeFactor")
+    finally:
+        gmsh.finalize()
+    assert used[0] == 128.0 and used[-2] == 2.0 * estimate.factor and used[-1] == 2.0 and after == 1.0
+    assert all(np.array_equal(a, b) for a, b in zip(kept, own))
+    exact = estimate_cells(g.module(), g.params)
+    assert exact.exact and exact.cells == len(own[1]) // 4
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("Mesh.MeshSizeFactor", 3.0)
+        report = g.module().describe(g.params).report
+        assert gmsh.option.getNumber("Mesh.MeshSizeFactor") == 3.0
+    finally:
+        gmsh.finalize()
+    assert "the script's Mesh.MeshSizeFactor 2 scales every element size" in report
+
+
 def test_cad_in_millimetres_is_scaled_as_it_is_read(files, tmp_path):
     """A STEP file in mm (unit = "mm") gives the geometry of the same file in m: the same bounding
     box to 1e-12 m and the same volumes to 1e-9, its planes and cylinders still analytic (scaled
