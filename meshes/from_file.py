@@ -18,7 +18,9 @@ found; and ``generate``, on the meshing rank):
 4. find the named surfaces: the file's physical surface groups and [geometry.surfaces].
 
 CAD is meshed with gmsh's HXT unless ``mesh_algorithm`` says "delaunay"; a ``.geo`` script keeps
-its own choice unless told. A failed 3-D meshing is an InputError naming the other algorithm.
+its own choice unless told, and its own ``Mesh.MeshSizeFactor``; a script's options that make other
+elements than linear tetrahedra are refused (``TETRAHEDRA``), and so is a mesh that holds any. A
+failed 3-D meshing is an InputError naming the other algorithm.
 
 The macro model's body 0 ("fixed") holds every fixed body as a material region (bodies that touch
 are bonded: one conforming mesh), body 1 the rotating body. Tags: body k -> cell tag 1 + k,
@@ -50,6 +52,10 @@ NORMAL_TOLERANCE = np.cos(np.radians(5.0))
 # geometry.estimate_cells meshes its trials at its factor times the script's, and a kept session
 # remeshed at factor 1 gives the script's mesh.
 SIZE_FACTOR = "Mesh.MeshSizeFactor"
+# gmsh options a script could set that make other elements than linear tetrahedra (quadratic ones,
+# quadrangles, pyramids, hexahedra), with the values that do not: refused when the script is read
+# (after a 3-D meshing with recombined quadrangles failed, gmsh 4.15's finalize crashed the process)
+TETRAHEDRA = {"Mesh.ElementOrder": 1, "Mesh.RecombineAll": 0, "Mesh.Recombine3DAll": 0, "Mesh.SubdivisionAlgorithm": 0}
 ALGORITHM_3D = {"delaunay": 1, "hxt": 10}   # gmsh's Mesh.Algorithm3D by mesh_algorithm; CAD takes HXT
 #   (Marot, Pellerin & Remacle 2019, Int. J. Numer. Methods Eng. 117, 967-990) unless told: on one
 #   thread 6x faster than gmsh's default Delaunay on the car brake, of better worst quality
@@ -145,6 +151,11 @@ def remesh(model, params) -> None:
                          "or other mesh sizes") from None
     finally:
         gmsh.option.setNumber(SIZE_FACTOR, factor)
+    others = [model.mesh.getElementProperties(t)[0] for t in model.mesh.getElementTypes(3)
+              if model.mesh.getElementProperties(t)[0] != "Tetrahedron 4"]
+    if others and not trial:
+        raise InputError("geometry.file", params.file.name, f"its mesh holds {', '.join(others)} elements: the macro "
+                         "model needs linear tetrahedra (a Recombine or Transfinite constraint of the script?)")
 
 
 def _script_factor(model) -> float:
@@ -175,6 +186,10 @@ def _load(model, g) -> Found:
             own = gmsh.option.getNumber(SIZE_FACTOR)  # set by the script, or 1
             gmsh.option.setNumber(SIZE_FACTOR, factor)
         model.setAttribute(SIZE_FACTOR, [repr(own)])
+        changed = [f"{k} = {gmsh.option.getNumber(k):g}" for k, v in TETRAHEDRA.items() if gmsh.option.getNumber(k) != v]
+        if changed:
+            raise InputError("geometry.file", g.file.name, f"sets {', '.join(changed)}: the macro model is meshed with "
+                             "linear tetrahedra; remove it from the script")
         order = [t for _, t in model.getEntities(3)]
     if not order:
         raise InputError("geometry.file", g.file.name, "holds no volume (3-D solid)")

@@ -2,6 +2,8 @@
 gmsh mesh (.msh), a gmsh script (.geo, in mm) and CAD (.step) gives the builder's results, and bad
 input is one clear line with exit code 2, nothing written."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -9,7 +11,7 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 import gmsh  # noqa: E402
 
-from meshes import pin_on_disc  # noqa: E402
+from meshes import from_file, pin_on_disc  # noqa: E402
 from multiscale.cli import main  # noqa: E402
 from multiscale.errors import InputError  # noqa: E402
 from multiscale.geometry import MAX_CELLS, check_cells, estimate_cells, gmsh_session  # noqa: E402
@@ -326,6 +328,32 @@ def test_bad_geometry_files_are_one_clear_line(files, tmp_path, capsys):
     err = check(tmp_path, capsys, good.replace('surfaces = ["disc_bore"]', 'surfaces = ["bore"]'))
     assert 'boundary[2].surfaces: "bore" is not a surface' in err and "disc_bore" in err
 
+
+
+def test_a_script_that_would_mesh_other_elements_than_linear_tetrahedra_is_refused(files, tmp_path, capsys):
+    """Options of a .geo script that make quadratic elements, quadrangles, pyramids or hexahedra
+    are one clear line at check (before: a UFL error deep in the run, or with Mesh.RecombineAll a
+    crash of the process in gmsh's finalize after a failed 3-D meshing); a mesh that still holds
+    other elements (a constraint on an entity of a script) is refused once meshed, not run."""
+    for line in ("Mesh.RecombineAll = 1;", "Mesh.ElementOrder = 2;", "Mesh.SubdivisionAlgorithm = 2;"):
+        (tmp_path / "pod.geo").write_text(GEO + line + "\n")
+        text = FILE.format(name="geo", file=tmp_path / "pod.geo", folder=tmp_path / "out", surfaces=CAD_SURFACES,
+                           extra='unit = "mm"\nmesh_size = "15 mm"', **{b: f"contains = {p}" for b, p in INSIDE.items()})
+        err = check(tmp_path, capsys, text)
+        assert f"geometry.file = 'pod.geo': sets {line[:-1]}: the macro model is meshed with linear tetrahedra" in err
+    (tmp_path / "prism.geo").write_text("Point(1) = {0, 0, 0};\nPoint(2) = {1, 0, 0};\nPoint(3) = {0, 1, 0};\n"
+                                        "Line(1) = {1, 2};\nLine(2) = {2, 3};\nLine(3) = {3, 1};\n"
+                                        "Curve Loop(1) = {1, 2, 3};\nPlane Surface(1) = {1};\n"
+                                        "Extrude {0, 0, 1} { Surface{1}; Layers{2}; Recombine; }\n")
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.merge(str(tmp_path / "prism.geo"))
+        with pytest.raises(InputError, match="its mesh holds Prism 6 elements: the macro model needs linear tetrahedra"):
+            from_file.remesh(gmsh.model, replace(scene_for(files, "geo", tmp_path).geometry.params,
+                                                 file=tmp_path / "prism.geo"))
+    finally:
+        gmsh.finalize()
 
 def test_a_rough_interface_must_be_planar(tmp_path, capsys):
     """A fixed block pressed on the curved rim of a rotating wheel: fine in perfect contact, refused
