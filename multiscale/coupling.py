@@ -76,7 +76,7 @@ from pathlib import Path
 import numpy as np
 
 from multiscale import checkpoint, io
-from multiscale.errors import ConvergenceError, InputError
+from multiscale.errors import ConvergenceError, InputError, MultiscaleError
 from multiscale.geometry import Rotation
 from multiscale.macro.mechanics import SolveResult
 from multiscale.macro.model import MacroModel
@@ -169,6 +169,24 @@ class Restored:
     fields_written: int        # last step whose fields were written (-1: none)
 
 
+def collective(comm, call):
+    """``call()`` on every rank of ``comm`` (a rank's share of the zones); a ``MultiscaleError`` met
+    by any rank is raised on every rank (the rank that met it raises its own, the others a
+    ``MultiscaleError`` with its message), so that no rank waits for another in the next exchange."""
+    try:
+        value, failure = call(), None
+    except MultiscaleError as exc:
+        value, failure = None, exc
+    failed = [(rank, message) for rank, message in enumerate(comm.allgather(None if failure is None else str(failure)))
+              if message is not None]
+    if failure is not None:
+        raise failure
+    if failed:
+        rank, message = failed[0]
+        raise MultiscaleError(f"micro analysis on rank {rank}: {message}")
+    return value
+
+
 def anderson(passes, weight, mixing: float) -> np.ndarray:
     """The next partitions of Anderson's acceleration (Walker & Ni 2011, type II) of the fixed point
     p = G(p): ``passes`` [(p_j, r_j = G(p_j) − p_j), ...], the last one current; the residuals
@@ -258,9 +276,10 @@ class Multiscale:
         T = load.temperature[mine]
         remote = np.column_stack([T[:, 0] if self.settings.remote == "bulk" else T[:, 1], T[:, 1]])
         mu = None if self.settings.friction is None else self.settings.friction[mine]
-        res = self.post.run([zones[i] for i in mine], load.pressure[mine], speed=load.speed[mine],
-                            angle=load.angle[mine], remote=remote, warm=self.warm[mine], mu=mu,
-                            duration=self.settings.dt, hardness_temperature=self._hardness_temperature(mine, T[:, 1]))
+        res = collective(comm, lambda: self.post.run(
+            [zones[i] for i in mine], load.pressure[mine], speed=load.speed[mine], angle=load.angle[mine],
+            remote=remote, warm=self.warm[mine], mu=mu, duration=self.settings.dt,
+            hardness_temperature=self._hardness_temperature(mine, T[:, 1])))
         self._last = (mine, res, load, remote, loaded)
         implicit = self.settings.coupling == "implicit"
         parts = comm.allgather((mine, res.pressure, res.max_pressure, res.max_temperature,
@@ -317,7 +336,8 @@ class Multiscale:
         frictional work [J] of the interval."""
         mine, res, load, remote, _ = self._last
         zones = self.rough.zones
-        res = self.post.wear([zones[i] for i in mine], res, load.speed[mine] * duration, remote)
+        res = collective(self.comm, lambda: self.post.wear([zones[i] for i in mine], res, load.speed[mine] * duration,
+                                                           remote))
         volume = np.zeros(len(zones))
         for ids, warm, heights, lost, w in self.comm.allgather((mine, res.worn_pressure, res.heights,
                                                                  res.counter_volume, res.plastic)):

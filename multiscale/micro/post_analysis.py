@@ -234,6 +234,8 @@ class PostAnalysis:
         without heating. Returns ``result`` with the worn heights, depth, volumes, pressures."""
         heights, p, load, mu = result.heights, result.pressure, result.load, result.mu
         B = len(zones)
+        if B == 0:                 # a rank that holds no loaded zone
+            return result
         T, T1 = result.temperature, result.counter_temperature
         for rate, field, col in ((self.rate, "T", 1), (self.counter_rate, "T1", 0)):
             if rate is not None and rate.depends_on_temperature and (T if field == "T" else T1) is None:

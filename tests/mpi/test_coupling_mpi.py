@@ -10,6 +10,8 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from mpi4py import MPI  # noqa: E402
 
+from multiscale.coupling import collective  # noqa: E402
+from multiscale.errors import InputError, MultiscaleError  # noqa: E402
 from multiscale.io import solver_statistic  # noqa: E402
 from multiscale.workflows.multiscale import run  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
@@ -36,3 +38,33 @@ def test_two_ranks_give_the_serial_multiscale_history(tmp_path):
         # residual and the heat exchanged, measured in CI; docs/architecture.md §7), far below the
         # loop's own tolerance (coupling_tol 1e-3): every column is held to 1e-5
         np.testing.assert_allclose(parallel[key], serial[key], rtol=1e-5, atol=1e-12, err_msg=key)
+
+
+def test_a_rank_without_a_loaded_zone_wears_nothing_and_waits_for_nobody(tmp_path):
+    """One zone for the whole pin on two ranks: rank 1 holds no loaded zone in the post-analysis
+    and its wear (before: the micro solver refused the empty batch on rank 1 only, and the job was
+    aborted with nothing written); the run ends on both with the zone worn."""
+    world = MPI.COMM_WORLD
+    base = world.bcast(str(tmp_path), root=0)
+    scene = loads(POD.format(folder=f"{base}/one").replace("zones = [5, 5]", "zones = 1"))
+    h = run(scene, comm=world, verbose=False).history.columns
+    assert h["zones_in_contact"][-1] == 1 and h["wear_volume"][-1] > 0
+    np.testing.assert_allclose(h["interface_force"], 200.0, rtol=1e-6)
+
+
+def test_a_micro_failure_on_one_rank_is_raised_on_every_rank():
+    """``coupling.collective``: rank 1's error is raised on rank 1 as it is and on rank 0 as a
+    MultiscaleError naming rank 1 and the message; nobody is left in the exchange."""
+    world = MPI.COMM_WORLD
+
+    def call():
+        if world.rank == 1:
+            raise InputError("zones", 3, "a test failure")
+        return 7
+
+    with pytest.raises(MultiscaleError) as info:
+        collective(world, call)
+    expected = InputError if world.rank == 1 else MultiscaleError
+    assert type(info.value) is expected and "zones = 3: a test failure" in str(info.value)
+    assert world.rank == 1 or str(info.value).startswith("micro analysis on rank 1: ")
+    assert world.allreduce(collective(world, lambda: world.rank)) == 1
