@@ -11,9 +11,10 @@ One macro step Δt (Fig. 7.2) runs:
 3. the micro post-analysis of the loaded zones (Fig. 7.5, ``micro.post_analysis``): local pressure
    under P, local surface temperatures, flash temperature and partition (steady sliding heating,
    or with ``PostAnalysis.heating.transient_steps`` the transient heating over Δt, Table 7.1),
-   and, every ``wear_every`` steps, the Archard wear of the patch over the sliding of those steps
-   with k_w(T) (and the counter-face's, spread over its wear track: ``rough.track_depth``); the
-   zones are spread over the MPI ranks and the worn topographies shared;
+   and, every ``wear_every`` steps (and at the last step), the Archard wear of the patch over the
+   load-weighted sliding of those steps with k_w(T) (and the counter-face's, spread over its wear
+   track: ``rough.track_depth``); the zones are spread over the MPI ranks and the worn topographies
+   shared;
 4. the laws of the zones whose topography changed are recomputed (``rough.RoughInterface``: the
    others come from the pool's cache), the facet laws updated and the mechanics re-solved at the
    same time (from the state plus the previous step's change by this solve, ``law_increment``,
@@ -100,6 +101,7 @@ class LoopSettings:
     partition_law: bool = False   # micro partition per zone (ch. 6) instead of the constant
     wear: bool = False            # Archard wear of the zones
     wear_every: int = 1           # macro steps per wear update
+    steps: int | None = None      # macro steps of the run: the last wears the rest of a wear interval
     flash_softening: bool = False  # H(T) of each zone at its last micro flash temperature (plasticity)
     forces: dict = field(default_factory=dict)   # N, per interface: the load it nominally carries
     friction: np.ndarray | None = None            # mu of every zone (its interface's; None: the post-analysis')
@@ -130,6 +132,7 @@ class ZoneLoading:
     speed: np.ndarray          # m/s, sliding speed of the counter-face at the zone centre
     angle: np.ndarray          # rad, its direction in the interface plane (from +x)
     temperature: np.ndarray    # K, (Z, 2): facet-mean surface temperatures (counter-face, rough body)
+    reach: np.ndarray          # m per unit of body 1's sliding (rad or m): the zone's sliding distance
 
 
 @dataclass
@@ -254,16 +257,21 @@ class Multiscale:
                 T[:, col] = np.where(area > 0, total / np.where(area > 0, area, 1.0), T[:, col])
         centres, axes = self.rough.zone_frames()
         motion = self.tm.spec.motion
-        speed = model.speed(model.time)
-        if isinstance(motion, Rotation):
+        if isinstance(motion, Rotation):                 # the velocity at unit speed
             axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
-            w = speed * np.cross(axis, centres - np.asarray(motion.centre, float))
+            w = np.cross(axis, centres - np.asarray(motion.centre, float))
         else:
             e = np.asarray(motion.direction, float) / np.linalg.norm(motion.direction)
-            w = np.tile(speed * e, (Z, 1))
+            w = np.tile(e, (Z, 1))
         w = np.einsum("zij,zj->zi", axes, w)             # in each zone's plane coordinates
-        return ZoneLoading(force, force / self.rough.zone_area, np.hypot(w[:, 0], w[:, 1]),
-                           np.arctan2(w[:, 1], w[:, 0]), T)
+        reach = np.hypot(w[:, 0], w[:, 1])
+        # the speed now; at a standstill that of the step that led to it (a partition is defined
+        # only while sliding: the zones' heating needs a speed)
+        speed = model.speed(model.time)
+        if speed == 0.0 and self.settings.dt:
+            speed = model.drive.mean_speed(max(model.time - self.settings.dt, 0.0), model.time)
+        return ZoneLoading(force, force / self.rough.zone_area, reach * abs(speed),
+                           np.arctan2(w[:, 1], w[:, 0]) + (np.pi if speed < 0 else 0.0), T, reach)
 
     def analyse(self) -> MicroStep:
         """Post-analysis (local contact, heating, conductance) of the loaded zones at the current
@@ -331,12 +339,14 @@ class Multiscale:
             self.rough.plastic[ids] += w
 
     def wear(self, duration: float) -> float:
-        """Wear of the zones of the last ``analyse`` over ``duration`` [s] of sliding (their
-        topographies change; a wearing counter-face recedes along its track); returns the
-        frictional work [J] of the interval."""
+        """Wear of the zones of the last ``analyse`` over the last ``duration`` [s] (their topographies
+        change; a wearing counter-face recedes along its track): the pressure fields of the last
+        analysis slide over the interval's load-weighted sliding (``MacroModel.sliding``: none while
+        released, exact for a stop or a release inside it); returns the frictional work [J]."""
         mine, res, load, remote, _ = self._last
-        zones = self.rough.zones
-        res = collective(self.comm, lambda: self.post.wear([zones[i] for i in mine], res, load.speed[mine] * duration,
+        zones, m = self.rough.zones, self.model
+        sliding = m.sliding(m.time - duration, m.time)
+        res = collective(self.comm, lambda: self.post.wear([zones[i] for i in mine], res, load.reach[mine] * sliding,
                                                            remote))
         volume = np.zeros(len(zones))
         for ids, warm, heights, lost, w in self.comm.allgather((mine, res.worn_pressure, res.heights,
@@ -351,16 +361,27 @@ class Multiscale:
             self.counter_depth += self.rough.track_depth(volume, contact.facet_heat_flux() * iface.areas)
             self.counter_volume += volume.sum()
             iface.set_field(contact.initial_gap, self.datum_gap + self.counter_depth)
-        work = sum(self.model.contact.heat_power()) * duration            # mu ∫ p |w| dA Δt
+        work = self._sliding_power() * sliding                            # mu ∫ p |w| dA dt
         self.work += work
         return work
+
+    def _sliding_power(self) -> float:
+        """mu ∫ p |w| dA [W] of the last solved pressure at unit speed of body 1."""
+        c = self.model.contact
+        kept = c.speed.value, c.heating.value
+        c.speed.value, c.heating.value = 1.0, 1.0
+        try:
+            return sum(c.heat_power())
+        finally:
+            c.speed.value, c.heating.value = kept
 
     def accept(self, micro: MicroStep) -> MicroStep:
         """The partitions (and exchanges) of the last ``analyse`` become the zones' (partition law);
         ``micro`` with their (min, mean, max) over the loaded zones."""
         loaded = self._last[-1]
-        if self.partition_law:
-            self.partition[loaded] = self.proposed[loaded]
+        if self.partition_law:                  # a zone that did not slide (no heat) keeps its partition
+            proposed = self.proposed[loaded]
+            self.partition[loaded] = np.where(np.isfinite(proposed), proposed, self.partition[loaded])
         if self.settings.coupling == "implicit":
             self.exchange[:] = 0.0
             self.exchange[loaded] = self.proposed_exchange[loaded]
@@ -368,15 +389,11 @@ class Multiscale:
         micro.partition = (float(used.min()), float(used.mean()), float(used.max()))
         return micro
 
-    def micro_step(self, wear: bool, duration: float = 0.0) -> MicroStep:
-        """Post-analysis of the loaded zones at the current macro state, its partitions accepted;
-        with ``wear`` the zones wear over ``duration`` [s] of sliding."""
+    def micro_step(self) -> MicroStep:
+        """Post-analysis of the loaded zones at the current macro state (no wear), its partitions
+        accepted."""
         micro = self.analyse()
-        if wear:
-            t0 = _time.perf_counter()
-            micro.work = self.wear(duration)
-            micro.seconds += _time.perf_counter() - t0
-        elif self.plastic:
+        if self.plastic:
             self.deform()
         return self.accept(micro)
 
@@ -392,6 +409,8 @@ class Multiscale:
         if not len(loaded):
             return 0.0
         Q = self.micro_heat[loaded]
+        if not Q.mean() > 0:                    # no frictional heat (no sliding): nothing to couple
+            return 0.0
         given = self.partition[loaded] * Q - self.exchange[loaded] * self.remote_difference[loaded]
         return float(np.abs(self.micro_heat_rough[loaded] - given).max() / Q.mean())
 
@@ -464,7 +483,7 @@ class Multiscale:
 
     def _constants(self) -> list:
         m = self.model
-        return [m.contact.speed, m.contact.engaged, m.mechanics.load]
+        return [m.contact.speed, m.contact.engaged, m.contact.heating, m.mechanics.load]
 
     # ---- the run ---------------------------------------------------------------------------
     def start(self) -> StepResult:
@@ -476,7 +495,7 @@ class Multiscale:
         self.tm.interface.set_field(self.model.contact.initial_gap, self.datum_gap + self.counter_depth)
         self.model.start()
         t2 = _time.perf_counter()
-        micro = self.micro_step(wear=False)
+        micro = self.micro_step()
         self.apply_zone_fields()
         return StepResult(0, np.zeros(2), micro, t2 - t1, micro.seconds, t1 - t0)
 
@@ -484,7 +503,8 @@ class Multiscale:
         """Macro step n (1, 2, ...): the macro transient and the post-analysis (iterated to the
         fixed point of the partitions with ``coupling = "fixed-point"``), wear, the new laws."""
         s = self.settings
-        wear = s.wear and n % s.wear_every == 0 and self.post.wears
+        interval = n % s.wear_every or s.wear_every      # steps since the last wear if this one wears
+        wear = s.wear and self.post.wears and (interval == s.wear_every or n == s.steps)
         state = self.snapshot() if self.iterating else None
         residuals, passes, time_macro, time_micro = [], [], 0.0, 0.0
         while True:
@@ -506,7 +526,7 @@ class Multiscale:
             self.apply_zone_fields()
         t2 = _time.perf_counter()
         if wear:
-            micro.work = self.wear(s.dt * s.wear_every)
+            micro.work = self.wear(s.dt * interval)
         elif self.plastic:
             self.deform()
         self.accept(micro)
@@ -605,7 +625,7 @@ class Multiscale:
         reason, its, force, max_p = attrs["solve"]
         m.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
         self.tm.interface.set_field(m.contact.initial_gap, self.datum_gap + self.counter_depth)
-        m.contact.speed.value = m.speed(m.time)
+        m.contact.speed.value = m.solved_speed = m.speed(m.time)
         m.load = float(attrs["load"])
         m.mechanics.load.value = m.load * m.drive.factor(m.time)
         self.rough.update_laws()

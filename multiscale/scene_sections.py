@@ -52,6 +52,15 @@ def mean(table, x0: float, x1: float) -> float:
     return sum(0.5 * (a + b) * (x1_ - x0_) for a, b, x0_, x1_ in zip(ys, ys[1:], xs, xs[1:])) / (x1 - x0)
 
 
+def piecewise_mean(fn, knots, x0: float, x1: float) -> float:
+    """Mean over [x0, x1] of ``fn``, a function that is quadratic (or linear) between its ``knots``:
+    Simpson's rule on each piece, exact for it. ``fn`` at x0 if the interval is empty."""
+    if x1 <= x0:
+        return fn(x0)
+    xs = sorted({x0, x1, *(x for x in knots if x0 < x < x1)})
+    return sum((b - a) * (fn(a) + 4.0 * fn(0.5 * (a + b)) + fn(b)) / 6.0 for a, b in zip(xs, xs[1:])) / (x1 - x0)
+
+
 def interpolate(table, x: float) -> float:
     """Piecewise-linear interpolation of ((x, y), ...) rows at ``x``, held constant beyond the ends."""
     xs, ys = zip(*table)
@@ -341,6 +350,22 @@ class Loading:
         """Mean load factor over [t0, t1] [s]."""
         return 1.0 if self.load_profile is None else mean(self.load_profile, t0, t1)
 
+    def knots(self) -> tuple:
+        """Times [s] where the load factor or the angular speed may change slope (between them
+        both are linear in time)."""
+        out = [t for table in (self.load_profile, self.speed_profile) if table is not None for t, _ in table]
+        stop = None if self.vehicle is None else self.vehicle.stop_time
+        return tuple(out + ([stop] if stop is not None else []))
+
+    def mean_angular_speed(self, t0: float, t1: float) -> float:
+        """Mean of omega(t) over [t0, t1] [rad/s] (exact, a stop inside the interval included)."""
+        return piecewise_mean(self.angular_speed, self.knots(), t0, t1)
+
+    def mean_sliding_factor(self, t0: float, t1: float) -> float:
+        """Mean of factor(t) omega(t) over [t0, t1] [rad/s]: the loaded sliding of the interval
+        (exact for the piecewise-linear profiles and a stop; frictional heat and wear follow it)."""
+        return piecewise_mean(lambda t: self.factor(t) * self.angular_speed(t), self.knots(), t0, t1)
+
 
 @dataclass(frozen=True)
 class Time:
@@ -501,8 +526,9 @@ class Wear:
     """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (default: the
     rough body's material k_w, else the shape of thesis Fig. 7.9, ``FIG_7_9_WEAR_RATE``, whose
     level is calibrated on the thesis' ch. 7 worn volume: ``FIG_7_9_CALIBRATION``). Every
-    ``update_every`` macro steps the zones wear over the sliding of those steps in ``substeps``
-    load-controlled increments; a counter-face whose material gives ``k_w`` wears too."""
+    ``update_every`` macro steps (and at the last step) the zones wear over the sliding of those
+    steps, weighted by the load factor (none while released), in ``substeps`` load-controlled
+    increments; a counter-face whose material gives ``k_w`` wears too."""
 
     k_w: float | None = key(_WEAR_RATE)                      # 1/Pa
     k_w_table: tuple | None = key(Curve(_TEMPERATURE, Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)),

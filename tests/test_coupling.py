@@ -272,6 +272,47 @@ def test_rough_pin_on_disc_bookkeeping_and_outputs(straight):
     assert all(name in text for name in ("contact_stiffness", "partition", "wear_depth"))
 
 
+
+def run_pod(folder, overrides: dict, text: str = POD):
+    from multiscale.workflows import run
+    return run(loads(text.format(folder=folder), overrides=overrides), verbose=False).history
+
+
+def test_the_zones_wear_with_the_loaded_sliding_and_at_the_last_step(straight, tmp_path):
+    """Archard wear and the frictional work follow the sliding weighted by the load factor: released
+    after 0.6 s (within 10 ms), step 2 works and wears 1/120 of step 1 (before: the end-of-step
+    state over the whole step, 1/1); the work of every step is the frictional heat it put into the
+    bodies within 0.1 % (the work takes the pressure at the step's end, the heat that of its start,
+    which thermal expansion changes: 3e-4 here). Wearing every 3 steps over 2, the last step wears both (before: none), the
+    volume of wearing every step within 2 %."""
+    h = run_pod(tmp_path / "released", {"loading.load_profile": [["0 s", 1.0], ["0.6 s", 1.0], ["0.61 s", 0.0]]})
+    work, wear = np.diff(h["frictional_work"]), np.diff(h["wear_volume"])
+    np.testing.assert_allclose(work, h["heat_step_pin"][1:] + h["heat_step_disc"][1:], rtol=1e-3)
+    assert work[1] / work[0] == pytest.approx(1 / 120, rel=0.05) and wear[1] / wear[0] == pytest.approx(1 / 120, rel=0.05)
+    late = run_pod(tmp_path / "late", {"wear.update_every": 3})
+    every = straight[1].history
+    assert late["wear_volume"][1] == 0.0 and late["wear_volume"][2] == pytest.approx(every["wear_volume"][2], rel=0.02)
+
+
+def test_a_stop_and_a_restart_keep_every_result_finite(tmp_path):
+    """200 rpm to a standstill in 0.6 s, 0.6 s at rest, back to 200 rpm: the zones of the step that
+    ended the stop take the sliding of that step, the zones at rest keep their partitions (no heat
+    to share: before, a NaN partition, an infinite coupling residual and log(0) warnings), no heat
+    and no wear at rest; every scalar of the history finite (the coupling residual before the first
+    step has no value)."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", RuntimeWarning)
+        h = run_pod(tmp_path / "stop", {"time.end": "2.4 s", "time.steps": 4,
+                                        "loading.speed_profile": [["0 s", "200 rpm"], ["0.6 s", "0 rpm"],
+                                                                  ["1.2 s", "0 rpm"], ["1.8 s", "200 rpm"]]},
+                    POD.replace('rotation_speed = "200 rpm"\n', ""))
+    for key, values in h.columns.items():       # the scalar columns (per-zone ones mark unloaded zones NaN)
+        if np.ndim(values) == 1:
+            assert np.all(np.isfinite(values[1:] if key == "coupling_residual" else values)), key
+    assert h["partition_mean"][2] == h["partition_mean"][1] and h["wear_volume"][2] == h["wear_volume"][1]
+    assert h["heat_step_pin"][2] == 0.0 and h["wear_volume"][3] > h["wear_volume"][2]
+
 def resumed_rtol(key: str, rtol: float = 1e-6) -> float:
     """Relative tolerance of history column ``key`` between a resumed run and the straight one
     (``rtol`` for the state columns): the coupling residual, a difference of partitions, shows the

@@ -79,7 +79,7 @@ def two_zones(tmp_path_factory):
         ms = build(loads(scene_text(tmp_path_factory.mktemp(scheme), micro=micro)))
         ms.start()
         hot_pin(ms)
-        ms.micro_step(wear=False)          # the partitions (and exchanges) of these temperatures
+        ms.micro_step()          # the partitions (and exchanges) of these temperatures
         ms.apply_zone_fields()
         stored = np.array(ms.model.thermal.stored_heat())
         moment = abs(ms.model.contact.friction_moment())

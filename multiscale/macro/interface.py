@@ -70,8 +70,9 @@ class ContactInterface:
     global per-facet arrays): ``stiffness`` K_n [Pa/m], ``initial_gap`` g_0 [m], ``friction`` mu
     (one value per interface, or per facet), ``partition`` p_1 (share of the frictional heat into
     body 0) and ``conductance`` h_c [W/(m^2 K)]. ``speed`` (rad/s or m/s, see ``rigid_velocity``)
-    and ``engaged`` (1: in contact; 0: released, no frictional heat and no conductance) are
-    Constants. ``law`` defaults to ``PenaltyLaw(stiffness)``; pass ``law=`` a callable to use another
+    ``engaged`` (1: in contact; 0: released, no conductance) and ``heating`` (the factor of the
+    frictional heat: 1 in contact, 0 released; over a step, the mean of load factor x speed over
+    the mean speed) are Constants. ``law`` defaults to ``PenaltyLaw(stiffness)``; pass ``law=`` a callable to use another
     pressure–gap law.
     """
 
@@ -89,6 +90,7 @@ class ContactInterface:
         self.friction = iface.field("friction", friction)
         self.speed = fem.Constant(tm.parent, float(speed))
         self.engaged = fem.Constant(tm.parent, 1.0)
+        self.heating = fem.Constant(tm.parent, 1.0)
         self.normal = ufl.FacetNormal(tm.parent)("-")
         x = ufl.SpatialCoordinate(tm.parent)
         w = velocity if velocity is not None else rigid_velocity(tm.spec.motion, x, self.speed)
@@ -101,7 +103,7 @@ class ContactInterface:
         mu = self.friction("+")
         self.traction = self.pressure * self.normal + mu * self.pressure * self.slip_direction
         self.friction_traction = mu * self.pressure * self.slip_direction
-        self.heat_flux = self.engaged * mu * self.pressure * self.slip_speed
+        self.heat_flux = self.heating * mu * self.pressure * self.slip_speed
         self.cache = FormCache(tm)
 
     # ---- mechanics -------------------------------------------------------------------------

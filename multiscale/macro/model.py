@@ -43,6 +43,18 @@ class Drive:
     mean_factor: Callable[[float, float], float] = lambda t0, t1: 1.0   # mean of factor over [t0, t1]
     steady: bool = True              # the speed never changes
     torque: float | None = None      # N m, braking torque the friction must give
+    # with a changing speed (not ``steady``): the exact means over [t0, t1] of speed(t) and of
+    # factor(t) speed(t) (``scene_sections.Loading.mean_angular_speed``, ``mean_sliding_factor``)
+    speed_mean: Callable[[float, float], float] | None = None
+    sliding_mean: Callable[[float, float], float] | None = None
+
+    def mean_speed(self, t0: float, t1: float) -> float:
+        """Mean sliding speed over [t0, t1] (rad/s or m/s)."""
+        return self.speed(t0) if self.steady else self.speed_mean(t0, t1)
+
+    def mean_sliding(self, t0: float, t1: float) -> float:
+        """Mean of factor(t) speed(t) over [t0, t1]: frictional heat and wear go with it."""
+        return self.mean_factor(t0, t1) * self.speed(t0) if self.steady else self.sliding_mean(t0, t1)
 
 
 @dataclass
@@ -59,6 +71,7 @@ class MacroModel:
     heat_exchanged: float = 0.0                        # J, body 0 -> body 1 through the conductance, last step
     heat_exchanged_total: float = 0.0                  # J, since the start
     last_solve: SolveResult | None = None
+    solved_speed: float = 0.0                          # the speed of the last contact solve (friction on if > 0)
     load: float | None = None                          # N or Pa at factor 1 (the drive's, or scaled to its torque)
 
     @property
@@ -94,6 +107,7 @@ class MacroModel:
             self.load *= self.drive.torque / moment
             self.last_solve = self.mechanics.solve(self.load * factor)
         self.contact.engaged.value = float(self.drive.factor(0.0) > 0)
+        self.solved_speed = float(self.contact.speed.value)
         return self.last_solve
 
     def macro_step(self, dt: float, substeps: int = 1) -> np.ndarray:
@@ -103,27 +117,40 @@ class MacroModel:
         heat, self.heat_exchanged = np.zeros(2), 0.0
         delta, start = dt / substeps, self.time
         for k in range(substeps):
-            if self.thermal is not None:            # the mean speed of the step for a changing speed
-                self.contact.speed.value = self.speed(self.time) if self.drive.steady else \
-                    0.5 * (self.speed(self.time) + self.speed(self.time + delta))
-                # the pressure was solved at the load factor of the step's start: its heat scales
-                # with the mean factor over the step (a release inside the step, a load ramp)
+            if self.thermal is not None:            # the mean speed of the step (transport, convection)
+                t0, t1 = self.time, self.time + delta
+                speed = self.drive.mean_speed(t0, t1)
+                self.contact.speed.value = speed
+                # the pressure was solved at the load factor of the step's start: the conductance
+                # scales with the mean factor over the step (a release inside it, a load ramp), the
+                # frictional heat with the mean of factor x speed (exact for a stop inside the step)
                 solved = float(self.mechanics.load.value)
-                self.contact.engaged.value = self.drive.mean_factor(self.time, self.time + delta) * self.load / solved \
-                    if solved > 0 else 0.0
+                scale = self.load / solved if solved > 0 else 0.0
+                self.contact.engaged.value = self.drive.mean_factor(t0, t1) * scale
+                self.contact.heating.value = self.drive.mean_sliding(t0, t1) / speed * scale if speed else 0.0
                 done = self.thermal.step(delta)
                 heat += done.heat_in
                 self.heat_exchanged += done.heat_exchanged
             self.time = step_time(start, dt) if k == substeps - 1 else start + (k + 1) * delta
             self.contact.speed.value = self.speed(self.time)
             factor = self.drive.factor(self.time)
-            self.contact.engaged.value = float(factor > 0)
+            self.contact.engaged.value = self.contact.heating.value = float(factor > 0)
             load = self.load * factor
-            if factor > 0 and (self.mechanics.temperatures is not None or load != self.mechanics.load.value):
+            speed = float(self.contact.speed.value)      # friction acts while sliding: a start or a stop changes it
+            if factor > 0 and (self.mechanics.temperatures is not None or load != self.mechanics.load.value
+                               or (speed == 0.0) != (self.solved_speed == 0.0)):
                 self.last_solve = self.mechanics.solve(load)
+                self.solved_speed = speed
         self.heat_total += heat
         self.heat_exchanged_total += self.heat_exchanged
         return heat
+
+    def sliding(self, t0: float, t1: float) -> float:
+        """Sliding of body 1 over [t0, t1] weighted by the load (rad or m): the integral of
+        factor(t) speed(t) over the factor of the pressure last solved, so that the frictional work
+        or wear of that pressure field over it is the interval's (0 while released)."""
+        solved = float(self.mechanics.load.value)
+        return self.drive.mean_sliding(t0, t1) * (t1 - t0) * self.load / solved if solved > 0 and t1 > t0 else 0.0
 
     def record(self, heat_step=(0.0, 0.0)) -> dict:
         """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal

@@ -100,7 +100,8 @@ class ZoneResult:
     max_pressure: np.ndarray      # Pa, (B,): largest local pressure before wear
     area_fraction: np.ndarray     # (B,): real contact area / zone area before wear
     max_temperature: np.ndarray   # K, (B,): largest rough-body surface temperature (NaN without heating)
-    partition: np.ndarray         # (B,): share of the frictional heat into the rough body (NaN without)
+    partition: np.ndarray         # (B,): share of the frictional heat into the rough body (NaN: no heating,
+    #                               or a zone at zero speed: no heat)
     conductance: np.ndarray       # W/(m^2 K), (B,): zone conductance h_c (NaN without)
     iterations: np.ndarray        # (B,): contact-solver iterations of the step
     load: np.ndarray = None       # Pa, (B,): the zone mean pressures
@@ -205,6 +206,9 @@ class PostAnalysis:
                 raise InputError("remote", None, "heating needs the remote temperatures of both bodies")
             T, T1 = np.empty(H.shape), np.empty(H.shape)
             for b in range(B):
+                if speed[b] == 0.0:              # no sliding, no frictional heat: the bulk temperatures
+                    T1[b], T[b], max_T[b], heat[b], heat_rough[b], exchange[b] = *remote[b], remote[b, 1], 0, 0, 0
+                    continue
                 T1[b], T[b], max_T[b], heat[b], heat_rough[b] = self._heat(r.pressure[b], speed[b], angle[b],
                                                                            mu[b], remote[b], duration)
                 if self.heating.conduction:

@@ -97,7 +97,8 @@ def drive(scene, tm) -> Drive:
     else:
         load = force if force is not None else ld.pressure
     if scene.geometry.motion == "rotation":
-        return Drive(load, ld.angular_speed, ld.ramp_steps, ld.factor, ld.mean_factor, ld.steady_speed, torque)
+        return Drive(load, ld.angular_speed, ld.ramp_steps, ld.factor, ld.mean_factor, ld.steady_speed, torque,
+                     ld.mean_angular_speed, ld.mean_sliding_factor)
     speed = ld.sliding_speed or 0.0
     return Drive(load, lambda t: speed, ld.ramp_steps, ld.factor, ld.mean_factor)
 

@@ -108,7 +108,7 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
     settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature,
                             partition=float(scene.partition) if scene.has("heat_partition") else np.nan,
                             partition_law=scene.micro.partition_law, wear=wear,
-                            wear_every=scene.wear.update_every if wear else 1,
+                            wear_every=scene.wear.update_every if wear else 1, steps=t.steps,
                             flash_softening=scene.micro.flash_softening,
                             forces=interface_forces(scene, tm), friction=mu,
                             remote=scene.micro.remote(scene.effects), coupling=scene.micro.coupling_scheme(scene.effects),
