@@ -224,3 +224,36 @@ def test_bccg_float32_steps_keep_bounded_and_displacement_controlled_answers(con
     assert single.iterations == double.iterations
     assert rel(single.pressure, double.pressure) < 1e-11
     assert rel(single.displacement, solver.operator(single.pressure)) < 0.01 * 1e-10
+
+
+@pytest.mark.parametrize("shape, seed", [((509, 16), 4), ((512, 64), 2), ((16, 512), 3)])
+def test_long_periodic_patches_under_displacement_control(shape, seed):
+    """Elongated periodic patches pushed to 0.3-0.66 of their mean depth: both methods give one
+    answer (identical contact, pressures within 1e-6) with zero gap on the contact. Before, the
+    local start over-estimated the pressure 35x and a uniform excess is invisible on a periodic
+    grid: "bccg" stopped in full contact with a uniform gap of 1/3 of the RMS, marked converged,
+    and "pk" overflowed (``contact.PERIODIC_LOCAL_START``)."""
+    s = fractal_surface(shape, (1e-4, 1e-4 * shape[1] / shape[0]), 0.8, 2, 4, 1e-6, seed=seed)
+    z = s.heights.max() - s.heights
+    delta = (0.66 if seed % 2 == 0 else 0.3) * z.mean()
+    r = {m: ContactSolver(HalfSpace(1e9), s.heights.shape, s.dx, s.dy, method=m).solve(s.heights, approach=delta)
+         for m in ("bccg", "pk")}
+    assert 0.0 < r["bccg"].area_fraction < 0.5
+    np.testing.assert_array_equal(r["bccg"].contact, r["pk"].contact)
+    assert rel(r["bccg"].pressure, r["pk"].pressure) < 1e-6
+    assert np.abs(r["bccg"].gap[r["bccg"].contact]).max() < 1e-6 * z.max()
+
+
+@pytest.mark.parametrize("periodic", [True, False])
+@pytest.mark.parametrize("method", ["bccg", "pk"])
+def test_a_zero_warm_start_is_no_warm_start(periodic, method):
+    """A patch whose warm start is all zero (the carry-over of a step without contact) starts as if
+    it had none, under displacement control too (before: ||p|| = 0 made the first residual
+    non-finite, a ContactNonFiniteError for every such patch)."""
+    s = fractal_surface(64, 1e-4, 0.8, 2, 16, 1e-6, seed=1)
+    solver = ContactSolver(HalfSpace(1e9), (64, 64), s.dx, periodic=periodic, method=method)
+    for control in ({"approach": 1e-7}, {"load": 1e6}):
+        cold = solver.solve(s.heights, **control)
+        warm = solver.solve(np.stack([s.heights] * 2), initial_pressure=np.stack([np.zeros((64, 64)), cold.pressure]),
+                            **control)
+        assert rel(warm.pressure[0], cold.pressure) < 1e-12 and rel(warm.pressure[1], cold.pressure) < 1e-7
