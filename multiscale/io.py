@@ -7,6 +7,7 @@ stage of a run on rank 0 (``stage``, ``bar``) and keeps the wall time of every s
 """
 from __future__ import annotations
 
+import os
 import sys
 import time as _time
 from contextlib import contextmanager
@@ -60,12 +61,16 @@ class History:
         return len(next(iter(self.columns.values()), []))
 
     def write(self, path: Path, attrs: dict | None = None) -> Path:
-        """Write every column as a dataset (attribute ``unit``) of an HDF5 file."""
-        with h5py.File(path, "w") as f:
+        """Write every column as a dataset (attribute ``unit``) of an HDF5 file, replacing ``path``
+        at once (written beside it first: a run killed while writing leaves the previous file)."""
+        path = Path(path)
+        part = path.with_name(path.name + ".part")
+        with h5py.File(part, "w") as f:
             for key, values in self.columns.items():
                 f.create_dataset(key, data=np.asarray(values)).attrs["unit"] = unit_of(key)
             for key, value in (attrs or {}).items():
                 f.attrs[key] = value
+        os.replace(part, path)
         return path
 
     @classmethod

@@ -107,3 +107,29 @@ def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
         run(scene, verbose=False)
     with pytest.raises(InputError, match="resume"):
         run(scene, resume=True, verbose=False)
+
+
+def test_a_transient_run_that_fails_keeps_the_history_of_its_steps(tmp_path, monkeypatch):
+    """The third macro step of a 4-step run fails (simulated): history.h5 holds the start and the
+    two steps done, as the uninterrupted run wrote them (before: written only at the end, so a
+    failed, killed or interrupted transient run kept no history; it cannot be resumed)."""
+    from multiscale.errors import ConvergenceError
+    from multiscale.macro.model import MacroModel
+    scene = loads(pin_on_disc(tmp_path / "full"), overrides={"time.steps": 4})
+    full = run(scene, verbose=False).history
+    step, calls = MacroModel.macro_step, []
+
+    def failing(self, dt, substeps=1):
+        calls.append(dt)
+        if len(calls) == 3:
+            raise ConvergenceError("step 3 fails (simulated)")
+        return step(self, dt, substeps)
+
+    monkeypatch.setattr(MacroModel, "macro_step", failing)
+    folder = tmp_path / "failed"
+    with pytest.raises(ConvergenceError, match="simulated"):
+        run(loads(pin_on_disc(folder), overrides={"time.steps": 4}), verbose=False)
+    kept = History.read(folder / "history.h5")
+    assert len(kept) == 3 and not list(folder.glob("*.part"))
+    for key, values in kept.columns.items():
+        np.testing.assert_allclose(values, full[key][:3], rtol=1e-12, err_msg=key)

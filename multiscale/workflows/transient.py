@@ -31,13 +31,15 @@ class TransientResult(RunResult):
     field_files: list           # XDMF files
 
 
-def write_history(history: io.History, folder: Path, name: str, comm) -> tuple[Path, Path]:
-    """``history.h5`` and ``history.png`` (rank 0 writes; a failure is an OutputError on every rank)."""
+def write_history(history: io.History, folder: Path, name: str, comm, plot: bool = True) -> tuple[Path, Path]:
+    """``history.h5`` and (with ``plot``) ``history.png`` (rank 0 writes; a failure is an
+    OutputError on every rank)."""
     h5, png = folder / "history.h5", folder / "history.png"
 
     def write():
         history.write(h5, {"scene": name, "ranks": comm.size})
-        history_figure(history, png, title=name)
+        if plot:
+            history_figure(history, png, title=name)
     io.on_root(comm, write, f"the history {h5}")
     return h5, png
 
@@ -64,6 +66,8 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
             history.append(**model.record(heat))
             if n % scene.output.every == 0 or n == steps:
                 writer.write()
+            if n < steps:                    # an interrupted run keeps the history of its steps
+                write_history(history, folder, scene.name, comm, plot=False)
     with io.stage("writing history and plots"):
         h5, png = write_history(history, folder, scene.name, comm)
     result = TransientResult(folder, writer.files + [h5, png], _time.perf_counter() - start, history, h5, png,
