@@ -172,6 +172,14 @@ class Restored:
     fields_written: int        # last step whose fields were written (-1: none)
 
 
+def same_scene(attrs: dict, fingerprint: str, path) -> None:
+    """InputError unless the checkpoint attributes ``attrs`` (of ``path``) are of the scene whose
+    ``fingerprint`` is given (``--resume`` of a changed scene)."""
+    if attrs.get("scene") != fingerprint:
+        raise InputError("--resume", str(path), "the scene changed since this checkpoint was written; "
+                         "run it with --overwrite")
+
+
 def collective(comm, call):
     """``call()`` on every rank of ``comm`` (a rank's share of the zones); a ``MultiscaleError`` met
     by any rank is raised on every rank (the rank that met it raises its own, the others a
@@ -602,9 +610,7 @@ class Multiscale:
     def restore(self, path: Path) -> Restored:
         """State of the checkpoint ``path`` (collective)."""
         attrs, arrays = checkpoint.load(path, self.comm, self._functions())
-        if attrs["scene"] != self.fingerprint:
-            raise InputError("--resume", str(path), "the scene changed since this checkpoint was written; "
-                             "run it with --overwrite")
+        same_scene(attrs, self.fingerprint, path)
         m = self.model
         self.rough.set_heights(range(len(arrays["heights"])), arrays["heights"])
         if self.plastic:

@@ -351,7 +351,7 @@ def test_resume_after_an_interrupted_run_gives_the_straight_history(straight, tm
 
 def test_resume_of_a_finished_run_has_nothing_to_do(straight, capsys):
     """--resume of a run that ended reads its results and says so: no model is built, nothing is
-    written (the checkpoint and the history keep their bytes)."""
+    written (the checkpoint and the history keep their bytes); of a changed scene, it is refused."""
     from multiscale.workflows.multiscale import run
     scene, reference = straight
     ckpt, h5 = reference.folder / "checkpoint.h5", reference.history_file
@@ -362,6 +362,11 @@ def test_resume_of_a_finished_run_has_nothing_to_do(straight, capsys):
     assert (ckpt.read_bytes(), h5.read_bytes()) == before
     np.testing.assert_array_equal(again.history["time"], reference.history["time"])
     assert sorted(again.field_files) == sorted(reference.field_files)
+    # a changed scene is refused as for a run that did not end (before: "nothing to do", its
+    # results left as those of the new scene)
+    changed = loads(POD.format(folder=reference.folder).replace("friction = 0.4", "friction = 0.5"))
+    with pytest.raises(InputError, match="the scene changed since this checkpoint was written"):
+        run(changed, resume=True)
 
 
 def test_micro_conductance_couples_the_temperature_fields(tmp_path):
