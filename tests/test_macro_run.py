@@ -133,3 +133,14 @@ def test_a_transient_run_that_fails_keeps_the_history_of_its_steps(tmp_path, mon
     assert len(kept) == 3 and not list(folder.glob("*.part"))
     for key, values in kept.columns.items():
         np.testing.assert_allclose(values, full[key][:3], rtol=1e-12, err_msg=key)
+
+
+@pytest.mark.parametrize("change", [("[output]", '[[boundary]]\nsurfaces = ["plate_ends"]\nfix = ["z"]\n[output]'),
+                                    ("friction = 0.4", 'friction = 0.4\ndirection = [1, 0, 0]')])
+def test_a_load_that_a_support_takes_is_refused(tmp_path, change):
+    """The pin's plate held along the load, or a load across the contact normal: the contact
+    carries nothing of the 200 N, which the first solve says in an InputError (before: the run
+    ended normally with zero contact force and no heat)."""
+    scene = loads(pin_on_disc(tmp_path / "out", effects=("contact", "friction")).replace(*change))
+    with pytest.raises(InputError, match=r"the contact carries .* of the 200 N applied: a support takes the load"):
+        run(scene, verbose=False)

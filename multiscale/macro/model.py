@@ -20,9 +20,12 @@ import numpy as np
 
 from multiscale.outputs import step_time
 from multiscale.errors import InputError
-from multiscale.macro.mechanics import Mechanics, SolveResult
+from multiscale.macro.mechanics import Mechanics, SolveResult, load_face_forces
 from multiscale.macro.mesh import TwoBodyMesh
 from multiscale.macro.thermal import Thermal
+
+
+CARRIED = 0.01       # the first solve's contact must carry this share of a force or pressure load at least
 
 
 @dataclass(frozen=True)
@@ -108,6 +111,15 @@ class MacroModel:
             self.last_solve = self.mechanics.solve(self.load * factor)
         self.contact.engaged.value = float(self.drive.factor(0.0) > 0)
         self.solved_speed = float(self.contact.speed.value)
+        mech = self.mechanics
+        if mech.load_kind != "fluid":          # (a fluid's tractions on facing faces cancel: not checked)
+            applied = sum(load_face_forces(self.tm, float(mech.load.value), mech.load_kind).values())
+            carried = self.last_solve.normal_force
+            if carried < CARRIED * applied:
+                raise InputError("loading.faces", list(self.tm.spec.load_faces),
+                                 f"the contact carries {carried:.3g} N of the {applied:.3g} N applied: a support "
+                                 "takes the load (load a face of a body that the supports leave free to move "
+                                 "towards the contact; loading.direction along the contact normal)")
         return self.last_solve
 
     def macro_step(self, dt: float, substeps: int = 1) -> np.ndarray:
