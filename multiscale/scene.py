@@ -239,6 +239,16 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
             if table is not None and table.body is not None and table.body not in g.bodies:
                 problems.append(f'{section}.body = "{table.body}": not a body of {where}; allowed: '
                                 f'{", ".join(g.bodies)}')
+            elif section == "roughness" and table is not None and table.body not in (None, g.bodies[0]):
+                problems.append(f'roughness.body = "{table.body}": the rough body must be the stationary one, '
+                                f'"{g.bodies[0]}" (zones do not move)')
+        if "contact" not in effects and not any("contact" in EFFECTS[e].requires for e in effects):
+            problems.append(f'effects: {where} is a macro contact model: add effect "contact"')
+        if "thermal" in effects and g.motion != "rotation" and (scene.loading is not None
+                                                               and scene.loading.sliding_speed):
+            problems.append(f'loading.sliding_speed = {scene.loading.sliding_speed:g} m/s: heat transport needs a '
+                            f'rotating body ({where} translates; with effect "thermal" it slides only at '
+                            "sliding_speed = 0)")
         problems += _surface_checks(scene, g, where, effects)
         problems += _hardness_checks(scene, g, raw, effects)
         if "wear" in effects and scene.wear is not None and scene.materials is not None and not problems:
@@ -314,6 +324,9 @@ def _surface_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]
         for s in ((b.surfaces or ()) if b is not None else ()):
             if s not in known:
                 problems.append(f'boundary[{i}].surfaces: "{s}" is not a surface of {where}; known: {", ".join(known)}')
+            elif b.fix and s not in g.spec.faces:        # a support holds named faces (its facets' dofs)
+                problems.append(f'boundary[{i}].surfaces: "{s}" cannot be fixed (boundary[{i}].fix): supports hold '
+                                f'named faces ({", ".join(g.spec.faces)}); "free:" surfaces take thermal conditions')
     faces = scene.loading.faces if scene.loading is not None else None
     for s in faces or ():
         if s not in g.spec.faces:
