@@ -208,6 +208,9 @@ class Conditioned:
     report: tuple[str, ...]
 
 
+LONG_CUTOFF = 0.5    # λc beyond this share of the surface's shorter side: filtered in Fourier space
+
+
 def gaussian_transmission(wavelength, cutoff: float) -> np.ndarray:
     """Amplitude transmission of the ISO 16610-61 areal Gaussian filter's mean surface (waviness)
     at a wavelength: exp(−π (α λc/λ)²), α = sqrt(ln 2/π) (50 % at λ = λc); the roughness keeps the
@@ -226,11 +229,30 @@ def gaussian_filter(surface: Surface, cutoff: float) -> Surface:
     check_positive("cutoff", cutoff)
     if cutoff < 2 * max(surface.dx, surface.dy):
         raise InputError("cutoff", cutoff, f"λc must span at least 2 pixels ({2 * max(surface.dx, surface.dy):.3g} m)")
-    sigma = ALPHA * cutoff / np.sqrt(2 * np.pi)              # exp(-π x²/(αλc)²) = exp(-x²/(2σ²))
     h = surface.heights
+    ny, nx = h.shape[-2:]
+    if cutoff > LONG_CUTOFF * min(ny * surface.dy, nx * surface.dx):
+        return _fourier_filter(surface, cutoff)
+    sigma = ALPHA * cutoff / np.sqrt(2 * np.pi)              # exp(-π x²/(αλc)²) = exp(-x²/(2σ²))
     axes = (h.ndim - 2, h.ndim - 1)
     w = scipy.ndimage.gaussian_filter(h, sigma=(sigma / surface.dy, sigma / surface.dx), axes=axes,
                                       mode="wrap" if surface.periodic else "mirror", truncate=cutoff / sigma)
+    return Surface(w, surface.dx, surface.dy, periodic=surface.periodic)
+
+
+def _fourier_filter(surface: Surface, cutoff: float) -> Surface:
+    """``gaussian_filter`` by its transmission in Fourier space, on the surface (periodic) or on its
+    whole-sample mirror image (period 2n - 2 along each axis, the convolution's "mirror" edges): the
+    cost does not grow with λc, whose kernel would be longer than the surface."""
+    h = surface.heights
+    ny, nx = h.shape[-2:]
+    if not surface.periodic:
+        h = np.concatenate([h, h[..., -2:0:-1, :]], axis=-2) if ny > 2 else h
+        h = np.concatenate([h, h[..., -2:0:-1]], axis=-1) if nx > 2 else h
+    qy = np.fft.fftfreq(h.shape[-2], d=surface.dy)[:, None]
+    qx = np.fft.rfftfreq(h.shape[-1], d=surface.dx)[None, :]
+    keep = np.exp(-np.pi * (ALPHA * cutoff) ** 2 * (qx ** 2 + qy ** 2))      # gaussian_transmission at 1/|q|
+    w = np.fft.irfft2(np.fft.rfft2(h) * keep, s=h.shape[-2:])[..., :ny, :nx]
     return Surface(w, surface.dx, surface.dy, periodic=surface.periodic)
 
 
