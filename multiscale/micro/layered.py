@@ -40,6 +40,11 @@ from multiscale.references.love import love_rectangle
 _NEAR = 4        # cells |i|, |j| <= _NEAR around the loaded cell use the exact corner formula
 _GAUSS = 4       # Gauss points per direction on the other cells
 _EXCESS_TOL = 1e-15
+# A top layer thinner than this share of a cell is refused on non-periodic grids: its kernel's
+# excess reaches q ~ 1/h, and the Hankel quadratures, whose panels resolve the Bessel oscillations
+# up to the grid's extent, grow like (cell / h): 4.8 s at h = dx/156, 47 s and 1.7 GB at dx/1560 on
+# 64², out of memory at dx/1.5e6 (a periodic grid takes the spectrum itself: no limit)
+THINNEST = 1e-3
 
 
 class LayeredKernel(Kernel):
@@ -100,6 +105,10 @@ class LayeredKernel(Kernel):
         """
         ny, nx = int(ny), int(nx)
         dx, dy = check_positive("dx", dx), check_positive("dy", dy)
+        if self.thickness[0] < THINNEST * min(dx, dy):
+            raise InputError("thickness", self.thickness[0], f"the top layer is thinner than {THINNEST:g} of a cell "
+                             f"({min(dx, dy):.3g} m) of a non-periodic patch: its kernel would take hours and "
+                             "gigabytes; drop the layer (its effect is below the grid's resolution) or refine the grid")
         ox = wrap_offsets(nx) * dx
         oy = wrap_offsets(ny) * dy
         coeffs = love_rectangle(ox[None, :], oy[:, None], dx / 2, dy / 2) * (self.top_coefficient / (2 * np.pi))
