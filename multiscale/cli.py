@@ -14,6 +14,7 @@ from pathlib import Path
 
 from multiscale import __version__
 from multiscale.errors import InputError, MultiscaleError, SceneError
+from multiscale.geometry import too_many_cells
 from multiscale.io import abort, ended_together
 from multiscale.micro.spectrum import surface_statistics
 from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition, formats, read_topography
@@ -68,7 +69,13 @@ def _check(args) -> int:
             continue
         print("\n".join(summary(scene) + plan_summary(plan(scene))))
         if args.cells:
-            print(cells_line(scene))
+            line, estimate = cells_line(scene)
+            print(line)
+            if estimate.cells > scene.geometry.max_cells:      # what run would refuse
+                print(f"error: {too_many_cells(estimate, scene.geometry.max_cells)}", file=sys.stderr)
+                print(f"{path}: 1 problem", file=sys.stderr)
+                failed += 1
+                continue
         print(f"{path}: OK")
     return 2 if failed else 0
 

@@ -251,11 +251,16 @@ def check_cells(module: ModuleType, params, max_cells: int, keep: bool = False) 
     within the limit is left meshed in the open gmsh session (``estimate_cells``)."""
     estimate = estimate_cells(module, params, enough=max_cells, keep=keep)
     if estimate.cells > max_cells:
-        raise InputError("geometry.max_cells", max_cells,
-                         f"the mesh would have about {estimate.cells:.3g} cells (a trial mesh {estimate.factor:.3g}x "
-                         f"coarser has {estimate.trial}): coarsen the geometry's mesh sizes (geometry.mesh_size "
-                         "and the other *mesh_size), or allow it with geometry.max_cells or multiscale run --max-cells")
+        raise too_many_cells(estimate, max_cells)
     return estimate
+
+
+def too_many_cells(estimate: CellEstimate, max_cells: int) -> InputError:
+    """The error of a mesh estimated above ``max_cells`` (what to change)."""
+    return InputError("geometry.max_cells", max_cells,
+                      f"the mesh would have about {estimate.cells:.3g} cells (a trial mesh {estimate.factor:.3g}x "
+                      f"coarser has {estimate.trial}): coarsen the geometry's mesh sizes (geometry.mesh_size "
+                      "and the other *mesh_size), or allow it with geometry.max_cells or multiscale run --max-cells")
 
 
 # ---- gmsh helpers shared by the builders (model is ``gmsh.model``) ----------------------------

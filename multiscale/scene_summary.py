@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import math
 
-from multiscale.geometry import estimate_cells
+from multiscale.geometry import CellEstimate, estimate_cells
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
 from multiscale.schema import reference as schema_reference
 
@@ -110,11 +110,12 @@ def _effect_line(scene: Scene, effect: str) -> str:
     return EFFECTS[effect].doc
 
 
-def cells_line(scene: Scene) -> str:
-    """The mesh's estimated cell count against its limit (``check --cells``; runs gmsh trials)."""
+def cells_line(scene: Scene) -> tuple[str, CellEstimate]:
+    """The mesh's estimated cell count against its limit (``check --cells``; runs gmsh trials),
+    and the estimate."""
     g = scene.geometry
     e = estimate_cells(g.module(), g.params if g.builder == "file" else dict(g.params))
     how = "exact" if e.exact else f"from a trial mesh {e.factor:.3g}x coarser with {e.trial} cells"
     verdict = "refused by run" if e.cells > g.max_cells else "within"
-    return f"  mesh      {'' if e.exact else 'about '}{e.cells:,} cells ({how}); {verdict} geometry.max_cells = " \
-           f"{g.max_cells:,}"
+    return (f"  mesh      {'' if e.exact else 'about '}{e.cells:,} cells ({how}); {verdict} geometry.max_cells = "
+            f"{g.max_cells:,}", e)

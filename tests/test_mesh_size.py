@@ -143,6 +143,13 @@ def test_max_cells_in_the_scene_and_on_the_command_line(tmp_path, capsys):
     out = capsys.readouterr().out
     line = next(x for x in out.splitlines() if x.startswith("  mesh "))
     assert line.endswith("cells (exact); within geometry.max_cells = 1,000,000") and "about" not in line
+    # a mesh above the limit is a problem for check too (before: "refused by run", then OK, exit 0)
+    path.write_text(text.replace('mesh_size = "5 mm"', 'mesh_size = "5 mm"\nmax_cells = 100'))
+    assert main(["check", str(path), "--cells"]) == 2
+    captured = capsys.readouterr()
+    assert "refused by run geometry.max_cells = 100" in captured.out and "scene.toml: OK" not in captured.out
+    errors = [x for x in captured.err.splitlines() if x.startswith("error: ")]
+    assert len(errors) == 1 and errors[0].startswith("error: geometry.max_cells = 100: the mesh would have about")
     with pytest.raises(SystemExit):
         main(["run", str(path), "--max-cells", "2.5"])
     assert "a whole number" in capsys.readouterr().err
