@@ -231,3 +231,24 @@ def test_covering_an_interface():
     c, _ = cover(s, (64, 48), (128e-6, 96e-6), "equivalent", seed=6)
     np.testing.assert_array_equal(a.heights, b.heights)
     assert a.shape == (48, 64) and a.dx == 2e-6 and not np.allclose(a.heights, c.heights)
+
+
+def test_undefined_points_of_a_plain_matrix_are_filled_like_an_instrument_files(tmp_path):
+    """NaN in a .npy height matrix marks undefined points: conditioned like those of an instrument
+    file (filled up to max_undefined, said in the report; before: refused whatever max_undefined);
+    an infinite height is refused."""
+    h = fractal_surface(64, 64e-6, 0.8, 2, 16, 1e-6, seed=2).heights
+    h[10, 10:19] = np.nan
+    np.save(tmp_path / "holes.npy", h / 1e-6)
+    m = read_topography(tmp_path / "holes.npy", pixel_size=1e-6, height_unit=1e-6)
+    assert np.isnan(m.heights).sum() == 9
+    done = condition(m, detrend="none")
+    assert np.all(np.isfinite(done.surface.heights)) and any("filled 9 undefined points" in r for r in done.report)
+    kept, given = done.surface.heights[~np.isnan(h)], h[~np.isnan(h)]          # the defined points stay
+    np.testing.assert_allclose(kept - kept.mean(), given - given.mean(), atol=1e-12 * np.abs(given).max())
+    with pytest.raises(InputError, match="undefined"):
+        condition(m, detrend="none", max_undefined=1e-4)
+    h[0, 0] = np.inf
+    np.save(tmp_path / "inf.npy", h)
+    with pytest.raises(InputError, match="infinite values"):
+        read_topography(tmp_path / "inf.npy", pixel_size=1e-6)

@@ -145,17 +145,10 @@ def check_seed(seed):
     return check_count("seed", seed, minimum=0)
 
 
-def load_surface(path, dx: float, dy: float | None = None, *, scale: float = 1.0,
-                 detrend: str = "plane") -> Surface:
-    """Measured topography from .npy or a .txt/.csv matrix (rows ↔ y) with pixel size dx (dy) [m].
-
-    ``scale`` converts the file's height unit to metres (1e-6 for µm). ``detrend`` removes the
-    least-squares 'plane', the 'mean', or 'none'. The result is not periodic.
-    """
+def read_matrix(path) -> np.ndarray:
+    """The height matrix (rows ↔ y) of a .npy or .txt/.csv/.dat/.asc file, as stored (NaN kept)."""
     if not isinstance(path, (str, os.PathLike)):
         raise InputError("path", path, "a file name (str or Path)")
-    if not isinstance(detrend, str):
-        raise InputError("detrend", detrend, "one of 'plane', 'mean', 'none'")
     path = Path(path)
     if not path.is_file():
         raise InputError("path", str(path), "no such file")
@@ -168,13 +161,27 @@ def load_surface(path, dx: float, dy: float | None = None, *, scale: float = 1.0
             h = np.loadtxt(path, delimiter=delimiter, comments="#", ndmin=2)
         else:
             raise InputError("path", str(path), "expected .npy, .txt, .csv, .dat or .asc")
-    except (ValueError, OSError) as exc:
+        h = np.asarray(h, dtype=float)
+    except (ValueError, TypeError, OSError) as exc:
         if isinstance(exc, InputError):
             raise
         raise InputError("path", str(path), f"could not read a height matrix ({exc})") from None
-    h = np.asarray(h, dtype=float) * check_positive("scale", scale)
     if h.ndim != 2:
         raise InputError("path", str(path), f"expected a 2-D height matrix, got shape {h.shape}")
+    return h
+
+
+def load_surface(path, dx: float, dy: float | None = None, *, scale: float = 1.0,
+                 detrend: str = "plane") -> Surface:
+    """Measured topography from .npy or a .txt/.csv matrix (rows ↔ y) with pixel size dx (dy) [m].
+
+    ``scale`` converts the file's height unit to metres (1e-6 for µm). ``detrend`` removes the
+    least-squares 'plane', the 'mean', or 'none'. The result is not periodic (undefined points:
+    ``topography.read_topography`` fills them).
+    """
+    if not isinstance(detrend, str):
+        raise InputError("detrend", detrend, "one of 'plane', 'mean', 'none'")
+    h = read_matrix(path) * check_positive("scale", scale)
     if not np.all(np.isfinite(h)):
         raise InputError("path", str(path), "height matrix contains NaN/inf (fill missing points first)")
     if detrend == "plane":

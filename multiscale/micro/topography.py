@@ -4,8 +4,8 @@ and spread over an interface larger than the measurement.
 Reading (``read_topography``): every format SurfaceTopography reads (x3p, Digital Surf .sur, Sensofar
 .plu, Wyko .opd, Zygo .dat/.datx, Alicona .al3d, AFM files, ...; ``formats()``), a chosen channel,
 the file's own units and pixel sizes (a caller may override them: noted in the result). Plain height
-matrices without units (.npy, .txt, .csv, .asc) go through ``multiscale.micro.surface.load_surface``
-and need a pixel size. Undefined points (no value from the instrument) are NaN.
+matrices without units (.npy, .txt, .csv, .asc) are read by ``multiscale.micro.surface.read_matrix``
+and need a pixel size. Undefined points (no value from the instrument; NaN in a matrix) are NaN.
 
 Conditioning (``condition``), in the order of ISO 25178-3 and each step reported: form removal (the
 F-operator: least-squares mean, plane or polynomial fitted on the defined points), undefined points
@@ -29,7 +29,7 @@ import numpy as np
 
 from multiscale.errors import InputError, check_positive
 from multiscale.micro.spectrum import as_topography, equivalent_surface, power_spectrum, surface_topography
-from multiscale.micro.surface import Surface, load_surface
+from multiscale.micro.surface import Surface, read_matrix
 
 MATRIX_SUFFIXES = (".npy", ".txt", ".csv", ".asc")    # plain height matrices (no units in the file)
 MAX_UNDEFINED = 0.1       # default largest fraction of undefined points that is filled
@@ -134,10 +134,13 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
             raise InputError(f"{prefix}pixel_size", None, f"{path.name} is a plain height matrix without units: "
                              "give its pixel size")
         try:
-            s = load_surface(path, *pair, scale=1.0 if height_unit is None else height_unit, detrend="none")
+            h = read_matrix(path) * (1.0 if height_unit is None else height_unit)
         except InputError as exc:
             raise InputError(f"{prefix}file", path.name, exc.allowed) from None
-        return Measurement(s.heights, s.dx, s.dy, path, 0, "matrix", None)
+        if np.any(np.isinf(h)):
+            raise InputError(f"{prefix}file", path.name, "the height matrix holds infinite values (NaN marks an "
+                             "undefined point)")
+        return Measurement(h, *pair, path, 0, "matrix", None)
     ch = _channel(_reader(path, f"{prefix}file"), path, channel, prefix)
     unit = ch.unit if isinstance(ch.unit, str) else None
     notes = []
