@@ -136,10 +136,12 @@ def test_form_removal_plane_and_polynomial():
         return condition(Measurement(h, d, d, Path("synthetic.x3p")), detrend=mode).surface.heights
 
     tilt, bowl = 3e-3 * x + 1e-3 * y, 2e2 * ((x - 16e-6) ** 2 + (y - 10e-6) ** 2)
-    assert np.abs(conditioned(tilt, "plane")).max() < 1e-12 * np.abs(tilt).max()
-    assert np.abs(conditioned(bowl, "poly2")).max() < 1e-12 * np.abs(bowl).max()
+    for form, mode in ((tilt, "plane"), (bowl, "poly2")):       # removed to round-off: nothing left
+        with pytest.raises(InputError, match="no roughness is left after the form removal"):
+            conditioned(form, mode)
     assert np.abs(conditioned(bowl, "plane")).max() > 1e-2 * np.abs(bowl).max()   # a plane leaves the bowl
     np.testing.assert_allclose(conditioned(tilt + rough, "plane"), conditioned(rough, "plane"), atol=1e-20)
+    np.testing.assert_allclose(conditioned(bowl + rough, "poly2"), conditioned(rough, "poly2"), atol=1e-12 * 1e-8)
     with pytest.raises(InputError, match=r"detrend = 'cubic': one of none, mean, plane, poly2"):
         conditioned(tilt, "cubic")
 
@@ -252,3 +254,15 @@ def test_undefined_points_of_a_plain_matrix_are_filled_like_an_instrument_files(
     np.save(tmp_path / "inf.npy", h)
     with pytest.raises(InputError, match="infinite values"):
         read_topography(tmp_path / "inf.npy", pixel_size=1e-6)
+
+
+@pytest.mark.parametrize("heights", [np.zeros((32, 32)), np.ones((32, 32)),
+                                     np.add.outer(np.arange(32) * 1e-3, np.arange(32) * 2e-3)])
+def test_a_flat_or_planar_matrix_has_no_roughness(tmp_path, heights):
+    """A constant or a plane leaves only round-off after the form removal: one InputError naming
+    the file (before: the zeros were refused by the spectrum under a Python name, a constant or a
+    plane gave the statistics of its round-off, Sq 1e-17 m)."""
+    np.save(tmp_path / "flat.npy", heights)
+    m = read_topography(tmp_path / "flat.npy", pixel_size=1e-6)
+    with pytest.raises(InputError, match=r"file = 'flat.npy': no roughness is left after the form removal"):
+        condition(m, prefix="roughness.")

@@ -211,6 +211,7 @@ class Conditioned:
     report: tuple[str, ...]
 
 
+FLAT = 1e-10        # a conditioned surface whose Sq is below this share of its largest height is flat
 LONG_CUTOFF = 0.5    # λc beyond this share of the surface's shorter side: filtered in Fourier space
 
 
@@ -304,6 +305,11 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
         report.append(f"waviness removed: Gaussian filter (ISO 16610-61) at λc = {cutoff * 1e3:.4g} mm{longer}: "
                       f"Sq waviness {_um(float(waviness.heights.std()))} um, roughness "
                       f"{_um(float(surface.heights.std()))} um")
+    scale = float(np.nanmax(np.abs(m.heights), initial=0.0))
+    if not surface.heights.std() > FLAT * scale:
+        raise InputError(f"{prefix}file", m.path.name, "no roughness is left after the form removal and filtering "
+                         f"(Sq {float(surface.heights.std()):.3g} m against heights up to {scale:.3g} m: a constant or "
+                         "a plane, to round-off)")
     return Conditioned(surface, waviness, tuple(report))
 
 
