@@ -266,3 +266,11 @@ def test_a_flat_or_planar_matrix_has_no_roughness(tmp_path, heights):
     m = read_topography(tmp_path / "flat.npy", pixel_size=1e-6)
     with pytest.raises(InputError, match=r"file = 'flat.npy': no roughness is left after the form removal"):
         condition(m, prefix="roughness.")
+
+
+def test_a_plain_matrix_has_one_channel(tmp_path):
+    """--channel 2 on a .npy is refused (before: silently read as channel 0); 0 reads it."""
+    np.save(tmp_path / "rough.npy", fractal_surface(32, 32e-6, 0.8, 2, 8, 1e-6, seed=1).heights)
+    assert read_topography(tmp_path / "rough.npy", channel=0, pixel_size=1e-6).shape == (32, 32)
+    with pytest.raises(InputError, match="channel = 2: rough.npy is a plain height matrix: one channel, 0"):
+        read_topography(tmp_path / "rough.npy", channel=2, pixel_size=1e-6)

@@ -130,6 +130,8 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
     if height_unit is not None:
         check_positive(f"{prefix}height_unit", height_unit)
     if path.suffix.lower() in MATRIX_SUFFIXES:
+        if channel not in (None, 0):
+            raise InputError(f"{prefix}channel", channel, f"{path.name} is a plain height matrix: one channel, 0")
         if pair is None:
             raise InputError(f"{prefix}pixel_size", None, f"{path.name} is a plain height matrix without units: "
                              "give its pixel size")
