@@ -86,6 +86,15 @@ def check_count(name: str, value, minimum: int = 1) -> int:
     return int(v)
 
 
+def check_pair(name: str, value, check) -> tuple:
+    """One value or two (x, y), each passed through ``check(name, v)`` (e.g. ``check_positive``,
+    ``check_count``), as a pair; else ``InputError``."""
+    values = tuple(value) if isinstance(value, (tuple, list, np.ndarray)) else (value,)
+    if len(values) not in (1, 2):
+        raise InputError(name, value, "one value or a pair (x, y)")
+    return tuple(check(name, v) for v in values * (3 - len(values)))
+
+
 def check_flag(name: str, value) -> bool:
     """True or False (numpy bools too), else ``InputError`` (``"no"`` is not False)."""
     if type(value).__name__ not in ("bool", "bool_"):

@@ -134,6 +134,7 @@ def test_solve_checks_every_argument(kwargs, name):
     ("rough", "heights"), ([[1, 2], [3]], "heights"), (np.zeros(8), "heights.shape"),
     (np.zeros((8, 9)), "heights.shape"), (np.full((8, 8), np.inf), "heights"),
     (np.array([[1e308, -1e308] * 4] * 8), "heights"),
+    (np.zeros((8, 8)) + 1e-6j, "heights"), (np.eye(8, dtype=bool), "heights"),   # (were read as real / 0-1 m)
 ])
 def test_bad_heights_are_named(heights, name):
     with pytest.raises(InputError) as info:

@@ -274,3 +274,23 @@ def test_a_plain_matrix_has_one_channel(tmp_path):
     assert read_topography(tmp_path / "rough.npy", channel=0, pixel_size=1e-6).shape == (32, 32)
     with pytest.raises(InputError, match="channel = 2: rough.npy is a plain height matrix: one channel, 0"):
         read_topography(tmp_path / "rough.npy", channel=2, pixel_size=1e-6)
+
+
+@pytest.mark.parametrize("call, message", [
+    (lambda s, p: read_topography(p, pixel_size=(1e-6, 2e-6, 3e-6)), "pixel_size = (1e-06, 2e-06, 3e-06): one value or a pair"),
+    (lambda s, p: read_topography(p, pixel_size="1 um"), "pixel_size = '1 um': must be a real number"),
+    (lambda s, p: cover(s, 0, (1e-4, 1e-4)), "n = 0: must be a whole number >= 1"),
+    (lambda s, p: cover(s, 64.7, (6e-5, 6e-5)), "n = 64.7: must be a whole number >= 1"),
+    (lambda s, p: cover(s, 64, (-5e-5, 5e-5)), "size = -5e-05: must be finite and > 0"),
+    (lambda s, p: resample(s, -4), "n = -4: must be a whole number >= 1"),
+    (lambda s, p: condition(Measurement(s.heights, 1e-6, 1e-6, p), max_undefined="0.1"),
+     "max_undefined = '0.1': must be a real number"),
+])
+def test_bad_arguments_of_the_measured_surface_functions_name_themselves(tmp_path, call, message):
+    """Each is one InputError naming the argument (before: numpy's broadcast ValueError, a
+    ZeroDivisionError, a count of 64.7 cut to 64, a grid of (160, 0) cells, a TypeError)."""
+    s = fractal_surface(64, 64e-6, 0.8, 2, 16, 1e-6, seed=2)
+    np.save(tmp_path / "m.npy", s.heights)
+    with pytest.raises(InputError) as info:
+        call(Surface(s.heights, s.dx, s.dy, periodic=False), tmp_path / "m.npy")
+    assert message in str(info.value)

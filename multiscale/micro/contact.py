@@ -125,10 +125,7 @@ class ContactSolver:
         ``ContactNonFiniteError`` if the numbers overflow (never a non-finite result).
         """
         method = self.method if method is None else _method(method)
-        try:
-            h = np.asarray(heights, dtype=float)
-        except (TypeError, ValueError):
-            raise InputError("heights", heights, "must be an array of numbers") from None
+        h = real_heights(heights)
         if h.ndim < 2 or h.shape[-2:] != self.shape:
             raise InputError("heights.shape", h.shape, f"last two axes must be {self.shape}")
         if h.size == 0:
@@ -382,6 +379,19 @@ def bounded_start(p, upper, total=None):
     return p
 
 
+def real_heights(heights) -> np.ndarray:
+    """``heights`` as a float array; InputError for what is not real numbers (strings, ragged
+    lists, complex or bool arrays: numpy would drop an imaginary part or read True as 1 m)."""
+    try:
+        given = np.asarray(heights)
+        h = np.asarray(given, dtype=float) if given.dtype.kind not in "cb" else None
+    except (TypeError, ValueError):
+        raise InputError("heights", heights, "must be an array of numbers") from None
+    if h is None:
+        raise InputError("heights", "array", "must be real numbers [m] (not complex or bool)")
+    return h
+
+
 def _method(method) -> str:
     if not isinstance(method, str) or method not in METHODS:
         raise InputError("method", method, f"choose one of {', '.join(METHODS)}")
@@ -402,10 +412,7 @@ def _batch_values(name: str, value, shape) -> np.ndarray:
 def solve_contact(heights, dx: float, kernel: Kernel, *, dy: float | None = None, periodic: bool = True,
                   **options) -> ContactResult:
     """One-call form of ``ContactSolver(kernel, heights.shape[-2:], dx, dy, periodic).solve(...)``."""
-    try:
-        h = np.asarray(heights, dtype=float)
-    except (TypeError, ValueError):
-        raise InputError("heights", heights, "must be an array of numbers") from None
+    h = real_heights(heights)
     if h.ndim < 2:
         raise InputError("heights", h.shape, "must be at least 2-D (..., ny, nx)")
     return ContactSolver(kernel, h.shape[-2:], dx, dy, periodic).solve(h, **options)

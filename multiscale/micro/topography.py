@@ -27,7 +27,7 @@ from pathlib import Path
 
 import numpy as np
 
-from multiscale.errors import InputError, check_positive
+from multiscale.errors import InputError, check_count, check_pair, check_positive, check_real
 from multiscale.micro.spectrum import as_topography, equivalent_surface, power_spectrum, surface_topography
 from multiscale.micro.surface import Surface, read_matrix
 
@@ -123,10 +123,7 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{prefix}file", path.name, f"no such file ({path})")
-    pair = None if pixel_size is None else tuple(float(v) for v in np.broadcast_to(np.asarray(pixel_size), (2,)))
-    if pair is not None:
-        for v in pair:
-            check_positive(f"{prefix}pixel_size", v)
+    pair = None if pixel_size is None else check_pair(f"{prefix}pixel_size", pixel_size, check_positive)
     if height_unit is not None:
         check_positive(f"{prefix}height_unit", height_unit)
     if path.suffix.lower() in MATRIX_SUFFIXES:
@@ -271,7 +268,7 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
         raise InputError(f"{prefix}detrend", detrend, f"one of {', '.join(DETREND)}")
     if cutoff is not None:
         check_positive(f"{prefix}cutoff", cutoff)
-    if not 0 <= max_undefined <= 1:
+    if not 0 <= check_real(f"{prefix}max_undefined", max_undefined) <= 1:
         raise InputError(f"{prefix}max_undefined", max_undefined, "a fraction of the points, in [0, 1]")
     too_many = _too_many_undefined(m, max_undefined, prefix)
     if too_many is not None:
@@ -326,8 +323,8 @@ def resample(surface: Surface, n, size=None) -> tuple[Surface, str]:
     first low-passes with the Gaussian S-filter at λs = ``S_FILTER_PIXELS`` new pixels (against
     aliasing). Returns the surface and one report line."""
     import scipy.ndimage  # ~0.4 s to import: only when a surface is resampled
-    nx, ny = (int(v) for v in np.broadcast_to(np.asarray(n), (2,)))
-    Lx, Ly = surface.size if size is None else (float(v) for v in np.broadcast_to(np.asarray(size, float), (2,)))
+    nx, ny = check_pair("n", n, check_count)
+    Lx, Ly = surface.size if size is None else check_pair("size", size, check_positive)
     dx, dy = Lx / nx, Ly / ny
     if (ny, nx) == surface.shape and np.isclose(dx, surface.dx, rtol=1e-9) and np.isclose(dy, surface.dy, rtol=1e-9):
         return surface, "on the micro grid already"
@@ -364,8 +361,8 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
     """
     if method not in COVER:
         raise InputError(f"{prefix}cover", method, f"one of {', '.join(COVER)}")
-    nx, ny = (int(v) for v in np.broadcast_to(np.asarray(n), (2,)))
-    Lx, Ly = (float(v) for v in np.broadcast_to(np.asarray(size, float), (2,)))
+    nx, ny = check_pair(f"{prefix}n", n, check_count)
+    Lx, Ly = check_pair(f"{prefix}size", size, check_positive)
     mx, my = surface.size
     wide = f"the measurement ({mx * 1e3:.4g} x {my * 1e3:.4g} mm)"
     target = f"the interface ({Lx * 1e3:.4g} x {Ly * 1e3:.4g} mm)"
