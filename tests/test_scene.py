@@ -338,6 +338,10 @@ def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
     no_heat = loads(GOOD.replace('"heat_partition", ', "").replace('partition = "effusivity"\n', ""), tmp_path)
     assert no_heat.warnings == ('effects "friction" and "thermal" without "heat_partition": no frictional '
                                 "heat enters the bodies",)
+    # a static run takes neither the time stepping nor the profiles (before: no word of it)
+    static = loads(text + '[time]\nend = "1 s"\nsteps = 4\n', tmp_path)
+    assert static.warnings[-1] == ('time.end, time.steps: ignored without effect "thermal" or "wear": the run is '
+                                   "one contact solve at t = 0")
 
 
 @pytest.mark.parametrize("old, new, warning", [
