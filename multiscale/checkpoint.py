@@ -116,6 +116,14 @@ def mark(path, comm, **attrs) -> None:
     on_root(comm, write, f"the checkpoint {path}")
 
 
+def same_scene(attrs: dict, fingerprint: str, path) -> None:
+    """InputError unless the checkpoint attributes ``attrs`` (of ``path``) are of the scene whose
+    ``fingerprint`` is given (``--resume`` of a changed scene)."""
+    if attrs.get("scene") != fingerprint:
+        raise InputError("--resume", str(path), "the scene changed since this checkpoint was written; "
+                         "run it with --overwrite")
+
+
 def peek(path, comm) -> dict:
     """The scalar attributes of a checkpoint, read by rank 0 for every rank without loading its
     data ({} if there is none or it cannot be read: ``load`` then says why)."""

@@ -77,8 +77,7 @@ from pathlib import Path
 import numpy as np
 
 from multiscale import checkpoint, io
-from multiscale.errors import ConvergenceError, InputError, MultiscaleError
-from multiscale.geometry import Rotation
+from multiscale.errors import ConvergenceError, InputError
 from multiscale.macro.mechanics import SolveResult
 from multiscale.macro.model import MacroModel
 from multiscale.micro.post_analysis import PostAnalysis
@@ -172,32 +171,6 @@ class Restored:
     fields_written: int        # last step whose fields were written (-1: none)
 
 
-def same_scene(attrs: dict, fingerprint: str, path) -> None:
-    """InputError unless the checkpoint attributes ``attrs`` (of ``path``) are of the scene whose
-    ``fingerprint`` is given (``--resume`` of a changed scene)."""
-    if attrs.get("scene") != fingerprint:
-        raise InputError("--resume", str(path), "the scene changed since this checkpoint was written; "
-                         "run it with --overwrite")
-
-
-def collective(comm, call):
-    """``call()`` on every rank of ``comm`` (a rank's share of the zones); a ``MultiscaleError`` met
-    by any rank is raised on every rank (the rank that met it raises its own, the others a
-    ``MultiscaleError`` with its message), so that no rank waits for another in the next exchange."""
-    try:
-        value, failure = call(), None
-    except MultiscaleError as exc:
-        value, failure = None, exc
-    failed = [(rank, message) for rank, message in enumerate(comm.allgather(None if failure is None else str(failure)))
-              if message is not None]
-    if failure is not None:
-        raise failure
-    if failed:
-        rank, message = failed[0]
-        raise MultiscaleError(f"micro analysis on rank {rank}: {message}")
-    return value
-
-
 def anderson(passes, weight, mixing: float) -> np.ndarray:
     """The next partitions of Anderson's acceleration (Walker & Ni 2011, type II) of the fixed point
     p = G(p): ``passes`` [(p_j, r_j = G(p_j) − p_j), ...], the last one current; the residuals
@@ -263,23 +236,14 @@ class Multiscale:
             for col, side in ((0, 1), (1, 0)):
                 total = np.bincount(zone_of, model.thermal.facet_temperature(side)[rough] * areas, minlength=Z)
                 T[:, col] = np.where(area > 0, total / np.where(area > 0, area, 1.0), T[:, col])
-        centres, axes = self.rough.zone_frames()
-        motion = self.tm.spec.motion
-        if isinstance(motion, Rotation):                 # the velocity at unit speed
-            axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
-            w = np.cross(axis, centres - np.asarray(motion.centre, float))
-        else:
-            e = np.asarray(motion.direction, float) / np.linalg.norm(motion.direction)
-            w = np.tile(e, (Z, 1))
-        w = np.einsum("zij,zj->zi", axes, w)             # in each zone's plane coordinates
-        reach = np.hypot(w[:, 0], w[:, 1])
+        reach, angle = self.rough.zone_sliding(self.tm.spec.motion)
         # the speed now; at a standstill that of the step that led to it (a partition is defined
         # only while sliding: the zones' heating needs a speed)
         speed = model.speed(model.time)
         if speed == 0.0 and self.settings.dt:
             speed = model.drive.mean_speed(max(model.time - self.settings.dt, 0.0), model.time)
         return ZoneLoading(force, force / self.rough.zone_area, reach * abs(speed),
-                           np.arctan2(w[:, 1], w[:, 0]) + (np.pi if speed < 0 else 0.0), T, reach)
+                           angle + (np.pi if speed < 0 else 0.0), T, reach)
 
     def analyse(self) -> MicroStep:
         """Post-analysis (local contact, heating, conductance) of the loaded zones at the current
@@ -292,7 +256,7 @@ class Multiscale:
         T = load.temperature[mine]
         remote = np.column_stack([T[:, 0] if self.settings.remote == "bulk" else T[:, 1], T[:, 1]])
         mu = None if self.settings.friction is None else self.settings.friction[mine]
-        res = collective(comm, lambda: self.post.run(
+        res = io.collective(comm, lambda: self.post.run(
             [zones[i] for i in mine], load.pressure[mine], speed=load.speed[mine], angle=load.angle[mine],
             remote=remote, warm=self.warm[mine], mu=mu, duration=self.settings.dt,
             hardness_temperature=self._hardness_temperature(mine, T[:, 1])))
@@ -354,7 +318,7 @@ class Multiscale:
         mine, res, load, remote, _ = self._last
         zones, m = self.rough.zones, self.model
         sliding = m.sliding(m.time - duration, m.time)
-        res = collective(self.comm, lambda: self.post.wear([zones[i] for i in mine], res, load.reach[mine] * sliding,
+        res = io.collective(self.comm, lambda: self.post.wear([zones[i] for i in mine], res, load.reach[mine] * sliding,
                                                            remote))
         volume = np.zeros(len(zones))
         for ids, warm, heights, lost, w in self.comm.allgather((mine, res.worn_pressure, res.heights,
@@ -369,19 +333,9 @@ class Multiscale:
             self.counter_depth += self.rough.track_depth(volume, contact.facet_heat_flux() * iface.areas)
             self.counter_volume += volume.sum()
             iface.set_field(contact.initial_gap, self.datum_gap + self.counter_depth)
-        work = self._sliding_power() * sliding                            # mu ∫ p |w| dA dt
+        work = m.sliding_power() * sliding                                 # mu ∫ p |w| dA dt
         self.work += work
         return work
-
-    def _sliding_power(self) -> float:
-        """mu ∫ p |w| dA [W] of the last solved pressure at unit speed of body 1."""
-        c = self.model.contact
-        kept = c.speed.value, c.heating.value
-        c.speed.value, c.heating.value = 1.0, 1.0
-        try:
-            return sum(c.heat_power())
-        finally:
-            c.speed.value, c.heating.value = kept
 
     def accept(self, micro: MicroStep) -> MicroStep:
         """The partitions (and exchanges) of the last ``analyse`` become the zones' (partition law);
@@ -610,7 +564,7 @@ class Multiscale:
     def restore(self, path: Path) -> Restored:
         """State of the checkpoint ``path`` (collective)."""
         attrs, arrays = checkpoint.load(path, self.comm, self._functions())
-        same_scene(attrs, self.fingerprint, path)
+        checkpoint.same_scene(attrs, self.fingerprint, path)
         m = self.model
         self.rough.set_heights(range(len(arrays["heights"])), arrays["heights"])
         if self.plastic:

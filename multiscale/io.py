@@ -18,7 +18,7 @@ import numpy as np
 from mpi4py import MPI
 from tqdm import tqdm
 
-from multiscale.errors import OutputError
+from multiscale.errors import MultiscaleError, OutputError
 
 UNITS = {"time": "s", "force": "N", "pressure": "Pa", "temperature": "K", "heat": "J", "iterations": "-",
          "volume": "m^3", "depth": "m", "rms": "m", "work": "J", "area": "m^2"}
@@ -105,6 +105,24 @@ def on_ranks(comm, jobs, what: str) -> None:
     failures = [f for f in comm.allgather(failure) if f]
     if failures:
         raise OutputError(failures[0])
+
+
+def collective(comm, call):
+    """``call()`` on every rank of ``comm`` (e.g. a rank's share of the zones); a ``MultiscaleError`` met
+    by any rank is raised on every rank (the rank that met it raises its own, the others a
+    ``MultiscaleError`` with its message), so that no rank waits for another in the next exchange."""
+    try:
+        value, failure = call(), None
+    except MultiscaleError as exc:
+        value, failure = None, exc
+    failed = [(rank, message) for rank, message in enumerate(comm.allgather(None if failure is None else str(failure)))
+              if message is not None]
+    if failure is not None:
+        raise failure
+    if failed:
+        rank, message = failed[0]
+        raise MultiscaleError(f"on rank {rank}: {message}")
+    return value
 
 
 def ended_together(comm, timeout: float = 10.0) -> bool:

@@ -153,6 +153,20 @@ class RoughInterface:
                 axes.append(plane.frame[:2])
         return np.array(centres), np.array(axes)
 
+    def zone_sliding(self, motion) -> tuple[np.ndarray, np.ndarray]:
+        """Per zone, the counter-face's sliding in the zone's plane per unit of body 1's motion
+        (``motion``: a Rotation, per rad; else a translation, per m) [m] and its direction [rad
+        from the zone's +u axis]."""
+        centres, axes = self.zone_frames()
+        if isinstance(motion, Rotation):
+            axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
+            w = np.cross(axis, centres - np.asarray(motion.centre, float))
+        else:
+            e = np.asarray(motion.direction, float) / np.linalg.norm(motion.direction)
+            w = np.tile(e, (len(centres), 1))
+        w = np.einsum("zij,zj->zi", axes, w)             # in each zone's plane coordinates
+        return np.hypot(w[:, 0], w[:, 1]), np.arctan2(w[:, 1], w[:, 0])
+
     def heights(self) -> np.ndarray:
         """Current zone topographies (Z, ny, nx) [m]."""
         return np.stack([z.surface.heights for z in self.zones])

@@ -396,9 +396,8 @@ def test_scene_errors_of_the_loop(tmp_path):
     (tmp_path / "none").mkdir()
     with pytest.raises(InputError, match="no checkpoint.h5"):
         run(scene, resume=True, verbose=False)
-    disc_rough = loads(POD.format(folder=tmp_path / "x").replace('body = "pin"', 'body = "disc"'))
-    with pytest.raises(InputError, match="stationary"):
-        run(disc_rough, verbose=False)
+    with pytest.raises(InputError, match="stationary"):          # now when the scene is read
+        loads(POD.format(folder=tmp_path / "x").replace('body = "pin"', 'body = "disc"'))
     with pytest.raises(InputError, match="micro.model"):
         run(loads(POD.format(folder=tmp_path / "y").replace("law_points = 8", 'law_points = 8\nmodel = "asperity"')),
             verbose=False)

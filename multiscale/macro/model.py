@@ -164,6 +164,16 @@ class MacroModel:
         solved = float(self.mechanics.load.value)
         return self.drive.mean_sliding(t0, t1) * (t1 - t0) * self.load / solved if solved > 0 and t1 > t0 else 0.0
 
+    def sliding_power(self) -> float:
+        """mu ∫ p |w| dA [W] of the last solved pressure at unit speed of body 1 (per rad/s or m/s)."""
+        c = self.contact
+        kept = c.speed.value, c.heating.value
+        c.speed.value, c.heating.value = 1.0, 1.0
+        try:
+            return sum(c.heat_power())
+        finally:
+            c.speed.value, c.heating.value = kept
+
     def record(self, heat_step=(0.0, 0.0)) -> dict:
         """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal
         boundary conditions, ``heat_lost_step_<body>`` is the heat lost since the previous record."""

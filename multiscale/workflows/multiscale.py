@@ -31,7 +31,7 @@ import numpy as np
 from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs
-from multiscale.coupling import LoopSettings, Multiscale, same_scene
+from multiscale.coupling import LoopSettings, Multiscale
 from multiscale.errors import InputError
 from multiscale.geometry import Rotation
 from multiscale.macro.output import FieldOutput
@@ -131,7 +131,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         raise InputError("--resume", str(folder), f"no {CHECKPOINT} in the output folder to resume from")
     stored = checkpoint.peek(ckpt, comm) if resume else {}
     if stored.get("finished"):
-        same_scene(stored, fingerprint(scene), ckpt)
+        checkpoint.same_scene(stored, fingerprint(scene), ckpt)
         return finished(folder, scene.name, int(stored["step"]), comm, verbose)
     ms = build(scene, comm, progress=verbose and comm.rank == 0)
     steps = scene.time.steps if (ms.model.thermal is not None or scene.has("wear")) else 0

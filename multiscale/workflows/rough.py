@@ -51,11 +51,9 @@ P_MAX_PLASTIC = 0.9        # with plasticity, the top node of the laws is at mos
 
 
 def check_rough_scene(scene) -> None:
-    """The rules every rough analysis shares (InputError naming the field)."""
+    """The rules every rough analysis shares (InputError naming the field; the rough body is the
+    stationary one: checked when the scene is read)."""
     bodies = scene.geometry.bodies
-    if scene.roughness.body not in (None, bodies[0]):
-        raise InputError("roughness.body", scene.roughness.body,
-                         f'the rough body must be the stationary one, "{bodies[0]}" (zones do not move)')
     if scene.micro.model != "fft-bem":
         raise InputError("micro.model", scene.micro.model, 'the zone laws are computed by FFT-BEM: "fft-bem"')
     if scene.has("layers") and scene.layers.body not in (None, bodies[0]):

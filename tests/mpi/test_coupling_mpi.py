@@ -10,9 +10,8 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from mpi4py import MPI  # noqa: E402
 
-from multiscale.coupling import collective  # noqa: E402
 from multiscale.errors import InputError, MultiscaleError  # noqa: E402
-from multiscale.io import solver_statistic  # noqa: E402
+from multiscale.io import collective, solver_statistic  # noqa: E402
 from multiscale.workflows.multiscale import run  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 
@@ -53,7 +52,7 @@ def test_a_rank_without_a_loaded_zone_wears_nothing_and_waits_for_nobody(tmp_pat
 
 
 def test_a_micro_failure_on_one_rank_is_raised_on_every_rank():
-    """``coupling.collective``: rank 1's error is raised on rank 1 as it is and on rank 0 as a
+    """``io.collective``: rank 1's error is raised on rank 1 as it is and on rank 0 as a
     MultiscaleError naming rank 1 and the message; nobody is left in the exchange."""
     world = MPI.COMM_WORLD
 
@@ -66,5 +65,5 @@ def test_a_micro_failure_on_one_rank_is_raised_on_every_rank():
         collective(world, call)
     expected = InputError if world.rank == 1 else MultiscaleError
     assert type(info.value) is expected and "zones = 3: a test failure" in str(info.value)
-    assert world.rank == 1 or str(info.value).startswith("micro analysis on rank 1: ")
+    assert world.rank == 1 or str(info.value).startswith("on rank 1: ")
     assert world.allreduce(collective(world, lambda: world.rank)) == 1
