@@ -319,6 +319,9 @@ class Loading:
         elif law and law[0] != "friction" and "stability" not in ctx.effects:
             return [f"{path}.{law[0]}: a speed-dependent friction is read by the squeal analysis only "
                     f'(effect "stability"); give {path}.friction']
+        if self.vehicle is not None and self.load_profile is not None:
+            ctx.warnings.append(f"{path}.load_profile with {path}.vehicle: the speed follows the vehicle's "
+                                "deceleration (or slope) whatever the load factor; a release does not stop it")
         given = [k for k in ("normal_force", "pressure") if getattr(self, k) is not None]
         by_mass = self.vehicle is not None and self.vehicle.mass is not None
         if given and by_mass:

@@ -338,6 +338,12 @@ def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
     no_heat = loads(GOOD.replace('"heat_partition", ', "").replace('partition = "effusivity"\n', ""), tmp_path)
     assert no_heat.warnings == ('effects "friction" and "thermal" without "heat_partition": no frictional '
                                 "heat enters the bodies",)
+    # a vehicle's speed does not follow a load profile
+    pod = (DEMOS / "pin_on_disc_perfect.toml").read_text().replace('rotation_speed = "200 rpm"', "")
+    stop = loads(pod.replace("[loading]", '[loading]\nload_profile = [["0 s", 1], ["5 s", 0]]')
+                 + '\n[loading.vehicle]\nspeed = "36 km/h"\ndeceleration = "1 m/s^2"\nwheel_radius = "300 mm"\n',
+                 tmp_path)
+    assert any("a release does not stop it" in w for w in stop.warnings)
     # a static run takes neither the time stepping nor the profiles (before: no word of it)
     static = loads(text + '[time]\nend = "1 s"\nsteps = 4\n', tmp_path)
     assert static.warnings[-1] == ('time.end, time.steps: ignored without effect "thermal" or "wear": the run is '
