@@ -78,12 +78,15 @@ def test_scene_without_thermal_builds_no_heat_problem(tmp_path):
 
 
 def test_thermal_on_a_sliding_translating_flat_is_refused(tmp_path):
-    scene = loads(BLOCK.format(effects='"contact", "thermal"', folder=tmp_path / "out"),
-                  overrides={"loading.sliding_speed": "0.1 m/s"})
+    """By the scene check, and by the heat problem itself for a model made in Python."""
     with pytest.raises(InputError, match="rotating body"):
-        build_model(scene)
+        loads(BLOCK.format(effects='"contact", "thermal"', folder=tmp_path / "out"),
+              overrides={"loading.sliding_speed": "0.1 m/s"})
     at_rest = build_model(loads(BLOCK.format(effects='"contact", "thermal"', folder=tmp_path / "out")))
     assert at_rest.problems == ("mechanics", "heat")           # no transport at rest: allowed
+    at_rest.contact.speed.value = 0.1
+    with pytest.raises(InputError, match="rotating body"):
+        at_rest.thermal.step(0.1)
 
 
 def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
