@@ -8,7 +8,7 @@ import pytest
 pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from multiscale.errors import InputError  # noqa: E402
-from multiscale.io import History  # noqa: E402
+from multiscale.io import History, solver_statistic  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 from multiscale.workflows.model import build_model  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
@@ -134,8 +134,9 @@ def test_a_transient_run_that_fails_keeps_the_history_of_its_steps(tmp_path, mon
         run(loads(pin_on_disc(folder), overrides={"time.steps": 4}), verbose=False)
     kept = History.read(folder / "history.h5")
     assert len(kept) == 3 and not list(folder.glob("*.part"))
-    for key, values in kept.columns.items():
-        np.testing.assert_allclose(values, full[key][:3], rtol=1e-12, err_msg=key)
+    for key, values in kept.columns.items():     # runs repeat to the Newton tolerance, not bit for bit
+        if not solver_statistic(key):            # (its timed refactorisations: docs, "Repeatability")
+            np.testing.assert_allclose(values, full[key][:3], rtol=1e-7, atol=1e-12, err_msg=key)
 
 
 @pytest.mark.parametrize("change", [("[output]", '[[boundary]]\nsurfaces = ["plate_ends"]\nfix = ["z"]\n[output]'),
