@@ -269,7 +269,9 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         if section in raw and spec.needed_by and not any(e in effects for e in spec.needed_by):
             warnings.append(f'[{section}] is ignored: effect "{spec.needed_by[0]}" is not in effects')
     timing = raw.get("time") if isinstance(raw.get("time"), dict) else {}
-    unused = [f"time.{k}" for k in ("end", "steps", "substeps") if k in timing] + \
+    defaults = {f.name: f.default for f in dataclasses.fields(Time)}      # as written back by resolved_toml
+    unused = [f"time.{k}" for k in ("end", "steps", "substeps") if k in timing and
+              getattr(scene.time, k) != defaults[k]] + \
              [f"loading.{k}" for k in ("load_profile", "speed_profile") if k in loading]
     if unused and "contact" in effects and not {"thermal", "wear", "stability"} & set(effects):
         warnings.append(f'{", ".join(unused)}: ignored without effect "thermal" or "wear": the run is one contact '

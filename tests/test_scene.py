@@ -348,6 +348,7 @@ def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
     static = loads(text + '[time]\nend = "1 s"\nsteps = 4\n', tmp_path)
     assert static.warnings[-1] == ('time.end, time.steps: ignored without effect "thermal" or "wear": the run is '
                                    "one contact solve at t = 0")
+    assert not any("time.steps" in w for w in loads(text + "[time]\nsteps = 1\nsubsteps = 1\n", tmp_path).warnings)
 
 
 @pytest.mark.parametrize("old, new, warning", [
