@@ -250,7 +250,8 @@ def build_parser() -> argparse.ArgumentParser:
                          formatter_class=argparse.RawDescriptionHelpFormatter)
     run.add_argument("scene", metavar="SCENE", help="scene TOML file")
     again = run.add_mutually_exclusive_group()
-    again.add_argument("--overwrite", action="store_true", help="replace results already in the output folder")
+    again.add_argument("--overwrite", action="store_true",
+                       help="delete the results of the run before (the entries its provenance.json lists) and run again")
     again.add_argument("--resume", action="store_true", help="continue from the last checkpoint in the output folder")
     run.add_argument("--quiet", action="store_true", help="no stage lines or summary (errors only)")
     run.add_argument("--max-cells", type=_count, metavar="N", help="largest mesh (cells) the run may build; "

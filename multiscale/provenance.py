@@ -179,9 +179,12 @@ def now() -> str:
 
 
 def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict, wall_time: float,
-          status: str = "finished", command: list[str] | None = None, analysis: str = "") -> list[Path]:
+          status: str = "finished", command: list[str] | None = None, analysis: str = "",
+          files: list[str] = ()) -> list[Path]:
     """``scene.toml`` (the file as given; the resolved scene when it came from text),
-    ``scene_resolved.toml`` and ``provenance.json`` in ``folder``; call on rank 0."""
+    ``scene_resolved.toml`` and ``provenance.json`` in ``folder``; call on rank 0. ``files``: the
+    names of every entry the run writes (``multiscale.outputs.plan``), recorded so that
+    ``results_of`` knows them when the folder is overwritten."""
     folder = Path(folder)
     given = scene.source.read_text(encoding="utf-8") if scene.source and scene.source.is_file() else \
         "# The scene came from text, not a file: here it is as resolved.\n" + resolved_toml(scene)
@@ -192,9 +195,22 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
               "command": list(sys.argv if command is None else command), "ranks": ranks,
               "start": started, "end": now(),
               "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()},
-              "total_wall_time_s": round(wall_time, 3), "versions": versions()}
+              "total_wall_time_s": round(wall_time, 3), "versions": versions(), "files": sorted(files)}
     paths[2].write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
     return paths
 
 
-__all__ = ["now", "resolved_toml", "versions", "write"]
+def results_of(folder: Path) -> list[str]:
+    """Names of the entries an earlier run recorded writing into ``folder`` (its
+    ``provenance.json``, the record itself included), with the ``.part`` files a killed run can
+    leave beside them; empty when there is no readable record (another program's folder)."""
+    try:
+        record = json.loads((Path(folder) / "provenance.json").read_text(encoding="utf-8"))
+        names = [str(n) for n in record.get("files", [])] if isinstance(record, dict) else []
+    except (OSError, ValueError):
+        return []
+    names = [n for n in names if Path(n).name == n and n not in ("", ".", "..")]     # entries of the folder only
+    return sorted({*names, *(n + ".part" for n in names)} | ({"provenance.json"} if names else set()))
+
+
+__all__ = ["now", "resolved_toml", "results_of", "versions", "write"]

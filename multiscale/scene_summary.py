@@ -4,6 +4,7 @@ from __future__ import annotations
 import math
 
 from multiscale.geometry import CellEstimate, estimate_cells
+from multiscale.provenance import results_of
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
 from multiscale.schema import reference as schema_reference
 
@@ -65,8 +66,10 @@ def summary(scene: Scene) -> list[str]:
                      f"T0 = {t.initial_temperature - 273.15:g} degC")
     lines.append(f"  output    {o.folder} every {o.every} step(s): {', '.join(o.fields)}")
     if o.existing_results():
-        lines.append(f"  note      the output folder already holds {len(o.existing_results())} entries: "
-                     "run needs --overwrite or --resume")
+        names = [p.name for p in o.existing_results()]
+        earlier = len(set(names) & set(results_of(o.folder)))
+        lines.append(f"  note      the output folder already holds {len(names)} entries: run needs --overwrite "
+                     f"(deletes the {earlier} the run before wrote) or --resume")
     lines += [f"  warning   {w}" for w in scene.warnings]
     return lines
 

@@ -1,5 +1,7 @@
 """CLI `multiscale check|run`: clear one-line errors and a non-zero exit for bad input, never a
 traceback; a summary for a good scene; earlier results are not overwritten without --overwrite."""
+import io
+import json
 import sys
 import types
 from pathlib import Path
@@ -139,7 +141,8 @@ def test_run_refuses_to_overwrite_results(tmp_path, capsys, monkeypatch):
     module.run = lambda scene, overwrite=False, resume=False, **kw: fake_runner.append((scene.name, overwrite, resume))
     monkeypatch.setitem(sys.modules, "multiscale.workflows", module)
     assert main(["check", path]) == 0
-    assert "the output folder already holds 1 entries: run needs --overwrite or --resume" in capsys.readouterr().out
+    assert ("the output folder already holds 1 entries: run needs --overwrite (deletes the 0 the run before wrote) "
+            "or --resume") in capsys.readouterr().out
     assert main(["run", path, "--overwrite"]) == 0
     assert main(["run", path, "--resume"]) == 0
     assert fake_runner == [("block_on_flat", True, False), ("block_on_flat", False, True)]
@@ -263,3 +266,61 @@ def test_output_times_are_exact_decimals():
     for _ in range(30):
         t = step_time(t, 0.4)
     assert t == 12.0 and repr(t) == "12.0"
+
+
+def _earlier_run(folder, files):
+    """A results folder as a run leaves it: its entries (a .bp folder among them) and the record."""
+    folder.mkdir()
+    for name in files:
+        if name.endswith(".bp"):
+            (folder / name).mkdir()
+            (folder / name / "data.0").write_bytes(b"x")
+        else:
+            (folder / name).write_bytes(b"x")
+    (folder / "provenance.json").write_text(json.dumps({"status": "finished", "files": files + ["provenance.json"]}))
+
+
+def test_overwrite_deletes_what_the_run_before_wrote_and_keeps_the_rest(tmp_path):
+    """--overwrite: the earlier run's results go (a field file or figure the new scene would not
+    write is not left beside its results), with the .part a killed run left; the user's own
+    entries and names only looking like results stay, and the message says so."""
+    from mpi4py import MPI
+
+    from multiscale.io import Reporter
+    from multiscale.workflows.output import prepare_folder
+    folder = tmp_path / "out"
+    _earlier_run(folder, ["pad.xdmf", "pad.h5", "modes_pad.bp", "history.h5", "wear_map_b.png"])
+    (folder / "history.h5.part").write_bytes(b"x")
+    (folder / "notes.txt").write_text("mine")
+    (folder / "disc.xdmf").write_bytes(b"x")            # not recorded: kept
+    scene = types.SimpleNamespace(output=types.SimpleNamespace(folder=folder))
+    stream = io.StringIO()
+    with Reporter(MPI.COMM_SELF, stream=stream):
+        assert prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF) == folder
+    assert sorted(p.name for p in folder.iterdir()) == ["disc.xdmf", "notes.txt"]
+    assert f"--overwrite: 2 entries of {folder} stay (not written by the run before): disc.xdmf, notes.txt" \
+        in stream.getvalue()
+
+
+def test_overwrite_without_a_record_deletes_nothing_and_resume_never_does(tmp_path):
+    from mpi4py import MPI
+
+    from multiscale.io import Reporter
+    from multiscale.workflows.output import prepare_folder
+    folder = tmp_path / "out"
+    _earlier_run(folder, ["pad.xdmf"])
+    (folder / "provenance.json").write_text(json.dumps({"files": ["../x", "..", "pad.xdmf"]}))
+    (tmp_path / "x").write_text("outside")
+    scene = types.SimpleNamespace(output=types.SimpleNamespace(folder=folder))
+    prepare_folder(scene, overwrite=False, resume=True, comm=MPI.COMM_SELF)
+    assert (folder / "pad.xdmf").exists()                    # --resume continues, deletes nothing
+    prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF)
+    assert sorted(p.name for p in folder.iterdir()) == [] and (tmp_path / "x").exists()   # only entries of the folder
+    _earlier_run(tmp_path / "other", ["a.csv"])
+    (tmp_path / "other" / "provenance.json").write_text("{not json")      # another program's record
+    stream = io.StringIO()
+    with Reporter(MPI.COMM_SELF, stream=stream):
+        prepare_folder(types.SimpleNamespace(output=types.SimpleNamespace(folder=tmp_path / "other")),
+                       overwrite=True, resume=False, comm=MPI.COMM_SELF)
+    assert sorted(p.name for p in (tmp_path / "other").iterdir()) == ["a.csv", "provenance.json"]
+    assert "stay (no record of a run (provenance.json with its files))" in stream.getvalue()

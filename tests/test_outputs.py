@@ -127,6 +127,7 @@ def test_provenance_and_paraview_script(case):
     else:
         assert {"meshing", "macro steps"} <= set(record["stage_wall_time_s"])
     assert record["start"] <= record["end"] and record["total_wall_time_s"] > 0
+    assert record["files"] == sorted(p.files)          # what a later --overwrite deletes
     assert (p.folder / "scene.toml").read_text() == scene.source.read_text()
     resolved = (p.folder / "scene_resolved.toml").read_text()
     again = loads(resolved, scene.source.parent, name=scene.name)

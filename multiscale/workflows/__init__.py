@@ -41,6 +41,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         raise InputError("--resume", True, why)
     ended = resume and checkpoint.peek(Path(scene.output.folder) / multiscale.CHECKPOINT, comm).get("finished")
     started, start = provenance.now(), time.perf_counter()
+    written = list(outputs.plan(scene).files)          # recorded: a later --overwrite deletes exactly these
     with io.Reporter(comm, quiet=not verbose) as reporter:
         try:
             if kind == "multiscale":
@@ -51,7 +52,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         except BaseException as exc:
             if reporter.folder is not None and comm.rank == 0:
                 provenance.write(reporter.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
-                                 wall_time=time.perf_counter() - start, analysis=kind,
+                                 wall_time=time.perf_counter() - start, analysis=kind, files=written,
                                  status=f"failed: {type(exc).__name__}: {exc}")
             raise
     result.files += [f.with_suffix(".h5") for f in result.files if f.suffix == ".xdmf"]   # their data
@@ -62,7 +63,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
 
     def write():
         files = provenance.write(result.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
-                                 wall_time=time.perf_counter() - start, analysis=kind,
+                                 wall_time=time.perf_counter() - start, analysis=kind, files=written,
                                  status="resumed and finished" if resume else "finished")
         script.write_text(outputs.paraview_script(outputs.plan(scene)))
         return files + [script]

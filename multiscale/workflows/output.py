@@ -1,10 +1,11 @@
 """Where a run writes: the output-folder check (the only one) and the result every workflow returns."""
 from __future__ import annotations
 
+import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
-from multiscale import io
+from multiscale import io, provenance
 from multiscale.errors import InputError, SceneError
 
 
@@ -20,7 +21,10 @@ class RunResult:
 def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
     """The scene's output folder, created; refuses to touch earlier results unless ``overwrite``
     (replace them) or ``resume`` (continue them; a missing folder is then an error and is not
-    created). Rank 0 decides for every rank (collective)."""
+    created). ``overwrite`` first deletes every entry the earlier run recorded writing
+    (``provenance.results_of``: no stale field file, figure or checkpoint of another scene stays
+    beside the new results) and keeps, with a message, entries no run recorded (the user's own).
+    Rank 0 decides for every rank (collective)."""
     folder = Path(scene.output.folder)
     if resume and not comm.bcast(folder.is_dir() if comm.rank == 0 else None, root=0):
         raise InputError("--resume", str(folder), "the output folder does not exist: there is nothing to resume "
@@ -33,6 +37,8 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
                          "use --overwrite to replace them, --resume to continue the run, or choose another folder")
 
     def create():
+        if existing and overwrite and not resume:
+            clear(folder, existing)
         folder.mkdir(parents=True, exist_ok=True)
         probe = folder / ".multiscale_write_test"
         probe.write_bytes(b"")              # a read-only folder fails here, before any work
@@ -40,3 +46,19 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
     io.on_root(comm, create, f"into the output folder {folder}")
     io.reporter().folder = folder         # where a failed run leaves its provenance
     return folder
+
+
+def clear(folder: Path, existing: list[str]) -> None:
+    """Delete the entries of ``existing`` (names in ``folder``) that the run before recorded writing;
+    say which others stay (call on rank 0)."""
+    earlier = set(provenance.results_of(folder))
+    for name in existing:
+        if name in earlier:
+            path = folder / name
+            shutil.rmtree(path) if path.is_dir() and not path.is_symlink() else path.unlink()
+    kept = [name for name in existing if name not in earlier]
+    if kept:
+        shown = ", ".join(kept[:3]) + (", ..." if len(kept) > 3 else "")
+        why = "not written by the run before" if earlier else "no record of a run (provenance.json with its files)"
+        io.reporter().say(f"--overwrite: {len(kept)} entries of {folder} stay ({why}): {shown}; "
+                          "files of the same name as a result are replaced")
