@@ -18,7 +18,7 @@ from multiscale.geometry import too_many_cells
 from multiscale.io import abort, ended_together
 from multiscale.micro.spectrum import surface_statistics
 from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition, formats, read_topography
-from multiscale.outputs import plan
+from multiscale.outputs import analysis, plan
 from multiscale.outputs import summary as plan_summary
 from multiscale.scene import load
 from multiscale.scene_summary import cells_line, reference, summary
@@ -26,6 +26,7 @@ from multiscale.units import UnitError, to_si
 
 DESCRIPTION = """Multi-scale thermo-mechanical simulation of frictional sliding contacts (disc brakes,
 pin-on-disc): validate a scene file (check), run it (run), sweep parameters (study)."""
+INTERRUPTED = 130        # exit code after Ctrl-C (128 + SIGINT, as shells report it)
 MPIEXEC = f"{Path(sys.executable).parent / 'mpiexec'}"
 EPILOG = f"""Parallel runs: {MPIEXEC} -n N multiscale run scene.toml
 Use the mpiexec of this environment: the launcher of another MPI (a system mpirun or mpiexec)
@@ -134,6 +135,7 @@ def _run(args) -> int:
         if shown:
             print(f"error: {message}", file=sys.stderr)
         return 2
+    scene = None
     try:
         scene = load(args.scene)
         if args.max_cells is not None:
@@ -153,7 +155,22 @@ def _run(args) -> int:
         if rank == 0:
             raise
         return 2
+    except KeyboardInterrupt:       # Ctrl-C (mpiexec hands SIGINT to every rank)
+        if rank == 0:
+            print(f"interrupted: {_kept(scene, args.scene)}", file=sys.stderr, flush=True)
+        if comm is not None and not ended_together(comm):
+            abort(comm, INTERRUPTED)          # a rank was caught inside a collective operation
+        return INTERRUPTED
     return 0
+
+
+def _kept(scene, path: str) -> str:
+    """What a run interrupted by Ctrl-C leaves (``scene``: None if it was still being read)."""
+    if scene is None:
+        return "nothing was written"
+    how = (f"multiscale run {path} --resume continues from the last finished step" if analysis(scene) == "multiscale"
+           else f"multiscale run {path} --overwrite starts again")
+    return f"what was written stays in {scene.output.folder} (its provenance.json says so); {how}"
 
 
 def _study(args) -> int:

@@ -54,6 +54,18 @@ class ConvergenceError(MultiscaleError, RuntimeError):
         super().__init__(message)
 
 
+def interrupted(exc: BaseException) -> bool:
+    """Whether ``exc`` is a Ctrl-C: a ``KeyboardInterrupt``, or an error it caused on its way out of
+    a library (petsc4py turns one raised in a callback of SNES into ``PETSc.Error`` 101)."""
+    seen = set()
+    while exc is not None and id(exc) not in seen:
+        if isinstance(exc, KeyboardInterrupt):
+            return True
+        seen.add(id(exc))
+        exc = exc.__cause__ or exc.__context__
+    return False
+
+
 def _short(value, limit: int = 60) -> str:
     text = repr(value)
     return text if len(text) <= limit else text[: limit - 3] + "..."

@@ -1,6 +1,7 @@
 """Faults that used to hang a parallel job (issue 21): an error met by one rank only, and a NaN on
 one rank. Each runs ``multiscale run`` under ``mpiexec -n 2`` in a subprocess and asserts that the
 job ends within seconds, with one clear message and a non-zero exit code."""
+import os
 import subprocess
 import sys
 import time
@@ -168,3 +169,68 @@ def test_a_full_disk_at_the_history_is_one_clear_error(tmp_path, monkeypatch):
     monkeypatch.setattr(io.History, "write", full)
     with pytest.raises(OutputError, match="cannot write the history .*history.h5: No space left on device"):
         run(loads(SCENE.format(folder=tmp_path / "out")), verbose=False)
+
+
+# ---------------------------------------------------------------- Ctrl-C
+def interrupt(tmp_path, ranks: int):
+    """``multiscale run`` of the cooling block in 4000 heat steps, sent SIGINT (Ctrl-C; under
+    mpiexec to the launcher, which hands it to every rank) once the steps have begun."""
+    import signal
+    scene = tmp_path / "scene.toml"
+    scene.write_text(SCENE.format(folder=tmp_path / "out").replace("steps = 3\n", "steps = 4000\n")
+                     .replace("[output]\n", "[output]\nevery = 1000\n"))
+    command = [str(Path(sys.executable).with_name("multiscale")), "run", str(scene)]
+    command = [str(MPIEXEC), "-n", str(ranks), *command] if ranks > 1 else command
+    job = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+                           start_new_session=True)
+    for line in job.stdout:                 # stage lines; the macro steps' bar comes after these
+        if line.startswith(("first contact solve", "model set-up")):
+            break
+    time.sleep(1.0)
+    sent = time.monotonic()
+    job.send_signal(signal.SIGINT)
+    try:
+        out, err = job.communicate(timeout=120)
+    except subprocess.TimeoutExpired:
+        os.killpg(job.pid, signal.SIGKILL)
+        raise
+    return job.returncode, err, time.monotonic() - sent, tmp_path / "out"
+
+
+@pytest.mark.parametrize("ranks", [1, 2])
+def test_ctrl_c_ends_the_run_with_one_line_and_keeps_what_was_written(tmp_path, ranks):
+    """Ctrl-C during the steps: the job ends within seconds with exit code 130 and one line saying
+    where the results are and how to go on (before: a Python traceback per rank, or PETSc's
+    "error code 101" when the signal came inside a Newton callback); provenance.json says
+    "interrupted" and history.h5 holds the steps done."""
+    import json
+
+    from multiscale.io import History
+    code, err, seconds, folder = interrupt(tmp_path, ranks)
+    assert code == 130 and seconds < 30, err[-3000:]
+    assert "Traceback" not in err and "PETSC ERROR" not in err and "error code" not in err, err[-3000:]
+    lines = [line for line in err.splitlines() if line.startswith("interrupted")]
+    assert lines == [f"interrupted: what was written stays in {folder} (its provenance.json says so); "
+                     f"multiscale run {tmp_path / 'scene.toml'} --overwrite starts again"]
+    assert json.loads((folder / "provenance.json").read_text())["status"] == "interrupted"
+    assert 1 <= len(History.read(folder / "history.h5")) < 4001
+
+
+def test_an_interrupt_is_recognised_through_the_errors_it_caused():
+    """petsc4py raises PETSc.Error(101) from a KeyboardInterrupt met in an SNES callback: that is a
+    Ctrl-C too; an ordinary error is not, and a cycle of causes ends the search."""
+    from petsc4py import PETSc
+
+    from multiscale.errors import ConvergenceError, interrupted
+    try:
+        try:
+            raise KeyboardInterrupt
+        except KeyboardInterrupt as exc:
+            raise PETSc.Error(101) from exc
+    except PETSc.Error as exc:
+        assert interrupted(exc)
+    plain = ConvergenceError("no")
+    looped = RuntimeError("a")
+    looped.__context__ = plain
+    plain.__context__ = looped
+    assert not interrupted(plain) and not interrupted(ValueError()) and interrupted(KeyboardInterrupt())

@@ -15,7 +15,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs, provenance
-from multiscale.errors import InputError
+from multiscale.errors import InputError, interrupted
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.output import RunResult
 
@@ -50,10 +50,13 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                 module = squeal if kind == "squeal" else transient
                 result = module.run(scene, overwrite=overwrite, comm=comm, verbose=verbose)
         except BaseException as exc:
+            stopped = interrupted(exc)
             if reporter.folder is not None and comm.rank == 0:
                 provenance.write(reporter.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
                                  wall_time=time.perf_counter() - start, analysis=kind, files=written,
-                                 status=f"failed: {type(exc).__name__}: {exc}")
+                                 status="interrupted" if stopped else f"failed: {type(exc).__name__}: {exc}")
+            if stopped and not isinstance(exc, KeyboardInterrupt):
+                raise KeyboardInterrupt from None          # not PETSc's error 101 around it
             raise
     result.files += [f.with_suffix(".h5") for f in result.files if f.suffix == ".xdmf"]   # their data
     if ended:                 # --resume of a finished run: nothing to do, its provenance stays as it was
