@@ -276,6 +276,11 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
     if unused and "contact" in effects and not {"thermal", "wear", "stability"} & set(effects):
         warnings.append(f'{", ".join(unused)}: ignored without effect "thermal" or "wear": the run is one contact '
                         "solve at t = 0")
+    if g is not None and scene.materials is not None and scene.time is not None:
+        T0 = scene.time.initial_temperature       # every property of a run starts there
+        warnings += [f"materials.{name}.{phrase} (the initial temperature)" for name in g.materials
+                     if scene.materials.get(name) is not None
+                     for phrase in scene.materials[name].beyond(T0).values()]
     for i, b in enumerate(scene.boundary or (), 1):
         given = [k for k in Boundary.THERMAL if b is not None and getattr(b, k) is not None]
         if given and "thermal" not in effects:

@@ -76,7 +76,8 @@ def interpolate(table, x: float) -> float:
 @dataclass(frozen=True)
 class Material:
     """One body's material (Table 7.2). Every property is a constant or a table against the
-    temperature ((K, value), ...), interpolated linearly and held constant beyond its ends; ``alpha``
+    temperature ((K, value), ...), interpolated linearly and held constant beyond its ends (warned
+    about when the initial temperature, or after a run a body's largest one, leaves it); ``alpha``
     is the mean (secant) expansion coefficient from the initial temperature. Thermal needs kappa and
     c (with rho) or chi. ``k_w``: the Archard wear rate of this material (effect "wear"), taken at
     the local surface temperature: the rough body's (instead of [wear]'s), or the counter-face's
@@ -119,6 +120,17 @@ class Material:
     def tabulated(self, name: str) -> bool:
         """True if property ``name`` is a temperature table."""
         return isinstance(getattr(self, name), tuple)
+
+    def beyond(self, T: float) -> dict[str, str]:
+        """The tables (E, ..., hardness, k_w) that the temperature T [K] leaves, each with a phrase:
+        {"kappa": "kappa: 300 degC above its last point 250 degC, held at 6 there"}."""
+        out = {}
+        for name in (*self.PROPERTIES, "k_w"):
+            table = getattr(self, name)
+            if isinstance(table, tuple) and not table[0][0] <= T <= table[-1][0]:
+                (end, y), side = (table[0], "below its first") if T < table[0][0] else (table[-1], "above its last")
+                out[name] = f"{name}: {T - 273.15:.4g} degC {side} point {end - 273.15:.4g} degC, held at {y:.4g} there"
+        return out
 
     @property
     def constant(self) -> bool:

@@ -148,3 +148,21 @@ def test_a_load_that_a_support_takes_is_refused(tmp_path, change):
     scene = loads(pin_on_disc(tmp_path / "out", effects=("contact", "friction")).replace(*change))
     with pytest.raises(InputError, match=r"the contact carries .* of the 200 N applied: a support takes the load"):
         run(scene, verbose=False)
+
+
+def test_temperatures_beyond_a_material_table_are_warned_about(tmp_path):
+    """A table is held constant beyond its ends (macro.materials): an initial temperature outside
+    it is warned about when the scene is read, a body hotter than its last point after the run
+    (printed and kept in provenance.json). Before: no word of either."""
+    text = pin_on_disc(tmp_path / "pod").replace(
+        'kappa = "35 W/(m K)"', 'kappa = [["20 degC", "35 W/(m K)"], ["20.5 degC", "35 W/(m K)"]]').replace(
+        'alpha = "1e-5 1/K"', 'alpha = [["-50 degC", "1e-5 1/K"], ["0 degC", "1e-5 1/K"]]')
+    scene = loads(text)
+    assert scene.warnings == ("materials.disc.alpha: 20 degC above its last point 0 degC, held at 1e-05 there "
+                              "(the initial temperature)",)
+    result = run(scene, verbose=False)
+    hottest = max(result.history["max_temperature_pin"]) - 273.15
+    assert hottest > 20.5
+    record = json.loads((result.folder / "provenance.json").read_text())
+    assert record["warnings"] == [*scene.warnings, f"materials.pin.kappa: {hottest:.4g} degC above its last point "
+                                  f"20.5 degC, held at 35 there (in the pin)"]

@@ -9,8 +9,11 @@ provenance (``multiscale.provenance``) and a pvpython script (``multiscale.outpu
 """
 from __future__ import annotations
 
+import sys
 import time
 from pathlib import Path
+
+import numpy as np
 
 from mpi4py import MPI
 
@@ -54,7 +57,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             if reporter.folder is not None and comm.rank == 0:
                 provenance.write(reporter.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
                                  wall_time=time.perf_counter() - start, analysis=kind, files=written,
-                                 status="interrupted" if stopped else f"failed: {type(exc).__name__}: {exc}")
+                                 status="interrupted" if stopped else f"failed: {type(exc).__name__}: {exc}",
+                                 warnings=scene.warnings)
             if stopped and not isinstance(exc, KeyboardInterrupt):
                 raise KeyboardInterrupt from None          # not PETSc's error 101 around it
             raise
@@ -63,15 +67,38 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         result.files += [result.folder / name for name in outputs.PROVENANCE]
         return result
     script = result.folder / "paraview.py"
+    beyond = tables_left(scene, getattr(result, "history", None))
+    for line in beyond if comm.rank == 0 and verbose else ():
+        print(f"warning: {line}", file=sys.stderr, flush=True)
 
     def write():
         files = provenance.write(result.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
                                  wall_time=time.perf_counter() - start, analysis=kind, files=written,
-                                 status="resumed and finished" if resume else "finished")
+                                 status="resumed and finished" if resume else "finished",
+                                 warnings=[*scene.warnings, *beyond])
         script.write_text(outputs.paraview_script(outputs.plan(scene)))
         return files + [script]
     result.files += comm.bcast(io.on_root(comm, write, f"the provenance into {result.folder}"), root=0)
     return result
 
 
-__all__ = ["RunResult", "run", "workflow"]
+def tables_left(scene, history) -> list[str]:
+    """Warnings for the material tables a run's temperatures left (held constant beyond their
+    ends, ``Material.beyond``): the largest temperature over the history of the bodies made of
+    each material, for the tables the initial temperature (checked when the scene is read) was in."""
+    if history is None:
+        return []
+    T0, hottest = scene.time.initial_temperature, {}
+    for body in scene.geometry.spec.bodies:
+        column = f"max_temperature_{body.name}"
+        for name in (r.material for r in body.regions if column in history.columns):
+            hottest[name] = max(hottest.get(name, (-np.inf, "")), (float(np.max(history[column])), body.name))
+    out = []
+    for name, (T, body) in hottest.items():
+        known = scene.materials[name].beyond(T0)
+        out += [f"materials.{name}.{phrase} (in the {body})"
+                for key, phrase in scene.materials[name].beyond(T).items() if key not in known]
+    return out
+
+
+__all__ = ["RunResult", "run", "tables_left", "workflow"]
