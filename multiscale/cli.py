@@ -155,9 +155,9 @@ def _run(args) -> int:
         if rank == 0:
             raise
         return 2
-    except KeyboardInterrupt:       # Ctrl-C (mpiexec hands SIGINT to every rank)
+    except KeyboardInterrupt as exc:       # Ctrl-C (mpiexec hands SIGINT to every rank)
         if rank == 0:
-            print(f"interrupted: {_kept(scene, args.scene)}", file=sys.stderr, flush=True)
+            print(f"interrupted {exc}".strip() + f": {_kept(scene, args.scene)}", file=sys.stderr, flush=True)
         if comm is not None and not ended_together(comm):
             abort(comm, INTERRUPTED)          # a rank was caught inside a collective operation
         return INTERRUPTED

@@ -54,6 +54,11 @@ class ConvergenceError(MultiscaleError, RuntimeError):
         super().__init__(message)
 
 
+class Interrupted(KeyboardInterrupt):
+    """Ctrl-C honoured at the end of a step (``multiscale.io.StepStop``): the results up to that
+    step were written. The message says which ("after step 12 of 50")."""
+
+
 def interrupted(exc: BaseException) -> bool:
     """Whether ``exc`` is a Ctrl-C: a ``KeyboardInterrupt``, or an error it caused on its way out of
     a library (petsc4py turns one raised in a callback of SNES into ``PETSc.Error`` 101)."""

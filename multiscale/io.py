@@ -8,7 +8,9 @@ stage of a run on rank 0 (``stage``, ``bar``) and keeps the wall time of every s
 from __future__ import annotations
 
 import os
+import signal
 import sys
+import threading
 import time as _time
 from contextlib import contextmanager
 from pathlib import Path
@@ -123,6 +125,39 @@ def collective(comm, call):
         rank, message = failed[0]
         raise MultiscaleError(f"on rank {rank}: {message}")
     return value
+
+
+class StepStop:
+    """Ctrl-C in a loop of steps (a context manager): the first SIGINT asks the loop to stop after
+    its current step, when ``requested()`` (every rank together: one stops, all stop, at the same
+    step) is True; a second interrupts at once (``KeyboardInterrupt``). Under ``mpiexec`` the second
+    Ctrl-C is the launcher's: it ends every rank. Without the main thread, nothing is installed."""
+
+    MESSAGE = b"\nCtrl-C: stopping after this step, with its results written (Ctrl-C again stops at once)\n"
+
+    def __init__(self, comm):
+        self.comm, self.asked, self.previous = comm, False, None
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self.previous = signal.signal(signal.SIGINT, self._handle)
+        return self
+
+    def __exit__(self, *exc):
+        if self.previous is not None:
+            signal.signal(signal.SIGINT, self.previous)
+        return False
+
+    def _handle(self, signum, frame):
+        if self.asked:
+            raise KeyboardInterrupt
+        self.asked = True
+        if self.comm.rank == 0:
+            os.write(2, self.MESSAGE)        # not print: the handler may run inside a write to stderr
+
+    def requested(self) -> bool:
+        """Whether any rank was asked to stop (collective)."""
+        return bool(self.comm.allreduce(self.asked, op=MPI.LOR))
 
 
 def ended_together(comm, timeout: float = 10.0) -> bool:

@@ -268,6 +268,12 @@ def test_output_times_are_exact_decimals():
     assert t == 12.0 and repr(t) == "12.0"
 
 
+def _scene_into(tmp_path, folder):
+    """The block demo writing into ``folder``."""
+    from multiscale.scene import load
+    return load(_write(tmp_path, BLOCK.replace("../results/block_on_flat", str(folder)), name=f"{folder.name}.toml"))
+
+
 def _earlier_run(folder, files):
     """A results folder as a run leaves it: its entries (a .bp folder among them) and the record."""
     folder.mkdir()
@@ -293,11 +299,15 @@ def test_overwrite_deletes_what_the_run_before_wrote_and_keeps_the_rest(tmp_path
     (folder / "history.h5.part").write_bytes(b"x")
     (folder / "notes.txt").write_text("mine")
     (folder / "disc.xdmf").write_bytes(b"x")            # not recorded: kept
-    scene = types.SimpleNamespace(output=types.SimpleNamespace(folder=folder))
     stream = io.StringIO()
     with Reporter(MPI.COMM_SELF, stream=stream):
-        assert prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF) == folder
-    assert sorted(p.name for p in folder.iterdir()) == ["disc.xdmf", "notes.txt"]
+        assert prepare_folder(_scene_into(tmp_path, folder), overwrite=True, resume=False,
+                              comm=MPI.COMM_SELF) == folder
+    # the new run's provenance, written at once: a run killed now is known as such, with its files
+    assert sorted(p.name for p in folder.iterdir()) == ["disc.xdmf", "notes.txt", "provenance.json", "scene.toml",
+                                                        "scene_resolved.toml"]
+    record = json.loads((folder / "provenance.json").read_text())
+    assert record["status"] == "running (or killed: no end was recorded)" and "block.xdmf" in record["files"]
     assert f"--overwrite: 2 entries of {folder} stay (not written by the run before): disc.xdmf, notes.txt" \
         in stream.getvalue()
 
@@ -311,16 +321,15 @@ def test_overwrite_without_a_record_deletes_nothing_and_resume_never_does(tmp_pa
     _earlier_run(folder, ["pad.xdmf"])
     (folder / "provenance.json").write_text(json.dumps({"files": ["../x", "..", "pad.xdmf"]}))
     (tmp_path / "x").write_text("outside")
-    scene = types.SimpleNamespace(output=types.SimpleNamespace(folder=folder))
+    scene = _scene_into(tmp_path, folder)
     prepare_folder(scene, overwrite=False, resume=True, comm=MPI.COMM_SELF)
-    assert (folder / "pad.xdmf").exists()                    # --resume continues, deletes nothing
+    assert sorted(p.name for p in folder.iterdir()) == ["pad.xdmf", "provenance.json"]   # --resume: as it was
     prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF)
-    assert sorted(p.name for p in folder.iterdir()) == [] and (tmp_path / "x").exists()   # only entries of the folder
+    assert not (folder / "pad.xdmf").exists() and (tmp_path / "x").exists()     # only entries of the folder
     _earlier_run(tmp_path / "other", ["a.csv"])
     (tmp_path / "other" / "provenance.json").write_text("{not json")      # another program's record
     stream = io.StringIO()
     with Reporter(MPI.COMM_SELF, stream=stream):
-        prepare_folder(types.SimpleNamespace(output=types.SimpleNamespace(folder=tmp_path / "other")),
-                       overwrite=True, resume=False, comm=MPI.COMM_SELF)
-    assert sorted(p.name for p in (tmp_path / "other").iterdir()) == ["a.csv", "provenance.json"]
+        prepare_folder(_scene_into(tmp_path, tmp_path / "other"), overwrite=True, resume=False, comm=MPI.COMM_SELF)
+    assert "a.csv" in [p.name for p in (tmp_path / "other").iterdir()]
     assert "stay (no record of a run (provenance.json with its files))" in stream.getvalue()

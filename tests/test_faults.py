@@ -198,22 +198,48 @@ def interrupt(tmp_path, ranks: int):
 
 
 @pytest.mark.parametrize("ranks", [1, 2])
-def test_ctrl_c_ends_the_run_with_one_line_and_keeps_what_was_written(tmp_path, ranks):
-    """Ctrl-C during the steps: the job ends within seconds with exit code 130 and one line saying
-    where the results are and how to go on (before: a Python traceback per rank, or PETSc's
-    "error code 101" when the signal came inside a Newton callback); provenance.json says
-    "interrupted" and history.h5 holds the steps done."""
+def test_ctrl_c_stops_the_run_after_its_step_with_the_results_written(tmp_path, ranks):
+    """Ctrl-C during the steps: every rank stops after the same step, the history, its plot, the
+    fields of that step and paraview.py are written, and the job ends with exit code 130 and one
+    line saying where the results are (before: a Python traceback per rank, or PETSc's "error code
+    101" when the signal came inside a Newton callback, and no plot); provenance.json says so."""
     import json
 
     from multiscale.io import History
     code, err, seconds, folder = interrupt(tmp_path, ranks)
     assert code == 130 and seconds < 30, err[-3000:]
     assert "Traceback" not in err and "PETSC ERROR" not in err and "error code" not in err, err[-3000:]
+    assert err.count("Ctrl-C: stopping after this step") == 1
+    record = json.loads((folder / "provenance.json").read_text())
+    done = int(record["status"].split()[3])
+    assert record["status"] == f"interrupted after step {done} of 4000" and 1 <= done < 4000
     lines = [line for line in err.splitlines() if line.startswith("interrupted")]
-    assert lines == [f"interrupted: what was written stays in {folder} (its provenance.json says so); "
-                     f"multiscale run {tmp_path / 'scene.toml'} --overwrite starts again"]
-    assert json.loads((folder / "provenance.json").read_text())["status"] == "interrupted"
-    assert 1 <= len(History.read(folder / "history.h5")) < 4001
+    assert lines == [f"interrupted after step {done} of 4000: what was written stays in {folder} (its "
+                     f"provenance.json says so); multiscale run {tmp_path / 'scene.toml'} --overwrite starts again"]
+    assert len(History.read(folder / "history.h5")) == done + 1
+    assert (folder / "history.png").stat().st_size > 0 and (folder / "paraview.py").exists()
+    import meshio
+    with meshio.xdmf.TimeSeriesReader(str(folder / "block.xdmf")) as reader:
+        reader.read_points_cells()
+        assert reader.read_data(reader.num_steps - 1)[0] == pytest.approx(done * 3 / 4000)   # the stop's fields
+
+
+def test_a_second_ctrl_c_interrupts_at_once():
+    """StepStop: the first SIGINT is a request (collective ``requested()``), the second raises."""
+    import signal
+
+    from mpi4py import MPI
+
+    from multiscale.io import StepStop
+    with StepStop(MPI.COMM_SELF) as stop:
+        assert not stop.requested()
+        os.kill(os.getpid(), signal.SIGINT)
+        time.sleep(0.01)
+        assert stop.requested()
+        with pytest.raises(KeyboardInterrupt):
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.01)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler      # restored
 
 
 def test_an_interrupt_is_recognised_through_the_errors_it_caused():

@@ -9,6 +9,7 @@ each output time exactly once, the same times, and nothing printed an HDF5 error
 leaves the field files AHEAD of the checkpoint (the state of a run killed after writing fields but
 before its next checkpoint was complete): the resumed run drops those ghost times (they are gone
 when it stops again) and writes them again, once; a --resume after the end writes nothing."""
+import json
 import os
 import shutil
 import signal
@@ -146,6 +147,8 @@ def test_killed_mid_run_and_resumed_writes_the_uninterrupted_results(base, tmp_p
     assert job.returncode != 0, err
     with h5py.File(ckpt, "r") as f:
         assert 2 <= int(f.attrs["step"]) < 4 and "finished" not in f.attrs
+    record = json.loads((folder / "provenance.json").read_text())       # written when the run began
+    assert record["status"] == "running (or killed: no end was recorded)" and "checkpoint.h5" in record["files"]
     resumed = subprocess.run(launcher + [str(MULTISCALE), "run", str(path), "--resume", "--quiet"],
                              capture_output=True, text=True, timeout=300, start_new_session=True)
     assert resumed.returncode == 0, resumed.stderr

@@ -18,7 +18,7 @@ import numpy as np
 from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs, provenance
-from multiscale.errors import InputError, interrupted
+from multiscale.errors import InputError, Interrupted, interrupted
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.output import RunResult
 
@@ -57,8 +57,10 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             if reporter.folder is not None and comm.rank == 0:
                 provenance.write(reporter.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
                                  wall_time=time.perf_counter() - start, analysis=kind, files=written,
-                                 status="interrupted" if stopped else f"failed: {type(exc).__name__}: {exc}",
-                                 warnings=scene.warnings)
+                                 status=f"interrupted {exc}".strip() if stopped else
+                                 f"failed: {type(exc).__name__}: {exc}", warnings=scene.warnings)
+                if isinstance(exc, Interrupted):          # stopped after a step: its results are written
+                    (reporter.folder / "paraview.py").write_text(outputs.paraview_script(outputs.plan(scene)))
             if stopped and not isinstance(exc, KeyboardInterrupt):
                 raise KeyboardInterrupt from None          # not PETSc's error 101 around it
             raise

@@ -32,7 +32,7 @@ from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs
 from multiscale.coupling import LoopSettings, Multiscale
-from multiscale.errors import InputError
+from multiscale.errors import InputError, Interrupted
 from multiscale.geometry import Rotation
 from multiscale.macro.output import FieldOutput
 from multiscale.micro.heat_kernels import ThermalMaterial
@@ -153,14 +153,17 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         writer.write()
         ms.mark_fields(ckpt, done, comm)
     last = steps if stop_after is None else min(steps, stop_after)
-    with io.stage("macro steps"):
+    stopping = False
+    with io.stage("macro steps"), io.StepStop(comm) as stop:
         for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
             history.append(**ms.record(ms.step(n)))
             ms.save(ckpt, n, history)
-            if n % every == 0 or n == steps:
-                writer.write()
+            done, stopping = n, stop.requested()
+            if n % every == 0 or n == steps:          # not at a stop: a resumed run's field times stay those of
+                writer.write()                        # an uninterrupted one
                 ms.mark_fields(ckpt, n, comm)
-            done = n
+            if stopping:
+                break
     with io.stage("writing history and plots"):
         h5, png = write_history(history, folder, scene.name, comm)
         plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
@@ -170,6 +173,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                               history, h5, png, writer.files, plot, maps, zones, done)
     del ms, writer            # the model holds reference cycles of PETSc objects: free them on every
     gc.collect()              # rank at the same point (collected later, ranks could hang at exit)
+    if stopping:                 # decided by every rank together
+        raise Interrupted(f"after step {done} of {steps}")
     if verbose and comm.rank == 0:
         print(f"{scene.name}: {len(history)} records ({done}/{steps} steps) in {result.wall_time:.1f} s "
               f"on {comm.size} rank(s)")

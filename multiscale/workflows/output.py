@@ -5,8 +5,11 @@ import shutil
 from dataclasses import dataclass
 from pathlib import Path
 
-from multiscale import io, provenance
+from multiscale import io, outputs, provenance
 from multiscale.errors import InputError, SceneError
+
+
+RUNNING = "running (or killed: no end was recorded)"
 
 
 @dataclass
@@ -24,6 +27,7 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
     created). ``overwrite`` first deletes every entry the earlier run recorded writing
     (``provenance.results_of``: no stale field file, figure or checkpoint of another scene stays
     beside the new results) and keeps, with a message, entries no run recorded (the user's own).
+    A new run's provenance is written at once, with status ``RUNNING`` (what a killed run leaves).
     Rank 0 decides for every rank (collective)."""
     folder = Path(scene.output.folder)
     if resume and not comm.bcast(folder.is_dir() if comm.rank == 0 else None, root=0):
@@ -43,6 +47,10 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
         probe = folder / ".multiscale_write_test"
         probe.write_bytes(b"")              # a read-only folder fails here, before any work
         probe.unlink()
+        if not resume:                      # a killed run's folder says so and lists its files
+            provenance.write(folder, scene, ranks=comm.size, started=provenance.now(), stages={}, wall_time=0.0,
+                             status=RUNNING, analysis=outputs.analysis(scene), files=list(outputs.plan(scene).files),
+                             warnings=scene.warnings)
     io.on_root(comm, create, f"into the output folder {folder}")
     io.reporter().folder = folder         # where a failed run leaves its provenance
     return folder

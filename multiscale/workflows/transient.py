@@ -15,6 +15,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from multiscale import io, outputs
+from multiscale.errors import Interrupted
 from multiscale.macro.output import FieldOutput
 from multiscale.plots.history import history_figure
 from multiscale.workflows.model import build_mesh, build_model
@@ -60,16 +61,22 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     history.append(**model.record())
     writer.write()
     steps = scene.time.steps if model.thermal is not None else 0
-    with io.stage("macro steps"):
+    done, stopping = 0, False
+    with io.stage("macro steps"), io.StepStop(comm) as stop:
         for n in io.bar(range(1, steps + 1), "macro steps"):
             heat = model.macro_step(scene.time.dt, scene.time.substeps)
             history.append(**model.record(heat))
-            if n % scene.output.every == 0 or n == steps:
+            done, stopping = n, stop.requested()
+            if n % scene.output.every == 0 or n == steps or stopping:
                 writer.write()
-            if n < steps:                    # an interrupted run keeps the history of its steps
+            if n < steps:                    # a killed run keeps the history of its steps
                 write_history(history, folder, scene.name, comm, plot=False)
+            if stopping:
+                break
     with io.stage("writing history and plots"):
         h5, png = write_history(history, folder, scene.name, comm)
+    if stopping:                     # decided by every rank together
+        raise Interrupted(f"after step {done} of {steps}")
     result = TransientResult(folder, writer.files + [h5, png], _time.perf_counter() - start, history, h5, png,
                              writer.files)
     if verbose and comm.rank == 0:
