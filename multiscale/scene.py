@@ -128,6 +128,33 @@ class Scene:
         return self.geometry.bodies
 
     @property
+    def inputs(self) -> frozenset[Path]:
+        """Every file the scene reads, resolved: the scene file, a geometry file, measured surfaces."""
+        found = {self.source.resolve()} if self.source is not None else set()
+
+        def walk(value):
+            if isinstance(value, Path):
+                found.add(value.resolve())
+            elif dataclasses.is_dataclass(value) and not isinstance(value, type):
+                for f in dataclasses.fields(value):
+                    walk(getattr(value, f.name))
+            elif isinstance(value, (tuple, list, FrozenMap)):
+                for item in value.values() if isinstance(value, FrozenMap) else value:
+                    walk(item)
+        for f in dataclasses.fields(self):
+            if f.name not in ("output", "source"):
+                walk(getattr(self, f.name))
+        return frozenset(found)
+
+    def earlier_results(self) -> list[str]:
+        """Names of the entries already in the output folder (what ``run`` must not overwrite
+        silently), the scene's own inputs left out (a scene may sit in its output folder)."""
+        folder = self.output.folder if self.output is not None else None
+        if folder is None or not folder.is_dir():
+            return []
+        return sorted(p.name for p in folder.iterdir() if p.resolve() not in self.inputs)
+
+    @property
     def partition(self) -> float | None:
         """Share of frictional heat into body 0 (pin, pads, block) at the first interface (see
         ``partition_at``)."""

@@ -406,10 +406,6 @@ class Output:
     every: int = key(Integer(ge=1), default=1)            # write fields every n macro steps
     fields: tuple = key(ListOf(Choice(OUTPUT_FIELDS), unique=True))
 
-    def existing_results(self) -> list[Path]:
-        """Entries already in the output folder (what ``run`` must not overwrite silently)."""
-        return sorted(self.folder.iterdir()) if self.folder is not None and self.folder.is_dir() else []
-
 
 # ------------------------------------------------------------------ later effects (validated only)
 @dataclass(frozen=True)

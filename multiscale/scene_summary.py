@@ -65,8 +65,8 @@ def summary(scene: Scene) -> list[str]:
         lines.append(f"  time      {t.end:g} s in {t.steps} step(s) of {t.dt:g} s x {t.substeps} substep(s); "
                      f"T0 = {t.initial_temperature - 273.15:g} degC")
     lines.append(f"  output    {o.folder} every {o.every} step(s): {', '.join(o.fields)}")
-    if o.existing_results():
-        names = [p.name for p in o.existing_results()]
+    names = scene.earlier_results()
+    if names:
         earlier = len(set(names) & set(results_of(o.folder)))
         lines.append(f"  note      the output folder already holds {len(names)} entries: run needs --overwrite "
                      f"(deletes the {earlier} the run before wrote) or --resume")

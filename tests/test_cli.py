@@ -333,3 +333,24 @@ def test_overwrite_without_a_record_deletes_nothing_and_resume_never_does(tmp_pa
         prepare_folder(_scene_into(tmp_path, tmp_path / "other"), overwrite=True, resume=False, comm=MPI.COMM_SELF)
     assert "a.csv" in [p.name for p in (tmp_path / "other").iterdir()]
     assert "stay (no record of a run (provenance.json with its files))" in stream.getvalue()
+
+
+def test_a_scene_in_its_own_output_folder_is_not_a_result(tmp_path, capsys):
+    """output.folder = "." beside the scene (and its measured surface): the scene and the files it
+    reads are not earlier results (a first run was refused for them), and --overwrite never deletes
+    them (it deleted the scene file itself, recorded as the copy scene.toml, and wrote the resolved
+    scene in its place)."""
+    from mpi4py import MPI
+
+    from multiscale.scene import load
+    from multiscale.workflows.output import prepare_folder
+    text = BLOCK.replace("../results/block_on_flat", ".") + "\n# the user's comment\n"
+    path = _write(tmp_path, text)
+    assert main(["check", path]) == 0 and "already holds" not in capsys.readouterr().out
+    scene = load(path)
+    assert scene.inputs == {Path(path).resolve()} and scene.earlier_results() == []
+    prepare_folder(scene, overwrite=False, resume=False, comm=MPI.COMM_SELF)     # refused before
+    for _ in range(2):
+        prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF)
+        assert Path(path).read_text() == text
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["provenance.json", "scene.toml", "scene_resolved.toml"]

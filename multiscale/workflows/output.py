@@ -33,8 +33,7 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
     if resume and not comm.bcast(folder.is_dir() if comm.rank == 0 else None, root=0):
         raise InputError("--resume", str(folder), "the output folder does not exist: there is nothing to resume "
                          "(run without --resume)")
-    existing = comm.bcast(sorted(p.name for p in folder.iterdir()) if comm.rank == 0 and folder.is_dir() else [],
-                          root=0)
+    existing = comm.bcast(scene.earlier_results() if comm.rank == 0 else None, root=0)
     if existing and not (overwrite or resume):
         shown = ", ".join(existing[:3]) + (", ..." if len(existing) > 3 else "")
         raise SceneError(f'output.folder = "{folder}": already holds results ({len(existing)} entries: {shown}); '
