@@ -107,7 +107,7 @@ def test_each_interface_has_its_own_friction_and_its_own_results(tmp_path):
         assert h[f"interface_force_{pad}"][0] == pytest.approx(clamp, rel=0.02)
     ratio = {p: h[f"friction_force_{p}"][0] / h[f"interface_force_{p}"][0] for p in ("inner_pad", "outer_pad")}
     assert ratio["inner_pad"] / ratio["outer_pad"] == pytest.approx(0.5, rel=0.01)
-    assert ratio["outer_pad"] == pytest.approx(0.4, rel=0.03)          # direction spread over the pad
+    assert ratio["outer_pad"] == pytest.approx(0.4, rel=1e-3)           # magnitudes: all of the pad slides
 
 
 def test_a_rough_interface_beside_one_in_perfect_contact(tmp_path):

@@ -402,3 +402,82 @@ grid = [16, 16]
     err = check(tmp_path, capsys, text)
     assert "interfaces.shoe: a rough interface must be planar" in err
     assert not (tmp_path / "results").exists()
+
+
+# two pads on one face of a disc, at y = +80 mm and y = -80 mm: their friction forces are opposite
+TWO_PADS_GEO = """SetFactory("OpenCASCADE");
+Cylinder(1) = {0, 0, 0, 0, 0, 10, 100};
+Cylinder(2) = {0, 0, 0, 0, 0, 10, 40};
+BooleanDifference(3) = { Volume{1}; Delete; }{ Volume{2}; Delete; };
+Box(4) = {-10, 70, 10, 20, 20, 8};
+Box(5) = {-10, -90, 10, 20, 20, 8};"""
+TWO_PADS = """name = "two"
+effects = ["contact", "friction", "thermal", "heat_partition"]
+[geometry]
+file = "twopads.geo"
+unit = "mm"
+mesh_size = "15 mm"
+interface_mesh_size = "5 mm"
+rotating = "disc"
+[geometry.bodies.disc]
+contains = ["0 mm", "60 mm", "5 mm"]
+material = "steel"
+[geometry.bodies.pad_a]
+contains = ["0 mm", "80 mm", "14 mm"]
+material = "pad"
+[geometry.bodies.pad_b]
+contains = ["0 mm", "-80 mm", "14 mm"]
+material = "pad"
+[geometry.surfaces.backs]
+contains = [["0 mm", "80 mm", "18 mm"], ["0 mm", "-80 mm", "18 mm"]]
+[geometry.surfaces.bore]
+body = "disc"
+contains = ["40 mm", "0 mm", "5 mm"]
+[geometry.surfaces.sides]
+contains = [["-10 mm", "80 mm", "14 mm"], ["10 mm", "80 mm", "14 mm"], ["-10 mm", "-80 mm", "14 mm"], ["10 mm", "-80 mm", "14 mm"]]
+[materials.steel]
+E = "210 GPa"
+nu = 0.3
+rho = "7850 kg/m^3"
+kappa = "45 W/(m K)"
+c = "480 J/(kg K)"
+[materials.pad]
+E = "3 GPa"
+nu = 0.25
+rho = "2500 kg/m^3"
+kappa = "1.5 W/(m K)"
+c = "1000 J/(kg K)"
+[interface]
+penalty = "1e13 Pa/m"
+partition = 0.1
+[loading]
+faces = ["backs"]
+normal_force = "1000 N"
+rotation_speed = "300 rpm"
+friction = 0.4
+[[boundary]]
+surfaces = ["bore"]
+fix = ["x", "y", "z"]
+[[boundary]]
+surfaces = ["sides"]
+fix = ["x", "y"]
+[time]
+end = "2 s"
+steps = 2
+[output]
+folder = "{folder}"
+"""
+
+
+def test_the_friction_force_of_several_pads_is_the_sum_of_theirs(tmp_path):
+    """history friction_force is the sum of the local friction forces' magnitudes (mu times the
+    normal force when everything slides), per interface and in all: before, it was the length of
+    the resultant vector, 0.001 N for these two opposite pads braking with 200 N each."""
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO)
+    scene = loads(TWO_PADS.replace("{folder}", str(tmp_path / "out")), tmp_path)
+    h = run(scene, verbose=False).history
+    for pad in ("pad_a", "pad_b"):
+        assert h[f"friction_force_{pad}"][-1] == pytest.approx(0.4 * h[f"interface_force_{pad}"][-1], rel=1e-3)
+    assert h["friction_force"][-1] == pytest.approx(h["friction_force_pad_a"][-1] + h["friction_force_pad_b"][-1],
+                                                    rel=1e-12)
+    assert h["friction_force"][-1] == pytest.approx(0.4 * 1000, rel=1e-3)

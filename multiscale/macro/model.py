@@ -176,18 +176,21 @@ class MacroModel:
 
     def record(self, heat_step=(0.0, 0.0)) -> dict:
         """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal
-        boundary conditions, ``heat_lost_step_<body>`` is the heat lost since the previous record."""
+        boundary conditions, ``heat_lost_step_<body>`` is the heat lost since the previous record.
+        ``friction_force`` (in all and per interface) sums the friction forces' magnitudes over the
+        facets, mu times the normal force where all slides: opposite pads do not cancel."""
         on = not self.released
+        friction = np.linalg.norm(self.contact.facet_friction(), axis=1) * on     # N per facet, magnitudes
         row = {"time": self.time, "interface_force": self.last_solve.normal_force * on,
-               "friction_force": float(np.linalg.norm(self.contact.friction_force())) * on,
+               "friction_force": float(friction.sum()),
                "max_pressure": self.last_solve.max_pressure * on,
                "newton_iterations": self.last_solve.iterations}
         masks = self.tm.interface.masks()
         if len(masks) > 1:                        # per interface (a brake's pads, a disc's pucks)
-            p, friction = self.contact.facet_pressure() * on, self.contact.facet_friction() * on
+            p = self.contact.facet_pressure() * on
             for name, m in masks.items():
                 row[f"interface_force_{name}"] = float(p[m] @ self.tm.interface.areas[m])
-                row[f"friction_force_{name}"] = float(np.linalg.norm(friction[m].sum(axis=0)))
+                row[f"friction_force_{name}"] = float(friction[m].sum())
                 row[f"max_pressure_{name}"] = float(p[m].max(initial=0.0))
         if self.thermal is not None:
             stored, hottest = self.thermal.stored_heat(), self.thermal.max_temperature()
