@@ -399,7 +399,7 @@ class Multiscale:
     def facet_fields(self) -> dict:
         """Interface output fields of the loop: name -> per-facet array maker."""
         iface, contact, rough = self.tm.interface, self.model.contact, self.rough
-        fields = {"contact_stiffness": lambda: rough.law.evaluate(contact.facet_gap())[1],
+        fields = {"contact_stiffness": lambda: rough.law.evaluate(contact.facet_gap())[1] * (not self.model.released),
                   "partition": lambda: iface.values(contact.partition),
                   "wear_depth": lambda: np.where(rough.zone_of_facet >= 0,
                                                  rough.wear_depth().mean(axis=(-2, -1))[rough.zone_of_facet], 0.0)}
@@ -509,11 +509,11 @@ class Multiscale:
 
     def record(self, result: StepResult) -> dict:
         """One history row (units: ``io.UNITS``)."""
-        micro = result.micro
+        micro, on = result.micro, not self.model.released      # released: no contact (the last loads kept)
         row = self.model.record(result.heat)
-        row.update(zones_in_contact=micro.loaded, laws_computed=self.rough.laws_computed,
-                   max_zone_pressure=micro.zone_pressure, micro_max_pressure=micro.max_pressure,
-                   real_contact_area=micro.real_area)
+        row.update(zones_in_contact=micro.loaded * on, laws_computed=self.rough.laws_computed,
+                   max_zone_pressure=micro.zone_pressure * on, micro_max_pressure=micro.max_pressure * on,
+                   real_contact_area=micro.real_area * on)
         if self.post.heating is not None:
             row.update(micro_max_temperature=micro.max_temperature, partition_min=micro.partition[0],
                        partition_mean=micro.partition[1], partition_max=micro.partition[2],

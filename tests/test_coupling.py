@@ -286,6 +286,9 @@ def test_the_zones_wear_with_the_loaded_sliding_and_at_the_last_step(straight, t
     which thermal expansion changes: 3e-4 here). Wearing every 3 steps over 2, the last step wears both (before: none), the
     volume of wearing every step within 2 %."""
     h = run_pod(tmp_path / "released", {"loading.load_profile": [["0 s", 1.0], ["0.6 s", 1.0], ["0.61 s", 0.0]]})
+    off = h["time"] > 0.61                     # released: no contact on either scale (before: the last loads')
+    for key in ("interface_force", "zones_in_contact", "real_contact_area", "max_zone_pressure", "micro_max_pressure"):
+        assert np.all(h[key][~off] > 0) and np.all(h[key][off] == 0), key
     work, wear = np.diff(h["frictional_work"]), np.diff(h["wear_volume"])
     np.testing.assert_allclose(work, h["heat_step_pin"][1:] + h["heat_step_disc"][1:], rtol=1e-3)
     assert work[1] / work[0] == pytest.approx(1 / 120, rel=0.05) and wear[1] / wear[0] == pytest.approx(1 / 120, rel=0.05)

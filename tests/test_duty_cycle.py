@@ -72,6 +72,11 @@ def test_a_release_phase_has_no_contact_and_no_frictional_heat(tmp_path):
     # (the disc's Eulerian transport through its faceted rim is not exactly conservative: 6e-5 here)
     np.testing.assert_allclose(stored[off], stored[off][0], rtol=5e-4)
     assert np.all(np.diff(h["max_temperature_pin"][off]) < 0)
+    import meshio                      # the contact pressure field is 0 too (before: the last solve's)
+    with meshio.xdmf.TimeSeriesReader(str(tmp_path / "release" / "interface.xdmf")) as reader:
+        reader.read_points_cells()
+        pressure = [reader.read_data(k)[2]["contact pressure [Pa]"][0] for k in range(reader.num_steps)]
+    assert pressure[1].max() > 1e5 and all(np.all(p == 0.0) for p in pressure[3:])
 
 
 

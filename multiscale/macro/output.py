@@ -250,7 +250,7 @@ class FieldOutput:
                 self.von_mises.append((f, fem.Expression(mech.von_mises(i), V.element.interpolation_points)))
                 body[i]["von_mises"] = f
         contact = mech.contact
-        makers = {"contact_pressure": contact.facet_pressure}
+        makers = {"contact_pressure": lambda: contact.facet_pressure() * (contact.engaged.value != 0.0)}   # 0 released
         if th is not None:
             makers["heat_flux"] = contact.facet_heat_flux
             makers["partition"] = lambda: tm.interface.values(contact.partition)
