@@ -27,9 +27,11 @@ def array_name(field: str) -> str:
 
 
 def step_time(t: float, dt: float) -> float:
-    """t + dt rounded to 12 significant digits: output times stay exact decimals (12.0, not
-    11.999999999999998 after 30 steps of 0.4 s)."""
-    return float(f"{t + dt:.12g}")
+    """t + dt [s] as the multiple n dt it is (to 1e-9 dt), rounded to 12 significant digits:
+    output times stay exact decimals and do not drift (12.0, not 11.999999999999998 after 30 steps
+    of 0.4 s; 10.0, not 9.99999999999, after 7 steps of 10/7 s)."""
+    n = round((t + dt) / dt)
+    return float(f"{n * dt if abs(n * dt - (t + dt)) <= 1e-9 * dt else t + dt:.12g}")
 
 
 BODY_FIELDS = ("displacement", "temperature", "von_mises")

@@ -266,6 +266,12 @@ def test_output_times_are_exact_decimals():
     for _ in range(30):
         t = step_time(t, 0.4)
     assert t == 12.0 and repr(t) == "12.0"
+    for steps in (3, 7, 11, 13, 999):            # each step rounded to 12 digits, t drifted: 9.99999999999 (7)
+        t = 0.0
+        for _ in range(steps):
+            t = step_time(t, 10.0 / steps)
+        assert t == 10.0, steps
+    assert step_time(0.25, 1.0) == 1.25           # not a multiple of dt: t + dt
 
 
 def _scene_into(tmp_path, folder):
