@@ -105,6 +105,17 @@ def test_bad_surface_input(tmp_path):
     (tmp_path / "bad.csv").write_text("1,2,x\n3,4,5\n")
     with pytest.raises(InputError, match="path"):
         load_surface(tmp_path / "bad.csv", 1e-6)
+    # an empty file, a row, complex or boolean values: one clear error (before: a ZeroDivisionError
+    # later, a read row, the imaginary part dropped with numpy's ComplexWarning)
+    (tmp_path / "empty.txt").write_text("# no data\n")
+    np.save(tmp_path / "row.npy", np.ones((1, 9)))
+    np.save(tmp_path / "complex.npy", np.ones((8, 8)) * (1 + 1j))
+    np.save(tmp_path / "mask.npy", np.ones((8, 8), bool))
+    for name, why in [("empty.txt", r"at least 2 x 2 points, got shape \(0, 1\)"),
+                      ("row.npy", r"at least 2 x 2 points, got shape \(1, 9\)"),
+                      ("complex.npy", "real numbers, not complex128"), ("mask.npy", "real numbers, not bool")]:
+        with pytest.raises(InputError, match=why):
+            load_surface(tmp_path / name, 1e-6)
     with pytest.raises(InputError, match="dx"):
         Surface(np.zeros((8, 8)), -1.0, 1.0)
     with pytest.raises(InputError, match="hurst"):

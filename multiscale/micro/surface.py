@@ -6,6 +6,7 @@ row index ↔ y, column index ↔ x. Generated surfaces are periodic; imported o
 from __future__ import annotations
 
 import os
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -158,16 +159,22 @@ def read_matrix(path) -> np.ndarray:
             h = np.load(path, allow_pickle=False)
         elif suffix in (".txt", ".csv", ".dat", ".asc"):
             delimiter = "," if suffix == ".csv" else None
-            h = np.loadtxt(path, delimiter=delimiter, comments="#", ndmin=2)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", UserWarning)       # "input contained no data": checked below
+                h = np.loadtxt(path, delimiter=delimiter, comments="#", ndmin=2)
         else:
             raise InputError("path", str(path), "expected .npy, .txt, .csv, .dat or .asc")
+        if h.dtype.kind not in "iuf":
+            raise InputError("path", str(path), f"heights must be real numbers, not {h.dtype} (an imaginary "
+                             "part or a flag is no height)")
         h = np.asarray(h, dtype=float)
     except (ValueError, TypeError, OSError) as exc:
         if isinstance(exc, InputError):
             raise
         raise InputError("path", str(path), f"could not read a height matrix ({exc})") from None
-    if h.ndim != 2:
-        raise InputError("path", str(path), f"expected a 2-D height matrix, got shape {h.shape}")
+    if h.ndim != 2 or min(h.shape) < 2:
+        raise InputError("path", str(path), f"expected a 2-D height matrix of at least 2 x 2 points, got shape "
+                         f"{h.shape}")
     return h
 
 
