@@ -10,6 +10,7 @@ import argparse
 import dataclasses
 import os
 import sys
+import warnings
 from pathlib import Path
 
 from multiscale import __version__
@@ -17,7 +18,8 @@ from multiscale.errors import InputError, MultiscaleError, SceneError
 from multiscale.geometry import too_many_cells
 from multiscale.io import abort, ended_together
 from multiscale.micro.spectrum import surface_statistics
-from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition, formats, read_topography
+from multiscale.micro.topography import (DETREND, MAX_UNDEFINED, TopographyWarning, condition, formats,
+                                        read_topography)
 from multiscale.outputs import analysis, plan
 from multiscale.outputs import summary as plan_summary
 from multiscale.scene import load
@@ -228,7 +230,9 @@ def _surface(args) -> int:
     pixel, unit, cutoff = (_length(o, v) for o, v in (("--pixel-size", args.pixel_size),
                                                        ("--height-unit", args.height_unit), ("--cutoff", args.cutoff)))
     try:
-        measurement = read_topography(args.file, args.channel, pixel_size=pixel, height_unit=unit)
+        with warnings.catch_warnings():
+            warnings.simplefilter("ignore", TopographyWarning)      # the report's "warning:" lines say them
+            measurement = read_topography(args.file, args.channel, pixel_size=pixel, height_unit=unit)
         done = condition(measurement, args.detrend, cutoff, args.max_undefined)
     except InputError as exc:     # the micro fields by their command-line names
         name = "FILE" if exc.name == "file" else "--" + exc.name.replace("_", "-")

@@ -3,6 +3,7 @@ sizes and RMS values equal its own), channels and overrides, one clear error per
 conditioning steps checked against exact answers: harmonic filling of a plane, form removal, the
 ISO 16610-61 Gaussian filter's transmission, resampling and covering an interface."""
 import os
+import warnings
 from pathlib import Path
 
 import numpy as np
@@ -256,8 +257,8 @@ def test_undefined_points_of_a_plain_matrix_are_filled_like_an_instrument_files(
         read_topography(tmp_path / "inf.npy", pixel_size=1e-6)
 
 
-@pytest.mark.parametrize("heights", [np.zeros((32, 32)), np.ones((32, 32)),
-                                     np.add.outer(np.arange(32) * 1e-3, np.arange(32) * 2e-3)])
+@pytest.mark.parametrize("heights", [np.zeros((32, 32)), np.ones((32, 32)) * 1e-3,
+                                     np.add.outer(np.arange(32) * 1e-5, np.arange(32) * 2e-5)])
 def test_a_flat_or_planar_matrix_has_no_roughness(tmp_path, heights):
     """A constant or a plane leaves only round-off after the form removal: one InputError naming
     the file (before: the zeros were refused by the spectrum under a Python name, a constant or a
@@ -266,6 +267,25 @@ def test_a_flat_or_planar_matrix_has_no_roughness(tmp_path, heights):
     m = read_topography(tmp_path / "flat.npy", pixel_size=1e-6)
     with pytest.raises(InputError, match=r"file = 'flat.npy': no roughness is left after the form removal"):
         condition(m, prefix="roughness.")
+
+
+def test_heights_in_the_wrong_unit_are_warned_about_and_an_overflow_refused(tmp_path, capsys):
+    """A matrix in um read as metres (Sq 2 m on a 20 mm pin ran to the end without a word): a
+    warning naming the file and height_unit, also in `multiscale check`; heights whose spread
+    overflows (1e294) one InputError (before: Sq inf, then a ContactNonFiniteError in every zone)."""
+    from multiscale.micro.topography import TopographyWarning, probe_topography
+    h = fractal_surface(32, 32e-6, 0.8, 2, 8, 1e-6, seed=1).heights
+    np.save(tmp_path / "um.npy", h * 1e6)
+    with pytest.warns(TopographyWarning, match=r"roughness\.file = 'um.npy': heights up to [0-9.]+ m \(Sq [0-9.]+ m, "
+                      r"one unit of the file = m\), far beyond a rough surface's: is roughness\.height_unit right\?"):
+        read_topography(tmp_path / "um.npy", pixel_size=1e-6, prefix="roughness.")
+    assert probe_topography(tmp_path / "um.npy", pixel_size=1e-6)[1][0].startswith("file = 'um.npy': heights up to")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", TopographyWarning)
+        read_topography(tmp_path / "um.npy", pixel_size=1e-6, height_unit=1e-6)      # in its unit: no word
+    np.save(tmp_path / "huge.npy", h * 1e300)
+    with pytest.raises(InputError, match=r"file = 'huge.npy': heights up to .* m overflow"):
+        read_topography(tmp_path / "huge.npy", pixel_size=1e-6)
 
 
 def test_a_plain_matrix_has_one_channel(tmp_path):

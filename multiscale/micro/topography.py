@@ -33,6 +33,7 @@ from multiscale.micro.surface import Surface, read_matrix
 
 MATRIX_SUFFIXES = (".npy", ".txt", ".csv", ".asc")    # plain height matrices (no units in the file)
 MAX_UNDEFINED = 0.1       # default largest fraction of undefined points that is filled
+TALLEST = 1e-2            # m: heights beyond are no roughness measurement (an instrument's z range is mm)
 DETREND = {"none": None, "mean": "mean", "plane": "height", "poly2": "curvature"}   # -> SurfaceTopography
 COVER = ("measured", "mirror", "tile", "equivalent")
 ALPHA = np.sqrt(np.log(2) / np.pi)     # ISO 16610-21/-61 Gaussian: 50 % transmission at the cut-off
@@ -139,7 +140,10 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
         if np.any(np.isinf(h)):
             raise InputError(f"{prefix}file", path.name, "the height matrix holds infinite values (NaN marks an "
                              "undefined point)")
-        return Measurement(h, *pair, path, 0, "matrix", None)
+        notes = _height_range(h, path, prefix, "m" if height_unit is None else f"{height_unit:.4g} m")
+        for note in notes:
+            warnings.warn(note, TopographyWarning, stacklevel=2)
+        return Measurement(h, *pair, path, 0, "matrix", None, tuple(notes))
     ch = _channel(_reader(path, f"{prefix}file"), path, channel, prefix)
     unit = ch.unit if isinstance(ch.unit, str) else None
     notes = []
@@ -170,9 +174,24 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
     h = np.ma.filled(np.ma.masked_invalid(np.ma.asarray(raw, dtype=float)), np.nan).T * factor
     if not np.isfinite(h).any():
         raise InputError(f"{prefix}file", path.name, f"channel {ch.index} (\"{ch.name}\") holds no defined height")
+    notes += _height_range(h, path, prefix, f"{factor:.4g} m")
     for note in notes:
         warnings.warn(note, TopographyWarning, stacklevel=2)
     return Measurement(h, dx, dy, path, ch.index, str(ch.name), unit, tuple(notes))
+
+
+def _height_range(h: np.ndarray, path: Path, prefix: str, unit: str) -> list[str]:
+    """A note if the heights [m] (NaN: undefined) reach beyond ``TALLEST`` (heights read in the
+    wrong unit, e.g. um as m); an InputError if their spread overflows."""
+    with np.errstate(over="ignore", invalid="ignore"):
+        peak, sq = float(np.nanmax(np.abs(h))), float(np.nanstd(h))
+    if not np.isfinite(sq):
+        raise InputError(f"{prefix}file", path.name, f"heights up to {peak:.3g} m overflow (one unit of the "
+                         f"file = {unit}): is {prefix}height_unit right?")
+    if peak > TALLEST:
+        return [f"{prefix}file = '{path.name}': heights up to {peak:.3g} m (Sq {sq:.3g} m, one unit of the file = "
+                f"{unit}), far beyond a rough surface's: is {prefix}height_unit right?"]
+    return []
 
 
 def probe_topography(path, channel: int | None = None, *, pixel_size=None, height_unit=None,
