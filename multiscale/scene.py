@@ -303,6 +303,15 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
     if unused and "contact" in effects and not {"thermal", "wear", "stability"} & set(effects):
         warnings.append(f'{", ".join(unused)}: ignored without effect "thermal" or "wear": the run is one contact '
                         "solve at t = 0")
+    end = scene.time.end if scene.time is not None else None
+    for key in ("load_profile", "speed_profile") if scene.loading is not None and end is not None else ():
+        table = getattr(scene.loading, key)
+        if table is not None and (table[0][0] > 0 or table[-1][0] < end):
+            unit = " rad/s" if key == "speed_profile" else ""
+            held = ([f"at {table[0][1]:g}{unit} before {table[0][0]:g} s"] if table[0][0] > 0 else []) + \
+                   ([f"at {table[-1][1]:g}{unit} from {table[-1][0]:g} s to time.end = {end:g} s"]
+                    if table[-1][0] < end else [])
+            warnings.append(f"loading.{key} is held {' and '.join(held)} (it does not cover the run)")
     if g is not None and scene.materials is not None and scene.time is not None:
         T0 = scene.time.initial_temperature       # every property of a run starts there
         warnings += [f"materials.{name}.{phrase} (the initial temperature)" for name in g.materials

@@ -349,6 +349,12 @@ def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
     assert static.warnings[-1] == ('time.end, time.steps: ignored without effect "thermal" or "wear": the run is '
                                    "one contact solve at t = 0")
     assert not any("time.steps" in w for w in loads(text + "[time]\nsteps = 1\nsubsteps = 1\n", tmp_path).warnings)
+    # a profile that does not cover the run is held at its ends: said (before: silently)
+    short = loads(pod.replace("[loading]", '[loading]\nload_profile = [["1 s", 1], ["5 s", 0.5]]\n'
+                              'speed_profile = [["0 s", "60 rpm"], ["20 s", "30 rpm"]]'), tmp_path)
+    assert [w for w in short.warnings if "profile" in w] == [
+        "loading.load_profile is held at 1 before 1 s and at 0.5 from 5 s to time.end = 30 s (it does not cover the run)",
+        "loading.speed_profile is held at 3.14159 rad/s from 20 s to time.end = 30 s (it does not cover the run)"]
 
 
 @pytest.mark.parametrize("old, new, warning", [
