@@ -22,7 +22,7 @@ from pathlib import Path
 
 from multiscale.errors import InputError, SceneError
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
-                               read, show, unknown_keys)
+                               read, reference, show, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
 from multiscale.scene_sections import (COUPLING_DEFAULT, DEFAULT_GRID, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
@@ -72,6 +72,11 @@ class InterfacesSection(Named):
 
     def __init__(self):
         super().__init__(InterfaceSettings)
+
+    def reference(self, path: str) -> list[str]:
+        """The keys of ``multiscale check --keys``, with the override sub-tables."""
+        return reference(InterfaceSettings, f"{path}.<name>") + [
+            f"  [{path}.<name>.roughness], [{path}.<name>.micro]: keys of [roughness] or [micro] for this interface"]
 
     def read(self, raw, path, ctx):
         if not isinstance(raw, dict):

@@ -571,17 +571,18 @@ def read(cls, raw, path: str, ctx: Context):
 def reference(cls, path: str = "") -> list[str]:
     """Every key of ``cls`` (recursively) with what it accepts and when it is needed: the scene
     format reference printed by ``multiscale check --keys``."""
-    lines = []
+    lines, nested = [], []          # a table's own keys and rules first, then its sub-tables
     for name, spec in fields_of(cls):
         where = f"{path}.{name}" if path else name
         when = ("required" if spec.required else
                 f"needed by {', '.join(spec.needed_by)}" + (f" unless {', '.join(spec.unless)}" if spec.unless else "")
                 if spec.needed_by else "optional")
         if isinstance(spec.parser, Section):
-            header = {Tables: f"[[{where}]]", Named: f"[{where}.<name>]"}.get(type(spec.parser), f"[{where}]")
+            header = f"[[{where}]]" if isinstance(spec.parser, Tables) else \
+                f"[{where}.<name>]" if isinstance(spec.parser, Named) else f"[{where}]"
             sub = spec.parser.reference(where) if hasattr(spec.parser, "reference") else \
                 reference(spec.parser.cls, where + (".<name>" if isinstance(spec.parser, Named) else ""))
-            lines += ["", f"{header}  ({when})"] + sub
+            nested += ["", f"{header}  ({when})"] + sub
             continue
         default = next(f.default for f in dataclasses.fields(cls) if f.name == name)
         if default is not None and not spec.required:
@@ -589,4 +590,4 @@ def reference(cls, path: str = "") -> list[str]:
         lines.append(f"  {name:<20} {spec.parser.describe()}  [{when}]")
     for rule in getattr(cls, "rules", ()):
         lines.append(f"  rule: {rule.text()}")
-    return lines
+    return lines + nested

@@ -402,6 +402,12 @@ def test_reference_lists_every_section_and_key():
         assert (f"[{name}" in text) or (f"  {name} " in text), name
     for key in ("penalty", "k_w_table", "partition_law", "modes", "thickness", "initial_temperature"):
         assert f"  {key} " in text
+    # a table's own keys and rules before its sub-tables (before: [loading]'s keys after
+    # vehicle's were listed under [loading.vehicle], its rules under [loading.stribeck])
+    sections = {block.split("\n")[0].split("  (")[0]: block for block in text.split("\n\n")}
+    assert "  ramp_steps " in sections["[loading]"] and "rule: one of normal_force, pressure" in sections["[loading]"]
+    assert "friction" not in sections["[loading.vehicle]"] and "rule" not in sections["[loading.stribeck]"]
+    assert "  rough " in sections["[interfaces.<name>]"] and "[interfaces.<name>.roughness]" in text
 
 
 def test_overrides_are_validated_like_the_file(tmp_path):
