@@ -10,7 +10,8 @@ rho c) and the conductivity kappa(T) [W/(m K)],
 
 w = 0 in body 0 and w = omega e × (x − c) in the rotating body 1 (steady sliding seen from the lab
 frame; a translating body is accepted only at rest, w = 0). Backward Euler in time, P1 in space,
-SUPG on body 1 with tau = [(2/dt)^2 + (2|w|/h)^2 + 9 (4 chi/h^2)^2]^(-1/2), chi = kappa/(rho c):
+the storage term lumped (vertex quadrature) in a body without transport, so that a heat pulse
+thinner than the elements neither under- nor overshoots (``Thermal._storage_dx``), SUPG on body 1 with tau = [(2/dt)^2 + (2|w|/h)^2 + 9 (4 chi/h^2)^2]^(-1/2), chi = kappa/(rho c):
 find T^{n+1} such that for every test function r
 
     ∫ [(e(T^{n+1}) − e(T^n))/dt r + kappa ∇T^{n+1}·∇r + rho c (w·∇T^{n+1}) r] dx + SUPG
@@ -195,10 +196,7 @@ class Thermal:
         F = []
         for i in range(2):
             conduction = self.kappa[i] * ufl.dot(ufl.grad(self.T[i]), ufl.grad(r[i]))
-            if self.capacity[i].constant:
-                F.append((self._rate(i) * r[i] + conduction) * self._dx(i))
-            else:
-                F.append(self._rate(i) * r[i] * self._dx(i, ENTHALPY_QUADRATURE) + conduction * self._dx(i))
+            F.append(self._rate(i) * r[i] * self._storage_dx(i) + conduction * self._dx(i))
         if self.transport:
             F[1] += self._advection(r[1])
         Fi = contact.heat_residuals(self.T[0], self.T[1], r[0], r[1], frictional_heat=frictional_heat,
@@ -237,10 +235,23 @@ class Thermal:
             self.problem.solver.setMonitor(self._watch)
 
     # ---- forms -----------------------------------------------------------------------------
-    def _dx(self, i: int, degree: int | None = None):
-        """Volume measure of body i on the parent mesh (optionally a fixed quadrature degree)."""
+    def _dx(self, i: int, degree: int | None = None, scheme: str | None = None):
+        """Volume measure of body i on the parent mesh (optionally a fixed quadrature degree, or
+        the "vertex" scheme: the nodal values weighted by a quarter of each tetrahedron)."""
         tags = tuple(reg.tag for reg in self.tm.bodies[i].spec.regions)
+        if scheme is not None:
+            return self.tm.dx(tags, degree=1, scheme=scheme)
         return self.tm.dx(tags) if degree is None else self.tm.dx(tags, degree=degree)
+
+    def _storage_dx(self, i: int):
+        """Measure of body i's storage term (and stored heat): the vertex rule, i.e. a lumped
+        capacity, in a body without transport (the discrete maximum principle of backward Euler:
+        a heat pulse thinner than the elements gave a consistent capacity 65 K and 2863 K in the
+        car-brake pads from 303 K; Abaqus lumps first-order heat-transfer elements the same way);
+        the transported body 1 keeps the consistent one (its SUPG term weighs the same residual)."""
+        if not (i == 1 and self.transport):
+            return self._dx(i, scheme="vertex")
+        return self._dx(i) if self.capacity[i].constant else self._dx(i, ENTHALPY_QUADRATURE)
 
     def _rate(self, i: int):
         """(e(T) − e(T_old))/dt [W/m^3]: rho c (T − T_old)/dt for a constant rho c."""
@@ -452,11 +463,11 @@ class Thermal:
     def stored_heat(self) -> tuple:
         """Heat stored in each body since the start [J], ∫ (e(T) − e(T_0)) dx (rho c (T − T_0) for
         a constant rho c)."""
-        def energy(i):
+        def energy(i):          # with the storage term's own quadrature: the balance is exact
             p = self.capacity[i]
             if p.constant:
-                return self.rho_c[i] * (self.T[i] - self.T_ref) * self._dx(i)
-            return p.integral(self.T[i], self.T_ref) * self._dx(i, ENTHALPY_QUADRATURE)
+                return self.rho_c[i] * (self.T[i] - self.T_ref) * self._storage_dx(i)
+            return p.integral(self.T[i], self.T_ref) * self._storage_dx(i)
         return tuple(self.cache.scalar(("stored", i), lambda: energy(i)) for i in range(2))
 
     def facet_temperature(self, side: int = 0) -> np.ndarray:
