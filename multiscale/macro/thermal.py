@@ -11,7 +11,8 @@ rho c) and the conductivity kappa(T) [W/(m K)],
 w = 0 in body 0 and w = omega e × (x − c) in the rotating body 1 (steady sliding seen from the lab
 frame; a translating body is accepted only at rest, w = 0). Backward Euler in time, P1 in space,
 the storage term lumped (vertex quadrature) in a body without transport, so that a heat pulse
-thinner than the elements neither under- nor overshoots (``Thermal._storage_dx``), SUPG on body 1 with tau = [(2/dt)^2 + (2|w|/h)^2 + 9 (4 chi/h^2)^2]^(-1/2), chi = kappa/(rho c):
+thinner than the elements neither under- nor overshoots (``Thermal._storage_dx``), SUPG on body 1
+with tau = [(2/dt)^2 + (2|w|/h)^2 + 9 (4 chi/h^2)^2]^(-1/2), chi = kappa/(rho c):
 find T^{n+1} such that for every test function r
 
     ∫ [(e(T^{n+1}) − e(T^n))/dt r + kappa ∇T^{n+1}·∇r + rho c (w·∇T^{n+1}) r] dx + SUPG
