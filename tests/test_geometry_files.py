@@ -481,3 +481,15 @@ def test_the_friction_force_of_several_pads_is_the_sum_of_theirs(tmp_path):
     assert h["friction_force"][-1] == pytest.approx(h["friction_force_pad_a"][-1] + h["friction_force_pad_b"][-1],
                                                     rel=1e-12)
     assert h["friction_force"][-1] == pytest.approx(0.4 * 1000, rel=1e-3)
+
+
+def test_a_solid_free_to_move_is_named_as_the_likely_cause_of_a_failed_solve(tmp_path):
+    """Without the pads' side supports nothing holds them sideways: the first linear solve fails,
+    and the error says what usually causes that (before: only "SNES reason -3")."""
+    from multiscale.errors import ConvergenceError
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO)
+    text = TWO_PADS.replace("{folder}", str(tmp_path / "out")).replace(
+        '[[boundary]]\nsurfaces = ["sides"]\nfix = ["x", "y"]\n', "")
+    with pytest.raises(ConvergenceError, match=r"SNES reason -3, .* the linear solve failed, as it does when a body, "
+                                               r"or a solid of one, can move as a rigid body: give each a support"):
+        run(loads(text, tmp_path), verbose=False)

@@ -356,6 +356,10 @@ class Mechanics:
         if not result.converged:
             failed = "" if self.factors.inner is None else mumps.describe(self.factors.inner)  # same on every rank
             cause = f"; the preconditioner's factorisation failed: {failed}" if failed else ""
+            if result.reason == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE:
+                cause += ("; the linear solve failed, as it does when a body, or a solid of one, can move as a "
+                          "rigid body: give each a support ([[boundary]] fix) or a contact that holds it in "
+                          "every direction (friction does not hold a body)")
             raise ConvergenceError(
                 f"contact Newton did not converge at load {float(self.load.value):.6g} "
                 f"(SNES reason {result.reason}, {result.iterations} iterations, residuals "
