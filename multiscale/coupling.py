@@ -147,6 +147,7 @@ class MicroStep:
     seconds: float
     plastic_fraction: float = 0.0  # largest share of a zone's cells at the hardness (0 without plasticity)
     real_area: float = 0.0     # m^2, real contact area summed over the loaded zones (before wear)
+    law_reach: float = 0.0     # largest zone pressure over the top of its law (> 1: extrapolated)
 
 
 @dataclass
@@ -286,7 +287,8 @@ class Multiscale:
         max_p = np.concatenate(max_p)
         return MicroStep(len(loaded), float(load.pressure.max()), float(max_p.max(initial=0.0)),
                          float(np.nanmax(hot)) if np.isfinite(hot).any() else np.nan, (np.nan,) * 3, 0.0,
-                         _time.perf_counter() - t0, float(np.concatenate(flow).max(initial=0.0)), real)
+                         _time.perf_counter() - t0, float(np.concatenate(flow).max(initial=0.0)), real,
+                         float(np.max(load.pressure[loaded] / self.rough.law_top[loaded], initial=0.0)))
 
     def _hardness_temperature(self, ids, rough_temperature) -> np.ndarray | None:
         """Where the zones ``ids`` take H(T): with ``settings.flash_softening``, their flash
@@ -513,7 +515,7 @@ class Multiscale:
         row = self.model.record(result.heat)
         row.update(zones_in_contact=micro.loaded * on, laws_computed=self.rough.laws_computed,
                    max_zone_pressure=micro.zone_pressure * on, micro_max_pressure=micro.max_pressure * on,
-                   real_contact_area=micro.real_area * on)
+                   real_contact_area=micro.real_area * on, law_reach=micro.law_reach * on)
         if self.post.heating is not None:
             row.update(micro_max_temperature=micro.max_temperature, partition_min=micro.partition[0],
                        partition_mean=micro.partition[1], partition_max=micro.partition[2],
@@ -539,10 +541,8 @@ class Multiscale:
     # ---- checkpoints -----------------------------------------------------------------------
     def _functions(self) -> dict:
         m = self.model
-        out = {f"u{i}": u for i, u in enumerate(m.mechanics.u)}
-        if m.thermal is not None:
-            out.update({f"T{i}": T for i, T in enumerate(m.thermal.T)})
-        return out
+        return {**{f"u{i}": u for i, u in enumerate(m.mechanics.u)},
+                **({f"T{i}": T for i, T in enumerate(m.thermal.T)} if m.thermal is not None else {})}
 
     def save(self, path: Path, step: int, history: io.History) -> None:
         """Checkpoint after macro step ``step`` (collective)."""

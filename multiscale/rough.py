@@ -142,6 +142,12 @@ class RoughInterface:
         """Nominal area of every zone [m^2]."""
         return np.array([z.area for z in self.zones])
 
+    @property
+    def law_top(self) -> np.ndarray:
+        """Largest pressure of every zone's law [Pa]: p_max, halved where a law failed (beyond it
+        the facet law is extrapolated linearly)."""
+        return self.spec.p_max / 2.0 ** self.levels
+
     def zone_frames(self) -> tuple[np.ndarray, np.ndarray]:
         """Centre (Z, 3) [m] of every zone in space and the (Z, 2, 3) in-plane directions (e_u, e_v)
         of its interface (zone coordinates and sliding directions are along these)."""

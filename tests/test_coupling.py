@@ -1,6 +1,7 @@
 """The multiscale loop (thesis §1.4–1.5, ch. 7): facet laws in UFL, the ch. 1 block verification,
 the seam against perfect contact, wear bookkeeping, checkpoints and resume."""
 import dataclasses
+import json
 from types import SimpleNamespace
 
 from pathlib import Path
@@ -270,6 +271,23 @@ def test_rough_pin_on_disc_bookkeeping_and_outputs(straight):
         assert f.exists() and f.stat().st_size > 0
     text = (result.folder / "interface.xdmf").read_text()
     assert all(name in text for name in ("contact_stiffness", "partition", "wear_depth"))
+    # the zone pressures against the top of their laws (default p_max 20 x nominal): inside
+    tops = 20 * 200 / 400e-6
+    np.testing.assert_allclose(h["law_reach"], h["max_zone_pressure"] / tops, rtol=1e-12)
+    assert 0 < h["law_reach"].max() < 1
+    assert not json.loads((result.folder / "provenance.json").read_text())["warnings"]
+
+
+def test_zone_pressures_above_the_laws_are_warned_about(tmp_path):
+    """micro.p_max below the zone pressures: the laws are extrapolated linearly above it, which the
+    run says after its end (before: no word, with zone pressures 48 x the top of the laws)."""
+    h = run_pod(tmp_path / "low", {"micro.p_max": "0.2 MPa", "time.steps": 1, "time.end": "0.6 s"})
+    assert h["law_reach"].max() == pytest.approx(h["max_zone_pressure"].max() / 0.2e6, rel=1e-12)
+    assert h["law_reach"].max() > 2
+    record = json.loads((tmp_path / "low" / "provenance.json").read_text())
+    assert record["warnings"] == [f"the zone pressures reached {h['law_reach'].max():.3g} times the top of their laws "
+                                  "(micro.p_max, halved for a zone whose law failed): beyond it a law is extrapolated "
+                                  "linearly; raise micro.p_max"]
 
 
 

@@ -69,7 +69,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         result.files += [result.folder / name for name in outputs.PROVENANCE]
         return result
     script = result.folder / "paraview.py"
-    beyond = tables_left(scene, getattr(result, "history", None))
+    beyond = run_warnings(scene, getattr(result, "history", None))
     for line in beyond if comm.rank == 0 and verbose else ():
         print(f"warning: {line}", file=sys.stderr, flush=True)
 
@@ -84,12 +84,16 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     return result
 
 
-def tables_left(scene, history) -> list[str]:
-    """Warnings for the material tables a run's temperatures left (held constant beyond their
-    ends, ``Material.beyond``): the largest temperature over the history of the bodies made of
-    each material, for the tables the initial temperature (checked when the scene is read) was in."""
+def run_warnings(scene, history) -> list[str]:
+    """What a run's history shows it extrapolated: material tables its temperatures left (held
+    constant beyond their ends, ``Material.beyond``: the largest temperature over the history of
+    the bodies made of each material, for the tables the initial temperature, checked when the
+    scene is read, was in), and zone pressures above the top of their laws (extrapolated linearly)."""
     if history is None:
         return []
+    reach = float(np.max(history["law_reach"])) if "law_reach" in history.columns else 0.0
+    laws = [f"the zone pressures reached {reach:.3g} times the top of their laws (micro.p_max, halved for a "
+            "zone whose law failed): beyond it a law is extrapolated linearly; raise micro.p_max"] if reach > 1 else []
     T0, hottest = scene.time.initial_temperature, {}
     for body in scene.geometry.spec.bodies:
         column = f"max_temperature_{body.name}"
@@ -100,7 +104,7 @@ def tables_left(scene, history) -> list[str]:
         known = scene.materials[name].beyond(T0)
         out += [f"materials.{name}.{phrase} (in the {body})"
                 for key, phrase in scene.materials[name].beyond(T).items() if key not in known]
-    return out
+    return out + laws
 
 
-__all__ = ["RunResult", "run", "tables_left", "workflow"]
+__all__ = ["RunResult", "run", "run_warnings", "workflow"]
