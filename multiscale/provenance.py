@@ -76,7 +76,7 @@ def _table(cls, obj) -> dict:
               for k in rule.keys}            # defaults of keys allowed only with an absent one
     for name, spec in fields_of(cls):
         v = getattr(obj, name)
-        if v is None or name in unused:
+        if v is None or (isinstance(v, str) and v == "") or name in unused:     # "": no description
             continue
         parser = spec.parser
         if isinstance(parser, Named):
