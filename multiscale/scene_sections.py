@@ -14,6 +14,7 @@ from pathlib import Path
 
 from multiscale.errors import InputError
 from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_topography
+from multiscale.scene_geometry import LengthUnit
 from multiscale.scene_stability import Stribeck
 from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, ListOf, OneOf, OnlyWith, Pair,
                                Quantity, Requires, Section, TableOr, Tables, Text, Vector, key)
@@ -433,7 +434,7 @@ class Roughness:
     file: Path | None = key(FilePath())                                       # measured topography
     channel: int | None = key(Integer(ge=0))                                  # default: the file's default
     pixel_size: tuple | None = key(Pair(_LENGTH))                             # m, (dx, dy): overrides the file's
-    height_unit: float | None = key(_LENGTH)                                  # m per file height unit
+    height_unit: float | None = key(Either(_LENGTH, LengthUnit()))    # m per file height unit ("1 um" or "um")
     detrend: str = key(Choice(tuple(DETREND)), default="plane")               # form removal
     cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)))  # m, Gaussian filter λc
     max_undefined: float = key(Quantity("dimensionless", ge=0, le=1), default=MAX_UNDEFINED)

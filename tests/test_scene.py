@@ -292,12 +292,17 @@ def test_sections_of_later_effects_validate_in_si(tmp_path):
 
 
 def test_measured_surface_path_is_relative_to_the_scene(tmp_path):
+    from multiscale.provenance import resolved_toml
     (tmp_path / "data").mkdir()
     np.save(tmp_path / "data" / "pin.npy", np.zeros((8, 8)))
     text = GOOD + '[roughness]\nbody = "block"\nfile = "data/pin.npy"\npixel_size = "20 um"\nheight_unit = "1 um"\n'
     rough = loads(text, tmp_path).roughness
     assert rough.file == (tmp_path / "data" / "pin.npy").resolve()
     assert (rough.pixel_size, rough.height_unit) == ((2e-5, 2e-5), 1e-6)
+    for unit, size in (("um", 1e-6), ("nm", 1e-9), ("mm", 1e-3)):     # a unit's name, as geometry.unit takes
+        again = loads(text.replace('"1 um"', f'"{unit}"'), tmp_path)
+        assert again.roughness.height_unit == pytest.approx(size) and resolved_toml(again) == resolved_toml(
+            loads(resolved_toml(again), tmp_path))
     with pytest.raises(SceneError, match="no such file"):
         loads(text.replace("data/pin.npy", "pin.npy"), tmp_path)
 
