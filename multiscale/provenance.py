@@ -180,12 +180,13 @@ def now() -> str:
 
 def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict, wall_time: float,
           status: str = "finished", command: list[str] | None = None, analysis: str = "",
-          files: list[str] = (), warnings: list[str] = ()) -> list[Path]:
+          files: list[str] = (), warnings: list[str] = (), running: bool = False) -> list[Path]:
     """``scene.toml`` (the file as given; the resolved scene when it came from text),
     ``scene_resolved.toml`` and ``provenance.json`` in ``folder``; call on rank 0. ``files``: the
     names of every entry the run writes (``multiscale.outputs.plan``), recorded so that
     ``results_of`` knows them when the folder is overwritten; ``warnings``: the scene's and the
-    run's (e.g. temperatures beyond a material table)."""
+    run's (e.g. temperatures beyond a material table); ``running``: written as the run begins (no
+    end time)."""
     folder = Path(folder)
     given = scene.source.read_text(encoding="utf-8") if scene.source and scene.source.is_file() else \
         "# The scene came from text, not a file: here it is as resolved.\n" + resolved_toml(scene)
@@ -194,7 +195,7 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     paths[1].write_text(resolved_toml(scene), encoding="utf-8")
     record = {"status": status, "analysis": analysis, "scene": str(scene.source or scene.name),
               "command": list(sys.argv if command is None else command), "ranks": ranks,
-              "start": started, "end": now(),
+              "start": started, "end": None if running else now(),
               "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()},
               "total_wall_time_s": round(wall_time, 3), "versions": versions(), "files": sorted(files),
               "warnings": list(warnings)}

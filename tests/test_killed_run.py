@@ -149,6 +149,7 @@ def test_killed_mid_run_and_resumed_writes_the_uninterrupted_results(base, tmp_p
         assert 2 <= int(f.attrs["step"]) < 4 and "finished" not in f.attrs
     record = json.loads((folder / "provenance.json").read_text())       # written when the run began
     assert record["status"] == "running (or killed: no end was recorded)" and "checkpoint.h5" in record["files"]
+    assert record["end"] is None
     resumed = subprocess.run(launcher + [str(MULTISCALE), "run", str(path), "--resume", "--quiet"],
                              capture_output=True, text=True, timeout=300, start_new_session=True)
     assert resumed.returncode == 0, resumed.stderr

@@ -49,7 +49,7 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
         if not resume:                      # a killed run's folder says so and lists its files
             provenance.write(folder, scene, ranks=comm.size, started=provenance.now(), stages={}, wall_time=0.0,
                              status=RUNNING, analysis=outputs.analysis(scene), files=list(outputs.plan(scene).files),
-                             warnings=scene.warnings)
+                             warnings=scene.warnings, running=True)
     io.on_root(comm, create, f"into the output folder {folder}")
     io.reporter().folder = folder         # where a failed run leaves its provenance
     return folder
