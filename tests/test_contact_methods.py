@@ -1,7 +1,6 @@
 """The two contact methods (issue 23): the preconditioned constrained CG ("bccg", default) and
 Polonsky–Keer ("pk") give the same discrete answer; the stopping rule ends within the tolerance
 of a tight reference; iterations that do not grow like sqrt(N); batches over threads; FFT pairs per iteration."""
-import threading
 from unittest import mock
 
 import numpy as np
@@ -136,8 +135,9 @@ def test_iterations_do_not_grow_when_the_grid_is_refined():
 
 @pytest.mark.parametrize("method", ["bccg", "pk"])
 def test_batch_on_two_threads_equals_the_loop(method, monkeypatch):
-    """7 patches, chunks of at most 2: two threads, each with its part (4 and 3 patches: chunks of
-    2 + 2 and 2 + 1) and its nested start."""
+    """7 patches, chunks of at most 2, two threads: two parts (4 and 3 patches: chunks of 2 + 2 and
+    2 + 1), each with its nested start, handed to a pool of two threads (which thread runs which part
+    is the pool's: under load one thread took both, so that is not asserted)."""
     monkeypatch.setitem(contact.CHUNK_CELLS, method, 2 * 64 * 64)
     module = bccg_solver if method == "bccg" else pk_solver
     run, chunks = module.run, []
@@ -145,7 +145,7 @@ def test_batch_on_two_threads_equals_the_loop(method, monkeypatch):
     def recorded(*args):
         z = args[2] if method == "bccg" else args[3]
         if z.shape[-1] == 64:                       # not a chunk of the nested start
-            chunks.append((threading.get_ident(), z.shape[0]))
+            chunks.append(z.shape[0])
         return run(*args)
 
     monkeypatch.setattr(module, "run", recorded)
@@ -158,8 +158,7 @@ def test_batch_on_two_threads_equals_the_loop(method, monkeypatch):
         batched = solver.solve(h, load=load)
     finally:
         fft.set_threads(before)
-    assert len({ident for ident, _ in chunks}) == 2
-    assert sorted(n for _, n in chunks) == [1, 2, 2, 2]
+    assert sorted(chunks) == [1, 2, 2, 2]
     for k in range(7):
         one = solver.solve(h[k], load=load[k])
         assert batched.iterations[k] == one.iterations
