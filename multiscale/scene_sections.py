@@ -451,7 +451,7 @@ class Roughness:
             return []
         problems, notes = probe_topography(self.file, self.channel, pixel_size=self.pixel_size,
                                            height_unit=self.height_unit, max_undefined=self.max_undefined,
-                                           prefix=f"{path}.")
+                                           detrend=self.detrend, prefix=f"{path}.")
         ctx.warnings.extend(notes)
         return problems
 

@@ -294,7 +294,7 @@ def test_sections_of_later_effects_validate_in_si(tmp_path):
 def test_measured_surface_path_is_relative_to_the_scene(tmp_path):
     from multiscale.provenance import resolved_toml
     (tmp_path / "data").mkdir()
-    np.save(tmp_path / "data" / "pin.npy", np.zeros((8, 8)))
+    np.save(tmp_path / "data" / "pin.npy", np.random.default_rng(1).normal(size=(8, 8)))
     text = GOOD + '[roughness]\nbody = "block"\nfile = "data/pin.npy"\npixel_size = "20 um"\nheight_unit = "1 um"\n'
     rough = loads(text, tmp_path).roughness
     assert rough.file == (tmp_path / "data" / "pin.npy").resolve()

@@ -262,11 +262,14 @@ def test_undefined_points_of_a_plain_matrix_are_filled_like_an_instrument_files(
 def test_a_flat_or_planar_matrix_has_no_roughness(tmp_path, heights):
     """A constant or a plane leaves only round-off after the form removal: one InputError naming
     the file (before: the zeros were refused by the spectrum under a Python name, a constant or a
-    plane gave the statistics of its round-off, Sq 1e-17 m)."""
+    plane gave the statistics of its round-off, Sq 1e-17 m), also from `multiscale check`'s probe
+    (before: OK, then the run refused it)."""
     np.save(tmp_path / "flat.npy", heights)
     m = read_topography(tmp_path / "flat.npy", pixel_size=1e-6)
     with pytest.raises(InputError, match=r"file = 'flat.npy': no roughness is left after the form removal"):
         condition(m, prefix="roughness.")
+    problems, _ = probe_topography(tmp_path / "flat.npy", pixel_size=1e-6, prefix="roughness.")   # check says so
+    assert len(problems) == 1 and "roughness.file = 'flat.npy': no roughness is left" in problems[0]
 
 
 def test_heights_in_the_wrong_unit_are_warned_about_and_an_overflow_refused(tmp_path, capsys):

@@ -195,7 +195,8 @@ def _height_range(h: np.ndarray, path: Path, prefix: str, unit: str) -> list[str
 
 
 def probe_topography(path, channel: int | None = None, *, pixel_size=None, height_unit=None,
-                     max_undefined: float = MAX_UNDEFINED, prefix: str = "") -> tuple[list[str], list[str]]:
+                     max_undefined: float = MAX_UNDEFINED, detrend: str = "plane",
+                     prefix: str = "") -> tuple[list[str], list[str]]:
     """What ``read_topography`` and ``condition`` would refuse in a file, without conditioning it
     (``multiscale check``): (problems, notes), one line each; no problems for a usable file, the
     notes say what overrides the file."""
@@ -205,8 +206,24 @@ def probe_topography(path, channel: int | None = None, *, pixel_size=None, heigh
             m = read_topography(path, channel, pixel_size=pixel_size, height_unit=height_unit, prefix=prefix)
     except InputError as exc:
         return [str(exc)], []
-    too_many = _too_many_undefined(m, max_undefined, prefix)
-    return ([] if too_many is None else [str(InputError(f"{prefix}file", m.path.name, too_many))]), list(m.notes)
+    why = _too_many_undefined(m, max_undefined, prefix) or _form_only(m, detrend)
+    return ([] if why is None else [str(InputError(f"{prefix}file", m.path.name, why))]), list(m.notes)
+
+
+def _form_only(m: Measurement, detrend: str) -> str | None:
+    """Why nothing but the form ``detrend`` removes is in the heights (a constant; a plane for
+    "plane" and "poly2"), or None: the cheap part of ``condition``'s test, for ``check``."""
+    defined = np.isfinite(m.heights)
+    h, scale = m.heights[defined], float(np.max(np.abs(m.heights[defined]), initial=0.0))
+    columns = [np.ones(h.size)] + ([c[defined] for c in np.indices(m.shape)] if detrend in ("plane", "poly2") else [])
+    A = np.column_stack(columns)
+    h = h - A @ np.linalg.lstsq(A, h, rcond=None)[0]
+    return None if h.std() > FLAT * scale else _no_roughness(float(h.std()), scale)
+
+
+def _no_roughness(sq: float, scale: float) -> str:
+    return (f"no roughness is left after the form removal and filtering (Sq {sq:.3g} m against heights up to "
+            f"{scale:.3g} m: a constant or a plane, to round-off)")
 
 
 def _too_many_undefined(m: Measurement, max_undefined: float, prefix: str) -> str | None:
@@ -325,9 +342,7 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
                       f"{_um(float(surface.heights.std()))} um")
     scale = float(np.nanmax(np.abs(m.heights), initial=0.0))
     if not surface.heights.std() > FLAT * scale:
-        raise InputError(f"{prefix}file", m.path.name, "no roughness is left after the form removal and filtering "
-                         f"(Sq {float(surface.heights.std()):.3g} m against heights up to {scale:.3g} m: a constant or "
-                         "a plane, to round-off)")
+        raise InputError(f"{prefix}file", m.path.name, _no_roughness(float(surface.heights.std()), scale))
     return Conditioned(surface, waviness, tuple(report))
 
 
