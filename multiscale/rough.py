@@ -203,8 +203,10 @@ class RoughInterface:
             try:
                 laws = self.pool.laws(todo[comm.rank::comm.size], spec, gather="all")
             except LawError as exc:
-                if level == P_MAX_HALVINGS:
-                    raise
+                if level == P_MAX_HALVINGS:           # the messages name the last p_max: say how it came
+                    raise LawError([dataclasses.replace(f, message=f"{f.message}, reached by {level} halvings of "
+                                                        f"p_max = {self.spec.p_max:.3g} Pa") for f in exc.failures],
+                                   exc.result) from None
                 laws = exc.result
                 self.levels[[f.zone_id for f in exc.failures]] = level + 1
             computed += self.pool.stats.computed - self.pool.stats.failed

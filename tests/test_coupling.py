@@ -473,3 +473,15 @@ def test_plastic_pin_on_disc_caps_the_micro_pressure_and_keeps_archard(tmp_path)
     assert np.all(np.diff(h["plastic_max_depth"]) >= 0) and h["plastic_max_depth"][-1] > 0
     np.testing.assert_allclose(h["interface_force"], 200.0, rtol=1e-6)
     assert h["wear_volume"][-1] == pytest.approx(1e-14 * h["frictional_work"][-1], rel=0.01)
+
+
+def test_laws_failing_at_every_p_max_say_how_it_was_reached(tmp_path):
+    """Zones close to full contact far below p_max: their laws fail at p_max and at each of its
+    P_MAX_HALVINGS halvings; the error names the last p_max tried and how it came from the scene's
+    (before: "lower p_max (now 6.25e+06 Pa)" for a scene that set 100 MPa)."""
+    from multiscale.micro.laws import LawError
+    from multiscale.rough import P_MAX_HALVINGS
+    with pytest.raises(LawError, match=rf"close to full contact\); lower p_max \(this law's: 6.25e\+06 Pa\), reached by "
+                                       rf"{P_MAX_HALVINGS} halvings of p_max = 1e\+08 Pa"):
+        run_pod(tmp_path / "full", {"roughness.rms": "0.01 um", "micro.p_max": "100 MPa", "time.steps": 1,
+                                    "time.end": "0.6 s"})

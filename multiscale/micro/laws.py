@@ -311,7 +311,7 @@ def _batch_nodes(zones: list[Zone], spec: LawSpec) -> tuple[list[ZoneNodes], lis
         gap = z.top - approach[b] + c * pressure[b]
         problem = _monotone_problem(gap, pressure[b])
         if problem:
-            failures[b] = ZoneFailure(z.id, "InputError", problem + f"; lower p_max (now {spec.p_max:.3g} Pa)")
+            failures[b] = ZoneFailure(z.id, "InputError", problem + f"; lower p_max (this law's: {spec.p_max:.3g} Pa)")
             continue
         nodes.append(ZoneNodes(z.id, z.topography_hash, approach[b], pressure[b], gap, fraction[b],
                                iterations[b], z.top, c, extra, seconds, z.shape[0] * z.shape[1]))
