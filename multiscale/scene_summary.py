@@ -79,6 +79,12 @@ def _effect_line(scene: Scene, effect: str) -> str:
     if effect == "contact":
         return f"penalty K_n = {i.penalty:g} Pa/m" if not scene.has("roughness") else "rough per-zone laws"
     if effect == "friction":
+        if ld.friction_curve is not None:
+            return "mu(slip speed) from friction_curve: " + ", ".join(f"{mu:g} at {v:g} m/s" for v, mu in ld.friction_curve)
+        if ld.stribeck is not None:
+            st = ld.stribeck
+            return (f"Stribeck mu(v) = {st.kinetic:g} + ({st.static:g} - {st.kinetic:g}) exp(-(v / {st.speed:g} m/s)"
+                    f"^{st.exponent:g})")
         return f"Coulomb, mu = {ld.friction:g}"
     if effect == "thermal":
         return f"transient conduction in {', '.join(scene.bodies)}"

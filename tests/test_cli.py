@@ -360,3 +360,19 @@ def test_a_scene_in_its_own_output_folder_is_not_a_result(tmp_path, capsys):
         prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF)
         assert Path(path).read_text() == text
     assert sorted(p.name for p in tmp_path.iterdir()) == ["provenance.json", "scene.toml", "scene_resolved.toml"]
+
+
+@pytest.mark.parametrize("law, line", [
+    ('friction_curve = [["0 m/s", 0.6], ["1 m/s", 0.2]]', "mu(slip speed) from friction_curve: 0.6 at 0 m/s, 0.2 at 1 m/s"),
+    ('[loading.stribeck]\nstatic = 0.5\nkinetic = 0.3\nspeed = "0.5 m/s"',
+     "Stribeck mu(v) = 0.3 + (0.5 - 0.3) exp(-(v / 0.5 m/s)^1)")])
+def test_check_summarises_a_friction_law_falling_with_speed(tmp_path, capsys, law, line):
+    """check of a squeal scene with mu(v): the summary names the law (before: a TypeError
+    traceback formatting the absent constant mu; found by an adversarial test)."""
+    text = (Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml").read_text()
+    assert "friction = 0.4\n" in text
+    text = text.replace("friction = 0.4\n", law.split("\n")[0] + "\n" if law.startswith("friction_curve") else "")
+    if law.startswith("[loading.stribeck]"):
+        text += "\n" + law + "\n"
+    assert main(["check", _write(tmp_path, text.replace("../results/", str(tmp_path) + "/"))]) == 0
+    assert line in capsys.readouterr().out
