@@ -108,6 +108,13 @@ def plan(scene) -> Plan:
         files["pressure.png"] = "contact pressure on each interface at the preload"
         files["re_im.png"] = "complex eigenvalues: growth rate against frequency"
         files["energy.png"] = "strain-energy share of each component per mode"
+        if scene.stability.prestress:
+            files["prestress.csv"] = "frequency of every mode with and without the prestress stiffness"
+        if scene.stability.sweep is not None:
+            files.update({"map.csv": "every mode at every point of the sweep (frequency, growth rate, track)",
+                          "onsets.csv": "the bracketed parameter at which each track turns unstable",
+                          "map.h5": "the stability map's arrays", "map.png": "growth rate and frequency against "
+                          "the swept parameter", "map_tracks.png": "the modes' tracks over the sweep"})
     else:
         files["history.h5"] = "scalar history per step (forces, pressures, temperatures, heat), unit per dataset"
         files["history.png"] = "the history against time"

@@ -21,6 +21,7 @@ from multiscale.geometry import Rotation, builder  # noqa: E402
 from multiscale.macro import damped, eigen  # noqa: E402
 from multiscale.macro import mesh as two_body  # noqa: E402
 from multiscale.macro.friction import StribeckFriction, facet_slip_speed, friction_damping  # noqa: E402
+from multiscale.outputs import plan  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
 from multiscale.macro.operators import geometric_form, rotation_forms, rotation_velocity  # noqa: E402
 from multiscale.macro.preload import linearise, preload  # noqa: E402
@@ -167,6 +168,8 @@ def test_scene_friction_sweep_writes_the_map(tmp_path):
     run = squeal.run(scene, degree=1, verbose=False)
     names = {p.name for p in run.files}
     assert {"map.csv", "onsets.csv", "map.h5", "map.png", "map_tracks.png"} <= names
+    # what check promised (and a later --overwrite deletes; before, the map's files were missing)
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(set(plan(scene).files) - {"paraview.py"})
     smap = run.map
     np.testing.assert_allclose(smap.values, [0.0, 0.2, 0.4, 0.6])
     assert not smap.unstable()[0].any()                       # no friction: stable
@@ -181,9 +184,11 @@ def test_scene_damping_and_stribeck_options(tmp_path):
     overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 10, "output.folder": str(tmp_path / "out"),
                  "stability.rayleigh_alpha": "20 1/s", "stability.prestress": True,
                  "materials.pad.loss_factor": 0.05}
-    run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
+    scene = scenes.load(DEMO, overrides)
+    run = squeal.run(scene, degree=1, verbose=False)
     assert {"material loss factors", "prestress", "proportional damping"} <= set(run.case.terms)
     assert (tmp_path / "out" / "prestress.csv").exists()
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(set(plan(scene).files) - {"paraview.py"})
     assert np.all(np.abs(run.case.prestress.shift) < 0.01 * run.case.prestress.frequency)
     with pytest.raises(InputError, match="quadratic"):
         scenes.load(DEMO, dict(overrides, **{"stability.method": "quadratic"}))
