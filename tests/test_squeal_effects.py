@@ -213,3 +213,11 @@ def test_scene_stribeck_friction_sets_mu_per_facet_and_its_slope_damping(tmp_pat
     assert plain.terms == () and plain.modes.method == "gnhep"
     # the falling mu(v) damps negatively: on average the growth rates rise
     assert np.mean(case.modes.growth - plain.modes.growth) > 0
+
+
+def test_eigen_solver_errors_name_the_scene_keys(tmp_path):
+    """A band below the first mode: the error names stability.band (it named the solver's f_max)."""
+    overrides = {"geometry.mesh_size": "30 mm", "stability.modes": 6, "output.folder": str(tmp_path / "out"),
+                 "stability.band": ["10 Hz", "500 Hz"]}
+    with pytest.raises(InputError, match=r"^stability\.band = \(10\.0, 500\.0\): no eigenvalue in this frequency band"):
+        squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)

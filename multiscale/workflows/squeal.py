@@ -167,9 +167,16 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     name = name or scene.name
     prefix = "squeal_" + "".join(ch if ch.isalnum() else "_" for ch in name) + "_"
     mech = build_squeal_mechanics(scene, tm, degree=degree, prefix=prefix)
-    return squeal_case(mech, dict(scene.materials), name, load=drive(model_scene(scene), tm).load,
-                       steps=scene.loading.ramp_steps, band=tuple(st.band), n_modes=st.modes, target=st.target,
-                       energy=energy, options=squeal_options(scene, tm))
+    try:
+        return squeal_case(mech, dict(scene.materials), name, load=drive(model_scene(scene), tm).load,
+                           steps=scene.loading.ramp_steps, band=tuple(st.band), n_modes=st.modes, target=st.target,
+                           energy=energy, options=squeal_options(scene, tm))
+    except InputError as exc:        # the eigen solvers' arguments by their scene keys
+        keys = {"f_min": ("stability.band", st.band), "f_max": ("stability.band", st.band),
+                "n_modes": ("stability.modes", st.modes)}
+        if exc.name not in keys:
+            raise
+        raise InputError(*keys[exc.name], exc.allowed) from None
 
 
 def write_prestress_csv(effect: PrestressEffect, path) -> Path:
