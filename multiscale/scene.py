@@ -16,7 +16,9 @@ output; roughness, micro, wear and layers (the multiscale loop); stability (the 
 from __future__ import annotations
 
 import dataclasses
+import os
 import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -197,6 +199,8 @@ def load(path, overrides=None) -> Scene:
 
     ``overrides`` maps dotted key paths to raw values applied before validation (a study's sweep:
     ``{"loading.friction": 0.2, "geometry.mesh_size": "6 mm"}``); they are validated like the file."""
+    if not isinstance(path, (str, os.PathLike)):
+        raise InputError("path", path, "a scene file name (str or Path)")
     path = Path(path)
     try:
         text = path.read_text(encoding="utf-8")
@@ -209,6 +213,10 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
           overrides=None) -> Scene:
     """Validate scene TOML text; relative paths are taken from ``directory``; ``name`` is the
     default scene name (the file stem for ``load``); ``overrides`` as in ``load``."""
+    if not isinstance(text, str):
+        raise InputError("text", text, "the scene's TOML text (a str; load(path) reads a file)")
+    if overrides is not None and not (isinstance(overrides, Mapping) and all(isinstance(k, str) for k in overrides)):
+        raise InputError("overrides", overrides, 'a mapping of dotted keys to values, e.g. {"loading.friction": 0.2}')
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:

@@ -166,3 +166,20 @@ def test_temperatures_beyond_a_material_table_are_warned_about(tmp_path):
     record = json.loads((result.folder / "provenance.json").read_text())
     assert record["warnings"] == [*scene.warnings, f"materials.pin.kappa: {hottest:.4g} degC above its last point "
                                   f"20.5 degC, held at 35 there (in the pin)"]
+
+
+def test_the_python_entry_points_name_bad_arguments(tmp_path):
+    """A path where a scene is expected, overrides that are no mapping, bytes for text: one
+    InputError naming the argument (before: AttributeError / TypeError from deep inside)."""
+    from multiscale.scene import load
+    with pytest.raises(InputError, match=r"scene = 'pod.toml': a validated scene: multiscale.scene.load\(path\)"):
+        run("pod.toml")
+    path = tmp_path / "pod.toml"
+    path.write_text(pin_on_disc(tmp_path / "out"))
+    for bad in ([("time.steps", 3)], {3: 3}):
+        with pytest.raises(InputError, match="overrides = .*: a mapping of dotted keys to values"):
+            load(path, bad)
+    with pytest.raises(InputError, match="path = 3: a scene file name"):
+        load(3)
+    with pytest.raises(InputError, match="text = .*: the scene's TOML text"):
+        loads(path.read_bytes())

@@ -36,6 +36,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     Besides the analysis' results, the folder receives ``scene.toml``, ``scene_resolved.toml``,
     ``provenance.json`` (also after a failure, once the folder was prepared) and ``paraview.py``.
     ``verbose``: stage lines and the summary on rank 0."""
+    if not all(hasattr(scene, a) for a in ("has", "effects", "output")):
+        raise InputError("scene", scene, "a validated scene: multiscale.scene.load(path) or loads(text)")
     kind = workflow(scene)
     if resume and kind != "multiscale":
         why = ("the squeal analysis has no checkpoints to resume from" if kind == "squeal" else

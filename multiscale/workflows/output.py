@@ -37,7 +37,8 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
     if existing and not (overwrite or resume):
         shown = ", ".join(existing[:3]) + (", ..." if len(existing) > 3 else "")
         raise SceneError(f'output.folder = "{folder}": already holds results ({len(existing)} entries: {shown}); '
-                         "use --overwrite to replace them, --resume to continue the run, or choose another folder")
+                         "use --overwrite to replace them, --resume to continue the run (in Python: overwrite=True, "
+                         "resume=True), or choose another folder")
 
     def create():
         if existing and overwrite and not resume:
