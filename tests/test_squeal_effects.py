@@ -175,6 +175,7 @@ def test_scene_friction_sweep_writes_the_map(tmp_path):
     assert not smap.unstable()[0].any()                       # no friction: stable
     assert smap.unstable()[-1].any() and smap.onsets
     assert np.nanmax(smap.residual) < 0.05                    # measured 0.023
+    assert any(w.startswith("the stability map's modes have relative residuals up to") for w in run.warnings)
     # mu = 0.4 in the map against the nominal analysis (same preload, projected)
     f_map = np.sort(smap.frequency[2][~np.isnan(smap.frequency[2])])
     assert f_map[:8] == pytest.approx(run.case.modes.frequency[:8], rel=1e-4)    # measured 8e-6
@@ -213,6 +214,16 @@ def test_scene_stribeck_friction_sets_mu_per_facet_and_its_slope_damping(tmp_pat
     assert plain.terms == () and plain.modes.method == "gnhep"
     # the falling mu(v) damps negatively: on average the growth rates rise
     assert np.mean(case.modes.growth - plain.modes.growth) > 0
+
+
+def test_a_band_cut_short_by_the_number_of_modes_is_said(tmp_path):
+    """6 modes of a 0-16 kHz band reach ~3 kHz: the run says the rest of the band was not searched
+    (before: "6 modes up to 3017 Hz" and nothing else; found by an adversarial test)."""
+    overrides = {"geometry.mesh_size": "30 mm", "stability.modes": 6, "output.folder": str(tmp_path / "out")}
+    run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
+    top = run.case.modes.frequency.max()
+    assert top < 8e3 and run.warnings == (f"stability.modes = 6: the modes found reach {top:.0f} Hz; the band above, "
+                                          "up to 16000 Hz, was not searched (raise stability.modes)",)
 
 
 def test_eigen_solver_errors_name_the_scene_keys(tmp_path):

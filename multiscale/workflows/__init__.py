@@ -71,7 +71,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         result.files += [result.folder / name for name in outputs.PROVENANCE]
         return result
     script = result.folder / "paraview.py"
-    beyond = run_warnings(scene, getattr(result, "history", None))
+    beyond = run_warnings(scene, getattr(result, "history", None)) + list(getattr(result, "warnings", ()))
     for line in beyond if comm.rank == 0 and verbose else ():
         print(f"warning: {line}", file=sys.stderr, flush=True)
 

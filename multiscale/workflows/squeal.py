@@ -55,6 +55,7 @@ from multiscale.workflows.output import RunResult, prepare_folder
 from multiscale.workflows.rough import build_rough_interface
 
 SQUEAL_DEGREE = 2     # quadratic tetrahedra: linear ones are far too stiff in bending (tests)
+MAP_RESIDUAL = 1e-3   # a stability map's modes with larger relative residuals are warned to be approximate
 
 
 @dataclass(frozen=True)
@@ -206,6 +207,22 @@ class SquealResult(RunResult):
 
     case: SquealCase
     map: StabilityMap | None = None  # with [stability.sweep]
+    warnings: tuple = ()             # what the results leave out or approximate (one line each)
+
+
+def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
+    """Warnings: a band cut short by stability.modes, a map whose modes are approximate."""
+    st, out = scene.stability, []
+    top = float(case.modes.frequency.max(initial=0.0))
+    if st.modes is not None and len(case.modes) >= st.modes and top < 0.99 * st.band[1]:
+        out.append(f"stability.modes = {st.modes}: the modes found reach {top:.0f} Hz; the band above, up to "
+                   f"{st.band[1]:.0f} Hz, was not searched (raise stability.modes)")
+    worst = float(np.nanmax(smap.residual)) if smap is not None and np.isfinite(smap.residual).any() else 0.0
+    if worst > MAP_RESIDUAL:
+        out.append(f"the stability map's modes have relative residuals up to {worst:.1e}: its frequencies and growth "
+                   "rates are approximate, and a mode outside its basis is missed (stability.sweep.preload = \"each\" "
+                   "solves every point in full)")
+    return out
 
 
 def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = True,
@@ -242,7 +259,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
                                             lambda changed: build_squeal_mechanics(changed, tm, degree=degree,
                                                                                    prefix="squeal_map_"))
             files += squeal_map.write(smap, folder, comm)
-    result = SquealResult(folder, files, time.perf_counter() - t0, case, smap)
+    result = SquealResult(folder, files, time.perf_counter() - t0, case, smap, tuple(_left_out(scene, case, smap)))
     if verbose and comm.rank == 0:
         rep = case.report
         print(f"{scene.name}: {len(case.modes)} modes up to {case.modes.frequency.max():.0f} Hz, "
