@@ -204,3 +204,13 @@ def test_mu_zero_like_symmetric_problem_gives_real_eigenvalues():
     assert len(r) == 15 and not r.unstable().any()
     assert np.abs(r.theta.imag).max() <= 1e-8 * np.abs(r.theta).max()
     assert math.isfinite(r.time) and r.method == "gnhep"
+
+
+def test_the_mode_table_writes_no_negative_zero(tmp_path):
+    """An undamped mode's sigma and damping ratio of -0.0 are written as 0 (they read
+    -0.000000e+00; found by an adversarial test)."""
+    lam = np.array([-0.0 + 10.0j])
+    modes = eigen.ModalResult(lam, np.array([100.0]), np.zeros((1, 1), complex), np.zeros(1), (0.0, 10.0), 0.0, 1,
+                              "gnhep", 1, 1, 0.0)
+    rows = list(csv.reader(modes.write_csv(tmp_path / "modes.csv").open()))
+    assert rows[1][2] == rows[1][3] == "0.000000e+00"

@@ -95,7 +95,7 @@ class ModalResult:
             w.writerow(["mode", "frequency_Hz", "sigma_1_per_s", "damping_ratio", "unstable", "residual"])
             for j, (fr, s, z, u, e) in enumerate(zip(self.frequency, self.growth, self.damping_ratio,
                                                      self.unstable(rtol), self.errors), start=1):
-                w.writerow([j, f"{fr:.6f}", f"{s:.6e}", f"{z:.6e}", int(u), f"{e:.2e}"])
+                w.writerow([j, f"{fr:.6f}", f"{s + 0.0:.6e}", f"{z + 0.0:.6e}", int(u), f"{e:.2e}"])   # no -0
         return path
 
 

@@ -263,7 +263,9 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     if verbose and comm.rank == 0:
         rep = case.report
         print(f"{scene.name}: {len(case.modes)} modes up to {case.modes.frequency.max():.0f} Hz, "
-              f"{rep.unstable.size} unstable ({', '.join(f'{f:.0f} Hz' for f in rep.frequency[rep.unstable - 1])}), "
+              f"{rep.unstable.size} unstable"
+              + (f" ({', '.join(f'{f:.0f} Hz' for f in rep.frequency[rep.unstable - 1])})" if rep.unstable.size else "")
+              + ", "
               f"{rep.potentially_unstable.size} potentially unstable; {result.wall_time:.1f} s on {comm.size} rank(s)")
         if case.prestress is not None:
             shift = case.prestress.shift
