@@ -41,8 +41,11 @@ class Row:
 
 
 def relative_error(value: float, ref: float) -> float:
-    """|value − ref| / |ref| (|value − ref| when ref = 0)."""
-    return abs(value - ref) / abs(ref) if ref != 0 else abs(value - ref)
+    """|value − ref| / |ref|; against ref = 0, 0 for value = 0 and NaN (no relative error, shown
+    "n/a") otherwise: |value| shown as a percentage read as 6e3 % for a growth rate of 60 1/s."""
+    if ref == 0:
+        return 0.0 if value == 0 else math.nan
+    return abs(value - ref) / abs(ref)
 
 
 def collect(study: Study) -> list[Row]:
