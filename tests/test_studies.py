@@ -248,6 +248,24 @@ geometry.mesh_siz = ["2 mm", "3 mm"]
     assert 'metrics item 2 ("max_pressure:sum"): a history column, optionally with :last|:first' in err
 
 
+def test_a_squeal_scene_study_checks_its_metrics_before_running(tmp_path, capsys):
+    """A squeal scene's metrics are known before it runs: a misspelt one is refused with the
+    others (before: the whole analysis ran, then the run was recorded failed and stayed so)."""
+    scene = (ROOT / "demos" / "brake_squeal.toml").resolve()
+    path = write(tmp_path, f"""
+problem = "scene"
+scene = "{scene}"
+metrics = ["max_growth", "max_growthh"]
+[sweep]
+loading.friction = [0.3, 0.4]
+""")
+    assert main(["study", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert ('metrics item 2 ("max_growthh"): unknown metric of a squeal scene (did you mean "max_growth"?); '
+            "allowed: modes, unstable_modes, max_growth") in err
+    assert not (tmp_path / "results").exists()
+
+
 def test_shipped_study_files_are_valid():
     files = sorted((ROOT / "studies").glob("*/*.toml"))
     assert len(files) >= 8

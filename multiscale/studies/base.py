@@ -42,8 +42,9 @@ class Problem:
         """One run of validated ``params``; files it writes go under ``workdir``."""
         raise NotImplementedError
 
-    def check_metric(self, name: str) -> str | None:
-        """None if ``name`` is a metric of this problem, else the problem (one line)."""
+    def check_metric(self, name: str, scene=None) -> str | None:
+        """None if ``name`` is a metric of this problem (of its ``scene`` file, for problem
+        "scene"), else the problem (one line)."""
         if name in self.metrics:
             return None
         return f'unknown metric of problem "{self.name}"{suggest(name, self.metrics)}; allowed: ' \

@@ -87,7 +87,7 @@ def load_study(path) -> Study:
         raise SceneError("scene: missing; problem \"scene\" needs the base scene file" if scene_problem else
                          f"scene: only used with problem = \"scene\" (problem is \"{f.problem}\")")
     for i, name in enumerate(f.metrics, 1):
-        why = problem.check_metric(name)
+        why = problem.check_metric(name, f.scene)
         if why:
             ctx.problems.append(f"metrics item {i} ({show(name)}): {why}")
     before = len(ctx.problems)

@@ -13,9 +13,10 @@ from pathlib import Path
 
 import numpy as np
 
-from multiscale.errors import SceneError
+from multiscale.errors import MultiscaleError, SceneError
 from multiscale.io import History
 from multiscale.scene import load
+from multiscale.schema import suggest
 from multiscale.studies.base import Outcome, Problem, jsonable
 
 __all__ = ["SQUEAL_METRICS", "SceneProblem", "SceneRun", "failure_line", "squeal_metrics"]
@@ -55,6 +56,14 @@ def squeal_metrics(modes_csv) -> dict:
             "min_damping_ratio": float(table["damping_ratio"].min())}
 
 
+def _squeal(scene) -> bool:
+    """Whether a scene file runs the squeal analysis (False if it cannot be read: said elsewhere)."""
+    try:
+        return load(scene).has("stability")
+    except MultiscaleError:
+        return False
+
+
 @dataclass(frozen=True)
 class SceneRun:
     """A macro scene with overrides (dotted scene paths -> raw values) and MPI ranks per run."""
@@ -89,7 +98,10 @@ class SceneProblem(Problem):
         return {"scene": str(params.scene), "scene_sha256": hashlib.sha256(text).hexdigest(),
                 "overrides": jsonable(params.overrides)}
 
-    def check_metric(self, name):
+    def check_metric(self, name, scene=None):
+        if scene is not None and _squeal(scene):       # its metrics are known before it runs
+            return None if name in SQUEAL_METRICS else \
+                f'unknown metric of a squeal scene{suggest(name, SQUEAL_METRICS)}; allowed: {", ".join(SQUEAL_METRICS)}'
         column, _, reducer = name.partition(":")
         if not column or (reducer and reducer not in _REDUCERS):
             return (f"a history column, optionally with :{'|:'.join(_REDUCERS)} "
