@@ -233,11 +233,13 @@ def test_bad_study_files_give_clear_errors(tmp_path, capsys, what, change, messa
     assert "Traceback" not in err and not (tmp_path / "results").exists()
 
 
+def scene_study(tmp_path, demo: str, rest: str) -> Path:
+    """A study file of problem "scene" on a demo scene; ``rest``: its metrics and tables."""
+    return write(tmp_path, f'problem = "scene"\nscene = "{(ROOT / "demos" / demo).resolve()}"\n{rest}')
+
+
 def test_bad_scene_study_names_the_scene_path(tmp_path, capsys):
-    scene = (ROOT / "demos" / "block_on_flat.toml").resolve()
-    path = write(tmp_path, f"""
-problem = "scene"
-scene = "{scene}"
+    path = scene_study(tmp_path, "block_on_flat.toml", """
 metrics = ["interface_force:last", "max_pressure:sum"]
 [sweep]
 geometry.mesh_siz = ["2 mm", "3 mm"]
@@ -251,10 +253,7 @@ geometry.mesh_siz = ["2 mm", "3 mm"]
 def test_a_squeal_scene_study_checks_its_metrics_before_running(tmp_path, capsys):
     """A squeal scene's metrics are known before it runs: a misspelt one is refused with the
     others (before: the whole analysis ran, then the run was recorded failed and stayed so)."""
-    scene = (ROOT / "demos" / "brake_squeal.toml").resolve()
-    path = write(tmp_path, f"""
-problem = "scene"
-scene = "{scene}"
+    path = scene_study(tmp_path, "brake_squeal.toml", """
 metrics = ["max_growth", "max_growthh"]
 [sweep]
 loading.friction = [0.3, 0.4]
@@ -281,10 +280,7 @@ def test_scene_problem_errors_are_user_errors(tmp_path):
 
 def test_scene_study_runs_the_macro_scene_with_overrides(tmp_path):
     """A macro scene swept through its keys: the block-on-flat force is pressure x face area."""
-    scene = (ROOT / "demos" / "block_on_flat.toml").resolve()
-    path = write(tmp_path, f"""
-problem = "scene"
-scene = "{scene}"
+    path = scene_study(tmp_path, "block_on_flat.toml", """
 metrics = ["interface_force:last", "max_pressure:max"]
 [fixed]
 geometry.mesh_size = "5 mm"
