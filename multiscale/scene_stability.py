@@ -85,6 +85,10 @@ class Sweep:
             return [f"{where}: sweeps loading.pressure; the scene gives no loading.pressure"]
         if name == "speed" and "sliding_speed" in loading:
             return [f"{where}: an angular speed of the rotating body; this geometry translates"]
+        stability = ctx.root.get("stability") if isinstance(ctx.root.get("stability"), dict) else {}
+        if name == "speed" and not ({"friction_curve", "stribeck"} & set(loading) or stability.get("gyroscopic")):
+            ctx.warnings.append(f"{where}: nothing of the linearised system depends on the speed (a constant "
+                                "friction, stability.gyroscopic = false): every point of the map is the same")
         return []
 
 

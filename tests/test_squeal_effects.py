@@ -181,6 +181,17 @@ def test_scene_friction_sweep_writes_the_map(tmp_path):
     assert f_map[:8] == pytest.approx(run.case.modes.frequency[:8], rel=1e-4)    # measured 8e-6
 
 
+def test_a_speed_sweep_that_changes_nothing_is_warned_about(tmp_path):
+    """Speed sweep with a constant friction and no gyroscopic terms: identical points, said at
+    check (before: OK and a flat map; found by an adversarial test); with them, no warning."""
+    sweep = {"stability.sweep.speed": ["1 rad/s", "100 rad/s"], "output.folder": str(tmp_path / "out")}
+    warned = [w for w in scenes.load(DEMO, sweep).warnings if "depends on the speed" in w]
+    assert warned == ["stability.sweep.speed: nothing of the linearised system depends on the speed (a constant "
+                      "friction, stability.gyroscopic = false): every point of the map is the same"]
+    assert not any("depends on the speed" in w
+                   for w in scenes.load(DEMO, {**sweep, "stability.gyroscopic": True}).warnings)
+
+
 def test_scene_damping_and_stribeck_options(tmp_path):
     overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 10, "output.folder": str(tmp_path / "out"),
                  "stability.rayleigh_alpha": "20 1/s", "stability.prestress": True,
