@@ -89,6 +89,7 @@ def test_hertz_study_errors_match_an_independent_computation(hertz_study):
     worst = {int(r["grid"]): float(r["max_error"]) for r in rows}
     time = {int(r["grid"]): float(r["wall_time"]) for r in rows}
     text = (out / "hertz.md").read_text()
+    assert f"4 ok, 0 failed; {sum(time.values()):.1f} s of run wall time in all (failed runs included)" in text
     for tol, shown in ((0.01, "| 1 % |"), (0.05, "| 5 % |")):
         good = [g for g in GRIDS if worst[g] <= tol]
         line = next(line for line in text.splitlines() if line.startswith(shown))
