@@ -18,11 +18,13 @@ from importlib import metadata
 from pathlib import Path
 
 from multiscale import __version__
+from multiscale.outputs import plan
 from multiscale.schema import (Choice, Curve, Either, FilePath, ListOf, Named, OnlyWith, Quantity, Section, TableOr,
                                Tables, fields_of)
 from multiscale.scene import EFFECTS, Scene
 from multiscale.scene_geometry import FileGeometry, LengthUnit, Points
 
+RUNNING = "running (or killed: no end was recorded)"      # status of a run's first record
 LENGTH_UNITS = {1.0: "m", 1e-3: "mm", 1e-2: "cm", 1e-6: "um", 0.0254: "in", 0.3048: "ft"}
 
 
@@ -180,13 +182,12 @@ def now() -> str:
 
 def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict, wall_time: float,
           status: str = "finished", command: list[str] | None = None, analysis: str = "",
-          files: list[str] = (), warnings: list[str] = (), running: bool = False) -> list[Path]:
+          warnings: list[str] = ()) -> list[Path]:
     """``scene.toml`` (the file as given; the resolved scene when it came from text),
-    ``scene_resolved.toml`` and ``provenance.json`` in ``folder``; call on rank 0. ``files``: the
-    names of every entry the run writes (``multiscale.outputs.plan``), recorded so that
-    ``results_of`` knows them when the folder is overwritten; ``warnings``: the scene's and the
-    run's (e.g. temperatures beyond a material table); ``running``: written as the run begins (no
-    end time)."""
+    ``scene_resolved.toml`` and ``provenance.json`` in ``folder``; call on rank 0. The record lists
+    every entry the run writes (``multiscale.outputs.plan``), so that ``results_of`` knows them
+    when the folder is overwritten; ``warnings``: the scene's and the run's (e.g. temperatures
+    beyond a material table); status ``RUNNING`` (written as the run begins) has no end time."""
     folder = Path(folder)
     given = scene.source.read_text(encoding="utf-8") if scene.source and scene.source.is_file() else \
         "# The scene came from text, not a file: here it is as resolved.\n" + resolved_toml(scene)
@@ -195,9 +196,9 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     paths[1].write_text(resolved_toml(scene), encoding="utf-8")
     record = {"status": status, "analysis": analysis, "scene": str(scene.source or scene.name),
               "command": list(sys.argv if command is None else command), "ranks": ranks,
-              "start": started, "end": None if running else now(),
+              "start": started, "end": None if status == RUNNING else now(),
               "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()},
-              "total_wall_time_s": round(wall_time, 3), "versions": versions(), "files": sorted(files),
+              "total_wall_time_s": round(wall_time, 3), "versions": versions(), "files": sorted(plan(scene).files),
               "warnings": list(warnings)}
     paths[2].write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
     return paths
@@ -216,4 +217,4 @@ def results_of(folder: Path) -> list[str]:
     return sorted({*names, *(n + ".part" for n in names)} | ({"provenance.json"} if names else set()))
 
 
-__all__ = ["now", "resolved_toml", "results_of", "versions", "write"]
+__all__ = ["RUNNING", "now", "resolved_toml", "results_of", "versions", "write"]

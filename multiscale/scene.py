@@ -159,7 +159,8 @@ class Scene:
         folder = self.output.folder if self.output is not None else None
         if folder is None or not folder.is_dir():
             return []
-        return sorted(p.name for p in folder.iterdir() if p.resolve() not in self.inputs)
+        inputs = self.inputs          # a walk over the whole scene: once, not per entry
+        return sorted(p.name for p in folder.iterdir() if p.resolve() not in inputs)
 
     @property
     def partition(self) -> float | None:

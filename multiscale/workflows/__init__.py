@@ -14,7 +14,6 @@ import time
 from pathlib import Path
 
 import numpy as np
-
 from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs, provenance
@@ -46,7 +45,6 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         raise InputError("--resume", True, why)
     ended = resume and checkpoint.peek(Path(scene.output.folder) / multiscale.CHECKPOINT, comm).get("finished")
     started, start = provenance.now(), time.perf_counter()
-    written = list(outputs.plan(scene).files)          # recorded: a later --overwrite deletes exactly these
     with io.Reporter(comm, quiet=not verbose) as reporter:
         try:
             if kind == "multiscale":
@@ -58,11 +56,11 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             stopped = interrupted(exc)
             if reporter.folder is not None and comm.rank == 0:
                 provenance.write(reporter.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
-                                 wall_time=time.perf_counter() - start, analysis=kind, files=written,
+                                 wall_time=time.perf_counter() - start, analysis=kind,
                                  status=f"interrupted {exc}".strip() if stopped else
                                  f"failed: {type(exc).__name__}: {exc}", warnings=scene.warnings)
                 if isinstance(exc, Interrupted):          # stopped after a step: its results are written
-                    (reporter.folder / "paraview.py").write_text(outputs.paraview_script(outputs.plan(scene)))
+                    _write_script(reporter.folder, scene)
             if stopped and not isinstance(exc, KeyboardInterrupt):
                 raise KeyboardInterrupt from None          # not PETSc's error 101 around it
             raise
@@ -70,20 +68,25 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     if ended:                 # --resume of a finished run: nothing to do, its provenance stays as it was
         result.files += [result.folder / name for name in outputs.PROVENANCE]
         return result
-    script = result.folder / "paraview.py"
     beyond = run_warnings(scene, getattr(result, "history", None)) + list(getattr(result, "warnings", ()))
     for line in beyond if comm.rank == 0 and verbose else ():
         print(f"warning: {line}", file=sys.stderr, flush=True)
 
     def write():
         files = provenance.write(result.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
-                                 wall_time=time.perf_counter() - start, analysis=kind, files=written,
+                                 wall_time=time.perf_counter() - start, analysis=kind,
                                  status="resumed and finished" if resume else "finished",
                                  warnings=[*scene.warnings, *beyond])
-        script.write_text(outputs.paraview_script(outputs.plan(scene)))
-        return files + [script]
+        return files + [_write_script(result.folder, scene)]
     result.files += comm.bcast(io.on_root(comm, write, f"the provenance into {result.folder}"), root=0)
     return result
+
+
+def _write_script(folder: Path, scene) -> Path:
+    """``paraview.py`` beside the results (rank 0)."""
+    path = Path(folder) / "paraview.py"
+    path.write_text(outputs.paraview_script(outputs.plan(scene)))
+    return path
 
 
 def run_warnings(scene, history) -> list[str]:

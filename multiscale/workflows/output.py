@@ -9,9 +9,6 @@ from multiscale import io, outputs, provenance
 from multiscale.errors import InputError, SceneError
 
 
-RUNNING = "running (or killed: no end was recorded)"
-
-
 @dataclass
 class RunResult:
     """What a run wrote: its folder, the files (fields for ParaView, tables, plots) and its wall time."""
@@ -27,7 +24,8 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
     created). ``overwrite`` first deletes every entry the earlier run recorded writing
     (``provenance.results_of``: no stale field file, figure or checkpoint of another scene stays
     beside the new results) and keeps, with a message, entries no run recorded (the user's own).
-    A new run's provenance is written at once, with status ``RUNNING`` (what a killed run leaves).
+    A new run's provenance is written at once, with status ``provenance.RUNNING`` (what a killed
+    run leaves).
     Rank 0 decides for every rank (collective)."""
     folder = Path(scene.output.folder)
     if resume and not comm.bcast(folder.is_dir() if comm.rank == 0 else None, root=0):
@@ -49,8 +47,7 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
         probe.unlink()
         if not resume:                      # a killed run's folder says so and lists its files
             provenance.write(folder, scene, ranks=comm.size, started=provenance.now(), stages={}, wall_time=0.0,
-                             status=RUNNING, analysis=outputs.analysis(scene), files=list(outputs.plan(scene).files),
-                             warnings=scene.warnings, running=True)
+                             status=provenance.RUNNING, analysis=outputs.analysis(scene), warnings=scene.warnings)
     io.on_root(comm, create, f"into the output folder {folder}")
     io.reporter().folder = folder         # where a failed run leaves its provenance
     return folder
