@@ -9,7 +9,7 @@ from petsc4py import PETSc
 from multiscale.errors import InputError
 from multiscale.macro import damped, eigen
 from multiscale.macro.friction import StribeckFriction, TableFriction
-from multiscale.macro.stability_map import build_map
+from multiscale.macro.stability_map import BELOW, build_map
 from multiscale.references.stability import (belt_onset_speed, damped_hoffmann_onset, hoffmann_matrices,
                                               hoffmann_onset, rayleigh_damping_ratio, stribeck,
                                               vanishing_damping_onset)
@@ -184,3 +184,24 @@ def test_map_tracks_the_hoffmann_pair_and_bisects_its_lock_in(tmp_path):
     with h5py.File(tmp_path / "map.h5") as f:
         np.testing.assert_allclose(f["onsets/value"][:], [onset.value])
         assert f["growth"].shape == (6, 2)
+
+
+def test_map_bisects_the_onset_of_a_lock_in_branch_that_fails_the_mac_test(tmp_path):
+    """With a strict MAC threshold the coalesced pair starts new tracks at mu = 0.6; the unstable
+    one's onset is still bisected (from its stable best match at 0.4), once; a map starting above
+    the onset lists the unstable track as below the sweep."""
+    values = np.linspace(0.0, 1.0, 6)
+    sub = damped.Subspace([np.eye(2)], petsc_mat(np.eye(2)))
+    results, reduced = [], []
+    for mu in values:
+        r, red = damped.solve_projected(hoffmann_system(mu), sub, band=(0.0, 1.0), expand=False)
+        results.append(r), reduced.append(red)
+    for mac_min in (0.9, 0.999):                     # 0.999: the branch is new at every point
+        smap = build_map("friction", "-", values, results, reduced, (0.0, 1.0), xtol=1e-9, mac_min=mac_min)
+        assert smap.n_tracks > 2 and len(smap.onsets) == 1
+        assert smap.onsets[0].value == pytest.approx(MU_C, rel=1e-6) and smap.onsets[0].kind == "lock-in"
+    smap = build_map("friction", "-", values[3:], results[3:], reduced[3:], (0.0, 1.0))
+    assert [(o.kind, o.track) for o in smap.onsets] == [(BELOW, int(np.nanargmax(smap.growth[0])) + 1)]
+    assert np.isnan(smap.onsets[0].value) and "below the sweep" in smap.summary()
+    rows = smap.write_onsets_csv(tmp_path / "onsets.csv").read_text().splitlines()
+    assert rows[1].split(",")[1] == "" and rows[1].split(",")[-1] == "0.6"

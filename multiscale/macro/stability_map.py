@@ -8,7 +8,9 @@ projected on the same M-orthonormal basis V) and its modes in the band. ``build_
   coordinates, y^H y = q^H V^T V q) less the relative eigenvalue jump, MAC >= ``mac_min``
   (``modal.pair_modes``); a mode without a partner starts a new track. The tracks are the
   mode-pairing table (``map.csv``: track, mode number and MAC with the previous point);
-- finds where a track turns unstable between v_{k-1} and v_k and bisects the onset value
+- finds where a track turns unstable between v_{k-1} and v_k (a track stable at v_{k-1}, or one
+  that starts unstable at v_k because its branch failed the MAC test, e.g. at a lock-in, and whose
+  best match at v_{k-1} was stable) and bisects the onset value
   (as ``eigen.onset_of_instability`` does) on the reduced system blended linearly between the two
   points (exact where the operators are affine in the parameter: friction at a fixed preload;
   otherwise the blend is the interpolation of the linearised operators between two preloads).
@@ -16,7 +18,8 @@ projected on the same M-orthonormal basis V) and its modes in the band. ``build_
   its unstable shape at v_k. The onset's partner is the track nearest in frequency at v_k: a
   "lock-in" when at the onset the two coalesced (frequency gap <= 0.1 %), "mode coupling" when
   damping holds them apart but the partner's growth rate fell while this one's rose, otherwise
-  "negative damping" (e.g. the falling mu(v) of ``macro.friction``).
+  "negative damping" (e.g. the falling mu(v) of ``macro.friction``). A track unstable at the
+  first value is recorded as ``BELOW`` (its onset is not in the sweep; value NaN).
 
 ``MapBuilder`` takes the points one by one (per-point bases: the caller projects the two
 neighbouring points on the union of their modes for the bisection); ``build_map`` runs it on
@@ -41,6 +44,7 @@ from multiscale.macro.modal import mac_matrix, pair_modes
 
 
 LOCK_IN_GAP = 1e-3       # relative frequency gap of a coalesced (locked-in) pair
+BELOW = "below the sweep"  # kind of a track unstable at the first value: its onset is not in the sweep
 
 
 @dataclass
@@ -48,10 +52,10 @@ class Onset:
     """Where one tracked mode turns unstable."""
 
     track: int                   # track number (from 1)
-    value: float                 # onset value of the parameter (bisected)
+    value: float                 # onset value of the parameter (bisected; NaN: unstable at the first value)
     frequency: float             # Hz, of the mode at the onset
     partner: int | None          # track nearest in frequency at the first unstable point
-    kind: str                    # "lock-in", "mode coupling" (damped) or "negative damping"
+    kind: str                    # "lock-in", "mode coupling" (damped), "negative damping" or BELOW
     bracket: tuple               # (stable value, unstable value) after the bisection
 
 
@@ -94,6 +98,10 @@ class StabilityMap:
                  f"{self.values.size} points, {self.n_tracks} tracked modes (basis {self.basis_size}), "
                  f"{int(bad.sum())} unstable somewhere; max residual {np.nanmax(self.residual):.1e}; {self.time:.1f} s"]
         for o in self.onsets:
+            if o.kind == BELOW:
+                lines.append(f"    track {o.track}: unstable at the first value already ({o.frequency:.0f} Hz): "
+                             f"its onset is below the sweep")
+                continue
             lines.append(f"    track {o.track}: {o.kind} at {self.parameter} = {o.value:.6g} ({o.frequency:.0f} Hz"
                          + (f", with track {o.partner})" if o.partner is not None else ")"))
         return "\n".join(lines)
@@ -123,8 +131,8 @@ class StabilityMap:
             w.writerow(["track", f"onset_{self.parameter}_{self.unit}", "frequency_Hz", "partner_track", "kind",
                         "stable_value", "unstable_value"])
             for o in self.onsets:
-                w.writerow([o.track, f"{o.value:.8g}", f"{o.frequency:.6f}", "" if o.partner is None else o.partner,
-                            o.kind, f"{o.bracket[0]:.8g}", f"{o.bracket[1]:.8g}"])
+                w.writerow([o.track, _number(o.value), f"{o.frequency:.6f}", "" if o.partner is None else o.partner,
+                            o.kind, _number(o.bracket[0]), _number(o.bracket[1])])
         return path
 
     def write_h5(self, path) -> Path:
@@ -143,6 +151,10 @@ class StabilityMap:
         return path
 
 
+def _number(x: float) -> str:
+    return "" if np.isnan(x) else f"{x:.8g}"
+
+
 def _unstable(lam: np.ndarray, rtol: float) -> np.ndarray:
     return lam.real > rtol * np.abs(lam)
 
@@ -155,10 +167,15 @@ def _match(lam: np.ndarray, Q: np.ndarray, q_ref: np.ndarray, lam_ref: complex, 
 
 
 def bisect_onset(lo: ReducedSystem, hi: ReducedSystem, v_lo: float, v_hi: float, q_ref, lam_ref, gram, band,
-                 *, rtol: float = 1e-6, xtol: float = 1e-6, max_steps: int = 60) -> tuple[float, float, tuple]:
+                 *, rtol: float = 1e-6, xtol: float = 1e-6, max_steps: int = 60) -> tuple | None:
     """Bisect the value in [v_lo, v_hi] where the mode continuing (q_ref, lam_ref) (unstable at
     v_hi) turns unstable, on the reduced systems blended linearly; returns (value, frequency at
-    the onset [Hz], final bracket, relative frequency gap to the nearest other mode there)."""
+    the onset [Hz], final bracket, relative frequency gap to the nearest other mode there), or
+    None when that mode is unstable at v_lo already (no onset in the bracket)."""
+    lam, Q = lo.eigenpairs()
+    keep = select(lam, band, None, band[0])
+    if _unstable(lam[keep][_match(lam[keep], Q[:, keep], q_ref, lam_ref, gram)][None], rtol)[0]:
+        return None
     a, b, f_b, gap = 0.0, 1.0, lam_ref.imag / TWO_PI, np.inf
     span = abs(v_hi - v_lo)
     for _ in range(max_steps):
@@ -194,7 +211,8 @@ class MapBuilder:
 
     def add(self, value: float, result: ModalResult) -> list[tuple[int, int]]:
         """Pair ``result`` with the previous point; returns (track, mode index) of every mode that
-        is unstable here and whose track was stable at the previous point."""
+        is unstable here and whose track was stable at the previous point or starts here (a
+        branch that failed the MAC test, e.g. at a lock-in)."""
         value = float(value)
         if self.values and value <= self.values[-1]:
             raise InputError("stability.sweep", value, f"the values must increase (after {self.values[-1]:g})")
@@ -207,22 +225,31 @@ class MapBuilder:
             if here[j] < 0:
                 here[j], self.n_tracks = self.n_tracks, self.n_tracks + 1
         turned = []
-        if self.prev is not None:
+        if self.prev is None:
+            self.onsets += [Onset(here[j] + 1, np.nan, float(result.frequency[j]), None, BELOW, (np.nan, value))
+                            for j in np.nonzero(_unstable(result.eigenvalues, self.rtol))[0]]
+        else:
             was = {t: bool(_unstable(self.prev.eigenvalues[i:i + 1], self.rtol)[0])
                    for i, t in enumerate(self.rows[-1][0])}
             bad = _unstable(result.eigenvalues, self.rtol)
-            turned = [(t, j) for j, t in enumerate(here) if bad[j] and t in was and not was[t]]
+            turned = [(t, j) for j, t in enumerate(here) if bad[j] and not was.get(t, False)]
         self.values.append(value)
         self.rows.append((here, mk, result.frequency.copy(), result.growth.copy(), result.errors.copy()))
         self.prev = result
         return turned
 
-    def onset(self, track: int, j: int, lo: ReducedSystem, hi: ReducedSystem, q_ref: np.ndarray, gram) -> Onset:
+    def onset(self, track: int, j: int, lo: ReducedSystem, hi: ReducedSystem, q_ref: np.ndarray,
+              gram) -> Onset | None:
         """Bisect the onset of ``track`` (mode j of the last point, coordinates ``q_ref`` in the
-        basis of ``lo`` and ``hi``, the reduced systems at the last two points) and record it."""
+        basis of ``lo`` and ``hi``, the reduced systems at the last two points) and record it; None
+        when the mode continuing it at the previous point was unstable already (a new track that
+        continues an unstable one)."""
         r = self.prev
-        value, freq, bracket, gap = bisect_onset(lo, hi, self.values[-2], self.values[-1], q_ref, r.eigenvalues[j],
-                                                 gram, self.band, rtol=self.rtol, xtol=self.xtol)
+        found = bisect_onset(lo, hi, self.values[-2], self.values[-1], q_ref, r.eigenvalues[j], gram, self.band,
+                             rtol=self.rtol, xtol=self.xtol)
+        if found is None:
+            return None
+        value, freq, bracket, gap = found
         others = [i for i in range(len(r)) if i != j]
         partner, kind = None, "negative damping"
         if others:
@@ -247,7 +274,7 @@ class MapBuilder:
                 out["frequency"][k, t], out["growth"][k, t], out["residual"][k, t] = f[j], g[j], e[j]
                 out["mac"][k, t], mode[k, t] = mk[j], j + 1
         return StabilityMap(self.parameter, self.unit, np.array(self.values), out["frequency"], out["growth"], mode,
-                            out["mac"], out["residual"], sorted(self.onsets, key=lambda o: (o.value, o.frequency)),
+                            out["mac"], out["residual"], sorted(self.onsets, key=lambda o: (np.nan_to_num(o.value, nan=-np.inf), o.frequency)),
                             basis_size, self.rtol, time)
 
 
