@@ -279,10 +279,11 @@ def test_scene_problem_errors_are_user_errors(tmp_path):
         load_study(write(tmp_path, 'problem = "scene"\nmetrics = ["time"]\n[sweep]\n"time.steps" = [1, 2]\n'))
 
 
-def test_scene_study_runs_the_macro_scene_with_overrides(tmp_path):
-    """A macro scene swept through its keys: the block-on-flat force is pressure x face area."""
+def test_scene_study_runs_the_macro_scene_with_overrides(tmp_path, capsys):
+    """A macro scene swept through its keys: the block-on-flat force is pressure x face area. A
+    misspelt history metric fails the run's record; corrected, it is read from the same run."""
     path = scene_study(tmp_path, "block_on_flat.toml", """
-metrics = ["interface_force:last", "max_pressure:max"]
+metrics = ["interface_forc:last", "max_pressure:max"]
 [fixed]
 geometry.mesh_size = "5 mm"
 geometry.width = "6 mm"
@@ -291,8 +292,15 @@ loading.pressure = ["3 MPa"]
 [report]
 plots = false
 """)
-    assert main(["study", str(path)]) == 0
+    assert main(["study", str(path)]) == 1
     out = tmp_path / "results" / "study"
+    row = table(out / "results.csv")[0]
+    assert row["status"] == "failed"
+    assert 'metric "interface_forc:last" not produced (did you mean "interface_force:last"?)' in row["message"]
+    path.write_text(path.read_text().replace("interface_forc:", "interface_force:"))
+    capsys.readouterr()
+    assert main(["study", str(path)]) == 0
+    assert "1 recorded before, 0 run now" in capsys.readouterr().out
     row = table(out / "results.csv")[0]
     assert float(row["loading.pressure"]) == 3e6
     assert float(row["interface_force:last"]) == pytest.approx(3e6 * 10e-3 * 6e-3, rel=1e-6)

@@ -1,15 +1,18 @@
 """Run records on disk: one JSON file ``<folder>/runs/<key>.json`` per run, written atomically by
-the worker (or by ``running`` for a run that crashed or timed out)."""
+the worker (or by ``running`` for a run that crashed or timed out). A run that completed
+(``"ran": true``) keeps every metric it produced and is judged by the study's metrics when read:
+a misspelt metric of a scene's history, corrected in the study file, needs no new run."""
 from __future__ import annotations
 
 import json
+import math
 import os
 from pathlib import Path
 
-from multiscale.schema import FrozenMap
+from multiscale.schema import FrozenMap, suggest
 from multiscale.studies.expand import Study, StudyRun
 
-__all__ = ["FAILED", "json_default", "read_records", "record_path", "write_json"]
+__all__ = ["FAILED", "json_default", "metric_problem", "read_records", "record_path", "write_json"]
 
 FAILED = "failed"              # a record's status when the run did not produce its metrics
 
@@ -19,16 +22,31 @@ def record_path(study: Study, run: StudyRun) -> Path:
     return study.folder / "runs" / f"{run.key}.json"
 
 
+def metric_problem(metrics: dict, names) -> str | None:
+    """Why a run's ``metrics`` (name -> value) do not give the study's metric ``names``; None if they do."""
+    for name in names:
+        if name not in metrics:
+            return f'metric "{name}" not produced{suggest(name, metrics)}; available: {", ".join(sorted(metrics))}'
+        if not math.isfinite(metrics[name]):
+            return f'metric "{name}" is {metrics[name]} (not finite)'
+    return None
+
+
 def read_records(study: Study) -> dict:
-    """key -> record of the runs of ``study`` recorded on disk."""
+    """key -> record of the runs of ``study`` recorded on disk; a run that completed is ok or failed
+    by the study's metrics now."""
     out = {}
     for run in study.runs:
         p = record_path(study, run)
         if p.is_file():
             try:
-                out[run.key] = json.loads(p.read_text())
+                record = json.loads(p.read_text())
             except ValueError:
                 continue                  # a torn file: treat the run as not done
+            if record.get("ran") or record.get("status") == "ok":
+                why = metric_problem(record.get("metrics", {}), study.metrics)
+                record.update(status=FAILED if why else "ok", error=why or "")
+            out[run.key] = record
     return out
 
 

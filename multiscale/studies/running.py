@@ -62,7 +62,7 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     if comm is not None:
         comm.barrier()
     records = read_records(study)
-    todo = [r for r in study.runs if not _done(records.get(r.key), study.metrics, rerun_failed)]
+    todo = [r for r in study.runs if not _done(records.get(r.key), rerun_failed)]
     mine = todo[rank::size]
     bar = None
     if progress and rank == 0 and mine:
@@ -101,14 +101,10 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     return ExecStats(len(study.runs), len(study.runs) - len(todo), len(mine), failed, time.perf_counter() - start)
 
 
-def _done(record, metrics, rerun_failed: bool) -> bool:
-    """A run is done if it failed (unless retried) or recorded every metric the study asks for
-    (a study may ask for a new metric of a scene history after its runs were made)."""
-    if record is None:
-        return False
-    if record.get("status") == FAILED:
-        return not rerun_failed
-    return all(m in record.get("metrics", {}) for m in metrics)
+def _done(record, rerun_failed: bool) -> bool:
+    """A run is done if it has a record, unless that failed and failed runs are retried (a record
+    that completed is judged by the study's metrics when read: ``records.read_records``)."""
+    return record is not None and not (rerun_failed and record.get("status") == FAILED)
 
 
 def _spawn(study: Study, run: StudyRun, rank: int) -> subprocess.Popen:
