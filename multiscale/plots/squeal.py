@@ -12,6 +12,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 from matplotlib.figure import Figure
+from matplotlib.ticker import MaxNLocator
 
 
 def _save(fig: Figure, path) -> Path:
@@ -65,15 +66,18 @@ def plot_energy(case, path, split: tuple[str, str] | None = None) -> Path:
     for j, name in enumerate(sh.names):
         a.bar(n, sh.share[:, j], bottom=bottom, label=name, width=0.9)
         bottom += sh.share[:, j]
-    a.set(ylabel="strain-energy share [-]", title=f"{case.name}: share of the strain energy of each mode per component")
-    a.legend(fontsize=7, ncol=4)
+    a.set(ylabel="strain-energy share [-]", ylim=(0.0, 1.3), yticks=np.linspace(0.0, 1.0, 6),
+          title=f"{case.name}: share of the strain energy of each mode per component")
+    a.legend(fontsize=7, ncol=min(len(sh.names), 6), loc="upper center")      # above the bars (shares sum to 1)
     if split is not None:
         b.bar(n, sh.split(*split), width=0.9, label=f"{split[0]} / ({split[0]} + {split[1]})")
         b.axhline(0.5, color="k", lw=0.5)
-        b.legend(fontsize=7)
+        b.set(ylim=(0.0, 1.3), yticks=np.linspace(0.0, 1.0, 6))
+        b.legend(fontsize=7, loc="upper center")
     for j in case.report.unstable:
         b.axvline(j, color="r", lw=0.8, ls=":")
     b.set(xlabel="mode number (red: unstable)", ylabel="energy share [-]")
+    b.xaxis.set_major_locator(MaxNLocator(integer=True))
     return _save(fig, path)
 
 
