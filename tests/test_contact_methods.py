@@ -46,6 +46,25 @@ def test_methods_give_the_same_discrete_answer(periodic):
 
 
 @pytest.mark.parametrize("periodic", (True, False))
+def test_a_patch_whose_rings_stall_continues_without_them_to_the_same_answer(periodic, monkeypatch):
+    """``bccg_solver.STALL``: a patch whose best eps is not halved within STALL iterations drops
+    its rings (gamma = 0: Vollebregt's M on F) and restarts; forced here by STALL = 0 (after the
+    first iteration), the answer is still Polonsky–Keer's (the real stall: a measured plateau
+    surface, tests/test_topography.py)."""
+    h, dx = slope_one(64, seed=3, batch=(2,))
+    load = np.array([0.01, 0.2])
+    ref = ContactSolver(E, h.shape[-2:], dx, periodic=periodic, method="pk").solve(h, load=load, tol=1e-11)
+    dropped = []
+    extend = bccg_steps.extend
+    monkeypatch.setattr(bccg_solver, "STALL", 0)
+    monkeypatch.setattr(bccg_steps, "extend", lambda *a: (dropped.append(a[9][:, 0].copy()), extend(*a))[1])
+    got = ContactSolver(E, h.shape[-2:], dx, periodic=periodic, method="bccg").solve(h, load=load, tol=1e-11)
+    assert (dropped[0] > 0).all() and (dropped[-1] == 0).all()       # the rings were dropped on the way
+    for k in range(2):
+        assert rel(got.pressure[k], ref.pressure[k]) < 1e-9
+
+
+@pytest.mark.parametrize("periodic", (True, False))
 @pytest.mark.parametrize("fraction", (0.05, 0.3, 0.6))
 def test_the_two_ways_of_extending_the_residual_agree(periodic, fraction):
     """The preconditioner's extension E into two rings around the free set F, by scattering from

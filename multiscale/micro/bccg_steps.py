@@ -132,8 +132,8 @@ def by_rows(n, ny, nx):
 @njit(cache=True, nogil=True)
 def extend(label, fi, fj, nf, bi, bj, ring_end, count, X, gammas, periodic, active, ny, nx, Fx):
     """X = E r on the physical grid (X holds r on F from ``free_set``): ring by ring
-    (8-neighbourhood), gamma_k times the mean of the values of the neighbouring cells of ring
-    k - 1. Builds the rings (``label`` k) and ``count``, the neighbours of each ring cell in the
+    (8-neighbourhood), gamma_k (``gammas[b, k - 1]`` of patch b) times the mean of the values of
+    the neighbouring cells of ring k - 1. Builds the rings (``label`` k) and ``count``, the neighbours of each ring cell in the
     ring inside it: by scattering from the listed cells (``bi``/``bj``/``ring_end`` list the
     rings), or by row sweeps when F covers ``DENSE_FROM`` of the grid or more (then F and its
     rings cover most of it and the scatter would visit each ring cell from up to 8 sides)."""
@@ -141,10 +141,10 @@ def extend(label, fi, fj, nf, bi, bj, ring_end, count, X, gammas, periodic, acti
         if not active[b]:
             continue
         if by_rows(nf[b], ny, nx):
-            extend_rows(label[b], X[b], count[b], gammas, periodic, ny, nx, Fx)
+            extend_rows(label[b], X[b], count[b], gammas[b], periodic, ny, nx, Fx)
         else:
-            extend_cells(label[b], fi[b], fj[b], nf[b], bi[b], bj[b], ring_end[b], count[b], X[b], gammas, periodic,
-                          ny, nx, Fx)
+            extend_cells(label[b], fi[b], fj[b], nf[b], bi[b], bj[b], ring_end[b], count[b], X[b], gammas[b],
+                         periodic, ny, nx, Fx)
 
 
 @njit(cache=True, nogil=True)
@@ -240,10 +240,10 @@ def back_extend(label, fi, fj, nf, bi, bj, ring_end, count, Y, s, gammas, period
             continue
         n = nf[b]
         if by_rows(n, ny, nx):
-            total = back_rows(label[b], count[b], Y[b], s[b], X[b], gammas, periodic, ny, nx, Fx)
+            total = back_rows(label[b], count[b], Y[b], s[b], X[b], gammas[b], periodic, ny, nx, Fx)
         else:
             total = back_cells(label[b], fi[b], fj[b], n, bi[b], bj[b], ring_end[b], count[b], Y[b], s[b], X[b],
-                               gammas, periodic, ny, nx, Fx)
+                               gammas[b], periodic, ny, nx, Fx)
         mean = total / n if load_control and n > 0 else 0.0
         ss = 0.0
         for m in range(n):
