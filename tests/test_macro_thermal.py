@@ -1,6 +1,7 @@
 """Thermal boundary conditions and temperature-dependent materials of the macro heat problem, through
 scenes (``multiscale.workflows``), against closed forms (``multiscale.references.thermal``); a failed factorisation named."""
 import dataclasses
+import json
 
 import numpy as np
 import pytest
@@ -413,3 +414,115 @@ def test_a_failed_heat_factorisation_is_named_in_the_error(petsc_options):
     petsc_options(heat_mat_mumps_icntl_23=1)
     with pytest.raises(ConvergenceError, match=r"MUMPS INFOG\(1\) = -19 \(more memory than ICNTL\(23\)"):
         march(block_scene(geometry='mesh_size = "1 mm"'))
+
+
+TWO_PADS = """
+name = "two_pads"
+effects = ["contact", "friction", "thermal", "heat_partition"]
+[geometry]
+file = "{step}"
+unit = "mm"
+mesh_size = "12 mm"
+interface_mesh_size = "6 mm"
+rotating = "disc"
+[geometry.bodies.disc]
+contains = ["0 mm", "100 mm", "10 mm"]
+material = "iron"
+[geometry.bodies.pad_a]
+contains = ["0 mm", "100 mm", "25 mm"]
+material = "pad"
+[geometry.bodies.pad_b]
+contains = ["0 mm", "-100 mm", "25 mm"]
+material = "pad"
+[geometry.surfaces.top_a]
+body = "pad_a"
+normal = [0, 0, 1]
+[geometry.surfaces.top_b]
+body = "pad_b"
+normal = [0, 0, 1]
+[geometry.surfaces.bore]
+body = "disc"
+contains = ["60 mm", "0 mm", "10 mm"]
+[materials.iron]
+E = "110 GPa"
+nu = 0.26
+rho = "7200 kg/m^3"
+kappa = "50 W/(m K)"
+c = "500 J/(kg K)"
+[materials.pad]
+E = "3 GPa"
+nu = 0.25
+rho = "2500 kg/m^3"
+kappa = "1.5 W/(m K)"
+c = "1000 J/(kg K)"
+[interface]
+penalty = "1e13 Pa/m"
+partition = 0.0
+[loading]
+faces = ["top_a", "top_b"]
+normal_force = "2000 N"
+rotation_speed = "500 rpm"
+friction = 0.4
+[[boundary]]
+surfaces = ["bore"]
+fix = ["x", "y", "z"]
+[[boundary]]
+surfaces = ["top_a", "top_b"]
+fix = ["x", "y"]
+[time]
+end = "4 s"
+steps = 8
+[output]
+folder = "{folder}"
+"""
+
+
+def test_a_rotating_disc_heated_by_two_pads_against_the_semi_infinite_solid(tmp_path, monkeypatch):
+    """A CAD disc (60-120 mm, 20 mm thick) under two pads (80-115 mm, 50 degrees) at 500 rpm, all
+    the frictional heat into it, 12 mm elements (6 mm at the interface): after 4 s (33 turns) the
+    heat has gone 7.5 mm deep, and the track's surface is the semi-infinite solid's under the flux
+    averaged over the swept annulus (``semi_infinite_constant_flux``: 32 K) within 20 % (P2: 27.8
+    K); no node of the bottom face below twice that solid's rise 20 mm deep (the insulated face's
+    image) by more than 10 % of the surface rise, and none of the disc below the initial
+    temperature by as much. With P1 temperatures in the disc (before
+    ``thermal.TRANSPORT_DEGREE``) the track rose 17 K and the bottom fell 6.5 K below the initial
+    temperature (found by an adversarial test), which the run warns of."""
+    import gmsh
+    import meshio
+    from multiscale.references.thermal import semi_infinite_constant_flux
+    step = tmp_path / "two_pads.step"
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        occ = gmsh.model.occ
+        ring, bore = occ.addCylinder(0, 0, 0, 0, 0, 20, 120), occ.addCylinder(0, 0, 0, 0, 0, 20, 60)
+        occ.cut([(3, ring)], [(3, bore)])
+        for centre in (90, 270):
+            outer, inner = occ.addCylinder(0, 0, 20, 0, 0, 10, 115, angle=np.radians(50)), \
+                occ.addCylinder(0, 0, 20, 0, 0, 10, 80, angle=np.radians(50))
+            pad, _ = occ.cut([(3, outer)], [(3, inner)])
+            occ.rotate(pad, 0, 0, 0, 0, 0, 1, np.radians(centre - 25))
+        occ.synchronize()
+        gmsh.write(str(step))
+    finally:
+        gmsh.finalize()
+    result = run(loads(TWO_PADS.format(step=step, folder=tmp_path / "out")), verbose=False)
+    h = result.history
+    power = h["heat_total_disc"][-1] / 4.0                                    # W, constant
+    flux = power / (np.pi * (0.115**2 - 0.080**2))                            # W/m^2 over the annulus
+    chi = 50.0 / (7200 * 500)
+    surface, bottom = (semi_infinite_constant_flux(d, 4.0, flux, 50.0, chi) for d in (0.0, 0.02))
+    reader = meshio.xdmf.TimeSeriesReader(str(tmp_path / "out" / "disc.xdmf"))
+    points, _ = reader.read_points_cells()
+    T = reader.read_data(reader.num_steps - 1)[1]["temperature [K]"] - 293.15
+    r, z = np.hypot(points[:, 0], points[:, 1]), points[:, 2]
+    track = (np.abs(z - 0.02) < 1e-6) & (r > 0.09) & (r < 0.105)
+    assert np.mean(T[track]) == pytest.approx(surface, rel=0.2)
+    assert np.min(T[np.abs(z) < 1e-6]) > 2 * bottom - 0.1 * surface
+    assert h["min_temperature_disc"].min() > 293.15 - 0.1 * surface
+    monkeypatch.setattr(thermal, "TRANSPORT_DEGREE", 1)
+    p1 = run(loads(TWO_PADS.format(step=step, folder=tmp_path / "p1")), verbose=False)
+    low = p1.history["min_temperature_disc"].min()
+    assert low < 293.15 - 0.1 * surface
+    assert f"the disc's temperature fell to {low:.2f} K" in \
+        json.loads((tmp_path / "p1" / "provenance.json").read_text())["warnings"][-1]

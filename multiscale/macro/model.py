@@ -193,9 +193,11 @@ class MacroModel:
                 row[f"friction_force_{name}"] = float(friction[m].sum())
                 row[f"max_pressure_{name}"] = float(p[m].max(initial=0.0))
         if self.thermal is not None:
-            stored, hottest = self.thermal.stored_heat(), self.thermal.max_temperature()
+            stored, hottest, coldest = self.thermal.stored_heat(), self.thermal.max_temperature(), \
+                self.thermal.min_temperature()
             for i, body in enumerate(self.tm.bodies):
                 row[f"max_temperature_{body.name}"] = hottest[i]
+                row[f"min_temperature_{body.name}"] = coldest[i]
                 row[f"heat_step_{body.name}"] = heat_step[i]
                 row[f"heat_total_{body.name}"] = self.heat_total[i]
                 row[f"stored_heat_{body.name}"] = stored[i]

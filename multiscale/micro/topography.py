@@ -264,23 +264,30 @@ def gaussian_filter(surface: Surface, cutoff: float) -> Surface:
     ``gaussian_transmission(λ, λc)`` of its amplitude. Edges:
     periodic surfaces wrap, others are mirrored (one of the end-effect treatments of ISO 16610-28).
     SurfaceTopography filters periodic topographies in Fourier space only, hence this one."""
-    import scipy.ndimage  # ~0.4 s to import: only when a surface is filtered
     check_positive("cutoff", cutoff)
     if cutoff < 2 * max(surface.dx, surface.dy):
         raise InputError("cutoff", cutoff, f"λc must span at least 2 pixels ({2 * max(surface.dx, surface.dy):.3g} m)")
+    return _gaussian(surface, cutoff, cutoff)
+
+
+def _gaussian(surface: Surface, cut_x: float, cut_y: float) -> Surface:
+    """``gaussian_filter`` with a cut-off per axis [m] (0: that axis unfiltered): the ISO filter
+    (cut_x = cut_y) or the anti-aliasing S-filter of ``resample`` (its new pixel per axis)."""
+    import scipy.ndimage  # ~0.4 s to import: only when a surface is filtered
     h = surface.heights
     ny, nx = h.shape[-2:]
-    if cutoff > LONG_CUTOFF * min(ny * surface.dy, nx * surface.dx):
-        return _fourier_filter(surface, cutoff)
-    sigma = ALPHA * cutoff / np.sqrt(2 * np.pi)              # exp(-π x²/(αλc)²) = exp(-x²/(2σ²))
+    if max(cut_x, cut_y) > LONG_CUTOFF * min(ny * surface.dy, nx * surface.dx):
+        return _fourier_filter(surface, cut_x, cut_y)
+    sigma = ALPHA * np.array([cut_y, cut_x]) / np.sqrt(2 * np.pi)      # exp(-π x²/(αλc)²) = exp(-x²/(2σ²))
     axes = (h.ndim - 2, h.ndim - 1)
-    w = scipy.ndimage.gaussian_filter(h, sigma=(sigma / surface.dy, sigma / surface.dx), axes=axes,
-                                      mode="wrap" if surface.periodic else "mirror", truncate=cutoff / sigma)
+    w = scipy.ndimage.gaussian_filter(h, sigma=(sigma[0] / surface.dy, sigma[1] / surface.dx), axes=axes,
+                                      mode="wrap" if surface.periodic else "mirror",
+                                      truncate=np.sqrt(2 * np.pi) / ALPHA)      # at ±λc
     return Surface(w, surface.dx, surface.dy, periodic=surface.periodic)
 
 
-def _fourier_filter(surface: Surface, cutoff: float) -> Surface:
-    """``gaussian_filter`` by its transmission in Fourier space, on the surface (periodic) or on its
+def _fourier_filter(surface: Surface, cut_x: float, cut_y: float) -> Surface:
+    """``_gaussian`` by its transmission in Fourier space, on the surface (periodic) or on its
     whole-sample mirror image (period 2n - 2 along each axis, the convolution's "mirror" edges): the
     cost does not grow with λc, whose kernel would be longer than the surface."""
     h = surface.heights
@@ -290,7 +297,7 @@ def _fourier_filter(surface: Surface, cutoff: float) -> Surface:
         h = np.concatenate([h, h[..., -2:0:-1]], axis=-1) if nx > 2 else h
     qy = np.fft.fftfreq(h.shape[-2], d=surface.dy)[:, None]
     qx = np.fft.rfftfreq(h.shape[-1], d=surface.dx)[None, :]
-    keep = np.exp(-np.pi * (ALPHA * cutoff) ** 2 * (qx ** 2 + qy ** 2))      # gaussian_transmission at 1/|q|
+    keep = np.exp(-np.pi * ALPHA ** 2 * ((cut_x * qx) ** 2 + (cut_y * qy) ** 2))   # gaussian_transmission per axis
     w = np.fft.irfft2(np.fft.rfft2(h) * keep, s=h.shape[-2:])[..., :ny, :nx]
     return Surface(w, surface.dx, surface.dy, periodic=surface.periodic)
 
@@ -354,8 +361,9 @@ def _um(value: float) -> str:
 def resample(surface: Surface, n, size=None) -> tuple[Surface, str]:
     """The surface on a grid of n = (nx, ny) cells over size (Lx, Ly) [m] (default: its own size),
     cell centres at ((i + ½) Lx/nx, (j + ½) Ly/ny) from its corner, by cubic splines; a coarser grid
-    first low-passes with the Gaussian S-filter at λs = ``S_FILTER_PIXELS`` new pixels (against
-    aliasing). Returns the surface and one report line."""
+    first low-passes with the Gaussian S-filter at λs = ``S_FILTER_PIXELS`` new pixels along each
+    coarsened axis (against aliasing; an axis kept as fine is not filtered). Returns the surface
+    and one report line."""
     import scipy.ndimage  # ~0.4 s to import: only when a surface is resampled
     nx, ny = check_pair("n", n, check_count)
     Lx, Ly = surface.size if size is None else check_pair("size", size, check_positive)
@@ -363,10 +371,14 @@ def resample(surface: Surface, n, size=None) -> tuple[Surface, str]:
     if (ny, nx) == surface.shape and np.isclose(dx, surface.dx, rtol=1e-9) and np.isclose(dy, surface.dy, rtol=1e-9):
         return surface, "on the micro grid already"
     source, filtered = surface, ""
-    if dx > surface.dx * (1 + 1e-9) or dy > surface.dy * (1 + 1e-9):
-        cut = S_FILTER_PIXELS * max(dx, dy)
-        source = gaussian_filter(surface, cut)
-        filtered = f" after an S-filter at λs = {cut * 1e6:.4g} um against aliasing"
+    cut_x = S_FILTER_PIXELS * dx if dx > surface.dx * (1 + 1e-9) else 0.0
+    cut_y = S_FILTER_PIXELS * dy if dy > surface.dy * (1 + 1e-9) else 0.0
+    if cut_x or cut_y:
+        source = _gaussian(surface, cut_x, cut_y)
+        cuts = f"{cut_x * 1e6:.4g} um" if cut_x == cut_y else \
+            f"{cut_x * 1e6:.4g} um along x, {cut_y * 1e6:.4g} um along y" if cut_x and cut_y else \
+            f"{max(cut_x, cut_y) * 1e6:.4g} um along {'x' if cut_x else 'y'}"
+        filtered = f" after an S-filter at λs = {cuts} against aliasing"
     rows = (np.arange(ny) + 0.5) * dy / surface.dy - 0.5
     cols = (np.arange(nx) + 0.5) * dx / surface.dx - 0.5
     R, Cc = np.meshgrid(rows, cols, indexing="ij")

@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import numpy as np
 from scipy.optimize import brentq
+from scipy.special import erfc
 
 from multiscale.errors import InputError, check_positive
 
@@ -75,6 +76,16 @@ def radiative_cooling_time(T, T_initial: float, ambient: float, rate: float):
 def radiative_cooling(time, T_initial: float, ambient: float, rate: float):
     """T(t) of the lumped radiating body of ``radiative_cooling_time`` (its monotone inverse)."""
     return _invert(lambda T: radiative_cooling_time(T, T_initial, ambient, rate), time, T_initial, ambient)
+
+
+def semi_infinite_constant_flux(depth, time, flux: float, kappa: float, diffusivity: float):
+    """Temperature rise [K] at ``depth`` [m] below the surface of a semi-infinite solid heated by a
+    uniform flux q [W/m^2] since t = 0 (Carslaw & Jaeger §2.9, Eq. 2.9(5)):
+    2 q sqrt(chi t) / kappa * ierfc(depth / (2 sqrt(chi t))), ierfc(x) = exp(-x^2)/sqrt(pi) - x erfc(x);
+    at the surface 2 q sqrt(t / (pi rho c kappa))."""
+    root = np.sqrt(diffusivity * np.asarray(time, float))
+    x = np.asarray(depth, float) / (2 * root)
+    return 2 * flux * root / kappa * (np.exp(-x * x) / np.sqrt(np.pi) - x * erfc(x))
 
 
 def slab_eigenvalues(biot: float, terms: int) -> np.ndarray:

@@ -93,7 +93,8 @@ def run_warnings(scene, history) -> list[str]:
     """What a run's history shows it extrapolated: material tables its temperatures left (held
     constant beyond their ends, ``Material.beyond``: the largest temperature over the history of
     the bodies made of each material, for the tables the initial temperature, checked when the
-    scene is read, was in), and zone pressures above the top of their laws (extrapolated linearly)."""
+    scene is read, was in), zone pressures above the top of their laws (extrapolated linearly) and
+    temperatures below every imposed one (``UNDERSHOOT``)."""
     if history is None:
         return []
     reach = float(np.max(history["law_reach"])) if "law_reach" in history.columns else 0.0
@@ -109,7 +110,31 @@ def run_warnings(scene, history) -> list[str]:
         known = scene.materials[name].beyond(T0)
         out += [f"materials.{name}.{phrase} (in the {body})"
                 for key, phrase in scene.materials[name].beyond(T).items() if key not in known]
-    return out + laws
+    return out + laws + _undershoots(scene, history)
+
+
+UNDERSHOOT = 0.05     # a body's undershoot warned about: this share of its temperature rise [-]
+
+
+def _undershoots(scene, history) -> list[str]:
+    """Bodies whose temperature fell below every temperature the scene imposes (the initial one,
+    ambients, fixed ones; frictional heat only adds) by more than ``UNDERSHOOT`` of their rise: the
+    discretisation's undershoot (docs/architecture.md, Known problems)."""
+    floor = min([scene.time.initial_temperature] + [t for b in scene.boundary for t in (b.ambient, b.temperature)
+                                                    if t is not None])
+    out = []
+    for body in scene.geometry.spec.bodies:
+        cold, hot = f"min_temperature_{body.name}", f"max_temperature_{body.name}"
+        if cold not in history.columns:
+            continue
+        low, rise = float(np.min(history[cold])), float(np.max(history[hot])) - floor
+        if floor - low > max(UNDERSHOOT * rise, 1e-3):
+            out.append(f"the {body.name}'s temperature fell to {low:.2f} K, {floor - low:.3g} K below the lowest "
+                       f"imposed temperature ({floor:.2f} K) while it rose by {rise:.3g} K: an undershoot of the "
+                       "discretisation (a heated layer thinner than the elements; with a rotating body, its Eulerian "
+                       "transport): temperatures near the rubbing surface are uncertain by at least as much; refine "
+                       "the mesh across the thickness (docs/architecture.md, Known problems)")
+    return out
 
 
 __all__ = ["RunResult", "run", "run_warnings", "workflow"]
