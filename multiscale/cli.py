@@ -206,8 +206,9 @@ def _count(text: str) -> int:
     return int(value)
 
 
-def _length(option: str, text: str | None) -> float | None:
-    """A length option ("0.8 mm", or a number in metres) in metres."""
+def _length(option: str, text: str | None, unit_name: bool = False) -> float | None:
+    """A length option ("0.8 mm", or a number in metres; with ``unit_name`` also a unit's name,
+    "um", as in a scene's ``roughness.height_unit``) in metres."""
     if text is None:
         return None
     try:
@@ -217,6 +218,11 @@ def _length(option: str, text: str | None) -> float | None:
     try:
         return to_si(value, "length")
     except UnitError as exc:
+        if unit_name and isinstance(value, str):
+            try:
+                return to_si(f"1 {value}", "length")
+            except UnitError:
+                pass
         raise InputError(option, text, str(exc)) from None
 
 
@@ -227,8 +233,8 @@ def _surface(args) -> int:
         return 0
     if not args.file:
         raise MultiscaleError("multiscale surface: give a topography file, or --formats for the formats it reads")
-    pixel, unit, cutoff = (_length(o, v) for o, v in (("--pixel-size", args.pixel_size),
-                                                       ("--height-unit", args.height_unit), ("--cutoff", args.cutoff)))
+    pixel, cutoff = _length("--pixel-size", args.pixel_size), _length("--cutoff", args.cutoff)
+    unit = _length("--height-unit", args.height_unit, unit_name=True)
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", TopographyWarning)      # the report's "warning:" lines say them
@@ -300,7 +306,7 @@ def build_parser() -> argparse.ArgumentParser:
     surface.add_argument("--max-undefined", type=float, default=MAX_UNDEFINED, metavar="FRACTION",
                          help=f"largest share of undefined points that is filled (default {MAX_UNDEFINED})")
     surface.add_argument("--pixel-size", metavar="LENGTH", help="override the file's pixel size")
-    surface.add_argument("--height-unit", metavar="LENGTH", help='override the file\'s height unit, e.g. "1 um"')
+    surface.add_argument("--height-unit", metavar="LENGTH", help='override the file\'s height unit, e.g. "um" or "1 um"')
     surface.add_argument("--figure", metavar="PNG", help="figure path (default FILE-stem_surface.png; none: no figure)")
     surface.add_argument("--formats", action="store_true", help="list the file formats")
     surface.set_defaults(func=_surface)

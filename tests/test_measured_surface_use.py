@@ -46,6 +46,10 @@ def test_surface_command_prints_the_steps_and_surfacetopographys_sq(tmp_path, ca
     assert main(["surface", str(TOP), "--cutoff", "0.1 um", "--detrend", "poly2", "--figure", "none"]) == 0
     out = capsys.readouterr().out
     assert "Gaussian filter (ISO 16610-61) at λc = 0.0001 mm" in out and "statistics of the roughness" in out
+    # --height-unit takes a unit's name as a scene's roughness.height_unit does (it was refused)
+    for unit in ("um", "1 um"):
+        assert main(["surface", str(TOP), "--height-unit", unit, "--figure", "none"]) == 0
+        assert f"Sq   RMS height              {sq:.4g} um" in capsys.readouterr().out   # its nm read as um
 
 
 @pytest.mark.parametrize("args, message", [
