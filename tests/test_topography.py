@@ -87,20 +87,26 @@ def test_plain_matrices_still_read_as_before(tmp_path):
     ("missing", r"roughness\.file = '.*nowhere\.x3p': no such file"),
     ("unknown channel", r"roughness\.channel = 3: top-1\.top has the channels 0 \"Default\" \(2-D\)"),
     ("all undefined", r"roughness\.file = '.*empty\.nc': channel 0 \(\"[^\"]*\"\) holds no defined height"),
+    ("all undefined matrix", r"roughness\.file = '.*empty\.npy': the height matrix holds no defined height$"),
     ("profile", r"roughness\.file = '.*opdx-3\.opdx': channel 0 \(\"Height\"\) is a 1-D profile \(line scan\): "
                 r"a height map \(2-D\) is needed"),
 ])
 def test_bad_input_is_one_clear_error_naming_the_file_and_the_field(tmp_path, case, message):
     path, channel = {"unreadable": (tmp_path / "pad.x3p", None), "garbage sur": (tmp_path / "pad.sur", None),
                      "missing": (tmp_path / "nowhere.x3p", None), "unknown channel": (DATA / "top-1.top", 3),
-                     "all undefined": (tmp_path / "empty.nc", None), "profile": (DATA / "opdx-3.opdx", None)}[case]
+                     "all undefined": (tmp_path / "empty.nc", None), "profile": (DATA / "opdx-3.opdx", None),
+                     "all undefined matrix": (tmp_path / "empty.npy", None)}[case]
     if case in ("unreadable", "garbage sur"):
         path.write_bytes(b"this is no topography\n" * 40)
     if case == "all undefined":
         write_nc(path, np.full((6, 8), np.nan), 1e-6, 1e-6)
+    pixel = None
+    if case == "all undefined matrix":     # it said "heights up to nan m overflow ... is height_unit right?"
+        np.save(path, np.full((6, 8), np.nan))
+        pixel = 1e-6
     with pytest.raises(InputError, match=message):
-        read_topography(path, channel, prefix="roughness.")
-    problems, _ = probe_topography(path, channel, prefix="roughness.")      # what `multiscale check` says
+        read_topography(path, channel, prefix="roughness.", pixel_size=pixel)
+    problems, _ = probe_topography(path, channel, prefix="roughness.", pixel_size=pixel)   # what `multiscale check` says
     assert len(problems) == 1 and problems[0].startswith("roughness.")
 
 

@@ -172,17 +172,17 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
     elif factor is None:
         raise InputError(f"{prefix}height_unit", None, f"{path.name} gives no height unit: give it (m per unit)")
     h = np.ma.filled(np.ma.masked_invalid(np.ma.asarray(raw, dtype=float)), np.nan).T * factor
-    if not np.isfinite(h).any():
-        raise InputError(f"{prefix}file", path.name, f"channel {ch.index} (\"{ch.name}\") holds no defined height")
-    notes += _height_range(h, path, prefix, f"{factor:.4g} m")
+    notes += _height_range(h, path, prefix, f"{factor:.4g} m", f"channel {ch.index} (\"{ch.name}\")")
     for note in notes:
         warnings.warn(note, TopographyWarning, stacklevel=2)
     return Measurement(h, dx, dy, path, ch.index, str(ch.name), unit, tuple(notes))
 
 
-def _height_range(h: np.ndarray, path: Path, prefix: str, unit: str) -> list[str]:
+def _height_range(h: np.ndarray, path: Path, prefix: str, unit: str, what: str = "the height matrix") -> list[str]:
     """A note if the heights [m] (NaN: undefined) reach beyond ``TALLEST`` (heights read in the
-    wrong unit, e.g. um as m); an InputError if their spread overflows."""
+    wrong unit, e.g. um as m); an InputError if none is defined or their spread overflows."""
+    if not np.isfinite(h).any():
+        raise InputError(f"{prefix}file", path.name, f"{what} holds no defined height")
     with np.errstate(over="ignore", invalid="ignore"):
         peak, sq = float(np.nanmax(np.abs(h))), float(np.nanstd(h))
     if not np.isfinite(sq):
