@@ -51,7 +51,7 @@ gmsh.write(str(OUT / "car_brake.step"))
 # ## A railway brake disc with sintered pucks
 # Railway disc: a ring of 200–320 mm radius, 40 mm thick (faces z = 0 and 40 mm). One brake pad on
 # the z > 40 mm side: a steel holder plate (an 80-degree sector, 215–305 mm, 12 mm thick, 10 mm
-# above the disc) carrying 9 sintered pucks (cylinders of 20 mm radius, 10 mm high) in three rows,
+# above the disc) carrying 9 sintered pucks (cylinders of 12 mm radius, 10 mm high) in three rows,
 # each standing on the disc. The pucks are the contact: 9 interfaces.
 gmsh.model.add("railway_disc")
 ring = occ.addCylinder(0, 0, 0, 0, 0, 40, 320)
