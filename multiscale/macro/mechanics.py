@@ -362,6 +362,7 @@ class Mechanics:
                           "every direction (friction does not hold a body)")
             raise ConvergenceError(
                 f"contact Newton did not converge at load {float(self.load.value):.6g} "
+                f"{'N' if self.load_kind == 'force' else 'Pa'} "
                 f"(SNES reason {result.reason}, {result.iterations} iterations, residuals "
                 f"{['%.3g' % r for r in result.residuals]}{cause})", result.residuals, result)
         result.normal_force = self.contact.normal_force()
