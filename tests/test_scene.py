@@ -472,3 +472,20 @@ def test_a_fractional_number_of_vanes_is_a_problem():
     brake = (Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml")
     with pytest.raises(SceneError, match="geometry.vanes = 2.5: must be an integer >= 0"):
         load(brake, {"geometry.vanes": 2.5})
+
+
+def test_the_summary_gives_each_interfaces_effusivity_partition():
+    """Pads of different materials: `check` lists the share of each interface (it showed the first
+    one's, 0.126, for a sintered outer pad taking 0.404; found by an adversarial test)."""
+    import subprocess
+    import sys
+    from multiscale.scene_summary import summary
+    if not (DEMOS / "cad" / "car_brake.step").exists():
+        subprocess.run([sys.executable, str(DEMOS / "cad_models.py")], check=True, capture_output=True, cwd=DEMOS)
+    scene = load(DEMOS / "car_brake_stop.toml", overrides={"geometry.bodies.outer_pad.material": "steel"})
+    shares = {n: scene.partition_at(n) for n in scene.geometry.spec.interfaces}
+    assert len(set(shares.values())) == 2
+    line = next(x for x in summary(scene) if "heat_partition share" in x)
+    assert ", ".join(f"{v:.3g} at {n}" for n, v in shares.items()) + " (effusivity)" in line
+    plain = next(x for x in summary(load(DEMOS / "car_brake_stop.toml")) if "heat_partition share" in x)
+    assert "share 0.126 (effusivity) of mu p |v| into the fixed" in plain
