@@ -1,4 +1,6 @@
 """Archard wear of a rough surface (thesis §3.4–3.5, Eq. 3.10; k_w(T) of §7.2.2)."""
+import warnings
+
 import numpy as np
 import pytest
 
@@ -7,7 +9,7 @@ from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.layered import LayeredElastic
 from multiscale.micro.surface import Surface, fractal_surface
-from multiscale.micro.wear import WearRate, simulate_wear, wear_step
+from multiscale.micro.wear import WearRate, WearWarning, simulate_wear, wear_step
 
 # Thesis §3.5.1: p = 1 MPa, mu = 0.4, S = 10 mm, k_w = 1e-12 /Pa, E = 4 GPa, nu = 0.15 vs a rigid flat,
 # fractal surface (H = 0.8, cut-offs 2 and 10 per patch, RMS 6 um) on a 1 mm patch.
@@ -61,6 +63,23 @@ def test_wear_volume_is_kw_mu_P_S_whatever_the_number_of_steps(steps):
     assert np.all(res.depth >= 0) and np.all(res.depth[1] == 0)
     assert res.history.area_fraction[0, 1] == 0 and np.all(res.history.area_fraction[:, [0, 2]] > 0)
     assert np.allclose(res.history.mean_depth[-1], KW * MU * loads * S, rtol=1e-12)
+
+
+def test_steps_that_wear_deeper_than_the_relief_are_warned_about():
+    """The explicit step at k_w = 5e-10 /Pa: one step of the whole 10 mm wears 21 times the relief
+    and leaves an RMS of 28 um (the relief inverted), 64 and 256 steps agree on 3.50 um; the first
+    warns (``WearWarning``, found by an adversarial test), the others do not."""
+    surface = thesis_surface(32)
+    rms, warned = {}, {}
+    for steps in (1, 64, 256):
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            res = simulate_wear(surface, KERNEL, load=P, mu=MU, distance=S, steps=steps, k_w=5e-10)
+        rms[steps] = res.history.rms_height[-1]
+        warned[steps] = [str(w.message) for w in caught if w.category is WearWarning]
+    assert rms[64] == pytest.approx(rms[256], rel=1e-3) and rms[1] > 5 * rms[256]
+    assert not warned[64] and not warned[256]
+    assert len(warned[1]) == 1 and "depends on the step count (steps = 1): use more, at least 21" in warned[1][0]
 
 
 def test_wear_step_convergence_N300_vs_N600_on_the_thesis_example(thesis_runs):

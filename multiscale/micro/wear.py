@@ -16,6 +16,7 @@ pressure [Pa] positive in compression; sliding distance [m].
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -26,6 +27,10 @@ from multiscale.errors import InputError, check_count, check_field, check_flag, 
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import Kernel
 from multiscale.micro.surface import Surface, check_surface
+
+
+class WearWarning(UserWarning):
+    """Wear steps too coarse for the relief they wear (``simulate_wear``)."""
 
 
 class WearRate:
@@ -160,6 +165,12 @@ def simulate_wear(surface: Surface, contact: Kernel | ContactSolver, *, load, mu
     k_w. law_steps: steps (0…N) at which the p_n–g_n law is sampled at the mean pressures
     ``law_loads`` [Pa]. initial_pressure: warm start of the first solve (e.g. a previous call's
     ``pressure``).
+
+    The step is explicit: a step that wears a patch deeper than the relief (peak to valley) it
+    starts from lowers the loaded asperities below the unloaded valleys, and the result depends on
+    the step count (an opd patch slid 10 m: RMS 136 nm in 1 step, 9.6 nm in 16, 4.6 nm in 64 and
+    256; 25 and 32 steps, whose steps still wore 1.47 and 1.11 times the relief, 5.8 and 5.1 nm); a
+    ``WearWarning`` then asks for more steps.
     """
     t0 = time.perf_counter()
     check_surface(surface)
@@ -202,9 +213,14 @@ def simulate_wear(surface: Surface, contact: Kernel | ContactSolver, *, load, mu
     steps_iter = range(1, steps + 1)
     if progress:
         steps_iter = tqdm(steps_iter, desc="wear steps", unit="step")
+    overshoot = 0.0                          # largest step depth over the relief it started from
     for j in [0, *steps_iter]:
         if j > 0:
-            current = wear_step(current, p, rate, mu, dS, T).surface
+            relief = np.ptp(current.heights, axis=(-2, -1))
+            increment = wear_step(current, p, rate, mu, dS, T)
+            worn = increment.depth.max(axis=(-2, -1))
+            overshoot = max(overshoot, float(np.max(worn / np.maximum(relief, np.finfo(float).tiny))))
+            current = increment.surface
             p = _solve_at_load(solver, current.heights, loads, p, rows, j, options)
         depth = h0 - current.heights
         rows["max_depth"][j] = depth.max(axis=(-2, -1))
@@ -215,6 +231,10 @@ def simulate_wear(surface: Surface, contact: Kernel | ContactSolver, *, load, mu
         if j in law_steps:
             laws.append(_pressure_gap_law(solver, current.heights, law_loads, j, j * dS, options))
     history = WearHistory(sliding=np.arange(steps + 1) * dS, **rows)
+    if overshoot > 1.0:
+        warnings.warn(f"simulate_wear: a step wore up to {overshoot:.3g} times the relief (peak to valley) it "
+                      f"started from, so the result depends on the step count (steps = {steps}): use more, at least "
+                      f"{int(np.ceil(steps * overshoot))}, until the result stops changing", WearWarning, stacklevel=2)
     return WearResult(current, h0 - current.heights, p, history, laws, time.perf_counter() - t0)
 
 
