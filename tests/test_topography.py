@@ -358,3 +358,17 @@ def test_resampling_to_unequal_pixels_filters_each_axis_at_its_own_pixel():
     assert "30 um along x, 120 um along y" in note
     assert kept[1] == pytest.approx(kept[0], rel=1e-3)
     assert kept[1] == pytest.approx(gaussian_transmission(lam, 30e-6), rel=0.01)
+
+
+def test_copies_of_a_small_measurement_are_filtered_once():
+    """tile / mirror: the measurement is coarsened once to whole cells of the micro grid (the
+    S-filter at 3 cells: half the amplitude of a 3-cell wave) and its copies are sampled at their
+    pixels, not filtered again (a wave kept 0.37 of itself, about the square; found by an
+    adversarial test); a measurement narrower than 4 cells is warned about."""
+    d, lam, A = 1e-6, 0.9e-3, 1e-6
+    x = (np.arange(2000) + 0.5) * d
+    s = Surface(A * np.cos(2 * np.pi * (x - 0.1e-3) / lam)[None, :].repeat(200, axis=0), d, d, periodic=False)
+    for method, rel in (("tile", 0.06), ("mirror", 0.12)):        # the filter's mirrored edges, the seams
+        with pytest.warns(TopographyWarning, match=r"spans fewer than 4 cells of the micro grid \(300 x 300 um\)"):
+            out, _ = cover(s, (10, 10), (3e-3, 3e-3), method)
+        assert out.heights.std() / (A / np.sqrt(2)) == pytest.approx(gaussian_transmission(lam, 0.9e-3), rel=rel)

@@ -398,8 +398,9 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
     - ``"measured"``: the measurement itself, cropped at its centre and resampled; it must cover
       the size;
     - ``"mirror"`` / ``"tile"``: copies of it (mirror-stitched by SurfaceTopography, so without
-      steps at the seams, or repeated as they are), a ``TopographyWarning`` if more than one copy is
-      needed: wavelengths longer than the measurement are missing and the pattern repeats;
+      steps at the seams, or repeated as they are), coarsened once to whole cells of the grid and
+      sampled, a ``TopographyWarning`` if more than one copy is needed (wavelengths longer than
+      the measurement are missing and the pattern repeats) and if it spans fewer than 4 cells;
     - ``"equivalent"``: a statistically equivalent surface from its PSD
       (``spectrum.equivalent_surface``, ``seed``) over the whole size.
 
@@ -433,8 +434,15 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
             base = Surface(np.asarray(t.heights()).T, surface.dx, surface.dy, periodic=True)
         cell = (Lx / nx, Ly / ny)
         if base.dx < cell[0] * (1 - 1e-9) or base.dy < cell[1] * (1 - 1e-9):     # coarsen once, then copy
-            base, note = resample(base, tuple(max(4, round(b / c)) for b, c in zip(base.size, cell)))
-            lines.append(note)
+            counts = tuple(max(4, int(np.floor(b / c + 1e-9))) for b, c in zip(base.size, cell))
+            if min(b / c for b, c in zip(base.size, cell)) < 4:
+                few = (f"{prefix}cover = \"{method}\": {wide} spans fewer than 4 cells of the micro grid "
+                       f"({cell[0] * 1e6:.4g} x {cell[1] * 1e6:.4g} um) along an axis: its roughness is finer than "
+                       "the grid and the copies keep little of it; use \"equivalent\" or a finer micro.grid")
+                warnings.warn(few, TopographyWarning, stacklevel=2)
+                lines.append(f"warning: {few}")
+            base, note = resample(base, counts, (counts[0] * cell[0], counts[1] * cell[1]))   # whole cells: the
+            lines.append(note)        # copies are sampled at their pixels below, not filtered a second time
         reps = (int(np.ceil(Ly / base.size[1])), int(np.ceil(Lx / base.size[0])))
         surface = Surface(np.tile(base.heights, reps), base.dx, base.dy, periodic=False)
         message = (f"{prefix}cover = \"{method}\": {wide} is smaller than {target}: {reps[1]} x {reps[0]} "
