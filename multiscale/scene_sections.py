@@ -296,7 +296,10 @@ class Loading:
 
     The load acts on ``faces`` (default: the builder's load faces; required for geometry files,
     where it is a pressure normal to each face, -p n, and a force is spread as a uniform pressure;
-    with ``direction`` a traction along it whose resultant is the force, or the pressure itself),
+    with ``direction`` a traction along it whose resultant is the force, or the pressure itself).
+    ``normal_force`` is the total over all the load faces: a piston face and the caliper's fingers
+    given 4000 N take 2000 N each when their areas are equal (give the clamp force times the number
+    of faces, or ``pressure``),
     scaled in time by ``load_profile`` (factor, 0 = released: no contact, no frictional heat). The
     speed of the rotating body: ``rotation_speed``, a ``speed_profile`` against time, or a
     ``vehicle`` stop or drag; a translating body slides at ``sliding_speed``. Friction: a

@@ -192,8 +192,8 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: b
 
 
 def interface_forces(scene, tm) -> dict:
-    """Normal force [N] every interface nominally carries: its area's share of the load on the
-    load faces (a pin carries the whole load; each pad of a brake the clamp force of its piston)."""
+    """Normal force [N] every interface nominally carries: its area's share of the total load on
+    the load faces (a pin carries the whole load; two pads of equal area half of it each)."""
     d = drive(scene, tm)
     total = sum(load_face_forces(tm, d.load, load_kind(scene)).values())
     areas = {n: tm.interface.areas[m].sum() for n, m in tm.interface.masks().items()}
