@@ -194,12 +194,14 @@ def _load(model, g) -> Found:
     if not order:
         raise InputError("geometry.file", g.file.name, "holds no volume (3-D solid)")
     occ = bool(model.occ.getEntities(3))
+    split = []                    # solids of the file that the fragment cut into pieces: they overlap
     if occ and g.kind != "mesh":  # before a script's scaling: fast on its analytic faces
         volumes = model.occ.getEntities(3)
         _, mapping = model.occ.fragment(volumes, [])
         model.occ.synchronize()
         after = {t: [b for d, b in m if d == 3] for (_, t), m in zip(volumes, mapping)}
         order = [t for old in order for t in after.get(old, [old])]
+        split = sorted(old for old, pieces in after.items() if len(pieces) > 1)
     if g.unit != 1.0 and g.kind != "cad":
         if g.kind == "mesh":
             s = g.unit
@@ -212,7 +214,14 @@ def _load(model, g) -> Found:
             model.geo.synchronize()
     extent = _extent(model, g)
     labels = {t: _label(model, t) for _, t in model.getEntities(3)}
-    found = Found(_bodies(model, g, order, labels), labels, {t: _volume(model, t, occ) for t in labels},
+    try:
+        bodies = _bodies(model, g, order, labels)
+    except InputError as exc:
+        if not split:
+            raise
+        raise InputError(exc.name, exc.value, f"{exc.allowed} (the file's solids {split} overlap: gmsh cut them "
+                         "into pieces where they intersect; make the parts touch without overlapping)") from None
+    found = Found(bodies, labels, {t: _volume(model, t, occ) for t in labels},
                   extent=extent, size_factor=_script_factor(model))
     _interfaces(model, g, found, occ)
     _surfaces(model, g, found)

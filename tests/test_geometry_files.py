@@ -494,3 +494,42 @@ def test_a_solid_free_to_move_is_named_as_the_likely_cause_of_a_failed_solve(tmp
                                                r"as it does when a body, or a solid of one, can move as a rigid "
                                                r"body: give each a support"):
         run(loads(text, tmp_path), verbose=False)
+
+
+def test_overlapping_parts_are_named_as_the_cause_of_an_unassigned_volume(tmp_path, capsys):
+    """Two blocks sunk 1 mm into each other: gmsh's fragment cuts them into three volumes, the
+    shared one in no body; the error says the file's solids overlap (it named only the volume;
+    found by an adversarial test)."""
+    (tmp_path / "overlap.geo").write_text('SetFactory("OpenCASCADE");\nBox(1) = {0, 0, 0, 20, 20, 10};\n'
+                                          'Box(2) = {5, 5, 9, 10, 10, 5};\n')
+    (tmp_path / "overlap.toml").write_text("""
+name = "overlap"
+effects = ["contact"]
+[geometry]
+file = "overlap.geo"
+unit = "mm"
+mesh_size = "5 mm"
+rotating = "base"
+[geometry.bodies.base]
+contains = ["2 mm", "2 mm", "5 mm"]
+material = "steel"
+[geometry.bodies.block]
+contains = ["10 mm", "10 mm", "12 mm"]
+material = "steel"
+[geometry.surfaces.top]
+body = "block"
+normal = [0, 0, 1]
+[materials.steel]
+E = "200 GPa"
+nu = 0.3
+[interface]
+penalty = "1e13 Pa/m"
+[loading]
+faces = ["top"]
+normal_force = "100 N"
+rotation_speed = "1 rpm"
+""")
+    assert main(["check", str(tmp_path / "overlap.toml"), "--cells"]) != 0
+    err = capsys.readouterr().err
+    assert "every volume must belong to a body; not assigned: volume" in err
+    assert "(the file's solids [1, 2] overlap: gmsh cut them into pieces where they intersect" in err
