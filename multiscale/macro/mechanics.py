@@ -356,10 +356,13 @@ class Mechanics:
         if not result.converged:
             failed = "" if self.factors.inner is None else mumps.describe(self.factors.inner)  # same on every rank
             cause = f"; the preconditioner's factorisation failed: {failed}" if failed else ""
+            free = ("a body, or a solid of one, can move as a rigid body: give each a support ([[boundary]] fix) "
+                    "or a contact that holds it in every direction (friction does not hold a body; a part that "
+                    "touches nothing is held by its supports alone)")
             if result.reason == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE:
-                cause += ("; the linear solve failed, as it does when a body, or a solid of one, can move as a "
-                          "rigid body: give each a support ([[boundary]] fix) or a contact that holds it in "
-                          "every direction (friction does not hold a body)")
+                cause += f"; the linear solve failed, as it does when {free}"
+            elif result.reason == PETSc.SNES.ConvergedReason.DIVERGED_DTOL:
+                cause += f"; the residual grew, as it can when {free}"
             raise ConvergenceError(
                 f"contact Newton did not converge at load {float(self.load.value):.6g} "
                 f"{'N' if self.load_kind == 'force' else 'Pa'} "
