@@ -162,13 +162,16 @@ def test_belt_oscillator_negative_damping_onset():
 
 
 # ---------------------------------------------------------------- stability map of the Hoffmann model
+def hoffmann_points(values):
+    """The modes and reduced systems of the Hoffmann model at each friction coefficient of ``values``."""
+    sub = damped.Subspace([np.eye(2)], petsc_mat(np.eye(2)))
+    points = [damped.solve_projected(hoffmann_system(mu), sub, band=(0.0, 1.0), expand=False) for mu in values]
+    return [r for r, _ in points], [red for _, red in points]
+
+
 def test_map_tracks_the_hoffmann_pair_and_bisects_its_lock_in(tmp_path):
     values = np.linspace(0.0, 1.0, 6)
-    sub = damped.Subspace([np.eye(2)], petsc_mat(np.eye(2)))
-    results, reduced = [], []
-    for mu in values:
-        r, red = damped.solve_projected(hoffmann_system(mu), sub, band=(0.0, 1.0), expand=False)
-        results.append(r), reduced.append(red)
+    results, reduced = hoffmann_points(values)
     smap = build_map("friction", "-", values, results, reduced, (0.0, 1.0), xtol=1e-9)
     assert smap.n_tracks == 2 and (smap.mode >= 0).all()
     assert len(smap.onsets) == 1
@@ -191,11 +194,7 @@ def test_map_bisects_the_onset_of_a_lock_in_branch_that_fails_the_mac_test(tmp_p
     one's onset is still bisected (from its stable best match at 0.4), once; a map starting above
     the onset lists the unstable track as below the sweep."""
     values = np.linspace(0.0, 1.0, 6)
-    sub = damped.Subspace([np.eye(2)], petsc_mat(np.eye(2)))
-    results, reduced = [], []
-    for mu in values:
-        r, red = damped.solve_projected(hoffmann_system(mu), sub, band=(0.0, 1.0), expand=False)
-        results.append(r), reduced.append(red)
+    results, reduced = hoffmann_points(values)
     for mac_min in (0.9, 0.999):                     # 0.999: the branch is new at every point
         smap = build_map("friction", "-", values, results, reduced, (0.0, 1.0), xtol=1e-9, mac_min=mac_min)
         assert smap.n_tracks > 2 and len(smap.onsets) == 1
