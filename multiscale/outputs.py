@@ -17,7 +17,8 @@ FIELDS = {"displacement": ("displacement", "m"), "temperature": ("temperature", 
           "von_mises": ("von Mises stress", "Pa"), "contact_pressure": ("contact pressure", "Pa"),
           "heat_flux": ("frictional heat flux", "W/m^2"), "contact_stiffness": ("contact stiffness", "Pa/m"),
           "partition": ("heat partition into body 0", "-"), "wear_depth": ("wear depth", "m"),
-          "flash_temperature": ("flash temperature", "K"), "counter_wear_depth": ("wear depth of body 1", "m")}
+          "flash_temperature": ("flash temperature", "K"), "counter_wear_depth": ("wear depth of body 1", "m"),
+          "interface": ("interface number", "-")}
 
 
 def array_name(field: str) -> str:
@@ -36,9 +37,10 @@ def step_time(t: float, dt: float) -> float:
 
 BODY_FIELDS = ("displacement", "temperature", "von_mises")
 # output fields each analysis writes (when the scene asks for them)
-WRITES = {"transient": ("displacement", "temperature", "von_mises", "contact_pressure", "heat_flux", "partition"),
+WRITES = {"transient": ("displacement", "temperature", "von_mises", "contact_pressure", "heat_flux", "partition",
+                        "interface"),
           "multiscale": tuple(FIELDS),
-          "squeal": ("displacement", "von_mises", "contact_pressure")}
+          "squeal": ("displacement", "von_mises", "contact_pressure", "interface")}
 PROVENANCE = {"scene.toml": "the scene file as given",
               "scene_resolved.toml": "the scene with every default filled in, SI units",
               "provenance.json": "versions, command line, ranks, start and end time, wall time per stage",
@@ -97,9 +99,11 @@ def plan(scene) -> Plan:
     times = output_times(scene)
     when = "the preload" if kind == "squeal" else f"{len(times)} output time(s)"
     files = {}
+    numbers = ", ".join(f"{k} {n}" for k, n in enumerate(scene.geometry.spec.interfaces, 1))
     for name, held in [(b, body) for b in scene.bodies] + [("interface", iface)]:
         if held:
-            files[f"{name}.xdmf"] = f"fields of {name} at {when}: {', '.join(array_name(f) for f in held)}"
+            files[f"{name}.xdmf"] = f"fields of {name} at {when}: {', '.join(array_name(f) for f in held)}" + (
+                f" ({numbers})" if name == "interface" and "interface" in held else "")
             files[f"{name}.h5"] = f"data of {name}.xdmf"
     if kind == "squeal":
         files["modes.csv"] = "frequency, growth rate, damping ratio and SLEPc error of every mode"

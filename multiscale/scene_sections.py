@@ -245,7 +245,7 @@ OUTPUT_FIELDS: dict[str, tuple[str, ...]] = {
     "displacement": (), "von_mises": (), "contact_pressure": ("contact",),
     "temperature": ("thermal",), "heat_flux": ("thermal",),
     "contact_stiffness": ("roughness",), "partition": ("heat_partition",), "wear_depth": ("wear",),
-    "flash_temperature": ("roughness", "heat_partition"), "counter_wear_depth": ("wear",),
+    "flash_temperature": ("roughness", "heat_partition"), "counter_wear_depth": ("wear",), "interface": (),
 }
 
 

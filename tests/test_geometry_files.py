@@ -478,6 +478,18 @@ def test_the_friction_force_of_several_pads_is_the_sum_of_theirs(tmp_path):
     h = run(scene, verbose=False).history
     for pad in ("pad_a", "pad_b"):
         assert h[f"friction_force_{pad}"][-1] == pytest.approx(0.4 * h[f"interface_force_{pad}"][-1], rel=1e-3)
+    # interface.xdmf numbers the facets of each interface (1 pad_a, 2 pad_b, as `check` lists them):
+    # the pressure over those of each is that pad's force
+    import meshio
+    reader = meshio.xdmf.TimeSeriesReader(str(tmp_path / "out" / "interface.xdmf"))
+    points, cells = reader.read_points_cells()
+    cell_data = reader.read_data(reader.num_steps - 1)[2]
+    tri = points[cells[0].data]
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    number, p = cell_data["interface number [-]"][0], cell_data["contact pressure [Pa]"][0]
+    assert sorted(set(number)) == [1.0, 2.0]
+    for k, pad in ((1, "pad_a"), (2, "pad_b")):
+        assert p[number == k] @ area[number == k] == pytest.approx(h[f"interface_force_{pad}"][-1], rel=1e-9)
     assert h["friction_force"][-1] == pytest.approx(h["friction_force_pad_a"][-1] + h["friction_force_pad_b"][-1],
                                                     rel=1e-12)
     assert h["friction_force"][-1] == pytest.approx(0.4 * 1000, rel=1e-3)

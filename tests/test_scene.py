@@ -182,7 +182,7 @@ def test_block_demo_validates():
     block = load(DEMOS / "block_on_flat.toml")
     assert block.effects == {"contact"} and block.loading.pressure == 1e6
     assert block.interface.penalty == 1e13 and block.time.end is None
-    assert block.output.fields == ("displacement", "von_mises", "contact_pressure")
+    assert block.output.fields == ("displacement", "von_mises", "contact_pressure", "interface")
     assert any("penalty K_n = 1e+13 Pa/m" in line for line in summary(block))
 
 

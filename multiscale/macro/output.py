@@ -250,7 +250,8 @@ class FieldOutput:
                 self.von_mises.append((f, fem.Expression(mech.von_mises(i), V.element.interpolation_points)))
                 body[i]["von_mises"] = f
         contact = mech.contact
-        makers = {"contact_pressure": lambda: contact.facet_pressure() * (contact.engaged.value != 0.0)}   # 0 released
+        makers = {"contact_pressure": lambda: contact.facet_pressure() * (contact.engaged.value != 0.0),   # 0 released
+                  "interface": lambda: tm.interface.tag_index + 1.0}     # 1, 2, ... in the order of tm.interface.tags
         if th is not None:
             makers["heat_flux"] = contact.facet_heat_flux
             makers["partition"] = lambda: tm.interface.values(contact.partition)
