@@ -27,7 +27,8 @@ from multiscale.scene_summary import cells_line, reference, summary
 from multiscale.units import UnitError, to_si
 
 DESCRIPTION = """Multi-scale thermo-mechanical simulation of frictional sliding contacts (disc brakes,
-pin-on-disc): validate a scene file (check), run it (run), sweep parameters (study)."""
+pin-on-disc): validate a scene file (check), run it (run), sweep parameters (study), analyse a
+measured topography (surface), print the versions (info)."""
 INTERRUPTED = 130        # exit code after Ctrl-C (128 + SIGINT, as shells report it)
 MPIEXEC = f"{Path(sys.executable).parent / 'mpiexec'}"
 EPILOG = f"""Parallel runs: {MPIEXEC} -n N multiscale run scene.toml
@@ -287,7 +288,8 @@ def build_parser() -> argparse.ArgumentParser:
     study = sub.add_parser("study", help=f"parametric study: sweep, resumable runs, accuracy-vs-time report "
                                          f"(in parallel: {MPIEXEC} -n N multiscale study STUDY)",
                            description="Sweep the knobs of a problem, run what is missing (resumable) and "
-                           "write tables, plots and a Markdown report.", epilog=EPILOG,
+                           "write tables, plots and a Markdown report.",
+                           epilog=EPILOG.replace("multiscale run scene.toml", "multiscale study STUDY.toml"),
                            formatter_class=argparse.RawDescriptionHelpFormatter)
     study.add_argument("studies", nargs="*", metavar="STUDY", help="study TOML file(s)")
     study.add_argument("--rerun-failed", action="store_true", help="run the failed runs again")
@@ -296,7 +298,10 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("--problems", action="store_true", help="list the problems, their parameters and metrics")
     study.set_defaults(func=_study)
     surface = sub.add_parser("surface", help="measured topography: conditioning, statistics (Sq, Sdq, Ssk, Sku, "
-                                             "Nayak, summits, PSD fit) and a figure")
+                                             "Nayak, summits, PSD fit) and a figure",
+                             description="Read a measured topography (through SurfaceTopography), remove its form, "
+                             "fill undefined points, optionally split waviness from roughness, and print its "
+                             "statistics; writes a figure of the height map and the PSD with its fit.")
     surface.add_argument("file", nargs="?", metavar="FILE", help="topography file (x3p, sur, plu, opd, ...; "
                                                                  "--formats lists them)")
     surface.add_argument("--channel", type=int, metavar="N", help="channel index (default: the file's default)")

@@ -50,6 +50,7 @@ class History:
         self.columns: dict[str, list[float]] = {}
 
     def append(self, **row: float) -> None:
+        """Add one row (every column of the first row, no other; KeyError otherwise)."""
         if self.columns and set(row) != set(self.columns):
             raise KeyError(f"history row keys {sorted(row)} differ from {sorted(self.columns)}")
         for key, value in row.items():
@@ -77,6 +78,7 @@ class History:
 
     @classmethod
     def read(cls, path: Path) -> "History":
+        """The history written by ``write`` to ``path``."""
         h = cls()
         with h5py.File(path, "r") as f:
             h.columns = {key: list(f[key][...]) for key in f.keys()}

@@ -132,6 +132,7 @@ class Scene:
 
     @property
     def bodies(self) -> tuple[str, str]:
+        """Names of the two bodies: the stationary one (body 0: pin, pads) and the moving one."""
         return self.geometry.bodies
 
     @property

@@ -483,7 +483,8 @@ class Micro:
     "explicit" (from the previous step), "fixed-point" (iterated within the step to
     ``coupling_tol`` in at most ``coupling_iterations`` passes) or "implicit" (bulk only: the
     partition at equal temperatures and the zone's exchange G as an interface conductance);
-    default ``COUPLING_DEFAULT`` (see ``multiscale.coupling``)."""
+    default "implicit" with "bulk" remote temperatures, "explicit" with "rough" (nothing to iterate:
+    the partition does not depend on the temperatures)."""
 
     zones: tuple | None = key(Pair(Integer(ge=1)), required=True)             # (nx, ny) zones
     grid: tuple | None = key(Pair(Integer(ge=8)))                             # (nx, ny) per zone
@@ -563,6 +564,9 @@ class Wear:
 
 @dataclass(frozen=True)
 class Layer:
+    """One layer of [[layers.layer]] (top first): its thickness and elastic constants, and its
+    conductivity with effect "thermal"."""
+
     thickness: float = key(Quantity("length", gt=0, plausible=(1e-9, 0.1)), required=True)  # m
     E: float = key(_MODULUS, required=True)                                   # Pa
     nu: float = key(_POISSON, required=True)
