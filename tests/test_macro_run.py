@@ -183,3 +183,17 @@ def test_the_python_entry_points_name_bad_arguments(tmp_path):
         load(3)
     with pytest.raises(InputError, match="text = .*: the scene's TOML text"):
         loads(path.read_bytes())
+
+
+def test_the_sliding_power_leaves_the_speed_and_the_heating_as_they_were(tmp_path):
+    """``sliding_power`` evaluates mu ∫ p |w| dA at unit speed and heating and restores both: it
+    saved views of the Constants, so a wear update left the speed at 1 rad/s and the heating at
+    1 (the heat-flux field of every wear run 1/omega too low, friction after a stop; found by an
+    adversarial test). The power is the frictional heat rate over the speed."""
+    model = build_model(loads(pin_on_disc(tmp_path / "pod")))
+    model.start()
+    c = model.contact
+    c.speed.value, c.heating.value = 20.9, 0.5
+    unit = model.sliding_power()
+    assert (float(c.speed.value), float(c.heating.value)) == (20.9, 0.5)
+    assert unit == pytest.approx(sum(c.heat_power()) / (20.9 * 0.5), rel=1e-12)

@@ -167,7 +167,7 @@ class MacroModel:
     def sliding_power(self) -> float:
         """mu ∫ p |w| dA [W] of the last solved pressure at unit speed of body 1 (per rad/s or m/s)."""
         c = self.contact
-        kept = c.speed.value, c.heating.value
+        kept = float(c.speed.value), float(c.heating.value)     # copies: .value is a view of the Constant
         c.speed.value, c.heating.value = 1.0, 1.0
         try:
             return sum(c.heat_power())
