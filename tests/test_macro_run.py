@@ -197,3 +197,18 @@ def test_the_sliding_power_leaves_the_speed_and_the_heating_as_they_were(tmp_pat
     unit = model.sliding_power()
     assert (float(c.speed.value), float(c.heating.value)) == (20.9, 0.5)
     assert unit == pytest.approx(sum(c.heat_power()) / (20.9 * 0.5), rel=1e-12)
+
+
+def test_a_wear_update_deeper_than_the_roughness_is_warned_about(tmp_path):
+    """``workflows.COARSE_WEAR``: a wear update that deepens the deepest wear by more than the RMS
+    height before it (a k_w of 1e-12 /Pa wore 9 RMS in one step of the demo, without a word; found
+    by an adversarial test) is warned about; the demo's 0.08 RMS per update is not."""
+    from multiscale.workflows import run_warnings
+    scene = loads(BLOCK.format(effects='"contact"', folder=tmp_path / "out"))
+    for per_step, warned in ((0.08e-5, False), (9e-5, True)):
+        h = History()
+        for k in range(3):
+            h.append(time=1.2 * k, wear_max_depth=per_step * k, rms_height=1e-5)
+        lines = [w for w in run_warnings(scene, h) if "wear update" in w]
+        assert bool(lines) == warned
+    assert lines[0].startswith("a wear update deepened the wear by 9 times the RMS height (at t = 1.2 s)")
