@@ -73,7 +73,7 @@ if comm.rank == 0:
     rows = [("face RMS height [nm]", "rms_height", 1e9, 0), ("zones in contact", "zones_in_contact", 1, 0),
             ("max zone pressure [MPa]", "max_zone_pressure", 1e-6, 0),
             ("max micro pressure [MPa]", "micro_max_pressure", 1e-6, 0),
-            ("heat into the pin, mean [%]", "partition_mean", 100, 0),
+            ("zones' partition into the pin, mean [%]", "partition_mean", 100, 0),
             ("max pin temperature [degC]", "max_temperature_pin", 1, -273.15),
             ("max micro temperature [degC]", "micro_max_temperature", 1, -273.15),
             ("wear volume [um^3]", "wear_volume", 1e18, 0)]
