@@ -40,6 +40,9 @@ from multiscale.micro.zones import Zone, ZoneGrid
 from multiscale.pool import MicroPool
 
 P_MAX_HALVINGS = 4         # a zone whose law fails is retried with p_max / 2, ... / 16
+FULL_CONTACT = ("every zone is close to full contact even at p_max / 16: at these pressures the surface is too "
+                "smooth for laws of rough contact; perfect contact (effects without \"roughness\", the "
+                "interface's penalty) is the model for it")
 
 
 @dataclass(frozen=True)
@@ -204,9 +207,10 @@ class RoughInterface:
                 laws = self.pool.laws(todo[comm.rank::comm.size], spec, gather="all")
             except LawError as exc:
                 if level == P_MAX_HALVINGS:           # the messages name the last p_max: say how it came
+                    full = len(exc.failures) == len(todo) and all("full contact" in f.message for f in exc.failures)
                     raise LawError([dataclasses.replace(f, message=f"{f.message}, reached by {level} halvings of "
                                                         f"p_max = {self.spec.p_max:.3g} Pa") for f in exc.failures],
-                                   exc.result) from None
+                                   exc.result, FULL_CONTACT if full else "") from None
                 laws = exc.result
                 self.levels[[f.zone_id for f in exc.failures]] = level + 1
             computed += self.pool.stats.computed - self.pool.stats.failed

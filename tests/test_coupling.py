@@ -478,10 +478,13 @@ def test_plastic_pin_on_disc_caps_the_micro_pressure_and_keeps_archard(tmp_path)
 def test_laws_failing_at_every_p_max_say_how_it_was_reached(tmp_path):
     """Zones close to full contact far below p_max: their laws fail at p_max and at each of its
     P_MAX_HALVINGS halvings; the error names the last p_max tried and how it came from the scene's
-    (before: "lower p_max (now 6.25e+06 Pa)" for a scene that set 100 MPa)."""
+    (before: "lower p_max (now 6.25e+06 Pa)" for a scene that set 100 MPa), and, every zone failing,
+    that perfect contact is the model (lowering p_max further traded the failure for laws
+    extrapolated 1e3 times beyond their top; found by an adversarial test)."""
     from multiscale.micro.laws import LawError
-    from multiscale.rough import P_MAX_HALVINGS
+    from multiscale.rough import FULL_CONTACT, P_MAX_HALVINGS
     with pytest.raises(LawError, match=rf"close to full contact\); lower p_max \(this law's: 6.25e\+06 Pa\), reached by "
-                                       rf"{P_MAX_HALVINGS} halvings of p_max = 1e\+08 Pa"):
+                                       rf"{P_MAX_HALVINGS} halvings of p_max = 1e\+08 Pa") as caught:
         run_pod(tmp_path / "full", {"roughness.rms": "0.01 um", "micro.p_max": "100 MPa", "time.steps": 1,
                                     "time.end": "0.6 s"})
+    assert str(caught.value).endswith(FULL_CONTACT)

@@ -170,12 +170,12 @@ class LawError(ConvergenceError):
     """Laws of some zones could not be computed; ``failures`` lists them (zone ids, reasons) and
     ``result`` holds the ``ZoneLaws`` of the others (or None)."""
 
-    def __init__(self, failures: list[ZoneFailure], result=None):
-        self.failures = list(failures)
+    def __init__(self, failures: list[ZoneFailure], result=None, note: str = ""):
+        self.failures, self.note = list(failures), note
         lines = [f"zone {f.zone_id}: {f.kind}: {f.message}" for f in self.failures[:10]]
         more = len(self.failures) - len(lines)
         text = f"laws failed for {len(self.failures)} zone(s):\n  " + "\n  ".join(lines) \
-            + (f"\n  ... and {more} more" if more > 0 else "")
+            + (f"\n  ... and {more} more" if more > 0 else "") + (f"\n{note}" if note else "")
         super().__init__(text, history=None, result=result)
 
 
