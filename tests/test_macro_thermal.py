@@ -520,6 +520,12 @@ def test_a_rotating_disc_heated_by_two_pads_against_the_semi_infinite_solid(tmp_
     assert np.mean(T[track]) == pytest.approx(surface, rel=0.2)
     assert np.min(T[np.abs(z) < 1e-6]) > 2 * bottom - 0.1 * surface
     assert h["min_temperature_disc"].min() > 293.15 - 0.1 * surface
+    # the disc's c as a (flat) table: the enthalpy path's quadrature, exact for P2 (the P1 rule of
+    # degree 3 made the P2 storage matrix indefinite), gives the constant material's temperatures
+    table = loads(TWO_PADS.format(step=step, folder=tmp_path / "table").replace(
+        'c = "500 J/(kg K)"', 'c = [["0 degC", "500 J/(kg K)"], ["1000 degC", "500 J/(kg K)"]]', 1))
+    np.testing.assert_allclose(run(table, verbose=False).history["max_temperature_disc"], h["max_temperature_disc"],
+                               rtol=1e-8)                # the Newton's tolerance
     monkeypatch.setattr(thermal, "TRANSPORT_DEGREE", 1)
     p1 = run(loads(TWO_PADS.format(step=step, folder=tmp_path / "p1")), verbose=False)
     low = p1.history["min_temperature_disc"].min()

@@ -85,7 +85,9 @@ NEWTON_OPTIONS = {"snes_type": "newtonls", "snes_linesearch_type": "basic", "sne
 STEFAN_BOLTZMANN = 5.670374419e-8      # W/(m^2 K^4), CODATA 2018 (exact)
 CONVECTION_QUADRATURE = 2              # exact for h (T − T_a) r, P1 on flat facets
 RADIATION_QUADRATURE = 5               # exact for (T^4 − T_a^4) r, P1
-ENTHALPY_QUADRATURE = 3                # e(T) r with a tabulated rho c (same rule for the stored heat)
+ENTHALPY_QUADRATURE = 3                # e(T) r with a tabulated rho c, P1 (same rule for the stored heat);
+                                       # + 2 per degree above 1 (P2: FFCx's degree-3 rule, one negative weight,
+                                       # made the P2 storage matrix indefinite, rank 5 of 10)
 CHORD_CONTRACTION = 0.01               # keep the Newton tangent while ||F_k|| <= this times ||F_k-1|| (0: never)
 FACTOR_PRECISION = "single"            # the Newton's LU factors (mumps.precision); a linear step's stay double
 
@@ -268,7 +270,11 @@ class Thermal:
         the transported body 1 keeps the consistent one (its SUPG term weighs the same residual)."""
         if not (i == 1 and self.transport):
             return self._dx(i, scheme="vertex")
-        return self._dx(i) if self.capacity[i].constant else self._dx(i, ENTHALPY_QUADRATURE)
+        return self._dx(i) if self.capacity[i].constant else self._dx(i, self._enthalpy_degree(i))
+
+    def _enthalpy_degree(self, i: int) -> int:
+        """Quadrature degree of body i's terms with tabulated materials (``ENTHALPY_QUADRATURE``)."""
+        return ENTHALPY_QUADRATURE + 2 * (self.spaces[i].element.basix_element.degree - 1)
 
     def _rate(self, i: int):
         """(e(T) − e(T_old))/dt [W/m^3]: rho c (T − T_old)/dt for a constant rho c."""
@@ -304,7 +310,8 @@ class Thermal:
             residual -= ufl.div(kappa * ufl.grad(T))
         # a tabulated disc makes rho_c and tau high-degree expressions (UFL estimates 9): integrate
         # with the enthalpy's rule, exact for the Galerkin part with P1 (constant materials: unchanged)
-        dx = self._dx(1) if self.capacity[1].constant and self.kappa_constant[1] else self._dx(1, ENTHALPY_QUADRATURE)
+        dx = self._dx(1) if self.capacity[1].constant and self.kappa_constant[1] else \
+            self._dx(1, self._enthalpy_degree(1))
         return (rho_c * ufl.dot(w, ufl.grad(T)) * r + tau * ufl.dot(w, ufl.grad(r)) * residual) * dx
 
     def _apply_boundaries(self, r) -> list[AppliedBoundary]:
