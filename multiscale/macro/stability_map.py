@@ -167,15 +167,18 @@ def _match(lam: np.ndarray, Q: np.ndarray, q_ref: np.ndarray, lam_ref: complex, 
 
 
 def bisect_onset(lo: ReducedSystem, hi: ReducedSystem, v_lo: float, v_hi: float, q_ref, lam_ref, gram, band,
-                 *, rtol: float = 1e-6, xtol: float = 1e-6, max_steps: int = 60) -> tuple | None:
+                 *, rtol: float = 1e-6, xtol: float = 1e-6, max_steps: int = 60,
+                 check_lo: bool = False) -> tuple | None:
     """Bisect the value in [v_lo, v_hi] where the mode continuing (q_ref, lam_ref) (unstable at
     v_hi) turns unstable, on the reduced systems blended linearly; returns (value, frequency at
-    the onset [Hz], final bracket, relative frequency gap to the nearest other mode there), or
-    None when that mode is unstable at v_lo already (no onset in the bracket)."""
-    lam, Q = lo.eigenpairs()
-    keep = select(lam, band, None, band[0])
-    if _unstable(lam[keep][_match(lam[keep], Q[:, keep], q_ref, lam_ref, gram)][None], rtol)[0]:
-        return None
+    the onset [Hz], final bracket, relative frequency gap to the nearest other mode there); with
+    ``check_lo`` (a track that starts at v_hi: its mode at v_lo is not known) None when the best
+    match at v_lo is unstable already (no onset in the bracket)."""
+    if check_lo:
+        lam, Q = lo.eigenpairs()
+        keep = select(lam, band, None, band[0])
+        if _unstable(lam[keep][_match(lam[keep], Q[:, keep], q_ref, lam_ref, gram)][None], rtol)[0]:
+            return None
     a, b, f_b, gap = 0.0, 1.0, lam_ref.imag / TWO_PI, np.inf
     span = abs(v_hi - v_lo)
     for _ in range(max_steps):
@@ -208,6 +211,7 @@ class MapBuilder:
         self.values, self.rows, self.onsets = [], [], []    # rows: per point, per mode (track, MAC)
         self.prev: ModalResult | None = None
         self.n_tracks = 0
+        self.new: set = set()                                # tracks that start at the last point
 
     def add(self, value: float, result: ModalResult) -> list[tuple[int, int]]:
         """Pair ``result`` with the previous point; returns (track, mode index) of every mode that
@@ -221,9 +225,11 @@ class MapBuilder:
             mac = mac_matrix(self.prev, result, gram=result.gram)
             for i, j in pair_modes(mac, self.prev.eigenvalues, result.eigenvalues, self.mac_min):
                 here[j], mk[j] = self.rows[-1][0][i], mac[i, j]
+        first = self.n_tracks
         for j in range(len(result)):
             if here[j] < 0:
                 here[j], self.n_tracks = self.n_tracks, self.n_tracks + 1
+        self.new = set(range(first, self.n_tracks))
         turned = []
         if self.prev is None:
             self.onsets += [Onset(here[j] + 1, np.nan, float(result.frequency[j]), None, BELOW, (np.nan, value))
@@ -246,7 +252,7 @@ class MapBuilder:
         continues an unstable one)."""
         r = self.prev
         found = bisect_onset(lo, hi, self.values[-2], self.values[-1], q_ref, r.eigenvalues[j], gram, self.band,
-                             rtol=self.rtol, xtol=self.xtol)
+                             rtol=self.rtol, xtol=self.xtol, check_lo=track in self.new)
         if found is None:
             return None
         value, freq, bracket, gap = found
