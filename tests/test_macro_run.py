@@ -209,6 +209,8 @@ def test_a_wear_update_deeper_than_the_roughness_is_warned_about(tmp_path):
         h = History()
         for k in range(3):
             h.append(time=1.2 * k, wear_max_depth=per_step * k, rms_height=1e-5)
-        lines = [w for w in run_warnings(scene, h) if "wear update" in w]
+        lines = [w for w in run_warnings(scene, h) if "wear increment" in w]
         assert bool(lines) == warned
-    assert lines[0].startswith("a wear update deepened the wear by 9 times the RMS height (at t = 1.2 s)")
+    assert lines[0].startswith("a wear increment deepened the wear by 9 times the RMS height (at t = 1.2 s)")
+    substeps = loads(BLOCK.format(effects='"contact"', folder=tmp_path / "out"), overrides={"wear.substeps": 10})
+    assert not [w for w in run_warnings(substeps, h) if "wear increment" in w]     # 0.9 RMS per substep

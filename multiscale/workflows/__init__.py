@@ -110,25 +110,27 @@ def run_warnings(scene, history) -> list[str]:
         known = scene.materials[name].beyond(T0)
         out += [f"materials.{name}.{phrase} (in the {body})"
                 for key, phrase in scene.materials[name].beyond(T).items() if key not in known]
-    return out + laws + _undershoots(scene, history) + _coarse_wear(history)
+    return out + laws + _undershoots(scene, history) + _coarse_wear(scene, history)
 
 
 UNDERSHOOT = 0.05     # a body's undershoot warned about: this share of its temperature rise [-]
 COARSE_WEAR = 1.0     # a wear update deepening the deepest wear by this many RMS heights is warned about [-]
 
 
-def _coarse_wear(history) -> list[str]:
-    """A wear update that deepened the deepest wear by more than ``COARSE_WEAR`` times the RMS
-    height before it: the explicit Archard step wears the loaded asperities below the valleys and
-    the worn laws depend on the step count (``micro.wear.simulate_wear`` warns alike; the demo's
-    updates take 0.08 RMS, a 1e-12 /Pa wear rate 9 RMS in one step)."""
+def _coarse_wear(scene, history) -> list[str]:
+    """A wear increment (an update's deepening over its ``wear.substeps``) that deepened the
+    deepest wear by more than ``COARSE_WEAR`` times the RMS height before it: the explicit Archard
+    step wears the loaded asperities below the valleys and the worn laws depend on the step count
+    (``micro.wear.simulate_wear`` warns alike; the demo's updates take 0.08 RMS, a 1e-12 /Pa wear
+    rate 9 RMS in one step)."""
     if "wear_max_depth" not in history.columns:
         return []
-    deeper = np.diff(history["wear_max_depth"]) / np.maximum(history["rms_height"][:-1], np.finfo(float).tiny)
+    deeper = np.diff(history["wear_max_depth"]) / np.maximum(history["rms_height"][:-1], np.finfo(float).tiny) \
+        / (scene.wear.substeps if scene.wear is not None else 1)
     if not deeper.size or deeper.max() <= COARSE_WEAR:
         return []
     row = int(np.argmax(deeper)) + 1
-    return [f"a wear update deepened the wear by {deeper.max():.3g} times the RMS height (at t = "
+    return [f"a wear increment deepened the wear by {deeper.max():.3g} times the RMS height (at t = "
             f"{history['time'][row]:g} s): the explicit wear step is coarse for this wear rate and the results depend "
             "on it; use more wear.substeps or time.steps"]
 
