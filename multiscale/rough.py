@@ -207,7 +207,8 @@ class RoughInterface:
                 laws = self.pool.laws(todo[comm.rank::comm.size], spec, gather="all")
             except LawError as exc:
                 if level == P_MAX_HALVINGS:           # the messages name the last p_max: say how it came
-                    full = len(exc.failures) == len(todo) and all("full contact" in f.message for f in exc.failures)
+                    full = len(exc.failures) == len(self.used) and all("full contact" in f.message
+                                                                        for f in exc.failures)
                     raise LawError([dataclasses.replace(f, message=f"{f.message}, reached by {level} halvings of "
                                                         f"p_max = {self.spec.p_max:.3g} Pa") for f in exc.failures],
                                    exc.result, FULL_CONTACT if full else "") from None
