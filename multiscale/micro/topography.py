@@ -358,12 +358,13 @@ def _um(value: float) -> str:
 
 
 # --------------------------------------------------------------------------- grids
-def resample(surface: Surface, n, size=None) -> tuple[Surface, str]:
+def resample(surface: Surface, n, size=None, antialias: bool = True) -> tuple[Surface, str]:
     """The surface on a grid of n = (nx, ny) cells over size (Lx, Ly) [m] (default: its own size),
     cell centres at ((i + ½) Lx/nx, (j + ½) Ly/ny) from its corner, by cubic splines; a coarser grid
     first low-passes with the Gaussian S-filter at λs = ``S_FILTER_PIXELS`` new pixels along each
-    coarsened axis (against aliasing; an axis kept as fine is not filtered). Returns the surface
-    and one report line."""
+    coarsened axis (against aliasing; an axis kept as fine is not filtered; none with
+    ``antialias`` False, for a surface filtered at about the new pixels already). Returns the
+    surface and one report line."""
     import scipy.ndimage  # ~0.4 s to import: only when a surface is resampled
     nx, ny = check_pair("n", n, check_count)
     Lx, Ly = surface.size if size is None else check_pair("size", size, check_positive)
@@ -371,8 +372,8 @@ def resample(surface: Surface, n, size=None) -> tuple[Surface, str]:
     if (ny, nx) == surface.shape and np.isclose(dx, surface.dx, rtol=1e-9) and np.isclose(dy, surface.dy, rtol=1e-9):
         return surface, "on the micro grid already"
     source, filtered = surface, ""
-    cut_x = S_FILTER_PIXELS * dx if dx > surface.dx * (1 + 1e-9) else 0.0
-    cut_y = S_FILTER_PIXELS * dy if dy > surface.dy * (1 + 1e-9) else 0.0
+    cut_x = S_FILTER_PIXELS * dx if antialias and dx > surface.dx * (1 + 1e-9) else 0.0
+    cut_y = S_FILTER_PIXELS * dy if antialias and dy > surface.dy * (1 + 1e-9) else 0.0
     if cut_x or cut_y:
         source = _gaussian(surface, cut_x, cut_y)
         cuts = f"{cut_x * 1e6:.4g} um" if cut_x == cut_y else \
@@ -398,8 +399,8 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
     - ``"measured"``: the measurement itself, cropped at its centre and resampled; it must cover
       the size;
     - ``"mirror"`` / ``"tile"``: copies of it (mirror-stitched by SurfaceTopography, so without
-      steps at the seams, or repeated as they are), coarsened once to whole cells of the grid and
-      sampled, a ``TopographyWarning`` if more than one copy is needed (wavelengths longer than
+      steps at the seams, or repeated as they are), coarsened once (to whole cells of the grid,
+      or whole periods of the mirror-stitched one) and sampled, a ``TopographyWarning`` if more than one copy is needed (wavelengths longer than
       the measurement are missing and the pattern repeats) and if it spans fewer than 4 cells;
     - ``"equivalent"``: a statistically equivalent surface from its PSD
       (``spectrum.equivalent_surface``, ``seed``) over the whole size.
@@ -422,7 +423,7 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
                    f"um (measured {_um(float(surface.heights.std()))} um; the grid resolves wavelengths down to "
                    f"{2 * max(Lx / nx, Ly / ny) * 1e6:.4g} um, the measurement "
                    f"{2 * max(surface.dx, surface.dy) * 1e6:.4g} um)"]
-    lines = []
+    lines, filtered = [], False
     short = mx < Lx * (1 - 1e-6) or my < Ly * (1 - 1e-6)
     if short and method == "measured":
         raise InputError(f"{prefix}cover", method, f"{wide} does not cover {target}: use \"equivalent\" (a "
@@ -434,15 +435,19 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
             base = Surface(np.asarray(t.heights()).T, surface.dx, surface.dy, periodic=True)
         cell = (Lx / nx, Ly / ny)
         if base.dx < cell[0] * (1 - 1e-9) or base.dy < cell[1] * (1 - 1e-9):     # coarsen once, then copy
-            counts = tuple(max(4, int(np.floor(b / c + 1e-9))) for b, c in zip(base.size, cell))
+            if base.periodic:         # mirror-stitched: whole periods, so that the copies meet without steps
+                counts = tuple(max(4, round(b / c)) for b, c in zip(base.size, cell))
+            else:                     # tiles of whole cells
+                counts = tuple(max(4, int(np.floor(b / c + 1e-9))) for b, c in zip(base.size, cell))
             if min(b / c for b, c in zip(base.size, cell)) < 4:
                 few = (f"{prefix}cover = \"{method}\": {wide} spans fewer than 4 cells of the micro grid "
                        f"({cell[0] * 1e6:.4g} x {cell[1] * 1e6:.4g} um) along an axis: its roughness is finer than "
                        "the grid and the copies keep little of it; use \"equivalent\" or a finer micro.grid")
                 warnings.warn(few, TopographyWarning, stacklevel=2)
                 lines.append(f"warning: {few}")
-            base, note = resample(base, counts, (counts[0] * cell[0], counts[1] * cell[1]))   # whole cells: the
-            lines.append(note)        # copies are sampled at their pixels below, not filtered a second time
+            base, note = resample(base, counts, None if base.periodic else (counts[0] * cell[0], counts[1] * cell[1]))
+            lines.append(note)
+            filtered = True           # the copies are sampled below, not filtered a second time
         reps = (int(np.ceil(Ly / base.size[1])), int(np.ceil(Lx / base.size[0])))
         surface = Surface(np.tile(base.heights, reps), base.dx, base.dy, periodic=False)
         message = (f"{prefix}cover = \"{method}\": {wide} is smaller than {target}: {reps[1]} x {reps[0]} "
@@ -457,6 +462,6 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
     crop = Surface(surface.heights[r0:r1, c0:c1], surface.dx, surface.dy, periodic=False)
     if crop.shape != surface.shape:
         lines.append(f"cropped the central {Lx * 1e3:.4g} x {Ly * 1e3:.4g} mm")
-    out, note = resample(crop, (nx, ny), (Lx, Ly))
+    out, note = resample(crop, (nx, ny), (Lx, Ly), antialias=not filtered)
     lines.append(note)
     return Surface(out.heights - out.heights.mean(), out.dx, out.dy, periodic=False), lines
