@@ -19,6 +19,8 @@ import numpy as np
 from multiscale.errors import InputError
 from multiscale.io import on_root
 
+FORMAT = 2    # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns
+
 
 def fingerprint(text: str) -> str:
     """Short hash of a text (e.g. the repr of a scene) to detect a changed set-up on resume."""
@@ -63,6 +65,7 @@ def save(path, comm, *, attrs: dict, arrays: dict, functions: dict, scale: float
                 for key, value in attrs.items():
                     h5.attrs[key] = value
                 h5.attrs["length_scale"] = scale
+                h5.attrs["format"] = FORMAT
                 h5.attrs["checksum"] = _digest(data)
                 for name, value in data.items():
                     h5.create_dataset(name, data=value)
@@ -77,7 +80,8 @@ def save(path, comm, *, attrs: dict, arrays: dict, functions: dict, scale: float
 def load(path, comm, functions: dict) -> tuple[dict, dict]:
     """Read a checkpoint: sets ``functions`` (name -> Function, matched by dof coordinates) and
     returns (attrs, arrays). Raises InputError (on every rank: each reads the whole file) if the
-    file is unreadable, truncated or corrupted (its checksum), or a function's dofs are not in it."""
+    file is unreadable, truncated or corrupted (its checksum), of another ``FORMAT``, or a
+    function's dofs are not in it."""
     data = {}
     try:
         with h5py.File(path, "r") as h5:
@@ -92,6 +96,9 @@ def load(path, comm, functions: dict) -> tuple[dict, dict]:
     if _digest(data) != checksum:
         raise InputError("--resume", str(path), "the checkpoint is corrupted (its checksum does not match its "
                          "data); start again with --overwrite")
+    if int(attrs.get("format", 1)) != FORMAT:
+        raise InputError("--resume", str(path), f"written by another version of multiscale (checkpoint format "
+                         f"{int(attrs.get('format', 1))}, this one reads {FORMAT}); start again with --overwrite")
     arrays = {name[len("arrays/"):]: value for name, value in data.items() if name.startswith("arrays/")}
     for name, f in functions.items():
         keys, values = _dof_table(f, scale)

@@ -102,6 +102,26 @@ def test_a_damaged_checkpoint_is_one_clear_error(stopped, tmp_path, damage, mess
         run(_with_folder(scene, folder), resume=True, verbose=False)
 
 
+def test_a_checkpoint_of_another_format_is_one_clear_error(stopped, tmp_path):
+    """A checkpoint written before ``checkpoint.FORMAT`` 2 (P1 disc temperatures, no
+    min_temperature columns) would resume into "the mesh changed" or a KeyError at the first row
+    (found in review); it is refused naming its format."""
+    import shutil
+
+    import h5py
+
+    from multiscale.errors import InputError
+    from multiscale.workflows.multiscale import run
+    scene, checkpoint = stopped
+    folder = tmp_path / "copy"
+    shutil.copytree(checkpoint.parent, folder)
+    with h5py.File(folder / "checkpoint.h5", "a") as h5:
+        del h5.attrs["format"]                                  # as written before the format existed
+    with pytest.raises(InputError, match=r"written by another version of multiscale \(checkpoint format 1, this "
+                                         r"one reads 2\); start again with --overwrite"):
+        run(_with_folder(scene, folder), resume=True, verbose=False)
+
+
 def _with_folder(scene, folder):
     import dataclasses
     return dataclasses.replace(scene, output=dataclasses.replace(scene.output, folder=folder))
