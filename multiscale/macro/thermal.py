@@ -83,8 +83,8 @@ NEWTON_OPTIONS = {"snes_type": "newtonls", "snes_linesearch_type": "basic", "sne
                   "snes_atol": 1e-12, "snes_stol": 1e-12, "snes_max_it": 30,
                   "ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
 STEFAN_BOLTZMANN = 5.670374419e-8      # W/(m^2 K^4), CODATA 2018 (exact)
-CONVECTION_QUADRATURE = 2              # exact for h (T − T_a) r, P1 on flat facets
-RADIATION_QUADRATURE = 5               # exact for (T^4 − T_a^4) r, P1
+CONVECTION_QUADRATURE = 2              # exact for h (T − T_a) r, P1 on flat facets (times the degree: P2)
+RADIATION_QUADRATURE = 5               # exact for (T^4 − T_a^4) r, P1 (times the degree: P2)
 ENTHALPY_QUADRATURE = 3                # e(T) r with a tabulated rho c, P1 (same rule for the stored heat);
                                        # + 2 per degree above 1 (P2: FFCx's degree-3 rule, one negative weight,
                                        # made the P2 storage matrix indefinite, rank 5 of 10)
@@ -272,6 +272,11 @@ class Thermal:
             return self._dx(i, scheme="vertex")
         return self._dx(i) if self.capacity[i].constant else self._dx(i, self._enthalpy_degree(i))
 
+    def _facet_degree(self, i: int, p1: int) -> int:
+        """Quadrature degree of a boundary term of body i exact for P1 at ``p1``: ``p1`` times its
+        temperature's degree (a product of P2 factors)."""
+        return p1 * self.spaces[i].element.basix_element.degree
+
     def _enthalpy_degree(self, i: int) -> int:
         """Quadrature degree of body i's terms with tabulated materials (``ENTHALPY_QUADRATURE``)."""
         return ENTHALPY_QUADRATURE + 2 * (self.spaces[i].element.basix_element.degree - 1)
@@ -350,11 +355,11 @@ class Thermal:
                 a.bc = fem.dirichletbc(float(c.temperature), dofs, self.spaces[a.body])
             if c.convection is not None:
                 a.h = fem.Constant(tm.parent, c.h(float(self.contact.speed.value)))
-                self.residuals[a.body] += a.h * (T - a.ambient) * r[a.body] * ds(a.index + 1,
-                                                                                  degree=CONVECTION_QUADRATURE)
+                self.residuals[a.body] += a.h * (T - a.ambient) * r[a.body] * ds(
+                    a.index + 1, degree=self._facet_degree(a.body, CONVECTION_QUADRATURE))
             if c.emissivity is not None:
-                self.residuals[a.body] += self._radiation(a) * r[a.body] * ds(a.index + 1,
-                                                                              degree=RADIATION_QUADRATURE)
+                self.residuals[a.body] += self._radiation(a) * r[a.body] * ds(
+                    a.index + 1, degree=self._facet_degree(a.body, RADIATION_QUADRATURE))
         return applied
 
     def _radiation(self, a: AppliedBoundary):
@@ -454,10 +459,10 @@ class Thermal:
             key = (a.index, a.body)
             if a.h is not None:
                 out[key] += dt * self.cache.scalar(("convection",) + key, lambda: a.h * (T - a.ambient) * ds(
-                    a.index + 1, degree=CONVECTION_QUADRATURE))
+                    a.index + 1, degree=self._facet_degree(a.body, CONVECTION_QUADRATURE)))
             if a.condition.emissivity is not None:
                 out[key] += dt * self.cache.scalar(("radiation",) + key, lambda: self._radiation(a) * ds(
-                    a.index + 1, degree=RADIATION_QUADRATURE))
+                    a.index + 1, degree=self._facet_degree(a.body, RADIATION_QUADRATURE)))
             if a.bc is not None:
                 if a.body not in residual:
                     residual[a.body] = self._residual_vector(a.body)
