@@ -99,7 +99,7 @@ class Mechanics:
 
     ``materials`` maps material names (of the geometry's regions) to objects with ``E`` [Pa],
     ``nu`` and, with ``temperatures`` given, ``alpha`` [1/K], each a constant or a temperature table
-    ((K, value), ...). ``temperatures`` is a pair of P1 functions on the body submeshes (thermal
+    ((K, value), ...). ``temperatures`` is a pair of Lagrange functions on the body submeshes (thermal
     expansion relative to ``reference_temperature`` [K], the temperature of tables without them).
     ``stiffness`` [Pa/m] (scalar or per-facet array), ``friction``, ``speed`` and ``law`` go to
     ``ContactInterface``. ``load`` is the total force [N] along the spec's load direction on its
