@@ -130,7 +130,7 @@ def plot_map(smap, path) -> Path:
     art = ax.scatter(smap.frequency[ok], smap.growth[ok], c=values[ok], s=8, cmap="viridis")
     fig.colorbar(art, ax=ax, label=f"{smap.parameter} [{smap.unit}]")
     ax.axhline(0.0, color="k", lw=0.5)
-    for o in smap.onsets:
+    for o in (o for o in smap.onsets if np.isfinite(o.value)):      # not those below the sweep
         ax.plot(o.frequency, 0.0, "rx", ms=7)
     ax.set(xlabel="frequency [Hz]", ylabel="growth rate sigma [1/s]",
            title=f"stability map over {smap.parameter} (x: onsets)")
