@@ -214,3 +214,29 @@ def test_a_wear_update_deeper_than_the_roughness_is_warned_about(tmp_path):
     assert lines[0].startswith("a wear increment deepened the wear by 9 times the RMS height (at t = 1.2 s)")
     substeps = loads(BLOCK.format(effects='"contact"', folder=tmp_path / "out"), overrides={"wear.substeps": 10})
     assert not [w for w in run_warnings(substeps, h) if "wear increment" in w]     # 0.9 RMS per substep
+
+
+def test_kept_heat_factors_give_the_factorised_answer(tmp_path, monkeypatch):
+    """``thermal.KEPT_ITERATIONS``: a linear heat step solves by GMRES on LU factors of an earlier
+    step's matrix (the interface terms change every step: it refactorised every step, 1.05 s of
+    each ch. 7 step with the P2 disc). Over 8 steps of a slowing disc (its transport term changes
+    at every step) the temperatures are those of factors refreshed at every step to 1e-10 of
+    their values (3e-11 measured), with 2 factorisations instead of 8."""
+    from multiscale.macro import thermal
+
+    def march(kept: int):
+        monkeypatch.setattr(thermal, "KEPT_ITERATIONS", kept)
+        scene = loads(pin_on_disc(tmp_path / f"pod{kept}").replace(      # a slowing disc: the matrix changes
+            'rotation_speed = "200 rpm"', 'speed_profile = [["0 s", "200 rpm"], ["4.8 s", "150 rpm"]]'),
+            overrides={"time.steps": 8, "time.end": "4.8 s"})
+        model = build_model(scene)
+        model.start()
+        for _ in range(scene.time.steps):
+            model.macro_step(scene.time.dt, scene.time.substeps)
+        return [T.x.array.copy() for T in model.thermal.T], model.thermal.factorisations
+    default = thermal.KEPT_ITERATIONS
+    fresh, every = march(-1)                      # -1: refactorised at every step
+    kept, fewer = march(default)
+    assert every == 8 and fewer < every
+    for a, b in zip(kept, fresh):
+        np.testing.assert_allclose(a, b, rtol=1e-10)         # GMRES to 1e-12 of each step's residual
