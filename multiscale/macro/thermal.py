@@ -254,6 +254,7 @@ class Thermal:
                 self.problem.solver.getKSP().setType("preonly")
         self.factorisations = 0                # linear steps: LU factorisations so far
         self._stale = True                     # linear steps: refactorise at the next step
+        self._kept = False                     # linear steps: the last solve ran on earlier factors
         self.jacobians = 0                     # Newton: tangents assembled (and factorised) so far
         self._norms: list = []                 # Newton: residual norms of the current solve
         self._chords = 0                       # Newton: iterations of the current solve on a kept tangent
@@ -389,7 +390,8 @@ class Thermal:
         fpetsc.assign(x, self.T)
         self._tangent.update()
         self._tangent.compose(J)
-        if self._stale or snes.getKSP().getIterationNumber() > KEPT_ITERATIONS:   # global: alike on every rank
+        self._kept = not (self._stale or snes.getKSP().getIterationNumber() > KEPT_ITERATIONS)   # global count
+        if not self._kept:
             J.copy(P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
             self._stale, self.factorisations = False, self.factorisations + 1
 
@@ -423,6 +425,11 @@ class Thermal:
         finite = bool(self.tm.comm.allreduce(all(np.isfinite(T.x.array).all() for T in self.T), op=MPI.LAND))
         return self.problem.solver.getConvergedReason() > 0 and finite
 
+    def _back_to_start(self) -> None:
+        """The temperatures of the start of the step (to solve it again)."""
+        for new, old in zip(self.T, self.T_old):
+            new.x.array[:] = old.x.array
+
     def step(self, dt: float) -> ThermalStep:
         """Advance by dt [s] with the current contact state (pressure, speed) as heat source."""
         self.dt.value = check_positive("dt", dt)
@@ -435,14 +442,12 @@ class Thermal:
         for new, old in zip(self.T, self.T_old):
             old.x.array[:] = new.x.array
         ok = self._solve()                                        # the same answer on every rank
-        if not ok and not self.nonlinear and not self._stale:    # kept factors: redo with fresh ones
-            for new, old in zip(self.T, self.T_old):
-                new.x.array[:] = old.x.array
+        if not ok and not self.nonlinear and self._kept:    # earlier factors: redo with fresh ones
+            self._back_to_start()
             self._stale, self.redone = True, self.redone + 1
             ok = self._solve()
         if not ok and (self._chords or self.precision != "double"):    # redo with fresh double factors
-            for new, old in zip(self.T, self.T_old):
-                new.x.array[:] = old.x.array
+            self._back_to_start()
             if self.precision != "double":                        # a new analysis in double, kept from now on
                 self.precision = "double"
                 self.problem.solver.getKSP().getPC().reset()
