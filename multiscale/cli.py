@@ -311,7 +311,8 @@ def build_parser() -> argparse.ArgumentParser:
     surface.add_argument("--max-undefined", type=float, default=MAX_UNDEFINED, metavar="FRACTION",
                          help=f"largest share of undefined points that is filled (default {MAX_UNDEFINED})")
     surface.add_argument("--pixel-size", metavar="LENGTH", help="override the file's pixel size")
-    surface.add_argument("--height-unit", metavar="LENGTH", help='override the file\'s height unit, e.g. "um" or "1 um"')
+    surface.add_argument("--height-unit", metavar="LENGTH",
+                         help='override the file\'s height unit, e.g. "um" or "1 um"')
     surface.add_argument("--figure", metavar="PNG", help="figure path (default FILE-stem_surface.png; none: no figure)")
     surface.add_argument("--formats", action="store_true", help="list the file formats")
     surface.set_defaults(func=_surface)

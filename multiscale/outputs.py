@@ -129,8 +129,8 @@ def plan(scene) -> Plan:
         if scene.has("wear"):
             rough = scene.rough_interfaces
             files.update({("wear_map.png" if len(rough) == 1 else f"wear_map_{n}.png"):
-                          f"wear depth over {'the interface' if n == 'interface' else f'the interface {n}'}: per zone and the micro "
-                          "field" for n in rough})
+                          f"wear depth over the interface{'' if n == 'interface' else ' ' + n}: per zone and the "
+                          "micro field" for n in rough})
     files.update(PROVENANCE)
     return Plan(kind, scene.output.folder, tuple(scene.bodies), body, iface, times, files,
                 tuple(f for f in scene.output.fields if f not in WRITES[kind]))

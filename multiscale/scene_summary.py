@@ -80,7 +80,8 @@ def _effect_line(scene: Scene, effect: str) -> str:
         return f"penalty K_n = {i.penalty:g} Pa/m" if not scene.has("roughness") else "rough per-zone laws"
     if effect == "friction":
         if ld.friction_curve is not None:
-            return "mu(slip speed) from friction_curve: " + ", ".join(f"{mu:g} at {v:g} m/s" for v, mu in ld.friction_curve)
+            return "mu(slip speed) from friction_curve: " + ", ".join(f"{mu:g} at {v:g} m/s"
+                                                                      for v, mu in ld.friction_curve)
         if ld.stribeck is not None:
             st = ld.stribeck
             return (f"Stribeck mu(v) = {st.kinetic:g} + ({st.static:g} - {st.kinetic:g}) exp(-(v / {st.speed:g} m/s)"

@@ -280,7 +280,8 @@ class MapBuilder:
                 out["frequency"][k, t], out["growth"][k, t], out["residual"][k, t] = f[j], g[j], e[j]
                 out["mac"][k, t], mode[k, t] = mk[j], j + 1
         return StabilityMap(self.parameter, self.unit, np.array(self.values), out["frequency"], out["growth"], mode,
-                            out["mac"], out["residual"], sorted(self.onsets, key=lambda o: (np.nan_to_num(o.value, nan=-np.inf), o.frequency)),
+                            out["mac"], out["residual"],
+                            sorted(self.onsets, key=lambda o: (np.nan_to_num(o.value, nan=-np.inf), o.frequency)),
                             basis_size, self.rtol, time)
 
 

@@ -133,8 +133,8 @@ def by_rows(n, ny, nx):
 def extend(label, fi, fj, nf, bi, bj, ring_end, count, X, gammas, periodic, active, ny, nx, Fx):
     """X = E r on the physical grid (X holds r on F from ``free_set``): ring by ring
     (8-neighbourhood), gamma_k (``gammas[b, k - 1]`` of patch b) times the mean of the values of
-    the neighbouring cells of ring k - 1. Builds the rings (``label`` k) and ``count``, the neighbours of each ring cell in the
-    ring inside it: by scattering from the listed cells (``bi``/``bj``/``ring_end`` list the
+    the neighbouring cells of ring k - 1. Builds the rings (``label`` k) and ``count``, the
+    neighbours of each ring cell in the ring inside it: by scattering from the listed cells (``bi``/``bj``/``ring_end`` list the
     rings), or by row sweeps when F covers ``DENSE_FROM`` of the grid or more (then F and its
     rings cover most of it and the scatter would visit each ring cell from up to 8 sides)."""
     for b in range(label.shape[0]):

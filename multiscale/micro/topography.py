@@ -400,8 +400,9 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
       the size;
     - ``"mirror"`` / ``"tile"``: copies of it (mirror-stitched by SurfaceTopography, so without
       steps at the seams, or repeated as they are), coarsened once (to whole cells of the grid,
-      or whole periods of the mirror-stitched one) and sampled, a ``TopographyWarning`` if more than one copy is needed (wavelengths longer than
-      the measurement are missing and the pattern repeats) and if it spans fewer than 4 cells;
+      or whole periods of the mirror-stitched one) and sampled, a ``TopographyWarning`` if more
+      than one copy is needed (wavelengths longer than the measurement are missing and the
+      pattern repeats) and if it spans fewer than 4 cells;
     - ``"equivalent"``: a statistically equivalent surface from its PSD
       (``spectrum.equivalent_surface``, ``seed``) over the whole size.
 

@@ -37,8 +37,8 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
               f"- Reference: {reference_text(study)}"
               + ("; error = |m − m_ref| / |m_ref|" if study.reference else ""),
               f"- Runs: {len(ok)} ok, {len(failed)} failed; {sum(r.record.get('wall_time', 0) for r in rows):.1f} s "
-              f"of run wall time in all (failed runs included). Wall time: best of {study.options.repeat} repetition(s) in a fresh "
-              "process (one thread); peak memory: the run process's maximum resident set (interpreter and "
+              f"of run wall time in all (failed runs included). Wall time: best of {study.options.repeat} "
+              "repetition(s) in a fresh process (one thread); peak memory: the run process's maximum resident set (interpreter and "
               "libraries included; in brackets what the run added to the process's baseline).",
               f"- Generated {now()} on a {os.cpu_count()}-core machine by `{command or 'multiscale study ' + study.source.name}`.",
               ""]

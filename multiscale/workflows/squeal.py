@@ -239,8 +239,8 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     with io.stage("writing results"):
         plan = outputs.plan(scene)
         rep = case.report
-        files = io.on_root(comm, lambda: [case.modes.write_csv(folder / "modes.csv", rep.rtol, rep.potentially_unstable)],
-                           f"{folder / 'modes.csv'}") or []
+        files = io.on_root(comm, lambda: [case.modes.write_csv(folder / "modes.csv", rep.rtol,
+                                                              rep.potentially_unstable)], f"{folder / 'modes.csv'}") or []
         files += write_state(folder, case.mech, plan.body_fields + plan.interface_fields)
         files += write_modes(folder, case.modes, case.mech.u, [b.name for b in tm.bodies])
         split = energy_split(tm)
