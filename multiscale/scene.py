@@ -169,16 +169,20 @@ class Scene:
         ``partition_at``)."""
         return self.partition_at(None)
 
-    def partition_at(self, interface: str | None) -> float | None:
+    def partition_at(self, interface: str | None, areas: tuple[float, float] = (1.0, 1.0)) -> float | None:
         """Share of frictional heat into body 0 at an interface: the constant, or the effusivity
-        ratio e_0/(e_0 + e_1), e = sqrt(kappa rho c), of the materials on both sides of it at the
-        initial temperature. None if unset."""
+        partition e_0 A_0 / (e_0 A_0 + e_1 A_1), e = sqrt(kappa rho c) of the materials on both
+        sides at the initial temperature, ``areas`` (A_0, A_1) [m^2] the interface's face and the
+        part of body 1's surface it heats: the track a rotating body 1 sweeps (Newcomb & Spurr
+        1967, Limpert 1975: equal mean surface temperatures of two semi-infinite bodies, the
+        track's flux averaged over a revolution; ``workflows.model.partitions``), default equal
+        areas (two stationary bodies, Carslaw & Jaeger §2.9). None if unset."""
         value = self.interface.partition
         if value != "effusivity":
             return value
         T0 = self.time.initial_temperature
         e0, e1 = (self.materials[m].at(T0).effusivity for m in self.geometry.spec.interface_materials(interface))
-        return e0 / (e0 + e1)
+        return e0 * areas[0] / (e0 * areas[0] + e1 * areas[1])
 
     def interface_settings(self, name: str) -> InterfaceSettings:
         """The settings of interface ``name``: its [interfaces.<name>] table, defaults filled

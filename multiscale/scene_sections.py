@@ -174,7 +174,10 @@ class Material:
 
 @dataclass(frozen=True)
 class Interface:
-    """[interface]: the defaults of every contact interface (perfect-contact baseline, §7.3.1)."""
+    """[interface]: the defaults of every contact interface (perfect-contact baseline, §7.3.1).
+    ``partition``: the share of the frictional heat into body 0, or "effusivity": e_0 A_0 /
+    (e_0 A_0 + e_1 A_1) with e = sqrt(kappa rho c) at the initial temperature, A_0 the interface's
+    area and A_1 the track it sweeps on a rotating body 1 (equal areas under a translation)."""
 
     penalty: float | None = key(Quantity("stiffness", gt=0, plausible=(1e8, 1e19)), needed_by=("contact",),
                                 unless=("roughness",))          # Pa/m, normal penalty stiffness K_n

@@ -95,12 +95,16 @@ def _effect_line(scene: Scene, effect: str) -> str:
         return (f"micro partition per zone ({heating} heating, remote temperatures: {m.remote(scene.effects)}, "
                 f"{m.coupling_scheme(scene.effects)} coupling; {scene.partition:.3g} before the first)")
     if effect == "heat_partition":
+        if i.partition != "effusivity":
+            return f"share {scene.partition:.3g} of mu p |v| into the {scene.bodies[0]}"
         names = scene.geometry.spec.interfaces
-        shares = {n: f"{scene.partition_at(n):.3g}" for n in names} if i.partition == "effusivity" else {}
+        shares = {n: f"{scene.partition_at(n):.3g}" for n in names}      # at equal areas
         share = ", ".join(f"{v} at {n}" for n, v in shares.items()) if len(set(shares.values())) > 1 else \
             f"{scene.partition:.3g}"           # the effusivity ratio per pair of materials
-        share += " (effusivity)" if i.partition == "effusivity" else ""
-        return f"share {share} of mu p |v| into the {scene.bodies[0]}"
+        if scene.geometry.motion != "rotation":
+            return f"share {share} (effusivity) of mu p |v| into the {scene.bodies[0]}"
+        return (f"effusivity share of mu p |v| into the {scene.bodies[0]}: {share} at equal areas, weighted at "
+                f"meshing by the {scene.bodies[0]}'s face against the track it sweeps on the {scene.bodies[1]}")
     if effect == "conductance":
         return f"h_c = {i.conductance:g} W/(m^2 K)" if not scene.has("roughness") else "h_c(p) per zone (micro)"
     if effect == "roughness":

@@ -1,5 +1,6 @@
 """Scenes through the workflows: only the requested effects are built; files a run writes."""
 import json
+import math
 from pathlib import Path
 
 import numpy as np
@@ -95,10 +96,14 @@ def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
     h = History.read(result.history_file)
     assert len(h) == 3 and h["time"][-1] == pytest.approx(1.2)
     np.testing.assert_allclose(h["interface_force"], 200.0, rtol=1e-6)
-    # the effusivity partition (Material.effusivity of pin and disc) goes to the pin
+    # the effusivity partition goes to the pin, weighted by its 20 x 20 mm face against the track
+    # its corners sweep on the disc, r from 80 to hypot(100, 10) mm (Newcomb & Spurr; 2.8 %, not
+    # the 43 % of equal areas)
     e_pin, e_disc = (scene.materials[m].effusivity for m in ("pin", "disc"))
+    face, track = 0.02 ** 2, math.pi * (math.hypot(0.1, 0.01) ** 2 - 0.08 ** 2)
     share = h["heat_total_pin"][-1] / (h["heat_total_pin"][-1] + h["heat_total_disc"][-1])
-    assert share == pytest.approx(e_pin / (e_pin + e_disc), rel=1e-9)
+    assert share == pytest.approx(e_pin * face / (e_pin * face + e_disc * track), rel=1e-9)
+    assert 0.02 < share < 0.04
     # energy: what the fields store equals the frictional heat put in (adiabatic bodies)
     assert h["stored_heat_pin"][-1] == pytest.approx(h["heat_total_pin"][-1], rel=1e-6)
     assert h["stored_heat_disc"][-1] == pytest.approx(h["heat_total_disc"][-1], rel=1e-2)

@@ -485,7 +485,7 @@ def test_the_summary_gives_each_interfaces_effusivity_partition():
     scene = load(DEMOS / "car_brake_stop.toml", overrides={"geometry.bodies.outer_pad.material": "steel"})
     shares = {n: scene.partition_at(n) for n in scene.geometry.spec.interfaces}
     assert len(set(shares.values())) == 2
-    line = next(x for x in summary(scene) if "heat_partition share" in x)
-    assert ", ".join(f"{v:.3g} at {n}" for n, v in shares.items()) + " (effusivity)" in line
-    plain = next(x for x in summary(load(DEMOS / "car_brake_stop.toml")) if "heat_partition share" in x)
-    assert "share 0.126 (effusivity) of mu p |v| into the fixed" in plain
+    line = next(x for x in summary(scene) if "heat_partition effusivity" in x)
+    assert ", ".join(f"{v:.3g} at {n}" for n, v in shares.items()) + " at equal areas" in line
+    plain = next(x for x in summary(load(DEMOS / "car_brake_stop.toml")) if "heat_partition effusivity" in x)
+    assert "into the fixed: 0.126 at equal areas, weighted at meshing by the fixed's face against the track" in plain

@@ -122,14 +122,27 @@ class Interface:
         """{interface name: boolean mask over the global facets}."""
         return {name: self.tag_index == k for k, name in enumerate(self.tags)}
 
-    def box(self, name: str) -> tuple[np.ndarray, np.ndarray]:
-        """Lower and upper corners (3-vectors) [m] of the vertices of interface ``name`` (collective)."""
+    def swept_area(self, name: str, axis, centre) -> float:
+        """Area [m^2] of the surface of revolution that interface ``name`` sweeps about ``axis``
+        through ``centre`` (collective): the frustum over the extremes of its vertices' radius r and
+        axial position a, pi (r_lo + r_hi) sqrt((r_hi - r_lo)^2 + (a_hi - a_lo)^2) — a disc's annular
+        track pi (r_hi^2 - r_lo^2), a drum's band 2 pi r (a_hi - a_lo)."""
+        lo, hi = self.box(name, axis, centre)
+        return float(np.pi * (lo[0] + hi[0]) * np.hypot(hi[0] - lo[0], hi[1] - lo[1]))
+
+    def box(self, name: str, axis=None, centre=None) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper corners (3-vectors) [m] of the vertices of interface ``name`` (collective);
+        with ``axis`` (unit vector) and ``centre``: of their (radius, axial position) about that axis."""
         k = list(self.tags).index(name)
         owned = self.tag_index[self.owned_index] == k
         x = self.mesh.geometry.x[self.mesh.geometry.dofmaps[0][:len(self.owned_index)][owned]].reshape(-1, 3)
-        lo, hi = np.empty(3), np.empty(3)
-        self.comm.Allreduce(x.min(axis=0) if len(x) else np.full(3, np.inf), lo, op=MPI.MIN)
-        self.comm.Allreduce(x.max(axis=0) if len(x) else np.full(3, -np.inf), hi, op=MPI.MAX)
+        if axis is not None:
+            e, x = np.asarray(axis, dtype=float) / np.linalg.norm(axis), x - np.asarray(centre, dtype=float)
+            a = x @ e
+            x = np.column_stack([np.linalg.norm(x - np.outer(a, e), axis=1), a])
+        lo, hi = np.empty(x.shape[1]), np.empty(x.shape[1])
+        self.comm.Allreduce(x.min(axis=0) if len(x) else np.full(x.shape[1], np.inf), lo, op=MPI.MIN)
+        self.comm.Allreduce(x.max(axis=0) if len(x) else np.full(x.shape[1], -np.inf), hi, op=MPI.MAX)
         return lo, hi
 
     def _owned_dofs(self, space=None) -> np.ndarray:

@@ -77,6 +77,22 @@ def interface_radii(scene, tm) -> dict:
     return {n: float(r[m] @ iface.areas[m] / iface.areas[m].sum()) for n, m in iface.masks().items()}
 
 
+def partitions(scene, tm) -> dict:
+    """Share of frictional heat into body 0 [-] at every interface (``Scene.partition_at``): the
+    effusivity partition weighted by the interface's area A_0 and, for a rotating body 1, the
+    track it sweeps (``Interface.swept_area``; a pad of 4 cm^2 on a 113 cm^2 track takes 2.7 %,
+    not the 43 % of equal areas); a translating body 1 keeps equal areas (collective)."""
+    iface, motion = tm.interface, tm.spec.motion
+    out = {}
+    for name, m in iface.masks().items():
+        areas = (1.0, 1.0)
+        if scene.interface.partition == "effusivity" and scene.geometry.motion == "rotation":
+            face = float(iface.areas[m].sum())
+            areas = (face, max(iface.swept_area(name, motion.axis, motion.centre), face))
+        out[name] = scene.partition_at(name, areas)
+    return out
+
+
 def drive(scene, tm) -> Drive:
     """Load [N or Pa] (``load_kind``), ramp, load factor and speed of body 1 (rad/s for a
     rotation, m/s for a translation) against time."""
@@ -182,9 +198,9 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: b
                        conductance=scene.has("conductance") if conductance is None else conductance, temperatures=T,
                        boundaries=thermal_conditions(scene))
         if scene.has("heat_partition"):
-            share = np.zeros(tm.interface.n_facets)
+            share, shares = np.zeros(tm.interface.n_facets), partitions(scene, tm)
             for name, m in tm.interface.masks().items():
-                share[m] = scene.partition_at(name)
+                share[m] = shares[name]
             tm.interface.set_field(mech.contact.partition, share)
         if scene.has("conductance") and scene.interface.conductance is not None:   # else per facet later
             tm.interface.set_field(mech.contact.conductance, scene.interface.conductance)

@@ -40,7 +40,7 @@ from multiscale.micro.laws import Conductance
 from multiscale.micro.post_analysis import Heating, PostAnalysis
 from multiscale.plots.history import multiscale_figure, wear_map
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, interface_forces, \
-    interface_materials
+    interface_materials, partitions
 from multiscale.workflows.output import prepare_folder
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
@@ -106,7 +106,7 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
     t, wear = scene.time, scene.has("wear")
     mu = np.concatenate([np.full(g.n_zones, friction_coefficient(scene, n)) for n, g in zip(rough.names, rough.grids)])
     settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature,
-                            partition=float(scene.partition) if scene.has("heat_partition") else np.nan,
+                            partition=next(iter(partitions(scene, tm).values())) if scene.has("heat_partition") else np.nan,
                             partition_law=scene.micro.partition_law, wear=wear,
                             wear_every=scene.wear.update_every if wear else 1, steps=t.steps,
                             flash_softening=scene.micro.flash_softening,
