@@ -19,7 +19,8 @@ import numpy as np
 from multiscale.errors import InputError
 from multiscale.io import on_root
 
-FORMAT = 2    # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns
+FORMAT = 3    # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns;
+#               3: the drive's state (speed, engagement, load last solved) and the area-weighted effusivity partition
 
 
 def fingerprint(text: str) -> str:

@@ -238,11 +238,13 @@ class Multiscale:
                 total = np.bincount(zone_of, model.thermal.facet_temperature(side)[rough] * areas, minlength=Z)
                 T[:, col] = np.where(area > 0, total / np.where(area > 0, area, 1.0), T[:, col])
         reach, angle = self.rough.zone_sliding(self.tm.spec.motion)
-        # the speed now; at a standstill that of the step that led to it (a partition is defined
-        # only while sliding: the zones' heating needs a speed)
-        speed = model.speed(model.time)
-        if speed == 0.0 and self.settings.dt:
-            speed = model.drive.mean_speed(max(model.time - self.settings.dt, 0.0), model.time)
+        # the speed now; at a standstill the mean of the step that follows (the one these fields
+        # act on), else of the step that led to it (a partition is defined only while sliding: the
+        # zones' heating needs a speed; before, a restart from rest had no exchange for a step)
+        speed, dt = model.speed(model.time), self.settings.dt
+        if speed == 0.0 and dt:
+            speed = model.drive.mean_speed(model.time, model.time + dt) or \
+                model.drive.mean_speed(max(model.time - dt, 0.0), model.time)
         return ZoneLoading(force, force / self.rough.zone_area, reach * abs(speed),
                            angle + (np.pi if speed < 0 else 0.0), T, reach)
 
@@ -556,7 +558,8 @@ class Multiscale:
                   **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
         attrs = {"step": step, "time": m.time, "work": self.work, "counter_volume": self.counter_volume,
                  "heat_exchanged": [m.heat_exchanged, m.heat_exchanged_total], "scene": self.fingerprint, "load": m.load,
-                 "ranks": self.comm.size, "fields_written": -1,
+                 "ranks": self.comm.size, "fields_written": -1, "solved_speed": m.solved_speed,
+                 "constants": [float(c.value) for c in self._constants()],
                  "solve": [last.reason, last.iterations, last.normal_force, last.max_pressure]}
         checkpoint.save(path, self.comm, attrs=attrs, arrays=arrays, functions=self._functions(),
                         scale=self.tm.spec.length_scale)
@@ -585,9 +588,9 @@ class Multiscale:
         reason, its, force, max_p = attrs["solve"]
         m.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
         self.tm.interface.set_field(m.contact.initial_gap, self.datum_gap + self.counter_depth)
-        m.contact.speed.value = m.solved_speed = m.speed(m.time)
-        m.load = float(attrs["load"])
-        m.mechanics.load.value = m.load * m.drive.factor(m.time)
+        m.load, m.solved_speed = float(attrs["load"]), float(attrs["solved_speed"])
+        for c, value in zip(self._constants(), attrs["constants"]):   # speed, engagement, load last solved:
+            c.value = value                                            # released, the load stays that of before
         self.rough.update_laws()
         self.apply_zone_fields()
         history = io.History()

@@ -316,23 +316,25 @@ def test_the_zones_wear_with_the_loaded_sliding_and_at_the_last_step(straight, t
 
 
 def test_a_stop_and_a_restart_keep_every_result_finite(tmp_path):
-    """200 rpm to a standstill in 0.6 s, 0.6 s at rest, back to 200 rpm: the zones of the step that
+    """200 rpm to a standstill in 0.6 s, 1.2 s at rest, back to 200 rpm: the zones of the step that
     ended the stop take the sliding of that step, the zones at rest keep their partitions (no heat
     to share: before, a NaN partition, an infinite coupling residual and log(0) warnings), no heat
-    and no wear at rest; every scalar of the history finite (the coupling residual before the first
-    step has no value)."""
+    and no wear at rest; the zones before the restart take the sliding of the step that restarts
+    (before: no exchange between the bodies in that step, an adversarial test); every scalar of the
+    history finite (the coupling residual before the first step has no value)."""
     import warnings
     with warnings.catch_warnings():
         warnings.simplefilter("error", RuntimeWarning)
-        h = run_pod(tmp_path / "stop", {"time.end": "2.4 s", "time.steps": 4,
+        h = run_pod(tmp_path / "stop", {"time.end": "3 s", "time.steps": 5,
                                         "loading.speed_profile": [["0 s", "200 rpm"], ["0.6 s", "0 rpm"],
-                                                                  ["1.2 s", "0 rpm"], ["1.8 s", "200 rpm"]]},
+                                                                  ["1.8 s", "0 rpm"], ["2.4 s", "200 rpm"]]},
                     POD.replace('rotation_speed = "200 rpm"\n', ""))
     for key, values in h.columns.items():       # the scalar columns (per-zone ones mark unloaded zones NaN)
         if np.ndim(values) == 1:
             assert np.all(np.isfinite(values[1:] if key == "coupling_residual" else values)), key
     assert h["partition_mean"][2] == h["partition_mean"][1] and h["wear_volume"][2] == h["wear_volume"][1]
-    assert h["heat_step_pin"][2] == 0.0 and h["wear_volume"][3] > h["wear_volume"][2]
+    assert h["heat_step_pin"][2] == h["heat_step_pin"][3] == 0.0 and h["wear_volume"][4] > h["wear_volume"][3]
+    assert h["partition_mean"][3] != h["partition_mean"][2] and h["heat_exchanged_step"][4] != 0.0
 
 def resumed_rtol(key: str, rtol: float = 1e-6) -> float:
     """Relative tolerance of history column ``key`` between a resumed run and the straight one
@@ -368,6 +370,25 @@ def test_resume_after_an_interrupted_run_gives_the_straight_history(straight, tm
             np.testing.assert_allclose(h[key], ref[key], rtol=resumed_rtol(key), atol=1e-12, err_msg=key)
     assert (tmp_path / "killed" / "interface.xdmf").read_text().count("<Time ") == \
         (reference.folder / "interface.xdmf").read_text().count("<Time ")
+
+
+def test_resume_from_a_released_step_gives_the_straight_history(tmp_path):
+    """Released after 0.6 s and loaded again from 1.21 s; stopped after step 2 (released), then
+    resumed: the same history as the straight run. Before, the checkpoint did not keep the drive's
+    state: the resumed model took the load of its released time (0) as the load last solved, and
+    the solve at the re-engaged load diverged (SNES -9, an adversarial test); the uninterrupted
+    run kept that of the last solve."""
+    from multiscale.workflows.multiscale import run
+    cycle = {"time.end": "1.8 s", "time.steps": 3,
+             "loading.load_profile": [["0 s", 1.0], ["0.6 s", 1.0], ["0.61 s", 0.0], ["1.2 s", 0.0], ["1.21 s", 1.0]]}
+    reference = run(loads(POD.format(folder=tmp_path / "straight"), overrides=cycle), verbose=False).history
+    scene = loads(POD.format(folder=tmp_path / "stopped"), overrides=cycle)
+    assert run(scene, verbose=False, stop_after=2).steps_done == 2
+    h = History.read(run(scene, resume=True, verbose=False).history_file)
+    assert reference["interface_force"][2] == 0.0 and reference["interface_force"][3] > 0.0
+    for key in reference.columns:
+        if not solver_statistic(key):
+            np.testing.assert_allclose(h[key], reference[key], rtol=resumed_rtol(key), atol=1e-12, err_msg=key)
 
 
 def test_resume_of_a_finished_run_has_nothing_to_do(straight, capsys):
