@@ -71,6 +71,11 @@ NEWTON_OPTIONS = {
 # iterations (~90 per step at 49k dofs with a fixed lag of 5), which the timed rule weighs against
 # the factorisations they save.
 PRECONDITIONERS = ("lu", "cholesky")
+# The Newton's absolute tolerance is at least this share of the norm of the load vector: the
+# residual's round-off floor is ~1.5e-12 of it (the coarse pin-on-disc at 200 and 867 N), so a solve
+# starting near its answer (a load changed by 1 N of 867 N: first residual 0.15) stalled at 1.7e-10
+# above the fixed 1e-10 N and failed.
+NEWTON_FLOOR = 1e-10
 FACTOR_PRECISION = "single"
 
 
@@ -148,6 +153,7 @@ class Mechanics:
             i = tm.body_of_face(name)
             F[i] -= ufl.dot(self.traction(), v[i]) * tm.ds(tm.face(name))
         self.residuals = F
+        self._unit_load = self._load_norm(v)
         self.bcs = self._supports()
         self.refresh = None if refresh is None else int(refresh)
         P = self._frictionless_jacobian() if preconditioner == "cholesky" else None
@@ -306,6 +312,21 @@ class Mechanics:
         area = sum(self.tm.assemble_scalar(1.0 * self.tm.ds(self.tm.face(f))) for f in spec.load_faces)
         return self.load / area * direction
 
+    def _load_norm(self, v) -> float:
+        """Norm [N] of the load faces' nodal forces at load 1 (linear in the load; collective)."""
+        forms = {}
+        for name in self.tm.spec.load_faces:
+            i = self.tm.body_of_face(name)
+            forms[i] = forms.get(i, 0) + ufl.dot(self.traction(), v[i]) * self.tm.ds(self.tm.face(name))
+        kept, self.load.value, total = float(self.load.value), 1.0, 0.0
+        for f in forms.values():
+            b = fpetsc.assemble_vector(fem.form(f, entity_maps=self.tm.entity_maps))
+            b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
+            total += b.norm() ** 2
+            b.destroy()
+        self.load.value = kept
+        return float(np.sqrt(total))
+
     def _supports(self) -> list:
         bcs = []
         fdim = self.tm.parent.topology.dim - 1
@@ -335,6 +356,8 @@ class Mechanics:
         the residual there is smaller (e.g. the increment of a similar solve before)."""
         if load is not None:
             self.load.value = float(load)
+        floor = NEWTON_FLOOR * abs(float(self.load.value)) * self._unit_load
+        self.problem.solver.setTolerances(atol=max(NEWTON_OPTIONS["snes_atol"], floor))
         start = [u.x.array.copy() for u in self.u]
         if guess is not None:
             before = self._residual_norm()
