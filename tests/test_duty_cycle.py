@@ -53,6 +53,23 @@ def test_a_vehicle_stop_brakes_the_mass_and_turns_its_energy_into_heat(tmp_path,
     np.testing.assert_allclose(h["heat_step_pin"][1:][h["time"][:-1] > 2.0 - 1e-9], 0.0, atol=1e-12)
 
 
+def test_a_vehicle_stop_with_thermal_expansion_keeps_the_torque(tmp_path):
+    """With thermal expansion the pressure moves over the pin as it heats; the clamp force is
+    scaled after every solve so that the friction moment stays the braking torque within
+    ``TORQUE_TOL`` (before: once, at the start), so the frictional heat of the stop is the
+    kinetic energy within 1e-3 and the clamp force changes along the stop."""
+    from multiscale.macro.model import TORQUE_TOL
+    text = pin_on_disc(tmp_path / "stop", partition="0.5").replace('rotation_speed = "200 rpm"\n', "")
+    scene = loads(text.replace("normal_force = \"200 N\"\n", ""), overrides={
+        "loading.vehicle": {"speed": f"{V0} m/s", "deceleration": f"{DECEL} m/s^2", "wheel_radius": f"{WHEEL} m",
+                            "mass": f"{MASS} kg"}, "time.end": "2 s", "time.steps": 8,
+        "materials.pin.alpha": "2e-4 1/K"})
+    h = run(scene, verbose=False).history
+    heat = h["heat_total_pin"][-1] + h["heat_total_disc"][-1]
+    assert heat == pytest.approx(0.5 * MASS * V0**2, rel=TORQUE_TOL)
+    assert np.ptp(h["interface_force"]) > 10 * TORQUE_TOL * h["interface_force"][0]
+
+
 def test_a_release_phase_has_no_contact_and_no_frictional_heat(tmp_path):
     """Loaded for 0.6 s, released over the next 10 ms: no contact force after; the step holding the
     release gets the frictional heat of its loaded part only (1/60 of a full 0.3 s step); no heat
