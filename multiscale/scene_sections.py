@@ -25,7 +25,8 @@ _MODULUS = Quantity("pressure", gt=0, plausible=(1e5, 1.2e12))           # rubbe
 _POISSON = Quantity("dimensionless", gt=-1, lt=0.5, plausible=(0.0, 0.5))
 _CONDUCTIVITY = Quantity("conductivity", gt=0, plausible=(0.01, 2500.0))  # foam to diamond
 _LENGTH = Quantity("length", gt=0)
-_TEMPERATURE = Quantity("temperature", gt=0, plausible=(20.0, 2500.0))    # cryogenic to molten iron
+HOTTEST = 2500.0     # K, the top of the plausible temperatures (molten iron), of inputs and results
+_TEMPERATURE = Quantity("temperature", gt=0, plausible=(20.0, HOTTEST))    # cryogenic to molten iron
 _DENSITY = Quantity("density", gt=0, plausible=(100.0, 23e3))            # cork to osmium
 _SPECIFIC_HEAT = Quantity("specific_heat", gt=0, plausible=(50.0, 5e3))
 _DIFFUSIVITY = Quantity("diffusivity", gt=0, plausible=(1e-8, 1.2e-3))

@@ -221,6 +221,22 @@ def test_a_wear_update_deeper_than_the_roughness_is_warned_about(tmp_path):
     assert not [w for w in run_warnings(substeps, h) if "wear increment" in w]     # 0.9 RMS per substep
 
 
+def test_a_body_hotter_than_any_material_is_warned_about(tmp_path):
+    """``scene_sections.HOTTEST``: a body above 2500 K is warned about with its time (a car pad
+    reached 23 000 K without a word; an adversarial test); 2400 K is not."""
+    from multiscale.workflows import run_warnings
+    scene = loads(BLOCK.format(effects='"contact", "thermal"', folder=tmp_path / "out"))
+    for top, warned in ((2400.0, False), (23115.0, True)):
+        h = History()
+        for k, T in enumerate((293.15, top, 900.0)):
+            h.append(time=0.5 * k, max_temperature_block=T, max_temperature_flat=400.0)
+        lines = [w for w in run_warnings(scene, h) if "plausible" in w]
+        assert bool(lines) == warned
+    assert lines == ["the block reached 2.312e+04 K at t = 0.5 s, above any plausible temperature (2500 K: molten "
+                     "iron): check the load, the heat partition and the materials (the model has no melting, wear "
+                     "of hot material or fade)"]
+
+
 def test_kept_heat_factors_give_the_factorised_answer(tmp_path, monkeypatch):
     """``thermal.KEPT_ITERATIONS``: a linear heat step solves by GMRES on LU factors of an earlier
     step's matrix (the interface terms change every step: it refactorised every step, 1.05 s of

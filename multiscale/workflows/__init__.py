@@ -18,6 +18,7 @@ from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError, Interrupted, interrupted
+from multiscale.scene_sections import HOTTEST
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.output import RunResult
 
@@ -110,7 +111,7 @@ def run_warnings(scene, history) -> list[str]:
         known = scene.materials[name].beyond(T0)
         out += [f"materials.{name}.{phrase} (in the {body})"
                 for key, phrase in scene.materials[name].beyond(T).items() if key not in known]
-    return out + laws + _undershoots(scene, history) + _coarse_wear(scene, history)
+    return out + laws + _undershoots(scene, history) + _coarse_wear(scene, history) + _too_hot(scene, history)
 
 
 UNDERSHOOT = 0.05     # a body's undershoot warned about: this share of its temperature rise [-]
@@ -133,6 +134,20 @@ def _coarse_wear(scene, history) -> list[str]:
     return [f"a wear increment deepened the wear by {deeper.max():.3g} times the RMS height (at t = "
             f"{history['time'][row]:g} s): the explicit wear step is coarse for this wear rate and the results depend "
             "on it; use more wear.substeps or time.steps"]
+
+
+def _too_hot(scene, history) -> list[str]:
+    """Bodies hotter than any plausible temperature (``scene_sections.HOTTEST``): the load, the
+    partition or the materials are wrong for the case (a car pad reached 23 000 K without a word)."""
+    out = []
+    for body in scene.geometry.spec.bodies:
+        column = f"max_temperature_{body.name}"
+        if column in history.columns and float(np.max(history[column])) > HOTTEST:
+            row = int(np.argmax(history[column]))
+            out.append(f"the {body.name} reached {float(history[column][row]):.4g} K at t = {history['time'][row]:g} s, "
+                       f"above any plausible temperature ({HOTTEST:g} K: molten iron): check the load, the heat "
+                       "partition and the materials (the model has no melting, wear of hot material or fade)")
+    return out
 
 
 def _undershoots(scene, history) -> list[str]:
