@@ -221,6 +221,19 @@ def test_a_wear_update_deeper_than_the_roughness_is_warned_about(tmp_path):
     assert not [w for w in run_warnings(substeps, h) if "wear increment" in w]     # 0.9 RMS per substep
 
 
+def test_a_solve_starting_next_to_its_answer_converges(tmp_path):
+    """``mechanics.NEWTON_FLOOR``: the pin-on-disc solved at 867 N, then at loads 1e-3 N and 1 N
+    higher, which start with residuals of 1.5e-4 and 0.15 near the round-off floor (~1.5e-12 of
+    the load vector's norm, 1.7e-10 here): they converge and carry their load (before, the fixed
+    absolute tolerance of 1e-10 N was below that floor, and they failed after 30 iterations)."""
+    model = build_model(loads(pin_on_disc(tmp_path / "out")))
+    model.start()
+    mech = model.mechanics
+    mech.solve(867.0)
+    for load in (867.001, 868.0):
+        assert mech.solve(load).normal_force == pytest.approx(load, rel=1e-9)
+
+
 def test_a_body_hotter_than_any_material_is_warned_about(tmp_path):
     """``scene_sections.HOTTEST``: a body above 2500 K is warned about with its time (a car pad
     reached 23 000 K without a word; an adversarial test); 2400 K is not."""
