@@ -124,6 +124,24 @@ def test_permanent_deformation_reloads_elastically_to_the_same_field():
     assert again.plastic.max() < 1e-8 * first.plastic.max()
 
 
+def test_periodic_displacement_control_beyond_full_elastic_contact_with_a_hardness():
+    """A periodic patch with a hardness carries at most H at any approach: displacement control at
+    the approach load control finds at 0.95 H (1.5 times mean(z), beyond which an elastic patch
+    would carry an infinite load) gives the same pressures (before: refused as for an elastic
+    patch; an adversarial test); the elastic patch is still refused."""
+    s = rough(64)
+    solver = ContactSolver(E, s.shape, s.dx)
+    H = 1e7
+    by_load = solver.solve(s.heights, load=0.95 * H, tol=1e-10, hardness=H)
+    depth = (s.heights.max() - s.heights).mean()
+    assert by_load.approach > 1.2 * depth
+    by_approach = solver.solve(s.heights, approach=by_load.approach, tol=1e-10, hardness=H)
+    assert by_approach.mean_pressure == pytest.approx(0.95 * H, rel=1e-9)
+    np.testing.assert_allclose(by_approach.pressure, by_load.pressure, rtol=0, atol=1e-8 * H)
+    with pytest.raises(InputError, match="full contact has no finite load"):
+        solver.solve(s.heights, approach=by_load.approach, tol=1e-10)
+
+
 def test_batched_bounds_per_patch_match_single_solves():
     s = rough(64, batch=(3,))
     H = np.array([1e7, 3e7, np.inf])
@@ -168,6 +186,9 @@ def test_load_unload_reload_of_a_fractal_patch():
     assert flat[5] == pytest.approx(flat[3], rel=1e-9)                           # reloading = unloading
     assert flat[6] == pytest.approx(flat[2], rel=1e-9)                           # meets loading at the max
     assert steps[6].result.plastic.max() < 1e-9 * steps[2].result.plastic.max()
+    # the cells at H again (reached elastically, within tol of H: before, only those that rounded
+    # to H or above counted, about half; an adversarial test)
+    assert steps[6].plastic_area_fraction == steps[2].plastic_area_fraction > 0.01
     direct = load_path(solver, s.heights, [6e6], 3e7, tol=1e-11)[0][0]
     assert float(steps[7].flat) == pytest.approx(float(direct.flat), rel=1e-9)
     assert np.all(deformed <= s.heights) and np.any(deformed < s.heights)

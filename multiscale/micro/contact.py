@@ -154,9 +154,6 @@ class ContactSolver:
             delta = _batch_values("approach", approach, batch)
             if not np.all(np.isfinite(delta)) or np.any(delta < 0):
                 raise InputError("approach", approach, "rigid approach must be finite and >= 0")
-            if self.periodic and np.any(delta >= z.mean(axis=(-2, -1))):
-                raise InputError("approach", approach, "a periodic patch under displacement control needs "
-                                 "approach < max(h) - mean(h) (full contact has no finite load)")
         upper = None
         if hardness is not None:
             upper = _batch_values("hardness", hardness, batch)
@@ -169,6 +166,12 @@ class ContactSolver:
             elif target is not None and np.any(target >= upper):
                 raise InputError("load", load, "mean pressure must be below the hardness (a fully plastic "
                                  "patch carries at most H)")
+        if delta is not None and self.periodic:       # elastic patches: full contact has no finite load
+            unbounded = np.ones(batch, dtype=bool) if upper is None else np.broadcast_to(upper, batch) == np.inf
+            if np.any(unbounded & (delta >= z.mean(axis=(-2, -1)))):
+                raise InputError("approach", approach, "a periodic elastic patch under displacement control "
+                                 "needs approach < max(h) - mean(h) (full contact has no finite load; with a "
+                                 "hardness it has)")
         p0 = None
         if initial_pressure is not None:
             p0 = _batch_values("initial_pressure", initial_pressure, h.shape)
@@ -253,8 +256,8 @@ class ContactSolver:
             if fields:
                 np.add(u[c], z[c], out=gap[c])
                 gap[c] -= solved["d"][:, None, None]
-                if plastic is not None:                      # the interpenetration at p = H
-                    flow = p[c] >= uc[:, None, None]
+                if plastic is not None:                      # the interpenetration at p = H (within tol:
+                    flow = p[c] >= uc[:, None, None] * (1.0 - tol)   # reloaded cells reach H from below)
                     np.copyto(plastic[c], -gap[c], where=flow)
                     np.maximum(plastic[c], 0.0, out=plastic[c])
                     out["plastic_area_fraction"][c] = flow.mean(axis=(1, 2))
