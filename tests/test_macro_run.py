@@ -108,6 +108,10 @@ def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
     assert h["stored_heat_pin"][-1] == pytest.approx(h["heat_total_pin"][-1], rel=1e-6)
     assert h["stored_heat_disc"][-1] == pytest.approx(h["heat_total_disc"][-1], rel=1e-2)
     assert np.all(np.diff(h["max_temperature_pin"]) > 0)
+    # the pin body's materials: the friction pin itself is the hottest, its steel holder cooler
+    np.testing.assert_array_equal(h["max_temperature_pin"], h["max_temperature_pin_in_pin"])
+    assert np.all(h["max_temperature_pin_in_disc"][1:] < h["max_temperature_pin_in_pin"][1:])
+    assert "max_temperature_disc_in_disc" not in h.columns                 # one material: no column
     assert not any(k.startswith("heat_lost") for k in h.columns)      # insulated: no loss columns
     for f in result.field_files + [result.plot_file]:
         assert f.exists() and f.stat().st_size > 0
@@ -232,6 +236,25 @@ def test_a_solve_starting_next_to_its_answer_converges(tmp_path):
     mech.solve(867.0)
     for load in (867.001, 868.0):
         assert mech.solve(load).normal_force == pytest.approx(load, rel=1e-9)
+
+
+def test_a_material_table_is_judged_by_the_temperatures_of_its_own_cells(tmp_path):
+    """The pin body holds the pin material and the steel ("disc") holder: a disc table ending at
+    300 degC is left by the pin material's 644 degC, not by any disc-material cell (213 degC in
+    the holder, 233 degC in the disc): no warning (before, the body's maximum was taken for each
+    of its materials; an adversarial test); the disc body at 350 degC is named."""
+    from multiscale.workflows import run_warnings
+    table = '[["20 degC", "50 W/(m K)"], ["300 degC", "45 W/(m K)"]]'
+    scene = loads(pin_on_disc(tmp_path / "out").replace('kappa = "50 W/(m K)"', f"kappa = {table}"))
+    for disc, warned in ((233.0, False), (350.0, True)):
+        h = History()
+        for k, scale in enumerate((0.0, 1.0)):
+            h.append(time=0.6 * k, max_temperature_pin=293.15 + scale * 624, max_temperature_pin_in_pin=293.15 + scale * 624,
+                     max_temperature_pin_in_disc=293.15 + scale * 193, max_temperature_disc=293.15 + scale * (disc - 20))
+        lines = run_warnings(scene, h)
+        assert [w for w in lines if "materials.disc.kappa" in w] == (
+            ["materials.disc.kappa: 350 degC above its last point 300 degC, held at 45 there (in the disc)"]
+            if warned else []), lines
 
 
 def test_a_body_hotter_than_any_material_is_warned_about(tmp_path):

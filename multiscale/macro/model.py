@@ -211,6 +211,9 @@ class MacroModel:
                 self.thermal.min_temperature()
             for i, body in enumerate(self.tm.bodies):
                 row[f"max_temperature_{body.name}"] = hottest[i]
+                if len({r.material for r in body.spec.regions}) > 1:     # per material (their tables)
+                    for material, T in self.thermal.material_max_temperature(i).items():
+                        row[f"max_temperature_{body.name}_in_{material}"] = T
                 row[f"min_temperature_{body.name}"] = coldest[i]
                 row[f"heat_step_{body.name}"] = heat_step[i]
                 row[f"heat_total_{body.name}"] = self.heat_total[i]

@@ -519,6 +519,18 @@ class Thermal:
         comm = self.tm.comm
         return tuple(comm.allreduce(T.x.array.max(initial=-np.inf), op=MPI.MAX) for T in self.T)
 
+    def material_max_temperature(self, i: int) -> dict:
+        """Largest nodal temperature [K] of the cells of each material of body ``i`` (collective;
+        a node on a boundary between materials counts for both)."""
+        body, T = self.tm.bodies[i], self.T[i]
+        dofs = T.function_space.dofmap.list[:len(body.region_tags)]
+        out = {}
+        for material in sorted({r.material for r in body.spec.regions}):
+            tags = [r.tag for r in body.spec.regions if r.material == material]
+            mine = np.unique(dofs[np.isin(body.region_tags, tags)])
+            out[material] = self.tm.comm.allreduce(T.x.array[mine].max(initial=-np.inf), op=MPI.MAX)
+        return out
+
     def min_temperature(self) -> tuple:
         """Smallest nodal temperature of each body [K] (below every imposed temperature: an undershoot
         of the discretisation, ``workflows.run_warnings``)."""

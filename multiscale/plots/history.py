@@ -16,6 +16,14 @@ import numpy as np
 from matplotlib.figure import Figure
 
 
+def column_label(key: str) -> str:
+    """Legend of a per-body column: max_temperature_outer_pad -> "outer pad",
+    max_temperature_pin_in_disc -> "pin in disc" (the pin's cells of material disc)."""
+    for prefix in ("max_temperature_", "heat_total_"):
+        key = key.removeprefix(prefix)
+    return key.replace("_", " ")
+
+
 def history_figure(history, path: Path, title: str = "") -> Path:
     """PNG of the history: force, max pressure, max temperatures, heat per body vs time."""
     t = history["time"]
@@ -28,7 +36,7 @@ def history_figure(history, path: Path, title: str = "") -> Path:
     axes = fig.subplots(1, len(groups), squeeze=False)
     for ax, (label, keys, scale, shift) in zip(axes[0], groups):
         for key in keys:
-            ax.plot(t, history[key] * scale + shift, "o-", ms=3, label=key.split("_")[-1] if len(keys) > 1 else None)
+            ax.plot(t, history[key] * scale + shift, "o-", ms=3, label=column_label(key) if len(keys) > 1 else None)
         ax.set_xlabel("time [s]")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
@@ -51,7 +59,7 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
     hot = [k for k in cols if k.startswith("max_temperature")]
     panels = [("max contact pressure [MPa]", [("max_pressure", "macro facet"), ("max_zone_pressure", "macro zone"),
                                                ("micro_max_pressure", "micro")], 1e-6, 0),
-              ("max temperature [°C]", [(k, "macro " + k.split("_")[-1]) for k in hot]
+              ("max temperature [°C]", [(k, "macro " + column_label(k)) for k in hot]
                + [("micro_max_temperature", "micro")], 1.0, -273.15),
               ("zones' heat partition into the rough body [%]",     # the coefficients of Fig. 7.12, not
                [("partition_max", "max"), ("partition_mean", "mean over zones"),    # weighted by the heat

@@ -103,9 +103,11 @@ def run_warnings(scene, history) -> list[str]:
             "zone whose law failed): beyond it a law is extrapolated linearly; raise micro.p_max"] if reach > 1 else []
     T0, hottest = scene.time.initial_temperature, {}
     for body in scene.geometry.spec.bodies:
-        column = f"max_temperature_{body.name}"
-        for name in (r.material for r in body.regions if column in history.columns):
-            hottest[name] = max(hottest.get(name, (-np.inf, "")), (float(np.max(history[column])), body.name))
+        for name in (r.material for r in body.regions):       # the material's own column if the body has several
+            column = next((c for c in (f"max_temperature_{body.name}_in_{name}", f"max_temperature_{body.name}")
+                           if c in history.columns), None)
+            if column is not None:
+                hottest[name] = max(hottest.get(name, (-np.inf, "")), (float(np.max(history[column])), body.name))
     out = []
     for name, (T, body) in hottest.items():
         known = scene.materials[name].beyond(T0)
