@@ -391,6 +391,25 @@ def test_resume_from_a_released_step_gives_the_straight_history(tmp_path):
             np.testing.assert_allclose(h[key], reference[key], rtol=resumed_rtol(key), atol=1e-12, err_msg=key)
 
 
+def test_a_loop_that_fails_keeps_the_history_of_its_steps(tmp_path, monkeypatch):
+    """Step 2 fails (simulated): history.h5 holds the start and step 1 as the checkpoint does
+    (before: written only at the end of the loop, so a killed or failed run had none to look at)."""
+    from multiscale.coupling import Multiscale
+    from multiscale.errors import ConvergenceError
+    from multiscale.workflows.multiscale import run
+    step = Multiscale.step
+
+    def failing(self, n):
+        if n == 2:
+            raise ConvergenceError("step 2 fails (simulated)")
+        return step(self, n)
+    monkeypatch.setattr(Multiscale, "step", failing)
+    with pytest.raises(ConvergenceError, match="simulated"):
+        run(loads(POD.format(folder=tmp_path / "failed")), verbose=False)
+    h = History.read(tmp_path / "failed" / "history.h5")
+    np.testing.assert_allclose(h["time"], [0.0, 0.6])
+
+
 def test_resume_of_a_finished_run_has_nothing_to_do(straight, capsys):
     """--resume of a run that ended reads its results and says so: no model is built, nothing is
     written (the checkpoint and the history keep their bytes); of a changed scene, it is refused."""

@@ -158,6 +158,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
             history.append(**ms.record(ms.step(n)))
             ms.save(ckpt, n, history)
+            write_history(history, folder, scene.name, comm, plot=False)   # readable if the run is killed
             done, stopping = n, stop.requested()
             if n % every == 0 or n == steps:          # not at a stop: a resumed run's field times stay those of
                 writer.write()                        # an uninterrupted one
