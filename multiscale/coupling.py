@@ -60,9 +60,7 @@ a light zone's partition counts for the heat it moves). Schemes:
   harder at the next macro step (after the worn laws' re-solve) receives that multiple of a much
   larger frictional heat (−74 W, the pin's whole share turned negative).
 
-The default (``scene_sections.COUPLING_DEFAULT``) was chosen by measurement
-(``docs/accuracy/coupling.md``).
-
+The default (``scene_sections.COUPLING_DEFAULT``) was chosen by measurement (docs/accuracy/coupling.md).
 The initial laws are computed before the first solve; the rigid datum gap starts Newton close to
 equilibrium. ``save``/``restore`` write and read the whole state (``checkpoint``), so that a killed
 run continues to the same history (to solver tolerance: a resumed run recomputes its zone laws).
@@ -238,9 +236,8 @@ class Multiscale:
                 total = np.bincount(zone_of, model.thermal.facet_temperature(side)[rough] * areas, minlength=Z)
                 T[:, col] = np.where(area > 0, total / np.where(area > 0, area, 1.0), T[:, col])
         reach, angle = self.rough.zone_sliding(self.tm.spec.motion)
-        # the speed now; at a standstill the mean of the step that follows (the one these fields
-        # act on), else of the step that led to it (a partition is defined only while sliding: the
-        # zones' heating needs a speed; before, a restart from rest had no exchange for a step)
+        # the speed now; at a standstill the mean of the next step (these fields act on it), else of
+        # the last (the zones' heating needs a speed; a restart from rest had no exchange for a step)
         speed, dt = model.speed(model.time), self.settings.dt
         if speed == 0.0 and dt:
             speed = model.drive.mean_speed(model.time, model.time + dt) or \
@@ -589,8 +586,8 @@ class Multiscale:
         m.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
         self.tm.interface.set_field(m.contact.initial_gap, self.datum_gap + self.counter_depth)
         m.load, m.solved_speed = float(attrs["load"]), float(attrs["solved_speed"])
-        for c, value in zip(self._constants(), attrs["constants"]):   # speed, engagement, load last solved:
-            c.value = value                                            # released, the load stays that of before
+        for c, value in zip(self._constants(), attrs["constants"]):   # speed, engagement, load last solved
+            c.value = value
         self.rough.update_laws()
         self.apply_zone_fields()
         history = io.History()

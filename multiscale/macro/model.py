@@ -164,9 +164,9 @@ class MacroModel:
         linear in the load; before, scaled once at the start, the moment of a car stop with thermal
         expansion drifted 2.5 % above the torque and the work 0.95 % above the kinetic energy)."""
         target = (self.drive.torque or 0.0) * factor
-        for _ in range(TORQUE_SOLVES):
+        for _ in range(TORQUE_SOLVES if target > 0 else 0):
             moment = abs(self.contact.friction_moment())
-            if not (target > 0 and moment > 0) or abs(moment - target) <= TORQUE_TOL * target:
+            if not moment > 0 or abs(moment - target) <= TORQUE_TOL * target:
                 return
             self.load *= target / moment
             self.last_solve = self.mechanics.solve(self.load * factor)
