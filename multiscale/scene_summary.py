@@ -93,7 +93,9 @@ def _effect_line(scene: Scene, effect: str) -> str:
         m = scene.micro
         heating = f"transient, N_t = {m.heating_steps}" if m.heating == "transient" else "steady"
         return (f"micro partition per zone ({heating} heating, remote temperatures: {m.remote(scene.effects)}, "
-                f"{m.coupling_scheme(scene.effects)} coupling; {scene.partition:.3g} before the first)")
+                f"{m.coupling_scheme(scene.effects)} coupling; "
+                + ("the effusivity share weighted by the areas" if i.partition == "effusivity" else
+                   f"{scene.partition:.3g}") + " before the first)")
     if effect == "heat_partition":
         if i.partition != "effusivity":
             return f"share {scene.partition:.3g} of mu p |v| into the {scene.bodies[0]}"
