@@ -112,6 +112,23 @@ def test_rayleigh_damping_ratio_of_every_mode(method):
         assert r.errors.max() < 1e-10                 # exact: the basis holds the damped modes
 
 
+def test_stiffness_proportional_damping_adds_no_mode_at_the_supports():
+    """A support as DOLFINx writes it (its row and column 0, diagonal 1 in K and 0 in M): beta K
+    of Rayleigh damping in the quadratic solver gives the modes of the free dofs alone (before, a
+    mode lambda = -1/beta at 0 Hz for every supported dof, which filled the requested count; an
+    adversarial test)."""
+    K, M = chain(12)
+    K[0, :] = K[:, 0] = M[0, :] = M[:, 0] = 0.0
+    K[0, 0] = 1.0
+    beta, C = 2e-6, 50.0 * M
+    system = damped.LinearSystem(petsc_mat(K), petsc_mat(M), petsc_mat(C), damping=eigen.Damping(0.0, beta))
+    r = damped.solve_system(system, f_max=4e3, method="quadratic")
+    ref = companion_eigenvalues(K[1:, 1:], C[1:, 1:] + beta * K[1:, 1:], M[1:, 1:])
+    ref = ref[ref.imag / (2 * np.pi) <= 4e3]
+    assert len(r) == ref.size == 5
+    np.testing.assert_allclose(r.eigenvalues, ref, rtol=1e-8)
+
+
 def test_hysteretic_damping_needs_the_projection():
     K, M = chain(8)
     system = damped.LinearSystem(petsc_mat(K), petsc_mat(M), H=petsc_mat(0.02 * K))

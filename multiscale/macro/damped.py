@@ -289,8 +289,11 @@ def total_damping_matrix(system: LinearSystem) -> PETSc.Mat:
     C = system.M.duplicate(copy=True)
     C.scale(d.alpha)
     pattern = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
-    if d.beta:
-        C.axpy(d.beta, system.K, pattern)
+    if d.beta:          # not on the supports' rows: K holds 1 on their diagonal and M 0, so beta K
+        C.axpy(d.beta, system.K, pattern)           # there made a mode lambda = -1/beta at 0 Hz of each
+        held, k = system.M.getDiagonal(), system.K.getDiagonal()
+        k.array[:] = np.where(held.array == 0.0, -d.beta * k.array, 0.0)
+        C.setDiagonal(k, addv=PETSc.InsertMode.ADD_VALUES)
     if system.C is not None:
         C.axpy(1.0, system.C, pattern)
     return C
