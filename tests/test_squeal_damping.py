@@ -206,6 +206,18 @@ def test_map_tracks_the_hoffmann_pair_and_bisects_its_lock_in(tmp_path):
         assert f["growth"].shape == (6, 2)
 
 
+def test_the_map_table_writes_no_negative_zero(tmp_path):
+    """A neutral mode of a map (sigma -0.0) is written with sigma and damping ratio 0, as in
+    modes.csv (map.csv read -0.000000e+00; an adversarial test)."""
+    import csv
+    from multiscale.macro.stability_map import StabilityMap
+    one = np.ones((1, 1))
+    smap = StabilityMap("friction", "-", np.array([0.0]), 250.0 * one, -0.0 * one, np.zeros((1, 1), int),
+                        np.full((1, 1), np.nan), 1e-9 * one, [], 2, 1e-6, 0.0)
+    rows = list(csv.reader(smap.write_csv(tmp_path / "map.csv").open()))
+    assert rows[1][5] == rows[1][6] == "0.000000e+00"
+
+
 def test_map_bisects_the_onset_of_a_lock_in_branch_that_fails_the_mac_test(tmp_path):
     """With a strict MAC threshold the coalesced pair starts new tracks at mu = 0.6; the unstable
     one's onset is still bisected (from its stable best match at 0.4), once; a map starting above
