@@ -111,7 +111,7 @@ def _common_basis(model: MapModel, builder: MapBuilder, st, options) -> int:
     bases = []
     for value in (values[0], values[-1]):
         lin = model.linearise(value)
-        bases.append(basis_modes(lin.system, band=band, n_modes=st.modes, target=st.target, basis=options.basis).modes)
+        bases += basis_modes(lin.system, band=band, n_modes=st.modes, target=st.target, basis=options.basis)[1]
         if value == values[0]:
             _free(lin)
     sub = Subspace(bases, lin.system.M, matrix_comm(lin.system.K))
