@@ -229,13 +229,16 @@ def basis_band(band, n_modes, target, basis: float) -> dict:
                 n_modes=None if n_modes is None else int(math.ceil(basis * n_modes)))
 
 
-def basis_modes(system: LinearSystem, *, band, n_modes, target, basis: float, **kw) -> tuple[ModalResult, list]:
+def basis_modes(system: LinearSystem, *, band, n_modes, target, basis: float, left: bool = True,
+                **kw) -> tuple[ModalResult, list]:
     """The undamped modes of (K, M) in the projection basis' band (``basis_band``) and the vectors
-    that span the basis: those modes and, when K is not symmetric (friction), the modes of
-    (K^T, M), the left eigenvectors (module docstring)."""
+    that span the basis: those modes and, with ``left`` and K not symmetric (friction), the modes
+    of (K^T, M), the left eigenvectors (module docstring)."""
     wanted = basis_band(band, n_modes, target, basis)
     base = solve_modes(system.K, system.M, **wanted, **kw)
     vectors = [base.modes]
+    if not left:
+        return base, vectors
     KT = PETSc.Mat()
     system.K.transpose(KT)                # a new matrix (without one, petsc4py transposes in place)
     try:

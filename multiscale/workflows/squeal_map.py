@@ -111,7 +111,8 @@ def _common_basis(model: MapModel, builder: MapBuilder, st, options) -> int:
     bases = []
     for value in (values[0], values[-1]):
         lin = model.linearise(value)
-        bases += basis_modes(lin.system, band=band, n_modes=st.modes, target=st.target, basis=options.basis)[1]
+        bases += basis_modes(lin.system, band=band, n_modes=st.modes, target=st.target, basis=options.basis,
+                             left=lin.system.general)[1]      # the left modes for the damping's shifts
         if value == values[0]:
             _free(lin)
     sub = Subspace(bases, lin.system.M, matrix_comm(lin.system.K))
