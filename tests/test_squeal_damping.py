@@ -223,6 +223,7 @@ def test_map_tracks_the_hoffmann_pair_and_bisects_its_lock_in(tmp_path):
     with h5py.File(tmp_path / "map.h5") as f:
         np.testing.assert_allclose(f["onsets/value"][:], [onset.value])
         assert f["growth"].shape == (6, 2)
+        assert (f["frequency"].attrs["unit"], f["growth"].attrs["unit"], f["values"].attrs["unit"]) == ("Hz", "1/s", "-")
 
 
 def test_the_map_table_writes_no_negative_zero(tmp_path):

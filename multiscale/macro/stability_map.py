@@ -140,12 +140,16 @@ class StabilityMap:
         with h5py.File(path, "w") as f:
             f.attrs.update(parameter=self.parameter, unit=self.unit, basis_size=self.basis_size, rtol=self.rtol,
                            time=self.time)
-            for name in ("values", "frequency", "growth", "mode", "mac", "residual"):
+            units = {"values": self.unit, "frequency": "Hz", "growth": "1/s", "mode": "-", "mac": "-", "residual": "-"}
+            for name, unit in units.items():          # a unit per dataset, as in history.h5
                 f[name] = getattr(self, name)
+                f[name].attrs["unit"] = unit
             g = f.create_group("onsets")
             g["track"] = np.array([o.track for o in self.onsets], int)
             g["value"] = np.array([o.value for o in self.onsets], float)
+            g["value"].attrs["unit"] = self.unit
             g["frequency"] = np.array([o.frequency for o in self.onsets], float)
+            g["frequency"].attrs["unit"] = "Hz"
             g["partner"] = np.array([-1 if o.partner is None else o.partner for o in self.onsets], int)
             g["kind"] = np.array([o.kind for o in self.onsets], dtype=h5py.string_dtype())
         return path
