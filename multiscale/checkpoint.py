@@ -124,12 +124,21 @@ def mark(path, comm, **attrs) -> None:
     on_root(comm, write, f"the checkpoint {path}")
 
 
+def file_digest(path) -> str:
+    """SHA-1 of a file's bytes (read in blocks)."""
+    digest = hashlib.sha1()
+    with open(path, "rb") as f:
+        for block in iter(lambda: f.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
 def same_scene(attrs: dict, fingerprint: str, path) -> None:
     """InputError unless the checkpoint attributes ``attrs`` (of ``path``) are of the scene whose
-    ``fingerprint`` is given (``--resume`` of a changed scene)."""
+    ``fingerprint`` is given (``--resume`` of a changed scene or of changed input files)."""
     if attrs.get("scene") != fingerprint:
-        raise InputError("--resume", str(path), "the scene changed since this checkpoint was written; "
-                         "run it with --overwrite")
+        raise InputError("--resume", str(path), "the scene or a file it reads (geometry, measured surface) "
+                         "changed since this checkpoint was written; run it with --overwrite")
 
 
 def peek(path, comm) -> dict:

@@ -63,6 +63,16 @@ def test_surface_command_bad_options_are_one_line(capsys, args, message):
     assert err.startswith(message) and "Traceback" not in err and len(err.strip().splitlines()) == 1
 
 
+@pytest.mark.parametrize("figure, message", [("missing_folder/x.png", "No such file or directory"),
+                                             ("x.txt", "Format 'txt' is not supported")])
+def test_surface_command_figure_that_cannot_be_written_is_one_line(tmp_path, capsys, figure, message):
+    """(A traceback from matplotlib before; an adversarial test.)"""
+    assert main(["surface", str(TOP), "--figure", str(tmp_path / figure)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: --figure = ") and "cannot write the figure there: " in err
+    assert message in err and len(err.strip().splitlines()) == 1
+
+
 def test_surface_command_lists_the_formats(capsys):
     assert main(["surface", "--formats"]) == 0
     assert "XML 3D surface profile (X3P) (.x3p)" in capsys.readouterr().out
@@ -134,3 +144,19 @@ def test_zones_from_a_measured_file_for_every_cover(tmp_path):
     _, b = make_zones(eq, lo, (4e-6, 4e-6), seed=10)
     assert a[0].shape == (50, 50) and np.array_equal(a[3].surface.heights, b[3].surface.heights)
     assert any("statistically equivalent surface" in line for line in lines)
+
+
+def test_a_rewritten_measured_file_changes_the_runs_fingerprint(tmp_path):
+    """``--resume`` compares fingerprints: a measured surface rewritten under the same name makes
+    another one (before, the resume went on: the checkpoint's worn heights against the new file's
+    unworn ones gave wear depths 12 % off; an adversarial test); the same bytes the same one."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+    from multiscale.workflows.multiscale import fingerprint
+    heights = np.random.default_rng(1).normal(size=(64, 64))
+    np.save(tmp_path / "pad.npy", heights)
+    text = 'file = "pad.npy"\npixel_size = "1 um"\nheight_unit = "um"'
+    before = fingerprint(scene(tmp_path, text))
+    np.save(tmp_path / "pad.npy", heights)
+    assert fingerprint(scene(tmp_path, text)) == before
+    np.save(tmp_path / "pad.npy", 3 * heights)
+    assert fingerprint(scene(tmp_path, text)) != before

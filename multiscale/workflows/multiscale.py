@@ -85,10 +85,14 @@ def post_analysis(scene, zone) -> PostAnalysis:
 
 
 def fingerprint(scene) -> str:
-    """Hash of what the results depend on (not the output section; effects sorted: a set's order
-    changes between processes)."""
+    """Hash of what the results depend on: the scene (not the output section; effects sorted: a
+    set's order changes between processes) and the bytes of every file it reads (a measured surface
+    rewritten under the same name was resumed into wrong wear depths: the checkpoint holds the worn
+    heights, the unworn ones are read again)."""
     s = dataclasses.replace(scene, output=None, source=None, warnings=(), effects=tuple(sorted(scene.effects)))
-    return checkpoint.fingerprint(repr(s))
+    source = scene.source.resolve() if scene.source is not None else None
+    files = sorted(p for p in scene.inputs if p != source and p.is_file())
+    return checkpoint.fingerprint(repr(s) + "".join(f"{p}:{checkpoint.file_digest(p)}" for p in files))
 
 
 def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
