@@ -14,7 +14,7 @@ import warnings
 from pathlib import Path
 
 from multiscale import __version__
-from multiscale.errors import InputError, MultiscaleError, SceneError
+from multiscale.errors import InputError, MultiscaleError, OutputError, SceneError
 from multiscale.geometry import too_many_cells
 from multiscale.io import abort, ended_together
 from multiscale.micro.spectrum import surface_statistics
@@ -191,8 +191,18 @@ def _study(args) -> int:
             print(f"error: {foreign[0]}", file=sys.stderr)
         return 2
     command = " ".join(["multiscale study", *args.studies] + (["--report", args.report] if args.report else []))
-    failed = run_studies(args.studies, rerun_failed=args.rerun_failed, report_folder=args.report,
-                         processes=args.processes, command=command)
+    try:
+        failed = run_studies(args.studies, rerun_failed=args.rerun_failed, report_folder=args.report,
+                             processes=args.processes, command=command)
+    except KeyboardInterrupt:                # Ctrl-C: the runs that ended are recorded, the others stopped
+        if comm is None or comm.rank == 0:
+            print(f"interrupted: the runs that ended are recorded; {command} runs the others", file=sys.stderr,
+                  flush=True)
+        return INTERRUPTED
+    except OSError as exc:                   # a results or report folder that cannot be written
+        if isinstance(exc, MultiscaleError):
+            raise
+        raise OutputError(f"cannot write {exc.filename}: {exc.strerror or exc}") from None
     return 1 if failed else 0
 
 
@@ -251,8 +261,11 @@ def _surface(args) -> int:
     if args.figure != "none":
         from multiscale.plots.surface import surface_figure   # matplotlib: only when a figure is drawn
         path = Path(args.figure or f"{Path(args.file).stem}_surface.png")
-        surface_figure(done.surface, stats, path, f"{Path(args.file).name}, channel {measurement.channel}",
-                       waviness=done.waviness)
+        try:
+            surface_figure(done.surface, stats, path, f"{Path(args.file).name}, channel {measurement.channel}",
+                           waviness=done.waviness)
+        except (OSError, ValueError) as exc:   # no such folder, a format matplotlib does not write
+            raise InputError("--figure", str(path), f"cannot write the figure there: {exc}") from None
         print(f"figure: {path}")
     return 0
 
@@ -294,7 +307,7 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("studies", nargs="*", metavar="STUDY", help="study TOML file(s)")
     study.add_argument("--rerun-failed", action="store_true", help="run the failed runs again")
     study.add_argument("--report", metavar="DIR", help="write every report into DIR, with an index README.md")
-    study.add_argument("--processes", type=int, metavar="N", help="runs at a time (overrides [run] processes)")
+    study.add_argument("--processes", type=_count, metavar="N", help="runs at a time (overrides [run] processes)")
     study.add_argument("--problems", action="store_true", help="list the problems, their parameters and metrics")
     study.set_defaults(func=_study)
     surface = sub.add_parser("surface", help="measured topography: conditioning, statistics (Sq, Sdq, Ssk, Sku, "

@@ -140,6 +140,23 @@ def test_reference_from_a_stored_file_and_records_shared_by_studies(hertz_study,
     assert "stored result hertz.json" in (tmp_path / "stored.md").read_text()
 
 
+def test_study_command_errors_are_one_line(tmp_path, capsys):
+    """A reference file with unit strings says a number is expected (it said 'no number for metric
+    "contact_radius" (did you mean "contact_radius"?)'); --processes 0 is refused (it hung); a
+    report folder under a file is one error line, not a traceback (adversarial tests)."""
+    (tmp_path / "ref.json").write_text(json.dumps({"contact_radius": "68.76 um", "max_pressure": 1e9, "approach": 1e-6}))
+    stored = write(tmp_path, HERTZ.replace('kind = "analytic"', 'kind = "file"\nfile = "ref.json"') + "plots = false\n")
+    assert main(["study", str(stored)]) == 2
+    assert 'metric "contact_radius" is \'68.76 um\': give a number in SI units' in capsys.readouterr().err
+    path = write(tmp_path, HERTZ + "plots = false\n", "plain.toml")
+    with pytest.raises(SystemExit) as e:
+        main(["study", str(path), "--processes", "0"])
+    assert e.value.code == 2 and "a whole number >= 1" in capsys.readouterr().err
+    (tmp_path / "afile").write_text("")
+    assert main(["study", str(path), "--report", str(tmp_path / "afile" / "rep")]) == 2
+    assert capsys.readouterr().err.strip().splitlines()[-1].startswith("error: cannot write ")
+
+
 def test_failing_and_timed_out_runs_are_recorded_and_the_rest_completes(tmp_path, capsys):
     text = HERTZ.replace("[sweep]\ngrid = [12, 16, 24, 32]",
                          '[sweep]\ncombine = "zip"\ngrid = [12, 16, 24]\nmax_iter = [5000, 1, 5000]') + "plots = false\n"

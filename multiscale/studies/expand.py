@@ -364,7 +364,10 @@ def _check_reference(f: StudyFile, problem, knobs, axes, runs, ctx):
             ctx.problems.append(f"reference.file = \"{ref.file}\": must hold a JSON object {{metric: value}}")
             return
         for m in f.metrics:
-            if not isinstance(values.get(m), (int, float)) or isinstance(values.get(m), bool):
+            if m in values and (not isinstance(values[m], (int, float)) or isinstance(values[m], bool)):
+                ctx.problems.append(f"reference.file = \"{ref.file}\": metric \"{m}\" is {values[m]!r}: give a "
+                                    "number in SI units (the metric's own unit)")
+            elif m not in values:
                 ctx.problems.append(f"reference.file = \"{ref.file}\": no number for metric \"{m}\""
                                     f"{suggest(m, values)}")
 
