@@ -313,7 +313,8 @@ plots = false
     out = tmp_path / "results" / "study"
     row = table(out / "results.csv")[0]
     assert row["status"] == "failed"
-    assert 'metric "interface_forc:last" not produced (did you mean "interface_force:last"?)' in row["message"]
+    assert ('metric "interface_forc:last" not produced (did you mean "interface_force:last"?) (fix the name: the '
+            'runs need not run again)' in row["message"])
     path.write_text(path.read_text().replace("interface_forc:", "interface_force:"))
     capsys.readouterr()
     assert main(["study", str(path)]) == 0

@@ -26,8 +26,10 @@ def metric_problem(metrics: dict, names) -> str | None:
     """Why a run's ``metrics`` (name -> value) do not give the study's metric ``names``; None if they do."""
     for name in names:
         if name not in metrics:
-            return (f'metric "{name}" not produced{suggest(name, metrics)} (by a run older than the metric: '
-                    f'--rerun-failed recomputes it); available: {", ".join(sorted(metrics))}')
+            hint = suggest(name, metrics)     # a misspelt name: fix it, the records are judged on read
+            return (f'metric "{name}" not produced' + (hint + " (fix the name: the runs need not run again)" if hint
+                    else " (a run older than the metric: --rerun-failed recomputes it)")
+                    + f'; available: {", ".join(sorted(metrics))}')
         if not math.isfinite(metrics[name]):
             return f'metric "{name}" is {metrics[name]} (not finite)'
     return None
