@@ -339,7 +339,7 @@ def test_runs_are_shared_out_over_mpi_ranks(tmp_path):
                           capture_output=True, text=True, env=env, timeout=300, start_new_session=True)
     assert done.returncode == 0, done.stderr
     out = tmp_path / "results" / "hertz"
-    assert done.stdout.count("hertz: 2 runs") == 1                  # rank 0 reports
+    assert done.stdout.count("hertz: 2 runs (0 recorded before, 2 run now, 0 failed)") == 1   # rank 0 reports all
     ranks = sorted(json.loads(p.read_text())["rank"] for p in (out / "runs").glob("*.json"))
     assert ranks == [0, 1]
     assert [r["status"] for r in table(out / "results.csv")] == ["ok"] * 2

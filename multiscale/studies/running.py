@@ -22,7 +22,7 @@ __all__ = ["ExecStats", "execute", "world"]
 
 @dataclass
 class ExecStats:
-    """What ``execute`` did on this process (rank)."""
+    """What ``execute`` did, over all ranks (under mpiexec rank 0 counted only its own runs)."""
 
     total: int            # runs in the study
     done: int             # already recorded, skipped
@@ -97,8 +97,8 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
         if bar is not None:
             bar.close()
     if comm is not None:
-        comm.barrier()
-    return ExecStats(len(study.runs), len(study.runs) - len(todo), len(mine), failed, time.perf_counter() - start)
+        failed = comm.allreduce(failed)
+    return ExecStats(len(study.runs), len(study.runs) - len(todo), len(todo), failed, time.perf_counter() - start)
 
 
 def _done(record, rerun_failed: bool) -> bool:
