@@ -348,6 +348,21 @@ def resumed_rtol(key: str, rtol: float = 1e-6) -> float:
     return max(rtol, 1e-5) if key.startswith("heat_exchanged") else rtol
 
 
+def test_a_coarse_wear_step_that_opens_the_contact_is_solved_with_backtracking(tmp_path):
+    """The demo with k_w = 1e-11 /Pa (1000 x its level) in one 1.2 s step: the worn laws open the
+    contact and the full Newton step of the re-solve overshoots (residual 77 -> 1.5e6 N, SNES -9,
+    a ConvergenceError blaming the supports before); the solve is retried with a backtracking line
+    search: the run ends, wears k_w W within 1 % and warns that the wear step is coarse."""
+    from multiscale.scene import load
+    from multiscale.workflows import run
+    scene = load(Path(__file__).resolve().parents[1] / "demos" / "pin_on_disc.toml", overrides={
+        "materials.pin.k_w": "1e-11 1/Pa", "time.end": "1.2 s", "time.steps": 1, "output.folder": str(tmp_path / "out")})
+    h = run(scene, verbose=False).history
+    assert h["wear_volume"][-1] == pytest.approx(1e-11 * h["frictional_work"][-1], rel=0.01)
+    warnings = json.loads((tmp_path / "out" / "provenance.json").read_text())["warnings"]
+    assert any(w.startswith("a wear increment deepened the wear by") for w in warnings)
+
+
 def test_resume_after_an_interrupted_run_gives_the_straight_history(straight, tmp_path):
     """Stopped after step 1 (its checkpoint and fields on disk, nothing else), then resumed in a
     fresh model: the same history as the straight run to solver tolerance (the resumed run

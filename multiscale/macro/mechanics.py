@@ -42,7 +42,7 @@ from multiscale.macro.mesh import TwoBodyMesh
 # "ski rental" rule: never more than twice the better of the two choices in hindsight). Factors of a
 # loaded state keep GMRES at a few iterations for steps on end on the thesis ch. 7 configuration
 # (issue 23). A solve that fails with old factors is repeated from its start with fresh ones every
-# iteration (``Mechanics.solve``). The preconditioner is built from a matrix of its own, written only
+# iteration, and then once more with a backtracking line search (``Mechanics.solve``). The preconditioner is built from a matrix of its own, written only
 # at a refresh: PETSc refactorises when that matrix changed, and only then. The factors are in
 # single precision (``FACTOR_PRECISION``; GMRES on the double tangent takes their rounding out, the
 # Newton's residual and answer are double): half the factors' memory; on the thesis ch. 7 run (2
@@ -376,6 +376,15 @@ class Mechanics:
                 result = self._newton()
             finally:
                 self._fresh = False
+        if not result.converged:           # a full step overshot (worn laws that open the contact: the
+            for u, x in zip(self.u, start):  # residual 77 -> 1.5e6 N, SNES -9): again, backtracking
+                u.x.array[:] = x
+            search = self.problem.solver.getLineSearch()
+            search.setType("bt")
+            try:
+                result = self._newton()
+            finally:
+                search.setType(NEWTON_OPTIONS["snes_linesearch_type"])
         if not result.converged:
             failed = "" if self.factors.inner is None else mumps.describe(self.factors.inner)  # same on every rank
             cause = f"; the preconditioner's factorisation failed: {failed}" if failed else ""
