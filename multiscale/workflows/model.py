@@ -80,8 +80,8 @@ def interface_radii(scene, tm) -> dict:
 def partitions(scene, tm) -> dict:
     """Share of frictional heat into body 0 [-] at every interface (``Scene.partition_at``): the
     effusivity partition weighted by the interface's area A_0 and, for a rotating body 1, the
-    track it sweeps (``Interface.swept_area``; a pad of 4 cm^2 on a 113 cm^2 track takes 2.7 %,
-    not the 43 % of equal areas); a translating body 1 keeps equal areas (collective)."""
+    track it sweeps (``Interface.swept_area``; the ch. 7 pin, 4 cm^2 sweeping 116 cm^2, takes
+    2.8 %, not the 43.5 % of equal areas); a translating body 1 keeps equal areas (collective)."""
     iface, motion = tm.interface, tm.spec.motion
     out = {}
     for name, m in iface.masks().items():
