@@ -15,18 +15,20 @@ H += eta K. ``solve_system`` picks the method:
 - ``"projection"`` (``"auto"`` with hysteretic terms, which the real PEP cannot take): the
   complex modes of the undamped, friction-coupled system (K, M) up to ``basis`` x f_max and,
   with friction (K not symmetric), those of (K^T, M), its left eigenvectors, span a real
-  M-orthonormal basis V (``Subspace``); the reduced quadratic problem (lambda^2 V'MV + lambda V'CV + V'(K + iH)V) q = 0 is solved densely
+  M-orthonormal basis V (``Subspace``); the reduced quadratic problem
+  (lambda^2 V'MV + lambda V'CV + V'(K + iH)V) q = 0 is solved densely
   (companion form), phi = V q. This is the subspace projection of commercial complex-eigenvalue
   solvers (Abaqus projects on the undamped modes of the symmetrised stiffness; here the basis
   already holds the friction coupling). The left modes make the damping's first-order shift of
   each eigenvalue exact (the two-sided Rayleigh quotient): on the right modes alone, a bar of two
   prisms with loss factors 0.02 and friction 0.2 had the instability of every lock-in pair on
   the wrong member (264.5 Hz unstable where a dense solve has 267.8 Hz; an adversarial test); with
-  them every eigenvalue is within 2e-6 of the dense solve, at the cost of a second modal solve. Its accuracy is reported per mode: the relative residual
-  of the full quadratic problem. Damping spread like the mass or the stiffness is represented
-  well; damping localised at the interface (the friction slope) is not: on the demo brake with a
-  Stribeck law the growth rates of the projection on 1.5 x f_max were off by up to 50 1/s against
-  the PEP (10 1/s with 5 x f_max; frequencies within 2e-5), hence the PEP by default.
+  them every eigenvalue is within 2e-6 of the dense solve, at the cost of a second modal solve.
+  Its accuracy is reported per mode: the relative residual of the full quadratic problem.
+  Damping spread like the mass or the stiffness is represented well; damping localised at the
+  interface (the friction slope) is not: on the demo brake with a Stribeck law the growth rates of
+  the projection on 1.5 x f_max were off by up to 50 1/s against the PEP (10 1/s with 5 x f_max;
+  frequencies within 2e-5), hence the PEP by default.
 - ``"subspace"`` (any system that carries ``K0``; never picked by ``"auto"``): the same projection
   on a basis that needs no non-symmetric factorisation, for models whose LU does not fit in
   memory: the real modes of the frictionless, symmetric tangent (K0, M) up to ``basis`` x f_max
@@ -244,9 +246,10 @@ def basis_modes(system: LinearSystem, *, band, n_modes, target, basis: float, le
     try:
         skew = KT.copy()
         skew.axpy(-1.0, system.K)
-        if skew.norm(PETSc.NormType.INFINITY) > SYMMETRIC * system.K.norm(PETSc.NormType.INFINITY):
-            vectors.append(solve_modes(KT, system.M, **wanted, **kw).modes)
+        asymmetric = skew.norm(PETSc.NormType.INFINITY) > SYMMETRIC * system.K.norm(PETSc.NormType.INFINITY)
         skew.destroy()
+        if asymmetric:
+            vectors.append(solve_modes(KT, system.M, **wanted, **kw).modes)
     finally:
         KT.destroy()
     return base, vectors

@@ -89,7 +89,7 @@ class StabilityMap:
     def damping_ratio(self) -> np.ndarray:
         lam = np.abs(self.growth + 1j * TWO_PI * self.frequency)
         with np.errstate(invalid="ignore", divide="ignore"):
-            return 0.0 - self.growth / lam          # +0, not -0, for a neutral mode
+            return -self.growth / lam
 
     def summary(self) -> str:
         """A few lines for the console: size, unstable tracks and onsets."""
@@ -119,7 +119,7 @@ class StabilityMap:
             for k, v in enumerate(self.values):
                 for t in np.nonzero(self.mode[k] >= 0)[0]:
                     w.writerow([k + 1, f"{v:.8g}", t + 1, self.mode[k, t], f"{self.frequency[k, t]:.6f}",
-                                f"{self.growth[k, t] + 0.0:.6e}", f"{zeta[k, t]:.6e}", int(bad[k, t]),
+                                f"{self.growth[k, t] + 0.0:.6e}", f"{zeta[k, t] + 0.0:.6e}", int(bad[k, t]),
                                 "" if np.isnan(self.mac[k, t]) else f"{self.mac[k, t]:.4f}",
                                 f"{self.residual[k, t]:.2e}"])
         return path

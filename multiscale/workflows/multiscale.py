@@ -109,8 +109,8 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
         model = build_model(scene, comm, law=rough.law, tm=tm, conductance=scene.has("conductance") or exchange)
     t, wear = scene.time, scene.has("wear")
     mu = np.concatenate([np.full(g.n_zones, friction_coefficient(scene, n)) for n, g in zip(rough.names, rough.grids)])
-    settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature,
-                            partition=next(iter(partitions(scene, tm).values())) if scene.has("heat_partition") else np.nan,
+    first = next(iter(partitions(scene, tm).values())) if scene.has("heat_partition") else np.nan
+    settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature, partition=first,
                             partition_law=scene.micro.partition_law, wear=wear,
                             wear_every=scene.wear.update_every if wear else 1, steps=t.steps,
                             flash_softening=scene.micro.flash_softening,
