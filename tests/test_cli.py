@@ -307,8 +307,9 @@ def test_overwrite_deletes_what_the_run_before_wrote_and_keeps_the_rest(tmp_path
     (folder / "disc.xdmf").write_bytes(b"x")            # not recorded: kept
     stream = io.StringIO()
     with Reporter(MPI.COMM_SELF, stream=stream):
-        assert prepare_folder(_scene_into(tmp_path, folder), overwrite=True, resume=False,
-                              comm=MPI.COMM_SELF) == folder
+        prepared = prepare_folder(_scene_into(tmp_path, folder), overwrite=True, resume=False, comm=MPI.COMM_SELF)
+        assert "pad.xdmf" in [p.name for p in folder.iterdir()]      # kept until the run has something to write
+        assert prepared.claim() == folder
     # the new run's provenance, written at once: a run killed now is known as such, with its files
     assert sorted(p.name for p in folder.iterdir()) == ["disc.xdmf", "notes.txt", "provenance.json", "scene.toml",
                                                         "scene_resolved.toml"]
@@ -316,6 +317,23 @@ def test_overwrite_deletes_what_the_run_before_wrote_and_keeps_the_rest(tmp_path
     assert record["status"] == "running (or killed: no end was recorded)" and "block.xdmf" in record["files"]
     assert f"--overwrite: 2 entries of {folder} stay (not written by the run before): disc.xdmf, notes.txt" \
         in stream.getvalue()
+
+
+def test_overwrite_keeps_the_earlier_results_when_the_run_fails_before_writing(tmp_path, capsys):
+    """run --overwrite of a scene refused at meshing (--max-cells): the earlier run's results and
+    its provenance stay as they were (before: deleted, then the refusal); the same run that meshes
+    replaces them."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+    folder = tmp_path / "out"
+    _earlier_run(folder, ["block.xdmf", "block.h5", "history.h5"])
+    before = {p.name: p.read_bytes() for p in folder.iterdir()}
+    path = _write(tmp_path, BLOCK.replace("../results/block_on_flat", str(folder)))
+    assert main(["run", path, "--overwrite", "--quiet", "--max-cells", "50"]) == 2
+    assert "error: geometry.max_cells = 50" in capsys.readouterr().err
+    assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
+    assert main(["run", path, "--overwrite", "--quiet"]) == 0
+    record = json.loads((folder / "provenance.json").read_text())
+    assert record["status"] == "finished" and (folder / "block.xdmf").read_bytes() != b"x"
 
 
 def test_overwrite_without_a_record_deletes_nothing_and_resume_never_does(tmp_path):
@@ -330,13 +348,14 @@ def test_overwrite_without_a_record_deletes_nothing_and_resume_never_does(tmp_pa
     scene = _scene_into(tmp_path, folder)
     prepare_folder(scene, overwrite=False, resume=True, comm=MPI.COMM_SELF)
     assert sorted(p.name for p in folder.iterdir()) == ["pad.xdmf", "provenance.json"]   # --resume: as it was
-    prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF)
+    prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF).claim()
     assert not (folder / "pad.xdmf").exists() and (tmp_path / "x").exists()     # only entries of the folder
     _earlier_run(tmp_path / "other", ["a.csv"])
     (tmp_path / "other" / "provenance.json").write_text("{not json")      # another program's record
     stream = io.StringIO()
     with Reporter(MPI.COMM_SELF, stream=stream):
-        prepare_folder(_scene_into(tmp_path, tmp_path / "other"), overwrite=True, resume=False, comm=MPI.COMM_SELF)
+        prepare_folder(_scene_into(tmp_path, tmp_path / "other"), overwrite=True, resume=False,
+                       comm=MPI.COMM_SELF).claim()
     assert "a.csv" in [p.name for p in (tmp_path / "other").iterdir()]
     assert "stay (no record of a run (provenance.json with its files))" in stream.getvalue()
 
@@ -357,7 +376,7 @@ def test_a_scene_in_its_own_output_folder_is_not_a_result(tmp_path, capsys):
     assert scene.inputs == {Path(path).resolve()} and scene.earlier_results() == []
     prepare_folder(scene, overwrite=False, resume=False, comm=MPI.COMM_SELF)     # refused before
     for _ in range(2):
-        prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF)
+        prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF).claim()
         assert Path(path).read_text() == text
     assert sorted(p.name for p in tmp_path.iterdir()) == ["provenance.json", "scene.toml", "scene_resolved.toml"]
 

@@ -129,7 +129,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     """
     start = _time.perf_counter()
     io.abort_on_exception(comm)
-    folder = prepare_folder(scene, overwrite, resume, comm)
+    out = prepare_folder(scene, overwrite, resume, comm)
+    folder = out.path
     ckpt = folder / CHECKPOINT
     if resume and not comm.bcast(ckpt.is_file() if comm.rank == 0 else None, root=0):
         raise InputError("--resume", str(folder), f"no {CHECKPOINT} in the output folder to resume from")
@@ -148,6 +149,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             first = ms.start()
         done, history, written = 0, io.History(), -1
         history.append(**ms.record(first))
+        out.claim()                      # --overwrite: the earlier results go now, not before a failed start
         ms.save(ckpt, 0, history)
     ms.rough.pool.progress = False
     plan = outputs.plan(scene)

@@ -18,14 +18,48 @@ class RunResult:
     wall_time: float       # s
 
 
-def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
-    """The scene's output folder, created; refuses to touch earlier results unless ``overwrite``
-    (replace them) or ``resume`` (continue them; a missing folder is then an error and is not
-    created). ``overwrite`` first deletes every entry the earlier run recorded writing
-    (``provenance.results_of``: no stale field file, figure or checkpoint of another scene stays
-    beside the new results) and keeps, with a message, entries no run recorded (the user's own).
-    A new run's provenance is written at once, with status ``provenance.RUNNING`` (what a killed
-    run leaves).
+@dataclass
+class OutputFolder:
+    """A run's output folder, prepared (checked, created, writable) but not yet written into.
+    ``claim`` is called when the run has its first result to write: only then does ``--overwrite``
+    delete the earlier results, so a run that fails before (a scene the mesh refuses, a first solve
+    that does not converge, Ctrl-C) leaves them as they were."""
+
+    path: Path
+    scene: object
+    comm: object
+    replace: list          # names of earlier results that claim deletes (--overwrite)
+    resume: bool = False
+    claimed: bool = False
+
+    def claim(self) -> Path:
+        """Delete the earlier results (``--overwrite``: every entry the earlier run recorded writing,
+        ``provenance.results_of``, so no stale field file, figure or checkpoint of another scene stays
+        beside the new results; entries no run recorded, the user's own, stay with a message) and
+        write the new run's provenance with status ``provenance.RUNNING`` (what a killed run leaves).
+        Collective; once per run (later calls do nothing)."""
+        if self.claimed:
+            return self.path
+        scene, comm = self.scene, self.comm
+
+        def start():
+            if self.replace:
+                clear(self.path, self.replace)
+            if not self.resume:                 # a killed run's folder says so and lists its files
+                provenance.write(self.path, scene, ranks=comm.size, started=provenance.now(), stages={},
+                                 wall_time=0.0, status=provenance.RUNNING, analysis=outputs.analysis(scene),
+                                 warnings=scene.warnings)
+        io.on_root(comm, start, f"into the output folder {self.path}")
+        io.reporter().folder = self.path        # where a failed run leaves its provenance
+        self.claimed = True
+        return self.path
+
+
+def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
+    """The scene's output folder, created and tested for writing (a read-only folder fails here,
+    before any work); refuses to touch earlier results unless ``overwrite`` (replace them, at
+    ``OutputFolder.claim``) or ``resume`` (continue them; a missing folder is then an error and is
+    not created). A folder without earlier results, or one resumed, is claimed at once.
     Rank 0 decides for every rank (collective)."""
     folder = Path(scene.output.folder)
     if resume and not comm.bcast(folder.is_dir() if comm.rank == 0 else None, root=0):
@@ -39,18 +73,15 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> Path:
                          "resume=True), or choose another folder")
 
     def create():
-        if existing and overwrite and not resume:
-            clear(folder, existing)
         folder.mkdir(parents=True, exist_ok=True)
         probe = folder / ".multiscale_write_test"
-        probe.write_bytes(b"")              # a read-only folder fails here, before any work
+        probe.write_bytes(b"")
         probe.unlink()
-        if not resume:                      # a killed run's folder says so and lists its files
-            provenance.write(folder, scene, ranks=comm.size, started=provenance.now(), stages={}, wall_time=0.0,
-                             status=provenance.RUNNING, analysis=outputs.analysis(scene), warnings=scene.warnings)
     io.on_root(comm, create, f"into the output folder {folder}")
-    io.reporter().folder = folder         # where a failed run leaves its provenance
-    return folder
+    out = OutputFolder(folder, scene, comm, [] if resume else existing, resume)
+    if not out.replace:
+        out.claim()
+    return out
 
 
 def clear(folder: Path, existing: list[str]) -> None:

@@ -232,10 +232,12 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     if not scene.has("stability"):
         raise InputError("effects", sorted(scene.effects), 'the squeal analysis needs effect "stability"')
     io.abort_on_exception(comm)
-    folder = prepare_folder(scene, overwrite, False, comm)
+    out = prepare_folder(scene, overwrite, False, comm)
+    folder = out.path
     with io.stage("meshing"):
         tm = build_mesh(scene, comm)
     case = analyse(scene, tm, degree=degree)
+    out.claim()                          # --overwrite: the earlier results go now, not before a failed analysis
     with io.stage("writing results"):
         plan = outputs.plan(scene)
         rep = case.report

@@ -49,12 +49,14 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     """Run a perfect-contact scene (see module docstring)."""
     start = _time.perf_counter()
     io.abort_on_exception(comm)
-    folder = prepare_folder(scene, overwrite, False, comm)
+    out = prepare_folder(scene, overwrite, False, comm)
+    folder = out.path
     with io.stage("meshing"):
         tm = build_mesh(scene, comm)
     with io.stage("first contact solve"):
         model = build_model(scene, comm, tm=tm)
         model.start()
+    out.claim()                          # --overwrite: the earlier results go now, not before a failed start
     plan = outputs.plan(scene)
     writer = FieldOutput(model, folder, plan.body_fields + plan.interface_fields)
     history = io.History()
