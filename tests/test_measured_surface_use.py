@@ -144,6 +144,13 @@ def test_zones_from_a_measured_file_for_every_cover(tmp_path):
     _, b = make_zones(eq, lo, (4e-6, 4e-6), seed=10)
     assert a[0].shape == (50, 50) and np.array_equal(a[3].surface.heights, b[3].surface.heights)
     assert any("statistically equivalent surface" in line for line in lines)
+    # what overrides the file is a warning of the scene (printed at the start of a run), not a report
+    # line again (it was printed twice)
+    over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "equivalent"')
+    lines = []
+    make_zones(over, lo, (4e-6, 4e-6), seed=10, log=lines.append)
+    assert over.warnings == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",)
+    assert lines[0].startswith("roughness: read top-1.top") and not any("overrides" in line for line in lines)
 
 
 def test_a_rewritten_measured_file_changes_the_runs_fingerprint(tmp_path):

@@ -237,7 +237,7 @@ def test_covering_an_interface():
     assert tiled.shape == (60, 100) and not tiled.periodic
     with pytest.warns(TopographyWarning, match="13 x 7 mirror-stitched copies"):     # coarsened before copying
         coarse, lines = cover(s, (100, 50), (1e-3, 0.5e-3), "mirror")
-    assert coarse.shape == (50, 100) and lines[0].startswith("resampled 80 x 80 points of 1 um to 8 x 8 of 10 x 10 um")
+    assert coarse.shape == (50, 100) and lines[0].startswith("resampled 80 x 80 points of 1 um to 8 x 8 of 10 um")
     a, _ = cover(s, (64, 48), (128e-6, 96e-6), "equivalent", seed=5)
     b, _ = cover(s, (64, 48), (128e-6, 96e-6), "equivalent", seed=5)
     c, _ = cover(s, (64, 48), (128e-6, 96e-6), "equivalent", seed=6)
@@ -359,6 +359,9 @@ def test_resampling_to_unequal_pixels_filters_each_axis_at_its_own_pixel():
         out, note = resample(s, n)
         kept.append(out.heights[:, 10:-10].std() * np.sqrt(2) / 1e-7)
     assert "30 um along x, 120 um along y" in note
+    assert note.startswith("resampled 800 x 800 points of 1 um to 80 x 20 of 10 x 40 um")
+    _, back = resample(out, (40, 40))                   # unequal source pixels are both named (was dx only)
+    assert back.startswith("resampled 80 x 20 points of 10 x 40 um to 40 x 40 of 20 um")
     assert kept[1] == pytest.approx(kept[0], rel=1e-3)
     assert kept[1] == pytest.approx(gaussian_transmission(lam, 30e-6), rel=0.01)
 

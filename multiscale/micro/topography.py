@@ -357,6 +357,11 @@ def _um(value: float) -> str:
     return f"{value * 1e6:.4g}"
 
 
+def _pixel(dx: float, dy: float) -> str:
+    """A pixel size for people: "1 um", or "1 x 2 um" when dx and dy differ [m in, um out]."""
+    return f"{_um(dx)} um" if _um(dx) == _um(dy) else f"{_um(dx)} x {_um(dy)} um"
+
+
 # --------------------------------------------------------------------------- grids
 def resample(surface: Surface, n, size=None, antialias: bool = True) -> tuple[Surface, str]:
     """The surface on a grid of n = (nx, ny) cells over size (Lx, Ly) [m] (default: its own size),
@@ -387,8 +392,8 @@ def resample(surface: Surface, n, size=None, antialias: bool = True) -> tuple[Su
                                       mode="grid-wrap" if surface.periodic else "mirror")
     same = np.isclose(Lx, surface.size[0], rtol=1e-9) and np.isclose(Ly, surface.size[1], rtol=1e-9)
     out = Surface(h, dx, dy, periodic=surface.periodic and same)
-    return out, (f"resampled {surface.shape[1]} x {surface.shape[0]} points of {surface.dx * 1e6:.4g} um to "
-                 f"{nx} x {ny} of {dx * 1e6:.4g} x {dy * 1e6:.4g} um (cubic splines){filtered}: Sq "
+    return out, (f"resampled {surface.shape[1]} x {surface.shape[0]} points of {_pixel(surface.dx, surface.dy)} to "
+                 f"{nx} x {ny} of {_pixel(dx, dy)} (cubic splines){filtered}: Sq "
                  f"{_um(float(surface.heights.std()))} -> {_um(float(out.heights.std()))} um")
 
 

@@ -112,8 +112,10 @@ def measured_face(r, m, counts, size, seed: int, log=None) -> Surface:
                                  f"per zone: set micro.grid (at most {MAX_CELLS} without it)")
         surface, lines = cover(done.surface, (counts[0] * cells[0], counts[1] * cells[1]), tuple(size), r.cover,
                                seed, prefix="roughness.")
+    known = {f"warning: {note}" for note in measured.notes}      # the scene's warnings already (check, run)
     for line in (*done.report, *lines) if log is not None else ():
-        log(f"roughness: {line}")
+        if line not in known:
+            log(f"roughness: {line}")
     return surface
 
 
