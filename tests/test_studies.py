@@ -89,6 +89,8 @@ def test_hertz_study_errors_match_an_independent_computation(hertz_study):
     worst = {int(r["grid"]): float(r["max_error"]) for r in rows}
     time = {int(r["grid"]): float(r["wall_time"]) for r in rows}
     text = (out / "hertz.md").read_text()
+    # the runs table names each metric's unit (from the problem's description of it)
+    assert "| grid | contact_radius [m] | error | max_pressure [Pa] | error | approach [m] | error |" in text
     assert f"4 ok, 0 failed; {sum(time.values()):.1f} s of run wall time in all (failed runs included)" in text
     for tol, shown in ((0.01, "| 1 % |"), (0.05, "| 5 % |")):
         good = [g for g in GRIDS if worst[g] <= tol]
@@ -378,3 +380,16 @@ Abort(1) on node 1 (rank 1 in comm 0): application called MPI_Abort(MPI_COMM_WOR
     assert failure_line("KeyboardInterrupt\nnothing\n") == "KeyboardInterrupt"
     assert failure_line("segfault in rank 0\n  \n") == "segfault in rank 0"
     assert failure_line("") == "no output"
+
+
+def test_metric_units_of_every_problem():
+    """Every registered problem's metric has a unit in brackets (tables and axes show it); a scene
+    study's metric takes its history column's unit, or the squeal metric's."""
+    from multiscale.studies.problems import PROBLEMS
+    for name, problem in PROBLEMS.items():
+        assert all(problem.metric_unit(m) for m in problem.metrics), name
+    scene = PROBLEMS["scene"]
+    from multiscale.studies.scene_problem import SQUEAL_METRICS
+    assert all(scene.metric_unit(m) for m in SQUEAL_METRICS)
+    assert [scene.metric_unit(m) for m in ("max_temperature_pin:rise", "wear_volume", "max_growth",
+                                           "partition_mean:max")] == ["K", "m^3", "1/s", "-"]

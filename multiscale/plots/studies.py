@@ -13,7 +13,8 @@ import numpy as np
 from matplotlib.ticker import NullFormatter
 
 from multiscale.studies.expand import Study, StudyRun
-from multiscale.studies.formatting import percent, value_text
+from multiscale.studies.formatting import metric_heading, percent, value_text
+from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.results import Row, case_key, pareto
 
 __all__ = ["plot"]
@@ -130,7 +131,8 @@ def _plot_axis(study, ok, axis, folder):
             ax.set_yscale("log")
         if kind == "time":
             ax.set_yscale("log")
-        ax.set(xlabel=" / ".join(axis), ylabel={"error": f"relative error of {m}", "value": m, "time": "wall time [s]"}[kind],
+        value = metric_heading(m, PROBLEMS[study.problem].metric_unit(m))
+        ax.set(xlabel=" / ".join(axis), ylabel={"error": f"relative error of {m}", "value": value, "time": "wall time [s]"}[kind],
                title={"error": f"error of {m}", "value": m, "time": "wall time of a run"}[kind])
         if log_x:             # ticks at the swept values, no minor labels (they overlap on short decades)
             ax.set_xscale("log")

@@ -2,6 +2,7 @@
 and ``jsonable`` (a run's identity for its record key). The registry is ``problems``."""
 from __future__ import annotations
 
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -42,6 +43,10 @@ class Problem:
         """One run of validated ``params``; files it writes go under ``workdir``."""
         raise NotImplementedError
 
+    def metric_unit(self, name: str) -> str:
+        """The unit of metric ``name`` (``unit_in`` its description), "" if unknown."""
+        return unit_in(self.metrics.get(name, ""))
+
     def check_metric(self, name: str, scene=None) -> str | None:
         """None if ``name`` is a metric of this problem (of its ``scene`` file, for problem
         "scene"), else the problem (one line)."""
@@ -49,6 +54,13 @@ class Problem:
             return None
         return f'unknown metric of problem "{self.name}"{suggest(name, self.metrics)}; allowed: ' \
                f'{", ".join(self.metrics)}'
+
+
+def unit_in(description: str) -> str:
+    """The unit a metric's description ends with in brackets ("peak contact pressure [Pa]" ->
+    "Pa"), "" if none."""
+    unit = re.search(r"\[([^\]]+)\]\s*$", description)
+    return unit.group(1) if unit else ""
 
 
 def jsonable(value):

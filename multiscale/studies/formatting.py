@@ -5,7 +5,7 @@ import math
 import re
 import time
 
-__all__ = ["now", "number_text", "percent", "value_text"]
+__all__ = ["metric_heading", "now", "number_text", "percent", "value_text"]
 
 
 # unit spellings of the study files -> their symbols in tables and plots
@@ -30,6 +30,11 @@ def value_text(value) -> str:
 def number_text(v) -> str:
     """A metric value, "n/a" when not finite."""
     return value_text(v) if not isinstance(v, float) or math.isfinite(v) else "n/a"
+
+
+def metric_heading(name: str, unit: str) -> str:
+    """A metric's table heading or axis label: "max_pressure [Pa]" ("max_pressure" without a unit)."""
+    return f"{name} [{unit}]" if unit else name
 
 
 def percent(v: float) -> str:

@@ -9,7 +9,7 @@ from pathlib import Path
 import numpy as np
 
 from multiscale.studies.expand import Study
-from multiscale.studies.formatting import now, number_text, percent, value_text
+from multiscale.studies.formatting import metric_heading, now, number_text, percent, value_text
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.results import Row, cheapest, reference_text
 
@@ -93,7 +93,8 @@ def _average_table(study, rows) -> list[str]:
     groups = {}
     for r in rows:
         groups.setdefault(tuple(r.run.shown[k] for k in keep), []).append(r)
-    head = keep + [f"{m} mean ± std (min … max)" for m in study.metrics] + ["samples"]
+    unit = PROBLEMS[study.problem].metric_unit
+    head = keep + [f"{metric_heading(m, unit(m))} mean ± std (min … max)" for m in study.metrics] + ["samples"]
     lines = [f"## Averaged over {', '.join(study.averaged)}", "",
              "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for label, group in groups.items():
@@ -106,9 +107,9 @@ def _average_table(study, rows) -> list[str]:
 
 
 def _runs_table(study, rows) -> list[str]:
-    head = list(study.knobs)
+    head, unit = list(study.knobs), PROBLEMS[study.problem].metric_unit
     for m in study.metrics:
-        head += [m] + (["error"] if study.reference else [])
+        head += [metric_heading(m, unit(m))] + (["error"] if study.reference else [])
     head += ["wall time [s]", "peak memory [MB]", "iterations", "status"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:

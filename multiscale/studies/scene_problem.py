@@ -14,10 +14,10 @@ from pathlib import Path
 import numpy as np
 
 from multiscale.errors import MultiscaleError, SceneError
-from multiscale.io import History
+from multiscale.io import History, unit_of
 from multiscale.scene import load
 from multiscale.schema import suggest
-from multiscale.studies.base import Outcome, Problem, jsonable
+from multiscale.studies.base import Outcome, Problem, jsonable, unit_in
 
 __all__ = ["SQUEAL_METRICS", "SceneProblem", "SceneRun", "failure_line", "squeal_metrics"]
 
@@ -36,7 +36,7 @@ def failure_line(output: str) -> str:
 
 
 SQUEAL_METRICS = {
-    "modes": "number of complex modes found in the band",
+    "modes": "number of complex modes found in the band [-]",
     "unstable_modes": "modes with a positive real part (growth rate) [-]",
     "max_growth": "largest real part sigma of the eigenvalues [1/s]",
     "max_growth_frequency": "frequency of the mode with the largest real part [Hz]",
@@ -97,6 +97,12 @@ class SceneProblem(Problem):
         text = params.scene.read_bytes()
         return {"scene": str(params.scene), "scene_sha256": hashlib.sha256(text).hexdigest(),
                 "overrides": jsonable(params.overrides)}
+
+    def metric_unit(self, name: str) -> str:
+        """A squeal metric's unit (``SQUEAL_METRICS``), else its history column's (``io.unit_of``)."""
+        if name in SQUEAL_METRICS:
+            return unit_in(SQUEAL_METRICS[name])
+        return unit_of(name.partition(":")[0])
 
     def check_metric(self, name, scene=None):
         if scene is not None and _squeal(scene):       # its metrics are known before it runs
