@@ -41,7 +41,7 @@ DEFAULTS: dict[str, float] = {
     "disc_outer_radius": 0.140,      # m
     "ring_inner_radius": 0.085,      # m, inner radius of the friction ring (= hat wall outer radius)
     "disc_thickness": 0.022,         # m
-    "vanes": 0.0,                    # number of radial vanes (0: solid disc)
+    "vanes": 0.0,                    # number of radial vanes (0: solid disc; the heat problem needs 0)
     "cheek_thickness": 0.007,        # m, ventilated disc only
     "vane_width": 0.008,             # m, ventilated disc only
     "hat_height": 0.040,             # m, from the outboard friction face to the flange top

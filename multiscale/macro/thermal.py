@@ -303,7 +303,23 @@ class Thermal:
         return (p.integral(T, self.T_ref) - p.integral(T_old, self.T_ref)) / self.dt
 
     def _check_motion(self) -> None:
-        """A translating body has no steady Eulerian frame: heat only at rest (no transport)."""
+        """A translating body has no steady Eulerian frame: heat only at rest (no transport). A
+        rotating body needs a surface of revolution: where the rotation crosses its surface (vanes,
+        holes) the transport has inflow boundaries without a condition, and its temperatures
+        diverged (a ventilated disc: 76 000 K after 2 s, 25 times the heat put in)."""
+        if self.transport:
+            motion, body = self.tm.spec.motion, self.tm.bodies[1]
+            c = body.crossing(motion.axis, motion.centre)
+            if c.share > 0:
+                r = np.linalg.norm(np.cross(np.asarray(motion.axis, float) / np.linalg.norm(motion.axis),
+                                            c.where - np.asarray(motion.centre, float)))
+                raise InputError("effects", "thermal", f"the rotating body {body.name!r} is not a body of revolution "
+                                 f"about its axis: its rotation crosses {100 * c.share:.2g} % of its surface "
+                                 f"(weighted by speed; e.g. at r = {r * 1e3:.1f} mm, point "
+                                 f"{np.round(c.where * 1e3, 1).tolist()} mm: vanes, holes or slots). Its heat "
+                                 "problem is solved in a fixed (Eulerian) frame, which needs a surface of "
+                                 "revolution: fill the holes and vanes of the geometry (e.g. geometry.vanes = 0) "
+                                 "for the thermal effects, or run without effect \"thermal\"")
         speed = float(self.contact.speed.value)
         if not self.transport and speed != 0.0:
             raise InputError("loading.sliding_speed", speed,
