@@ -333,6 +333,10 @@ def test_overwrite_keeps_the_earlier_results_when_the_run_fails_before_writing(t
     assert {p.name: p.read_bytes() for p in folder.iterdir()} == before
     assert main(["run", path, "--overwrite", "--quiet"]) == 0
     record = json.loads((folder / "provenance.json").read_text())
+    # a fresh folder: the refused run leaves nothing that makes the next run need --overwrite
+    fresh = _write(tmp_path, BLOCK.replace("../results/block_on_flat", str(tmp_path / "fresh")), name="fresh.toml")
+    assert main(["run", fresh, "--quiet", "--max-cells", "50"]) == 2
+    assert list((tmp_path / "fresh").iterdir()) == [] and main(["run", fresh, "--quiet"]) == 0
     assert record["status"] == "finished" and (folder / "block.xdmf").read_bytes() != b"x"
 
 

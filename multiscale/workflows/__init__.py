@@ -34,7 +34,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     """Run a scene (``multiscale run``) with its workflow; only the multiscale loop resumes.
 
     Besides the analysis' results, the folder receives ``scene.toml``, ``scene_resolved.toml``,
-    ``provenance.json`` (also after a failure, once the folder was prepared) and ``paraview.py``.
+    ``provenance.json`` (also after a failure, once the run has written into the folder) and ``paraview.py``.
     ``verbose``: stage lines and the summary on rank 0."""
     if not all(hasattr(scene, a) for a in ("has", "effects", "output")):
         raise InputError("scene", scene, "a validated scene: multiscale.scene.load(path) or loads(text)")

@@ -22,8 +22,8 @@ class RunResult:
 class OutputFolder:
     """A run's output folder, prepared (checked, created, writable) but not yet written into.
     ``claim`` is called when the run has its first result to write: only then does ``--overwrite``
-    delete the earlier results, so a run that fails before (a scene the mesh refuses, a first solve
-    that does not converge, Ctrl-C) leaves them as they were."""
+    delete the earlier results and the new provenance appear, so a run that fails before (a scene
+    the mesh refuses, a first solve that does not converge, Ctrl-C) leaves the folder as it was."""
 
     path: Path
     scene: object
@@ -59,7 +59,9 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
     """The scene's output folder, created and tested for writing (a read-only folder fails here,
     before any work); refuses to touch earlier results unless ``overwrite`` (replace them, at
     ``OutputFolder.claim``) or ``resume`` (continue them; a missing folder is then an error and is
-    not created). A folder without earlier results, or one resumed, is claimed at once.
+    not created). A resumed folder is claimed at once; any other when the run first writes, so
+    that a run refused before (at meshing, in its first solve) leaves no entry that would make
+    the next run need ``--overwrite``.
     Rank 0 decides for every rank (collective)."""
     folder = Path(scene.output.folder)
     if resume and not comm.bcast(folder.is_dir() if comm.rank == 0 else None, root=0):
@@ -79,7 +81,7 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
         probe.unlink()
     io.on_root(comm, create, f"into the output folder {folder}")
     out = OutputFolder(folder, scene, comm, [] if resume else existing, resume)
-    if not out.replace:
+    if resume:
         out.claim()
     return out
 
