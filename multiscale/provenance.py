@@ -204,6 +204,11 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     return paths
 
 
+def entries(n: int) -> str:
+    """A count of folder entries for people: "1 entry", "3 entries"."""
+    return f"{n} entry" if n == 1 else f"{n} entries"
+
+
 def results_of(folder: Path) -> list[str]:
     """Names of the entries an earlier run recorded writing into ``folder`` (its
     ``provenance.json``, the record itself included), with the ``.part`` files a killed run can

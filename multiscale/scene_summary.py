@@ -4,7 +4,8 @@ from __future__ import annotations
 import math
 
 from multiscale.geometry import CellEstimate, estimate_cells
-from multiscale.provenance import results_of
+from multiscale.outputs import analysis
+from multiscale.provenance import entries, results_of
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
 from multiscale.schema import reference as schema_reference
 
@@ -68,8 +69,9 @@ def summary(scene: Scene) -> list[str]:
     names = scene.earlier_results()
     if names:
         earlier = len(set(names) & set(results_of(o.folder)))
-        lines.append(f"  note      the output folder already holds {len(names)} entries: run needs --overwrite "
-                     f"(deletes the {earlier} the run before wrote) or --resume")
+        lines.append(f"  note      the output folder already holds {entries(len(names))}: run needs --overwrite "
+                     f"(deletes the {earlier} the run before wrote)"
+                     + (" or --resume" if analysis(scene) == "multiscale" else ""))
     lines += [f"  warning   {w}" for w in scene.warnings]
     return lines
 

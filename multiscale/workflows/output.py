@@ -70,9 +70,11 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
     existing = comm.bcast(scene.earlier_results() if comm.rank == 0 else None, root=0)
     if existing and not (overwrite or resume):
         shown = ", ".join(existing[:3]) + (", ..." if len(existing) > 3 else "")
-        raise SceneError(f'output.folder = "{folder}": already holds results ({len(existing)} entries: {shown}); '
-                         "use --overwrite to replace them, --resume to continue the run (in Python: overwrite=True, "
-                         "resume=True), or choose another folder")
+        resumes = outputs.analysis(scene) == "multiscale"           # the only analysis with checkpoints
+        raise SceneError(f'output.folder = "{folder}": already holds results ({provenance.entries(len(existing))}: {shown}); '
+                         + ("use --overwrite to replace them, --resume to continue the run (in Python: overwrite=True, "
+                            "resume=True), or choose another folder" if resumes else
+                            "use --overwrite to replace them (in Python: overwrite=True), or choose another folder"))
 
     def create():
         folder.mkdir(parents=True, exist_ok=True)
@@ -98,5 +100,5 @@ def clear(folder: Path, existing: list[str]) -> None:
     if kept:
         shown = ", ".join(kept[:3]) + (", ..." if len(kept) > 3 else "")
         why = "not written by the run before" if earlier else "no record of a run (provenance.json with its files)"
-        io.reporter().say(f"--overwrite: {len(kept)} entries of {folder} stay ({why}): {shown}; "
+        io.reporter().say(f"--overwrite: {provenance.entries(len(kept))} of {folder} stay ({why}): {shown}; "
                           "files of the same name as a result are replaced")
