@@ -117,8 +117,9 @@ def plan(scene) -> Plan:
         if scene.stability.sweep is not None:
             files.update({"map.csv": "every mode at every point of the sweep (frequency, growth rate, track)",
                           "onsets.csv": "the bracketed parameter at which each track turns unstable",
-                          "map.h5": "the stability map's arrays", "map.png": "growth rate and frequency against "
-                          "the swept parameter", "map_tracks.png": "the modes' tracks over the sweep"})
+                          "map.h5": "the stability map's arrays", "map.png": "growth rate against frequency of "
+                          "every mode, coloured by the swept value",
+                          "map_tracks.png": "frequency and growth rate of each tracked mode against the swept value"})
     else:
         files["history.h5"] = "scalar history per step (forces, pressures, temperatures, heat), unit per dataset"
         files["history.png"] = "the history against time"

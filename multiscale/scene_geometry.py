@@ -52,6 +52,10 @@ class LengthUnit:
     def describe(self) -> str:
         return 'a length unit such as "m", "mm", "in"'
 
+    def show_default(self, metres: float) -> str:
+        """The default as the user would write it (``check --keys``): "m" for 1 m."""
+        return '"m"' if metres == 1.0 else f"{metres:g} m"
+
     def __call__(self, raw, ctx):
         try:
             return to_si(f"1 {raw}", "length") if isinstance(raw, str) else None

@@ -586,7 +586,8 @@ def reference(cls, path: str = "") -> list[str]:
             continue
         default = next(f.default for f in dataclasses.fields(cls) if f.name == name)
         if default is not None and not spec.required:
-            when = f"default {show(default)}" + ("" if when == "optional" else f"; {when}")
+            shown = spec.parser.show_default(default) if hasattr(spec.parser, "show_default") else show(default)
+            when = f"default {shown}" + ("" if when == "optional" else f"; {when}")
         lines.append(f"  {name:<20} {spec.parser.describe()}  [{when}]")
     for rule in getattr(cls, "rules", ()):
         lines.append(f"  rule: {rule.text()}")

@@ -413,6 +413,8 @@ def test_reference_lists_every_section_and_key():
     assert "  ramp_steps " in sections["[loading]"] and "rule: one of normal_force, pressure" in sections["[loading]"]
     assert "friction" not in sections["[loading.vehicle]"] and "rule" not in sections["[loading.stribeck]"]
     assert "  rough " in sections["[interfaces.<name>]"] and "[interfaces.<name>.roughness]" in text
+    # a CAD file's length unit defaults to metres, shown as the user writes it (was "[default 1.0]")
+    assert 'unit                 a length unit such as "m", "mm", "in"  [default "m"]' in text
 
 
 def test_overrides_are_validated_like_the_file(tmp_path):

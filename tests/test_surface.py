@@ -50,6 +50,7 @@ def test_statistics_of_a_sinusoid():
     assert st.m2 == pytest.approx(A**2 * q**2 / 4, rel=1e-12)      # average of x (A²q²/2) and y (0)
     assert st.m4 == pytest.approx(A**2 * q**4 / 4, rel=1e-12)
     assert st.nayak == pytest.approx(2.0, rel=1e-12)
+    assert np.ndim(st.nayak) == 0 and "array" not in repr(st)     # one surface: scalars (nayak was a 0-d array)
     fd = statistics(Surface(h, L / n, L / n, periodic=False))        # finite differences
     assert fd.rms_slope == pytest.approx(st.rms_slope, rel=2e-2)
 

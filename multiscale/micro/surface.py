@@ -242,7 +242,7 @@ def statistics(surface: Surface) -> SurfaceStats:
     m2, m4 = (m20 + m02) / 2, (m40 + m04) / 2
     with np.errstate(divide="ignore", invalid="ignore"):
         nayak = np.where(m2 > 0, m0 * m4 / np.where(m2 > 0, m2, 1) ** 2, np.inf)
-    return SurfaceStats(np.sqrt(m0), np.sqrt(m20 + m02), m0, m2, m4, nayak)
+    return SurfaceStats(np.sqrt(m0), np.sqrt(m20 + m02), m0, m2, m4, nayak[()])     # a scalar like the others
 
 
 @dataclass(frozen=True)

@@ -81,7 +81,7 @@ def partitions(scene, tm) -> dict:
     """Share of frictional heat into body 0 [-] at every interface (``Scene.partition_at``): the
     effusivity partition weighted by the interface's area A_0 and, for a rotating body 1, the
     track it sweeps (``Interface.swept_area``; the ch. 7 pin, 4 cm^2 sweeping 116 cm^2, takes
-    2.8 %, not the 43.5 % of equal areas); a translating body 1 keeps equal areas (collective)."""
+    2.6 %, not the 43.5 % of equal areas); a translating body 1 keeps equal areas (collective)."""
     iface, motion = tm.interface, tm.spec.motion
     out = {}
     for name, m in iface.masks().items():
