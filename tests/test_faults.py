@@ -244,6 +244,31 @@ def test_ctrl_c_stops_the_run_after_its_step_with_the_results_written(tmp_path, 
         assert reader.read_data(reader.num_steps - 1)[0] == pytest.approx(done * 3 / 4000)   # the stop's fields
 
 
+def test_ctrl_c_while_the_end_is_written_lets_it_finish(tmp_path, monkeypatch):
+    """Ctrl-C after the last step, while the history and plots are written: the writing finishes
+    and the run ends as finished (before: a KeyboardInterrupt inside the writing, MPI_Abort under
+    mpiexec, provenance "interrupted" without a step; an adversarial docs audit)."""
+    import json
+    import signal
+
+    from multiscale.io import History
+    from multiscale.scene import loads
+    from multiscale.workflows import run, transient
+    written = transient.write_history
+
+    def interrupted_write(history, folder, name, comm, plot=True):
+        if plot:                                     # the final write, after the steps
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.01)
+        return written(history, folder, name, comm, plot=plot)
+    monkeypatch.setattr(transient, "write_history", interrupted_write)
+    result = run(loads(SCENE.format(folder=tmp_path / "out")), verbose=False)
+    folder = tmp_path / "out"
+    assert json.loads((folder / "provenance.json").read_text())["status"] == "finished"
+    assert len(History.read(folder / "history.h5")) == 4 and (folder / "history.png").stat().st_size > 0
+    assert result.history_file == folder / "history.h5"
+
+
 def test_a_second_ctrl_c_interrupts_at_once():
     """StepStop: the first SIGINT is a request (collective ``requested()``), the second raises."""
     import signal

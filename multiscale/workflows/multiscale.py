@@ -160,20 +160,21 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         ms.mark_fields(ckpt, done, comm)
     last = steps if stop_after is None else min(steps, stop_after)
     stopping = False
-    with io.stage("macro steps"), io.StepStop(comm) as stop:
-        for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
-            history.append(**ms.record(ms.step(n)))
-            ms.save(ckpt, n, history)
-            write_history(history, folder, scene.name, comm, plot=False)   # readable if the run is killed
-            done, stopping = n, stop.requested()
-            if n % every == 0 or n == steps:          # not at a stop: a resumed run's field times stay those of
-                writer.write()                        # an uninterrupted one
-                ms.mark_fields(ckpt, n, comm)
-            if stopping:
-                break
-    with io.stage("writing history and plots"):
-        h5, png = write_history(history, folder, scene.name, comm)
-        plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
+    with io.StepStop(comm) as stop:          # a Ctrl-C while the end is written lets it finish
+        with io.stage("macro steps"):
+            for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
+                history.append(**ms.record(ms.step(n)))
+                ms.save(ckpt, n, history)
+                write_history(history, folder, scene.name, comm, plot=False)   # readable if the run is killed
+                done, stopping = n, stop.requested()
+                if n % every == 0 or n == steps:          # not at a stop: a resumed run's field times stay those of
+                    writer.write()                        # an uninterrupted one
+                    ms.mark_fields(ckpt, n, comm)
+                if stopping:
+                    break
+        with io.stage("writing history and plots"):
+            h5, png = write_history(history, folder, scene.name, comm)
+            plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
     if done == steps:
         checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
     result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones, ckpt] + maps, _time.perf_counter() - start,

@@ -64,19 +64,20 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     writer.write()
     steps = scene.time.steps if model.thermal is not None else 0
     done, stopping = 0, False
-    with io.stage("macro steps"), io.StepStop(comm) as stop:
-        for n in io.bar(range(1, steps + 1), "macro steps"):
-            heat = model.macro_step(scene.time.dt, scene.time.substeps)
-            history.append(**model.record(heat))
-            done, stopping = n, stop.requested()
-            if n % scene.output.every == 0 or n == steps or stopping:
-                writer.write()
-            if n < steps:                    # a killed run keeps the history of its steps
-                write_history(history, folder, scene.name, comm, plot=False)
-            if stopping:
-                break
-    with io.stage("writing history and plots"):
-        h5, png = write_history(history, folder, scene.name, comm)
+    with io.StepStop(comm) as stop:          # a Ctrl-C while the end is written lets it finish
+        with io.stage("macro steps"):
+            for n in io.bar(range(1, steps + 1), "macro steps"):
+                heat = model.macro_step(scene.time.dt, scene.time.substeps)
+                history.append(**model.record(heat))
+                done, stopping = n, stop.requested()
+                if n % scene.output.every == 0 or n == steps or stopping:
+                    writer.write()
+                if n < steps:                    # a killed run keeps the history of its steps
+                    write_history(history, folder, scene.name, comm, plot=False)
+                if stopping:
+                    break
+        with io.stage("writing history and plots"):
+            h5, png = write_history(history, folder, scene.name, comm)
     if stopping:                     # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}")
     result = TransientResult(folder, writer.files + [h5, png], _time.perf_counter() - start, history, h5, png,
