@@ -50,6 +50,7 @@ def describe(params=None) -> GeometrySpec:
         load_direction=(0.0, 0.0, -1.0),
         motion=Translation((1.0, 0.0, 0.0)),
         length_scale=max(p["length"], p["width"], p["height"]),
+        symmetry={"symmetry_x": (1.0, 0.0, 0.0), "symmetry_y": (0.0, 1.0, 0.0)},
     )
 
 

@@ -98,6 +98,8 @@ class GeometrySpec:
     report: tuple[str, ...] = ()       # what the builder found (bodies, volumes, interfaces), for check
     interface_regions: Mapping[str, str] = field(default_factory=dict)   # interface -> region of
     #                                    body 0 along it (default: body 0's first region)
+    symmetry: Mapping[str, tuple] = field(default_factory=dict)   # face -> unit normal of a symmetry
+    #                                    plane there (the model is a part of a symmetric whole)
 
     @property
     def materials(self) -> tuple[str, ...]:

@@ -22,6 +22,8 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
+
 from multiscale.errors import InputError, SceneError
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, unknown_keys)
@@ -296,6 +298,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                             f'rotating body ({where} translates; with effect "thermal" it slides only at '
                             "sliding_speed = 0)")
         problems += _surface_checks(scene, g, where, effects)
+        problems += _symmetry_checks(scene, g, where, effects)
         problems += _hardness_checks(scene, g, raw, effects)
         if "wear" in effects and scene.wear is not None and scene.materials is not None and not problems:
             rough = {scene.geometry.spec.interface_materials(n)[0] for n in scene.geometry.spec.interfaces}
@@ -382,6 +385,27 @@ def _nyquist(scene: Scene) -> list[str]:
             out.append(f"{where}.k_max = {list(r.k_max)}: must not exceed the Nyquist index {[c // 2 for c in cells]} "
                        f"of the {'face' if r.patch == 'face' else 'zone'}'s micro grid of {cells} cells")
     return sorted(set(out))
+
+
+def _symmetry_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]:
+    """Friction with a moving body on a part model: a symmetry plane that the sliding does not
+    respect (a translation with a component along its normal; a rotation about an axis not normal
+    to it) mirrors the friction, holding two halves pulled against each other (found by an
+    adversarial test: the block's pressure peaked at its symmetry plane, 1.35 MPa for 1 MPa)."""
+    motion = g.spec.motion
+    moving = scene.loading is not None and (g.motion == "rotation" or bool(scene.loading.sliding_speed))
+    if "friction" not in effects or not moving or ("thermal" in effects and g.motion != "rotation"):
+        return []                            # (with "thermal" a translation is refused at any speed)
+    along = np.asarray(motion.axis if g.motion == "rotation" else motion.direction, dtype=float)
+    along /= np.linalg.norm(along)
+    problems = []
+    for face, normal in g.spec.symmetry.items():
+        c = abs(float(np.dot(along, normal)))
+        if (c < 1 - 1e-9) if g.motion == "rotation" else (c > 1e-9):
+            problems.append(f'effects: "friction" with a sliding body on {where}: its face {face} is a symmetry '
+                            f"plane (normal {list(normal)}) that the sliding does not respect, so the model would "
+                            "mirror the friction; use a whole model (a geometry file) or no sliding speed")
+    return problems
 
 
 def _surface_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]:

@@ -97,7 +97,7 @@ def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
     assert len(h) == 3 and h["time"][-1] == pytest.approx(1.2)
     np.testing.assert_allclose(h["interface_force"], 200.0, rtol=1e-6)
     # the effusivity partition goes to the pin, weighted by its 20 x 20 mm face against the track
-    # its corners sweep on the disc, r from 80 to hypot(100, 10) mm (Newcomb & Spurr; 2.8 %, not
+    # its corners sweep on the disc, r from 80 to hypot(100, 10) mm (Newcomb & Spurr; 2.6 %, not
     # the 43 % of equal areas)
     e_pin, e_disc = (scene.materials[m].effusivity for m in ("pin", "disc"))
     face, track = 0.02 ** 2, math.pi * (math.hypot(0.1, 0.01) ** 2 - 0.08 ** 2)

@@ -417,6 +417,23 @@ def test_reference_lists_every_section_and_key():
     assert 'unit                 a length unit such as "m", "mm", "in"  [default "m"]' in text
 
 
+def test_friction_on_a_sliding_part_model_is_refused(tmp_path):
+    """block_on_flat is a quarter model (symmetry planes x = 0, y = 0): sliding along x mirrors the
+    friction at x = 0 (an adversarial run: the pressure peaked at that plane, 1.35 MPa for 1 MPa,
+    and check said OK). At rest, or without friction, the block stays a valid model."""
+    text = GOOD.replace('effects = ["contact", "friction", "thermal", "heat_partition", "conductance", "expansion"]',
+                        'effects = ["contact", "friction"]')
+    with pytest.raises(SceneError) as info:
+        loads(text, tmp_path, overrides={"loading.sliding_speed": "1 m/s"})
+    assert info.value.problems == [
+        'effects: "friction" with a sliding body on builder "block_on_flat": its face symmetry_x is a symmetry '
+        "plane (normal [1.0, 0.0, 0.0]) that the sliding does not respect, so the model would mirror the "
+        "friction; use a whole model (a geometry file) or no sliding speed"]
+    assert loads(text, tmp_path).loading.sliding_speed == 0.0
+    loads(text.replace('"contact", "friction"', '"contact"').replace("friction = 0.4\n", ""), tmp_path,
+          overrides={"loading.sliding_speed": "1 m/s"})
+
+
 def test_overrides_are_validated_like_the_file(tmp_path):
     scene = loads(GOOD, tmp_path, overrides={"loading.friction": 0.2, "geometry.mesh_size": "1 mm",
                                              "materials.block.E": "5 GPa"})
