@@ -7,7 +7,7 @@ One macro step Δt (Fig. 7.2) runs:
    laws and partitions (Fig. 7.4; ``macro.model.MacroModel.macro_step``);
 2. per zone, the macro loading at the end of the step (``loading``): zone pressure P = (contact
    force on the zone's facets) / (zone area) — so that the micro patch carries the macro force —,
-   the facet temperatures of both bodies, the sliding speed and direction at the zone centre;
+   the facet temperatures of both bodies, the sliding speed (force-weighted over the zone) and direction;
 3. the micro post-analysis of the loaded zones (Fig. 7.5, ``micro.post_analysis``): local pressure
    under P, local surface temperatures, flash temperature and partition (steady sliding heating,
    or with ``PostAnalysis.heating.transient_steps`` the transient heating over Δt, Table 7.1),
@@ -126,7 +126,7 @@ class ZoneLoading:
 
     force: np.ndarray          # N, contact force on the zone's facets
     pressure: np.ndarray       # Pa, force / zone area
-    speed: np.ndarray          # m/s, sliding speed of the counter-face at the zone centre
+    speed: np.ndarray          # m/s, sliding speed of the counter-face, force-weighted over the zone
     angle: np.ndarray          # rad, its direction in the interface plane (from +x)
     temperature: np.ndarray    # K, (Z, 2): facet-mean surface temperatures (counter-face, rough body)
     reach: np.ndarray          # m per unit of body 1's sliding (rad or m): the zone's sliding distance
@@ -228,14 +228,14 @@ class Multiscale:
         iface, model, Z = self.tm.interface, self.model, len(self.rough.zones)
         rough = self.rough.zone_of_facet >= 0
         zone_of, areas = self.rough.zone_of_facet[rough], iface.areas[rough]
-        force = np.bincount(zone_of, (model.contact.facet_pressure() * iface.areas)[rough], minlength=Z)
-        area = np.bincount(zone_of, areas, minlength=Z)
+        pressure_area = model.contact.facet_pressure() * iface.areas          # N per facet
+        force, area = (np.bincount(zone_of, f[rough], minlength=Z) for f in (pressure_area, iface.areas))
         T = np.full((Z, 2), self.settings.initial_temperature)
         if model.thermal is not None:
             for col, side in ((0, 1), (1, 0)):
                 total = np.bincount(zone_of, model.thermal.facet_temperature(side)[rough] * areas, minlength=Z)
                 T[:, col] = np.where(area > 0, total / np.where(area > 0, area, 1.0), T[:, col])
-        reach, angle = self.rough.zone_sliding(self.tm.spec.motion)
+        reach, angle = self.rough.zone_sliding(self.tm.spec.motion, pressure_area)
         # the speed now; at a standstill the mean of the next step (these fields act on it), else of
         # the last (the zones' heating needs a speed; a restart from rest had no exchange for a step)
         speed, dt = model.speed(model.time), self.settings.dt

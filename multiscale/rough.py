@@ -100,6 +100,19 @@ def track_spread(radius, source_radius, volume, half: float) -> np.ndarray:
     return out
 
 
+def in_plane_motion(motion, points, axes) -> tuple[np.ndarray, np.ndarray]:
+    """Body 1's velocity per unit motion at ``points`` (n, 3) [m] in the planes of ``axes`` (n, 2, 3):
+    its magnitude [m per rad, or per m] and direction [rad from the first axis]."""
+    if isinstance(motion, Rotation):
+        axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
+        w = np.cross(axis, points - np.asarray(motion.centre, float))
+    else:
+        e = np.asarray(motion.direction, float) / np.linalg.norm(motion.direction)
+        w = np.tile(e, (len(points), 1))
+    w = np.einsum("zij,zj->zi", axes, w)
+    return np.hypot(w[:, 0], w[:, 1]), np.arctan2(w[:, 1], w[:, 0])
+
+
 @dataclass
 class RoughInterface:
     """Zones, laws and facet law of the rough interfaces of ``tm`` (see module docstring).
@@ -162,19 +175,23 @@ class RoughInterface:
                 axes.append(plane.frame[:2])
         return np.array(centres), np.array(axes)
 
-    def zone_sliding(self, motion) -> tuple[np.ndarray, np.ndarray]:
+    def zone_sliding(self, motion, weights=None) -> tuple[np.ndarray, np.ndarray]:
         """Per zone, the counter-face's sliding in the zone's plane per unit of body 1's motion
         (``motion``: a Rotation, per rad; else a translation, per m) [m] and its direction [rad
-        from the zone's +u axis]."""
+        from the zone's +u axis], at the zone's centre. With ``weights`` per global facet (the
+        normal force p A [N]), the sliding is their weighted mean over the zone's facets where
+        they sum to > 0, so that a zone's mu F s equals the macro frictional work of its facets
+        (at the centre a one-zone pin wore 2.7 % more than k_w W)."""
         centres, axes = self.zone_frames()
-        if isinstance(motion, Rotation):
-            axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
-            w = np.cross(axis, centres - np.asarray(motion.centre, float))
-        else:
-            e = np.asarray(motion.direction, float) / np.linalg.norm(motion.direction)
-            w = np.tile(e, (len(centres), 1))
-        w = np.einsum("zij,zj->zi", axes, w)             # in each zone's plane coordinates
-        return np.hypot(w[:, 0], w[:, 1]), np.arctan2(w[:, 1], w[:, 0])
+        reach, angle = in_plane_motion(motion, centres, axes)
+        if weights is not None:
+            on = self.zone_of_facet >= 0
+            zone = self.zone_of_facet[on]
+            at_facet, _ = in_plane_motion(motion, self.tm.interface.midpoints[on], axes[zone])
+            total = np.bincount(zone, weights[on], minlength=len(reach))
+            moment = np.bincount(zone, (weights[on] * at_facet), minlength=len(reach))
+            reach = np.where(total > 0, moment / np.where(total > 0, total, 1.0), reach)
+        return reach, angle
 
     def heights(self) -> np.ndarray:
         """Current zone topographies (Z, ny, nx) [m]."""

@@ -256,13 +256,14 @@ def straight(tmp_path_factory):
 
 def test_rough_pin_on_disc_bookkeeping_and_outputs(straight):
     """Worn volume summed over the zones = k_w x (time integral of mu p |v| over the interface)
-    within 1 %; the load is carried; partitions in [0, 1]; every result file written."""
+    within 0.05 % (1.1e-4: the zones slide at their facets' force-weighted speed; at their centres
+    it was 1.6e-3); the load is carried; partitions in [0, 1]; every result file written."""
     scene, result = straight
     h = History.read(result.history_file)
     assert len(h) == 3 and h["time"][-1] == pytest.approx(1.2)
     np.testing.assert_allclose(h["interface_force"], 200.0, rtol=1e-6)
     assert h["frictional_work"][-1] == pytest.approx(0.4 * 200 * 2 * np.pi * 200 / 60 * 0.09 * 1.2, rel=0.03)
-    assert h["wear_volume"][-1] == pytest.approx(1e-14 * h["frictional_work"][-1], rel=0.01)
+    assert h["wear_volume"][-1] == pytest.approx(1e-14 * h["frictional_work"][-1], rel=5e-4)
     assert np.all(np.diff(h["wear_volume"]) > 0) and np.all(np.diff(h["rms_height"]) < 0)
     assert np.all((h["partition_min"] >= 0) & (h["partition_max"] <= 1))
     assert np.all(h["micro_max_pressure"] > h["max_pressure"])
