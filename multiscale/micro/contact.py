@@ -47,6 +47,8 @@ CHUNK_CELLS = {"bccg": 65536, "pk": 32768}   # cells per chunk of a batch (the w
 COARSE_MIN = 32      # smallest side of the grids of the nested start of "bccg"
 COARSE_TOL = 1e-1    # tolerance of the coarse solves of the nested start
 SNAP = 1e-12         # a start within this relative distance below the hardness is at the hardness
+AT_HARDNESS = 10     # a cell within AT_HARDNESS x tol below H is at H (plastic): a cell's error reaches a
+#                      few tol (2.7 tol where a fractal patch is reloaded to its maximum load)
 # The local start of displacement control, max(delta - z, 0) / L_00, ignores the neighbours'
 # displacement and over-estimates the pressure (35x on a 509 x 16 patch). On a periodic grid a
 # uniform excess is invisible to the iteration (a uniform pressure moves nothing, L(q = 0) = 0, and
@@ -114,7 +116,8 @@ class ContactSolver:
         (``approach`` = delta [m]); scalars or arrays of the batch shape. ``hardness`` H [Pa]
         (scalar or per patch, > 0; inf or None: elastic) bounds the pressure (p <= H, load < H):
         the result's ``plastic`` field is then the permanent deformation d - z - u on the cells at
-        H (``plastic_area_fraction``); H = inf computes bit for bit what None computes.
+        H (``plastic_area_fraction``: p >= H (1 - AT_HARDNESS tol)); H = inf computes bit for bit what
+        None computes.
 
         Stopping criterion (both methods): eps = ||s||₂ / ||p||₂ <= ``tol`` per patch, where s is
         the preconditioned residual over the free set (contact cells, and cells with a negative
@@ -256,8 +259,8 @@ class ContactSolver:
             if fields:
                 np.add(u[c], z[c], out=gap[c])
                 gap[c] -= solved["d"][:, None, None]
-                if plastic is not None:                      # the interpenetration at p = H (within tol:
-                    flow = p[c] >= uc[:, None, None] * (1.0 - tol)   # reloaded cells reach H from below)
+                if plastic is not None:                      # the interpenetration at p = H (reloaded
+                    flow = p[c] >= uc[:, None, None] * (1.0 - AT_HARDNESS * tol)    # cells reach it from below)
                     np.copyto(plastic[c], -gap[c], where=flow)
                     np.maximum(plastic[c], 0.0, out=plastic[c])
                     out["plastic_area_fraction"][c] = flow.mean(axis=(1, 2))
