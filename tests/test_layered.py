@@ -9,6 +9,7 @@ from scipy.special import j0
 from multiscale.errors import InputError
 from multiscale.micro.kernels import HalfSpace, InfluenceOperator, ThermalHalfSpace
 from multiscale.micro.layered import LayeredElastic, LayeredThermal, layer_boundaries, layer_means
+from multiscale.micro.surface import fractal_surface
 from multiscale.references.conduction import exponential_graded_compliance, thermal_layer_compliance
 from multiscale.references.layered import layer_on_rigid_base_compliance, oedometric_compliance
 from multiscale.references.love import love_rectangle
@@ -273,3 +274,20 @@ def test_a_layer_too_thin_for_a_non_periodic_grid_is_refused():
     layered = InfluenceOperator(same, (64, 64), dx, periodic=True).multiplier
     np.testing.assert_allclose(layered, InfluenceOperator(HalfSpace.from_materials(2e11, 0.3, np.inf, 0.3), (64, 64),
                                                           dx, periodic=True).multiplier, rtol=1e-9)
+
+
+@pytest.mark.parametrize("method", ["bccg", "pk"])
+def test_displacement_control_of_a_layer_on_a_rigid_base_reaches_full_contact(method):
+    """A layer on a rigid base has a finite static compliance F(0): a periodic patch in full contact
+    carries a finite load, (delta - mean z) / F(0) + the relief's share. Displacement control gives
+    load control's state at partial and full contact (it was refused above max(h) - mean(h), "full
+    contact has no finite load": an adversarial test)."""
+    from multiscale.micro.contact import ContactSolver
+    s = fractal_surface(64, 1e-4, 0.8, 2, 16, 1e-7, seed=3)
+    solver = ContactSolver(LayeredElastic((2e-6,), (2e9,), (0.45,)), s.shape, s.dx, method=method)
+    for load in (1e7, 1e9):
+        by_load = solver.solve(s.heights, load=load, tol=1e-10)
+        by_approach = solver.solve(s.heights, approach=by_load.approach, tol=1e-10)
+        assert by_approach.mean_pressure == pytest.approx(load, rel=1e-8)
+        assert by_approach.area_fraction == by_load.area_fraction
+    assert by_load.area_fraction == 1.0

@@ -169,7 +169,9 @@ class ContactSolver:
             elif target is not None and np.any(target >= upper):
                 raise InputError("load", load, "mean pressure must be below the hardness (a fully plastic "
                                  "patch carries at most H)")
-        if delta is not None and self.periodic:       # elastic patches: full contact has no finite load
+        # an elastic periodic patch in full contact has no finite load, unless its kernel has a finite
+        # static compliance F(0) (a layer on a rigid base: the load is then (delta - mean z) / F(0))
+        if delta is not None and self.periodic and not np.isfinite(getattr(self.kernel, "static_compliance", np.inf)):
             unbounded = np.ones(batch, dtype=bool) if upper is None else np.broadcast_to(upper, batch) == np.inf
             if np.any(unbounded & (delta >= z.mean(axis=(-2, -1)))):
                 raise InputError("approach", approach, "a periodic elastic patch under displacement control "
