@@ -106,7 +106,7 @@ def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
     assert 0.02 < share < 0.04
     # energy: what the fields store equals the frictional heat put in (adiabatic bodies)
     assert h["stored_heat_pin"][-1] == pytest.approx(h["heat_total_pin"][-1], rel=1e-6)
-    assert h["stored_heat_disc"][-1] == pytest.approx(h["heat_total_disc"][-1], rel=1e-2)
+    assert h["stored_heat_disc"][-1] == pytest.approx(h["heat_total_disc"][-1], rel=1e-9)   # was 6e-4 off
     assert np.all(np.diff(h["max_temperature_pin"]) > 0)
     # the pin body's materials: the friction pin itself is the hottest, its steel holder cooler
     np.testing.assert_array_equal(h["max_temperature_pin"], h["max_temperature_pin_in_pin"])
