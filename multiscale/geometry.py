@@ -65,12 +65,22 @@ class Rotation:
     axis: tuple[float, float, float] = (0.0, 0.0, 1.0)
     centre: tuple[float, float, float] = (0.0, 0.0, 0.0)
 
+    def velocity(self, points) -> np.ndarray:
+        """w per unit angular speed at ``points`` (n, 3) [m]: e x (x − c) [m per rad]."""
+        e = np.asarray(self.axis, dtype=float) / np.linalg.norm(self.axis)
+        return np.cross(e, np.asarray(points, dtype=float) - np.asarray(self.centre, dtype=float))
+
 
 @dataclass(frozen=True)
 class Translation:
     """Rigid translation of body 1 along the unit vector ``direction``: w = v e [m/s]."""
 
     direction: tuple[float, float, float] = (1.0, 0.0, 0.0)
+
+    def velocity(self, points) -> np.ndarray:
+        """w per unit speed at ``points`` (n, 3): the unit direction at every point [-]."""
+        e = np.asarray(self.direction, dtype=float) / np.linalg.norm(self.direction)
+        return np.tile(e, (len(points), 1))
 
 
 @dataclass(frozen=True)

@@ -103,13 +103,7 @@ def track_spread(radius, source_radius, volume, half: float) -> np.ndarray:
 def in_plane_motion(motion, points, axes) -> tuple[np.ndarray, np.ndarray]:
     """Body 1's velocity per unit motion at ``points`` (n, 3) [m] in the planes of ``axes`` (n, 2, 3):
     its magnitude [m per rad, or per m] and direction [rad from the first axis]."""
-    if isinstance(motion, Rotation):
-        axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
-        w = np.cross(axis, points - np.asarray(motion.centre, float))
-    else:
-        e = np.asarray(motion.direction, float) / np.linalg.norm(motion.direction)
-        w = np.tile(e, (len(points), 1))
-    w = np.einsum("zij,zj->zi", axes, w)
+    w = np.einsum("zij,zj->zi", axes, motion.velocity(points))
     return np.hypot(w[:, 0], w[:, 1]), np.arctan2(w[:, 1], w[:, 0])
 
 

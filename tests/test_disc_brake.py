@@ -95,12 +95,12 @@ def test_a_ventilated_disc_is_refused_by_the_heat_problem(tmp_path):
     adversarial run: 76 000 K after 2 s, 25 times the heat put in, and only warnings). Such a disc
     is refused, naming where; a solid disc's faceted surface stays far below the threshold."""
     from multiscale.workflows.model import build_mesh, build_model
-    axis, centre = (0.0, 0.0, 1.0), (0.0, 0.0, 0.0)
-    solid = two_body.build(builder("disc_brake"), {"mesh_size": 0.03}).bodies[1].crossing(axis, centre)
+    from multiscale.geometry import Rotation
+    solid = two_body.build(builder("disc_brake"), {"mesh_size": 0.03}).bodies[1].crossing(Rotation())
     assert solid.share == 0.0 and solid.worst < 0.1
     scene = scenes.loads(VENTED, tmp_path)
     tm = build_mesh(scene, MPI.COMM_WORLD)
-    vented = tm.bodies[1].crossing(axis, centre)
+    vented = tm.bodies[1].crossing(Rotation())
     p = disc_brake.parameters({"vanes": 12})
     r = np.hypot(*vented.where[:2])
     assert vented.worst > 0.99 and 0.02 < vented.share < 0.2          # a vane of constant thickness

@@ -495,6 +495,25 @@ def test_the_friction_force_of_several_pads_is_the_sum_of_theirs(tmp_path):
     assert h["friction_force"][-1] == pytest.approx(0.4 * 1000, rel=1e-3)
 
 
+def test_an_axis_that_crosses_the_interfaces_is_refused(tmp_path):
+    """The disc turns about z; geometry.axis = [0, 1, 0] makes it cross the pads' faces instead of
+    sliding along them. The mesh is refused, naming the interface (a squeal run had reported 0
+    unstable modes instead of 1, and check said OK: an adversarial test); the right axis passes
+    (the faceted faces are crossed nowhere)."""
+    from multiscale.errors import InputError
+    from multiscale.geometry import Rotation
+    from multiscale.workflows.model import build_mesh
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO)
+    text = TWO_PADS.replace("{folder}", str(tmp_path / "out"))
+    assert 'rotating = "disc"\n' in text
+    with pytest.raises(InputError, match=r"geometry.axis = \[0.0, 1.0, 0.0\]: the rotation through \[0.0, 0.0, 0.0\] "
+                                         r"m crosses interface 'pad_(a|b)' instead of sliding along it \(\d+ % of its "
+                                         r"area, e.g. at .* mm\): check the rotating body's axis and centre"):
+        build_mesh(loads(text.replace('rotating = "disc"\n', 'rotating = "disc"\naxis = [0, 1, 0]\n'), tmp_path))
+    tm = build_mesh(loads(text, tmp_path))
+    assert all(tm.interface.crossing(name, Rotation()).worst < 1e-9 for name in ("pad_a", "pad_b"))
+
+
 def test_a_solid_free_to_move_is_named_as_the_likely_cause_of_a_failed_solve(tmp_path):
     """Without the pads' side supports nothing holds them sideways: the first linear solve fails,
     and the error says what usually causes that (before: only "SNES reason -3")."""

@@ -35,11 +35,28 @@ CROSSES = 0.5     # |w.n|/|w| above which the rotation crosses a boundary facet 
 
 @dataclass
 class Crossing:
-    """Where a rotation crosses a body's surface (``Body.crossing``)."""
+    """Where a rigid motion w crosses a surface of triangles (``crossing``)."""
 
     share: float          # share of the surface, weighted by the speed |w|, with |w.n| > CROSSES |w| [-]
-    worst: float          # largest |w.n|/|w| of a boundary facet [-]
-    where: np.ndarray     # centroid of that facet [m]
+    worst: float          # largest |w.n|/|w| of a triangle [-]
+    where: np.ndarray     # centroid of that triangle [m]
+
+
+def crossing(triangles: np.ndarray, motion, comm) -> Crossing:
+    """How much of a surface, the (owned) ``triangles`` (n, 3, 3) [m] of every rank, the rigid
+    ``motion`` crosses: |w.n| > ``CROSSES`` |w| at a triangle's centroid (collective)."""
+    x = np.asarray(triangles, dtype=float).reshape(-1, 3, 3)
+    n = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+    area = 0.5 * np.linalg.norm(n, axis=1)
+    mid = x.mean(axis=1)
+    w = motion.velocity(mid)
+    speed = np.linalg.norm(w, axis=1)
+    cos = np.abs((w * n).sum(axis=1)) / np.maximum(speed * 2 * area, np.finfo(float).tiny)
+    crossed = cos > CROSSES
+    sums = comm.allreduce(np.array([(area * speed)[crossed].sum(), (area * speed).sum()]), op=MPI.SUM)
+    k = int(np.argmax(cos)) if len(cos) else -1
+    worst, where = max(comm.allgather((cos[k], tuple(mid[k])) if k >= 0 else (-1.0, (np.nan,) * 3)))
+    return Crossing(float(sums[0] / sums[1]) if sums[1] > 0 else 0.0, float(worst), np.array(where))
 
 
 @dataclass
@@ -73,28 +90,15 @@ class Body:
         f.x.array[self.region_space.dofmap.list[:, 0]] = values
         return f
 
-    def crossing(self, axis, centre) -> Crossing:
-        """How far the body's surface departs from one of revolution about ``axis`` through ``centre``:
-        where the rotation velocity w = e x (x - c) crosses it, |w.n| > ``CROSSES`` |w| at a
-        boundary facet's centroid (vanes, holes, slots; a faceted circle stays below 0.08 at the
-        demos' meshes), as a share of the surface weighted by |w| (collective)."""
+    def crossing(self, motion) -> Crossing:
+        """Where the rigid ``motion`` (a ``Rotation`` or ``Translation``) crosses the body's
+        surface: for a rotation, how far it departs from a surface of revolution (vanes, holes,
+        slots; a faceted circle stays below 0.08 at the demos' meshes). Collective."""
         m, tdim = self.mesh, self.mesh.topology.dim
         m.topology.create_connectivity(tdim - 1, tdim)
         facets = dmesh.exterior_facet_indices(m.topology)
         facets = facets[facets < m.topology.index_map(tdim - 1).size_local]       # owned: each once
-        x = m.geometry.x[dmesh.entities_to_geometry(m, tdim - 1, facets)]       # (facets, 3, 3)
-        n = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
-        area = 0.5 * np.linalg.norm(n, axis=1)
-        e = np.asarray(axis, dtype=float) / np.linalg.norm(axis)
-        mid = x.mean(axis=1)
-        w = np.cross(e, mid - np.asarray(centre, dtype=float))
-        speed = np.linalg.norm(w, axis=1)
-        cos = np.abs((w * n).sum(axis=1)) / np.maximum(speed * 2 * area, np.finfo(float).tiny)
-        crossed = cos > CROSSES
-        sums = self.mesh.comm.allreduce(np.array([(area * speed)[crossed].sum(), (area * speed).sum()]), op=MPI.SUM)
-        k = int(np.argmax(cos)) if len(cos) else -1
-        worst, where = max(self.mesh.comm.allgather((cos[k], tuple(mid[k])) if k >= 0 else (-1.0, (np.nan,) * 3)))
-        return Crossing(float(sums[0] / sums[1]) if sums[1] > 0 else 0.0, float(worst), np.array(where))
+        return crossing(m.geometry.x[dmesh.entities_to_geometry(m, tdim - 1, facets)], motion, m.comm)
 
     def has_face(self, tag: int) -> bool:
         """True if the face ``tag`` belongs to this body (on any rank)."""
@@ -164,6 +168,13 @@ class Interface:
         track pi (r_hi^2 - r_lo^2), a drum's band 2 pi r (a_hi - a_lo)."""
         lo, hi = self.box(name, axis, centre)
         return float(np.pi * (lo[0] + hi[0]) * np.hypot(hi[0] - lo[0], hi[1] - lo[1]))
+
+    def crossing(self, name: str, motion) -> Crossing:
+        """Where body 1's rigid ``motion`` crosses interface ``name`` instead of sliding along it
+        (``crossing``; collective)."""
+        owned = self.tag_index[self.owned_index] == list(self.tags).index(name)
+        dofs = self.mesh.geometry.dofmaps[0][:len(self.owned_index)][owned]
+        return crossing(self.mesh.geometry.x[dofs], motion, self.comm)
 
     def box(self, name: str, axis=None, centre=None) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper corners (3-vectors) [m] of the vertices of interface ``name`` (collective);

@@ -313,7 +313,7 @@ class Thermal:
         diverged (a ventilated disc: 76 000 K after 2 s, 25 times the heat put in)."""
         if self.transport:
             motion, body = self.tm.spec.motion, self.tm.bodies[1]
-            c = body.crossing(motion.axis, motion.centre)
+            c = body.crossing(motion)
             if c.share > 0:
                 r = np.linalg.norm(np.cross(np.asarray(motion.axis, float) / np.linalg.norm(motion.axis),
                                             c.where - np.asarray(motion.centre, float)))

@@ -30,7 +30,7 @@ import numpy as np
 from mpi4py import MPI
 
 from multiscale.errors import InputError
-from multiscale.geometry import GeometrySpec, Support
+from multiscale.geometry import GeometrySpec, Rotation, Support
 from multiscale.macro import mesh as two_body
 from multiscale.macro.interface import PenaltyLaw, SumLaw
 from multiscale.macro.mechanics import Mechanics, load_face_forces
@@ -127,10 +127,25 @@ def interface_materials(scene, interface: str | None = None) -> tuple:
 
 
 def build_mesh(scene, comm=MPI.COMM_WORLD) -> two_body.TwoBodyMesh:
-    """The scene's mesh (gmsh on rank 0, distributed), with the scene's supports and loads."""
+    """The scene's mesh (gmsh on rank 0, distributed), with the scene's supports and loads. With
+    friction, body 1 must slide along every interface: one its motion crosses (a wrong
+    ``geometry.axis`` or ``centre``) is refused (collective; a squeal run with a wrong axis had
+    reported 0 unstable modes instead of 1: an adversarial test)."""
     g = scene.geometry
     params = g.params if g.builder == "file" else dict(g.params)
-    return two_body.build(g.module(), params, comm, spec=scene_spec(scene), max_cells=g.max_cells)
+    tm = two_body.build(g.module(), params, comm, spec=scene_spec(scene), max_cells=g.max_cells)
+    motion = tm.spec.motion
+    for name in tm.interface.tags if scene.has("friction") else ():
+        c = tm.interface.crossing(name, motion)
+        if c.share > 0:
+            turns = isinstance(motion, Rotation)
+            what = (f"the rotation through {list(motion.centre)} m" if turns else "the translation of body 1")
+            raise InputError("geometry.axis" if turns else "geometry.direction",
+                             list(motion.axis if turns else motion.direction),
+                             f"{what} crosses interface {name!r} instead of sliding along it ({100 * c.share:.2g} "
+                             f"% of its area, e.g. at {np.round(c.where * 1e3, 1).tolist()} mm): check the "
+                             "rotating body's axis and centre" if turns else f"{what} crosses interface {name!r}")
+    return tm
 
 
 def build_mechanics(scene, tm, *, law=None, temperatures=None, degree: int = 1,
