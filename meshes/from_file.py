@@ -421,6 +421,14 @@ def _surfaces(model, g, found: Found) -> None:
                 faces += [f for f in near if f not in faces]
         if not faces:
             raise InputError(where, name, f"selects no face of {g.file.name}")
+        inner = sorted({n for n, fs in found.interfaces.items() if set(fs) & set(faces)})
+        if inner:                    # e.g. a pad's face by its normal towards the disc
+            raise InputError(where, name, f"selects the face of interface {', '.join(inner)}: an interface "
+                             "carries no load or boundary condition; select a free face")
+        taken = sorted(n for n in g.surfaces if n in found.surfaces and set(found.surfaces[n]) & set(faces))
+        if taken:                    # a face carries one name (the mesh tags it once)
+            raise InputError(where, name, f"selects a face that geometry.surfaces.{taken[0]} already selects; "
+                             "a face can carry one surface name")
         found.surfaces[name] = faces
 
 

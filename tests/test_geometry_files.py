@@ -495,6 +495,23 @@ def test_the_friction_force_of_several_pads_is_the_sum_of_theirs(tmp_path):
     assert h["friction_force"][-1] == pytest.approx(0.4 * 1000, rel=1e-3)
 
 
+def test_a_surface_on_an_interface_or_on_anothers_face_is_refused_by_check(tmp_path, capsys):
+    """A surface selected by a pad's normal towards the disc is the interface; two surfaces naming
+    one face leave the second without facets. Both went through check and failed after meshing
+    with a traceback ("face 'backB' belongs to bodies [], expected one"; an adversarial test)."""
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO)
+    text = TWO_PADS.replace("{folder}", str(tmp_path / "out"))
+    inner = text.replace('[geometry.surfaces.bore]', '[geometry.surfaces.front]\nbody = "pad_a"\nnormal = [0, 0, -1]\n'
+                         '[geometry.surfaces.bore]')
+    err = check(tmp_path, capsys, inner)
+    assert "geometry.surfaces.front = 'front': selects the face of interface pad_a: an interface carries no load " \
+           "or boundary condition; select a free face" in err
+    twice = text.replace('[geometry.surfaces.bore]', '[geometry.surfaces.back_a]\ncontains = ["0 mm", "80 mm", '
+                         '"18 mm"]\n[geometry.surfaces.bore]')
+    err = check(tmp_path, capsys, twice)
+    assert "geometry.surfaces.back_a = 'back_a': selects a face that geometry.surfaces.backs already selects" in err
+
+
 def test_an_axis_that_crosses_the_interfaces_is_refused(tmp_path):
     """The disc turns about z; geometry.axis = [0, 1, 0] makes it cross the pads' faces instead of
     sliding along them. The mesh is refused, naming the interface (a squeal run had reported 0

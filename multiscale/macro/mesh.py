@@ -289,11 +289,15 @@ class TwoBodyMesh:
         return ufl.Measure("ds", domain=self.parent, subdomain_data=[(1, np.asarray(rows, dtype=np.int32))])(1)
 
     def body_of_face(self, name: str) -> int:
-        """Index of the body that holds the named boundary face."""
+        """Index of the body that holds the named (load) face; a face on no body's surface (an
+        interface, a face between two parts, or one another surface of the scene already names)
+        or on both is an InputError (collective)."""
         tag = self.face(name)
         owners = [i for i, b in enumerate(self.bodies) if b.has_face(tag)]
         if len(owners) != 1:
-            raise RuntimeError(f"face {name!r} (tag {tag}) belongs to bodies {owners}, expected one")
+            where = ("is on no body's free surface: an interface, a face between two parts, or a face "
+                     "another surface already names" if not owners else "lies on both bodies")
+            raise InputError("loading.faces", name, f"the load face {where}; name a free face of one body")
         return owners[0]
 
     def assemble_scalar(self, expr) -> float:
