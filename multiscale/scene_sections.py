@@ -104,11 +104,17 @@ class Material:
     rules = (OneOf(("c", "chi"), needed_by=("thermal",)), Requires("c", ("rho",), needed_by=("thermal",)))
 
     PROPERTIES = ("E", "nu", "rho", "kappa", "c", "chi", "alpha", "hardness")
+    STRAIN = ("E", "nu", "alpha")       # read at the temperatures only with effect "expansion"
     DAMPING = ("loss_factor", "damping_alpha", "damping_beta")
 
     def problems(self, path, ctx):
         if self.k_w is not None and "wear" not in ctx.effects:
             ctx.warnings.append(f'{path}.k_w is ignored: effect "wear" is not in effects')
+        tables = [k for k in self.STRAIN if self.tabulated(k)]
+        if tables and "thermal" in ctx.effects and "expansion" not in ctx.effects:
+            ctx.warnings.append(f'{path}.{tables[0]} depends on the temperature, but without effect "expansion" the '
+                                "mechanics takes it at the initial temperature (add \"expansion\" to follow the "
+                                "temperatures)")
         given = [k for k in self.DAMPING if getattr(self, k) is not None]
         if given and "stability" not in ctx.effects:
             ctx.warnings.append(f'{path}.{given[0]} is ignored: effect "stability" is not in effects')

@@ -508,3 +508,26 @@ def test_the_summary_gives_each_interfaces_effusivity_partition():
     assert ", ".join(f"{v:.3g} at {n}" for n, v in shares.items()) + " at equal areas" in line
     plain = next(x for x in summary(load(DEMOS / "car_brake_stop.toml")) if "heat_partition effusivity" in x)
     assert "into the fixed: 0.126 at equal areas, weighted at meshing by the fixed's face against the track" in plain
+
+
+def test_a_strain_table_without_expansion_is_said_to_be_read_at_the_start(tmp_path):
+    """E(T) with "thermal" but without "expansion": the mechanics takes E at the initial temperature
+    (it is not solved again as the bodies heat), which the scene says; the run's warning about
+    temperatures beyond such a table is not given (it implied the table was followed: an
+    adversarial test)."""
+    from multiscale.io import History
+    from multiscale.workflows import run_warnings
+    text = GOOD.replace('effects = ["contact", "friction", "thermal", "heat_partition", "conductance", "expansion"]',
+                        'effects = ["contact", "friction", "thermal", "heat_partition", "conductance"]').replace(
+        'E = "4 GPa"', 'E = [["20 degC", "4 GPa"], ["60 degC", "0.4 GPa"]]')
+    scene = loads(text, tmp_path)
+    assert ('materials.block.E depends on the temperature, but without effect "expansion" the mechanics takes it '
+            'at the initial temperature (add "expansion" to follow the temperatures)') in scene.warnings
+    hot = History()
+    hot.append(time=0.0, max_temperature_block=293.15, max_temperature_flat=293.15)
+    hot.append(time=1.0, max_temperature_block=400.0, max_temperature_flat=300.0)
+    assert run_warnings(scene, hot) == []
+    coupled = loads(text.replace('"conductance"]', '"conductance", "expansion"]'), tmp_path)
+    assert not any("depends on the temperature" in w for w in coupled.warnings)
+    assert run_warnings(coupled, hot) == ["materials.block.E: 126.9 degC above its last point 60 degC, held at "
+                                          "4e+08 there (in the block)"]

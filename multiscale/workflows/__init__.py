@@ -18,7 +18,7 @@ from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError, Interrupted, interrupted
-from multiscale.scene_sections import HOTTEST
+from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.output import RunResult
 
@@ -111,8 +111,9 @@ def run_warnings(scene, history) -> list[str]:
     out = []
     for name, (T, body) in hottest.items():
         known = scene.materials[name].beyond(T0)
+        unread = () if scene.has("expansion") else Material.STRAIN      # read at the initial temperature only
         out += [f"materials.{name}.{phrase} (in the {body})"
-                for key, phrase in scene.materials[name].beyond(T).items() if key not in known]
+                for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
     return out + laws + _undershoots(scene, history) + _coarse_wear(scene, history) + _too_hot(scene, history)
 
 
