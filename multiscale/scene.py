@@ -299,6 +299,11 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                             "sliding_speed = 0)")
         problems += _surface_checks(scene, g, where, effects)
         problems += _symmetry_checks(scene, g, where, effects)
+        given = raw.get("geometry") if isinstance(raw.get("geometry"), dict) else {}
+        warnings += [f'geometry.{key} = {size:g} m is larger than the geometry ({g.spec.length_scale:g} m across): '
+                     'a bare number is in metres; give a unit ("12 mm")' for key, size in g.resolved().items()
+                     if key.endswith("mesh_size") and isinstance(given.get(key), (int, float))
+                     and size > g.spec.length_scale]
         problems += _hardness_checks(scene, g, raw, effects)
         if "wear" in effects and scene.wear is not None and scene.materials is not None and not problems:
             rough = {scene.geometry.spec.interface_materials(n)[0] for n in scene.geometry.spec.interfaces}

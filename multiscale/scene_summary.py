@@ -136,7 +136,8 @@ def cells_line(scene: Scene) -> tuple[str, CellEstimate]:
     """The mesh's estimated cell count against its limit (``check --cells``; runs gmsh trials),
     and the estimate."""
     g = scene.geometry
-    e = estimate_cells(g.module(), g.params if g.builder == "file" else dict(g.params))
+    e = estimate_cells(g.module(), g.params if g.builder == "file" else dict(g.params),
+                       length_scale=g.spec.length_scale)
     how = "exact" if e.exact else f"from a trial mesh {e.factor:.3g}x coarser with {e.trial} cells"
     verdict = "refused by run" if e.cells > g.max_cells else "within"
     return (f"  mesh      {'' if e.exact else 'about '}{e.cells:,} cells ({how}); {verdict} geometry.max_cells = "

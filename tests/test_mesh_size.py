@@ -72,6 +72,22 @@ def test_an_absurd_mesh_size_is_refused_before_meshing():
     assert "64x coarser" in str(info.value)
 
 
+def test_a_mesh_size_far_below_the_geometry_starts_from_coarse_enough_trials():
+    """1 um on the 10 mm block: a first trial 64x coarser has elements of 64 um, millions of cells
+    (a 12 um size on a CAD brake meshed for minutes, "check --cells" and "run" alike: an adversarial
+    test). With the geometry's size the first trial's elements are at least 1/16 of it; the
+    estimate still refuses the mesh, from a trial of at most a few times the target."""
+    spec = builder("block_on_flat").describe({"mesh_size": 1e-6})
+    estimate = estimate_cells(builder("block_on_flat"), {"mesh_size": 1e-6}, enough=MAX_CELLS,
+                              length_scale=spec.length_scale)
+    assert estimate.cells > 1e9 and estimate.trial < 200_000 and estimate.factor > 64
+    from multiscale.scene import loads
+    from test_faults import SCENE
+    bare = loads(SCENE.format(folder="out").replace('mesh_size = "5 mm"', "mesh_size = 5"))
+    assert "geometry.mesh_size = 5 m is larger than the geometry (0.01 m across): a bare number is in metres; " \
+           'give a unit ("12 mm")' in bare.warnings
+
+
 def test_a_mesh_below_the_limit_is_settled_by_a_coarse_trial():
     """The estimate over-estimates, so a coarse trial below the limit settles it: the mesh itself
     is not built twice."""

@@ -354,7 +354,8 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
         import gmsh   # rank 0 alone builds the geometry
         try:
             if max_cells is not None:
-                check_cells(builder, params, max_cells, keep=True)   # its trials' session holds the mesh
+                check_cells(builder, params, max_cells, keep=True,    # its trials' session holds the mesh
+                            length_scale=spec.length_scale)
             else:
                 gmsh_session(builder)
                 builder.generate(gmsh.model, params)
