@@ -512,6 +512,22 @@ def test_a_surface_on_an_interface_or_on_anothers_face_is_refused_by_check(tmp_p
     assert "geometry.surfaces.back_a = 'back_a': selects a face that geometry.surfaces.backs already selects" in err
 
 
+def test_a_part_that_touches_nothing_is_refused_after_meshing(tmp_path):
+    """A steel box beside the pads, in pad_b's body, touching nothing and held by no support: it
+    could move freely (a squeal run reported its rigid motions as three unstable 0 Hz modes, and
+    every other mode's residual rose to 1e-2: an adversarial test). Meshing refuses it, naming the
+    region and a point."""
+    from multiscale.errors import InputError
+    from multiscale.workflows.model import build_mesh
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO + "\nBox(6) = {150, -10, 0, 20, 20, 10};")
+    text = TWO_PADS.replace("{folder}", str(tmp_path / "out")).replace(
+        '[geometry.bodies.pad_b]\ncontains = ["0 mm", "-80 mm", "14 mm"]',
+        '[geometry.bodies.pad_b]\ncontains = [["0 mm", "-80 mm", "14 mm"], ["160 mm", "0 mm", "5 mm"]]')
+    with pytest.raises(InputError, match=r"1 part\(s\) touch no interface and no support \(one of region 'pad_b' "
+                                         r"around \[160\.0, 0\.0, 5\.0\] mm\): they could move freely"):
+        build_mesh(loads(text, tmp_path))
+
+
 def test_an_axis_that_crosses_the_interfaces_is_refused(tmp_path):
     """The disc turns about z; geometry.axis = [0, 1, 0] makes it cross the pads' faces instead of
     sliding along them. The mesh is refused, naming the interface (a squeal run had reported 0

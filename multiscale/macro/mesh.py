@@ -25,7 +25,7 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from multiscale.errors import InputError, MultiscaleError
-from multiscale.geometry import BodySpec, GeometrySpec, check_cells, gmsh_session
+from multiscale.geometry import BodySpec, GeometrySpec, check_cells, check_held, gmsh_session
 
 INTERFACE_QUADRATURE = 2      # exact for P1 displacements times P1 tests on a facet
 
@@ -359,6 +359,7 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
             else:
                 gmsh_session(builder)
                 builder.generate(gmsh.model, params)
+            check_held(gmsh.model, spec)
         except Exception as exc:  # re-raised on every rank below
             error = exc
     failed = comm.bcast(error if isinstance(error, MultiscaleError) else repr(error) if error is not None else None,
