@@ -531,3 +531,19 @@ def test_a_strain_table_without_expansion_is_said_to_be_read_at_the_start(tmp_pa
     assert not any("depends on the temperature" in w for w in coupled.warnings)
     assert run_warnings(coupled, hot) == ["materials.block.E: 126.9 degC above its last point 60 degC, held at "
                                           "4e+08 there (in the block)"]
+
+
+def test_an_interface_that_carries_no_force_is_warned_about(tmp_path):
+    """A pad whose load face was put on the disc carried 7e-12 N beside two loaded pads, and the run
+    said nothing (an adversarial test): an interface below UNLOADED of the largest force is named."""
+    from multiscale.io import History
+    from multiscale.workflows import run_warnings
+    scene = load(DEMOS / "car_brake_stop.toml")
+    h = History()
+    for t, inner in ((0.0, 0.0), (1.0, 7e-12)):
+        h.append(time=t, interface_force_inner_pad=inner, interface_force_outer_pad=3000.0 * t)
+    assert run_warnings(scene, h) == ["interface inner_pad carried no force (7e-12 N at most, against 3e+03 N): "
+                                      "nothing presses it; check loading.faces and the supports"]
+    h = History()
+    h.append(time=0.0, interface_force_inner_pad=2990.0, interface_force_outer_pad=3000.0)
+    assert run_warnings(scene, h) == []

@@ -114,7 +114,8 @@ def run_warnings(scene, history) -> list[str]:
         unread = () if scene.has("expansion") else Material.STRAIN      # read at the initial temperature only
         out += [f"materials.{name}.{phrase} (in the {body})"
                 for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
-    return out + laws + _undershoots(scene, history) + _coarse_wear(scene, history) + _too_hot(scene, history)
+    return (out + laws + _undershoots(scene, history) + _coarse_wear(scene, history) + _too_hot(scene, history)
+            + _unloaded(scene, history))
 
 
 UNDERSHOOT = 0.05     # a body's undershoot warned about: this share of its temperature rise [-]
@@ -137,6 +138,19 @@ def _coarse_wear(scene, history) -> list[str]:
     return [f"a wear increment deepened the wear by {deeper.max():.3g} times the RMS height (at t = "
             f"{history['time'][row]:g} s): the explicit wear step is coarse for this wear rate and the results depend "
             "on it; use more wear.substeps or time.steps"]
+
+
+UNLOADED = 1e-6   # an interface carrying less than this share of the largest one's force is warned about
+
+
+def _unloaded(scene, history) -> list[str]:
+    """Interfaces that carried no force while others did (a pad whose load face was put on the
+    disc ran at 7e-12 N beside two loaded pads, silently: an adversarial test)."""
+    forces = {n: float(np.max(np.abs(history[f"interface_force_{n}"]))) for n in scene.geometry.spec.interfaces
+              if f"interface_force_{n}" in history.columns}
+    top = max(forces.values(), default=0.0)
+    return [f"interface {n} carried no force ({f:.3g} N at most, against {top:.3g} N): nothing presses it; check "
+            "loading.faces and the supports" for n, f in forces.items() if top > 0 and f < UNLOADED * top]
 
 
 def _too_hot(scene, history) -> list[str]:
