@@ -541,3 +541,19 @@ def test_a_rotating_disc_heated_by_two_pads_against_the_semi_infinite_solid(tmp_
     assert low < 293.15 - 0.1 * surface
     assert f"the disc's temperature fell to {low:.2f} K" in \
         json.loads((tmp_path / "p1" / "provenance.json").read_text())["warnings"][-1]
+
+
+def test_a_failed_heat_step_names_the_temperature_tables(tmp_path, monkeypatch):
+    """A heat solve that does not converge with tabulated materials says which bodies' tables may be
+    the cause and what to change (before: only "SNES reason -5, 30 iterations"; a steep kappa(T) of
+    a CAD disc failed that way at any time step: an adversarial test)."""
+    from multiscale.errors import ConvergenceError
+    from multiscale.macro.thermal import Thermal
+    model = build_model(loads(STOP.replace("{folder}", str(tmp_path / "stop"))))
+    model.start()
+    solve = Thermal._solve
+    monkeypatch.setattr(Thermal, "_solve", lambda self: solve(self) and False)     # solved, said to fail
+    with pytest.raises(ConvergenceError, match=r"heat step at t = 1 s failed \(SNES reason .*\); Newton may cycle on "
+                                               r"the kinks of the temperature tables of pin \(kappa, c\): a steep "
+                                               r"change between two points of a table is one"):
+        model.thermal.step(1.0)

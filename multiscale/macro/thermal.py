@@ -240,6 +240,8 @@ class Thermal:
         self.lost_total = np.zeros((len(self.boundaries), 2))     # J, since the start
         self.nonlinear = (any(b.emissivity is not None for b in self.boundaries)
                           or not all(p.constant for p in conductivity + self.capacity))
+        self.tables = [f"{b.name} ({', '.join(n for n, p in (('kappa', k), ('c', c)) if not p.constant)})"
+                       for b, k, c in zip(tm.bodies, conductivity, self.capacity) if not (k.constant and c.constant)]
         self.problem = fpetsc.NonlinearProblem(self.residuals, self.T, bcs=self.bcs, petsc_options_prefix=prefix,
                                                petsc_options=NEWTON_OPTIONS if self.nonlinear else KEPT_OPTIONS,
                                                entity_maps=tm.entity_maps)
@@ -481,9 +483,12 @@ class Thermal:
         snes = self.problem.solver
         if not ok:
             failed = mumps.describe(snes.getKSP().getPC())        # the factorisation's failure, if any
+            why = (f"; Newton may cycle on the kinks of the temperature tables of {', '.join(self.tables)}: a "
+                   "steep change between two points of a table is one, spread it over a wider range or more "
+                   "points" if self.tables and not failed else "")
             raise ConvergenceError(f"heat step at t = {self.time + dt:.6g} s failed "
                                    f"(SNES reason {snes.getConvergedReason()}, "
-                                   f"{snes.getIterationNumber()} iterations{'; ' + failed if failed else ''})")
+                                   f"{snes.getIterationNumber()} iterations{'; ' + failed if failed else ''}){why}")
         self.time += dt
         self.lost_step = self._losses(dt)
         self.lost_total += self.lost_step
