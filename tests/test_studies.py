@@ -393,3 +393,21 @@ def test_metric_units_of_every_problem():
     assert all(scene.metric_unit(m) for m in SQUEAL_METRICS)
     assert [scene.metric_unit(m) for m in ("max_temperature_pin:rise", "wear_volume", "max_growth",
                                            "partition_mean:max")] == ["K", "m^3", "1/s", "-"]
+
+
+def test_a_scene_study_report_labels_its_metrics_with_units(tmp_path):
+    """The plots and tables of a scene study (no reference: value panels and the wall-time panel)
+    carry each history column's unit; the wall-time panel has no metric (it crashed on it, the
+    units' first version: found by `make report`)."""
+    from multiscale.studies.reporting import report
+    from multiscale.studies.results import Row
+    study = load_study(scene_study(tmp_path, "block_on_flat.toml", """
+metrics = ["max_pressure:max", "interface_force"]
+[sweep]
+loading.pressure = ["1 MPa", "2 MPa"]
+"""))
+    rows = [Row(r, {"status": "ok", "metrics": {"max_pressure:max": 1e6 * (k + 1), "interface_force": 100.0 * (k + 1)},
+                    "wall_time": 1.0 + k, "iterations": 3}) for k, r in enumerate(study.runs)]
+    text = report(study, rows).read_text()
+    assert "| max_pressure:max [Pa] | interface_force [N] |" in text
+    assert any(p.suffix == ".png" for p in study.report_folder.iterdir())

@@ -131,7 +131,7 @@ def _plot_axis(study, ok, axis, folder):
             ax.set_yscale("log")
         if kind == "time":
             ax.set_yscale("log")
-        value = metric_heading(m, PROBLEMS[study.problem].metric_unit(m))
+        value = metric_heading(m, PROBLEMS[study.problem].metric_unit(m)) if kind == "value" else ""
         ax.set(xlabel=" / ".join(axis), ylabel={"error": f"relative error of {m}", "value": value, "time": "wall time [s]"}[kind],
                title={"error": f"error of {m}", "value": m, "time": "wall time of a run"}[kind])
         if log_x:             # ticks at the swept values, no minor labels (they overlap on short decades)
