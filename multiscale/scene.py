@@ -26,7 +26,7 @@ import numpy as np
 
 from multiscale.errors import InputError, SceneError
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
-                               read, reference, show, unknown_keys)
+                               read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
 from multiscale.scene_sections import (COUPLING_DEFAULT, DEFAULT_GRID, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
@@ -267,7 +267,12 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
     g = scene.geometry
     where = f'builder "{g.builder}"' if g is not None and g.builder != "file" else "the geometry"
     if g is not None and scene.materials is not None:
-        typos = unknown_keys(scene.materials, g.materials, "materials", ctx, f"material of {where}")
+        missing = [m for m in g.materials if m not in scene.materials]
+        near = {name: suggest(name, missing) for name in scene.materials if name not in g.materials}
+        typos = unknown_keys({n: 0 for n, hint in near.items() if hint}, g.materials, "materials", ctx,
+                             f"material of {where}")
+        warnings += [f"materials.{name} is not used: {where} has the materials {', '.join(g.materials)}"
+                     for name, hint in near.items() if not hint]
         for name in g.materials:
             if name not in scene.materials and name not in typos:
                 problems.append(f'materials.{name}: missing; {where} needs the materials {", ".join(g.materials)}')

@@ -547,3 +547,17 @@ def test_an_interface_that_carries_no_force_is_warned_about(tmp_path):
     h = History()
     h.append(time=0.0, interface_force_inner_pad=2990.0, interface_force_outer_pad=3000.0)
     assert run_warnings(scene, h) == []
+
+
+def test_a_material_the_geometry_does_not_use_is_a_warning_a_misspelt_one_a_problem(tmp_path):
+    """A material table no region uses (e.g. left from a removed caliper) is said to be unused, as a
+    warning (it was an error calling it "unknown"; an adversarial test); one close to a missing
+    name is a misspelling, refused with a "did you mean"."""
+    extra = GOOD.replace("[interface]", '[materials.steel]\nE = "210 GPa"\nnu = 0.3\nrho = 7850\nkappa = 45\nc = 480\n'
+                                        'alpha = 1.2e-5\n\n[interface]')
+    scene = loads(extra, tmp_path)
+    assert 'materials.steel is not used: builder "block_on_flat" has the materials block, flat' in scene.warnings
+    with pytest.raises(SceneError) as info:
+        loads(GOOD.replace("[materials.flat]", "[materials.flta]"), tmp_path)
+    assert any(p.startswith('materials.flta: unknown material of builder "block_on_flat" (did you mean "flat"?)')
+               for p in info.value.problems)
