@@ -138,13 +138,13 @@ def build_mesh(scene, comm=MPI.COMM_WORLD) -> two_body.TwoBodyMesh:
     for name in tm.interface.tags if scene.has("friction") else ():
         c = tm.interface.crossing(name, motion)
         if c.share > 0:
-            turns = isinstance(motion, Rotation)
-            what = (f"the rotation through {list(motion.centre)} m" if turns else "the translation of body 1")
-            raise InputError("geometry.axis" if turns else "geometry.direction",
-                             list(motion.axis if turns else motion.direction),
-                             f"{what} crosses interface {name!r} instead of sliding along it ({100 * c.share:.2g} "
-                             f"% of its area, e.g. at {np.round(c.where * 1e3, 1).tolist()} mm): check the "
-                             "rotating body's axis and centre" if turns else f"{what} crosses interface {name!r}")
+            where = f"({100 * c.share:.2g} % of its area, e.g. at {np.round(c.where * 1e3, 1).tolist()} mm)"
+            if isinstance(motion, Rotation):
+                raise InputError("geometry.axis", list(motion.axis), f"the rotation through {list(motion.centre)} m "
+                                 f"crosses interface {name!r} instead of sliding along it {where}: check the "
+                                 "rotating body's axis and centre")
+            raise InputError("geometry", g.builder, f"the translation along {list(motion.direction)} crosses "
+                             f"interface {name!r} instead of sliding along it {where}")
     return tm
 
 
