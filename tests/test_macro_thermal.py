@@ -557,3 +557,20 @@ def test_a_failed_heat_step_names_the_temperature_tables(tmp_path, monkeypatch):
                                                r"the kinks of the temperature tables of pin \(kappa, c\): a steep "
                                                r"change between two points of a table is one"):
         model.thermal.step(1.0)
+
+
+def test_a_run_that_fails_in_its_first_heat_step_keeps_its_start(tmp_path, monkeypatch):
+    """The history of t = 0 (the first contact solve's record) is on disk before the first step: a
+    run failing there leaves it, with its provenance saying why (before: no history.h5 at all)."""
+    import json
+
+    from multiscale.errors import ConvergenceError
+    from multiscale.macro.thermal import Thermal
+    solve = Thermal._solve
+    monkeypatch.setattr(Thermal, "_solve", lambda self: solve(self) and False)
+    with pytest.raises(ConvergenceError):
+        run(loads(STOP.replace("{folder}", str(tmp_path / "stop"))), verbose=False)
+    h = History.read(tmp_path / "stop" / "history.h5")
+    assert len(h) == 1 and h["time"][0] == 0.0 and h["interface_force"][0] > 0
+    assert json.loads((tmp_path / "stop" / "provenance.json").read_text())["status"].startswith(
+        "failed: ConvergenceError: heat step at t = ")

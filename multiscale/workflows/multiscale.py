@@ -151,6 +151,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         history.append(**ms.record(first))
         out.claim()                      # --overwrite: the earlier results go now, not before a failed start
         ms.save(ckpt, 0, history)
+        write_history(history, folder, scene.name, comm, plot=False)   # a run failing in step 1 keeps t = 0
     ms.rough.pool.progress = False
     plan = outputs.plan(scene)
     writer = FieldOutput(ms.model, folder, plan.body_fields + plan.interface_fields, extra=ms.facet_fields(),

@@ -62,6 +62,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     history = io.History()
     history.append(**model.record())
     writer.write()
+    write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
     steps = scene.time.steps if model.thermal is not None else 0
     done, stopping = 0, False
     with io.StepStop(comm) as stop:          # a Ctrl-C while the end is written lets it finish
