@@ -350,6 +350,17 @@ def _nodes(model, faces: list[int]) -> tuple[np.ndarray, np.ndarray]:
     return np.concatenate(tris)
 
 
+def _coplanar(model, faces: list[int]) -> bool:
+    """True for one face, or flat faces of one plane (the pieces of a face that fragmenting split)."""
+    flats = [_flat(model, f) for f in faces]
+    if len(faces) == 1:
+        return True
+    if any(f is None for f in flats):
+        return False
+    (n0, p0), size = flats[0], max(np.ptp([p for _, p in flats], axis=0).max(), np.finfo(float).tiny)
+    return all(abs(n @ n0) > 1 - 1e-9 and abs((p - p0) @ n0) <= 1e-9 * max(size, 1.0) for n, p in flats)
+
+
 def _flat(model, face: int):
     """(unit normal, a point) of a flat face, or None: normals and points sampled over the face's
     parameter range (a scaled CAD face is a B-spline surface, so its type says nothing)."""
@@ -418,6 +429,10 @@ def _surfaces(model, g, found: Found) -> None:
                 if not near:
                     raise InputError(f"{where}.contains", list(point), f"no face of {g.file.name} passes through "
                                      "this point [m]")
+                if not _coplanar(model, near):   # an edge or a corner: it selected every face there, silently
+                    raise InputError(f"{where}.contains", list(point), f"the point lies on {len(near)} faces of "
+                                     f"{g.file.name} that meet at an edge or a corner: move it inside the face you "
+                                     "mean [m]")
                 faces += [f for f in near if f not in faces]
         if not faces:
             raise InputError(where, name, f"selects no face of {g.file.name}")

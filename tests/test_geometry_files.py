@@ -510,6 +510,12 @@ def test_a_surface_on_an_interface_or_on_anothers_face_is_refused_by_check(tmp_p
                          '"18 mm"]\n[geometry.surfaces.bore]')
     err = check(tmp_path, capsys, twice)
     assert "geometry.surfaces.back_a = 'back_a': selects a face that geometry.surfaces.backs already selects" in err
+    # a point on the edge between pad_a's back and its side selected both faces, silently
+    edge = text.replace('contains = [["0 mm", "80 mm", "18 mm"], ["0 mm", "-80 mm", "18 mm"]]',
+                        'contains = [["10 mm", "80 mm", "18 mm"], ["0 mm", "-80 mm", "18 mm"]]')
+    err = check(tmp_path, capsys, edge)
+    assert "geometry.surfaces.backs.contains = [0.01, 0.08, 0.018]: the point lies on 2 faces of twopads.geo that " \
+           "meet at an edge or a corner: move it inside the face you mean [m]" in err
 
 
 def test_a_part_that_touches_nothing_is_refused_after_meshing(tmp_path):
