@@ -561,3 +561,20 @@ def test_a_material_the_geometry_does_not_use_is_a_warning_a_misspelt_one_a_prob
         loads(GOOD.replace("[materials.flat]", "[materials.flta]"), tmp_path)
     assert any(p.startswith('materials.flta: unknown material of builder "block_on_flat" (did you mean "flat"?)')
                for p in info.value.problems)
+
+
+def test_a_contact_pressure_beyond_small_strains_is_warned_about(tmp_path):
+    """The model is linear elastic: a pressure above 2 % of the softer side's E is named (a stop with
+    mu 0.02 put 184 MPa on a 3 GPa pad, silently: an adversarial test)."""
+    from multiscale.io import History
+    from multiscale.workflows import run_warnings
+    scene = load(DEMOS / "car_brake_stop.toml")           # pads of 3 GPa, cast iron of 110 GPa
+    h = History()
+    h.append(time=0.0, max_pressure=184e6)
+    assert run_warnings(scene, h) == [
+        "the contact pressure reached 1.84e+08 Pa, 6.1 % of the softer side's E (3e+09 Pa): beyond the small "
+        "strains of the linear elastic model; check the load (a vehicle stop asks mu F r of the brake: a small "
+        "mu needs a large clamp)"]
+    h = History()
+    h.append(time=0.0, max_pressure=5e6)
+    assert run_warnings(scene, h) == []

@@ -115,7 +115,7 @@ def run_warnings(scene, history) -> list[str]:
         out += [f"materials.{name}.{phrase} (in the {body})"
                 for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
     return (out + laws + _undershoots(scene, history) + _coarse_wear(scene, history) + _too_hot(scene, history)
-            + _unloaded(scene, history))
+            + _unloaded(scene, history) + _overloaded(scene, history))
 
 
 UNDERSHOOT = 0.05     # a body's undershoot warned about: this share of its temperature rise [-]
@@ -141,6 +141,20 @@ def _coarse_wear(scene, history) -> list[str]:
 
 
 UNLOADED = 1e-6   # an interface carrying less than this share of the largest one's force is warned about
+STRAINED = 0.02   # a contact pressure above this share of the softer side's E (at T0) is warned about
+
+
+def _overloaded(scene, history) -> list[str]:
+    """A contact pressure far beyond small strains of the softer side (the model is linear elastic):
+    a stop with mu 0.02 asked 184 MPa of a 3 GPa pad, silently (an adversarial test)."""
+    if "max_pressure" not in history.columns or scene.materials is None:
+        return []
+    T0, spec = scene.time.initial_temperature, scene.geometry.spec
+    soft = min(scene.materials[m].value("E", T0) for n in spec.interfaces for m in spec.interface_materials(n))
+    p = float(np.max(history["max_pressure"]))
+    return [f"the contact pressure reached {p:.3g} Pa, {100 * p / soft:.2g} % of the softer side's E ({soft:.3g} Pa): "
+            "beyond the small strains of the linear elastic model; check the load (a vehicle stop asks mu F r of "
+            "the brake: a small mu needs a large clamp)"] if p > STRAINED * soft else []
 
 
 def _unloaded(scene, history) -> list[str]:
