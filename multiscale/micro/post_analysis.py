@@ -16,7 +16,8 @@ area, sliding speed V and direction, macro surface temperatures of both bodies):
    (``partition``) is what the macro heat split uses next; with equal remote temperatures it lies
    in [0, 1] and is clipped there (``Heating.bounded``); with different ones the heat conducted
    from the hotter body is part of it and it may leave [0, 1]. Speeds and directions are rounded
-   to a relative step (``Heating``) so that the kernel tables are shared between zones;
+   to a relative step (``Heating``) so that the kernel tables are shared between zones; the heat
+   rates are scaled back to the true speed (mu p V is linear in it; the partition is unchanged);
 3. optionally the thermal contact conductance h_c of the zone at that contact
    (``laws.Conductance``, the zone-scale spreading resistance taken out);
 4. Archard wear over the sliding distance s = V Δt (Eq. 3.10, dh = k_w(T) mu p ds, T the local
@@ -176,6 +177,10 @@ class PostAnalysis:
         flash softening passes each zone's last flash temperature).
         """
         B = len(zones)
+        triangles = [z.id for z in zones if z.triangle is not None]
+        if triangles:        # its load and wear would spread over the bounding box (twice the load: a test)
+            raise InputError("zones", triangles, "the post-analysis takes rectangular zones (cut_zones, "
+                             "generate_zones): a triangular zone's patch covers its bounding box")
         H = np.stack([z.surface.heights for z in zones]) if B else np.zeros((0,) + self.shape)
         if H.shape[1:] != self.shape:
             raise InputError("zones", H.shape[1:], f"patches of the post-analysis grid {self.shape}")
@@ -275,12 +280,15 @@ class PostAnalysis:
         the step, its heat rates the means over the step."""
         heater = self._heater(speed, angle, duration)
         remote = tuple(float(v) for v in remote)
+        rounded = float(self.heating.rounded(speed, angle)[0])
+        scale = speed / rounded if rounded > 0 else 1.0     # heat rates at the true speed (mu p V: linear)
         if isinstance(heater, SteadyHeating):
             h = heater.solve(pressure, mu, tol=self.tol, remote_temperatures=remote)
-            return h.temperature_1, h.temperature_2, h.temperature_2.max(), float(h.heat), float(h.heat_2)
+            return (h.temperature_1, h.temperature_2, h.temperature_2.max(), scale * float(h.heat),
+                    scale * float(h.heat_2))
         h = heater.run(pressure, mu, tol=self.tol, remote_temperatures=remote, field_times=[duration])
-        return (h.temperature_1[-1], h.temperature_2[-1], h.max_temperature_2.max(), float(h.heat.mean()),
-                float(h.heat_2.mean()))
+        return (h.temperature_1[-1], h.temperature_2[-1], h.max_temperature_2.max(), scale * float(h.heat.mean()),
+                scale * float(h.heat_2.mean()))
 
     def _solve(self, zones, heights, load, warm, hardness=None):
         """Load-controlled contact of the batch; patches that do not converge within
