@@ -352,9 +352,9 @@ def _nodes(model, faces: list[int]) -> tuple[np.ndarray, np.ndarray]:
 
 def _coplanar(model, faces: list[int]) -> bool:
     """True for one face, or flat faces of one plane (the pieces of a face that fragmenting split)."""
-    flats = [_flat(model, f) for f in faces]
     if len(faces) == 1:
         return True
+    flats = [_flat(model, f) for f in faces]
     if any(f is None for f in flats):
         return False
     (n0, p0), size = flats[0], max(np.ptp([p for _, p in flats], axis=0).max(), np.finfo(float).tiny)

@@ -317,8 +317,7 @@ class Thermal:
             motion, body = self.tm.spec.motion, self.tm.bodies[1]
             c = body.crossing(motion)
             if c.share > 0:
-                r = np.linalg.norm(np.cross(np.asarray(motion.axis, float) / np.linalg.norm(motion.axis),
-                                            c.where - np.asarray(motion.centre, float)))
+                r = np.linalg.norm(motion.velocity(c.where[None])[0])       # the distance from the axis
                 raise InputError("effects", "thermal", f"the rotating body {body.name!r} is not a body of revolution "
                                  f"about its axis: its rotation crosses {100 * c.share:.2g} % of its surface "
                                  f"(weighted by speed; e.g. at r = {r * 1e3:.1f} mm, point "

@@ -30,16 +30,13 @@ class OutputFolder:
     comm: object
     replace: list          # names of earlier results that claim deletes (--overwrite)
     resume: bool = False
-    claimed: bool = False
 
     def claim(self) -> Path:
         """Delete the earlier results (``--overwrite``: every entry the earlier run recorded writing,
         ``provenance.results_of``, so no stale field file, figure or checkpoint of another scene stays
         beside the new results; entries no run recorded, the user's own, stay with a message) and
         write the new run's provenance with status ``provenance.RUNNING`` (what a killed run leaves).
-        Collective; once per run (later calls do nothing)."""
-        if self.claimed:
-            return self.path
+        Collective; once per run."""
         scene, comm = self.scene, self.comm
 
         def start():
@@ -51,7 +48,6 @@ class OutputFolder:
                                  warnings=scene.warnings)
         io.on_root(comm, start, f"into the output folder {self.path}")
         io.reporter().folder = self.path        # where a failed run leaves its provenance
-        self.claimed = True
         return self.path
 
 
@@ -71,7 +67,8 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
     if existing and not (overwrite or resume):
         shown = ", ".join(existing[:3]) + (", ..." if len(existing) > 3 else "")
         resumes = outputs.analysis(scene) == "multiscale"           # the only analysis with checkpoints
-        raise SceneError(f'output.folder = "{folder}": already holds results ({provenance.entries(len(existing))}: {shown}); '
+        raise SceneError(f'output.folder = "{folder}": already holds results ({provenance.entries(len(existing))}: '
+                         f"{shown}); "
                          + ("use --overwrite to replace them, --resume to continue the run (in Python: overwrite=True, "
                             "resume=True), or choose another folder" if resumes else
                             "use --overwrite to replace them (in Python: overwrite=True), or choose another folder"))
