@@ -79,6 +79,7 @@ class MacroModel:
     last_solve: SolveResult | None = None
     solved_speed: float = 0.0                          # the speed of the last contact solve (friction on if > 0)
     load: float | None = None                          # N or Pa at factor 1 (the drive's, or scaled to its torque)
+    partitions: dict = field(default_factory=dict)     # share of frictional heat into body 0 per interface [-]
 
     @property
     def contact(self):

@@ -65,6 +65,7 @@ disc's heat; an adversarial test). The SUPG term sums to zero as well (its weigh
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 from typing import Callable, Mapping, Sequence
 
 import numpy as np
@@ -545,17 +546,23 @@ class Thermal:
         comm = self.tm.comm
         return tuple(comm.allreduce(T.x.array.max(initial=-np.inf), op=MPI.MAX) for T in self.T)
 
+    @cached_property
+    def material_dofs(self) -> tuple:
+        """Per body: the local temperature dofs of the cells of each material (a node on a
+        boundary between materials belongs to both)."""
+        out = []
+        for body, T in zip(self.tm.bodies, self.T):
+            dofs = T.function_space.dofmap.list[:len(body.region_tags)]
+            out.append({m: np.unique(dofs[np.isin(body.region_tags, [r.tag for r in body.spec.regions
+                                                                      if r.material == m])])
+                        for m in sorted({r.material for r in body.spec.regions})})
+        return tuple(out)
+
     def material_max_temperature(self, i: int) -> dict:
-        """Largest nodal temperature [K] of the cells of each material of body ``i`` (collective;
-        a node on a boundary between materials counts for both)."""
-        body, T = self.tm.bodies[i], self.T[i]
-        dofs = T.function_space.dofmap.list[:len(body.region_tags)]
-        out = {}
-        for material in sorted({r.material for r in body.spec.regions}):
-            tags = [r.tag for r in body.spec.regions if r.material == material]
-            mine = np.unique(dofs[np.isin(body.region_tags, tags)])
-            out[material] = self.tm.comm.allreduce(T.x.array[mine].max(initial=-np.inf), op=MPI.MAX)
-        return out
+        """Largest nodal temperature [K] of the cells of each material of body ``i`` (collective)."""
+        T = self.T[i].x.array
+        return {m: self.tm.comm.allreduce(T[mine].max(initial=-np.inf), op=MPI.MAX)
+                for m, mine in self.material_dofs[i].items()}
 
     def min_temperature(self) -> tuple:
         """Smallest nodal temperature of each body [K] (below every imposed temperature: an undershoot

@@ -206,7 +206,7 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: b
         for f in T:
             f.x.array[:] = t.initial_temperature
     mech = build_mechanics(scene, tm, law=law, temperatures=T if scene.has("expansion") else None)
-    heat = None
+    heat, shares = None, {}
     if T is not None:
         heat = Thermal(mech.contact, dict(scene.materials), initial_temperature=t.initial_temperature,
                        dt=t.dt / t.substeps, frictional_heat=scene.has("heat_partition"),
@@ -219,7 +219,7 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: b
             tm.interface.set_field(mech.contact.partition, share)
         if scene.has("conductance") and scene.interface.conductance is not None:   # else per facet later
             tm.interface.set_field(mech.contact.conductance, scene.interface.conductance)
-    return MacroModel(tm, mech, heat, drive(scene, tm))
+    return MacroModel(tm, mech, heat, drive(scene, tm), partitions=shares)
 
 
 def interface_forces(scene, tm) -> dict:

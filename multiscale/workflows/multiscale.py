@@ -40,7 +40,7 @@ from multiscale.micro.laws import Conductance
 from multiscale.micro.post_analysis import Heating, PostAnalysis
 from multiscale.plots.history import multiscale_figure, wear_map
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, interface_forces, \
-    interface_materials, partitions
+    interface_materials
 from multiscale.workflows.output import prepare_folder
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
@@ -109,7 +109,7 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
         model = build_model(scene, comm, law=rough.law, tm=tm, conductance=scene.has("conductance") or exchange)
     t, wear = scene.time, scene.has("wear")
     mu = np.concatenate([np.full(g.n_zones, friction_coefficient(scene, n)) for n, g in zip(rough.names, rough.grids)])
-    first = next(iter(partitions(scene, tm).values())) if scene.has("heat_partition") else np.nan
+    first = next(iter(model.partitions.values())) if scene.has("heat_partition") else np.nan
     settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature, partition=first,
                             partition_law=scene.micro.partition_law, wear=wear,
                             wear_every=scene.wear.update_every if wear else 1, steps=t.steps,
