@@ -10,8 +10,9 @@ ParaView's XDMF reader shows one block per file whose arrays colour it directly,
 writes every function as its own grid (coincident unnamed blocks in ParaView).
 
 - ``FieldWriter``: the series of a set of meshes; the mesh is gathered to rank 0 once in a
-  rank-independent order (nodes sorted by coordinates, cells by their nodes), so that a run
-  resumed on another number of ranks appends to the same files. Files are closed after every
+  rank-independent order (nodes sorted by coordinates, cells by their nodes; quadratic cells
+  where a body has a quadratic field: ``MeshLayout``), so that a run resumed on another number
+  of ranks appends to the same files. Files are closed after every
   write: a run killed between two writes leaves them readable; the resumed run drops the times
   the killed one wrote after its checkpoint, and replaces a time written again: no time twice.
 - ``FieldOutput``: a model's requested fields (``output.fields``) refreshed and written at each
@@ -26,6 +27,7 @@ from pathlib import Path
 from typing import Callable, Mapping, Sequence
 from xml.sax.saxutils import quoteattr
 
+import basix
 import h5py
 import numpy as np
 from dolfinx import fem
@@ -38,28 +40,42 @@ from multiscale.outputs import FIELDS, array_name
 # DOLFINx cell name -> (XDMF topology type, DOLFINx vertex order -> XDMF/VTK order)
 CELLS = {"tetrahedron": ("Tetrahedron", [0, 1, 2, 3]), "triangle": ("Triangle", [0, 1, 2]),
          "hexahedron": ("Hexahedron", [0, 1, 3, 2, 4, 5, 7, 6]), "quadrilateral": ("Quadrilateral", [0, 1, 3, 2])}
+# the edges of VTK's (and XDMF's) quadratic cells, in the order of their midpoint nodes
+QUADRATIC = {"tetrahedron": ("Tetrahedron_10", [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)]),
+             "triangle": ("Triangle_6", [(0, 1), (1, 2), (0, 2)])}
 MODE_UNIT = "m/kg^0.5"     # mode shapes normalised to unit modal mass
 
 
 class MeshLayout:
-    """A linear mesh gathered on rank 0 in a rank-independent order, and the maps that gather
-    point values (at the mesh nodes) and cell values into that order (collective)."""
+    """The nodes of a mesh gathered on rank 0 in a rank-independent order, and the maps that gather
+    point values (at the nodes) and cell values into that order (collective). ``degree`` 1: the
+    vertices of a linear mesh; 2: the nodes of quadratic Lagrange elements (XDMF ``Tetrahedron_10``,
+    ``Triangle_6``), so that a quadratic field keeps its values at the edge midpoints too (ParaView
+    draws and integrates it on the quadratic cells) and a linear one is interpolated exactly."""
 
-    def __init__(self, mesh):
+    def __init__(self, mesh, degree: int = 1):
         if mesh.geometry.cmaps[0].degree != 1:
             raise InputError("mesh", mesh.geometry.cmaps[0].degree, "field files need a linear mesh geometry")
         tdim, cell = mesh.topology.dim, mesh.topology.cell_name()
-        if cell not in CELLS:
-            raise InputError("mesh", cell, f"field files support {', '.join(CELLS)} cells")
-        self.mesh, self.comm, self.cell_type = mesh, mesh.comm, CELLS[cell][0]
-        self.n_nodes = mesh.geometry.index_map().size_local
+        kinds = CELLS if degree == 1 else QUADRATIC if degree == 2 else {}
+        if cell not in kinds:
+            raise InputError("mesh", f"{cell} of degree {degree}",
+                             f"field files support {', '.join(kinds) or 'degrees 1 and 2'}")
+        self.mesh, self.comm, self.degree, self.cell_type = mesh, mesh.comm, degree, kinds[cell][0]
         self.n_cells = mesh.topology.index_map(tdim).size_local
-        self.xdofs = mesh.geometry.dofmaps[0]
-        x = mesh.geometry.x
+        x, corners = mesh.geometry.x, mesh.geometry.dofmaps[0]
+        if degree == 1:
+            self.n_nodes, self.xdofs = mesh.geometry.index_map().size_local, corners
+            order = CELLS[cell][1]
+        else:
+            self.n_nodes, self.xdofs, x, order = quadratic_nodes(mesh, x[corners], kinds[cell][1])
         parts = self.comm.gather((x[:self.n_nodes], x[self.xdofs[:self.n_cells]]), root=0)
-        self._p1 = {}
-        if self.comm.rank != 0:
-            return
+        self._spaces = {}
+        io.collective(self.comm, lambda: self._order(parts, order) if self.comm.rank == 0 else None)
+
+    def _order(self, parts, order) -> None:
+        """On rank 0: the nodes sorted by coordinates, the cells by their nodes (``order``: the cell's
+        node order -> XDMF/VTK order)."""
         nodes = np.concatenate([p[0] for p in parts])
         corners = np.concatenate([p[1] for p in parts])
         unique, inverse = np.unique(np.vstack([nodes, corners.reshape(-1, 3)]), axis=0, return_inverse=True)
@@ -68,11 +84,12 @@ class MeshLayout:
             raise InputError("mesh", len(nodes), "nodes of the field mesh must have distinct coordinates")
         self.node_position = inverse[:len(nodes)]
         topology = inverse[len(nodes):].reshape(len(corners), -1)
-        order = np.lexsort(np.sort(topology, axis=1).T[::-1])
-        self.cell_position = np.empty(len(order), dtype=np.int64)
-        self.cell_position[order] = np.arange(len(order))
+        cells = np.lexsort(np.sort(topology, axis=1).T[::-1])
+        self.cell_position = np.empty(len(cells), dtype=np.int64)
+        self.cell_position[cells] = np.arange(len(cells))
         self.geometry = unique
-        self.topology = topology[order][:, CELLS[cell][1]].astype(np.int64)
+        self.topology = topology[cells][:, order].astype(np.int64)
+
 
     def _gather(self, owned: np.ndarray, position_name: str):
         parts = self.comm.gather(owned, root=0)
@@ -84,15 +101,15 @@ class MeshLayout:
         return out
 
     def point_values(self, f: fem.Function) -> np.ndarray | None:
-        """Values of a Lagrange function at the mesh nodes (interpolated to degree 1), on rank 0:
-        (nodes,) or (nodes, components)."""
+        """Values of a Lagrange function at the layout's nodes (interpolated to its degree), on
+        rank 0: (nodes,) or (nodes, components)."""
         shape = f.function_space.value_shape
-        if shape not in self._p1:
-            V = fem.functionspace(self.mesh, ("Lagrange", 1, shape))
-            node_dof = np.empty(self.mesh.geometry.x.shape[0], dtype=np.int64)
+        if shape not in self._spaces:
+            V = fem.functionspace(self.mesh, ("Lagrange", self.degree, shape))
+            node_dof = np.empty(int(self.xdofs.max(initial=-1)) + 1, dtype=np.int64)
             node_dof[self.xdofs] = V.dofmap.list
-            self._p1[shape] = (fem.Function(V), node_dof[:self.n_nodes])
-        work, node_dof = self._p1[shape]
+            self._spaces[shape] = (fem.Function(V), node_dof[:self.n_nodes])
+        work, node_dof = self._spaces[shape]
         work.interpolate(f)
         bs = work.function_space.dofmap.bs
         return self._gather(components(work.x.array, bs)[node_dof], "node_position")
@@ -104,6 +121,23 @@ class MeshLayout:
         return self._gather(components(f.x.array, bs)[dofs], "cell_position")
 
 
+def quadratic_nodes(mesh, vertices: np.ndarray, edges) -> tuple:
+    """The nodes of the scalar quadratic Lagrange space of ``mesh`` (vertices (cells, corners, 3) the
+    cells' corner coordinates): owned count, cell dofmap, coordinates of every local dof, and the
+    cell's dof order -> VTK order for its ``edges``. A midpoint is (x_a + x_b) / 2, the same bits
+    from every cell and rank (``tabulate_dof_coordinates`` differs in the last bit between cells,
+    and the ranks' copies of a node would not match)."""
+    V = fem.functionspace(mesh, ("Lagrange", 2))
+    cell_edges = [tuple(e) for e in basix.topology(V.element.basix_element.cell_type)[1]]
+    n = vertices.shape[1]
+    local = np.concatenate([vertices, np.stack([(vertices[:, a] + vertices[:, b]) / 2 for a, b in cell_edges],
+                                               axis=1)], axis=1)
+    dofs = V.dofmap.list
+    x = np.empty((V.dofmap.index_map.size_local + V.dofmap.index_map.num_ghosts, 3))
+    x[dofs] = local
+    order = list(range(n)) + [n + cell_edges.index(e) for e in edges]    # both list edges as (low, high)
+    return V.dofmap.index_map.size_local, dofs, x, order
+
 def components(values: np.ndarray, bs: int) -> np.ndarray:
     """A function's dof array as (dofs,) for a scalar, (dofs, bs) otherwise (``squeeze`` would also
     drop the first axis where a rank owns one node or cell)."""
@@ -114,6 +148,12 @@ def components(values: np.ndarray, bs: int) -> np.ndarray:
 def is_cell_field(f: fem.Function) -> bool:
     """True for a DG0 function (written as cell data)."""
     return f.function_space.element.basix_element.degree == 0
+
+
+def layout_degree(functions) -> int:
+    """Degree of the layout of a set of functions of one mesh: 2 when one is quadratic (or more:
+    its values at the quadratic nodes), else 1."""
+    return 2 if any(f.function_space.element.basix_element.degree >= 2 for f in functions) else 1
 
 
 class SeriesFile:
@@ -202,7 +242,8 @@ class FieldWriter:
     that cannot be written or continued is an ``OutputError`` on every rank."""
 
     def __init__(self, folder: Path, groups: Sequence[tuple], resume_at: float | None = None):
-        self.groups = [(SeriesFile(Path(folder) / f"{name}.xdmf", MeshLayout(mesh)), dict(functions))
+        self.groups = [(SeriesFile(Path(folder) / f"{name}.xdmf", MeshLayout(mesh, layout_degree(functions.values()))),
+                        dict(functions))
                        for name, mesh, functions in groups if functions]
         self.files = [s.path for s, _ in self.groups]
         if self.groups:

@@ -27,3 +27,23 @@ def test_a_failure_on_one_rank_is_an_output_error_on_every_rank():
     with pytest.raises(OutputError, match="cannot write the wear maps: No space left on device"):
         io.on_ranks(comm, [lambda: None, full, lambda: None], "the wear maps")
     comm.Barrier()                      # both ranks got here: no rank is left waiting
+
+
+def test_a_field_mesh_refused_on_rank_0_is_refused_on_every_rank():
+    """The field files' layout is ordered on rank 0 (``output.MeshLayout``): its refusal of a mesh
+    with two nodes at one place reaches every rank (it once left rank 1 waiting in the next write)."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+    import basix.ufl
+    import numpy as np
+    import ufl
+    from dolfinx import mesh
+
+    from multiscale.errors import MultiscaleError
+    from multiscale.macro.output import MeshLayout
+    x = np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]] * 2) if comm.rank == 0 else np.zeros((0, 2))
+    cells = np.array([[0, 1, 2], [3, 4, 5]], dtype=np.int64) if comm.rank == 0 else np.zeros((0, 3), dtype=np.int64)
+    domain = ufl.Mesh(basix.ufl.element("Lagrange", "triangle", 1, shape=(2,)))
+    twice = mesh.create_mesh(comm, cells, domain, x)     # two triangles on top of each other, not sharing nodes
+    with pytest.raises(MultiscaleError, match="distinct coordinates"):
+        MeshLayout(twice)
+    comm.Barrier()
