@@ -2,6 +2,7 @@
 sizes and RMS values equal its own), channels and overrides, one clear error per bad input, and the
 conditioning steps checked against exact answers: harmonic filling of a plane, form removal, the
 ISO 16610-61 Gaussian filter's transmission, resampling and covering an interface."""
+import logging
 import os
 import warnings
 from pathlib import Path
@@ -306,6 +307,27 @@ def test_a_plain_matrix_has_one_channel(tmp_path):
     assert read_topography(tmp_path / "rough.npy", channel=0, pixel_size=1e-6).shape == (32, 32)
     with pytest.raises(InputError, match="channel = 2: rough.npy is a plain height matrix: one channel, 0"):
         read_topography(tmp_path / "rough.npy", channel=2, pixel_size=1e-6)
+
+
+@pytest.mark.filterwarnings("ignore::RuntimeWarning")
+def test_a_truncated_file_gets_its_readers_diagnosis_and_no_log_of_its_bytes(tmp_path, caplog):
+    """A damaged file of a known format: what its format's reader says (before: 'not a format
+    SurfaceTopography recognises'); igor2's reader, tried during the format detection, logged the
+    bytes of a truncated .opd as an error (6.5 MB on the terminal for half of opd-1.opd); a
+    folder is not 'no such file'."""
+    whole = (DATA / "opdx-3.opdx").read_bytes()
+    (tmp_path / "cut.opdx").write_bytes(whole[:len(whole) // 2])
+    with pytest.raises(InputError, match=r"cut\.opdx': cannot read it as a topography: as Dektak OPDx, "
+                                         r"CorruptFile: .*probably truncated"):
+        read_topography(tmp_path / "cut.opdx")
+    (tmp_path / "pad.plu").mkdir()
+    with pytest.raises(InputError, match=r"'pad\.plu': a folder, not a file"):
+        read_topography(tmp_path / "pad.plu")
+    if SHARED is not None:
+        (tmp_path / "cut.opd").write_bytes((SHARED / "opd-1.opd").read_bytes()[:3000])
+        with caplog.at_level(logging.DEBUG), pytest.raises(InputError, match="as Wyko OPD, CorruptFile"):
+            read_topography(tmp_path / "cut.opd")
+        assert not caplog.records
 
 
 @pytest.mark.parametrize("call, message", [

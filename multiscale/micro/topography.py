@@ -21,7 +21,9 @@ repeats), or a statistically equivalent surface drawn from the measured PSD
 """
 from __future__ import annotations
 
+import logging
 import warnings
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -84,12 +86,40 @@ class Measurement:
 def _reader(path: Path, name: str):
     ST = surface_topography()
     try:
-        return ST.open_topography(str(path))
+        with _quiet():
+            return ST.open_topography(str(path))
     except (ST.Exceptions.UnknownFileFormat, ST.Exceptions.CannotDetectFileFormat):
-        raise InputError(name, path.name, "cannot read it as a topography: not a format SurfaceTopography "
-                         "recognises (`multiscale surface --formats` lists them)") from None
+        raise InputError(name, path.name, "cannot read it as a topography: " + (_format_error(path) or (
+            "not a format SurfaceTopography recognises (`multiscale surface --formats` lists them)"))) from None
     except Exception as exc:    # any other parser failure on a user's file: one error naming it
         raise InputError(name, path.name, f"cannot read it as a topography ({_first_line(exc)})") from None
+
+
+@contextmanager
+def _quiet():
+    """No logging while SurfaceTopography's readers try a file: on a damaged one some log its bytes
+    as errors (igor2's on a truncated .opd: megabytes on the terminal)."""
+    before = logging.root.manager.disable
+    logging.disable(logging.CRITICAL)
+    try:
+        yield
+    finally:
+        logging.disable(before)
+
+
+def _format_error(path: Path) -> str | None:
+    """What the readers of the file's extension say about a file the format detection refused (a
+    truncated or damaged file of a known format), or None for an extension no reader claims."""
+    suffix = path.suffix.lower().lstrip(".")
+    said = []
+    for reader in surface_topography().IO.readers:
+        if suffix and suffix in reader.file_extensions():
+            try:
+                with _quiet():
+                    reader(str(path))
+            except Exception as exc:    # the reader's own words on what is wrong with the file
+                said.append(f"as {reader.name()}, {_first_line(exc)}")
+    return "; ".join(said) or None
 
 
 def _first_line(exc: Exception) -> str:
@@ -123,7 +153,8 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
     """
     path = Path(path)
     if not path.is_file():
-        raise InputError(f"{prefix}file", path.name, f"no such file ({path})")
+        raise InputError(f"{prefix}file", path.name, f"{'a folder, not a file' if path.is_dir() else 'no such file'} "
+                         f"({path})")
     pair = None if pixel_size is None else check_pair(f"{prefix}pixel_size", pixel_size, check_positive)
     if height_unit is not None:
         check_positive(f"{prefix}height_unit", height_unit)
