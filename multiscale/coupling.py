@@ -145,7 +145,8 @@ class MicroStep:
     seconds: float
     plastic_fraction: float = 0.0  # largest share of a zone's cells at the hardness (0 without plasticity)
     real_area: float = 0.0     # m^2, real contact area summed over the loaded zones (before wear)
-    law_reach: float = 0.0     # largest zone pressure over the top of its law (> 1: extrapolated)
+    law_reach: float = 0.0     # largest zone pressure over micro.p_max, the top of the laws (> 1: extrapolated)
+    law_reach_halved: float = 0.0  # the same over the zones whose law failed, against their halved top
 
 
 @dataclass
@@ -282,12 +283,11 @@ class Multiscale:
             max_p.append(mp)
         if self.post.conductance is not None:
             self.conductance[np.setdiff1d(np.arange(len(zones)), loaded)] = 0.0
-        hot = self.flash[loaded]
-        max_p = np.concatenate(max_p)
+        hot, max_p = self.flash[loaded], np.concatenate(max_p)
         return MicroStep(len(loaded), float(load.pressure.max()), float(max_p.max(initial=0.0)),
                          float(np.nanmax(hot)) if np.isfinite(hot).any() else np.nan, (np.nan,) * 3, 0.0,
                          _time.perf_counter() - t0, float(np.concatenate(flow).max(initial=0.0)), real,
-                         float(np.max(load.pressure[loaded] / self.rough.law_top[loaded], initial=0.0)))
+                         *self.rough.law_reach(load.pressure, loaded))
 
     def _hardness_temperature(self, ids, rough_temperature) -> np.ndarray | None:
         """Where the zones ``ids`` take H(T): with ``settings.flash_softening``, their flash
@@ -445,8 +445,7 @@ class Multiscale:
             m.thermal.lost_total, m.thermal.lost_step = state["lost_total"].copy(), state["lost_step"].copy()
 
     def _constants(self) -> list:
-        m = self.model
-        return [m.contact.speed, m.contact.engaged, m.contact.heating, m.mechanics.load]
+        return [*(getattr(self.model.contact, k) for k in ("speed", "engaged", "heating")), self.model.mechanics.load]
 
     # ---- the run ---------------------------------------------------------------------------
     def start(self) -> StepResult:
@@ -514,7 +513,8 @@ class Multiscale:
         row = self.model.record(result.heat)
         row.update(zones_in_contact=micro.loaded * on, laws_computed=self.rough.laws_computed,
                    max_zone_pressure=micro.zone_pressure * on, micro_max_pressure=micro.max_pressure * on,
-                   real_contact_area=micro.real_area * on, law_reach=micro.law_reach * on)
+                   real_contact_area=micro.real_area * on, law_reach=micro.law_reach * on,
+                   law_reach_halved=micro.law_reach_halved * on)
         if self.post.heating is not None:
             row.update(micro_max_temperature=micro.max_temperature, partition_min=micro.partition[0],
                        partition_mean=micro.partition[1], partition_max=micro.partition[2],

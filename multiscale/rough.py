@@ -158,6 +158,13 @@ class RoughInterface:
         the facet law is extrapolated linearly)."""
         return self.spec.p_max / 2.0 ** self.levels
 
+    def law_reach(self, pressure: np.ndarray, ids) -> tuple[float, float]:
+        """Largest zone pressure [Pa, per zone] over the top of its law among the zones ``ids``: over
+        those with the full p_max, and over those whose law failed (a halved top); 0 if none."""
+        reach = pressure[ids] / self.law_top[ids]
+        halved = self.levels[ids] > 0
+        return float(reach[~halved].max(initial=0.0)), float(reach[halved].max(initial=0.0))
+
     def zone_frames(self) -> tuple[np.ndarray, np.ndarray]:
         """Centre (Z, 3) [m] of every zone in space and the (Z, 2, 3) in-plane directions (e_u, e_v)
         of its interface (zone coordinates and sliding directions are along these)."""
