@@ -90,7 +90,8 @@ def test_scene_reads_a_measured_file_with_its_options(tmp_path):
 
 
 @pytest.mark.parametrize("roughness, fragment", [
-    ('file = "pad.x3p"', "roughness.file = 'pad.x3p': cannot read it as a topography: not a format"),
+    ('file = "pad.x3p"', "roughness.file = 'pad.x3p': cannot read it as a topography: as XML 3D surface profile "
+                        "(X3P), FileFormatMismatch: Stream is not a valid ZIP archive"),
     (f'file = "{TOP}"\nchannel = 4', 'roughness.channel = 4: top-1.top has the channels 0 "Default" (2-D)'),
     (f'file = "{DATA / "opdx-3.opdx"}"', "is a 1-D profile (line scan): a height map (2-D) is needed"),
     ('file = "pad.npy"', "roughness.pixel_size = None: pad.npy is a plain height matrix without units"),
