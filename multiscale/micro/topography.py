@@ -39,7 +39,7 @@ TALLEST = 1e-2            # m: heights beyond are no roughness measurement (an i
 DETREND = {"none": None, "mean": "mean", "plane": "height", "poly2": "curvature"}   # -> SurfaceTopography
 COVER = ("measured", "mirror", "tile", "equivalent")
 ALPHA = np.sqrt(np.log(2) / np.pi)     # ISO 16610-21/-61 Gaussian: 50 % transmission at the cut-off
-S_FILTER_PIXELS = 3.0     # anti-aliasing before coarsening: λs = 3 new pixels (21 % at the new Nyquist)
+S_FILTER_PIXELS = 3.0     # anti-aliasing before coarsening: resolved to λs = 3 new pixels (21 % at the new Nyquist)
 
 
 class TopographyWarning(UserWarning):
@@ -397,10 +397,12 @@ def _pixel(dx: float, dy: float) -> str:
 def resample(surface: Surface, n, size=None, antialias: bool = True) -> tuple[Surface, str]:
     """The surface on a grid of n = (nx, ny) cells over size (Lx, Ly) [m] (default: its own size),
     cell centres at ((i + ½) Lx/nx, (j + ½) Ly/ny) from its corner, by cubic splines; a coarser grid
-    first low-passes with the Gaussian S-filter at λs = ``S_FILTER_PIXELS`` new pixels along each
-    coarsened axis (against aliasing; an axis kept as fine is not filtered; none with
-    ``antialias`` False, for a surface filtered at about the new pixels already). Returns the
-    surface and one report line."""
+    first low-passes with the Gaussian S-filter along each coarsened axis, against aliasing, to a
+    resolution of λs = ``S_FILTER_PIXELS`` new pixels: the surface counts as resolved to that many
+    of its own pixels already and Gaussian cut-offs add in quadrature, so the filter is at
+    ``S_FILTER_PIXELS`` sqrt(new² − old²) pixel sizes (a grid barely coarser is barely filtered;
+    an axis kept as fine is not; none with ``antialias`` False, for a surface filtered at about the
+    new pixels already). Returns the surface and one report line."""
     import scipy.ndimage  # ~0.4 s to import: only when a surface is resampled
     nx, ny = check_pair("n", n, check_count)
     Lx, Ly = surface.size if size is None else check_pair("size", size, check_positive)
@@ -408,8 +410,8 @@ def resample(surface: Surface, n, size=None, antialias: bool = True) -> tuple[Su
     if (ny, nx) == surface.shape and np.isclose(dx, surface.dx, rtol=1e-9) and np.isclose(dy, surface.dy, rtol=1e-9):
         return surface, "on the micro grid already"
     source, filtered = surface, ""
-    cut_x = S_FILTER_PIXELS * dx if antialias and dx > surface.dx * (1 + 1e-9) else 0.0
-    cut_y = S_FILTER_PIXELS * dy if antialias and dy > surface.dy * (1 + 1e-9) else 0.0
+    cut_x = S_FILTER_PIXELS * np.sqrt(dx ** 2 - surface.dx ** 2) if antialias and dx > surface.dx * (1 + 1e-9) else 0.0
+    cut_y = S_FILTER_PIXELS * np.sqrt(dy ** 2 - surface.dy ** 2) if antialias and dy > surface.dy * (1 + 1e-9) else 0.0
     if cut_x or cut_y:
         source = _gaussian(surface, cut_x, cut_y)
         cuts = f"{cut_x * 1e6:.4g} um" if cut_x == cut_y else \
