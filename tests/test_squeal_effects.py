@@ -243,3 +243,18 @@ def test_eigen_solver_errors_name_the_scene_keys(tmp_path):
                  "stability.band": ["10 Hz", "500 Hz"]}
     with pytest.raises(InputError, match=r"^stability\.band = \(10\.0, 500\.0\): no eigenvalue in this frequency band"):
         squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
+
+
+def test_a_band_cut_short_below_a_target_is_said(tmp_path):
+    """stability.target mid-band: the 6 modes nearest 8 kHz span 7.4-8.2 kHz and the band from 0 Hz
+    below them was not searched (before: only 'the band above ... was not searched'; with the
+    target at 15.5 kHz, 'above' though the search reached 17.9 kHz, and not a word on the 0-12.8 kHz
+    left out; found by an adversarial test)."""
+    overrides = {"geometry.mesh_size": "30 mm", "stability.modes": 6, "output.folder": str(tmp_path / "out"),
+                 "stability.target": "8 kHz"}
+    run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
+    f = run.case.modes.frequency
+    assert f.min() > 5e3 and len(run.warnings) == 1
+    assert run.warnings[0].startswith(f"stability.modes = 6: the modes found span {f.min():.0f} to {f.max():.0f} Hz "
+                                      "around stability.target = 8000 Hz; the band below ")
+    assert "from 0 Hz, and above" in run.warnings[0] and run.warnings[0].endswith("move stability.target)")

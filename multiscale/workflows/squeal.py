@@ -213,10 +213,23 @@ class SquealResult(RunResult):
 def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
     """Warnings: a band cut short by stability.modes, a map whose modes are approximate."""
     st, out = scene.stability, []
-    top = float(case.modes.frequency.max(initial=0.0))
-    if st.modes is not None and len(case.modes) >= st.modes and top < 0.99 * st.band[1]:
+    f = case.modes.frequency
+    top = float(f.max(initial=0.0))
+    lo, hi = st.band
+    floor, ceiling = lo, top               # PEP: found by frequency from the band's low edge
+    if case.modes.method == "gnhep" and len(f):    # the modes nearest theta_t = (2 pi target)^2: searched
+        t = lo if st.target is None else st.target   # within the farthest found |theta - theta_t|
+        r = float(np.abs(f ** 2 - t ** 2).max())
+        floor, ceiling = np.sqrt(max(t ** 2 - r, 0.0)), np.sqrt(t ** 2 + r)
+    below, above = floor > 1.01 * lo + 1.0, ceiling < 0.99 * hi
+    if st.modes is not None and len(case.modes) >= st.modes and below:
+        out.append(f"stability.modes = {st.modes}: the modes found span {f.min():.0f} to {top:.0f} Hz around "
+                   f"stability.target = {st.target:.0f} Hz; the band below {floor:.0f} Hz, from {lo:.0f} Hz"
+                   + (f", and above {ceiling:.0f} Hz, up to {hi:.0f} Hz," if above else ",")
+                   + " was not searched (raise stability.modes or move stability.target)")
+    elif st.modes is not None and len(case.modes) >= st.modes and above:
         out.append(f"stability.modes = {st.modes}: the modes found reach {top:.0f} Hz; the band above, up to "
-                   f"{st.band[1]:.0f} Hz, was not searched (raise stability.modes)")
+                   f"{hi:.0f} Hz, was not searched (raise stability.modes)")
     worst = float(np.nanmax(smap.residual)) if smap is not None and np.isfinite(smap.residual).any() else 0.0
     if worst > MAP_RESIDUAL:
         out.append(f"the stability map's modes have relative residuals up to {worst:.1e}: its frequencies and growth "
