@@ -19,8 +19,9 @@ import numpy as np
 from multiscale.errors import InputError
 from multiscale.io import on_root
 
-FORMAT = 3    # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns;
-#               3: the drive's state (speed, engagement, load last solved) and the area-weighted effusivity partition
+FORMAT = 4    # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns;
+#               3: the drive's state (speed, engagement, load last solved) and the area-weighted effusivity partition;
+#               4: the law_reach_halved history column, quadratic cells in the field files beside it
 
 
 def fingerprint(text: str) -> str:
