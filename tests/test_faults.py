@@ -118,7 +118,7 @@ def test_a_checkpoint_of_another_format_is_one_clear_error(stopped, tmp_path):
     with h5py.File(folder / "checkpoint.h5", "a") as h5:
         del h5.attrs["format"]                                  # as written before the format existed
     with pytest.raises(InputError, match=r"written by another version of multiscale \(checkpoint format 1, this "
-                                         r"one reads 3\); start again with --overwrite"):
+                                         r"one reads 4\); start again with --overwrite"):
         run(_with_folder(scene, folder), resume=True, verbose=False)
 
 
