@@ -411,3 +411,42 @@ loading.pressure = ["1 MPa", "2 MPa"]
     text = report(study, rows).read_text()
     assert "| max_pressure:max [Pa] | interface_force [N] |" in text
     assert any(p.suffix == ".png" for p in study.report_folder.iterdir())
+
+
+def test_a_terminated_study_ends_its_workers(tmp_path):
+    """SIGTERM to `multiscale study` (a batch time limit, `timeout`) kills the running workers and
+    exits 143; before, the driver died at once and its workers, each in a session of its own, ran on
+    orphaned (adversarial test)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    import time
+    path = write(tmp_path, 'name = "slow"\nproblem = "wear_steps"\nmetrics = ["area_fraction"]\n'
+                 '[fixed]\nn = 64\n[sweep]\nsteps = [100000, 100001]\n[run]\nprocesses = 2\n')
+    proc = subprocess.Popen([Path(sys.executable).with_name("multiscale"), "study", str(path)],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    workers = []
+    for _ in range(300):                            # the two workers' pids, from /proc
+        time.sleep(0.05)
+        workers = [int(p.name) for p in Path("/proc").iterdir() if p.name.isdigit()
+                   and b"multiscale.studies.worker" in _cmdline(p) and str(path.parent).encode() in _cmdline(p)]
+        if len(workers) == 2:
+            break
+    assert len(workers) == 2
+    proc.send_signal(signal.SIGTERM)
+    try:
+        assert proc.wait(timeout=30) == 128 + signal.SIGTERM
+        time.sleep(0.5)
+        assert [pid for pid in workers if _cmdline(Path(f"/proc/{pid}"))] == []
+    finally:
+        for pid in workers:                        # the old code's orphans
+            if _cmdline(Path(f"/proc/{pid}")):
+                os.kill(pid, signal.SIGKILL)
+
+
+def _cmdline(proc: Path) -> bytes:
+    try:
+        return (proc / "cmdline").read_bytes()
+    except OSError:
+        return b""

@@ -1,6 +1,7 @@
 """Running a study: each run without a record in a fresh worker process (``python -m
 multiscale.studies.worker``), ``[run] processes`` at a time, with timeouts; under ``mpiexec`` the
-runs are shared out over the ranks. A crash or timeout becomes a failed record."""
+runs are shared out over the ranks. A crash or timeout becomes a failed record; a study ended by
+SIGTERM or SIGHUP (a batch limit, ``timeout``, a closed terminal) kills its workers first."""
 from __future__ import annotations
 
 import json
@@ -8,6 +9,7 @@ import os
 import signal
 import subprocess
 import sys
+import threading
 import time
 from dataclasses import dataclass
 
@@ -69,6 +71,7 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
         bar = tqdm(total=len(mine), desc=study.name, unit="run")
     failed = 0
     queue, running = list(mine), {}
+    previous = _exit_on_termination()
     try:
         while queue or running:
             while queue and len(running) < study.options.processes:
@@ -94,11 +97,25 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     finally:
         for proc in running:
             _kill(proc)
+        for signum, handler in previous.items():
+            signal.signal(signum, handler)
         if bar is not None:
             bar.close()
     if comm is not None:
         failed = comm.allreduce(failed)
     return ExecStats(len(study.runs), len(study.runs) - len(todo), len(todo), failed, time.perf_counter() - start)
+
+
+def _exit_on_termination() -> dict:
+    """Make SIGTERM and SIGHUP a ``SystemExit(128 + signal)`` (so ``execute`` kills its workers,
+    each in a session of its own, before the driver ends: they ran on, orphaned); returns the
+    previous handlers ({} off the main thread)."""
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+
+    def stop(signum, frame):
+        raise SystemExit(128 + signum)
+    return {s: signal.signal(s, stop) for s in (signal.SIGTERM, signal.SIGHUP)}
 
 
 def _done(record, rerun_failed: bool) -> bool:
