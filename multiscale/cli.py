@@ -20,7 +20,7 @@ from multiscale.io import abort, ended_together
 from multiscale.micro.spectrum import surface_statistics
 from multiscale.micro.topography import (DETREND, MAX_UNDEFINED, TopographyWarning, condition, formats,
                                         read_topography)
-from multiscale.outputs import analysis, plan
+from multiscale.outputs import CHECKPOINT, analysis, plan
 from multiscale.outputs import summary as plan_summary
 from multiscale.scene import load
 from multiscale.scene_summary import cells_line, reference, summary
@@ -160,19 +160,23 @@ def _run(args) -> int:
         return 2
     except KeyboardInterrupt as exc:       # Ctrl-C (mpiexec hands SIGINT to every rank)
         if rank == 0:
-            print(f"interrupted {exc}".strip() + f": {_kept(scene, args.scene)}", file=sys.stderr, flush=True)
+            print(f"interrupted {exc}".strip() + f": {_kept(scene, args)}", file=sys.stderr, flush=True)
         if comm is not None and not ended_together(comm):
             abort(comm, INTERRUPTED)          # a rank was caught inside a collective operation
         return INTERRUPTED
     return 0
 
 
-def _kept(scene, path: str) -> str:
-    """What a run interrupted by Ctrl-C leaves (``scene``: None if it was still being read)."""
+def _kept(scene, args) -> str:
+    """What a run interrupted by Ctrl-C leaves (``scene``: None if it was still being read); --resume
+    is advised only with a checkpoint (before its first macro step ended it refused to resume)."""
     if scene is None:
         return "nothing was written"
-    how = (f"multiscale run {path} --resume continues from the last finished step" if analysis(scene) == "multiscale"
-           else f"multiscale run {path} --overwrite starts again")
+    if analysis(scene) == "multiscale" and not (Path(scene.output.folder) / CHECKPOINT).is_file():
+        return (f"no macro step ended, there is nothing to resume; multiscale run {args.scene}"
+                + (" --overwrite" if args.overwrite else "") + " starts again")
+    how = (f"multiscale run {args.scene} --resume continues from the last finished step"
+           if analysis(scene) == "multiscale" else f"multiscale run {args.scene} --overwrite starts again")
     return f"what was written stays in {scene.output.folder} (its provenance.json says so); {how}"
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+CHECKPOINT = "checkpoint.h5"      # a multiscale run's last macro step (``multiscale run --resume``)
 
 # output field (scene key output.fields) -> (array name in the field files, unit)
 FIELDS = {"displacement": ("displacement", "m"), "temperature": ("temperature", "K"),
@@ -124,7 +125,7 @@ def plan(scene) -> Plan:
         files["history.h5"] = "scalar history per step (forces, pressures, temperatures, heat), unit per dataset"
         files["history.png"] = "the history against time"
     if kind == "multiscale":
-        files["checkpoint.h5"] = "the last macro step's state (multiscale run --resume)"
+        files[CHECKPOINT] = "the last macro step's state (multiscale run --resume)"
         files["multiscale.png"] = "both scales of the loop against time: pressures, temperatures, partition, wear"
         files["zones.h5"] = "final state of every zone: centre, wear depth and volume, partition, conductance"
         if scene.has("wear"):

@@ -181,3 +181,27 @@ def test_field_times_after_the_checkpoint_are_dropped_and_written_once(base, tmp
     again = workflows.run(scene, resume=True, verbose=False)
     assert {f.name: f.read_bytes() for f in folder.iterdir()} == before
     assert sorted(f.name for f in again.files) == sorted(f.name for f in result.files) == sorted(plan(scene).files)
+
+
+def test_a_run_stopped_before_its_first_step_is_not_advised_to_resume(tmp_path, capsys, monkeypatch):
+    """Ctrl-C before the first macro step ended (no checkpoint) advises running again, not --resume;
+    a --resume there says why and leaves the folder as it was. Before: 'multiscale run --resume
+    continues', which then wrote a failed provenance and the scene copies into the empty folder,
+    so that the plain run was refused for those 3 entries (adversarial test)."""
+    from multiscale import workflows
+    from multiscale.cli import main
+    from multiscale.errors import InputError
+    folder = tmp_path / "out"
+    path = tmp_path / "scene.toml"
+    path.write_text(scene_text(folder))
+    folder.mkdir()                                    # as the interrupted run left it: empty
+    with pytest.raises(InputError, match="no checkpoint.h5 in the output folder to resume from"):
+        workflows.run(loads(path.read_text()), resume=True, verbose=False)
+    assert list(folder.iterdir()) == []
+
+    def interrupted(scene, **kw):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(workflows, "run", interrupted)
+    assert main(["run", str(path)]) == 130
+    err = capsys.readouterr().err
+    assert "no macro step ended, there is nothing to resume" in err and "--resume" not in err

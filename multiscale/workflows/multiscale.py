@@ -46,7 +46,7 @@ from multiscale.workflows.rough import (build_rough_interface, check_rough_scene
                                         thermal_kernels)
 from multiscale.workflows.transient import TransientResult, write_history
 
-CHECKPOINT = "checkpoint.h5"
+CHECKPOINT = outputs.CHECKPOINT
 
 
 @dataclass
@@ -129,11 +129,13 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     """
     start = _time.perf_counter()
     io.abort_on_exception(comm)
+    ckpt = Path(scene.output.folder) / CHECKPOINT
+    if resume and comm.bcast(ckpt.parent.is_dir() and not ckpt.is_file() if comm.rank == 0 else None, root=0):
+        raise InputError("--resume", str(ckpt.parent), f"no {CHECKPOINT} in the output folder to resume from (no "
+                         "macro step of a run ended there): run without --resume (with --overwrite if the folder "
+                         "holds results)")     # before the folder is claimed: it stays as it was
     out = prepare_folder(scene, overwrite, resume, comm)
     folder = out.path
-    ckpt = folder / CHECKPOINT
-    if resume and not comm.bcast(ckpt.is_file() if comm.rank == 0 else None, root=0):
-        raise InputError("--resume", str(folder), f"no {CHECKPOINT} in the output folder to resume from")
     stored = checkpoint.peek(ckpt, comm) if resume else {}
     if stored.get("finished"):
         checkpoint.same_scene(stored, fingerprint(scene), ckpt)
