@@ -1,6 +1,7 @@
 """Parametric studies (`multiscale study`): sweep expansion, resumable runs in fresh processes, errors
 against independent computations, failed and timed-out runs, clear errors for bad study files."""
 import csv
+import hashlib
 import json
 import math
 from pathlib import Path
@@ -284,6 +285,26 @@ loading.friction = [0.3, 0.4]
             "allowed: modes, unstable_modes, max_growth") in err
     assert not (tmp_path / "results").exists()
 
+
+def test_a_scene_study_run_is_named_by_the_files_its_scene_reads(tmp_path):
+    """A CAD file rewritten under its name makes new runs (before: the same keys, so the old
+    geometry's records were reused as 'recorded before'); a scene reading no file keeps its key."""
+    import shutil
+    (tmp_path / "cad").mkdir()
+    shutil.copy(ROOT / "demos" / "car_brake_stop.toml", tmp_path)
+    shutil.copy(ROOT / "demos" / "cad" / "car_brake.step", tmp_path / "cad")
+    path = write(tmp_path, 'problem = "scene"\nscene = "car_brake_stop.toml"\nmetrics = ["time"]\n'
+                 '[sweep]\nloading.friction = [0.3, 0.4]\n')
+    before = [r.key for r in load_study(path).runs]
+    with open(tmp_path / "cad" / "car_brake.step", "a") as f:
+        f.write("/* another disc */\n")
+    after = [r.key for r in load_study(path).runs]
+    assert len(set(before + after)) == 4
+    plain = scene_study(tmp_path, "block_on_flat.toml", 'metrics = ["time"]\n[sweep]\n"time.steps" = [1]\n')
+    scene = (ROOT / "demos" / "block_on_flat.toml").resolve()
+    ident = {"problem": "scene", "params": {"scene": str(scene), "overrides": {"time.steps": 1},
+                                            "scene_sha256": hashlib.sha256(scene.read_bytes()).hexdigest()}}
+    assert load_study(plain).runs[0].key == hashlib.sha256(json.dumps(ident, sort_keys=True).encode()).hexdigest()[:16]
 
 def test_shipped_study_files_are_valid():
     files = sorted((ROOT / "studies").glob("*/*.toml"))

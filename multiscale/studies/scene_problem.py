@@ -66,11 +66,13 @@ def _squeal(scene) -> bool:
 
 @dataclass(frozen=True)
 class SceneRun:
-    """A macro scene with overrides (dotted scene paths -> raw values) and MPI ranks per run."""
+    """A macro scene with overrides (dotted scene paths -> raw values) and MPI ranks per run;
+    ``files``: the other files it reads (geometry, measured surfaces), whose bytes name the run."""
 
     scene: Path
     overrides: dict = field(default_factory=dict)
     ranks: int = 1
+    files: tuple = ()
 
 
 class SceneProblem(Problem):
@@ -87,16 +89,20 @@ class SceneProblem(Problem):
 
     def parse(self, raw, path, ctx, scene=None, ranks=1):
         try:
-            load(scene, overrides=raw)
+            loaded = load(scene, overrides=raw)
         except SceneError as exc:
             ctx.problems.extend(f"{path}: {line}" if path else line for line in exc.problems)
             return None
-        return SceneRun(Path(scene), dict(raw), ranks)
+        own = Path(scene).resolve()
+        return SceneRun(Path(scene), dict(raw), ranks, tuple(sorted(p for p in loaded.inputs if p != own)))
 
     def key(self, params: SceneRun) -> dict:
+        """The scene's path and bytes, the overrides and the bytes of the files it reads (a CAD file
+        or measured surface rewritten under its name makes new runs; its old records were reused)."""
         text = params.scene.read_bytes()
+        files = {str(p): hashlib.sha256(p.read_bytes()).hexdigest() for p in params.files if p.is_file()}
         return {"scene": str(params.scene), "scene_sha256": hashlib.sha256(text).hexdigest(),
-                "overrides": jsonable(params.overrides)}
+                "overrides": jsonable(params.overrides), **({"files": files} if files else {})}
 
     def metric_unit(self, name: str) -> str:
         """A squeal metric's unit (``SQUEAL_METRICS``), else its history column's (``io.unit_of``)."""
