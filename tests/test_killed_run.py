@@ -205,3 +205,25 @@ def test_a_run_stopped_before_its_first_step_is_not_advised_to_resume(tmp_path, 
     assert main(["run", str(path)]) == 130
     err = capsys.readouterr().err
     assert "no macro step ended, there is nothing to resume" in err and "--resume" not in err
+
+
+def test_a_damaged_field_file_says_how_to_resume(tmp_path):
+    """A field file cut short (a run killed while writing it) is named with the way on: delete it to
+    resume without its fields, which then start at the next output time (before: only HDF5's
+    'truncated file: eof = ...' after 'cannot write the field files'; adversarial test)."""
+    from multiscale import workflows
+    from multiscale.errors import OutputError
+    from multiscale.workflows.multiscale import run
+    folder = tmp_path / "out"
+    scene = loads(scene_text(folder))
+    run(scene, verbose=False, stop_after=1)
+    size = (folder / "pin.h5").stat().st_size
+    with open(folder / "pin.h5", "r+b") as f:
+        f.truncate(size // 2)
+    with pytest.raises(OutputError, match=r"pin.h5 is damaged \(.*truncated.*\): delete it and pin.xdmf to resume"):
+        workflows.run(scene, resume=True, verbose=False)
+    for name in ("pin.h5", "pin.xdmf"):
+        (folder / name).unlink()
+    assert workflows.run(scene, resume=True, verbose=False).steps_done == 4
+    times = field_times(folder)
+    assert times["pin.xdmf"] == list(plan(scene).times[2:]) and times["disc.xdmf"] == list(plan(scene).times)

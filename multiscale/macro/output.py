@@ -165,7 +165,8 @@ class SeriesFile:
     def start(self, resume_at: float | None = None) -> None:
         """Create the files (rank 0), or with ``resume_at`` [s] continue those of a run resumed from
         a checkpoint at that time: the times after it, written by the run that was killed, are dropped
-        (the resumed run writes them again, once)."""
+        (the resumed run writes them again, once). A file that cannot be read (a run killed while
+        writing it) is an OSError saying how to go on (it said only what HDF5 found)."""
         if resume_at is None or not self.h5.is_file():
             with h5py.File(self.h5, "w") as f:
                 f.create_dataset("mesh/geometry", data=self.layout.geometry).attrs["unit"] = "m"
@@ -173,10 +174,15 @@ class SeriesFile:
                 f.create_dataset("times", data=np.zeros(0), maxshape=(None,)).attrs["unit"] = "s"
             self._write_xml()
             return
-        with h5py.File(self.h5, "r") as f:
-            if f["mesh/geometry"].shape != self.layout.geometry.shape:
-                raise OutputError(f"{self.h5} holds another mesh than this run's (resume with the same scene)")
-            times = f["times"][...]
+        try:
+            with h5py.File(self.h5, "r") as f:
+                shape, times = f["mesh/geometry"].shape, f["times"][...]
+        except (OSError, KeyError) as exc:
+            raise OSError(f"{self.h5.name} is damaged ({exc}; a run killed while writing it?): delete it and "
+                          f"{self.path.name} to resume without the fields it held, or start again with "
+                          "--overwrite") from None
+        if shape != self.layout.geometry.shape:
+            raise OutputError(f"{self.h5} holds another mesh than this run's (resume with the same scene)")
         keep = int(np.count_nonzero(times <= resume_at))
         if keep < len(times):
             with h5py.File(self.h5, "a") as f:
