@@ -203,9 +203,11 @@ def _study(args) -> int:
             print(f"interrupted: the runs that ended are recorded; {command} runs the others", file=sys.stderr,
                   flush=True)
         return INTERRUPTED
-    except OSError as exc:                   # a results or report folder that cannot be written
-        if isinstance(exc, MultiscaleError):
+    except MultiscaleError:                  # raised on every rank (running: collective): one speaks
+        if comm is None or comm.rank == 0:
             raise
+        return 2
+    except OSError as exc:                   # a results or report folder that cannot be written
         raise OutputError(f"cannot write {exc.filename}: {exc.strerror or exc}") from None
     return 1 if failed else 0
 

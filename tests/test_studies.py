@@ -366,6 +366,30 @@ def test_runs_are_shared_out_over_mpi_ranks(tmp_path):
     ranks = sorted(json.loads(p.read_text())["rank"] for p in (out / "runs").glob("*.json"))
     assert ranks == [0, 1]
     assert [r["status"] for r in table(out / "results.csv")] == ["ok"] * 2
+    # a study folder that cannot be made is one error on every rank (rank 1 waited for rank 0 for ever)
+    (tmp_path / "afile").write_text("")
+    path.write_text(path.read_text().replace("[run]", f'[run]\nfolder = "{tmp_path / "afile" / "sub"}"'))
+    done = subprocess.run([str(mpiexec), "-n", "2", sys.executable, "-m", "multiscale.cli", "study", str(path)],
+                          capture_output=True, text=True, env=env, timeout=60, start_new_session=True)
+    assert done.returncode == 2 and done.stderr.count("error: cannot write the study folder") == 1, done.stderr
+
+
+def test_a_study_folder_in_use_is_refused(tmp_path, capsys):
+    """A second study on the folder of one still running is refused, naming the holder (before: it
+    ran every run again beside the first, deleting the records the first had written; adversarial)."""
+    import fcntl
+    path = write(tmp_path, HERTZ + "plots = false\n")
+    runs = tmp_path / "results" / "hertz" / "runs"
+    runs.mkdir(parents=True)
+    with open(runs / ".lock", "a+") as held:          # as the first study holds it
+        fcntl.flock(held, fcntl.LOCK_EX)
+        held.write("4242")
+        held.flush()
+        assert main(["study", str(path)]) == 2
+        assert (f"error: {runs.parent} is in use by another multiscale study (process 4242): let it end"
+                in capsys.readouterr().err)
+    assert not list(runs.glob("*.json"))
+    assert main(["study", str(path)]) == 0              # released: it runs
 
 
 def test_squeal_scene_metrics_from_the_mode_table(tmp_path):

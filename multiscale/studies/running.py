@@ -4,6 +4,7 @@ runs are shared out over the ranks. A crash or timeout becomes a failed record; 
 SIGTERM or SIGHUP (a batch limit, ``timeout``, a closed terminal) kills its workers first."""
 from __future__ import annotations
 
+import fcntl
 import json
 import os
 import signal
@@ -15,6 +16,8 @@ from dataclasses import dataclass
 
 from tqdm import tqdm
 
+from multiscale.errors import MultiscaleError
+from multiscale.io import on_root
 from multiscale.studies.expand import Study, StudyRun
 from multiscale.studies.formatting import now
 from multiscale.studies.records import FAILED, json_default, read_records, record_path, write_json
@@ -59,10 +62,7 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     round-robin over its ranks (collective)."""
     start = time.perf_counter()
     rank, size = (comm.rank, comm.size) if comm is not None else (0, 1)
-    if rank == 0:
-        (study.folder / "runs").mkdir(parents=True, exist_ok=True)
-    if comm is not None:
-        comm.barrier()
+    lock = _claim(study, comm)
     records = read_records(study)
     todo = [r for r in study.runs if not _done(records.get(r.key), rerun_failed)]
     mine = todo[rank::size]
@@ -99,11 +99,43 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
             _kill(proc)
         for signum, handler in previous.items():
             signal.signal(signum, handler)
+        if lock is not None:
+            lock.close()                     # releases the folder
         if bar is not None:
             bar.close()
     if comm is not None:
         failed = comm.allreduce(failed)
     return ExecStats(len(study.runs), len(study.runs) - len(todo), len(todo), failed, time.perf_counter() - start)
+
+
+def _claim(study: Study, comm):
+    """Create the study's ``runs/`` folder and hold its lock (rank 0; collective): a second study on
+    the same folder at the same time is refused (it ran every run again beside the first, each
+    deleting the other's records as it started them, with doubled wall times). Returns the open
+    lock file (None on the other ranks); a folder that cannot be made is an OutputError on every
+    rank (under mpiexec the other ranks waited for rank 0 for ever)."""
+    held = []
+
+    def claim():
+        (study.folder / "runs").mkdir(parents=True, exist_ok=True)
+        lock = open(study.folder / "runs" / ".lock", "a+")
+        try:
+            fcntl.flock(lock, fcntl.LOCK_EX | fcntl.LOCK_NB)
+        except BlockingIOError:
+            lock.seek(0)
+            owner = lock.read().strip()
+            lock.close()
+            return (f"{study.folder} is in use by another multiscale study (process {owner or '?'}): let it end, "
+                    "then run this one (its finished runs are not run again), or give this one another [run] folder")
+        lock.truncate(0)
+        lock.write(str(os.getpid()))
+        lock.flush()
+        held.append(lock)
+        return None
+    busy = claim() if comm is None else comm.bcast(on_root(comm, claim, f"the study folder {study.folder}"), root=0)
+    if busy:
+        raise MultiscaleError(busy)
+    return held[0] if held else None
 
 
 def _exit_on_termination() -> dict:
