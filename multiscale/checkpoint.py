@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import hashlib
 import os
+import shutil
 from pathlib import Path
 
 import h5py
@@ -117,11 +118,22 @@ def load(path, comm, functions: dict) -> tuple[dict, dict]:
 
 def mark(path, comm, **attrs) -> None:
     """Set scalar attributes of the checkpoint ``path`` (e.g. the last step whose fields are
-    written, or that the run finished); outside the checksum, which covers the data (collective)."""
+    written, or that the run finished); outside the checksum, which covers the data (collective).
+    All or nothing: a copy is marked and replaces the checkpoint (HDF5 edits in place are not
+    crash-safe: a run killed while its only checkpoint was being edited could lose it)."""
+    path = Path(path)
+
     def write():
-        with h5py.File(path, "r+") as h5:
-            for key, value in attrs.items():
-                h5.attrs[key] = value
+        tmp = path.with_name(path.name + ".tmp")
+        try:
+            shutil.copyfile(path, tmp)
+            with h5py.File(tmp, "r+") as h5:
+                for key, value in attrs.items():
+                    h5.attrs[key] = value
+            os.replace(tmp, path)
+        except OSError:
+            tmp.unlink(missing_ok=True)
+            raise
     on_root(comm, write, f"the checkpoint {path}")
 
 

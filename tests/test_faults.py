@@ -7,6 +7,7 @@ import sys
 import time
 from pathlib import Path
 
+import numpy as np
 import pytest
 
 pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
@@ -305,3 +306,31 @@ def test_an_interrupt_is_recognised_through_the_errors_it_caused():
     looped.__context__ = plain
     plain.__context__ = looped
     assert not interrupted(plain) and not interrupted(ValueError()) and interrupted(KeyboardInterrupt())
+
+
+def test_marking_a_checkpoint_is_all_or_nothing(tmp_path, monkeypatch):
+    """``checkpoint.mark`` edits a copy and replaces the file: a failure while the attributes are
+    written (here at the second) leaves the checkpoint as it was. It edited the only checkpoint in
+    place, where a run killed mid-edit could leave it half written (an adversarial review)."""
+    import h5py
+    from mpi4py import MPI
+
+    from multiscale import checkpoint as ckpt
+    from multiscale.errors import OutputError
+    path = ckpt.save(tmp_path / "checkpoint.h5", MPI.COMM_SELF, attrs={"step": 3, "fields_written": 2},
+                     arrays={"x": np.arange(4.0)}, functions={})
+    before = path.read_bytes()
+    setitem = h5py.AttributeManager.__setitem__
+
+    def failing(self, key, value):
+        if key == "finished":
+            raise OSError(28, "No space left on device")
+        setitem(self, key, value)
+    monkeypatch.setattr(h5py.AttributeManager, "__setitem__", failing)
+    with pytest.raises(OutputError, match="cannot write the checkpoint"):
+        ckpt.mark(path, MPI.COMM_SELF, fields_written=3, finished=True)
+    assert path.read_bytes() == before and not path.with_name("checkpoint.h5.tmp").exists()
+    monkeypatch.setattr(h5py.AttributeManager, "__setitem__", setitem)
+    ckpt.mark(path, MPI.COMM_SELF, fields_written=3, finished=True)
+    attrs, arrays = ckpt.load(path, MPI.COMM_SELF, {})
+    assert (attrs["fields_written"], bool(attrs["finished"]), list(arrays["x"])) == (3, True, [0, 1, 2, 3])
