@@ -4,6 +4,7 @@ import csv
 import hashlib
 import json
 import math
+import time
 from pathlib import Path
 
 import h5py
@@ -462,32 +463,68 @@ def test_a_terminated_study_ends_its_workers(tmp_path):
     """SIGTERM to `multiscale study` (a batch time limit, `timeout`) kills the running workers and
     exits 143; before, the driver died at once and its workers, each in a session of its own, ran on
     orphaned (adversarial test)."""
-    import os
     import signal
+    proc, workers = _slow_study(tmp_path)
+    try:
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=30) == 128 + signal.SIGTERM
+        time.sleep(0.5)
+        assert [pid for pid in workers if _cmdline(Path(f"/proc/{pid}"))] == []
+    finally:
+        _end(proc, workers)
+
+
+def test_a_study_under_nohup_outlives_its_terminal(tmp_path):
+    """A study started with SIGHUP ignored (`nohup multiscale study ... &`, then the terminal
+    closed) runs on, workers and all; SIGTERM still ends it and them. Before, the driver's SIGTERM
+    and SIGHUP handler replaced nohup's SIG_IGN: the closed terminal killed the workers and ended
+    the study with 129."""
+    import signal
+    proc, workers = _slow_study(tmp_path, preexec_fn=lambda: signal.signal(signal.SIGHUP, signal.SIG_IGN))
+    try:
+        proc.send_signal(signal.SIGHUP)
+        time.sleep(1.0)
+        assert proc.poll() is None and all(_cmdline(Path(f"/proc/{pid}")) for pid in workers)
+        proc.send_signal(signal.SIGTERM)
+        assert proc.wait(timeout=30) == 128 + signal.SIGTERM
+        time.sleep(0.5)
+        assert [pid for pid in workers if _cmdline(Path(f"/proc/{pid}"))] == []
+    finally:
+        _end(proc, workers)
+
+
+def _slow_study(tmp_path, **popen):
+    """`multiscale study` of two long wear_steps runs in a process of its own, and its two workers'
+    pids (from /proc) once both run."""
     import subprocess
     import sys
-    import time
     path = write(tmp_path, 'name = "slow"\nproblem = "wear_steps"\nmetrics = ["area_fraction"]\n'
                  '[fixed]\nn = 64\n[sweep]\nsteps = [100000, 100001]\n[run]\nprocesses = 2\n')
     proc = subprocess.Popen([Path(sys.executable).with_name("multiscale"), "study", str(path)],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, **popen)
     workers = []
-    for _ in range(300):                            # the two workers' pids, from /proc
+    for _ in range(300):
         time.sleep(0.05)
         workers = [int(p.name) for p in Path("/proc").iterdir() if p.name.isdigit()
                    and b"multiscale.studies.worker" in _cmdline(p) and str(path.parent).encode() in _cmdline(p)]
         if len(workers) == 2:
             break
+    if len(workers) != 2:
+        _end(proc, workers)
     assert len(workers) == 2
-    proc.send_signal(signal.SIGTERM)
-    try:
-        assert proc.wait(timeout=30) == 128 + signal.SIGTERM
-        time.sleep(0.5)
-        assert [pid for pid in workers if _cmdline(Path(f"/proc/{pid}"))] == []
-    finally:
-        for pid in workers:                        # the old code's orphans
-            if _cmdline(Path(f"/proc/{pid}")):
-                os.kill(pid, signal.SIGKILL)
+    return proc, workers
+
+
+def _end(proc, workers) -> None:
+    """Kill what a failed test left running: the driver, then its workers (orphans of the old code)."""
+    import os
+    import signal
+    if proc.poll() is None:
+        proc.kill()
+        proc.wait()
+    for pid in workers:
+        if _cmdline(Path(f"/proc/{pid}")):
+            os.kill(pid, signal.SIGKILL)
 
 
 def _cmdline(proc: Path) -> bytes:

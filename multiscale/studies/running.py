@@ -141,13 +141,15 @@ def _claim(study: Study, comm):
 def _exit_on_termination() -> dict:
     """Make SIGTERM and SIGHUP a ``SystemExit(128 + signal)`` (so ``execute`` kills its workers,
     each in a session of its own, before the driver ends: they ran on, orphaned); returns the
-    previous handlers ({} off the main thread)."""
+    previous handlers ({} off the main thread). A signal ignored when the study started stays
+    ignored: ``nohup multiscale study`` outlives its terminal, workers and all."""
     if threading.current_thread() is not threading.main_thread():
         return {}
 
     def stop(signum, frame):
         raise SystemExit(128 + signum)
-    return {s: signal.signal(s, stop) for s in (signal.SIGTERM, signal.SIGHUP)}
+    return {s: signal.signal(s, stop) for s in (signal.SIGTERM, signal.SIGHUP)
+            if signal.getsignal(s) is not signal.SIG_IGN}
 
 
 def _done(record, rerun_failed: bool) -> bool:
