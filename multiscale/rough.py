@@ -159,8 +159,9 @@ class RoughInterface:
         return self.spec.p_max / 2.0 ** self.levels
 
     def law_reach(self, pressure: np.ndarray, ids) -> tuple[float, float]:
-        """Largest zone pressure [Pa, per zone] over the top of its law among the zones ``ids``: over
-        those with the full p_max, and over those whose law failed (a halved top); 0 if none."""
+        """Largest ratio [-] of a zone's pressure (``pressure`` [Pa] per zone) to the top of its law
+        among the zones ``ids``: over those with the full p_max, and over those whose law failed (a
+        halved top); 0 if none."""
         reach = pressure[ids] / self.law_top[ids]
         halved = self.levels[ids] > 0
         return float(reach[~halved].max(initial=0.0)), float(reach[halved].max(initial=0.0))

@@ -63,16 +63,15 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     start = time.perf_counter()
     rank, size = (comm.rank, comm.size) if comm is not None else (0, 1)
     lock = _claim(study, comm)
-    records = read_records(study)
-    todo = [r for r in study.runs if not _done(records.get(r.key), rerun_failed)]
-    mine = todo[rank::size]
-    bar = None
-    if progress and rank == 0 and mine:
-        bar = tqdm(total=len(mine), desc=study.name, unit="run")
-    failed = 0
-    queue, running = list(mine), {}
-    previous = _exit_on_termination()
-    try:
+    bar, failed, running, previous = None, 0, {}, {}
+    try:                                     # the lock is released whatever happens from here
+        records = read_records(study)
+        todo = [r for r in study.runs if not _done(records.get(r.key), rerun_failed)]
+        mine = todo[rank::size]
+        if progress and rank == 0 and mine:
+            bar = tqdm(total=len(mine), desc=study.name, unit="run")
+        queue = list(mine)
+        previous = _exit_on_termination()
         while queue or running:
             while queue and len(running) < study.options.processes:
                 run = queue.pop(0)
