@@ -305,7 +305,8 @@ class Loading:
     """Normal load (force or pressure on the load faces), sliding speed, friction, duty cycle.
 
     The load acts on ``faces`` (default: the builder's load faces; required for geometry files,
-    where it is a pressure normal to each face, -p n, and a force is spread as a uniform pressure;
+    where it is a pressure normal to each face, -p n, and a force is spread as a uniform pressure
+    whose resultants on the faces sum to it (a curved face counts with its projected area);
     with ``direction`` a traction along it whose resultant is the force, or the pressure itself).
     ``normal_force`` is the total over all the load faces: a piston face and the caliper's fingers
     given 4000 N take 2000 N each when their areas are equal (give the clamp force times the number

@@ -603,3 +603,33 @@ rotation_speed = "1 rpm"
     err = capsys.readouterr().err
     assert "every volume must belong to a body; not assigned: volume" in err
     assert "(the file's solids [1, 2] overlap: gmsh cut them into pieces where they intersect" in err
+
+
+# a pin with a hemispherical top (radius 10 mm) on a disc, loaded on the dome; lengths in metres
+DOME_GEO = """SetFactory("OpenCASCADE");
+Cylinder(1) = {0, 0, 0, 0, 0, 0.010, 0.100};
+Cylinder(2) = {0, 0, 0, 0, 0, 0.010, 0.040};
+BooleanDifference(3) = { Volume{1}; Delete; }{ Volume{2}; Delete; };
+Cylinder(4) = {0, 0.080, 0.010, 0, 0, 0.008, 0.010};
+Sphere(5) = {0, 0.080, 0.018, 0.010, 0, Pi/2, 2*Pi};
+BooleanUnion(6) = { Volume{4}; Delete; }{ Volume{5}; Delete; };"""
+
+
+def test_a_force_on_a_curved_load_face_is_the_force_the_contact_carries(tmp_path):
+    """A normal force on a geometry file's faces is spread as a uniform pressure -p n whose
+    resultant is the force: p = F / (pi R^2) on a hemisphere of radius R, its projected area
+    (the resultant of a uniform pressure on a surface is p int n dA). Before, p = F / (2 pi R^2),
+    its area, and the contact carried 509 N of the 1000 N asked, silently."""
+    (tmp_path / "dome.geo").write_text(DOME_GEO)
+    text = (TWO_PADS.replace('"twopads.geo"', '"dome.geo"').replace('unit = "mm"', 'unit = "m"')
+            .replace('effects = ["contact", "friction", "thermal", "heat_partition"]', 'effects = ["contact"]')
+            .replace('interface_mesh_size = "5 mm"', 'interface_mesh_size = "4 mm"')
+            .replace('[geometry.bodies.pad_b]\ncontains = ["0 mm", "-80 mm", "14 mm"]\nmaterial = "pad"\n', "")
+            .replace('contains = [["0 mm", "80 mm", "18 mm"], ["0 mm", "-80 mm", "18 mm"]]',
+                     'contains = ["0 mm", "80 mm", "28 mm"]')
+            .replace('contains = [["-10 mm", "80 mm", "14 mm"], ["10 mm", "80 mm", "14 mm"], ["-10 mm", "-80 mm", '
+                     '"14 mm"], ["10 mm", "-80 mm", "14 mm"]]', 'contains = ["10 mm", "80 mm", "14 mm"]')
+            .replace('rotation_speed = "300 rpm"\nfriction = 0.4', 'rotation_speed = "0 rpm"')
+            .replace('{folder}', str(tmp_path / "out")))
+    h = run(loads(text, tmp_path), verbose=False).history
+    assert h["interface_force"][-1] == pytest.approx(1000.0, rel=1e-6)

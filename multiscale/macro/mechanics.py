@@ -91,10 +91,28 @@ class SolveResult:
     max_pressure: float = 0.0      # Pa, largest per-facet mean pressure
 
 
+def load_face_areas(tm: TwoBodyMesh, load_kind: str) -> dict:
+    """Area [m^2] of each load face whose product with a pressure is the face's resultant: the
+    face area for a traction along the load direction; for a fluid pressure (traction -p n) the
+    length of its vector area |int n dA|, the area projected normal to the resultant (a flat face:
+    its area; a hemisphere of radius R: pi R^2, not 2 pi R^2; 0 where the normals cancel to within
+    1e-9 of the area, e.g. a whole cylinder wall)."""
+    out = {}
+    for f in tm.spec.load_faces:
+        ds = tm.ds(tm.face(f))
+        area = tm.assemble_scalar(1.0 * ds)
+        if load_kind == "fluid":
+            n = ufl.FacetNormal(tm.parent)
+            vector = np.linalg.norm([tm.assemble_scalar(n[i] * ds) for i in range(3)])
+            area = float(vector) if vector > 1e-9 * area else 0.0
+        out[f] = area
+    return out
+
+
 def load_face_forces(tm: TwoBodyMesh, load: float, load_kind: str) -> dict:
     """Resultant [N] of the load on each load face: its area's share of a force ``load`` [N]
-    (``load_kind="force"``), or the (fluid) pressure ``load`` [Pa] times the face area."""
-    area = {f: tm.assemble_scalar(1.0 * tm.ds(tm.face(f))) for f in tm.spec.load_faces}
+    (``load_kind="force"``), or the (fluid) pressure ``load`` [Pa] times its ``load_face_areas``."""
+    area = load_face_areas(tm, load_kind)
     total = sum(area.values())
     return {f: float(load) * (a / total if load_kind == "force" else a) for f, a in area.items()}
 

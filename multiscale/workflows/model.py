@@ -11,7 +11,8 @@ The rules that more than one analysis follows live here once:
 - friction coefficient of an interface: its [interfaces.<name>] ``friction``, else
   ``loading.friction``, with effect ``friction``; else 0;
 - load: a fluid pressure -p n for builders that declare ``fluid_load`` and for geometry files (a
-  normal force spread as the uniform pressure F / A of the load faces; with ``loading.direction``
+  normal force spread as the uniform pressure F / A, A the load faces' areas projected normal to
+  each face's resultant, ``load_face_areas``; with ``loading.direction``
   a traction along it), else the scene's normal force [N] or pressure [Pa] on the load faces; with
   ``loading.vehicle.mass`` the load whose friction moment about the axis is the braking torque
   (braking force x wheel radius): first guessed with every interface carrying the same clamp
@@ -33,7 +34,7 @@ from multiscale.errors import InputError
 from multiscale.geometry import GeometrySpec, Rotation, Support
 from multiscale.macro import mesh as two_body
 from multiscale.macro.interface import PenaltyLaw, SumLaw
-from multiscale.macro.mechanics import Mechanics, load_face_forces
+from multiscale.macro.mechanics import Mechanics, load_face_areas, load_face_forces
 from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import Thermal, ThermalBoundary, temperature_functions
 
@@ -108,7 +109,11 @@ def drive(scene, tm) -> Drive:
         torque = vehicle.braking_force * vehicle.wheel_radius
         force = len(radius) * torque / moment          # a first guess: the model scales it to the torque
     if force is not None and kind != "force":          # a force as a uniform pressure on the load faces
-        area = sum(tm.assemble_scalar(1.0 * tm.ds(tm.face(f))) for f in tm.spec.load_faces)
+        area = sum(load_face_areas(tm, kind).values())  # with that resultant (a fluid's: projected areas)
+        if not area > 0:
+            raise InputError("loading.faces", list(tm.spec.load_faces), "a pressure on them has no resultant "
+                             "(their normals cancel), so no normal force can act there: load faces that push "
+                             "the parts towards the contact, or loading.pressure")
         load = force / area
     else:
         load = force if force is not None else ld.pressure
