@@ -310,6 +310,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                      if key.endswith("mesh_size") and isinstance(given.get(key), (int, float))
                      and size > g.spec.length_scale]
         problems += _hardness_checks(scene, g, raw, effects)
+        warnings += _penalty_warnings(scene, g, effects)
         if "wear" in effects and scene.wear is not None and scene.materials is not None and not problems:
             rough = {scene.geometry.spec.interface_materials(n)[0] for n in scene.geometry.spec.interfaces}
             given = [k for k in ("k_w", "k_w_table") if getattr(scene.wear, k) is not None]
@@ -377,6 +378,34 @@ def _hardness_checks(scene: Scene, g: Geometry, raw: dict, effects) -> list[str]
             problems.append(f'materials.{sides[0]}.hardness: missing; effect "plasticity" needs the hardness of '
                             f'the softer body of interface "{name}" ({" or ".join(sides)})')
     return problems
+
+
+def _penalty_warnings(scene: Scene, g: Geometry, effects) -> list[str]:
+    """A perfect-contact penalty K_n [Pa/m] below E*/h on an interface, E* the contact modulus of its
+    two materials at the initial temperature, 1/E* = (1 - nu_0^2)/E_0 + (1 - nu_1^2)/E_1 (Johnson
+    1985, Eq. 4.22), and h its element size [m]: the penetration p/K_n then exceeds the elastic
+    deflection p h/E* over an element, and the displacements and pressure peaks follow the penalty
+    (block on flat, 4 GPa, h 2.5 mm: the top moves 2.27 um with 1e12 Pa/m, 1.27 um converged; a
+    steel punch on a 21 MPa flat peaks at 3.6 MPa with 1e11 Pa/m, 5.2 MPa converged)."""
+    K, sizes = scene.interface.penalty if scene.interface is not None else None, g.resolved()
+    h = sizes.get("interface_mesh_size") or sizes.get("mesh_size")
+    if "contact" not in effects or K is None or h is None or scene.materials is None or scene.time is None:
+        return []
+    out = []
+    for name in g.spec.interfaces:
+        try:
+            if name in scene.rough_interfaces:
+                continue
+            sides = [scene.materials[m].at(scene.time.initial_temperature) for m in g.spec.interface_materials(name)]
+            modulus = 1.0 / sum((1.0 - m.nu ** 2) / m.E for m in sides)
+        except (AttributeError, KeyError, StopIteration, TypeError):   # a partial scene: reported elsewhere
+            continue
+        if K < modulus / h:
+            out.append(f"interface.penalty = {K:g} Pa/m is softer than the bodies at interface {name}: E*/h = "
+                       f"{modulus / h:.3g} Pa/m (contact modulus E* = {modulus:.3g} Pa, element size h = {h:g} m), "
+                       "so the penetration p/K_n exceeds their elastic deflection and the displacements and "
+                       "pressure peaks follow the penalty; perfect contact needs K_n well above E*/h")
+    return out
 
 
 def _nyquist(scene: Scene) -> list[str]:
