@@ -615,13 +615,10 @@ Sphere(5) = {0, 0.080, 0.018, 0.010, 0, Pi/2, 2*Pi};
 BooleanUnion(6) = { Volume{4}; Delete; }{ Volume{5}; Delete; };"""
 
 
-def test_a_force_on_a_curved_load_face_is_the_force_the_contact_carries(tmp_path):
-    """A normal force on a geometry file's faces is spread as a uniform pressure -p n whose
-    resultant is the force: p = F / (pi R^2) on a hemisphere of radius R, its projected area
-    (the resultant of a uniform pressure on a surface is p int n dA). Before, p = F / (2 pi R^2),
-    its area, and the contact carried 509 N of the 1000 N asked, silently."""
+def dome(tmp_path) -> str:
+    """The scene of DOME_GEO: 1000 N on the dome ("backs"), the pin's wall ("sides") held in x and y."""
     (tmp_path / "dome.geo").write_text(DOME_GEO)
-    text = (TWO_PADS.replace('"twopads.geo"', '"dome.geo"').replace('unit = "mm"', 'unit = "m"')
+    return (TWO_PADS.replace('"twopads.geo"', '"dome.geo"').replace('unit = "mm"', 'unit = "m"')
             .replace('effects = ["contact", "friction", "thermal", "heat_partition"]', 'effects = ["contact"]')
             .replace('interface_mesh_size = "5 mm"', 'interface_mesh_size = "4 mm"')
             .replace('[geometry.bodies.pad_b]\ncontains = ["0 mm", "-80 mm", "14 mm"]\nmaterial = "pad"\n', "")
@@ -631,5 +628,24 @@ def test_a_force_on_a_curved_load_face_is_the_force_the_contact_carries(tmp_path
                      '"14 mm"], ["10 mm", "-80 mm", "14 mm"]]', 'contains = ["10 mm", "80 mm", "14 mm"]')
             .replace('rotation_speed = "300 rpm"\nfriction = 0.4', 'rotation_speed = "0 rpm"')
             .replace('{folder}', str(tmp_path / "out")))
-    h = run(loads(text, tmp_path), verbose=False).history
+
+
+def test_a_force_on_a_curved_load_face_is_the_force_the_contact_carries(tmp_path):
+    """A normal force on a geometry file's faces is spread as a uniform pressure -p n whose
+    resultant is the force: p = F / (pi R^2) on a hemisphere of radius R, its projected area
+    (the resultant of a uniform pressure on a surface is p int n dA). Before, p = F / (2 pi R^2),
+    its area, and the contact carried 509 N of the 1000 N asked, silently."""
+    h = run(loads(dome(tmp_path), tmp_path), verbose=False).history
     assert h["interface_force"][-1] == pytest.approx(1000.0, rel=1e-6)
+
+
+def test_a_pressure_on_a_face_without_resultant_is_refused(tmp_path):
+    """A fluid pressure on the pin's cylindrical wall pushes it sideways into its supports: its
+    normals cancel, so it has no resultant towards the contact. Before, 1 MPa there ran without a
+    word (the carried-load check skipped fluid loads), the contact carrying 2.4 N, the faceted
+    wall's vector area times p; a force there is refused before the solve."""
+    wall = dome(tmp_path).replace('faces = ["backs"]', 'faces = ["sides"]')
+    with pytest.raises(InputError, match=r"the contact carries 2.43 N of the 0 N applied: a support takes the load"):
+        run(loads(wall.replace('normal_force = "1000 N"', 'pressure = "1 MPa"'), tmp_path), verbose=False)
+    with pytest.raises(InputError, match=r"a pressure on them has no resultant \(their normals cancel\)"):
+        run(loads(wall, tmp_path), verbose=False)

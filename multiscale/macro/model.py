@@ -113,14 +113,15 @@ class MacroModel:
         self.contact.engaged.value = float(self.drive.factor(0.0) > 0)
         self.solved_speed = float(self.contact.speed.value)
         mech = self.mechanics
-        if mech.load_kind != "fluid":          # (a fluid's tractions on facing faces cancel: not checked)
-            applied = sum(load_face_forces(self.tm, float(mech.load.value), mech.load_kind).values())
-            carried = self.last_solve.normal_force
-            if carried < CARRIED * applied:
-                raise InputError("loading.faces", list(self.tm.spec.load_faces),
-                                 f"the contact carries {carried:.3g} N of the {applied:.3g} N applied: a support "
-                                 "takes the load (load a face of a body that the supports leave free to move "
-                                 "towards the contact; loading.direction along the contact normal)")
+        # the sum of the faces' resultants' magnitudes (a fluid's on facing faces do not cancel)
+        applied = sum(load_face_forces(self.tm, float(mech.load.value), mech.load_kind).values())
+        carried = self.last_solve.normal_force
+        if not applied > 0 or carried < CARRIED * applied:
+            raise InputError("loading.faces", list(self.tm.spec.load_faces),
+                             f"the contact carries {carried:.3g} N of the {applied:.3g} N applied: a support "
+                             "takes the load (load a face of a body that the supports leave free to move "
+                             "towards the contact; loading.direction along the contact normal; a pressure "
+                             "normal to a face whose normals cancel, a cylinder's wall, has no resultant)")
         return self.last_solve
 
     def macro_step(self, dt: float, substeps: int = 1) -> np.ndarray:

@@ -113,7 +113,7 @@ def drive(scene, tm) -> Drive:
         if not area > 0:
             raise InputError("loading.faces", list(tm.spec.load_faces), "a pressure on them has no resultant "
                              "(their normals cancel), so no normal force can act there: load faces that push "
-                             "the parts towards the contact, or loading.pressure")
+                             "the parts towards the contact")
         load = force / area
     else:
         load = force if force is not None else ld.pressure
