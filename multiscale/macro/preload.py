@@ -38,7 +38,7 @@ class Preload:
     friction: dict           # friction coefficient mu [-] per interface name (its facets' mean)
     normal_force: dict       # N, per interface name: integral of p_n
     friction_force: dict     # N, per interface name: resultant of mu p_n s (3-vector)
-    load_force: dict         # N, per load face: pressure times the face area (its share of a force load)
+    load_force: dict         # N, per load face: its resultant (``load_face_forces``; a share of a force load)
     max_pressure: float      # Pa, largest per-facet mean contact pressure
     iterations: int          # Newton iterations of the last load step
     residuals: list          # residual norms of the last load step
