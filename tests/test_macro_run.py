@@ -238,6 +238,17 @@ def test_a_solve_starting_next_to_its_answer_converges(tmp_path):
         assert mech.solve(load).normal_force == pytest.approx(load, rel=1e-9)
 
 
+def test_a_stiff_pin_carried_far_by_a_soft_disc_converges_at_the_round_off_floor(tmp_path):
+    """``mechanics.ROUNDOFF``: a steel pin on a 500 MPa (polymer) disc, which bends by mm under
+    200 N: the residual stalls at its round-off, ~0.65 eps ||diag(K) x|| (sums of K_ij x_j with
+    terms up to K_ii x_i), above the absolute tolerance from the load; the solve is accepted
+    there and carries its load (before, a ConvergenceError after 30 iterations at 1.08e-8 N)."""
+    text = pin_on_disc(tmp_path / "out", effects=("contact", "friction"))
+    text = text.replace('E = "220 GPa"', 'E = "500 MPa"').replace('E = "5 GPa"', 'E = "220 GPa"')
+    mech = build_model(loads(text)).mechanics
+    assert mech.solve(200.0).normal_force == pytest.approx(200.0, rel=1e-9)
+
+
 def test_a_material_table_is_judged_by_the_temperatures_of_its_own_cells(tmp_path):
     """The pin body holds the pin material and the steel ("disc") holder: a disc table ending at
     300 degC is left by the pin material's 644 degC, not by any disc-material cell (213 degC in
