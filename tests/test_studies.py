@@ -463,15 +463,8 @@ def test_a_terminated_study_ends_its_workers(tmp_path):
     """SIGTERM to `multiscale study` (a batch time limit, `timeout`) kills the running workers and
     exits 143; before, the driver died at once and its workers, each in a session of its own, ran on
     orphaned (adversarial test)."""
-    import signal
     proc, workers = _slow_study(tmp_path)
-    try:
-        proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=30) == 128 + signal.SIGTERM
-        time.sleep(0.5)
-        assert [pid for pid in workers if _cmdline(Path(f"/proc/{pid}"))] == []
-    finally:
-        _end(proc, workers)
+    _terminated(proc, workers)
 
 
 def test_a_study_under_nohup_outlives_its_terminal(tmp_path):
@@ -485,6 +478,14 @@ def test_a_study_under_nohup_outlives_its_terminal(tmp_path):
         proc.send_signal(signal.SIGHUP)
         time.sleep(1.0)
         assert proc.poll() is None and all(_cmdline(Path(f"/proc/{pid}")) for pid in workers)
+    finally:
+        _terminated(proc, workers)
+
+
+def _terminated(proc, workers):
+    """SIGTERM ends the study ``proc`` with 143 and its ``workers`` with it (both killed in any case)."""
+    import signal
+    try:
         proc.send_signal(signal.SIGTERM)
         assert proc.wait(timeout=30) == 128 + signal.SIGTERM
         time.sleep(0.5)
