@@ -7,7 +7,8 @@ integer powers with ``^``, ``**`` or superscripts (``kg/m^3``, ``m²/s``, ``1/K`
 G M k c m u µ n p apply to m g s N Pa bar W J Hz rad; ``gn`` is the standard gravity
 (9.80665 m/s²), ``t`` the tonne, ``in`` the inch. The angle is its own dimension (so "rpm"
 and "Hz" are not confused): ``rad``, ``deg``, ``rev``; ``rpm`` = rev/min. ``degC`` alone is an
-absolute temperature (+273.15 K); inside a compound unit (``1/degC``) it is a kelvin. ``%`` is
+absolute temperature (+273.15 K); inside a compound unit (``1/degC``) it is a kelvin, and a
+compound unit of temperature with it (``(degC)``, ``degC^1``) is refused. ``%`` is
 0.01. Temperatures must carry their unit (a bare 20 would be 20 K).
 """
 from __future__ import annotations
@@ -214,6 +215,9 @@ def parse_unit(text: str) -> tuple[Fraction, Fraction, tuple[int, ...]]:
     factor, dim = parser.expr()
     if parser.i != len(parser.tokens):
         raise UnitError(f'cannot read unit "{text}" at "{parser.peek()[1]}"')
+    if dim == TH and any(tok in _ABSOLUTE for _, tok in parser.tokens):   # "(degC)" would be a kelvin
+        raise UnitError(f'write a temperature in degrees Celsius as "<number> degC" (the unit "{text}" '
+                        "would read degC as a kelvin, without the 273.15)")
     return factor, _F(0), dim
 
 

@@ -105,6 +105,8 @@ def test_unit_strings_to_si(text, kind, expected):
     ("3 m^x", "length", "exponent must be an integer"),
     (True, "length", "got a bool"),
     (float("inf"), "length", "finite"),
+    ("20 (degC)", "temperature", 'as "<number> degC"'),      # was 20 K: degC read as a kelvin
+    ("20 °C¹", "temperature", 'as "<number> degC"'),
 ])
 def test_unit_errors_say_what_is_expected(text, kind, fragment):
     with pytest.raises(UnitError, match=None) as info:
