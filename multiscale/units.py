@@ -102,6 +102,10 @@ _ABSOLUTE = {"degC": _F("273.15"), "°C": _F("273.15")}   # offsets of a whole-u
 _PREFIXES = {"G": _F(10**9), "M": _F(10**6), "k": _F(1000), "c": _F(1, 100), "m": _F(1, 1000),
              "u": _F(1, 10**6), "µ": _F(1, 10**6), "μ": _F(1, 10**6), "n": _F(1, 10**9),
              "p": _F(1, 10**12)}
+_FAHRENHEIT, _KELVIN, _CALORIE = ("Fahrenheit is not read: give the temperature in degC or K",
+                                   'the kelvin is written "K"', "the calorie is not read: 1 cal = 4.184 J")
+_NOT_READ = {"degF": _FAHRENHEIT, "°F": _FAHRENHEIT, "degK": _KELVIN, "°K": _KELVIN,    # advice, not a look-alike
+             "cal": _CALORIE, "kcal": _CALORIE}
 _SUPERSCRIPT = str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻", "0123456789-")
 _NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 VALUE = re.compile(rf"^\s*({_NUMBER})\s*(.*?)\s*$")       # "<number> <unit>": groups number, unit
@@ -117,6 +121,8 @@ def _lookup(name: str) -> tuple[Fraction, tuple[int, ...]]:
         base = _UNITS.get(name[1:])
         if base is not None and base[2]:
             return _PREFIXES[name[0]] * base[0], base[1]
+    if name in _NOT_READ:
+        raise UnitError(f'unknown unit "{name}": {_NOT_READ[name]}')
     known = list(_UNITS) + [p + u for u, (_, _, pre) in _UNITS.items() if pre for p in "GMkmu"]
     near = difflib.get_close_matches(name, known, n=1, cutoff=0.5)
     hint = f' (did you mean "{near[0]}"?)' if near else ""

@@ -107,6 +107,9 @@ def test_unit_strings_to_si(text, kind, expected):
     (float("inf"), "length", "finite"),
     ("20 (degC)", "temperature", 'as "<number> degC"'),      # was 20 K: degC read as a kelvin
     ("20 °C¹", "temperature", 'as "<number> degC"'),
+    ("68 degF", "temperature", "Fahrenheit is not read"),     # was: did you mean "deg" (an angle)
+    ("300 °K", "temperature", 'the kelvin is written "K"'),   # was: did you mean "°"
+    ("0.1 kcal/(kg K)", "specific_heat", "1 cal = 4.184 J"),  # was: did you mean "kPa"
 ])
 def test_unit_errors_say_what_is_expected(text, kind, fragment):
     with pytest.raises(UnitError, match=None) as info:
