@@ -57,8 +57,8 @@ def _value(parser, v):
         return _value(parser.table if isinstance(v, tuple) else parser.value, v)
     if isinstance(parser, Curve):
         rows = [[_value(parser.x, x)[0], _value(parser.y, y)[0]] for x, y in v]
-        return rows, f"[{parser.x_name}, {parser.y_name}] in [{_value(parser.x, v[0][0])[1] or '-'}, " \
-                     f"{_value(parser.y, v[0][1])[1] or '-'}]"
+        return rows, f"[{parser.x_name}, {parser.y_name}] in [{_column_unit(parser.x, v[0][0])}, " \
+                     f"{_column_unit(parser.y, v[0][1])}]"
     if isinstance(parser, Points):
         return [[float(c) for c in point] for point in v], "m"
     if isinstance(parser, ListOf):           # also Pair, Vector
@@ -69,6 +69,13 @@ def _value(parser, v):
     if isinstance(parser, LengthUnit):
         return next((n for size, n in LENGTH_UNITS.items() if math.isclose(size, v)), f"{v!r} m"), ""
     return v, ""
+
+
+def _column_unit(parser, v) -> str:
+    """The unit of a table column for its comment: a temperature's K (its values carry it), "-" if none."""
+    if isinstance(parser, Quantity) and parser.kind.needs_unit:
+        return parser.kind.si
+    return _value(parser, v)[1] or "-"
 
 
 def _table(cls, obj) -> dict:

@@ -151,6 +151,16 @@ def test_resolved_scene_loads_back_to_itself(path):
     assert again.effects == scene.effects and again.output == scene.output and again.time == scene.time
 
 
+def test_a_temperature_column_of_the_resolved_scene_is_commented_in_kelvin():
+    """The comment of a table against the temperature named its column "-" (dimensionless)."""
+    scene = load(DEMOS / "block_on_flat.toml", {"effects": ["contact", "thermal"], "materials.block.kappa":
+                 [["20 degC", "5 W/(m K)"], ["100 degC", "6 W/(m K)"]], "materials.block.chi": "1e-6 m^2/s",
+                 "materials.flat.kappa": 50, "materials.flat.chi": 1e-5, "time.initial_temperature": "20 degC",
+                 "time.end": 1, "time.steps": 1})
+    line = next(x for x in resolved_toml(scene).splitlines() if x.startswith("kappa = [["))
+    assert line.endswith('= [["293.15 K", 5.0], ["373.15 K", 6.0]]   # [temperature, kappa] in [K, W/(m K)]')
+
+
 def test_a_rank_owning_one_node_or_cell_keeps_its_axis():
     """``output.components``: the gathered per-rank arrays keep their first axis (a rank owning one
     interface cell of the perfect-contact demo on 2 ranks stopped the run with squeeze's 0-d array)."""
