@@ -207,6 +207,29 @@ run = {dt = "50 us"}
     assert study.folder == tmp_path / "results" / "study"
 
 
+def test_a_range_of_temperatures_in_degc(tmp_path):
+    """A scene's temperature swept by a range: its values were bare kelvins (293.15, refused: "a
+    temperature needs its unit"), and a step of "20 degC" was 293.15 K (one value)."""
+    (tmp_path / "scene.toml").write_text((ROOT / "demos" / "block_on_flat.toml").read_text())
+    path = write(tmp_path, """
+problem = "scene"
+scene = "scene.toml"
+metrics = ["max_pressure"]
+[fixed]
+effects = ["contact", "thermal"]
+"materials.block.kappa" = "5 W/(m K)"
+"materials.block.chi" = "1e-6 m^2/s"
+"materials.flat.kappa" = "50 W/(m K)"
+"materials.flat.chi" = "1e-5 m^2/s"
+"time.end" = "1 s"
+"time.steps" = 1
+[sweep]
+"time.initial_temperature" = {start = "20 degC", stop = "100 degC", step = "40 degC"}
+""")
+    runs = load_study(path).runs
+    assert [r.raw["time.initial_temperature"] for r in runs] == ["293.15 K", "333.15 K", "373.15 K"]
+
+
 def test_pareto_front():
     times = [1.0, 2.0, 3.0, 4.0, 2.5, 5.0]
     errors = [0.1, 0.2, 0.05, 0.01, 0.05, 0.0]       # the 0 (the reference itself) is left out

@@ -15,7 +15,7 @@ from multiscale.schema import Bad, Context, Integer, Quantity, fields_of, read, 
 from multiscale.studies.formatting import value_text
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.spec import RANGE_KEYS, ReportOptions, Reference, RunOptions, StudyFile, is_range
-from multiscale.units import VALUE, UnitError, parse_unit
+from multiscale.units import KINDS, VALUE, UnitError, parse_unit
 
 __all__ = ["Study", "StudyRun", "load_study", "normalise", "parser_of", "reference_run"]
 
@@ -232,7 +232,8 @@ def _range(spec: dict, where, parser, ctx) -> list | None:
         return None
     try:
         start, stop = (_si(spec[k], parser) for k in ("start", "stop"))
-        step = _si(spec["step"], parser) if "step" in spec else None
+        kelvin = _is_temperature(spec["start"])    # the values keep their unit: a bare 293.15 is refused
+        step = _si(spec["step"], parser, difference=kelvin) if "step" in spec else None
     except (Bad, UnitError) as exc:
         ctx.problems.append(f"{text}: {exc}")
         return None
@@ -263,16 +264,23 @@ def _range(spec: dict, where, parser, ctx) -> list | None:
     if integer:
         values = list(dict.fromkeys(int(round(v)) for v in values))
     else:
-        values = [float(f"{v:.12g}") for v in values]
+        values = [f"{v:.12g} K" if kelvin else float(f"{v:.12g}") for v in values]
     if len(values) > 10000:
         ctx.problems.append(f"{text}: more than 10000 values")
         return None
     return values
 
 
-def _si(value, parser=None):
-    """A number or "<number> <unit>" in SI (by the parameter's kind when known)."""
-    if parser is not None and isinstance(parser.parser, Quantity):
+def _is_temperature(value) -> bool:
+    """True for a "<number> <unit>" string of a temperature ("20 degC", "300 K")."""
+    match = VALUE.match(value) if isinstance(value, str) else None
+    return bool(match and match.group(2)) and parse_unit(match.group(2))[2] == KINDS["temperature"].dim
+
+
+def _si(value, parser=None, difference: bool = False):
+    """A number or "<number> <unit>" in SI (by the parameter's kind when known); a temperature
+    ``difference`` (a range's step) takes degC as a kelvin: "20 degC" is 20 K, not 293.15 K."""
+    if parser is not None and isinstance(parser.parser, Quantity) and not difference:
         return parser.parser(value, Context())
     if isinstance(value, bool) or not isinstance(value, (int, float, str)):
         raise Bad("range bounds must be numbers or \"<number> <unit>\" strings")
@@ -281,7 +289,7 @@ def _si(value, parser=None):
         if not match:
             raise Bad(f"cannot read {show(value)} as a number with a unit")
         factor, offset, _ = parse_unit(match.group(2))
-        return float(float(match.group(1)) * factor + offset)
+        return float(float(match.group(1)) * factor + (0 if difference else offset))
     return value
 
 
