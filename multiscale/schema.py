@@ -302,8 +302,11 @@ class Curve:
                 rows.append((self.x(x, ctx), self.y(y, ctx)))
             except Bad as exc:
                 errors.append(f"row {i} ({show([x, y])}): {exc}")
-        if not errors and any(b[0] <= a[0] for a, b in zip(rows, rows[1:])):
-            errors.append(f"{self.x_name} must increase strictly from row to row")
+        back = next((i for i in range(1, len(rows)) if rows[i][0] <= rows[i - 1][0]), None) if not errors else None
+        if back is not None:     # in SI: "100 degC" then "300 K" goes back, which the raw values hide
+            unit = f" {self.x.kind.si}" if isinstance(self.x, Quantity) and self.x.kind.si else ""
+            errors.append(f"{self.x_name} must increase strictly from row to row (row {back + 1}: "
+                          f"{rows[back][0]:.6g}{unit} after {rows[back - 1][0]:.6g}{unit})")
         if errors:
             raise Bad("; ".join(errors))
         return tuple(rows)

@@ -68,7 +68,8 @@ BAD = [  # (name, the demo block scene changed, the one expected message)
      'materials.block.kappa = [["300 K", 5]]: needs at least 2 rows [temperature, kappa] with increasing '
      "temperature"),
     ("material table out of order", THERMAL.replace('kappa = "5 W/(m K)"', 'kappa = [["400 K", 5], ["300 K", 6]]'),
-     'materials.block.kappa = [["400 K", 5], ["300 K", 6]]: temperature must increase strictly from row to row'),
+     'materials.block.kappa = [["400 K", 5], ["300 K", 6]]: temperature must increase strictly from row to row '
+     '(row 2: 300 K after 400 K)'),
 ]
 
 

@@ -227,6 +227,8 @@ def test_every_problem_is_reported_at_once(tmp_path):
     ('builder = "block_on_flat"', 'builder = "blok_on_flat"', 'did you mean "block_on_flat"'),
     ('[output]', '[output]\nfields = ["wear_depth"]', 'output.fields: "wear_depth" needs effect "wear"'),
     ('initial_temperature = "20 degC"', "initial_temperature = 20", "a temperature needs its unit"),
+    ('kappa = "5 W/(m K)"', 'kappa = [["100 degC", "5 W/(m K)"], ["300 K", "6 W/(m K)"]]',   # was silent on why
+     "temperature must increase strictly from row to row (row 2: 300 K after 373.15 K)"),
     ('end = "2 min"', 'end = "2 mni"', 'unknown unit "mni" (did you mean "min"?)'),
     # refused by run only, before (after meshing):
     ('effects = ["contact", "friction", "thermal", "heat_partition", "conductance", "expansion"]',
