@@ -158,6 +158,16 @@ def test_radiation_against_the_lumped_solution():
     assert stored[0] + lost[0] == pytest.approx(0.0, abs=1e-10 * lost[0])
 
 
+def test_a_radiation_step_too_long_for_newton_says_to_shorten_it():
+    """A 300 K block in 2000 K surroundings (eps = 1) in one 1000 s step: Newton from 300 K, where
+    T^4 is flat, overshoots and diverges (SNES reason -9 after 1 iteration, said without a cause
+    before: an adversarial test); 10 steps of 100 s converge (1917 K, lumped backward Euler 1921 K)."""
+    boundary = '[[boundary]]\nsurfaces = ["free:block"]\nemissivity = 1\nambient = "2000 K"'
+    with pytest.raises(ConvergenceError, match=r"with radiation a step of 1000 s can take Newton far off: more "
+                                               r"time.steps or substeps"):
+        march(block_scene(T0=300.0, end=1000.0, steps=1, boundary=boundary))
+
+
 def test_temperature_dependent_heat_capacity_conserves_energy_and_cools_like_the_lumped_body():
     """rho c(T) = 7800 c(T) with c linear from 400 J/(kg K) at 300 K to 700 at 900 K, h = 10 from
     800 K: the enthalpy stored equals minus the heat lost to round-off, and the enthalpy-mean

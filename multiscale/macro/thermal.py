@@ -491,6 +491,8 @@ class Thermal:
             why = (f"; Newton may cycle on the kinks of the temperature tables of {', '.join(self.tables)}: a "
                    "steep change between two points of a table is one, spread it over a wider range or more "
                    "points" if self.tables and not failed else "")
+            if not failed and any(a.condition.emissivity for a in self.applied):   # T^4: a long step strays far
+                why += f"; with radiation a step of {dt:.4g} s can take Newton far off: more time.steps or substeps"
             raise ConvergenceError(f"heat step at t = {self.time + dt:.6g} s failed "
                                    f"(SNES reason {snes.getConvergedReason()}, "
                                    f"{snes.getIterationNumber()} iterations{'; ' + failed if failed else ''}){why}")
