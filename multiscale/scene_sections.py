@@ -110,6 +110,9 @@ class Material:
     def problems(self, path, ctx):
         if self.k_w is not None and "wear" not in ctx.effects:
             ctx.warnings.append(f'{path}.k_w is ignored: effect "wear" is not in effects')
+        if self.hardness is not None and "plasticity" not in ctx.effects:
+            ctx.warnings.append(f'{path}.hardness is ignored: effect "plasticity" is not in effects (the asperities '
+                                "stay elastic)")
         tables = [k for k in self.STRAIN if self.tabulated(k)]
         if tables and "thermal" in ctx.effects and "expansion" not in ctx.effects:
             ctx.warnings.append(f'{path}.{tables[0]} depends on the temperature, but without effect "expansion" the '

@@ -347,6 +347,9 @@ def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
         'pressure = "1 MPa"', 'pressure = "1 MPa"\nfriction = 0.4')
     scene = loads(text, tmp_path)
     assert scene.warnings == ('loading.friction is ignored: effect "friction" is not in effects',)
+    soft = loads(text.replace("[materials.flat]", '[materials.flat]\nhardness = "100 MPa"', 1), tmp_path)
+    assert soft.warnings == ('materials.flat.hardness is ignored: effect "plasticity" is not in effects (the '
+                             "asperities stay elastic)", *scene.warnings)     # before, silently elastic
     no_heat = loads(GOOD.replace('"heat_partition", ', "").replace('partition = "effusivity"\n', ""), tmp_path)
     assert no_heat.warnings == ('effects "friction" and "thermal" without "heat_partition": no frictional '
                                 "heat enters the bodies",)
