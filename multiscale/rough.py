@@ -100,6 +100,19 @@ def track_spread(radius, source_radius, volume, half: float) -> np.ndarray:
     return out
 
 
+def _check_zone_size(grid, areas, name: str) -> None:
+    """Refuse zones smaller than the facets of interface ``name`` (``areas`` [m^2]): a facet loads only
+    the zone holding its midpoint, with its force over that zone's area, and the zones between hold
+    none (20 x 20 zones of 1 mm^2 on the test pin-on-disc's 2.5 mm facets: 19 of 400 loaded, zone
+    pressures 15 times the 5 x 5 grid's, a real contact area 0.57 times its)."""
+    zone, facet = grid.size[0] * grid.size[1], float(np.median(areas))
+    if zone < facet:
+        fit = np.maximum(np.floor(np.asarray(grid.counts) * np.sqrt(zone / facet)), 1).astype(int)
+        raise InputError("micro.zones", list(grid.counts), f"zones of {zone * 1e6:.3g} mm^2 on interface {name} are "
+                         f"smaller than its facets (median {facet * 1e6:.3g} mm^2): a facet loads only the zone "
+                         f"holding its midpoint; use at most {fit[0]} x {fit[1]} zones or a finer interface mesh")
+
+
 def in_plane_motion(motion, points, axes) -> tuple[np.ndarray, np.ndarray]:
     """Body 1's velocity per unit motion at ``points`` (n, 3) [m] in the planes of ``axes`` (n, 2, 3):
     its magnitude [m per rad, or per m] and direction [rad from the first axis]."""
@@ -141,6 +154,7 @@ class RoughInterface:
         for k, name in enumerate(self.names):
             uv = self.planes[k].uv(iface.midpoints[masks[name]])
             self.zone_of_facet[masks[name]] = offsets[k] + self.grids[k].zone_of(uv[:, 0], uv[:, 1])
+            _check_zone_size(self.grids[k], iface.areas[masks[name]], name)
         self.used = np.unique(self.zone_of_facet[self.zone_of_facet >= 0])
         self.initial = np.stack([z.surface.heights for z in self.zones])
         self.plastic = np.zeros_like(self.initial)

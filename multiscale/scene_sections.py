@@ -486,8 +486,8 @@ COUPLING_DEFAULT = {"rough": "explicit", "bulk": "implicit"}
 
 @dataclass(frozen=True)
 class Micro:
-    """How the rough interface is solved (issue 7): zone grid on the interface, grid per zone
-    (default 50 x 50; a measured surface's own pixel size, rounded, unless it is replaced by a
+    """How the rough interface is solved (issue 7): zone grid on the interface (zones no smaller than
+    its facets), grid per zone (default 50 x 50; a measured surface's own pixel size, rounded, unless replaced by a
     statistically equivalent one), micro model, points of each p_n(g_n) law (top node at ``p_max``, default 20 x the nominal
     interface pressure; contact solver tolerance ``tol``), micro partition law (ch. 6) or the
     constant one. The micro heating of the loop (issue 19): ``heating`` "steady" (§6.5) or

@@ -332,6 +332,16 @@ def test_the_zones_wear_with_the_loaded_sliding_and_at_the_last_step(straight, t
     assert late["wear_volume"][1] == 0.0 and late["wear_volume"][2] == pytest.approx(every["wear_volume"][2], rel=0.02)
 
 
+def test_zones_smaller_than_the_facets_are_refused(tmp_path):
+    """20 x 20 zones (1 mm^2) on the 2.5 mm facets (2.64 mm^2): a facet loaded only the zone holding
+    its midpoint with its whole force, so 19 of 400 zones carried the load at 65 MPa, 15 times the
+    5 x 5 grid's 4.3 MPa, with 0.57 times its real contact area (40 x 40: 6 zones, 274 MPa), and
+    the run said "raise micro.p_max". Now refused before the first law (an adversarial test)."""
+    with pytest.raises(InputError, match=r"micro.zones = \[20, 20\]: zones of 1 mm\^2 on interface interface are "
+                                         r"smaller than its facets \(median 2.64 mm\^2\).*at most 12 x 12 zones"):
+        run_pod(tmp_path / "fine", {"micro.zones": [20, 20]})
+
+
 def test_a_stop_and_a_restart_keep_every_result_finite(tmp_path):
     """200 rpm to a standstill in 0.6 s, 1.2 s at rest, back to 200 rpm: the zones of the step that
     ended the stop take the sliding of that step, the zones at rest keep their partitions (no heat
