@@ -287,7 +287,9 @@ def test_zone_pressures_above_the_laws_are_warned_about(tmp_path):
     assert h["law_reach"].max() > 2
     record = json.loads((tmp_path / "low" / "provenance.json").read_text())
     assert record["warnings"] == [f"the zone pressures reached {h['law_reach'].max():.3g} times micro.p_max, the top "
-                                  "of their laws: beyond it a law is extrapolated linearly; raise micro.p_max"]
+                                  "of their laws: beyond it a law is extrapolated linearly, with the contact stiffness "
+                                  "at the top; raise micro.p_max, unless the surface is in full contact near it (a "
+                                  "nm-smooth face: perfect contact is the model it tends to)"]
     assert h["law_reach_halved"].max() == 0.0          # no law failed
 
 

@@ -124,7 +124,9 @@ def _law_reach(history) -> list[str]:
     out = []
     if "law_reach" in history.columns and float(np.max(history["law_reach"])) > 1:
         out.append(f"the zone pressures reached {float(np.max(history['law_reach'])):.3g} times micro.p_max, the top "
-                   "of their laws: beyond it a law is extrapolated linearly; raise micro.p_max")
+                   "of their laws: beyond it a law is extrapolated linearly, with the contact stiffness at the top; "
+                   "raise micro.p_max, unless the surface is in full contact near it (a nm-smooth face: perfect "
+                   "contact is the model it tends to)")
     if "law_reach_halved" in history.columns and float(np.max(history["law_reach_halved"])) > 1:
         out.append(f"zones whose laws failed close to full contact (their top p_max halved) were loaded to "
                    f"{float(np.max(history['law_reach_halved'])):.3g} times that top: their laws are extrapolated "
