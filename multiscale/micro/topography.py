@@ -89,10 +89,9 @@ def _reader(path: Path, name: str):
         with _quiet():
             return ST.open_topography(str(path))
     except (ST.Exceptions.UnknownFileFormat, ST.Exceptions.CannotDetectFileFormat):
-        said = _format_error(path)
-        raise InputError(name, path.name, "cannot read it as a topography: " + (
-            f"{said} (`multiscale surface --formats` lists the formats)" if said else
-            "not a format SurfaceTopography recognises (`multiscale surface --formats` lists them)")) from None
+        said = _format_error(path) or "not a format SurfaceTopography recognises"
+        raise InputError(name, path.name, f"cannot read it as a topography: {said} (`multiscale surface --formats` "
+                         "lists the formats)") from None
     except Exception as exc:    # any other parser failure on a user's file: one error naming it
         raise InputError(name, path.name, f"cannot read it as a topography ({_first_line(exc)})") from None
 

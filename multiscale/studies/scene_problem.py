@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
+from multiscale.checkpoint import file_digest
 from multiscale.errors import MultiscaleError, SceneError
 from multiscale.io import History, unit_of
 from multiscale.scene import load
@@ -100,7 +101,7 @@ class SceneProblem(Problem):
         """The scene's path and bytes, the overrides and the bytes of the files it reads (a CAD file
         or measured surface rewritten under its name makes new runs; its old records were reused)."""
         text = params.scene.read_bytes()
-        files = {str(p): hashlib.sha256(p.read_bytes()).hexdigest() for p in params.files if p.is_file()}
+        files = {str(p): file_digest(p) for p in params.files if p.is_file()}
         return {"scene": str(params.scene), "scene_sha256": hashlib.sha256(text).hexdigest(),
                 "overrides": jsonable(params.overrides), **({"files": files} if files else {})}
 

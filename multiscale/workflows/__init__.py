@@ -121,17 +121,19 @@ def _law_reach(history) -> list[str]:
     """Zone pressures beyond the top of their laws (extrapolated linearly there): micro.p_max, or
     for a zone whose law failed close to full contact its halved top (raising p_max cannot help
     it; the demo's worn zone at its last step)."""
+    reach, halved = (float(np.max(history[c])) if c in history.columns else 0.0
+                     for c in ("law_reach", "law_reach_halved"))
     out = []
-    if "law_reach" in history.columns and float(np.max(history["law_reach"])) > 1:
-        out.append(f"the zone pressures reached {float(np.max(history['law_reach'])):.3g} times micro.p_max, the top "
-                   "of their laws: beyond it a law is extrapolated linearly, with the contact stiffness at the top; "
-                   "raise micro.p_max, unless the surface is in full contact near it (a nm-smooth face: perfect "
-                   "contact is the model it tends to)")
-    if "law_reach_halved" in history.columns and float(np.max(history["law_reach_halved"])) > 1:
+    if reach > 1:
+        out.append(f"the zone pressures reached {reach:.3g} times micro.p_max, the top of their laws: beyond it a "
+                   "law is extrapolated linearly, with the contact stiffness at the top; raise micro.p_max, unless "
+                   "the surface is in full contact near it (a nm-smooth face: perfect contact is the model it tends "
+                   "to)")
+    if halved > 1:
         out.append(f"zones whose laws failed close to full contact (their top p_max halved) were loaded to "
-                   f"{float(np.max(history['law_reach_halved'])):.3g} times that top: their laws are extrapolated "
-                   "linearly there, with the contact stiffness at the top; such a zone is nearly flat (worn), "
-                   "and perfect contact is the model it tends to")
+                   f"{halved:.3g} times that top: their laws are extrapolated linearly there, with the contact "
+                   "stiffness at the top; such a zone is nearly flat (worn), and perfect contact is the model it "
+                   "tends to")
     return out
 
 
