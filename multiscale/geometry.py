@@ -274,47 +274,6 @@ def check_cells(module: ModuleType, params, max_cells: int, keep: bool = False,
     return estimate
 
 
-def check_held(model, spec: GeometrySpec) -> None:
-    """Every connected part of the meshed ``model`` (gmsh) touches an interface or a support of
-    ``spec``; a part that touches neither could move freely (a squeal analysis reported its rigid
-    motions as unstable 0 Hz modes, with residuals up to 1.4: an adversarial test): InputError
-    naming its region and a point."""
-    import scipy.sparse  # local: scipy only once a mesh exists (scene reading stays light)
-    from scipy.sparse.csgraph import connected_components  # local: as above
-    tets, regions = [], []
-    for _, entity in model.getEntities(3):
-        tags = model.getPhysicalGroupsForEntity(3, entity)
-        _, _, nodes = model.mesh.getElements(3, entity)
-        for n in nodes:
-            tets.append(np.asarray(n, dtype=np.int64).reshape(-1, 4))
-            regions.append(np.full(len(tets[-1]), tags[0] if len(tags) else -1))
-    if not tets:
-        return
-    tets, regions = np.concatenate(tets), np.concatenate(regions)
-    nodes, local = np.unique(tets, return_inverse=True)
-    local = local.reshape(tets.shape)
-    n_tets, n_nodes = len(tets), len(nodes)
-    graph = scipy.sparse.coo_matrix((np.ones(local.size), (np.repeat(np.arange(n_tets), 4), n_tets + local.ravel())),
-                                    shape=(n_tets + n_nodes,) * 2)
-    _, label = connected_components(graph, directed=False)
-    held = [spec.interfaces[n] for n in spec.interfaces] + [spec.faces[s.face] for s in spec.supports
-                                                             if s.face in spec.faces]
-    touching = np.concatenate([model.mesh.getNodesForPhysicalGroup(2, tag)[0] for tag in held] or [np.zeros(0)])
-    on = np.isin(nodes, touching.astype(np.int64))
-    free = np.setdiff1d(np.unique(label[n_tets:]), np.unique(label[n_tets:][on]))
-    if free.size:
-        part = label[:n_tets] == free[0]
-        names = {r.tag: r.name for b in spec.bodies for r in b.regions}
-        all_tags, xyz, _ = model.mesh.getNodes()
-        order = np.argsort(all_tags)
-        x = xyz.reshape(-1, 3)[order][np.searchsorted(all_tags[order], nodes[np.unique(local[part])])]
-        point = (x.min(axis=0) + x.max(axis=0)) / 2          # the centre of its bounding box
-        raise InputError("geometry", names.get(int(regions[part][0]), "a part"),
-                         f"{free.size} part(s) touch no interface and no support (one of region "
-                         f"{names.get(int(regions[part][0]), '?')!r} around {np.round(point * 1e3, 1).tolist()} mm): "
-                         "they could move freely; remove them from the geometry or hold them ([[boundary]] fix)")
-
-
 def too_many_cells(estimate: CellEstimate, max_cells: int) -> InputError:
     """The error of a mesh estimated above ``max_cells`` (what to change)."""
     return InputError("geometry.max_cells", max_cells,

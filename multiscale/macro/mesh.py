@@ -25,7 +25,8 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from multiscale.errors import InputError, MultiscaleError
-from multiscale.geometry import BodySpec, GeometrySpec, check_cells, check_held, gmsh_session
+from multiscale.geometry import BodySpec, GeometrySpec, check_cells, gmsh_session
+from multiscale.macro.held import check_held
 
 INTERFACE_QUADRATURE = 2      # exact for P1 displacements times P1 tests on a facet
 

@@ -1,0 +1,164 @@
+"""Rigid motions a meshed geometry leaves free, found before anything is solved.
+
+A part is a connected set of one body's cells (cells that share a node share displacements). Each
+part has six rigid motions: translations along x, y, z and rotations about x, y, z through its
+centre. A support holds the components it fixes at every node of its face; an interface holds the
+normal component of the motion of the part on one side relative to the part on the other (penalty
+contact, thesis §1.4); friction holds nothing. With
+r(x, d) = [d, ((x − c)/L) × d] the work-conjugate of the motions along direction d at point x
+(c the centre of the part's bounding box, L its largest side), the holding matrix N = sum_rows w r r^T (w the area [m^2] a node
+stands for) is singular exactly in the motions nothing holds. A singular stiffness made the first
+Newton solve fail on one machine and run with arbitrary sideways pad positions on another, and a
+squeal analysis report rigid motions as unstable 0 Hz modes (adversarial tests); both are refused
+here, before meshing is handed to DOLFINx.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from multiscale.errors import InputError
+from multiscale.geometry import GeometrySpec
+
+MOTIONS = ("translation along x", "translation along y", "translation along z",
+           "rotation about x", "rotation about y", "rotation about z")
+FREE = 1e-10       # eigenvalues of N below FREE * its largest are motions nothing holds
+
+
+def _elements(model, dim: int, tag: int | None = None):
+    """Corner nodes (n, dim + 1) and the entity's physical tag (-1: none) of the dim-cells of
+    physical group ``tag`` (default: every entity)."""
+    entities = (model.getEntitiesForPhysicalGroup(dim, tag) if tag is not None
+                else [e for _, e in model.getEntities(dim)])
+    out, groups = [], []
+    for entity in entities:
+        tags = model.getPhysicalGroupsForEntity(dim, entity)
+        for kind, nodes in zip(*model.mesh.getElements(dim, entity)[::2]):
+            per = model.mesh.getElementProperties(kind)[3]
+            out.append(np.asarray(nodes, dtype=np.int64).reshape(-1, per)[:, :dim + 1])
+            groups.append(np.full(len(out[-1]), tags[0] if len(tags) else -1))
+    if not out:
+        return np.zeros((0, dim + 1), np.int64), np.zeros(0, np.int64)
+    return np.concatenate(out), np.concatenate(groups)
+
+
+def _rows_in(a, b) -> np.ndarray:
+    """Which rows of the integer array ``a`` (n, k) occur in ``b`` (m, k)."""
+    _, inverse = np.unique(np.concatenate([b, a]), axis=0, return_inverse=True)
+    inverse = inverse.ravel()
+    return np.isin(inverse[len(b):], inverse[:len(b)])
+
+
+def _rows(points, directions, centre, size) -> np.ndarray:
+    """r(x, d) = [d, ((x − c)/L) × d] per row (m, 6): d · (translation e_k, rotation e_k × (x − c)/L)."""
+    return np.hstack([directions, np.cross((points - centre) / size, directions)])
+
+
+def check_held(model, spec: GeometrySpec) -> None:
+    """Every part of the meshed ``model`` (gmsh, linear or quadratic cells) is held against its six
+    rigid motions by the supports and interfaces of ``spec`` (module docstring); otherwise an
+    InputError names a free part's region, a point and its free motions (a part touching nothing:
+    that it touches nothing)."""
+    import scipy.sparse  # local: scipy only once a mesh exists (scene reading stays light)
+    from scipy.sparse.csgraph import connected_components  # local: as above
+    body_of = {r.tag: i for i, b in enumerate(spec.bodies) for r in b.regions}
+    names = {r.tag: r.name for b in spec.bodies for r in b.regions}
+    tets, regions = _elements(model, 3)
+    body = np.array([body_of.get(int(t), -1) for t in regions], dtype=np.int64)
+    tets, regions, body = tets[body >= 0], regions[body >= 0], body[body >= 0]
+    if not len(tets):
+        return
+    all_tags, xyz, _ = model.mesh.getNodes()
+    order = np.argsort(all_tags)
+    base = int(all_tags.max()) + 1
+    keys, local = np.unique(tets + body[:, None] * base, return_inverse=True)   # (body, node) pairs
+    local = local.reshape(tets.shape)
+    n_tets, n_keys = len(tets), len(keys)
+    graph = scipy.sparse.coo_matrix((np.ones(local.size), (np.repeat(np.arange(n_tets), 4), n_tets + local.ravel())),
+                                    shape=(n_tets + n_keys,) * 2)
+    n_parts, label = connected_components(graph, directed=False)
+    point = xyz.reshape(-1, 3)[order][np.searchsorted(all_tags[order], keys % base)]
+    part_of_key = label[n_tets:]
+    box = np.array([(point[part_of_key == p].min(axis=0), point[part_of_key == p].max(axis=0))
+                    for p in range(n_parts)])
+    centre, size = box.mean(axis=1), np.ptp(box, axis=1).max(axis=1)     # bounding-box centre and size
+
+    def part(b: int, nodes) -> np.ndarray:
+        """Part of body b holding each node (-1: not in body b)."""
+        k = nodes + b * base
+        at = np.minimum(np.searchsorted(keys, k), n_keys - 1)
+        return np.where(keys[at] == k, part_of_key[at], -1)
+
+    def triangles(tag: int):
+        """Corner nodes (m, 3), node positions (m, 3, 3), unit normals and areas of a face group."""
+        tri = _elements(model, 2, tag)[0]
+        x = xyz.reshape(-1, 3)[order][np.searchsorted(all_tags[order], tri)]
+        n = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+        area = np.linalg.norm(n, axis=1) / 2
+        return tri, x, n / np.maximum(2 * area, 1e-300)[:, None], area
+
+    N = np.zeros((6 * n_parts, 6 * n_parts))
+
+    def hold(p: int, q: int, x, d, w) -> None:
+        """Add rows r_p(x, d) − r_q(x, d) (q = -1: the ground) with weights w to N."""
+        rp = _rows(x, d, centre[p], size[p])
+        blocks = [(p, rp, 1.0)] + ([(q, _rows(x, d, centre[q], size[q]), -1.0)] if q >= 0 else [])
+        for a, ra, sa in blocks:
+            for b, rb, sb in blocks:
+                N[6 * a:6 * a + 6, 6 * b:6 * b + 6] += sa * sb * np.einsum("i,ij,ik->jk", w, ra, rb)
+
+    faces = [np.sort(tets[body == b][:, [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]]].reshape(-1, 3), axis=1)
+             for b in range(len(spec.bodies))]          # the triangles of each body's cells
+    for sup in spec.supports:
+        if sup.face not in spec.faces:
+            continue
+        tri, x, _, area = triangles(spec.faces[sup.face])
+        for b in range(len(spec.bodies)):       # a support holds the bodies whose cells the face bounds
+            on = _rows_in(np.sort(tri, axis=1), faces[b])
+            owner = part(b, tri[:, 0])
+            for p in np.unique(owner[on]):
+                at = on & (owner == p)
+                for c in sup.components:
+                    for corner in range(3):      # each corner stands for a third of its triangle
+                        hold(int(p), -1, x[at, corner], np.tile(np.eye(3)[c], (at.sum(), 1)), area[at] / 3)
+    for tag in spec.interfaces.values():
+        tri, x, n, area = triangles(tag)
+        if not len(tri):
+            continue
+        pair = np.stack([part(0, tri[:, 0]), part(1, tri[:, 0])], axis=1)
+        for p, q in np.unique(pair[(pair >= 0).all(axis=1)], axis=0):
+            on = (pair == (p, q)).all(axis=1)
+            for corner in range(3):      # each corner stands for a third of its triangle
+                hold(int(p), int(q), x[on, corner], n[on], area[on] / 3)
+    values, vectors = np.linalg.eigh(N)
+    free = vectors[:, values <= FREE * max(values[-1], 0.0)]
+    if not free.shape[1]:
+        return
+    share = np.sum(free ** 2, axis=1).reshape(n_parts, 6)   # how far each motion is free
+    loose = [p for p in range(n_parts) if share[p].sum() > 1e-6]
+    first = max(loose, key=lambda p: share[p].sum())
+
+    def region(p: int) -> str:
+        return names.get(int(regions[label[:n_tets] == p][0]), "?")
+
+    block = slice(6 * first, 6 * first + 6)
+    where = f"of region {region(first)!r} around {(np.round(centre[first] * 1e3, 1) + 0.0).tolist()} mm"
+    if not np.diag(N)[block].any():
+        untouched = sum(not np.diag(N)[6 * p:6 * p + 6].any() for p in loose)
+        raise InputError("geometry", region(first),
+                         f"{untouched} part(s) touch no interface and no support (one {where}): they could move "
+                         "freely; remove them from the geometry or hold them ([[boundary]] fix)")
+    own, alone = np.linalg.eigh(N[block, block])
+    alone = alone[:, own <= FREE * values[-1]]       # its motions free while every other part stays
+    if alone.shape[1]:
+        mode, others = np.sum(alone ** 2, axis=1), []
+    else:                                            # it moves only together with others
+        mode = free[:, np.argmax(np.sum(free[block] ** 2, axis=0))]
+        others = [region(p) for p in range(n_parts) if p != first and np.sum(mode[6 * p:6 * p + 6] ** 2) > 1e-6]
+        mode = mode[block] ** 2
+    motions = [m for m, s in zip(MOTIONS, mode) if s > 0.5 * mode.max()]
+    along = f", together with region(s) {', '.join(map(repr, others))}" if others else ""
+    raise InputError("geometry", region(first),
+                     f"{len(loose)} part(s) could move as rigid bodies (one {where}: {', '.join(motions)}{along}): "
+                     "nothing holds them there; a support holds the components it fixes on its face, an "
+                     "interface only along its normal, and friction does not hold: add a [[boundary]] fix "
+                     "that holds these motions (e.g. fix = [\"x\", \"y\"] on a pad's sides)")
