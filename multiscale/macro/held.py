@@ -4,9 +4,9 @@ A part is a connected set of one body's cells (cells that share a node share dis
 part has six rigid motions: translations along x, y, z and rotations about x, y, z through its
 centre. A support holds the components it fixes at every node of its face; an interface holds the
 normal component of the motion of the part on one side relative to the part on the other (penalty
-contact, thesis §1.4); friction holds nothing. With
-r(x, d) = [d, ((x − c)/L) × d] the work-conjugate of the motions along direction d at point x
-(c the centre of the part's bounding box, L its largest side), the holding matrix N = sum_rows w r r^T (w the area [m^2] a node
+contact, thesis §1.4); friction holds nothing. With r(x, d) = [d, ((x − c)/L) × d] the
+work-conjugate of the motions along direction d at point x (c the centre of the part's bounding
+box, L its largest side), the holding matrix N = sum_rows w r r^T (w the area [m^2] a node
 stands for) is singular exactly in the motions nothing holds. A singular stiffness made the first
 Newton solve fail on one machine and run with arbitrary sideways pad positions on another, and a
 squeal analysis report rigid motions as unstable 0 Hz modes (adversarial tests); both are refused
