@@ -216,11 +216,12 @@ _COMPONENTS = {"x": 0, "y": 1, "z": 2}
 @dataclass(frozen=True)
 class Boundary:
     """[[boundary]]: conditions on named surfaces of the geometry (a builder's faces, the file's
-    physical surfaces or [geometry.surfaces]; "free:<body>" is every surface of a body that touches
-    nothing else). ``fix``: displacement components held at zero; ``convection`` h [W/(m^2 K)],
-    constant or a table against the rotating body's speed [rad/s], towards ``ambient``;
-    ``emissivity``: radiation eps sigma (T^4 - T_ambient^4); ``temperature``: a fixed temperature.
-    Surfaces without a thermal condition are insulated."""
+    physical surfaces or [geometry.surfaces]; "free:<body>": a body's surfaces that touch nothing
+    else). ``fix``: displacement components held at zero (with the interfaces' normals, friction
+    holding nothing, they must hold every part against its six rigid motions: ``macro.held``);
+    ``convection`` h [W/(m^2 K)], constant or a table against the rotating body's speed [rad/s],
+    towards ``ambient``; ``emissivity``: radiation eps sigma (T^4 - T_ambient^4); ``temperature``:
+    a fixed temperature. Surfaces without a thermal condition are insulated."""
 
     surfaces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), required=True)
     fix: tuple | None = key(ListOf(Choice(_COMPONENTS), unique=True, min_len=1))
@@ -384,8 +385,7 @@ class Loading:
         return 1.0 if self.load_profile is None else mean(self.load_profile, t0, t1)
 
     def knots(self) -> tuple:
-        """Times [s] where the load factor or the angular speed may change slope (between them
-        both are linear in time)."""
+        """Times [s] where the load factor or the angular speed may change slope (linear between)."""
         out = [t for table in (self.load_profile, self.speed_profile) if table is not None for t, _ in table]
         stop = None if self.vehicle is None else self.vehicle.stop_time
         return tuple(out + ([stop] if stop is not None else []))
