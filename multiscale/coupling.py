@@ -38,7 +38,7 @@ a light zone's partition counts for the heat it moves). Schemes:
 - "explicit": the partitions of step n + 1 come from the post-analysis of step n (thesis Fig. 7.2).
 - "fixed-point" (thesis form, converged): the partitions p of step n solve p = G(p), G = the
   post-analysis' partitions at the end of a macro step run with p: the step is restarted from its
-  initial state (``snapshot``/``restore_state``) with the next p of Anderson's acceleration
+  initial state (``MacroModel.snapshot``/``restore``) with the next p of Anderson's acceleration
   (``anderson``: a multisecant quasi-Newton on the per-zone partitions, residuals weighted by the
   zones' heat, first step p + ``relaxation`` (G(p) − p)) until the residual is <= ``coupling_tol``;
   wear is then done once, at the converged state. A scalar relaxation (Aitken's Δ²) does not do:
@@ -419,34 +419,6 @@ class Multiscale:
         flash = np.where(zone_of >= 0, self.flash[zone_of], np.nan)
         return np.where(np.isfinite(flash), flash, macro)
 
-    # ---- state of a macro step (the fixed point restarts it) -------------------------------
-    def snapshot(self) -> dict:
-        """The macro state a step starts from (fields, time, heat counters, drive constants)."""
-        m = self.model
-        state = {"arrays": [f.x.array.copy() for f in self._functions().values()], "time": m.time,
-                 "heat_total": m.heat_total.copy(), "exchanged": m.heat_exchanged_total, "last_solve": m.last_solve,
-                 "constants": [float(c.value) for c in self._constants()]}
-        if m.thermal is not None:
-            state.update(thermal_time=m.thermal.time, lost_total=m.thermal.lost_total.copy(),
-                         lost_step=m.thermal.lost_step.copy())
-        return state
-
-    def restore_state(self, state: dict) -> None:
-        """Back to a ``snapshot``."""
-        m = self.model
-        for f, values in zip(self._functions().values(), state["arrays"]):
-            f.x.array[:] = values
-        for c, value in zip(self._constants(), state["constants"]):
-            c.value = value
-        m.time, m.heat_total, m.last_solve = state["time"], state["heat_total"].copy(), state["last_solve"]
-        m.heat_exchanged_total = state["exchanged"]
-        if m.thermal is not None:
-            m.thermal.time = state["thermal_time"]
-            m.thermal.lost_total, m.thermal.lost_step = state["lost_total"].copy(), state["lost_step"].copy()
-
-    def _constants(self) -> list:
-        return [*(getattr(self.model.contact, k) for k in ("speed", "engaged", "heating")), self.model.mechanics.load]
-
     # ---- the run ---------------------------------------------------------------------------
     def start(self) -> StepResult:
         """Initial laws, rigid datum gap, first (ramped) solve and the initial post-analysis."""
@@ -467,7 +439,7 @@ class Multiscale:
         s = self.settings
         interval = n % s.wear_every or s.wear_every      # steps since the last wear if this one wears
         wear = s.wear and self.post.wears and (interval == s.wear_every or n == s.steps)
-        state = self.snapshot() if self.iterating else None
+        state = self.model.snapshot() if self.iterating else None
         residuals, passes, time_macro, time_micro = [], [], 0.0, 0.0
         while True:
             t0 = _time.perf_counter()
@@ -483,7 +455,7 @@ class Multiscale:
                 raise ConvergenceError(f"step {n}: the partitions did not converge in {len(residuals)} passes "
                                        f"(residual {residuals[-1]:.3g} > {s.coupling_tol:g})", residuals)
             passes.append((self.partition.copy(), self.residual()))
-            self.restore_state(state)
+            self.model.restore(state)
             self.partition = anderson(passes[-ANDERSON_MEMORY - 1:], self.zone_heat(), s.relaxation)
             self.apply_zone_fields()
         t2 = _time.perf_counter()
@@ -538,11 +510,6 @@ class Multiscale:
         return row
 
     # ---- checkpoints -----------------------------------------------------------------------
-    def _functions(self) -> dict:
-        m = self.model
-        return {**{f"u{i}": u for i, u in enumerate(m.mechanics.u)},
-                **({f"T{i}": T for i, T in enumerate(m.thermal.T)} if m.thermal is not None else {})}
-
     def save(self, path: Path, step: int, history: io.History) -> None:
         """Checkpoint after macro step ``step`` (collective)."""
         m, last = self.model, self.model.last_solve
@@ -556,14 +523,14 @@ class Multiscale:
         attrs = {"step": step, "time": m.time, "work": self.work, "counter_volume": self.counter_volume,
                  "heat_exchanged": [m.heat_exchanged, m.heat_exchanged_total], "scene": self.fingerprint, "load": m.load,
                  "ranks": self.comm.size, "fields_written": -1, "solved_speed": m.solved_speed,
-                 "constants": [float(c.value) for c in self._constants()],
+                 "constants": [float(c.value) for c in self.model.drive_constants],
                  "solve": [last.reason, last.iterations, last.normal_force, last.max_pressure]}
-        checkpoint.save(path, self.comm, attrs=attrs, arrays=arrays, functions=self._functions(),
+        checkpoint.save(path, self.comm, attrs=attrs, arrays=arrays, functions=self.model.functions,
                         scale=self.tm.spec.length_scale)
 
     def restore(self, path: Path) -> Restored:
         """State of the checkpoint ``path`` (collective)."""
-        attrs, arrays = checkpoint.load(path, self.comm, self._functions())
+        attrs, arrays = checkpoint.load(path, self.comm, self.model.functions)
         checkpoint.same_scene(attrs, self.fingerprint, path)
         m = self.model
         self.rough.set_heights(range(len(arrays["heights"])), arrays["heights"])
@@ -586,7 +553,7 @@ class Multiscale:
         m.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
         self.tm.interface.set_field(m.contact.initial_gap, self.datum_gap + self.counter_depth)
         m.load, m.solved_speed = float(attrs["load"]), float(attrs["solved_speed"])
-        for c, value in zip(self._constants(), attrs["constants"]):   # speed, engagement, load last solved
+        for c, value in zip(self.model.drive_constants, attrs["constants"]):   # speed, engagement, load last solved
             c.value = value
         self.rough.update_laws()
         self.apply_zone_fields()

@@ -190,6 +190,40 @@ class MacroModel:
         finally:
             c.speed.value, c.heating.value = kept
 
+    # ---- state (a fixed point restarts a step from it; checkpoints store it) ----------------
+    @property
+    def functions(self) -> dict:
+        """The fields by checkpoint name: displacements u0, u1 [m], temperatures T0, T1 [K]."""
+        return {**{f"u{i}": u for i, u in enumerate(self.mechanics.u)},
+                **({f"T{i}": T for i, T in enumerate(self.thermal.T)} if self.thermal is not None else {})}
+
+    @property
+    def drive_constants(self) -> list:
+        """The contact's speed, engagement and heating constants and the mechanics' load."""
+        return [*(getattr(self.contact, k) for k in ("speed", "engaged", "heating")), self.mechanics.load]
+
+    def snapshot(self) -> dict:
+        """The state a step starts from (fields, time, heat counters, drive constants)."""
+        state = {"arrays": [f.x.array.copy() for f in self.functions.values()], "time": self.time,
+                 "heat_total": self.heat_total.copy(), "exchanged": self.heat_exchanged_total,
+                 "last_solve": self.last_solve, "constants": [float(c.value) for c in self.drive_constants]}
+        if self.thermal is not None:
+            state.update(thermal_time=self.thermal.time, lost_total=self.thermal.lost_total.copy(),
+                         lost_step=self.thermal.lost_step.copy())
+        return state
+
+    def restore(self, state: dict) -> None:
+        """Back to a ``snapshot``."""
+        for f, values in zip(self.functions.values(), state["arrays"]):
+            f.x.array[:] = values
+        for c, value in zip(self.drive_constants, state["constants"]):
+            c.value = value
+        self.time, self.heat_total, self.last_solve = state["time"], state["heat_total"].copy(), state["last_solve"]
+        self.heat_exchanged_total = state["exchanged"]
+        if self.thermal is not None:
+            self.thermal.time = state["thermal_time"]
+            self.thermal.lost_total, self.thermal.lost_step = state["lost_total"].copy(), state["lost_step"].copy()
+
     def record(self, heat_step=(0.0, 0.0)) -> dict:
         """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal
         boundary conditions, ``heat_lost_step_<body>`` is the heat lost since the previous record.
