@@ -1,6 +1,10 @@
 """Rigid motions a meshed geometry leaves free, found before anything is solved.
 
-A part is a connected set of one body's cells (cells that share a node share displacements). Each
+A part is a set of one body's cells joined through shared faces. Parts of one body that share
+only nodes (along an edge or at a vertex) share those nodes' displacements: such a joint holds
+their relative translation there, not a rotation about it (a box touching another of its body
+along an edge turned about it, unheld, when parts were cells joined through nodes: the check
+passed and repeated runs ended with different forces; an adversarial test). Each
 part has six rigid motions: translations along x, y, z and rotations about x, y, z through its
 centre. A support holds the components it fixes at every node of its face; an interface holds the
 normal component of the motion of the part on one side relative to the part on the other (penalty
@@ -41,13 +45,6 @@ def _elements(model, dim: int, tag: int | None = None):
     return np.concatenate(out), np.concatenate(groups)
 
 
-def _rows_in(a, b) -> np.ndarray:
-    """Which rows of the integer array ``a`` (n, k) occur in ``b`` (m, k)."""
-    _, inverse = np.unique(np.concatenate([b, a]), axis=0, return_inverse=True)
-    inverse = inverse.ravel()
-    return np.isin(inverse[len(b):], inverse[:len(b)])
-
-
 def _rows(points, directions, centre, size) -> np.ndarray:
     """r(x, d) = [d, ((x − c)/L) × d] per row (m, 6): d · (translation e_k, rotation e_k × (x − c)/L)."""
     return np.hstack([directions, np.cross((points - centre) / size, directions)])
@@ -69,29 +66,39 @@ def check_held(model, spec: GeometrySpec) -> None:
         return
     all_tags, xyz, _ = model.mesh.getNodes()
     order = np.argsort(all_tags)
-    base = int(all_tags.max()) + 1
-    keys, local = np.unique(tets + body[:, None] * base, return_inverse=True)   # (body, node) pairs
-    local = local.reshape(tets.shape)
-    n_tets, n_keys = len(tets), len(keys)
-    graph = scipy.sparse.coo_matrix((np.ones(local.size), (np.repeat(np.arange(n_tets), 4), n_tets + local.ravel())),
-                                    shape=(n_tets + n_keys,) * 2)
+    xyz = xyz.reshape(-1, 3)[order]
+    all_tags = all_tags[order]
+    n_tets = len(tets)
+    # parts: cells of one body joined through shared faces (triangles keyed by body and sorted nodes)
+    faces = np.sort(tets[:, [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]]].reshape(-1, 3), axis=1)
+    face_keys = np.hstack([np.repeat(body, 4)[:, None], faces])
+    face_rows, face_of = np.unique(face_keys, axis=0, return_inverse=True)
+    face_of = face_of.ravel()
+    graph = scipy.sparse.coo_matrix((np.ones(face_of.size), (np.repeat(np.arange(n_tets), 4), n_tets + face_of)),
+                                    shape=(n_tets + len(face_rows),) * 2)
     n_parts, label = connected_components(graph, directed=False)
-    point = xyz.reshape(-1, 3)[order][np.searchsorted(all_tags[order], keys % base)]
-    part_of_key = label[n_tets:]
-    box = np.array([(point[part_of_key == p].min(axis=0), point[part_of_key == p].max(axis=0))
-                    for p in range(n_parts)])
-    centre, size = box.mean(axis=1), np.ptp(box, axis=1).max(axis=1)     # bounding-box centre and size
+    label = label[:n_tets]
+    corner = xyz[np.searchsorted(all_tags, tets)]                          # (n_tets, 4, 3)
+    low, high = np.full((n_parts, 3), np.inf), np.full((n_parts, 3), -np.inf)
+    np.minimum.at(low, label, corner.min(axis=1))
+    np.maximum.at(high, label, corner.max(axis=1))
+    centre, size = (low + high) / 2, (high - low).max(axis=1)            # bounding-box centre and size
+    face_part = np.full(len(face_rows), -1)
+    face_part[face_of] = np.repeat(label, 4)
 
-    def part(b: int, nodes) -> np.ndarray:
-        """Part of body b holding each node (-1: not in body b)."""
-        k = nodes + b * base
-        at = np.minimum(np.searchsorted(keys, k), n_keys - 1)
-        return np.where(keys[at] == k, part_of_key[at], -1)
+    def part(b: int, tri) -> np.ndarray:
+        """Part of body b whose cells the triangles ``tri`` (m, 3) bound (-1: none)."""
+        rows = np.hstack([np.full((len(tri), 1), b), np.sort(tri, axis=1)])
+        _, inverse = np.unique(np.concatenate([face_rows, rows]), axis=0, return_inverse=True)
+        inverse = inverse.ravel()
+        at = np.full(inverse.max() + 1, -1)
+        at[inverse[:len(face_rows)]] = face_part
+        return at[inverse[len(face_rows):]]
 
     def triangles(tag: int):
         """Corner nodes (m, 3), node positions (m, 3, 3), unit normals and areas of a face group."""
         tri = _elements(model, 2, tag)[0]
-        x = xyz.reshape(-1, 3)[order][np.searchsorted(all_tags[order], tri)]
+        x = xyz[np.searchsorted(all_tags, tri)]
         n = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
         area = np.linalg.norm(n, axis=1) / 2
         return tri, x, n / np.maximum(2 * area, 1e-300)[:, None], area
@@ -106,29 +113,40 @@ def check_held(model, spec: GeometrySpec) -> None:
             for b, rb, sb in blocks:
                 N[6 * a:6 * a + 6, 6 * b:6 * b + 6] += sa * sb * np.einsum("i,ij,ik->jk", w, ra, rb)
 
-    faces = [np.sort(tets[body == b][:, [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]]].reshape(-1, 3), axis=1)
-             for b in range(len(spec.bodies))]          # the triangles of each body's cells
+    # joints: a node shared by parts of one body (along an edge or at a vertex) is one displacement
+    # of both: it holds their relative translation there, not the rotation about it (weight: the
+    # squared size of the cells at the node)
+    keys = np.unique(np.stack([np.repeat(body, 4), tets.ravel(), np.repeat(label, 4)], axis=1), axis=0)
+    node_keys, first, count = np.unique(keys[:, :2], axis=0, return_index=True, return_counts=True)
+    cell_size = np.zeros(int(all_tags.max()) + 1)
+    volume = np.abs(np.einsum("ij,ij->i", corner[:, 1] - corner[:, 0],
+                              np.cross(corner[:, 2] - corner[:, 0], corner[:, 3] - corner[:, 0]))) / 6
+    np.maximum.at(cell_size, tets.ravel(), np.repeat(volume ** (2 / 3), 4))
+    for k in np.flatnonzero(count > 1):
+        node = keys[first[k], 1]
+        x = np.tile(xyz[np.searchsorted(all_tags, node)], (3, 1))
+        for other in keys[first[k] + 1:first[k] + count[k], 2]:
+            hold(int(keys[first[k], 2]), int(other), x, np.eye(3), np.full(3, cell_size[node]))
     for sup in spec.supports:
         if sup.face not in spec.faces:
             continue
         tri, x, _, area = triangles(spec.faces[sup.face])
         for b in range(len(spec.bodies)):       # a support holds the bodies whose cells the face bounds
-            on = _rows_in(np.sort(tri, axis=1), faces[b])
-            owner = part(b, tri[:, 0])
-            for p in np.unique(owner[on]):
-                at = on & (owner == p)
+            owner = part(b, tri)
+            for p in np.unique(owner[owner >= 0]):
+                at = owner == p
                 for c in sup.components:
-                    for corner in range(3):      # each corner stands for a third of its triangle
-                        hold(int(p), -1, x[at, corner], np.tile(np.eye(3)[c], (at.sum(), 1)), area[at] / 3)
+                    for corner_ in range(3):      # each corner stands for a third of its triangle
+                        hold(int(p), -1, x[at, corner_], np.tile(np.eye(3)[c], (at.sum(), 1)), area[at] / 3)
     for tag in spec.interfaces.values():
         tri, x, n, area = triangles(tag)
         if not len(tri):
             continue
-        pair = np.stack([part(0, tri[:, 0]), part(1, tri[:, 0])], axis=1)
+        pair = np.stack([part(0, tri), part(1, tri)], axis=1)
         for p, q in np.unique(pair[(pair >= 0).all(axis=1)], axis=0):
             on = (pair == (p, q)).all(axis=1)
-            for corner in range(3):      # each corner stands for a third of its triangle
-                hold(int(p), int(q), x[on, corner], n[on], area[on] / 3)
+            for corner_ in range(3):      # each corner stands for a third of its triangle
+                hold(int(p), int(q), x[on, corner_], n[on], area[on] / 3)
     values, vectors = np.linalg.eigh(N)
     free = vectors[:, values <= FREE * max(values[-1], 0.0)]
     if not free.shape[1]:
@@ -138,7 +156,7 @@ def check_held(model, spec: GeometrySpec) -> None:
     first = max(loose, key=lambda p: share[p].sum())
 
     def region(p: int) -> str:
-        return names.get(int(regions[label[:n_tets] == p][0]), "?")
+        return names.get(int(regions[label == p][0]), "?")
 
     block = slice(6 * first, 6 * first + 6)
     where = f"of region {region(first)!r} around {(np.round(centre[first] * 1e3, 1) + 0.0).tolist()} mm"
