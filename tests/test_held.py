@@ -28,7 +28,9 @@ def test_a_part_joined_to_another_only_along_an_edge_turns_about_it(tmp_path):
     hinge = text.replace(PAD_A, '[geometry.bodies.pad_a]\ncontains = [["0 mm", "80 mm", "14 mm"], '
                                 '["20 mm", "60 mm", "14 mm"]]')
     with pytest.raises(InputError, match=r"1 part\(s\) could move as rigid bodies \(one of region 'pad_a' around "
-                                         r"\[20\.0, 60\.0, 14\.0\] mm: rotation about z"):
+                                         r"\[20\.0, 60\.0, 14\.0\] mm: rotation about z; it shares only an edge or a "
+                                         r"vertex with the part\(s\) of 'pad_a' around \[0\.0, 80\.0, 14\.0\] mm: "
+                                         r"a joint holds no turn about it\)"):
         build_mesh(loads(hinge, tmp_path))
     # held at its own sides too, it passes
     sides = hinge.replace('["10 mm", "-80 mm", "14 mm"]]', '["10 mm", "-80 mm", "14 mm"], ["30 mm", "60 mm", "14 mm"]]')
@@ -57,5 +59,6 @@ def test_a_part_joined_to_another_at_one_vertex_turns_about_it(tmp_path):
     text = TWO_PADS.replace("{folder}", str(tmp_path / "out")).replace(
         PAD_A, '[geometry.bodies.pad_a]\ncontains = [["0 mm", "80 mm", "14 mm"], ["24 mm", "62 mm", "11 mm"]]')
     with pytest.raises(InputError, match=r"1 part\(s\) could move as rigid bodies \(one of region 'pad_a' around "
-                                         r"\[20\.0, 60\.0, 14\.0\] mm: rotation about z\)"):
+                                         r"\[20\.0, 60\.0, 14\.0\] mm: rotation about z; it shares only an edge or a "
+                                         r"vertex with the part\(s\) of 'pad_a' around"):
         build_mesh(loads(text, tmp_path))

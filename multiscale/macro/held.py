@@ -122,11 +122,14 @@ def check_held(model, spec: GeometrySpec) -> None:
     volume = np.abs(np.einsum("ij,ij->i", corner[:, 1] - corner[:, 0],
                               np.cross(corner[:, 2] - corner[:, 0], corner[:, 3] - corner[:, 0]))) / 6
     np.maximum.at(cell_size, tets.ravel(), np.repeat(volume ** (2 / 3), 4))
+    joined = {}                                 # part -> parts it shares only nodes with
     for k in np.flatnonzero(count > 1):
         node = keys[first[k], 1]
         x = np.tile(xyz[np.searchsorted(all_tags, node)], (3, 1))
         for other in keys[first[k] + 1:first[k] + count[k], 2]:
             hold(int(keys[first[k], 2]), int(other), x, np.eye(3), np.full(3, cell_size[node]))
+            joined.setdefault(int(other), set()).add(int(keys[first[k], 2]))
+            joined.setdefault(int(keys[first[k], 2]), set()).add(int(other))
     for sup in spec.supports:
         if sup.face not in spec.faces:
             continue
@@ -175,6 +178,10 @@ def check_held(model, spec: GeometrySpec) -> None:
         mode = mode[block] ** 2
     motions = [m for m, s in zip(MOTIONS, mode) if s > 0.5 * mode.max()]
     along = f", together with region(s) {', '.join(map(repr, others))}" if others else ""
+    if first in joined:
+        at = ", ".join(f"{region(q)!r} around {(np.round(centre[q] * 1e3, 1) + 0.0).tolist()} mm"
+                       for q in sorted(joined[first]))
+        along += f"; it shares only an edge or a vertex with the part(s) of {at}: a joint holds no turn about it"
     raise InputError("geometry", region(first),
                      f"{len(loose)} part(s) could move as rigid bodies (one {where}: {', '.join(motions)}{along}): "
                      "nothing holds them there; a support holds the components it fixes on its face, an "
