@@ -45,6 +45,11 @@ def _elements(model, dim: int, tag: int | None = None):
     return np.concatenate(out), np.concatenate(groups)
 
 
+def _records(rows) -> np.ndarray:
+    """Integer rows (n, 4) as one record each, ordered like the rows (for ``np.searchsorted``)."""
+    return np.ascontiguousarray(rows, dtype=np.int64).view([(f"f{k}", np.int64) for k in range(4)]).ravel()
+
+
 def _rows(points, directions, centre, size) -> np.ndarray:
     """r(x, d) = [d, ((x − c)/L) × d] per row (m, 6): d · (translation e_k, rotation e_k × (x − c)/L)."""
     return np.hstack([directions, np.cross((points - centre) / size, directions)])
@@ -86,14 +91,13 @@ def check_held(model, spec: GeometrySpec) -> None:
     face_part = np.full(len(face_rows), -1)
     face_part[face_of] = np.repeat(label, 4)
 
+    known = _records(face_rows)                  # sorted, as np.unique returns them
+
     def part(b: int, tri) -> np.ndarray:
         """Part of body b whose cells the triangles ``tri`` (m, 3) bound (-1: none)."""
-        rows = np.hstack([np.full((len(tri), 1), b), np.sort(tri, axis=1)])
-        _, inverse = np.unique(np.concatenate([face_rows, rows]), axis=0, return_inverse=True)
-        inverse = inverse.ravel()
-        at = np.full(inverse.max() + 1, -1)
-        at[inverse[:len(face_rows)]] = face_part
-        return at[inverse[len(face_rows):]]
+        rows = _records(np.hstack([np.full((len(tri), 1), b), np.sort(tri, axis=1)]))
+        at = np.minimum(np.searchsorted(known, rows), len(known) - 1)
+        return np.where(known[at] == rows, face_part[at], -1)
 
     def triangles(tag: int):
         """Corner nodes (m, 3), node positions (m, 3, 3), unit normals and areas of a face group."""
