@@ -21,7 +21,7 @@ from __future__ import annotations
 import numpy as np
 
 from multiscale.errors import InputError
-from multiscale.geometry import GeometrySpec
+from multiscale.geometry import GeometrySpec, Rotation
 
 MOTIONS = ("translation along x", "translation along y", "translation along z",
            "rotation about x", "rotation about y", "rotation about z")
@@ -55,11 +55,15 @@ def _rows(points, directions, centre, size) -> np.ndarray:
     return np.hstack([directions, np.cross((points - centre) / size, directions)])
 
 
-def check_held(model, spec: GeometrySpec) -> None:
+def check_held(model, spec: GeometrySpec, sliding: bool = False) -> None:
     """Every part of the meshed ``model`` (gmsh, linear or quadratic cells) is held against its six
     rigid motions by the supports and interfaces of ``spec`` (module docstring); otherwise an
     InputError names a free part's region, a point and its free motions (a part touching nothing:
-    that it touches nothing)."""
+    that it touches nothing). With ``sliding`` (friction), the interfaces do not hold the parts of
+    body 1 in its motion along them (``spec.motion``), however the mesh facets a curved interface:
+    a shaft turning in a bush, its end held along z alone, was held about its axis only by the
+    facets of the cylinder; friction turned it against them and Newton stalled (SNES -6, residual
+    stuck near 7.8 from the 5th iteration on: an adversarial test)."""
     import scipy.sparse  # local: scipy only once a mesh exists (scene reading stays light)
     from scipy.sparse.csgraph import connected_components  # local: as above
     body_of = {r.tag: i for i, b in enumerate(spec.bodies) for r in b.regions}
@@ -108,11 +112,21 @@ def check_held(model, spec: GeometrySpec) -> None:
         return tri, x, n / np.maximum(2 * area, 1e-300)[:, None], area
 
     N = np.zeros((6 * n_parts, 6 * n_parts))
+    turns = isinstance(spec.motion, Rotation)
+    axis = np.asarray(spec.motion.axis, float) / np.linalg.norm(spec.motion.axis) if turns else np.zeros(3)
+    slides = np.hstack([spec.motion.velocity(centre), size[:, None] * axis])     # body 1's motion per part
+    slides /= np.linalg.norm(slides, axis=1, keepdims=True)
+    lost = np.zeros(n_parts)
 
-    def hold(p: int, q: int, x, d, w) -> None:
-        """Add rows r_p(x, d) − r_q(x, d) (q = -1: the ground) with weights w to N."""
+    def hold(p: int, q: int, x, d, w, slide=None) -> None:
+        """Add rows r_p(x, d) − r_q(x, d) (q = -1: the ground) with weights w to N; ``slide``: a
+        unit motion of q that the rows do not hold (their component along it removed)."""
         rp = _rows(x, d, centre[p], size[p])
-        blocks = [(p, rp, 1.0)] + ([(q, _rows(x, d, centre[q], size[q]), -1.0)] if q >= 0 else [])
+        rq = _rows(x, d, centre[q], size[q]) if q >= 0 else None
+        if slide is not None:
+            lost[q] += np.sum(w * (rq @ slide) ** 2)      # what the facets held of it
+            rq = rq - np.outer(rq @ slide, slide)
+        blocks = [(p, rp, 1.0)] + ([(q, rq, -1.0)] if q >= 0 else [])
         for a, ra, sa in blocks:
             for b, rb, sb in blocks:
                 N[6 * a:6 * a + 6, 6 * b:6 * b + 6] += sa * sb * np.einsum("i,ij,ik->jk", w, ra, rb)
@@ -153,7 +167,7 @@ def check_held(model, spec: GeometrySpec) -> None:
         for p, q in np.unique(pair[(pair >= 0).all(axis=1)], axis=0):
             on = (pair == (p, q)).all(axis=1)
             for corner_ in range(3):      # each corner stands for a third of its triangle
-                hold(int(p), int(q), x[on, corner_], n[on], area[on] / 3)
+                hold(int(p), int(q), x[on, corner_], n[on], area[on] / 3, slides[q] if sliding else None)
     values, vectors = np.linalg.eigh(N)
     free = vectors[:, values <= FREE * max(values[-1], 0.0)]
     if not free.shape[1]:
@@ -182,6 +196,8 @@ def check_held(model, spec: GeometrySpec) -> None:
         mode = mode[block] ** 2
     motions = [m for m, s in zip(MOTIONS, mode) if s > 0.5 * mode.max()]
     along = f", together with region(s) {', '.join(map(repr, others))}" if others else ""
+    if lost[first] > FREE * values[-1]:
+        along += "; the facets of its curved interfaces alone held its sliding along them"
     if first in joined:
         at = ", ".join(f"{region(q)!r} around {(np.round(centre[q] * 1e3, 1) + 0.0).tolist()} mm"
                        for q in sorted(joined[first]))

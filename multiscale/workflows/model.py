@@ -138,7 +138,8 @@ def build_mesh(scene, comm=MPI.COMM_WORLD) -> two_body.TwoBodyMesh:
     reported 0 unstable modes instead of 1: an adversarial test)."""
     g = scene.geometry
     params = g.params if g.builder == "file" else dict(g.params)
-    tm = two_body.build(g.module(), params, comm, spec=scene_spec(scene), max_cells=g.max_cells)
+    tm = two_body.build(g.module(), params, comm, spec=scene_spec(scene), max_cells=g.max_cells,
+                        sliding=scene.has("friction"))
     motion = tm.spec.motion
     for name in tm.interface.tags if scene.has("friction") else ():
         c = tm.interface.crossing(name, motion)
