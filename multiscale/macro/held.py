@@ -59,11 +59,12 @@ def check_held(model, spec: GeometrySpec, sliding: bool = False) -> None:
     """Every part of the meshed ``model`` (gmsh, linear or quadratic cells) is held against its six
     rigid motions by the supports and interfaces of ``spec`` (module docstring); otherwise an
     InputError names a free part's region, a point and its free motions (a part touching nothing:
-    that it touches nothing). With ``sliding`` (friction), the interfaces do not hold the parts of
-    body 1 in its motion along them (``spec.motion``), however the mesh facets a curved interface:
-    a shaft turning in a bush, its end held along z alone, was held about its axis only by the
-    facets of the cylinder; friction turned it against them and Newton stalled (SNES -6, residual
-    stuck near 7.8 from the 5th iteration on: an adversarial test)."""
+    that it touches nothing). With ``sliding`` (friction), the interfaces hold no part, on either
+    side, in body 1's motion along them (``spec.motion``), however the mesh facets a curved
+    interface: a shaft turning in a bush, its end held along z alone, was held about its axis only
+    by the facets of the cylinder; friction turned it against them and Newton stalled (SNES -6,
+    residual stuck near 7.8 from the 5th iteration on); so did the bush, held along z alone
+    around a held shaft (SNES -6 and -5 on two runs: adversarial tests)."""
     import scipy.sparse  # local: scipy only once a mesh exists (scene reading stays light)
     from scipy.sparse.csgraph import connected_components  # local: as above
     body_of = {r.tag: i for i, b in enumerate(spec.bodies) for r in b.regions}
@@ -114,19 +115,19 @@ def check_held(model, spec: GeometrySpec, sliding: bool = False) -> None:
     N = np.zeros((6 * n_parts, 6 * n_parts))
     turns = isinstance(spec.motion, Rotation)
     axis = np.asarray(spec.motion.axis, float) / np.linalg.norm(spec.motion.axis) if turns else np.zeros(3)
-    slides = np.hstack([spec.motion.velocity(centre), size[:, None] * axis])     # body 1's motion per part
+    slides = np.hstack([spec.motion.velocity(centre), size[:, None] * axis])     # body 1's motion, per part
     slides /= np.linalg.norm(slides, axis=1, keepdims=True)
     lost = np.zeros(n_parts)
 
-    def hold(p: int, q: int, x, d, w, slide=None) -> None:
-        """Add rows r_p(x, d) − r_q(x, d) (q = -1: the ground) with weights w to N; ``slide``: a
-        unit motion of q that the rows do not hold (their component along it removed)."""
-        rp = _rows(x, d, centre[p], size[p])
-        rq = _rows(x, d, centre[q], size[q]) if q >= 0 else None
-        if slide is not None:
-            lost[q] += np.sum(w * (rq @ slide) ** 2)      # what the facets held of it
-            rq = rq - np.outer(rq @ slide, slide)
-        blocks = [(p, rp, 1.0)] + ([(q, rq, -1.0)] if q >= 0 else [])
+    def hold(p: int, q: int, x, d, w, slide: bool = False) -> None:
+        """Add rows r_p(x, d) − r_q(x, d) (q = -1: the ground) with weights w to N; ``slide``: the
+        rows hold neither part in body 1's motion (their components along it removed)."""
+        blocks = [(p, _rows(x, d, centre[p], size[p]), 1.0)] + ([(q, _rows(x, d, centre[q], size[q]), -1.0)]
+                                                                 if q >= 0 else [])
+        if slide:
+            for k, (a, ra, sa) in enumerate(blocks):
+                lost[a] += np.sum(w * (ra @ slides[a]) ** 2)      # what the facets held of it
+                blocks[k] = (a, ra - np.outer(ra @ slides[a], slides[a]), sa)
         for a, ra, sa in blocks:
             for b, rb, sb in blocks:
                 N[6 * a:6 * a + 6, 6 * b:6 * b + 6] += sa * sb * np.einsum("i,ij,ik->jk", w, ra, rb)
@@ -167,7 +168,7 @@ def check_held(model, spec: GeometrySpec, sliding: bool = False) -> None:
         for p, q in np.unique(pair[(pair >= 0).all(axis=1)], axis=0):
             on = (pair == (p, q)).all(axis=1)
             for corner_ in range(3):      # each corner stands for a third of its triangle
-                hold(int(p), int(q), x[on, corner_], n[on], area[on] / 3, slides[q] if sliding else None)
+                hold(int(p), int(q), x[on, corner_], n[on], area[on] / 3, sliding)
     values, vectors = np.linalg.eigh(N)
     free = vectors[:, values <= FREE * max(values[-1], 0.0)]
     if not free.shape[1]:
