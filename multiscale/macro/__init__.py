@@ -32,3 +32,17 @@ from threadpoolctl import threadpool_limits  # noqa: E402
 # 2 ranks on the 2-core machine; docs/architecture.md).
 if MPI.COMM_WORLD.size > 1 and not {"OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"} & set(os.environ):
     threadpool_limits(1, user_api="blas")
+
+from petsc4py import PETSc  # noqa: E402
+
+# PETSc (3.25; option -vec_mdot_use_gemv, on by default) computes VecMDot, the orthogonalisation
+# of (F)GMRES, by BLAS gemv over runs of vectors that happen to lie at one stride in memory and by
+# its own loops otherwise: its rounding followed the heap's layout, and two serial runs of the same
+# scene differed from the first macro Newton solve on (docs/architecture.md, "Repeatability"). Its
+# loops always, unless the user chose (vectors read the option when created: before any DOLFINx
+# object exists; read here once, so that a process that makes no vector is not warned of an unused
+# option at exit).
+for _option in ("vec_mdot_use_gemv", "vec_maxpy_use_gemv"):
+    if not PETSc.Options().hasName(_option):
+        PETSc.Options()[_option] = False
+    PETSc.Options().getBool(_option)
