@@ -88,7 +88,8 @@ def check_held(model, spec: GeometrySpec, sliding: bool = False) -> None:
                                     shape=(n_tets + len(face_rows),) * 2)
     n_parts, label = connected_components(graph, directed=False)
     label = label[:n_tets]
-    corner = xyz[np.searchsorted(all_tags, tets)]                          # (n_tets, 4, 3)
+    index = np.searchsorted(all_tags, tets)                               # nodes as rows of xyz
+    corner = xyz[index]                                                    # (n_tets, 4, 3)
     low, high = np.full((n_parts, 3), np.inf), np.full((n_parts, 3), -np.inf)
     np.minimum.at(low, label, corner.min(axis=1))
     np.maximum.at(high, label, corner.max(axis=1))
@@ -135,16 +136,16 @@ def check_held(model, spec: GeometrySpec, sliding: bool = False) -> None:
     # joints: a node shared by parts of one body (along an edge or at a vertex) is one displacement
     # of both: it holds their relative translation there, not the rotation about it (weight: the
     # squared size of the cells at the node)
-    keys = np.unique(np.stack([np.repeat(body, 4), tets.ravel(), np.repeat(label, 4)], axis=1), axis=0)
-    node_keys, first, count = np.unique(keys[:, :2], axis=0, return_index=True, return_counts=True)
-    cell_size = np.zeros(int(all_tags.max()) + 1)
+    keys = np.unique(np.stack([np.repeat(body, 4), index.ravel(), np.repeat(label, 4)], axis=1), axis=0)
+    _, first, count = np.unique(keys[:, :2], axis=0, return_index=True, return_counts=True)
+    cell_size = np.zeros(len(all_tags))
     volume = np.abs(np.einsum("ij,ij->i", corner[:, 1] - corner[:, 0],
                               np.cross(corner[:, 2] - corner[:, 0], corner[:, 3] - corner[:, 0]))) / 6
-    np.maximum.at(cell_size, tets.ravel(), np.repeat(volume ** (2 / 3), 4))
+    np.maximum.at(cell_size, index.ravel(), np.repeat(volume ** (2 / 3), 4))
     joined = {}                                 # part -> parts it shares only nodes with
     for k in np.flatnonzero(count > 1):
         node = keys[first[k], 1]
-        x = np.tile(xyz[np.searchsorted(all_tags, node)], (3, 1))
+        x = np.tile(xyz[node], (3, 1))
         for other in keys[first[k] + 1:first[k] + count[k], 2]:
             hold(int(keys[first[k], 2]), int(other), x, np.eye(3), np.full(3, cell_size[node]))
             joined.setdefault(int(other), set()).add(int(keys[first[k], 2]))
