@@ -11,7 +11,8 @@ normal component of the motion of the part on one side relative to the part on t
 contact, thesis §1.4); friction holds nothing. With r(x, d) = [d, ((x − c)/L) × d] the
 work-conjugate of the motions along direction d at point x (c the centre of the part's bounding
 box, L its largest side), the holding matrix N = sum_rows w r r^T (w the area [m^2] a node
-stands for) is singular exactly in the motions nothing holds. A singular stiffness made the first
+stands for; at a joint, the squared size of its cells) is singular exactly in the motions nothing
+holds. With friction, no interface holds a part in body 1's motion along it (``check_held``). A singular stiffness made the first
 Newton solve fail on one machine and run with arbitrary sideways pad positions on another, and a
 squeal analysis report rigid motions as unstable 0 Hz modes (adversarial tests); both are refused
 here, before meshing is handed to DOLFINx.
