@@ -155,3 +155,53 @@ def test_a_stationary_part_held_about_the_axis_only_by_the_facets_of_its_interfa
                                          r"interfaces alone held its sliding along them\)"):
         build_mesh(loads(text, tmp_path))
     assert build_mesh(loads(text.replace('effects = ["contact", "friction"]', 'effects = ["contact"]'), tmp_path))
+
+
+def test_a_part_that_touches_nothing_is_refused_after_meshing(tmp_path):
+    """A steel box beside the pads, in pad_b's body, touching nothing and held by no support: it
+    could move freely (a squeal run reported its rigid motions as three unstable 0 Hz modes, and
+    every other mode's residual rose to 1e-2: an adversarial test). Meshing refuses it, naming the
+    region and a point."""
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO + "\nBox(6) = {150, -10, 0, 20, 20, 10};")
+    text = TWO_PADS.replace("{folder}", str(tmp_path / "out")).replace(
+        '[geometry.bodies.pad_b]\ncontains = ["0 mm", "-80 mm", "14 mm"]',
+        '[geometry.bodies.pad_b]\ncontains = [["0 mm", "-80 mm", "14 mm"], ["160 mm", "0 mm", "5 mm"]]')
+    with pytest.raises(InputError, match=r"1 part\(s\) touch no interface and no support \(one of region 'pad_b' "
+                                         r"around \[160\.0, 0\.0, 5\.0\] mm\): they could move freely"):
+        build_mesh(loads(text, tmp_path))
+
+
+def test_pads_free_to_slide_sideways_are_refused_before_solving(tmp_path):
+    """Without the pads' side supports nothing holds them sideways: the contact holds them along
+    its normal only. The stiffness is singular, and the first solve failed on one machine and ran
+    on another (CI), with whatever sideways position MUMPS gave the pads. Meshing refuses it,
+    naming a pad and its free motions; so it does a pad held along x only, a disc whose bore is
+    held along z only (the pads' side supports reach its nodes at their edge, not its cells), and
+    the pads and disc that can move along z together; with the supports the same mesh passes."""
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO)
+    text = TWO_PADS.replace("{folder}", str(tmp_path / "out"))
+    free = text.replace('[[boundary]]\nsurfaces = ["sides"]\nfix = ["x", "y"]\n', "")
+    assert free != text
+    with pytest.raises(InputError, match=r"2 part\(s\) could move as rigid bodies \(one of region 'pad_(a|b)' "
+                                         r"around \[0\.0, -?80\.0, 14\.0\] mm: translation along x, translation "
+                                         r"along y, rotation about z\)"):
+        build_mesh(loads(free, tmp_path))
+    sides = ('[geometry.surfaces.sides]\ncontains = [["-10 mm", "80 mm", "14 mm"], ["10 mm", "80 mm", "14 mm"], '
+             '["-10 mm", "-80 mm", "14 mm"], ["10 mm", "-80 mm", "14 mm"]]\n')
+    assert sides in text
+    x_only = text.replace(sides, sides.replace(', ["-10 mm", "-80 mm", "14 mm"], ["10 mm", "-80 mm", "14 mm"]', '')
+                          + '[geometry.surfaces.b_sides]\ncontains = [["-10 mm", "-80 mm", "14 mm"], '
+                            '["10 mm", "-80 mm", "14 mm"]]\n') + '[[boundary]]\nsurfaces = ["b_sides"]\nfix = ["x"]\n'
+    with pytest.raises(InputError, match=r"1 part\(s\) could move as rigid bodies \(one of region 'pad_b' around "
+                                         r"\[0\.0, -80\.0, 14\.0\] mm: translation along y\)"):
+        build_mesh(loads(x_only, tmp_path))     # pad_b's sides fixed along x only
+    bore = 'surfaces = ["bore"]\nfix = ["x", "y", "z"]'
+    with pytest.raises(InputError, match=r"1 part\(s\) could move as rigid bodies \(one of region 'disc' around "
+                                         r"\[0\.0, 0\.0, 5\.0\] mm: translation along x, translation along y, "
+                                         r"rotation about z\)"):   # a support at the edge of the pads' sides
+        build_mesh(loads(text.replace(bore, 'surfaces = ["bore"]\nfix = ["z"]'), tmp_path))   # holds no disc
+    with pytest.raises(InputError, match=r"3 part\(s\) could move as rigid bodies \(one of region '\w+' around .*: "
+                                         r"translation along z, together with region\(s\) '\w+', '\w+'\)"):
+        build_mesh(loads(text.replace(bore, 'surfaces = ["bore"]\nfix = ["x", "y"]'), tmp_path))  # all along z
+    held = build_mesh(loads(text, tmp_path))
+    assert held.interface is not None
