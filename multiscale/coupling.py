@@ -283,6 +283,8 @@ class Multiscale:
             max_p.append(mp)
         if self.post.conductance is not None:
             self.conductance[np.setdiff1d(np.arange(len(zones)), loaded)] = 0.0
+        if self.model.released:         # no contact, no flash (the zones' last loads stay analysed for wear)
+            self.flash[:] = np.nan
         hot, max_p = self.flash[loaded], np.concatenate(max_p)
         return MicroStep(len(loaded), float(load.pressure.max()), float(max_p.max(initial=0.0)),
                          float(np.nanmax(hot)) if np.isfinite(hot).any() else np.nan, (np.nan,) * 3, 0.0,
@@ -476,6 +478,7 @@ class Multiscale:
             before = [u.x.array.copy() for u in mech.u]
             self.model.last_solve = mech.solve(guess=self.law_increment)
             self.law_increment = [u.x.array - x for u, x in zip(mech.u, before)]
+            self.model.keep_torque(self.model.drive.factor(self.model.time))   # the worn laws moved the pressure
         return StepResult(n, heat, micro, time_macro + _time.perf_counter() - t4, time_micro + t3 - t2, t4 - t3,
                           residuals)
 
