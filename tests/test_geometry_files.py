@@ -620,3 +620,34 @@ def test_a_pressure_on_a_face_without_resultant_is_refused(tmp_path):
         run(loads(wall.replace('normal_force = "1000 N"', 'pressure = "1 MPa"'), tmp_path), verbose=False)
     with pytest.raises(InputError, match=r"a pressure on them has no resultant \(their normals cancel\)"):
         run(loads(wall, tmp_path), verbose=False)
+
+
+def caliper(tmp_path, outboard: str, load: str) -> str:
+    """TWO_PADS with pad_b moved under the disc, opposite pad_a (an inboard and an outboard pad),
+    its back (facing -z) in the one surface "backs" with pad_a's (facing +z); ``outboard`` its
+    box in mm, ``load`` the [loading] line."""
+    x0, y0, size = {"same": (-10, 70, 20), "larger": (-15, 65, 30)}[outboard]
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO.replace("Box(5) = {-10, -90, 10, 20, 20, 8};",
+                                                               f"Box(5) = {{{x0}, {y0}, -8, {size}, {size}, 8}};"))
+    return (TWO_PADS.replace('contains = ["0 mm", "-80 mm", "14 mm"]', 'contains = ["0 mm", "80 mm", "-4 mm"]')
+            .replace('["0 mm", "-80 mm", "18 mm"]', '["0 mm", "80 mm", "-8 mm"]')
+            .replace('["-10 mm", "-80 mm", "14 mm"], ["10 mm", "-80 mm", "14 mm"]',
+                     f'["{x0} mm", "80 mm", "-4 mm"], ["{-x0} mm", "80 mm", "-4 mm"]')
+            .replace('contains = ["0 mm", "60 mm", "5 mm"]', 'contains = ["0 mm", "50 mm", "5 mm"]')
+            .replace('normal_force = "1000 N"', load).replace('{folder}', str(tmp_path / "out")))
+
+
+def test_one_load_surface_on_pads_on_both_sides_of_the_disc_shares_the_force_by_area(tmp_path):
+    """The backs of an inboard pad (400 mm^2, facing +z) and a larger outboard one (900 mm^2,
+    facing -z) as one surface: a force is spread as one pressure whose resultants on the two backs
+    sum to it, 1000 N -> 307.7 N and 692.3 N, like two load surfaces. Before, the surface counted
+    with its net vector area (500 mm^2): 2 MPa, 800 N and 1800 N, 2.6 times the force asked,
+    silently; and two equal pads under 2 MPa (net vector area 0) were refused after the solve
+    ("the contact carries 1.6e+03 N of the 0 N applied"), 1000 N on them before it ("no
+    resultant (their normals cancel)"). An adversarial test."""
+    h = run(loads(caliper(tmp_path, "larger", 'normal_force = "1000 N"'), tmp_path), verbose=False).history
+    assert h["interface_force_pad_a"][-1] == pytest.approx(1000 * 400 / 1300, rel=1e-6)
+    assert h["interface_force_pad_b"][-1] == pytest.approx(1000 * 900 / 1300, rel=1e-6)
+    h = run(loads(caliper(tmp_path, "same", 'pressure = "2 MPa"'), tmp_path), verbose=False, overwrite=True).history
+    assert h["interface_force_pad_a"][-1] == pytest.approx(800.0, rel=1e-6)
+    assert h["interface_force_pad_b"][-1] == pytest.approx(800.0, rel=1e-6)

@@ -12,8 +12,8 @@ The rules that more than one analysis follows live here once:
   ``loading.friction``, with effect ``friction``; else 0;
 - load: a fluid pressure -p n for builders that declare ``fluid_load`` and for geometry files (a
   normal force spread as the uniform pressure F / A, A the load faces' areas projected normal to
-  each face's resultant, ``load_face_areas``; with ``loading.direction``
-  a traction along it), else the scene's normal force [N] or pressure [Pa] on the load faces; with
+  each face's resultant, or of each of a face's flat parts facing opposite ways, ``load_face_areas``;
+  with ``loading.direction`` a traction along it), else the scene's normal force [N] or pressure [Pa] on the load faces; with
   ``loading.vehicle.mass`` the load whose friction moment about the axis is the braking torque
   (braking force x wheel radius): first guessed with every interface carrying the same clamp
   force N, sum_k mu_k N r_k = torque (r_k the interface's mean radius), then scaled by the model
