@@ -333,7 +333,7 @@ class Multiscale:
                 self.rough.plastic[ids] += w
         if self.post.counter_rate is not None:
             contact, iface = self.model.contact, self.tm.interface
-            self.counter_depth += self.rough.track_depth(volume, contact.facet_heat_flux() * iface.areas)
+            self.counter_depth += self.rough.track_depth(volume, m.facet_sliding_power())    # (its flux now: 0 at rest)
             self.counter_volume += volume.sum()
             iface.set_field(contact.initial_gap, self.datum_gap + self.counter_depth)
         work = m.sliding_power() * sliding                                 # mu ∫ p |w| dA dt

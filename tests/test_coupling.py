@@ -361,7 +361,10 @@ def test_a_stop_and_a_restart_keep_every_result_finite(tmp_path):
     for key, values in h.columns.items():       # the scalar columns (per-zone ones mark unloaded zones NaN)
         if np.ndim(values) == 1:
             assert np.all(np.isfinite(values[1:] if key == "coupling_residual" else values)), key
-    assert h["partition_mean"][2] == h["partition_mean"][1] and h["wear_volume"][2] == h["wear_volume"][1]
+    # (the stop at 0.6 s keeps the friction of the sliding that ended it, the rest from 1.2 s is solved without:
+    # the zones loaded differ, so their mean partition moves by 1 %, each zone keeping its own)
+    assert h["partition_mean"][2] == pytest.approx(h["partition_mean"][1], rel=0.02)
+    assert h["wear_volume"][2] == h["wear_volume"][1]
     assert h["heat_step_pin"][2] == h["heat_step_pin"][3] == 0.0 and h["wear_volume"][4] > h["wear_volume"][3]
     assert h["partition_mean"][3] != h["partition_mean"][2] and h["heat_exchanged_step"][4] != 0.0
 

@@ -150,12 +150,17 @@ class MacroModel:
             factor = self.drive.factor(self.time)
             self.contact.engaged.value = self.contact.heating.value = float(factor > 0)
             load = self.load * factor
-            speed = float(self.contact.speed.value)      # friction acts while sliding: a start or a stop changes it
+            # friction acts while sliding: a start or a stop changes it; a stop at the end of a substep
+            # keeps the friction of the sliding that ended it (the pressure the step's wear and work take)
+            speed = float(self.contact.speed.value)
+            moving = speed or self.drive.mean_speed(start + k * delta, start + (k + 1) * delta)
             if factor > 0 and (self.mechanics.temperatures is not None or load != self.mechanics.load.value
-                               or (speed == 0.0) != (self.solved_speed == 0.0)):
+                               or (moving == 0.0) != (self.solved_speed == 0.0)):
+                self.contact.speed.value = moving
                 self.last_solve = self.mechanics.solve(load)
-                self.solved_speed = speed
+                self.solved_speed = moving
                 self.keep_torque(factor)
+                self.contact.speed.value = speed
         self.heat_total += heat
         self.heat_exchanged_total += self.heat_exchanged
         return heat
@@ -182,11 +187,16 @@ class MacroModel:
 
     def sliding_power(self) -> float:
         """mu ∫ p |w| dA [W] of the last solved pressure at unit speed of body 1 (per rad/s or m/s)."""
+        return float(self.facet_sliding_power().sum())
+
+    def facet_sliding_power(self) -> np.ndarray:
+        """mu p |w| dA [W] per interface facet of the last solved pressure at unit speed of body 1,
+        whatever the speed and the load factor now (at rest or released the heat flux is 0)."""
         c = self.contact
         kept = float(c.speed.value), float(c.heating.value)     # copies: .value is a view of the Constant
         c.speed.value, c.heating.value = 1.0, 1.0
         try:
-            return sum(c.heat_power())
+            return c.facet_heat_flux() * self.tm.interface.areas
         finally:
             c.speed.value, c.heating.value = kept
 
