@@ -201,3 +201,23 @@ def test_a_step_ending_at_a_standstill_wears_with_the_sliding_pressure(tmp_path)
             shares[end] = [zones[k][()] / zones[k][()].sum() for k in ("wear_volume", "counter_wear_depth")]
     for at_rest, sliding in zip(shares["0 rpm"], shares["1 rpm"]):
         np.testing.assert_allclose(at_rest, sliding, atol=1e-3 * sliding.max())
+
+
+def test_the_passes_of_the_fixed_point_solve_the_contact_at_rest_without_friction(tmp_path):
+    """Rough pin without wear or expansion, 200 rpm to rest at 0.6 s, restarting from 1.2 s; the
+    partitions iterated to 1e-6 (fixed point, 3 passes in the step to rest): at rest the contact
+    is solved without friction as in one pass (max pressure 7.06 MPa). Before, a pass restored the
+    fields but not the speed of the last solve, so the next pass saw no change and kept the
+    sliding state (5.74 MPa; an adversarial test)."""
+    from test_coupling import POD
+    text = POD.replace('rotation_speed = "200 rpm"\n', "").replace('"expansion", ', "").replace(', "wear"]', "]")
+    pressure = {}
+    for tol in (1e-6, 0.9):
+        scene = loads(text.format(folder=tmp_path / str(tol)), overrides={
+            "time.end": "1.8 s", "time.steps": 3, "micro.coupling": "fixed-point", "micro.coupling_tol": tol,
+            "loading.speed_profile": [["0 s", "200 rpm"], ["0.6 s", "0 rpm"], ["1.2 s", "0 rpm"], ["1.8 s", "200 rpm"]]})
+        h = run_multiscale(scene, verbose=False).history
+        assert h["coupling_iterations"][2] >= (2 if tol < 0.9 else 1)
+        pressure[tol] = h["max_pressure"]
+    np.testing.assert_allclose(pressure[1e-6], pressure[0.9], rtol=1e-6)
+    assert pressure[0.9][2] > 1.2 * pressure[0.9][0]            # at rest (without friction) against sliding

@@ -213,10 +213,12 @@ class MacroModel:
         return [*(getattr(self.contact, k) for k in ("speed", "engaged", "heating")), self.mechanics.load]
 
     def snapshot(self) -> dict:
-        """The state a step starts from (fields, time, heat counters, drive constants)."""
+        """The state a step starts from (fields, time, heat counters, drive constants, the speed and
+        load of the last solve: a pass of a fixed point that solved at a start or a stop is undone)."""
         state = {"arrays": [f.x.array.copy() for f in self.functions.values()], "time": self.time,
                  "heat_total": self.heat_total.copy(), "exchanged": self.heat_exchanged_total,
-                 "last_solve": self.last_solve, "constants": [float(c.value) for c in self.drive_constants]}
+                 "last_solve": self.last_solve, "constants": [float(c.value) for c in self.drive_constants],
+                 "solved_speed": self.solved_speed, "load": self.load}
         if self.thermal is not None:
             state.update(thermal_time=self.thermal.time, lost_total=self.thermal.lost_total.copy(),
                          lost_step=self.thermal.lost_step.copy())
@@ -230,6 +232,7 @@ class MacroModel:
             c.value = value
         self.time, self.heat_total, self.last_solve = state["time"], state["heat_total"].copy(), state["last_solve"]
         self.heat_exchanged_total = state["exchanged"]
+        self.solved_speed, self.load = state["solved_speed"], state["load"]
         if self.thermal is not None:
             self.thermal.time = state["thermal_time"]
             self.thermal.lost_total, self.thermal.lost_step = state["lost_total"].copy(), state["lost_step"].copy()
