@@ -108,46 +108,75 @@ def load_face_areas(tm: TwoBodyMesh, load_kind: str) -> dict:
     length of its vector area |int n dA|, the area projected normal to the resultant (a flat face:
     its area; a hemisphere of radius R: pi R^2, not 2 pi R^2), 0 below ``NO_RESULTANT`` of the area.
     A face made of flat parts that face opposite ways (one surface naming the backs of an inboard
-    and an outboard pad) counts with the sum of the parts' areas (``_opposite_parts``): the
+    and an outboard pad) counts with the sum of the parts' areas (``load_face_parts``): the
     pressure pushes each part with its own resultant, and a force is their sum of magnitudes, as
     over several load faces."""
+    if load_kind != "fluid":
+        return {f: tm.assemble_scalar(1.0 * tm.ds(tm.face(f))) for f in tm.spec.load_faces}
+    return {f: float(sum(np.linalg.norm(v) for v in parts)) for f, parts in load_face_parts(tm).items()}
+
+
+def load_face_parts(tm: TwoBodyMesh) -> dict:
+    """Vector areas int n dA [m^2] of the parts of each load face that a fluid pressure pushes as
+    one (-p times each is its resultant): the face's, or its two flat parts facing opposite ways
+    (``_opposite_parts``); none if it has no resultant (below ``NO_RESULTANT`` of its area)."""
     out = {}
+    n = ufl.FacetNormal(tm.parent)
     for f in tm.spec.load_faces:
         ds = tm.ds(tm.face(f))
         area = tm.assemble_scalar(1.0 * ds)
-        if load_kind == "fluid":
-            n = ufl.FacetNormal(tm.parent)
-            resultant = np.array([tm.assemble_scalar(n[i] * ds) for i in range(3)])
-            vector = float(np.linalg.norm(resultant))
-            parts = _opposite_parts(tm, ds, resultant if vector > NO_RESULTANT * area else None, area)
-            area = parts if parts is not None else vector if vector > NO_RESULTANT * area else 0.0
-        out[f] = area
+        resultant = np.array([tm.assemble_scalar(n[i] * ds) for i in range(3)])
+        some = bool(np.linalg.norm(resultant) > NO_RESULTANT * area)
+        parts = _opposite_parts(tm, ds, resultant if some else None, area)
+        out[f] = parts if parts is not None else [resultant] if some else []
     return out
 
 
 FLAT = 0.9     # a part of a load face is flat if its vector area is at least this share of its area
 
 
-def _opposite_parts(tm: TwoBodyMesh, ds, resultant, area: float) -> float | None:
-    """Sum of the vector areas of a face's two parts whose normals point along and against a
-    direction (the resultant's, or without one the principal direction of its normals) if both
-    are flat (``FLAT``) and each holds more than ``NO_RESULTANT`` of the area; else None (a dome,
-    a cylinder's wall). Measured: two pad backs of 400 and 900 mm^2 facing -z and +z as one
-    surface counted as 500 mm^2, so 1000 N asked put 800 N and 1800 N on the pads."""
+def _opposite_parts(tm: TwoBodyMesh, ds, resultant, area: float) -> list | None:
+    """The vector areas of a face's two parts whose normals point along and against a direction
+    (the resultant's, or without one the principal direction of its normals) if both are flat
+    (``FLAT``) and each holds more than ``NO_RESULTANT`` of the area; else None (a dome, a
+    cylinder's wall). Measured: two pad backs of 400 and 900 mm^2 facing -z and +z as one surface
+    counted as its net 500 mm^2, so 1000 N asked put 800 N and 1800 N on the pads."""
     n = ufl.FacetNormal(tm.parent)
     if resultant is None:
         moment = np.array([[tm.assemble_scalar(n[i] * n[j] * ds) for j in range(3)] for i in range(3)])
         resultant = np.linalg.eigh(moment)[1][:, -1]
     d = fem.Constant(tm.parent, np.asarray(resultant, dtype=float) / np.linalg.norm(resultant))
-    total = 0.0
+    out = []
     for side in (ufl.gt(ufl.dot(n, d), 0.0), ufl.lt(ufl.dot(n, d), 0.0)):
         chi = ufl.conditional(side, 1.0, 0.0)
         part = tm.assemble_scalar(chi * ds)
-        vector = np.linalg.norm([tm.assemble_scalar(chi * n[i] * ds) for i in range(3)])
-        if not (part > NO_RESULTANT * area and vector >= FLAT * part):
+        vector = np.array([tm.assemble_scalar(chi * n[i] * ds) for i in range(3)])
+        if not (part > NO_RESULTANT * area and np.linalg.norm(vector) >= FLAT * part):
             return None
-        total += float(vector)
-    return total
+        out.append(vector)
+    return out
+
+
+UNBALANCED = 0.01    # a clamp whose sides' resultants differ by more than this share of their sum is noted
+
+
+def clamp_imbalance(tm: TwoBodyMesh, pressure: float) -> str | None:
+    """A note if a fluid ``pressure`` [Pa] pushes load parts (``load_face_parts``) against each
+    other, clamping (an inboard and an outboard pad, a piston and a caliper's bore), with a net
+    resultant beyond ``UNBALANCED`` of their sum: the difference goes into the supports (the
+    disc's mount), not through both contacts; None otherwise (all parts push one way, a pin on a
+    disc: the whole load goes to the mount, as meant). Measured: pads of 400 and 900 mm^2 on both
+    sides of a disc under 2 MPa carried 800 N and 1800 N, the mount 1000 N, without a word."""
+    forces = [-pressure * v for parts in load_face_parts(tm).values() for v in parts]
+    if not any(a @ b < 0 for a in forces for b in forces):
+        return None
+    net, total = np.linalg.norm(np.sum(forces, axis=0)), sum(np.linalg.norm(f) for f in forces)
+    if net <= UNBALANCED * total:
+        return None
+    return (f"loading.faces = {list(tm.spec.load_faces)}: the load pushes parts against each other (clamping) with "
+            f"{', '.join(f'{np.linalg.norm(f):.4g}' for f in forces)} N; the difference, {net:.4g} N, goes into "
+            "the supports (the rotating body's mount), not through the contacts on both sides (a floating caliper "
+            "would balance them): give the sides equal areas if the clamp is meant to be balanced")
 
 
 def load_face_forces(tm: TwoBodyMesh, load: float, load_kind: str) -> dict:

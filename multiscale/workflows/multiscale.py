@@ -181,7 +181,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     if done == steps:
         checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
     result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones, ckpt] + maps, _time.perf_counter() - start,
-                              history, h5, png, writer.files, plot, maps, zones, done)
+                              history, h5, png, writer.files, plot, maps, zones, done,
+                              warnings=tuple(ms.model.notes))
     del ms, writer            # the model holds reference cycles of PETSc objects: free them on every
     gc.collect()              # rank at the same point (collected later, ranks could hang at exit)
     if stopping:                 # decided by every rank together

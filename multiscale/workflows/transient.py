@@ -9,7 +9,7 @@ writes ``history.h5``, ``history.png`` and the field files (``multiscale.outputs
 from __future__ import annotations
 
 import time as _time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from mpi4py import MPI
@@ -30,6 +30,7 @@ class TransientResult(RunResult):
     history_file: Path          # history.h5
     plot_file: Path             # history.png
     field_files: list           # XDMF files
+    warnings: tuple = field(default=(), kw_only=True)   # what the model noted (``MacroModel.notes``)
 
 
 def write_history(history: io.History, folder: Path, name: str, comm, plot: bool = True) -> tuple[Path, Path]:
@@ -82,7 +83,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     if stopping:                     # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}")
     result = TransientResult(folder, writer.files + [h5, png], _time.perf_counter() - start, history, h5, png,
-                             writer.files)
+                             writer.files, warnings=tuple(model.notes))
     if verbose and comm.rank == 0:
         print(f"{scene.name}: {len(history)} records in {result.wall_time:.1f} s on {comm.size} rank(s)")
         print(f"  ParaView: {', '.join(str(f) for f in writer.files)}")
