@@ -271,8 +271,11 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         near = {name: suggest(name, missing) for name in scene.materials if name not in g.materials}
         typos = unknown_keys({n: 0 for n, hint in near.items() if hint}, g.materials, "materials", ctx,
                              f"material of {where}")
-        warnings += [f"materials.{name} is not used: {where} has the materials {', '.join(g.materials)}"
-                     for name, hint in near.items() if not hint]
+        for name in (n for n, hint in near.items() if not hint):     # a library's spare tables: their problems
+            own = [p for p in problems if p.startswith((f"materials.{name}.", f"materials.{name}:"))]  # warned
+            problems[:] = [p for p in problems if p not in own]
+            warnings.append(f"materials.{name} is not used: {where} has the materials {', '.join(g.materials)}"
+                            + (f" (ignored with its problems: {', '.join(p.split(': ')[0] for p in own)})" if own else ""))
         for name in g.materials:
             if name not in scene.materials and name not in typos:
                 problems.append(f'materials.{name}: missing; {where} needs the materials {", ".join(g.materials)}')
