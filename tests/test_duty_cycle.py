@@ -188,19 +188,22 @@ def test_a_step_ending_at_a_standstill_wears_with_the_sliding_pressure(tmp_path)
     the largest share; measured 1.5e-5). Before, the stop at the step's end solved the contact
     without friction and the whole step wore with that pressure (the pin's largest zone share 43 %
     instead of 35 %, 22 % off), and the disc's track took the zones' volumes by facet area, the
-    heat flux being 0 at rest (the depth profile 11 % off; an adversarial test)."""
+    heat flux being 0 at rest (the depth profile 11 % off; an adversarial test). The same with the
+    stop at the end of the first of two substeps, the second at rest (or at 1 rpm)."""
     import h5py
     from test_coupling import POD
     text = POD.replace('rotation_speed = "200 rpm"\n', "")
-    shares = {}
-    for end in ("0 rpm", "1 rpm"):
-        scene = loads(text.format(folder=tmp_path / end[0]), overrides={
-            "time.end": "0.6 s", "time.steps": 1, "materials.disc.k_w": "1e-15 1/Pa",
-            "loading.speed_profile": [["0 s", "200 rpm"], ["0.6 s", end]]})
-        with h5py.File(run_multiscale(scene, verbose=False).zones_file) as zones:
-            shares[end] = [zones[k][()] / zones[k][()].sum() for k in ("wear_volume", "counter_wear_depth")]
-    for at_rest, sliding in zip(shares["0 rpm"], shares["1 rpm"]):
-        np.testing.assert_allclose(at_rest, sliding, atol=1e-3 * sliding.max())
+    cases = {"end of the step": ("0.6 s", 1), "end of the first substep": ("0.3 s", 2)}   # the stop, substeps
+    for case, (stop, substeps) in cases.items():
+        shares = {}
+        for end in ("0 rpm", "1 rpm"):
+            scene = loads(text.format(folder=tmp_path / f"{substeps}{end[0]}"), overrides={
+                "time.end": "0.6 s", "time.steps": 1, "time.substeps": substeps, "materials.disc.k_w": "1e-15 1/Pa",
+                "loading.speed_profile": [["0 s", "200 rpm"], [stop, end]]})     # (held after its end)
+            with h5py.File(run_multiscale(scene, verbose=False).zones_file) as zones:
+                shares[end] = [zones[k][()] / zones[k][()].sum() for k in ("wear_volume", "counter_wear_depth")]
+        for at_rest, sliding in zip(shares["0 rpm"], shares["1 rpm"]):
+            np.testing.assert_allclose(at_rest, sliding, atol=1e-3 * sliding.max(), err_msg=case)
 
 
 def test_the_passes_of_the_fixed_point_solve_the_contact_at_rest_without_friction(tmp_path):

@@ -153,10 +153,10 @@ class MacroModel:
             factor = self.drive.factor(self.time)
             self.contact.engaged.value = self.contact.heating.value = float(factor > 0)
             load = self.load * factor
-            # friction acts while sliding: a start or a stop changes it; a stop at the end of a substep
+            # friction acts while sliding: a start or a stop changes it; a stop inside the macro step
             # keeps the friction of the sliding that ended it (the pressure the step's wear and work take)
             speed = float(self.contact.speed.value)
-            moving = speed or self.drive.mean_speed(start + k * delta, start + (k + 1) * delta)
+            moving = speed or self.drive.mean_speed(start, start + (k + 1) * delta)
             if factor > 0 and (self.mechanics.temperatures is not None or load != self.mechanics.load.value
                                or (moving == 0.0) != (self.solved_speed == 0.0)):
                 self.contact.speed.value = moving
