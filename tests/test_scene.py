@@ -615,3 +615,20 @@ def test_a_penalty_softer_than_the_bodies_is_warned_about(tmp_path):
     soft = loads(text.replace('penalty = "1e13 Pa/m"', 'penalty = "1e12 Pa/m"'), tmp_path)
     assert len(soft.warnings) == 1 and soft.warnings[0].startswith(
         "interface.penalty = 1e+12 Pa/m is softer than the bodies at interface interface: E*/h = 1.61e+12 Pa/m")
+
+
+def test_a_squeal_analysis_of_a_duty_cycle_says_which_state_it_takes():
+    """The squeal analysis linearises one state (the full load at the speed at t = 0): a speed
+    profile from rest gave 0 unstable modes of the demo brake (4 at 5 rad/s) without a word; now
+    the cycle and the state at rest are warned about (an adversarial test)."""
+    text = (DEMOS / "brake_squeal.toml").read_text()
+    assert not loads(text, name="brake").warnings
+    cycle = loads(text.replace('rotation_speed = "5 rad/s"', 'speed_profile = [["0 s", "0 rpm"], ["1 s", "500 rpm"]]'),
+                  name="brake").warnings
+    assert cycle == ("loading.speed_profile: the squeal analysis is of one state, the full load at the speed at t = 0 "
+                     "(0 rad/s); the rest of the cycle is ignored",
+                     "the squeal analysis is at rest (speed 0 rad/s at t = 0): the preload has no friction, so no "
+                     "friction-induced instability can be found; give the speed of the sliding state to analyse")
+    swept = loads(text.replace('rotation_speed = "5 rad/s"', 'rotation_speed = "0 rad/s"'), name="brake",
+                  overrides={"stability.sweep": {"speed": ["1 rad/s", "5 rad/s"]}}).warnings
+    assert not [w for w in swept if "at rest" in w]
