@@ -559,8 +559,8 @@ class Wear:
     """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (default: the
     rough body's material k_w, else the shape of thesis Fig. 7.9, ``FIG_7_9_WEAR_RATE``, whose
     level is calibrated on the thesis' ch. 7 worn volume: ``FIG_7_9_CALIBRATION``). Every
-    ``update_every`` macro steps (and at the last step) the zones wear over the sliding of those
-    steps, weighted by the load factor (none while released), in ``substeps`` load-controlled
+    ``update_every`` macro steps (and at the last step, and a step ending at a stop) the zones wear
+    over the sliding since, weighted by the load factor (none while released), in ``substeps`` load-controlled
     increments; a counter-face whose material gives ``k_w`` wears too."""
 
     k_w: float | None = key(_WEAR_RATE)                      # 1/Pa
