@@ -352,6 +352,10 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                    ([f"at {table[-1][1]:g}{unit} from {table[-1][0]:g} s to time.end = {end:g} s"]
                     if table[-1][0] < end else [])
             warnings.append(f"loading.{key} is held {' and '.join(held)} (it does not cover the run)")
+    profile = scene.loading.load_profile if scene.loading is not None else None
+    if profile is not None and not any(factor > 0 for _, factor in profile):
+        warnings.append("loading.load_profile is 0 throughout: the load is released for the whole run (no "
+                        "contact, no frictional heat)")
     if g is not None and scene.materials is not None and scene.time is not None:
         T0 = scene.time.initial_temperature       # every property of a run starts there
         warnings += [f"materials.{name}.{phrase} (the initial temperature)" for name in g.materials

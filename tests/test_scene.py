@@ -370,6 +370,9 @@ def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
     assert [w for w in short.warnings if "profile" in w] == [
         "loading.load_profile is held at 1 before 1 s and at 0.5 from 5 s to time.end = 30 s (it does not cover the run)",
         "loading.speed_profile is held at 3.14159 rad/s from 20 s to time.end = 30 s (it does not cover the run)"]
+    idle = loads((DEMOS / "pin_on_disc_perfect.toml").read_text().replace("[loading]", '[loading]\nload_profile = [["0 s", 0], ["30 s", 0]]'), tmp_path)
+    assert [w for w in idle.warnings if "profile" in w] == [     # before: no word of it
+        "loading.load_profile is 0 throughout: the load is released for the whole run (no contact, no frictional heat)"]
 
 
 @pytest.mark.parametrize("old, new, warning", [

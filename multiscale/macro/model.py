@@ -101,7 +101,7 @@ class MacroModel:
 
     def start(self) -> SolveResult:
         """First contact solve from rest with the drive's load ramp (at the initial load factor;
-        a start in a released phase solves at the first engaged load, then releases); with a
+        a start in a released phase solves at the full load, factor 1, then releases); with a
         torque, the load is scaled to it and solved again."""
         self.contact.speed.value = self.speed(0.0)
         self.load = self.drive.load
