@@ -397,7 +397,7 @@ class Mechanics:
         direction = ufl.as_vector(np.asarray(spec.load_direction, float) / np.linalg.norm(spec.load_direction))
         if self.load_kind == "pressure":
             return self.load * direction
-        area = sum(self.tm.assemble_scalar(1.0 * self.tm.ds(self.tm.face(f))) for f in spec.load_faces)
+        area = sum(load_face_areas(self.tm, self.load_kind).values())
         return self.load / area * direction
 
     def _load_norm(self, v) -> float:
