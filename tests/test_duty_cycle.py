@@ -246,3 +246,21 @@ def test_a_stop_inside_a_wear_interval_wears_at_the_stop(tmp_path):
         if end == "0 rpm":                    # worn at the stop, nothing at rest
             assert result.history["wear_volume"][1] > 0 and result.history["wear_volume"][2] == result.history["wear_volume"][1]
     np.testing.assert_allclose(shares["0 rpm"], shares["1 rpm"], atol=1e-2 * shares["1 rpm"].max())
+
+
+def test_a_history_of_released_rows_plots_without_a_warning(tmp_path):
+    """A history whose rows are all released (pressures 0, no flash temperature) plots its pressure
+    panel on a linear axis with a note, without matplotlib's warning (before: "Data has no
+    positive values, and therefore cannot be log-scaled", twice; an adversarial test)."""
+    import warnings
+    from multiscale import io
+    from multiscale.plots.history import multiscale_figure
+    history = io.History()
+    for t in (0.0, 0.6, 1.2):
+        history.append(time=t, max_pressure=0.0, max_zone_pressure=0.0, micro_max_pressure=0.0,
+                       max_temperature_pin=300.0, micro_max_temperature=np.nan)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        multiscale_figure(history, tmp_path / "released.png")
+    assert [str(w.message) for w in caught] == []
+    assert (tmp_path / "released.png").stat().st_size > 0

@@ -3,10 +3,11 @@ loop (thesis ch. 7) and the wear map.
 
 ``history_figure``: interface force, max contact pressure, max temperatures and heat into each body
 against time. ``multiscale_figure``: max contact pressure macro (facets, zones) vs micro (Fig. 7.14;
-log scale), max temperature macro vs micro (Fig. 7.15), heat partition min/mean/max (Fig. 7.12),
-wear volume (Fig. 7.16), max wear depth (Fig. 7.17) and RMS of the worn surface (Fig. 7.18) — the
-panels whose columns the history has. ``wear_map``: the mean wear depth of every zone over the
-interface (Fig. 7.13) beside the micro wear depth field of the whole face.
+log scale, linear with a note if no row has contact), max temperature macro vs micro (Fig. 7.15),
+heat partition min/mean/max (Fig. 7.12), wear volume (Fig. 7.16), max wear depth (Fig. 7.17) and
+RMS of the worn surface (Fig. 7.18) — the panels whose columns the history has. ``wear_map``: the
+mean wear depth of every zone over the interface (Fig. 7.13) beside the micro wear depth field of
+the whole face.
 """
 from __future__ import annotations
 
@@ -78,7 +79,11 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
         for key, name in keys:
             ax.plot(t, history[key] * scale + shift, "o-", ms=3, label=name)
         if label.startswith("max contact pressure"):
-            ax.set_yscale("log")
+            values = np.concatenate([np.asarray(history[k], dtype=float) for k, _ in keys])
+            if (values > 0).any():     # log of the positive values (0 released or between zones)
+                ax.set_yscale("log")
+            else:                      # a history of released rows only: nothing to log-scale
+                ax.text(0.5, 0.5, "no contact in this history", transform=ax.transAxes, ha="center", va="center")
         ax.set_xlabel("time [s]")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
