@@ -138,6 +138,8 @@ class MacroModel:
                 t0, t1 = self.time, self.time + delta
                 speed = self.drive.mean_speed(t0, t1)
                 self.contact.speed.value = speed
+                if speed and self.solved_speed == 0.0 and not self.released:
+                    self.start_sliding(speed, self.drive.factor(t0))
                 # the pressure was solved at the load factor of the step's start: the conductance
                 # scales with the mean factor over the step (a release inside it, a load ramp), the
                 # frictional heat with the mean of factor x speed (exact for a stop inside the step)
@@ -167,6 +169,16 @@ class MacroModel:
         self.heat_total += heat
         self.heat_exchanged_total += self.heat_exchanged
         return heat
+
+    def start_sliding(self, speed: float, factor: float) -> None:
+        """Solve the contact with friction at the sliding ``speed`` (rad/s or m/s; its sign the
+        direction) and the load last solved, before a heat step that slides from rest: the step
+        heats with the frictional pressure (before, with the frictionless one of the solve at rest:
+        the test pin-on-disc restarting from a stop, 0 to 200 rpm over a 0.6 s step, 1.24e-3 off in
+        the step's heat)."""
+        self.last_solve = self.mechanics.solve()
+        self.solved_speed = speed
+        self.keep_torque(factor)
 
     def keep_torque(self, factor: float) -> None:
         """With the drive's torque and while sliding: scale the load until the friction moment is
