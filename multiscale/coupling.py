@@ -369,9 +369,10 @@ class Multiscale:
     def heat_residual(self) -> float:
         """The coupling residual: max over the loaded zones of |heat into the rough body by the last
         post-analysis − heat the macro model put into it at the same state (its partition of Phi,
-        minus the exchange G (T_rough − T_counter))| / the zones' mean Phi."""
+        minus the exchange G (T_rough − T_counter))| / the zones' mean Phi; 0 while released (no
+        contact, no heat: the zones' last loads are analysed, but nothing couples)."""
         loaded = self._last[-1]
-        if not len(loaded):
+        if not len(loaded) or self.model.released:
             return 0.0
         Q = self.micro_heat[loaded]
         if not Q.mean() > 0:                    # no frictional heat (no sliding): nothing to couple
@@ -498,10 +499,10 @@ class Multiscale:
                    max_zone_pressure=micro.zone_pressure * on, micro_max_pressure=micro.max_pressure * on,
                    real_contact_area=micro.real_area * on, law_reach=micro.law_reach * on,
                    law_reach_halved=micro.law_reach_halved * on)
-        if self.post.heating is not None:
-            row.update(micro_max_temperature=micro.max_temperature, partition_min=micro.partition[0],
-                       partition_mean=micro.partition[1], partition_max=micro.partition[2],
-                       zone_flash_temperature=self.flash.copy())
+        if self.post.heating is not None:           # released: no heat to share (NaN, as the flash)
+            low, mean, high = micro.partition if on else (np.nan,) * 3
+            row.update(micro_max_temperature=micro.max_temperature, partition_min=low, partition_mean=mean,
+                       partition_max=high, zone_flash_temperature=self.flash.copy())
         if self.partition_law:
             row.update(coupling_residual=result.residuals[-1] if result.residuals else np.nan,
                        coupling_iterations=len(result.residuals))

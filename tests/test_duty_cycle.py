@@ -97,6 +97,46 @@ def test_a_release_phase_has_no_contact_and_no_frictional_heat(tmp_path):
 
 
 
+
+def body_fields(path) -> list:
+    """(time, displacement [m] at the nodes, von Mises stress [Pa] per cell) of a body's field file."""
+    import meshio
+    with meshio.xdmf.TimeSeriesReader(str(path)) as reader:
+        reader.read_points_cells()
+        steps = [reader.read_data(k) for k in range(reader.num_steps)]
+    return [(t, point["displacement [m]"], cell["von Mises stress [Pa]"][0]) for t, point, cell in steps]
+
+
+@pytest.mark.parametrize("expansion", [False, True], ids=["no expansion", "expansion"])
+def test_a_released_phase_writes_the_unloaded_bodies(tmp_path, expansion):
+    """Loaded to 0.6 s, released within 10 ms, loaded again from 1.2 s within 10 ms: at 1.2 s
+    nothing is solved and the field files hold the unloaded bodies: without thermal expansion a
+    displacement and a von Mises stress of exactly 0 (no load, no contact, zero supports, no body
+    force); with it NaN (that state needs a solve without the contact: docs/results.rst). Loaded
+    again, the state is the loaded one (no expansion: that of 0.6 s to 1e-6; the solve starts from
+    the loaded displacements, kept). Before, the released time showed the last loaded state (an
+    adversarial test)."""
+    effects = ("contact", "friction", "thermal", "heat_partition") + (("expansion",) if expansion else ())
+    folder = tmp_path / "release"
+    scene = loads(pin_on_disc(folder, effects=effects, partition="0.14"), overrides={
+        "loading.load_profile": [["0 s", 1.0], ["0.6 s", 1.0], ["0.61 s", 0.0], ["1.2 s", 0.0], ["1.21 s", 1.0]],
+        "time.end": "1.8 s", "time.steps": 3})
+    h = run(scene, verbose=False).history
+    assert h["interface_force"][2] == 0.0 and h["interface_force"][3] > 199.0
+    for body in ("pin", "disc"):
+        fields = body_fields(folder / f"{body}.xdmf")
+        assert [t for t, _, _ in fields] == pytest.approx([0.0, 0.6, 1.2, 1.8])
+        for t, u, s in (fields[1], fields[3]):              # loaded
+            assert np.isfinite(u).all() and np.abs(u).max() > 1e-7 and np.isfinite(s).all() and s.max() > 1e5, t
+        _, u, s = fields[2]                                 # released
+        if expansion:
+            assert np.isnan(u).all() and np.isnan(s).all(), body
+        else:
+            assert np.all(u == 0.0) and np.all(s == 0.0), body
+            np.testing.assert_allclose(fields[3][1], fields[1][1], rtol=1e-6, atol=1e-6 * np.abs(fields[1][1]).max())
+            np.testing.assert_allclose(fields[3][2], fields[1][2], rtol=1e-6, atol=1e-6 * fields[1][2].max())
+
+
 def test_sliding_from_a_standstill_solves_the_contact_with_friction(tmp_path):
     """A disc at rest (no friction), then spun up: once it slides the contact is solved again with
     friction, the state of a start at 1 rpm (before: the frictionless state of the start stayed for
@@ -192,7 +232,9 @@ def test_a_rough_stop_keeps_the_torque_after_the_worn_laws(tmp_path):
 def test_a_released_rough_contact_has_no_flash_temperature(tmp_path):
     """Released after 0.6 s (within 10 ms): the zones keep their last loads for the wear of the
     step, but nothing touches, so no zone has a flash temperature (before: 340 K, the flash of
-    the last loads sliding at 200 rpm, beside the pin's 295 K; an adversarial test)."""
+    the last loads sliding at 200 rpm, beside the pin's 295 K; an adversarial test), no partition
+    (NaN), a coupling residual of 0 and the pin's fields NaN (with expansion, as in
+    test_a_released_phase_writes_the_unloaded_bodies; before, those of the last loads)."""
     from test_coupling import POD
     scene = loads(POD.format(folder=tmp_path / "released"), overrides={
         "loading.load_profile": [["0 s", 1.0], ["0.6 s", 1.0], ["0.61 s", 0.0]], "time.end": "1.8 s", "time.steps": 3})
@@ -202,6 +244,11 @@ def test_a_released_rough_contact_has_no_flash_temperature(tmp_path):
     assert np.all(h["micro_max_temperature"][~off] > h["max_temperature_pin"][~off])
     assert np.all(np.isnan(h["micro_max_temperature"][off])) and np.all(np.isnan(flash[off]))
     assert np.isfinite(flash[~off]).any(axis=1).all()
+    # no heat to share, nothing to couple (before: the partitions and the residual of the last loads)
+    assert np.all(np.isnan(h["partition_mean"][off])) and np.all(np.isfinite(h["partition_mean"][~off]))
+    assert np.all(h["coupling_residual"][off] == 0.0)
+    _, u, s = body_fields(tmp_path / "released" / "pin.xdmf")[-1]     # expansion: no unloaded state solved
+    assert np.isnan(u).all() and np.isnan(s).all()
 
 
 def test_a_step_ending_at_a_standstill_wears_with_the_sliding_pressure(tmp_path):
