@@ -505,6 +505,71 @@ def test_a_study_under_nohup_outlives_its_terminal(tmp_path):
         _terminated(proc, workers)
 
 
+def test_a_study_killed_by_sigkill_ends_its_workers(tmp_path):
+    """SIGKILL to `multiscale study` (`kill -9`, the OOM killer, a scheduler's hard limit) cannot be
+    caught; its workers read the end of the driver's lifeline pipe and kill their process groups:
+    both gone within 10 s (measured 0.13 s during their runs, 0.5-0.6 s while they still load their
+    modules). Before, they ran on orphaned (here: 100000 wear steps each), a known problem of the
+    thirty-first session."""
+    import signal
+    proc, workers = _slow_study(tmp_path)
+    try:
+        proc.send_signal(signal.SIGKILL)
+        assert proc.wait(timeout=10) == -signal.SIGKILL
+        assert _gone(workers, within=10.0) == []
+    finally:
+        _end(proc, workers)
+
+
+def test_a_worker_whose_driver_is_gone_ends_its_process_group(tmp_path):
+    """The watchdog of a worker (`worker.watch_driver`) kills the process group it leads, not only
+    itself: what it started there, as a scene run's `mpiexec -n 2`, ends with it (hydra's proxy ends
+    the ranks, in sessions of their own, when `mpiexec` goes). Here a stand-in worker, in a session
+    of its own as `running._spawn` starts one, watches a pipe and runs `mpiexec -n 2 sleep`; the
+    pipe's write end closed (the driver's end), the worker and both ranks are gone within 10 s."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    mpiexec = Path(sys.executable).with_name("mpiexec")
+    if not mpiexec.exists():
+        pytest.skip("no mpiexec beside the interpreter")
+    mark = f"{time.time() % 1000:.6f}"                         # the ranks' `sleep 9xx.xxxxxx`, found in /proc
+    read, write = os.pipe()
+    code = ("import subprocess, sys, time\nfrom multiscale.studies.worker import watch_driver\n"
+            f"watch_driver({read})\nsubprocess.Popen([{str(mpiexec)!r}, '-n', '2', 'sleep', '9{mark}'])\n"
+            "time.sleep(60)\n")
+    worker = subprocess.Popen([sys.executable, "-c", code], pass_fds=(read,), start_new_session=True)
+    os.close(read)
+    ranks = []
+    try:
+        for _ in range(300):
+            time.sleep(0.05)
+            ranks = [int(p.name) for p in Path("/proc").iterdir() if p.name.isdigit()
+                     and _cmdline(p) == b"sleep\x009" + mark.encode() + b"\x00"]
+            if len(ranks) == 2:
+                break
+        assert len(ranks) == 2 and worker.poll() is None
+        os.close(write)                                         # the driver is gone
+        write = None
+        assert worker.wait(timeout=10) == -signal.SIGKILL
+        assert _gone(ranks, within=10.0) == []
+    finally:
+        if write is not None:
+            os.close(write)
+        _end(worker, ranks)
+
+
+def _gone(pids, within: float) -> list:
+    """The processes of ``pids`` still running after ``within`` seconds at most (polled)."""
+    deadline = time.monotonic() + within
+    while True:
+        alive = [pid for pid in pids if _cmdline(Path(f"/proc/{pid}"))]
+        if not alive or time.monotonic() > deadline:
+            return alive
+        time.sleep(0.05)
+
+
 def _terminated(proc, workers):
     """SIGTERM ends the study ``proc`` with 143 and its ``workers`` with it (both killed in any case)."""
     import signal

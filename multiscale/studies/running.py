@@ -1,7 +1,10 @@
 """Running a study: each run without a record in a fresh worker process (``python -m
 multiscale.studies.worker``), ``[run] processes`` at a time, with timeouts; under ``mpiexec`` the
 runs are shared out over the ranks. A crash or timeout becomes a failed record; a study ended by
-SIGTERM or SIGHUP (a batch limit, ``timeout``, a closed terminal) kills its workers first."""
+SIGTERM or SIGHUP (a batch limit, ``timeout``, a closed terminal) kills its workers first. A
+driver killed by SIGKILL (``kill -9``, the OOM killer, a scheduler's hard limit) can do nothing:
+its workers notice it gone themselves, through a pipe only the driver writes to (``_lifeline``,
+``worker.watch_driver``), and end with their process groups."""
 from __future__ import annotations
 
 import fcntl
@@ -63,7 +66,7 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     start = time.perf_counter()
     rank, size = (comm.rank, comm.size) if comm is not None else (0, 1)
     lock = _claim(study, comm)
-    bar, failed, running, previous = None, 0, {}, {}
+    bar, failed, running, previous, lifeline = None, 0, {}, {}, None
     try:                                     # the lock is released whatever happens from here
         records = read_records(study)
         todo = [r for r in study.runs if not _done(records.get(r.key), rerun_failed)]
@@ -72,10 +75,11 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
             bar = tqdm(total=len(mine), desc=study.name, unit="run")
         queue = list(mine)
         previous = _exit_on_termination()
+        lifeline = _lifeline()
         while queue or running:
             while queue and len(running) < study.options.processes:
                 run = queue.pop(0)
-                running[_spawn(study, run, rank)] = (run, time.monotonic())
+                running[_spawn(study, run, rank, lifeline[0])] = (run, time.monotonic())
             time.sleep(0.05)
             for proc, (run, t0) in list(running.items()):
                 timeout = study.options.timeout
@@ -96,6 +100,8 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     finally:
         for proc in running:
             _kill(proc)
+        for fd in lifeline or ():
+            os.close(fd)
         for signum, handler in previous.items():
             signal.signal(signum, handler)
         if lock is not None:
@@ -151,13 +157,30 @@ def _exit_on_termination() -> dict:
             if signal.getsignal(s) is not signal.SIG_IGN}
 
 
+def _lifeline() -> tuple[int, int]:
+    """A pipe (read end, write end) whose read end every worker gets (``_spawn``) and whose write
+    end only this process holds and never writes to: the kernel closes it when the driver ends,
+    however it ends, and each worker's watchdog then reads end-of-file and kills the worker's
+    process group (``worker.watch_driver``). SIGKILL cannot be caught, so the driver cannot kill
+    its workers then (they ran on, orphaned, each in a session of its own). Why a pipe: its
+    end-of-file comes at once and cannot be missed, even when the driver died before the worker
+    started watching; polling ``os.getppid()`` would wait a period and need the driver's pid;
+    Linux's ``prctl(PR_SET_PDEATHSIG)`` signals the worker alone (not the ``mpiexec`` of a scene
+    run in its group) and fires when the thread that forked it ends, not the process. Both ends
+    are created non-inheritable (PEP 446): no other child of the driver holds the write end open
+    (a ``fork`` without ``exec`` in the driver would, and delay the end-of-file until it ends)."""
+    return os.pipe()
+
+
 def _done(record, rerun_failed: bool) -> bool:
     """A run is done if it has a record, unless that failed and failed runs are retried (a record
     that completed is judged by the study's metrics when read: ``records.read_records``)."""
     return record is not None and not (rerun_failed and record.get("status") == FAILED)
 
 
-def _spawn(study: Study, run: StudyRun, rank: int) -> subprocess.Popen:
+def _spawn(study: Study, run: StudyRun, rank: int, lifeline: int) -> subprocess.Popen:
+    """The run's worker, in a session (and process group) of its own, ``lifeline`` (the read end of
+    ``_lifeline``) passed on to it."""
     workdir = study.folder / "runs" / run.key
     task = {"problem": study.problem, "raw": run.raw, "label": run.label, "key": run.key,
             "metrics": list(study.metrics), "repeat": study.options.repeat,
@@ -170,7 +193,7 @@ def _spawn(study: Study, run: StudyRun, rank: int) -> subprocess.Popen:
     log = open(study.folder / "runs" / f"{run.key}.log", "w")
     try:
         return subprocess.Popen([sys.executable, "-m", "multiscale.studies.worker",
-                                 json.dumps(task, default=json_default)],
+                                 json.dumps(task, default=json_default), str(lifeline)], pass_fds=(lifeline,),
                                 stdout=log, stderr=subprocess.STDOUT, env=_child_env(), start_new_session=True)
     finally:
         log.close()

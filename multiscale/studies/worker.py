@@ -1,7 +1,9 @@
-"""One study run in this fresh process: ``python -m multiscale.studies.worker TASK_JSON``, spawned
-by ``running.execute``. Parses the run's parameters, runs it ``repeat`` times and writes its
+"""One study run in this fresh process: ``python -m multiscale.studies.worker TASK_JSON [LIFELINE]``,
+spawned by ``running.execute``. Parses the run's parameters, runs it ``repeat`` times and writes its
 record; a failure is recorded, never raised. The problem modules (and the numba-compiled micro
-modules they import) are loaded with this module, before the run's clock and memory baseline."""
+modules they import) are loaded with this module, before the run's clock and memory baseline.
+``LIFELINE``: a file descriptor the driver passed on (``running._lifeline``); when the driver is
+gone, ``watch_driver`` ends this worker and its process group."""
 from __future__ import annotations
 
 import hashlib
@@ -9,7 +11,9 @@ import json
 import os
 import platform
 import resource
+import signal
 import sys
+import threading
 import time
 import traceback
 from pathlib import Path
@@ -21,7 +25,7 @@ from multiscale.studies.formatting import now
 from multiscale.studies.problems import problem as get_problem
 from multiscale.studies.records import FAILED, metric_problem, write_json
 
-__all__ = ["run_task"]
+__all__ = ["run_task", "watch_driver"]
 
 
 def _peak_mb() -> float:
@@ -38,6 +42,34 @@ def _cpu() -> float:
         u = resource.getrusage(who)
         total += u.ru_utime + u.ru_stime
     return total
+
+
+def watch_driver(lifeline: int) -> threading.Thread:
+    """Start a daemon thread that ends this worker's process group as soon as the study's driver is
+    gone: ``lifeline`` is the read end of a pipe whose write end only the driver holds and never
+    writes to (``running._lifeline``), so a read returns end-of-file exactly when the kernel has
+    closed it, at the driver's end, a SIGKILL included (which the driver cannot catch to kill its
+    workers, as it does on SIGTERM and SIGHUP). The thread then sends SIGKILL to the group this
+    process leads (``running._spawn`` starts it in a session of its own): the worker and what it
+    started there, a scene run's ``python`` or ``mpiexec``, whose hydra proxy then ends the ranks
+    (it puts them in sessions of their own; they go when ``mpiexec`` does). Not the parent's death
+    signal (Linux ``prctl(PR_SET_PDEATHSIG)``): it reaches this process only, not its children, and
+    fires when the forking thread ends rather than the driver; not polling ``os.getppid()``: a
+    period of delay. Outside a group of its own (started by hand) the worker ends alone. A Python
+    thread needs the GIL: a call that holds it (none of the solvers' numba kernels do; a scene run
+    waits in ``subprocess``) delays the end until it returns."""
+    def watch():
+        try:
+            while os.read(lifeline, 64):      # the driver writes nothing: b"" is its end
+                pass
+        except OSError:
+            pass
+        if os.getpgrp() == os.getpid():
+            os.killpg(os.getpid(), signal.SIGKILL)
+        os.kill(os.getpid(), signal.SIGKILL)
+    thread = threading.Thread(target=watch, name="watch_driver", daemon=True)
+    thread.start()
+    return thread
 
 
 def run_task(task: dict) -> int:
@@ -91,4 +123,6 @@ def _exact(problem, params, folder: Path) -> dict:
 
 
 if __name__ == "__main__":
+    if len(sys.argv) > 2:
+        watch_driver(int(sys.argv[2]))
     sys.exit(run_task(json.loads(sys.argv[1])))
