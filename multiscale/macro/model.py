@@ -7,7 +7,8 @@ load}. The drive gives the load and the speed of the sliding body against time: 
 factor is 0 the contact is released (no solve, no frictional heat, no interface conductance) and
 the bodies only exchange heat with their surroundings. The sliding direction does not depend on the
 speed's magnitude, so a changing speed needs no contact solve (only its heat changes: a heat step
-takes the mean of the speeds at its ends, exact for a speed linear in time). ``start``
+takes the mean of the speeds at its ends, exact for a speed linear in time); a step sliding from
+rest solves with friction before its heat step (``start_sliding``). ``start``
 makes the first (ramped) contact solve; ``record`` gives one history row. The model is built from
 plain objects (``multiscale.workflows.model.build_model`` makes one from a scene).
 """
