@@ -49,7 +49,21 @@ round-off times the condition, which the next iteration's double residual takes 
 chord's own error (Higham & Mary 2022, Acta Numerica 31, 347–414, §7), at 0.6x the factorisation's
 time (car-brake stop: heat solves 8.3-9.1 → 7.7-8.1 s, benchmarks/README). A linear step, one solve, keeps double
 factors. A solve that fails with kept or single factors is redone from the step's start with
-fresh double ones, which then stay (``redone`` counts the redone steps).
+fresh double ones, which then stay (``redone`` counts the redone steps). A Newton step still
+failing is redone once more with PETSc's backtracking line search (``bt``: the full step if it
+lowers ||F||^2 enough, else a shorter one along it) and a fresh tangent every iteration
+(``backtracked`` counts them). Where the tangent is flat a full step overshoots far: a block from
+300 K into 2000 K surroundings in one 1000 s step (T^4 flat at the start) went to ~6e4 K, the
+residual 33 W -> 3e7 W (SNES reason -9); backtracking converges in 5 iterations, the mean
+temperature within 0.44 K of the lumped body's backward Euler step (tests/test_macro_thermal.py).
+Only on a failed step: on every step it kept the full steps of the radiation and c(T) tests (the
+same temperatures, bit for bit) but shortened those that overshoot and recover (a radiating
+column: 14 -> 4 iterations, another path to the same answer), so the steps that converge keep
+their iterates. Not the critical-point search (``cp``, stalled at the start: |F| 33.2 W for 30
+iterations); backtracking converged every step tried (up to 1e6 s, 3000 K surroundings, tables),
+so a failed step is not cut into substeps (that would change the user's time discretisation).
+Options the user set under the prefix (``PETSC_OPTIONS="-heat_snes_linesearch_type ..."``) win
+over ours; a line search the user chose is not replaced on a failed step.
 
 Energy balance. P1 test functions sum to one, so the residual summed over every dof of a body is
 its heat balance over the step. The heat lost [J] during a step, consistent with it, is
@@ -70,12 +84,11 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Callable, Mapping, Sequence
+from typing import Mapping, Sequence
 
 import numpy as np
 import ufl
 from dolfinx import fem, la
-from dolfinx import mesh as dmesh
 from dolfinx.fem import petsc as fpetsc
 from dolfinx.fem.forms import derivative_block
 from mpi4py import MPI
@@ -87,7 +100,8 @@ from multiscale.macro import mumps
 from multiscale.macro.interface import ContactInterface, rigid_velocity
 from multiscale.macro.kept_cells import KeptCells, assemble
 from multiscale.macro.materials import body_properties, heat_capacity
-from multiscale.macro.mesh import FormCache, TwoBodyMesh
+from multiscale.macro.mesh import FormCache
+from multiscale.macro.thermal_conditions import AppliedBoundary, ThermalBoundary, surface_rows
 
 LINEAR_OPTIONS = {"snes_type": "ksponly", "ksp_type": "preonly", "pc_type": "lu",
                   "pc_factor_mat_solver_type": "mumps"}
@@ -128,48 +142,6 @@ def temperature_functions(tm) -> list:
                          name=f"temperature_{b.name}") for i, b in enumerate(tm.bodies)]
 
 
-@dataclass(frozen=True)
-class ThermalBoundary:
-    """A thermal condition on named surfaces (``TwoBodyMesh.surface`` names: a face, or
-    "free:<body or region>"), on every body that holds some of their exterior facets.
-
-    ``convection``: h [W/(m^2 K)], a constant or a callable h(speed) of the rotating body's speed
-    [rad/s]; ``emissivity``: eps in (0, 1], radiation eps sigma (T^4 − T_a^4); ``ambient``: T_a [K]
-    of both (default: the initial temperature); ``temperature``: a fixed temperature [K] (not
-    combined with the others). Fluxes are positive out of the body."""
-
-    surfaces: tuple
-    convection: float | Callable[[float], float] | None = None
-    emissivity: float | None = None
-    ambient: float | None = None
-    temperature: float | None = None
-
-    def __post_init__(self):
-        if self.temperature is not None and (self.convection is not None or self.emissivity is not None):
-            raise InputError("temperature", self.temperature, "a fixed temperature excludes convection and radiation")
-        if self.temperature is None and self.convection is None and self.emissivity is None:
-            raise InputError("surfaces", self.surfaces, "give convection, emissivity or temperature")
-
-    def h(self, speed: float) -> float:
-        """Convection coefficient [W/(m^2 K)] at the speed [rad/s] (0 without convection)."""
-        if self.convection is None:
-            return 0.0
-        value = self.convection(speed) if callable(self.convection) else self.convection
-        return check_positive("convection", value, allow_zero=True)
-
-
-def surface_rows(tm: TwoBodyMesh, name: str) -> np.ndarray:
-    """(cell, local facet) rows (n, 2) on the parent mesh of the exterior facets of a named surface
-    owned by this rank."""
-    if name.startswith("free:"):
-        (_, rows), = tm.surface(name).subdomain_data()
-        return np.asarray(rows, dtype=np.int32).reshape(-1, 2)
-    facets = np.intersect1d(tm.facet_tags.find(tm.face(name)), dmesh.exterior_facet_indices(tm.parent.topology))
-    rows = fem.compute_integration_domains(fem.IntegralType.exterior_facet, tm.parent.topology,
-                                           facets.astype(np.int32))
-    return np.asarray(rows, dtype=np.int32).reshape(-1, 2)
-
-
 @dataclass
 class ThermalStep:
     """One thermal time step."""
@@ -181,19 +153,6 @@ class ThermalStep:
     heat_exchanged: float = 0.0    # J, conducted from body 0 to body 1 through the interface conductance
 
 
-@dataclass
-class AppliedBoundary:
-    """A ``ThermalBoundary`` on one body: its measure id and, for a fixed temperature, its BC."""
-
-    index: int                     # position in Thermal.boundaries
-    body: int
-    condition: ThermalBoundary
-    ambient: float                 # K
-    facets: np.ndarray             # facets of the body's submesh (this rank)
-    h: fem.Constant | None = None
-    bc: fem.DirichletBC | None = None
-
-
 class Thermal:
     """Heat problem of both bodies driven by the contact's frictional heat (see module docstring).
 
@@ -202,7 +161,8 @@ class Thermal:
     [K] is also the reference of the stored heat. ``boundaries``: ``ThermalBoundary`` conditions
     (none: every outer surface insulated). With Newton's method, ``jacobians`` counts the tangents
     assembled and factorised so far, ``redone`` the steps redone with fresh tangents (and double
-    factors), ``precision`` that of the LU factors ("single", or "double" after a redone step).
+    factors), ``backtracked`` those redone once more with a backtracking line search,
+    ``precision`` that of the LU factors ("single", or "double" after a redone step).
     """
 
     def __init__(self, contact: ContactInterface, materials: Mapping[str, object], *,
@@ -246,9 +206,16 @@ class Thermal:
                           or not all(p.constant for p in conductivity + self.capacity))
         self.tables = [f"{b.name} ({', '.join(n for n, p in (('kappa', k), ('c', c)) if not p.constant)})"
                        for b, k, c in zip(tm.bodies, conductivity, self.capacity) if not (k.constant and c.constant)]
+        # options the user set under the prefix (PETSC_OPTIONS="-heat_...") win: given to DOLFINx, ours
+        # overwrote them in PETSc's database. DOLFINx 0.11 leaves ours there (its deletion misses the
+        # pushed prefix): removed here, else the next heat problem would take them for the user's
+        user = PETSc.Options(prefix)
+        options = {k: v for k, v in (NEWTON_OPTIONS if self.nonlinear else KEPT_OPTIONS).items() if not user.hasName(k)}
+        self._backtrack = self.nonlinear and not user.hasName("snes_linesearch_type")   # a failed step, again
         self.problem = fpetsc.NonlinearProblem(self.residuals, self.T, bcs=self.bcs, petsc_options_prefix=prefix,
-                                               petsc_options=NEWTON_OPTIONS if self.nonlinear else KEPT_OPTIONS,
-                                               entity_maps=tm.entity_maps)
+                                               petsc_options=options, entity_maps=tm.entity_maps)
+        for name in options:
+            user.delValue(name)
         self._residual_forms: dict = {}
         # constant materials: the Jacobian's cell part (storage, conduction, transport with SUPG;
         # 105 of its 110 ms on the ch. 7 mesh, one rank) changes only with the constants and
@@ -270,6 +237,7 @@ class Thermal:
         self._chords = 0                       # Newton: iterations of the current solve on a kept tangent
         self._tangent_dt = None                # Newton: the step of the kept tangent [s]
         self.redone = 0                        # Newton: steps redone with fresh tangents
+        self.backtracked = 0                   # Newton: steps redone with a backtracking line search
         self.precision = FACTOR_PRECISION if self.nonlinear else "double"    # of the LU factors
         self._fresh = False                    # Newton: a fresh tangent every iteration (a step redone)
         if self.nonlinear:
@@ -485,6 +453,16 @@ class Thermal:
                 ok = self._solve()
             finally:
                 self._fresh = False
+        if not ok and self._backtrack:          # a full Newton step overshot: again, backtracking (module docstring)
+            self._back_to_start()
+            search = self.problem.solver.getLineSearch()
+            search.setType("bt")
+            self._fresh, self.backtracked = True, self.backtracked + 1
+            try:
+                ok = self._solve()
+            finally:
+                self._fresh = False
+                search.setType(NEWTON_OPTIONS["snes_linesearch_type"])
         snes = self.problem.solver
         if not ok:
             failed = mumps.describe(snes.getKSP().getPC())        # the factorisation's failure, if any
@@ -492,7 +470,8 @@ class Thermal:
                    "steep change between two points of a table is one, spread it over a wider range or more "
                    "points" if self.tables and not failed else "")
             if not failed and any(a.condition.emissivity for a in self.applied):   # T^4: a long step strays far
-                why += f"; with radiation a step of {dt:.4g} s can take Newton far off: more time.steps or substeps"
+                why += (f"; with radiation a step of {dt:.4g} s can take Newton far off"
+                        f"{' (a backtracking line search too)' if self._backtrack else ''}: more time.steps or substeps")
             raise ConvergenceError(f"heat step at t = {self.time + dt:.6g} s failed "
                                    f"(SNES reason {snes.getConvergedReason()}, "
                                    f"{snes.getIterationNumber()} iterations{'; ' + failed if failed else ''}){why}")

@@ -1,0 +1,73 @@
+"""The thermal conditions of the heat problem's surfaces (``macro.thermal``): convection h(speed),
+grey-body radiation and fixed temperatures on named surfaces (``ThermalBoundary``), one of them on
+one body (``AppliedBoundary``), and the exterior facets a surface name stands for (``surface_rows``).
+Every outer surface without a condition is insulated."""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+import numpy as np
+from dolfinx import fem
+from dolfinx import mesh as dmesh
+
+from multiscale.errors import InputError, check_positive
+from multiscale.macro.mesh import TwoBodyMesh
+
+
+@dataclass(frozen=True)
+class ThermalBoundary:
+    """A thermal condition on named surfaces (``TwoBodyMesh.surface`` names: a face, or
+    "free:<body or region>"), on every body that holds some of their exterior facets.
+
+    ``convection``: h [W/(m^2 K)], a constant or a callable h(speed) of the rotating body's speed
+    [rad/s]; ``emissivity``: eps in (0, 1], radiation eps sigma (T^4 − T_a^4); ``ambient``: T_a [K]
+    of both (default: the initial temperature); ``temperature``: a fixed temperature [K] (not
+    combined with the others). Fluxes are positive out of the body."""
+
+    surfaces: tuple
+    convection: float | Callable[[float], float] | None = None
+    emissivity: float | None = None
+    ambient: float | None = None
+    temperature: float | None = None
+
+    def __post_init__(self):
+        if self.temperature is not None and (self.convection is not None or self.emissivity is not None):
+            raise InputError("temperature", self.temperature, "a fixed temperature excludes convection and radiation")
+        if self.temperature is None and self.convection is None and self.emissivity is None:
+            raise InputError("surfaces", self.surfaces, "give convection, emissivity or temperature")
+
+    def h(self, speed: float) -> float:
+        """Convection coefficient [W/(m^2 K)] at the speed [rad/s] (0 without convection)."""
+        if self.convection is None:
+            return 0.0
+        value = self.convection(speed) if callable(self.convection) else self.convection
+        return check_positive("convection", value, allow_zero=True)
+
+
+@dataclass
+class AppliedBoundary:
+    """A ``ThermalBoundary`` on one body: its measure id and, for a fixed temperature, its BC."""
+
+    index: int                     # position in Thermal.boundaries
+    body: int
+    condition: ThermalBoundary
+    ambient: float                 # K
+    facets: np.ndarray             # facets of the body's submesh (this rank)
+    h: fem.Constant | None = None
+    bc: fem.DirichletBC | None = None
+
+
+def surface_rows(tm: TwoBodyMesh, name: str) -> np.ndarray:
+    """(cell, local facet) rows (n, 2) on the parent mesh of the exterior facets of a named surface
+    owned by this rank."""
+    if name.startswith("free:"):
+        (_, rows), = tm.surface(name).subdomain_data()
+        return np.asarray(rows, dtype=np.int32).reshape(-1, 2)
+    facets = np.intersect1d(tm.facet_tags.find(tm.face(name)), dmesh.exterior_facet_indices(tm.parent.topology))
+    rows = fem.compute_integration_domains(fem.IntegralType.exterior_facet, tm.parent.topology,
+                                           facets.astype(np.int32))
+    return np.asarray(rows, dtype=np.int32).reshape(-1, 2)
+
+
+__all__ = ["AppliedBoundary", "ThermalBoundary", "surface_rows"]
