@@ -147,6 +147,7 @@ class MicroStep:
     real_area: float = 0.0     # m^2, real contact area summed over the loaded zones (before wear)
     law_reach: float = 0.0     # largest zone pressure over micro.p_max, the top of the laws (> 1: extrapolated)
     law_reach_halved: float = 0.0  # the same over the zones whose law failed, against their halved top
+    wear_error: float = 0.0    # estimated error of the worn real contact area / that area, from the substeps
 
 
 @dataclass
@@ -201,6 +202,7 @@ class Multiscale:
         self.conductance = np.zeros(Z)
         self.warm = np.zeros(rough.initial.shape)     # previous local pressures (warm starts)
         self.work = 0.0                               # J, frictional work over the wear intervals
+        self.interval_work = 0.0                      # J, that of the steps since the last wear
         self.datum_gap = np.zeros(self.tm.interface.n_facets)   # m, uniform initial gap g_0 per facet
         self.counter_depth = np.zeros(self.tm.interface.n_facets)   # m, counter-face worn along its track
         self.counter_volume = 0.0                     # m^3, lost by the counter-face
@@ -313,19 +315,26 @@ class Multiscale:
             self.rough.set_heights(ids, heights)
             self.rough.plastic[ids] += w
 
-    def wear(self, duration: float) -> float:
+    def wear(self, duration: float) -> tuple[float, float]:
         """Wear of the zones of the last ``analyse`` over the last ``duration`` [s] (their topographies
         change; a wearing counter-face recedes along its track): the pressure fields of the last
         analysis slide over the interval's load-weighted sliding (``MacroModel.sliding``: none while
-        released, exact for a stop or a release inside it); returns the frictional work [J]."""
+        released, exact for a stop or a release inside it). Returns the interval's frictional work
+        [J], the macro steps' ``work_step``: the heat's pressures and quadrature, so that it is the
+        frictional heat put in (the wear takes the pressure at the end of the interval); and the
+        estimated error of the worn zones' real contact area, the zones' |errors| summed over that
+        area in twice the substeps (``PostAnalysis.wear``'s step doubling)."""
         mine, res, load, remote, _ = self._last
         zones, m = self.rough.zones, self.model
         sliding = m.sliding(m.time - duration, m.time)
         res = io.collective(self.comm, lambda: self.post.wear([zones[i] for i in mine], res, load.reach[mine] * sliding,
                                                            remote))
-        volume = np.zeros(len(zones))
-        for ids, warm, heights, lost, w in self.comm.allgather((mine, res.worn_pressure, res.heights,
-                                                                 res.counter_volume, res.plastic)):
+        volume, area, error = np.zeros(len(zones)), 0.0, 0.0
+        for ids, warm, heights, lost, w, worn, off in self.comm.allgather((
+                mine, res.worn_pressure, res.heights, res.counter_volume, res.plastic, res.worn_area_fraction,
+                res.wear_error)):
+            area += float((worn - off / 2) @ self.rough.zone_area[ids])     # in twice the substeps
+            error += float(np.abs(off) @ self.rough.zone_area[ids])
             self.warm[ids] = warm
             self.rough.set_heights(ids, heights)
             volume[ids] = lost
@@ -336,9 +345,9 @@ class Multiscale:
             self.counter_depth += self.rough.track_depth(volume, m.facet_sliding_power())    # (its flux now: 0 at rest)
             self.counter_volume += volume.sum()
             iface.set_field(contact.initial_gap, self.datum_gap + self.counter_depth)
-        work = m.sliding_power() * sliding                                 # mu ∫ p |w| dA dt
+        work, self.interval_work = self.interval_work, 0.0                 # mu ∫ p |w| dA dt
         self.work += work
-        return work
+        return work, error / area if area > 0 else 0.0
 
     def accept(self, micro: MicroStep) -> MicroStep:
         """The partitions (and exchanges) of the last ``analyse`` become the zones' (partition law);
@@ -469,9 +478,10 @@ class Multiscale:
             self.model.restore(state)
             self.partition = anderson(passes[-ANDERSON_MEMORY - 1:], self.zone_heat(), s.relaxation)
             self.apply_zone_fields()
+        self.interval_work += self.model.work_step          # the last pass's
         t2 = _time.perf_counter()
         if wear:
-            micro.work = self.wear(s.dt * interval)
+            micro.work, micro.wear_error = self.wear(s.dt * interval)
         elif self.plastic:
             self.deform()
         self.accept(micro)
@@ -514,7 +524,7 @@ class Multiscale:
             depth = self.rough.wear_depth()
             row.update(wear_volume=float(self.rough.zone_wear_volume(depth).sum()), wear_max_depth=float(depth.max()),
                        rms_height=float(np.sqrt(np.mean((heights - heights.mean()) ** 2))),
-                       frictional_work=self.work)
+                       frictional_work=self.work, wear_substep_error=result.micro.wear_error)
             if self.post.counter_rate is not None:
                 row.update(counter_wear_volume=self.counter_volume,
                            counter_wear_max_depth=float(self.counter_depth.max(initial=0.0)))
@@ -532,7 +542,8 @@ class Multiscale:
                   "heat_lost_recorded": m.heat_lost_recorded, "datum_gap": self.datum_gap,
                   **({"lost_total": m.thermal.lost_total} if m.thermal is not None else {}),
                   **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
-        attrs = {"step": step, "time": m.time, "work": self.work, "counter_volume": self.counter_volume,
+        attrs = {"step": step, "time": m.time, "work": self.work, "interval_work": self.interval_work,
+                 "counter_volume": self.counter_volume,
                  "heat_exchanged": [m.heat_exchanged, m.heat_exchanged_total], "scene": self.fingerprint, "load": m.load,
                  "ranks": self.comm.size, "fields_written": -1, "solved_speed": m.solved_speed,
                  "constants": [float(c.value) for c in self.model.drive_constants],
@@ -559,6 +570,7 @@ class Multiscale:
         if m.thermal is not None:
             m.thermal.lost_total = arrays["lost_total"].copy()
         m.time, self.work = float(attrs["time"]), float(attrs["work"])
+        self.interval_work = float(attrs.get("interval_work", 0.0))     # absent from older checkpoints
         if m.thermal is not None:
             m.thermal.time = m.time
         reason, its, force, max_p = attrs["solve"]

@@ -334,6 +334,28 @@ def test_the_zones_wear_with_the_loaded_sliding_and_at_the_last_step(straight, t
     assert late["wear_volume"][1] == 0.0 and late["wear_volume"][2] == pytest.approx(every["wear_volume"][2], rel=0.02)
 
 
+def test_too_few_wear_substeps_are_warned_about_with_their_estimated_error(tmp_path):
+    """k_w = 1e-12 /Pa over 3 steps: 4 wear substeps wear 0.27 RMS heights each (below
+    ``STEP_RMS``) and left the real contact area after the first update 30.5 % below the converged
+    one (128 substeps), silently. ``PostAnalysis.wear`` now wears each update again in twice the
+    substeps (discarded): the estimate 2 |A_n - A_2n| / A_2n of that update is 1 to 4 times the
+    true difference (72 %: 2.4 times), and the run warns, naming it and a substep count for
+    ``SUBSTEP_TOL``. 32 substeps: estimates <= 0.5 % (a few contact cells), no warning."""
+    from multiscale.micro.wear import SUBSTEP_TOL, STEP_RMS
+    runs = {n: run_pod(tmp_path / str(n), {"wear.k_w": "1e-12 1/Pa", "wear.substeps": n, "time.steps": 3,
+                                           "time.end": "1.8 s"}) for n in (4, 32, 128)}
+    coarse, converged = runs[4], runs[128]
+    deeper = np.diff(coarse["wear_max_depth"]) / coarse["rms_height"][:-1] / 4
+    assert 0.2 < deeper.max() < STEP_RMS
+    true = abs(coarse["real_contact_area"][2] / converged["real_contact_area"][2] - 1)    # the first update's
+    assert true > 0.25
+    assert 1.0 <= coarse["wear_substep_error"][1] / true <= 4.0
+    warnings = json.loads((tmp_path / "4" / "provenance.json").read_text())["warnings"]
+    assert [w for w in warnings if w.startswith("the wear.substeps (4) left the real contact area of a wear update")]
+    assert runs[32]["wear_substep_error"].max() < SUBSTEP_TOL / 10
+    assert not json.loads((tmp_path / "32" / "provenance.json").read_text())["warnings"]
+
+
 def test_zones_smaller_than_the_facets_are_refused(tmp_path):
     """20 x 20 zones (1 mm^2) on the 2.5 mm facets (2.64 mm^2): a facet loaded only the zone holding
     its midpoint with its whole force, so 19 of 400 zones carried the load at 65 MPa, 15 times the

@@ -229,6 +229,22 @@ def test_a_rough_stop_keeps_the_torque_after_the_worn_laws(tmp_path):
     np.testing.assert_allclose(heat, MASS * DECEL * np.diff(travel), rtol=TORQUE_TOL)
 
 
+def test_a_one_step_rough_stop_works_the_heat_it_puts_in(tmp_path):
+    """A rough wearing pin (thermal expansion on) stopping the mass in one step: the frictional
+    work the loop records is the frictional heat put into the bodies to 1e-6 (the same pressures
+    and quadrature in time: ``MacroModel.work_step``). Before, the work took the pressure at the
+    step's end, the heat that of its start: 0.5 % apart (an adversarial test)."""
+    from test_coupling import POD
+    text = POD.replace('rotation_speed = "200 rpm"\n', "").replace('normal_force = "200 N"\n', "")
+    scene = loads(text.format(folder=tmp_path / "one_step_stop"), overrides={
+        "loading.vehicle": {"speed": f"{V0} m/s", "deceleration": f"{DECEL} m/s^2", "wheel_radius": f"{WHEEL} m",
+                            "mass": f"{MASS} kg"}, "time.end": "2 s", "time.steps": 1})
+    h = run(scene, verbose=False).history
+    heat = h["heat_total_pin"][-1] + h["heat_total_disc"][-1]
+    assert h["frictional_work"][-1] == pytest.approx(heat, rel=1e-6)
+    assert heat == pytest.approx(0.5 * MASS * V0**2, rel=0.01)
+
+
 def test_a_released_rough_contact_has_no_flash_temperature(tmp_path):
     """Released after 0.6 s (within 10 ms): the zones keep their last loads for the wear of the
     step, but nothing touches, so no zone has a flash temperature (before: 340 K, the flash of

@@ -117,6 +117,9 @@ class ZoneResult:
     plastic_area_fraction: np.ndarray = None  # (B,): cells at the hardness / zone cells at the macro load (0 if elastic)
     plastic: np.ndarray = None              # m, (B, ny, nx): permanent deformation of this step, >= 0 (0 if elastic)
     hardness: np.ndarray | None = None      # Pa, (B,): the hardness of each zone's solves (None: elastic)
+    worn_area_fraction: np.ndarray = None   # (B,): real contact area / zone area after the wear (None: no wear)
+    wear_error: np.ndarray = None           # (B,): estimated error of that fraction from the wear substeps,
+    #                                         signed (step doubling, ``PostAnalysis.wear``; 0 without wear)
 
 
 class PostAnalysis:
@@ -240,7 +243,11 @@ class PostAnalysis:
     def wear(self, zones: list[Zone], result: ZoneResult, sliding, remote=None) -> ZoneResult:
         """Archard wear of the zones of ``result`` (``run`` of these zones without sliding) over
         ``sliding`` [m] (B,) in ``substeps`` increments; remote (B, 2) [K] gives k_w's temperatures
-        without heating. Returns ``result`` with the worn heights, depth, volumes, pressures."""
+        without heating. Returns ``result`` with the worn heights, depth, volumes, pressures. The
+        explicit substeps' error is estimated by step doubling: the update is worn again, from the
+        same start, in twice the substeps and discarded; ``wear_error`` = 2 (A_n - A_2n), the
+        first-order Richardson estimate of the real area fraction's error (3 n contact solves
+        instead of n: the test pin-on-disc's micro time 0.13 -> 0.16 s with 4 substeps)."""
         heights, p, load, mu = result.heights, result.pressure, result.load, result.mu
         B = len(zones)
         if B == 0:                 # a rank that holds no loaded zone
@@ -253,10 +260,29 @@ class PostAnalysis:
                 value = np.broadcast_to(np.broadcast_to(np.asarray(remote, float), (B, 2))[:, col, None, None],
                                         heights.shape)
                 T, T1 = (value, T1) if field == "T" else (T, value)
-        ds = _per_zone("sliding", sliding, B) / self.substeps
-        depth, counter, iterations = np.zeros(heights.shape), np.zeros(B), result.iterations.copy()
-        plastic = result.plastic
-        for _ in range(self.substeps):
+        sliding = _per_zone("sliding", sliding, B)
+        start = (heights, p, result.plastic, result.area_fraction)
+        heights, p, depth, counter, plastic, iterations, area = self._substeps(
+            zones, start, load, mu, sliding, T, T1, result.hardness, self.substeps)
+        error = np.zeros(B)
+        if self.rate is not None:   # step doubling: the same wear in twice the substeps, discarded
+            twice = self._substeps(zones, start, load, mu, sliding, T, T1, result.hardness, 2 * self.substeps)[-1]
+            error = 2.0 * (area - twice)       # Richardson, first order: A_n - A = 2 (A_n - A_2n)
+        return replace(result, worn_pressure=p, heights=heights, depth=depth,
+                       volume=depth.sum(axis=(-2, -1)) * self.dx * self.dy,
+                       iterations=result.iterations + iterations, counter_volume=counter,
+                       plastic=plastic, worn_area_fraction=area, wear_error=error)
+
+    def _substeps(self, zones, start, load, mu, sliding, T, T1, hardness, n):
+        """Wear from ``start`` = (heights, pressure, permanent deformation, real area fraction)
+        over ``sliding`` (B,) [m] in ``n`` explicit increments (Eq. 3.10), each with the pressure of
+        the solve before it; returns (heights, pressure, depth, counter-face volume, permanent
+        deformation, solver iterations, real area fraction of the last solve)."""
+        heights, p, plastic, area = start
+        B = len(zones)
+        depth, counter, iterations = np.zeros(heights.shape), np.zeros(B), 0
+        ds = sliding / n
+        for _ in range(n):
             work = mu[:, None, None] * p * ds[:, None, None]      # mu p ds [J/m^2], per-zone sliding folded in
             if self.counter_rate is not None:
                 counter += wear_step(Surface(heights, self.dx, self.dy, periodic=False), work,
@@ -266,13 +292,12 @@ class PostAnalysis:
             # Archard with the per-zone sliding folded into the work density mu p ds [J/m^2]
             worn = wear_step(Surface(heights, self.dx, self.dy, periodic=False), work, self.rate, 1.0, 1.0, T)
             heights, depth = worn.surface.heights, depth + worn.depth
-            again = self._solve(zones, heights, load, p, result.hardness)
+            again = self._solve(zones, heights, load, p, hardness)
             p, heights = again.pressure, heights - again.plastic
             plastic = plastic + again.plastic
-            iterations += np.asarray(again.iterations)
-        return replace(result, worn_pressure=p, heights=heights, depth=depth,
-                       volume=depth.sum(axis=(-2, -1)) * self.dx * self.dy, iterations=iterations,
-                       counter_volume=counter, plastic=plastic)
+            iterations = iterations + np.asarray(again.iterations)
+            area = np.asarray(again.area_fraction, dtype=float)
+        return heights, p, depth, counter, plastic, iterations, area
 
     def _heat(self, pressure, speed, angle, mu, remote, duration):
         """(counter-face field, rough-body field, flash temperature, Phi, Phi_2) of one zone: the

@@ -30,6 +30,7 @@ from multiscale.micro.surface import Surface, check_surface
 
 
 STEP_RMS = 0.5   # a simulate_wear step wearing deeper than this many RMS heights is warned about [-]
+SUBSTEP_TOL = 0.05   # a wear update whose real contact area the substeps leave this far off is warned about [-]
 
 
 class WearWarning(UserWarning):

@@ -18,7 +18,7 @@ from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError, Interrupted, interrupted
-from multiscale.micro.wear import STEP_RMS
+from multiscale.micro.wear import STEP_RMS, SUBSTEP_TOL
 from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.output import RunResult
@@ -146,17 +146,29 @@ def _coarse_wear(scene, history) -> list[str]:
     Archard step wears the loaded asperities below the valleys and the worn laws depend on the step
     count (``micro.wear.simulate_wear`` warns at the same depth; the demo's updates take 0.08 RMS,
     a 1e-12 /Pa wear rate 9 RMS in one step; the test pin-on-disc at 1e-12 /Pa, 0.83 RMS per
-    substep, ended at 49 % of the real contact area of 32 substeps)."""
+    substep, ended at 49 % of the real contact area of 32 substeps). And an update whose real
+    contact area the substeps leave more than ``micro.wear.SUBSTEP_TOL`` off by the step-doubling
+    estimate (``wear_substep_error``, ``PostAnalysis.wear``): 4 substeps of 0.27 RMS, below
+    STEP_RMS, left the test pin-on-disc's area 31 % below the converged one (estimate 72 %)."""
     if "wear_max_depth" not in history.columns:
         return []
+    substeps = scene.wear.substeps if scene.wear is not None else 1
     deeper = np.diff(history["wear_max_depth"]) / np.maximum(history["rms_height"][:-1], np.finfo(float).tiny) \
-        / (scene.wear.substeps if scene.wear is not None else 1)
-    if not deeper.size or deeper.max() <= STEP_RMS:
-        return []
-    row = int(np.argmax(deeper)) + 1
-    return [f"a wear increment deepened the wear by {deeper.max():.3g} times the RMS height (at t = "
-            f"{history['time'][row]:g} s): the explicit wear step is coarse for this wear rate and the results depend "
-            "on it; use more wear.substeps or time.steps"]
+        / substeps
+    out = []
+    if deeper.size and deeper.max() > STEP_RMS:
+        row = int(np.argmax(deeper)) + 1
+        out.append(f"a wear increment deepened the wear by {deeper.max():.3g} times the RMS height (at t = "
+                   f"{history['time'][row]:g} s): the explicit wear step is coarse for this wear rate and the results "
+                   "depend on it; use more wear.substeps or time.steps")
+    error = np.asarray(history["wear_substep_error"]) if "wear_substep_error" in history.columns else np.zeros(0)
+    if error.size and error.max() > SUBSTEP_TOL:
+        row = int(np.argmax(error))
+        need = int(np.ceil(substeps * error.max() / SUBSTEP_TOL))
+        out.append(f"the wear.substeps ({substeps}) left the real contact area of a wear update (at t = "
+                   f"{history['time'][row]:g} s) an estimated {100 * error.max():.3g} % off (against twice the "
+                   f"substeps); for {100 * SUBSTEP_TOL:g} % use about {need} (the step is first order: fewer may do)")
+    return out
 
 
 UNLOADED = 1e-6   # an interface carrying less than this share of the largest one's force is warned about
