@@ -112,6 +112,62 @@ def test_a_failed_factorisation_is_named_in_the_error(tm, petsc_options):
         m.solve(1e6)
 
 
+def test_a_mechanics_problem_leaves_no_solver_options_to_the_next(tm):
+    """Our Newton options are removed from PETSc's database once the solver has them (DOLFINx 0.11
+    leaves them there: all 15 were left before). As the user's options win, a later problem with
+    the prefix would take them for the user's: a line search "chosen" is kept on a failed solve,
+    and the second problem here would not retry with backtracking. It tries as the first would:
+    as it was, fresh double factors, backtracking (the line search restored after)."""
+    from petsc4py import PETSc
+
+    from multiscale.macro.mechanics import NEWTON_OPTIONS, SolveResult
+    ours = {"block_o_" + k for k in NEWTON_OPTIONS}
+    Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_o_")
+    assert not ours & set(PETSc.Options().getAll())
+    m = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_o_")
+    assert not ours & set(PETSc.Options().getAll())
+    real, tries = m._newton, []
+
+    def said_to_fail():                     # every solve runs, and reports a failure
+        tries.append(m.problem.solver.getLineSearch().getType())
+        real()
+        return SolveResult(False, -9, 1, [1.0])
+    m._newton = said_to_fail
+    with pytest.raises(ConvergenceError, match="did not converge"):
+        m.solve(1e6)
+    assert tries == ["basic", "basic", "bt"] and m.problem.solver.getLineSearch().getType() == "basic"
+
+
+def test_the_users_newton_options_win(tm, petsc_options):
+    """Options the user set under the prefix (PETSC_OPTIONS="-mech_...", here block_u_) are the
+    solver's, not ours (DOLFINx overwrote them before): 5 Newton iterations at most, GMRES instead
+    of FGMRES, an absolute tolerance of 1e-3 N instead of 1e-10 N as the floors' base (the solve
+    stops after 1 iteration at 2.7e-5 N; with ours 2 iterations, 2e-11 N), and the l2 line search,
+    kept on a failed solve (tried as it was and with fresh factors, no backtracking, not restored
+    to basic). The user's options stay in the database."""
+    from petsc4py import PETSc
+
+    from multiscale.macro.mechanics import SolveResult
+    petsc_options(block_u_snes_max_it=5, block_u_ksp_type="gmres", block_u_snes_atol=1e-3,
+                  block_u_snes_linesearch_type="l2")
+    m = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_u_")
+    snes = m.problem.solver
+    assert (snes.getTolerances()[3], snes.getKSP().getType(), snes.getLineSearch().getType()) == (5, "gmres", "l2")
+    r = m.solve(1e6)
+    assert r.iterations == 1 and 1e-9 < r.residuals[-1] < 1e-3 and snes.getTolerances()[1] == 1e-3
+    real, tries = m._newton, []
+
+    def said_to_fail():
+        tries.append(snes.getLineSearch().getType())
+        real()
+        return SolveResult(False, -9, 1, [1.0])
+    m._newton = said_to_fail
+    with pytest.raises(ConvergenceError, match="did not converge"):
+        m.solve(1.1e6)
+    assert tries == ["l2", "l2"] and snes.getLineSearch().getType() == "l2"
+    assert PETSc.Options().getInt("block_u_snes_max_it") == 5
+
+
 def test_missing_material_and_unknown_builder_are_input_errors(tm):
     with pytest.raises(InputError, match="materials.flat"):
         Mechanics(tm, {"block": MATERIALS["block"]}, prefix="block_e_")

@@ -10,8 +10,13 @@ form (tests/test_macro_block.py, tests/test_macro_thermal.py) at a fraction of i
 The Jacobian's matrix ignores exact zeros of the element matrices once its pattern is fixed
 (``MAT_IGNORE_ZERO_ENTRIES``; the values are the same): most entries of the facet blocks of a
 vector field are zeros, and every add searches its row (docs/architecture.md §5, the macro Newton).
+
+``nonlinear_problem`` sets up the DOLFINx problem such a Jacobian belongs to (the contact's and the
+heat's Newton) with our solver options, the user's winning.
 """
 from __future__ import annotations
+
+from typing import Mapping
 
 import numpy as np
 import ufl
@@ -38,6 +43,22 @@ def assemble(A: PETSc.Mat, form, bcs) -> PETSc.Mat:
     fpetsc.assemble_matrix(A, form, bcs=bcs)
     A.assemble()
     return A
+
+
+def nonlinear_problem(F, u, prefix: str, options: Mapping, **kwargs) -> fpetsc.NonlinearProblem:
+    """DOLFINx's ``NonlinearProblem`` of the residuals ``F`` in ``u`` under the options prefix
+    ``prefix`` (``kwargs``: its other arguments), with our solver ``options`` less those the user
+    set under the prefix (``PETSC_OPTIONS="-<prefix>..."``): theirs win (given to DOLFINx, ours
+    overwrote them). Ours are removed from PETSc's database after the set-up: DOLFINx 0.11 leaves
+    them there (its deletion misses the prefix it pushed), and a later problem with the prefix
+    would take them for the user's. Only the user's then remain under the prefix."""
+    user = PETSc.Options(prefix)
+    ours = {k: v for k, v in options.items() if not user.hasName(k)}
+    try:
+        return fpetsc.NonlinearProblem(F, u, petsc_options_prefix=prefix, petsc_options=ours, **kwargs)
+    finally:
+        for name in ours:
+            user.delValue(name)
 
 
 class KeptCells:

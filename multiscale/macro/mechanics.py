@@ -29,7 +29,7 @@ from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.macro import mumps
 from multiscale.macro.compact_factor import CompactFactor
 from multiscale.macro.interface import ContactInterface, PressureLaw
-from multiscale.macro.kept_cells import KeptCells, assemble, integrals
+from multiscale.macro.kept_cells import KeptCells, assemble, integrals, nonlinear_problem
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
@@ -205,7 +205,9 @@ class Mechanics:
     from which on the next Newton iteration factorises afresh (0: a fresh factorisation every
     iteration; fresh serial processes then repeat bit for bit, docs/architecture.md "Known
     problems"); ``preconditioner``: one of ``PRECONDITIONERS`` (see there). ``factorisations``
-    counts the preconditioner's factorisations so far.
+    counts the preconditioner's factorisations so far. Options the user set under ``prefix``
+    (``PETSC_OPTIONS="-mech_snes_max_it 50"``) win over ``NEWTON_OPTIONS``; a line search the user
+    chose is not replaced on a failed solve.
     """
 
     LOAD_KINDS = ("force", "pressure", "fluid")
@@ -245,8 +247,12 @@ class Mechanics:
         self.bcs = self._supports()
         self.refresh = None if refresh is None else int(refresh)
         P = self._frictionless_jacobian() if preconditioner == "cholesky" else None
-        self.problem = fpetsc.NonlinearProblem(F, self.u, bcs=self.bcs, petsc_options_prefix=prefix,
-                                               petsc_options=NEWTON_OPTIONS, P=P, entity_maps=tm.entity_maps)
+        # the user's options under the prefix (PETSC_OPTIONS="-mech_...") win over ours
+        self.problem = nonlinear_problem(F, self.u, prefix, NEWTON_OPTIONS, bcs=self.bcs, P=P,
+                                         entity_maps=tm.entity_maps)
+        self._atol = self.problem.solver.getTolerances()[1]     # ours or the user's: the floors' base
+        # a failed solve is redone with backtracking unless the user chose a line search (theirs alone remain)
+        self._backtrack = not PETSc.Options(prefix).hasName("snes_linesearch_type")
         self.factors = CompactFactor(preconditioner, prefix=prefix + "factor_", precision=FACTOR_PRECISION)
         self.problem.solver.getKSP().getPC().setPythonContext(self.factors)
         if P is not None:
@@ -445,7 +451,7 @@ class Mechanics:
         if load is not None:
             self.load.value = float(load)
         floor = max(NEWTON_FLOOR * abs(float(self.load.value)) * self._unit_load, self._roundoff())
-        self.problem.solver.setTolerances(atol=max(NEWTON_OPTIONS["snes_atol"], floor))
+        self.problem.solver.setTolerances(atol=max(self._atol, floor))
         start = [u.x.array.copy() for u in self.u]
         if guess is not None:
             before = self._residual_norm()
@@ -464,7 +470,7 @@ class Mechanics:
                 result = self._newton()
             finally:
                 self._fresh = False
-        if not result.converged:           # a full step overshot (worn laws that open the contact: the
+        if not result.converged and self._backtrack:   # a full step overshot (worn laws opening the contact: the
             for u, x in zip(self.u, start):  # residual 77 -> 1.5e6 N, SNES -9): again, backtracking
                 u.x.array[:] = x
             search = self.problem.solver.getLineSearch()

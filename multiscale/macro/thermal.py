@@ -98,7 +98,7 @@ from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.geometry import Rotation
 from multiscale.macro import mumps
 from multiscale.macro.interface import ContactInterface, rigid_velocity
-from multiscale.macro.kept_cells import KeptCells, assemble
+from multiscale.macro.kept_cells import KeptCells, assemble, nonlinear_problem
 from multiscale.macro.materials import body_properties, heat_capacity
 from multiscale.macro.mesh import FormCache
 from multiscale.macro.thermal_conditions import AppliedBoundary, ThermalBoundary, surface_rows
@@ -206,16 +206,11 @@ class Thermal:
                           or not all(p.constant for p in conductivity + self.capacity))
         self.tables = [f"{b.name} ({', '.join(n for n, p in (('kappa', k), ('c', c)) if not p.constant)})"
                        for b, k, c in zip(tm.bodies, conductivity, self.capacity) if not (k.constant and c.constant)]
-        # options the user set under the prefix (PETSC_OPTIONS="-heat_...") win: given to DOLFINx, ours
-        # overwrote them in PETSc's database. DOLFINx 0.11 leaves ours there (its deletion misses the
-        # pushed prefix): removed here, else the next heat problem would take them for the user's
-        user = PETSc.Options(prefix)
-        options = {k: v for k, v in (NEWTON_OPTIONS if self.nonlinear else KEPT_OPTIONS).items() if not user.hasName(k)}
-        self._backtrack = self.nonlinear and not user.hasName("snes_linesearch_type")   # a failed step, again
-        self.problem = fpetsc.NonlinearProblem(self.residuals, self.T, bcs=self.bcs, petsc_options_prefix=prefix,
-                                               petsc_options=options, entity_maps=tm.entity_maps)
-        for name in options:
-            user.delValue(name)
+        # the user's options under the prefix (PETSC_OPTIONS="-heat_...") win over ours
+        self.problem = nonlinear_problem(self.residuals, self.T, prefix, NEWTON_OPTIONS if self.nonlinear
+                                         else KEPT_OPTIONS, bcs=self.bcs, entity_maps=tm.entity_maps)
+        # a failed step is redone with backtracking unless the user chose a line search (theirs alone remain)
+        self._backtrack = self.nonlinear and not PETSc.Options(prefix).hasName("snes_linesearch_type")
         self._residual_forms: dict = {}
         # constant materials: the Jacobian's cell part (storage, conduction, transport with SUPG;
         # 105 of its 110 ms on the ch. 7 mesh, one rank) changes only with the constants and
