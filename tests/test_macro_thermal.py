@@ -175,9 +175,13 @@ def test_a_radiation_step_too_long_for_full_newton_steps_converges_with_backtrac
     temperature differences inside the block; the heat still flowing in at the step's end,
     q = rho c V (T - T0)/(dt A) = 14 kW/m^2, across V/A = 1.67 mm of kappa = 50 W/(m K) makes
     q V/(A kappa) = 0.47 K, the hotter surface takes in less radiation: measured 0.44 K below.
-    Stored heat = heat taken in through the radiating faces."""
-    model = march(block_scene(T0=300.0, end=1000.0, steps=1, boundary=HEAT_UP))
+    Stored heat = heat taken in through the radiating faces. The step is warned about (it was
+    silent before): too long for full Newton steps, more time.steps or substeps."""
+    with pytest.warns(thermal.HeatStepWarning, match=r"the heat step to t = 1000 s was too long for full Newton "
+                                                     r"steps \(1000 s: .* more time.steps or substeps") as caught:
+        model = march(block_scene(T0=300.0, end=1000.0, steps=1, boundary=HEAT_UP))
     th = model.thermal
+    assert len(caught) == 1 and th.notes == [str(caught[0].message)]
     assert (th.redone, th.backtracked) == (1, 1) and th.problem.solver.getIterationNumber() <= 8
     assert th.problem.solver.getLineSearch().getType() == "basic"         # restored for the next step
     mean = 300 + th.stored_heat()[0] / (5e6 * VOLUME)
@@ -219,6 +223,36 @@ def test_a_heat_problem_leaves_no_solver_options_to_the_next():
     assert not linear.thermal.nonlinear and not ours & set(PETSc.Options().getAll())
     th = march(block_scene(T0=800.0, end=1.0, steps=1, boundary=HEAT_UP.replace("2000 K", "300 K"))).thermal
     assert th.problem.solver.getType() == "newtonls" and not ours & set(PETSc.Options().getAll())
+
+
+def test_backtracked_heat_steps_are_warned_about_once_per_run(tmp_path):
+    """Every heat step that needs backtracking (here: its first two solves said to fail, three
+    steps) is solved, and the first alone is warned about. Through a run (the 1000 s step of
+    the block above), the warning is a line of the run's warnings and of its provenance, not also
+    a Python warning (the report says it, once, not per rank)."""
+    import warnings
+    model = march(block_scene(T0=800.0, end=30.0, steps=3, boundary=HEAT_UP), 0)
+    th = model.thermal
+    solve = th._solve
+
+    def full_steps_said_to_fail():
+        ok = solve()
+        return ok and th.problem.solver.getLineSearch().getType() == "bt"
+    th._solve = full_steps_said_to_fail
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        for _ in range(3):
+            model.macro_step(10.0, 1)
+    assert th.backtracked == 3 and [c.category for c in caught] == [thermal.HeatStepWarning]
+    assert th.notes == [str(caught[0].message)] and "t = 10 s" in th.notes[0]
+    folder = tmp_path / "out"
+    scene = block_scene(T0=300.0, end=1000.0, steps=1, boundary=f'{HEAT_UP}\n[output]\nfolder = "{folder}"')
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = run(scene, verbose=False)
+    said = [w for w in result.warnings if "too long for full Newton steps" in w]
+    assert len(said) == 1 and not [c for c in caught if c.category is thermal.HeatStepWarning]
+    assert said[0] in json.loads((folder / "provenance.json").read_text())["warnings"]
 
 
 def test_a_radiation_step_failing_even_with_backtracking_says_to_shorten_it():

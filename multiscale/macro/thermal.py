@@ -52,10 +52,11 @@ factors. A solve that fails with kept or single factors is redone from the step'
 fresh double ones, which then stay (``redone`` counts the redone steps). A Newton step still
 failing is redone once more with PETSc's backtracking line search (``bt``: the full step if it
 lowers ||F||^2 enough, else a shorter one along it) and a fresh tangent every iteration
-(``backtracked`` counts them). Where the tangent is flat a full step overshoots far: a block from
-300 K into 2000 K surroundings in one 1000 s step (T^4 flat at the start) went to ~6e4 K, the
-residual 33 W -> 3e7 W (SNES reason -9); backtracking converges in 5 iterations, the mean
-temperature within 0.44 K of the lumped body's backward Euler step (tests/test_macro_thermal.py).
+(``backtracked`` counts them; the first is warned about, ``HeatStepWarning``). Where the
+tangent is flat a full step overshoots far: a block from 300 K into 2000 K surroundings in one
+1000 s step (T^4 flat at the start) went to ~6e4 K, the residual 33 W -> 3e7 W (SNES reason -9);
+backtracking converges in 5 iterations, the mean temperature within 0.44 K of the lumped body's
+backward Euler step (tests/test_macro_thermal.py).
 Only on a failed step: on every step it kept the full steps of the radiation and c(T) tests (the
 same temperatures, bit for bit) but shortened those that overshoot and recover (a radiating
 column: 14 -> 4 iterations, another path to the same answer), so the steps that converge keep
@@ -82,6 +83,7 @@ disc's heat; an adversarial test). The SUPG term sums to zero as well (its weigh
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 from functools import cached_property
 from typing import Mapping, Sequence
@@ -142,6 +144,10 @@ def temperature_functions(tm) -> list:
                          name=f"temperature_{b.name}") for i, b in enumerate(tm.bodies)]
 
 
+class HeatStepWarning(UserWarning):
+    """A heat step too long for full Newton steps (converged with a backtracking line search)."""
+
+
 @dataclass
 class ThermalStep:
     """One thermal time step."""
@@ -162,7 +168,8 @@ class Thermal:
     (none: every outer surface insulated). With Newton's method, ``jacobians`` counts the tangents
     assembled and factorised so far, ``redone`` the steps redone with fresh tangents (and double
     factors), ``backtracked`` those redone once more with a backtracking line search,
-    ``precision`` that of the LU factors ("single", or "double" after a redone step).
+    ``precision`` that of the LU factors ("single", or "double" after a redone step). ``notes``:
+    what the run's warnings add (the first backtracked step, also a ``HeatStepWarning`` on rank 0).
     """
 
     def __init__(self, contact: ContactInterface, materials: Mapping[str, object], *,
@@ -233,6 +240,7 @@ class Thermal:
         self._tangent_dt = None                # Newton: the step of the kept tangent [s]
         self.redone = 0                        # Newton: steps redone with fresh tangents
         self.backtracked = 0                   # Newton: steps redone with a backtracking line search
+        self.notes: list = []                  # what the run's warnings add (said once per run)
         self.precision = FACTOR_PRECISION if self.nonlinear else "double"    # of the LU factors
         self._fresh = False                    # Newton: a fresh tangent every iteration (a step redone)
         if self.nonlinear:
@@ -458,6 +466,8 @@ class Thermal:
             finally:
                 self._fresh = False
                 search.setType(NEWTON_OPTIONS["snes_linesearch_type"])
+            if ok and not self.notes:
+                self._note_backtracking(dt)
         snes = self.problem.solver
         if not ok:
             failed = mumps.describe(snes.getKSP().getPC())        # the factorisation's failure, if any
@@ -476,6 +486,17 @@ class Thermal:
         lost = self.lost_step.sum(axis=0)
         return ThermalStep(self.time, (power[0] * dt, power[1] * dt), self.max_temperature(),
                            (float(lost[0]), float(lost[1])), dt * self.exchange_power() if self.conductance else 0.0)
+
+    def _note_backtracking(self, dt: float) -> None:
+        """The first step that converged only with backtracking, said once: a note for the run's
+        warnings and a ``HeatStepWarning`` (rank 0; the step is collective)."""
+        note = (f"the heat step to t = {self.time + dt:.6g} s was too long for full Newton steps ({dt:.4g} s: "
+                "the radiation or the temperature tables change too much over it) and converged only with a "
+                "backtracking line search; a step that long is coarse in time: more time.steps or substeps "
+                "follow the heating more closely (said for the first such step only)")
+        self.notes.append(note)
+        if self.tm.comm.rank == 0:
+            warnings.warn(note, HeatStepWarning, stacklevel=3)
 
     def exchange_power(self) -> float:
         """Heat [W] conducted from body 0 to body 1 through the interface conductance at the current
@@ -567,4 +588,4 @@ class Thermal:
         return self.cache.facet_mean(("T", side), lambda: T)
 
 
-__all__ = ["STEFAN_BOLTZMANN", "Thermal", "ThermalBoundary", "ThermalStep", "temperature_functions"]
+__all__ = ["STEFAN_BOLTZMANN", "HeatStepWarning", "Thermal", "ThermalBoundary", "ThermalStep", "temperature_functions"]

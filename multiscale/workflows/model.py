@@ -26,6 +26,8 @@ The rules that more than one analysis follows live here once:
 from __future__ import annotations
 
 import dataclasses
+import warnings
+from contextlib import contextmanager
 
 import numpy as np
 from mpi4py import MPI
@@ -36,7 +38,7 @@ from multiscale.macro import mesh as two_body
 from multiscale.macro.interface import PenaltyLaw, SumLaw
 from multiscale.macro.mechanics import Mechanics, load_face_areas, load_face_forces
 from multiscale.macro.model import Drive, MacroModel
-from multiscale.macro.thermal import Thermal, ThermalBoundary, temperature_functions
+from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
 
 
 def friction_coefficient(scene, interface: str | None = None) -> float:
@@ -226,6 +228,21 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: b
         if scene.has("conductance") and scene.interface.conductance is not None:   # else per facet later
             tm.interface.set_field(mech.contact.conductance, scene.interface.conductance)
     return MacroModel(tm, mech, heat, drive(scene, tm), partitions=shares)
+
+
+def run_notes(model: MacroModel) -> tuple:
+    """What a run of the model adds to its warnings: the model's notes (``MacroModel.notes``) and
+    the heat's (``Thermal.notes``)."""
+    return (*model.notes, *(model.thermal.notes if model.thermal is not None else ()))
+
+
+@contextmanager
+def heat_warnings_as_notes():
+    """The heat's ``HeatStepWarning`` kept quiet in the block: the run's report says it, once, with
+    the other warnings and in the provenance (``run_notes``)."""
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", HeatStepWarning)
+        yield
 
 
 def interface_forces(scene, tm) -> dict:

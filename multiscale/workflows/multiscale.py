@@ -39,8 +39,8 @@ from multiscale.micro.heat_kernels import ThermalMaterial
 from multiscale.micro.laws import Conductance
 from multiscale.micro.post_analysis import Heating, PostAnalysis
 from multiscale.plots.history import multiscale_figure, wear_map
-from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, interface_forces, \
-    interface_materials
+from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, heat_warnings_as_notes, \
+    interface_forces, interface_materials, run_notes
 from multiscale.workflows.output import prepare_folder
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
@@ -163,7 +163,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         ms.mark_fields(ckpt, done, comm)
     last = steps if stop_after is None else min(steps, stop_after)
     stopping = False
-    with io.StepStop(comm) as stop:          # a Ctrl-C while the end is written lets it finish
+    with io.StepStop(comm) as stop, heat_warnings_as_notes():   # a Ctrl-C while the end is written lets it finish
         with io.stage("macro steps"):
             for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
                 history.append(**ms.record(ms.step(n)))
@@ -182,7 +182,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
     result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones, ckpt] + maps, _time.perf_counter() - start,
                               history, h5, png, writer.files, plot, maps, zones, done,
-                              warnings=tuple(ms.model.notes))
+                              warnings=run_notes(ms.model))
     del ms, writer            # the model holds reference cycles of PETSc objects: free them on every
     gc.collect()              # rank at the same point (collected later, ranks could hang at exit)
     if stopping:                 # decided by every rank together

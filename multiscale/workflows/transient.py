@@ -18,7 +18,7 @@ from multiscale import io, outputs
 from multiscale.errors import Interrupted
 from multiscale.macro.output import FieldOutput
 from multiscale.plots.history import history_figure
-from multiscale.workflows.model import build_mesh, build_model
+from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, run_notes
 from multiscale.workflows.output import RunResult, prepare_folder
 
 
@@ -30,7 +30,7 @@ class TransientResult(RunResult):
     history_file: Path          # history.h5
     plot_file: Path             # history.png
     field_files: list           # XDMF files
-    warnings: tuple = field(default=(), kw_only=True)   # what the model noted (``MacroModel.notes``)
+    warnings: tuple = field(default=(), kw_only=True)   # what the model noted (``workflows.model.run_notes``)
 
 
 def write_history(history: io.History, folder: Path, name: str, comm, plot: bool = True) -> tuple[Path, Path]:
@@ -66,7 +66,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
     steps = scene.time.steps if model.thermal is not None else 0
     done, stopping = 0, False
-    with io.StepStop(comm) as stop:          # a Ctrl-C while the end is written lets it finish
+    with io.StepStop(comm) as stop, heat_warnings_as_notes():   # a Ctrl-C while the end is written lets it finish
         with io.stage("macro steps"):
             for n in io.bar(range(1, steps + 1), "macro steps"):
                 heat = model.macro_step(scene.time.dt, scene.time.substeps)
@@ -83,7 +83,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     if stopping:                     # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}")
     result = TransientResult(folder, writer.files + [h5, png], _time.perf_counter() - start, history, h5, png,
-                             writer.files, warnings=tuple(model.notes))
+                             writer.files, warnings=run_notes(model))
     if verbose and comm.rank == 0:
         print(f"{scene.name}: {len(history)} records in {result.wall_time:.1f} s on {comm.size} rank(s)")
         print(f"  ParaView: {', '.join(str(f) for f in writer.files)}")
