@@ -202,6 +202,9 @@ def _load(model, g) -> Found:
         after = {t: [b for d, b in m if d == 3] for (_, t), m in zip(volumes, mapping)}
         order = [t for old in order for t in after.get(old, [old])]
         split = sorted(old for old, pieces in after.items() if len(pieces) > 1)
+    # the extent before a script's or a mesh's scaling, scaled: gmsh's bounding box of some OpenCASCADE
+    # surfaces is stale after occ.dilate (a partial Sphere 80 mm off the origin in mm spanned 80 m)
+    extent = _extent(model, g, g.unit if g.kind != "cad" else 1.0)
     if g.unit != 1.0 and g.kind != "cad":
         if g.kind == "mesh":
             s = g.unit
@@ -212,7 +215,6 @@ def _load(model, g) -> Found:
         else:
             model.geo.dilate(model.getEntities(), 0, 0, 0, g.unit, g.unit, g.unit)
             model.geo.synchronize()
-    extent = _extent(model, g)
     labels = {t: _label(model, t) for _, t in model.getEntities(3)}
     try:
         bodies = _bodies(model, g, order, labels)
@@ -228,9 +230,11 @@ def _load(model, g) -> Found:
     return found
 
 
-def _extent(model, g) -> float:
+def _extent(model, g, scale: float) -> float:
+    """The largest side [m] of the model's bounding box times ``scale`` (m per model unit),
+    refused if implausible."""
     box = np.array(model.getBoundingBox(-1, -1))
-    extent = float((box[3:] - box[:3]).max())
+    extent = float((box[3:] - box[:3]).max()) * scale
     if not PLAUSIBLE[0] <= extent <= PLAUSIBLE[1]:
         raise InputError("geometry.unit", g.unit, f"the geometry of {g.file.name} spans {extent:.4g} m, implausible for "
                          f"a brake or tribometer ({PLAUSIBLE[0]:g}..{PLAUSIBLE[1]:g} m): is the file's length unit "

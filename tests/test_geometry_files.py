@@ -623,6 +623,65 @@ def test_a_pressure_on_a_face_without_resultant_is_refused(tmp_path):
         run(loads(wall, tmp_path), verbose=False)
 
 
+# half a band of a sphere of radius 10 mm (latitudes -45..45 degrees, y >= 0) on a small block
+PARTIAL_SPHERE_GEO = """SetFactory("OpenCASCADE");
+Sphere(1) = {0, 0, 0, 10, -Pi/4, Pi/4, Pi};
+Box(2) = {-8, 0, -12.0710678118654752, 16, 8, 5};"""
+PARTIAL_SPHERE = """name = "band"
+effects = ["contact"]
+[geometry]
+file = "band.geo"
+unit = "mm"
+mesh_size = "5 mm"
+rotating = "block"
+[geometry.bodies.block]
+contains = ["0 mm", "4 mm", "-10 mm"]
+material = "steel"
+[geometry.bodies.band]
+contains = ["0 mm", "5 mm", "0 mm"]
+material = "steel"
+[geometry.surfaces.top]
+contains = ["0 mm", "3 mm", "7.0710678 mm"]
+[materials.steel]
+E = "200 GPa"
+nu = 0.3
+[interface]
+penalty = "1e13 Pa/m"
+[loading]
+faces = ["top"]
+normal_force = "100 N"
+rotation_speed = "1 rpm"
+"""
+
+
+@pytest.mark.parametrize("shape", ["partial sphere", "dome"])
+def test_a_script_in_millimetres_with_a_sphere_spans_what_it_does_in_metres(tmp_path, shape):
+    """The extent of an OpenCASCADE script in mm (unit = "mm") is that of the file in metres, to
+    the 1e-7 file units OCC's bounding boxes add (1e-6 m tested): gmsh's bounding box after the
+    script's scaling (occ.dilate) is stale for a sphere's faces. Before, the partial sphere above
+    (20 mm across) spanned 28.28 mm, and the dome of the pin above (its sphere 80 mm off the
+    origin) 80.17 m, refused as implausible; the same files in metres span 20 mm and 0.2 m. The
+    dome's interface keeps its normal."""
+    mm, m = tmp_path / "mm", tmp_path / "m"
+    mm.mkdir(), m.mkdir()
+    if shape == "dome":
+        text, extent = dome(m), 0.2
+        (mm / "dome.geo").write_text(re.sub(r"0\.(\d{3})", lambda n: str(int(n.group(1))), DOME_GEO))
+        assert "Sphere(5) = {0, 80, 18, 10, 0, Pi/2, 2*Pi};" in (mm / "dome.geo").read_text()
+        in_m, in_mm = text, text.replace('unit = "m"', 'unit = "mm"')
+    else:
+        in_mm, in_m, extent = PARTIAL_SPHERE, PARTIAL_SPHERE.replace('unit = "mm"', 'unit = "m"'), 0.02
+        (mm / "band.geo").write_text(PARTIAL_SPHERE_GEO)
+        (m / "band.geo").write_text(PARTIAL_SPHERE_GEO.replace("0, 0, 0, 10,", "0, 0, 0, 0.010,").replace(
+            "{-8, 0, -12.0710678118654752, 16, 8, 5}", "{-0.008, 0, -0.0120710678118654752, 0.016, 0.008, 0.005}"))
+    spec_mm, spec_m = loads(in_mm, mm).geometry.spec, loads(in_m, m).geometry.spec
+    assert spec_mm.length_scale == pytest.approx(extent, abs=1e-6)
+    assert spec_m.length_scale == pytest.approx(extent, abs=1e-6)
+    assert spec_mm.interface_normals.keys() == spec_m.interface_normals.keys()
+    for name, normal in spec_m.interface_normals.items():
+        np.testing.assert_allclose(spec_mm.interface_normals[name], normal, rtol=0, atol=1e-9)
+
+
 def caliper(tmp_path, outboard: str, load: str) -> str:
     """TWO_PADS with pad_b moved under the disc, opposite pad_a (an inboard and an outboard pad),
     its back (facing -z) in the one surface "backs" with pad_a's (facing +z); ``outboard`` its
