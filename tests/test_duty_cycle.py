@@ -155,25 +155,48 @@ def test_sliding_from_a_standstill_solves_the_contact_with_friction(tmp_path):
     assert heat[0] == pytest.approx(heat[1], rel=0.01)
 
 
-@pytest.mark.parametrize("profile", [[["0 s", "200 rpm"], ["0.6 s", "0 rpm"], ["1.2 s", "0 rpm"], ["1.8 s", "200 rpm"]],
-                                     [["0 s", "0 rpm"], ["0.6 s", "200 rpm"]]], ids=["after a stop", "from the start"])
-def test_the_first_sliding_step_after_rest_heats_with_the_frictional_pressure(tmp_path, profile):
-    """Sliding from rest (a restart after a stop; a start at rest): the step's frictional heat is
-    the frictional work mu ∫ p |w| dA ∫ factor w dt of the pressure solved with friction at its
-    end (no expansion: the same pressure all through the step), to 1e-8 (measured 3e-16). Before,
-    the step heated with the frictionless pressure of the solve at rest (1.24e-3 off; an
-    adversarial test)."""
+ENGAGE = [["0 s", 0.0], ["0.01 s", 1.0]]                           # released at the start, engaged in 10 ms
+REENGAGE = [["0 s", 1.0], ["1.2 s", 1.0], ["1.21 s", 0.0], ["1.8 s", 0.0], ["1.81 s", 1.0]]
+
+
+@pytest.mark.parametrize("profile, factor", [
+    ([["0 s", "200 rpm"], ["0.6 s", "0 rpm"], ["1.2 s", "0 rpm"], ["1.8 s", "200 rpm"]], None),
+    ([["0 s", "0 rpm"], ["0.6 s", "200 rpm"]], None), ([["0 s", "0 rpm"], ["0.6 s", "200 rpm"]], ENGAGE),
+    ([["0 s", "200 rpm"], ["0.6 s", "0 rpm"], ["1.8 s", "0 rpm"], ["2.4 s", "200 rpm"]], REENGAGE)],
+    ids=["after a stop", "from the start", "released at the start", "released at rest, restarting on engaging"])
+def test_the_first_sliding_step_after_rest_heats_with_the_frictional_pressure(tmp_path, profile, factor):
+    """Sliding from rest (a restart after a stop; a start at rest; either released at the step's
+    start and engaged within 10 ms): the step's frictional heat is the frictional work
+    mu ∫ p |w| dA ∫ factor w dt of the pressure solved with friction at its end (no expansion: the
+    same pressure all through the step), to 1e-8 (measured 4e-16). Before, the step heated with
+    the frictionless pressure of the solve at rest (1.24e-3 off; adversarial tests: the released
+    cases were left by the first fix)."""
     from multiscale.workflows.model import build_model
     text = pod(tmp_path / "restart").replace('rotation_speed = "200 rpm"\n', "")
-    scene = loads(text, overrides={"loading.speed_profile": profile})
+    scene = loads(text, overrides={"loading.speed_profile": profile, **({"loading.load_profile": factor} if factor else {})})
     model, dt = build_model(scene), 0.6
     model.start()
-    for n in range(1, len(profile)):
+    for n in range(round(float(profile[-1][0].split()[0]) / dt)):      # to the profile's end
         heat = model.macro_step(dt).sum()
     t0 = float(f"{model.time - dt:.12g}")              # the step's start (outputs.step_time)
     work = model.sliding_power() * model.drive.mean_sliding(t0, model.time) * dt     # J
     assert model.drive.mean_speed(t0, model.time) > 0 and model.speed(t0) == 0.0
     assert heat == pytest.approx(work, rel=1e-8)
+
+
+def test_a_step_from_rest_without_heat_works_with_the_frictional_pressure(tmp_path):
+    """Without the heat problem (a wear run without "thermal"), 0 to 200 rpm over one 0.6 s step:
+    the step's frictional work ``work_step`` is that of the pressure solved with friction, to 1e-8
+    (measured 0). Before, ``start_sliding`` ran only with the heat: the work took the frictionless
+    pressure of the start at rest, 1.24e-3 off (an adversarial test)."""
+    from multiscale.workflows.model import build_model
+    text = pin_on_disc(tmp_path / "cold", effects=("contact", "friction")).replace('rotation_speed = "200 rpm"\n', "")
+    scene = loads(text, overrides={"loading.speed_profile": [["0 s", "0 rpm"], ["0.6 s", "200 rpm"]], "time.end": "0.6 s"})
+    model = build_model(scene)
+    model.start()
+    model.macro_step(0.6)
+    assert model.thermal is None
+    assert model.work_step == pytest.approx(model.sliding_power() * model.sliding(0.0, 0.6), rel=1e-8)
 
 
 BRAKE = {"geometry.mesh_size": "20 mm", "output.folder": None}

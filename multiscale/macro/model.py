@@ -141,11 +141,10 @@ class MacroModel:
         delta, start = dt / substeps, self.time
         for k in range(substeps):
             t0, t1 = self.time, self.time + delta
-            if self.thermal is not None:            # the mean speed of the step (transport, convection)
-                speed = self.drive.mean_speed(t0, t1)
-                self.contact.speed.value = speed
-                if speed and self.solved_speed == 0.0 and not self.released:
-                    self.start_sliding(speed, self.drive.factor(t0))
+            speed = self.drive.mean_speed(t0, t1)   # the mean speed of the step (transport, convection)
+            self.contact.speed.value = speed
+            if speed and self.solved_speed == 0.0 and self.drive.mean_sliding(t0, t1):   # (released at t0 too)
+                self.start_sliding(speed, float(self.mechanics.load.value) / self.load)
             # the frictional work of the substep with the pressure and the sliding its heat step takes
             self.work_step += self.sliding_power() * self.sliding(t0, t1)
             if self.thermal is not None:
@@ -181,10 +180,11 @@ class MacroModel:
 
     def start_sliding(self, speed: float, factor: float) -> None:
         """Solve the contact with friction at the sliding ``speed`` (rad/s or m/s; its sign the
-        direction) and the load last solved, before a heat step that slides from rest: the step
-        heats with the frictional pressure (before, with the frictionless one of the solve at rest:
-        the test pin-on-disc restarting from a stop, 0 to 200 rpm over a 0.6 s step, 1.24e-3 off in
-        the step's heat)."""
+        direction) and the load last solved (at load ``factor``), before a heat step that slides from
+        rest, also one that starts released and engages inside it: the step heats with the
+        frictional pressure (before, with the frictionless one of the solve at rest: the test
+        pin-on-disc restarting from a stop, 0 to 200 rpm over a 0.6 s step, 1.24e-3 off in the
+        step's heat; a start released at rest, engaging within 10 ms, as much)."""
         self.last_solve = self.mechanics.solve()
         self.solved_speed = speed
         self.keep_torque(factor)
