@@ -60,7 +60,7 @@ def _records(rows) -> np.ndarray:
     return np.ascontiguousarray(rows, dtype=np.int64).view([(f"f{k}", np.int64) for k in range(4)]).ravel()
 
 
-def _rows(points, directions, centre, size) -> np.ndarray:
+def motion_rows(points, directions, centre, size) -> np.ndarray:
     """r(x, d) = [d, ((x − c)/L) × d] per row (m, 6): d · (translation e_k, rotation e_k × (x − c)/L)."""
     return np.hstack([directions, np.cross((points - centre) / size, directions)])
 
@@ -152,7 +152,8 @@ class Holding:
         """Add rows r_p(x, d) − r_q(x, d) (q = -1: the ground) with weights w; ``slide``: the rows
         hold neither part in body 1's motion (their components along it removed)."""
         c, s = self.parts.centre, self.parts.size
-        blocks = [(p, _rows(x, d, c[p], s[p]), 1.0)] + ([(q, _rows(x, d, c[q], s[q]), -1.0)] if q >= 0 else [])
+        blocks = [(p, motion_rows(x, d, c[p], s[p]), 1.0)]
+        blocks += [(q, motion_rows(x, d, c[q], s[q]), -1.0)] if q >= 0 else []
         if slide:
             for k, (a, ra, sa) in enumerate(blocks):
                 along = ra @ self.slides[a]

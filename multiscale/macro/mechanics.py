@@ -282,7 +282,7 @@ class Mechanics:
         self._offset, self._start, self._step = (self.problem.b.duplicate() for _ in range(3))
         self._offset.setAttr("_blocks", self._blocks)
         self._offset_stale = True
-        self._bcs_by_body = fem.bcs_by_block(fem.extract_function_spaces(self._cell_residual), self.bcs)
+        self.bcs_by_body = fem.bcs_by_block(fem.extract_function_spaces(self._cell_residual), self.bcs)
         self.problem.solver.setFunction(self._residual, self.problem.b)
         self._frictionless = None          # (matrix, form) of ``frictionless_tangent`` without P
         self._history: list[float] = []
@@ -365,7 +365,7 @@ class Mechanics:
         self._step.waxpy(-1.0, self._start, x)                     # x - x_0
         self._split[0].bulk.multAdd(self._step, b, b)
         b.axpy(1.0, self._offset)
-        fpetsc.set_bc(b, self._bcs_by_body, x0=x, alpha=-1.0)
+        fpetsc.set_bc(b, self.bcs_by_body, x0=x, alpha=-1.0)
         b.ghostUpdate(addv=PETSc.InsertMode.INSERT, mode=PETSc.ScatterMode.FORWARD)
 
     @staticmethod
@@ -551,6 +551,26 @@ class Mechanics:
             P = assemble(*self._frictionless, self.bcs)
         P.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         return P
+
+    def cell_system(self) -> tuple[PETSc.Mat, PETSc.Vec]:
+        """(K, r_0) of the bodies without contact and load, K u + r_0 = 0: K the tangent's kept cell
+        part at the current temperatures (elasticity, block-diagonal, the supports' rows unit;
+        owned by the Mechanics and overwritten when an input of it changes), r_0 a new vector, the
+        cell residual at u = 0 (minus the thermal load [N], 0 on the supports' rows). Collective;
+        the displacements are kept."""
+        self._split[0].update()
+        kept = [u.x.array.copy() for u in self.u]
+        r0 = self._offset.duplicate()
+        r0.setAttr("_blocks", self._blocks)
+        try:
+            for u in self.u:
+                u.x.array[:] = 0.0
+            self._assemble_vector(r0, self._cell_residual)
+        finally:
+            for u, x in zip(self.u, kept):
+                u.x.array[:] = x
+        fpetsc.set_bc(r0, self.bcs_by_body)
+        return self._split[0].bulk, r0
 
     def tangent(self) -> PETSc.Mat:
         """The assembled block Jacobian at the current state (assembled on request)."""

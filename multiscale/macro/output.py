@@ -23,6 +23,7 @@ writes every function as its own grid (coincident unnamed blocks in ParaView).
 """
 from __future__ import annotations
 
+import warnings
 from pathlib import Path
 from typing import Callable, Mapping, Sequence
 from xml.sax.saxutils import quoteattr
@@ -35,6 +36,7 @@ from dolfinx.io import VTXMeshPolicy, VTXWriter
 
 from multiscale import io
 from multiscale.errors import InputError, OutputError
+from multiscale.macro.unloaded import Unloaded, UnloadedWarning
 from multiscale.outputs import FIELDS, array_name
 
 # DOLFINx cell name -> (XDMF topology type, DOLFINx vertex order -> XDMF/VTK order)
@@ -308,6 +310,8 @@ class FieldOutput:
         groups.append(("interface", tm.interface.mesh, {f.name: f for f, _ in self.interface}))
         self.writer = FieldWriter(folder, groups, resume_at=resume_at)
         self.files = self.writer.files
+        self.body_fields = "displacement" in fields or bool(self.von_mises)   # a released state to write
+        self._unloaded = None                   # its solver (``unloaded``), made on first use
 
     def write(self, time: float | None = None) -> None:
         """Refresh the derived fields and write them at ``time`` (default: the model's time). While
@@ -315,11 +319,11 @@ class FieldOutput:
         displacements the next solve starts from are kept."""
         for f, make in self.interface:
             self.tm.interface.set_field(f, make())
-        released = self.model is not None and self.model.released
+        released = self.model is not None and self.model.released and self.body_fields
         kept = [u.x.array.copy() for u in self.mech.u] if released else []
         try:
-            for u in self.mech.u if released else ():
-                u.x.array[:] = self.unloaded
+            for u, x in zip(self.mech.u, self.unloaded() if released else ()):
+                u.x.array[:] = x
             for f, expr in self.von_mises:
                 f.interpolate(expr)
             self.writer.write(self.model.time if time is None else time)
@@ -327,13 +331,26 @@ class FieldOutput:
             for u, x in zip(self.mech.u, kept):
                 u.x.array[:] = x
 
-    @property
-    def unloaded(self) -> float:
-        """Displacement [m] (and so von Mises stress) written while released: nothing is solved
-        then. 0 without thermal expansion, exact (no load, no contact, zero supports, no body
-        force); NaN with it: the heated bodies' state without the contact would need a solve that a
-        body held only by the contact (a pin pushed by its load) cannot have (docs/results.rst)."""
-        return 0.0 if self.mech.temperatures is None else np.nan
+    def unloaded(self) -> list:
+        """Per body, the displacement [m] written while released (and so the von Mises stress): the
+        bodies under their supports alone, without contact and load. 0 without thermal expansion
+        (exact: no load, zero supports, no body force); with it the thermo-elastic state of
+        ``unloaded.Unloaded`` (one linear solve; a part the supports leave free keeps the rigid
+        motion of the last loaded state), NaN with an ``UnloadedWarning`` if that fails (a
+        mechanism beyond rigid motions). Collective."""
+        if self.mech.temperatures is None:
+            return [0.0] * len(self.mech.u)
+        if self._unloaded is None:
+            self._unloaded = Unloaded(self.mech)
+        out = self._unloaded.solve()
+        if out is None:
+            if self.tm.comm.rank == 0:
+                warnings.warn(UnloadedWarning(
+                    "the released bodies' thermo-elastic state did not converge (a part held by neither "
+                    "supports nor rigid motions alone: two parts joined at an edge or a vertex?): their "
+                    "displacement and von Mises stress are written NaN"), stacklevel=2)
+            return [np.nan] * len(self.mech.u)
+        return out
 
 
 def write_state(folder: Path, mechanics, fields, time: float = 0.0) -> list[Path]:

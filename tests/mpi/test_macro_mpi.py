@@ -54,3 +54,17 @@ def test_two_ranks_give_the_serial_history(tmp_path):
                         x, y = a[f"data/{k}/{field}"][...], b[f"data/{k}/{field}"][...]
                         np.testing.assert_allclose(x, y, rtol=1e-7, atol=1e-8 * np.abs(y).max(), err_msg=field)
         assert json.loads(Path(f"{base}/parallel/provenance.json").read_text())["ranks"] == 2
+
+
+def test_the_unloaded_state_on_two_ranks():
+    """The exact checks of tests/test_unloaded.py with the block on a flat split over two ranks:
+    the parts and the free motion are found across the ranks (the released state of a run with
+    thermal expansion)."""
+    import test_unloaded as t
+    from multiscale.geometry import builder
+    from multiscale.macro import mesh
+    tm = mesh.build(builder("block_on_flat"), {"mesh_size": 2.5e-3}, comm=MPI.COMM_WORLD)
+    assert tm.comm.size == 2 and all(b.mesh.topology.index_map(3).size_local > 0 for b in tm.bodies)
+    t.test_a_uniform_rise_expands_the_bodies_freely(tm)
+    t.test_a_linear_temperature_bends_the_free_block_without_stress(tm)
+    t.test_a_held_flat_is_stressed_as_the_linear_elasticity_solved_directly(tm)
