@@ -168,6 +168,20 @@ def test_the_users_newton_options_win(tm, petsc_options):
     assert PETSc.Options().getInt("block_u_snes_max_it") == 5
 
 
+@pytest.mark.parametrize("option", [{"block_v_ksp_type": "nonsense"}, {"block_v_snes_linesearch_type": "nonsense"},
+                                    {"block_v_pc_type": "nonsense"}])
+def test_a_solver_option_petsc_refuses_is_an_input_error(tm, petsc_options, option):
+    """A value PETSc refuses among the user's options (PETSC_OPTIONS="-mech_ksp_type nonsense") is
+    an InputError naming them (before: petsc4py's Error 86 with PETSc's traceback, from inside
+    DOLFINx's set-up); the process goes on, and a problem built after, with good options, solves."""
+    petsc_options(**option)
+    [(name, value)] = option.items()
+    with pytest.raises(InputError, match=rf"PETSC_OPTIONS = '-{name} {value}': PETSc refused .*error 86"):
+        Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_v_")
+    m = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_w_")
+    assert m.solve(1e6).converged
+
+
 def test_missing_material_and_unknown_builder_are_input_errors(tm):
     with pytest.raises(InputError, match="materials.flat"):
         Mechanics(tm, {"block": MATERIALS["block"]}, prefix="block_e_")

@@ -27,6 +27,8 @@ from petsc4py import PETSc
 from ufl.algorithms import expand_derivatives
 from ufl.algorithms.analysis import extract_coefficients, extract_constants
 
+from multiscale.errors import InputError
+
 
 def integrals(form, cells: bool):
     """The cell integrals (``cells``) or all the others of a UFL form; None if there are none."""
@@ -51,7 +53,9 @@ def nonlinear_problem(F, u, prefix: str, options: Mapping, **kwargs) -> fpetsc.N
     set under the prefix (``PETSC_OPTIONS="-<prefix>..."``): theirs win (given to DOLFINx, ours
     overwrote them). Ours are removed from PETSc's database after the set-up: DOLFINx 0.11 leaves
     them there (its deletion misses the prefix it pushed), and a later problem with the prefix
-    would take them for the user's. Only the user's then remain under the prefix."""
+    would take them for the user's. Only the user's then remain under the prefix. A value PETSc
+    refuses among the user's raises ``InputError`` on every rank first (``check_user_options``)."""
+    check_user_options((u[0] if isinstance(u, (list, tuple)) else u).function_space.mesh.comm, prefix)
     user = PETSc.Options(prefix)
     ours = {k: v for k, v in options.items() if not user.hasName(k)}
     try:
@@ -59,6 +63,28 @@ def nonlinear_problem(F, u, prefix: str, options: Mapping, **kwargs) -> fpetsc.N
     finally:
         for name in ours:
             user.delValue(name)
+
+
+def check_user_options(comm, prefix: str) -> None:
+    """Raise ``InputError`` on every rank of ``comm`` if PETSc refuses a value of the options the
+    user set under ``prefix`` (``PETSC_OPTIONS="-<prefix>ksp_type nonsense"``: an unknown type,
+    error 86). They are tried on a bare SNES (its KSP, PC and line search) destroyed after: a
+    DOLFINx problem that failed half-way through its set-up crashed the process when collected."""
+    snes = PETSc.SNES().create(comm)
+    snes.setOptionsPrefix(prefix)
+    try:
+        snes.setFromOptions()
+        failure = None
+    except PETSc.Error as exc:
+        failure = exc.ierr
+    finally:
+        snes.destroy()
+    codes = [c for c in comm.allgather(failure) if c is not None]
+    if codes:
+        given = " ".join(f"-{k} {v}".rstrip() for k, v in sorted(PETSc.Options().getAll().items())
+                         if k.startswith(prefix))
+        raise InputError("PETSC_OPTIONS", given, f"PETSc refused one of these solver options (error {codes[0]}: "
+                         "an unknown type or a value it cannot read); see PETSc's manual pages for the choices")
 
 
 class KeptCells:
