@@ -16,6 +16,7 @@ heat's Newton) with our solver options, the user's winning.
 """
 from __future__ import annotations
 
+from contextlib import contextmanager
 from typing import Mapping
 
 import numpy as np
@@ -63,6 +64,19 @@ def nonlinear_problem(F, u, prefix: str, options: Mapping, **kwargs) -> fpetsc.N
     finally:
         for name in ours:
             user.delValue(name)
+
+
+@contextmanager
+def backtracking(snes: PETSc.SNES):
+    """``snes`` with PETSc's backtracking line search (``bt``) inside the block and the full Newton
+    step (``basic``, ours) after: the retry of a solve whose full steps overshot (the contact's and
+    the heat's Newton; not when the user chose a line search)."""
+    search = snes.getLineSearch()
+    search.setType("bt")
+    try:
+        yield
+    finally:
+        search.setType("basic")
 
 
 def check_user_options(comm, prefix: str) -> None:

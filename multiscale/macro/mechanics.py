@@ -29,7 +29,7 @@ from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.macro import mumps
 from multiscale.macro.compact_factor import CompactFactor
 from multiscale.macro.interface import ContactInterface, PressureLaw
-from multiscale.macro.kept_cells import KeptCells, assemble, integrals, nonlinear_problem
+from multiscale.macro.kept_cells import KeptCells, assemble, backtracking, integrals, nonlinear_problem
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
@@ -473,12 +473,8 @@ class Mechanics:
         if not result.converged and self._backtrack:   # a full step overshot (worn laws opening the contact: the
             for u, x in zip(self.u, start):  # residual 77 -> 1.5e6 N, SNES -9): again, backtracking
                 u.x.array[:] = x
-            search = self.problem.solver.getLineSearch()
-            search.setType("bt")
-            try:
+            with backtracking(self.problem.solver):
                 result = self._newton()
-            finally:
-                search.setType(NEWTON_OPTIONS["snes_linesearch_type"])
         if not result.converged:
             failed = "" if self.factors.inner is None else mumps.describe(self.factors.inner)  # same on every rank
             cause = f"; the preconditioner's factorisation failed: {failed}" if failed else ""

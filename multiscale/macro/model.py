@@ -146,7 +146,9 @@ class MacroModel:
             if speed and self.solved_speed == 0.0 and self.drive.mean_sliding(t0, t1):   # (released at t0 too)
                 self.start_sliding(speed, float(self.mechanics.load.value) / self.load)
             # the frictional work of the substep with the pressure and the sliding its heat step takes
-            self.work_step += self.sliding_power() * self.sliding(t0, t1)
+            slid = self.sliding(t0, t1)
+            if slid:                                # (at rest or released: no work, no assembly)
+                self.work_step += self.sliding_power() * slid
             if self.thermal is not None:
                 # the pressure was solved at the load factor of the step's start: the conductance
                 # scales with the mean factor over the step (a release inside it, a load ramp), the

@@ -100,7 +100,7 @@ from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.geometry import Rotation
 from multiscale.macro import mumps
 from multiscale.macro.interface import ContactInterface, rigid_velocity
-from multiscale.macro.kept_cells import KeptCells, assemble, nonlinear_problem
+from multiscale.macro.kept_cells import KeptCells, assemble, backtracking, nonlinear_problem
 from multiscale.macro.materials import body_properties, heat_capacity
 from multiscale.macro.mesh import FormCache
 from multiscale.macro.thermal_conditions import AppliedBoundary, ThermalBoundary, surface_rows
@@ -458,14 +458,12 @@ class Thermal:
                 self._fresh = False
         if not ok and self._backtrack:          # a full Newton step overshot: again, backtracking (module docstring)
             self._back_to_start()
-            search = self.problem.solver.getLineSearch()
-            search.setType("bt")
             self._fresh, self.backtracked = True, self.backtracked + 1
             try:
-                ok = self._solve()
+                with backtracking(self.problem.solver):
+                    ok = self._solve()
             finally:
                 self._fresh = False
-                search.setType(NEWTON_OPTIONS["snes_linesearch_type"])
             if ok and not self.notes:
                 self._note_backtracking(dt)
         snes = self.problem.solver
