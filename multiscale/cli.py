@@ -264,9 +264,12 @@ def _surface(args) -> int:
     print("\n".join(done.report))
     print(f"statistics of the {'roughness' if done.waviness is not None else 'surface'}:")
     print("\n".join(stats.table()))
-    if args.figure != "none":
+    if args.figure in (None, "none"):        # a figure only where asked: nothing lands in the working folder
+        if args.figure is None:
+            print("figure: none written (--figure PATH.png draws the height map and the PSD with its fit)")
+    else:
         from multiscale.plots.surface import surface_figure   # matplotlib: only when a figure is drawn
-        path = Path(args.figure or f"{Path(args.file).stem}_surface.png")
+        path = Path(args.figure)
         try:
             surface_figure(done.surface, stats, path, f"{Path(args.file).name}, channel {measurement.channel}",
                            waviness=done.waviness)
@@ -317,10 +320,10 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("--problems", action="store_true", help="list the problems, their parameters and metrics")
     study.set_defaults(func=_study)
     surface = sub.add_parser("surface", help="measured topography: conditioning, statistics (Sq, Sdq, Ssk, Sku, "
-                                             "Nayak, summits, PSD fit) and a figure",
+                                             "Nayak, summits, PSD fit), a figure with --figure",
                              description="Read a measured topography (through SurfaceTopography), remove its form, "
                              "fill undefined points, optionally split waviness from roughness, and print its "
-                             "statistics; writes a figure of the height map and the PSD with its fit.")
+                             "statistics; with --figure, a figure of the height map and the PSD with its fit.")
     surface.add_argument("file", nargs="?", metavar="FILE", help="topography file (x3p, sur, plu, opd, ...; "
                                                                  "--formats lists them)")
     surface.add_argument("--channel", type=int, metavar="N", help="channel index (default: the file's default)")
@@ -332,7 +335,8 @@ def build_parser() -> argparse.ArgumentParser:
     surface.add_argument("--pixel-size", metavar="LENGTH", help="override the file's pixel size")
     surface.add_argument("--height-unit", metavar="LENGTH",
                          help='override the file\'s height unit, e.g. "um" or "1 um"')
-    surface.add_argument("--figure", metavar="PNG", help="figure path (default FILE-stem_surface.png; none: no figure)")
+    surface.add_argument("--figure", metavar="PATH", help="write a figure of the height map and the PSD with its fit "
+                         "there (.png, .pdf, .svg); default: no figure")
     surface.add_argument("--formats", action="store_true", help="list the file formats")
     surface.set_defaults(func=_surface)
     return parser

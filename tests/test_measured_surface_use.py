@@ -168,3 +168,14 @@ def test_a_rewritten_measured_file_changes_the_runs_fingerprint(tmp_path):
     assert fingerprint(scene(tmp_path, text)) == before
     np.save(tmp_path / "pad.npy", 3 * heights)
     assert fingerprint(scene(tmp_path, text)) != before
+
+
+def test_surface_command_writes_no_figure_unless_asked(tmp_path, monkeypatch, capsys):
+    """Without --figure nothing is written: it wrote FILE-stem_surface.png into the working folder,
+    the stray *_surface.png files found in the repository's root."""
+    monkeypatch.chdir(tmp_path)
+    assert main(["surface", str(TOP)]) == 0
+    assert list(tmp_path.iterdir()) == []
+    assert "figure: none written (--figure PATH.png" in capsys.readouterr().out
+    assert main(["surface", str(TOP), "--figure", "none"]) == 0
+    assert list(tmp_path.iterdir()) == [] and "figure:" not in capsys.readouterr().out
