@@ -125,7 +125,9 @@ def test_bad_surface_input(tmp_path):
     np.save(tmp_path / "row.npy", np.ones((1, 9)))
     np.save(tmp_path / "complex.npy", np.ones((8, 8)) * (1 + 1j))
     np.save(tmp_path / "mask.npy", np.ones((8, 8), bool))
+    (tmp_path / "empty.npy").write_bytes(b"")          # numpy's EOFError came through as a traceback
     for name, why in [("empty.txt", r"at least 2 x 2 points, got shape \(0, 1\)"),
+                      ("empty.npy", "could not read a height matrix"),
                       ("row.npy", r"at least 2 x 2 points, got shape \(1, 9\)"),
                       ("complex.npy", "real numbers, not complex128"), ("mask.npy", "real numbers, not bool")]:
         with pytest.raises(InputError, match=why):

@@ -91,17 +91,23 @@ def test_plain_matrices_still_read_as_before(tmp_path):
     ("all undefined matrix", r"roughness\.file = '.*empty\.npy': the height matrix holds no defined height$"),
     ("profile", r"roughness\.file = '.*opdx-3\.opdx': channel 0 \(\"Height\"\) is a 1-D profile \(line scan\): "
                 r"a height map \(2-D\) is needed"),
+    # an empty file (a failed copy): it asked for the pixel size (SurfaceTopography's .hgt reader took
+    # it for a 0 x 0 map), or a .npy ended in numpy's EOFError traceback
+    ("empty x3p", r"roughness\.file = 'pad\.x3p': the file is empty \(0 bytes\)$"),
+    ("empty npy", r"roughness\.file = 'pad\.npy': the file is empty \(0 bytes\)$"),
 ])
 def test_bad_input_is_one_clear_error_naming_the_file_and_the_field(tmp_path, case, message):
-    path, channel = {"unreadable": (tmp_path / "pad.x3p", None), "garbage sur": (tmp_path / "pad.sur", None),
+    path, channel = {"empty x3p": (tmp_path / "pad.x3p", None), "empty npy": (tmp_path / "pad.npy", None),"unreadable": (tmp_path / "pad.x3p", None), "garbage sur": (tmp_path / "pad.sur", None),
                      "missing": (tmp_path / "nowhere.x3p", None), "unknown channel": (DATA / "top-1.top", 3),
                      "all undefined": (tmp_path / "empty.nc", None), "profile": (DATA / "opdx-3.opdx", None),
                      "all undefined matrix": (tmp_path / "empty.npy", None)}[case]
     if case in ("unreadable", "garbage sur"):
         path.write_bytes(b"this is no topography\n" * 40)
+    if case.startswith("empty"):
+        path.write_bytes(b"")
     if case == "all undefined":
         write_nc(path, np.full((6, 8), np.nan), 1e-6, 1e-6)
-    pixel = None
+    pixel = 1e-6 if case == "empty npy" else None
     if case == "all undefined matrix":     # it said "heights up to nan m overflow ... is height_unit right?"
         np.save(path, np.full((6, 8), np.nan))
         pixel = 1e-6

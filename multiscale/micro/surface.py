@@ -178,7 +178,7 @@ def read_matrix(path) -> np.ndarray:
             raise InputError("path", str(path), f"heights must be real numbers, not {h.dtype} (an imaginary "
                              "part or a flag is no height)")
         h = np.asarray(h, dtype=float)
-    except (ValueError, TypeError, OSError) as exc:
+    except (ValueError, TypeError, OSError, EOFError) as exc:     # EOFError: an empty .npy
         if isinstance(exc, InputError):
             raise
         raise InputError("path", str(path), f"could not read a height matrix ({exc})") from None

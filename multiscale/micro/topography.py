@@ -156,6 +156,8 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
     if not path.is_file():
         raise InputError(f"{prefix}file", path.name, f"{'a folder, not a file' if path.is_dir() else 'no such file'} "
                          f"({path})")
+    if path.stat().st_size == 0:     # some readers take it for a 0 x 0 map, then ask for its pixel size
+        raise InputError(f"{prefix}file", path.name, "the file is empty (0 bytes)")
     pair = None if pixel_size is None else check_pair(f"{prefix}pixel_size", pixel_size, check_positive)
     if height_unit is not None:
         check_positive(f"{prefix}height_unit", height_unit)
