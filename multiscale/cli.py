@@ -20,7 +20,7 @@ from multiscale.io import abort, ended_together
 from multiscale.micro.spectrum import surface_statistics
 from multiscale.micro.topography import (DETREND, MAX_UNDEFINED, TopographyWarning, condition, formats,
                                         read_topography)
-from multiscale.outputs import CHECKPOINT, analysis, plan
+from multiscale.outputs import CHECKPOINT, analysis, folder_problem, plan
 from multiscale.outputs import summary as plan_summary
 from multiscale.scene import load
 from multiscale.scene_summary import cells_line, reference, summary
@@ -72,6 +72,12 @@ def _check(args) -> int:
             failed += 1
             continue
         print("\n".join(summary(scene) + plan_summary(plan(scene))))
+        unwritable = folder_problem(scene.output.folder)          # what run would stop at
+        if unwritable is not None:
+            print(f'error: output.folder = "{scene.output.folder}": {unwritable}', file=sys.stderr)
+            print(f"{path}: 1 problem", file=sys.stderr)
+            failed += 1
+            continue
         if args.cells:
             line, estimate = cells_line(scene)
             print(line)

@@ -9,7 +9,9 @@ nothing heavy (``multiscale check`` uses it; so does ``multiscale.macro``).
 """
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
+from pathlib import Path
 
 CHECKPOINT = "checkpoint.h5"      # a multiscale run's last macro step (``multiscale run --resume``)
 
@@ -20,6 +22,20 @@ FIELDS = {"displacement": ("displacement", "m"), "temperature": ("temperature", 
           "partition": ("heat partition into body 0", "-"), "wear_depth": ("wear depth", "m"),
           "flash_temperature": ("flash temperature", "K"), "counter_wear_depth": ("wear depth of body 1", "m"),
           "interface": ("interface number", "-")}
+
+
+def folder_problem(folder) -> str | None:
+    """Why a run could not create or write into the output folder ``folder`` (its nearest existing
+    ancestor is a file, or not writable: permissions, a read-only file system), or None. What
+    ``multiscale check`` says without writing anything; the run itself tries (``workflows.output``)."""
+    folder = Path(folder)
+    existing = next(p for p in (folder, *folder.parents) if p.exists())
+    if not existing.is_dir():
+        return f"cannot be created: {existing} is a file, not a folder"
+    if not os.access(existing, os.W_OK | os.X_OK):
+        return (f"cannot be {'written into' if existing == folder else 'created'}: {existing} is not writable "
+                "(permissions or a read-only file system)")
+    return None
 
 
 def array_name(field: str) -> str:

@@ -2,6 +2,7 @@
 traceback; a summary for a good scene; earlier results are not overwritten without --overwrite."""
 import io
 import json
+import os
 import sys
 import types
 from pathlib import Path
@@ -110,6 +111,25 @@ def test_check_several_files_fails_if_one_fails(tmp_path, capsys):
     captured = capsys.readouterr()
     assert f"{good}: OK" in captured.out
     assert "error: materials.flat.nu = 0.7: must be in (-1, 0.5)" in captured.err
+
+
+def test_check_refuses_an_output_folder_run_cannot_create(tmp_path, capsys):
+    """check said OK where run stopped at once ('cannot write into the output folder ...: Not a
+    directory'): a folder under a file, or in a folder without write permission."""
+    (tmp_path / "notes.txt").write_text("mine")
+    scene = BLOCK.replace('folder = "../results/block_on_flat"', 'folder = "notes.txt/run1"')
+    assert main(["check", _write(tmp_path, scene)]) == 2
+    err = capsys.readouterr().err
+    assert err.splitlines()[0] == (f'error: output.folder = "{tmp_path / "notes.txt" / "run1"}": cannot be created: '
+                                   f"{tmp_path / 'notes.txt'} is a file, not a folder")
+    locked = tmp_path / "locked"
+    locked.mkdir(mode=0o555)
+    scene = BLOCK.replace('folder = "../results/block_on_flat"', 'folder = "locked/run1"')
+    code = main(["check", _write(tmp_path, scene)])
+    err = capsys.readouterr().err
+    if os.geteuid() != 0:          # root writes anywhere
+        assert code == 2 and f"cannot be created: {locked} is not writable" in err
+    assert main(["check", _write(tmp_path, BLOCK.replace('"../results/block_on_flat"', '"new/deeper"'))]) == 0
 
 
 @pytest.fixture
