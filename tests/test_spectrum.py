@@ -1,6 +1,7 @@
 """PSD, self-affine fit, statistically equivalent surfaces and roughness statistics (issue 17):
 H and cut-offs of synthetic self-affine surfaces, the measured PSD, Sq and Sdq carried over to
 equivalent surfaces on larger grids, ISO 25178-2 parameters against independent values."""
+import dataclasses
 import os
 from pathlib import Path
 
@@ -65,6 +66,16 @@ def test_a_power_law_to_the_end_of_the_data():
     fit = fit_power_law(power_spectrum(s))
     assert fit.hurst == pytest.approx(0.7, abs=0.05) and not fit.resolved[1]
     assert "(not resolved: <= this)" in "\n".join(surface_statistics(s).table())
+
+
+def test_the_statistics_table_writes_cut_offs_as_plain_numbers():
+    """Cut-offs to 2 digits in mm, um or nm: '110 um' and '670 nm', not '1.1e+02 um' and '6.7e+02 nm' (as
+    multiscale surface printed for sur-2.sur and x3p-2.x3p of ../shared/data/topographies)."""
+    stats = surface_statistics(self_affine(0.8, n=128, periodic=False))
+    fit = dataclasses.replace(stats.power_law, q_r=2 * np.pi / 1.1e-4, q_s=2 * np.pi / 6.7e-7)
+    table = "\n".join(dataclasses.replace(stats, power_law=fit).table())
+    assert "long cut-off  2pi/q_r        110 um  " in table and "short cut-off 2pi/q_s        670 nm  " in table
+    assert "e+" not in table.split("Hurst")[1]
 
 
 def test_measured_psd_holds_sq_exactly():

@@ -408,6 +408,6 @@ def _length(value: float, digits: int = 4) -> str:
     PSD bin, 26 % in q at 10 bins per decade: its best break moved 6 % with the round-off of a
     rescaled measurement; an adversarial test)."""
     for unit, factor in (("mm", 1e-3), ("um", 1e-6), ("nm", 1e-9)):
-        if abs(value) >= factor:
-            return f"{value / factor:.{digits}g} {unit}"
+        if abs(value) >= factor:           # rounded, then plain: "110 um", not "1.1e+02 um"
+            return f"{float(f'{value / factor:.{digits}g}'):g} {unit}"
     return f"{value:.{digits}g} m"
