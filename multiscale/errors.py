@@ -16,11 +16,12 @@ class MultiscaleError(Exception):
 
 
 class InputError(MultiscaleError, ValueError):
-    """Bad input: names the argument (or field), the value and what is allowed."""
+    """Bad input: names the argument (or field), the value and what is allowed. ``value`` None: no
+    value to show (a missing option or key): the message is "name: allowed", not "name = None: ..."."""
 
     def __init__(self, name: str, value, allowed: str):
         self.name, self.value, self.allowed = name, value, allowed
-        super().__init__(f"{name} = {_short(value)}: {allowed}")
+        super().__init__(f"{name}: {allowed}" if value is None else f"{name} = {_short(value)}: {allowed}")
 
     def __reduce__(self):      # pickled as given (MPI broadcasts of an error met by one rank)
         return type(self), (self.name, self.value, self.allowed)

@@ -318,3 +318,10 @@ def test_kept_heat_factors_give_the_factorised_answer(tmp_path, monkeypatch):
     assert redone > 0 and factorised == 1 + redone
     for a, b in zip(retried, fresh):
         np.testing.assert_allclose(a, b, rtol=1e-10)
+
+
+def test_resume_of_a_scene_without_checkpoints_names_the_option_without_a_value(tmp_path):
+    """It said "--resume = True: this scene has no checkpoints ..." (an adversarial review)."""
+    with pytest.raises(InputError) as info:
+        run(loads(BLOCK.format(effects='"contact"', folder=tmp_path / "out")), resume=True, verbose=False)
+    assert str(info.value).startswith("--resume: this scene has no checkpoints to resume from")

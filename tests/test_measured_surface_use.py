@@ -94,7 +94,7 @@ def test_scene_reads_a_measured_file_with_its_options(tmp_path):
                         "(X3P), FileFormatMismatch: Stream is not a valid ZIP archive"),
     (f'file = "{TOP}"\nchannel = 4', 'roughness.channel = 4: top-1.top has the channels 0 "Default" (2-D)'),
     (f'file = "{DATA / "opdx-3.opdx"}"', "is a 1-D profile (line scan): a height map (2-D) is needed"),
-    ('file = "pad.npy"', "roughness.pixel_size = None: pad.npy is a plain height matrix without units"),
+    ('file = "pad.npy"', "roughness.pixel_size: pad.npy is a plain height matrix without units"),
     (f'file = "{TOP}"\ncover = "stretch"', 'roughness.cover = "stretch": unknown'),
     (f'file = "{TOP}"\nhurst = 0.5', "roughness.hurst: only used with roughness.rms"),
 ])
@@ -179,3 +179,14 @@ def test_surface_command_writes_no_figure_unless_asked(tmp_path, monkeypatch, ca
     assert "figure: none written (--figure PATH.png" in capsys.readouterr().out
     assert main(["surface", str(TOP), "--figure", "none"]) == 0
     assert list(tmp_path.iterdir()) == [] and "figure:" not in capsys.readouterr().out
+
+
+def test_a_missing_option_is_named_without_a_python_value(tmp_path, capsys):
+    """A missing option or key is named, not shown as a Python value: "--pixel-size = None: h.npy
+    is a plain height matrix ..." was the error of `multiscale surface h.npy` (an adversarial review)."""
+    np.save(tmp_path / "h.npy", np.zeros((8, 8)))
+    assert main(["surface", str(tmp_path / "h.npy")]) == 2
+    assert capsys.readouterr().err.splitlines() == [
+        'error: --pixel-size: h.npy is a plain height matrix without units: give its pixel size, e.g. "0.5 um"']
+    assert str(InputError("roughness.height_unit", None, "give it")) == "roughness.height_unit: give it"
+    assert str(InputError("x", 0, "must be > 0")) == "x = 0: must be > 0"        # a value is still shown

@@ -77,7 +77,7 @@ def test_plain_matrices_still_read_as_before(tmp_path):
     np.testing.assert_array_equal(m.heights, load_surface(tmp_path / "pad.npy", 2e-6, scale=1e-6,
                                                           detrend="none").heights)
     assert (m.dx, m.dy) == (2e-6, 2e-6)
-    with pytest.raises(InputError, match=r"roughness\.pixel_size = None: pad\.npy is a plain height matrix"):
+    with pytest.raises(InputError, match=r"^roughness\.pixel_size: pad\.npy is a plain height matrix"):
         read_topography(tmp_path / "pad.npy", prefix="roughness.")
 
 

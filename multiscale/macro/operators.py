@@ -151,7 +151,7 @@ def geometric_stiffness(mech: Mechanics, extra=None) -> PETSc.Mat:
 def _rotation(mech: Mechanics) -> Rotation:
     motion = mech.tm.spec.motion
     if not isinstance(motion, Rotation):
-        raise InputError("stability.gyroscopic", True, "needs a rotating body (the geometry's body 1 translates)")
+        raise InputError("stability.gyroscopic", None, "needs a rotating body (the geometry's body 1 translates)")
     return motion
 
 

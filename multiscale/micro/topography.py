@@ -166,7 +166,7 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
             raise InputError(f"{prefix}channel", channel, f"{path.name} is a plain height matrix: one channel, 0")
         if pair is None:
             raise InputError(f"{prefix}pixel_size", None, f"{path.name} is a plain height matrix without units: "
-                             "give its pixel size")
+                             'give its pixel size, e.g. "0.5 um"')
         try:
             h = read_matrix(path) * (1.0 if height_unit is None else height_unit)
         except InputError as exc:
@@ -190,7 +190,7 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
     if ch.physical_sizes is None or factor is None:
         if pair is None:
             raise InputError(f"{prefix}pixel_size", None, f"{path.name} gives no lateral "
-                             f"{'size' if ch.physical_sizes is None else 'unit'}: give the pixel size")
+                             f"{'size' if ch.physical_sizes is None else 'unit'}: give its pixel size, e.g. \"0.5 um\"")
         dx, dy = pair
     else:
         dx, dy = (float(v) * factor for v in t.pixel_size)
@@ -204,7 +204,8 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
                          f"({unit} = {factor:.4g} m)")
         factor = height_unit
     elif factor is None:
-        raise InputError(f"{prefix}height_unit", None, f"{path.name} gives no height unit: give it (m per unit)")
+        raise InputError(f"{prefix}height_unit", None, f"{path.name} gives no height unit: give it, e.g. \"nm\" "
+                         "or \"1 um\"")
     h = np.ma.filled(np.ma.masked_invalid(np.ma.asarray(raw, dtype=float)), np.nan).T * factor
     notes += _height_range(h, path, prefix, f"{factor:.4g} m", f"channel {ch.index} (\"{ch.name}\")")
     for note in notes:

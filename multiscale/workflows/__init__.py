@@ -44,7 +44,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         why = ("the squeal analysis has no checkpoints to resume from" if kind == "squeal" else
                'this scene has no checkpoints to resume from (only the multiscale loop, effect "roughness", '
                "writes checkpoints)")
-        raise InputError("--resume", True, why)
+        raise InputError("--resume", None, why)
     ended = resume and checkpoint.peek(Path(scene.output.folder) / multiscale.CHECKPOINT, comm).get("finished")
     started, start = provenance.now(), time.perf_counter()
     with io.Reporter(comm, quiet=not verbose) as reporter:
