@@ -457,8 +457,8 @@ class Roughness:
     max_undefined: float = key(Quantity("dimensionless", ge=0, le=1), default=MAX_UNDEFINED)
     cover: str = key(Choice(COVER), default="measured")
 
-    rules = (OneOf(("rms", "file"), required=True), Requires("rms", ("hurst", "k_min", "k_max")),
-             OnlyWith("rms", ("hurst", "k_min", "k_max", "patch")),
+    rules = (OneOf(("rms", "file"), required=True, meaning="a generated fractal surface or a measured file"),
+             Requires("rms", ("hurst", "k_min", "k_max")), OnlyWith("rms", ("hurst", "k_min", "k_max", "patch")),
              OnlyWith("file", ("channel", "pixel_size", "height_unit", "detrend", "cutoff", "max_undefined", "cover")))
 
     def problems(self, path, ctx):

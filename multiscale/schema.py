@@ -433,11 +433,12 @@ def _needing(needed_by, unless, effects) -> str | None:
 
 @dataclass(frozen=True)
 class OneOf:
-    """At most one of ``keys``; exactly one when required or an effect in ``needed_by`` is on."""
+    """At most one of ``keys`` (``meaning``: what they are); exactly one when required or needed_by."""
 
     keys: tuple[str, ...]
     required: bool = False
     needed_by: tuple[str, ...] = ()
+    meaning: str = ""
 
     def text(self) -> str:
         return f"one of {', '.join(self.keys)}" + (" (required)" if self.required else
@@ -447,7 +448,7 @@ class OneOf:
         given = [k for k in self.keys if k in present]
         names = " or ".join(f"{path}.{k}" for k in self.keys)
         if len(given) > 1:
-            return [f"{names}: give only one of them (got {', '.join(given)})"]
+            return [f"{names}: give only one of them{self.meaning and ': ' + self.meaning} (got {', '.join(given)})"]
         effect = _needing(self.needed_by, (), ctx.effects)
         if not given and (self.required or effect):
             why = f'effect "{effect}" needs it' if effect else "required"
@@ -563,8 +564,10 @@ def read(cls, raw, path: str, ctx: Context):
         elif (spec.required or effect) and missing:
             ctx.problems.append(f"{where}: missing; {why}: {spec.parser.describe()}")
     present = {k for k in raw if k in specs}
-    for rule in getattr(cls, "rules", ()):
-        ctx.problems.extend(rule.check(present, path or "scene", ctx))
+    rules = getattr(cls, "rules", ())
+    clash = {k for r in rules if isinstance(r, OneOf) and len(present & set(r.keys)) > 1 for k in r.keys}
+    for rule in (r for r in rules if getattr(r, "key", None) not in clash):   # alternatives given together:
+        ctx.problems.extend(rule.check(present, path or "scene", ctx))        # one problem, not what each needs
     obj = cls(**values)
     if len(ctx.problems) == before and hasattr(obj, "problems"):
         ctx.problems.extend(obj.problems(path, ctx))

@@ -342,6 +342,24 @@ def test_later_sections_report_clear_problems(tmp_path, old, new, fragment):
     assert any(fragment in p for p in info.value.problems), info.value.problems
 
 
+def test_alternatives_given_together_are_one_problem(tmp_path):
+    """rms with file said that rms and file exclude each other and then that hurst, k_min and
+    k_max were missing "with roughness.rms" (four errors for one mistake; an adversarial review);
+    c with chi and no rho likewise asked for rho."""
+    np.save(tmp_path / "pad.npy", np.zeros((8, 8)))
+    text = (GOOD + LATER).replace("hurst = 0.6\nk_min = 1\nk_max = [50, 40]\n",
+                                  'file = "pad.npy"\npixel_size = "1 um"\n')
+    with pytest.raises(SceneError) as info:
+        loads(text, tmp_path)
+    assert info.value.problems == ["roughness.rms or roughness.file: give only one of them: a generated fractal "
+                                   "surface or a measured file (got rms, file)"]
+    text = GOOD.replace('c = "900 J/(kg K)"', 'c = "900 J/(kg K)"\nchi = "1e-6 m^2/s"').replace(
+        'rho = "2000 kg/m^3"\n', "")
+    with pytest.raises(SceneError) as info:
+        loads(text, tmp_path)
+    assert info.value.problems == ["materials.block.c or materials.block.chi: give only one of them (got c, chi)"]
+
+
 def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
     text = (DEMOS / "block_on_flat.toml").read_text().replace(
         'pressure = "1 MPa"', 'pressure = "1 MPa"\nfriction = 0.4')
