@@ -68,6 +68,7 @@ This module reads no scene: ``multiscale.workflows.multiscale`` builds and runs 
 """
 from __future__ import annotations
 
+import json
 import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -547,7 +548,8 @@ class Multiscale:
                  "heat_exchanged": [m.heat_exchanged, m.heat_exchanged_total], "scene": self.fingerprint, "load": m.load,
                  "ranks": self.comm.size, "fields_written": -1, "solved_speed": m.solved_speed,
                  "constants": [float(c.value) for c in self.model.drive_constants],
-                 "solve": [last.reason, last.iterations, last.normal_force, last.max_pressure]}
+                 "solve": [last.reason, last.iterations, last.normal_force, last.max_pressure],
+                 "notes": json.dumps([m.notes, m.thermal.notes if m.thermal is not None else []])}   # said once a run
         checkpoint.save(path, self.comm, attrs=attrs, arrays=arrays, functions=self.model.functions,
                         scale=self.tm.spec.length_scale)
 
@@ -573,6 +575,10 @@ class Multiscale:
         self.interval_work = float(attrs.get("interval_work", 0.0))     # absent from older checkpoints
         if m.thermal is not None:
             m.thermal.time = m.time
+        # the run's warnings before (not said again), then this session's own (set-up: the options)
+        for holder, said in zip((m, m.thermal), json.loads(attrs.get("notes", "[[], []]"))):
+            if holder is not None:
+                holder.notes = said + [n for n in holder.notes if n not in said]
         reason, its, force, max_p = attrs["solve"]
         m.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
         self.tm.interface.set_field(m.contact.initial_gap, self.datum_gap + self.counter_depth)

@@ -57,7 +57,12 @@ class ConvergenceError(MultiscaleError, RuntimeError):
 
 class Interrupted(KeyboardInterrupt):
     """Ctrl-C honoured at the end of a step (``multiscale.io.StepStop``): the results up to that
-    step were written. The message says which ("after step 12 of 50")."""
+    step were written. The message says which ("after step 12 of 50"); ``warnings``: what the run
+    noted up to there (``workflows.model.run_notes``), for its provenance."""
+
+    def __init__(self, message: str = "", warnings=()):
+        super().__init__(message)
+        self.warnings = tuple(warnings)
 
 
 def interrupted(exc: BaseException) -> bool:

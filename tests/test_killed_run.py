@@ -227,3 +227,40 @@ def test_a_damaged_field_file_says_how_to_resume(tmp_path):
     assert workflows.run(scene, resume=True, verbose=False).steps_done == 4
     times = field_times(folder)
     assert times["pin.xdmf"] == list(plan(scene).times[2:]) and times["disc.xdmf"] == list(plan(scene).times)
+
+
+def test_a_resumed_run_says_the_heat_warnings_of_the_whole_run_once(tmp_path, monkeypatch):
+    """The first heat step that needed the backtracking line search is said once per run
+    (``Thermal.notes``; test_macro_thermal.py): a run stopped after step 2 (Ctrl-C) and resumed says
+    the one of step 1, as the run straight through does, once, in its warnings and its provenance;
+    the stopped run's provenance says it too. The pin radiates (a Newton heat step), and its full
+    Newton steps are said to fail at steps 1 and 3. Before: the resumed run lost step 1's note and
+    said step 3's as the first ("t = 1.8 s"); the stopped run's provenance said nothing."""
+    from multiscale import io, workflows
+    from multiscale.macro import thermal
+    radiating = '[[boundary]]\nsurfaces = ["free:pin"]\nemissivity = 0.5\nambient = "20 degC"\n[output]'
+    solve = thermal.Thermal._solve
+
+    def full_steps_said_to_fail(th):
+        ok = solve(th)
+        step = round((th.time + float(th.dt.value)) / 0.6)          # the macro step solved, of 0.6 s
+        return ok and not (step in (1, 3) and th.problem.solver.getLineSearch().getType() != "bt")
+    monkeypatch.setattr(thermal.Thermal, "_solve", full_steps_said_to_fail)
+    said = {}
+    for how in ("straight", "stopped"):
+        folder = tmp_path / how / "out"
+        scene = loads(scene_text(folder).replace("[output]", radiating))
+        if how == "stopped":
+            asked = iter([False, True])                                 # Ctrl-C during step 2
+            with monkeypatch.context() as m:
+                m.setattr(io.StepStop, "requested", lambda self: next(asked))
+                with pytest.raises(KeyboardInterrupt, match="after step 2 of 4"):
+                    workflows.run(scene, verbose=False)
+            said["interrupted"] = json.loads((folder / "provenance.json").read_text())["warnings"]
+        result = workflows.run(scene, resume=how == "stopped", verbose=False)
+        said[how] = ([w for w in result.warnings if "too long for full Newton steps" in w],
+                     json.loads((folder / "provenance.json").read_text())["warnings"])
+    notes, provenance = said["straight"]
+    assert len(notes) == 1 and notes[0].startswith("the heat step to t = 0.6 s was too long") and notes[0] in provenance
+    assert said["stopped"] == said["straight"]
+    assert [w for w in said["interrupted"] if "too long for full Newton steps" in w] == notes

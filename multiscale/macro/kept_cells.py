@@ -101,6 +101,41 @@ def check_user_options(comm, prefix: str) -> None:
                          "an unknown type or a value it cannot read); see PETSc's manual pages for the choices")
 
 
+def splits(form: list) -> bool:
+    """Whether ``KeptCells`` of the block form ``form`` (UFL, a list of lists) keeps its cell part
+    apart (``KeptCells.split``): the integrals other than the cells' leave no row or column of
+    blocks empty. Known before the problem is set up (its solver options depend on it)."""
+    others = [[integrals(f, False) for f in row] for row in form]
+    return (all(any(f is not None for f in row) for row in others)
+            and all(any(f is not None for f in column) for column in zip(*others)))
+
+
+# options under a prefix that only a Newton method reads: a linear solve (SNES "ksponly": one
+# Jacobian, one KSP solve) queries some of them (PETSc's "option left" does not list them) and
+# uses none
+NEWTON_ONLY = ("snes_linesearch_", "snes_rtol", "snes_atol", "snes_stol", "snes_max_it", "snes_max_funcs",
+               "snes_max_fail", "snes_max_linear_solve_fail", "snes_divergence_tolerance", "snes_lag_",
+               "snes_ksp_ew")
+
+
+class SolverOptionWarning(UserWarning):
+    """Options the user set under a solver's prefix that the solver does not use."""
+
+
+def newton_options_unused(snes: PETSc.SNES, problem: str) -> str:
+    """A note naming the options the user set under ``snes``' prefix that only a Newton method
+    uses (``NEWTON_ONLY``) when ``snes`` is a linear solve (type "ksponly"; "" if none or if it is
+    not): ``problem`` says why it is linear."""
+    prefix = snes.getOptionsPrefix() or ""
+    unused = sorted(f"-{k}" for k in PETSc.Options().getAll()
+                    if k.startswith(prefix) and k[len(prefix):].startswith(NEWTON_ONLY))
+    if not unused or snes.getType() != PETSc.SNES.Type.KSPONLY:
+        return ""
+    return (f"PETSC_OPTIONS: {' '.join(unused)} had no effect: {problem}, one linear solve a step, not Newton's "
+            f"method; its Krylov solver and preconditioner take -{prefix}ksp_... and -{prefix}pc_... options "
+            f"(-{prefix}snes_type newtonls would solve it by Newton's method)")
+
+
 class KeptCells:
     """The block Jacobian ``form`` (UFL, a list of lists) of the matrix ``A`` (compiled:
     ``compiled``) split into its cell part, kept in ``bulk`` (of A's sparsity), and the rest.
@@ -114,8 +149,7 @@ class KeptCells:
 
     def __init__(self, A: PETSc.Mat, compiled, form: list, entity_maps, bcs):
         others = [[integrals(f, False) for f in row] for row in form]
-        self.split = (all(any(f is not None for f in row) for row in others)
-                      and all(any(f is not None for f in column) for column in zip(*others)))
+        self.split = splits(form)
         self.compiled, self.bcs = compiled, bcs
         cells = [[integrals(f, True) for f in row] for row in form]
         self.cells = fem.form(cells, entity_maps=entity_maps)

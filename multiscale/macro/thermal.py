@@ -64,7 +64,9 @@ their iterates. Not the critical-point search (``cp``, stalled at the start: |F|
 iterations); backtracking converged every step tried (up to 1e6 s, 3000 K surroundings, tables),
 so a failed step is not cut into substeps (that would change the user's time discretisation).
 Options the user set under the prefix (``PETSC_OPTIONS="-heat_snes_linesearch_type ..."``) win
-over ours; a line search the user chose is not replaced on a failed step.
+over ours; a line search the user chose is not replaced on a failed step. So do a linear problem's
+KSP and PC options (``-heat_ksp_type cg``; a user's ``preonly`` factorises every step afresh); the
+Newton's ones (``kept_cells.NEWTON_ONLY``) have no effect on it, a ``SolverOptionWarning`` says.
 
 Energy balance. P1 test functions sum to one, so the residual summed over every dof of a body is
 its heat balance over the step. The heat lost [J] during a step, consistent with it, is
@@ -98,18 +100,19 @@ from petsc4py import PETSc
 
 from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.geometry import Rotation
-from multiscale.macro import mumps
+from multiscale.macro import kept_cells, mumps
 from multiscale.macro.interface import ContactInterface, rigid_velocity
 from multiscale.macro.kept_cells import KeptCells, assemble, backtracking, nonlinear_problem
 from multiscale.macro.materials import body_properties, heat_capacity
 from multiscale.macro.mesh import FormCache
 from multiscale.macro.thermal_conditions import AppliedBoundary, ThermalBoundary, surface_rows
 
+# a linear step without a kept cell part (kept_cells.splits): one LU solve (tolerances: for a user's KSP)
 LINEAR_OPTIONS = {"snes_type": "ksponly", "ksp_type": "preonly", "pc_type": "lu",
-                  "pc_factor_mat_solver_type": "mumps"}
+                  "pc_factor_mat_solver_type": "mumps", "ksp_rtol": 1e-12, "ksp_atol": 0.0}
 # a linear step with a kept cell part: GMRES on the step's matrix, preconditioned by the LU factors
 # of an earlier step's, refactorised when a solve took more than KEPT_ITERATIONS iterations (or failed)
-KEPT_OPTIONS = {**LINEAR_OPTIONS, "ksp_type": "gmres", "ksp_rtol": 1e-12, "ksp_atol": 0.0, "ksp_max_it": 50}
+KEPT_OPTIONS = {**LINEAR_OPTIONS, "ksp_type": "gmres", "ksp_max_it": 50}
 KEPT_ITERATIONS = 8
 NEWTON_OPTIONS = {"snes_type": "newtonls", "snes_linesearch_type": "basic", "snes_rtol": 1e-10,
                   "snes_atol": 1e-12, "snes_stol": 1e-12, "snes_max_it": 30,
@@ -122,6 +125,7 @@ ENTHALPY_QUADRATURE = 3                # e(T) r with a tabulated rho c, P1 (same
                                        # made the P2 storage matrix indefinite, rank 5 of 10)
 CHORD_CONTRACTION = 0.01               # keep the Newton tangent while ||F_k|| <= this times ||F_k-1|| (0: never)
 FACTOR_PRECISION = "single"            # the Newton's LU factors (mumps.precision); a linear step's stay double
+BACKTRACKED = "converged only with a backtracking line search"     # in the note of the first such step
 
 
 TRANSPORT_DEGREE = 2    # Lagrange degree of the temperature of a rotating body (its Eulerian transport)
@@ -213,24 +217,26 @@ class Thermal:
                           or not all(p.constant for p in conductivity + self.capacity))
         self.tables = [f"{b.name} ({', '.join(n for n, p in (('kappa', k), ('c', c)) if not p.constant)})"
                        for b, k, c in zip(tm.bodies, conductivity, self.capacity) if not (k.constant and c.constant)]
-        # the user's options under the prefix (PETSC_OPTIONS="-heat_...") win over ours
-        self.problem = nonlinear_problem(self.residuals, self.T, prefix, NEWTON_OPTIONS if self.nonlinear
-                                         else KEPT_OPTIONS, bcs=self.bcs, entity_maps=tm.entity_maps)
+        # the user's options under the prefix (PETSC_OPTIONS="-heat_...") win over ours, a linear problem's too
+        J = None if self.nonlinear else derivative_block(self.residuals, self.T)
+        options = NEWTON_OPTIONS if self.nonlinear else KEPT_OPTIONS if kept_cells.splits(J) else LINEAR_OPTIONS
+        self.problem = nonlinear_problem(self.residuals, self.T, prefix, options, bcs=self.bcs,
+                                         entity_maps=tm.entity_maps)
+        self.notes: list = []                  # what the run's warnings add (said once per run)
         # a failed step is redone with backtracking unless the user chose a line search (theirs alone remain)
         self._backtrack = self.nonlinear and not PETSc.Options(prefix).hasName("snes_linesearch_type")
         self._residual_forms: dict = {}
         # constant materials: the Jacobian's cell part (storage, conduction, transport with SUPG;
         # 105 of its 110 ms on the ch. 7 mesh, one rank) changes only with the constants and
         # coefficients in it (dt, the speed): kept, and reassembled when one of them changed
-        if not self.nonlinear:
-            J = derivative_block(self.residuals, self.T)
+        if not self.nonlinear:                 # (its SNES is "ksponly": the Newton's options have no effect)
+            why = "the heat problem is linear (no radiation, no temperature tables)"
+            self._say(kept_cells.newton_options_unused(self.problem.solver, why), kept_cells.SolverOptionWarning)
             tangent = KeptCells(self.problem.A, self.problem.J, J, tm.entity_maps, self.bcs)
             if tangent.split:
                 self._tangent = tangent
                 self._factored = self.problem.A.duplicate()     # the matrix of the kept LU factors
                 self.problem.solver.setJacobian(self._jacobian, self.problem.A, self._factored)
-            else:
-                self.problem.solver.getKSP().setType("preonly")
         self.factorisations = 0                # linear steps: LU factorisations so far
         self._stale = True                     # linear steps: refactorise at the next step
         self._kept = False                     # linear steps: the last solve ran on earlier factors
@@ -240,7 +246,6 @@ class Thermal:
         self._tangent_dt = None                # Newton: the step of the kept tangent [s]
         self.redone = 0                        # Newton: steps redone with fresh tangents
         self.backtracked = 0                   # Newton: steps redone with a backtracking line search
-        self.notes: list = []                  # what the run's warnings add (said once per run)
         self.precision = FACTOR_PRECISION if self.nonlinear else "double"    # of the LU factors
         self._fresh = False                    # Newton: a fresh tangent every iteration (a step redone)
         if self.nonlinear:
@@ -390,7 +395,9 @@ class Thermal:
         fpetsc.assign(x, self.T)
         self._tangent.update()
         self._tangent.compose(J)
-        self._kept = not (self._stale or snes.getKSP().getIterationNumber() > KEPT_ITERATIONS)   # global count
+        ksp = snes.getKSP()                   # a direct solve (the user's preonly) needs this step's factors
+        self._kept = not (self._stale or ksp.getType() == PETSc.KSP.Type.PREONLY
+                          or ksp.getIterationNumber() > KEPT_ITERATIONS)      # a global count
         if not self._kept:
             J.copy(P, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
             self._stale, self.factorisations = False, self.factorisations + 1
@@ -464,7 +471,7 @@ class Thermal:
                     ok = self._solve()
             finally:
                 self._fresh = False
-            if ok and not self.notes:
+            if ok and not any(BACKTRACKED in n for n in self.notes):    # notes restored on resume count
                 self._note_backtracking(dt)
         snes = self.problem.solver
         if not ok:
@@ -488,13 +495,17 @@ class Thermal:
     def _note_backtracking(self, dt: float) -> None:
         """The first step that converged only with backtracking, said once: a note for the run's
         warnings and a ``HeatStepWarning`` (rank 0; the step is collective)."""
-        note = (f"the heat step to t = {self.time + dt:.6g} s was too long for full Newton steps ({dt:.4g} s: "
-                "the radiation or the temperature tables change too much over it) and converged only with a "
-                "backtracking line search; a step that long is coarse in time: more time.steps or substeps "
-                "follow the heating more closely (said for the first such step only)")
-        self.notes.append(note)
-        if self.tm.comm.rank == 0:
-            warnings.warn(note, HeatStepWarning, stacklevel=3)
+        self._say(f"the heat step to t = {self.time + dt:.6g} s was too long for full Newton steps ({dt:.4g} s: "
+                  f"the radiation or the temperature tables change too much over it) and {BACKTRACKED}; a step "
+                  "that long is coarse in time: more time.steps or substeps follow the heating more closely "
+                  "(said for the first such step only)", HeatStepWarning)
+
+    def _say(self, note: str, category: type) -> None:
+        """``note`` (if any) added to the run's warnings, and a Python warning of ``category`` on rank 0."""
+        if note:
+            self.notes.append(note)
+            if self.tm.comm.rank == 0:
+                warnings.warn(note, category, stacklevel=4)
 
     def exchange_power(self) -> float:
         """Heat [W] conducted from body 0 to body 1 through the interface conductance at the current

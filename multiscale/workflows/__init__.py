@@ -60,7 +60,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                 provenance.write(reporter.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
                                  wall_time=time.perf_counter() - start, analysis=kind,
                                  status=f"interrupted {exc}".strip() if stopped else
-                                 f"failed: {type(exc).__name__}: {exc}", warnings=scene.warnings)
+                                 f"failed: {type(exc).__name__}: {exc}",
+                                 warnings=[*scene.warnings, *(exc.warnings if isinstance(exc, Interrupted) else ())])
                 if isinstance(exc, Interrupted):          # stopped after a step: its results are written
                     _write_script(reporter.folder, scene)
             if stopped and not isinstance(exc, KeyboardInterrupt):

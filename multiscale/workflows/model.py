@@ -36,6 +36,7 @@ from multiscale.errors import InputError
 from multiscale.geometry import GeometrySpec, Rotation, Support
 from multiscale.macro import mesh as two_body
 from multiscale.macro.interface import PenaltyLaw, SumLaw
+from multiscale.macro.kept_cells import SolverOptionWarning
 from multiscale.macro.mechanics import Mechanics, load_face_areas, load_face_forces
 from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
@@ -238,10 +239,12 @@ def run_notes(model: MacroModel) -> tuple:
 
 @contextmanager
 def heat_warnings_as_notes():
-    """The heat's ``HeatStepWarning`` kept quiet in the block: the run's report says it, once, with
-    the other warnings and in the provenance (``run_notes``)."""
+    """The heat's ``HeatStepWarning`` and ``SolverOptionWarning`` (the model's build) kept quiet in
+    the block: the run's report says them, once, with the other warnings and in the provenance
+    (``run_notes``)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", HeatStepWarning)
+        warnings.simplefilter("ignore", SolverOptionWarning)
         yield
 
 

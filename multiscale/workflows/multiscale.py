@@ -102,7 +102,7 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
     check_rough_scene(scene)              # before meshing
     with io.stage("meshing"):
         tm = build_mesh(scene, comm)
-    with io.stage("model set-up"):
+    with io.stage("model set-up"), heat_warnings_as_notes():
         rough = build_rough_interface(scene, tm, progress=progress)
         exchange = (scene.has("heat_partition") and scene.micro.partition_law
                     and scene.micro.coupling_scheme(scene.effects) == "implicit")
@@ -163,21 +163,19 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         ms.mark_fields(ckpt, done, comm)
     last = steps if stop_after is None else min(steps, stop_after)
     stopping = False
-    with io.StepStop(comm, done) as stop, heat_warnings_as_notes():   # a Ctrl-C while the end is written lets it finish
+    with io.StepStop(comm) as stop, heat_warnings_as_notes():   # a Ctrl-C while the end is written lets it finish
         with io.stage("macro steps"):
             for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
-                stepped = ms.step(n)
-                with stop.writing(n):                     # the step's checkpoint, history and fields, whole
-                    history.append(**ms.record(stepped))
-                    ms.save(ckpt, n, history)
-                    write_history(history, folder, scene.name, comm, plot=False)   # readable if the run is killed
-                    done, stopping = n, stop.requested()
-                    if n % every == 0 or n == steps:      # not at a stop: a resumed run's field times stay those of
-                        writer.write()                    # an uninterrupted one
-                        ms.mark_fields(ckpt, n, comm)
+                history.append(**ms.record(ms.step(n)))
+                ms.save(ckpt, n, history)
+                write_history(history, folder, scene.name, comm, plot=False)   # readable if the run is killed
+                done, stopping = n, stop.requested()
+                if n % every == 0 or n == steps:          # not at a stop: a resumed run's field times stay those of
+                    writer.write()                        # an uninterrupted one
+                    ms.mark_fields(ckpt, n, comm)
                 if stopping:
                     break
-        with io.stage("writing history and plots"), stop.writing(done):
+        with io.stage("writing history and plots"):
             h5, png = write_history(history, folder, scene.name, comm)
             plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
     if done == steps:
@@ -188,7 +186,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     del ms, writer            # the model holds reference cycles of PETSc objects: free them on every
     gc.collect()              # rank at the same point (collected later, ranks could hang at exit)
     if stopping:                 # decided by every rank together
-        raise Interrupted(f"after step {done} of {steps}")
+        raise Interrupted(f"after step {done} of {steps}", result.warnings)
     if verbose and comm.rank == 0:
         print(f"{scene.name}: {len(history)} records ({done}/{steps} steps) in {result.wall_time:.1f} s "
               f"on {comm.size} rank(s)")

@@ -54,7 +54,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     folder = out.path
     with io.stage("meshing"):
         tm = build_mesh(scene, comm)
-    with io.stage("first contact solve"):
+    with io.stage("first contact solve"), heat_warnings_as_notes():
         model = build_model(scene, comm, tm=tm)
         model.start()
     out.claim()                          # --overwrite: the earlier results go now, not before a failed start
@@ -70,19 +70,18 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         with io.stage("macro steps"):
             for n in io.bar(range(1, steps + 1), "macro steps"):
                 heat = model.macro_step(scene.time.dt, scene.time.substeps)
-                with stop.writing(n):            # the step's fields and history, whole
-                    history.append(**model.record(heat))
-                    done, stopping = n, stop.requested()
-                    if n % scene.output.every == 0 or n == steps or stopping:
-                        writer.write()
-                    if n < steps:                # a killed run keeps the history of its steps
-                        write_history(history, folder, scene.name, comm, plot=False)
+                history.append(**model.record(heat))
+                done, stopping = n, stop.requested()
+                if n % scene.output.every == 0 or n == steps or stopping:
+                    writer.write()
+                if n < steps:                    # a killed run keeps the history of its steps
+                    write_history(history, folder, scene.name, comm, plot=False)
                 if stopping:
                     break
-        with io.stage("writing history and plots"), stop.writing(done):
+        with io.stage("writing history and plots"):
             h5, png = write_history(history, folder, scene.name, comm)
     if stopping:                     # decided by every rank together
-        raise Interrupted(f"after step {done} of {steps}")
+        raise Interrupted(f"after step {done} of {steps}", run_notes(model))
     result = TransientResult(folder, writer.files + [h5, png], _time.perf_counter() - start, history, h5, png,
                              writer.files, warnings=run_notes(model))
     if verbose and comm.rank == 0:
