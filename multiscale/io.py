@@ -130,15 +130,30 @@ def collective(comm, call):
 
 
 class StepStop:
-    """Ctrl-C in a loop of steps (a context manager): the first SIGINT asks the loop to stop after
+    """Ctrl-C in a loop of steps (a context manager). The first SIGINT asks the loop to stop after
     its current step, when ``requested()`` (every rank together: one stops, all stop, at the same
-    step) is True; a second interrupts at once (``KeyboardInterrupt``). Under ``mpiexec`` the second
-    Ctrl-C is the launcher's: it ends every rank. Without the main thread, nothing is installed."""
+    step) is True. The second is held: the step ends and its results are written. A third abandons
+    the step in progress (``KeyboardInterrupt`` naming the last step whose results are written),
+    unless it comes inside ``writing()``, which no Ctrl-C interrupts: a step's results are written
+    whole or not at all. ``done``: the steps whose results are already written (a resumed run's).
+    Under ``mpiexec`` the second Ctrl-C is the launcher's: it kills every rank (MPICH's hydra).
+    Without the main thread, nothing is installed."""
 
-    MESSAGE = b"\nCtrl-C: stopping after this step, with its results written (Ctrl-C again stops at once)\n"
+    FIRST = "\nCtrl-C: stopping after this step, with its results written ({})\n"
+    AGAIN = {1: "Ctrl-C again is mpiexec's: it kills the job at once",
+             0: "Ctrl-C twice more abandons the step"}
+    HELD = ("\nCtrl-C: still finishing the step and writing its results; Ctrl-C again abandons the step "
+            "(the results written stay as they are)\n")
+    WRITING = "\nCtrl-C: held until the results being written are complete\n"
 
-    def __init__(self, comm):
-        self.comm, self.asked, self.previous = comm, False, None
+    def __init__(self, comm, done: int = 0):
+        self.comm, self.done, self.previous = comm, done, None
+        self.count, self.saving = 0, False
+
+    @property
+    def asked(self) -> bool:
+        """Whether this rank was sent Ctrl-C."""
+        return self.count > 0
 
     def __enter__(self):
         if threading.current_thread() is threading.main_thread():
@@ -151,11 +166,24 @@ class StepStop:
         return False
 
     def _handle(self, signum, frame):
-        if self.asked:
-            raise KeyboardInterrupt
-        self.asked = True
-        if self.comm.rank == 0:
-            os.write(2, self.MESSAGE)        # not print: the handler may run inside a write to stderr
+        self.count += 1
+        if self.count > 2 and not self.saving:
+            raise KeyboardInterrupt(f"during step {self.done + 1}, abandoned: the results of step {self.done} "
+                                    "are the last written")
+        if self.comm.rank == 0:          # os.write, not print: the handler may run inside a write to stderr
+            os.write(2, (self.FIRST.format(self.AGAIN[self.comm.size > 1]) if self.count == 1 else
+                         self.HELD if self.count == 2 else self.WRITING).encode())
+
+    @contextmanager
+    def writing(self, step: int):
+        """The block writing the results of ``step``: Ctrl-C does not interrupt it; once it ends,
+        they are the last written (``done``)."""
+        self.saving = True
+        try:
+            yield
+        finally:
+            self.saving = False
+        self.done = step
 
     def requested(self) -> bool:
         """Whether any rank was asked to stop (collective)."""

@@ -22,6 +22,7 @@ from multiscale.geometry import MAX_CELLS, GeometrySpec, Rotation, builder, buil
 from multiscale.schema import (Bad, Choice, FilePath, FrozenMap, Integer, ListOf, Named, OneOf, Quantity,
                                Section, Text, Vector, key, parse, read, show, unknown_keys)
 from multiscale.schema import reference as schema_reference
+from multiscale.scene_plain import contains_hint
 from multiscale.units import UnitError, to_si
 
 _LENGTH = Quantity("length", gt=0)
@@ -275,13 +276,13 @@ class GeometrySection(Section):
         params = read(FileGeometry, {k: v for k, v in raw.items() if k != "builder"}, path, ctx)
         if len(ctx.problems) > before:
             return None
-        return self._describe("file", builder("file"), params, params, ctx)
+        return self._describe("file", builder("file"), params, params, ctx, lambda exc: contains_hint(raw, path, exc))
 
     @staticmethod
-    def _describe(name, module, params, arguments, ctx):
+    def _describe(name, module, params, arguments, ctx, hint=lambda exc: ""):
         try:
             spec = module.describe(arguments)        # the builder's consistency checks; a file is inspected
         except InputError as exc:
-            ctx.problems.append(str(exc))
+            ctx.problems.append(str(exc) + hint(exc))
             return None
         return Geometry(name, params, spec)

@@ -15,6 +15,7 @@ from pathlib import Path
 from multiscale.errors import InputError
 from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_topography
 from multiscale.scene_geometry import LengthUnit
+from multiscale.scene_plain import PixelSize
 from multiscale.scene_stability import Stribeck
 from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, ListOf, OneOf, OnlyWith, Pair,
                                Quantity, Requires, Section, TableOr, Tables, Text, Vector, key)
@@ -24,7 +25,6 @@ from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, L
 _MODULUS = Quantity("pressure", gt=0, plausible=(1e5, 1.2e12))           # rubber to diamond
 _POISSON = Quantity("dimensionless", gt=-1, lt=0.5, plausible=(0.0, 0.5))
 _CONDUCTIVITY = Quantity("conductivity", gt=0, plausible=(0.01, 2500.0))  # foam to diamond
-_LENGTH = Quantity("length", gt=0)
 HOTTEST = 2500.0     # K, the top of the plausible temperatures (molten iron), of inputs and results
 _TEMPERATURE = Quantity("temperature", gt=0, plausible=(20.0, HOTTEST))    # cryogenic to molten iron
 _DENSITY = Quantity("density", gt=0, plausible=(100.0, 23e3))            # cork to osmium
@@ -450,8 +450,8 @@ class Roughness:
     patch: str = key(Choice(("face", "zone")), default="face")
     file: Path | None = key(FilePath())                                       # measured topography
     channel: int | None = key(Integer(ge=0))                                  # default: the file's default
-    pixel_size: tuple | None = key(Pair(_LENGTH))                             # m, (dx, dy): overrides the file's
-    height_unit: float | None = key(Either(_LENGTH, LengthUnit()))    # m per file height unit ("1 um" or "um")
+    pixel_size: tuple | None = key(Pair(PixelSize()))                         # m, (dx, dy): overrides the file's
+    height_unit: float | None = key(Either(Quantity("length", gt=0), LengthUnit()))   # m per height unit ("1 um", "um")
     detrend: str = key(Choice(tuple(DETREND)), default="plane")               # form removal
     cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)))  # m, Gaussian filter λc
     max_undefined: float = key(Quantity("dimensionless", ge=0, le=1), default=MAX_UNDEFINED)

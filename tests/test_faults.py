@@ -270,22 +270,79 @@ def test_ctrl_c_while_the_end_is_written_lets_it_finish(tmp_path, monkeypatch):
     assert result.history_file == folder / "history.h5"
 
 
-def test_a_second_ctrl_c_interrupts_at_once():
-    """StepStop: the first SIGINT is a request (collective ``requested()``), the second raises."""
+def test_a_second_ctrl_c_is_held_and_a_third_abandons_the_step_but_not_a_write():
+    """StepStop: the first SIGINT is a request (collective ``requested()``), the second is held
+    (the step ends with its results written), a third abandons the step in progress, naming the last
+    step written, except inside ``writing()``, which it lets finish (before: the second raised
+    wherever it came, inside the writing of a step's results too)."""
     import signal
 
     from mpi4py import MPI
 
     from multiscale.io import StepStop
-    with StepStop(MPI.COMM_SELF) as stop:
-        assert not stop.requested()
+
+    def ctrl_c():
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(0.01)
+    with StepStop(MPI.COMM_SELF) as stop:
+        assert not stop.requested()
+        ctrl_c()
         assert stop.requested()
-        with pytest.raises(KeyboardInterrupt):
-            os.kill(os.getpid(), signal.SIGINT)
-            time.sleep(0.01)
+        ctrl_c()                                  # held
+        with stop.writing(5):
+            ctrl_c()                              # held: the results of step 5 are being written
+        with pytest.raises(KeyboardInterrupt, match="during step 6, abandoned: the results of step 5 are the last "
+                                                    "written"):
+            ctrl_c()
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler      # restored
+
+
+def test_a_second_ctrl_c_while_the_run_stops_leaves_its_results_whole(tmp_path):
+    """Two Ctrl-C a moment apart (the second once the first is acknowledged): the run still stops
+    after its step with every result of that step written: history, fields, plot, paraview.py and
+    provenance.json agree (before: the second interrupted the writing: fields of t = 30.0 s beside a
+    history to 30.6 s, provenance "interrupted" without the step, no history.png nor paraview.py)."""
+    import json
+    import signal
+
+    import h5py
+    import meshio
+    scene = tmp_path / "scene.toml"
+    scene.write_text(SCENE.format(folder=tmp_path / "out").replace("steps = 3\n", "steps = 4000\n")
+                     .replace("[output]\n", "[output]\nevery = 1000\n"))
+    folder = tmp_path / "out"
+    job = subprocess.Popen([str(Path(sys.executable).with_name("multiscale")), "run", str(scene)],
+                           stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        rows, start = 0, time.monotonic()
+        while rows < 3 and time.monotonic() - start < 120:    # the steps have begun: their history is written
+            time.sleep(0.05)
+            try:
+                with h5py.File(folder / "history.h5", "r") as f:
+                    rows = len(f["time"])
+            except (OSError, KeyError):
+                pass
+        job.send_signal(signal.SIGINT)
+        for line in job.stderr:                               # the first is acknowledged
+            if line.startswith("Ctrl-C: stopping after this step"):
+                break
+        job.send_signal(signal.SIGINT)
+        err = line + job.stderr.read()
+        job.wait(timeout=120)
+    finally:
+        if job.poll() is None:
+            os.killpg(job.pid, signal.SIGKILL)
+    assert job.returncode == 130, err[-3000:]
+    assert "Traceback" not in err and "Ctrl-C: still finishing the step and writing its results" in err, err[-3000:]
+    status = json.loads((folder / "provenance.json").read_text())["status"]
+    done = int(status.split()[3])
+    assert status == f"interrupted after step {done} of 4000"
+    with h5py.File(folder / "history.h5", "r") as f:
+        assert f["time"][-1] == pytest.approx(done * 3 / 4000) and len(f["time"]) == done + 1
+    with meshio.xdmf.TimeSeriesReader(str(folder / "block.xdmf")) as reader:
+        reader.read_points_cells()
+        assert reader.read_data(reader.num_steps - 1)[0] == pytest.approx(done * 3 / 4000)   # the stop's fields
+    assert (folder / "history.png").stat().st_size > 0 and (folder / "paraview.py").exists()
 
 
 def test_an_interrupt_is_recognised_through_the_errors_it_caused():

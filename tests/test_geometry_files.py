@@ -717,3 +717,20 @@ def test_one_load_surface_on_pads_on_both_sides_of_the_disc_shares_the_force_by_
     assert result.history["interface_force_pad_a"][-1] == pytest.approx(800.0, rel=1e-6)
     assert result.history["interface_force_pad_b"][-1] == pytest.approx(800.0, rel=1e-6)
     assert result.warnings == ()
+
+
+def test_a_point_in_plain_numbers_is_in_metres_and_a_miss_says_so(tmp_path, capsys):
+    """Plain numbers are metres whatever geometry.unit: contains = [0, 60, 5] with unit = "mm" is a
+    point 60 m away. The error said "no volume ... contains this point [m]" without a hint (an
+    adversarial review); it now says what the numbers in the file's unit would be."""
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO)
+    text = TWO_PADS.replace("{folder}", str(tmp_path / "out"))
+    err = check(tmp_path, capsys, text.replace('contains = ["0 mm", "60 mm", "5 mm"]', "contains = [0, 60, 5]"))
+    assert err == ("error: geometry.bodies.disc.contains = [0.0, 60.0, 5.0]: no volume of twopads.geo contains this "
+                   'point [m]; plain numbers are metres: did you mean ["0 mm", "60 mm", "5 mm"]?')
+    backs = 'contains = [["0 mm", "80 mm", "18 mm"], ["0 mm", "-80 mm", "18 mm"]]'
+    err = check(tmp_path, capsys, text.replace(backs, 'contains = [["0 mm", "80 mm", "18 mm"], [0, -80, 18.5]]'))
+    assert err.endswith('passes through this point [m]; plain numbers are metres: did you mean ["0 mm", "-80 mm", '
+                        '"18.5 mm"]?')
+    err = check(tmp_path, capsys, text.replace('contains = ["0 mm", "60 mm", "5 mm"]', 'contains = ["0 mm", "60 m", 0]'))
+    assert err.endswith("contains this point [m]")            # not all plain numbers: no guess

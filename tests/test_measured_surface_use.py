@@ -190,3 +190,19 @@ def test_a_missing_option_is_named_without_a_python_value(tmp_path, capsys):
         'error: --pixel-size: h.npy is a plain height matrix without units: give its pixel size, e.g. "0.5 um"']
     assert str(InputError("roughness.height_unit", None, "give it")) == "roughness.height_unit: give it"
     assert str(InputError("x", 0, "must be > 0")) == "x = 0: must be > 0"        # a value is still shown
+
+
+@pytest.mark.parametrize("pixel, problem", [
+    ("10", 'roughness.pixel_size = 10: 10 m per pixel; a measured surface\'s pixel is far below 1 mm (refused from '
+           '1 mm up); plain numbers are metres: did you mean "10 um"?'),
+    ('["0.5 um", "2 mm"]', 'roughness.pixel_size = ["0.5 um", "2 mm"]: item 2 ("2 mm"): 0.002 m per pixel; a '
+                           "measured surface's pixel is far below 1 mm (refused from 1 mm up)"),
+])
+def test_a_pixel_size_of_a_millimetre_or_more_is_refused(tmp_path, pixel, problem):
+    """pixel_size = 10 is a 10 m pixel (plain numbers are metres) and passed check silently (an
+    adversarial review); a measured surface's pixel is far below 1 mm."""
+    np.save(tmp_path / "pad.npy", np.random.default_rng(1).normal(0.0, 1e-6, (8, 8)))
+    with pytest.raises(SceneError) as info:
+        scene(tmp_path, f'file = "pad.npy"\npixel_size = {pixel}')
+    assert info.value.problems == [problem]
+    assert scene(tmp_path, 'file = "pad.npy"\npixel_size = "0.5 mm"').roughness.pixel_size == (5e-4, 5e-4)

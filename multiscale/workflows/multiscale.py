@@ -163,19 +163,21 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         ms.mark_fields(ckpt, done, comm)
     last = steps if stop_after is None else min(steps, stop_after)
     stopping = False
-    with io.StepStop(comm) as stop, heat_warnings_as_notes():   # a Ctrl-C while the end is written lets it finish
+    with io.StepStop(comm, done) as stop, heat_warnings_as_notes():   # a Ctrl-C while the end is written lets it finish
         with io.stage("macro steps"):
             for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
-                history.append(**ms.record(ms.step(n)))
-                ms.save(ckpt, n, history)
-                write_history(history, folder, scene.name, comm, plot=False)   # readable if the run is killed
-                done, stopping = n, stop.requested()
-                if n % every == 0 or n == steps:          # not at a stop: a resumed run's field times stay those of
-                    writer.write()                        # an uninterrupted one
-                    ms.mark_fields(ckpt, n, comm)
+                stepped = ms.step(n)
+                with stop.writing(n):                     # the step's checkpoint, history and fields, whole
+                    history.append(**ms.record(stepped))
+                    ms.save(ckpt, n, history)
+                    write_history(history, folder, scene.name, comm, plot=False)   # readable if the run is killed
+                    done, stopping = n, stop.requested()
+                    if n % every == 0 or n == steps:      # not at a stop: a resumed run's field times stay those of
+                        writer.write()                    # an uninterrupted one
+                        ms.mark_fields(ckpt, n, comm)
                 if stopping:
                     break
-        with io.stage("writing history and plots"):
+        with io.stage("writing history and plots"), stop.writing(done):
             h5, png = write_history(history, folder, scene.name, comm)
             plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
     if done == steps:

@@ -70,15 +70,16 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         with io.stage("macro steps"):
             for n in io.bar(range(1, steps + 1), "macro steps"):
                 heat = model.macro_step(scene.time.dt, scene.time.substeps)
-                history.append(**model.record(heat))
-                done, stopping = n, stop.requested()
-                if n % scene.output.every == 0 or n == steps or stopping:
-                    writer.write()
-                if n < steps:                    # a killed run keeps the history of its steps
-                    write_history(history, folder, scene.name, comm, plot=False)
+                with stop.writing(n):            # the step's fields and history, whole
+                    history.append(**model.record(heat))
+                    done, stopping = n, stop.requested()
+                    if n % scene.output.every == 0 or n == steps or stopping:
+                        writer.write()
+                    if n < steps:                # a killed run keeps the history of its steps
+                        write_history(history, folder, scene.name, comm, plot=False)
                 if stopping:
                     break
-        with io.stage("writing history and plots"):
+        with io.stage("writing history and plots"), stop.writing(done):
             h5, png = write_history(history, folder, scene.name, comm)
     if stopping:                     # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", run_notes(model))
