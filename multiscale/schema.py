@@ -361,7 +361,7 @@ class FilePath:
         if self.folder and path.exists() and not path.is_dir():
             raise Bad(f"exists and is not a folder ({path})")
         if not self.folder and not path.is_file():
-            raise Bad(f"no such file ({path})")
+            raise Bad(f"{'is a folder, not a file' if path.is_dir() else 'no such file'} ({path})")
         return path
 
 

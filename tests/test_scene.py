@@ -360,6 +360,17 @@ def test_alternatives_given_together_are_one_problem(tmp_path):
     assert info.value.problems == ["materials.block.c or materials.block.chi: give only one of them (got c, chi)"]
 
 
+def test_a_folder_given_as_a_file_is_said_to_be_a_folder(tmp_path):
+    """geometry.file = a folder said "no such file" (an adversarial review)."""
+    (tmp_path / "brake.step").mkdir()
+    text = GOOD.replace('builder = "block_on_flat"\nmesh_size = "2 mm"', 'file = "brake.step"\nrotating = "flat"\n'
+                        '[geometry.bodies.block]\nindex = [1]\nmaterial = "block"\n'
+                        '[geometry.bodies.flat]\nindex = [2]\nmaterial = "flat"')
+    with pytest.raises(SceneError) as info:
+        loads(text, tmp_path)
+    assert f'geometry.file = "brake.step": is a folder, not a file ({tmp_path / "brake.step"})' in info.value.problems
+
+
 def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
     text = (DEMOS / "block_on_flat.toml").read_text().replace(
         'pressure = "1 MPa"', 'pressure = "1 MPa"\nfriction = 0.4')

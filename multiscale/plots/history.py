@@ -19,10 +19,19 @@ from matplotlib.figure import Figure
 
 def column_label(key: str) -> str:
     """Legend of a per-body column: max_temperature_outer_pad -> "outer pad",
-    max_temperature_pin_in_disc -> "pin in disc" (the pin's cells of material disc)."""
+    max_temperature_pin_in_disc -> "pin, disc material" (the pin's cells of material disc)."""
     for prefix in ("max_temperature_", "heat_total_"):
         key = key.removeprefix(prefix)
-    return key.replace("_", " ")
+    body, within, material = key.partition("_in_")
+    return body.replace("_", " ") + (f", {material.replace('_', ' ')} material" if within else "")
+
+
+def temperature_columns(columns) -> list[str]:
+    """The max-temperature columns to draw: per body, or per material for a body of several
+    materials (max_temperature_pin_in_pin, ..._pin_in_disc), whose whole-body column is the highest
+    of those and would hide under one of them."""
+    hot = [k for k in columns if k.startswith("max_temperature")]
+    return [k for k in hot if not any(j.startswith(k + "_in_") for j in hot)]
 
 
 def history_figure(history, path: Path, title: str = "") -> Path:
@@ -30,7 +39,7 @@ def history_figure(history, path: Path, title: str = "") -> Path:
     t = history["time"]
     groups = [("interface force [N]", ["interface_force"], 1.0, 0.0),
               ("max contact pressure [MPa]", ["max_pressure"], 1e-6, 0.0),
-              ("max temperature [°C]", [k for k in history.columns if k.startswith("max_temperature")], 1.0, -273.15),
+              ("max temperature [°C]", temperature_columns(history.columns), 1.0, -273.15),
               ("heat into body [J]", [k for k in history.columns if k.startswith("heat_total")], 1.0, 0.0)]
     groups = [g for g in groups if g[1] and all(k in history.columns for k in g[1])]
     fig = Figure(figsize=(4.2 * len(groups), 3.4))
@@ -57,7 +66,7 @@ def history_figure(history, path: Path, title: str = "") -> Path:
 def multiscale_figure(history, path: Path, title: str = "") -> Path:
     """PNG of the multiscale history columns at both scales (see module docstring)."""
     cols = history.columns
-    hot = [k for k in cols if k.startswith("max_temperature")]
+    hot = temperature_columns(cols)
     panels = [("max contact pressure [MPa]", [("max_pressure", "macro facet"), ("max_zone_pressure", "macro zone"),
                                                ("micro_max_pressure", "micro")], 1e-6, 0),
               ("max temperature [°C]", [(k, "macro " + column_label(k)) for k in hot]

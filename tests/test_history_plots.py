@@ -1,0 +1,42 @@
+"""The history figures (``multiscale.plots.history``): every curve visible and named once."""
+import numpy as np
+import pytest
+
+from multiscale.io import History
+from multiscale.plots import history as plots
+
+
+@pytest.fixture
+def drawn(monkeypatch):
+    """The figures the plotting functions make, kept to be inspected."""
+    figures = []
+
+    class Kept(plots.Figure):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            figures.append(self)
+
+    monkeypatch.setattr(plots, "Figure", Kept)
+    return figures
+
+
+def test_a_body_of_several_materials_has_one_visible_named_curve_per_material(tmp_path, drawn):
+    """The pin-on-disc's pin (material pin, its holder of material disc) has the columns
+    max_temperature_pin (the whole body), ..._pin_in_pin and ..._pin_in_disc: history.png drew the
+    first hidden under the second (the same values), with the legends "pin" and "pin in pin" (an
+    adversarial review). The whole-body curve is the highest of its materials': it is left out."""
+    history = History()
+    for t in (0.0, 1.0, 2.0):
+        history.append(time=t, interface_force=200.0, max_pressure=1e6, max_temperature_pin=300.0 + t,
+                       max_temperature_pin_in_pin=300.0 + t, max_temperature_pin_in_disc=295.0 + t,
+                       max_temperature_disc=298.0 + t, heat_total_pin=t, heat_total_disc=2 * t,
+                       micro_max_temperature=310.0 + t)
+    plots.history_figure(history, tmp_path / "history.png")
+    plots.multiscale_figure(history, tmp_path / "multiscale.png")
+    for figure, prefix in zip(drawn, ("", "macro ")):
+        axis = next(ax for ax in figure.axes if ax.get_ylabel() == "max temperature [°C]")
+        curves = {line.get_label(): tuple(line.get_ydata()) for line in axis.get_lines()}
+        names = [prefix + n for n in ("pin, pin material", "pin, disc material", "disc")]
+        assert [n for n in curves if n != "micro"] == names
+        assert len(set(curves.values())) == len(curves)          # no curve drawn over another
+        np.testing.assert_allclose(curves[prefix + "pin, disc material"], [21.85, 22.85, 23.85])
