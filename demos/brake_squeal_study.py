@@ -24,14 +24,15 @@ from multiscale.scene import load
 from multiscale.workflows.model import build_mesh
 from multiscale.workflows.squeal import analyse, energy_split
 
-ROOT = Path(__file__).resolve().parents[1]
+from demo_output import ROOT, add_out
+
 parser = argparse.ArgumentParser(description="Squeal of a disc brake with the rough pads of thesis Table 4.1")
 parser.add_argument("--cases", nargs="+", default=["perfect", "0", "1", "2", "3", "4", "5"],
                     choices=["perfect", "0", "1", "2", "3", "4", "5"], help='"perfect" and/or Table 4.1 cases')
 parser.add_argument("--mesh-size", help='geometry.mesh_size, e.g. "20 mm"')
 parser.add_argument("--modes", type=int, help="stability.modes")
 parser.add_argument("--seed", type=int, default=0, help="seed of the pad surfaces")
-parser.add_argument("--out", default=str(ROOT / "results" / "brake_squeal_study"))
+add_out(parser, __file__)
 args = parser.parse_args()
 comm = MPI.COMM_WORLD
 io.abort_on_exception(comm)

@@ -35,12 +35,14 @@ from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.surface import fractal_surface, statistics
 
+from demo_output import add_out
+
 matplotlib.use("Agg")  # PNG files only, no display
 
 parser = argparse.ArgumentParser(description="The four asperity models of thesis ch. 1 against the FFT-BEM")
 parser.add_argument("--size", type=float, default=1.0, help="patch size [mm] (Table 1.1 spectrum per mm)")
 parser.add_argument("--seed", type=int, default=1)
-parser.add_argument("--out", default="results/ch1_asperity_models", help="output folder")
+add_out(parser, __file__)
 args = parser.parse_args()
 out = Path(args.out)
 

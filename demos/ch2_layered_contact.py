@@ -31,11 +31,13 @@ from multiscale.micro.layered import LayeredElastic
 from multiscale.micro.layered_asperity import LayeredAsperity, layered_law
 from multiscale.micro.surface import find_asperities, fractal_surface
 
+from demo_output import add_out
+
 matplotlib.use("Agg")  # PNG files only, no display
 
 parser = argparse.ArgumentParser(description="Contact of a rough two-layered solid (thesis ch. 2)")
 parser.add_argument("--n", type=int, default=128, help="grid points per side of the rough surface")
-parser.add_argument("--out", default="results/ch2_layered_contact", help="output folder")
+add_out(parser, __file__)
 args = parser.parse_args()
 out = Path(args.out)
 

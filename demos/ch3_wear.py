@@ -29,6 +29,8 @@ from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.surface import fractal_surface
 from multiscale.micro.wear import simulate_wear
 
+from demo_output import add_out
+
 matplotlib.use("Agg")  # PNG files only, no display
 
 # The loading of thesis §3.5.1: mean pressure [Pa], friction coefficient, sliding distance [m] and
@@ -39,7 +41,7 @@ parser = argparse.ArgumentParser(description="Wear of a rough surface under slid
 parser.add_argument("--n", type=int, default=128, help="grid points per side")
 parser.add_argument("--steps", type=int, default=300, help="wear steps")
 parser.add_argument("--kw", type=float, default=KW, help="wear rate k_w [1/Pa] (thesis: 1e-12)")
-parser.add_argument("--out", default="results/ch3_wear", help="output folder")
+add_out(parser, __file__)
 args = parser.parse_args()
 out = Path(args.out)
 t0 = time.perf_counter()

@@ -28,11 +28,13 @@ from multiscale.micro.contact import ContactSolver
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
 from multiscale.micro.surface import fractal_surface
 
+from demo_output import add_out
+
 matplotlib.use("Agg")  # PNG files only, no display
 
 parser = argparse.ArgumentParser(description="Thermal contact conductance of a rough two-layered solid")
 parser.add_argument("--n", type=int, default=150, help="grid points per side (thesis: 150)")
-parser.add_argument("--out", default="results/ch5_conduction", help="output folder")
+add_out(parser, __file__)
 args = parser.parse_args()
 out = Path(args.out)
 t0 = time.perf_counter()

@@ -38,12 +38,14 @@ from multiscale.micro.heating import InterfaceLayer, SteadyHeating, TransientHea
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.surface import Surface, fractal_surface
 
+from demo_output import add_out
+
 matplotlib.use("Agg")  # PNG files only, no display
 
 parser = argparse.ArgumentParser(description="Heat partition and flash temperatures of a rough pin on a disc")
 parser.add_argument("--n", type=int, default=75, choices=(30, 50, 75, 150),
                     help="grid cells per side (thesis: 150; coarser grids subsample the same surface)")
-parser.add_argument("--out", default="results/ch6_heat_partition", help="output folder")
+add_out(parser, __file__)
 args = parser.parse_args()
 out = Path(args.out)
 start = time.perf_counter()

@@ -22,12 +22,13 @@ from multiscale.plots.surface import surface_figure
 from multiscale.scene import load
 from multiscale.workflows.multiscale import run
 
-ROOT = Path(__file__).resolve().parents[1]
+from demo_output import ROOT, add_out
+
 SHARED = ROOT.parent / "shared" / "data" / "topographies"        # the shared data beside the repository
 parser = argparse.ArgumentParser(description="The thesis pin-on-disc with a measured pin face")
 parser.add_argument("--file", default=str(SHARED / "plu-1.plu"), help="the measurement (any SurfaceTopography format)")
 parser.add_argument("--steps", type=int, default=25, help="macro steps of 1.2 s (the coarse scenes': 25, 30 s)")
-parser.add_argument("--out", default=str(ROOT / "results" / "measured_pin_on_disc"))
+add_out(parser, __file__)
 args = parser.parse_args()
 comm = MPI.COMM_WORLD
 io.abort_on_exception(comm)

@@ -24,11 +24,13 @@ from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.surface import fractal_surface, statistics
 
+from demo_output import add_out
+
 matplotlib.use("Agg")  # PNG files only, no display
 
 parser = argparse.ArgumentParser(description="A fractal surface pressed on a rigid flat by FFT-BEM")
 parser.add_argument("--n", type=int, default=256, help="grid points per side")
-parser.add_argument("--out", default="results/micro_contact", help="output folder")
+add_out(parser, __file__)
 args = parser.parse_args()
 out = Path(args.out)
 
