@@ -7,6 +7,7 @@ stopped with a message saying so (``launcher_problem``).
 from __future__ import annotations
 
 import argparse
+import contextlib
 import dataclasses
 import os
 import sys
@@ -16,7 +17,7 @@ from pathlib import Path
 from multiscale import __version__
 from multiscale.errors import InputError, MultiscaleError, OutputError, SceneError
 from multiscale.geometry import too_many_cells
-from multiscale.io import abort, ended_together
+from multiscale.io import CtrlCWatch, abort, ended_together
 from multiscale.micro.spectrum import surface_statistics
 from multiscale.micro.topography import (DETREND, MAX_UNDEFINED, TopographyWarning, condition, formats,
                                         read_topography)
@@ -135,7 +136,7 @@ def _run(args) -> int:
     is deterministic, the output folder is judged by rank 0 for all, solver failures are decided
     collectively) and printed by rank 0. An error met by some ranks only (the others wait in a
     collective operation) is printed by the rank that met it, which then aborts the job: nothing
-    hangs."""
+    hangs. Ctrl-C ends every rank with exit code 130 and one line (``multiscale.io.CtrlCWatch``)."""
     comm = _world()
     rank = comm.rank if comm is not None else 0
     foreign = launcher_problem(comm) if comm is not None else None
@@ -145,31 +146,36 @@ def _run(args) -> int:
             print(f"error: {message}", file=sys.stderr)
         return 2
     scene = None
-    try:
-        scene = load(args.scene)
-        if args.max_cells is not None:
-            scene = dataclasses.replace(scene, geometry=dataclasses.replace(scene.geometry, max_cells=args.max_cells))
-        for line in scene.warnings if rank == 0 else ():
-            print(f"warning: {line}", file=sys.stderr, flush=True)
+    watch = None if comm is None else CtrlCWatch(comm, lambda: f"interrupted: {_kept(scene, args)}", INTERRUPTED)
+    with watch or contextlib.nullcontext():     # a Ctrl-C that a rank's main thread cannot meet
         try:
-            from multiscale.workflows import run   # DOLFINx: optional ([fem] extra), slow to import
-        except ModuleNotFoundError as exc:
-            raise MultiscaleError(f"multiscale run needs DOLFINx and the macro workflows ({exc}); install "
-                                  "them with pip install -e '.[fem]'") from None
-        run(scene, overwrite=args.overwrite, resume=args.resume, verbose=not args.quiet)
-    except MultiscaleError as exc:
-        if comm is not None and not ended_together(comm):
-            print(f"error (rank {rank} of {comm.size}): {exc}", file=sys.stderr)
-            abort(comm, 2)
-        if rank == 0:
-            raise
-        return 2
-    except KeyboardInterrupt as exc:       # Ctrl-C (mpiexec hands SIGINT to every rank)
-        if rank == 0:
-            print(f"interrupted {exc}".strip() + f": {_kept(scene, args)}", file=sys.stderr, flush=True)
-        if comm is not None and not ended_together(comm):
-            abort(comm, INTERRUPTED)          # a rank was caught inside a collective operation
-        return INTERRUPTED
+            scene = load(args.scene)
+            if args.max_cells is not None:
+                scene = dataclasses.replace(scene, geometry=dataclasses.replace(scene.geometry,
+                                                                                max_cells=args.max_cells))
+            for line in scene.warnings if rank == 0 else ():
+                print(f"warning: {line}", file=sys.stderr, flush=True)
+            try:
+                from multiscale.workflows import run   # DOLFINx: optional ([fem] extra), slow to import
+            except ModuleNotFoundError as exc:
+                raise MultiscaleError(f"multiscale run needs DOLFINx and the macro workflows ({exc}); install "
+                                      "them with pip install -e '.[fem]'") from None
+            run(scene, overwrite=args.overwrite, resume=args.resume, verbose=not args.quiet)
+        except MultiscaleError as exc:
+            if comm is not None and not ended_together(comm):
+                print(f"error (rank {rank} of {comm.size}): {exc}", file=sys.stderr)
+                abort(comm, 2)
+            if rank == 0:
+                raise
+            return 2
+        except KeyboardInterrupt as exc:       # Ctrl-C (mpiexec hands SIGINT to every rank)
+            sys.unraisablehook = lambda unraisable: None   # finalizers of what the interrupt left half-built
+            line = f"interrupted {exc}".strip() + f": {_kept(scene, args)}"
+            if watch is None:
+                print(line, file=sys.stderr, flush=True)
+            else:
+                watch.end(line)                # every rank, or one that ends the job: no rank left waiting
+            return INTERRUPTED
     return 0
 
 

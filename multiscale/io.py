@@ -204,15 +204,82 @@ def ended_together(comm, timeout: float = 10.0) -> bool:
     return True
 
 
-def abort(comm, code: int, grace: float = 1.0) -> None:
+def abort(comm, code: int, grace: float = 1.0, quiet: bool = False) -> None:
     """End every rank of the job from this one, ``grace`` [s] after flushing its output: mpiexec
     (MPICH's hydra) forwards a rank's stdout/stderr asynchronously and an immediate abort can kill
     the forwarder first, losing the rank's last message (1 in 6 and 1 in 20 runs of
-    tests/test_faults.py on a loaded 2-core machine)."""
+    tests/test_faults.py on a loaded 2-core machine). ``quiet``: without MPICH's own line
+    ("Abort(code) on node 0 ... application called MPI_Abort"), this rank's stderr closed before."""
     sys.stdout.flush()
     sys.stderr.flush()
     _time.sleep(grace)
+    if quiet:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), 2)
     comm.Abort(code)
+
+
+class CtrlCWatch:
+    """Ctrl-C outside a loop of steps, whatever each rank is doing (a context manager; the cli's).
+    Python meets a SIGINT only between bytecodes of the main thread: a rank inside a long C call
+    (gmsh meshing, a factorisation) or waiting in a collective operation for a rank that already
+    left meets it late or never, while the ranks that left wait for it. This thread wakes at the
+    signal itself (``signal.set_wakeup_fd``); if the main thread has not met the interrupt
+    (``end``) within ``WAIT`` [s] (plus ``STAGGER`` [s] per rank: rank 0 first, the others only if
+    it cannot), it prints ``line()`` and ends every rank with ``code`` (``abort``, quiet). Signals
+    the default handler does not take (``StepStop``'s, an ignored SIGINT) are left alone."""
+
+    WAIT, STAGGER = 1.0, 2.5
+
+    def __init__(self, comm, line, code: int):
+        self.comm, self.line, self.code = comm, line, code
+        self.taken, self.pipe, self.previous, self.watcher = threading.Event(), None, None, None
+        self.lock, self.ending = threading.Lock(), False
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            self.pipe = os.pipe()
+            os.set_blocking(self.pipe[1], False)
+            self.previous = signal.set_wakeup_fd(self.pipe[1], warn_on_full_buffer=False)
+            self.watcher = threading.Thread(target=self._watch, args=(self.pipe[0],), daemon=True)
+            self.watcher.start()
+        return self
+
+    def __exit__(self, *exc):
+        if self.pipe is not None:
+            signal.set_wakeup_fd(self.previous)
+            self.taken.set()
+            os.close(self.pipe[1])            # the watcher reads the end of the pipe and stops
+        return False
+
+    def end(self, line: str) -> None:
+        """The main thread met the interrupt: rank 0 prints ``line`` once every rank has met it
+        (within ``WAIT``); if one has not (it is inside a C call or a collective operation the
+        interrupt cannot reach), rank 0, or the next rank ``STAGGER`` later if rank 0 is that one,
+        prints it and ends every rank. If the watcher is already ending the job, it waits for it."""
+        with self.lock:
+            self.taken.set()
+        if self.ending:
+            self.watcher.join()               # its abort ends this process
+        if ended_together(self.comm, self.WAIT):
+            if self.comm.rank == 0:
+                print(line, file=sys.stderr, flush=True)
+            return
+        _time.sleep(self.STAGGER * self.comm.rank)
+        print(line, file=sys.stderr, flush=True)
+        abort(self.comm, self.code, quiet=True)
+
+    def _watch(self, fd: int) -> None:
+        try:
+            while (data := os.read(fd, 64)) and not self.taken.is_set():
+                if signal.SIGINT in data and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+                    self.taken.wait(self.WAIT + self.STAGGER * self.comm.rank)
+                    with self.lock:
+                        self.ending = not self.taken.is_set()
+                    if self.ending:
+                        print(self.line(), file=sys.stderr, flush=True)
+                        abort(self.comm, self.code, quiet=True)
+        finally:
+            os.close(fd)
 
 
 def abort_on_exception(comm=None) -> None:

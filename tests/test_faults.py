@@ -2,6 +2,7 @@
 one rank. Each runs ``multiscale run`` under ``mpiexec -n 2`` in a subprocess and asserts that the
 job ends within seconds, with one clear message and a non-zero exit code."""
 import os
+import re
 import subprocess
 import sys
 import time
@@ -343,6 +344,60 @@ def test_a_second_ctrl_c_while_the_run_stops_leaves_its_results_whole(tmp_path):
         reader.read_points_cells()
         assert reader.read_data(reader.num_steps - 1)[0] == pytest.approx(done * 3 / 4000)   # the stop's fields
     assert (folder / "history.png").stat().st_size > 0 and (folder / "paraview.py").exists()
+
+
+# the mesh build of the cooling block held up: one rank in a collective operation that waits for
+# the other, which sleeps (where Ctrl-C reaches Python); as rank 0 meshing with gmsh while rank 1
+# waits for the mesh, or rank 1 assembling while rank 0 waits
+HELD_UP = """
+import os, sys, time
+from mpi4py import MPI
+from multiscale.cli import main
+from multiscale.workflows import transient
+
+def held_up(scene, comm):
+    print(f"held up on rank {comm.rank}: pid {os.getpid()}", flush=True)
+    if comm.rank == int(sys.argv[2]):
+        comm.bcast(None, root=1 - comm.rank)  # never completes: Python never regains this rank
+    time.sleep(120)
+
+transient.build_mesh = held_up
+sys.exit(main(["run", sys.argv[1], "--overwrite"]))
+"""
+
+
+@pytest.mark.parametrize("waiting", [0, 1])
+def test_an_early_ctrl_c_ends_every_rank_at_once_with_one_line(tmp_path, waiting):
+    """Ctrl-C under mpiexec -n 2 while one rank waits inside a collective operation (the rank
+    ``waiting``) and the other meets the signal: the job ends within seconds, with exit code 130 and
+    the one line saying what was written (before: 11 s, ended_together's 10 s and MPI_Abort, then
+    MPICH's "Abort(130) ... MPI_Abort" line; with rank 0 waiting, no line of ours at all)."""
+    import contextlib
+    import signal
+    scene, driver = tmp_path / "scene.toml", tmp_path / "driver.py"
+    scene.write_text(SCENE.format(folder=tmp_path / "out"))
+    driver.write_text(HELD_UP)
+    job = subprocess.Popen([str(MPIEXEC), "-n", "2", sys.executable, str(driver), str(scene), str(waiting)],
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        pids = set()
+        for line in job.stdout:                  # mpiexec may join the ranks' lines into one
+            pids |= {int(pid) for pid in re.findall(r"held up on rank \d: pid (\d+)", line)}
+            if len(pids) == 2:
+                break
+        time.sleep(0.5)                          # into the broadcast
+        sent = time.monotonic()
+        job.send_signal(signal.SIGINT)
+        err = job.communicate(timeout=60)[1]
+        seconds = time.monotonic() - sent
+    finally:
+        for pid in pids | {job.pid}:             # the ranks run in sessions of their own
+            with contextlib.suppress(ProcessLookupError):
+                os.kill(pid, signal.SIGKILL)
+    assert job.returncode == 130 and seconds < 8, (seconds, err[-3000:])
+    assert [line for line in err.splitlines() if line.strip()] == [
+        f"interrupted: what was written stays in {tmp_path / 'out'} (its provenance.json says so); multiscale run "
+        f"{scene} --overwrite starts again"], err[-3000:]
 
 
 def test_an_interrupt_is_recognised_through_the_errors_it_caused():
