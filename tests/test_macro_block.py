@@ -182,6 +182,48 @@ def test_a_solver_option_petsc_refuses_is_an_input_error(tm, petsc_options, opti
     assert m.solve(1e6).converged
 
 
+@pytest.mark.parametrize("option", [{"block_x_factor_pc_factor_mat_solver_type": "superlu"},
+                                    {"block_x_pc_type": "lu", "block_x_pc_factor_mat_solver_type": "superlu"}])
+def test_a_factorisation_package_petsc_lacks_is_an_input_error(tm, petsc_options, option):
+    """A solver package this PETSc does not have (superlu; the wheel's has mumps, superlu_dist and
+    PETSc's own), for the Newton's own factors (``-mech_factor_...``) or for a PC of the user's, is
+    an InputError naming the option and the packages there are, before any solve (before: PETSc's
+    error 92 with its traceback at the first solve)."""
+    petsc_options(**option)
+    with pytest.raises(InputError, match=r"PETSC_OPTIONS = '-block_x_\w*pc_factor_mat_solver_type superlu.*: "
+                       r"this PETSc cannot factorise \(pc_type lu\) .*; it has .*mumps.*superlu_dist"):
+        Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_x_")
+
+
+def test_a_users_preconditioner_replaces_the_newtons_own(tm, petsc_options):
+    """A user's ``-mech_pc_type`` is the Newton's preconditioner (read back from its PC) in place of
+    its own kept factors (never set up): Jacobi solves the block to the same contact force, 1e-9
+    (before: a segmentation fault attaching our PC context to the user's PC). ``none`` fails, and
+    the error names the user's preconditioner."""
+    default = Mechanics(tm, MATERIALS, stiffness=K_N, friction=0.3, speed=0.5, load_kind="force", prefix="block_y_")
+    petsc_options(block_z_pc_type="jacobi", block_n_pc_type="none")
+    m = Mechanics(tm, MATERIALS, stiffness=K_N, friction=0.3, speed=0.5, load_kind="force", prefix="block_z_")
+    assert not m.own_pc and m.problem.solver.getKSP().getPC().getType() == "jacobi"
+    np.testing.assert_allclose(m.solve(100.0).normal_force, default.solve(100.0).normal_force, rtol=1e-9)
+    assert m.factors.analyses == 0 and default.factors.analyses > 0
+    none = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="force", prefix="block_n_")
+    with pytest.raises(ConvergenceError, match="preconditioned by PETSC_OPTIONS' pc_type none instead of the "
+                       "contact Newton's own factorisation"):
+        none.solve(100.0)
+
+
+def test_pc_options_beside_the_newtons_own_preconditioner_are_said_to_have_no_effect(tm, petsc_options):
+    """``-mech_pc_...`` options without ``-mech_pc_type`` reach no PC (the Newton's own factors take
+    ``-mech_factor_...``): a SolverOptionWarning says so, and the model's notes (the run's
+    warnings). Before: silent, only PETSc's "Option left" at exit."""
+    from multiscale.macro.kept_cells import SolverOptionWarning
+    petsc_options(block_o_pc_factor_mat_solver_type="superlu_dist")
+    with pytest.warns(SolverOptionWarning, match="-block_o_pc_factor_mat_solver_type had no effect: the contact "
+                      "Newton's preconditioner is its own kept factorisation, whose options are under -block_o_factor_"):
+        m = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="pressure", prefix="block_o_")
+    assert m.own_pc and len(m.notes) == 1
+
+
 def test_missing_material_and_unknown_builder_are_input_errors(tm):
     with pytest.raises(InputError, match="materials.flat"):
         Mechanics(tm, {"block": MATERIALS["block"]}, prefix="block_e_")

@@ -281,6 +281,31 @@ def test_a_krylov_option_petsc_refuses_for_a_linear_heat_problem_is_an_input_err
         build_model(block_scene(boundary=COOLED.format(flat="")))
 
 
+@pytest.mark.parametrize("boundary", [COOLED.format(flat=""), HEAT_UP])
+def test_a_factorisation_package_petsc_lacks_for_the_heat_is_an_input_error(petsc_options, boundary):
+    """``PETSC_OPTIONS="-heat_pc_factor_mat_solver_type superlu"`` (a package this PETSc does not
+    have) for a linear heat problem and for the radiation Newton is an InputError naming the
+    option and the packages there are, building the model (before: PETSc's error 92 with its
+    traceback at the first heat step)."""
+    from multiscale.errors import InputError
+    petsc_options(heat_pc_factor_mat_solver_type="superlu")
+    with pytest.raises(InputError, match=r"PETSC_OPTIONS = '-heat_pc_factor_mat_solver_type superlu': this PETSc "
+                       r"cannot factorise \(pc_type lu\) .*; it has .*mumps.* for this factorisation on 1 rank"):
+        march(block_scene(boundary=boundary), 1)
+
+
+def test_a_heat_step_failing_with_the_users_preconditioner_names_it(petsc_options):
+    """The user's ``-heat_pc_type jacobi`` is the radiation Newton's PC (no PC of ours replaces it);
+    with our ``preonly`` one Jacobi sweep a step cannot converge, and the error names the user's
+    options (before: only "more time.steps or substeps")."""
+    from multiscale.errors import ConvergenceError
+    petsc_options(heat_pc_type="jacobi")
+    scene = block_scene(T0=800.0, end=1.0, steps=2, boundary='[[boundary]]\nsurfaces = ["free:block"]\n'
+                        'emissivity = 1.0\nambient = "300 K"')
+    with pytest.raises(ConvergenceError, match=r"heat step .* failed .*; PETSC_OPTIONS = '-heat_pc_type jacobi'\)"):
+        march(scene)
+
+
 def test_newton_options_for_a_linear_heat_problem_are_said_to_have_no_effect(petsc_options, tmp_path):
     """Newton's options under the heat prefix (line search, tolerances) have no effect on a linear
     heat problem (one KSP solve a step, SNES "ksponly"; PETSc reads some of them, so its "option

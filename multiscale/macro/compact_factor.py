@@ -66,6 +66,11 @@ class CompactFactor:
     def entries(self) -> int:
         return 0 if self.keys is None else len(self.keys)
 
+    @property
+    def options(self) -> dict:
+        """The inner PC's kind as PETSc options under ``prefix`` (a user's of the same names win)."""
+        return {"pc_type": self.factor, "pc_factor_mat_solver_type": self.solver}
+
     def setUp(self, pc) -> None:
         _, P = pc.getOperators()
         comm = P.getComm().tompi4py()

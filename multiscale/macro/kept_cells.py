@@ -55,8 +55,9 @@ def nonlinear_problem(F, u, prefix: str, options: Mapping, **kwargs) -> fpetsc.N
     overwrote them). Ours are removed from PETSc's database after the set-up: DOLFINx 0.11 leaves
     them there (its deletion misses the prefix it pushed), and a later problem with the prefix
     would take them for the user's. Only the user's then remain under the prefix. A value PETSc
-    refuses among the user's raises ``InputError`` on every rank first (``check_user_options``)."""
-    check_user_options((u[0] if isinstance(u, (list, tuple)) else u).function_space.mesh.comm, prefix)
+    refuses among the user's, or with ours, raises ``InputError`` on every rank first
+    (``check_user_options``)."""
+    check_user_options((u[0] if isinstance(u, (list, tuple)) else u).function_space.mesh.comm, prefix, options)
     user = PETSc.Options(prefix)
     ours = {k: v for k, v in options.items() if not user.hasName(k)}
     try:
@@ -79,26 +80,90 @@ def backtracking(snes: PETSc.SNES):
         search.setType("basic")
 
 
-def check_user_options(comm, prefix: str) -> None:
-    """Raise ``InputError`` on every rank of ``comm`` if PETSc refuses a value of the options the
-    user set under ``prefix`` (``PETSC_OPTIONS="-<prefix>ksp_type nonsense"``: an unknown type,
-    error 86). They are tried on a bare SNES (its KSP, PC and line search) destroyed after: a
-    DOLFINx problem that failed half-way through its set-up crashed the process when collected."""
-    snes = PETSc.SNES().create(comm)
-    snes.setOptionsPrefix(prefix)
+# PC types that factorise by a package (``pc_factor_mat_solver_type``), and PETSc's error code when
+# that package cannot (not installed, or not for this factorisation or matrix type)
+FACTORISATIONS = ("lu", "cholesky", "ilu", "icc")
+MISSING_FACTOR = 92
+
+
+def check_user_options(comm, prefix: str, ours: Mapping | None = None) -> None:
+    """Raise ``InputError`` on every rank of ``comm`` if PETSc refuses the options the user set under
+    ``prefix``, with ``ours`` (the solver's own) where the user set none: a value it cannot read
+    (``PETSC_OPTIONS="-<prefix>ksp_type nonsense"``: an unknown type, error 86) or a factorisation
+    by a package it does not have (``-heat_pc_factor_mat_solver_type superlu``, error 92; the error
+    names those it has, ``factor_packages``). They are tried on a bare SNES (its KSP, PC and line
+    search; a factorising PC resolves its package on a small matrix over ``comm``, as a solve's
+    first set-up does) destroyed after: a DOLFINx problem that failed half-way through its set-up
+    crashed the process when collected. Nothing to try if the user set no option under ``prefix``."""
+    options, given = PETSc.Options(prefix), user_options(prefix)
+    if not given:
+        return
+    put = {k: v for k, v in (ours or {}).items() if not options.hasName(k)}
+    for name, value in put.items():
+        options[name] = value
+    snes, A = PETSc.SNES().create(comm), _unit_matrix(comm)
+    failure = factor = None
     try:
+        snes.setOptionsPrefix(prefix)
         snes.setFromOptions()
-        failure = None
+        pc = snes.getKSP().getPC()
+        if pc.getType() in FACTORISATIONS:
+            factor = pc.getType()
+            pc.setOperators(A, A)
+            pc.setFactorSetUpSolverType()
     except PETSc.Error as exc:
         failure = exc.ierr
     finally:
         snes.destroy()
+        for name in put:
+            options.delValue(name)
     codes = [c for c in comm.allgather(failure) if c is not None]
-    if codes:
-        given = " ".join(f"-{k} {v}".rstrip() for k, v in sorted(PETSc.Options().getAll().items())
-                         if k.startswith(prefix))
-        raise InputError("PETSC_OPTIONS", given, f"PETSc refused one of these solver options (error {codes[0]}: "
-                         "an unknown type or a value it cannot read); see PETSc's manual pages for the choices")
+    try:
+        if codes and codes[0] == MISSING_FACTOR and factor is not None:
+            raise InputError("PETSC_OPTIONS", given, f"this PETSc cannot factorise (pc_type {factor}) by the package "
+                             f"-{prefix}pc_factor_mat_solver_type asks for (error {MISSING_FACTOR}); it has "
+                             f"{', '.join(factor_packages(A, factor)) or 'none'} for this factorisation on "
+                             f"{comm.size} rank(s)")
+        if codes:
+            raise InputError("PETSC_OPTIONS", given, f"PETSc refused one of these solver options (error {codes[0]}: "
+                             "an unknown type or a value it cannot read); see PETSc's manual pages for the choices")
+    finally:
+        A.destroy()
+
+
+def user_options(prefix: str) -> str:
+    """The options set under ``prefix`` as given (``-heat_pc_type jacobi ...``; "" if none): the
+    user's, outside a problem's set-up."""
+    return " ".join(f"-{k} {v}".rstrip() for k, v in sorted(PETSc.Options().getAll().items()) if k.startswith(prefix))
+
+
+def _unit_matrix(comm) -> PETSc.Mat:
+    """The identity as an AIJ matrix of one row per rank of ``comm`` (sequential on one rank, as
+    the problems' matrices are)."""
+    A = PETSc.Mat().createAIJ(((1, None), (1, None)), nnz=1, comm=comm)
+    first = A.getOwnershipRange()[0]
+    A.setValue(first, first, 1.0)
+    A.assemble()
+    return A
+
+
+def factor_packages(A: PETSc.Mat, factor: str) -> list[str]:
+    """The packages (PETSc's solver types) that factorise ``A`` by ``factor`` ("lu", "cholesky",
+    "ilu", "icc") in this PETSc, each tried (collective; the same on every rank)."""
+    found = []
+    for package in sorted(getattr(PETSc.Mat.SolverType, n) for n in dir(PETSc.Mat.SolverType) if n.isupper()):
+        pc = PETSc.PC().create(A.getComm())
+        try:
+            pc.setType(factor)
+            pc.setFactorSolverType(package)
+            pc.setOperators(A, A)
+            pc.setFactorSetUpSolverType()
+            found.append(package)
+        except PETSc.Error:
+            pass
+        finally:
+            pc.destroy()
+    return found
 
 
 def splits(form: list) -> bool:

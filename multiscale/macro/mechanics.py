@@ -14,6 +14,7 @@ functions of T (``macro.materials``); without a temperature field, tables are ta
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 from typing import Mapping
 
@@ -29,7 +30,8 @@ from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.macro import mumps
 from multiscale.macro.compact_factor import CompactFactor
 from multiscale.macro.interface import ContactInterface, PressureLaw
-from multiscale.macro.kept_cells import KeptCells, assemble, backtracking, integrals, nonlinear_problem
+from multiscale.macro.kept_cells import (KeptCells, SolverOptionWarning, assemble, backtracking, check_user_options,
+                                         integrals, nonlinear_problem, user_options)
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
@@ -207,7 +209,8 @@ class Mechanics:
     problems"); ``preconditioner``: one of ``PRECONDITIONERS`` (see there). ``factorisations``
     counts the preconditioner's factorisations so far. Options the user set under ``prefix``
     (``PETSC_OPTIONS="-mech_snes_max_it 50"``) win over ``NEWTON_OPTIONS``; a line search the user
-    chose is not replaced on a failed solve.
+    chose is not replaced on a failed solve, a ``-mech_pc_type`` replaces the preconditioner
+    (``own_pc`` False; else its ``-mech_pc_...`` options have no effect, ``notes`` says so).
     """
 
     LOAD_KINDS = ("force", "pressure", "fluid")
@@ -254,7 +257,18 @@ class Mechanics:
         # a failed solve is redone with backtracking unless the user chose a line search (theirs alone remain)
         self._backtrack = not PETSc.Options(prefix).hasName("snes_linesearch_type")
         self.factors = CompactFactor(preconditioner, prefix=prefix + "factor_", precision=FACTOR_PRECISION)
-        self.problem.solver.getKSP().getPC().setPythonContext(self.factors)
+        # a -<prefix>pc_type of the user's replaces ours (``CompactFactor``), of the same matrix P
+        self.own_pc = not PETSc.Options(prefix).hasName("pc_type")
+        if self.own_pc:
+            check_user_options(tm.comm, self.factors.prefix, self.factors.options)
+            self.problem.solver.getKSP().getPC().setPythonContext(self.factors)
+        unused = sorted(f"-{k}" for k in PETSc.Options().getAll() if k.startswith(prefix + "pc_"))
+        self.notes = [] if not (self.own_pc and unused) else [   # said as a SolverOptionWarning
+            f"PETSC_OPTIONS: {' '.join(unused)} had no effect: the contact Newton's preconditioner is its own kept "
+            f"factorisation, whose options are under -{prefix}factor_ (e.g. -{prefix}factor_pc_factor_mat_solver_type"
+            f"); -{prefix}pc_type would replace it by PETSc's"]
+        for note in self.notes:
+            warnings.warn(note, SolverOptionWarning, stacklevel=2)
         if P is not None:
             self.problem.P_mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             self.problem.P_mat.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
@@ -476,8 +490,13 @@ class Mechanics:
             with backtracking(self.problem.solver):
                 result = self._newton()
         if not result.converged:
-            failed = "" if self.factors.inner is None else mumps.describe(self.factors.inner)  # same on every rank
+            pc = self.factors.inner if self.own_pc else self.problem.solver.getKSP().getPC()
+            failed = "" if pc is None else mumps.describe(pc)  # the same on every rank
             cause = f"; the preconditioner's factorisation failed: {failed}" if failed else ""
+            if not self.own_pc:
+                cause += (f"; preconditioned by the user's PC (PETSC_OPTIONS = "
+                          f"'{user_options(self.problem.solver.getOptionsPrefix())}') instead of the contact "
+                          "Newton's own factorisation (leave pc_type unset for it)")
             free = ("a body, or a solid of one, can move as a rigid body: give each a support ([[boundary]] fix) "
                     "or a contact that holds it in every direction (friction does not hold a body; a part that "
                     "touches nothing is held by its supports alone)")

@@ -82,7 +82,7 @@ class MacroModel:
     solved_speed: float = 0.0                          # the speed of the last contact solve (friction on if > 0)
     load: float | None = None                          # N or Pa at factor 1 (the drive's, or scaled to its torque)
     partitions: dict = field(default_factory=dict)     # share of frictional heat into body 0 per interface [-]
-    notes: list = field(default_factory=list)          # what the run's warnings add (an unbalanced clamp)
+    notes: list = field(default_factory=list)          # what the run's warnings add (an unbalanced clamp, Mechanics.notes)
 
     @property
     def contact(self):
@@ -126,7 +126,7 @@ class MacroModel:
                              "towards the contact; loading.direction along the contact normal; a pressure "
                              "normal to a face whose normals cancel, a cylinder's wall, has no resultant)")
         clamp = clamp_imbalance(self.tm, float(mech.load.value)) if mech.load_kind == "fluid" else None
-        self.notes = [clamp] if clamp is not None else []
+        self.notes = [*mech.notes, *([clamp] if clamp is not None else [])]
         return self.last_solve
 
     def macro_step(self, dt: float, substeps: int = 1) -> np.ndarray:

@@ -63,10 +63,10 @@ column: 14 -> 4 iterations, another path to the same answer), so the steps that 
 their iterates. Not the critical-point search (``cp``, stalled at the start: |F| 33.2 W for 30
 iterations); backtracking converged every step tried (up to 1e6 s, 3000 K surroundings, tables),
 so a failed step is not cut into substeps (that would change the user's time discretisation).
-Options the user set under the prefix (``PETSC_OPTIONS="-heat_snes_linesearch_type ..."``) win
-over ours; a line search the user chose is not replaced on a failed step. So do a linear problem's
-KSP and PC options (``-heat_ksp_type cg``; a user's ``preonly`` factorises every step afresh); the
-Newton's ones (``kept_cells.NEWTON_ONLY``) have no effect on it, a ``SolverOptionWarning`` says.
+The user's options under the prefix (``PETSC_OPTIONS="-heat_snes_linesearch_type ..."``) win over
+ours, and a failed step's error names them; a line search the user chose is not replaced. So do a
+linear problem's KSP and PC options (``-heat_ksp_type cg``; a user's ``preonly`` factorises every
+step afresh); Newton's (``kept_cells.NEWTON_ONLY``) have no effect on it, a warning says so.
 
 Energy balance. P1 test functions sum to one, so the residual summed over every dof of a body is
 its heat balance over the step. The heat lost [J] during a step, consistent with it, is
@@ -475,16 +475,16 @@ class Thermal:
                 self._note_backtracking(dt)
         snes = self.problem.solver
         if not ok:
-            failed = mumps.describe(snes.getKSP().getPC())        # the factorisation's failure, if any
+            failed, given = mumps.describe(snes.getKSP().getPC()), kept_cells.user_options(snes.getOptionsPrefix())
             why = (f"; Newton may cycle on the kinks of the temperature tables of {', '.join(self.tables)}: a "
                    "steep change between two points of a table is one, spread it over a wider range or more "
                    "points" if self.tables and not failed else "")
             if not failed and any(a.condition.emissivity for a in self.applied):   # T^4: a long step strays far
                 why += (f"; with radiation a step of {dt:.4g} s can take Newton far off"
                         f"{' (a backtracking line search too)' if self._backtrack else ''}: more time.steps or substeps")
-            raise ConvergenceError(f"heat step at t = {self.time + dt:.6g} s failed "
-                                   f"(SNES reason {snes.getConvergedReason()}, "
-                                   f"{snes.getIterationNumber()} iterations{'; ' + failed if failed else ''}){why}")
+            raise ConvergenceError(f"heat step at t = {self.time + dt:.6g} s failed (SNES reason "
+                                   f"{snes.getConvergedReason()}, {snes.getIterationNumber()} iterations"
+                                   f"{'; ' + failed if failed else ''}{given and f'; PETSC_OPTIONS = {given!r}'}){why}")
         self.time += dt
         self.lost_step = self._losses(dt)
         self.lost_total += self.lost_step
