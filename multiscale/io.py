@@ -252,19 +252,19 @@ class CtrlCWatch:
         return False
 
     def end(self, line: str) -> None:
-        """The main thread met the interrupt: rank 0 prints ``line`` once every rank has met it
-        (within ``WAIT``); if one has not (it is inside a C call or a collective operation the
-        interrupt cannot reach), rank 0, or the next rank ``STAGGER`` later if rank 0 is that one,
-        prints it and ends every rank. If the watcher is already ending the job, it waits for it."""
+        """The main thread met the interrupt: rank 0 prints ``line`` once every rank has met it;
+        if one has not within ``WAIT`` (+ ``STAGGER`` per rank: it is inside a C call or a
+        collective operation the interrupt cannot reach), rank 0, or the next rank if rank 0 is
+        that one, prints it and ends every rank. If the watcher is already ending the job, it
+        waits for it."""
         with self.lock:
             self.taken.set()
         if self.ending:
             self.watcher.join()               # its abort ends this process
-        if ended_together(self.comm, self.WAIT):
+        if ended_together(self.comm, self.WAIT + self.STAGGER * self.comm.rank):
             if self.comm.rank == 0:
                 print(line, file=sys.stderr, flush=True)
             return
-        _time.sleep(self.STAGGER * self.comm.rank)
         print(line, file=sys.stderr, flush=True)
         abort(self.comm, self.code, quiet=True)
 
