@@ -24,6 +24,7 @@ from multiscale.micro.topography import (DETREND, MAX_UNDEFINED, TopographyWarni
 from multiscale.outputs import CHECKPOINT, analysis, folder_problem, plan
 from multiscale.outputs import summary as plan_summary
 from multiscale.scene import load
+from multiscale.scene_plain import pixel_problem
 from multiscale.scene_summary import cells_line, reference, summary
 from multiscale.units import UnitError, to_si
 
@@ -235,15 +236,20 @@ def _count(text: str) -> int:
     return int(value)
 
 
+def _number_or_text(text: str):
+    """A command-line value as a number if it is one (then SI), else the text."""
+    try:
+        return float(text)
+    except ValueError:
+        return text
+
+
 def _length(option: str, text: str | None, unit_name: bool = False) -> float | None:
     """A length option ("0.8 mm", or a number in metres; with ``unit_name`` also a unit's name,
     "um", as in a scene's ``roughness.height_unit``) in metres."""
     if text is None:
         return None
-    try:
-        value = float(text)
-    except ValueError:
-        value = text
+    value = _number_or_text(text)
     try:
         return to_si(value, "length")
     except UnitError as exc:
@@ -263,6 +269,8 @@ def _surface(args) -> int:
     if not args.file:
         raise MultiscaleError("multiscale surface: give a topography file, or --formats for the formats it reads")
     pixel, cutoff = _length("--pixel-size", args.pixel_size), _length("--cutoff", args.cutoff)
+    if pixel is not None and (problem := pixel_problem(pixel, _number_or_text(args.pixel_size))):
+        raise InputError("--pixel-size", args.pixel_size, problem)
     unit = _length("--height-unit", args.height_unit, unit_name=True)
     try:
         with warnings.catch_warnings():

@@ -1,6 +1,7 @@
 """Plain numbers in a scene are SI (lengths in metres); a length in another unit is a string
 ("105 mm", "10 um"). Where a plain number was likely meant in another unit, the scene says so:
-``PixelSize`` refuses a measured surface's pixel from ``PIXEL_LIMIT`` up (``pixel_size = 10`` is
+``PixelSize`` (and ``pixel_problem``, for the command line) refuses a measured surface's pixel from
+``PIXEL_LIMIT`` up (``pixel_size = 10`` is
 a 10 m pixel), and ``contains_hint`` adds to a geometry file's point that hits nothing the same
 numbers in the file's unit (``contains = [0, 105, 12]`` with ``unit = "mm"``).
 """
@@ -32,11 +33,19 @@ class PixelSize(Quantity):
 
     def __call__(self, raw, ctx):
         v = super().__call__(raw, ctx)
-        if v >= PIXEL_LIMIT:
-            hint = f'; plain numbers are metres: did you mean "{raw:g} um"?' if plain(raw) else ""
-            raise Bad(f"{v:g} m per pixel; a measured surface's pixel is far below {PIXEL_LIMIT * 1e3:g} mm "
-                      f"(refused from {PIXEL_LIMIT * 1e3:g} mm up){hint}")
+        if problem := pixel_problem(v, raw):
+            raise Bad(problem)
         return v
+
+
+def pixel_problem(v: float, raw) -> str:
+    """Why a pixel size of ``v`` [m], written ``raw`` (a plain number in metres or a string with a
+    unit), cannot be a measured surface's; "" if it can (below ``PIXEL_LIMIT``)."""
+    if v < PIXEL_LIMIT:
+        return ""
+    hint = f'; plain numbers are metres: did you mean "{raw:g} um"?' if plain(raw) else ""
+    return (f"{v:g} m per pixel; a measured surface's pixel is far below {PIXEL_LIMIT * 1e3:g} mm "
+            f"(refused from {PIXEL_LIMIT * 1e3:g} mm up){hint}")
 
 
 def contains_hint(raw: dict, path: str, exc: InputError) -> str:

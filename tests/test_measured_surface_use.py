@@ -206,3 +206,15 @@ def test_a_pixel_size_of_a_millimetre_or_more_is_refused(tmp_path, pixel, proble
         scene(tmp_path, f'file = "pad.npy"\npixel_size = {pixel}')
     assert info.value.problems == [problem]
     assert scene(tmp_path, 'file = "pad.npy"\npixel_size = "0.5 mm"').roughness.pixel_size == (5e-4, 5e-4)
+
+
+def test_a_pixel_size_of_a_millimetre_or_more_is_refused_on_the_command_line(tmp_path, capsys):
+    """`multiscale surface h.npy --pixel-size 10` read a 10 m pixel (the scene's limit was not the
+    command's): the same refusal and hint."""
+    np.save(tmp_path / "h.npy", np.random.default_rng(1).normal(0.0, 1e-6, (8, 8)))
+    for given, hint in (("10", '; plain numbers are metres: did you mean "10 um"?'), ("2 mm", "")):
+        assert main(["surface", str(tmp_path / "h.npy"), "--pixel-size", given]) == 2
+        assert capsys.readouterr().err.splitlines() == [
+            f"error: --pixel-size = {given!r}: {float(given.split()[0]) * (1e-3 if 'mm' in given else 1):g} m per "
+            f"pixel; a measured surface's pixel is far below 1 mm (refused from 1 mm up){hint}"]
+    assert main(["surface", str(tmp_path / "h.npy"), "--pixel-size", "0.5 um"]) == 0
