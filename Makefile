@@ -35,9 +35,9 @@ test: docs test-serial test-mpi
 docs: $(STAMP)
 	$(BIN)/python -m sphinx -b html -E -W --keep-going -n -q docs docs/_build/html
 
-# one pytest process per test module: in one process for the whole suite, a SIGTERM (turned into
-# exit code 15 by PETSc's signal handler) ended the run after ~4 minutes, at a SLEPc test; cause not
-# found (docs/architecture.md, "Known problems")
+# one pytest process per test module (each module starts clean). The whole suite in one process
+# once ended after ~4 minutes with exit code 15: MPICH's abort for "Too many communicators" (its
+# error code 203515151 ends in the byte 15), models never freed (fixed: kept_cells.weak_callback)
 test-serial: $(STAMP)
 	@failed=""; for f in tests/test_*.py; do \
 	  $(BIN)/python -m pytest -q -p no:cacheprovider $$f || failed="$$failed $$f"; done; \

@@ -157,7 +157,7 @@ def test_killed_mid_run_and_resumed_writes_the_uninterrupted_results(base, tmp_p
     # 2 ranks: MUMPS' parallel factorisation is not bitwise repeatable (two perfect-contact 2-rank
     # runs differ by ~4e-15), and the rough loop's discrete decisions (an iteration more or less near
     # a tolerance) amplify that: 4 uninterrupted 2-rank runs of this scene agreed to 8.6e-7 (heat
-    # exchanged per step; 1.2e-5 the coupling residual); 1 rank holds 1e-6 (docs/architecture.md §7)
+    # exchanged per step; 1.2e-5 the coupling residual); 1 rank holds 1e-6 (docs/architecture.md §8, "Repeatability")
     same_results(folder, uninterrupted_run(base, ranks), rtol=1e-6 if ranks == 1 else 1e-5)
 
 

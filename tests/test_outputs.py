@@ -41,9 +41,9 @@ def case(request, tmp_path_factory):
     folder = tmp_path_factory.mktemp(request.param) / "results"
     scene = load(DEMOS / name, {**overrides, "output.folder": str(folder)})
     if request.param == "squeal":
-        # `multiscale run` in a process of its own: inside the whole suite's process the squeal run
-        # was ended by a SIGTERM turned into exit code 15 by PETSc's signal handler (not seen when
-        # run alone or after any half of the suite; cause not found)
+        # `multiscale run` in a process of its own, as a user runs it (inside the whole suite's
+        # process it once ended with exit code 15: MPICH out of communicators, the models of
+        # earlier tests never freed; fixed by kept_cells.weak_callback)
         path = folder.parent / "scene.toml"
         path.write_text(resolved_toml(scene))
         scene = load(path)

@@ -34,7 +34,7 @@ def test_two_ranks_give_the_serial_multiscale_history(tmp_path):
     for key in (k for k in serial if not solver_statistic(k)):
         # MUMPS' parallel factorisation differs from the serial one in the last bits (~4e-15); the
         # iterative micro solves and the coupling loop amplify that to 1.3e-6 relative (the coupling
-        # residual and the heat exchanged, measured in CI; docs/architecture.md §7), far below the
+        # residual and the heat exchanged, measured in CI; docs/architecture.md §8), far below the
         # loop's own tolerance (coupling_tol 1e-3): every column is held to 1e-5
         np.testing.assert_allclose(parallel[key], serial[key], rtol=1e-5, atol=1e-12, err_msg=key)
 
