@@ -12,12 +12,10 @@ The Jacobian's matrix ignores exact zeros of the element matrices once its patte
 vector field are zeros, and every add searches its row (docs/architecture.md §5, the macro Newton).
 
 ``nonlinear_problem`` sets up the DOLFINx problem such a Jacobian belongs to (the contact's and the
-heat's Newton) with our solver options, the user's winning; ``weak_callback`` hands it our methods
-as callbacks without keeping their owner alive.
+heat's Newton) with our solver options, the user's winning.
 """
 from __future__ import annotations
 
-import weakref
 from contextlib import contextmanager
 from typing import Mapping
 
@@ -31,20 +29,6 @@ from ufl.algorithms import expand_derivatives
 from ufl.algorithms.analysis import extract_coefficients, extract_constants
 
 from multiscale.errors import InputError
-
-
-def weak_callback(method):
-    """A PETSc callback (``setFunction``, ``setJacobian``, ``setMonitor``) that calls the bound
-    ``method`` through a weak reference. PETSc keeps its callbacks in a dict of the C object, which
-    Python's cycle collector cannot see: a bound method there kept its owner, the owner its solver,
-    for good, and with them the meshes, matrices and MPI communicators (about 35 a model; MPICH has
-    2048 per process, and the 58th model built in one process aborted,
-    ``tests/test_macro_thermal.py::test_a_model_dropped_frees_its_communicators``)."""
-    ref = weakref.WeakMethod(method)
-
-    def call(*args):
-        return ref()(*args)
-    return call
 
 
 def integrals(form, cells: bool):

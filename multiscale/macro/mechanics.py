@@ -31,7 +31,7 @@ from multiscale.macro import mumps
 from multiscale.macro.compact_factor import CompactFactor
 from multiscale.macro.interface import ContactInterface, PressureLaw
 from multiscale.macro.kept_cells import (KeptCells, SolverOptionWarning, assemble, backtracking, check_user_options,
-                                         integrals, nonlinear_problem, user_options, weak_callback)
+                                         integrals, nonlinear_problem, user_options)
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
@@ -285,9 +285,9 @@ class Mechanics:
         self._excess = 0                   # GMRES iterations beyond one per linear solve since then
         self.factorisations = 0
         self._clock = {"mark": 0.0, "factor": 0.0, "iteration": 0.0, "refreshing": False}   # s
-        self.problem.solver.getKSP().setMonitor(weak_callback(self._tick))
+        self.problem.solver.getKSP().setMonitor(self._tick)
         self._pc_mat = self.problem.P_mat if P is not None else self.problem.A.duplicate()
-        self.problem.solver.setJacobian(weak_callback(self._jacobian), self.problem.A, self._pc_mat)
+        self.problem.solver.setJacobian(self._jacobian, self.problem.A, self._pc_mat)
         # the residual's cell part is affine in u: assembled at a solve's start x_0, then updated by
         # the kept cell matrix times x - x_0; its facet part every evaluation
         self._cell_residual, self._facet_residual = (
@@ -297,11 +297,10 @@ class Mechanics:
         self._offset.setAttr("_blocks", self._blocks)
         self._offset_stale = True
         self.bcs_by_body = fem.bcs_by_block(fem.extract_function_spaces(self._cell_residual), self.bcs)
-        self.problem.solver.setFunction(weak_callback(self._residual), self.problem.b)
+        self.problem.solver.setFunction(self._residual, self.problem.b)
         self._frictionless = None          # (matrix, form) of ``frictionless_tangent`` without P
         self._history: list[float] = []
-        history = self._history                      # not self: see weak_callback
-        self.problem.solver.setMonitor(lambda snes, it, norm: history.append(norm))
+        self.problem.solver.setMonitor(lambda snes, it, norm: self._history.append(norm))
 
     def release(self) -> None:
         """Free the factors of the Newton preconditioner (the next solve factorises afresh): a modal

@@ -102,7 +102,7 @@ from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.geometry import Rotation
 from multiscale.macro import kept_cells, mumps
 from multiscale.macro.interface import ContactInterface, rigid_velocity
-from multiscale.macro.kept_cells import KeptCells, assemble, backtracking, nonlinear_problem, weak_callback
+from multiscale.macro.kept_cells import KeptCells, assemble, backtracking, nonlinear_problem
 from multiscale.macro.materials import body_properties, heat_capacity
 from multiscale.macro.mesh import FormCache
 from multiscale.macro.thermal_conditions import AppliedBoundary, ThermalBoundary, surface_rows
@@ -236,7 +236,7 @@ class Thermal:
             if tangent.split:
                 self._tangent = tangent
                 self._factored = self.problem.A.duplicate()     # the matrix of the kept LU factors
-                self.problem.solver.setJacobian(weak_callback(self._jacobian), self.problem.A, self._factored)
+                self.problem.solver.setJacobian(self._jacobian, self.problem.A, self._factored)
         self.factorisations = 0                # linear steps: LU factorisations so far
         self._stale = True                     # linear steps: refactorise at the next step
         self._kept = False                     # linear steps: the last solve ran on earlier factors
@@ -249,8 +249,8 @@ class Thermal:
         self.precision = FACTOR_PRECISION if self.nonlinear else "double"    # of the LU factors
         self._fresh = False                    # Newton: a fresh tangent every iteration (a step redone)
         if self.nonlinear:
-            self.problem.solver.setJacobian(weak_callback(self._chord_jacobian), self.problem.A, self.problem.P_mat)
-            self.problem.solver.setMonitor(weak_callback(self._watch))
+            self.problem.solver.setJacobian(self._chord_jacobian, self.problem.A, self.problem.P_mat)
+            self.problem.solver.setMonitor(self._watch)
 
     # ---- forms -----------------------------------------------------------------------------
     def _dx(self, i: int, degree: int | None = None, scheme: str | None = None):
