@@ -207,8 +207,8 @@ def test_a_users_preconditioner_replaces_the_newtons_own(tm, petsc_options):
     np.testing.assert_allclose(m.solve(100.0).normal_force, default.solve(100.0).normal_force, rtol=1e-9)
     assert m.factors.analyses == 0 and default.factors.analyses > 0
     none = Mechanics(tm, MATERIALS, stiffness=K_N, load_kind="force", prefix="block_n_")
-    with pytest.raises(ConvergenceError, match="preconditioned by PETSC_OPTIONS' pc_type none instead of the "
-                       "contact Newton's own factorisation"):
+    with pytest.raises(ConvergenceError, match=r"preconditioned by the user's PC \(PETSC_OPTIONS = '-block_n_pc_type "
+                       r"none'\) instead of the contact Newton's own factorisation \(leave pc_type unset for it\)"):
         none.solve(100.0)
 
 
