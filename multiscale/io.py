@@ -129,6 +129,11 @@ def collective(comm, call):
     return value
 
 
+def counted(n: int, noun: str) -> str:
+    """"1 record", "2 records": ``n`` and the noun, plural unless n is 1."""
+    return f"{n} {noun}{'s' * (n != 1)}"
+
+
 class StepStop:
     """Ctrl-C in a loop of steps (a context manager). The first SIGINT asks the loop to stop after
     its current step, when ``requested()`` (every rank together: one stops, all stop, at the same

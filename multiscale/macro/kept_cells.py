@@ -170,7 +170,11 @@ def splits(form: list) -> bool:
     """Whether ``KeptCells`` of the block form ``form`` (UFL, a list of lists) keeps its cell part
     apart (``KeptCells.split``): the integrals other than the cells' leave no row or column of
     blocks empty. Known before the problem is set up (its solver options depend on it)."""
-    others = [[integrals(f, False) for f in row] for row in form]
+    return _apart([[integrals(f, False) for f in row] for row in form])
+
+
+def _apart(others: list) -> bool:
+    """``splits`` of the block form whose non-cell integrals are ``others``."""
     return (all(any(f is not None for f in row) for row in others)
             and all(any(f is not None for f in column) for column in zip(*others)))
 
@@ -183,6 +187,13 @@ NEWTON_ONLY = ("snes_linesearch_", "snes_rtol", "snes_atol", "snes_stol", "snes_
                "snes_ksp_ew")
 
 
+def options_named(prefix: str, starts: str | tuple) -> list[str]:
+    """The options set under ``prefix`` whose names after it start with ``starts`` (one or a tuple),
+    as given and sorted: ["-heat_snes_rtol", ...]."""
+    return sorted(f"-{k}" for k in PETSc.Options().getAll()
+                  if k.startswith(prefix) and k[len(prefix):].startswith(starts))
+
+
 class SolverOptionWarning(UserWarning):
     """Options the user set under a solver's prefix that the solver does not use."""
 
@@ -192,8 +203,7 @@ def newton_options_unused(snes: PETSc.SNES, problem: str) -> str:
     uses (``NEWTON_ONLY``) when ``snes`` is a linear solve (type "ksponly"; "" if none or if it is
     not): ``problem`` says why it is linear."""
     prefix = snes.getOptionsPrefix() or ""
-    unused = sorted(f"-{k}" for k in PETSc.Options().getAll()
-                    if k.startswith(prefix) and k[len(prefix):].startswith(NEWTON_ONLY))
+    unused = options_named(prefix, NEWTON_ONLY)
     if not unused or snes.getType() != PETSc.SNES.Type.KSPONLY:
         return ""
     return (f"PETSC_OPTIONS: {' '.join(unused)} had no effect: {problem}, one linear solve a step, not Newton's "
@@ -214,7 +224,7 @@ class KeptCells:
 
     def __init__(self, A: PETSc.Mat, compiled, form: list, entity_maps, bcs):
         others = [[integrals(f, False) for f in row] for row in form]
-        self.split = splits(form)
+        self.split = _apart(others)
         self.compiled, self.bcs = compiled, bcs
         cells = [[integrals(f, True) for f in row] for row in form]
         self.cells = fem.form(cells, entity_maps=entity_maps)

@@ -31,7 +31,7 @@ from multiscale.macro import mumps
 from multiscale.macro.compact_factor import CompactFactor
 from multiscale.macro.interface import ContactInterface, PressureLaw
 from multiscale.macro.kept_cells import (KeptCells, SolverOptionWarning, assemble, backtracking, check_user_options,
-                                         integrals, nonlinear_problem, user_options)
+                                         integrals, nonlinear_problem, options_named, user_options)
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
@@ -262,7 +262,7 @@ class Mechanics:
         if self.own_pc:
             check_user_options(tm.comm, self.factors.prefix, self.factors.options)
             self.problem.solver.getKSP().getPC().setPythonContext(self.factors)
-        unused = sorted(f"-{k}" for k in PETSc.Options().getAll() if k.startswith(prefix + "pc_"))
+        unused = options_named(prefix, "pc_")
         self.notes = [] if not (self.own_pc and unused) else [   # said as a SolverOptionWarning
             f"PETSC_OPTIONS: {' '.join(unused)} had no effect: the contact Newton's preconditioner is its own kept "
             f"factorisation, whose options are under -{prefix}factor_ (e.g. -{prefix}factor_pc_factor_mat_solver_type"

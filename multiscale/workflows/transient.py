@@ -86,7 +86,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     result = TransientResult(folder, writer.files + [h5, png], _time.perf_counter() - start, history, h5, png,
                              writer.files, warnings=run_notes(model))
     if verbose and comm.rank == 0:
-        print(f"{scene.name}: {len(history)} record{'s' * (len(history) != 1)} in {result.wall_time:.1f} s on "
+        print(f"{scene.name}: {io.counted(len(history), 'record')} in {result.wall_time:.1f} s on "
               f"{comm.size} rank(s)")
         print(f"  ParaView: {', '.join(str(f) for f in writer.files)}")
         print(f"  history:  {h5}  plot: {png}")
