@@ -35,9 +35,10 @@ test: docs test-serial test-mpi
 docs: $(STAMP)
 	$(BIN)/python -m sphinx -b html -E -W --keep-going -n -q docs docs/_build/html
 
-# one pytest process per test module: every model built stays in memory with ~35-100 MPI
-# communicators of MPICH's 2048 per process, and the whole suite in one process ended with exit code
-# 15, MPICH's abort for "Too many communicators" (203515151 & 0xff; docs/architecture.md §7)
+# one pytest process per test module: a model not closed (the tests build most through the API and
+# keep them open) stays in memory with ~35-100 MPI communicators of MPICH's 2048 per process, and
+# the whole suite in one process ended with exit code 15, MPICH's abort for "Too many
+# communicators" (203515151 & 0xff; docs/architecture.md §7)
 test-serial: $(STAMP)
 	@failed=""; for f in tests/test_*.py; do \
 	  $(BIN)/python -m pytest -q -p no:cacheprovider $$f || failed="$$failed $$f"; done; \

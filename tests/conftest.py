@@ -36,3 +36,22 @@ def petsc_options():
     yield put
     for name in names:
         PETSc.Options().delValue(name)
+
+
+@pytest.fixture
+def free_communicators():
+    """``free_communicators()``: the MPI communicators this process can still create (MPICH: 2048
+    in all), found by duplicating COMM_SELF until MPI refuses (mpi4py raises) and freeing them."""
+    from mpi4py import MPI    # on use: after h5py, as above
+
+    def count() -> int:
+        made = []
+        try:
+            while len(made) < 10000:
+                made.append(MPI.COMM_SELF.Dup())
+        except MPI.Exception:
+            pass
+        for comm in made:
+            comm.Free()
+        return len(made)
+    return count

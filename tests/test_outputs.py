@@ -43,7 +43,7 @@ def case(request, tmp_path_factory):
     if request.param == "squeal":
         # `multiscale run` in a process of its own, as a user runs it (inside the whole suite's
         # process it once ended with exit code 15: MPICH out of communicators, the models of
-        # earlier tests never freed; docs/architecture.md §7)
+        # earlier tests not closed; docs/architecture.md §7)
         path = folder.parent / "scene.toml"
         path.write_text(resolved_toml(scene))
         scene = load(path)

@@ -12,7 +12,7 @@ The Jacobian's matrix ignores exact zeros of the element matrices once its patte
 vector field are zeros, and every add searches its row (docs/architecture.md §5, the macro Newton).
 
 ``nonlinear_problem`` sets up the DOLFINx problem such a Jacobian belongs to (the contact's and the
-heat's Newton) with our solver options, the user's winning.
+heat's Newton) with our solver options, the user's winning; ``destroy`` frees it.
 """
 from __future__ import annotations
 
@@ -65,6 +65,20 @@ def nonlinear_problem(F, u, prefix: str, options: Mapping, **kwargs) -> fpetsc.N
     finally:
         for name in ours:
             user.delValue(name)
+
+
+def destroy(problem: fpetsc.NonlinearProblem, *others) -> None:
+    """Destroy ``problem``'s SNES (with its KSP and PC: their factors, and the callbacks PETSc
+    keeps), matrices and vectors, then the PETSc ``others`` (None skipped), in this order.
+    Collective, on every rank in the same order: MUMPS' destruction communicates. Dropping is no
+    substitute: PETSc keeps the callbacks (bound methods of their owner) in a dict of the C object
+    that Python's cycle collector cannot see, so a problem never destroyed keeps its owner, meshes
+    and MPI communicators for good (about 35 a model; MPICH has 2048 per process); and objects
+    freed by each rank's collector go in a different order on each rank, which hangs MUMPS.
+    DOLFINx's own destruction of the objects after this is a no-op."""
+    for obj in (problem.solver, problem.A, problem.P_mat, problem.b, problem.x, *others):
+        if obj is not None:
+            obj.destroy()
 
 
 @contextmanager

@@ -31,7 +31,7 @@ from multiscale.macro import mumps
 from multiscale.macro.compact_factor import CompactFactor
 from multiscale.macro.interface import ContactInterface, PressureLaw
 from multiscale.macro.kept_cells import (KeptCells, SolverOptionWarning, assemble, backtracking, check_user_options,
-                                         integrals, nonlinear_problem, options_named, user_options)
+                                         destroy, integrals, nonlinear_problem, options_named, user_options)
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
@@ -307,6 +307,13 @@ class Mechanics:
         analysis after the preload then does not hold two factorisations at once."""
         self.problem.solver.getKSP().getPC().reset()
         self._pc_stale = True
+
+    def close(self) -> None:
+        """Destroy the Newton's PETSc objects, factors first (``kept_cells.destroy``: collective, on
+        every rank in the same order); the model is unusable after, and freed when dropped."""
+        self.factors.reset(None)
+        destroy(self.problem, None if self._pc_mat is self.problem.P_mat else self._pc_mat, self._offset, self._start,
+                self._step, self._frictionless[0] if self._frictionless else None, *(k.bulk for k in self._split))
 
     # ---- forms -----------------------------------------------------------------------------
     def _frictionless_jacobian(self) -> list:

@@ -88,6 +88,14 @@ class MacroModel:
     def contact(self):
         return self.mechanics.contact
 
+    def close(self) -> None:
+        """Destroy the PETSc objects of the mechanics, then of the heat problem (collective: call it
+        on every rank; ``Mechanics.close``). The fields stay readable; nothing can be solved after.
+        A model not closed is never freed (docs/architecture.md §7)."""
+        self.mechanics.close()
+        if self.thermal is not None:
+            self.thermal.close()
+
     @property
     def problems(self) -> tuple[str, ...]:
         return ("mechanics",) + (("heat",) if self.thermal is not None else ())

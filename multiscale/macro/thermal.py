@@ -10,15 +10,14 @@ rho c) and the conductivity kappa(T) [W/(m K)],
 
 w = 0 in body 0 and w = omega e × (x − c) in the rotating body 1 (steady sliding seen from the lab
 frame; a translating body is accepted only at rest, w = 0). Backward Euler in time, P1 in space
-(P2 in a rotating body 1: ``temperature_functions``), the storage term lumped (vertex
-quadrature) in a body without transport, so that a heat pulse thinner than the elements neither
-under- nor overshoots (``Thermal._storage_dx``), SUPG on body 1
-with tau = [(2/dt)^2 + (2|w|/h)^2 + 9 (4 chi/h^2)^2]^(-1/2), chi = kappa/(rho c), on the full
-residual (with P2 its conduction term too, ∇·(kappa ∇T) = kappa ΔT + kappa'(T^n) |∇T|^2, a table's
-slope taken at the step's start: kappa' jumps at the table's points, and at T^{n+1} the residual
-jumped where a quadrature point crossed one, so that Newton cycled, |F| stuck at 0.857 W, on a CAD
-disc with kappa 54 -> 20 W/(m K) over 40 K; at T^n it differs only where T crossed a point during
-the step, tests/test_macro_thermal.py):
+(P2 in a rotating body 1: ``temperature_functions``), the storage term lumped (vertex quadrature)
+in a body without transport, so that a heat pulse thinner than the elements neither under- nor
+overshoots (``Thermal._storage_dx``), SUPG on body 1 with
+tau = [(2/dt)^2 + (2|w|/h)^2 + 9 (4 chi/h^2)^2]^(-1/2), chi = kappa/(rho c), on the full residual
+(with P2 its conduction term too, ∇·(kappa ∇T) = kappa ΔT + kappa'(T^n) |∇T|^2, a table's slope
+at the step's start: at T^{n+1} the residual jumped where a quadrature point crossed one of the
+table's points, and Newton cycled, |F| stuck at 0.857 W, on a CAD disc with kappa 54 -> 20 W/(m K)
+over 40 K; at T^n it differs only where T crossed a point in the step, tests/test_macro_thermal.py):
 find T^{n+1} such that for every test function r
 
     ∫ [(e(T^{n+1}) − e(T^n))/dt r + kappa ∇T^{n+1}·∇r − e(T^{n+1}) w·∇r] dx + SUPG
@@ -52,17 +51,14 @@ factors. A solve that fails with kept or single factors is redone from the step'
 fresh double ones, which then stay (``redone`` counts the redone steps). A Newton step still
 failing is redone once more with PETSc's backtracking line search (``bt``: the full step if it
 lowers ||F||^2 enough, else a shorter one along it) and a fresh tangent every iteration
-(``backtracked`` counts them; the first is warned about, ``HeatStepWarning``). Where the
-tangent is flat a full step overshoots far: a block from 300 K into 2000 K surroundings in one
-1000 s step (T^4 flat at the start) went to ~6e4 K, the residual 33 W -> 3e7 W (SNES reason -9);
+(``backtracked`` counts them; the first is warned about, ``HeatStepWarning``). Where the tangent
+is flat a full step overshoots far: a block from 300 K into 2000 K surroundings in one 1000 s
+step (T^4 flat at the start) went to ~6e4 K, the residual 33 W -> 3e7 W (SNES reason -9);
 backtracking converges in 5 iterations, the mean temperature within 0.44 K of the lumped body's
-backward Euler step (tests/test_macro_thermal.py).
-Only on a failed step: on every step it kept the full steps of the radiation and c(T) tests (the
-same temperatures, bit for bit) but shortened those that overshoot and recover (a radiating
-column: 14 -> 4 iterations, another path to the same answer), so the steps that converge keep
-their iterates. Not the critical-point search (``cp``, stalled at the start: |F| 33.2 W for 30
-iterations); backtracking converged every step tried (up to 1e6 s, 3000 K surroundings, tables),
-so a failed step is not cut into substeps (that would change the user's time discretisation).
+backward Euler step (tests/test_macro_thermal.py). Only on a failed step: always on, it shortened
+steps that overshoot and recover (a radiating column: 14 -> 4 iterations, another path to the
+same answer). Not ``cp`` (stalled: |F| 33.2 W for 30 iterations). Backtracking converged every
+step tried (to 1e6 s, 3000 K surroundings, tables): a failed step is not cut into substeps.
 The user's options under the prefix (``PETSC_OPTIONS="-heat_snes_linesearch_type ..."``) win over
 ours, and a failed step's error names them; a line search the user chose is not replaced. So do a
 linear problem's KSP and PC options (``-heat_ksp_type cg``; a user's ``preonly`` factorises every
@@ -223,6 +219,7 @@ class Thermal:
         self.problem = nonlinear_problem(self.residuals, self.T, prefix, options, bcs=self.bcs,
                                          entity_maps=tm.entity_maps)
         self.notes: list = []                  # what the run's warnings add (said once per run)
+        self._tangent = self._factored = None  # linear steps: the kept cell part, the kept factors' matrix
         # a failed step is redone with backtracking unless the user chose a line search (theirs alone remain)
         self._backtrack = self.nonlinear and not PETSc.Options(prefix).hasName("snes_linesearch_type")
         self._residual_forms: dict = {}
@@ -234,8 +231,7 @@ class Thermal:
             self._say(kept_cells.newton_options_unused(self.problem.solver, why), kept_cells.SolverOptionWarning)
             tangent = KeptCells(self.problem.A, self.problem.J, J, tm.entity_maps, self.bcs)
             if tangent.split:
-                self._tangent = tangent
-                self._factored = self.problem.A.duplicate()     # the matrix of the kept LU factors
+                self._tangent, self._factored = tangent, self.problem.A.duplicate()
                 self.problem.solver.setJacobian(self._jacobian, self.problem.A, self._factored)
         self.factorisations = 0                # linear steps: LU factorisations so far
         self._stale = True                     # linear steps: refactorise at the next step
@@ -251,6 +247,10 @@ class Thermal:
         if self.nonlinear:
             self.problem.solver.setJacobian(self._chord_jacobian, self.problem.A, self.problem.P_mat)
             self.problem.solver.setMonitor(self._watch)
+
+    def close(self) -> None:
+        """Destroy the solver's PETSc objects (collective, ``Mechanics.close``); unusable after."""
+        kept_cells.destroy(self.problem, self._factored, self._tangent.bulk if self._tangent else None)
 
     # ---- forms -----------------------------------------------------------------------------
     def _dx(self, i: int, degree: int | None = None, scheme: str | None = None):

@@ -20,7 +20,6 @@ per-facet stiffness, partition, wear depth, flash temperature and the counter-fa
 from __future__ import annotations
 
 import dataclasses
-import gc
 import time as _time
 from dataclasses import dataclass
 from functools import partial
@@ -185,8 +184,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones, ckpt] + maps, _time.perf_counter() - start,
                               history, h5, png, writer.files, plot, maps, zones, done,
                               warnings=run_notes(ms.model))
-    del ms, writer            # the model holds reference cycles of PETSc objects: free them on every
-    gc.collect()              # rank at the same point (collected later, ranks could hang at exit)
+    ms.model.close()          # on every rank in the same order (MUMPS' destruction communicates)
     if stopping:                 # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", result.warnings)
     if verbose and comm.rank == 0:

@@ -82,7 +82,7 @@ class SquealCase:
     report: StabilityReport
     energy: EnergyShares | None
     facet_pressure: np.ndarray      # Pa, per interface facet (global order of tm.interface)
-    mech: Mechanics | None = field(default=None, repr=False)   # the model (spaces of the modes)
+    mech: Mechanics | None = field(default=None, repr=False)   # the model (spaces of the modes; closed by ``run``)
     prestress: PrestressEffect | None = None    # the frequencies without the prestress stiffness
     terms: tuple = ()                           # parts of the linearised system beyond K and M
 
@@ -276,6 +276,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
                                             lambda changed: build_squeal_mechanics(changed, tm, degree=degree,
                                                                                    prefix="squeal_map_"))
             files += squeal_map.write(smap, folder, comm)
+    case.mech.close()                # on every rank in the same order (MUMPS' destruction communicates)
     result = SquealResult(folder, files, time.perf_counter() - t0, case, smap, tuple(_left_out(scene, case, smap)))
     if verbose and comm.rank == 0:
         rep = case.report

@@ -51,15 +51,22 @@ class MapModel:
 
     def __init__(self, scene, tm, mech, options, load: float, rebuild: Callable):
         self.scene, self.tm, self.mech, self.options, self.load = scene, tm, mech, options, load
+        self.nominal = mech
         self.rebuild = rebuild
         self.sweep = scene.stability.sweep
         self.materials = dict(scene.materials)
 
+    def close(self, mech) -> None:
+        """Close ``mech`` (collective) if it is one this map rebuilt."""
+        if mech is not self.nominal:
+            mech.close()
+
     def linearise(self, value: float):
         """Set the parameter to ``value``, preload if asked, and linearise: a ``Linearised``."""
         name, opt = self.sweep.parameter, self.options
-        if name == "rms":
-            self.mech = self.rebuild(with_rms(self.scene, value))
+        if name == "rms":               # the nominal analysis' model is its caller's, the others ours
+            mech, self.mech = self.mech, self.rebuild(with_rms(self.scene, value))
+            self.close(mech)
         mech = self.mech
         if name == "friction":
             self.tm.interface.set_field(mech.contact.friction, value)
@@ -102,6 +109,7 @@ def stability_map(scene, tm, mech, options, load: float, rebuild: Callable) -> S
         size = _common_basis(model, builder, st, options)
     else:
         size = _per_point(model, builder, st, options)
+    model.close(model.mech)
     return builder.finish(basis_size=size, time=time.perf_counter() - t0)
 
 

@@ -81,6 +81,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
                     break
         with io.stage("writing history and plots"), stop.writing(done):
             h5, png = write_history(history, folder, scene.name, comm)
+    model.close()                    # on every rank in the same order (MUMPS' destruction communicates)
     if stopping:                     # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", run_notes(model))
     result = TransientResult(folder, writer.files + [h5, png], _time.perf_counter() - start, history, h5, png,
