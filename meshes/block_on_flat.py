@@ -51,6 +51,7 @@ def describe(params=None) -> GeometrySpec:
         motion=Translation((1.0, 0.0, 0.0)),
         length_scale=max(p["length"], p["width"], p["height"]),
         symmetry={"symmetry_x": (1.0, 0.0, 0.0), "symmetry_y": (0.0, 1.0, 0.0)},
+        interface_extents={"interface": (p["length"], p["width"])},      # the block's footprint
     )
 
 

@@ -140,7 +140,15 @@ def describe(params=None) -> GeometrySpec:
         length_scale=p["disc_outer_radius"],
         fluid_load=True,                          # the hydraulic pressure on piston and caliper bore
         interface_regions={"inner_pad": "pad_inner", "outer_pad": "pad_outer"},
+        interface_extents=dict.fromkeys(("inner_pad", "outer_pad"), _pad_extent(p)),
     )
+
+
+def _pad_extent(p) -> tuple[float, float]:
+    """Size (x, y) [m] of a pad's friction face, an annular sector centred on +y: its outer arc's
+    chord across, from its inner corners to the outer radius along y."""
+    half = p["pad_angle"] / 2
+    return 2 * p["pad_outer_radius"] * math.sin(half), p["pad_outer_radius"] - p["pad_inner_radius"] * math.cos(half)
 
 
 def _z_levels(p) -> dict:

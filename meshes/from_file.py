@@ -14,7 +14,7 @@ found; and ``generate``, on the meshing rank):
    file's volume number (``index``), or as the volume containing a point (``contains``);
 3. find the contact interfaces: faces shared by a fixed body and the rotating one (given pairs,
    or every such pair, one interface per fixed body named after it), with their area, and their
-   normal when planar;
+   normal and extent in their plane when planar;
 4. find the named surfaces: the file's physical surface groups and [geometry.surfaces].
 
 CAD is meshed with gmsh's HXT unless ``mesh_algorithm`` says "delaunay"; a ``.geo`` script keeps
@@ -34,13 +34,14 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from multiscale.errors import InputError
-from multiscale.geometry import BodySpec, GeometrySpec, Region, Rotation, add_group
+from multiscale.geometry import BodySpec, GeometrySpec, Region, Rotation, add_group, plane_extent
 
 NAME = "file"
 DEFAULTS: dict = {}          # no numeric parameters: [geometry] of the scene is a FileGeometry
 FIXED = "fixed"              # name of body 0 (the fixed bodies), body 1 is the rotating body
 PLAUSIBLE = (1e-3, 10.0)     # m, smallest and largest extent of a brake or tribometer model
 NORMAL_TOLERANCE = np.cos(np.radians(5.0))
+CURVE_POINTS = 65           # points along each boundary curve of an interface face for its box
 # CAD is scaled to metres by gmsh's Geometry.OCCScaling at import, a similarity that keeps planes
 # and cylinders analytic; occ.dilate (a general affine map) turns every surface into a B-spline:
 # the fragment then took 1.1 s instead of 0.03 s on the railway disc and HXT meshed 1.4-1.8x slower
@@ -73,6 +74,7 @@ class Found:
     pairs: dict = field(default_factory=dict)        # name -> (fixed body, rotating body)
     areas: dict = field(default_factory=dict)        # name -> m^2
     normals: dict = field(default_factory=dict)      # name -> unit normal (fixed towards rotating), None if not planar
+    extents: dict = field(default_factory=dict)      # planar interface -> size (u, v) [m] in its plane
     surfaces: dict = field(default_factory=dict)     # name -> face tags
     extent: float = 0.0                              # m, largest side of the bounding box
     size_factor: float = 1.0                         # a script's own Mesh.MeshSizeFactor (SIZE_FACTOR)
@@ -331,6 +333,8 @@ def _interfaces(model, g, found: Found, occ: bool) -> None:
             continue
         found.interfaces[name], found.pairs[name] = faces, (fixed, g.rotating)
         found.areas[name], found.normals[name] = _plane(model, faces, found.bodies[fixed], occ)
+        if found.normals[name] is not None:
+            found.extents[name] = plane_extent(found.normals[name], *_box(model, faces, g.kind == "mesh"))
     if not found.interfaces:
         raise InputError("geometry.rotating", g.rotating, f"no fixed body of {g.file.name} touches it: no contact "
                          "interface (bodies must share a face; give [geometry.interfaces] to see the gaps)")
@@ -352,6 +356,20 @@ def _nodes(model, faces: list[int]) -> tuple[np.ndarray, np.ndarray]:
         for etype, conn in zip(*model.mesh.getElements(2, f)[::2]):
             tris.append(np.array([x[n] for n in conn]).reshape(-1, 3, 3)[:, :3])
     return np.concatenate(tris)
+
+
+def _box(model, faces: list[int], mesh: bool) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corners [m] of the faces' bounding box: of their nodes in a .msh (the box a
+    run takes), else of their boundary curves at ``CURVE_POINTS`` points each (a flat face's box is
+    its boundary's; gmsh's boxes of OpenCASCADE shapes are larger by its tolerance, 1e-7 m)."""
+    if mesh:
+        x = _nodes(model, faces).reshape(-1, 3)
+    else:
+        curves = model.getBoundary([(2, f) for f in faces], combined=False, oriented=False)
+        x = np.concatenate([np.reshape(model.getValue(1, c, np.linspace(*model.getParametrizationBounds(1, c),
+                                                                         CURVE_POINTS).ravel()), (-1, 3))
+                            for _, c in dict.fromkeys(curves)])
+    return x.min(axis=0), x.max(axis=0)
 
 
 def _coplanar(model, faces: list[int]) -> bool:
@@ -510,5 +528,5 @@ def _spec(g, found: Found) -> GeometrySpec:
         faces={n: 2001 + k for k, n in enumerate(found.surfaces)},
         supports=(), load_faces=(), motion=Rotation(tuple(g.axis), tuple(g.centre)),
         length_scale=found.extent, fluid_load=True,
-        interface_normals=dict(found.normals), report=tuple(report),
+        interface_normals=dict(found.normals), interface_extents=dict(found.extents), report=tuple(report),
         interface_regions={name: fixed for name, (fixed, _) in found.pairs.items()})

@@ -71,6 +71,7 @@ def describe(params=None) -> GeometrySpec:
         load_direction=(0.0, 0.0, -1.0),
         motion=Rotation((0.0, 0.0, 1.0), (0.0, 0.0, 0.0)),
         length_scale=p["outer_radius"],
+        interface_extents={"interface": (p["pin_size"], p["pin_size"])},
     )
 
 

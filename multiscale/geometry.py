@@ -5,7 +5,8 @@ A builder (the modules of ``meshes/``: ``block_on_flat``, ``pin_on_disc``, ``dis
 user's own) is a module providing ``DEFAULTS`` (its parameters in SI units), optionally
 ``PARAMETER_KINDS`` (unit kind of a parameter, default "length", or "angle" when the name says so),
 ``parameters(params) -> dict`` (defaults updated and checked), ``describe(params) ->
-GeometrySpec`` (pure Python: tags, bodies, supports) and ``generate(model, params)`` (builds the
+GeometrySpec`` (pure Python: tags, bodies, supports; the interfaces' extents, without which
+``check`` cannot compare a measured surface with its face) and ``generate(model, params)`` (builds the
 gmsh model on one rank and ends by meshing it with ``model.mesh.generate(3)``: ``estimate_cells``
 remeshes that model at other sizes, and ``macro.mesh.build`` takes the real mesh from it), and
 optionally ``remesh(model, params)`` (meshes the built model again in 3-D, after
@@ -110,6 +111,9 @@ class GeometrySpec:
     #                                    body 0 along it (default: body 0's first region)
     symmetry: Mapping[str, tuple] = field(default_factory=dict)   # face -> unit normal of a symmetry
     #                                    plane there (the model is a part of a symmetric whole)
+    interface_extents: Mapping[str, tuple] = field(default_factory=dict)   # planar interface -> size
+    #                                    (u, v) [m] of its face in its plane's frame (``plane_extent``),
+    #                                    known before meshing (absent: known from the mesh only)
 
     @property
     def materials(self) -> tuple[str, ...]:
@@ -124,6 +128,26 @@ class GeometrySpec:
         name = self.interface_regions.get(interface, self.bodies[0].regions[0].name)
         region = next(r for r in self.bodies[0].regions if r.name == name)
         return region.material, self.bodies[1].regions[0].material
+
+
+def plane_frame(normal) -> np.ndarray:
+    """The frame (3, 3) of a plane, rows e_u, e_v, n, of its unit ``normal``: (x, y, z) itself for a
+    normal along ±z; otherwise e_u is x projected on the plane (or y, if x is nearly normal to it)
+    and e_v = n x e_u (the frame of rough interfaces' zones)."""
+    n = np.asarray(normal, dtype=float) / np.linalg.norm(normal)
+    if abs(n[2]) > 1 - 1e-12:
+        return np.eye(3)
+    e_u = np.array([1.0, 0.0, 0.0]) - n[0] * n
+    e_u = e_u if np.linalg.norm(e_u) > 1e-6 else np.array([0.0, 1.0, 0.0]) - n[1] * n
+    e_u /= np.linalg.norm(e_u)
+    return np.array([e_u, np.cross(n, e_u), n])
+
+
+def plane_extent(normal, lo, hi) -> tuple[float, float]:
+    """Size (u, v) [m] of the box [lo, hi] (3-D corners [m]) along e_u, e_v of ``plane_frame(normal)``:
+    the spread of its corners there, sum_i |e_i| (hi_i - lo_i)."""
+    span = np.abs(plane_frame(normal)[:2]) @ (np.asarray(hi, dtype=float) - np.asarray(lo, dtype=float))
+    return float(span[0]), float(span[1])
 
 
 BUILDER_GROUP = "multiscale.builders"

@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from multiscale.errors import InputError
-from multiscale.geometry import Rotation
+from multiscale.geometry import Rotation, plane_frame
 from multiscale.macro.laws_ufl import FacetLaw
 from multiscale.macro.mesh import TwoBodyMesh
 from multiscale.micro.laws import LawError, LawSpec, ZoneLaws
@@ -63,8 +63,8 @@ class Plane:
 
 def interface_plane(tm: TwoBodyMesh, name: str) -> tuple[Plane, np.ndarray, np.ndarray]:
     """The plane of interface ``name`` and the lower and upper corners (u, v) [m] of its facets'
-    vertices in it; InputError if the interface is not planar. For a normal along z the frame is
-    (x, y, z) itself; otherwise e_u is the direction of x projected on the plane (or y)."""
+    vertices in it; InputError if the interface is not planar. The frame is ``geometry.plane_frame``'s:
+    (x, y, z) itself for a normal along z; otherwise e_u is x projected on the plane (or y)."""
     iface = tm.interface
     mask = iface.masks()[name]
     mid, areas = iface.midpoints[mask], iface.areas[mask]
@@ -75,14 +75,7 @@ def interface_plane(tm: TwoBodyMesh, name: str) -> tuple[Plane, np.ndarray, np.n
     size = max(float((hi3 - lo3).max()), np.finfo(float).tiny)
     if np.abs((mid - centre) @ n).max() > 1e-9 * size:
         raise InputError("geometry", name, "a rough interface must be planar")
-    if abs(n[2]) > 1 - 1e-12:
-        frame = np.eye(3)
-    else:
-        e_u = np.array([1.0, 0.0, 0.0]) - n[0] * n
-        e_u = e_u if np.linalg.norm(e_u) > 1e-6 else np.array([0.0, 1.0, 0.0]) - n[1] * n
-        e_u /= np.linalg.norm(e_u)
-        frame = np.array([e_u, np.cross(n, e_u), n])
-    plane = Plane(np.zeros(3) if abs(n[2]) > 1 - 1e-12 else centre, frame)
+    plane = Plane(np.zeros(3) if abs(n[2]) > 1 - 1e-12 else centre, plane_frame(n))
     corners = plane.uv(np.array([[a, b, c] for a in (lo3[0], hi3[0]) for b in (lo3[1], hi3[1])
                                  for c in (lo3[2], hi3[2])]))
     return plane, corners.min(axis=0), corners.max(axis=0)

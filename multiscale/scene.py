@@ -18,6 +18,7 @@ from __future__ import annotations
 import dataclasses
 import os
 import tomllib
+import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,6 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from multiscale.errors import InputError, SceneError
+from multiscale.micro.topography import TopographyWarning, covers, read_topography
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
@@ -322,7 +324,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                     problems.append(f"wear.{given[0]}: the rough body's material gives k_w "
                                     f"(materials.{name}.k_w): give one of them")
         if not problems:
-            problems += _nyquist(scene)
+            problems += _nyquist(scene) + _measured_cover(scene)
     if scene.output is not None and scene.output.fields is not None:
         for f in scene.output.fields:
             missing = [e for e in OUTPUT_FIELDS[f] if e not in effects]
@@ -440,17 +442,43 @@ def _nyquist(scene: Scene) -> list[str]:
     micro grid, or zones x grid for patch = "face")."""
     out = []
     for name in scene.rough_interfaces:
-        own = scene.interfaces.get(name)
         s = scene.interface_settings(name)
         r, m = s.roughness, s.micro
         if r is None or r.rms is None or m is None or m.zones is None:
             continue
         cells = [g * (z if r.patch == "face" else 1) for g, z in zip(m.grid or DEFAULT_GRID, m.zones)]
         if any(k > c // 2 for k, c in zip(r.k_max, cells)):
-            where = f"interfaces.{name}.roughness" if own is not None and own.roughness is not None else "roughness"
-            out.append(f"{where}.k_max = {list(r.k_max)}: must not exceed the Nyquist index {[c // 2 for c in cells]} "
-                       f"of the {'face' if r.patch == 'face' else 'zone'}'s micro grid of {cells} cells")
+            out.append(f"{_roughness_key(scene, name)}.k_max = {list(r.k_max)}: must not exceed the Nyquist index "
+                       f"{[c // 2 for c in cells]} of the {'face' if r.patch == 'face' else 'zone'}'s micro grid "
+                       f"of {cells} cells")
     return sorted(set(out))
+
+
+def _measured_cover(scene: Scene) -> list[str]:
+    """A measurement used as it is (``cover = "measured"``) covers its face: the run's refusal
+    (``topography.covers``) before meshing, for the faces whose extent the geometry knows then
+    (``GeometrySpec.interface_extents``; the others are refused after meshing)."""
+    out = []
+    for name in scene.rough_interfaces:
+        r, size = scene.interface_settings(name).roughness, scene.geometry.spec.interface_extents.get(name)
+        if r is None or r.file is None or r.cover != "measured" or size is None:
+            continue
+        prefix = f"{_roughness_key(scene, name)}."
+        try:
+            with warnings.catch_warnings():        # the file's notes are the scene's warnings already
+                warnings.simplefilter("ignore", TopographyWarning)
+                measured = read_topography(r.file, r.channel, pixel_size=r.pixel_size, height_unit=r.height_unit,
+                                           prefix=prefix)
+            covers(measured.size, size, r.cover, prefix=prefix)
+        except InputError as exc:
+            out.append(str(exc))
+    return sorted(set(out))
+
+
+def _roughness_key(scene: Scene, name: str) -> str:
+    """Where interface ``name``'s roughness is given: "interfaces.<name>.roughness" or "roughness"."""
+    own = scene.interfaces.get(name)
+    return f"interfaces.{name}.roughness" if own is not None and own.roughness is not None else "roughness"
 
 
 def _symmetry_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]:

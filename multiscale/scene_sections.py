@@ -437,9 +437,9 @@ class Roughness:
     ``height_unit`` override them, with a warning), or a plain height matrix (.npy, .txt, .csv,
     .asc: ``pixel_size`` needed, ``height_unit`` default 1 m). It is conditioned (``detrend``,
     undefined points filled up to ``max_undefined``, Gaussian filter at ``cutoff``), then
-    ``cover``s the face: the measurement itself ("measured": it must cover the face), copies
-    ("mirror", "tile": warned) or a statistically equivalent surface from its PSD ("equivalent",
-    drawn with ``seed``). ``multiscale check`` reads the file's header and heights, nothing more."""
+    ``cover``s the face: the measurement itself ("measured": it must cover the face; checked when
+    the scene is read), copies ("mirror", "tile": warned) or a statistically equivalent surface
+    from its PSD ("equivalent", drawn with ``seed``). ``multiscale check`` conditions nothing."""
 
     body: str | None = key(Text())               # the stationary (rough) side; default: that side
     rms: float | None = key(_ROUGHNESS)                                        # m

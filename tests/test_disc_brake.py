@@ -21,6 +21,7 @@ from multiscale.macro import eigen, modal  # noqa: E402
 from multiscale.macro import mesh as two_body  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
 from multiscale.macro.output import write_modes  # noqa: E402
+from multiscale.rough import interface_plane  # noqa: E402
 from multiscale import scene as scenes  # noqa: E402
 from multiscale.workflows import squeal  # noqa: E402
 from multiscale.workflows.output import RunResult  # noqa: E402
@@ -340,3 +341,12 @@ def test_multiscale_run_hands_stability_scenes_to_the_squeal_analysis(tmp_path, 
                                                   "scene_resolved.toml"]      # the provenance beside
     with pytest.raises(InputError, match="no checkpoints"):
         workflows.run(scene, resume=True)
+
+
+def test_the_pads_extent_before_meshing_is_the_meshs(brake):
+    """The extent of each pad's face in its plane that `check` compares a measured surface with
+    (``describe``, before meshing) is the one a run's zones cover (the mesh's), to 1e-9."""
+    extents = disc_brake.describe(COARSE).interface_extents
+    for name in ("inner_pad", "outer_pad"):
+        _, lo, hi = interface_plane(brake[0], name)
+        np.testing.assert_allclose(hi - lo, extents[name], rtol=1e-9)

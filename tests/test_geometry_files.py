@@ -734,3 +734,64 @@ def test_a_point_in_plain_numbers_is_in_metres_and_a_miss_says_so(tmp_path, caps
                         '"18.5 mm"]?')
     err = check(tmp_path, capsys, text.replace('contains = ["0 mm", "60 mm", "5 mm"]', 'contains = ["0 mm", "60 m", 0]'))
     assert err.endswith("contains this point [m]")            # not all plain numbers: no guess
+
+
+# a pad on the face of a disc whose axis lies in the x-y plane, 30 degrees from x: the interface's
+# normal is neither z nor a coordinate axis (e_u = x projected on the plane, e_v along z)
+TILTED_GEO = """SetFactory("OpenCASCADE");
+Cylinder(1) = {0, 0, 0, 10, 0, 0, 100};
+Cylinder(2) = {0, 0, 0, 10, 0, 0, 40};
+BooleanDifference(3) = { Volume{1}; Delete; }{ Volume{2}; Delete; };
+Box(4) = {10, 60, -15, 8, 20, 30};
+Rotate {{0, 0, 1}, {0, 0, 0}, Pi/6} { Volume{3, 4}; }"""
+
+
+def _turned(x, y, z):
+    """The point (x, y, z) [mm] turned 30 degrees about z, as a scene's list of lengths."""
+    c, s = np.cos(np.pi / 6), np.sin(np.pi / 6)
+    return "[" + ", ".join(f'"{v:.6f} mm"' for v in (c * x - s * y, s * x + c * y, z)) + "]"
+
+
+@pytest.mark.parametrize("kind", ["msh", "step", "geo"])
+def test_an_interface_face_is_measured_before_meshing(files, tmp_path, kind):
+    """A planar interface's extent in its plane's frame comes from the file before meshing (for
+    check's refusal of a measured surface that does not cover it): the pin's 20 x 20 mm, as the
+    builder says, to 1e-9 (gmsh's own boxes of OpenCASCADE faces are 2e-7 m larger: 1e-5 here)."""
+    spec = scene_for(files, kind, tmp_path).geometry.spec
+    assert spec.interface_extents.keys() == {"pin"}
+    assert pin_on_disc.describe(SIZES).interface_extents == {"interface": (0.02, 0.02)}
+    np.testing.assert_allclose(spec.interface_extents["pin"], (0.02, 0.02), rtol=1e-9)
+
+
+def test_a_tilted_interface_face_is_measured_in_its_plane(tmp_path):
+    """The pad's 20 x 30 mm face on a disc turning about an axis 30 degrees from x: 20 mm along e_u
+    (x projected on the plane: the face's horizontal side), 30 mm along e_v (z), to 1e-9, not its
+    box's 12.5 x 17.3 x 30 mm."""
+    (tmp_path / "tilted.geo").write_text(TILTED_GEO)
+    text = f"""effects = ["contact"]
+[geometry]
+file = "tilted.geo"
+unit = "mm"
+mesh_size = "15 mm"
+rotating = "disc"
+axis = [{np.cos(np.pi / 6)}, {np.sin(np.pi / 6)}, 0]
+[geometry.bodies.disc]
+contains = {_turned(5, 60, 0)}
+material = "steel"
+[geometry.bodies.pad]
+contains = {_turned(14, 70, 0)}
+material = "steel"
+[geometry.surfaces.back]
+contains = {_turned(18, 70, 0)}
+[materials.steel]
+E = "210 GPa"
+nu = 0.3
+[interface]
+penalty = "1e13 Pa/m"
+[loading]
+faces = ["back"]
+normal_force = "100 N"
+"""
+    spec = loads(text, tmp_path).geometry.spec
+    assert spec.interface_extents.keys() == {"pad"}
+    np.testing.assert_allclose(spec.interface_extents["pad"], (0.02, 0.03), rtol=1e-9)

@@ -1,6 +1,7 @@
 """Measured surfaces in use (issue 17): `multiscale surface FILE` (steps, statistics, figure),
 scenes with `[roughness] file = ...` (validated by `multiscale check` from the file itself), and the
 zones the one rough-interface builder makes from them."""
+import dataclasses
 import subprocess
 import sys
 import warnings
@@ -12,6 +13,7 @@ import SurfaceTopography as ST
 
 from multiscale.cli import main
 from multiscale.errors import InputError, SceneError
+from multiscale.micro.topography import condition, cover, read_topography
 from multiscale.scene import loads
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -85,7 +87,7 @@ def test_scene_reads_a_measured_file_with_its_options(tmp_path):
     assert (r.file, r.channel, r.detrend, r.cutoff, r.cover, r.seed, r.max_undefined) == (
         TOP, 0, "poly2", pytest.approx(2e-7), "equivalent", 4, 0.2)
     assert r.pixel_size is None and r.height_unit is None and s.warnings == ()
-    over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"')
+    over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "tile"')
     assert over.warnings == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",)
 
 
@@ -132,12 +134,15 @@ def test_zones_from_a_measured_file_for_every_cover(tmp_path):
                                  lo, (2e-6, 1e-6), seed=0, log=lines.append)
     assert len(zones) == 4 and zones[0].shape == (32, 64) and grid.size == pytest.approx((1e-6, 0.5e-6))
     assert any(line.startswith("roughness: warning: roughness.cover = \"mirror\"") for line in lines)
-    # the measurement as it is: its own pixels, rounded to whole cells per zone
-    grid, zones = make_zones(scene(tmp_path, f'file = "{TOP}"'), lo, (0.3e-6, 0.3e-6), seed=0)
+    # the measurement as it is: its own pixels, rounded to whole cells per zone (on the faces given
+    # here: the scene's 10 mm block, which it cannot cover, is refused when the scene is read)
+    tiled = scene(tmp_path, f'file = "{TOP}"\ncover = "tile"')
+    as_is = dataclasses.replace(tiled.roughness, cover="measured")
+    grid, zones = rough.make_zones(as_is, tiled.micro, lo, (0.3e-6, 0.3e-6), seed=0)
     assert zones[0].shape == (64, 64) and zones[0].surface.dx == pytest.approx(0.15e-6 / 64)
     with pytest.raises(InputError, match=r'roughness\.cover = .measured.: the measurement \(0\.0006 x 0\.0006 mm\) '
                                          r'does not cover the interface'):
-        make_zones(scene(tmp_path, f'file = "{TOP}"'), lo, (1e-6, 1e-6), seed=0)
+        rough.make_zones(as_is, tiled.micro, lo, (1e-6, 1e-6), seed=0)
     # a statistically equivalent face: 50 x 50 cells per zone unless micro.grid says otherwise, seeded
     eq = scene(tmp_path, f'file = "{TOP}"\ncover = "equivalent"\nseed = 3')
     lines = []
@@ -154,6 +159,37 @@ def test_zones_from_a_measured_file_for_every_cover(tmp_path):
     assert lines[0].startswith("roughness: read top-1.top") and not any("overrides" in line for line in lines)
 
 
+def test_a_measurement_smaller_than_the_face_is_refused_by_check_before_meshing(tmp_path):
+    """A measurement used as it is (cover = "measured") that does not cover the interface passed
+    `multiscale check` and was refused by a run after meshing. Now check refuses it, and a run
+    stops before meshing, with the run's own message, from the builder's face (the block's
+    10 x 10 mm); one that covers the face passes."""
+    rng = np.random.default_rng(1)
+    np.save(tmp_path / "short.npy", rng.normal(0.0, 1e-6, (64, 48)))      # 9.6 x 12.8 mm at 200 um
+    np.save(tmp_path / "wide.npy", rng.normal(0.0, 1e-6, (64, 64)))       # 12.8 x 12.8 mm
+    for name in ("short", "wide"):
+        (tmp_path / f"{name}.toml").write_text(SCENE.format(
+            roughness=f'file = "{name}.npy"\npixel_size = "200 um"', micro="grid = [16, 16]").replace(
+            'folder = "../results/block_on_flat"', f'folder = "{tmp_path / name}"'))
+    code = ("import sys; from multiscale.cli import main; rcs = [main([c, sys.argv[1]]) for c in ('check', 'run')]; "
+            "heavy = sorted(m for m in sys.modules if m.split('.')[0] in ('dolfinx', 'gmsh')); "
+            "assert not heavy, heavy; sys.exit(max(rcs))")
+    result = subprocess.run([sys.executable, "-c", code, str(tmp_path / "short.toml")], capture_output=True, text=True)
+    # the run's refusal of that face (multiscale.workflows.rough.measured_face, after meshing)
+    measured = read_topography(tmp_path / "short.npy", pixel_size=2e-4)
+    with pytest.raises(InputError) as later:
+        cover(condition(measured).surface, (32, 32), (10e-3, 10e-3), "measured", prefix="roughness.")
+    message = ("roughness.cover = 'measured': the measurement (9.6 x 12.8 mm) does not cover the interface (10 x 10 mm): "
+               'use "equivalent" (a statistically equivalent surface) or "mirror"/"tile" (copies)')
+    assert str(later.value) == message
+    assert result.returncode == 2, result.stderr
+    assert result.stderr.splitlines() == [f"error: {message}", f"{tmp_path / 'short.toml'}: 1 problem",
+                                          f"error: {message}"]
+    assert main(["check", str(tmp_path / "wide.toml")]) == 0
+    # other covers than "measured" take a small measurement (with a warning, at the run)
+    assert scene(tmp_path, 'file = "short.npy"\npixel_size = "200 um"\ncover = "tile"').roughness.cover == "tile"
+
+
 def test_a_rewritten_measured_file_changes_the_runs_fingerprint(tmp_path):
     """``--resume`` compares fingerprints: a measured surface rewritten under the same name makes
     another one (before, the resume went on: the checkpoint's worn heights against the new file's
@@ -162,7 +198,7 @@ def test_a_rewritten_measured_file_changes_the_runs_fingerprint(tmp_path):
     from multiscale.workflows.multiscale import fingerprint
     heights = np.random.default_rng(1).normal(size=(64, 64))
     np.save(tmp_path / "pad.npy", heights)
-    text = 'file = "pad.npy"\npixel_size = "1 um"\nheight_unit = "um"'
+    text = 'file = "pad.npy"\npixel_size = "1 um"\nheight_unit = "um"\ncover = "tile"'
     before = fingerprint(scene(tmp_path, text))
     np.save(tmp_path / "pad.npy", heights)
     assert fingerprint(scene(tmp_path, text)) == before
@@ -201,7 +237,7 @@ def test_a_missing_option_is_named_without_a_python_value(tmp_path, capsys):
 def test_a_pixel_size_of_a_millimetre_or_more_is_refused(tmp_path, pixel, problem):
     """pixel_size = 10 is a 10 m pixel (plain numbers are metres) and passed check silently (an
     adversarial review); a measured surface's pixel is far below 1 mm."""
-    np.save(tmp_path / "pad.npy", np.random.default_rng(1).normal(0.0, 1e-6, (8, 8)))
+    np.save(tmp_path / "pad.npy", np.random.default_rng(1).normal(0.0, 1e-6, (24, 24)))    # 12 mm at 0.5 mm
     with pytest.raises(SceneError) as info:
         scene(tmp_path, f'file = "pad.npy"\npixel_size = {pixel}')
     assert info.value.problems == [problem]

@@ -14,10 +14,10 @@ the areal Gaussian filter of ISO 16610-61 (the L-filter, cut-off wavelength λc:
 S-L surface). ``resample`` puts a surface on another grid (the micro grid) with an anti-aliasing
 S-filter when it coarsens.
 
-Covering an interface (``cover``): the measurement itself (it must cover the interface), mirrored or
-tiled copies (with a warning: wavelengths longer than the measurement are missing and the pattern
-repeats), or a statistically equivalent surface drawn from the measured PSD
-(``multiscale.micro.spectrum.equivalent_surface``).
+Covering an interface (``cover``): the measurement itself (it must cover the interface: ``covers``,
+which ``multiscale check`` asks before meshing), mirrored or tiled copies (with a warning:
+wavelengths longer than the measurement are missing and the pattern repeats), or a statistically
+equivalent surface drawn from the measured PSD (``multiscale.micro.spectrum.equivalent_surface``).
 """
 from __future__ import annotations
 
@@ -450,13 +450,10 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
 
     Returns the (non-periodic) surface and report lines.
     """
-    if method not in COVER:
-        raise InputError(f"{prefix}cover", method, f"one of {', '.join(COVER)}")
     nx, ny = check_pair(f"{prefix}n", n, check_count)
     Lx, Ly = check_pair(f"{prefix}size", size, check_positive)
-    mx, my = surface.size
-    wide = f"the measurement ({mx * 1e3:.4g} x {my * 1e3:.4g} mm)"
-    target = f"the interface ({Lx * 1e3:.4g} x {Ly * 1e3:.4g} mm)"
+    short = not covers(surface.size, (Lx, Ly), method, prefix)
+    wide, target = _sized("the measurement", surface.size), _sized("the interface", (Lx, Ly))
     if method == "equivalent":
         spectrum = power_spectrum(surface)
         s = equivalent_surface(spectrum, (nx, ny), (Lx, Ly), seed)
@@ -467,10 +464,6 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
                    f"{2 * max(Lx / nx, Ly / ny) * 1e6:.4g} um, the measurement "
                    f"{2 * max(surface.dx, surface.dy) * 1e6:.4g} um)"]
     lines, filtered = [], False
-    short = mx < Lx * (1 - 1e-6) or my < Ly * (1 - 1e-6)
-    if short and method == "measured":
-        raise InputError(f"{prefix}cover", method, f"{wide} does not cover {target}: use \"equivalent\" (a "
-                         "statistically equivalent surface) or \"mirror\"/\"tile\" (copies)")
     if short:
         base = surface
         if method == "mirror":
@@ -508,3 +501,24 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
     out, note = resample(crop, (nx, ny), (Lx, Ly), antialias=not filtered)
     lines.append(note)
     return Surface(out.heights - out.heights.mean(), out.dx, out.dy, periodic=False), lines
+
+
+def covers(measured, size, method: str = "measured", prefix: str = "") -> bool:
+    """Whether a measurement of ``measured`` = (mx, my) [m] covers a face of ``size`` = (Lx, Ly) [m]
+    (to 1e-6 of the face); if not, and ``method`` (one of ``COVER``) is "measured", the InputError
+    of ``cover``. ``multiscale check`` asks it with the face's extent before meshing, a run with
+    the mesh's."""
+    if method not in COVER:
+        raise InputError(f"{prefix}cover", method, f"one of {', '.join(COVER)}")
+    (mx, my), (Lx, Ly) = measured, size
+    short = mx < Lx * (1 - 1e-6) or my < Ly * (1 - 1e-6)
+    if short and method == "measured":
+        raise InputError(f"{prefix}cover", method, f"{_sized('the measurement', measured)} does not cover "
+                         f"{_sized('the interface', size)}: use "
+                         "\"equivalent\" (a statistically equivalent surface) or \"mirror\"/\"tile\" (copies)")
+    return not short
+
+
+def _sized(what: str, size) -> str:
+    """``what`` and its size (x, y) [m] in mm, as the messages of ``cover`` give them."""
+    return f"{what} ({size[0] * 1e3:.4g} x {size[1] * 1e3:.4g} mm)"
