@@ -540,6 +540,7 @@ class Multiscale:
                   **({"plastic": self.rough.plastic} if self.plastic else {}),    # else zero: not stored
                   "conductance": self.conductance, "flash": self.flash, "counter_depth": self.counter_depth,
                   "exchange": self.exchange, "levels": self.rough.levels, "heat_total": m.heat_total,
+                  "interface_heat_total": m.interface_heat_total,
                   "heat_lost_recorded": m.heat_lost_recorded, "datum_gap": self.datum_gap,
                   **({"lost_total": m.thermal.lost_total} if m.thermal is not None else {}),
                   **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
@@ -567,7 +568,8 @@ class Multiscale:
         self.counter_volume = float(attrs["counter_volume"])
         m.heat_exchanged, m.heat_exchanged_total = (float(v) for v in attrs["heat_exchanged"])
         self.exchange = arrays["exchange"]
-        m.heat_total = arrays["heat_total"].copy()
+        unknown = np.full(len(self.tm.interface.tags), np.nan)           # absent from older checkpoints
+        m.heat_total, m.interface_heat_total = arrays["heat_total"].copy(), arrays.get("interface_heat_total", unknown)
         m.heat_lost_recorded = arrays["heat_lost_recorded"].copy()
         if m.thermal is not None:
             m.thermal.lost_total = arrays["lost_total"].copy()

@@ -241,6 +241,69 @@ def test_each_interface_has_its_own_friction_and_its_own_results(tmp_path):
     assert ratio["outer_pad"] == pytest.approx(0.4, rel=1e-3)           # magnitudes: all of the pad slides
 
 
+def heated_brake(folder, inner_friction: float = 0.4):
+    """The 20 mm disc brake with heat: 50 rad/s, friction 0.4 (``inner_friction`` on the inner pad),
+    30 % of the frictional heat into the pads, two 0.1 s steps, constant materials, no conductance
+    between the bodies and no expansion (a linear heat problem on a fixed pressure field)."""
+    thermal = {f"materials.{m}.{k}": v for m in ("disc", "pad", "backplate", "piston", "caliper")
+               for k, v in (("kappa", "1.5 W/(m K)" if m == "pad" else "40 W/(m K)"), ("c", "500 J/(kg K)"))}
+    return load(ROOT / "demos" / "brake_squeal.toml", {
+        **BRAKE, "output.folder": str(folder), "output.fields": [],
+        "effects": ["contact", "friction", "thermal", "heat_partition"], "interface.partition": 0.3,
+        "interfaces.inner_pad.friction": inner_friction, "loading.rotation_speed": "50 rad/s",
+        "time": {"end": "0.2 s", "steps": 2}, **thermal})
+
+
+PADS = ("inner_pad", "outer_pad")
+
+
+def test_each_pad_has_its_own_frictional_heat_and_face_temperatures(tmp_path):
+    """Per pad: the frictional heat generated on it (``frictional_heat_step/total_<pad>``) and the
+    face temperatures. (a) The pads' heat sums to the heat into both bodies to 1e-9 (the same
+    facet integrals). (b) Halving the inner pad's friction at the same pressure halves its heat
+    (mu p |w| per facet; measured 0.49988: friction moves the pressure a little) and leaves the
+    outer pad's (measured 3e-5); the pad's face heats half as much, the heat problem being linear
+    and the pad getting only its own pad's heat (measured 0.4984). At equal friction the pads
+    differ: the outer pad, pressed by the fingers, carries its load further out (392 J against
+    421 J a step at equal normal forces)."""
+    h = {mu: run(heated_brake(tmp_path / f"mu{mu}", mu), verbose=False).history for mu in (0.4, 0.2)}
+    for history in h.values():
+        for kind in ("step", "total"):
+            pads = sum(history[f"frictional_heat_{kind}_{p}"] for p in PADS)
+            bodies = history[f"heat_{kind}_brake"] + history[f"heat_{kind}_disc"]
+            assert bodies[-1] > 100.0
+            np.testing.assert_allclose(pads, bodies, rtol=1e-9, atol=0.0)
+    half = {p: h[0.2][f"frictional_heat_total_{p}"][1:] / h[0.4][f"frictional_heat_total_{p}"][1:] for p in PADS}
+    np.testing.assert_allclose(half["inner_pad"], 0.5, rtol=1e-3)
+    np.testing.assert_allclose(half["outer_pad"], 1.0, rtol=1e-3)
+    rise = {mu: h[mu]["face_mean_temperature_inner_pad_on_brake"][1:] - 293.15 for mu in h}
+    assert np.all(rise[0.4] > 1.0)
+    np.testing.assert_allclose(rise[0.2] / rise[0.4], 0.5, rtol=1e-2)
+
+
+def test_a_pads_face_temperatures_are_those_of_its_facets(tmp_path):
+    """``face_max_temperature_<pad>_on_<body>`` is the largest facet-mean temperature of the pad's
+    facets (``Thermal.facet_temperature``), at most the body's largest nodal temperature;
+    ``face_mean_temperature_<pad>_on_<body>`` is the pad's integral of the temperature trace over
+    its area, assembled over its tag (dS_tag) here: equal to 1e-12."""
+    import ufl
+    from multiscale.workflows.model import build_model
+    model = build_model(heated_brake(tmp_path / "out"))
+    model.start()
+    heat = model.macro_step(0.1)
+    row, iface, thermal = model.record(heat), model.tm.interface, model.thermal
+    for side, body in enumerate(("brake", "disc")):
+        trace = thermal.T[0]("+") if side == 0 else thermal.T[1]("-")
+        for name, mask in iface.masks().items():
+            assert row[f"face_max_temperature_{name}_on_{body}"] == thermal.facet_temperature(side)[mask].max()
+            assert row[f"face_max_temperature_{name}_on_{body}"] <= row[f"max_temperature_{body}"]
+            mean = (model.tm.assemble_scalar(trace * iface.dS_tag[name])
+                    / model.tm.assemble_scalar(ufl.as_ufl(1.0) * iface.dS_tag[name]))
+            assert row[f"face_mean_temperature_{name}_on_{body}"] == pytest.approx(mean, rel=1e-12)
+            assert mean > 293.15 + 0.1
+    model.close()
+
+
 def test_a_rough_interface_beside_one_in_perfect_contact(tmp_path):
     """Rough inner pad, perfect outer pad: zone laws only on the inner pad's zones, both pads carry
     the clamp force (the rigid datum gap on the rough one, the penalty on the other)."""

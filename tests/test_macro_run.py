@@ -205,7 +205,7 @@ def test_the_sliding_power_leaves_the_speed_and_the_heating_as_they_were(tmp_pat
     c.speed.value, c.heating.value = 20.9, 0.5
     unit = model.sliding_power()
     assert (float(c.speed.value), float(c.heating.value)) == (20.9, 0.5)
-    assert unit == pytest.approx(sum(c.heat_power()) / (20.9 * 0.5), rel=1e-12)
+    assert unit == pytest.approx(c.facet_heat_power().sum() / (20.9 * 0.5), rel=1e-12)
 
 
 def test_a_wear_update_deeper_than_the_roughness_is_warned_about(tmp_path):

@@ -164,11 +164,12 @@ class ContactInterface:
             F0, F1 = (G0, G1) if F0 is None else (F0 + G0, F1 + G1)
         return F0, F1
 
-    def heat_power(self) -> tuple[float, float]:
-        """Frictional heat power into body 0 and body 1 [W] at the current state."""
+    def facet_heat_power(self) -> np.ndarray:
+        """Frictional heat power [W] per interface facet (global order, every rank) into body 0 and
+        into body 1 at the current state, (n_facets, 2)."""
         Q = self.cache.facet_integrals("q", lambda: self.heat_flux)     # W per facet
         p1 = self.tm.interface.values(self.partition)                    # constant per facet
-        return float((p1 * Q).sum()), float(((1 - p1) * Q).sum())
+        return np.column_stack((p1 * Q, (1 - p1) * Q))
 
     def facet_heat_flux(self) -> np.ndarray:
         """Mean frictional heat flux per interface facet [W/m^2] (global order)."""

@@ -74,6 +74,10 @@ class MacroModel:
     drive: Drive
     time: float = 0.0                                  # s
     heat_total: np.ndarray = field(default_factory=lambda: np.zeros(2))   # J, frictional heat in
+    # J, frictional heat generated on each interface (``tm.interface.tags``, into both bodies): the last step's
+    # and since the start
+    interface_heat: np.ndarray = field(init=False)
+    interface_heat_total: np.ndarray = field(init=False)
     heat_lost_recorded: np.ndarray = field(default_factory=lambda: np.zeros(2))   # J, lost at the last record
     heat_exchanged: float = 0.0                        # J, body 0 -> body 1 through the conductance, last step
     heat_exchanged_total: float = 0.0                  # J, since the start
@@ -87,6 +91,9 @@ class MacroModel:
     @property
     def contact(self):
         return self.mechanics.contact
+
+    def __post_init__(self):
+        self.interface_heat, self.interface_heat_total = np.zeros((2, len(self.tm.interface.tags)))
 
     def close(self) -> None:
         """Destroy the PETSc objects of the mechanics, then of the heat problem (collective: call it
@@ -146,6 +153,7 @@ class MacroModel:
         significant digits (``outputs.step_time``): output times are exact decimals, not sums of
         rounded steps."""
         heat, self.heat_exchanged, self.work_step = np.zeros(2), 0.0, 0.0
+        facet_heat = np.zeros(self.tm.interface.n_facets)        # J, into both bodies
         delta, start = dt / substeps, self.time
         for k in range(substeps):
             t0, t1 = self.time, self.time + delta
@@ -167,6 +175,7 @@ class MacroModel:
                 self.contact.heating.value = self.drive.mean_sliding(t0, t1) / speed * scale if speed else 0.0
                 done = self.thermal.step(delta)
                 heat += done.heat_in
+                facet_heat += done.facet_heat.sum(axis=1)
                 self.heat_exchanged += done.heat_exchanged
             self.time = step_time(start, dt) if k == substeps - 1 else start + (k + 1) * delta
             self.contact.speed.value = self.speed(self.time)
@@ -185,6 +194,9 @@ class MacroModel:
                 self.keep_torque(factor)
                 self.contact.speed.value = speed
         self.heat_total += heat
+        iface = self.tm.interface
+        self.interface_heat = np.bincount(iface.tag_index, facet_heat, minlength=len(iface.tags))
+        self.interface_heat_total += self.interface_heat
         self.heat_exchanged_total += self.heat_exchanged
         return heat
 
@@ -211,6 +223,22 @@ class MacroModel:
                 return
             self.load *= target / moment
             self.last_solve = self.mechanics.solve(self.load * factor)
+
+    def interface_heat_row(self, masks: dict) -> dict:
+        """Per interface (``masks``: its facets): the frictional heat generated on it [J] in the last
+        step and since the start (into both bodies: the interfaces' sum is the bodies'
+        ``heat_step_<body>`` and ``heat_total_<body>``), and on each body's face of it the largest
+        facet-mean temperature and the area-weighted mean temperature [K] (``Thermal.facet_temperature``:
+        global arrays, the same on every rank)."""
+        row, areas = {}, self.tm.interface.areas
+        faces = [self.thermal.facet_temperature(side) for side in (0, 1)]
+        for k, (name, m) in enumerate(masks.items()):
+            row[f"frictional_heat_step_{name}"] = float(self.interface_heat[k])
+            row[f"frictional_heat_total_{name}"] = float(self.interface_heat_total[k])
+            for body, T in zip(self.tm.bodies, faces):
+                row[f"face_max_temperature_{name}_on_{body.name}"] = float(T[m].max())
+                row[f"face_mean_temperature_{name}_on_{body.name}"] = float(T[m] @ areas[m] / areas[m].sum())
+        return row
 
     def sliding(self, t0: float, t1: float) -> float:
         """Sliding of body 1 over [t0, t1] weighted by the load (rad or m): the integral of
@@ -250,7 +278,8 @@ class MacroModel:
         """The state a step starts from (fields, time, heat counters, drive constants, the speed and
         load of the last solve: a pass of a fixed point that solved at a start or a stop is undone)."""
         state = {"arrays": [f.x.array.copy() for f in self.functions.values()], "time": self.time,
-                 "heat_total": self.heat_total.copy(), "exchanged": self.heat_exchanged_total,
+                 "heat_total": self.heat_total.copy(), "interface_heat_total": self.interface_heat_total.copy(),
+                 "exchanged": self.heat_exchanged_total,
                  "last_solve": self.last_solve, "constants": [float(c.value) for c in self.drive_constants],
                  "solved_speed": self.solved_speed, "load": self.load}
         if self.thermal is not None:
@@ -265,7 +294,7 @@ class MacroModel:
         for c, value in zip(self.drive_constants, state["constants"]):
             c.value = value
         self.time, self.heat_total, self.last_solve = state["time"], state["heat_total"].copy(), state["last_solve"]
-        self.heat_exchanged_total = state["exchanged"]
+        self.heat_exchanged_total, self.interface_heat_total = state["exchanged"], state["interface_heat_total"].copy()
         self.solved_speed, self.load = state["solved_speed"], state["load"]
         if self.thermal is not None:
             self.thermal.time = state["thermal_time"]
@@ -275,7 +304,8 @@ class MacroModel:
         """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal
         boundary conditions, ``heat_lost_step_<body>`` is the heat lost since the previous record.
         ``friction_force`` (in all and per interface) sums the friction forces' magnitudes over the
-        facets, mu times the normal force where all slides: opposite pads do not cancel."""
+        facets, mu times the normal force where all slides: opposite pads do not cancel. With several
+        interfaces and heat, ``interface_heat_row`` gives each one's heat and face temperatures."""
         on = not self.released
         friction = np.linalg.norm(self.contact.facet_friction(), axis=1) * on     # N per facet, magnitudes
         row = {"time": self.time, "interface_force": self.last_solve.normal_force * on,
@@ -289,6 +319,8 @@ class MacroModel:
                 row[f"interface_force_{name}"] = float(p[m] @ self.tm.interface.areas[m])
                 row[f"friction_force_{name}"] = float(friction[m].sum())
                 row[f"max_pressure_{name}"] = float(p[m].max(initial=0.0))
+            if self.thermal is not None:
+                row.update(self.interface_heat_row(masks))
         if self.thermal is not None:
             stored, hottest, coldest = self.thermal.stored_heat(), self.thermal.max_temperature(), \
                 self.thermal.min_temperature()

@@ -157,6 +157,7 @@ class ThermalStep:
     max_temperature: tuple         # K, per body
     heat_lost: tuple = (0.0, 0.0)  # J, heat lost through the boundary conditions of each body
     heat_exchanged: float = 0.0    # J, conducted from body 0 to body 1 through the interface conductance
+    facet_heat: np.ndarray | None = None   # J, frictional heat per interface facet into body 0 and 1, (n, 2)
 
 
 class Thermal:
@@ -445,7 +446,7 @@ class Thermal:
         for a in self.applied:
             if a.h is not None:
                 a.h.value = a.condition.h(speed)
-        power = self.contact.heat_power() if self.frictional_heat else (0.0, 0.0)
+        power = self.contact.facet_heat_power() if self.frictional_heat else np.zeros((self.tm.interface.n_facets, 2))
         for new, old in zip(self.T, self.T_old):
             old.x.array[:] = new.x.array
         ok = self._solve()                                        # the same answer on every rank
@@ -489,8 +490,8 @@ class Thermal:
         self.lost_step = self._losses(dt)
         self.lost_total += self.lost_step
         lost = self.lost_step.sum(axis=0)
-        return ThermalStep(self.time, (power[0] * dt, power[1] * dt), self.max_temperature(),
-                           (float(lost[0]), float(lost[1])), dt * self.exchange_power() if self.conductance else 0.0)
+        return ThermalStep(self.time, tuple(dt * power.sum(axis=0)), self.max_temperature(), tuple(map(float, lost)),
+                           dt * self.exchange_power() if self.conductance else 0.0, dt * power)
 
     def _note_backtracking(self, dt: float) -> None:
         """The first step that converged only with backtracking, said once: a note for the run's
@@ -554,8 +555,7 @@ class Thermal:
 
     def max_temperature(self) -> tuple:
         """Largest nodal temperature of each body [K]."""
-        comm = self.tm.comm
-        return tuple(comm.allreduce(T.x.array.max(initial=-np.inf), op=MPI.MAX) for T in self.T)
+        return tuple(self.tm.comm.allreduce(T.x.array.max(initial=-np.inf), op=MPI.MAX) for T in self.T)
 
     @cached_property
     def material_dofs(self) -> tuple:

@@ -1,4 +1,5 @@
-"""Two MPI ranks give the same pin-on-disc history as one (run: mpiexec -n 2 python -m pytest tests/mpi)."""
+"""Two MPI ranks give the same pin-on-disc history as one, and the same heated disc brake's (two
+interfaces: per-pad heat and face temperatures); run: mpiexec -n 2 python -m pytest tests/mpi."""
 import json
 import sys
 from pathlib import Path
@@ -18,6 +19,7 @@ from multiscale.scene import loads  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from test_macro_run import pin_on_disc  # noqa: E402
+from test_duty_cycle import PADS, heated_brake  # noqa: E402
 
 
 def scene(folder):
@@ -68,3 +70,26 @@ def test_the_unloaded_state_on_two_ranks():
     t.test_a_uniform_rise_expands_the_bodies_freely(tm)
     t.test_a_linear_temperature_bends_the_free_block_without_stress(tm)
     t.test_a_held_flat_is_stressed_as_the_linear_elasticity_solved_directly(tm)
+
+
+def test_two_ranks_give_the_serial_per_pad_heat(tmp_path):
+    """The heated disc brake's history on two ranks is the serial one (1e-8), and its per-pad
+    columns (frictional heat, face temperatures: from global facet arrays) are the same on both
+    ranks to the last bit."""
+    world = MPI.COMM_WORLD
+    assert world.size == 2, "run under mpiexec -n 2"
+    base = world.bcast(str(tmp_path), root=0)
+    parallel = run(heated_brake(f"{base}/parallel"), comm=world, verbose=False).history
+    serial = None
+    if world.rank == 0:
+        serial = run(heated_brake(f"{base}/serial"), comm=MPI.COMM_SELF, verbose=False).history
+    serial = world.bcast(serial.columns if serial is not None else None, root=0)
+    assert set(serial) == set(parallel.columns)
+    pads = [k for k in serial if k.startswith(("frictional_heat_", "face_"))]
+    # per pad: heat of the step and in all, max and mean temperature on each body's face
+    assert len(pads) == len(PADS) * (2 + 2 * 2) and parallel["frictional_heat_total_inner_pad"][-1] > 100.0
+    for key in (k for k in serial if not solver_statistic(k)):
+        np.testing.assert_allclose(parallel[key], serial[key], rtol=1e-8, atol=1e-8, err_msg=key)
+    on_rank_0 = world.bcast({k: parallel[k] for k in pads}, root=0)
+    for key in pads:
+        np.testing.assert_array_equal(parallel[key], on_rank_0[key], err_msg=key)
