@@ -40,3 +40,24 @@ def test_a_body_of_several_materials_has_one_visible_named_curve_per_material(tm
         assert [n for n in curves if n != "micro"] == names
         assert len(set(curves.values())) == len(curves)          # no curve drawn over another
         np.testing.assert_allclose(curves[prefix + "pin, disc material"], [21.85, 22.85, 23.85])
+
+
+def test_the_pads_heat_and_face_temperatures_have_their_own_panels(tmp_path, drawn):
+    """A brake's per-pad columns: the frictional heat of each pad in a panel of its own (not among
+    the bodies' heat_total_<body>, which they would double), the hottest facet of each face in
+    another, named "<pad> on <body>"; six panels in two rows."""
+    history = History()
+    for t in (0.0, 1.0, 2.0):
+        pads = {f"frictional_heat_total_{p}": k * t for k, p in ((1, "inner_pad"), (2, "outer_pad"))}
+        faces = {f"face_max_temperature_{p}_on_{b}": 300.0 + k * t
+                 for k, (p, b) in enumerate([(p, b) for p in ("inner_pad", "outer_pad") for b in ("brake", "disc")])}
+        history.append(time=t, interface_force=200.0, max_pressure=1e6, max_temperature_brake=310.0 + t,
+                       max_temperature_disc=305.0 + t, heat_total_brake=t, heat_total_disc=2 * t, **pads, **faces)
+    plots.history_figure(history, tmp_path / "history.png")
+    shown = [ax for ax in drawn[0].axes if ax.get_visible()]
+    assert len(shown) == 6 and len(drawn[0].axes) == 6
+    curves = {ax.get_ylabel(): [line.get_label() for line in ax.get_lines()] for ax in shown}
+    assert curves["heat into body [J]"] == ["brake", "disc"]
+    assert curves["frictional heat per interface [J]"] == ["inner pad", "outer pad"]
+    assert curves["max face temperature [°C]"] == ["inner pad on brake", "inner pad on disc", "outer pad on brake",
+                                                   "outer pad on disc"]

@@ -2,12 +2,13 @@
 loop (thesis ch. 7) and the wear map.
 
 ``history_figure``: interface force, max contact pressure, max temperatures and heat into each body
-against time. ``multiscale_figure``: max contact pressure macro (facets, zones) vs micro (Fig. 7.14;
-log scale, linear with a note if no row has contact), max temperature macro vs micro (Fig. 7.15),
-heat partition min/mean/max (Fig. 7.12), wear volume (Fig. 7.16), max wear depth (Fig. 7.17) and
-RMS of the worn surface (Fig. 7.18) — the panels whose columns the history has. ``wear_map``: the
-mean wear depth of every zone over the interface (Fig. 7.13) beside the micro wear depth field of
-the whole face.
+against time, and with several interfaces and heat each one's frictional heat and the hottest facet
+of each face (two rows of panels then). ``multiscale_figure``: max contact pressure macro (facets,
+zones) vs micro (Fig. 7.14; log scale, linear with a note if no row has contact), max temperature
+macro vs micro (Fig. 7.15), heat partition min/mean/max (Fig. 7.12), wear volume (Fig. 7.16), max
+wear depth (Fig. 7.17) and RMS of the worn surface (Fig. 7.18) — the panels whose columns the
+history has. ``wear_map``: the mean wear depth of every zone over the interface (Fig. 7.13) beside
+the micro wear depth field of the whole face.
 """
 from __future__ import annotations
 
@@ -18,9 +19,11 @@ from matplotlib.figure import Figure
 
 
 def column_label(key: str) -> str:
-    """Legend of a per-body column: max_temperature_outer_pad -> "outer pad",
-    max_temperature_pin_in_disc -> "pin, disc material" (the pin's cells of material disc)."""
-    for prefix in ("max_temperature_", "heat_total_"):
+    """Legend of a per-body or per-interface column: max_temperature_outer_pad -> "outer pad",
+    max_temperature_pin_in_disc -> "pin, disc material" (the pin's cells of material disc),
+    face_max_temperature_inner_pad_on_disc -> "inner pad on disc" (the disc's face of interface
+    inner_pad)."""
+    for prefix in ("max_temperature_", "heat_total_", "frictional_heat_total_", "face_max_temperature_"):
         key = key.removeprefix(prefix)
     body, within, material = key.partition("_in_")
     return body.replace("_", " ") + (f", {material.replace('_', ' ')} material" if within else "")
@@ -35,16 +38,25 @@ def temperature_columns(columns) -> list[str]:
 
 
 def history_figure(history, path: Path, title: str = "") -> Path:
-    """PNG of the history: force, max pressure, max temperatures, heat per body vs time."""
+    """PNG of the history: force, max pressure, max temperatures, heat per body (and per
+    interface, max face temperatures) vs time."""
     t = history["time"]
     groups = [("interface force [N]", ["interface_force"], 1.0, 0.0),
               ("max contact pressure [MPa]", ["max_pressure"], 1e-6, 0.0),
               ("max temperature [°C]", temperature_columns(history.columns), 1.0, -273.15),
-              ("heat into body [J]", [k for k in history.columns if k.startswith("heat_total")], 1.0, 0.0)]
+              ("heat into body [J]", [k for k in history.columns if k.startswith("heat_total")], 1.0, 0.0),
+              ("frictional heat per interface [J]",
+               [k for k in history.columns if k.startswith("frictional_heat_total_")], 1.0, 0.0),
+              ("max face temperature [°C]", [k for k in history.columns if k.startswith("face_max_temperature_")],
+               1.0, -273.15)]
     groups = [g for g in groups if g[1] and all(k in history.columns for k in g[1])]
-    fig = Figure(figsize=(4.2 * len(groups), 3.4))
-    axes = fig.subplots(1, len(groups), squeeze=False)
-    for ax, (label, keys, scale, shift) in zip(axes[0], groups):
+    rows = 1 if len(groups) <= 4 else 2
+    cols = -(-len(groups) // rows)
+    fig = Figure(figsize=(4.2 * cols, 3.4 * rows))
+    axes = fig.subplots(rows, cols, squeeze=False).ravel()
+    for ax in axes[len(groups):]:
+        ax.set_visible(False)
+    for ax, (label, keys, scale, shift) in zip(axes, groups):
         for key in keys:
             ax.plot(t, history[key] * scale + shift, "o-", ms=3, label=column_label(key) if len(keys) > 1 else None)
         ax.set_xlabel("time [s]")
