@@ -298,6 +298,53 @@ def test_a_second_ctrl_c_is_held_and_a_third_abandons_the_step_but_not_a_write()
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler      # restored
 
 
+
+@pytest.mark.parametrize("kind", ["transient", "multiscale"])
+def test_an_abandoned_step_leaves_the_plots_and_paraview_script_of_what_was_written(tmp_path, monkeypatch, kind):
+    """Three Ctrl-C during step 2 abandon it (``StepStop``): history.png (and multiscale.png) are
+    drawn from history.h5 as written (t = 0 and step 1) and paraview.py opens the fields written,
+    as after a stop at the end of a step (before: the run ended with neither history.png nor
+    paraview.py; the loop writes history.h5 alone)."""
+    import json
+    import signal
+
+    from test_coupling import POD
+
+    from multiscale import outputs
+    from multiscale.coupling import Multiscale
+    from multiscale.io import History
+    from multiscale.macro.model import MacroModel
+    from multiscale.plots.history import history_figure, multiscale_figure
+    from multiscale.scene import loads
+    from multiscale.workflows import run
+    folder = tmp_path / "out"
+    scene = loads((SCENE if kind == "transient" else POD).format(folder=folder))
+    cls, name = (MacroModel, "macro_step") if kind == "transient" else (Multiscale, "step")
+    original, calls = getattr(cls, name), []
+
+    def abandoned(self, *args):
+        calls.append(args)
+        if len(calls) == 2:
+            for _ in range(3):                   # the third abandons the step
+                os.kill(os.getpid(), signal.SIGINT)
+                time.sleep(0.01)
+        return original(self, *args)
+    monkeypatch.setattr(cls, name, abandoned)
+    with pytest.raises(KeyboardInterrupt, match="during step 2, abandoned: the results of step 1 are the last "
+                                                "written"):
+        run(scene, verbose=False)
+    status = json.loads((folder / "provenance.json").read_text())["status"]
+    assert status == "interrupted during step 2, abandoned: the results of step 1 are the last written"
+    history = History.read(folder / "history.h5")
+    assert len(history) == 2
+    plots = [("history.png", history_figure)] + ([("multiscale.png", multiscale_figure)] if kind == "multiscale"
+                                                 else [])
+    for png, figure in plots:                    # the figure of the history written, nothing else
+        figure(history, tmp_path / png, scene.name)
+        assert (folder / png).read_bytes() == (tmp_path / png).read_bytes(), png
+    assert (folder / "paraview.py").read_text() == outputs.paraview_script(outputs.plan(scene))
+
+
 def test_a_second_ctrl_c_while_the_run_stops_leaves_its_results_whole(tmp_path):
     """Two Ctrl-C a moment apart (the second once the first is acknowledged): the run still stops
     after its step with every result of that step written: history, fields, plot, paraview.py and

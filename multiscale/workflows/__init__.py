@@ -19,6 +19,7 @@ from mpi4py import MPI
 from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError, Interrupted, interrupted
 from multiscale.micro.wear import STEP_RMS, SUBSTEP_TOL
+from multiscale.plots.history import history_figure, multiscale_figure
 from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.output import RunResult
@@ -64,6 +65,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                                  warnings=[*scene.warnings, *(exc.warnings if isinstance(exc, Interrupted) else ())])
                 if isinstance(exc, Interrupted):          # stopped after a step: its results are written
                     _write_script(reporter.folder, scene)
+                elif stopped:                             # a step abandoned: the plots of what was written
+                    _abandoned(reporter.folder, scene)
             if stopped and not isinstance(exc, KeyboardInterrupt):
                 raise KeyboardInterrupt from None          # not PETSc's error 101 around it
             raise
@@ -90,6 +93,24 @@ def _write_script(folder: Path, scene) -> Path:
     path = Path(folder) / "paraview.py"
     path.write_text(outputs.paraview_script(outputs.plan(scene)))
     return path
+
+
+def _abandoned(folder: Path, scene) -> None:
+    """After a Ctrl-C that abandoned a step (the third, ``io.StepStop``) or came outside the steps
+    of a run with a history (rank 0): history.png (and a multiscale run's multiscale.png) drawn
+    from history.h5 as written (the loop writes each step's row whole) and paraview.py once a
+    field file is written. The zone results of a multiscale run (zones.h5, wear maps) need the
+    state of its last step: they stay as they were."""
+    kind, h5 = workflow(scene), Path(folder) / "history.h5"
+    if kind == "squeal":
+        return
+    if h5.is_file():
+        history = io.History.read(h5)
+        history_figure(history, h5.with_name("history.png"), title=scene.name)
+        if kind == "multiscale":
+            multiscale_figure(history, h5.with_name("multiscale.png"), scene.name)
+    if any((Path(folder) / name).is_file() for name in outputs.plan(scene).field_files):
+        _write_script(folder, scene)
 
 
 def run_warnings(scene, history) -> list[str]:
