@@ -66,15 +66,12 @@ class History:
     def write(self, path: Path, attrs: dict | None = None) -> Path:
         """Write every column as a dataset (attribute ``unit``) of an HDF5 file, replacing ``path``
         at once (written beside it first: a run killed while writing leaves the previous file)."""
-        path = Path(path)
-        part = path.with_name(path.name + ".part")
-        with h5py.File(part, "w") as f:
+        with replacing(path) as part, h5py.File(part, "w") as f:
             for key, values in self.columns.items():
                 f.create_dataset(key, data=np.asarray(values)).attrs["unit"] = unit_of(key)
             for key, value in (attrs or {}).items():
                 f.attrs[key] = value
-        os.replace(part, path)
-        return path
+        return Path(path)
 
     @classmethod
     def read(cls, path: Path) -> "History":
@@ -83,6 +80,22 @@ class History:
         with h5py.File(path, "r") as f:
             h.columns = {key: list(f[key][...]) for key in f.keys()}
         return h
+
+
+@contextmanager
+def replacing(path: Path):
+    """``with replacing(path) as part:`` write the new ``path`` into ``part`` (``<name>.part``
+    beside it), which then replaces ``path`` at once: a run killed while writing leaves the
+    previous file and the part (``--overwrite`` clears it, ``provenance.results_of``); a write
+    that fails deletes the part and leaves the previous file."""
+    path = Path(path)
+    part = path.with_name(path.name + ".part")
+    try:
+        yield part
+    except BaseException:
+        part.unlink(missing_ok=True)
+        raise
+    os.replace(part, path)
 
 
 def on_root(comm, write, what: str):

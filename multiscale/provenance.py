@@ -18,6 +18,7 @@ from importlib import metadata
 from pathlib import Path
 
 from multiscale import __version__
+from multiscale.io import replacing
 from multiscale.outputs import plan
 from multiscale.schema import (Choice, Curve, Either, FilePath, ListOf, Named, OnlyWith, Quantity, Section, TableOr,
                                Tables, fields_of)
@@ -198,17 +199,18 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     folder = Path(folder)
     given = scene.source.read_text(encoding="utf-8") if scene.source and scene.source.is_file() else \
         "# The scene came from text, not a file: here it is as resolved.\n" + resolved_toml(scene)
-    paths = [folder / "scene.toml", folder / "scene_resolved.toml", folder / "provenance.json"]
-    paths[0].write_text(given, encoding="utf-8")
-    paths[1].write_text(resolved_toml(scene), encoding="utf-8")
     record = {"status": status, "analysis": analysis, "scene": str(scene.source or scene.name),
               "command": list(sys.argv if command is None else command), "ranks": ranks,
               "start": started, "end": None if status == RUNNING else now(),
               "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()},
               "total_wall_time_s": round(wall_time, 3), "versions": versions(), "files": sorted(plan(scene).files),
               "warnings": list(warnings)}
-    paths[2].write_text(json.dumps(record, indent=2) + "\n", encoding="utf-8")
-    return paths
+    texts = {"scene.toml": given, "scene_resolved.toml": resolved_toml(scene),
+             "provenance.json": json.dumps(record, indent=2) + "\n"}
+    for name, text in texts.items():              # each replaced whole: a killed run leaves the earlier one
+        with replacing(folder / name) as part:
+            part.write_text(text, encoding="utf-8")
+    return [folder / name for name in texts]
 
 
 def entries(n: int) -> str:

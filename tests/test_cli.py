@@ -340,6 +340,36 @@ def test_overwrite_deletes_what_the_run_before_wrote_and_keeps_the_rest(tmp_path
         in stream.getvalue()
 
 
+
+def test_a_provenance_write_that_fails_midway_leaves_the_earlier_record(tmp_path, monkeypatch):
+    """The record is replaced whole: a write of provenance.json that fails after half its text (a
+    full disk; a kill leaves its .part, which --overwrite clears) leaves the earlier record as it
+    was, readable with its files, and no file beside it (before: the record was written in place
+    and left truncated, so results_of no longer knew the folder's results)."""
+    import errno
+
+    from multiscale import provenance
+    folder = tmp_path / "out"
+    scene = _scene_into(tmp_path, folder)
+    folder.mkdir()
+    provenance.write(folder, scene, ranks=1, started=provenance.now(), stages={}, wall_time=0.0,
+                     status=provenance.RUNNING)
+    before = sorted(folder.iterdir())
+    earlier = (folder / "provenance.json").read_text()
+    written = Path.write_text
+
+    def half_then_full(path, text, *args, **kwargs):
+        if path.name.startswith("provenance.json"):
+            written(path, text[:len(text) // 2], *args, **kwargs)
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return written(path, text, *args, **kwargs)
+    monkeypatch.setattr(Path, "write_text", half_then_full)
+    with pytest.raises(OSError, match="No space left on device"):
+        provenance.write(folder, scene, ranks=1, started=provenance.now(), stages={"meshing": 1.0}, wall_time=1.0)
+    assert (folder / "provenance.json").read_text() == earlier and sorted(folder.iterdir()) == before
+    assert "block.xdmf" in provenance.results_of(folder)
+
+
 def test_overwrite_keeps_the_earlier_results_when_the_run_fails_before_writing(tmp_path, capsys):
     """run --overwrite of a scene refused at meshing (--max-cells): the earlier run's results and
     its provenance stay as they were (before: deleted, then the refusal); the same run that meshes
