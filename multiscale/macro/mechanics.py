@@ -267,7 +267,7 @@ class Mechanics:
             f"PETSC_OPTIONS: {' '.join(unused)} had no effect: the contact Newton's preconditioner is its own kept "
             f"factorisation, whose options are under -{prefix}factor_ (e.g. -{prefix}factor_pc_factor_mat_solver_type"
             f"); -{prefix}pc_type would replace it by PETSc's"]
-        for note in self.notes:
+        for note in self.notes if tm.comm.rank == 0 else ():     # once a run, as the heat's (Thermal._say)
             warnings.warn(note, SolverOptionWarning, stacklevel=2)
         if P is not None:
             self.problem.P_mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
