@@ -1,6 +1,7 @@
 """Scenes through the workflows: only the requested effects are built; files a run writes."""
 import json
 import math
+import re
 from pathlib import Path
 
 import numpy as np
@@ -328,7 +329,7 @@ def test_resume_of_a_scene_without_checkpoints_names_the_option_without_a_value(
 
 
 def test_the_run_summary_counts_its_records_in_english(tmp_path, capsys):
-    """A one-step run said "block: 1 records in 0.3 s" (an adversarial review)."""
+    """A one-step run said "block: 1 records in 0.3 s" (an adversarial review), and "on 1 rank(s)"."""
     result = run(loads(BLOCK.format(effects='"contact"', folder=tmp_path / "out")), verbose=True)
     assert len(result.history) == 1
-    assert "block: 1 record in " in capsys.readouterr().out
+    assert re.search(r"^block: 1 record in [0-9.]+ s on 1 rank$", capsys.readouterr().out, re.MULTILINE)

@@ -29,6 +29,7 @@ from ufl.algorithms import expand_derivatives
 from ufl.algorithms.analysis import extract_coefficients, extract_constants
 
 from multiscale.errors import InputError
+from multiscale.io import counted
 
 
 def integrals(form, cells: bool):
@@ -137,7 +138,7 @@ def check_user_options(comm, prefix: str, ours: Mapping | None = None) -> None:
             raise InputError("PETSC_OPTIONS", given, f"this PETSc cannot factorise (pc_type {factor}) by the package "
                              f"-{prefix}pc_factor_mat_solver_type asks for (error {MISSING_FACTOR}); it has "
                              f"{', '.join(factor_packages(A, factor)) or 'none'} for this factorisation on "
-                             f"{comm.size} rank(s)")
+                             f"{counted(comm.size, 'rank')}")
         if codes:
             raise InputError("PETSC_OPTIONS", given, f"PETSc refused one of these solver options (error {codes[0]}: "
                              "an unknown type or a value it cannot read); see PETSc's manual pages for the choices")

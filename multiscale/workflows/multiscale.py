@@ -189,7 +189,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         raise Interrupted(f"after step {done} of {steps}", result.warnings)
     if verbose and comm.rank == 0:
         print(f"{scene.name}: {io.counted(len(history), 'record')} ({done}/{steps} steps) in "
-              f"{result.wall_time:.1f} s on {comm.size} rank(s)")
+              f"{result.wall_time:.1f} s on {io.counted(comm.size, 'rank')}")
         print(f"  ParaView: {', '.join(str(f) for f in result.field_files)}")
         print(f"  history:  {h5}  plots: {', '.join(str(p) for p in [png, plot] + maps)}")
     return result

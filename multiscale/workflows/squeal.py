@@ -283,8 +283,8 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         print(f"{scene.name}: {len(case.modes)} modes up to {case.modes.frequency.max():.0f} Hz, "
               f"{rep.unstable.size} unstable"
               + (f" ({', '.join(f'{f:.0f} Hz' for f in rep.frequency[rep.unstable - 1])})" if rep.unstable.size else "")
-              + ", "
-              f"{rep.potentially_unstable.size} potentially unstable; {result.wall_time:.1f} s on {comm.size} rank(s)")
+              + f", {rep.potentially_unstable.size} potentially unstable; {result.wall_time:.1f} s on "
+              f"{io.counted(comm.size, 'rank')}")
         if case.prestress is not None:
             shift = case.prestress.shift
             print(f"  prestress shifts the frequencies by {np.nanmin(shift):+.2f} to {np.nanmax(shift):+.2f} Hz")

@@ -88,7 +88,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
                              writer.files, warnings=run_notes(model))
     if verbose and comm.rank == 0:
         print(f"{scene.name}: {io.counted(len(history), 'record')} in {result.wall_time:.1f} s on "
-              f"{comm.size} rank(s)")
+              f"{io.counted(comm.size, 'rank')}")
         print(f"  ParaView: {', '.join(str(f) for f in writer.files)}")
         print(f"  history:  {h5}  plot: {png}")
     return result
