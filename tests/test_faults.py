@@ -193,6 +193,24 @@ def test_a_full_disk_at_the_history_is_one_clear_error(tmp_path, monkeypatch):
         run(loads(SCENE.format(folder=tmp_path / "out")), verbose=False)
 
 
+
+def test_a_factorisation_package_petsc_lacks_ends_both_ranks_with_one_input_error(tmp_path):
+    """``PETSC_OPTIONS="-heat_pc_factor_mat_solver_type superlu"`` (a package this PETSc lacks,
+    ``kept_cells.check_user_options``) for ``multiscale run`` under mpiexec -n 2: every rank meets
+    the InputError building the model, so the job ends within the timeout, exit code 2, with the
+    one line of rank 0 (not a rank's own "error (rank k of 2)" and an abort) and no PETSc error."""
+    scene = tmp_path / "scene.toml"
+    scene.write_text(SCENE.format(folder=tmp_path / "out"))
+    command = [str(MPIEXEC), "-n", "2", str(Path(sys.executable).with_name("multiscale")), "run", str(scene)]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=120, start_new_session=True,
+                          env={**os.environ, "PETSC_OPTIONS": "-heat_pc_factor_mat_solver_type superlu"})
+    lines = [line for line in done.stderr.splitlines() if line.startswith("error")]
+    assert done.returncode == 2 and len(lines) == 1, done.stderr[-3000:]
+    assert re.fullmatch(r"error: PETSC_OPTIONS = '-heat_pc_factor_mat_solver_type superlu': this PETSc cannot "
+                        r"factorise \(pc_type lu\) .*; it has .*mumps.* for this factorisation on 2 ranks", lines[0])
+    assert "PETSC ERROR" not in done.stderr and "Traceback" not in done.stderr, done.stderr[-3000:]
+
+
 # ---------------------------------------------------------------- Ctrl-C
 def interrupt(tmp_path, ranks: int):
     """``multiscale run`` of the cooling block in 4000 heat steps, sent SIGINT (Ctrl-C; under
