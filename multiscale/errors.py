@@ -55,6 +55,11 @@ class ConvergenceError(MultiscaleError, RuntimeError):
         super().__init__(message)
 
 
+class ClosedError(MultiscaleError, RuntimeError):
+    """A model used to solve after its ``close()`` destroyed its PETSc solvers (its fields stay
+    readable): raised instead of PETSc's crash on the destroyed objects."""
+
+
 class Interrupted(KeyboardInterrupt):
     """Ctrl-C honoured at the end of a step (``multiscale.io.StepStop``): the results up to that
     step were written. The message says which ("after step 12 of 50"); ``warnings``: what the run

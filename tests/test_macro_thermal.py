@@ -8,7 +8,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from multiscale.errors import ConvergenceError
+from multiscale.errors import ClosedError, ConvergenceError
 from multiscale.references.thermal import (STEFAN_BOLTZMANN, kirchhoff_slab, kirchhoff_transform,
                                            lumped_convective_cooling, lumped_cooling_linear_capacity,
                                            radiative_cooling, slab_convection)
@@ -165,6 +165,28 @@ def test_a_closed_model_is_freed_with_its_communicators(boundary, free_communica
     gc.collect()
     assert [ref() for ref in alive] == [None, None]
     assert free_communicators() == before
+
+
+def test_a_closed_model_says_so_when_asked_to_solve():
+    """After ``MacroModel.close`` every way to solve raises ``ClosedError`` naming the closed model;
+    before, the first use of a destroyed PETSc object crashed the process (segfault, exit 139: a
+    macro step, a contact solve, a heat step, ``cell_system``, ``preload``). The fields stay
+    readable (the history row is the one before the close) and a second close does nothing."""
+    from multiscale.macro.preload import preload  # local: the squeal workflow's preload, used on a closed model
+    scene = block_scene(T0=800.0, end=2.0, steps=2)
+    model = march(scene)
+    row = model.record()
+    model.close()
+    model.close()
+    mech = model.mechanics
+    for call, owner in [(lambda: model.macro_step(scene.time.dt), "Thermal"), (model.start, "Mechanics"),
+                        (mech.solve, "Mechanics"), (lambda: mech.ramp(100.0), "Mechanics"),
+                        (mech.tangent, "Mechanics"), (mech.frictionless_tangent, "Mechanics"),
+                        (mech.cell_system, "Mechanics"), (mech.release, "Mechanics"),
+                        (lambda: preload(mech, 1e6), "Mechanics"), (lambda: model.thermal.step(1.0), "Thermal")]:
+        with pytest.raises(ClosedError, match=f"^{owner} is closed"):
+            call()
+    assert model.record() == row
 
 
 def test_radiation_against_the_lumped_solution():

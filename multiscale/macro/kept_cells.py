@@ -12,7 +12,8 @@ The Jacobian's matrix ignores exact zeros of the element matrices once its patte
 vector field are zeros, and every add searches its row (docs/architecture.md §5, the macro Newton).
 
 ``nonlinear_problem`` sets up the DOLFINx problem such a Jacobian belongs to (the contact's and the
-heat's Newton) with our solver options, the user's winning; ``destroy`` frees it.
+heat's Newton) with our solver options, the user's winning; ``destroy`` frees it, ``Closed`` stands
+for it after.
 """
 from __future__ import annotations
 
@@ -28,7 +29,7 @@ from petsc4py import PETSc
 from ufl.algorithms import expand_derivatives
 from ufl.algorithms.analysis import extract_coefficients, extract_constants
 
-from multiscale.errors import InputError
+from multiscale.errors import ClosedError, InputError
 from multiscale.io import counted
 
 
@@ -68,9 +69,22 @@ def nonlinear_problem(F, u, prefix: str, options: Mapping, **kwargs) -> fpetsc.N
             user.delValue(name)
 
 
-def destroy(problem: fpetsc.NonlinearProblem, *others) -> None:
+class Closed:
+    """A closed model's ``problem`` (``destroy``): any use raises ``ClosedError`` naming the model,
+    not PETSc's crash (a segfault) on its destroyed objects."""
+
+    def __init__(self, owner: str):
+        self.owner = owner
+
+    def __getattr__(self, name: str):
+        raise ClosedError(f"{self.owner} is closed: close() destroyed its PETSc solvers (asked for problem.{name}); "
+                          "its fields stay readable, but to solve again build a new model")
+
+
+def destroy(problem: fpetsc.NonlinearProblem, owner: str, *others) -> Closed:
     """Destroy ``problem``'s SNES (with its KSP and PC: their factors, and the callbacks PETSc
-    keeps), matrices and vectors, then the PETSc ``others`` (None skipped), in this order.
+    keeps), matrices and vectors, then the PETSc ``others`` (None skipped, one destroyed already a
+    no-op), in this order; returns what replaces ``problem`` in its ``owner`` (named: "Mechanics").
     Collective, on every rank in the same order: MUMPS' destruction communicates. Dropping is no
     substitute: PETSc keeps the callbacks (bound methods of their owner) in a dict of the C object
     that Python's cycle collector cannot see, so a problem never destroyed keeps its owner, meshes
@@ -80,6 +94,7 @@ def destroy(problem: fpetsc.NonlinearProblem, *others) -> None:
     for obj in (problem.solver, problem.A, problem.P_mat, problem.b, problem.x, *others):
         if obj is not None:
             obj.destroy()
+    return Closed(owner)
 
 
 @contextmanager

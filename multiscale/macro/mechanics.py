@@ -30,7 +30,7 @@ from multiscale.errors import ConvergenceError, InputError, check_positive
 from multiscale.macro import mumps
 from multiscale.macro.compact_factor import CompactFactor
 from multiscale.macro.interface import ContactInterface, PressureLaw
-from multiscale.macro.kept_cells import (KeptCells, SolverOptionWarning, assemble, backtracking, check_user_options,
+from multiscale.macro.kept_cells import (Closed, KeptCells, SolverOptionWarning, assemble, backtracking, check_user_options,
                                          destroy, integrals, nonlinear_problem, options_named, user_options)
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
@@ -310,10 +310,11 @@ class Mechanics:
 
     def close(self) -> None:
         """Destroy the Newton's PETSc objects, factors first (``kept_cells.destroy``: collective, on
-        every rank in the same order); the model is unusable after, and freed when dropped."""
-        self.factors.reset(None)
-        destroy(self.problem, None if self._pc_mat is self.problem.P_mat else self._pc_mat, self._offset, self._start,
-                self._step, self._frictionless[0] if self._frictionless else None, *(k.bulk for k in self._split))
+        every rank in the same order); freed when dropped. A solve after raises ``ClosedError``."""
+        if not isinstance(self.problem, Closed):              # (a second close does nothing)
+            self.factors.reset(None)
+            self.problem = destroy(self.problem, "Mechanics", self._pc_mat, self._offset, self._start, self._step,
+                                   self._frictionless and self._frictionless[0], *(k.bulk for k in self._split))
 
     # ---- forms -----------------------------------------------------------------------------
     def _frictionless_jacobian(self) -> list:
@@ -580,10 +581,10 @@ class Mechanics:
         owned by the Mechanics and overwritten when an input of it changes), r_0 a new vector, the
         cell residual at u = 0 (minus the thermal load [N], 0 on the supports' rows). Collective;
         the displacements are kept."""
+        r0 = self.problem.b.duplicate()          # (ClosedError after close, before a destroyed matrix is used)
+        r0.setAttr("_blocks", self._blocks)
         self._split[0].update()
         kept = [u.x.array.copy() for u in self.u]
-        r0 = self._offset.duplicate()
-        r0.setAttr("_blocks", self._blocks)
         try:
             for u in self.u:
                 u.x.array[:] = 0.0

@@ -122,9 +122,7 @@ ENTHALPY_QUADRATURE = 3                # e(T) r with a tabulated rho c, P1 (same
 CHORD_CONTRACTION = 0.01               # keep the Newton tangent while ||F_k|| <= this times ||F_k-1|| (0: never)
 FACTOR_PRECISION = "single"            # the Newton's LU factors (mumps.precision); a linear step's stay double
 BACKTRACKED = "converged only with a backtracking line search"     # in the note of the first such step
-
-
-TRANSPORT_DEGREE = 2    # Lagrange degree of the temperature of a rotating body (its Eulerian transport)
+TRANSPORT_DEGREE = 2                   # Lagrange degree of the temperature of a rotating body (Eulerian transport)
 
 
 def temperature_functions(tm) -> list:
@@ -250,8 +248,9 @@ class Thermal:
             self.problem.solver.setMonitor(self._watch)
 
     def close(self) -> None:
-        """Destroy the solver's PETSc objects (collective, ``Mechanics.close``); unusable after."""
-        kept_cells.destroy(self.problem, self._factored, self._tangent.bulk if self._tangent else None)
+        """Destroy the solver's PETSc objects (collective, ``Mechanics.close``); then ``ClosedError``."""
+        if not isinstance(self.problem, kept_cells.Closed):
+            self.problem = kept_cells.destroy(self.problem, "Thermal", self._factored, self._tangent and self._tangent.bulk)
 
     # ---- forms -----------------------------------------------------------------------------
     def _dx(self, i: int, degree: int | None = None, scheme: str | None = None):
