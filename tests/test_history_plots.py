@@ -61,3 +61,29 @@ def test_the_pads_heat_and_face_temperatures_have_their_own_panels(tmp_path, dra
     assert curves["frictional heat per interface [J]"] == ["inner pad", "outer pad"]
     assert curves["max face temperature [°C]"] == ["inner pad on brake", "inner pad on disc", "outer pad on brake",
                                                    "outer pad on disc"]
+
+
+def test_nine_pads_have_distinct_curves_and_legends_inside_their_panels(tmp_path, drawn):
+    """The railway disc's 9 pucks (demos/railway_drag.toml): history.png drew the 18 face curves in
+    matplotlib's 10 colours (puck 1 on disc and puck 6 on disc alike) with a legend of 18 lines
+    taller than its panel, over the panel above and its curves. Now each curve of a panel differs in
+    colour or line style (the pad's colour, the body's style) and every legend lies within its panel."""
+    history = History()
+    pads = [f"puck_{k}" for k in range(1, 10)]
+    for t in (0.0, 10.0, 20.0):
+        history.append(time=t, interface_force=6e3, max_pressure=3e6, max_temperature_disc=300.0 + t,
+                       max_temperature_fixed=300.0 + t, heat_total_disc=t, heat_total_fixed=2 * t,
+                       **{f"frictional_heat_total_{p}": k * t for k, p in enumerate(pads)},
+                       **{f"face_max_temperature_{p}_on_{b}": 300.0 + k * t + j
+                          for k, p in enumerate(pads) for j, b in enumerate(("disc", "fixed"))})
+    plots.history_figure(history, tmp_path / "history.png")
+    figure = drawn[0]
+    figure.canvas.draw()
+    for ax in figure.axes:
+        lines = ax.get_lines()
+        assert len({(str(line.get_color()), line.get_linestyle()) for line in lines}) == len(lines), ax.get_ylabel()
+        legend = ax.get_legend()
+        if legend is not None:
+            inside, box = legend.get_window_extent(), ax.get_window_extent()
+            assert (inside.x0 >= box.x0 - 1 and inside.x1 <= box.x1 + 1 and inside.y0 >= box.y0 - 1
+                    and inside.y1 <= box.y1 + 1), ax.get_ylabel()

@@ -15,7 +15,12 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from matplotlib import colormaps
 from matplotlib.figure import Figure
+from matplotlib.lines import Line2D
+
+LEGEND_ROWS = 6                 # entries in a legend column before it takes another
+BODY_STYLES = ("-", "--", ":", "-.")
 
 
 def column_label(key: str) -> str:
@@ -35,6 +40,25 @@ def temperature_columns(columns) -> list[str]:
     of those and would hide under one of them."""
     hot = [k for k in columns if k.startswith("max_temperature")]
     return [k for k in hot if not any(j.startswith(k + "_in_") for j in hot)]
+
+
+def curve_styles(keys) -> tuple[list[dict], list]:
+    """The colour and line style of each column of a panel, and its legend's entries (a Line2D
+    each): a colour per column, or for faces (face_max_temperature_<interface>_on_<body>) a colour
+    per interface and a line style per body, each named once (9 pads on 2 bodies: 11 entries, and
+    no two curves alike; tab10 repeats its colours beyond 10)."""
+    faces = [column_label(k).rpartition(" on ") for k in keys]
+    faced = all(on for _, on, _ in faces) and len(keys) > 1
+    names = list(dict.fromkeys(pad for pad, _, _ in faces)) if faced else [column_label(k) for k in keys]
+    bodies = list(dict.fromkeys(body for _, _, body in faces)) if faced else []
+    cmap = colormaps["tab10" if len(names) <= 10 else "tab20" if len(names) <= 20 else "turbo"]
+    colour = {n: cmap(k if len(names) <= 20 else k / (len(names) - 1)) for k, n in enumerate(names)}
+    style = {b: BODY_STYLES[k % len(BODY_STYLES)] for k, b in enumerate(bodies)}
+    if not faced:
+        return [{"color": colour[n], "ls": "-"} for n in names], []
+    entries = [Line2D([], [], color=colour[n], label=n) for n in names]
+    entries += [Line2D([], [], color="0.4", ls=style[b], label=f"on {b}") for b in bodies]
+    return [{"color": colour[pad], "ls": style[body]} for pad, _, body in faces], entries
 
 
 def history_figure(history, path: Path, title: str = "") -> Path:
@@ -57,8 +81,10 @@ def history_figure(history, path: Path, title: str = "") -> Path:
     for ax in axes[len(groups):]:
         ax.set_visible(False)
     for ax, (label, keys, scale, shift) in zip(axes, groups):
-        for key in keys:
-            ax.plot(t, history[key] * scale + shift, "o-", ms=3, label=column_label(key) if len(keys) > 1 else None)
+        styles, entries = curve_styles(keys)
+        for key, style in zip(keys, styles):
+            ax.plot(t, history[key] * scale + shift, marker="o", ms=3, label=column_label(key) if len(keys) > 1 else None,
+                    **style)
         ax.set_xlabel("time [s]")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
@@ -67,7 +93,9 @@ def history_figure(history, path: Path, title: str = "") -> Path:
             centre = values.mean()
             ax.set_ylim(centre - 0.05 * abs(centre) - 1e-30, centre + 0.05 * abs(centre) + 1e-30)
         if len(keys) > 1:
-            ax.legend()
+            handles = entries or ax.get_lines()
+            ax.legend(handles=handles, fontsize="medium" if len(handles) <= LEGEND_ROWS else "x-small",
+                      ncol=-(-len(handles) // LEGEND_ROWS))
     fig.suptitle(f"{title}: interface force, contact pressure, temperatures and heat against time" if title else
                  "interface force, contact pressure, temperatures and heat against time")
     fig.tight_layout()
