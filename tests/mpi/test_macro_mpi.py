@@ -26,16 +26,24 @@ def scene(folder):
     return loads(pin_on_disc(folder, name="pod_mpi", partition="0.14"), overrides={"loading.ramp_steps": 2})
 
 
-def test_two_ranks_give_the_serial_history(tmp_path):
+def histories(make, base: str):
+    """The history columns of the scene ``make(folder)`` run on both ranks (in ``base``/parallel)
+    and on rank 0 alone (``base``/serial), the latter broadcast: (parallel, serial)."""
     world = MPI.COMM_WORLD
     assert world.size == 2, "run under mpiexec -n 2"
-    base = world.bcast(str(tmp_path), root=0)
-    parallel = run(scene(f"{base}/parallel"), comm=world, verbose=False).history
+    parallel = run(make(f"{base}/parallel"), comm=world, verbose=False).history
     serial = None
     if world.rank == 0:
-        serial = run(scene(f"{base}/serial"), comm=MPI.COMM_SELF, verbose=False).history
+        serial = run(make(f"{base}/serial"), comm=MPI.COMM_SELF, verbose=False).history
     serial = world.bcast(serial.columns if serial is not None else None, root=0)
     assert set(serial) == set(parallel.columns)
+    return parallel, serial
+
+
+def test_two_ranks_give_the_serial_history(tmp_path):
+    world = MPI.COMM_WORLD
+    base = world.bcast(str(tmp_path), root=0)
+    parallel, serial = histories(scene, base)
     assert parallel["interface_force"] == pytest.approx(200.0, rel=1e-6)
     for key in (k for k in serial if not solver_statistic(k)):
         np.testing.assert_allclose(parallel[key], serial[key], rtol=1e-8, atol=1e-8, err_msg=key)
@@ -77,14 +85,7 @@ def test_two_ranks_give_the_serial_per_pad_heat(tmp_path):
     columns (frictional heat, face temperatures: from global facet arrays) are the same on both
     ranks to the last bit."""
     world = MPI.COMM_WORLD
-    assert world.size == 2, "run under mpiexec -n 2"
-    base = world.bcast(str(tmp_path), root=0)
-    parallel = run(heated_brake(f"{base}/parallel"), comm=world, verbose=False).history
-    serial = None
-    if world.rank == 0:
-        serial = run(heated_brake(f"{base}/serial"), comm=MPI.COMM_SELF, verbose=False).history
-    serial = world.bcast(serial.columns if serial is not None else None, root=0)
-    assert set(serial) == set(parallel.columns)
+    parallel, serial = histories(heated_brake, world.bcast(str(tmp_path), root=0))
     pads = [k for k in serial if k.startswith(("frictional_heat_", "face_"))]
     # per pad: heat of the step and in all, max and mean temperature on each body's face
     assert len(pads) == len(PADS) * (2 + 2 * 2) and parallel["frictional_heat_total_inner_pad"][-1] > 100.0
