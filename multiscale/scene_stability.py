@@ -47,8 +47,9 @@ class Sweep:
     rules = (OneOf(tuple(SWEEP_PARAMETERS), required=True),)
 
     @property
-    def parameter(self) -> str:
-        return next(k for k in SWEEP_PARAMETERS if getattr(self, k) is not None)
+    def parameter(self) -> str | None:
+        """The swept key; None on a table whose values failed validation (the problem is reported)."""
+        return next((k for k in SWEEP_PARAMETERS if getattr(self, k) is not None), None)
 
     @property
     def preload_mode(self) -> str:

@@ -664,3 +664,21 @@ def test_a_squeal_analysis_of_a_duty_cycle_says_which_state_it_takes():
     swept = loads(text.replace('rotation_speed = "5 rad/s"', 'rotation_speed = "0 rad/s"'), name="brake",
                   overrides={"stability.sweep": {"speed": ["1 rad/s", "5 rad/s"]}}).warnings
     assert not [w for w in swept if "at rest" in w]
+
+
+@pytest.mark.parametrize("sweep, fragment", [
+    ("friction = [0.3]", "stability.sweep.friction = [0.3]: needs at least 2 item(s)"),
+    ("friction = [0.1, nan]", "stability.sweep.friction = [0.1, nan]: item 2 (nan): must be a finite number"),
+    ("points = 3", "stability.sweep.friction or stability.sweep.pressure or stability.sweep.speed or "
+                   "stability.sweep.rms: missing"),
+    ("frequency = [1, 2]", "stability.sweep.frequency: unknown key"),
+])
+def test_a_sweep_without_a_valid_parameter_is_a_problem_not_a_traceback(sweep, fragment):
+    """A [stability.sweep] whose swept values failed validation (one value, a NaN, none, an unknown
+    parameter) raised StopIteration from Sweep.parameter in the cross checks: `multiscale check`
+    printed a traceback, exit 1. Now the table's own problem is reported (SceneError, exit 2)."""
+    text = (DEMOS / "brake_squeal.toml").read_text() + f"\n[stability.sweep]\n{sweep}\n"
+    with pytest.raises(SceneError) as info:
+        loads(text, name="brake")
+    assert any(fragment in p for p in info.value.problems), info.value.problems
+    assert all(p.startswith("stability.sweep") for p in info.value.problems), info.value.problems
