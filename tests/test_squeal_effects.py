@@ -181,6 +181,24 @@ def test_scene_friction_sweep_writes_the_map(tmp_path):
     assert f_map[:8] == pytest.approx(run.case.modes.frequency[:8], rel=1e-4)    # measured 8e-6
 
 
+def test_a_mode_count_never_cuts_a_lock_in_pair_in_two(tmp_path):
+    """With stability.modes ending inside a lock-in pair (sigma +-57.7 1/s at 2670 Hz, modes 8 and 9
+    of the 20-mm demo brake), the direct analysis kept both (9 modes) but the projected solves kept
+    the stable member only: a friction map over [0.1, 0.6] said "0 unstable somewhere" where the
+    nominal mu = 0.4 is unstable. Now ``damped.select`` keeps every mode as near the target as the
+    last one (1e-8 relative)."""
+    w = 2 * np.pi * np.array([750.0, 2670.0, 2670.0, 2701.0])
+    lam = np.array([0, -57.7, 57.7, 0]) + 1j * w            # stable member first, as the solver gave
+    assert sorted(damped.select(lam, (0.0, 6e3), 2, 0.0)) == [0, 1, 2]
+    assert sorted(damped.select(lam, (0.0, 6e3), 1, 0.0)) == [0]
+    overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 8, "stability.band": ["0 Hz", "3 kHz"],
+                 "output.folder": str(tmp_path / "out"), "stability.sweep.friction": [0.1, 0.6]}
+    run = squeal.run(scenes.load(DEMO, overrides), verbose=False)          # quadratic elements, as the CLI
+    assert run.case.modes.frequency.size == 9 and run.case.modes.unstable().sum() == 1
+    assert run.map.unstable()[-1].sum() == 1                  # sigma = +79 1/s at mu = 0.6 (measured)
+    assert [o.kind for o in run.map.onsets] == ["lock-in"]    # bisected: mu = 0.127
+
+
 def test_scene_roughness_sweep_rebuilds_the_laws_and_frees_the_models(tmp_path):
     """An rms sweep rebuilds the zone laws and the mechanics at every point: its first point (the
     nominal R_q) gives the nominal analysis' modes; a rougher surface is more compliant (a lower

@@ -159,11 +159,14 @@ class ReducedSystem:
 
 
 def select(lam: np.ndarray, band, n_modes: int | None, target: float) -> np.ndarray:
-    """Indices of the eigenvalues in the band (the ``n_modes`` nearest ``target`` [Hz]), by frequency."""
+    """Indices of the eigenvalues in the band (the ``n_modes`` nearest ``target`` [Hz], and those as
+    near as the last to 1e-8 relative: a lock-in pair, sigma +-, is never cut in two), by frequency."""
     f = lam.imag / TWO_PI
     idx = np.nonzero((f >= band[0]) & (f <= band[1]))[0]
     if n_modes is not None and idx.size > n_modes:
-        idx = idx[np.argsort(np.abs(f[idx] - target), kind="stable")[:n_modes]]
+        gap = np.abs(f[idx] - target)
+        cut = np.sort(gap)[n_modes - 1]
+        idx = idx[gap <= cut + 1e-8 * (cut + abs(target))]
     return idx[np.lexsort((lam[idx].real, lam[idx].imag))]
 
 
