@@ -55,8 +55,8 @@ from petsc4py import PETSc
 from multiscale.errors import InputError
 from multiscale.macro.block_lanczos import ShiftInvert, m_orthonormalise, symmetric_modes
 from multiscale.macro.dense import mat_mult
-from multiscale.macro.eigen import (TWO_PI, Damping, ModalResult, lambda_from_theta, matrix_comm, reduce_sum,
-                                    solve_modes, solve_quadratic)
+from multiscale.macro.eigen import (TWO_PI, Damping, ModalResult, by_frequency, lambda_from_theta, matrix_comm,
+                                    reduce_sum, solve_modes, solve_quadratic)
 from multiscale.macro.modal import mac_matrix, pair_modes
 
 METHODS = ("auto", "projection", "quadratic", "subspace")
@@ -167,7 +167,7 @@ def select(lam: np.ndarray, band, n_modes: int | None, target: float) -> np.ndar
         gap = np.abs(f[idx] - target)
         cut = np.sort(gap)[n_modes - 1]
         idx = idx[gap <= cut + 1e-8 * (cut + abs(target))]
-    return idx[np.lexsort((lam[idx].real, lam[idx].imag))]
+    return idx[by_frequency(lam[idx])]
 
 
 def project(system: LinearSystem, sub: Subspace) -> tuple[ReducedSystem, dict]:

@@ -229,6 +229,16 @@ def mat_apply(A, phi: np.ndarray) -> np.ndarray:
     return out[:, :k] + 1j * out[:, k:]
 
 
+def by_frequency(lam: np.ndarray, rtol: float = 1e-9) -> np.ndarray:
+    """Indices ordering eigenvalues by frequency, then growth rate; frequencies within ``rtol``
+    relative count as equal, so that the members of a lock-in pair (sigma +-) are numbered stable
+    first whatever the rounding (it differed between 1 and 2 ranks)."""
+    order = np.lexsort((lam.real, lam.imag))
+    f = lam.imag[order]
+    group = np.concatenate([[0], np.cumsum(np.diff(f) > rtol * np.abs(f[1:]))])
+    return order[np.lexsort((lam.real[order], group))]
+
+
 def _sorted(lam, theta, vecs, errs, band, seen_f):
     """Modes sorted by frequency then growth; none (an empty band) is an InputError.
 
@@ -238,7 +248,7 @@ def _sorted(lam, theta, vecs, errs, band, seen_f):
         hint = (f"nearest found: {seen_f[np.argmin(np.minimum(abs(seen_f - band[0]), abs(seen_f - band[1])))]:.6g} Hz"
                 if seen_f.size else "none found")
         raise InputError("f_max", band, f"no eigenvalue in this frequency band [Hz]; widen it ({hint})")
-    order = np.lexsort((lam.real, lam.imag))
+    order = by_frequency(lam)
     return lam[order], theta[order], vecs[:, order], errs[order]
 
 
