@@ -90,6 +90,10 @@ class Sweep:
         if name == "speed" and not ({"friction_curve", "stribeck"} & set(loading) or stability.get("gyroscopic")):
             ctx.warnings.append(f"{where}: nothing of the linearised system depends on the speed (a constant "
                                 "friction, stability.gyroscopic = false): every point of the map is the same")
+        if name == "pressure" and not ("roughness" in ctx.effects or stability.get("prestress")):
+            ctx.warnings.append(f"{where}: nothing of the linearised system depends on the pressure (penalty contact "
+                                "without initial gaps scales with the load, stability.prestress = false): every point "
+                                "of the map is the same")
         return []
 
 

@@ -172,6 +172,7 @@ def test_scene_friction_sweep_writes_the_map(tmp_path):
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(set(plan(scene).files) - {"paraview.py"})
     smap = run.map
     np.testing.assert_allclose(smap.values, [0.0, 0.2, 0.4, 0.6])
+    assert f"(common basis of {smap.basis_size})" in smap.summary() and smap.basis_size > 0
     assert not smap.unstable()[0].any()                       # no friction: stable
     assert smap.unstable()[-1].any() and smap.onsets
     assert np.nanmax(smap.residual) < 0.05                    # measured 0.023
@@ -231,6 +232,7 @@ def test_scene_roughness_sweep_rebuilds_the_laws_and_frees_the_models(tmp_path):
     run = squeal.run(scene, degree=1, verbose=False)
     smap, nominal = run.map, run.case.modes.frequency
     np.testing.assert_allclose(smap.values, [5e-8, 2e-6])
+    assert "basis" not in smap.summary()                      # every point solved on its own (was "basis 0")
     f = [np.sort(smap.frequency[k][~np.isnan(smap.frequency[k])]) for k in range(2)]
     assert f[0][:8] == pytest.approx(nominal[:8], rel=1e-6)
     assert f[1][0] < 0.9 * f[0][0]                             # measured 830 against 1089 Hz
@@ -247,6 +249,23 @@ def test_a_speed_sweep_that_changes_nothing_is_warned_about(tmp_path):
                       "friction, stability.gyroscopic = false): every point of the map is the same"]
     assert not any("depends on the speed" in w
                    for w in scenes.load(DEMO, {**sweep, "stability.gyroscopic": True}).warnings)
+
+
+def test_a_pressure_sweep_that_changes_nothing_is_warned_about(tmp_path):
+    """Pressure sweep of a perfect-contact brake without prestress: linear elasticity, penalty
+    contact without initial gaps and Coulomb friction scale with the load, so the tangent and every
+    point of the map are the same (a helper's 5-15 bar sweep: 750.210388 Hz at each point; before, no
+    warning); with the prestress stiffness or rough laws the points differ, no warning."""
+    sweep = {"stability.sweep.pressure": ["5 bar", "15 bar"], "output.folder": str(tmp_path / "out")}
+    warned = [w for w in scenes.load(DEMO, sweep).warnings if "depends on the pressure" in w]
+    assert warned == ["stability.sweep.pressure: nothing of the linearised system depends on the pressure (penalty "
+                      "contact without initial gaps scales with the load, stability.prestress = false): every point "
+                      "of the map is the same"]
+    rough = {"effects": ["contact", "friction", "stability", "roughness"], "roughness.body": "brake",
+             "roughness.rms": "0.05 um", "roughness.hurst": 0.8, "roughness.k_min": 1, "roughness.k_max": 16,
+             "roughness.patch": "zone", "micro.zones": [4, 2], "micro.grid": [32, 32]}
+    for other in ({"stability.prestress": True}, rough):
+        assert not any("depends on the pressure" in w for w in scenes.load(DEMO, {**sweep, **other}).warnings)
 
 
 def test_scene_damping_and_stribeck_options(tmp_path):

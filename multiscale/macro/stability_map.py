@@ -95,8 +95,10 @@ class StabilityMap:
         """A few lines for the console: size, unstable tracks and onsets."""
         bad = self.unstable().any(axis=0)
         lines = [f"  stability map over {self.parameter} [{self.unit}] from {self.values[0]:g} to {self.values[-1]:g}: "
-                 f"{self.values.size} points, {self.n_tracks} tracked modes (basis {self.basis_size}), "
-                 f"{int(bad.sum())} unstable somewhere; max residual {np.nanmax(self.residual):.1e}; {self.time:.1f} s"]
+                 f"{self.values.size} points, {self.n_tracks} tracked modes"
+                 + (f" (common basis of {self.basis_size})" if self.basis_size else "")      # preload "once"
+                 + f", {int(bad.sum())} unstable somewhere; max residual {np.nanmax(self.residual):.1e}; "
+                 f"{self.time:.1f} s"]
         for o in self.onsets:
             if o.kind == BELOW:
                 lines.append(f"    track {o.track}: unstable at the first value already ({o.frequency:.0f} Hz): "
