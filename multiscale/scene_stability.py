@@ -109,7 +109,9 @@ class Stability:
     ``"subspace"``: projection on the real modes of the frictionless tangent and their static
     corrections, for models whose LU does not fit in memory (docs/squeal.md).
     ``prestress``: the initial-stress stiffness of the preload, its effect on every frequency
-    reported; ``gyroscopic``: the rotating body's Coriolis and centrifugal terms (docs/squeal.md)."""
+    reported; ``gyroscopic``: the rotating body's Coriolis and centrifugal terms (docs/squeal.md).
+    A mode is unstable when its damping ratio -sigma/|lambda| is below -``threshold`` (default 1e-6:
+    any growth beyond round-off; e.g. 1e-3 reports only modes growing faster than 0.1 % of critical)."""
 
     band: tuple = key(Pair(Quantity("frequency", ge=0), single=False, names="[low, high]"),
                       default=(0.0, 16e3))                                    # Hz
@@ -123,6 +125,7 @@ class Stability:
     friction_damping: bool = key(Flag(), default=True)
     method: str = key(Choice(("auto", "projection", "quadratic", "subspace")), default="auto")
     basis: float = key(Quantity("dimensionless", ge=1), default=1.5)
+    threshold: float = key(Quantity("dimensionless", gt=0, plausible=(1e-9, 0.05)), default=1e-6)   # damping ratio
     sweep: Sweep | None = key(Section(Sweep))
 
     def problems(self, path, ctx):

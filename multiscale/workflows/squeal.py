@@ -171,7 +171,7 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     try:
         return squeal_case(mech, dict(scene.materials), name, load=drive(model_scene(scene), tm).load,
                            steps=scene.loading.ramp_steps, band=tuple(st.band), n_modes=st.modes, target=st.target,
-                           energy=energy, options=squeal_options(scene, tm))
+                           energy=energy, rtol=st.threshold, options=squeal_options(scene, tm))
     except InputError as exc:        # the eigen solvers' arguments by their scene keys
         keys = {"f_min": ("stability.band", st.band), "f_max": ("stability.band", st.band),
                 "n_modes": ("stability.modes", st.modes)}

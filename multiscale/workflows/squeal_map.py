@@ -104,7 +104,7 @@ def stability_map(scene, tm, mech, options, load: float, rebuild: Callable) -> S
     t0 = time.perf_counter()
     st, sw = scene.stability, scene.stability.sweep
     model = MapModel(scene, tm, mech, options, load, rebuild)
-    builder = MapBuilder(sw.parameter, UNITS[sw.parameter], st.band, mac_min=sw.mac)
+    builder = MapBuilder(sw.parameter, UNITS[sw.parameter], st.band, mac_min=sw.mac, rtol=st.threshold)
     if sw.preload_mode == "once":
         size = _common_basis(model, builder, st, options)
     else:
