@@ -27,11 +27,11 @@ UNITS = {"time": "s", "force": "N", "pressure": "Pa", "temperature": "K", "heat"
 
 
 def unit_of(name: str) -> str:
-    """Unit of a history column from its name (e.g. max_temperature_pin -> K)."""
-    for word, unit in UNITS.items():
-        if word in name:
-            return unit
-    return "-"
+    """Unit of a history column from its name: the quantity word that comes first in it (e.g.
+    max_temperature_pin -> K; max_temperature_pressure_plate -> K: a body's or interface's name
+    follows the quantity, and a unit word in it does not count)."""
+    found = [(name.find(word), unit) for word, unit in UNITS.items() if word in name]
+    return min(found)[1] if found else "-"
 
 
 def solver_statistic(name: str) -> bool:

@@ -1,4 +1,5 @@
-"""The history figures (``multiscale.plots.history``): every curve visible and named once."""
+"""The history (``multiscale.io.History``, ``multiscale.plots.history``): units per column, every curve visible and named once."""
+import h5py
 import numpy as np
 import pytest
 
@@ -87,3 +88,17 @@ def test_nine_pads_have_distinct_curves_and_legends_inside_their_panels(tmp_path
             inside, box = legend.get_window_extent(), ax.get_window_extent()
             assert (inside.x0 >= box.x0 - 1 and inside.x1 <= box.x1 + 1 and inside.y0 >= box.y0 - 1
                     and inside.y1 <= box.y1 + 1), ax.get_ylabel()
+
+
+def test_a_unit_word_in_a_body_or_interface_name_does_not_set_the_unit(tmp_path):
+    """A clutch's rotating "pressure_plate" or a pad "force_pad": each column keeps the unit of its
+    quantity (the name comes after it), in ``history.h5`` as in ``unit_of``."""
+    h = History()
+    h.append(time=0.0, max_temperature_pressure_plate=300.0, frictional_heat_total_force_pad=1.0,
+             face_mean_temperature_force_pad_on_pressure_plate=300.0, interface_force_heat_pad=5.0,
+             max_pressure_time_pad=1e6)
+    with h5py.File(h.write(tmp_path / "history.h5"), "r") as f:
+        units = {key: f[key].attrs["unit"] for key in f}
+    assert units == {"time": "s", "max_temperature_pressure_plate": "K", "frictional_heat_total_force_pad": "J",
+                     "face_mean_temperature_force_pad_on_pressure_plate": "K", "interface_force_heat_pad": "N",
+                     "max_pressure_time_pad": "Pa"}
