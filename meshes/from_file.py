@@ -77,6 +77,7 @@ class Found:
     extents: dict = field(default_factory=dict)      # planar interface -> size (u, v) [m] in its plane
     surfaces: dict = field(default_factory=dict)     # name -> face tags
     extent: float = 0.0                              # m, largest side of the bounding box
+    loose: list = field(default_factory=list)        # warnings: fixed bodies that touch no interface
     size_factor: float = 1.0                         # a script's own Mesh.MeshSizeFactor (SIZE_FACTOR)
 
 
@@ -338,6 +339,25 @@ def _interfaces(model, g, found: Found, occ: bool) -> None:
     if not found.interfaces:
         raise InputError("geometry.rotating", g.rotating, f"no fixed body of {g.file.name} touches it: no contact "
                          "interface (bodies must share a face; give [geometry.interfaces] to see the gaps)")
+    touching = {found.pairs[name][0] for name in found.interfaces}
+    for group in _groups(model, {n: v for n, v in found.bodies.items() if n != g.rotating}):
+        if not touching & set(group):
+            gap = _gap(model, [t for n in group for t in found.bodies[n]], rotating, occ)
+            found.loose.append(f"geometry.bodies: {', '.join(group)} share no face with {g.rotating}, nor a body bonded "
+                               f"to them (gap {gap}): no contact interface holds them, no friction or heat reaches "
+                               f"them; a pad must share a face with {g.rotating} in the file")
+
+
+def _groups(model, bodies: dict) -> list[list[str]]:
+    """The bodies in groups that touch (share a face, an edge or a vertex), in ``bodies``' order."""
+    ends = {n: {e for v in vs for e in model.getBoundary([(3, v)], combined=False, oriented=False)}
+            | set(model.getBoundary([(3, v) for v in vs], combined=False, oriented=False, recursive=True))
+            for n, vs in bodies.items()}
+    groups: list[list[str]] = []
+    for name in bodies:
+        joined = [grp for grp in groups if any(ends[name] & ends[m] for m in grp)]
+        groups = [grp for grp in groups if grp not in joined] + [[m for grp in joined for m in grp] + [name]]
+    return [sorted(grp, key=list(bodies).index) for grp in groups]
 
 
 def _gap(model, a: list[int], b: list[int], occ: bool) -> str:
@@ -529,4 +549,5 @@ def _spec(g, found: Found) -> GeometrySpec:
         supports=(), load_faces=(), motion=Rotation(tuple(g.axis), tuple(g.centre)),
         length_scale=found.extent, fluid_load=True,
         interface_normals=dict(found.normals), interface_extents=dict(found.extents), report=tuple(report),
+        warnings=tuple(found.loose),
         interface_regions={name: fixed for name, (fixed, _) in found.pairs.items()})

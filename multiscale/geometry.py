@@ -107,6 +107,7 @@ class GeometrySpec:
     interface_normals: Mapping[str, tuple | None] = field(default_factory=dict)   # unit normal of a
     #                                    planar interface (None: not planar; absent: not inspected)
     report: tuple[str, ...] = ()       # what the builder found (bodies, volumes, interfaces), for check
+    warnings: tuple[str, ...] = ()     # what the builder found suspect (a pad off the disc), one line each
     interface_regions: Mapping[str, str] = field(default_factory=dict)   # interface -> region of
     #                                    body 0 along it (default: body 0's first region)
     symmetry: Mapping[str, tuple] = field(default_factory=dict)   # face -> unit normal of a symmetry

@@ -315,7 +315,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                      if key.endswith("mesh_size") and isinstance(given.get(key), (int, float))
                      and size > g.spec.length_scale]
         problems += _hardness_checks(scene, g, raw, effects)
-        warnings += _penalty_warnings(scene, g, effects)
+        warnings += _penalty_warnings(scene, g, effects) + list(g.spec.warnings)
         if "wear" in effects and scene.wear is not None and scene.materials is not None and not problems:
             rough = {scene.geometry.spec.interface_materials(n)[0] for n in scene.geometry.spec.interfaces}
             given = [k for k in ("k_w", "k_w_table") if getattr(scene.wear, k) is not None]

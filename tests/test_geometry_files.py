@@ -795,3 +795,23 @@ normal_force = "100 N"
     spec = loads(text, tmp_path).geometry.spec
     assert spec.interface_extents.keys() == {"pad"}
     np.testing.assert_allclose(spec.interface_extents["pad"], (0.02, 0.03), rtol=1e-9)
+
+
+def test_a_pad_off_the_disc_is_named_by_check(tmp_path, capsys):
+    """A pad modelled 1 mm off the disc (a CAD clearance): check said OK and listed one interface
+    fewer without a word; the run then refused a free translation along z, suggesting supports. Now
+    check warns which bodies touch no interface and how far they are; a backplate bonded to a pad on
+    the disc (pad_a's) is not named."""
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO.replace("Box(5) = {-10, -90, 10, 20, 20, 8};",
+                                                               "Box(5) = {-10, -90, 11, 20, 20, 7};")
+                                          + "\nBox(6) = {-10, 70, 18, 20, 20, 4};")
+    text = TWO_PADS.replace("{folder}", str(tmp_path / "out")).replace(
+        '[geometry.surfaces.backs]', '[geometry.bodies.plate]\ncontains = ["0 mm", "80 mm", "20 mm"]\n'
+        'material = "steel"\n[geometry.surfaces.backs]').replace('["0 mm", "80 mm", "18 mm"]', '["0 mm", "80 mm", "22 mm"]')
+    path = tmp_path / "gap.toml"
+    path.write_text(text)
+    assert main(["check", str(path)]) == 0
+    warnings = [line.strip() for line in capsys.readouterr().out.splitlines() if line.strip().startswith("warning")]
+    assert warnings == ["warning   geometry.bodies: pad_b share no face with disc, nor a body bonded to them (gap "
+                        "0.001 m): no contact interface holds them, no friction or heat reaches them; a pad must "
+                        "share a face with disc in the file"]
