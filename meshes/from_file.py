@@ -33,6 +33,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from meshes import cad_units
 from multiscale.errors import InputError
 from multiscale.geometry import BodySpec, GeometrySpec, Region, Rotation, add_group, plane_extent
 
@@ -170,8 +171,9 @@ def _script_factor(model) -> float:
 def _load(model, g) -> Found:
     import gmsh   # the module-level functions (merge, option) of the model's gmsh
     path = str(g.file)
-    if g.kind == "cad":          # scaled to metres as it is imported (the note above ALGORITHM_3D)
-        gmsh.option.setNumber("Geometry.OCCScaling", g.unit)
+    if g.kind == "cad":          # scaled to metres as it is imported (the note above ALGORITHM_3D), from the
+        #                          millimetres OpenCASCADE converts a STEP or IGES file to (meshes.cad_units)
+        gmsh.option.setNumber("Geometry.OCCScaling", cad_units.scaling(g.file, g.unit))
         try:
             shapes = model.occ.importShapes(path)
         finally:
@@ -241,8 +243,13 @@ def _extent(model, g, scale: float) -> float:
     if not PLAUSIBLE[0] <= extent <= PLAUSIBLE[1]:
         raise InputError("geometry.unit", g.unit, f"the geometry of {g.file.name} spans {extent:.4g} m, implausible for "
                          f"a brake or tribometer ({PLAUSIBLE[0]:g}..{PLAUSIBLE[1]:g} m): is the file's length unit "
-                         f"right? (unit = {g.unit:g} m per file unit)")
+                         f"right? (unit = {g.unit:g} m per file unit{_declared(g)})")
     return extent
+
+
+def _declared(g) -> str:
+    unit = cad_units.declared(g.file) if g.kind == "cad" else None
+    return "" if unit in (None, g.unit) else f"; the file declares {unit:g} m per unit"
 
 
 def _label(model, tag: int) -> str:

@@ -113,7 +113,7 @@ class FileGeometry:
     every length of the scene is in SI (or a unit string)."""
 
     file: Path | None = key(FilePath(), required=True)
-    unit: float = key(LengthUnit(), default=1.0)              # m per length unit of the file
+    unit: float = key(LengthUnit(), default=1.0)              # m per length unit of the file's numbers
     mesh_size: float | None = key(_LENGTH)                     # m, global element size (CAD, .geo)
     interface_mesh_size: float | None = key(_LENGTH)           # m, element size on the interfaces
     mesh_algorithm: str | None = key(Choice(MESH_ALGORITHMS))  # gmsh's 3-D mesher (CAD: "hxt"; .geo: the script's)

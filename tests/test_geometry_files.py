@@ -12,7 +12,7 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 import gmsh  # noqa: E402
 
-from meshes import from_file, pin_on_disc  # noqa: E402
+from meshes import cad_units, from_file, pin_on_disc  # noqa: E402
 from multiscale.cli import main  # noqa: E402
 from multiscale.errors import InputError  # noqa: E402
 from multiscale.geometry import MAX_CELLS, check_cells, estimate_cells, gmsh_session  # noqa: E402
@@ -292,6 +292,53 @@ def test_cad_in_millimetres_is_scaled_as_it_is_read(files, tmp_path):
     np.testing.assert_allclose(box_mm, box, rtol=0, atol=1e-12)
     np.testing.assert_allclose(volumes_mm, volumes, rtol=1e-9)
     assert types_mm == types and types <= {"Plane", "Cylinder"} and scaling == 1.0
+
+
+def test_cad_declaring_its_unit_is_read_in_it(files, tmp_path):
+    """OpenCASCADE converts a STEP or IGES file from the length unit it declares to millimetres, so
+    a file in metres that says so, read with unit = "m", spanned 217.5 m (refused as implausible)
+    and one in inches with unit = "in" would be 25.4 times too large. pod.step holds metre numbers
+    under gmsh's millimetre label: declared in metres (STEP header, IGES units flag 6), it gives the
+    same model with unit = "m" as the file without a unit, to 1e-12 m; and an inch file with
+    unit = "in" the same too. gmsh writes IGES as faces only (no solid to read back): its units flag
+    is checked as read (``cad_units.declared``)."""
+    step = (files / "pod.step").read_text()
+    (tmp_path / "pod_m.step").write_text(step.replace("SI_UNIT(.MILLI.,.METRE.)", "SI_UNIT($,.METRE.)"))
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.model.occ.importShapes(str(files / "pod.step"))
+        gmsh.model.occ.synchronize()
+        gmsh.write(str(tmp_path / "pod.igs"))
+    finally:
+        gmsh.finalize()
+    iges = (tmp_path / "pod.igs").read_text()
+    assert ",2,2HMM," in iges                                      # gmsh's label: millimetres
+    (tmp_path / "pod_m.igs").write_text(iges.replace(",2,2HMM,", ",6,1HM, "))
+    assert (cad_units.declared(tmp_path / "pod.igs"), cad_units.declared(tmp_path / "pod_m.igs")) == (1e-3, 1.0)
+    inch = re.sub(r"\( LENGTH_UNIT\(\) NAMED_UNIT\(\*\) SI_UNIT\(\.MILLI\.,\.METRE\.\) \)",
+                  "( CONVERSION_BASED_UNIT('INCH',#900001) LENGTH_UNIT() NAMED_UNIT(#900002) )", step)
+    inch = inch.replace("ENDSEC;\nEND-ISO", "#900001 = LENGTH_MEASURE_WITH_UNIT(LENGTH_MEASURE(25.4),#900003);\n"
+                        "#900003 = ( LENGTH_UNIT() NAMED_UNIT(*) SI_UNIT(.MILLI.,.METRE.) );\n"
+                        "#900002 = DIMENSIONAL_EXPONENTS(1.,0.,0.,0.,0.,0.,0.);\nENDSEC;\nEND-ISO")
+    (tmp_path / "pod_in.step").write_text(inch)                    # its numbers taken as inches
+    assert cad_units.declared(tmp_path / "pod_in.step") == 0.0254
+
+    def read():
+        return np.array(gmsh.model.getBoundingBox(-1, -1))
+
+    box = built(scene_for(files, "step", tmp_path).geometry, read)
+    np.testing.assert_allclose(built(scene_for(files, "step", tmp_path, 'unit = "m"', tmp_path / "pod_m.step").geometry,
+                                     read), box, rtol=0, atol=1e-12)
+    gmsh.initialize()                 # the inch file's numbers, as inches (its points miss the scene's)
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("Geometry.OCCScaling", cad_units.scaling(tmp_path / "pod_in.step", 0.0254))
+        gmsh.model.occ.importShapes(str(tmp_path / "pod_in.step"))
+        gmsh.model.occ.synchronize()
+        np.testing.assert_allclose(read(), box * 0.0254, rtol=0, atol=2e-7)   # OCC's boxes add 1e-7 units
+    finally:
+        gmsh.finalize()
 
 
 def check(tmp_path, capsys, text) -> str:
