@@ -2,7 +2,9 @@
 file: its lengths reach gmsh in millimetres whatever the file's unit (``xstep.cascade.unit``), so
 ``meshes.from_file`` scales them by ``geometry.unit`` over the declared unit to take the file's own
 numbers in ``geometry.unit``. A file that declares no unit, or several, counts as millimetres
-(OpenCASCADE's default; a .brep holds no unit and is read as it is: ``scaling``).
+(OpenCASCADE's default; a .brep holds no unit and is read as it is: ``scaling``). Not gmsh's
+``Geometry.OCCTargetUnit``: it converts to a chosen unit but does not tell which unit the file
+declared, and ``geometry.unit`` (the unit of the file's numbers) needs that.
 """
 from __future__ import annotations
 
