@@ -1,8 +1,10 @@
 """The length unit a STEP or IGES file declares, which OpenCASCADE converts from when it reads the
 file: its lengths reach gmsh in millimetres whatever the file's unit (``xstep.cascade.unit``), so
-``meshes.from_file`` scales them by ``geometry.unit`` over the declared unit to take the file's own
-numbers in ``geometry.unit``. A file that declares no unit, or several, counts as millimetres
-(OpenCASCADE's default; a .brep holds no unit and is read as it is: ``scaling``). Not gmsh's
+``meshes.from_file`` scales them by the unit of the file's numbers over the declared unit. That unit
+(``file_unit``) is ``geometry.unit`` if the scene gives it, else the declared one, as any CAD
+importer reads the file. A file that declares no unit, or several, counts as millimetres
+(OpenCASCADE's default); a .brep holds no unit and is read as it is (``scaling``), in metres like a
+.msh or .geo unless ``geometry.unit`` says otherwise. Not gmsh's
 ``Geometry.OCCTargetUnit``: it converts to a chosen unit but does not tell which unit the file
 declared, and ``geometry.unit`` (the unit of the file's numbers) needs that.
 """
@@ -12,6 +14,7 @@ import re
 from pathlib import Path
 
 MILLIMETRE = 1e-3
+STEP, IGES = (".step", ".stp"), (".iges", ".igs")
 STEP_PREFIXES = {"$": 1.0, "KILO": 1e3, "DECI": 1e-1, "CENTI": 1e-2, "MILLI": 1e-3, "MICRO": 1e-6, "NANO": 1e-9}
 STEP_NAMED = {"INCH": 0.0254, "FOOT": 0.3048, "MIL": 2.54e-5, "MILE": 1609.344}
 # IGES global parameter 14, the model's units flag (IGES 5.3, section 2.2.4.3)
@@ -27,9 +30,20 @@ def declared(path: Path) -> float | None:
     """Metres per length unit that the STEP or IGES file at ``path`` declares (None if it declares
     none, several, or one not known here, and for any other file)."""
     suffix = Path(path).suffix.lower()
-    text = Path(path).read_text(errors="replace") if suffix in (".step", ".stp", ".iges", ".igs") else ""
-    units = set(_step(text) if suffix in (".step", ".stp") else _iges(text) if text else [])
+    text = Path(path).read_text(errors="replace") if suffix in STEP + IGES else ""
+    units = set(_step(text) if suffix in STEP else _iges(text) if text else [])
     return units.pop() if len(units) == 1 else None
+
+
+def file_unit(path: Path, unit: float | None) -> tuple[float, str]:
+    """Metres per unit of the numbers of the file at ``path``, and where it comes from: ``unit``
+    (``geometry.unit``) if given; else the unit a STEP or IGES file declares (mm if none); else m."""
+    if unit is not None:
+        return unit, "geometry.unit"
+    if Path(path).suffix.lower() not in STEP + IGES:
+        return 1.0, "no geometry.unit: metres"
+    own = declared(path)
+    return (own, "declared by the file") if own else (MILLIMETRE, "the file declares none: millimetres")
 
 
 def scaling(path: Path, unit: float) -> float:

@@ -6,7 +6,8 @@ scene).
 Reading (``describe``, run when the scene is read, so that ``multiscale check`` reports what it
 found; and ``generate``, on the meshing rank):
 
-1. load the file into a gmsh model and scale it to metres (``unit``); CAD and OpenCASCADE scripts
+1. load the file into a gmsh model and scale it to metres (``unit``, else the unit a STEP or IGES
+   file declares: ``cad_units.file_unit``); CAD and OpenCASCADE scripts
    are fragmented (``occ.fragment``) so that faces where two volumes touch become one shared face
    and the mesh is conforming there (a ``.msh`` must be conforming already: gmsh writes shared
    faces as one entity);
@@ -80,6 +81,7 @@ class Found:
     extent: float = 0.0                              # m, largest side of the bounding box
     loose: list = field(default_factory=list)        # warnings: fixed bodies that touch no interface
     size_factor: float = 1.0                         # a script's own Mesh.MeshSizeFactor (SIZE_FACTOR)
+    unit: tuple = (1.0, "")                          # m per unit of the file's numbers, where it comes from
 
 
 def parameters(params) -> dict:
@@ -170,10 +172,11 @@ def _script_factor(model) -> float:
 # ---------------------------------------------------------------- reading
 def _load(model, g) -> Found:
     import gmsh   # the module-level functions (merge, option) of the model's gmsh
-    path = str(g.file)
+    path, unit = str(g.file), cad_units.file_unit(g.file, g.unit)
+    scale = unit[0]
     if g.kind == "cad":          # scaled to metres as it is imported (the note above ALGORITHM_3D), from the
         #                          millimetres OpenCASCADE converts a STEP or IGES file to (meshes.cad_units)
-        gmsh.option.setNumber("Geometry.OCCScaling", cad_units.scaling(g.file, g.unit))
+        gmsh.option.setNumber("Geometry.OCCScaling", cad_units.scaling(g.file, scale))
         try:
             shapes = model.occ.importShapes(path)
         finally:
@@ -209,16 +212,16 @@ def _load(model, g) -> Found:
         split = sorted(old for old, pieces in after.items() if len(pieces) > 1)
     # the extent before a script's or a mesh's scaling, scaled: gmsh's bounding box of some OpenCASCADE
     # surfaces is stale after occ.dilate (a partial Sphere 80 mm off the origin in mm spanned 80 m)
-    extent = _extent(model, g, g.unit if g.kind != "cad" else 1.0)
-    if g.unit != 1.0 and g.kind != "cad":
+    extent = _extent(model, g, scale if g.kind != "cad" else 1.0, unit)
+    if scale != 1.0 and g.kind != "cad":
         if g.kind == "mesh":
-            s = g.unit
+            s = scale
             model.mesh.affineTransform([s, 0, 0, 0, 0, s, 0, 0, 0, 0, s, 0])
         elif occ:
-            model.occ.dilate(model.occ.getEntities(), 0, 0, 0, g.unit, g.unit, g.unit)
+            model.occ.dilate(model.occ.getEntities(), 0, 0, 0, scale, scale, scale)
             model.occ.synchronize()
         else:
-            model.geo.dilate(model.getEntities(), 0, 0, 0, g.unit, g.unit, g.unit)
+            model.geo.dilate(model.getEntities(), 0, 0, 0, scale, scale, scale)
             model.geo.synchronize()
     labels = {t: _label(model, t) for _, t in model.getEntities(3)}
     try:
@@ -229,27 +232,27 @@ def _load(model, g) -> Found:
         raise InputError(exc.name, exc.value, f"{exc.allowed} (the file's solids {split} overlap: gmsh cut them "
                          "into pieces where they intersect; make the parts touch without overlapping)") from None
     found = Found(bodies, labels, {t: _volume(model, t, occ) for t in labels},
-                  extent=extent, size_factor=_script_factor(model))
+                  extent=extent, size_factor=_script_factor(model), unit=unit)
     _interfaces(model, g, found, occ)
     _surfaces(model, g, found)
     return found
 
 
-def _extent(model, g, scale: float) -> float:
+def _extent(model, g, scale: float, unit: tuple) -> float:
     """The largest side [m] of the model's bounding box times ``scale`` (m per model unit),
-    refused if implausible."""
+    refused if implausible (``unit``: the file's, ``cad_units.file_unit``)."""
     box = np.array(model.getBoundingBox(-1, -1))
     extent = float((box[3:] - box[:3]).max()) * scale
     if not PLAUSIBLE[0] <= extent <= PLAUSIBLE[1]:
         raise InputError("geometry.unit", g.unit, f"the geometry of {g.file.name} spans {extent:.4g} m, implausible for "
                          f"a brake or tribometer ({PLAUSIBLE[0]:g}..{PLAUSIBLE[1]:g} m): is the file's length unit "
-                         f"right? (unit = {g.unit:g} m per file unit{_declared(g)})")
+                         f"right? (read in {unit[0]:g} m per file unit: {unit[1]}{_declared(g, unit[0])})")
     return extent
 
 
-def _declared(g) -> str:
+def _declared(g, read: float) -> str:
     unit = cad_units.declared(g.file) if g.kind == "cad" else None
-    return "" if unit in (None, g.unit) else f"; the file declares {unit:g} m per unit"
+    return "" if unit in (None, read) else f"; the file declares {unit:g} m per unit"
 
 
 def _label(model, tag: int) -> str:
@@ -537,7 +540,8 @@ def _spec(g, found: Found) -> GeometrySpec:
     fixed = [n for n in g.bodies if n != g.rotating]
     tag = {n: 1 + k for k, n in enumerate(g.bodies)}
     regions = tuple(Region(n, tag[n], g.bodies[n].material) for n in fixed)
-    report = [f"file {g.file.name}: {len(found.labels)} volume(s), extent {found.extent:.4g} m"]
+    report = [f"file {g.file.name}: {len(found.labels)} volume(s), extent {found.extent:.4g} m, read in "
+              f"{found.unit[0]:g} m per file unit ({found.unit[1]})"]
     if found.size_factor != 1.0:
         report.append(f"the script's Mesh.MeshSizeFactor {found.size_factor:g} scales every element size")
     report += [f"body {n}: {len(found.bodies[n])} volume(s), {sum(found.volume[t] for t in found.bodies[n]) * 1e6:.4g} cm^3, "

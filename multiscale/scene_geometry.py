@@ -53,10 +53,6 @@ class LengthUnit:
     def describe(self) -> str:
         return 'a length unit such as "m", "mm", "in"'
 
-    def show_default(self, metres: float) -> str:
-        """The default as the user would write it (``check --keys``): "m" for 1 m."""
-        return '"m"' if metres == 1.0 else f"{metres:g} m"
-
     def __call__(self, raw, ctx):
         try:
             return to_si(f"1 {raw}", "length") if isinstance(raw, str) else None
@@ -109,11 +105,13 @@ class ContactPair:
 
 @dataclass(frozen=True)
 class FileGeometry:
-    """[geometry] from the user's file (see module docstring). Lengths of the file are in ``unit``;
-    every length of the scene is in SI (or a unit string)."""
+    """[geometry] from the user's file (see module docstring). The file's lengths are in ``unit`` if
+    given; else a STEP or IGES file's are in the unit it declares (millimetres if it declares none,
+    as OpenCASCADE reads it) and a .msh, .geo or .brep file's in metres. Every length of the scene
+    is in SI (or a unit string)."""
 
     file: Path | None = key(FilePath(), required=True)
-    unit: float = key(LengthUnit(), default=1.0)              # m per length unit of the file's numbers
+    unit: float | None = key(LengthUnit())                    # m per unit of the file's numbers (None: see above)
     mesh_size: float | None = key(_LENGTH)                     # m, global element size (CAD, .geo)
     interface_mesh_size: float | None = key(_LENGTH)           # m, element size on the interfaces
     mesh_algorithm: str | None = key(Choice(MESH_ALGORITHMS))  # gmsh's 3-D mesher (CAD: "hxt"; .geo: the script's)

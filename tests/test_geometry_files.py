@@ -16,6 +16,7 @@ from meshes import cad_units, from_file, pin_on_disc  # noqa: E402
 from multiscale.cli import main  # noqa: E402
 from multiscale.errors import InputError  # noqa: E402
 from multiscale.geometry import MAX_CELLS, check_cells, estimate_cells, gmsh_session  # noqa: E402
+from multiscale.provenance import resolved_toml  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 
@@ -121,10 +122,13 @@ def files(tmp_path_factory):
 
 
 def scene_for(files, kind, tmp_path, more="", file=None):
+    """The scene of the pin-on-disc file ``pod.<kind>`` (or ``file``); pod.step holds metre numbers
+    under gmsh's millimetre label, so it is read with unit = "m" unless ``more`` gives a unit."""
     by_name = {b: f'volumes = ["{b}"]' for b in INSIDE}
     by_point = {b: f"contains = {p}" for b, p in INSIDE.items()}
     extra = {"msh": "", "step": 'mesh_size = "15 mm"\ninterface_mesh_size = "2.5 mm"',
              "geo": 'unit = "mm"\nmesh_size = "15 mm"\ninterface_mesh_size = "2.5 mm"'}[kind] + "\n" + more
+    extra += '\nunit = "m"' if kind == "step" and "unit" not in more else ""
     text = FILE.format(name=kind, file=file or files / f"pod.{kind}", extra=extra, folder=tmp_path / kind,
                        surfaces="" if kind == "msh" else CAD_SURFACES, **(by_name if kind == "msh" else by_point))
     return loads(text, files)
@@ -299,7 +303,7 @@ def test_cad_declaring_its_unit_is_read_in_it(files, tmp_path):
     a file in metres that says so, read with unit = "m", spanned 217.5 m (refused as implausible)
     and one in inches with unit = "in" would be 25.4 times too large. pod.step holds metre numbers
     under gmsh's millimetre label: declared in metres (STEP header, IGES units flag 6), it gives the
-    same model with unit = "m" as the file without a unit, to 1e-12 m; and an inch file with
+    same model with unit = "m" as pod.step with unit = "m", to 1e-12 m; and an inch file with
     unit = "in" the same too. gmsh writes IGES as faces only (no solid to read back): its units flag
     is checked as read (``cad_units.declared``)."""
     step = (files / "pod.step").read_text()
@@ -341,6 +345,44 @@ def test_cad_declaring_its_unit_is_read_in_it(files, tmp_path):
         gmsh.finalize()
 
 
+def test_cad_without_a_unit_is_read_in_the_unit_it_declares(files, tmp_path):
+    """Without geometry.unit a STEP file is read in the unit it declares, as any CAD importer reads
+    it (before: in metres, so a file in mm spanned 217.5 m and was refused as implausible): the
+    pin-on-disc written in mm has the bounding box of the metre model to 1e-9 m, as with unit = "mm";
+    a .msh without a unit is still in metres (extent 0.2175 m to 1e-9 m). check reports the unit
+    and where it comes from; the resolved scene leaves unit out and loads back to the same model."""
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("Geometry.OCCScaling", 1000.0)      # the metre model written in mm
+        gmsh.model.occ.importShapes(str(files / "pod.step"))
+        gmsh.model.occ.synchronize()
+        gmsh.write(str(tmp_path / "pod_mm.step"))
+    finally:
+        gmsh.finalize()
+    assert "SI_UNIT(.MILLI.,.METRE.)" in (tmp_path / "pod_mm.step").read_text()
+
+    def read():
+        return np.array(gmsh.model.getBoundingBox(-1, -1))
+
+    box = built(scene_for(files, "step", tmp_path).geometry, read)            # pod.step, unit = "m"
+    bare = scene_for(files, "step", tmp_path, "# no unit: the file's own", tmp_path / "pod_mm.step")
+    np.testing.assert_allclose(built(bare.geometry, read), box, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(built(scene_for(files, "step", tmp_path, 'unit = "mm"', tmp_path / "pod_mm.step")
+                                     .geometry, read), box, rtol=0, atol=1e-9)
+    assert bare.geometry.params.unit is None
+    assert "read in 0.001 m per file unit (declared by the file)" in bare.geometry.spec.report[0]
+    resolved = resolved_toml(bare)
+    assert "unit =" not in resolved.split("[geometry]")[1].split("\n[")[0]
+    again = loads(resolved, tmp_path, name=bare.name)
+    assert again.geometry.params == bare.geometry.params and again.geometry.spec.report == bare.geometry.spec.report
+    msh = scene_for(files, "msh", tmp_path).geometry
+    assert msh.params.unit is None and abs(msh.spec.length_scale - 0.2175) < 1e-9
+    assert "read in 1 m per file unit (no geometry.unit: metres)" in msh.spec.report[0]
+    (tmp_path / "bare.step").write_text("ISO-10303-21;\nDATA;\nENDSEC;\nEND-ISO-10303-21;\n")
+    assert [cad_units.file_unit(tmp_path / f, None)[0] for f in ("bare.step", "pod.brep")] == [1e-3, 1.0]
+
+
 def check(tmp_path, capsys, text) -> str:
     """``multiscale check`` of a scene: exit code 2, exactly one error line, which is returned."""
     path = tmp_path / "bad.toml"
@@ -360,7 +402,7 @@ def test_bad_geometry_files_are_one_clear_line(files, tmp_path, capsys):
     assert "spans 0.0002175 m, implausible" in err and "unit" in err
     far = good.replace('rotating = "disc"', 'rotating = "disc"\n[geometry.interfaces.plate]\nbetween = ["plate", "disc"]')
     step = far.replace(str(files / "pod.msh"), str(files / "pod.step")).replace(
-        'rotating = "disc"', 'rotating = "disc"\nmesh_size = "15 mm"', 1)
+        'rotating = "disc"', 'rotating = "disc"\nmesh_size = "15 mm"\nunit = "m"', 1)
     for b, p in INSIDE.items():
         step = step.replace(f'volumes = ["{b}"]', f"contains = {p}")
     err = check(tmp_path, capsys, step)
@@ -421,6 +463,7 @@ def test_a_rough_interface_must_be_planar(tmp_path, capsys):
 effects = ["contact", "roughness"]
 [geometry]
 file = "{tmp_path / 'rim.step'}"
+unit = "m"
 mesh_size = "5 mm"
 rotating = "wheel"
 [geometry.bodies.wheel]
