@@ -269,20 +269,26 @@ def test_a_scripts_own_size_factor_scales_its_mesh_its_trials_and_the_kept_sessi
     assert "the script's Mesh.MeshSizeFactor 2 scales every element size" in report
 
 
+def write_in_millimetres(source, target) -> None:
+    """The STEP file ``source`` (numbers in m) written to ``target`` with its numbers in mm (gmsh
+    labels what it writes as mm)."""
+    gmsh.initialize()
+    try:
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("Geometry.OCCScaling", 1000.0)
+        gmsh.model.occ.importShapes(str(source))
+        gmsh.model.occ.synchronize()
+        gmsh.write(str(target))
+    finally:
+        gmsh.finalize()
+
+
 def test_cad_in_millimetres_is_scaled_as_it_is_read(files, tmp_path):
     """A STEP file in mm (unit = "mm") gives the geometry of the same file in m: the same bounding
     box to 1e-12 m and the same volumes to 1e-9, its planes and cylinders still analytic (scaled
     by a similarity at import: occ.dilate would have made every face a B-spline, whose fragment and
     meshing are much slower, benchmarks/README), and gmsh's import scaling reset afterwards."""
-    gmsh.initialize()
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("Geometry.OCCScaling", 1000.0)      # the metre file written in mm
-        gmsh.model.occ.importShapes(str(files / "pod.step"))
-        gmsh.model.occ.synchronize()
-        gmsh.write(str(tmp_path / "pod_mm.step"))
-    finally:
-        gmsh.finalize()
+    write_in_millimetres(files / "pod.step", tmp_path / "pod_mm.step")
 
     def read():
         box = np.array(gmsh.model.getBoundingBox(-1, -1))
@@ -351,15 +357,7 @@ def test_cad_without_a_unit_is_read_in_the_unit_it_declares(files, tmp_path):
     pin-on-disc written in mm has the bounding box of the metre model to 1e-9 m, as with unit = "mm";
     a .msh without a unit is still in metres (extent 0.2175 m to 1e-9 m). check reports the unit
     and where it comes from; the resolved scene leaves unit out and loads back to the same model."""
-    gmsh.initialize()
-    try:
-        gmsh.option.setNumber("General.Terminal", 0)
-        gmsh.option.setNumber("Geometry.OCCScaling", 1000.0)      # the metre model written in mm
-        gmsh.model.occ.importShapes(str(files / "pod.step"))
-        gmsh.model.occ.synchronize()
-        gmsh.write(str(tmp_path / "pod_mm.step"))
-    finally:
-        gmsh.finalize()
+    write_in_millimetres(files / "pod.step", tmp_path / "pod_mm.step")
     assert "SI_UNIT(.MILLI.,.METRE.)" in (tmp_path / "pod_mm.step").read_text()
 
     def read():
