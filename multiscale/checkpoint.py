@@ -17,6 +17,7 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from multiscale import __version__
 from multiscale.errors import InputError
 from multiscale.io import on_root
 
@@ -68,7 +69,7 @@ def save(path, comm, *, attrs: dict, arrays: dict, functions: dict, scale: float
                 for key, value in attrs.items():
                     h5.attrs[key] = value
                 h5.attrs["length_scale"] = scale
-                h5.attrs["format"] = FORMAT
+                h5.attrs["format"], h5.attrs["version"] = FORMAT, __version__
                 h5.attrs["checksum"] = _digest(data)
                 for name, value in data.items():
                     h5.create_dataset(name, data=value)
@@ -150,7 +151,9 @@ def same_scene(attrs: dict, fingerprint: str, path) -> None:
     """InputError unless the checkpoint attributes ``attrs`` (of ``path``) are of the scene whose
     ``fingerprint`` is given (``--resume`` of a changed scene or of changed input files)."""
     if attrs.get("scene") != fingerprint:
-        raise InputError("--resume", str(path), "the scene or a file it reads (geometry, measured surface) "
+        written = attrs.get("version", __version__)       # (older checkpoints did not say)
+        other = "" if written == __version__ else f", or multiscale (it was written by {written}, this is {__version__})"
+        raise InputError("--resume", str(path), f"the scene or a file it reads (geometry, measured surface){other} "
                          "changed since this checkpoint was written; run it with --overwrite")
 
 
