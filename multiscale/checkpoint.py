@@ -10,7 +10,6 @@ temporary name and renamed, so a run killed while writing keeps its previous che
 from __future__ import annotations
 
 import hashlib
-import os
 import shutil
 from pathlib import Path
 
@@ -19,7 +18,7 @@ import numpy as np
 
 from multiscale import __version__
 from multiscale.errors import InputError
-from multiscale.io import on_root
+from multiscale.io import on_root, replacing
 
 FORMAT = 4    # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns;
 #               3: the drive's state (speed, engagement, load last solved) and the area-weighted effusivity partition;
@@ -59,24 +58,18 @@ def save(path, comm, *, attrs: dict, arrays: dict, functions: dict, scale: float
     tables = {name: comm.gather(_dof_table(f, scale), root=0) for name, f in functions.items()}
 
     def write():
-        tmp = path.with_name(path.name + ".tmp")
         data = {f"arrays/{name}": np.asarray(value) for name, value in arrays.items()}
         for name, parts in tables.items():
             data[f"functions/{name}/keys"] = np.concatenate([k for k, _ in parts])
             data[f"functions/{name}/values"] = np.concatenate([v for _, v in parts])
-        try:
-            with h5py.File(tmp, "w") as h5:
-                for key, value in attrs.items():
-                    h5.attrs[key] = value
-                h5.attrs["length_scale"] = scale
-                h5.attrs["format"], h5.attrs["version"] = FORMAT, __version__
-                h5.attrs["checksum"] = _digest(data)
-                for name, value in data.items():
-                    h5.create_dataset(name, data=value)
-            os.replace(tmp, path)
-        except OSError:
-            tmp.unlink(missing_ok=True)
-            raise
+        with replacing(path) as part, h5py.File(part, "w") as h5:
+            for key, value in attrs.items():
+                h5.attrs[key] = value
+            h5.attrs["length_scale"] = scale
+            h5.attrs["format"], h5.attrs["version"] = FORMAT, __version__
+            h5.attrs["checksum"] = _digest(data)
+            for name, value in data.items():
+                h5.create_dataset(name, data=value)
     on_root(comm, write, f"the checkpoint {path}")
     return path
 
@@ -125,16 +118,11 @@ def mark(path, comm, **attrs) -> None:
     path = Path(path)
 
     def write():
-        tmp = path.with_name(path.name + ".tmp")
-        try:
-            shutil.copyfile(path, tmp)
-            with h5py.File(tmp, "r+") as h5:
+        with replacing(path) as part:
+            shutil.copyfile(path, part)
+            with h5py.File(part, "r+") as h5:
                 for key, value in attrs.items():
                     h5.attrs[key] = value
-            os.replace(tmp, path)
-        except OSError:
-            tmp.unlink(missing_ok=True)
-            raise
     on_root(comm, write, f"the checkpoint {path}")
 
 

@@ -86,16 +86,16 @@ class History:
 def replacing(path: Path):
     """``with replacing(path) as part:`` write the new ``path`` into ``part`` (``<name>.part``
     beside it), which then replaces ``path`` at once: a run killed while writing leaves the
-    previous file and the part (``--overwrite`` clears it, ``provenance.results_of``); a write
-    that fails deletes the part and leaves the previous file."""
+    previous file and the part (``--overwrite`` clears it, ``provenance.results_of``); a write or
+    a replacement that fails deletes the part and leaves the previous file."""
     path = Path(path)
     part = path.with_name(path.name + ".part")
     try:
         yield part
+        os.replace(part, path)
     except BaseException:
         part.unlink(missing_ok=True)
         raise
-    os.replace(part, path)
 
 
 def on_root(comm, write, what: str):

@@ -136,7 +136,6 @@ def test_a_full_disk_keeps_the_previous_checkpoint(stopped, tmp_path, monkeypatc
     import os
     import shutil
 
-    from multiscale import checkpoint as ckpt
     from multiscale.errors import OutputError
     from multiscale.workflows.multiscale import run
     scene, checkpoint = stopped
@@ -146,11 +145,11 @@ def test_a_full_disk_keeps_the_previous_checkpoint(stopped, tmp_path, monkeypatc
 
     def full(*args):
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
-    monkeypatch.setattr(ckpt.os, "replace", full)
+    monkeypatch.setattr(os, "replace", full)
     with pytest.raises(OutputError, match="cannot write the checkpoint .*No space left on device"):
         run(_with_folder(scene, folder), resume=True, verbose=False)
     assert (folder / "checkpoint.h5").read_bytes() == before
-    assert not (folder / "checkpoint.h5.tmp").exists()
+    assert not (folder / "checkpoint.h5.part").exists()
 
 
 def test_a_read_only_output_folder_is_one_clear_error(tmp_path, monkeypatch):
@@ -542,7 +541,7 @@ def test_marking_a_checkpoint_is_all_or_nothing(tmp_path, monkeypatch):
     monkeypatch.setattr(h5py.AttributeManager, "__setitem__", failing)
     with pytest.raises(OutputError, match="cannot write the checkpoint"):
         ckpt.mark(path, MPI.COMM_SELF, fields_written=3, finished=True)
-    assert path.read_bytes() == before and not path.with_name("checkpoint.h5.tmp").exists()
+    assert path.read_bytes() == before and not path.with_name("checkpoint.h5.part").exists()
     monkeypatch.setattr(h5py.AttributeManager, "__setitem__", setitem)
     ckpt.mark(path, MPI.COMM_SELF, fields_written=3, finished=True)
     attrs, arrays = ckpt.load(path, MPI.COMM_SELF, {})

@@ -238,9 +238,8 @@ class SeriesFile:
         text = ('<?xml version="1.0"?>\n<Xdmf Version="3.0">\n<Domain>\n'
                 f'<Grid Name="{self.path.stem}" GridType="Collection" CollectionType="Temporal">\n'
                 + "\n".join(grids) + "\n</Grid>\n</Domain>\n</Xdmf>\n")
-        tmp = self.path.with_name(self.path.name + ".tmp")
-        tmp.write_text(text)
-        tmp.replace(self.path)
+        with io.replacing(self.path) as part:
+            part.write_text(text)
 
 
 class FieldWriter:
