@@ -33,6 +33,7 @@ from multiscale import checkpoint, io, outputs
 from multiscale.coupling import LoopSettings, Multiscale
 from multiscale.errors import InputError, Interrupted
 from multiscale.geometry import Rotation
+from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.output import FieldOutput
 from multiscale.micro.heat_kernels import ThermalMaterial
 from multiscale.micro.laws import Conductance
@@ -140,51 +141,53 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         checkpoint.same_scene(stored, fingerprint(scene), ckpt)
         return finished(folder, scene.name, int(stored["step"]), comm, verbose)
     ms = build(scene, comm, progress=verbose and comm.rank == 0)
-    steps = scene.time.steps if (ms.model.thermal is not None or scene.has("wear")) else 0
-    every = scene.output.every
-    if resume:
-        with io.stage("restoring the checkpoint"):
-            done, history, written = dataclasses.astuple(ms.restore(ckpt))
-    else:
-        with io.stage("zone laws and first solve"):
-            first = ms.start()
-        done, history, written = 0, io.History(), -1
-        history.append(**ms.record(first))
-        out.claim()                      # --overwrite: the earlier results go now, not before a failed start
-        ms.save(ckpt, 0, history)
-        write_history(history, folder, scene.name, comm, plot=False)   # a run failing in step 1 keeps t = 0
-    ms.rough.pool.progress = False
-    plan = outputs.plan(scene)
-    writer = FieldOutput(ms.model, folder, plan.body_fields + plan.interface_fields, extra=ms.facet_fields(),
-                         resume_at=ms.model.time if resume else None)
-    if written < done and (done % every == 0 or done == steps):
-        writer.write()
-        ms.mark_fields(ckpt, done, comm)
-    last = steps if stop_after is None else min(steps, stop_after)
-    stopping = False
-    with io.StepStop(comm, done) as stop, heat_warnings_as_notes():   # a Ctrl-C while the end is written lets it finish
-        with io.stage("macro steps"):
-            for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
-                stepped = ms.step(n)
-                with stop.writing(n):                     # the step's checkpoint, history and fields, whole
-                    history.append(**ms.record(stepped))
-                    ms.save(ckpt, n, history)
-                    write_history(history, folder, scene.name, comm, plot=False)   # readable if the run is killed
-                    done, stopping = n, stop.requested()
-                    if n % every == 0 or n == steps:      # not at a stop: a resumed run's field times stay those of
-                        writer.write()                    # an uninterrupted one
-                        ms.mark_fields(ckpt, n, comm)
-                if stopping:
-                    break
-        with io.stage("writing history and plots"), stop.writing(done):
-            h5, png = write_history(history, folder, scene.name, comm)
-            plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
-    if done == steps:
-        checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
-    result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones, ckpt] + maps, _time.perf_counter() - start,
-                              history, h5, png, writer.files, plot, maps, zones, done,
-                              warnings=run_notes(ms.model))
-    ms.model.close()          # on every rank in the same order (MUMPS' destruction communicates)
+    with closed_on_error(ms.model, comm):        # a script going on after a failed run gets its communicators
+        steps = scene.time.steps if (ms.model.thermal is not None or scene.has("wear")) else 0
+        every = scene.output.every
+        if resume:
+            with io.stage("restoring the checkpoint"):
+                done, history, written = dataclasses.astuple(ms.restore(ckpt))
+        else:
+            with io.stage("zone laws and first solve"):
+                first = ms.start()
+            done, history, written = 0, io.History(), -1
+            history.append(**ms.record(first))
+            out.claim()                      # --overwrite: the earlier results go now, not before a failed start
+            ms.save(ckpt, 0, history)
+            write_history(history, folder, scene.name, comm, plot=False)   # a run failing in step 1 keeps t = 0
+        ms.rough.pool.progress = False
+        plan = outputs.plan(scene)
+        writer = FieldOutput(ms.model, folder, plan.body_fields + plan.interface_fields, extra=ms.facet_fields(),
+                             resume_at=ms.model.time if resume else None)
+        if written < done and (done % every == 0 or done == steps):
+            writer.write()
+            ms.mark_fields(ckpt, done, comm)
+        last = steps if stop_after is None else min(steps, stop_after)
+        stopping = False
+        # a Ctrl-C while the end is written lets it finish
+        with io.StepStop(comm, done) as stop, heat_warnings_as_notes():
+            with io.stage("macro steps"):
+                for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
+                    stepped = ms.step(n)
+                    with stop.writing(n):                     # the step's checkpoint, history and fields, whole
+                        history.append(**ms.record(stepped))
+                        ms.save(ckpt, n, history)
+                        write_history(history, folder, scene.name, comm, plot=False)   # readable if the run is killed
+                        done, stopping = n, stop.requested()
+                        if n % every == 0 or n == steps:      # not at a stop: a resumed run's field times stay those of
+                            writer.write()                    # an uninterrupted one
+                            ms.mark_fields(ckpt, n, comm)
+                    if stopping:
+                        break
+            with io.stage("writing history and plots"), stop.writing(done):
+                h5, png = write_history(history, folder, scene.name, comm)
+                plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
+        if done == steps:
+            checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
+        result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones, ckpt] + maps,
+                                  _time.perf_counter() - start, history, h5, png, writer.files, plot, maps, zones,
+                                  done, warnings=run_notes(ms.model))
+        ms.model.close()          # on every rank in the same order (MUMPS' destruction communicates)
     if stopping:                 # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", result.warnings)
     if verbose and comm.rank == 0:

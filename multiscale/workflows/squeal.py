@@ -42,6 +42,7 @@ from multiscale.errors import InputError
 from multiscale.macro.damped import PrestressEffect, prestress_effect, solve_system
 from multiscale.macro.eigen import Damping, ModalResult
 from multiscale.macro.friction import ConstantFriction, StribeckFriction, TableFriction, set_friction
+from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.mechanics import Mechanics
 from multiscale.macro.modal import EnergyShares, RegionEnergy, StabilityReport, stability_report, \
     strain_energy_shares
@@ -169,9 +170,10 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     prefix = "squeal_" + "".join(ch if ch.isalnum() else "_" for ch in name) + "_"
     mech = build_squeal_mechanics(scene, tm, degree=degree, prefix=prefix)
     try:
-        return squeal_case(mech, dict(scene.materials), name, load=drive(model_scene(scene), tm).load,
-                           steps=scene.loading.ramp_steps, band=tuple(st.band), n_modes=st.modes, target=st.target,
-                           energy=energy, rtol=st.threshold, options=squeal_options(scene, tm))
+        with closed_on_error(mech, tm.comm):
+            return squeal_case(mech, dict(scene.materials), name, load=drive(model_scene(scene), tm).load,
+                               steps=scene.loading.ramp_steps, band=tuple(st.band), n_modes=st.modes,
+                               target=st.target, energy=energy, rtol=st.threshold, options=squeal_options(scene, tm))
     except InputError as exc:        # the eigen solvers' arguments by their scene keys
         keys = {"f_min": ("stability.band", st.band), "f_max": ("stability.band", st.band),
                 "n_modes": ("stability.modes", st.modes)}
@@ -250,33 +252,36 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     with io.stage("meshing"):
         tm = build_mesh(scene, comm)
     case = analyse(scene, tm, degree=degree)
-    out.claim()                          # --overwrite: the earlier results go now, not before a failed analysis
-    with io.stage("writing results"):
-        plan = outputs.plan(scene)
-        rep = case.report
-        files = io.on_root(comm, lambda: [case.modes.write_csv(folder / "modes.csv", rep.rtol,
-                                                              rep.potentially_unstable)], f"{folder / 'modes.csv'}") or []
-        files += write_state(folder, case.mech, plan.body_fields + plan.interface_fields)
-        files += write_modes(folder, case.modes, case.mech.u, [b.name for b in tm.bodies])
-        split = energy_split(tm)
-        masks = tm.interface.masks()
+    with closed_on_error(case.mech, comm):       # a script going on after a failed run gets its communicators
+        out.claim()                          # --overwrite: the earlier results go now, not before a failed analysis
+        with io.stage("writing results"):
+            plan = outputs.plan(scene)
+            rep = case.report
+            files = io.on_root(comm, lambda: [case.modes.write_csv(folder / "modes.csv", rep.rtol,
+                                                                  rep.potentially_unstable)],
+                               f"{folder / 'modes.csv'}") or []
+            files += write_state(folder, case.mech, plan.body_fields + plan.interface_fields)
+            files += write_modes(folder, case.modes, case.mech.u, [b.name for b in tm.bodies])
+            split = energy_split(tm)
+            masks = tm.interface.masks()
 
-        def figures():
-            out = [plot_pressure(tm.interface.midpoints, masks, case.facet_pressure, case.name, folder / "pressure.png"),
-                   plot_re_im([case], folder / "re_im.png"), plot_energy(case, folder / "energy.png", split)]
-            if case.prestress is not None:
-                out.append(write_prestress_csv(case.prestress, folder / "prestress.csv"))
-            return out
-        files += io.on_root(comm, figures, f"the figures in {folder}") or []
-    smap = None
-    if scene.stability.sweep is not None:
-        with io.stage("stability map"):
-            smap = squeal_map.stability_map(scene, tm, case.mech, squeal_options(scene, tm),
-                                            drive(model_scene(scene), tm).load,
-                                            lambda changed: build_squeal_mechanics(changed, tm, degree=degree,
-                                                                                   prefix="squeal_map_"))
-            files += squeal_map.write(smap, folder, comm)
-    case.mech.close()                # on every rank in the same order (MUMPS' destruction communicates)
+            def figures():
+                out = [plot_pressure(tm.interface.midpoints, masks, case.facet_pressure, case.name,
+                                     folder / "pressure.png"),
+                       plot_re_im([case], folder / "re_im.png"), plot_energy(case, folder / "energy.png", split)]
+                if case.prestress is not None:
+                    out.append(write_prestress_csv(case.prestress, folder / "prestress.csv"))
+                return out
+            files += io.on_root(comm, figures, f"the figures in {folder}") or []
+        smap = None
+        if scene.stability.sweep is not None:
+            with io.stage("stability map"):
+                smap = squeal_map.stability_map(scene, tm, case.mech, squeal_options(scene, tm),
+                                                drive(model_scene(scene), tm).load,
+                                                lambda changed: build_squeal_mechanics(changed, tm, degree=degree,
+                                                                                       prefix="squeal_map_"))
+                files += squeal_map.write(smap, folder, comm)
+        case.mech.close()                # on every rank in the same order (MUMPS' destruction communicates)
     result = SquealResult(folder, files, time.perf_counter() - t0, case, smap, tuple(_left_out(scene, case, smap)))
     if verbose and comm.rank == 0:
         rep = case.report

@@ -16,6 +16,7 @@ from mpi4py import MPI
 
 from multiscale import io, outputs
 from multiscale.errors import Interrupted
+from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.output import FieldOutput
 from multiscale.plots.history import history_figure
 from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, run_notes
@@ -54,34 +55,36 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     folder = out.path
     with io.stage("meshing"):
         tm = build_mesh(scene, comm)
-    with io.stage("first contact solve"), heat_warnings_as_notes():
+    with io.stage("model set-up"), heat_warnings_as_notes():
         model = build_model(scene, comm, tm=tm)
-        model.start()
-    out.claim()                          # --overwrite: the earlier results go now, not before a failed start
-    plan = outputs.plan(scene)
-    writer = FieldOutput(model, folder, plan.body_fields + plan.interface_fields)
-    history = io.History()
-    history.append(**model.record())
-    writer.write()
-    write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
-    steps = scene.time.steps if model.thermal is not None else 0
-    done, stopping = 0, False
-    with io.StepStop(comm) as stop, heat_warnings_as_notes():   # a Ctrl-C while the end is written lets it finish
-        with io.stage("macro steps"):
-            for n in io.bar(range(1, steps + 1), "macro steps"):
-                heat = model.macro_step(scene.time.dt, scene.time.substeps)
-                with stop.writing(n):            # the step's fields and history, whole
-                    history.append(**model.record(heat))
-                    done, stopping = n, stop.requested()
-                    if n % scene.output.every == 0 or n == steps or stopping:
-                        writer.write()
-                    if n < steps:                # a killed run keeps the history of its steps
-                        write_history(history, folder, scene.name, comm, plot=False)
-                if stopping:
-                    break
-        with io.stage("writing history and plots"), stop.writing(done):
-            h5, png = write_history(history, folder, scene.name, comm)
-    model.close()                    # on every rank in the same order (MUMPS' destruction communicates)
+    with closed_on_error(model, comm):           # a script going on after a failed run gets its communicators
+        with io.stage("first contact solve"), heat_warnings_as_notes():
+            model.start()
+        out.claim()                          # --overwrite: the earlier results go now, not before a failed start
+        plan = outputs.plan(scene)
+        writer = FieldOutput(model, folder, plan.body_fields + plan.interface_fields)
+        history = io.History()
+        history.append(**model.record())
+        writer.write()
+        write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
+        steps = scene.time.steps if model.thermal is not None else 0
+        done, stopping = 0, False
+        with io.StepStop(comm) as stop, heat_warnings_as_notes():   # a Ctrl-C while the end is written lets it finish
+            with io.stage("macro steps"):
+                for n in io.bar(range(1, steps + 1), "macro steps"):
+                    heat = model.macro_step(scene.time.dt, scene.time.substeps)
+                    with stop.writing(n):            # the step's fields and history, whole
+                        history.append(**model.record(heat))
+                        done, stopping = n, stop.requested()
+                        if n % scene.output.every == 0 or n == steps or stopping:
+                            writer.write()
+                        if n < steps:                # a killed run keeps the history of its steps
+                            write_history(history, folder, scene.name, comm, plot=False)
+                    if stopping:
+                        break
+            with io.stage("writing history and plots"), stop.writing(done):
+                h5, png = write_history(history, folder, scene.name, comm)
+        model.close()                    # on every rank in the same order (MUMPS' destruction communicates)
     if stopping:                     # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", run_notes(model))
     result = TransientResult(folder, writer.files + [h5, png], _time.perf_counter() - start, history, h5, png,
