@@ -9,12 +9,14 @@ of every key, as the pages name them (a test checks that every key appears).
 from __future__ import annotations
 
 import dataclasses
+import re
 
-from multiscale.geometry import builder
+from multiscale.geometry import MAX_CELLS, builder
 from multiscale.outputs import WRITES, array_name
-from multiscale.schema import (Curve, Either, ListOf, Named, Quantity, Section, TableOr, Tables, fields_of, show)
+from multiscale.schema import (Curve, Either, Integer, ListOf, Named, Quantity, Section, TableOr, Tables, fields_of,
+                               show)
 from multiscale.scene import EFFECTS, OUTPUT_FIELDS, Scene
-from multiscale.scene_geometry import FileGeometry, GeometrySection
+from multiscale.scene_geometry import MAX_CELLS_TEXT, FileGeometry, GeometrySection, parameter_kind
 from multiscale.scene_sections import InterfaceSettings
 
 
@@ -97,19 +99,30 @@ def _tables(cls, path: str, effects: tuple, title: str, level: str = "-") -> lis
     return lines
 
 
+def _sentences(text: str, words: int) -> str:
+    """The leading whole sentences of ``text`` within ``words`` words (at least the first sentence)."""
+    out = []
+    for sentence in re.split(r"(?<=\.)\s+(?=[A-Z])", " ".join(text.split())):
+        if out and len(" ".join(out + [sentence]).split()) > words:
+            break
+        out.append(sentence)
+    return " ".join(out)
+
+
 def _geometry() -> list[str]:
-    lines = ["[geometry]", "-" * 10, "", _cell(" ".join(GeometrySection.__doc__.split())), ""]
     section = GeometrySection()
+    rows = [("``geometry.builder``", _cell(section.builders.describe()), " ", "required (or file)", " ", "any"),
+            ("``geometry.max_cells``", _cell(f"{Integer(ge=1).describe()}: {MAX_CELLS_TEXT}"), "-", show(MAX_CELLS),
+             " ", "any")]
+    lines = ["[geometry]", "-" * 10, "", _cell(" ".join(GeometrySection.__doc__.split())), ""] + _list_table(rows)
     for name in section.builders.options:
         module = builder(name)
         title = f'builder = "{name}"'
-        doc = " ".join((module.__doc__ or "").split()[:60])
+        doc = _sentences(module.__doc__ or "", 60)
         lines += [title, "~" * len(title), "", _cell(doc), "", ".. list-table::", "   :header-rows: 1", "",
                   "   * - key", "     - kind", "     - default (SI)"]
-        kinds = getattr(module, "PARAMETER_KINDS", {})
         for key, value in module.DEFAULTS.items():
-            kind = kinds.get(key, "angle" if "angle" in key else "length")
-            lines += [f"   * - ``geometry.{key}``", f"     - {kind}", f"     - {value:g}"]
+            lines += [f"   * - ``geometry.{key}``", f"     - {parameter_kind(module, key)}", f"     - {value:g}"]
         lines.append("")
     return lines + _tables(FileGeometry, "geometry", (), 'file = "..." (your own geometry)', "~")
 
@@ -164,6 +177,7 @@ def key_paths(cls=Scene, path: str = "") -> list[str]:
         where = f"{path}.{name}" if path else name
         parser = spec.parser
         if isinstance(parser, GeometrySection):
+            out += ["geometry.builder", "geometry.max_cells"]
             out += [f"geometry.{k}" for b in parser.builders.options for k in builder(b).DEFAULTS]
             out += key_paths(FileGeometry, "geometry")
         elif where == "interfaces":

@@ -202,7 +202,11 @@ class Geometry:
         return tuple(self.spec.faces) + tuple(f"free:{n}" for n in dict.fromkeys(self.bodies + self.regions))
 
 
-def _parameter_kind(module, name: str) -> str:
+MAX_CELLS_TEXT = ("a mesh estimated larger (trial meshes before meshing) is refused; multiscale run --max-cells "
+                  "overrides it")
+
+
+def parameter_kind(module, name: str) -> str:
     """Unit kind of a builder parameter: the module's PARAMETER_KINDS ("count": a whole number),
     else angle/length by name."""
     kinds = getattr(module, "PARAMETER_KINDS", {})
@@ -222,12 +226,11 @@ class GeometrySection(Section):
 
     def reference(self, path) -> list[str]:
         lines = [f"  {'builder':<20} {self.builders.describe()}  [or file]",
-                 f"  {'max_cells':<20} integer >= 1, default {MAX_CELLS}: a mesh estimated larger (trial meshes "
-                 "before meshing) is refused; multiscale run --max-cells overrides it"]
+                 f"  {'max_cells':<20} integer >= 1, default {MAX_CELLS}: {MAX_CELLS_TEXT}"]
         for name in self.builders.options:
             module = builder(name)
             lines.append(f"  builder = \"{name}\" parameters (SI defaults; 0 = the builder's fallback):")
-            lines += [f"    {k:<22} {_parameter_kind(module, k):<8} {v:g}" for k, v in module.DEFAULTS.items()]
+            lines += [f"    {k:<22} {parameter_kind(module, k):<8} {v:g}" for k, v in module.DEFAULTS.items()]
         lines.append("  file = \"...\" (.msh, .geo, .step/.stp, .iges/.igs, .brep) with:")
         return lines + ["  " + line for line in schema_reference(FileGeometry, path)]
 
@@ -259,7 +262,7 @@ class GeometrySection(Section):
         for param, value in given.items():
             if param in module.DEFAULTS:
                 zero_ok = float(module.DEFAULTS[param]) == 0.0    # 0 means "builder's fallback"
-                kind = _parameter_kind(module, param)
+                kind = parameter_kind(module, param)
                 parser = Integer(ge=0 if zero_ok else 1) if kind == "count" else \
                     Quantity(kind, **({"ge": 0} if zero_ok else {"gt": 0}), plausible=_PLAUSIBLE.get(kind))
                 params[param] = parse(parser, value, f"{path}.{param}", ctx)
