@@ -38,6 +38,7 @@ from __future__ import annotations
 import numpy as np
 import scipy.sparse
 from dolfinx import fem
+from dolfinx.cpp.mesh import cell_num_entities
 from dolfinx.fem import petsc as fpetsc
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -61,10 +62,10 @@ def cell_parts(mesh) -> tuple[np.ndarray, int]:
     tdim = mesh.topology.dim
     mesh.topology.create_connectivity(tdim, tdim - 1)
     cells, facets = mesh.topology.index_map(tdim), mesh.topology.index_map(tdim - 1)
-    owned = cells.size_local
-    c2f = mesh.topology.connectivity(tdim, tdim - 1).array.reshape(owned + cells.num_ghosts, -1)
+    owned, per_cell = cells.size_local, cell_num_entities(mesh.topology.cell_type, tdim - 1)
+    c2f = mesh.topology.connectivity(tdim, tdim - 1).array.reshape(-1, per_cell)   # a rank may hold no cells
     mine = (cells.local_to_global(np.arange(owned, dtype=np.int32)),
-            facets.local_to_global(c2f[:owned].ravel()).reshape(owned, -1))
+            facets.local_to_global(c2f[:owned].ravel()).reshape(owned, per_cell))
     gathered = mesh.comm.gather(mine, root=0)
     labels = None
     if mesh.comm.rank == 0:

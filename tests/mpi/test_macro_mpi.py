@@ -80,6 +80,25 @@ def test_the_unloaded_state_on_two_ranks():
     t.test_a_held_flat_is_stressed_as_the_linear_elasticity_solved_directly(tm)
 
 
+def test_the_parts_of_a_body_whose_cells_are_all_on_one_rank():
+    """``unloaded.cell_parts`` on a mesh of which rank 1 holds no cell (the pin of the pin-on-disc
+    demo on two ranks: its first released step, with expansion, stopped with a reshape error on
+    that rank): the cells of two slabs of a cube that rank 0 owns get parts 0 .. count-1 there,
+    both ranks the same count."""
+    from dolfinx import mesh as dmesh
+    from multiscale.macro.unloaded import cell_parts
+    world = MPI.COMM_WORLD
+    whole = dmesh.create_unit_cube(world, 5, 5, 5, ghost_mode=dmesh.GhostMode.shared_facet)
+    owned = np.arange(whole.topology.index_map(3).size_local if world.rank == 0 else 0, dtype=np.int32)
+    x = dmesh.compute_midpoints(whole, 3, owned)[:, 0]
+    slabs = dmesh.create_submesh(whole, 3, owned[(x < 0.2) | (x > 0.8)])[0]
+    cells = slabs.topology.index_map(3)
+    assert cells.size_global > 0 and (cells.size_local + cells.num_ghosts == 0) == (world.rank == 1)
+    label, count = cell_parts(slabs)
+    assert label.size == cells.size_local + cells.num_ghosts and world.allgather(count) == [count] * 2
+    assert count >= 1 and (world.rank == 1 or set(label) == set(range(count)))
+
+
 def test_two_ranks_give_the_serial_per_pad_heat(tmp_path):
     """The heated disc brake's history on two ranks is the serial one (1e-8), and its per-pad
     columns (frictional heat, face temperatures: from global facet arrays) are the same on both
