@@ -2,6 +2,9 @@
 the guide itself is built by `make docs` (part of `make test`), failing on any warning."""
 import dataclasses
 import re
+from pathlib import Path
+
+import pytest
 
 from multiscale.reference_docs import key_paths, scene_rst, study_rst
 from multiscale.schema import Section, fields_of
@@ -57,3 +60,20 @@ def test_every_study_key_appears_in_the_generated_study_format():
     text = study_rst()
     for path in key_paths(StudyFile):
         assert f"``{path}``" in text, path
+
+
+def test_the_micro_patch_tutorial_runs_and_gives_the_numbers_it_quotes(capsys):
+    """The tutorial's first code block, run as shown (256², seconds), prints the 256² numbers its
+    text quotes: area, approach and iterations (the first of each quoted triple)."""
+    text = (Path(__file__).resolve().parents[1] / "docs" / "tutorials" / "micro_patch.rst").read_text()
+    block = re.search(r"\.\. code-block:: python\n\n((?:    .*\n|\n)+)", text).group(1)
+    scope = {}
+    exec("\n".join(line[4:] for line in block.splitlines()), scope)
+    assert "real contact area" in capsys.readouterr().out
+    r = scope["r"]
+    approach = float(re.search(r"approach settles .*?\((\S+),", text).group(1))
+    area = float(re.search(r"real contact area still\s+moves .*?\((\S+),", text, re.S).group(1))
+    iterations = int(re.search(r"\((\d+), \d+, \d+ here\)", text).group(1))
+    assert 1e6 * r.approach == pytest.approx(approach, abs=5e-4)       # quoted to 1e-3 um
+    assert 100 * r.area_fraction == pytest.approx(area, abs=5e-3)      # quoted to 0.01 %
+    assert r.iterations == iterations
