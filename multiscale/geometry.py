@@ -301,9 +301,10 @@ def check_cells(module: ModuleType, params, max_cells: int, keep: bool = False,
 
 def too_many_cells(estimate: CellEstimate, max_cells: int) -> InputError:
     """The error of a mesh estimated above ``max_cells`` (what to change)."""
+    size = f"{estimate.cells} cells (exact)" if estimate.exact else \
+        f"about {estimate.cells:.3g} cells (a trial mesh {estimate.factor:.3g}x coarser has {estimate.trial})"
     return InputError("geometry.max_cells", max_cells,
-                      f"the mesh would have about {estimate.cells:.3g} cells (a trial mesh {estimate.factor:.3g}x "
-                      f"coarser has {estimate.trial}): coarsen the geometry's mesh sizes (geometry.mesh_size "
+                      f"the mesh would have {size}: coarsen the geometry's mesh sizes (geometry.mesh_size "
                       "and the other *mesh_size), or allow it with geometry.max_cells or multiscale run --max-cells")
 
 

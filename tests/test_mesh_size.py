@@ -2,6 +2,7 @@
 meshing without end): trial meshes with every element size scaled up, extrapolated as a volume
 mesh (``multiscale.geometry.estimate_cells``); a mesh estimated above ``geometry.max_cells`` is
 refused before meshing, on every rank, with one message."""
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -61,6 +62,16 @@ def test_the_estimate_of_a_small_mesh_is_its_count():
     """A mesh smaller than the trial target is meshed at its size: the exact count."""
     estimate = estimate_cells(builder("block_on_flat"), {})
     assert estimate.exact and estimate.cells == cells("block_on_flat", {})
+
+
+def test_a_small_mesh_above_the_limit_is_refused_with_its_exact_count():
+    """Counted on the mesh itself (factor 1), the refusal gives the count, not 'a trial mesh 1x
+    coarser' (multiscale run of the perfect pin-on-disc with geometry.max_cells = 100 said so)."""
+    estimate = estimate_cells(builder("block_on_flat"), {})
+    with pytest.raises(InputError) as info:
+        check_cells(builder("block_on_flat"), {}, 100)
+    assert estimate.exact and f"the mesh would have {estimate.cells} cells (exact): " in str(info.value)
+    assert "coarser" not in str(info.value)
 
 
 def test_an_absurd_mesh_size_is_refused_before_meshing():
@@ -140,7 +151,7 @@ def test_the_limit_of_a_run_two_ranks(tmp_path):
                           start_new_session=True)
     errors = [line for line in done.stderr.splitlines() if line.startswith("error")]
     assert done.returncode == 2, done.stderr[-2000:]
-    assert len(errors) == 1 and "geometry.max_cells = 50: the mesh would have about" in errors[0]
+    assert len(errors) == 1 and re.search(r"geometry.max_cells = 50: the mesh would have \d+ cells \(exact\)", errors[0])
 
 
 def test_max_cells_in_the_scene_and_on_the_command_line(tmp_path, capsys):
@@ -165,7 +176,8 @@ def test_max_cells_in_the_scene_and_on_the_command_line(tmp_path, capsys):
     captured = capsys.readouterr()
     assert "refused by run geometry.max_cells = 100" in captured.out and "scene.toml: OK" not in captured.out
     errors = [x for x in captured.err.splitlines() if x.startswith("error: ")]
-    assert len(errors) == 1 and errors[0].startswith("error: geometry.max_cells = 100: the mesh would have about")
+    assert len(errors) == 1 and re.match(r"error: geometry.max_cells = 100: the mesh would have \d+ cells \(exact\)",
+                                         errors[0])
     with pytest.raises(SystemExit):
         main(["run", str(path), "--max-cells", "2.5"])
     assert "a whole number" in capsys.readouterr().err
