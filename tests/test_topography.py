@@ -95,19 +95,30 @@ def test_plain_matrices_still_read_as_before(tmp_path):
     # it for a 0 x 0 map), or a .npy ended in numpy's EOFError traceback
     ("empty x3p", r"roughness\.file = 'pad\.x3p': the file is empty \(0 bytes\)$"),
     ("empty npy", r"roughness\.file = 'pad\.npy': the file is empty \(0 bytes\)$"),
+    # a map 1 or 3 points wide: Surface's "heights.shape = (50, 1): need a grid of at least 4 x 4
+    # points", naming neither the file nor the field, and `multiscale check` passed it
+    ("one pixel wide", r"roughness\.file = 'line\.nc': channel 0 \(\"[^\"]*\"\) has 1 x 50 points: a height map "
+                       r"of at least 4 x 4 points is needed$"),
+    ("tiny matrix", r"roughness\.file = 'crop\.npy': the height matrix has 3 x 3 points: a height map of at "
+                    r"least 4 x 4 points is needed$"),
 ])
 def test_bad_input_is_one_clear_error_naming_the_file_and_the_field(tmp_path, case, message):
     path, channel = {"empty x3p": (tmp_path / "pad.x3p", None), "empty npy": (tmp_path / "pad.npy", None),"unreadable": (tmp_path / "pad.x3p", None), "garbage sur": (tmp_path / "pad.sur", None),
                      "missing": (tmp_path / "nowhere.x3p", None), "unknown channel": (DATA / "top-1.top", 3),
                      "all undefined": (tmp_path / "empty.nc", None), "profile": (DATA / "opdx-3.opdx", None),
-                     "all undefined matrix": (tmp_path / "empty.npy", None)}[case]
+                     "all undefined matrix": (tmp_path / "empty.npy", None),
+                     "one pixel wide": (tmp_path / "line.nc", None), "tiny matrix": (tmp_path / "crop.npy", None)}[case]
     if case in ("unreadable", "garbage sur"):
         path.write_bytes(b"this is no topography\n" * 40)
     if case.startswith("empty"):
         path.write_bytes(b"")
     if case == "all undefined":
         write_nc(path, np.full((6, 8), np.nan), 1e-6, 1e-6)
-    pixel = 1e-6 if case == "empty npy" else None
+    if case == "one pixel wide":
+        write_nc(path, np.linspace(0, 1e-6, 50)[:, None] ** 2, 1e-6, 1e-6)
+    if case == "tiny matrix":
+        np.save(path, np.arange(9.0).reshape(3, 3) ** 2 * 1e-9)
+    pixel = 1e-6 if case in ("empty npy", "tiny matrix") else None
     if case == "all undefined matrix":     # it said "heights up to nan m overflow ... is height_unit right?"
         np.save(path, np.full((6, 8), np.nan))
         pixel = 1e-6

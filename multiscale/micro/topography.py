@@ -215,7 +215,11 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
 
 def _height_range(h: np.ndarray, path: Path, prefix: str, unit: str, what: str = "the height matrix") -> list[str]:
     """A note if the heights [m] (NaN: undefined) reach beyond ``TALLEST`` (heights read in the
-    wrong unit, e.g. um as m); an InputError if none is defined or their spread overflows."""
+    wrong unit, e.g. um as m); an InputError if the map is narrower than a ``Surface`` (4 points a
+    side), none is defined or their spread overflows."""
+    if min(h.shape) < 4:        # a line scan stored as a map, a tiny crop: Surface's error named no file
+        raise InputError(f"{prefix}file", path.name, f"{what} has {h.shape[1]} x {h.shape[0]} points: a height map "
+                         "of at least 4 x 4 points is needed")
     if not np.isfinite(h).any():
         raise InputError(f"{prefix}file", path.name, f"{what} holds no defined height")
     with np.errstate(over="ignore", invalid="ignore"):
