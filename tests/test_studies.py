@@ -278,6 +278,22 @@ def test_bad_study_files_give_clear_errors(tmp_path, capsys, what, change, messa
     assert "Traceback" not in err and not (tmp_path / "results").exists()
 
 
+def test_every_problem_of_a_study_file_at_once(tmp_path, capsys):
+    """A problem of [run] or [report] hid those of the metrics, [fixed] and [sweep] (and the
+    reference): the user fixed them in rounds, the docs say every problem at once."""
+    text = HERTZ.replace("processes = 2", "processes = 0").replace('"approach"]', '"aproach"]')
+    text = text.replace('load = "10 N"', "load = -10").replace("grid = [12", "gird = [12")
+    text = text.replace('kind = "analytic"', 'kind = "run"').replace('errors = ["1 %", "5 %"]', 'errors = ["abc"]')
+    assert main(["study", str(write(tmp_path, text))]) == 2
+    err = capsys.readouterr().err
+    for message in ("run.processes = 0: must be an integer >= 1", "report.errors = [\"abc\"]",
+                    'metrics item 3 ("aproach"): unknown metric', "fixed.load = -10: must be > 0 N",
+                    'sweep.gird: unknown parameter of problem "hertz"',
+                    'reference.run: missing; needed with reference.kind = "run"'):
+        assert message in err, err
+    assert len(err.strip().splitlines()) == 6 and "Traceback" not in err
+
+
 def scene_study(tmp_path, demo: str, rest: str) -> Path:
     """A study file of problem "scene" on a demo scene; ``rest``: its metrics and tables."""
     return write(tmp_path, f'problem = "scene"\nscene = "{(ROOT / "demos" / demo).resolve()}"\n{rest}')

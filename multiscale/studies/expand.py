@@ -79,14 +79,14 @@ def load_study(path) -> Study:
     if f.problem is not None and f.problem not in PROBLEMS:
         ctx.problems.append(f"problem = {show(f.problem)}: unknown problem{suggest(f.problem, PROBLEMS)}; "
                             f"known: {', '.join(PROBLEMS)}")
-    if ctx.problems:
-        raise SceneError(ctx.problems)
-    problem = PROBLEMS[f.problem]
     scene_problem = f.problem == "scene"
-    if scene_problem != (f.scene is not None):
-        raise SceneError("scene: missing; problem \"scene\" needs the base scene file" if scene_problem else
-                         f"scene: only used with problem = \"scene\" (problem is \"{f.problem}\")")
-    for i, name in enumerate(f.metrics, 1):
+    if f.problem in PROBLEMS and scene_problem != ("scene" in raw):
+        ctx.problems.append("scene: missing; problem \"scene\" needs the base scene file" if scene_problem else
+                            f"scene: only used with problem = \"scene\" (problem is \"{f.problem}\")")
+    if f.problem not in PROBLEMS or scene_problem and f.scene is None or f.sweep is None:
+        raise SceneError(ctx.problems)        # nothing to check the rest against; else every problem at once
+    problem = PROBLEMS[f.problem]
+    for i, name in enumerate(f.metrics or (), 1):
         why = problem.check_metric(name, f.scene)
         if why:
             ctx.problems.append(f"metrics item {i} ({show(name)}): {why}")
@@ -95,7 +95,8 @@ def load_study(path) -> Study:
     name = f.name or path.stem
     extra = {"scene": f.scene, "ranks": f.run.ranks} if scene_problem else {}
     runs = _runs(f, problem, knobs, values, extra, ctx) if len(ctx.problems) == before else ()
-    if f.reference is not None and runs:
+    ref = f.reference      # checked against the runs when the schema found it whole
+    if runs and f.metrics and ref is not None and ref.kind is not None and not ref.problems("reference", ctx):
         _check_reference(f, problem, knobs, axes, runs, ctx)
     for option in ("cases", "average_over"):
         for k in getattr(f.report, option):
