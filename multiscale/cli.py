@@ -24,7 +24,7 @@ from multiscale.micro.topography import (DETREND, MAX_UNDEFINED, TopographyWarni
 from multiscale.outputs import CHECKPOINT, analysis, folder_problem, plan
 from multiscale.outputs import summary as plan_summary
 from multiscale.scene import load
-from multiscale.scene_plain import pixel_problem
+from multiscale.scene_plain import pixel_problem, plain
 from multiscale.scene_summary import cells_line, reference, summary
 from multiscale.units import UnitError, to_si
 
@@ -272,10 +272,19 @@ def _surface(args) -> int:
     if pixel is not None and (problem := pixel_problem(pixel, _number_or_text(args.pixel_size))):
         raise InputError("--pixel-size", args.pixel_size, problem)
     unit = _length("--height-unit", args.height_unit, unit_name=True)
+    figure = None if args.figure in (None, "none") else Path(args.figure)
+    if figure is not None:
+        from multiscale.plots.surface import figure_problem   # local: matplotlib only when a figure is drawn
+        if why := figure_problem(figure):     # said before the analysis (minutes on a large file), not after
+            raise InputError("--figure", args.figure, f"cannot write the figure there: {why}")
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", TopographyWarning)      # the report's "warning:" lines say them
             measurement = read_topography(args.file, args.channel, pixel_size=pixel, height_unit=unit)
+        if cutoff is not None and plain(_number_or_text(args.cutoff)) and cutoff > min(measurement.size):
+            Lx, Ly = measurement.size       # ISO cut-offs are given in mm: "--cutoff 0.8" was 0.8 m, silently
+            raise InputError("cutoff", args.cutoff, f"{cutoff:g} m, longer than the measurement ({Lx * 1e3:.4g} x "
+                             f'{Ly * 1e3:.4g} mm); plain numbers are metres: did you mean "{args.cutoff} mm"?')
         done = condition(measurement, args.detrend, cutoff, args.max_undefined)
     except InputError as exc:     # the micro fields by their command-line names
         name = "FILE" if exc.name == "file" else "--" + exc.name.replace("_", "-")
@@ -284,18 +293,17 @@ def _surface(args) -> int:
     print("\n".join(done.report))
     print(f"statistics of the {'roughness' if done.waviness is not None else 'surface'}:")
     print("\n".join(stats.table()))
-    if args.figure in (None, "none"):        # a figure only where asked: nothing lands in the working folder
+    if figure is None:        # a figure only where asked: nothing lands in the working folder
         if args.figure is None:
             print("figure: none written (--figure PATH.png draws the height map and the PSD with its fit)")
     else:
-        from multiscale.plots.surface import surface_figure   # matplotlib: only when a figure is drawn
-        path = Path(args.figure)
+        from multiscale.plots.surface import surface_figure   # local: matplotlib only when a figure is drawn
         try:
-            surface_figure(done.surface, stats, path, f"{Path(args.file).name}, channel {measurement.channel}",
+            surface_figure(done.surface, stats, figure, f"{Path(args.file).name}, channel {measurement.channel}",
                            waviness=done.waviness)
-        except (OSError, ValueError) as exc:   # no such folder, a format matplotlib does not write
-            raise InputError("--figure", str(path), f"cannot write the figure there: {exc}") from None
-        print(f"figure: {path}")
+        except (OSError, ValueError) as exc:   # a folder it may not write into, a full disk
+            raise InputError("--figure", str(figure), f"cannot write the figure there: {exc}") from None
+        print(f"figure: {figure}")
     return 0
 
 

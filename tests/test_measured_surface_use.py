@@ -58,6 +58,9 @@ def test_surface_command_prints_the_steps_and_surfacetopographys_sq(tmp_path, ca
     (["--channel", "2"], 'error: --channel = 2: top-1.top has the channels 0 "Default" (2-D)'),
     (["--cutoff", "3 kg"], 'error: --cutoff = \'3 kg\': expected a length'),
     (["--cutoff", "1 nm"], "error: --cutoff = 1e-09: λc must span at least 2 pixels (4.69e-09 m): top-1.top's pixels"),
+    # ISO cut-offs are said in mm: "--cutoff 0.8" filtered at 0.8 m, "little is removed", and went on
+    (["--cutoff", "0.8"], "error: --cutoff = '0.8': 0.8 m, longer than the measurement (0.0006 x 0.0006 mm); plain "
+                          'numbers are metres: did you mean "0.8 mm"?'),
 ])
 def test_surface_command_bad_options_are_one_line(capsys, args, message):
     assert main(["surface", str(TOP), "--figure", "none", *args]) == 2
@@ -65,14 +68,18 @@ def test_surface_command_bad_options_are_one_line(capsys, args, message):
     assert err.startswith(message) and "Traceback" not in err and len(err.strip().splitlines()) == 1
 
 
-@pytest.mark.parametrize("figure, message", [("missing_folder/x.png", "No such file or directory"),
-                                             ("x.txt", "Format 'txt' is not supported")])
+@pytest.mark.parametrize("figure, message", [("missing_folder/x.png", "no folder "),
+                                             ("x.txt", "a figure is a .avif, .eps, "),
+                                             ("x", "(matplotlib), not a name without extension")])
 def test_surface_command_figure_that_cannot_be_written_is_one_line(tmp_path, capsys, figure, message):
-    """(A traceback from matplotlib before; an adversarial test.)"""
+    """(A traceback from matplotlib before; an adversarial test.) Said before the analysis, which
+    takes minutes on a large file (it came after the statistics); a name without extension was
+    written as NAME.png while the command said NAME."""
     assert main(["surface", str(TOP), "--figure", str(tmp_path / figure)]) == 2
-    err = capsys.readouterr().err
+    out, err = capsys.readouterr()
     assert err.startswith("error: --figure = ") and "cannot write the figure there: " in err
     assert message in err and len(err.strip().splitlines()) == 1
+    assert out == "" and list(tmp_path.iterdir()) == []
 
 
 def test_surface_command_lists_the_formats(capsys):

@@ -5,7 +5,20 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
+from matplotlib.backend_bases import FigureCanvasBase
 from matplotlib.figure import Figure
+
+
+def figure_problem(path: Path) -> str | None:
+    """Why ``surface_figure`` cannot write ``path`` (no such folder, a format matplotlib does not
+    write), or None."""
+    kinds = FigureCanvasBase.get_supported_filetypes()
+    if not path.parent.is_dir():
+        return f"no folder {path.parent}"
+    if path.suffix[1:].lower() not in kinds:     # none: matplotlib wrote PATH.png, not the PATH said
+        return (f"a figure is a .{', .'.join(sorted(kinds))} file (matplotlib), not "
+                f"{'.' + path.suffix[1:] if path.suffix else 'a name without extension'}")
+    return None
 
 
 def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -> Path:
