@@ -120,7 +120,11 @@ def test_rerun_skips_finished_runs_and_runs_only_new_points(hertz_study, capsys)
     path.write_text(HERTZ.replace("grid = [12, 16, 24, 32]", "grid = {start = 12, stop = 24, step = 4}")
                     + "plots = false\n")
     assert main(["study", str(path)]) == 0
-    assert "4 recorded before, 0 run now" in capsys.readouterr().out
+    out_text = capsys.readouterr().out
+    assert "4 recorded before, 0 run now" in out_text
+    # the run of grid 32 is no longer in the study: said (nothing was), kept, out of the table
+    assert f"hertz: 1 other record in {out / 'runs'} (runs not in this study: its file changed since they ran" in out_text
+    assert len(table(out / "results.csv")) == 4 and len(list((out / "runs").glob("*.json"))) == 5
 
 
 def test_reference_from_a_stored_file_and_records_shared_by_studies(hertz_study, tmp_path, capsys):

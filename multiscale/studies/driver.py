@@ -6,6 +6,7 @@ from pathlib import Path
 
 from multiscale.errors import SceneError
 from multiscale.studies.expand import load_study
+from multiscale.studies.records import foreign_records
 from multiscale.studies.reporting import report, write_index
 from multiscale.studies.results import collect, write_tables
 from multiscale.studies.running import execute, world
@@ -43,8 +44,12 @@ def run_studies(paths, *, rerun_failed: bool = False, report_folder=None, proces
         bad = sum(not r.ok for r in rows)
         failed += bad
         summaries.append((study, rows, md))
+        other = foreign_records(study)        # a changed study ran anew with nothing said
         print(f"{study.name}: {len(rows)} runs ({stats.done} recorded before, {stats.started} run now, "
-              f"{bad} failed); table {study.folder / 'results.csv'}; report {md}")
+              f"{bad} failed); table {study.folder / 'results.csv'}; report {md}" + (
+                  f"\n{study.name}: {other} other record{'s' if other > 1 else ''} in {study.folder / 'runs'} (runs "
+                  "not in this study: its file changed since they ran, or another study shares the folder): kept, "
+                  "not in the tables" if other else ""))
     if rank == 0 and report_folder is not None:
         index = write_index(summaries, Path(report_folder).resolve(), command)
         print(f"index {index}")

@@ -12,7 +12,7 @@ from pathlib import Path
 from multiscale.schema import FrozenMap, suggest
 from multiscale.studies.expand import Study, StudyRun
 
-__all__ = ["FAILED", "json_default", "metric_problem", "read_records", "record_path", "write_json"]
+__all__ = ["FAILED", "foreign_records", "json_default", "metric_problem", "read_records", "record_path", "write_json"]
 
 FAILED = "failed"              # a record's status when the run did not produce its metrics
 
@@ -51,6 +51,14 @@ def read_records(study: Study) -> dict:
                 record.update(status=FAILED if why else "ok", error=why or "")
             out[run.key] = record
     return out
+
+
+def foreign_records(study: Study) -> int:
+    """Records in the study's folder of runs it does not have: the study file changed since they
+    ran (a fixed value, a swept one taken out) or another study shares the folder. Kept (a change
+    undone finds them again) and left out of the tables."""
+    keys = {run.key for run in study.runs}
+    return sum(p.stem not in keys for p in (study.folder / "runs").glob("*.json"))
 
 
 def write_json(path: Path, data) -> None:
