@@ -17,8 +17,8 @@ from pathlib import Path
 from multiscale import __version__
 from multiscale.errors import InputError, MultiscaleError, OutputError, SceneError
 from multiscale.geometry import too_many_cells
-from multiscale.io import CtrlCWatch, abort, ended_together
-from multiscale.micro.spectrum import surface_statistics
+from multiscale.io import CtrlCWatch, abort, ended_together, memory_available
+from multiscale.micro.spectrum import statistics_memory, surface_statistics
 from multiscale.micro.topography import (DETREND, MAX_UNDEFINED, TopographyWarning, condition, formats,
                                         read_topography)
 from multiscale.outputs import CHECKPOINT, analysis, folder_problem, plan
@@ -281,6 +281,11 @@ def _surface(args) -> int:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", TopographyWarning)      # the report's "warning:" lines say them
             measurement = read_topography(args.file, args.channel, pixel_size=pixel, height_unit=unit)
+        need, free = statistics_memory(measurement.shape), memory_available()
+        if free is not None and need > free:      # the OOM killer ended it, without a word (8000² points)
+            raise InputError("file", measurement.path.name, f"{measurement.shape[1]} x {measurement.shape[0]} points: "
+                             f"their statistics need about {need / 1e9:.2g} GB of memory, {free / 1e9:.2g} GB are "
+                             "available: crop or coarsen the map first")
         if cutoff is not None and plain(_number_or_text(args.cutoff)) and cutoff > min(measurement.size):
             Lx, Ly = measurement.size       # ISO cut-offs are given in mm: "--cutoff 0.8" was 0.8 m, silently
             raise InputError("cutoff", args.cutoff, f"{cutoff:g} m, longer than the measurement ({Lx * 1e3:.4g} x "

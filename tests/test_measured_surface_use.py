@@ -4,6 +4,7 @@ zones the one rough-interface builder makes from them."""
 import dataclasses
 import subprocess
 import sys
+import tracemalloc
 import warnings
 from pathlib import Path
 
@@ -11,8 +12,11 @@ import numpy as np
 import pytest
 import SurfaceTopography as ST
 
+import multiscale.cli as cli
 from multiscale.cli import main
 from multiscale.errors import InputError, SceneError
+from multiscale.micro.spectrum import statistics_memory, surface_statistics
+from multiscale.micro.surface import Surface
 from multiscale.micro.topography import condition, cover, read_topography
 from multiscale.scene import loads
 
@@ -261,3 +265,28 @@ def test_a_pixel_size_of_a_millimetre_or_more_is_refused_on_the_command_line(tmp
             f"error: --pixel-size = {given!r}: {float(given.split()[0]) * (1e-3 if 'mm' in given else 1):g} m per "
             f"pixel; a measured surface's pixel is far below 1 mm (refused from 1 mm up){hint}"]
     assert main(["surface", str(tmp_path / "h.npy"), "--pixel-size", "0.5 um"]) == 0
+
+
+def test_a_map_too_large_for_the_memory_is_refused_before_its_statistics(monkeypatch, capsys):
+    """An 8000 x 8000 map took 20 GB for its statistics (2 min): beyond the memory available, the
+    OOM killer ends the command without a word; it is refused first, naming the file."""
+    monkeypatch.setattr(cli, "memory_available", lambda: 1e7)
+    assert main(["surface", str(TOP)]) == 2
+    out, err = capsys.readouterr()
+    assert err.splitlines() == ["error: FILE = 'top-1.top': 256 x 256 points: their statistics need about 0.02 GB of "
+                                "memory, 0.01 GB are available: crop or coarsen the map first"] and out == ""
+    monkeypatch.setattr(cli, "memory_available", lambda: None)       # unknown (not Linux): no check
+    assert main(["surface", str(TOP), "--figure", "none"]) == 0
+
+
+def test_the_memory_of_the_statistics_is_what_they_take():
+    """``statistics_memory`` against the peak that tracemalloc sees (numpy's arrays included), 5 %."""
+    s = Surface(np.random.default_rng(2).normal(0.0, 1e-7, (192, 320)), 1e-6, 1e-6, periodic=False)
+    surface_statistics(s)          # first call: imports and caches out of the count
+    tracemalloc.start()
+    try:
+        surface_statistics(s)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak == pytest.approx(statistics_memory(s.shape), rel=0.05)

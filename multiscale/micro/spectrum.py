@@ -380,6 +380,13 @@ class Statistics:
         return [f"  {name:<28} {value}" for name, value in rows]
 
 
+def statistics_memory(shape) -> float:
+    """Peak memory [bytes] of ``surface_statistics`` on a patch of ``shape`` (ny, nx): 300 bytes a
+    point, traced alike from 256² to 2000² points (the mirror-stitched periodogram, four times
+    the points, and its map of modes and bins)."""
+    return 300.0 * shape[0] * shape[1]
+
+
 def surface_statistics(surface: Surface, points_per_decade: int = 10) -> Statistics:
     """``Statistics`` of one patch (complete heights: fill undefined points first)."""
     if surface.heights.ndim != 2:
