@@ -186,6 +186,13 @@ def test_failing_and_timed_out_runs_are_recorded_and_the_rest_completes(tmp_path
     assert main(["study", str(slow)]) == 1
     rows = table(tmp_path / "results" / "slow" / "results.csv")
     assert all(r["status"] == "failed" and r["message"] == "timed out after 0.05 s (run.timeout)" for r in rows)
+    # the same limit: not run again; a longer one runs them (they stayed failed, "--rerun-failed" needed)
+    capsys.readouterr()
+    assert main(["study", str(slow)]) == 1
+    assert "3 recorded before, 0 run now, 3 failed" in capsys.readouterr().out
+    slow.write_text(slow.read_text().replace('timeout = "0.05 s"', 'timeout = "1 h"'))
+    assert main(["study", str(slow)]) == 1
+    assert "0 recorded before, 3 run now, 1 failed" in capsys.readouterr().out
 
 
 def test_sweep_expansion_products_zips_and_ranges(tmp_path):

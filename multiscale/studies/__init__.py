@@ -27,10 +27,10 @@ memory (``ru_maxrss``, children included) is its own; ``[run] processes`` of the
 under ``mpiexec -n N`` the runs are shared out over the ranks. A run's record (wall time, CPU
 time, peak memory, iterations, convergence, status, error message, metrics, analytic reference)
 is one JSON file ``runs/<key>.json``, ``key`` = hash of the problem and its validated parameters:
-finished runs are never recomputed (``--rerun-failed`` retries the failed ones); a failing,
-crashing or timed-out run is recorded as failed and the others go on. A run that completed keeps
-every metric it produced and is judged by the study's metrics when read: a misspelt history
-metric, corrected, is read from the same run.
+finished runs are never recomputed (``--rerun-failed`` retries the failed ones, a longer
+``run.timeout`` the timed-out ones); a failing, crashing or timed-out run is recorded as failed and
+the others go on. A run that completed keeps every metric it produced and is judged by the study's
+metrics when read: a misspelt history metric, corrected, is read from the same run.
 
 Output: ``results.csv`` and ``results.h5`` (one row per run), PNGs of each metric's relative error
 |m − m_ref| / |m_ref| against wall time (Pareto front highlighted) and against each knob, and a

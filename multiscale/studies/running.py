@@ -69,7 +69,7 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     bar, failed, running, previous, lifeline = None, 0, {}, {}, None
     try:                                     # the lock is released whatever happens from here
         records = read_records(study)
-        todo = [r for r in study.runs if not _done(records.get(r.key), rerun_failed)]
+        todo = [r for r in study.runs if not _done(records.get(r.key), rerun_failed, study.options.timeout)]
         mine = todo[rank::size]
         if progress and rank == 0 and mine:
             bar = tqdm(total=len(mine), desc=study.name, unit="run")
@@ -87,7 +87,7 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
                     continue
                 if proc.poll() is None:
                     _kill(proc)
-                    _failed_record(study, run, f"timed out after {timeout:g} s (run.timeout)")
+                    _failed_record(study, run, f"timed out after {timeout:g} s (run.timeout)", timed_out=timeout)
                 elif proc.returncode != 0 or not record_path(study, run).is_file():
                     _failed_record(study, run, _crash_message(study, run, proc.returncode))
                 del running[proc]
@@ -172,10 +172,15 @@ def _lifeline() -> tuple[int, int]:
     return os.pipe()
 
 
-def _done(record, rerun_failed: bool) -> bool:
-    """A run is done if it has a record, unless that failed and failed runs are retried (a record
-    that completed is judged by the study's metrics when read: ``records.read_records``)."""
-    return record is not None and not (rerun_failed and record.get("status") == FAILED)
+def _done(record, rerun_failed: bool, timeout: float | None) -> bool:
+    """A run is done if it has a record, unless that failed and failed runs are retried, or it timed
+    out under a shorter ``run.timeout`` than the study's ``timeout`` [s] now (None: none), raised to
+    let it finish (it stayed failed). A record that completed is judged by the study's metrics when
+    read (``records.read_records``)."""
+    if record is None or record.get("status") != FAILED:
+        return record is not None
+    limit = record.get("timed_out")
+    return not (rerun_failed or limit is not None and (timeout is None or timeout > limit))
 
 
 def _spawn(study: Study, run: StudyRun, rank: int, lifeline: int) -> subprocess.Popen:
@@ -218,6 +223,6 @@ def _crash_message(study, run, code) -> str:
     return why + (f": {lines[-1].strip()}" if lines else "")
 
 
-def _failed_record(study, run, message) -> None:
+def _failed_record(study, run, message, **extra) -> None:
     write_json(record_path(study, run), {"key": run.key, "problem": study.problem, "label": run.label,
-                                         "status": FAILED, "error": message, "metrics": {}, "finished": now()})
+                                         "status": FAILED, "error": message, "metrics": {}, "finished": now(), **extra})
