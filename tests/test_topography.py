@@ -313,6 +313,11 @@ def test_heights_in_the_wrong_unit_are_warned_about_and_an_overflow_refused(tmp_
     with warnings.catch_warnings():
         warnings.simplefilter("error", TopographyWarning)
         read_topography(tmp_path / "um.npy", pixel_size=1e-6, height_unit=1e-6)      # in its unit: no word
+    # the other way (a file in m said to be in nm: Sq 7.7e-17 m printed as a result, without a word)
+    with pytest.warns(TopographyWarning, match=r"file = 'm.npy': heights up to [0-9.e-]+ m \(Sq 1e-15 m, one unit of "
+                      r"the file = 1e-09 m\), far below a rough surface's: is height_unit right\?"):
+        np.save(tmp_path / "m.npy", h)
+        read_topography(tmp_path / "m.npy", pixel_size=1e-6, height_unit=1e-9)
     np.save(tmp_path / "huge.npy", h * 1e300)
     with pytest.raises(InputError, match=r"file = 'huge.npy': heights up to .* m overflow"):
         read_topography(tmp_path / "huge.npy", pixel_size=1e-6)

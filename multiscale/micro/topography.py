@@ -36,6 +36,7 @@ from multiscale.micro.surface import Surface, read_matrix
 MATRIX_SUFFIXES = (".npy", ".txt", ".csv", ".asc")    # plain height matrices (no units in the file)
 MAX_UNDEFINED = 0.1       # default largest fraction of undefined points that is filled
 TALLEST = 1e-2            # m: heights beyond are no roughness measurement (an instrument's z range is mm)
+LOWEST = 1e-10            # m: heights all within it are none either (an atomic step; offsets and noise exceed it)
 DETREND = {"none": None, "mean": "mean", "plane": "height", "poly2": "curvature"}   # -> SurfaceTopography
 COVER = ("measured", "mirror", "tile", "equivalent")
 ALPHA = np.sqrt(np.log(2) / np.pi)     # ISO 16610-21/-61 Gaussian: 50 % transmission at the cut-off
@@ -214,8 +215,8 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
 
 
 def _height_range(h: np.ndarray, path: Path, prefix: str, unit: str, what: str = "the height matrix") -> list[str]:
-    """A note if the heights [m] (NaN: undefined) reach beyond ``TALLEST`` (heights read in the
-    wrong unit, e.g. um as m); an InputError if the map is narrower than a ``Surface`` (4 points a
+    """A note if the heights [m] (NaN: undefined) reach beyond ``TALLEST`` or stay within ``LOWEST``
+    (heights read in the wrong unit, e.g. um as m, m as nm); an InputError if the map is narrower than a ``Surface`` (4 points a
     side), none is defined or their spread overflows."""
     if min(h.shape) < 4:        # a line scan stored as a map, a tiny crop: Surface's error named no file
         raise InputError(f"{prefix}file", path.name, f"{what} has {h.shape[1]} x {h.shape[0]} points: a height map "
@@ -227,9 +228,10 @@ def _height_range(h: np.ndarray, path: Path, prefix: str, unit: str, what: str =
     if not np.isfinite(sq):
         raise InputError(f"{prefix}file", path.name, f"heights up to {peak:.3g} m overflow (one unit of the "
                          f"file = {unit}): is {prefix}height_unit right?")
-    if peak > TALLEST:
+    if peak > TALLEST or 0 < peak < LOWEST:
         return [f"{prefix}file = '{path.name}': heights up to {peak:.3g} m (Sq {sq:.3g} m, one unit of the file = "
-                f"{unit}), far beyond a rough surface's: is {prefix}height_unit right?"]
+                f"{unit}), far {'beyond' if peak > TALLEST else 'below'} a rough surface's: is {prefix}height_unit "
+                "right?"]
     return []
 
 
