@@ -320,7 +320,7 @@ def test_overwrite_deletes_what_the_run_before_wrote_and_keeps_the_rest(tmp_path
     from mpi4py import MPI
 
     from multiscale.io import Reporter
-    from multiscale.workflows.output import prepare_folder
+    from multiscale.workflows.output import clear, prepare_folder
     folder = tmp_path / "out"
     _earlier_run(folder, ["pad.xdmf", "pad.h5", "modes_pad.bp", "history.h5", "wear_map_b.png"])
     (folder / "history.h5.part").write_bytes(b"x")
@@ -338,6 +338,11 @@ def test_overwrite_deletes_what_the_run_before_wrote_and_keeps_the_rest(tmp_path
     assert record["status"] == "running (or killed: no end was recorded)" and "block.xdmf" in record["files"]
     assert f"--overwrite: 2 entries of {folder} stay (not written by the run before): disc.xdmf, notes.txt" \
         in stream.getvalue()
+    (folder / "provenance.json").unlink()
+    stream = io.StringIO()
+    with Reporter(MPI.COMM_SELF, stream=stream):
+        clear(folder, ["notes.txt"])                    # one entry: "stays" (it said "1 entry ... stay")
+    assert f"--overwrite: 1 entry of {folder} stays (no record of a run" in stream.getvalue()
 
 
 

@@ -97,5 +97,5 @@ def clear(folder: Path, existing: list[str]) -> None:
     if kept:
         shown = ", ".join(kept[:3]) + (", ..." if len(kept) > 3 else "")
         why = "not written by the run before" if earlier else "no record of a run (provenance.json with its files)"
-        io.reporter().say(f"--overwrite: {provenance.entries(len(kept))} of {folder} stay ({why}): {shown}; "
-                          "files of the same name as a result are replaced")
+        io.reporter().say(f"--overwrite: {provenance.entries(len(kept))} of {folder} stay{'s' * (len(kept) == 1)} "
+                          f"({why}): {shown}; files of the same name as a result are replaced")
