@@ -109,7 +109,7 @@ class InterfacesSection(Named):
 class Scene:
     """A validated scene (SI units). ``effects`` is a frozenset; ask ``scene.has(effect)``."""
 
-    name: str | None = key(Text(r"[A-Za-z0-9_.-]+", "a name of letters, digits, _ . -"))
+    name: str | None = key(Text(r"[A-Za-z0-9_.-]+", "a name of letters, digits, _ . -"), absent="the scene file's name")
     description: str = key(Text(), default="")
     effects: frozenset = key(ListOf(_EFFECT_CHOICE, unique=True, min_len=1), required=True)
     geometry: Geometry | None = key(GeometrySection(), required=True)

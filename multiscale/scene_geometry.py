@@ -111,10 +111,12 @@ class FileGeometry:
     is in SI (or a unit string)."""
 
     file: Path | None = key(FilePath(), required=True)
-    unit: float | None = key(LengthUnit())                    # m per unit of the file's numbers (None: see above)
-    mesh_size: float | None = key(_LENGTH)                     # m, global element size (CAD, .geo)
-    interface_mesh_size: float | None = key(_LENGTH)           # m, element size on the interfaces
-    mesh_algorithm: str | None = key(Choice(MESH_ALGORITHMS))  # gmsh's 3-D mesher (CAD: "hxt"; .geo: the script's)
+    unit: float | None = key(LengthUnit(), absent="a STEP/IGES file's declared unit (mm if it declares none); "
+                             "metres for .msh, .geo, .brep")       # m per unit of the file's numbers
+    mesh_size: float | None = key(_LENGTH, absent="a .msh file's own mesh; needed for the other files")   # m
+    interface_mesh_size: float | None = key(_LENGTH, absent="mesh_size on the interfaces too")   # m
+    mesh_algorithm: str | None = key(Choice(MESH_ALGORITHMS), absent='"hxt" for CAD files; a .geo script\'s own '
+                                     "choice")                     # gmsh's 3-D mesher
     rotating: str | None = key(Text(), required=True)          # the body that rotates
     axis: tuple = key(_DIRECTION, default=(0.0, 0.0, 1.0))
     centre: tuple = key(_POINT, default=(0.0, 0.0, 0.0))       # m, a point on the axis

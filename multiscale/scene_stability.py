@@ -39,8 +39,9 @@ class Sweep:
     pressure: tuple | None = key(ListOf(Quantity("pressure", gt=0), min_len=2))          # Pa
     speed: tuple | None = key(ListOf(Quantity("angular_speed", ge=0), min_len=2))       # rad/s
     rms: tuple | None = key(ListOf(Quantity("length", gt=0), min_len=2))                # m
-    points: int | None = key(Integer(ge=2))
-    preload: str | None = key(Choice(("each", "once")))      # default: once for friction and speed
+    points: int | None = key(Integer(ge=2), absent="the values listed")
+    preload: str | None = key(Choice(("each", "once")), absent='"once" for friction and speed, "each" for pressure '
+                              "and rms")
     mac: float = key(Quantity("dimensionless", gt=0, le=1), default=0.5)
     onsets: bool = key(Flag(), default=True)
 
@@ -116,7 +117,7 @@ class Stability:
     band: tuple = key(Pair(Quantity("frequency", ge=0), single=False, names="[low, high]"),
                       default=(0.0, 16e3))                                    # Hz
     modes: int | None = key(Integer(ge=1), required=True)
-    target: float | None = key(Quantity("frequency", ge=0))                   # Hz; default: the band's lower edge
+    target: float | None = key(Quantity("frequency", ge=0), absent="the band's lower edge")   # Hz
     damping: float = key(Quantity("dimensionless", ge=0, plausible=(0.0, 0.5)), default=0.0)  # structural loss factor
     rayleigh_alpha: float = key(Quantity("frequency", ge=0), default=0.0)     # 1/s
     rayleigh_beta: float = key(Quantity("time", ge=0), default=0.0)           # s

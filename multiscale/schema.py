@@ -22,10 +22,9 @@ from typing import Any
 
 from multiscale.units import KINDS, UnitError, to_si
 
-__all__ = ["Bad", "Choice", "Context", "Curve", "Either", "FilePath", "Flag", "FrozenMap",
-           "Integer", "ListOf", "Named", "OneOf", "OnlyWith", "Pair", "Quantity", "Requires",
-           "Section", "TableOr", "Tables", "Text", "Vector", "fields_of", "key", "parse", "read", "reference", "show",
-           "suggest", "unknown_keys"]
+__all__ = ["Bad", "Choice", "Context", "Curve", "Either", "FilePath", "Flag", "FrozenMap", "Integer", "ListOf", "Named",
+           "OneOf", "OnlyWith", "Pair", "Quantity", "Requires", "Section", "TableOr", "Tables", "Text", "Vector",
+           "fields_of", "key", "parse", "read", "reference", "show", "suggest", "unknown_keys"]
 
 
 class Bad(ValueError):
@@ -280,8 +279,7 @@ class Pair(ListOf):
 
 
 class Curve:
-    """A table of [x, y] rows with strictly increasing x (at least ``min_rows``), as a tuple of
-    (x, y) tuples."""
+    """A table of [x, y] rows with strictly increasing x (at least ``min_rows``): (x, y) tuples."""
 
     def __init__(self, x, y, x_name: str, y_name: str, *, min_rows: int = 1):
         self.x, self.y, self.x_name, self.y_name, self.min_rows = x, y, x_name, y_name, min_rows
@@ -416,11 +414,12 @@ class Spec:
     needed_by: tuple[str, ...] = ()       # effects that need this key
     unless: tuple[str, ...] = ()          # ... except when one of these effects is on
     warn_unused: bool = False             # warn when given while none of needed_by is on
+    absent: str = ""                      # what an optional key without default means when not given
 
 
-def key(parser, *, default=None, required: bool = False, needed_by=(), unless=(), warn_unused=False):
-    """A dataclass field read from the TOML key of the same name."""
-    spec = Spec(parser, required, tuple(needed_by), tuple(unless), warn_unused)
+def key(parser, *, default=None, required: bool = False, needed_by=(), unless=(), warn_unused=False, absent=""):
+    """A dataclass field read from the TOML key of the same name (``absent``: what no value means)."""
+    spec = Spec(parser, required, tuple(needed_by), tuple(unless), warn_unused, absent)
     return field(default=default, metadata={"spec": spec})
 
 
@@ -594,6 +593,7 @@ def reference(cls, path: str = "") -> list[str]:
         if default is not None and not spec.required:
             shown = spec.parser.show_default(default) if hasattr(spec.parser, "show_default") else show(default)
             when = f"default {shown}" + ("" if when == "optional" else f"; {when}")
+        when += f"; without it: {spec.absent}" if spec.absent and default is None else ""
         lines.append(f"  {name:<20} {spec.parser.describe()}  [{when}]")
     for rule in getattr(cls, "rules", ()):
         lines.append(f"  rule: {rule.text()}")

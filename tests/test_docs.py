@@ -55,6 +55,20 @@ def test_check_keys_and_the_generated_reference_name_the_same_keys():
     assert len(builders) == 3 and all(b.endswith(".") for b in builders), builders
 
 
+def test_an_optional_key_without_default_says_what_its_absence_means():
+    """`check --keys` and the page say what an optional key without a default means when left out
+    (they said "[optional]" and "none": geometry.unit without a value is the unit a STEP file
+    declares, not none), and the sweep's preload text is what the scene does."""
+    from multiscale.scene_stability import Sweep
+    lines = reference()
+    unit = next(line for line in lines if re.match(r" +unit +a length unit", line))
+    assert unit.endswith("[optional; without it: a STEP/IGES file's declared unit (mm if it declares none); "
+                         "metres for .msh, .geo, .brep]")
+    assert "| a STEP/IGES file's declared unit" in scene_rst().replace("\n     - ", " | ")
+    assert [Sweep(**{p: (1.0, 2.0)}).preload_mode for p in ("friction", "speed", "pressure", "rms")] == \
+        ["once", "once", "each", "each"]
+
+
 def test_every_study_key_appears_in_the_generated_study_format():
     from multiscale.studies.spec import StudyFile
     text = study_rst()

@@ -455,8 +455,9 @@ def test_reference_lists_every_section_and_key():
     assert "  ramp_steps " in sections["[loading]"] and "rule: one of normal_force, pressure" in sections["[loading]"]
     assert "friction" not in sections["[loading.vehicle]"] and "rule" not in sections["[loading.stribeck]"]
     assert "  rough " in sections["[interfaces.<name>]"] and "[interfaces.<name>.roughness]" in text
-    # a CAD file's length unit defaults to metres, shown as the user writes it (was "[default 1.0]")
-    assert 'unit                 a length unit such as "m", "mm", "in"  [optional]' in text   # else the file's own
+    # a CAD file's length unit: what no value means, as the user reads it (was "[default 1.0]", then "[optional]")
+    assert ('unit                 a length unit such as "m", "mm", "in"  [optional; without it: a STEP/IGES file\'s '
+            'declared unit') in text
 
 
 def test_friction_on_a_sliding_part_model_is_refused(tmp_path):
