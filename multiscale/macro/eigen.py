@@ -29,6 +29,7 @@ from pathlib import Path
 from typing import Callable
 
 import numpy as np
+from mpi4py import MPI
 from petsc4py import PETSc
 from slepc4py import SLEPc
 
@@ -354,6 +355,8 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     pep.setOperators([K, C, M])
     pep.setProblemType(SLEPc.PEP.ProblemType.GENERAL)
     pep.setType(SLEPc.PEP.Type.TOAR)
+    if comm is not None and comm.allreduce(K.getLocalSize()[0] == 0, op=MPI.LOR):
+        pep.getBV().setType(SLEPc.BV.Type.VECS)     # the default BV's LAPACK fails on a rank without rows
     _shift_invert(pep, s, tol, max_it, options_prefix)
     want = min(2 * int(n_modes if n_modes is not None else max(nev, 1)), 2 * n)
     solves = 0

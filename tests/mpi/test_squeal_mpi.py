@@ -1,4 +1,6 @@
 """Squeal analysis on 2 ranks equals the serial one (preload forces, complex modes, MAC, energies)."""
+import sys
+from pathlib import Path
 from types import SimpleNamespace as NS
 
 import numpy as np
@@ -7,12 +9,17 @@ import pytest
 pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from mpi4py import MPI  # noqa: E402
+from petsc4py import PETSc  # noqa: E402
 
 from multiscale.geometry import builder  # noqa: E402
 from multiscale.macro import mesh as two_body  # noqa: E402
-from multiscale.macro import modal  # noqa: E402
+from multiscale.macro import eigen, modal  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
+from multiscale.references.stability import spring_chain, spring_chain_frequencies  # noqa: E402
 from multiscale.workflows.squeal import squeal_case  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from test_stability import dense_quadratic  # noqa: E402
 
 STEEL = NS(E=210e9, nu=0.3, rho=7850.0)
 MATERIALS = {"disc": NS(E=125e9, nu=0.25, rho=7200.0), "pad": NS(E=5e9, nu=0.25, rho=2500.0),
@@ -41,3 +48,31 @@ def test_two_ranks_reproduce_the_serial_squeal_analysis():
 def _summary(c):
     return {"eigenvalues": c.modes.eigenvalues, "forces": list(c.preload.normal_force.values()),
             "energy": c.energy.share, "unstable": c.report.unstable.tolist()}
+
+
+def test_the_quadratic_modes_with_a_rank_that_owns_no_row():
+    """``eigen.solve_quadratic`` (SLEPc PEP, the default with viscous damping or gyroscopic terms)
+    with every row on rank 0 and none on rank 1 (a rank that holds no cell of the mesh): SLEPc's
+    eigenvector normalisation called LAPACK with a zero leading dimension there ("lascl: info=-9",
+    PEPSolve failed on that rank alone). Now the eigenvalues of a damped 38-mass chain are those of
+    its companion form (1e-7, as the serial test in tests/test_stability.py)."""
+    comm = MPI.COMM_WORLD
+    K, M = spring_chain(n=40, drift=0.05)
+    K, M = K[1:-1, 1:-1], M[1:-1, 1:-1]
+    C = 30.0 * M + 2e-7 * K
+    n, rows = K.shape[0], K.shape[0] if comm.rank == 0 else 0
+
+    def distributed(A):
+        m = PETSc.Mat().createAIJ([(rows, n), (rows, n)], nnz=3, comm=comm)
+        m.setUp()
+        for i, j in zip(*np.nonzero(A)) if rows else ():
+            m.setValue(i, j, A[i, j])
+        m.assemble()
+        return m
+
+    f_max = 0.4 * spring_chain_frequencies(40).max()
+    ref = dense_quadratic(K, C, M)
+    ref = ref[ref.imag / (2 * np.pi) <= f_max]
+    q = eigen.solve_quadratic(distributed(K), distributed(C), distributed(M), f_max=f_max,
+                              n_modes=len(ref) + 4, target=1.0)
+    np.testing.assert_allclose(q.eigenvalues, ref, rtol=1e-7)
