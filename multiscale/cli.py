@@ -99,6 +99,19 @@ LAUNCHERS = {"Open MPI": ("OMPI_COMM_WORLD_SIZE", "OMPI_COMM_WORLD_RANK"),
              "Slurm srun": ("SLURM_STEP_NUM_TASKS", "SLURM_PROCID")}
 
 
+SERIAL = ("info", "check", "surface")    # commands of one process: under a launcher its rank 0 alone runs them
+
+
+def launched_rank(environ=None) -> int:
+    """The rank a launcher gave this process, read from its environment (``LAUNCHERS``) without
+    starting MPI; 0 without a launcher."""
+    environ = os.environ if environ is None else environ
+    for _, rank_var in LAUNCHERS.values():
+        if environ.get(rank_var, "").isdigit():
+            return int(environ[rank_var])
+    return 0
+
+
 def launcher_problem(comm, environ=None) -> tuple[str, bool] | None:
     """(message, print it) when a launcher started several processes that all see an MPI world
     of size 1: ``mpiexec``/``mpirun`` of another MPI than the one mpi4py was built with. ``print
@@ -377,6 +390,8 @@ def build_parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
+    if args.command in SERIAL and launched_rank() > 0:      # `mpiexec -n 4 multiscale check`: said once, not 4 times
+        return 0
     try:
         return int(args.func(args) or 0)
     except SceneError as exc:

@@ -249,6 +249,20 @@ def test_a_foreign_mpi_launcher_is_detected(tmp_path, capsys, monkeypatch, fake_
     assert launcher_problem(types.SimpleNamespace(size=1), {}) is None
 
 
+def test_one_process_commands_under_a_launcher_speak_once(tmp_path, capsys, monkeypatch):
+    """`mpiexec -n 2 multiscale check scene.toml` printed the summary twice (every process checked,
+    and with --cells meshed): check, surface and info now run on the launcher's rank 0 alone, the
+    others end at once with 0 (rank 0's exit code is the job's)."""
+    path = _write(tmp_path, BLOCK)
+    monkeypatch.setenv("PMI_SIZE", "2")
+    monkeypatch.setenv("PMI_RANK", "1")
+    assert main(["check", path]) == 0 and main(["check", "missing.toml"]) == 0 and main(["info"]) == 0
+    assert capsys.readouterr() == ("", "")
+    monkeypatch.setenv("PMI_RANK", "0")
+    assert main(["check", path]) == 0 and f"{path}: OK" in capsys.readouterr().out
+    assert main(["check", "missing.toml"]) == 2
+
+
 def test_stage_lines_one_per_stage_quiet_and_timed():
     import io as stdio
 
