@@ -270,18 +270,20 @@ def test_a_pixel_size_of_a_millimetre_or_more_is_refused_on_the_command_line(tmp
 def test_a_map_too_large_for_the_memory_is_refused_before_its_statistics(monkeypatch, capsys):
     """An 8000 x 8000 map took 20 GB for its statistics (2 min): beyond the memory available, the
     OOM killer ends the command without a word; it is refused first, naming the file."""
-    monkeypatch.setattr(cli, "memory_available", lambda: 1e7)
+    monkeypatch.setattr(cli, "memory_available", lambda: 1e6)
     assert main(["surface", str(TOP)]) == 2
     out, err = capsys.readouterr()
-    assert err.splitlines() == ["error: FILE = 'top-1.top': 256 x 256 points: their statistics need about 0.02 GB of "
-                                "memory, 0.01 GB are available: crop or coarsen the map first"] and out == ""
+    assert err.splitlines() == ["error: FILE = 'top-1.top': 256 x 256 points: their statistics need about 0.0016 GB "
+                                "of memory, 0.001 GB are available: crop or coarsen the map first"] and out == ""
     monkeypatch.setattr(cli, "memory_available", lambda: None)       # unknown (not Linux): no check
     assert main(["surface", str(TOP), "--figure", "none"]) == 0
 
 
 def test_the_memory_of_the_statistics_is_what_they_take():
-    """``statistics_memory`` against the peak that tracemalloc sees (numpy's arrays included), 5 %."""
-    s = Surface(np.random.default_rng(2).normal(0.0, 1e-7, (192, 320)), 1e-6, 1e-6, periodic=False)
+    """``statistics_memory`` against the peak that tracemalloc sees (numpy's arrays included), 5 %:
+    25 bytes a point on white noise (the most summits; old code: 300, the mirror-stitched
+    periodogram), from 512 x 640 points (on fewer, the row blocks' temporaries of a few MB count)."""
+    s = Surface(np.random.default_rng(2).normal(0.0, 1e-7, (512, 640)), 1e-6, 1e-6, periodic=False)
     surface_statistics(s)          # first call: imports and caches out of the count
     tracemalloc.start()
     try:

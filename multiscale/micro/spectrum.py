@@ -4,9 +4,10 @@ areal roughness parameters (ISO 25178-2), computed through SurfaceTopography whe
 Conventions (Jacobs, Junge & Pastewka, Surf. Topogr. Metrol. Prop. 5 (2017) 013001): wavevector q
 [rad/m]; the two-dimensional PSD C(q) = |h̃(q)|²/A with h̃ = Δx Δy Σ h e^(−i q·x), so that
 <h²> = (2π)⁻² ∫ C(q) d²q; ``Spectrum`` holds the map C(q) and its radial average C_iso(q) [m⁴] in
-logarithmic bins, from SurfaceTopography's ``power_spectrum_from_area``: of the patch itself if it
-is periodic, of its mirror-stitched double if it is measured (no window needed, Parseval exact: see
-``power_spectrum``; SurfaceTopography's Hann window on request).
+logarithmic bins, those of SurfaceTopography's ``power_spectrum_from_area`` (to round-off): of the
+patch itself if it is periodic, of its mirror-stitched double if it is measured (no window needed,
+Parseval exact: see ``power_spectrum``; SurfaceTopography's Hann window on request), computed from
+half or a quarter of the modes in row blocks.
 
 A self-affine surface has C(q) ∝ q^(−2−2H) between a long-wavelength roll-off q_r (below it C is
 flat, or zero for a band-limited surface) and a short-wavelength cut-off q_s (thesis Eqs. 1.24–1.25);
@@ -23,9 +24,10 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.fft
 
 from multiscale.errors import InputError, check_positive
-from multiscale.micro.surface import Surface, find_asperities, statistics
+from multiscale.micro.surface import Surface, find_asperities, row_blocks, statistics
 
 POWER_FLOOR = 1e-24     # modes below this fraction of the largest C carry no power (FFT round-off: ~1e-32)
 HURST_RANGE = (0.0, 1.5)   # the power-law segment of a fit (a flat roll-off is no self-affine range)
@@ -57,15 +59,17 @@ def as_topography(surface: Surface, heights=None):
 # --------------------------------------------------------------------------- spectrum
 @dataclass(frozen=True)
 class Spectrum:
-    """PSD of one patch: the map C(q) [m⁴] on the modes of its periodic grid, and its radial
-    average in logarithmic bins (bins holding modes only).
+    """PSD of one patch: C(q) [m⁴] on the modes of its periodic grid (``grid`` (My, Mx) points of
+    size ``period`` (Px, Py) [m]: the patch itself, or its mirror-stitched double, see
+    ``power_spectrum``), and its radial average in logarithmic bins (bins holding modes only).
 
-    ``map``: C at every mode, fft2 layout [y, x] of the periodic grid of size ``period`` (Px, Py)
-    [m] (the patch itself, or its mirror-stitched double, see ``power_spectrum``). ``complete``:
-    every mode of the bin carries power (False in the bins a band-limited surface fills only
-    partly: fits and comparisons leave them out). ``band``: lowest and highest |q| carrying power;
-    ``limits``: the grid's lowest |q|, 2π/max(Px, Py), and the top of the radial average,
-    π/max(Δx, Δy).
+    ``power``: C on the modes that determine all others (C(−q) = C(q)): the half qx >= 0 (rfft2
+    layout [y, x], Mx//2 + 1 columns) or, ``mirrored``, the quarter qx, qy >= 0 below Nyquist
+    (My/2, Mx/2: the map is even in qx and in qy, its Nyquist modes vanish); ``map`` expands it.
+    ``complete``: every mode of the bin carries power (False in the bins a band-limited surface
+    fills only partly: fits and comparisons leave them out). ``band``: lowest and highest |q|
+    carrying power; ``limits``: the grid's lowest |q|, 2π/max(Px, Py), and the top of the radial
+    average, π/max(Δx, Δy).
     """
 
     q: np.ndarray          # rad/m, mean |q| of the bin's modes
@@ -75,54 +79,114 @@ class Spectrum:
     complete: np.ndarray   # bool
     band: tuple[float, float]
     limits: tuple[float, float]
-    map: np.ndarray        # m^4, (My, Mx)
+    power: np.ndarray      # m^4, the half or quarter of the map (above)
     period: tuple[float, float]
+    grid: tuple[int, int]
+    mirrored: bool
+
+    @property
+    def map(self) -> np.ndarray:
+        """C [m⁴] at every mode, fft2 layout [y, x] (My, Mx); built on each call (32 bytes per
+        measured point if mirror-stitched)."""
+        (My, Mx), P = self.grid, self.power
+        full = np.zeros((My, Mx))
+        if self.mirrored:
+            ny, nx = P.shape
+            full[:ny, :nx] = P
+            full[:ny, nx + 1:] = P[:, :0:-1]
+            full[ny + 1:] = full[ny - 1:0:-1]
+        else:
+            full[:, :P.shape[1]] = P
+            full[:, P.shape[1]:] = P[-np.arange(My) % My][:, Mx - np.arange(P.shape[1], Mx)]
+        return full
+
+
+def _radial_sums(power, qy, wy, qx, wx, edges, q_hi):
+    """Per bin (SurfaceTopography's: edges[i-1] < |q| <= edges[i], index 0 and len(edges) beyond
+    them): modes, Σ|q|, ΣC (all modes, as its radial average), modes inside 0 < |q| <= q_hi, those
+    carrying power (C > ``POWER_FLOOR`` max C), and the band of these. ``power`` holds the first
+    rows and columns of the modes (qy, qx) [rad/m], each standing for wy × wx modes (its mirror
+    images); the modes beyond it (a mirror-stitched grid's Nyquist modes) have no power and count
+    only in the average. Row blocks: no temporaries of the map's size."""
+    n = len(edges) + 1
+    sums = np.zeros((5, n))
+    band = [np.inf, -np.inf]
+    floor = POWER_FLOOR * power.max()
+    for rows in row_blocks(len(qy), len(qx)):
+        q = np.hypot(qy[rows, None], qx[None, :])
+        w = wy[rows, None] * wx[None, :]
+        C = np.zeros(q.shape)
+        held = power[rows]
+        C[:len(held), :power.shape[1]] = held
+        which = np.searchsorted(edges, q)
+        inside = (q > 0) & (q <= q_hi)
+        inside[len(held):] = False
+        inside[:, power.shape[1]:] = False
+        on = inside & (C > floor)
+        for i, values in enumerate((w, w * q, w * C)):
+            sums[i] += np.bincount(which.ravel(), values.ravel(), minlength=n)
+        sums[3] += np.bincount(which[inside], w[inside], minlength=n)
+        sums[4] += np.bincount(which[on], w[on], minlength=n)
+        if on.any():
+            band = [min(band[0], q[on].min()), max(band[1], q[on].max())]
+    return sums, band
 
 
 def power_spectrum(surface: Surface, points_per_decade: int = 10, window: str | None = None,
                    edges=None) -> Spectrum:
-    """PSD of one patch through SurfaceTopography's ``power_spectrum_from_area`` (Jacobs et al.
-    2017), ``points_per_decade`` bins per decade.
+    """PSD of one patch (Jacobs et al. 2017), ``points_per_decade`` bins per decade: the map and
+    radial average of SurfaceTopography's ``power_spectrum_from_area`` (equal to round-off),
+    computed without full-size temporaries.
 
-    A periodic surface: its own periodogram. A measured (non-periodic) one: by default the
-    periodogram of its mirror-stitched double (SurfaceTopography ``mirror_stitch``: the patch and its
-    three reflections, periodic and without steps at the borders), which needs no window, so that
-    Parseval holds: (2π)⁻² Σ C Δq² is exactly Sq², and the finite-difference Sdq² is likewise the
-    map's sum — what ``equivalent_surface`` needs to reproduce both. ``window="hann"`` gives
-    SurfaceTopography's default for non-periodic data instead (radial Hann window, <w²> = 1; it
-    weights the middle of the patch and leaves the corners out). ``edges``: explicit bin edges
-    [rad/m] instead (e.g. another spectrum's, to compare two surfaces bin by bin).
+    A periodic surface: its own periodogram (rfft2). A measured (non-periodic) one: by default the
+    periodogram of its mirror-stitched double (SurfaceTopography ``mirror_stitch``: the patch and
+    its three reflections, periodic and without steps at the borders), which needs no window, so
+    that Parseval holds: (2π)⁻² Σ C Δq² is exactly Sq², and the finite-difference Sdq² is likewise
+    the map's sum — what ``equivalent_surface`` needs to reproduce both. Its transform is the
+    patch's DCT-II (|h̃| at qx, qy >= 0; scipy.fft.dctn): a quarter of the double's modes, real.
+    ``window="hann"`` gives SurfaceTopography's default for non-periodic data instead (radial Hann
+    window, <w²> = 1; it weights the middle of the patch and leaves the corners out). ``edges``:
+    explicit bin edges [rad/m] instead (e.g. another spectrum's, to compare two surfaces bin by
+    bin).
     """
     if points_per_decade < 2:
         raise InputError("points_per_decade", points_per_decade, "need at least 2 bins per decade")
     if window not in (None, "hann"):
         raise InputError("window", window, "None (mirror-stitched periodogram) or 'hann'")
-    t = as_topography(surface)
+    (ny, nx), (dx, dy) = surface.shape, (surface.dx, surface.dy)
     mirrored = not surface.periodic and window is None
-    if mirrored:
-        t = t.mirror_stitch()
-    (Px, Py), (nx, ny) = t.physical_sizes, t.nb_grid_pts
-    q_lo, q_hi = 2 * np.pi / max(Px, Py), np.pi / max(surface.dx, surface.dy)
+    My, Mx = (2 * ny, 2 * nx) if mirrored else (ny, nx)
+    Px, Py = Mx * dx, My * dy
+    q_lo, q_hi = 2 * np.pi / max(Px, Py), np.pi / max(dx, dy)
     if edges is None:
         edges = make_grid(q_lo, q_hi, points_per_decade)
-    q, C, C_map = t.power_spectrum_from_area(collocation=edges, reliable=False, return_map=True,
-                                             window=window)
-    C_map = np.array(C_map, dtype=float).T                 # [y, x]
-    C_map[0, 0] = 0.0                                      # the mean (a window leaves some) is no roughness
-    qq = np.hypot(2 * np.pi * np.fft.fftfreq(ny, surface.dy)[:, None], 2 * np.pi * np.fft.fftfreq(nx, surface.dx))
-    inside = (qq > 0) & (qq <= q_hi)
-    if mirrored:      # a mirror-stitched grid's Nyquist modes vanish by symmetry: not a band edge
-        inside[ny // 2, :] = inside[:, nx // 2] = False
-    on = (C_map > POWER_FLOOR * C_map.max()) & inside
-    if not on.any():
+    edges = np.asarray(edges, dtype=float)
+    if mirrored:
+        power = scipy.fft.dctn(surface.heights, type=2)       # |h̃| of the double at qx, qy >= 0
+        power *= power
+        rows, columns = np.arange(ny + 1), np.arange(nx + 1)     # with the (vanishing) Nyquist modes
+    else:
+        h = surface.heights if window is None else \
+            as_topography(surface).window(window=window, direction="radial").heights().T
+        transform = scipy.fft.rfft2(h)
+        power = np.abs(transform)
+        del transform
+        power *= power
+        rows, columns = np.fft.fftfreq(ny, 1 / ny), np.arange(nx // 2 + 1)
+    power *= (dx * dy) ** 2 / (Px * Py)
+    power[0, 0] = 0.0                                      # the mean (a window leaves some) is no roughness
+    folded = 2.0 - (columns == 0) - (2 * columns == Mx)    # a mode with qx > 0 stands for its image at -qx
+    weights_y = 2.0 - (rows == 0) - (2 * rows == My) if mirrored else np.ones(len(rows))
+    (count, q_sum, C_sum, total, powered), band = _radial_sums(
+        power, 2 * np.pi * rows / Py, weights_y, 2 * np.pi * columns / Px, folded, edges, q_hi)
+    if not np.isfinite(band[0]):
         raise InputError("surface.heights", "flat", "the surface has no roughness (zero power spectrum)")
-    which = np.searchsorted(edges, qq)            # SurfaceTopography's bins: edges[i-1] < |q| <= edges[i]
-    total = np.bincount(which[inside], minlength=len(edges) + 1)[1:len(edges)]
-    powered = np.bincount(which[on], minlength=len(edges) + 1)[1:len(edges)]
-    keep = ~np.ma.getmaskarray(C) & (total > 0)
+    inner = slice(1, len(edges))
+    keep = (count[inner] > 0) & (total[inner] > 0)
     pairs = np.column_stack([edges[:-1], edges[1:]])
-    return Spectrum(np.asarray(q)[keep], np.asarray(C)[keep], pairs[keep], total[keep], (powered == total)[keep],
-                    (float(qq[on].min()), float(qq[on].max())), (q_lo, q_hi), C_map, (float(Px), float(Py)))
+    return Spectrum((q_sum / np.maximum(count, 1))[inner][keep], (C_sum / np.maximum(count, 1))[inner][keep],
+                    pairs[keep], total[inner][keep].astype(int), (powered == total)[inner][keep],
+                    (float(band[0]), float(band[1])), (q_lo, q_hi), power, (float(Px), float(Py)), (My, Mx), mirrored)
 
 
 # --------------------------------------------------------------------------- self-affine fit
@@ -290,7 +354,7 @@ def equivalent_surface(spectrum: Spectrum, n, size, seed=0, *, amplitudes: str =
         raise InputError("n", n, "need at least 4 points per side")
     if amplitudes not in ("constant", "gaussian"):
         raise InputError("amplitudes", amplitudes, "one of 'constant', 'gaussian'")
-    (My, Mx), (Px, Py) = spectrum.map.shape, spectrum.period
+    (My, Mx), (Px, Py), measured = spectrum.grid, spectrum.period, spectrum.map
     old_q, new_q = _wavevectors((My, Mx), (Px, Py)), _wavevectors((ny, nx), (Lx, Ly))
     top = (np.pi * min(Mx / Px, nx / Lx), np.pi * min(My / Py, ny / Ly))     # wavevectors both grids hold
 
@@ -298,7 +362,7 @@ def equivalent_surface(spectrum: Spectrum, n, size, seed=0, *, amplitudes: str =
         return (np.abs(qx) <= top[0] * (1 + 1e-12)) & (np.abs(qy) <= top[1] * (1 + 1e-12)) & ((qx != 0) | (qy != 0))
 
     keep_old, keep_new = common(*old_q), common(*new_q)
-    (ox, oy), C_old = (v[keep_old] for v in old_q), spectrum.map[keep_old]
+    (ox, oy), C_old = (v[keep_old] for v in old_q), measured[keep_old]
     nqx, nqy = (v[keep_new] for v in new_q)
     C = np.zeros((ny, nx))
     if len(C_old) and len(nqx):
@@ -337,9 +401,9 @@ def equivalent_surface(spectrum: Spectrum, n, size, seed=0, *, amplitudes: str =
 class Statistics:
     """Areal roughness parameters of one patch (ISO 25178-2 names) and its spectrum.
 
-    Sq, Sdq: SurfaceTopography's ``Sq`` and ``rms_gradient`` (upwind finite
-    differences, what its users compare with). Ssk = <h³>/Sq³ and Sku = <h⁴>/Sq⁴ (ISO 25178-2;
-    SurfaceTopography has neither). m0, m2, m4 and Nayak's α = m0 m4/m2² (Nayak,
+    Sq, Sdq: SurfaceTopography's ``Sq`` and ``rms_gradient`` (upwind finite differences, what its
+    users compare with), computed alike in row blocks. Ssk = <h³>/Sq³ and Sku = <h⁴>/Sq⁴ (ISO
+    25178-2; SurfaceTopography has neither). m0, m2, m4 and Nayak's α = m0 m4/m2² (Nayak,
     ASME J. Lubr. Technol. 93 (1971) 398): profile moments averaged over x and y,
     ``multiscale.micro.surface.statistics`` (what the asperity models use). Summit density: strict
     8-neighbour maxima with a curvature (``find_asperities``) per unit area, and Nayak's value for
@@ -381,19 +445,39 @@ class Statistics:
 
 
 def statistics_memory(shape) -> float:
-    """Peak memory [bytes] of ``surface_statistics`` on a patch of ``shape`` (ny, nx): 300 bytes a
-    point, traced alike from 256² to 2000² points (the mirror-stitched periodogram, four times
-    the points, and its map of modes and bins)."""
-    return 300.0 * shape[0] * shape[1]
+    """Peak memory [bytes] of ``surface_statistics`` on a patch of ``shape`` (ny, nx): 25 bytes a
+    point (traced from 512 x 640 to 2000² points of white noise, the most summits: the
+    periodogram's quarter, 8 bytes a point, and the summits' table; a self-affine map takes 12)."""
+    return 25.0 * shape[0] * shape[1]
+
+
+def _height_moments(surface: Surface) -> tuple[float, float, float, float]:
+    """<h²>, <h³>, <h⁴> [m², m³, m⁴] about the mean height and Sdq² [-]: upwind differences,
+    SurfaceTopography's ``rms_gradient`` (periodic: wrapping; else the last row and column have
+    no forward neighbour and are left out), in row blocks (no temporaries of the map's size)."""
+    h, (ny, nx) = surface.heights, surface.shape
+    mean = h.mean()
+    m, k = (ny, nx) if surface.periodic else (ny - 1, nx - 1)
+    sums = np.zeros(4)
+    for rows in row_blocks(ny, nx):
+        d = h[rows] - mean
+        d2 = d * d
+        sums[:3] += d2.sum(), np.vdot(d2, d), np.vdot(d2, d2)
+        if rows.start < m:
+            block = h[rows.start:min(rows.stop, m)]
+            below = h[np.arange(rows.start + 1, rows.start + len(block) + 1) % ny]     # the next rows
+            gx = (np.roll(block, -1, axis=1) - block)[:, :k] / surface.dx
+            gy = (below - block)[:, :k] / surface.dy
+            sums[3] += np.vdot(gx, gx) + np.vdot(gy, gy)
+    return sums[0] / h.size, sums[1] / h.size, sums[2] / h.size, sums[3] / (m * k)
 
 
 def surface_statistics(surface: Surface, points_per_decade: int = 10) -> Statistics:
     """``Statistics`` of one patch (complete heights: fill undefined points first)."""
     if surface.heights.ndim != 2:
         raise InputError("surface.heights", surface.heights.shape, "statistics of one 2-D patch at a time")
-    t = as_topography(surface)
-    h = surface.heights - surface.heights.mean()
-    Sq = float(t.Sq())
+    m0, m3, m4_height, slope2 = _height_moments(surface)
+    Sq = float(np.sqrt(m0))
     moments = statistics(surface)
     m2, m4 = float(moments.m2), float(moments.m4)
     ny, nx = surface.shape
@@ -403,9 +487,9 @@ def surface_statistics(surface: Surface, points_per_decade: int = 10) -> Statist
         fit = fit_power_law(spectrum)
     except InputError:
         fit = None
-    return Statistics(Sq=Sq, Sdq=float(t.rms_gradient()), Ssk=float(np.mean(h**3) / Sq**3),
-                      Sku=float(np.mean(h**4) / Sq**4), m0=float(moments.m0), m2=m2, m4=m4,
-                      nayak=float(moments.nayak), summit_density=len(find_asperities(surface)) / inner,
+    return Statistics(Sq=Sq, Sdq=float(np.sqrt(slope2)), Ssk=float(m3 / Sq**3), Sku=float(m4_height / Sq**4),
+                      m0=float(moments.m0), m2=m2, m4=m4, nayak=float(moments.nayak),
+                      summit_density=len(find_asperities(surface)) / inner,
                       summit_density_gaussian=m4 / (6 * np.pi * np.sqrt(3) * m2) if m2 > 0 else 0.0,
                       spectrum=spectrum, power_law=fit)
 

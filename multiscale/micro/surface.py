@@ -225,17 +225,26 @@ class SurfaceStats:
     nayak: np.ndarray       # -, m0 m4 / m2²
 
 
+def row_blocks(rows: int, columns: int, size: int = 1 << 16):
+    """Slices of ``rows`` of about ``size`` values each (``columns`` per row): row-block
+    reductions need temporaries of a block, not of the map."""
+    step = max(1, size // max(columns, 1))
+    return (slice(a, min(a + step, rows)) for a in range(0, rows, step))
+
+
 def statistics(surface: Surface) -> SurfaceStats:
     """RMS height and slope, spectral moments m0, m2, m4 and Nayak's parameter.
 
-    Periodic surfaces: exact spectral derivatives. Others: central finite differences.
+    Periodic surfaces: exact spectral derivatives. Others: central finite differences (in row
+    blocks: no temporaries of the map's size).
     """
     check_surface(surface)
-    h = surface.heights - surface.heights.mean(axis=(-2, -1), keepdims=True)
     dx, dy = surface.dx, surface.dy
-    m0 = np.mean(h**2, axis=(-2, -1))
+    ny, nx = surface.shape
+    mean = surface.heights.mean(axis=(-2, -1), keepdims=True)
     if surface.periodic:
-        ny, nx = surface.shape
+        h = surface.heights - mean
+        m0 = np.mean(h**2, axis=(-2, -1))
         H = np.fft.fft2(h) / (nx * ny)
         P = np.abs(H) ** 2
         qx = 2 * np.pi * np.fft.fftfreq(nx, dx)[None, :]
@@ -243,12 +252,16 @@ def statistics(surface: Surface) -> SurfaceStats:
         m20, m02 = np.sum(P * qx**2, axis=(-2, -1)), np.sum(P * qy**2, axis=(-2, -1))
         m40, m04 = np.sum(P * qx**4, axis=(-2, -1)), np.sum(P * qy**4, axis=(-2, -1))
     else:
-        hx = (h[..., :, 2:] - h[..., :, :-2]) / (2 * dx)
-        hy = (h[..., 2:, :] - h[..., :-2, :]) / (2 * dy)
-        hxx = (h[..., :, 2:] - 2 * h[..., :, 1:-1] + h[..., :, :-2]) / dx**2
-        hyy = (h[..., 2:, :] - 2 * h[..., 1:-1, :] + h[..., :-2, :]) / dy**2
-        m20, m02 = np.mean(hx**2, axis=(-2, -1)), np.mean(hy**2, axis=(-2, -1))
-        m40, m04 = np.mean(hxx**2, axis=(-2, -1)), np.mean(hyy**2, axis=(-2, -1))
+        sums = np.zeros((5,) + surface.heights.shape[:-2])     # h², hx², hy², hxx², hyy²
+        for rows in row_blocks(ny, nx):
+            h = surface.heights[..., rows, :] - mean
+            v = surface.heights[..., rows.start:rows.stop + 2, :] - mean      # the block and two rows below
+            hx, hxx = (h[..., 2:] - h[..., :-2]) / (2 * dx), (h[..., 2:] - 2 * h[..., 1:-1] + h[..., :-2]) / dx**2
+            hy, hyy = ((v[..., 2:, :] - v[..., :-2, :]) / (2 * dy),
+                       (v[..., 2:, :] - 2 * v[..., 1:-1, :] + v[..., :-2, :]) / dy**2)
+            sums += [np.sum(d * d, axis=(-2, -1)) for d in (h, hx, hy, hxx, hyy)]
+        counts = np.array([ny * nx, ny * (nx - 2), (ny - 2) * nx, ny * (nx - 2), (ny - 2) * nx])
+        m0, m20, m02, m40, m04 = sums / counts.reshape((5,) + (1,) * (sums.ndim - 1))
     m2, m4 = (m20 + m02) / 2, (m40 + m04) / 2
     with np.errstate(divide="ignore", invalid="ignore"):
         nayak = np.where(m2 > 0, m0 * m4 / np.where(m2 > 0, m2, 1) ** 2, np.inf)
@@ -302,27 +315,24 @@ def find_asperities(surface: Surface) -> AsperityTable:
     if surface.heights.ndim != 2:
         raise InputError("surface.heights", surface.heights.shape, "asperity detection takes one patch (2-D)")
     h, dx, dy = surface.heights, surface.dx, surface.dy
-    if surface.periodic:
-        def nb(di, dj):
-            return np.roll(h, (-di, -dj), axis=(0, 1))
-    else:
-        hp = np.pad(h, 1, mode="edge")  # border cells are never candidates
-
-        def nb(di, dj):
-            return hp[1 + di:hp.shape[0] - 1 + di, 1 + dj:hp.shape[1] - 1 + dj]
-    peak = np.ones(h.shape, dtype=bool)
+    (ny, nx), inner = h.shape, (slice(None),) * 2 if surface.periodic else (slice(1, -1),) * 2
+    peak = np.zeros(h.shape, dtype=bool)
+    peak[inner] = True
     for di in (-1, 0, 1):
         for dj in (-1, 0, 1):
-            if di or dj:
-                peak &= h > nb(di, dj)
-    if not surface.periodic:
-        peak[[0, -1], :] = False
-        peak[:, [0, -1]] = False
-    hxx = (nb(0, 1) - 2 * h + nb(0, -1)) / dx**2
-    hyy = (nb(1, 0) - 2 * h + nb(-1, 0)) / dy**2
-    hxy = (nb(1, 1) - nb(1, -1) - nb(-1, 1) + nb(-1, -1)) / (4 * dx * dy)
+            if di or dj:        # periodic: wrapped copies; others: views (border cells are never candidates)
+                peak[inner] &= h[inner] > (np.roll(h, (-di, -dj), axis=(0, 1)) if surface.periodic else
+                                           h[1 + di:ny - 1 + di, 1 + dj:nx - 1 + dj])
     r, c = np.nonzero(peak)
-    a, b, d = -hxx[r, c], -hxy[r, c], -hyy[r, c]          # curvature tensor K = −Hessian
+    del peak
+
+    def nb(di, dj):
+        """Heights of the summits' neighbours (the border wraps: only periodic summits reach it)."""
+        return h[(r + di) % ny, (c + dj) % nx]
+    hxx = (nb(0, 1) - 2 * h[r, c] + nb(0, -1)) / dx**2
+    hyy = (nb(1, 0) - 2 * h[r, c] + nb(-1, 0)) / dy**2
+    hxy = (nb(1, 1) - nb(1, -1) - nb(-1, 1) + nb(-1, -1)) / (4 * dx * dy)
+    a, b, d = -hxx, -hxy, -hyy                              # curvature tensor K = −Hessian
     mean, dev = (a + d) / 2, np.sqrt(((a - d) / 2) ** 2 + b**2)
     k_small, k_large = mean - dev, mean + dev               # R1 = 1/k_small >= R2 = 1/k_large
     keep = k_small > 0

@@ -8,8 +8,8 @@ matrices without units (.npy, .txt, .csv, .asc) are read by ``multiscale.micro.s
 and need a pixel size. Undefined points (no value from the instrument; NaN in a matrix) are NaN.
 
 Conditioning (``condition``), in the order of ISO 25178-3 and each step reported: form removal (the
-F-operator: least-squares mean, plane or polynomial fitted on the defined points), undefined points
-filled (harmonic interpolation; refused above a stated fraction), waviness and roughness separated by
+F-operator: least-squares mean, plane or polynomial fitted on the defined points, ``remove_form``),
+undefined points filled (harmonic interpolation; refused above a stated fraction), waviness and roughness separated by
 the areal Gaussian filter of ISO 16610-61 (the L-filter, cut-off wavelength λc: the roughness is the
 S-L surface). ``resample`` puts a surface on another grid (the micro grid) with an anti-aliasing
 S-filter when it coarsens.
@@ -31,7 +31,7 @@ import numpy as np
 
 from multiscale.errors import InputError, check_count, check_pair, check_positive, check_real
 from multiscale.micro.spectrum import as_topography, equivalent_surface, power_spectrum, surface_topography
-from multiscale.micro.surface import Surface, read_matrix
+from multiscale.micro.surface import Surface, read_matrix, row_blocks
 
 MATRIX_SUFFIXES = (".npy", ".txt", ".csv", ".asc")    # plain height matrices (no units in the file)
 MAX_UNDEFINED = 0.1       # default largest fraction of undefined points that is filled
@@ -343,6 +343,41 @@ def _fourier_filter(surface: Surface, cut_x: float, cut_y: float) -> Surface:
     return Surface(w, surface.dx, surface.dy, periodic=surface.periodic)
 
 
+def _defined_std(h: np.ndarray) -> float:
+    """Standard deviation [m] of the defined (not NaN) heights, in row blocks."""
+    sums = np.zeros(3)
+    for rows in row_blocks(*h.shape):
+        sums[:2] += np.sum(np.isfinite(h[rows])), np.nansum(h[rows])
+    for rows in row_blocks(*h.shape):
+        sums[2] += np.nansum((h[rows] - sums[1] / sums[0]) ** 2)
+    return float(np.sqrt(sums[2] / sums[0]))
+
+
+def remove_form(heights: np.ndarray, detrend: str) -> np.ndarray:
+    """The heights [m] (NaN: undefined, kept) minus their form ``detrend`` (not "none"): the
+    least-squares polynomial of degree 0, 1 or 2 in x/Lx, y/Ly on the defined points, as
+    SurfaceTopography's detrend (``DETREND``) and by its tall-skinny QR (the R factors of row
+    blocks stacked): no temporaries of the map's size. A new array."""
+    ny, nx = heights.shape
+    terms = {"mean": 1, "plane": 3, "poly2": 6}[detrend]
+
+    def design(rows):         # SurfaceTopography's columns: 1, x, y, x², y², xy
+        y, x = np.meshgrid(np.arange(rows.start, rows.stop) / ny, np.arange(nx) / nx, indexing="ij")
+        return [np.ones_like(x), x, y, x * x, y * y, x * y][:terms]
+    factor = np.zeros((0, terms + 1))
+    for rows in row_blocks(ny, nx):
+        defined = np.isfinite(heights[rows])
+        block = np.column_stack([c[defined] for c in design(rows)] + [heights[rows][defined]])
+        factor = np.linalg.qr(np.concatenate([factor, block]), mode="r")
+    coefficients = np.linalg.lstsq(factor[:, :-1], factor[:, -1], rcond=None)[0]
+    out = np.empty((ny, nx))
+    for rows in row_blocks(ny, nx):
+        out[rows] = heights[rows]
+        for a, c in zip(coefficients, design(rows)):       # its order of subtraction
+            out[rows] -= a * c
+    return out
+
+
 def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = None,
               max_undefined: float = MAX_UNDEFINED, prefix: str = "") -> Conditioned:
     """Form removal, filling of undefined points, waviness/roughness separation (see module
@@ -360,22 +395,23 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
     report = [f"read {m.path.name}, channel {m.channel} (\"{m.channel_name}\"): {m.shape[1]} x {m.shape[0]} points "
               f"of {m.dx * 1e6:.4g} x {m.dy * 1e6:.4g} um ({m.size[0] * 1e3:.4g} x {m.size[1] * 1e3:.4g} mm)"
               + (f", heights in {m.unit}" if m.unit else "")] + [f"warning: {n}" for n in m.notes]
-    frame = Surface(np.zeros(m.shape), m.dx, m.dy, periodic=False)
-    masked = np.ma.masked_invalid(m.heights)
-    t = as_topography(frame, masked)
-    before = float(masked.std())
+    before, h = _defined_std(m.heights), m.heights
     if DETREND[detrend] is not None:
-        t = t.detrend(detrend_mode=DETREND[detrend])
+        h = remove_form(m.heights, detrend)
         names = {"mean": "mean height", "plane": "least-squares plane", "poly2": "least-squares polynomial of degree 2"}
-        h = np.ma.masked_invalid(np.ma.filled(t.heights(), np.nan).T)
         report.append(f"form removed: {names[detrend]} (SurfaceTopography detrend \"{DETREND[detrend]}\"): "
-                      f"Sq {_um(before)} -> {_um(float(h.std()))} um")
+                      f"Sq {_um(before)} -> {_um(_defined_std(h))} um")
     if m.undefined:
-        t = t.interpolate_undefined_data("harmonic")
+        frame = Surface(np.broadcast_to(0.0, m.shape), m.dx, m.dy, periodic=False)
+        t = as_topography(frame, np.ma.masked_invalid(h)).interpolate_undefined_data("harmonic")
+        h = np.ascontiguousarray(np.asarray(t.heights(), dtype=float).T)
         report.append(f"filled {m.undefined} undefined points ({m.undefined / m.heights.size:.2%}) by harmonic "
                       "interpolation (SurfaceTopography interpolate_undefined_data)")
-    h = np.asarray(t.heights(), dtype=float).T
-    surface = Surface(h - h.mean(), m.dx, m.dy, periodic=False)
+    if h is m.heights:            # nothing removed or filled: a copy, not the measurement's array
+        h = h - h.mean()
+    else:
+        h -= h.mean()
+    surface = Surface(h, m.dx, m.dy, periodic=False)
     waviness = None
     if cutoff is not None:
         try:

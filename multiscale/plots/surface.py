@@ -8,6 +8,8 @@ import numpy as np
 from matplotlib.backend_bases import FigureCanvasBase
 from matplotlib.figure import Figure
 
+SHOWN = 1000      # height-map points per side drawn at most (a strided view; the figure has ~500 pixels a side)
+
 
 def figure_problem(path: Path) -> str | None:
     """Why ``surface_figure`` cannot write ``path`` (no such folder, a format matplotlib does not
@@ -30,8 +32,10 @@ def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -
     axes = fig.subplots(1, len(maps) + 1, squeeze=False)[0]
     for ax, (label, s) in zip(axes, maps):
         Lx, Ly = s.size
-        image = ax.imshow(s.heights * 1e6, origin="lower", extent=(0, Lx * 1e3, 0, Ly * 1e3), cmap="viridis",
-                          interpolation="nearest")
+        step = -(-max(s.shape) // SHOWN)            # every step-th point along both axes
+        image = ax.imshow(s.heights[::step, ::step] * 1e6, origin="lower", extent=(0, Lx * 1e3, 0, Ly * 1e3),
+                          cmap="viridis", interpolation="nearest", vmin=s.heights.min() * 1e6,
+                          vmax=s.heights.max() * 1e6)
         ax.set_xlabel("x [mm]")
         ax.set_ylabel("y [mm]")
         ax.set_title(label)
