@@ -64,9 +64,11 @@ class LengthUnit:
 class BodySelection:
     """[geometry.bodies.<name>]: the volumes of one body and its material."""
 
-    volumes: tuple | None = key(ListOf(Text(), unique=True, min_len=1))   # physical names or CAD labels
-    index: tuple | None = key(ListOf(Integer(ge=1), unique=True, min_len=1))   # volume numbers of the file
-    contains: tuple | None = key(Points())                                # m, points inside its volumes
+    volumes: tuple | None = key(ListOf(Text(), unique=True, min_len=1),   # physical names or CAD labels
+                                absent="index or contains picks the volumes")
+    index: tuple | None = key(ListOf(Integer(ge=1), unique=True, min_len=1),   # volume numbers of the file
+                              absent="volumes or contains picks the volumes")
+    contains: tuple | None = key(Points(), absent="volumes or index picks the volumes")   # m, points inside them
     material: str | None = key(Text(), required=True)
 
     rules = (OneOf(("volumes", "index", "contains"), required=True),)
@@ -78,10 +80,10 @@ class SurfaceSelection:
     faces of ``body`` whose outward ``normal`` is the given direction (within 5 degrees), or the
     faces through the points ``contains`` (of ``body`` if given; within 1e-4 of the model's size)."""
 
-    group: str | None = key(Text())
-    body: str | None = key(Text())
-    normal: tuple | None = key(_DIRECTION)
-    contains: tuple | None = key(Points())                 # m, a point on each face
+    group: str | None = key(Text(), absent="normal or contains picks the faces")
+    body: str | None = key(Text(), absent="the faces of any body (normal needs it)")
+    normal: tuple | None = key(_DIRECTION, absent="group or contains picks the faces")
+    contains: tuple | None = key(Points(), absent="group or normal picks the faces")   # m, a point on each face
 
     rules = (OneOf(("group", "normal", "contains"), required=True),)
 

@@ -38,6 +38,7 @@ _ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0))  # up 
 _WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # Archard k/H
 _HARDNESS = Quantity("pressure", gt=0, plausible=(1e6, 1e11))            # soft polymer to diamond
 GRAVITY = 9.80665                  # m/s^2, standard gravity
+_WITH_RMS = "needed with rms (a generated surface)"
 
 
 def _property(value: Quantity, name: str) -> TableOr:
@@ -80,26 +81,25 @@ class Material:
     """One body's material (Table 7.2). Every property is a constant or a table against the
     temperature ((K, value), ...), interpolated linearly and held constant beyond its ends (warned
     about when the initial temperature, or after a run a body's largest one, leaves it); ``alpha``
-    is the mean (secant) expansion coefficient from the initial temperature. Thermal needs kappa and
-    c (with rho) or chi. ``k_w``: the Archard wear rate of this material (effect "wear"), taken at
-    the local surface temperature: the rough body's (instead of [wear]'s), or the counter-face's
-    (only a counter-face with k_w wears). The squeal analysis reads the material damping: a
-    structural loss factor eta (complex stiffness E (1 + i eta)) and Rayleigh coefficients (alpha M
-    + beta K of this material's mass and stiffness)."""
+    is the mean (secant) expansion coefficient from the initial temperature, ``k_w`` the Archard wear
+    rate (effect "wear"). The squeal analysis reads the material damping: a structural loss factor eta
+    (complex stiffness E (1 + i eta)) and Rayleigh alpha M + beta K (this material's mass, stiffness)."""
 
     E: float | tuple = key(_property(_MODULUS, "E"), required=True)                          # Pa
     nu: float | tuple = key(_property(_POISSON, "nu"), required=True)
     rho: float | tuple | None = key(_property(_DENSITY, "rho"), needed_by=("stability",))  # kg/m^3
     kappa: float | tuple | None = key(_property(_CONDUCTIVITY, "kappa"), needed_by=("thermal",))  # W/(m K)
-    c: float | tuple | None = key(_property(_SPECIFIC_HEAT, "c"))           # J/(kg K)
-    chi: float | tuple | None = key(_property(_DIFFUSIVITY, "chi"))         # m^2/s
+    c: float | tuple | None = key(_property(_SPECIFIC_HEAT, "c"), absent="with thermal: rho c = kappa/chi")  # J/(kg K)
+    chi: float | tuple | None = key(_property(_DIFFUSIVITY, "chi"), absent="with thermal: kappa/(rho c)")    # m^2/s
     alpha: float | tuple | None = key(_property(_EXPANSION, "alpha"), needed_by=("expansion",),
                                       warn_unused=True)                                      # 1/K
-    k_w: float | tuple | None = key(_property(Quantity("wear_rate", ge=0), "k_w"))          # 1/Pa, Archard
-    hardness: float | tuple | None = key(_property(_HARDNESS, "hardness"))   # Pa, plastic flow pressure of asperities
-    loss_factor: float | None = key(Quantity("dimensionless", ge=0))      # structural damping eta (squeal)
-    damping_alpha: float | None = key(Quantity("frequency", ge=0))        # 1/s, Rayleigh: alpha M (squeal)
-    damping_beta: float | None = key(Quantity("time", ge=0))              # s, Rayleigh: beta K (squeal)
+    k_w: float | tuple | None = key(_property(Quantity("wear_rate", ge=0), "k_w"),
+                                    absent="rough body: wear.k_w's rate; counter-face: no wear")     # 1/Pa, Archard
+    hardness: float | tuple | None = key(_property(_HARDNESS, "hardness"),      # Pa, asperities' flow pressure
+                                         absent="with plasticity: the other side's")
+    loss_factor: float | None = key(Quantity("dimensionless", ge=0), absent="0: no structural damping")
+    damping_alpha: float | None = key(Quantity("frequency", ge=0), absent="0: no alpha M damping")   # 1/s
+    damping_beta: float | None = key(Quantity("time", ge=0), absent="0: no beta K damping")           # s
 
     rules = (OneOf(("c", "chi"), needed_by=("thermal",)), Requires("c", ("rho",), needed_by=("thermal",)))
 
@@ -204,7 +204,7 @@ class InterfaceSettings:
     interface (its own surface, zones, laws); ``rough = false`` keeps it in perfect contact when
     the scene has effect "roughness"."""
 
-    friction: float | None = key(_FRICTION)     # mu of this interface (default loading.friction)
+    friction: float | None = key(_FRICTION, absent="loading.friction, friction_curve or stribeck")   # mu
     rough: bool = key(Flag(), default=True)                           # with effect "roughness"
     roughness: object = None          # Roughness of this interface (the merged [roughness] table)
     micro: object = None              # Micro of this interface (the merged [micro] table)
@@ -220,16 +220,15 @@ class Boundary:
     else). ``fix``: displacement components held at zero (with the interfaces' normals, friction
     holding nothing, they must hold every part against its six rigid motions: ``macro.held``);
     ``convection`` h [W/(m^2 K)], constant or a table against the rotating body's speed [rad/s],
-    towards ``ambient``; ``emissivity``: radiation eps sigma (T^4 - T_ambient^4); ``temperature``:
-    a fixed temperature. Surfaces without a thermal condition are insulated."""
+    towards ``ambient``; ``emissivity``: radiation eps sigma (T^4 - T_ambient^4); ``temperature``: fixed."""
 
     surfaces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), required=True)
-    fix: tuple | None = key(ListOf(Choice(_COMPONENTS), unique=True, min_len=1))
+    fix: tuple | None = key(ListOf(Choice(_COMPONENTS), unique=True, min_len=1), absent="no component held here")
     convection: float | tuple | None = key(TableOr(_CONVECTION, Curve(
-        Quantity("angular_speed", ge=0), _CONVECTION, "speed", "h", min_rows=2)))
-    emissivity: float | None = key(Quantity("dimensionless", gt=0, le=1))
-    ambient: float | None = key(_TEMPERATURE)                        # K, default time.initial_temperature
-    temperature: float | None = key(_TEMPERATURE)                    # K, fixed
+        Quantity("angular_speed", ge=0), _CONVECTION, "speed", "h", min_rows=2)), absent="no convection")
+    emissivity: float | None = key(Quantity("dimensionless", gt=0, le=1), absent="no radiation")
+    ambient: float | None = key(_TEMPERATURE, absent="time.initial_temperature")            # K
+    temperature: float | None = key(_TEMPERATURE, absent="not fixed (no condition at all: insulated)")   # K
 
     THERMAL = ("convection", "emissivity", "temperature")
 
@@ -273,9 +272,11 @@ class Vehicle:
 
     speed: float | None = key(Quantity("speed", gt=0, plausible=(0.1, 150.0)), required=True)  # m/s, initial
     wheel_radius: float | None = key(Quantity("length", gt=0, plausible=(0.05, 2.0)), required=True)  # m
-    deceleration: float | None = key(Quantity("acceleration", gt=0, plausible=(0.01, 15.0)))  # m/s^2: a stop
-    slope: float | None = key(Quantity("dimensionless", gt=0, plausible=(0.0, 0.5)))  # grade (rise/run): a drag
-    mass: float | None = key(Quantity("mass", gt=0, plausible=(1.0, 1e7)))                               # kg
+    deceleration: float | None = key(Quantity("acceleration", gt=0, plausible=(0.01, 15.0)),   # m/s^2: a stop
+                                     absent="slope: a drag; neither: a constant speed")
+    slope: float | None = key(Quantity("dimensionless", gt=0, plausible=(0.0, 0.5)),   # grade (rise/run): a drag
+                              absent="deceleration: a stop; neither: a constant speed")
+    mass: float | None = key(Quantity("mass", gt=0, plausible=(1.0, 1e7)), absent="the load: normal_force or pressure")
 
     rules = (OneOf(("deceleration", "slope")),)
 
@@ -308,13 +309,11 @@ class Vehicle:
 class Loading:
     """Normal load (force or pressure on the load faces), sliding speed, friction, duty cycle.
 
-    The load acts on ``faces`` (default: the builder's load faces; required for geometry files,
-    where it is a pressure normal to each face, -p n, and a force is spread as a uniform pressure
-    whose resultants on the faces sum to it (a curved face counts with its projected area);
-    with ``direction`` a traction along it whose resultant is the force, or the pressure itself).
-    ``normal_force`` is the total over all the load faces: a piston face and the caliper's fingers
-    given 4000 N take 2000 N each when their areas are equal (give the clamp force times the number
-    of faces, or ``pressure``),
+    The load acts on ``faces``: on a geometry file's a pressure normal to each face, -p n (a force is
+    spread as a uniform pressure whose resultants on the faces sum to it; a curved face counts with
+    its projected area); with ``direction`` a traction along it whose resultant is the force, or the
+    pressure itself. ``normal_force`` is the total over all the load faces: two faces of equal areas
+    given 4000 N take 2000 N each (give the clamp force times the number of faces, or ``pressure``),
     scaled in time by ``load_profile`` (factor, 0 = released: no contact, no frictional heat). The
     speed of the rotating body: ``rotation_speed``, a ``speed_profile`` against time, or a
     ``vehicle`` stop or drag; a translating body slides at ``sliding_speed``. Friction: a
@@ -322,21 +321,24 @@ class Loading:
     ``friction_curve`` or a ``stribeck`` law, taken per interface facet at its steady slip speed;
     its slope enters the modal analysis as damping."""
 
-    normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)))                 # N
-    pressure: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e9)))  # Pa
-    faces: tuple | None = key(ListOf(Text(), unique=True, min_len=1))         # where the load acts
-    direction: tuple | None = key(Vector(Quantity("dimensionless")))         # traction direction (else -n)
-    load_profile: tuple | None = key(Curve(Quantity("time", ge=0), Quantity("dimensionless", ge=0),
-                                           "time", "factor"))                 # ((s, -), ...)
-    rotation_speed: float | None = key(_ANGULAR_SPEED)       # rad/s (rotation builders)
-    speed_profile: tuple | None = key(Curve(Quantity("time", ge=0), _ANGULAR_SPEED,
-                                            "time", "speed"))                 # ((s, rad/s), ...)
+    normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)),                 # N
+                                     absent="pressure or vehicle.mass gives the load")
+    pressure: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e9)),                   # Pa
+                                 absent="normal_force or vehicle.mass gives the load")
+    faces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), absent="the builder's load faces (files: needed)")
+    direction: tuple | None = key(Vector(Quantity("dimensionless")),
+                                  absent="-p n on each face (disc_brake, files); else -z")
+    load_profile: tuple | None = key(Curve(Quantity("time", ge=0), Quantity("dimensionless", ge=0), "time",
+                                           "factor"), absent="factor 1 throughout")   # ((s, -), ...)
+    rotation_speed: float | None = key(_ANGULAR_SPEED, absent="speed_profile or vehicle; else at rest")  # rad/s
+    speed_profile: tuple | None = key(Curve(Quantity("time", ge=0), _ANGULAR_SPEED, "time", "speed"),
+                                      absent="rotation_speed or vehicle gives the speed")   # ((s, rad/s), ...)
     vehicle: Vehicle | None = key(Section(Vehicle))
-    sliding_speed: float | None = key(Quantity("speed", ge=0, plausible=(0.0, 200.0)))  # m/s (translation builders)
-    friction: float | None = key(_FRICTION)                                   # mu
+    sliding_speed: float | None = key(Quantity("speed", ge=0, plausible=(0.0, 200.0)), absent="at rest")  # m/s
+    friction: float | None = key(_FRICTION, absent="friction_curve or stribeck gives mu")   # mu
     ramp_steps: int = key(Integer(ge=1), default=1)       # load increments of the first mechanical solve
-    friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), Quantity("dimensionless", ge=0),
-                                             "slip speed", "mu", min_rows=2))  # ((m/s, -), ...)
+    friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), Quantity("dimensionless", ge=0), "slip speed",
+                                             "mu", min_rows=2), absent="friction or stribeck gives mu")  # ((m/s, -),..)
     stribeck: Stribeck | None = key(Section(Stribeck))
 
     FRICTION = ("friction", "friction_curve", "stribeck")
@@ -417,12 +419,11 @@ class Time:
 
 @dataclass(frozen=True)
 class Output:
-    """Where and what to write. Defaults: folder results/<name> next to the scene file; every
-    field the scene's effects produce."""
+    """Where and what to write."""
 
-    folder: Path | None = key(FilePath(folder=True))
+    folder: Path | None = key(FilePath(folder=True), absent="results/<name> next to the scene file")
     every: int = key(Integer(ge=1), default=1)            # write fields every n macro steps
-    fields: tuple = key(ListOf(Choice(OUTPUT_FIELDS), unique=True))
+    fields: tuple = key(ListOf(Choice(OUTPUT_FIELDS), unique=True), absent="every field the effects produce")
 
 
 # ------------------------------------------------------------------ later effects (validated only)
@@ -433,27 +434,27 @@ class Roughness:
     is generated for the whole face and cut into zones, or one per zone (per-zone seeds).
 
     A measured ``file`` (issue 17; ``multiscale.micro.topography``): any format SurfaceTopography
-    reads (x3p, sur, plu, opd, ...) with its own units and pixel sizes (``pixel_size`` and
-    ``height_unit`` override them, with a warning), or a plain height matrix (.npy, .txt, .csv,
-    .asc: ``pixel_size`` needed, ``height_unit`` default 1 m). It is conditioned (``detrend``,
+    reads (x3p, sur, plu, opd, ...) with its own units and pixel sizes (``pixel_size`` and ``height_unit``
+    override them, with a warning), or a plain height matrix (.npy, .txt, .csv, .asc). It is conditioned (``detrend``,
     undefined points filled up to ``max_undefined``, Gaussian filter at ``cutoff``), then
     ``cover``s the face: the measurement itself ("measured": it must cover the face; checked when
     the scene is read), copies ("mirror", "tile": warned) or a statistically equivalent surface
     from its PSD ("equivalent", drawn with ``seed``). ``multiscale check`` conditions nothing."""
 
-    body: str | None = key(Text())               # the stationary (rough) side; default: that side
-    rms: float | None = key(_ROUGHNESS)                                        # m
-    hurst: float | None = key(Quantity("dimensionless", gt=0, le=1, plausible=(0.1, 1.0)))
-    k_min: tuple | None = key(Pair(Quantity("dimensionless", gt=0)))          # wavelengths, (x, y)
-    k_max: tuple | None = key(Pair(Quantity("dimensionless", gt=0)))
+    body: str | None = key(Text(), absent="the stationary body, the only one allowed")
+    rms: float | None = key(_ROUGHNESS, absent="file gives the surface")                     # m
+    hurst: float | None = key(Quantity("dimensionless", gt=0, le=1, plausible=(0.1, 1.0)), absent=_WITH_RMS)
+    k_min: tuple | None = key(Pair(Quantity("dimensionless", gt=0)), absent=_WITH_RMS)   # wavelengths, (x, y)
+    k_max: tuple | None = key(Pair(Quantity("dimensionless", gt=0)), absent=_WITH_RMS)
     seed: int = key(Integer(ge=0), default=0)
     patch: str = key(Choice(("face", "zone")), default="face")
-    file: Path | None = key(FilePath())                                       # measured topography
-    channel: int | None = key(Integer(ge=0))                                  # default: the file's default
-    pixel_size: tuple | None = key(Pair(PixelSize()))                         # m, (dx, dy): overrides the file's
-    height_unit: float | None = key(Either(Quantity("length", gt=0), LengthUnit()))   # m per height unit ("1 um", "um")
+    file: Path | None = key(FilePath(), absent="rms: a generated fractal surface")     # measured topography
+    channel: int | None = key(Integer(ge=0), absent="the file's default channel")
+    pixel_size: tuple | None = key(Pair(PixelSize()), absent="the file's (needed if it has none)")   # m, (dx, dy)
+    height_unit: float | None = key(Either(Quantity("length", gt=0), LengthUnit()),   # m per height unit ("um")
+                                    absent="the file's unit; metres for a plain height matrix")
     detrend: str = key(Choice(tuple(DETREND)), default="plane")               # form removal
-    cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)))  # m, Gaussian filter λc
+    cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)), absent="no filter")  # m, Gaussian λc
     max_undefined: float = key(Quantity("dimensionless", ge=0, le=1), default=MAX_UNDEFINED)
     cover: str = key(Choice(COVER), default="measured")
 
@@ -487,32 +488,32 @@ COUPLING_DEFAULT = {"rough": "explicit", "bulk": "implicit"}
 @dataclass(frozen=True)
 class Micro:
     """How the rough interface is solved (issue 7): zone grid on the interface (zones no smaller than
-    its facets), grid per zone (default 50 x 50; a measured surface's own pixel size, rounded, unless replaced by a
-    statistically equivalent one), micro model, points of each p_n(g_n) law (top node at ``p_max``, default 20 x the nominal
-    interface pressure; contact solver tolerance ``tol``), micro partition law (ch. 6) or the
-    constant one. The micro heating of the loop (issue 19): ``heating`` "steady" (§6.5) or
+    its facets), grid per zone (a measured surface's pixel size rounded), micro model, points of each
+    p_n(g_n) law (top node at ``p_max``; contact solver tolerance ``tol``), micro partition law (ch. 6)
+    or the constant one. The micro heating of the loop (issue 19): ``heating`` "steady" (§6.5) or
     "transient" over each macro step in ``heating_steps`` = N_t steps (§6.3, Table 7.1: 10);
-    ``remote_temperatures`` "rough" (both bodies' at the rough body's macro surface temperature)
-    or "bulk" (each body's own: §7.2.2, §6.5; the default, "rough" with effect "conductance",
-    whose h_c conducts between the bodies already); ``coupling`` of partitions and temperatures
-    "explicit" (from the previous step), "fixed-point" (iterated within the step to
-    ``coupling_tol`` in at most ``coupling_iterations`` passes) or "implicit" (bulk only: the
-    partition at equal temperatures and the zone's exchange G as an interface conductance);
-    default "implicit" with "bulk" remote temperatures, "explicit" with "rough" (nothing to iterate:
-    the partition does not depend on the temperatures)."""
+    ``remote_temperatures`` "rough" (both bodies' at the rough body's macro surface temperature; with
+    effect "conductance" h_c conducts between the bodies already) or "bulk" (each body's own: §7.2.2,
+    §6.5); ``coupling`` of partitions and temperatures "explicit" (from the previous step),
+    "fixed-point" (iterated within the step to ``coupling_tol`` in at most ``coupling_iterations``
+    passes) or "implicit" (bulk only: the partition at equal temperatures and the zone's exchange G
+    as an interface conductance); defaults: ``remote``, ``coupling_scheme``."""
 
     zones: tuple | None = key(Pair(Integer(ge=1)), required=True)             # (nx, ny) zones
-    grid: tuple | None = key(Pair(Integer(ge=8)))                             # (nx, ny) per zone
+    grid: tuple | None = key(Pair(Integer(ge=8)),                             # (nx, ny) per zone
+                             absent='50 x 50; a measured file\'s pixels (not with cover "equivalent")')
     model: str = key(Choice(("fft-bem", "asperity", "asperity-interacting")), default="fft-bem")
     law_points: int = key(Integer(ge=4), default=20)
     partition_law: bool = key(Flag(), default=False)
-    p_max: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e10)))  # Pa, top node of the laws
+    p_max: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e10)),   # Pa, top node of the laws
+                              absent="20 x the nominal interface pressure")
     tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)     # micro contact solves
     flash_softening: bool = key(Flag(), default=False)   # H(T) of each zone at its last flash temperature
     heating: str = key(Choice(("steady", "transient")), default="steady")
     heating_steps: int = key(Integer(ge=1), default=10)                       # N_t per macro step (transient)
-    remote_temperatures: str | None = key(Choice(("rough", "bulk")))             # default: ``remote``
-    coupling: str | None = key(Choice(("explicit", "fixed-point", "implicit")))   # default: COUPLING_DEFAULT
+    remote_temperatures: str | None = key(Choice(("rough", "bulk")), absent='"bulk"; "rough" with effect conductance')
+    coupling: str | None = key(Choice(("explicit", "fixed-point", "implicit")),
+                               absent='"implicit" with "bulk" remote temperatures, else "explicit"')
     coupling_tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-3)   # max |dp| per pass
     coupling_iterations: int = key(Integer(ge=1), default=30)
 
@@ -556,16 +557,15 @@ FIG_7_9_WEAR_RATE = ((293.15, 8.2e-15), (373.15, 1.09e-14), (473.15, 2.04e-14), 
 
 @dataclass(frozen=True)
 class Wear:
-    """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (default: the
-    rough body's material k_w, else the shape of thesis Fig. 7.9, ``FIG_7_9_WEAR_RATE``, whose
-    level is calibrated on the thesis' ch. 7 worn volume: ``FIG_7_9_CALIBRATION``). Every
-    ``update_every`` macro steps (and at the last step, and a step ending at a stop) the zones wear
-    over the sliding since, weighted by the load factor (none while released), in ``substeps`` load-controlled
-    increments; a counter-face whose material gives ``k_w`` wears too."""
+    """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (``FIG_7_9_WEAR_RATE``:
+    calibrated as ``FIG_7_9_CALIBRATION`` says). Every ``update_every`` macro steps (and at the last
+    step, and a step ending at a stop) the zones wear over the sliding since, weighted by the load factor
+    (none while released), in ``substeps`` load-controlled increments; a counter-face whose material
+    gives ``k_w`` wears too."""
 
-    k_w: float | None = key(_WEAR_RATE)                      # 1/Pa
-    k_w_table: tuple | None = key(Curve(_TEMPERATURE, Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)),
-                                        "temperature", "k_w"))                # ((K, 1/Pa), ...)
+    k_w: float | None = key(_WEAR_RATE, absent="k_w_table, else the rough material's k_w, else thesis Fig. 7.9")
+    k_w_table: tuple | None = key(Curve(_TEMPERATURE, Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)), "temperature",
+                                        "k_w"), absent="k_w, else the rough material's k_w, else thesis Fig. 7.9")
     update_every: int = key(Integer(ge=1), default=1)                         # macro steps per update
     substeps: int = key(Integer(ge=1), default=1)                             # wear increments per update
 
@@ -595,6 +595,6 @@ class Layers:
     """Layers on one body's face, top first ([[layers.layer]]), on the body's material as a
     half-space or on a rigid base (ch. 2, §5.3)."""
 
-    body: str | None = key(Text())               # the stationary (rough) side; default: that side
+    body: str | None = key(Text(), absent="the stationary body, the only one allowed")
     base: str = key(Choice(("half-space", "rigid")), default="half-space")
     layer: tuple | None = key(Tables(Layer), required=True)

@@ -22,6 +22,7 @@ class Stribeck:
 
 
 SWEEP_PARAMETERS = {"friction": "-", "pressure": "Pa", "speed": "rad/s", "rms": "m"}
+_OTHER = "another of friction, pressure, speed, rms is swept"
 
 
 @dataclass(frozen=True)
@@ -35,10 +36,10 @@ class Sweep:
     (``mac``: the lowest MAC of a pair) and the onset of every unstable mode is bisected
     (``onsets``); see ``multiscale.workflows.squeal_map``."""
 
-    friction: tuple | None = key(ListOf(Quantity("dimensionless", ge=0), min_len=2))
-    pressure: tuple | None = key(ListOf(Quantity("pressure", gt=0), min_len=2))          # Pa
-    speed: tuple | None = key(ListOf(Quantity("angular_speed", ge=0), min_len=2))       # rad/s
-    rms: tuple | None = key(ListOf(Quantity("length", gt=0), min_len=2))                # m
+    friction: tuple | None = key(ListOf(Quantity("dimensionless", ge=0), min_len=2), absent=_OTHER)
+    pressure: tuple | None = key(ListOf(Quantity("pressure", gt=0), min_len=2), absent=_OTHER)          # Pa
+    speed: tuple | None = key(ListOf(Quantity("angular_speed", ge=0), min_len=2), absent=_OTHER)       # rad/s
+    rms: tuple | None = key(ListOf(Quantity("length", gt=0), min_len=2), absent=_OTHER)                # m
     points: int | None = key(Integer(ge=2), absent="the values listed")
     preload: str | None = key(Choice(("each", "once")), absent='"once" for friction and speed, "each" for pressure '
                               "and rms")

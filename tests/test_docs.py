@@ -69,6 +69,53 @@ def test_an_optional_key_without_default_says_what_its_absence_means():
         ["once", "once", "each", "each"]
 
 
+def test_every_optional_key_without_default_says_what_its_absence_means():
+    """No key of `check --keys` is a bare "[optional]" (56 were): an optional key without a default says
+    what leaving it out does (a new key must too), and the page's default column never says "none"
+    for such a key (only keys needed by an effect may)."""
+    lines = reference()
+    assert [line for line in lines if line.endswith("[optional]")] == []
+    assert sum("[optional; without it: " in line for line in lines) >= 64
+    rows = scene_rst().split("   * - ")
+    bare = [r.split("\n")[0] for r in rows if "\n     - none\n" in r]
+    needed = {f"``{p}``" for p in ("materials.<name>.rho", "materials.<name>.kappa", "materials.<name>.alpha",
+                                   "interface.penalty", "interface.partition", "interface.conductance", "time.end",
+                                   "layers.layer.kappa")}
+    assert set(bare) == needed, set(bare) ^ needed
+
+
+def test_the_absence_texts_say_what_the_code_does(tmp_path):
+    """Some absence texts against the code that reads the key: output.folder and output.fields, a
+    boundary's ambient and convection, an interface's friction, the load factor and the speed, the
+    micro grid, remote temperatures and coupling, and the wear rate."""
+    from multiscale.scene import loads
+    from multiscale.scene_sections import (DEFAULT_GRID, FIG_7_9_WEAR_RATE, Boundary, InterfaceSettings, Loading,
+                                           Micro, Output, Wear)
+    text = (Path(__file__).parents[1] / "demos" / "block_on_flat.toml").read_text()
+    text = text.replace('folder = "../results/block_on_flat"', "")
+    scene = loads(text, tmp_path, name="x")
+    assert _absent(Output, "folder") == "results/<name> next to the scene file"
+    assert scene.output.folder == tmp_path.resolve() / "results" / "block_on_flat"
+    assert _absent(Output, "fields") == "every field the effects produce"
+    assert scene.output.fields == ("displacement", "von_mises", "contact_pressure", "interface")
+    assert _absent(Boundary, "ambient") == "time.initial_temperature"       # read in workflows.model
+    assert Boundary(surfaces=("a",), fix=("z",)).h(10.0) == 0.0 and _absent(Boundary, "convection") == "no convection"
+    assert _absent(InterfaceSettings, "friction").startswith("loading.friction")
+    pin = loads((Path(__file__).parents[1] / "demos" / "pin_on_disc.toml").read_text(), tmp_path, name="x")
+    assert pin.interfaces == {} and pin.interface_settings("interface").friction == pin.loading.friction == 0.4
+    assert _absent(Loading, "load_profile") == "factor 1 throughout" and Loading().factor(5.0) == 1.0
+    assert _absent(Loading, "rotation_speed").endswith("else at rest") and Loading().angular_speed(1.0) == 0.0
+    assert _absent(Micro, "grid").startswith(f"{DEFAULT_GRID[0]} x {DEFAULT_GRID[1]};")
+    assert [Micro().remote(e) for e in (set(), {"conductance"})] == ["bulk", "rough"]
+    assert _absent(Micro, "remote_temperatures") == '"bulk"; "rough" with effect conductance'
+    assert [Micro().coupling_scheme(e) for e in (set(), {"conductance"})] == ["implicit", "explicit"]
+    assert _absent(Wear, "k_w").endswith("else thesis Fig. 7.9") and Wear().rate == tuple(zip(*FIG_7_9_WEAR_RATE))
+
+
+def _absent(cls, name: str) -> str:
+    return dict(fields_of(cls))[name].absent
+
+
 def test_every_study_key_appears_in_the_generated_study_format():
     from multiscale.studies.spec import StudyFile
     text = study_rst()
