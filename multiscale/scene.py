@@ -297,8 +297,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
             if table is not None and table.body is not None and table.body not in g.bodies:
                 problems.append(f'{section}.body = "{table.body}": not a body of {where}; allowed: '
                                 f'{", ".join(g.bodies)}')
-            elif section == "roughness" and table is not None and table.body not in (None, g.bodies[0]):
-                problems.append(f'roughness.body = "{table.body}": the rough body must be the stationary one, '
+            elif table is not None and table.body not in (None, g.bodies[0]):      # layers: on the rough body
+                problems.append(f'{section}.body = "{table.body}": the rough body must be the stationary one, '
                                 f'"{g.bodies[0]}" (zones do not move)')
         if "contact" not in effects and not any("contact" in EFFECTS[e].requires for e in effects):
             problems.append(f'effects: {where} is a macro contact model: add effect "contact"')

@@ -321,6 +321,8 @@ def test_measured_surface_path_is_relative_to_the_scene(tmp_path):
     ('body = "block"\nrms', 'body = "flat"\nrms', 'roughness.body = "flat": the rough body must be the stationary '
      'one, "block"'),
     ("hurst = 0.6", "hurst = 1.6", "roughness.hurst = 1.6: must be in (0, 1]"),
+    ('[layers]\nbody = "block"', '[layers]\nbody = "flat"', 'layers.body = "flat": the rough body must be the '
+     'stationary one, "block"'),         # was accepted by check, refused by run (check_rough_scene)
     ("grid = 50", "grid = [50, 50, 50]", "micro.grid = [50, 50, 50]: a pair needs exactly 2 values"),
     ('model = "fft-bem"', 'model = "bem"', 'micro.model = "bem": unknown (did you mean "fft-bem"?)'),
     ('model = "fft-bem"', "partition_law = true", 'micro.partition_law = true: needs effect "heat_partition"'),

@@ -51,13 +51,10 @@ P_MAX_PLASTIC = 0.9        # with plasticity, the top node of the laws is at mos
 
 
 def check_rough_scene(scene) -> None:
-    """The rules every rough analysis shares (InputError naming the field; the rough body is the
-    stationary one: checked when the scene is read)."""
-    bodies = scene.geometry.bodies
+    """The rules every rough analysis shares (InputError naming the field; the rough body, and the
+    layers' body, is the stationary one: checked when the scene is read)."""
     if scene.micro.model != "fft-bem":
         raise InputError("micro.model", scene.micro.model, 'the zone laws are computed by FFT-BEM: "fft-bem"')
-    if scene.has("layers") and scene.layers.body not in (None, bodies[0]):
-        raise InputError("layers.body", scene.layers.body, f'the layers belong to the rough body "{bodies[0]}"')
     if not scene.rough_interfaces:
         raise InputError("interfaces", "rough = false", 'effect "roughness" needs at least one rough interface')
     pairs = {scene.geometry.spec.interface_materials(n) for n in scene.rough_interfaces}
