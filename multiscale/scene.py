@@ -307,6 +307,11 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
             problems.append(f'loading.sliding_speed = {scene.loading.sliding_speed:g} m/s: heat transport needs a '
                             f'rotating body ({where} translates; with effect "thermal" it slides only at '
                             "sliding_speed = 0)")
+        ld = scene.loading
+        if ld is not None and ld.normal_force is not None and ld.direction is None and g.spec.fluid_load \
+                and not isinstance(g.params, FileGeometry):
+            problems.append(f"loading.normal_force: {where} is loaded by a fluid pressure on its load faces, whose "
+                            "forces cancel: give loading.pressure (or loading.direction for a force along it)")
         problems += _surface_checks(scene, g, where, effects)
         problems += _symmetry_checks(scene, g, where, effects)
         given = raw.get("geometry") if isinstance(raw.get("geometry"), dict) else {}

@@ -344,6 +344,21 @@ def test_later_sections_report_clear_problems(tmp_path, old, new, fragment):
     assert any(fragment in p for p in info.value.problems), info.value.problems
 
 
+def test_a_fluid_loaded_builder_refuses_a_normal_force_when_read(tmp_path):
+    """disc_brake's piston and bore faces take a fluid pressure whose forces cancel: loading.normal_force
+    without loading.direction is refused by check (it was accepted, and run stopped after meshing);
+    with a direction it is a traction along it, accepted."""
+    text = (Path(__file__).parents[1] / "demos" / "brake_squeal.toml").read_text()
+    force = text.replace('pressure = "10 bar"', 'normal_force = "4000 N"', 1)
+    assert force != text
+    with pytest.raises(SceneError) as info:
+        loads(force, tmp_path)
+    assert [p for p in info.value.problems if p.startswith("loading.normal_force: builder \"disc_brake\" is loaded by "
+                                                           "a fluid pressure")], info.value.problems
+    assert loads(force.replace('normal_force = "4000 N"', 'normal_force = "4000 N"\ndirection = [0, 0, 1]'),
+                 tmp_path).loading.direction == (0.0, 0.0, 1.0)
+
+
 def test_alternatives_given_together_are_one_problem(tmp_path):
     """rms with file said that rms and file exclude each other and then that hurst, k_min and
     k_max were missing "with roughness.rms" (four errors for one mistake; an adversarial review);

@@ -63,13 +63,9 @@ def scene_spec(scene) -> GeometrySpec:
 
 def load_kind(scene) -> str:
     """How the load acts: "fluid" (-p n: builders with ``fluid_load``, files), "force" or "pressure"."""
-    ld = scene.loading
-    if scene_spec(scene).fluid_load:
-        if ld.pressure is None and scene.geometry.builder != "file" and (ld.vehicle is None or ld.vehicle.mass is None):
-            raise InputError("loading.pressure", None, f'builder "{scene.geometry.builder}" is loaded by a '
-                             "fluid pressure on its load faces (give loading.pressure)")
+    if scene_spec(scene).fluid_load:        # a builder's fluid load takes no normal_force: refused when read
         return "fluid"
-    return "force" if ld.pressure is None else "pressure"
+    return "force" if scene.loading.pressure is None else "pressure"
 
 
 def interface_radii(scene, tm) -> dict:
