@@ -240,6 +240,32 @@ def test_scene_roughness_sweep_rebuilds_the_laws_and_frees_the_models(tmp_path):
     assert models() == before
 
 
+def test_a_roughness_sweep_that_fails_closes_the_model_it_rebuilt(tmp_path, monkeypatch):
+    """The preload of the first rebuilt point fails (simulated): the run's error passes on and the
+    mechanics the map rebuilt is closed and freed with the nominal one (one rank; before: it stayed
+    alive with its MPI communicators)."""
+    import gc      # local: this test alone looks at the collector
+    from multiscale.errors import ConvergenceError
+    from multiscale.workflows import squeal_map
+    overrides = {"effects": ["contact", "friction", "stability", "roughness"], "roughness.body": "brake",
+                 "roughness.rms": "0.05 um", "roughness.hurst": 0.8, "roughness.k_min": 1, "roughness.k_max": 16,
+                 "roughness.patch": "zone", "micro.zones": [4, 2], "micro.grid": [32, 32], "micro.law_points": 10,
+                 "micro.p_max": "30 kPa", "geometry.mesh_size": "30 mm", "stability.modes": 6,
+                 "stability.sweep.rms": ["0.05 um", "2 um"], "output.folder": str(tmp_path / "out")}
+
+    def failing(*args, **kwargs):
+        raise ConvergenceError("the preload fails (simulated)")
+    monkeypatch.setattr(squeal_map, "preload", failing)
+
+    def models():
+        gc.collect()
+        return sum(isinstance(o, Mechanics) for o in gc.get_objects())
+    before = models()
+    with pytest.raises(ConvergenceError, match="simulated"):
+        squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
+    assert models() == before
+
+
 def test_a_speed_sweep_that_changes_nothing_is_warned_about(tmp_path):
     """Speed sweep with a constant friction and no gyroscopic terms: identical points, said at
     check (before: OK and a flat map; found by an adversarial test); with them, no warning."""

@@ -37,6 +37,7 @@ from multiscale import io
 from multiscale.macro.damped import Subspace, basis_modes, project, solve_projected, solve_system
 from multiscale.macro.eigen import matrix_comm, reduce_sum
 from multiscale.macro.friction import set_friction
+from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.preload import linearise_system, preload
 from multiscale.macro.stability_map import MapBuilder, StabilityMap
 from multiscale.plots.squeal import plot_map, plot_tracks
@@ -56,8 +57,9 @@ class MapModel:
         self.sweep = scene.stability.sweep
         self.materials = dict(scene.materials)
 
-    def close(self, mech) -> None:
-        """Close ``mech`` (collective) if it is one this map rebuilt."""
+    def close(self, mech=None) -> None:
+        """Close ``mech`` (default: the current one; collective) if it is one this map rebuilt."""
+        mech = self.mech if mech is None else mech
         if mech is not self.nominal:
             mech.close()
 
@@ -105,11 +107,9 @@ def stability_map(scene, tm, mech, options, load: float, rebuild: Callable) -> S
     st, sw = scene.stability, scene.stability.sweep
     model = MapModel(scene, tm, mech, options, load, rebuild)
     builder = MapBuilder(sw.parameter, UNITS[sw.parameter], st.band, mac_min=sw.mac, rtol=st.threshold)
-    if sw.preload_mode == "once":
-        size = _common_basis(model, builder, st, options)
-    else:
-        size = _per_point(model, builder, st, options)
-    model.close(model.mech)
+    with closed_on_error(model, tm.comm):        # a rebuilt model of a failed point (one rank)
+        size = (_common_basis if sw.preload_mode == "once" else _per_point)(model, builder, st, options)
+    model.close()
     return builder.finish(basis_size=size, time=time.perf_counter() - t0)
 
 
