@@ -18,6 +18,7 @@ from multiscale import __version__
 from multiscale.errors import InputError, MultiscaleError, OutputError, SceneError
 from multiscale.geometry import too_many_cells
 from multiscale.io import CtrlCWatch, abort, ended_together, memory_available
+from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.spectrum import statistics_memory, surface_statistics
 from multiscale.micro.topography import (DETREND, MAX_UNDEFINED, TopographyWarning, condition, formats,
                                         read_topography)
@@ -297,23 +298,23 @@ def _surface(args) -> int:
         from multiscale.plots.surface import figure_problem   # local: matplotlib only when a figure is drawn
         if why := figure_problem(figure):     # said before the analysis (minutes on a large file), not after
             raise InputError("--figure", args.figure, f"cannot write the figure there: {why}")
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", TopographyWarning)      # the report's "warning:" lines say them
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", TopographyWarning)      # the report's "warning:" lines say them
+        try:
             measurement = read_topography(args.file, args.channel, pixel_size=pixel, height_unit=unit)
-        need, free = surface_memory(measurement.shape), memory_available()
-        if free is not None and need > free:      # the OOM killer ended it, without a word (8000² points)
-            raise InputError("file", measurement.path.name, f"{measurement.shape[1]} x {measurement.shape[0]} points: "
-                             f"their statistics need about {need / 1e9:.2g} GB of memory, {free / 1e9:.2g} GB are "
-                             "available: crop or coarsen the map first")
-        if cutoff is not None and plain(_number_or_text(args.cutoff)) and cutoff > min(measurement.size):
-            Lx, Ly = measurement.size       # ISO cut-offs are given in mm: "--cutoff 0.8" was 0.8 m, silently
-            raise InputError("cutoff", args.cutoff, f"{cutoff:g} m, longer than the measurement ({Lx * 1e3:.4g} x "
-                             f'{Ly * 1e3:.4g} mm); plain numbers are metres: did you mean "{args.cutoff} mm"?')
-        done = condition(measurement, args.detrend, cutoff, args.max_undefined)
-    except InputError as exc:     # the micro fields by their command-line names
-        name = "FILE" if exc.name == "file" else "--" + exc.name.replace("_", "-")
-        raise InputError(name, exc.value, exc.allowed) from None
+            need, free = surface_memory(measurement.shape), memory_available()
+            if free is not None and need > free:      # the OOM killer ended it, without a word (8000² points)
+                raise InputError("file", measurement.path.name, f"{measurement.shape[1]} x {measurement.shape[0]} "
+                                 f"points: their statistics need about {need / 1e9:.2g} GB of memory, {free / 1e9:.2g} GB are "
+                                 "available: crop or coarsen the map first")
+            if cutoff is not None and plain(_number_or_text(args.cutoff)) and cutoff > min(measurement.size):
+                Lx, Ly = measurement.size       # ISO cut-offs are given in mm: "--cutoff 0.8" was 0.8 m, silently
+                raise InputError("cutoff", args.cutoff, f"{cutoff:g} m, longer than the measurement ({Lx * 1e3:.4g} x "
+                                 f'{Ly * 1e3:.4g} mm); plain numbers are metres: did you mean "{args.cutoff} mm"?')
+            done = condition(measurement, args.detrend, cutoff, args.max_undefined, despike=args.despike)
+        except InputError as exc:     # the micro fields by their command-line names
+            name = "FILE" if exc.name == "file" else "--" + exc.name.replace("_", "-")
+            raise InputError(name, exc.value, exc.allowed) from None
     stats = surface_statistics(done.surface)
     print("\n".join(done.report))
     print(f"statistics of the {'roughness' if done.waviness is not None else 'surface'}:")
@@ -375,8 +376,9 @@ def build_parser() -> argparse.ArgumentParser:
     surface = sub.add_parser("surface", help="measured topography: conditioning, statistics (Sq, Sdq, Ssk, Sku, "
                                              "Nayak, summits, PSD fit), a figure with --figure",
                              description="Read a measured topography (through SurfaceTopography), remove its form, "
-                             "fill undefined points, optionally split waviness from roughness, and print its "
-                             "statistics; with --figure, a figure of the height map and the PSD with its fit.")
+                             "warn of outliers, fill undefined points (and outliers with --despike), optionally "
+                             "split waviness from roughness, and print its statistics; with --figure, a figure of "
+                             "the height map and the PSD with its fit.")
     surface.add_argument("file", nargs="?", metavar="FILE", help="topography file (x3p, sur, plu, opd, ...; "
                                                                  "--formats lists them)")
     surface.add_argument("--channel", type=int, metavar="N", help="channel index (default: the file's default)")
@@ -385,6 +387,9 @@ def build_parser() -> argparse.ArgumentParser:
                                                             "keep the roughness, report the waviness")
     surface.add_argument("--max-undefined", type=float, default=MAX_UNDEFINED, metavar="FRACTION",
                          help=f"largest share of undefined points that is filled (default {MAX_UNDEFINED})")
+    surface.add_argument("--despike", type=float, metavar="K", help="remove the outliers (points deviating from "
+                         "their neighbourhood's median by more than K times the other heights' Sq) and fill them "
+                         f"like undefined points; default: warn of those beyond {DESPIKE:g}")
     surface.add_argument("--pixel-size", metavar="LENGTH", help="override the file's pixel size")
     surface.add_argument("--height-unit", metavar="LENGTH",
                          help='override the file\'s height unit, e.g. "um" or "1 um"')

@@ -13,6 +13,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from multiscale.errors import InputError
+from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_topography
 from multiscale.scene_geometry import LengthUnit
 from multiscale.scene_plain import PixelSize
@@ -429,17 +430,14 @@ class Output:
 # ------------------------------------------------------------------ later effects (validated only)
 @dataclass(frozen=True)
 class Roughness:
-    """Rough face of one body (§7.3.1: only the pin is rough): generated (fractal, Eqs. 1.24–1.25)
-    or measured. Cut-offs are wavelengths per generated patch; ``patch`` says whether one surface
-    is generated for the whole face and cut into zones, or one per zone (per-zone seeds).
-
-    A measured ``file`` (issue 17; ``multiscale.micro.topography``): any format SurfaceTopography
-    reads (x3p, sur, plu, opd, ...) with its own units and pixel sizes (``pixel_size`` and ``height_unit``
-    override them, with a warning), or a plain height matrix (.npy, .txt, .csv, .asc). It is conditioned (``detrend``,
-    undefined points filled up to ``max_undefined``, Gaussian filter at ``cutoff``), then
-    ``cover``s the face: the measurement itself ("measured": it must cover the face; checked when
-    the scene is read), copies ("mirror", "tile": warned) or a statistically equivalent surface
-    from its PSD ("equivalent", drawn with ``seed``). ``multiscale check`` conditions nothing."""
+    """Rough face of one body (§7.3.1: only the pin is rough): generated (fractal, Eqs. 1.24–1.25;
+    cut-offs are wavelengths per patch: the whole face cut into zones, or each zone, ``patch``) or
+    a measured ``file`` (issue 17; ``multiscale.micro.topography``): any format SurfaceTopography
+    reads with its units and pixel sizes (``pixel_size``, ``height_unit`` override them, warned) or
+    a plain height matrix (.npy, .txt, .csv, .asc), conditioned (``detrend``, outliers warned of or
+    removed at ``despike``, undefined points filled up to ``max_undefined``, ``cutoff``), then
+    ``cover``ing the face: itself ("measured": it must cover it; checked when the scene is read),
+    copies ("mirror", "tile": warned) or a surface from its PSD ("equivalent", ``seed``)."""
 
     body: str | None = key(Text(), absent="the stationary body, the only one allowed")
     rms: float | None = key(_ROUGHNESS, absent="file gives the surface")                     # m
@@ -456,11 +454,13 @@ class Roughness:
     detrend: str = key(Choice(tuple(DETREND)), default="plane")               # form removal
     cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)), absent="no filter")  # m, Gaussian λc
     max_undefined: float = key(Quantity("dimensionless", ge=0, le=1), default=MAX_UNDEFINED)
+    despike: float | None = key(Quantity("dimensionless", gt=0), absent=f"outliers warned of (k = {DESPIKE:g}), kept")
     cover: str = key(Choice(COVER), default="measured")
 
     rules = (OneOf(("rms", "file"), required=True, meaning="a generated fractal surface or a measured file"),
              Requires("rms", ("hurst", "k_min", "k_max")), OnlyWith("rms", ("hurst", "k_min", "k_max", "patch")),
-             OnlyWith("file", ("channel", "pixel_size", "height_unit", "detrend", "cutoff", "max_undefined", "cover")))
+             OnlyWith("file", ("channel", "pixel_size", "height_unit", "detrend", "cutoff", "max_undefined", "despike",
+                               "cover")))
 
     def problems(self, path, ctx):
         if self.rms is not None and any(hi <= lo for lo, hi in zip(self.k_min, self.k_max)):
@@ -469,7 +469,7 @@ class Roughness:
             return []
         problems, notes = probe_topography(self.file, self.channel, pixel_size=self.pixel_size,
                                            height_unit=self.height_unit, max_undefined=self.max_undefined,
-                                           detrend=self.detrend, prefix=f"{path}.")
+                                           detrend=self.detrend, despike=self.despike, prefix=f"{path}.")
         ctx.warnings.extend(notes)
         return problems
 

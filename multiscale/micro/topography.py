@@ -9,7 +9,8 @@ and need a pixel size. Undefined points (no value from the instrument; NaN in a 
 
 Conditioning (``condition``), in the order of ISO 25178-3 and each step reported: form removal (the
 F-operator: least-squares mean, plane or polynomial fitted on the defined points, ``remove_form``),
-undefined points filled (harmonic interpolation; refused above a stated fraction), waviness and roughness separated by
+outliers found (``multiscale.micro.outliers``: warned of, or removed with ``despike``), undefined
+points filled (harmonic interpolation; refused above a stated fraction), waviness and roughness separated by
 the areal Gaussian filter of ISO 16610-61 (the L-filter, cut-off wavelength λc: the roughness is the
 S-L surface). ``resample`` puts a surface on another grid (the micro grid) with an anti-aliasing
 S-filter when it coarsens.
@@ -30,6 +31,7 @@ from pathlib import Path
 import numpy as np
 
 from multiscale.errors import InputError, check_count, check_pair, check_positive, check_real
+from multiscale.micro.outliers import DESPIKE, find_outliers
 from multiscale.micro.spectrum import as_topography, equivalent_surface, power_spectrum, surface_topography
 from multiscale.micro.surface import Surface, read_matrix, row_blocks
 
@@ -236,11 +238,11 @@ def _height_range(h: np.ndarray, path: Path, prefix: str, unit: str, what: str =
 
 
 def probe_topography(path, channel: int | None = None, *, pixel_size=None, height_unit=None,
-                     max_undefined: float = MAX_UNDEFINED, detrend: str = "plane",
+                     max_undefined: float = MAX_UNDEFINED, detrend: str = "plane", despike: float | None = None,
                      prefix: str = "") -> tuple[list[str], list[str]]:
-    """What ``read_topography`` and ``condition`` would refuse in a file, without conditioning it
-    (``multiscale check``): (problems, notes), one line each; no problems for a usable file, the
-    notes say what overrides the file."""
+    """What ``read_topography`` and ``condition`` would refuse in a file, without filling or
+    filtering it (``multiscale check``): (problems, notes), one line each; no problems for a usable
+    file, the notes say what overrides the file and ``condition``'s warning of outliers."""
     try:
         with warnings.catch_warnings():
             warnings.simplefilter("ignore", TopographyWarning)      # returned as notes
@@ -248,7 +250,18 @@ def probe_topography(path, channel: int | None = None, *, pixel_size=None, heigh
     except InputError as exc:
         return [str(exc)], []
     why = _too_many_undefined(m, max_undefined, prefix) or _form_only(m, detrend)
-    return ([] if why is None else [str(InputError(f"{prefix}file", m.path.name, why))]), list(m.notes)
+    if why is not None:
+        return [str(InputError(f"{prefix}file", m.path.name, why))], list(m.notes)
+    h = m.heights if detrend == "none" or despike is not None else remove_form(m.heights, detrend)
+    return [], list(m.notes) + ([] if despike is not None else _outlier_notes(m, h, prefix))   # removed: said then
+
+
+def _outlier_notes(m: Measurement, h: np.ndarray, prefix: str) -> list[str]:
+    """``condition``'s warning of outliers in the form-removed heights ``h`` [m] at the default
+    threshold (none or one line)."""
+    found = find_outliers(h)
+    option = f"{prefix}despike = {DESPIKE:g}" if prefix else f"--despike {DESPIKE:g}"
+    return [found.note(m.path.name, option)] if found.count else []
 
 
 def _form_only(m: Measurement, detrend: str) -> str | None:
@@ -280,11 +293,13 @@ def _too_many_undefined(m: Measurement, max_undefined: float, prefix: str) -> st
 @dataclass(frozen=True)
 class Conditioned:
     """A conditioned measurement: ``surface`` (the roughness, non-periodic, mean zero), ``waviness``
-    (what the Gaussian filter took out; None without a cut-off) and ``report`` (one line per step)."""
+    (what the Gaussian filter took out; None without a cut-off), ``report`` (one line per step) and
+    ``notes`` (its warnings, "warning: " lines of the report too)."""
 
     surface: Surface
     waviness: Surface | None
     report: tuple[str, ...]
+    notes: tuple[str, ...] = ()
 
 
 FLAT = 1e-10        # a conditioned surface whose Sq is below this share of its largest height is flat
@@ -379,14 +394,18 @@ def remove_form(heights: np.ndarray, detrend: str) -> np.ndarray:
 
 
 def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = None,
-              max_undefined: float = MAX_UNDEFINED, prefix: str = "") -> Conditioned:
-    """Form removal, filling of undefined points, waviness/roughness separation (see module
+              max_undefined: float = MAX_UNDEFINED, prefix: str = "", despike: float | None = None) -> Conditioned:
+    """Form removal, outliers, filling of undefined points, waviness/roughness separation (see module
     docstring); ``detrend`` one of ``DETREND`` (SurfaceTopography's detrend modes: mean, least-squares
-    plane, second-order polynomial), ``cutoff`` λc [m] of the Gaussian filter (None: no filter)."""
+    plane, second-order polynomial), ``cutoff`` λc [m] of the Gaussian filter (None: no filter),
+    ``despike`` the threshold k of ``outliers.find_outliers`` at which outliers are removed (filled as
+    undefined points; None: found at k = ``DESPIKE``, a warning, a ``TopographyWarning`` too)."""
     if detrend not in DETREND:
         raise InputError(f"{prefix}detrend", detrend, f"one of {', '.join(DETREND)}")
     if cutoff is not None:
         check_positive(f"{prefix}cutoff", cutoff)
+    if despike is not None:
+        check_positive(f"{prefix}despike", despike)
     if not 0 <= check_real(f"{prefix}max_undefined", max_undefined) <= 1:
         raise InputError(f"{prefix}max_undefined", max_undefined, "a fraction of the points, in [0, 1]")
     too_many = _too_many_undefined(m, max_undefined, prefix)
@@ -401,11 +420,26 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
         names = {"mean": "mean height", "plane": "least-squares plane", "poly2": "least-squares polynomial of degree 2"}
         report.append(f"form removed: {names[detrend]} (SurfaceTopography detrend \"{DETREND[detrend]}\"): "
                       f"Sq {_um(before)} -> {_um(_defined_std(h))} um")
-    if m.undefined:
+    undefined, notes = m.undefined, []
+    if despike is None:
+        notes = _outlier_notes(m, h, prefix)
+        for note in notes:
+            warnings.warn(note, TopographyWarning, stacklevel=2)
+        report += [f"warning: {note}" for note in notes]
+    elif (found := find_outliers(h, despike)).count:
+        h = h.copy() if h is m.heights else h
+        h[found.rows, found.cols] = np.nan
+        undefined += found.count
+        report.append(f"removed {found.count} outliers ({prefix}despike = {despike:g}), {found.describe()}: "
+                      "filled as undefined points")
+        if undefined > max_undefined * h.size:
+            raise InputError(f"{prefix}despike", despike, f"{undefined} of {m.path.name}'s {h.size} points are "
+                             f"undefined or outliers, more than {prefix}max_undefined = {100 * max_undefined:.3g} %")
+    if undefined:
         frame = Surface(np.broadcast_to(0.0, m.shape), m.dx, m.dy, periodic=False)
         t = as_topography(frame, np.ma.masked_invalid(h)).interpolate_undefined_data("harmonic")
         h = np.ascontiguousarray(np.asarray(t.heights(), dtype=float).T)
-        report.append(f"filled {m.undefined} undefined points ({m.undefined / m.heights.size:.2%}) by harmonic "
+        report.append(f"filled {undefined} undefined points ({undefined / m.heights.size:.2%}) by harmonic "
                       "interpolation (SurfaceTopography interpolate_undefined_data)")
     if h is m.heights:            # nothing removed or filled: a copy, not the measurement's array
         h = h - h.mean()
@@ -427,7 +461,7 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
     scale = float(np.nanmax(np.abs(m.heights), initial=0.0))
     if not surface.heights.std() > FLAT * scale:
         raise InputError(f"{prefix}file", m.path.name, _no_roughness(float(surface.heights.std()), scale))
-    return Conditioned(surface, waviness, tuple(report))
+    return Conditioned(surface, waviness, tuple(report), tuple(notes))
 
 
 def _um(value: float) -> str:

@@ -91,14 +91,14 @@ def make_zones(r, m, lo, hi, seed: int, log=None) -> tuple[ZoneGrid, list]:
 
 def measured_face(r, m, counts, size, seed: int, log=None) -> Surface:
     """The face of ``size`` [m] from ``roughness.file``: read, conditioned (``roughness.detrend``,
-    ``cutoff``, ``max_undefined``) and covering the face (``roughness.cover``), on counts x
+    ``cutoff``, ``max_undefined``, ``despike``) and covering the face (``roughness.cover``), on counts x
     ``micro.grid`` cells (without ``micro.grid``: 50 x 50 per zone for an equivalent surface, else
     the measurement's pixel size rounded to whole cells per zone)."""
     with warnings.catch_warnings():      # the warnings are lines of the report: printed once, not per rank
         warnings.simplefilter("ignore", TopographyWarning)
         measured = read_topography(r.file, r.channel, pixel_size=r.pixel_size, height_unit=r.height_unit,
                                    prefix="roughness.")
-        done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix="roughness.")
+        done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix="roughness.", despike=r.despike)
         cells = m.grid
         if cells is None and r.cover == "equivalent":
             cells = DEFAULT_GRID
@@ -109,7 +109,7 @@ def measured_face(r, m, counts, size, seed: int, log=None) -> Surface:
                                  f"per zone: set micro.grid (at most {MAX_CELLS} without it)")
         surface, lines = cover(done.surface, (counts[0] * cells[0], counts[1] * cells[1]), tuple(size), r.cover,
                                seed, prefix="roughness.")
-    known = {f"warning: {note}" for note in measured.notes}      # the scene's warnings already (check, run)
+    known = {f"warning: {note}" for note in (*measured.notes, *done.notes)}   # the scene's warnings already
     for line in (*done.report, *lines) if log is not None else ():
         if line not in known:
             log(f"roughness: {line}")
