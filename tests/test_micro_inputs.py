@@ -15,6 +15,7 @@ from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
 from multiscale.micro.laws import LawSpec
 from multiscale.micro.layered_asperity import LayeredAsperity, layered_law
+from multiscale.micro.plasticity import Hardness
 from multiscale.micro.post_analysis import Heating, PostAnalysis
 from multiscale.micro.surface import Surface, find_asperities, fractal_surface, load_surface, statistics
 from multiscale.micro.wear import simulate_wear, wear_step
@@ -190,3 +191,29 @@ def test_the_valid_calls_of_the_cases_work():
     asperity_solve()
     assert fft.get_threads() >= 1
     fft.set_threads(fft.get_threads())
+
+
+def test_post_analysis_without_friction_has_no_heat():
+    """mu = 0 (a scene's loading.friction = 0) is no frictional heat, as a zone at rest: the bulk
+    temperatures, zero heat, no partition (NaN) and no wear; it was an InputError of the heating
+    ('mu = np.float64(0.0): must be finite and > 0') after the laws of a rough run."""
+    zones = cut_zones(S, (1, 1))[1]
+    for conduction_on in (False, True):
+        post = PostAnalysis(E, zones[0].shape, S.dx, S.dy, mu=0.0, wear_rate=1e-14,
+                            heating=Heating(DISC, PIN, conduction=conduction_on))
+        r = post.run(zones, [1e6], speed=2.0, remote=[[300.0, 310.0]], sliding=[1e-3])
+        assert r.heat[0] == 0.0 and r.heat_rough[0] == 0.0 and np.isnan(r.partition[0])
+        assert r.max_temperature[0] == 310.0 and np.all(r.temperature == 310.0) and np.all(r.counter_temperature == 300.0)
+        assert r.volume[0] == 0.0 and np.all(np.isfinite(r.pressure))
+    with pytest.raises(InputError, match="mu"):
+        post.run(zones, [1e6], speed=2.0, remote=[[300.0, 310.0]], mu=[-0.1])
+
+
+def test_a_zone_loaded_at_or_above_the_hardness_is_named():
+    """A zone mean pressure >= H (laws tabulated to 0.9 H, extrapolated beyond) is refused naming
+    the hardness, the zone and the pressures, not as the solver's 'load = array([...])'."""
+    zones = cut_zones(S, (2, 1))[1]
+    post = PostAnalysis(E, zones[0].shape, S.dx, S.dy, mu=0.4, hardness=Hardness(1e6))
+    with pytest.raises(InputError, match=r"hardness: 1 zone\(s\) .*zone 1: 1.2e\+06 Pa against H = 1e\+06 Pa"):
+        post.run(zones, [5e5, 1.2e6], speed=1.0)
+    assert np.all(post.run(zones, [5e5, 9e5], speed=1.0).max_pressure <= 1e6)

@@ -102,7 +102,7 @@ class ZoneResult:
     area_fraction: np.ndarray     # (B,): real contact area / zone area before wear
     max_temperature: np.ndarray   # K, (B,): largest rough-body surface temperature (NaN without heating)
     partition: np.ndarray         # (B,): share of the frictional heat into the rough body (NaN: no heating,
-    #                               or a zone at zero speed: no heat)
+    #                               or a zone at zero speed or friction: no heat)
     conductance: np.ndarray       # W/(m^2 K), (B,): zone conductance h_c (NaN without)
     iterations: np.ndarray        # (B,): contact-solver iterations of the step
     load: np.ndarray = None       # Pa, (B,): the zone mean pressures
@@ -192,6 +192,8 @@ class PostAnalysis:
             raise InputError("load", load, "zone pressures must be > 0 (skip unloaded zones)")
         speed, angle = _per_zone("speed", speed, B), _per_zone("angle", angle, B)
         mu = np.full(B, self.mu) if mu is None else _per_zone("mu", mu, B)
+        if np.any(mu < 0):
+            raise InputError("mu", mu, "friction coefficients must be >= 0")
         remote = None if remote is None else np.broadcast_to(np.asarray(remote, dtype=float), (B, 2))
         nan = np.full(B, np.nan)
         if B == 0:
@@ -206,6 +208,13 @@ class PostAnalysis:
                 raise InputError("remote", None, "a temperature-dependent hardness needs temperatures")
             at = remote[:, 1] if hardness_temperature is None and remote is not None else hardness_temperature
             hard = np.broadcast_to(self.hardness(at), (B,))
+            over = np.flatnonzero(load >= hard)
+            if len(over):             # a fully plastic zone has no finite approach (nor a law beyond 0.9 H)
+                b = over[np.argmax(load[over] / hard[over])]
+                raise InputError("hardness", None, f"{len(over)} zone(s) carry a mean pressure at or above the "
+                                 f"hardness of the rough body (zone {zones[b].id}: {load[b]:.3g} Pa against H = "
+                                 f"{hard[b]:.3g} Pa): such a zone would be fully plastic; raise the hardness "
+                                 "(materials.<name>.hardness) or lower the load")
         r = self._solve(zones, H, load, _warm(warm, H.shape), hard)
         T = T1 = None
         max_T, partition, heat, heat_rough, exchange, equal = (nan.copy() for _ in range(6))
@@ -214,7 +223,7 @@ class PostAnalysis:
                 raise InputError("remote", None, "heating needs the remote temperatures of both bodies")
             T, T1 = np.empty(H.shape), np.empty(H.shape)
             for b in range(B):
-                if speed[b] == 0.0:              # no sliding, no frictional heat: the bulk temperatures
+                if speed[b] == 0.0 or mu[b] == 0.0:     # no sliding or no friction, no heat: the bulk temperatures
                     T1[b], T[b], max_T[b], heat[b], heat_rough[b], exchange[b] = *remote[b], remote[b, 1], 0, 0, 0
                     continue
                 T1[b], T[b], max_T[b], heat[b], heat_rough[b] = self._heat(r.pressure[b], speed[b], angle[b],
