@@ -414,13 +414,19 @@ def _hardness_checks(scene: Scene, g: Geometry, raw: dict, effects) -> list[str]
     return problems
 
 
+STIFF_PENALTY = 1e4   # a penalty above this many times E*/h is warned about (ill-conditioned tangent)
+
+
 def _penalty_warnings(scene: Scene, g: Geometry, effects) -> list[str]:
     """A perfect-contact penalty K_n [Pa/m] below E*/h on an interface, E* the contact modulus of its
     two materials at the initial temperature, 1/E* = (1 - nu_0^2)/E_0 + (1 - nu_1^2)/E_1 (Johnson
     1985, Eq. 4.22), and h its element size [m]: the penetration p/K_n then exceeds the elastic
     deflection p h/E* over an element, and the displacements and pressure peaks follow the penalty
     (block on flat, 4 GPa, h 2.5 mm: the top moves 2.27 um with 1e12 Pa/m, 1.27 um converged; a
-    steel punch on a 21 MPa flat peaks at 3.6 MPa with 1e11 Pa/m, 5.2 MPa converged)."""
+    steel punch on a 21 MPa flat peaks at 3.6 MPa with 1e11 Pa/m, 5.2 MPa converged). Or above
+    ``STIFF_PENALTY`` E*/h: the tangent's conditioning grows with K_n h/E*, and the contact Newton's
+    linear solves failed (the coarse demo brake at 1e17 Pa/m, 4.9e5 E*/h; 1e16 ran; the pin on
+    disc at 1e19 Pa/m, 4.7e6 E*/h; 1e17 ran), inside the plausible range of K_n."""
     K, sizes = scene.interface.penalty if scene.interface is not None else None, g.resolved()
     h = sizes.get("interface_mesh_size") or sizes.get("mesh_size")
     if "contact" not in effects or K is None or h is None or scene.materials is None or scene.time is None:
@@ -439,6 +445,12 @@ def _penalty_warnings(scene: Scene, g: Geometry, effects) -> list[str]:
                        f"{modulus / h:.3g} Pa/m (contact modulus E* = {modulus:.3g} Pa, element size h = {h:g} m), "
                        "so the penetration p/K_n exceeds their elastic deflection and the displacements and "
                        "pressure peaks follow the penalty; perfect contact needs K_n well above E*/h")
+        elif K > STIFF_PENALTY * modulus / h:
+            out.append(f"interface.penalty = {K:g} Pa/m is {K * h / modulus:.2g} times E*/h = {modulus / h:.3g} Pa/m "
+                       f"at interface {name} (contact modulus E* = {modulus:.3g} Pa, element size h = {h:g} m): the "
+                       "contact makes the stiffness matrix ill-conditioned and the Newton's linear solves may fail "
+                       f"(they did from about 1e5 E*/h); at {STIFF_PENALTY:.0e} E*/h the penetration is already "
+                       f"{1 / STIFF_PENALTY:.0e} of the elastic deflection")
     return out
 
 

@@ -507,7 +507,7 @@ class Mechanics:
                           "Newton's own factorisation (leave pc_type unset for it)")
             free = ("a body, or a solid of one, can move as a rigid body: give each a support ([[boundary]] fix) "
                     "or a contact that holds it in every direction (friction does not hold a body; a part that "
-                    "touches nothing is held by its supports alone)")
+                    "touches nothing is held by its supports alone), or a penalty far above E*/h ill-conditions it")
             if result.reason == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE:
                 cause += f"; the linear solve failed, as it does when {free}"
             elif result.reason == PETSc.SNES.ConvergedReason.DIVERGED_DTOL:
