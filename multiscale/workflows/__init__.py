@@ -22,6 +22,7 @@ from multiscale.micro.wear import STEP_RMS, SUBSTEP_TOL
 from multiscale.plots.history import history_figure, multiscale_figure
 from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
+from multiscale.workflows.model import interface_materials
 from multiscale.workflows.output import RunResult
 
 
@@ -135,8 +136,32 @@ def run_warnings(scene, history) -> list[str]:
         unread = () if scene.has("expansion") else Material.STRAIN      # read at the initial temperature only
         out += [f"materials.{name}.{phrase} (in the {body})"
                 for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
-    return (out + laws + _undershoots(scene, history) + _coarse_wear(scene, history) + _too_hot(scene, history)
-            + _unloaded(scene, history) + _overloaded(scene, history))
+    return (out + laws + _undershoots(scene, history) + _coarse_wear(scene, history) + _wear_table_ends(scene, history)
+            + _too_hot(scene, history) + _unloaded(scene, history) + _overloaded(scene, history))
+
+
+def _wear_table_ends(scene, history) -> list[str]:
+    """The zones' k_w(T) table (wear.k_w_table, else thesis Fig. 7.9: 20 to 400 degC) held at an
+    end: below it at the initial temperature, above it where the rough surface's micro temperature
+    went (``micro_max_temperature``). A rough run started at 1 K or 3000 K wore at the end values
+    without a word, where a material's table is warned about (``Material.beyond``)."""
+    if not scene.has("wear") or scene.wear.k_w is not None or "micro_max_temperature" not in history.columns:
+        return []
+    if interface_materials(scene, scene.rough_interfaces[0])[0].k_w is not None:   # the material's own k_w
+        return []
+    temperatures, rates = scene.wear.rate
+    table = "wear.k_w_table" if scene.wear.k_w_table else "wear.k_w_table (absent: thesis Fig. 7.9)"
+    micro = np.asarray(history["micro_max_temperature"], dtype=float)
+    out = []
+    for T, where, end, rate, side in ((scene.time.initial_temperature, "the initial temperature", temperatures[0],
+                                       rates[0], "below its first"),
+                                      (np.max(micro, initial=-np.inf, where=np.isfinite(micro)),
+                                       "the rough surface's largest micro temperature", temperatures[-1], rates[-1],
+                                       "above its last")):
+        if (T < end) if side == "below its first" else (T > end):
+            out.append(f"{table}: {where}, {T - 273.15:.4g} degC, is {side} point {end - 273.15:.4g} degC: the "
+                       f"zones wore with k_w held at {rate:.3g} 1/Pa there")
+    return out
 
 
 def _law_reach(history) -> list[str]:
