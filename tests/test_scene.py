@@ -658,6 +658,25 @@ def test_a_contact_pressure_beyond_small_strains_is_warned_about(tmp_path):
     assert run_warnings(scene, h) == []
 
 
+def test_a_contact_pressure_beyond_small_strains_of_a_softened_side_is_warned_about(tmp_path):
+    """With effect "expansion" E(T) is read at the bodies' temperatures: the least E over those the
+    run saw counts (a pin softening from 5 GPa to 1 MPa by 60 degC carried 1.0 MPa, 100 % of its
+    E, while the warning took E at the initial temperature)."""
+    from multiscale.io import History
+    from multiscale.workflows import run_warnings
+    text = (DEMOS / "pin_on_disc_perfect.toml").read_text().replace(
+        'E = "5 GPa"', 'E = [["20 degC", "5 GPa"], ["60 degC", "1 MPa"], ["100 degC", "2 GPa"]]')
+    h = History()
+    for T in (293.15, 373.15):
+        h.append(time=0.0, max_pressure=1e6, max_temperature_pin=T, max_temperature_disc=293.15)
+    assert run_warnings(loads(text, tmp_path), h) == [
+        "the contact pressure reached 1e+06 Pa, 1e+02 % of the softer side's E (1e+06 Pa): beyond the small "
+        "strains of the linear elastic model; check the load (a vehicle stop asks mu F r of the brake: a small "
+        "mu needs a large clamp)"]
+    fixed = text.replace('"heat_partition", "expansion"]', '"heat_partition"]')     # E read at T0 only: 5 GPa
+    assert run_warnings(loads(fixed, tmp_path), h) == []
+
+
 def test_a_wear_table_left_by_the_run_is_warned_about(tmp_path):
     """The zones' k_w(T) (thesis Fig. 7.9 by default: 20 to 400 degC) is held at its ends: a rough
     run started at 1 K, or whose micro temperatures reached 2769 degC, wore at the end values
