@@ -249,6 +249,18 @@ def test_a_solve_starting_next_to_its_answer_converges(tmp_path):
         assert mech.solve(load).normal_force == pytest.approx(load, rel=1e-9)
 
 
+def test_a_tiny_load_is_carried_to_the_same_relative_tolerance(tmp_path):
+    """``mechanics.TINY_LOAD``: the fixed absolute tolerance of 1e-10 N is 10 % of a 1e-9 N load:
+    the pin-on-disc stopped after one Newton iteration carrying 1.045e-9 N, marked converged. The
+    tolerance now shrinks with the load's norm: the load is carried to 1e-7 of itself, and the
+    contact pressure scales with it (linear for a fixed contact set: 200 N gives 1e-9 N's x 2e11)."""
+    mech = build_model(loads(pin_on_disc(tmp_path / "out", effects=("contact", "friction")))).mechanics
+    small = mech.solve(1e-9)        # from rest (from a 200 N state the relative tolerance rules)
+    big = mech.solve(200.0)
+    assert small.converged and small.normal_force == pytest.approx(1e-9, rel=1e-7)
+    assert small.max_pressure * 2e11 == pytest.approx(big.max_pressure, rel=0.05)
+
+
 def test_a_stiff_pin_carried_far_by_a_soft_disc_converges_at_the_round_off_floor(tmp_path):
     """``mechanics.ROUNDOFF``: a steel pin on a 500 MPa (polymer) disc, which bends by mm under
     200 N: the residual stalls at its round-off, ~0.65 eps ||diag(K) x|| (sums of K_ij x_j with

@@ -75,9 +75,9 @@ NEWTON_OPTIONS = {
 PRECONDITIONERS = ("lu", "cholesky")
 # The Newton's absolute tolerance is at least this share of the norm of the load vector: the
 # residual's round-off floor is ~1.5e-12 of it (the coarse pin-on-disc at 200 and 867 N), so a solve
-# starting near its answer (a load changed by 1 N of 867 N: first residual 0.15) stalled at 1.7e-10
-# above the fixed 1e-10 N and failed.
-NEWTON_FLOOR = 1e-10
+# starting near its answer (a load changed by 1 N of 867 N: first residual 0.15) stalled at 1.7e-10 above the
+# fixed 1e-10 N and failed. Ours is at most TINY_LOAD of it (1e-9 N on the pin stopped at 1.045e-9 N).
+NEWTON_FLOOR, TINY_LOAD = 1e-10, 1e-8
 # ... and at least this many times eps ||diag(K_cell) x||, the residual's round-off at the state x:
 # its cell part sums K_ij x_j, terms up to K_ii x_i. A stiff body carried far by a soft one stalls
 # there (a steel pin on a 500 MPa disc at 100 N, the disc bending 1.4 mm: 5.8e-9 N against an
@@ -253,7 +253,8 @@ class Mechanics:
         # the user's options under the prefix (PETSC_OPTIONS="-mech_...") win over ours
         self.problem = nonlinear_problem(F, self.u, prefix, NEWTON_OPTIONS, bcs=self.bcs, P=P,
                                          entity_maps=tm.entity_maps)
-        self._atol = self.problem.solver.getTolerances()[1]     # ours or the user's: the floors' base
+        self._atol = self.problem.solver.getTolerances()[1]     # ours or the user's: the floors' base (ours:
+        self._own_atol = not PETSc.Options(prefix).hasName("snes_atol")   # at most TINY_LOAD of the load)
         # a failed solve is redone with backtracking unless the user chose a line search (theirs alone remain)
         self._backtrack = not PETSc.Options(prefix).hasName("snes_linesearch_type")
         self.factors = CompactFactor(preconditioner, prefix=prefix + "factor_", precision=FACTOR_PRECISION)
@@ -472,8 +473,9 @@ class Mechanics:
         the residual there is smaller (e.g. the increment of a similar solve before)."""
         if load is not None:
             self.load.value = float(load)
-        floor = max(NEWTON_FLOOR * abs(float(self.load.value)) * self._unit_load, self._roundoff())
-        self.problem.solver.setTolerances(atol=max(self._atol, floor))
+        scale = abs(float(self.load.value)) * self._unit_load          # N, the load vector's norm
+        atol = min(self._atol, TINY_LOAD * scale) if scale > 0 and self._own_atol else self._atol
+        self.problem.solver.setTolerances(atol=max(atol, NEWTON_FLOOR * scale, self._roundoff()))
         start = [u.x.array.copy() for u in self.u]
         if guess is not None:
             before = self._residual_norm()
@@ -561,12 +563,10 @@ class Mechanics:
         return result
 
     def frictionless_tangent(self) -> PETSc.Mat:
-        """The assembled block Jacobian with mu = 0 at the current state (symmetric, flagged so).
-        Owned by the model (with ``preconditioner="cholesky"`` the preconditioner matrix) and
-        overwritten by the next call or solve, as ``tangent``."""
+        """The assembled block Jacobian with mu = 0 at the current state (symmetric, flagged so). Owned by the
+        model (with ``preconditioner="cholesky"`` the preconditioner matrix), overwritten by the next call or solve."""
         if self.problem.P_mat is not None:       # the preconditioner's matrix: refactorise next time
-            P = self._compose(self.problem.P_mat, 1)
-            self._pc_stale = True
+            P, self._pc_stale = self._compose(self.problem.P_mat, 1), True
         else:
             if self._frictionless is None:
                 form = fem.form(self._frictionless_jacobian(), entity_maps=self.tm.entity_maps)
