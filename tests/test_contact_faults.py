@@ -32,6 +32,13 @@ def test_an_overflowing_solve_raises_and_does_not_poison_the_solver(method, peri
     np.testing.assert_allclose(after.pressure, before.pressure, rtol=0, atol=1e-12 * fresh.pressure.max())
 
 
+def test_an_underflowing_load_is_named_as_such():
+    """A load of 1e-300 Pa on a 4 GPa solid underflows: the error said "overflowed" (a stress test)."""
+    s = fractal_surface(32, 1e-3, 0.8, 2, 8, 1e-6, seed=1)
+    with pytest.raises(ContactNonFiniteError, match="overflow or underflow"):
+        ContactSolver(E, s.shape, s.dx).solve(s.heights, load=1e-300)
+
+
 def circular_punch(n, size, radius_cells):
     """Isolated patch with a flat circular plateau (the punch) and the rest far below it."""
     dx = size / n

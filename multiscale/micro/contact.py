@@ -252,8 +252,9 @@ class ContactSolver:
                 for w in (work if isinstance(work, tuple) else (work,)):
                     w.clear()
                 free.put(work)
-                raise ContactNonFiniteError("the contact iteration overflowed float64 (non-finite pressure or "
-                                            "displacement): rescale the problem (heights, load, modulus)")
+                raise ContactNonFiniteError("the contact iteration left float64's range (non-finite pressure or "
+                                            "displacement: its scales overflow or underflow): rescale the problem "
+                                            "(heights, load, modulus)")
             free.put(work)
             for name, values in solved.items():
                 out[name][c] = values
