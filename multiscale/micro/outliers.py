@@ -25,7 +25,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multiscale.micro.surface import row_blocks
+from multiscale.micro.surface import defined_sums, row_blocks
 
 HALO = 4                # the median's neighbourhood: (2 HALO + 1)² points
 DESPIKE = 7.0           # default threshold k [Sq of the other heights]
@@ -82,19 +82,10 @@ def find_outliers(heights: np.ndarray, k: float = DESPIKE) -> Outliers:
     """The outliers (module docstring) of ``heights`` [m] (ny, nx), NaN where undefined (never
     outliers; left out of the medians), at ``k`` times the Sq of the other heights. In row blocks
     with a halo of ``HALO`` rows: no temporaries of the map's size."""
-    ny, nx = heights.shape
-    blocks = list(row_blocks(ny, nx))
-    sums = np.zeros(5)          # count, sum, sums of |h - mean|^2, ^3, ^4 of the defined heights
-    for rows in blocks:
-        h = heights[rows][np.isfinite(heights[rows])]
-        sums[:2] += h.size, h.sum()
-    mean = sums[1] / sums[0]
-    for rows in blocks:
-        c = np.abs(heights[rows][np.isfinite(heights[rows])] - mean)
-        sums[2:] += [np.sum(c ** 2), np.sum(c ** 3), np.sum(c ** 4)]
-    sq = np.sqrt(sums[2] / sums[0])
+    count, mean, (squares, *absolute) = defined_sums(heights, (2, 3, 4))   # |h - mean|^2, ^3, ^4 summed
+    sq = np.sqrt(squares / count)
     found = [[], [], []]        # candidates: rows, columns, deviations beyond k Sq / CLIP
-    for rows in blocks:
+    for rows in row_blocks(*heights.shape):
         d = _deviations(heights, rows)
         with np.errstate(invalid="ignore"):
             i, j = np.nonzero(np.isfinite(d) & (np.abs(d) > k * sq / CLIP))
@@ -104,12 +95,13 @@ def find_outliers(heights: np.ndarray, k: float = DESPIKE) -> Outliers:
     c = heights[rows, cols] - mean
     out = np.zeros(rows.size, dtype=bool)
     for _ in range(rows.size + 1):      # Sq without the outliers, to a fixed point (it only falls)
-        n = sums[0] - out.sum()
-        clean = max(np.sqrt(max((sums[2] - np.sum(c[out] ** 2)) / n - (np.sum(c[out]) / n) ** 2, 0.0)), sq / CLIP)
+        n = count - out.sum()
+        clean = max(np.sqrt(max((squares - np.sum(c[out] ** 2)) / n - (np.sum(c[out]) / n) ** 2, 0.0)), sq / CLIP)
         if np.array_equal(more := np.abs(deviations) > k * clean, out):
             break
         out = more
-    shares = tuple(float(np.sum(np.abs(c[out]) ** n) / sums[n]) if sums[n] > 0 else 0.0 for n in (3, 4))
+    shares = tuple(float(np.sum(np.abs(c[out]) ** n) / total) if total > 0 else 0.0
+                   for n, total in zip((3, 4), absolute))
     return Outliers(rows[out], cols[out], deviations[out], float(k), float(clean), shares)
 
 

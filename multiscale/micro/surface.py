@@ -232,6 +232,21 @@ def row_blocks(rows: int, columns: int, size: int = 1 << 16):
     return (slice(a, min(a + step, rows)) for a in range(0, rows, step))
 
 
+def defined_sums(h: np.ndarray, orders=(2,)) -> tuple[int, float, list]:
+    """Count, mean [m] and the sums of |h - mean|^k for each k of ``orders`` over the defined
+    (finite) heights of ``h`` (NaN: undefined), in row blocks (``row_blocks``)."""
+    blocks = list(row_blocks(*h.shape))
+    count, total = 0, 0.0
+    for rows in blocks:
+        d = h[rows][np.isfinite(h[rows])]
+        count, total = count + d.size, total + d.sum()
+    mean, sums = total / count, [0.0] * len(orders)
+    for rows in blocks:
+        c = np.abs(h[rows][np.isfinite(h[rows])] - mean)
+        sums = [s + float(np.sum(c ** k)) for s, k in zip(sums, orders)]
+    return count, mean, sums
+
+
 def statistics(surface: Surface) -> SurfaceStats:
     """RMS height and slope, spectral moments m0, m2, m4 and Nayak's parameter.
 

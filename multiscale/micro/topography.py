@@ -33,7 +33,7 @@ import numpy as np
 from multiscale.errors import InputError, check_count, check_pair, check_positive, check_real
 from multiscale.micro.outliers import DESPIKE, find_outliers
 from multiscale.micro.spectrum import as_topography, equivalent_surface, power_spectrum, surface_topography
-from multiscale.micro.surface import Surface, read_matrix, row_blocks
+from multiscale.micro.surface import Surface, defined_sums, read_matrix, row_blocks
 
 MATRIX_SUFFIXES = (".npy", ".txt", ".csv", ".asc")    # plain height matrices (no units in the file)
 MAX_UNDEFINED = 0.1       # default largest fraction of undefined points that is filled
@@ -360,12 +360,8 @@ def _fourier_filter(surface: Surface, cut_x: float, cut_y: float) -> Surface:
 
 def _defined_std(h: np.ndarray) -> float:
     """Standard deviation [m] of the defined (not NaN) heights, in row blocks."""
-    sums = np.zeros(3)
-    for rows in row_blocks(*h.shape):
-        sums[:2] += np.sum(np.isfinite(h[rows])), np.nansum(h[rows])
-    for rows in row_blocks(*h.shape):
-        sums[2] += np.nansum((h[rows] - sums[1] / sums[0]) ** 2)
-    return float(np.sqrt(sums[2] / sums[0]))
+    count, _, (squares,) = defined_sums(h)
+    return float(np.sqrt(squares / count))
 
 
 def remove_form(heights: np.ndarray, detrend: str) -> np.ndarray:
