@@ -358,6 +358,26 @@ def test_a_band_cut_short_by_the_number_of_modes_is_said(tmp_path):
                                           "up to 16000 Hz, was not searched (raise stability.modes)",)
 
 
+def test_a_pressure_beyond_small_strains_is_warned_about_also_at_a_map_point(tmp_path):
+    """A squeal run warns of a contact pressure above workflows.strain.STRAINED (2 %) of the softer
+    side's E, as the transient runs do: at 10 bar nothing, at a pressure sweep's 1000 bar point
+    (its own preload) the warning. Before, a squeal run had none: the coarse demo at 5000 bar
+    carried 1.2 GPa on its 5 GPa pads silently. Penalty contact without gaps scales with the
+    load, so the map's peak is 100 times the nominal one."""
+    overrides = {"geometry.mesh_size": "30 mm", "stability.modes": 6, "stability.band": ["0 Hz", "3 kHz"],
+                 "stability.sweep.pressure": ["10 bar", "1000 bar"], "stability.sweep.onsets": False,
+                 "output.folder": str(tmp_path / "out")}
+    run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
+    nominal = run.case.facet_pressure.max()
+    assert nominal < 0.02 * 5e9 < run.map.max_pressure
+    assert run.map.max_pressure == pytest.approx(100 * nominal, rel=1e-6)
+    strained = [w for w in run.warnings if w.startswith("the contact pressure reached")]
+    assert strained == [f"the contact pressure reached {run.map.max_pressure:.3g} Pa, "
+                        f"{100 * run.map.max_pressure / 5e9:.2g} % of the softer side's E (5e+09 Pa): beyond the small "
+                        "strains of the linear elastic model; check the load (a vehicle stop asks mu F r of the brake: "
+                        "a small mu needs a large clamp)"]
+
+
 def test_eigen_solver_errors_name_the_scene_keys(tmp_path):
     """A band below the first mode: the error names stability.band (it named the solver's f_max).
     The failed run's Mechanics is closed (one rank) and freed (before: it stayed alive with its MPI

@@ -75,6 +75,7 @@ class StabilityMap:
     basis_size: int = 0
     rtol: float = 1e-6
     time: float = 0.0
+    max_pressure: float = 0.0    # Pa, the largest facet pressure of the points' own preloads (0: preload "once")
 
     @property
     def n_tracks(self) -> int:
@@ -277,7 +278,7 @@ class MapBuilder:
         self.onsets.append(found)
         return found
 
-    def finish(self, *, basis_size: int = 0, time: float = 0.0) -> StabilityMap:
+    def finish(self, *, basis_size: int = 0, time: float = 0.0, max_pressure: float = 0.0) -> StabilityMap:
         P, T = len(self.values), self.n_tracks
         out = {name: np.full((P, T), np.nan) for name in ("frequency", "growth", "mac", "residual")}
         mode = np.full((P, T), -1, int)
@@ -288,7 +289,7 @@ class MapBuilder:
         return StabilityMap(self.parameter, self.unit, np.array(self.values), out["frequency"], out["growth"], mode,
                             out["mac"], out["residual"],
                             sorted(self.onsets, key=lambda o: (np.nan_to_num(o.value, nan=-np.inf), o.frequency)),
-                            basis_size, self.rtol, time)
+                            basis_size, self.rtol, time, max_pressure)
 
 
 def build_map(parameter: str, unit: str, values: Sequence[float], results: Sequence[ModalResult],

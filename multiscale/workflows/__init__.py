@@ -24,6 +24,7 @@ from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.model import interface_materials
 from multiscale.workflows.output import RunResult
+from multiscale.workflows.strain import overloaded
 
 
 def workflow(scene) -> str:
@@ -137,7 +138,9 @@ def run_warnings(scene, history) -> list[str]:
         out += [f"materials.{name}.{phrase} (in the {body})"
                 for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
     return (out + laws + _undershoots(scene, history) + _coarse_wear(scene, history) + _wear_table_ends(scene, history)
-            + _too_hot(scene, history) + _unloaded(scene, history) + _overloaded(scene, history, hottest))
+            + _too_hot(scene, history) + _unloaded(scene, history)
+            + (overloaded(scene, float(np.max(history["max_pressure"])), hottest)
+               if "max_pressure" in history.columns else []))
 
 
 def _wear_table_ends(scene, history) -> list[str]:
@@ -219,31 +222,6 @@ def _coarse_wear(scene, history) -> list[str]:
 
 
 UNLOADED = 1e-6   # an interface carrying less than this share of the largest one's force is warned about
-STRAINED = 0.02   # a contact pressure above this share of the softer side's E is warned about
-
-
-def _overloaded(scene, history, hottest) -> list[str]:
-    """A contact pressure far beyond small strains of the softer side (the model is linear elastic):
-    a stop with mu 0.02 asked 184 MPa of a 3 GPa pad, silently (an adversarial test). E is the
-    least over the temperatures a material saw (``hottest``: its largest, with effect "expansion",
-    which reads E(T)): a pin softening from 5 GPa to 1 MPa carried 1.0 MPa with no word."""
-    if "max_pressure" not in history.columns or scene.materials is None:
-        return []
-    T0, spec = scene.time.initial_temperature, scene.geometry.spec
-    soft = min(_least_E(scene.materials[m], T0, hottest[m][0] if m in hottest and scene.has("expansion") else T0)
-               for n in spec.interfaces for m in spec.interface_materials(n))
-    p = float(np.max(history["max_pressure"]))
-    return [f"the contact pressure reached {p:.3g} Pa, {100 * p / soft:.2g} % of the softer side's E ({soft:.3g} Pa): "
-            "beyond the small strains of the linear elastic model; check the load (a vehicle stop asks mu F r of "
-            "the brake: a small mu needs a large clamp)"] if p > STRAINED * soft else []
-
-
-def _least_E(material, T0: float, T1: float) -> float:
-    """The least E [Pa] of ``material`` between the temperatures T0 and T1 [K] (a table is linear
-    between its points)."""
-    lo, hi = min(T0, T1), max(T0, T1)
-    inside = [T for T, _ in material.E if lo < T < hi] if material.tabulated("E") else []
-    return min(material.value("E", T) for T in (lo, hi, *inside))
 
 
 def _unloaded(scene, history) -> list[str]:

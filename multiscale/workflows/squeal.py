@@ -54,6 +54,7 @@ from multiscale.workflows import squeal_map
 from multiscale.workflows.model import build_mechanics, build_mesh, drive, interface_forces
 from multiscale.workflows.output import RunResult, prepare_folder
 from multiscale.workflows.rough import build_rough_interface
+from multiscale.workflows.strain import overloaded
 
 SQUEAL_DEGREE = 2     # quadratic tetrahedra: linear ones are far too stiff in bending (tests)
 MAP_RESIDUAL = 1e-3   # a stability map's modes with larger relative residuals are warned to be approximate
@@ -213,7 +214,8 @@ class SquealResult(RunResult):
 
 
 def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
-    """Warnings: a band cut short by stability.modes, a map whose modes are approximate."""
+    """Warnings: a band cut short by stability.modes, a map whose modes are approximate, a contact
+    pressure beyond small strains (at the preload, or at a map point's own preload)."""
     st, out = scene.stability, []
     f = case.modes.frequency
     top = float(f.max(initial=0.0))
@@ -237,7 +239,8 @@ def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
         out.append(f"the stability map's modes have relative residuals up to {worst:.1e}: its frequencies and growth "
                    "rates are approximate, and a mode outside its basis is missed (stability.sweep.preload = \"each\" "
                    "solves every point in full)")
-    return out
+    peak = max(float(case.facet_pressure.max(initial=0.0)), smap.max_pressure if smap is not None else 0.0)
+    return out + overloaded(scene, peak)
 
 
 def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = True,

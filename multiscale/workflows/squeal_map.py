@@ -56,6 +56,7 @@ class MapModel:
         self.rebuild = rebuild
         self.sweep = scene.stability.sweep
         self.materials = dict(scene.materials)
+        self.max_pressure = 0.0        # Pa, the largest facet pressure of the points' own preloads
 
     def close(self, mech=None) -> None:
         """Close ``mech`` (default: the current one; collective) if it is one this map rebuilt."""
@@ -79,6 +80,7 @@ class MapModel:
             slope = set_friction(mech, opt.friction_laws)[1]
         if self.sweep.preload_mode == "each":
             preload(mech, value if name == "pressure" else self.load, 1, reset=name == "rms")
+            self.max_pressure = max(self.max_pressure, float(mech.contact.facet_pressure().max(initial=0.0)))
         return linearise_system(mech, self.materials, damping=opt.damping,
                                 slope=slope if opt.friction_damping else None, prestress=opt.prestress,
                                 gyroscopic=opt.gyroscopic, material=opt.material_damping)
@@ -110,7 +112,7 @@ def stability_map(scene, tm, mech, options, load: float, rebuild: Callable) -> S
     with closed_on_error(model, tm.comm):        # a rebuilt model of a failed point (one rank)
         size = (_common_basis if sw.preload_mode == "once" else _per_point)(model, builder, st, options)
     model.close()
-    return builder.finish(basis_size=size, time=time.perf_counter() - t0)
+    return builder.finish(basis_size=size, time=time.perf_counter() - t0, max_pressure=model.max_pressure)
 
 
 def _common_basis(model: MapModel, builder: MapBuilder, st, options) -> int:

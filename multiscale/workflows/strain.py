@@ -1,0 +1,30 @@
+"""The small-strain warning of a run: a contact pressure far beyond the small strains of the softer
+side of an interface (every model here is linear elastic). Read by the transient and multiscale
+runs from their history (``max_pressure``) and by the squeal analysis from its preloads."""
+from __future__ import annotations
+
+STRAINED = 0.02   # a contact pressure above this share of the softer side's E is warned about
+
+
+def least_E(material, T0: float, T1: float) -> float:
+    """The least E [Pa] of ``material`` between the temperatures T0 and T1 [K] (a table is linear
+    between its points)."""
+    lo, hi = min(T0, T1), max(T0, T1)
+    inside = [T for T, _ in material.E if lo < T < hi] if material.tabulated("E") else []
+    return min(material.value("E", T) for T in (lo, hi, *inside))
+
+
+def overloaded(scene, p: float, hottest=None) -> list[str]:
+    """The warning if the largest contact pressure ``p`` [Pa] of a run exceeds ``STRAINED`` times
+    the least E of the interfaces' materials: a stop with mu 0.02 asked 184 MPa of a 3 GPa pad,
+    silently (an adversarial test). E is the least over the temperatures a material saw
+    (``hottest``: material -> (its largest temperature [K], body), read with effect "expansion",
+    which reads E(T)): a pin softening from 5 GPa to 1 MPa carried 1.0 MPa with no word."""
+    if scene.materials is None:
+        return []
+    T0, spec, hottest = scene.time.initial_temperature, scene.geometry.spec, hottest or {}
+    soft = min(least_E(scene.materials[m], T0, hottest[m][0] if m in hottest and scene.has("expansion") else T0)
+               for n in spec.interfaces for m in spec.interface_materials(n))
+    return [f"the contact pressure reached {p:.3g} Pa, {100 * p / soft:.2g} % of the softer side's E ({soft:.3g} Pa): "
+            "beyond the small strains of the linear elastic model; check the load (a vehicle stop asks mu F r of "
+            "the brake: a small mu needs a large clamp)"] if p > STRAINED * soft else []
