@@ -155,13 +155,13 @@ def _wear_table_ends(scene, history) -> list[str]:
     temperatures, rates = scene.wear.rate
     table = "wear.k_w_table" if scene.wear.k_w_table else "wear.k_w_table (absent: thesis Fig. 7.9)"
     micro = np.asarray(history["micro_max_temperature"], dtype=float)
+    T0, hottest = scene.time.initial_temperature, np.max(micro, initial=-np.inf, where=np.isfinite(micro))
     out = []
-    for T, where, end, rate, side in ((scene.time.initial_temperature, "the initial temperature", temperatures[0],
-                                       rates[0], "below its first"),
-                                      (np.max(micro, initial=-np.inf, where=np.isfinite(micro)),
-                                       "the rough surface's largest micro temperature", temperatures[-1], rates[-1],
-                                       "above its last")):
-        if (T < end) if side == "below its first" else (T > end):
+    for T, where, end, rate, side, beyond in (
+            (T0, "the initial temperature", temperatures[0], rates[0], "below its first", T0 < temperatures[0]),
+            (hottest, "the rough surface's largest micro temperature", temperatures[-1], rates[-1], "above its last",
+             hottest > temperatures[-1])):
+        if beyond:
             out.append(f"{table}: {where}, {T - 273.15:.4g} degC, is {side} point {end - 273.15:.4g} degC: the "
                        f"zones wore with k_w held at {rate:.3g} 1/Pa there")
     return out
