@@ -312,6 +312,13 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                 and not isinstance(g.params, FileGeometry):
             problems.append(f"loading.normal_force: {where} is loaded by a fluid pressure on its load faces, whose "
                             "forces cancel: give loading.pressure (or loading.direction for a force along it)")
+        if "friction" in effects and not any(k in loading for k in Loading.FRICTION):
+            own = scene.interfaces or {}
+            bare = [n for n in g.spec.interfaces if getattr(own.get(n), "friction", None) is None]
+            if bare:
+                problems.append(f'{" or ".join("loading." + k for k in Loading.FRICTION)}: missing; effect "friction" '
+                                "needs it" + (f" for {', '.join(f'interfaces.{n}' for n in bare)} (the others give "
+                                              "their own friction)" if len(bare) < len(g.spec.interfaces) else ""))
         problems += _surface_checks(scene, g, where, effects)
         problems += _symmetry_checks(scene, g, where, effects)
         given = raw.get("geometry") if isinstance(raw.get("geometry"), dict) else {}

@@ -336,7 +336,7 @@ class Loading:
                                       absent="rotation_speed or vehicle gives the speed")   # ((s, rad/s), ...)
     vehicle: Vehicle | None = key(Section(Vehicle))
     sliding_speed: float | None = key(Quantity("speed", ge=0, plausible=(0.0, 200.0)), absent="at rest")  # m/s
-    friction: float | None = key(_FRICTION, absent="friction_curve or stribeck gives mu")   # mu
+    friction: float | None = key(_FRICTION, absent="friction_curve, stribeck or each interface's own friction")  # mu
     ramp_steps: int = key(Integer(ge=1), default=1)       # load increments of the first mechanical solve
     friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), Quantity("dimensionless", ge=0), "slip speed",
                                              "mu", min_rows=2), absent="friction or stribeck gives mu")  # ((m/s, -),..)
@@ -344,7 +344,7 @@ class Loading:
 
     FRICTION = ("friction", "friction_curve", "stribeck")
     rules = (OneOf(("normal_force", "pressure")), OneOf(("rotation_speed", "speed_profile", "vehicle")),
-             OneOf(FRICTION, needed_by=("friction",)))
+             OneOf(FRICTION))      # needed with effect friction unless every interface has its own: scene.py
 
     def problems(self, path, ctx):
         law = [k for k in self.FRICTION if getattr(self, k) is not None]

@@ -88,7 +88,7 @@ def _effect_line(scene: Scene, effect: str) -> str:
             st = ld.stribeck
             return (f"Stribeck mu(v) = {st.kinetic:g} + ({st.static:g} - {st.kinetic:g}) exp(-(v / {st.speed:g} m/s)"
                     f"^{st.exponent:g})")
-        return f"Coulomb, mu = {ld.friction:g}"
+        return f"Coulomb, mu = {ld.friction:g}" if ld.friction is not None else "Coulomb, mu per interface"
     if effect == "thermal":
         return f"transient conduction in {', '.join(scene.bodies)}"
     if effect == "heat_partition" and scene.has("roughness") and scene.micro.partition_law:

@@ -227,11 +227,14 @@ BRAKE = {"geometry.mesh_size": "20 mm", "output.folder": None}
 
 
 def test_each_interface_has_its_own_friction_and_its_own_results(tmp_path):
-    """The disc brake with mu = 0.2 on the inner pad and 0.4 on the outer one: per-interface
-    columns; both pads carry the clamp force, their friction resultants scale with their mu."""
-    scene = load(ROOT / "demos" / "brake_squeal.toml", {
+    """The disc brake with mu = 0.2 on the inner pad and 0.4 on the outer one, each its own and no
+    loading.friction (before, it was required even then): per-interface columns; both pads carry
+    the clamp force, their friction resultants scale with their mu."""
+    text = (ROOT / "demos" / "brake_squeal.toml").read_text().replace("\nfriction = 0.4\n", "\n", 1)
+    scene = loads(text, ROOT / "demos", overrides={
         **BRAKE, "output.folder": str(tmp_path / "brake"), "effects": ["contact", "friction"],
-        "interfaces.inner_pad.friction": 0.2})
+        "interfaces.inner_pad.friction": 0.2, "interfaces.outer_pad.friction": 0.4})
+    assert scene.loading.friction is None
     h = run(scene, verbose=False).history
     clamp = 1e6 * np.pi * 0.023**2
     for pad in ("inner_pad", "outer_pad"):

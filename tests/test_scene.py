@@ -496,6 +496,21 @@ def test_friction_on_a_sliding_part_model_is_refused(tmp_path):
           overrides={"loading.sliding_speed": "1 m/s"})
 
 
+def test_loading_friction_is_needed_only_for_interfaces_without_their_own(tmp_path):
+    """With effect "friction" the scene-wide law is needed only by interfaces that give no friction
+    of their own (before: always, "loading.friction or ...: missing" with both pads' own mu)."""
+    text = (DEMOS / "brake_squeal.toml").read_text().replace("\nfriction = 0.4\n", "\n", 1)
+    with pytest.raises(SceneError) as err:
+        loads(text, DEMOS)
+    assert str(err.value).count("friction") == 3 and ('loading.friction or loading.friction_curve or '
+                                                      'loading.stribeck: missing; effect "friction" needs it') in str(err.value)
+    with pytest.raises(SceneError, match=r'needs it for interfaces.outer_pad \(the others give their own friction\)'):
+        loads(text, DEMOS, overrides={"interfaces.inner_pad.friction": 0.2})
+    scene = loads(text, DEMOS, overrides={"interfaces.inner_pad.friction": 0.2, "interfaces.outer_pad.friction": 0.3})
+    assert [scene.interface_settings(n).friction for n in ("inner_pad", "outer_pad")] == [0.2, 0.3]
+    assert "Coulomb, mu per interface" in "\n".join(summary(scene))
+
+
 def test_overrides_are_validated_like_the_file(tmp_path):
     scene = loads(GOOD, tmp_path, overrides={"loading.friction": 0.2, "geometry.mesh_size": "1 mm",
                                              "materials.block.E": "5 GPa"})

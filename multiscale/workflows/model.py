@@ -42,11 +42,11 @@ from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
 
 
-def friction_coefficient(scene, interface: str | None = None) -> float:
-    """mu [-] of an interface (default: ``loading.friction``) with effect "friction", else 0."""
+def friction_coefficient(scene, interface: str) -> float:
+    """mu [-] of an interface (its own, else ``loading.friction``) with effect "friction", else 0."""
     if not scene.has("friction"):
         return 0.0
-    return scene.interface_settings(interface).friction if interface is not None else scene.loading.friction
+    return scene.interface_settings(interface).friction
 
 
 def scene_spec(scene) -> GeometrySpec:

@@ -77,7 +77,7 @@ def post_analysis(scene, zone) -> PostAnalysis:
         raise InputError("materials.k_w", counter.k_w, "the counter-face wears along a circular track: it must "
                          "rotate (give k_w to a rotating counter-face only)")
     s = zone.surface
-    return PostAnalysis(contact_kernel(scene)[0], s.shape, s.dx, s.dy, mu=friction_coefficient(scene),
+    return PostAnalysis(contact_kernel(scene)[0], s.shape, s.dx, s.dy, mu=friction_coefficient(scene, scene.rough_interfaces[0]),
                         heating=heating,
                         conductance=Conductance(*thermal_kernels(scene)) if scene.has("conductance") else None,
                         wear_rate=rate, counter_rate=counter_rate, substeps=scene.wear.substeps if wear else 1,
