@@ -36,11 +36,10 @@ import numpy as np
 
 from meshes import cad_units
 from multiscale.errors import InputError
-from multiscale.geometry import BodySpec, GeometrySpec, Region, Rotation, add_group, plane_extent
+from multiscale.geometry import FIXED_BODY, BodySpec, GeometrySpec, Region, Rotation, add_group, plane_extent
 
 NAME = "file"
 DEFAULTS: dict = {}          # no numeric parameters: [geometry] of the scene is a FileGeometry
-FIXED = "fixed"              # name of body 0 (the fixed bodies), body 1 is the rotating body
 PLAUSIBLE = (1e-3, 10.0)     # m, smallest and largest extent of a brake or tribometer model
 NORMAL_TOLERANCE = np.cos(np.radians(5.0))
 CURVE_POINTS = 65           # points along each boundary curve of an interface face for its box
@@ -553,7 +552,7 @@ def _spec(g, found: Found) -> GeometrySpec:
                       f"{found.areas[name] * 1e6:.4g} mm^2, {normal}")
     report += [f"surface {n}: {len(f)} face(s)" for n, f in found.surfaces.items()]
     return GeometrySpec(
-        bodies=(BodySpec(FIXED, regions), BodySpec(g.rotating, (Region(g.rotating, tag[g.rotating],
+        bodies=(BodySpec(FIXED_BODY, regions), BodySpec(g.rotating, (Region(g.rotating, tag[g.rotating],
                                                                        g.bodies[g.rotating].material),))),
         interfaces={n: 1001 + k for k, n in enumerate(found.interfaces)},
         faces={n: 2001 + k for k, n in enumerate(found.surfaces)},

@@ -152,6 +152,7 @@ def plane_extent(normal, lo, hi) -> tuple[float, float]:
 
 
 BUILDER_GROUP = "multiscale.builders"
+FIXED_BODY = "fixed"         # body 0 of a geometry file: every fixed body of it, each a material region
 
 
 def builder_names() -> tuple[str, ...]:

@@ -10,10 +10,17 @@ nothing heavy (``multiscale check`` uses it; so does ``multiscale.macro``).
 from __future__ import annotations
 
 import os
+import re
 from dataclasses import dataclass
 from pathlib import Path
 
 CHECKPOINT = "checkpoint.h5"      # a multiscale run's last macro step (``multiscale run --resume``)
+# files of a run named without a body: a body of that name would write its fields over them
+OWN_FILES = {"interface": "interface.xdmf", "history": "history.h5", "zones": "zones.h5",
+             "checkpoint": CHECKPOINT, "map": "map.h5"}
+MODE_UNIT = "m/kg^0.5"     # mode shapes normalised to unit modal mass
+MODE_ARRAYS = tuple(f"mode shape {part} part [{MODE_UNIT}]" for part in ("real", "imaginary"))   # in modes_<body>.bp
+NAME = re.compile(r"[A-Za-z0-9_.-]+")    # a body, interface or material name that goes into file and column names
 
 # output field (scene key output.fields) -> (array name in the field files, unit)
 FIELDS = {"displacement": ("displacement", "m"), "temperature": ("temperature", "K"),
@@ -35,6 +42,17 @@ def folder_problem(folder) -> str | None:
     if not os.access(existing, os.W_OK | os.X_OK):
         return (f"cannot be {'written into' if existing == folder else 'created'}: {existing} is not writable "
                 "(permissions or a read-only file system)")
+    return None
+
+
+def name_problem(name: str, body: bool = False) -> str | None:
+    """Why ``name`` cannot name a body (``body``: its fields go to ``<name>.xdmf`` and ``<name>.h5``),
+    an interface or a material, which also name files (``wear_map_<interface>.png``) and history
+    columns (``max_temperature_<body>_in_<material>``: a "/" makes an HDF5 group of it); None if it can."""
+    if not NAME.fullmatch(name):
+        return "must be letters, digits, _ . - only (it names files and history columns)"
+    if body and name in OWN_FILES:
+        return f"is taken: the run writes {OWN_FILES[name]} of its own (name the body otherwise)"
     return None
 
 
@@ -166,6 +184,13 @@ def summary(p: Plan) -> list[str]:
     return lines
 
 
+def script_name(file: str) -> str:
+    """The Python variable of ``file`` in ``paraview_script``: ``src_`` and the file's stem with
+    every other character than letters, digits and _ as _ (a body called "view", "os" or "in"
+    must not replace the script's own names, nor be a keyword)."""
+    return "src_" + re.sub(r"\W", "_", file.rsplit(".", 1)[0])
+
+
 def paraview_script(p: Plan) -> str:
     """A pvpython script that opens the results of ``p`` beside it: the bodies coloured by
     temperature (else displacement or von Mises stress), the interface by contact pressure; for
@@ -179,7 +204,7 @@ def paraview_script(p: Plan) -> str:
              f"here = os.path.dirname(os.path.abspath(__file__)) if '__file__' in globals() else {str(p.folder)!r}",
              "view = GetActiveViewOrCreate('RenderView')", ""]
     for name, fields in files.items():
-        var = name.split(".")[0].replace("-", "_")
+        var = script_name(name)
         shown = next((f for f in ("temperature", "contact_pressure", "von_mises", "displacement") if f in fields),
                      fields[0])
         centre = "CELLS" if shown not in ("temperature", "displacement") else "POINTS"
@@ -190,12 +215,12 @@ def paraview_script(p: Plan) -> str:
     if p.analysis == "squeal":
         lines += ["# mode shapes (VTX, ADIOS2 reader): time = mode number, see modes.csv for the frequencies"]
         for b in p.bodies:
-            var = f"modes_{b}".replace("-", "_")
+            var = script_name(f"modes_{b}.bp")
             lines += [f"{var} = ADIOS2VTXReader(registrationName='modes_{b}.bp', "
                       f"FileName=os.path.join(here, 'modes_{b}.bp'))",
-                      f"{var}_warp = WarpByVector(Input={var}, Vectors=['POINTS', "
-                      f"'mode shape real part [m/kg^0.5]'], ScaleFactor=0.01)",
+                      f"{var}_warp = WarpByVector(Input={var}, Vectors=['POINTS', {MODE_ARRAYS[0]!r}], "
+                      "ScaleFactor=0.01)",
                       f"{var}_view = Show({var}_warp, view)",
-                      f"ColorBy({var}_view, ('POINTS', 'mode shape real part [m/kg^0.5]', 'Magnitude'))", ""]
+                      f"ColorBy({var}_view, ('POINTS', {MODE_ARRAYS[0]!r}, 'Magnitude'))", ""]
     lines += ["view.ResetCamera()", "Render()", "if __name__ == '__main__':", "    Interact()", ""]
     return "\n".join(lines)

@@ -18,7 +18,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from multiscale.errors import InputError
-from multiscale.geometry import MAX_CELLS, GeometrySpec, Rotation, builder, builder_names
+from multiscale.geometry import FIXED_BODY, MAX_CELLS, GeometrySpec, Rotation, builder, builder_names
+from multiscale.outputs import name_problem
 from multiscale.schema import (Bad, Choice, FilePath, FrozenMap, Integer, ListOf, Named, OneOf, Quantity,
                                Section, Text, Vector, key, parse, read, show, unknown_keys)
 from multiscale.schema import reference as schema_reference
@@ -141,6 +142,16 @@ class FileGeometry:
             out.append(f"{path}.mesh_algorithm: not used with a {self.file.suffix} file (it is meshed already)")
         if self.rotating not in self.bodies:
             out.append(f"{path}.rotating = \"{self.rotating}\": not a body; bodies: {', '.join(self.bodies)}")
+        elif self.rotating == FIXED_BODY:
+            out.append(f"{path}.rotating = \"{FIXED_BODY}\": is taken: the fixed bodies together are the body "
+                       f"\"{FIXED_BODY}\" of the results (name the rotating body otherwise)")
+        elif problem := name_problem(self.rotating, body=True):
+            out.append(f"{path}.bodies.{self.rotating}: the rotating body's name {problem}")
+        out += [f"{path}.{kind}.{name}: the name {problem}" for kind, names in (("bodies", self.bodies),
+                                                                                ("interfaces", self.interfaces))
+                for name in names if name != self.rotating and (problem := name_problem(name))]
+        out += [f"{path}.bodies.{name}.material = \"{b.material}\": {problem}" for name, b in self.bodies.items()
+                if b is not None and b.material is not None and (problem := name_problem(b.material))]
         if len(self.bodies) < 2:
             out.append(f"{path}.bodies: give at least two bodies (a fixed one and the rotating one)")
         if sum(a * a for a in self.axis) == 0:

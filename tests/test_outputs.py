@@ -9,13 +9,14 @@ ranks, times per stage) and the pvpython script are there."""
 import json
 import subprocess
 import sys
+import types
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from multiscale.cli import main
-from multiscale.outputs import FIELDS, array_name, plan
+from multiscale.outputs import FIELDS, MODE_ARRAYS, Plan, array_name, paraview_script, plan
 from multiscale.provenance import resolved_toml
 from multiscale.scene import load, loads
 
@@ -137,6 +138,70 @@ def test_provenance_and_paraview_script(case):
     for name in p.field_files:
         assert repr(name) in script
     assert "'temperature [K]'" in script if scene.has("thermal") else "'contact pressure [Pa]'" in script
+
+
+class StubParaView:
+    """paraview.simple as far as paraview.py uses it, recording what the script opens, shows and
+    colours (``opened``: path -> reader; ``coloured``: (reader, array name))."""
+
+    def __init__(self):
+        self.view = types.SimpleNamespace(ResetCamera=lambda: None)
+        self.opened, self.coloured, self.shown_in = {}, [], []
+        m = self.module = types.ModuleType("paraview.simple")
+        m.__all__ = ["GetActiveViewOrCreate", "Xdmf3ReaderS", "ADIOS2VTXReader", "WarpByVector", "Show", "ColorBy",
+                     "Render", "Interact"]
+        m.GetActiveViewOrCreate = lambda kind: self.view
+        m.Xdmf3ReaderS = lambda registrationName, FileName: self.open(FileName[0])
+        m.ADIOS2VTXReader = lambda registrationName, FileName: self.open(FileName)
+        m.WarpByVector = lambda Input, Vectors, ScaleFactor: self.coloured.append((Input, Vectors[1])) or Input
+        m.Show = lambda source, view: self.shown_in.append(view) or types.SimpleNamespace(
+            source=source, SetScalarBarVisibility=lambda view, on: None)
+        m.ColorBy = lambda shown, array: self.coloured.append((shown.source, array[1]))
+        m.Render = m.Interact = lambda: None
+
+    def open(self, path):
+        self.opened[path] = types.SimpleNamespace(path=path)
+        return self.opened[path]
+
+
+def run_script(script: str, folder: Path, monkeypatch) -> StubParaView:
+    """Execute a paraview.py as if it lay in ``folder``, against ``StubParaView``."""
+    stub = StubParaView()
+    monkeypatch.setitem(sys.modules, "paraview", types.ModuleType("paraview"))
+    monkeypatch.setitem(sys.modules, "paraview.simple", stub.module)
+    exec(compile(script, "paraview.py", "exec"), {"__file__": str(folder / "paraview.py"), "__name__": "pv"})
+    return stub
+
+
+def test_the_paraview_script_opens_files_and_arrays_that_exist(case, monkeypatch):
+    """paraview.py, run against a stub of paraview.simple: every file it opens is in the folder and
+    every array it colours or warps by is in that file."""
+    import h5py
+    _, p, _ = case
+    stub = run_script((p.folder / "paraview.py").read_text(), p.folder, monkeypatch)
+    assert sorted(Path(path).name for path in stub.opened) == sorted(
+        list(p.field_files) + ([f"modes_{b}.bp" for b in p.bodies] if p.analysis == "squeal" else []))
+    assert stub.shown_in and all(view is stub.view for view in stub.shown_in)
+    for source, array in stub.coloured:
+        path = Path(source.path)
+        assert path.parent == p.folder and path.exists()
+        if path.suffix == ".bp":
+            assert array == MODE_ARRAYS[0]
+        else:
+            with h5py.File(path.with_suffix(".h5"), "r") as f:
+                assert array in {d.attrs["name"] for d in f["data/0"].values()}
+
+
+def test_a_body_named_like_a_name_of_the_script_keeps_the_script_working(tmp_path, monkeypatch):
+    """Bodies called "view" and "in" (a user's geometry file names them): the script assigned its
+    readers to those names, showing the disc in a reader instead of the view, or did not compile."""
+    fields = ("displacement", "temperature")
+    for bodies in (("view", "os"), ("in", "here")):
+        p = Plan("squeal", tmp_path, bodies, fields, ("contact_pressure",), (0.0,), {}, ())
+        stub = run_script(paraview_script(p), tmp_path, monkeypatch)
+        assert sorted(Path(f).name for f in stub.opened) == sorted(
+            [f"{b}.xdmf" for b in bodies] + ["interface.xdmf"] + [f"modes_{b}.bp" for b in bodies])
+        assert all(view is stub.view for view in stub.shown_in) and len(stub.shown_in) == 5
 
 
 @pytest.mark.parametrize("path", sorted(DEMOS.glob("*.toml")), ids=lambda p: p.stem)

@@ -388,6 +388,30 @@ def test_a_folder_given_as_a_file_is_said_to_be_a_folder(tmp_path):
     assert f'geometry.file = "brake.step": is a folder, not a file ({tmp_path / "brake.step"})' in info.value.problems
 
 
+def test_a_geometry_file_s_names_must_not_clash_with_the_results(tmp_path):
+    """A rotating body called "history" wrote its fields into history.h5, which the scalar history
+    then replaced: the run ended in a KeyError after its last step ("interface", "zones",
+    "checkpoint", "map" alike; "fixed" is body 0's name). A name with "/" or a space went into file
+    names (wear_map_<interface>.png) and HDF5 column names. Before, `check` said OK to all."""
+    (tmp_path / "brake.step").write_text("")
+    text = GOOD.replace('builder = "block_on_flat"\nmesh_size = "2 mm"', 'file = "brake.step"\nrotating = "{r}"\n'
+                        '[geometry.bodies.{b}]\nindex = [1]\nmaterial = "{m}"\n'
+                        '[geometry.bodies.{r}]\nindex = [2]\nmaterial = "flat"')
+    for rotating, problem in [("history", "geometry.bodies.history: the rotating body's name is taken: the run "
+                                          "writes history.h5 of its own (name the body otherwise)"),
+                              ("fixed", 'geometry.rotating = "fixed": is taken: the fixed bodies together are the '
+                                        'body "fixed" of the results (name the rotating body otherwise)')]:
+        with pytest.raises(SceneError) as info:
+            loads(text.format(r=rotating, b="block", m="block"), tmp_path)
+        assert problem in info.value.problems
+    with pytest.raises(SceneError) as info:
+        loads(text.format(r="flat", b='"pad 1"', m="pad/1").replace("[materials.block]", '[materials."pad/1"]'),
+              tmp_path)
+    assert {"geometry.bodies.pad 1: the name must be letters, digits, _ . - only (it names files and history columns)",
+            'geometry.bodies.pad 1.material = "pad/1": must be letters, digits, _ . - only (it names files and '
+            "history columns)"} <= set(info.value.problems)
+
+
 def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
     text = (DEMOS / "block_on_flat.toml").read_text().replace(
         'pressure = "1 MPa"', 'pressure = "1 MPa"\nfriction = 0.4')

@@ -37,7 +37,7 @@ from dolfinx.io import VTXMeshPolicy, VTXWriter
 from multiscale import io
 from multiscale.errors import InputError, OutputError
 from multiscale.macro.unloaded import Unloaded, UnloadedWarning
-from multiscale.outputs import FIELDS, array_name
+from multiscale.outputs import FIELDS, MODE_ARRAYS, array_name
 
 # DOLFINx cell name -> (XDMF topology type, DOLFINx vertex order -> XDMF/VTK order)
 CELLS = {"tetrahedron": ("Tetrahedron", [0, 1, 2, 3]), "triangle": ("Triangle", [0, 1, 2]),
@@ -45,7 +45,6 @@ CELLS = {"tetrahedron": ("Tetrahedron", [0, 1, 2, 3]), "triangle": ("Triangle", 
 # the edges of VTK's (and XDMF's) quadratic cells, in the order of their midpoint nodes
 QUADRATIC = {"tetrahedron": ("Tetrahedron_10", [(0, 1), (1, 2), (0, 2), (0, 3), (1, 3), (2, 3)]),
              "triangle": ("Triangle_6", [(0, 1), (1, 2), (0, 2)])}
-MODE_UNIT = "m/kg^0.5"     # mode shapes normalised to unit modal mass
 
 
 class MeshLayout:
@@ -376,8 +375,7 @@ def write_modes(folder: str | Path, result, functions: Sequence, names: Sequence
     files = []
     for k, (u, name) in enumerate(zip(functions, names)):
         V = u.function_space
-        parts = (fem.Function(V, name=f"mode shape real part [{MODE_UNIT}]"),
-                 fem.Function(V, name=f"mode shape imaginary part [{MODE_UNIT}]"))
+        parts = tuple(fem.Function(V, name=name) for name in MODE_ARRAYS)
         out = folder / f"modes_{name}.bp"
         with VTXWriter(V.mesh.comm, out, list(parts), engine="BP4", mesh_policy=VTXMeshPolicy.reuse) as w:
             for j in sel:
