@@ -192,7 +192,8 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
           status: str = "finished", command: list[str] | None = None, analysis: str = "",
           warnings: list[str] = ()) -> list[Path]:
     """``scene.toml`` (the file as given; the resolved scene when it came from text),
-    ``scene_resolved.toml`` and ``provenance.json`` in ``folder``; call on rank 0. The record lists
+    ``scene_resolved.toml`` and ``provenance.json`` in ``folder``; call on rank 0. The record names
+    the overrides given over the scene file (``scene.load``: a study's point), and lists
     every entry the run writes (``multiscale.outputs.plan``), so that ``results_of`` knows them
     when the folder is overwritten; ``warnings``: the scene's and the run's (e.g. temperatures
     beyond a material table); status ``RUNNING`` (written as the run begins) has no end time."""
@@ -200,13 +201,14 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     given = scene.source.read_text(encoding="utf-8") if scene.source and scene.source.is_file() else \
         "# The scene came from text, not a file: here it is as resolved.\n" + resolved_toml(scene)
     record = {"status": status, "analysis": analysis, "scene": str(scene.source or scene.name),
+              "overrides": {k: v for k, v in scene.overrides},
               "command": list(sys.argv if command is None else command), "ranks": ranks,
               "start": started, "end": None if status == RUNNING else now(),
               "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()},
               "total_wall_time_s": round(wall_time, 3), "versions": versions(), "files": sorted(plan(scene).files),
               "warnings": list(warnings)}
     texts = {"scene.toml": given, "scene_resolved.toml": resolved_toml(scene),
-             "provenance.json": json.dumps(record, indent=2) + "\n"}
+             "provenance.json": json.dumps(record, indent=2, default=str) + "\n"}
     for name, text in texts.items():              # each replaced whole: a killed run leaves the earlier one
         with replacing(folder / name) as part:
             part.write_text(text, encoding="utf-8")

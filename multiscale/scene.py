@@ -126,6 +126,7 @@ class Scene:
     layers: Layers | None = key(Section(Layers), needed_by=("layers",))
     stability: Stability | None = key(Section(Stability), needed_by=("stability",))
     source: Path | None = None                   # the scene file (None for loads without a path)
+    overrides: tuple = field(default=())        # ((dotted key, raw value), ...) given over the file (``load``)
     warnings: tuple = field(default=())         # things accepted but ignored (one line each)
 
     def has(self, effect: str) -> bool:
@@ -154,7 +155,7 @@ class Scene:
                 for item in value.values() if isinstance(value, FrozenMap) else value:
                     walk(item)
         for f in dataclasses.fields(self):
-            if f.name not in ("output", "source"):
+            if f.name not in ("output", "source", "overrides"):
                 walk(getattr(self, f.name))
         return frozenset(found)
 
@@ -254,7 +255,7 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
         fields=scene.output.fields if scene.output.fields is not None else tuple(
             f for f, needs in OUTPUT_FIELDS.items() if all(e in active for e in needs)))
     return dataclasses.replace(scene, name=name, effects=frozenset(scene.effects), output=output,
-                               source=source, warnings=tuple(warnings))
+                               source=source, overrides=tuple((overrides or {}).items()), warnings=tuple(warnings))
 
 
 def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:

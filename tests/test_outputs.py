@@ -7,6 +7,7 @@ with one mesh, the promised named arrays at exactly the promised times, units re
 provenance (scene as given, resolved scene that loads back to itself, versions, command line,
 ranks, times per stage) and the pvpython script are there."""
 import json
+import re
 import subprocess
 import sys
 import types
@@ -23,6 +24,7 @@ from multiscale.scene import load, loads
 pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 DEMOS = Path(__file__).resolve().parents[1] / "demos"
+RESULTS_DOC = (Path(__file__).resolve().parents[1] / "docs" / "results.rst").read_text()
 COARSE_POD = {"geometry.mesh_size": "15 mm", "geometry.holder_mesh_size": "6 mm",
               "geometry.interface_mesh_size": "2.5 mm", "geometry.track_mesh_size": "8 mm",
               "time.end": "2.4 s", "time.steps": 2, "output.every": 1}
@@ -129,6 +131,12 @@ def test_provenance_and_paraview_script(case):
         assert {"meshing", "macro steps"} <= set(record["stage_wall_time_s"])
     assert record["start"] <= record["end"] and record["total_wall_time_s"] > 0
     assert record["files"] == sorted(p.files)          # what a later --overwrite deletes
+    overrides = dict(record["overrides"])         # scene.toml alone is not this run (before: nothing said so)
+    if p.analysis == "squeal":                    # run from its resolved scene, no overrides
+        assert overrides == {}
+    else:
+        assert Path(overrides.pop("output.folder")).resolve() == p.folder.resolve()
+        assert overrides == next(o for f, o in CASES.values() if Path(f).stem == scene.name)
     assert (p.folder / "scene.toml").read_text() == scene.source.read_text()
     resolved = (p.folder / "scene_resolved.toml").read_text()
     again = loads(resolved, scene.source.parent, name=scene.name)
@@ -138,6 +146,48 @@ def test_provenance_and_paraview_script(case):
     for name in p.field_files:
         assert repr(name) in script
     assert "'temperature [K]'" in script if scene.has("thermal") else "'contact pressure [Pa]'" in script
+
+
+def documented(name: str) -> bool:
+    """Whether docs/results.rst names ``name`` as a literal, ``<body>``, ``<name>``, ``<material>``
+    standing for any name."""
+    return any(re.fullmatch(re.sub(r"<(body|name|material)>", "[A-Za-z0-9_.-]+", re.escape(literal)), name)
+               for literal in re.findall(r"``([^`]+)``", RESULTS_DOC) if not re.fullmatch(r"<\w+>", literal))
+
+
+def test_every_column_and_dataset_written_is_documented(case):
+    """Every history column, zones.h5 dataset and modes.csv column is in docs/results.rst (before:
+    22 of the rough run's 38 columns were not, nor the modes.csv columns)."""
+    import h5py
+    _, p, _ = case
+    names = []
+    for file in ("history.h5", "zones.h5"):
+        if (p.folder / file).is_file():
+            with h5py.File(p.folder / file, "r") as f:
+                names += list(f) + list(f.attrs)
+                assert all("unit" in f[k].attrs for k in f)
+    if (p.folder / "modes.csv").is_file():
+        names += (p.folder / "modes.csv").read_text().splitlines()[0].split(",")
+    assert names and [n for n in names if not documented(n)] == []
+
+
+def test_zone_results_say_where_each_value_is(case):
+    """zones.h5 gives the facets of its per-facet data (``counter_wear_depth``: in the interface's
+    global facet order, not that of interface.xdmf's cells) and each zone's centre in space
+    (``centre`` is in the interface's plane); before, neither could be placed."""
+    import h5py
+    _, p, _ = case
+    if p.analysis != "multiscale":
+        pytest.skip("zone results: multiscale loop only")
+    with h5py.File(p.folder / "zones.h5", "r") as z, h5py.File(p.folder / "interface.h5", "r") as f:
+        facets = f["mesh/geometry"][...][f["mesh/topology"][...]].mean(axis=1)
+        centres = z["facet_centre"][...]
+        assert centres.shape == facets.shape and z["counter_wear_depth"].shape == (len(facets),)
+        distance = np.linalg.norm(centres[:, None] - facets[None], axis=2)        # every centre is a cell's, once
+        assert distance.min(axis=1).max() < 1e-12 and len(set(distance.argmin(axis=1))) == len(facets)
+        position = z["position"][...]
+        np.testing.assert_allclose(position[:, :2], z["centre"][...], rtol=0, atol=1e-15)   # the pin face: z = 0
+        np.testing.assert_allclose(position[:, 2], 0.0, atol=1e-15)
 
 
 class StubParaView:

@@ -89,7 +89,8 @@ def fingerprint(scene) -> str:
     set's order changes between processes) and the bytes of every file it reads (a measured surface
     rewritten under the same name was resumed into wrong wear depths: the checkpoint holds the worn
     heights, the unworn ones are read again)."""
-    s = dataclasses.replace(scene, output=None, source=None, warnings=(), effects=tuple(sorted(scene.effects)))
+    s = dataclasses.replace(scene, output=None, source=None, overrides=(), warnings=(),
+                            effects=tuple(sorted(scene.effects)))
     source = scene.source.resolve() if scene.source is not None else None
     files = sorted(p for p in scene.inputs if p != source and p.is_file())
     return checkpoint.fingerprint(repr(s) + "".join(f"{p}:{checkpoint.file_digest(p)}" for p in files))
@@ -226,13 +227,15 @@ def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: 
     def write():
         multiscale_figure(history, plot, name)
         with h5py.File(zones, "w") as h5:
-            h5.create_dataset("centre", data=np.array([z.centre for z in rough.zones])).attrs["unit"] = "m"
+            h5.create_dataset("centre", data=np.array([z.centre for z in rough.zones])).attrs["unit"] = "m"   # (u, v)
+            h5.create_dataset("position", data=rough.zone_frames()[0]).attrs["unit"] = "m"   # the centre in space
             h5.create_dataset("mean_wear_depth", data=depth.mean(axis=(-2, -1))).attrs["unit"] = "m"
             h5.create_dataset("max_wear_depth", data=depth.max(axis=(-2, -1))).attrs["unit"] = "m"
             h5.create_dataset("wear_volume", data=rough.zone_wear_volume(depth)).attrs["unit"] = "m^3"
             h5.create_dataset("partition", data=ms.partition).attrs["unit"] = "-"     # share into body 0
             h5.create_dataset("flash_temperature", data=ms.flash).attrs["unit"] = "K"
             h5.create_dataset("counter_wear_depth", data=ms.counter_depth).attrs["unit"] = "m"   # per facet
+            h5.create_dataset("facet_centre", data=ms.tm.interface.midpoints).attrs["unit"] = "m"  # of those facets
             h5.create_dataset("conductance", data=ms.conductance).attrs["unit"] = "W/(m^2 K)"
             h5.attrs["counts"] = np.array([g.counts for g in rough.grids])     # (interfaces, 2)
     offsets = np.cumsum([0] + [g.n_zones for g in rough.grids])
