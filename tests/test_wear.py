@@ -95,7 +95,23 @@ def test_steps_that_wear_deeper_than_the_rms_height_are_warned_about():
     area = {n: h.area_fraction[-1] for n, (h, _) in run_in.items()}
     assert area[32] == pytest.approx(area[128], rel=0.01) and area[16] < 0.8 * area[128]
     assert not run_in[32][1] and not run_in[128][1] and len(run_in[16][1]) == 1
-    assert "simulate_wear: a step wore up to 0.6" in run_in[16][1][0] and "use more, at least 4" in run_in[16][1][0]
+    assert "simulate_wear: a step changed the relief by up to 0.6" in run_in[16][1][0] \
+        and "use more, at least 4" in run_in[16][1][0]
+
+
+def test_uniform_wear_of_a_flat_is_not_a_coarse_step():
+    """A periodic flat in full contact wears alike everywhere: exact at any step count, no warning
+    (before: "a step wore up to 4.49e+296 times the RMS height", its RMS 0). A non-periodic flat
+    punch wears its edges first, a relief from nothing that depends on the step count: warned,
+    without a ratio to a zero RMS."""
+    runs = {periodic: _wear_runs(Surface(np.zeros((32, 32)), 1e-6, 1e-6, periodic=periodic), (4,),
+                                 contact=HalfSpace(1e11), load=1e6, mu=0.4, distance=1e-3, k_w=1e-13)[4]
+            for periodic in (True, False)}
+    history, warned = runs[True]
+    assert history.max_depth[-1] == pytest.approx(1e-13 * 0.4 * 1e6 * 1e-3, rel=1e-12) and warned == []
+    assert runs[False][1] == ["simulate_wear: a step wore a relief into a surface flat to round-off (e.g. a flat "
+                              "punch's edges), so the result depends on the step count (steps = 4): use more until "
+                              "the result stops changing"]
 
 
 def test_wear_step_convergence_N300_vs_N600_on_the_thesis_example(thesis_runs):
