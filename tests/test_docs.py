@@ -72,12 +72,13 @@ def test_an_optional_key_without_default_says_what_its_absence_means():
 def test_every_optional_key_without_default_says_what_its_absence_means():
     """No key of `check --keys` is a bare "[optional]" (56 were): an optional key without a default says
     what leaving it out does (a new key must too), and the page's default column never says "none"
-    for such a key (only keys needed by an effect may)."""
+    (a key without a default that an effect needs says "required with" it; 8 said "none")."""
     lines = reference()
     assert [line for line in lines if line.endswith("[optional]")] == []
     assert sum("[optional; without it: " in line for line in lines) >= 64
     rows = scene_rst().split("   * - ")
-    bare = [r.split("\n")[0] for r in rows if "\n     - none\n" in r]
+    assert [r.split("\n")[0] for r in rows if "\n     - none\n" in r] == []
+    bare = [r.split("\n")[0] for r in rows if "\n     - required with " in r]
     needed = {f"``{p}``" for p in ("materials.<name>.rho", "materials.<name>.kappa", "materials.<name>.alpha",
                                    "interface.penalty", "interface.partition", "interface.conductance", "time.end",
                                    "layers.layer.kappa")}
