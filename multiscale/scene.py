@@ -32,7 +32,7 @@ from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Sectio
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
 from multiscale.scene_sections import (COUPLING_DEFAULT, DEFAULT_GRID, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
-                                       Micro, Output, Roughness, Time, Vehicle, Wear)
+                                       Micro, Output, Roughness, Time, Vehicle, Wear, interpolate)
 from multiscale.scene_stability import Stability
 
 __all__ = ["COUPLING_DEFAULT", "EFFECTS", "FIG_7_9_CALIBRATION", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Boundary",
@@ -359,14 +359,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
             scene.stability.sweep.parameter == "speed"
         warnings += _squeal_state(scene.loading, g.motion, "friction" in effects and not swept)
     end = scene.time.end if scene.time is not None else None
-    for key in ("load_profile", "speed_profile") if scene.loading is not None and end is not None else ():
-        table = getattr(scene.loading, key)
-        if table is not None and (table[0][0] > 0 or table[-1][0] < end):
-            unit = " rad/s" if key == "speed_profile" else ""
-            held = ([f"at {table[0][1]:g}{unit} before {table[0][0]:g} s"] if table[0][0] > 0 else []) + \
-                   ([f"at {table[-1][1]:g}{unit} from {table[-1][0]:g} s to time.end = {end:g} s"]
-                    if table[-1][0] < end else [])
-            warnings.append(f"loading.{key} is held {' and '.join(held)} (it does not cover the run)")
+    if scene.loading is not None and end is not None:
+        warnings += _cycle_coverage(scene.loading, end)
     profile = scene.loading.load_profile if scene.loading is not None else None
     if profile is not None and not any(factor > 0 for _, factor in profile):
         warnings.append("loading.load_profile is 0 throughout: the load is released for the whole run (no "
@@ -384,6 +378,34 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         warnings.append('effects "friction" and "thermal" without "heat_partition": no frictional heat '
                         "enters the bodies")
     return ctx.warnings + warnings
+
+
+def _cycle_coverage(ld, end: float) -> list[str]:
+    """How the duty cycle and the run [0, end] [s] differ: a profile held at its ends inside the run,
+    one that changes after ``end`` (a second stop the run never reaches), a vehicle stop still
+    running at ``end`` (its share 1 - (v(end)/v0)^2 of the kinetic energy braked)."""
+    out = []
+    for key in ("load_profile", "speed_profile"):
+        table = getattr(ld, key)
+        if table is None:
+            continue
+        unit = " rad/s" if key == "speed_profile" else ""
+        held = ([f"at {table[0][1]:g}{unit} before {table[0][0]:g} s"] if table[0][0] > 0 else []) + \
+               ([f"at {table[-1][1]:g}{unit} from {table[-1][0]:g} s to time.end = {end:g} s"]
+                if table[-1][0] < end else [])
+        if held:
+            out.append(f"loading.{key} is held {' and '.join(held)} (it does not cover the run)")
+        if any(t > end and value != interpolate(table, end) for t, value in table):
+            out.append(f"loading.{key} changes after time.end = {end:g} s (its rows to {table[-1][0]:g} s): the run "
+                       "ends before that part of the cycle; a longer time.end runs it")
+    v = ld.vehicle
+    if v is not None and v.stop_time is not None and v.stop_time > end:
+        left = v.speed - v.deceleration * end                     # m/s at the run's end
+        out.append(f"loading.vehicle: the stop from {v.speed * 3.6:.3g} km/h at {v.deceleration:.3g} m/s^2 takes "
+                   f"{v.stop_time:.3g} s, beyond time.end = {end:g} s: the run ends at {left * 3.6:.3g} km/h, having "
+                   f"braked {100 * (1 - (left / v.speed) ** 2):.0f} % of the kinetic energy; a longer time.end "
+                   f'brakes the rest (a deceleration in g is written "{v.deceleration:.3g} gn")')
+    return out
 
 
 def _squeal_state(ld, motion: str, friction: bool) -> list[str]:

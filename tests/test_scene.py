@@ -445,6 +445,32 @@ def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
         "loading.load_profile is 0 throughout: the load is released for the whole run (no contact, no frictional heat)"]
 
 
+def test_a_cycle_the_run_ends_before_is_warned_about(tmp_path):
+    """A braking cycle longer than time.end is cut silently (before): a second stop written in the
+    profiles after time.end, or a vehicle stop still running at time.end (a deceleration of 0.6 read
+    as 0.6 m/s^2 where 0.6 g was meant: a 46 s stop in a 4.8 s run braked 19 % of the energy)."""
+    pod = (DEMOS / "pin_on_disc_perfect.toml").read_text().replace('end = "30 s"', 'end = "1 s"')
+    cycle = loads(pod.replace('rotation_speed = "200 rpm"', 'load_profile = [["0 s", 1], ["0.6 s", 1], ["1 s", 0], '
+                              '["2 s", 0], ["2.01 s", 1]]\nspeed_profile = [["0 s", "200 rpm"], ["0.6 s", "0 rpm"], '
+                              '["1.2 s", "0 rpm"], ["1.21 s", "200 rpm"], ["1.8 s", "0 rpm"]]'), tmp_path)
+    assert [w for w in cycle.warnings if "after time.end" in w] == [
+        "loading.load_profile changes after time.end = 1 s (its rows to 2.01 s): the run ends before that part of "
+        "the cycle; a longer time.end runs it",
+        "loading.speed_profile changes after time.end = 1 s (its rows to 1.8 s): the run ends before that part of "
+        "the cycle; a longer time.end runs it"]
+    held = loads(pod.replace('rotation_speed = "200 rpm"', 'speed_profile = [["0 s", "200 rpm"], ["0.6 s", "0 rpm"], '
+                             '["2 s", "0 rpm"]]'), tmp_path)
+    assert not any("after time.end" in w for w in held.warnings)      # nothing changes after it
+    stop = pod.replace('rotation_speed = "200 rpm"', "").replace('end = "1 s"', 'end = "4.8 s"') + \
+        '\n[loading.vehicle]\nspeed = "100 km/h"\ndeceleration = 0.6\nwheel_radius = "310 mm"\n'
+    assert [w for w in loads(stop, tmp_path).warnings if "loading.vehicle" in w] == [
+        "loading.vehicle: the stop from 100 km/h at 0.6 m/s^2 takes 46.3 s, beyond time.end = 4.8 s: the run "
+        "ends at 89.6 km/h, having braked 20 % of the kinetic energy; a longer time.end brakes the rest (a "
+        'deceleration in g is written "0.6 gn")']
+    assert not any("loading.vehicle" in w for w in loads(stop.replace("deceleration = 0.6", 'deceleration = "0.6 gn"'),
+                                                           tmp_path).warnings)
+
+
 @pytest.mark.parametrize("old, new, warning", [
     ('initial_temperature = "20 degC"', 'initial_temperature = "1e-300 K"',
      'time.initial_temperature = "1e-300 K": 1e-300 K is outside the plausible range 20 to 2500 K'),
