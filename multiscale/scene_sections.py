@@ -343,8 +343,8 @@ class Loading:
     stribeck: Stribeck | None = key(Section(Stribeck))
 
     FRICTION = ("friction", "friction_curve", "stribeck")
-    rules = (OneOf(("normal_force", "pressure")), OneOf(("rotation_speed", "speed_profile", "vehicle")),
-             OneOf(FRICTION))      # needed with effect friction unless every interface has its own: scene.py
+    rules = (OneOf(("normal_force", "pressure")), OneOf(FRICTION), OneOf(("rotation_speed", "speed_profile", "vehicle"),
+             meaning="a vehicle is one stop or drag; several stops: speed and load profiles"))   # FRICTION: scene.py
 
     def problems(self, path, ctx):
         law = [k for k in self.FRICTION if getattr(self, k) is not None]

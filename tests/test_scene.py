@@ -375,6 +375,16 @@ def test_alternatives_given_together_are_one_problem(tmp_path):
     with pytest.raises(SceneError) as info:
         loads(text, tmp_path)
     assert info.value.problems == ["materials.block.c or materials.block.chi: give only one of them (got c, chi)"]
+    # a vehicle with a speed profile (several stops of a vehicle tried): said how a cycle is written (before: only
+    # "give only one of them")
+    pod = (DEMOS / "pin_on_disc_perfect.toml").read_text().replace('rotation_speed = "200 rpm"', 'speed_profile = '
+                                                                    '[["0 s", "200 rpm"], ["1 s", "0 rpm"]]')
+    with pytest.raises(SceneError) as info:
+        loads(pod + '[loading.vehicle]\nspeed = "36 km/h"\ndeceleration = "1 m/s^2"\nwheel_radius = "300 mm"\n',
+              tmp_path)
+    assert info.value.problems == ["loading.rotation_speed or loading.speed_profile or loading.vehicle: give only one "
+                                   "of them: a vehicle is one stop or drag; several stops: speed and load profiles "
+                                   "(got speed_profile, vehicle)"]
 
 
 def test_a_folder_given_as_a_file_is_said_to_be_a_folder(tmp_path):
