@@ -361,6 +361,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
     end = scene.time.end if scene.time is not None else None
     if scene.loading is not None and end is not None:
         warnings += _cycle_coverage(scene.loading, end)
+        if g is not None and g.motion == "rotation" and "thermal" in effects:
+            warnings += _convection_coverage(scene.boundary or (), scene.loading, end)
     profile = scene.loading.load_profile if scene.loading is not None else None
     if profile is not None and not any(factor > 0 for _, factor in profile):
         warnings.append("loading.load_profile is 0 throughout: the load is released for the whole run (no "
@@ -405,6 +407,27 @@ def _cycle_coverage(ld, end: float) -> list[str]:
                    f"{v.stop_time:.3g} s, beyond time.end = {end:g} s: the run ends at {left * 3.6:.3g} km/h, having "
                    f"braked {100 * (1 - (left / v.speed) ** 2):.0f} % of the kinetic energy; a longer time.end "
                    f'brakes the rest (a deceleration in g is written "{v.deceleration:.3g} gn")')
+    return out
+
+
+def _convection_coverage(boundaries, ld, end: float) -> list[str]:
+    """A convection table h [W/(m^2 K)] against the rotating body's speed [rad/s] is held at its
+    ends: said where the run's speeds (piecewise linear between the cycle's knots, so their
+    extremes are at knots or at 0 and ``end`` [s]) leave it."""
+    speeds = [ld.angular_speed(t) for t in (0.0, end, *(t for t in ld.knots() if 0 < t < end))]
+    low, high = min(speeds), max(speeds)
+    out = []
+    for i, b in enumerate(boundaries, 1):
+        if b is None or not isinstance(b.convection, tuple):
+            continue
+        (x0, h0), (x1, h1) = b.convection[0], b.convection[-1]
+        below, above = low < x0, high > x1
+        reach = [f"falls to {low:.5g} rad/s"] * below + [f"reaches {high:.5g} rad/s"] * above
+        held = [f"{h0:g} W/(m^2 K) below {x0:.5g} rad/s"] * below + [f"{h1:g} W/(m^2 K) above {x1:.5g} rad/s"] * above
+        if held:
+            out.append(f"boundary[{i}].convection covers {x0:.5g} to {x1:.5g} rad/s of the rotating body's speed, "
+                       f"which {' and '.join(reach)} in the run: h is held at {' and at '.join(held)} (extend the "
+                       "table)")
     return out
 
 

@@ -481,6 +481,22 @@ def test_a_cycle_the_run_ends_before_is_warned_about(tmp_path):
                                                            tmp_path).warnings)
 
 
+def test_a_convection_table_the_speeds_leave_is_warned_about(tmp_path):
+    """h(speed) is held at its table's ends like a material's table, but (before) silently: a car
+    stop from 856 rpm with a table to 300 rpm cooled at h(300 rpm), a dwell at rest with a table
+    from 300 rpm at h(300 rpm) instead of the still-air value."""
+    pod = (DEMOS / "pin_on_disc_perfect.toml").read_text().replace(
+        'rotation_speed = "200 rpm"', 'speed_profile = [["0 s", "200 rpm"], ["10 s", "0 rpm"]]')
+    table = '\n[[boundary]]\nsurfaces = ["free:disc"]\nconvection = [["{} rpm", "20 W/(m^2 K)"], ["{} rpm", "50 W/(m^2 K)"]]\n'
+    warned = [w for w in loads(pod + table.format(0, 100), tmp_path).warnings if "convection" in w]
+    assert warned == ["boundary[1].convection covers 0 to 10.472 rad/s of the rotating body's speed, which reaches "
+                      "20.944 rad/s in the run: h is held at 50 W/(m^2 K) above 10.472 rad/s (extend the table)"]
+    warned = [w for w in loads(pod + table.format(100, 300), tmp_path).warnings if "convection" in w]
+    assert warned == ["boundary[1].convection covers 10.472 to 31.416 rad/s of the rotating body's speed, which "
+                      "falls to 0 rad/s in the run: h is held at 20 W/(m^2 K) below 10.472 rad/s (extend the table)"]
+    assert not any("convection" in w for w in loads(pod + table.format(0, 200), tmp_path).warnings)
+
+
 @pytest.mark.parametrize("old, new, warning", [
     ('initial_temperature = "20 degC"', 'initial_temperature = "1e-300 K"',
      'time.initial_temperature = "1e-300 K": 1e-300 K is outside the plausible range 20 to 2500 K'),
