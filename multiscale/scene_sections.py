@@ -329,8 +329,8 @@ class Loading:
     faces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), absent="the builder's load faces (files: needed)")
     direction: tuple | None = key(Vector(Quantity("dimensionless")),
                                   absent="-p n on each face (disc_brake, files); else -z")
-    load_profile: tuple | None = key(Curve(Quantity("time", ge=0), Quantity("dimensionless", ge=0), "time",
-                                           "factor"), absent="factor 1 throughout")   # ((s, -), ...)
+    load_profile: tuple | None = key(Curve(Quantity("time", ge=0), Quantity("dimensionless", ge=0, plausible=(
+        0.0, 10.0)), "time", "factor"), absent="factor 1 throughout")   # ((s, -), ...): a factor of the load, not N
     rotation_speed: float | None = key(_ANGULAR_SPEED, absent="speed_profile or vehicle; else at rest")  # rad/s
     speed_profile: tuple | None = key(Curve(Quantity("time", ge=0), _ANGULAR_SPEED, "time", "speed"),
                                       absent="rotation_speed or vehicle gives the speed")   # ((s, rad/s), ...)

@@ -506,6 +506,9 @@ def test_a_convection_table_the_speeds_leave_is_warned_about(tmp_path):
     ('mesh_size = "2 mm"', 'mesh_size = "20 m"', 'geometry.mesh_size = "20 m": 20 m is outside'),
     ('kappa = "5 W/(m K)"', 'kappa = [["20 degC", "5 W/(m K)"], ["3000 degC", "6 W/(m K)"]]',
      'materials.block.kappa = [["20 degC", "5 W/(m K)"], ["3000 degC", "6 W/(m K)"]]: 3273.15 K is outside'),
+    # a clamp force in N written as the load factor (before: 2500 times the load, silently)
+    ('pressure = "10 bar"', 'pressure = "10 bar"\nload_profile = [["0 s", 1], ["2 min", 2500]]',
+     'loading.load_profile = [["0 s", 1], ["2 min", 2500]]: 2500 is outside the plausible range 0 to 10'),
 ])
 def test_implausible_values_are_warned_with_their_path(tmp_path, old, new, warning):
     """A value outside its documented plausible range (check --keys) runs, with one warning naming the
