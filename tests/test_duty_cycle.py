@@ -49,6 +49,11 @@ def test_a_vehicle_stop_brakes_the_mass_and_turns_its_energy_into_heat(tmp_path,
     np.testing.assert_allclose(h["interface_force"], h["interface_force"][0], rtol=1e-10)
     heat = h["heat_total_pin"][-1] + h["heat_total_disc"][-1]
     assert heat == pytest.approx(0.5 * MASS * V0**2, rel=1e-6)
+    # the history's braking torque is m a R while sliding (every row before the stop), 0 without friction
+    sliding = h["friction_force"] > 0
+    assert np.all(sliding[h["time"] < 2.0 - 1e-9])
+    np.testing.assert_allclose(h["friction_moment"][sliding], MASS * DECEL * WHEEL, rtol=1e-3)
+    assert np.all(h["friction_moment"][~sliding] == 0.0)
     # no heat comes in by the steps that start after the stop (t >= 2 s)
     np.testing.assert_allclose(h["heat_step_pin"][1:][h["time"][:-1] > 2.0 - 1e-9], 0.0, atol=1e-12)
 

@@ -21,6 +21,7 @@ import numpy as np
 
 from multiscale.outputs import step_time
 from multiscale.errors import InputError
+from multiscale.geometry import Rotation
 from multiscale.macro.mechanics import Mechanics, SolveResult, clamp_imbalance, load_face_forces
 from multiscale.macro.mesh import TwoBodyMesh
 from multiscale.macro.thermal import Thermal
@@ -304,7 +305,8 @@ class MacroModel:
         """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal
         boundary conditions, ``heat_lost_step_<body>`` is the heat lost since the previous record.
         ``friction_force`` (in all and per interface) sums the friction forces' magnitudes over the
-        facets, mu times the normal force where all slides: opposite pads do not cancel. With several
+        facets, mu times the normal force where all slides: opposite pads do not cancel;
+        ``friction_moment`` [N m], with a rotating body 1, is the magnitude of their moment about its axis. With several
         interfaces and heat, ``interface_heat_row`` gives each one's heat and face temperatures."""
         on = not self.released
         friction = np.linalg.norm(self.contact.facet_friction(), axis=1) * on     # N per facet, magnitudes
@@ -312,6 +314,8 @@ class MacroModel:
                "friction_force": float(friction.sum()),
                "max_pressure": self.last_solve.max_pressure * on,
                "newton_iterations": self.last_solve.iterations}
+        if isinstance(self.tm.spec.motion, Rotation):   # the braking torque: frictional heat power = it x omega
+            row["friction_moment"] = abs(self.contact.friction_moment()) * on
         masks = self.tm.interface.masks()
         if len(masks) > 1:                        # per interface (a brake's pads, a disc's pucks)
             p = self.contact.facet_pressure() * on
