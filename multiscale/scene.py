@@ -31,8 +31,8 @@ from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Sectio
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
 from multiscale.scene_sections import (COUPLING_DEFAULT, DEFAULT_GRID, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
-                                       OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
-                                       Micro, Output, Roughness, Time, Vehicle, Wear, interpolate)
+                                       GRAVITY, OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading,
+                                       Material, Micro, Output, Roughness, Time, Vehicle, Wear, interpolate)
 from multiscale.scene_stability import Stability
 
 __all__ = ["COUPLING_DEFAULT", "EFFECTS", "FIG_7_9_CALIBRATION", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Boundary",
@@ -403,10 +403,11 @@ def _cycle_coverage(ld, end: float) -> list[str]:
     v = ld.vehicle
     if v is not None and v.stop_time is not None and v.stop_time > end:
         left = v.speed - v.deceleration * end                     # m/s at the run's end
-        out.append(f"loading.vehicle: the stop from {v.speed * 3.6:.3g} km/h at {v.deceleration:.3g} m/s^2 takes "
+        out.append(f"loading.vehicle: the stop from {v.speed * 3.6:.3g} km/h at {v.deceleration:.3g} m/s^2 "
+                   f"({v.deceleration / GRAVITY:.3g} g) takes "
                    f"{v.stop_time:.3g} s, beyond time.end = {end:g} s: the run ends at {left * 3.6:.3g} km/h, having "
                    f"braked {100 * (1 - (left / v.speed) ** 2):.0f} % of the kinetic energy; a longer time.end "
-                   f'brakes the rest (a deceleration in g is written "{v.deceleration:.3g} gn")')
+                   'brakes the rest (a deceleration in g is written "0.6 gn")')
     return out
 
 

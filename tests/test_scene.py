@@ -474,11 +474,15 @@ def test_a_cycle_the_run_ends_before_is_warned_about(tmp_path):
     stop = pod.replace('rotation_speed = "200 rpm"', "").replace('end = "1 s"', 'end = "4.8 s"') + \
         '\n[loading.vehicle]\nspeed = "100 km/h"\ndeceleration = 0.6\nwheel_radius = "310 mm"\n'
     assert [w for w in loads(stop, tmp_path).warnings if "loading.vehicle" in w] == [
-        "loading.vehicle: the stop from 100 km/h at 0.6 m/s^2 takes 46.3 s, beyond time.end = 4.8 s: the run "
-        "ends at 89.6 km/h, having braked 20 % of the kinetic energy; a longer time.end brakes the rest (a "
+        "loading.vehicle: the stop from 100 km/h at 0.6 m/s^2 (0.0612 g) takes 46.3 s, beyond time.end = 4.8 s: "
+        "the run ends at 89.6 km/h, having braked 20 % of the kinetic energy; a longer time.end brakes the rest (a "
         'deceleration in g is written "0.6 gn")']
     assert not any("loading.vehicle" in w for w in loads(stop.replace("deceleration = 0.6", 'deceleration = "0.6 gn"'),
                                                            tmp_path).warnings)
+    short = loads(stop.replace("deceleration = 0.6", 'deceleration = "0.6 gn"').replace('end = "4.8 s"', 'end = "2 s"'),
+                  tmp_path)          # a deceleration given in g: said so, not "written" in g again
+    assert [w for w in short.warnings if "loading.vehicle" in w][0].startswith(
+        "loading.vehicle: the stop from 100 km/h at 5.88 m/s^2 (0.6 g) takes 4.72 s, beyond time.end = 2 s")
 
 
 def test_a_convection_table_the_speeds_leave_is_warned_about(tmp_path):
