@@ -31,8 +31,9 @@ from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Sectio
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
 from multiscale.scene_sections import (COUPLING_DEFAULT, DEFAULT_GRID, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
-                                       GRAVITY, OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading,
-                                       Material, Micro, Output, Roughness, Time, Vehicle, Wear, interpolate)
+                                       OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
+                                       Micro, Output, Roughness, Time, Vehicle, Wear)
+from multiscale.scene_cycle import convection_coverage, cycle_coverage, squeal_state
 from multiscale.scene_stability import Stability
 
 __all__ = ["COUPLING_DEFAULT", "EFFECTS", "FIG_7_9_CALIBRATION", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Boundary",
@@ -357,12 +358,12 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
     if "stability" in effects and scene.loading is not None and g is not None:
         swept = scene.stability is not None and scene.stability.sweep is not None and \
             scene.stability.sweep.parameter == "speed"
-        warnings += _squeal_state(scene.loading, g.motion, "friction" in effects and not swept)
+        warnings += squeal_state(scene.loading, g.motion, "friction" in effects and not swept)
     end = scene.time.end if scene.time is not None else None
     if scene.loading is not None and end is not None:
-        warnings += _cycle_coverage(scene.loading, end)
+        warnings += cycle_coverage(scene.loading, end)
         if g is not None and g.motion == "rotation" and "thermal" in effects:
-            warnings += _convection_coverage(scene.boundary or (), scene.loading, end)
+            warnings += convection_coverage(scene.boundary or (), scene.loading, end)
     profile = scene.loading.load_profile if scene.loading is not None else None
     if profile is not None and not any(factor > 0 for _, factor in profile):
         warnings.append("loading.load_profile is 0 throughout: the load is released for the whole run (no "
@@ -380,72 +381,6 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         warnings.append('effects "friction" and "thermal" without "heat_partition": no frictional heat '
                         "enters the bodies")
     return ctx.warnings + warnings
-
-
-def _cycle_coverage(ld, end: float) -> list[str]:
-    """How the duty cycle and the run [0, end] [s] differ: a profile held at its ends inside the run,
-    one that changes after ``end`` (a second stop the run never reaches), a vehicle stop still
-    running at ``end`` (its share 1 - (v(end)/v0)^2 of the kinetic energy braked)."""
-    out = []
-    for key in ("load_profile", "speed_profile"):
-        table = getattr(ld, key)
-        if table is None:
-            continue
-        unit = " rad/s" if key == "speed_profile" else ""
-        held = ([f"at {table[0][1]:g}{unit} before {table[0][0]:g} s"] if table[0][0] > 0 else []) + \
-               ([f"at {table[-1][1]:g}{unit} from {table[-1][0]:g} s to time.end = {end:g} s"]
-                if table[-1][0] < end else [])
-        if held:
-            out.append(f"loading.{key} is held {' and '.join(held)} (it does not cover the run)")
-        if any(t > end and value != interpolate(table, end) for t, value in table):
-            out.append(f"loading.{key} changes after time.end = {end:g} s (its rows to {table[-1][0]:g} s): the run "
-                       "ends before that part of the cycle; a longer time.end runs it")
-    v = ld.vehicle
-    if v is not None and v.stop_time is not None and v.stop_time > end:
-        left = v.speed - v.deceleration * end                     # m/s at the run's end
-        out.append(f"loading.vehicle: the stop from {v.speed * 3.6:.3g} km/h at {v.deceleration:.3g} m/s^2 "
-                   f"({v.deceleration / GRAVITY:.3g} g) takes "
-                   f"{v.stop_time:.3g} s, beyond time.end = {end:g} s: the run ends at {left * 3.6:.3g} km/h, having "
-                   f"braked {100 * (1 - (left / v.speed) ** 2):.0f} % of the kinetic energy; a longer time.end "
-                   'brakes the rest (a deceleration in g is written "0.6 gn")')
-    return out
-
-
-def _convection_coverage(boundaries, ld, end: float) -> list[str]:
-    """A convection table h [W/(m^2 K)] against the rotating body's speed [rad/s] is held at its
-    ends: said where the run's speeds (piecewise linear between the cycle's knots, so their
-    extremes are at knots or at 0 and ``end`` [s]) leave it."""
-    speeds = [ld.angular_speed(t) for t in (0.0, end, *(t for t in ld.knots() if 0 < t < end))]
-    low, high = min(speeds), max(speeds)
-    out = []
-    for i, b in enumerate(boundaries, 1):
-        if b is None or not isinstance(b.convection, tuple):
-            continue
-        (x0, h0), (x1, h1) = b.convection[0], b.convection[-1]
-        below, above = low < x0, high > x1
-        reach = [f"falls to {low:.5g} rad/s"] * below + [f"reaches {high:.5g} rad/s"] * above
-        held = [f"{h0:g} W/(m^2 K) below {x0:.5g} rad/s"] * below + [f"{h1:g} W/(m^2 K) above {x1:.5g} rad/s"] * above
-        if held:
-            out.append(f"boundary[{i}].convection covers {x0:.5g} to {x1:.5g} rad/s of the rotating body's speed, "
-                       f"which {' and '.join(reach)} in the run: h is held at {' and at '.join(held)} (extend the "
-                       "table)")
-    return out
-
-
-def _squeal_state(ld, motion: str, friction: bool) -> list[str]:
-    """The squeal analysis linearises one sliding state, the full load at the speed at t = 0: a duty
-    cycle's rest is ignored, and at rest the preload has no friction (a speed profile from 0 rpm
-    gave 0 unstable modes of the demo brake where 5 rad/s gives 4, silently: an adversarial test)."""
-    cycle = [f"loading.{k}" for k in ("load_profile", "speed_profile") if getattr(ld, k) is not None]
-    cycle += ["loading.vehicle"] if ld.vehicle is not None and not ld.steady_speed else []
-    speed = ld.angular_speed(0.0) if motion == "rotation" else ld.sliding_speed or 0.0
-    unit = "rad/s" if motion == "rotation" else "m/s"
-    out = [f"{', '.join(cycle)}: the squeal analysis is of one state, the full load at the speed at t = 0 "
-           f"({speed:g} {unit}); the rest of the cycle is ignored"] if cycle else []
-    if friction and speed == 0.0:
-        out.append(f"the squeal analysis is at rest (speed 0 {unit} at t = 0): the preload has no friction, so no "
-                   "friction-induced instability can be found; give the speed of the sliding state to analyse")
-    return out
 
 
 def _hardness_checks(scene: Scene, g: Geometry, raw: dict, effects) -> list[str]:

@@ -342,9 +342,9 @@ class Loading:
                                              "mu", min_rows=2), absent="friction or stribeck gives mu")  # ((m/s, -),..)
     stribeck: Stribeck | None = key(Section(Stribeck))
 
-    FRICTION = ("friction", "friction_curve", "stribeck")
+    FRICTION = ("friction", "friction_curve", "stribeck")     # one needed with effect friction: scene._cross_checks
     rules = (OneOf(("normal_force", "pressure")), OneOf(FRICTION), OneOf(("rotation_speed", "speed_profile", "vehicle"),
-             meaning="a vehicle is one stop or drag; several stops: speed and load profiles"))   # FRICTION: scene.py
+             meaning="a vehicle is one stop or drag; several stops: speed and load profiles"))
 
     def problems(self, path, ctx):
         law = [k for k in self.FRICTION if getattr(self, k) is not None]
