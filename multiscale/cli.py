@@ -357,7 +357,7 @@ def build_parser() -> argparse.ArgumentParser:
     again.add_argument("--overwrite", action="store_true",
                        help="delete the results of the run before (the entries its provenance.json lists) and run again")
     again.add_argument("--resume", action="store_true", help="continue from the last checkpoint in the output folder")
-    run.add_argument("--quiet", action="store_true", help="no stage lines or summary (errors only)")
+    run.add_argument("--quiet", action="store_true", help="no stage lines or summary (warnings and errors only)")
     run.add_argument("--max-cells", type=_count, metavar="N", help="largest mesh (cells) the run may build; "
                                                                    "overrides geometry.max_cells (default 1e6)")
     run.set_defaults(func=_run)

@@ -389,6 +389,19 @@ def test_a_provenance_write_that_fails_midway_leaves_the_earlier_record(tmp_path
     assert "block.xdmf" in provenance.results_of(folder)
 
 
+def test_a_quiet_run_still_prints_what_its_results_leave_out(tmp_path, capsys):
+    """run --quiet prints the run's warnings as it does the scene's (before: the scene's only; the
+    small-strain warning of a 200 MPa load on the 4 GPa block was in provenance.json alone)."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+    folder = tmp_path / "out"
+    path = _write(tmp_path, BLOCK.replace("../results/block_on_flat", str(folder)).replace('"1 MPa"', '"200 MPa"'))
+    assert main(["run", path, "--quiet"]) == 0
+    err = capsys.readouterr().err
+    record = json.loads((folder / "provenance.json").read_text())
+    assert [w for w in record["warnings"] if "softer side's E" in w] == \
+        [line.removeprefix("warning: ") for line in err.splitlines() if "softer side's E" in line] != []
+
+
 def test_overwrite_keeps_the_earlier_results_when_the_run_fails_before_writing(tmp_path, capsys):
     """run --overwrite of a scene refused at meshing (--max-cells): the earlier run's results and
     its provenance stay as they were (before: deleted, then the refusal); the same run that meshes

@@ -39,7 +39,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
 
     Besides the analysis' results, the folder receives ``scene.toml``, ``scene_resolved.toml``,
     ``provenance.json`` (also after a failure, once the run has written into the folder) and ``paraview.py``.
-    ``verbose``: stage lines and the summary on rank 0."""
+    ``verbose``: stage lines and the summary on rank 0 (the warnings are printed in any case)."""
     if not all(hasattr(scene, a) for a in ("has", "effects", "output")):
         raise InputError("scene", scene, "a validated scene: multiscale.scene.load(path) or loads(text)")
     kind = workflow(scene)
@@ -77,7 +77,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         result.files += [result.folder / name for name in outputs.PROVENANCE]
         return result
     beyond = run_warnings(scene, getattr(result, "history", None)) + list(getattr(result, "warnings", ()))
-    for line in beyond if comm.rank == 0 and verbose else ():
+    for line in beyond if comm.rank == 0 else ():           # what the results leave out: also when quiet
         print(f"warning: {line}", file=sys.stderr, flush=True)
 
     def write():
