@@ -310,17 +310,17 @@ class Vehicle:
 class Loading:
     """Normal load (force or pressure on the load faces), sliding speed, friction, duty cycle.
 
-    The load acts on ``faces``: on a geometry file's a pressure normal to each face, -p n (a force is
-    spread as a uniform pressure whose resultants on the faces sum to it; a curved face counts with
-    its projected area); with ``direction`` a traction along it whose resultant is the force, or the
-    pressure itself. ``normal_force`` is the total over all the load faces: two faces of equal areas
-    given 4000 N take 2000 N each (give the clamp force times the number of faces, or ``pressure``),
-    scaled in time by ``load_profile`` (factor, 0 = released: no contact, no frictional heat). The
-    speed of the rotating body: ``rotation_speed``, a ``speed_profile`` against time, or a
-    ``vehicle`` stop or drag; a translating body slides at ``sliding_speed``. Friction: a
-    constant ``friction``, or (squeal analysis only) mu against the slip speed: a table
-    ``friction_curve`` or a ``stribeck`` law, taken per interface facet at its steady slip speed;
-    its slope enters the modal analysis as damping."""
+    The load acts on ``faces``: on a geometry file's a pressure normal to each face, -p n (a force is spread as
+    a uniform pressure whose resultants on the faces sum to it; a curved face counts with its projected area);
+    with ``direction`` a traction along it whose resultant is the force, or the pressure itself.
+    ``normal_force`` is the total over all the load faces: two faces of equal areas given 4000 N take 2000 N
+    each (give the clamp force times the number of faces, or ``pressure``, which acts on the whole face: a brake
+    line's pressure on a backplate's back is not the piston's force, line pressure x piston area: give that as
+    the force per face), scaled in time by ``load_profile`` (factor, 0 = released: no contact, no frictional
+    heat). The speed of the rotating body: ``rotation_speed``, a ``speed_profile`` against time, or a
+    ``vehicle`` stop or drag; a translating body slides at ``sliding_speed``. Friction: a constant ``friction``,
+    or (squeal analysis only) mu against the slip speed: a table ``friction_curve`` or a ``stribeck`` law, taken
+    per interface facet at its steady slip speed; its slope enters the modal analysis as damping."""
 
     normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)),                 # N
                                      absent="pressure or vehicle.mass gives the load")
