@@ -5,7 +5,10 @@ record of the run (versions, command line, ranks, start and end, wall time per s
 value (defaults filled in, SI numbers, the unit as a comment; temperatures as "... K" strings,
 since the scene format refuses bare temperatures): loading it gives the same scene. ``versions()``
 lists the software of the process (DOLFINx, PETSc and SLEPc when they are loaded). ``write`` puts
-``scene.toml``, ``scene_resolved.toml`` and ``provenance.json`` into a folder (rank 0).
+``scene.toml``, ``scene_resolved.toml`` and ``provenance.json`` into a folder (rank 0). A run
+stopped and resumed (``--resume``) is recorded part by part: ``parts`` lists each part's command,
+ranks, start, end, status and stage wall times, and the record's stage and total wall times are
+their sums (``parts_of`` reads the parts recorded before).
 """
 from __future__ import annotations
 
@@ -190,29 +193,66 @@ def now() -> str:
 
 def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict, wall_time: float,
           status: str = "finished", command: list[str] | None = None, analysis: str = "",
-          warnings: list[str] = ()) -> list[Path]:
+          warnings: list[str] = (), earlier: list[dict] = ()) -> list[Path]:
     """``scene.toml`` (the file as given; the resolved scene when it came from text),
     ``scene_resolved.toml`` and ``provenance.json`` in ``folder``; call on rank 0. The record names
     the overrides given over the scene file (``scene.load``: a study's point), and lists
     every entry the run writes (``multiscale.outputs.plan``), so that ``results_of`` knows them
     when the folder is overwritten; ``warnings``: the scene's and the run's (e.g. temperatures
-    beyond a material table); status ``RUNNING`` (written as the run begins) has no end time."""
+    beyond a material table); status ``RUNNING`` (written as the run begins) has no end time.
+    ``earlier``: the parts of the run before this one (a resumed run: ``parts_of`` the folder
+    before it wrote); the record's ``parts`` are those and this one, its ``start`` the first
+    part's, its ``command``, ``ranks``, ``end`` and ``status`` this part's, its stage and total
+    wall times [s] the sums over the parts."""
     folder = Path(folder)
     given = scene.source.read_text(encoding="utf-8") if scene.source and scene.source.is_file() else \
         "# The scene came from text, not a file: here it is as resolved.\n" + resolved_toml(scene)
+    part = {"status": status, "command": list(sys.argv if command is None else command), "ranks": ranks,
+            "start": started, "end": None if status == RUNNING else now(),
+            "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()}, "total_wall_time_s": round(wall_time, 3)}
+    parts = [*earlier, part]
+    total: dict[str, float] = {}
+    for p in parts:
+        for k, v in p["stage_wall_time_s"].items():
+            total[k] = total.get(k, 0.0) + v
     record = {"status": status, "analysis": analysis, "scene": str(scene.source or scene.name),
-              "overrides": {k: v for k, v in scene.overrides},
-              "command": list(sys.argv if command is None else command), "ranks": ranks,
-              "start": started, "end": None if status == RUNNING else now(),
-              "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()},
-              "total_wall_time_s": round(wall_time, 3), "versions": versions(), "files": sorted(plan(scene).files),
-              "warnings": list(warnings)}
+              "overrides": {k: v for k, v in scene.overrides}, "command": part["command"], "ranks": ranks,
+              "start": parts[0]["start"], "end": part["end"],
+              "stage_wall_time_s": {k: round(v, 3) for k, v in total.items()},
+              "total_wall_time_s": round(sum(p["total_wall_time_s"] for p in parts), 3), "parts": parts,
+              "versions": versions(), "files": sorted(plan(scene).files), "warnings": list(warnings)}
     texts = {"scene.toml": given, "scene_resolved.toml": resolved_toml(scene),
              "provenance.json": json.dumps(record, indent=2, default=str) + "\n"}
     for name, text in texts.items():              # each replaced whole: a killed run leaves the earlier one
         with replacing(folder / name) as part:
             part.write_text(text, encoding="utf-8")
     return [folder / name for name in texts]
+
+
+PART = ("status", "command", "ranks", "start", "end", "stage_wall_time_s", "total_wall_time_s")   # a part's keys
+
+
+def parts_of(folder: Path) -> list[dict]:
+    """The parts of the run recorded in ``folder``'s ``provenance.json`` (``write``), for the record
+    of a run that resumes it; a record written before parts were kept is one part; empty when there
+    is no readable record."""
+    try:
+        record = json.loads((Path(folder) / "provenance.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return []
+    if not isinstance(record, dict) or "start" not in record:
+        return []
+    parts = record.get("parts") if isinstance(record.get("parts"), list) else [record]
+    return [_part(p) for p in parts if isinstance(p, dict)]
+
+
+def _part(record: dict) -> dict:
+    """A part read back: the keys of ``PART``, its wall times numbers [s] (0 for what is not)."""
+    def seconds(v) -> float:
+        return float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else 0.0
+    stages = record.get("stage_wall_time_s")
+    return {**{k: record.get(k) for k in PART}, "total_wall_time_s": seconds(record.get("total_wall_time_s")),
+            "stage_wall_time_s": {str(k): seconds(v) for k, v in stages.items()} if isinstance(stages, dict) else {}}
 
 
 def entries(n: int) -> str:
@@ -233,4 +273,4 @@ def results_of(folder: Path) -> list[str]:
     return sorted({*names, *(n + ".part" for n in names)} | ({"provenance.json"} if names else set()))
 
 
-__all__ = ["RUNNING", "now", "resolved_toml", "results_of", "versions", "write"]
+__all__ = ["RUNNING", "now", "parts_of", "resolved_toml", "results_of", "versions", "write"]

@@ -154,6 +154,10 @@ def test_killed_mid_run_and_resumed_writes_the_uninterrupted_results(base, tmp_p
                              capture_output=True, text=True, timeout=300, start_new_session=True)
     assert resumed.returncode == 0, resumed.stderr
     assert "HDF5" not in resumed.stderr + resumed.stdout
+    # the killed part stays in the record, as it was recorded when it began (before: the resumed part only)
+    parts = json.loads((folder / "provenance.json").read_text())["parts"]
+    assert [p["status"] for p in parts] == [record["status"], "resumed and finished"]
+    assert parts[0] == record["parts"][0] and parts[0]["end"] is None and parts[1]["ranks"] == ranks
     # 2 ranks: MUMPS' parallel factorisation is not bitwise repeatable (two perfect-contact 2-rank
     # runs differ by ~4e-15), and the rough loop's discrete decisions (an iteration more or less near
     # a tolerance) amplify that: 4 uninterrupted 2-rank runs of this scene agreed to 8.6e-7 (heat
@@ -235,7 +239,9 @@ def test_a_resumed_run_says_the_heat_warnings_of_the_whole_run_once(tmp_path, mo
     the one of step 1, as the run straight through does, once, in its warnings and its provenance;
     the stopped run's provenance says it too. The pin radiates (a Newton heat step), and its full
     Newton steps are said to fail at steps 1 and 3. Before: the resumed run lost step 1's note and
-    said step 3's as the first ("t = 1.8 s"); the stopped run's provenance said nothing."""
+    said step 3's as the first ("t = 1.8 s"); the stopped run's provenance said nothing.
+    The resumed run's provenance keeps the stopped part (command, ranks, start, end, status, its
+    stages: the zone laws) beside its own, and its times are the sums (before: the resumed part's only)."""
     from multiscale import io, workflows
     from multiscale.macro import thermal
     radiating = '[[boundary]]\nsurfaces = ["free:pin"]\nemissivity = 0.5\nambient = "20 degC"\n[output]'
@@ -256,10 +262,21 @@ def test_a_resumed_run_says_the_heat_warnings_of_the_whole_run_once(tmp_path, mo
                 m.setattr(io.StepStop, "requested", lambda self: next(asked))
                 with pytest.raises(KeyboardInterrupt, match="after step 2 of 4"):
                     workflows.run(scene, verbose=False)
-            said["interrupted"] = json.loads((folder / "provenance.json").read_text())["warnings"]
+            stopped = json.loads((folder / "provenance.json").read_text())
+            said["interrupted"] = stopped["warnings"]
         result = workflows.run(scene, resume=how == "stopped", verbose=False)
-        said[how] = ([w for w in result.warnings if "too long for full Newton steps" in w],
-                     json.loads((folder / "provenance.json").read_text())["warnings"])
+        record = json.loads((folder / "provenance.json").read_text())
+        said[how] = ([w for w in result.warnings if "too long for full Newton steps" in w], record["warnings"])
+    first, last = record["parts"]
+    assert first == stopped["parts"][0] and first["status"] == "interrupted after step 2 of 4"
+    assert "zone laws and first solve" in first["stage_wall_time_s"] and first["end"] is not None
+    assert last["status"] == record["status"] == "resumed and finished" and last["ranks"] == record["ranks"] == 1
+    assert "restoring the checkpoint" in last["stage_wall_time_s"] and (record["start"], record["end"]) == (
+        first["start"], last["end"])
+    assert record["total_wall_time_s"] == pytest.approx(first["total_wall_time_s"] + last["total_wall_time_s"],
+                                                        abs=2e-3)
+    for stage, seconds in record["stage_wall_time_s"].items():
+        assert seconds == pytest.approx(sum(p["stage_wall_time_s"].get(stage, 0.0) for p in (first, last)), abs=2e-3)
     notes, provenance = said["straight"]
     assert len(notes) == 1 and notes[0].startswith("the heat step to t = 0.6 s was too long") and notes[0] in provenance
     assert said["stopped"] == said["straight"]

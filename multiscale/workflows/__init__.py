@@ -49,6 +49,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                "writes checkpoints)")
         raise InputError("--resume", None, why)
     ended = resume and checkpoint.peek(Path(scene.output.folder) / multiscale.CHECKPOINT, comm).get("finished")
+    # the parts of the run before this one (rank 0 writes the record): resumed, they stay in it
+    earlier = provenance.parts_of(Path(scene.output.folder)) if resume and comm.rank == 0 else []
     started, start = provenance.now(), time.perf_counter()
     with io.Reporter(comm, quiet=not verbose) as reporter:
         try:
@@ -63,7 +65,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                 provenance.write(reporter.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
                                  wall_time=time.perf_counter() - start, analysis=kind,
                                  status=f"interrupted {exc}".strip() if stopped else
-                                 f"failed: {type(exc).__name__}: {exc}",
+                                 f"failed: {type(exc).__name__}: {exc}", earlier=earlier,
                                  warnings=[*scene.warnings, *(exc.warnings if isinstance(exc, Interrupted) else ())])
                 if isinstance(exc, Interrupted):          # stopped after a step: its results are written
                     _write_script(reporter.folder, scene)
@@ -83,7 +85,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     def write():
         files = provenance.write(result.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
                                  wall_time=time.perf_counter() - start, analysis=kind,
-                                 status="resumed and finished" if resume else "finished",
+                                 status="resumed and finished" if resume else "finished", earlier=earlier,
                                  warnings=[*scene.warnings, *beyond])
         return files + [_write_script(result.folder, scene)]
     result.files += comm.bcast(io.on_root(comm, write, f"the provenance into {result.folder}"), root=0)
