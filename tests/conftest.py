@@ -55,3 +55,15 @@ def free_communicators():
             comm.Free()
         return len(made)
     return count
+
+
+@pytest.fixture(scope="session")
+def documented():
+    """``documented(name)``: whether docs/results.rst names a results file's column or dataset
+    ``name`` as a literal, ``<body>``, ``<name>``, ``<material>`` standing for any name."""
+    import re
+    from pathlib import Path
+    doc = (Path(__file__).resolve().parents[1] / "docs" / "results.rst").read_text()
+    literals = [re.sub(r"<(body|name|material)>", "[A-Za-z0-9_.-]+", re.escape(literal))
+                for literal in re.findall(r"``([^`]+)``", doc) if not re.fullmatch(r"<\w+>", literal)]
+    return lambda name: any(re.fullmatch(literal, name) for literal in literals)

@@ -253,3 +253,102 @@ def test_map_bisects_the_onset_of_a_lock_in_branch_that_fails_the_mac_test(tmp_p
     assert np.isnan(smap.onsets[0].value) and "below the sweep" in smap.summary()
     rows = smap.write_onsets_csv(tmp_path / "onsets.csv").read_text().splitlines()
     assert rows[1].split(",")[1] == "" and rows[1].split(",")[-1] == "0.6"
+
+
+def check_map_files(folder, smap, documented) -> None:
+    """``map.csv``, ``onsets.csv`` and ``map.h5`` in ``folder`` hold the numbers of ``smap`` (the csv
+    rounded as written), every column, dataset and attribute is in docs/results.rst, every dataset
+    has a unit, and each onset lies in its bracket, the bracket between the two points around it
+    where the track was stable (or absent) and unstable."""
+    import csv
+
+    import h5py
+    names = []
+    with h5py.File(folder / "map.h5", "r") as f:
+        names += list(f.attrs)
+        f.visititems(lambda name, obj: names.append(name.split("/")[-1]) if isinstance(obj, h5py.Dataset) else None)
+        f.visititems(lambda name, obj: assert_unit(name, obj) if isinstance(obj, h5py.Dataset) else None)
+        assert (f.attrs["parameter"], f.attrs["unit"], f.attrs["rtol"]) == (smap.parameter, smap.unit, smap.rtol)
+        for name in ("values", "frequency", "growth", "mode", "mac", "residual"):
+            np.testing.assert_array_equal(f[name][...], getattr(smap, name), err_msg=name)
+        h5_onsets = {name: f["onsets"][name][...] for name in f["onsets"]}
+    with open(folder / "map.csv", newline="") as f:
+        rows = list(csv.reader(f))
+    names += rows[0]
+    column = f"{smap.parameter}_{smap.unit}"
+    bad = smap.unstable()
+    assert len(rows) - 1 == int((smap.mode >= 0).sum())
+    for row in (dict(zip(rows[0], r)) for r in rows[1:]):
+        k, t = int(row["point"]) - 1, int(row["track"]) - 1
+        assert float(row[column]) == float(f"{smap.values[k]:.8g}") and int(row["mode"]) == smap.mode[k, t]
+        assert float(row["frequency_Hz"]) == pytest.approx(smap.frequency[k, t], abs=5e-7)
+        assert float(row["sigma_1_per_s"]) == pytest.approx(smap.growth[k, t], rel=5e-7, abs=1e-300)
+        assert int(row["unstable"]) == bad[k, t]
+        assert row["mac_previous"] == "" if np.isnan(smap.mac[k, t]) else \
+            float(row["mac_previous"]) == pytest.approx(smap.mac[k, t], abs=5e-5)
+    with open(folder / "onsets.csv", newline="") as f:
+        rows = list(csv.reader(f))
+    names += rows[0]
+    assert len(rows) - 1 == len(smap.onsets) == h5_onsets["track"].size
+    for j, (o, row) in enumerate(zip(smap.onsets, (dict(zip(rows[0], r)) for r in rows[1:]))):
+        lo, hi = o.bracket
+        assert (int(row["track"]), row["kind"], row["partner_track"]) == (o.track, o.kind, str(o.partner or ""))
+        assert float(row["frequency_Hz"]) == pytest.approx(o.frequency, abs=5e-7)
+        for key, v in ((f"onset_{column}", o.value), ("stable_value", lo), ("unstable_value", hi)):
+            assert row[key] == ("" if np.isnan(v) else f"{v:.8g}")
+        h5_row = {name: h5_onsets[name][j] for name in h5_onsets}
+        assert h5_row["kind"].decode() == o.kind and h5_row["partner"] == (o.partner or -1)
+        np.testing.assert_array_equal([h5_row[n] for n in ("track", "value", "frequency", "stable_value",
+                                                           "unstable_value")], [o.track, o.value, o.frequency, lo, hi])
+        if np.isfinite(o.value):
+            k = int(np.searchsorted(smap.values, o.value))         # values[k - 1] < onset <= values[k]
+            assert smap.values[k - 1] <= lo <= o.value <= hi <= smap.values[k]
+            assert bad[k, o.track - 1] and not bad[k - 1, o.track - 1]
+        else:
+            assert hi == smap.values[0] and bad[0, o.track - 1]
+    assert [n for n in names if not documented(n)] == []
+
+
+def assert_unit(name, dataset) -> None:
+    assert "unit" in dataset.attrs, f"map.h5: {name} has no unit"
+
+
+def test_the_map_files_hold_the_map_and_say_it_in_documented_terms(tmp_path, documented):
+    """map.csv, onsets.csv and map.h5 of the Hoffmann map agree with each other and the map (before:
+    map.h5 held no onset bracket, which onsets.csv gives, and no unit for the onsets' track,
+    partner and kind; none of the three files was documented)."""
+    values = np.linspace(0.0, 1.0, 6)
+    results, reduced = hoffmann_points(values)
+    smap = build_map("friction", "-", values, results, reduced, (0.0, 1.0))
+    smap.write_csv(tmp_path / "map.csv"), smap.write_onsets_csv(tmp_path / "onsets.csv")
+    smap.write_h5(tmp_path / "map.h5")
+    check_map_files(tmp_path, smap, documented)
+    below = build_map("friction", "-", values[3:], results[3:], reduced[3:], (0.0, 1.0))    # onset below the sweep
+    below.write_csv(tmp_path / "map.csv"), below.write_onsets_csv(tmp_path / "onsets.csv")
+    below.write_h5(tmp_path / "map.h5")
+    check_map_files(tmp_path, below, documented)
+
+
+def test_a_track_of_one_point_is_seen_in_the_tracks_figure(tmp_path, monkeypatch):
+    """map_tracks.png drew each track as a line through its points: an unstable track present at one
+    point only (a branch that fails the MAC test at every point) was named in the legend and not
+    drawn (found on the 20-mm brake's friction map, tracks 31 and 37). Every point has a marker now."""
+    from multiscale.plots import squeal as plots
+    drawn = []
+
+    class Kept(plots.Figure):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            drawn.append(self)
+    monkeypatch.setattr(plots, "Figure", Kept)
+    values = np.linspace(0.0, 1.0, 6)
+    results, reduced = hoffmann_points(values)
+    smap = build_map("friction", "-", values, results, reduced, (0.0, 1.0), mac_min=0.999)
+    alone = [t for t in range(smap.n_tracks) if smap.unstable()[:, t].any() and (smap.mode[:, t] >= 0).sum() == 1]
+    assert alone
+    plots.plot_tracks(smap, tmp_path / "map_tracks.png")
+    for axis in drawn[0].axes:
+        lines = [line for line in axis.get_lines() if np.size(line.get_xdata()) == values.size]    # the tracks
+        assert len(lines) == smap.n_tracks
+        for t in alone:
+            assert lines[t].get_marker() not in (None, "None", "", " "), f"track {t + 1}"

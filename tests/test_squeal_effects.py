@@ -1,5 +1,6 @@
 """Squeal-analysis options on finite-element models (issue 20): prestress (pre-tensioned beam),
 gyroscopic terms (spinning disc), per-material damping, friction-slope damping, scene sweeps."""
+import csv
 from pathlib import Path
 from types import SimpleNamespace as NS
 
@@ -27,6 +28,7 @@ from multiscale.macro.operators import geometric_form, rotation_forms, rotation_
 from multiscale.macro.preload import linearise, preload  # noqa: E402
 from multiscale.references.stability import spinning_disc_split, tensioned_beam_frequency  # noqa: E402
 from multiscale.workflows import squeal  # noqa: E402
+from test_squeal_damping import check_map_files  # noqa: E402
 
 DEMO = Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml"
 STEEL = NS(E=210e9, nu=0.3, rho=7850.0)
@@ -161,7 +163,7 @@ def test_friction_slope_damping_of_a_rigid_disc_rotation(brake):
 
 
 # ---------------------------------------------------------------- scene options and sweeps
-def test_scene_friction_sweep_writes_the_map(tmp_path):
+def test_scene_friction_sweep_writes_the_map(tmp_path, documented):
     overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 30, "output.folder": str(tmp_path / "out"),
                  "stability.sweep.friction": [0.0, 0.6], "stability.sweep.points": 4}
     scene = scenes.load(DEMO, overrides)
@@ -180,6 +182,7 @@ def test_scene_friction_sweep_writes_the_map(tmp_path):
     # mu = 0.4 in the map against the nominal analysis (same preload, projected)
     f_map = np.sort(smap.frequency[2][~np.isnan(smap.frequency[2])])
     assert f_map[:8] == pytest.approx(run.case.modes.frequency[:8], rel=1e-4)    # measured 8e-6
+    check_map_files(tmp_path / "out", smap, documented)      # the files hold the map, its onsets in their brackets
 
 
 def test_a_mode_count_never_cuts_a_lock_in_pair_in_two(tmp_path):
@@ -282,7 +285,6 @@ def test_the_instability_threshold_is_the_users(tmp_path):
     brake's lock-in mode (mu = 0.4, 20 mm mesh, P2) grows at a damping ratio of -3.4e-3: unstable
     by the default 1e-6, not by 1e-2, in the report, modes.csv and a map alike (before: 1e-6,
     fixed, which flagged modes at damping ratios of -6e-6 that industrial practice leaves out)."""
-    import csv
     overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 8, "stability.band": ["0 Hz", "3 kHz"],
                  "output.folder": str(tmp_path / "out"), "stability.threshold": 1e-2,
                  "stability.sweep.friction": [0.35, 0.4]}
@@ -313,7 +315,7 @@ def test_a_pressure_sweep_that_changes_nothing_is_warned_about(tmp_path):
         assert not any("depends on the pressure" in w for w in scenes.load(DEMO, {**sweep, **other}).warnings)
 
 
-def test_scene_damping_and_stribeck_options(tmp_path):
+def test_scene_damping_and_stribeck_options(tmp_path, documented):
     overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 10, "output.folder": str(tmp_path / "out"),
                  "stability.rayleigh_alpha": "20 1/s", "stability.prestress": True,
                  "materials.pad.loss_factor": 0.05}
@@ -323,6 +325,18 @@ def test_scene_damping_and_stribeck_options(tmp_path):
     assert (tmp_path / "out" / "prestress.csv").exists()
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(set(plan(scene).files) - {"paraview.py"})
     assert np.all(np.abs(run.case.prestress.shift) < 0.01 * run.case.prestress.frequency)
+    with open(tmp_path / "out" / "prestress.csv", newline="") as f:
+        table = list(csv.DictReader(f))
+    with open(tmp_path / "out" / "modes.csv", newline="") as f:
+        modes = list(csv.DictReader(f))
+    assert not [n for n in table[0] if not documented(n)]
+    effect = run.case.prestress
+    assert [r["frequency_Hz"] for r in table] == [r["frequency_Hz"] for r in modes]    # one row per mode
+    for name, column, rtol, atol in (("frequency_without", "frequency_without_prestress_Hz", 0, 5e-7),
+                                     ("shift", "shift_Hz", 0, 5e-7), ("mac", "mac", 0, 5e-5),
+                                     ("growth_without", "sigma_without_prestress_1_per_s", 5e-7, 1e-300)):
+        np.testing.assert_allclose([float(r[column]) for r in table], getattr(effect, name), rtol=rtol, atol=atol,
+                                   err_msg=column)            # as written: 6 decimals, 4 for the MAC, 7 digits
     with pytest.raises(InputError, match="quadratic"):
         scenes.load(DEMO, dict(overrides, **{"stability.method": "quadratic"}))
 

@@ -147,14 +147,17 @@ class StabilityMap:
             for name, unit in units.items():          # a unit per dataset, as in history.h5
                 f[name] = getattr(self, name)
                 f[name].attrs["unit"] = unit
-            g = f.create_group("onsets")
-            g["track"] = np.array([o.track for o in self.onsets], int)
-            g["value"] = np.array([o.value for o in self.onsets], float)
-            g["value"].attrs["unit"] = self.unit
-            g["frequency"] = np.array([o.frequency for o in self.onsets], float)
-            g["frequency"].attrs["unit"] = "Hz"
-            g["partner"] = np.array([-1 if o.partner is None else o.partner for o in self.onsets], int)
-            g["kind"] = np.array([o.kind for o in self.onsets], dtype=h5py.string_dtype())
+            g = f.create_group("onsets")         # the columns of onsets.csv
+            onsets = {"track": (np.array([o.track for o in self.onsets], int), "-"),
+                      "value": (np.array([o.value for o in self.onsets], float), self.unit),
+                      "frequency": (np.array([o.frequency for o in self.onsets], float), "Hz"),
+                      "partner": (np.array([-1 if o.partner is None else o.partner for o in self.onsets], int), "-"),
+                      "kind": (np.array([o.kind for o in self.onsets], dtype=h5py.string_dtype()), "-"),
+                      "stable_value": (np.array([o.bracket[0] for o in self.onsets], float), self.unit),
+                      "unstable_value": (np.array([o.bracket[1] for o in self.onsets], float), self.unit)}
+            for name, (data, unit) in onsets.items():
+                g[name] = data
+                g[name].attrs["unit"] = unit
         return path
 
 

@@ -143,10 +143,10 @@ def plot_tracks(smap, path) -> Path:
     fig = Figure(figsize=(8, 7))
     a, b = fig.subplots(2, 1, sharex=True)
     bad = smap.unstable().any(axis=0)
-    for t in range(smap.n_tracks):
-        style = dict(lw=1.2, label=f"track {t + 1}") if bad[t] else dict(color="0.75", lw=0.6)
-        line = a.plot(smap.values, smap.frequency[:, t], **style)[0]
-        b.plot(smap.values, smap.growth[:, t], color=line.get_color(), lw=style["lw"])
+    for t in range(smap.n_tracks):       # a marker at each point: a track of one point is seen too
+        style = dict(lw=1.2, marker=".", ms=5) if bad[t] else dict(color="0.75", lw=0.6, marker=".", ms=2)
+        line = a.plot(smap.values, smap.frequency[:, t], label=f"track {t + 1}" if bad[t] else None, **style)[0]
+        b.plot(smap.values, smap.growth[:, t], **dict(style, color=line.get_color()))
     for o in smap.onsets:
         a.plot(o.value, o.frequency, "kx", ms=6)
         b.plot(o.value, 0.0, "kx", ms=6)
