@@ -385,6 +385,26 @@ def test_a_released_rough_contact_has_no_flash_temperature(tmp_path):
     fields = body_fields(tmp_path / "released" / "pin.xdmf")     # expansion: the unloaded, heated pin
     _, u, s = fields[-1]
     assert np.isfinite(u).all() and np.isfinite(s).all() and 0 < s.max() < 0.1 * fields[1][2].max()
+    # the rest of what docs/results.rst says of a released state: nothing in contact, heated or
+    # conducted (the last step is released throughout), no zone flash temperature in zones.h5 either
+    # (the final state), and on the interface no pressure, stiffness or heat flux, the flash
+    # temperature field the rough pin's surface temperature
+    import h5py
+    import meshio
+    for column in ("friction_force", "friction_moment", "max_pressure", "max_zone_pressure", "micro_max_pressure",
+                   "zones_in_contact", "real_contact_area"):
+        assert np.all(h[column][off] == 0.0) and np.all(np.abs(h[column][~off]) > 0.0), column
+    assert h["heat_step_pin"][-1] == h["heat_step_disc"][-1] == h["heat_exchanged_step"][-1] == 0.0
+    with h5py.File(tmp_path / "released" / "zones.h5", "r") as f:
+        assert np.isnan(f["flash_temperature"][...]).all()
+    with meshio.xdmf.TimeSeriesReader(str(tmp_path / "released" / "interface.xdmf")) as reader:
+        reader.read_points_cells()
+        steps = [reader.read_data(k) for k in range(reader.num_steps)]
+    assert [t for t, _, _ in steps] == [0.0, 0.6, 1.2, 1.8]
+    for (t, _, cells), hot, cold in zip(steps[2:], h["max_temperature_pin"][off], h["min_temperature_pin"][off]):
+        for name in ("contact pressure [Pa]", "contact stiffness [Pa/m]", "frictional heat flux [W/m^2]"):
+            assert np.all(cells[name][0] == 0.0), (t, name)
+        assert np.all((cold <= cells["flash temperature [K]"][0]) & (cells["flash temperature [K]"][0] <= hot)), t
 
 
 def test_a_step_ending_at_a_standstill_wears_with_the_sliding_pressure(tmp_path):
