@@ -17,6 +17,7 @@ from multiscale.micro.laws import LawSpec
 from multiscale.micro.layered_asperity import LayeredAsperity, layered_law
 from multiscale.micro.plasticity import Hardness
 from multiscale.micro.post_analysis import Heating, PostAnalysis
+from multiscale.micro.spectrum import fit_power_law, power_spectrum, surface_statistics
 from multiscale.micro.surface import Surface, find_asperities, fractal_surface, load_surface, statistics
 from multiscale.micro.wear import simulate_wear, wear_step
 from multiscale.micro.zones import cut_zones, generate_zones
@@ -97,6 +98,9 @@ CASES = [
     (run, dict(interface="thin"), "interface"),
     (steady, dict(body1=1.0), "body1"),
     (steady, dict(angle="x"), "angle"),
+    (run, dict(remote_temperatures=(300.0, 310.0, 320.0)), "remote_temperatures"),
+    (run, dict(remote_temperatures=300.0), "remote_temperatures"),
+    (run, dict(remote_temperatures=("300", "310")), "remote_temperatures"),
     (steady_solve, dict(remote_temperatures=(0.0,)), "remote_temperatures"),
     (steady_solve, dict(max_iter=10.5), "max_iter"),
     (steady_solve, dict(partial=None), "partial"),
@@ -137,6 +141,17 @@ CASES = [
     (lambda **k: Surface(**{**dict(heights=S.heights, dx=S.dx, dy=S.dy), **k}), dict(heights="x"), "heights"),
     (lambda **k: Surface(**{**dict(heights=S.heights, dx=S.dx, dy=S.dy), **k}), dict(periodic="no"), "periodic"),
     (lambda **k: statistics(**k), dict(surface=np.zeros((8, 8))), "surface"),
+    (lambda **k: power_spectrum(**{"surface": S, **k}), dict(points_per_decade="10"), "points_per_decade"),
+    (lambda **k: power_spectrum(**{"surface": S, **k}), dict(points_per_decade=np.nan), "points_per_decade"),
+    (lambda **k: power_spectrum(**{"surface": S, **k}), dict(surface=S.heights), "surface"),
+    (lambda **k: power_spectrum(**{"surface": S, **k}), dict(surface=Surface(np.stack([S.heights] * 2), S.dx, S.dy)),
+     "surface"),
+    (lambda **k: power_spectrum(**{"surface": S, **k}), dict(edges="x"), "edges"),
+    (lambda **k: power_spectrum(**{"surface": S, **k}), dict(edges=[1e5, 1e4, 1e6]), "edges"),
+    (lambda **k: surface_statistics(**k), dict(surface=S.heights), "surface"),
+    (lambda **k: fit_power_law(**{"spectrum": power_spectrum(S), **k}), dict(spectrum=np.ones(8)), "spectrum"),
+    (lambda **k: fit_power_law(**{"spectrum": power_spectrum(S), **k}), dict(step=0), "step"),
+    (lambda **k: fit_power_law(**{"spectrum": power_spectrum(S), **k}), dict(full_weight=0), "full_weight"),
     (lambda **k: find_asperities(**k), dict(surface=None), "surface"),
     (lambda **k: fractal_surface(**{**dict(n=16, size=1e-3, hurst=0.8, k_min=2, k_max=4, rms=1e-6), **k}),
      dict(hurst="0.8"), "hurst"),
@@ -148,6 +163,11 @@ CASES = [
      "substrate_nu"),
     (lambda **k: LayeredThermal(**{**dict(thickness=(1e-6,), kappa=(1.0,)), **k}), dict(substrate_kappa=None),
      "substrate_kappa"),
+    (lambda **k: LayeredElastic.graded(**{**dict(E=1e9, nu=0.3, depth=1e-5, n_layers=2), **k}), dict(n_layers=np.inf),
+     "n_layers"),
+    (lambda **k: LayeredElastic.graded(**{**dict(E=1e9, nu=0.3, depth=1e-5, n_layers=2), **k}), dict(n_layers=None),
+     "n_layers"),
+    (lambda **k: LayeredElastic.graded(**{**dict(E=1e9, nu=0.3, depth=1e-5, n_layers=2), **k}), dict(nu="0.3"), "nu"),
     (lambda **k: cut_zones(**{**dict(surface=S, counts=(2, 2)), **k}), dict(counts=(2, 2.5)), "counts"),
     (lambda **k: cut_zones(**{**dict(surface=S, counts=(2, 2)), **k}), dict(origin=np.nan), "origin"),
     (lambda **k: generate_zones(**{**dict(grid=cut_zones(S, (2, 2))[0], n=8, hurst=0.8, k_min=1, k_max=3,

@@ -247,6 +247,14 @@ def _check_iteration(tol, max_iter, partial):
     return check_count("max_iter", max_iter)
 
 
+def _remote_temperatures(value) -> tuple[float, float]:
+    """(theta_1^0, theta_2^0) [K] of both heating solvers: two finite numbers, else InputError."""
+    th = check_field("remote_temperatures", value)
+    if th.shape != (2,):
+        raise InputError("remote_temperatures", value, "two finite temperatures [K]")
+    return float(th[0]), float(th[1])
+
+
 def _partition(part, total):
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(total != 0, part / np.where(total != 0, total, 1.0), np.nan)
@@ -317,9 +325,7 @@ class TransientHeating:
         """
         p = _check_pressure(pressure, self.shape)
         mu = check_positive("mu", mu)
-        th1, th2 = (float(v) for v in remote_temperatures)
-        if not (np.isfinite(th1) and np.isfinite(th2)):
-            raise InputError("remote_temperatures", remote_temperatures, "two finite temperatures [K]")
+        th1, th2 = _remote_temperatures(remote_temperatures)
         n_steps = self.n_steps if n_steps is None else check_count("n_steps", n_steps)
         if not n_steps <= self.n_steps:
             raise InputError("n_steps", n_steps, f"between 1 and the tabulated {self.n_steps}")
@@ -429,10 +435,7 @@ class SteadyHeating:
         """
         p = _check_pressure(pressure, self.shape)
         mu = check_positive("mu", mu)
-        th = check_field("remote_temperatures", remote_temperatures)
-        if th.shape != (2,):
-            raise InputError("remote_temperatures", remote_temperatures, "two finite temperatures [K]")
-        th1, th2 = th
+        th1, th2 = _remote_temperatures(remote_temperatures)
         max_iter = _check_iteration(tol, max_iter, partial)
         layer = _Layer(interface, np.inf, p.shape)
         mask = p > 0

@@ -33,7 +33,7 @@ import numpy as np
 from scipy.interpolate import CubicSpline
 from scipy.special import j0, j1
 
-from multiscale.errors import InputError, check_field, check_positive, check_real
+from multiscale.errors import InputError, check_count, check_field, check_positive, check_real
 from multiscale.micro.kernels import Kernel, poisson_ratio, wrap_offsets
 from multiscale.references.love import love_rectangle
 
@@ -417,7 +417,8 @@ class LayeredElastic(LayeredKernel):
         discretised into ``n_layers`` (``layer_boundaries``): E_i is the harmonic mean of E
         over the layer (exact static oedometric compliance when nu is constant), nu_i the mean."""
         h, z = layer_boundaries(depth, n_layers, growth)
-        return cls(h, layer_means(E, z, harmonic=True), layer_means(nu, z), substrate_E, substrate_nu)
+        return cls(h, layer_means(E, z, harmonic=True, name="E"), layer_means(nu, z, name="nu"), substrate_E,
+                   substrate_nu)
 
 
 @dataclass(frozen=True)
@@ -465,30 +466,30 @@ class LayeredThermal(LayeredKernel):
         """Graded conductivity kappa(z) over ``depth`` in ``n_layers``: kappa_i is the harmonic
         mean over the layer, which keeps the 1-D through-thickness resistance exact."""
         h, z = layer_boundaries(depth, n_layers, growth)
-        return cls(h, layer_means(kappa, z, harmonic=True), substrate_kappa)
+        return cls(h, layer_means(kappa, z, harmonic=True, name="kappa"), substrate_kappa)
 
 
 def layer_boundaries(depth: float, n_layers: int, growth: float = 1.0):
     """Thicknesses h_i = h_1 growth^(i-1) summing to ``depth`` (growth > 1 refines near the
     surface) and the n+1 interface depths z [m]."""
     depth = check_positive("depth", depth)
-    if int(n_layers) != n_layers or n_layers < 1:
-        raise InputError("n_layers", n_layers, "must be an integer >= 1")
+    n_layers = check_count("n_layers", n_layers)
     growth = check_positive("growth", growth)
-    h = growth ** np.arange(int(n_layers), dtype=float)
+    h = growth ** np.arange(n_layers, dtype=float)
     h *= depth / h.sum()
     return h, np.concatenate([[0.0], np.cumsum(h)])
 
 
-def layer_means(profile, z, harmonic: bool = False, points: int = 5) -> np.ndarray:
-    """Mean of ``profile(z)`` (callable, vectorised, or a constant) over each interval of ``z``
-    (Gauss-Legendre, ``points`` per layer); harmonic=True gives 1 / mean(1/profile)."""
+def layer_means(profile, z, harmonic: bool = False, points: int = 5, name: str = "profile") -> np.ndarray:
+    """Mean of ``profile(z)`` (callable, vectorised, or a real number) over each interval of ``z``
+    (Gauss-Legendre, ``points`` per layer); harmonic=True gives 1 / mean(1/profile). Errors name
+    the profile ``name``."""
     z = np.asarray(z, dtype=float)
     if not callable(profile):
-        return np.full(z.size - 1, float(profile))
+        return np.full(z.size - 1, check_real(name, profile))
     x, w = np.polynomial.legendre.leggauss(points)
     zz = (z[:-1, None] + z[1:, None]) / 2 + (z[1:, None] - z[:-1, None]) / 2 * x
     values = np.asarray(profile(zz), dtype=float) * np.ones_like(zz)
     if not np.all(np.isfinite(values)) or (harmonic and np.any(values <= 0)):
-        raise InputError("profile", profile, "must give finite (and > 0 for moduli) values over the depth")
+        raise InputError(name, profile, "must give finite (and > 0 for moduli) values over the depth")
     return 1.0 / (np.dot(1.0 / values, w) / 2) if harmonic else np.dot(values, w) / 2

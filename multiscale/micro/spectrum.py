@@ -26,8 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.fft
 
-from multiscale.errors import InputError, check_positive
-from multiscale.micro.surface import Surface, find_asperities, row_blocks, statistics
+from multiscale.errors import InputError, check_count, check_field, check_instance, check_positive
+from multiscale.micro.surface import Surface, check_surface, find_asperities, row_blocks, statistics
 
 POWER_FLOOR = 1e-24     # modes below this fraction of the largest C carry no power (FFT round-off: ~1e-32)
 HURST_RANGE = (0.0, 1.5)   # the power-law segment of a fit (a flat roll-off is no self-affine range)
@@ -149,9 +149,11 @@ def power_spectrum(surface: Surface, points_per_decade: int = 10, window: str | 
     explicit bin edges [rad/m] instead (e.g. another spectrum's, to compare two surfaces bin by
     bin).
     """
-    if points_per_decade < 2:
-        raise InputError("points_per_decade", points_per_decade, "need at least 2 bins per decade")
-    if window not in (None, "hann"):
+    check_surface(surface)
+    if surface.heights.ndim != 2:
+        raise InputError("surface.heights", surface.heights.shape, "the spectrum of one 2-D patch at a time")
+    points_per_decade = check_count("points_per_decade", points_per_decade, minimum=2)
+    if not (window is None or isinstance(window, str) and window == "hann"):
         raise InputError("window", window, "None (mirror-stitched periodogram) or 'hann'")
     (ny, nx), (dx, dy) = surface.shape, (surface.dx, surface.dy)
     mirrored = not surface.periodic and window is None
@@ -160,7 +162,9 @@ def power_spectrum(surface: Surface, points_per_decade: int = 10, window: str | 
     q_lo, q_hi = 2 * np.pi / max(Px, Py), np.pi / max(dx, dy)
     if edges is None:
         edges = make_grid(q_lo, q_hi, points_per_decade)
-    edges = np.asarray(edges, dtype=float)
+    edges = check_field("edges", edges)
+    if edges.ndim != 1 or edges.size < 2 or np.any(edges <= 0) or np.any(np.diff(edges) <= 0):
+        raise InputError("edges", edges, "bin edges [rad/m]: a 1-D increasing sequence of at least 2 values > 0")
     if mirrored:
         power = scipy.fft.dctn(surface.heights, type=2)       # |h̃| of the double at qx, qy >= 0
         power *= power
@@ -237,6 +241,10 @@ def fit_power_law(spectrum: Spectrum, step: float = 0.02, noise: float = 0.05, f
     data (the true one lies beyond). SurfaceTopography generates self-affine surfaces but fits
     none, hence this fit.
     """
+    check_instance("spectrum", spectrum, Spectrum, "a Spectrum (power_spectrum)")
+    step = check_positive("step", step)
+    noise = check_positive("noise", noise)
+    full_weight = check_count("full_weight", full_weight)
     x, y = np.log(spectrum.q[spectrum.complete]), np.log(spectrum.C[spectrum.complete])
     w = np.minimum(spectrum.modes[spectrum.complete] / full_weight, 1.0)      # few modes: a noisy mean
     n = len(x)
@@ -474,7 +482,7 @@ def _height_moments(surface: Surface) -> tuple[float, float, float, float]:
 
 def surface_statistics(surface: Surface, points_per_decade: int = 10) -> Statistics:
     """``Statistics`` of one patch (complete heights: fill undefined points first)."""
-    if surface.heights.ndim != 2:
+    if check_surface(surface).heights.ndim != 2:
         raise InputError("surface.heights", surface.heights.shape, "statistics of one 2-D patch at a time")
     m0, m3, m4_height, slope2 = _height_moments(surface)
     Sq = float(np.sqrt(m0))
