@@ -210,7 +210,8 @@ def load(path, overrides=None) -> Scene:
     """Read and validate a scene file; raises SceneError listing every problem.
 
     ``overrides`` maps dotted key paths to raw values applied before validation (a study's sweep:
-    ``{"loading.friction": 0.2, "geometry.mesh_size": "6 mm"}``); they are validated like the file."""
+    ``{"loading.friction": 0.2, "geometry.mesh_size": "6 mm"}``); they are validated like the file
+    (numpy scalars and arrays, tuples and paths are read as the TOML values they stand for)."""
     if not isinstance(path, (str, os.PathLike)):
         raise InputError("path", path, "a scene file name (str or Path)")
     path = Path(path)
@@ -233,7 +234,8 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise SceneError(f"{source or 'scene'}: not valid TOML: {exc}") from None
-    for dotted, value in (overrides or {}).items():
+    overrides = {dotted: _toml_value(value) for dotted, value in (overrides or {}).items()}
+    for dotted, value in overrides.items():
         *parents, last = dotted.split(".")
         table = raw
         for part in parents:
@@ -256,7 +258,21 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
         fields=scene.output.fields if scene.output.fields is not None else tuple(
             f for f, needs in OUTPUT_FIELDS.items() if all(e in active for e in needs)))
     return dataclasses.replace(scene, name=name, effects=frozenset(scene.effects), output=output,
-                               source=source, overrides=tuple((overrides or {}).items()), warnings=tuple(warnings))
+                               source=source, overrides=tuple(overrides.items()), warnings=tuple(warnings))
+
+
+def _toml_value(value):
+    """An override as TOML would give it: numpy scalars as Python numbers and bools, arrays and
+    tuples as lists, paths as strings, tables item by item (a loop over ``np.arange(5, 30, 5)``
+    gave "time.steps = np.int64(10): must be an integer >= 1", a tuple (4, 4) for micro.zones the
+    same)."""
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, (np.ndarray, tuple, list)):
+        return [_toml_value(v) for v in value]
+    if isinstance(value, Mapping):
+        return {k: _toml_value(v) for k, v in value.items()}
+    return os.fspath(value) if isinstance(value, os.PathLike) else value
 
 
 def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:

@@ -609,6 +609,16 @@ def test_overrides_are_validated_like_the_file(tmp_path):
         loads(GOOD, tmp_path, overrides={"loading.friction.x": 1})
 
 
+def test_overrides_from_a_python_loop_take_numpy_values_tuples_and_paths(tmp_path):
+    """A sweep written in Python passes numpy scalars (np.arange, np.linspace), tuples and Paths;
+    they are read as the TOML values they stand for (np.int64(6) for time.steps was refused as
+    "must be an integer >= 1", a Path for output.folder as "must be a folder path")."""
+    scene = loads(GOOD, tmp_path, overrides={"time.steps": np.arange(6, 7)[0], "loading.friction": np.float32(0.25),
+                                             "output.folder": tmp_path / "sweep", "output.every": np.int32(2)})
+    assert (scene.time.steps, scene.loading.friction, scene.output.folder) == (6, 0.25, tmp_path / "sweep")
+    assert dict(scene.overrides)["time.steps"] == 6 and type(dict(scene.overrides)["time.steps"]) is int
+
+
 def _paths(table, prefix=""):
     for k, v in table.items():
         path = f"{prefix}{k}"
