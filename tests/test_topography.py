@@ -361,10 +361,14 @@ def test_a_truncated_file_gets_its_readers_diagnosis_and_no_log_of_its_bytes(tmp
     (lambda s, p: resample(s, -4), "n = -4: must be a whole number >= 1"),
     (lambda s, p: condition(Measurement(s.heights, 1e-6, 1e-6, p), max_undefined="0.1"),
      "max_undefined = '0.1': must be a real number"),
+    (lambda s, p: condition(Measurement(s.heights, 1e-6, 1e-6, p), detrend=["plane"]), "detrend = ['plane']: one of"),
+    (lambda s, p: condition(s.heights), "must be a Measurement"),
+    (lambda s, p: read_topography(None), "file: a file name"),
 ])
 def test_bad_arguments_of_the_measured_surface_functions_name_themselves(tmp_path, call, message):
     """Each is one InputError naming the argument (before: numpy's broadcast ValueError, a
-    ZeroDivisionError, a count of 64.7 cut to 64, a grid of (160, 0) cells, a TypeError)."""
+    ZeroDivisionError, a count of 64.7 cut to 64, a grid of (160, 0) cells, a TypeError; for a
+    detrend list, a height array for the Measurement, a None path: TypeError, AttributeError)."""
     s = fractal_surface(64, 64e-6, 0.8, 2, 16, 1e-6, seed=2)
     np.save(tmp_path / "m.npy", s.heights)
     with pytest.raises(InputError) as info:

@@ -30,7 +30,7 @@ from pathlib import Path
 
 import numpy as np
 
-from multiscale.errors import InputError, check_count, check_pair, check_positive, check_real
+from multiscale.errors import InputError, check_count, check_instance, check_pair, check_positive, check_real
 from multiscale.micro.outliers import DESPIKE, find_outliers
 from multiscale.micro.spectrum import as_topography, equivalent_surface, power_spectrum, surface_topography
 from multiscale.micro.surface import Surface, defined_sums, read_matrix, row_blocks
@@ -155,6 +155,8 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
     ``Measurement.notes``); a plain matrix needs ``pixel_size`` (``height_unit`` default 1).
     Errors (``InputError``) name the file and the field ``prefix + "file"``, ``"channel"``, ...
     """
+    if not isinstance(path, (str, Path)):
+        raise InputError(f"{prefix}file", path, "a file name (str or Path)")
     path = Path(path)
     if not path.is_file():
         raise InputError(f"{prefix}file", path.name, f"{'a folder, not a file' if path.is_dir() else 'no such file'} "
@@ -396,7 +398,8 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
     plane, second-order polynomial), ``cutoff`` λc [m] of the Gaussian filter (None: no filter),
     ``despike`` the threshold k of ``outliers.find_outliers`` at which outliers are removed (filled as
     undefined points; None: found at k = ``DESPIKE``, a warning, a ``TopographyWarning`` too)."""
-    if detrend not in DETREND:
+    check_instance("m", m, Measurement, "a Measurement (read_topography)")
+    if not isinstance(detrend, str) or detrend not in DETREND:
         raise InputError(f"{prefix}detrend", detrend, f"one of {', '.join(DETREND)}")
     if cutoff is not None:
         check_positive(f"{prefix}cutoff", cutoff)
