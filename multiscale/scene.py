@@ -266,9 +266,9 @@ def _toml_value(value):
     tuples as lists, paths as strings, tables item by item (a loop over ``np.arange(5, 30, 5)``
     gave "time.steps = np.int64(10): must be an integer >= 1", a tuple (4, 4) for micro.zones the
     same)."""
-    if isinstance(value, np.generic):
-        return value.item()
-    if isinstance(value, (np.ndarray, tuple, list)):
+    if isinstance(value, (np.generic, np.ndarray)):
+        return value.tolist()                       # Python numbers, bools and nested lists
+    if isinstance(value, (tuple, list)):
         return [_toml_value(v) for v in value]
     if isinstance(value, Mapping):
         return {k: _toml_value(v) for k, v in value.items()}
