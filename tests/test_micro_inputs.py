@@ -227,6 +227,10 @@ def test_post_analysis_without_friction_has_no_heat():
         assert r.volume[0] == 0.0 and np.all(np.isfinite(r.pressure))
     with pytest.raises(InputError, match="mu"):
         post.run(zones, [1e6], speed=2.0, remote=[[300.0, 310.0]], mu=[-0.1])
+    for remote in ([[300.0, np.nan]], [300.0, 310.0, 320.0], "hot"):    # before: NaN ran, the others numpy's errors
+        with pytest.raises(InputError) as info:
+            post.run(zones, [1e6], speed=2.0, remote=remote)
+        assert info.value.name.split(".")[0] == "remote"
 
 
 def test_a_zone_loaded_at_or_above_the_hardness_is_named():

@@ -40,7 +40,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
-from multiscale.errors import InputError, check_count, check_instance, check_positive
+from multiscale.errors import InputError, check_count, check_field, check_instance, check_positive
 from multiscale.micro.contact import ContactConvergenceError, ContactSolver
 from multiscale.micro.heat_kernels import ThermalMaterial, Translation
 from multiscale.micro.heating import SteadyHeating, TransientHeating
@@ -194,7 +194,7 @@ class PostAnalysis:
         mu = np.full(B, self.mu) if mu is None else _per_zone("mu", mu, B)
         if np.any(mu < 0):
             raise InputError("mu", mu, "friction coefficients must be >= 0")
-        remote = None if remote is None else np.broadcast_to(np.asarray(remote, dtype=float), (B, 2))
+        remote = None if remote is None else _per_zone("remote", remote, B, (2,))
         nan = np.full(B, np.nan)
         if B == 0:
             empty = np.zeros((0,) + self.shape)
@@ -362,14 +362,14 @@ class PostAnalysis:
         return self._heaters[key]
 
 
-def _per_zone(name, value, B) -> np.ndarray:
-    v = np.asarray(value, dtype=float)
+def _per_zone(name, value, B, each=()) -> np.ndarray:
+    """``value`` broadcast to (B, *each): finite numbers, else InputError naming it."""
+    v = check_field(name, value)
     try:
-        v = np.broadcast_to(v, (B,)).copy()
+        v = np.broadcast_to(v, (B, *each)).copy()
     except ValueError:
-        raise InputError(f"{name}.shape", v.shape, f"a scalar or one value per zone ({B})") from None
-    if not np.all(np.isfinite(v)):
-        raise InputError(name, "array with NaN/inf", "must be finite")
+        raise InputError(f"{name}.shape", v.shape, f"an array broadcasting to {(B, *each)}, one row per zone" if each
+                         else f"a scalar or one value per zone ({B})") from None
     return v
 
 
