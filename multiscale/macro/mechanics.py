@@ -78,12 +78,11 @@ PRECONDITIONERS = ("lu", "cholesky")
 # starting near its answer (a load changed by 1 N of 867 N: first residual 0.15) stalled at 1.7e-10 above the
 # fixed 1e-10 N and failed. Ours is at most TINY_LOAD of it (1e-9 N on the pin stopped at 1.045e-9 N).
 NEWTON_FLOOR, TINY_LOAD = 1e-10, 1e-8
-# ... and at least this many times eps ||diag(K_cell) x||, the residual's round-off at the state x:
-# its cell part sums K_ij x_j, terms up to K_ii x_i. A stiff body carried far by a soft one stalls
-# there (a steel pin on a 500 MPa disc at 100 N, the disc bending 1.4 mm: 5.8e-9 N against an
-# absolute tolerance of 1.4e-9 N, eps ||diag(K) x|| = 9.2e-9 N; 2 GPa: 1.5e-9 against 2.3e-9), and
-# the solve failed. A solve that stops short is accepted if its last residual is below it.
-ROUNDOFF = 10.0
+# ... and at least this many times eps ||diag(K_cell) x||, the residual's round-off at x (its cell
+# part sums K_ij x_j): a stiff body carried far by a soft one stalls there (a steel pin on a 500 MPa
+# disc at 100 N, bending 1.4 mm: 5.8e-9 N against a tolerance of 1.4e-9 N, eps ||diag(K) x|| = 9.2e-9
+# N), and failed. A solve that stops short is accepted below it (``_newton``: a stall, not a runaway).
+ROUNDOFF, SNES_LINEAR_FAILED = 10.0, PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
 FACTOR_PRECISION = "single"
 # A fluid pressure on a face whose normals (nearly) cancel, a cylinder's wall, has no resultant: the
 # faceting of a closed band leaves a few per mille of its area as vector area (a 10 mm radius wall
@@ -510,7 +509,7 @@ class Mechanics:
             free = ("a body, or a solid of one, can move as a rigid body: give each a support ([[boundary]] fix) "
                     "or a contact that holds it in every direction (friction does not hold a body; a part that "
                     "touches nothing is held by its supports alone), or a penalty far above E*/h ill-conditions it")
-            if result.reason == PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE:
+            if result.reason == SNES_LINEAR_FAILED:
                 cause += f"; the linear solve failed, as it does when {free}"
             elif result.reason == PETSc.SNES.ConvergedReason.DIVERGED_DTOL:
                 cause += f"; the residual grew, as it can when {free}"
@@ -542,17 +541,18 @@ class Mechanics:
         return floor
 
     def _newton(self) -> SolveResult:
-        """One SNES solve from the current state; converged only if finite on every rank, and
-        either converged by SNES or stopped with its last residual within ``_roundoff``."""
+        """One SNES solve from the current state; converged only if finite on every rank, and either
+        converged by SNES or stalled: linear solves done, the last residual within ``_roundoff`` and
+        not above the first (a block pulled off its flat ran away to 3.6e9 m, residual 20 -> 83 N)."""
         self._history.clear()
         self._offset_stale = True
         self.problem.solve()
         snes = self.problem.solver
-        reason, its = snes.getConvergedReason(), snes.getIterationNumber()
-        history = list(self._history)
+        reason, its, history = snes.getConvergedReason(), snes.getIterationNumber(), list(self._history)
         finite = all(np.isfinite(history)) and all(np.isfinite(u.x.array).all() for u in self.u)
         finite = bool(self.tm.comm.allreduce(finite, op=MPI.LAND))     # every rank decides alike
-        converged = reason > 0 or (finite and bool(history) and history[-1] <= self._roundoff())
+        converged = reason > 0 or (finite and bool(history) and reason != SNES_LINEAR_FAILED
+                                   and history[-1] <= min(history[0], self._roundoff()))
         return SolveResult(converged and finite, reason, its, history)
 
     def ramp(self, load: float, steps: int = 1) -> SolveResult:
