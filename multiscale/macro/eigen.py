@@ -203,13 +203,20 @@ def _pairs(solver, i, vr, vi):
     return complex(val), vr.getArray() + 1j * vi.getArray()
 
 
-def _normalise(phi: np.ndarray, M, comm) -> np.ndarray:
-    """Scale columns to phi^H M phi = 1 and rotate so that phi^T phi is real positive."""
+def _products(phi: np.ndarray, M, comm, other: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(phi^H M phi, phi'^T phi) of every column over all ranks, phi' = ``other`` (phi: phi^T phi;
+    phi.conj(): phi^H phi)."""
     mphi = mat_apply(M, phi)
     gram = np.array([np.vdot(phi[:, j], mphi[:, j]).real for j in range(phi.shape[1])])
-    sq = np.einsum("ij,ij->j", phi, phi)
+    sq = np.einsum("ij,ij->j", other, phi)
     gram, sq = reduce_sum(np.concatenate([gram, sq]), comm).reshape(2, -1)
-    scale = np.exp(-0.5j * np.angle(sq)) / np.sqrt(np.maximum(gram.real, np.finfo(float).tiny))
+    return gram.real, sq
+
+
+def _normalise(phi: np.ndarray, M, comm) -> np.ndarray:
+    """Scale columns to phi^H M phi = 1 and rotate so that phi^T phi is real positive."""
+    gram, sq = _products(phi, M, comm, phi)
+    scale = np.exp(-0.5j * np.angle(sq)) / np.sqrt(np.maximum(gram, np.finfo(float).tiny))
     return phi * scale
 
 
@@ -223,11 +230,8 @@ def _carry_mass(phi: np.ndarray, M, comm) -> np.ndarray:
     at 0 Hz, in every band. The least Rayleigh quotient of a consistent mass matrix is 0.07 (P1)
     and 0.05 (P2) of its largest diagonal on a uniform mesh, that times the ratio of the smallest
     to the largest cell volume on a graded one (above 1e-9 up to a 100-fold element size)."""
-    mphi = mat_apply(M, phi)
-    gram = np.array([np.vdot(phi[:, j], mphi[:, j]).real for j in range(phi.shape[1])])
-    norm = np.einsum("ij,ij->j", phi.conj(), phi).real
-    gram, norm = reduce_sum(np.concatenate([gram, norm]), comm).reshape(2, -1)
-    return gram > MASSLESS * M.getDiagonal().max()[1] * norm
+    gram, norm = _products(phi, M, comm, phi.conj())
+    return gram > MASSLESS * M.getDiagonal().max()[1] * norm.real
 
 
 def reduce_sum(a: np.ndarray, comm) -> np.ndarray:
