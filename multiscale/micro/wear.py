@@ -32,6 +32,7 @@ from multiscale.micro.surface import Surface, check_surface
 STEP_RMS = 0.5   # a simulate_wear step wearing deeper than this many RMS heights is warned about [-]
 SUBSTEP_TOL = 0.05   # a wear update whose real contact area the substeps leave this far off is warned about [-]
 UNIFORM = 1e-12      # a step's depths equal to this share of the deepest: uniform wear (full contact of a flat)
+ROUND_OFF_FLAT = 1e12   # a step's relief over this many RMS heights of its start: worn into a flat to round-off [-]
 
 
 class WearWarning(UserWarning):
@@ -240,7 +241,7 @@ def simulate_wear(surface: Surface, contact: Kernel | ContactSolver, *, load, mu
         if j in law_steps:
             laws.append(_pressure_gap_law(solver, current.heights, law_loads, j, j * dS, options))
     history = WearHistory(sliding=np.arange(steps + 1) * dS, **rows)
-    if overshoot > 1 / UNIFORM:
+    if overshoot > ROUND_OFF_FLAT:
         warnings.warn(f"simulate_wear: a step wore a relief into a surface flat to round-off (e.g. a flat punch's "
                       f"edges), so the result depends on the step count (steps = {steps}): use more until the "
                       "result stops changing", WearWarning, stacklevel=2)
