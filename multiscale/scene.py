@@ -33,7 +33,7 @@ from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
 from multiscale.scene_sections import (COUPLING_DEFAULT, DEFAULT_GRID, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Vehicle, Wear)
-from multiscale.scene_cycle import convection_coverage, cycle_coverage, squeal_state
+from multiscale.scene_cycle import convection_coverage, cycle_coverage, short_phases, squeal_state
 from multiscale.scene_stability import Stability
 
 __all__ = ["COUPLING_DEFAULT", "EFFECTS", "FIG_7_9_CALIBRATION", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Boundary",
@@ -378,6 +378,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
     end = scene.time.end if scene.time is not None else None
     if scene.loading is not None and end is not None:
         warnings += cycle_coverage(scene.loading, end)
+        if g is not None and {"friction", "thermal", "heat_partition"} <= effects:
+            warnings += short_phases(scene.loading, g.motion, end, scene.time.dt)
         if g is not None and g.motion == "rotation" and "thermal" in effects:
             warnings += convection_coverage(scene.boundary or (), scene.loading, end)
     profile = scene.loading.load_profile if scene.loading is not None else None

@@ -485,6 +485,31 @@ def test_a_cycle_the_run_ends_before_is_warned_about(tmp_path):
         "loading.vehicle: the stop from 100 km/h at 5.88 m/s^2 (0.6 g) takes 4.72 s, beyond time.end = 2 s")
 
 
+def test_a_braking_phase_shorter_than_a_step_is_warned_about(tmp_path):
+    """A step takes the mean frictional heat over its length: a brake application shorter than the
+    step was spread over it silently (before), its temperatures too low (the coarse pin-on-disc's
+    pin rose 0.38 K with one 1.6 s step over a 0.2 s application, 1.25 K with 0.1 s steps)."""
+    pod = (DEMOS / "pin_on_disc_perfect.toml").read_text()       # 50 steps of 0.6 s
+    cycle = '[loading]\nload_profile = [["0 s", 0], ["1 s", 0], ["1.01 s", 1], ["1.4 s", 1], ["1.41 s", 0], ["9 s", 0], ' \
+            '["9.01 s", 1], ["10 s", 1], ["10.01 s", 0], ["20 s", 0], ["20.01 s", 1], ["20.5 s", 1], ["20.51 s", 0]]'
+    warned = [w for w in loads(pod.replace("[loading]", cycle), tmp_path).warnings if "braking phase" in w]
+    assert warned == ["loading: 2 braking phases (loaded and sliding), the shortest from 1 to 1.41 s, are shorter "
+                      "than the time step time.end / time.steps = 0.6 s: a step takes the mean frictional heat over "
+                      "its length, so the phase's heat is spread over the step and its temperatures come out too low; "
+                      "give time.steps >= 74 (a step no longer than the phase; finer for its peak)"]
+    # a stop at rest from 2 s: the speed, not the load, ends the phase
+    stop = pod.replace('rotation_speed = "200 rpm"', 'speed_profile = [["0 s", "200 rpm"], ["0.5 s", "0 rpm"]]')
+    assert [w for w in loads(stop, tmp_path).warnings if "braking phase" in w] == [
+        "loading: the braking phase (loaded and sliding) from 0 to 0.5 s is shorter than the time step time.end / "
+        "time.steps = 0.6 s: a step takes the mean frictional heat over its length, so the phase's heat is spread over "
+        "the step and its temperatures come out too low; give time.steps >= 60 (a step no longer than the phase; finer "
+        "for its peak)"]
+    assert not any("braking phase" in w for w in loads(stop.replace("steps = 50", "steps = 60"), tmp_path).warnings)
+    assert not any("braking phase" in w for w in loads(pod, tmp_path).warnings)       # braked throughout
+    cold = pod.replace('"thermal", "heat_partition", "expansion"', '"thermal"')     # no frictional heat
+    assert not any("braking phase" in w for w in loads(cold.replace("[loading]", cycle), tmp_path).warnings)
+
+
 def test_a_convection_table_the_speeds_leave_is_warned_about(tmp_path):
     """h(speed) is held at its table's ends like a material's table, but (before) silently: a car
     stop from 856 rpm with a table to 300 rpm cooled at h(300 rpm), a dwell at rest with a table
