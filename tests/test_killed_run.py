@@ -166,7 +166,7 @@ def test_killed_mid_run_and_resumed_writes_the_uninterrupted_results(base, tmp_p
 
 
 def test_field_times_after_the_checkpoint_are_dropped_and_written_once(base, tmp_path):
-    from multiscale import workflows
+    from multiscale import provenance, workflows
     from multiscale.workflows.multiscale import run
     folder = tmp_path / "out"
     scene = loads(scene_text(folder))
@@ -178,7 +178,12 @@ def test_field_times_after_the_checkpoint_are_dropped_and_written_once(base, tmp
     assert all(len(t) == 5 for t in field_times(folder).values())
     run(scene, resume=True, verbose=False, stop_after=2)   # the ghosts of steps 3 and 4 are gone
     assert all(t == list(plan(scene).times[:3]) for t in field_times(folder).values())
+    # each part as a killed one leaves it, its own (before: the first part's record alone)
+    parts = json.loads((folder / "provenance.json").read_text())["parts"]
+    assert [(p["status"], p["end"]) for p in parts] == [(provenance.RUNNING, None)] * 3
     result = workflows.run(scene, resume=True, verbose=False)
+    statuses = [p["status"] for p in json.loads((folder / "provenance.json").read_text())["parts"]]
+    assert statuses == [provenance.RUNNING] * 3 + ["resumed and finished"]
     same_results(folder, uninterrupted_run(base, 1))
     # --resume once more: nothing to do, nothing written, the provenance of the run stays as it was
     before = {f.name: f.read_bytes() for f in folder.iterdir()}

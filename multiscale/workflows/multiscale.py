@@ -141,6 +141,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     if stored.get("finished"):
         checkpoint.same_scene(stored, fingerprint(scene), ckpt)
         return finished(folder, scene.name, int(stored["step"]), comm, verbose)
+    if resume:
+        out.claim()                          # a part of its own in the provenance, also if it is killed
     ms = build(scene, comm, progress=verbose and comm.rank == 0)
     with closed_on_error(ms.model, comm):        # a script going on after a failed run gets its communicators
         steps = scene.time.steps if (ms.model.thermal is not None or scene.has("wear")) else 0

@@ -35,17 +35,16 @@ class OutputFolder:
         """Delete the earlier results (``--overwrite``: every entry the earlier run recorded writing,
         ``provenance.results_of``, so no stale field file, figure or checkpoint of another scene stays
         beside the new results; entries no run recorded, the user's own, stay with a message) and
-        write the new run's provenance with status ``provenance.RUNNING`` (what a killed run leaves).
-        Collective; once per run."""
+        write the new run's provenance with status ``provenance.RUNNING`` (what a killed run leaves;
+        resumed, a part of that status after the earlier parts). Collective; once per run."""
         scene, comm = self.scene, self.comm
 
         def start():
             if self.replace:
                 clear(self.path, self.replace)
-            if not self.resume:                 # a killed run's folder says so and lists its files
-                provenance.write(self.path, scene, ranks=comm.size, started=provenance.now(), stages={},
-                                 wall_time=0.0, status=provenance.RUNNING, analysis=outputs.analysis(scene),
-                                 warnings=scene.warnings)
+            provenance.write(self.path, scene, ranks=comm.size, started=provenance.now(), stages={},
+                             wall_time=0.0, status=provenance.RUNNING, analysis=outputs.analysis(scene),
+                             warnings=scene.warnings, earlier=provenance.parts_of(self.path) if self.resume else ())
         io.on_root(comm, start, f"into the output folder {self.path}")
         io.reporter().folder = self.path        # where a failed run leaves its provenance
         return self.path
@@ -55,9 +54,9 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
     """The scene's output folder, created and tested for writing (a read-only folder fails here,
     before any work); refuses to touch earlier results unless ``overwrite`` (replace them, at
     ``OutputFolder.claim``) or ``resume`` (continue them; a missing folder is then an error and is
-    not created). A resumed folder is claimed at once; any other when the run first writes, so
-    that a run refused before (at meshing, in its first solve) leaves no entry that would make
-    the next run need ``--overwrite``.
+    not created). The folder is claimed when the run first writes (resumed: once it has steps
+    left), so that a run refused before (at meshing, in its first solve) leaves no entry that
+    would make the next run need ``--overwrite``.
     Rank 0 decides for every rank (collective)."""
     folder = Path(scene.output.folder)
     if resume and not comm.bcast(folder.is_dir() if comm.rank == 0 else None, root=0):
@@ -79,10 +78,7 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
         probe.write_bytes(b"")
         probe.unlink()
     io.on_root(comm, create, f"into the output folder {folder}")
-    out = OutputFolder(folder, scene, comm, [] if resume else existing, resume)
-    if resume:
-        out.claim()
-    return out
+    return OutputFolder(folder, scene, comm, [] if resume else existing, resume)
 
 
 def clear(folder: Path, existing: list[str]) -> None:
