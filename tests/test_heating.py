@@ -10,7 +10,7 @@ from multiscale.micro.contact import ContactSolver
 from multiscale.micro.heat_kernels import (Rotation, SpeedProfile, ThermalMaterial, Translation,
                                            fixed_rectangle_temperature, moving_rectangle_temperature,
                                            pulse_tables)
-from multiscale.micro.heating import (HeatingConvergenceError, InterfaceLayer, SteadyHeating,
+from multiscale.micro.heating import (HeatingConvergenceError, InterfaceLayer, PartitionLaw, SteadyHeating,
                                       TransientHeating, partition_law)
 from multiscale.micro.kernels import HalfSpace, padded_size
 from multiscale.micro.surface import Surface, fractal_surface
@@ -394,6 +394,18 @@ def test_partition_law_from_surface_and_from_contact_result_agree():
     again = partition_law(contact, DISC, PIN, 10.0, mu=0.4, dx=s.dx)
     assert np.allclose(again.partition_1[0], law.partition_1[1], rtol=1e-9)
     assert again(50e6) == pytest.approx(law.partition_1[1, -1])           # clamped
+
+
+
+def test_partition_law_refuses_a_nan_pressure_or_speed():
+    """A NaN pressure or speed gave a NaN partition (clipping and interpolation pass NaN through;
+    an adversarial test): an InputError naming it."""
+    law = PartitionLaw(np.array([1e6, 4e6]), np.array([1.0, 10.0]), np.array([[0.6, 0.7], [0.8, 0.9]]),
+                       np.array([0.1, 0.2]), np.zeros((2, 2)), np.zeros((2, 2)), mu=0.4)
+    assert law([2e6, 50e6], 10.0) == pytest.approx([0.85, 0.9], rel=1e-12)
+    for pressure, speed, name in ((np.nan, 1.0, "pressure"), ([1e6, np.inf], 1.0, "pressure"), (1e6, np.nan, "speed")):
+        with pytest.raises(InputError, match=f"^{name} = .*must be finite"):
+            law(pressure, speed)
 
 
 # --- errors -------------------------------------------------------------------------------------

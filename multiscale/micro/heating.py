@@ -480,14 +480,14 @@ class PartitionLaw:
 
     def __call__(self, pressure, speed=None) -> np.ndarray:
         """p_1 at mean pressure(s) [Pa] (and speed(s) [m/s], needed when several were sampled):
-        linear in log p and in V, clamped to the sampled ranges."""
-        logp = np.log(np.clip(np.asarray(pressure, dtype=float), self.mean_pressure[0], self.mean_pressure[-1]))
+        linear in log p and in V, clamped to the sampled ranges; InputError for a NaN or inf."""
+        logp = np.log(np.clip(check_field("pressure", pressure), self.mean_pressure[0], self.mean_pressure[-1]))
         rows = np.array([np.interp(logp, np.log(self.mean_pressure), row) for row in self.partition_1])
         if self.speed.size == 1:
             return rows[0]
         if speed is None:
             raise InputError("speed", speed, f"the law was sampled at {self.speed.size} speeds: give one")
-        v = np.clip(np.broadcast_to(np.asarray(speed, dtype=float), logp.shape), self.speed[0], self.speed[-1])
+        v = np.clip(np.broadcast_to(check_field("speed", speed), logp.shape), self.speed[0], self.speed[-1])
         i = np.clip(np.searchsorted(self.speed, v, side="right") - 1, 0, self.speed.size - 2)
         w = (v - self.speed[i]) / (self.speed[i + 1] - self.speed[i])
         lo = np.take_along_axis(rows, i[None], 0)[0]
