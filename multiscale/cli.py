@@ -19,9 +19,9 @@ from multiscale.errors import InputError, MultiscaleError, OutputError, SceneErr
 from multiscale.geometry import too_many_cells
 from multiscale.io import CtrlCWatch, abort, ended_together, memory_available
 from multiscale.micro.outliers import DESPIKE
+from multiscale.micro.reading import TopographyWarning, formats, read_topography
 from multiscale.micro.spectrum import statistics_memory, surface_statistics
-from multiscale.micro.topography import (DETREND, MAX_UNDEFINED, TopographyWarning, condition, formats,
-                                        read_topography)
+from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition
 from multiscale.outputs import CHECKPOINT, analysis, folder_problem, plan
 from multiscale.outputs import summary as plan_summary
 from multiscale.scene import load

@@ -198,6 +198,11 @@ class Scene:
             own, friction=own.friction if own.friction is not None else self.loading.friction,
             roughness=own.roughness or self.roughness, micro=own.micro or self.micro)
 
+    def roughness_key(self, name: str) -> str:
+        """Where interface ``name``'s roughness is given: "interfaces.<name>.roughness" or "roughness"."""
+        own = self.interfaces.get(name)
+        return f"interfaces.{name}.roughness" if own is not None and own.roughness is not None else "roughness"
+
     @property
     def rough_interfaces(self) -> tuple[str, ...]:
         """Names of the interfaces carrying zone laws (effect "roughness" and ``rough`` not false)."""
@@ -472,7 +477,7 @@ def _nyquist(scene: Scene) -> list[str]:
             continue
         cells = [g * (z if r.patch == "face" else 1) for g, z in zip(m.grid or DEFAULT_GRID, m.zones)]
         if any(k > c // 2 for k, c in zip(r.k_max, cells)):
-            out.append(f"{_roughness_key(scene, name)}.k_max = {list(r.k_max)}: must not exceed the Nyquist index "
+            out.append(f"{scene.roughness_key(name)}.k_max = {list(r.k_max)}: must not exceed the Nyquist index "
                        f"{[c // 2 for c in cells]} of the {'face' if r.patch == 'face' else 'zone'}'s micro grid "
                        f"of {cells} cells")
     return sorted(set(out))
@@ -487,7 +492,7 @@ def _measured_cover(scene: Scene) -> list[str]:
         r, size = scene.interface_settings(name).roughness, scene.geometry.spec.interface_extents.get(name)
         if r is None or r.file is None or r.cover != "measured" or size is None:
             continue
-        prefix = f"{_roughness_key(scene, name)}."
+        prefix = f"{scene.roughness_key(name)}."
         try:
             with warnings.catch_warnings():        # the file's notes are the scene's warnings already
                 warnings.simplefilter("ignore", TopographyWarning)
@@ -497,12 +502,6 @@ def _measured_cover(scene: Scene) -> list[str]:
         except InputError as exc:
             out.append(str(exc))
     return sorted(set(out))
-
-
-def _roughness_key(scene: Scene, name: str) -> str:
-    """Where interface ``name``'s roughness is given: "interfaces.<name>.roughness" or "roughness"."""
-    own = scene.interfaces.get(name)
-    return f"interfaces.{name}.roughness" if own is not None and own.roughness is not None else "roughness"
 
 
 def _symmetry_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]:

@@ -1,9 +1,12 @@
 """Measured surfaces in use (issue 17): `multiscale surface FILE` (steps, statistics, figure),
 scenes with `[roughness] file = ...` (validated by `multiscale check` from the file itself), and the
 zones the one rough-interface builder makes from them."""
+import collections
 import dataclasses
+import os
 import subprocess
 import sys
+import time
 import tracemalloc
 import warnings
 from pathlib import Path
@@ -15,6 +18,7 @@ import SurfaceTopography as ST
 import multiscale.cli as cli
 from multiscale.cli import main
 from multiscale.errors import InputError, SceneError
+from multiscale.micro import reading, topography
 from multiscale.micro.spectrum import statistics_memory, surface_statistics
 from multiscale.micro.surface import Surface
 from multiscale.micro.topography import condition, cover, read_topography
@@ -310,3 +314,37 @@ def test_the_memory_check_counts_what_the_command_takes(tmp_path, capsys):
         tracemalloc.stop()
     capsys.readouterr()
     assert peak == pytest.approx(cli.surface_memory((512, 640)), rel=0.05)
+
+
+def test_a_measured_file_is_read_and_searched_for_outliers_once(tmp_path, monkeypatch):
+    """A scene with a measured surface read its file three times and searched it for outliers twice
+    in one `multiscale run` (the scene's check of the file, its cover check, the zones): 5 s a search
+    on a 4000² map. Now once; a changed file is read again, and one just written is not kept (file
+    times are as coarse as a clock tick: its next change might keep them)."""
+    from multiscale.workflows import rough      # local: imports DOLFINx
+    calls = collections.Counter()
+
+    def counted(name, f):
+        def call(*args, **kwargs):
+            calls[name] += 1
+            return f(*args, **kwargs)
+        return call
+
+    monkeypatch.setattr(reading, "read_matrix", counted("read", reading.read_matrix))
+    monkeypatch.setattr(topography, "find_outliers", counted("search", topography.find_outliers))
+    path, old = tmp_path / "map.npy", time.time() - 60
+    np.save(path, np.random.default_rng(2).normal(0.0, 1e-6, (64, 64)))   # 12.8 mm at 200 um: covers the block
+    os.utime(path, (old, old))
+    s = scene(tmp_path, 'file = "map.npy"\npixel_size = "200 um"', "grid = [16, 16]")
+    zones = rough.make_zones(s.roughness, s.micro, (0.0, 0.0), (10e-3, 10e-3), seed=0)[1]
+    assert calls == {"read": 1, "search": 1}
+    assert not read_topography(path, pixel_size=2e-4, prefix="roughness.").heights.flags.writeable    # shared
+    np.save(path, -np.load(path))          # the same size, a later time
+    os.utime(path, (old + 1, old + 1))
+    again = rough.make_zones(s.roughness, s.micro, (0.0, 0.0), (10e-3, 10e-3), seed=0)[1]
+    assert calls == {"read": 2, "search": 2}
+    assert np.allclose(again[0].surface.heights, -zones[0].surface.heights, rtol=0, atol=1e-18)
+    np.save(path, np.load(path))           # just written
+    for _ in range(2):
+        read_topography(path, pixel_size=2e-4, prefix="roughness.")
+    assert calls["read"] == 4

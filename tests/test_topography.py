@@ -14,9 +14,10 @@ from SurfaceTopography.Support.UnitConversion import get_unit_conversion_factor
 
 from multiscale.errors import InputError
 from multiscale.micro import topography
+from multiscale.micro.reading import formats
 from multiscale.micro.spectrum import surface_statistics
 from multiscale.micro.surface import Surface, fractal_surface, load_surface
-from multiscale.micro.topography import (Measurement, TopographyWarning, condition, cover, formats,
+from multiscale.micro.topography import (Measurement, TopographyWarning, condition, cover,
                                          gaussian_filter, gaussian_transmission, probe_topography,
                                          read_topography, resample)
 
@@ -444,3 +445,22 @@ def test_copies_of_a_small_measurement_are_filtered_once():
         with pytest.warns(TopographyWarning, match=r"spans fewer than 4 cells of the micro grid \(300 x 300 um\)"):
             out, _ = cover(s, (10, 10), (3e-3, 3e-3), method)
         assert out.heights.std() / (A / np.sqrt(2)) == pytest.approx(gaussian_transmission(lam, 0.9e-3), rel=rel)
+
+
+def test_read_topography_takes_a_path_like_and_a_home_folder_not_an_open_file(tmp_path, monkeypatch):
+    """Only str and Path were taken: "~" was not expanded ("no such file"), another os.PathLike and
+    an open file were refused alike ("a file name (str or Path)"). An open file is still refused
+    (the format detection, the messages and the kept reads need its name), saying so."""
+    monkeypatch.setenv("HOME", str(tmp_path))
+    np.save(tmp_path / "m.npy", np.random.default_rng(0).normal(0.0, 1e-6, (8, 6)))
+
+    class Named:
+        def __fspath__(self):
+            return str(tmp_path / "m.npy")
+
+    assert read_topography("~/m.npy", pixel_size=1e-6).shape == (8, 6)
+    assert read_topography(Named(), pixel_size=1e-6).shape == (8, 6)
+    with open(tmp_path / "m.npy", "rb") as f, pytest.raises(InputError) as opened:
+        read_topography(f, pixel_size=1e-6, prefix="roughness.")
+    assert str(opened.value) == ("roughness.file = 'an open BufferedReader': a file name (str or os.PathLike, e.g. "
+                                 "pathlib.Path): pass the name of the open file")

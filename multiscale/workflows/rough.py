@@ -71,15 +71,16 @@ def check_rough_scene(scene) -> None:
                                  f"interface (micro.{key} = {getattr(scene.micro, key)}); only zones may differ")
 
 
-def make_zones(r, m, lo, hi, seed: int, log=None) -> tuple[ZoneGrid, list]:
+def make_zones(r, m, lo, hi, seed: int, log=None, prefix: str = "roughness.") -> tuple[ZoneGrid, list]:
     """The zone grid over the box [lo, hi] (u, v) [m] of one interface and each zone's initial
-    patch (``r``: its [roughness], ``m``: its [micro]; see module docstring; ids from 0).
+    patch (``r``: its [roughness], ``m``: its [micro]; see module docstring; ids from 0; errors
+    name ``prefix`` + the key, as the scene's check does: ``Scene.roughness_key``).
     ``log(line)`` receives the steps that made a measured surface (the warnings among them too,
     instead of Python warnings on every rank)."""
     counts = tuple(int(c) for c in m.zones)
     size = np.asarray(hi, float) - np.asarray(lo, float)
     if r.file is not None:
-        return cut_zones(measured_face(r, m, counts, size, seed, log), counts, origin=tuple(lo))
+        return cut_zones(measured_face(r, m, counts, size, seed, log, prefix), counts, origin=tuple(lo))
     cells_per_zone = m.grid or DEFAULT_GRID
     if r.patch == "face":
         cells = (counts[0] * cells_per_zone[0], counts[1] * cells_per_zone[1])
@@ -89,7 +90,7 @@ def make_zones(r, m, lo, hi, seed: int, log=None) -> tuple[ZoneGrid, list]:
     return grid, generate_zones(grid, tuple(cells_per_zone), r.hurst, r.k_min, r.k_max, r.rms, seed=seed)
 
 
-def measured_face(r, m, counts, size, seed: int, log=None) -> Surface:
+def measured_face(r, m, counts, size, seed: int, log=None, prefix: str = "roughness.") -> Surface:
     """The face of ``size`` [m] from ``roughness.file``: read, conditioned (``roughness.detrend``,
     ``cutoff``, ``max_undefined``, ``despike``) and covering the face (``roughness.cover``), on counts x
     ``micro.grid`` cells (without ``micro.grid``: 50 x 50 per zone for an equivalent surface, else
@@ -97,8 +98,8 @@ def measured_face(r, m, counts, size, seed: int, log=None) -> Surface:
     with warnings.catch_warnings():      # the warnings are lines of the report: printed once, not per rank
         warnings.simplefilter("ignore", TopographyWarning)
         measured = read_topography(r.file, r.channel, pixel_size=r.pixel_size, height_unit=r.height_unit,
-                                   prefix="roughness.")
-        done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix="roughness.", despike=r.despike)
+                                   prefix=prefix)      # the scene's read, kept (read_topography)
+        done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix=prefix, despike=r.despike)
         cells = m.grid
         if cells is None and r.cover == "equivalent":
             cells = DEFAULT_GRID
@@ -108,7 +109,7 @@ def measured_face(r, m, counts, size, seed: int, log=None) -> Surface:
                 raise InputError("micro.grid", None, f"{r.file.name}'s pixels give {cells[0]} x {cells[1]} cells "
                                  f"per zone: set micro.grid (at most {MAX_CELLS} without it)")
         surface, lines = cover(done.surface, (counts[0] * cells[0], counts[1] * cells[1]), tuple(size), r.cover,
-                               seed, prefix="roughness.")
+                               seed, prefix=prefix)
     known = {f"warning: {note}" for note in (*measured.notes, *done.notes)}   # the scene's warnings already
     for line in (*done.report, *lines) if log is not None else ():
         if line not in known:
@@ -172,8 +173,8 @@ def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterfac
         settings = scene.interface_settings(name)
         k = list(tm.interface.tags).index(name)
         plane, lo, hi = interface_plane(tm, name)
-        grid, patches = make_zones(settings.roughness, settings.micro, lo, hi,
-                                   settings.roughness.seed + SEED_STRIDE * k, log=log)
+        grid, patches = make_zones(settings.roughness, settings.micro, lo, hi, settings.roughness.seed + SEED_STRIDE * k,
+                                   log=log, prefix=f"{scene.roughness_key(name)}.")
         offset = len(zones)
         planes.append(plane)
         grids.append(grid)
