@@ -353,6 +353,20 @@ def test_a_truncated_file_gets_its_readers_diagnosis_and_no_log_of_its_bytes(tmp
         assert not caplog.records
 
 
+
+def test_contents_of_another_format_than_the_extension_are_refused(tmp_path):
+    """A .x3p cut to 2 n² bytes was taken for NASA SRTM elevations (HGT, detected by its size
+    alone), and the error asked for a pixel size (given, the zip's bytes would be heights); a
+    .top renamed .x3p was read as WSxM without a word. Both are refused with the extension's
+    reader's diagnosis."""
+    (tmp_path / "cut.x3p").write_bytes(b"PK\x03\x04" + bytes(2 * 100 ** 2 - 4))     # a zip's start
+    (tmp_path / "top.x3p").write_bytes((DATA / "top-1.top").read_bytes())
+    for name, taken in (("cut", "NASA SRTM"), ("top", "WSxM")):
+        with pytest.raises(InputError, match=rf"^roughness\.file = '{name}\.x3p': its contents were taken for {taken}, "
+                                             r"not the format of its \.x3p extension: as XML 3D surface profile \(X3P\), "
+                                             r"FileFormatMismatch: .*\(a damaged file, or one to rename\)$"):
+            read_topography(tmp_path / f"{name}.x3p", prefix="roughness.")
+
 @pytest.mark.parametrize("call, message", [
     (lambda s, p: read_topography(p, pixel_size=(1e-6, 2e-6, 3e-6)), "pixel_size = (1e-06, 2e-06, 3e-06): one value or a pair"),
     (lambda s, p: read_topography(p, pixel_size="1 um"), "pixel_size = '1 um': must be a real number"),

@@ -76,13 +76,20 @@ def _reader(path: Path, name: str):
     ST = surface_topography()
     try:
         with _quiet():
-            return ST.open_topography(str(path))
+            reader = ST.open_topography(str(path))
     except (ST.Exceptions.UnknownFileFormat, ST.Exceptions.CannotDetectFileFormat):
         said = _format_error(path) or "not a format SurfaceTopography recognises"
         raise InputError(name, path.name, f"cannot read it as a topography: {said} (`multiscale surface --formats` "
                          "lists the formats)") from None
     except Exception as exc:    # any other parser failure on a user's file: one error naming it
         raise InputError(name, path.name, f"cannot read it as a topography ({_first_line(exc)})") from None
+    suffix = path.suffix.lower().lstrip(".")
+    claimed = tuple(r for r in ST.IO.readers if suffix and suffix in r.file_extensions())
+    if claimed and not isinstance(reader, claimed):   # a .x3p cut to 2 n² bytes was "NASA SRTM" (by its size)
+        said = _format_error(path) or f"as {', '.join(r.name() for r in claimed)}, it was read without error"
+        raise InputError(name, path.name, f"its contents were taken for {reader.name()}, not the format of its "
+                         f".{suffix} extension: {said} (a damaged file, or one to rename)")
+    return reader
 
 
 @contextmanager
