@@ -478,3 +478,17 @@ def test_read_topography_takes_a_path_like_and_a_home_folder_not_an_open_file(tm
         read_topography(f, pixel_size=1e-6, prefix="roughness.")
     assert str(opened.value) == ("roughness.file = 'an open BufferedReader': a file name (str or os.PathLike, e.g. "
                                  "pathlib.Path): pass the name of the open file")
+
+
+def test_an_equivalent_surface_with_no_measured_wavelength_on_the_grid_is_refused():
+    """A measurement smaller than two cells of the micro grid (x3p-2.x3p, 0.08 x 0.2 mm, on the
+    312.5 um cells of a 10 mm face at 32 x 32) gave a flat "equivalent" surface (Sq 0, reported as
+    such) and the run failed in the zone laws with "lower p_max". Refused, naming the cause."""
+    s = fractal_surface(64, 64e-6, 0.8, 2, 16, 1e-6, seed=2)
+    s = Surface(s.heights, s.dx, s.dy, periodic=False)
+    with pytest.raises(InputError) as flat:
+        cover(s, (32, 32), (10e-3, 10e-3), "equivalent", prefix="roughness.")
+    assert str(flat.value) == ("roughness.cover = 'equivalent': the measurement (0.064 x 0.064 mm) holds no wavelength "
+                               "the micro grid resolves (32 x 32 cells of 312.5 x 312.5 um: wavelengths from 625 um "
+                               "up): the equivalent surface would be flat; use a finer micro.grid or a larger measurement")
+    assert cover(s, (320, 320), (1e-3, 1e-3), "equivalent")[0].heights.std() > 0.1 * s.heights.std()

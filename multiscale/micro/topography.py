@@ -336,6 +336,11 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
         spectrum = power_spectrum(surface)
         s = equivalent_surface(spectrum, (nx, ny), (Lx, Ly), seed)
         s = Surface(s.heights, s.dx, s.dy, periodic=False)
+        if not np.any(s.heights):     # flat: its zone laws failed later, "lower p_max", far from the cause
+            raise InputError(f"{prefix}cover", method, f"{wide} holds no wavelength the micro grid resolves ({nx} x {ny} "
+                             f"cells of {Lx / nx * 1e6:.4g} x {Ly / ny * 1e6:.4g} um: wavelengths from "
+                             f"{2 * max(Lx / nx, Ly / ny) * 1e6:.4g} um up): the equivalent surface would be flat; "
+                             "use a finer micro.grid or a larger measurement")
         return s, [f"statistically equivalent surface over {target} from the measured PSD (seed {seed}): "
                    f"{nx} x {ny} cells of {Lx / nx * 1e6:.4g} x {Ly / ny * 1e6:.4g} um, Sq {_um(float(s.heights.std()))} "
                    f"um (measured {_um(float(surface.heights.std()))} um; the grid resolves wavelengths down to "
