@@ -49,10 +49,13 @@ def probe_topography(path, channel: int | None = None, *, pixel_size=None, heigh
             m = read_topography(path, channel, pixel_size=pixel_size, height_unit=height_unit, prefix=prefix)
     except InputError as exc:
         return [str(exc)], []
-    why = _too_many_undefined(m, max_undefined, prefix) or _form_only(m, detrend)
+    form = "plane" if detrend in ("plane", "poly2") else "mean"      # the cheap part of condition's test
+    flattened = remove_form(m.heights, form)
+    why = _too_many_undefined(m, max_undefined, prefix) or _form_only(m, flattened)
     if why is not None:
         return [str(InputError(f"{prefix}file", m.path.name, why))], list(m.notes)
-    return [], list(m.notes) + ([] if despike is not None else _outlier_notes(m, detrend, prefix))   # removed: said then
+    searched = flattened if detrend == form else None         # the outlier search's heights, if these
+    return [], list(m.notes) + ([] if despike is not None else _outlier_notes(m, detrend, prefix, searched))
 
 
 def _outlier_notes(m: Measurement, detrend: str, prefix: str, h: np.ndarray | None = None) -> list[str]:
@@ -69,15 +72,12 @@ def _outlier_notes(m: Measurement, detrend: str, prefix: str, h: np.ndarray | No
     return [found.note(m.path.name, option)] if found.count else []
 
 
-def _form_only(m: Measurement, detrend: str) -> str | None:
-    """Why nothing but the form ``detrend`` removes is in the heights (a constant; a plane for
-    "plane" and "poly2"), or None: the cheap part of ``condition``'s test, for ``check``."""
-    defined = np.isfinite(m.heights)
-    h, scale = m.heights[defined], float(np.max(np.abs(m.heights[defined]), initial=0.0))
-    columns = [np.ones(h.size)] + ([c[defined] for c in np.indices(m.shape)] if detrend in ("plane", "poly2") else [])
-    A = np.column_stack(columns)
-    h = h - A @ np.linalg.lstsq(A, h, rcond=None)[0]
-    return None if h.std() > FLAT * scale else _no_roughness(float(h.std()), scale)
+def _form_only(m: Measurement, flattened: np.ndarray) -> str | None:
+    """Why nothing but a form is in ``m``'s heights, or None: ``flattened`` [m] are they with the
+    least-squares mean (or plane) removed, Sq within ``FLAT`` of their largest height (a constant
+    or a plane, to round-off)."""
+    scale, sq = float(np.nanmax(np.abs(m.heights), initial=0.0)), _defined_std(flattened)
+    return None if sq > FLAT * scale else _no_roughness(sq, scale)
 
 
 def _no_roughness(sq: float, scale: float) -> str:
