@@ -348,3 +348,23 @@ def test_a_measured_file_is_read_and_searched_for_outliers_once(tmp_path, monkey
     for _ in range(2):
         read_topography(path, pixel_size=2e-4, prefix="roughness.")
     assert calls["read"] == 4
+
+
+def test_an_interfaces_own_measured_file_is_named_by_its_key_and_read_once(tmp_path, monkeypatch):
+    """With [interfaces.<name>.roughness] the zones' read and errors said "roughness." where the
+    scene's check said "interfaces.<name>.roughness.", and the run read the file again."""
+    from multiscale.workflows import rough      # local: imports DOLFINx
+    reads = []
+    monkeypatch.setattr(reading, "read_matrix", lambda path: reads.append(path) or np.load(path))
+    np.save(tmp_path / "map.npy", np.random.default_rng(3).normal(0.0, 1e-6, (64, 64)))
+    os.utime(tmp_path / "map.npy", (1e9, 1e9))       # long settled: kept
+    s = scene(tmp_path, 'file = "map.npy"\npixel_size = "300 um"', "grid = [16, 16]\n"
+              '[interfaces.interface.roughness]\nfile = "map.npy"\npixel_size = "200 um"')
+    own = s.interface_settings("interface")
+    prefix = f"{s.roughness_key('interface')}."
+    assert prefix == "interfaces.interface.roughness." and len(reads) == 2     # the [roughness] table's too
+    rough.make_zones(own.roughness, own.micro, (0.0, 0.0), (10e-3, 10e-3), seed=0, prefix=prefix)
+    assert len(reads) == 2
+    with pytest.raises(InputError, match=r"^interfaces\.interface\.roughness\.cover = 'measured': the measurement "
+                                         r"\(12\.8 x 12\.8 mm\) does not cover"):
+        rough.make_zones(own.roughness, own.micro, (0.0, 0.0), (20e-3, 20e-3), seed=0, prefix=prefix)
