@@ -236,7 +236,7 @@ class RoughInterface:
                     full = len(exc.failures) == len(self.used) and all("full contact" in f.message
                                                                         for f in exc.failures)
                     raise LawError([dataclasses.replace(f, message=f"{f.message}, reached by {level} halvings of "
-                                                        f"p_max = {self.spec.p_max:.3g} Pa") for f in exc.failures],
+                                                        f"micro.p_max = {self.spec.p_max:.3g} Pa") for f in exc.failures],
                                    exc.result, FULL_CONTACT if full else "") from None
                 laws = exc.result
                 self.levels[[f.zone_id for f in exc.failures]] = level + 1

@@ -610,7 +610,7 @@ def test_laws_failing_at_every_p_max_say_how_it_was_reached(tmp_path):
     from multiscale.micro.laws import LawError
     from multiscale.rough import FULL_CONTACT, P_MAX_HALVINGS
     with pytest.raises(LawError, match=rf"close to full contact\); lower p_max \(this law's: 6.25e\+06 Pa\), reached by "
-                                       rf"{P_MAX_HALVINGS} halvings of p_max = 1e\+08 Pa") as caught:
+                                       rf"{P_MAX_HALVINGS} halvings of micro.p_max = 1e\+08 Pa") as caught:
         run_pod(tmp_path / "full", {"roughness.rms": "0.01 um", "micro.p_max": "100 MPa", "time.steps": 1,
                                     "time.end": "0.6 s"})
     assert str(caught.value).endswith(FULL_CONTACT)
