@@ -139,3 +139,13 @@ def test_the_micro_patch_tutorial_runs_and_gives_the_numbers_it_quotes(capsys):
     assert 1e6 * r.approach == pytest.approx(approach, abs=5e-4)       # quoted to 1e-3 um
     assert 100 * r.area_fraction == pytest.approx(area, abs=5e-3)      # quoted to 0.01 %
     assert r.iterations == iterations
+
+
+def test_the_readme_names_every_tutorial_of_the_user_guide():
+    """README's summary of the user guide names each tutorial by its title (before: the braking
+    cycle tutorial was missing from it)."""
+    root = Path(__file__).resolve().parents[1]
+    readme = " ".join((root / "README.md").read_text().split())
+    for page in sorted((root / "docs" / "tutorials").glob("*.rst")):
+        title = page.read_text().splitlines()[0].removeprefix("Tutorial: ")
+        assert title in readme, f"{page.name}: {title!r}"
