@@ -66,6 +66,19 @@ def test_the_folder_holds_exactly_what_check_promised(case, capsys):
     assert all(f"    {name} " in shown for name in p.files)      # check lists every file
 
 
+def test_check_names_every_column_of_modes_csv(case):
+    """check's line for modes.csv names each column the squeal run writes (before: not the
+    unstable and potentially unstable flags)."""
+    scene, p, result = case
+    if p.analysis != "squeal":
+        pytest.skip("modes.csv: squeal analysis only")
+    words = {"frequency_Hz": "frequency", "sigma_1_per_s": "growth rate", "damping_ratio": "damping ratio",
+             "unstable": "unstable", "potentially_unstable": "potentially unstable", "residual": "residual"}
+    header = (p.folder / "modes.csv").read_text().splitlines()[0].split(",")
+    assert set(header) == {"mode", *words}
+    assert all(w in p.files["modes.csv"] for w in words.values())
+
+
 def test_field_files_hold_one_mesh_with_named_arrays_at_the_output_times(case):
     import h5py
     import meshio
