@@ -127,7 +127,7 @@ def launcher_problem(comm, environ=None) -> tuple[str, bool] | None:
             continue
         if size > 1:
             mpiexec = Path(sys.executable).parent / "mpiexec"
-            message = (f"started by a {name} launcher for {size} processes ({size_var}={size}), but every process "
+            message = (f"started by the {name} launcher for {size} processes ({size_var}={size}), but every process "
                        f"sees an MPI world of 1: that launcher belongs to another MPI than the one multiscale "
                        f"uses. Start parallel runs with the mpiexec of this environment: {mpiexec} -n {size} "
                        f"multiscale ...")

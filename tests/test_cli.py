@@ -238,7 +238,7 @@ def test_a_foreign_mpi_launcher_is_detected(tmp_path, capsys, monkeypatch, fake_
     monkeypatch.setenv("OMPI_COMM_WORLD_RANK", "0")
     assert main(["run", path]) == 2
     err = capsys.readouterr().err
-    assert "Open MPI launcher for 2 processes" in err and f"{Path(sys.executable).parent / 'mpiexec'} -n 2" in err
+    assert "started by the Open MPI launcher for 2 processes" in err and f"{Path(sys.executable).parent / 'mpiexec'} -n 2" in err
     assert fake_runner == []
     monkeypatch.setenv("OMPI_COMM_WORLD_RANK", "1")             # the other processes stay silent
     assert main(["run", path]) == 2 and capsys.readouterr().err == ""
