@@ -3,6 +3,7 @@ traceback; a summary for a good scene; earlier results are not overwritten witho
 import io
 import json
 import os
+import subprocess
 import sys
 import types
 from pathlib import Path
@@ -194,7 +195,6 @@ def test_run_without_runner_says_so(tmp_path, capsys, monkeypatch):
 
 
 def test_check_does_not_import_dolfinx(tmp_path):
-    import subprocess
     code = ("import sys; from multiscale.cli import main; rc = main(['check', sys.argv[1]]); "
             "assert not any(m.split('.')[0] in ('dolfinx', 'gmsh', 'petsc4py') for m in sys.modules), "
             "sorted(m for m in sys.modules if 'dolfinx' in m or 'gmsh' in m); sys.exit(rc)")
@@ -208,6 +208,9 @@ def test_version_prints_the_package_version(capsys):
     with pytest.raises(SystemExit) as stop:
         main(["--version"])
     assert stop.value.code == 0 and capsys.readouterr().out.strip() == f"multiscale {__version__}"
+    # python -m multiscale is the command too (before: "No module named multiscale.__main__")
+    ran = subprocess.run([sys.executable, "-m", "multiscale", "--version"], capture_output=True, text=True)
+    assert ran.returncode == 0 and ran.stdout.strip() == f"multiscale {__version__}", ran.stderr
 
 
 def _commands():
