@@ -36,22 +36,24 @@ from multiscale.macro.eigen import TWO_PI, ModalResult, check_band, lambda_from_
 
 
 class ShiftInvert:
-    """MUMPS LDL^T factors of K - theta_t M (K symmetric) that solve blocks of right-hand sides
-    (a too-small workspace retried, ``macro.mumps``); raises InputError if K - theta_t M cannot be
-    factorised (singular). ``destroy`` frees them."""
+    """MUMPS LDL^T factors of K - theta_t M (K symmetric; LU with ``symmetric=False``) that solve
+    blocks of right-hand sides (a too-small workspace retried, ``macro.mumps``); raises InputError
+    if K - theta_t M cannot be factorised (singular). ``destroy`` frees them."""
 
-    def __init__(self, K: PETSc.Mat, M: PETSc.Mat, shift: float = 0.0, prefix: str = "modes_"):
+    def __init__(self, K: PETSc.Mat, M: PETSc.Mat, shift: float = 0.0, prefix: str = "modes_",
+                 symmetric: bool = True):
         self.shift = float(shift)
         self.A = K
         if self.shift:
             self.A = K.duplicate(copy=True)
             self.A.axpy(-self.shift, M, PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-        self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        if symmetric:
+            self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         self.ksp = PETSc.KSP().create(K.getComm())
         self.ksp.setOperators(self.A)
         self.ksp.setType(PETSc.KSP.Type.PREONLY)
         pc = self.ksp.getPC()
-        pc.setType(PETSc.PC.Type.CHOLESKY)
+        pc.setType(PETSc.PC.Type.CHOLESKY if symmetric else PETSc.PC.Type.LU)
         if PETSc.Sys.hasExternalPackage("mumps"):
             pc.setFactorSolverType("mumps")
         self.ksp.setOptionsPrefix(prefix)
@@ -68,9 +70,10 @@ class ShiftInvert:
                              f"K - (2 pi target)^2 M could not be factorised (singular at this shift? a free "
                              f"body needs a target > 0 away from an eigenvalue) [{failed}]")
 
-    def solve(self, X: np.ndarray) -> np.ndarray:
-        """(K - theta_t M)^-1 X for real columns X of owned entries."""
-        return block_solve(self.ksp, X)
+    def solve(self, X: np.ndarray, transpose: bool = False) -> np.ndarray:
+        """(K - theta_t M)^-1 X (with ``transpose`` (K^T - theta_t M)^-1 X) for real columns X of
+        owned entries."""
+        return block_solve(self.ksp, X, transpose)
 
     def destroy(self) -> None:
         self.ksp.destroy()

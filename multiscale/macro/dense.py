@@ -41,12 +41,15 @@ def mat_mult(A: PETSc.Mat, X: np.ndarray) -> np.ndarray:
         B.destroy()
 
 
-def block_solve(ksp: PETSc.KSP, X: np.ndarray) -> np.ndarray:
-    """The solutions of ``ksp``'s operator for the real right-hand sides X (KSPMatSolve)."""
+def block_solve(ksp: PETSc.KSP, X: np.ndarray, transpose: bool = False) -> np.ndarray:
+    """The solutions of ``ksp``'s operator (its transpose with ``transpose``) for the real
+    right-hand sides X (KSPMatSolve, KSPMatSolveTranspose)."""
+    if X.shape[1] == 0:
+        return np.empty_like(X)
     A = ksp.getOperators()[0]
     B, Y = to_dense(X, A), to_dense(np.zeros_like(X), A)
     try:
-        ksp.matSolve(B, Y)
+        (ksp.matSolveTranspose if transpose else ksp.matSolve)(B, Y)
         return Y.getDenseArray().copy()
     finally:
         B.destroy(), Y.destroy()

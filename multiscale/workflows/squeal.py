@@ -58,6 +58,7 @@ from multiscale.workflows.strain import overloaded
 
 SQUEAL_DEGREE = 2     # quadratic tetrahedra: linear ones are far too stiff in bending (tests)
 MAP_RESIDUAL = 1e-3   # a stability map's modes with larger relative residuals are warned to be approximate
+MODE_RESIDUAL = 3e-2  # the analysis' modes with larger relative residuals are warned to be approximate
 
 
 @dataclass(frozen=True)
@@ -213,10 +214,26 @@ class SquealResult(RunResult):
     warnings: tuple = ()             # what the results leave out or approximate (one line each)
 
 
+def approximate_modes(scene, case: SquealCase) -> list[str]:
+    """A warning naming the modes whose relative residual of the full problem exceeds
+    ``MODE_RESIDUAL`` (a projected solve's modes; the exact solvers' are near round-off)."""
+    st, modes = scene.stability, case.modes
+    bad = np.flatnonzero(modes.errors > MODE_RESIDUAL)
+    if not bad.size:
+        return []
+    named = ", ".join(f"{j + 1} ({modes.frequency[j]:.0f} Hz, {modes.errors[j]:.1e})" for j in bad[:6])
+    more = f" and {bad.size - 6} more" if bad.size > 6 else ""
+    hysteretic = st.damping or "material loss factors" in case.terms
+    exact = "" if hysteretic else '; stability.method = "quadratic" solves viscous damping exactly'
+    return [f"modes {named}{more} have relative residuals above {MODE_RESIDUAL:g}: their frequencies and growth "
+            f"rates are approximate (projected on the modes up to stability.basis x f_max; a larger "
+            f"stability.basis, now {st.basis:g}, widens the basis{exact})"]
+
+
 def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
-    """Warnings: a band cut short by stability.modes, a map whose modes are approximate, a contact
-    pressure beyond small strains (at the preload, or at a map point's own preload)."""
-    st, out = scene.stability, []
+    """Warnings: a band cut short by stability.modes, modes or a map whose modes are approximate, a
+    contact pressure beyond small strains (at the preload, or at a map point's own preload)."""
+    st, out = scene.stability, approximate_modes(scene, case)
     f = case.modes.frequency
     top = float(f.max(initial=0.0))
     lo, hi = st.band
