@@ -202,12 +202,15 @@ def test_modes_with_large_residuals_are_warned_about():
     lam = np.array([-28.8 + 4714.0j, -40.4 + 9688.0j, -1.1 + 9884.0j])
     modes = eigen.ModalResult(lam, -lam**2, np.zeros((1, 3)), np.array([0.22, 0.031, 1e-3]), (0.0, 16e3), 0.0, 1,
                               "projection", 0, 0, 0.0)
-    scene = NS(stability=NS(basis=1.5, damping=0.0))
+    scene = NS(stability=NS(basis=1.5, damping=0.0, method="auto"))
     lossy = squeal.approximate_modes(scene, NS(modes=modes, terms=("material loss factors",)))
     assert lossy == ["modes 1 (750 Hz, 2.2e-01), 2 (1542 Hz, 3.1e-02) have relative residuals above 0.03: their "
                      "frequencies and growth rates are approximate (projected on the modes up to stability.basis x "
                      "f_max; a larger stability.basis, now 1.5, widens the basis)"]
     viscous = squeal.approximate_modes(scene, NS(modes=modes, terms=("friction slope",)))
+    subspace = NS(stability=NS(basis=1.5, damping=0.0, method="subspace"))     # a wider basis did not help it
+    assert squeal.approximate_modes(subspace, NS(modes=modes, terms=("material loss factors",)))[0].endswith(
+        "widens the basis; stability.method = \"projection\" adds the static responses to the loss factors' forces)")
     assert viscous[0].endswith('widens the basis; stability.method = "quadratic" solves viscous damping exactly)')
     modes.errors[:] = 1e-3
     assert squeal.approximate_modes(scene, NS(modes=modes, terms=())) == []

@@ -223,11 +223,14 @@ def approximate_modes(scene, case: SquealCase) -> list[str]:
         return []
     named = ", ".join(f"{j + 1} ({modes.frequency[j]:.0f} Hz, {modes.errors[j]:.1e})" for j in bad[:6])
     more = f" and {bad.size - 6} more" if bad.size > 6 else ""
-    hysteretic = st.damping or "material loss factors" in case.terms
-    exact = "" if hysteretic else '; stability.method = "quadratic" solves viscous damping exactly'
+    lossy = "material loss factors" in case.terms
+    if st.method == "subspace" and lossy:        # its basis has no static responses to H (docs/squeal.md)
+        hint = '; stability.method = "projection" adds the static responses to the loss factors\' forces'
+    else:
+        hint = "" if st.damping or lossy else '; stability.method = "quadratic" solves viscous damping exactly'
     return [f"modes {named}{more} have relative residuals above {MODE_RESIDUAL:g}: their frequencies and growth "
             f"rates are approximate (projected on the modes up to stability.basis x f_max; a larger "
-            f"stability.basis, now {st.basis:g}, widens the basis{exact})"]
+            f"stability.basis, now {st.basis:g}, widens the basis{hint})"]
 
 
 def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
