@@ -143,8 +143,12 @@ def test_a_full_disk_keeps_the_previous_checkpoint(stopped, tmp_path, monkeypatc
     shutil.copytree(checkpoint.parent, folder)
     before = (folder / "checkpoint.h5").read_bytes()
 
-    def full(*args):
-        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+    replace = os.replace
+
+    def full(src, dst, *args, **kw):         # the checkpoint's rename (the resumed part's provenance is written before)
+        if os.path.basename(dst) == "checkpoint.h5":
+            raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
+        return replace(src, dst, *args, **kw)
     monkeypatch.setattr(os, "replace", full)
     with pytest.raises(OutputError, match="cannot write the checkpoint .*No space left on device"):
         run(_with_folder(scene, folder), resume=True, verbose=False)
