@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from multiscale.errors import InputError, SceneError
-from multiscale.micro.topography import TopographyWarning, covers, read_topography
+from multiscale.micro.topography import TopographyWarning, check_resolved, covers, read_topography
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
@@ -484,13 +484,16 @@ def _nyquist(scene: Scene) -> list[str]:
 
 
 def _measured_cover(scene: Scene) -> list[str]:
-    """A measurement used as it is (``cover = "measured"``) covers its face: the run's refusal
-    (``topography.covers``) before meshing, for the faces whose extent the geometry knows then
-    (``GeometrySpec.interface_extents``; the others are refused after meshing)."""
+    """A measurement used as it is (``cover = "measured"``) covers its face, one drawn from
+    (``"equivalent"``) holds a wavelength the face's micro grid resolves (``micro.zones`` x
+    ``micro.grid``, default ``DEFAULT_GRID``, as the run's): the run's refusals
+    (``topography.covers``, ``topography.check_resolved``) before meshing, for the faces whose extent
+    the geometry knows then (``GeometrySpec.interface_extents``; the others are refused after meshing)."""
     out = []
     for name in scene.rough_interfaces:
-        r, size = scene.interface_settings(name).roughness, scene.geometry.spec.interface_extents.get(name)
-        if r is None or r.file is None or r.cover != "measured" or size is None:
+        s, size = scene.interface_settings(name), scene.geometry.spec.interface_extents.get(name)
+        r = s.roughness
+        if r is None or r.file is None or r.cover not in ("measured", "equivalent") or size is None:
             continue
         prefix = f"{scene.roughness_key(name)}."
         try:
@@ -498,7 +501,11 @@ def _measured_cover(scene: Scene) -> list[str]:
                 warnings.simplefilter("ignore", TopographyWarning)
                 measured = read_topography(r.file, r.channel, pixel_size=r.pixel_size, height_unit=r.height_unit,
                                            prefix=prefix)
-            covers(measured.size, size, r.cover, prefix=prefix)
+            if r.cover == "measured":
+                covers(measured.size, size, r.cover, prefix=prefix)
+            else:
+                cells = [z * g for z, g in zip(s.micro.zones, s.micro.grid or DEFAULT_GRID)]
+                check_resolved(measured.size, cells, size, prefix=prefix)
         except InputError as exc:
             out.append(str(exc))
     return sorted(set(out))

@@ -96,11 +96,11 @@ def test_surface_command_lists_the_formats(capsys):
 
 
 def test_scene_reads_a_measured_file_with_its_options(tmp_path):
-    s = scene(tmp_path, f'file = "{TOP}"\nchannel = 0\ndetrend = "poly2"\ncutoff = "0.2 um"\ncover = "equivalent"\n'
-                        'seed = 4\nmax_undefined = 0.2')
+    s = scene(tmp_path, f'file = "{TOP}"\nchannel = 0\ndetrend = "poly2"\ncutoff = "0.2 um"\ncover = "mirror"\n'
+                        'seed = 4\nmax_undefined = 0.2')    # ("equivalent" of 0.6 um on a 10 mm face: refused, flat)
     r = s.roughness
     assert (r.file, r.channel, r.detrend, r.cutoff, r.cover, r.seed, r.max_undefined) == (
-        TOP, 0, "poly2", pytest.approx(2e-7), "equivalent", 4, 0.2)
+        TOP, 0, "poly2", pytest.approx(2e-7), "mirror", 4, 0.2)
     assert r.pixel_size is None and r.height_unit is None and s.warnings == ()
     over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "tile"')
     assert over.warnings == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",)
@@ -138,8 +138,9 @@ def test_check_of_a_bad_file_runs_nothing_heavy(tmp_path):
 def test_zones_from_a_measured_file_for_every_cover(tmp_path):
     from multiscale.workflows import rough
 
-    def make_zones(s, *args, **kwargs):
-        return rough.make_zones(s.roughness, s.micro, *args, **kwargs)
+    def make_zones(s, *args, cover=None, **kwargs):       # cover: instead of the scene's
+        r = s.roughness if cover is None else dataclasses.replace(s.roughness, cover=cover)
+        return rough.make_zones(r, s.micro, *args, **kwargs)
 
     lo = (0.0, 0.0)
     lines = []
@@ -159,17 +160,18 @@ def test_zones_from_a_measured_file_for_every_cover(tmp_path):
                                          r'does not cover the interface'):
         rough.make_zones(as_is, tiled.micro, lo, (1e-6, 1e-6), seed=0)
     # a statistically equivalent face: 50 x 50 cells per zone unless micro.grid says otherwise, seeded
-    eq = scene(tmp_path, f'file = "{TOP}"\ncover = "equivalent"\nseed = 3')
+    # (on the faces given here: on the block's, the 0.6 um measurement is shorter than a cell)
+    eq = scene(tmp_path, f'file = "{TOP}"\ncover = "tile"\nseed = 3')
     lines = []
-    _, a = make_zones(eq, lo, (4e-6, 4e-6), seed=10, log=lines.append)
-    _, b = make_zones(eq, lo, (4e-6, 4e-6), seed=10)
+    _, a = make_zones(eq, lo, (4e-6, 4e-6), seed=10, log=lines.append, cover="equivalent")
+    _, b = make_zones(eq, lo, (4e-6, 4e-6), seed=10, cover="equivalent")
     assert a[0].shape == (50, 50) and np.array_equal(a[3].surface.heights, b[3].surface.heights)
     assert any("statistically equivalent surface" in line for line in lines)
     # what overrides the file is a warning of the scene (printed at the start of a run), not a report
     # line again (it was printed twice)
-    over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "equivalent"')
+    over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "tile"')
     lines = []
-    make_zones(over, lo, (4e-6, 4e-6), seed=10, log=lines.append)
+    make_zones(over, lo, (4e-6, 4e-6), seed=10, log=lines.append, cover="equivalent")
     assert over.warnings == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",)
     assert lines[0].startswith("roughness: read top-1.top") and not any("overrides" in line for line in lines)
 
@@ -203,6 +205,29 @@ def test_a_measurement_smaller_than_the_face_is_refused_by_check_before_meshing(
     assert main(["check", str(tmp_path / "wide.toml")]) == 0
     # other covers than "measured" take a small measurement (with a warning, at the run)
     assert scene(tmp_path, 'file = "short.npy"\npixel_size = "200 um"\ncover = "tile"').roughness.cover == "tile"
+
+
+def test_an_equivalent_cover_the_grid_cannot_resolve_is_refused_by_check_before_meshing(tmp_path):
+    """cover = "equivalent" from a measurement shorter than a cell of the face's micro grid along
+    both axes (x3p-2.x3p's 0.08 x 0.2 mm on the 312.5 um cells of the block's 10 mm face at 2 x 16)
+    passed `multiscale check`; the run refused its flat surface when it built the zones, after
+    meshing. Now the scene's check, which a run makes before meshing, refuses it with the run's
+    message under the interface's own key; 0.4 mm along one axis passes."""
+    rng = np.random.default_rng(4)
+    np.save(tmp_path / "wide.npy", rng.normal(0.0, 1e-6, (64, 64)))       # 12.8 mm at 200 um: [roughness]
+    np.save(tmp_path / "small.npy", rng.normal(0.0, 1e-6, (40, 16)))      # 0.08 x 0.2 mm at 5 um
+    own = ('grid = [16, 16]\n[interfaces.interface.roughness]\nfile = "small.npy"\npixel_size = "{pixel}"\n'
+           'cover = "equivalent"')
+    with pytest.raises(SceneError) as info:
+        scene(tmp_path, 'file = "wide.npy"\npixel_size = "200 um"', own.format(pixel="5 um"))
+    # the run's refusal of that face (multiscale.workflows.rough.measured_face, after meshing)
+    measured = condition(read_topography(tmp_path / "small.npy", pixel_size=5e-6)).surface
+    with pytest.raises(InputError) as later:
+        cover(measured, (32, 32), (10e-3, 10e-3), "equivalent", prefix="interfaces.interface.roughness.")
+    assert info.value.problems == [str(later.value)]
+    assert str(later.value).startswith("interfaces.interface.roughness.cover = 'equivalent': the measurement (0.08 x "
+                                       "0.2 mm) holds no wavelength the micro grid resolves (32 x 32 cells of 312.5")
+    scene(tmp_path, 'file = "wide.npy"\npixel_size = "200 um"', own.format(pixel="10 um"))     # 0.16 x 0.4 mm
 
 
 def test_a_rewritten_measured_file_changes_the_runs_fingerprint(tmp_path):

@@ -13,7 +13,7 @@ import SurfaceTopography as ST
 from SurfaceTopography.Support.UnitConversion import get_unit_conversion_factor
 
 from multiscale.errors import InputError
-from multiscale.micro import topography
+from multiscale.micro import spectrum, topography
 from multiscale.micro.reading import formats
 from multiscale.micro.spectrum import surface_statistics
 from multiscale.micro.surface import Surface, fractal_surface, load_surface
@@ -481,7 +481,7 @@ def test_read_topography_takes_a_path_like_and_a_home_folder_not_an_open_file(tm
 
 
 def test_an_equivalent_surface_with_no_measured_wavelength_on_the_grid_is_refused():
-    """A measurement smaller than two cells of the micro grid (x3p-2.x3p, 0.08 x 0.2 mm, on the
+    """A measurement shorter than a cell of the micro grid (x3p-2.x3p, 0.08 x 0.2 mm, on the
     312.5 um cells of a 10 mm face at 32 x 32) gave a flat "equivalent" surface (Sq 0, reported as
     such) and the run failed in the zone laws with "lower p_max". Refused, naming the cause."""
     s = fractal_surface(64, 64e-6, 0.8, 2, 16, 1e-6, seed=2)
@@ -492,3 +492,21 @@ def test_an_equivalent_surface_with_no_measured_wavelength_on_the_grid_is_refuse
                                "the micro grid resolves (32 x 32 cells of 312.5 x 312.5 um: wavelengths from 625 um "
                                "up): the equivalent surface would be flat; use a finer micro.grid or a larger measurement")
     assert cover(s, (320, 320), (1e-3, 1e-3), "equivalent")[0].heights.std() > 0.1 * s.heights.std()
+
+
+@pytest.mark.parametrize("cells, flat", [((64e-6 * (1 + 1e-9),) * 2, True), ((64e-6 * (1 - 1e-9),) * 2, False),
+                                         ((64e-6 * (1 + 1e-9), 64e-6 * (1 - 1e-9)), False)])
+def test_check_resolved_says_what_the_equivalent_surface_would_be(cells, flat):
+    """``check_resolved`` (what `multiscale check` asks before meshing, and ``cover``) refuses
+    exactly the grids on which ``equivalent_surface`` is flat: a measurement shorter than one cell
+    along both axes (its longest wavelength, 2 m, shorter than the grid's shortest, two cells)."""
+    s = fractal_surface(64, 64e-6, 0.8, 2, 16, 1e-6, seed=2)
+    s = Surface(s.heights, s.dx, s.dy, periodic=False)          # 64 x 64 um
+    n, size = (8, 8), (8 * cells[0], 8 * cells[1])
+    drawn = spectrum.equivalent_surface(spectrum.power_spectrum(s), n, size)
+    assert (not np.any(drawn.heights)) == flat
+    if flat:
+        with pytest.raises(InputError, match="roughness.cover = 'equivalent': the measurement .* holds no wavelength"):
+            topography.check_resolved(s.size, n, size, prefix="roughness.")
+    else:
+        topography.check_resolved(s.size, n, size, prefix="roughness.")

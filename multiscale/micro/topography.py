@@ -15,7 +15,9 @@ S-filter when it coarsens.
 Covering an interface (``cover``): the measurement itself (it must cover the interface: ``covers``,
 which ``multiscale check`` asks before meshing), mirrored or tiled copies (with a warning:
 wavelengths longer than the measurement are missing and the pattern repeats), or a statistically
-equivalent surface drawn from the measured PSD (``multiscale.micro.spectrum.equivalent_surface``).
+equivalent surface drawn from the measured PSD (``multiscale.micro.spectrum.equivalent_surface``;
+the measurement must hold a wavelength the micro grid resolves: ``check_resolved``, asked before
+meshing too).
 """
 from __future__ import annotations
 
@@ -333,14 +335,9 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
     short = not covers(surface.size, (Lx, Ly), method, prefix)
     wide, target = _sized("the measurement", surface.size), _sized("the interface", (Lx, Ly))
     if method == "equivalent":
-        spectrum = power_spectrum(surface)
-        s = equivalent_surface(spectrum, (nx, ny), (Lx, Ly), seed)
+        check_resolved(surface.size, (nx, ny), (Lx, Ly), prefix)
+        s = equivalent_surface(power_spectrum(surface), (nx, ny), (Lx, Ly), seed)
         s = Surface(s.heights, s.dx, s.dy, periodic=False)
-        if not np.any(s.heights):     # flat: its zone laws failed later, "lower p_max", far from the cause
-            raise InputError(f"{prefix}cover", method, f"{wide} holds no wavelength the micro grid resolves ({nx} x {ny} "
-                             f"cells of {Lx / nx * 1e6:.4g} x {Ly / ny * 1e6:.4g} um: wavelengths from "
-                             f"{2 * max(Lx / nx, Ly / ny) * 1e6:.4g} um up): the equivalent surface would be flat; "
-                             "use a finer micro.grid or a larger measurement")
         return s, [f"statistically equivalent surface over {target} from the measured PSD (seed {seed}): "
                    f"{nx} x {ny} cells of {Lx / nx * 1e6:.4g} x {Ly / ny * 1e6:.4g} um, Sq {_um(float(s.heights.std()))} "
                    f"um (measured {_um(float(surface.heights.std()))} um; the grid resolves wavelengths down to "
@@ -400,6 +397,23 @@ def covers(measured, size, method: str = "measured", prefix: str = "") -> bool:
                          f"{_sized('the interface', size)}: use "
                          "\"equivalent\" (a statistically equivalent surface) or \"mirror\"/\"tile\" (copies)")
     return not short
+
+
+def check_resolved(measured, n, size, prefix: str = "") -> None:
+    """The InputError of ``cover = "equivalent"`` if a measurement of ``measured`` = (mx, my) [m]
+    holds no wavelength that a grid of n = (nx, ny) cells over ``size`` = (Lx, Ly) [m] resolves: its
+    equivalent surface would be flat (its zone laws then failed far from the cause, "lower p_max").
+    ``equivalent_surface`` draws only the wavevectors that both the measured PSD and the grid hold
+    (|q_x| <= π nx/Lx, |q_y| <= π ny/Ly); the measured PSD (``power_spectrum``: the mirror-stitched
+    double, period 2 mx x 2 my) has its lowest at q_x = π/mx and q_y = π/my, so the measurement must
+    be at least one cell long along an axis (its longest wavelength 2 m, the grid's shortest two
+    cells). ``multiscale check`` asks it with the face's extent before meshing, a run with the mesh's."""
+    (mx, my), (nx, ny), (Lx, Ly) = measured, n, size
+    if mx * (1 + 1e-12) < Lx / nx and my * (1 + 1e-12) < Ly / ny:     # equivalent_surface's tolerance
+        raise InputError(f"{prefix}cover", "equivalent", f"{_sized('the measurement', measured)} holds no wavelength "
+                         f"the micro grid resolves ({nx} x {ny} cells of {Lx / nx * 1e6:.4g} x {Ly / ny * 1e6:.4g} um: "
+                         f"wavelengths from {2 * max(Lx / nx, Ly / ny) * 1e6:.4g} um up): the equivalent surface would "
+                         "be flat; use a finer micro.grid or a larger measurement")
 
 
 def _sized(what: str, size) -> str:
