@@ -19,7 +19,7 @@ from multiscale.errors import InputError, MultiscaleError, OutputError, SceneErr
 from multiscale.geometry import too_many_cells
 from multiscale.io import CtrlCWatch, abort, ended_together, memory_available
 from multiscale.micro.outliers import DESPIKE
-from multiscale.micro.reading import TopographyWarning, formats, read_topography
+from multiscale.micro.reading import COMMAND_LINE, TopographyWarning, formats, read_topography
 from multiscale.micro.spectrum import statistics_memory, surface_statistics
 from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition
 from multiscale.outputs import CHECKPOINT, analysis, folder_problem, plan
@@ -300,21 +300,18 @@ def _surface(args) -> int:
             raise InputError("--figure", args.figure, f"cannot write the figure there: {why}")
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", TopographyWarning)      # the report's "warning:" lines say them
-        try:
-            measurement = read_topography(args.file, args.channel, pixel_size=pixel, height_unit=unit)
-            need, free = surface_memory(measurement.shape), memory_available()
-            if free is not None and need > free:      # the OOM killer ended it, without a word (8000² points)
-                raise InputError("file", measurement.path.name, f"{measurement.shape[1]} x {measurement.shape[0]} "
-                                 f"points: their statistics need about {need / 1e9:.2g} GB of memory, {free / 1e9:.2g} GB are "
-                                 "available: crop or coarsen the map first")
-            if cutoff is not None and plain(_number_or_text(args.cutoff)) and cutoff > min(measurement.size):
-                Lx, Ly = measurement.size       # ISO cut-offs are given in mm: "--cutoff 0.8" was 0.8 m, silently
-                raise InputError("cutoff", args.cutoff, f"{cutoff:g} m, longer than the measurement ({Lx * 1e3:.4g} x "
-                                 f'{Ly * 1e3:.4g} mm); plain numbers are metres: did you mean "{args.cutoff} mm"?')
-            done = condition(measurement, args.detrend, cutoff, args.max_undefined, despike=args.despike)
-        except InputError as exc:     # the micro fields by their command-line names
-            name = "FILE" if exc.name == "file" else "--" + exc.name.replace("_", "-")
-            raise InputError(name, exc.value, exc.allowed) from None
+        measurement = read_topography(args.file, args.channel, pixel_size=pixel, height_unit=unit, prefix=COMMAND_LINE)
+        need, free = surface_memory(measurement.shape), memory_available()
+        if free is not None and need > free:      # the OOM killer ended it, without a word (8000² points)
+            raise InputError("FILE", measurement.path.name, f"{measurement.shape[1]} x {measurement.shape[0]} "
+                             f"points: their statistics need about {need / 1e9:.2g} GB of memory, {free / 1e9:.2g} GB "
+                             "are available: crop or coarsen the map first")
+        if cutoff is not None and plain(_number_or_text(args.cutoff)) and cutoff > min(measurement.size):
+            Lx, Ly = measurement.size       # ISO cut-offs are given in mm: "--cutoff 0.8" was 0.8 m, silently
+            raise InputError("--cutoff", args.cutoff, f"{cutoff:g} m, longer than the measurement ({Lx * 1e3:.4g} x "
+                             f'{Ly * 1e3:.4g} mm); plain numbers are metres: did you mean "{args.cutoff} mm"?')
+        done = condition(measurement, args.detrend, cutoff, args.max_undefined, prefix=COMMAND_LINE,
+                         despike=args.despike)      # errors and notes name the options as given here
     stats = surface_statistics(done.surface)
     print("\n".join(done.report))
     print(f"statistics of the {'roughness' if done.waviness is not None else 'surface'}:")

@@ -90,6 +90,23 @@ def test_surface_command_figure_that_cannot_be_written_is_one_line(tmp_path, cap
     assert out == "" and list(tmp_path.iterdir()) == []
 
 
+def test_surface_command_warnings_name_its_options_a_scenes_warnings_its_keys(tmp_path, capsys):
+    """`multiscale surface FILE --height-unit ... --pixel-size ...` warned "height_unit = ... overrides"
+    and "file = '...': ... is height_unit right?" (the scene's keys) where its errors say --height-unit
+    and FILE. Now its options (reading.option); the scene's warnings of the same file keep its keys."""
+    assert main(["surface", str(TOP), "--height-unit", "1 mm", "--pixel-size", "3 nm", "--figure", "none"]) == 0
+    warned = [line for line in capsys.readouterr().out.splitlines() if line.startswith("warning: ")]
+    heights = ("'top-1.top': heights up to 0.134 m (Sq 0.00315 m, one unit of the file = 0.001 m), far beyond a "
+               "rough surface's: is {}height_unit right?")
+    assert warned == ["warning: --pixel-size 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",
+                      "warning: --height-unit 0.001 m overrides the file's unit (nm = 1e-09 m)",
+                      "warning: FILE = " + heights.replace("{}height_unit", "--height-unit")]
+    s = scene(tmp_path, f'file = "{TOP}"\nheight_unit = "1 mm"\npixel_size = "3 nm"\ncover = "tile"')
+    assert s.warnings == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",
+                          "roughness.height_unit = 0.001 m overrides the file's unit (nm = 1e-09 m)",
+                          "roughness.file = " + heights.format("roughness."))
+
+
 def test_surface_command_lists_the_formats(capsys):
     assert main(["surface", "--formats"]) == 0
     assert "XML 3D surface profile (X3P) (.x3p)" in capsys.readouterr().out

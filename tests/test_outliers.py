@@ -74,7 +74,7 @@ def test_condition_warns_and_keeps_them_unless_despike_removes_them():
                                                r"\(Sq 99.9 nm without them\), up to \+39.6 Sq"):
         kept = condition(m)
     line = next(line for line in kept.report if line.startswith("warning: outliers"))
-    assert "Ssk and Sku are theirs, not the surface's; kept (--despike 7 removes them" in line
+    assert "Ssk and Sku are theirs, not the surface's; kept (despike = 7 removes them" in line     # the keyword
     assert kept.notes == (line.removeprefix("warning: "),)
     assert kept.surface.heights.max() > 30e-7 and "filled 1 undefined points (0.00%)" in kept.report[-1]
     with warnings.catch_warnings():
@@ -114,7 +114,7 @@ def test_surface_command_warns_and_removes_with_despike(tmp_path, capsys):
     assert "warning: outliers in 'spiky.npy': 9 points" in out and "kept (--despike 7 removes them" in out
     assert main(["surface", str(path), "--pixel-size", "1 um", "--despike", "7"]) == 0
     out = capsys.readouterr().out
-    assert "warning" not in out and "removed 9 outliers (despike = 7)" in out and "filled 10 undefined" in out
+    assert "warning" not in out and "removed 9 outliers (--despike 7)" in out and "filled 10 undefined" in out
     assert main(["surface", str(path), "--pixel-size", "1 um", "--despike", "-1"]) == 2
     assert "--despike = -1" in capsys.readouterr().err
 

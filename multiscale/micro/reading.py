@@ -33,6 +33,20 @@ class TopographyWarning(UserWarning):
     """Something the file said was overridden, or an interface covered by copies of a measurement."""
 
 
+COMMAND_LINE = "--"       # the prefix that names the options as ``multiscale surface`` takes them
+
+
+def option(prefix: str, key: str, value: str | None = None) -> str:
+    """Option ``key`` (a keyword of ``read_topography`` or ``condition``) as messages name it, with
+    its ``value`` if given: ``prefix`` + key (a scene's "roughness.height_unit = 1e-09 m"; "" the
+    Python keyword) or, ``prefix`` ``COMMAND_LINE``, as ``multiscale surface`` takes it
+    ("--height-unit 1e-09 m"; the file: "FILE")."""
+    if prefix == COMMAND_LINE:
+        name = "FILE" if key == "file" else COMMAND_LINE + key.replace("_", "-")
+        return name if value is None else f"{name} {value}"
+    return prefix + key if value is None else f"{prefix}{key} = {value}"
+
+
 def formats() -> list[str]:
     """Name (extensions) of every format SurfaceTopography reads."""
     return [f"{r.name()} (.{', .'.join(r.file_extensions())})" for r in surface_topography().IO.readers
@@ -130,12 +144,12 @@ def _channel(reader, path: Path, channel, prefix: str):
     if channel is None:
         ch = reader.default_channel
     elif not isinstance(channel, (int, np.integer)) or not 0 <= channel < len(channels):
-        raise InputError(f"{prefix}channel", channel, f"{path.name} has the channels {listing}")
+        raise InputError(option(prefix, "channel"), channel, f"{path.name} has the channels {listing}")
     else:
         ch = channels[int(channel)]
     if ch.dim != 2:
-        raise InputError(f"{prefix}file", path.name, f"channel {ch.index} (\"{ch.name}\") is a {ch.dim}-D profile "
-                         f"(line scan): a height map (2-D) is needed; channels: {listing}")
+        raise InputError(option(prefix, "file"), path.name, f"channel {ch.index} (\"{ch.name}\") is a {ch.dim}-D "
+                         f"profile (line scan): a height map (2-D) is needed; channels: {listing}")
     return ch
 
 
@@ -147,26 +161,29 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
     date and size the format detection and the cache need. ``channel``: its index (default: the
     file's default channel). ``pixel_size`` (dx or (dx, dy) [m]) and ``height_unit`` [m per height
     unit of the file] override the file's (noted in ``Measurement.notes``); a plain matrix needs
-    ``pixel_size`` (``height_unit`` default 1). Errors (``InputError``) name the file and the field
-    ``prefix + "file"``, ``"channel"``, ... A file is read once per process while its modification
+    ``pixel_size`` (``height_unit`` default 1). Errors (``InputError``) and notes name the file and
+    the options as ``option(prefix, ...)`` does ("roughness.file", "--pixel-size", ...). A file is
+    read once per process while its modification
     time and size stay the same: the same ``Measurement`` (its heights read-only) is returned for
     the same options, up to ``KEPT_BYTES`` of heights kept (the latest read always); a file
     modified less than ``SETTLED`` before is read again (its next change might keep its time).
     """
     if not isinstance(path, (str, os.PathLike)):
         opened = hasattr(path, "read")
-        raise InputError(f"{prefix}file", f"an open {type(path).__name__}" if opened else path, "a file name (str or "
-                         f"os.PathLike, e.g. pathlib.Path){': pass the name of the open file' if opened else ''}")
+        raise InputError(option(prefix, "file"), f"an open {type(path).__name__}" if opened else path,
+                         "a file name (str or os.PathLike, e.g. pathlib.Path)"
+                         f"{': pass the name of the open file' if opened else ''}")
     path = Path(path).expanduser()
     if not path.is_file():
-        raise InputError(f"{prefix}file", path.name, f"{'a folder, not a file' if path.is_dir() else 'no such file'} "
+        raise InputError(option(prefix, "file"), path.name,
+                         f"{'a folder, not a file' if path.is_dir() else 'no such file'} "
                          f"({path})")
     stat = path.stat()
     if stat.st_size == 0:     # some readers take it for a 0 x 0 map, then ask for its pixel size
-        raise InputError(f"{prefix}file", path.name, "the file is empty (0 bytes)")
-    pair = None if pixel_size is None else check_pair(f"{prefix}pixel_size", pixel_size, check_positive)
+        raise InputError(option(prefix, "file"), path.name, "the file is empty (0 bytes)")
+    pair = None if pixel_size is None else check_pair(option(prefix, "pixel_size"), pixel_size, check_positive)
     if height_unit is not None:
-        check_positive(f"{prefix}height_unit", height_unit)
+        check_positive(option(prefix, "height_unit"), height_unit)
     key, stamp = (path.resolve(), repr(channel), pair, height_unit, prefix), (stat.st_mtime_ns, stat.st_size)
     kept = _KEPT.pop(key, None)
     m = kept[1] if kept is not None and kept[0] == stamp else _read(path, channel, pair, height_unit, prefix)
@@ -184,47 +201,49 @@ def _read(path: Path, channel, pair, height_unit: float | None, prefix: str) -> 
     """``read_topography``'s reading of the file ``path`` (checked), its heights made read-only."""
     if path.suffix.lower() in MATRIX_SUFFIXES:
         if channel not in (None, 0):
-            raise InputError(f"{prefix}channel", channel, f"{path.name} is a plain height matrix: one channel, 0")
+            raise InputError(option(prefix, "channel"), channel,
+                             f"{path.name} is a plain height matrix: one channel, 0")
         if pair is None:
-            raise InputError(f"{prefix}pixel_size", None, f"{path.name} is a plain height matrix without units: "
+            raise InputError(option(prefix, "pixel_size"), None, f"{path.name} is a plain height matrix without units: "
                              'give its pixel size, e.g. "0.5 um"')
         try:
             h = read_matrix(path) * (1.0 if height_unit is None else height_unit)
         except InputError as exc:
-            raise InputError(f"{prefix}file", path.name, exc.allowed) from None
+            raise InputError(option(prefix, "file"), path.name, exc.allowed) from None
         if np.any(np.isinf(h)):
-            raise InputError(f"{prefix}file", path.name, "the height matrix holds infinite values (NaN marks an "
+            raise InputError(option(prefix, "file"), path.name, "the height matrix holds infinite values (NaN marks an "
                              "undefined point)")
         notes = _height_range(h, path, prefix, "m" if height_unit is None else f"{height_unit:.4g} m")
         h.flags.writeable = False
         return Measurement(h, *pair, path, 0, "matrix", None, tuple(notes))
-    ch = _channel(_reader(path, f"{prefix}file"), path, channel, prefix)
+    ch = _channel(_reader(path, option(prefix, "file")), path, channel, prefix)
     unit = ch.unit if isinstance(ch.unit, str) else None
     notes = []
     try:
         t = ch.topography(**({} if ch.physical_sizes is not None else {"physical_sizes": ch.nb_grid_pts}))
         raw = t.heights()
     except Exception as exc:    # the header was fine, the data is not: still one error naming the file
-        raise InputError(f"{prefix}file", path.name, f"cannot read channel {ch.index} ({_first_line(exc)})") from None
+        raise InputError(option(prefix, "file"), path.name,
+                         f"cannot read channel {ch.index} ({_first_line(exc)})") from None
     factor = None if unit is None else surface_topography().Support.UnitConversion.get_unit_conversion_factor(unit, "m")
     if ch.physical_sizes is None or factor is None:
         if pair is None:
-            raise InputError(f"{prefix}pixel_size", None, f"{path.name} gives no lateral "
+            raise InputError(option(prefix, "pixel_size"), None, f"{path.name} gives no lateral "
                              f"{'size' if ch.physical_sizes is None else 'unit'}: give its pixel size, e.g. \"0.5 um\"")
         dx, dy = pair
     else:
         dx, dy = (float(v) * factor for v in t.pixel_size)
         if pair is not None:
-            notes.append(f"{prefix}pixel_size = {pair[0]:.4g} x {pair[1]:.4g} m overrides the file's "
+            notes.append(f"{option(prefix, 'pixel_size', f'{pair[0]:.4g} x {pair[1]:.4g} m')} overrides the file's "
                          f"{dx:.4g} x {dy:.4g} m")
             dx, dy = pair
     if height_unit is not None:
         if factor is not None:
-            notes.append(f"{prefix}height_unit = {height_unit:.4g} m overrides the file's unit "
+            notes.append(f"{option(prefix, 'height_unit', f'{height_unit:.4g} m')} overrides the file's unit "
                          f"({unit} = {factor:.4g} m)")
         factor = height_unit
     elif factor is None:
-        raise InputError(f"{prefix}height_unit", None, f"{path.name} gives no height unit: give it, e.g. \"nm\" "
+        raise InputError(option(prefix, "height_unit"), None, f"{path.name} gives no height unit: give it, e.g. \"nm\" "
                          "or \"1 um\"")
     h = np.ma.filled(np.ma.masked_invalid(np.ma.asarray(raw, dtype=float)), np.nan).T * factor
     notes += _height_range(h, path, prefix, f"{factor:.4g} m", f"channel {ch.index} (\"{ch.name}\")")
@@ -237,17 +256,17 @@ def _height_range(h: np.ndarray, path: Path, prefix: str, unit: str, what: str =
     (heights read in the wrong unit, e.g. um as m, m as nm); an InputError if the map is narrower than a ``Surface`` (4 points a
     side), none is defined or their spread overflows."""
     if min(h.shape) < 4:        # a line scan stored as a map, a tiny crop: Surface's error named no file
-        raise InputError(f"{prefix}file", path.name, f"{what} has {h.shape[1]} x {h.shape[0]} points: a height map "
-                         "of at least 4 x 4 points is needed")
+        raise InputError(option(prefix, "file"), path.name, f"{what} has {h.shape[1]} x {h.shape[0]} points: a "
+                         "height map of at least 4 x 4 points is needed")
     if not np.isfinite(h).any():
-        raise InputError(f"{prefix}file", path.name, f"{what} holds no defined height")
+        raise InputError(option(prefix, "file"), path.name, f"{what} holds no defined height")
     with np.errstate(over="ignore", invalid="ignore"):
         peak, sq = float(np.nanmax(np.abs(h))), float(np.nanstd(h))
     if not np.isfinite(sq):
-        raise InputError(f"{prefix}file", path.name, f"heights up to {peak:.3g} m overflow (one unit of the "
-                         f"file = {unit}): is {prefix}height_unit right?")
+        raise InputError(option(prefix, "file"), path.name, f"heights up to {peak:.3g} m overflow (one unit of the "
+                         f"file = {unit}): is {option(prefix, 'height_unit')} right?")
     if peak > TALLEST or 0 < peak < LOWEST:
-        return [f"{prefix}file = '{path.name}': heights up to {peak:.3g} m (Sq {sq:.3g} m, one unit of the file = "
-                f"{unit}), far {'beyond' if peak > TALLEST else 'below'} a rough surface's: is {prefix}height_unit "
-                "right?"]
+        return [f"{option(prefix, 'file')} = '{path.name}': heights up to {peak:.3g} m (Sq {sq:.3g} m, one unit of "
+                f"the file = {unit}), far {'beyond' if peak > TALLEST else 'below'} a rough surface's: is "
+                f"{option(prefix, 'height_unit')} right?"]
     return []

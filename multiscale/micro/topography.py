@@ -28,7 +28,7 @@ import numpy as np
 
 from multiscale.errors import InputError, check_count, check_instance, check_pair, check_positive, check_real
 from multiscale.micro.outliers import DESPIKE, find_outliers
-from multiscale.micro.reading import Measurement, TopographyWarning, read_topography
+from multiscale.micro.reading import Measurement, TopographyWarning, option, read_topography
 from multiscale.micro.spectrum import as_topography, equivalent_surface, power_spectrum
 from multiscale.micro.surface import Surface, defined_sums, row_blocks
 
@@ -55,7 +55,7 @@ def probe_topography(path, channel: int | None = None, *, pixel_size=None, heigh
     flattened = remove_form(m.heights, form)
     why = _too_many_undefined(m, max_undefined, prefix) or _form_only(m, flattened)
     if why is not None:
-        return [str(InputError(f"{prefix}file", m.path.name, why))], list(m.notes)
+        return [str(InputError(option(prefix, "file"), m.path.name, why))], list(m.notes)
     searched = flattened if detrend == form else None         # the outlier search's heights, if these
     return [], list(m.notes) + ([] if despike is not None else _outlier_notes(m, detrend, prefix, searched))
 
@@ -70,8 +70,7 @@ def _outlier_notes(m: Measurement, detrend: str, prefix: str, h: np.ndarray | No
             h = m.heights if DETREND[detrend] is None else remove_form(m.heights, detrend)
         m.found[detrend] = find_outliers(h)
     found = m.found[detrend]
-    option = f"{prefix}despike = {DESPIKE:g}" if prefix else f"--despike {DESPIKE:g}"
-    return [found.note(m.path.name, option)] if found.count else []
+    return [found.note(m.path.name, option(prefix, "despike", f"{DESPIKE:g}"))] if found.count else []
 
 
 def _form_only(m: Measurement, flattened: np.ndarray) -> str | None:
@@ -92,7 +91,7 @@ def _too_many_undefined(m: Measurement, max_undefined: float, prefix: str) -> st
     share = m.undefined / m.heights.size
     if share > max_undefined:
         return (f"{m.undefined} of its {m.heights.size} points ({100 * share:.2g} %) are undefined, more than "
-                f"{prefix}max_undefined = {100 * max_undefined:.3g} % (too much to fill by interpolation)")
+                f"{option(prefix, 'max_undefined')} = {100 * max_undefined:.3g} % (too much to fill by interpolation)")
     return None
 
 
@@ -202,19 +201,21 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
     docstring); ``detrend`` one of ``DETREND`` (SurfaceTopography's detrend modes: mean, least-squares
     plane, second-order polynomial), ``cutoff`` λc [m] of the Gaussian filter (None: no filter),
     ``despike`` the threshold k of ``outliers.find_outliers`` at which outliers are removed (filled as
-    undefined points; None: found at k = ``DESPIKE``, a warning, a ``TopographyWarning`` too)."""
+    undefined points; None: found at k = ``DESPIKE``, a warning, a ``TopographyWarning`` too).
+    Errors and warnings name the options as ``reading.option(prefix, ...)`` does (a scene's keys,
+    or with ``reading.COMMAND_LINE`` those of ``multiscale surface``)."""
     check_instance("m", m, Measurement, "a Measurement (read_topography)")
     if not isinstance(detrend, str) or detrend not in DETREND:
-        raise InputError(f"{prefix}detrend", detrend, f"one of {', '.join(DETREND)}")
+        raise InputError(option(prefix, "detrend"), detrend, f"one of {', '.join(DETREND)}")
     if cutoff is not None:
-        check_positive(f"{prefix}cutoff", cutoff)
+        check_positive(option(prefix, "cutoff"), cutoff)
     if despike is not None:
-        check_positive(f"{prefix}despike", despike)
-    if not 0 <= check_real(f"{prefix}max_undefined", max_undefined) <= 1:
-        raise InputError(f"{prefix}max_undefined", max_undefined, "a fraction of the points, in [0, 1]")
+        check_positive(option(prefix, "despike"), despike)
+    if not 0 <= check_real(option(prefix, "max_undefined"), max_undefined) <= 1:
+        raise InputError(option(prefix, "max_undefined"), max_undefined, "a fraction of the points, in [0, 1]")
     too_many = _too_many_undefined(m, max_undefined, prefix)
     if too_many is not None:
-        raise InputError(f"{prefix}file", m.path.name, too_many)
+        raise InputError(option(prefix, "file"), m.path.name, too_many)
     report = [f"read {m.path.name}, channel {m.channel} (\"{m.channel_name}\"): {m.shape[1]} x {m.shape[0]} points "
               f"of {m.dx * 1e6:.4g} x {m.dy * 1e6:.4g} um ({m.size[0] * 1e3:.4g} x {m.size[1] * 1e3:.4g} mm)"
               + (f", heights in {m.unit}" if m.unit else "")] + [f"warning: {n}" for n in m.notes]
@@ -234,11 +235,12 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
         h = h.copy() if h is m.heights else h
         h[found.rows, found.cols] = np.nan
         undefined += found.count
-        report.append(f"removed {found.count} outliers ({prefix}despike = {despike:g}), {found.describe()}: "
-                      "filled as undefined points")
+        report.append(f"removed {found.count} outliers ({option(prefix, 'despike', f'{despike:g}')}), "
+                      f"{found.describe()}: filled as undefined points")
         if undefined > max_undefined * h.size:
-            raise InputError(f"{prefix}despike", despike, f"{undefined} of {m.path.name}'s {h.size} points are "
-                             f"undefined or outliers, more than {prefix}max_undefined = {100 * max_undefined:.3g} %")
+            raise InputError(option(prefix, "despike"), despike, f"{undefined} of {m.path.name}'s {h.size} points are "
+                             f"undefined or outliers, more than {option(prefix, 'max_undefined')} = "
+                             f"{100 * max_undefined:.3g} %")
     if undefined:
         frame = Surface(np.broadcast_to(0.0, m.shape), m.dx, m.dy, periodic=False)
         t = as_topography(frame, np.ma.masked_invalid(h)).interpolate_undefined_data("harmonic")
@@ -255,7 +257,7 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
         try:
             waviness = gaussian_filter(surface, cutoff)
         except InputError as exc:
-            raise InputError(f"{prefix}cutoff", cutoff, f"{exc.allowed}: {m.path.name}'s pixels") from None
+            raise InputError(option(prefix, "cutoff"), cutoff, f"{exc.allowed}: {m.path.name}'s pixels") from None
         rough = surface.heights - waviness.heights
         surface = Surface(rough - rough.mean(), m.dx, m.dy, periodic=False)
         longer = " (longer than the measurement: little is removed)" if cutoff > min(m.size) else ""
@@ -264,7 +266,7 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
                       f"{_um(float(surface.heights.std()))} um")
     scale = float(np.nanmax(np.abs(m.heights), initial=0.0))
     if not surface.heights.std() > FLAT * scale:
-        raise InputError(f"{prefix}file", m.path.name, _no_roughness(float(surface.heights.std()), scale))
+        raise InputError(option(prefix, "file"), m.path.name, _no_roughness(float(surface.heights.std()), scale))
     return Conditioned(surface, waviness, tuple(report), tuple(notes))
 
 
