@@ -110,6 +110,25 @@ def test_band_search_finds_every_mode_and_skips_dirichlet_rows():
     np.testing.assert_allclose(sub.frequency, inband[inband >= 0.2 * f_exact.max()], rtol=1e-8)
 
 
+def test_a_mode_cap_keeps_both_members_of_the_lock_in_pair_it_ends_in():
+    """stability.modes = 21 ending inside a lock-in pair (theta = a +- i b, the 21st and 22nd
+    nearest the shift): both are kept. Before, solve_modes ranked max(nev, n_modes) = 21
+    eigenvalues, the partner was not among them, and the unstable member could be dropped (the
+    20-mm demo brake on P1 elements with 27 modes reported "0 unstable"; helper h3)."""
+    theta = (2 * np.pi * np.r_[10.0:201.0:10.0, 210.0:281.0:10.0]) ** 2      # 28 real modes
+    a, b = (2 * np.pi * 205.0) ** 2, 1e-2 * (2 * np.pi * 205.0) ** 2        # the pair, ranks 21-22
+    K = np.zeros((30, 30))
+    K[np.arange(28), np.arange(28)] = theta
+    K[28:, 28:] = [[a, b], [-b, a]]
+    r = eigen.solve_modes(petsc_mat(K), petsc_mat(np.eye(30)), f_max=1e3, n_modes=21)
+    pair = np.sqrt(-(a + 1j * b)), np.sqrt(-(a - 1j * b))          # lambda = sqrt(-theta), omega > 0
+    expected = np.sort(np.abs(np.imag(pair))) / (2 * np.pi)
+    assert len(r) == 22
+    np.testing.assert_allclose(r.frequency[-2:], expected, rtol=1e-10)
+    np.testing.assert_allclose(np.sort(r.growth[-2:]), [-abs(pair[0].real), abs(pair[0].real)], rtol=1e-8)
+    assert r.unstable().sum() == 1
+
+
 def dense_quadratic(K, C, M):
     """All lambda of (lambda^2 M + lambda C + K) phi = 0 with omega >= 0 (companion form)."""
     n = K.shape[0]

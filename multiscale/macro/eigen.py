@@ -297,7 +297,7 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
     radius = max((TWO_PI * f_max) ** 2 - shift, shift - (TWO_PI * f_min) ** 2)
     if n_modes is not None and n_modes > n:
         raise InputError("n_modes", n_modes, f"must not exceed the number of dofs ({n})")
-    want = min(max(int(nev), int(n_modes or 0)), n)
+    want = min(max(int(nev), int(n_modes or 0) + 1), n)     # + 1: the last mode's conjugate partner
 
     eps = SLEPc.EPS().create(K.getComm())
     eps.setOperators(K, M)
