@@ -509,6 +509,40 @@ loading.pressure = ["1 MPa", "2 MPa"]
     assert any(p.suffix == ".png" for p in study.report_folder.iterdir())
 
 
+def test_a_sigterm_while_a_worker_starts_ends_that_worker_too(tmp_path, monkeypatch):
+    """SIGTERM between a worker's start and its registration (the driver's poll found it running
+    and was terminated at once: a 2-core CI machine under load) still kills it before the driver
+    ends. Before, the SystemExit left the worker out of the running set: it ran on until its
+    watchdog noticed the driver gone (test_a_terminated_study_ends_its_workers failed in CI)."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    from multiscale.studies import running
+    started = []
+
+    def spawn(*args):           # a worker that would run for a minute, then the signal, as it starts
+        started.append(subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"],
+                                        start_new_session=True))
+        os.kill(os.getpid(), signal.SIGTERM)
+        return started[-1]
+    monkeypatch.setattr(running, "_spawn", spawn)
+    study = load_study(write(tmp_path, 'name = "term"\nproblem = "wear_steps"\nmetrics = ["area_fraction"]\n'
+                                       '[fixed]\nn = 64\n[sweep]\nsteps = [1, 2]\n'))
+    handler = signal.getsignal(signal.SIGTERM)
+    try:
+        with pytest.raises(SystemExit) as exc:
+            running.execute(study, progress=False)
+        assert exc.value.code == 128 + signal.SIGTERM
+        assert len(started) == 1 and started[0].returncode == -signal.SIGKILL     # killed and waited for
+    finally:
+        for proc in started:
+            if proc.poll() is None:
+                proc.kill()
+                proc.wait()
+    assert signal.getsignal(signal.SIGTERM) is handler          # the caller's handler back
+
+
 def test_a_terminated_study_ends_its_workers(tmp_path):
     """SIGTERM to `multiscale study` (a batch time limit, `timeout`) kills the running workers and
     exits 143; before, the driver died at once and its workers, each in a session of its own, ran on

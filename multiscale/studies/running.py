@@ -15,6 +15,7 @@ import subprocess
 import sys
 import threading
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass
 
 from tqdm import tqdm
@@ -66,7 +67,7 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     start = time.perf_counter()
     rank, size = (comm.rank, comm.size) if comm is not None else (0, 1)
     lock = _claim(study, comm)
-    bar, failed, running, previous, lifeline = None, 0, {}, {}, None
+    bar, failed, running, termination, lifeline = None, 0, {}, None, None
     try:                                     # the lock is released whatever happens from here
         records = read_records(study)
         todo = [r for r in study.runs if not _done(records.get(r.key), rerun_failed, study.options.timeout)]
@@ -74,12 +75,13 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
         if progress and rank == 0 and mine:
             bar = tqdm(total=len(mine), desc=study.name, unit="run")
         queue = list(mine)
-        previous = _exit_on_termination()
+        termination = Termination()
         lifeline = _lifeline()
         while queue or running:
             while queue and len(running) < study.options.processes:
                 run = queue.pop(0)
-                running[_spawn(study, run, rank, lifeline[0])] = (run, time.monotonic())
+                with termination.deferred():
+                    running[_spawn(study, run, rank, lifeline[0])] = (run, time.monotonic())
             time.sleep(0.05)
             for proc, (run, t0) in list(running.items()):
                 timeout = study.options.timeout
@@ -102,8 +104,8 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
             _kill(proc)
         for fd in lifeline or ():
             os.close(fd)
-        for signum, handler in previous.items():
-            signal.signal(signum, handler)
+        if termination is not None:
+            termination.restore()
         if lock is not None:
             lock.close()                     # releases the folder
         if bar is not None:
@@ -143,18 +145,40 @@ def _claim(study: Study, comm):
     return held[0] if held else None
 
 
-def _exit_on_termination() -> dict:
-    """Make SIGTERM and SIGHUP a ``SystemExit(128 + signal)`` (so ``execute`` kills its workers,
-    each in a session of its own, before the driver ends: they ran on, orphaned); returns the
-    previous handlers ({} off the main thread). A signal ignored when the study started stays
-    ignored: ``nohup multiscale study`` outlives its terminal, workers and all."""
-    if threading.current_thread() is not threading.main_thread():
-        return {}
+class Termination:
+    """SIGTERM and SIGHUP as a ``SystemExit(128 + signal)`` (so ``execute`` kills its workers, each
+    in a session of its own, before the driver ends: they ran on, orphaned), held back while a
+    worker is started and registered (``deferred``: a signal between the worker's exec and its
+    registration left it running after the driver, until its watchdog noticed). A signal ignored
+    when the study started stays ignored: ``nohup multiscale study`` outlives its terminal, workers
+    and all. Off the main thread nothing is installed."""
 
-    def stop(signum, frame):
-        raise SystemExit(128 + signum)
-    return {s: signal.signal(s, stop) for s in (signal.SIGTERM, signal.SIGHUP)
-            if signal.getsignal(s) is not signal.SIG_IGN}
+    def __init__(self):
+        self.holding, self.pending, self.previous = False, None, {}
+        if threading.current_thread() is threading.main_thread():
+            self.previous = {s: signal.signal(s, self._stop) for s in (signal.SIGTERM, signal.SIGHUP)
+                             if signal.getsignal(s) is not signal.SIG_IGN}
+
+    def _stop(self, signum, frame):
+        if self.holding:
+            self.pending = signum
+        else:
+            raise SystemExit(128 + signum)
+
+    @contextmanager
+    def deferred(self):
+        """The block runs to its end; a signal that came meanwhile then ends the driver."""
+        self.holding = True
+        try:
+            yield
+        finally:
+            self.holding = False
+        if self.pending is not None:
+            raise SystemExit(128 + self.pending)
+
+    def restore(self) -> None:
+        for signum, handler in self.previous.items():
+            signal.signal(signum, handler)
 
 
 def _lifeline() -> tuple[int, int]:
