@@ -33,7 +33,10 @@ $(STAMP): pyproject.toml
 demo: $(STAMP)
 	$(BIN)/mpiexec -n $(NP) $(BIN)/multiscale run demos/pin_on_disc.toml --overwrite
 
-test: docs test-serial test-mpi
+# The user guide is built as one more job beside the test modules (WITH=docs), then tests/mpi runs.
+test: $(STAMP)
+	@$(MAKE) --no-print-directory test-serial WITH=docs
+	@$(MAKE) --no-print-directory test-mpi
 
 # The user guide (docs/_build/html): any warning, a broken cross-reference among them, fails it.
 docs: $(STAMP)
@@ -44,7 +47,8 @@ docs: $(STAMP)
 # the whole suite in one process ended with exit code 15, MPICH's abort for "Too many
 # communicators" (203515151 & 0xff; docs/architecture.md §7). JOBS modules run at a time, each
 # module's output printed whole when it ends (-O), the slowest started first so that the jobs end
-# together; every module runs (-k), and the failed ones are named at the end.
+# together; every module runs (-k), and the failed ones are named at the end. WITH: more targets
+# run beside them.
 JOBS ?= 2
 SLOW_TESTS := duty_cycle squeal_effects killed_run coupling macro_thermal faults studies architecture macro_run
 TESTS := $(SLOW_TESTS:%=tests/test_%.py) $(filter-out $(SLOW_TESTS:%=tests/test_%.py),$(sort $(wildcard tests/test_*.py)))
@@ -52,7 +56,7 @@ TEST_RUNS := $(TESTS:tests/%.py=run-%)
 .PHONY: $(TEST_RUNS)
 
 test-serial: $(STAMP) demos/cad/car_brake.step
-	@rm -f .test-failed; $(MAKE) --no-print-directory -k -j$(JOBS) -O $(TEST_RUNS); status=$$?; \
+	@rm -f .test-failed; $(MAKE) --no-print-directory -k -j$(JOBS) -O $(WITH) $(TEST_RUNS); status=$$?; \
 	  if [ -s .test-failed ]; then echo "failed:$$(tr -d '\n' < .test-failed)"; fi; rm -f .test-failed; exit $$status
 
 $(TEST_RUNS): run-%:
