@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 
 from multiscale.errors import InputError, SceneError
-from multiscale.micro.topography import TopographyWarning, check_resolved, covers, read_topography
+from multiscale.micro.topography import TopographyWarning, check_resolved, covers, read_topography, zone_cells
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
@@ -484,16 +484,17 @@ def _nyquist(scene: Scene) -> list[str]:
 
 
 def _measured_cover(scene: Scene) -> list[str]:
-    """A measurement used as it is (``cover = "measured"``) covers its face, one drawn from
-    (``"equivalent"``) holds a wavelength the face's micro grid resolves (``micro.zones`` x
-    ``micro.grid``, default ``DEFAULT_GRID``, as the run's): the run's refusals
-    (``topography.covers``, ``topography.check_resolved``) before meshing, for the faces whose extent
-    the geometry knows then (``GeometrySpec.interface_extents``; the others are refused after meshing)."""
+    """A face's cells per zone taken from a measurement's pixels stay within
+    ``topography.MAX_CELLS`` (``topography.zone_cells``, the run's rule), a measurement used as it
+    is (``cover = "measured"``) covers its face, one drawn from (``"equivalent"``) holds a
+    wavelength the face's micro grid resolves: the run's refusals (``topography.covers``,
+    ``topography.check_resolved``) before meshing, for the faces whose extent the geometry knows then
+    (``GeometrySpec.interface_extents``; the others are refused after meshing)."""
     out = []
     for name in scene.rough_interfaces:
         s, size = scene.interface_settings(name), scene.geometry.spec.interface_extents.get(name)
         r = s.roughness
-        if r is None or r.file is None or r.cover not in ("measured", "equivalent") or size is None:
+        if r is None or r.file is None or size is None:
             continue
         prefix = f"{scene.roughness_key(name)}."
         try:
@@ -501,11 +502,12 @@ def _measured_cover(scene: Scene) -> list[str]:
                 warnings.simplefilter("ignore", TopographyWarning)
                 measured = read_topography(r.file, r.channel, pixel_size=r.pixel_size, height_unit=r.height_unit,
                                            prefix=prefix)
+            cells = zone_cells(s.micro.grid, r.cover, size, s.micro.zones, (measured.dx, measured.dy), DEFAULT_GRID,
+                               r.file.name)
             if r.cover == "measured":
                 covers(measured.size, size, r.cover, prefix=prefix)
-            else:
-                cells = [z * g for z, g in zip(s.micro.zones, s.micro.grid or DEFAULT_GRID)]
-                check_resolved(measured.size, cells, size, prefix=prefix)
+            elif r.cover == "equivalent":
+                check_resolved(measured.size, [z * c for z, c in zip(s.micro.zones, cells)], size, prefix=prefix)
         except InputError as exc:
             out.append(str(exc))
     return sorted(set(out))

@@ -38,6 +38,9 @@ zones = [2, 2]
 """
 
 
+GRID = "grid = [16, 16]"     # micro.grid of scenes whose file's pixels give too many cells (topography.MAX_CELLS)
+
+
 def scene(tmp_path, roughness, micro=""):
     return loads(SCENE.format(roughness=roughness, micro=micro), tmp_path)
 
@@ -101,7 +104,7 @@ def test_surface_command_warnings_name_its_options_a_scenes_warnings_its_keys(tm
     assert warned == ["warning: --pixel-size 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",
                       "warning: --height-unit 0.001 m overrides the file's unit (nm = 1e-09 m)",
                       "warning: FILE = " + heights.replace("{}height_unit", "--height-unit")]
-    s = scene(tmp_path, f'file = "{TOP}"\nheight_unit = "1 mm"\npixel_size = "3 nm"\ncover = "tile"')
+    s = scene(tmp_path, f'file = "{TOP}"\nheight_unit = "1 mm"\npixel_size = "3 nm"\ncover = "tile"', GRID)
     assert s.warnings == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",
                           "roughness.height_unit = 0.001 m overrides the file's unit (nm = 1e-09 m)",
                           "roughness.file = " + heights.format("roughness."))
@@ -114,12 +117,12 @@ def test_surface_command_lists_the_formats(capsys):
 
 def test_scene_reads_a_measured_file_with_its_options(tmp_path):
     s = scene(tmp_path, f'file = "{TOP}"\nchannel = 0\ndetrend = "poly2"\ncutoff = "0.2 um"\ncover = "mirror"\n'
-                        'seed = 4\nmax_undefined = 0.2')    # ("equivalent" of 0.6 um on a 10 mm face: refused, flat)
+                        'seed = 4\nmax_undefined = 0.2', GRID)   # ("equivalent" of 0.6 um on 10 mm: refused, flat)
     r = s.roughness
     assert (r.file, r.channel, r.detrend, r.cutoff, r.cover, r.seed, r.max_undefined) == (
         TOP, 0, "poly2", pytest.approx(2e-7), "mirror", 4, 0.2)
     assert r.pixel_size is None and r.height_unit is None and s.warnings == ()
-    over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "tile"')
+    over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "tile"', GRID)
     assert over.warnings == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",)
 
 
@@ -155,30 +158,32 @@ def test_check_of_a_bad_file_runs_nothing_heavy(tmp_path):
 def test_zones_from_a_measured_file_for_every_cover(tmp_path):
     from multiscale.workflows import rough
 
-    def make_zones(s, *args, cover=None, **kwargs):       # cover: instead of the scene's
+    def make_zones(s, *args, cover=None, grid=None, **kwargs):       # cover, micro.grid: instead of the scene's
         r = s.roughness if cover is None else dataclasses.replace(s.roughness, cover=cover)
-        return rough.make_zones(r, s.micro, *args, **kwargs)
+        return rough.make_zones(r, dataclasses.replace(s.micro, grid=grid), *args, **kwargs)
 
     lo = (0.0, 0.0)
     lines = []
     with warnings.catch_warnings():
         warnings.simplefilter("error")             # the warnings come as report lines, not per rank
-        grid, zones = make_zones(scene(tmp_path, f'file = "{TOP}"\ncover = "mirror"', "grid = [64, 32]"),
-                                 lo, (2e-6, 1e-6), seed=0, log=lines.append)
+        grid, zones = make_zones(scene(tmp_path, f'file = "{TOP}"\ncover = "mirror"', GRID),
+                                 lo, (2e-6, 1e-6), seed=0, log=lines.append, grid=(64, 32))
     assert len(zones) == 4 and zones[0].shape == (32, 64) and grid.size == pytest.approx((1e-6, 0.5e-6))
     assert any(line.startswith("roughness: warning: roughness.cover = \"mirror\"") for line in lines)
     # the measurement as it is: its own pixels, rounded to whole cells per zone (on the faces given
-    # here: the scene's 10 mm block, which it cannot cover, is refused when the scene is read)
-    tiled = scene(tmp_path, f'file = "{TOP}"\ncover = "tile"')
+    # here: the scene's 10 mm block, which it cannot cover, is refused when the scene is read, and
+    # without micro.grid its zones would take 1.7 million cells per side)
+    tiled = scene(tmp_path, f'file = "{TOP}"\ncover = "tile"', GRID)
     as_is = dataclasses.replace(tiled.roughness, cover="measured")
-    grid, zones = rough.make_zones(as_is, tiled.micro, lo, (0.3e-6, 0.3e-6), seed=0)
+    pixels = dataclasses.replace(tiled.micro, grid=None)
+    grid, zones = rough.make_zones(as_is, pixels, lo, (0.3e-6, 0.3e-6), seed=0)
     assert zones[0].shape == (64, 64) and zones[0].surface.dx == pytest.approx(0.15e-6 / 64)
     with pytest.raises(InputError, match=r'roughness\.cover = .measured.: the measurement \(0\.0006 x 0\.0006 mm\) '
                                          r'does not cover the interface'):
-        rough.make_zones(as_is, tiled.micro, lo, (1e-6, 1e-6), seed=0)
+        rough.make_zones(as_is, pixels, lo, (1e-6, 1e-6), seed=0)
     # a statistically equivalent face: 50 x 50 cells per zone unless micro.grid says otherwise, seeded
     # (on the faces given here: on the block's, the 0.6 um measurement is shorter than a cell)
-    eq = scene(tmp_path, f'file = "{TOP}"\ncover = "tile"\nseed = 3')
+    eq = scene(tmp_path, f'file = "{TOP}"\ncover = "tile"\nseed = 3', GRID)
     lines = []
     _, a = make_zones(eq, lo, (4e-6, 4e-6), seed=10, log=lines.append, cover="equivalent")
     _, b = make_zones(eq, lo, (4e-6, 4e-6), seed=10, cover="equivalent")
@@ -186,7 +191,7 @@ def test_zones_from_a_measured_file_for_every_cover(tmp_path):
     assert any("statistically equivalent surface" in line for line in lines)
     # what overrides the file is a warning of the scene (printed at the start of a run), not a report
     # line again (it was printed twice)
-    over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "tile"')
+    over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "tile"', GRID)
     lines = []
     make_zones(over, lo, (4e-6, 4e-6), seed=10, log=lines.append, cover="equivalent")
     assert over.warnings == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",)
@@ -247,6 +252,28 @@ def test_an_equivalent_cover_the_grid_cannot_resolve_is_refused_by_check_before_
     scene(tmp_path, 'file = "wide.npy"\npixel_size = "200 um"', own.format(pixel="10 um"))     # 0.16 x 0.4 mm
 
 
+def test_cells_from_the_pixels_beyond_the_cap_are_refused_by_check_before_meshing(tmp_path):
+    """Without micro.grid a zone takes the measurement's pixels as its cells, at most
+    topography.MAX_CELLS per side: 2 um pixels on the block's 10 mm face at 2 x 2 zones give 2500
+    (5 um: 1000). The cap was the run's, after meshing; now the scene's check (which a run makes
+    before meshing) refuses it with the run's message (topography.zone_cells, which both ask);
+    micro.grid lifts it."""
+    np.save(tmp_path / "fine.npy", np.random.default_rng(2).normal(0.0, 1e-6, (64, 64)))
+    tiled = 'file = "fine.npy"\npixel_size = "{}"\ncover = "tile"'
+    with pytest.raises(SceneError) as info:
+        scene(tmp_path, tiled.format("2 um"))
+    with pytest.raises(InputError) as later:        # the run's rule (workflows.rough.measured_face)
+        topography.zone_cells(None, "tile", (10e-3, 10e-3), (2, 2), (2e-6, 2e-6), (50, 50), "fine.npy")
+    assert info.value.problems == [str(later.value)]
+    assert str(later.value) == ("micro.grid: fine.npy's pixels give 2500 x 2500 cells per zone: set micro.grid "
+                                "(at most 1024 without it)")
+    assert topography.zone_cells(None, "tile", (10e-3, 10e-3), (2, 2), (5e-6, 5e-6), (50, 50), "f") == (1000, 1000)
+    assert topography.zone_cells(None, "equivalent", (10e-3, 10e-3), (2, 2), (2e-6, 2e-6), (50, 50), "f") == (50, 50)
+    assert topography.zone_cells([16, 8], "tile", (10e-3, 10e-3), (2, 2), (2e-6, 2e-6), (50, 50), "f") == (16, 8)
+    scene(tmp_path, tiled.format("5 um"))
+    scene(tmp_path, tiled.format("2 um"), "grid = [64, 64]")
+
+
 def test_a_rewritten_measured_file_changes_the_runs_fingerprint(tmp_path):
     """``--resume`` compares fingerprints: a measured surface rewritten under the same name makes
     another one (before, the resume went on: the checkpoint's worn heights against the new file's
@@ -255,7 +282,7 @@ def test_a_rewritten_measured_file_changes_the_runs_fingerprint(tmp_path):
     from multiscale.workflows.multiscale import fingerprint
     heights = np.random.default_rng(1).normal(size=(64, 64))
     np.save(tmp_path / "pad.npy", heights)
-    text = 'file = "pad.npy"\npixel_size = "1 um"\nheight_unit = "um"\ncover = "tile"'
+    text = 'file = "pad.npy"\npixel_size = "10 um"\nheight_unit = "um"\ncover = "tile"'
     before = fingerprint(scene(tmp_path, text))
     np.save(tmp_path / "pad.npy", heights)
     assert fingerprint(scene(tmp_path, text)) == before

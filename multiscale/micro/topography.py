@@ -35,6 +35,7 @@ from multiscale.micro.surface import Surface, defined_sums, row_blocks
 MAX_UNDEFINED = 0.1       # default largest fraction of undefined points that is filled
 DETREND = {"none": None, "mean": "mean", "plane": "height", "poly2": "curvature"}   # -> SurfaceTopography
 COVER = ("measured", "mirror", "tile", "equivalent")
+MAX_CELLS = 1024          # cells per zone side taken from a measurement's own pixel size (no micro.grid)
 ALPHA = np.sqrt(np.log(2) / np.pi)     # ISO 16610-21/-61 Gaussian: 50 % transmission at the cut-off
 S_FILTER_PIXELS = 3.0     # anti-aliasing before coarsening: resolved to λs = 3 new pixels (21 % at the new Nyquist)
 
@@ -416,6 +417,24 @@ def check_resolved(measured, n, size, prefix: str = "") -> None:
                          f"the micro grid resolves ({nx} x {ny} cells of {Lx / nx * 1e6:.4g} x {Ly / ny * 1e6:.4g} um: "
                          f"wavelengths from {2 * max(Lx / nx, Ly / ny) * 1e6:.4g} um up): the equivalent surface would "
                          "be flat; use a finer micro.grid or a larger measurement")
+
+
+def zone_cells(grid, method: str, size, zones, pixel, default, name: str) -> tuple[int, int]:
+    """Cells (nx, ny) per zone of a face of ``size`` = (Lx, Ly) [m] cut into ``zones`` = (zx, zy),
+    covered by ``method`` (one of ``COVER``) from a measurement of ``pixel`` = (dx, dy) [m] named
+    ``name``: ``grid`` (``micro.grid``) when given, ``default`` for "equivalent", else the pixel
+    size rounded to whole cells per zone (at least 4), refused (InputError naming micro.grid)
+    above ``MAX_CELLS``. ``multiscale check`` asks it with the face's extent before meshing, a run
+    with the mesh's."""
+    if grid is not None:
+        return tuple(int(g) for g in grid)
+    if method == "equivalent":
+        return tuple(int(g) for g in default)
+    cells = tuple(max(4, int(round(s / z / d))) for s, z, d in zip(size, zones, pixel))
+    if max(cells) > MAX_CELLS:
+        raise InputError("micro.grid", None, f"{name}'s pixels give {cells[0]} x {cells[1]} cells per zone: set "
+                         f"micro.grid (at most {MAX_CELLS} without it)")
+    return cells
 
 
 def _sized(what: str, size) -> str:

@@ -37,7 +37,7 @@ from multiscale.micro.layered import LayeredElastic, LayeredThermal
 from multiscale.micro.laws import LawSpec
 from multiscale.micro.plasticity import Hardness
 from multiscale.micro.surface import Surface, fractal_surface
-from multiscale.micro.topography import TopographyWarning, condition, cover, read_topography
+from multiscale.micro.topography import TopographyWarning, condition, cover, read_topography, zone_cells
 from multiscale.micro.zones import ZoneGrid, cut_zones, generate_zones
 from multiscale.pool import MicroPool
 from multiscale.rough import RoughInterface, interface_plane
@@ -46,7 +46,6 @@ from multiscale.workflows.model import interface_forces, interface_materials
 
 P_MAX_FACTOR = 20.0        # default top node of the laws: 20 x the nominal interface pressure
 SEED_STRIDE = 7919         # interface k draws its surfaces with seed + SEED_STRIDE k
-MAX_CELLS = 1024           # cells per zone side taken from a measurement's own pixel size
 P_MAX_PLASTIC = 0.9        # with plasticity, the top node of the laws is at most this x the hardness
 
 
@@ -93,21 +92,14 @@ def make_zones(r, m, lo, hi, seed: int, log=None, prefix: str = "roughness.") ->
 def measured_face(r, m, counts, size, seed: int, log=None, prefix: str = "roughness.") -> Surface:
     """The face of ``size`` [m] from ``roughness.file``: read, conditioned (``roughness.detrend``,
     ``cutoff``, ``max_undefined``, ``despike``) and covering the face (``roughness.cover``), on counts x
-    ``micro.grid`` cells (without ``micro.grid``: 50 x 50 per zone for an equivalent surface, else
-    the measurement's pixel size rounded to whole cells per zone)."""
+    ``topography.zone_cells`` cells (``micro.grid``; without it 50 x 50 per zone for an equivalent
+    surface, else the measurement's pixel size rounded to whole cells per zone)."""
     with warnings.catch_warnings():      # the warnings are lines of the report: printed once, not per rank
         warnings.simplefilter("ignore", TopographyWarning)
         measured = read_topography(r.file, r.channel, pixel_size=r.pixel_size, height_unit=r.height_unit,
                                    prefix=prefix)      # the scene's read, kept (read_topography)
+        cells = zone_cells(m.grid, r.cover, size, counts, (measured.dx, measured.dy), DEFAULT_GRID, r.file.name)
         done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix=prefix, despike=r.despike)
-        cells = m.grid
-        if cells is None and r.cover == "equivalent":
-            cells = DEFAULT_GRID
-        elif cells is None:
-            cells = tuple(max(4, int(round(s / c / d))) for s, c, d in zip(size, counts, (measured.dx, measured.dy)))
-            if max(cells) > MAX_CELLS:
-                raise InputError("micro.grid", None, f"{r.file.name}'s pixels give {cells[0]} x {cells[1]} cells "
-                                 f"per zone: set micro.grid (at most {MAX_CELLS} without it)")
         surface, lines = cover(done.surface, (counts[0] * cells[0], counts[1] * cells[1]), tuple(size), r.cover,
                                seed, prefix=prefix)
     known = {f"warning: {note}" for note in (*measured.notes, *done.notes)}   # the scene's warnings already
