@@ -139,6 +139,27 @@ def dense_quadratic(K, C, M):
     return lam[np.lexsort((lam.real, lam.imag))]
 
 
+def test_a_mode_cap_on_the_quadratic_path_keeps_both_members_of_the_lock_in_pair_it_ends_in():
+    """The viscous path (SLEPc PEP) ranks by |lambda - s|: with C = c M the two members of a lock-in
+    pair share their frequency, growth -c/2 +- beta. A cap of 21 ending between them kept one (the
+    unstable, the nearer s; found reading the code); now both, as solve_modes keeps them, for any
+    shift; a cap of 20 ends before the pair."""
+    theta = (2 * np.pi * np.r_[10.0:201.0:10.0, 210.0:281.0:10.0]) ** 2      # 28 real modes
+    a, b = (2 * np.pi * 205.0) ** 2, 1e-2 * (2 * np.pi * 205.0) ** 2        # the pair, ranks 21-22
+    K = np.zeros((30, 30))
+    K[np.arange(28), np.arange(28)] = theta
+    K[28:, 28:] = [[a, b], [-b, a]]
+    M, C = np.eye(30), 4.0 * np.eye(30)
+    ref = dense_quadratic(K, C, M)                  # by frequency, then growth: the pair at 20-21
+    assert ref[21].real > 0 > ref[20].real and ref[21].imag == pytest.approx(ref[20].imag, rel=1e-12)
+    for target in (0.0, 100.0):
+        q = eigen.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_max=1e3, n_modes=21, target=target)
+        assert len(q) == 22 and q.unstable().sum() == 1
+        np.testing.assert_allclose(q.eigenvalues, ref[:22], rtol=1e-9)
+    q = eigen.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_max=1e3, n_modes=20)
+    np.testing.assert_allclose(q.eigenvalues, ref[:20], rtol=1e-9)
+
+
 def test_proportional_damping_mapping_matches_companion_form_and_pep():
     K, M = chain(n=40, drift=0.05)
     K, M = K[1:-1, 1:-1], M[1:-1, 1:-1]

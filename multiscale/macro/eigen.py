@@ -362,7 +362,8 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     (K + s C + s^2 M is non-singular for s > 0 even for a free-free structure) and eigenvalues
     converge in order of |lambda - s|, i.e. by frequency for light damping. ``n_modes`` counts
     modes with omega >= 0 (conjugate pairs are computed together; at most ``n_modes`` in the band,
-    the nearest s, are returned); ``n_modes=None`` asks for the
+    the nearest s, are returned, and the other member of a lock-in pair at one frequency that the
+    cap ends in, as ``solve_modes`` keeps it); ``n_modes=None`` asks for the
     whole band: the subspace grows until a converged |lambda - s| exceeds |i 2 pi f_max - s|.
     The result is filtered to the band. ``theta`` is reported as -lambda^2.
     """
@@ -379,7 +380,7 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     if comm is not None and comm.allreduce(K.getLocalSize()[0] == 0, op=MPI.LOR):
         pep.getBV().setType(SLEPc.BV.Type.VECS)     # the default BV's LAPACK fails on a rank without rows
     _shift_invert(pep, s, tol, max_it, options_prefix)
-    want = min(2 * int(n_modes if n_modes is not None else max(nev, 1)), 2 * n)
+    want = min(2 * (int(n_modes) + 1 if n_modes is not None else max(nev, 1)), 2 * n)   # + 1: a lock-in partner
     solves = 0
     while True:
         _set_up(pep, want, ("target", target, "K + s C + s^2 M could not be factorised"))
@@ -411,7 +412,11 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     seen = lam.imag / TWO_PI
     inband = np.nonzero((seen >= f_min) & (seen <= f_max) & _carry_mass(vecs, M, comm))[0]
     if n_modes is not None:             # the n_modes nearest the shift, as they converge
-        inband = inband[np.argsort(np.abs(lam[inband] - s), kind="stable")[:int(n_modes)]]
+        ranked = inband[np.argsort(np.abs(lam[inband] - s), kind="stable")]
+        cut = int(n_modes)
+        if ranked.size > cut and np.isclose(lam[ranked[cut]].imag, lam[ranked[cut - 1]].imag, rtol=1e-9, atol=0.0):
+            cut += 1                    # the other member of a lock-in pair (one frequency) the cap ends in
+        inband = ranked[:cut]
     lam, theta, vecs, errs = _sorted(lam[inband], -lam[inband] ** 2, vecs[:, inband], errs[inband],
                                      (f_min, f_max), seen)
     return ModalResult(lam, theta, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
