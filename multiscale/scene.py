@@ -312,6 +312,9 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
             if k in loading:
                 problems.append(f'loading.{k}: not used by {where} ({g.motion}); '
                                 f'use {" or ".join("loading." + m for m in moving)}')
+        if "braking_torque" in loading and g.motion != "rotation":
+            problems.append(f"loading.braking_torque: a moment about the axis of a rotating body; {where} has a "
+                            f"{g.motion}: give loading.normal_force or loading.pressure")
         if "friction" in effects and not any(k in loading for k in moving + wrong):
             problems.append(f'{" or ".join("loading." + m for m in moving)}: missing; effect "friction" '
                             f'needs the sliding speed')

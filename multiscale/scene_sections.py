@@ -317,15 +317,20 @@ class Loading:
     each (give the clamp force times the number of faces, or ``pressure``, which acts on the whole face: a brake
     line's pressure on a backplate's back is not the piston's force, line pressure x piston area: give that as
     the force per face), scaled in time by ``load_profile`` (factor, 0 = released: no contact, no frictional
-    heat). The speed of the rotating body: ``rotation_speed``, a ``speed_profile`` against time, or a
-    ``vehicle`` stop or drag; a translating body slides at ``sliding_speed``. Friction: a constant ``friction``,
+    heat). ``braking_torque`` (a rotating body) gives the load instead: the clamp force is scaled during the
+    run so that the friction moment about the axis is the torque times the load factor while sliding (a cycle
+    of stops under a vehicle's torque; ``vehicle.mass`` does it for one stop). The speed of the rotating body:
+    ``rotation_speed``, a ``speed_profile`` against time, or a ``vehicle`` stop or drag; a translating body
+    slides at ``sliding_speed``. Friction: a constant ``friction``,
     or (squeal analysis only) mu against the slip speed: a table ``friction_curve`` or a ``stribeck`` law, taken
     per interface facet at its steady slip speed; its slope enters the modal analysis as damping."""
 
     normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)),                 # N
-                                     absent="pressure or vehicle.mass gives the load")
+                                     absent="pressure, braking_torque or vehicle.mass gives the load")
     pressure: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e9)),                   # Pa
-                                 absent="normal_force or vehicle.mass gives the load")
+                                 absent="normal_force, braking_torque or vehicle.mass gives the load")
+    braking_torque: float | None = key(Quantity("torque", gt=0, plausible=(1e-3, 1e6)),              # N m
+                                       absent="normal_force, pressure or vehicle.mass gives the load")
     faces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), absent="the builder's load faces (files: needed)")
     direction: tuple | None = key(Vector(Quantity("dimensionless")),
                                   absent="-p n on each face (disc_brake, files); else -z")
@@ -358,12 +363,33 @@ class Loading:
                                 "deceleration (or slope) whatever the load factor; a release does not stop it")
         given = [k for k in ("normal_force", "pressure") if getattr(self, k) is not None]
         by_mass = self.vehicle is not None and self.vehicle.mass is not None
+        if (self.braking_torque is not None or by_mass) and "stability" in ctx.effects:
+            ctx.warnings.append(f"{path}.{'braking_torque' if self.braking_torque is not None else 'vehicle.mass'}: "
+                                "the squeal analysis preloads at the clamp force guessed from the torque (each "
+                                "interface at its mean radius), not scaled to the friction moment of the solved "
+                                "pressure as a transient run does (0.4 % off on the car-brake demo)")
+        if self.braking_torque is not None:
+            if given or by_mass:
+                return [f"{path}.braking_torque: give the torque or {path}.{(given or ['vehicle.mass'])[0]}, not both"]
+            if "friction" not in ctx.effects:
+                return [f'{path}.braking_torque: the clamp force follows from the friction moment: needs effect '
+                        f'"friction"']
+            return []
         if given and by_mass:
             return [f"{path}.{given[0]}: give the load or {path}.vehicle.mass, not both"]
         if not given and not by_mass and "contact" in ctx.effects:
             return [f"{path}.normal_force or {path}.pressure: missing; effect \"contact\" needs it "
-                    f"(or {path}.vehicle.mass)"]
+                    f"(or {path}.braking_torque, {path}.vehicle.mass)"]
         return []
+
+    @property
+    def torque(self) -> float | None:
+        """Braking torque [N m] the friction moment is held at (times the load factor, while sliding):
+        ``braking_torque``, or a vehicle's braking force times its wheel radius; None: a load is given."""
+        if self.braking_torque is not None:
+            return self.braking_torque
+        v = self.vehicle
+        return None if v is None or v.mass is None else v.braking_force * v.wheel_radius
 
     def angular_speed(self, t: float) -> float:
         """omega(t) [rad/s]: constant, the speed profile (linear in time, held constant beyond its

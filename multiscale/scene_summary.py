@@ -40,6 +40,7 @@ def summary(scene: Scene) -> list[str]:
     v = ld.vehicle
     load_text = (f"{ld.normal_force:g} N" if ld.normal_force is not None else
                  f"{ld.pressure / 1e6:g} MPa" if ld.pressure is not None else
+                 f"braking torque {ld.braking_torque:g} N m" if ld.braking_torque is not None else
                  f"braking {v.mass:g} kg" if v is not None and v.mass is not None else "none")
     motion = (f"{ld.rotation_speed * 30 / math.pi:g} rpm" if ld.rotation_speed is not None else
               f"speed profile of {len(ld.speed_profile)} points" if ld.speed_profile is not None else

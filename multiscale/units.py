@@ -64,6 +64,7 @@ KINDS: dict[str, Kind] = {
     "mass": Kind("mass", M, "kg", "kg, t"),
     "angular_speed": Kind("angular speed", _dim((A, 1), (T, -1)), "rad/s", "rpm, rad/s"),
     "force": Kind("force", _dim((M, 1), (L, 1), (T, -2)), "N", "N, kN"),
+    "torque": Kind("torque", _dim((M, 1), (L, 2), (T, -2)), "N m", "N m, kN m"),
     "pressure": Kind("pressure or modulus", _dim((M, 1), (L, -1), (T, -2)), "Pa", "Pa, kPa, MPa, GPa, bar"),
     "stiffness": Kind("stiffness per area", _dim((M, 1), (L, -2), (T, -2)), "Pa/m", "Pa/m, N/mm^3"),
     "temperature": Kind("temperature", TH, "K", "K, degC", needs_unit=True),

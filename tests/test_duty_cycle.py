@@ -75,6 +75,34 @@ def test_a_vehicle_stop_with_thermal_expansion_keeps_the_torque(tmp_path):
     assert np.ptp(h["interface_force"]) > 10 * TORQUE_TOL * h["interface_force"][0]
 
 
+def test_a_cycle_under_a_braking_torque_holds_the_moment_and_turns_its_work_into_heat(tmp_path):
+    """loading.braking_torque T with speed and load profiles (a cycle the vehicle section cannot
+    write: at rest and released, speeding up, braked to half speed, released while coasting,
+    braked to rest): the clamp force is scaled so that the friction moment is T while braked and
+    sliding (0 released or at rest), from rest once sliding starts, and the frictional heat is
+    T times the integral of load factor x angular speed (trapezoids on 1 us, independent of the
+    run's exact means). Before, a cycle took a fixed clamp force (docs/tutorials/braking_cycle.rst)."""
+    from multiscale.macro.model import TORQUE_TOL
+    torque, w0 = MASS * DECEL * WHEEL, V0 / WHEEL           # 30 N m, 33.3 rad/s
+    speed = [(0.0, 0.0), (0.25, w0), (1.25, w0 / 2), (1.75, w0 / 2), (2.75, 0.0)]
+    load = [(0.0, 0.0), (0.25, 0.0), (0.26, 1.0), (1.25, 1.0), (1.26, 0.0), (1.75, 0.0), (1.76, 1.0)]
+    text = pod(tmp_path / "cycle").replace('rotation_speed = "200 rpm"\n', "").replace('normal_force = "200 N"\n', "")
+    scene = loads(text, overrides={
+        "loading.braking_torque": f"{torque} N m", "loading.load_profile": [[f"{t} s", f] for t, f in load],
+        "loading.speed_profile": [[f"{t} s", f"{w} rad/s"] for t, w in speed], "time.end": "2.75 s", "time.steps": 11})
+    h = run(scene, verbose=False).history
+    t = np.linspace(0.0, 2.75, 2_750_001)
+    power = np.interp(t, *zip(*load)) * np.interp(t, *zip(*speed))
+    work = torque * np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(t))
+    assert h["heat_total_pin"][-1] + h["heat_total_disc"][-1] == pytest.approx(work, rel=1e-9)
+    braked = (np.interp(h["time"], *zip(*load)) == 1.0) & (np.interp(h["time"], *zip(*speed)) > 0.0)
+    assert braked.sum() == 7
+    np.testing.assert_allclose(h["friction_moment"][braked], torque, rtol=TORQUE_TOL)
+    assert np.all(h["friction_moment"][~braked] == 0.0)
+    loaded = h["interface_force"] > 0.0
+    np.testing.assert_array_equal(loaded, np.interp(h["time"], *zip(*load)) > 0.0)
+
+
 def test_a_release_phase_has_no_contact_and_no_frictional_heat(tmp_path):
     """Loaded for 0.6 s, released over the next 10 ms: no contact force after; the step holding the
     release gets the frictional heat of its loaded part only (1/60 of a full 0.3 s step); no heat

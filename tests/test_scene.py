@@ -387,6 +387,36 @@ def test_alternatives_given_together_are_one_problem(tmp_path):
                                    "(got speed_profile, vehicle)"]
 
 
+def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_path):
+    """loading.braking_torque [N m] instead of a clamp force (a cycle of stops under a vehicle's
+    torque; the run scales the force, tests/test_duty_cycle.py): read in torque units, named in the
+    summary, and refused beside another load, without effect "friction" and on a translating body."""
+    pod = (DEMOS / "pin_on_disc_perfect.toml").read_text()
+    torque = pod.replace('normal_force = "200 N"', 'braking_torque = "0.03 kN m"')
+    assert loads(torque, tmp_path).loading.torque == pytest.approx(30.0, rel=1e-15)
+    assert any(line.startswith("  loading   braking torque 30 N m, 200 rpm") for line in summary(loads(torque,
+                                                                                                     tmp_path)))
+    assert to_si("957.6 N m", "torque") == pytest.approx(957.6) and to_si("1 kN*m", "torque") == 1e3
+    cases = [(pod.replace('normal_force = "200 N"', 'normal_force = "200 N"\nbraking_torque = "30 N m"'),
+              "loading.braking_torque: give the torque or loading.normal_force, not both"),
+             (torque.replace('"friction", ', ""),
+              'loading.braking_torque: the clamp force follows from the friction moment: needs effect "friction"'),
+             (torque.replace('braking_torque = "0.03 kN m"', 'braking_torque = "30 N"'),
+              'loading.braking_torque = "30 N": expected a torque (N m, kN m); the unit "N" is a force')]
+    for text, message in cases:
+        with pytest.raises(SceneError) as info:
+            loads(text, tmp_path)
+        assert any(p.startswith(message) for p in info.value.problems), info.value.problems
+    squeal = (DEMOS / "brake_squeal.toml").read_text().replace('pressure = "10 bar"', 'braking_torque = "30 N m"')
+    assert loads(squeal, DEMOS).warnings[-1].startswith("loading.braking_torque: the squeal analysis preloads at the "
+                                                        "clamp force guessed from the torque")
+    block = GOOD.replace('pressure = "10 bar"', 'braking_torque = "30 N m"')
+    with pytest.raises(SceneError) as info:
+        loads(block, tmp_path)
+    assert any(p.startswith("loading.braking_torque: a moment about the axis of a rotating body;")
+               for p in info.value.problems), info.value.problems
+
+
 def test_a_folder_given_as_a_file_is_said_to_be_a_folder(tmp_path):
     """geometry.file = a folder said "no such file" (an adversarial review)."""
     (tmp_path / "brake.step").mkdir()
@@ -628,9 +658,9 @@ def test_overrides_are_validated_like_the_file(tmp_path):
     with pytest.raises(SceneError) as info:
         loads(GOOD, tmp_path, overrides={"loading.frictoin": 0.2, "time.end": "-1 s"})
     assert info.value.problems == [
-        'loading.frictoin: unknown key (did you mean "friction"?); allowed: normal_force, pressure, faces, direction, '
-        "load_profile, rotation_speed, speed_profile, vehicle, sliding_speed, friction, ramp_steps, friction_curve, "
-        "stribeck",
+        'loading.frictoin: unknown key (did you mean "friction"?); allowed: normal_force, pressure, braking_torque, '
+        "faces, direction, load_profile, rotation_speed, speed_profile, vehicle, sliding_speed, friction, ramp_steps, "
+        "friction_curve, stribeck",
         'time.end = "-1 s": must be > 0 s (got -1 s)']
     with pytest.raises(SceneError, match="cannot override, friction is not a table"):
         loads(GOOD, tmp_path, overrides={"loading.friction.x": 1})

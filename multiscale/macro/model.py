@@ -120,14 +120,14 @@ class MacroModel:
     def start(self) -> SolveResult:
         """First contact solve from rest with the drive's load ramp (at the initial load factor;
         a start in a released phase solves at the full load, factor 1, then releases); with a
-        torque, the load is scaled to it and solved again."""
+        torque, the load is scaled to it and solved again (from rest: once sliding starts)."""
         self.contact.speed.value = self.speed(0.0)
         self.load = self.drive.load
         factor = self.drive.factor(0.0) or 1.0
         self.last_solve = self.mechanics.ramp(self.load * factor, self.drive.ramp_steps)
-        if self.drive.torque is not None and not abs(self.contact.friction_moment()) > 0:
-            raise InputError("loading.vehicle", self.drive.torque, "braking needs a friction moment: give "
-                             "friction and a speed at the start of the stop")
+        if self.drive.torque is not None and self.speed(0.0) and not abs(self.contact.friction_moment()) > 0:
+            raise InputError("loading", None, f"the braking torque ({self.drive.torque:.6g} N m) needs a friction "
+                             "moment: give friction")
         self.keep_torque(factor)
         self.contact.engaged.value = float(self.drive.factor(0.0) > 0)
         self.solved_speed = float(self.contact.speed.value)

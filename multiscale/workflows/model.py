@@ -14,8 +14,8 @@ The rules that more than one analysis follows live here once:
   normal force spread as the uniform pressure F / A, A the load faces' areas projected normal to
   each face's resultant, or of each of a face's flat parts facing opposite ways, ``load_face_areas``;
   with ``loading.direction`` a traction along it), else the scene's normal force [N] or pressure [Pa] on the load faces; with
-  ``loading.vehicle.mass`` the load whose friction moment about the axis is the braking torque
-  (braking force x wheel radius): first guessed with every interface carrying the same clamp
+  ``loading.braking_torque`` or ``loading.vehicle.mass`` the load whose friction moment about the axis is the braking
+  torque (that torque, or the braking force x wheel radius): first guessed with every interface carrying the same clamp
   force N, sum_k mu_k N r_k = torque (r_k the interface's mean radius), then scaled by the model
   after its first solve to the friction moment of the real pressure distribution;
 - interface forces: every interface carries its area's share of the resultant of the load on the
@@ -97,15 +97,14 @@ def drive(scene, tm) -> Drive:
     """Load [N or Pa] (``load_kind``), ramp, load factor and speed of body 1 (rad/s for a
     rotation, m/s for a translation) against time."""
     ld, kind = scene.loading, load_kind(scene)
-    force, torque = ld.normal_force, None
-    vehicle = ld.vehicle
-    if vehicle is not None and vehicle.mass is not None:
+    force, torque = ld.normal_force, ld.torque
+    if torque is not None:
         radius = interface_radii(scene, tm)
         moment = sum(friction_coefficient(scene, n) * radius[n] for n in tm.interface.tags)
         if moment <= 0:
-            raise InputError("loading.vehicle.mass", vehicle.mass, 'braking needs friction (effect "friction" and '
-                             "loading.friction > 0)")
-        torque = vehicle.braking_force * vehicle.wheel_radius
+            key = "loading.braking_torque" if ld.braking_torque is not None else "loading.vehicle.mass"
+            raise InputError(key, ld.braking_torque or ld.vehicle.mass, 'braking needs friction (effect "friction" '
+                             "and loading.friction > 0)")
         force = len(radius) * torque / moment          # a first guess: the model scales it to the torque
     if force is not None and kind != "force":          # a force as a uniform pressure on the load faces
         area = sum(load_face_areas(tm, kind).values())  # with that resultant (a fluid's: projected areas)
