@@ -363,11 +363,6 @@ class Loading:
                                 "deceleration (or slope) whatever the load factor; a release does not stop it")
         given = [k for k in ("normal_force", "pressure") if getattr(self, k) is not None]
         by_mass = self.vehicle is not None and self.vehicle.mass is not None
-        if (self.braking_torque is not None or by_mass) and "stability" in ctx.effects:
-            ctx.warnings.append(f"{path}.{'braking_torque' if self.braking_torque is not None else 'vehicle.mass'}: "
-                                "the squeal analysis preloads at the clamp force guessed from the torque (each "
-                                "interface at its mean radius), not scaled to the friction moment of the solved "
-                                "pressure as a transient run does (0.4 % off on the car-brake demo)")
         if self.braking_torque is not None:
             if given or by_mass:
                 return [f"{path}.braking_torque: give the torque or {path}.{(given or ['vehicle.mass'])[0]}, not both"]

@@ -63,7 +63,7 @@ def test_a_vehicle_stop_with_thermal_expansion_keeps_the_torque(tmp_path):
     scaled after every solve so that the friction moment stays the braking torque within
     ``TORQUE_TOL`` (before: once, at the start), so the frictional heat of the stop is the
     kinetic energy within 1e-3 and the clamp force changes along the stop."""
-    from multiscale.macro.model import TORQUE_TOL
+    from multiscale.macro.preload import TORQUE_TOL
     text = pin_on_disc(tmp_path / "stop", partition="0.5").replace('rotation_speed = "200 rpm"\n', "")
     scene = loads(text.replace("normal_force = \"200 N\"\n", ""), overrides={
         "loading.vehicle": {"speed": f"{V0} m/s", "deceleration": f"{DECEL} m/s^2", "wheel_radius": f"{WHEEL} m",
@@ -82,7 +82,7 @@ def test_a_cycle_under_a_braking_torque_holds_the_moment_and_turns_its_work_into
     sliding (0 released or at rest), from rest once sliding starts, and the frictional heat is
     T times the integral of load factor x angular speed (trapezoids on 1 us, independent of the
     run's exact means). Before, a cycle took a fixed clamp force (docs/tutorials/braking_cycle.rst)."""
-    from multiscale.macro.model import TORQUE_TOL
+    from multiscale.macro.preload import TORQUE_TOL
     torque, w0 = MASS * DECEL * WHEEL, V0 / WHEEL           # 30 N m, 33.3 rad/s
     speed = [(0.0, 0.0), (0.25, w0), (1.25, w0 / 2), (1.75, w0 / 2), (2.75, 0.0)]
     load = [(0.0, 0.0), (0.25, 0.0), (0.26, 1.0), (1.25, 1.0), (1.26, 0.0), (1.75, 0.0), (1.76, 1.0)]
@@ -362,7 +362,7 @@ def test_a_rough_stop_keeps_the_torque_after_the_worn_laws(tmp_path):
     the braking torque after that solve too (before: only after the drive's solves, none here once
     started, so the friction moment drifted: the heat of step 2 was 1.6e-3 above its share of the
     kinetic energy, more than ``TORQUE_TOL``; an adversarial test)."""
-    from multiscale.macro.model import TORQUE_TOL
+    from multiscale.macro.preload import TORQUE_TOL
     from test_coupling import POD
     text = POD.replace('rotation_speed = "200 rpm"\n', "").replace('normal_force = "200 N"\n', "")
     scene = loads(text.replace('"expansion", ', "").format(folder=tmp_path / "rough_stop"), overrides={

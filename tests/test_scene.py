@@ -407,9 +407,6 @@ def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_pa
         with pytest.raises(SceneError) as info:
             loads(text, tmp_path)
         assert any(p.startswith(message) for p in info.value.problems), info.value.problems
-    squeal = (DEMOS / "brake_squeal.toml").read_text().replace('pressure = "10 bar"', 'braking_torque = "30 N m"')
-    assert loads(squeal, DEMOS).warnings[-1].startswith("loading.braking_torque: the squeal analysis preloads at the "
-                                                        "clamp force guessed from the torque")
     block = GOOD.replace('pressure = "10 bar"', 'braking_torque = "30 N m"')
     with pytest.raises(SceneError) as info:
         loads(block, tmp_path)

@@ -24,12 +24,11 @@ from multiscale.errors import InputError
 from multiscale.geometry import Rotation
 from multiscale.macro.mechanics import Mechanics, SolveResult, clamp_imbalance, load_face_forces
 from multiscale.macro.mesh import TwoBodyMesh
+from multiscale.macro.preload import hold_moment
 from multiscale.macro.thermal import Thermal
 
 
 CARRIED = 0.01       # the first solve's contact must carry this share of a force or pressure load at least
-TORQUE_TOL = 1e-3    # relative error of the friction moment left by the load's scaling to a torque
-TORQUE_SOLVES = 5    # contact solves at most per scaling
 
 
 @dataclass(frozen=True)
@@ -214,16 +213,12 @@ class MacroModel:
 
     def keep_torque(self, factor: float) -> None:
         """With the drive's torque and while sliding: scale the load until the friction moment is
-        the torque times ``factor`` within ``TORQUE_TOL`` (secant steps, the moment being nearly
-        linear in the load; before, scaled once at the start, the moment of a car stop with thermal
-        expansion drifted 2.5 % above the torque and the work 0.95 % above the kinetic energy)."""
-        target = (self.drive.torque or 0.0) * factor
-        for _ in range(TORQUE_SOLVES if target > 0 else 0):
-            moment = abs(self.contact.friction_moment())
-            if not moment > 0 or abs(moment - target) <= TORQUE_TOL * target:
-                return
-            self.load *= target / moment
-            self.last_solve = self.mechanics.solve(self.load * factor)
+        the torque times ``factor`` (``preload.hold_moment``; before, scaled once at the start, the
+        moment of a car stop with thermal expansion drifted 2.5 % above the torque and the work
+        0.95 % above the kinetic energy)."""
+        load, solved = hold_moment(self.mechanics, self.load * factor, (self.drive.torque or 0.0) * factor)
+        if solved is not None:                   # (only with a positive target: factor > 0)
+            self.load, self.last_solve = load / factor, solved
 
     def interface_heat_row(self, masks: dict) -> dict:
         """Per interface (``masks``: its facets): the frictional heat generated on it [J] in the last

@@ -46,13 +46,33 @@ class Preload:
 
 
 NEWTON_FORCE_TOL = 1e-11    # absolute Newton tolerance relative to the applied force [-]
+TORQUE_TOL = 1e-3    # relative error of the friction moment left by the load's scaling to a torque
+TORQUE_SOLVES = 5    # contact solves at most per scaling
 
 
-def preload(mech: Mechanics, pressure: float, steps: int = 1, reset: bool = True) -> Preload:
+def hold_moment(mech: Mechanics, load: float, target: float):
+    """Scale ``load`` [N or Pa], the one ``mech`` solved last, until the friction moment about the
+    rotation axis is ``target`` [N m] within ``TORQUE_TOL`` (secant steps, the moment being nearly
+    linear in the load; at most ``TORQUE_SOLVES`` solves). Returns the load and the last
+    ``SolveResult`` (None: no solve was needed, or there is no moment: at rest, no friction)."""
+    solved = None
+    for _ in range(TORQUE_SOLVES if target > 0 else 0):
+        moment = abs(mech.contact.friction_moment())
+        if not moment > 0 or abs(moment - target) <= TORQUE_TOL * target:
+            break
+        load *= target / moment
+        solved = mech.solve(load)
+    return load, solved
+
+
+def preload(mech: Mechanics, pressure: float, steps: int = 1, reset: bool = True,
+            torque: float | None = None) -> Preload:
     """Ramp the load to ``pressure`` [Pa] (a force [N] for ``load_kind="force"``) in ``steps``
-    Newton solves, from rest if ``reset``. The absolute residual tolerance is NEWTON_FORCE_TOL
-    times the applied force: a re-solve from a nearly balanced state otherwise asks for a relative
-    reduction below the round-off floor of the penalty-stiff system."""
+    Newton solves, from rest if ``reset``; with ``torque`` [N m], ``pressure`` is a first guess,
+    scaled after the ramp until the friction moment is the torque (``hold_moment``). The absolute
+    residual tolerance is NEWTON_FORCE_TOL times the applied force: a re-solve from a nearly
+    balanced state otherwise asks for a relative reduction below the round-off floor of the
+    penalty-stiff system."""
     check_positive("pressure", pressure)
     t0 = time.perf_counter()
     tm, c = mech.tm, mech.contact
@@ -64,6 +84,9 @@ def preload(mech: Mechanics, pressure: float, steps: int = 1, reset: bool = True
         for u in mech.u:
             u.x.array[:] = 0.0
     solved = mech.ramp(pressure, steps)
+    if torque is not None:
+        pressure, again = hold_moment(mech, pressure, torque)
+        solved = again or solved
     normal, tangential = {}, {}
     mu, masks = tm.interface.values(c.friction), tm.interface.masks()
     for name, dS in tm.interface.dS_tag.items():

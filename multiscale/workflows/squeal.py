@@ -94,14 +94,15 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
                 steps: int = 1, band=(0.0, 16e3), n_modes: int | None = None,
                 target: float | None = None, damping: Damping | None = None, energy: bool = True,
                 rtol: float = 1e-6, close_tol: float = 1e-3, options: SquealOptions | None = None,
-                reset: bool = True) -> SquealCase:
-    """Preload ``mech`` from rest (``reset``) to ``load`` [Pa or N] in ``steps``, linearise and
-    extract the complex modes in ``band`` [Hz] (§4.3.1, two steps); ``damping`` (or
-    ``options.damping``) is the proportional part, ``options`` the rest (``SquealOptions``)."""
+                reset: bool = True, torque: float | None = None) -> SquealCase:
+    """Preload ``mech`` from rest (``reset``) to ``load`` [Pa or N] in ``steps`` (with ``torque``
+    [N m] a first guess, scaled to that friction moment: ``preload``), linearise and extract the
+    complex modes in ``band`` [Hz] (§4.3.1, two steps); ``damping`` (or ``options.damping``) is the
+    proportional part, ``options`` the rest (``SquealOptions``)."""
     opt = options or SquealOptions()
     slope = set_friction(mech, opt.friction_laws)[1] if opt.friction_laws else None
     with io.stage("preload"):
-        pre = preload(mech, load, steps, reset=reset)
+        pre = preload(mech, load, steps, reset=reset, torque=torque)
     with io.stage("eigen solve"):
         lin = linearise_system(mech, materials, damping=damping or opt.damping,
                                slope=slope if opt.friction_damping else None, prestress=opt.prestress,
@@ -173,7 +174,8 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     mech = build_squeal_mechanics(scene, tm, degree=degree, prefix=prefix)
     try:
         with closed_on_error(mech, tm.comm):
-            return squeal_case(mech, dict(scene.materials), name, load=drive(model_scene(scene), tm).load,
+            d = drive(model_scene(scene), tm)
+            return squeal_case(mech, dict(scene.materials), name, load=d.load, torque=d.torque,
                                steps=scene.loading.ramp_steps, band=tuple(st.band), n_modes=st.modes,
                                target=st.target, energy=energy, rtol=st.threshold, options=squeal_options(scene, tm))
     except InputError as exc:        # the eigen solvers' arguments by their scene keys
@@ -300,7 +302,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         if scene.stability.sweep is not None:
             with io.stage("stability map"):
                 smap = squeal_map.stability_map(scene, tm, case.mech, squeal_options(scene, tm),
-                                                drive(model_scene(scene), tm).load,
+                                                case.preload.pressure,         # (scaled to a braking torque)
                                                 lambda changed: build_squeal_mechanics(changed, tm, degree=degree,
                                                                                        prefix="squeal_map_"))
                 files += squeal_map.write(smap, folder, comm)
