@@ -32,9 +32,10 @@ from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Sectio
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
 from multiscale.scene_sections import (COUPLING_DEFAULT, DEFAULT_GRID, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
-                                       Micro, Output, Roughness, Time, Vehicle, Wear)
+                                       Micro, Output, Roughness, Time, Wear)
 from multiscale.scene_cycle import convection_coverage, cycle_coverage, short_phases, squeal_state
 from multiscale.scene_stability import Stability
+from multiscale.scene_vehicle import Vehicle
 
 __all__ = ["COUPLING_DEFAULT", "EFFECTS", "FIG_7_9_CALIBRATION", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Boundary",
            "Geometry", "Interface", "InterfaceSettings", "Loading", "Material", "Scene", "Vehicle", "load", "loads"]

@@ -6,7 +6,8 @@ from __future__ import annotations
 
 import math
 
-from multiscale.scene_sections import GRAVITY, interpolate
+from multiscale.scene_sections import interpolate
+from multiscale.scene_vehicle import GRAVITY
 
 
 def cycle_coverage(ld, end: float) -> list[str]:

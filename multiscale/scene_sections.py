@@ -2,8 +2,9 @@
 
 Materials (constants or temperature tables), the interface defaults and per-interface settings,
 boundary conditions (supports, convection, radiation, fixed temperatures), the loading and its duty
-cycle (load and speed against time, a vehicle stop or drag), time, output, and the sections of the
-multiscale loop (roughness, micro, wear, layers); the squeal analysis' in ``scene_stability``. Values are
+cycle (load and speed against time, a braking torque; a vehicle stop or drag: ``scene_vehicle``), time,
+output, and the sections of the multiscale loop (roughness, micro, wear, layers); the squeal analysis' in
+``scene_stability``. Values are
 SI numbers or unit strings (``multiscale.units``).
 """
 from __future__ import annotations
@@ -18,6 +19,7 @@ from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_top
 from multiscale.scene_geometry import LengthUnit
 from multiscale.scene_plain import PixelSize
 from multiscale.scene_stability import Stribeck
+from multiscale.scene_vehicle import Vehicle
 from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, ListOf, OneOf, OnlyWith, Pair,
                                Quantity, Requires, Section, TableOr, Tables, Text, Vector, key)
 
@@ -38,7 +40,6 @@ _CONVECTION = Quantity("conductance", ge=0, plausible=(0.0, 1e4))         # stil
 _ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0))  # up to ~24 000 rpm
 _WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # Archard k/H
 _HARDNESS = Quantity("pressure", gt=0, plausible=(1e6, 1e11))            # soft polymer to diamond
-GRAVITY = 9.80665                  # m/s^2, standard gravity
 _WITH_RMS = "needed with rms (a generated surface)"
 
 
@@ -261,49 +262,6 @@ OUTPUT_FIELDS: dict[str, tuple[str, ...]] = {
     "contact_stiffness": ("roughness",), "partition": ("heat_partition",), "wear_depth": ("wear",),
     "flash_temperature": ("roughness", "heat_partition"), "counter_wear_depth": ("wear",), "interface": (),
 }
-
-
-@dataclass(frozen=True)
-class Vehicle:
-    """[loading.vehicle]: the brake of a vehicle: a stop from ``speed`` at ``deceleration`` (or a
-    drag at constant ``speed`` down a ``slope``), the rotating body turning with the wheel
-    (omega = v / wheel_radius). With ``mass`` (the vehicle mass braked by this brake) the brake
-    load follows from the braking force at the tyre (m a for a stop, m g sin(atan(slope)) for a
-    drag): the friction power is then mu F v = that force times the vehicle speed."""
-
-    speed: float | None = key(Quantity("speed", gt=0, plausible=(0.1, 150.0)), required=True)  # m/s, initial
-    wheel_radius: float | None = key(Quantity("length", gt=0, plausible=(0.05, 2.0)), required=True)  # m
-    deceleration: float | None = key(Quantity("acceleration", gt=0, plausible=(0.01, 15.0)),   # m/s^2: a stop
-                                     absent="slope: a drag; neither: a constant speed")
-    slope: float | None = key(Quantity("dimensionless", gt=0, plausible=(0.0, 0.5)),   # grade (rise/run): a drag
-                              absent="deceleration: a stop; neither: a constant speed")
-    mass: float | None = key(Quantity("mass", gt=0, plausible=(1.0, 1e7)), absent="the load: normal_force or pressure")
-
-    rules = (OneOf(("deceleration", "slope")),)
-
-    def problems(self, path, ctx):
-        if self.mass is not None and self.deceleration is None and self.slope is None:
-            return [f"{path}.mass: needs {path}.deceleration (a stop) or {path}.slope (a drag) for the braking force"]
-        return []
-
-    @property
-    def stop_time(self) -> float | None:
-        """Duration of the stop [s] (None for a drag)."""
-        return None if self.deceleration is None else self.speed / self.deceleration
-
-    def angular_speed(self, t: float) -> float:
-        """omega(t) [rad/s] of the wheel (and the rotating body)."""
-        v = self.speed if self.deceleration is None else max(self.speed - self.deceleration * t, 0.0)
-        return v / self.wheel_radius
-
-    @property
-    def braking_force(self) -> float | None:
-        """Force at the tyre contact [N] that the brake must give (None without a mass)."""
-        if self.mass is None:
-            return None
-        if self.deceleration is not None:
-            return self.mass * self.deceleration
-        return self.mass * GRAVITY * math.sin(math.atan(self.slope))
 
 
 @dataclass(frozen=True)
