@@ -144,9 +144,12 @@ def squeal_options(scene, tm) -> SquealOptions:
 
 def model_scene(scene):
     """The scene the model factory reads: with a mu(v) law, a placeholder constant friction
-    (the law sets the per-facet mu before the preload)."""
-    if scene.loading.friction is None and scene.has("friction"):
-        return dataclasses.replace(scene, loading=dataclasses.replace(scene.loading, friction=0.0))
+    (the law sets the per-facet mu before the preload), the law's kinetic or mean mu (the first
+    guess of the clamp force of a braking torque divides by it; 0 made it "braking needs friction")."""
+    ld = scene.loading
+    if ld.friction is None and scene.has("friction"):
+        mu = ld.stribeck.kinetic if ld.stribeck is not None else float(np.mean([m for _, m in ld.friction_curve]))
+        return dataclasses.replace(scene, loading=dataclasses.replace(ld, friction=mu))
     return scene
 
 
