@@ -43,6 +43,24 @@ def test_a_body_of_several_materials_has_one_visible_named_curve_per_material(tm
         np.testing.assert_allclose(curves[prefix + "pin, disc material"], [21.85, 22.85, 23.85])
 
 
+def test_a_body_of_several_parts_has_one_curve_per_part(tmp_path, drawn):
+    """A brake's fixed body of pads and backplates (two materials): its parts' columns
+    max_temperature_fixed_part_<part> are drawn, named by the part, instead of the body's and its
+    materials' (before, the pads' bulk temperatures were not in the history: only per material)."""
+    history = History()
+    for t in (0.0, 1.0, 2.0):
+        parts = {f"max_temperature_fixed_part_{p}": 300.0 + k * t
+                 for k, p in enumerate(("inner_pad", "inner_backplate", "outer_pad"), 1)}
+        history.append(time=t, interface_force=200.0, max_pressure=1e6, max_temperature_fixed=303.0 + 3 * t,
+                       max_temperature_fixed_in_pad=303.0 + 3 * t, max_temperature_fixed_in_steel=302.0 + 2 * t,
+                       max_temperature_disc=305.0 + t, heat_total_fixed=t, heat_total_disc=2 * t, **parts)
+    plots.history_figure(history, tmp_path / "history.png")
+    axis = next(ax for ax in drawn[0].axes if ax.get_ylabel() == "max temperature [°C]")
+    curves = {line.get_label(): tuple(line.get_ydata()) for line in axis.get_lines()}
+    assert list(curves) == ["disc", "inner pad", "inner backplate", "outer pad"]     # in the columns' order
+    np.testing.assert_allclose(curves["outer pad"], [26.85, 29.85, 32.85])
+
+
 def test_the_pads_heat_and_face_temperatures_have_their_own_panels(tmp_path, drawn):
     """A brake's per-pad columns: the frictional heat of each pad in a panel of its own (not among
     the bodies' heat_total_<body>, which they would double), the hottest facet of each face in

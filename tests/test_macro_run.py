@@ -113,6 +113,13 @@ def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
     np.testing.assert_array_equal(h["max_temperature_pin"], h["max_temperature_pin_in_pin"])
     assert np.all(h["max_temperature_pin_in_disc"][1:] < h["max_temperature_pin_in_pin"][1:])
     assert "max_temperature_disc_in_disc" not in h.columns                 # one material: no column
+    # and its parts (the pin, its housing and plate, both of material disc): the body's largest
+    # nodal temperature is that of one of them; the housing's, the plate's are the disc material's
+    parts = [h[f"max_temperature_pin_part_{p}"] for p in ("pin", "housing", "plate")]
+    np.testing.assert_array_equal(h["max_temperature_pin"], np.max(parts, axis=0))
+    np.testing.assert_array_equal(parts[0], h["max_temperature_pin_in_pin"])
+    np.testing.assert_array_equal(np.maximum(parts[1], parts[2]), h["max_temperature_pin_in_disc"])
+    assert np.all(parts[2][1:] < parts[1][1:]) and "max_temperature_disc_part_disc" not in h.columns
     assert not any(k.startswith("heat_lost") for k in h.columns)      # insulated: no loss columns
     for f in result.field_files + [result.plot_file]:
         assert f.exists() and f.stat().st_size > 0

@@ -326,8 +326,11 @@ class MacroModel:
             for i, body in enumerate(self.tm.bodies):
                 row[f"max_temperature_{body.name}"] = hottest[i]
                 if len({r.material for r in body.spec.regions}) > 1:     # per material (their tables)
-                    for material, T in self.thermal.material_max_temperature(i).items():
+                    for material, T in self.thermal.region_max_temperature(i).items():
                         row[f"max_temperature_{body.name}_in_{material}"] = T
+                if len(body.spec.regions) > 1:                          # per part (a brake's pads)
+                    for part, T in self.thermal.region_max_temperature(i, "name").items():
+                        row[f"max_temperature_{body.name}_part_{part}"] = T
                 row[f"min_temperature_{body.name}"] = coldest[i]
                 row[f"heat_step_{body.name}"] = heat_step[i]
                 row[f"heat_total_{body.name}"] = self.heat_total[i]

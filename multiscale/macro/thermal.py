@@ -83,7 +83,6 @@ from __future__ import annotations
 
 import warnings
 from dataclasses import dataclass
-from functools import cached_property
 from typing import Mapping, Sequence
 
 import numpy as np
@@ -556,23 +555,20 @@ class Thermal:
         """Largest nodal temperature of each body [K]."""
         return tuple(self.tm.comm.allreduce(T.x.array.max(initial=-np.inf), op=MPI.MAX) for T in self.T)
 
-    @cached_property
-    def material_dofs(self) -> tuple:
-        """Per body: the local temperature dofs of the cells of each material (a node on a
-        boundary between materials belongs to both)."""
-        out = []
-        for body, T in zip(self.tm.bodies, self.T):
+    def region_max_temperature(self, i: int, by: str = "material") -> dict:
+        """Largest nodal temperature [K] of the cells of body ``i`` grouped by their regions'
+        ``by``: "material", or "name" (the parts of a geometry file, a brake's pads; collective; a
+        node on a boundary between two groups belongs to both)."""
+        groups = self.__dict__.setdefault("_region_dofs", {})      # the local dofs of each group
+        if (i, by) not in groups:
+            body, T = self.tm.bodies[i], self.T[i]
             dofs = T.function_space.dofmap.list[:len(body.region_tags)]
-            out.append({m: np.unique(dofs[np.isin(body.region_tags, [r.tag for r in body.spec.regions
-                                                                      if r.material == m])])
-                        for m in sorted({r.material for r in body.spec.regions})})
-        return tuple(out)
-
-    def material_max_temperature(self, i: int) -> dict:
-        """Largest nodal temperature [K] of the cells of each material of body ``i`` (collective)."""
+            tags = {g: [r.tag for r in body.spec.regions if getattr(r, by) == g] for g in
+                    dict.fromkeys(getattr(r, by) for r in body.spec.regions)}
+            groups[i, by] = {g: np.unique(dofs[np.isin(body.region_tags, t)]) for g, t in tags.items()}
         T = self.T[i].x.array
-        return {m: self.tm.comm.allreduce(T[mine].max(initial=-np.inf), op=MPI.MAX)
-                for m, mine in self.material_dofs[i].items()}
+        return {g: self.tm.comm.allreduce(T[mine].max(initial=-np.inf), op=MPI.MAX)
+                for g, mine in groups[i, by].items()}
 
     def min_temperature(self) -> tuple:
         """Smallest nodal temperature of each body [K] (below every imposed temperature: an undershoot

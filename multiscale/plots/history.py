@@ -26,20 +26,25 @@ BODY_STYLES = ("-", "--", ":", "-.")
 def column_label(key: str) -> str:
     """Legend of a per-body or per-interface column: max_temperature_outer_pad -> "outer pad",
     max_temperature_pin_in_disc -> "pin, disc material" (the pin's cells of material disc),
+    max_temperature_fixed_part_inner_pad -> "inner pad" (a part of body fixed),
     face_max_temperature_inner_pad_on_disc -> "inner pad on disc" (the disc's face of interface
     inner_pad)."""
     for prefix in ("max_temperature_", "heat_total_", "frictional_heat_total_", "face_max_temperature_"):
         key = key.removeprefix(prefix)
+    key = key.partition("_part_")[2] or key
     body, within, material = key.partition("_in_")
     return body.replace("_", " ") + (f", {material.replace('_', ' ')} material" if within else "")
 
 
 def temperature_columns(columns) -> list[str]:
-    """The max-temperature columns to draw: per body, or per material for a body of several
-    materials (max_temperature_pin_in_pin, ..._pin_in_disc), whose whole-body column is the highest
-    of those and would hide under one of them."""
+    """The max-temperature columns to draw: per body, or for a body of several parts per part
+    (max_temperature_fixed_part_inner_pad, ...; a brake's pads), else per material for a body of
+    several materials (max_temperature_pin_in_pin, ..._pin_in_disc). A body's whole-body column is
+    the highest of those and would hide under one of them; its materials' under its parts'."""
     hot = [k for k in columns if k.startswith("max_temperature")]
-    return [k for k in hot if not any(j.startswith(k + "_in_") for j in hot)]
+    parted = {k.partition("_part_")[0] for k in hot if "_part_" in k}
+    return [k for k in hot if k not in parted and k.partition("_in_")[0] not in parted
+            and not any(j.startswith(k + "_in_") for j in hot)]
 
 
 def curve_styles(keys) -> tuple[list[dict], list]:
