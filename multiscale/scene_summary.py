@@ -50,6 +50,10 @@ def summary(scene: Scene) -> list[str]:
     where = f" on {', '.join(ld.faces)}" if ld.faces else ""
     profile = f", load profile of {len(ld.load_profile)} points" if ld.load_profile else ""
     lines.append(f"  loading   {load_text}{where}, {motion}{profile}, {ld.ramp_steps} ramp step(s)")
+    end = scene.time.end if scene.has("thermal") or scene.has("wear") else None
+    if ld.torque is not None and end and g.motion == "rotation":     # the heat the run must account for
+        work = ld.torque * ld.mean_sliding_factor(0.0, end) * end      # torque x load factor x angle, to time.end
+        lines.append(f"            braking work to time.end: {work / 1e3:.6g} kJ (the frictional heat of the run)")
     for name in g.spec.interfaces:
         if name in scene.interfaces or len(g.spec.interfaces) > 1:
             s = scene.interface_settings(name)

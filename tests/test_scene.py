@@ -394,8 +394,16 @@ def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_pa
     pod = (DEMOS / "pin_on_disc_perfect.toml").read_text()
     torque = pod.replace('normal_force = "200 N"', 'braking_torque = "0.03 kN m"')
     assert loads(torque, tmp_path).loading.torque == pytest.approx(30.0, rel=1e-15)
-    assert any(line.startswith("  loading   braking torque 30 N m, 200 rpm") for line in summary(loads(torque,
-                                                                                                     tmp_path)))
+    lines = summary(loads(torque, tmp_path))
+    # check states the work the run's frictional heat must add up to: T x 200 rpm x 30 s here,
+    # 1/2 m v^2 for a vehicle stop that ends before time.end (20 kg from 36 km/h: 1 kJ)
+    at = next(k for k, line in enumerate(lines) if line.startswith("  loading   braking torque 30 N m, 200 rpm"))
+    assert lines[at + 1] == (f"            braking work to time.end: {30 * 200 * math.pi / 30 * 30 / 1e3:.6g} kJ (the "
+                             "frictional heat of the run)")
+    stop = loads(pod.replace('rotation_speed = "200 rpm"\n', "").replace('normal_force = "200 N"\n', "")
+                 + '[loading.vehicle]\nspeed = "36 km/h"\ndeceleration = "1 m/s^2"\nwheel_radius = "300 mm"\n'
+                   'mass = "20 kg"\n', tmp_path)
+    assert "            braking work to time.end: 1 kJ (the frictional heat of the run)" in summary(stop)
     assert to_si("957.6 N m", "torque") == pytest.approx(957.6) and to_si("1 kN*m", "torque") == 1e3
     cases = [(pod.replace('normal_force = "200 N"', 'normal_force = "200 N"\nbraking_torque = "30 N m"'),
               "loading.braking_torque: give the torque or loading.normal_force, not both"),
