@@ -464,6 +464,8 @@ def test_a_braking_torque_preloads_the_squeal_analysis_at_that_friction_moment(t
         tmp_path / "t")})), degree=1, verbose=False).case
     assert abs(case.mech.contact.friction_moment()) == pytest.approx(torque, rel=TORQUE_TOL)
     assert case.preload.pressure == pytest.approx(1.5e6, rel=TORQUE_TOL)
+    assert sum(case.preload.load_force.values()) == pytest.approx(1.5 * sum(nominal.preload.load_force.values()),
+                                                                  rel=TORQUE_TOL)
     # with mu(v) (a Stribeck law) the first guess divides by the law's kinetic mu (it took the
     # placeholder mu = 0: "braking needs friction")
     stribeck = text.replace("friction = 0.4\n", "") + ('\n[loading.stribeck]\nstatic = 0.5\nkinetic = 0.35\n'

@@ -86,7 +86,7 @@ def preload(mech: Mechanics, pressure: float, steps: int = 1, reset: bool = True
     solved = mech.ramp(pressure, steps)
     if torque is not None:
         pressure, again = hold_moment(mech, pressure, torque)
-        solved = again or solved
+        solved, loads = again or solved, load_face_forces(tm, pressure, mech.load_kind)
     normal, tangential = {}, {}
     mu, masks = tm.interface.values(c.friction), tm.interface.masks()
     for name, dS in tm.interface.dS_tag.items():
