@@ -4,8 +4,7 @@ Materials (constants or temperature tables), the interface defaults and per-inte
 boundary conditions (supports, convection, radiation, fixed temperatures), the loading and its duty
 cycle (load and speed against time, a braking torque; a vehicle stop or drag: ``scene_vehicle``), time,
 output, and the sections of the multiscale loop (roughness, micro, wear, layers); the squeal analysis' in
-``scene_stability``. Values are
-SI numbers or unit strings (``multiscale.units``).
+``scene_stability``. Values are SI numbers or unit strings (``multiscale.units``).
 """
 from __future__ import annotations
 

@@ -24,7 +24,8 @@ class Vehicle:
                                      absent="slope: a drag; neither: a constant speed")
     slope: float | None = key(Quantity("dimensionless", gt=0, plausible=(0.0, 0.5)),   # grade (rise/run): a drag
                               absent="deceleration: a stop; neither: a constant speed")
-    mass: float | None = key(Quantity("mass", gt=0, plausible=(1.0, 1e7)), absent="the load: normal_force or pressure")
+    mass: float | None = key(Quantity("mass", gt=0, plausible=(1.0, 1e7)),
+                             absent="the load: normal_force, pressure or braking_torque")
 
     rules = (OneOf(("deceleration", "slope")),)
 

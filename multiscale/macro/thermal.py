@@ -189,6 +189,7 @@ class Thermal:
         self.dt = fem.Constant(tm.parent, check_positive("dt", dt))
         self.time = 0.0
         self.cache = FormCache(tm)
+        self.region_dofs: dict = {}     # (body, "material" or "name") -> {group: its local dofs}
         self.transport = isinstance(tm.spec.motion, Rotation)
         self._check_motion()
         r = [ufl.TestFunction(V) for V in self.spaces]
@@ -559,16 +560,15 @@ class Thermal:
         """Largest nodal temperature [K] of the cells of body ``i`` grouped by their regions'
         ``by``: "material", or "name" (the parts of a geometry file, a brake's pads; collective; a
         node on a boundary between two groups belongs to both)."""
-        groups = self.__dict__.setdefault("_region_dofs", {})      # the local dofs of each group
-        if (i, by) not in groups:
+        if (i, by) not in self.region_dofs:
             body, T = self.tm.bodies[i], self.T[i]
             dofs = T.function_space.dofmap.list[:len(body.region_tags)]
             tags = {g: [r.tag for r in body.spec.regions if getattr(r, by) == g] for g in
                     dict.fromkeys(getattr(r, by) for r in body.spec.regions)}
-            groups[i, by] = {g: np.unique(dofs[np.isin(body.region_tags, t)]) for g, t in tags.items()}
+            self.region_dofs[i, by] = {g: np.unique(dofs[np.isin(body.region_tags, t)]) for g, t in tags.items()}
         T = self.T[i].x.array
         return {g: self.tm.comm.allreduce(T[mine].max(initial=-np.inf), op=MPI.MAX)
-                for g, mine in groups[i, by].items()}
+                for g, mine in self.region_dofs[i, by].items()}
 
     def min_temperature(self) -> tuple:
         """Smallest nodal temperature of each body [K] (below every imposed temperature: an undershoot
