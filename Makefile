@@ -10,8 +10,9 @@ export UCX_TLS ?= self,sm,tcp
 export OMP_NUM_THREADS ?= 1
 export MPLBACKEND ?= Agg
 # Python caches the package's bytecode (__pycache__, ignored by git) even where the environment
-# says not to: the suite starts ~200 fresh interpreters (test_architecture's imports alone took
-# 88 s without the cache, 53-60 s with it).
+# says not to: the suite starts an interpreter per test module, more for the CLI and MPI tests, and
+# a process per package module in test_architecture (its imports took 88 s without the cache, 53-60 s
+# with it, when each was an interpreter of its own).
 unexport PYTHONDONTWRITEBYTECODE
 
 # First interpreter >= 3.12 found: PYTHON=..., then the pyenv-selected `python` (.python-version), then pythonX.Y.
