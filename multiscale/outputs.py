@@ -168,6 +168,8 @@ def plan(scene) -> Plan:
             files.update({("wear_map.png" if len(rough) == 1 else f"wear_map_{n}.png"):
                           f"wear depth over the interface{'' if n == 'interface' else ' ' + n}: per zone and the "
                           "micro field" for n in rough})
+    if not scene.output.figures:
+        files = {name: what for name, what in files.items() if not name.endswith(".png")}
     files.update(PROVENANCE)
     return Plan(kind, scene.output.folder, tuple(scene.bodies), body, iface, times, files,
                 tuple(f for f in scene.output.fields if f not in WRITES[kind]))

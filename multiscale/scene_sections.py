@@ -403,6 +403,7 @@ class Output:
     folder: Path | None = key(FilePath(folder=True), absent="results/<name> next to the scene file")
     every: int = key(Integer(ge=1), default=1)            # write fields every n macro steps
     fields: tuple = key(ListOf(Choice(OUTPUT_FIELDS), unique=True), absent="every field the effects produce")
+    figures: bool = key(Flag(), default=True)           # the PNG figures (false: their tables and fields only)
 
 
 # ------------------------------------------------------------------ later effects (validated only)

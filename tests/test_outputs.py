@@ -28,7 +28,8 @@ COARSE_POD = {"geometry.mesh_size": "15 mm", "geometry.holder_mesh_size": "6 mm"
               "time.end": "2.4 s", "time.steps": 2, "output.every": 1}
 CASES = {
     "block": ("block_on_flat.toml", {}),
-    "perfect": ("pin_on_disc_perfect.toml", {**COARSE_POD, "time.steps": 3, "output.every": 2}),
+    "perfect": ("pin_on_disc_perfect.toml", {**COARSE_POD, "time.steps": 3, "output.every": 2,
+                                             "output.figures": False}),     # (the others draw them)
     "rough": ("pin_on_disc.toml", {**COARSE_POD, "micro.zones": [3, 3], "micro.grid": [16, 16],
                                    "micro.law_points": 8}),
     "squeal": ("brake_squeal.toml", {"geometry.mesh_size": "20 mm", "stability.modes": 6}),
@@ -64,6 +65,18 @@ def test_the_folder_holds_exactly_what_check_promised(case, capsys):
     assert main(["check", str(scene.source)]) == 0
     shown = capsys.readouterr().out
     assert all(f"    {name} " in shown for name in p.files)      # check lists every file
+
+
+@pytest.mark.parametrize("name, overrides, pngs", [
+    ("pin_on_disc.toml", {}, {"history", "multiscale", "wear_map"}),
+    ("brake_squeal.toml", {"stability.sweep.friction": [0.2, 0.4], "stability.prestress": True},
+     {"pressure", "re_im", "energy", "map", "map_tracks"})])
+def test_without_figures_check_promises_every_file_but_the_pngs(name, overrides, pngs):
+    """output.figures = false drops the PNG figures from the plan and nothing else (the tables
+    and fields they are drawn from stay)."""
+    drawn, bare = (plan(load(DEMOS / name, {**overrides, "output.figures": f})).files for f in (True, False))
+    assert {n[:-4] for n in drawn if n.endswith(".png")} == pngs
+    assert bare == {n: w for n, w in drawn.items() if not n.endswith(".png")}
 
 
 def test_check_names_every_column_of_modes_csv(case):

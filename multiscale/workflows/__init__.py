@@ -101,14 +101,14 @@ def _write_script(folder: Path, scene) -> Path:
 
 def _abandoned(folder: Path, scene) -> None:
     """After a Ctrl-C that abandoned a step (the third, ``io.StepStop``) or came outside the steps
-    of a run with a history (rank 0): history.png (and a multiscale run's multiscale.png) drawn
-    from history.h5 as written (the loop writes each step's row whole) and paraview.py once a
+    of a run with a history (rank 0): history.png (and a multiscale run's multiscale.png; with
+    ``output.figures``) drawn from history.h5 as written (the loop writes each step's row whole) and paraview.py once a
     field file is written. The zone results of a multiscale run (zones.h5, wear maps) need the
     state of its last step: they stay as they were."""
     kind, h5 = workflow(scene), Path(folder) / "history.h5"
     if kind == "squeal":
         return
-    if h5.is_file():
+    if h5.is_file() and scene.output.figures:
         history = io.History.read(h5)
         history_figure(history, h5.with_name("history.png"), title=scene.name)
         if kind == "multiscale":

@@ -53,8 +53,8 @@ CHECKPOINT = outputs.CHECKPOINT
 class MultiscaleResult(TransientResult):
     """``TransientResult`` plus the multiscale plots and the final per-zone state."""
 
-    multiscale_plot: Path
-    wear_maps: list             # one per interface (none without wear)
+    multiscale_plot: Path | None   # multiscale.png (None with output.figures = false)
+    wear_maps: list             # one per interface (none without wear or figures)
     zones_file: Path
     steps_done: int
 
@@ -183,11 +183,11 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                     if stopping:
                         break
             with io.stage("writing history and plots"), stop.writing(done):
-                h5, png = write_history(history, folder, scene.name, comm)
-                plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm)
+                h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures)
+                plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm, scene.output.figures)
         if done == steps:
             checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
-        result = MultiscaleResult(folder, writer.files + [h5, png, plot, zones, ckpt] + maps,
+        result = MultiscaleResult(folder, writer.files + [f for f in (h5, png, plot, zones, ckpt) if f] + maps,
                                   _time.perf_counter() - start, history, h5, png, writer.files, plot, maps, zones,
                                   done, warnings=run_notes(ms.model))
         ms.model.close()          # on every rank in the same order (MUMPS' destruction communicates)
@@ -197,7 +197,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         print(f"{scene.name}: {io.counted(len(history), 'record')} ({done}/{steps} steps) in "
               f"{result.wall_time:.1f} s on {io.counted(comm.size, 'rank')}")
         print(f"  ParaView: {', '.join(str(f) for f in result.field_files)}")
-        print(f"  history:  {h5}  plots: {', '.join(str(p) for p in [png, plot] + maps)}")
+        plots = [str(p) for p in [png, plot] + maps if p]
+        print(f"  history:  {h5}" + (f"  plots: {', '.join(plots)}" if plots else ""))
     return result
 
 
@@ -206,28 +207,32 @@ def finished(folder: Path, name: str, steps: int, comm, verbose: bool) -> Multis
     history = io.History.read(folder / "history.h5")
     fields = sorted(folder.glob("*.xdmf"))
     maps = sorted(folder.glob("wear_map*.png"))
-    files = fields + [folder / n for n in ("history.h5", "history.png", "multiscale.png", "zones.h5", CHECKPOINT)] + maps
+    png, plot = [p if p.is_file() else None for p in (folder / "history.png", folder / "multiscale.png")]
+    files = fields + [f for f in (folder / "history.h5", png, plot, folder / "zones.h5", folder / CHECKPOINT) if f]
+    files += maps
     if verbose and comm.rank == 0:
         print(f"{name}: nothing to do, the run in {folder} has ended after {steps} step(s); "
               "use --overwrite to run it again")
-    return MultiscaleResult(folder, files, 0.0, history, folder / "history.h5", folder / "history.png", fields,
-                            folder / "multiscale.png", maps, folder / "zones.h5", steps)
+    return MultiscaleResult(folder, files, 0.0, history, folder / "history.h5", png, fields, plot, maps,
+                            folder / "zones.h5", steps)
 
 
-def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: str, comm) -> tuple:
-    """multiscale.png, the wear maps (with wear: ``wear_map.png``, or ``wear_map_<interface>.png``
-    for several interfaces) and zones.h5: rank 0 writes multiscale.png and zones.h5, the wear maps
-    are spread over the ranks (every rank holds the wear depths); a failure is an OutputError on
-    every rank."""
+def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: str, comm,
+                       figures: bool = True) -> tuple:
+    """zones.h5 and, with ``figures``, multiscale.png and the wear maps (with wear: ``wear_map.png``,
+    or ``wear_map_<interface>.png`` for several interfaces): rank 0 writes multiscale.png and
+    zones.h5, the wear maps are spread over the ranks (every rank holds the wear depths); a failure
+    is an OutputError on every rank. Returns (multiscale.png or None, the wear maps, zones.h5)."""
     rough = ms.rough
-    plot, zones = folder / "multiscale.png", folder / "zones.h5"
+    plot, zones = folder / "multiscale.png" if figures else None, folder / "zones.h5"
     names = list(rough.names)
-    maps = [] if not ms.settings.wear else [folder / "wear_map.png"] if len(names) == 1 else \
+    maps = [] if not (ms.settings.wear and figures) else [folder / "wear_map.png"] if len(names) == 1 else \
         [folder / f"wear_map_{n}.png" for n in names]
     depth = rough.wear_depth()
 
     def write():
-        multiscale_figure(history, plot, name)
+        if plot:
+            multiscale_figure(history, plot, name)
         with h5py.File(zones, "w") as h5:
             h5.create_dataset("centre", data=np.array([z.centre for z in rough.zones])).attrs["unit"] = "m"   # (u, v)
             h5.create_dataset("position", data=rough.zone_frames()[0]).attrs["unit"] = "m"   # the centre in space

@@ -22,7 +22,8 @@ stability map (``workflows.squeal_map``).
 
 ``run`` writes into ``output.folder``: ``modes.csv``, mode shapes (``modes_<body>.bp``, VTX), the
 preloaded state's fields (``<body>.xdmf``, ``interface.xdmf``), ``pressure.png`` (Fig. 4.12),
-``re_im.png`` (Fig. 4.13) and ``energy.png`` (Figs. 4.20–4.21); ``multiscale.outputs.plan``.
+``re_im.png`` (Fig. 4.13) and ``energy.png`` (Figs. 4.20–4.21), the figures unless
+``output.figures = false``; ``multiscale.outputs.plan``.
 With prestress also ``prestress.csv``; with a sweep the map's files (``workflows.squeal_map.write``).
 """
 from __future__ import annotations
@@ -296,7 +297,8 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
             def figures():
                 out = [plot_pressure(tm.interface.midpoints, masks, case.facet_pressure, case.name,
                                      folder / "pressure.png"),
-                       plot_re_im([case], folder / "re_im.png"), plot_energy(case, folder / "energy.png", split)]
+                       plot_re_im([case], folder / "re_im.png"),
+                       plot_energy(case, folder / "energy.png", split)] if scene.output.figures else []
                 if case.prestress is not None:
                     out.append(write_prestress_csv(case.prestress, folder / "prestress.csv"))
                 return out
@@ -308,7 +310,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
                                                 case.preload.pressure,         # (scaled to a braking torque)
                                                 lambda changed: build_squeal_mechanics(changed, tm, degree=degree,
                                                                                        prefix="squeal_map_"))
-                files += squeal_map.write(smap, folder, comm)
+                files += squeal_map.write(smap, folder, comm, scene.output.figures)
         case.mech.close()                # on every rank in the same order (MUMPS' destruction communicates)
     result = SquealResult(folder, files, time.perf_counter() - t0, case, smap, tuple(_left_out(scene, case, smap)))
     if verbose and comm.rank == 0:

@@ -29,15 +29,15 @@ class TransientResult(RunResult):
 
     history: io.History
     history_file: Path          # history.h5
-    plot_file: Path             # history.png
+    plot_file: Path | None      # history.png (None with output.figures = false)
     field_files: list           # XDMF files
     warnings: tuple = field(default=(), kw_only=True)   # what the model noted (``workflows.model.run_notes``)
 
 
-def write_history(history: io.History, folder: Path, name: str, comm, plot: bool = True) -> tuple[Path, Path]:
-    """``history.h5`` and (with ``plot``) ``history.png`` (rank 0 writes; a failure is an
+def write_history(history: io.History, folder: Path, name: str, comm, plot: bool = True) -> tuple[Path, Path | None]:
+    """``history.h5`` and (with ``plot``) ``history.png``, else None (rank 0 writes; a failure is an
     OutputError on every rank)."""
-    h5, png = folder / "history.h5", folder / "history.png"
+    h5, png = folder / "history.h5", folder / "history.png" if plot else None
 
     def write():
         history.write(h5, {"scene": name, "ranks": comm.size})
@@ -83,15 +83,15 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
                     if stopping:
                         break
             with io.stage("writing history and plots"), stop.writing(done):
-                h5, png = write_history(history, folder, scene.name, comm)
+                h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures)
         model.close()                    # on every rank in the same order (MUMPS' destruction communicates)
     if stopping:                     # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", run_notes(model))
-    result = TransientResult(folder, writer.files + [h5, png], _time.perf_counter() - start, history, h5, png,
-                             writer.files, warnings=run_notes(model))
+    result = TransientResult(folder, writer.files + [f for f in (h5, png) if f], _time.perf_counter() - start, history,
+                             h5, png, writer.files, warnings=run_notes(model))
     if verbose and comm.rank == 0:
         print(f"{scene.name}: {io.counted(len(history), 'record')} in {result.wall_time:.1f} s on "
               f"{io.counted(comm.size, 'rank')}")
         print(f"  ParaView: {', '.join(str(f) for f in writer.files)}")
-        print(f"  history:  {h5}  plot: {png}")
+        print(f"  history:  {h5}" + (f"  plot: {png}" if png else ""))
     return result
