@@ -243,6 +243,7 @@ k_w = "1e-14 1/Pa"
 substeps = 2
 [output]
 folder = "{folder}"
+figures = false
 """.replace("{base}", BASE)
 
 
@@ -250,7 +251,7 @@ folder = "{folder}"
 def straight(tmp_path_factory):
     from multiscale.workflows import run
     folder = tmp_path_factory.mktemp("pod") / "straight"
-    scene = loads(POD.format(folder=folder))
+    scene = loads(POD.format(folder=folder), overrides={"output.figures": True})     # (the others draw none)
     return scene, run(scene, verbose=False)
 
 

@@ -375,7 +375,7 @@ def test_an_abandoned_step_leaves_the_plots_and_paraview_script_of_what_was_writ
     from multiscale.scene import loads
     from multiscale.workflows import run
     folder = tmp_path / "out"
-    scene = loads((SCENE if kind == "transient" else POD).format(folder=folder))
+    scene = loads((SCENE if kind == "transient" else POD).format(folder=folder), overrides={"output.figures": True})
     cls, name = (MacroModel, "macro_step") if kind == "transient" else (Multiscale, "step")
     original, calls = getattr(cls, name), []
 

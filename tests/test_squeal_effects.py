@@ -35,6 +35,7 @@ STEEL = NS(E=210e9, nu=0.3, rho=7850.0)
 MATERIALS = {"disc": NS(E=125e9, nu=0.25, rho=7200.0), "pad": NS(E=5e9, nu=0.25, rho=2500.0),
              "backplate": STEEL, "piston": STEEL, "caliper": STEEL}
 PRESSURE = 1e6
+NO_FIGURES = {"output.figures": False}     # the runs' figures are looked at in test_outputs and the map test
 
 
 def elasticity(V, m):
@@ -249,7 +250,8 @@ def test_a_mode_count_never_cuts_a_lock_in_pair_in_two(tmp_path):
     lam = np.array([0, -57.7, 57.7, 0]) + 1j * w            # stable member first, as the solver gave
     assert sorted(damped.select(lam, (0.0, 6e3), 2, 0.0)) == [0, 1, 2]
     assert sorted(damped.select(lam, (0.0, 6e3), 1, 0.0)) == [0]
-    overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 8, "stability.band": ["0 Hz", "3 kHz"],
+    overrides = {**NO_FIGURES,
+                 "geometry.mesh_size": "20 mm", "stability.modes": 8, "stability.band": ["0 Hz", "3 kHz"],
                  "output.folder": str(tmp_path / "out"), "stability.sweep.friction": [0.1, 0.6]}
     run = squeal.run(scenes.load(DEMO, overrides), verbose=False)          # quadratic elements, as the CLI
     assert run.case.modes.frequency.size == 9 and run.case.modes.unstable().sum() == 1
@@ -274,7 +276,8 @@ def test_scene_roughness_sweep_rebuilds_the_laws_and_frees_the_models(tmp_path):
     first mode). Every model the run built is closed and freed after it (before, each stayed
     alive with ~35 MPI communicators of MPICH's 2048: a long sweep aborted the process)."""
     import gc      # local: this test alone looks at the collector
-    overrides = {"effects": ["contact", "friction", "stability", "roughness"], "roughness.body": "brake",
+    overrides = {**NO_FIGURES,
+                 "effects": ["contact", "friction", "stability", "roughness"], "roughness.body": "brake",
                  "roughness.rms": "0.05 um", "roughness.hurst": 0.8, "roughness.k_min": 1, "roughness.k_max": 16,
                  "roughness.patch": "zone", "micro.zones": [4, 2], "micro.grid": [32, 32], "micro.law_points": 10,
                  "micro.p_max": "30 kPa", "geometry.mesh_size": "20 mm", "stability.modes": 20,
@@ -304,7 +307,8 @@ def test_a_roughness_sweep_that_fails_closes_the_model_it_rebuilt(tmp_path, monk
     import gc      # local: this test alone looks at the collector
     from multiscale.errors import ConvergenceError
     from multiscale.workflows import squeal_map
-    overrides = {"effects": ["contact", "friction", "stability", "roughness"], "roughness.body": "brake",
+    overrides = {**NO_FIGURES,
+                 "effects": ["contact", "friction", "stability", "roughness"], "roughness.body": "brake",
                  "roughness.rms": "0.05 um", "roughness.hurst": 0.8, "roughness.k_min": 1, "roughness.k_max": 16,
                  "roughness.patch": "zone", "micro.zones": [4, 2], "micro.grid": [32, 32], "micro.law_points": 10,
                  "micro.p_max": "30 kPa", "geometry.mesh_size": "30 mm", "stability.modes": 6,
@@ -340,7 +344,7 @@ def test_the_instability_threshold_is_the_users(tmp_path):
     damping ratio of -2.9e-3: unstable by the default 1e-6, not by 1e-2, in the report, modes.csv
     and a map alike (before: 1e-6, fixed, which flagged modes at damping ratios of -6e-6 that
     industrial practice leaves out)."""
-    overrides = {"geometry.mesh_size": "20 mm", "stability.band": ["0 Hz", "9 kHz"],
+    overrides = {**NO_FIGURES, "geometry.mesh_size": "20 mm", "stability.band": ["0 Hz", "9 kHz"],
                  "output.folder": str(tmp_path / "out"), "stability.threshold": 1e-2,
                  "stability.sweep.friction": [0.35, 0.4]}
     run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)     # P1: the lock-in at 8507 Hz
@@ -371,7 +375,8 @@ def test_a_pressure_sweep_that_changes_nothing_is_warned_about(tmp_path):
 
 
 def test_scene_damping_and_stribeck_options(tmp_path, documented):
-    overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 10, "output.folder": str(tmp_path / "out"),
+    overrides = {**NO_FIGURES,
+                 "geometry.mesh_size": "20 mm", "stability.modes": 10, "output.folder": str(tmp_path / "out"),
                  "stability.rayleigh_alpha": "20 1/s", "stability.prestress": True,
                  "materials.pad.loss_factor": 0.05}
     scene = scenes.load(DEMO, overrides)
@@ -401,7 +406,8 @@ def test_scene_damping_and_stribeck_options(tmp_path, documented):
 def test_scene_stribeck_friction_sets_mu_per_facet_and_its_slope_damping(tmp_path):
     text = DEMO.read_text().replace("friction = 0.4\n", "") + (
         '\n[loading.stribeck]\nstatic = 0.5\nkinetic = 0.35\nspeed = "1 m/s"\n')
-    overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 20, "output.folder": str(tmp_path / "out")}
+    overrides = {**NO_FIGURES,
+                 "geometry.mesh_size": "20 mm", "stability.modes": 20, "output.folder": str(tmp_path / "out")}
     scene = scenes.loads(text, DEMO.parent, overrides=overrides)
     run = squeal.run(scene, degree=1, verbose=False)
     case, law = run.case, StribeckFriction(0.5, 0.35, 1.0)
@@ -422,7 +428,8 @@ def test_scene_stribeck_friction_sets_mu_per_facet_and_its_slope_damping(tmp_pat
 def test_a_band_cut_short_by_the_number_of_modes_is_said(tmp_path):
     """6 modes of a 0-16 kHz band reach ~3 kHz: the run says the rest of the band was not searched
     (before: "6 modes up to 3017 Hz" and nothing else; found by an adversarial test)."""
-    overrides = {"geometry.mesh_size": "30 mm", "stability.modes": 6, "output.folder": str(tmp_path / "out")}
+    overrides = {**NO_FIGURES,
+                 "geometry.mesh_size": "30 mm", "stability.modes": 6, "output.folder": str(tmp_path / "out")}
     run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
     top = run.case.modes.frequency.max()
     assert top < 8e3 and run.warnings == (f"stability.modes = 6: the modes found reach {top:.0f} Hz; the band above, "
@@ -435,7 +442,8 @@ def test_a_pressure_beyond_small_strains_is_warned_about_also_at_a_map_point(tmp
     (its own preload) the warning. Before, a squeal run had none: the coarse demo at 5000 bar
     carried 1.2 GPa on its 5 GPa pads silently. Penalty contact without gaps scales with the
     load, so the map's peak is 100 times the nominal one."""
-    overrides = {"geometry.mesh_size": "30 mm", "stability.modes": 6, "stability.band": ["0 Hz", "3 kHz"],
+    overrides = {**NO_FIGURES,
+                 "geometry.mesh_size": "30 mm", "stability.modes": 6, "stability.band": ["0 Hz", "3 kHz"],
                  "stability.sweep.pressure": ["10 bar", "1000 bar"], "stability.sweep.onsets": False,
                  "output.folder": str(tmp_path / "out")}
     run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
@@ -455,7 +463,8 @@ def test_a_braking_torque_preloads_the_squeal_analysis_at_that_friction_moment(t
     (``preload.hold_moment``; before, the squeal analysis took the guess: 260.5 N m for 243.3).
     Penalty contact without gaps is linear in the load: 1.5 times the 10 bar moment is 15 bar."""
     from multiscale.macro.preload import TORQUE_TOL
-    overrides = {"geometry.mesh_size": "30 mm", "stability.modes": 6, "stability.band": ["0 Hz", "3 kHz"],
+    overrides = {**NO_FIGURES,
+                 "geometry.mesh_size": "30 mm", "stability.modes": 6, "stability.band": ["0 Hz", "3 kHz"],
                  "output.folder": str(tmp_path / "p")}
     nominal = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False).case
     torque = 1.5 * abs(nominal.mech.contact.friction_moment())
@@ -481,7 +490,8 @@ def test_eigen_solver_errors_name_the_scene_keys(tmp_path):
     The failed run's Mechanics is closed (one rank) and freed (before: it stayed alive with its MPI
     communicators, and a script going on after failed runs ran out of them)."""
     import gc      # local: this test alone looks at the collector
-    overrides = {"geometry.mesh_size": "30 mm", "stability.modes": 6, "output.folder": str(tmp_path / "out"),
+    overrides = {**NO_FIGURES,
+                 "geometry.mesh_size": "30 mm", "stability.modes": 6, "output.folder": str(tmp_path / "out"),
                  "stability.band": ["10 Hz", "500 Hz"]}
 
     def models():
@@ -498,7 +508,8 @@ def test_a_band_cut_short_below_a_target_is_said(tmp_path):
     below them was not searched (before: only 'the band above ... was not searched'; with the
     target at 15.5 kHz, 'above' though the search reached 17.9 kHz, and not a word on the 0-12.8 kHz
     left out; found by an adversarial test)."""
-    overrides = {"geometry.mesh_size": "30 mm", "stability.modes": 6, "output.folder": str(tmp_path / "out"),
+    overrides = {**NO_FIGURES,
+                 "geometry.mesh_size": "30 mm", "stability.modes": 6, "output.folder": str(tmp_path / "out"),
                  "stability.target": "8 kHz"}
     run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
     f = run.case.modes.frequency
