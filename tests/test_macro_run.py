@@ -48,8 +48,8 @@ THERMAL = ("contact", "friction", "thermal", "heat_partition", "expansion")
 
 def pin_on_disc(folder, name: str = "pod", effects: tuple = THERMAL, partition: str = '"effusivity"') -> str:
     """The coarse pin-on-disc test scene (15 mm mesh, 2.5 mm at the interface, penalty 1e13 Pa/m)
-    writing to ``folder``; ``partition`` is TOML (a number or a quoted rule). Shared by the
-    macro-run, duty-cycle and MPI tests."""
+    writing to ``folder`` without figures; ``partition`` is TOML (a number or a quoted rule).
+    Shared by the macro-run, duty-cycle and MPI tests."""
     return f"""
 name = "{name}"
 effects = {json.dumps(list(effects))}
@@ -64,6 +64,7 @@ penalty = "1e13 Pa/m"
 partition = {partition}
 [output]
 folder = "{folder}"
+figures = false
 """
 
 
@@ -92,7 +93,7 @@ def test_thermal_on_a_sliding_translating_flat_is_refused(tmp_path):
 
 
 def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
-    scene = loads(pin_on_disc(tmp_path / "pod"), overrides={"time.substeps": 2})
+    scene = loads(pin_on_disc(tmp_path / "pod"), overrides={"time.substeps": 2, "output.figures": True})
     result = run(scene, verbose=False)
     h = History.read(result.history_file)
     assert len(h) == 3 and h["time"][-1] == pytest.approx(1.2)
