@@ -121,6 +121,10 @@ def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
     np.testing.assert_array_equal(parts[0], h["max_temperature_pin_in_pin"])
     np.testing.assert_array_equal(np.maximum(parts[1], parts[2]), h["max_temperature_pin_in_disc"])
     assert np.all(parts[2][1:] < parts[1][1:]) and "max_temperature_disc_part_disc" not in h.columns
+    # the parts' stored heat adds up to the body's; the pin part, heated, holds most of it
+    stored = [h[f"stored_heat_pin_part_{p}"] for p in ("pin", "housing", "plate")]
+    np.testing.assert_allclose(np.sum(stored, axis=0), h["stored_heat_pin"], rtol=1e-12, atol=0)
+    assert np.all(stored[0][1:] > 0.9 * h["stored_heat_pin"][1:]) and "stored_heat_disc_part_disc" not in h.columns
     assert not any(k.startswith("heat_lost") for k in h.columns)      # insulated: no loss columns
     for f in result.field_files + [result.plot_file]:
         assert f.exists() and f.stat().st_size > 0

@@ -93,6 +93,33 @@ def march(scene, steps=None):
     return model
 
 
+def test_each_parts_stored_heat_is_its_rho_c_times_its_volume_at_a_uniform_rise(tmp_path):
+    """The pin body of the coarse pin-on-disc (a pin of material "pin" in a housing and a plate of
+    material "disc") 10 K above its initial temperature: each part's stored heat, and each
+    material's, is rho c x 10 K x its volume (rho c = kappa / chi of the scene; the volumes
+    integrated over the parent mesh's cell tags), to 1e-12; they add up to the body's."""
+    from mpi4py import MPI
+    from test_macro_run import pin_on_disc
+
+    from dolfinx import fem
+    model = build_model(loads(pin_on_disc(tmp_path / "out")))
+    th, tm = model.thermal, model.tm
+    th.T[0].x.array[:] = th.T_ref + 10.0
+    rho_c = {"pin": 35 / 8.3e-6, "disc": 50 / 1e-5}
+    parts, materials = {}, {}
+    for r in tm.bodies[0].spec.regions:
+        volume = tm.comm.allreduce(fem.assemble_scalar(fem.form(fem.Constant(tm.parent, 1.0) * tm.dx(r.tag))),
+                                   op=MPI.SUM)
+        parts[r.name] = parts.get(r.name, 0.0) + rho_c[r.material] * 10.0 * volume
+        materials[r.material] = materials.get(r.material, 0.0) + rho_c[r.material] * 10.0 * volume
+    assert set(parts) == {"pin", "housing", "plate"}
+    assert th.region_stored_heat(0) == pytest.approx(parts, rel=1e-12)
+    assert th.region_stored_heat(0, by="material") == pytest.approx(materials, rel=1e-12)
+    body, disc = th.stored_heat()          # the disc at its initial temperature (P2: to round-off)
+    assert body == pytest.approx(sum(parts.values()), rel=1e-12) and abs(disc) < 1e-12 * body
+    model.close()
+
+
 def test_newton_cooling_of_a_block_with_small_biot_number():
     """Convection h = 20 W/(m^2 K) on every free face (Bi = h V/(A kappa) = 7e-4) from 400 K to 300 K:
     the mean temperature (from the stored heat) follows T_a + (T_i - T_a) exp(-h A t/(rho c V))

@@ -20,7 +20,7 @@ import numpy as np
 
 import dolfinx
 import ufl
-from dolfinx import fem
+from dolfinx import fem, la
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
@@ -78,6 +78,12 @@ class Body:
     @property
     def region_space(self) -> fem.FunctionSpace:
         return fem.functionspace(self.mesh, ("DG", 0))
+
+    def region_cells(self, by: str) -> dict:
+        """{group: mask of the local cells} of the regions grouped by their ``by``: "material", or
+        "name" (a geometry file's parts, a brake's pads), in the regions' order."""
+        groups = dict.fromkeys(getattr(r, by) for r in self.spec.regions)
+        return {g: np.isin(self.region_tags, [r.tag for r in self.spec.regions if getattr(r, by) == g]) for g in groups}
 
     def cell_field(self, name: str, by_region: dict) -> fem.Function:
         """DG0 field on the body, constant per region: ``by_region`` maps region tag -> value."""
@@ -325,6 +331,13 @@ class FormCache:
         """Integral of the scalar form ``make()`` (summed over ranks)."""
         local = fem.assemble_scalar(self._form(key, make))
         return self.tm.comm.allreduce(local, op=MPI.SUM)
+
+    def vector(self, key, make) -> np.ndarray:
+        """Local array (owned and ghost entries) of the vector form ``make()`` assembled, the ghost
+        contributions added to their owners."""
+        vec = fem.assemble_vector(self._form(key, make))
+        vec.scatter_reverse(la.InsertMode.add)
+        return vec.array
 
     def facet_integrals(self, key, make, vector: bool = False) -> np.ndarray:
         """Global per-facet integrals of the interface expression ``make()``: (n_facets,) for a

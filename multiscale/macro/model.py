@@ -331,6 +331,8 @@ class MacroModel:
                 if len(body.spec.regions) > 1:                          # per part (a brake's pads)
                     for part, T in self.thermal.region_max_temperature(i, "name").items():
                         row[f"max_temperature_{body.name}_part_{part}"] = T
+                    for part, Q in self.thermal.region_stored_heat(i).items():
+                        row[f"stored_heat_{body.name}_part_{part}"] = Q
                 row[f"min_temperature_{body.name}"] = coldest[i]
                 row[f"heat_step_{body.name}"] = heat_step[i]
                 row[f"heat_total_{body.name}"] = self.heat_total[i]

@@ -87,7 +87,7 @@ from typing import Mapping, Sequence
 
 import numpy as np
 import ufl
-from dolfinx import fem, la
+from dolfinx import fem
 from dolfinx.fem import petsc as fpetsc
 from dolfinx.fem.forms import derivative_block
 from mpi4py import MPI
@@ -190,6 +190,7 @@ class Thermal:
         self.time = 0.0
         self.cache = FormCache(tm)
         self.region_dofs: dict = {}     # (body, "material" or "name") -> {group: its local dofs}
+        self.cell_spaces = [b.region_space for b in tm.bodies]    # DG0: the stored heat per cell
         self.transport = isinstance(tm.spec.motion, Rotation)
         self._check_motion()
         r = [ufl.TestFunction(V) for V in self.spaces]
@@ -221,7 +222,6 @@ class Thermal:
         self._tangent = self._factored = None  # linear steps: the kept cell part, the kept factors' matrix
         # a failed step is redone with backtracking unless the user chose a line search (theirs alone remain)
         self._backtrack = self.nonlinear and not PETSc.Options(prefix).hasName("snes_linesearch_type")
-        self._residual_forms: dict = {}
         # constant materials: the Jacobian's cell part (storage, conduction, transport with SUPG;
         # 105 of its 110 ms on the ch. 7 mesh, one rank) changes only with the constants and
         # coefficients in it (dt, the speed): kept, and reassembled when one of them changed
@@ -531,21 +531,12 @@ class Thermal:
                     a.index + 1, degree=self._facet_degree(a.body, RADIATION_QUADRATURE)))
             if a.bc is not None:
                 if a.body not in residual:
-                    residual[a.body] = self._residual_vector(a.body)
+                    residual[a.body] = self.cache.vector(("residual", a.body), lambda: self.residuals[a.body])
                 dofs, owned = a.bc.dof_indices()
                 dofs = np.setdiff1d(dofs[:owned], claimed[a.body])      # a dof counts once
                 claimed[a.body] = np.union1d(claimed[a.body], dofs)
                 out[key] -= dt * self.tm.comm.allreduce(residual[a.body][dofs].sum(), op=MPI.SUM)
         return out
-
-    def _residual_vector(self, i: int) -> np.ndarray:
-        """The heat residual of body i [W] at the current temperatures, assembled without boundary
-        conditions (owned and ghost dofs, ghost contributions added to their owners)."""
-        if i not in self._residual_forms:
-            self._residual_forms[i] = fem.form(self.residuals[i], entity_maps=self.tm.entity_maps)
-        vec = fem.assemble_vector(self._residual_forms[i])
-        vec.scatter_reverse(la.InsertMode.add)
-        return vec.array
 
     @property
     def heat_lost(self) -> np.ndarray:
@@ -561,11 +552,9 @@ class Thermal:
         ``by``: "material", or "name" (the parts of a geometry file, a brake's pads; collective; a
         node on a boundary between two groups belongs to both)."""
         if (i, by) not in self.region_dofs:
-            body, T = self.tm.bodies[i], self.T[i]
-            dofs = T.function_space.dofmap.list[:len(body.region_tags)]
-            tags = {g: [r.tag for r in body.spec.regions if getattr(r, by) == g] for g in
-                    dict.fromkeys(getattr(r, by) for r in body.spec.regions)}
-            self.region_dofs[i, by] = {g: np.unique(dofs[np.isin(body.region_tags, t)]) for g, t in tags.items()}
+            body = self.tm.bodies[i]
+            dofs = self.T[i].function_space.dofmap.list[:len(body.region_tags)]
+            self.region_dofs[i, by] = {g: np.unique(dofs[cells]) for g, cells in body.region_cells(by).items()}
         T = self.T[i].x.array
         return {g: self.tm.comm.allreduce(T[mine].max(initial=-np.inf), op=MPI.MAX)
                 for g, mine in self.region_dofs[i, by].items()}
@@ -577,14 +566,25 @@ class Thermal:
         return tuple(comm.allreduce(T.x.array.min(initial=np.inf), op=MPI.MIN) for T in self.T)
 
     def stored_heat(self) -> tuple:
-        """Heat stored in each body since the start [J], ∫ (e(T) − e(T_0)) dx (rho c (T − T_0) for
-        a constant rho c)."""
-        def energy(i):          # with the storage term's own quadrature: the balance is exact
+        """Heat stored in each body since the start [J] (``cell_stored_heat`` summed; collective)."""
+        return tuple(self.tm.comm.allreduce(self.cell_stored_heat(i).sum(), op=MPI.SUM) for i in range(2))
+
+    def region_stored_heat(self, i: int, by: str = "name") -> dict:
+        """Heat stored since the start [J] in the cells of body ``i`` grouped by their regions' ``by``
+        (``region_max_temperature``; the groups' sum is the body's; collective)."""
+        heat = self.cell_stored_heat(i)
+        return {g: self.tm.comm.allreduce(heat[cells].sum(), op=MPI.SUM)
+                for g, cells in self.tm.bodies[i].region_cells(by).items()}
+
+    def cell_stored_heat(self, i: int) -> np.ndarray:
+        """Heat stored in each local cell of body ``i`` since the start [J], ∫ (e(T) − e(T_0)) dx
+        (rho c (T − T_0) for a constant rho c) with the storage term's own quadrature, so that the
+        balance is exact; 0 in ghost cells."""
+        def energy():
             p = self.capacity[i]
-            if p.constant:
-                return self.rho_c[i] * (self.T[i] - self.T_ref) * self._storage_dx(i)
-            return p.integral(self.T[i], self.T_ref) * self._storage_dx(i)
-        return tuple(self.cache.scalar(("stored", i), lambda: energy(i)) for i in range(2))
+            e = self.rho_c[i] * (self.T[i] - self.T_ref) if p.constant else p.integral(self.T[i], self.T_ref)
+            return e * ufl.TestFunction(self.cell_spaces[i]) * self._storage_dx(i)
+        return self.cache.vector(("stored", i), energy)[self.cell_spaces[i].dofmap.list[:, 0]]
 
     def facet_temperature(self, side: int = 0) -> np.ndarray:
         """Mean temperature per interface facet [K] of body 0 ("+") or body 1 ("−")."""
