@@ -101,10 +101,10 @@ def _write_script(folder: Path, scene) -> Path:
 
 def _abandoned(folder: Path, scene) -> None:
     """After a Ctrl-C that abandoned a step (the third, ``io.StepStop``) or came outside the steps
-    of a run with a history (rank 0): history.png (and a multiscale run's multiscale.png; with
-    ``output.figures``) drawn from history.h5 as written (the loop writes each step's row whole) and paraview.py once a
-    field file is written. The zone results of a multiscale run (zones.h5, wear maps) need the
-    state of its last step: they stay as they were."""
+    of a run with a history (rank 0): with ``output.figures``, history.png (and a multiscale run's
+    multiscale.png) drawn from history.h5 as written (the loop writes each step's row whole), and
+    paraview.py once a field file is written. The zone results of a multiscale run (zones.h5, wear
+    maps) need the state of its last step: they stay as they were."""
     kind, h5 = workflow(scene), Path(folder) / "history.h5"
     if kind == "squeal":
         return
