@@ -113,7 +113,8 @@ def _effect_line(scene: Scene, effect: str) -> str:
         if scene.geometry.motion != "rotation":
             return f"share {share} (effusivity) of mu p |v| into the {scene.bodies[0]}"
         return (f"effusivity share of mu p |v| into the {scene.bodies[0]}: {share} at equal areas, weighted at "
-                f"meshing by the {scene.bodies[0]}'s face against the track it sweeps on the {scene.bodies[1]}")
+                f"meshing by the {scene.bodies[0]}'s face against the track it sweeps on the {scene.bodies[1]} "
+                "(interfaces on one track share it by their areas)")
     if effect == "conductance":
         return f"h_c = {i.conductance:g} W/(m^2 K)" if not scene.has("roughness") else "h_c(p) per zone (micro)"
     if effect == "roughness":

@@ -2,6 +2,7 @@
 scenes (``multiscale.workflows``), against closed forms (``multiscale.references.thermal``); a failed factorisation named."""
 import dataclasses
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -675,20 +676,10 @@ folder = "{folder}"
 """
 
 
-def test_a_rotating_disc_heated_by_two_pads_against_the_semi_infinite_solid(tmp_path, monkeypatch):
-    """A CAD disc (60-120 mm, 20 mm thick) under two pads (80-115 mm, 50 degrees) at 500 rpm, all
-    the frictional heat into it, 12 mm elements (6 mm at the interface): after 4 s (33 turns) the
-    heat has gone 7.5 mm deep, and the track's surface is the semi-infinite solid's under the flux
-    averaged over the swept annulus (``semi_infinite_constant_flux``: 32 K) within 20 % (P2: 27.8
-    K); no node of the bottom face below twice that solid's rise 20 mm deep (the insulated face's
-    image) by more than 10 % of the surface rise, and none of the disc below the initial
-    temperature by as much. With P1 temperatures in the disc (before
-    ``thermal.TRANSPORT_DEGREE``) the track rose 17 K and the bottom fell 6.5 K below the initial
-    temperature (found by an adversarial test), which the run warns of."""
+def two_pads_step(path: Path) -> Path:
+    """STEP file of a disc (60-120 mm, 20 mm thick) and two pads (80-115 mm, 50 degrees, centred at
+    90 and 270 degrees) on its top face, in mm."""
     import gmsh
-    import meshio
-    from multiscale.references.thermal import semi_infinite_constant_flux
-    step = tmp_path / "two_pads.step"
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 0)
     try:
@@ -701,9 +692,58 @@ def test_a_rotating_disc_heated_by_two_pads_against_the_semi_infinite_solid(tmp_
             pad, _ = occ.cut([(3, outer)], [(3, inner)])
             occ.rotate(pad, 0, 0, 0, 0, 0, 1, np.radians(centre - 25))
         occ.synchronize()
-        gmsh.write(str(step))
+        gmsh.write(str(path))
     finally:
         gmsh.finalize()
+    return path
+
+
+def test_two_pads_on_one_track_share_it_in_the_effusivity_partition(tmp_path):
+    """Two 50-degree pads on one face of a disc heat one track: each takes half of it, e_p A_p /
+    (e_p A_p + e_d A_track / 2) = 3.85 % (A_p / A_track = 50/360, e = sqrt(kappa rho c); within
+    1e-3 of the faceted mesh), where one alone would take 1.97 % (before, each pad took that)."""
+    from multiscale.workflows.model import partitions
+    scene = loads(TWO_PADS.format(step=two_pads_step(tmp_path / "two_pads.step"), folder=tmp_path / "out")
+                  .replace("partition = 0.0", 'partition = "effusivity"'))
+    model = build_model(scene)
+    e_pad, e_disc = np.sqrt(1.5 * 2500 * 1000), np.sqrt(50 * 7200 * 500)
+    pad, track = 50 / 360, 1.0                    # areas over the track's
+    shared, alone = (e_pad * pad / (e_pad * pad + e_disc * track / n) for n in (2, 1))
+    assert partitions(scene, model.tm) == pytest.approx({"pad_a": shared, "pad_b": shared}, rel=1e-3)
+    assert shared == pytest.approx(0.0385, abs=5e-5) and alone == pytest.approx(0.0197, abs=5e-5)
+    model.close()
+
+
+def test_interfaces_share_a_track_where_their_swept_bands_overlap():
+    """(radius, axial position) bands [m]: pads on one face with overlapping radii share it (also
+    through a third), a pad on the other face or on a ring beside it does not, nor a ring that
+    touches it at one radius; on a drum, bands at one radius overlapping along the axis share."""
+    from multiscale.workflows.model import shared_tracks
+    band = lambda r0, r1, a0, a1: (np.array([r0, a0]), np.array([r1, a1]))     # noqa: E731
+    disc = {"a": band(0.08, 0.115, 0.02, 0.02), "b": band(0.10, 0.12, 0.02, 0.02),
+            "c": band(0.06, 0.09, 0.02, 0.02), "back": band(0.08, 0.115, 0.0, 0.0),
+            "touching": band(0.12, 0.125, 0.02, 0.02), "inner": band(0.03, 0.05, 0.02, 0.02)}
+    tracks = shared_tracks(disc)
+    assert tracks["b"] == ["a", "b", "c"] and tracks["c"] == ["a", "b", "c"]
+    assert [tracks[k] for k in ("back", "touching", "inner")] == [["back"], ["touching"], ["inner"]]
+    drum = shared_tracks({"a": band(0.1, 0.1, 0.0, 0.03), "b": band(0.1, 0.1, 0.02, 0.05),
+                          "c": band(0.1, 0.1, 0.06, 0.08)})
+    assert drum == {"a": ["a", "b"], "b": ["a", "b"], "c": ["c"]}
+
+
+def test_a_rotating_disc_heated_by_two_pads_against_the_semi_infinite_solid(tmp_path, monkeypatch):
+    """A CAD disc (60-120 mm, 20 mm thick) under two pads (80-115 mm, 50 degrees) at 500 rpm, all
+    the frictional heat into it, 12 mm elements (6 mm at the interface): after 4 s (33 turns) the
+    heat has gone 7.5 mm deep, and the track's surface is the semi-infinite solid's under the flux
+    averaged over the swept annulus (``semi_infinite_constant_flux``: 32 K) within 20 % (P2: 27.8
+    K); no node of the bottom face below twice that solid's rise 20 mm deep (the insulated face's
+    image) by more than 10 % of the surface rise, and none of the disc below the initial
+    temperature by as much. With P1 temperatures in the disc (before
+    ``thermal.TRANSPORT_DEGREE``) the track rose 17 K and the bottom fell 6.5 K below the initial
+    temperature (found by an adversarial test), which the run warns of."""
+    import meshio
+    from multiscale.references.thermal import semi_infinite_constant_flux
+    step = two_pads_step(tmp_path / "two_pads.step")
     result = run(loads(TWO_PADS.format(step=step, folder=tmp_path / "out")), verbose=False)
     h = result.history
     power = h["heat_total_disc"][-1] / 4.0                                    # W, constant

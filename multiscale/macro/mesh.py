@@ -168,12 +168,13 @@ class Interface:
         """{interface name: boolean mask over the global facets}."""
         return {name: self.tag_index == k for k, name in enumerate(self.tags)}
 
-    def swept_area(self, name: str, axis, centre) -> float:
-        """Area [m^2] of the surface of revolution that interface ``name`` sweeps about ``axis``
-        through ``centre`` (collective): the frustum over the extremes of its vertices' radius r and
-        axial position a, pi (r_lo + r_hi) sqrt((r_hi - r_lo)^2 + (a_hi - a_lo)^2) — a disc's annular
-        track pi (r_hi^2 - r_lo^2), a drum's band 2 pi r (a_hi - a_lo)."""
-        lo, hi = self.box(name, axis, centre)
+    def swept_area(self, names, axis, centre) -> float:
+        """Area [m^2] of the surface of revolution that the interfaces ``names`` sweep together about
+        ``axis`` through ``centre`` (collective): the frustum over the extremes of their vertices'
+        radius r and axial position a, pi (r_lo + r_hi) sqrt((r_hi - r_lo)^2 + (a_hi - a_lo)^2) — a
+        disc's annular track pi (r_hi^2 - r_lo^2), a drum's band 2 pi r (a_hi - a_lo)."""
+        boxes = [self.box(name, axis, centre) for name in names]
+        lo, hi = np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
         return float(np.pi * (lo[0] + hi[0]) * np.hypot(hi[0] - lo[0], hi[1] - lo[1]))
 
     def crossing(self, name: str, motion) -> Crossing:

@@ -26,6 +26,7 @@ The rules that more than one analysis follows live here once:
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import warnings
 from contextlib import contextmanager
 
@@ -79,18 +80,39 @@ def interface_radii(scene, tm) -> dict:
 
 def partitions(scene, tm) -> dict:
     """Share of frictional heat into body 0 [-] at every interface (``Scene.partition_at``): the
-    effusivity partition weighted by the interface's area A_0 and, for a rotating body 1, the
-    track it sweeps (``Interface.swept_area``; the ch. 7 pin, 4 cm^2 sweeping 116 cm^2, takes
-    2.6 %, not the 43.5 % of equal areas); a translating body 1 keeps equal areas (collective)."""
+    effusivity partition weighted by the interface's area A_0 and, for a rotating body 1, by its
+    share of the track it sweeps (``Interface.swept_area``; the ch. 7 pin, 4 cm^2 sweeping
+    116 cm^2, takes 2.6 %, not the 43.5 % of equal areas). Interfaces on one track
+    (``shared_tracks``: a pad's pucks, two pads on one face of a disc) heat it together: each
+    takes the track's area times its share of their faces' area, the equal mean temperatures of
+    the rule with each one's heat in proportion to its area (N equal pads: 1/N of the track each,
+    where each alone would take all of it). A translating body 1 keeps equal areas (collective)."""
     iface, motion = tm.interface, tm.spec.motion
+    masks = iface.masks()
+    if scene.interface.partition != "effusivity" or scene.geometry.motion != "rotation":
+        return {name: scene.partition_at(name) for name in masks}
+    face = {name: float(iface.areas[m].sum()) for name, m in masks.items()}
     out = {}
-    for name, m in iface.masks().items():
-        areas = (1.0, 1.0)
-        if scene.interface.partition == "effusivity" and scene.geometry.motion == "rotation":
-            face = float(iface.areas[m].sum())
-            areas = (face, max(iface.swept_area(name, motion.axis, motion.centre), face))
-        out[name] = scene.partition_at(name, areas)
+    for name, together in shared_tracks({n: iface.box(n, motion.axis, motion.centre) for n in masks}).items():
+        track = iface.swept_area(together, motion.axis, motion.centre) * face[name] / sum(face[n] for n in together)
+        out[name] = scene.partition_at(name, (face[name], max(track, face[name])))
     return out
+
+
+def shared_tracks(bands: dict, rtol: float = 1e-6) -> dict:
+    """{name: the names of the interfaces on its track, itself included, in the order of
+    ``bands``}: ``bands`` {name: (lo, hi)} are the (radius, axial position) corners [m] of the
+    band each interface sweeps (``Interface.box``). Two bands share a track where they overlap in
+    both, within ``rtol`` of the largest radius, by more than that in one (a disc face's bands
+    are segments at one axial position, a drum's at one radius); joined transitively."""
+    tol = rtol * max(float(hi[0]) for _, hi in bands.values())
+    track = {name: {name} for name in bands}
+    for a, b in itertools.combinations(bands, 2):
+        overlap = np.minimum(bands[a][1], bands[b][1]) - np.maximum(bands[a][0], bands[b][0])
+        if overlap.min() >= -tol and overlap.max() > tol:
+            joined = track[a] | track[b]
+            track.update(dict.fromkeys(joined, joined))
+    return {name: [n for n in bands if n in track[name]] for name in bands}
 
 
 def drive(scene, tm) -> Drive:
