@@ -67,11 +67,13 @@ def _phi(T, a: float, b: float, floats: bool):
     return (c - a) ** 2 / 2 + (b - a) * ufl.max_value(T - b, 0.0)
 
 
-def table_integral(table, T, T0: float):
-    """UFL: ∫_{T0}^{T} y(s) ds of the table's interpolation y (piecewise quadratic in T)."""
+def table_integral(table, T, T0):
+    """UFL: ∫_{T0}^{T} y(s) ds of the table's interpolation y (piecewise quadratic in T); T0 [K] a
+    number or a ``fem.Constant`` (whose value is taken now in the table's segments)."""
     out = float(table[0][1]) * (T - T0)
+    t0 = float(getattr(T0, "value", T0))
     for a, b, s in _segments(table):
-        out = out + s * (_phi(T, a, b, False) - _phi(float(T0), a, b, True))
+        out = out + s * (_phi(T, a, b, False) - _phi(t0, a, b, True))
     return out
 
 
@@ -139,7 +141,7 @@ class BodyProperty:
             return self.field(reference)
         return self._by_region(lambda table: table_expression(table, T), lambda f: f)
 
-    def integral(self, T, T0: float):
+    def integral(self, T, T0):
         """UFL: ∫_{T0}^{T} y(s) ds, the enthalpy e(T) for the heat capacity (module docstring)."""
         return self._by_region(lambda table: table_integral(table, T, T0), lambda f: f * (T - T0))
 

@@ -231,8 +231,8 @@ class Mechanics:
         T, T_ref = temperatures, self.reference_temperature
         self.E = body_expressions(tm, materials, "E", T, T_ref)        # DG0, or UFL of T with tables
         self.nu = body_expressions(tm, materials, "nu", T, T_ref)
-        if temperatures is not None:
-            self.alpha = body_expressions(tm, materials, "alpha", T, T_ref)
+        if temperatures is not None:     # T_ref a form constant (a literal: new forms for each value)
+            self.alpha, self.T0 = body_expressions(tm, materials, "alpha", T, T_ref), fem.Constant(tm.parent, T_ref)
         self.contact = ContactInterface(tm, *self.u, stiffness=stiffness, friction=friction, speed=speed,
                                         law=law, velocity=velocity)
         self.load = fem.Constant(tm.parent, 0.0)        # N (force) or Pa (pressure), ramped
@@ -408,7 +408,7 @@ class Mechanics:
         lam, mu = E * nu / ((1 + nu) * (1 - 2 * nu)), E / (2 * (1 + nu))
         eps = ufl.sym(ufl.grad(self.u[i]))
         if self.temperatures is not None:
-            eps = eps - self.alpha[i] * (self.temperatures[i] - self.reference_temperature) * ufl.Identity(3)
+            eps = eps - self.alpha[i] * (self.temperatures[i] - self.T0) * ufl.Identity(3)
         return lam * ufl.tr(eps) * ufl.Identity(3) + 2 * mu * eps
 
     def von_mises(self, i: int):

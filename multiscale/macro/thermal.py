@@ -180,6 +180,7 @@ class Thermal:
         self.spaces = [T.function_space for T in self.T]
         self.T_old = [fem.Function(V) for V in self.spaces]
         self.T_ref = float(initial_temperature)
+        self.T0 = fem.Constant(tm.parent, self.T_ref)    # in forms: a literal compiled new ones for each T_ref
         for f in self.T + self.T_old:
             f.x.array[:] = self.T_ref
         self.conductivity = conductivity = body_properties(tm, materials, "kappa")
@@ -286,7 +287,7 @@ class Thermal:
         if self.capacity[i].constant:
             return self.rho_c[i] * (T - T_old) / self.dt
         p = self.capacity[i]
-        return (p.integral(T, self.T_ref) - p.integral(T_old, self.T_ref)) / self.dt
+        return (p.integral(T, self.T0) - p.integral(T_old, self.T0)) / self.dt
 
     def _check_motion(self) -> None:
         """A translating body has no steady Eulerian frame: heat only at rest (no transport). A
@@ -322,10 +323,10 @@ class Thermal:
         chi = kappa / rho_c
         tau = 1 / ufl.sqrt((2 / self.dt) ** 2 + 4 * ufl.dot(w, w) / h**2 + 9 * (4 * chi / h**2) ** 2)
         if self.capacity[1].constant:
-            e = rho_c * (T - self.T_ref)
+            e = rho_c * (T - self.T0)
             residual = rho_c * ((T - self.T_old[1]) / self.dt + ufl.dot(w, ufl.grad(T)))
         else:
-            e = self.capacity[1].integral(T, self.T_ref)
+            e = self.capacity[1].integral(T, self.T0)
             residual = self._rate(1) + rho_c * ufl.dot(w, ufl.grad(T))
         if self.spaces[1].element.basix_element.degree > 1:     # the conduction term (0 in a P1 cell)
             T_n = ufl.variable(self.T_old[1])                   # kappa'(T) at T^n: see the module docstring
@@ -361,7 +362,7 @@ class Thermal:
             c2f = body.mesh.topology.connectivity(tdim, tdim - 1)       # same local facets as the parent's cell
             facets = np.unique(c2f.array[c2f.offsets[sub_cells] + found[:, 1]]).astype(np.int32)
             cond = self.boundaries[k]
-            ambient = self.T_ref if cond.ambient is None else float(cond.ambient)
+            ambient = fem.Constant(tm.parent, self.T_ref if cond.ambient is None else float(cond.ambient))
             applied.append(AppliedBoundary(k, i, cond, ambient, facets))
             data[i].append((k + 1, found.astype(np.int32).ravel()))
         self.ds = [ufl.Measure("ds", domain=tm.parent, subdomain_data=d) if d else None for d in data]
@@ -382,7 +383,8 @@ class Thermal:
 
     def _radiation(self, a: AppliedBoundary):
         """eps sigma (T^4 − T_a^4) [W/m^2], out of the body."""
-        return a.condition.emissivity * STEFAN_BOLTZMANN * (self.T[a.body] ** 4 - a.ambient**4)
+        eps_sigma = fem.Constant(self.tm.parent, a.condition.emissivity * STEFAN_BOLTZMANN)
+        return eps_sigma * (self.T[a.body] ** 4 - a.ambient**4)
 
     # ---- solution --------------------------------------------------------------------------
     def _jacobian(self, snes, x, J, P) -> None:
@@ -582,7 +584,7 @@ class Thermal:
         balance is exact; 0 in ghost cells."""
         def energy():
             p = self.capacity[i]
-            e = self.rho_c[i] * (self.T[i] - self.T_ref) if p.constant else p.integral(self.T[i], self.T_ref)
+            e = self.rho_c[i] * (self.T[i] - self.T0) if p.constant else p.integral(self.T[i], self.T0)
             return e * ufl.TestFunction(self.cell_spaces[i]) * self._storage_dx(i)
         return self.cache.vector(("stored", i), energy)[self.cell_spaces[i].dofmap.list[:, 0]]
 

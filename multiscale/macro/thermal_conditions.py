@@ -52,7 +52,7 @@ class AppliedBoundary:
     index: int                     # position in Thermal.boundaries
     body: int
     condition: ThermalBoundary
-    ambient: float                 # K
+    ambient: fem.Constant          # K (a form constant: a literal would compile new forms for each value)
     facets: np.ndarray             # facets of the body's submesh (this rank)
     h: fem.Constant | None = None
     bc: fem.DirichletBC | None = None
