@@ -60,6 +60,14 @@ def crossing(triangles: np.ndarray, motion, comm) -> Crossing:
     return Crossing(float(sums[0] / sums[1]) if sums[1] > 0 else 0.0, float(worst), np.array(where))
 
 
+def swept_area(lo, hi) -> float:
+    """Area [m^2] of the surface of revolution over the (radius r, axial position a) box ``lo``,
+    ``hi`` of what sweeps it (``Interface.box`` about the axis): the frustum pi (r_lo + r_hi)
+    sqrt((r_hi - r_lo)^2 + (a_hi - a_lo)^2) — a disc's annular track pi (r_hi^2 - r_lo^2), a
+    drum's band 2 pi r (a_hi - a_lo)."""
+    return float(np.pi * (lo[0] + hi[0]) * np.hypot(hi[0] - lo[0], hi[1] - lo[1]))
+
+
 @dataclass
 class Body:
     """One body: its submesh and the maps to the parent mesh."""
@@ -167,15 +175,6 @@ class Interface:
     def masks(self) -> dict:
         """{interface name: boolean mask over the global facets}."""
         return {name: self.tag_index == k for k, name in enumerate(self.tags)}
-
-    def swept_area(self, names, axis, centre) -> float:
-        """Area [m^2] of the surface of revolution that the interfaces ``names`` sweep together about
-        ``axis`` through ``centre`` (collective): the frustum over the extremes of their vertices'
-        radius r and axial position a, pi (r_lo + r_hi) sqrt((r_hi - r_lo)^2 + (a_hi - a_lo)^2) — a
-        disc's annular track pi (r_hi^2 - r_lo^2), a drum's band 2 pi r (a_hi - a_lo)."""
-        boxes = [self.box(name, axis, centre) for name in names]
-        lo, hi = np.min([b[0] for b in boxes], axis=0), np.max([b[1] for b in boxes], axis=0)
-        return float(np.pi * (lo[0] + hi[0]) * np.hypot(hi[0] - lo[0], hi[1] - lo[1]))
 
     def crossing(self, name: str, motion) -> Crossing:
         """Where body 1's rigid ``motion`` crosses interface ``name`` instead of sliding along it

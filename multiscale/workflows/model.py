@@ -81,7 +81,7 @@ def interface_radii(scene, tm) -> dict:
 def partitions(scene, tm) -> dict:
     """Share of frictional heat into body 0 [-] at every interface (``Scene.partition_at``): the
     effusivity partition weighted by the interface's area A_0 and, for a rotating body 1, by its
-    share of the track it sweeps (``Interface.swept_area``; the ch. 7 pin, 4 cm^2 sweeping
+    share of the track it sweeps (``macro.mesh.swept_area``; the ch. 7 pin, 4 cm^2 sweeping
     116 cm^2, takes 2.6 %, not the 43.5 % of equal areas). Interfaces on one track
     (``shared_tracks``: a pad's pucks, two pads on one face of a disc) heat it together: each
     takes the track's area times its share of their faces' area, the equal mean temperatures of
@@ -92,9 +92,11 @@ def partitions(scene, tm) -> dict:
     if scene.interface.partition != "effusivity" or scene.geometry.motion != "rotation":
         return {name: scene.partition_at(name) for name in masks}
     face = {name: float(iface.areas[m].sum()) for name, m in masks.items()}
+    bands = {name: iface.box(name, motion.axis, motion.centre) for name in masks}
     out = {}
-    for name, together in shared_tracks({n: iface.box(n, motion.axis, motion.centre) for n in masks}).items():
-        track = iface.swept_area(together, motion.axis, motion.centre) * face[name] / sum(face[n] for n in together)
+    for name, together in shared_tracks(bands).items():
+        lo, hi = np.min([bands[n][0] for n in together], axis=0), np.max([bands[n][1] for n in together], axis=0)
+        track = two_body.swept_area(lo, hi) * face[name] / sum(face[n] for n in together)
         out[name] = scene.partition_at(name, (face[name], max(track, face[name])))
     return out
 
