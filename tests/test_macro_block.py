@@ -275,3 +275,36 @@ def test_the_residual_of_kept_cell_matrix_and_fresh_facet_part_is_the_full_assem
     assert reference.norm() > abs(m.contact.normal_force())   # N; off equilibrium (measured 1546 vs 135 N)
     ours.axpy(-1.0, reference)
     assert ours.norm() <= 1e-12 * reference.norm()               # measured 1.7e-14
+
+
+def test_a_force_load_compiles_the_same_forms_on_another_mesh():
+    """A force's traction is the force over the load faces' area, a number of the mesh: as a
+    literal in the form each mesh compiled its forms anew (7 of the coarse pin-on-disc's 45 at
+    another interface mesh size, about 0.5 s each on a cold cache). Blocks of 10 and 12 mm (load
+    face 1e-4 and 1.44e-4 m^2) give the same residual forms (UFL signatures)."""
+    def signatures(size):
+        m = Mechanics(mesh.build(builder("block_on_flat"), {"length": size, "width": size, "mesh_size": 2.5e-3}),
+                      MATERIALS, stiffness=K_N, load_kind="force", prefix="block_sig_")
+        out = [F.signature() for F in m.residuals]
+        m.close()
+        return out
+    assert signatures(10e-3) == signatures(12e-3)
+
+
+def test_a_derivative_block_that_expands_to_zero_is_none(tm):
+    """``nonzero``: a Jacobian block is None where it is zero once its derivatives are expanded
+    (the cell part of an off-diagonal block: compiled, an empty form of no kernel that still cost a
+    compilation for every new scene); ``integrals`` splits a block into its cell and other
+    integrals."""
+    import ufl
+    from dolfinx import fem
+
+    from multiscale.macro.kept_cells import integrals, nonzero
+    V = fem.functionspace(tm.parent, ("Lagrange", 1))
+    u, w, v = fem.Function(V), fem.Function(V), ufl.TestFunction(V)
+    F = u * u * v * ufl.dx + w * v * ufl.ds
+    by_u, by_w = ufl.derivative(F, u), ufl.derivative(F, w)
+    assert nonzero(integrals(by_u, True)) is not None and nonzero(integrals(by_u, False)) is None
+    assert nonzero(integrals(by_w, True)) is None and nonzero(integrals(by_w, False)) is not None
+    assert [i.integral_type() for i in integrals(by_w, False).integrals()] == ["exterior_facet"]
+    assert integrals(by_w, True) is not None and nonzero(None) is None      # not expanded: a zero form

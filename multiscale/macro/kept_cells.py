@@ -41,6 +41,16 @@ def integrals(form, cells: bool):
     return None if part.empty() else part
 
 
+def nonzero(form):
+    """A UFL form with its derivatives expanded; None if it is zero then (an off-diagonal block of
+    a derivative whose integrals do not hold the other body's field: compiled, a form with no
+    kernel that still costs a compilation for each new scene) or if it is None."""
+    if form is None:
+        return None
+    form = expand_derivatives(form)
+    return None if form.empty() else form
+
+
 def assemble(A: PETSc.Mat, form, bcs) -> PETSc.Mat:
     """``A`` overwritten by the block matrix of the compiled ``form``, with the Dirichlet rows of
     ``bcs`` (unit diagonal)."""
@@ -271,10 +281,13 @@ class KeptCells:
         others = [[integrals(f, False) for f in row] for row in form]
         self.split = _apart(others)
         self.compiled, self.bcs = compiled, bcs
-        cells = [[integrals(f, True) for f in row] for row in form]
+        # the cell part without its zero blocks; the other part keeps them: DOLFINx assembles no
+        # block form with an empty row or column, nor one without a diagonal block where a
+        # Dirichlet condition holds
+        cells = [[nonzero(integrals(f, True)) for f in row] for row in form]
         self.cells = fem.form(cells, entity_maps=entity_maps)
-        expanded = [expand_derivatives(f) for row in cells for f in row if f is not None]
-        self.inputs = sorted({c for f in expanded for c in extract_constants(f) + extract_coefficients(f)}, key=str)
+        self.inputs = sorted({c for row in cells for f in row if f is not None
+                              for c in extract_constants(f) + extract_coefficients(f)}, key=str)
         self._state = None                  # the inputs' values at the last refresh
         self.others = fem.form(others, entity_maps=entity_maps) if self.split else None
         assemble(A, compiled, bcs)              # fixes A's sparsity (an empty assembly would drop it)

@@ -421,12 +421,10 @@ class Mechanics:
         """Applied traction on the load faces [Pa]."""
         if self.load_kind == "fluid":
             return -self.load * ufl.FacetNormal(self.tm.parent)
-        spec = self.tm.spec
-        direction = ufl.as_vector(np.asarray(spec.load_direction, float) / np.linalg.norm(spec.load_direction))
-        if self.load_kind == "pressure":
-            return self.load * direction
-        area = sum(load_face_areas(self.tm, self.load_kind).values())
-        return self.load / area * direction
+        direction = np.asarray(self.tm.spec.load_direction, float) / np.linalg.norm(self.tm.spec.load_direction)
+        if self.load_kind == "force":                   # per unit area [1/m^2]: the faces' area, a mesh's number
+            direction = direction / sum(load_face_areas(self.tm, self.load_kind).values())
+        return self.load * fem.Constant(self.tm.parent, direction)      # a constant: no form per mesh
 
     def _load_norm(self, v) -> float:
         """Norm [N] of the load faces' nodal forces at load 1 (linear in the load; collective)."""
