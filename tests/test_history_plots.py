@@ -76,10 +76,38 @@ def test_the_pads_heat_and_face_temperatures_have_their_own_panels(tmp_path, dra
     shown = [ax for ax in drawn[0].axes if ax.get_visible()]
     assert len(shown) == 6 and len(drawn[0].axes) == 6
     curves = {ax.get_ylabel(): [line.get_label() for line in ax.get_lines()] for ax in shown}
-    assert curves["heat into body [J]"] == ["brake", "disc"]
+    assert curves["heat of each body [J]"] == ["brake", "disc"]
     assert curves["frictional heat per interface [J]"] == ["inner pad", "outer pad"]
     assert curves["max face temperature [°C]"] == ["inner pad on brake", "inner pad on disc", "outer pad on brake",
                                                    "outer pad on disc"]
+
+
+def test_each_bodys_heat_in_stored_and_lost_and_each_parts_stored_heat_are_drawn(tmp_path, drawn):
+    """The heat of each body: into it (heat_total_<body>, solid), stored in it (stored_heat_<body>,
+    dashed) and lost by it (heat_lost_total_<body>, dotted), a colour per body, each named once
+    in the legend; a body of several parts has each part's stored heat in a panel of its own
+    (before, only the heat into each body was drawn)."""
+    history = History()
+    for t in (0.0, 1.0, 2.0):
+        history.append(time=t, interface_force=200.0, max_pressure=1e6, max_temperature_fixed=310.0 + t,
+                       max_temperature_disc=305.0 + t, heat_total_fixed=t, heat_total_disc=9 * t,
+                       stored_heat_fixed=0.8 * t, stored_heat_disc=7 * t, heat_lost_total_fixed=0.2 * t,
+                       heat_lost_total_disc=2 * t, stored_heat_fixed_part_pad=0.6 * t,
+                       stored_heat_fixed_part_backplate=0.2 * t)
+    plots.history_figure(history, tmp_path / "history.png")
+    axes = {ax.get_ylabel(): ax for ax in drawn[0].axes if ax.get_visible()}
+    heat = axes["heat of each body [J]"]
+    drawn_as = {(line.get_label(), line.get_linestyle()): tuple(line.get_ydata()) for line in heat.get_lines()}
+    assert drawn_as == {("fixed", "-"): (0, 1, 2), ("fixed", "--"): (0, 0.8, 1.6), ("fixed", ":"): (0, 0.2, 0.4),
+                        ("disc", "-"): (0, 9, 18), ("disc", "--"): (0, 7, 14), ("disc", ":"): (0, 2, 4)}
+    colours = {line.get_label(): {str(other.get_color()) for other in heat.get_lines()
+                                  if other.get_label() == line.get_label()} for line in heat.get_lines()}
+    assert all(len(c) == 1 for c in colours.values()) and colours["fixed"] != colours["disc"]
+    assert [t.get_text() for t in heat.get_legend().get_texts()] == ["fixed", "disc", "into", "stored", "lost"]
+    parts = axes["heat stored in each part [J]"]
+    assert {line.get_label(): tuple(line.get_ydata()) for line in parts.get_lines()} == \
+        {"pad": (0, 0.6, 1.2), "backplate": (0, 0.2, 0.4)}
+    assert [t.get_text() for t in parts.get_legend().get_texts()] == ["pad", "backplate"]
 
 
 def test_nine_pads_have_distinct_curves_and_legends_inside_their_panels(tmp_path, drawn):

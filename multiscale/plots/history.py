@@ -1,9 +1,10 @@
 """Figures of a run's history (``history.h5``): the macro quantities, both scales of the multiscale
 loop (thesis ch. 7) and the wear map.
 
-``history_figure``: interface force, max contact pressure, max temperatures and heat into each body
-against time, and with several interfaces and heat each one's frictional heat and the hottest facet
-of each face (two rows of panels then). ``multiscale_figure``: max contact pressure macro (facets,
+``history_figure``: interface force, max contact pressure, max temperatures and the heat of each body
+(into it, stored in it, lost by it) against time; with several interfaces each one's frictional heat
+and the hottest facet of each face, with a body of several parts each part's stored heat (two rows
+of panels then). ``multiscale_figure``: max contact pressure macro (facets,
 zones) vs micro (Fig. 7.14; log scale, linear with a note if no row has contact), max temperature
 macro vs micro (Fig. 7.15), heat partition min/mean/max (Fig. 7.12), wear volume (Fig. 7.16), max
 wear depth (Fig. 7.17) and RMS of the worn surface (Fig. 7.18) — the panels whose columns the
@@ -29,7 +30,8 @@ def column_label(key: str) -> str:
     max_temperature_fixed_part_inner_pad -> "inner pad" (a part of body fixed),
     face_max_temperature_inner_pad_on_disc -> "inner pad on disc" (the disc's face of interface
     inner_pad)."""
-    for prefix in ("max_temperature_", "heat_total_", "frictional_heat_total_", "face_max_temperature_"):
+    for prefix in ("max_temperature_", "heat_total_", "stored_heat_", "heat_lost_total_", "frictional_heat_total_",
+                   "face_max_temperature_"):
         key = key.removeprefix(prefix)
     key = key.partition("_part_")[2] or key
     body, within, material = key.partition("_in_")
@@ -47,37 +49,57 @@ def temperature_columns(columns) -> list[str]:
             and not any(j.startswith(k + "_in_") for j in hot)]
 
 
+# the heat of a body by what it is (heat_total_<body> etc.): its word in the legend, in this order
+HEAT_KINDS = {"heat_total_": "into", "stored_heat_": "stored", "heat_lost_total_": "lost"}
+
+
+def curve_pairs(keys) -> list | None:
+    """(colour, line style) names of a panel's columns drawn by two properties, or None: faces
+    (face_max_temperature_<interface>_on_<body>: a colour per interface, a style per body) or the
+    heat of bodies (heat_total_, stored_heat_, heat_lost_total_ <body>: a colour per body, a style
+    per kind, if there are several kinds)."""
+    if all(k.startswith("face_max_temperature_") for k in keys):
+        return [(pad, f"on {body}") for pad, _, body in (column_label(k).rpartition(" on ") for k in keys)]
+    kinds = [next((word for prefix, word in HEAT_KINDS.items() if k.startswith(prefix)), None) for k in keys]
+    if all(kinds) and len(set(kinds)) > 1:
+        return [(column_label(k), kind) for k, kind in zip(keys, kinds)]
+    return None
+
+
 def curve_styles(keys) -> tuple[list[dict], list]:
     """The colour and line style of each column of a panel, and its legend's entries (a Line2D
-    each): a colour per column, or for faces (face_max_temperature_<interface>_on_<body>) a colour
-    per interface and a line style per body, each named once (9 pads on 2 bodies: 11 entries, and
-    no two curves alike; tab10 repeats its colours beyond 10)."""
-    faces = [column_label(k).rpartition(" on ") for k in keys]
-    faced = all(on for _, on, _ in faces) and len(keys) > 1
-    names = list(dict.fromkeys(pad for pad, _, _ in faces)) if faced else [column_label(k) for k in keys]
-    bodies = list(dict.fromkeys(body for _, _, body in faces)) if faced else []
+    each): a colour per column, or for ``curve_pairs`` a colour and a line style by its two names,
+    each named once (9 pads on 2 bodies: 11 entries, and no two curves alike; tab10 repeats its
+    colours beyond 10)."""
+    pairs = curve_pairs(keys) if len(keys) > 1 else None
+    names = list(dict.fromkeys(n for n, _ in pairs)) if pairs else [column_label(k) for k in keys]
+    kinds = list(dict.fromkeys(k for _, k in pairs)) if pairs else []
     cmap = colormaps["tab10" if len(names) <= 10 else "tab20" if len(names) <= 20 else "turbo"]
     colour = {n: cmap(k if len(names) <= 20 else k / (len(names) - 1)) for k, n in enumerate(names)}
-    style = {b: BODY_STYLES[k % len(BODY_STYLES)] for k, b in enumerate(bodies)}
-    if not faced:
+    style = {b: BODY_STYLES[k % len(BODY_STYLES)] for k, b in enumerate(kinds)}
+    if not pairs:
         return [{"color": colour[n], "ls": "-"} for n in names], []
     entries = [Line2D([], [], color=colour[n], label=n) for n in names]
-    entries += [Line2D([], [], color="0.4", ls=style[b], label=f"on {b}") for b in bodies]
-    return [{"color": colour[pad], "ls": style[body]} for pad, _, body in faces], entries
+    entries += [Line2D([], [], color="0.4", ls=style[b], label=b) for b in kinds]
+    return [{"color": colour[n], "ls": style[b]} for n, b in pairs], entries
 
 
 def history_figure(history, path: Path, title: str = "") -> Path:
     """PNG of the history: force, max pressure, max temperatures, heat per body (and per
-    interface, max face temperatures) vs time."""
+    interface, max face temperatures, stored heat per part) vs time."""
     t = history["time"]
+    bodies = [k.removeprefix("heat_total_") for k in history.columns if k.startswith("heat_total_")]
+    heat = [prefix + b for b in bodies for prefix in HEAT_KINDS if prefix + b in history.columns]
     groups = [("interface force [N]", ["interface_force"], 1.0, 0.0),
               ("max contact pressure [MPa]", ["max_pressure"], 1e-6, 0.0),
               ("max temperature [°C]", temperature_columns(history.columns), 1.0, -273.15),
-              ("heat into body [J]", [k for k in history.columns if k.startswith("heat_total")], 1.0, 0.0),
+              ("heat of each body [J]", heat, 1.0, 0.0),
               ("frictional heat per interface [J]",
                [k for k in history.columns if k.startswith("frictional_heat_total_")], 1.0, 0.0),
               ("max face temperature [°C]", [k for k in history.columns if k.startswith("face_max_temperature_")],
-               1.0, -273.15)]
+               1.0, -273.15),
+              ("heat stored in each part [J]",
+               [k for k in history.columns if k.startswith("stored_heat_") and "_part_" in k], 1.0, 0.0)]
     groups = [g for g in groups if g[1] and all(k in history.columns for k in g[1])]
     rows = 1 if len(groups) <= 4 else 2
     cols = -(-len(groups) // rows)
