@@ -7,6 +7,9 @@ a matrix of its own when its owner says so (``refresh``) and composes the Jacobi
 it and a fresh assembly of the other integrals (``compose``): equal to the assembly of the whole
 form (tests/test_macro_block.py, tests/test_macro_thermal.py) at a fraction of its cost.
 
+Blocks that are zero once their derivatives are expanded are left out (``jacobian``): compiled,
+each was a form without kernels, new for every scene (docs/architecture.md §2, numbers in forms).
+
 The Jacobian's matrix ignores exact zeros of the element matrices once its pattern is fixed
 (``MAT_IGNORE_ZERO_ENTRIES``; the values are the same): most entries of the facet blocks of a
 vector field are zeros, and every add searches its row (docs/architecture.md §5, the macro Newton).
@@ -24,6 +27,7 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc as fpetsc
+from dolfinx.fem.forms import derivative_block
 from mpi4py import MPI
 from petsc4py import PETSc
 from ufl.algorithms import expand_derivatives
@@ -49,6 +53,27 @@ def nonzero(form):
         return None
     form = expand_derivatives(form)
     return None if form.empty() else form
+
+
+def jacobian(F: list, u: list) -> list:
+    """The block Jacobian dF_i/du_j (UFL, a list of lists) without its zero blocks (``nonzero``)."""
+    return [[nonzero(f) for f in row] for row in derivative_block(F, u)]
+
+
+# the subdomain id of no cell or facet (gmsh's physical tags and MeshTags' values are int32)
+NOWHERE = 2**31 - 1
+
+
+def empty_block(block):
+    """The mass-like form of ``block``'s arguments over nothing (subdomain ``NOWHERE`` of its first
+    integral's measure): a diagonal block with nothing to assemble still needs a form, as DOLFINx
+    assembles no block form with a row or column of None, nor a None diagonal block where a
+    Dirichlet condition holds. Its signature is of the spaces only: compiled once for every scene."""
+    test, trial = block.arguments()
+    first = block.integrals()[0]
+    nowhere = ufl.Measure(first.integral_type(), domain=first.ufl_domain(), subdomain_id=NOWHERE,
+                          subdomain_data=first.subdomain_data())
+    return ufl.inner(trial, test) * nowhere
 
 
 def assemble(A: PETSc.Mat, form, bcs) -> PETSc.Mat:
@@ -221,19 +246,6 @@ def factor_packages(A: PETSc.Mat, factor: str) -> list[str]:
     return found
 
 
-def splits(form: list) -> bool:
-    """Whether ``KeptCells`` of the block form ``form`` (UFL, a list of lists) keeps its cell part
-    apart (``KeptCells.split``): the integrals other than the cells' leave no row or column of
-    blocks empty. Known before the problem is set up (its solver options depend on it)."""
-    return _apart([[integrals(f, False) for f in row] for row in form])
-
-
-def _apart(others: list) -> bool:
-    """``splits`` of the block form whose non-cell integrals are ``others``."""
-    return (all(any(f is not None for f in row) for row in others)
-            and all(any(f is not None for f in column) for column in zip(*others)))
-
-
 # options under a prefix that only a Newton method reads: a linear solve (SNES "ksponly": one
 # Jacobian, one KSP solve) queries some of them (PETSc's "option left" does not list them) and
 # uses none
@@ -267,29 +279,25 @@ def newton_options_unused(snes: PETSc.SNES, problem: str) -> str:
 
 
 class KeptCells:
-    """The block Jacobian ``form`` (UFL, a list of lists) of the matrix ``A`` (compiled:
-    ``compiled``) split into its cell part, kept in ``bulk`` (of A's sparsity), and the rest.
-    ``refresh`` reassembles ``bulk`` at the current state (``update``: only if a constant or
+    """The block Jacobian ``form`` (UFL, a list of lists, ``jacobian``) of the matrix ``A``
+    (compiled: ``compiled``) split into its cell part, kept in ``bulk`` (of A's sparsity), and the
+    rest. ``refresh`` reassembles ``bulk`` at the current state (``update``: only if a constant or
     coefficient of the cell integrals changed since, e.g. dt or a speed); ``compose`` overwrites a
     matrix of A's sparsity by bulk plus the rest at the current state, with the Dirichlet rows of
-    ``bcs``.
-    Where the rest leaves a body's row or column of blocks empty (a body without interface or
-    boundary terms: DOLFINx cannot assemble such a block form), ``split`` is False and
-    ``compose`` assembles the whole form (``bulk`` is still the cell part)."""
+    ``bcs``. Blocks of either part that are zero are left out, and a body's diagonal block of the
+    rest that has nothing is an ``empty_block`` (a body without interface or boundary terms)."""
 
     def __init__(self, A: PETSc.Mat, compiled, form: list, entity_maps, bcs):
-        others = [[integrals(f, False) for f in row] for row in form]
-        self.split = _apart(others)
-        self.compiled, self.bcs = compiled, bcs
-        # the cell part without its zero blocks; the other part keeps them: DOLFINx assembles no
-        # block form with an empty row or column, nor one without a diagonal block where a
-        # Dirichlet condition holds
+        self.bcs = bcs
         cells = [[nonzero(integrals(f, True)) for f in row] for row in form]
+        others = [[nonzero(integrals(f, False)) for f in row] for row in form]
+        for i, row in enumerate(others):
+            row[i] = row[i] or empty_block(form[i][i])
         self.cells = fem.form(cells, entity_maps=entity_maps)
         self.inputs = sorted({c for row in cells for f in row if f is not None
                               for c in extract_constants(f) + extract_coefficients(f)}, key=str)
         self._state = None                  # the inputs' values at the last refresh
-        self.others = fem.form(others, entity_maps=entity_maps) if self.split else None
+        self.others = fem.form(others, entity_maps=entity_maps)
         assemble(A, compiled, bcs)              # fixes A's sparsity (an empty assembly would drop it)
         A.setOption(PETSc.Mat.Option.IGNORE_ZERO_ENTRIES, True)
         self.bulk = A.duplicate()
@@ -312,8 +320,6 @@ class KeptCells:
 
     def compose(self, A: PETSc.Mat) -> PETSc.Mat:
         """``A`` = the kept cell part + the other integrals at the current state."""
-        if not self.split:
-            return assemble(A, self.compiled, self.bcs)
         self.bulk.copy(A, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)
         fpetsc.assemble_matrix(A, self.others, bcs=self.bcs)
         A.assemble()

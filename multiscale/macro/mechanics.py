@@ -22,7 +22,6 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc as fpetsc
-from dolfinx.fem.forms import derivative_block
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -31,7 +30,8 @@ from multiscale.macro import mumps
 from multiscale.macro.compact_factor import CompactFactor
 from multiscale.macro.interface import ContactInterface, PressureLaw
 from multiscale.macro.kept_cells import (Closed, KeptCells, SolverOptionWarning, assemble, backtracking, check_user_options,
-                                         destroy, integrals, nonlinear_problem, options_named, user_options)
+                                         destroy, integrals, jacobian, nonlinear_problem, options_named,
+                                         user_options)
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
@@ -248,9 +248,10 @@ class Mechanics:
         self._unit_load = self._load_norm(v)
         self.bcs = self._supports()
         self.refresh = None if refresh is None else int(refresh)
+        J = jacobian(F, self.u)
         P = self._frictionless_jacobian() if preconditioner == "cholesky" else None
         # the user's options under the prefix (PETSC_OPTIONS="-mech_...") win over ours
-        self.problem = nonlinear_problem(F, self.u, prefix, NEWTON_OPTIONS, bcs=self.bcs, P=P,
+        self.problem = nonlinear_problem(F, self.u, prefix, NEWTON_OPTIONS, bcs=self.bcs, J=J, P=P,
                                          entity_maps=tm.entity_maps)
         self._atol = self.problem.solver.getTolerances()[1]     # ours or the user's: the floors' base (ours:
         self._own_atol = not PETSc.Options(prefix).hasName("snes_atol")   # at most TINY_LOAD of the load)
@@ -275,8 +276,7 @@ class Mechanics:
         # the tangent's cell integrals (small-strain elasticity: E, nu constant or of T, not of u)
         # are kept until an input of theirs changes (T with E(T), nu(T)), its facet integrals are
         # assembled every iteration
-        self._split = [KeptCells(self.problem.A, self.problem.J, derivative_block(F, self.u), tm.entity_maps,
-                                 self.bcs)]
+        self._split = [KeptCells(self.problem.A, self.problem.J, J, tm.entity_maps, self.bcs)]
         if P is not None:
             self._split.append(KeptCells(self.problem.P_mat, self.problem.preconditioner, P, tm.entity_maps,
                                          self.bcs))
@@ -320,8 +320,8 @@ class Mechanics:
     def _frictionless_jacobian(self) -> list:
         """Block Jacobian of the residuals with mu = 0 (UFL forms; symmetric)."""
         zero = fem.Constant(self.tm.parent, 0.0)
-        J = derivative_block(self.residuals, self.u)
-        return [[None if f is None else ufl.replace(f, {self.contact.friction: zero}) for f in row] for row in J]
+        return [[None if f is None else ufl.replace(f, {self.contact.friction: zero}) for f in row]
+                for row in jacobian(self.residuals, self.u)]
 
     def _jacobian(self, snes, x, J, P) -> None:
         """SNES Jacobian callback: J = cell part (kept) + facet part at x; the preconditioner

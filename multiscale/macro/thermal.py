@@ -89,7 +89,6 @@ import numpy as np
 import ufl
 from dolfinx import fem
 from dolfinx.fem import petsc as fpetsc
-from dolfinx.fem.forms import derivative_block
 from mpi4py import MPI
 from petsc4py import PETSc
 
@@ -102,12 +101,11 @@ from multiscale.macro.materials import body_properties, heat_capacity
 from multiscale.macro.mesh import FormCache
 from multiscale.macro.thermal_conditions import AppliedBoundary, ThermalBoundary, surface_rows
 
-# a linear step without a kept cell part (kept_cells.splits): one LU solve (tolerances: for a user's KSP)
-LINEAR_OPTIONS = {"snes_type": "ksponly", "ksp_type": "preonly", "pc_type": "lu",
-                  "pc_factor_mat_solver_type": "mumps", "ksp_rtol": 1e-12, "ksp_atol": 0.0}
-# a linear step with a kept cell part: GMRES on the step's matrix, preconditioned by the LU factors
-# of an earlier step's, refactorised when a solve took more than KEPT_ITERATIONS iterations (or failed)
-KEPT_OPTIONS = {**LINEAR_OPTIONS, "ksp_type": "gmres", "ksp_max_it": 50}
+# a linear step (its matrix's cell part kept): GMRES on the step's matrix, preconditioned by the LU
+# factors of an earlier step's, refactorised when a solve took more than KEPT_ITERATIONS iterations
+# (or failed)
+KEPT_OPTIONS = {"snes_type": "ksponly", "ksp_type": "gmres", "ksp_max_it": 50, "pc_type": "lu",
+                "pc_factor_mat_solver_type": "mumps", "ksp_rtol": 1e-12, "ksp_atol": 0.0}
 KEPT_ITERATIONS = 8
 NEWTON_OPTIONS = {"snes_type": "newtonls", "snes_linesearch_type": "basic", "snes_rtol": 1e-10,
                   "snes_atol": 1e-12, "snes_stol": 1e-12, "snes_max_it": 30,
@@ -215,9 +213,9 @@ class Thermal:
         self.tables = [f"{b.name} ({', '.join(n for n, p in (('kappa', k), ('c', c)) if not p.constant)})"
                        for b, k, c in zip(tm.bodies, conductivity, self.capacity) if not (k.constant and c.constant)]
         # the user's options under the prefix (PETSC_OPTIONS="-heat_...") win over ours, a linear problem's too
-        J = None if self.nonlinear else derivative_block(self.residuals, self.T)
-        options = NEWTON_OPTIONS if self.nonlinear else KEPT_OPTIONS if kept_cells.splits(J) else LINEAR_OPTIONS
-        self.problem = nonlinear_problem(self.residuals, self.T, prefix, options, bcs=self.bcs,
+        J = kept_cells.jacobian(self.residuals, self.T)
+        self.problem = nonlinear_problem(self.residuals, self.T, prefix,
+                                         NEWTON_OPTIONS if self.nonlinear else KEPT_OPTIONS, bcs=self.bcs, J=J,
                                          entity_maps=tm.entity_maps)
         self.notes: list = []                  # what the run's warnings add (said once per run)
         self._tangent = self._factored = None  # linear steps: the kept cell part, the kept factors' matrix
@@ -229,10 +227,9 @@ class Thermal:
         if not self.nonlinear:                 # (its SNES is "ksponly": the Newton's options have no effect)
             why = "the heat problem is linear (no radiation, no temperature tables)"
             self._say(kept_cells.newton_options_unused(self.problem.solver, why), kept_cells.SolverOptionWarning)
-            tangent = KeptCells(self.problem.A, self.problem.J, J, tm.entity_maps, self.bcs)
-            if tangent.split:
-                self._tangent, self._factored = tangent, self.problem.A.duplicate()
-                self.problem.solver.setJacobian(self._jacobian, self.problem.A, self._factored)
+            self._tangent = KeptCells(self.problem.A, self.problem.J, J, tm.entity_maps, self.bcs)
+            self._factored = self.problem.A.duplicate()
+            self.problem.solver.setJacobian(self._jacobian, self.problem.A, self._factored)
         self.factorisations = 0                # linear steps: LU factorisations so far
         self._stale = True                     # linear steps: refactorise at the next step
         self._kept = False                     # linear steps: the last solve ran on earlier factors
