@@ -10,7 +10,9 @@ import argparse
 import contextlib
 import dataclasses
 import os
+import shlex
 import sys
+import tomllib
 import warnings
 from pathlib import Path
 
@@ -66,7 +68,7 @@ def _check(args) -> int:
     failed = 0
     for path in args.scenes:
         try:
-            scene = load(path)
+            scene = load(path, overrides={k: v for k, v, _ in args.settings})
         except SceneError as exc:
             for line in exc.problems:
                 print(f"error: {line}", file=sys.stderr)
@@ -164,7 +166,7 @@ def _run(args) -> int:
     watch = None if comm is None else CtrlCWatch(comm, lambda: f"interrupted: {_kept(scene, args)}", INTERRUPTED)
     with watch or contextlib.nullcontext():     # a Ctrl-C that a rank's main thread cannot meet
         try:
-            scene = load(args.scene)
+            scene = load(args.scene, overrides={k: v for k, v, _ in args.settings})
             if args.max_cells is not None:
                 scene = dataclasses.replace(scene, geometry=dataclasses.replace(scene.geometry,
                                                                                 max_cells=args.max_cells))
@@ -199,11 +201,12 @@ def _kept(scene, args) -> str:
     is advised only with a checkpoint (before its first macro step ended it refused to resume)."""
     if scene is None:
         return "nothing was written"
+    command = shlex.join(["multiscale", "run", args.scene, *(f"--set={k}={text}" for k, _, text in args.settings)])
     if analysis(scene) == "multiscale" and not (Path(scene.output.folder) / CHECKPOINT).is_file():
-        return (f"no macro step ended, there is nothing to resume; multiscale run {args.scene}"
+        return (f"no macro step ended, there is nothing to resume; {command}"
                 + (" --overwrite" if args.overwrite else "") + " starts again")
-    how = (f"multiscale run {args.scene} --resume continues from the last finished step"
-           if analysis(scene) == "multiscale" else f"multiscale run {args.scene} --overwrite starts again")
+    how = (f"{command} --resume continues from the last finished step"
+           if analysis(scene) == "multiscale" else f"{command} --overwrite starts again")
     return f"what was written stays in {scene.output.folder} (its provenance.json says so); {how}"
 
 
@@ -248,6 +251,20 @@ def _count(text: str) -> int:
     if not (value >= 1 and value == int(value)):
         raise argparse.ArgumentTypeError(f"{text!r}: a whole number >= 1")
     return int(value)
+
+
+def _setting(text: str) -> tuple[str, object, str]:
+    """A ``--set KEY=VALUE`` of the command line: the dotted scene key, the value as TOML reads it
+    (40, 0.3, false, [4, 4], "300 N") or else the text itself (300 N, runs/a), and the text."""
+    key, equals, value = text.partition("=")
+    if not equals or not key.strip() or not value.strip():
+        raise argparse.ArgumentTypeError(f"{text!r}: KEY=VALUE, a scene key and its value, e.g. time.steps=40 or "
+                                         '"loading.normal_force=300 N"')
+    try:
+        read = tomllib.loads(f"value = {value}")["value"]
+    except tomllib.TOMLDecodeError:
+        read = value.strip()
+    return key.strip(), read, value
 
 
 def _number_or_text(text: str):
@@ -330,6 +347,13 @@ def _surface(args) -> int:
     return 0
 
 
+# --set KEY=VALUE of check and run: scene keys over the file's (a study's overrides, by hand)
+SET = dict(type=_setting, action="append", default=[], dest="settings", metavar="KEY=VALUE",
+           help='a scene key\'s value over the file\'s, repeatable: time.steps=40, "loading.normal_force=300 N", '
+                "micro.zones=[4,4], output.folder=runs/a (a value TOML does not read is text; paths from the "
+                "scene file's folder); provenance.json records them")
+
+
 def build_parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="multiscale", description=DESCRIPTION, epilog=EPILOG,
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -343,6 +367,7 @@ def build_parser() -> argparse.ArgumentParser:
     check.add_argument("scenes", nargs="*", metavar="SCENE", help="scene TOML file(s)")
     check.add_argument("--keys", action="store_true", help="print the scene format: every section and key")
     check.add_argument("--cells", action="store_true", help="estimate the mesh's cell count (trial meshes, seconds)")
+    check.add_argument("--set", **SET)
     check.set_defaults(func=_check)
     run = sub.add_parser("run", help=f"run a scene (in parallel: {MPIEXEC} -n N multiscale run SCENE)",
                          description="Run a scene: its effects decide the analysis (transient, multiscale loop "
@@ -354,6 +379,7 @@ def build_parser() -> argparse.ArgumentParser:
     again.add_argument("--overwrite", action="store_true",
                        help="delete the results of the run before (the entries its provenance.json lists) and run again")
     again.add_argument("--resume", action="store_true", help="continue from the last checkpoint in the output folder")
+    run.add_argument("--set", **SET)
     run.add_argument("--quiet", action="store_true", help="no stage lines or summary (warnings and errors only)")
     run.add_argument("--max-cells", type=_count, metavar="N", help="largest mesh (cells) the run may build; "
                                                                    "overrides geometry.max_cells (default 1e6)")

@@ -149,6 +149,35 @@ def test_run_hands_the_scene_to_the_runner(tmp_path, fake_runner):
     assert fake_runner == [("block_on_flat", False, False)]
 
 
+def test_set_gives_scene_keys_over_the_files_to_check_and_run(tmp_path, capsys, monkeypatch):
+    """``--set KEY=VALUE``: a value TOML reads (a number, a list, a quoted string) or else the text;
+    check judges and summarises the scene with them, run hands it on with them (recorded in its
+    overrides, which provenance.json lists); a bad key is the scene's error, a setting without "="
+    the command line's."""
+    path = _write(tmp_path, BLOCK.replace("../results/block_on_flat", "out"))
+    assert main(["check", path, "--set", "loading.pressure=2 MPa", "--set", "interface.penalty=2e13"]) == 0
+    out = capsys.readouterr().out
+    assert "  loading   2 MPa" in out and "penalty K_n = 2e+13 Pa/m" in out
+    assert main(["check", path, "--set", "loading.pressur=2"]) == 2
+    assert 'error: loading.pressur: unknown key (did you mean "pressure"?)' in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exit_:
+        main(["check", path, "--set", "loading.pressure"])
+    assert exit_.value.code == 2 and "KEY=VALUE" in capsys.readouterr().err
+    handed = []
+    module = types.ModuleType("multiscale.workflows")
+    module.run = lambda scene, **kw: handed.append(scene)
+    monkeypatch.setitem(sys.modules, "multiscale.workflows", module)
+    settings = ["--set=output.fields=['displacement', 'contact_pressure']", "--set", "loading.pressure='3 MPa'",
+                "--set", "output.folder=elsewhere/a", "--set", "interface.penalty=3e13", "--set", "output.figures=false"]
+    assert main(["run", path, *settings]) == 0
+    scene = handed[0]
+    assert scene.output.fields == ("displacement", "contact_pressure") and scene.loading.pressure == 3e6
+    assert scene.output.folder == tmp_path / "elsewhere" / "a" and scene.interface.penalty == 3e13
+    assert scene.output.figures is False
+    assert dict(scene.overrides) == {"output.fields": ["displacement", "contact_pressure"], "loading.pressure": "3 MPa",
+                                     "output.folder": "elsewhere/a", "interface.penalty": 3e13, "output.figures": False}
+
+
 def test_run_refuses_to_overwrite_results(tmp_path, capsys, monkeypatch):
     pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")   # the real workflow
     path = _write(tmp_path, BLOCK.replace("../results/block_on_flat", "out"))
