@@ -1,6 +1,7 @@
 """What ``multiscale check`` prints: the scene format (``--keys``) and a scene's summary."""
 from __future__ import annotations
 
+import json
 import math
 
 from multiscale.geometry import CellEstimate, estimate_cells
@@ -21,6 +22,11 @@ def reference() -> list[str]:
 
 
 
+def _toml(value) -> str:
+    """A value as a TOML file would have it (numbers short: 2e+13)."""
+    return f"{value:g}" if isinstance(value, float) else json.dumps(value)
+
+
 def summary(scene: Scene) -> list[str]:
     """A few lines: bodies, effects, loading, time, output — what a run would compute."""
     g, ld, t, o = scene.geometry, scene.loading, scene.time, scene.output
@@ -30,6 +36,7 @@ def summary(scene: Scene) -> list[str]:
     sizes = ", ".join(f"{k} {params[k] * 1e3:g} mm" for k in params if k.endswith("mesh_size"))
     source = f"file {g.params.file.name}" if g.builder == "file" else g.builder
     lines = [f"scene {scene.name}" + (f" ({scene.source})" if scene.source else ""),
+             *([f"  set       {', '.join(f'{k} = {_toml(v)}' for k, v in scene.overrides)}"] if scene.overrides else []),
              f"  geometry  {source}, {g.motion} of {g.bodies[1]}" + (f"; {sizes}" if sizes else ""),
              *(f"            {line}" for line in g.spec.report),
              f"  bodies    {bodies}",

@@ -158,6 +158,7 @@ def test_set_gives_scene_keys_over_the_files_to_check_and_run(tmp_path, capsys, 
     assert main(["check", path, "--set", "loading.pressure=2 MPa", "--set", "interface.penalty=2e13"]) == 0
     out = capsys.readouterr().out
     assert "  loading   2 MPa" in out and "penalty K_n = 2e+13 Pa/m" in out
+    assert out.splitlines()[1] == '  set       loading.pressure = "2 MPa", interface.penalty = 2e+13'
     assert main(["check", path, "--set", "loading.pressur=2"]) == 2
     assert 'error: loading.pressur: unknown key (did you mean "pressure"?)' in capsys.readouterr().err
     with pytest.raises(SystemExit) as exit_:
