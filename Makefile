@@ -43,10 +43,12 @@ test: $(STAMP)
 docs: $(STAMP)
 	$(BIN)/python -m sphinx -b html -E -W --keep-going -n -q docs docs/_build/html
 
-# One pytest process per test module: a model not closed (the tests build most through the API and
-# keep them open) stays in memory with ~35-100 MPI communicators of MPICH's 2048 per process, and
-# the whole suite in one process ended with exit code 15, MPICH's abort for "Too many
-# communicators" (203515151 & 0xff; docs/architecture.md §7). JOBS modules run at a time, each
+# One pytest process per test module: a model not closed stays in memory with ~35-100 MPI
+# communicators of MPICH's 2048 per process, and the whole suite in one process ended with exit code
+# 15, MPICH's abort for "Too many communicators" (203515151 & 0xff; docs/architecture.md §7). The
+# tests' conftest now closes every model a module leaves open (four heavy modules in one process
+# pass); the processes per module stay: two run at a time, and a crash names its module. JOBS
+# modules run at a time, each
 # module's output printed whole when it ends (-O), the slowest started first so that the jobs end
 # together; every module runs (-k), and the failed ones are named at the end. WITH: more targets
 # run beside them.

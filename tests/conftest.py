@@ -67,3 +67,33 @@ def documented():
     literals = [re.sub(r"<(body|name|material)>", "[A-Za-z0-9_.-]+", re.escape(literal))
                 for literal in re.findall(r"``([^`]+)``", doc) if not re.fullmatch(r"<\w+>", literal)]
     return lambda name: any(re.fullmatch(literal, name) for literal in literals)
+
+
+@pytest.fixture(scope="module", autouse=True)
+def models_closed():
+    """Every ``Mechanics`` and ``Thermal`` a test module builds is closed after the module (their
+    ``close``: collective, in the same order on every rank). A model not closed keeps its MPI
+    communicators (about 35-100 of MPICH's 2048; docs/architecture.md §7, known problems), so
+    several test modules in one pytest process ended in MPICH's abort (exit code 15). Held by weak
+    references: a model closed and dropped by a test is freed (tests check that); one not closed is
+    kept alive by PETSc, on every rank."""
+    import sys
+    import weakref
+    built, patched = [], []
+    for name, kind in (("multiscale.macro.mechanics", "Mechanics"), ("multiscale.macro.thermal", "Thermal")):
+        module = sys.modules.get(name)           # imported by the test module, if it builds models
+        if module is None:
+            continue
+        cls = getattr(module, kind)
+        patched.append((cls, cls.__init__))
+
+        def tracked(self, *args, __init__=cls.__init__, **kwargs):
+            __init__(self, *args, **kwargs)
+            built.append(weakref.ref(self))
+        cls.__init__ = tracked
+    yield
+    for cls, init in patched:
+        cls.__init__ = init
+    for ref in reversed(built):
+        if (model := ref()) is not None:
+            model.close()
