@@ -292,7 +292,8 @@ class KeptCells:
         cells = [[nonzero(integrals(f, True)) for f in row] for row in form]
         others = [[nonzero(integrals(f, False)) for f in row] for row in form]
         for i, row in enumerate(others):
-            row[i] = row[i] or empty_block(form[i][i])
+            if row[i] is None:
+                row[i] = empty_block(form[i][i])
         self.cells = fem.form(cells, entity_maps=entity_maps)
         self.inputs = sorted({c for row in cells for f in row if f is not None
                               for c in extract_constants(f) + extract_coefficients(f)}, key=str)
