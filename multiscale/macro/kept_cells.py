@@ -279,18 +279,18 @@ def newton_options_unused(snes: PETSc.SNES, problem: str) -> str:
 
 
 class KeptCells:
-    """The block Jacobian ``form`` (UFL, a list of lists, ``jacobian``) of the matrix ``A``
-    (compiled: ``compiled``) split into its cell part, kept in ``bulk`` (of A's sparsity), and the
-    rest. ``refresh`` reassembles ``bulk`` at the current state (``update``: only if a constant or
-    coefficient of the cell integrals changed since, e.g. dt or a speed); ``compose`` overwrites a
-    matrix of A's sparsity by bulk plus the rest at the current state, with the Dirichlet rows of
-    ``bcs``. Blocks of either part that are zero are left out, and a body's diagonal block of the
+    """The block Jacobian ``form`` (UFL, a list of lists: ``jacobian``'s, whose expanded blocks hold
+    no zero integral) of the matrix ``A`` (compiled: ``compiled``) split into its cell part, kept in
+    ``bulk`` (of A's sparsity), and the rest. ``refresh`` reassembles ``bulk`` at the current state
+    (``update``: only if a constant or coefficient of the cell integrals changed since, e.g. dt or a
+    speed); ``compose`` overwrites a matrix of A's sparsity by bulk plus the rest at the current
+    state, with the Dirichlet rows of ``bcs``. Blocks of either part that are zero are left out, and a body's diagonal block of the
     rest that has nothing is an ``empty_block`` (a body without interface or boundary terms)."""
 
     def __init__(self, A: PETSc.Mat, compiled, form: list, entity_maps, bcs):
         self.bcs = bcs
-        cells = [[nonzero(integrals(f, True)) for f in row] for row in form]
-        others = [[nonzero(integrals(f, False)) for f in row] for row in form]
+        cells = [[integrals(f, True) for f in row] for row in form]
+        others = [[integrals(f, False) for f in row] for row in form]
         for i, row in enumerate(others):
             if row[i] is None:
                 row[i] = empty_block(form[i][i])
