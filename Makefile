@@ -9,6 +9,9 @@ NP ?= 2
 export UCX_TLS ?= self,sm,tcp
 export OMP_NUM_THREADS ?= 1
 export MPLBACKEND ?= Agg
+# pip installs without compiling every installed module to bytecode (--no-compile): that took 43 of
+# the install's 77 s on a fresh machine (warm download cache); Python compiles and caches the modules
+# a process imports when it first imports them (the suite's first imports: ~10 s more, once).
 # Python caches the package's bytecode (__pycache__, ignored by git) even where the environment
 # says not to: the suite starts an interpreter per test module, more for the CLI and MPI tests, and
 # a process per package module in test_architecture (its imports took 88 s without the cache, 53-60 s
@@ -28,7 +31,7 @@ $(STAMP): pyproject.toml
 	@test -n "$(PYTHON)" || { echo "error: no Python >= 3.12 found (pyenv install 3.12, or make PYTHON=/path/to/python3.12)"; exit 1; }
 	@test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/python -m pip install -q --upgrade pip
-	$(BIN)/python -m pip install -q -e '.[fem,test,docs]'
+	$(BIN)/python -m pip install -q --no-compile -e '.[fem,test,docs]'
 	@touch $(STAMP)
 
 demo: $(STAMP)
@@ -74,7 +77,7 @@ test-mpi: $(STAMP)
 	  $(BIN)/mpiexec -n $(NP) $(BIN)/python -m pytest -q -p no:cacheprovider tests/mpi --override-ini addopts= ; fi
 
 $(BENCH_STAMP): $(STAMP)
-	$(BIN)/python -m pip install -q -e '.[fem,test,bench]'
+	$(BIN)/python -m pip install -q --no-compile -e '.[fem,test,bench]'
 	@touch $(BENCH_STAMP)
 
 bench: $(BENCH_STAMP)
