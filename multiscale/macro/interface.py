@@ -114,7 +114,11 @@ class ContactInterface:
 
     def normal_force(self) -> float:
         """Total normal contact force [N] (integral of p_n, same quadrature as the residual)."""
-        return float(self.cache.facet_integrals("p", lambda: self.pressure).sum())
+        return float(self.facet_normal_force().sum())
+
+    def facet_normal_force(self) -> np.ndarray:
+        """Normal contact force per interface facet [N] (integral of p_n; global order, every rank)."""
+        return self.cache.facet_integrals("p", lambda: self.pressure)
 
     def force(self) -> np.ndarray:
         """Resultant interface force on body 0 [N] (3-vector: normal pressure plus friction)."""

@@ -32,6 +32,7 @@ from multiscale.macro.interface import ContactInterface, PressureLaw
 from multiscale.macro.kept_cells import (Closed, KeptCells, SolverOptionWarning, assemble, backtracking, check_user_options,
                                          destroy, integrals, jacobian, nonlinear_problem, options_named,
                                          user_options)
+from multiscale.macro.load_faces import load_face_areas
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
@@ -84,11 +85,6 @@ NEWTON_FLOOR, TINY_LOAD = 1e-10, 1e-8
 # N), and failed. A solve that stops short is accepted below it (``_newton``: a stall, not a runaway).
 ROUNDOFF, SNES_LINEAR_FAILED = 10.0, PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
 FACTOR_PRECISION = "single"
-# A fluid pressure on a face whose normals (nearly) cancel, a cylinder's wall, has no resultant: the
-# faceting of a closed band leaves a few per mille of its area as vector area (a 10 mm radius wall
-# meshed at 15 mm: 0.5 %, which the contact then carried). Below this share of the area it counts as
-# 0 (a dome has 0.5, a cone of 3 degrees half-angle 0.05).
-NO_RESULTANT = 0.05
 
 
 @dataclass
@@ -101,91 +97,6 @@ class SolveResult:
     residuals: list = field(default_factory=list)   # residual norm per Newton iteration
     normal_force: float = 0.0      # N, total contact force
     max_pressure: float = 0.0      # Pa, largest per-facet mean pressure
-
-
-def load_face_areas(tm: TwoBodyMesh, load_kind: str) -> dict:
-    """Area [m^2] of each load face whose product with a pressure is the face's resultant: the
-    face area for a traction along the load direction; for a fluid pressure (traction -p n) the
-    length of its vector area |int n dA|, the area projected normal to the resultant (a flat face:
-    its area; a hemisphere of radius R: pi R^2, not 2 pi R^2), 0 below ``NO_RESULTANT`` of the area.
-    A face made of flat parts that face opposite ways (one surface naming the backs of an inboard
-    and an outboard pad) counts with the sum of the parts' areas (``load_face_parts``): the
-    pressure pushes each part with its own resultant, and a force is their sum of magnitudes, as
-    over several load faces."""
-    if load_kind != "fluid":
-        return {f: tm.assemble_scalar(1.0 * tm.ds(tm.face(f))) for f in tm.spec.load_faces}
-    return {f: float(sum(np.linalg.norm(v) for v in parts)) for f, parts in load_face_parts(tm).items()}
-
-
-def load_face_parts(tm: TwoBodyMesh) -> dict:
-    """Vector areas int n dA [m^2] of the parts of each load face that a fluid pressure pushes as
-    one (-p times each is its resultant): the face's, or its two flat parts facing opposite ways
-    (``_opposite_parts``); none if it has no resultant (below ``NO_RESULTANT`` of its area)."""
-    out = {}
-    n = ufl.FacetNormal(tm.parent)
-    for f in tm.spec.load_faces:
-        ds = tm.ds(tm.face(f))
-        area = tm.assemble_scalar(1.0 * ds)
-        resultant = np.array([tm.assemble_scalar(n[i] * ds) for i in range(3)])
-        some = bool(np.linalg.norm(resultant) > NO_RESULTANT * area)
-        parts = _opposite_parts(tm, ds, resultant if some else None, area)
-        out[f] = parts if parts is not None else [resultant] if some else []
-    return out
-
-
-FLAT = 0.9     # a part of a load face is flat if its vector area is at least this share of its area
-
-
-def _opposite_parts(tm: TwoBodyMesh, ds, resultant, area: float) -> list | None:
-    """The vector areas of a face's two parts whose normals point along and against a direction
-    (the resultant's, or without one the principal direction of its normals) if both are flat
-    (``FLAT``) and each holds more than ``NO_RESULTANT`` of the area; else None (a dome, a
-    cylinder's wall). Measured: two pad backs of 400 and 900 mm^2 facing -z and +z as one surface
-    counted as its net 500 mm^2, so 1000 N asked put 800 N and 1800 N on the pads."""
-    n = ufl.FacetNormal(tm.parent)
-    if resultant is None:
-        moment = np.array([[tm.assemble_scalar(n[i] * n[j] * ds) for j in range(3)] for i in range(3)])
-        resultant = np.linalg.eigh(moment)[1][:, -1]
-    d = fem.Constant(tm.parent, np.asarray(resultant, dtype=float) / np.linalg.norm(resultant))
-    out = []
-    for side in (ufl.gt(ufl.dot(n, d), 0.0), ufl.lt(ufl.dot(n, d), 0.0)):
-        chi = ufl.conditional(side, 1.0, 0.0)
-        part = tm.assemble_scalar(chi * ds)
-        vector = np.array([tm.assemble_scalar(chi * n[i] * ds) for i in range(3)])
-        if not (part > NO_RESULTANT * area and np.linalg.norm(vector) >= FLAT * part):
-            return None
-        out.append(vector)
-    return out
-
-
-UNBALANCED = 0.01    # a clamp whose sides' resultants differ by more than this share of their sum is noted
-
-
-def clamp_imbalance(tm: TwoBodyMesh, pressure: float) -> str | None:
-    """A note if a fluid ``pressure`` [Pa] pushes load parts (``load_face_parts``) against each
-    other, clamping (an inboard and an outboard pad, a piston and a caliper's bore), with a net
-    resultant beyond ``UNBALANCED`` of their sum: the difference goes into the supports (the
-    disc's mount), not through both contacts; None otherwise (all parts push one way, a pin on a
-    disc: the whole load goes to the mount, as meant). Measured: pads of 400 and 900 mm^2 on both
-    sides of a disc under 2 MPa carried 800 N and 1800 N, the mount 1000 N, without a word."""
-    forces = [-pressure * v for parts in load_face_parts(tm).values() for v in parts]
-    if not any(a @ b < 0 for a in forces for b in forces):
-        return None
-    net, total = np.linalg.norm(np.sum(forces, axis=0)), sum(np.linalg.norm(f) for f in forces)
-    if net <= UNBALANCED * total:
-        return None
-    return (f"loading.faces = {list(tm.spec.load_faces)}: the load pushes parts against each other (clamping) with "
-            f"{', '.join(f'{np.linalg.norm(f):.4g}' for f in forces)} N; the difference, {net:.4g} N, goes into "
-            "the supports (the rotating body's mount), not through the contacts on both sides (a floating caliper "
-            "would balance them): give the sides equal areas if the clamp is meant to be balanced")
-
-
-def load_face_forces(tm: TwoBodyMesh, load: float, load_kind: str) -> dict:
-    """Resultant [N] of the load on each load face: its area's share of a force ``load`` [N]
-    (``load_kind="force"``), or the (fluid) pressure ``load`` [Pa] times its ``load_face_areas``."""
-    area = load_face_areas(tm, load_kind)
-    total = sum(area.values())
-    return {f: float(load) * (a / total if load_kind == "force" else a) for f, a in area.items()}
 
 
 class Mechanics:

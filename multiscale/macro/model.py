@@ -22,7 +22,8 @@ import numpy as np
 from multiscale.outputs import step_time
 from multiscale.errors import InputError
 from multiscale.geometry import Rotation
-from multiscale.macro.mechanics import Mechanics, SolveResult, clamp_imbalance, load_face_forces
+from multiscale.macro.load_faces import clamp_imbalance, load_face_forces
+from multiscale.macro.mechanics import Mechanics, SolveResult
 from multiscale.macro.mesh import TwoBodyMesh
 from multiscale.macro.preload import hold_moment
 from multiscale.macro.thermal import Thermal

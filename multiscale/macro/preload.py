@@ -25,7 +25,8 @@ from multiscale.macro.damped import LinearSystem
 from multiscale.macro.eigen import Damping
 from multiscale.macro.friction import friction_damping
 from multiscale.macro.materials import body_fields
-from multiscale.macro.mechanics import Mechanics, load_face_forces
+from multiscale.macro.load_faces import load_face_forces
+from multiscale.macro.mechanics import Mechanics
 from multiscale.macro.operators import (centrifugal_displacement, geometric_stiffness, material_damping,
                                         rotation_matrices)
 
@@ -87,11 +88,10 @@ def preload(mech: Mechanics, pressure: float, steps: int = 1, reset: bool = True
     if torque is not None:
         pressure, again = hold_moment(mech, pressure, torque)
         solved, loads = again or solved, load_face_forces(tm, pressure, mech.load_kind)
-    normal, tangential = {}, {}
     mu, masks = tm.interface.values(c.friction), tm.interface.masks()
-    for name, dS in tm.interface.dS_tag.items():
-        normal[name] = tm.assemble_scalar(c.pressure * dS)
-        tangential[name] = np.array([tm.assemble_scalar(c.friction_traction[i] * dS) for i in range(3)])
+    facet_normal, facet_friction = c.facet_normal_force(), c.facet_friction()
+    normal = {name: float(facet_normal[m].sum()) for name, m in masks.items()}
+    tangential = {name: facet_friction[m].sum(axis=0) for name, m in masks.items()}
     friction = {name: float(mu[m].mean()) for name, m in masks.items()}
     return Preload(float(pressure), friction, normal, tangential, loads,
                    solved.max_pressure, solved.iterations, list(solved.residuals),

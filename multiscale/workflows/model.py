@@ -38,7 +38,8 @@ from multiscale.geometry import GeometrySpec, Rotation, Support
 from multiscale.macro import mesh as two_body
 from multiscale.macro.interface import PenaltyLaw, SumLaw
 from multiscale.macro.kept_cells import SolverOptionWarning
-from multiscale.macro.mechanics import Mechanics, load_face_areas, load_face_forces
+from multiscale.macro.load_faces import load_face_areas, load_face_forces
+from multiscale.macro.mechanics import Mechanics
 from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
 

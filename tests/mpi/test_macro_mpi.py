@@ -20,6 +20,7 @@ from multiscale.scene import loads  # noqa: E402
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from test_macro_run import pin_on_disc  # noqa: E402
 from test_duty_cycle import PADS, heated_brake  # noqa: E402
+from test_macro_block import check_face_vector_areas  # noqa: E402
 
 
 def scene(folder):
@@ -113,3 +114,8 @@ def test_two_ranks_give_the_serial_per_pad_heat(tmp_path):
     on_rank_0 = world.bcast({k: parallel[k] for k in pads}, root=0)
     for key in pads:
         np.testing.assert_array_equal(parallel[key], on_rank_0[key], err_msg=key)
+
+
+def test_a_faces_vector_areas_on_two_ranks():
+    """Each owned facet counted once: the sums over both ranks are DOLFINx's integrals."""
+    check_face_vector_areas(MPI.COMM_WORLD)
