@@ -313,11 +313,14 @@ def test_a_derivative_block_that_expands_to_zero_is_none(tm):
 def check_face_vector_areas(comm, names=("piston_back", "piston_wall", "disc_mount")) -> None:
     """The disc brake's (20 mm) faces: ``face_vector_areas`` summed over the ranks of ``comm`` are
     DOLFINx's integrals of 1 and of n over ``ds(tag)``, to 1e-12 of the area: a flat face
-    (piston_back), a cylinder's wall whose normals nearly cancel (piston_wall), a mount."""
+    (piston_back), a cylinder's wall whose normals nearly cancel (piston_wall), a mount. The
+    interface facets' areas (global order) are the integrals of 1 over each."""
     import ufl
     from dolfinx import fem
     from mpi4py import MPI
     tm = mesh.build(builder("disc_brake"), {"mesh_size": 0.02}, comm=comm)
+    per_facet = mesh.FormCache(tm).facet_integrals(None, lambda: ufl.as_ufl(1.0))
+    np.testing.assert_allclose(tm.interface.areas, per_facet, rtol=1e-12)
     n, e = ufl.FacetNormal(tm.parent), fem.Constant(tm.parent, np.zeros(3))
     for name in names:
         ds = tm.ds(tm.face(name))
@@ -336,6 +339,7 @@ def check_face_vector_areas(comm, names=("piston_back", "piston_wall", "disc_mou
 
 def test_a_faces_vector_areas_are_the_integrals_of_its_normal():
     """``TwoBodyMesh.face_vector_areas`` sums the facets' areas and outward normals (exact on the
-    linear tetrahedra) where a form per face and component was compiled before (~0.4 s each)."""
+    linear tetrahedra) where a form per face and component was compiled before (~0.4 s each); the
+    interface's facet areas likewise (a form per set of interface tags before)."""
     from mpi4py import MPI
     check_face_vector_areas(MPI.COMM_WORLD)

@@ -43,16 +43,23 @@ class Crossing:
     where: np.ndarray     # centroid of that triangle [m]
 
 
+def vector_areas(triangles: np.ndarray) -> np.ndarray:
+    """Vector areas [m^2] of straight-sided triangles (n, 3, 3) [m]: half the cross product of
+    two edges, (n, 3), along the normal of the vertices' right-hand order."""
+    x = np.asarray(triangles, dtype=float).reshape(-1, 3, 3)
+    return 0.5 * np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+
+
 def crossing(triangles: np.ndarray, motion, comm) -> Crossing:
     """How much of a surface, the (owned) ``triangles`` (n, 3, 3) [m] of every rank, the rigid
     ``motion`` crosses: |w.n| > ``CROSSES`` |w| at a triangle's centroid (collective)."""
     x = np.asarray(triangles, dtype=float).reshape(-1, 3, 3)
-    n = np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
-    area = 0.5 * np.linalg.norm(n, axis=1)
+    n = vector_areas(x)
+    area = np.linalg.norm(n, axis=1)
     mid = x.mean(axis=1)
     w = motion.velocity(mid)
     speed = np.linalg.norm(w, axis=1)
-    cos = np.abs((w * n).sum(axis=1)) / np.maximum(speed * 2 * area, np.finfo(float).tiny)
+    cos = np.abs((w * n).sum(axis=1)) / np.maximum(speed * area, np.finfo(float).tiny)
     crossed = cos > CROSSES
     sums = comm.allreduce(np.array([(area * speed)[crossed].sum(), (area * speed).sum()]), op=MPI.SUM)
     k = int(np.argmax(cos)) if len(cos) else -1
@@ -135,10 +142,10 @@ class Interface:
     tags: dict
     measure: ufl.Measure
     midpoints: np.ndarray              # m, global
+    areas: np.ndarray                  # m^2, global
     owned_index: np.ndarray            # global index of the owned submesh cells 0..n_owned-1
     tag_index: np.ndarray              # global: index into ``tags`` of every facet
     plus_regions: dict                 # interface name -> region (cell) tags of body 0 along it
-    areas: np.ndarray = field(default=None)   # m^2, global
     _dg0: fem.FunctionSpace = field(default=None, repr=False)
     _dg0_vector: fem.FunctionSpace = field(default=None, repr=False)
 
@@ -309,7 +316,7 @@ class TwoBodyMesh:
         x = m.geometry.x[dmesh.entities_to_geometry(m, tdim - 1, facets)]                     # (n, 3, 3)
         cells = np.array([f2c.links(f)[0] for f in facets], dtype=np.int32)
         inside = m.geometry.x[dmesh.entities_to_geometry(m, tdim, cells)].mean(axis=1)    # a point of the cell
-        n = 0.5 * np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
+        n = vector_areas(x)
         return np.where((((inside - x[:, 0]) * n).sum(axis=1) > 0)[:, None], -n, n)
 
     def body_of_face(self, name: str) -> int:
@@ -421,9 +428,7 @@ def from_mesh(spec: GeometrySpec, parent: dmesh.Mesh, cell_tags: dmesh.MeshTags,
     parent.topology.create_connectivity(tdim, tdim - 1)
     bodies = tuple(_body(parent, cell_tags, facet_tags, b) for b in spec.bodies)
     interface = _interface(parent, cell_tags, facet_tags, spec, bodies)
-    tm = TwoBodyMesh(spec, parent, cell_tags, facet_tags, bodies, interface)
-    interface.areas = FormCache(tm).facet_integrals(None, lambda: ufl.as_ufl(1.0))
-    return tm
+    return TwoBodyMesh(spec, parent, cell_tags, facet_tags, bodies, interface)
 
 
 def _body(parent, cell_tags, facet_tags, spec: BodySpec) -> Body:
@@ -464,6 +469,8 @@ def _interface(parent, cell_tags, facet_tags, spec: GeometrySpec, bodies) -> Int
                           metadata={"quadrature_degree": INTERFACE_QUADRATURE})
     mid_local = dmesh.compute_midpoints(sub, tdim - 1, np.arange(n_owned, dtype=np.int32))
     midpoints = np.concatenate(comm.allgather(mid_local)).reshape(-1, 3)
+    areas = np.concatenate(comm.allgather(np.linalg.norm(vector_areas(sub.geometry.x[sub.geometry.dofmaps[0][:n_owned]]),
+                                                         axis=1)))
     counts = comm.allgather(n_owned)
     key = np.round(midpoints / spec.length_scale, 9)
     order = np.lexsort(key.T[::-1])                  # sort by x, then y, then z
@@ -473,7 +480,8 @@ def _interface(parent, cell_tags, facet_tags, spec: GeometrySpec, bodies) -> Int
     owned_index = rank_of_sorted[start:start + n_owned]
     tag_index = np.empty(len(order), dtype=int)
     tag_index[np.concatenate(comm.allgather(owned_index))] = np.concatenate(comm.allgather(tag_of_cell))
-    return Interface(sub, facet_map, dict(spec.interfaces), measure, midpoints[order], owned_index, tag_index, plus)
+    return Interface(sub, facet_map, dict(spec.interfaces), measure, midpoints[order], areas[order], owned_index,
+                     tag_index, plus)
 
 
 def _orient(rows: np.ndarray, bodies, name: str) -> np.ndarray:
