@@ -343,3 +343,27 @@ def test_a_faces_vector_areas_are_the_integrals_of_its_normal():
     interface's facet areas likewise (a form per set of interface tags before)."""
     from mpi4py import MPI
     check_face_vector_areas(MPI.COMM_WORLD)
+
+
+def test_interface_forms_do_not_depend_on_the_geometrys_interface_tag(tm):
+    """A tag is a number of the compiled form: the interface measure's ids are the interfaces'
+    positions (0, 1, ...), so the same mesh with its interface tagged 21 instead of 10 gives the
+    same interface forms (UFL signatures), and the same integrals."""
+    import dataclasses
+    import ufl
+    from dolfinx import fem
+    from dolfinx import mesh as dmesh
+    (name, tag), = tm.spec.interfaces.items()
+    ft = tm.facet_tags
+    values = np.where(ft.values == tag, 21, ft.values).astype(ft.values.dtype)
+    other = mesh.from_mesh(dataclasses.replace(tm.spec, interfaces={name: 21}), tm.parent, tm.cell_tags,
+                           dmesh.meshtags(tm.parent, ft.dim, ft.indices, values))
+
+    def per_facet(t):
+        x = ufl.SpatialCoordinate(t.parent)
+        form = ufl.inner(x[0] ** 2, ufl.TestFunction(t.interface.space)("+")) * t.interface.dS
+        return form.signature(), mesh.FormCache(t).facet_integrals(None, lambda: x[0] ** 2)
+    (signature, values), (other_signature, other_values) = per_facet(tm), per_facet(other)
+    assert other.interface.tags == {name: 21} and signature == other_signature
+    np.testing.assert_allclose(other_values, values, rtol=1e-14)
+    assert values.sum() > 0

@@ -131,7 +131,9 @@ class Body:
 class Interface:
     """The contact interface: a facet submesh, its measure and a rank-independent facet ordering.
 
-    ``dS`` integrates over all interface tags ("+" = body 0); ``dS_tag[name]`` over one tag.
+    ``dS`` integrates over all interfaces ("+" = body 0); ``dS_tag[name]`` over one. The measure's
+    subdomain ids are the interfaces' positions in ``tags`` (0, 1, ...), not the geometry's tags: a
+    tag is a number of the compiled form, and scenes whose interfaces are tagged otherwise share it.
     ``midpoints`` (n_facets, 3), ``areas`` (n_facets,) and ``tag_index`` (n_facets,: position of
     each facet's tag in ``tags``) are global and the same on every rank; ``owned_index`` gives the
     global index of each owned facet of the submesh.
@@ -151,11 +153,11 @@ class Interface:
 
     @property
     def dS(self):
-        return self.measure(tuple(self.tags.values()))
+        return self.measure(tuple(range(len(self.tags))))
 
     @property
     def dS_tag(self) -> dict:
-        return {name: self.measure(tag) for name, tag in self.tags.items()}
+        return {name: self.measure(k) for k, name in enumerate(self.tags)}
 
     @property
     def n_facets(self) -> int:
@@ -456,14 +458,14 @@ def _interface(parent, cell_tags, facet_tags, spec: GeometrySpec, bodies) -> Int
     tag_of_cell = np.full(n_owned, -1)
     region_of = np.full(parent.topology.index_map(tdim).size_local + parent.topology.index_map(tdim).num_ghosts, -1)
     region_of[cell_tags.indices] = cell_tags.values
-    for k, (name, tag) in enumerate(spec.interfaces.items()):
+    for k, name in enumerate(spec.interfaces):
         cells = facet_map.sub_topology_to_topology(facets[name].astype(np.int32), inverse=True)
         cells = cells[(cells >= 0) & (cells < n_owned)]
         tag_of_cell[cells] = k
         rows = fem.compute_integration_domains(fem.IntegralType.interior_facet, parent.topology,
                                                facets[name].astype(np.int32))
         rows = _orient(np.asarray(rows, dtype=np.int32).reshape(-1, 4), bodies, name)
-        data.append((tag, rows.ravel()))
+        data.append((k, rows.ravel()))         # ids 0, 1, ...: scenes of other tags share the forms
         plus[name] = tuple(sorted(set().union(*comm.allgather(set(region_of[rows[:, 0]].tolist())))))
     measure = ufl.Measure("dS", domain=parent, subdomain_data=data,
                           metadata={"quadrature_degree": INTERFACE_QUADRATURE})
