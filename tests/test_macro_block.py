@@ -367,3 +367,31 @@ def test_interface_forms_do_not_depend_on_the_geometrys_interface_tag(tm):
     assert other.interface.tags == {name: 21} and signature == other_signature
     np.testing.assert_allclose(other_values, values, rtol=1e-14)
     assert values.sum() > 0
+
+
+def test_body_forms_do_not_depend_on_the_geometrys_region_tags(tm):
+    """The bodies' volume measure has ids 0 and 1 (``body_dx``), not the region tags: the same mesh
+    with its regions tagged 41, 42 instead of 1, 2 gives the same body forms (UFL signatures) and
+    integrals; the region measure ``dx(tag)`` integrates the same body."""
+    import dataclasses
+    import ufl
+    from dolfinx import fem
+    from dolfinx import mesh as dmesh
+    from mpi4py import MPI
+    ct, shift = tm.cell_tags, 40
+    bodies = tuple(dataclasses.replace(b, regions=tuple(dataclasses.replace(r, tag=r.tag + shift) for r in b.regions))
+                   for b in tm.spec.bodies)
+    other = mesh.from_mesh(dataclasses.replace(tm.spec, bodies=bodies), tm.parent,
+                           dmesh.meshtags(tm.parent, ct.dim, ct.indices, ct.values + shift), tm.facet_tags)
+
+    def body_integrals(t):
+        x = ufl.SpatialCoordinate(t.parent)
+        forms = [x[0] ** 2 * t.body_dx(i) for i in range(2)]
+        return ([f.signature() for f in forms],
+                [t.comm.allreduce(fem.assemble_scalar(fem.form(f)), op=MPI.SUM) for f in forms])
+    (signatures, values), (other_signatures, other_values) = body_integrals(tm), body_integrals(other)
+    assert signatures == other_signatures and min(values) > 0
+    np.testing.assert_allclose(other_values, values, rtol=1e-14)
+    x = ufl.SpatialCoordinate(tm.parent)
+    by_region = sum(fem.assemble_scalar(fem.form(x[0] ** 2 * tm.dx(r.tag))) for r in tm.spec.bodies[1].regions)
+    assert tm.comm.allreduce(by_region, op=MPI.SUM) == pytest.approx(values[1], rel=1e-12)

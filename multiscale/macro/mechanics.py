@@ -311,7 +311,7 @@ class Mechanics:
 
     def dx(self, i: int):
         """Volume measure over the regions of body i (on the parent mesh)."""
-        return self.tm.dx(tuple(r.tag for r in self.tm.bodies[i].spec.regions))
+        return self.tm.body_dx(i)
 
     def stress(self, i: int):
         """Cauchy stress of body i [Pa], sigma = C(T):(eps − alpha(T) (T − T_ref) I)."""

@@ -259,10 +259,23 @@ class TwoBodyMesh:
     facet_tags: dmesh.MeshTags
     bodies: tuple[Body, Body]
     interface: Interface
+    _bodies_dx: ufl.Measure = field(init=False, repr=False)
+
+    def __post_init__(self):
+        owned = self.parent.topology.index_map(self.parent.topology.dim).size_local
+        cells = [np.unique(np.concatenate([self.cell_tags.find(r.tag) for r in b.spec.regions])) for b in self.bodies]
+        self._bodies_dx = ufl.Measure("dx", domain=self.parent,
+                                      subdomain_data=[(i, c[c < owned].astype(np.int32)) for i, c in enumerate(cells)])
 
     @property
     def comm(self):
         return self.parent.comm
+
+    def body_dx(self, i: int, degree: int | None = None, scheme: str | None = None) -> ufl.Measure:
+        """Volume measure of body ``i`` (optionally a quadrature degree and scheme). Its subdomain
+        ids are the bodies' indices (0, 1), not the geometry's region tags: a tag is a number of the
+        compiled form, and scenes whose regions are tagged otherwise share it."""
+        return self._bodies_dx(i, degree=degree, scheme=scheme)
 
     @property
     def entity_maps(self) -> list:
@@ -270,6 +283,7 @@ class TwoBodyMesh:
 
     @property
     def dx(self) -> ufl.Measure:
+        """Volume measure of the geometry's region tags (``body_dx``: of a body)."""
         return ufl.Measure("dx", domain=self.parent, subdomain_data=self.cell_tags)
 
     @property
