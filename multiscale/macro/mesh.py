@@ -91,6 +91,12 @@ class Body:
         return self.spec.name
 
     @property
+    def owned_parent_cells(self) -> np.ndarray:
+        """Parent-mesh indices of the body's owned cells (sorted)."""
+        n = self.mesh.topology.index_map(self.mesh.topology.dim).size_local
+        return np.sort(self.cell_map.sub_topology_to_topology(np.arange(n, dtype=np.int32), inverse=False))
+
+    @property
     def region_space(self) -> fem.FunctionSpace:
         return fem.functionspace(self.mesh, ("DG", 0))
 
@@ -262,10 +268,8 @@ class TwoBodyMesh:
     _bodies_dx: ufl.Measure = field(init=False, repr=False)
 
     def __post_init__(self):
-        owned = self.parent.topology.index_map(self.parent.topology.dim).size_local
-        cells = [np.unique(np.concatenate([self.cell_tags.find(r.tag) for r in b.spec.regions])) for b in self.bodies]
         self._bodies_dx = ufl.Measure("dx", domain=self.parent,
-                                      subdomain_data=[(i, c[c < owned].astype(np.int32)) for i, c in enumerate(cells)])
+                                      subdomain_data=[(i, b.owned_parent_cells) for i, b in enumerate(self.bodies)])
 
     @property
     def comm(self):
