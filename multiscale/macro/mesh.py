@@ -50,6 +50,13 @@ def vector_areas(triangles: np.ndarray) -> np.ndarray:
     return 0.5 * np.cross(x[:, 1] - x[:, 0], x[:, 2] - x[:, 0])
 
 
+def _attached_cells(f2c, facets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(number of cells, first cell) of each of ``facets`` by the facet-to-cell connectivity ``f2c``
+    (one cell: an exterior facet)."""
+    offsets = f2c.offsets
+    return offsets[facets + 1] - offsets[facets], f2c.array[offsets[facets]].astype(np.int32)
+
+
 def crossing(triangles: np.ndarray, motion, comm) -> Crossing:
     """How much of a surface, the (owned) ``triangles`` (n, 3, 3) [m] of every rank, the rigid
     ``motion`` crosses: |w.n| > ``CROSSES`` |w| at a triangle's centroid (collective)."""
@@ -313,8 +320,7 @@ class TwoBodyMesh:
             raise InputError("surfaces", name, f"free:<body or region>, one of {', '.join(dict.fromkeys(known))}")
         tdim = self.parent.topology.dim
         facets = dmesh.exterior_facet_indices(self.parent.topology)
-        f2c = self.parent.topology.connectivity(tdim - 1, tdim)
-        cells = np.array([f2c.links(f)[0] for f in facets], dtype=np.int32)
+        cells = _attached_cells(self.parent.topology.connectivity(tdim - 1, tdim), facets)[1]
         region = np.full(self.parent.topology.index_map(tdim).size_local
                          + self.parent.topology.index_map(tdim).num_ghosts, -1)
         region[self.cell_tags.indices] = self.cell_tags.values
@@ -331,10 +337,9 @@ class TwoBodyMesh:
         m, tdim = self.parent, self.parent.topology.dim
         facets = self.facet_tags.find(self.face(name))
         facets = facets[facets < m.topology.index_map(tdim - 1).size_local]      # owned: each once
-        f2c = m.topology.connectivity(tdim - 1, tdim)
-        facets = facets[np.array([len(f2c.links(f)) == 1 for f in facets], dtype=bool)]    # what ds sees
+        count, cells = _attached_cells(m.topology.connectivity(tdim - 1, tdim), facets)
+        facets, cells = facets[count == 1], cells[count == 1]                              # what ds sees
         x = m.geometry.x[dmesh.entities_to_geometry(m, tdim - 1, facets)]                     # (n, 3, 3)
-        cells = np.array([f2c.links(f)[0] for f in facets], dtype=np.int32)
         inside = m.geometry.x[dmesh.entities_to_geometry(m, tdim, cells)].mean(axis=1)    # a point of the cell
         n = vector_areas(x)
         return np.where((((inside - x[:, 0]) * n).sum(axis=1) > 0)[:, None], -n, n)

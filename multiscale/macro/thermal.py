@@ -254,7 +254,7 @@ class Thermal:
     def _dx(self, i: int, degree: int | None = None, scheme: str | None = None):
         """Volume measure of body i on the parent mesh (optionally a fixed quadrature degree, or
         the "vertex" scheme: the nodal values weighted by a quarter of each tetrahedron)."""
-        return self.tm.body_dx(i, degree=1, scheme=scheme) if scheme is not None else self.tm.body_dx(i, degree)
+        return self.tm.body_dx(i, degree=1 if scheme is not None else degree, scheme=scheme)
 
     def _storage_dx(self, i: int):
         """Measure of body i's storage term (and stored heat): the vertex rule, i.e. a lumped
