@@ -8,6 +8,7 @@ from petsc4py import PETSc
 
 from multiscale.errors import InputError
 from multiscale.macro import damped, eigen
+from multiscale.macro.dense import block_solve
 from multiscale.macro.friction import StribeckFriction, TableFriction
 from multiscale.macro.stability_map import BELOW, build_map
 from multiscale.references.stability import (belt_onset_speed, damped_hoffmann_onset, hoffmann_matrices,
@@ -146,6 +147,31 @@ def test_loss_factors_with_friction_are_projected_with_the_left_modes():
     ref = ref[ref.imag / (2 * np.pi) <= 2e3]
     assert len(r) == ref.size == 8 and ref[0].real > 3.0
     np.testing.assert_allclose(r.eigenvalues, ref, rtol=1e-5)
+
+
+def test_the_left_modes_are_solved_with_the_right_modes_factors_transposed():
+    """The modes of (K^T, M) by shift-and-invert through the transposed solves of the factors of
+    K - theta_t M (``transpose_of``; no second LU) on a chain with skew couplings strong enough for
+    lock-in (complex theta): the eigenvalues of its own factorisation (1e-10) and eigenvectors of
+    (K^T, M) (relative residual 1e-9), and the factors solve (K - theta_t M) x = b and the
+    transposed system as numpy does (1e-10)."""
+    K, M = chain(40)
+    for i in range(0, 37, 9):
+        K[i, i + 2] += 4e6
+        K[i + 2, i] -= 4e6
+    band = dict(f_max=3e3, target=1e3)
+    own = eigen.solve_modes(petsc_mat(K.T), petsc_mat(M), **band)
+    B = np.random.default_rng(1).standard_normal((40, 3))
+    A = K - (2 * np.pi * band["target"]) ** 2 * M
+    with eigen.shift_invert_modes(petsc_mat(K), petsc_mat(M), **band) as (right, factors):
+        np.testing.assert_allclose(block_solve(factors, B), np.linalg.solve(A, B), rtol=1e-10)
+        np.testing.assert_allclose(block_solve(factors, B, transpose=True), np.linalg.solve(A.T, B), rtol=1e-10)
+        left = eigen.solve_modes(petsc_mat(K.T), petsc_mat(M), **band, transpose_of=factors)
+    assert np.iscomplex(left.theta).sum() == 12
+    np.testing.assert_allclose(left.eigenvalues, own.eigenvalues, rtol=1e-10)
+    np.testing.assert_allclose(left.eigenvalues, right.eigenvalues, rtol=1e-10)
+    residual = K.T @ left.modes - M @ left.modes * left.theta
+    assert np.all(np.linalg.norm(residual, axis=0) < 1e-9 * np.linalg.norm(K.T @ left.modes, axis=0))
 
 
 def segment_stiffness(n, k, first, last):

@@ -23,10 +23,11 @@ H += eta K. ``solve_system`` picks the method:
   each eigenvalue exact (the two-sided Rayleigh quotient): on the right modes alone, a bar of two
   prisms with loss factors 0.02 and friction 0.2 had the instability of every lock-in pair on
   the wrong member (264.5 Hz unstable where a dense solve has 267.8 Hz; an adversarial test); with
-  them every eigenvalue is within 2e-6 of the dense solve, at the cost of a second modal solve.
+  them every eigenvalue is within 2e-6 of the dense solve, at the cost of a second modal solve
+  (without a second factorisation: ``eigen.shift_invert_modes(transpose_of=...)``).
   With hysteretic terms H the basis also holds the static responses to their forces,
   (K - theta_t M)^-1 H phi of the right and (K^T - theta_t M)^-1 H psi of the left modes in the
-  band (those of the modes above it, which only pad the basis, changed little), with one
+  band (those of the modes above it, which only pad the basis, changed little), by the same
   LU of K - theta_t M (modal truncation augmentation, Dickens, Nakagawa & Wittbrodt, Comput.
   Struct. 62 (1997) 985): a loss factor of one part (the pad) loads the part's faces to its
   neighbours with eta K_b phi, which no mode of the band balances. On the 20-mm demo brake (pad
@@ -63,9 +64,9 @@ from petsc4py import PETSc
 
 from multiscale.errors import InputError
 from multiscale.macro.block_lanczos import ShiftInvert, m_orthonormalise, symmetric_modes
-from multiscale.macro.dense import mat_mult
+from multiscale.macro.dense import block_solve, mat_mult
 from multiscale.macro.eigen import (TWO_PI, Damping, ModalResult, by_frequency, lambda_from_theta, matrix_comm,
-                                    reduce_sum, solve_modes, solve_quadratic)
+                                    reduce_sum, shift_invert_modes, solve_modes, solve_quadratic)
 from multiscale.macro.modal import mac_matrix, pair_modes
 
 METHODS = ("auto", "projection", "quadratic", "subspace")
@@ -253,42 +254,39 @@ def basis_modes(system: LinearSystem, *, band, n_modes, target, basis: float, le
     """The undamped modes of (K, M) in the projection basis' band (``basis_band``) and the vectors
     that span the basis: those modes, with ``left`` and K not symmetric (friction) the modes of
     (K^T, M), the left eigenvectors, and with hysteretic terms the static responses to their forces
-    of the modes in ``band`` (``hysteretic_corrections``; module docstring)."""
+    of the modes in ``band`` (``hysteretic_corrections``; module docstring). One LU of
+    K - theta_t M serves them all, solved transposed for the left modes and their responses."""
     wanted = basis_band(band, n_modes, target, basis)
-    base = solve_modes(system.K, system.M, **wanted, **kw)
-    found = [base]
-    if left:
-        KT = PETSc.Mat()
-        system.K.transpose(KT)            # a new matrix (without one, petsc4py transposes in place)
-        try:
-            skew = KT.copy()
-            skew.axpy(-1.0, system.K)
-            asymmetric = skew.norm(PETSc.NormType.INFINITY) > SYMMETRIC * system.K.norm(PETSc.NormType.INFINITY)
-            skew.destroy()
-            if asymmetric:
-                found.append(solve_modes(KT, system.M, **wanted, **kw))
-        finally:
-            KT.destroy()
-    vectors = [r.modes for r in found]
-    if system.H is not None:          # the modes of the band itself; those above it pad the basis
-        inside = [r.modes[:, (r.frequency >= band[0]) & (r.frequency <= band[1])] for r in found]
-        vectors += hysteretic_corrections(system, (TWO_PI * wanted["target"]) ** 2, *inside)
+    with shift_invert_modes(system.K, system.M, **wanted, **kw) as (base, factors):
+        found = [base]
+        if left:
+            KT = PETSc.Mat()
+            system.K.transpose(KT)            # a new matrix (without one, petsc4py transposes in place)
+            try:
+                skew = KT.copy()
+                skew.axpy(-1.0, system.K)
+                asymmetric = skew.norm(PETSc.NormType.INFINITY) > SYMMETRIC * system.K.norm(PETSc.NormType.INFINITY)
+                skew.destroy()
+                if asymmetric:
+                    found.append(solve_modes(KT, system.M, **wanted, **kw, transpose_of=factors))
+            finally:
+                KT.destroy()
+        vectors = [r.modes for r in found]
+        if system.H is not None:          # the modes of the band itself; those above it pad the basis
+            inside = [r.modes[:, (r.frequency >= band[0]) & (r.frequency <= band[1])] for r in found]
+            vectors += hysteretic_corrections(system.H, factors, *inside)
     return base, vectors
 
 
-def hysteretic_corrections(system: LinearSystem, shift: float, right: np.ndarray,
+def hysteretic_corrections(H: PETSc.Mat, factors: PETSc.KSP, right: np.ndarray,
                            left: np.ndarray | None = None) -> list:
     """Static responses to the hysteretic forces of the basis modes, (K - theta_t M)^-1 H phi of
     the right modes phi and (K^T - theta_t M)^-1 H psi of the left modes psi (real and imaginary
-    parts), with one LU of K - theta_t M (modal truncation augmentation, Dickens, Nakagawa &
+    parts), by the ``factors`` of K - theta_t M (modal truncation augmentation, Dickens, Nakagawa &
     Wittbrodt, Comput. Struct. 62 (1997) 985; module docstring)."""
-    factors = ShiftInvert(system.K, system.M, shift, prefix="corrections_", symmetric=False)
-    try:
-        out = [factors.solve(mat_mult(system.H, real_columns(right)))]
-        if left is not None:
-            out.append(factors.solve(mat_mult(system.H, real_columns(left)), transpose=True))
-    finally:
-        factors.destroy()
+    out = [block_solve(factors, mat_mult(H, real_columns(right)))]
+    if left is not None:
+        out.append(block_solve(factors, mat_mult(H, real_columns(left)), transpose=True))
     return out
 
 

@@ -24,9 +24,10 @@ from __future__ import annotations
 import csv
 import math
 import time
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Callable
+from typing import Callable, Iterator
 
 import numpy as np
 from mpi4py import MPI
@@ -261,8 +262,8 @@ def by_frequency(lam: np.ndarray, rtol: float = 1e-9) -> np.ndarray:
     return order[np.lexsort((lam.real[order], group))]
 
 
-def _sorted(lam, theta, vecs, errs, band, seen_f):
-    """Modes sorted by frequency then growth; none (an empty band) is an InputError.
+def _sorted(lam, band, seen_f) -> np.ndarray:
+    """The order of the modes by frequency then growth; none (an empty band) is an InputError.
 
     ``seen_f`` are the frequencies [Hz] of every converged eigenvalue (for the message).
     """
@@ -270,14 +271,34 @@ def _sorted(lam, theta, vecs, errs, band, seen_f):
         hint = (f"nearest found: {seen_f[np.argmin(np.minimum(abs(seen_f - band[0]), abs(seen_f - band[1])))]:.6g} Hz"
                 if seen_f.size else "none found")
         raise InputError("f_max", band, f"no eigenvalue in this frequency band [Hz]; widen it ({hint})")
-    order = by_frequency(lam)
-    return lam[order], theta[order], vecs[:, order], errs[order]
+    return by_frequency(lam)
 
 
-def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int | None = None,
-                target: float | None = None, damping: Damping | None = None, tol: float = 1e-10,
-                max_it: int = 300, nev: int = 20, options_prefix: str = "stability_") -> ModalResult:
-    """Modes with f_min <= f <= f_max [Hz] of K phi = theta M phi (GNHEP, shift-and-invert, §4.3.1).
+def solve_modes(K, M, **kw) -> ModalResult:
+    """Modes with f_min <= f <= f_max [Hz] of K phi = theta M phi (GNHEP, shift-and-invert, §4.3.1):
+    ``shift_invert_modes``' result, its factors freed."""
+    with shift_invert_modes(K, M, **kw) as (result, _):
+        return result
+
+
+class TransposedSolve:
+    """A PETSc python PC: the transposed solve of another KSP's factors (``solveTranspose``)."""
+
+    def __init__(self, ksp: PETSc.KSP):
+        self.ksp = ksp
+
+    def apply(self, pc, x, y) -> None:
+        self.ksp.solveTranspose(x, y)
+
+
+@contextmanager
+def shift_invert_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int | None = None,
+                       target: float | None = None, damping: Damping | None = None, tol: float = 1e-10,
+                       max_it: int = 300, nev: int = 20, options_prefix: str = "stability_",
+                       transpose_of: PETSc.KSP | None = None) -> Iterator[tuple[ModalResult, PETSc.KSP]]:
+    """Modes with f_min <= f <= f_max [Hz] of K phi = theta M phi (GNHEP, shift-and-invert, §4.3.1)
+    and, inside the block, the KSP of the shift-and-invert: its factors of K - theta_t M solve blocks
+    both ways (``dense.block_solve``).
 
     ``K`` (tangent, may be non-symmetric) and ``M`` (mass, diag 0 on Dirichlet rows so that the
     constrained modes go to infinity) are assembled PETSc matrices. The shift is
@@ -286,8 +307,10 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
     subspace grows (from ``nev``) until every theta with |theta - theta_t| <= max((2 pi f_max)^2 -
     theta_t, theta_t - (2 pi f_min)^2) is converged, i.e. the band is complete for modes with
     |sigma| << omega, or until ``n_modes`` band modes nearest the target are found (a cap; the
-    conjugate partner of the last one is kept with it). Raises InputError for a bad request or an
-    empty band, ConvergenceError if SLEPc does not converge.
+    conjugate partner of the last one is kept with it). ``transpose_of``: the KSP of this block for
+    the transposed pencil (K^T, M) at the same band: its factors, solved transposed, invert
+    K - theta_t M here, so that the left modes need no second factorisation. Raises InputError for a
+    bad request or an empty band, ConvergenceError if SLEPc does not converge.
     """
     f_min, f_max, target = check_band(f_min, f_max, target, n_modes)
     t0 = time.perf_counter()
@@ -300,57 +323,63 @@ def solve_modes(K, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int |
     want = min(max(int(nev), int(n_modes or 0) + 1), n)     # + 1: the last mode's conjugate partner
 
     eps = SLEPc.EPS().create(K.getComm())
-    eps.setOperators(K, M)
-    eps.setProblemType(SLEPc.EPS.ProblemType.GNHEP)
-    eps.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
-    _shift_invert(eps, shift, tol, max_it, options_prefix)
-    failure = ("target", target, "K - (2 pi target)^2 M could not be factorised (singular at this shift? "
-                                 "choose a target > 0 away from an eigenvalue)")
-    solves = 0
-    while True:
-        _set_up(eps, want, failure)
-        eps.solve()
-        solves += 1
-        nconv = eps.getConverged()
-        if nconv < want:
-            raise ConvergenceError(f"SLEPc converged {nconv} of {want} eigenpairs "
-                                   f"(reason {eps.getConvergedReason()})",
-                                   history=[eps.getIterationNumber()])
-        theta = np.array([eps.getEigenvalue(i) for i in range(nconv)], dtype=complex)
-        order = np.argsort(np.abs(theta - shift), kind="stable")[:want]   # complete up to 'reached'
-        reached = abs(theta[order[-1]] - shift)
-        f = lambda_from_theta(theta[order]).imag / TWO_PI
-        inband = order[(f >= f_min) & (f <= f_max)]
-        if n_modes is not None and inband.size >= n_modes:
-            keep = inband[:n_modes]
-            partner = inband[n_modes:n_modes + 1]
-            if partner.size and np.isclose(theta[partner[0]], theta[keep[-1]].conjugate(), rtol=1e-10):
-                keep = inband[:n_modes + 1]
-            break
-        if reached > radius or want >= n:
-            keep = inband
-            break
-        # Weyl: the count of theta below R grows like R^(3/2) in 3D; aim 20 % beyond the band.
-        grow = (1.2 * radius / max(reached, 1e-300)) ** 1.5
-        if n_modes is not None and inband.size:
-            grow = min(grow, 1.2 * n_modes / inband.size)
-        want = min(n, max(want + 10, int(math.ceil(want * min(grow, 8.0)))))
-
     vr, vi = K.createVecs()
-    vecs = np.empty((vr.getLocalSize(), keep.size), dtype=complex)
-    errs = np.empty(keep.size)
-    vals = np.empty(keep.size, dtype=complex)
-    for j, i in enumerate(keep):
-        vals[j], vecs[:, j] = _pairs(eps, int(i), vr, vi)
-        errs[j] = eps.computeError(int(i), SLEPc.EPS.ErrorType.RELATIVE)
-    iterations = eps.getIterationNumber()
-    eps.destroy(), vr.destroy(), vi.destroy()
+    try:
+        eps.setOperators(K, M)
+        eps.setProblemType(SLEPc.EPS.ProblemType.GNHEP)
+        eps.setType(SLEPc.EPS.Type.KRYLOVSCHUR)
+        _shift_invert(eps, shift, tol, max_it, options_prefix)
+        if transpose_of is not None:
+            eps.getST().setMatMode(SLEPc.ST.MatMode.SHELL)     # K - theta_t M is never formed
+            pc = eps.getST().getKSP().getPC()
+            pc.setType(PETSc.PC.Type.PYTHON)
+            pc.setPythonContext(TransposedSolve(transpose_of))
+        failure = ("target", target, "K - (2 pi target)^2 M could not be factorised (singular at this shift? "
+                                     "choose a target > 0 away from an eigenvalue)")
+        solves = 0
+        while True:
+            _set_up(eps, want, failure)
+            eps.solve()
+            solves += 1
+            nconv = eps.getConverged()
+            if nconv < want:
+                raise ConvergenceError(f"SLEPc converged {nconv} of {want} eigenpairs "
+                                       f"(reason {eps.getConvergedReason()})",
+                                       history=[eps.getIterationNumber()])
+            theta = np.array([eps.getEigenvalue(i) for i in range(nconv)], dtype=complex)
+            order = np.argsort(np.abs(theta - shift), kind="stable")[:want]   # complete up to 'reached'
+            reached = abs(theta[order[-1]] - shift)
+            f = lambda_from_theta(theta[order]).imag / TWO_PI
+            inband = order[(f >= f_min) & (f <= f_max)]
+            if n_modes is not None and inband.size >= n_modes:
+                keep = inband[:n_modes]
+                partner = inband[n_modes:n_modes + 1]
+                if partner.size and np.isclose(theta[partner[0]], theta[keep[-1]].conjugate(), rtol=1e-10):
+                    keep = inband[:n_modes + 1]
+                break
+            if reached > radius or want >= n:
+                keep = inband
+                break
+            # Weyl: the count of theta below R grows like R^(3/2) in 3D; aim 20 % beyond the band.
+            grow = (1.2 * radius / max(reached, 1e-300)) ** 1.5
+            if n_modes is not None and inband.size:
+                grow = min(grow, 1.2 * n_modes / inband.size)
+            want = min(n, max(want + 10, int(math.ceil(want * min(grow, 8.0)))))
 
-    lam = lambda_from_theta(vals, damping)
-    lam, vals, vecs, errs = _sorted(lam, vals, vecs, errs, (f_min, f_max),
-                                    lambda_from_theta(theta).imag / TWO_PI)
-    return ModalResult(lam, vals, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
-                       "gnhep", iterations, solves, time.perf_counter() - t0, comm)
+        vecs = np.empty((vr.getLocalSize(), keep.size), dtype=complex)
+        errs = np.empty(keep.size)
+        vals = np.empty(keep.size, dtype=complex)
+        for j, i in enumerate(keep):
+            vals[j], vecs[:, j] = _pairs(eps, int(i), vr, vi)
+            errs[j] = eps.computeError(int(i), SLEPc.EPS.ErrorType.RELATIVE)
+        lam = lambda_from_theta(vals, damping)
+        order = _sorted(lam, (f_min, f_max), lambda_from_theta(theta).imag / TWO_PI)
+        result = ModalResult(lam[order], vals[order], _normalise(vecs[:, order], M, comm), errs[order],
+                             (f_min, f_max), target, n, "gnhep", eps.getIterationNumber(), solves,
+                             time.perf_counter() - t0, comm)
+        yield result, eps.getST().getKSP()
+    finally:
+        eps.destroy(), vr.destroy(), vi.destroy()
 
 
 def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int | None = 20,
@@ -417,9 +446,9 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
         if ranked.size > cut and np.isclose(lam[ranked[cut]].imag, lam[ranked[cut - 1]].imag, rtol=1e-9, atol=0.0):
             cut += 1                    # the other member of a lock-in pair (one frequency) the cap ends in
         inband = ranked[:cut]
-    lam, theta, vecs, errs = _sorted(lam[inband], -lam[inband] ** 2, vecs[:, inband], errs[inband],
-                                     (f_min, f_max), seen)
-    return ModalResult(lam, theta, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
+    order = inband[_sorted(lam[inband], (f_min, f_max), seen)]
+    lam, vecs, errs = lam[order], vecs[:, order], errs[order]
+    return ModalResult(lam, -lam ** 2, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
                        "pep", iterations, solves, time.perf_counter() - t0, comm)
 
 
