@@ -380,6 +380,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
     if unused and "contact" in effects and not {"thermal", "wear", "stability"} & set(effects):
         warnings.append(f'{", ".join(unused)}: ignored without effect "thermal" or "wear": the run is one contact '
                         "solve at t = 0")
+    if problems:            # what follows only warns, and reads values that a problem left unset
+        return ctx.warnings + warnings
     if "stability" in effects and scene.loading is not None and g is not None:
         swept = scene.stability is not None and scene.stability.sweep is not None and \
             scene.stability.sweep.parameter == "speed"

@@ -208,6 +208,20 @@ def test_every_problem_is_reported_at_once(tmp_path):
         assert sum(fragment in p for p in problems) == 1, (fragment, problems)
 
 
+@pytest.mark.parametrize("speed, radius, fragment", [
+    ('"100 rad/s"', '"0.3 m"', 'loading.vehicle.speed = "100 rad/s": expected a speed'),
+    ("-5", '"0.3 m"', "loading.vehicle.speed = -5: must be > 0 m/s"),
+    ('"30 m/s"', '"300 N"', 'loading.vehicle.wheel_radius = "300 N": expected a length')])
+def test_a_refused_vehicle_value_is_a_problem_not_a_crash(speed, radius, fragment):
+    """A [loading.vehicle] value refused by its reader is left unset; the cross-section checks
+    that only warn (the stop beyond time.end) ran on it and raised a TypeError in check and run."""
+    text = (DEMOS / "pin_on_disc.toml").read_text().replace('rotation_speed = "200 rpm"\n', "") + \
+        f'\n[loading.vehicle]\nspeed = {speed}\nwheel_radius = {radius}\ndeceleration = "0.6 gn"\n'
+    with pytest.raises(SceneError) as info:
+        loads(text, DEMOS)
+    assert [fragment in p for p in info.value.problems] == [True]
+
+
 @pytest.mark.parametrize("old, new, fragment", [
     ('effects = ["contact", "friction",', 'effects = ["friction",',
      'effects: "friction", "conductance" need effect "contact" too'),
