@@ -311,9 +311,15 @@ def too_many_cells(estimate: CellEstimate, max_cells: int) -> InputError:
 
 # ---- gmsh helpers shared by the builders (model is ``gmsh.model``) ----------------------------
 
+OCC_BOX = 1e-7      # OpenCASCADE enlarges every entity's bounding box by this (Precision::Confusion) [m]
+
+
 def entities_in_box(model, dim: int, lo: Sequence[float], hi: Sequence[float]) -> list[int]:
-    """Tags of the dim-entities whose bounding box lies inside [lo, hi] (OCC, synchronized)."""
-    return [tag for _, tag in model.getEntitiesInBoundingBox(*lo, *hi, dim)]
+    """Tags of the dim-entities whose bounding box lies inside [lo, hi] (OCC, synchronized), the
+    box taken 2 ``OCC_BOX`` wider on every side: a selection whose own margin was below OCC's
+    enlargement selected nothing (a pin face of 1.5 mm with a margin of 1e-4 of it)."""
+    pad = 2 * OCC_BOX
+    return [tag for _, tag in model.getEntitiesInBoundingBox(*(x - pad for x in lo), *(x + pad for x in hi), dim)]
 
 
 def entities_where(model, dim: int, predicate) -> list[int]:

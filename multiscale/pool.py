@@ -128,7 +128,7 @@ class MicroPool:
         seconds = time.perf_counter() - t1
 
         gathered = comm.allgather((nodes, failures, seconds))
-        all_failures = sorted((f for _, fs, _ in gathered for f in fs), key=lambda f: f.zone_id)
+        all_failures = [f for _, fs, _ in gathered for f in fs]
         for ns, _, _ in gathered:
             for nd, key in ns:
                 self._remember(key, nd)
@@ -140,6 +140,11 @@ class MicroPool:
 
         if gather == "all":
             requested = sorted({item for _, _, _, req in shared for item in req})
+        key_of = {zid: key for zid, key, _, _ in work}     # a failed topography fails every zone that has it
+        by_key = {key_of[f.zone_id]: f for f in all_failures}
+        shared_failures = {zid: replace(by_key[key], zone_id=zid) for zid, key in requested if key in by_key}
+        all_failures = sorted(({f.zone_id: f for f in all_failures} | shared_failures).values(),
+                              key=lambda f: f.zone_id)
         failed = {f.zone_id for f in all_failures}
         found = [replace(known[key], zone_id=zid) for zid, key in requested if zid not in failed and key in known]
         result = ZoneLaws(found, spec)

@@ -466,6 +466,11 @@ def test_pool_caches_unchanged_zones_and_matches_compute_laws(tiled):
     with pytest.raises(PoolError) as info:
         pool.laws(zones[:2] + [flat])
     assert [f.zone_id for f in info.value.failures] == [99] and len(info.value.result) == 2
+    twin = Zone(98, flat.surface)     # one topography, solved once: both zones fail (before: 99 alone,
+    with pytest.raises(PoolError) as info:                    # and 98 had no law and no failure)
+        pool.laws([flat, twin] + zones[:1])
+    assert [f.zone_id for f in info.value.failures] == [98, 99] and info.value.result.ids.tolist() == [0]
+    assert pool.stats.computed == pool.stats.failed == 1      # one solve (zone 0 was cached)
     small = MicroPool(spec, comm=MPI.COMM_SELF, cache_size=2)        # a call returns all it computed
     assert small.laws(zones[:4]).ids.tolist() == [0, 1, 2, 3] and len(small._cache) == 2
 
