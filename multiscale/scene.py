@@ -26,7 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from multiscale.errors import InputError, SceneError
-from multiscale.micro.topography import TopographyWarning, check_resolved, covers, read_topography, zone_cells
+from multiscale.micro.topography import (TopographyWarning, check_cutoff, check_resolved, covers, read_topography,
+                                         zone_cells)
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
@@ -495,12 +496,13 @@ def _measured_cover(scene: Scene) -> list[str]:
     is (``cover = "measured"``) covers its face, one drawn from (``"equivalent"``) holds a
     wavelength the face's micro grid resolves: the run's refusals (``topography.covers``,
     ``topography.check_resolved``) before meshing, for the faces whose extent the geometry knows then
-    (``GeometrySpec.interface_extents``; the others are refused after meshing)."""
+    (``GeometrySpec.interface_extents``; the others are refused after meshing), and a filter
+    ``cutoff`` spans 2 of its pixels (``topography.check_cutoff``)."""
     out = []
     for name in scene.rough_interfaces:
         s, size = scene.interface_settings(name), scene.geometry.spec.interface_extents.get(name)
         r = s.roughness
-        if r is None or r.file is None or size is None:
+        if r is None or r.file is None:
             continue
         prefix = f"{scene.roughness_key(name)}."
         try:
@@ -508,6 +510,10 @@ def _measured_cover(scene: Scene) -> list[str]:
                 warnings.simplefilter("ignore", TopographyWarning)
                 measured = read_topography(r.file, r.channel, pixel_size=r.pixel_size, height_unit=r.height_unit,
                                            prefix=prefix)
+            if r.cutoff is not None:
+                check_cutoff(f"{prefix}cutoff", r.cutoff, measured.dx, measured.dy, r.file.name)
+            if size is None:
+                continue
             cells = zone_cells(s.micro.grid, r.cover, size, s.micro.zones, (measured.dx, measured.dy), DEFAULT_GRID,
                                r.file.name)
             if r.cover == "measured":

@@ -134,6 +134,8 @@ def test_scene_reads_a_measured_file_with_its_options(tmp_path):
     ('file = "pad.npy"', "roughness.pixel_size: pad.npy is a plain height matrix without units"),
     (f'file = "{TOP}"\ncover = "stretch"', 'roughness.cover = "stretch": unknown'),
     (f'file = "{TOP}"\nhurst = 0.5', "roughness.hurst: only used with roughness.rms"),
+    (f'file = "{TOP}"\ncutoff = "1 nm"', "roughness.cutoff = 1e-09: λc must span at least 2 pixels (4.69e-09 m): "
+                                         "top-1.top's pixels"),       # before: refused by the run, after meshing
 ])
 def test_check_reports_a_bad_measured_file_from_the_file_itself(tmp_path, roughness, fragment):
     (tmp_path / "pad.x3p").write_bytes(b"\x00garbage" * 50)

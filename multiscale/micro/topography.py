@@ -127,10 +127,17 @@ def gaussian_filter(surface: Surface, cutoff: float) -> Surface:
     ``gaussian_transmission(λ, λc)`` of its amplitude. Edges:
     periodic surfaces wrap, others are mirrored (one of the end-effect treatments of ISO 16610-28).
     SurfaceTopography filters periodic topographies in Fourier space only, hence this one."""
-    check_positive("cutoff", cutoff)
-    if cutoff < 2 * max(surface.dx, surface.dy):
-        raise InputError("cutoff", cutoff, f"λc must span at least 2 pixels ({2 * max(surface.dx, surface.dy):.3g} m)")
+    check_cutoff("cutoff", cutoff, surface.dx, surface.dy)
     return _gaussian(surface, cutoff, cutoff)
+
+
+def check_cutoff(name: str, cutoff: float, dx: float, dy: float, pixels: str = "") -> None:
+    """Raise ``InputError`` (naming ``name``) unless λc = ``cutoff`` [m] spans at least 2 pixels of
+    dx x dy [m] (``pixels``: whose, for the message)."""
+    check_positive(name, cutoff)
+    if cutoff < 2 * max(dx, dy):
+        raise InputError(name, cutoff, f"λc must span at least 2 pixels ({2 * max(dx, dy):.3g} m)"
+                         + (f": {pixels}'s pixels" if pixels else ""))
 
 
 def _gaussian(surface: Surface, cut_x: float, cut_y: float) -> Surface:
@@ -209,7 +216,7 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
     if not isinstance(detrend, str) or detrend not in DETREND:
         raise InputError(option(prefix, "detrend"), detrend, f"one of {', '.join(DETREND)}")
     if cutoff is not None:
-        check_positive(option(prefix, "cutoff"), cutoff)
+        check_cutoff(option(prefix, "cutoff"), cutoff, m.dx, m.dy, m.path.name)
     if despike is not None:
         check_positive(option(prefix, "despike"), despike)
     if not 0 <= check_real(option(prefix, "max_undefined"), max_undefined) <= 1:
@@ -255,10 +262,7 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
     surface = Surface(h, m.dx, m.dy, periodic=False)
     waviness = None
     if cutoff is not None:
-        try:
-            waviness = gaussian_filter(surface, cutoff)
-        except InputError as exc:
-            raise InputError(option(prefix, "cutoff"), cutoff, f"{exc.allowed}: {m.path.name}'s pixels") from None
+        waviness = gaussian_filter(surface, cutoff)
         rough = surface.heights - waviness.heights
         surface = Surface(rough - rough.mean(), m.dx, m.dy, periodic=False)
         longer = " (longer than the measurement: little is removed)" if cutoff > min(m.size) else ""
