@@ -403,6 +403,17 @@ def test_scene_damping_and_stribeck_options(tmp_path, documented):
         scenes.load(DEMO, dict(overrides, **{"stability.method": "quadratic"}))
 
 
+def test_a_pad_the_preload_leaves_without_force_is_warned_about(tmp_path):
+    """The fluid load on the piston alone (loading.faces without the caliper bore): the outer pad
+    carries nothing (3e-9 N against 1.6 kN), its modes are those of a free pad, and the squeal run
+    said nothing where a braking run warns (found by a user trial)."""
+    scene = scenes.load(DEMO, {**NO_FIGURES, "geometry.mesh_size": "20 mm", "stability.modes": 2,
+                               "loading.faces": ["piston_back"], "output.folder": str(tmp_path / "out")})
+    run = squeal.run(scene, degree=1, verbose=False)
+    unloaded = [w for w in run.warnings if "carried no force" in w]
+    assert len(unloaded) == 1 and unloaded[0].startswith("interface outer_pad carried no force (")
+
+
 def test_scene_stribeck_friction_sets_mu_per_facet_and_its_slope_damping(tmp_path):
     text = DEMO.read_text().replace("friction = 0.4\n", "") + (
         '\n[loading.stribeck]\nstatic = 0.5\nkinetic = 0.35\nspeed = "1 m/s"\n')

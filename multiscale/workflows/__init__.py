@@ -24,7 +24,7 @@ from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.model import interface_materials
 from multiscale.workflows.output import RunResult
-from multiscale.workflows.strain import overloaded
+from multiscale.workflows.strain import overloaded, unloaded
 
 
 def workflow(scene) -> str:
@@ -223,17 +223,10 @@ def _coarse_wear(scene, history) -> list[str]:
     return out
 
 
-UNLOADED = 1e-6   # an interface carrying less than this share of the largest one's force is warned about
-
-
 def _unloaded(scene, history) -> list[str]:
-    """Interfaces that carried no force while others did (a pad whose load face was put on the
-    disc ran at 7e-12 N beside two loaded pads, silently: an adversarial test)."""
-    forces = {n: float(np.max(np.abs(history[f"interface_force_{n}"]))) for n in scene.geometry.spec.interfaces
-              if f"interface_force_{n}" in history.columns}
-    top = max(forces.values(), default=0.0)
-    return [f"interface {n} carried no force ({f:.3g} N at most, against {top:.3g} N): nothing presses it; check "
-            "loading.faces and the supports" for n, f in forces.items() if top > 0 and f < UNLOADED * top]
+    """``strain.unloaded`` of the interfaces' largest normal forces in ``history``."""
+    return unloaded({n: float(np.max(np.abs(history[f"interface_force_{n}"]))) for n in scene.geometry.spec.interfaces
+                     if f"interface_force_{n}" in history.columns})
 
 
 def _too_hot(scene, history) -> list[str]:

@@ -55,7 +55,7 @@ from multiscale.workflows import squeal_map
 from multiscale.workflows.model import build_mechanics, build_mesh, drive, interface_forces
 from multiscale.workflows.output import RunResult, prepare_folder
 from multiscale.workflows.rough import build_rough_interface
-from multiscale.workflows.strain import overloaded
+from multiscale.workflows.strain import overloaded, unloaded
 
 SQUEAL_DEGREE = 2     # quadratic tetrahedra: linear ones are far too stiff in bending (tests)
 MAP_RESIDUAL = 1e-3   # a stability map's modes with larger relative residuals are warned to be approximate
@@ -241,7 +241,8 @@ def approximate_modes(scene, case: SquealCase) -> list[str]:
 
 def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
     """Warnings: a band cut short by stability.modes, modes or a map whose modes are approximate, a
-    contact pressure beyond small strains (at the preload, or at a map point's own preload)."""
+    contact pressure beyond small strains (at the preload, or at a map point's own preload), an
+    interface that the preload left without force."""
     st, out = scene.stability, approximate_modes(scene, case)
     f = case.modes.frequency
     top = float(f.max(initial=0.0))
@@ -266,7 +267,7 @@ def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
                    "rates are approximate, and a mode outside its basis is missed (stability.sweep.preload = \"each\" "
                    "solves every point in full)")
     peak = max(float(case.facet_pressure.max(initial=0.0)), smap.max_pressure if smap is not None else 0.0)
-    return out + overloaded(scene, peak)
+    return out + overloaded(scene, peak) + unloaded({n: abs(f) for n, f in case.preload.normal_force.items()})
 
 
 def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = True,

@@ -1,9 +1,13 @@
-"""The small-strain warning of a run: a contact pressure far beyond the small strains of the softer
-side of an interface (every model here is linear elastic). Read by the transient and multiscale
-runs from their history (``max_pressure``) and by the squeal analysis from its preloads."""
+"""The load warnings of a run: a contact pressure far beyond the small strains of the softer side of
+an interface (every model here is linear elastic), and an interface that carried no force while
+others did. Read by the transient and multiscale runs from their history (``max_pressure``,
+``interface_force_<name>``) and by the squeal analysis from its preloads."""
 from __future__ import annotations
 
+from collections.abc import Mapping
+
 STRAINED = 0.02   # a contact pressure above this share of the softer side's E is warned about
+UNLOADED = 1e-6   # an interface carrying less than this share of the largest one's force is warned about
 
 
 def least_E(material, T0: float, T1: float) -> float:
@@ -28,3 +32,12 @@ def overloaded(scene, p: float, hottest=None) -> list[str]:
     return [f"the contact pressure reached {p:.3g} Pa, {100 * p / soft:.2g} % of the softer side's E ({soft:.3g} Pa): "
             "beyond the small strains of the linear elastic model; check the load (a vehicle stop asks mu F r of "
             "the brake: a small mu needs a large clamp)"] if p > STRAINED * soft else []
+
+
+def unloaded(forces: Mapping[str, float]) -> list[str]:
+    """The interfaces whose largest normal force [N] (``forces``, per interface) stayed below
+    ``UNLOADED`` times the largest one's: nothing presses them (a pad whose load face was put on the
+    disc ran at 7e-12 N beside two loaded pads, silently: an adversarial test)."""
+    top = max(forces.values(), default=0.0)
+    return [f"interface {n} carried no force ({f:.3g} N at most, against {top:.3g} N): nothing presses it; check "
+            "loading.faces and the supports" for n, f in forces.items() if top > 0 and f < UNLOADED * top]
