@@ -409,3 +409,28 @@ def test_a_track_of_one_point_is_seen_in_the_tracks_figure(tmp_path, monkeypatch
         assert len(lines) == smap.n_tracks
         for t in alone:
             assert lines[t].get_marker() not in (None, "None", "", " "), f"track {t + 1}"
+
+
+@pytest.mark.parametrize("split, panels", [(None, 1), (("inner", "outer"), 2)])
+def test_the_energy_figure_has_a_split_panel_only_with_two_pads(tmp_path, monkeypatch, split, panels):
+    """energy.png: the strain-energy shares (Fig. 4.20) and, for two pads, the share of one in both
+    (Fig. 4.21). With three pads (no split) the second panel was drawn empty but for the unstable
+    modes' markers (found by a user trial); the markers go on the last panel drawn."""
+    from types import SimpleNamespace as NS
+
+    from multiscale.macro.modal import EnergyShares
+    from multiscale.plots import squeal as plots
+    drawn = []
+
+    class Kept(plots.Figure):
+        def __init__(self, *args, **kwargs):
+            super().__init__(*args, **kwargs)
+            drawn.append(self)
+    monkeypatch.setattr(plots, "Figure", Kept)
+    energy = np.array([[1.0, 2.0, 3.0], [2.0, 1.0, 1.0], [0.5, 0.5, 3.0]])
+    shares = EnergyShares(["inner", "outer", "disc"], energy, energy / energy.sum(axis=1, keepdims=True))
+    case = NS(name="three pads", modes=np.zeros(3), energy=shares, report=NS(unstable=np.array([2])))
+    plots.plot_energy(case, tmp_path / "energy.png", split)
+    axes = drawn[0].axes
+    assert len(axes) == panels and all(ax.patches for ax in axes)         # every panel has bars
+    assert [line.get_xdata()[0] for line in axes[-1].get_lines() if line.get_linestyle() == ":"] == [2]

@@ -55,12 +55,14 @@ def plot_re_im(cases: Sequence, path) -> Path:
 
 
 def plot_energy(case, path, split: tuple[str, str] | None = None) -> Path:
-    """Strain-energy share of each component per mode (Fig. 4.20) and, with ``split`` = (a, b), the
-    share of component a in the energy of a and b (Fig. 4.21: inner vs outer pad); unstable modes
-    marked. ``case`` has ``name``, ``modes``, ``energy`` (``EnergyShares``) and ``report``."""
+    """Strain-energy share of each component per mode (Fig. 4.20) and, with ``split`` = (a, b), a
+    second panel: the share of component a in the energy of a and b (Fig. 4.21: inner vs outer
+    pad); unstable modes marked. ``case`` has ``name``, ``modes``, ``energy`` (``EnergyShares``) and
+    ``report``."""
     sh = case.energy
-    fig = Figure(figsize=(9, 6))
-    a, b = fig.subplots(2, 1, sharex=True)
+    fig = Figure(figsize=(9, 6 if split is not None else 3.5))
+    axes = list(fig.subplots(2, 1, sharex=True)) if split is not None else [fig.subplots()]
+    a = axes[0]
     n = np.arange(1, len(case.modes) + 1)
     bottom = np.zeros(len(n))
     for j, name in enumerate(sh.names):
@@ -70,14 +72,15 @@ def plot_energy(case, path, split: tuple[str, str] | None = None) -> Path:
           title=f"{case.name}: share of the strain energy of each mode per component")
     a.legend(fontsize=7, ncol=min(len(sh.names), 6), loc="upper center")      # above the bars (shares sum to 1)
     if split is not None:
+        b = axes[1]
         b.bar(n, sh.split(*split), width=0.9, label=f"{split[0]} / ({split[0]} + {split[1]})")
         b.axhline(0.5, color="k", lw=0.5)
-        b.set(ylim=(0.0, 1.3), yticks=np.linspace(0.0, 1.0, 6))
+        b.set(ylim=(0.0, 1.3), yticks=np.linspace(0.0, 1.0, 6), ylabel="energy share [-]")
         b.legend(fontsize=7, loc="upper center")
     for j in case.report.unstable:
-        b.axvline(j, color="r", lw=0.8, ls=":")
-    b.set(xlabel="mode number (red: unstable)", ylabel="energy share [-]")
-    b.xaxis.set_major_locator(MaxNLocator(integer=True))
+        axes[-1].axvline(j, color="r", lw=0.8, ls=":", zorder=3)     # over the bars
+    axes[-1].set(xlabel="mode number (red: unstable)")
+    axes[-1].xaxis.set_major_locator(MaxNLocator(integer=True))
     return _save(fig, path)
 
 
