@@ -10,7 +10,10 @@ temporary name and renamed, so a run killed while writing keeps its previous che
 from __future__ import annotations
 
 import hashlib
+import json
 import shutil
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 from pathlib import Path
 
 import h5py
@@ -135,14 +138,49 @@ def file_digest(path) -> str:
     return digest.hexdigest()
 
 
-def same_scene(attrs: dict, fingerprint: str, path) -> None:
+@dataclass(frozen=True)
+class Fingerprint:
+    """What a run's results depend on: ``digest``, compared on ``--resume``, and ``inputs``, the
+    same named (a scene key or "file <path>" -> its value or its bytes' SHA-1), to say what changed."""
+
+    digest: str = ""
+    inputs: Mapping[str, str] = field(default_factory=dict)
+
+    def attrs(self) -> dict:
+        """The checkpoint attributes that hold it."""
+        return {"scene": self.digest, "inputs": json.dumps(dict(self.inputs))}
+
+
+CHANGES_NAMED = 6    # at most this many changes are named in a refused --resume
+
+
+def changes(before: Mapping[str, str], after: Mapping[str, str]) -> list[str]:
+    """The inputs that differ between two ``Fingerprint.inputs``, in words."""
+    out = []
+    for key in sorted(set(before) | set(after)):
+        old, new = before.get(key), after.get(key)
+        if old == new:
+            continue
+        if key.startswith("file "):
+            out.append(f"{key} ({'new' if old is None else 'gone' if new is None else 'other bytes'})")
+        else:
+            out.append(f"{key} = {new}" if old is None else f"{key} (was {old}, gone)" if new is None
+                       else f"{key}: {old} -> {new}")
+    return out
+
+
+def same_scene(attrs: dict, fingerprint: Fingerprint, path) -> None:
     """InputError unless the checkpoint attributes ``attrs`` (of ``path``) are of the scene whose
-    ``fingerprint`` is given (``--resume`` of a changed scene or of changed input files)."""
-    if attrs.get("scene") != fingerprint:
+    ``fingerprint`` is given (``--resume`` of a changed scene or of changed input files); the error
+    names what changed when the checkpoint says (it holds ``Fingerprint.inputs``)."""
+    if attrs.get("scene") != fingerprint.digest:
         written = attrs.get("version", __version__)       # (older checkpoints did not say)
         other = "" if written == __version__ else f", or multiscale (it was written by {written}, this is {__version__})"
+        named = changes(json.loads(attrs["inputs"]), fingerprint.inputs) if "inputs" in attrs else []
+        more = f" and {len(named) - CHANGES_NAMED} more" if len(named) > CHANGES_NAMED else ""
+        what = f" ({'; '.join(named[:CHANGES_NAMED])}{more})" if named else ""
         raise InputError("--resume", str(path), f"the scene or a file it reads (geometry, measured surface){other} "
-                         "changed since this checkpoint was written; run it with --overwrite")
+                         f"changed since this checkpoint was written{what}; run it with --overwrite")
 
 
 def peek(path, comm) -> dict:

@@ -191,7 +191,7 @@ class Multiscale:
     """The loop over a ``MacroModel`` whose contact law is ``rough.law`` (see module docstring)."""
 
     def __init__(self, model: MacroModel, rough: RoughInterface, post: PostAnalysis, settings: LoopSettings,
-                 fingerprint: str = ""):
+                 fingerprint: checkpoint.Fingerprint = checkpoint.Fingerprint()):
         self.model, self.rough, self.post, self.settings = model, rough, post, settings
         self.tm, self.comm = model.tm, model.tm.comm
         self.fingerprint = fingerprint
@@ -546,7 +546,7 @@ class Multiscale:
                   **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
         attrs = {"step": step, "time": m.time, "work": self.work, "interval_work": self.interval_work,
                  "counter_volume": self.counter_volume,
-                 "heat_exchanged": [m.heat_exchanged, m.heat_exchanged_total], "scene": self.fingerprint, "load": m.load,
+                 "heat_exchanged": [m.heat_exchanged, m.heat_exchanged_total], **self.fingerprint.attrs(), "load": m.load,
                  "ranks": self.comm.size, "fields_written": -1, "solved_speed": m.solved_speed,
                  "constants": [float(c.value) for c in self.model.drive_constants],
                  "solve": [last.reason, last.iterations, last.normal_force, last.max_pressure],

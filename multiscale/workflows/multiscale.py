@@ -20,7 +20,9 @@ per-facet stiffness, partition, wear depth, flash temperature and the counter-fa
 from __future__ import annotations
 
 import dataclasses
+import json
 import time as _time
+import tomllib
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -39,6 +41,7 @@ from multiscale.micro.heat_kernels import ThermalMaterial
 from multiscale.micro.laws import Conductance
 from multiscale.micro.post_analysis import Heating, PostAnalysis
 from multiscale.plots.history import multiscale_figure, wear_map
+from multiscale.provenance import resolved_toml
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, heat_warnings_as_notes, \
     interface_forces, interface_materials, run_notes
 from multiscale.workflows.output import prepare_folder
@@ -84,16 +87,32 @@ def post_analysis(scene, zone) -> PostAnalysis:
                         tol=m.tol, hardness=interface_hardness(scene) if scene.has("plasticity") else None)
 
 
-def fingerprint(scene) -> str:
-    """Hash of what the results depend on: the scene (not the output section; effects sorted: a
-    set's order changes between processes) and the bytes of every file it reads (a measured surface
-    rewritten under the same name was resumed into wrong wear depths: the checkpoint holds the worn
-    heights, the unworn ones are read again)."""
+def fingerprint(scene) -> checkpoint.Fingerprint:
+    """What the results depend on: the scene (not the output section; effects sorted: a set's order
+    changes between processes) and the bytes of every file it reads (a measured surface rewritten
+    under the same name was resumed into wrong wear depths: the checkpoint holds the worn heights,
+    the unworn ones are read again); its inputs by name: every key of the resolved scene but
+    [output], and each file's SHA-1."""
     s = dataclasses.replace(scene, output=None, source=None, overrides=(), warnings=(),
                             effects=tuple(sorted(scene.effects)))
     source = scene.source.resolve() if scene.source is not None else None
-    files = sorted(p for p in scene.inputs if p != source and p.is_file())
-    return checkpoint.fingerprint(repr(s) + "".join(f"{p}:{checkpoint.file_digest(p)}" for p in files))
+    files = {p: checkpoint.file_digest(p) for p in sorted(p for p in scene.inputs if p != source and p.is_file())}
+    resolved = tomllib.loads(resolved_toml(scene))
+    resolved.pop("output", None)
+    inputs = {**_dotted(resolved), **{f"file {p}": digest for p, digest in files.items()}}
+    return checkpoint.Fingerprint(checkpoint.fingerprint(repr(s) + "".join(f"{p}:{d}" for p, d in files.items())),
+                                  inputs)
+
+
+def _dotted(table: dict, prefix: str = "") -> dict[str, str]:
+    """A TOML table's values by dotted key (arrays of tables as one value), as JSON."""
+    out = {}
+    for key, value in table.items():
+        if isinstance(value, dict):
+            out.update(_dotted(value, f"{prefix}{key}."))
+        else:
+            out[prefix + key] = json.dumps(value, default=str)
+    return out
 
 
 def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
