@@ -9,6 +9,7 @@ from matplotlib.backend_bases import FigureCanvasBase
 from matplotlib.figure import Figure
 
 SHOWN = 1000      # height-map points per side drawn at most (a strided view; the figure has ~500 pixels a side)
+SPAN = (0.1, 99.9)   # percentiles of the whole map's heights that the colours span (beyond: the bar's arrows)
 
 
 def figure_problem(path: Path) -> str | None:
@@ -23,6 +24,14 @@ def figure_problem(path: Path) -> str | None:
     return None
 
 
+def colour_range(heights: np.ndarray) -> tuple[float, float]:
+    """The heights [m] the colours span: the ``SPAN`` percentiles of the whole map (single outlier
+    points set the range of the whole map's extremes: a 1.2 um spike hid a 14 nm texture), its
+    extremes if they coincide."""
+    lo, hi = np.percentile(heights, SPAN)
+    return (float(lo), float(hi)) if hi > lo else (float(heights.min()), float(heights.max()))
+
+
 def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -> Path:
     """PNG: height map [µm] (and the waviness taken out, if given), then C(q) [m⁴] against q [1/m]
     (complete bins as points, partial ones hollow) with the power-law fit between its cut-offs."""
@@ -33,13 +42,16 @@ def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -
     for ax, (label, s) in zip(axes, maps):
         Lx, Ly = s.size
         step = -(-max(s.shape) // SHOWN)            # every step-th point along both axes
+        lo, hi = colour_range(s.heights)
         image = ax.imshow(s.heights[::step, ::step] * 1e6, origin="lower", extent=(0, Lx * 1e3, 0, Ly * 1e3),
-                          cmap="viridis", interpolation="nearest", vmin=s.heights.min() * 1e6,
-                          vmax=s.heights.max() * 1e6)
+                          cmap="viridis", interpolation="nearest", vmin=lo * 1e6, vmax=hi * 1e6)
         ax.set_xlabel("x [mm]")
         ax.set_ylabel("y [mm]")
         ax.set_title(label)
-        fig.colorbar(image, ax=ax, label="height [µm]", shrink=0.85)
+        below, above = s.heights.min() < lo, s.heights.max() > hi
+        fig.colorbar(image, ax=ax, shrink=0.85, extend={(0, 0): "neither", (1, 0): "min", (0, 1): "max",
+                                                        (1, 1): "both"}[below, above],
+                     label="height [µm]" + (f" ({SPAN[0]:g}–{SPAN[1]:g} % of points)" if below or above else ""))
     ax = axes[-1]
     sp = stats.spectrum
     ax.loglog(sp.q[sp.complete], sp.C[sp.complete], "o", ms=3, label="PSD (radial average)")
