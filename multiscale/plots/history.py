@@ -138,7 +138,7 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
                                                ("micro_max_pressure", "micro")], 1e-6, 0),
               ("max temperature [°C]", [(k, "macro " + column_label(k)) for k in hot]
                + [("micro_max_temperature", "micro")], 1.0, -273.15),
-              ("zones' heat partition into the rough body [%]",     # the coefficients of Fig. 7.12, not
+              ("zones' heat partition\ninto the rough body [%]",   # the coefficients of Fig. 7.12, not
                [("partition_max", "max"), ("partition_mean", "mean over zones"),    # weighted by the heat
                 ("partition_min", "min")], 100.0, 0),
               ("wear volume [µm³]", [("wear_volume", None)], 1e18, 0),
