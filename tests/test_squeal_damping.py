@@ -386,18 +386,25 @@ def test_the_map_files_hold_the_map_and_say_it_in_documented_terms(tmp_path, doc
     check_map_files(tmp_path, below, documented)
 
 
-def test_a_track_of_one_point_is_seen_in_the_tracks_figure(tmp_path, monkeypatch):
-    """map_tracks.png drew each track as a line through its points: an unstable track present at one
-    point only (a branch that fails the MAC test at every point) was named in the legend and not
-    drawn (found on the 20-mm brake's friction map, tracks 31 and 37). Every point has a marker now."""
+@pytest.fixture
+def drawn(monkeypatch):
+    """The figures ``multiscale.plots.squeal`` makes, kept to be inspected."""
     from multiscale.plots import squeal as plots
-    drawn = []
+    figures = []
 
     class Kept(plots.Figure):
         def __init__(self, *args, **kwargs):
             super().__init__(*args, **kwargs)
-            drawn.append(self)
+            figures.append(self)
     monkeypatch.setattr(plots, "Figure", Kept)
+    return figures
+
+
+def test_a_track_of_one_point_is_seen_in_the_tracks_figure(tmp_path, drawn):
+    """map_tracks.png drew each track as a line through its points: an unstable track present at one
+    point only (a branch that fails the MAC test at every point) was named in the legend and not
+    drawn (found on the 20-mm brake's friction map, tracks 31 and 37). Every point has a marker now."""
+    from multiscale.plots import squeal as plots
     values = np.linspace(0.0, 1.0, 6)
     results, reduced = hoffmann_points(values)
     smap = build_map("friction", "-", values, results, reduced, (0.0, 1.0), mac_min=0.999)
@@ -412,7 +419,7 @@ def test_a_track_of_one_point_is_seen_in_the_tracks_figure(tmp_path, monkeypatch
 
 
 @pytest.mark.parametrize("split, panels", [(None, 1), (("inner", "outer"), 2)])
-def test_the_energy_figure_has_a_split_panel_only_with_two_pads(tmp_path, monkeypatch, split, panels):
+def test_the_energy_figure_has_a_split_panel_only_with_two_pads(tmp_path, drawn, split, panels):
     """energy.png: the strain-energy shares (Fig. 4.20) and, for two pads, the share of one in both
     (Fig. 4.21). With three pads (no split) the second panel was drawn empty but for the unstable
     modes' markers (found by a user trial); the markers go on the last panel drawn."""
@@ -420,13 +427,6 @@ def test_the_energy_figure_has_a_split_panel_only_with_two_pads(tmp_path, monkey
 
     from multiscale.macro.modal import EnergyShares
     from multiscale.plots import squeal as plots
-    drawn = []
-
-    class Kept(plots.Figure):
-        def __init__(self, *args, **kwargs):
-            super().__init__(*args, **kwargs)
-            drawn.append(self)
-    monkeypatch.setattr(plots, "Figure", Kept)
     energy = np.array([[1.0, 2.0, 3.0], [2.0, 1.0, 1.0], [0.5, 0.5, 3.0]])
     shares = EnergyShares(["inner", "outer", "disc"], energy, energy / energy.sum(axis=1, keepdims=True))
     case = NS(name="three pads", modes=np.zeros(3), energy=shares, report=NS(unstable=np.array([2])))
