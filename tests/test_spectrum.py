@@ -78,6 +78,16 @@ def test_the_statistics_table_writes_cut_offs_as_plain_numbers():
     assert "e+" not in table.split("Hurst")[1]
 
 
+def test_a_fit_outside_the_self_affine_range_is_said_to_be_one():
+    """White noise (flat PSD) fits H = -1 (C ∝ q^0): the table said "H -1.05" without a word (found by
+    a user trial); it names the range and what the number is. A self-affine surface's line has no remark."""
+    noise = Surface(np.random.default_rng(1).normal(size=(256, 256)), 1e-6, 1e-6, periodic=False)
+    line = next(r for r in surface_statistics(noise).table() if "Hurst" in r)
+    assert surface_statistics(noise).power_law.hurst == pytest.approx(-1.0, abs=0.1)
+    assert line.endswith("outside 0-1.5: no self-affine range (e.g. noise), the fit only gives the PSD's slope")
+    assert "outside" not in next(r for r in surface_statistics(self_affine(0.6, n=128)).table() if "Hurst" in r)
+
+
 def test_measured_psd_holds_sq_exactly():
     """Parseval on the mirror-stitched periodogram: (2π)^-2 Σ C Δq² = <h²> of the patch."""
     s = self_affine(0.8, n=128, periodic=False)

@@ -443,8 +443,11 @@ class Statistics:
             rows.append(("PSD fit", "too few bins"))
         else:
             (lr, ls), (rr, rs) = fit.wavelengths, fit.resolved
+            outside = not HURST_RANGE[0] <= fit.hurst <= HURST_RANGE[1]
             rows += [("Hurst exponent H (PSD fit)", f"{fit.hurst:.3f}  (rms misfit {fit.misfit:.2f} in ln C "
-                                                   f"over {fit.bins} bins)"),
+                                                   f"over {fit.bins} bins)" + (
+                          f"; outside {HURST_RANGE[0]:g}-{HURST_RANGE[1]:g}: no self-affine range (e.g. noise), "
+                          "the fit only gives the PSD's slope" if outside else "")),
                      ("long cut-off  2pi/q_r", _length(lr, 2) + ("  (to a PSD bin)" if rr else
                                                               "  (not resolved: >= this)")),
                      ("short cut-off 2pi/q_s", _length(ls, 2) + ("  (to a PSD bin)" if rs else
