@@ -10,7 +10,7 @@ from pathlib import Path
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.ticker import NullFormatter
+from matplotlib.ticker import FuncFormatter, NullFormatter
 
 from multiscale.studies.expand import Study, StudyRun
 from multiscale.studies.formatting import metric_heading, percent, value_text
@@ -46,7 +46,9 @@ def _short(run: StudyRun, skip=()) -> str:
 
 
 def _plot_pareto(study, ok, folder):
-    """Relative error vs wall time, one panel per metric (None if no error is positive)."""
+    """Relative error vs wall time, one panel per metric, the Pareto front of each case of
+    [report] cases in its colour (a case is a problem of its own: one front across them put a
+    setting 17 % off at one load on the front for its 7 % at another; None if no error is positive)."""
     n = len(study.metrics)
     fig, axes = plt.subplots(1, n, figsize=(5.2 * n, 4.3), squeeze=False)
     cases = list(dict.fromkeys(case_key(study, r) for r in ok))
@@ -54,24 +56,29 @@ def _plot_pareto(study, ok, folder):
     for ax, m in zip(axes[0], study.metrics):
         t = [r.record["wall_time"] for r in ok]
         e = [r.errors.get(m, math.nan) for r in ok]
-        front = pareto(t, e)
-        labelled = set(range(len(ok))) if len(ok) <= 16 else set(front)
-        for c, case in enumerate(cases):
-            idx = [i for i, r in enumerate(ok) if case_key(study, r) == case and math.isfinite(e[i]) and e[i] > 0]
+        members = [[i for i, r in enumerate(ok) if case_key(study, r) == case and math.isfinite(e[i]) and e[i] > 0]
+                   for case in cases]
+        fronts = [[idx[j] for j in pareto([t[i] for i in idx], [e[i] for i in idx])] for idx in members]
+        labelled = set(range(len(ok))) if len(ok) <= 16 else {i for front in fronts for i in front}
+        named = False                  # the fronts' legend entry: once per panel
+        for c, (case, idx, front) in enumerate(zip(cases, members, fronts)):
             ax.scatter([t[i] for i in idx], [e[i] for i in idx], color=f"C{c}", s=28, zorder=3,
                        label=", ".join(f"{k} = {v}" for k, v in zip(study.cases, case)) or None)
             for i in (i for i in idx if i in labelled):
                 ax.annotate(_short(ok[i].run, study.cases), (t[i], e[i]), fontsize=6,
                             xytext=(3, 3), textcoords="offset points")
+            if front:
+                ax.step([t[i] for i in front], [e[i] for i in front], where="post", color=f"C{c}", lw=2, alpha=0.6,
+                        zorder=2, label=None if named else "Pareto front" + (" of each case" if len(cases) > 1 else ""))
+                drawn = named = True
         refs = sorted(r.record["wall_time"] for r in ok if r.is_reference)
         if refs:
             ax.axvspan(refs[0], refs[-1], color="green", alpha=0.15, lw=0)
             ax.axvline(refs[len(refs) // 2], color="green", ls=":", label="reference run" + "s" * (len(refs) > 1))
-        if front:
-            drawn = True
-            ax.step([t[i] for i in front], [e[i] for i in front], where="post", color="red", lw=2, alpha=0.6,
-                    zorder=2, label="Pareto front")
+        if any(fronts):
             ax.set(xscale="log", yscale="log")
+            for axis in (ax.xaxis, ax.yaxis):
+                _plain_log(axis)
         for tol in study.report.errors:
             ax.axhline(tol, color="gray", ls="--", lw=0.8)
             ax.annotate(percent(tol), (1, tol), xycoords=("axes fraction", "data"), fontsize=7, ha="right",
@@ -88,6 +95,18 @@ def _plot_pareto(study, ok, folder):
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
+
+
+def _plain_log(axis) -> None:
+    """Plain numbers on a log axis, "0.4" and not "4 x 10^-1" (those overlapped on short decades):
+    every decade, and 2, 3 and 5 times it on an axis that spans less than one."""
+    def label(x, _):
+        lo, hi = axis.get_view_interval()
+        mantissa = x / 10 ** math.floor(math.log10(x) + 1e-9)
+        shown = (1,) if hi > 10 * lo else (1, 2, 3, 5)
+        return f"{x:g}" if any(abs(mantissa - m) < 1e-6 for m in shown) else ""
+    axis.set_major_formatter(FuncFormatter(label))
+    axis.set_minor_formatter(FuncFormatter(label))
 
 
 def _plot_axis(study, ok, axis, folder):

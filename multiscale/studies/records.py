@@ -37,7 +37,8 @@ def metric_problem(metrics: dict, names) -> str | None:
 
 def read_records(study: Study) -> dict:
     """key -> record of the runs of ``study`` recorded on disk; a run that completed is ok or failed
-    by the study's metrics now."""
+    by the study's metrics now; one timed fewer times than the study's ``repeat`` now is left out
+    (it runs again: its wall time would not be the best of that many)."""
     out = {}
     for run in study.runs:
         p = record_path(study, run)
@@ -47,6 +48,8 @@ def read_records(study: Study) -> dict:
             except ValueError:
                 continue                  # a torn file: treat the run as not done
             if record.get("ran") or record.get("status") == "ok":
+                if record.get("repeat", 1) < study.options.repeat:
+                    continue
                 why = metric_problem(record.get("metrics", {}), study.metrics)
                 record.update(status=FAILED if why else "ok", error=why or "")
             out[run.key] = record

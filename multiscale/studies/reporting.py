@@ -37,7 +37,7 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
               f"- Reference: {reference_text(study)}"
               + ("; error = |m − m_ref| / |m_ref|" if study.reference else ""),
               f"- Runs: {len(ok)} ok, {len(failed)} failed; {sum(r.record.get('wall_time', 0) for r in rows):.1f} s "
-              f"of run wall time in all (failed runs included). Wall time: best of {study.options.repeat} "
+              f"of run wall time in all (failed runs included). Wall time: best of {_repeats(ok)} "
               "repetition(s) in a fresh process (one thread); peak memory: the run process's maximum resident set (interpreter and "
               "libraries included; in brackets what the run added to the process's baseline).",
               f"- Generated {now()} on a {os.cpu_count()}-core machine by `{command or 'multiscale study ' + study.source.name}`.",
@@ -54,6 +54,13 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
     path = folder / f"{study.name}.md"
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+def _repeats(rows) -> str:
+    """How many times the runs were timed, as their records say (a record timed more often than the
+    study asks now is kept: '1-3')."""
+    counts = sorted({int(r.record.get("repeat", 1)) for r in rows}) or [0]
+    return f"{counts[0]}" if len(counts) == 1 else f"{counts[0]}-{counts[-1]}"
 
 
 def _memory(record: dict) -> str:
