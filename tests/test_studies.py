@@ -303,6 +303,9 @@ BAD = [   # (what, replacement applied to HERTZ, the message expected on stderr)
      "reference.run = {grid = 64}: not in the sweep (swept grid: 12, 16, 24, 32)"),
     ("reference of an unswept parameter", ('kind = "analytic"', 'kind = "run"\nrun = {load = "1 N"}'),
      "reference.run.load: not a swept parameter; swept: grid"),
+    ("reference of an unswept parameter and a missing point",           # both at once (they came in rounds)
+     ('kind = "analytic"', 'kind = "run"\nrun = {load = "1 N", grid = 64}'),
+     "reference.run.load: not a swept parameter; swept: grid\nerror: reference.run = {grid = 64}: not in the sweep"),
     ("unknown problem", ('problem = "hertz"', 'problem = "herz"'),
      'problem = "herz": unknown problem (did you mean "hertz"?)'),
     ("unknown metric", ('"approach"]', '"aproach"]'),
@@ -334,6 +337,19 @@ def test_bad_study_files_give_clear_errors(tmp_path, capsys, what, change, messa
     err = capsys.readouterr().err
     assert message in err, err
     assert "Traceback" not in err and not (tmp_path / "results").exists()
+
+
+@pytest.mark.parametrize("values, message", [
+    ('{"contact_radius": 0.0, "max_pressure": 1e9, "approach": 1e-6}', 'metric "contact_radius" is 0.0'),
+    ('{"contact_radius": 1e-4, "max_pressure": NaN, "approach": 1e-6}', 'metric "max_pressure" is nan')])
+def test_a_reference_file_value_no_error_can_be_relative_to_is_refused(tmp_path, capsys, values, message):
+    """A reference of 0 or NaN made every error "n/a" and the figure was left out without a word
+    (found by a user trial)."""
+    (tmp_path / "ref.json").write_text(values)
+    path = write(tmp_path, HERTZ.replace('kind = "analytic"', 'kind = "file"\nfile = "ref.json"'))
+    assert main(["study", str(path)]) == 2
+    err = capsys.readouterr().err
+    assert f"{message}: errors are relative to it; give a finite, nonzero number" in err, err
 
 
 def test_every_problem_of_a_study_file_at_once(tmp_path, capsys):

@@ -351,16 +351,14 @@ def _check_reference(f: StudyFile, problem, knobs, axes, runs, ctx):
             ctx.problems.append(f'reference.kind = "analytic": no analytic value of {", ".join(missing)} '
                                 f'(the problem gives {", ".join(problem.exact_metrics)})')
     elif ref.kind == "run":
-        bad = [k for k in ref.run if k not in knobs]
-        for k in bad:
+        for k in (k for k in ref.run if k not in knobs):
             ctx.problems.append(f"reference.run.{k}: not a swept parameter{suggest(k, knobs)}; swept: {', '.join(knobs)}")
-        if bad:
-            return
-        want = {k: normalise(v, parser_of(problem, k)) for k, v in ref.run.items()}
-        for r in runs:
+        given = {k: v for k, v in ref.run.items() if k in knobs}     # the swept ones are checked too
+        want = {k: normalise(v, parser_of(problem, k)) for k, v in given.items()}
+        for r in runs if want else ():
             if reference_run(runs, r.label, want, axes) is None:
-                swept = "; ".join(f"{k}: {', '.join(dict.fromkeys(x.shown[k] for x in runs))}" for k in ref.run)
-                ctx.problems.append(f"reference.run = {{{', '.join(f'{k} = {value_text(v)}' for k, v in ref.run.items())}}}: "
+                swept = "; ".join(f"{k}: {', '.join(dict.fromkeys(x.shown[k] for x in runs))}" for k in given)
+                ctx.problems.append(f"reference.run = {{{', '.join(f'{k} = {value_text(v)}' for k, v in given.items())}}}: "
                                     f"not in the sweep (swept {swept})")
                 return
     else:
@@ -376,6 +374,9 @@ def _check_reference(f: StudyFile, problem, knobs, axes, runs, ctx):
             if m in values and (not isinstance(values[m], (int, float)) or isinstance(values[m], bool)):
                 ctx.problems.append(f"reference.file = \"{ref.file}\": metric \"{m}\" is {values[m]!r}: give a "
                                     "number in SI units (the metric's own unit)")
+            elif m in values and not (math.isfinite(values[m]) and values[m] != 0):
+                ctx.problems.append(f"reference.file = \"{ref.file}\": metric \"{m}\" is {values[m]!r}: errors are "
+                                    "relative to it; give a finite, nonzero number")
             elif m not in values:
                 ctx.problems.append(f"reference.file = \"{ref.file}\": no number for metric \"{m}\""
                                     f"{suggest(m, values)}")
