@@ -310,7 +310,8 @@ class TwoBodyMesh:
     def surface(self, name: str) -> ufl.Measure:
         """Boundary measure of a named surface: a named face (``ds(tag)``), or "free:<body or
         region>", every exterior facet of the parent mesh that bounds that body's cells (the faces
-        that touch nothing else: not the interfaces, not the faces bonded to another part)."""
+        that touch nothing else: not the interfaces, not the faces bonded to another part) but its
+        symmetry planes (``GeometrySpec.symmetry``: the model's cut, where nothing leaves)."""
         if not name.startswith("free:"):
             return self.ds(self.face(name))
         who = name[len("free:"):]
@@ -324,7 +325,8 @@ class TwoBodyMesh:
         region = np.full(self.parent.topology.index_map(tdim).size_local
                          + self.parent.topology.index_map(tdim).num_ghosts, -1)
         region[self.cell_tags.indices] = self.cell_tags.values
-        chosen = facets[np.isin(region[cells], tags)].astype(np.int32)
+        cut = self.facet_tags.indices[np.isin(self.facet_tags.values, [self.face(n) for n in self.spec.symmetry])]
+        chosen = facets[np.isin(region[cells], tags) & ~np.isin(facets, cut)].astype(np.int32)
         rows = fem.compute_integration_domains(fem.IntegralType.exterior_facet, self.parent.topology, chosen)
         return ufl.Measure("ds", domain=self.parent, subdomain_data=[(1, np.asarray(rows, dtype=np.int32))])(1)
 
