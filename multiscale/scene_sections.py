@@ -218,10 +218,13 @@ _COMPONENTS = {"x": 0, "y": 1, "z": 2}
 class Boundary:
     """[[boundary]]: conditions on named surfaces of the geometry (a builder's faces, the file's
     physical surfaces or [geometry.surfaces]; "free:<body>": a body's surfaces that touch nothing
-    else, its symmetry planes left out). ``fix``: displacement components held at zero (with the interfaces' normals, friction
-    holding nothing, they must hold every part against its six rigid motions: ``macro.held``);
-    ``convection`` h [W/(m^2 K)], constant or a table against the rotating body's speed [rad/s],
-    towards ``ambient``; ``emissivity``: radiation eps sigma (T^4 - T_ambient^4); ``temperature``: fixed."""
+    else, its symmetry planes left out). ``fix``: displacement components held at zero (with the
+    interfaces' normals, friction holding nothing, they must hold every part against its six rigid
+    motions: ``macro.held``); ``convection`` h [W/(m^2 K)], constant or a table against the rotating
+    body's speed [rad/s], towards ``ambient``; ``emissivity``: radiation eps sigma (T^4 -
+    T_ambient^4); ``temperature``: fixed. A face named in one entry takes that entry's convection,
+    radiation or temperature instead of those a "free:" surface of another gives there; two entries
+    giving one of them on one face otherwise are refused."""
 
     surfaces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), required=True)
     fix: tuple | None = key(ListOf(Choice(_COMPONENTS), unique=True, min_len=1), absent="no component held here")

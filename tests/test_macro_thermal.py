@@ -9,7 +9,7 @@ import pytest
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
-from multiscale.errors import ClosedError, ConvergenceError
+from multiscale.errors import ClosedError, ConvergenceError, InputError
 from multiscale.references.thermal import (STEFAN_BOLTZMANN, kirchhoff_slab, kirchhoff_transform,
                                            lumped_convective_cooling, lumped_cooling_linear_capacity,
                                            radiative_cooling, slab_convection)
@@ -138,6 +138,31 @@ def test_newton_cooling_of_a_block_with_small_biot_number():
     assert (mean - 300) == pytest.approx(expected - 300, rel=2e-3)
     assert stored[0] + lost[0] == pytest.approx(0.0, abs=1e-10 * lost[0])     # what is lost left the store
     assert stored[1] == lost[1] == 0.0                                          # the flat is insulated
+
+
+def test_a_face_named_for_a_condition_replaces_what_free_gives_there():
+    """free:block convected (h 20 to 300 K) and its top face named with h 40 to 350 K, from 400 K:
+    the heat lost in a short first step is dt (20 x 1e-4 m^2 x 100 K + 40 x 1e-4 m^2 x 50 K) =
+    dt 0.4 W (1e-3: the step's cooling); the top did not take both (0.6 W, and the second's
+    ambient defaulted; found by a user trial). Convection and radiation on one face add up."""
+    free = '[[boundary]]\nsurfaces = ["free:block"]\nconvection = "20 W/(m^2 K)"\nambient = "300 K"\n'
+    top = '[[boundary]]\nsurfaces = ["block_top"]\nconvection = "40 W/(m^2 K)"\nambient = "350 K"\n'
+    th = march(block_scene(T0=400.0, end=1e-3, boundary=free + top)).thermal
+    assert th.heat_lost[0] == pytest.approx(1e-3 * 0.4, rel=1e-3)
+    glow = top.replace('convection = "40 W/(m^2 K)"', "emissivity = 1")           # another kind: both
+    th = march(block_scene(T0=400.0, end=1e-3, boundary=free + glow)).thermal
+    radiated = STEFAN_BOLTZMANN * 1e-4 * (400.0**4 - 350.0**4)
+    assert th.heat_lost[0] == pytest.approx(1e-3 * (20 * AREA * 100 + radiated), rel=1e-3)
+
+
+@pytest.mark.parametrize("second", ['temperature = "350 K"', 'convection = "40 W/(m^2 K)"'])
+def test_two_conditions_of_one_kind_on_a_face_are_refused(second):
+    """Two fixed temperatures on one face: the last won, silently; two convections added up."""
+    first = second.replace("350 K", "320 K").replace("40 W", "20 W")
+    boundary = "".join(f'[[boundary]]\nsurfaces = ["block_top"]\n{c}\n' for c in (first, second))
+    with pytest.raises(InputError, match=r"boundary\[1\] and boundary\[2\] = '(temperature|convection)': both give it "
+                                         r"on \d+ facets: give each facet one"):
+        march(block_scene(T0=400.0, end=1e-3, boundary=boundary))
 
 
 @pytest.mark.parametrize("face, body", [("block_top", 0), ("flat_bottom", 1)])

@@ -99,7 +99,8 @@ from multiscale.macro.interface import ContactInterface, rigid_velocity
 from multiscale.macro.kept_cells import KeptCells, assemble, backtracking, nonlinear_problem
 from multiscale.macro.materials import body_properties, heat_capacity
 from multiscale.macro.mesh import FormCache
-from multiscale.macro.thermal_conditions import AppliedBoundary, ThermalBoundary, surface_rows
+from multiscale.macro.thermal_conditions import (AppliedBoundary, ThermalBoundary, kinds, measure_id, settle,
+                                                 surface_rows)
 
 # a linear step (its matrix's cell part kept): GMRES on the step's matrix, preconditioned by the LU
 # factors of an earlier step's, refactorised when a solve took more than KEPT_ITERATIONS iterations
@@ -335,7 +336,7 @@ class Thermal:
     def _apply_boundaries(self, r) -> list[AppliedBoundary]:
         """Measures, residual terms and Dirichlet conditions of the boundary conditions."""
         tm, tdim = self.tm, self.tm.parent.topology.dim
-        rows = {}               # (condition, body) -> rows of the body's exterior facets
+        rows = {}               # (condition, body) -> (through "free:", rows of the body's exterior facets)
         for k, cond in enumerate(self.boundaries):
             for name in cond.surfaces:
                 found = surface_rows(tm, name)
@@ -344,21 +345,20 @@ class Thermal:
                                      "face between two parts cannot carry a thermal condition)")
                 for i, body in enumerate(tm.bodies):
                     inside = body.cell_map.sub_topology_to_topology(found[:, 0], inverse=True) >= 0
-                    rows.setdefault((k, i), []).append(found[inside])
-        applied, data = [], ([], [])
-        for (k, i), parts in rows.items():
-            found = np.unique(np.concatenate(parts), axis=0)
-            if tm.comm.allreduce(len(found), op=MPI.SUM) == 0:
+                    rows.setdefault((k, i), []).append((name.startswith("free:"), found[inside]))
+        settled, applied, data = settle(rows, self.boundaries, tm.comm), [], ([], [])
+        for k, i in rows:
+            cond = self.boundaries[k]
+            if tm.comm.allreduce(sum(len(settled[k, i, kind]) for kind in kinds(cond)), op=MPI.SUM) == 0:
                 continue
-            body = tm.bodies[i]
+            body, found = tm.bodies[i], settled[k, i, kinds(cond)[0]]    # a fixed temperature is alone
             sub_cells = body.cell_map.sub_topology_to_topology(found[:, 0], inverse=True)
             body.mesh.topology.create_connectivity(tdim, tdim - 1)
             c2f = body.mesh.topology.connectivity(tdim, tdim - 1)       # same local facets as the parent's cell
             facets = np.unique(c2f.array[c2f.offsets[sub_cells] + found[:, 1]]).astype(np.int32)
-            cond = self.boundaries[k]
             ambient = fem.Constant(tm.parent, self.T_ref if cond.ambient is None else float(cond.ambient))
             applied.append(AppliedBoundary(k, i, cond, ambient, facets))
-            data[i].append((k + 1, found.astype(np.int32).ravel()))
+            data[i].extend((measure_id(k, kind), settled[k, i, kind].astype(np.int32).ravel()) for kind in kinds(cond))
         self.ds = [ufl.Measure("ds", domain=tm.parent, subdomain_data=d) if d else None for d in data]
         for a in applied:
             T, ds = self.T[a.body], self.ds[a.body]
@@ -369,10 +369,10 @@ class Thermal:
             if c.convection is not None:
                 a.h = fem.Constant(tm.parent, c.h(float(self.contact.speed.value)))
                 self.residuals[a.body] += a.h * (T - a.ambient) * r[a.body] * ds(
-                    a.index + 1, degree=self._facet_degree(a.body, CONVECTION_QUADRATURE))
+                    measure_id(a.index, "convection"), degree=self._facet_degree(a.body, CONVECTION_QUADRATURE))
             if c.emissivity is not None:
                 self.residuals[a.body] += self._radiation(a) * r[a.body] * ds(
-                    a.index + 1, degree=self._facet_degree(a.body, RADIATION_QUADRATURE))
+                    measure_id(a.index, "emissivity"), degree=self._facet_degree(a.body, RADIATION_QUADRATURE))
         return applied
 
     def _radiation(self, a: AppliedBoundary):
@@ -521,10 +521,10 @@ class Thermal:
             key = (a.index, a.body)
             if a.h is not None:
                 out[key] += dt * self.cache.scalar(("convection",) + key, lambda: a.h * (T - a.ambient) * ds(
-                    a.index + 1, degree=self._facet_degree(a.body, CONVECTION_QUADRATURE)))
+                    measure_id(a.index, "convection"), degree=self._facet_degree(a.body, CONVECTION_QUADRATURE)))
             if a.condition.emissivity is not None:
                 out[key] += dt * self.cache.scalar(("radiation",) + key, lambda: self._radiation(a) * ds(
-                    a.index + 1, degree=self._facet_degree(a.body, RADIATION_QUADRATURE)))
+                    measure_id(a.index, "emissivity"), degree=self._facet_degree(a.body, RADIATION_QUADRATURE)))
             if a.bc is not None:
                 if a.body not in residual:
                     residual[a.body] = self.cache.vector(("residual", a.body), lambda: self.residuals[a.body])

@@ -58,6 +58,50 @@ class AppliedBoundary:
     bc: fem.DirichletBC | None = None
 
 
+KINDS = ("temperature", "convection", "emissivity")   # a condition's kinds, each with its own measure id
+
+
+def kinds(condition: ThermalBoundary) -> tuple[str, ...]:
+    """The kinds of condition it gives (``KINDS``)."""
+    return tuple(k for k in KINDS if getattr(condition, k) is not None)
+
+
+def measure_id(k: int, kind: str) -> int:
+    """The boundary measure's id of kind ``kind`` of condition ``k`` (its own facets per kind)."""
+    return len(KINDS) * k + KINDS.index(kind) + 1
+
+
+def settle(found: dict, boundaries, comm) -> dict:
+    """Rows (cell, local facet) of each condition's kinds on each body, (k, body, kind) -> rows,
+    from ``found``: (k, body) -> [(reached through "free:", rows), ...] of ``boundaries[k]``. On a
+    facet that one condition names as a face, a condition that reaches it only through a "free:"
+    surface does not apply its kinds that the first gives (the face's own convection replaces the
+    free surface's there: before, both applied, h twice and the second's ambient defaulted). Two
+    conditions of one kind on one facet otherwise are an InputError (collective): the last of two
+    fixed temperatures won, two convections added up (found by a user trial)."""
+    def key(rows):
+        return rows[:, 0].astype(np.int64) * 64 + rows[:, 1]          # a (cell, local facet) row as one number
+
+    empty = np.empty((0, 2), np.int32)
+    whole = {ki: np.unique(np.concatenate([r for _, r in parts] + [empty]), axis=0) for ki, parts in found.items()}
+    named = {ki: key(np.concatenate([r for free, r in parts if not free] + [empty])) for ki, parts in found.items()}
+    out = {}
+    for (k, i), rows in whole.items():
+        for kind in kinds(boundaries[k]):
+            theirs = [named[j, b] for j, b in found if b == i and j != k and kind in kinds(boundaries[j])]
+            taken = np.concatenate(theirs + [np.empty(0, np.int64)])
+            out[k, i, kind] = rows[~(np.isin(key(rows), taken) & ~np.isin(key(rows), named[k, i]))]
+    for (k, i, kind), rows in out.items():
+        for (j, b, other), more in out.items():
+            if j > k and b == i and other == kind:
+                n = comm.allreduce(np.isin(key(rows), key(more)).sum())
+                if n:
+                    raise InputError(f"boundary[{k + 1}] and boundary[{j + 1}]", kind,
+                                     f"both give it on {n} facets: give each facet one (a face named in one "
+                                     'entry replaces what a "free:" surface of another gives there)')
+    return out
+
+
 def surface_rows(tm: TwoBodyMesh, name: str) -> np.ndarray:
     """(cell, local facet) rows (n, 2) on the parent mesh of the exterior facets of a named surface
     owned by this rank."""
@@ -70,4 +114,4 @@ def surface_rows(tm: TwoBodyMesh, name: str) -> np.ndarray:
     return np.asarray(rows, dtype=np.int32).reshape(-1, 2)
 
 
-__all__ = ["AppliedBoundary", "ThermalBoundary", "surface_rows"]
+__all__ = ["AppliedBoundary", "KINDS", "ThermalBoundary", "kinds", "measure_id", "settle", "surface_rows"]
