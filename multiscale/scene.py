@@ -34,7 +34,8 @@ from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
 from multiscale.scene_sections import (COUPLING_DEFAULT, DEFAULT_GRID, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
-from multiscale.scene_cycle import convection_coverage, cycle_coverage, short_phases, squeal_state
+from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_phases, squeal_state,
+                                   thin_heated_layers)
 from multiscale.scene_stability import Stability
 from multiscale.scene_vehicle import Vehicle
 
@@ -392,6 +393,9 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         warnings += cycle_coverage(scene.loading, end)
         if g is not None and {"friction", "thermal", "heat_partition"} <= effects:
             warnings += short_phases(scene.loading, g.motion, end, scene.time.dt)
+            if scene.materials is not None:
+                warnings += thin_heated_layers(scene.loading, g.motion, end, g.spec, g.resolved(), scene.materials,
+                                               scene.time.initial_temperature)
         if g is not None and g.motion == "rotation" and "thermal" in effects:
             warnings += convection_coverage(scene.boundary or (), scene.loading, end)
     profile = scene.loading.load_profile if scene.loading is not None else None

@@ -559,6 +559,33 @@ def test_a_braking_phase_shorter_than_a_step_is_warned_about(tmp_path):
     assert not any("braking phase" in w for w in loads(cold.replace("[loading]", cycle), tmp_path).warnings)
 
 
+def test_the_frictional_heat_flux_field_needs_friction(tmp_path):
+    """output.fields = ["heat_flux"] of a thermal run without friction wrote a field of zeros (a
+    user trial); without fields given, the run writes no such field."""
+    text = GOOD.replace('effects = ["contact", "friction", "thermal", "heat_partition", "conductance", "expansion"]',
+                        'effects = ["contact", "thermal"]')
+    assert "temperature" in loads(text, tmp_path).output.fields and "heat_flux" not in loads(text, tmp_path).output.fields
+    with pytest.raises(SceneError, match='output.fields: "heat_flux" needs effect "friction"'):
+        loads(text.replace("[output]", '[output]\nfields = ["heat_flux"]'), tmp_path)
+
+
+def test_a_heated_layer_thinner_than_the_interfaces_elements_is_warned_about(tmp_path):
+    """The perfect-contact pin-on-disc braked for 0.1 s: the heat reaches sqrt(pi chi t) = 1.6 mm into
+    the pin (chi 8.3e-6 m^2/s), less than its 2.5 mm elements at the interface, so its face
+    temperatures come out low (the demo car pad's rose 34 K with 4 mm elements where the
+    semi-infinite solid gives 103 K; found by a user trial); 0.8 mm elements resolve it."""
+    pod = (DEMOS / "pin_on_disc_perfect.toml").read_text().replace('end = "30 s"', 'end = "0.1 s"')
+    warned = [w for w in loads(pod, tmp_path).warnings if "reaches about" in w]
+    assert warned == ["materials.pin: the heat of the shortest braking (0.1 s) reaches about sqrt(pi chi t) = 1.6 mm "
+                      "into it (chi 8.3e-06 m^2/s), less than the interface's elements (2.5 mm): its surface "
+                      "temperatures come out low, about 65% of the rise by the phase's end (less before; 1-D "
+                      "estimate); an interface_mesh_size of 0.81 mm or less resolves them"]
+    finer = pod.replace('interface_mesh_size = "2.5 mm"', 'interface_mesh_size = "0.8 mm"')
+    assert not [w for w in loads(finer, tmp_path).warnings if "reaches about" in w]
+    cold = pod.replace('"thermal", "heat_partition", "expansion"', '"thermal"')     # no frictional heat
+    assert not [w for w in loads(cold, tmp_path).warnings if "reaches about" in w]
+
+
 def test_a_convection_table_the_speeds_leave_is_warned_about(tmp_path):
     """h(speed) is held at its table's ends like a material's table, but (before) silently: a car
     stop from 856 rpm with a table to 300 rpm cooled at h(300 rpm), a dwell at rest with a table
