@@ -555,6 +555,9 @@ def _surface_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]
     interfaces are planar; a file's load faces are given."""
     problems, known = [], g.surfaces
     for i, b in enumerate(scene.boundary or (), 1):
+        if b is not None and isinstance(b.convection, tuple) and g.motion != "rotation":   # was read at speed 0
+            problems.append(f"boundary[{i}].convection: a table against the rotating body's speed; {where} has a "
+                            f"{g.motion}: give a constant h")
         for s in ((b.surfaces or ()) if b is not None else ()):
             if s not in known:
                 problems.append(f'boundary[{i}].surfaces: "{s}" is not a surface of {where}; known: {", ".join(known)}')

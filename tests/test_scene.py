@@ -559,6 +559,15 @@ def test_a_braking_phase_shorter_than_a_step_is_warned_about(tmp_path):
     assert not any("braking phase" in w for w in loads(cold.replace("[loading]", cycle), tmp_path).warnings)
 
 
+def test_a_convection_table_against_speed_needs_a_rotating_body(tmp_path):
+    """h(speed) on the block sliding over a flat was read at speed 0, silently (a user trial)."""
+    table = '\n[[boundary]]\nsurfaces = ["free:block"]\nconvection = [["0 rad/s", "10 W/(m^2 K)"], ["100 rad/s", "50 W/(m^2 K)"]]\n'
+    with pytest.raises(SceneError) as info:
+        loads(GOOD + table, tmp_path)
+    assert info.value.problems == ["boundary[1].convection: a table against the rotating body's speed; builder "
+                                   '"block_on_flat" has a translation: give a constant h']
+
+
 def test_the_frictional_heat_flux_field_needs_friction(tmp_path):
     """output.fields = ["heat_flux"] of a thermal run without friction wrote a field of zeros (a
     user trial); without fields given, the run writes no such field."""
