@@ -407,6 +407,10 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         warnings += [f"materials.{name}.{phrase} (the initial temperature)" for name in g.materials
                      if scene.materials.get(name) is not None
                      for phrase in scene.materials[name].beyond(T0).values()]
+    if "wear" in effects and scene.wear is not None and g is not None and scene.materials is not None \
+            and scene.time is not None and scene.rough_interfaces:     # the rough material's own k_w: no table
+        if getattr(scene.materials.get(g.spec.interface_materials(scene.rough_interfaces[0])[0]), "k_w", None) is None:
+            warnings += scene.wear.held_ends(T0=scene.time.initial_temperature)
     for i, b in enumerate(scene.boundary or (), 1):
         given = [k for k in Boundary.THERMAL if b is not None and getattr(b, k) is not None]
         if given and "thermal" not in effects:

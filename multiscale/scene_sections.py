@@ -560,6 +560,27 @@ class Wear:
             return self.k_w
         return tuple(zip(*(self.k_w_table or FIG_7_9_WEAR_RATE)))
 
+    def held_ends(self, T0: float | None = None, hottest: float | None = None) -> list[str]:
+        """The k_w(T) table held at an end: below its first point at the initial temperature ``T0``
+        (``multiscale check``), above its last at ``hottest`` [K] (the rough surface's largest micro
+        temperature, after a run); [] with a constant k_w. A rough run started at 1 K or 3000 K wore
+        at the end values without a word, where a material's table is warned about
+        (``Material.beyond``)."""
+        if self.k_w is not None:
+            return []
+        temperatures, rates = self.rate
+        table = "wear.k_w_table" if self.k_w_table else "wear.k_w_table (absent: thesis Fig. 7.9)"
+        out = []
+        for T, where, end, rate, side, beyond in (
+                (T0, "the initial temperature", temperatures[0], rates[0], "below its first",
+                 T0 is not None and T0 < temperatures[0]),
+                (hottest, "the rough surface's largest micro temperature", temperatures[-1], rates[-1],
+                 "above its last", hottest is not None and hottest > temperatures[-1])):
+            if beyond:
+                out.append(f"{table}: {where}, {T - 273.15:.4g} degC, is {side} point {end - 273.15:.4g} degC: the "
+                           f"zones wear with k_w held at {rate:.3g} 1/Pa there")
+        return out
+
 
 @dataclass(frozen=True)
 class Layer:

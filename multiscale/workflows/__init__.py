@@ -146,27 +146,14 @@ def run_warnings(scene, history) -> list[str]:
 
 
 def _wear_table_ends(scene, history) -> list[str]:
-    """The zones' k_w(T) table (wear.k_w_table, else thesis Fig. 7.9: 20 to 400 degC) held at an
-    end: below it at the initial temperature, above it where the rough surface's micro temperature
-    went (``micro_max_temperature``). A rough run started at 1 K or 3000 K wore at the end values
-    without a word, where a material's table is warned about (``Material.beyond``)."""
+    """``Wear.held_ends`` at the rough surface's largest micro temperature (``micro_max_temperature``;
+    the initial temperature is the scene's warning); none where the rough material gives its k_w."""
     if not scene.has("wear") or scene.wear.k_w is not None or "micro_max_temperature" not in history.columns:
         return []
     if interface_materials(scene, scene.rough_interfaces[0])[0].k_w is not None:   # the material's own k_w
         return []
-    temperatures, rates = scene.wear.rate
-    table = "wear.k_w_table" if scene.wear.k_w_table else "wear.k_w_table (absent: thesis Fig. 7.9)"
     micro = np.asarray(history["micro_max_temperature"], dtype=float)
-    T0, hottest = scene.time.initial_temperature, np.max(micro, initial=-np.inf, where=np.isfinite(micro))
-    out = []
-    for T, where, end, rate, side, beyond in (
-            (T0, "the initial temperature", temperatures[0], rates[0], "below its first", T0 < temperatures[0]),
-            (hottest, "the rough surface's largest micro temperature", temperatures[-1], rates[-1], "above its last",
-             hottest > temperatures[-1])):
-        if beyond:
-            out.append(f"{table}: {where}, {T - 273.15:.4g} degC, is {side} point {end - 273.15:.4g} degC: the "
-                       f"zones wore with k_w held at {rate:.3g} 1/Pa there")
-    return out
+    return scene.wear.held_ends(hottest=float(np.max(micro, initial=-np.inf, where=np.isfinite(micro))))
 
 
 def _law_reach(history) -> list[str]:
