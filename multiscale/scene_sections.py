@@ -222,9 +222,8 @@ class Boundary:
     interfaces' normals, friction holding nothing, they must hold every part against its six rigid
     motions: ``macro.held``); ``convection`` h [W/(m^2 K)], constant or a table against the rotating
     body's speed [rad/s], towards ``ambient``; ``emissivity``: radiation eps sigma (T^4 -
-    T_ambient^4); ``temperature``: fixed. A face named in one entry takes that entry's convection,
-    radiation or temperature instead of those a "free:" surface of another gives there; two entries
-    giving one of them on one face otherwise are refused."""
+    T_ambient^4); ``temperature``: fixed. A face named in one entry takes its kinds of condition
+    instead of a "free:" surface's of another; two of one kind on a face are refused otherwise."""
 
     surfaces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), required=True)
     fix: tuple | None = key(ListOf(Choice(_COMPONENTS), unique=True, min_len=1), absent="no component held here")
@@ -562,10 +561,8 @@ class Wear:
 
     def held_ends(self, T0: float | None = None, hottest: float | None = None) -> list[str]:
         """The k_w(T) table held at an end: below its first point at the initial temperature ``T0``
-        (``multiscale check``), above its last at ``hottest`` [K] (the rough surface's largest micro
-        temperature, after a run); [] with a constant k_w. A rough run started at 1 K or 3000 K wore
-        at the end values without a word, where a material's table is warned about
-        (``Material.beyond``)."""
+        (check), above its last at ``hottest`` [K] (the largest micro temperature, after a run); []
+        with a constant k_w (a run at 1 K or 3000 K wore at the end values without a word)."""
         if self.k_w is not None:
             return []
         temperatures, rates = self.rate

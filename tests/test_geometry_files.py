@@ -899,7 +899,8 @@ def test_a_pad_off_the_disc_is_named_by_check(tmp_path, capsys):
     path = tmp_path / "gap.toml"
     path.write_text(text)
     assert main(["check", str(path)]) == 0
-    warnings = [line.strip() for line in capsys.readouterr().out.splitlines() if line.strip().startswith("warning")]
+    warnings = [line.strip() for line in capsys.readouterr().out.splitlines()
+                if line.strip().startswith("warning   geometry")]
     assert warnings == ["warning   geometry.bodies: pad_b share no face with disc, nor a body bonded to them (gap "
                         "0.001 m): no contact interface holds them, no friction or heat reaches them; a pad must "
                         "share a face with disc in the file"]
