@@ -163,7 +163,8 @@ def _run(args) -> int:
             print(f"error: {message}", file=sys.stderr)
         return 2
     scene = None
-    watch = None if comm is None else CtrlCWatch(comm, lambda: f"interrupted: {_kept(scene, args)}", INTERRUPTED)
+    watch = None if comm is None else CtrlCWatch(comm, lambda: f"interrupted: {_kept(scene, args, comm.size)}",
+                                                    INTERRUPTED)
     with watch or contextlib.nullcontext():     # a Ctrl-C that a rank's main thread cannot meet
         try:
             scene = load(args.scene, overrides={k: v for k, v, _ in args.settings})
@@ -187,7 +188,7 @@ def _run(args) -> int:
             return 2
         except KeyboardInterrupt as exc:       # Ctrl-C (mpiexec hands SIGINT to every rank)
             sys.unraisablehook = lambda unraisable: None   # finalizers of what the interrupt left half-built
-            line = f"interrupted {exc}".strip() + f": {_kept(scene, args)}"
+            line = f"interrupted {exc}".strip() + f": {_kept(scene, args, 1 if comm is None else comm.size)}"
             if watch is None:
                 print(line, file=sys.stderr, flush=True)
             else:
@@ -196,18 +197,25 @@ def _run(args) -> int:
     return 0
 
 
-def _kept(scene, args) -> str:
-    """What a run interrupted by Ctrl-C leaves (``scene``: None if it was still being read); --resume
-    is advised only with a checkpoint (before its first macro step ended it refused to resume)."""
+def _kept(scene, args, ranks: int = 1) -> str:
+    """What a run interrupted by Ctrl-C leaves (``scene``: None if it was still being read), and the
+    command that goes on, under this environment's mpiexec for ``ranks`` > 1; --resume is advised
+    only with a checkpoint (before its first macro step ended it refused to resume), --overwrite
+    when the folder holds files (a user trial was told to start again and refused)."""
     if scene is None:
         return "nothing was written"
-    command = shlex.join(["multiscale", "run", args.scene, *(f"--set={k}={text}" for k, _, text in args.settings)])
-    if analysis(scene) == "multiscale" and not (Path(scene.output.folder) / CHECKPOINT).is_file():
-        return (f"no macro step ended, there is nothing to resume; {command}"
-                + (" --overwrite" if args.overwrite else "") + " starts again")
-    how = (f"{command} --resume continues from the last finished step"
-           if analysis(scene) == "multiscale" else f"{command} --overwrite starts again")
-    return f"what was written stays in {scene.output.folder} (its provenance.json says so); {how}"
+    launcher = [MPIEXEC, "-n", str(ranks)] if ranks > 1 else []
+    command = shlex.join([*launcher, "multiscale", "run", args.scene,
+                          *(f"--set={k}={text}" for k, _, text in args.settings)])
+    folder = Path(scene.output.folder)
+    written = folder.is_dir() and any(folder.iterdir())
+    again = f"{command}{' --overwrite' if written else ''} starts again"
+    if analysis(scene) == "multiscale" and not (folder / CHECKPOINT).is_file():
+        return f"no macro step ended, there is nothing to resume; {again}"
+    if not written:
+        return f"nothing was written; {again}"
+    how = f"{command} --resume continues from the last finished step" if analysis(scene) == "multiscale" else again
+    return f"what was written stays in {folder} (its provenance.json says so); {how}"
 
 
 def _study(args) -> int:
@@ -424,7 +432,11 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
-    args = build_parser().parse_args(argv)
+    with open(os.devnull, "w") as void, contextlib.ExitStack() as quiet:
+        if launched_rank() > 0:       # the usage and its errors once under mpiexec, by rank 0 (a user trial)
+            quiet.enter_context(contextlib.redirect_stderr(void))
+            quiet.enter_context(contextlib.redirect_stdout(void))
+        args = build_parser().parse_args(argv)
     if args.command in SERIAL and launched_rank() > 0:      # `mpiexec -n 4 multiscale check`: said once, not 4 times
         return 0
     try:

@@ -294,6 +294,14 @@ def test_one_process_commands_under_a_launcher_speak_once(tmp_path, capsys, monk
     monkeypatch.setenv("PMI_RANK", "0")
     assert main(["check", path]) == 0 and f"{path}: OK" in capsys.readouterr().out
     assert main(["check", "missing.toml"]) == 2
+    capsys.readouterr()
+    # a mistake on the command line: the usage and the error once, by rank 0 (every rank printed it)
+    for rank, said in (("1", ""), ("0", "error: argument --max-cells: '0': a whole number >= 1")):
+        monkeypatch.setenv("PMI_RANK", rank)
+        with pytest.raises(SystemExit):
+            main(["run", path, "--max-cells", "0"])
+        err = capsys.readouterr().err
+        assert (said in err) if said else err == "", (rank, err)
 
 
 def test_stage_lines_one_per_stage_quiet_and_timed():

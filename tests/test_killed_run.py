@@ -230,6 +230,10 @@ def test_a_run_stopped_before_its_first_step_is_not_advised_to_resume(tmp_path, 
     assert main(["run", str(path)]) == 130
     err = capsys.readouterr().err
     assert "no macro step ended, there is nothing to resume" in err and "--resume" not in err
+    assert f"multiscale run {path} starts again" in err               # the folder is empty: a plain run
+    (folder / "provenance.json").write_text("{}")    # an interrupted run's record: the plain run is refused
+    assert main(["run", str(path)]) == 130
+    assert f"multiscale run {path} --overwrite starts again" in capsys.readouterr().err     # (a user trial)
 
 
 def test_a_damaged_field_file_says_how_to_resume(base):

@@ -72,8 +72,9 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
         records = read_records(study)
         todo = [r for r in study.runs if not _done(records.get(r.key), rerun_failed, study.options.timeout)]
         mine = todo[rank::size]
-        if progress and rank == 0 and mine:
-            bar = tqdm(total=len(mine), desc=study.name, unit="run")
+        if progress and rank == 0 and mine:      # under MPI the bar follows rank 0's share (it said 2/2 of 3)
+            share = f" (rank 0's of {len(todo)})" if size > 1 else ""
+            bar = tqdm(total=len(mine), desc=study.name + share, unit="run")
         queue = list(mine)
         termination = Termination()
         lifeline = _lifeline()
