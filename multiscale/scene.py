@@ -213,6 +213,14 @@ class Scene:
             return ()
         return tuple(n for n in self.geometry.spec.interfaces if self.interface_settings(n).rough)
 
+    @property
+    def rough_material_wears(self) -> bool:
+        """True if the rough body's material (at the first rough interface) gives its own k_w: the
+        zones wear by it, not by [wear]'s k_w, its k_w(T) table or the default table."""
+        rough = self.rough_interfaces
+        name = self.geometry.spec.interface_materials(rough[0])[0] if rough else None
+        return getattr((self.materials or {}).get(name), "k_w", None) is not None
+
 
 def load(path, overrides=None) -> Scene:
     """Read and validate a scene file; raises SceneError listing every problem.
@@ -408,9 +416,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                      if scene.materials.get(name) is not None
                      for phrase in scene.materials[name].beyond(T0).values()]
     if "wear" in effects and scene.wear is not None and g is not None and scene.materials is not None \
-            and scene.time is not None and scene.rough_interfaces:     # the rough material's own k_w: no table
-        if getattr(scene.materials.get(g.spec.interface_materials(scene.rough_interfaces[0])[0]), "k_w", None) is None:
-            warnings += scene.wear.held_ends(T0=scene.time.initial_temperature)
+            and scene.time is not None and not scene.rough_material_wears:
+        warnings += scene.wear.held_ends(T0=scene.time.initial_temperature)
     for i, b in enumerate(scene.boundary or (), 1):
         given = [k for k in Boundary.THERMAL if b is not None and getattr(b, k) is not None]
         if given and "thermal" not in effects:

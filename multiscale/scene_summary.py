@@ -134,10 +134,10 @@ def _effect_line(scene: Scene, effect: str) -> str:
         return f"{r.body or scene.bodies[0]}: {surface}; {m.zones[0]} x {m.zones[1]} zones of {cells}, {m.law_points}-point laws"
     if effect == "wear":
         w = scene.wear
-        rough, counter = (scene.materials[m] for m in scene.geometry.spec.interface_materials(
-            scene.rough_interfaces[0] if scene.rough_interfaces else None))
+        counter = scene.materials[scene.geometry.spec.interface_materials(
+            scene.rough_interfaces[0] if scene.rough_interfaces else None)[1]]
         rate = f"k_w = {w.k_w:g} 1/Pa" if w.k_w is not None else (
-            "k_w(T) table" if w.k_w_table is not None else "k_w of its material" if rough.k_w is not None else
+            "k_w(T) table" if w.k_w_table is not None else "k_w of its material" if scene.rough_material_wears else
             f"k_w(T) default table: {FIG_7_9_CALIBRATION}")
         both = f"; the {scene.bodies[1]} wears too (k_w of its material)" if counter.k_w is not None else ""
         return f"Archard every {w.update_every} step(s) in {w.substeps} increment(s){both}; {rate}"

@@ -918,6 +918,11 @@ def test_a_wear_table_left_by_the_run_is_warned_about(tmp_path):
         "20 degC: the zones wear with k_w held at 8.2e-15 1/Pa there"]
     assert len(run_warnings(cold, h)) == 1
     assert run_warnings(loads(text.replace("substeps = 2", 'substeps = 2\nk_w = "1e-14 1/Pa"'), tmp_path), h) == []
+    own = text.replace('alpha = "5e-6 1/K"', 'alpha = "5e-6 1/K"\nk_w = "1e-14 1/Pa"')   # the pin material's k_w
+    assert run_warnings(loads(own, tmp_path), h) == []
+    assert not [w for w in loads(own.replace('"20 degC"', '"1 K"'), tmp_path).warnings if w.startswith("wear.")]
+    from multiscale.scene_summary import summary
+    assert any(line.endswith("; k_w of its material") for line in summary(loads(own, tmp_path)))
 
 
 def test_a_penalty_softer_than_the_bodies_is_warned_about(tmp_path):

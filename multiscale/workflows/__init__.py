@@ -148,9 +148,8 @@ def run_warnings(scene, history) -> list[str]:
 def _wear_table_ends(scene, history) -> list[str]:
     """``Wear.held_ends`` at the rough surface's largest micro temperature (``micro_max_temperature``;
     the initial temperature is the scene's warning); none where the rough material gives its k_w."""
-    if not scene.has("wear") or scene.wear.k_w is not None or "micro_max_temperature" not in history.columns:
-        return []
-    if interface_materials(scene, scene.rough_interfaces[0])[0].k_w is not None:   # the material's own k_w
+    if not scene.has("wear") or scene.wear.k_w is not None or scene.rough_material_wears \
+            or "micro_max_temperature" not in history.columns:
         return []
     micro = np.asarray(history["micro_max_temperature"], dtype=float)
     return scene.wear.held_ends(hottest=float(np.max(micro, initial=-np.inf, where=np.isfinite(micro))))

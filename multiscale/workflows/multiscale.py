@@ -74,7 +74,7 @@ def post_analysis(scene, zone) -> PostAnalysis:
                           bounded=m.remote(scene.effects) == "rough",
                           conduction=m.coupling_scheme(scene.effects) == "implicit")
     wear = scene.has("wear")
-    rate = (rough.wear_rate if rough.k_w is not None else scene.wear.rate) if wear else None
+    rate = (rough.wear_rate if scene.rough_material_wears else scene.wear.rate) if wear else None
     counter_rate = counter.wear_rate if wear and counter.k_w is not None else None
     if counter_rate is not None and not isinstance(scene.geometry.spec.motion, Rotation):
         raise InputError("materials.k_w", counter.k_w, "the counter-face wears along a circular track: it must "
