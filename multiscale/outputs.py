@@ -78,9 +78,8 @@ WRITES = {"transient": ("displacement", "temperature", "von_mises", "contact_pre
           "squeal": ("displacement", "von_mises", "contact_pressure", "interface")}
 PROVENANCE = {"scene.toml": "the scene file as given",
               "scene_resolved.toml": "the scene with every default filled in, SI units",
-              "provenance.json": "versions, command line, ranks, start and end time, wall time per stage",
-              "paraview.py": "pvpython script that opens the fields (pvpython paraview.py, or ParaView's "
-                             "Python shell)"}
+              "provenance.json": "versions, command line, ranks, start and end time, wall time per stage"}
+SCRIPT = {"paraview.py": "pvpython script that opens the fields (pvpython paraview.py, or ParaView's Python shell)"}
 
 
 def analysis(scene) -> str:
@@ -171,6 +170,8 @@ def plan(scene) -> Plan:
     if not scene.output.figures:
         files = {name: what for name, what in files.items() if not name.endswith(".png")}
     files.update(PROVENANCE)
+    if body or iface or kind == "squeal":       # something to open: fields or mode shapes
+        files.update(SCRIPT)
     return Plan(kind, scene.output.folder, tuple(scene.bodies), body, iface, times, files,
                 tuple(f for f in scene.output.fields if f not in WRITES[kind]))
 

@@ -76,7 +76,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             raise
     result.files += [f.with_suffix(".h5") for f in result.files if f.suffix == ".xdmf"]   # their data
     if ended:                 # --resume of a finished run: nothing to do, its provenance stays as it was
-        result.files += [result.folder / name for name in outputs.PROVENANCE]
+        result.files += [result.folder / name for name in [*outputs.PROVENANCE, *outputs.SCRIPT]
+                         if (result.folder / name).is_file()]
         return result
     beyond = run_warnings(scene, getattr(result, "history", None)) + list(getattr(result, "warnings", ()))
     for line in beyond if comm.rank == 0 else ():           # what the results leave out: also when quiet
@@ -87,16 +88,18 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                                  wall_time=time.perf_counter() - start, analysis=kind,
                                  status="resumed and finished" if resume else "finished", earlier=earlier,
                                  warnings=[*scene.warnings, *beyond])
-        return files + [_write_script(result.folder, scene)]
+        return files + _write_script(result.folder, scene)
     result.files += comm.bcast(io.on_root(comm, write, f"the provenance into {result.folder}"), root=0)
     return result
 
 
-def _write_script(folder: Path, scene) -> Path:
-    """``paraview.py`` beside the results (rank 0)."""
-    path = Path(folder) / "paraview.py"
-    path.write_text(outputs.paraview_script(outputs.plan(scene)))
-    return path
+def _write_script(folder: Path, scene) -> list[Path]:
+    """``paraview.py`` beside the results (rank 0), if they hold fields or mode shapes to open."""
+    p, path = outputs.plan(scene), Path(folder) / "paraview.py"
+    if path.name not in p.files:
+        return []
+    path.write_text(outputs.paraview_script(p))
+    return [path]
 
 
 def _abandoned(folder: Path, scene) -> None:
