@@ -201,14 +201,17 @@ def _load(model, g) -> Found:
     if not order:
         raise InputError("geometry.file", g.file.name, "holds no volume (3-D solid)")
     occ = bool(model.occ.getEntities(3))
-    split = []                    # solids of the file that the fragment cut into pieces: they overlap
+    split, after = [], {}         # solids of the file that the fragment cut into pieces: they overlap
+    groups = _physical_groups(model) if occ and g.kind == "script" else []
     if occ and g.kind != "mesh":  # before a script's scaling: fast on its analytic faces
         volumes = model.occ.getEntities(3)
+        boxes = {t: model.getBoundingBox(2, t) for dim, _, _, tags in groups if dim == 2 for t in tags}
         _, mapping = model.occ.fragment(volumes, [])
         model.occ.synchronize()
         after = {t: [b for d, b in m if d == 3] for (_, t), m in zip(volumes, mapping)}
         order = [t for old in order for t in after.get(old, [old])]
         split = sorted(old for old, pieces in after.items() if len(pieces) > 1)
+        _check_surface_groups(model, g, groups, boxes)
     # the extent before a script's or a mesh's scaling, scaled: gmsh's bounding box of some OpenCASCADE
     # surfaces is stale after occ.dilate (a partial Sphere 80 mm off the origin in mm spanned 80 m)
     extent = _extent(model, g, scale if g.kind != "cad" else 1.0, unit)
@@ -222,6 +225,12 @@ def _load(model, g) -> Found:
         else:
             model.geo.dilate(model.getEntities(), 0, 0, 0, scale, scale, scale)
             model.geo.synchronize()
+    if groups:                    # gmsh dropped those of remade entities (the fragment), or all (occ.dilate)
+        model.removePhysicalGroups()
+        for dim, group, name, tags in groups:
+            model.removePhysicalName(name)         # (else the name stays with the dropped group)
+            model.addPhysicalGroup(dim, [p for t in tags for p in after.get(t, [t])] if dim == 3 else tags, group,
+                                   name=name)
     labels = {t: _label(model, t) for _, t in model.getEntities(3)}
     try:
         bodies = _bodies(model, g, order, labels)
@@ -235,6 +244,25 @@ def _load(model, g) -> Found:
     _interfaces(model, g, found, occ)
     _surfaces(model, g, found)
     return found
+
+
+def _physical_groups(model) -> list[tuple[int, int, str, list[int]]]:
+    """(dimension, tag, name, entity tags) of the model's physical volumes and surfaces."""
+    return [(d, t, model.getPhysicalName(d, t), [int(e) for e in model.getEntitiesForPhysicalGroup(d, t)])
+            for d, t in model.getPhysicalGroups() if d >= 2]
+
+
+def _check_surface_groups(model, g, groups, boxes: dict) -> None:
+    """Refuse a script's physical surface that the fragment cut or renumbered (its faces before it:
+    ``boxes``, tag -> bounding box): its group would name other faces than the script's."""
+    there = {t for _, t in model.getEntities(2)}
+    moved = sorted({name for dim, _, name, tags in groups if dim == 2 for t in tags
+                    if t not in there or not np.allclose(model.getBoundingBox(2, t), boxes[t], rtol=0, atol=1e-9
+                                                         * max(1.0, float(np.abs(boxes[t]).max())))})
+    if moved:
+        raise InputError("geometry.file", g.file.name, f"the physical surface(s) {', '.join(moved)} lie where "
+                         "solids touch: joining the solids (OpenCASCADE fragment) remade those faces; put "
+                         "Coherence; (or BooleanFragments) before the Physical Surface lines of the script")
 
 
 def _extent(model, g, scale: float, unit: tuple) -> float:
@@ -496,6 +524,9 @@ def _surfaces(model, g, found: Found) -> None:
             raise InputError(where, name, f"selects a face that geometry.surfaces.{taken[0]} already selects; "
                              "a face can carry one surface name")
         found.surfaces[name] = faces
+    named = {f for n in g.surfaces for f in found.surfaces[n]}      # the scene's names win over the file's
+    for n in [n for n in groups if n in found.surfaces and n not in g.surfaces and set(groups[n]) & named]:
+        del found.surfaces[n]
 
 
 def _faces_of(model, volumes: list[int]) -> list[int]:

@@ -212,8 +212,6 @@ class Multiscale:
         self.micro_heat = np.full(Z, np.nan)          # W, Phi of the last post-analysis
         self.micro_heat_rough = np.full(Z, np.nan)    # W, heat into the rough body by it
         self.remote_difference = np.zeros(Z)          # K, T_rough − T_counter of the macro surfaces
-        self.facet_area = np.bincount(rough.zone_of_facet[rough.zone_of_facet >= 0],
-                                      self.tm.interface.areas[rough.zone_of_facet >= 0], minlength=Z)
         self._last = None                             # this rank's zones, their post-analysis, loading, remote
         self.law_increment = None                     # m, displacement change of the last solve after new laws
 
@@ -246,7 +244,8 @@ class Multiscale:
         if speed == 0.0 and dt:
             speed = model.drive.mean_speed(model.time, model.time + dt) or \
                 model.drive.mean_speed(max(model.time - dt, 0.0), model.time)
-        return ZoneLoading(force, force / self.rough.zone_area, reach * abs(speed),
+        covered = self.rough.covered_area           # the mean pressure of each zone's facets
+        return ZoneLoading(force, force / np.where(covered > 0, covered, 1.0), reach * abs(speed),
                            angle + (np.pi if speed < 0 else 0.0), T, reach)
 
     def analyse(self) -> MicroStep:
@@ -266,10 +265,11 @@ class Multiscale:
             hardness_temperature=self._hardness_temperature(mine, T[:, 1])))
         self._last = (mine, res, load, remote, loaded)
         implicit = self.settings.coupling == "implicit"
+        cover = self.rough.cover[mine]              # the patches' heat and area over their facets'
         parts = comm.allgather((mine, res.pressure, res.max_pressure, res.max_temperature,
-                                res.partition_equal if implicit else res.partition, res.conductance, res.heat,
-                                res.heat_rough, res.exchange, remote[:, 1] - remote[:, 0], res.plastic_area_fraction,
-                                res.area_fraction * self.rough.zone_area[mine]))
+                                res.partition_equal if implicit else res.partition, res.conductance, res.heat * cover,
+                                res.heat_rough * cover, res.exchange * cover, remote[:, 1] - remote[:, 0],
+                                res.plastic_area_fraction, res.area_fraction * self.rough.covered_area[mine]))
         for a in (self.proposed, self.flash, self.micro_heat, self.micro_heat_rough):
             a[:] = np.nan
         self.proposed_exchange[:] = 0.0
@@ -334,11 +334,11 @@ class Multiscale:
         for ids, warm, heights, lost, w, worn, off in self.comm.allgather((
                 mine, res.worn_pressure, res.heights, res.counter_volume, res.plastic, res.worn_area_fraction,
                 res.wear_error)):
-            area += float((worn - off / 2) @ self.rough.zone_area[ids])     # in twice the substeps
-            error += float(np.abs(off) @ self.rough.zone_area[ids])
+            area += float((worn - off / 2) @ self.rough.covered_area[ids])     # in twice the substeps
+            error += float(np.abs(off) @ self.rough.covered_area[ids])
             self.warm[ids] = warm
             self.rough.set_heights(ids, heights)
-            volume[ids] = lost
+            volume[ids] = lost * self.rough.cover[ids]
             if self.plastic:
                 self.rough.plastic[ids] += w
         if self.post.counter_rate is not None:
@@ -405,7 +405,8 @@ class Multiscale:
         if self.partition_law:
             iface.set_field(contact.partition, np.where(rough, self.partition[zone_of], iface.values(contact.partition)))
         if self.settings.coupling == "implicit":   # the exchange G of each zone over its facets
-            self.conductance = self.exchange / np.where(self.facet_area > 0, self.facet_area, 1.0)
+            covered = self.rough.covered_area
+            self.conductance = self.exchange / np.where(covered > 0, covered, 1.0)
         if self.post.conductance is not None or self.settings.coupling == "implicit":
             iface.set_field(contact.conductance,
                             np.where(rough, self.conductance[zone_of], iface.values(contact.conductance)))

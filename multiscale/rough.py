@@ -134,6 +134,7 @@ class RoughInterface:
     initial: np.ndarray = field(init=False)              # (Z, ny, nx) initial topographies [m]
     plastic: np.ndarray = field(init=False)              # (Z, ny, nx) accumulated permanent deformation [m]
     levels: np.ndarray = field(init=False)               # p_max halvings of each zone's law
+    covered_area: np.ndarray = field(init=False)         # m^2, area of the facets each zone holds
     used: np.ndarray = field(init=False)                 # ids of the zones holding a facet
     laws_computed: int = 0                               # laws computed by the last update
 
@@ -148,7 +149,9 @@ class RoughInterface:
             uv = self.planes[k].uv(iface.midpoints[masks[name]])
             self.zone_of_facet[masks[name]] = offsets[k] + self.grids[k].zone_of(uv[:, 0], uv[:, 1])
             _check_zone_size(self.grids[k], iface.areas[masks[name]], name)
-        self.used = np.unique(self.zone_of_facet[self.zone_of_facet >= 0])
+        rough = self.zone_of_facet >= 0
+        self.used = np.unique(self.zone_of_facet[rough])
+        self.covered_area = np.bincount(self.zone_of_facet[rough], iface.areas[rough], minlength=len(self.zones))
         self.initial = np.stack([z.surface.heights for z in self.zones])
         self.plastic = np.zeros_like(self.initial)
         self.levels = np.zeros(len(self.zones), dtype=int)
@@ -156,8 +159,18 @@ class RoughInterface:
 
     @property
     def zone_area(self) -> np.ndarray:
-        """Nominal area of every zone [m^2]."""
+        """Nominal area of every zone [m^2]: its patch's (the cells of its footprint)."""
         return np.array([z.area for z in self.zones])
+
+    @property
+    def cover(self) -> np.ndarray:
+        """Per zone, the area of its facets over its patch's (``covered_area / zone_area``; 0 for a
+        zone holding no facet). A zone's patch is a sample of the roughness under its facets: it is
+        loaded at their mean pressure, and what it gives per unit of its area (real contact area,
+        heat, exchange, worn volume) counts over their area. A zone on the edge of a round face
+        covers a part of its box (0.33 for a corner zone of 4 x 4 on a disc face); one inside it about
+        1, up to how the facets' midpoints fall."""
+        return self.covered_area / self.zone_area
 
     @property
     def law_top(self) -> np.ndarray:
@@ -216,9 +229,10 @@ class RoughInterface:
         return self.initial - self.heights() - self.plastic
 
     def zone_wear_volume(self, depth: np.ndarray) -> np.ndarray:
-        """Worn volume of each zone [m^3] from its depth field (Z, ny, nx) [m]."""
+        """Worn volume of each zone [m^3] from its depth field (Z, ny, nx) [m]: over its facets'
+        area (``cover``)."""
         s = self.zones[0].surface
-        return depth.sum(axis=(-2, -1)) * s.dx * s.dy
+        return depth.sum(axis=(-2, -1)) * s.dx * s.dy * self.cover
 
     def update_laws(self) -> int:
         """Laws of every used zone (cached ones reused), loaded into the facet law (collective);
