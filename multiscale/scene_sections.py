@@ -37,7 +37,7 @@ _FRICTION = Quantity("dimensionless", ge=0, plausible=(0.0, 2.0))
 _ROUGHNESS = Quantity("length", gt=0, plausible=(1e-10, 1e-3))            # RMS height
 _CONVECTION = Quantity("conductance", ge=0, plausible=(0.0, 1e4))         # still air to boiling water
 _ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0))  # up to ~24 000 rpm
-_WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # Archard k/H
+_WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # per frictional work (Eq. 3.10)
 _HARDNESS = Quantity("pressure", gt=0, plausible=(1e6, 1e11))            # soft polymer to diamond
 _WITH_RMS = "needed with rms (a generated surface)"
 
