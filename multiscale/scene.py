@@ -26,8 +26,8 @@ from pathlib import Path
 import numpy as np
 
 from multiscale.errors import InputError, SceneError
-from multiscale.micro.topography import (TopographyWarning, check_cutoff, check_resolved, covers, read_topography,
-                                         zone_cells)
+from multiscale.micro.topography import (TopographyWarning, check_cutoff, check_resolved, coarse_grid, condition,
+                                         covers, read_topography, zone_cells)
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
@@ -373,7 +373,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                     problems.append(f"wear.{given[0]}: the rough body's material gives k_w "
                                     f"(materials.{name}.k_w): give one of them")
         if not problems:
-            problems += _nyquist(scene) + _measured_cover(scene)
+            problems += _nyquist(scene) + _measured_cover(scene, warnings)
     if scene.output is not None and scene.output.fields is not None:
         for f in scene.output.fields:
             missing = [e for e in OUTPUT_FIELDS[f] if e not in effects]
@@ -505,14 +505,15 @@ def _nyquist(scene: Scene) -> list[str]:
     return sorted(set(out))
 
 
-def _measured_cover(scene: Scene) -> list[str]:
+def _measured_cover(scene: Scene, warnings_out: list) -> list[str]:
     """A face's cells per zone taken from a measurement's pixels stay within
     ``topography.MAX_CELLS`` (``topography.zone_cells``, the run's rule), a measurement used as it
     is (``cover = "measured"``) covers its face, one drawn from (``"equivalent"``) holds a
     wavelength the face's micro grid resolves: the run's refusals (``topography.covers``,
     ``topography.check_resolved``) before meshing, for the faces whose extent the geometry knows then
     (``GeometrySpec.interface_extents``; the others are refused after meshing), and a filter
-    ``cutoff`` spans 2 of its pixels (``topography.check_cutoff``)."""
+    ``cutoff`` spans 2 of its pixels (``topography.check_cutoff``); a grid too coarse for the measured
+    gradient is warned about (``topography.coarse_grid``, into ``warnings_out``)."""
     out = []
     for name in scene.rough_interfaces:
         s, size = scene.interface_settings(name), scene.geometry.spec.interface_extents.get(name)
@@ -535,6 +536,11 @@ def _measured_cover(scene: Scene) -> list[str]:
                 covers(measured.size, size, r.cover, prefix=prefix)
             elif r.cover == "equivalent":
                 check_resolved(measured.size, [z * c for z, c in zip(s.micro.zones, cells)], size, prefix=prefix)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", TopographyWarning)
+                done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix=prefix, despike=r.despike)
+            cell = [L / (z * c) for L, z, c in zip(size, s.micro.zones, cells)]
+            warnings_out += [w for w in [coarse_grid(done.surface, cell, prefix)] if w and w not in warnings_out]
         except InputError as exc:
             out.append(str(exc))
     return sorted(set(out))

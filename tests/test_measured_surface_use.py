@@ -45,6 +45,12 @@ def scene(tmp_path, roughness, micro=""):
     return loads(SCENE.format(roughness=roughness, micro=micro), tmp_path)
 
 
+def apart(found) -> tuple:
+    """The scene's warnings but the micro grid's on the measured gradient (``topography.coarse_grid``:
+    top-1.top's 0.6 um measurement on the block's 10 mm face keeps none of it, and says so)."""
+    return tuple(w for w in found if "of the measured RMS gradient" not in w)
+
+
 def test_surface_command_prints_the_steps_and_surfacetopographys_sq(tmp_path, capsys):
     figure = tmp_path / "top.png"
     assert main(["surface", str(TOP), "--figure", str(figure)]) == 0
@@ -105,7 +111,7 @@ def test_surface_command_warnings_name_its_options_a_scenes_warnings_its_keys(tm
                       "warning: --height-unit 0.001 m overrides the file's unit (nm = 1e-09 m)",
                       "warning: FILE = " + heights.replace("{}height_unit", "--height-unit")]
     s = scene(tmp_path, f'file = "{TOP}"\nheight_unit = "1 mm"\npixel_size = "3 nm"\ncover = "tile"', GRID)
-    assert s.warnings == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",
+    assert apart(s.warnings) == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",
                           "roughness.height_unit = 0.001 m overrides the file's unit (nm = 1e-09 m)",
                           "roughness.file = " + heights.format("roughness."))
 
@@ -121,9 +127,10 @@ def test_scene_reads_a_measured_file_with_its_options(tmp_path):
     r = s.roughness
     assert (r.file, r.channel, r.detrend, r.cutoff, r.cover, r.seed, r.max_undefined) == (
         TOP, 0, "poly2", pytest.approx(2e-7), "mirror", 4, 0.2)
-    assert r.pixel_size is None and r.height_unit is None and s.warnings == ()
+    assert r.pixel_size is None and r.height_unit is None and apart(s.warnings) == ()
+    assert [w for w in s.warnings if "resolve 0.0% of the measured RMS gradient" in w]
     over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "tile"', GRID)
-    assert over.warnings == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",)
+    assert apart(over.warnings) == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",)
 
 
 @pytest.mark.parametrize("roughness, fragment", [
@@ -196,7 +203,7 @@ def test_zones_from_a_measured_file_for_every_cover(tmp_path):
     over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "tile"', GRID)
     lines = []
     make_zones(over, lo, (4e-6, 4e-6), seed=10, log=lines.append, cover="equivalent")
-    assert over.warnings == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",)
+    assert apart(over.warnings) == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",)
     assert lines[0].startswith("roughness: read top-1.top") and not any("overrides" in line for line in lines)
 
 
@@ -442,3 +449,32 @@ def test_an_interfaces_own_measured_file_is_named_by_its_key_and_read_once(tmp_p
     with pytest.raises(InputError, match=r"^interfaces\.interface\.roughness\.cover = 'measured': the measurement "
                                          r"\(12\.8 x 12\.8 mm\) does not cover"):
         rough.make_zones(own.roughness, own.micro, (0.0, 0.0), (20e-3, 20e-3), seed=0, prefix=prefix)
+
+
+def test_a_micro_grid_too_coarse_for_the_measured_gradient_is_warned_about(tmp_path):
+    """The real contact area follows the RMS gradient (Bush, Gibson & Thomas 1975), which a micro grid
+    coarser than the measurement's pixels loses: a user trial's x3p file on 41.6 um cells kept 1 % of
+    it, and check said nothing. ``topography.kept_gradient`` (the PSD's gradient below the grid's
+    Nyquist) is the gradient ratio of the equivalent surface drawn on that grid within 15 %; check
+    warns below ``GRADIENT_KEPT`` with the cells that keep that much, and they do (to 2 %)."""
+    from multiscale.micro.spectrum import surface_statistics
+    from multiscale.micro.surface import fractal_surface
+    f = fractal_surface((256, 256), (2.56e-3, 2.56e-3), 0.3, 1, 128, 1e-6, seed=2)
+    measured = Surface(f.heights, f.dx, f.dy, periodic=False)
+    np.save(tmp_path / "pad.npy", measured.heights)
+    for pixels in (2, 8):
+        cell = (pixels * measured.dx, pixels * measured.dy)
+        with warnings.catch_warnings(record=True):        # the run's report line instead (below half: 8 pixels)
+            drawn, lines = cover(measured, (256 // pixels, 256 // pixels), measured.size, "equivalent")
+        assert any("of the measured RMS gradient" in line for line in lines) == (pixels == 8)
+        ratio = surface_statistics(drawn).Sdq / surface_statistics(measured).Sdq
+        assert topography.kept_gradient(measured, cell) == pytest.approx(ratio, rel=0.15)
+    s = scene(tmp_path, 'file = "pad.npy"\npixel_size = "10 um"\ncover = "equivalent"', "grid = [50, 50]")
+    (warned,) = [w for w in s.warnings if "of the measured RMS gradient" in w]       # 100 um cells
+    kept = topography.kept_gradient(condition(read_topography(tmp_path / "pad.npy", pixel_size=1e-5)).surface,
+                                    (1e-4, 1e-4))
+    assert kept < topography.GRADIENT_KEPT and f"resolve {kept:.1%} of" in warned
+    half = float(warned.split("cells of ")[1].split(" x")[0]) * 1e-6       # the cells it names
+    assert topography.kept_gradient(measured, (half, half)) == pytest.approx(topography.GRADIENT_KEPT, rel=0.02)
+    fine = scene(tmp_path, 'file = "pad.npy"\npixel_size = "10 um"\ncover = "equivalent"', "grid = [500, 500]")
+    assert not [w for w in fine.warnings if "of the measured RMS gradient" in w]      # 10 um cells: the pixels
