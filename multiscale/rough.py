@@ -12,9 +12,9 @@ id. Zone coordinates (u, v) are those of the interface plane's frame (``interfac
 plane z = const, (u, v) = (x, y).
 
 ``update_laws`` computes the laws of the zones whose topography changed (the pool's cache keeps
-the others) and loads them into the facet law; a zone whose law fails (close to full contact
-below p_max) is retried with p_max halved, up to ``P_MAX_HALVINGS`` times (remembered for its
-later laws). ``datum_gap`` is the per-facet uniform initial gap at which the rigid rough bodies
+the others) and loads them into the facet law; a zone whose law fails (its roughness stiffer below
+p_max than the zone's own compliance resolves) is retried with p_max halved, up to
+``P_MAX_HALVINGS`` times (remembered for its later laws). ``datum_gap`` is the per-facet uniform initial gap at which the rigid rough bodies
 carry given forces, one bisection per interface: it starts Newton close to equilibrium.
 
 ``track_depth`` spreads the volume the counter-face (a rotating body 1) loses in each zone over its
@@ -35,14 +35,14 @@ from multiscale.errors import InputError
 from multiscale.geometry import Rotation, plane_frame
 from multiscale.macro.laws_ufl import FacetLaw
 from multiscale.macro.mesh import TwoBodyMesh
-from multiscale.micro.laws import LawError, LawSpec, ZoneLaws
+from multiscale.micro.laws import STIFF, LawError, LawSpec, ZoneLaws
 from multiscale.micro.zones import Zone, ZoneGrid
 from multiscale.pool import MicroPool
 
 P_MAX_HALVINGS = 4         # a zone whose law fails is retried with p_max / 2, ... / 16
-FULL_CONTACT = ("every zone is close to full contact even at p_max / 16: at these pressures the surface is too "
-                "smooth for laws of rough contact; perfect contact (effects without \"roughness\", the "
-                "interface's penalty) is the model for it")
+FULL_CONTACT = ("every zone's law stops below p_max / 16: at these pressures the roughness is stiffer than the "
+                "zones' own compliance resolves; more micro.zones (smaller zones) carry the laws further, and a "
+                "face this smooth tends to perfect contact (effects without \"roughness\", the interface's penalty)")
 
 
 @dataclass(frozen=True)
@@ -247,7 +247,7 @@ class RoughInterface:
                 laws = self.pool.laws(todo[comm.rank::comm.size], spec, gather="all")
             except LawError as exc:
                 if level == P_MAX_HALVINGS:           # the messages name the last p_max: say how it came
-                    full = len(exc.failures) == len(self.used) and all("full contact" in f.message
+                    full = len(exc.failures) == len(self.used) and all(STIFF in f.message
                                                                         for f in exc.failures)
                     raise LawError([dataclasses.replace(f, message=f"{f.message}, reached by {level} halvings of "
                                                         f"micro.p_max = {self.spec.p_max:.3g} Pa") for f in exc.failures],

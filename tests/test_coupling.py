@@ -304,8 +304,9 @@ def test_a_failed_law_loaded_beyond_its_halved_top_is_not_told_to_raise_p_max():
     for reach, halved in ((0.4, 0.0), (0.6, 1.09)):
         h.append(time=0.6, law_reach=reach, law_reach_halved=halved)
     (warning,) = run_warnings(scene, h)
-    assert warning.startswith("zones whose laws failed close to full contact (their top p_max halved) were loaded to "
-                              "1.09 times that top") and "raise" not in warning
+    assert warning.startswith("zones whose laws stopped below micro.p_max (their top halved: the roughness stiffer "
+                              "there than the zone's own compliance resolves) were loaded to 1.09 times that top") \
+        and "raise" not in warning
     h.columns["law_reach"][1] = 1.5
     assert [w[:40] for w in run_warnings(scene, h)] == ["the zone pressures reached 1.5 times mic", warning[:40]]
 
@@ -624,7 +625,8 @@ def test_laws_failing_at_every_p_max_say_how_it_was_reached(tmp_path):
     extrapolated 1e3 times beyond their top; found by an adversarial test)."""
     from multiscale.micro.laws import LawError
     from multiscale.rough import FULL_CONTACT, P_MAX_HALVINGS
-    with pytest.raises(LawError, match=rf"close to full contact\); lower p_max \(this law's: 6.25e\+06 Pa\), reached by "
+    with pytest.raises(LawError, match=rf"smaller zones carry a law further\); lower p_max \(this law's: 6.25e\+06 Pa\), "
+                                       rf"reached by "
                                        rf"{P_MAX_HALVINGS} halvings of micro.p_max = 1e\+08 Pa") as caught:
         run_pod(tmp_path / "full", {"roughness.rms": "0.01 um", "micro.p_max": "100 MPa", "time.steps": 1,
                                     "time.end": "0.6 s"})

@@ -309,7 +309,7 @@ def _batch_nodes(zones: list[Zone], spec: LawSpec) -> tuple[list[ZoneNodes], lis
         extra = {name: values[b] for name, values in extras.items()}
         c = 0.0 if spec.love == "none" else z.love(spec.love) / (np.pi * spec.E_star)
         gap = z.top - approach[b] + c * pressure[b]
-        problem = _monotone_problem(gap, pressure[b])
+        problem = _monotone_problem(gap, pressure[b], fraction[b])
         if problem:
             failures[b] = ZoneFailure(z.id, "InputError", problem + f"; lower p_max (this law's: {spec.p_max:.3g} Pa)")
             continue
@@ -335,15 +335,25 @@ def _masked_heights(zones, masks, spec):
     return h, tol
 
 
-def _monotone_problem(gap, pressure) -> str:
+STIFF = "the Love-corrected gap stops decreasing"
+
+
+def _monotone_problem(gap, pressure, fraction) -> str:
+    """Why nodes (gap [m], pressure [Pa], real area fraction) make no monotone law ("" if they do).
+    The gap stops decreasing where the roughness adds less compliance than Love's correction is off
+    the patch's own: an isolated patch in near full contact carries a flat punch's edge pressures,
+    whose mean displacement is 7 % below the uniform pressure's on a square (7.5 % on a circle: pi/2
+    against 16/(3 pi) p a/E*, Johnson 1985 §3.8; a user trial's smooth
+    face on 1.3 mm zones: at 30 % real contact), so smaller zones carry a law further."""
     if not np.all(np.isfinite(gap)) or not np.all(np.isfinite(pressure)):
         return "non-finite node values"
     if not np.all(np.diff(pressure) > 0) or pressure[0] <= 0:
         return "the zone pressure does not grow with the approach"
     if not np.all(np.diff(gap) < 0):
         k = int(np.argmax(np.diff(gap) >= 0))
-        return (f"the Love-corrected gap stops decreasing above p = {pressure[k]:.3g} Pa "
-                "(the zone is close to full contact)")
+        return (f"{STIFF} above p = {pressure[k]:.3g} Pa, at {fraction[k]:.0%} real contact: there the roughness "
+                "adds less compliance than the zone's own elastic compliance is uncertain by (an isolated patch's "
+                "edge pressures: about 7 % of it; smaller zones carry a law further)")
     return ""
 
 

@@ -160,8 +160,8 @@ def _wear_table_ends(scene, history) -> list[str]:
 
 def _law_reach(history) -> list[str]:
     """Zone pressures beyond the top of their laws (extrapolated linearly there): micro.p_max, or
-    for a zone whose law failed close to full contact its halved top (raising p_max cannot help
-    it; the demo's worn zone at its last step)."""
+    for a zone whose law stopped below it its halved top (raising p_max cannot help it; the demo's
+    worn zone at its last step)."""
     reach, halved = (float(np.max(history[c])) if c in history.columns else 0.0
                      for c in ("law_reach", "law_reach_halved"))
     out = []
@@ -171,10 +171,10 @@ def _law_reach(history) -> list[str]:
                    "the surface is in full contact near it (a nm-smooth face: perfect contact is the model it tends "
                    "to)")
     if halved > 1:
-        out.append(f"zones whose laws failed close to full contact (their top p_max halved) were loaded to "
-                   f"{halved:.3g} times that top: their laws are extrapolated linearly there, with the contact "
-                   "stiffness at the top; such a zone is nearly flat (worn), and perfect contact is the model it "
-                   "tends to")
+        out.append(f"zones whose laws stopped below micro.p_max (their top halved: the roughness stiffer there than "
+                   f"the zone's own compliance resolves) were loaded to {halved:.3g} times that top: their laws are "
+                   "extrapolated linearly there, with the contact stiffness at the top; more micro.zones (smaller "
+                   "zones) carry the laws further, and a smooth or worn face tends to perfect contact")
     return out
 
 
