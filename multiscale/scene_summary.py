@@ -131,7 +131,9 @@ def _effect_line(scene: Scene, effect: str) -> str:
         measured_pixels = r.file is not None and r.cover != "equivalent"
         cells = f"{m.grid[0]} x {m.grid[1]} cells" if m.grid else \
             "the measurement's pixel size" if measured_pixels else "50 x 50 cells"
-        return f"{r.body or scene.bodies[0]}: {surface}; {m.zones[0]} x {m.zones[1]} zones of {cells}, {m.law_points}-point laws"
+        top = f"{m.p_max:g} Pa" if m.p_max is not None else "20 x the nominal pressure (the run prints it)"
+        return (f"{r.body or scene.bodies[0]}: {surface}; {m.zones[0]} x {m.zones[1]} zones of {cells}, "
+                f"{m.law_points}-point laws up to p_max {top}")
     if effect == "wear":
         w = scene.wear
         counter = scene.materials[scene.geometry.spec.interface_materials(

@@ -175,8 +175,12 @@ def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterfac
     kernel, E_star = contact_kernel(scene)
     nominal = sum(interface_forces(scene, tm).values()) / tm.interface.areas.sum()
     p_max, hardness = m.p_max or P_MAX_FACTOR * nominal, None
+    why = "micro.p_max" if m.p_max is not None else f"{P_MAX_FACTOR:g} x the nominal pressure {nominal:.4g} Pa"
     if scene.has("plasticity"):
         hardness = float(interface_hardness(scene)(scene.time.initial_temperature))
-        p_max = min(p_max, P_MAX_PLASTIC * hardness)
+        if P_MAX_PLASTIC * hardness < p_max:
+            p_max, why = P_MAX_PLASTIC * hardness, f"{P_MAX_PLASTIC:g} x the hardness"
     spec = LawSpec(kernel, p_max, n_points=m.law_points, tol=m.tol, E_star=E_star, hardness=hardness)
+    if log is not None:
+        log(f"laws: {m.law_points} nodes up to p_max = {p_max:.4g} Pa ({why})")
     return RoughInterface(tm, names, planes, grids, zones, spec, MicroPool(spec, tm.comm, progress=progress))
