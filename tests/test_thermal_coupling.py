@@ -49,15 +49,17 @@ def hot_pin(ms):
 
 
 def direct_micro(ms, zone):
-    """The micro problem of a zone solved directly from the macro state: its pressure, both bodies'
-    facet temperatures as remote temperatures, the sliding speed over its facets weighted by their
-    force and the direction at its centre (rounded like the loop's kernel tables), contact by
-    FFT-BEM, steady heating (§6.5); and the true speed over the rounded one (heat rates scale with it)."""
+    """The micro problem of a zone solved directly from the macro state: its pressure (its facets'
+    force over their area), both bodies' facet temperatures as remote temperatures, the sliding
+    speed over its facets weighted by their force and the direction at its centre (rounded like the
+    loop's kernel tables), contact by FFT-BEM, steady heating (§6.5); and the scale of the patch's
+    heat rates to the zone's: the true speed over the rounded one, times its facets' area over the
+    patch's (``RoughInterface.cover``)."""
     iface, contact, thermal = ms.tm.interface, ms.model.contact, ms.model.thermal
     on = ms.rough.zone_of_facet == zone
     a = iface.areas[on]
     z = ms.rough.zones[zone]
-    P = (contact.facet_pressure()[on] * a).sum() / z.area
+    P = (contact.facet_pressure()[on] * a).sum() / a.sum()
     remote = [(thermal.facet_temperature(side)[on] * a).sum() / a.sum() for side in (1, 0)]
     centre = ms.rough.zone_frames()[0][zone]
     omega = ms.model.speed(ms.model.time)
@@ -70,7 +72,7 @@ def direct_micro(ms, zone):
     p = ContactSolver(ms.post.solver.kernel, s.shape, s.dx, s.dy, periodic=False).solve(
         s.heights, load=P, tol=1e-10).pressure
     heat = SteadyHeating(s.shape, s.dx, DISC, PIN, float(speed), s.dy, float(angle))
-    return heat, p, remote, true / float(speed)
+    return heat, p, remote, true / float(speed) * a.sum() / z.area
 
 
 @pytest.fixture(scope="module")
@@ -298,14 +300,15 @@ def test_scene_rules_of_the_thermal_coupling(tmp_path):
 
 def test_real_contact_area_is_that_of_the_direct_micro_solves(two_zones):
     """The history's real contact area: the cells in contact of each loaded zone's micro problem,
-    solved directly from the macro state (FFT-BEM, tol 1e-10), times the cell area, summed."""
+    solved directly from the macro state (FFT-BEM, tol 1e-10), times the cell area, over the zone's
+    facets' area (its share of the patch), summed."""
     ms, result, _, _ = two_zones["fixed-point"]
     loaded = np.flatnonzero(np.isfinite(ms.proposed))
     direct = 0.0
     for z in loaded:
         _, p, _, _ = direct_micro(ms, z)
         s = ms.rough.zones[z].surface
-        direct += np.count_nonzero(p > 0) * s.dx * s.dy
+        direct += np.count_nonzero(p > 0) / p.size * ms.tm.interface.areas[ms.rough.zone_of_facet == z].sum()
     assert direct > 0
     assert ms.record(result)["real_contact_area"] == pytest.approx(direct, rel=1e-9)
 
