@@ -36,6 +36,7 @@ pin-on-disc): validate a scene file (check), run it (run), sweep parameters (stu
 measured topography (surface), print the versions (info)."""
 INTERRUPTED = 130        # exit code after Ctrl-C (128 + SIGINT, as shells report it)
 MPIEXEC = f"{Path(sys.executable).parent / 'mpiexec'}"
+COMMAND = f"{Path(sys.executable).parent / 'multiscale'}"      # this environment's (also where it is not on PATH)
 EPILOG = f"""Parallel runs: {MPIEXEC} -n N multiscale run scene.toml
 Use the mpiexec of this environment: the launcher of another MPI (a system mpirun or mpiexec)
 starts N separate serial runs, or stops with a PMI error."""
@@ -199,13 +200,14 @@ def _run(args) -> int:
 
 def _kept(scene, args, ranks: int = 1) -> str:
     """What a run interrupted by Ctrl-C leaves (``scene``: None if it was still being read), and the
-    command that goes on, under this environment's mpiexec for ``ranks`` > 1; --resume is advised
+    command that goes on (this environment's multiscale, under its mpiexec for ``ranks`` > 1: a user
+    trial's copy of the bare name failed where the environment was not activated); --resume is advised
     only with a checkpoint (before its first macro step ended it refused to resume), --overwrite
     when the folder holds files (a user trial was told to start again and refused)."""
     if scene is None:
         return "nothing was written"
     launcher = [MPIEXEC, "-n", str(ranks)] if ranks > 1 else []
-    command = shlex.join([*launcher, "multiscale", "run", args.scene,
+    command = shlex.join([*launcher, COMMAND, "run", args.scene,
                           *(f"--set={k}={text}" for k, _, text in args.settings)])
     folder = Path(scene.output.folder)
     written = folder.is_dir() and any(folder.iterdir())

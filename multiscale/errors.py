@@ -70,16 +70,17 @@ class Interrupted(KeyboardInterrupt):
         self.warnings = tuple(warnings)
 
 
-def interrupted(exc: BaseException) -> bool:
-    """Whether ``exc`` is a Ctrl-C: a ``KeyboardInterrupt``, or an error it caused on its way out of
-    a library (petsc4py turns one raised in a callback of SNES into ``PETSc.Error`` 101)."""
+def interrupted(exc: BaseException) -> KeyboardInterrupt | None:
+    """The Ctrl-C behind ``exc``: ``exc`` if a ``KeyboardInterrupt``, or the one that caused it on
+    its way out of a library (petsc4py turns one raised in a callback of SNES into ``PETSc.Error``
+    101, whose text is PETSc's stack); None if there is none."""
     seen = set()
     while exc is not None and id(exc) not in seen:
         if isinstance(exc, KeyboardInterrupt):
-            return True
+            return exc
         seen.add(id(exc))
         exc = exc.__cause__ or exc.__context__
-    return False
+    return None
 
 
 def _short(value, limit: int = 60) -> str:

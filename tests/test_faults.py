@@ -16,6 +16,7 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 from test_macro_run import BLOCK  # noqa: E402
 
 MPIEXEC = Path(sys.executable).with_name("mpiexec")
+COMMAND = Path(sys.executable).with_name("multiscale")
 # test_macro_run's block, cooling 3 s from a hot top face
 SCENE = (BLOCK.replace("{effects}", '"contact", "thermal"').replace('name = "block"', 'name = "cooling_block"')
          .replace('mesh_size = "2.5 mm"', 'mesh_size = "5 mm"')
@@ -259,7 +260,7 @@ def test_ctrl_c_stops_the_run_after_its_step_with_the_results_written(tmp_path, 
     lines = [line for line in err.splitlines() if line.startswith("interrupted")]
     launcher = f"{MPIEXEC} -n {ranks} " if ranks > 1 else ""         # the command goes on as it ran (a user trial)
     assert lines == [f"interrupted after step {done} of 4000: what was written stays in {folder} (its "
-                     f"provenance.json says so); {launcher}multiscale run {tmp_path / 'scene.toml'} --overwrite "
+                     f"provenance.json says so); {launcher}{COMMAND} run {tmp_path / 'scene.toml'} --overwrite "
                      "starts again"]
     assert len(History.read(folder / "history.h5")) == done + 1
     assert (folder / "history.png").stat().st_size > 0 and (folder / "paraview.py").exists()
@@ -502,8 +503,36 @@ def test_an_early_ctrl_c_ends_every_rank_at_once_with_one_line(tmp_path, waiting
                 os.kill(pid, signal.SIGKILL)
     assert job.returncode == 130 and seconds < 8, (seconds, err[-3000:])
     assert [line for line in err.splitlines() if line.strip()] == [
-        f"interrupted: nothing was written; {MPIEXEC} -n 2 multiscale run {scene} starts again"], err[-3000:]
+        f"interrupted: nothing was written; {MPIEXEC} -n 2 {COMMAND} run {scene} starts again"], err[-3000:]
     # (before: "what was written stays in ... (its provenance.json says so)" of a folder still empty)
+
+
+ABORT_IN_GMSH = """
+import threading, time
+import gmsh
+from mpi4py import MPI
+from multiscale import io
+gmsh.initialize()
+gmsh.option.setNumber("General.Terminal", 0)
+gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+gmsh.model.occ.synchronize()
+gmsh.option.setNumber("Mesh.MeshSizeMax", 0.01)
+threading.Thread(target=lambda: (time.sleep(1.0), io.abort(MPI.COMM_WORLD, 130, quiet=True)), daemon=True).start()
+gmsh.model.mesh.generate(3)
+print("meshed")
+"""
+
+
+def test_a_serial_run_ended_from_the_watcher_inside_gmsh_exits_with_its_code(tmp_path):
+    """The Ctrl-C watcher ends a job whose main thread is inside a C call; serial, its MPI_Abort
+    while gmsh meshed ended the process in a segmentation fault (exit 139, 6 of 9 Ctrl-Cs during
+    meshing, a user trial) instead of the documented 130. One rank now simply exits."""
+    driver = tmp_path / "driver.py"
+    driver.write_text(ABORT_IN_GMSH)
+    started = time.monotonic()
+    done = subprocess.run([sys.executable, str(driver)], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 130 and "meshed" not in done.stdout, (done.returncode, done.stderr[-2000:])
+    assert time.monotonic() - started < 60
 
 
 def test_an_interrupt_is_recognised_through_the_errors_it_caused():

@@ -304,3 +304,42 @@ def test_a_resumed_run_says_the_heat_warnings_of_the_whole_run_once(tmp_path, mo
     assert len(notes) == 1 and notes[0].startswith("the heat step to t = 0.6 s was too long") and notes[0] in provenance
     assert said["stopped"] == said["straight"]
     assert [w for w in said["interrupted"] if "too long for full Newton steps" in w] == notes
+
+
+def test_a_ctrl_c_inside_a_petsc_solve_and_a_full_disk_keep_their_own_words(tmp_path, capsys, monkeypatch):
+    """A third Ctrl-C met inside a PETSc solve comes out as PETSc's error 101 around it: the run's
+    status was PETSc's stack ("interrupted error code 101 [0] SNESSolve() ..."), not the step
+    abandoned; the Ctrl-C itself is raised on. A full disk that also stops the failed run's record
+    from being written gave that OSError's traceback instead of the run's own error: the error stays,
+    and a warning says the record is missing (both found by a user trial)."""
+    from multiscale import errors, io, provenance, workflows
+    from multiscale.workflows import transient
+    folder = tmp_path / "out"
+    scene = loads((Path(__file__).resolve().parents[1] / "demos" / "block_on_flat.toml").read_text().replace(
+        'folder = "../results/block_on_flat"', f'folder = "{folder}"'))
+    step = "during step 3, abandoned: the results of step 2 are the last written"
+
+    def ctrl_c_in_petsc(scene, **kw):
+        io.reporter().folder = folder
+        folder.mkdir(exist_ok=True)
+        try:
+            raise KeyboardInterrupt(step)
+        except KeyboardInterrupt as inner:
+            raise RuntimeError("error code 101\n[0] SNESSolve() at snes.c:4951") from inner
+    monkeypatch.setattr(transient, "run", ctrl_c_in_petsc)
+    with pytest.raises(KeyboardInterrupt, match=step):
+        workflows.run(scene, verbose=False)
+    assert json.loads((folder / "provenance.json").read_text())["status"] == f"interrupted {step}"
+
+    def full_disk(scene, **kw):
+        io.reporter().folder = folder
+        raise errors.OutputError("cannot write the fields at t = 0 s: No space left on device")
+
+    def no_space(*args, **kwargs):
+        raise OSError(28, "No space left on device")
+    monkeypatch.setattr(transient, "run", full_disk)
+    monkeypatch.setattr(provenance, "write", no_space)
+    with pytest.raises(errors.OutputError, match="cannot write the fields"):
+        workflows.run(scene, verbose=False)
+    assert "warning: the record of this run was not written ([Errno 28] No space left on device)" in \
+        capsys.readouterr().err

@@ -62,17 +62,20 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         except BaseException as exc:
             stopped = interrupted(exc)
             if reporter.folder is not None and comm.rank == 0:
-                provenance.write(reporter.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
-                                 wall_time=time.perf_counter() - start, analysis=kind,
-                                 status=f"interrupted {exc}".strip() if stopped else
-                                 f"failed: {type(exc).__name__}: {exc}", earlier=earlier,
-                                 warnings=[*scene.warnings, *(exc.warnings if isinstance(exc, Interrupted) else ())])
-                if isinstance(exc, Interrupted):          # stopped after a step: its results are written
-                    _write_script(reporter.folder, scene)
-                elif stopped:                             # a step abandoned: the plots of what was written
-                    _abandoned(reporter.folder, scene)
-            if stopped and not isinstance(exc, KeyboardInterrupt):
-                raise KeyboardInterrupt from None          # not PETSc's error 101 around it
+                try:
+                    provenance.write(reporter.folder, scene, ranks=comm.size, started=started,
+                                     stages=reporter.times, wall_time=time.perf_counter() - start, analysis=kind,
+                                     status=f"interrupted {stopped}".strip() if stopped else
+                                     f"failed: {type(exc).__name__}: {exc}", earlier=earlier,
+                                     warnings=[*scene.warnings, *(exc.warnings if isinstance(exc, Interrupted) else ())])
+                    if isinstance(exc, Interrupted):          # stopped after a step: its results are written
+                        _write_script(reporter.folder, scene)
+                    elif stopped:                             # a step abandoned: the plots of what was written
+                        _abandoned(reporter.folder, scene)
+                except OSError as lost:                       # (a full disk): the error that stopped the run counts
+                    print(f"warning: the record of this run was not written ({lost})", file=sys.stderr, flush=True)
+            if stopped and stopped is not exc:
+                raise stopped from None                       # not PETSc's error 101 around it
             raise
     result.files += [f.with_suffix(".h5") for f in result.files if f.suffix == ".xdmf"]   # their data
     if ended:                 # --resume of a finished run: nothing to do, its provenance stays as it was
