@@ -165,9 +165,12 @@ class StepStop:
     unless it comes inside ``writing()``, which no Ctrl-C interrupts: a step's results are written
     whole or not at all. ``done``: the steps whose results are already written (a resumed run's).
     Under ``mpiexec`` the second Ctrl-C is the launcher's: it kills every rank (MPICH's hydra).
-    Without the main thread, nothing is installed."""
+    SIGTERM and SIGHUP (a batch scheduler's time limit, ``timeout``, a closed terminal; unless
+    ignored, as under ``nohup``) count as Ctrl-Cs: the first stops the run after its step (they
+    killed it, its provenance left "running"). Without the main thread, nothing is installed."""
 
-    FIRST = "\nCtrl-C: stopping after this step, with its results written ({})\n"
+    SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    FIRST = "\n{}: stopping after this step, with its results written ({})\n"
     AGAIN = {1: "Ctrl-C again is mpiexec's: it kills the job at once",
              0: "Ctrl-C twice more abandons the step"}
     HELD = ("\nCtrl-C: still finishing the step and writing its results; Ctrl-C again abandons the step "
@@ -186,22 +189,24 @@ class StepStop:
 
     def __enter__(self):
         if threading.current_thread() is threading.main_thread():
-            self.previous = signal.signal(signal.SIGINT, self._handle)
+            self.previous = {s: signal.signal(s, self._handle) for s in self.SIGNALS
+                             if s == signal.SIGINT or signal.getsignal(s) is not signal.SIG_IGN}
         return self
 
     def __exit__(self, *exc):
-        if self.previous is not None:
-            signal.signal(signal.SIGINT, self.previous)
+        for s, handler in (self.previous or {}).items():
+            signal.signal(s, handler)
         return False
 
     def _handle(self, signum, frame):
         self.count += 1
-        StepStop.taken += 1
+        StepStop.taken += signum == signal.SIGINT
         if self.count > 2 and not self.saving:
             raise KeyboardInterrupt(f"during step {self.done + 1}, abandoned: the results of step {self.done} "
                                     "are the last written")
         if self.comm.rank == 0:          # os.write, not print: the handler may run inside a write to stderr
-            os.write(2, (self.FIRST.format(self.AGAIN[self.comm.size > 1]) if self.count == 1 else
+            name = "Ctrl-C" if signum == signal.SIGINT else signal.Signals(signum).name
+            os.write(2, (self.FIRST.format(name, self.AGAIN[self.comm.size > 1]) if self.count == 1 else
                          self.HELD if self.count == 2 else self.WRITING).encode())
 
     @contextmanager

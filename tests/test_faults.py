@@ -216,9 +216,10 @@ def test_a_factorisation_package_petsc_lacks_ends_both_ranks_with_one_input_erro
 
 
 # ---------------------------------------------------------------- Ctrl-C
-def interrupt(tmp_path, ranks: int):
+def interrupt(tmp_path, ranks: int, sent_signal: str = "SIGINT"):
     """``multiscale run`` of the cooling block in 4000 heat steps, sent SIGINT (Ctrl-C; under
-    mpiexec to the launcher, which hands it to every rank) once the steps have begun."""
+    mpiexec to the launcher, which hands it to every rank), or ``sent_signal``, once the steps have
+    begun."""
     import signal
     scene = tmp_path / "scene.toml"
     scene.write_text(SCENE.format(folder=tmp_path / "out").replace("steps = 3\n", "steps = 4000\n")
@@ -232,7 +233,7 @@ def interrupt(tmp_path, ranks: int):
             break
     time.sleep(1.0)
     sent = time.monotonic()
-    job.send_signal(signal.SIGINT)
+    job.send_signal(getattr(signal, sent_signal))
     try:
         out, err = job.communicate(timeout=120)
     except subprocess.TimeoutExpired:
@@ -241,19 +242,21 @@ def interrupt(tmp_path, ranks: int):
     return job.returncode, err, time.monotonic() - sent, tmp_path / "out"
 
 
-@pytest.mark.parametrize("ranks", [1, 2])
-def test_ctrl_c_stops_the_run_after_its_step_with_the_results_written(tmp_path, ranks):
+@pytest.mark.parametrize("ranks, sent_signal", [(1, "SIGINT"), (2, "SIGINT"), (1, "SIGTERM")])
+def test_ctrl_c_stops_the_run_after_its_step_with_the_results_written(tmp_path, ranks, sent_signal):
     """Ctrl-C during the steps: every rank stops after the same step, the history, its plot, the
     fields of that step and paraview.py are written, and the job ends with exit code 130 and one
     line saying where the results are (before: a Python traceback per rank, or PETSc's "error code
-    101" when the signal came inside a Newton callback, and no plot); provenance.json says so."""
+    101" when the signal came inside a Newton callback, and no plot); provenance.json says so.
+    SIGTERM (a batch scheduler's time limit) does the same: it killed the run, its provenance left
+    "running" and no plot (a user trial)."""
     import json
 
     from multiscale.io import History
-    code, err, seconds, folder = interrupt(tmp_path, ranks)
+    code, err, seconds, folder = interrupt(tmp_path, ranks, sent_signal)
     assert code == 130 and seconds < 30, err[-3000:]
     assert "Traceback" not in err and "PETSC ERROR" not in err and "error code" not in err, err[-3000:]
-    assert err.count("Ctrl-C: stopping after this step") == 1
+    assert err.count(f"{'Ctrl-C' if sent_signal == 'SIGINT' else sent_signal}: stopping after this step") == 1
     record = json.loads((folder / "provenance.json").read_text())
     done = int(record["status"].split()[3])
     assert record["status"] == f"interrupted after step {done} of 4000" and 1 <= done < 4000
