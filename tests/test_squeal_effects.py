@@ -499,7 +499,9 @@ def test_a_braking_torque_preloads_the_squeal_analysis_at_that_friction_moment(t
 def test_eigen_solver_errors_name_the_scene_keys(tmp_path):
     """A band below the first mode: the error names stability.band (it named the solver's f_max).
     The failed run's Mechanics is closed (one rank) and freed (before: it stayed alive with its MPI
-    communicators, and a script going on after failed runs ran out of them)."""
+    communicators, and a script going on after failed runs ran out of them). The preloaded state
+    was written before the eigen solve and stays (a user trial's failed or stopped eigen solve had
+    thrown away a preload of minutes)."""
     import gc      # local: this test alone looks at the collector
     overrides = {**NO_FIGURES,
                  "geometry.mesh_size": "30 mm", "stability.modes": 6, "output.folder": str(tmp_path / "out"),
@@ -509,9 +511,13 @@ def test_eigen_solver_errors_name_the_scene_keys(tmp_path):
         gc.collect()
         return sum(isinstance(o, Mechanics) for o in gc.get_objects())
     before = models()
+    scene = scenes.load(DEMO, overrides)
     with pytest.raises(InputError, match=r"^stability\.band = \(10\.0, 500\.0\): no eigenvalue in this frequency band"):
-        squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
+        squeal.run(scene, degree=1, verbose=False)
     assert models() == before
+    written = {p.name for p in (tmp_path / "out").iterdir()}
+    fields = {n for f in plan(scene).field_files for n in (f, f.replace(".xdmf", ".h5"))}
+    assert fields <= written and "modes.csv" not in written and "provenance.json" in written
 
 
 def test_a_band_cut_short_below_a_target_is_said(tmp_path):

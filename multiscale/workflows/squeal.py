@@ -95,15 +95,18 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
                 steps: int = 1, band=(0.0, 16e3), n_modes: int | None = None,
                 target: float | None = None, damping: Damping | None = None, energy: bool = True,
                 rtol: float = 1e-6, close_tol: float = 1e-3, options: SquealOptions | None = None,
-                reset: bool = True, torque: float | None = None) -> SquealCase:
+                reset: bool = True, torque: float | None = None, on_preload=None) -> SquealCase:
     """Preload ``mech`` from rest (``reset``) to ``load`` [Pa or N] in ``steps`` (with ``torque``
     [N m] a first guess, scaled to that friction moment: ``preload``), linearise and extract the
     complex modes in ``band`` [Hz] (§4.3.1, two steps); ``damping`` (or ``options.damping``) is the
-    proportional part, ``options`` the rest (``SquealOptions``)."""
+    proportional part, ``options`` the rest (``SquealOptions``). ``on_preload(mech)`` is called
+    between the preload and the eigen solve (``run`` writes the preloaded state then)."""
     opt = options or SquealOptions()
     slope = set_friction(mech, opt.friction_laws)[1] if opt.friction_laws else None
     with io.stage("preload"):
         pre = preload(mech, load, steps, reset=reset, torque=torque)
+    if on_preload is not None:
+        on_preload(mech)
     with io.stage("eigen solve"):
         lin = linearise_system(mech, materials, damping=damping or opt.damping,
                                slope=slope if opt.friction_damping else None, prestress=opt.prestress,
@@ -169,9 +172,11 @@ def build_squeal_mechanics(scene, tm, *, degree: int = SQUEAL_DEGREE, prefix: st
     return mech
 
 
-def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: int = SQUEAL_DEGREE) -> SquealCase:
+def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: int = SQUEAL_DEGREE,
+            on_preload=None) -> SquealCase:
     """The squeal case of a scene on the mesh ``tm``: perfect penalty contact, or the rough zone
-    laws of [roughness]/[micro] with effect ``roughness`` (see module docstring)."""
+    laws of [roughness]/[micro] with effect ``roughness`` (see module docstring); ``on_preload`` as
+    in ``squeal_case``."""
     st = scene.stability
     name = name or scene.name
     prefix = "squeal_" + "".join(ch if ch.isalnum() else "_" for ch in name) + "_"
@@ -181,7 +186,8 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
             d = drive(model_scene(scene), tm)
             return squeal_case(mech, dict(scene.materials), name, load=d.load, torque=d.torque,
                                steps=scene.loading.ramp_steps, band=tuple(st.band), n_modes=st.modes,
-                               target=st.target, energy=energy, rtol=st.threshold, options=squeal_options(scene, tm))
+                               target=st.target, energy=energy, rtol=st.threshold, options=squeal_options(scene, tm),
+                               on_preload=on_preload)
     except InputError as exc:        # the eigen solvers' arguments by their scene keys
         keys = {"f_min": ("stability.band", st.band), "f_max": ("stability.band", st.band),
                 "n_modes": ("stability.modes", st.modes)}
@@ -281,24 +287,28 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     folder = out.path
     with io.stage("meshing"):
         tm = build_mesh(scene, comm)
-    case = analyse(scene, tm, degree=degree)
+    plan, masks, files = outputs.plan(scene), tm.interface.masks(), []
+
+    def preloaded(mech):         # the first results: written before the eigen solve, which may fail or be stopped
+        out.claim()              # --overwrite: the earlier results go now, not before a failed preload
+        with io.stage("writing the preload"):
+            files.extend(write_state(folder, mech, plan.body_fields + plan.interface_fields))
+            pressure = mech.contact.facet_pressure()
+            files.extend(io.on_root(comm, lambda: [plot_pressure(tm.interface.midpoints, masks, pressure, scene.name,
+                                                                 folder / "pressure.png")]
+                                    if scene.output.figures else [], f"the figures in {folder}") or [])
+    case = analyse(scene, tm, degree=degree, on_preload=preloaded)
     with closed_on_error(case.mech, comm):       # a script going on after a failed run gets its communicators
-        out.claim()                          # --overwrite: the earlier results go now, not before a failed analysis
         with io.stage("writing results"):
-            plan = outputs.plan(scene)
             rep = case.report
-            files = io.on_root(comm, lambda: [case.modes.write_csv(folder / "modes.csv", rep.rtol,
-                                                                  rep.potentially_unstable)],
-                               f"{folder / 'modes.csv'}") or []
-            files += write_state(folder, case.mech, plan.body_fields + plan.interface_fields)
+            files += io.on_root(comm, lambda: [case.modes.write_csv(folder / "modes.csv", rep.rtol,
+                                                                   rep.potentially_unstable)],
+                                f"{folder / 'modes.csv'}") or []
             files += write_modes(folder, case.modes, case.mech.u, [b.name for b in tm.bodies])
             split = energy_split(tm)
-            masks = tm.interface.masks()
 
             def figures():
-                out = [plot_pressure(tm.interface.midpoints, masks, case.facet_pressure, case.name,
-                                     folder / "pressure.png"),
-                       plot_re_im([case], folder / "re_im.png"),
+                out = [plot_re_im([case], folder / "re_im.png"),
                        plot_energy(case, folder / "energy.png", split)] if scene.output.figures else []
                 if case.prestress is not None:
                     out.append(write_prestress_csv(case.prestress, folder / "prestress.csv"))
