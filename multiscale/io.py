@@ -388,16 +388,17 @@ class Reporter:
             self.stream.write(f"{name} ...")
             self.stream.flush()
         self.depth += 1
-        start = _time.perf_counter()
+        start, ended = _time.perf_counter(), "stopped after "    # (an error or Ctrl-C inside: not as if done)
         try:
             yield self
+            ended = ""
         finally:
             seconds = _time.perf_counter() - start
             self.depth -= 1
             self.times[name] = self.times.get(name, 0.0) + seconds
             if top and self.show:
                 clear = "\r\033[K" if self.tty else ""
-                self.stream.write(f"{clear}{name}: {seconds:.1f} s\n")
+                self.stream.write(f"{clear}{name}: {ended}{seconds:.1f} s\n")
                 self.stream.flush()
 
     def bar(self, iterable, name: str, total: int | None = None, initial: int = 0, unit: str = "step"):

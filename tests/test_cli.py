@@ -328,6 +328,10 @@ def test_stage_lines_one_per_stage_quiet_and_timed():
         with io.stage("meshing"):
             list(io.bar(range(3), "steps"))
     assert quiet.getvalue() == ""
+    cut = stdio.StringIO()        # a stage an error or Ctrl-C ends is not told as done (a user trial)
+    with pytest.raises(KeyboardInterrupt), io.Reporter(MPI.COMM_SELF, stream=cut), io.stage("eigen solve"):
+        raise KeyboardInterrupt
+    assert cut.getvalue().startswith("eigen solve: stopped after ") and cut.getvalue().endswith(" s\n")
 
 
 def test_times_left_read_as_durations():
