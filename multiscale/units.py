@@ -261,13 +261,29 @@ def to_si(value, kind: str) -> float:
         number = _F(match.group(1))
         if not match.group(2) and spec.needs_unit:
             raise UnitError(f'{_a(spec.name)} needs its unit, e.g. "{match.group(1)} degC"')
-        factor, offset, dim = parse_unit(match.group(2))
+        try:
+            factor, offset, dim = parse_unit(match.group(2))
+        except UnitError as exc:          # a look-alike of this kind's units first: "mpa" is MPa here, not mPa
+            whole = re.fullmatch(r'unknown unit "(.*?)"(?: \(did you mean ".*"\?\))?', str(exc))
+            near = _kind_unit(match.group(2), spec) if whole and whole.group(1) == match.group(2) else None
+            if near is None:
+                raise
+            raise UnitError(f'unknown unit "{match.group(2)}" (did you mean "{near}"?)') from None
         if dim != spec.dim:
             raise UnitError(f"{expect}; the unit \"{match.group(2)}\" is {_a(describe(dim))}")
     try:
         return float(number * factor + offset)
     except OverflowError:
         raise UnitError("must be a finite number") from None
+
+
+def _kind_unit(text: str, spec: Kind) -> str | None:
+    """The unit of ``spec``'s dimension that ``text`` likely meant: one written alike but for case
+    (its examples first: "mpa" is MPa, "kn" kN), else the closest (difflib); None if none is close."""
+    named = [u.strip() for u in spec.examples.split(",")] + \
+        [p + u for u, (_, dim, pre) in _UNITS.items() if dim == spec.dim for p in ("", *("GMkmu" if pre else ""))]
+    same = [u for u in named if u.lower() == text.lower()]
+    return same[0] if same else next(iter(difflib.get_close_matches(text, named, n=1, cutoff=0.5)), None)
 
 
 def _a(words: str) -> str:

@@ -98,6 +98,8 @@ def test_unit_strings_to_si(text, kind, expected):
 @pytest.mark.parametrize("text, kind, fragment", [
     ("4 GW", "pressure", 'the unit "GW" is a power'),
     ("4 GPA", "pressure", 'unknown unit "GPA" (did you mean "GPa"?)'),
+    ("10 mpa", "pressure", 'unknown unit "mpa" (did you mean "MPa"?)'),       # not mPa (a user trial)
+    ("200 kn", "force", 'unknown unit "kn" (did you mean "kN"?)'),            # not ks
     ("200 Hz", "angular_speed", 'expected an angular speed (rpm, rad/s); the unit "Hz" is a frequency'),
     (20, "temperature", "a temperature needs its unit"),
     ("20", "temperature", "a temperature needs its unit"),
