@@ -7,6 +7,7 @@ where one exists, the partial result.
 from __future__ import annotations
 
 import numbers
+import re
 
 import numpy as np
 
@@ -81,6 +82,16 @@ def interrupted(exc: BaseException) -> KeyboardInterrupt | None:
         seen.add(id(exc))
         exc = exc.__cause__ or exc.__context__
     return None
+
+
+def toml_problem(source, exc: Exception, text: str) -> SceneError:
+    """A TOML syntax error of ``text`` (from ``source``) with the line it is on: tomllib gives the
+    position only, and "Cannot overwrite a value (at line 35, column 23)" is a key given twice."""
+    at = re.search(r"\(at line (\d+), column \d+\)", str(exc))
+    lines = text.splitlines()
+    shown = f": {lines[int(at.group(1)) - 1].strip()!r}" if at and 0 < int(at.group(1)) <= len(lines) else ""
+    twice = " (a key or table given twice)" if "Cannot overwrite" in str(exc) or "Cannot declare" in str(exc) else ""
+    return SceneError(f"{source}: not valid TOML: {exc}{shown}{twice}")
 
 
 def _short(value, limit: int = 60) -> str:

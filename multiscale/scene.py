@@ -25,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 
-from multiscale.errors import InputError, SceneError
+from multiscale.errors import InputError, SceneError, toml_problem
 from multiscale.micro.topography import (TopographyWarning, check_cutoff, check_resolved, coarse_grid, condition,
                                          covers, read_topography, zone_cells)
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
@@ -249,7 +249,7 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
     try:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{source or 'scene'}: not valid TOML: {exc}") from None
+        raise toml_problem(source or "scene", exc, text) from None
     overrides = {dotted: _toml_value(value) for dotted, value in (overrides or {}).items()}
     for dotted, value in overrides.items():
         *parents, last = dotted.split(".")

@@ -55,6 +55,8 @@ BAD = [  # (name, the demo block scene changed, the one expected message)
     ("unknown body material", BLOCK.replace("[materials.flat]", "[materials.flat_]"),
      'materials.flat_: unknown material of builder "block_on_flat" (did you mean "flat"?)'),
     ("malformed TOML", BLOCK.replace('E = "4 GPa"', 'E = "4 GPa'), "not valid TOML: "),
+    ("a key twice", BLOCK.replace('E = "4 GPa"', 'E = "4 GPa"\nE = "5 GPa"'),      # (it gave the position only)
+     "not valid TOML: Cannot overwrite a value (at line 18, column 12): 'E = \"5 GPa\"' (a key or table given twice)"),
     ("not a table", "loading = 3\n" + BLOCK.replace('[loading]\npressure = "1 MPa"\n', ""),
      "loading = 3: must be a table [loading]"),
     ("unknown thermal surface", COOLED.replace('"free:block"', '"block_topp"'),

@@ -10,7 +10,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from multiscale.errors import SceneError
+from multiscale.errors import SceneError, toml_problem
 from multiscale.schema import Bad, Context, Integer, Quantity, fields_of, read, show, suggest
 from multiscale.studies.formatting import value_text
 from multiscale.studies.problems import PROBLEMS
@@ -69,11 +69,12 @@ def load_study(path) -> Study:
     """Read, validate and expand a study file; raises SceneError listing every problem."""
     path = Path(path)
     try:
-        raw = tomllib.loads(path.read_text(encoding="utf-8"))
+        text = path.read_text(encoding="utf-8")
+        raw = tomllib.loads(text)
     except (OSError, UnicodeDecodeError) as exc:
         raise SceneError(f"{path}: cannot read the study file ({getattr(exc, 'strerror', None) or exc})") from None
     except tomllib.TOMLDecodeError as exc:
-        raise SceneError(f"{path}: not valid TOML: {exc}") from None
+        raise toml_problem(path, exc, text) from None
     ctx = Context(directory=path.resolve().parent)
     f = read(StudyFile, raw, "", ctx)
     if f.problem is not None and f.problem not in PROBLEMS:
