@@ -450,6 +450,9 @@ def main(argv: list[str] | None = None) -> int:
     except MultiscaleError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:     # Ctrl-C in a command without its own words (check --cells: a traceback)
+        print(f"interrupted: multiscale {args.command}", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":  # pragma: no cover

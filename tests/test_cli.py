@@ -529,3 +529,15 @@ def test_check_summarises_a_friction_law_falling_with_speed(tmp_path, capsys, la
         text += "\n" + law + "\n"
     assert main(["check", _write(tmp_path, text.replace("../results/", str(tmp_path) + "/"))]) == 0
     assert line in capsys.readouterr().out
+
+
+def test_ctrl_c_in_a_command_without_its_own_words_is_one_line(monkeypatch, capsys):
+    """Ctrl-C during `multiscale check --cells` (gmsh trials) printed a KeyboardInterrupt traceback
+    (a user trial); every command now ends with one line and exit code 130."""
+    from multiscale import cli
+
+    def meshing(args):
+        raise KeyboardInterrupt
+    monkeypatch.setattr(cli, "_check", meshing)
+    assert main(["check", "scene.toml", "--cells"]) == 130
+    assert capsys.readouterr().err == "interrupted: multiscale check\n"
