@@ -392,7 +392,7 @@ class Mechanics:
             if not self._residual_norm() < before:       # the same on every rank (a global norm)
                 for u, x in zip(self.u, start):
                     u.x.array[:] = x
-        result = self._newton()
+        result = first = self._newton()
         if not result.converged:           # old or single-precision factors can mislead: again, fresh double ones
             for u, x in zip(self.u, start):
                 u.x.array[:] = x
@@ -416,8 +416,12 @@ class Mechanics:
                           f"'{user_options(self.problem.solver.getOptionsPrefix())}') instead of the contact "
                           "Newton's own factorisation (leave pc_type unset for it)")
             free = ("a body, or a solid of one, can move as a rigid body: give each a support ([[boundary]] fix) "
-                    "or a contact that holds it in every direction (friction does not hold a body; a part that "
-                    "touches nothing is held by its supports alone), or a penalty far above E*/h ill-conditions it")
+                    "or a contact that holds it in every direction (friction does not hold a body, and can tip one "
+                    "its supports hold sideways only; a part that touches nothing is held by its supports alone), "
+                    "or a penalty far above E*/h ill-conditions it")
+            if first is not result:       # the retries start afresh: the first attempt says more
+                cause += (f"; the first of its attempts: SNES reason {first.reason}, {first.iterations} iterations, "
+                          f"residuals {['%.3g' % r for r in first.residuals[-4:]]}")
             if result.reason == SNES_LINEAR_FAILED:
                 cause += f"; the linear solve failed, as it does when {free}"
             elif result.reason == PETSc.SNES.ConvergedReason.DIVERGED_DTOL:
