@@ -6,7 +6,7 @@ One macro step Δt (Fig. 7.2) runs:
 1. the macro transient over Δt in ``substeps`` thermo-mechanical sub-steps δt with the current
    laws and partitions (Fig. 7.4; ``macro.model.MacroModel.macro_step``);
 2. per zone, the macro loading at the end of the step (``loading``): zone pressure P = (contact
-   force on the zone's facets) / (zone area) — so that the micro patch carries the macro force —,
+   force on the zone's facets) / (their area), the patch's results counted over it (``cover``),
    the facet temperatures of both bodies, the sliding speed (force-weighted over the zone) and direction;
 3. the micro post-analysis of the loaded zones (Fig. 7.5, ``micro.post_analysis``): local pressure
    under P, local surface temperatures, flash temperature and partition (steady sliding heating,
