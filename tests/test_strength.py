@@ -72,11 +72,12 @@ def test_the_law_beyond_its_last_node_keeps_a_bounded_stiffness():
 
 def test_zone_wear_volume_uses_both_pixel_sizes():
     """Mutant: dx * dx for the pixel area. A zone of 2 x 1 um pixels worn 1 um everywhere lost
-    its area times 1 um."""
+    its area times 1 um; one whose facets cover half its patch (``cover``) half of it."""
     from multiscale.rough import RoughInterface   # imports DOLFINx (the macro facet law)
     zone = SimpleNamespace(surface=Surface(np.zeros((4, 8)), 2e-6, 1e-6, periodic=False))
-    volume = RoughInterface.zone_wear_volume(SimpleNamespace(zones=[zone]), np.full((1, 4, 8), 1e-6))
-    assert volume[0] == pytest.approx(8 * 2e-6 * 4 * 1e-6 * 1e-6, rel=1e-12, abs=0)
+    volume = RoughInterface.zone_wear_volume(SimpleNamespace(zones=[zone, zone], cover=np.array([1.0, 0.5])),
+                                             np.full((2, 4, 8), 1e-6))
+    np.testing.assert_allclose(volume, [8 * 2e-6 * 4 * 1e-6 * 1e-6, 4 * 2e-6 * 4 * 1e-6 * 1e-6], rtol=1e-12)
 
 
 def test_a_negative_stiffness_eigenvalue_is_a_divergence_and_unstable():
