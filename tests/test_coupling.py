@@ -1,6 +1,7 @@
 """The multiscale loop (thesis §1.4–1.5, ch. 7): facet laws in UFL, the ch. 1 block verification,
 the seam against perfect contact, wear bookkeeping, checkpoints and resume."""
 import dataclasses
+import functools
 import json
 from types import SimpleNamespace
 
@@ -338,8 +339,8 @@ def test_the_zones_wear_with_the_loaded_sliding_and_at_the_last_step(straight, c
     assert late["wear_volume"][1] == 0.0 and late["wear_volume"][2] == pytest.approx(every["wear_volume"][2], rel=0.02)
 
 
-def test_too_few_wear_substeps_are_warned_about_with_their_estimated_error(tmp_path):
-    """k_w = 1e-12 /Pa over 3 steps: 4 wear substeps wear 0.27 RMS heights each (below
+def test_too_few_wear_substeps_are_warned_about_with_their_estimated_error(tmp_path, monkeypatch):
+    """k_w = 1e-12 /Pa over 2 steps: 4 wear substeps wear 0.27 RMS heights each (below
     ``STEP_RMS``) and left the real contact area after the first update 30.5 % below the converged
     one (128 substeps), silently. ``PostAnalysis.wear`` now wears each update again in twice the
     substeps (discarded): the estimate 2 |A_n - A_2n| / A_2n of that update is 1 to 4 times the
@@ -347,7 +348,11 @@ def test_too_few_wear_substeps_are_warned_about_with_their_estimated_error(tmp_p
     ``SUBSTEP_TOL``. 32 substeps: estimates <= 0.5 % (a few contact cells), no warning."""
     from multiscale.micro.wear import SUBSTEP_TOL, STEP_RMS
     from multiscale.workflows.multiscale import run
-    scene = {"wear.k_w": "1e-12 1/Pa", "time.steps": 3, "time.end": "1.8 s"}
+    from multiscale.macro.mechanics import Mechanics
+    scene = {"wear.k_w": "1e-12 1/Pa", "time.steps": 2, "time.end": "1.2 s"}
+    # Newton with fresh factors at every iteration: the wear is 100 x the demo's, and from the worn
+    # laws the contact Newton of the timed refactorisation rule failed in 1 run of 6 (docs/architecture)
+    monkeypatch.setattr(Mechanics, "__init__", functools.partialmethod(Mechanics.__init__, refresh=1))
     runs = {n: run_pod(tmp_path / str(n), {**scene, "wear.substeps": n}) for n in (4, 32)}
     coarse = runs[4]
     converged = run(loads(POD.format(folder=tmp_path / "128"), overrides={**scene, "wear.substeps": 128}),
