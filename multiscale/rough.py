@@ -231,8 +231,8 @@ class RoughInterface:
     def zone_wear_volume(self, depth: np.ndarray) -> np.ndarray:
         """Worn volume of each zone [m^3] from its depth field (Z, ny, nx) [m]: over its facets'
         area (``cover``)."""
-        s = self.zones[0].surface
-        return depth.sum(axis=(-2, -1)) * s.dx * s.dy * self.cover
+        cell = np.array([z.surface.dx * z.surface.dy for z in self.zones])     # each zone's own (several pads)
+        return depth.sum(axis=(-2, -1)) * cell * self.cover
 
     def update_laws(self) -> int:
         """Laws of every used zone (cached ones reused), loaded into the facet law (collective);

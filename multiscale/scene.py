@@ -18,7 +18,6 @@ from __future__ import annotations
 import dataclasses
 import os
 import tomllib
-import warnings
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -26,12 +25,11 @@ from pathlib import Path
 import numpy as np
 
 from multiscale.errors import InputError, SceneError, toml_problem
-from multiscale.micro.topography import (TopographyWarning, check_cutoff, check_resolved, coarse_grid, condition,
-                                         covers, read_topography, zone_cells)
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
-from multiscale.scene_sections import (COUPLING_DEFAULT, DEFAULT_GRID, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
+from multiscale.scene_rough import measured_cover, nyquist, rough_rules
+from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
 from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_phases, squeal_state,
@@ -373,7 +371,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                     problems.append(f"wear.{given[0]}: the rough body's material gives k_w "
                                     f"(materials.{name}.k_w): give one of them")
         if not problems:
-            problems += _nyquist(scene) + _measured_cover(scene, warnings)
+            problems += [str(e) for e in rough_rules(scene)] + nyquist(scene) + measured_cover(scene, warnings)
     if scene.output is not None and scene.output.fields is not None:
         for f in scene.output.fields:
             missing = [e for e in OUTPUT_FIELDS[f] if e not in effects]
@@ -486,64 +484,6 @@ def _penalty_warnings(scene: Scene, g: Geometry, effects) -> list[str]:
                        f"(they did from about 1e5 E*/h); at {STIFF_PENALTY:.0e} E*/h the penetration is already "
                        f"{1 / STIFF_PENALTY:.0e} of the elastic deflection")
     return out
-
-
-def _nyquist(scene: Scene) -> list[str]:
-    """A generated surface's k_max within the Nyquist index of the cells it is drawn on (the zone's
-    micro grid, or zones x grid for patch = "face")."""
-    out = []
-    for name in scene.rough_interfaces:
-        s = scene.interface_settings(name)
-        r, m = s.roughness, s.micro
-        if r is None or r.rms is None or m is None or m.zones is None:
-            continue
-        cells = [g * (z if r.patch == "face" else 1) for g, z in zip(m.grid or DEFAULT_GRID, m.zones)]
-        if any(k > c // 2 for k, c in zip(r.k_max, cells)):
-            out.append(f"{scene.roughness_key(name)}.k_max = {list(r.k_max)}: must not exceed the Nyquist index "
-                       f"{[c // 2 for c in cells]} of the {'face' if r.patch == 'face' else 'zone'}'s micro grid "
-                       f"of {cells} cells")
-    return sorted(set(out))
-
-
-def _measured_cover(scene: Scene, warnings_out: list) -> list[str]:
-    """A face's cells per zone taken from a measurement's pixels stay within
-    ``topography.MAX_CELLS`` (``topography.zone_cells``, the run's rule), a measurement used as it
-    is (``cover = "measured"``) covers its face, one drawn from (``"equivalent"``) holds a
-    wavelength the face's micro grid resolves: the run's refusals (``topography.covers``,
-    ``topography.check_resolved``) before meshing, for the faces whose extent the geometry knows then
-    (``GeometrySpec.interface_extents``; the others are refused after meshing), and a filter
-    ``cutoff`` spans 2 of its pixels (``topography.check_cutoff``); a grid too coarse for the measured
-    gradient is warned about (``topography.coarse_grid``, into ``warnings_out``)."""
-    out = []
-    for name in scene.rough_interfaces:
-        s, size = scene.interface_settings(name), scene.geometry.spec.interface_extents.get(name)
-        r = s.roughness
-        if r is None or r.file is None:
-            continue
-        prefix = f"{scene.roughness_key(name)}."
-        try:
-            with warnings.catch_warnings():        # the file's notes are the scene's warnings already
-                warnings.simplefilter("ignore", TopographyWarning)
-                measured = read_topography(r.file, r.channel, pixel_size=r.pixel_size, height_unit=r.height_unit,
-                                           prefix=prefix)
-            if r.cutoff is not None:
-                check_cutoff(f"{prefix}cutoff", r.cutoff, measured.dx, measured.dy, r.file.name)
-            if size is None:
-                continue
-            cells = zone_cells(s.micro.grid, r.cover, size, s.micro.zones, (measured.dx, measured.dy), DEFAULT_GRID,
-                               r.file.name)
-            if r.cover == "measured":
-                covers(measured.size, size, r.cover, prefix=prefix)
-            elif r.cover == "equivalent":
-                check_resolved(measured.size, [z * c for z, c in zip(s.micro.zones, cells)], size, prefix=prefix)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore", TopographyWarning)
-                done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix=prefix, despike=r.despike)
-            cell = [L / (z * c) for L, z, c in zip(size, s.micro.zones, cells)]
-            warnings_out += [w for w in [coarse_grid(done.surface, cell, prefix)] if w and w not in warnings_out]
-        except InputError as exc:
-            out.append(str(exc))
-    return sorted(set(out))
 
 
 def _symmetry_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]:

@@ -1003,3 +1003,21 @@ def test_the_zones_of_a_round_pin_face_stand_for_their_facets(tmp_path):
                                         "Surface In BoundingBox{-41, -41, -0.1, 41, 41, 0.1};")
     with pytest.raises(SceneError, match=r"physical surface\(s\) disc_top lie where solids touch.*Coherence"):
         loads(ROUND_PIN.format(folder=tmp_path / "out"), tmp_path)
+
+
+def test_rough_pads_of_different_materials_are_refused_by_check(tmp_path):
+    """The rough interfaces share one micro solid: pads of two materials passed `multiscale check`
+    and were refused by the run (a user trial); the scene's check now refuses them, with the run's
+    words (``scene_rough.rough_rules``)."""
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO)
+    rough = TWO_PADS.replace('effects = ["contact", "friction", "thermal", "heat_partition"]',
+                             'effects = ["contact", "friction", "thermal", "heat_partition", "roughness"]') + \
+        '[roughness]\nrms = "1 um"\nhurst = 0.8\nk_min = 1\nk_max = 4\n[micro]\nzones = [2, 2]\ngrid = [16, 16]\n'
+    assert loads(rough.format(folder=tmp_path / "out"), tmp_path).rough_interfaces == ("pad_a", "pad_b")
+    other = rough.replace('[geometry.bodies.pad_b]\ncontains = ["0 mm", "-80 mm", "14 mm"]\nmaterial = "pad"',
+                          '[geometry.bodies.pad_b]\ncontains = ["0 mm", "-80 mm", "14 mm"]\nmaterial = "soft"') + \
+        '[materials.soft]\nE = "1 GPa"\nnu = 0.3\nrho = "2000 kg/m^3"\nkappa = "1.5 W/(m K)"\nc = "1000 J/(kg K)"\n'
+    with pytest.raises(SceneError, match=r"interfaces = \['pad_a', 'pad_b'\]: the rough interfaces must have the same "
+                                         r"materials on both sides \(one micro solid\); found \[\('pad', 'steel'\), "
+                                         r"\('soft', 'steel'\)\]"):
+        loads(other.format(folder=tmp_path / "out"), tmp_path)

@@ -241,3 +241,33 @@ def test_a_zone_loaded_at_or_above_the_hardness_is_named():
     with pytest.raises(InputError, match=r"hardness: 1 zone\(s\) .*zone 1: 1.2e\+06 Pa against H = 1e\+06 Pa"):
         post.run(zones, [5e5, 1.2e6], speed=1.0)
     assert np.all(post.run(zones, [5e5, 9e5], speed=1.0).max_pressure <= 1e6)
+
+
+def test_zones_of_two_grids_are_post_analysed_each_on_its_own():
+    """Two pads whose zones differ in cell size (a round puck's 352.6 um beside a square pad's
+    312.5 um, a user trial): every zone took the first grid's cells, so the second pad's heat and
+    worn volume came out 1.27 times too large. ``PostAnalyses`` hands each zone to its grid's
+    post-analysis: the results are those of each grid's own to round-off, in the zones' order, and
+    the heat rate is mu P A V of each patch; a zone of another grid is refused by a PostAnalysis."""
+    from multiscale.micro.post_analysis import PostAnalyses, grid_of
+    from multiscale.micro.zones import Zone
+    a = cut_zones(S, (2, 1))[1]
+    wide = Surface(S.heights, 1.2 * S.dx, 1.2 * S.dy, periodic=False)
+    b = [Zone(10 + z.id, z.surface) for z in cut_zones(wide, (2, 1))[1]]
+    settings = dict(mu=0.4, heating=Heating(DISC, PIN), wear_rate=1e-14)
+    own = {grid_of(z[0]): PostAnalysis(E, z[0].shape, z[0].surface.dx, z[0].surface.dy, **settings) for z in (a, b)}
+    posts = PostAnalyses(own)
+    zones = [a[0], b[0], a[1], b[1]]
+    load, speed, remote = np.array([1e6, 2e6, 3e6, 4e6]), np.array([1.0, 2.0, 1.5, 2.5]), np.full((4, 2), 300.0)
+    mixed = posts.run(zones, load, speed=speed, remote=remote)
+    worn = posts.wear(zones, mixed, np.full(4, 1e-3), remote)
+    for ids, z in (([0, 2], a), ([1, 3], b)):
+        alone = own[grid_of(z[0])].run([zones[i] for i in ids], load[ids], speed=speed[ids], remote=remote[ids])
+        np.testing.assert_allclose(mixed.heat[ids], alone.heat, rtol=1e-12)
+        np.testing.assert_allclose(mixed.pressure[ids], alone.pressure, rtol=1e-12, atol=1e-12 * load.max())
+        area = z[0].surface.size[0] * z[0].surface.size[1]
+        np.testing.assert_allclose(alone.heat, 0.4 * load[ids] * area * speed[ids], rtol=1e-9)
+        np.testing.assert_allclose(worn.volume[ids], own[grid_of(z[0])].wear(
+            [zones[i] for i in ids], alone, np.full(2, 1e-3), remote[ids]).volume, rtol=1e-12)
+    with pytest.raises(InputError, match="cells"):
+        own[grid_of(a[0])].run([b[0]], [1e6], speed=1.0, remote=[[300.0, 300.0]])

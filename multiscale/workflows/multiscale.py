@@ -39,7 +39,7 @@ from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.output import FieldOutput
 from multiscale.micro.heat_kernels import ThermalMaterial
 from multiscale.micro.laws import Conductance
-from multiscale.micro.post_analysis import Heating, PostAnalysis
+from multiscale.micro.post_analysis import Heating, PostAnalyses, PostAnalysis, grid_of
 from multiscale.plots.history import multiscale_figure, wear_map
 from multiscale.provenance import resolved_toml
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, heat_warnings_as_notes, \
@@ -137,7 +137,9 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
                             forces=interface_forces(scene, tm), friction=mu,
                             remote=scene.micro.remote(scene.effects), coupling=scene.micro.coupling_scheme(scene.effects),
                             coupling_tol=scene.micro.coupling_tol, coupling_iterations=scene.micro.coupling_iterations)
-    return Multiscale(model, rough, post_analysis(scene, rough.zones[0]), settings, fingerprint(scene))
+    grids = {grid_of(z): z for z in rough.zones}          # interfaces whose zones differ in cell size
+    post = PostAnalyses({grid: post_analysis(scene, z) for grid, z in grids.items()})
+    return Multiscale(model, rough, post, settings, fingerprint(scene))
 
 
 def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_WORLD, verbose: bool = True,

@@ -41,6 +41,7 @@ from multiscale.micro.topography import TopographyWarning, condition, cover, rea
 from multiscale.micro.zones import ZoneGrid, cut_zones, generate_zones
 from multiscale.pool import MicroPool
 from multiscale.rough import RoughInterface, interface_plane
+from multiscale.scene_rough import rough_rules
 from multiscale.scene_sections import DEFAULT_GRID
 from multiscale.workflows.model import interface_forces, interface_materials
 
@@ -50,24 +51,11 @@ P_MAX_PLASTIC = 0.9        # with plasticity, the top node of the laws is at mos
 
 
 def check_rough_scene(scene) -> None:
-    """The rules every rough analysis shares (InputError naming the field; the rough body, and the
-    layers' body, is the stationary one: checked when the scene is read)."""
-    if scene.micro.model != "fft-bem":
-        raise InputError("micro.model", scene.micro.model, 'the zone laws are computed by FFT-BEM: "fft-bem"')
-    if not scene.rough_interfaces:
-        raise InputError("interfaces", "rough = false", 'effect "roughness" needs at least one rough interface')
-    pairs = {scene.geometry.spec.interface_materials(n) for n in scene.rough_interfaces}
-    if len(pairs) > 1:
-        raise InputError("interfaces", sorted(scene.rough_interfaces), "the rough interfaces must have the same "
-                         f"materials on both sides (one micro solid); found {sorted(pairs)}")
-    shared = ("grid", "law_points", "model", "p_max", "tol", "partition_law", "heating", "heating_steps",
-              "remote_temperatures", "coupling", "coupling_tol", "coupling_iterations")
-    for name in scene.rough_interfaces:
-        m = scene.interface_settings(name).micro
-        for key in shared:
-            if getattr(m, key) != getattr(scene.micro, key):
-                raise InputError(f"interfaces.{name}.micro.{key}", getattr(m, key), f"must be the same on every "
-                                 f"interface (micro.{key} = {getattr(scene.micro, key)}); only zones may differ")
+    """The rules every rough analysis shares (``scene_rough.rough_rules``, the first broken raised;
+    the rough body, and the layers' body, is the stationary one: checked when the scene is read)."""
+    broken = rough_rules(scene)
+    if broken:
+        raise broken[0]
 
 
 def make_zones(r, m, lo, hi, seed: int, log=None, prefix: str = "roughness.") -> tuple[ZoneGrid, list]:

@@ -1,0 +1,98 @@
+"""The rules of a scene's rough interfaces that ``multiscale check`` applies before meshing (the
+scene's cross-checks call them once the sections read; the run applies ``rough_rules`` again,
+``workflows.rough.check_rough_scene``): one micro solid and one set of micro settings over the
+rough interfaces, a generated surface within its grid's Nyquist index, a measured one covering its
+face with a grid that resolves it."""
+from __future__ import annotations
+
+import warnings
+
+from multiscale.errors import InputError
+from multiscale.micro.topography import (TopographyWarning, check_cutoff, check_resolved, coarse_grid, condition,
+                                         covers, read_topography, zone_cells)
+from multiscale.scene_sections import DEFAULT_GRID
+
+SHARED_MICRO = ("grid", "law_points", "model", "p_max", "tol", "partition_law", "heating", "heating_steps",
+                "remote_temperatures", "coupling", "coupling_tol", "coupling_iterations")
+
+
+def rough_rules(scene) -> list[InputError]:
+    """What every rough analysis needs (each an InputError naming the key): FFT-BEM laws, a rough
+    interface, the same materials on both sides of every rough interface (one micro solid: a pad of
+    another material was refused by the run only, after check said OK; a user trial) and the same
+    micro settings but the zones (``SHARED_MICRO``)."""
+    if not scene.has("roughness") or scene.micro is None:
+        return []
+    if scene.micro.model != "fft-bem":
+        return [InputError("micro.model", scene.micro.model, 'the zone laws are computed by FFT-BEM: "fft-bem"')]
+    if not scene.rough_interfaces:
+        return [InputError("interfaces", "rough = false", 'effect "roughness" needs at least one rough interface')]
+    out = []
+    pairs = {scene.geometry.spec.interface_materials(n) for n in scene.rough_interfaces}
+    if len(pairs) > 1:
+        out.append(InputError("interfaces", sorted(scene.rough_interfaces), "the rough interfaces must have the same "
+                              f"materials on both sides (one micro solid); found {sorted(pairs)}"))
+    for name in scene.rough_interfaces:
+        m = scene.interface_settings(name).micro
+        out += [InputError(f"interfaces.{name}.micro.{key}", getattr(m, key), f"must be the same on every interface "
+                           f"(micro.{key} = {getattr(scene.micro, key)}); only zones may differ")
+                for key in SHARED_MICRO if getattr(m, key) != getattr(scene.micro, key)]
+    return out
+
+
+def nyquist(scene) -> list[str]:
+    """A generated surface's k_max within the Nyquist index of the cells it is drawn on (the zone's
+    micro grid, or zones x grid for patch = "face")."""
+    out = []
+    for name in scene.rough_interfaces:
+        s = scene.interface_settings(name)
+        r, m = s.roughness, s.micro
+        if r is None or r.rms is None or m is None or m.zones is None:
+            continue
+        cells = [g * (z if r.patch == "face" else 1) for g, z in zip(m.grid or DEFAULT_GRID, m.zones)]
+        if any(k > c // 2 for k, c in zip(r.k_max, cells)):
+            out.append(f"{scene.roughness_key(name)}.k_max = {list(r.k_max)}: must not exceed the Nyquist index "
+                       f"{[c // 2 for c in cells]} of the {'face' if r.patch == 'face' else 'zone'}'s micro grid "
+                       f"of {cells} cells")
+    return sorted(set(out))
+
+
+def measured_cover(scene, warnings_out: list) -> list[str]:
+    """A face's cells per zone taken from a measurement's pixels stay within
+    ``topography.MAX_CELLS`` (``topography.zone_cells``, the run's rule), a measurement used as it
+    is (``cover = "measured"``) covers its face, one drawn from (``"equivalent"``) holds a
+    wavelength the face's micro grid resolves: the run's refusals (``topography.covers``,
+    ``topography.check_resolved``) before meshing, for the faces whose extent the geometry knows then
+    (``GeometrySpec.interface_extents``; the others are refused after meshing), and a filter
+    ``cutoff`` spans 2 of its pixels (``topography.check_cutoff``); a grid too coarse for the measured
+    gradient is warned about (``topography.coarse_grid``, into ``warnings_out``)."""
+    out = []
+    for name in scene.rough_interfaces:
+        s, size = scene.interface_settings(name), scene.geometry.spec.interface_extents.get(name)
+        r = s.roughness
+        if r is None or r.file is None:
+            continue
+        prefix = f"{scene.roughness_key(name)}."
+        try:
+            with warnings.catch_warnings():        # the file's notes are the scene's warnings already
+                warnings.simplefilter("ignore", TopographyWarning)
+                measured = read_topography(r.file, r.channel, pixel_size=r.pixel_size, height_unit=r.height_unit,
+                                           prefix=prefix)
+            if r.cutoff is not None:
+                check_cutoff(f"{prefix}cutoff", r.cutoff, measured.dx, measured.dy, r.file.name)
+            if size is None:
+                continue
+            cells = zone_cells(s.micro.grid, r.cover, size, s.micro.zones, (measured.dx, measured.dy), DEFAULT_GRID,
+                               r.file.name)
+            if r.cover == "measured":
+                covers(measured.size, size, r.cover, prefix=prefix)
+            elif r.cover == "equivalent":
+                check_resolved(measured.size, [z * c for z, c in zip(s.micro.zones, cells)], size, prefix=prefix)
+            with warnings.catch_warnings():
+                warnings.simplefilter("ignore", TopographyWarning)
+                done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix=prefix, despike=r.despike)
+            cell = [L / (z * c) for L, z, c in zip(size, s.micro.zones, cells)]
+            warnings_out += [w for w in [coarse_grid(done.surface, cell, prefix)] if w and w not in warnings_out]
+        except InputError as exc:
+            out.append(str(exc))
+    return sorted(set(out))
