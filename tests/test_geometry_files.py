@@ -993,8 +993,10 @@ def test_the_zones_of_a_round_pin_face_stand_for_their_facets(tmp_path):
     assert areas.sum() == pytest.approx(np.pi * 3e-3**2, rel=2e-2)          # the round face
     depth = reader.read_data(reader.num_steps - 1)[2]["wear depth [m]"][0]
     with h5py.File(tmp_path / "out" / "zones.h5") as z:
-        zones = z["wear_volume"][...]
+        zones, facets, mean = (z[k][...] for k in ("wear_volume", "facet_area", "mean_wear_depth"))
     volume = h["wear_volume"][-1]
+    assert facets.sum() == pytest.approx(areas.sum(), rel=1e-12) and facets.max() > 2.5 * facets[0] > 0   # a corner
+    np.testing.assert_allclose(zones, mean * facets, rtol=1e-12)           # each zone's depth over its facets
     assert float(depth @ areas) == pytest.approx(volume, rel=1e-9)
     assert zones.sum() == pytest.approx(volume, rel=1e-12)
     assert volume == pytest.approx(1e-14 * h["frictional_work"][-1], rel=5e-3)

@@ -260,6 +260,7 @@ def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: 
             h5.create_dataset("mean_wear_depth", data=depth.mean(axis=(-2, -1))).attrs["unit"] = "m"
             h5.create_dataset("max_wear_depth", data=depth.max(axis=(-2, -1))).attrs["unit"] = "m"
             h5.create_dataset("wear_volume", data=rough.zone_wear_volume(depth)).attrs["unit"] = "m^3"
+            h5.create_dataset("facet_area", data=rough.covered_area).attrs["unit"] = "m^2"
             h5.create_dataset("partition", data=ms.partition).attrs["unit"] = "-"     # share into body 0
             h5.create_dataset("flash_temperature", data=ms.flash).attrs["unit"] = "K"
             h5.create_dataset("counter_wear_depth", data=ms.counter_depth).attrs["unit"] = "m"   # per facet
