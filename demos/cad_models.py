@@ -10,13 +10,18 @@
 # Then: `multiscale check demos/car_brake_stop.toml` lists what the file holds (bodies, volumes,
 # interfaces with their areas and normals) before anything is meshed.
 
+import argparse
 import math
 from pathlib import Path
 
 import gmsh
 
-OUT = Path(__file__).resolve().parent / "cad"
-OUT.mkdir(exist_ok=True)
+parser = argparse.ArgumentParser(description="Write the two STEP models the CAD demo scenes read (car_brake.step, "
+                                 "railway_disc.step)")
+parser.add_argument("--out", default=str(Path(__file__).resolve().parent / "cad"),
+                    help="folder (default: %(default)s, where the demo scenes read them)")
+OUT = Path(parser.parse_args().out)
+OUT.mkdir(parents=True, exist_ok=True)
 gmsh.initialize()
 gmsh.option.setNumber("General.Terminal", 0)
 occ = gmsh.model.occ

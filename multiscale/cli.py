@@ -43,20 +43,18 @@ starts N separate serial runs, or stops with a PMI error."""
 
 
 def _info(args) -> int:
-    # versions only: numba, scipy and pyfftw take seconds to load, which `check` must not pay
-    import numba
-    import numpy
-    import scipy
+    """The versions a run's provenance.json records (``provenance.versions``; a user trial found
+    PETSc, SLEPc, MPI, gmsh and Python missing here) and the FFT backend."""
+    # local: numba, scipy, pyfftw and DOLFINx take seconds to load, which `check` must not pay
     from multiscale.micro.fft import get_threads, pyfftw
-    print(f"multiscale {__version__}  numpy {numpy.__version__}  scipy {scipy.__version__}  "
-          f"numba {numba.__version__}  fft {'pyfftw' if pyfftw else 'scipy'} ({get_threads()} thread(s))")
+    from multiscale.provenance import versions
     try:
-        # DOLFINx is optional; multiscale.macro loads its prerequisites first
-        import multiscale.macro  # noqa: F401
-        import dolfinx
-        print(f"dolfinx {dolfinx.__version__}")
+        import multiscale.macro  # noqa: F401  (DOLFINx is optional; this loads its prerequisites first)
+        import dolfinx  # noqa: F401
     except ImportError:
         print("dolfinx not installed (macro models unavailable)")
+    print("  ".join(f"{name} {version}" for name, version in versions().items()))
+    print(f"fft {'pyfftw' if pyfftw else 'scipy'} ({get_threads()} thread(s))")
     return 0
 
 
@@ -388,7 +386,8 @@ def build_parser() -> argparse.ArgumentParser:
     again = run.add_mutually_exclusive_group()
     again.add_argument("--overwrite", action="store_true",
                        help="delete the results of the run before (the entries its provenance.json lists) and run again")
-    again.add_argument("--resume", action="store_true", help="continue from the last checkpoint in the output folder")
+    again.add_argument("--resume", action="store_true", help="continue from the last checkpoint in the output folder "
+                       '(the multiscale loop, effect "roughness", writes them; other runs start again)')
     run.add_argument("--set", **SET)
     run.add_argument("--quiet", action="store_true", help="no stage lines or summary (warnings and errors only)")
     run.add_argument("--max-cells", type=_count, metavar="N", help="largest mesh (cells) the run may build; "

@@ -29,7 +29,8 @@ def problems_text() -> str:
             lines += ["  parameters ([fixed] and [sweep] keys):"] + ["  " + line for line in reference(entry.params)]
         else:
             lines.append("  parameters: dotted keys of the base scene (scene = \"file.toml\"), e.g. geometry.mesh_size")
-        lines += ["  metrics:"] + [f"    {m:<22} {doc}" for m, doc in entry.metrics.items()]
+        if entry.metrics:                     # (a scene's are its history columns: said in its line)
+            lines += ["  metrics:"] + [f"    {m:<22} {doc}" for m, doc in entry.metrics.items()]
         if getattr(entry, "exact", None):
             lines.append(f"  analytic reference of: {', '.join(entry.exact_metrics)}")
     return "\n".join(lines[1:])
