@@ -26,6 +26,7 @@ from multiscale.micro.spectrum import statistics_memory, surface_statistics
 from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition
 from multiscale.outputs import CHECKPOINT, analysis, folder_problem, plan
 from multiscale.outputs import summary as plan_summary
+from multiscale.provenance import versions
 from multiscale.scene import load
 from multiscale.scene_plain import pixel_problem, plain
 from multiscale.scene_summary import cells_line, reference, summary
@@ -47,7 +48,6 @@ def _info(args) -> int:
     PETSc, SLEPc, MPI, gmsh and Python missing here) and the FFT backend."""
     # local: numba, scipy, pyfftw and DOLFINx take seconds to load, which `check` must not pay
     from multiscale.micro.fft import get_threads, pyfftw
-    from multiscale.provenance import versions
     try:
         import multiscale.macro  # noqa: F401  (DOLFINx is optional; this loads its prerequisites first)
         import dolfinx  # noqa: F401
