@@ -14,8 +14,9 @@ plane z = const, (u, v) = (x, y).
 ``update_laws`` computes the laws of the zones whose topography changed (the pool's cache keeps
 the others) and loads them into the facet law; a zone whose law fails (its roughness stiffer below
 p_max than the zone's own compliance resolves) is retried with p_max halved, up to
-``P_MAX_HALVINGS`` times (remembered for its later laws). ``datum_gap`` is the per-facet uniform initial gap at which the rigid rough bodies
-carry given forces, one bisection per interface: it starts Newton close to equilibrium.
+``P_MAX_HALVINGS`` times (remembered for its later laws). ``datum_gap`` is the per-facet uniform
+initial gap at which the rigid rough bodies carry given forces, one bisection per interface: it
+starts Newton close to equilibrium.
 
 ``track_depth`` spreads the volume the counter-face (a rotating body 1) loses in each zone over its
 circular wear track: the counter-face stays flat at the zone scale and its surface recedes by a
