@@ -192,8 +192,7 @@ class Interface:
 
     penalty: float | None = key(Quantity("stiffness", gt=0, plausible=(1e8, 1e19)), needed_by=("contact",),
                                 unless=("roughness",))          # Pa/m, normal penalty stiffness K_n
-    partition: float | str | None = key(Either(Quantity("dimensionless", ge=0, le=1),
-                                               Choice(("effusivity",))),
+    partition: float | str | None = key(Either(Quantity("dimensionless", ge=0, le=1), Choice(("effusivity",))),
                                         needed_by=("heat_partition",), warn_unused=True)  # into body 0
     conductance: float | None = key(Quantity("conductance", gt=0, plausible=(1.0, 1e8)), needed_by=("conductance",),
                                     unless=("roughness",), warn_unused=True)   # W/(m^2 K), h_c
@@ -456,6 +455,7 @@ class Roughness:
 
 
 DEFAULT_GRID = (50, 50)    # cells per zone without micro.grid (generated surfaces)
+P_MAX_FACTOR = 20.0        # without micro.p_max, the laws' top node is this x the nominal interface pressure
 
 
 # Default coupling of partitions and temperatures for each choice of remote temperatures, chosen by
@@ -487,7 +487,7 @@ class Micro:
     law_points: int = key(Integer(ge=4), default=20)
     partition_law: bool = key(Flag(), default=False)
     p_max: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e10)),   # Pa, top node of the laws
-                              absent="20 x the nominal interface pressure")
+                              absent=f"{P_MAX_FACTOR:g} x the nominal interface pressure")
     tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)     # micro contact solves
     flash_softening: bool = key(Flag(), default=False)   # H(T) of each zone at its last flash temperature
     heating: str = key(Choice(("steady", "transient")), default="steady")

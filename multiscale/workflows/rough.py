@@ -42,10 +42,9 @@ from multiscale.micro.zones import ZoneGrid, cut_zones, generate_zones
 from multiscale.pool import MicroPool
 from multiscale.rough import RoughInterface, interface_plane
 from multiscale.scene_rough import rough_rules
-from multiscale.scene_sections import DEFAULT_GRID
+from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR
 from multiscale.workflows.model import interface_forces, interface_materials
 
-P_MAX_FACTOR = 20.0        # default top node of the laws: 20 x the nominal interface pressure
 SEED_STRIDE = 7919         # interface k draws its surfaces with seed + SEED_STRIDE k
 P_MAX_PLASTIC = 0.9        # with plasticity, the top node of the laws is at most this x the hardness
 
