@@ -244,8 +244,7 @@ class Multiscale:
         if speed == 0.0 and dt:
             speed = model.drive.mean_speed(model.time, model.time + dt) or \
                 model.drive.mean_speed(max(model.time - dt, 0.0), model.time)
-        covered = self.rough.covered_area           # the mean pressure of each zone's facets
-        return ZoneLoading(force, force / np.where(covered > 0, covered, 1.0), reach * abs(speed),
+        return ZoneLoading(force, self.rough.per_facet_area(force), reach * abs(speed),   # their mean pressure
                            angle + (np.pi if speed < 0 else 0.0), T, reach)
 
     def analyse(self) -> MicroStep:
@@ -405,8 +404,7 @@ class Multiscale:
         if self.partition_law:
             iface.set_field(contact.partition, np.where(rough, self.partition[zone_of], iface.values(contact.partition)))
         if self.settings.coupling == "implicit":   # the exchange G of each zone over its facets
-            covered = self.rough.covered_area
-            self.conductance = self.exchange / np.where(covered > 0, covered, 1.0)
+            self.conductance = self.rough.per_facet_area(self.exchange)
         if self.post.conductance is not None or self.settings.coupling == "implicit":
             iface.set_field(contact.conductance,
                             np.where(rough, self.conductance[zone_of], iface.values(contact.conductance)))

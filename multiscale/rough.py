@@ -173,6 +173,12 @@ class RoughInterface:
         1, up to how the facets' midpoints fall."""
         return self.covered_area / self.zone_area
 
+    def per_facet_area(self, values) -> np.ndarray:
+        """Per-zone totals ``values`` (a force [N], an exchange [W/K]) over the area of each zone's
+        facets (a pressure, a conductance per area); 0 for a zone holding no facet."""
+        covered = self.covered_area
+        return np.asarray(values, dtype=float) / np.where(covered > 0, covered, 1.0)
+
     @property
     def law_top(self) -> np.ndarray:
         """Largest pressure of every zone's law [Pa]: p_max, halved where a law failed (beyond it
