@@ -145,7 +145,7 @@ class MicroStep:
     work: float                # J, mu ∫ p |v| dA over the wear interval (0 without wear)
     seconds: float
     plastic_fraction: float = 0.0  # largest share of a zone's cells at the hardness (0 without plasticity)
-    real_area: float = 0.0     # m^2, real contact area summed over the loaded zones (before wear)
+    real_area: np.ndarray = None  # m^2, per zone: real contact area over its facets (before wear; 0 unloaded)
     law_reach: float = 0.0     # largest zone pressure over micro.p_max, the top of the laws (> 1: extrapolated)
     law_reach_halved: float = 0.0  # the same over the zones whose law failed, against their halved top
     wear_error: float = 0.0    # estimated error of the worn real contact area / that area, from the substeps
@@ -272,10 +272,10 @@ class Multiscale:
         for a in (self.proposed, self.flash, self.micro_heat, self.micro_heat_rough):
             a[:] = np.nan
         self.proposed_exchange[:] = 0.0
-        max_p, flow, real = [], [np.zeros(0)], 0.0
+        max_p, flow, real = [], [np.zeros(0)], np.zeros(len(zones))
         for ids, warm, mp, mT, part, h_c, heat, rough, exchange, diff, fraction, area in parts:
             flow.append(fraction)
-            real += float(np.sum(area))
+            real[ids] = area
             self.warm[ids], self.proposed[ids], self.flash[ids] = warm, part, mT
             self.micro_heat[ids], self.micro_heat_rough[ids], self.remote_difference[ids] = heat, rough, diff
             if implicit:
@@ -507,8 +507,9 @@ class Multiscale:
         row = self.model.record(result.heat)
         row.update(zones_in_contact=micro.loaded * on, laws_computed=self.rough.laws_computed,
                    max_zone_pressure=micro.zone_pressure * on, micro_max_pressure=micro.max_pressure * on,
-                   real_contact_area=micro.real_area * on, law_reach=micro.law_reach * on,
+                   real_contact_area=float(micro.real_area.sum()) * on, law_reach=micro.law_reach * on,
                    law_reach_halved=micro.law_reach_halved * on)
+        row.update({f"real_contact_area_{n}": a * on for n, a in self.rough.interface_sums(micro.real_area).items()})
         if self.post.heating is not None:           # released: no heat to share (NaN, as the flash)
             low, mean, high = micro.partition if on else (np.nan,) * 3
             row.update(micro_max_temperature=micro.max_temperature, partition_min=low, partition_mean=mean,
@@ -520,9 +521,10 @@ class Multiscale:
             row.update(micro_plastic_fraction=micro.plastic_fraction,
                        plastic_max_depth=float(self.rough.plastic.max(initial=0.0)))
         if self.settings.wear:
-            heights = self.rough.heights()
-            depth = self.rough.wear_depth()
-            row.update(wear_volume=float(self.rough.zone_wear_volume(depth).sum()), wear_max_depth=float(depth.max()),
+            heights, depth = self.rough.heights(), self.rough.wear_depth()
+            volume = self.rough.zone_wear_volume(depth)
+            row.update({f"wear_volume_{n}": v for n, v in self.rough.interface_sums(volume).items()})
+            row.update(wear_volume=float(volume.sum()), wear_max_depth=float(depth.max()),
                        rms_height=float(np.sqrt(np.mean((heights - heights.mean()) ** 2))),
                        frictional_work=self.work, wear_substep_error=result.micro.wear_error)
             if self.post.counter_rate is not None:

@@ -273,6 +273,11 @@ class RoughInterface:
         start = sum(g.n_zones for g in self.grids[:k])
         return np.arange(start, start + self.grids[k].n_zones)
 
+    def interface_sums(self, values) -> dict:
+        """{name: sum of the per-zone ``values`` over its zones} for each rough interface when there
+        are several (the history's per-interface columns), else {}."""
+        return {} if len(self.names) < 2 else {n: float(np.sum(values[self.zone_of(n)])) for n in self.names}
+
     def datum_gap(self, forces) -> np.ndarray:
         """Per-facet uniform gap g_0 [m] of each rough interface at which its rigid rough body
         carries ``forces[name]`` [N] (bisection); 0 on the other facets."""
