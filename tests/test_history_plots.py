@@ -148,3 +148,30 @@ def test_a_unit_word_in_a_body_or_interface_name_does_not_set_the_unit(tmp_path)
     assert units == {"time": "s", "max_temperature_pressure_plate": "K", "frictional_heat_total_force_pad": "J",
                      "face_mean_temperature_force_pad_on_pressure_plate": "K", "interface_force_heat_pad": "N",
                      "max_pressure_time_pad": "Pa"}
+
+
+def test_the_wear_map_of_a_round_face_leaves_its_corners_blank(tmp_path, drawn):
+    """A round face (a 48-gon of radius 3 mm, fan-triangulated) under 4 x 4 zones of 8 x 8 cells:
+    the micro cells drawn are those whose centre is on the face, their area that of the 48-gon to
+    the cells' quantisation (2 %), and a corner zone with no cell on it is blank. Before, the map
+    drew every patch over its whole box, wear outside the pin included (a user trial). An L-shaped
+    face (non-convex) keeps its notch blank."""
+    from multiscale.micro.zones import ZoneGrid
+    r, n = 3e-3, 48
+    a = 2 * np.pi * np.arange(n + 1) / n
+    rim = r * np.column_stack([np.cos(a), np.sin(a)])
+    disc = np.stack([np.zeros((n, 2)), rim[:-1], rim[1:]], axis=1)
+    grid = ZoneGrid((-r, -r), (4, 4), (r / 2, r / 2))
+    plots.wear_map(grid, np.full((16, 8, 8), 1e-6), tmp_path / "wear.png", face=disc)
+    zones, cells = (ax.images[0].get_array() for ax in drawn[-1].axes[:2])
+    drawn_zones, drawn_cells = (~np.ma.getmaskarray(a) & np.isfinite(np.ma.getdata(a)) for a in (zones, cells))
+    area = 0.5 * n * r**2 * np.sin(2 * np.pi / n)
+    assert np.count_nonzero(drawn_cells) * (r / 16)**2 == pytest.approx(area, rel=2e-2)
+    assert not drawn_cells[0, 0] and cells[16, 16] == pytest.approx(1.0)          # µm
+    assert drawn_zones.all()                                  # each corner zone holds a sliver of the face
+    plots.wear_map(ZoneGrid((-2 * r, -r), (5, 4), (r / 2, r / 2)), np.full((20, 8, 8), 1e-6), tmp_path / "w.png",
+                   face=disc)
+    assert not (~np.ma.getmaskarray(drawn[-1].axes[0].images[0].get_array())).reshape(4, 5)[:, 0].any()   # none
+    ell = np.array([[[0, 0], [2, 0], [2, 1]], [[0, 0], [2, 1], [0, 1]], [[0, 1], [1, 1], [1, 2]], [[0, 1], [1, 2], [0, 2]]])
+    on = plots.cells_on_face(ZoneGrid((0, 0), (2, 2), (1e-3, 1e-3)), (2, 2), 1e-3 * ell)
+    np.testing.assert_array_equal(on, [[1, 1, 1, 1], [1, 1, 1, 1], [1, 1, 0, 0], [1, 1, 0, 0]])

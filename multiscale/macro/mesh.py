@@ -201,16 +201,22 @@ class Interface:
     def crossing(self, name: str, motion) -> Crossing:
         """Where body 1's rigid ``motion`` crosses interface ``name`` instead of sliding along it
         (``crossing``; collective)."""
+        return crossing(self._owned_nodes(name), motion, self.comm)
+
+    def _owned_nodes(self, name: str) -> np.ndarray:
+        """Nodes (facets, nodes, 3) [m] of the owned facets of interface ``name``."""
         owned = self.tag_index[self.owned_index] == list(self.tags).index(name)
-        dofs = self.mesh.geometry.dofmaps[0][:len(self.owned_index)][owned]
-        return crossing(self.mesh.geometry.x[dofs], motion, self.comm)
+        return self.mesh.geometry.x[self.mesh.geometry.dofmaps[0][:len(self.owned_index)][owned]]
+
+    def triangles(self, name: str) -> np.ndarray:
+        """Corners (facets, 3, 3) [m] of every facet of interface ``name``, in no particular order, the
+        same on every rank (collective)."""
+        return np.concatenate(self.comm.allgather(self._owned_nodes(name)[:, :3])).reshape(-1, 3, 3)
 
     def box(self, name: str, axis=None, centre=None) -> tuple[np.ndarray, np.ndarray]:
         """Lower and upper corners (3-vectors) [m] of the vertices of interface ``name`` (collective);
         with ``axis`` (unit vector) and ``centre``: of their (radius, axial position) about that axis."""
-        k = list(self.tags).index(name)
-        owned = self.tag_index[self.owned_index] == k
-        x = self.mesh.geometry.x[self.mesh.geometry.dofmaps[0][:len(self.owned_index)][owned]].reshape(-1, 3)
+        x = self._owned_nodes(name).reshape(-1, 3)
         if axis is not None:
             e, x = np.asarray(axis, dtype=float) / np.linalg.norm(axis), x - np.asarray(centre, dtype=float)
             a = x @ e

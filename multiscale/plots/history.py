@@ -9,7 +9,7 @@ zones) vs micro (Fig. 7.14; log scale, linear with a note if no row has contact)
 macro vs micro (Fig. 7.15), heat partition min/mean/max (Fig. 7.12), wear volume (Fig. 7.16), max
 wear depth (Fig. 7.17) and RMS of the worn surface (Fig. 7.18) — the panels whose columns the
 history has. ``wear_map``: the mean wear depth of every zone over the interface (Fig. 7.13) beside
-the micro wear depth field of the whole face.
+the micro wear depth field of the whole face (blank off the face).
 """
 from __future__ import annotations
 
@@ -176,14 +176,41 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
     return path
 
 
-def wear_map(grid, depth: np.ndarray, path: Path, title: str = "") -> Path:
-    """PNG of the zone-mean wear depth (zone grid) and of the micro wear depth field [µm]."""
+def cells_on_face(grid, cells, triangles) -> np.ndarray:
+    """(ny my, nx mx) booleans: whether the centre of each micro cell of ``grid`` (``cells`` = (my, mx)
+    per zone; rows along v) lies on one of ``triangles`` (n, 3, 2) [m], a planar face's facets in the
+    grid's plane (edges included to 1e-9 of a cell)."""
+    (nx, ny), (my, mx) = grid.counts, cells
+    on = np.zeros((ny * my, nx * mx), dtype=bool)
+    t = (np.asarray(triangles, dtype=float) - grid.origin) / (grid.size[0] / mx, grid.size[1] / my) - 0.5
+    lo = np.maximum(np.ceil(t.min(axis=1) - 1e-9), 0).astype(int)
+    hi = np.minimum(np.floor(t.max(axis=1) + 1e-9), (nx * mx - 1, ny * my - 1)).astype(int)
+    for (a, b, c), (i0, j0), (i1, j1) in zip(t, lo, hi):
+        det = (b[1] - c[1]) * (a[0] - c[0]) + (c[0] - b[0]) * (a[1] - c[1])
+        if i1 < i0 or j1 < j0 or det == 0:
+            continue
+        i, j = np.meshgrid(np.arange(i0, i1 + 1), np.arange(j0, j1 + 1))
+        l1 = ((b[1] - c[1]) * (i - c[0]) + (c[0] - b[0]) * (j - c[1])) / det     # barycentric coordinates
+        l2 = ((c[1] - a[1]) * (i - c[0]) + (a[0] - c[0]) * (j - c[1])) / det
+        inside = (l1 >= -1e-9) & (l2 >= -1e-9) & (l1 + l2 <= 1 + 1e-9)
+        on[j[inside], i[inside]] = True
+    return on
+
+
+def wear_map(grid, depth: np.ndarray, path: Path, title: str = "", face=None) -> Path:
+    """PNG of the zone-mean wear depth (zone grid) and of the micro wear depth field [µm]. With
+    ``face`` (the interface's facets (n, 3, 2) in the grid's plane [m]), the cells whose centre lies
+    off the face, and the zones holding none on it, are left blank (a round face's corners)."""
     nx, ny = grid.counts
     _, my, mx = depth.shape
     x0, y0 = grid.origin
     extent = [1e3 * x0, 1e3 * (x0 + nx * grid.size[0]), 1e3 * y0, 1e3 * (y0 + ny * grid.size[1])]
     zone_mean = depth.mean(axis=(-2, -1)).reshape(ny, nx)
     field = depth.reshape(ny, nx, my, mx).transpose(0, 2, 1, 3).reshape(ny * my, nx * mx)
+    if face is not None:
+        on = cells_on_face(grid, (my, mx), face)
+        field = np.where(on, field, np.nan)
+        zone_mean = np.where(on.reshape(ny, my, nx, mx).any(axis=(1, 3)), zone_mean, np.nan)
     fig = Figure(figsize=(10, 4.2))
     axes = fig.subplots(1, 2)
     for ax, data, label in ((axes[0], zone_mean, "mean wear depth per zone [µm]"),

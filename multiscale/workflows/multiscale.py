@@ -268,7 +268,8 @@ def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: 
             h5.create_dataset("conductance", data=ms.conductance).attrs["unit"] = "W/(m^2 K)"
             h5.attrs["counts"] = np.array([g.counts for g in rough.grids])     # (interfaces, 2)
     offsets = np.cumsum([0] + [g.n_zones for g in rough.grids])
-    jobs = [write] + [partial(wear_map, grid, depth[offsets[k]:offsets[k + 1]], path, f"{name}: {interface}")
-                      for k, (grid, path, interface) in enumerate(zip(rough.grids, maps, names))]
+    faces = [rough.planes[k].uv(ms.tm.interface.triangles(n)) for k, n in enumerate(names)] if maps else []
+    jobs = [write] + [partial(wear_map, grid, depth[offsets[k]:offsets[k + 1]], path, f"{name}: {interface}", face)
+                      for k, (grid, path, interface, face) in enumerate(zip(rough.grids, maps, names, faces))]
     io.on_ranks(comm, jobs, f"the zone results in {folder}")        # the wear maps spread over the ranks
     return plot, maps, zones
