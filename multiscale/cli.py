@@ -170,14 +170,12 @@ def _run(args) -> int:
             if args.max_cells is not None:
                 scene = dataclasses.replace(scene, geometry=dataclasses.replace(scene.geometry,
                                                                                 max_cells=args.max_cells))
-            for line in scene.warnings if rank == 0 else ():
-                print(f"warning: {line}", file=sys.stderr, flush=True)
             try:
                 from multiscale.workflows import run   # DOLFINx: optional ([fem] extra), slow to import
             except ModuleNotFoundError as exc:
                 raise MultiscaleError(f"multiscale run needs DOLFINx and the macro workflows ({exc}); install "
                                       "them with pip install -e '.[fem]'") from None
-            run(scene, overwrite=args.overwrite, resume=args.resume, verbose=not args.quiet)
+            run(scene, overwrite=args.overwrite, resume=args.resume, verbose=not args.quiet)   # warns first
         except MultiscaleError as exc:
             if comm is not None and not ended_together(comm):
                 print(f"error (rank {rank} of {comm.size}): {exc}", file=sys.stderr)

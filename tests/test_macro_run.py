@@ -179,10 +179,12 @@ def test_a_load_that_a_support_takes_is_refused(tmp_path, change):
         run(scene, verbose=False)
 
 
-def test_temperatures_beyond_a_material_table_are_warned_about(tmp_path):
+def test_temperatures_beyond_a_material_table_are_warned_about(tmp_path, capsys):
     """A table is held constant beyond its ends (macro.materials): an initial temperature outside
     it is warned about when the scene is read, a body hotter than its last point after the run
-    (printed and kept in provenance.json). Before: no word of either."""
+    (printed and kept in provenance.json). Before: no word of either. ``workflows.run`` prints
+    both and returns them in ``result.warnings`` for a script (before, a script saw neither the
+    scene's warning, which only the command line printed, nor any in the result: a user trial)."""
     text = pin_on_disc(tmp_path / "pod").replace(
         'kappa = "35 W/(m K)"', 'kappa = [["20 degC", "35 W/(m K)"], ["20.5 degC", "35 W/(m K)"]]').replace(
         'alpha = "1e-5 1/K"', 'alpha = [["-50 degC", "1e-5 1/K"], ["0 degC", "1e-5 1/K"]]')
@@ -195,6 +197,9 @@ def test_temperatures_beyond_a_material_table_are_warned_about(tmp_path):
     record = json.loads((result.folder / "provenance.json").read_text())
     assert record["warnings"] == [*scene.warnings, f"materials.pin.kappa: {hottest:.4g} degC above its last point "
                                   f"20.5 degC, held at 35 there (in the pin)"]
+    assert list(result.warnings) == record["warnings"]
+    assert [line for line in capsys.readouterr().err.splitlines() if "materials." in line] == \
+        [f"warning: {line}" for line in record["warnings"]]
 
 
 def test_the_python_entry_points_name_bad_arguments(tmp_path):

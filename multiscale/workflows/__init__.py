@@ -39,7 +39,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
 
     Besides the analysis' results, the folder receives ``scene.toml``, ``scene_resolved.toml``,
     ``provenance.json`` (also after a failure, once the run has written into the folder) and ``paraview.py``.
-    ``verbose``: stage lines and the summary on rank 0 (the warnings are printed in any case)."""
+    ``verbose``: stage lines and the summary on rank 0 (the warnings are printed in any case, the
+    scene's first; ``result.warnings`` holds them all, for a script)."""
     if not all(hasattr(scene, a) for a in ("has", "effects", "output")):
         raise InputError("scene", scene, "a validated scene: multiscale.scene.load(path) or loads(text)")
     kind = workflow(scene)
@@ -48,6 +49,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                'this scene has no checkpoints to resume from (only the multiscale loop, effect "roughness", '
                "writes checkpoints)")
         raise InputError("--resume", None, why)
+    for line in scene.warnings if comm.rank == 0 else ():
+        print(f"warning: {line}", file=sys.stderr, flush=True)
     ended = resume and checkpoint.peek(Path(scene.output.folder) / multiscale.CHECKPOINT, comm).get("finished")
     # the parts of the run before this one (rank 0 writes the record): resumed, they stay in it
     earlier = provenance.parts_of(Path(scene.output.folder)) if resume and comm.rank == 0 else []
@@ -93,6 +96,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                                  warnings=[*scene.warnings, *beyond])
         return files + _write_script(result.folder, scene)
     result.files += comm.bcast(io.on_root(comm, write, f"the provenance into {result.folder}"), root=0)
+    result.warnings = (*scene.warnings, *beyond)
     return result
 
 

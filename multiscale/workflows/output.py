@@ -2,7 +2,7 @@
 from __future__ import annotations
 
 import shutil
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from multiscale import io, outputs, provenance
@@ -11,11 +11,15 @@ from multiscale.errors import InputError, SceneError
 
 @dataclass
 class RunResult:
-    """What a run wrote: its folder, the files (fields for ParaView, tables, plots) and its wall time."""
+    """What a run wrote: its folder, the files (fields for ParaView, tables, plots) and its wall time;
+    ``warnings``, once ``workflows.run`` returns it, every warning of the run, one line each (the
+    scene's, what the model noted, what the results leave out: those it printed on rank 0 and
+    provenance.json records)."""
 
     folder: Path
     files: list            # written paths
     wall_time: float       # s
+    warnings: tuple = field(default=(), kw_only=True)
 
 
 @dataclass

@@ -223,7 +223,6 @@ class SquealResult(RunResult):
 
     case: SquealCase
     map: StabilityMap | None = None  # with [stability.sweep]
-    warnings: tuple = ()             # what the results leave out or approximate (one line each)
 
 
 def approximate_modes(scene, case: SquealCase) -> list[str]:
@@ -323,7 +322,8 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
                                                                                        prefix="squeal_map_"))
                 files += squeal_map.write(smap, folder, comm, scene.output.figures)
         case.mech.close()                # on every rank in the same order (MUMPS' destruction communicates)
-    result = SquealResult(folder, files, time.perf_counter() - t0, case, smap, tuple(_left_out(scene, case, smap)))
+    result = SquealResult(folder, files, time.perf_counter() - t0, case, smap,
+                          warnings=tuple(_left_out(scene, case, smap)))   # what the results leave out or approximate
     if verbose and comm.rank == 0:
         rep = case.report
         print(f"{scene.name}: {len(case.modes)} modes up to {case.modes.frequency.max():.0f} Hz, "

@@ -9,7 +9,7 @@ writes ``history.h5``, ``history.png`` and the field files (``multiscale.outputs
 from __future__ import annotations
 
 import time as _time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
 
 from mpi4py import MPI
@@ -31,7 +31,6 @@ class TransientResult(RunResult):
     history_file: Path          # history.h5
     plot_file: Path | None      # history.png (None with output.figures = false)
     field_files: list           # XDMF files
-    warnings: tuple = field(default=(), kw_only=True)   # what the model noted (``workflows.model.run_notes``)
 
 
 def write_history(history: io.History, folder: Path, name: str, comm, plot: bool = True) -> tuple[Path, Path | None]:
