@@ -41,6 +41,7 @@ from multiscale.errors import ConvergenceError, InputError, check_count, check_f
 from multiscale.micro import bccg_solver, pk_solver
 from multiscale.micro.fft import get_threads
 from multiscale.micro.kernels import InfluenceOperator, Kernel
+from multiscale.micro.surface import Surface
 
 METHODS = ("bccg", "pk")
 CHUNK_CELLS = {"bccg": 65536, "pk": 32768}   # cells per chunk of a batch (the working set stays in L2)
@@ -109,11 +110,24 @@ class ContactSolver:
         self._pool: ThreadPoolExecutor | None = None
         self._pool_threads = 0
 
+    def _heights_of(self, surface: Surface) -> np.ndarray:
+        """The heights of ``surface`` (m), refused unless it lies on this solver's grid: its shape,
+        pixel sizes and periodicity (a measured, non-periodic surface on a periodic solver would be
+        solved as a repeating patch)."""
+        op = self.operator
+        for name, own, theirs in (("shape", self.shape, surface.shape), ("dx", op.dx, surface.dx),
+                                  ("dy", op.dy, surface.dy), ("periodic", self.periodic, surface.periodic)):
+            if own != theirs:
+                raise InputError(f"surface.{name}", theirs, f"the solver's is {own}: make the solver from the "
+                                 "surface (ContactSolver(kernel, s.shape, s.dx, s.dy, s.periodic)) or use solve_contact")
+        return surface.heights
+
     def solve(self, heights, *, load=None, approach=None, tol: float = 1e-8, max_iter: int = 5000,
               initial_pressure=None, partial: bool = False, method: str | None = None,
               hardness=None) -> ContactResult:
         """Solve under load control (``load`` = mean pressure [Pa]) or displacement control
-        (``approach`` = delta [m]); scalars or arrays of the batch shape. ``hardness`` H [Pa]
+        (``approach`` = delta [m]); scalars or arrays of the batch shape. ``heights`` [m]: an array
+        (..., ny, nx) or a ``Surface`` on the solver's grid (checked: shape, dx, dy, periodic). ``hardness`` H [Pa]
         (scalar or per patch, > 0; inf or None: elastic) bounds the pressure (p <= H, load < H):
         the result's ``plastic`` field is then the permanent deformation d - z - u on the cells at
         H (``plastic_area_fraction``: p >= H (1 - AT_HARDNESS tol)); H = inf computes bit for bit what
@@ -128,7 +142,7 @@ class ContactSolver:
         ``ContactNonFiniteError`` if the numbers overflow (never a non-finite result).
         """
         method = self.method if method is None else _method(method)
-        h = real_heights(heights)
+        h = real_heights(self._heights_of(heights) if isinstance(heights, Surface) else heights)
         if h.ndim < 2 or h.shape[-2:] != self.shape:
             raise InputError("heights.shape", h.shape, f"last two axes must be {self.shape}")
         if h.size == 0:
@@ -415,13 +429,28 @@ def _batch_values(name: str, value, shape) -> np.ndarray:
     try:
         return np.broadcast_to(a.astype(float), shape)
     except ValueError:
-        raise InputError(name, a.shape, f"must broadcast to {shape}") from None
+        sweep = " (a sweep on one patch: its heights broadcast to the values' shape, " \
+                "np.broadcast_to(h, (n, ny, nx)))" if not shape else ""
+        raise InputError(f"{name}.shape", a.shape, f"must broadcast to the batch's shape {shape}, one value "
+                         f"per patch{sweep}") from None
 
 
-def solve_contact(heights, dx: float, kernel: Kernel, *, dy: float | None = None, periodic: bool = True,
-                  **options) -> ContactResult:
-    """One-call form of ``ContactSolver(kernel, heights.shape[-2:], dx, dy, periodic).solve(...)``."""
+def solve_contact(heights, dx: float | None = None, kernel: Kernel | None = None, *, dy: float | None = None,
+                  periodic: bool | None = None, **options) -> ContactResult:
+    """One-call form of ``ContactSolver(kernel, heights.shape[-2:], dx, dy, periodic).solve(...)``:
+    ``heights`` [m] an array (..., ny, nx) with ``dx`` (``periodic`` True unless given), or a
+    ``Surface``, whose pixel sizes and periodicity are taken (``solve_contact(s, kernel=k, load=p)``)."""
+    if kernel is None:
+        raise InputError("kernel", None, "a Kernel (e.g. HalfSpace(E, nu)) is required")
+    if isinstance(heights, Surface):
+        given = {"dx": dx, "dy": dy, "periodic": periodic}
+        if any(v is not None for v in given.values()):
+            raise InputError(", ".join(k for k, v in given.items() if v is not None), None,
+                             "a Surface gives its own pixel sizes and periodicity: leave them out")
+        return ContactSolver(kernel, heights.shape, heights.dx, heights.dy, heights.periodic).solve(heights, **options)
     h = real_heights(heights)
     if h.ndim < 2:
         raise InputError("heights", h.shape, "must be at least 2-D (..., ny, nx)")
-    return ContactSolver(kernel, h.shape[-2:], dx, dy, periodic).solve(h, **options)
+    if dx is None:
+        raise InputError("dx", None, "the pixel size [m] is required with an array of heights")
+    return ContactSolver(kernel, h.shape[-2:], dx, dy, True if periodic is None else periodic).solve(h, **options)
