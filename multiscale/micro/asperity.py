@@ -41,29 +41,29 @@ _SCREEN = 400           # more active candidates than this: screening pass with 
 class AsperityResult:
     """Contact state of an asperity model at one approach."""
 
-    approach: float            # m, rigid approach delta from the first touch of the highest summit
-    force: float               # N, total force F (Eq. 1.7)
-    area: float                # m², real contact area A (Eq. 1.8)
-    mean_pressure: float       # Pa, F / A0
-    area_fraction: float       # -, A / A0
-    mean_gap: float            # m, g_n = (z_M − z̄) − delta (Eq. 1.9)
-    kappa: float | None        # -, (A/A0) E* sqrt(<|grad h|²>) / p_n (§1.3.2); None without contact/slope
-    semi_axes: np.ndarray      # m, (N, 2): major a and minor b of each contact (0, 0 out of contact)
-    forces: np.ndarray         # N, force of each asperity
-    contact: np.ndarray        # bool, asperity in contact
-    pressure: np.ndarray | None  # Pa, (ny, nx) map of Eq. 1.4 on the surface grid (None without grid)
+    approach: float            #: m, rigid approach delta from the first touch of the highest summit
+    force: float               #: N, total force F (Eq. 1.7)
+    area: float                #: m², real contact area A (Eq. 1.8)
+    mean_pressure: float       #: Pa, F / A0
+    area_fraction: float       #: -, A / A0
+    mean_gap: float            #: m, g_n = (z_M − z̄) − delta (Eq. 1.9)
+    kappa: float | None        #: -, (A/A0) E* sqrt(<|grad h|²>) / p_n (§1.3.2); None without contact/slope
+    semi_axes: np.ndarray      #: m, (N, 2): major a and minor b of each contact (0, 0 out of contact)
+    forces: np.ndarray         #: N, force of each asperity
+    contact: np.ndarray        #: bool, asperity in contact
+    pressure: np.ndarray | None  #: Pa, (ny, nx) map of Eq. 1.4 on the surface grid (None without grid)
     n_contacts: int
-    absorbed: np.ndarray       # indices of summits absorbed by a higher one (interacting models only)
+    absorbed: np.ndarray       #: indices of summits absorbed by a higher one (interacting models only)
     interaction: bool
-    route: str                 # "direct" (no interaction), "kinematic" or "energy"
-    method: str                # scipy minimiser
-    iterations: int            # minimiser iterations (all active-set passes)
-    evaluations: int           # interaction-sum evaluations
-    residual: float            # max |min(P_k/P̄, gap_k/delta)| over candidates (route's own gap; P̄ the
+    route: str                 #: "direct" (no interaction), "kinematic" or "energy"
+    method: str                #: scipy minimiser
+    iterations: int            #: minimiser iterations (all active-set passes)
+    evaluations: int           #: interaction-sum evaluations
+    residual: float            #: max |min(P_k/P̄, gap_k/delta)| over candidates (route's own gap; P̄ the
     #                            mean non-interacting force): the complementarity of Eq. 1.11
     converged: bool
-    truncation: float          # relative bound on the neglected part of each interaction sum
-    wall_time: float           # s
+    truncation: float          #: relative bound on the neglected part of each interaction sum
+    wall_time: float           #: s
 
 
 @dataclass

@@ -62,18 +62,18 @@ class ConductionConvergenceError(ConvergenceError):
 class ConductionResult:
     """Steady thermal contact of a (batch of) patch(es); per-patch arrays have the batch shape."""
 
-    flux: np.ndarray                   # W/m², phi_1 into solid 1, zero off the contact, (..., ny, nx)
-    temperature_1: np.ndarray          # K, surface temperature of solid 1, (..., ny, nx)
-    temperature_2: np.ndarray          # K, surface temperature of solid 2, (..., ny, nx)
-    contact: np.ndarray                # bool, contacting points, (..., ny, nx)
-    conductance: np.ndarray            # W/(m² K), K_t total (Eq. 5.9)
-    interface_conductance: np.ndarray  # W/(m² K), K_i = 1/(1/K_t − 1/K_p); inf for a perfect interface
-    perfect_conductance: float         # W/(m² K), K_p = 1/(F_1(0) + F_2(0)); inf if a body is semi-infinite
-    contact_temperature_1: np.ndarray  # K, T_s: mean of temperature_1 over the contact
-    contact_temperature_2: np.ndarray  # K, mean of temperature_2 over the contact (= T_s when R = 0)
-    iterations: np.ndarray             # CG iterations per patch
-    residual: np.ndarray               # |(T + R)phi − Δθ| on the contact / |Δθ| (2-norms), per patch
-    converged: np.ndarray              # bool per patch
+    flux: np.ndarray                   #: W/m², phi_1 into solid 1, zero off the contact, (..., ny, nx)
+    temperature_1: np.ndarray          #: K, surface temperature of solid 1, (..., ny, nx)
+    temperature_2: np.ndarray          #: K, surface temperature of solid 2, (..., ny, nx)
+    contact: np.ndarray                #: bool, contacting points, (..., ny, nx)
+    conductance: np.ndarray            #: W/(m² K), K_t total (Eq. 5.9)
+    interface_conductance: np.ndarray  #: W/(m² K), K_i = 1/(1/K_t − 1/K_p); inf for a perfect interface
+    perfect_conductance: float         #: W/(m² K), K_p = 1/(F_1(0) + F_2(0)); inf if a body is semi-infinite
+    contact_temperature_1: np.ndarray  #: K, T_s: mean of temperature_1 over the contact
+    contact_temperature_2: np.ndarray  #: K, mean of temperature_2 over the contact (= T_s when R = 0)
+    iterations: np.ndarray             #: CG iterations per patch
+    residual: np.ndarray               #: |(T + R)phi − Δθ| on the contact / |Δθ| (2-norms), per patch
+    converged: np.ndarray              #: bool per patch
 
 
 class ConductionSolver:

@@ -63,20 +63,20 @@ PERIODIC_LOCAL_START = 1e-3
 class ContactResult:
     """Solution of a (batch of) contact problem(s); per-patch arrays have the batch shape."""
 
-    pressure: np.ndarray       # Pa, (..., ny, nx)
-    displacement: np.ndarray   # m, elastic normal displacement, positive into the solid
-    gap: np.ndarray            # m, >= 0, zero on the contact
-    contact: np.ndarray        # bool, p > 0
-    area_fraction: np.ndarray  # real contact area / nominal area
-    mean_pressure: np.ndarray  # Pa, total force / nominal area
-    approach: np.ndarray       # m, rigid approach delta from first touch
-    mean_gap: np.ndarray       # m, mean separation between the flat and the deformed surface
-    plastic_area_fraction: np.ndarray  # cells at p = H (plastic flow) / all cells; 0 without a hardness
-    plastic: np.ndarray | None  # m, permanent (plastic) deformation, >= 0 into the solid: d - z - u at p = H
-    iterations: np.ndarray     # per patch
-    residual: np.ndarray       # per patch, see ContactSolver.solve
-    converged: np.ndarray      # bool per patch
-    history: list = field(default_factory=list, repr=False)  # max residual per iteration
+    pressure: np.ndarray       #: Pa, (..., ny, nx)
+    displacement: np.ndarray   #: m, elastic normal displacement, positive into the solid
+    gap: np.ndarray            #: m, >= 0, zero on the contact
+    contact: np.ndarray        #: bool, p > 0
+    area_fraction: np.ndarray  #: real contact area / nominal area
+    mean_pressure: np.ndarray  #: Pa, total force / nominal area
+    approach: np.ndarray       #: m, rigid approach delta from first touch
+    mean_gap: np.ndarray       #: m, mean separation between the flat and the deformed surface
+    plastic_area_fraction: np.ndarray  #: cells at p = H (plastic flow) / all cells; 0 without a hardness
+    plastic: np.ndarray | None  #: m, permanent (plastic) deformation, >= 0 into the solid: d - z - u at p = H
+    iterations: np.ndarray     #: per patch
+    residual: np.ndarray       #: per patch, see ContactSolver.solve
+    converged: np.ndarray      #: bool per patch
+    history: list = field(default_factory=list, repr=False)  #: max residual per iteration
 
 
 class ContactConvergenceError(ConvergenceError):

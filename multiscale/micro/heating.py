@@ -138,39 +138,39 @@ class _Layer:
 class HeatingResult:
     """Transient frictional heating (§6.3). Per-step arrays: (n_steps, *batch)."""
 
-    times: np.ndarray              # s, end t_{N+1} of each step (the matching instant)
-    heat: np.ndarray               # W, Phi: frictional heat rate during each step (mu F_n V)
-    heat_1: np.ndarray             # W, Phi_1 into body 1 (moving)
-    heat_2: np.ndarray             # W, Phi_2 into body 2 (fixed)
-    partition_1: np.ndarray        # p_1 = Phi_1/Phi; NaN where Phi = 0 (no heat: undefined)
-    partition_2: np.ndarray        # p_2 = Phi_2/Phi = 1 − p_1
-    max_temperature_1: np.ndarray  # K, max surface temperature rise of body 1 on the window (+ theta_1^0)
-    max_temperature_2: np.ndarray  # K, same for body 2
-    field_times: np.ndarray        # s, step ends at which fields were stored
-    temperature_1: np.ndarray      # K, (n_fields, *batch, ny, nx) surface temperature rise of body 1 (+ theta_1^0)
-    temperature_2: np.ndarray      # K, same for body 2
-    flux_1: np.ndarray             # W/m², (n_fields, *batch, ny, nx) phi_1 (phi_2 = flux − flux_1)
-    flux: np.ndarray               # W/m², (n_fields, *batch, ny, nx) generated phi
-    iterations: np.ndarray         # conjugate-gradient iterations per step
-    residual: np.ndarray           # relative temperature mismatch on the contact per step
-    converged: np.ndarray          # bool per step
+    times: np.ndarray              #: s, end t_{N+1} of each step (the matching instant)
+    heat: np.ndarray               #: W, Phi: frictional heat rate during each step (mu F_n V)
+    heat_1: np.ndarray             #: W, Phi_1 into body 1 (moving)
+    heat_2: np.ndarray             #: W, Phi_2 into body 2 (fixed)
+    partition_1: np.ndarray        #: p_1 = Phi_1/Phi; NaN where Phi = 0 (no heat: undefined)
+    partition_2: np.ndarray        #: p_2 = Phi_2/Phi = 1 − p_1
+    max_temperature_1: np.ndarray  #: K, max surface temperature rise of body 1 on the window (+ theta_1^0)
+    max_temperature_2: np.ndarray  #: K, same for body 2
+    field_times: np.ndarray        #: s, step ends at which fields were stored
+    temperature_1: np.ndarray      #: K, (n_fields, *batch, ny, nx) surface temperature rise of body 1 (+ theta_1^0)
+    temperature_2: np.ndarray      #: K, same for body 2
+    flux_1: np.ndarray             #: W/m², (n_fields, *batch, ny, nx) phi_1 (phi_2 = flux − flux_1)
+    flux: np.ndarray               #: W/m², (n_fields, *batch, ny, nx) generated phi
+    iterations: np.ndarray         #: conjugate-gradient iterations per step
+    residual: np.ndarray           #: relative temperature mismatch on the contact per step
+    converged: np.ndarray          #: bool per step
 
 
 @dataclass
 class SteadyHeatingResult:
     """Steady sliding with remote temperatures (§6.5). Per-patch arrays have the batch shape."""
 
-    heat: np.ndarray               # W, Phi = mu F_n V
-    heat_1: np.ndarray             # W, into body 1 (includes conduction from the remote temperatures)
-    heat_2: np.ndarray             # W, into body 2
-    partition_1: np.ndarray        # Phi_1/Phi (NaN where Phi = 0)
+    heat: np.ndarray               #: W, Phi = mu F_n V
+    heat_1: np.ndarray             #: W, into body 1 (includes conduction from the remote temperatures)
+    heat_2: np.ndarray             #: W, into body 2
+    partition_1: np.ndarray        #: Phi_1/Phi (NaN where Phi = 0)
     partition_2: np.ndarray
-    max_temperature_1: np.ndarray  # K, including the remote temperature theta_1^0
-    max_temperature_2: np.ndarray  # K
-    temperature_1: np.ndarray      # K, (*batch, ny, nx), Eq. 6.24
-    temperature_2: np.ndarray      # K
-    flux_1: np.ndarray             # W/m², (*batch, ny, nx)
-    flux: np.ndarray               # W/m², generated
+    max_temperature_1: np.ndarray  #: K, including the remote temperature theta_1^0
+    max_temperature_2: np.ndarray  #: K
+    temperature_1: np.ndarray      #: K, (*batch, ny, nx), Eq. 6.24
+    temperature_2: np.ndarray      #: K
+    flux_1: np.ndarray             #: W/m², (*batch, ny, nx)
+    flux: np.ndarray               #: W/m², generated
     iterations: np.ndarray
     residual: np.ndarray
     converged: np.ndarray

@@ -217,12 +217,12 @@ def load_surface(path, dx: float, dy: float | None = None, *, scale: float = 1.0
 class SurfaceStats:
     """Roughness statistics (per patch for batches). Profile moments are x/y averages."""
 
-    rms_height: np.ndarray  # m, sqrt(m0)
-    rms_slope: np.ndarray   # -, sqrt(<|grad h|²>)
-    m0: np.ndarray          # m², <h²>
-    m2: np.ndarray          # -, (<h_x²> + <h_y²>)/2
-    m4: np.ndarray          # 1/m², (<h_xx²> + <h_yy²>)/2
-    nayak: np.ndarray       # -, m0 m4 / m2²
+    rms_height: np.ndarray  #: m, sqrt(m0)
+    rms_slope: np.ndarray   #: -, sqrt(<|grad h|²>)
+    m0: np.ndarray          #: m², <h²>
+    m2: np.ndarray          #: -, (<h_x²> + <h_y²>)/2
+    m4: np.ndarray          #: 1/m², (<h_xx²> + <h_yy²>)/2
+    nayak: np.ndarray       #: -, m0 m4 / m2²
 
 
 def row_blocks(rows: int, columns: int, size: int = 1 << 16):

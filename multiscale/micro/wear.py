@@ -148,12 +148,12 @@ class WearHistory:
 class WearResult:
     """Outcome of ``simulate_wear``."""
 
-    surface: Surface            # worn topography
-    depth: np.ndarray           # m, accumulated wear depth field (..., ny, nx), >= 0
-    pressure: np.ndarray        # Pa, contact pressure on the worn surface at the load
+    surface: Surface            #: worn topography
+    depth: np.ndarray           #: m, accumulated wear depth field (..., ny, nx), >= 0
+    pressure: np.ndarray        #: Pa, contact pressure on the worn surface at the load
     history: WearHistory
-    laws: list = field(default_factory=list)   # PressureGapLaw at the requested steps
-    wall_time: float = 0.0      # s
+    laws: list = field(default_factory=list)   #: PressureGapLaw at the requested steps
+    wall_time: float = 0.0      #: s
 
 
 def simulate_wear(surface: Surface, contact: Kernel | ContactSolver, *, load, mu: float, distance: float,

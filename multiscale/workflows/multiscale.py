@@ -56,8 +56,8 @@ CHECKPOINT = outputs.CHECKPOINT
 class MultiscaleResult(TransientResult):
     """``TransientResult`` plus the multiscale plots and the final per-zone state."""
 
-    multiscale_plot: Path | None   # multiscale.png (None with output.figures = false)
-    wear_maps: list             # one per interface (none without wear or figures)
+    multiscale_plot: Path | None   #: multiscale.png (None with output.figures = false)
+    wear_maps: list             #: one per interface (none without wear or figures)
     zones_file: Path
     steps_done: int
 

@@ -17,8 +17,8 @@ class RunResult:
     provenance.json records)."""
 
     folder: Path
-    files: list            # written paths
-    wall_time: float       # s
+    files: list            #: written paths
+    wall_time: float       #: s
     warnings: tuple = field(default=(), kw_only=True)
 
 

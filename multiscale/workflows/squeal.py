@@ -222,7 +222,7 @@ class SquealResult(RunResult):
     """``RunResult`` of the squeal analysis, with its case."""
 
     case: SquealCase
-    map: StabilityMap | None = None  # with [stability.sweep]
+    map: StabilityMap | None = None  #: with [stability.sweep]
 
 
 def approximate_modes(scene, case: SquealCase) -> list[str]:

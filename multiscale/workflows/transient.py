@@ -28,9 +28,9 @@ class TransientResult(RunResult):
     """``RunResult`` of a macro run with a history."""
 
     history: io.History
-    history_file: Path          # history.h5
-    plot_file: Path | None      # history.png (None with output.figures = false)
-    field_files: list           # XDMF files
+    history_file: Path          #: history.h5
+    plot_file: Path | None      #: history.png (None with output.figures = false)
+    field_files: list           #: XDMF files
 
 
 def write_history(history: io.History, folder: Path, name: str, comm, plot: bool = True) -> tuple[Path, Path | None]:
