@@ -152,7 +152,7 @@ def check_field(name: str, value, *, min_ndim: int = 0, nonnegative: bool = Fals
     if a.ndim < min_ndim:
         raise InputError(name + ".shape", a.shape, f"needs at least {min_ndim} axes")
     if not np.all(np.isfinite(a)):
-        raise InputError(name, _summary(value), "must be finite (no NaN or inf)")
+        raise InputError(name, _summary(value), f"{non_finite(a)}: must be finite")
     if nonnegative and np.any(a < 0):
         raise InputError(name, _summary(value), "must be >= 0")
     return a
@@ -183,6 +183,13 @@ def _scalar_array(value) -> bool:
     """A 0-d numpy array or numpy scalar of a real (non-bool) number."""
     dtype, shape = getattr(value, "dtype", None), getattr(value, "shape", None)
     return dtype is not None and shape == () and dtype.kind in "iuf"
+
+
+def non_finite(a: np.ndarray) -> str:
+    """What an error message says of an array holding NaN or inf: how many and where the first is."""
+    bad = ~np.isfinite(a)
+    first = tuple(int(i) for i in np.argwhere(bad)[0]) if a.ndim else ()
+    return f"{int(bad.sum())} of its {a.size} values are NaN or inf" + (f" (the first at index {first})" if a.ndim else "")
 
 
 def _summary(value):

@@ -178,7 +178,8 @@ def test_bad_kernel_grid_and_heights():
         ContactSolver(E, (3, 8), 1e-6)
     h = np.zeros((8, 8))
     h[2, 2] = np.nan
-    with pytest.raises(InputError, match="heights"):
+    with pytest.raises(InputError, match=r"heights = 'array of shape \(8, 8\)': 1 of its 64 values are NaN or inf "
+                                         r"\(the first at index \(2, 2\)\)"):    # (before: neither how many nor where)
         solve_contact(h, 1e-6, E, load=1e6)
 
 

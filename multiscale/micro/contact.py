@@ -37,7 +37,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from multiscale.errors import ConvergenceError, InputError, check_count, check_flag, check_positive
+from multiscale.errors import ConvergenceError, InputError, check_count, check_flag, check_positive, non_finite
 from multiscale.micro import bccg_solver, pk_solver
 from multiscale.micro.fft import get_threads
 from multiscale.micro.kernels import InfluenceOperator, Kernel
@@ -148,7 +148,7 @@ class ContactSolver:
         if h.size == 0:
             raise InputError("heights.shape", h.shape, "the batch holds no patch")
         if not np.all(np.isfinite(h)):
-            raise InputError("heights", "array with NaN/inf", "all heights must be finite")
+            raise InputError("heights", f"array of shape {h.shape}", f"{non_finite(h)}: all heights must be finite")
         tol = check_positive("tol", tol)
         if tol >= 1:
             raise InputError("tol", tol, "relative tolerance must lie in (0, 1)")

@@ -17,7 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from multiscale.errors import InputError
+from multiscale.errors import InputError, non_finite
 
 
 def _pchip_slopes(x, y):
@@ -105,7 +105,7 @@ class PressureGapLaw:
         uses row i, or row 0 for a single law). Vectorised; never NaN for finite gaps."""
         g, rows, shape = _points(gap, rows, self.n_zones)
         if not np.all(np.isfinite(g)):
-            raise InputError("gap", "array with NaN/inf", "gaps must be finite")
+            raise InputError("gap", f"array of shape {g.shape}", f"{non_finite(g)}: gaps must be finite")
         n = self.gap.shape[1]
         d = self.g_open[rows] - g                              # interpenetration, > 0 in contact
         x = np.log(np.where(d > 0, d, 1.0))

@@ -218,7 +218,7 @@ class SurfaceStats:
     """Roughness statistics (per patch for batches). Profile moments are x/y averages."""
 
     rms_height: np.ndarray  #: m, sqrt(m0)
-    rms_slope: np.ndarray   #: -, sqrt(<|grad h|²>)
+    rms_slope: np.ndarray   #: -, sqrt(<|grad h|²>), spectral or central differences (not Sdq's forward ones)
     m0: np.ndarray          #: m², <h²>
     m2: np.ndarray          #: -, (<h_x²> + <h_y²>)/2
     m4: np.ndarray          #: 1/m², (<h_xx²> + <h_yy²>)/2
@@ -251,7 +251,9 @@ def statistics(surface: Surface) -> SurfaceStats:
     """RMS height and slope, spectral moments m0, m2, m4 and Nayak's parameter.
 
     Periodic surfaces: exact spectral derivatives. Others: central finite differences (in row
-    blocks: no temporaries of the map's size).
+    blocks: no temporaries of the map's size). The asperity models and κ take this slope. It is not
+    ``spectrum.surface_statistics``' Sdq (SurfaceTopography's forward differences), which on a
+    measured map with pixel-scale noise is larger: 0.0181 against 0.0146 on the shared opd-1 file.
     """
     check_surface(surface)
     dx, dy = surface.dx, surface.dy

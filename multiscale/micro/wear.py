@@ -23,7 +23,7 @@ import numpy as np
 from tqdm import tqdm
 
 from multiscale.errors import InputError, check_count, check_field, check_flag, check_instance, check_positive, \
-    check_table
+    check_table, non_finite
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import Kernel
 from multiscale.micro.surface import Surface, check_surface
@@ -75,7 +75,7 @@ class WearRate:
             raise InputError("temperature", None, "a temperature-dependent wear rate needs a temperature")
         T = np.asarray(temperature, dtype=float)
         if not np.all(np.isfinite(T)):
-            raise InputError("temperature", "array with NaN/inf", "temperatures must be finite")
+            raise InputError("temperature", f"array of shape {T.shape}", f"{non_finite(T)}: temperatures must be finite")
         if self.table is not None:
             return np.interp(T, *self.table)
         k = np.asarray(self.function(T), dtype=float)
