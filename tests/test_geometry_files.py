@@ -798,13 +798,14 @@ def test_one_load_surface_on_pads_on_both_sides_of_the_disc_shares_the_force_by_
     h = result.history
     assert h["interface_force_pad_a"][-1] == pytest.approx(1000 * 400 / 1300, rel=1e-6)
     assert h["interface_force_pad_b"][-1] == pytest.approx(1000 * 900 / 1300, rel=1e-6)
-    assert len(result.warnings) == 1 and re.match(r"loading.faces = \['backs'\]: the load pushes parts against each "
-                                                  r"other \(clamping\) with (692.3, 307.7|307.7, 692.3) N; the "
-                                                  r"difference, 384.6 N, goes into the supports", result.warnings[0])
+    clamp = [w for w in result.warnings if w.startswith("loading.faces")]
+    assert len(clamp) == 1 and re.match(r"loading.faces = \['backs'\]: the load pushes parts against each "
+                                        r"other \(clamping\) with (692.3, 307.7|307.7, 692.3) N; the "
+                                        r"difference, 384.6 N, goes into the supports", clamp[0])
     result = run(loads(caliper(tmp_path, "same", 'pressure = "2 MPa"'), tmp_path), verbose=False, overwrite=True)
     assert result.history["interface_force_pad_a"][-1] == pytest.approx(800.0, rel=1e-6)
     assert result.history["interface_force_pad_b"][-1] == pytest.approx(800.0, rel=1e-6)
-    assert result.warnings == ()
+    assert not [w for w in result.warnings if w.startswith("loading.faces")]
 
 
 def test_a_point_in_plain_numbers_is_in_metres_and_a_miss_says_so(tmp_path, capsys):
