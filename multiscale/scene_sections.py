@@ -325,8 +325,7 @@ class Loading:
             if given or by_mass:
                 return [f"{path}.braking_torque: give the torque or {path}.{(given or ['vehicle.mass'])[0]}, not both"]
             if "friction" not in ctx.effects:
-                return [f'{path}.braking_torque: the clamp force follows from the friction moment: needs effect '
-                        f'"friction"']
+                return [f'{path}.braking_torque: the clamp force follows from the friction moment: needs effect "friction"']
             return []
         if given and by_mass:
             return [f"{path}.{given[0]}: give the load or {path}.vehicle.mass, not both"]
@@ -405,6 +404,7 @@ class Output:
     every: int = key(Integer(ge=1), default=1)            # write fields every n macro steps
     fields: tuple = key(ListOf(Choice(OUTPUT_FIELDS), unique=True), absent="every field the effects produce")
     figures: bool = key(Flag(), default=True)           # the PNG figures (false: their tables and fields only)
+    repeatable: bool = key(Flag(), default=False)       # Newton factors renewed by count, not time: repeat bit for bit
 
 
 # ------------------------------------------------------------------ later effects (validated only)

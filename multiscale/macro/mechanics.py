@@ -85,6 +85,10 @@ NEWTON_FLOOR, TINY_LOAD = 1e-10, 1e-8
 # N), and failed. A solve that stops short is accepted below it (``_newton``: a stall, not a runaway).
 ROUNDOFF, SNES_LINEAR_FAILED = 10.0, PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
 FACTOR_PRECISION = "single"
+# ``refresh`` with a scene's ``output.repeatable``: the factors renewed once the GMRES iterations
+# beyond one per solve reach this count, not by measured times, so serial runs repeat bit for bit
+# (docs/architecture.md §8: the count the runs there were compared with).
+REPEATABLE_REFRESH = 20
 
 
 @dataclass

@@ -39,7 +39,7 @@ from multiscale.macro import mesh as two_body
 from multiscale.macro.interface import PenaltyLaw, SumLaw
 from multiscale.macro.kept_cells import SolverOptionWarning
 from multiscale.macro.load_faces import load_face_areas, load_face_forces
-from multiscale.macro.mechanics import Mechanics
+from multiscale.macro.mechanics import REPEATABLE_REFRESH, Mechanics
 from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
 
@@ -200,7 +200,8 @@ def build_mechanics(scene, tm, *, law=None, temperatures=None, degree: int = 1,
     return Mechanics(tm, dict(scene.materials), stiffness=penalty, friction=mu, speed=d.speed(0.0), law=law,
                      temperatures=temperatures, reference_temperature=scene.time.initial_temperature,
                      load_kind=load_kind(scene), degree=degree, prefix=prefix,
-                     preconditioner="cholesky" if lean else "lu")
+                     preconditioner="cholesky" if lean else "lu",
+                     refresh=REPEATABLE_REFRESH if scene.output is not None and scene.output.repeatable else None)
 
 
 def thermal_conditions(scene) -> tuple[ThermalBoundary, ...]:
