@@ -5,7 +5,9 @@ record of the run (versions, command line, ranks, start and end, wall time per s
 value (defaults filled in, SI numbers, the unit as a comment; temperatures as "... K" strings,
 since the scene format refuses bare temperatures): loading it gives the same scene. ``versions()``
 lists the software of the process (DOLFINx, PETSc and SLEPc when they are loaded). ``write`` puts
-``scene.toml``, ``scene_resolved.toml`` and ``provenance.json`` into a folder (rank 0). A run
+``scene.toml``, ``scene_resolved.toml`` and ``provenance.json`` into a folder (rank 0); the
+record identifies the code (``code``: its files' digest, a git commit), the environment variables
+that change a run (``environment``) and the bytes of every input file (``input_digests``). A run
 stopped and resumed (``--resume``) is recorded part by part: ``parts`` lists each part's command,
 ranks, start, end, status and stage wall times, and the record's stage and total wall times are
 their sums (``parts_of`` reads the parts recorded before).
@@ -13,14 +15,19 @@ their sums (``parts_of`` reads the parts recorded before).
 from __future__ import annotations
 
 import datetime
+import functools
+import hashlib
 import json
 import math
+import os
 import platform
 import sys
 from importlib import metadata
 from pathlib import Path
 
+import multiscale
 from multiscale import __version__
+from multiscale.checkpoint import file_digest
 from multiscale.io import replacing
 from multiscale.outputs import plan
 from multiscale.schema import (Choice, Curve, Either, FilePath, ListOf, Named, OnlyWith, Quantity, Section, TableOr,
@@ -186,6 +193,70 @@ def versions() -> dict:
     return out
 
 
+@functools.cache
+def code() -> dict:
+    """The code that runs: ``path`` (the package's folder), ``sha1`` of its Python files (relative
+    names and bytes, sorted: two copies of one version that differ in a file differ here) and, when
+    the package is the ``multiscale`` folder of a git checkout, the ``commit`` checked out (its
+    files may differ from it; ``sha1`` is of those that ran). Git's files are read, not git run
+    (no process forked from an MPI rank)."""
+    package = Path(multiscale.__file__).resolve().parent
+    digest = hashlib.sha1()
+    for path in sorted(package.rglob("*.py")):
+        digest.update(path.relative_to(package).as_posix().encode() + b"\0" + path.read_bytes())
+    out = {"path": str(package), "sha1": digest.hexdigest()}
+    try:
+        commit = git_commit(package.parent / ".git")
+    except (OSError, ValueError, UnicodeDecodeError):
+        commit = None
+    return out | ({"commit": commit} if commit else {})
+
+
+def git_commit(dot: Path) -> str | None:
+    """The commit checked out in the git folder (or worktree file) ``dot``, None without one."""
+    if not dot.exists():
+        return None
+    gitdir = dot if dot.is_dir() else (dot.parent / dot.read_text().split("gitdir:", 1)[1].strip()).resolve()
+    head = (gitdir / "HEAD").read_text().strip()
+    if not head.startswith("ref: "):
+        return head                                            # a detached head
+    common = (gitdir / (gitdir / "commondir").read_text().strip()).resolve() if (gitdir / "commondir").is_file() \
+        else gitdir
+    ref = head[5:]
+    for folder in (gitdir, common):
+        if (folder / ref).is_file():
+            return (folder / ref).read_text().strip()
+    packed = common / "packed-refs"
+    lines = packed.read_text().splitlines() if packed.is_file() else []
+    return next((line.split()[0] for line in lines if line.endswith(" " + ref)), None)
+
+
+# the environment variables that change a run's numbers or speed, recorded as set
+ENVIRONMENT = ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS", "PETSC_OPTIONS", "UCX_TLS",
+               "PYTHONHASHSEED")
+
+
+def environment() -> dict:
+    """Those of ``ENVIRONMENT`` and every ``MULTISCALE_*`` variable set in this process."""
+    return {k: v for k, v in sorted(os.environ.items()) if k in ENVIRONMENT or k.startswith("MULTISCALE_")}
+
+
+@functools.lru_cache(maxsize=64)
+def _digest(path: str, mtime_ns: int, size: int) -> str:
+    return file_digest(path)
+
+
+def input_digests(scene: Scene) -> dict:
+    """{path: SHA-1 of its bytes} of every file the scene reads (``Scene.inputs``: the scene file,
+    a geometry file, measured surfaces), each read once per process while unchanged."""
+    out = {}
+    for path in sorted(scene.inputs):
+        if path.is_file():
+            stat = path.stat()
+            out[str(path)] = _digest(str(path), stat.st_mtime_ns, stat.st_size)
+    return out
+
+
 def now() -> str:
     """The local time, ISO 8601 with its offset."""
     return datetime.datetime.now().astimezone().isoformat(timespec="seconds")
@@ -194,7 +265,8 @@ def now() -> str:
 def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict, wall_time: float,
           status: str = "finished", command: list[str] | None = None, analysis: str = "",
           warnings: list[str] = (), earlier: list[dict] = ()) -> list[Path]:
-    """``scene.toml`` (the file as given; the resolved scene when it came from text),
+    """``scene.toml`` (the file's text as read when the run began, ``Scene.text``: an edit of the
+    file during the run is not the scene that ran; the resolved scene when it came from text),
     ``scene_resolved.toml`` and ``provenance.json`` in ``folder``; call on rank 0. The record names
     the overrides given over the scene file (``scene.load``: a study's point), and lists
     every entry the run writes (``multiscale.outputs.plan``), so that ``results_of`` knows them
@@ -205,7 +277,7 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     part's, its ``command``, ``ranks``, ``end`` and ``status`` this part's, its stage and total
     wall times [s] the sums over the parts."""
     folder = Path(folder)
-    given = scene.source.read_text(encoding="utf-8") if scene.source and scene.source.is_file() else \
+    given = scene.text if scene.source else \
         "# The scene came from text, not a file: here it is as resolved.\n" + resolved_toml(scene)
     part = {"status": status, "command": list(sys.argv if command is None else command), "ranks": ranks,
             "start": started, "end": None if status == RUNNING else now(),
@@ -220,7 +292,8 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
               "start": parts[0]["start"], "end": part["end"],
               "stage_wall_time_s": {k: round(v, 3) for k, v in total.items()},
               "total_wall_time_s": round(sum(p["total_wall_time_s"] for p in parts), 3), "parts": parts,
-              "versions": versions(), "files": sorted(plan(scene).files), "warnings": list(warnings)}
+              "versions": versions(), "code": code(), "environment": environment(), "inputs": input_digests(scene),
+              "files": sorted(plan(scene).files), "warnings": list(warnings)}
     texts = {"scene.toml": given, "scene_resolved.toml": resolved_toml(scene),
              "provenance.json": json.dumps(record, indent=2, default=str) + "\n"}
     for name, text in texts.items():              # each replaced whole: a killed run leaves the earlier one

@@ -128,6 +128,7 @@ class Scene:
     layers: Layers | None = key(Section(Layers), needed_by=("layers",))
     stability: Stability | None = key(Section(Stability), needed_by=("stability",))
     source: Path | None = None                   # the scene file (None for loads without a path)
+    text: str = field(default="", repr=False, compare=False)   # its TOML text as read (provenance's scene.toml)
     overrides: tuple = field(default=())        # ((dotted key, raw value), ...) given over the file (``load``)
     warnings: tuple = field(default=())         # things accepted but ignored (one line each)
 
@@ -272,7 +273,8 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
         fields=scene.output.fields if scene.output.fields is not None else tuple(
             f for f, needs in OUTPUT_FIELDS.items() if all(e in active for e in needs)))
     return dataclasses.replace(scene, name=name, effects=frozenset(scene.effects), output=output,
-                               source=source, overrides=tuple(overrides.items()), warnings=tuple(warnings))
+                               source=source, text=text, overrides=tuple(overrides.items()),
+                               warnings=tuple(warnings))
 
 
 def _toml_value(value):

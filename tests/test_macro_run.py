@@ -13,7 +13,7 @@ from multiscale.errors import InputError  # noqa: E402
 from multiscale.io import History, solver_statistic  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 from multiscale.workflows.model import build_model  # noqa: E402
-from multiscale.scene import loads  # noqa: E402
+from multiscale.scene import load, loads  # noqa: E402
 
 BLOCK = """
 name = "block"
@@ -369,3 +369,15 @@ def test_the_run_summary_counts_its_records_in_english(tmp_path, capsys):
     result = run(loads(BLOCK.format(effects='"contact"', folder=tmp_path / "out")), verbose=True)
     assert len(result.history) == 1
     assert re.search(r"^block: 1 record in [0-9.]+ s on 1 rank$", capsys.readouterr().out, re.MULTILINE)
+
+
+def test_the_scene_file_recorded_is_the_one_that_ran(tmp_path):
+    """The scene file edited while its run goes on (friction 0.4 -> 0.5): the results folder's
+    scene.toml is the text the run read (before: the file was read again when the record was
+    written at the end, so it held a scene that did not run; a user trial)."""
+    path = tmp_path / "block.toml"
+    path.write_text(BLOCK.format(effects='"contact"', folder=tmp_path / "out"))
+    scene = load(path)
+    path.write_text(path.read_text() + "\n# edited during the run\n")
+    result = run(scene, verbose=False)
+    assert (result.folder / "scene.toml").read_text() == scene.text != path.read_text()

@@ -6,7 +6,9 @@ file is read back (meshio's XDMF time-series reader and h5py; the VTX mode shape
 with one mesh, the promised named arrays at exactly the promised times, units recorded; the
 provenance (scene as given, resolved scene that loads back to itself, versions, command line,
 ranks, times per stage) and the pvpython script are there."""
+import hashlib
 import json
+import os
 import subprocess
 import sys
 import types
@@ -17,6 +19,7 @@ import pytest
 
 from multiscale.cli import main
 from multiscale.outputs import FIELDS, MODE_ARRAYS, Plan, array_name, paraview_script, plan
+from multiscale import provenance
 from multiscale.provenance import resolved_toml
 from multiscale.scene import load, loads
 
@@ -164,6 +167,10 @@ def test_provenance_and_paraview_script(case):
         assert Path(overrides.pop("output.folder")).resolve() == p.folder.resolve()
         assert overrides == next(o for f, o in CASES.values() if Path(f).stem == scene.name)
     assert (p.folder / "scene.toml").read_text() == scene.source.read_text()
+    # the code, environment and inputs that ran (before: "multiscale": "0.1.0" for any copy; a user trial)
+    assert record["code"] == provenance.code() and len(record["code"]["sha1"]) == 40
+    assert record["inputs"][str(scene.source.resolve())] == hashlib.sha1(scene.source.read_bytes()).hexdigest()
+    assert record["environment"].get("OMP_NUM_THREADS") == os.environ.get("OMP_NUM_THREADS")
     resolved = (p.folder / "scene_resolved.toml").read_text()
     again = loads(resolved, scene.source.parent, name=scene.name)
     assert resolved_toml(again).splitlines()[2:] == resolved.splitlines()[2:]
@@ -350,3 +357,27 @@ def test_a_quadratic_field_is_written_on_quadratic_cells_and_integrates_exactly(
 def ufl_dx(msh):
     import ufl
     return ufl.dx(domain=msh)
+
+
+def test_the_commit_is_read_from_git_files(tmp_path):
+    """``provenance.code`` reads the commit a checkout holds from git's files (no process forked
+    from an MPI rank): a branch's ref file, a packed ref, a detached head and a worktree's
+    ``.git`` file; none without a git folder."""
+    from multiscale.provenance import git_commit
+    a, b = "1" * 40, "2" * 40
+    git = tmp_path / "repo" / ".git"
+    (git / "refs" / "heads").mkdir(parents=True)
+    (git / "HEAD").write_text("ref: refs/heads/main\n")
+    (git / "refs" / "heads" / "main").write_text(a + "\n")
+    assert git_commit(git) == a
+    (git / "refs" / "heads" / "main").unlink()
+    (git / "packed-refs").write_text(f"# pack-refs with: peeled\n{b} refs/heads/other\n{a} refs/heads/main\n")
+    assert git_commit(git) == a
+    work = tmp_path / "work"
+    (git / "worktrees" / "work").mkdir(parents=True)
+    (git / "worktrees" / "work" / "HEAD").write_text(b + "\n")              # detached
+    (git / "worktrees" / "work" / "commondir").write_text("../..\n")
+    work.mkdir()
+    (work / ".git").write_text(f"gitdir: {git / 'worktrees' / 'work'}\n")
+    assert git_commit(work / ".git") == b
+    assert git_commit(tmp_path / "none" / ".git") is None
