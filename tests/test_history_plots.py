@@ -175,3 +175,20 @@ def test_the_wear_map_of_a_round_face_leaves_its_corners_blank(tmp_path, drawn):
     ell = np.array([[[0, 0], [2, 0], [2, 1]], [[0, 0], [2, 1], [0, 1]], [[0, 1], [1, 1], [1, 2]], [[0, 1], [1, 2], [0, 2]]])
     on = plots.cells_on_face(ZoneGrid((0, 0), (2, 2), (1e-3, 1e-3)), (2, 2), 1e-3 * ell)
     np.testing.assert_array_equal(on, [[1, 1, 1, 1], [1, 1, 1, 1], [1, 1, 0, 0], [1, 1, 0, 0]])
+
+
+def test_a_log_axis_of_pressures_ends_on_labelled_ticks(tmp_path, drawn):
+    """The multiscale figure's pressure panel: facets at 12.6-15.1 MPa beside micro peaks of
+    99 MPa had no labelled tick near the facets' curves (a user trial). Its limits are now the
+    1, 2 or 5 x 10^k around the values, ticks labelled in plain numbers; a worn volume above
+    0.001 mm³ is in mm³."""
+    assert plots.nice_range([12.6, 99.0]) == (10.0, 100.0)
+    assert plots.nice_range([0.03, 0.7]) == (0.02, 1.0) and plots.nice_range([2.0, 5.0]) == (2.0, 5.0)
+    history = History()
+    for t, (facet, micro, volume) in enumerate([(12.6e6, 99e6, 0.0), (15.1e6, 40e6, 1.2e-11)]):
+        history.append(time=float(t), max_pressure=facet, micro_max_pressure=micro, wear_volume=volume)
+    plots.multiscale_figure(history, tmp_path / "m.png")
+    pressure, worn = drawn[-1].axes[:2]
+    assert pressure.get_ylim() == pytest.approx((10.0, 100.0))
+    assert {t.get_text() for t in pressure.get_yticklabels()} >= {"10", "20", "50", "100"}
+    assert worn.get_ylabel() == "wear volume [mm³]"

@@ -19,6 +19,7 @@ import numpy as np
 from matplotlib import colormaps
 from matplotlib.figure import Figure
 from matplotlib.lines import Line2D
+from matplotlib.ticker import FuncFormatter, LogLocator, NullFormatter
 
 LEGEND_ROWS = 6                 # entries in a legend column before it takes another
 BODY_STYLES = ("-", "--", ":", "-.")
@@ -130,18 +131,30 @@ def history_figure(history, path: Path, title: str = "") -> Path:
     return path
 
 
+def nice_range(values) -> tuple[float, float]:
+    """The largest 1, 2 or 5 x 10^k at or below the smallest of the positive ``values`` and the
+    smallest at or above their largest: the limits of a log axis that carry a tick."""
+    def step(v, up):
+        k = np.floor(np.log10(v))
+        choices = np.array([1.0, 2.0, 5.0, 10.0]) * 10.0**k
+        return float(choices[choices >= v * (1 - 1e-12)][0] if up else choices[choices <= v * (1 + 1e-12)][-1])
+    return step(float(np.min(values)), False), step(float(np.max(values)), True)
+
+
 def multiscale_figure(history, path: Path, title: str = "") -> Path:
     """PNG of the multiscale history columns at both scales (see module docstring)."""
     cols = history.columns
     hot = temperature_columns(cols)
-    panels = [("max contact pressure [MPa]", [("max_pressure", "macro facet"), ("max_zone_pressure", "macro zone"),
-                                               ("micro_max_pressure", "micro")], 1e-6, 0),
+    volume = 1e9 if np.nanmax(np.abs(cols.get("wear_volume", [0.0])), initial=0.0) > 1e-12 else 1e18   # mm³ or µm³
+    panels = [("max contact pressure [MPa]", [("max_pressure", "macro, largest facet"),
+                                               ("max_zone_pressure", "macro, largest zone (mean)"),
+                                               ("micro_max_pressure", "micro, largest local")], 1e-6, 0),
               ("max temperature [°C]", [(k, "macro " + column_label(k)) for k in hot]
                + [("micro_max_temperature", "micro")], 1.0, -273.15),
               ("zones' heat partition\ninto the rough body [%]",   # the coefficients of Fig. 7.12, not
                [("partition_max", "max"), ("partition_mean", "mean over zones"),    # weighted by the heat
                 ("partition_min", "min")], 100.0, 0),
-              ("wear volume [µm³]", [("wear_volume", None)], 1e18, 0),
+              ("wear volume [mm³]" if volume == 1e9 else "wear volume [µm³]", [("wear_volume", None)], volume, 0),
               ("max wear depth [µm]", [("wear_max_depth", None)], 1e6, 0),
               ("RMS of the worn surface [µm]", [("rms_height", None)], 1e6, 0)]
     panels = [(label, [(k, n) for k, n in keys if k in cols], s, o) for label, keys, s, o in panels]
@@ -157,7 +170,11 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
         if label.startswith("max contact pressure"):
             values = np.concatenate([np.asarray(history[k], dtype=float) for k, _ in keys])
             if (values > 0).any():     # log of the positive values (0 released or between zones)
-                ax.set_yscale("log")
+                ax.set_yscale("log")   # ticks at 1, 2, 5 x 10^k in plain numbers, the limits on such ticks
+                ax.yaxis.set_major_locator(LogLocator(subs=(1.0, 2.0, 5.0)))
+                ax.yaxis.set_major_formatter(FuncFormatter(lambda v, _: f"{v:g}"))
+                ax.yaxis.set_minor_formatter(NullFormatter())
+                ax.set_ylim(*nice_range(values[values > 0] * scale))
             else:                      # a history of released rows only: nothing to log-scale
                 ax.text(0.5, 0.5, "no contact in this history", transform=ax.transAxes, ha="center", va="center")
         ax.set_xlabel("time [s]")
