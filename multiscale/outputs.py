@@ -140,8 +140,8 @@ def plan(scene) -> Plan:
                 f" ({numbers})" if name == "interface" and "interface" in held else "")
             files[f"{name}.h5"] = f"data of {name}.xdmf"
     if kind == "squeal":
-        files["modes.csv"] = ("frequency, growth rate, damping ratio, unstable and potentially unstable flags "
-                              "and SLEPc residual of every mode")
+        files["modes.csv"] = ("frequency, growth rate, damping ratio, unstable and potentially unstable flags, "
+                              "SLEPc residual and each component's strain-energy share of every mode")
         files.update({f"modes_{b}.bp": f"mode shapes of {b} (VTX): real and imaginary parts, time = mode number"
                       for b in scene.bodies})
         files["pressure.png"] = "contact pressure on each interface at the preload"

@@ -6,6 +6,7 @@ file is read back (meshio's XDMF time-series reader and h5py; the VTX mode shape
 with one mesh, the promised named arrays at exactly the promised times, units recorded; the
 provenance (scene as given, resolved scene that loads back to itself, versions, command line,
 ranks, times per stage) and the pvpython script are there."""
+import csv
 import hashlib
 import json
 import os
@@ -84,15 +85,19 @@ def test_without_figures_check_promises_every_file_but_the_pngs(name, overrides,
 
 def test_check_names_every_column_of_modes_csv(case):
     """check's line for modes.csv names each column the squeal run writes (before: not the
-    unstable and potentially unstable flags)."""
+    unstable and potentially unstable flags); the strain-energy share of each component, the
+    numbers of energy.png, add up to 1 per mode (before: in the figure only; a user trial)."""
     scene, p, result = case
     if p.analysis != "squeal":
         pytest.skip("modes.csv: squeal analysis only")
     words = {"frequency_Hz": "frequency", "sigma_1_per_s": "growth rate", "damping_ratio": "damping ratio",
              "unstable": "unstable", "potentially_unstable": "potentially unstable", "residual": "residual"}
-    header = (p.folder / "modes.csv").read_text().splitlines()[0].split(",")
-    assert set(header) == {"mode", *words}
+    words["energy_share_"] = "strain-energy share"
+    rows = list(csv.DictReader((p.folder / "modes.csv").open()))
+    shares = [k for k in rows[0] if k.startswith("energy_share_")]
+    assert set(rows[0]) == {"mode", *words, *shares} - {"energy_share_"} and len(shares) >= 2
     assert all(w in p.files["modes.csv"] for w in words.values())
+    np.testing.assert_allclose([sum(float(r[k]) for k in shares) for r in rows], 1.0, atol=1e-5)
 
 
 def test_field_files_hold_one_mesh_with_named_arrays_at_the_output_times(case):

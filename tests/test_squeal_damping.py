@@ -434,3 +434,41 @@ def test_the_energy_figure_has_a_split_panel_only_with_two_pads(tmp_path, drawn,
     axes = drawn[0].axes
     assert len(axes) == panels and all(ax.patches for ax in axes)         # every panel has bars
     assert [line.get_xdata()[0] for line in axes[-1].get_lines() if line.get_linestyle() == ":"] == [2]
+
+
+def test_the_squeal_figures_compare_like_with_like(tmp_path, drawn):
+    """Found by a user trial: pressure.png gave each pad its own colour scale (0-1.26 and 0-2.44
+    MPa in the same colours); energy.png drew the inner/outer split as a full bar for modes whose
+    pads hold next to none of the energy (the unstable pair among them); re_im.png did not mark the
+    unstable modes and had a one-entry legend. Now one scale and one colour bar for every pad, the
+    split of modes whose two pads hold under SPLIT_FLOOR of the energy hatched, the unstable modes
+    circled in red."""
+    from types import SimpleNamespace as NS
+
+    from multiscale.macro.modal import EnergyShares
+    from multiscale.plots import squeal as plots
+    x, y = np.meshgrid(np.linspace(0, 0.02, 6), np.linspace(0, 0.01, 4))
+    mid = np.column_stack([np.r_[x.ravel(), x.ravel()], np.r_[y.ravel(), y.ravel() + 0.05], np.zeros(48)])
+    masks = {"inner": np.arange(48) < 24, "outer": np.arange(48) >= 24}
+    pressure = np.r_[np.linspace(0, 1.26e6, 24), np.linspace(0, 2.44e6, 24)]
+    plots.plot_pressure(mid, masks, pressure, "brake", tmp_path / "pressure.png")
+    inner, outer, *bars = drawn[-1].axes
+    assert len(bars) == 1 and bars[0].get_ylabel() == "contact pressure [MPa]"           # one colour bar
+    np.testing.assert_array_equal(inner.collections[0].levels, outer.collections[0].levels)
+    assert outer.collections[0].levels[-1] == pytest.approx(2.44)
+    energy = np.array([[1.0, 2.0, 3.0], [0.001, 0.002, 10.0], [0.5, 0.5, 3.0]])
+    shares = EnergyShares(["inner", "outer", "disc"], energy, energy / energy.sum(axis=1, keepdims=True))
+    class Modes(NS):
+        def __len__(self):
+            return len(self.frequency)
+    modes = Modes(frequency=np.array([800.0, 1500.0, 1500.0]), growth=np.array([0.0, 3.0, -3.0]))
+    case = NS(name="brake", modes=modes, energy=shares, report=NS(unstable=np.array([2])))
+    plots.plot_energy(case, tmp_path / "energy.png", ("inner", "outer"))
+    split = drawn[-1].axes[1]
+    hatched = [round(p.get_x() + p.get_width() / 2) for p in split.patches if p.get_hatch() == "//"]
+    assert hatched == [2]                                  # 0.03 % of mode 2's energy in the pads
+    plots.plot_re_im([case], tmp_path / "re_im.png")
+    ax = drawn[-1].axes[0]
+    circled = [line for line in ax.get_lines() if line.get_markeredgecolor() == "r"]
+    assert len(circled) == 1 and list(circled[0].get_xdata()) == [1500.0] and list(circled[0].get_ydata()) == [3.0]
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == ["brake", "unstable"]

@@ -88,20 +88,22 @@ class ModalResult:
     def __len__(self) -> int:
         return self.eigenvalues.size
 
-    def write_csv(self, path: str | Path, rtol: float = 1e-6, potentially_unstable=()) -> Path:
+    def write_csv(self, path: str | Path, rtol: float = 1e-6, potentially_unstable=(), energy=None) -> Path:
         """Mode table: number, frequency [Hz], sigma [1/s], damping ratio, unstable flag, potentially
-        unstable flag (mode numbers from 1, ``modal.StabilityReport``), residual."""
+        unstable flag (mode numbers from 1, ``modal.StabilityReport``), residual; with ``energy``
+        (``modal.EnergyShares``) each component's share of the mode's strain energy."""
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         close = set(int(m) for m in potentially_unstable)
+        names, shares = ([], np.zeros((len(self.frequency), 0))) if energy is None else (energy.names, energy.share)
         with path.open("w", newline="") as f:
             w = csv.writer(f)
             w.writerow(["mode", "frequency_Hz", "sigma_1_per_s", "damping_ratio", "unstable", "potentially_unstable",
-                        "residual"])
-            for j, (fr, s, z, u, e) in enumerate(zip(self.frequency, self.growth, self.damping_ratio,
-                                                     self.unstable(rtol), self.errors), start=1):
+                        "residual", *(f"energy_share_{n}" for n in names)])
+            for j, (fr, s, z, u, e, share) in enumerate(zip(self.frequency, self.growth, self.damping_ratio,
+                                                            self.unstable(rtol), self.errors, shares), start=1):
                 w.writerow([j, f"{fr:.6f}", f"{s + 0.0:.6e}", f"{z + 0.0:.6e}", int(u), int(j in close),
-                            f"{e:.2e}"])   # no -0
+                            f"{e:.2e}", *(f"{v:.6f}" for v in share)])   # no -0
         return path
 
 

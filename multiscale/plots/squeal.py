@@ -14,11 +14,14 @@ import numpy as np
 from matplotlib.figure import Figure
 from matplotlib.ticker import MaxNLocator
 
+SPLIT_FLOOR = 0.01     # energy.png: a split drawn hatched where its two components hold less of the mode's
 
-def _save(fig: Figure, path) -> Path:
+
+def _save(fig: Figure, path, tight: bool = True) -> Path:
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fig.tight_layout()
+    if tight:
+        fig.tight_layout()
     fig.savefig(path, dpi=120)
     return path
 
@@ -29,28 +32,35 @@ def plot_pressure(midpoints: np.ndarray, masks: Mapping[str, np.ndarray], facet_
 
     ``midpoints`` and ``facet_pressure`` are global per interface facet; ``masks`` select each
     interface's facets."""
-    fig = Figure(figsize=(5 * len(masks), 3.6))
-    axes = fig.subplots(1, len(masks), squeeze=False)
+    fig = Figure(figsize=(4.2 * len(masks) + 1.2, 3.8))
+    axes = fig.subplots(1, len(masks), squeeze=False)[0]
     mid, p = midpoints, facet_pressure / 1e6
-    for ax, (iface, mask) in zip(axes[0], masks.items()):
-        art = ax.tricontourf(mid[mask, 0] * 1e3, mid[mask, 1] * 1e3, p[mask], levels=20, cmap="jet")
-        fig.colorbar(art, ax=ax, label="contact pressure [MPa]")
-        ax.set(title=f"contact pressure at the preload: {iface}", xlabel="x [mm]", ylabel="y [mm]", aspect="equal")
-    fig.suptitle(name)
-    return _save(fig, path)
+    levels = np.linspace(0.0, max(float(p.max(initial=0.0)), 1e-12), 21)    # one scale for every interface
+    for ax, (iface, mask) in zip(axes, masks.items()):
+        art = ax.tricontourf(mid[mask, 0] * 1e3, mid[mask, 1] * 1e3, p[mask], levels=levels, cmap="viridis")
+        ax.set(title=iface, xlabel="x [mm]", ylabel="y [mm]", aspect="equal")
+    fig.suptitle(f"{name}: contact pressure at the preload")
+    fig.tight_layout()
+    fig.colorbar(art, ax=list(axes), label="contact pressure [MPa]", shrink=0.9, ticks=MaxNLocator(6))
+    return _save(fig, path, tight=False)
 
 
 def plot_re_im(cases: Sequence, path) -> Path:
-    """Real part against imaginary part of the eigenvalues, one marker set per case (Fig. 4.13);
-    ``cases`` have ``name`` and ``modes`` (``ModalResult``)."""
+    """Real part against imaginary part of the eigenvalues, one marker set per case (Fig. 4.13),
+    the unstable modes circled in red; ``cases`` have ``name``, ``modes`` (``ModalResult``) and
+    ``report`` (``StabilityReport``)."""
     fig = Figure(figsize=(8, 4.5))
     ax = fig.subplots()
     for c in cases:
-        ax.plot(c.modes.frequency, c.modes.growth, "o", ms=3, label=c.name)
+        art, = ax.plot(c.modes.frequency, c.modes.growth, "o", ms=3, label=c.name)
+        bad = np.asarray(c.report.unstable, dtype=int) - 1                   # mode numbers from 1
+        ax.plot(c.modes.frequency[bad], c.modes.growth[bad], "o", ms=8, mfc="none", mec="r", mew=1.2,
+                label=f"{c.name}: unstable" if len(cases) > 1 else "unstable")
     ax.axhline(0.0, color="k", lw=0.5)
     ax.set(xlabel="imaginary part: frequency [Hz]", ylabel="real part sigma [1/s]",
            title="complex eigenvalues (sigma > 0: unstable)")
-    ax.legend(fontsize=7)
+    if len(cases) > 1 or any(len(c.report.unstable) for c in cases):
+        ax.legend(fontsize=7)
     return _save(fig, path)
 
 
@@ -73,7 +83,12 @@ def plot_energy(case, path, split: tuple[str, str] | None = None) -> Path:
     a.legend(fontsize=7, ncol=min(len(sh.names), 6), loc="upper center")      # above the bars (shares sum to 1)
     if split is not None:
         b = axes[1]
-        b.bar(n, sh.split(*split), width=0.9, label=f"{split[0]} / ({split[0]} + {split[1]})")
+        ratio, held = sh.split(*split), sh.share[:, sh.names.index(split[0])] + sh.share[:, sh.names.index(split[1])]
+        faint = held < SPLIT_FLOOR                        # the pads hold next to none of the mode's energy
+        b.bar(n[~faint], ratio[~faint], width=0.9, label=f"{split[0]} / ({split[0]} + {split[1]})")
+        if faint.any():
+            b.bar(n[faint], ratio[faint], width=0.9, color="none", edgecolor="0.6", hatch="//",
+                  label=f"the two hold < {SPLIT_FLOOR:.0%} of the mode's energy")
         b.axhline(0.5, color="k", lw=0.5)
         b.set(ylim=(0.0, 1.3), yticks=np.linspace(0.0, 1.0, 6), ylabel="energy share [-]")
         b.legend(fontsize=7, loc="upper center")
