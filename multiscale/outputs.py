@@ -197,9 +197,12 @@ def script_name(file: str) -> str:
 
 def paraview_script(p: Plan) -> str:
     """A pvpython script that opens the results of ``p`` beside it: the bodies coloured by
-    temperature (else displacement or von Mises stress), the interface by contact pressure; for
-    the squeal analysis the mode shapes, warped."""
-    files = p.field_files
+    temperature (else displacement or von Mises stress), at the last output time with colour
+    ranges over every time; the interface by contact pressure in a view of its own (it lies on
+    the bodies' faces, where it would be hidden); for the squeal analysis the mode shapes, warped,
+    the preloaded bodies open but hidden."""
+    files, squeal = p.field_files, p.analysis == "squeal"
+    interface = OWN_FILES["interface"]
     lines = ['"""Open these results in ParaView: pvpython paraview.py (a window), or paste into',
              "View > Python Shell. Each .xdmf holds one mesh with every field as a named array",
              "(unit in the name); the time slider steps through the output times.",
@@ -207,16 +210,25 @@ def paraview_script(p: Plan) -> str:
              "# the folder of this script (the results folder where it was written, if run without a file)",
              f"here = os.path.dirname(os.path.abspath(__file__)) if '__file__' in globals() else {str(p.folder)!r}",
              "view = GetActiveViewOrCreate('RenderView')", ""]
+    if interface in files:
+        lines += ["# the interface lies on the bodies' faces: it gets a view of its own, right of theirs",
+                  "layout = GetLayout(view)", "layout.SplitHorizontal(0, 0.5)",
+                  "face_view = CreateView('RenderView')", "layout.AssignView(2, face_view)", ""]
     for name, fields in files.items():
         var = script_name(name)
         shown = next((f for f in ("temperature", "contact_pressure", "von_mises", "displacement") if f in fields),
                      fields[0])
         centre = "CELLS" if shown not in ("temperature", "displacement") else "POINTS"
-        lines += [f"{var} = Xdmf3ReaderS(registrationName={name!r}, FileName=[os.path.join(here, {name!r})])",
-                  f"{var}_view = Show({var}, view)",
+        where = "face_view" if name == interface else "view"
+        lines += [f"{var} = Xdmf3ReaderS(registrationName={name!r}, FileName=[os.path.join(here, {name!r})])"]
+        if squeal and name != interface:
+            lines += [f"# {name}: the preloaded state, open but hidden behind the mode shapes (its eye)", ""]
+            continue
+        lines += [f"{var}_view = Show({var}, {where})",
                   f"ColorBy({var}_view, ({centre!r}, {array_name(shown)!r}))",
-                  f"{var}_view.SetScalarBarVisibility(view, True)", ""]
-    if p.analysis == "squeal":
+                  f"{var}_view.RescaleTransferFunctionToDataRangeOverTime()   # the range of every output time",
+                  f"{var}_view.SetScalarBarVisibility({where}, True)", ""]
+    if squeal:
         lines += ["# mode shapes (VTX, ADIOS2 reader): time = mode number, see modes.csv for the frequencies"]
         for b in p.bodies:
             var = script_name(f"modes_{b}.bp")
@@ -226,5 +238,9 @@ def paraview_script(p: Plan) -> str:
                       "ScaleFactor=0.01)",
                       f"{var}_view = Show({var}_warp, view)",
                       f"ColorBy({var}_view, ('POINTS', {MODE_ARRAYS[0]!r}, 'Magnitude'))", ""]
-    lines += ["view.ResetCamera()", "Render()", "if __name__ == '__main__':", "    Interact()", ""]
+    else:
+        lines += ["animation = GetAnimationScene()   # at the last output time (t = 0: the uniform start)",
+                  "animation.UpdateAnimationUsingDataTimeSteps()", "animation.GoToLast()", ""]
+    lines += ["view.ResetCamera()"] + (["face_view.ResetCamera()"] if interface in files else []) + \
+        ["Render()", "if __name__ == '__main__':", "    Interact()", ""]
     return "\n".join(lines)
