@@ -212,3 +212,11 @@ def test_bad_input_is_named():
                       steps=2, k_w=KW)
     with pytest.raises(InputError, match="k_w"):
         wear_step(surface, p, lambda t: -t, MU, 1e-3, temperature=300.0)
+
+
+def test_a_wear_rate_says_what_it_is():
+    """``repr`` of a WearRate gives its value, table range or function (before: ``<... object at
+    0x...>``; a user trial)."""
+    assert repr(WearRate(1e-14)) == "WearRate(1e-14 1/Pa)"
+    assert repr(WearRate(([300.0, 500.0], [1e-14, 5e-14]))) == "WearRate(table of 2 points, 300-500: 1e-14-5e-14 1/Pa)"
+    assert repr(WearRate(np.exp)) == "WearRate(exp)"

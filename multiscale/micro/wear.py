@@ -67,6 +67,14 @@ class WearRate:
     def depends_on_temperature(self) -> bool:
         return self.value is None
 
+    def __repr__(self) -> str:
+        if self.value is not None:
+            return f"WearRate({self.value:g} 1/Pa)"
+        if self.table is not None:
+            temps, rates = self.table
+            return f"WearRate(table of {len(temps)} points, {temps[0]:g}-{temps[-1]:g}: {rates.min():g}-{rates.max():g} 1/Pa)"
+        return f"WearRate({getattr(self.function, '__name__', self.function)!s})"
+
     def __call__(self, temperature=None) -> np.ndarray:
         """k_w [1/Pa] at ``temperature`` (any shape; ignored when constant)."""
         if self.value is not None:
