@@ -184,6 +184,7 @@ def test_a_log_axis_of_pressures_ends_on_labelled_ticks(tmp_path, drawn):
     0.001 mm³ is in mm³."""
     assert plots.nice_range([12.6, 99.0]) == (10.0, 100.0)
     assert plots.nice_range([0.03, 0.7]) == (0.02, 1.0) and plots.nice_range([2.0, 5.0]) == (2.0, 5.0)
+    assert plots.nice_range([5.0, 5.0]) == (2.0, 10.0)
     history = History()
     for t, (facet, micro, volume) in enumerate([(12.6e6, 99e6, 0.0), (15.1e6, 40e6, 1.2e-11)]):
         history.append(time=float(t), max_pressure=facet, micro_max_pressure=micro, wear_volume=volume)

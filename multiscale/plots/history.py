@@ -110,9 +110,10 @@ def history_figure(history, path: Path, title: str = "") -> Path:
         ax.set_visible(False)
     for ax, (label, keys, scale, shift) in zip(axes, groups):
         styles, entries = curve_styles(keys)
-        for key, style in zip(keys, styles):
-            ax.plot(t, history[key] * scale + shift, marker="o", ms=3, label=column_label(key) if len(keys) > 1 else None,
-                    **style)
+        for k, (key, style) in enumerate(zip(keys, styles)):    # each curve thinner than the one before:
+            wide = (len(keys) - 1 - k) / max(len(keys) - 1, 1)   # one on another (equal pads) stays seen
+            ax.plot(t, history[key] * scale + shift, marker="o", ms=3 + 3 * wide, lw=1.2 + 2.4 * wide,
+                    label=column_label(key) if len(keys) > 1 else None, **style)
         ax.set_xlabel("time [s]")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
@@ -138,7 +139,8 @@ def nice_range(values) -> tuple[float, float]:
         k = np.floor(np.log10(v))
         choices = np.array([1.0, 2.0, 5.0, 10.0]) * 10.0**k
         return float(choices[choices >= v * (1 - 1e-12)][0] if up else choices[choices <= v * (1 + 1e-12)][-1])
-    return step(float(np.min(values)), False), step(float(np.max(values)), True)
+    lo, hi = step(float(np.min(values)), False), step(float(np.max(values)), True)
+    return (lo, hi) if hi > lo else (step(lo * 0.999, False), step(hi * 1.001, True))    # one value on a tick
 
 
 def multiscale_figure(history, path: Path, title: str = "") -> Path:
