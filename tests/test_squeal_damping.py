@@ -472,3 +472,19 @@ def test_the_squeal_figures_compare_like_with_like(tmp_path, drawn):
     circled = [line for line in ax.get_lines() if line.get_markeredgecolor() == "r"]
     assert len(circled) == 1 and list(circled[0].get_xdata()) == [1500.0] and list(circled[0].get_ydata()) == [3.0]
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["brake", "unstable"]
+
+
+def test_a_track_that_turns_stable_again_says_so():
+    """A friction map's 4.4 kHz pair was unstable from 0.137 to about 0.23 only; the console said
+    its onset and nothing of its end, so a reader took it as unstable from 0.137 up (a user trial).
+    The summary now gives the sampled interval where it turns stable again."""
+    from multiscale.macro.stability_map import Onset, StabilityMap
+    values = np.array([0.1, 0.15, 0.2, 0.25, 0.3])
+    growth = np.array([[-0.0], [7.2], [8.1], [0.0], [0.0]])
+    smap = StabilityMap("friction", "-", values, np.full((5, 1), 4400.0), growth, np.ones((5, 1), int),
+                        np.ones((5, 1)), np.zeros((5, 1)),
+                        [Onset(1, 0.137, 4400.0, None, "negative damping", (0.1, 0.15))])
+    assert smap.summary().splitlines()[1] == ("    track 1: negative damping at friction = 0.137 (4400 Hz); stable "
+                                              "again between 0.2 and 0.25")
+    smap.growth[3:] = 5.0                                     # unstable to the end: nothing more said
+    assert smap.summary().splitlines()[1].endswith("(4400 Hz)")

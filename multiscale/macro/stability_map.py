@@ -106,8 +106,17 @@ class StabilityMap:
                              f"its onset is below the sweep")
                 continue
             lines.append(f"    track {o.track}: {o.kind} at {self.parameter} = {o.value:.6g} ({o.frequency:.0f} Hz"
-                         + (f", with track {o.partner})" if o.partner is not None else ")"))
+                         + (f", with track {o.partner})" if o.partner is not None else ")") + self.restabilised(o))
         return "\n".join(lines)
+
+    def restabilised(self, onset) -> str:
+        """"; stable again ..." where the track of ``onset`` is stable at a later point of the sweep
+        (between the last unstable point and that one; not bisected), else ""."""
+        bad, present = self.unstable()[:, onset.track - 1], self.mode[:, onset.track - 1] >= 0
+        after = np.flatnonzero(self.values > onset.value)
+        again = next((k for k in after if present[k] and not bad[k] and k > 0 and bad[k - 1]), None)
+        return "" if again is None else \
+            f"; stable again between {self.values[again - 1]:.6g} and {self.values[again]:.6g}"
 
     def write_csv(self, path) -> Path:
         """Mode-pairing table: point, value, track, mode, frequency, sigma, damping ratio,

@@ -266,6 +266,12 @@ def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
     elif st.modes is not None and len(case.modes) >= st.modes and above:
         out.append(f"stability.modes = {st.modes}: the modes found reach {top:.0f} Hz; the band above, up to "
                    f"{hi:.0f} Hz, was not searched (raise stability.modes)")
+    if smap is not None and smap.onsets and st.sweep.preload_mode == "once":
+        out.append(f"the stability map's onsets are for the preloaded state of the nominal analysis "
+                   f"(stability.sweep.preload = \"once\"): its points change the {smap.parameter}'s coupling, not "
+                   "the contact state and deformation that preload holds, so they are not the onsets of full "
+                   "analyses at those values (demo brake: friction onset 0.109 against 0.062); "
+                   "stability.sweep.preload = \"each\" preloads every point")
     worst = float(np.nanmax(smap.residual)) if smap is not None and np.isfinite(smap.residual).any() else 0.0
     if worst > MAP_RESIDUAL:
         out.append(f"the stability map's modes have relative residuals up to {worst:.1e}: its frequencies and growth "
@@ -331,6 +337,8 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
               + (f" ({', '.join(f'{f:.0f} Hz' for f in rep.frequency[rep.unstable - 1])})" if rep.unstable.size else "")
               + f", {rep.potentially_unstable.size} potentially unstable; {result.wall_time:.1f} s on "
               f"{io.counted(comm.size, 'rank')}")
+        print("  preload: " + ", ".join(f"{abs(f):.6g} N on {n}" for n, f in case.preload.normal_force.items())
+              + " (normal contact force)")
         if case.prestress is not None:
             shift = case.prestress.shift
             print(f"  prestress shifts the frequencies by {np.nanmin(shift):+.2f} to {np.nanmax(shift):+.2f} Hz")
