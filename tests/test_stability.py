@@ -267,3 +267,23 @@ def test_the_mode_table_flags_unstable_and_potentially_unstable_modes(tmp_path):
     rows = list(csv.DictReader(modes.write_csv(tmp_path / "modes.csv", rep.rtol, rep.potentially_unstable).open()))
     assert [(r["unstable"], r["potentially_unstable"]) for r in rows] == [("0", "1"), ("0", "1"), ("0", "0"),
                                                                          ("1", "0")]
+
+
+def test_without_friction_no_pair_is_potentially_unstable():
+    """Nothing couples two modes without friction: an axisymmetric disc's doublets at mu = 0 were
+    all "potentially unstable" (16 of 20 modes, a user trial). ``close_tol`` 0 flags none, and the
+    squeal analysis passes it when no interface has friction (``squeal.frictional``)."""
+    from pathlib import Path
+
+    from multiscale.macro.modal import stability_report
+    from multiscale.scene import load
+    from multiscale.workflows.squeal import frictional
+    lam = np.array([-1.0 + 2e3j, -1.0 + 2.001e3j])
+    modes = eigen.ModalResult(lam, np.abs(lam) ** 2, np.zeros((1, 2), complex), np.zeros(2), (0.0, 1e3), 0.0,
+                              2, "gnhep", 1, 1, 0.0)
+    assert stability_report(modes).potentially_unstable.size == 2
+    assert stability_report(modes, close_tol=0.0).potentially_unstable.size == 0
+    demo = Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml"
+    assert frictional(load(demo))
+    assert not frictional(load(demo, {"loading.friction": 0.0}))
+    assert not frictional(load(demo, {"effects": ["contact", "stability"]}))

@@ -56,14 +56,15 @@ def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float =
     """Unstable modes (sigma > rtol |lambda|) and potentially unstable ones (Fig. 4.14).
 
     A stable mode is potentially unstable when a neighbouring stable mode lies within
-    ``close_tol`` relative frequency: the pair is close to coalescence but not yet locked in.
+    ``close_tol`` relative frequency: the pair is close to coalescence but not yet locked in
+    (``close_tol`` 0: none, as without friction, where nothing couples two modes).
     """
     check_positive("rtol", rtol)
-    check_positive("close_tol", close_tol)
+    check_positive("close_tol", close_tol, allow_zero=True)
     f = result.frequency
     bad = result.unstable(rtol)
     close = np.zeros(f.size, bool)
-    if f.size > 1:
+    if f.size > 1 and close_tol > 0:
         gap = np.diff(f) <= close_tol * np.maximum(f[1:], np.finfo(float).tiny)
         both_stable = ~bad[1:] & ~bad[:-1]
         pair = gap & both_stable
