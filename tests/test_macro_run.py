@@ -381,3 +381,19 @@ def test_the_scene_file_recorded_is_the_one_that_ran(tmp_path):
     path.write_text(path.read_text() + "\n# edited during the run\n")
     result = run(scene, verbose=False)
     assert (result.folder / "scene.toml").read_text() == scene.text != path.read_text()
+
+
+def test_a_run_says_the_size_of_its_model(tmp_path, capsys):
+    """The console gives the model's size after its set-up (a user could not tell how many dofs a
+    run solved): cells, displacement dofs (3 per vertex of each body, P1) and temperature dofs."""
+    from multiscale.workflows.model import build_mesh
+    scene = loads(pin_on_disc(tmp_path / "pod"), overrides={"time.steps": 1})
+    run(scene, verbose=True)
+    said = [line for line in capsys.readouterr().out.splitlines() if line.startswith("  model: ")]
+    tm = build_mesh(scene)
+    vertices = sum(b.mesh.topology.index_map(0).size_global for b in tm.bodies)
+    cells = tm.parent.topology.index_map(3).size_global
+    def spaced(n):
+        return f"{n:,}".replace(",", " ")
+    assert len(said) == 1 and said[0].startswith(f"  model: {spaced(cells)} cells, {spaced(3 * vertices)} displacement dofs, ")
+    assert said[0].endswith(" temperature dofs")

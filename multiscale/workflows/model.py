@@ -177,6 +177,18 @@ def build_mesh(scene, comm=MPI.COMM_WORLD) -> two_body.TwoBodyMesh:
     return tm
 
 
+def model_size(tm, mechanics, thermal=None) -> str:
+    """The size of a model, a console line: its cells, displacement dofs and (with heat) temperature
+    dofs (collective: global counts)."""
+    def dofs(functions) -> str:
+        n = sum(f.function_space.dofmap.index_map.size_global * f.function_space.dofmap.index_map_bs
+                for f in functions)
+        return f"{n:,}".replace(",", " ")
+    cells = f"{tm.parent.topology.index_map(tm.parent.topology.dim).size_global:,}".replace(",", " ")
+    heat = f", {dofs(thermal.T)} temperature dofs" if thermal is not None else ""
+    return f"  model: {cells} cells, {dofs(mechanics.u)} displacement dofs{heat}"
+
+
 def build_mechanics(scene, tm, *, law=None, temperatures=None, degree: int = 1,
                     prefix: str = "mech_") -> Mechanics:
     """Quasi-static sliding mechanics of the scene on ``tm``: perfect-contact penalty, or ``law``

@@ -52,7 +52,8 @@ from multiscale.macro.preload import Preload, linearise_system, preload
 from multiscale.macro.stability_map import StabilityMap
 from multiscale.plots.squeal import plot_energy, plot_pressure, plot_re_im
 from multiscale.workflows import squeal_map
-from multiscale.workflows.model import build_mechanics, build_mesh, drive, friction_coefficient, interface_forces
+from multiscale.workflows.model import build_mechanics, build_mesh, drive, friction_coefficient, interface_forces, \
+    model_size
 from multiscale.workflows.output import RunResult, prepare_folder
 from multiscale.workflows.rough import build_rough_interface
 from multiscale.workflows.strain import overloaded, unloaded
@@ -182,6 +183,7 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     name = name or scene.name
     prefix = "squeal_" + "".join(ch if ch.isalnum() else "_" for ch in name) + "_"
     mech = build_squeal_mechanics(scene, tm, degree=degree, prefix=prefix)
+    io.reporter().say(model_size(tm, mech))
     try:
         with closed_on_error(mech, tm.comm):
             d = drive(model_scene(scene), tm)

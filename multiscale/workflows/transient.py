@@ -19,7 +19,7 @@ from multiscale.errors import Interrupted
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.output import FieldOutput
 from multiscale.plots.history import history_figure
-from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, run_notes
+from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, model_size, run_notes
 from multiscale.workflows.output import RunResult, prepare_folder
 
 
@@ -56,6 +56,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         tm = build_mesh(scene, comm)
     with io.stage("model set-up"), heat_warnings_as_notes():
         model = build_model(scene, comm, tm=tm)
+    io.reporter().say(model_size(tm, model.mechanics, model.thermal))
     with closed_on_error(model, comm):           # a script going on after a failed run gets its communicators
         with io.stage("first contact solve"), heat_warnings_as_notes():
             model.start()
