@@ -248,10 +248,14 @@ def _digest(path: str, mtime_ns: int, size: int) -> str:
 
 def input_digests(scene: Scene) -> dict:
     """{path: SHA-1 of its bytes} of every file the scene reads (``Scene.inputs``: the scene file,
-    a geometry file, measured surfaces), each read once per process while unchanged."""
+    a geometry file, measured surfaces), each read once per process while unchanged; the scene
+    file's are those of the text the run read (``Scene.text``, as scene.toml)."""
+    source = scene.source.resolve() if scene.source is not None else None
     out = {}
     for path in sorted(scene.inputs):
-        if path.is_file():
+        if path == source:
+            out[str(path)] = hashlib.sha1(scene.text.encode("utf-8")).hexdigest()
+        elif path.is_file():
             stat = path.stat()
             out[str(path)] = _digest(str(path), stat.st_mtime_ns, stat.st_size)
     return out

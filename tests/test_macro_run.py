@@ -1,4 +1,5 @@
 """Scenes through the workflows: only the requested effects are built; files a run writes."""
+import hashlib
 import json
 import math
 import re
@@ -381,6 +382,8 @@ def test_the_scene_file_recorded_is_the_one_that_ran(tmp_path):
     path.write_text(path.read_text() + "\n# edited during the run\n")
     result = run(scene, verbose=False)
     assert (result.folder / "scene.toml").read_text() == scene.text != path.read_text()
+    record = json.loads((result.folder / "provenance.json").read_text())       # its digest is of that text
+    assert record["inputs"][str(path.resolve())] == hashlib.sha1(scene.text.encode()).hexdigest()
 
 
 def test_a_run_says_the_size_of_its_model(tmp_path, capsys):
