@@ -533,6 +533,16 @@ def _surface_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]
     for name in scene.interfaces:
         if name not in g.spec.interfaces:
             problems.append(f'interfaces.{name}: not an interface of {where}; interfaces: {", ".join(g.spec.interfaces)}')
+    ld = scene.loading
+    direction = ld.direction if ld is not None and ld.direction is not None else \
+        None if g.spec.fluid_load else g.spec.load_direction        # (a fluid load: along each face's normal)
+    for i, b in enumerate(scene.boundary or (), 1):     # a support that holds a load face along the load
+        held = [s for s in ((b.surfaces or ()) if b is not None and b.fix else ()) if s in (faces or g.spec.load_faces)]
+        free = [c for c in range(3) if c not in (b.components if b is not None else ())]
+        if held and direction is not None and np.linalg.norm(np.asarray(direction, float)[free]) < 1e-9:
+            problems.append(f"boundary[{i}].fix = {list(b.fix)} on {', '.join(held)}, where the load pushes along "
+                            f"{list(direction)}: the support would take the load and the contact none; hold "
+                            "another face or leave that component free")
     if "roughness" in effects and scene.roughness is not None and scene.effects is not None and not problems:
         for name in scene.rough_interfaces:
             normal = g.spec.interface_normals.get(name, ())

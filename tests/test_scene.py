@@ -982,3 +982,14 @@ def test_a_sweep_without_a_valid_parameter_is_a_problem_not_a_traceback(sweep, f
         loads(text, name="brake")
     assert any(fragment in p for p in info.value.problems), info.value.problems
     assert all(p.startswith("stability.sweep") for p in info.value.problems), info.value.problems
+
+
+def test_a_support_that_would_take_the_load_is_refused_when_read():
+    """A block held along z on its loaded top face: check said OK and the run stopped after its
+    first solve ("the contact carries 0 N ...", a user trial). The scene refuses it now; a support
+    across the load (x, y) on that face passes."""
+    text = (DEMOS / "block_on_flat.toml").read_text()
+    with pytest.raises(SceneError, match=r"boundary\[\d\]\.fix = \['z'\] on block_top, where the load pushes along "
+                                         r"\[0.0, 0.0, -1.0\]: the support would take the load and the contact none"):
+        loads(text + '\n[[boundary]]\nsurfaces = ["block_top"]\nfix = ["z"]\n', DEMOS)
+    loads(text + '\n[[boundary]]\nsurfaces = ["block_top"]\nfix = ["x", "y"]\n', DEMOS)
