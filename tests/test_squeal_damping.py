@@ -296,13 +296,19 @@ def test_the_map_table_writes_no_negative_zero(tmp_path):
 
 
 def test_map_bisects_the_onset_of_a_lock_in_branch_that_fails_the_mac_test(tmp_path):
-    """With a strict MAC threshold the coalesced pair starts new tracks at mu = 0.6; the unstable
-    one's onset is still bisected (from its stable best match at 0.4), once; a map starting above
-    the onset lists the unstable track as below the sweep."""
+    """With a strict MAC threshold and the single MAC only (``subspace=False``) the coalesced pair
+    starts new tracks at mu = 0.6; the unstable one's onset is still bisected (from its stable best
+    match at 0.4), once; a map starting above the onset lists the unstable track as below the
+    sweep. By default the pair's two-mode subspace (here the whole space) keeps both tracks."""
     values = np.linspace(0.0, 1.0, 6)
     results, reduced = hoffmann_points(values)
-    for mac_min in (0.9, 0.999):                     # 0.999: the branch is new at every point
+    for mac_min in (0.9, 0.999):
         smap = build_map("friction", "-", values, results, reduced, (0.0, 1.0), xtol=1e-9, mac_min=mac_min)
+        assert smap.n_tracks == 2 and len(smap.onsets) == 1
+        assert smap.onsets[0].value == pytest.approx(MU_C, rel=1e-6) and smap.onsets[0].kind == "lock-in"
+    for mac_min in (0.9, 0.999):                     # 0.999: the branch is new at every point
+        smap = build_map("friction", "-", values, results, reduced, (0.0, 1.0), xtol=1e-9, mac_min=mac_min,
+                         subspace=False)
         assert smap.n_tracks > 2 and len(smap.onsets) == 1
         assert smap.onsets[0].value == pytest.approx(MU_C, rel=1e-6) and smap.onsets[0].kind == "lock-in"
     smap = build_map("friction", "-", values[3:], results[3:], reduced[3:], (0.0, 1.0))
@@ -310,6 +316,46 @@ def test_map_bisects_the_onset_of_a_lock_in_branch_that_fails_the_mac_test(tmp_p
     assert np.isnan(smap.onsets[0].value) and "below the sweep" in smap.summary()
     rows = smap.write_onsets_csv(tmp_path / "onsets.csv").read_text().splitlines()
     assert rows[1].split(",")[1] == "" and rows[1].split(",")[-1] == "0.6"
+
+
+def hoffmann_spectator_points(values, spectator=4.0, coupling=0.1):
+    """``hoffmann_points`` of the Hoffmann pair plus a third mode (stiffness ``spectator``, coupled
+    to the second dof by ``coupling``), so that the pair's two-mode subspace is not the whole space."""
+    def system(mu):
+        K = np.zeros((3, 3))
+        K[:2, :2] = hoffmann_matrices(mu, **HOFFMANN)[0]
+        K[2, 2], K[1, 2], K[2, 1] = spectator, coupling, coupling
+        return damped.LinearSystem(petsc_mat(K), petsc_mat(np.eye(3)))
+    sub = damped.Subspace([np.eye(3)], petsc_mat(np.eye(3)))
+    points = [damped.solve_projected(system(mu), sub, band=(0.0, 1.0), expand=False) for mu in values]
+    return [r for r, _ in points], [red for _, red in points]
+
+
+def test_a_lock_in_between_two_points_keeps_both_tracks_by_the_pairs_subspace():
+    """A pair that locks in between two sweep points: both conjugate members have the same MAC with a
+    given parent, 0.82 with one and 0.18 with the other, so the single-MAC pairing (mac 0.5) ended
+    the second parent's track and started the partner as a new track, named as the onset's partner
+    (found by a user trial on the 12-mm demo brake: 0.916 / 0.42). The pair's two-mode subspace
+    has the parents' one (subspace MAC 1.0): both tracks go on, the partner is the other parent."""
+    from multiscale.macro.modal import mac_matrix, subspace_mac
+    values = np.array([0.0, 0.6, 1.0])
+    results, reduced = hoffmann_spectator_points(values)
+    a, b = results[0], results[1]
+    mac = mac_matrix(a, b)
+    np.testing.assert_allclose(mac[:2, 0], mac[:2, 1], rtol=1e-12)     # conjugate members, real parents
+    assert mac[1, :2].max() < 0.5 < mac[0, :2].min()
+    np.testing.assert_allclose(b.modes[:, 1], b.modes[:, 0].conj() * np.exp(1j * np.angle(
+        np.vdot(b.modes[:, 0].conj(), b.modes[:, 1]))), atol=1e-12)
+    assert subspace_mac(a, b, [0, 1], [0, 1]) == pytest.approx(1.0, abs=1e-6)
+    assert subspace_mac(a, b, [1], [0]) == pytest.approx(mac[1, 0])     # one mode each: the MAC
+    assert subspace_mac(a, b, [1, 2], [0, 1]) < 0.5                     # not the pair's subspace
+    old = build_map("friction", "-", values, results, reduced, (0.0, 1.0), xtol=1e-9, subspace=False)
+    assert old.n_tracks == 4 and old.onsets[0].track == 4               # the former behaviour
+    smap = build_map("friction", "-", values, results, reduced, (0.0, 1.0), xtol=1e-9)
+    assert smap.n_tracks == 3 and (smap.mode >= 0).all()
+    assert [(o.kind, o.partner) for o in smap.onsets] == [("lock-in", 3 - smap.onsets[0].track)]
+    assert smap.onsets[0].value == pytest.approx(old.onsets[0].value, rel=1e-12)
+    assert np.nanmin(smap.mac[1, :2]) < 0.5                            # the pair's own MAC is kept
 
 
 def check_map_files(folder, smap, documented) -> None:
@@ -407,7 +453,7 @@ def test_a_track_of_one_point_is_seen_in_the_tracks_figure(tmp_path, drawn):
     from multiscale.plots import squeal as plots
     values = np.linspace(0.0, 1.0, 6)
     results, reduced = hoffmann_points(values)
-    smap = build_map("friction", "-", values, results, reduced, (0.0, 1.0), mac_min=0.999)
+    smap = build_map("friction", "-", values, results, reduced, (0.0, 1.0), mac_min=0.999, subspace=False)
     alone = [t for t in range(smap.n_tracks) if smap.unstable()[:, t].any() and (smap.mode[:, t] >= 0).sum() == 1]
     assert alone
     plots.plot_tracks(smap, tmp_path / "map_tracks.png")

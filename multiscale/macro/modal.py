@@ -74,6 +74,17 @@ def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float =
     return StabilityReport(number[bad], number[close], f.copy(), result.growth.copy(), rtol, close_tol)
 
 
+def _modes(x) -> np.ndarray:
+    return x.modes if isinstance(x, ModalResult) else np.asarray(x)
+
+
+def _metric(a, b, comm, gram):
+    """(gram, comm) of ``mac_matrix``: the reduced coordinates' Gram matrix, or the communicator."""
+    gram = gram if gram is not None else getattr(a, "gram", None)
+    comm = None if gram is not None else comm or getattr(a, "comm", None) or getattr(b, "comm", None)
+    return gram, comm
+
+
 def mac_matrix(a: ModalResult | np.ndarray, b: ModalResult | np.ndarray, comm=None, gram=None) -> np.ndarray:
     """MAC_ij = |y_i^H y_j|^2 / (y_i^H y_i  y_j^H y_j) between modes of two cases (§4.4).
 
@@ -81,10 +92,8 @@ def mac_matrix(a: ModalResult | np.ndarray, b: ModalResult | np.ndarray, comm=No
     of one basis V (``ModalResult.gram`` = V^T V, or ``gram``): y^H y = q^H (V^T V) q. Returns
     (n_a, n_b) in [0, 1].
     """
-    gram = gram if gram is not None else getattr(a, "gram", None)
-    comm = None if gram is not None else comm or getattr(a, "comm", None) or getattr(b, "comm", None)
-    ya = a.modes if isinstance(a, ModalResult) else np.asarray(a)
-    yb = b.modes if isinstance(b, ModalResult) else np.asarray(b)
+    gram, comm = _metric(a, b, comm, gram)
+    ya, yb = _modes(a), _modes(b)
     if ya.shape[0] != yb.shape[0]:
         raise InputError("modes", (ya.shape, yb.shape), "the two cases must share the dof layout")
     gb = yb if gram is None else gram @ yb
@@ -95,16 +104,67 @@ def mac_matrix(a: ModalResult | np.ndarray, b: ModalResult | np.ndarray, comm=No
     return np.abs(cross) ** 2 / np.maximum(np.outer(na, nb), np.finfo(float).tiny)
 
 
-def pair_modes(mac: np.ndarray, lam_a: np.ndarray, lam_b: np.ndarray, mac_min: float = 0.5) -> list[tuple[int, int]]:
+def subspace_mac(a: ModalResult | np.ndarray, b: ModalResult | np.ndarray, ia, ib, comm=None, gram=None,
+                 rank_tol: float = 1e-12) -> float:
+    """MAC of two subspaces: cos^2 of the largest principal angle between the span of modes ``ia``
+    of ``a`` and the span of modes ``ib`` of ``b`` (inner product as in ``mac_matrix``); 1 when they
+    coincide, the MAC for one mode each, 0 when their dimensions differ (numerical rank, relative
+    ``rank_tol``). Collective over ``comm`` like ``mac_matrix``.
+
+    A pair of modes that coalesces (a lock-in) or splits passes an exceptional point, where the
+    single eigenvectors are not continuous in the parameter (they go as its square root) but the
+    pair's invariant subspace is (Kato's total projection): each member of the coalesced pair is a
+    mix of both parents, and only the two-mode subspace compares with the parents' one.
+    """
+    gram, comm = _metric(a, b, comm, gram)
+    ya, yb = _modes(a)[:, list(ia)], _modes(b)[:, list(ib)]
+    G = (lambda y: y) if gram is None else (lambda y: gram @ y)
+    gaa, gbb, gab = (reduce_sum(x.conj().T @ G(y), comm) for x, y in ((ya, ya), (yb, yb), (ya, yb)))
+
+    def whiten(g):                     # T with T^H g T = I on the numerical range of g
+        w, U = np.linalg.eigh(0.5 * (g + g.conj().T))
+        keep = w > rank_tol * max(w.max(initial=0.0), np.finfo(float).tiny)
+        return U[:, keep] / np.sqrt(w[keep])
+
+    ta, tb = whiten(gaa), whiten(gbb)
+    if ta.shape[1] != tb.shape[1] or ta.shape[1] == 0:
+        return 0.0
+    s = np.linalg.svd(ta.conj().T @ gab @ tb, compute_uv=False)
+    return float(min(s.min() ** 2, 1.0))
+
+
+def pair_modes(mac: np.ndarray, lam_a: np.ndarray, lam_b: np.ndarray, mac_min: float = 0.5,
+               subspace=None) -> list[tuple[int, int]]:
     """One-to-one pairs (i, j) of modes of two neighbouring cases that maximise the sum of
     MAC_ij - |lambda_j - lambda_i| / |lambda_i| (the eigenvalue distance tells apart the two
     members of a locked-in pair, whose shapes are complex conjugates); pairs with MAC < ``mac_min``
-    are dropped."""
+    are dropped, unless ``subspace`` (a callable (rows, cols) -> ``subspace_mac`` of those modes)
+    is given and the pair forms, with the pair of the mode nearest in frequency to j (to i), a
+    block of two whose subspaces have a subspace MAC >= ``mac_min``: a pair that coalesces (splits)
+    between the two cases, whose members are each a mix of both parents (``subspace_mac``)."""
     if mac.size == 0:
         return []
     dist = np.abs(lam_b[None, :] - lam_a[:, None]) / np.maximum(np.abs(lam_a)[:, None], np.finfo(float).tiny)
     rows, cols = linear_sum_assignment(-(mac - np.minimum(dist, 1.0)))
-    return [(int(i), int(j)) for i, j in zip(rows, cols) if mac[i, j] >= mac_min]
+    pairs = [(int(i), int(j)) for i, j in zip(rows, cols)]
+    if subspace is None:
+        return [(i, j) for i, j in pairs if mac[i, j] >= mac_min]
+    to_b, to_a = dict(pairs), {j: i for i, j in pairs}
+
+    def nearest(lam, k):
+        gap = np.abs(lam.imag - lam[k].imag)
+        gap[k] = np.inf
+        return int(np.argmin(gap)) if gap.size > 1 else None
+
+    kept = []
+    for i, j in pairs:
+        if mac[i, j] < mac_min:
+            jn, i_n = nearest(lam_b, j), nearest(lam_a, i)
+            blocks = ({(to_a[jn], jn)} if jn in to_a else set()) | ({(i_n, to_b[i_n])} if i_n in to_b else set())
+            if not any(subspace([i, i2], [j, j2]) >= mac_min for i2, j2 in sorted(blocks) if i2 != i):
+                continue
+        kept.append((i, j))
+    return kept
 
 
 def mmac(mac: np.ndarray) -> np.ndarray:

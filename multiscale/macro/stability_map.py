@@ -6,7 +6,12 @@ projected on the same M-orthonormal basis V) and its modes in the band. ``build_
 
 - tracks the modes from point to point: one-to-one pairs of maximal MAC (computed in reduced
   coordinates, y^H y = q^H V^T V q) less the relative eigenvalue jump, MAC >= ``mac_min``
-  (``modal.pair_modes``); a mode without a partner starts a new track. The tracks are the
+  (``modal.pair_modes``), or a pair below ``mac_min`` in a block of two (with the pair of the
+  mode nearest in frequency) whose two-mode subspaces have a subspace MAC >= ``mac_min``
+  (``modal.subspace_mac``): a pair that locks in (or splits) between two points, whose members
+  are each a mix of both parents (at a lock-in both conjugate members have the same MAC with a
+  given parent, high with one, low with the other); its ``mac`` is then the pair's own MAC, below
+  ``mac_min``. A mode without a partner starts a new track. The tracks are the
   mode-pairing table (``map.csv``: track, mode number and MAC with the previous point);
 - finds where a track turns unstable between v_{k-1} and v_k (a track stable at v_{k-1}, or one
   that starts unstable at v_k because its branch failed the MAC test, e.g. at a lock-in, and whose
@@ -40,7 +45,7 @@ import numpy as np
 from multiscale.errors import InputError
 from multiscale.macro.damped import ReducedSystem, select
 from multiscale.macro.eigen import TWO_PI, ModalResult
-from multiscale.macro.modal import mac_matrix, pair_modes
+from multiscale.macro.modal import mac_matrix, pair_modes, subspace_mac
 
 
 LOCK_IN_GAP = 1e-3       # relative frequency gap of a coalesced (locked-in) pair
@@ -224,9 +229,10 @@ class MapBuilder:
     reduced systems of a common basis; ``finish`` returns the map."""
 
     def __init__(self, parameter: str, unit: str, band, *, mac_min: float = 0.5, rtol: float = 1e-6,
-                 xtol: float = 1e-4):
+                 xtol: float = 1e-4, subspace: bool = True):
         self.parameter, self.unit, self.band = parameter, unit, tuple(band)
         self.mac_min, self.rtol, self.xtol = mac_min, rtol, xtol
+        self.subspace = subspace                             # keep a lock-in pair by its subspace MAC
         self.values, self.rows, self.onsets = [], [], []    # rows: per point, per mode (track, MAC)
         self.prev: ModalResult | None = None
         self.n_tracks = 0
@@ -242,7 +248,10 @@ class MapBuilder:
         here, mk = [-1] * len(result), np.full(len(result), np.nan)
         if self.prev is not None:
             mac = mac_matrix(self.prev, result, gram=result.gram)
-            for i, j in pair_modes(mac, self.prev.eigenvalues, result.eigenvalues, self.mac_min):
+            prev = self.prev
+            block = (lambda rows, cols: subspace_mac(prev, result, rows, cols, gram=result.gram)) \
+                if self.subspace else None
+            for i, j in pair_modes(mac, prev.eigenvalues, result.eigenvalues, self.mac_min, block):
                 here[j], mk[j] = self.rows[-1][0][i], mac[i, j]
         first = self.n_tracks
         for j in range(len(result)):
@@ -306,13 +315,14 @@ class MapBuilder:
 
 def build_map(parameter: str, unit: str, values: Sequence[float], results: Sequence[ModalResult],
               reduced: Sequence[ReducedSystem], band, *, mac_min: float = 0.5, rtol: float = 1e-6,
-              xtol: float = 1e-4, onsets: bool = True, basis_size: int = 0, time: float = 0.0) -> StabilityMap:
+              xtol: float = 1e-4, onsets: bool = True, basis_size: int = 0, time: float = 0.0,
+              subspace: bool = True) -> StabilityMap:
     """Track the modes of ``results`` (reduced coordinates of one basis, ``ModalResult.gram``)
     over ``values`` and bisect the onsets on ``reduced`` (module docstring). ``xtol`` is relative
-    to the step between the two bracketing values."""
+    to the step between the two bracketing values; ``subspace`` False: pairs by the single MAC only."""
     if len(values) != len(results) or len(results) != len(reduced) or len(values) < 2:
         raise InputError("stability.sweep", len(values), "at least two points, one result and system each")
-    builder = MapBuilder(parameter, unit, band, mac_min=mac_min, rtol=rtol, xtol=xtol)
+    builder = MapBuilder(parameter, unit, band, mac_min=mac_min, rtol=rtol, xtol=xtol, subspace=subspace)
     for k, (value, result) in enumerate(zip(values, results)):
         for track, j in builder.add(value, result):
             if onsets:
