@@ -57,6 +57,10 @@ from multiscale.micro.asperity_laws import AsperityLaw
 _FLOOR = 1e-10          # smallest relative size a/a_ref used where derivatives are divided by a
 _DENSE_BYTES = 256e6    # far-field matrix kept in memory up to this size (~5600 candidates)
 _LS_CALLBACK = "callback" in inspect.signature(optimize.least_squares).parameters   # scipy >= 1.16
+# TNC stops where the energy stalls in its last digits ("|f_n - f_(n-1)| ~= 0"), which with scipy
+# 1.18 left the thesis set-2 surface at a complementarity residual of 1.1e-6 > tol 1e-6; a restart
+# from there (TNC rescales its variables) goes on, up to this many times
+TNC_RESTARTS = 3
 
 
 class Interactions:
@@ -259,8 +263,13 @@ def _energy_route(inter, dk, cand, a_top, a_init, method, tol, max_iter):
         opts.update(ftol=0.0, maxcor=20, maxiter=max_iter, maxls=50)
     res = optimize.minimize(fun, z0, jac=True, method=method.upper(), bounds=bounds, options=opts,
                             callback=None if method == "tnc" else _Stop(measure, tol))
-    resid = measure(res.x)
-    return _drop_negligible(last["a"], last["P"], Pu, tol), int(getattr(res, "nit", 0)), resid
+    resid, nit = measure(res.x), int(getattr(res, "nit", 0))
+    for _ in range(TNC_RESTARTS if method == "tnc" else 0):      # TNC stops where f stalls in its last digits
+        if resid <= tol:
+            break
+        res = optimize.minimize(fun, res.x, jac=True, method="TNC", bounds=bounds, options=opts)
+        resid, nit = measure(res.x), nit + int(getattr(res, "nit", 0))
+    return _drop_negligible(last["a"], last["P"], Pu, tol), nit, resid
 
 
 def _energy_gradient(st: _State, dW, dk, n):

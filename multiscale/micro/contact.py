@@ -431,8 +431,8 @@ def _batch_values(name: str, value, shape) -> np.ndarray:
     except ValueError:
         sweep = " (a sweep on one patch: its heights broadcast to the values' shape, " \
                 "np.broadcast_to(h, (n, ny, nx)))" if not shape else ""
-        raise InputError(f"{name}.shape", a.shape, f"must broadcast to the batch's shape {shape}, one value "
-                         f"per patch{sweep}") from None
+        raise InputError(name, f"array of shape {a.shape}", f"must broadcast to the batch's shape {shape}, one "
+                         f"value per patch{sweep}") from None
 
 
 def solve_contact(heights, dx: float | None = None, kernel: Kernel | None = None, *, dy: float | None = None,
