@@ -99,7 +99,7 @@ class Material:
     hardness: float | tuple | None = key(_property(_HARDNESS, "hardness"),      # Pa, asperities' flow pressure
                                          absent="with plasticity: the other side's")
     loss_factor: float | None = key(Quantity("dimensionless", ge=0), absent="0: no structural damping")
-    damping_alpha: float | None = key(Quantity("frequency", ge=0), absent="0: no alpha M damping")   # 1/s
+    damping_alpha: float | None = key(Quantity("rate", ge=0), absent="0: no alpha M damping")   # 1/s
     damping_beta: float | None = key(Quantity("time", ge=0), absent="0: no beta K damping")           # s
 
     rules = (OneOf(("c", "chi"), needed_by=("thermal",)), Requires("c", ("rho",), needed_by=("thermal",)))

@@ -120,7 +120,7 @@ class Stability:
     modes: int | None = key(Integer(ge=1), required=True)
     target: float | None = key(Quantity("frequency", ge=0), absent="the band's lower edge")   # Hz
     damping: float = key(Quantity("dimensionless", ge=0, plausible=(0.0, 0.5)), default=0.0)  # structural loss factor
-    rayleigh_alpha: float = key(Quantity("frequency", ge=0), default=0.0)     # 1/s
+    rayleigh_alpha: float = key(Quantity("rate", ge=0), default=0.0)     # 1/s
     rayleigh_beta: float = key(Quantity("time", ge=0), default=0.0)           # s
     prestress: bool = key(Flag(), default=False)
     gyroscopic: bool = key(Flag(), default=False)

@@ -59,6 +59,7 @@ KINDS: dict[str, Kind] = {
     "angle": Kind("angle", A, "rad", "rad, deg"),
     "time": Kind("time", T, "s", "s, ms, min, h"),
     "frequency": Kind("frequency", _dim((T, -1)), "Hz", "Hz, kHz"),
+    "rate": Kind("rate", _dim((T, -1)), "1/s", "1/s"),       # e.g. Rayleigh's alpha (not a frequency: no 2 pi)
     "speed": Kind("speed", _dim((L, 1), (T, -1)), "m/s", "m/s, mm/s"),
     "acceleration": Kind("acceleration", _dim((L, 1), (T, -2)), "m/s^2", "m/s^2, gn"),
     "mass": Kind("mass", M, "kg", "kg, t"),

@@ -993,3 +993,12 @@ def test_a_support_that_would_take_the_load_is_refused_when_read():
                                          r"\[0.0, 0.0, -1.0\]: the support would take the load and the contact none"):
         loads(text + '\n[[boundary]]\nsurfaces = ["block_top"]\nfix = ["z"]\n', DEMOS)
     loads(text + '\n[[boundary]]\nsurfaces = ["block_top"]\nfix = ["x", "y"]\n', DEMOS)
+
+
+def test_rayleighs_alpha_is_a_rate_not_a_frequency():
+    """stability.rayleigh_alpha and materials.<m>.damping_alpha multiply M: a rate in 1/s, not a
+    frequency in Hz (no 2 pi); they were read and written back as "Hz" (a user trial)."""
+    from multiscale.provenance import resolved_toml
+    scene = load(DEMOS / "brake_squeal.toml", {"stability.rayleigh_alpha": "20 1/s"})
+    assert scene.stability.rayleigh_alpha == 20.0
+    assert "rayleigh_alpha = 20.0   # 1/s" in resolved_toml(scene).splitlines()
