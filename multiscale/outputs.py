@@ -205,7 +205,8 @@ def paraview_script(p: Plan) -> str:
     interface = OWN_FILES["interface"]
     lines = ['"""Open these results in ParaView: pvpython paraview.py (a window), or paste into',
              "View > Python Shell. Each .xdmf holds one mesh with every field as a named array",
-             "(unit in the name); the time slider steps through the output times.",
+             "(unit in the name); the time slider steps through the output times. In the arrays'",
+             f"names body 0 is {p.bodies[0]} and body 1 is {p.bodies[1]}.",
              '"""', "import os", "from paraview.simple import *  # noqa: F401,F403", "",
              "# the folder of this script (the results folder where it was written, if run without a file)",
              f"here = os.path.dirname(os.path.abspath(__file__)) if '__file__' in globals() else {str(p.folder)!r}",

@@ -296,6 +296,7 @@ def test_a_body_named_like_a_name_of_the_script_keeps_the_script_working(tmp_pat
     for bodies in (("view", "os"), ("in", "here")):
         p = Plan("squeal", tmp_path, bodies, fields, ("contact_pressure",), (0.0,), {}, ())
         stub = run_script(paraview_script(p), tmp_path, monkeypatch)
+        assert f"body 0 is {bodies[0]} and body 1 is {bodies[1]}" in paraview_script(p)   # the arrays' words
         assert sorted(Path(f).name for f in stub.opened) == sorted(
             [f"{b}.xdmf" for b in bodies] + ["interface.xdmf"] + [f"modes_{b}.bp" for b in bodies])
         assert stub.shown_in(stub.view) == sorted(f"modes_{b}.bp" for b in bodies)
