@@ -1044,3 +1044,19 @@ def test_two_rough_pads_have_each_their_real_contact_area_and_worn_volume(tmp_pa
     for pad in ("pad_a", "pad_b"):
         assert 0 < h[f"real_contact_area_{pad}"][-1] < 0.02 * 0.02
         assert h[f"wear_volume_{pad}"][-1] == pytest.approx(1e-14 * h[f"frictional_heat_total_{pad}"][-1], rel=5e-3)
+
+
+def test_geometry_files_that_gmsh_cannot_take_are_refused_by_name(tmp_path):
+    """Found by a trial of odd files: a .geo with ``Exit;`` ended check and run with status 0 and no
+    word (gmsh exits the process); an MSH 2.2 mesh was a KeyError traceback; an empty or truncated
+    STEP a raw gmsh exception. Each is now an error naming the file and what to do."""
+    cases = {"exit.geo": (TWO_PADS_GEO + "\nExit;\n", r"has an Exit command, which would end this process"),
+             "old.msh": ("$MeshFormat\n2.2 0 8\n$EndMeshFormat\n", r"an MSH 2 file .* save it as MSH 4.1"),
+             "cut.step": ("ISO-10303-21;\nHEADER;\nFILE_DESCRIPTION(('x'),'2;1');\n",
+                          r"OpenCASCADE cannot read it .*: is it a whole STEP file\?")}
+    for name, (text, message) in cases.items():
+        (tmp_path / name).write_text(text)
+        with pytest.raises(SceneError, match=message):
+            loads(TWO_PADS.replace('"twopads.geo"', f'"{name}"').format(folder=tmp_path / "out"), tmp_path)
+    (tmp_path / "commented.geo").write_text(TWO_PADS_GEO + "\n// Exit;\n/* Exit; */\n")      # a comment passes
+    loads(TWO_PADS.replace('"twopads.geo"', '"commented.geo"').format(folder=tmp_path / "out"), tmp_path)
