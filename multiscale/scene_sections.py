@@ -300,7 +300,7 @@ class Loading:
     vehicle: Vehicle | None = key(Section(Vehicle))
     sliding_speed: float | None = key(Quantity("speed", ge=0, plausible=(0.0, 200.0)), absent="at rest")  # m/s
     friction: float | None = key(_FRICTION, absent="friction_curve, stribeck or each interface's own friction")  # mu
-    ramp_steps: int = key(Integer(ge=1), default=1)       # load increments of the first mechanical solve
+    ramp_steps: int = key(Integer(ge=1, le=10**4), default=1)   # load increments of the first mechanical solve
     friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), Quantity("dimensionless", ge=0), "slip speed",
                                              "mu", min_rows=2), absent="friction or stribeck gives mu")  # ((m/s, -),..)
     stribeck: Stribeck | None = key(Section(Stribeck))
@@ -386,8 +386,8 @@ class Time:
     """Staggered time loop (Fig. 7.4): ``steps`` macro steps Δt over ``end``, each in ``substeps``."""
 
     end: float | None = key(Quantity("time", gt=0, plausible=(1e-6, 1e6)), needed_by=("thermal", "wear"))  # s
-    steps: int = key(Integer(ge=1), default=1)
-    substeps: int = key(Integer(ge=1), default=1)
+    steps: int = key(Integer(ge=1, le=10**6), default=1)        # (1e9 steps: check's plan took ~30 min)
+    substeps: int = key(Integer(ge=1, le=10**4), default=1)
     initial_temperature: float = key(_TEMPERATURE, default=293.15)  # K
 
     @property

@@ -185,7 +185,7 @@ class Flag:
 
 
 class Text:
-    def __init__(self, pattern: str = r".+", what: str = "a non-empty string"):
+    def __init__(self, pattern: str = r"(?s).*\S.*", what: str = "a non-empty string"):   # (lines; not blank)
         self.pattern, self.what = re.compile(pattern), what
 
     def describe(self) -> str:

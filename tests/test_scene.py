@@ -1002,3 +1002,16 @@ def test_rayleighs_alpha_is_a_rate_not_a_frequency():
     scene = load(DEMOS / "brake_squeal.toml", {"stability.rayleigh_alpha": "20 1/s"})
     assert scene.stability.rayleigh_alpha == 20.0
     assert "rayleigh_alpha = 20.0   # 1/s" in resolved_toml(scene).splitlines()
+
+
+def test_a_description_of_lines_passes_and_absurd_step_counts_are_refused():
+    """From a trial of odd inputs: a multi-line description was refused as "must be a non-empty
+    string" while one of spaces passed; time.steps = 1e9 made check build its output plan for
+    about 30 minutes. Now lines pass, blanks do not, and steps stop at 1e6 (substeps and the first
+    solve's ramp_steps at 1e4)."""
+    text = (DEMOS / "block_on_flat.toml").read_text()
+    assert loads(text, DEMOS, overrides={"description": "two\nlines"}).description == "two\nlines"
+    for key, value, message in (("description", "   ", "a non-empty string"), ("time.steps", 10**9, "<= 1000000"),
+                                ("time.substeps", 10**5, "<= 10000"), ("loading.ramp_steps", 10**5, "<= 10000")):
+        with pytest.raises(SceneError, match=f"{key} = .*must be .*{message}"):
+            loads(text, DEMOS, overrides={key: value})
