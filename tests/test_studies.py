@@ -745,3 +745,30 @@ def _cmdline(proc: Path) -> bytes:
         return (proc / "cmdline").read_bytes()
     except OSError:
         return b""
+
+
+def test_records_of_another_shape_are_run_again(hertz_study, tmp_path, capsys):
+    """Run records that are valid JSON of another shape (a list, a metric null, a wall time "x"):
+    the study ended in an AttributeError, TypeError or ValueError traceback and wrote no table (a
+    trial of odd files). A list or a wall time of text is taken as not done, like a torn file, and
+    runs again; a metric that is no number fails that run, saying so (--rerun-failed reruns it)."""
+    import shutil
+
+    from multiscale.studies.expand import load_study
+    path, out = hertz_study
+    runs = tmp_path / "runs"
+    shutil.copytree(out / "runs", runs)
+    other = write(tmp_path, HERTZ.replace("[run]", f'[run]\nfolder = "{tmp_path}"') + "plots = false\n")
+    study = load_study(other)
+    bad = [lambda r: [1, 2, 3], lambda r: {**r, "metrics": {k: None for k in r["metrics"]}},
+           lambda r: {**r, "wall_time": "x"}]
+    for run, spoil in zip(study.runs, bad):
+        p = runs / f"{run.key}.json"
+        p.write_text(json.dumps(spoil(json.loads(p.read_text()))))
+    capsys.readouterr()
+    assert main(["study", str(other)]) == 1
+    assert "2 recorded before, 2 run now, 1 failed" in capsys.readouterr().out
+    rows = table(tmp_path / "results.csv")
+    assert [r["status"] for r in rows] == ["ok", "failed", "ok", "ok"]
+    assert rows[1]["message"] == 'metric "contact_radius" is None (not a number)'
+

@@ -30,9 +30,21 @@ def metric_problem(metrics: dict, names) -> str | None:
             return (f'metric "{name}" not produced' + (hint + " (fix the name: the runs need not run again)" if hint
                     else " (a run older than the metric: --rerun-failed recomputes it)")
                     + f'; available: {", ".join(sorted(metrics))}')
-        if not math.isfinite(metrics[name]):
-            return f'metric "{name}" is {metrics[name]} (not finite)'
+        value = metrics[name]
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            return f'metric "{name}" is {value!r} (not a number)'
+        if not math.isfinite(value):
+            return f'metric "{name}" is {value} (not finite)'
     return None
+
+
+def _well_formed(record) -> bool:
+    """Whether a record read back has the shape a run writes: a table whose metrics are a table and
+    whose times, memory and iterations are numbers (a record edited or written by hand may not be)."""
+    if not isinstance(record, dict) or not isinstance(record.get("metrics", {}), dict):
+        return False
+    return all(isinstance(record.get(k, 0), (int, float)) and not isinstance(record.get(k, 0), bool)
+               for k in ("wall_time", "cpu_time", "peak_memory_mb", "iterations", "repeat"))
 
 
 def read_records(study: Study) -> dict:
@@ -47,6 +59,8 @@ def read_records(study: Study) -> dict:
                 record = json.loads(p.read_text())
             except ValueError:
                 continue                  # a torn file: treat the run as not done
+            if not _well_formed(record):
+                continue                  # valid JSON of another shape: the same
             if record.get("ran") or record.get("status") == "ok":
                 if record.get("repeat", 1) < study.options.repeat:
                     continue
