@@ -510,3 +510,14 @@ def test_check_resolved_says_what_the_equivalent_surface_would_be(cells, flat):
             topography.check_resolved(s.size, n, size, prefix="roughness.")
     else:
         topography.check_resolved(s.size, n, size, prefix="roughness.")
+
+
+def test_heights_that_underflow_are_refused_by_name(tmp_path):
+    """Heights of 1e-170 m (a height unit of 1e-200 m on micrometre numbers): ``multiscale surface``
+    ended in a ZeroDivisionError traceback (a trial of odd files); now the file is named and the
+    height unit questioned."""
+    from multiscale.errors import InputError
+    from multiscale.micro.reading import read_topography
+    np.save(tmp_path / "tiny.npy", np.random.default_rng(1).normal(size=(16, 16)) * 1e-170)
+    with pytest.raises(InputError, match=r"'tiny.npy': heights up to .* m underflow .*: is height_unit right\?"):
+        read_topography(tmp_path / "tiny.npy", pixel_size=1e-6)

@@ -24,6 +24,7 @@ from multiscale.micro.surface import read_matrix
 MATRIX_SUFFIXES = (".npy", ".txt", ".csv", ".asc")    # plain height matrices (no units in the file)
 TALLEST = 1e-2            # m: heights beyond are no roughness measurement (an instrument's z range is mm)
 LOWEST = 1e-10            # m: heights all within it are none either (an atomic step; offsets and noise exceed it)
+UNDERFLOW = 1e-60         # m: heights all within it have powers (h^4 in Sku) that underflow: refused
 KEPT_BYTES = 2**30        # heights of the measurements kept for the next read (an 8000² map is 0.5 GB)
 SETTLED = 2.0             # s: a file modified more recently is not kept (file times are as coarse as a clock tick)
 _KEPT: dict = {}          # (file, channel, pixel size, height unit, prefix) -> ((mtime, size), Measurement)
@@ -264,6 +265,9 @@ def _height_range(h: np.ndarray, path: Path, prefix: str, unit: str, what: str =
         peak, sq = float(np.nanmax(np.abs(h))), float(np.nanstd(h))
     if not np.isfinite(sq):
         raise InputError(option(prefix, "file"), path.name, f"heights up to {peak:.3g} m overflow (one unit of the "
+                         f"file = {unit}): is {option(prefix, 'height_unit')} right?")
+    if 0 < peak < UNDERFLOW:          # their powers underflow: the statistics divided by zero
+        raise InputError(option(prefix, "file"), path.name, f"heights up to {peak:.3g} m underflow (one unit of the "
                          f"file = {unit}): is {option(prefix, 'height_unit')} right?")
     if peak > TALLEST or 0 < peak < LOWEST:
         return [f"{option(prefix, 'file')} = '{path.name}': heights up to {peak:.3g} m (Sq {sq:.3g} m, one unit of "
