@@ -351,15 +351,17 @@ class FilePath:
         return f"{what} (relative to the scene file)"
 
     def __call__(self, raw, ctx):
-        if not isinstance(raw, str) or not raw:
-            raise Bad(f"must be {self.describe()}")
-        if "\x00" in raw:
-            raise Bad("holds a NUL character; a path cannot")
-        path = (ctx.directory / Path(raw).expanduser()).resolve()
-        if self.folder and path.exists() and not path.is_dir():
+        if not isinstance(raw, str) or not raw or "\x00" in raw:
+            raise Bad("holds a NUL character; a path cannot" if isinstance(raw, str) and raw else f"must be {self.describe()}")
+        try:                             # (a name part over 255 bytes: "File name too long")
+            path = (ctx.directory / Path(raw).expanduser()).resolve()
+            folder, file, exists = path.is_dir(), path.is_file(), path.exists()
+        except OSError as exc:
+            raise Bad(f"cannot be used as a path ({exc.strerror or exc})") from None
+        if self.folder and exists and not folder:
             raise Bad(f"exists and is not a folder ({path})")
-        if not self.folder and not path.is_file():
-            raise Bad(f"{'is a folder, not a file' if path.is_dir() else 'no such file'} ({path})")
+        if not self.folder and not file:
+            raise Bad(f"{'is a folder, not a file' if folder else 'no such file'} ({path})")
         return path
 
 
@@ -535,10 +537,8 @@ def read(cls, raw, path: str, ctx: Context):
     if not isinstance(raw, dict):
         ctx.problems.append(f"{path} = {show(raw)}: must be a table [{path}]")
         return None
-    before = len(ctx.problems)
-    specs = dict(fields_of(cls))
+    before, specs, values = len(ctx.problems), dict(fields_of(cls)), {}
     typos = unknown_keys(raw, specs, path, ctx)
-    values = {}
     for name, spec in specs.items():
         where = prefix + name
         effect = _needing(spec.needed_by, spec.unless, ctx.effects)
@@ -562,8 +562,7 @@ def read(cls, raw, path: str, ctx: Context):
                 ctx.warnings.append(f"{where} is ignored: effect {users} is not in effects")
         elif (spec.required or effect) and missing:
             ctx.problems.append(f"{where}: missing; {why}: {spec.parser.describe()}")
-    present = {k for k in raw if k in specs}
-    rules = getattr(cls, "rules", ())
+    present, rules = {k for k in raw if k in specs}, getattr(cls, "rules", ())
     clash = {k for r in rules if isinstance(r, OneOf) and len(present & set(r.keys)) > 1 for k in r.keys}
     for rule in (r for r in rules if getattr(r, "key", None) not in clash):   # alternatives given together:
         ctx.problems.extend(rule.check(present, path or "scene", ctx))        # one problem, not what each needs

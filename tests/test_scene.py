@@ -1015,3 +1015,14 @@ def test_a_description_of_lines_passes_and_absurd_step_counts_are_refused():
                                 ("time.substeps", 10**5, "<= 10000"), ("loading.ramp_steps", 10**5, "<= 10000")):
         with pytest.raises(SceneError, match=f"{key} = .*must be .*{message}"):
             loads(text, DEMOS, overrides={key: value})
+
+
+def test_a_path_part_too_long_for_the_file_system_is_an_error_not_a_traceback(tmp_path):
+    """A name part over 255 bytes in output.folder (or a geometry or surface file): an OSError
+    traceback ("File name too long") in check and run (a trial of odd files); now the key's error."""
+    from multiscale.micro.reading import read_topography
+    text = (DEMOS / "block_on_flat.toml").read_text()
+    with pytest.raises(SceneError, match=r"output.folder = .*: cannot be used as a path \(File name too long\)"):
+        loads(text, DEMOS, overrides={"output.folder": str(tmp_path / ("a" * 300))})
+    with pytest.raises(InputError, match=r"cannot be used as a path \(File name too long\)"):
+        read_topography(tmp_path / ("b" * 300 + ".npy"))

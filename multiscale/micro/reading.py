@@ -175,9 +175,12 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
                          "a file name (str or os.PathLike, e.g. pathlib.Path)"
                          f"{': pass the name of the open file' if opened else ''}")
     path = Path(path).expanduser()
-    if not path.is_file():
-        raise InputError(option(prefix, "file"), path.name,
-                         f"{'a folder, not a file' if path.is_dir() else 'no such file'} "
+    try:
+        found, folder = path.is_file(), path.is_dir()
+    except OSError as exc:                        # a name part over 255 bytes
+        raise InputError(option(prefix, "file"), path.name[:60], f"cannot be used as a path ({exc.strerror})") from None
+    if not found:
+        raise InputError(option(prefix, "file"), path.name, f"{'a folder, not a file' if folder else 'no such file'} "
                          f"({path})")
     stat = path.stat()
     if stat.st_size == 0:     # some readers take it for a 0 x 0 map, then ask for its pixel size
