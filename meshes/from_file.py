@@ -29,13 +29,13 @@ interface k -> facet tag 1001 + k, surface k -> facet tag 2001 + k.
 """
 from __future__ import annotations
 
-import re
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from meshes import cad_units
+from meshes.foreign import refuse_foreign
 from multiscale.errors import InputError
 from multiscale.geometry import FIXED_BODY, BodySpec, GeometrySpec, Region, Rotation, add_group, plane_extent
 
@@ -170,20 +170,6 @@ def _script_factor(model) -> float:
 
 
 # ---------------------------------------------------------------- reading
-def _refuse_foreign(g) -> None:
-    """A ``.geo`` script with an ``Exit`` command (gmsh would end this process, silently, with
-    status 0: check and run said nothing and wrote nothing) or an MSH 2 file (no entity topology:
-    the volumes' boundary nodes are not found) is refused by name."""
-    if g.file.suffix.lower() == ".geo":
-        code = re.sub(r"//[^\n]*|/\*.*?\*/", "", g.file.read_text(encoding="utf-8", errors="replace"), flags=re.S)
-        if re.search(r"(^|[;\s])Exit\s*;", code):
-            raise InputError("geometry.file", g.file.name, "the script has an Exit command, which would end this "
-                             "process (gmsh exits); remove it")
-    elif g.file.suffix.lower() == ".msh" and re.match(rb"\s*\$MeshFormat\s+2\.", g.file.read_bytes()[:64]):
-        raise InputError("geometry.file", g.file.name, "an MSH 2 file (no entity topology for the volumes' "
-                         "boundaries): save it as MSH 4.1 (gmsh -save -format msh41, or File > Export)")
-
-
 def _load(model, g) -> Found:
     import gmsh   # the module-level functions (merge, option) of the model's gmsh
     path, unit = str(g.file), cad_units.file_unit(g.file, g.unit)
@@ -201,7 +187,7 @@ def _load(model, g) -> Found:
         model.occ.synchronize()
         order = [t for d, t in shapes if d == 3]
     else:
-        _refuse_foreign(g)
+        refuse_foreign(g)
         factor = gmsh.option.getNumber(SIZE_FACTOR)   # a trial's (geometry.estimate_cells), else 1
         gmsh.option.setNumber(SIZE_FACTOR, 1.0)
         try:
