@@ -52,7 +52,10 @@ class EnergyShares:
         return self.names.index(name)
 
 
-def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float = 1e-3) -> StabilityReport:
+CLOSE = 1e-3     # relative frequency gap of two stable modes that are "potentially unstable" (Fig. 4.14)
+
+
+def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float = CLOSE) -> StabilityReport:
     """Unstable modes (sigma > rtol |lambda|) and potentially unstable ones (Fig. 4.14).
 
     A stable mode is potentially unstable when a neighbouring stable mode lies within

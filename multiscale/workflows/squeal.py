@@ -45,7 +45,7 @@ from multiscale.macro.eigen import Damping, ModalResult
 from multiscale.macro.friction import ConstantFriction, StribeckFriction, TableFriction, set_friction
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.mechanics import Mechanics
-from multiscale.macro.modal import EnergyShares, RegionEnergy, StabilityReport, stability_report, \
+from multiscale.macro.modal import CLOSE, EnergyShares, RegionEnergy, StabilityReport, stability_report, \
     strain_energy_shares
 from multiscale.macro.output import write_modes, write_state
 from multiscale.macro.preload import Preload, linearise_system, preload
@@ -59,7 +59,6 @@ from multiscale.workflows.rough import build_rough_interface
 from multiscale.workflows.strain import overloaded, unloaded
 
 SQUEAL_DEGREE = 2     # quadratic tetrahedra: linear ones are far too stiff in bending (tests)
-CLOSE = 1e-3         # relative frequency gap of two stable modes that are "potentially unstable" (with friction)
 MAP_RESIDUAL = 1e-3   # a stability map's modes with larger relative residuals are warned to be approximate
 MODE_RESIDUAL = 3e-2  # the analysis' modes with larger relative residuals are warned to be approximate
 
@@ -96,7 +95,7 @@ class SquealCase:
 def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "case", *, load: float = 1e6,
                 steps: int = 1, band=(0.0, 16e3), n_modes: int | None = None,
                 target: float | None = None, damping: Damping | None = None, energy: bool = True,
-                rtol: float = 1e-6, close_tol: float = 1e-3, options: SquealOptions | None = None,
+                rtol: float = 1e-6, close_tol: float = CLOSE, options: SquealOptions | None = None,
                 reset: bool = True, torque: float | None = None, on_preload=None) -> SquealCase:
     """Preload ``mech`` from rest (``reset``) to ``load`` [Pa or N] in ``steps`` (with ``torque``
     [N m] a first guess, scaled to that friction moment: ``preload``), linearise and extract the
