@@ -123,12 +123,14 @@ def test_bad_surface_input(tmp_path):
     # later, a read row, the imaginary part dropped with numpy's ComplexWarning)
     (tmp_path / "empty.txt").write_text("# no data\n")
     np.save(tmp_path / "row.npy", np.ones((1, 9)))
+    np.save(tmp_path / "small.npy", np.ones((3, 9)))    # said 2 x 2 here, 4 x 4 in Surface
     np.save(tmp_path / "complex.npy", np.ones((8, 8)) * (1 + 1j))
     np.save(tmp_path / "mask.npy", np.ones((8, 8), bool))
     (tmp_path / "empty.npy").write_bytes(b"")          # numpy's EOFError came through as a traceback
-    for name, why in [("empty.txt", r"at least 2 x 2 points, got shape \(0, 1\)"),
+    for name, why in [("empty.txt", r"at least 4 x 4 points, got shape \(0, 1\)"),
                       ("empty.npy", "could not read a height matrix"),
-                      ("row.npy", r"at least 2 x 2 points, got shape \(1, 9\)"),
+                      ("row.npy", r"at least 4 x 4 points, got shape \(1, 9\)"),
+                      ("small.npy", r"at least 4 x 4 points, got shape \(3, 9\)"),
                       ("complex.npy", "real numbers, not complex128"), ("mask.npy", "real numbers, not bool")]:
         with pytest.raises(InputError, match=why):
             load_surface(tmp_path / name, 1e-6)

@@ -182,8 +182,8 @@ def read_matrix(path) -> np.ndarray:
         if isinstance(exc, InputError):
             raise
         raise InputError("path", str(path), f"could not read a height matrix ({exc})") from None
-    if h.ndim != 2 or min(h.shape) < 2:
-        raise InputError("path", str(path), f"expected a 2-D height matrix of at least 2 x 2 points, got shape "
+    if h.ndim != 2 or min(h.shape) < 4:
+        raise InputError("path", str(path), f"expected a 2-D height matrix of at least 4 x 4 points, got shape "
                          f"{h.shape}")
     return h
 
