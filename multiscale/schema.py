@@ -340,8 +340,7 @@ class Vector(ListOf):
 
 
 class FilePath:
-    """A path, relative ones taken from the scene file's directory: an existing file, or with
-    ``folder`` a folder that need not exist yet."""
+    """A path relative to the scene file: an existing file, or a folder (need not exist) with ``folder``."""
 
     def __init__(self, *, folder: bool = False):
         self.folder = folder
@@ -361,7 +360,9 @@ class FilePath:
         if self.folder and exists and not folder:
             raise Bad(f"exists and is not a folder ({path})")
         if not self.folder and not file:
-            raise Bad(f"{'is a folder, not a file' if folder else 'no such file'} ({path})")
+            kind = "is a folder, not a file" if folder else "is no regular file (a FIFO, device or socket)" if exists \
+                else "no such file"
+            raise Bad(f"{kind} ({path})")
         return path
 
 

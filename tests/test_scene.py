@@ -1,6 +1,7 @@
 """Scenes: unit strings to SI, validation into frozen dataclasses, every problem at once."""
 import dataclasses
 import math
+import os
 import pickle
 import tomllib
 from pathlib import Path
@@ -447,6 +448,12 @@ def test_a_folder_given_as_a_file_is_said_to_be_a_folder(tmp_path):
     with pytest.raises(SceneError) as info:
         loads(text, tmp_path)
     assert f'geometry.file = "brake.step": is a folder, not a file ({tmp_path / "brake.step"})' in info.value.problems
+    (tmp_path / "brake.step").rmdir()           # a FIFO was "no such file" (a trial of odd files)
+    os.mkfifo(tmp_path / "brake.step")
+    with pytest.raises(SceneError) as info:
+        loads(text, tmp_path)
+    assert f'geometry.file = "brake.step": is no regular file (a FIFO, device or socket) ({tmp_path / "brake.step"})' \
+        in info.value.problems
 
 
 def test_a_geometry_file_s_names_must_not_clash_with_the_results(tmp_path):
