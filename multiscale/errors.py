@@ -84,6 +84,28 @@ def interrupted(exc: BaseException) -> KeyboardInterrupt | None:
     return None
 
 
+MAX_TOML_BYTES = 16 * 2**20      # a scene or study file larger than this is not one
+
+
+def read_toml_text(path, what: str) -> str:
+    """The text of the ``what`` file (e.g. "scene") at ``path``: UTF-8, with or without a byte-order
+    mark (Windows editors write one). A SceneError names the file when it cannot be read, is not
+    UTF-8 (UTF-16 is named) or holds over MAX_TOML_BYTES (/dev/zero given as a scene filled memory)."""
+    try:
+        with open(path, "rb") as stream:
+            data = stream.read(MAX_TOML_BYTES + 1)
+    except OSError as exc:
+        raise SceneError(f"{path}: cannot read the {what} file ({exc.strerror or exc})") from None
+    if len(data) > MAX_TOML_BYTES:
+        raise SceneError(f"{path}: is no {what} file, it holds over {MAX_TOML_BYTES // 2**20} MiB")
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        why = "it is UTF-16: save it as UTF-8" if data[:2] in (b"\xff\xfe", b"\xfe\xff") \
+            else f"{exc.reason} at byte {exc.start}"
+        raise SceneError(f"{path}: cannot read the {what} file, it is not UTF-8 text ({why})") from None
+
+
 def toml_problem(source, exc: Exception, text: str) -> SceneError:
     """A TOML syntax error of ``text`` (from ``source``) with the line it is on: tomllib gives the
     position only, and "Cannot overwrite a value (at line 35, column 23)" is a key given twice."""

@@ -24,7 +24,7 @@ from pathlib import Path
 
 import numpy as np
 
-from multiscale.errors import InputError, SceneError, toml_problem
+from multiscale.errors import InputError, SceneError, read_toml_text, toml_problem
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
@@ -230,10 +230,7 @@ def load(path, overrides=None) -> Scene:
     if not isinstance(path, (str, os.PathLike)):
         raise InputError("path", path, "a scene file name (str or Path)")
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SceneError(f"{path}: cannot read the scene file ({getattr(exc, 'strerror', None) or exc})") from None
+    text = read_toml_text(path, "scene")
     return loads(text, path.resolve().parent, name=path.stem, source=path.resolve(), overrides=overrides)
 
 

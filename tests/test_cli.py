@@ -96,6 +96,24 @@ def test_missing_file_is_a_clear_error(tmp_path, capsys):
     assert "cannot read the scene file" in err and "Traceback" not in err
 
 
+def test_scene_encodings_and_endless_files(tmp_path, capsys, monkeypatch):
+    """A UTF-8 scene with a byte-order mark (Windows editors) is read; a UTF-16 one is named with
+    what to do (before: a codec message); a file larger than any scene is refused after a bounded
+    read (before: /dev/zero given as the scene filled memory)."""
+    bom = tmp_path / "bom.toml"
+    bom.write_bytes(b"\xef\xbb\xbf" + BLOCK.encode())
+    assert main(["check", str(bom)]) == 0
+    capsys.readouterr()
+    wide = tmp_path / "wide.toml"
+    wide.write_text(BLOCK, encoding="utf-16")
+    assert main(["check", str(wide)]) == 2
+    assert "it is UTF-16: save it as UTF-8" in capsys.readouterr().err
+    monkeypatch.setattr("multiscale.errors.MAX_TOML_BYTES", 100)
+    assert main(["check", _write(tmp_path, BLOCK)]) == 2
+    err = capsys.readouterr().err
+    assert "is no scene file, it holds over" in err and "Traceback" not in err
+
+
 def test_check_good_scene_prints_summary(tmp_path, capsys):
     path = _write(tmp_path, BLOCK)
     assert main(["check", path]) == 0

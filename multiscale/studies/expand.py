@@ -10,7 +10,7 @@ import tomllib
 from dataclasses import dataclass
 from pathlib import Path
 
-from multiscale.errors import SceneError, toml_problem
+from multiscale.errors import SceneError, read_toml_text, toml_problem
 from multiscale.schema import Bad, Context, Integer, Quantity, fields_of, read, show, suggest
 from multiscale.studies.formatting import value_text
 from multiscale.studies.problems import PROBLEMS
@@ -68,11 +68,9 @@ class Study:
 def load_study(path) -> Study:
     """Read, validate and expand a study file; raises SceneError listing every problem."""
     path = Path(path)
+    text = read_toml_text(path, "study")
     try:
-        text = path.read_text(encoding="utf-8")
         raw = tomllib.loads(text)
-    except (OSError, UnicodeDecodeError) as exc:
-        raise SceneError(f"{path}: cannot read the study file ({getattr(exc, 'strerror', None) or exc})") from None
     except tomllib.TOMLDecodeError as exc:
         raise toml_problem(path, exc, text) from None
     ctx = Context(directory=path.resolve().parent)
