@@ -11,8 +11,9 @@ found; and ``generate``, on the meshing rank):
    are fragmented (``occ.fragment``) so that faces where two volumes touch become one shared face
    and the mesh is conforming there (a ``.msh`` must be conforming already: gmsh writes shared
    faces as one entity);
-2. assign every volume to one body: by physical-group name or CAD label (``volumes``), by the
-   file's volume number (``index``), or as the volume containing a point (``contains``);
+2. assign every volume to one body (``meshes.cad_bodies``): by physical-group name or CAD label
+   (``volumes``), by the file's volume number (``index``), or as the volume containing a point
+   (``contains``);
 3. find the contact interfaces: faces shared by a fixed body and the rotating one (given pairs,
    or every such pair, one interface per fixed body named after it), with their area, and their
    normal and extent in their plane when planar;
@@ -35,8 +36,9 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from meshes import cad_units
+from meshes.cad_bodies import assign_bodies
 from meshes.foreign import refuse_foreign
-from multiscale.errors import InputError
+from multiscale.errors import InputError, InputErrors
 from multiscale.geometry import FIXED_BODY, BodySpec, GeometrySpec, Region, Rotation, add_group, plane_extent
 
 NAME = "file"
@@ -238,12 +240,13 @@ def _load(model, g) -> Found:
                                    name=name)
     labels = {t: _label(model, t) for _, t in model.getEntities(3)}
     try:
-        bodies = _bodies(model, g, order, labels)
+        bodies = assign_bodies(model, g, order, labels)
     except InputError as exc:
         if not split:
             raise
-        raise InputError(exc.name, exc.value, f"{exc.allowed} (the file's solids {split} overlap: gmsh cut them "
-                         "into pieces where they intersect; make the parts touch without overlapping)") from None
+        note = (f"(the file's solids {split} overlap: gmsh cut them into pieces where they intersect; make the "
+                "parts touch without overlapping)")
+        raise InputErrors([InputError(e.name, e.value, f"{e.allowed} {note}") for e in InputErrors.each(exc)]) from None
     found = Found(bodies, labels, {t: _volume(model, t, occ) for t in labels},
                   extent=extent, size_factor=_script_factor(model), unit=unit)
     _interfaces(model, g, found, occ)
@@ -306,50 +309,6 @@ def _volume(model, tag: int, occ: bool) -> float:
         total += np.abs(np.einsum("ij,ij->i", tets[:, 1] - tets[:, 0],
                                   np.cross(tets[:, 2] - tets[:, 0], tets[:, 3] - tets[:, 0]))).sum() / 6
     return total
-
-
-def _bodies(model, g, order: list[int], labels: dict) -> dict:
-    """Body name -> volume tags; every volume in exactly one body."""
-    groups = {model.getPhysicalName(3, t): list(model.getEntitiesForPhysicalGroup(3, t))
-              for _, t in model.getPhysicalGroups(3)}
-    out, owner = {}, {}
-    for name, sel in g.bodies.items():
-        where = f"geometry.bodies.{name}"
-        if sel.volumes is not None:
-            tags = []
-            for v in sel.volumes:
-                hit = groups.get(v) or [t for t, label in labels.items()
-                                        if v in (label, label.rsplit("/", 1)[-1]) or label.endswith("/" + v)]
-                if not hit:
-                    known = sorted(set(groups) | {lab for lab in labels.values() if lab})
-                    raise InputError(f"{where}.volumes", v, f"no volume of {g.file.name} has this name; known: "
-                                     f"{', '.join(known) or 'none (use index or contains)'}")
-                tags += hit
-        elif sel.index is not None:
-            bad = [i for i in sel.index if i > len(order)]
-            if bad:
-                raise InputError(f"{where}.index", bad, f"{g.file.name} has {len(order)} volumes (1..{len(order)})")
-            tags = [order[i - 1] for i in sel.index]
-        else:
-            tags = []
-            for point in sel.contains:
-                inside = [t for t in labels if model.isInside(3, t, list(point))]
-                if not inside:
-                    raise InputError(f"{where}.contains", list(point), f"no volume of {g.file.name} contains "
-                                     "this point [m]")
-                tags += inside
-        for t in tags:
-            if t in owner and owner[t] != name:
-                raise InputError(f"{where}", name, f"volume {t} ({labels[t] or 'no label'}) also belongs to body "
-                                 f"\"{owner[t]}\"")
-            owner[t] = name
-        out[name] = sorted(set(tags))
-    left = [t for t in labels if t not in owner]
-    if left:
-        centres = [np.round(model.occ.getCenterOfMass(3, t), 4).tolist() if model.occ.getEntities(3) else "" for t in left]
-        raise InputError("geometry.bodies", sorted(g.bodies), "every volume must belong to a body; not assigned: "
-                         + "; ".join(f"volume {t} ({labels[t] or 'no label'}) at {c} m" for t, c in zip(left, centres)))
-    return out
 
 
 def _shared_faces(model, a: list[int], b: list[int]) -> list[int]:

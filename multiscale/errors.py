@@ -40,6 +40,23 @@ class SceneError(InputError):
         return type(self), (self.problems,)
 
 
+class InputErrors(SceneError):
+    """Several InputErrors found together (every body of a geometry file that names no volume);
+    ``errors`` keeps each with its name and value."""
+
+    def __init__(self, errors: list[InputError]):
+        self.errors = list(errors)
+        super().__init__([str(e) for e in self.errors])
+
+    def __reduce__(self):
+        return type(self), (self.errors,)
+
+    @staticmethod
+    def each(exc: InputError) -> list[InputError]:
+        """The InputErrors that ``exc`` stands for: its ``errors``, or itself."""
+        return exc.errors if isinstance(exc, InputErrors) else [exc]
+
+
 class OutputError(MultiscaleError, OSError):
     """A result could not be written (disk full, read-only folder, ...); raised on every rank."""
 

@@ -17,7 +17,7 @@ import dataclasses
 from dataclasses import dataclass
 from pathlib import Path
 
-from multiscale.errors import InputError
+from multiscale.errors import InputError, InputErrors
 from multiscale.geometry import FIXED_BODY, MAX_CELLS, GeometrySpec, Rotation, builder, builder_names
 from multiscale.outputs import name_problem
 from multiscale.schema import (Bad, Choice, FilePath, FrozenMap, Integer, ListOf, Named, OneOf, Quantity,
@@ -299,6 +299,6 @@ class GeometrySection(Section):
         try:
             spec = module.describe(arguments)        # the builder's consistency checks; a file is inspected
         except InputError as exc:
-            ctx.problems.append(str(exc) + hint(exc))
+            ctx.problems += [str(e) + hint(e) for e in InputErrors.each(exc)]
             return None
         return Geometry(name, params, spec)

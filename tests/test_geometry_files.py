@@ -381,14 +381,14 @@ def test_cad_without_a_unit_is_read_in_the_unit_it_declares(files, tmp_path):
     assert [cad_units.file_unit(tmp_path / f, None)[0] for f in ("bare.step", "pod.brep")] == [1e-3, 1.0]
 
 
-def check(tmp_path, capsys, text) -> str:
-    """``multiscale check`` of a scene: exit code 2, exactly one error line, which is returned."""
+def check(tmp_path, capsys, text, count=1) -> str:
+    """``multiscale check`` of a scene: exit code 2, exactly ``count`` error lines, returned as one."""
     path = tmp_path / "bad.toml"
     path.write_text(text)
     assert main(["check", str(path)]) == 2
     errors = [line for line in capsys.readouterr().err.splitlines() if line.startswith("error:")]
-    assert len(errors) == 1, errors
-    return errors[0]
+    assert len(errors) == count, errors
+    return "\n".join(errors)
 
 
 def test_bad_geometry_files_are_one_clear_line(files, tmp_path, capsys):
@@ -396,6 +396,12 @@ def test_bad_geometry_files_are_one_clear_line(files, tmp_path, capsys):
                        **{b: f'volumes = ["{b}"]' for b in INSIDE})
     err = check(tmp_path, capsys, good.replace('volumes = ["housing"]', 'volumes = ["sleeve"]'))
     assert 'geometry.bodies.housing.volumes = \'sleeve\'' in err and "known: disc, housing, pin, plate" in err
+    # every body that names no volume at once (check named only the first), and no "not assigned"
+    # line for the volumes they leave over
+    err = check(tmp_path, capsys, good.replace('volumes = ["housing"]', 'volumes = ["sleeve"]').replace(
+        'volumes = ["pin"]', 'volumes = ["peg"]'), count=2)
+    assert "geometry.bodies.housing.volumes = 'sleeve'" in err and "geometry.bodies.pin.volumes = 'peg'" in err
+    assert "not assigned" not in err
     err = check(tmp_path, capsys, good.replace('rotating = "disc"', 'rotating = "disc"\nunit = "mm"'))
     assert "spans 0.0002175 m, implausible" in err and "unit" in err
     far = good.replace('rotating = "disc"', 'rotating = "disc"\n[geometry.interfaces.plate]\nbetween = ["plate", "disc"]')
