@@ -33,15 +33,17 @@ FIELDS = {"displacement": ("displacement", "m"), "temperature": ("temperature", 
 
 def folder_problem(folder) -> str | None:
     """Why a run could not create or write into the output folder ``folder`` (its nearest existing
-    ancestor is a file, or not writable: permissions, a read-only file system), or None. What
+    ancestor is a file, or not writable: permissions, a read-only file system, /proc), or None. What
     ``multiscale check`` says without writing anything; the run itself tries (``workflows.output``)."""
     folder = Path(folder)
     existing = next(p for p in (folder, *folder.parents) if p.exists())
     if not existing.is_dir():
         return f"cannot be created: {existing} is a file, not a folder"
+    what = "written into" if existing == folder else "created"
     if not os.access(existing, os.W_OK | os.X_OK):
-        return (f"cannot be {'written into' if existing == folder else 'created'}: {existing} is not writable "
-                "(permissions or a read-only file system)")
+        return f"cannot be {what}: {existing} is not writable (permissions or a read-only file system)"
+    if os.statvfs(existing).f_blocks == 0:          # root may "write" there, but no file can be made
+        return f"cannot be {what}: {existing} is on a file system without storage (such as /proc or /sys)"
     return None
 
 

@@ -136,7 +136,7 @@ def test_check_several_files_fails_if_one_fails(tmp_path, capsys):
 
 def test_check_refuses_an_output_folder_run_cannot_create(tmp_path, capsys):
     """check said OK where run stopped at once ('cannot write into the output folder ...: Not a
-    directory'): a folder under a file, or in a folder without write permission."""
+    directory'): a folder under a file, in a folder without write permission, or in /proc."""
     (tmp_path / "notes.txt").write_text("mine")
     scene = BLOCK.replace('folder = "../results/block_on_flat"', 'folder = "notes.txt/run1"')
     assert main(["check", _write(tmp_path, scene)]) == 2
@@ -151,6 +151,9 @@ def test_check_refuses_an_output_folder_run_cannot_create(tmp_path, capsys):
     if os.geteuid() != 0:          # root writes anywhere
         assert code == 2 and f"cannot be created: {locked} is not writable" in err
     assert main(["check", _write(tmp_path, BLOCK.replace('"../results/block_on_flat"', '"new/deeper"'))]) == 0
+    if os.path.isdir("/proc") and os.statvfs("/proc").f_blocks == 0:     # root "may write" in /proc, in vain
+        assert main(["check", _write(tmp_path, BLOCK.replace('"../results/block_on_flat"', '"/proc/run1"'))]) == 2
+        assert "cannot be created: /proc is on a file system without storage" in capsys.readouterr().err
 
 
 @pytest.fixture
