@@ -14,6 +14,7 @@ their sums (``parts_of`` reads the parts recorded before).
 """
 from __future__ import annotations
 
+import dataclasses
 import datetime
 import functools
 import hashlib
@@ -32,7 +33,7 @@ from multiscale.io import replacing
 from multiscale.outputs import plan
 from multiscale.schema import (Choice, Curve, Either, FilePath, ListOf, Named, OnlyWith, Quantity, Section, TableOr,
                                Tables, fields_of)
-from multiscale.scene import EFFECTS, Scene
+from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE, Scene
 from multiscale.scene_geometry import FileGeometry, LengthUnit, Points
 
 RUNNING = "running (or killed: no end was recorded)"      # status of a run's first record
@@ -164,6 +165,12 @@ def resolved_toml(scene: Scene) -> str:
     head = ["# The scene as multiscale read it: every default filled in, SI units (unit in the comment).",
             f"# Read from {scene.source}" if scene.source else "# Read from text (no file)."]
     head += [f"# warning: {w}" for w in scene.warnings]
+    wear = scene.wear
+    if "wear" in scene.effects and wear is not None and wear.k_w is None and wear.k_w_table is None \
+            and not scene.rough_material_wears:       # the default k_w(T) table that runs, written out
+        scene = dataclasses.replace(scene, wear=dataclasses.replace(wear, k_w_table=FIG_7_9_WEAR_RATE))
+    if scene.wear is not None and scene.wear.k_w_table == FIG_7_9_WEAR_RATE:
+        head.append(f"# wear.k_w_table is the default table: {FIG_7_9_CALIBRATION}")
     return "\n".join(head + [""] + _emit(_table(Scene, scene))) + "\n"
 
 

@@ -22,7 +22,7 @@ from multiscale.cli import main
 from multiscale.outputs import FIELDS, MODE_ARRAYS, Plan, array_name, paraview_script, plan
 from multiscale import provenance
 from multiscale.provenance import resolved_toml
-from multiscale.scene import load, loads
+from multiscale.scene import FIG_7_9_WEAR_RATE, load, loads
 
 pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
@@ -313,6 +313,20 @@ def test_resolved_scene_loads_back_to_itself(path):
     again = loads(text, path.parent, name=scene.name)
     assert resolved_toml(again).splitlines()[2:] == text.splitlines()[2:]
     assert again.effects == scene.effects and again.output == scene.output and again.time == scene.time
+
+
+def test_the_default_wear_rate_table_is_written_out_in_the_resolved_scene():
+    """scene_resolved.toml ("every default filled in") left wear.k_w_table unset when the default
+    table of thesis Fig. 7.9 ran; a rough material's own k_w, which that table would override, stays
+    unwritten."""
+    scene = load(DEMOS / "pin_on_disc_thesis.toml")
+    text = resolved_toml(scene)
+    assert "# wear.k_w_table is the default table: shape of thesis Fig. 7.9" in text
+    again = loads(text, DEMOS, name=scene.name)
+    assert again.wear.k_w_table == FIG_7_9_WEAR_RATE and again.wear.rate == scene.wear.rate
+    pad = scene.geometry.spec.interface_materials(scene.rough_interfaces[0])[0]
+    own = load(DEMOS / "pin_on_disc_thesis.toml", {f"materials.{pad}.k_w": "1e-14 1/Pa"})
+    assert own.rough_material_wears and "k_w_table" not in resolved_toml(own)
 
 
 def test_a_temperature_column_of_the_resolved_scene_is_commented_in_kelvin():
