@@ -315,7 +315,35 @@ def test_map_bisects_the_onset_of_a_lock_in_branch_that_fails_the_mac_test(tmp_p
     assert [(o.kind, o.track) for o in smap.onsets] == [(BELOW, int(np.nanargmax(smap.growth[0])) + 1)]
     assert np.isnan(smap.onsets[0].value) and "below the sweep" in smap.summary()
     rows = smap.write_onsets_csv(tmp_path / "onsets.csv").read_text().splitlines()
-    assert rows[1].split(",")[1] == "" and rows[1].split(",")[-1] == "0.6"
+    assert rows[1].split(",")[1] == "" and rows[1].split(",")[6] == "0.6"       # unstable_value
+
+
+def test_a_band_of_instability_is_bisected_at_both_ends(tmp_path):
+    """K(v) = [[1 + v, m], [-m, 2 - v]], M = I: the squared frequencies are complex (flutter) for
+    |2 v - 1| < 2 m, unstable only for v in (0.5 - m, 0.5 + m). The summary said "stable again
+    between 0.5 and 0.65" (sampled; an NVH trial's 4.4 kHz pair); the end is now bisected as the
+    onset is, and written to onsets.csv and map.h5."""
+    m, values = 0.1, np.linspace(0.05, 0.95, 7)
+
+    def system(v):
+        return damped.LinearSystem(petsc_mat(np.array([[1.0 + v, m], [-m, 2.0 - v]])), petsc_mat(np.eye(2)))
+    sub = damped.Subspace([np.eye(2)], petsc_mat(np.eye(2)))
+    points = [damped.solve_projected(system(v), sub, band=(0.0, 1.0), expand=False) for v in values]
+    smap = build_map("friction", "-", values, [r for r, _ in points], [red for _, red in points], (0.0, 1.0),
+                     xtol=1e-9)
+    assert smap.unstable().any(axis=1).tolist() == [False, False, False, True, False, False, False]
+    assert len(smap.onsets) == 1 and smap.onsets[0].kind == "lock-in"
+    assert smap.onsets[0].value == pytest.approx(0.5 - m, rel=1e-6)
+    assert smap.onsets[0].end == pytest.approx(0.5 + m, rel=1e-6)
+    assert "; stable again at 0.6\n" in smap.summary() + "\n"
+    row = smap.write_onsets_csv(tmp_path / "onsets.csv").read_text().splitlines()
+    assert row[0].endswith(",stable_again_friction_-") and float(row[1].split(",")[-1]) == pytest.approx(0.6)
+    import h5py
+    with h5py.File(smap.write_h5(tmp_path / "map.h5"), "r") as f:
+        assert f["onsets/stable_again"][0] == pytest.approx(0.6) and f["onsets/stable_again"].attrs["unit"] == "-"
+    ends = build_map("friction", "-", values[:4], [r for r, _ in points[:4]], [red for _, red in points[:4]],
+                     (0.0, 1.0))
+    assert np.isnan(ends.onsets[0].end) and "stable again" not in ends.summary()     # unstable to the end
 
 
 def hoffmann_spectator_points(values, spectator=4.0, coupling=0.1):
@@ -518,19 +546,3 @@ def test_the_squeal_figures_compare_like_with_like(tmp_path, drawn):
     circled = [line for line in ax.get_lines() if line.get_markeredgecolor() == "r"]
     assert len(circled) == 1 and list(circled[0].get_xdata()) == [1500.0] and list(circled[0].get_ydata()) == [3.0]
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["brake", "unstable"]
-
-
-def test_a_track_that_turns_stable_again_says_so():
-    """A friction map's 4.4 kHz pair was unstable from 0.137 to about 0.23 only; the console said
-    its onset and nothing of its end, so a reader took it as unstable from 0.137 up (a user trial).
-    The summary now gives the sampled interval where it turns stable again."""
-    from multiscale.macro.stability_map import Onset, StabilityMap
-    values = np.array([0.1, 0.15, 0.2, 0.25, 0.3])
-    growth = np.array([[-0.0], [7.2], [8.1], [0.0], [0.0]])
-    smap = StabilityMap("friction", "-", values, np.full((5, 1), 4400.0), growth, np.ones((5, 1), int),
-                        np.ones((5, 1)), np.zeros((5, 1)),
-                        [Onset(1, 0.137, 4400.0, None, "negative damping", (0.1, 0.15))])
-    assert smap.summary().splitlines()[1] == ("    track 1: negative damping at friction = 0.137 (4400 Hz); stable "
-                                              "again between 0.2 and 0.25")
-    smap.growth[3:] = 5.0                                     # unstable to the end: nothing more said
-    assert smap.summary().splitlines()[1].endswith("(4400 Hz)")

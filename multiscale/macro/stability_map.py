@@ -24,7 +24,9 @@ projected on the same M-orthonormal basis V) and its modes in the band. ``build_
   "lock-in" when at the onset the two coalesced (frequency gap <= 0.1 %), "mode coupling" when
   damping holds them apart but the partner's growth rate fell while this one's rose, otherwise
   "negative damping" (e.g. the falling mu(v) of ``macro.friction``). A track unstable at the
-  first value is recorded as ``BELOW`` (its onset is not in the sweep; value NaN).
+  first value is recorded as ``BELOW`` (its onset is not in the sweep; value NaN);
+- finds where a track turns stable again between v_{k-1} and v_k and bisects that value the same
+  way, from the stable end (``Onset.end``: the unstable band of a mode that couples and uncouples).
 
 ``MapBuilder`` takes the points one by one (per-point bases: the caller projects the two
 neighbouring points on the union of their modes for the bisection); ``build_map`` runs it on
@@ -62,6 +64,7 @@ class Onset:
     partner: int | None          # track nearest in frequency at the first unstable point
     kind: str                    # "lock-in", "mode coupling" (damped), "negative damping" or BELOW
     bracket: tuple               # (stable value, unstable value) after the bisection
+    end: float = np.nan          # value where the track is stable again (bisected; NaN: not in the sweep)
 
 
 @dataclass
@@ -106,22 +109,14 @@ class StabilityMap:
                  + f", {int(bad.sum())} unstable somewhere; max residual {np.nanmax(self.residual):.1e}; "
                  f"{self.time:.1f} s"]
         for o in self.onsets:
+            again = f"; stable again at {o.end:.6g}" if np.isfinite(o.end) else ""
             if o.kind == BELOW:
                 lines.append(f"    track {o.track}: unstable at the first value already ({o.frequency:.0f} Hz): "
-                             f"its onset is below the sweep")
+                             f"its onset is below the sweep{again}")
                 continue
             lines.append(f"    track {o.track}: {o.kind} at {self.parameter} = {o.value:.6g} ({o.frequency:.0f} Hz"
-                         + (f", with track {o.partner})" if o.partner is not None else ")") + self.restabilised(o))
+                         + (f", with track {o.partner})" if o.partner is not None else ")") + again)
         return "\n".join(lines)
-
-    def restabilised(self, onset) -> str:
-        """"; stable again ..." where the track of ``onset`` is stable at a later point of the sweep
-        (between the last unstable point and that one; not bisected), else ""."""
-        bad, present = self.unstable()[:, onset.track - 1], self.mode[:, onset.track - 1] >= 0
-        after = np.flatnonzero(self.values > onset.value)
-        again = next((k for k in after if present[k] and not bad[k] and k > 0 and bad[k - 1]), None)
-        return "" if again is None else \
-            f"; stable again between {self.values[again - 1]:.6g} and {self.values[again]:.6g}"
 
     def write_csv(self, path) -> Path:
         """Mode-pairing table: point, value, track, mode, frequency, sigma, damping ratio,
@@ -146,10 +141,10 @@ class StabilityMap:
         with path.open("w", newline="") as f:
             w = csv.writer(f)
             w.writerow(["track", f"onset_{self.parameter}_{self.unit}", "frequency_Hz", "partner_track", "kind",
-                        "stable_value", "unstable_value"])
+                        "stable_value", "unstable_value", f"stable_again_{self.parameter}_{self.unit}"])
             for o in self.onsets:
                 w.writerow([o.track, _number(o.value), f"{o.frequency:.6f}", "" if o.partner is None else o.partner,
-                            o.kind, _number(o.bracket[0]), _number(o.bracket[1])])
+                            o.kind, _number(o.bracket[0]), _number(o.bracket[1]), _number(o.end)])
         return path
 
     def write_h5(self, path) -> Path:
@@ -168,7 +163,8 @@ class StabilityMap:
                       "partner": (np.array([-1 if o.partner is None else o.partner for o in self.onsets], int), "-"),
                       "kind": (np.array([o.kind for o in self.onsets], dtype=h5py.string_dtype()), "-"),
                       "stable_value": (np.array([o.bracket[0] for o in self.onsets], float), self.unit),
-                      "unstable_value": (np.array([o.bracket[1] for o in self.onsets], float), self.unit)}
+                      "unstable_value": (np.array([o.bracket[1] for o in self.onsets], float), self.unit),
+                      "stable_again": (np.array([o.end for o in self.onsets], float), self.unit)}
             for name, (data, unit) in onsets.items():
                 g[name] = data
                 g[name].attrs["unit"] = unit
@@ -237,11 +233,14 @@ class MapBuilder:
         self.prev: ModalResult | None = None
         self.n_tracks = 0
         self.new: set = set()                                # tracks that start at the last point
+        self.calmed: list = []        # (track, mode at the point before, mode at the last point): stable again
+        self.before: ModalResult | None = None               # the point before the last
 
     def add(self, value: float, result: ModalResult) -> list[tuple[int, int]]:
         """Pair ``result`` with the previous point; returns (track, mode index) of every mode that
         is unstable here and whose track was stable at the previous point or starts here (a
-        branch that failed the MAC test, e.g. at a lock-in)."""
+        branch that failed the MAC test, e.g. at a lock-in); ``calmed`` lists the tracks unstable
+        at the previous point and stable here (``end`` bisects where)."""
         value = float(value)
         if self.values and value <= self.values[-1]:
             raise InputError("stability.sweep", value, f"the values must increase (after {self.values[-1]:g})")
@@ -267,6 +266,8 @@ class MapBuilder:
                    for i, t in enumerate(self.rows[-1][0])}
             bad = _unstable(result.eigenvalues, self.rtol)
             turned = [(t, j) for j, t in enumerate(here) if bad[j] and not was.get(t, False)]
+            self.calmed = [(t, self.rows[-1][0].index(t), j) for j, t in enumerate(here) if not bad[j] and was.get(t)]
+        self.before = self.prev
         self.values.append(value)
         self.rows.append((here, mk, result.frequency.copy(), result.growth.copy(), result.errors.copy()))
         self.prev = result
@@ -299,6 +300,16 @@ class MapBuilder:
         self.onsets.append(found)
         return found
 
+    def end(self, track: int, i: int, lo: ReducedSystem, hi: ReducedSystem, q_ref: np.ndarray, gram) -> None:
+        """Bisect where ``track`` (mode i of the point before the last, unstable there, coordinates
+        ``q_ref`` in the basis of ``lo`` and ``hi``, the reduced systems at those two points) turns
+        stable again, from the stable end, and record it as the ``end`` of the track's last onset."""
+        value = bisect_onset(hi, lo, self.values[-1], self.values[-2], q_ref, self.before.eigenvalues[i], gram,
+                             self.band, rtol=self.rtol, xtol=self.xtol)[0]
+        onset = next((o for o in reversed(self.onsets) if o.track == track + 1), None)
+        if onset is not None:
+            onset.end = value
+
     def finish(self, *, basis_size: int = 0, time: float = 0.0, max_pressure: float = 0.0) -> StabilityMap:
         P, T = len(self.values), self.n_tracks
         out = {name: np.full((P, T), np.nan) for name in ("frequency", "growth", "mac", "residual")}
@@ -327,4 +338,6 @@ def build_map(parameter: str, unit: str, values: Sequence[float], results: Seque
         for track, j in builder.add(value, result):
             if onsets:
                 builder.onset(track, j, reduced[k - 1], reduced[k], result.modes[:, j], result.gram)
+        for track, i, _ in builder.calmed if onsets else ():
+            builder.end(track, i, reduced[k - 1], reduced[k], results[k - 1].modes[:, i], result.gram)
     return builder.finish(basis_size=basis_size, time=time)

@@ -138,12 +138,14 @@ def _common_basis(model: MapModel, builder: MapBuilder, st, options) -> int:
         for track, j in builder.add(value, result):
             if sw.onsets:
                 builder.onset(track, j, reduced[k - 1], reduced[k], result.modes[:, j], result.gram)
+        for track, i, _ in builder.calmed if sw.onsets else ():
+            builder.end(track, i, reduced[k - 1], reduced[k], results[k - 1].modes[:, i], result.gram)
     return sub.size
 
 
 def _per_point(model: MapModel, builder: MapBuilder, st, options) -> int:
-    """Every point preloaded and solved on its own; an onset is bisected on the two neighbouring
-    points projected on the union of their modes."""
+    """Every point preloaded and solved on its own; an onset (or a track's return to stability) is
+    bisected on the two neighbouring points projected on the union of their modes."""
     band, sw = tuple(st.band), st.sweep
     prev = None
     for value in sw.values:
@@ -151,12 +153,14 @@ def _per_point(model: MapModel, builder: MapBuilder, st, options) -> int:
         result = solve_system(lin.system, f_min=band[0], f_max=band[1], n_modes=st.modes, target=st.target,
                               method=options.method, basis=options.basis)
         turned = builder.add(value, result)
-        if turned and sw.onsets and prev is not None:
+        if (turned or builder.calmed) and sw.onsets and prev is not None:
             sub = Subspace([prev[1].modes, result.modes], lin.system.M, result.comm)
             lo, hi = project(prev[0], sub)[0], project(lin.system, sub)[0]
             MV = sub.apply(lin.system.M)
             for track, j in turned:
                 builder.onset(track, j, lo, hi, reduce_sum(MV.T @ result.modes[:, j], sub.comm), sub.gram)
+            for track, i, _ in builder.calmed:
+                builder.end(track, i, lo, hi, reduce_sum(MV.T @ prev[1].modes[:, i], sub.comm), sub.gram)
         if prev is not None:
             prev[0].K.destroy()
             _free(prev[2])
