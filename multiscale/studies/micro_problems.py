@@ -386,22 +386,28 @@ class ZoneLawParams(SurfaceParams):
     p_max: float = key(Quantity("pressure", gt=0), default=50e6)              # Pa, top law node
     law_points: int = key(Integer(ge=4), default=20)
     love: str = key(Choice(("average", "centre")), default="average")
-    reference_n: int | None = key(Integer(ge=8))
+    reference_n: int | None = key(Integer(ge=8), absent="n")
     tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)
+
+    def __post_init__(self):
+        """An absent ``reference_n`` is ``n``, in the run's record key and in its reference's cache key
+        (the reference of a sweep over n was cached without n: every n was judged against one)."""
+        if self.reference_n is None:
+            object.__setattr__(self, "reference_n", self.n)
 
     def problems(self, path, ctx):
         out = super().problems(path, ctx)
         where = f"{path}." if path else ""
         if any(self.n % z or self.n // z < 4 for z in self.zones):
             out.append(f"{where}zones = {list(self.zones)}: must divide n = {self.n} into zones of >= 4 x 4 cells")
-        if self.reference_n is not None and self.reference_n <= 2 * max(self.k_max):
+        if self.reference_n != self.n and self.reference_n <= 2 * max(self.k_max):
             out.append(f"{where}reference_n = {self.reference_n}: must exceed 2 k_max")
         return out
 
 
 def _zone_reference(p: ZoneLawParams) -> dict:
     """FFT-BEM of the whole (isolated) surface at the same approach on ``reference_n``."""
-    surface = rough_surface(replace(p, n=p.reference_n or p.n), periodic=False)
+    surface = rough_surface(replace(p, n=p.reference_n), periodic=False)
     r = ContactSolver(HalfSpace.from_materials(p.E, p.nu), surface.shape, surface.dx, periodic=False).solve(
         surface.heights, approach=p.approach, tol=p.tol)
     return {"mean_pressure": float(r.mean_pressure), "area_fraction": float(r.area_fraction)}
