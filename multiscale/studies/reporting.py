@@ -76,20 +76,22 @@ def _label_text(row: Row) -> str:
 def _cheapest_table(study, rows) -> list[str]:
     knobs = [k for k in study.knobs if k not in study.cases]
     head = ["error ≤"] + list(study.cases) + knobs + ["wall time [s]", "peak memory [MB]", "worst error", "time / base"]
+    samples = (f" over every sample of {', '.join(study.averaged)} (its wall time their mean)"
+               if study.averaged else "")
     lines = ["## What accuracy costs", "",
-             "The cheapest run (least wall time) whose worst error over the metrics meets each stated error; "
-             "'time / base' compares it with " + ("the reference run" if study.reference.kind == "run"
-                                                  else "the most expensive run") + ".", "",
+             f"The cheapest setting (least wall time) whose worst error over the metrics{samples} meets each "
+             "stated error; 'time / base' compares it with " + ("the reference run" if study.reference.kind == "run"
+                                                                else "the most expensive setting") + ".", "",
              "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for c in cheapest(study, rows):
-        r, base = c["row"], c["base"]
-        if r is None:
+        g, base = c["setting"], c["base"]
+        if g is None:
             cells = ["none of the runs"] + [""] * (len(knobs) + 3)
         else:
-            speed = r.record["wall_time"] / base.record["wall_time"] if base else math.nan
-            cells = [r.run.shown[k] for k in knobs] + [f"{r.record['wall_time']:.3g}", _memory(r.record),
-                                                                percent(r.max_error), f"{speed:.2g}"]
-            if r.is_reference:
+            speed = g.wall_time / base.wall_time if base else math.nan
+            cells = [g.shown(study, k) for k in knobs] + [f"{g.wall_time:.3g}", _memory(g.record("peak_memory_mb")),
+                                                           percent(g.max_error), f"{speed:.2g}"]
+            if g.is_reference:
                 cells[-1] += " (only the reference)"
         lines.append("| " + " | ".join([percent(c["error"]), *c["case"], *cells]) + " |")
     return lines + [""]
@@ -160,10 +162,10 @@ def write_index(summaries, folder: Path, command: str) -> Path:
         for tol in study.report.errors:
             cells = [percent(tol)]
             for c in (c for c in found if c["error"] == tol):
-                r = c["row"]
-                cells.append("none" if r is None else ", ".join(
-                    f"{k} = {r.run.shown[k]}" for k in study.knobs if k not in study.cases)
-                    + f" ({r.record['wall_time']:.3g} s, {percent(r.max_error)})" + (" (the reference)" * r.is_reference))
+                g = c["setting"]
+                cells.append("none" if g is None else ", ".join(
+                    f"{k} = {g.shown(study, k)}" for k in study.knobs if k not in study.cases)
+                    + f" ({g.wall_time:.3g} s, {percent(g.max_error)})" + (" (the reference)" * g.is_reference))
             lines.append("| " + " | ".join(cells) + " |")
         lines.append("")
     path = folder / "README.md"

@@ -16,7 +16,8 @@ from multiscale.studies.formatting import value_text
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.records import read_records
 
-__all__ = ["Row", "case_key", "cheapest", "collect", "pareto", "reference_text", "relative_error", "write_tables"]
+__all__ = ["Row", "Setting", "case_key", "cheapest", "collect", "pareto", "reference_text", "relative_error",
+           "write_tables"]
 
 
 @dataclass
@@ -38,6 +39,37 @@ class Row:
     def max_error(self) -> float:
         values = list(self.errors.values())
         return max(values) if values and all(math.isfinite(v) for v in values) else math.nan
+
+
+@dataclass
+class Setting:
+    """The runs of one setting of a case: equal in every knob but those averaged over (seeds), one
+    run when nothing is averaged."""
+
+    rows: list
+
+    @property
+    def wall_time(self) -> float:
+        """Mean wall time [s] of its runs."""
+        return float(np.mean([r.record["wall_time"] for r in self.rows]))
+
+    @property
+    def max_error(self) -> float:
+        """Worst error over the metrics and the runs; NaN if a run failed or has no error."""
+        errors = [r.max_error if r.ok else math.nan for r in self.rows]
+        return max(errors) if all(math.isfinite(e) for e in errors) else math.nan
+
+    @property
+    def is_reference(self) -> bool:
+        return any(r.is_reference for r in self.rows)
+
+    def shown(self, study: Study, knob: str) -> str:
+        """The knob's value as the study wrote it; of an averaged knob, how many samples."""
+        return f"{len(self.rows)} samples" if knob in study.averaged else self.rows[0].run.shown[knob]
+
+    def record(self, name: str) -> dict:
+        """The record of its most expensive run in ``name`` ("peak_memory_mb": the largest)."""
+        return max((r.record for r in self.rows), key=lambda rec: rec.get(name, -math.inf))
 
 
 def relative_error(value: float, ref: float) -> float:
@@ -151,18 +183,24 @@ def case_key(study: Study, row: Row) -> tuple:
 
 
 def cheapest(study: Study, rows: list[Row]) -> list[dict]:
-    """Per stated error and case: the run of least wall time whose worst error meets it."""
-    out = []
+    """Per stated error and case: the ``Setting`` of least mean wall time whose worst error, over the
+    metrics and the samples averaged over (``report.average_over``: every seed, not one lucky
+    seed), meets it ("setting"), and the base it is compared with ("base": the reference runs, else
+    the most expensive setting)."""
+    out, chosen = [], [k for k in study.knobs if k not in study.cases and k not in study.averaged]
     cases = list(dict.fromkeys(case_key(study, r) for r in rows))
-    for tol in study.report.errors:
-        for case in cases:
-            pool = [r for r in rows if r.ok and case_key(study, r) == case]
-            good = [r for r in pool if math.isfinite(r.max_error) and r.max_error <= tol]
-            best = min(good, key=lambda r: r.record["wall_time"]) if good else None
-            refs = [r for r in pool if r.is_reference]
-            base = refs[0] if refs else (max(pool, key=lambda r: r.record["wall_time"]) if pool else None)
-            out.append({"error": tol, "case": case, "row": best, "base": base})
-    return out
+    for case in cases:
+        groups = {}
+        for r in (r for r in rows if case_key(study, r) == case):
+            groups.setdefault(tuple(r.run.shown[k] for k in chosen), []).append(r)
+        settings = [Setting(g) for g in groups.values() if all(r.ok for r in g)]
+        refs = [r for g in settings for r in g.rows if r.is_reference]
+        base = Setting(refs) if refs else max(settings, key=lambda g: g.wall_time, default=None)
+        for tol in study.report.errors:
+            good = [g for g in settings if g.max_error <= tol]
+            out.append({"error": tol, "case": case, "setting": min(good, key=lambda g: g.wall_time, default=None),
+                        "base": base})
+    return sorted(out, key=lambda c: study.report.errors.index(c["error"]))
 
 
 def pareto(times, errors) -> list[int]:
