@@ -80,6 +80,12 @@ def test_hertz_study_errors_match_an_independent_computation(hertz_study):
     for row in rows:
         assert row["status"] == "ok" and row["converged"] == "True"
         assert float(row["wall_time"]) > 0 and float(row["peak_memory_mb"]) > 10 and int(row["iterations"]) > 0
+        # the first timing of a fresh process holds numba's loading of its compiled code (~1 s against
+        # a solve of ~0.01 s: grid 32 was reported at 14.9 s, 1.0-1.9 s the others; a user trial):
+        # such a run is timed once more, and the best time kept
+        record = json.loads((out / "runs" / f"{row['run']}.json").read_text())
+        assert record["jit_time"] > 0.05 * record["wall_times"][0] and len(record["wall_times"]) == 2
+        assert record["wall_time"] == min(record["wall_times"]) == record["wall_times"][1]
         mine = hertz_independent(int(row["grid"]))
         for m, err in mine.items():
             assert float(row[f"{m}_error"]) == pytest.approx(err, rel=1e-6, abs=1e-12)
@@ -275,6 +281,16 @@ average_over = ["seed"]
     assert {c["error"]: c["setting"] for c in cheapest(study, rows)}[0.5].rows[0].run.shown["model"] != "circular"
 
 
+def test_a_sweep_of_too_many_runs_is_refused_before_it_is_made(tmp_path):
+    """Two ranges within the 10 000-value cap each made 10 M runs: the expansion ran silently for
+    minutes at 1 GB (a user trial). The product is counted first."""
+    path = write(tmp_path, HERTZ.replace("grid = [12, 16, 24, 32]",
+                                         'grid = {start = 8, stop = 2000, step = 1}\nmax_iter = {start = 1, stop = '
+                                         '5000, step = 1}'))
+    with pytest.raises(SceneError, match=r"sweep: the sweep makes 9,965,000 runs or more, over 100,000"):
+        load_study(path)
+
+
 def test_study_command_errors_are_one_line(tmp_path, capsys):
     """A reference file with unit strings says a number is expected (it said 'no number for metric
     "contact_radius" (did you mean "contact_radius"?)'); --processes 0 is refused (it hung); a
@@ -366,6 +382,34 @@ effects = ["contact", "thermal"]
 """)
     runs = load_study(path).runs
     assert [r.raw["time.initial_temperature"] for r in runs] == ["293.15 K", "333.15 K", "373.15 K"]
+
+
+def test_a_range_with_whole_bounds_keeps_its_fractional_values(tmp_path):
+    """{start = 0, stop = 1, num = 11} of a scene's friction gave the two runs 0 and 1, and
+    {start = 3, stop = 10, num = 50} of hertz's (real) window the eight 3 ... 10: whole bounds were
+    taken for an integer range (a user trial). An integer parameter, or a scene key whose values
+    are all whole, still gets integers."""
+    (tmp_path / "scene.toml").write_text((ROOT / "demos" / "block_on_flat.toml").read_text())
+    scene = write(tmp_path, """
+problem = "scene"
+scene = "scene.toml"
+metrics = ["max_pressure"]
+[[sweep]]
+"loading.friction" = {start = 0, stop = 1, num = 11}
+[[sweep]]
+"time.steps" = {start = 1, stop = 7, num = 4}
+""", "scene_study.toml")
+    labels = [r.label for r in load_study(scene).runs]
+    assert sorted({x["loading.friction"] for x in labels}) == pytest.approx([i / 10 for i in range(11)])
+    assert sorted({x["time.steps"] for x in labels}) == [1, 3, 5, 7]
+    assert all(isinstance(x["time.steps"], int) for x in labels)
+    one = {r.key for r in load_study(scene).runs}          # ranks name the runs (2 reused the times of 1)
+    scene.write_text(scene.read_text() + "[run]\nranks = 2\n")
+    assert not one & {r.key for r in load_study(scene).runs}
+    window = write(tmp_path, HERTZ.replace("grid = [12, 16, 24, 32]", "window = {start = 3, stop = 10, num = 50}\n"
+                                           "grid = {start = 12, stop = 30, num = 4}"), "hertz.toml")
+    labels = [r.label for r in load_study(window).runs]
+    assert len({x["window"] for x in labels}) == 50 and sorted({x["grid"] for x in labels}) == [12, 18, 24, 30]
 
 
 def test_pareto_front():

@@ -34,7 +34,7 @@ metrics when read: a misspelt history metric, corrected, is read from the same r
 
 Output: ``results.csv`` and ``results.h5`` (one row per run), PNGs of each metric's relative error
 |m − m_ref| / |m_ref| against wall time (Pareto front highlighted) and against each knob, and a
-Markdown report stating the cheapest run meeting each stated error.
+Markdown report stating the cheapest setting meeting each stated error.
 
 Modules, in import order: ``spec`` (the file schema), ``problems`` (the registry; ``base``,
 ``micro_problems``, ``scene_problem``), ``expand`` (validation, runs), ``records`` (run records on

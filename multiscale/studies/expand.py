@@ -17,7 +17,9 @@ from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.spec import RANGE_KEYS, ReportOptions, Reference, RunOptions, StudyFile, is_range
 from multiscale.units import KINDS, VALUE, UnitError, parse_unit
 
-__all__ = ["Study", "StudyRun", "load_study", "normalise", "parser_of", "reference_run"]
+__all__ = ["MAX_RUNS", "Study", "StudyRun", "load_study", "normalise", "parser_of", "reference_run"]
+
+MAX_RUNS = 100_000        # runs a study may make (a range may give 10 000 values)
 
 
 @dataclass(frozen=True)
@@ -137,7 +139,7 @@ def _expand_groups(f: StudyFile, problem, ctx):
                 parser_of(problem, name).parser(value, ctx)
             except Bad as exc:
                 ctx.problems.append(f"fixed.{name} = {show(value)}: {exc}")
-    knobs, groups, lines, axes = [], [], [], []
+    knobs, groups, lines, axes, total = [], [], [], [], 1
     single = len(f.sweep) == 1
     for i, group in enumerate(f.sweep, 1):
         path = "sweep" if single else f"sweep[{i}]"
@@ -167,6 +169,11 @@ def _expand_groups(f: StudyFile, problem, ctx):
                 knobs.append(name)
         if len(lists) != len(params):
             continue
+        total *= len(next(iter(lists.values()))) if combine == "zip" else math.prod(map(len, lists.values()))
+        if total > MAX_RUNS:      # counted before the runs are made: 10 M runs expanded for 35 min, silent
+            ctx.problems.append(f"{path}: the sweep makes {total:,} runs or more, over {MAX_RUNS:,}: sweep fewer "
+                                "values or split the study")
+            break
         if combine == "zip":
             sizes = {k: len(v) for k, v in lists.items()}
             if len(set(sizes.values())) > 1:
@@ -237,8 +244,6 @@ def _range(spec: dict, where, parser, ctx) -> list | None:
     except (Bad, UnitError) as exc:
         ctx.problems.append(f"{text}: {exc}")
         return None
-    integer = (parser is not None and isinstance(parser.parser, Integer)) or \
-        all(isinstance(spec[k], int) and not isinstance(spec[k], bool) for k in ("start", "stop", "step") if k in spec)
     num = spec.get("num")
     if num is not None and (isinstance(num, bool) or not isinstance(num, int) or num < 1):
         ctx.problems.append(f"{text}: num must be an integer >= 1")
@@ -261,7 +266,11 @@ def _range(spec: dict, where, parser, ctx) -> list | None:
         values = [start * (stop / start) ** (i / (num - 1)) for i in range(num)]
     else:
         values = [start + (stop - start) * i / (num - 1) for i in range(num)]
-    if integer:
+    # whole numbers for an integer parameter (rounded), or for a scene key (no parser) given whole
+    # bounds whose values are all whole; {start = 0, stop = 1, num = 11} of a friction gave [0, 1]
+    if (parser is not None and isinstance(parser.parser, Integer)) or parser is None and all(
+            isinstance(spec[k], int) and not isinstance(spec[k], bool) for k in ("start", "stop", "step") if k in spec) \
+            and all(float(v).is_integer() for v in values):
         values = list(dict.fromkeys(int(round(v)) for v in values))
     else:
         values = [f"{v:.12g} K" if kelvin else float(f"{v:.12g}") for v in values]

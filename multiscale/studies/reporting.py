@@ -12,6 +12,7 @@ from multiscale.studies.expand import Study
 from multiscale.studies.formatting import metric_heading, now, number_text, percent, value_text
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.results import Row, cheapest, reference_text
+from multiscale.studies.worker import JIT_SHARE
 
 __all__ = ["report", "write_index"]
 
@@ -38,8 +39,10 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
               + ("; error = |m − m_ref| / |m_ref|" if study.reference else ""),
               f"- Runs: {len(ok)} ok, {len(failed)} failed; {sum(r.record.get('wall_time', 0) for r in rows):.1f} s "
               f"of run wall time in all (failed runs included). Wall time: best of {_repeats(ok)} "
-              "repetition(s) in a fresh process (one thread); peak memory: the run process's maximum resident set (interpreter and "
-              "libraries included; in brackets what the run added to the process's baseline).",
+              f"repetition(s) in a fresh process ({_processes(study)}; a run whose first timing spent over "
+              f"{JIT_SHARE:.0%} of it loading or compiling numba code is timed once more); peak memory: the largest "
+              "process's maximum resident set (interpreter and libraries included; in brackets what the run added "
+              "to the process's baseline).",
               f"- Generated {now()} on a {os.cpu_count()}-core machine by `{command or 'multiscale study ' + study.source.name}`.",
               ""]
     if study.reference is not None and ok:
@@ -54,6 +57,12 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
     path = folder / f"{study.name}.md"
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+def _processes(study: Study) -> str:
+    """How the runs ran: one thread, or a scene on its ranks."""
+    ranks = study.options.ranks if study.problem == "scene" else 1
+    return "one thread" if ranks == 1 else f"{ranks} MPI ranks of one thread each"
 
 
 def _repeats(rows) -> str:

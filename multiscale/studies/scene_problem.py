@@ -98,12 +98,14 @@ class SceneProblem(Problem):
         return SceneRun(Path(scene), dict(raw), ranks, tuple(sorted(p for p in loaded.inputs if p != own)))
 
     def key(self, params: SceneRun) -> dict:
-        """The scene's path and bytes, the overrides and the bytes of the files it reads (a CAD file
-        or measured surface rewritten under its name makes new runs; its old records were reused)."""
+        """The scene's path and bytes, the overrides, the bytes of the files it reads (a CAD file
+        or measured surface rewritten under its name makes new runs; its old records were reused)
+        and the ranks above one (a study at 2 ranks reused the times of 1)."""
         text = params.scene.read_bytes()
         files = {str(p): file_digest(p) for p in params.files if p.is_file()}
         return {"scene": str(params.scene), "scene_sha256": hashlib.sha256(text).hexdigest(),
-                "overrides": jsonable(params.overrides), **({"files": files} if files else {})}
+                "overrides": jsonable(params.overrides), **({"files": files} if files else {}),
+                **({"ranks": params.ranks} if params.ranks > 1 else {})}
 
     def metric_unit(self, name: str) -> str:
         """A squeal metric's unit (``SQUEAL_METRICS``), else its history column's (``io.unit_of``)."""

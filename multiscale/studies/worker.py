@@ -1,7 +1,10 @@
 """One study run in this fresh process: ``python -m multiscale.studies.worker TASK_JSON [LIFELINE]``,
 spawned by ``running.execute``. Parses the run's parameters, runs it ``repeat`` times and writes its
 record; a failure is recorded, never raised. The problem modules (and the numba-compiled micro
-modules they import) are loaded with this module, before the run's clock and memory baseline.
+modules they import) are loaded with this module, before the run's clock and memory baseline; the
+compiled code itself numba loads from its cache (or compiles) at a function's first call, inside
+the first timing: 1.1-1.4 s measured against a 0.015 s Hertz solve on 64^2. A run whose first
+timing spent more than ``JIT_SHARE`` of it there is timed once more (``jit_time`` in the record).
 ``LIFELINE``: a file descriptor the driver passed on (``running._lifeline``); when the driver is
 gone, ``watch_driver`` ends this worker and its process group."""
 from __future__ import annotations
@@ -18,6 +21,9 @@ import time
 import traceback
 from pathlib import Path
 
+import numpy as np
+from numba.core import event
+
 import multiscale
 from multiscale.errors import SceneError
 from multiscale.schema import Context
@@ -25,7 +31,9 @@ from multiscale.studies.formatting import now
 from multiscale.studies.problems import problem as get_problem
 from multiscale.studies.records import FAILED, metric_problem, write_json
 
-__all__ = ["run_task", "watch_driver"]
+__all__ = ["JIT_SHARE", "run_task", "watch_driver"]
+
+JIT_SHARE = 0.05      # a first timing with more than this share in numba's compiler is timed again
 
 
 def _peak_mb() -> float:
@@ -87,12 +95,14 @@ def run_task(task: dict) -> int:
         record["params"] = problem.key(params)
         workdir = Path(task["workdir"])
         record["base_memory_mb"] = _peak_mb()
-        times, cpu0 = [], _cpu()
-        for _ in range(task["repeat"]):
-            t0 = time.perf_counter()
-            outcome = problem.run(params, workdir)
-            times.append(time.perf_counter() - t0)
-        record.update(wall_time=min(times), wall_times=times, cpu_time=(_cpu() - cpu0) / len(times),
+        jit = [0.0]                                  # s in numba's compiler (cache loads included)
+        with event.install_timer("numba:compiler_lock", lambda dt: jit.__setitem__(0, jit[0] + dt)):
+            timings = [_timed(problem, params, workdir)]
+        runs = task["repeat"] + (jit[0] > JIT_SHARE * timings[0][0])     # the first one again
+        timings += [_timed(problem, params, workdir) for _ in range(runs - 1)]
+        times, cpus, outcome = [t[0] for t in timings], [t[1] for t in timings], timings[-1][2]
+        best = int(np.argmin(times))
+        record.update(wall_time=times[best], wall_times=times, cpu_time=cpus[best], jit_time=jit[0],
                       peak_memory_mb=_peak_mb(), iterations=int(outcome.iterations),
                       converged=bool(outcome.converged))
         record["metrics"] = {k: float(v) for k, v in outcome.metrics.items()}
@@ -108,6 +118,13 @@ def run_task(task: dict) -> int:
     record.setdefault("peak_memory_mb", _peak_mb())
     write_json(Path(task["record"]), record)
     return 0
+
+
+def _timed(problem, params, workdir) -> tuple:
+    """(wall time [s], CPU time [s], outcome) of one run."""
+    t0, c0 = time.perf_counter(), _cpu()
+    outcome = problem.run(params, workdir)
+    return time.perf_counter() - t0, _cpu() - c0, outcome
 
 
 def _exact(problem, params, folder: Path) -> dict:
