@@ -214,10 +214,9 @@ class ContactSolver:
         B = int(np.prod(batch, dtype=int))
         size = max(1, CHUNK_CELLS[method] // (grid[0] * grid[1]))
         z = np.ascontiguousarray(np.reshape(z, (B,) + grid))
-        target = None if target is None else np.ascontiguousarray(np.reshape(target, B), dtype=float)
-        delta = None if delta is None else np.ascontiguousarray(np.reshape(delta, B), dtype=float)
+        target, delta, upper = (None if a is None else _writable(np.ascontiguousarray(np.reshape(a, B), dtype=float))
+                                for a in (target, delta, upper))
         p0 = None if p0 is None else np.reshape(p0, (B,) + grid)
-        upper = None if upper is None else np.ascontiguousarray(np.reshape(upper, B), dtype=float)
         threads = get_threads() if threads is None else threads
         workers = max(1, min(threads, B // size))   # one contiguous part of the batch per thread
         inner = 1 if workers > 1 else threads       # FFT threads of a part and of its nested start
@@ -419,6 +418,14 @@ def _method(method) -> str:
     if not isinstance(method, str) or method not in METHODS:
         raise InputError("method", method, f"choose one of {', '.join(METHODS)}")
     return method
+
+
+def _writable(a: np.ndarray) -> np.ndarray:
+    """``a``, or a copy of it if it is read-only (``_batch_values`` gives read-only views): the
+    compiled kernels take these per-patch values, and numba compiles every kernel once more for a
+    read-only argument (the same machine code: 16 extra compilations, ~1-2 s each, on a fresh
+    cache; the copy holds B numbers)."""
+    return a if a.flags.writeable else a.copy()
 
 
 def _batch_values(name: str, value, shape) -> np.ndarray:
