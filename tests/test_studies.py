@@ -281,6 +281,17 @@ average_over = ["seed"]
     assert {c["error"]: c["setting"] for c in cheapest(study, rows)}[0.5].rows[0].run.shown["model"] != "circular"
 
 
+def test_a_knob_that_changes_nothing_gets_its_report(tmp_path, capsys):
+    """Errors 0 in every run (the metric does not depend on the knob) made the knob figure's log
+    axis raise: no Markdown report, a matplotlib traceback (a user trial)."""
+    path = write(tmp_path, HERTZ.replace("grid = [12, 16, 24, 32]", "max_iter = [3000, 5000]").replace(
+        'kind = "analytic"', 'kind = "run"\nrun = {max_iter = 5000}').replace("[fixed]", "[fixed]\ngrid = 12"))
+    assert main(["study", str(path)]) == 0, capsys.readouterr().err
+    assert all(float(r["max_error"]) == 0 for r in table(tmp_path / "results" / "hertz" / "results.csv"))
+    assert (tmp_path / "results" / "hertz" / "hertz.md").is_file()
+    assert (tmp_path / "results" / "hertz" / "hertz_max_iter.png").stat().st_size > 5000
+
+
 def test_a_sweep_of_too_many_runs_is_refused_before_it_is_made(tmp_path):
     """Two ranges within the 10 000-value cap each made 10 M runs: the expansion ran silently for
     minutes at 1 GB (a user trial). The product is counted first."""

@@ -15,7 +15,7 @@ from matplotlib.ticker import FuncFormatter, NullFormatter
 from multiscale.studies.expand import Study, StudyRun
 from multiscale.studies.formatting import metric_heading, percent, value_text
 from multiscale.studies.problems import PROBLEMS
-from multiscale.studies.results import Row, case_key, pareto
+from multiscale.studies.results import Row, case_key, pareto, sample_std
 
 __all__ = ["plot"]
 
@@ -140,14 +140,18 @@ def _plot_axis(study, ok, axis, folder):
             mean = np.array([np.mean(pts[v]) for v in x])
             label = ", ".join(f"{k} = {v}" for k, v in zip(others, other)) if others else None
             if averaged and kind != "error":
-                std = np.array([np.std(pts[v]) for v in x])
+                std = np.array([sample_std(pts[v]) for v in x])
                 ax.errorbar(x, mean, yerr=std, marker="o", ms=4, color=f"C{c % 10}", capsize=3, label=label)
             else:
                 ax.plot(x, mean, "o-", ms=4, color=f"C{c % 10}", label=label)
         if kind == "error":
+            if any(np.isfinite(np.asarray(line.get_ydata(), float)).any() for line in ax.get_lines()):
+                ax.set_yscale("log")
+            else:            # a metric the knob does not change: no error to draw on a log axis (it raised)
+                ax.text(0.5, 0.5, "error 0 in every run:\nequal to the reference", transform=ax.transAxes,
+                        ha="center", va="center")
             for tol in study.report.errors:
                 ax.axhline(tol, color="gray", ls="--", lw=0.8)
-            ax.set_yscale("log")
         if kind == "time":
             ax.set_yscale("log")
         value = metric_heading(m, PROBLEMS[study.problem].metric_unit(m)) if kind == "value" else ""
@@ -165,7 +169,7 @@ def _plot_axis(study, ok, axis, folder):
         if others and len(lines) <= 8:
             ax.legend(fontsize=6)
     fig.suptitle(f"{study.name}: {' and '.join(study.metrics)} and wall time against {' / '.join(axis)}"
-                 + (f" (mean ± std over {', '.join(averaged)})" if averaged else ""))
+                 + (f" (mean ± sample std over {', '.join(averaged)})" if averaged else ""))
     fig.tight_layout()
     path = folder / f"{study.name}_{axis[0].replace('.', '_')}.png"
     fig.savefig(path, dpi=100)

@@ -11,7 +11,7 @@ import numpy as np
 from multiscale.studies.expand import Study
 from multiscale.studies.formatting import metric_heading, now, number_text, percent, value_text
 from multiscale.studies.problems import PROBLEMS
-from multiscale.studies.results import Row, cheapest, reference_text
+from multiscale.studies.results import Row, cheapest, reference_text, sample_std
 from multiscale.studies.worker import JIT_SHARE
 
 __all__ = ["report", "write_index"]
@@ -112,14 +112,14 @@ def _average_table(study, rows) -> list[str]:
     for r in rows:
         groups.setdefault(tuple(r.run.shown[k] for k in keep), []).append(r)
     unit = PROBLEMS[study.problem].metric_unit
-    head = keep + [f"{metric_heading(m, unit(m))} mean ± std (min … max)" for m in study.metrics] + ["samples"]
+    head = keep + [f"{metric_heading(m, unit(m))} mean ± sample std (min … max)" for m in study.metrics] + ["samples"]
     lines = [f"## Averaged over {', '.join(study.averaged)}", "",
              "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for label, group in groups.items():
         cells = list(label)
         for m in study.metrics:
             v = np.array([r.record["metrics"][m] for r in group])
-            cells.append(f"{v.mean():.4g} ± {v.std():.2g} ({v.min():.4g} … {v.max():.4g})")
+            cells.append(f"{v.mean():.4g} ± {sample_std(v):.2g} ({v.min():.4g} … {v.max():.4g})")
         lines.append("| " + " | ".join(cells + [str(len(group))]) + " |")
     return lines + [""]
 

@@ -17,7 +17,7 @@ from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.records import read_records
 
 __all__ = ["Row", "Setting", "case_key", "cheapest", "collect", "pareto", "reference_text", "relative_error",
-           "write_tables"]
+           "sample_std", "write_tables"]
 
 
 @dataclass
@@ -201,6 +201,11 @@ def cheapest(study: Study, rows: list[Row]) -> list[dict]:
             out.append({"error": tol, "case": case, "setting": min(good, key=lambda g: g.wall_time, default=None),
                         "base": base})
     return sorted(out, key=lambda c: study.report.errors.index(c["error"]))
+
+
+def sample_std(values) -> float:
+    """The sample standard deviation (n − 1 in the denominator) of ``values``; 0 for one value."""
+    return float(np.std(values, ddof=1)) if len(values) > 1 else 0.0
 
 
 def pareto(times, errors) -> list[int]:
