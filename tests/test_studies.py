@@ -101,6 +101,9 @@ def test_hertz_study_errors_match_an_independent_computation(hertz_study):
     # the runs table names each metric's unit (from the problem's description of it)
     assert "| grid | contact_radius [m] | error | max_pressure [Pa] | error | approach [m] | error |" in text
     assert f"4 ok, 0 failed; {sum(time.values()):.1f} s of run wall time in all (failed runs included)" in text
+    # the code that made the runs (a record is reused across code changes: the report says which)
+    from multiscale.provenance import code
+    assert f"- Code: package SHA-1 {code()['sha1'][:12]}" in text and {r["code"] for r in rows} == {code()["sha1"][:12]}
     for tol, shown in ((0.01, "| 1 % |"), (0.05, "| 5 % |")):
         good = [g for g in GRIDS if worst[g] <= tol]
         line = next(line for line in text.splitlines() if line.startswith(shown))
@@ -151,6 +154,11 @@ def test_runs_timed_fewer_times_than_asked_run_again_and_the_report_says_how_oft
     path.write_text(study + "plots = false\n")
     assert main(["study", str(path)]) == 0
     assert "2 recorded before, 0 run now" in capsys.readouterr().out and "best of 2 repetition(s)" in report.read_text()
+    # a record of other code is reused; the report says so (it said nothing: a user trial)
+    record = json.loads(runs[0].read_text())
+    runs[0].write_text(json.dumps({**record, "code": {"sha1": "0" * 40}}))
+    assert main(["study", str(path)]) == 0
+    assert "**the runs were made by 2 versions of the package** (SHA-1 " in report.read_text()
 
 
 def test_the_error_figure_draws_the_pareto_front_of_each_case(tmp_path, monkeypatch):

@@ -43,6 +43,7 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
               f"{JIT_SHARE:.0%} of it loading or compiling numba code is timed once more); peak memory: the largest "
               "process's maximum resident set (interpreter and libraries included; in brackets what the run added "
               "to the process's baseline).",
+              _code_line(rows),
               f"- Generated {now()} on a {os.cpu_count()}-core machine by `{command or 'multiscale study ' + study.source.name}`.",
               ""]
     if study.reference is not None and ok:
@@ -57,6 +58,23 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
     path = folder / f"{study.name}.md"
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+def _code_line(rows) -> str:
+    """Which code made the runs (their records' SHA-1 of the package): a record is reused whatever
+    code made it, so a table of several versions says so."""
+    versions = {}
+    for r in rows:
+        if "ran" in r.record:
+            made = r.record.get("code") or {}
+            versions.setdefault(made.get("sha1", "not recorded")[:12], made.get("commit", "")[:12])
+    if not versions:
+        return "- Code: no run recorded"
+    if len(versions) == 1:
+        return "- Code: " + ", ".join(f"package SHA-1 {s}" + (f" (commit {c})" if c else "") for s, c in versions.items())
+    return (f"- Code: **the runs were made by {len(versions)} versions of the package** (SHA-1 "
+            f"{', '.join(versions)}; column `code` of results.csv): a record is reused whatever code made it; "
+            "delete the records of runs/ to run them again with this code.")
 
 
 def _processes(study: Study) -> str:

@@ -26,6 +26,7 @@ from numba.core import event
 
 import multiscale
 from multiscale.errors import SceneError
+from multiscale.provenance import code
 from multiscale.schema import Context
 from multiscale.studies.formatting import now
 from multiscale.studies.problems import problem as get_problem
@@ -84,7 +85,7 @@ def run_task(task: dict) -> int:
     """One run in this (fresh) process: parse, run ``repeat`` times, write the record."""
     record = {"key": task["key"], "problem": task["problem"], "label": task["label"], "status": FAILED,
               "metrics": {}, "started": now(), "repeat": task["repeat"], "python": platform.python_version(),
-              "multiscale": multiscale.__version__, "cpus": os.cpu_count(), "rank": task["rank"]}
+              "multiscale": multiscale.__version__, "code": code(), "cpus": os.cpu_count(), "rank": task["rank"]}
     try:
         problem = get_problem(task["problem"])
         ctx = Context(directory=Path(task["directory"]))
