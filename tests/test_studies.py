@@ -595,6 +595,7 @@ plots = false
     assert row["status"] == "failed"
     assert ('metric "interface_forc:last" not produced (did you mean "interface_force:last"?) (fix the name: the '
             'runs need not run again)' in row["message"])
+    assert "in all: the run's record lists them)" in row["message"] and len(row["message"]) < 800    # not ~180 names
     path.write_text(path.read_text().replace("interface_forc:", "interface_force:"))
     capsys.readouterr()
     assert main(["study", str(path)]) == 0

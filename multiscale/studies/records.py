@@ -15,6 +15,7 @@ from multiscale.studies.expand import Study, StudyRun
 __all__ = ["FAILED", "foreign_records", "json_default", "metric_problem", "read_records", "record_path", "write_json"]
 
 FAILED = "failed"              # a record's status when the run did not produce its metrics
+MAX_LISTED = 12                # metrics named in the message of a run that lacks one
 
 
 def record_path(study: Study, run: StudyRun) -> Path:
@@ -27,9 +28,11 @@ def metric_problem(metrics: dict, names) -> str | None:
     for name in names:
         if name not in metrics:
             hint = suggest(name, metrics)     # a misspelt name: fix it, the records are judged on read
+            names = sorted(metrics)           # a scene's history: ~180 names, in every failed run's line
+            shown = ", ".join(names[:MAX_LISTED]) + (f", ... ({len(names)} in all: the run's record lists them)"
+                                                    if len(names) > MAX_LISTED else "")
             return (f'metric "{name}" not produced' + (hint + " (fix the name: the runs need not run again)" if hint
-                    else " (a run older than the metric: --rerun-failed recomputes it)")
-                    + f'; available: {", ".join(sorted(metrics))}')
+                    else " (a run older than the metric: --rerun-failed recomputes it)") + f"; available: {shown}")
         value = metrics[name]
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             return f'metric "{name}" is {value!r} (not a number)'
