@@ -16,7 +16,7 @@ from multiscale.errors import SceneError
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.surface import fractal_surface
-from multiscale.studies import load_study, pareto, relative_error
+from multiscale.studies import Row, load_study, pareto, relative_error
 
 ROOT = Path(__file__).resolve().parents[1]
 GRIDS = (12, 16, 24, 32)
@@ -189,6 +189,26 @@ def test_the_error_figure_draws_the_pareto_front_of_each_case(tmp_path, monkeypa
         assert len(steps) == 2
 
 
+@pytest.mark.parametrize("dt, ticks, label", [('{start = "50 us", stop = "450 us", num = 3, log = true}',
+                                               ["50 µs", "150 µs", "450 µs"], "dt"),
+                                              ("[5e-05, 0.00015, 0.00045]", ["5e-05", "0.00015", "0.00045"], "dt [s]")])
+def test_a_knob_axis_is_labelled_as_the_study_wrote_it(tmp_path, monkeypatch, dt, ticks, label):
+    """A range in rpm was ticked in rad/s without a unit (1000 rpm shown "104.7"; a user trial): the
+    ticks are the values as written, in the range's unit; bare numbers get the SI unit on the axis."""
+    import matplotlib.pyplot as plt
+
+    from multiscale.plots import studies as figures
+    made = []
+    subplots = plt.subplots
+    monkeypatch.setattr(figures.plt, "subplots", lambda *a, **k: made.append(subplots(*a, **k)) or made[-1])
+    monkeypatch.setattr(figures.plt, "close", lambda fig: None)
+    study = load_study(write(tmp_path, f'problem = "heat_partition"\nmetrics = ["partition_1"]\n[sweep]\ndt = {dt}\n'))
+    rows = [Row(run, {"status": "ok", "wall_time": 1.0, "metrics": {"partition_1": 0.5}}) for run in study.runs]
+    figures.plot(study, rows, tmp_path)
+    ax = made[0][1][0][0]
+    assert [t.get_text() for t in ax.get_xticklabels()] == ticks and ax.get_xlabel() == label
+
+
 def test_reference_from_a_stored_file_and_records_shared_by_studies(hertz_study, tmp_path, capsys):
     """kind = "file": the stored exact values give the analytic errors; a second study pointing at
     the same run folder reuses the first one's runs (records are keyed by parameters)."""
@@ -253,7 +273,7 @@ def test_the_cheapest_setting_meets_the_error_on_every_sample_averaged_over(tmp_
     """With ``average_over = ["seed"]`` the table of what accuracy costs named one lucky seed as the
     setting ("circular, seed 1: 19.6 %" where seeds 2 and 3 gave 31.7 % and 38.6 %; a user trial).
     A setting is now judged by its worst error over the seeds and costed by their mean time."""
-    from multiscale.studies import Row, cheapest
+    from multiscale.studies import cheapest
     path = write(tmp_path, """
 name = "rough"
 problem = "rough_contact"

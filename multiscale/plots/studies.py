@@ -12,8 +12,8 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.ticker import FuncFormatter, NullFormatter
 
-from multiscale.studies.expand import Study, StudyRun
-from multiscale.studies.formatting import metric_heading, percent, value_text
+from multiscale.studies.expand import Study, StudyRun, parser_of
+from multiscale.studies.formatting import metric_heading, percent
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.results import Row, case_key, pareto, sample_std
 
@@ -109,6 +109,15 @@ def _plain_log(axis) -> None:
     axis.set_minor_formatter(FuncFormatter(label))
 
 
+def _axis_label(study, axis, shown) -> str:
+    """The knobs of an axis, with the SI unit of a micro parameter whose values are bare numbers
+    ("E [Pa]"; "E / nu" of a zipped axis read as a ratio: "E, nu")."""
+    parser = parser_of(PROBLEMS[study.problem], axis[0])
+    unit = getattr(getattr(getattr(parser, "parser", None), "kind", None), "si", "")
+    bare = all(not any(c.isalpha() for c in text.replace("e", "")) for text in shown)
+    return ", ".join(axis) + (f" [{unit}]" if unit and bare else "")
+
+
 def _plot_axis(study, ok, axis, folder):
     """Errors (or metric values) and wall time against one axis (a knob, or zipped knobs plotted
     against the first), one line per setting of the other knobs (mean ± std over averaged ones)."""
@@ -119,6 +128,7 @@ def _plot_axis(study, ok, axis, folder):
     numeric = _numeric(raw) and len(set(raw)) == len(raw)    # else categorical, one tick per setting
     xs = {v: (x if numeric else i) for i, (v, x) in enumerate(zip(values, raw))}
     ticks = {point(r): ", ".join(r.run.shown[k] for k in axis) for r in ok}
+    shown_at = {json.loads(point(r))[0]: r.run.shown[axis[0]] for r in ok}     # as written: "100 rpm", not 10.47
     log_x = numeric and min(raw) > 0 and max(raw) / min(raw) > 5
     averaged = set(study.averaged)
     others = [k for k in study.knobs if k not in axis and k not in averaged]
@@ -155,20 +165,20 @@ def _plot_axis(study, ok, axis, folder):
         if kind == "time":
             ax.set_yscale("log")
         value = metric_heading(m, PROBLEMS[study.problem].metric_unit(m)) if kind == "value" else ""
-        ax.set(xlabel=" / ".join(axis), ylabel={"error": f"relative error of {m}", "value": value, "time": "wall time [s]"}[kind],
+        ax.set(xlabel=_axis_label(study, axis, shown_at.values()), ylabel={"error": f"relative error of {m}", "value": value, "time": "wall time [s]"}[kind],
                title={"error": f"error of {m}", "value": m, "time": "wall time of a run"}[kind])
         if log_x:             # ticks at the swept values, no minor labels (they overlap on short decades)
             ax.set_xscale("log")
             ax.xaxis.set_minor_formatter(NullFormatter())
         if numeric:
             ticks_at = sorted(set(raw))
-            ax.set_xticks(ticks_at, [value_text(v) for v in ticks_at], rotation=30 if len(ticks_at) > 5 else 0)
+            ax.set_xticks(ticks_at, [shown_at[v] for v in ticks_at], rotation=30 if len(ticks_at) > 5 else 0)
         else:
             ax.set_xticks(range(len(values)), [ticks[v] for v in values], rotation=30, ha="right", fontsize=7)
         ax.grid(True, which="both", alpha=0.25)
         if others and len(lines) <= 8:
             ax.legend(fontsize=6)
-    fig.suptitle(f"{study.name}: {' and '.join(study.metrics)} and wall time against {' / '.join(axis)}"
+    fig.suptitle(f"{study.name}: {' and '.join(study.metrics)} and wall time against {', '.join(axis)}"
                  + (f" (mean ± sample std over {', '.join(averaged)})" if averaged else ""))
     fig.tight_layout()
     path = folder / f"{study.name}_{axis[0].replace('.', '_')}.png"

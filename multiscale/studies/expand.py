@@ -223,7 +223,8 @@ def _values(value, where, parser, ctx, unique: bool = True) -> list | None:
 
 
 def _range(spec: dict, where, parser, ctx) -> list | None:
-    """The values of a range table (SI; integers when the parameter or the bounds are)."""
+    """The values of a range table: integers for an integer parameter (or whole bounds and values of a
+    scene key), "<number> <unit>" in the start's unit when it has one, else SI numbers."""
     unknown = [k for k in spec if k not in RANGE_KEYS]
     if unknown:
         ctx.problems.append(f"{where}.{unknown[0]}: unknown key of a range{suggest(unknown[0], RANGE_KEYS)}; "
@@ -272,8 +273,14 @@ def _range(spec: dict, where, parser, ctx) -> list | None:
             isinstance(spec[k], int) and not isinstance(spec[k], bool) for k in ("start", "stop", "step") if k in spec) \
             and all(float(v).is_integer() for v in values):
         values = list(dict.fromkeys(int(round(v)) for v in values))
+    elif kelvin:
+        values = [f"{v:.12g} K" for v in values]
+    elif isinstance(spec["start"], str):       # in the start's unit, shown so ("104.7 rpm", not 10.47)
+        unit = VALUE.match(spec["start"]).group(2)
+        factor, offset, _ = parse_unit(unit)
+        values = [f"{(v - offset) / factor:.12g} {unit}" for v in values]
     else:
-        values = [f"{v:.12g} K" if kelvin else float(f"{v:.12g}") for v in values]
+        values = [float(f"{v:.12g}") for v in values]
     if len(values) > 10000:
         ctx.problems.append(f"{text}: more than 10000 values")
         return None
