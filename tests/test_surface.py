@@ -127,10 +127,10 @@ def test_bad_surface_input(tmp_path):
     np.save(tmp_path / "complex.npy", np.ones((8, 8)) * (1 + 1j))
     np.save(tmp_path / "mask.npy", np.ones((8, 8), bool))
     (tmp_path / "empty.npy").write_bytes(b"")          # numpy's EOFError came through as a traceback
-    for name, why in [("empty.txt", r"at least 4 x 4 points, got shape \(0, 1\)"),
+    for name, why in [("empty.txt", r"the height matrix has 1 x 0 points: a height map of at least 4 x 4"),
                       ("empty.npy", "could not read a height matrix"),
-                      ("row.npy", r"at least 4 x 4 points, got shape \(1, 9\)"),
-                      ("small.npy", r"at least 4 x 4 points, got shape \(3, 9\)"),
+                      ("row.npy", r"has 9 x 1 points: a height map of at least 4 x 4 points is needed"),
+                      ("small.npy", r"has 9 x 3 points: a height map of at least 4 x 4 points is needed"),
                       ("complex.npy", "real numbers, not complex128"), ("mask.npy", "real numbers, not bool")]:
         with pytest.raises(InputError, match=why):
             load_surface(tmp_path / name, 1e-6)

@@ -182,9 +182,11 @@ def read_matrix(path) -> np.ndarray:
         if isinstance(exc, InputError):
             raise
         raise InputError("path", str(path), f"could not read a height matrix ({exc})") from None
-    if h.ndim != 2 or min(h.shape) < 4:
-        raise InputError("path", str(path), f"expected a 2-D height matrix of at least 4 x 4 points, got shape "
-                         f"{h.shape}")
+    if h.ndim != 2:
+        raise InputError("path", str(path), f"expected a 2-D height matrix, got shape {h.shape}")
+    if min(h.shape) < 4:      # as reading.py says it of an instrument file's map (it said 2 x 2 here)
+        raise InputError("path", str(path), f"the height matrix has {h.shape[1]} x {h.shape[0]} points: a height "
+                         "map of at least 4 x 4 points is needed")
     return h
 
 
