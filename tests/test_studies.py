@@ -610,6 +610,8 @@ loading.pressure = ["3 MPa"]
 plots = false
 """)
     assert main(["study", str(path)]) == 1
+    assert 'warning: study: metric "interface_forc:last" not produced (did you mean "interface_force:last"?)' \
+        in capsys.readouterr().err                    # when its first run ends, not in the report after the last
     out = tmp_path / "results" / "study"
     row = table(out / "results.csv")[0]
     assert row["status"] == "failed"

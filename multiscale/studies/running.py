@@ -67,7 +67,7 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     start = time.perf_counter()
     rank, size = (comm.rank, comm.size) if comm is not None else (0, 1)
     lock = _claim(study, comm)
-    bar, failed, running, termination, lifeline = None, 0, {}, None, None
+    bar, failed, running, termination, lifeline, warned = None, 0, {}, None, None, False
     try:                                     # the lock is released whatever happens from here
         records = read_records(study)
         todo = [r for r in study.runs if not _done(records.get(r.key), rerun_failed, study.options.timeout)]
@@ -94,7 +94,13 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
                 elif proc.returncode != 0 or not record_path(study, run).is_file():
                     _failed_record(study, run, _crash_message(study, run, proc.returncode))
                 del running[proc]
-                failed += json.loads(record_path(study, run).read_text()).get("status") == FAILED
+                record = json.loads(record_path(study, run).read_text())
+                failed += record.get("status") == FAILED
+                if record.get("ran") and "did you mean" in record.get("error", "") and not warned:
+                    warned = True        # a misspelt metric: said at the first run, not after the last
+                    tqdm.write(f"warning: {study.name}: {record['error'].split('; available:')[0]}; every run "
+                               "will lack it: stop (Ctrl-C), correct the study's metrics and start again (finished "
+                               "runs are kept)", file=sys.stderr)
                 log = study.folder / "runs" / f"{run.key}.log"
                 if log.is_file() and not log.stat().st_size:
                     log.unlink()
