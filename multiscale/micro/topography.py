@@ -93,7 +93,7 @@ def _too_many_undefined(m: Measurement, max_undefined: float, prefix: str) -> st
     """Why the measurement has too many undefined points to fill, or None."""
     share = m.undefined / m.heights.size
     if share > max_undefined:
-        return (f"{m.undefined} of its {m.heights.size} points ({100 * share:.2g} %) are undefined, more than "
+        return (f"{m.undefined} of its {m.heights.size} points ({100 * share:.3g} %) are undefined, more than "
                 f"{option(prefix, 'max_undefined')} = {100 * max_undefined:.3g} % (too much to fill by interpolation)")
     return None
 

@@ -33,7 +33,7 @@ def colour_range(heights: np.ndarray) -> tuple[float, float]:
 
 
 def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -> Path:
-    """PNG: height map [µm] (and the waviness taken out, if given), then C(q) [m⁴] against q [1/m]
+    """PNG: height map [µm] (and the waviness taken out, if given), then C(q) [m⁴] against q [rad/m]
     (complete bins as points, partial ones hollow) with the power-law fit between its cut-offs."""
     maps = [("roughness" if waviness is not None else "heights", surface)] + (
         [("waviness", waviness)] if waviness is not None else [])
@@ -64,8 +64,9 @@ def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -
         ax.loglog(q[inside], fit(q[inside]), "-", color="C1", label=f"fit: H = {fit.hurst:.2f}")
         for value, resolved, name in ((fit.q_r, fit.resolved[0], "q_r"), (fit.q_s, fit.resolved[1], "q_s")):
             ax.axvline(value, color="C1", ls="--" if resolved else ":", lw=1,
-                       label=f"{name} = {value:.3g} 1/m" + ("" if resolved else " (end of data)"))
-    ax.set_xlabel("wavevector q [1/m]")
+                       label=f"{name} = {value:.3g} rad/m (λ = {2 * np.pi / value:.3g} m)"
+                       + ("" if resolved else " (end of data)"))
+    ax.set_xlabel("wavevector q = 2π/λ [rad/m]")
     ax.set_ylabel("PSD C(q) [m⁴]")
     ax.grid(True, which="both", alpha=0.25)
     ax.legend(fontsize=8)
