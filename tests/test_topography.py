@@ -147,10 +147,10 @@ def test_undefined_points_of_a_plane_are_filled_exactly_and_too_many_refused(tmp
     done = condition(m, detrend="none")
     np.testing.assert_allclose(done.surface.heights, plane - plane.mean(), atol=1e-12 * np.abs(plane).max())
     assert "filled 19 undefined points (1.19%) by harmonic interpolation" in " ".join(done.report)
-    with pytest.raises(InputError, match=r"roughness\.file = '.*holes\.nc': 19 of its 1600 points \(1\.2 %\) are "
+    with pytest.raises(InputError, match=r"roughness\.file = '.*holes\.nc': 19 of its 1600 points \(1\.19 %\) are "
                                          r"undefined, more than roughness\.max_undefined = 1 %"):
         condition(m, max_undefined=0.01, prefix="roughness.")
-    with pytest.raises(InputError, match=r"19 of its 1600 points \(1\.2 %\) are undefined, more than "
+    with pytest.raises(InputError, match=r"19 of its 1600 points \(1\.19 %\) are undefined, more than "
                                          r"max_undefined = 0 %"):          # (it said 0.0% of 0.0%)
         condition(m, max_undefined=0.0)
     assert probe_topography(m.path, max_undefined=0.01)[0]

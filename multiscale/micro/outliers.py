@@ -31,6 +31,7 @@ HALO = 4                # the median's neighbourhood: (2 HALO + 1)² points
 DESPIKE = 7.0           # default threshold k [Sq of the other heights]
 CLIP = 2.0              # the Sq without the outliers is taken no lower than the Sq with them / CLIP
 DOMINATED = 0.5         # outliers carrying more of the 3rd or 4th absolute moment dominate Ssk or Sku
+SLOPES = 0.1            # a share of Sdq² above which the warning names the slopes and the spectrum
 
 
 @dataclass(frozen=True)
@@ -68,14 +69,41 @@ class Outliers:
                 f"neighbourhood by more than {self.k:g} Sq (Sq {self.sq * 1e9:.3g} nm without them), up to "
                 f"{self.largest / self.sq:+.3g} Sq ({self.largest * 1e9:+.4g} nm)")
 
-    def note(self, name: str, option: str) -> str:
+    def gradient_share(self, heights: np.ndarray, dx: float, dy: float) -> float:
+        """The share of Sdq² (the mean squared slope of the forward differences of ``heights`` [m],
+        pixels ``dx`` x ``dy`` [m]; pairs with an undefined point left out) that the outliers carry:
+        what it loses when each takes its neighbourhood's median. The map's sum in row blocks, the
+        change on the differences next to the outliers."""
+        total = 0.0
+        for rows in row_blocks(*heights.shape):
+            block = heights[rows.start:min(rows.stop + 1, heights.shape[0])]
+            total += np.nansum((np.diff(block[:rows.stop - rows.start], axis=1) / dx) ** 2) \
+                + np.nansum((np.diff(block, axis=0) / dy) ** 2)
+        if not self.count or total <= 0:
+            return 0.0
+        fixed = {(i, j): heights[i, j] - d for i, j, d in zip(self.rows, self.cols, self.deviations)}
+        starts = {(i + a, j + b) for i, j in fixed for a in (-1, 0) for b in (-1, 0) if i + a >= 0 and j + b >= 0}
+        ny, nx = heights.shape
+        lost = 0.0
+        for i, j in starts:             # the pairs (i, j)-(i, j+1) and (i, j)-(i+1, j) an outlier is in
+            for (a, b), step in (((i, j + 1), dx), ((i + 1, j), dy)):
+                if a < ny and b < nx and ((i, j) in fixed or (a, b) in fixed):
+                    before = (heights[a, b] - heights[i, j]) / step
+                    after = (fixed.get((a, b), heights[a, b]) - fixed.get((i, j), heights[i, j])) / step
+                    lost += np.nan_to_num(before ** 2 - after ** 2)
+        return float(min(max(lost / total, 0.0), 1.0))
+
+    def note(self, name: str, option: str, slope_share: float = 0.0) -> str:
         """The warning for file ``name``: how many, what they are, whether they dominate Ssk and Sku,
-        and that ``option`` (e.g. "--despike 7") removes them."""
+        the share of Sdq² they carry (``gradient_share``) and that ``option`` (e.g. "--despike 7")
+        removes them."""
         share3, share4 = self.shares
         dominates = (f"; they carry {share3:.0%} of the heights' third and {share4:.0%} of their fourth absolute "
                      "moment: Ssk and Sku are theirs, not the surface's" if self.dominated else "")
+        slopes = (f"; {slope_share:.0%} of Sdq² is theirs: the slopes, the spectrum's short wavelengths and a "
+                  "surface drawn from it (cover = \"equivalent\") are theirs too" if slope_share > SLOPES else "")
         return (f"outliers in '{name}': {self.count} {self.describe()}, spikes or pits an instrument makes"
-                f"{dominates}; kept ({option} removes them and fills them as undefined points)")
+                f"{dominates}{slopes}; kept ({option} removes them and fills them as undefined points)")
 
 
 def find_outliers(heights: np.ndarray, k: float = DESPIKE) -> Outliers:

@@ -73,7 +73,11 @@ def _outlier_notes(m: Measurement, detrend: str, prefix: str, h: np.ndarray | No
             h = m.heights if DETREND[detrend] is None else remove_form(m.heights, detrend)
         m.found[detrend] = find_outliers(h)
     found = m.found[detrend]
-    return [found.note(m.path.name, option(prefix, "despike", f"{DESPIKE:g}"))] if found.count else []
+    if not found.count:
+        return []
+    if h is None:
+        h = m.heights if DETREND[detrend] is None else remove_form(m.heights, detrend)
+    return [found.note(m.path.name, option(prefix, "despike", f"{DESPIKE:g}"), found.gradient_share(h, m.dx, m.dy))]
 
 
 def _form_only(m: Measurement, flattened: np.ndarray) -> str | None:
@@ -93,7 +97,7 @@ def _too_many_undefined(m: Measurement, max_undefined: float, prefix: str) -> st
     """Why the measurement has too many undefined points to fill, or None."""
     share = m.undefined / m.heights.size
     if share > max_undefined:
-        return (f"{m.undefined} of its {m.heights.size} points ({100 * share:.3g} %) are undefined, more than "
+        return (f"{m.undefined} of its {m.heights.size} points ({100 * share:.2f} %) are undefined, more than "
                 f"{option(prefix, 'max_undefined')} = {100 * max_undefined:.3g} % (too much to fill by interpolation)")
     return None
 
