@@ -450,6 +450,9 @@ def main(argv: list[str] | None = None) -> int:
     except KeyboardInterrupt:     # Ctrl-C in a command without its own words (check --cells: a traceback)
         print(f"interrupted: multiscale {args.command}", file=sys.stderr)
         return 130
+    except BrokenPipeError:       # `multiscale surface FILE | head`: the reader left; no traceback
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())    # (nor at the interpreter's flush)
+        return 141
 
 
 if __name__ == "__main__":  # pragma: no cover

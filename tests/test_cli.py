@@ -1,5 +1,6 @@
 """CLI `multiscale check|run`: clear one-line errors and a non-zero exit for bad input, never a
 traceback; a summary for a good scene; earlier results are not overwritten without --overwrite."""
+import contextlib
 import io
 import json
 import os
@@ -112,6 +113,28 @@ def test_scene_encodings_and_endless_files(tmp_path, capsys, monkeypatch):
     assert main(["check", _write(tmp_path, BLOCK)]) == 2
     err = capsys.readouterr().err
     assert "is no scene file, it holds over" in err and "Traceback" not in err
+
+
+def test_output_into_a_closed_pipe_ends_quietly(tmp_path, monkeypatch, capsys):
+    """`multiscale surface FILE | head` ended with a BrokenPipeError traceback (a user trial): the
+    reader is gone, the command ends with status 141 (a shell's 128 + SIGPIPE) and no traceback."""
+    import numpy as np
+    np.save(tmp_path / "h.npy", np.random.default_rng(0).normal(size=(32, 32)) * 1e-7)
+    read, write = os.pipe()
+    os.close(read)
+    saved = os.dup(1)
+    stream = open(os.dup(write), "w", buffering=1)          # line-buffered, as a pipe
+    monkeypatch.setattr(sys, "stdout", stream)
+    try:
+        os.dup2(write, 1)
+        assert main(["surface", str(tmp_path / "h.npy"), "--pixel-size", "1 um"]) == 141
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(write)
+        with contextlib.suppress(OSError):
+            stream.close()                 # its last line cannot go anywhere
+    assert "Traceback" not in capsys.readouterr().err
 
 
 def test_check_good_scene_prints_summary(tmp_path, capsys):
