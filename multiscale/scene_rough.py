@@ -8,8 +8,8 @@ from __future__ import annotations
 import warnings
 
 from multiscale.errors import InputError
-from multiscale.micro.topography import (TopographyWarning, check_cutoff, check_resolved, coarse_grid, condition,
-                                         covers, read_topography, zone_cells)
+from multiscale.micro.topography import (TopographyWarning, beyond_measurement, check_cutoff, check_resolved, coarse_grid,
+                                         condition, covers, read_topography, zone_cells)
 from multiscale.scene_sections import DEFAULT_GRID
 
 SHARED_MICRO = ("grid", "law_points", "model", "p_max", "tol", "partition_law", "heating", "heating_steps",
@@ -92,7 +92,8 @@ def measured_cover(scene, warnings_out: list) -> list[str]:
                 warnings.simplefilter("ignore", TopographyWarning)
                 done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix=prefix, despike=r.despike)
             cell = [L / (z * c) for L, z, c in zip(size, s.micro.zones, cells)]
-            warnings_out += [w for w in [coarse_grid(done.surface, cell, prefix)] if w and w not in warnings_out]
+            beyond = beyond_measurement(done.surface, cell, prefix) if r.cover == "equivalent" else None
+            warnings_out += [w for w in [coarse_grid(done.surface, cell, prefix), beyond] if w and w not in warnings_out]
         except InputError as exc:
             out.append(str(exc))
     return sorted(set(out))

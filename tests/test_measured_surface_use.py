@@ -478,3 +478,33 @@ def test_a_micro_grid_too_coarse_for_the_measured_gradient_is_warned_about(tmp_p
     assert topography.kept_gradient(measured, (half, half)) == pytest.approx(topography.GRADIENT_KEPT, rel=0.02)
     fine = scene(tmp_path, 'file = "pad.npy"\npixel_size = "10 um"\ncover = "equivalent"', "grid = [500, 500]")
     assert not [w for w in fine.warnings if "of the measured RMS gradient" in w]      # 10 um cells: the pixels
+
+
+SHARED = next((p for p in (Path(os.environ.get("MULTISCALE_TOPOGRAPHIES", "/nonexistent")),
+                           Path(__file__).resolve().parents[2] / "shared/data/topographies") if p.is_dir()), None)
+
+
+@pytest.mark.skipif(SHARED is None, reason="../shared/data/topographies not here")
+@pytest.mark.parametrize("name, warned", [("x3p-2.x3p", True), ("opd-1.opd", True), ("plu-1.plu", False),
+                                          ("sur-2.sur", False)])
+def test_an_equivalent_surface_from_beyond_the_measurement_is_warned_about(name, warned):
+    """On 78 um cells an 83 x 204 um x3p map gave an equivalent surface of 13 nm from ~5 modes, 99 % of
+    its power in the mirror-stitched spectrum's first modes (wavelengths longer than the map: its
+    form, not roughness), and an opd map one of 0.12 nm whose zone laws failed naming p_max; check
+    said OK (a user trial). The share is computed here from the mirror-stitched map's FFT."""
+    done = condition(read_topography(SHARED / name))
+    cell = (20e-3 / 256, 20e-3 / 256)
+    t = ST.Topography(done.surface.heights.T, done.surface.size).mirror_stitch()
+    h = np.asarray(t.heights()).T                      # (2 my, 2 mx), period 2 m
+    C = np.abs(np.fft.fft2(h)) ** 2
+    ky, kx = (np.fft.fftfreq(n, 1 / n) for n in h.shape)
+    (Py, Px) = 2 * done.surface.size[1], 2 * done.surface.size[0]
+    band = (np.abs(ky)[:, None] * 2 * np.pi / Py <= np.pi / cell[1]) & (np.abs(kx)[None, :] * 2 * np.pi / Px
+                                                                          <= np.pi / cell[0])
+    band[0, 0] = False
+    first = (np.abs(ky)[:, None] == 1) | (np.abs(kx)[None, :] == 1)
+    share = C[band & first].sum() / C[band].sum()
+    note = topography.beyond_measurement(done.surface, cell, "roughness.")
+    assert (note is not None) == warned == (share > topography.LONG_POWER)
+    if warned:
+        assert f"roughness.file: {share:.0%} of the power the equivalent surface draws" in note

@@ -39,6 +39,7 @@ COVER = ("measured", "mirror", "tile", "equivalent")
 MAX_CELLS = 1024          # cells per zone side taken from a measurement's own pixel size (no micro.grid)
 ALPHA = np.sqrt(np.log(2) / np.pi)     # ISO 16610-21/-61 Gaussian: 50 % transmission at the cut-off
 GRADIENT_KEPT = 0.5       # a micro grid resolving less of the measured RMS gradient is warned about
+LONG_POWER = 0.5          # an equivalent surface with more of its power beyond the measurement is warned about
 S_FILTER_PIXELS = 3.0     # anti-aliasing before coarsening: resolved to λs = 3 new pixels (21 % at the new Nyquist)
 
 
@@ -353,6 +354,10 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
     lines = [f"warning: {coarse}"] if coarse is not None else []
     if method == "equivalent":
         check_resolved(surface.size, (nx, ny), (Lx, Ly), prefix)
+        beyond = beyond_measurement(surface, (Lx / nx, Ly / ny), prefix)
+        if beyond is not None:
+            warnings.warn(beyond, TopographyWarning, stacklevel=2)
+            lines.append(f"warning: {beyond}")
         s = equivalent_surface(power_spectrum(surface), (nx, ny), (Lx, Ly), seed)
         s = Surface(s.heights, s.dx, s.dy, periodic=False)
         return s, lines + [f"statistically equivalent surface over {target} from the measured PSD (seed {seed}): "
@@ -479,6 +484,35 @@ def coarse_grid(surface: Surface, cell, prefix: str = "") -> str | None:
             f"{low * cell[0] * 1e6:.3g} x {low * cell[1] * 1e6:.3g} um would resolve {GRADIENT_KEPT:.0%}): the real "
             "contact area, flash temperatures and heat partition follow the gradient, so they are those of a "
             "smoother surface than the one measured (a finer micro.grid or more micro.zones keep more)")
+
+
+def beyond_measurement(surface: Surface, cell, prefix: str = "") -> str | None:
+    """The warning for ``cover = "equivalent"`` on cells ``cell`` = (dx, dy) [m] when more than
+    ``LONG_POWER`` of the power that surface draws from the measurement ``surface`` (its modes
+    that the cells resolve) lies in the mirror-stitched spectrum's first modes along x or y
+    (``power_spectrum``: wavelength 2 mx or 2 my, longer than the measurement: its form left
+    after the detrending, not roughness; a user trial: 99 % of an 83 um x3p map's on 78 um cells,
+    a 13 nm face from ~5 modes), else None."""
+    s = power_spectrum(surface)
+    if not s.mirrored:
+        return None
+    (Px, Py), C = s.period, s.power
+    qy, qx = (2 * np.pi * np.arange(n) / P for n, P in zip(C.shape, (Py, Px)))
+    w = np.where(qy > 0, 2.0, 1.0)[:, None] * np.where(qx > 0, 2.0, 1.0)[None, :]   # mirror images
+    band = (qy[:, None] <= np.pi / cell[1]) & (qx[None, :] <= np.pi / cell[0])
+    band[0, 0] = False
+    first = np.zeros_like(band)
+    first[1:2, :], first[:, 1:2] = True, True
+    total = float((w * C)[band].sum())
+    share = float((w * C)[band & first].sum()) / total if total > 0 else 0.0
+    if share <= LONG_POWER:
+        return None
+    mx, my = surface.size
+    return (f"{prefix}file: {share:.0%} of the power the equivalent surface draws from the measurement "
+            f"({mx * 1e6:.4g} x {my * 1e6:.4g} um) is at wavelengths longer than it (its first mirror-stitched "
+            f"modes, {2 * mx * 1e6:.4g} or {2 * my * 1e6:.4g} um): the form its detrending left, not roughness; the "
+            f"micro grid's cells ({cell[0] * 1e6:.4g} x {cell[1] * 1e6:.4g} um) resolve little else of it: a longer "
+            "measurement or a finer micro.grid")
 
 
 def zone_cells(grid, method: str, size, zones, pixel, default, name: str) -> tuple[int, int]:
