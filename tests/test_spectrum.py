@@ -88,6 +88,19 @@ def test_a_fit_outside_the_self_affine_range_is_said_to_be_one():
     assert "outside" not in next(r for r in surface_statistics(self_affine(0.6, n=128)).table() if "Hurst" in r)
 
 
+def test_a_fit_that_misses_the_psd_says_h_is_only_a_slope():
+    """plu-1.plu's fit missed its PSD by a factor 11 (rms of ln C 2.44) and sur-2's by 9, printed as
+    H 0.315 and 0.030 without a word (a user trial). A fit whose misfit exceeds 1 in ln C, or one of
+    fewer than 5 bins, is said to give a slope only; a self-affine surface's is not."""
+    stats = surface_statistics(self_affine(0.8, n=128, periodic=False))
+    assert stats.power_law.misfit < 0.5
+    assert "no power law" not in next(r for r in stats.table() if "Hurst" in r)
+    for fit in (dataclasses.replace(stats.power_law, misfit=2.44), dataclasses.replace(stats.power_law, bins=3)):
+        line = next(r for r in dataclasses.replace(stats, power_law=fit).table() if "Hurst" in r)
+        assert line.endswith("; the PSD is no power law there (misfit over a factor e, or under 5 bins): H is only "
+                             "its mean slope")
+
+
 def test_measured_psd_holds_sq_exactly():
     """Parseval on the mirror-stitched periodogram: (2π)^-2 Σ C Δq² = <h²> of the patch."""
     s = self_affine(0.8, n=128, periodic=False)

@@ -31,6 +31,8 @@ from multiscale.micro.surface import Surface, check_surface, find_asperities, ro
 
 POWER_FLOOR = 1e-24     # modes below this fraction of the largest C carry no power (FFT round-off: ~1e-32)
 HURST_RANGE = (0.0, 1.5)   # the power-law segment of a fit (a flat roll-off is no self-affine range)
+POOR_MISFIT = 1.0          # rms misfit in ln C above which a fit's H is said to be no more than a slope
+FEW_BINS = 5               # bins below which too
 
 
 def surface_topography():
@@ -444,10 +446,13 @@ class Statistics:
         else:
             (lr, ls), (rr, rs) = fit.wavelengths, fit.resolved
             outside = not HURST_RANGE[0] <= fit.hurst <= HURST_RANGE[1]
+            poor = fit.misfit > POOR_MISFIT or fit.bins < FEW_BINS
             rows += [("Hurst exponent H (PSD fit)", f"{fit.hurst:.3f}  (rms misfit {fit.misfit:.2f} in ln C "
                                                    f"over {fit.bins} bins)" + (
                           f"; outside {HURST_RANGE[0]:g}-{HURST_RANGE[1]:g}: no self-affine range (e.g. noise), "
-                          "the fit only gives the PSD's slope" if outside else "")),
+                          "the fit only gives the PSD's slope" if outside else
+                          "; the PSD is no power law there (misfit over a factor e, or under "
+                          f"{FEW_BINS} bins): H is only its mean slope" if poor else "")),
                      ("long cut-off  2pi/q_r", _length(lr, 2) + ("  (to a PSD bin)" if rr else
                                                               "  (not resolved: >= this)")),
                      ("short cut-off 2pi/q_s", _length(ls, 2) + ("  (to a PSD bin)" if rs else
