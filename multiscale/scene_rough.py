@@ -82,11 +82,14 @@ def measured_cover(scene, warnings_out: list) -> list[str]:
                 check_cutoff(f"{prefix}cutoff", r.cutoff, measured.dx, measured.dy, r.file.name)
             if size is None:
                 continue
+            if r.cover == "measured":     # before the cells: said with a missing micro.grid too (it was hidden)
+                try:
+                    covers(measured.size, size, r.cover, prefix=prefix)
+                except InputError as exc:
+                    out.append(str(exc))
             cells = zone_cells(s.micro.grid, r.cover, size, s.micro.zones, (measured.dx, measured.dy), DEFAULT_GRID,
                                r.file.name)
-            if r.cover == "measured":
-                covers(measured.size, size, r.cover, prefix=prefix)
-            elif r.cover == "equivalent":
+            if r.cover == "equivalent":
                 check_resolved(measured.size, [z * c for z, c in zip(s.micro.zones, cells)], size, prefix=prefix)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", TopographyWarning)

@@ -508,3 +508,12 @@ def test_an_equivalent_surface_from_beyond_the_measurement_is_warned_about(name,
     assert (note is not None) == warned == (share > topography.LONG_POWER)
     if warned:
         assert f"roughness.file: {share:.0%} of the power the equivalent surface draws" in note
+
+
+def test_a_missing_micro_grid_does_not_hide_that_the_measurement_does_not_cover_the_face(tmp_path):
+    """check said only "set micro.grid" and the measurement's cover came out once the grid was set:
+    not every problem at once (a user trial)."""
+    with pytest.raises(SceneError) as info:
+        scene(tmp_path, f'file = "{TOP}"\ncover = "measured"')
+    problems = "\n".join(info.value.problems)
+    assert "set micro.grid" in problems and "does not cover the interface" in problems
