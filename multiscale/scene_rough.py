@@ -80,6 +80,10 @@ def measured_cover(scene, warnings_out: list) -> list[str]:
                                            prefix=prefix)
             if r.cutoff is not None:
                 check_cutoff(f"{prefix}cutoff", r.cutoff, measured.dx, measured.dy, r.file.name)
+                if r.cutoff > min(measured.size):       # (8 mm on a 1.3 mm map passed without a word)
+                    warnings_out.append(f"{prefix}cutoff = {r.cutoff * 1e6:.4g} um is longer than the measurement "
+                                        f"({measured.size[0] * 1e6:.4g} x {measured.size[1] * 1e6:.4g} um): the "
+                                        "filter takes out little more than its form")
             if size is None:
                 continue
             if r.cover == "measured":     # before the cells: said with a missing micro.grid too (it was hidden)

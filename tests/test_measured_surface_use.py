@@ -517,3 +517,13 @@ def test_a_missing_micro_grid_does_not_hide_that_the_measurement_does_not_cover_
         scene(tmp_path, f'file = "{TOP}"\ncover = "measured"')
     problems = "\n".join(info.value.problems)
     assert "set micro.grid" in problems and "does not cover the interface" in problems
+
+
+def test_a_cutoff_longer_than_the_measurement_is_warned_about(tmp_path):
+    """cutoff = 8 mm on a 1.3 mm measurement passed check without a word (a user trial); top-1.top
+    spans 0.6 um."""
+    s = scene(tmp_path, f'file = "{TOP}"\ncover = "tile"\ncutoff = "1 um"', GRID)
+    assert any(w.startswith("roughness.cutoff = 1 um is longer than the measurement (0.6") for w in s.warnings), \
+        s.warnings
+    assert not any("longer than the measurement" in w for w in scene(
+        tmp_path, f'file = "{TOP}"\ncover = "tile"\ncutoff = "0.2 um"', GRID).warnings)
