@@ -835,6 +835,27 @@ def test_a_failed_heat_step_names_the_temperature_tables(tmp_path, monkeypatch):
         model.thermal.step(1.0)
 
 
+def test_a_heat_step_below_absolute_zero_fails_and_keeps_what_was_written(tmp_path):
+    """30 kN at 100 rad/s into the disc alone, from 20 K, on the coarse perfect-contact pin-on-disc:
+    the disc's undershoot went to -11.9, -20.4 and -25.5 K in three steps, written as results with
+    exit code 0 and no warning (the undershoot warning asks 5 % of the rise; an adversarial trial).
+    A step whose temperature falls below 0 K now fails, naming the body, on every rank; the history
+    of t = 0 stays."""
+    import json
+
+    from multiscale.scene import load
+    demos = Path(__file__).resolve().parents[1] / "demos"
+    scene = load(demos / "pin_on_disc_perfect.toml", {
+        "time.initial_temperature": "20 K", "interface.partition": 0.0, "loading.normal_force": "30 kN",
+        "loading.rotation_speed": "100 rad/s", "materials.pin.E": "200 GPa", "interface.penalty": "1e15 Pa/m",
+        "time.end": "1 s", "time.steps": 1, "loading.ramp_steps": 1, "output.folder": str(tmp_path / "cold")})
+    with pytest.raises(ConvergenceError, match=r"heat step at t = 1 s gave -\d+(\.\d+)? K in the disc, below "
+                                               r"absolute zero: an undershoot of the discretisation"):
+        run(scene, verbose=False)
+    assert len(History.read(tmp_path / "cold" / "history.h5")) == 1
+    assert "below absolute zero" in json.loads((tmp_path / "cold" / "provenance.json").read_text())["status"]
+
+
 def test_a_run_that_fails_in_its_first_heat_step_keeps_its_start(tmp_path, monkeypatch):
     """The history of t = 0 (the first contact solve's record) is on disk before the first step: a
     run failing there leaves it, with its provenance saying why (before: no history.h5 at all)."""

@@ -481,6 +481,14 @@ class Thermal:
             raise ConvergenceError(f"heat step at t = {self.time + dt:.6g} s failed (SNES reason "
                                    f"{snes.getConvergedReason()}, {snes.getIterationNumber()} iterations"
                                    f"{'; ' + failed if failed else ''}{given and f'; PETSC_OPTIONS = {given!r}'}){why}")
+        cold = self.min_temperature()             # the same on every rank
+        if min(cold) < 0.0:
+            i = int(np.argmin(cold))
+            raise ConvergenceError(f"heat step at t = {self.time + dt:.6g} s gave {cold[i]:.4g} K in the "
+                                   f"{self.tm.bodies[i].name}, below absolute zero: an undershoot of the "
+                                   "discretisation (a heated layer thinner than the elements, or a heat input far too "
+                                   "large for the bodies); refine the mesh across the thickness near the interface "
+                                   "or check the load, speed and materials (docs/architecture.md, Known problems)")
         self.time += dt
         self.lost_step = self._losses(dt)
         self.lost_total += self.lost_step
