@@ -344,17 +344,34 @@ def entries(n: int) -> str:
     return f"{n} entry" if n == 1 else f"{n} entries"
 
 
+def _record_of(folder: Path) -> dict:
+    """The earlier run's ``provenance.json`` in ``folder``, {} if none is readable."""
+    try:
+        record = json.loads((Path(folder) / "provenance.json").read_text(encoding="utf-8"))
+    except (OSError, ValueError):
+        return {}
+    return record if isinstance(record, dict) else {}
+
+
+def inputs_in(folder: Path) -> list[str]:
+    """Names of the entries of ``folder`` that the earlier run there read as inputs (its scene file,
+    when it ran in its own folder: recorded as the copy ``scene.toml`` too)."""
+    record = _record_of(folder)
+    inputs = {Path(str(p)).resolve() for p in record.get("inputs", {})} if isinstance(record.get("inputs"), dict) \
+        else set()
+    return sorted(p.name for p in Path(folder).iterdir() if p.resolve() in inputs) if inputs else []
+
+
 def results_of(folder: Path) -> list[str]:
     """Names of the entries an earlier run recorded writing into ``folder`` (its
     ``provenance.json``, the record itself included), with the ``.part`` files a killed run can
-    leave beside them; empty when there is no readable record (another program's folder)."""
-    try:
-        record = json.loads((Path(folder) / "provenance.json").read_text(encoding="utf-8"))
-        names = [str(n) for n in record.get("files", [])] if isinstance(record, dict) else []
-    except (OSError, ValueError):
-        return []
-    names = [n for n in names if Path(n).name == n and n not in ("", ".", "..")]     # entries of the folder only
+    leave beside them, its own inputs left out (a scene in its own output folder: another scene's
+    --overwrite deleted it); empty when there is no readable record (another program's folder)."""
+    record = _record_of(folder)
+    names = [str(n) for n in record.get("files", [])] if isinstance(record.get("files"), list) else []
+    read = set(inputs_in(folder))
+    names = [n for n in names if Path(n).name == n and n not in ("", ".", "..") and n not in read]
     return sorted({*names, *(n + ".part" for n in names)} | ({"provenance.json"} if names else set()))
 
 
-__all__ = ["RUNNING", "now", "parts_of", "resolved_toml", "results_of", "versions", "write"]
+__all__ = ["RUNNING", "inputs_in", "now", "parts_of", "resolved_toml", "results_of", "versions", "write"]

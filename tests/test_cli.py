@@ -545,6 +545,7 @@ def test_a_scene_in_its_own_output_folder_is_not_a_result(tmp_path, capsys):
     scene in its place)."""
     from mpi4py import MPI
 
+    from multiscale.errors import SceneError
     from multiscale.scene import load
     from multiscale.workflows.output import prepare_folder
     text = BLOCK.replace("../results/block_on_flat", ".") + "\n# the user's comment\n"
@@ -557,6 +558,13 @@ def test_a_scene_in_its_own_output_folder_is_not_a_result(tmp_path, capsys):
         prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF).claim()
         assert Path(path).read_text() == text
     assert sorted(p.name for p in tmp_path.iterdir()) == ["provenance.json", "scene.toml", "scene_resolved.toml"]
+    # another scene run there with --overwrite deleted that scene file (recorded as the copy scene.toml)
+    # and wrote its own in its place (an adversarial trial): refused, the file kept
+    other = load(_write(tmp_path, text.replace("# the user's comment", "# another scene"), "other.toml"))
+    with pytest.raises(SceneError, match=r'holds scene.toml, an input of the run before \(a scene run in its own '
+                                         r"folder\); this run would write over it: choose another folder"):
+        prepare_folder(other, overwrite=True, resume=False, comm=MPI.COMM_SELF)
+    assert Path(path).read_text() == text
 
 
 @pytest.mark.parametrize("law, line", [

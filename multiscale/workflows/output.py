@@ -67,6 +67,11 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
         raise InputError("--resume", str(folder), "the output folder does not exist: there is nothing to resume "
                          "(run without --resume)")
     existing = comm.bcast(scene.earlier_results() if comm.rank == 0 else None, root=0)
+    taken = comm.bcast([n for n in provenance.inputs_in(folder) if n in outputs.plan(scene).files
+                        and (folder / n).resolve() not in scene.inputs] if comm.rank == 0 and existing else [], root=0)
+    if taken:                        # this run would write over them: the scene of a run in its own folder
+        raise SceneError(f'output.folder = "{folder}": holds {", ".join(taken)}, an input of the run before (a '
+                         "scene run in its own folder); this run would write over it: choose another folder")
     if existing and not (overwrite or resume):
         shown = ", ".join(existing[:3]) + (", ..." if len(existing) > 3 else "")
         resumes = outputs.analysis(scene) == "multiscale"           # the only analysis with checkpoints
