@@ -34,7 +34,7 @@ from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FI
                                        Micro, Output, Roughness, Time, Wear)
 from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_phases, squeal_state,
                                    thin_heated_layers)
-from multiscale.scene_stability import Stability
+from multiscale.scene_stability import Stability, unresolved_band
 from multiscale.scene_vehicle import Vehicle
 
 __all__ = ["COUPLING_DEFAULT", "EFFECTS", "FIG_7_9_CALIBRATION", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Boundary",
@@ -393,6 +393,9 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         swept = scene.stability is not None and scene.stability.sweep is not None and \
             scene.stability.sweep.parameter == "speed"
         warnings += squeal_state(scene.loading, g.motion, "friction" in effects and not swept)
+        if scene.stability is not None and scene.materials is not None:
+            warnings += unresolved_band(scene.stability, g.resolved(), scene.materials, g.materials,
+                                        (scene.time or Time()).initial_temperature)
     end = scene.time.end if scene.time is not None else None
     if scene.loading is not None and end is not None:
         warnings += cycle_coverage(scene.loading, end)
