@@ -8,6 +8,7 @@ from __future__ import annotations
 import warnings
 
 from multiscale.errors import InputError
+from multiscale.micro.spectrum import power_spectrum
 from multiscale.micro.topography import (TopographyWarning, beyond_measurement, check_cutoff, check_resolved, coarse_grid,
                                          condition, covers, read_topography, zone_cells)
 from multiscale.scene_sections import DEFAULT_GRID
@@ -99,8 +100,10 @@ def measured_cover(scene, warnings_out: list) -> list[str]:
                 warnings.simplefilter("ignore", TopographyWarning)
                 done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix=prefix, despike=r.despike)
             cell = [L / (z * c) for L, z, c in zip(size, s.micro.zones, cells)]
-            beyond = beyond_measurement(done.surface, cell, prefix) if r.cover == "equivalent" else None
-            warnings_out += [w for w in [coarse_grid(done.surface, cell, prefix), beyond] if w and w not in warnings_out]
+            spectrum = power_spectrum(done.surface)       # one PSD for both checks
+            beyond = beyond_measurement(done.surface, cell, prefix, spectrum) if r.cover == "equivalent" else None
+            warnings_out += [w for w in [coarse_grid(done.surface, cell, prefix, spectrum), beyond]
+                             if w and w not in warnings_out]
         except InputError as exc:
             out.append(str(exc))
     return sorted(set(out))

@@ -30,7 +30,7 @@ import numpy as np
 from multiscale.errors import InputError, check_count, check_instance, check_pair, check_positive, check_real
 from multiscale.micro.outliers import DESPIKE, find_outliers
 from multiscale.micro.reading import Measurement, TopographyWarning, option, read_topography
-from multiscale.micro.spectrum import as_topography, equivalent_surface, power_spectrum
+from multiscale.micro.spectrum import Spectrum, as_topography, equivalent_surface, power_spectrum
 from multiscale.micro.surface import Surface, defined_sums, row_blocks
 
 MAX_UNDEFINED = 0.1       # default largest fraction of undefined points that is filled
@@ -69,15 +69,13 @@ def _outlier_notes(m: Measurement, detrend: str, prefix: str, h: np.ndarray | No
     ``detrend`` removed (``h`` [m]: those heights, if at hand): none or one line. Searched once per
     ``Measurement`` (kept in ``m.found``; ``read_topography`` returns the same one while the file
     is unchanged: ``multiscale run`` reads and searches a file once, not at the scene's check too)."""
+    if h is None and (detrend not in m.found or m.found[detrend].count):     # to search, or for the slopes
+        h = m.heights if DETREND[detrend] is None else remove_form(m.heights, detrend)
     if detrend not in m.found:
-        if h is None:
-            h = m.heights if DETREND[detrend] is None else remove_form(m.heights, detrend)
         m.found[detrend] = find_outliers(h)
     found = m.found[detrend]
     if not found.count:
         return []
-    if h is None:
-        h = m.heights if DETREND[detrend] is None else remove_form(m.heights, detrend)
     return [found.note(m.path.name, option(prefix, "despike", f"{DESPIKE:g}"), found.gradient_share(h, m.dx, m.dy))]
 
 
@@ -348,17 +346,18 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
     Lx, Ly = check_pair(f"{prefix}size", size, check_positive)
     short = not covers(surface.size, (Lx, Ly), method, prefix)
     wide, target = _sized("the measurement", surface.size), _sized("the interface", (Lx, Ly))
-    coarse = coarse_grid(surface, (Lx / nx, Ly / ny), prefix)
+    spectrum = power_spectrum(surface)           # one PSD for the checks and the equivalent surface
+    coarse = coarse_grid(surface, (Lx / nx, Ly / ny), prefix, spectrum)
     if coarse is not None:
         warnings.warn(coarse, TopographyWarning, stacklevel=2)
     lines = [f"warning: {coarse}"] if coarse is not None else []
     if method == "equivalent":
         check_resolved(surface.size, (nx, ny), (Lx, Ly), prefix)
-        beyond = beyond_measurement(surface, (Lx / nx, Ly / ny), prefix)
+        beyond = beyond_measurement(surface, (Lx / nx, Ly / ny), prefix, spectrum)
         if beyond is not None:
             warnings.warn(beyond, TopographyWarning, stacklevel=2)
             lines.append(f"warning: {beyond}")
-        s = equivalent_surface(power_spectrum(surface), (nx, ny), (Lx, Ly), seed)
+        s = equivalent_surface(spectrum, (nx, ny), (Lx, Ly), seed)
         s = Surface(s.heights, s.dx, s.dy, periodic=False)
         return s, lines + [f"statistically equivalent surface over {target} from the measured PSD (seed {seed}): "
                    f"{nx} x {ny} cells of {Lx / nx * 1e6:.4g} x {Ly / ny * 1e6:.4g} um, Sq {_um(float(s.heights.std()))} "
@@ -447,17 +446,22 @@ def kept_gradient(surface: Surface, cell) -> float:
     return _gradient_share(surface)(cell)
 
 
-def _gradient_share(surface: Surface):
-    """``kept_gradient`` of ``surface`` as a function of the cell (dx, dy) [m] (one PSD)."""
-    s = power_spectrum(surface)
+def _modes(s: Spectrum) -> tuple:
+    """(qy, qx [rad/m], C [m⁴]) of the spectrum ``s``'s entries, C weighted by the modes each
+    stands for: of a mirrored one the quarter qx, qy >= 0 (a mode off an axis stands for its
+    mirror images), else the whole map."""
     (Px, Py), (My, Mx) = s.period, s.grid
-    if s.mirrored:                # the quarter qx, qy >= 0, each mode off an axis standing for its mirror images
-        C = s.power
-        qy, qx = (2 * np.pi * np.arange(n) / P for n, P in zip(C.shape, (Py, Px)))
-        C = C * np.where(qy > 0, 2.0, 1.0)[:, None] * np.where(qx > 0, 2.0, 1.0)[None, :]
-    else:
-        C = s.map
-        qy, qx = (2 * np.pi * np.fft.fftfreq(n, P / n) for n, P in ((My, Py), (Mx, Px)))
+    if s.mirrored:
+        qy, qx = (2 * np.pi * np.arange(n) / P for n, P in zip(s.power.shape, (Py, Px)))
+        return qy, qx, s.power * np.where(qy > 0, 2.0, 1.0)[:, None] * np.where(qx > 0, 2.0, 1.0)[None, :]
+    qy, qx = (2 * np.pi * np.fft.fftfreq(n, P / n) for n, P in ((My, Py), (Mx, Px)))
+    return qy, qx, s.map
+
+
+def _gradient_share(surface: Surface, spectrum: Spectrum | None = None):
+    """``kept_gradient`` of ``surface`` (its PSD ``spectrum``, if at hand) as a function of the
+    cell (dx, dy) [m]."""
+    qy, qx, C = _modes(spectrum or power_spectrum(surface))
     g = C * (qy[:, None] ** 2 + qx[None, :] ** 2)
     total, ay, ax = g.sum(), np.abs(qy), np.abs(qx)
 
@@ -467,11 +471,12 @@ def _gradient_share(surface: Surface):
     return share
 
 
-def coarse_grid(surface: Surface, cell, prefix: str = "") -> str | None:
+def coarse_grid(surface: Surface, cell, prefix: str = "", spectrum: Spectrum | None = None) -> str | None:
     """The warning for a micro grid of cells ``cell`` = (dx, dy) [m] that resolves less than
-    ``GRADIENT_KEPT`` of the RMS gradient of the conditioned measurement ``surface`` (with the
-    cells that would keep that much, by bisection on their scale), else None."""
-    share = _gradient_share(surface)
+    ``GRADIENT_KEPT`` of the RMS gradient of the conditioned measurement ``surface`` (its PSD
+    ``spectrum``, if at hand; with the cells that would keep that much, by bisection on their
+    scale), else None."""
+    share = _gradient_share(surface, spectrum)
     kept = share(cell)
     if kept >= GRADIENT_KEPT:
         return None
@@ -486,25 +491,23 @@ def coarse_grid(surface: Surface, cell, prefix: str = "") -> str | None:
             "smoother surface than the one measured (a finer micro.grid or more micro.zones keep more)")
 
 
-def beyond_measurement(surface: Surface, cell, prefix: str = "") -> str | None:
+def beyond_measurement(surface: Surface, cell, prefix: str = "", spectrum: Spectrum | None = None) -> str | None:
     """The warning for ``cover = "equivalent"`` on cells ``cell`` = (dx, dy) [m] when more than
     ``LONG_POWER`` of the power that surface draws from the measurement ``surface`` (its modes
     that the cells resolve) lies in the mirror-stitched spectrum's first modes along x or y
     (``power_spectrum``: wavelength 2 mx or 2 my, longer than the measurement: its form left
     after the detrending, not roughness; a user trial: 99 % of an 83 um x3p map's on 78 um cells,
-    a 13 nm face from ~5 modes), else None."""
-    s = power_spectrum(surface)
+    a 13 nm face from ~5 modes; ``spectrum``: its PSD, if at hand), else None."""
+    s = spectrum or power_spectrum(surface)
     if not s.mirrored:
         return None
-    (Px, Py), C = s.period, s.power
-    qy, qx = (2 * np.pi * np.arange(n) / P for n, P in zip(C.shape, (Py, Px)))
-    w = np.where(qy > 0, 2.0, 1.0)[:, None] * np.where(qx > 0, 2.0, 1.0)[None, :]   # mirror images
+    qy, qx, C = _modes(s)
     band = (qy[:, None] <= np.pi / cell[1]) & (qx[None, :] <= np.pi / cell[0])
     band[0, 0] = False
     first = np.zeros_like(band)
     first[1:2, :], first[:, 1:2] = True, True
-    total = float((w * C)[band].sum())
-    share = float((w * C)[band & first].sum()) / total if total > 0 else 0.0
+    total = float(C[band].sum())
+    share = float(C[band & first].sum()) / total if total > 0 else 0.0
     if share <= LONG_POWER:
         return None
     mx, my = surface.size

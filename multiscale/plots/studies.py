@@ -109,12 +109,12 @@ def _plain_log(axis) -> None:
     axis.set_minor_formatter(FuncFormatter(label))
 
 
-def _axis_label(study, axis, shown) -> str:
-    """The knobs of an axis, with the SI unit of a micro parameter whose values are bare numbers
-    ("E [Pa]"; "E / nu" of a zipped axis read as a ratio: "E, nu")."""
+def _axis_label(study, axis, raw) -> str:
+    """The knobs of an axis, with the SI unit of a micro parameter whose values ``raw`` (as the
+    study gave them) are bare numbers ("E [Pa]"; "E / nu" of a zipped axis read as a ratio: "E, nu")."""
     parser = parser_of(PROBLEMS[study.problem], axis[0])
     unit = getattr(getattr(getattr(parser, "parser", None), "kind", None), "si", "")
-    bare = all(not any(c.isalpha() for c in text.replace("e", "")) for text in shown)
+    bare = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in raw)
     return ", ".join(axis) + (f" [{unit}]" if unit and bare else "")
 
 
@@ -165,7 +165,7 @@ def _plot_axis(study, ok, axis, folder):
         if kind == "time":
             ax.set_yscale("log")
         value = metric_heading(m, PROBLEMS[study.problem].metric_unit(m)) if kind == "value" else ""
-        ax.set(xlabel=_axis_label(study, axis, shown_at.values()), ylabel={"error": f"relative error of {m}", "value": value, "time": "wall time [s]"}[kind],
+        ax.set(xlabel=_axis_label(study, axis, [r.run.raw[axis[0]] for r in ok]), ylabel={"error": f"relative error of {m}", "value": value, "time": "wall time [s]"}[kind],
                title={"error": f"error of {m}", "value": m, "time": "wall time of a run"}[kind])
         if log_x:             # ticks at the swept values, no minor labels (they overlap on short decades)
             ax.set_xscale("log")

@@ -71,7 +71,8 @@ def _code_line(rows) -> str:
     if not versions:
         return "- Code: no run recorded"
     if len(versions) == 1:
-        return "- Code: " + ", ".join(f"package SHA-1 {s}" + (f" (commit {c})" if c else "") for s, c in versions.items())
+        (sha1, commit), = versions.items()
+        return f"- Code: package SHA-1 {sha1}" + (f" (commit {commit})" if commit else "")
     return (f"- Code: **the runs were made by {len(versions)} versions of the package** (SHA-1 "
             f"{', '.join(versions)}; column `code` of results.csv): a record is reused whatever code made it; "
             "delete the records of runs/ to run them again with this code.")
