@@ -71,3 +71,28 @@ def test_laws_of_a_deformed_zone_reload_elastically_then_load_plastically(zones)
     assert np.all(reload.pressure[~below] < 0.99 * elastic[~below])                 # above: new yield
     with pytest.raises(InputError, match="p_max"):
         LawSpec(KERNEL, p_max=8e6, hardness=5e6)
+
+
+def test_a_zone_whose_touching_cells_all_flow_gets_a_monotone_law():
+    """A cell 2 um proud of a smooth dome, H = 3 MPa: it flows alone at H over the first two
+    approach-spaced nodes (the same pressure twice: a staircase of the grid, which made no law and
+    failed as 'lower p_max'); the repeat is re-solved under load control between its neighbours,
+    and every node is a point of the discrete law (a displacement-controlled solve at its approach
+    gives its pressure)."""
+    n, dx, H = 16, 78e-6, 3e6
+    x = (np.arange(n) - n / 2) * dx
+    h = -(x[:, None] ** 2 + x[None, :] ** 2) * 100.0
+    h[n // 2, n // 2] += 2e-6
+    zone = cut_zones(Surface(h, dx, dx, periodic=False), (1, 1))[1][0]
+    solver = ContactSolver(KERNEL, zone.shape, dx, dx, periodic=False)
+    spec = LawSpec(KERNEL, p_max=0.9 * H, n_points=10, hardness=H)
+    nodes = compute_laws([zone], spec).nodes[0]
+    cell = H / n**2                                   # one flowing cell's share of the zone pressure
+    first_two = solver.solve(np.broadcast_to(h, (2, n, n)), approach=nodes.approach[-1] * np.array([0.01, 0.04]),
+                             tol=1e-10, hardness=H).mean_pressure
+    np.testing.assert_allclose(first_two, [cell, cell], rtol=1e-12)        # the plateau
+    assert np.all(np.diff(nodes.pressure) > 0) and np.all(np.diff(nodes.gap) < 0)
+    assert nodes.pressure[0] == pytest.approx(cell, rel=1e-12)
+    assert nodes.pressure[1] == pytest.approx(np.sqrt(nodes.pressure[0] * nodes.pressure[2]), rel=1e-6)
+    again = solver.solve(np.broadcast_to(h, (10, n, n)), approach=nodes.approach, tol=1e-10, hardness=H)
+    np.testing.assert_allclose(again.mean_pressure, nodes.pressure, rtol=1e-8)
