@@ -30,6 +30,20 @@ def test_uniform_load_gives_uniform_pressure_and_penalty_gap(tm):
     assert np.abs(m.contact.facet_gap() / (-p0 / K_N) - 1).max() < 1e-6   # g = -p / K_n
 
 
+def test_a_solve_that_reaches_its_round_off_floor_stops_there(tm):
+    """A block 1e6 x stiffer than before (E = 4e15 Pa): its round-off floor eps ||diag(K) x||
+    is 0 at the start and ~1e-9 N at the answer; the residual stalled there from iteration 5
+    to the cap of 30 before the solve was accepted. The floor is now that of the current iterate."""
+    stiff = dict(MATERIALS, block=Material(E=4e15, nu=0.15, alpha=1e-5))
+    p0 = 1e6
+    m = Mechanics(tm, stiff, stiffness=K_N, load_kind="pressure", prefix="block_r_")
+    r = m.solve(p0)
+    assert r.converged and r.iterations <= 6, r.residuals
+    assert r.residuals[-1] <= m._roundoff()
+    assert np.abs(m.contact.facet_pressure() / p0 - 1).max() < 1e-6
+    assert np.abs(m.contact.facet_gap() / (-p0 / K_N) - 1).max() < 1e-6
+
+
 def test_per_facet_stiffness_field_roundtrip_and_effect(tm):
     iface = tm.interface
     assert iface.n_facets == len(iface.areas) and iface.areas.sum() == pytest.approx(1e-4, rel=1e-12)

@@ -215,7 +215,8 @@ class Mechanics:
         self.problem.solver.setFunction(self._residual, self.problem.b)
         self._frictionless = None          # (matrix, form) of ``frictionless_tangent`` without P
         self._history: list[float] = []
-        self.problem.solver.setMonitor(lambda snes, it, norm: self._history.append(norm))
+        self._solve_atol = self._atol      # N, the absolute tolerance of the current solve (``solve``)
+        self.problem.solver.setMonitor(self._watch)
 
     def release(self) -> None:
         """Free the factors of the Newton preconditioner (the next solve factorises afresh): a modal
@@ -387,7 +388,7 @@ class Mechanics:
             self.load.value = float(load)
         scale = abs(float(self.load.value)) * self._unit_load          # N, the load vector's norm
         atol = min(self._atol, TINY_LOAD * scale) if scale > 0 and self._own_atol else self._atol
-        self.problem.solver.setTolerances(atol=max(atol, NEWTON_FLOOR * scale, self._roundoff()))
+        self._solve_atol = max(atol, NEWTON_FLOOR * scale, self._roundoff())
         start = [u.x.array.copy() for u in self.u]
         if guess is not None:
             before = self._residual_norm()
@@ -449,13 +450,26 @@ class Mechanics:
 
     def _roundoff(self) -> float:
         """``ROUNDOFF`` eps ||diag(K_cell) x|| [N] at the current state (collective)."""
-        x = self.problem.x
-        fpetsc.assign(self.u, x)
+        fpetsc.assign(self.u, self.problem.x)
+        return self._floor(self.problem.x)
+
+    def _floor(self, x: PETSc.Vec) -> float:
+        """``ROUNDOFF`` eps ||diag(K_cell) x|| [N] at displacements x (collective)."""
         d = self._split[0].bulk.getDiagonal()
         d.pointwiseMult(d, x)
         floor = ROUNDOFF * np.finfo(float).eps * d.norm()
         d.destroy()
         return floor
+
+    def _watch(self, snes, it, norm) -> None:
+        """SNES monitor: the residual history, and the absolute tolerance raised to the round-off
+        floor at the current iterate, at most the first residual (``_newton``'s stall, accepted as
+        it comes: a block 1e6 x stiffer than its flat stalled at 3e-9 N from iteration 5 to the cap
+        of 30, its floor 0 at the start; a runaway's floor grows with it, its residual too)."""
+        self._history.append(norm)
+        floor = min(self._floor(snes.getSolution()), self._history[0])
+        if floor > snes.getTolerances()[1]:
+            snes.setTolerances(atol=floor)
 
     def _newton(self) -> SolveResult:
         """One SNES solve from the current state; converged only if finite on every rank, and either
@@ -463,6 +477,7 @@ class Mechanics:
         not above the first (a block pulled off its flat ran away to 3.6e9 m, residual 20 -> 83 N)."""
         self._history.clear()
         self._offset_stale = True
+        self.problem.solver.setTolerances(atol=self._solve_atol)     # each attempt from the solve's (``_watch``)
         self.problem.solve()
         snes = self.problem.solver
         reason, its, history = snes.getConvergedReason(), snes.getIterationNumber(), list(self._history)

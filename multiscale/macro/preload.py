@@ -46,7 +46,6 @@ class Preload:
     time: float              # s, wall time
 
 
-NEWTON_FORCE_TOL = 1e-11    # absolute Newton tolerance relative to the applied force [-]
 TORQUE_TOL = 1e-3    # relative error of the friction moment left by the load's scaling to a torque
 TORQUE_SOLVES = 5    # contact solves at most per scaling
 
@@ -70,17 +69,12 @@ def preload(mech: Mechanics, pressure: float, steps: int = 1, reset: bool = True
             torque: float | None = None) -> Preload:
     """Ramp the load to ``pressure`` [Pa] (a force [N] for ``load_kind="force"``) in ``steps``
     Newton solves, from rest if ``reset``; with ``torque`` [N m], ``pressure`` is a first guess,
-    scaled after the ramp until the friction moment is the torque (``hold_moment``). The absolute
-    residual tolerance is NEWTON_FORCE_TOL times the applied force: a re-solve from a nearly
-    balanced state otherwise asks for a relative reduction below the round-off floor of the
-    penalty-stiff system."""
+    scaled after the ramp until the friction moment is the torque (``hold_moment``); the Newton's
+    tolerances are ``Mechanics.solve``'s (floors scaled by the load and the round-off)."""
     check_positive("pressure", pressure)
     t0 = time.perf_counter()
     tm, c = mech.tm, mech.contact
     loads = load_face_forces(tm, pressure, mech.load_kind)
-    snes = mech.problem.solver
-    rtol, atol, stol, max_it = snes.getTolerances()
-    snes.setTolerances(atol=max(atol, NEWTON_FORCE_TOL * sum(loads.values())))
     if reset:
         for u in mech.u:
             u.x.array[:] = 0.0
