@@ -78,6 +78,8 @@ KINDS: dict[str, Kind] = {
     "diffusivity": Kind("thermal diffusivity", _dim((L, 2), (T, -1)), "m^2/s", "m^2/s, mm^2/s"),
     "conductance": Kind("thermal conductance per area", _dim((M, 1), (T, -3), (TH, -1)), "W/(m^2 K)",
                         "W/(m^2 K)"),
+    "resistance": Kind("thermal contact resistance per area", _dim((M, -1), (T, 3), (TH, 1)), "m^2 K/W",
+                       "m^2 K/W"),
     "wear_rate": Kind("wear rate per frictional work (dh = k_w mu p ds: a specific wear rate K per normal load "
                       "is k_w = K/mu)", _dim((M, -1), (L, 1), (T, 2)), "1/Pa", "1/Pa, 1/MPa, m^2/N, mm^3/(N m)"),
 }

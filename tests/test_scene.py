@@ -85,6 +85,7 @@ folder = "out/run1"
     ("1e13 Pa/m", "stiffness", 1e13),
     ("1 N/mm^3", "stiffness", 1e9),
     ("1e5 W/(m^2 K)", "conductance", 1e5),
+    ("1 mm^2 K/W", "resistance", 1e-6),         # the conductance study's local R (was "dimensionless")
     ("8.3e-6 m^2/s", "diffusivity", 8.3e-6),
     ("1e-12 1/Pa", "wear_rate", 1e-12),
     ("16 kHz", "frequency", 16e3),
@@ -113,6 +114,7 @@ def test_unit_strings_to_si(text, kind, expected):
     ("68 degF", "temperature", "Fahrenheit is not read"),     # was: did you mean "deg" (an angle)
     ("300 °K", "temperature", 'the kelvin is written "K"'),   # was: did you mean "°"
     ("0.1 kcal/(kg K)", "specific_heat", "1 cal = 4.184 J"),  # was: did you mean "kPa"
+    ("14 %", "resistance", 'the unit "%" is a dimensionless number'),
 ])
 def test_unit_errors_say_what_is_expected(text, kind, fragment):
     with pytest.raises(UnitError, match=None) as info:

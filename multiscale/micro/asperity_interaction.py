@@ -35,10 +35,10 @@ candidate summits, stored up to ~5600 candidates, rows recomputed beyond), and p
 a_ref >= a bounds the final contact size: it comes from the warm start or from a screening pass
 with point forces only, and is enlarged (and the solve repeated) if a contact outgrows it. For a
 Hertz contact of semi-axes a >= b the correction is the quadrupole term,
-|u − P g| <= (2a² − b²)/(10 r²) · P g (circular: (a/r)²/10), with the higher orders < 0.21 (a/r)²
-P g for r >= 3a, so the neglected part of every interaction sum is at most
+|u − P g| <= (2a² − b²)/(10 r²) · P g (circular: (a/r)²/10), with the higher orders < 0.211 (a/r)²
+P g for r >= 3a (measured over r = 3a … 60a: 0.104 circular, 0.2101 at R2/R1 = 1e-3), so the neglected part of every interaction sum is at most
 ``far_field_coefficient / cutoff²`` of it: ``interaction_tol`` (default 1e-3) sets
-cutoff = sqrt(0.21 / interaction_tol) ≈ 14.5, and results report the bound. With many candidates
+cutoff = sqrt(0.211 / interaction_tol) ≈ 14.5, and results report the bound. With many candidates
 the minimisation runs on the summits in contact after screening or within 5 % of delta of
 touching; the final state is checked on every candidate (those that penetrate join, re-solve).
 """

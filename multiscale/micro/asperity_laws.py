@@ -23,7 +23,7 @@ and ``idx`` the matching asperity indices (table order). Sizes may be tiny but n
 * ``point_response(r) -> g``  surface displacement [m] at distance r per unit normal point force
   [N] (half-space: 1/(π E* r)); the far-field kernel of the interaction sum.
 * attributes ``n`` (number of asperities), ``E_star`` [Pa] (modulus used in kappa),
-  ``far_field_coefficient`` (bound c on |u − P g| <= c (a/r)² P g for r >= 3a; Hertz 0.21).
+  ``far_field_coefficient`` (bound c on |u − P g| <= c (a/r)² P g for r >= 3a; Hertz 0.211: 0.104 circular, 0.2101 at R2/R1 = 1e-3).
 
 ``multiscale.micro.asperity.AsperityModel(table, law, interaction=...)`` solves any such law;
 ``HertzCircular`` and ``HertzElliptic`` are the homogeneous half-space implementations
@@ -49,7 +49,7 @@ class AsperityLaw(ABC):
 
     n: int
     E_star: float
-    far_field_coefficient: float = 0.21
+    far_field_coefficient: float = 0.211
 
     @abstractmethod
     def approach(self, a, idx):

@@ -1,7 +1,7 @@
 """Steady thermal conduction through a rough contact: thermal contact conductance (thesis §5.2–5.4).
 
 Two solids touch on the real contact area found by the mechanics solve. The surface temperature of
-solid i is ``theta_i = T_i * phi_i + theta_li`` (Eqs. 5.1–5.3) with ``phi_1 + phi_2 = 0``; on the
+solid i is ``theta_i = T_i * phi_i + theta_li`` (Eqs. 5.1–5.3 for one solid, §5.4.2 for two) with ``phi_1 + phi_2 = 0``; on the
 contact, ``theta_2 − theta_1 = R phi_1`` (local resistance R [m² K/W], f = R phi). Hence Eq. 5.8,
 
     (T_1 + T_2) * phi_1 + R phi_1 = theta_l2 − theta_l1   on the contact,   phi_1 = 0 elsewhere (Eq. 5.12),

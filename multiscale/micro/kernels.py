@@ -32,7 +32,7 @@ class Kernel(ABC):
 
     @abstractmethod
     def compliance(self, q: np.ndarray) -> np.ndarray:
-        """Fourier transfer function (response/load per unit wavenumber, e.g. û_z/p̂ [m/Pa·m])
+        """Fourier transfer function (response over load of one Fourier mode, e.g. û_z/p̂ [m/Pa] = 2/(E* q) on a half-space)
         at wavenumber modulus ``q`` [rad/m]. Where it is infinite (q = 0 on a half-space) it
         returns 0: a periodic patch then has a zero-mean response."""
 

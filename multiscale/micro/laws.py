@@ -379,7 +379,7 @@ def _monotone_problem(gap, pressure, fraction) -> str:
     The gap stops decreasing where the roughness adds less compliance than Love's correction is off
     the patch's own: an isolated patch in near full contact carries a flat punch's edge pressures,
     whose mean displacement is 7 % below the uniform pressure's on a square (7.5 % on a circle: pi/2
-    against 16/(3 pi) p a/E*, Johnson 1985 §3.8; a user trial's smooth
+    against 16/(3 pi) p a/E*, Johnson 1985 §3.4; a user trial's smooth
     face on 1.3 mm zones: at 30 % real contact), so smaller zones carry a law further."""
     if not np.all(np.isfinite(gap)) or not np.all(np.isfinite(pressure)):
         return "non-finite node values"

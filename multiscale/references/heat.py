@@ -2,7 +2,8 @@
 
 Conductivity κ [W/(m K)], diffusivity χ [m²/s], flux q [W/m²] into the body, power Q [W];
 temperatures are rises [K] above the initial one. Sliding speed V [m/s] enters through the Péclet
-number Pe = V l / (2χ) of a source of half-width l [m].
+number Pe = V l / (2χ) of a source of half-width l [m] (Jaeger's; thesis §6.2.3 writes Pe = R ω a / χ
+for the same half-width a, twice this).
 
 The fixed and moving rectangular sources of thesis Eqs. 6.1–6.8 are evaluated by quadrature in
 ``multiscale.micro.heat_kernels`` (they share its tables' quadrature); these are the closed forms

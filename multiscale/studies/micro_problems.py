@@ -265,7 +265,7 @@ class ConductanceParams(SurfaceParams):
     nu_s: float = key(_POISSON, default=0.33)
     kappa_s: float = key(Quantity("conductivity", gt=0), default=50.0)
     pressure: float = key(Quantity("pressure", gt=0), default=3e6)            # Pa
-    resistance: float = key(Quantity("dimensionless", ge=0), default=0.0)     # m^2 K/W, local R
+    resistance: float = key(Quantity("resistance", ge=0), default=0.0)        # m^2 K/W, local R
     tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)
 
     def problems(self, path, ctx):
