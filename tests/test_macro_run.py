@@ -322,7 +322,7 @@ def test_a_body_hotter_than_any_material_is_warned_about(tmp_path):
             h.append(time=0.5 * k, max_temperature_block=T, max_temperature_flat=400.0)
         lines = [w for w in run_warnings(scene, h) if "plausible" in w]
         assert bool(lines) == warned
-    assert lines == ["the block reached 2.312e+04 K at t = 0.5 s, above any plausible temperature (2500 K: molten "
+    assert lines == ["body 'block' reached 2.312e+04 K at t = 0.5 s, above any plausible temperature (2500 K: molten "
                      "iron): check the load, the heat partition and the materials (the model has no melting, wear "
                      "of hot material or fade)"]
 

@@ -815,7 +815,7 @@ def test_a_rotating_disc_heated_by_two_pads_against_the_semi_infinite_solid(tmp_
     p1 = run(loads(TWO_PADS.format(step=step, folder=tmp_path / "p1")), verbose=False)
     low = p1.history["min_temperature_disc"].min()
     assert low < 293.15 - 0.1 * surface
-    assert f"the disc's temperature fell to {low:.2f} K" in \
+    assert f"the temperature of body 'disc' fell to {low:.2f} K" in \
         json.loads((tmp_path / "p1" / "provenance.json").read_text())["warnings"][-1]
 
 

@@ -233,7 +233,7 @@ def _too_hot(scene, history) -> list[str]:
         column = f"max_temperature_{body.name}"
         if column in history.columns and float(np.max(history[column])) > HOTTEST:
             row = int(np.argmax(history[column]))
-            out.append(f"the {body.name} reached {float(history[column][row]):.4g} K at t = {history['time'][row]:g} s, "
+            out.append(f"body {body.name!r} reached {float(history[column][row]):.4g} K at t = {history['time'][row]:g} s, "
                        f"above any plausible temperature ({HOTTEST:g} K: molten iron): check the load, the heat "
                        "partition and the materials (the model has no melting, wear of hot material or fade)")
     return out
@@ -252,7 +252,7 @@ def _undershoots(scene, history) -> list[str]:
             continue
         low, rise = float(np.min(history[cold])), float(np.max(history[hot])) - floor
         if floor - low > max(UNDERSHOOT * rise, 1e-3):
-            out.append(f"the {body.name}'s temperature fell to {low:.2f} K, {floor - low:.3g} K below the lowest "
+            out.append(f"the temperature of body {body.name!r} fell to {low:.2f} K, {floor - low:.3g} K below the lowest "
                        f"imposed temperature ({floor:.2f} K) while it rose by {rise:.3g} K: an undershoot of the "
                        "discretisation (a heated layer thinner than the elements; with a rotating body, its Eulerian "
                        "transport): temperatures near the rubbing surface are uncertain by at least as much; refine "
