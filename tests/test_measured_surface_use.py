@@ -476,6 +476,12 @@ def test_a_micro_grid_too_coarse_for_the_measured_gradient_is_warned_about(tmp_p
     assert kept < topography.GRADIENT_KEPT and f"resolve {kept:.1%} of" in warned
     half = float(warned.split("cells of ")[1].split(" x")[0]) * 1e-6       # the cells it names
     assert topography.kept_gradient(measured, (half, half)) == pytest.approx(topography.GRADIENT_KEPT, rel=0.02)
+    from multiscale.workflows import rough
+    for said in (False, True):    # a run repeats it only where the scene's check could not (a face's extent unknown)
+        lines = []                # before meshing); it said it twice, with 78.12 and 78.13 um cells
+        rough.make_zones(s.roughness, s.micro, (0.0, 0.0), (10e-3, 10e-3), seed=0, log=lines.append, warned=said)
+        assert sum("of the measured RMS gradient" in line for line in lines) == (not said)
+    assert "interface" in s.geometry.spec.interface_extents        # so a run of this scene says it once
     fine = scene(tmp_path, 'file = "pad.npy"\npixel_size = "10 um"\ncover = "equivalent"', "grid = [500, 500]")
     assert not [w for w in fine.warnings if "of the measured RMS gradient" in w]      # 10 um cells: the pixels
 

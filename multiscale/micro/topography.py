@@ -326,7 +326,8 @@ def resample(surface: Surface, n, size=None, antialias: bool = True) -> tuple[Su
                  f"{_um(float(surface.heights.std()))} -> {_um(float(out.heights.std()))} um")
 
 
-def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: str = "") -> tuple[Surface, list[str]]:
+def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: str = "",
+          warn: bool = True) -> tuple[Surface, list[str]]:
     """A surface of n = (nx, ny) cells over size (Lx, Ly) [m] made from a conditioned measurement
     (at its own pixel size) by ``method`` (one of ``COVER``):
 
@@ -340,20 +341,23 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
     - ``"equivalent"``: a statistically equivalent surface from its PSD
       (``spectrum.equivalent_surface``, ``seed``) over the whole size.
 
-    Returns the (non-periodic) surface and report lines.
+    ``warn``: the grid's resolution of the gradient (``coarse_grid``) and the equivalent surface's
+    power beyond the measurement (``beyond_measurement``) checked (False: said already, e.g. by a
+    scene's check for a face whose extent its geometry knows). Returns the (non-periodic) surface
+    and report lines.
     """
     nx, ny = check_pair(f"{prefix}n", n, check_count)
     Lx, Ly = check_pair(f"{prefix}size", size, check_positive)
     short = not covers(surface.size, (Lx, Ly), method, prefix)
     wide, target = _sized("the measurement", surface.size), _sized("the interface", (Lx, Ly))
     spectrum = power_spectrum(surface)           # one PSD for the checks and the equivalent surface
-    coarse = coarse_grid(surface, (Lx / nx, Ly / ny), prefix, spectrum)
+    coarse = coarse_grid(surface, (Lx / nx, Ly / ny), prefix, spectrum) if warn else None
     if coarse is not None:
         warnings.warn(coarse, TopographyWarning, stacklevel=2)
     lines = [f"warning: {coarse}"] if coarse is not None else []
     if method == "equivalent":
         check_resolved(surface.size, (nx, ny), (Lx, Ly), prefix)
-        beyond = beyond_measurement(surface, (Lx / nx, Ly / ny), prefix, spectrum)
+        beyond = beyond_measurement(surface, (Lx / nx, Ly / ny), prefix, spectrum) if warn else None
         if beyond is not None:
             warnings.warn(beyond, TopographyWarning, stacklevel=2)
             lines.append(f"warning: {beyond}")

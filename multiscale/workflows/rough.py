@@ -57,16 +57,18 @@ def check_rough_scene(scene) -> None:
         raise broken[0]
 
 
-def make_zones(r, m, lo, hi, seed: int, log=None, prefix: str = "roughness.") -> tuple[ZoneGrid, list]:
+def make_zones(r, m, lo, hi, seed: int, log=None, prefix: str = "roughness.",
+               warned: bool = False) -> tuple[ZoneGrid, list]:
     """The zone grid over the box [lo, hi] (u, v) [m] of one interface and each zone's initial
     patch (``r``: its [roughness], ``m``: its [micro]; see module docstring; ids from 0; errors
     name ``prefix`` + the key, as the scene's check does: ``Scene.roughness_key``).
     ``log(line)`` receives the steps that made a measured surface (the warnings among them too,
-    instead of Python warnings on every rank)."""
+    instead of Python warnings on every rank; ``warned``: the scene's check said the measured face's
+    resolution warnings already, ``topography.cover``)."""
     counts = tuple(int(c) for c in m.zones)
     size = np.asarray(hi, float) - np.asarray(lo, float)
     if r.file is not None:
-        return cut_zones(measured_face(r, m, counts, size, seed, log, prefix), counts, origin=tuple(lo))
+        return cut_zones(measured_face(r, m, counts, size, seed, log, prefix, warned), counts, origin=tuple(lo))
     cells_per_zone = m.grid or DEFAULT_GRID
     if r.patch == "face":
         cells = (counts[0] * cells_per_zone[0], counts[1] * cells_per_zone[1])
@@ -76,7 +78,7 @@ def make_zones(r, m, lo, hi, seed: int, log=None, prefix: str = "roughness.") ->
     return grid, generate_zones(grid, tuple(cells_per_zone), r.hurst, r.k_min, r.k_max, r.rms, seed=seed)
 
 
-def measured_face(r, m, counts, size, seed: int, log=None, prefix: str = "roughness.") -> Surface:
+def measured_face(r, m, counts, size, seed: int, log=None, prefix: str = "roughness.", warned: bool = False) -> Surface:
     """The face of ``size`` [m] from ``roughness.file``: read, conditioned (``roughness.detrend``,
     ``cutoff``, ``max_undefined``, ``despike``) and covering the face (``roughness.cover``), on counts x
     ``topography.zone_cells`` cells (``micro.grid``; without it 50 x 50 per zone for an equivalent
@@ -88,7 +90,7 @@ def measured_face(r, m, counts, size, seed: int, log=None, prefix: str = "roughn
         cells = zone_cells(m.grid, r.cover, size, counts, (measured.dx, measured.dy), DEFAULT_GRID, r.file.name)
         done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix=prefix, despike=r.despike)
         surface, lines = cover(done.surface, (counts[0] * cells[0], counts[1] * cells[1]), tuple(size), r.cover,
-                               seed, prefix=prefix)
+                               seed, prefix=prefix, warn=not warned)
     known = {f"warning: {note}" for note in (*measured.notes, *done.notes)}   # the scene's warnings already
     for line in (*done.report, *lines) if log is not None else ():
         if line not in known:
@@ -153,7 +155,8 @@ def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterfac
         k = list(tm.interface.tags).index(name)
         plane, lo, hi = interface_plane(tm, name)
         grid, patches = make_zones(settings.roughness, settings.micro, lo, hi, settings.roughness.seed + SEED_STRIDE * k,
-                                   log=log, prefix=f"{scene.roughness_key(name)}.")
+                                   log=log, prefix=f"{scene.roughness_key(name)}.",
+                                   warned=name in scene.geometry.spec.interface_extents)   # by the scene's check
         offset = len(zones)
         planes.append(plane)
         grids.append(grid)
