@@ -136,20 +136,32 @@ def subspace_mac(a: ModalResult | np.ndarray, b: ModalResult | np.ndarray, ia, i
     return float(min(s.min() ** 2, 1.0))
 
 
+PAIR_TIE = 1e-8   # sums of MAC less eigenvalue jump that differ by less are a tie (round-off: ~1e-10)
+
+
 def pair_modes(mac: np.ndarray, lam_a: np.ndarray, lam_b: np.ndarray, mac_min: float = 0.5,
-               subspace=None) -> list[tuple[int, int]]:
+               subspace=None, tie: float = PAIR_TIE) -> list[tuple[int, int]]:
     """One-to-one pairs (i, j) of modes of two neighbouring cases that maximise the sum of
     MAC_ij - |lambda_j - lambda_i| / |lambda_i| (the eigenvalue distance tells apart the two
     members of a locked-in pair, whose shapes are complex conjugates); pairs with MAC < ``mac_min``
     are dropped, unless ``subspace`` (a callable (rows, cols) -> ``subspace_mac`` of those modes)
     is given and the pair forms, with the pair of the mode nearest in frequency to j (to i), a
     block of two whose subspaces have a subspace MAC >= ``mac_min``: a pair that coalesces (splits)
-    between the two cases, whose members are each a mix of both parents (``subspace_mac``)."""
+    between the two cases, whose members are each a mix of both parents (``subspace_mac``).
+
+    Ties (sums within ``tie``) keep the order of the mode numbers: two crossed pairs are uncrossed.
+    Where a pair locks in (splits), its two members y and conj(y), sigma -+, have the same MAC with
+    a stable (real-shaped) parent and the same eigenvalue jump from a parent on the imaginary axis:
+    the two assignments tie exactly, and the solver's choice followed the round-off (it differed
+    between 1 and 2 ranks, and between two serial runs). Now the lower parent continues into the
+    stable member (numbered first, ``eigen.by_frequency``) and, at a split, the stable member
+    into the lower child."""
     if mac.size == 0:
         return []
     dist = np.abs(lam_b[None, :] - lam_a[:, None]) / np.maximum(np.abs(lam_a)[:, None], np.finfo(float).tiny)
-    rows, cols = linear_sum_assignment(-(mac - np.minimum(dist, 1.0)))
-    pairs = [(int(i), int(j)) for i, j in zip(rows, cols)]
+    score = mac - np.minimum(dist, 1.0)
+    rows, cols = linear_sum_assignment(-score)
+    pairs = _uncross([(int(i), int(j)) for i, j in zip(rows, cols)], score, tie)
     if subspace is None:
         return [(i, j) for i, j in pairs if mac[i, j] >= mac_min]
     to_b, to_a = dict(pairs), {j: i for i, j in pairs}
@@ -168,6 +180,23 @@ def pair_modes(mac: np.ndarray, lam_a: np.ndarray, lam_b: np.ndarray, mac_min: f
                 continue
         kept.append((i, j))
     return kept
+
+
+def _uncross(pairs: list, score: np.ndarray, tie: float) -> list[tuple[int, int]]:
+    """``pairs`` (an optimal assignment of ``score``) with every two crossed pairs (i1 < i2,
+    j1 > j2) whose uncrossing lowers the sum by at most ``tie`` uncrossed: one result for all
+    the optimal assignments that differ by such swaps (each swap removes an inversion: it ends)."""
+    pairs = sorted(pairs)
+    changed = True
+    while changed:
+        changed = False
+        for a in range(len(pairs)):
+            for b in range(a + 1, len(pairs)):
+                (i1, j1), (i2, j2) = pairs[a], pairs[b]
+                if j1 > j2 and score[i1, j2] + score[i2, j1] >= score[i1, j1] + score[i2, j2] - tie:
+                    pairs[a], pairs[b] = (i1, j2), (i2, j1)
+                    changed = True
+    return pairs
 
 
 def mmac(mac: np.ndarray) -> np.ndarray:

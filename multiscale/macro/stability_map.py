@@ -11,8 +11,10 @@ projected on the same M-orthonormal basis V) and its modes in the band. ``build_
   (``modal.subspace_mac``): a pair that locks in (or splits) between two points, whose members
   are each a mix of both parents (at a lock-in both conjugate members have the same MAC with a
   given parent, high with one, low with the other); its ``mac`` is then the pair's own MAC, below
-  ``mac_min``. A mode without a partner starts a new track. The tracks are the
-  mode-pairing table (``map.csv``: track, mode number and MAC with the previous point);
+  ``mac_min``. A tie (the two members of a pair that locks in or splits have the same MAC with,
+  and eigenvalue jump from, a stable parent) keeps the order of the mode numbers
+  (``modal.pair_modes``), whatever the round-off. A mode without a partner starts a new track.
+  The tracks are the mode-pairing table (``map.csv``: track, mode number and MAC with the previous point);
 - finds where a track turns unstable between v_{k-1} and v_k (a track stable at v_{k-1}, or one
   that starts unstable at v_k because its branch failed the MAC test, e.g. at a lock-in, and whose
   best match at v_{k-1} was stable) and bisects the onset value
