@@ -47,6 +47,7 @@ METHODS = ("bccg", "pk")
 CHUNK_CELLS = {"bccg": 65536, "pk": 32768}   # cells per chunk of a batch (the working set stays in L2)
 COARSE_MIN = 32      # smallest side of the grids of the nested start of "bccg"
 COARSE_TOL = 1e-1    # tolerance of the coarse solves of the nested start
+BALANCE = 1e-9      # a load-controlled patch whose mean pressure is further off its load is not converged
 SNAP = 1e-12         # a start within this relative distance below the hardness is at the hardness
 AT_HARDNESS = 10     # a cell within AT_HARDNESS x tol below H is at H (plastic): a cell's error reaches a
 #                      few tol (2.7 tol where a fractal patch is reloaded to its maximum load)
@@ -272,6 +273,8 @@ class ContactSolver:
             for name, values in solved.items():
                 out[name][c] = values
             out["mean_pressure"][c] = p[c].mean(axis=(1, 2))
+            if tc is not None:                               # load control: balanced, whatever the residual says
+                out["converged"][c] &= np.abs(out["mean_pressure"][c] - tc) <= BALANCE * tc
             if fields:
                 np.add(u[c], z[c], out=gap[c])
                 gap[c] -= solved["d"][:, None, None]
@@ -377,7 +380,11 @@ def bounded_start(p, upper, total=None):
     (>= 0) such that Σ min(c p, H) = ``total`` (B,) under load control (exact on the sorted
     values: the k largest cells saturate, c v_k <= H <= c v_(k-1)), else c = 1. Values within
     ``SNAP`` of H are set to H: a warm start from a bounded solution (its cells at H rescaled by
-    1 ± 1e-16) keeps its saturated set (the first iteration's projection restores the balance)."""
+    1 ± 1e-16) keeps its saturated set (the first iteration's projection restores the balance).
+    A start with too few loaded cells to carry ``total`` at H (a warm start from a harder or less
+    loaded solve) has no such c: it is replaced by the uniform total / N (< H, ``solve``'s check);
+    before, its cells all at H carried part of the load (11-95 % in a user trial), which the solver
+    took for converged (no free cell left: residual 0)."""
     p = np.maximum(np.asarray(p, dtype=float), 0.0)
     H = upper[:, None]
     if total is None:
@@ -398,6 +405,8 @@ def bounded_start(p, upper, total=None):
     scale = c[np.arange(p.shape[0]), first]
     p = np.minimum(p * scale[:, None], H)
     p[p >= H * (1 - SNAP)] = np.broadcast_to(H, p.shape)[p >= H * (1 - SNAP)]   # ties at H stay saturated
+    short = ~ok.any(axis=1)
+    p[short] = (total[short] / p.shape[1])[:, None]
     return p
 
 
