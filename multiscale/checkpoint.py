@@ -23,9 +23,10 @@ from multiscale import __version__
 from multiscale.errors import InputError
 from multiscale.io import on_root, replacing
 
-FORMAT = 4    # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns;
+FORMAT = 5    # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns;
 #               3: the drive's state (speed, engagement, load last solved) and the area-weighted effusivity partition;
-#               4: the law_reach_halved history column, quadratic cells in the field files beside it
+#               4: the law_reach_halved history column, quadratic cells in the field files beside it;
+#               5: min_temperature_<body>_in_<material> history columns
 
 
 def fingerprint(text: str) -> str:

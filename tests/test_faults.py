@@ -120,8 +120,9 @@ def test_a_checkpoint_of_another_format_is_one_clear_error(stopped, tmp_path):
     shutil.copytree(checkpoint.parent, folder)
     with h5py.File(folder / "checkpoint.h5", "a") as h5:
         del h5.attrs["format"]                                  # as written before the format existed
+    from multiscale.checkpoint import FORMAT
     with pytest.raises(InputError, match=r"written by another version of multiscale \(checkpoint format 1, this "
-                                         r"one reads 4\); start again with --overwrite"):
+                                         rf"one reads {FORMAT}\); start again with --overwrite"):
         run(_with_folder(scene, folder), resume=True, verbose=False)
 
 

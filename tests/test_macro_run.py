@@ -199,7 +199,7 @@ def test_temperatures_beyond_a_material_table_are_warned_about(tmp_path, capsys)
     assert hottest > 20.5
     record = json.loads((result.folder / "provenance.json").read_text())
     assert record["warnings"] == [*scene.warnings, f"materials.pin.kappa: {hottest:.4g} degC above its last point "
-                                  f"20.5 degC, held at 35 there (in the pin)"]
+                                  f"20.5 degC, held at 35 there (in body 'pin')"]
     assert list(result.warnings) == record["warnings"]
     assert [line for line in capsys.readouterr().err.splitlines() if "materials." in line] == \
         [f"warning: {line}" for line in record["warnings"]]
@@ -307,7 +307,7 @@ def test_a_material_table_is_judged_by_the_temperatures_of_its_own_cells(tmp_pat
                      max_temperature_pin_in_disc=293.15 + scale * 193, max_temperature_disc=293.15 + scale * (disc - 20))
         lines = run_warnings(scene, h)
         assert [w for w in lines if "materials.disc.kappa" in w] == (
-            ["materials.disc.kappa: 350 degC above its last point 300 degC, held at 45 there (in the disc)"]
+            ["materials.disc.kappa: 350 degC above its last point 300 degC, held at 45 there (in body 'disc')"]
             if warned else []), lines
 
 
@@ -402,3 +402,23 @@ def test_a_run_says_the_size_of_its_model(tmp_path, capsys):
         return f"{n:,}".replace(",", " ")
     assert len(said) == 1 and said[0].startswith(f"  model: {spaced(cells)} cells, {spaced(3 * vertices)} displacement dofs, ")
     assert said[0].endswith(" temperature dofs")
+
+
+def test_a_body_that_cools_below_a_tables_first_point_is_named(tmp_path):
+    """A disc table from 100 degC, the run started at 150 degC: the disc cooling to 60 degC left
+    it below its first point (held there), which no warning said (only the hottest temperature
+    was compared; a materials engineer's trial: a block from 520 degC held at 20 degC). The pin
+    body's steel ("disc" material) holder is judged by its own cells."""
+    from multiscale.workflows import run_warnings
+    table = '[["100 degC", "50 W/(m K)"], ["300 degC", "45 W/(m K)"]]'
+    text = pin_on_disc(tmp_path / "out").replace('kappa = "50 W/(m K)"', f"kappa = {table}")
+    scene = loads(text.replace('initial_temperature = "20 degC"', 'initial_temperature = "150 degC"'))
+    for cold, warned in ((120.0, False), (60.0, True)):
+        h = History()
+        for k, T in enumerate((150.0, cold)):
+            h.append(time=0.6 * k, max_temperature_pin=423.15, min_temperature_pin=273.15 + T,   # (its pin material)
+                     max_temperature_pin_in_disc=423.15, min_temperature_pin_in_disc=413.15,
+                     max_temperature_disc=423.15, min_temperature_disc=273.15 + T)
+        lines = [w for w in run_warnings(scene, h) if "materials.disc.kappa" in w]
+        assert lines == (["materials.disc.kappa: 60 degC below its first point 100 degC, held at 50 there "
+                          "(in body 'disc')"] if warned else []), lines

@@ -823,7 +823,7 @@ def test_a_strain_table_without_expansion_is_said_to_be_read_at_the_start(tmp_pa
     coupled = loads(text.replace('"conductance"]', '"conductance", "expansion"]'), tmp_path)
     assert not any("depends on the temperature" in w for w in coupled.warnings)
     assert run_warnings(coupled, hot) == ["materials.block.E: 126.9 degC above its last point 60 degC, held at "
-                                          "4e+08 there (in the block)"]
+                                          "4e+08 there (in body 'block')"]
 
 
 def test_an_interface_that_carries_no_force_is_warned_about(tmp_path):

@@ -329,6 +329,8 @@ class MacroModel:
                 if len({r.material for r in body.spec.regions}) > 1:     # per material (their tables)
                     for material, T in self.thermal.region_max_temperature(i).items():
                         row[f"max_temperature_{body.name}_in_{material}"] = T
+                    for material, T in self.thermal.region_max_temperature(i, lowest=True).items():
+                        row[f"min_temperature_{body.name}_in_{material}"] = T
                 if len(body.spec.regions) > 1:                          # per part (a brake's pads)
                     for part, T in self.thermal.region_max_temperature(i, "name").items():
                         row[f"max_temperature_{body.name}_part_{part}"] = T

@@ -551,15 +551,18 @@ class Thermal:
         """Largest nodal temperature of each body [K]."""
         return tuple(self.tm.comm.allreduce(T.x.array.max(initial=-np.inf), op=MPI.MAX) for T in self.T)
 
-    def region_max_temperature(self, i: int, by: str = "material") -> dict:
-        """Largest nodal temperature [K] of the cells of body ``i`` grouped by their regions'
-        ``by``: "material", or "name" (the parts of a geometry file, a brake's pads; collective; a
-        node on a boundary between two groups belongs to both)."""
+    def region_max_temperature(self, i: int, by: str = "material", lowest: bool = False) -> dict:
+        """Largest (``lowest``: smallest) nodal temperature [K] of the cells of body ``i`` grouped by
+        their regions' ``by``: "material", or "name" (the parts of a geometry file, a brake's pads;
+        collective; a node on a boundary between two groups belongs to both)."""
         if (i, by) not in self.region_dofs:
             body = self.tm.bodies[i]
             dofs = self.T[i].function_space.dofmap.list[:len(body.region_tags)]
             self.region_dofs[i, by] = {g: np.unique(dofs[cells]) for g, cells in body.region_cells(by).items()}
         T = self.T[i].x.array
+        if lowest:
+            return {g: self.tm.comm.allreduce(T[mine].min(initial=np.inf), op=MPI.MIN)
+                    for g, mine in self.region_dofs[i, by].items()}
         return {g: self.tm.comm.allreduce(T[mine].max(initial=-np.inf), op=MPI.MAX)
                 for g, mine in self.region_dofs[i, by].items()}
 

@@ -129,26 +129,31 @@ def _abandoned(folder: Path, scene) -> None:
 
 def run_warnings(scene, history) -> list[str]:
     """What a run's history shows it extrapolated: material tables its temperatures left (held
-    constant beyond their ends, ``Material.beyond``: the largest temperature over the history of
-    the bodies made of each material, for the tables the initial temperature, checked when the
-    scene is read, was in), zone pressures above the top of their laws (extrapolated linearly) and
+    constant beyond their ends, ``Material.beyond``: the largest and the smallest temperature over
+    the history of the bodies made of each material, for the tables the initial temperature,
+    checked when the scene is read, was in; a body cooled below a table's first point was not
+    said), zone pressures above the top of their laws (extrapolated linearly) and
     temperatures below every imposed one (``UNDERSHOOT``)."""
     if history is None:
         return []
     laws = _law_reach(history)
-    T0, hottest = scene.time.initial_temperature, {}
+    T0, hottest, coldest = scene.time.initial_temperature, {}, {}
     for body in scene.geometry.spec.bodies:
         for name in (r.material for r in body.regions):       # the material's own column if the body has several
-            column = next((c for c in (f"max_temperature_{body.name}_in_{name}", f"max_temperature_{body.name}")
-                           if c in history.columns), None)
-            if column is not None:
-                hottest[name] = max(hottest.get(name, (-np.inf, "")), (float(np.max(history[column])), body.name))
+            for end, extreme, found in (("max", np.max, hottest), ("min", np.min, coldest)):
+                column = next((c for c in (f"{end}_temperature_{body.name}_in_{name}",
+                                           f"{end}_temperature_{body.name}") if c in history.columns), None)
+                if column is not None:
+                    T = float(extreme(history[column]))
+                    if name not in found or (T > found[name][0]) == (end == "max"):
+                        found[name] = (T, body.name)
     out = []
-    for name, (T, body) in hottest.items():
+    unread = () if scene.has("expansion") else Material.STRAIN      # read at the initial temperature only
+    for name in hottest:
         known = scene.materials[name].beyond(T0)
-        unread = () if scene.has("expansion") else Material.STRAIN      # read at the initial temperature only
-        out += [f"materials.{name}.{phrase} (in the {body})"
-                for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
+        for T, body in dict.fromkeys((hottest[name], coldest.get(name, hottest[name]))):   # the hottest, the coldest
+            out += [f"materials.{name}.{phrase} (in body {body!r})"
+                    for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
     return (out + laws + _undershoots(scene, history) + _coarse_wear(scene, history) + _wear_table_ends(scene, history)
             + _too_hot(scene, history) + _unloaded(scene, history)
             + (overloaded(scene, float(np.max(history["max_pressure"])), hottest)
