@@ -559,12 +559,8 @@ class Thermal:
             body = self.tm.bodies[i]
             dofs = self.T[i].function_space.dofmap.list[:len(body.region_tags)]
             self.region_dofs[i, by] = {g: np.unique(dofs[cells]) for g, cells in body.region_cells(by).items()}
-        T = self.T[i].x.array
-        if lowest:
-            return {g: self.tm.comm.allreduce(T[mine].min(initial=np.inf), op=MPI.MIN)
-                    for g, mine in self.region_dofs[i, by].items()}
-        return {g: self.tm.comm.allreduce(T[mine].max(initial=-np.inf), op=MPI.MAX)
-                for g, mine in self.region_dofs[i, by].items()}
+        T, (extreme, op, none) = self.T[i].x.array, (np.min, MPI.MIN, np.inf) if lowest else (np.max, MPI.MAX, -np.inf)
+        return {g: self.tm.comm.allreduce(extreme(T[mine], initial=none), op=op) for g, mine in self.region_dofs[i, by].items()}
 
     def min_temperature(self) -> tuple:
         """Smallest nodal temperature of each body [K] (below every imposed temperature: an undershoot
