@@ -41,6 +41,31 @@ def rough_rules(scene) -> list[InputError]:
     return out
 
 
+def micro_constants(scene) -> list[str]:
+    """Warnings of what the micro scale takes as constants: the rough interface's materials at the
+    initial temperature (``workflows.model.interface_materials``: E, nu for the zone laws; kappa,
+    chi, rho, c for the heat partition and flash temperatures; their tables act on the macro model
+    only; H(T) and k_w(T) are taken at the micro temperatures), and the rough body without its
+    layers for the heat partition and flash temperatures (``Heating``; only the conductance sees a
+    layer's kappa). Before, both were silent (a materials engineer's trial: a pin's kappa falling
+    10x over its 14 K rise left the partition to 5 digits)."""
+    if not scene.has("roughness") or not scene.rough_interfaces or scene.materials is None:
+        return []
+    used = ("E", "nu") + (("kappa", "chi", "rho", "c") if scene.has("thermal") else ())
+    T0 = scene.time.initial_temperature - 273.15
+    out = []
+    for name in dict.fromkeys(scene.geometry.spec.interface_materials(scene.rough_interfaces[0])):
+        tables = [p for p in used if name in scene.materials and scene.materials[name].tabulated(p)]
+        if tables:
+            out.append(f"materials.{name}: the micro scale (zone laws, heat partition, flash temperatures) takes "
+                       f"{', '.join(tables)} at the initial temperature ({T0:.4g} degC), constant; the tables act on "
+                       "the macro model only")
+    if scene.has("layers") and scene.has("heat_partition"):
+        out.append("layers: the heat partition and flash temperatures take the rough body without its layers "
+                   "(its own kappa and chi); a layer's kappa acts on the conductance only")
+    return out
+
+
 def nyquist(scene) -> list[str]:
     """A generated surface's k_max within the Nyquist index of the cells it is drawn on (the zone's
     micro grid, or zones x grid for patch = "face")."""

@@ -582,12 +582,12 @@ class Wear:
 @dataclass(frozen=True)
 class Layer:
     """One layer of [[layers.layer]] (top first): its thickness and elastic constants, and its
-    conductivity with effect "thermal"."""
+    conductivity with effect "conductance" (the heat partition does without: ``micro_constants``)."""
 
     thickness: float = key(Quantity("length", gt=0, plausible=(1e-9, 0.1)), required=True)  # m
     E: float = key(_MODULUS, required=True)                                   # Pa
     nu: float = key(_POISSON, required=True)
-    kappa: float | None = key(_CONDUCTIVITY, needed_by=("thermal",))          # W/(m K)
+    kappa: float | None = key(_CONDUCTIVITY, needed_by=("conductance",))      # W/(m K)
 
 
 @dataclass(frozen=True)

@@ -636,3 +636,21 @@ def test_laws_failing_at_every_p_max_say_how_it_was_reached(tmp_path):
         run_pod(tmp_path / "full", {"roughness.rms": "0.01 um", "micro.p_max": "100 MPa", "time.steps": 1,
                                     "time.end": "0.6 s"})
     assert str(caught.value).endswith(FULL_CONTACT)
+
+
+def test_what_the_micro_scale_takes_as_constants_is_said():
+    """The micro scale takes the rough interface's materials at the initial temperature and the
+    rough body without its layers for the heat partition: a pin kappa(T) falling 10x over its rise
+    left the partition to 5 digits, a layer's required kappa changed nothing, silently (a materials
+    engineer's trial). Now both are warnings, and a layer's kappa is needed by "conductance" only."""
+    table = 'kappa = [["20 degC", "35 W/(m K)"], ["25 degC", "3.5 W/(m K)"]]'
+    text = POD.format(folder="out").replace('"wear"]', '"wear", "layers"]').replace(
+        'kappa = "35 W/(m K)"', table) + '[layers]\nbody = "pin"\n[[layers.layer]]\nthickness = "5 um"\nE = "200 GPa"\nnu = 0.25\n'
+    assert table in text
+    warned = [w for w in loads(text).warnings if "micro scale" in w or "without its layers" in w]
+    assert warned == ["materials.pin: the micro scale (zone laws, heat partition, flash temperatures) takes kappa at "
+                      "the initial temperature (20 degC), constant; the tables act on the macro model only",
+                      "layers: the heat partition and flash temperatures take the rough body without its layers (its "
+                      "own kappa and chi); a layer's kappa acts on the conductance only"]
+    with pytest.raises(SceneError, match=r'layers.layer\[1\].kappa: missing; effect "conductance" needs it'):
+        loads(text.replace('"layers"]', '"layers", "conductance"]'))
