@@ -423,6 +423,8 @@ def test_cut_zones_grid_and_facet_mapping(tiled):
     x = np.array([z.centre[0], 0.0, s.size[0], 0.999 * grid.size[0]])
     y = np.array([z.centre[1], 0.0, s.size[1], 3.5 * grid.size[1]])
     np.testing.assert_array_equal(grid.zone_of(x, y), [6, 0, 15, 12])
+    border = 2 * grid.size[0]                          # a point on a zone border, as round-off leaves it
+    np.testing.assert_array_equal(grid.zone_of(border * (1 + np.array([-1e-15, 0.0, 1e-15])), [0.0] * 3), [2, 2, 2])
     with pytest.raises(InputError, match="outside"):
         grid.zone_of([-1e-3], [0.0])
     with pytest.raises(InputError, match="counts"):

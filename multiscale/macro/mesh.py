@@ -510,7 +510,11 @@ def _interface(parent, cell_tags, facet_tags, spec: GeometrySpec, bodies) -> Int
         plus[name] = tuple(sorted(set().union(*comm.allgather(set(region_of[rows[:, 0]].tolist())))))
     measure = ufl.Measure("dS", domain=parent, subdomain_data=data,
                           metadata={"quadrature_degree": INTERFACE_QUADRATURE})
-    mid_local = dmesh.compute_midpoints(sub, tdim - 1, np.arange(n_owned, dtype=np.int32))
+    # vertex coordinates summed in sorted order: a midpoint independent of the partition's vertex
+    # order (compute_midpoints' sums differed in the last bit between 1 and 2 ranks, which moved a
+    # facet on a zone border into the next zone)
+    corners = sub.geometry.x[dmesh.entities_to_geometry(sub, tdim - 1, np.arange(n_owned, dtype=np.int32))]
+    mid_local = np.sort(corners, axis=1).mean(axis=1)
     midpoints = np.concatenate(comm.allgather(mid_local)).reshape(-1, 3)
     areas = np.concatenate(comm.allgather(np.linalg.norm(vector_areas(sub.geometry.x[sub.geometry.dofmaps[0][:n_owned]]),
                                                          axis=1)))
