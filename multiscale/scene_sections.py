@@ -94,7 +94,7 @@ class Material:
     chi: float | tuple | None = key(_property(_DIFFUSIVITY, "chi"), absent="with thermal: kappa/(rho c)")    # m^2/s
     alpha: float | tuple | None = key(_property(_EXPANSION, "alpha"), needed_by=("expansion",),
                                       warn_unused=True)                                      # 1/K
-    k_w: float | tuple | None = key(_property(Quantity("wear_rate", ge=0), "k_w"),
+    k_w: float | tuple | None = key(_property(Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)), "k_w"),
                                     absent="rough body: wear.k_w's rate; counter-face: no wear")     # 1/Pa, Archard
     hardness: float | tuple | None = key(_property(_HARDNESS, "hardness"),      # Pa, asperities' flow pressure
                                          absent="with plasticity: the other side's")

@@ -429,5 +429,9 @@ def test_wear_deeper_than_the_worn_material_is_named(tm):
                                 wear_depth=lambda: np.full((2, 4, 4), depth))
         return SimpleNamespace(rough=rough, model=SimpleNamespace(tm=tm))
     assert worn_through(ms(4e-3)) == ()
-    (line,) = worn_through(ms(6e-3))
+    (line,) = worn_through(ms(6e-3), "materials.block.k_w")
     assert line.startswith(f"the wear on interface {name!r} reached 6 mm deep, more than the 5 mm of the material")
+    assert line.endswith("check the wear rate (materials.block.k_w) and the duration")
+    assert worn_through(ms(1e-6), layers=2e-6) == ()                 # a 2 um coating
+    (line,) = worn_through(ms(3e-6), layers=2e-6)
+    assert line.startswith(f"the wear on interface {name!r} reached 3 um deep, through its layers (2 um)")

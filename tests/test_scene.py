@@ -931,6 +931,13 @@ def test_a_wear_table_left_by_the_run_is_warned_about(tmp_path):
     assert run_warnings(loads(text.replace("substeps = 2", 'substeps = 2\nk_w = "1e-14 1/Pa"'), tmp_path), h) == []
     own = text.replace('alpha = "5e-6 1/K"', 'alpha = "5e-6 1/K"\nk_w = "1e-14 1/Pa"')   # the pin material's k_w
     assert run_warnings(loads(own, tmp_path), h) == []
+    typed = loads(own.replace('k_w = "1e-14 1/Pa"', 'k_w = "1e-5 1/Pa"'), tmp_path)     # a K typed as k_w: 466 m
+    assert [w for w in typed.warnings if w.startswith('materials.pin.k_w = "1e-5 1/Pa": 1e-05 1/Pa is outside the '
+                                                      'plausible range')]                   # (as wear.k_w's)
+    table = own.replace('k_w = "1e-14 1/Pa"', 'k_w = [["20 degC", "1e-14 1/Pa"], ["400 degC", "2e-14 1/Pa"]]')
+    assert run_warnings(loads(table, tmp_path), h) == [        # its table's end: it was not said
+        "materials.pin.k_w: 626.9 degC above its last point 400 degC, held at 2e-14 there (the rough surface's "
+        "largest micro temperature)"]
     assert not [w for w in loads(own.replace('"20 degC"', '"1 K"'), tmp_path).warnings if w.startswith("wear.")]
     from multiscale.scene_summary import summary
     assert any(line.endswith("; k_w of its material") for line in summary(loads(own, tmp_path)))

@@ -162,12 +162,17 @@ def run_warnings(scene, history) -> list[str]:
 
 def _wear_table_ends(scene, history) -> list[str]:
     """``Wear.held_ends`` at the rough surface's largest micro temperature (``micro_max_temperature``;
-    the initial temperature is the scene's warning); none where the rough material gives its k_w."""
-    if not scene.has("wear") or scene.wear.k_w is not None or scene.rough_material_wears \
-            or "micro_max_temperature" not in history.columns:
+    the initial temperature is the scene's warning), or the rough material's k_w table left there
+    (``Material.beyond``; it was not said)."""
+    if not scene.has("wear") or "micro_max_temperature" not in history.columns:
         return []
     micro = np.asarray(history["micro_max_temperature"], dtype=float)
-    return scene.wear.held_ends(hottest=float(np.max(micro, initial=-np.inf, where=np.isfinite(micro))))
+    hottest = float(np.max(micro, initial=-np.inf, where=np.isfinite(micro)))
+    if scene.rough_material_wears:
+        name = scene.geometry.spec.interface_materials(scene.rough_interfaces[0])[0]
+        phrase = scene.materials[name].beyond(hottest).get("k_w")
+        return [f"materials.{name}.{phrase} (the rough surface's largest micro temperature)"] if phrase else []
+    return scene.wear.held_ends(hottest=hottest)
 
 
 def _law_reach(history) -> list[str]:

@@ -211,7 +211,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
         result = MultiscaleResult(folder, writer.files + [f for f in (h5, png, plot, zones, ckpt) if f] + maps,
                                   _time.perf_counter() - start, history, h5, png, writer.files, plot, maps, zones,
-                                  done, warnings=run_notes(ms.model) + worn_through(ms))
+                                  done, warnings=run_notes(ms.model) + worn_through(ms, *_wear_keys(scene)))
         ms.model.close()          # on every rank in the same order (MUMPS' destruction communicates)
     if stopping:                 # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", result.warnings)
@@ -224,11 +224,13 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     return result
 
 
-def worn_through(ms: Multiscale) -> tuple:
+def worn_through(ms: Multiscale, rate: str = "wear.k_w", layers: float = 0.0) -> tuple:
     """Rough interfaces whose deepest wear exceeds the extent of the material it wears along the
-    interface's normal (its regions beside the interface): the body is worn through, which the model
-    does not follow (the zones' topographies wear, the macro geometry does not; an adversarial
-    trial's wear rate took a 15 mm pin 73 mm deep). Collective."""
+    interface's normal (its regions beside the interface), or the ``layers`` [m] on it (their
+    total thickness): the body or its coating is worn through, which the model does not follow
+    (the zones' topographies wear, the macro geometry and the micro kernel do not; an adversarial
+    trial's wear rate took a 15 mm pin 73 mm deep, a materials trial's a 2 um coating 15.6 um).
+    ``rate``: the key of the wear rate, for the message. Collective."""
     rough, tm = ms.rough, ms.model.tm
     depth = rough.wear_depth().max(axis=(-2, -1), initial=0.0)
     out = []
@@ -239,8 +241,19 @@ def worn_through(ms: Multiscale) -> tuple:
             out.append(f"the wear on interface {name!r} reached {deepest * 1e3:.3g} mm deep, more than the "
                        f"{extent * 1e3:.3g} mm of the material it wears along the contact normal: worn through, "
                        "which the model does not follow (the zones' topographies wear, the macro geometry does not); "
-                       "check the wear rate (wear.k_w) and the duration")
+                       f"check the wear rate ({rate}) and the duration")
+        elif deepest > layers > 0:
+            out.append(f"the wear on interface {name!r} reached {deepest * 1e6:.3g} um deep, through its layers "
+                       f"({layers * 1e6:.3g} um): the micro contact keeps them (its kernel is the layered one), so "
+                       f"the worn zones' laws are those of a coating that is gone; check the wear rate ({rate})")
     return tuple(out)
+
+
+def _wear_keys(scene) -> tuple[str, float]:
+    """(the key of the rough body's wear rate, the total thickness of its layers [m] or 0)."""
+    rate = (f"materials.{scene.geometry.spec.interface_materials(scene.rough_interfaces[0])[0]}.k_w"
+            if scene.rough_material_wears else "wear.k_w")
+    return rate, sum(x.thickness for x in scene.layers.layer) if scene.has("layers") else 0.0
 
 
 def finished(folder: Path, name: str, steps: int, comm, verbose: bool) -> MultiscaleResult:
