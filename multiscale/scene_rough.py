@@ -8,6 +8,7 @@ from __future__ import annotations
 import warnings
 
 from multiscale.errors import InputError
+from multiscale.micro.layered import THINNEST
 from multiscale.micro.spectrum import power_spectrum
 from multiscale.micro.topography import (TopographyWarning, beyond_measurement, check_cutoff, check_resolved, coarse_grid,
                                          condition, covers, read_topography, zone_cells)
@@ -64,6 +65,26 @@ def micro_constants(scene) -> list[str]:
         out.append("layers: the heat partition and flash temperatures take the rough body without its layers "
                    "(its own kappa and chi); a layer's kappa acts on the conductance only")
     return out
+
+
+def thin_layer(scene) -> list[str]:
+    """A top layer thinner than ``layered.THINNEST`` of a micro cell (the run refuses its kernel
+    after meshing; check said OK: a materials engineer's trial), for faces whose extent the
+    geometry knows and whose grid the scene gives (or the default of a generated surface)."""
+    if not scene.has("layers") or scene.layers is None:
+        return []
+    top = scene.layers.layer[0].thickness
+    out = []
+    for name in scene.rough_interfaces:
+        s, size = scene.interface_settings(name), scene.geometry.spec.interface_extents.get(name)
+        if size is None or s.micro is None or s.micro.zones is None or (s.roughness.file and not s.micro.grid):
+            continue
+        cell = min(L / (z * c) for L, z, c in zip(size, s.micro.zones, s.micro.grid or DEFAULT_GRID))
+        if top < THINNEST * cell:
+            out.append(f"layers.layer[1].thickness = {top:.3g} m: thinner than {THINNEST:g} of the micro cells of "
+                       f"interface {name} ({cell:.3g} m): its kernel would take hours and gigabytes; drop the layer "
+                       "(its effect is below the grid's resolution) or refine micro.grid")
+    return sorted(set(out))
 
 
 def nyquist(scene) -> list[str]:

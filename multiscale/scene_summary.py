@@ -8,6 +8,7 @@ from multiscale.geometry import CellEstimate, estimate_cells
 from multiscale.outputs import analysis
 from multiscale.provenance import entries, results_of
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
+from multiscale.micro.laws import P_MAX_PLASTIC
 from multiscale.scene_sections import P_MAX_FACTOR
 from multiscale.schema import reference as schema_reference
 
@@ -132,8 +133,10 @@ def _effect_line(scene: Scene, effect: str) -> str:
         measured_pixels = r.file is not None and r.cover != "equivalent"
         cells = f"{m.grid[0]} x {m.grid[1]} cells" if m.grid else \
             "the measurement's pixel size" if measured_pixels else "50 x 50 cells"
-        top = f"{m.p_max:g} Pa" if m.p_max is not None else \
-            f"{P_MAX_FACTOR:g} x the nominal pressure (the run prints it)"
+        top = f"{m.p_max:g} Pa" if m.p_max is not None else f"{P_MAX_FACTOR:g} x the nominal pressure"
+        if scene.has("plasticity"):
+            top += f", at most {P_MAX_PLASTIC:g} x the hardness"     # (check said 3e7 Pa, the run used 9e6)
+        top += "" if m.p_max is not None and not scene.has("plasticity") else " (the run prints it)"
         return (f"{r.body or scene.bodies[0]}: {surface}; {m.zones[0]} x {m.zones[1]} zones of {cells}, "
                 f"{m.law_points}-point laws up to p_max {top}")
     if effect == "wear":

@@ -654,3 +654,14 @@ def test_what_the_micro_scale_takes_as_constants_is_said():
                       "own kappa and chi); a layer's kappa acts on the conductance only"]
     with pytest.raises(SceneError, match=r'layers.layer\[1\].kappa: missing; effect "conductance" needs it'):
         loads(text.replace('"layers"]', '"layers", "conductance"]'))
+
+
+def test_a_layer_too_thin_for_the_micro_cells_is_refused_by_check():
+    """A 100 nm layer on 0.625 mm cells: the run refused its kernel after meshing ('thickness =
+    1e-07', no key), check said OK (a materials engineer's trial); now check names the key."""
+    text = POD.format(folder="out").replace('"wear"]', '"wear", "layers"]') + \
+        '[layers]\nbody = "pin"\n[[layers.layer]]\nthickness = "100 nm"\nE = "200 GPa"\nnu = 0.25\n'
+    with pytest.raises(SceneError, match=r"layers.layer\[1\].thickness = 1e-07 m: thinner than 0.001 of the micro "
+                                         r"cells of interface interface"):
+        loads(text)
+    loads(text.replace('"100 nm"', '"10 um"'))

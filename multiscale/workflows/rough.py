@@ -34,7 +34,7 @@ from multiscale.errors import InputError
 from multiscale.micro.conduction import SeriesKernel
 from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
-from multiscale.micro.laws import LawSpec
+from multiscale.micro.laws import P_MAX_PLASTIC, LawSpec
 from multiscale.micro.plasticity import Hardness
 from multiscale.micro.surface import Surface, fractal_surface
 from multiscale.micro.topography import TopographyWarning, condition, cover, read_topography, zone_cells
@@ -46,7 +46,6 @@ from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR
 from multiscale.workflows.model import interface_forces, interface_materials
 
 SEED_STRIDE = 7919         # interface k draws its surfaces with seed + SEED_STRIDE k
-P_MAX_PLASTIC = 0.9        # with plasticity, the top node of the laws is at most this x the hardness
 
 
 def check_rough_scene(scene) -> None:
