@@ -90,6 +90,7 @@ _OTHER_NAMES = {_ENERGY: "energy", _POWER: "power", M: "mass", _dim((M, 1), (T, 
 # symbol: (exact factor to SI, dimension, takes SI prefixes); factors are Fractions so that
 # "10 um" is exactly the float 1e-05 (the decimal number times the factor, rounded once).
 _F = Fraction
+_LBF = _F("4.4482216152605")         # N, the pound-force (0.45359237 kg x 9.80665 m/s^2)
 _UNITS: dict[str, tuple[Fraction, tuple[int, ...], bool]] = {
     "m": (_F(1), L, True), "g": (_F(1, 1000), M, True), "s": (_F(1), T, True), "K": (_F(1), TH, False),
     "N": (_F(1), _FORCE, True), "Pa": (_F(1), _PRESSURE, True), "bar": (_F(10**5), _PRESSURE, True),
@@ -100,7 +101,9 @@ _UNITS: dict[str, tuple[Fraction, tuple[int, ...], bool]] = {
     "rev": (_F(2 * math.pi), A, False), "rpm": (_F(2 * math.pi) / 60, _dim((A, 1), (T, -1)), False),
     "degC": (_F(1), TH, False), "°C": (_F(1), TH, False), "%": (_F(1, 100), ONE, False),
     "gn": (_F("9.80665"), _dim((L, 1), (T, -2)), False), "t": (_F(1000), M, False),
-    "in": (_F("0.0254"), L, False),
+    "in": (_F("0.0254"), L, False), "ft": (_F("0.3048"), L, False), "lb": (_F("0.45359237"), M, False),
+    "lbf": (_LBF, _FORCE, False), "psi": (_LBF / _F("0.0254") ** 2, _PRESSURE, False),      # exact (NIST SP 811)
+    "ksi": (1000 * _LBF / _F("0.0254") ** 2, _PRESSURE, False), "mph": (_F("0.44704"), _dim((L, 1), (T, -1)), False),
 }
 _ABSOLUTE = {"degC": _F("273.15"), "°C": _F("273.15")}   # offsets of a whole-unit absolute temperature
 _PREFIXES = {"G": _F(10**9), "M": _F(10**6), "k": _F(1000), "c": _F(1, 100), "m": _F(1, 1000),
@@ -109,7 +112,7 @@ _PREFIXES = {"G": _F(10**9), "M": _F(10**6), "k": _F(1000), "c": _F(1, 100), "m"
 _FAHRENHEIT, _KELVIN, _CALORIE = ("Fahrenheit is not read: give the temperature in degC or K",
                                    'the kelvin is written "K"', "the calorie is not read: 1 cal = 4.184 J")
 _NOT_READ = {"degF": _FAHRENHEIT, "°F": _FAHRENHEIT, "degK": _KELVIN, "°K": _KELVIN,    # advice, not a look-alike
-             "cal": _CALORIE, "kcal": _CALORIE}
+             "cal": _CALORIE, "kcal": _CALORIE, "ppm": "ppm is not read: write 1e-6 (or %)"}
 _SUPERSCRIPT = str.maketrans("⁰¹²³⁴⁵⁶⁷⁸⁹⁻", "0123456789-")
 _NUMBER = r"[+-]?(?:\d+\.?\d*|\.\d+)(?:[eE][+-]?\d+)?"
 VALUE = re.compile(rf"^\s*({_NUMBER})\s*(.*?)\s*$")       # "<number> <unit>": groups number, unit

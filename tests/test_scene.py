@@ -85,6 +85,9 @@ folder = "out/run1"
     ("1e13 Pa/m", "stiffness", 1e13),
     ("1 N/mm^3", "stiffness", 1e9),
     ("1e5 W/(m^2 K)", "conductance", 1e5),
+    ("1000 psi", "pressure", 6894757.293168361),    # a brake line's pressure (exact pound-force and inch)
+    ("30 ksi", "pressure", 206842718.79505083),     # was: did you mean "ks" (a materials trial)
+    ("100 lbf", "force", 444.82216152605), ("1 ft", "length", 0.3048), ("60 mph", "speed", 26.8224),
     ("1 mm^2 K/W", "resistance", 1e-6),         # the conductance study's local R (was "dimensionless")
     ("8.3e-6 m^2/s", "diffusivity", 8.3e-6),
     ("1e-12 1/Pa", "wear_rate", 1e-12),
@@ -114,6 +117,7 @@ def test_unit_strings_to_si(text, kind, expected):
     ("68 degF", "temperature", "Fahrenheit is not read"),     # was: did you mean "deg" (an angle)
     ("300 °K", "temperature", 'the kelvin is written "K"'),   # was: did you mean "°"
     ("0.1 kcal/(kg K)", "specific_heat", "1 cal = 4.184 J"),  # was: did you mean "kPa"
+    ("5 ppm", "dimensionless", "ppm is not read"),             # was: did you mean "rpm"
     ("14 %", "resistance", 'the unit "%" is a dimensionless number'),
 ])
 def test_unit_errors_say_what_is_expected(text, kind, fragment):
