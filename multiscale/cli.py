@@ -37,7 +37,10 @@ pin-on-disc): validate a scene file (check), run it (run), sweep parameters (stu
 measured topography (surface), print the versions (info)."""
 INTERRUPTED = 130        # exit code after Ctrl-C (128 + SIGINT, as shells report it)
 MPIEXEC = f"{Path(sys.executable).parent / 'mpiexec'}"
-COMMAND = f"{Path(sys.executable).parent / 'multiscale'}"      # this environment's (also where it is not on PATH)
+# this environment's (also where it is not on PATH), or its interpreter's ``-m multiscale`` as launched
+# (a checkout on PYTHONPATH: the console script runs the installed copy)
+COMMAND = ([sys.executable, "-m", "multiscale"] if Path(sys.argv[0]).parts[-2:] == ("multiscale", "__main__.py")
+           else [f"{Path(sys.executable).parent / 'multiscale'}"])
 EPILOG = f"""Parallel runs: {MPIEXEC} -n N multiscale run scene.toml
 Use the mpiexec of this environment: the launcher of another MPI (a system mpirun or mpiexec)
 starts N separate serial runs, or stops with a PMI error."""
@@ -203,7 +206,7 @@ def _kept(scene, args, ranks: int = 1) -> str:
     if scene is None:
         return "nothing was written"
     launcher = [MPIEXEC, "-n", str(ranks)] if ranks > 1 else []
-    command = shlex.join([*launcher, COMMAND, "run", args.scene,
+    command = shlex.join([*launcher, *COMMAND, "run", args.scene,
                           *(f"--set={k}={text}" for k, _, text in args.settings)])
     folder = Path(scene.output.folder)
     written = folder.is_dir() and any(folder.iterdir())

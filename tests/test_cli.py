@@ -593,3 +593,15 @@ def test_ctrl_c_in_a_command_without_its_own_words_is_one_line(monkeypatch, caps
     monkeypatch.setattr(cli, "_check", meshing)
     assert main(["check", "scene.toml", "--cells"]) == 130
     assert capsys.readouterr().err == "interrupted: multiscale check\n"
+
+
+def test_the_command_a_hint_repeats_is_the_one_launched():
+    """`python -m multiscale` from a checkout on PYTHONPATH: the resume hint after a Ctrl-C named the
+    environment's console script, which runs the installed copy (a rank-consistency audit)."""
+    import multiscale
+    main_py = str(Path(multiscale.__file__).with_name("__main__.py"))
+    for argv0, expected in ((main_py, [sys.executable, "-m", "multiscale"]),
+                            (str(Path(sys.executable).with_name("multiscale")), [str(Path(sys.executable).with_name("multiscale"))])):
+        code = f"import sys; sys.argv = [{argv0!r}]; import multiscale.cli as c; print(c.COMMAND)"
+        out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+        assert out.strip() == str(expected)
