@@ -46,7 +46,8 @@ def micro_constants(scene) -> list[str]:
     """Warnings of what the micro scale takes as constants: the rough interface's materials at the
     initial temperature (``workflows.model.interface_materials``: E, nu for the zone laws; kappa,
     chi, rho, c for the heat partition and flash temperatures; their tables act on the macro model
-    only; H(T) and k_w(T) are taken at the micro temperatures), and the rough body without its
+    only; H(T) and k_w(T) are taken at the micro temperatures, H(T) the softer body's at the initial
+    temperature, at the rough body's), and the rough body without its
     layers for the heat partition and flash temperatures (``Heating``; only the conductance sees a
     layer's kappa). Before, both were silent (a materials engineer's trial: a pin's kappa falling
     10x over its 14 K rise left the partition to 5 digits)."""
@@ -61,6 +62,15 @@ def micro_constants(scene) -> list[str]:
             out.append(f"materials.{name}: the micro scale (zone laws, heat partition, flash temperatures) takes "
                        f"{', '.join(tables)} at the initial temperature ({T0:.4g} degC), constant; the tables act on "
                        "the macro model only")
+    sides = [n for n in scene.geometry.spec.interface_materials(scene.rough_interfaces[0]) if n in scene.materials]
+    given = [n for n in sides if scene.materials[n].hardness is not None]
+    if scene.has("plasticity") and given and any(scene.materials[n].tabulated("hardness") for n in given):
+        soft = min(given, key=lambda n: scene.materials[n].value("hardness", T0 + 273.15))
+        other = [n for n in given if n != soft]
+        out.append(f"materials.{soft}.hardness: the micro solves take the hardness of the body softer at the initial "
+                   f"temperature, {soft}'s, at the rough body's temperatures"
+                   + (f"; materials.{other[0]}.hardness is not used, even where {other[0]} is the softer"
+                      if other else ""))     # (a materials engineer's trial: it was silent)
     if scene.has("layers") and scene.has("heat_partition"):
         out.append("layers: the heat partition and flash temperatures take the rough body without its layers "
                    "(its own kappa and chi); a layer's kappa acts on the conductance only")

@@ -654,6 +654,12 @@ def test_what_the_micro_scale_takes_as_constants_is_said():
                       "own kappa and chi); a layer's kappa acts on the conductance only"]
     with pytest.raises(SceneError, match=r'layers.layer\[1\].kappa: missing; effect "conductance" needs it'):
         loads(text.replace('"layers"]', '"layers", "conductance"]'))
+    plastic = loads(POD.format(folder="out").replace('"wear"]', '"wear", "plasticity"]').replace(
+        'kappa = "35 W/(m K)"', 'kappa = "35 W/(m K)"\nhardness = "20 MPa"').replace(
+        'kappa = "50 W/(m K)"', 'kappa = "50 W/(m K)"\nhardness = [["20 degC", "30 MPa"], ["25 degC", "3 MPa"]]'))
+    assert [w for w in plastic.warnings if "hardness" in w] == [
+        "materials.pin.hardness: the micro solves take the hardness of the body softer at the initial temperature, "
+        "pin's, at the rough body's temperatures; materials.disc.hardness is not used, even where disc is the softer"]
 
 
 def test_a_layer_too_thin_for_the_micro_cells_is_refused_by_check():
