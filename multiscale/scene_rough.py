@@ -8,7 +8,6 @@ from __future__ import annotations
 import warnings
 
 from multiscale.errors import InputError
-from multiscale.micro.layered import THINNEST
 from multiscale.micro.spectrum import power_spectrum
 from multiscale.micro.topography import (TopographyWarning, beyond_measurement, check_cutoff, check_resolved, coarse_grid,
                                          condition, covers, read_topography, zone_cells)
@@ -83,6 +82,7 @@ def thin_layer(scene) -> list[str]:
     geometry knows and whose grid the scene gives (or the default of a generated surface)."""
     if not scene.has("layers") or scene.layers is None:
         return []
+    from multiscale.micro.layered import THINNEST    # local: it loads the numba micro modules, which check needs not
     top = scene.layers.layer[0].thickness
     out = []
     for name in scene.rough_interfaces:

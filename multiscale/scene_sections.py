@@ -456,6 +456,7 @@ class Roughness:
 
 DEFAULT_GRID = (50, 50)    # cells per zone without micro.grid (generated surfaces)
 P_MAX_FACTOR = 20.0        # without micro.p_max, the laws' top node is this x the nominal interface pressure
+P_MAX_PLASTIC = 0.9        # with plasticity, it is at most this x the hardness (``LawSpec``: below it)
 
 
 # Default coupling of partitions and temperatures for each choice of remote temperatures, chosen by
@@ -581,8 +582,7 @@ class Wear:
 
 @dataclass(frozen=True)
 class Layer:
-    """One layer of [[layers.layer]] (top first): its thickness and elastic constants, and its
-    conductivity with effect "conductance" (the heat partition does without: ``micro_constants``)."""
+    """One layer of [[layers.layer]] (top first): thickness, elastic constants, conductivity (conductance)."""
 
     thickness: float = key(Quantity("length", gt=0, plausible=(1e-9, 0.1)), required=True)  # m
     E: float = key(_MODULUS, required=True)                                   # Pa

@@ -8,8 +8,7 @@ from multiscale.geometry import CellEstimate, estimate_cells
 from multiscale.outputs import analysis
 from multiscale.provenance import entries, results_of
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
-from multiscale.micro.laws import P_MAX_PLASTIC
-from multiscale.scene_sections import P_MAX_FACTOR
+from multiscale.scene_sections import P_MAX_FACTOR, P_MAX_PLASTIC
 from multiscale.schema import reference as schema_reference
 
 

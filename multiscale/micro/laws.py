@@ -371,7 +371,6 @@ def _masked_heights(zones, masks, spec):
     return h, tol
 
 
-P_MAX_PLASTIC = 0.9        # with a hardness, a scene's laws reach at most this x H (``LawSpec``: below it)
 STIFF = "the Love-corrected gap stops decreasing"
 
 

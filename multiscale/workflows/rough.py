@@ -34,7 +34,7 @@ from multiscale.errors import InputError
 from multiscale.micro.conduction import SeriesKernel
 from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
-from multiscale.micro.laws import P_MAX_PLASTIC, LawSpec
+from multiscale.micro.laws import LawSpec
 from multiscale.micro.plasticity import Hardness
 from multiscale.micro.surface import Surface, fractal_surface
 from multiscale.micro.topography import TopographyWarning, condition, cover, read_topography, zone_cells
@@ -42,7 +42,7 @@ from multiscale.micro.zones import ZoneGrid, cut_zones, generate_zones
 from multiscale.pool import MicroPool
 from multiscale.rough import RoughInterface, interface_plane
 from multiscale.scene_rough import rough_rules
-from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR
+from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR, P_MAX_PLASTIC
 from multiscale.workflows.model import interface_forces, interface_materials
 
 SEED_STRIDE = 7919         # interface k draws its surfaces with seed + SEED_STRIDE k
