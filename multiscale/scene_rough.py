@@ -11,6 +11,7 @@ from multiscale.errors import InputError
 from multiscale.micro.spectrum import power_spectrum
 from multiscale.micro.topography import (TopographyWarning, beyond_measurement, check_cutoff, check_resolved, coarse_grid,
                                          condition, covers, read_topography, zone_cells)
+from multiscale.micro.zones import THINNEST
 from multiscale.scene_sections import DEFAULT_GRID
 
 SHARED_MICRO = ("grid", "law_points", "model", "p_max", "tol", "partition_law", "heating", "heating_steps",
@@ -77,12 +78,11 @@ def micro_constants(scene) -> list[str]:
 
 
 def thin_layer(scene) -> list[str]:
-    """A top layer thinner than ``layered.THINNEST`` of a micro cell (the run refuses its kernel
+    """A top layer thinner than ``zones.THINNEST`` of a micro cell (the run refuses its kernel
     after meshing; check said OK: a materials engineer's trial), for faces whose extent the
     geometry knows and whose grid the scene gives (or the default of a generated surface)."""
     if not scene.has("layers") or scene.layers is None:
         return []
-    from multiscale.micro.layered import THINNEST    # local: it loads the numba micro modules, which check needs not
     top = scene.layers.layer[0].thickness
     out = []
     for name in scene.rough_interfaces:

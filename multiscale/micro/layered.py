@@ -35,16 +35,12 @@ from scipy.special import j0, j1
 
 from multiscale.errors import InputError, check_count, check_field, check_positive, check_real
 from multiscale.micro.kernels import Kernel, poisson_ratio, wrap_offsets
+from multiscale.micro.zones import THINNEST
 from multiscale.references.love import love_rectangle
 
 _NEAR = 4        # cells |i|, |j| <= _NEAR around the loaded cell use the exact corner formula
 _GAUSS = 4       # Gauss points per direction on the other cells
 _EXCESS_TOL = 1e-15
-# A top layer thinner than this share of a cell is refused on non-periodic grids: its kernel's
-# excess reaches q ~ 1/h, and the Hankel quadratures, whose panels resolve the Bessel oscillations
-# up to the grid's extent, grow like (cell / h): 4.8 s at h = dx/156, 47 s and 1.7 GB at dx/1560 on
-# 64², out of memory at dx/1.5e6 (a periodic grid takes the spectrum itself: no limit)
-THINNEST = 1e-3
 
 
 class LayeredKernel(Kernel):

@@ -26,6 +26,13 @@ from multiscale.micro.surface import Surface, check_surface, fractal_surface, wh
 from multiscale.references.love import (love_rectangle, love_rectangle_mean, love_triangle, love_triangle_mean,
                                         triangle_area, triangle_vertices)
 
+# A top layer thinner than this share of a zone's cell is refused on its non-periodic grid
+# (``layered.LayeredKernel.influence``; a scene's check, ``scene_rough.thin_layer``): its kernel's
+# excess reaches q ~ 1/h, and the Hankel quadratures, whose panels resolve the Bessel oscillations
+# up to the grid's extent, grow like (cell / h): 4.8 s at h = dx/156, 47 s and 1.7 GB at dx/1560 on
+# 64², out of memory at dx/1.5e6 (a periodic grid takes the spectrum itself: no limit)
+THINNEST = 1e-3
+
 
 # --------------------------------------------------------------------------- footprints
 def _inside_triangle(x, y, V) -> np.ndarray:
