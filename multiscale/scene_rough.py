@@ -47,10 +47,10 @@ def micro_constants(scene) -> list[str]:
     initial temperature (``workflows.model.interface_materials``: E, nu for the zone laws; kappa,
     chi, rho, c for the heat partition and flash temperatures; their tables act on the macro model
     only; H(T) and k_w(T) are taken at the micro temperatures, H(T) the softer body's at the initial
-    temperature, at the rough body's), and the rough body without its
-    layers for the heat partition and flash temperatures (``Heating``; only the conductance sees a
-    layer's kappa). Before, both were silent (a materials engineer's trial: a pin's kappa falling
-    10x over its 14 K rise left the partition to 5 digits)."""
+    temperature, at the rough body's), and the rough body without its layers for the heat partition
+    and flash temperatures (``Heating``; only the conductance sees a layer's kappa). Before, both
+    were silent (a materials engineer's trial: a pin's kappa falling 10x over its 14 K rise left the
+    partition to 5 digits)."""
     if not scene.has("roughness") or not scene.rough_interfaces or scene.materials is None:
         return []
     used = ("E", "nu") + (("kappa", "chi", "rho", "c") if scene.has("thermal") else ())

@@ -148,7 +148,8 @@ def run_warnings(scene, history) -> list[str]:
                     if name not in found or (T > found[name][0]) == (end == "max"):
                         found[name] = (T, body.name)
     out = []
-    unread = () if scene.has("expansion") else Material.STRAIN      # read at the initial temperature only
+    # k_w is read at the micro temperatures (``_wear_table_ends``), the strain's without expansion at T0
+    unread = ("k_w",) + (() if scene.has("expansion") else Material.STRAIN)
     for name in hottest:
         known = scene.materials[name].beyond(T0)
         for T, body in dict.fromkeys((hottest[name], coldest.get(name, hottest[name]))):   # the hottest, the coldest
