@@ -382,7 +382,9 @@ def bounded_start(p, upper, total=None):
     ``SNAP`` of H are set to H: a warm start from a bounded solution (its cells at H rescaled by
     1 ± 1e-16) keeps its saturated set (the first iteration's projection restores the balance).
     A start with too few loaded cells to carry ``total`` at H (a warm start from a harder or less
-    loaded solve) has no such c: it is replaced by the uniform total / N (< H, ``solve``'s check);
+    loaded solve) has no such c: it is replaced by the uniform total / N (< H, ``solve``'s check;
+    where round-off alone leaves no k exact, e.g. ties at H of a prolonged coarse start, the first
+    k's scale is kept: its free cells restore the balance);
     before, its cells all at H carried part of the load (11-95 % in a user trial), which the solver
     took for converged (no free cell left: residual 0)."""
     p = np.maximum(np.asarray(p, dtype=float), 0.0)
@@ -393,6 +395,7 @@ def bounded_start(p, upper, total=None):
     if not bounded.all():                                          # elastic patches keep p
         p[bounded] = bounded_start(p[bounded], upper[bounded], total[bounded])
         return p
+    short = np.count_nonzero(p, axis=1) * upper < total           # all its loaded cells at H carry less
     v = -np.sort(-p, axis=1)                                       # descending
     k = np.arange(p.shape[1] + 1)
     tail = np.concatenate([np.cumsum(v[:, ::-1], axis=1)[:, ::-1], np.zeros((p.shape[0], 1))], axis=1)
@@ -405,7 +408,6 @@ def bounded_start(p, upper, total=None):
     scale = c[np.arange(p.shape[0]), first]
     p = np.minimum(p * scale[:, None], H)
     p[p >= H * (1 - SNAP)] = np.broadcast_to(H, p.shape)[p >= H * (1 - SNAP)]   # ties at H stay saturated
-    short = ~ok.any(axis=1)
     p[short] = (total[short] / p.shape[1])[:, None]
     return p
 
