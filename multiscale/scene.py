@@ -447,7 +447,28 @@ def _hardness_checks(scene: Scene, g: Geometry, raw: dict, effects) -> list[str]
         if rough and sides and not given:
             problems.append(f'materials.{sides[0]}.hardness: missing; effect "plasticity" needs the hardness of '
                             f'the softer body of interface "{name}" ({" or ".join(sides)})')
+    problems += _plastic_everywhere(scene, g)
     return problems
+
+
+def _plastic_everywhere(scene: Scene, g: Geometry) -> list[str]:
+    """A hardness at the initial temperature at most the nominal pressure of the interfaces
+    (``loading.normal_force`` over their extents' boxes, which cover them: a lower bound), so
+    that some zone carries H or more, which the run refuses after its set-up (check said OK: a
+    materials engineer's trial)."""
+    force = getattr(scene.loading, "normal_force", None) if scene.loading is not None else None
+    boxes = [g.spec.interface_extents.get(n) for n in g.spec.interfaces]
+    hard = [m for m in {m for n in scene.rough_interfaces for m in g.spec.interface_materials(n)}
+            if m in scene.materials and scene.materials[m].hardness is not None]
+    if not force or not hard or None in boxes or scene.time is None:
+        return []
+    nominal = force / sum(a * b for a, b in boxes)
+    soft = min(hard, key=lambda m: scene.materials[m].value("hardness", scene.time.initial_temperature))
+    H = scene.materials[soft].value("hardness", scene.time.initial_temperature)
+    return [f"materials.{soft}.hardness = {H:.3g} Pa at the initial temperature: at most the interfaces' nominal "
+            f"pressure (loading.normal_force over them: at least {nominal:.3g} Pa), so a zone would carry the hardness "
+            "or more (fully plastic), which the micro model refuses; raise the hardness or lower the load"] \
+        if H <= nominal else []
 
 
 STIFF_PENALTY = 1e4   # a penalty above this many times E*/h is warned about (ill-conditioned tangent)
