@@ -213,12 +213,29 @@ class Scene:
         return tuple(n for n in self.geometry.spec.interfaces if self.interface_settings(n).rough)
 
     @property
-    def rough_material_wears(self) -> bool:
-        """True if the rough body's material (at the first rough interface) gives its own k_w: the
-        zones wear by it, not by [wear]'s k_w, its k_w(T) table or the default table."""
+    def rough_material(self) -> str | None:
+        """The rough body's material at the first rough interface (one pair over them all,
+        ``scene_rough.rough_rules``), None without a rough interface."""
         rough = self.rough_interfaces
-        name = self.geometry.spec.interface_materials(rough[0])[0] if rough else None
-        return getattr((self.materials or {}).get(name), "k_w", None) is not None
+        return self.geometry.spec.interface_materials(rough[0])[0] if rough else None
+
+    @property
+    def rough_material_wears(self) -> bool:
+        """True if the rough body's material gives its own k_w: the zones wear by it, not by
+        [wear]'s k_w, its k_w(T) table or the default table."""
+        return getattr((self.materials or {}).get(self.rough_material), "k_w", None) is not None
+
+    @property
+    def softer_hardness(self) -> str | None:
+        """Of the rough interfaces' two materials that give a hardness, the one with the lower value
+        at the initial temperature (the micro solves' H, at the rough body's temperatures); None
+        without one."""
+        if not self.rough_interfaces or self.materials is None or self.time is None:
+            return None
+        given = [m for m in self.geometry.spec.interface_materials(self.rough_interfaces[0])
+                 if m in self.materials and self.materials[m].hardness is not None]
+        T0 = self.time.initial_temperature
+        return min(given, key=lambda m: self.materials[m].value("hardness", T0)) if given else None
 
 
 def load(path, overrides=None) -> Scene:
@@ -458,12 +475,10 @@ def _plastic_everywhere(scene: Scene, g: Geometry) -> list[str]:
     materials engineer's trial)."""
     force = getattr(scene.loading, "normal_force", None) if scene.loading is not None else None
     boxes = [g.spec.interface_extents.get(n) for n in g.spec.interfaces]
-    hard = [m for m in {m for n in scene.rough_interfaces for m in g.spec.interface_materials(n)}
-            if m in scene.materials and scene.materials[m].hardness is not None]
-    if not force or not hard or None in boxes or scene.time is None:
+    soft = scene.softer_hardness
+    if not force or soft is None or None in boxes:
         return []
     nominal = force / sum(a * b for a, b in boxes)
-    soft = min(hard, key=lambda m: scene.materials[m].value("hardness", scene.time.initial_temperature))
     H = scene.materials[soft].value("hardness", scene.time.initial_temperature)
     return [f"materials.{soft}.hardness = {H:.3g} Pa at the initial temperature: at most the interfaces' nominal "
             f"pressure (loading.normal_force over them: at least {nominal:.3g} Pa), so a zone would carry the hardness "

@@ -54,18 +54,18 @@ def micro_constants(scene) -> list[str]:
     if not scene.has("roughness") or not scene.rough_interfaces or scene.materials is None:
         return []
     used = ("E", "nu") + (("kappa", "chi", "rho", "c") if scene.has("thermal") else ())
-    T0 = scene.time.initial_temperature - 273.15
+    sides = [n for n in dict.fromkeys(scene.geometry.spec.interface_materials(scene.rough_interfaces[0]))
+             if n in scene.materials]
     out = []
-    for name in dict.fromkeys(scene.geometry.spec.interface_materials(scene.rough_interfaces[0])):
-        tables = [p for p in used if name in scene.materials and scene.materials[name].tabulated(p)]
+    for name in sides:
+        tables = [p for p in used if scene.materials[name].tabulated(p)]
         if tables:
             out.append(f"materials.{name}: the micro scale (zone laws, heat partition, flash temperatures) takes "
-                       f"{', '.join(tables)} at the initial temperature ({T0:.4g} degC), constant; the tables act on "
-                       "the macro model only")
-    sides = [n for n in scene.geometry.spec.interface_materials(scene.rough_interfaces[0]) if n in scene.materials]
+                       f"{', '.join(tables)} at the initial temperature ({scene.time.initial_temperature - 273.15:.4g} "
+                       "degC), constant; the tables act on the macro model only")
     given = [n for n in sides if scene.materials[n].hardness is not None]
     if scene.has("plasticity") and given and any(scene.materials[n].tabulated("hardness") for n in given):
-        soft = min(given, key=lambda n: scene.materials[n].value("hardness", T0 + 273.15))
+        soft = scene.softer_hardness
         other = [n for n in given if n != soft]
         out.append(f"materials.{soft}.hardness: the micro solves take the hardness of the body softer at the initial "
                    f"temperature, {soft}'s, at the rough body's temperatures"

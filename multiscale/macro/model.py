@@ -327,12 +327,12 @@ class MacroModel:
             for i, body in enumerate(self.tm.bodies):
                 row[f"max_temperature_{body.name}"] = hottest[i]
                 if len({r.material for r in body.spec.regions}) > 1:     # per material (their tables)
-                    for material, T in self.thermal.region_max_temperature(i).items():
+                    for material, T in self.thermal.region_temperature(i).items():
                         row[f"max_temperature_{body.name}_in_{material}"] = T
-                    for material, T in self.thermal.region_max_temperature(i, lowest=True).items():
+                    for material, T in self.thermal.region_temperature(i, lowest=True).items():
                         row[f"min_temperature_{body.name}_in_{material}"] = T
                 if len(body.spec.regions) > 1:                          # per part (a brake's pads)
-                    for part, T in self.thermal.region_max_temperature(i, "name").items():
+                    for part, T in self.thermal.region_temperature(i, "name").items():
                         row[f"max_temperature_{body.name}_part_{part}"] = T
                     for part, Q in self.thermal.region_stored_heat(i).items():
                         row[f"stored_heat_{body.name}_part_{part}"] = Q

@@ -551,7 +551,7 @@ class Thermal:
         """Largest nodal temperature of each body [K]."""
         return tuple(self.tm.comm.allreduce(T.x.array.max(initial=-np.inf), op=MPI.MAX) for T in self.T)
 
-    def region_max_temperature(self, i: int, by: str = "material", lowest: bool = False) -> dict:
+    def region_temperature(self, i: int, by: str = "material", lowest: bool = False) -> dict:
         """Largest (``lowest``: smallest) nodal temperature [K] of the cells of body ``i`` grouped by
         their regions' ``by``: "material", or "name" (the parts of a geometry file, a brake's pads;
         collective; a node on a boundary between two groups belongs to both)."""
@@ -574,7 +574,7 @@ class Thermal:
 
     def region_stored_heat(self, i: int, by: str = "name") -> dict:
         """Heat stored since the start [J] in the cells of body ``i`` grouped by their regions' ``by``
-        (``region_max_temperature``; the groups' sum is the body's; collective)."""
+        (``region_temperature``; the groups' sum is the body's; collective)."""
         heat = self.cell_stored_heat(i)
         return {g: self.tm.comm.allreduce(heat[cells].sum(), op=MPI.SUM)
                 for g, cells in self.tm.bodies[i].region_cells(by).items()}

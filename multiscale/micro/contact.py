@@ -381,12 +381,12 @@ def bounded_start(p, upper, total=None):
     values: the k largest cells saturate, c v_k <= H <= c v_(k-1)), else c = 1. Values within
     ``SNAP`` of H are set to H: a warm start from a bounded solution (its cells at H rescaled by
     1 ± 1e-16) keeps its saturated set (the first iteration's projection restores the balance).
-    A start with too few loaded cells to carry ``total`` at H (a warm start from a harder or less
-    loaded solve) has no such c: it is replaced by the uniform total / N (< H, ``solve``'s check;
-    where round-off alone leaves no k exact, e.g. ties at H of a prolonged coarse start, the first
-    k's scale is kept: its free cells restore the balance);
-    before, its cells all at H carried part of the load (11-95 % in a user trial), which the solver
-    took for converged (no free cell left: residual 0)."""
+    A start whose loaded cells all at H carry less than ``total`` (a warm start from a harder or
+    less loaded solve) has no such c: it is replaced by the uniform total / N (< H, ``solve``'s
+    check); before, its cells all at H carried part of the load (11-95 % in a user trial), which
+    the solver took for converged (no free cell left: residual 0). Where round-off alone leaves no
+    k exact (ties at H of a prolonged coarse start), the first k's scale is kept: its free cells
+    restore the balance."""
     p = np.maximum(np.asarray(p, dtype=float), 0.0)
     H = upper[:, None]
     if total is None:

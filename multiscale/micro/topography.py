@@ -350,7 +350,8 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
     Lx, Ly = check_pair(f"{prefix}size", size, check_positive)
     short = not covers(surface.size, (Lx, Ly), method, prefix)
     wide, target = _sized("the measurement", surface.size), _sized("the interface", (Lx, Ly))
-    spectrum = power_spectrum(surface)           # one PSD for the checks and the equivalent surface
+    # one PSD for the checks and the equivalent surface, none for a cover neither takes
+    spectrum = power_spectrum(surface) if warn or method == "equivalent" else None
     coarse = coarse_grid(surface, (Lx / nx, Ly / ny), prefix, spectrum) if warn else None
     if coarse is not None:
         warnings.warn(coarse, TopographyWarning, stacklevel=2)

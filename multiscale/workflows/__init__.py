@@ -170,7 +170,7 @@ def _wear_table_ends(scene, history) -> list[str]:
     micro = np.asarray(history["micro_max_temperature"], dtype=float)
     hottest = float(np.max(micro, initial=-np.inf, where=np.isfinite(micro)))
     if scene.rough_material_wears:
-        name = scene.geometry.spec.interface_materials(scene.rough_interfaces[0])[0]
+        name = scene.rough_material
         phrase = scene.materials[name].beyond(hottest).get("k_w")
         return [f"materials.{name}.{phrase} (the rough surface's largest micro temperature)"] if phrase else []
     return scene.wear.held_ends(hottest=hottest)

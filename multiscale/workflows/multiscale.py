@@ -251,8 +251,7 @@ def worn_through(ms: Multiscale, rate: str = "wear.k_w", layers: float = 0.0) ->
 
 def _wear_keys(scene) -> tuple[str, float]:
     """(the key of the rough body's wear rate, the total thickness of its layers [m] or 0)."""
-    rate = (f"materials.{scene.geometry.spec.interface_materials(scene.rough_interfaces[0])[0]}.k_w"
-            if scene.rough_material_wears else "wear.k_w")
+    rate = f"materials.{scene.rough_material}.k_w" if scene.rough_material_wears else "wear.k_w"
     return rate, sum(x.thickness for x in scene.layers.layer) if scene.has("layers") else 0.0
 
 

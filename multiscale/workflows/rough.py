@@ -129,13 +129,10 @@ def interface_hardness(scene) -> Hardness:
     """The hardness of the softer body of the rough interfaces (one material pair, see
     ``check_rough_scene``): of the side(s) with materials.<name>.hardness, the one with the lower
     value at the initial temperature (constant or its H(T) table, in K)."""
-    T0 = scene.time.initial_temperature
-    sides = [scene.materials[m] for m in scene.geometry.spec.interface_materials(scene.rough_interfaces[0])]
-    given = [m.hardness for m in sides if m.hardness is not None]
-    if not given:
+    soft = scene.softer_hardness
+    if soft is None:
         raise InputError("hardness", None, 'effect "plasticity" needs materials.<name>.hardness on the rough interface')
-    softest = min(given, key=lambda h: Hardness(_table(h))(T0))
-    return Hardness(_table(softest))
+    return Hardness(_table(scene.materials[soft].hardness))
 
 
 def _table(value):
