@@ -5,7 +5,6 @@ unit strings (``multiscale.units``).
 from __future__ import annotations
 
 import math
-
 from dataclasses import dataclass
 
 from multiscale.schema import Choice, Flag, Integer, ListOf, OneOf, Pair, Quantity, Section, key
@@ -20,7 +19,6 @@ class Stribeck:
     kinetic: float | None = key(Quantity("dimensionless", ge=0), required=True)
     speed: float | None = key(Quantity("speed", gt=0), required=True)            # m/s, Stribeck speed
     exponent: float = key(Quantity("dimensionless", gt=0), default=1.0)
-
 
 
 SWEEP_PARAMETERS = {"friction": "-", "pressure": "Pa", "speed": "rad/s", "rms": "m"}

@@ -45,7 +45,7 @@ from multiscale.macro.mesh import TwoBodyMesh
 # "ski rental" rule: never more than twice the better of the two choices in hindsight). Factors of a
 # loaded state keep GMRES at a few iterations for steps on end on the thesis ch. 7 configuration
 # (issue 23). A solve that fails with old factors is repeated from its start with fresh ones every
-# iteration, and then once more with a backtracking line search (``Mechanics.solve``). The preconditioner is built from a matrix of its own, written only
+# iteration, and then once more with a backtracking line search, fresh ones too (``Mechanics.solve``). The preconditioner is built from a matrix of its own, written only
 # at a refresh: PETSc refactorises when that matrix changed, and only then. The factors are in
 # single precision (``FACTOR_PRECISION``; GMRES on the double tangent takes their rounding out, the
 # Newton's residual and answer are double): half the factors' memory; on the thesis ch. 7 run (2
@@ -399,19 +399,11 @@ class Mechanics:
                     u.x.array[:] = x
         result = first = self._newton()
         if not result.converged:           # old or single-precision factors can mislead: again, fresh double ones
-            for u, x in zip(self.u, start):
-                u.x.array[:] = x
-            self._fresh = True
             self.factors.set_precision("double")
-            try:
-                result = self._newton()
-            finally:
-                self._fresh = False
+            result = self._afresh(start)
         if not result.converged and self._backtrack:   # a full step overshot (worn laws opening the contact: the
-            for u, x in zip(self.u, start):  # residual 77 -> 1.5e6 N, SNES -9): again, backtracking
-                u.x.array[:] = x
-            with backtracking(self.problem.solver):
-                result = self._newton()
+            with backtracking(self.problem.solver):    # residual 77 -> 1.5e6 N, SNES -9): again, backtracking
+                result = self._afresh(start)
         if not result.converged:
             pc = self.factors.inner if self.own_pc else self.problem.solver.getKSP().getPC()
             failed = "" if pc is None else mumps.describe(pc)  # the same on every rank
@@ -439,6 +431,19 @@ class Mechanics:
         result.normal_force = self.contact.normal_force()
         result.max_pressure = float(self.contact.facet_pressure().max(initial=0.0))
         return result
+
+    def _afresh(self, start: list) -> SolveResult:
+        """``_newton`` from the displacements ``start`` with fresh factors at every iteration (a retry:
+        factors kept by the refresh rule over the backtracking steps of a nearly singular tangent let
+        GMRES reach its cap, SNES -3, where fresh ones converged; zone laws of H(T) flattened by flash
+        softening after a wear step)."""
+        for u, x in zip(self.u, start):
+            u.x.array[:] = x
+        self._fresh = True
+        try:
+            return self._newton()
+        finally:
+            self._fresh = False
 
     def _residual_norm(self) -> float:
         """||F(u)|| at the current state (collective)."""
