@@ -120,9 +120,9 @@ class FileGeometry:
     interface_mesh_size: float | None = key(_LENGTH, absent="mesh_size on the interfaces too")   # m
     mesh_algorithm: str | None = key(Choice(MESH_ALGORITHMS), absent='"hxt" for CAD files; a .geo script\'s own '
                                      "choice")                     # gmsh's 3-D mesher
-    rotating: str | None = key(Text(), required=True)          # the body that rotates
-    axis: tuple = key(_DIRECTION, default=(0.0, 0.0, 1.0))
-    centre: tuple = key(_POINT, default=(0.0, 0.0, 0.0))       # m, a point on the axis
+    rotating: str | None = key(Text(), required=True)          # the body that rotates, one of revolution about
+    axis: tuple = key(_DIRECTION, default=(0.0, 0.0, 1.0))     # its axis (or of n >= 3 equal sectors: checked on
+    centre: tuple = key(_POINT, default=(0.0, 0.0, 0.0))       # CAD, meshes.from_file); m, a point on the axis
     bodies: FrozenMap | None = key(Named(BodySelection), required=True)
     surfaces: FrozenMap = key(Named(SurfaceSelection), default=FrozenMap())
     interfaces: FrozenMap = key(Named(ContactPair), default=FrozenMap())

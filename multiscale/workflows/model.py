@@ -167,7 +167,7 @@ def build_mesh(scene, comm=MPI.COMM_WORLD) -> two_body.TwoBodyMesh:
     for name in tm.interface.tags if scene.has("friction") else ():
         c = tm.interface.crossing(name, motion)
         if c.share > 0:
-            where = f"({100 * c.share:.2g} % of its area, e.g. at {np.round(c.where * 1e3, 1).tolist()} mm)"
+            where = f"({100 * c.share:.3g} % of its area, e.g. at {np.round(c.where * 1e3, 1).tolist()} mm)"
             if isinstance(motion, Rotation):
                 raise InputError("geometry.axis", list(motion.axis), f"the rotation through {list(motion.centre)} m "
                                  f"crosses interface {name!r} instead of sliding along it {where}: check the "
