@@ -182,7 +182,8 @@ def summary(p: Plan) -> list[str]:
     """Lines of ``multiscale check``: the analysis, every file and the output times."""
     times = ", ".join(f"{t:g}" for t in p.times[:6]) + (f", ... {p.times[-1]:g}" if len(p.times) > 6 else "")
     lines = [f"  analysis  {p.analysis}", f"  writes    into {p.folder}:"]
-    lines += [f"    {name:<22}{what}" for name, what in p.files.items()]
+    width = max([22] + [len(name) + 2 for name in p.files])
+    lines += [f"    {name:<{width}}{what}" for name, what in p.files.items()]
     if p.analysis != "squeal":
         lines.append(f"  fields at t = {times} s")
     if p.ignored:

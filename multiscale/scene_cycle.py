@@ -35,7 +35,7 @@ def cycle_coverage(ld, end: float) -> list[str]:
                    f"({v.deceleration / GRAVITY:.3g} g) takes "
                    f"{v.stop_time:.3g} s, beyond time.end = {end:g} s: the run ends at {left * 3.6:.3g} km/h, having "
                    f"braked {100 * (1 - (left / v.speed) ** 2):.0f} % of the kinetic energy; a longer time.end "
-                   'brakes the rest (a deceleration in g is written "0.6 gn")')
+                   "brakes the rest" + (' (a deceleration in g is written "0.6 gn")' if v.deceleration < 1.0 else ""))
     return out
 
 

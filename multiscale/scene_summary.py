@@ -101,7 +101,10 @@ def _effect_line(scene: Scene, effect: str) -> str:
             st = ld.stribeck
             return (f"Stribeck mu(v) = {st.kinetic:g} + ({st.static:g} - {st.kinetic:g}) exp(-(v / {st.speed:g} m/s)"
                     f"^{st.exponent:g})")
-        return f"Coulomb, mu = {ld.friction:g}" if ld.friction is not None else "Coulomb, mu per interface"
+        own = [n for n in scene.geometry.spec.interfaces if scene.interface_settings(n).friction != ld.friction]
+        if ld.friction is None:
+            return "Coulomb, mu per interface"
+        return f"Coulomb, mu = {ld.friction:g}" + (f" (its own on {', '.join(own)})" if own else "")
     if effect == "thermal":
         return f"transient conduction in {', '.join(scene.bodies)}"
     if effect == "heat_partition" and scene.has("roughness") and scene.micro.partition_law:

@@ -13,13 +13,14 @@ import os
 import subprocess
 import sys
 import types
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 import pytest
 
 from multiscale.cli import main
-from multiscale.outputs import FIELDS, MODE_ARRAYS, Plan, array_name, paraview_script, plan
+from multiscale.outputs import FIELDS, MODE_ARRAYS, Plan, array_name, paraview_script, plan, summary
 from multiscale import provenance
 from multiscale.provenance import resolved_toml
 from multiscale.scene import FIG_7_9_WEAR_RATE, load, loads
@@ -81,6 +82,16 @@ def test_without_figures_check_promises_every_file_but_the_pngs(name, overrides,
     drawn, bare = (plan(load(DEMOS / name, {**overrides, "output.figures": f})).files for f in (True, False))
     assert {n[:-4] for n in drawn if n.endswith(".png")} == pngs
     assert bare == {n: w for n, w in drawn.items() if not n.endswith(".png")}
+
+
+def test_a_long_file_name_stays_apart_from_what_it_holds():
+    """check's file list pads names to the longest: wear_map_inner_pad_L.png (24 characters) ran into
+    its description ("wear_map_inner_pad_L.pngwear depth over...", a caliper trial)."""
+    p = plan(load(DEMOS / "pin_on_disc.toml"))
+    long = replace(p, files={"wear_map_inner_pad_L.png": "wear depth", **p.files})
+    lines = [line for line in summary(long) if line.startswith("    ") and not line.startswith("     ")]
+    starts = {line.index(what, 4) for line in lines for name, what in long.files.items() if line[4:].startswith(name)}
+    assert starts == {4 + len("wear_map_inner_pad_L.png") + 2}
 
 
 def test_check_names_every_column_of_modes_csv(case):

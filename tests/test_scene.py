@@ -545,8 +545,9 @@ def test_a_cycle_the_run_ends_before_is_warned_about(tmp_path):
                                                            tmp_path).warnings)
     short = loads(stop.replace("deceleration = 0.6", 'deceleration = "0.6 gn"').replace('end = "4.8 s"', 'end = "2 s"'),
                   tmp_path)          # a deceleration given in g: said so, not "written" in g again
-    assert [w for w in short.warnings if "loading.vehicle" in w][0].startswith(
-        "loading.vehicle: the stop from 100 km/h at 5.88 m/s^2 (0.6 g) takes 4.72 s, beyond time.end = 2 s")
+    (warning,) = [w for w in short.warnings if "loading.vehicle" in w]
+    assert warning.startswith("loading.vehicle: the stop from 100 km/h at 5.88 m/s^2 (0.6 g) takes 4.72 s, beyond "
+                              "time.end = 2 s") and warning.endswith("brakes the rest")     # (not: written in gn)
 
 
 def test_a_braking_phase_shorter_than_a_step_is_warned_about(tmp_path):
@@ -719,6 +720,8 @@ def test_loading_friction_is_needed_only_for_interfaces_without_their_own(tmp_pa
     scene = loads(text, DEMOS, overrides={"interfaces.inner_pad.friction": 0.2, "interfaces.outer_pad.friction": 0.3})
     assert [scene.interface_settings(n).friction for n in ("inner_pad", "outer_pad")] == [0.2, 0.3]
     assert "Coulomb, mu per interface" in "\n".join(summary(scene))
+    one = loads((DEMOS / "brake_squeal.toml").read_text(), DEMOS, overrides={"interfaces.inner_pad.friction": 0.3})
+    assert "    friction       Coulomb, mu = 0.4 (its own on inner_pad)" in summary(one)   # (said mu = 0.4 alone)
 
 
 def test_overrides_are_validated_like_the_file(tmp_path):
