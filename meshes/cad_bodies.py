@@ -8,6 +8,8 @@ import numpy as np
 
 from multiscale.errors import InputError, InputErrors
 
+CURVE_POINTS = 65           # points along each curve for a box of curves (``curve_box``)
+
 
 def assign_bodies(model, g, order: list[int], labels: dict) -> dict:
     """Body name -> sorted volume tags of the gmsh ``model`` for the FileGeometry ``g``; ``order``:
@@ -38,7 +40,7 @@ def assign_bodies(model, g, order: list[int], labels: dict) -> dict:
                 inside = [t for t in labels if model.isInside(3, t, list(point))]
                 if not inside:
                     problems.append(InputError(f"{where}.contains", list(point), f"no volume of {g.file.name} "
-                                               "contains this point [m]"))
+                                               f"contains this point [m]{_outside(model, labels, point, g)}"))
                 tags += inside
         for t in tags:
             if t in owner and owner[t] != name:
@@ -55,3 +57,25 @@ def assign_bodies(model, g, order: list[int], labels: dict) -> dict:
     if problems:
         raise problems[0] if len(problems) == 1 else InputErrors(problems)
     return out
+
+
+def curve_box(model, curves: list[int]) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corners [model units] of the box of the ``curves``, each at ``CURVE_POINTS``
+    points (tight where gmsh's box of a B-spline, a scaled script's, is its control net's: a disc
+    100 mm across spanned x -200..100 mm)."""
+    x = np.concatenate([np.reshape(model.getValue(1, c, np.linspace(*model.getParametrizationBounds(1, c),
+                                                                     CURVE_POINTS).ravel()), (-1, 3))
+                        for c in dict.fromkeys(curves)])
+    return x.min(axis=0), x.max(axis=0)
+
+
+def _outside(model, labels: dict, point, g) -> str:
+    """Words for a point outside the box of every volume (``labels``' tags): where the volumes lie,
+    in mm (a file in cm read in mm put every point of a scene outside, with no word of the unit)."""
+    faces = model.getBoundary([(3, t) for t in labels], combined=False, oriented=False)
+    low, high = curve_box(model, [c for _, c in model.getBoundary(faces, combined=False, oriented=False)])
+    if np.all(np.asarray(point) >= low) and np.all(np.asarray(point) <= high):
+        return ""
+    span = ", ".join(f"{axis} {a * 1e3:.4g}..{b * 1e3:.4g}" for axis, a, b in zip("xyz", low, high))
+    unit = f"geometry.unit = {g.unit:g} m: is it the file's?" if g.unit is not None else "is the file's unit right?"
+    return f"; it lies outside all of them, which span {span} mm ({unit})"

@@ -36,7 +36,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from meshes import cad_units
-from meshes.cad_bodies import assign_bodies
+from meshes.cad_bodies import assign_bodies, curve_box
 from meshes.foreign import refuse_foreign
 from multiscale.errors import InputError, InputErrors
 from multiscale.geometry import FIXED_BODY, BodySpec, GeometrySpec, Region, Rotation, add_group, plane_extent
@@ -45,7 +45,6 @@ NAME = "file"
 DEFAULTS: dict = {}          # no numeric parameters: [geometry] of the scene is a FileGeometry
 PLAUSIBLE = (1e-3, 10.0)     # m, smallest and largest extent of a brake or tribometer model
 NORMAL_TOLERANCE = np.cos(np.radians(5.0))
-CURVE_POINTS = 65           # points along each boundary curve of an interface face for its box
 REVOLUTION = 1e-3           # the rotating body's centre of mass off its axis (of its extent), its axis of inertia (rad)
 EQUAL_MOMENTS = 0.01        # principal moments of inertia this close (of the largest) are those of a body of revolution
 # CAD is scaled to metres by gmsh's Geometry.OCCScaling at import, a similarity that keeps planes
@@ -438,16 +437,12 @@ def _nodes(model, faces: list[int]) -> tuple[np.ndarray, np.ndarray]:
 
 def _box(model, faces: list[int], mesh: bool) -> tuple[np.ndarray, np.ndarray]:
     """Lower and upper corners [m] of the faces' bounding box: of their nodes in a .msh (the box a
-    run takes), else of their boundary curves at ``CURVE_POINTS`` points each (a flat face's box is
-    its boundary's; gmsh's boxes of OpenCASCADE shapes are larger by its tolerance, 1e-7 m)."""
+    run takes), else of their boundary curves (``curve_box``: a flat face's box is its boundary's;
+    gmsh's boxes of OpenCASCADE shapes are larger by its tolerance, 1e-7 m)."""
     if mesh:
         x = _nodes(model, faces).reshape(-1, 3)
-    else:
-        curves = model.getBoundary([(2, f) for f in faces], combined=False, oriented=False)
-        x = np.concatenate([np.reshape(model.getValue(1, c, np.linspace(*model.getParametrizationBounds(1, c),
-                                                                         CURVE_POINTS).ravel()), (-1, 3))
-                            for _, c in dict.fromkeys(curves)])
-    return x.min(axis=0), x.max(axis=0)
+        return x.min(axis=0), x.max(axis=0)
+    return curve_box(model, [c for _, c in model.getBoundary([(2, f) for f in faces], combined=False, oriented=False)])
 
 
 def _coplanar(model, faces: list[int]) -> bool:

@@ -894,13 +894,18 @@ def test_a_point_in_plain_numbers_is_in_metres_and_a_miss_says_so(tmp_path, caps
     text = TWO_PADS.replace("{folder}", str(tmp_path / "out"))
     err = check(tmp_path, capsys, text.replace('contains = ["0 mm", "60 mm", "5 mm"]', "contains = [0, 60, 5]"))
     assert err == ("error: geometry.bodies.disc.contains = [0.0, 60.0, 5.0]: no volume of twopads.geo contains this "
-                   'point [m]; plain numbers are metres: did you mean ["0 mm", "60 mm", "5 mm"]?')
+                   "point [m]; it lies outside all of them, which span x -100..100, y -99.93..99.93, z 0..18 mm "
+                   "(geometry.unit = 0.001 m: is it the file's?); plain numbers are metres: did you mean "
+                   '["0 mm", "60 mm", "5 mm"]?')        # (the span: 65 points a curve, a ring's at 0.07 mm)
     backs = 'contains = [["0 mm", "80 mm", "18 mm"], ["0 mm", "-80 mm", "18 mm"]]'
     err = check(tmp_path, capsys, text.replace(backs, 'contains = [["0 mm", "80 mm", "18 mm"], [0, -80, 18.5]]'))
     assert err.endswith('passes through this point [m]; plain numbers are metres: did you mean ["0 mm", "-80 mm", '
                         '"18.5 mm"]?')
     err = check(tmp_path, capsys, text.replace('contains = ["0 mm", "60 mm", "5 mm"]', 'contains = ["0 mm", "60 m", 0]'))
-    assert err.endswith("contains this point [m]")            # not all plain numbers: no guess
+    assert err.endswith("(geometry.unit = 0.001 m: is it the file's?)")   # not all plain numbers: no guess
+    err = check(tmp_path, capsys, text.replace('contains = ["0 mm", "60 mm", "5 mm"]', 'contains = ["0 mm", "0 mm", '
+                                               '"5 mm"]'))
+    assert err.endswith("contains this point [m]")            # in the bore, inside the volumes' box: no word of units
 
 
 # a pad on the face of a disc whose axis lies in the x-y plane, 30 degrees from x: the interface's
