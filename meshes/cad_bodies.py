@@ -41,6 +41,11 @@ def assign_bodies(model, g, order: list[int], labels: dict) -> dict:
                 if not inside:
                     problems.append(InputError(f"{where}.contains", list(point), f"no volume of {g.file.name} "
                                                f"contains this point [m]{_outside(model, labels, point, g)}"))
+                elif len(inside) > 1:        # on a face the volumes share: it took both, and the other body's
+                    problems.append(InputError(f"{where}.contains", list(point), "the point lies on the boundary of "
+                                               f"volumes {', '.join(f'{t} ({labels[t] or 'no label'})' for t in inside)}"
+                                               f" of {g.file.name}: move it inside the one you mean [m]"))
+                    continue
                 tags += inside
         for t in tags:
             if t in owner and owner[t] != name:

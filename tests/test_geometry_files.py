@@ -704,6 +704,17 @@ def test_a_rotating_body_off_its_axis_is_refused_by_check(tmp_path, capsys):
     assert main(["check", str(tmp_path / "bad.toml")]) == 0         # another point of the axis
 
 
+def test_a_body_point_on_a_face_two_volumes_share_is_refused_at_that_point(tmp_path, capsys):
+    """The disc's point on its face under pad_a: both volumes contain it, the disc took both, and the
+    error blamed pad_a ("volume 2 also belongs to body disc"; a caliper trial). Now the point is."""
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO)
+    text = TWO_PADS.replace("{folder}", str(tmp_path / "out"))
+    err = check(tmp_path, capsys, text.replace('contains = ["0 mm", "60 mm", "5 mm"]', 'contains = ["0 mm", "80 mm", '
+                                               '"10 mm"]'))
+    assert err == ("error: geometry.bodies.disc.contains = [0.0, 0.08, 0.01]: the point lies on the boundary of volumes "
+                   "3 (no label), 4 (no label) of twopads.geo: move it inside the one you mean [m]")
+
+
 def test_elements_three_times_as_thick_as_a_body_are_warned_about(tmp_path):
     """The pads are 8 mm thick (2 V / S = 4.44 mm); meshed at 15 mm on their interfaces they have
     about one element across, which check said nothing of (a caliper trial's 30 mm elements on
