@@ -58,6 +58,9 @@ def name_problem(name: str, body: bool = False) -> str | None:
     return None
 
 
+PART_ARRAY = "part number [-]"   # a body of several parts (a file's fixed bodies): its cells' part, 1, 2, ...
+
+
 def array_name(field: str) -> str:
     """Name of an output field's array in the files, with its unit: "temperature [K]"."""
     label, unit = FIELDS[field]
@@ -136,10 +139,13 @@ def plan(scene) -> Plan:
     when = "the preload" if kind == "squeal" else f"{len(times)} output time(s)"
     files = {}
     numbers = ", ".join(f"{k} {n}" for k, n in enumerate(scene.geometry.spec.interfaces, 1))
+    parts = {b.name: ", ".join(f"{k} {r.name}" for k, r in enumerate(b.regions, 1))
+             for b in scene.geometry.spec.bodies if len(b.regions) > 1}
     for name, held in [(b, body) for b in scene.bodies] + [("interface", iface)]:
         if held:
             files[f"{name}.xdmf"] = f"fields of {name} at {when}: {', '.join(array_name(f) for f in held)}" + (
-                f" ({numbers})" if name == "interface" and "interface" in held else "")
+                f" ({numbers})" if name == "interface" and "interface" in held else "") + (
+                f"; {PART_ARRAY} ({parts[name]})" if name in parts else "")
             files[f"{name}.h5"] = f"data of {name}.xdmf"
     if kind == "squeal":
         files["modes.csv"] = ("frequency, growth rate, damping ratio, unstable and potentially unstable flags, "

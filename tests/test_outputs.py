@@ -20,7 +20,7 @@ import numpy as np
 import pytest
 
 from multiscale.cli import main
-from multiscale.outputs import FIELDS, MODE_ARRAYS, Plan, array_name, paraview_script, plan, summary
+from multiscale.outputs import FIELDS, MODE_ARRAYS, PART_ARRAY, Plan, array_name, paraview_script, plan, summary
 from multiscale import provenance
 from multiscale.provenance import resolved_toml
 from multiscale.scene import FIG_7_9_WEAR_RATE, load, loads
@@ -122,6 +122,8 @@ def test_field_files_hold_one_mesh_with_named_arrays_at_the_output_times(case):
         steps = t.steps if scene.has("thermal") else 0
         assert expected_times == [0.0] + [float(f"{n * t.dt:.12g}") for n in range(1, steps + 1)
                                           if n % scene.output.every == 0 or n == steps]
+    parts = {f"{b.name}.xdmf": len(b.regions) for b in scene.geometry.spec.bodies if len(b.regions) > 1}
+    assert parts or scene.geometry.builder == "block_on_flat", "a case with a body of several parts"
     for name, fields in p.field_files.items():
         reader = meshio.xdmf.TimeSeriesReader(p.folder / name)
         points, cells = reader.read_points_cells()
@@ -132,7 +134,11 @@ def test_field_files_hold_one_mesh_with_named_arrays_at_the_output_times(case):
             times.append(t)
             assert sorted(point_data) + sorted(cell_data) == sorted(
                 [array_name(f) for f in fields if f in ("displacement", "temperature")]) + sorted(
-                [array_name(f) for f in fields if f not in ("displacement", "temperature")])
+                [array_name(f) for f in fields if f not in ("displacement", "temperature")]
+                + ([PART_ARRAY] if name in parts else []))
+            if name in parts:          # every part's cells, numbered 1, 2, ... (the plan names them)
+                assert set(cell_data[PART_ARRAY][0]) == set(range(1, parts[name] + 1))
+                assert f"{PART_ARRAY} (1 " in p.files[name]
             for values in point_data.values():
                 assert len(values) == len(points) and np.isfinite(values).all()
             for values in cell_data.values():

@@ -6,7 +6,8 @@ the interface's per-facet values), named with its unit ("temperature [K]", ``out
 ParaView's XDMF reader shows one block per file whose arrays colour it directly, and meshio's
 ``TimeSeriesReader`` or h5py read it back. The times are the model's exact output times.
 ``<name>.xdmf`` is the index and ``<name>.h5`` the data (``/mesh/geometry``, ``/mesh/topology``,
-``/times``, ``/data/<k>/<field>``); the writer is ours, not DOLFINx's ``XDMFFile``, because that one
+``/times``, ``/data/<k>/<field>``; a body of several parts ``/mesh/part``, its cells' part numbers,
+shown at every time); the writer is ours, not DOLFINx's ``XDMFFile``, because that one
 writes every function as its own grid (coincident unnamed blocks in ParaView).
 
 - ``FieldWriter``: the series of a set of meshes; the mesh is gathered to rank 0 once in a
@@ -37,7 +38,7 @@ from dolfinx.io import VTXMeshPolicy, VTXWriter
 from multiscale import io
 from multiscale.errors import InputError, OutputError
 from multiscale.macro.unloaded import Unloaded, UnloadedWarning
-from multiscale.outputs import FIELDS, MODE_ARRAYS, array_name
+from multiscale.outputs import FIELDS, MODE_ARRAYS, PART_ARRAY, array_name
 
 # DOLFINx cell name -> (XDMF topology type, DOLFINx vertex order -> XDMF/VTK order)
 CELLS = {"tetrahedron": ("Tetrahedron", [0, 1, 2, 3]), "triangle": ("Triangle", [0, 1, 2]),
@@ -158,10 +159,12 @@ def layout_degree(functions) -> int:
 
 
 class SeriesFile:
-    """One XDMF/HDF5 time series of one mesh (rank 0 writes; see module docstring)."""
+    """One XDMF/HDF5 time series of one mesh (rank 0 writes; see module docstring); ``parts``: the
+    cells' part numbers (``outputs.PART_ARRAY``, in the layout's cell order; None: one part), kept
+    once in ``/mesh/part`` and shown at every time."""
 
-    def __init__(self, path: Path, layout: MeshLayout):
-        self.path, self.h5, self.layout = Path(path), Path(path).with_suffix(".h5"), layout
+    def __init__(self, path: Path, layout: MeshLayout, parts: np.ndarray | None = None):
+        self.path, self.h5, self.layout, self.parts = Path(path), Path(path).with_suffix(".h5"), layout, parts
 
     def start(self, resume_at: float | None = None) -> None:
         """Create the files (rank 0), or with ``resume_at`` [s] continue those of a run resumed from
@@ -173,6 +176,8 @@ class SeriesFile:
                 f.create_dataset("mesh/geometry", data=self.layout.geometry).attrs["unit"] = "m"
                 f.create_dataset("mesh/topology", data=self.layout.topology).attrs["cell_type"] = self.layout.cell_type
                 f.create_dataset("times", data=np.zeros(0), maxshape=(None,)).attrs["unit"] = "s"
+                if self.parts is not None:
+                    f.create_dataset("mesh/part", data=self.parts).attrs.update(name=PART_ARRAY, unit="-")
             self._write_xml()
             return
         try:
@@ -225,6 +230,9 @@ class SeriesFile:
             mesh = (f'<Topology TopologyType="{lay.cell_type}" NumberOfElements="{cells[0]}" '
                     f'NodesPerElement="{cells[1]}">{item("/mesh/topology", cells, "Int")}</Topology>'
                     f'<Geometry GeometryType="XYZ">{item("/mesh/geometry", (nodes, 3))}</Geometry>')
+            if "mesh/part" in f:
+                mesh += (f'<Attribute Name={quoteattr(PART_ARRAY)} AttributeType="Scalar" Center="Cell">'
+                         f'{item("/mesh/part", (cells[0],))}</Attribute>')
             grids = []
             for k, (t, arrays) in enumerate(steps):
                 attrs = []
@@ -245,12 +253,17 @@ class FieldWriter:
     """Time series ``<folder>/<name>.xdmf`` (+ ``.h5``) of named meshes, each with its fields
     (``{field: Function}``, the keys among ``io.FIELDS``); ``resume_at`` [s]: continue the existing
     files of a run resumed from a checkpoint at that time (``SeriesFile.start``). Collective: a file
-    that cannot be written or continued is an ``OutputError`` on every rank."""
+    that cannot be written or continued is an ``OutputError`` on every rank. ``parts``: {name: DG0
+    function of its cells' part numbers} of the meshes of several parts (``SeriesFile``)."""
 
-    def __init__(self, folder: Path, groups: Sequence[tuple], resume_at: float | None = None):
-        self.groups = [(SeriesFile(Path(folder) / f"{name}.xdmf", MeshLayout(mesh, layout_degree(functions.values()))),
-                        dict(functions))
-                       for name, mesh, functions in groups if functions]
+    def __init__(self, folder: Path, groups: Sequence[tuple], resume_at: float | None = None,
+                 parts: Mapping[str, fem.Function] | None = None):
+        self.groups = []
+        for name, mesh, functions in groups:
+            if functions:
+                layout = MeshLayout(mesh, layout_degree(functions.values()))
+                numbers = layout.cell_values(parts[name]) if name in (parts or {}) else None
+                self.groups.append((SeriesFile(Path(folder) / f"{name}.xdmf", layout, numbers), dict(functions)))
         self.files = [s.path for s, _ in self.groups]
         if self.groups:
             io.on_root(self.groups[0][0].layout.comm, lambda: [s.start(resume_at) for s, _ in self.groups],
@@ -306,7 +319,9 @@ class FieldOutput:
         self.interface = [(tm.interface.field(name), make) for name, make in makers.items() if name in fields]
         groups = [(b.name, b.mesh, body[i]) for i, b in enumerate(tm.bodies)]
         groups.append(("interface", tm.interface.mesh, {f.name: f for f, _ in self.interface}))
-        self.writer = FieldWriter(folder, groups, resume_at=resume_at)
+        parts = {b.name: b.cell_field("part", {r.tag: float(k) for k, r in enumerate(b.spec.regions, 1)})
+                 for b in tm.bodies if len(b.spec.regions) > 1}
+        self.writer = FieldWriter(folder, groups, resume_at=resume_at, parts=parts)
         self.files = self.writer.files
         self.body_fields = "displacement" in fields or bool(self.von_mises)   # a released state to write
         self._unloaded = None                   # its solver (``unloaded``), made on first use
