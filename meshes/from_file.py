@@ -35,7 +35,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from meshes import cad_units
+from meshes import cad_checks, cad_units
 from meshes.cad_bodies import assign_bodies, curve_box
 from meshes.foreign import refuse_foreign
 from multiscale.errors import InputError, InputErrors
@@ -45,9 +45,6 @@ NAME = "file"
 DEFAULTS: dict = {}          # no numeric parameters: [geometry] of the scene is a FileGeometry
 PLAUSIBLE = (1e-3, 10.0)     # m, smallest and largest extent of a brake or tribometer model
 NORMAL_TOLERANCE = np.cos(np.radians(5.0))
-REVOLUTION = 1e-3           # the rotating body's centre of mass off its axis (of its extent), its axis of inertia (rad)
-THIN = 3.0                  # element size over a body's mean thickness beyond which check warns
-EQUAL_MOMENTS = 0.01        # principal moments of inertia this close (of the largest) are those of a body of revolution
 # CAD is scaled to metres by gmsh's Geometry.OCCScaling at import, a similarity that keeps planes
 # and cylinders analytic; occ.dilate (a general affine map) turns every surface into a B-spline:
 # the fragment then took 1.1 s instead of 0.03 s on the railway disc and HXT meshed 1.4-1.8x slower
@@ -224,7 +221,7 @@ def _load(model, g) -> Found:
     # the extent before a script's or a mesh's scaling, scaled: gmsh's bounding box of some OpenCASCADE
     # surfaces is stale after occ.dilate (a partial Sphere 80 mm off the origin in mm spanned 80 m)
     extent = _extent(model, g, scale if g.kind != "cad" else 1.0, unit)
-    inertia = _inertia(model, scale if g.kind != "cad" else 1.0) if occ else {}   # before a scaling to B-splines
+    inertia = cad_checks.inertia(model, scale if g.kind != "cad" else 1.0) if occ else {}   # before B-splines
     if scale != 1.0 and g.kind != "cad":
         if g.kind == "mesh":
             s = scale
@@ -255,9 +252,9 @@ def _load(model, g) -> Found:
     _interfaces(model, g, found, occ)
     _surfaces(model, g, found, occ)
     if occ and g.mesh_size is not None:
-        _check_thin(model, g, found)
+        found.loose += cad_checks.thin_bodies(model, g, found.bodies, found.volume, found.pairs)
     if occ:
-        _check_revolution(g, [inertia[v] for v in bodies[g.rotating]])
+        cad_checks.check_revolution(g, [inertia[v] for v in bodies[g.rotating]])
     return found
 
 
@@ -317,78 +314,6 @@ def _volume(model, tag: int, occ: bool) -> float:
         total += np.abs(np.einsum("ij,ij->i", tets[:, 1] - tets[:, 0],
                                   np.cross(tets[:, 2] - tets[:, 0], tets[:, 3] - tets[:, 0]))).sum() / 6
     return total
-
-
-def _inertia(model, scale: float) -> dict:
-    """Volume tag -> (volume [m^3], centre of mass [m], inertia tensor about it [m^5], bounding box
-    [m]) of the OpenCASCADE volumes, the model's lengths times ``scale`` [m per unit]. Measured before
-    a script is scaled: its scaled faces are B-splines, whose mass properties OpenCASCADE integrates
-    coarsely (a disc 200 mm across off its axis by 0.14 mm)."""
-    return {t: (model.occ.getMass(3, t) * scale ** 3, np.asarray(model.occ.getCenterOfMass(3, t)) * scale,
-                np.reshape(model.occ.getMatrixOfInertia(3, t), (3, 3)) * scale ** 5,
-                np.asarray(model.getBoundingBox(3, t)) * scale) for _, t in model.getEntities(3)}
-
-
-def _check_thin(model, g, found: Found) -> None:
-    """Warn of bodies thinner than a third of their elements: a mean thickness 2 V / S (V the
-    body's volume, S its outer surface's area; a plate's thickness) below a third of the element
-    size it is meshed at (``interface_mesh_size`` if it touches an interface, else ``mesh_size``).
-    A caliper trial's 30 mm elements on 10 mm pads and 6 mm backplates passed check: the peak
-    pressure came out 3.9 MPa against 6.7 MPa at 5 mm, said by a generic undershoot warning only.
-    (The demos' coarse meshes reach 2.4 times a backplate's or a holder's thickness.)"""
-    touching = {n for pair in found.pairs.values() for n in pair}
-    thin = []
-    for name, volumes in found.bodies.items():
-        faces = model.getBoundary([(3, v) for v in volumes], combined=True, oriented=False)
-        thickness = 2 * sum(found.volume[v] for v in volumes) / sum(model.occ.getMass(2, f) for _, f in faces)
-        size = g.interface_mesh_size if name in touching and g.interface_mesh_size else g.mesh_size
-        if size > THIN * thickness:
-            thin.append(f"{name} (about {thickness * 1e3:.3g} mm, meshed at {size * 1e3:.3g} mm)")
-    if thin:
-        found.loose.append(f"geometry.mesh_size: elements more than {THIN:g} times as thick as the bodies {', '.join(thin)} "
-                           "(thickness 2 x volume / surface): about one element across them, their stresses and "
-                           "temperatures unresolved; smaller mesh_size or interface_mesh_size resolve them")
-
-
-def _check_revolution(g, volumes: list[tuple]) -> None:
-    """Refuse an axis about which the rotating body (its ``volumes``' ``_inertia``) is not one of
-    revolution, by its mass properties: no two principal moments of inertia within
-    ``EQUAL_MOMENTS``, its axis (of the moment that differs from the two equal ones) off the axis
-    direction by more than ``REVOLUTION`` rad, or its centre of mass off the axis by more than
-    ``REVOLUTION`` of its extent. A body of revolution, or of n >= 3 equal sectors (a vented or
-    cross-drilled disc), passes all three; the rotating body's material (its sliding velocity, its
-    temperature) moves round the axis, and a disc 2 mm off it ran 58 K hotter, tilted by 1.15
-    degrees 165 K, with nothing said (a caliper trial). Checked on OpenCASCADE geometry (CAD,
-    OpenCASCADE scripts) only. With three equal moments (a cylinder 1.7 times as tall as its
-    radius) the direction is not judged."""
-    masses, centres = np.array([v[0] for v in volumes]), np.array([v[1] for v in volumes])
-    c = masses @ centres / masses.sum()
-    inertia = sum(i + m * ((d @ d) * np.eye(3) - np.outer(d, d)) for (m, _, i, _), d in zip(volumes, centres - c))
-    boxes = np.array([v[3] for v in volumes])
-    extent = float((boxes[:, 3:].max(axis=0) - boxes[:, :3].min(axis=0)).max())
-    e = np.asarray(g.axis, dtype=float) / np.linalg.norm(g.axis)
-    r = c - np.asarray(g.centre, dtype=float)
-    off = float(np.linalg.norm(r - (r @ e) * e))
-    what = ("turns about {}, so it must be a body of revolution about it (or of n >= 3 equal sectors, as a vented "
-            "disc): the run moves its material, and with it the sliding and the heat, round that axis")
-    moments, vectors = np.linalg.eigh(inertia)                    # ascending
-    equal = np.abs(np.diff(moments)) <= EQUAL_MOMENTS * moments[-1]   # (0, 1) and (1, 2)
-    if not equal.any():
-        raise InputError("geometry.rotating", g.rotating, f"the rotating body {g.rotating!r} {what.format('an axis')}, "
-                         "but no axis of it is one: its principal moments of inertia differ by more than "
-                         f"{EQUAL_MOMENTS:.0%} ({', '.join(f'{m / moments[-1]:.3g}' for m in moments)} of the largest)")
-    if not equal.all():              # the moment that differs from the two equal ones is about its axis
-        axis = vectors[:, 2 if equal[0] else 0]
-        axis = -axis if axis @ e < 0 else axis
-        angle = float(np.arccos(min(1.0, axis @ e)))
-        if angle > REVOLUTION:
-            raise InputError("geometry.axis", list(g.axis), f"the rotating body {g.rotating!r} "
-                             f"{what.format('this axis')}, but its own axis is {np.degrees(angle):.3g} degrees off it, "
-                             f"along {(np.round(axis, 4) + 0.0).tolist()}: give that axis")
-    if off > REVOLUTION * extent:
-        raise InputError("geometry.centre", list(g.centre), f"the rotating body {g.rotating!r} "
-                         f"{what.format('the axis through this point')}, but its centre of mass lies {off * 1e3:.3g} "
-                         f"mm from that axis, at {(np.round(c * 1e3, 2) + 0.0).tolist()} mm: give a point of its axis")
 
 
 def _shared_faces(model, a: list[int], b: list[int]) -> list[int]:
