@@ -18,9 +18,12 @@ every rank back the laws it asked for. Collective: every rank of ``comm`` must c
   where round-off moves a residual across it and an iteration count changes); on a given number
   of ranks the batches are the same in every run. Batches hold at most a quarter
   of a rank's share, so that the partition can balance.
-- Cache: every rank keeps the laws it received (LRU, ``cache_size`` zones), keyed by
+- Cache: every rank keeps the laws it received (least recently requested out first), keyed by
   (topography hash, ``LawSpec.key()``: kernel, E*, p_max, nodes, Love variant, tolerances,
-  extra laws); a zone whose topography did not change is not recomputed.
+  extra laws); a zone whose topography did not change is not recomputed. It holds ``cache_size``
+  laws, by default ``CACHE_CALLS`` times the most any call asked for: a worn zone's earlier
+  topographies are never asked for again, and a fixed 100 000 laws grew a 800-step run by
+  70 kB a step toward ~0.5 GB per rank (a long-run trial).
 - Failures (non-convergence, non-monotone law, any exception in a zone's solve) are caught per
   batch, gathered with their zone ids, and raised as ``PoolError`` on every rank after the
   collective exchange: no rank is left waiting.
@@ -64,20 +67,29 @@ class PoolStats:
     wall_seconds: float         # of the whole call on this rank
 
 
+CACHE_CALLS = 4      # the default cache holds this many times the laws of the largest call
+
+
 class MicroPool:
     """Distributes the laws of zones over the ranks of ``comm`` (default COMM_WORLD).
 
-    ``spec``: default ``LawSpec`` of every call; ``cache_size``: zones remembered per rank.
+    ``spec``: default ``LawSpec`` of every call; ``cache_size``: laws remembered per rank (None:
+    ``CACHE_CALLS`` times the most distinct topographies a call has asked for).
     """
 
-    def __init__(self, spec: LawSpec, comm=None, cache_size: int = 100_000, progress: bool = False):
+    def __init__(self, spec: LawSpec, comm=None, cache_size: int | None = None, progress: bool = False):
         self.spec = spec
         self.comm = comm if comm is not None else MPI.COMM_WORLD
-        self.cache_size = int(cache_size)
+        self.cache_size = None if cache_size is None else int(cache_size)
+        self._largest = 0                        # distinct topographies of the largest call, over the ranks
         self.progress = progress
         self._cache: OrderedDict[tuple, ZoneNodes] = OrderedDict()
         self._seconds: dict[int, float] = {}     # zone id -> last measured solve time
         self.stats: PoolStats | None = None
+
+    def __len__(self) -> int:
+        """Laws remembered on this rank."""
+        return len(self._cache)
 
     def laws(self, zones: list[Zone], spec: LawSpec | None = None, gather: str = "own") -> ZoneLaws:
         """Laws of ``zones`` (this rank's request), computed once across all ranks.
@@ -98,14 +110,18 @@ class MicroPool:
         for z, (_, key) in zip(zones, requested):
             if key not in self._cache:
                 misses.setdefault(key, z)
-        known = dict(self._cache) if gather == "all" else {k: self._cache[k] for _, k in requested
-                                                             if k in self._cache}
+            else:
+                self._cache.move_to_end(key)     # asked for again: kept longest
         # every rank learns every request: its misses (zone id, key, batch signature, expected cost)
         mine = [(z.id, key, batch_signature(z), self._expected_cost(z, spec)) for key, z in misses.items()]
         shared = comm.allgather((spec_key, mine, len(zones) - sum(k in misses for _, k in requested),
                                  requested if gather == "all" else None))
         if len({sk for sk, _, _, _ in shared}) != 1:
             raise InputError("spec", spec, "every rank must ask for the same LawSpec")
+        asked = {k for _, m, _, _ in shared for _, k, _, _ in m} | ({k for _, _, _, req in shared for _, k in req}
+                                                                   if gather == "all" else {k for _, k in requested})
+        self._largest = max(self._largest, len(asked))
+        known = {k: self._cache[k] for k in asked if k in self._cache}
         work, owner = self._plan_work([m for _, m, _, _ in shared])
         plan = self._partition(work, spec)
 
@@ -194,7 +210,7 @@ class MicroPool:
         self._cache[key] = nodes
         self._cache.move_to_end(key)
         self._seconds[nodes.zone_id] = (nodes.seconds, nodes.cells * len(nodes.pressure))
-        while len(self._cache) > self.cache_size:
+        while len(self._cache) > (self.cache_size or CACHE_CALLS * self._largest):
             self._cache.popitem(last=False)
 
 

@@ -466,7 +466,7 @@ def test_cut_triangles_assigns_every_cell_once():
 def test_pool_caches_unchanged_zones_and_matches_compute_laws(tiled):
     from mpi4py import MPI
 
-    from multiscale.pool import MicroPool, PoolError
+    from multiscale.pool import CACHE_CALLS, MicroPool, PoolError
     _, _, zones = tiled
     spec = LawSpec(E, p_max=3e6, n_points=6)
     pool = MicroPool(spec, comm=MPI.COMM_SELF)
@@ -489,7 +489,15 @@ def test_pool_caches_unchanged_zones_and_matches_compute_laws(tiled):
     assert [f.zone_id for f in info.value.failures] == [98, 99] and info.value.result.ids.tolist() == [0]
     assert pool.stats.computed == pool.stats.failed == 1      # one solve (zone 0 was cached)
     small = MicroPool(spec, comm=MPI.COMM_SELF, cache_size=2)        # a call returns all it computed
-    assert small.laws(zones[:4]).ids.tolist() == [0, 1, 2, 3] and len(small._cache) == 2
+    assert small.laws(zones[:4]).ids.tolist() == [0, 1, 2, 3] and len(small) == 2
+    # zone 0 worn at every call, 1-3 unchanged: by default the pool keeps CACHE_CALLS x 4 laws, the
+    # unchanged ones among them (a fixed 100 000 grew a long run's memory by every worn law)
+    pool = MicroPool(spec, comm=MPI.COMM_SELF)
+    pool.laws(zones[:4])
+    for k in range(1, 2 * CACHE_CALLS * 4):
+        pool.laws([zones[0].with_heights(zones[0].surface.heights - k * 1e-9)] + zones[1:4])
+        assert pool.stats.computed == 1 and pool.stats.cached == 3
+    assert len(pool) == CACHE_CALLS * 4
 
 
 def test_pool_worker_never_imports_dolfinx():
