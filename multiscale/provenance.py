@@ -292,7 +292,8 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
         "# The scene came from text, not a file: here it is as resolved.\n" + resolved_toml(scene)
     part = {"status": status, "command": list(sys.argv if command is None else command), "ranks": ranks,
             "start": started, "end": None if status == RUNNING else now(),
-            "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()}, "total_wall_time_s": round(wall_time, 3)}
+            "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()},
+            "total_wall_time_s": None if status == RUNNING else round(wall_time, 3)}
     parts = [*earlier, part]
     total: dict[str, float] = {}
     for p in parts:
@@ -302,7 +303,8 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
               "overrides": {k: v for k, v in scene.overrides}, "command": part["command"], "ranks": ranks,
               "start": parts[0]["start"], "end": part["end"],
               "stage_wall_time_s": {k: round(v, 3) for k, v in total.items()},
-              "total_wall_time_s": round(sum(p["total_wall_time_s"] for p in parts), 3), "parts": parts,
+              "total_wall_time_s": round(sum(p["total_wall_time_s"] or 0.0 for p in parts), 3), "parts": parts,
+              "process": process(),
               "versions": versions(), "code": code(), "environment": environment(), "inputs": input_digests(scene),
               "files": sorted(plan(scene).files), "warnings": list(warnings)}
     texts = {"scene.toml": given, "scene_resolved.toml": resolved_toml(scene),
@@ -331,12 +333,46 @@ def parts_of(folder: Path) -> list[dict]:
 
 
 def _part(record: dict) -> dict:
-    """A part read back: the keys of ``PART``, its wall times numbers [s] (0 for what is not)."""
+    """A part read back: the keys of ``PART``, its wall times numbers [s] (0 for what is not; the
+    total of a part that was killed stays null)."""
     def seconds(v) -> float:
         return float(v) if isinstance(v, (int, float)) and not isinstance(v, bool) else 0.0
-    stages = record.get("stage_wall_time_s")
-    return {**{k: record.get(k) for k in PART}, "total_wall_time_s": seconds(record.get("total_wall_time_s")),
+    stages, total = record.get("stage_wall_time_s"), record.get("total_wall_time_s")
+    return {**{k: record.get(k) for k in PART}, "total_wall_time_s": None if total is None else seconds(total),
             "stage_wall_time_s": {str(k): seconds(v) for k, v in stages.items()} if isinstance(stages, dict) else {}}
+
+
+def process(pid: int | None = None) -> dict:
+    """The writing process: host name, pid and its start (clock ticks since boot, Linux's
+    /proc/<pid>/stat; None elsewhere): with the pid it names one process, a reused pid another."""
+    pid = os.getpid() if pid is None else int(pid)
+    try:
+        started = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[19])
+    except (OSError, IndexError, ValueError):
+        started = None
+    return {"host": platform.node(), "pid": pid, "started": started}
+
+
+def writer(folder: Path) -> dict | None:
+    """The record of the run writing into ``folder`` now, if another process of this host is
+    (its ``provenance.json`` says ``RUNNING`` and that process lives: not a run that was killed);
+    else None. Two runs in one folder ended with both failing and one record lost (a long-run
+    trial). A process of another host cannot be told alive: None."""
+    record = _record_of(folder)
+    owner = record.get("process") if record.get("status") == RUNNING else None
+    if not isinstance(owner, dict) or owner.get("host") != platform.node() or not isinstance(owner.get("pid"), int):
+        return None
+    if owner["pid"] == os.getpid():
+        return None                   # this process: the Python API's runs, one after another
+    if owner.get("started") is not None:
+        return record if process(owner["pid"])["started"] == owner["started"] else None
+    try:                              # no /proc: the pid alone
+        os.kill(owner["pid"], 0)
+    except ProcessLookupError:
+        return None
+    except PermissionError:
+        pass
+    return record
 
 
 def entries(n: int) -> str:
@@ -374,4 +410,5 @@ def results_of(folder: Path) -> list[str]:
     return sorted({*names, *(n + ".part" for n in names)} | ({"provenance.json"} if names else set()))
 
 
-__all__ = ["RUNNING", "inputs_in", "now", "parts_of", "resolved_toml", "results_of", "versions", "write"]
+__all__ = ["RUNNING", "inputs_in", "now", "parts_of", "process", "resolved_toml", "results_of", "versions", "write",
+           "writer"]

@@ -465,3 +465,35 @@ def test_the_index_written_time_by_time_is_the_one_the_file_gives(tmp_path):
         del f["data/0/temperature"].attrs["centre"]
     resumed.write(2.0)
     assert (tmp_path / "disc.xdmf").read_text().count("<Grid ") == 6
+
+
+def test_a_run_refuses_a_folder_another_living_run_writes_into(tmp_path):
+    """Two runs in one folder (one started with --resume while the other ran) both failed, with
+    HDF5's lock errors, and one record was lost (a long-run trial). provenance.json names the
+    writing process (host, pid, its start); a run refuses a folder whose record says running by a
+    process that lives, on --overwrite or --resume alike, and takes one whose writer is gone (a
+    killed run) or is itself (the Python API's runs, one after another)."""
+    from multiscale.errors import SceneError
+    from multiscale.workflows import run
+    folder = tmp_path / "results"
+    scene = load(DEMOS / "pin_on_disc_perfect.toml", {"output.folder": str(folder), "time.steps": 1,
+                                                       "time.end": "0.1 s"})
+    run(scene, verbose=False)
+    record = json.loads((folder / "provenance.json").read_text())
+    assert record["process"] == provenance.process() and record["parts"][0]["total_wall_time_s"] > 0
+    other = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    try:
+        record.update(status=provenance.RUNNING, process=provenance.process(other.pid))
+        (folder / "provenance.json").write_text(json.dumps(record))
+        with pytest.raises(SceneError, match=rf'another run writes into it \(process {other.pid} on this host, '
+                                             r"started .*\): two runs would write over each other's files"):
+            run(scene, verbose=False, overwrite=True)
+        assert provenance.writer(folder)["process"]["pid"] == other.pid
+    finally:
+        other.kill()
+        other.wait()
+    assert provenance.writer(folder) is None                     # killed: its folder is free
+    run(scene, verbose=False, overwrite=True)
+    record.update(process=provenance.process())                  # this process's own record
+    (folder / "provenance.json").write_text(json.dumps(record))
+    assert provenance.writer(folder) is None

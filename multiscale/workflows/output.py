@@ -6,7 +6,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from multiscale import io, outputs, provenance
-from multiscale.errors import InputError, SceneError
+from multiscale.errors import InputError, OutputError, SceneError
 
 
 @dataclass
@@ -44,6 +44,9 @@ class OutputFolder:
         scene, comm = self.scene, self.comm
 
         def start():
+            busy = busy_message(self.path)        # (one that began since ``prepare_folder``)
+            if busy:
+                raise OutputError(busy)
             if self.replace:
                 clear(self.path, self.replace)
             provenance.write(self.path, scene, ranks=comm.size, started=provenance.now(), stages={},
@@ -66,6 +69,9 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
     if resume and not comm.bcast(folder.is_dir() if comm.rank == 0 else None, root=0):
         raise InputError("--resume", str(folder), "the output folder does not exist: there is nothing to resume "
                          "(run without --resume)")
+    busy = comm.bcast(busy_message(folder) if comm.rank == 0 else None, root=0)
+    if busy:
+        raise SceneError(busy)
     existing = comm.bcast(scene.earlier_results() if comm.rank == 0 else None, root=0)
     taken = comm.bcast([n for n in provenance.inputs_in(folder) if n in outputs.plan(scene).files
                         and (folder / n).resolve() not in scene.inputs] if comm.rank == 0 and existing else [], root=0)
@@ -88,6 +94,18 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
         probe.unlink()
     io.on_root(comm, create, f"into the output folder {folder}")
     return OutputFolder(folder, scene, comm, [] if resume else existing, resume)
+
+
+def busy_message(folder: Path) -> str | None:
+    """Why a run cannot write into ``folder``: another process of this host is (``provenance.writer``),
+    or None (call on rank 0)."""
+    record = provenance.writer(folder) if folder.is_dir() else None
+    if record is None:
+        return None
+    who = record["process"]
+    return (f'output.folder = "{folder}": another run writes into it (process {who["pid"]} on this host, '
+            f"started {record.get('start')}, command {' '.join(map(str, record.get('command') or []))}): two runs "
+            "would write over each other's files; wait for it to end, or choose another folder")
 
 
 def clear(folder: Path, existing: list[str]) -> None:
