@@ -350,6 +350,22 @@ def test_one_process_commands_under_a_launcher_speak_once(tmp_path, capsys, monk
         assert (said in err) if said else err == "", (rank, err)
 
 
+def test_the_time_left_leaves_out_the_first_step(monkeypatch):
+    """A first step 10 s (set-up, compilation), the others 1 s: at 2 of 11 the time left is 9 s,
+    not the mean rate's 49.5 s (a long-run trial's first step took 4.5 times the later ones)."""
+    import io as stdio
+
+    from mpi4py import MPI
+
+    from multiscale import io
+    clock = iter([0.0, 10.0] + [10.0 + k for k in range(1, 20) for _ in range(2)])
+    monkeypatch.setattr(io._time, "perf_counter", lambda: next(clock))
+    out = stdio.StringIO()
+    with io.Reporter(MPI.COMM_SELF, stream=out):
+        list(io.bar(range(11), "macro steps"))
+    assert out.getvalue().splitlines()[1] == "  macro steps: 2/11 steps, 11.0 s, ~9.0 s left"
+
+
 def test_stage_lines_one_per_stage_quiet_and_timed():
     import io as stdio
 

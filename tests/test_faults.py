@@ -258,6 +258,8 @@ def test_ctrl_c_stops_the_run_after_its_step_with_the_results_written(tmp_path, 
     assert code == 130 and seconds < 30, err[-3000:]
     assert "Traceback" not in err and "PETSC ERROR" not in err and "error code" not in err, err[-3000:]
     assert err.count(f"{'Ctrl-C' if sent_signal == 'SIGINT' else sent_signal}: stopping after this step") == 1
+    if sent_signal == "SIGTERM":          # (it said "Ctrl-C twice more abandons the step")
+        assert "(SIGTERM twice more abandons the step)" in err
     record = json.loads((folder / "provenance.json").read_text())
     done = int(record["status"].split()[3])
     assert record["status"] == f"interrupted after step {done} of 4000" and 1 <= done < 4000
