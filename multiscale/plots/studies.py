@@ -128,7 +128,7 @@ def _plot_axis(study, ok, axis, folder):
     numeric = _numeric(raw) and len(set(raw)) == len(raw)    # else categorical, one tick per setting
     xs = {v: (x if numeric else i) for i, (v, x) in enumerate(zip(values, raw))}
     ticks = {point(r): ", ".join(r.run.shown[k] for k in axis) for r in ok}
-    shown_at = {json.loads(point(r))[0]: r.run.shown[axis[0]] for r in ok}     # as written: "100 rpm", not 10.47
+    shown_at = {json.loads(point(r))[0]: r.run.shown[axis[0]] for r in ok} if numeric else {}   # "100 rpm", not 10.47
     log_x = numeric and min(raw) > 0 and max(raw) / min(raw) > 5
     averaged = set(study.averaged)
     others = [k for k in study.knobs if k not in axis and k not in averaged]
