@@ -521,6 +521,11 @@ def test_resume_of_a_finished_run_has_nothing_to_do(straight, capsys):
     assert (ckpt.read_bytes(), h5.read_bytes()) == before
     np.testing.assert_array_equal(again.history["time"], reference.history["time"])
     assert sorted(again.field_files) == sorted(reference.field_files)
+    # a new name, description or mesh limit changes no result: resumed (refused before; a long-run trial)
+    renamed = loads(POD.format(folder=reference.folder).replace('name = "pod_rough"', 'name = "other"\n'
+                                                                 'description = "edited"'),
+                    overrides={"geometry.max_cells": 2_000_000})
+    assert run(renamed, resume=True).steps_done == 2 and "nothing to do" in capsys.readouterr().out
     # a changed scene is refused as for a run that did not end (before: "nothing to do", its
     # results left as those of the new scene)
     changed = loads(POD.format(folder=reference.folder).replace("friction = 0.4", "friction = 0.5"))

@@ -34,7 +34,7 @@ from mpi4py import MPI
 from multiscale import checkpoint, io, outputs
 from multiscale.coupling import LoopSettings, Multiscale
 from multiscale.errors import InputError, Interrupted
-from multiscale.geometry import Rotation
+from multiscale.geometry import MAX_CELLS, Rotation
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.output import FieldOutput
 from multiscale.micro.heat_kernels import ThermalMaterial
@@ -88,17 +88,21 @@ def post_analysis(scene, zone) -> PostAnalysis:
 
 
 def fingerprint(scene) -> checkpoint.Fingerprint:
-    """What the results depend on: the scene (not the output section; effects sorted: a set's order
-    changes between processes) and the bytes of every file it reads (a measured surface rewritten
-    under the same name was resumed into wrong wear depths: the checkpoint holds the worn heights,
-    the unworn ones are read again); its inputs by name: every key of the resolved scene but
-    [output], and each file's SHA-1."""
-    s = dataclasses.replace(scene, output=None, source=None, overrides=(), warnings=(),
+    """What the results depend on: the scene (not the output section, ``name``, ``description`` or
+    ``geometry.max_cells``, a limit on the mesh: a long-run trial's resume was refused for a
+    changed description; effects sorted: a set's order changes between processes) and the bytes
+    of every file it reads (a measured surface rewritten under the same name was resumed into
+    wrong wear depths: the checkpoint holds the worn heights, the unworn ones are read again); its
+    inputs by name: every key of the resolved scene but those, and each file's SHA-1."""
+    s = dataclasses.replace(scene, output=None, source=None, overrides=(), warnings=(), name=None, description="",
+                            geometry=dataclasses.replace(scene.geometry, max_cells=MAX_CELLS),
                             effects=tuple(sorted(scene.effects)))
     source = scene.source.resolve() if scene.source is not None else None
     files = {p: checkpoint.file_digest(p) for p in sorted(p for p in scene.inputs if p != source and p.is_file())}
     resolved = tomllib.loads(resolved_toml(scene))
-    resolved.pop("output", None)
+    for key in ("output", "name", "description"):
+        resolved.pop(key, None)
+    resolved.get("geometry", {}).pop("max_cells", None)
     inputs = {**_dotted(resolved), **{f"file {p}": digest for p, digest in files.items()}}
     return checkpoint.Fingerprint(checkpoint.fingerprint(repr(s) + "".join(f"{p}:{d}" for p, d in files.items())),
                                   inputs)
