@@ -110,8 +110,6 @@ class MicroPool:
         for z, (_, key) in zip(zones, requested):
             if key not in self._cache:
                 misses.setdefault(key, z)
-            else:
-                self._cache.move_to_end(key)     # asked for again: kept longest
         # every rank learns every request: its misses (zone id, key, batch signature, expected cost)
         mine = [(z.id, key, batch_signature(z), self._expected_cost(z, spec)) for key, z in misses.items()]
         shared = comm.allgather((spec_key, mine, len(zones) - sum(k in misses for _, k in requested),
@@ -121,6 +119,11 @@ class MicroPool:
         asked = {k for _, m, _, _ in shared for _, k, _, _ in m} | ({k for _, _, _, req in shared for _, k in req}
                                                                    if gather == "all" else {k for _, k in requested})
         self._largest = max(self._largest, len(asked))
+        # asked for again: kept longest, in one order on every rank (with gather 'all' the ranks' caches must
+        # stay alike: a law one rank finds cached, every rank returns; refreshed by each rank's own requests,
+        # they parted, and a 2-rank run stopped with "no law for these zones")
+        for key in sorted(k for k in asked if k in self._cache):
+            self._cache.move_to_end(key)
         known = {k: self._cache[k] for k in asked if k in self._cache}
         work, owner = self._plan_work([m for _, m, _, _ in shared])
         plan = self._partition(work, spec)

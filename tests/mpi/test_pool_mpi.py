@@ -10,7 +10,7 @@ from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.laws import ExtraLaw, LawSpec, compute_laws
 from multiscale.micro.surface import Surface, fractal_surface
 from multiscale.micro.zones import Zone, cut_zones
-from multiscale.pool import MicroPool, PoolError
+from multiscale.pool import CACHE_CALLS, MicroPool, PoolError
 
 comm = MPI.COMM_WORLD
 E = HalfSpace(1e9)
@@ -54,6 +54,20 @@ def test_shared_zones_are_solved_once(zones):
     laws = pool.laws(zones[:3] + zones[3 + comm.rank:4 + comm.rank])
     assert pool.stats.computed == 3 + comm.size
     assert laws.ids.tolist() == [0, 1, 2, 3 + comm.rank]
+
+
+def test_the_ranks_caches_stay_alike_over_many_gathered_calls(zones):
+    """Zones 0-3 split over the ranks, zone 0 worn at every call, laws gathered from all: the
+    bounded cache (``CACHE_CALLS`` x 4 laws) kept each rank's own requests longest, the ranks'
+    caches parted, and a law one rank found cached the other could not return ("no law for these
+    zones": a 2-rank coupling study). Every call returns the four laws; only zone 0 is solved."""
+    pool = MicroPool(SPEC)
+    for k in range(2 * CACHE_CALLS * 4):
+        worn = [zones[0].with_heights(zones[0].surface.heights - k * 1e-9)] + zones[1:4]
+        laws = pool.laws(worn[comm.rank::comm.size], gather="all")
+        assert sorted(laws.ids.tolist()) == [0, 1, 2, 3]
+        assert pool.stats.computed == (4 if k == 0 else 1)
+    assert len(pool) == CACHE_CALLS * 4
 
 
 class Fragile(ExtraLaw):
