@@ -14,7 +14,7 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 import ufl  # noqa: E402
 
-from multiscale.errors import InputError, SceneError  # noqa: E402
+from multiscale.errors import ConvergenceError, InputError, SceneError  # noqa: E402
 from multiscale.io import History, solver_statistic  # noqa: E402
 from multiscale.geometry import Support, builder  # noqa: E402
 from multiscale.macro import mesh  # noqa: E402
@@ -339,6 +339,10 @@ def test_the_zones_wear_with_the_loaded_sliding_and_at_the_last_step(straight, c
     assert late["wear_volume"][1] == 0.0 and late["wear_volume"][2] == pytest.approx(every["wear_volume"][2], rel=0.02)
 
 
+@pytest.mark.xfail(strict=True, raises=ConvergenceError, reason=(
+    "known problem (docs/architecture.md 'Worn or softened zone laws'): after the first wear update "
+    "the contact Newton starts on a nearly singular tangent and fails; until 2026-12-01 its runaway "
+    "was accepted as converged with a 47.7 N residual of the 200 N load (ROUNDOFF_CAP)"))
 def test_too_few_wear_substeps_are_warned_about_with_their_estimated_error(tmp_path, monkeypatch):
     """k_w = 1e-12 /Pa over 2 steps: 4 wear substeps wear 0.27 RMS heights each (below
     ``STEP_RMS``) and left the real contact area after the first update 30.5 % below the converged

@@ -84,6 +84,10 @@ NEWTON_FLOOR, TINY_LOAD = 1e-10, 1e-8
 # disc at 100 N, bending 1.4 mm: 5.8e-9 N against a tolerance of 1.4e-9 N, eps ||diag(K) x|| = 9.2e-9
 # N), and failed. A solve that stops short is accepted below it (``_newton``: a stall, not a runaway).
 ROUNDOFF, SNES_LINEAR_FAILED = 10.0, PETSc.SNES.ConvergedReason.DIVERGED_LINEAR_SOLVE
+# ... and at most this share of the load vector's norm: a runaway's floor grows with it (a block
+# pulled off its flat, backtracking with fresh factors: 7e7 m, floor 25.8 N, residual 20 -> 15.7 N
+# of a ~400 N load taken as converged), the legitimate ones are ~1e-10 of the load
+ROUNDOFF_CAP = 1e-6
 FACTOR_PRECISION = "single"
 # ``refresh`` with a scene's ``output.repeatable``: the factors renewed once the GMRES iterations
 # beyond one per solve reach this count, not by measured times, so serial runs repeat bit for bit
@@ -216,6 +220,7 @@ class Mechanics:
         self._frictionless = None          # (matrix, form) of ``frictionless_tangent`` without P
         self._history: list[float] = []
         self._solve_atol = self._atol      # N, the absolute tolerance of the current solve (``solve``)
+        self._load_scale = 0.0             # N, the norm of the current solve's load vector (``solve``)
         self.problem.solver.setMonitor(self._watch)
 
     def release(self) -> None:
@@ -387,6 +392,7 @@ class Mechanics:
         if load is not None:
             self.load.value = float(load)
         scale = abs(float(self.load.value)) * self._unit_load          # N, the load vector's norm
+        self._load_scale = scale
         atol = min(self._atol, TINY_LOAD * scale) if scale > 0 and self._own_atol else self._atol
         self._solve_atol = max(atol, NEWTON_FLOOR * scale, self._roundoff())
         start = [u.x.array.copy() for u in self.u]
@@ -459,12 +465,13 @@ class Mechanics:
         return self._floor(self.problem.x)
 
     def _floor(self, x: PETSc.Vec) -> float:
-        """``ROUNDOFF`` eps ||diag(K_cell) x|| [N] at displacements x (collective)."""
+        """``ROUNDOFF`` eps ||diag(K_cell) x|| [N] at displacements x, at most ``ROUNDOFF_CAP`` of the
+        load (collective)."""
         d = self._split[0].bulk.getDiagonal()
         d.pointwiseMult(d, x)
         floor = ROUNDOFF * np.finfo(float).eps * d.norm()
         d.destroy()
-        return floor
+        return min(floor, ROUNDOFF_CAP * self._load_scale) if self._load_scale > 0 else floor
 
     def _watch(self, snes, it, norm) -> None:
         """SNES monitor: the residual history, and the absolute tolerance raised to the round-off
