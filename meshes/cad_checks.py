@@ -12,6 +12,12 @@ THIN = 3.0                  # element size over a body's mean thickness beyond w
 EQUAL_MOMENTS = 0.01        # principal moments of inertia this close (of the largest) are those of a body of revolution
 
 
+def box_extent(boxes) -> float:
+    """The largest side of the box holding ``boxes`` (rows of gmsh's xmin, ymin, zmin, xmax, ymax, zmax)."""
+    boxes = np.asarray(boxes, dtype=float)
+    return float((boxes[:, 3:].max(axis=0) - boxes[:, :3].min(axis=0)).max())
+
+
 def inertia(model, scale: float) -> dict:
     """Volume tag -> (volume [m^3], centre of mass [m], inertia tensor about it [m^5], bounding box
     [m]) of the OpenCASCADE volumes, the model's lengths times ``scale`` [m per unit]. Measured before
@@ -41,8 +47,8 @@ def thin_bodies(model, g, bodies: dict, volume: dict, pairs: dict) -> list[str]:
     if not thin:
         return []
     return [f"geometry.mesh_size: elements more than {THIN:g} times as thick as the bodies {', '.join(thin)} "
-                           "(thickness 2 x volume / surface): about one element across them, their stresses and "
-                           "temperatures unresolved; smaller mesh_size or interface_mesh_size resolve them"]
+            "(thickness 2 x volume / surface): about one element across them, their stresses and temperatures "
+            "unresolved; smaller mesh_size or interface_mesh_size resolve them"]
 
 
 def check_revolution(g, volumes: list[tuple]) -> None:
@@ -59,8 +65,7 @@ def check_revolution(g, volumes: list[tuple]) -> None:
     masses, centres = np.array([v[0] for v in volumes]), np.array([v[1] for v in volumes])
     c = masses @ centres / masses.sum()
     inertia = sum(i + m * ((d @ d) * np.eye(3) - np.outer(d, d)) for (m, _, i, _), d in zip(volumes, centres - c))
-    boxes = np.array([v[3] for v in volumes])
-    extent = float((boxes[:, 3:].max(axis=0) - boxes[:, :3].min(axis=0)).max())
+    extent = box_extent([v[3] for v in volumes])
     e = np.asarray(g.axis, dtype=float) / np.linalg.norm(g.axis)
     r = c - np.asarray(g.centre, dtype=float)
     off = float(np.linalg.norm(r - (r @ e) * e))

@@ -280,9 +280,9 @@ def _check_surface_groups(model, g, groups, boxes: dict) -> None:
 def _extent(model, g, scale: float, unit: tuple) -> float:
     """The largest side [m] of the model's bounding box times ``scale`` (m per model unit),
     refused if implausible (``unit``: the file's, ``cad_units.file_unit``)."""
-    boxes = np.array([model.getBoundingBox(3, t) for _, t in model.getEntities(3)])   # the model's (-1, -1)
-    extent = float((boxes[:, 3:].max(axis=0) - boxes[:, :3].min(axis=0)).max()) * scale  # is stale after a
-    #   scaled import of a spherical face: a crowned pad 0.28 m across spanned 134 m
+    # the volumes' boxes: the model's (-1, -1) is stale after a scaled import of a spherical face (a
+    # crowned pad 0.28 m across spanned 134 m)
+    extent = cad_checks.box_extent([model.getBoundingBox(3, t) for _, t in model.getEntities(3)]) * scale
     if not PLAUSIBLE[0] <= extent <= PLAUSIBLE[1]:
         raise InputError("geometry.unit", g.unit, f"the geometry of {g.file.name} spans {extent:.4g} m, implausible for "
                          f"a brake or tribometer ({PLAUSIBLE[0]:g}..{PLAUSIBLE[1]:g} m): is the file's length unit "

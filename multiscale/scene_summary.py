@@ -101,9 +101,9 @@ def _effect_line(scene: Scene, effect: str) -> str:
             st = ld.stribeck
             return (f"Stribeck mu(v) = {st.kinetic:g} + ({st.static:g} - {st.kinetic:g}) exp(-(v / {st.speed:g} m/s)"
                     f"^{st.exponent:g})")
-        own = [n for n in scene.geometry.spec.interfaces if scene.interface_settings(n).friction != ld.friction]
         if ld.friction is None:
             return "Coulomb, mu per interface"
+        own = [n for n in scene.geometry.spec.interfaces if scene.interface_settings(n).friction != ld.friction]
         return f"Coulomb, mu = {ld.friction:g}" + (f" (its own on {', '.join(own)})" if own else "")
     if effect == "thermal":
         return f"transient conduction in {', '.join(scene.bodies)}"

@@ -45,8 +45,9 @@ from multiscale.macro.mesh import TwoBodyMesh
 # "ski rental" rule: never more than twice the better of the two choices in hindsight). Factors of a
 # loaded state keep GMRES at a few iterations for steps on end on the thesis ch. 7 configuration
 # (issue 23). A solve that fails with old factors is repeated from its start with fresh ones every
-# iteration, and then once more with a backtracking line search, fresh ones too (``Mechanics.solve``). The preconditioner is built from a matrix of its own, written only
-# at a refresh: PETSc refactorises when that matrix changed, and only then. The factors are in
+# iteration, and then once more with a backtracking line search, fresh ones too (``Mechanics.solve``).
+# The preconditioner is built from a matrix of its own, written only at a refresh: PETSc
+# refactorises when that matrix changed, and only then. The factors are in
 # single precision (``FACTOR_PRECISION``; GMRES on the double tangent takes their rounding out, the
 # Newton's residual and answer are double): half the factors' memory; on the thesis ch. 7 run (2
 # ranks) a triangular solve takes 0.65x, a factorisation ~0.55x the time, and the Newton solves
@@ -477,7 +478,7 @@ class Mechanics:
         """SNES monitor: the residual history, and the absolute tolerance raised to the round-off
         floor at the current iterate, at most the first residual (``_newton``'s stall, accepted as
         it comes: a block 1e6 x stiffer than its flat stalled at 3e-9 N from iteration 5 to the cap
-        of 30, its floor 0 at the start; a runaway's floor grows with it, its residual too)."""
+        of 30, its floor 0 at the start; a runaway's floor grows with it: ``ROUNDOFF_CAP`` bounds it)."""
         self._history.append(norm)
         floor = min(self._floor(snes.getSolution()), self._history[0])
         if floor > snes.getTolerances()[1]:
