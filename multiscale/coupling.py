@@ -17,8 +17,8 @@ One macro step Δt (Fig. 7.2) runs:
    shared;
 4. the laws of the zones whose topography changed are recomputed (``rough.RoughInterface``: the
    others come from the pool's cache), the facet laws updated and the mechanics re-solved at the
-   same time (from the state plus the previous step's change by this solve, ``law_increment``,
-   if its residual is lower): the macro temperature field carries over to the next step unchanged.
+   same time (from the state plus the previous step's change by this solve, ``law_increment``, if
+   its residual is lower; where that fails, by ``macro.continuation``): the temperatures carry over.
 
 Remote temperatures of the micro heating (``LoopSettings.remote``). "bulk": each body's own macro
 surface temperature at the zone (thesis §7.2.2, §6.5: the heat conducted from the hotter body
@@ -62,9 +62,9 @@ a light zone's partition counts for the heat it moves). Schemes:
 
 The default (``scene_sections.COUPLING_DEFAULT``) was chosen by measurement (docs/accuracy/coupling.md).
 The initial laws are computed before the first solve; the rigid datum gap starts Newton close to
-equilibrium. ``save``/``restore`` write and read the whole state (``checkpoint``), so that a killed
-run continues to the same history (to solver tolerance: a resumed run recomputes its zone laws).
-This module reads no scene: ``multiscale.workflows.multiscale`` builds and runs it.
+equilibrium. ``save``/``restore`` write and read the whole state (``checkpoint``): a killed run
+continues to the same history (to solver tolerance: a resumed run recomputes its zone laws). This
+module reads no scene: ``multiscale.workflows.multiscale`` builds and runs it.
 """
 from __future__ import annotations
 
@@ -77,6 +77,7 @@ import numpy as np
 
 from multiscale import checkpoint, io
 from multiscale.errors import ConvergenceError, InputError
+from multiscale.macro.continuation import solve_on_new_laws
 from multiscale.macro.mechanics import SolveResult
 from multiscale.macro.model import MacroModel
 from multiscale.micro.post_analysis import PostAnalysis
@@ -364,8 +365,7 @@ class Multiscale:
         return micro
 
     def micro_step(self) -> MicroStep:
-        """Post-analysis of the loaded zones at the current macro state (no wear), its partitions
-        accepted."""
+        """Post-analysis of the loaded zones at the current state (no wear), its partitions accepted."""
         micro = self.analyse()
         if self.plastic:
             self.deform()
@@ -495,7 +495,7 @@ class Multiscale:
         if changed:
             mech = self.model.mechanics
             before = [u.x.array.copy() for u in mech.u]
-            self.model.last_solve = mech.solve(guess=self.law_increment)
+            self.model.last_solve = solve_on_new_laws(mech, self.rough.law, self.law_increment)
             self.law_increment = [u.x.array - x for u, x in zip(mech.u, before)]
             self.model.keep_torque(self.model.drive.factor(self.model.time))   # the worn laws moved the pressure
         return StepResult(n, heat, micro, time_macro + _time.perf_counter() - t4, time_micro + t3 - t2, t4 - t3,

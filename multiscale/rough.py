@@ -34,7 +34,7 @@ import numpy as np
 
 from multiscale.errors import InputError
 from multiscale.geometry import Rotation, plane_frame
-from multiscale.macro.laws_ufl import FacetLaw
+from multiscale.macro.laws_ufl import FacetLaw, gap_at
 from multiscale.macro.mesh import TwoBodyMesh
 from multiscale.micro.laws import STIFF, LawError, LawSpec, ZoneLaws
 from multiscale.micro.zones import Zone, ZoneGrid
@@ -294,18 +294,7 @@ class RoughInterface:
                 gap[mask] = G
                 return float(areas[mask] @ self.law.evaluate(gap)[0][mask])
 
-            hi = g_open.max()
-            step = max(np.median(g_open - laws.mechanical.gap[rows, -1]), 1e-12)
-            lo = hi - step
-            while force(lo) < target:
-                step *= 2
-                lo = hi - step
-            for _ in range(200):
-                mid = 0.5 * (lo + hi)
-                lo, hi = (mid, hi) if force(mid) > target else (lo, mid)
-                if hi - lo <= 1e-13 * step:
-                    break
-            out[mask] = 0.5 * (lo + hi)
+            out[mask] = gap_at(force, target, g_open.max(), np.median(g_open - laws.mechanical.gap[rows, -1]))
         return out
 
     def track_depth(self, volume, weight) -> np.ndarray:

@@ -18,6 +18,10 @@ derivatives at the inner knots: a sum of n − 2 small terms instead of a chain 
 conditionals (compact forms, fast compilation), equal to the Hermite table to ~1e-13 relative.
 Updating laws (wear) only rewrites the field: the compiled forms are reused.
 
+After new laws (wear) the facets can be shifted, L(g − s), by offsets s that let them carry the
+pressures of the laws they replaced at the same gaps (``carried_offsets``, ``shift``): the start of
+``macro.continuation``.
+
 Sign conventions follow ``interface.py``: g_n > 0 open, p_n >= 0 in compression.
 """
 from __future__ import annotations
@@ -93,6 +97,24 @@ def pressure_expression(c, g, n_points: int):
                                                        ufl.conditional(ufl.le(d, dn), inner, beyond)))
 
 
+def gap_at(pressure_of, target, top, span) -> np.ndarray:
+    """Gaps g <= ``top`` [m] at which ``pressure_of(g)``, decreasing in g and 0 at ``top``, equals
+    ``target`` (elementwise; arrays or scalars alike), by bisection to 1e-13 of the bracket: its low
+    end is moved below top by span, 2 span, 4 span ... until it carries the target."""
+    top, target = np.asarray(top, dtype=float), np.asarray(target, dtype=float)
+    step = np.broadcast_to(np.maximum(span, 1e-12), top.shape).copy()
+    while np.any(short := pressure_of(top - step) < target):
+        step = np.where(short, 2 * step, step)
+    lo, hi = top - step, top.copy()
+    for _ in range(200):
+        mid = 0.5 * (lo + hi)
+        above = pressure_of(mid) > target
+        lo, hi = np.where(above, mid, lo), np.where(above, hi, mid)
+        if np.all(hi - lo <= 1e-13 * step):
+            break
+    return 0.5 * (lo + hi)
+
+
 class FacetLaw:
     """Per-facet nonlinear pressure–gap laws p_n(g_n) for ``ContactInterface(law=...)``.
 
@@ -103,7 +125,7 @@ class FacetLaw:
     facet's law is scaled by A_zone / (area of the facets assigned to the zone), so that a zone
     carries exactly its micro force at a uniform gap even when facets do not tile the zones
     exactly (scale 1 when they do). ``laws``, ``zone_of_facet`` and ``scale`` are kept for numpy
-    evaluations (``evaluate``).
+    evaluations (``evaluate``), ``previous`` the laws the last ``set_laws`` replaced.
     """
 
     def __init__(self, tm, n_points: int):
@@ -113,6 +135,7 @@ class FacetLaw:
         self.space = fem.functionspace(iface.mesh, ("DG", 0, (self.size,)))
         self.coefficients = fem.Function(self.space, name="law_coefficients")
         self.laws: ZoneLaws | None = None
+        self.previous: ZoneLaws | None = None
         self.zone_of_facet: np.ndarray | None = None
 
     def __call__(self, g):
@@ -131,19 +154,44 @@ class FacetLaw:
         if zone_area is not None:
             covered = np.bincount(zones[~lawless], iface.areas[~lawless], minlength=len(zone_area))
             self.scale[~lawless] = np.asarray(zone_area, dtype=float)[zones[~lawless]] / covered[zones[~lawless]]
-        table = law_coefficients(laws.mechanical)
         owned = iface.owned_index
-        some = laws.ids[0] if len(laws.ids) else 0            # any law: scaled by 0 where lawless
-        values = table[laws.rows(np.where(lawless, some, zones)[owned])]
+        values = law_coefficients(laws.mechanical)[laws.rows(self._lawful(laws, zones)[owned])]
         values[:, _SCALE] = self.scale[owned]
-        blocks = self.space.dofmap.list[:len(owned), 0]
-        self.coefficients.x.array.reshape(-1, self.size)[blocks] = values
+        self.coefficients.x.array.reshape(-1, self.size)[self._blocks()] = values
         self.coefficients.x.scatter_forward()
-        self.laws, self.zone_of_facet = laws, zones
+        self.previous, self.laws, self.zone_of_facet = self.laws, laws, zones
+
+    @staticmethod
+    def _lawful(laws: ZoneLaws, zones: np.ndarray) -> np.ndarray:
+        """``zones`` with any law's id where a facet has none (-1; it is scaled by 0)."""
+        return np.where(zones < 0, laws.ids[0] if len(laws.ids) else 0, zones)
+
+    def _blocks(self) -> np.ndarray:
+        """The owned facets' rows in the coefficient field's array."""
+        return self.space.dofmap.list[:len(self.tm.interface.owned_index), 0]
+
+    def shift(self, offset=None) -> None:
+        """Every facet's law moved to L(g − s) by its offset s [m] (global facet order; None: the
+        laws themselves): its first-touch gap raised by s (collective)."""
+        owned = self.tm.interface.owned_index
+        rows = self.laws.rows(self._lawful(self.laws, self.zone_of_facet)[owned])
+        self.coefficients.x.array.reshape(-1, self.size)[self._blocks(), _G_OPEN] = (
+            self.laws.mechanical.g_open[rows] + (0.0 if offset is None else offset[owned]))
+        self.coefficients.x.scatter_forward()
+
+    def carried_offsets(self, gap) -> np.ndarray:
+        """Per-facet offsets s [m] with which the laws, L(g − s), carry at the facet gaps ``gap``
+        [m] the pressures of the ``previous`` laws there (0 where those are 0)."""
+        gap = np.asarray(gap, dtype=float)
+        zones = self._lawful(self.laws, self.zone_of_facet)
+        target = self.previous.pressure(gap, zones).pressure * (self.scale > 0)
+        mechanical, rows = self.laws.mechanical, self.laws.rows(zones)
+        top = mechanical.g_open[rows]
+        carrying = gap_at(lambda g: self.laws.pressure(g, zones).pressure, target, top, top - mechanical.gap[rows, -1])
+        return np.where(target > 0, gap - carrying, 0.0)
 
     def evaluate(self, gap) -> tuple[np.ndarray, np.ndarray]:
         """Per-facet (p_n [Pa], K_n [Pa/m]) of the numpy laws (scaled) at per-facet gaps [m]
         (0 on facets without a law)."""
-        zones = np.where(self.zone_of_facet < 0, self.laws.ids[0], self.zone_of_facet)
-        v = self.laws.pressure(np.asarray(gap, dtype=float), zones)
+        v = self.laws.pressure(np.asarray(gap, dtype=float), self._lawful(self.laws, self.zone_of_facet))
         return self.scale * v.pressure, self.scale * v.stiffness
