@@ -142,7 +142,7 @@ class MacroModel:
                              "towards the contact; loading.direction along the contact normal; a pressure "
                              "normal to a face whose normals cancel, a cylinder's wall, has no resultant)")
         clamp = clamp_imbalance(self.tm, float(mech.load.value)) if mech.load_kind == "fluid" else None
-        self.notes = [*mech.notes, *([clamp] if clamp is not None else [])]
+        self.notes = [*self.tm.notes, *mech.notes, *([clamp] if clamp is not None else [])]
         return self.last_solve
 
     def macro_step(self, dt: float, substeps: int = 1) -> np.ndarray:

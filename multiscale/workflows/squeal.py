@@ -258,8 +258,8 @@ def approximate_modes(scene, case: SquealCase) -> list[str]:
 def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
     """Warnings: a band cut short by stability.modes, modes or a map whose modes are approximate, a
     contact pressure beyond small strains (at the preload, or at a map point's own preload), an
-    interface that the preload left without force."""
-    st, out = scene.stability, approximate_modes(scene, case)
+    interface that the preload left without force; the mesh's (``TwoBodyMesh.notes``)."""
+    st, out = scene.stability, [*case.mech.tm.notes, *approximate_modes(scene, case)]
     f = case.modes.frequency
     top = float(f.max(initial=0.0))
     lo, hi = st.band
