@@ -9,9 +9,8 @@ uniform: the first check of the penalty interface.
 """
 from __future__ import annotations
 
-from multiscale.errors import InputError
 from multiscale.geometry import (BodySpec, GeometrySpec, Region, Support, Translation,
-                                       add_group, entities_in_box, entities_where, resolve_parameters)
+                                       add_group, entities_in_box, entities_where, require_below, resolve_parameters)
 
 DEFAULTS: dict[str, float] = {
     "length": 10e-3,              # m, block size along x
@@ -34,6 +33,9 @@ def parameters(params=None) -> dict:
     p["flat_length"] = p["flat_length"] or p["length"]
     p["flat_width"] = p["flat_width"] or p["width"]
     p["interface_mesh_size"] = p["interface_mesh_size"] or p["mesh_size"]
+    for flat, block in (("flat_length", "length"), ("flat_width", "width")):
+        require_below(p, params, block, flat, strict=False, why=": the flat is at least as large as the block",
+                      dependent=flat)
     return p
 
 
@@ -61,8 +63,6 @@ def generate(model, params=None) -> None:
     occ = model.occ
     lx, ly, h = p["length"], p["width"], p["height"]
     fx, fy, hf = p["flat_length"], p["flat_width"], p["flat_thickness"]
-    if fx < lx or fy < ly:
-        raise InputError("geometry.flat_length", (fx, fy), "the flat must be at least as large as the block")
     block = occ.addBox(0, 0, 0, lx, ly, h)
     flat = occ.addBox(0, 0, -hf, fx, fy, hf)
     occ.fragment([(3, block)], [(3, flat)])

@@ -15,9 +15,11 @@ enters the contact) is its y = −pin_size/2 edge.
 """
 from __future__ import annotations
 
+import numpy as np
+
 from multiscale.errors import InputError
 from multiscale.geometry import (BodySpec, GeometrySpec, Region, Rotation, Support, add_group,
-                                       entities_in_box, entities_where, resolve_parameters)
+                                       entities_in_box, entities_where, require_below, resolve_parameters)
 
 DEFAULTS: dict[str, float] = {
     "inner_radius": 12.5e-3,        # m, disc bore (§7.3.1)
@@ -45,15 +47,20 @@ def parameters(params=None) -> dict:
     """DEFAULTS updated by ``params`` (SI), with consistency checks."""
     p = resolve_parameters(DEFAULTS, params, NAME)
     p["track_mesh_size"] = p["track_mesh_size"] or p["mesh_size"]
-    half = p["pin_size"] / 2
-    if not p["inner_radius"] < p["track_radius"] - half < p["track_radius"] + half < p["outer_radius"]:
-        raise InputError("geometry.track_radius", p["track_radius"],
-                         "the pin must lie on the disc between inner_radius and outer_radius")
-    if not p["pin_size"] < p["housing_size"] < p["plate_width"] <= p["plate_length"]:
-        raise InputError("geometry.housing_size", p["housing_size"],
-                         "pin_size < housing_size < plate_width <= plate_length")
-    if not p["housing_height"] < p["pin_height"]:
-        raise InputError("geometry.housing_height", p["housing_height"], "must be < pin_height")
+    require_below(p, params, "inner_radius", "outer_radius", why=": the disc's bore and rim")
+    half, rc = p["pin_size"] / 2, p["track_radius"]
+    reach = (rc - half, float(np.hypot(rc + half, half)))     # m, the square's nearest edge and farthest corners
+    if not p["inner_radius"] < reach[0] < reach[1] < p["outer_radius"]:
+        key = "pin_size" if "pin_size" in (params or {}) and "track_radius" not in params else "track_radius"
+        raise InputError(f"geometry.{key}", p[key], f"the square pin of side pin_size = {1e3 * p['pin_size']:.4g} mm "
+                         f"at track_radius = {1e3 * rc:.4g} mm reaches from r = {1e3 * reach[0]:.4g} to {1e3 * reach[1]:.4g} mm (its outer "
+                         f"corners), beyond the disc's {1e3 * p['inner_radius']:.4g} to {1e3 * p['outer_radius']:.4g} mm "
+                         "(inner_radius, outer_radius): the pin must lie on the disc")
+    chain = ": pin_size < housing_size < plate_width <= plate_length (the sleeve around the pin, the plate holding it)"
+    require_below(p, params, "pin_size", "housing_size", why=chain)
+    require_below(p, params, "housing_size", "plate_width", why=chain)
+    require_below(p, params, "plate_width", "plate_length", strict=False, why=chain)
+    require_below(p, params, "housing_height", "pin_height", why=": the pin sticks out of its sleeve")
     return p
 
 

@@ -187,6 +187,20 @@ def resolve_parameters(defaults: Mapping[str, object], params: Mapping[str, obje
     return out
 
 
+def require_below(p: Mapping[str, float], given: Mapping | None, small: str, large: str, *, strict: bool = True,
+                  why: str = "", dependent: str | None = None) -> None:
+    """InputError unless p[small] < p[large] (<= unless ``strict``), naming the key of the two that
+    the user's parameters ``given`` hold (``dependent`` if both or neither, default ``small``), with
+    the other's value [m]."""
+    if p[small] < p[large] or (not strict and p[small] == p[large]):
+        return
+    given = [k for k in (small, large) if k in (given or {})]
+    named = given[0] if len(given) == 1 else dependent or small
+    name, other, relation = (large, small, ">") if named == large else (small, large, "<")
+    raise InputError(f"geometry.{name}", p[name], f"must be {relation}{'' if strict else '='} {other} "
+                     f"({p[other]:g} m){why}")
+
+
 MAX_CELLS = 1_000_000        # default refusal limit of estimate_cells (geometry.max_cells, run --max-cells)
 
 

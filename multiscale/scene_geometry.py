@@ -27,8 +27,18 @@ from multiscale.scene_plain import contains_hint
 from multiscale.units import UnitError, to_si
 
 _LENGTH = Quantity("length", gt=0)
+class Direction(Vector):
+    """Three numbers [x, y, z], not all zero: a direction (normalised where it is used)."""
+
+    def __call__(self, raw, ctx):
+        value = super().__call__(raw, ctx)
+        if not any(value):
+            raise Bad("must not be zero: it is a direction")
+        return value
+
+
 _POINT = Vector(Quantity("length"))
-_DIRECTION = Vector(Quantity("dimensionless"))
+_DIRECTION = Direction(Quantity("dimensionless"))
 # plausible builder parameters by kind (SI; warned outside): lengths of a tribometer or brake part
 _PLAUSIBLE = {"length": (1e-5, 10.0), "angle": (0.0, 6.2832)}
 MESH_ALGORITHMS = ("hxt", "delaunay")     # gmsh's 3-D algorithms a file can be meshed with
@@ -154,8 +164,6 @@ class FileGeometry:
                 if b is not None and b.material is not None and (problem := name_problem(b.material))]
         if len(self.bodies) < 2:
             out.append(f"{path}.bodies: give at least two bodies (a fixed one and the rotating one)")
-        if sum(a * a for a in self.axis) == 0:
-            out.append(f"{path}.axis = {list(self.axis)}: must not be zero")
         for name, pair in self.interfaces.items():
             for b in pair.between:
                 if b not in self.bodies:

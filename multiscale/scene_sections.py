@@ -15,12 +15,12 @@ from pathlib import Path
 from multiscale.errors import InputError
 from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_topography
-from multiscale.scene_geometry import LengthUnit
+from multiscale.scene_geometry import Direction, LengthUnit
 from multiscale.scene_plain import PixelSize
 from multiscale.scene_stability import Stribeck
 from multiscale.scene_vehicle import Vehicle
 from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, ListOf, OneOf, OnlyWith, Pair,
-                               Quantity, Requires, Section, TableOr, Tables, Text, Vector, key)
+                               Quantity, Requires, Section, TableOr, Tables, Text, key)
 
 # Plausible ranges (SI) are documented per key (``multiscale check --keys``); a value outside its
 # range is warned, not refused: foams, diamond, cryogenic tests exist, but 1e9 N on a pin is a typo.
@@ -290,7 +290,7 @@ class Loading:
     braking_torque: float | None = key(Quantity("torque", gt=0, plausible=(1e-3, 1e6)),              # N m
                                        absent="normal_force, pressure or vehicle.mass gives the load")
     faces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), absent="the builder's load faces (files: needed)")
-    direction: tuple | None = key(Vector(Quantity("dimensionless")),
+    direction: tuple | None = key(Direction(Quantity("dimensionless")),
                                   absent="-p n on each face (disc_brake, files); else -z")
     load_profile: tuple | None = key(Curve(Quantity("time", ge=0), Quantity("dimensionless", ge=0, plausible=(
         0.0, 10.0)), "time", "factor"), absent="factor 1 throughout")   # ((s, -), ...): a factor of the load, not N

@@ -382,6 +382,30 @@ def test_a_fluid_loaded_builder_refuses_a_normal_force_when_read(tmp_path):
                  tmp_path).loading.direction == (0.0, 0.0, 1.0)
 
 
+@pytest.mark.parametrize("demo, key, value, problem", [
+    ("pin_on_disc_perfect", "geometry.track_radius", "97.4 mm",      # its corners reach 107.86 mm: it ran
+     "geometry.track_radius = 0.0974: the square pin of side pin_size = 20 mm at track_radius = 97.4 mm reaches from "
+     "r = 87.4 to 107.9 mm (its outer corners), beyond the disc's 12.5 to 107.5 mm"),
+    ("pin_on_disc_perfect", "geometry.pin_size", "35 mm", "geometry.pin_size = 0.035: the square pin of side "
+     "pin_size = 35 mm at track_radius = 90 mm reaches from r = 72.5 to 108.9 mm"),      # (named track_radius)
+    ("pin_on_disc_perfect", "geometry.inner_radius", "120 mm",
+     "geometry.inner_radius = 0.12: must be < outer_radius (0.1075 m): the disc's bore and rim"),
+    ("pin_on_disc_perfect", "geometry.plate_length", "35 mm",                            # (named housing_size)
+     "geometry.plate_length = 0.035: must be >= plate_width (0.04 m): pin_size < housing_size < plate_width"),
+    ("block_on_flat", "geometry.flat_width", "5 mm",                     # (refused after meshing, by run)
+     "geometry.flat_width = 0.005: must be >= width (0.01 m): the flat is at least as large as the block"),
+    ("pin_on_disc_perfect", "loading.direction", [0, 0, 0],              # (a NaN traction and "Newton did not converge")
+     "loading.direction = [0, 0, 0]: must not be zero: it is a direction"),
+])
+def test_builder_sizes_and_directions_are_checked_when_read(demo, key, value, problem):
+    """A user's lab geometries (a trial, 2026-12-01): a pin whose corners overhang the disc ran;
+    sizes out of order named another key than the one given, or were found at meshing only; a
+    zero load direction passed check and failed in the first Newton solve."""
+    with pytest.raises(SceneError) as info:
+        load(DEMOS / f"{demo}.toml", overrides={key: value})
+    assert [p for p in info.value.problems if p.startswith(problem)], info.value.problems
+
+
 def test_alternatives_given_together_are_one_problem(tmp_path):
     """rms with file said that rms and file exclude each other and then that hurst, k_min and
     k_max were missing "with roughness.rms" (four errors for one mistake; an adversarial review);
