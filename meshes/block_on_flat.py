@@ -9,8 +9,9 @@ uniform: the first check of the penalty interface.
 """
 from __future__ import annotations
 
-from multiscale.geometry import (BodySpec, GeometrySpec, Region, Support, Translation,
-                                       add_group, entities_in_box, entities_where, require_below, resolve_parameters)
+from multiscale.geometry import (BodySpec, GeometrySpec, Region, Support, Translation, add_group,
+                                       entities_in_box, entities_where, require_below, resolve_parameters,
+                                       thin_warning)
 
 DEFAULTS: dict[str, float] = {
     "length": 10e-3,              # m, block size along x
@@ -54,6 +55,8 @@ def describe(params=None) -> GeometrySpec:
         length_scale=max(p["length"], p["width"], p["height"]),
         symmetry={"symmetry_x": (1.0, 0.0, 0.0), "symmetry_y": (0.0, 1.0, 0.0)},
         interface_extents={"interface": (p["length"], p["width"])},      # the block's footprint
+        warnings=tuple(thin_warning([("block", min(p["length"], p["width"], p["height"]), p["mesh_size"]),
+                                     ("flat", p["flat_thickness"], p["mesh_size"])])),
     )
 
 

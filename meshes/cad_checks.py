@@ -6,9 +6,9 @@ from __future__ import annotations
 import numpy as np
 
 from multiscale.errors import InputError
+from multiscale.geometry import thin_warning
 
 REVOLUTION = 1e-3           # the rotating body's centre of mass off its axis (of its extent), its axis of inertia (rad)
-THIN = 3.0                  # element size over a body's mean thickness beyond which check warns
 EQUAL_MOMENTS = 0.01        # principal moments of inertia this close (of the largest) are those of a body of revolution
 
 
@@ -37,18 +37,13 @@ def thin_bodies(model, g, bodies: dict, volume: dict, pairs: dict) -> list[str]:
     pressure came out 3.9 MPa against 6.7 MPa at 5 mm, said by a generic undershoot warning only.
     (The demos' coarse meshes reach 2.4 times a backplate's or a holder's thickness.)"""
     touching = {n for pair in pairs.values() for n in pair}
-    thin = []
+    sized = []
     for name, volumes in bodies.items():
         faces = model.getBoundary([(3, v) for v in volumes], combined=True, oriented=False)
         thickness = 2 * sum(volume[v] for v in volumes) / sum(model.occ.getMass(2, f) for _, f in faces)
-        size = g.interface_mesh_size if name in touching and g.interface_mesh_size else g.mesh_size
-        if size > THIN * thickness:
-            thin.append(f"{name} (about {thickness * 1e3:.3g} mm, meshed at {size * 1e3:.3g} mm)")
-    if not thin:
-        return []
-    return [f"geometry.mesh_size: elements more than {THIN:g} times as thick as the bodies {', '.join(thin)} "
-            "(thickness 2 x volume / surface): about one element across them, their stresses and temperatures "
-            "unresolved; smaller mesh_size or interface_mesh_size resolve them"]
+        sized.append((name, thickness, g.interface_mesh_size if name in touching and g.interface_mesh_size
+                      else g.mesh_size))
+    return thin_warning(sized, " (thickness 2 x volume / surface)")
 
 
 def check_revolution(g, volumes: list[tuple]) -> None:

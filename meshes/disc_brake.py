@@ -34,7 +34,7 @@ import math
 
 from multiscale.errors import InputError
 from multiscale.geometry import (BodySpec, GeometrySpec, Region, Rotation, Support, add_group,
-                                       entities_in_box, entities_where, resolve_parameters)
+                                       entities_in_box, entities_where, resolve_parameters, thin_warning)
 
 NAME = "disc_brake"
 PARAMETER_KINDS = {"vanes": "count"}
@@ -142,6 +142,9 @@ def describe(params=None) -> GeometrySpec:
         fluid_load=True,                          # the hydraulic pressure on piston and caliper bore
         interface_regions={"inner_pad": "pad_inner", "outer_pad": "pad_outer"},
         interface_extents=dict.fromkeys(("inner_pad", "outer_pad"), _pad_extent(p)),
+        warnings=tuple(thin_warning([("disc", p["cheek_thickness"] if p["vanes"] else p["disc_thickness"],
+                                      p["mesh_size"]), ("pads", p["pad_thickness"], p["pad_mesh_size"]),
+                                     ("backplates", p["backplate_thickness"], p["pad_mesh_size"])])),
     )
 
 

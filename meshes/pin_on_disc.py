@@ -19,7 +19,8 @@ import numpy as np
 
 from multiscale.errors import InputError
 from multiscale.geometry import (BodySpec, GeometrySpec, Region, Rotation, Support, add_group,
-                                       entities_in_box, entities_where, require_below, resolve_parameters)
+                                       entities_in_box, entities_where, require_below, resolve_parameters,
+                                       thin_warning)
 
 DEFAULTS: dict[str, float] = {
     "inner_radius": 12.5e-3,        # m, disc bore (§7.3.1)
@@ -78,6 +79,9 @@ def describe(params=None) -> GeometrySpec:
         load_direction=(0.0, 0.0, -1.0),
         motion=Rotation((0.0, 0.0, 1.0), (0.0, 0.0, 0.0)),
         length_scale=p["outer_radius"],
+        warnings=tuple(thin_warning([("disc", p["disc_thickness"], p["mesh_size"]),
+                                     ("pin", min(p["pin_size"], p["pin_height"]), p["holder_mesh_size"]),
+                                     ("plate", p["plate_thickness"], p["holder_mesh_size"])])),
         interface_extents={"interface": (p["pin_size"], p["pin_size"])},
     )
 

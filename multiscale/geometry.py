@@ -187,6 +187,22 @@ def resolve_parameters(defaults: Mapping[str, object], params: Mapping[str, obje
     return out
 
 
+THIN = 3.0      # element size over a body's thickness beyond which check warns (``thin_warning``)
+
+
+def thin_warning(bodies, how: str = "") -> list[str]:
+    """The warning (a list of one, or none) of the bodies of ``bodies``, (name, thickness [m],
+    element size [m]) each, meshed at elements more than ``THIN`` times as thick as they are (``how``
+    the thickness was found, said after them): about
+    one element across them, their bending and temperatures unresolved (a 1 mm disc under 12 mm
+    elements deflected 44 um, under 4 mm 329 um, and a 0.1 mm one 5 um: a lab-geometry trial)."""
+    thin = [f"{name} (about {t * 1e3:.3g} mm, meshed at {size * 1e3:.3g} mm)" for name, t, size in bodies
+            if size > THIN * t]
+    return [f"geometry.mesh_size: elements more than {THIN:g} times as thick as the bodies {', '.join(thin)}{how}: "
+            "about one element across them, their stresses and temperatures unresolved; smaller mesh sizes "
+            "resolve them"] if thin else []
+
+
 def require_below(p: Mapping[str, float], given: Mapping | None, small: str, large: str, *, strict: bool = True,
                   why: str = "", dependent: str | None = None) -> None:
     """InputError unless p[small] < p[large] (<= unless ``strict``), naming the key of the two that
