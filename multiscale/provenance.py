@@ -281,7 +281,8 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     ``scene_resolved.toml`` and ``provenance.json`` in ``folder``; call on rank 0. The record names
     the overrides given over the scene file (``scene.load``: a study's point), and lists
     every entry the run writes (``multiscale.outputs.plan``), so that ``results_of`` knows them
-    when the folder is overwritten; ``warnings``: the scene's and the run's (e.g. temperatures
+    when the folder is overwritten (a failed run: those it wrote; its record named a script and
+    figures it never wrote); ``warnings``: the scene's and the run's (e.g. temperatures
     beyond a material table); status ``RUNNING`` (written as the run begins) has no end time.
     ``earlier``: the parts of the run before this one (a resumed run: ``parts_of`` the folder
     before it wrote); the record's ``parts`` are those and this one, its ``start`` the first
@@ -307,8 +308,10 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
               "process": process(),
               "versions": versions(), "code": code(), "environment": environment(), "inputs": input_digests(scene),
               "files": sorted(plan(scene).files), "warnings": list(warnings)}
-    texts = {"scene.toml": given, "scene_resolved.toml": resolved_toml(scene),
-             "provenance.json": json.dumps(record, indent=2, default=str) + "\n"}
+    texts = {"scene.toml": given, "scene_resolved.toml": resolved_toml(scene)}
+    if status.startswith("failed"):              # (a run that ended writes its script after the record)
+        record["files"] = [n for n in record["files"] if n in texts or n == "provenance.json" or (folder / n).exists()]
+    texts["provenance.json"] = json.dumps(record, indent=2, default=str) + "\n"
     for name, text in texts.items():              # each replaced whole: a killed run leaves the earlier one
         with replacing(folder / name) as part:
             part.write_text(text, encoding="utf-8")

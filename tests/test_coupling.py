@@ -519,13 +519,14 @@ def test_resume_from_a_released_step_gives_the_straight_history(cycle, tmp_path)
 
 def test_a_loop_that_fails_keeps_the_history_of_its_steps(tmp_path, monkeypatch, free_communicators):
     """Step 2 fails (simulated): history.h5 holds the start and step 1 as the checkpoint does
-    (before: written only at the end of the loop, so a killed or failed run had none to look at).
+    (before: written only at the end of the loop, so a killed or failed run had none to look at);
+    its record lists the files it wrote (it named paraview.py, never written: a user trial).
     The failed run's model is closed (one rank): a second failed run in the process costs no MPI
     communicators (before: 58 of MPICH's 2048 each)."""
     import gc  # local: this test alone looks at the collector
     from multiscale.coupling import Multiscale
     from multiscale.errors import ConvergenceError
-    from multiscale.workflows.multiscale import run
+    from multiscale.workflows import run
     step = Multiscale.step
 
     def failing(self, n):
@@ -542,6 +543,10 @@ def test_a_loop_that_fails_keeps_the_history_of_its_steps(tmp_path, monkeypatch,
     h = History.read(tmp_path / "failed" / "history.h5")
     np.testing.assert_allclose(h["time"], [0.0, 0.6])
     assert counts[1] == counts[0]
+    record = json.loads((tmp_path / "failed" / "provenance.json").read_text())    # what it wrote
+    assert record["status"] == "failed: ConvergenceError: step 2 fails (simulated)"
+    assert "history.h5" in record["files"] and "paraview.py" not in record["files"]
+    assert all((tmp_path / "failed" / name).exists() for name in record["files"])
 
 
 def test_resume_of_a_finished_run_has_nothing_to_do(straight, capsys):
