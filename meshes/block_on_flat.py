@@ -55,6 +55,9 @@ def describe(params=None) -> GeometrySpec:
         length_scale=max(p["length"], p["width"], p["height"]),
         symmetry={"symmetry_x": (1.0, 0.0, 0.0), "symmetry_y": (0.0, 1.0, 0.0)},
         interface_extents={"interface": (p["length"], p["width"])},      # the block's footprint
+        report=(f"a quarter model of a {2e3 * p['length']:.4g} x {2e3 * p['width']:.4g} mm block (symmetry planes "
+                "x = 0, y = 0): its load, forces, areas, heats and worn volumes are the quarter's, a quarter of "
+                "the whole block's",),
         warnings=tuple(thin_warning([("block", min(p["length"], p["width"], p["height"]), p["mesh_size"]),
                                      ("flat", p["flat_thickness"], p["mesh_size"])])),
     )

@@ -79,6 +79,9 @@ def describe(params=None) -> GeometrySpec:
         load_direction=(0.0, 0.0, -1.0),
         motion=Rotation((0.0, 0.0, 1.0), (0.0, 0.0, 0.0)),
         length_scale=p["outer_radius"],
+        report=(f"a square pin of side pin_size = {1e3 * p['pin_size']:.4g} mm at track_radius = "
+                f"{1e3 * p['track_radius']:.4g} mm on a disc of {1e3 * p['inner_radius']:.4g} to "
+                f"{1e3 * p['outer_radius']:.4g} mm, {1e3 * p['disc_thickness']:.4g} mm thick",),
         warnings=tuple(thin_warning([("disc", p["disc_thickness"], p["mesh_size"]),
                                      ("pin", min(p["pin_size"], p["pin_height"]), p["holder_mesh_size"]),
                                      ("plate", p["plate_thickness"], p["holder_mesh_size"])])),

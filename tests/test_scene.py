@@ -425,6 +425,18 @@ def test_builder_bodies_thinner_than_their_elements_are_warned_about():
     assert not thin("pin_on_disc_perfect") and not thin("brake_squeal") and not thin("block_on_flat")
 
 
+def test_check_says_what_the_builders_sizes_mean():
+    """pin_size is the square's side (read as a diameter: 27 % more area), and block_on_flat is a
+    quarter model whose forces are the quarter's (its 100 N carried 400 N of the whole block): said
+    only in a demo's comment and the builders' docstrings (a lab-geometry trial)."""
+    lines = summary(load(DEMOS / "block_on_flat.toml"))
+    assert "            a quarter model of a 20 x 20 mm block (symmetry planes x = 0, y = 0): its load, forces, areas, " \
+           "heats and worn volumes are the quarter's, a quarter of the whole block's" in lines
+    lines = summary(load(DEMOS / "pin_on_disc.toml", overrides={"geometry.pin_size": "10 mm"}))
+    assert "            a square pin of side pin_size = 10 mm at track_radius = 90 mm on a disc of 12.5 to 107.5 mm, " \
+           "10 mm thick" in lines
+
+
 def test_alternatives_given_together_are_one_problem(tmp_path):
     """rms with file said that rms and file exclude each other and then that hurst, k_min and
     k_max were missing "with roughness.rms" (four errors for one mistake; an adversarial review);
