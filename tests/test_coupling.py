@@ -184,7 +184,7 @@ def test_identical_zones_equal_perfect_contact_with_the_secant_stiffness(tmp_pat
 def test_laws_that_leave_every_facet_open_are_reached_by_continuation(tmp_path):
     """New laws that first touch 3 (g_open - g) closer than the block's converged laws (identical
     zones, 1 MPa) leave every facet open: the tangent is singular along the load, as worn laws left
-    the coarse pin after its first wear update with k_w = 1e-12 /Pa, and the direct solve fails.
+    the coarse pin after its second wear update with k_w = 1e-12 /Pa, and the direct solve fails.
     ``solve_on_new_laws`` continues from the old laws' pressures to the exact answer: the block
     moved rigidly by that shift toward the flat, the flat and the pressures as before."""
     from multiscale.macro.continuation import solve_on_new_laws
@@ -213,12 +213,27 @@ def test_laws_that_leave_every_facet_open_are_reached_by_continuation(tmp_path):
     np.testing.assert_allclose(mech.contact.facet_pressure(), pressure, rtol=1e-9)
     mech.load.value = -1e6                          # pulled off the flat: no continuation reaches it
     law.set_laws(law.previous, ms.rough.zone_of_facet)
-    with pytest.raises(ConvergenceError, match=r"contact Newton did not converge at load -1e\+06 Pa .*; continued "
-                                               r"from the pressures of the laws before, it stopped at 0 of the way"):
+    with pytest.raises(ConvergenceError, match=r"^the contact solve on new zone laws \(a wear update or plastic "
+                                               r"flattening: .* failed: contact Newton did not converge at load "
+                                               r"-1e\+06 Pa .*; continued from the pressures of the laws before, it "
+                                               r"stopped at 0 of the way \(its last step 0.5\): .*; smaller wear steps"):
         solve_on_new_laws(mech, law)
     for u, x in zip(mech.u, before):
         u.x.array[:] = x
     np.testing.assert_allclose(mech.contact.facet_pressure(), pressure, rtol=1e-9)     # the laws unshifted
+
+
+def test_gap_at_inverts_decreasing_pressures_and_refuses_one_bounded_below_its_target():
+    """``gap_at`` (the datum gap's and the continuation's offsets' bisection): a linear penetration
+    law inverted elementwise and for a scalar to 1e-13 of the bracket; a pressure capped below the
+    target (a law without stiffness at its top) looped for ever (a user trial), now an InputError."""
+    from multiscale.macro.laws_ufl import gap_at
+    top, stiffness, target = 1e-6, 1e12, np.array([1e5, 6e5, 0.0])
+    np.testing.assert_allclose(gap_at(lambda g: stiffness * np.maximum(top - g, 0), target, np.full(3, top),
+                                      np.full(3, 1e-7)), top - target / stiffness, rtol=0, atol=1e-18)
+    assert gap_at(lambda g: stiffness * max(top - g, 0), 1e5, top, 1e-7) == pytest.approx(9e-7, abs=1e-18)
+    with pytest.raises(InputError, match=r"target = 600000.0: a pressure these laws do not reach at any gap"):
+        gap_at(lambda g: np.minimum(stiffness * np.maximum(top - g, 0), 5e5), target, np.full(3, top), np.full(3, top))
 
 
 def test_post_analysis_wears_exactly_archard_volume():
@@ -384,9 +399,9 @@ def test_too_few_wear_substeps_are_warned_about_with_their_estimated_error(tmp_p
     one (128 substeps), silently. ``PostAnalysis.wear`` now wears each update again in twice the
     substeps (discarded): the estimate 2 |A_n - A_2n| / A_2n of that update is 1 to 4 times the
     true difference (72 %: 2.4 times), and the run warns, naming it and a substep count for
-    ``SUBSTEP_TOL``. 32 substeps: estimates <= 0.5 % (a few contact cells), no warning. The first
-    update's laws leave every facet of the pin open: its solve is reached by continuation (until
-    2026-12-01 it ran away and was taken as converged at a 48 N residual of the 200 N load)."""
+    ``SUBSTEP_TOL``. 32 substeps: estimates <= 0.5 % (a few contact cells), no warning. The
+    updates' laws leave every facet of the pin open; the second's solve is reached by continuation
+    (until 2026-12-01 it ran away and was taken as converged at a 48 N residual of the 200 N load)."""
     from multiscale.micro.wear import SUBSTEP_TOL, STEP_RMS
     from multiscale.workflows.multiscale import run
     scene = {"wear.k_w": "1e-12 1/Pa", "time.steps": 2, "time.end": "1.2 s"}

@@ -30,7 +30,8 @@ FIRST_STEP, SMALLEST_STEP = 0.5, 1 / 64
 def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None) -> SolveResult:
     """``mech.solve(guess=guess)`` after ``law.set_laws`` replaced the laws, by continuation where
     it fails (module docstring; collective). The result's ``iterations`` sum the Newton
-    iterations of the converged solves. Raises ``ConvergenceError`` naming both failures."""
+    iterations of the converged solves (not the failed direct one's). Raises ``ConvergenceError``
+    naming both failures and the update that led to them."""
     start = [u.x.array.copy() for u in mech.u]
     try:
         return mech.solve(guess=guess)
@@ -50,15 +51,18 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None)
                 result = mech.solve()
             except ConvergenceError:
                 _restore(mech, kept)
-                step /= 2
-                if step < SMALLEST_STEP:
+                if step / 2 < SMALLEST_STEP:
                     raise
+                step /= 2
                 continue
             done, step, iterations = target, 2 * step, iterations + result.iterations
     except ConvergenceError as exc:
         law.shift(None)
-        raise ConvergenceError(f"{direct}; continued from the pressures of the laws before, it stopped at "
-                               f"{done:.3g} of the way (step {step:.3g}): {exc}", exc.history, exc.result) from exc
+        raise ConvergenceError(
+            f"the contact solve on new zone laws (a wear update or plastic flattening: the laws changed, no support "
+            f"did) failed: {direct}; continued from the pressures of the laws before, it stopped at {done:.3g} of "
+            f"the way (its last step {step:.3g}): {exc}; smaller wear steps change the laws less at an update "
+            "(more wear.substeps or time.steps, or a lower k_w)", exc.history, exc.result) from exc
     return dataclasses.replace(result, iterations=iterations)
 
 

@@ -100,11 +100,17 @@ def pressure_expression(c, g, n_points: int):
 def gap_at(pressure_of, target, top, span) -> np.ndarray:
     """Gaps g <= ``top`` [m] at which ``pressure_of(g)``, decreasing in g and 0 at ``top``, equals
     ``target`` (elementwise; arrays or scalars alike), by bisection to 1e-13 of the bracket: its low
-    end is moved below top by span, 2 span, 4 span ... until it carries the target."""
+    end is moved below top by span, 2 span, 4 span ... until it carries the target (``InputError``
+    after 2^64 span: a pressure bounded below it; the zone laws grow linearly beyond their top)."""
     top, target = np.asarray(top, dtype=float), np.asarray(target, dtype=float)
     step = np.broadcast_to(np.maximum(span, 1e-12), top.shape).copy()
-    while np.any(short := pressure_of(top - step) < target):
+    for _ in range(65):
+        if not np.any(short := pressure_of(top - step) < target):
+            break
         step = np.where(short, 2 * step, step)
+    else:
+        raise InputError("target", float(np.max(target[short] if target.ndim else target)),
+                         "a pressure these laws do not reach at any gap")
     lo, hi = top - step, top.copy()
     for _ in range(200):
         mid = 0.5 * (lo + hi)

@@ -20,8 +20,8 @@ from test_coupling import POD  # noqa: E402
 
 
 def test_two_ranks_give_the_serial_multiscale_history(tmp_path, monkeypatch):
-    """With k_w = 1e-12 /Pa in 4 wear substeps: the first update's laws leave every facet of the
-    pin open, the direct solve fails and ``macro.continuation`` reaches it on both ranks together
+    """With k_w = 1e-12 /Pa in 4 wear substeps: the updates' laws leave every facet of the pin
+    open, the second's direct solve fails and ``macro.continuation`` reaches it on both ranks together
     (its offsets computed on each)."""
     from multiscale.macro.laws_ufl import FacetLaw
     world, calls = MPI.COMM_WORLD, []
