@@ -70,7 +70,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                                      stages=reporter.times, wall_time=time.perf_counter() - start, analysis=kind,
                                      status=f"interrupted {stopped}".strip() if stopped else
                                      f"failed: {type(exc).__name__}: {exc}", earlier=earlier,
-                                     warnings=[*scene.warnings, *(exc.warnings if isinstance(exc, Interrupted) else ())])
+                                     warnings=[*scene.warnings, *(exc.warnings if isinstance(exc, Interrupted) else ()),
+                                               *run_warnings(scene, _written_history(reporter.folder))])
                     if isinstance(exc, Interrupted):          # stopped after a step: its results are written
                         _write_script(reporter.folder, scene)
                     elif stopped:                             # a step abandoned: the plots of what was written
@@ -125,6 +126,15 @@ def _abandoned(folder: Path, scene) -> None:
             multiscale_figure(history, h5.with_name("multiscale.png"), scene.name)
     if any((Path(folder) / name).is_file() for name in outputs.plan(scene).field_files):
         _write_script(folder, scene)
+
+
+def _written_history(folder: Path):
+    """The history a stopped run wrote into ``folder`` (its steps so far), or None: none, or one that
+    cannot be read (the record of the stop is written all the same)."""
+    try:
+        return io.History.read(folder / outputs.OWN_FILES["history"])
+    except Exception:      # h5py's and ours alike: a half-written file must not cost the record
+        return None
 
 
 def run_warnings(scene, history) -> list[str]:
