@@ -19,8 +19,8 @@ import numpy as np
 
 from multiscale.errors import InputError
 from multiscale.geometry import (BodySpec, GeometrySpec, Region, Rotation, Support, add_group,
-                                       entities_in_box, entities_where, require_below, resolve_parameters,
-                                       thin_warning)
+                                       entities_in_box, entities_where, named_key, require_below,
+                                       resolve_parameters, thin_warning)
 
 DEFAULTS: dict[str, float] = {
     "inner_radius": 12.5e-3,        # m, disc bore (§7.3.1)
@@ -52,11 +52,12 @@ def parameters(params=None) -> dict:
     half, rc = p["pin_size"] / 2, p["track_radius"]
     reach = (rc - half, float(np.hypot(rc + half, half)))     # m, the square's nearest edge and farthest corners
     if not p["inner_radius"] < reach[0] < reach[1] < p["outer_radius"]:
-        key = "pin_size" if "pin_size" in (params or {}) and "track_radius" not in params else "track_radius"
+        key = named_key(params, ("pin_size", "track_radius"), "track_radius")
         raise InputError(f"geometry.{key}", p[key], f"the square pin of side pin_size = {1e3 * p['pin_size']:.4g} mm "
-                         f"at track_radius = {1e3 * rc:.4g} mm reaches from r = {1e3 * reach[0]:.4g} to {1e3 * reach[1]:.4g} mm (its outer "
-                         f"corners), beyond the disc's {1e3 * p['inner_radius']:.4g} to {1e3 * p['outer_radius']:.4g} mm "
-                         "(inner_radius, outer_radius): the pin must lie on the disc")
+                         f"at track_radius = {1e3 * rc:.4g} mm reaches from r = {1e3 * reach[0]:.4g} to "
+                         f"{1e3 * reach[1]:.4g} mm (its outer corners), beyond the disc's "
+                         f"{1e3 * p['inner_radius']:.4g} to {1e3 * p['outer_radius']:.4g} mm (inner_radius, "
+                         "outer_radius): the pin must lie on the disc")
     chain = ": pin_size < housing_size < plate_width <= plate_length (the sleeve around the pin, the plate holding it)"
     require_below(p, params, "pin_size", "housing_size", why=chain)
     require_below(p, params, "housing_size", "plate_width", why=chain)

@@ -193,9 +193,9 @@ THIN = 3.0      # element size over a body's thickness beyond which check warns 
 def thin_warning(bodies, how: str = "") -> list[str]:
     """The warning (a list of one, or none) of the bodies of ``bodies``, (name, thickness [m],
     element size [m]) each, meshed at elements more than ``THIN`` times as thick as they are (``how``
-    the thickness was found, said after them): about
-    one element across them, their bending and temperatures unresolved (a 1 mm disc under 12 mm
-    elements deflected 44 um, under 4 mm 329 um, and a 0.1 mm one 5 um: a lab-geometry trial)."""
+    the thickness was found, said after them): about one element across them, their bending and
+    temperatures unresolved (a 1 mm disc under 12 mm elements deflected 44 um, under 4 mm 329 um,
+    and a 0.1 mm one 5 um: a lab-geometry trial)."""
     thin = [f"{name} (about {t * 1e3:.3g} mm, meshed at {size * 1e3:.3g} mm)" for name, t, size in bodies
             if size > THIN * t]
     return [f"geometry.mesh_size: elements more than {THIN:g} times as thick as the bodies {', '.join(thin)}{how}: "
@@ -203,15 +203,21 @@ def thin_warning(bodies, how: str = "") -> list[str]:
             "resolve them"] if thin else []
 
 
+def named_key(given: Mapping | None, keys: tuple[str, str], default: str) -> str:
+    """Which of two builder parameters an error about both names: the one the user's parameters
+    ``given`` hold, ``default`` if they hold both or neither."""
+    held = [k for k in keys if k in (given or {})]
+    return held[0] if len(held) == 1 else default
+
+
 def require_below(p: Mapping[str, float], given: Mapping | None, small: str, large: str, *, strict: bool = True,
                   why: str = "", dependent: str | None = None) -> None:
     """InputError unless p[small] < p[large] (<= unless ``strict``), naming the key of the two that
-    the user's parameters ``given`` hold (``dependent`` if both or neither, default ``small``), with
-    the other's value [m]."""
+    the user's parameters ``given`` hold (``named_key``; ``dependent`` if both or neither, default
+    ``small``), with the other's value [m]."""
     if p[small] < p[large] or (not strict and p[small] == p[large]):
         return
-    given = [k for k in (small, large) if k in (given or {})]
-    named = given[0] if len(given) == 1 else dependent or small
+    named = named_key(given, (small, large), dependent or small)
     name, other, relation = (large, small, ">") if named == large else (small, large, "<")
     raise InputError(f"geometry.{name}", p[name], f"must be {relation}{'' if strict else '='} {other} "
                      f"({p[other]:g} m){why}")

@@ -27,6 +27,8 @@ from multiscale.scene_plain import contains_hint
 from multiscale.units import UnitError, to_si
 
 _LENGTH = Quantity("length", gt=0)
+
+
 class Direction(Vector):
     """Three numbers [x, y, z], not all zero: a direction (normalised where it is used)."""
 

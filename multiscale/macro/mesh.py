@@ -507,8 +507,8 @@ def _coverage_notes(tm: TwoBodyMesh, coverage: dict) -> tuple:
     for n, r in off.items():                     # equal pucks said once
         mesh = areas[masks[n]].sum() * 1e6
         alike.setdefault(f"{100 * (1 - r):.3g} % ({mesh:.4g} of {mesh / r:.4g} mm^2)", []).append(n)
-    said = [f"{', '.join(names[:3])}{f' and {len(names) - 3} more' * (len(names) > 3)}: {loss}{' each' * (len(names) > 1)}"
-            for loss, names in alike.items()]
+    said = [f"{', '.join(names[:3])}{f' and {len(names) - 3} more' * (len(names) > 3)}: {loss}"
+            f"{' each' * (len(names) > 1)}" for loss, names in alike.items()]
     return (f"interface meshes cover less than their faces (negative: more): {'; '.join(said)}; their contact "
             "pressures are that much higher under the same force (round edges meshed by straight ones): a finer "
             "geometry.interface_mesh_size brings them closer, the loss falling with its square",)
