@@ -46,26 +46,32 @@ test: $(STAMP)
 docs: $(STAMP)
 	$(BIN)/python -m sphinx -b html -E -W --keep-going -n -q docs docs/_build/html
 
-# One pytest process per test module: a model not closed stays in memory with ~35-100 MPI
-# communicators of MPICH's 2048 per process, and the whole suite in one process ended with exit code
-# 15, MPICH's abort for "Too many communicators" (203515151 & 0xff; docs/architecture.md §7). The
-# tests' conftest now closes every model a module leaves open (four heavy modules in one process
-# pass); the processes per module stay: two run at a time, and a crash names its module. JOBS
-# modules run at a time, each
-# module's output printed whole when it ends (-O), the slowest started first so that the jobs end
-# together; every module runs (-k), and the failed ones are named at the end. WITH: more targets
-# run beside them.
+# The long test modules run one pytest process each, the slowest first, JOBS at a time, each
+# module's output printed whole when it ends (-O); every module runs (-k), and the failed ones are
+# named at the end. The ~45 quick modules (seconds each) share one process, started first: their
+# interpreter and imports (~3.4 s a module) took 451 s one by one, 303 s in one process. A shared
+# process must not run out of MPI communicators (MPICH's 2048; a model not closed keeps ~35-100):
+# the tests' conftest closes every model a module leaves open (docs/architecture.md, "Runs and
+# processes").
+# test_cli runs alone: one of its tests writes into a closed pipe, which ends the process (PETSc's
+# abort, exit code 15) once PETSc or gmsh has set SIGPIPE's handler. WITH: more targets beside.
 JOBS ?= 2
-SLOW_TESTS := duty_cycle squeal_effects killed_run coupling macro_thermal faults studies architecture macro_run
-TESTS := $(SLOW_TESTS:%=tests/test_%.py) $(filter-out $(SLOW_TESTS:%=tests/test_%.py),$(sort $(wildcard tests/test_*.py)))
-TEST_RUNS := $(TESTS:tests/%.py=run-%)
-.PHONY: $(TEST_RUNS)
+ALONE := duty_cycle squeal_effects killed_run coupling macro_thermal faults studies geometry_files architecture \
+	macro_run outputs mesh_size cli
+ALONE_TESTS := $(ALONE:%=tests/test_%.py)
+QUICK_TESTS := $(filter-out $(ALONE_TESTS),$(sort $(wildcard tests/test_*.py)))
+ALONE_RUNS := $(ALONE_TESTS:tests/%.py=run-%)
+.PHONY: run-quick $(ALONE_RUNS)
 
 test-serial: $(STAMP) demos/cad/car_brake.step
-	@rm -f .test-failed; $(MAKE) --no-print-directory -k -j$(JOBS) -O $(WITH) $(TEST_RUNS); status=$$?; \
+	@rm -f .test-failed; $(MAKE) --no-print-directory -k -j$(JOBS) -O $(WITH) run-quick $(ALONE_RUNS); status=$$?; \
 	  if [ -s .test-failed ]; then echo "failed:$$(tr -d '\n' < .test-failed)"; fi; rm -f .test-failed; exit $$status
 
-$(TEST_RUNS): run-%:
+run-quick:
+	@echo "tests/: $(words $(QUICK_TESTS)) quick modules in one process"; \
+	  $(BIN)/python -m pytest -q -p no:cacheprovider $(QUICK_TESTS) || { echo " (quick modules)" >> .test-failed; exit 1; }
+
+$(ALONE_RUNS): run-%:
 	@echo "tests/$*.py"; $(BIN)/python -m pytest -q -p no:cacheprovider tests/$*.py || { echo " tests/$*.py" >> .test-failed; exit 1; }
 
 # The CAD demos' STEP files (demos/cad_models.py writes both): the tests load every demo scene.
