@@ -494,9 +494,9 @@ class Multiscale:
         t4 = _time.perf_counter()
         if changed:
             mech = self.model.mechanics
-            before = [u.x.array.copy() for u in mech.u]
+            before = mech.displacements()
             self.model.last_solve = solve_on_new_laws(mech, self.rough.law, self.law_increment)
-            self.law_increment = [u.x.array - x for u, x in zip(mech.u, before)]
+            self.law_increment = [u - x for u, x in zip(mech.displacements(), before)]
             self.model.keep_torque(self.model.drive.factor(self.model.time))   # the worn laws moved the pressure
         return StepResult(n, heat, micro, time_macro + _time.perf_counter() - t4, time_micro + t3 - t2, t4 - t3,
                           residuals)

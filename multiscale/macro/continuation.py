@@ -32,12 +32,12 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None)
     it fails (module docstring; collective). The result's ``iterations`` sum the Newton
     iterations of the converged solves (not the failed direct one's). Raises ``ConvergenceError``
     naming both failures and the update that led to them."""
-    start = [u.x.array.copy() for u in mech.u]
+    start = mech.displacements()
     try:
         return mech.solve(guess=guess)
     except ConvergenceError as exc:
         direct = exc
-    _restore(mech, start)
+    mech.set_displacements(start)
     offset = law.carried_offsets(mech.contact.facet_gap())
     done, step, iterations = 0.0, FIRST_STEP, 0
     try:
@@ -45,12 +45,12 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None)
         result = mech.solve()
         iterations += result.iterations
         while done < 1.0:
-            target, kept = min(1.0, done + step), [u.x.array.copy() for u in mech.u]
+            target, kept = min(1.0, done + step), mech.displacements()
             law.shift((1.0 - target) * offset)
             try:
                 result = mech.solve()
             except ConvergenceError:
-                _restore(mech, kept)
+                mech.set_displacements(kept)
                 if step / 2 < SMALLEST_STEP:
                     raise
                 step /= 2
@@ -64,8 +64,3 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None)
             f"the way (its last step {step:.3g}): {exc}; smaller wear steps change the laws less at an update "
             "(more wear.substeps or time.steps, or a lower k_w)", exc.history, exc.result) from exc
     return dataclasses.replace(result, iterations=iterations)
-
-
-def _restore(mech: Mechanics, displacements: list) -> None:
-    for u, x in zip(mech.u, displacements):
-        u.x.array[:] = x

@@ -386,6 +386,16 @@ class Mechanics:
         return [[m[0], None], [None, m[1]]]
 
     # ---- solution --------------------------------------------------------------------------
+    def displacements(self) -> list:
+        """Copies of each body's displacement array [m] (owned and ghost entries: no scatter needed
+        to put them back with ``set_displacements``)."""
+        return [u.x.array.copy() for u in self.u]
+
+    def set_displacements(self, arrays) -> None:
+        """Each body's displacements [m] from ``arrays`` (``displacements``' layout, or a number)."""
+        for u, x in zip(self.u, arrays):
+            u.x.array[:] = x
+
     def solve(self, load: float | None = None, guess: list | None = None) -> SolveResult:
         """Newton solve at the given load (N or Pa); raises ConvergenceError on failure. ``guess``:
         per-body displacement increments [m] (arrays of the ``u`` layout) to start from instead, if
@@ -396,14 +406,12 @@ class Mechanics:
         self._load_scale = scale
         atol = min(self._atol, TINY_LOAD * scale) if scale > 0 and self._own_atol else self._atol
         self._solve_atol = max(atol, NEWTON_FLOOR * scale, self._roundoff())
-        start = [u.x.array.copy() for u in self.u]
+        start = self.displacements()
         if guess is not None:
             before = self._residual_norm()
-            for u, x, du in zip(self.u, start, guess):
-                u.x.array[:] = x + du
+            self.set_displacements([x + du for x, du in zip(start, guess)])
             if not self._residual_norm() < before:       # the same on every rank (a global norm)
-                for u, x in zip(self.u, start):
-                    u.x.array[:] = x
+                self.set_displacements(start)
         result = first = self._newton()
         if not result.converged:           # old or single-precision factors can mislead: again, fresh double ones
             self.factors.set_precision("double")
@@ -444,8 +452,7 @@ class Mechanics:
         factors kept by the refresh rule over the backtracking steps of a nearly singular tangent let
         GMRES reach its cap, SNES -3, where fresh ones converged; zone laws of H(T) flattened by flash
         softening after a wear step)."""
-        for u, x in zip(self.u, start):
-            u.x.array[:] = x
+        self.set_displacements(start)
         self._fresh = True
         try:
             return self._newton()
@@ -529,14 +536,12 @@ class Mechanics:
         r0 = self.problem.b.duplicate()          # (ClosedError after close, before a destroyed matrix is used)
         r0.setAttr("_blocks", self._blocks)
         self._split[0].update()
-        kept = [u.x.array.copy() for u in self.u]
+        kept = self.displacements()
         try:
-            for u in self.u:
-                u.x.array[:] = 0.0
+            self.set_displacements([0.0] * len(kept))
             self._assemble_vector(r0, self._cell_residual)
         finally:
-            for u, x in zip(self.u, kept):
-                u.x.array[:] = x
+            self.set_displacements(kept)
         fpetsc.set_bc(r0, self.bcs_by_body)
         return self._split[0].bulk, r0
 

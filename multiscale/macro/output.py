@@ -341,16 +341,14 @@ class FieldOutput:
         for f, make in self.interface:
             self.tm.interface.set_field(f, make())
         released = self.model is not None and self.model.released and self.body_fields
-        kept = [u.x.array.copy() for u in self.mech.u] if released else []
+        kept = self.mech.displacements() if released else []
         try:
-            for u, x in zip(self.mech.u, self.unloaded() if released else ()):
-                u.x.array[:] = x
+            self.mech.set_displacements(self.unloaded() if released else ())
             for f, expr in self.von_mises:
                 f.interpolate(expr)
             self.writer.write(self.model.time if time is None else time)
         finally:
-            for u, x in zip(self.mech.u, kept):
-                u.x.array[:] = x
+            self.mech.set_displacements(kept)
 
     def unloaded(self) -> list:
         """Per body, the displacement [m] written while released (and so the von Mises stress): the

@@ -76,8 +76,7 @@ def preload(mech: Mechanics, pressure: float, steps: int = 1, reset: bool = True
     tm, c = mech.tm, mech.contact
     loads = load_face_forces(tm, pressure, mech.load_kind)
     if reset:
-        for u in mech.u:
-            u.x.array[:] = 0.0
+        mech.set_displacements([0.0] * len(mech.u))
     solved = mech.ramp(pressure, steps)
     if torque is not None:
         pressure, again = hold_moment(mech, pressure, torque)
