@@ -171,9 +171,10 @@ def builder_names() -> tuple[str, ...]:
 
 def builder(name: str) -> ModuleType:
     """The builder module registered as ``name`` (InputError naming the known builders)."""
-    if name not in _registered():
+    module = _registered().get(name)
+    if module is None:
         raise InputError("geometry.builder", name, f"one of {', '.join(builder_names())}")
-    return import_module(_registered()[name])
+    return import_module(module)
 
 
 def resolve_parameters(defaults: Mapping[str, object], params: Mapping[str, object] | None,

@@ -301,7 +301,17 @@ def test_ctrl_c_while_the_end_is_written_lets_it_finish(tmp_path, monkeypatch):
     assert result.history_file == folder / "history.h5"
 
 
-def test_a_second_ctrl_c_is_held_and_a_third_abandons_the_step_but_not_a_write():
+@pytest.fixture
+def python_sigint():
+    """SIGINT taken by Python's handler during the test, as in a job started in the foreground (one
+    started with ``&`` ignores it, and ``CtrlCWatch`` leaves an ignored SIGINT alone); put back after."""
+    import signal
+    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
+    yield
+    signal.signal(signal.SIGINT, previous)
+
+
+def test_a_second_ctrl_c_is_held_and_a_third_abandons_the_step_but_not_a_write(python_sigint):
     """StepStop: the first SIGINT is a request (collective ``requested()``), the second is held
     (the step ends with its results written), a third abandons the step in progress, naming the last
     step written, except inside ``writing()``, which it lets finish (before: the second raised
@@ -315,7 +325,6 @@ def test_a_second_ctrl_c_is_held_and_a_third_abandons_the_step_but_not_a_write()
     def ctrl_c():
         os.kill(os.getpid(), signal.SIGINT)
         time.sleep(0.01)
-    before = signal.getsignal(signal.SIGINT)      # SIG_IGN in a job started in the background
     with StepStop(MPI.COMM_SELF) as stop:
         assert not stop.requested()
         ctrl_c()
@@ -326,17 +335,7 @@ def test_a_second_ctrl_c_is_held_and_a_third_abandons_the_step_but_not_a_write()
         with pytest.raises(KeyboardInterrupt, match="during step 6, abandoned: the results of step 5 are the last "
                                                     "written"):
             ctrl_c()
-    assert signal.getsignal(signal.SIGINT) is before                          # restored
-
-
-@pytest.fixture
-def python_sigint():
-    """SIGINT taken by Python's handler during the test, as in a job started in the foreground (one
-    started with ``&`` ignores it, and ``CtrlCWatch`` leaves an ignored SIGINT alone); put back after."""
-    import signal
-    previous = signal.signal(signal.SIGINT, signal.default_int_handler)
-    yield
-    signal.signal(signal.SIGINT, previous)
+    assert signal.getsignal(signal.SIGINT) is signal.default_int_handler      # restored
 
 
 def test_the_watcher_leaves_a_ctrl_c_a_step_stop_took_even_when_it_reads_it_late(monkeypatch, python_sigint):
