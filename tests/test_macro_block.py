@@ -7,6 +7,7 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 from multiscale.errors import ConvergenceError, InputError  # noqa: E402
 from multiscale.geometry import builder  # noqa: E402
 from multiscale.macro import mesh  # noqa: E402
+from multiscale.macro.kept_cells import jacobian  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
 from multiscale.scene import Material  # noqa: E402
 
@@ -252,13 +253,15 @@ def test_missing_material_and_unknown_builder_are_input_errors(tm):
 def test_the_tangent_of_kept_cell_and_fresh_facet_parts_is_the_full_assembly(tm):
     """The Newton tangent is composed of its cell part (assembled once) and its facet part (every
     iteration): at a sliding, loaded state it equals a direct assembly of the whole block
-    Jacobian to round-off (1e-12 of its largest entry)."""
+    Jacobian (compiled here: the model compiles the parts only) to round-off (1e-12 of its largest
+    entry)."""
+    from dolfinx import fem
     from dolfinx.fem import petsc as fpetsc
     from petsc4py import PETSc
     m = Mechanics(tm, MATERIALS, stiffness=K_N, friction=0.3, speed=0.5, load_kind="pressure", prefix="block_t_")
     m.solve(1e6)
     assert abs(m.contact.normal_force()) > 0
-    direct = fpetsc.assemble_matrix(m.problem.J, bcs=m.bcs)
+    direct = fpetsc.assemble_matrix(fem.form(jacobian(m.residuals, m.u), entity_maps=tm.entity_maps), bcs=m.bcs)
     direct.assemble()
     difference = m.tangent().copy()
     difference.axpy(-1.0, direct)
@@ -287,7 +290,8 @@ def test_the_residual_of_kept_cell_matrix_and_fresh_facet_part_is_the_full_assem
     x.setArray(x.getArray() * (1.0 + 0.01 * rng.standard_normal(x.getLocalSize())))   # supports stay 0
     ours, reference = m.problem.b.duplicate(), m.problem.b.duplicate()
     m.problem.solver.computeFunction(x, ours)
-    fpetsc.assemble_residual(m.problem.solver, x, reference, m.u, m.problem.F, m.problem.J, m.bcs, blocks)
+    F, J = (fem.form(f, entity_maps=tm.entity_maps) for f in (m.residuals, jacobian(m.residuals, m.u)))
+    fpetsc.assemble_residual(m.problem.solver, x, reference, m.u, F, J, m.bcs, blocks)
     assert reference.norm() > abs(m.contact.normal_force())   # N; off equilibrium (measured 1546 vs 135 N)
     ours.axpy(-1.0, reference)
     assert ours.norm() <= 1e-12 * reference.norm()               # measured 1.7e-14

@@ -5,7 +5,9 @@ constant materials) change only with a few parameters, while the interface and b
 (contact, friction, conductance) change at every call. ``KeptCells`` assembles the cell part into
 a matrix of its own when its owner says so (``refresh``) and composes the Jacobian from a copy of
 it and a fresh assembly of the other integrals (``compose``): equal to the assembly of the whole
-form (tests/test_macro_block.py, tests/test_macro_thermal.py) at a fraction of its cost.
+form (tests/test_macro_block.py, tests/test_macro_thermal.py) at a fraction of its cost. The
+whole form is never compiled: its matrix is created from the cell part and given the rest's
+entries by ``attach`` (docs/architecture.md §2, numbers in forms).
 
 Blocks that are zero once their derivatives are expanded are left out (``jacobian``): compiled,
 each was a form without kernels, new for every scene (docs/architecture.md §2, numbers in forms).
@@ -280,14 +282,16 @@ def newton_options_unused(snes: PETSc.SNES, problem: str) -> str:
 
 class KeptCells:
     """The block Jacobian ``form`` (UFL, a list of lists: ``jacobian``'s, whose expanded blocks hold
-    no zero integral) of the matrix ``A`` (compiled: ``compiled``) split into its cell part, kept in
-    ``bulk`` (of A's sparsity), and the rest. ``refresh`` reassembles ``bulk`` at the current state
-    (``update``: only if a constant or coefficient of the cell integrals changed since, e.g. dt or a
-    speed); ``compose`` overwrites a matrix of A's sparsity by bulk plus the rest at the current
-    state, with the Dirichlet rows of ``bcs``. Blocks of either part that are zero are left out, and a body's diagonal block of the
+    no zero integral) split into its cell part, kept in ``bulk``, and the rest, each compiled; the
+    whole form is never compiled (its kernels are the parts' again). The matrix A is created from
+    the cell part (``create_matrix(cells)``) and ``attach`` gives it the whole Jacobian's sparsity.
+    ``refresh`` reassembles ``bulk`` at the current state (``update``: only if a constant or
+    coefficient of the cell integrals changed since, e.g. dt or a speed); ``compose`` overwrites a
+    matrix of A's sparsity by bulk plus the rest at the current state, with the Dirichlet rows of
+    ``bcs``. Blocks of either part that are zero are left out, and a body's diagonal block of the
     rest that has nothing is an ``empty_block`` (a body without interface or boundary terms)."""
 
-    def __init__(self, A: PETSc.Mat, compiled, form: list, entity_maps, bcs):
+    def __init__(self, form: list, entity_maps, bcs):
         self.bcs = bcs
         cells = [[integrals(f, True) for f in row] for row in form]
         others = [[integrals(f, False) for f in row] for row in form]
@@ -299,7 +303,21 @@ class KeptCells:
                               for c in extract_constants(f) + extract_coefficients(f)}, key=str)
         self._state = None                  # the inputs' values at the last refresh
         self.others = fem.form(others, entity_maps=entity_maps)
-        assemble(A, compiled, bcs)              # fixes A's sparsity (an empty assembly would drop it)
+        self.bulk = None
+
+    def attach(self, A: PETSc.Mat) -> None:
+        """Give ``A``, created from ``cells``, the whole Jacobian's sparsity: the union of the parts'
+        entries assembled at the current state (an empty assembly would drop them), the rest added
+        as a matrix of its own (PETSc's MatAXPY, DIFFERENT_NONZERO_PATTERN: A's layout and local-
+        to-global maps kept; the interface integrals of a body's diagonal block reach beyond its
+        cells' pattern, which DOLFINx would drop silently). Then exact zeros are ignored (module
+        docstring), and ``bulk`` becomes a matrix of A's sparsity."""
+        assemble(A, self.cells, self.bcs)
+        rest = assemble(fpetsc.create_matrix(self.others), self.others, self.bcs)
+        try:
+            A.axpy(1.0, rest, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+        finally:
+            rest.destroy()
         A.setOption(PETSc.Mat.Option.IGNORE_ZERO_ENTRIES, True)
         self.bulk = A.duplicate()
 

@@ -168,10 +168,20 @@ class Mechanics:
         self._unit_load = self._load_norm(v)
         self.bcs = self._supports()
         self.refresh = None if refresh is None else int(refresh)
-        J = jacobian(F, self.u)
+        # the tangent's cell integrals (small-strain elasticity: E, nu constant or of T, not of u)
+        # are kept until an input of theirs changes (T with E(T), nu(T)), its facet integrals are
+        # assembled every iteration; the residual's cell part is affine in u: assembled at a solve's
+        # start x_0, then updated by the kept cell matrix times x - x_0, its facet part every
+        # evaluation. Only the parts are compiled: the problem's matrices are created from the cell
+        # parts (``KeptCells.attach``), its vectors from the cell residual
         P = self._frictionless_jacobian() if preconditioner == "cholesky" else None
+        self._split = [KeptCells(form, tm.entity_maps, self.bcs) for form in (jacobian(F, self.u), P)
+                       if form is not None]
+        self._cell_residual, self._facet_residual = (
+            fem.form([integrals(f, cells) for f in F], entity_maps=tm.entity_maps) for cells in (True, False))
         # the user's options under the prefix (PETSC_OPTIONS="-mech_...") win over ours
-        self.problem = nonlinear_problem(F, self.u, prefix, NEWTON_OPTIONS, bcs=self.bcs, J=J, P=P,
+        self.problem = nonlinear_problem(self._cell_residual, self.u, prefix, NEWTON_OPTIONS, bcs=self.bcs,
+                                         J=self._split[0].cells, P=None if P is None else self._split[1].cells,
                                          entity_maps=tm.entity_maps)
         self._atol = self.problem.solver.getTolerances()[1]     # ours or the user's: the floors' base (ours:
         self._own_atol = not PETSc.Options(prefix).hasName("snes_atol")   # at most TINY_LOAD of the load)
@@ -193,13 +203,8 @@ class Mechanics:
         if P is not None:
             self.problem.P_mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)
             self.problem.P_mat.setOption(PETSc.Mat.Option.SYMMETRY_ETERNAL, True)
-        # the tangent's cell integrals (small-strain elasticity: E, nu constant or of T, not of u)
-        # are kept until an input of theirs changes (T with E(T), nu(T)), its facet integrals are
-        # assembled every iteration
-        self._split = [KeptCells(self.problem.A, self.problem.J, J, tm.entity_maps, self.bcs)]
-        if P is not None:
-            self._split.append(KeptCells(self.problem.P_mat, self.problem.preconditioner, P, tm.entity_maps,
-                                         self.bcs))
+        for kept, matrix in zip(self._split, (self.problem.A, self.problem.P_mat)):
+            kept.attach(matrix)
         self._fresh = False                # a fresh factorisation every Newton iteration (retry)
         self._pc_stale = True              # the preconditioner matrix is to be rewritten
         self._excess = 0                   # GMRES iterations beyond one per linear solve since then
@@ -208,10 +213,6 @@ class Mechanics:
         self.problem.solver.getKSP().setMonitor(self._tick)
         self._pc_mat = self.problem.P_mat if P is not None else self.problem.A.duplicate()
         self.problem.solver.setJacobian(self._jacobian, self.problem.A, self._pc_mat)
-        # the residual's cell part is affine in u: assembled at a solve's start x_0, then updated by
-        # the kept cell matrix times x - x_0; its facet part every evaluation
-        self._cell_residual, self._facet_residual = (
-            fem.form([integrals(f, cells) for f in F], entity_maps=tm.entity_maps) for cells in (True, False))
         self._blocks = self.problem.b.getAttr("_blocks")          # DOLFINx's block layout of the vectors
         self._offset, self._start, self._step = (self.problem.b.duplicate() for _ in range(3))
         self._offset.setAttr("_blocks", self._blocks)

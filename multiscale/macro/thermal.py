@@ -214,21 +214,22 @@ class Thermal:
         self.tables = [f"{b.name} ({', '.join(n for n, p in (('kappa', k), ('c', c)) if not p.constant)})"
                        for b, k, c in zip(tm.bodies, conductivity, self.capacity) if not (k.constant and c.constant)]
         # the user's options under the prefix (PETSC_OPTIONS="-heat_...") win over ours, a linear problem's too
+        # constant materials: the Jacobian's cell part (storage, conduction, transport with SUPG;
+        # 105 of its 110 ms on the ch. 7 mesh, one rank) changes only with the constants and coefficients
+        # in it (dt, the speed): kept, reassembled when one of them changed (``KeptCells``)
         J = kept_cells.jacobian(self.residuals, self.T)
+        self._tangent = None if self.nonlinear else KeptCells(J, tm.entity_maps, self.bcs)
         self.problem = nonlinear_problem(self.residuals, self.T, prefix,
-                                         NEWTON_OPTIONS if self.nonlinear else KEPT_OPTIONS, bcs=self.bcs, J=J,
-                                         entity_maps=tm.entity_maps)
+                                         NEWTON_OPTIONS if self.nonlinear else KEPT_OPTIONS, bcs=self.bcs,
+                                         J=J if self.nonlinear else self._tangent.cells, entity_maps=tm.entity_maps)
         self.notes: list = []                  # what the run's warnings add (said once per run)
-        self._tangent = self._factored = None  # linear steps: the kept cell part, the kept factors' matrix
+        self._factored = None                  # linear steps: the kept factors' matrix
         # a failed step is redone with backtracking unless the user chose a line search (theirs alone remain)
         self._backtrack = self.nonlinear and not PETSc.Options(prefix).hasName("snes_linesearch_type")
-        # constant materials: the Jacobian's cell part (storage, conduction, transport with SUPG;
-        # 105 of its 110 ms on the ch. 7 mesh, one rank) changes only with the constants and
-        # coefficients in it (dt, the speed): kept, and reassembled when one of them changed
         if not self.nonlinear:                 # (its SNES is "ksponly": the Newton's options have no effect)
             why = "the heat problem is linear (no radiation, no temperature tables)"
             self._say(kept_cells.newton_options_unused(self.problem.solver, why), kept_cells.SolverOptionWarning)
-            self._tangent = KeptCells(self.problem.A, self.problem.J, J, tm.entity_maps, self.bcs)
+            self._tangent.attach(self.problem.A)
             self._factored = self.problem.A.duplicate()
             self.problem.solver.setJacobian(self._jacobian, self.problem.A, self._factored)
         self.factorisations = 0                # linear steps: LU factorisations so far
