@@ -106,8 +106,7 @@ class StribeckFriction:
 
 def facet_slip_speed(mech: Mechanics) -> np.ndarray:
     """Mean steady slip speed |w_t| [m/s] of every interface facet (global order)."""
-    c = mech.contact
-    return c.cache.facet_mean("slip speed", lambda: c.slip_speed)
+    return mech.contact.facet_means("slip")
 
 
 def set_friction(mech: Mechanics, laws: dict) -> tuple[np.ndarray, np.ndarray]:

@@ -180,7 +180,7 @@ class Interface:
     tag_index: np.ndarray              # global: index into ``tags`` of every facet
     plus_regions: dict                 # interface name -> region (cell) tags of body 0 along it
     _dg0: fem.FunctionSpace = field(default=None, repr=False)
-    _dg0_vector: fem.FunctionSpace = field(default=None, repr=False)
+    _dg0_blocked: dict = field(default_factory=dict, repr=False)
 
     @property
     def dS(self):
@@ -205,12 +205,11 @@ class Interface:
             self._dg0 = fem.functionspace(self.mesh, ("DG", 0))
         return self._dg0
 
-    @property
-    def vector_space(self) -> fem.FunctionSpace:
-        """Vector DG0 space (3 components) of per-facet vectors."""
-        if self._dg0_vector is None:
-            self._dg0_vector = fem.functionspace(self.mesh, ("DG", 0, (3,)))
-        return self._dg0_vector
+    def blocked_space(self, components: int) -> fem.FunctionSpace:
+        """DG0 space of per-facet arrays of ``components`` values."""
+        if components not in self._dg0_blocked:
+            self._dg0_blocked[components] = fem.functionspace(self.mesh, ("DG", 0, (components,)))
+        return self._dg0_blocked[components]
 
     def masks(self) -> dict:
         """{interface name: boolean mask over the global facets}."""
@@ -415,19 +414,15 @@ class FormCache:
         vec.scatter_reverse(la.InsertMode.add)
         return vec.array
 
-    def facet_integrals(self, key, make, vector: bool = False) -> np.ndarray:
+    def facet_integrals(self, key, make, components: int = 1) -> np.ndarray:
         """Global per-facet integrals of the interface expression ``make()``: (n_facets,) for a
-        scalar, (n_facets, 3) with ``vector`` for a 3-vector."""
+        scalar, (n_facets, components) for a vector of ``components``."""
         iface = self.tm.interface
-        space = iface.vector_space if vector else iface.space
+        space = iface.space if components == 1 else iface.blocked_space(components)
         q = ufl.TestFunction(space)
         form = self._form(None if key is None else ("per facet", key),
                           lambda: ufl.inner(make(), q("+")) * iface.dS)
         return iface.owned_values(fem.assemble_vector(form), space)
-
-    def facet_mean(self, key, make) -> np.ndarray:
-        """Global per-facet means (integral / facet area) of ``make()``."""
-        return self.facet_integrals(key, make) / self.tm.interface.areas
 
 
 def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometrySpec | None = None,

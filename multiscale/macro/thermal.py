@@ -591,9 +591,10 @@ class Thermal:
         return self.cache.vector(("stored", i), energy)[self.cell_spaces[i].dofmap.list[:, 0]]
 
     def facet_temperature(self, side: int = 0) -> np.ndarray:
-        """Mean temperature per interface facet [K] of body 0 ("+") or body 1 ("−")."""
-        T = self.T[0]("+") if side == 0 else self.T[1]("-")
-        return self.cache.facet_mean(("T", side), lambda: T)
+        """Mean temperature per interface facet [K] of body 0 ("+") or body 1 ("−") (both sides'
+        from one compiled form)."""
+        both = self.cache.facet_integrals("T", lambda: ufl.as_vector([self.T[0]("+"), self.T[1]("-")]), components=2)
+        return both[:, side] / self.tm.interface.areas
 
 
 __all__ = ["STEFAN_BOLTZMANN", "HeatStepWarning", "Thermal", "ThermalBoundary", "ThermalStep", "temperature_functions"]
