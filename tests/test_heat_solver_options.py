@@ -179,3 +179,23 @@ def test_newton_options_for_a_linear_heat_problem_are_said_to_have_no_effect(pet
     assert not [c for c in caught if c.category is SolverOptionWarning]
     assert [w for w in result.warnings if "had no effect" in w] == th.notes
     assert th.notes[0] in json.loads((folder / "provenance.json").read_text())["warnings"]
+
+
+def test_a_failed_run_says_and_records_the_warnings_it_had_so_far(petsc_options, tmp_path, monkeypatch, capsys):
+    """The run's notes (here the heat's Newton options that have no effect, from the model's build)
+    were said with its results only: a run that failed in a later step lost them from its report
+    and its provenance, the failing step's own notes with the rest. Now the error carries the notes
+    so far (PEP 678 ``__notes__``): said as warnings before the error, and recorded."""
+    petsc_options(heat_snes_rtol="1e-3")
+    solve, calls = thermal.Thermal._solve, []
+    monkeypatch.setattr(thermal.Thermal, "_solve", lambda self: calls.append(1) or (solve(self) and len(calls) < 2))
+    folder = tmp_path / "out"
+    with pytest.raises(ConvergenceError, match="heat step") as info:     # the second step's solves fail
+        run(block_scene(boundary=COOLED.format(flat="") + f'\n[output]\nfolder = "{folder}"', steps=3, end=3.0),
+            verbose=False)
+    said = "PETSC_OPTIONS: -heat_snes_rtol had no effect: the heat problem is linear"
+    assert [n for n in info.value.__notes__ if n.startswith(said)] and len(calls) > 2
+    assert f"warning: {said}" in capsys.readouterr().err
+    record = json.loads((folder / "provenance.json").read_text())
+    assert record["status"].startswith("failed: ConvergenceError: heat step")
+    assert [w for w in record["warnings"] if w.startswith(said)]

@@ -64,6 +64,9 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                 result = module.run(scene, overwrite=overwrite, comm=comm, verbose=verbose)
         except BaseException as exc:
             stopped = interrupted(exc)
+            notes = list(getattr(exc, "__notes__", ()))     # the run's warnings until it failed (model.heat_warnings_as_notes)
+            for line in notes if comm.rank == 0 else ():
+                print(f"warning: {line}", file=sys.stderr, flush=True)
             if reporter.folder is not None and comm.rank == 0:
                 try:
                     provenance.write(reporter.folder, scene, ranks=comm.size, started=started,
@@ -71,7 +74,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                                      status=f"interrupted {stopped}".strip() if stopped else
                                      f"failed: {type(exc).__name__}: {exc}", earlier=earlier,
                                      warnings=[*scene.warnings, *(exc.warnings if isinstance(exc, Interrupted) else ()),
-                                               *run_warnings(scene, _written_history(reporter.folder))])
+                                               *notes, *run_warnings(scene, _written_history(reporter.folder))])
                     if isinstance(exc, Interrupted):          # stopped after a step: its results are written
                         _write_script(reporter.folder, scene)
                     elif stopped:                             # a step abandoned: the plots of what was written

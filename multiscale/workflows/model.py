@@ -271,14 +271,22 @@ def run_notes(model: MacroModel) -> tuple:
 
 
 @contextmanager
-def heat_warnings_as_notes():
+def heat_warnings_as_notes(model: MacroModel | None = None):
     """The heat's ``HeatStepWarning`` and ``SolverOptionWarning`` (the model's build) kept quiet in
     the block: the run's report says them, once, with the other warnings and in the provenance
-    (``run_notes``)."""
+    (``run_notes``). With ``model``, an error that ends the block carries the run's notes so far as
+    its own (PEP 678, ``add_note``): a failed run's report and record say them too (before, a run
+    that failed lost them, the failing step's with the rest)."""
     with warnings.catch_warnings():
         warnings.simplefilter("ignore", HeatStepWarning)
         warnings.simplefilter("ignore", SolverOptionWarning)
-        yield
+        try:
+            yield
+        except BaseException as exc:
+            for note in run_notes(model) if model is not None else ():
+                if note not in getattr(exc, "__notes__", ()):
+                    exc.add_note(note)
+            raise
 
 
 def interface_forces(scene, tm) -> dict:

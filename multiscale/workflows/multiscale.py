@@ -177,7 +177,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             with io.stage("restoring the checkpoint"):
                 done, history, written = dataclasses.astuple(ms.restore(ckpt))
         else:
-            with io.stage("zone laws and first solve"):
+            with io.stage("zone laws and first solve"), heat_warnings_as_notes(ms.model):
                 first = ms.start()
             done, history, written = 0, io.History(), -1
             history.append(**ms.record(first))
@@ -194,7 +194,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         last = steps if stop_after is None else min(steps, stop_after)
         stopping = False
         # a Ctrl-C while the end is written lets it finish
-        with io.StepStop(comm, done) as stop, heat_warnings_as_notes():
+        with io.StepStop(comm, done) as stop, heat_warnings_as_notes(ms.model):
             with io.stage("macro steps"):
                 for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
                     stepped = ms.step(n)

@@ -58,7 +58,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         model = build_model(scene, comm, tm=tm)
     io.reporter().say(model_size(tm, model.mechanics, model.thermal))
     with closed_on_error(model, comm):           # a script going on after a failed run gets its communicators
-        with io.stage("first contact solve"), heat_warnings_as_notes():
+        with io.stage("first contact solve"), heat_warnings_as_notes(model):
             model.start()
         out.claim()                          # --overwrite: the earlier results go now, not before a failed start
         plan = outputs.plan(scene)
@@ -69,7 +69,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
         steps = scene.time.steps if model.thermal is not None else 0
         done, stopping = 0, False
-        with io.StepStop(comm) as stop, heat_warnings_as_notes():   # a Ctrl-C while the end is written lets it finish
+        with io.StepStop(comm) as stop, heat_warnings_as_notes(model):   # a Ctrl-C while the end is written lets it finish
             with io.stage("macro steps"):
                 for n in io.bar(range(1, steps + 1), "macro steps"):
                     heat = model.macro_step(scene.time.dt, scene.time.substeps)
