@@ -509,6 +509,21 @@ def test_a_quiet_run_still_prints_what_its_results_leave_out(tmp_path, capsys):
         [line.removeprefix("warning: ") for line in err.splitlines() if "softer side's E" in line] != []
 
 
+def test_a_load_beyond_small_strains_is_said_at_the_first_contact_solve(tmp_path, capsys):
+    """A run with steps to go says the small-strain warning of its first contact solve at once (before:
+    only after the whole run; a 20 um pin under 200 N ran to its end first), and the run's at its
+    end, which the record holds; a run without steps says the run's only (above)."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+    folder = tmp_path / "out"
+    text = THERMAL.replace("../results/block_on_flat", str(folder)).replace('"1 MPa"', '"200 MPa"')
+    assert main(["run", _write(tmp_path, text), "--quiet"]) == 0
+    said = [line.removeprefix("warning: ") for line in capsys.readouterr().err.splitlines() if "softer side's E" in line]
+    record = json.loads((folder / "provenance.json").read_text())
+    assert len(said) == 2 and said[0].startswith("at the first contact solve, the contact pressure reached 2e+08 Pa")
+    assert said[0].endswith("the run goes on (Ctrl-C stops it after a step, with its results written)")
+    assert [w for w in record["warnings"] if "softer side's E" in w] == said[1:]
+
+
 def test_overwrite_keeps_the_earlier_results_when_the_run_fails_before_writing(tmp_path, capsys):
     """run --overwrite of a scene refused at meshing (--max-cells): the earlier run's results and
     its provenance stay as they were (before: deleted, then the refusal); the same run that meshes

@@ -45,6 +45,7 @@ from multiscale.provenance import resolved_toml
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, heat_warnings_as_notes, \
     interface_forces, interface_materials, model_size, run_notes
 from multiscale.workflows.output import prepare_folder
+from multiscale.workflows.strain import say_at_once
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
 from multiscale.workflows.transient import TransientResult, write_history
@@ -181,6 +182,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                 first = ms.start()
             done, history, written = 0, io.History(), -1
             history.append(**ms.record(first))
+            if steps:
+                say_at_once(scene, history, comm)
             out.claim()                      # --overwrite: the earlier results go now, not before a failed start
             ms.save(ckpt, 0, history)
             write_history(history, folder, scene.name, comm, plot=False)   # a run failing in step 1 keeps t = 0

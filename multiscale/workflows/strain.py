@@ -4,6 +4,7 @@ others did. Read by the transient and multiscale runs from their history (``max_
 ``interface_force_<name>``) and by the squeal analysis from its preloads."""
 from __future__ import annotations
 
+import sys
 from collections.abc import Mapping
 
 STRAINED = 0.02   # a contact pressure above this share of the softer side's E is warned about
@@ -32,6 +33,17 @@ def overloaded(scene, p: float, hottest=None) -> list[str]:
     return [f"the contact pressure reached {p:.3g} Pa, {100 * p / soft:.2g} % of the softer side's E ({soft:.3g} Pa): "
             "beyond the small strains of the linear elastic model; check the load (a vehicle stop asks mu F r of "
             "the brake: a small mu needs a large clamp)"] if p > STRAINED * soft else []
+
+
+def say_at_once(scene, history, comm) -> None:
+    """``overloaded`` of the first contact solve's largest pressure (``history``'s last record, the
+    start's), said at once on rank 0 (stderr), for a run with steps to go: an impossible load (a
+    20 um pin under 200 N) was said only after the whole run. The run's warnings say it again, at
+    its largest pressure."""
+    if comm.rank == 0 and "max_pressure" in history.columns:
+        for line in overloaded(scene, float(history["max_pressure"][-1])):
+            print(f"warning: at the first contact solve, {line}; the run goes on (Ctrl-C stops it after a step, "
+                  "with its results written)", file=sys.stderr, flush=True)
 
 
 def unloaded(forces: Mapping[str, float]) -> list[str]:

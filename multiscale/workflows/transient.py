@@ -21,6 +21,7 @@ from multiscale.macro.output import FieldOutput
 from multiscale.plots.history import history_figure
 from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, model_size, run_notes
 from multiscale.workflows.output import RunResult, prepare_folder
+from multiscale.workflows.strain import say_at_once
 
 
 @dataclass
@@ -68,6 +69,8 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         writer.write()
         write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
         steps = scene.time.steps if model.thermal is not None else 0
+        if steps:
+            say_at_once(scene, history, comm)
         done, stopping = 0, False
         with io.StepStop(comm) as stop, heat_warnings_as_notes(model):   # a Ctrl-C while the end is written lets it finish
             with io.stage("macro steps"):
