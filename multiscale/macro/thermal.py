@@ -213,12 +213,12 @@ class Thermal:
                           or not all(p.constant for p in conductivity + self.capacity))
         self.tables = [f"{b.name} ({', '.join(n for n, p in (('kappa', k), ('c', c)) if not p.constant)})"
                        for b, k, c in zip(tm.bodies, conductivity, self.capacity) if not (k.constant and c.constant)]
-        # the user's options under the prefix (PETSC_OPTIONS="-heat_...") win over ours, a linear problem's too
         # constant materials: the Jacobian's cell part (storage, conduction, transport with SUPG;
         # 105 of its 110 ms on the ch. 7 mesh, one rank) changes only with the constants and coefficients
         # in it (dt, the speed): kept, reassembled when one of them changed (``KeptCells``)
         J = kept_cells.jacobian(self.residuals, self.T)
         self._tangent = None if self.nonlinear else KeptCells(J, tm.entity_maps, self.bcs)
+        # the user's options under the prefix (PETSC_OPTIONS="-heat_...") win over ours, a linear problem's too
         self.problem = nonlinear_problem(self.residuals, self.T, prefix,
                                          NEWTON_OPTIONS if self.nonlinear else KEPT_OPTIONS, bcs=self.bcs,
                                          J=J if self.nonlinear else self._tangent.cells, entity_maps=tm.entity_maps)

@@ -45,9 +45,9 @@ from multiscale.provenance import resolved_toml
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, heat_warnings_as_notes, \
     interface_forces, interface_materials, model_size, run_notes
 from multiscale.workflows.output import prepare_folder
-from multiscale.workflows.strain import say_at_once
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
+from multiscale.workflows.strain import say_at_once
 from multiscale.workflows.transient import TransientResult, write_history
 
 CHECKPOINT = outputs.CHECKPOINT
