@@ -42,6 +42,30 @@ def rough_rules(scene) -> list[InputError]:
     return out
 
 
+PERFECT_CONTACT = {"penalty": "contact", "conductance": "conductance"}   # [interface] key: the effect it serves
+
+
+def perfect_contact(scene, warnings_out: list) -> list[str]:
+    """The perfect-contact keys of [interface] (``PERFECT_CONTACT``) with effect "roughness": the
+    zones' laws replace them on the rough interfaces only, so the interfaces kept in perfect contact
+    (``rough = false``) need them (without, such an interface had K_n = 0, no contact, or h_c = 0,
+    said nowhere; found in review), and with every interface rough they are ignored (warned, into
+    ``warnings_out``). A key whose effect is off is the schema's (``warn_unused``)."""
+    if not scene.has("roughness") or not scene.rough_interfaces:
+        return []
+    perfect = [n for n in scene.geometry.spec.interfaces if n not in scene.rough_interfaces]
+    out = []
+    for key, effect in PERFECT_CONTACT.items():
+        given = getattr(scene.interface, key, None) is not None
+        if scene.has(effect) and perfect and not given:
+            out.append(f'interface.{key}: missing; effect "{effect}" needs it on the interfaces in perfect contact: '
+                       + ", ".join(f"interfaces.{n}.rough = false" for n in perfect))
+        elif scene.has(effect) and given and not perfect:
+            warnings_out.append(f'interface.{key} is ignored: every interface is rough (effect "roughness") '
+                                "and the zones' laws replace it")
+    return out
+
+
 def micro_constants(scene) -> list[str]:
     """Warnings of what the micro scale takes as constants: the rough interface's materials at the
     initial temperature (``workflows.model.interface_materials``: E, nu for the zone laws; kappa,

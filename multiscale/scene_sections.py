@@ -4,8 +4,7 @@ Materials (constants or temperature tables), the interface defaults and per-inte
 boundary conditions (supports, convection, radiation, fixed temperatures), the loading and its duty
 cycle (load and speed against time, a braking torque; a vehicle stop or drag: ``scene_vehicle``), time,
 output, and the sections of the multiscale loop (roughness, micro, wear, layers); the squeal analysis' in
-``scene_stability``. Values are SI numbers or unit strings (``multiscale.units``).
-"""
+``scene_stability``. Values are SI numbers or unit strings (``multiscale.units``)."""
 from __future__ import annotations
 
 import math
@@ -188,7 +187,8 @@ class Interface:
     """[interface]: the defaults of every contact interface (perfect-contact baseline, §7.3.1).
     ``partition``: the share of the frictional heat into body 0, or "effusivity": e_0 A_0 /
     (e_0 A_0 + e_1 A_1) with e = sqrt(kappa rho c) at the initial temperature, A_0 the interface's
-    area and A_1 the track it sweeps on a rotating body 1 (equal areas under a translation)."""
+    area and A_1 the track it sweeps on a rotating body 1 (equal areas under a translation). With
+    effect "roughness" the zone laws replace penalty and conductance except where rough = false."""
 
     penalty: float | None = key(Quantity("stiffness", gt=0, plausible=(1e8, 1e19)), needed_by=("contact",),
                                 unless=("roughness",))          # Pa/m, normal penalty stiffness K_n

@@ -92,7 +92,7 @@ def summary(scene: Scene) -> list[str]:
 def _effect_line(scene: Scene, effect: str) -> str:
     i, ld = scene.interface, scene.loading
     if effect == "contact":
-        return f"penalty K_n = {i.penalty:g} Pa/m" if not scene.has("roughness") else "rough per-zone laws"
+        return _rough_or_perfect(scene, "rough per-zone laws", "penalty K_n = {:g} Pa/m", i.penalty)
     if effect == "friction":
         if ld.friction_curve is not None:
             return "mu(slip speed) from friction_curve: " + ", ".join(f"{mu:g} at {v:g} m/s"
@@ -127,7 +127,7 @@ def _effect_line(scene: Scene, effect: str) -> str:
                 f"meshing by the {scene.bodies[0]}'s face against the track it sweeps on the {scene.bodies[1]} "
                 "(interfaces on one track share it by their areas)")
     if effect == "conductance":
-        return f"h_c = {i.conductance:g} W/(m^2 K)" if not scene.has("roughness") else "h_c(p) per zone (micro)"
+        return _rough_or_perfect(scene, "h_c(p) per zone (micro)", "h_c = {:g} W/(m^2 K)", i.conductance)
     if effect == "roughness":
         r, m = scene.roughness, scene.micro
         surface = f"RMS {r.rms * 1e6:g} um, H {r.hurst:g}" if r.rms is not None else \
@@ -164,3 +164,13 @@ def cells_line(scene: Scene) -> tuple[str, CellEstimate]:
     verdict = "refused by run" if e.cells > g.max_cells else "within"
     return (f"  mesh      {'' if e.exact else 'about '}{e.cells:,} cells ({how}); {verdict} geometry.max_cells = "
             f"{g.max_cells:,}", e)
+
+
+def _rough_or_perfect(scene: Scene, rough: str, perfect: str, value: float) -> str:
+    """An interface effect's line: ``rough`` without perfect-contact interfaces, ``perfect`` (a
+    format of the [interface] ``value``) without rough ones, else each with its interfaces."""
+    laws = scene.rough_interfaces
+    kept = [n for n in scene.geometry.spec.interfaces if n not in laws]
+    if not laws or not kept:
+        return rough if laws else perfect.format(value)
+    return f"{rough} on {', '.join(laws)}; {perfect.format(value)} on {', '.join(kept)}"
