@@ -30,7 +30,7 @@ FIRST_STEP, SMALLEST_STEP = 0.5, 1 / 64
 def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None) -> SolveResult:
     """``mech.solve(guess=guess)`` after ``law.set_laws`` replaced the laws, by continuation where
     it fails (module docstring; collective). The result's ``iterations`` sum the Newton
-    iterations of the converged solves (not the failed direct one's). Raises ``ConvergenceError``
+    iterations of every solve, the failed direct one's included. Raises ``ConvergenceError``
     naming both failures and the update that led to them."""
     start = mech.displacements()
     try:
@@ -39,7 +39,7 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None)
         direct = exc
     mech.set_displacements(start)
     offset = law.carried_offsets(mech.contact.facet_gap())
-    done, step, iterations = 0.0, FIRST_STEP, 0
+    done, step, iterations = 0.0, FIRST_STEP, direct.result.iterations if direct.result is not None else 0
     try:
         law.shift(offset)
         result = mech.solve()

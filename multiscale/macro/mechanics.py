@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import time
 import warnings
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import Mapping
 
 import numpy as np
@@ -102,8 +102,8 @@ class SolveResult:
 
     converged: bool
     reason: int                    # PETSc SNES converged reason
-    iterations: int
-    residuals: list = field(default_factory=list)   # residual norm per Newton iteration
+    iterations: int                # Newton iterations, of every attempt (retries with fresh factors)
+    residuals: list = field(default_factory=list)   # residual norm per Newton iteration (the last attempt)
     normal_force: float = 0.0      # N, total contact force
     max_pressure: float = 0.0      # Pa, largest per-facet mean pressure
 
@@ -414,12 +414,15 @@ class Mechanics:
             if not self._residual_norm() < before:       # the same on every rank (a global norm)
                 self.set_displacements(start)
         result = first = self._newton()
+        spent = first.iterations           # over the attempts
         if not result.converged:           # old or single-precision factors can mislead: again, fresh double ones
             self.factors.set_precision("double")
             result = self._afresh(start)
+            spent += result.iterations
         if not result.converged and self._backtrack:   # a full step overshot (worn laws opening the contact: the
             with backtracking(self.problem.solver):    # residual 77 -> 1.5e6 N, SNES -9): again, backtracking
                 result = self._afresh(start)
+            spent += result.iterations
         if not result.converged:
             pc = self.factors.inner if self.own_pc else self.problem.solver.getKSP().getPC()
             failed = "" if pc is None else mumps.describe(pc)  # the same on every rank
@@ -443,7 +446,9 @@ class Mechanics:
                 f"contact Newton did not converge at load {float(self.load.value):.6g} "
                 f"{'N' if self.load_kind == 'force' else 'Pa'} "
                 f"(SNES reason {result.reason}, {result.iterations} iterations, residuals "
-                f"{['%.3g' % r for r in result.residuals]}{cause})", result.residuals, result)
+                f"{['%.3g' % r for r in result.residuals]}{cause})", result.residuals,
+                replace(result, iterations=spent))
+        result.iterations = spent
         result.normal_force = self.contact.normal_force()
         result.max_pressure = float(self.contact.facet_pressure().max(initial=0.0))
         return result
