@@ -573,5 +573,7 @@ def _spec(g, found: Found) -> GeometrySpec:
         supports=(), load_faces=(), motion=Rotation(tuple(g.axis), tuple(g.centre)),
         length_scale=found.extent, fluid_load=True,
         interface_normals=dict(found.normals), interface_extents=dict(found.extents), report=tuple(report),
+        interface_sizes=dict.fromkeys(found.interfaces, min(g.mesh_size, g.interface_mesh_size or g.mesh_size))
+        if g.mesh_size is not None else {},
         warnings=tuple(found.loose),
         interface_regions={name: fixed for name, (fixed, _) in found.pairs.items()})

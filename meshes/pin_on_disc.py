@@ -87,6 +87,7 @@ def describe(params=None) -> GeometrySpec:
                                      ("pin", min(p["pin_size"], p["pin_height"]), p["holder_mesh_size"]),
                                      ("plate", p["plate_thickness"], p["holder_mesh_size"])])),
         interface_extents={"interface": (p["pin_size"], p["pin_size"])},
+        interface_sizes={"interface": p["interface_mesh_size"]},
     )
 
 

@@ -101,7 +101,7 @@ def _check_zone_size(grid, areas, name: str) -> None:
     pressures 15 times the 5 x 5 grid's, a real contact area 0.57 times its)."""
     zone, facet = grid.size[0] * grid.size[1], float(np.median(areas))
     if zone < facet:
-        fit = np.maximum(np.floor(np.asarray(grid.counts) * np.sqrt(zone / facet)), 1).astype(int)
+        fit = grid.counts_for(facet)
         raise InputError("micro.zones", list(grid.counts), f"zones of {zone * 1e6:.3g} mm^2 on interface {name} are "
                          f"smaller than its facets (median {facet * 1e6:.3g} mm^2): a facet loads only the zone "
                          f"holding its midpoint; use at most {fit[0]} x {fit[1]} zones or a finer interface mesh")

@@ -28,7 +28,8 @@ from multiscale.errors import InputError, SceneError, read_toml_text, toml_probl
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
-from multiscale.scene_rough import measured_cover, micro_constants, nyquist, perfect_contact, rough_rules, thin_layer
+from multiscale.scene_rough import (measured_cover, micro_constants, nyquist, perfect_contact, rough_rules, thin_layer,
+                                    zone_sizes)
 from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
@@ -389,7 +390,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         if not problems:
             problems += ([str(e) for e in rough_rules(scene)] + nyquist(scene) + thin_layer(scene)
                          + measured_cover(scene, warnings) + perfect_contact(scene, warnings))
-            warnings += micro_constants(scene)
+            warnings += micro_constants(scene) + zone_sizes(scene)
     if scene.output is not None and scene.output.fields is not None:
         for f in scene.output.fields:
             missing = [e for e in OUTPUT_FIELDS[f] if e not in effects]

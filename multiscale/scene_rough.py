@@ -11,9 +11,10 @@ from multiscale.errors import InputError
 from multiscale.micro.spectrum import power_spectrum
 from multiscale.micro.topography import (TopographyWarning, beyond_measurement, check_cutoff, check_resolved, coarse_grid,
                                          condition, covers, read_topography, zone_cells)
-from multiscale.micro.zones import THINNEST
+from multiscale.micro.zones import THINNEST, ZoneGrid
 from multiscale.scene_sections import DEFAULT_GRID
 
+FACET_AREA = 0.4   # median area of gmsh's interface triangles over h^2, h the size aimed at (0.37-0.43 on the demos)
 SHARED_MICRO = ("grid", "law_points", "model", "p_max", "tol", "partition_law", "heating", "heating_steps",
                 "remote_temperatures", "coupling", "coupling_tol", "coupling_iterations")
 
@@ -98,6 +99,30 @@ def micro_constants(scene) -> list[str]:
     if scene.has("layers") and scene.has("heat_partition"):
         out.append("layers: the heat partition and flash temperatures take the rough body without its layers "
                    "(its own kappa and chi); a layer's kappa acts on the conductance only")
+    return out
+
+
+def zone_sizes(scene) -> list[str]:
+    """Warnings of zones smaller than the facets an interface will likely have, ``FACET_AREA`` h^2
+    for the element size h its mesh aims at (``GeometrySpec.interface_sizes``), on faces whose
+    extent the geometry knows: after meshing, the run refuses zones smaller than the facets' median
+    area (``rough._check_zone_size``; check said nothing before)."""
+    out = []
+    spec = scene.geometry.spec
+    for name in scene.rough_interfaces:
+        s, size, h = scene.interface_settings(name), spec.interface_extents.get(name), spec.interface_sizes.get(name)
+        if size is None or h is None or s.micro is None or s.micro.zones is None:
+            continue
+        grid = ZoneGrid((0.0, 0.0), s.micro.zones, (size[0] / s.micro.zones[0], size[1] / s.micro.zones[1]))
+        zone, facet = grid.size[0] * grid.size[1], FACET_AREA * h ** 2
+        if zone < facet:
+            own = scene.interfaces.get(name) if scene.interfaces else None
+            key = f"interfaces.{name}.micro" if own is not None and own.micro is not None else "micro"
+            fit = grid.counts_for(facet)
+            out.append(f"{key}.zones = {list(s.micro.zones)}: zones of {zone * 1e6:.3g} mm^2 on interface {name} are "
+                       f"likely smaller than its facets (about {facet * 1e6:.3g} mm^2 for elements of {h * 1e3:.3g} "
+                       "mm), which the run refuses after meshing (a facet loads only the zone holding its midpoint); "
+                       f"use at most {fit[0]} x {fit[1]} zones or a finer interface mesh")
     return out
 
 

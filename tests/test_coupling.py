@@ -423,10 +423,18 @@ def test_zones_smaller_than_the_facets_are_refused(tmp_path):
     """20 x 20 zones (1 mm^2) on the 2.5 mm facets (2.64 mm^2): a facet loaded only the zone holding
     its midpoint with its whole force, so 19 of 400 zones carried the load at 65 MPa, 15 times the
     5 x 5 grid's 4.3 MPa, with 0.57 times its real contact area (40 x 40: 6 zones, 274 MPa), and
-    the run said "raise micro.p_max". Now refused before the first law (an adversarial test)."""
+    the run said "raise micro.p_max". Now refused before the first law (an adversarial test), and
+    warned by the scene's check before meshing, from the element size (about 0.4 h^2 a facet)."""
     with pytest.raises(InputError, match=r"micro.zones = \[20, 20\]: zones of 1 mm\^2 on interface interface are "
                                          r"smaller than its facets \(median 2.64 mm\^2\).*at most 12 x 12 zones"):
         run_pod(tmp_path / "fine", {"micro.zones": [20, 20]})
+    said = [w for w in loads(POD.format(folder=tmp_path / "fine"), overrides={"micro.zones": [20, 20]}).warnings
+            if "zones" in w]
+    assert len(said) == 1 and said[0].startswith("micro.zones = [20, 20]: zones of 1 mm^2 on interface interface are "
+                                                 "likely smaller than its facets (about 2.5 mm^2 for elements of 2.5 mm)")
+    assert said[0].endswith("use at most 12 x 12 zones or a finer interface mesh")
+    assert not [w for w in loads(POD.format(folder=tmp_path / "fine"), overrides={"micro.zones": [12, 12]}).warnings
+                if "zones" in w]
 
 
 def test_a_stop_and_a_restart_keep_every_result_finite(tmp_path):

@@ -177,6 +177,12 @@ class ZoneGrid:
     def n_zones(self) -> int:
         return self.counts[0] * self.counts[1]
 
+    def counts_for(self, area: float) -> tuple[int, int]:
+        """The most zones per direction over this grid's extent, in its proportions, whose area is at
+        least ``area`` [m^2] (at least 1 each)."""
+        scale = np.sqrt(self.size[0] * self.size[1] / area)
+        return tuple(max(int(np.floor(n * scale)), 1) for n in self.counts)
+
     def zone_of(self, x, y) -> np.ndarray:
         """Zone id holding each point (e.g. facet centroids) [m]; points outside raise. A point
         within 1e-9 of a zone's size from a border belongs to the zone above it, whatever the
