@@ -495,7 +495,7 @@ class Multiscale:
         if changed:
             mech = self.model.mechanics
             before = mech.displacements()
-            self.model.last_solve = solve_on_new_laws(mech, self.rough.law, self.law_increment)
+            self.model.last_solve = solve_on_new_laws(mech, self.rough.law, self.law_increment, self.model.released)
             self.law_increment = [u - x for u, x in zip(mech.displacements(), before)]
             self.model.keep_torque(self.model.drive.factor(self.model.time))   # the worn laws moved the pressure
         return StepResult(n, heat, micro, time_macro + _time.perf_counter() - t4, time_micro + t3 - t2, t4 - t3,

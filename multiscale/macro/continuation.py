@@ -27,11 +27,12 @@ from multiscale.macro.mechanics import Mechanics, SolveResult
 FIRST_STEP, SMALLEST_STEP = 0.5, 1 / 64
 
 
-def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None) -> SolveResult:
+def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None, released: bool = False) -> SolveResult:
     """``mech.solve(guess=guess)`` after ``law.set_laws`` replaced the laws, by continuation where
     it fails (module docstring; collective). The result's ``iterations`` sum the Newton
     iterations of every solve, the failed direct one's included. Raises ``ConvergenceError``
-    naming both failures and the update that led to them."""
+    naming both failures and the update that led to them; ``released``: the update came while
+    the load is released, and the load its message names is the last one kept."""
     start = mech.displacements()
     try:
         return mech.solve(guess=guess)
@@ -60,7 +61,8 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None)
         law.shift(None)
         raise ConvergenceError(
             f"the contact solve on new zone laws (a wear update or plastic flattening: the laws changed, no support "
-            f"did) failed: {direct}; continued from the pressures of the laws before, it stopped at {done:.3g} of "
+            f"did{'; released: solved at the last load, kept for the next engagement' if released else ''}) failed: "
+            f"{direct}; continued from the pressures of the laws before, it stopped at {done:.3g} of "
             f"the way (its last step {step:.3g}): {exc}; smaller wear steps change the laws less at an update "
             "(more wear.substeps or time.steps, or a lower k_w)", exc.history, exc.result) from exc
     return dataclasses.replace(result, iterations=iterations)

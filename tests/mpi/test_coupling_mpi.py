@@ -39,10 +39,10 @@ def test_two_ranks_give_the_serial_multiscale_history(tmp_path, monkeypatch):
             raise ConvergenceError("the direct solve on new laws, made to fail by the test")
         return solve(mech, *args, **kwargs)
 
-    def on_new_laws(mech, law, guess=None):
+    def on_new_laws(mech, law, *args):
         updates.append(1)
         fail.append(1)
-        return solve_on_new_laws(mech, law, guess)
+        return solve_on_new_laws(mech, law, *args)
 
     monkeypatch.setattr(Mechanics, "solve", direct_fails)
     monkeypatch.setattr(coupling, "solve_on_new_laws", on_new_laws)
