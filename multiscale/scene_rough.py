@@ -2,7 +2,8 @@
 scene's cross-checks call them once the sections read; the run applies ``rough_rules`` again,
 ``workflows.rough.check_rough_scene``): one micro solid and one set of micro settings over the
 rough interfaces, a generated surface within its grid's Nyquist index, a measured one covering its
-face with a grid that resolves it."""
+face with a grid that resolves it, zones no smaller than the facets, and the perfect-contact keys
+where an interface keeps perfect contact."""
 from __future__ import annotations
 
 import warnings
