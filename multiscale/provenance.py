@@ -100,16 +100,15 @@ def _table(cls, obj) -> dict:
         if v is None or (isinstance(v, str) and v == "") or name in unused:     # "": no description
             continue
         parser = spec.parser
-        if isinstance(parser, Named):
+        if isinstance(parser, Named):      # [interfaces.<name>] with their merged sub-tables (before: dropped)
             if v:
-                out[name] = {n: _table(parser.cls, t) for n, t in v.items()}
+                out[name] = _section(name, parser, v) if name == "interfaces" else \
+                    {n: _table(parser.cls, t) for n, t in v.items()}
         elif isinstance(parser, Tables):
             if v:
                 out[name] = [_table(parser.cls, t) for t in v]
         elif isinstance(parser, Section):
-            table = _section(name, parser, v)
-            if table or name != "interfaces":
-                out[name] = table
+            out[name] = _section(name, parser, v)
         else:
             out[name] = _value(parser, v)
     return out

@@ -28,8 +28,8 @@ from multiscale.errors import InputError, SceneError, read_toml_text, toml_probl
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
-from multiscale.scene_rough import (measured_cover, micro_constants, nyquist, perfect_contact, rough_rules, thin_layer,
-                                    zone_sizes)
+from multiscale.scene_rough import (measured_cover, micro_constants, nyquist, own_tables, perfect_contact, rough_rules,
+                                    roughness_over, thin_layer, zone_sizes)
 from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
@@ -76,8 +76,9 @@ _EFFECT_CHOICE = Choice(EFFECTS)
 
 class InterfacesSection(Named):
     """[interfaces.<name>]: ``InterfaceSettings``; a sub-table [interfaces.<name>.roughness] or
-    [interfaces.<name>.micro] overrides keys of [roughness] or [micro] for that interface (the merged
-    table is validated as a whole)."""
+    [interfaces.<name>.micro] overrides keys of [roughness] or [micro] for that interface, a surface
+    of its own replacing the other's (``scene_rough.roughness_over``; the merged table is validated
+    as a whole)."""
 
     def __init__(self):
         super().__init__(InterfaceSettings)
@@ -90,7 +91,7 @@ class InterfacesSection(Named):
     def read(self, raw, path, ctx):
         if not isinstance(raw, dict):
             ctx.problems.append(f"{path} = {show(raw)}: must be {self.describe()} ([{path}.<name>])")
-            return None
+            return FrozenMap()         # (None crashed the cross-checks)
         out = {}
         for name, table in raw.items():
             where = f"{path}.{name}"
@@ -99,11 +100,15 @@ class InterfacesSection(Named):
                 continue
             merged = {}
             for section, cls in (("roughness", Roughness), ("micro", Micro)):
-                if section in table:
+                own = table.get(section)
+                if own is not None and not isinstance(own, dict):   # (a file's path was taken as {}: ignored)
+                    ctx.problems.append(f"{where}.{section} = {show(own)}: must be a table [{where}.{section}]")
+                elif own is not None:
                     base = ctx.root.get(section) if isinstance(ctx.root.get(section), dict) else {}
-                    override = table[section] if isinstance(table[section], dict) else {}
-                    merged[section] = read(cls, {**base, **override}, f"{where}.{section}", ctx)
-            settings = read(InterfaceSettings, {k: v for k, v in table.items() if k not in merged}, where, ctx)
+                    over = roughness_over(base, own) if section == "roughness" else {**base, **own}
+                    merged[section] = read(cls, over, f"{where}.{section}", ctx)
+            settings = read(InterfaceSettings, {k: v for k, v in table.items() if k not in ("roughness", "micro")},
+                            where, ctx)
             out[name] = dataclasses.replace(settings, **merged) if settings is not None else None
         return FrozenMap(out)
 
@@ -389,7 +394,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                                     f"(materials.{name}.k_w): give one of them")
         if not problems:
             problems += ([str(e) for e in rough_rules(scene)] + nyquist(scene) + thin_layer(scene)
-                         + measured_cover(scene, warnings) + perfect_contact(scene, warnings))
+                         + measured_cover(scene, warnings) + perfect_contact(scene, warnings) + own_tables(scene, warnings))
             warnings += micro_constants(scene) + zone_sizes(scene)
     if scene.output is not None and scene.output.fields is not None:
         for f in scene.output.fields:

@@ -332,6 +332,24 @@ def test_resolved_scene_loads_back_to_itself(path):
     assert again.effects == scene.effects and again.output == scene.output and again.time == scene.time
 
 
+def test_the_resolved_scene_keeps_each_interfaces_own_roughness_and_micro():
+    """[interfaces.<name>.roughness] and [interfaces.<name>.micro] are written out merged (before:
+    dropped, so the resolved scene loaded back with the scene-wide rms and zones; a user trial)."""
+    scene = load(DEMOS / "brake_squeal.toml", {
+        "effects": ["contact", "friction", "roughness"], "roughness": {"rms": "3 um", "hurst": 0.8, "k_min": 1,
+                                                                    "k_max": 6},
+        "micro": {"zones": [2, 2], "grid": [16, 16]}, "interfaces.outer_pad.roughness.rms": "8 um",
+        "interfaces.inner_pad.micro.zones": [3, 3], "interfaces.outer_pad.friction": 0.2})
+    text = resolved_toml(scene)
+    again = loads(text, DEMOS, name=scene.name)
+    assert resolved_toml(again).splitlines()[2:] == text.splitlines()[2:]
+    for name in ("inner_pad", "outer_pad"):
+        assert again.interface_settings(name) == scene.interface_settings(name)
+    own = again.interface_settings
+    assert (own("outer_pad").roughness.rms, own("inner_pad").micro.zones, own("outer_pad").micro.zones) == (8e-6, (3, 3),
+                                                                                                         (2, 2))
+
+
 def test_the_default_wear_rate_table_is_written_out_in_the_resolved_scene():
     """scene_resolved.toml ("every default filled in") left wear.k_w_table unset when the default
     table of thesis Fig. 7.9 ran; a rough material's own k_w, which that table would override, stays

@@ -814,6 +814,53 @@ def test_perfect_contact_keys_with_rough_interfaces_are_needed_where_kept_and_sa
                for w in load(DEMOS / "car_brake_stop.toml", h_c).warnings) == 1
 
 
+def test_an_interface_surface_of_its_own_replaces_the_scene_wide_one(tmp_path):
+    """[interfaces.<name>.roughness] with a file over a generated [roughness] (or the reverse) is that
+    interface's surface alone, the other keys still taken from [roughness] (before: "give only one of
+    rms, file"), a file does not take another file's pixel size and height unit (an x3p read with a
+    .npy's: Sq 7.7e-14 m for 77 nm), and tables that are not tables are said (a path was ignored;
+    [[interfaces]] crashed check), a rough body that moves is refused and tables no interface reads
+    are warned about (they passed silently; user trials)."""
+    np.save(tmp_path / "a.npy", np.random.default_rng(1).normal(size=(64, 64)))
+    np.save(tmp_path / "b.npy", np.random.default_rng(2).normal(size=(64, 64)))
+    rough = {"effects": ["contact", "friction", "roughness"], "micro": {"zones": [2, 2], "grid": [16, 16]},
+             "roughness": {"rms": "5 um", "hurst": 0.8, "k_min": 1, "k_max": 6, "seed": 4}}
+    measured = {"file": str(tmp_path / "a.npy"), "pixel_size": "20 um", "height_unit": "um", "cover": "tile"}
+    text = (DEMOS / "brake_squeal.toml").read_text()
+    scene = loads(text, DEMOS, overrides={**rough, "interfaces.outer_pad.roughness": measured})
+    inner, outer = (scene.interface_settings(n).roughness for n in ("inner_pad", "outer_pad"))
+    assert (inner.rms, inner.file, outer.rms, outer.hurst, outer.file.name) == (5e-6, None, None, None, "a.npy")
+    assert (outer.seed, outer.pixel_size, outer.height_unit) == (4, (2e-5, 2e-5), 1e-6)
+    other = {"file": str(tmp_path / "b.npy")}
+    with pytest.raises(SceneError, match=r"interfaces.outer_pad.roughness.pixel_size: b.npy is a plain height matrix "
+                                         "without units: give its pixel size"):
+        loads(text, DEMOS, overrides={**rough, "roughness": measured, "interfaces.outer_pad.roughness": other})
+    scene = loads(text, DEMOS, overrides={**rough, "roughness": measured,
+                                          "interfaces.outer_pad.roughness": {**other, "pixel_size": "10 um"},
+                                          "interfaces.inner_pad.roughness": {"rms": "3 um", "hurst": 0.7, "k_min": 1,
+                                                                             "k_max": 4}})
+    inner, outer = (scene.interface_settings(n).roughness for n in ("inner_pad", "outer_pad"))
+    assert (inner.rms, inner.file, inner.cover, outer.file.name, outer.pixel_size, outer.height_unit,
+            outer.cover) == (3e-6, None, "measured", "b.npy", (1e-5, 1e-5), None, "tile")
+    with pytest.raises(SceneError) as err:
+        loads(text, DEMOS, overrides={**rough, "interfaces.outer_pad.roughness": "plu-1.plu",
+                                      "interfaces.outer_pad.micro": 3})
+    assert err.value.problems == ['interfaces.outer_pad.roughness = "plu-1.plu": must be a table '
+                                  "[interfaces.outer_pad.roughness]",
+                                  "interfaces.outer_pad.micro = 3: must be a table [interfaces.outer_pad.micro]"]
+    with pytest.raises(SceneError, match=r"interfaces = \[\{name, friction\}\]: must be a table of named tables"):
+        loads(text + '\n[[interfaces]]\nname = "outer_pad"\nfriction = 0.3\n', DEMOS)
+    with pytest.raises(SceneError, match=r'^interfaces.outer_pad.roughness.body = "disc": the rough body must be the '
+                                         r'stationary one, "brake"'):
+        loads(text, DEMOS, overrides={**rough, "interfaces.outer_pad.roughness.body": "disc"})   # (it passed)
+    plain = loads(text, DEMOS, overrides={"interfaces.outer_pad.micro.zones": [3, 3]})
+    assert 'interfaces.outer_pad.micro is ignored: effect "roughness" is not in effects' in plain.warnings
+    kept = loads(text, DEMOS, overrides={**rough, "interfaces.outer_pad.rough": False,
+                                         "interfaces.outer_pad.roughness.rms": "4 um"})
+    assert ("interfaces.outer_pad.roughness is ignored: interface outer_pad keeps perfect contact (rough = false)"
+            in kept.warnings)
+
+
 def test_overrides_are_validated_like_the_file(tmp_path):
     scene = loads(GOOD, tmp_path, overrides={"loading.friction": 0.2, "geometry.mesh_size": "1 mm",
                                              "materials.block.E": "5 GPa"})
