@@ -64,8 +64,7 @@ The default (``scene_sections.COUPLING_DEFAULT``) was chosen by measurement (doc
 The initial laws are computed before the first solve; the rigid datum gap starts Newton close to
 equilibrium. ``save``/``restore`` write and read the whole state (``checkpoint``): a killed run
 continues to the same history (to solver tolerance: a resumed run recomputes its zone laws). This
-module reads no scene: ``multiscale.workflows.multiscale`` builds and runs it.
-"""
+module reads no scene: ``multiscale.workflows.multiscale`` builds and runs it."""
 from __future__ import annotations
 
 import json
@@ -96,7 +95,7 @@ class LoopSettings:
     dt: float                     # s, macro step
     substeps: int                 # thermo-mechanical sub-steps per macro step
     initial_temperature: float    # K, also the temperature of zones without a heat problem
-    partition: float              # share of the frictional heat into the rough body until the first heating (NaN: none)
+    partition: float | np.ndarray  # share of the heat into the rough body, per zone, until the first heating (NaN: none)
     partition_law: bool = False   # micro partition per zone (ch. 6) instead of the constant
     wear: bool = False            # Archard wear of the zones
     wear_every: int = 1           # macro steps per wear update
@@ -198,7 +197,7 @@ class Multiscale:
         self.fingerprint = fingerprint
         self.nominal = sum(settings.forces.values()) / self.tm.interface.areas.sum()
         Z = len(rough.zones)
-        self.partition = np.full(Z, float(settings.partition))
+        self.partition = np.broadcast_to(np.asarray(settings.partition, dtype=float), (Z,)).copy()
         self.proposed = np.full(Z, np.nan)            # partitions of the last post-analysis (NaN: unloaded)
         self.flash = np.full(Z, np.nan)               # K, flash temperature of each zone (NaN: unloaded)
         self.conductance = np.zeros(Z)
@@ -352,7 +351,7 @@ class Multiscale:
 
     def accept(self, micro: MicroStep) -> MicroStep:
         """The partitions (and exchanges) of the last ``analyse`` become the zones' (partition law);
-        ``micro`` with their (min, mean, max) over the loaded zones."""
+        ``micro`` with their (min, mean, max) over the loaded zones with friction."""
         loaded = self._last[-1]
         if self.partition_law:                  # a zone that did not slide (no heat) keeps its partition
             proposed = self.proposed[loaded]
@@ -360,7 +359,8 @@ class Multiscale:
         if self.settings.coupling == "implicit":
             self.exchange[:] = 0.0
             self.exchange[loaded] = self.proposed_exchange[loaded]
-        used = self.partition[loaded] if len(loaded) else np.full(1, np.nan)
+        heated = loaded if self.settings.friction is None else loaded[self.settings.friction[loaded] > 0]
+        used = self.partition[heated] if len(heated) else np.full(1, np.nan)     # (without friction, no heat)
         micro.partition = (float(used.min()), float(used.mean()), float(used.max()))
         return micro
 

@@ -589,6 +589,28 @@ folder = "{folder}"
 """
 
 
+def test_each_rough_pad_starts_from_and_reports_its_own_heat_partition(tmp_path):
+    """Two rough pads on tracks of their own (effusivity shares 0.0057 and 0.0078): each pad's
+    zones take their interface's share, as the interface field does (before: every zone the first
+    interface's, so history's partition_min/mean/max and zones.h5 said 0.0057 where 0.0078 was
+    applied; a user trial), and the zones of a pad without friction (no heat) are left out of the
+    partition columns."""
+    from multiscale.workflows.multiscale import build
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO.replace("Box(5) = {-10, -90, 10, 20, 20, 8};",
+                                                               "Box(5) = {-10, -62, 10, 20, 12, 8};"))
+    text = TWO_PADS.replace('"-80 mm"', '"-56 mm"').replace("partition = 0.1", 'partition = "effusivity"').replace(
+        '"heat_partition"]', '"heat_partition", "roughness"]') + \
+        '[roughness]\nrms = "10 um"\nhurst = 0.8\nk_min = 1\nk_max = 4\n[micro]\nzones = [2, 2]\ngrid = [16, 16]\n'
+    ms = build(loads(text.replace("{folder}", str(tmp_path / "out")), tmp_path,
+                     overrides={"interfaces.pad_b.friction": 0.0}))
+    shares, k = ms.model.partitions, ms.rough.grids[0].n_zones
+    assert list(ms.rough.names) == ["pad_a", "pad_b"] and shares["pad_b"] > 1.1 * shares["pad_a"]
+    np.testing.assert_array_equal(ms.partition, [shares["pad_a"]] * k + [shares["pad_b"]] * k)
+    ms.start()
+    assert ms.micro_step().partition == (shares["pad_a"],) * 3        # pad_b without friction: no heat
+    ms.model.close()
+
+
 def test_the_friction_force_of_several_pads_is_the_sum_of_theirs(tmp_path):
     """history friction_force is the sum of the local friction forces' magnitudes (mu times the
     normal force when everything slides), per interface and in all: before, it was the length of

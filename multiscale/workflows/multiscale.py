@@ -135,8 +135,9 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
     io.reporter().say(model_size(tm, model.mechanics, model.thermal))
     t, wear = scene.time, scene.has("wear")
     mu = np.concatenate([np.full(g.n_zones, friction_coefficient(scene, n)) for n, g in zip(rough.names, rough.grids)])
-    first = next(iter(model.partitions.values())) if scene.has("heat_partition") else np.nan
-    settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature, partition=first,
+    shares = np.concatenate([np.full(g.n_zones, model.partitions[n]) for n, g in zip(rough.names, rough.grids)]) \
+        if scene.has("heat_partition") else np.nan      # each zone its interface's (before: the first's)
+    settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature, partition=shares,
                             partition_law=scene.micro.partition_law, wear=wear,
                             wear_every=scene.wear.update_every if wear else 1, steps=t.steps,
                             flash_softening=scene.micro.flash_softening,
