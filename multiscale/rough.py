@@ -65,7 +65,8 @@ class Plane:
 def interface_plane(tm: TwoBodyMesh, name: str) -> tuple[Plane, np.ndarray, np.ndarray]:
     """The plane of interface ``name`` and the lower and upper corners (u, v) [m] of its facets'
     vertices in it; InputError if the interface is not planar. The frame is ``geometry.plane_frame``'s:
-    (x, y, z) itself for a normal along z; otherwise e_u is x projected on the plane (or y)."""
+    (x, y, z) itself for a normal along z, the origin on the face's plane (before: at z = 0, and
+    zones.h5 put every zone there); otherwise e_u is x projected on the plane (or y)."""
     iface = tm.interface
     mask = iface.masks()[name]
     mid, areas = iface.midpoints[mask], iface.areas[mask]
@@ -76,7 +77,7 @@ def interface_plane(tm: TwoBodyMesh, name: str) -> tuple[Plane, np.ndarray, np.n
     size = max(float((hi3 - lo3).max()), np.finfo(float).tiny)
     if np.abs((mid - centre) @ n).max() > 1e-9 * size:
         raise InputError("geometry", name, "a rough interface must be planar")
-    plane = Plane(np.zeros(3) if abs(n[2]) > 1 - 1e-12 else centre, plane_frame(n))
+    plane = Plane(centre * [0, 0, 1] if abs(n[2]) > 1 - 1e-12 else centre, plane_frame(n))   # (u, v) = (x, y) there
     corners = plane.uv(np.array([[a, b, c] for a in (lo3[0], hi3[0]) for b in (lo3[1], hi3[1])
                                  for c in (lo3[2], hi3[2])]))
     return plane, corners.min(axis=0), corners.max(axis=0)

@@ -594,7 +594,7 @@ def test_each_rough_pad_starts_from_and_reports_its_own_heat_partition(tmp_path)
     zones take their interface's share, as the interface field does (before: every zone the first
     interface's, so history's partition_min/mean/max and zones.h5 said 0.0057 where 0.0078 was
     applied; a user trial), and the zones of a pad without friction (no heat) are left out of the
-    partition columns."""
+    partition columns. The zones' centres in space lie on the pads' face at z = 10 mm (before: z = 0)."""
     from multiscale.workflows.multiscale import build
     (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO.replace("Box(5) = {-10, -90, 10, 20, 20, 8};",
                                                                "Box(5) = {-10, -62, 10, 20, 12, 8};"))
@@ -606,6 +606,9 @@ def test_each_rough_pad_starts_from_and_reports_its_own_heat_partition(tmp_path)
     shares, k = ms.model.partitions, ms.rough.grids[0].n_zones
     assert list(ms.rough.names) == ["pad_a", "pad_b"] and shares["pad_b"] > 1.1 * shares["pad_a"]
     np.testing.assert_array_equal(ms.partition, [shares["pad_a"]] * k + [shares["pad_b"]] * k)
+    centres = ms.rough.zone_frames()[0]          # zones.h5 "position": on the pads' faces (before: at z = 0)
+    np.testing.assert_allclose(centres[:, 2], 0.010, rtol=0, atol=1e-12)
+    assert np.all(np.abs(centres[:k, 1] - 0.080) < 0.010) and np.all(np.abs(centres[k:, 1] + 0.056) < 0.006)
     ms.start()
     assert ms.micro_step().partition == (shares["pad_a"],) * 3        # pad_b without friction: no heat
     ms.model.close()

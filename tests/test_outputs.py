@@ -234,8 +234,8 @@ def test_zone_results_say_where_each_value_is(case):
         distance = np.linalg.norm(centres[:, None] - facets[None], axis=2)        # every centre is a cell's, once
         assert distance.min(axis=1).max() < 1e-12 and len(set(distance.argmin(axis=1))) == len(facets)
         position = z["position"][...]
-        np.testing.assert_allclose(position[:, :2], z["centre"][...], rtol=0, atol=1e-15)   # the pin face: z = 0
-        np.testing.assert_allclose(position[:, 2], 0.0, atol=1e-15)
+        np.testing.assert_allclose(position[:, :2], z["centre"][...], rtol=0, atol=1e-15)   # the pin face
+        np.testing.assert_allclose(position[:, 2], facets[:, 2].mean(), rtol=0, atol=1e-15)
 
 
 class StubParaView:
