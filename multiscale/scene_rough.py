@@ -68,7 +68,9 @@ def perfect_contact(scene, warnings_out: list) -> list[str]:
     zones' laws replace them on the rough interfaces only, so the interfaces kept in perfect contact
     (``rough = false``) need them (without, such an interface had K_n = 0, no contact, or h_c = 0,
     said nowhere; found in review), and with every interface rough they are ignored (warned, into
-    ``warnings_out``). A key whose effect is off is the schema's (``warn_unused``)."""
+    ``warnings_out``). A key whose effect is off is the schema's (``warn_unused``). With effect
+    "wear", such interfaces wear neither body (warned: a user trial's disc lost only the rough pad's
+    track, at half the rate the frictional work of both pads suggested)."""
     if not scene.has("roughness") or not scene.rough_interfaces:
         return []
     perfect = [n for n in scene.geometry.spec.interfaces if n not in scene.rough_interfaces]
@@ -81,6 +83,9 @@ def perfect_contact(scene, warnings_out: list) -> list[str]:
         elif scene.has(effect) and given and not perfect:
             warnings_out.append(f'interface.{key} is ignored: every interface is rough (effect "roughness") '
                                 "and the zones' laws replace it")
+    if scene.has("wear") and perfect:
+        warnings_out.append(f'effect "wear" wears the rough zones and their tracks only: {", ".join(perfect)} (rough = '
+                            "false) wear neither body, though the run's frictional_work counts their work")
     return out
 
 

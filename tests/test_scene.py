@@ -784,7 +784,8 @@ def test_loading_friction_is_needed_only_for_interfaces_without_their_own(tmp_pa
 def test_perfect_contact_keys_with_rough_interfaces_are_needed_where_kept_and_said_ignored_otherwise():
     """With effect "roughness", interface.penalty and .conductance act only on the interfaces kept
     in perfect contact: needed when one is (before: K_n = 0 there, the pad carried nothing, and
-    check said OK), warned as ignored when every interface is rough; the summary says which is which."""
+    check said OK), warned as ignored when every interface is rough; the summary says which is which.
+    With effect "wear" an interface kept in perfect contact is said to wear neither body."""
     rough = {"effects": ["contact", "friction", "roughness"], "micro": {"zones": [2, 2], "grid": [16, 16]},
              "roughness": {"rms": "5 um", "hurst": 0.8, "k_min": 1, "k_max": 6}}
     text = (DEMOS / "brake_squeal.toml").read_text()
@@ -796,7 +797,7 @@ def test_perfect_contact_keys_with_rough_interfaces_are_needed_where_kept_and_sa
                                   "contact: interfaces.outer_pad.rough = false"]
     assert not any("penalty" in w for w in loads(bare, DEMOS, overrides=rough).warnings)
     mixed = loads(text, DEMOS, overrides={**rough, "interfaces.outer_pad.rough": False})
-    assert not any("penalty" in w for w in mixed.warnings)
+    assert not any("penalty" in w for w in mixed.warnings) and not any("wear" in w for w in mixed.warnings)
     assert "    contact        rough per-zone laws on inner_pad; penalty K_n = 1e+13 Pa/m on outer_pad" in summary(mixed)
     ignored = [w for w in loads(text, DEMOS, overrides=rough).warnings if "penalty" in w]
     assert ignored == ['interface.penalty is ignored: every interface is rough (effect "roughness") and the zones\' '
@@ -808,8 +809,12 @@ def test_perfect_contact_keys_with_rough_interfaces_are_needed_where_kept_and_sa
     assert err.value.problems == ['interface.conductance: missing; effect "conductance" needs it on the interfaces in '
                                   "perfect contact: interfaces.outer_pad.rough = false"]
     h_c = {**hot, "interface.conductance": "1e5 W/(m^2 K)"}
-    assert not any("conductance" in w for w in load(DEMOS / "car_brake_stop.toml", {
-        **h_c, "interfaces.outer_pad.rough": False}).warnings)
+    kept = load(DEMOS / "car_brake_stop.toml", {**h_c, "interfaces.outer_pad.rough": False})
+    assert not any("conductance" in w for w in kept.warnings) and not any("wear" in w for w in kept.warnings)
+    worn = load(DEMOS / "car_brake_stop.toml", {**h_c, "interfaces.outer_pad.rough": False,
+                                                "effects": hot["effects"] + ["wear"]})
+    assert ('effect "wear" wears the rough zones and their tracks only: outer_pad (rough = false) wear neither '
+            "body, though the run's frictional_work counts their work") in worn.warnings
     assert sum("interface.conductance is ignored: every interface is rough" in w
                for w in load(DEMOS / "car_brake_stop.toml", h_c).warnings) == 1
 
