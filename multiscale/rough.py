@@ -95,15 +95,16 @@ def track_spread(radius, source_radius, volume, half: float) -> np.ndarray:
     return out
 
 
-def _check_zone_size(grid, areas, name: str) -> None:
-    """Refuse zones smaller than the facets of interface ``name`` (``areas`` [m^2]): a facet loads only
+def check_zone_size(grid, areas, name: str, key: str = "micro.zones") -> None:
+    """Refuse zones smaller than the facets of interface ``name`` (``areas`` [m^2]; ``key``: the scene
+    key of its zones, named by the InputError): a facet loads only
     the zone holding its midpoint, with its force over that zone's area, and the zones between hold
     none (20 x 20 zones of 1 mm^2 on the test pin-on-disc's 2.5 mm facets: 19 of 400 loaded, zone
     pressures 15 times the 5 x 5 grid's, a real contact area 0.57 times its)."""
     zone, facet = grid.size[0] * grid.size[1], float(np.median(areas))
     if zone < facet:
         fit = grid.counts_for(facet)
-        raise InputError("micro.zones", list(grid.counts), f"zones of {zone * 1e6:.3g} mm^2 on interface {name} are "
+        raise InputError(key, list(grid.counts), f"zones of {zone * 1e6:.3g} mm^2 on interface {name} are "
                          f"smaller than its facets (median {facet * 1e6:.3g} mm^2): a facet loads only the zone "
                          f"holding its midpoint; use at most {fit[0]} x {fit[1]} zones or a finer interface mesh")
 
@@ -150,7 +151,6 @@ class RoughInterface:
         for k, name in enumerate(self.names):
             uv = self.planes[k].uv(iface.midpoints[masks[name]])
             self.zone_of_facet[masks[name]] = offsets[k] + self.grids[k].zone_of(uv[:, 0], uv[:, 1])
-            _check_zone_size(self.grids[k], iface.areas[masks[name]], name)
         rough = self.zone_of_facet >= 0
         self.used = np.unique(self.zone_of_facet[rough])
         self.covered_area = np.bincount(self.zone_of_facet[rough], iface.areas[rough], minlength=len(self.zones))

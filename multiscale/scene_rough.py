@@ -142,11 +142,17 @@ def micro_constants(scene) -> list[str]:
     return out
 
 
+def micro_key(scene, name: str) -> str:
+    """Where interface ``name``'s micro settings are given: "interfaces.<name>.micro" or "micro"."""
+    own = scene.interfaces.get(name) if scene.interfaces else None
+    return f"interfaces.{name}.micro" if own is not None and own.micro is not None else "micro"
+
+
 def zone_sizes(scene) -> list[str]:
     """Warnings of zones smaller than the facets an interface will likely have, ``FACET_AREA`` h^2
     for the element size h its mesh aims at (``GeometrySpec.interface_sizes``), on faces whose
     extent the geometry knows: after meshing, the run refuses zones smaller than the facets' median
-    area (``rough._check_zone_size``; check said nothing before)."""
+    area (``rough.check_zone_size``; check said nothing before)."""
     out = []
     spec = scene.geometry.spec
     for name in scene.rough_interfaces:
@@ -156,10 +162,8 @@ def zone_sizes(scene) -> list[str]:
         grid = ZoneGrid((0.0, 0.0), s.micro.zones, (size[0] / s.micro.zones[0], size[1] / s.micro.zones[1]))
         zone, facet = grid.size[0] * grid.size[1], FACET_AREA * h ** 2
         if zone < facet:
-            own = scene.interfaces.get(name) if scene.interfaces else None
-            key = f"interfaces.{name}.micro" if own is not None and own.micro is not None else "micro"
             fit = grid.counts_for(facet)
-            out.append(f"{key}.zones = {list(s.micro.zones)}: zones of {zone * 1e6:.3g} mm^2 on interface {name} are "
+            out.append(f"{micro_key(scene, name)}.zones = {list(s.micro.zones)}: zones of {zone * 1e6:.3g} mm^2 on interface {name} are "
                        f"likely smaller than its facets (about {facet * 1e6:.3g} mm^2 for elements of {h * 1e3:.3g} "
                        "mm), which the run refuses after meshing (a facet loads only the zone holding its midpoint); "
                        f"use at most {fit[0]} x {fit[1]} zones or a finer interface mesh")

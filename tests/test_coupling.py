@@ -425,10 +425,13 @@ def test_zones_smaller_than_the_facets_are_refused(tmp_path):
     its midpoint with its whole force, so 19 of 400 zones carried the load at 65 MPa, 15 times the
     5 x 5 grid's 4.3 MPa, with 0.57 times its real contact area (40 x 40: 6 zones, 274 MPa), and
     the run said "raise micro.p_max". Now refused before the first law (an adversarial test), and
-    warned by the scene's check before meshing, from the element size (about 0.4 h^2 a facet)."""
+    warned by the scene's check before meshing, from the element size (about 0.4 h^2 a facet); both
+    name the key the zones came from."""
     with pytest.raises(InputError, match=r"micro.zones = \[20, 20\]: zones of 1 mm\^2 on interface interface are "
                                          r"smaller than its facets \(median 2.64 mm\^2\).*at most 12 x 12 zones"):
         run_pod(tmp_path / "fine", {"micro.zones": [20, 20]})
+    with pytest.raises(InputError, match=r"^interfaces.interface.micro.zones = \[20, 20\]: zones of 1 mm\^2"):
+        run_pod(tmp_path / "fine", {"interfaces.interface.micro.zones": [20, 20]})   # (it said micro.zones)
     said = [w for w in loads(POD.format(folder=tmp_path / "fine"), overrides={"micro.zones": [20, 20]}).warnings
             if "zones" in w]
     assert len(said) == 1 and said[0].startswith("micro.zones = [20, 20]: zones of 1 mm^2 on interface interface are "

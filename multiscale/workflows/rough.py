@@ -40,8 +40,8 @@ from multiscale.micro.surface import Surface, fractal_surface
 from multiscale.micro.topography import TopographyWarning, condition, cover, read_topography, zone_cells
 from multiscale.micro.zones import ZoneGrid, cut_zones, generate_zones
 from multiscale.pool import MicroPool
-from multiscale.rough import RoughInterface, interface_plane
-from multiscale.scene_rough import rough_rules
+from multiscale.rough import RoughInterface, check_zone_size, interface_plane
+from multiscale.scene_rough import micro_key, rough_rules
 from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR, P_MAX_PLASTIC
 from multiscale.workflows.model import interface_forces, interface_materials
 
@@ -153,6 +153,7 @@ def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterfac
         grid, patches = make_zones(settings.roughness, settings.micro, lo, hi, settings.roughness.seed + SEED_STRIDE * k,
                                    log=log, prefix=f"{scene.roughness_key(name)}.",
                                    warned=name in scene.geometry.spec.interface_extents)   # by the scene's check
+        check_zone_size(grid, tm.interface.areas[tm.interface.masks()[name]], name, f"{micro_key(scene, name)}.zones")
         offset = len(zones)
         planes.append(plane)
         grids.append(grid)
