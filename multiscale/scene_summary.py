@@ -67,7 +67,11 @@ def summary(scene: Scene) -> list[str]:
             s = scene.interface_settings(name)
             kind = "rough" if name in (scene.rough_interfaces if scene.has("roughness") else ()) else "perfect contact"
             mu = f", mu = {s.friction:g}" if scene.has("friction") and s.friction is not None else ""
-            lines.append(f"  interface {name}: {kind}{mu}")
+            own, extra = scene.interfaces.get(name), []
+            if kind == "rough" and own is not None:        # its own surface and zones (before: said nowhere)
+                extra += [f"its own surface: {_surface(s.roughness)}"] if own.roughness is not None else []
+                extra += [f"its own {s.micro.zones[0]} x {s.micro.zones[1]} zones"] if own.micro is not None else []
+            lines.append(f"  interface {name}: {kind}{mu}" + (f" ({'; '.join(extra)})" if extra else ""))
     for b in scene.boundary:
         what = [f"fix {''.join(b.fix)}" if b.fix else "",
                 "convection h(speed)" if isinstance(b.convection, tuple) else
@@ -130,8 +134,7 @@ def _effect_line(scene: Scene, effect: str) -> str:
         return _rough_or_perfect(scene, "h_c(p) per zone (micro)", "h_c = {:g} W/(m^2 K)", i.conductance)
     if effect == "roughness":
         r, m = scene.roughness, scene.micro
-        surface = f"RMS {r.rms * 1e6:g} um, H {r.hurst:g}" if r.rms is not None else \
-            f"file {r.file.name} ({r.cover}" + (f", seed {r.seed})" if r.cover == "equivalent" else ")")
+        surface = _surface(r)
         measured_pixels = r.file is not None and r.cover != "equivalent"
         cells = f"{m.grid[0]} x {m.grid[1]} cells" if m.grid else \
             "the measurement's pixel size" if measured_pixels else "50 x 50 cells"
@@ -174,3 +177,9 @@ def _rough_or_perfect(scene: Scene, rough: str, perfect: str, value: float) -> s
     if not laws or not kept:
         return rough if laws else perfect.format(value)
     return f"{rough} on {', '.join(laws)}; {perfect.format(value)} on {', '.join(kept)}"
+
+
+def _surface(r) -> str:
+    """A rough surface in words: generated (RMS, H) or measured (file, cover)."""
+    return f"RMS {r.rms * 1e6:g} um, H {r.hurst:g}" if r.rms is not None else \
+        f"file {r.file.name} ({r.cover}" + (f", seed {r.seed})" if r.cover == "equivalent" else ")")

@@ -835,6 +835,7 @@ def test_an_interface_surface_of_its_own_replaces_the_scene_wide_one(tmp_path):
     scene = loads(text, DEMOS, overrides={**rough, "interfaces.outer_pad.roughness": measured})
     inner, outer = (scene.interface_settings(n).roughness for n in ("inner_pad", "outer_pad"))
     assert (inner.rms, inner.file, outer.rms, outer.hurst, outer.file.name) == (5e-6, None, None, None, "a.npy")
+    assert "  interface outer_pad: rough, mu = 0.4 (its own surface: file a.npy (tile))" in summary(scene)
     assert (outer.seed, outer.pixel_size, outer.height_unit) == (4, (2e-5, 2e-5), 1e-6)
     other = {"file": str(tmp_path / "b.npy")}
     with pytest.raises(SceneError, match=r"interfaces.outer_pad.roughness.pixel_size: b.npy is a plain height matrix "
@@ -847,6 +848,8 @@ def test_an_interface_surface_of_its_own_replaces_the_scene_wide_one(tmp_path):
     inner, outer = (scene.interface_settings(n).roughness for n in ("inner_pad", "outer_pad"))
     assert (inner.rms, inner.file, inner.cover, outer.file.name, outer.pixel_size, outer.height_unit,
             outer.cover) == (3e-6, None, "measured", "b.npy", (1e-5, 1e-5), None, "tile")
+    zones = loads(text, DEMOS, overrides={**rough, "interfaces.inner_pad.micro.zones": [3, 3]})
+    assert "  interface inner_pad: rough, mu = 0.4 (its own 3 x 3 zones)" in summary(zones)     # (said nowhere)
     with pytest.raises(SceneError) as err:
         loads(text, DEMOS, overrides={**rough, "interfaces.outer_pad.roughness": "plu-1.plu",
                                       "interfaces.outer_pad.micro": 3})
