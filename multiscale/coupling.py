@@ -525,7 +525,7 @@ class Multiscale:
             volume = self.rough.zone_wear_volume(depth)
             row.update({f"wear_volume_{n}": v for n, v in self.rough.interface_sums(volume).items()})
             row.update(wear_volume=float(volume.sum()), wear_max_depth=float(depth.max()),
-                       rms_height=float(np.sqrt(np.mean((heights - heights.mean()) ** 2))),
+                       rms_height=self.rough.rms_height(heights),
                        frictional_work=self.work, wear_substep_error=result.micro.wear_error)
             if self.post.counter_rate is not None:
                 row.update(counter_wear_volume=self.counter_volume,

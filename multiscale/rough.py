@@ -279,6 +279,14 @@ class RoughInterface:
         are several (the history's per-interface columns), else {}."""
         return {} if len(self.names) < 2 else {n: float(np.sum(values[self.zone_of(n)])) for n in self.names}
 
+    def rms_height(self, heights) -> float:
+        """RMS [m] of the zones' ``heights`` (Z, ny, nx) about their mean, each zone weighted by the
+        area of the facets it holds (``covered_area``: an edge zone of a round face counts for its part,
+        a zone of a small pad for its size; before, every zone alike, over all interfaces)."""
+        w, means = self.covered_area, heights.mean(axis=(1, 2))
+        centre = np.average(means, weights=w)
+        return float(np.sqrt(np.average(((heights - centre) ** 2).mean(axis=(1, 2)), weights=w)))
+
     def datum_gap(self, forces) -> np.ndarray:
         """Per-facet uniform gap g_0 [m] of each rough interface at which its rigid rough body
         carries ``forces[name]`` [N] (bisection); 0 on the other facets."""

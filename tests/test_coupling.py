@@ -420,6 +420,17 @@ def test_too_few_wear_substeps_are_warned_about_with_their_estimated_error(tmp_p
     assert not json.loads((tmp_path / "32" / "provenance.json").read_text())["warnings"]
 
 
+def test_the_rms_height_weights_each_zone_by_the_area_it_covers():
+    """Zones of +1 and -1 um covering 3:1 of the face (an edge zone of a round face, pads of two
+    sizes): RMS sqrt(0.75) um about the area mean 0.5 um (before: 1 um, every zone alike); a zone
+    holding no facet counts for nothing."""
+    from types import SimpleNamespace
+    from multiscale.rough import RoughInterface
+    heights = np.stack([np.full((4, 4), 1e-6), np.full((4, 4), -1e-6), np.full((4, 4), 9e-6)])
+    rough = SimpleNamespace(covered_area=np.array([3.0, 1.0, 0.0]))
+    assert RoughInterface.rms_height(rough, heights) == pytest.approx(np.sqrt(0.75) * 1e-6, rel=1e-12)
+
+
 def test_zones_smaller_than_the_facets_are_refused(tmp_path):
     """20 x 20 zones (1 mm^2) on the 2.5 mm facets (2.64 mm^2): a facet loaded only the zone holding
     its midpoint with its whole force, so 19 of 400 zones carried the load at 65 MPa, 15 times the
