@@ -390,9 +390,8 @@ class Multiscale:
         return float(np.abs(self.micro_heat_rough[loaded] - given).max() / Q.mean())
 
     def zone_heat(self) -> np.ndarray:
-        """Frictional heat rate Phi of each zone loaded in the last ``analyse`` over their mean (0 on
-        the others): the weights of the partitions in the fixed point (a change of partition
-        counts as the heat it moves)."""
+        """Frictional heat rate Phi of each zone loaded in the last ``analyse`` over their mean (0 on the
+        others): the weights of the partitions in the fixed point (a partition's change counts as the heat it moves)."""
         loaded, Q = self._last[-1], np.zeros(len(self.rough.zones))
         Q[loaded] = self.micro_heat[loaded]
         return Q / Q[loaded].mean() if len(loaded) and Q[loaded].mean() > 0 else Q
@@ -412,7 +411,8 @@ class Multiscale:
     def facet_fields(self) -> dict:
         """Interface output fields of the loop: name -> per-facet array maker."""
         iface, contact, rough = self.tm.interface, self.model.contact, self.rough
-        fields = {"contact_stiffness": lambda: rough.law.evaluate(contact.facet_gap())[1] * (not self.model.released),
+        fields = {"contact_stiffness": lambda: rough.facet_stiffness(contact.facet_gap(), iface.values(contact.stiffness))
+                  * (not self.model.released),
                   "partition": lambda: iface.values(contact.partition),
                   "wear_depth": lambda: np.where(rough.zone_of_facet >= 0,
                                                  rough.wear_depth().mean(axis=(-2, -1))[rough.zone_of_facet], 0.0)}

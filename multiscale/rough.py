@@ -279,6 +279,12 @@ class RoughInterface:
         are several (the history's per-interface columns), else {}."""
         return {} if len(self.names) < 2 else {n: float(np.sum(values[self.zone_of(n)])) for n in self.names}
 
+    def facet_stiffness(self, gap, penalty) -> np.ndarray:
+        """Per-facet contact stiffness dp/dg [Pa/m] at the gaps ``gap`` [m]: the zone laws' on the rough
+        facets, the ``penalty`` K_n [Pa/m, per facet] where the others touch (before: 0 on an
+        interface in perfect contact that carried its pad's force; a user trial)."""
+        return np.where(self.zone_of_facet >= 0, self.law.evaluate(gap)[1], penalty * (np.asarray(gap) <= 0))
+
     def rms_height(self, heights) -> float:
         """RMS [m] of the zones' ``heights`` (Z, ny, nx) about their mean, each zone weighted by the
         area of the facets it holds (``covered_area``: an edge zone of a round face counts for its part,

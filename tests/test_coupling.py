@@ -431,6 +431,18 @@ def test_the_rms_height_weights_each_zone_by_the_area_it_covers():
     assert RoughInterface.rms_height(rough, heights) == pytest.approx(np.sqrt(0.75) * 1e-6, rel=1e-12)
 
 
+def test_the_contact_stiffness_field_is_the_penalty_where_a_perfect_interface_touches():
+    """The output field contact_stiffness: the zone laws' dp/dg on rough facets, K_n on the facets
+    of an interface in perfect contact that touch (g <= 0), 0 where they are open (before: 0 on all
+    of them, though that pad carried its force; a user trial)."""
+    from types import SimpleNamespace
+    from multiscale.rough import RoughInterface
+    law = SimpleNamespace(evaluate=lambda g: (None, np.where(np.arange(len(g)) < 2, 5e11, 0.0)))
+    rough = SimpleNamespace(zone_of_facet=np.array([0, 1, -1, -1]), law=law)
+    gap = np.array([1e-6, -1e-6, -2e-7, 3e-7])
+    np.testing.assert_array_equal(RoughInterface.facet_stiffness(rough, gap, np.full(4, 1e13)), [5e11, 5e11, 1e13, 0])
+
+
 def test_zones_smaller_than_the_facets_are_refused(tmp_path):
     """20 x 20 zones (1 mm^2) on the 2.5 mm facets (2.64 mm^2): a facet loaded only the zone holding
     its midpoint with its whole force, so 19 of 400 zones carried the load at 65 MPa, 15 times the
