@@ -19,6 +19,11 @@ from multiscale.scene import EFFECTS, OUTPUT_FIELDS, Scene
 from multiscale.scene_geometry import MAX_CELLS_TEXT, FileGeometry, GeometrySection, parameter_kind
 from multiscale.scene_sections import InterfaceSettings
 
+OWN_TABLES = ("Sub-tables ``[interfaces.<name>.roughness]`` and ``[interfaces.<name>.micro]`` take the keys of "
+              "``[roughness]`` and ``[micro]`` for that interface, over theirs; a surface of its own (``rms`` or "
+              "``file``) replaces the other, and a file does not take ``[roughness]``'s file keys (``channel``, "
+              "``pixel_size``, ``height_unit``).")
+
 
 def _quantities(parser) -> list[Quantity]:
     if isinstance(parser, Quantity):
@@ -90,8 +95,7 @@ def _tables(cls, path: str, effects: tuple, title: str, level: str = "-") -> lis
             continue                      # its own section
         if where == "interfaces":
             lines += _tables(InterfaceSettings, "interfaces.<name>", sub_effects, "[interfaces.<name>]", "~")
-            lines += ["Sub-tables ``[interfaces.<name>.roughness]`` and ``[interfaces.<name>.micro]`` take the "
-                      "keys of ``[roughness]`` and ``[micro]`` for that interface.", ""]
+            lines += [OWN_TABLES, ""]
             continue
         header = f"[[{where}]]" if isinstance(parser, Tables) else f"[{where}.<name>]" if isinstance(parser, Named) \
             else f"[{where}]"
@@ -153,8 +157,7 @@ def scene_rst() -> str:
             else f"[{where}]"
         if where == "interfaces":
             lines += _tables(InterfaceSettings, "interfaces.<name>", effects, "[interfaces.<name>]")
-            lines += ["Sub-tables ``[interfaces.<name>.roughness]`` and ``[interfaces.<name>.micro]`` take the "
-                      "keys of ``[roughness]`` and ``[micro]`` for that interface.", ""]
+            lines += [OWN_TABLES, ""]
             continue
         sub_path = where + (".<name>" if isinstance(parser, Named) else "")
         lines += _tables(parser.cls, sub_path, effects, header)

@@ -86,7 +86,7 @@ class InterfacesSection(Named):
     def reference(self, path: str) -> list[str]:
         """The keys of ``multiscale check --keys``, with the override sub-tables."""
         return reference(InterfaceSettings, f"{path}.<name>") + [
-            f"  [{path}.<name>.roughness], [{path}.<name>.micro]: keys of [roughness] or [micro] for this interface"]
+            f"  [{path}.<name>.roughness], [{path}.<name>.micro]: [roughness], [micro] keys for it (own rms/file replace)"]
 
     def read(self, raw, path, ctx):
         if not isinstance(raw, dict):
