@@ -412,5 +412,14 @@ def results_of(folder: Path) -> list[str]:
     return sorted({*names, *(n + ".part" for n in names)} | ({"provenance.json"} if names else set()))
 
 
-__all__ = ["RUNNING", "inputs_in", "now", "parts_of", "process", "resolved_toml", "results_of", "versions", "write",
-           "writer"]
+def unrecorded_results(scene, existing) -> list[str]:
+    """The entries ``existing`` (names in the scene's output folder) named as one of its run's results
+    (``outputs.plan``) that no run recorded writing (``results_of``): the user's own files, which a
+    run would write over (before, --overwrite replaced them, saying that the user's entries stay;
+    a user trial's own scene.toml and history.h5)."""
+    planned, recorded = set(plan(scene).files), set(results_of(scene.output.folder))
+    return [n for n in existing if n in planned and n not in recorded]
+
+
+__all__ = ["RUNNING", "inputs_in", "now", "parts_of", "process", "resolved_toml", "results_of", "unrecorded_results",
+           "versions", "write", "writer"]

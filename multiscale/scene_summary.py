@@ -6,7 +6,7 @@ import math
 
 from multiscale.geometry import CellEstimate, estimate_cells
 from multiscale.outputs import analysis
-from multiscale.provenance import entries, results_of
+from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
 from multiscale.scene_sections import P_MAX_FACTOR, P_MAX_PLASTIC
 from multiscale.schema import reference as schema_reference
@@ -86,9 +86,11 @@ def summary(scene: Scene) -> list[str]:
     names = scene.earlier_results()
     if names:
         earlier = len(set(names) & set(results_of(o.folder)))
+        own = unrecorded_results(scene, names)
         lines.append(f"  note      the output folder already holds {entries(len(names))}: run needs --overwrite "
                      f"(deletes the {earlier} the run before wrote)"
-                     + (" or --resume" if analysis(scene) == "multiscale" else ""))
+                     + (" or --resume" if analysis(scene) == "multiscale" else "")
+                     + (f"; it refuses to write over {', '.join(own)}, not written by a run" if own else ""))
     lines += [f"  warning   {w}" for w in scene.warnings]
     return lines
 

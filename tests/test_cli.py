@@ -240,7 +240,8 @@ def test_run_refuses_to_overwrite_results(tmp_path, capsys, monkeypatch):
     monkeypatch.setitem(sys.modules, "multiscale.workflows", module)
     assert main(["check", path]) == 0
     out = capsys.readouterr().out          # a transient scene cannot resume (it was advised to)
-    assert "the output folder already holds 1 entry: run needs --overwrite (deletes the 0 the run before wrote)\n" in out
+    assert ("the output folder already holds 1 entry: run needs --overwrite (deletes the 0 the run before wrote); it "
+            "refuses to write over history.h5, not written by a run\n") in out       # (no run recorded it)
     assert main(["run", path, "--overwrite"]) == 0
     assert main(["run", path, "--resume"]) == 0
     assert fake_runner == [("block_on_flat", True, False), ("block_on_flat", False, True)]
@@ -467,6 +468,30 @@ def test_overwrite_deletes_what_the_run_before_wrote_and_keeps_the_rest(tmp_path
 
 
 
+def test_overwrite_refuses_the_users_own_files_named_as_results(tmp_path, capsys):
+    """A folder holding the user's own scene.toml and history.h5, which no run recorded writing:
+    --overwrite refuses before any work and check says so (before: both were replaced, the run saying
+    that the user's entries stay; a user trial); with a run's record of them, they go as before."""
+    from mpi4py import MPI
+
+    from multiscale.errors import SceneError
+    from multiscale.workflows.output import prepare_folder
+    folder = tmp_path / "out"
+    folder.mkdir()
+    (folder / "scene.toml").write_text("# mine")
+    (folder / "history.h5").write_text("mine")
+    scene = _scene_into(tmp_path, folder)
+    with pytest.raises(SceneError, match=r'holds history.h5, scene.toml, named as this run\'s results but not written '
+                                         r"by a run .*: --overwrite would replace them"):
+        prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF)
+    assert (folder / "scene.toml").read_text() == "# mine" and (folder / "history.h5").read_text() == "mine"
+    assert main(["check", str(scene.source)]) == 0
+    assert "it refuses to write over history.h5, scene.toml, not written by a run" in capsys.readouterr().out
+    (folder / "provenance.json").write_text(json.dumps({"files": ["history.h5", "scene.toml"]}))
+    prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF).claim()
+    assert not (folder / "history.h5").exists()
+
+
 def test_a_provenance_write_that_fails_midway_leaves_the_earlier_record(tmp_path, monkeypatch):
     """The record is replaced whole: a write of provenance.json that fails after half its text (a
     full disk; a kill leaves its .part, which --overwrite clears) leaves the earlier record as it
@@ -548,6 +573,7 @@ def test_overwrite_keeps_the_earlier_results_when_the_run_fails_before_writing(t
 def test_overwrite_without_a_record_deletes_nothing_and_resume_never_does(tmp_path):
     from mpi4py import MPI
 
+    from multiscale.errors import SceneError
     from multiscale.io import Reporter
     from multiscale.workflows.output import prepare_folder
     folder = tmp_path / "out"
@@ -560,13 +586,16 @@ def test_overwrite_without_a_record_deletes_nothing_and_resume_never_does(tmp_pa
     prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF).claim()
     assert not (folder / "pad.xdmf").exists() and (tmp_path / "x").exists()     # only entries of the folder
     _earlier_run(tmp_path / "other", ["a.csv"])
-    (tmp_path / "other" / "provenance.json").write_text("{not json")      # another program's record
+    (tmp_path / "other" / "provenance.json").write_text("{not json")      # another program's record: not replaced
+    with pytest.raises(SceneError, match=r"holds provenance.json, named as this run's results but not written by a run"):
+        prepare_folder(_scene_into(tmp_path, tmp_path / "other"), overwrite=True, resume=False, comm=MPI.COMM_SELF)
+    (tmp_path / "other" / "provenance.json").unlink()
     stream = io.StringIO()
     with Reporter(MPI.COMM_SELF, stream=stream):
         prepare_folder(_scene_into(tmp_path, tmp_path / "other"), overwrite=True, resume=False,
                        comm=MPI.COMM_SELF).claim()
     assert "a.csv" in [p.name for p in (tmp_path / "other").iterdir()]
-    assert "stay (no record of a run (provenance.json with its files))" in stream.getvalue()
+    assert "stays (no record of a run (provenance.json with its files)): a.csv" in stream.getvalue()
 
 
 def test_a_scene_in_its_own_output_folder_is_not_a_result(tmp_path, capsys):

@@ -78,6 +78,11 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
     if taken:                        # this run would write over them: the scene of a run in its own folder
         raise SceneError(f'output.folder = "{folder}": holds {", ".join(taken)}, an input of the run before (a '
                          "scene run in its own folder); this run would write over it: choose another folder")
+    own = comm.bcast(provenance.unrecorded_results(scene, existing) if comm.rank == 0 and overwrite else [], root=0)
+    if own:
+        raise SceneError(f'output.folder = "{folder}": holds {", ".join(own)}, named as this run\'s results but not '
+                         "written by a run (no record of it in provenance.json): --overwrite would replace them; move "
+                         "them or choose another folder")
     if existing and not (overwrite or resume):
         shown = ", ".join(existing[:3]) + (", ..." if len(existing) > 3 else "")
         resumes = outputs.analysis(scene) == "multiscale"           # the only analysis with checkpoints
@@ -121,4 +126,4 @@ def clear(folder: Path, existing: list[str]) -> None:
         shown = ", ".join(kept[:3]) + (", ..." if len(kept) > 3 else "")
         why = "not written by the run before" if earlier else "no record of a run (provenance.json with its files)"
         io.reporter().say(f"--overwrite: {provenance.entries(len(kept))} of {folder} stay{'s' * (len(kept) == 1)} "
-                          f"({why}): {shown}; files of the same name as a result are replaced")
+                          f"({why}): {shown}")
