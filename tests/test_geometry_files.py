@@ -589,6 +589,20 @@ folder = "{folder}"
 """
 
 
+def test_a_load_face_between_two_parts_is_refused(tmp_path):
+    """A backplate bonded on pad_a: the load face "backs" is then pad_a's bonded top and pad_b's free
+    one. Refused, naming it (before: the whole force went to pad_b, 2 x its share, and only a warning
+    after the run said that pad_a carried nothing; a user trial)."""
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO + "\nBox(6) = {-10, 70, 18, 20, 20, 4};")
+    text = TWO_PADS.replace("[geometry.surfaces.backs]", '[geometry.bodies.plate_a]\ncontains = ["0 mm", "80 mm", '
+                            '"20 mm"]\nmaterial = "steel"\n[geometry.surfaces.backs]')
+    scene = loads(text.replace("{folder}", str(tmp_path / "out")).replace(', "thermal", "heat_partition"', ""),
+                  tmp_path)
+    with pytest.raises(InputError, match=r"^loading.faces = 'backs': \d+ of its facets lie between two parts "
+                                         r"\(bonded\), where no load acts"):
+        run(scene, verbose=False)
+
+
 def test_each_rough_pad_starts_from_and_reports_its_own_heat_partition(tmp_path):
     """Two rough pads on tracks of their own (effusivity shares 0.0057 and 0.0078): each pad's
     zones take their interface's share, as the interface field does (before: every zone the first

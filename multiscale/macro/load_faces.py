@@ -10,6 +10,7 @@ from __future__ import annotations
 import numpy as np
 from mpi4py import MPI
 
+from multiscale.errors import InputError
 from multiscale.macro.mesh import TwoBodyMesh
 
 # A fluid pressure on a face whose normals (nearly) cancel, a cylinder's wall, has no resultant: the
@@ -17,6 +18,17 @@ from multiscale.macro.mesh import TwoBodyMesh
 # meshed at 15 mm: 0.5 %, which the contact then carried). Below this share of the area it counts as
 # 0 (a dome has 0.5, a cone of 3 degrees half-angle 0.05).
 NO_RESULTANT = 0.05
+
+
+def check_load_faces(tm: TwoBodyMesh) -> None:
+    """InputError, on every rank, naming a load face with facets between two parts (a pad bonded to
+    its backplate), which carry no load (before: their share of a force went to the other load
+    faces, said only by a pad carrying no force after the run; a user trial)."""
+    for f in tm.spec.load_faces:
+        inner = tm.inner_facets(f)
+        if inner:
+            raise InputError("loading.faces", f, f"{inner} of its facets lie between two parts (bonded), where no "
+                             "load acts; name outer faces only (the back of a backplate)")
 
 
 def load_face_areas(tm: TwoBodyMesh, load_kind: str) -> dict:

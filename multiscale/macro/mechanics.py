@@ -32,7 +32,7 @@ from multiscale.macro.interface import ContactInterface, PressureLaw
 from multiscale.macro.kept_cells import (Closed, KeptCells, SolverOptionWarning, assemble, backtracking, check_user_options,
                                          destroy, integrals, jacobian, nonlinear_problem, options_named,
                                          user_options)
-from multiscale.macro.load_faces import load_face_areas
+from multiscale.macro.load_faces import check_load_faces, load_face_areas
 from multiscale.macro.materials import body_expressions
 from multiscale.macro.mesh import TwoBodyMesh
 
@@ -161,6 +161,7 @@ class Mechanics:
         F = [ufl.inner(self.stress(i), ufl.sym(ufl.grad(v[i]))) * self.dx(i) for i in range(2)]
         Fc = self.contact.residuals(*v)
         F = [F[i] + Fc[i] for i in range(2)]
+        check_load_faces(tm)
         for name in tm.spec.load_faces:
             i = tm.body_of_face(name)
             F[i] -= ufl.dot(self.traction(), v[i]) * tm.ds(tm.face(name))

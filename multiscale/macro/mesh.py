@@ -370,6 +370,15 @@ class TwoBodyMesh:
         n = vector_areas(x)
         return np.where((((inside - x[:, 0]) * n).sum(axis=1) > 0)[:, None], -n, n)
 
+    def inner_facets(self, name: str) -> int:
+        """Number of the named face's facets between two cells (bonded parts; no ``ds`` sees them),
+        over every rank (collective)."""
+        m, tdim = self.parent, self.parent.topology.dim
+        facets = self.facet_tags.find(self.face(name))
+        count = _attached_cells(m.topology.connectivity(tdim - 1, tdim), facets[facets < m.topology.index_map(
+            tdim - 1).size_local])[0]
+        return self.comm.allreduce(int((count == 2).sum()), op=MPI.SUM)
+
     def body_of_face(self, name: str) -> int:
         """Index of the body that holds the named (load) face; a face on no body's surface (an
         interface, a face between two parts, or one another surface of the scene already names)
