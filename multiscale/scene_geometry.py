@@ -223,7 +223,7 @@ class Geometry:
 
     @property
     def surfaces(self) -> tuple[str, ...]:
-        """Names a boundary condition or a load can use: the named faces and "free:<body or region>"."""
+        """Names a boundary condition or a load can use: the named faces and "free:<region or body>"."""
         return tuple(self.spec.faces) + tuple(f"free:{n}" for n in dict.fromkeys(self.bodies + self.regions))
 
 

@@ -216,8 +216,8 @@ _COMPONENTS = {"x": 0, "y": 1, "z": 2}
 @dataclass(frozen=True)
 class Boundary:
     """[[boundary]]: conditions on named surfaces of the geometry (a builder's faces, the file's
-    physical surfaces or [geometry.surfaces]; "free:<body>": a body's surfaces that touch nothing
-    else, its symmetry planes left out). ``fix``: displacement components held at zero (with the
+    physical surfaces or [geometry.surfaces]; "free:<part or body>": a part's (a body's) surfaces that
+    touch nothing else, its symmetry planes left out; a part's name before a body's). ``fix``: displacement components held at zero (with the
     interfaces' normals, friction holding nothing, they must hold every part against its six rigid
     motions: ``macro.held``); ``convection`` h [W/(m^2 K)], constant or a table against the rotating
     body's speed [rad/s], towards ``ambient``; ``emissivity``: radiation eps sigma (T^4 -

@@ -485,6 +485,22 @@ fields = []
 """
 
 
+def test_free_names_a_part_before_its_body():
+    """The pin-on-disc's body "pin" holds the parts pin, housing and plate: "free:pin" is the pin's
+    free surface, its 4 sides out of the sleeve, 4 x 20 mm x 5 mm (before: the whole body's, 30 times
+    that, so a convection meant for the pin took 56.7 J where 2.2 J; a user trial), "free:housing"
+    the sleeve's sides and the ring below the plate."""
+    import ufl
+
+    from multiscale.scene import load
+    from multiscale.workflows.model import build_mesh
+    tm = build_mesh(load(Path(__file__).resolve().parents[1] / "demos" / "pin_on_disc_perfect.toml",
+                         {"geometry.mesh_size": "20 mm"}))
+    area = {n: tm.assemble_scalar(ufl.as_ufl(1.0) * tm.surface(f"free:{n}")) for n in ("pin", "housing")}
+    assert area["pin"] == pytest.approx(4 * 0.02 * 0.005, rel=1e-12)
+    assert area["housing"] == pytest.approx(4 * 0.032 * 0.01 + 0.032**2 - 0.02**2, rel=1e-12)
+
+
 @pytest.mark.parametrize("disc_c", ["", 'rho = "7000 kg/m^3"\nc = [["20 degC", 460], ["50 degC", 500], '
                                     '["55 degC", 3000], ["60 degC", 500], ["400 degC", 610]]\n'])
 def test_energy_balance_of_a_stop(tmp_path, disc_c):

@@ -332,17 +332,18 @@ class TwoBodyMesh:
         return self.spec.faces[name]
 
     def surface(self, name: str) -> ufl.Measure:
-        """Boundary measure of a named surface: a named face (``ds(tag)``), or "free:<body or
-        region>", every exterior facet of the parent mesh that bounds that body's cells (the faces
-        that touch nothing else: not the interfaces, not the faces bonded to another part) but its
-        symmetry planes (``GeometrySpec.symmetry``: the model's cut, where nothing leaves)."""
+        """Boundary measure of a named surface: a named face (``ds(tag)``), or "free:<region or body>"
+        (a region first: the pin-on-disc's "free:pin" is its pin, not housing and plate too), every
+        exterior facet bounding its cells (touching nothing else: not the interfaces, not the faces
+        bonded to another part) but its symmetry planes (``GeometrySpec.symmetry``: the model's cut)."""
         if not name.startswith("free:"):
             return self.ds(self.face(name))
         who = name[len("free:"):]
-        tags = [r.tag for b in self.bodies for r in b.spec.regions if who in (b.name, r.name)]
+        tags = [r.tag for b in self.bodies for r in b.spec.regions if r.name == who] or \
+            [r.tag for b in self.bodies if b.name == who for r in b.spec.regions]
         if not tags:
             known = [b.name for b in self.bodies] + [r.name for b in self.bodies for r in b.spec.regions]
-            raise InputError("surfaces", name, f"free:<body or region>, one of {', '.join(dict.fromkeys(known))}")
+            raise InputError("surfaces", name, f"free:<region or body>, one of {', '.join(dict.fromkeys(known))}")
         tdim = self.parent.topology.dim
         facets = dmesh.exterior_facet_indices(self.parent.topology)
         cells = _attached_cells(self.parent.topology.connectivity(tdim - 1, tdim), facets)[1]

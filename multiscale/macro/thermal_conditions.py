@@ -18,7 +18,7 @@ from multiscale.macro.mesh import TwoBodyMesh
 @dataclass(frozen=True)
 class ThermalBoundary:
     """A thermal condition on named surfaces (``TwoBodyMesh.surface`` names: a face, or
-    "free:<body or region>"), on every body that holds some of their exterior facets.
+    "free:<region or body>"), on every body that holds some of their exterior facets.
 
     ``convection``: h [W/(m^2 K)], a constant or a callable h(speed) of the rotating body's speed
     [rad/s]; ``emissivity``: eps in (0, 1], radiation eps sigma (T^4 − T_a^4); ``ambient``: T_a [K]
