@@ -158,6 +158,21 @@ def test_a_mode_cap_on_the_quadratic_path_keeps_both_members_of_the_lock_in_pair
         np.testing.assert_allclose(q.eigenvalues, ref[:22], rtol=1e-9)
     q = eigen.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_max=1e3, n_modes=20)
     np.testing.assert_allclose(q.eigenvalues, ref[:20], rtol=1e-9)
+    C[28, 29], C[29, 28] = 0.05, -0.05               # a gyroscopic term splits the pair's frequency by 4e-5
+    ref = dense_quadratic(K, C, M)                  # (the brake's: 1.3e-5; the cap kept only its stable member)
+    assert 1e-5 < ref[21].imag / ref[20].imag - 1 < eigen.PAIR_RTOL and ref[21].real > 0 > ref[20].real
+    q = eigen.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_max=1e3, n_modes=21, target=100.0)
+    assert len(q) == 22 and q.unstable().sum() == 1
+    np.testing.assert_allclose(q.eigenvalues, ref[:22], rtol=1e-9)
+
+
+def test_a_mode_cap_on_a_reduced_damped_system_keeps_a_split_pair():
+    """damped.select: a cap of 3 ending in a pair split by damping (2e-5 of its frequency) keeps
+    both members (before: within 1e-8 only, so the unstable member went)."""
+    from multiscale.macro.damped import select
+    lam = np.array([-1 + 100j, -1 + 200j, -5 + 300j, 5 + 300.006j]) * 2 * np.pi
+    np.testing.assert_array_equal(select(lam, (0.0, 1e3), 3, 0.0), [0, 1, 2, 3])
+    np.testing.assert_array_equal(select(lam, (0.0, 1e3), 2, 0.0), [0, 1])
 
 
 def test_proportional_damping_mapping_matches_companion_form_and_pep():

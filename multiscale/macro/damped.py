@@ -65,8 +65,8 @@ from petsc4py import PETSc
 from multiscale.errors import InputError
 from multiscale.macro.block_lanczos import ShiftInvert, m_orthonormalise, symmetric_modes
 from multiscale.macro.dense import block_solve, mat_mult
-from multiscale.macro.eigen import (TWO_PI, Damping, ModalResult, by_frequency, lambda_from_theta, matrix_comm,
-                                    reduce_sum, shift_invert_modes, solve_modes, solve_quadratic)
+from multiscale.macro.eigen import (PAIR_RTOL, TWO_PI, Damping, ModalResult, by_frequency, lambda_from_theta,
+                                    matrix_comm, reduce_sum, shift_invert_modes, solve_modes, solve_quadratic)
 from multiscale.macro.modal import mac_matrix, pair_modes
 
 METHODS = ("auto", "projection", "quadratic", "subspace")
@@ -175,13 +175,14 @@ class ReducedSystem:
 
 def select(lam: np.ndarray, band, n_modes: int | None, target: float) -> np.ndarray:
     """Indices of the eigenvalues in the band (the ``n_modes`` nearest ``target`` [Hz], and those as
-    near as the last to 1e-8 relative: a lock-in pair, sigma +-, is never cut in two), by frequency."""
+    near as the last to ``PAIR_RTOL`` of its frequency: a lock-in pair, sigma +-, split by damping,
+    is never cut in two), by frequency."""
     f = lam.imag / TWO_PI
     idx = np.nonzero((f >= band[0]) & (f <= band[1]))[0]
     if n_modes is not None and idx.size > n_modes:
         gap = np.abs(f[idx] - target)
         cut = np.sort(gap)[n_modes - 1]
-        idx = idx[gap <= cut + 1e-8 * (cut + abs(target))]
+        idx = idx[gap <= cut + PAIR_RTOL * (cut + abs(target))]
     return idx[by_frequency(lam[idx])]
 
 
