@@ -84,6 +84,13 @@ class Sweep:
             return [f'{path}.preload = "once": a {name} sweep changes the preloaded state; use "each"']
         if name == "friction" and ("friction_curve" in loading or "stribeck" in loading):
             return [f"{where}: sets a constant friction; remove loading.friction_curve / loading.stribeck"]
+        if name == "friction" and "friction" not in ctx.effects:     # (the map had friction, the analysis none)
+            return [f'{where}: sweeps the friction of effect "friction", which the scene does not have']
+        own = [n for n, t in (ctx.root.get("interfaces") or {}).items() if isinstance(t, dict) and "friction" in t]
+        if name == "friction" and own:
+            given = ", ".join(f"interfaces.{n}.friction" for n in own)
+            ctx.warnings.append(f"{where}: sets every interface's friction, {given} too: no point of the map is "
+                                "the scene's analysis")
         if name == "pressure" and "pressure" not in loading:
             return [f"{where}: sweeps loading.pressure; the scene gives no loading.pressure"]
         if name == "speed" and "sliding_speed" in loading:

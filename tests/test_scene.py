@@ -1152,6 +1152,20 @@ def test_a_sweep_without_a_valid_parameter_is_a_problem_not_a_traceback(sweep, f
     assert all(p.startswith("stability.sweep") for p in info.value.problems), info.value.problems
 
 
+def test_a_friction_sweep_needs_the_friction_it_sweeps_and_says_it_overrides_the_pads_own():
+    """A friction map of a scene without effect "friction" (its analysis frictionless, its map with
+    mu: 1 unstable somewhere against 0) is refused; over an interface's own mu it is said that no
+    point of the map is the analysis (user trials)."""
+    text = (DEMOS / "brake_squeal.toml").read_text() + "\n[stability.sweep]\nfriction = [0.1, 0.4]\n"
+    with pytest.raises(SceneError, match=r'^stability.sweep.friction: sweeps the friction of effect "friction", which '
+                                         "the scene does not have"):
+        loads(text, name="brake", overrides={"effects": ["contact", "stability"]})
+    own = loads(text, name="brake", overrides={"interfaces.inner_pad.friction": 0.1}).warnings
+    assert ("stability.sweep.friction: sets every interface's friction, interfaces.inner_pad.friction too: no point "
+            "of the map is the scene's analysis") in own
+    assert not [w for w in loads(text, name="brake").warnings if "every interface's friction" in w]
+
+
 def test_a_support_that_would_take_the_load_is_refused_when_read():
     """A block held along z on its loaded top face: check said OK and the run stopped after its
     first solve ("the contact carries 0 N ...", a user trial). The scene refuses it now; a support
