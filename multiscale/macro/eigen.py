@@ -396,10 +396,13 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
 
     Real arithmetic cannot shift at i omega; the shift is the real rate s = 2 pi target [1/s]
     (K + s C + s^2 M is non-singular for s > 0 even for a free-free structure) and eigenvalues
-    converge in order of |lambda - s|, i.e. by frequency for light damping. ``n_modes`` counts
-    modes with omega >= 0 (conjugate pairs are computed together; at most ``n_modes`` in the band,
-    the nearest s, are returned, and the other member of a lock-in pair at one frequency that the
-    cap ends in, as ``solve_modes`` keeps it); ``n_modes=None`` asks for the
+    converge in order of |lambda - s|, i.e. by frequency for light damping, from the lowest: a
+    target or a band's lower edge does not reach the modes above the lowest ``n_modes`` (growing
+    the subspace to reach them gave unconverged ones, residuals 1e-4, one marked unstable: an open
+    defect, docs/squeal.md). ``n_modes`` counts modes with omega >= 0 (conjugate pairs are
+    computed together; at most ``n_modes`` in the band, the nearest s, are returned, and the
+    other member of a lock-in pair that the cap ends in, as ``solve_modes`` keeps it);
+    ``n_modes=None`` asks for the
     whole band: the subspace grows until a converged |lambda - s| exceeds |i 2 pi f_max - s|.
     The result is filtered to the band. ``theta`` is reported as -lambda^2.
     """
