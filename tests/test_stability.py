@@ -164,6 +164,9 @@ def test_a_mode_cap_on_the_quadratic_path_keeps_both_members_of_the_lock_in_pair
     q = eigen.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_max=1e3, n_modes=21, target=100.0)
     assert len(q) == 22 and q.unstable().sum() == 1
     np.testing.assert_allclose(q.eigenvalues, ref[:22], rtol=1e-9)
+    with pytest.raises(InputError, match=r"^stability.modes = 3: the quadratic solver finds the lowest modes first: "
+                                         r"its lowest reach 39.99\d+ Hz, below the band's 150 Hz"):   # (an open limit)
+        eigen.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_min=150.0, f_max=1e3, n_modes=3)
 
 
 def test_a_mode_cap_on_a_reduced_damped_system_keeps_a_split_pair():
