@@ -56,6 +56,8 @@ def summary(scene: Scene) -> list[str]:
                f"a drag at {v.speed * 3.6:g} km/h") + f" (wheel radius {v.wheel_radius * 1e3:g} mm)"
               if v is not None else f"{ld.sliding_speed:g} m/s" if ld.sliding_speed is not None else "no sliding")
     where = f" on {', '.join(ld.faces)}" if ld.faces else ""
+    if ld.normal_force is not None and ld.faces and len(ld.faces) > 1:   # (read as each pad's clamp force)
+        where = f" in all on {', '.join(ld.faces)}, shared by their areas"
     profile = f", load profile of {len(ld.load_profile)} points" if ld.load_profile else ""
     lines.append(f"  loading   {load_text}{where}, {motion}{profile}, {ld.ramp_steps} ramp step(s)")
     end = scene.time.end if scene.has("thermal") or scene.has("wear") else None

@@ -435,6 +435,12 @@ def test_check_says_what_the_builders_sizes_mean():
     lines = summary(load(DEMOS / "pin_on_disc.toml", overrides={"geometry.pin_size": "10 mm"}))
     assert "            a square pin of side pin_size = 10 mm at track_radius = 90 mm on a disc of 12.5 to 107.5 mm, " \
            "10 mm thick" in lines
+    text = (DEMOS / "car_brake_stop.toml").read_text().replace(
+        '[loading.vehicle]\nspeed = "100 km/h"\ndeceleration = "0.6 gn"\nwheel_radius = "310 mm"\nmass = "525 kg"',
+        'normal_force = "5000 N"\nrotation_speed = "800 rpm"\n#')
+    clamp = summary(loads(text, DEMOS))
+    assert any(line.startswith("  loading   5000 N in all on piston, fingers, shared by their areas, ")
+               for line in clamp)          # (read as each pad's clamp force: half the load meant; a user trial)
 
 
 def test_alternatives_given_together_are_one_problem(tmp_path):
