@@ -668,6 +668,8 @@ def test_a_heated_layer_thinner_than_the_interfaces_elements_is_warned_about(tmp
                       "estimate); an interface_mesh_size of 0.81 mm or less resolves them"]
     finer = pod.replace('interface_mesh_size = "2.5 mm"', 'interface_mesh_size = "0.8 mm"')
     assert not [w for w in loads(finer, tmp_path).warnings if "reaches about" in w]
+    near = pod.replace('interface_mesh_size = "2.5 mm"', 'interface_mesh_size = "1.7 mm"')   # 95 % of the rise
+    assert not [w for w in loads(near, tmp_path).warnings if "reaches about" in w]        # (it was warned)
     cold = pod.replace('"thermal", "heat_partition", "expansion"', '"thermal"')     # no frictional heat
     assert not [w for w in loads(cold, tmp_path).warnings if "reaches about" in w]
 
