@@ -113,7 +113,7 @@ class Material:
         if self.hardness is not None and "plasticity" not in ctx.effects:
             ctx.warnings.append(f'{path}.hardness is ignored: effect "plasticity" is not in effects (the asperities '
                                 "stay elastic)")
-        tables = [k for k in self.STRAIN if self.tabulated(k)]
+        tables = [k for k in self.STRAIN if self.tabulated(k) and k != "alpha"]   # (alpha: ignored, said)
         if tables and "thermal" in ctx.effects and "expansion" not in ctx.effects:
             ctx.warnings.append(f'{path}.{tables[0]} depends on the temperature, but without effect "expansion" the '
                                 "mechanics takes it at the initial temperature (add \"expansion\" to follow the "

@@ -976,6 +976,11 @@ def test_a_strain_table_without_expansion_is_said_to_be_read_at_the_start(tmp_pa
     scene = loads(text, tmp_path)
     assert ('materials.block.E depends on the temperature, but without effect "expansion" the mechanics takes it '
             'at the initial temperature (add "expansion" to follow the temperatures)') in scene.warnings
+    assert 'alpha = "10e-6 1/K"' in text
+    alpha = loads(text.replace('alpha = "10e-6 1/K"', 'alpha = [["20 degC", "1e-5 1/K"], ["60 degC", "2e-5 1/K"]]', 1),
+                  tmp_path).warnings        # ignored without expansion, said once (it was also "taken at T0")
+    assert [w for w in alpha if w.startswith("materials.block.alpha")] == [
+        'materials.block.alpha is ignored: effect "expansion" is not in effects']
     hot = History()
     hot.append(time=0.0, max_temperature_block=293.15, max_temperature_flat=293.15)
     hot.append(time=1.0, max_temperature_block=400.0, max_temperature_flat=300.0)
