@@ -163,10 +163,10 @@ def zone_sizes(scene) -> list[str]:
         zone, facet = grid.size[0] * grid.size[1], FACET_AREA * h ** 2
         if zone < facet:
             fit = grid.counts_for(facet)
-            out.append(f"{micro_key(scene, name)}.zones = {list(s.micro.zones)}: zones of {zone * 1e6:.3g} mm^2 on interface {name} are "
-                       f"likely smaller than its facets (about {facet * 1e6:.3g} mm^2 for elements of {h * 1e3:.3g} "
-                       "mm), which the run refuses after meshing (a facet loads only the zone holding its midpoint); "
-                       f"use at most {fit[0]} x {fit[1]} zones or a finer interface mesh")
+            out.append(f"{micro_key(scene, name)}.zones = {list(s.micro.zones)}: zones of {zone * 1e6:.3g} mm^2 on "
+                       f"interface {name} are likely smaller than its facets (about {facet * 1e6:.3g} mm^2 for "
+                       f"elements of {h * 1e3:.3g} mm), which the run refuses after meshing (a facet loads only the "
+                       f"zone holding its midpoint); use at most {fit[0]} x {fit[1]} zones or a finer interface mesh")
     return out
 
 

@@ -216,13 +216,13 @@ _COMPONENTS = {"x": 0, "y": 1, "z": 2}
 @dataclass(frozen=True)
 class Boundary:
     """[[boundary]]: conditions on named surfaces of the geometry (a builder's faces, the file's
-    physical surfaces or [geometry.surfaces]; "free:<part or body>": a part's (a body's) surfaces that
-    touch nothing else, its symmetry planes left out; a part's name before a body's). ``fix``: displacement components held at zero (with the
-    interfaces' normals, friction holding nothing, they must hold every part against its six rigid
-    motions: ``macro.held``); ``convection`` h [W/(m^2 K)], constant or a table against the rotating
-    body's speed [rad/s], towards ``ambient``; ``emissivity``: radiation eps sigma (T^4 -
-    T_ambient^4); ``temperature``: fixed. A face named in one entry takes its kinds of condition
-    instead of a "free:" surface's of another; two of one kind on a face are refused otherwise."""
+    physical surfaces or [geometry.surfaces]; "free:<part or body>": its surfaces that touch nothing
+    else, symmetry planes left out, a part's name before a body's). ``fix``: displacement components
+    held at zero (with the interfaces' normals, friction holding nothing, they must hold every part
+    against its six rigid motions: ``macro.held``); ``convection`` h [W/(m^2 K)], constant or a table
+    against the rotating body's speed [rad/s], towards ``ambient``; ``emissivity``: radiation eps
+    sigma (T^4 - T_ambient^4); ``temperature``: fixed. A face named in one entry takes its kinds of
+    condition instead of a "free:" surface's of another; two of one kind on a face are refused otherwise."""
 
     surfaces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), required=True)
     fix: tuple | None = key(ListOf(Choice(_COMPONENTS), unique=True, min_len=1), absent="no component held here")
