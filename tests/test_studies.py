@@ -584,6 +584,12 @@ loading.friction = [0.3, 0.4]
     assert ('metrics item 2 ("max_growthh"): unknown metric of a squeal scene (did you mean "max_growth"?); '
             "allowed: modes, unstable_modes, max_growth") in err
     assert not (tmp_path / "results").exists()
+    base = (ROOT / "demos" / "brake_squeal.toml").read_text().replace('"friction", "stability"]', '"friction"]')
+    (tmp_path / "base.toml").write_text(base.replace('"../results/', '"results/'))   # (no effect stability)
+    fixed = write(tmp_path, f'problem = "scene"\nscene = "{tmp_path / "base.toml"}"\nmetrics = ["max_grwth"]\n'
+                  '[fixed]\neffects = ["contact", "friction", "stability"]\n[sweep]\nloading.friction = [0.3, 0.4]\n')
+    assert main(["study", str(fixed)]) == 2           # [fixed] makes it a squeal scene (it ran, then failed)
+    assert 'metrics item 1 ("max_grwth"): unknown metric of a squeal scene' in capsys.readouterr().err
 
 
 def test_a_scene_study_run_is_named_by_the_files_its_scene_reads(tmp_path):

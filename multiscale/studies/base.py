@@ -47,9 +47,9 @@ class Problem:
         """The unit of metric ``name`` (``unit_in`` its description), "" if unknown."""
         return unit_in(self.metrics.get(name, ""))
 
-    def check_metric(self, name: str, scene=None) -> str | None:
-        """None if ``name`` is a metric of this problem (of its ``scene`` file, for problem
-        "scene"), else the problem (one line)."""
+    def check_metric(self, name: str, scene=None, fixed=None) -> str | None:
+        """None if ``name`` is a metric of this problem (of its ``scene`` file with the study's
+        ``fixed`` keys, for problem "scene"), else the problem (one line)."""
         if name in self.metrics:
             return None
         return f'unknown metric of problem "{self.name}"{suggest(name, self.metrics)}; allowed: ' \

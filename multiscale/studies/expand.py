@@ -88,7 +88,7 @@ def load_study(path) -> Study:
         raise SceneError(ctx.problems)        # nothing to check the rest against; else every problem at once
     problem = PROBLEMS[f.problem]
     for i, name in enumerate(f.metrics or (), 1):
-        why = problem.check_metric(name, f.scene)
+        why = problem.check_metric(name, f.scene, dict(f.fixed))
         if why:
             ctx.problems.append(f"metrics item {i} ({show(name)}): {why}")
     before = len(ctx.problems)

@@ -57,10 +57,11 @@ def squeal_metrics(modes_csv) -> dict:
             "min_damping_ratio": float(table["damping_ratio"].min())}
 
 
-def _squeal(scene) -> bool:
-    """Whether a scene file runs the squeal analysis (False if it cannot be read: said elsewhere)."""
+def _squeal(scene, fixed=None) -> bool:
+    """Whether a scene file, with a study's ``fixed`` keys, runs the squeal analysis (False if it
+    cannot be read: said elsewhere)."""
     try:
-        return load(scene).has("stability")
+        return load(scene, fixed or None).has("stability")
     except MultiscaleError:
         return False
 
@@ -113,8 +114,9 @@ class SceneProblem(Problem):
             return unit_in(SQUEAL_METRICS[name])
         return unit_of(name.partition(":")[0])
 
-    def check_metric(self, name, scene=None):
-        if scene is not None and _squeal(scene):       # its metrics are known before it runs
+    def check_metric(self, name, scene=None, fixed=None):
+        if scene is not None and _squeal(scene, fixed):    # its metrics are known before it runs (with [fixed]:
+            #                                                a base scene that [fixed] makes a squeal one was not)
             return None if name in SQUEAL_METRICS else \
                 f'unknown metric of a squeal scene{suggest(name, SQUEAL_METRICS)}; allowed: {", ".join(SQUEAL_METRICS)}'
         column, _, reducer = name.partition(":")
