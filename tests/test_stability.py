@@ -169,6 +169,15 @@ def test_a_mode_cap_on_the_quadratic_path_keeps_both_members_of_the_lock_in_pair
         eigen.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_min=150.0, f_max=1e3, n_modes=3)
 
 
+def test_overdamped_roots_are_not_potentially_unstable():
+    """Three overdamped roots at 0 Hz (heavy Rayleigh beta) and a close stable pair at 1000 and
+    1000.5 Hz: only the pair is potentially unstable (the roots were too: one frequency)."""
+    from types import SimpleNamespace
+    f, sigma = np.array([0.0, 0.0, 0.0, 1000.0, 1000.5]), np.array([-5e3, -2e3, -1e3, -1.0, -1.0])
+    result = SimpleNamespace(frequency=f, growth=sigma, unstable=lambda rtol: sigma > 0)
+    np.testing.assert_array_equal(modal.stability_report(result).potentially_unstable, [4, 5])
+
+
 def test_a_mode_cap_on_a_reduced_damped_system_keeps_a_split_pair():
     """damped.select: a cap of 3 ending in a pair split by damping (2e-5 of its frequency) keeps
     both members (before: within 1e-8 only, so the unstable member went)."""

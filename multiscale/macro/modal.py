@@ -60,7 +60,8 @@ def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float =
 
     A stable mode is potentially unstable when a neighbouring stable mode lies within
     ``close_tol`` relative frequency: the pair is close to coalescence but not yet locked in
-    (``close_tol`` 0: none, as without friction, where nothing couples two modes).
+    (``close_tol`` 0: none, as without friction, where nothing couples two modes). Overdamped roots
+    (0 Hz) do not oscillate and pair with nothing (five of them were flagged; a user trial).
     """
     check_positive("rtol", rtol)
     check_positive("close_tol", close_tol, allow_zero=True)
@@ -69,7 +70,7 @@ def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float =
     close = np.zeros(f.size, bool)
     if f.size > 1 and close_tol > 0:
         gap = np.diff(f) <= close_tol * np.maximum(f[1:], np.finfo(float).tiny)
-        both_stable = ~bad[1:] & ~bad[:-1]
+        both_stable = ~bad[1:] & ~bad[:-1] & (f[:-1] > 0)
         pair = gap & both_stable
         close[1:] |= pair
         close[:-1] |= pair
