@@ -38,9 +38,9 @@ def failure_line(output: str) -> str:
 
 SQUEAL_METRICS = {
     "modes": "number of complex modes found in the band [-]",
-    "unstable_modes": "modes with a positive real part (growth rate) [-]",
+    "unstable_modes": "modes flagged unstable in modes.csv: damping ratio below -stability.threshold [-]",
     "max_growth": "largest real part sigma of the eigenvalues [1/s]",
-    "max_growth_frequency": "frequency of the mode with the largest real part [Hz]",
+    "max_growth_frequency": "frequency of the mode with the largest real part, the lowest of a tie [Hz]",
     "lowest_unstable_frequency": "frequency of the lowest unstable mode, 0 if none [Hz]",
     "min_damping_ratio": "smallest damping ratio (negative: unstable) [-]",
 }
