@@ -159,7 +159,8 @@ def plan(scene) -> Plan:
             files["prestress.csv"] = "frequency of every mode with and without the prestress stiffness"
         if scene.stability.sweep is not None:
             files.update({"map.csv": "every mode at every point of the sweep (frequency, growth rate, track)",
-                          "onsets.csv": "the bracketed parameter at which each track turns unstable",
+                          **({"onsets.csv": "the bracketed parameter at which each track turns unstable"}
+                             if scene.stability.sweep.onsets else {}),
                           "map.h5": "the stability map's arrays", "map.png": "growth rate against frequency of "
                           "every mode, coloured by the swept value",
                           "map_tracks.png": "frequency and growth rate of each tracked mode against the swept value"})

@@ -471,6 +471,8 @@ def test_a_pressure_beyond_small_strains_is_warned_about_also_at_a_map_point(tmp
     nominal = run.case.facet_pressure.max()
     assert nominal < 0.02 * 5e9 < run.map.max_pressure
     assert run.map.max_pressure == pytest.approx(100 * nominal, rel=1e-6)
+    written = {p.name for p in (tmp_path / "out").iterdir()}       # onsets = false: no header-only onsets.csv
+    assert "map.csv" in written and "onsets.csv" not in written  # (read as "no track turns unstable")
     strained = [w for w in run.warnings if w.startswith("the contact pressure reached")]
     assert strained == [f"the contact pressure reached {run.map.max_pressure:.3g} Pa, "
                         f"{100 * run.map.max_pressure / 5e9:.2g} % of the softer side's E (5e+09 Pa): beyond the small "

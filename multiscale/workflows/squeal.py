@@ -337,7 +337,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
                                                 case.preload.pressure,         # (scaled to a braking torque)
                                                 lambda changed: build_squeal_mechanics(changed, tm, degree=degree,
                                                                                        prefix="squeal_map_"))
-                files += squeal_map.write(smap, folder, comm, scene.output.figures)
+                files += squeal_map.write(smap, folder, comm, scene.output.figures, scene.stability.sweep.onsets)
         case.mech.close()                # on every rank in the same order (MUMPS' destruction communicates)
     result = SquealResult(folder, files, time.perf_counter() - t0, case, smap,
                           warnings=tuple(_left_out(scene, case, smap)))   # what the results leave out or approximate

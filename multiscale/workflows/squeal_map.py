@@ -171,12 +171,13 @@ def _per_point(model: MapModel, builder: MapBuilder, st, options) -> int:
     return 0
 
 
-def write(smap: StabilityMap, folder, comm=MPI.COMM_WORLD, figures: bool = True) -> list[Path]:
-    """The map's tables and, with ``figures``, its figures (rank 0 writes, the list is empty
-    elsewhere; a failed write is an OutputError on every rank)."""
+def write(smap: StabilityMap, folder, comm=MPI.COMM_WORLD, figures: bool = True, onsets: bool = True) -> list[Path]:
+    """The map's tables (``onsets.csv`` only with ``onsets``: without, its header alone read as "no
+    track turns unstable"; a user trial) and, with ``figures``, its figures (rank 0 writes, the
+    list is empty elsewhere; a failed write is an OutputError on every rank)."""
     folder = Path(folder)
     return io.on_root(comm, lambda: [
-        smap.write_csv(folder / "map.csv"), smap.write_onsets_csv(folder / "onsets.csv"),
+        smap.write_csv(folder / "map.csv"), *([smap.write_onsets_csv(folder / "onsets.csv")] if onsets else []),
         smap.write_h5(folder / "map.h5")]
         + ([plot_map(smap, folder / "map.png"), plot_tracks(smap, folder / "map_tracks.png")] if figures else []),
         f"the stability map in {folder}") or []
