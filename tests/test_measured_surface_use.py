@@ -28,7 +28,7 @@ ROOT = Path(__file__).resolve().parents[1]
 DATA = ROOT / "tests" / "data"
 TOP = DATA / "top-1.top"
 SCENE = (ROOT / "demos" / "block_on_flat.toml").read_text().replace(
-    'effects = ["contact"]', 'effects = ["contact", "roughness"]') + """
+    'effects = ["contact"]', 'effects = ["contact", "roughness"]').replace('penalty = "1e13 Pa/m"', "") + """
 [roughness]
 body = "block"
 {roughness}

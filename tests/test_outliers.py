@@ -141,7 +141,7 @@ def test_surface_command_warns_and_removes_with_despike(tmp_path, capsys):
 
 
 SCENE = (ROOT / "demos" / "block_on_flat.toml").read_text().replace(
-    'effects = ["contact"]', 'effects = ["contact", "roughness"]') + """
+    'effects = ["contact"]', 'effects = ["contact", "roughness"]').replace('penalty = "1e13 Pa/m"', "") + """
 [roughness]
 body = "block"
 file = "spiky.npy"
