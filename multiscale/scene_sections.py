@@ -134,13 +134,13 @@ class Material:
 
     def beyond(self, T: float) -> dict[str, str]:
         """The tables (E, ..., hardness, k_w) that the temperature T [K] leaves, each with a phrase:
-        {"kappa": "kappa: 300 degC above its last point 250 degC, held at 6 there"}."""
+        {"kappa": "kappa: at 300 degC, above its last point 250 degC, held at 6 there"}."""
         out = {}
         for name in (*self.PROPERTIES, "k_w"):
             table = getattr(self, name)
             if isinstance(table, tuple) and not table[0][0] <= T <= table[-1][0]:
                 (end, y), side = (table[0], "below its first") if T < table[0][0] else (table[-1], "above its last")
-                out[name] = f"{name}: {T - 273.15:.4g} degC {side} point {end - 273.15:.4g} degC, held at {y:.4g} there"
+                out[name] = f"{name}: at {T - 273.15:.4g} degC, {side} point {end - 273.15:.4g} degC, held at {y:.4g} there"
         return out
 
     @property

@@ -192,13 +192,13 @@ def test_temperatures_beyond_a_material_table_are_warned_about(tmp_path, capsys)
         'kappa = "35 W/(m K)"', 'kappa = [["20 degC", "35 W/(m K)"], ["20.5 degC", "35 W/(m K)"]]').replace(
         'alpha = "1e-5 1/K"', 'alpha = [["-50 degC", "1e-5 1/K"], ["0 degC", "1e-5 1/K"]]')
     scene = loads(text)
-    assert scene.warnings == ("materials.disc.alpha: 20 degC above its last point 0 degC, held at 1e-05 there "
+    assert scene.warnings == ("materials.disc.alpha: at 20 degC, above its last point 0 degC, held at 1e-05 there "
                               "(the initial temperature)",)
     result = run(scene, verbose=False)
     hottest = max(result.history["max_temperature_pin"]) - 273.15
     assert hottest > 20.5
     record = json.loads((result.folder / "provenance.json").read_text())
-    assert record["warnings"] == [*scene.warnings, f"materials.pin.kappa: {hottest:.4g} degC above its last point "
+    assert record["warnings"] == [*scene.warnings, f"materials.pin.kappa: at {hottest:.4g} degC, above its last point "
                                   f"20.5 degC, held at 35 there (in body 'pin')"]
     assert list(result.warnings) == record["warnings"]
     assert [line for line in capsys.readouterr().err.splitlines() if "materials." in line] == \
@@ -307,7 +307,7 @@ def test_a_material_table_is_judged_by_the_temperatures_of_its_own_cells(tmp_pat
                      max_temperature_pin_in_disc=293.15 + scale * 193, max_temperature_disc=293.15 + scale * (disc - 20))
         lines = run_warnings(scene, h)
         assert [w for w in lines if "materials.disc.kappa" in w] == (
-            ["materials.disc.kappa: 350 degC above its last point 300 degC, held at 45 there (in body 'disc')"]
+            ["materials.disc.kappa: at 350 degC, above its last point 300 degC, held at 45 there (in body 'disc')"]
             if warned else []), lines
 
 
@@ -421,5 +421,5 @@ def test_a_body_that_cools_below_a_tables_first_point_is_named(tmp_path):
                      max_temperature_pin_in_disc=423.15, min_temperature_pin_in_disc=413.15,
                      max_temperature_disc=423.15, min_temperature_disc=273.15 + T)
         lines = [w for w in run_warnings(scene, h) if "materials.disc.kappa" in w]
-        assert lines == (["materials.disc.kappa: 60 degC below its first point 100 degC, held at 50 there "
+        assert lines == (["materials.disc.kappa: at 60 degC, below its first point 100 degC, held at 50 there "
                           "(in body 'disc')"] if warned else []), lines

@@ -987,7 +987,7 @@ def test_a_strain_table_without_expansion_is_said_to_be_read_at_the_start(tmp_pa
     assert run_warnings(scene, hot) == []
     coupled = loads(text.replace('"conductance"]', '"conductance", "expansion"]'), tmp_path)
     assert not any("depends on the temperature" in w for w in coupled.warnings)
-    assert run_warnings(coupled, hot) == ["materials.block.E: 126.9 degC above its last point 60 degC, held at "
+    assert run_warnings(coupled, hot) == ["materials.block.E: at 126.9 degC, above its last point 60 degC, held at "
                                           "4e+08 there (in body 'block')"]
 
 
@@ -1101,7 +1101,7 @@ def test_a_wear_table_left_by_the_run_is_warned_about(tmp_path):
                                                       'plausible range')]                   # (as wear.k_w's)
     table = own.replace('k_w = "1e-14 1/Pa"', 'k_w = [["20 degC", "1e-14 1/Pa"], ["400 degC", "2e-14 1/Pa"]]')
     assert run_warnings(loads(table, tmp_path), h) == [        # its table's end: it was not said
-        "materials.pin.k_w: 626.9 degC above its last point 400 degC, held at 2e-14 there (the rough surface's "
+        "materials.pin.k_w: at 626.9 degC, above its last point 400 degC, held at 2e-14 there (the rough surface's "
         "largest micro temperature)"]
     assert not [w for w in loads(own.replace('"20 degC"', '"1 K"'), tmp_path).warnings if w.startswith("wear.")]
     from multiscale.scene_summary import summary
