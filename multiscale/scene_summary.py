@@ -63,7 +63,9 @@ def summary(scene: Scene) -> list[str]:
     end = scene.time.end if scene.has("thermal") or scene.has("wear") else None
     if ld.torque is not None and end and g.motion == "rotation":     # the heat the run must account for
         work = ld.torque * ld.mean_sliding_factor(0.0, end) * end      # torque x load factor x angle, to time.end
-        lines.append(f"            braking work to time.end: {work / 1e3:.6g} kJ (the frictional heat of the run)")
+        heat = "the frictional heat of the run" if scene.has("heat_partition") else \
+            'no heat enters the bodies without effect "heat_partition"'   # (it said both; a user trial)
+        lines.append(f"            braking work to time.end: {work / 1e3:.6g} kJ ({heat})")
     for name in g.spec.interfaces:
         if name in scene.interfaces or len(g.spec.interfaces) > 1:
             s = scene.interface_settings(name)

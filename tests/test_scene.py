@@ -488,6 +488,9 @@ def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_pa
                  + '[loading.vehicle]\nspeed = "36 km/h"\ndeceleration = "1 m/s^2"\nwheel_radius = "300 mm"\n'
                    'mass = "20 kg"\n', tmp_path)
     assert "            braking work to time.end: 1 kJ (the frictional heat of the run)" in summary(stop)
+    cold = loads(torque.replace('"heat_partition", ', ""), tmp_path)
+    assert ('braking work to time.end: 18.8496 kJ (no heat enters the bodies without effect "heat_partition")'
+            in "\n".join(summary(cold)))
     assert to_si("957.6 N m", "torque") == pytest.approx(957.6) and to_si("1 kN*m", "torque") == 1e3
     cases = [(pod.replace('normal_force = "200 N"', 'normal_force = "200 N"\nbraking_torque = "30 N m"'),
               "loading.braking_torque: give the torque or loading.normal_force, not both"),
