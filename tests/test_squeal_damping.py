@@ -314,6 +314,7 @@ def test_map_bisects_the_onset_of_a_lock_in_branch_that_fails_the_mac_test(tmp_p
     smap = build_map("friction", "-", values[3:], results[3:], reduced[3:], (0.0, 1.0))
     assert [(o.kind, o.track) for o in smap.onsets] == [(BELOW, int(np.nanargmax(smap.growth[0])) + 1)]
     assert np.isnan(smap.onsets[0].value) and "below the sweep" in smap.summary()
+    assert {smap.onsets[0].track, smap.onsets[0].partner} == {1, 2}      # its partner, as above (it was none)
     rows = smap.write_onsets_csv(tmp_path / "onsets.csv").read_text().splitlines()
     assert rows[1].split(",")[1] == "" and rows[1].split(",")[6] == "0.6"       # unstable_value
 

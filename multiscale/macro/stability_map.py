@@ -260,9 +260,11 @@ class MapBuilder:
                 here[j], self.n_tracks = self.n_tracks, self.n_tracks + 1
         self.new = set(range(first, self.n_tracks))
         turned = []
-        if self.prev is None:
-            self.onsets += [Onset(here[j] + 1, np.nan, float(result.frequency[j]), None, BELOW, (np.nan, value))
-                            for j in np.nonzero(_unstable(result.eigenvalues, self.rtol))[0]]
+        if self.prev is None:             # (the partner: the nearest in frequency, as above; it was none)
+            for j in np.nonzero(_unstable(result.eigenvalues, self.rtol))[0]:
+                i = _nearest(result.frequency, j)
+                self.onsets.append(Onset(here[j] + 1, np.nan, float(result.frequency[j]),
+                                         None if i is None else here[i] + 1, BELOW, (np.nan, value)))
         else:
             was = {t: bool(_unstable(self.prev.eigenvalues[i:i + 1], self.rtol)[0])
                    for i, t in enumerate(self.rows[-1][0])}
@@ -287,10 +289,8 @@ class MapBuilder:
         if found is None:
             return None
         value, freq, bracket, gap = found
-        others = [i for i in range(len(r)) if i != j]
-        partner, kind = None, "negative damping"
-        if others:
-            i = others[int(np.argmin(np.abs(r.frequency[others] - r.frequency[j])))]
+        i, partner, kind = _nearest(r.frequency, j), None, "negative damping"
+        if i is not None:
             partner = self.rows[-1][0][i] + 1
             before = self.rows[-2][0]
             falling = partner - 1 in before and r.growth[i] < self.rows[-2][3][before.index(partner - 1)]
@@ -343,3 +343,9 @@ def build_map(parameter: str, unit: str, values: Sequence[float], results: Seque
         for track, i, _ in builder.calmed if onsets else ():
             builder.end(track, i, reduced[k - 1], reduced[k], results[k - 1].modes[:, i], result.gram)
     return builder.finish(basis_size=basis_size, time=time)
+
+
+def _nearest(frequency, j: int) -> int | None:
+    """Index of the mode nearest mode ``j`` in frequency, None if it is alone."""
+    others = [i for i in range(len(frequency)) if i != j]
+    return others[int(np.argmin(np.abs(frequency[others] - frequency[j])))] if others else None
