@@ -590,6 +590,10 @@ loading.friction = [0.3, 0.4]
                   '[fixed]\neffects = ["contact", "friction", "stability"]\n[sweep]\nloading.friction = [0.3, 0.4]\n')
     assert main(["study", str(fixed)]) == 2           # [fixed] makes it a squeal scene (it ran, then failed)
     assert 'metrics item 1 ("max_grwth"): unknown metric of a squeal scene' in capsys.readouterr().err
+    folder = scene_study(tmp_path, "brake_squeal.toml", 'metrics = ["max_growth"]\n[fixed]\noutput.folder = "mine"\n'
+                                                        "[sweep]\nloading.friction = [0.3, 0.4]\n")
+    assert main(["study", str(folder)]) == 2           # (it was replaced by the run's own folder without a word)
+    assert "fixed.output.folder: a study writes each run into its own folder" in capsys.readouterr().err
 
 
 def test_a_scene_study_run_is_named_by_the_files_its_scene_reads(tmp_path):

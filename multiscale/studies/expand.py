@@ -131,7 +131,10 @@ def _expand_groups(f: StudyFile, problem, ctx):
     where_of = {}
     for name, value in f.fixed.items():
         where_of[name] = "fixed"
-        if names is not None and name not in names:
+        if f.problem == "scene" and name == "output.folder":      # (it was replaced without a word; a user trial)
+            ctx.problems.append("fixed.output.folder: a study writes each run into its own folder, "
+                                "<study folder>/runs/<run key>/output; remove it")
+        elif names is not None and name not in names:
             ctx.problems.append(f"fixed.{name}: unknown parameter of problem \"{f.problem}\"{suggest(name, names)}; "
                                 f"allowed: {', '.join(names)}")
         elif names is not None:
