@@ -95,7 +95,7 @@ def track_spread(radius, source_radius, volume, half: float) -> np.ndarray:
     return out
 
 
-def check_zone_size(grid, areas, name: str, key: str = "micro.zones") -> None:
+def check_zone_size(grid, areas, name: str, key: str) -> None:
     """Refuse zones smaller than the facets of interface ``name`` (``areas`` [m^2]; ``key``: the scene
     key of its zones, named by the InputError): a facet loads only
     the zone holding its midpoint, with its force over that zone's area, and the zones between hold

@@ -427,7 +427,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         if g is not None and {"friction", "thermal", "heat_partition"} <= effects:
             warnings += short_phases(scene.loading, g.motion, end, scene.time.dt)
             if scene.materials is not None:
-                warnings += thin_heated_layers(scene.loading, g.motion, end, g.spec, g.resolved(), scene.materials,
+                warnings += thin_heated_layers(scene.loading, g.motion, end, g.spec, scene.materials,
                                                scene.time.initial_temperature)
         if g is not None and g.motion == "rotation" and "thermal" in effects:
             warnings += convection_coverage(scene.boundary or (), scene.loading, end)

@@ -78,23 +78,21 @@ def short_phases(ld, motion: str, end: float, dt: float) -> list[str]:
 RESOLVED = 0.9   # a braking's heat depth below this share of the interface's elements is warned about
 
 
-def thin_heated_layers(ld, motion: str, end: float, spec, sizes: dict, materials, T0: float) -> list[str]:
+def thin_heated_layers(ld, motion: str, end: float, spec, materials, T0: float) -> list[str]:
     """The fixed body's materials along the interfaces (``spec``: the ``GeometrySpec``) into which
     the heat of the shortest braking phase t reaches less deep, sqrt(pi chi t) at the initial
-    temperature ``T0`` [K], than the interface's elements (``GeometrySpec.interface_sizes``, else
-    ``sizes``: the geometry's resolved mesh sizes [m]; its P1 temperatures) by more than
+    temperature ``T0`` [K], than the interface's elements (``GeometrySpec.interface_sizes`` [m]; its
+    P1 temperatures) by more than
     ``RESOLVED`` (before: any, "about 99 % of the rise" said; and the disc brake's pads at its
     mesh_size, twice theirs; a user trial). 1-D: a linear element of size h under a flux q holds the heat
     q t in rho c h/2, where the exact surface rise is 2 q sqrt(t/(pi kappa rho c)); it reaches
     sqrt(pi chi t)/h of it. The demo car pad's face rose 34 K at 0.96 s with 4 mm elements, 58 K
     with 2 mm, 103 K by the semi-infinite solid (a user trial)."""
     phases = braking_phases(ld, motion, end)
-    given = sizes.get("interface_mesh_size") or sizes.get("mesh_size")
     elements = {}                                   # material along an interface -> its largest size
     for n in spec.interfaces:
-        h = spec.interface_sizes.get(n, given)
         name = spec.interface_materials(n)[0]
-        elements[name] = max(elements.get(name, 0.0), h or 0.0)
+        elements[name] = max(elements.get(name, 0.0), spec.interface_sizes.get(n, 0.0))
     if not phases:
         return []
     t = min(b - a for a, b in phases)

@@ -77,10 +77,12 @@ def perfect_contact(scene, warnings_out: list) -> list[str]:
     out = []
     for key, effect in PERFECT_CONTACT.items():
         given = getattr(scene.interface, key, None) is not None
-        if scene.has(effect) and perfect and not given:
+        if not scene.has(effect):
+            continue
+        if perfect and not given:
             out.append(f'interface.{key}: missing; effect "{effect}" needs it on the interfaces in perfect contact: '
                        + ", ".join(f"interfaces.{n}.rough = false" for n in perfect))
-        elif scene.has(effect) and given and not perfect:
+        elif given and not perfect:
             warnings_out.append(f'interface.{key} is ignored: every interface is rough (effect "roughness") '
                                 "and the zones' laws replace it")
     if scene.has("wear") and perfect:

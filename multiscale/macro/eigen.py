@@ -455,7 +455,7 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
         kept, rest = ranked[:int(n_modes)], ranked[int(n_modes):]
         if kept.size:                   # the other member of a lock-in pair the cap ends in (``PAIR_RTOL``)
             rest = rest[np.isclose(lam[rest].imag, lam[kept[-1]].imag, rtol=PAIR_RTOL, atol=0.0)]
-        inband = np.concatenate([kept, rest]) if kept.size else kept
+        inband = np.concatenate([kept, rest])
     if not inband.size and seen.size and seen.max() < f_min:   # (it said "widen it", nearest a spurious root)
         raise InputError("stability.modes", n_modes, f"the quadratic solver finds the lowest modes first: its lowest "
                          f"reach {seen.max():.6g} Hz, below the band's {f_min:g} Hz; cover the band from 0 Hz")
