@@ -22,7 +22,8 @@ from multiscale.scene_sections import InterfaceSettings
 OWN_TABLES = ("Sub-tables ``[interfaces.<name>.roughness]`` and ``[interfaces.<name>.micro]`` take the keys of "
               "``[roughness]`` and ``[micro]`` for that interface, over theirs; a surface of its own (``rms`` or "
               "``file``) replaces the other, and a file does not take ``[roughness]``'s file keys (``channel``, "
-              "``pixel_size``, ``height_unit``).")
+              "``pixel_size``, ``height_unit``). ``[roughness]`` may be left out when every rough interface gives a surface "
+              "of its own.")
 
 
 def _quantities(parser) -> list[Quantity]:

@@ -28,8 +28,8 @@ from multiscale.errors import InputError, SceneError, read_toml_text, toml_probl
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
-from multiscale.scene_rough import (measured_cover, micro_constants, nyquist, own_tables, perfect_contact, rough_rules,
-                                    roughness_over, thin_layer, zone_sizes)
+from multiscale.scene_rough import (measured_cover, micro_constants, nyquist, own_tables, penalty_range, perfect_contact,
+                                    rough_rules, roughness_over, thin_layer, zone_sizes)
 from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
@@ -112,6 +112,21 @@ class InterfacesSection(Named):
             out[name] = dataclasses.replace(settings, **merged) if settings is not None else None
         return FrozenMap(out)
 
+
+class RoughnessSection(Section):
+    """[roughness], left out where the interfaces give their own surfaces: absent while an
+    [interfaces.<name>.roughness] gives rms or file, it is None (``scene_rough.rough_rules`` then
+    wants a surface on every rough interface; before, [roughness] was required beside them, "rms or
+    file: missing", its keys unread; a user trial)."""
+
+    def read(self, raw, path, ctx):
+        own = ctx.root.get("interfaces") if isinstance(ctx.root.get("interfaces"), dict) else {}
+        if path not in ctx.root and any(isinstance(t, dict) and isinstance(t.get("roughness"), dict)
+                                        and {"rms", "file"} & t["roughness"].keys() for t in own.values()):
+            return None
+        return super().read(raw, path, ctx)
+
+
 # ------------------------------------------------------------------ the scene
 @dataclass(frozen=True)
 class Scene:
@@ -128,7 +143,7 @@ class Scene:
     loading: Loading | None = key(Section(Loading, always=True))
     time: Time | None = key(Section(Time, always=True))
     output: Output | None = key(Section(Output, always=True))
-    roughness: Roughness | None = key(Section(Roughness), needed_by=("roughness",))
+    roughness: Roughness | None = key(RoughnessSection(Roughness), needed_by=("roughness",))
     micro: Micro | None = key(Section(Micro), needed_by=("roughness",))
     wear: Wear | None = key(Section(Wear), needed_by=("wear",))
     layers: Layers | None = key(Section(Layers), needed_by=("layers",))
@@ -384,7 +399,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                      if key.endswith("mesh_size") and isinstance(given.get(key), (int, float))
                      and size > g.spec.length_scale]
         problems += _hardness_checks(scene, g, raw, effects)
-        warnings += _penalty_warnings(scene, g, effects) + list(g.spec.warnings)
+        warnings += penalty_range(scene, g.spec, effects) + list(g.spec.warnings)
         if "wear" in effects and scene.wear is not None and scene.materials is not None and not problems:
             rough = {scene.geometry.spec.interface_materials(n)[0] for n in scene.geometry.spec.interfaces}
             given = [k for k in ("k_w", "k_w_table") if getattr(scene.wear, k) is not None]
@@ -392,9 +407,10 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                 if given and name in scene.materials and scene.materials[name].k_w is not None:
                     problems.append(f"wear.{given[0]}: the rough body's material gives k_w "
                                     f"(materials.{name}.k_w): give one of them")
+        problems += [] if problems else [str(e) for e in rough_rules(scene)]
         if not problems:
-            problems += ([str(e) for e in rough_rules(scene)] + nyquist(scene) + thin_layer(scene)
-                         + measured_cover(scene, warnings) + perfect_contact(scene, warnings) + own_tables(scene, warnings))
+            problems += (nyquist(scene) + thin_layer(scene) + measured_cover(scene, warnings)
+                         + perfect_contact(scene, warnings) + own_tables(scene, warnings))
             warnings += micro_constants(scene) + zone_sizes(scene)
     if scene.output is not None and scene.output.fields is not None:
         for f in scene.output.fields:
@@ -490,46 +506,6 @@ def _plastic_everywhere(scene: Scene, g: Geometry) -> list[str]:
             f"pressure (loading.normal_force over them: at least {nominal:.3g} Pa), so a zone would carry the hardness "
             "or more (fully plastic), which the micro model refuses; raise the hardness or lower the load"] \
         if H <= nominal else []
-
-
-STIFF_PENALTY = 1e4   # a penalty above this many times E*/h is warned about (ill-conditioned tangent)
-
-
-def _penalty_warnings(scene: Scene, g: Geometry, effects) -> list[str]:
-    """A perfect-contact penalty K_n [Pa/m] below E*/h on an interface, E* the contact modulus of its
-    two materials at the initial temperature, 1/E* = (1 - nu_0^2)/E_0 + (1 - nu_1^2)/E_1 (Johnson
-    1985, Eq. 4.22), and h its element size [m]: the penetration p/K_n then exceeds the elastic
-    deflection p h/E* over an element, and the displacements and pressure peaks follow the penalty
-    (block on flat, 4 GPa, h 2.5 mm: the top moves 2.27 um with 1e12 Pa/m, 1.27 um converged; a
-    steel punch on a 21 MPa flat peaks at 3.6 MPa with 1e11 Pa/m, 5.2 MPa converged). Or above
-    ``STIFF_PENALTY`` E*/h: the tangent's conditioning grows with K_n h/E*, and the contact Newton's
-    linear solves failed (the coarse demo brake at 1e17 Pa/m, 4.9e5 E*/h; 1e16 ran; the pin on
-    disc at 1e19 Pa/m, 4.7e6 E*/h; 1e17 ran), inside the plausible range of K_n."""
-    K, sizes = scene.interface.penalty if scene.interface is not None else None, g.resolved()
-    h = sizes.get("interface_mesh_size") or sizes.get("mesh_size")
-    if "contact" not in effects or K is None or h is None or scene.materials is None or scene.time is None:
-        return []
-    out = []
-    for name in g.spec.interfaces:
-        try:
-            if name in scene.rough_interfaces:
-                continue
-            sides = [scene.materials[m].at(scene.time.initial_temperature) for m in g.spec.interface_materials(name)]
-            modulus = 1.0 / sum((1.0 - m.nu ** 2) / m.E for m in sides)
-        except (AttributeError, KeyError, StopIteration, TypeError):   # a partial scene: reported elsewhere
-            continue
-        if K < modulus / h:
-            out.append(f"interface.penalty = {K:g} Pa/m is softer than the bodies at interface {name}: E*/h = "
-                       f"{modulus / h:.3g} Pa/m (contact modulus E* = {modulus:.3g} Pa, element size h = {h:g} m), "
-                       "so the penetration p/K_n exceeds their elastic deflection and the displacements and "
-                       "pressure peaks follow the penalty; perfect contact needs K_n well above E*/h")
-        elif K > STIFF_PENALTY * modulus / h:
-            out.append(f"interface.penalty = {K:g} Pa/m is {K * h / modulus:.2g} times E*/h = {modulus / h:.3g} Pa/m "
-                       f"at interface {name} (contact modulus E* = {modulus:.3g} Pa, element size h = {h:g} m): the "
-                       "contact makes the stiffness matrix ill-conditioned and the Newton's linear solves may fail "
-                       f"(they did from about 1e5 E*/h); at {STIFF_PENALTY:.0e} E*/h the penetration is already "
-                       f"{1 / STIFF_PENALTY:.0e} of the elastic deflection")
-    return out
 
 
 def _symmetry_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]:

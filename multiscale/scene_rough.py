@@ -3,7 +3,7 @@ scene's cross-checks call them once the sections read; the run applies ``rough_r
 ``workflows.rough.check_rough_scene``): one micro solid and one set of micro settings over the
 rough interfaces, a generated surface within its grid's Nyquist index, a measured one covering its
 face with a grid that resolves it, zones no smaller than the facets, and the perfect-contact keys
-where an interface keeps perfect contact."""
+where an interface keeps perfect contact, with a penalty within the bodies' stiffness."""
 from __future__ import annotations
 
 import warnings
@@ -38,15 +38,19 @@ def roughness_over(base: dict, own: dict) -> dict:
 
 def rough_rules(scene) -> list[InputError]:
     """What every rough analysis needs (each an InputError naming the key): FFT-BEM laws, a rough
-    interface, the same materials on both sides of every rough interface (one micro solid: a pad of
-    another material was refused by the run only, after check said OK; a user trial) and the same
-    micro settings but the zones (``SHARED_MICRO``)."""
+    interface, a surface for each (its own or [roughness]'s), the same materials on both sides of
+    every rough interface (one micro solid: a pad of another material was refused by the run only,
+    after check said OK; a user trial) and the same micro settings but the zones (``SHARED_MICRO``)."""
     if not scene.has("roughness") or scene.micro is None:
         return []
     if scene.micro.model != "fft-bem":
         return [InputError("micro.model", scene.micro.model, 'the zone laws are computed by FFT-BEM: "fft-bem"')]
     if not scene.rough_interfaces:
         return [InputError("interfaces", "rough = false", 'effect "roughness" needs at least one rough interface')]
+    bare = [n for n in scene.rough_interfaces if scene.interface_settings(n).roughness is None]
+    if bare:                                    # ([roughness] left out: ``scene.RoughnessSection``)
+        return [InputError("roughness", None, 'missing; effect "roughness" needs a surface for ' + ", ".join(
+            f"interfaces.{n}" for n in bare) + ": give [roughness], or rms or file in [interfaces.<name>.roughness]")]
     out = []
     pairs = {scene.geometry.spec.interface_materials(n) for n in scene.rough_interfaces}
     if len(pairs) > 1:
@@ -91,12 +95,68 @@ def perfect_contact(scene, warnings_out: list) -> list[str]:
     return out
 
 
+STIFF_PENALTY = 1e4   # a penalty above this many times E*/h is warned about (ill-conditioned tangent)
+
+
+def penalty_range(scene, spec, effects) -> list[str]:
+    """A perfect-contact penalty K_n [Pa/m] below E*/h on an interface of ``spec`` (the
+    ``GeometrySpec``) in perfect contact, E* the contact modulus of its two materials at the initial
+    temperature, 1/E* = (1 - nu_0^2)/E_0 + (1 - nu_1^2)/E_1 (Johnson 1985, Eq. 4.22), and h its
+    element size [m] (``GeometrySpec.interface_sizes``: the disc brake's pads at pad_mesh_size; a
+    user trial): the penetration p/K_n then exceeds the elastic deflection
+    p h/E* over an element, and the displacements and pressure peaks follow the penalty
+    (block on flat, 4 GPa, h 2.5 mm: the top moves 2.27 um with 1e12 Pa/m, 1.27 um converged; a
+    steel punch on a 21 MPa flat peaks at 3.6 MPa with 1e11 Pa/m, 5.2 MPa converged). Or above
+    ``STIFF_PENALTY`` E*/h: the tangent's conditioning grows with K_n h/E*, and the contact Newton's
+    linear solves failed (the coarse demo brake at 1e17 Pa/m, 4.9e5 E*/h by its mesh_size, twice
+    its pads'; 1e16 ran; the pin on disc at 1e19 Pa/m, 4.7e6 E*/h; 1e17 ran), inside the plausible
+    range of K_n."""
+    K = scene.interface.penalty if scene.interface is not None else None
+    if "contact" not in effects or K is None or scene.materials is None or scene.time is None:
+        return []
+    out = []
+    for name in spec.interfaces:
+        h = spec.interface_sizes.get(name)
+        try:
+            if name in scene.rough_interfaces or h is None:
+                continue
+            sides = [scene.materials[m].at(scene.time.initial_temperature) for m in spec.interface_materials(name)]
+            modulus = 1.0 / sum((1.0 - m.nu ** 2) / m.E for m in sides)
+        except (AttributeError, KeyError, StopIteration, TypeError):   # a partial scene: reported elsewhere
+            continue
+        if K < modulus / h:
+            out.append(f"interface.penalty = {K:g} Pa/m is softer than the bodies at interface {name}: E*/h = "
+                       f"{modulus / h:.3g} Pa/m (contact modulus E* = {modulus:.3g} Pa, element size h = {h:g} m), "
+                       "so the penetration p/K_n exceeds their elastic deflection and the displacements and "
+                       "pressure peaks follow the penalty; perfect contact needs K_n well above E*/h")
+        elif K > STIFF_PENALTY * modulus / h:
+            out.append(f"interface.penalty = {K:g} Pa/m is {K * h / modulus:.2g} times E*/h = {modulus / h:.3g} Pa/m "
+                       f"at interface {name} (contact modulus E* = {modulus:.3g} Pa, element size h = {h:g} m): the "
+                       "contact makes the stiffness matrix ill-conditioned and the Newton's linear solves may fail "
+                       f"(they did from about 1e5 E*/h); at {STIFF_PENALTY:.0e} E*/h the penetration is already "
+                       f"{1 / STIFF_PENALTY:.0e} of the elastic deflection")
+    return out
+
+
+def scene_surface_used(scene) -> bool:
+    """Whether some rough interface takes [roughness]'s surface (its rms or file), not one of its own."""
+    r = scene.roughness
+    return r is not None and any((s.rms, s.file) == (r.rms, r.file) for s in
+                                 (scene.interface_settings(n).roughness for n in scene.rough_interfaces))
+
+
 def own_tables(scene, warnings_out: list) -> list[str]:
     """[interfaces.<name>.roughness] and [interfaces.<name>.micro]: a rough body other than the
     stationary one refused, as in [roughness] (it passed check), and tables no interface reads
     warned about (into ``warnings_out``): without effect "roughness", or on an interface kept in
-    perfect contact (rough = false). Before, both were silent (a user trial)."""
+    perfect contact (rough = false), and [roughness]'s surface where every rough interface gives its
+    own. Before, all were silent (a user trial: its file's notes read as the run's)."""
     out, stationary = [], scene.geometry.bodies[0]
+    r = scene.roughness
+    if scene.rough_interfaces and r is not None and not scene_surface_used(scene):
+        given = f"roughness.rms = {r.rms * 1e6:g} um" if r.rms is not None else f"roughness.file ({r.file.name})"
+        warnings_out.append(f"{given} is not used: every rough interface gives a surface of its own"
+                            + ("; the notes on its file concern no interface" if r.file is not None else ""))
     for name, own in (scene.interfaces or {}).items():
         body = own.roughness.body if own is not None and own.roughness is not None else None
         if body not in (None, stationary):
@@ -115,7 +175,8 @@ def micro_constants(scene) -> list[str]:
     chi, rho, c for the heat partition and flash temperatures; their tables act on the macro model
     only; H(T) and k_w(T) are taken at the micro temperatures, H(T) the softer body's at the initial
     temperature, at the rough body's), and the rough body without its layers for the heat partition
-    and flash temperatures (``Heating``; only the conductance sees a layer's kappa). Before, both
+    and flash temperatures (``Heating``; only the conductance sees a layer's kappa), and at the
+    softer body's hardness with layers too. Before, all
     were silent (a materials engineer's trial: a pin's kappa falling 10x over its 14 K rise left the
     partition to 5 digits)."""
     if not scene.has("roughness") or not scene.rough_interfaces or scene.materials is None:
@@ -141,6 +202,9 @@ def micro_constants(scene) -> list[str]:
     if scene.has("layers") and scene.has("heat_partition"):
         out.append("layers: the heat partition and flash temperatures take the rough body without its layers "
                    "(its own kappa and chi); a layer's kappa acts on the conductance only")
+    if scene.has("layers") and scene.has("plasticity") and scene.softer_hardness is not None:
+        out.append(f"layers: the micro contact yields at materials.{scene.softer_hardness}.hardness, layers or not (a "
+                   "layer has no hardness of its own: a hard coating is capped at its substrate's; a user trial)")
     return out
 
 

@@ -78,7 +78,9 @@ class Sweep:
         loading = ctx.root.get("loading") if isinstance(ctx.root.get("loading"), dict) else {}
         if name == "rms" and "roughness" not in ctx.effects:
             return [f'{where}: sweeps the rough surfaces: needs effect "roughness"']
-        if name == "rms" and "rms" not in (ctx.root.get("roughness") or {}):
+        tables = ctx.root.get("interfaces") if isinstance(ctx.root.get("interfaces"), dict) else {}
+        surfaces = [ctx.root.get("roughness")] + [t.get("roughness") for t in tables.values() if isinstance(t, dict)]
+        if name == "rms" and not any(isinstance(r, dict) and "rms" in r for r in surfaces):
             return [f"{where}: sweeps roughness.rms of a generated surface; the scene gives no roughness.rms"]
         if self.preload == "once" and name in ("pressure", "rms"):
             return [f'{path}.preload = "once": a {name} sweep changes the preloaded state; use "each"']

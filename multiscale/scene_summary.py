@@ -8,6 +8,7 @@ from multiscale.geometry import CellEstimate, estimate_cells
 from multiscale.outputs import analysis
 from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
+from multiscale.scene_rough import scene_surface_used
 from multiscale.scene_sections import P_MAX_FACTOR, P_MAX_PLASTIC
 from multiscale.schema import reference as schema_reference
 
@@ -139,8 +140,8 @@ def _effect_line(scene: Scene, effect: str) -> str:
     if effect == "conductance":
         return _rough_or_perfect(scene, "h_c(p) per zone (micro)", "h_c = {:g} W/(m^2 K)", i.conductance)
     if effect == "roughness":
-        r, m = scene.roughness, scene.micro
-        surface = _surface(r)
+        r, m = scene.interface_settings(scene.rough_interfaces[0]).roughness, scene.micro
+        surface = _surface(scene.roughness) if scene_surface_used(scene) else "each interface its own surface"
         measured_pixels = r.file is not None and r.cover != "equivalent"
         cells = f"{m.grid[0]} x {m.grid[1]} cells" if m.grid else \
             "the measurement's pixel size" if measured_pixels else "50 x 50 cells"

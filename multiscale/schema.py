@@ -504,11 +504,21 @@ def unknown_keys(raw, allowed, path: str, ctx: Context, what: str = "key") -> se
     prefix, typos = f"{path}." if path else "", set()
     for name in raw:
         if name not in allowed:
-            hint = suggest(name, allowed)
+            hint = suggest(name, allowed) or _in_section(name, allowed)
             typos.update(hint.split('"')[1:2])
             ctx.problems.append(f"{prefix}{name}: unknown {what}{hint}; "
                                 f"allowed: {', '.join(allowed) or 'none'}")
     return typos
+
+
+def _in_section(name: str, specs) -> str:
+    """' (did you mean "section.name"?)' for a key given a level too high, that a plain section of
+    ``specs`` has (``--set ramp_steps=1`` for loading.ramp_steps had no hint; a user trial), or ''."""
+    found = [f"{s}.{name}" for s, spec in (specs.items() if isinstance(specs, dict) else ())
+             if isinstance(getattr(spec, "parser", None), Section) and not isinstance(spec.parser, (Tables, Named))
+             and dataclasses.is_dataclass(spec.parser.cls)
+             and name in dict(fields_of(spec.parser.cls))]
+    return f' (did you mean "{found[0]}"?)' if found else ""
 
 
 def parse(parser, raw, where: str, ctx: Context):

@@ -740,7 +740,8 @@ def test_what_the_micro_scale_takes_as_constants_is_said():
     """The micro scale takes the rough interface's materials at the initial temperature and the
     rough body without its layers for the heat partition: a pin kappa(T) falling 10x over its rise
     left the partition to 5 digits, a layer's required kappa changed nothing, silently (a materials
-    engineer's trial). Now both are warnings, and a layer's kappa is needed by "conductance" only."""
+    engineer's trial). Now both are warnings, and a layer's kappa is needed by "conductance" only. So
+    is a layer's missing hardness: the micro contact yields at the rough body's (a user trial)."""
     table = 'kappa = [["20 degC", "35 W/(m K)"], ["25 degC", "3.5 W/(m K)"]]'
     text = POD.format(folder="out").replace('"wear"]', '"wear", "layers"]').replace(
         'kappa = "35 W/(m K)"', table) + '[layers]\nbody = "pin"\n[[layers.layer]]\nthickness = "5 um"\nE = "200 GPa"\nnu = 0.25\n'
@@ -758,6 +759,10 @@ def test_what_the_micro_scale_takes_as_constants_is_said():
     assert [w for w in plastic.warnings if "hardness" in w] == [
         "materials.pin.hardness: the micro solves take the hardness of the body softer at the initial temperature, "
         "pin's, at the rough body's temperatures; materials.disc.hardness is not used, even where disc is the softer"]
+    coated = loads(text.replace('"layers"]', '"layers", "plasticity"]').replace(
+        'kappa = "50 W/(m K)"', 'kappa = "50 W/(m K)"\nhardness = "2 GPa"').replace(table, table + '\nhardness = "20 MPa"'))
+    assert ("layers: the micro contact yields at materials.pin.hardness, layers or not (a layer has no hardness of its "
+            "own: a hard coating is capped at its substrate's; a user trial)") in coated.warnings   # (it was silent)
 
 
 def test_a_layer_too_thin_for_the_micro_cells_is_refused_by_check():

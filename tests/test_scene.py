@@ -880,6 +880,46 @@ def test_an_interface_surface_of_its_own_replaces_the_scene_wide_one(tmp_path):
             in kept.warnings)
 
 
+def test_roughness_may_be_left_to_the_interfaces_own_surfaces():
+    """With a surface of its own on every rough interface, [roughness] is not needed (it was:
+    "roughness.rms or roughness.file: missing; required", beside two pads' own files; a user
+    trial); a rough interface without one is named, and a rms sweep takes the interfaces' rms. A
+    [roughness] surface that no interface takes is said, and not shown as the one used."""
+    from multiscale.provenance import resolved_toml
+    rough = {"effects": ["contact", "friction", "roughness"], "micro": {"zones": [2, 2], "grid": [16, 16]}}
+    own = {"rms": "5 um", "hurst": 0.8, "k_min": 1, "k_max": 6}
+    text = (DEMOS / "brake_squeal.toml").read_text()
+    both = {**rough, "interfaces.inner_pad.roughness": own, "interfaces.outer_pad.roughness": {**own, "rms": "3 um"}}
+    scene = loads(text, DEMOS, overrides=both)
+    assert scene.roughness is None and [scene.interface_settings(n).roughness.rms
+                                        for n in ("inner_pad", "outer_pad")] == [5e-6, 3e-6]
+    assert any(line.startswith("    roughness      brake: each interface its own surface; 2 x 2 zones")
+               for line in summary(scene))
+    again = loads(resolved_toml(scene), DEMOS)
+    assert again.roughness is None and again.interfaces == scene.interfaces
+    with pytest.raises(SceneError) as err:
+        loads(text, DEMOS, overrides={**rough, "interfaces.outer_pad.roughness": own})
+    assert err.value.problems == ['roughness: missing; effect "roughness" needs a surface for interfaces.inner_pad: '
+                                  "give [roughness], or rms or file in [interfaces.<name>.roughness]"]
+    kept = loads(text, DEMOS, overrides={**rough, "interfaces.outer_pad.roughness": own,
+                                         "interfaces.inner_pad.rough": False})
+    assert kept.rough_interfaces == ("outer_pad",)
+    unused = loads(text, DEMOS, overrides={**both, "roughness": {**own, "rms": "9 um"}})    # (summary: "RMS 9 um",
+    assert "roughness.rms = 9 um is not used: every rough interface gives a surface of its own" in unused.warnings
+    assert any("roughness      brake: each interface its own surface;" in line for line in summary(unused))  # unused)
+    swept = {**both, "effects": rough["effects"] + ["stability"], "stability.sweep.rms": ["2 um", "4 um"]}
+    assert loads(text, DEMOS, overrides=swept).stability.sweep.rms == (2e-6, 4e-6)
+
+
+def test_a_key_given_a_level_too_high_names_its_section():
+    """`--set ramp_steps=1` said "unknown key" and listed the sections, where a typo got a "did you
+    mean" (a user trial): a key that a section has is suggested there."""
+    with pytest.raises(SceneError) as err:
+        load(DEMOS / "pin_on_disc.toml", {"ramp_steps": 1, "zones": [2, 2]})
+    assert [p[:p.index(";")] for p in err.value.problems] == [
+        'ramp_steps: unknown key (did you mean "loading.ramp_steps"?)', 'zones: unknown key (did you mean "micro.zones"?)']
+
+
 def test_overrides_are_validated_like_the_file(tmp_path):
     scene = loads(GOOD, tmp_path, overrides={"loading.friction": 0.2, "geometry.mesh_size": "1 mm",
                                              "materials.block.E": "5 GPa"})
@@ -1131,6 +1171,11 @@ def test_a_penalty_far_stiffer_than_the_bodies_is_warned_about(tmp_path):
     stiff = loads(text.replace('penalty = "1e13 Pa/m"', 'penalty = "1e17 Pa/m"'), tmp_path)
     assert len(stiff.warnings) == 1 and stiff.warnings[0].startswith(
         "interface.penalty = 1e+17 Pa/m is 6.2e+04 times E*/h = 1.61e+12 Pa/m at interface interface")
+    brake = (DEMOS / "brake_squeal.toml").read_text().replace('penalty = "1e13 Pa/m"', 'penalty = "1e17 Pa/m"')
+    assert [w[:w.index(":")] for w in loads(brake, DEMOS).warnings] == [
+        f"interface.penalty = 1e+17 Pa/m is 1.2e+05 times E*/h = 8.55e+11 Pa/m at interface {pad} (contact modulus "
+        "E* = 5.13e+09 Pa, element size h = 0.006 m)" for pad in ("inner_pad", "outer_pad")]   # the pads' 6 mm, not
+    #                                                      mesh_size's 12 mm (a user trial)
 
 
 def test_a_squeal_analysis_of_a_duty_cycle_says_which_state_it_takes():
