@@ -74,7 +74,7 @@ def test_surface_command_prints_the_steps_and_surfacetopographys_sq(tmp_path, ca
 @pytest.mark.parametrize("args, message", [
     (["--channel", "2"], 'error: --channel = 2: top-1.top has the channels 0 "Default" (2-D)'),
     (["--cutoff", "3 kg"], 'error: --cutoff = \'3 kg\': expected a length'),
-    (["--cutoff", "1 nm"], "error: --cutoff = 1e-09: λc must span at least 2 pixels (4.69e-09 m): top-1.top's pixels"),
+    (["--cutoff", "1 nm"], "error: --cutoff: λc = 0.001 um must span at least 2 pixels (0.004688 um): top-1.top's pixels"),
     # ISO cut-offs are said in mm: "--cutoff 0.8" filtered at 0.8 m, "little is removed", and went on
     (["--cutoff", "0.8"], "error: --cutoff = '0.8': 0.8 m, longer than the measurement (0.0006 x 0.0006 mm); plain "
                           'numbers are metres: did you mean "0.8 mm"?'),
@@ -141,7 +141,7 @@ def test_scene_reads_a_measured_file_with_its_options(tmp_path):
     ('file = "pad.npy"', "roughness.pixel_size: pad.npy is a plain height matrix without units"),
     (f'file = "{TOP}"\ncover = "stretch"', 'roughness.cover = "stretch": unknown'),
     (f'file = "{TOP}"\nhurst = 0.5', "roughness.hurst: only used with roughness.rms"),
-    (f'file = "{TOP}"\ncutoff = "1 nm"', "roughness.cutoff = 1e-09: λc must span at least 2 pixels (4.69e-09 m): "
+    (f'file = "{TOP}"\ncutoff = "1 nm"', "roughness.cutoff: λc = 0.001 um must span at least 2 pixels (0.004688 um): "
                                          "top-1.top's pixels"),       # before: refused by the run, after meshing
 ])
 def test_check_reports_a_bad_measured_file_from_the_file_itself(tmp_path, roughness, fragment):

@@ -80,12 +80,18 @@ def test_the_statistics_table_writes_cut_offs_as_plain_numbers():
 
 def test_a_fit_outside_the_self_affine_range_is_said_to_be_one():
     """White noise (flat PSD) fits H = -1 (C ∝ q^0): the table said "H -1.05" without a word (found by
-    a user trial); it names the range and what the number is. A self-affine surface's line has no remark."""
+    a user trial); it names the range and what the number is. A self-affine surface's line has no remark;
+    one above 1 says that no self-affine surface's is."""
     noise = Surface(np.random.default_rng(1).normal(size=(256, 256)), 1e-6, 1e-6, periodic=False)
     line = next(r for r in surface_statistics(noise).table() if "Hurst" in r)
     assert surface_statistics(noise).power_law.hurst == pytest.approx(-1.0, abs=0.1)
     assert line.endswith("outside 0-1.5: no self-affine range (e.g. noise), the fit only gives the PSD's slope")
     assert "outside" not in next(r for r in surface_statistics(self_affine(0.6, n=128)).table() if "Hurst" in r)
+    stats = surface_statistics(self_affine(0.8, n=128, periodic=False))       # x3p-2.x3p fitted 1.107 (a user trial)
+    steep = dataclasses.replace(stats, power_law=dataclasses.replace(stats.power_law, hurst=1.107))
+    assert next(r for r in steep.table() if "Hurst" in r).endswith(
+        "; above 1, steeper than a self-affine surface's (a scene's hurst is at most 1): a form or waviness the "
+        "detrending left, e.g. (--cutoff takes it out)")
 
 
 def test_a_fit_that_misses_the_psd_says_h_is_only_a_slope():

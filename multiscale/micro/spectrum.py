@@ -452,7 +452,10 @@ class Statistics:
                           f"; outside {HURST_RANGE[0]:g}-{HURST_RANGE[1]:g}: no self-affine range (e.g. noise), "
                           "the fit only gives the PSD's slope" if outside else
                           "; the PSD is no power law there (misfit over a factor e, or under "
-                          f"{FEW_BINS} bins): H is only its mean slope" if poor else "")),
+                          f"{FEW_BINS} bins): H is only its mean slope" if poor else
+                          "; above 1, steeper than a self-affine surface's (a scene's hurst is at most 1): "
+                          "a form or waviness the detrending left, e.g. (--cutoff takes it out)" if fit.hurst > 1 else
+                          "")),
                      ("long cut-off  2pi/q_r", _length(lr, 2) + ("  (to a PSD bin)" if rr else
                                                               "  (not resolved: >= this)")),
                      ("short cut-off 2pi/q_s", _length(ls, 2) + ("  (to a PSD bin)" if rs else

@@ -141,8 +141,8 @@ def check_cutoff(name: str, cutoff: float, dx: float, dy: float, pixels: str = "
     dx x dy [m] (``pixels``: whose, for the message)."""
     check_positive(name, cutoff)
     if cutoff < 2 * max(dx, dy):
-        raise InputError(name, cutoff, f"λc must span at least 2 pixels ({2 * max(dx, dy):.3g} m)"
-                         + (f": {pixels}'s pixels" if pixels else ""))
+        raise InputError(name, None, f"λc = {cutoff * 1e6:.4g} um must span at least 2 pixels "
+                         f"({2e6 * max(dx, dy):.4g} um)" + (f": {pixels}'s pixels" if pixels else ""))
 
 
 def _gaussian(surface: Surface, cut_x: float, cut_y: float) -> Surface:
