@@ -193,3 +193,26 @@ def test_a_log_axis_of_pressures_ends_on_labelled_ticks(tmp_path, drawn):
     assert pressure.get_ylim() == pytest.approx((10.0, 100.0))
     assert {t.get_text() for t in pressure.get_yticklabels()} >= {"10", "20", "50", "100"}
     assert worn.get_ylabel() == "wear volume [mm³]"
+
+
+def test_the_multiscale_figure_shows_the_real_contact_area_and_the_plastic_share(tmp_path, drawn):
+    """The real contact area (mm² or µm², each rough interface's beside the total) and the largest
+    plastic share of a zone have panels (a plastic contact run showed the pressures alone, the main
+    results nowhere; a user trial), and a one-panel figure's title is not cut off at both ends."""
+    history = History()
+    for t, (a, b) in enumerate([(2e-6, 1e-6), (3e-6, 1.5e-6)]):
+        history.append(time=float(t), max_pressure=1e6, real_contact_area=a + b, real_contact_area_inner=a,
+                       real_contact_area_outer=b, micro_plastic_fraction=0.1 * (t + 1))
+    plots.multiscale_figure(history, tmp_path / "m.png", "brake")
+    area = next(ax for ax in drawn[-1].axes if ax.get_ylabel() == "real contact area [mm²]")
+    curves = {line.get_label(): tuple(line.get_ydata()) for line in area.get_lines()}
+    assert curves == {"all interfaces": pytest.approx((3.0, 4.5)), "inner": pytest.approx((2.0, 3.0)),
+                      "outer": pytest.approx((1.0, 1.5))}
+    plastic = next(ax for ax in drawn[-1].axes if ax.get_ylabel() == "largest plastic share\nof a zone's cells [%]")
+    np.testing.assert_allclose(plastic.get_lines()[0].get_ydata(), [10.0, 20.0])
+    small = History()
+    small.append(time=0.0, real_contact_area=1.07e-9)
+    plots.multiscale_figure(small, tmp_path / "s.png", "bof_x3p")
+    (ax,) = [a for a in drawn[-1].axes if a.axison]
+    assert ax.get_ylabel() == "real contact area [µm²]" and ax.get_lines()[0].get_ydata()[0] == pytest.approx(1070.0)
+    assert drawn[-1]._suptitle.get_text() == "bof_x3p:\nboth scales of the multiscale loop against time"

@@ -7,9 +7,11 @@ and the hottest facet of each face, with a body of several parts each part's sto
 of panels then). ``multiscale_figure``: max contact pressure macro (facets,
 zones) vs micro (Fig. 7.14; log scale, linear with a note if no row has contact), max temperature
 macro vs micro (Fig. 7.15), heat partition min/mean/max (Fig. 7.12), wear volume (Fig. 7.16), max
-wear depth (Fig. 7.17) and RMS of the worn surface (Fig. 7.18) — the panels whose columns the
-history has. ``wear_map``: the mean wear depth of every zone over the interface (Fig. 7.13) beside
-the micro wear depth field of the whole face (blank off the face).
+wear depth (Fig. 7.17), RMS of the worn surface (Fig. 7.18), the real contact area (each rough
+interface's too) and the largest plastic share of a zone — the panels whose columns the history
+has. ``wear_map``: the mean wear depth of every zone over the interface (Fig. 7.13) beside the
+micro wear depth field of the whole face (blank off the face; the zones' edges, isolated patches'
+edges, wear the most: docs/results.rst).
 """
 from __future__ import annotations
 
@@ -147,6 +149,8 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
     """PNG of the multiscale history columns at both scales (see module docstring)."""
     cols = history.columns
     hot = temperature_columns(cols)
+    areas = [k for k in cols if k.startswith("real_contact_area_")]          # one per rough interface
+    area = 1e6 if np.nanmax(np.abs(cols.get("real_contact_area", [0.0])), initial=0.0) > 1e-8 else 1e12  # mm² or µm²
     volume = 1e9 if np.nanmax(np.abs(cols.get("wear_volume", [0.0])), initial=0.0) > 1e-12 else 1e18   # mm³ or µm³
     panels = [("max contact pressure [MPa]", [("max_pressure", "macro, largest facet"),
                                                ("max_zone_pressure", "macro, largest zone (mean)"),
@@ -158,7 +162,11 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
                 ("partition_min", "min")], 100.0, 0),
               ("wear volume [mm³]" if volume == 1e9 else "wear volume [µm³]", [("wear_volume", None)], volume, 0),
               ("max wear depth [µm]", [("wear_max_depth", None)], 1e6, 0),
-              ("RMS of the worn surface [µm]", [("rms_height", None)], 1e6, 0)]
+              ("RMS of the worn surface [µm]", [("rms_height", None)], 1e6, 0),
+              ("real contact area [mm²]" if area == 1e6 else "real contact area [µm²]",
+               [("real_contact_area", "all interfaces" if len(areas) > 1 else None)]
+               + [(k, k.removeprefix("real_contact_area_")) for k in areas], area, 0),
+              ("largest plastic share\nof a zone's cells [%]", [("micro_plastic_fraction", None)], 100.0, 0)]
     panels = [(label, [(k, n) for k, n in keys if k in cols], s, o) for label, keys, s, o in panels]
     panels = [p for p in panels if p[1]]
     ncol = min(3, len(panels))
@@ -188,8 +196,8 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
             ax.legend(fontsize=8)
     for ax in axes.ravel()[len(panels):]:
         ax.axis("off")
-    fig.suptitle(f"{title}: both scales of the multiscale loop against time" if title else
-                 "both scales of the multiscale loop against time")
+    fig.suptitle((f"{title}:" + ("\n" if ncol == 1 else " ") if title else "") +      # (one panel: cut off at
+                 "both scales of the multiscale loop against time")                     # both ends; a user trial)
     fig.tight_layout()
     fig.savefig(path, dpi=110)
     return path
@@ -238,6 +246,7 @@ def wear_map(grid, depth: np.ndarray, path: Path, title: str = "", face=None) ->
         ax.set_xlabel("x [mm]")
         ax.set_ylabel("y [mm]")
         fig.colorbar(im, ax=ax, label=label, shrink=0.85)
+    axes[1].set_title("each zone an isolated patch: its edges carry and wear the most", fontsize=8)
     fig.suptitle(f"wear depth over the interface ({title})" if title else "wear depth over the interface")
     fig.tight_layout()
     fig.savefig(path, dpi=110)
