@@ -28,6 +28,7 @@ from multiscale.errors import InputError, SceneError, read_toml_text, toml_probl
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
+from multiscale.scene_plain import plain_speeds
 from multiscale.scene_rough import (measured_cover, micro_constants, nyquist, own_tables, penalty_range, perfect_contact,
                                     rough_rules, roughness_over, thin_layer, zone_sizes)
 from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
@@ -447,6 +448,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                                                scene.time.initial_temperature)
         if g is not None and g.motion == "rotation" and "thermal" in effects:
             warnings += convection_coverage(scene.boundary or (), scene.loading, end)
+    if g is not None and g.motion == "rotation":
+        warnings += plain_speeds(raw)
     profile = scene.loading.load_profile if scene.loading is not None else None
     if profile is not None and not any(factor > 0 for _, factor in profile):
         warnings.append("loading.load_profile is 0 throughout: the load is released for the whole run (no "

@@ -3,10 +3,12 @@
 ``PixelSize`` (and ``pixel_problem``, for the command line) refuses a measured surface's pixel from
 ``PIXEL_LIMIT`` up (``pixel_size = 10`` is
 a 10 m pixel), and ``contains_hint`` adds to a geometry file's point that hits nothing the same
-numbers in the file's unit (``contains = [0, 105, 12]`` with ``unit = "mm"``).
+numbers in the file's unit (``contains = [0, 105, 12]`` with ``unit = "mm"``), and
+``plain_speeds`` warns of a speed table's plain speeds, rad/s.
 """
 from __future__ import annotations
 
+import math
 import numbers
 
 from multiscale.errors import InputError
@@ -67,3 +69,22 @@ def contains_hint(raw: dict, path: str, exc: InputError) -> str:
                     return "; plain numbers are metres: did you mean [" + ", ".join(
                         f'"{v:g} {unit}"' for v in point) + "]?"
     return ""
+
+
+def plain_speeds(raw: dict) -> list[str]:
+    """Warnings of speed tables written in plain numbers other than 0: an h(speed) convection of
+    [[boundary]] and ``loading.speed_profile``. Plain speeds are rad/s, where such tables are most
+    often thought of in rpm (``[[1700, 110]]`` is h at 16 234 rpm; from the review list)."""
+    out = []
+    boundary = raw.get("boundary") if isinstance(raw.get("boundary"), list) else []
+    loading = raw.get("loading") if isinstance(raw.get("loading"), dict) else {}
+    tables = [(f"boundary[{i}].convection", b.get("convection"), 0) for i, b in enumerate(boundary, 1)
+              if isinstance(b, dict)] + [("loading.speed_profile", loading.get("speed_profile"), 1)]
+    for where, rows, column in tables:
+        speeds = [r[column] for r in (rows if isinstance(rows, list) else ())
+                  if isinstance(r, list) and len(r) > column and plain(r[column])]
+        if any(v != 0 for v in speeds):
+            top = max(speeds)
+            out.append(f'{where}: plain speeds are rad/s ({top:g} rad/s = {top * 30 / math.pi:.0f} rpm); give '
+                       f'a unit, e.g. "{top:g} rpm"')
+    return out
