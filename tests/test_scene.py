@@ -399,12 +399,18 @@ def test_a_fluid_loaded_builder_refuses_a_normal_force_when_read(tmp_path):
     ("block_on_flat", "loading.direction", [1, 0, -1],                   # (ran: 0.26 to 1.75 MPa for 1 MPa)
      "loading.direction = [1.0, 0.0, -1.0]: has a component along the normal [1.0, 0.0, 0.0] of builder "
      "\"block_on_flat\"'s symmetry plane symmetry_x, which mirrors the load"),
+    ("pin_on_disc_perfect", "loading.direction", [0, 0, 1],              # (passed check; "Newton did not converge")
+     "loading.direction = [0.0, 0.0, 1.0]: pulls the loaded body away from the contact (builder \"pin_on_disc\" "
+     "presses along [0.0, 0.0, -1.0]): no contact would hold it"),
+    ("pin_on_disc_perfect", "loading.direction", [1, 0, 0],
+     "loading.direction = [1.0, 0.0, 0.0]: has no component towards the contact"),
 ])
 def test_builder_sizes_and_directions_are_checked_when_read(demo, key, value, problem):
     """A user's lab geometries (a trial, 2026-12-01): a pin whose corners overhang the disc ran;
     sizes out of order named another key than the one given, or were found at meshing only; a
-    zero load direction passed check and failed in the first Newton solve; one across a symmetry
-    plane of the quarter block ran, its halves pushed apart."""
+    zero load direction passed check and failed in the first Newton solve, as one away from the
+    contact did (the review list); one across a symmetry plane of the quarter block ran, its
+    halves pushed apart."""
     with pytest.raises(SceneError) as info:
         load(DEMOS / f"{demo}.toml", overrides={key: value})
     assert [p for p in info.value.problems if p.startswith(problem)], info.value.problems
