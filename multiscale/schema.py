@@ -95,10 +95,6 @@ def suggest(name: str, options) -> str:
     return f' (did you mean "{near[0]}"?)' if near else ""
 
 
-def _number(x) -> str:
-    return f"{x:g}"
-
-
 def _a(words: str) -> str:
     return ("an " if words[0] in "aeiou" else "a ") + words
 
@@ -115,15 +111,13 @@ class Quantity:
 
     def _range(self) -> str:
         unit = f" {self.kind.si}" if self.kind.si else ""
-        low = f"> {_number(self.gt)}" if self.gt is not None else (
-            f">= {_number(self.ge)}" if self.ge is not None else None)
-        high = f"< {_number(self.lt)}" if self.lt is not None else (
-            f"<= {_number(self.le)}" if self.le is not None else None)
+        low = f"> {self.gt:g}" if self.gt is not None else f">= {self.ge:g}" if self.ge is not None else None
+        high = f"< {self.lt:g}" if self.lt is not None else f"<= {self.le:g}" if self.le is not None else None
         if low and high:
             lb = "(" if self.gt is not None else "["
             rb = ")" if self.lt is not None else "]"
             lo, hi = (self.gt if self.gt is not None else self.ge), (self.lt if self.lt is not None else self.le)
-            return f"in {lb}{_number(lo)}, {_number(hi)}{rb}{unit}"
+            return f"in {lb}{lo:g}, {hi:g}{rb}{unit}"
         return f"{low or high}{unit}" if (low or high) else ""
 
     def range_text(self) -> str:
@@ -139,7 +133,7 @@ class Quantity:
         if self.plausible is None:
             return ""
         unit = f" {self.kind.si}" if self.kind.si else ""
-        return f", plausibly {_number(self.plausible[0])} to {_number(self.plausible[1])}{unit}"
+        return f", plausibly {self.plausible[0]:g} to {self.plausible[1]:g}{unit}"
 
     def __call__(self, raw, ctx):
         try:
@@ -153,8 +147,8 @@ class Quantity:
             raise Bad(f"must be {self._range()}{shown}")
         if self.plausible is not None and not self.plausible[0] <= v <= self.plausible[1]:
             unit = f" {self.kind.si}" if self.kind.si else ""
-            ctx.implausible.append(f"{v:g}{unit} is outside the plausible range {_number(self.plausible[0])} to "
-                                   f"{_number(self.plausible[1])}{unit}: check the value and its unit")
+            ctx.implausible.append(f"{v:g}{unit} is outside the plausible range {self.plausible[0]:g} to "
+                                   f"{self.plausible[1]:g}{unit}: check the value and its unit")
         return v
 
 
@@ -499,26 +493,21 @@ class OnlyWith:
 
 # ---------------------------------------------------------------- the reader
 def unknown_keys(raw, allowed, path: str, ctx: Context, what: str = "key") -> set[str]:
-    """Report keys of ``raw`` not in ``allowed`` (with a "did you mean"); return the suggested
+    """Report keys of ``raw`` not in ``allowed`` (with a "did you mean", also of a key that a plain
+    section has, given a level too high: ``--set ramp_steps=1``, a user trial); return the suggested
     names, so that their "missing" problem is not reported a second time."""
     prefix, typos = f"{path}." if path else "", set()
+    inner = {s: dict(fields_of(p.parser.cls)) for s, p in (allowed.items() if isinstance(allowed, dict) else ())
+             if isinstance(getattr(p, "parser", None), Section) and not isinstance(p.parser, (Tables, Named))
+             and dataclasses.is_dataclass(p.parser.cls)} if set(raw) - set(allowed) else {}
     for name in raw:
         if name not in allowed:
-            hint = suggest(name, allowed) or _in_section(name, allowed)
+            hint = suggest(name, allowed) or next((f' (did you mean "{s}.{name}"?)' for s, keys in inner.items()
+                                                   if name in keys), "")
             typos.update(hint.split('"')[1:2])
             ctx.problems.append(f"{prefix}{name}: unknown {what}{hint}; "
                                 f"allowed: {', '.join(allowed) or 'none'}")
     return typos
-
-
-def _in_section(name: str, specs) -> str:
-    """' (did you mean "section.name"?)' for a key given a level too high, that a plain section of
-    ``specs`` has (``--set ramp_steps=1`` for loading.ramp_steps had no hint; a user trial), or ''."""
-    found = [f"{s}.{name}" for s, spec in (specs.items() if isinstance(specs, dict) else ())
-             if isinstance(getattr(spec, "parser", None), Section) and not isinstance(spec.parser, (Tables, Named))
-             and dataclasses.is_dataclass(spec.parser.cls)
-             and name in dict(fields_of(spec.parser.cls))]
-    return f' (did you mean "{found[0]}"?)' if found else ""
 
 
 def parse(parser, raw, where: str, ctx: Context):
