@@ -382,11 +382,10 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                             "sliding_speed = 0)")
         ld = scene.loading
         along = float(np.dot(ld.direction, g.spec.load_direction)) if ld is not None and ld.direction else 1.0
-        if along <= 0.0 and not g.spec.fluid_load and not isinstance(g.params, FileGeometry):
+        if along <= 0.0 and not g.spec.fluid_load and not isinstance(g.params, FileGeometry):   # (it passed check)
             problems.append(f"loading.direction = {list(ld.direction)}: " + ("pulls the loaded body away from" if along
                             < 0 else "has no component towards") + f" the contact ({where} presses along "
-                            f"{list(g.spec.load_direction)}): no contact would hold it")   # (it ran into "contact
-        #                                                Newton did not converge"; the review list)
+                            f"{list(g.spec.load_direction)}): no contact would hold it")
         if ld is not None and ld.normal_force is not None and ld.direction is None and g.spec.fluid_load \
                 and not isinstance(g.params, FileGeometry):
             problems.append(f"loading.normal_force: {where} is loaded by a fluid pressure on its load faces, whose "
