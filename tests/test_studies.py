@@ -123,6 +123,9 @@ def test_rerun_skips_finished_runs_and_runs_only_new_points(hertz_study, capsys)
     assert main(["study", str(path)]) == 0
     assert "4 recorded before, 0 run now" in capsys.readouterr().out
     assert {p.name: p.read_text() for p in (out / "runs").glob("*.json")} == before
+    # a report without plots leaves none of the earlier ones beside it (a report of failed runs sat
+    # beside the plots of the study before; a user trial)
+    assert not [p for p in ("hertz_error_vs_time.png", "hertz_grid.png") if (out / p).exists()]
     # a fifth grid: only that run is computed; a range giving the same points names the same runs
     path.write_text(HERTZ.replace("grid = [12, 16, 24, 32]", "grid = [12, 16, 24, 32, 20]") + "plots = false\n")
     assert main(["study", str(path)]) == 0
@@ -703,6 +706,42 @@ def test_a_study_folder_in_use_is_refused(tmp_path, capsys):
                 in capsys.readouterr().err)
     assert not list(runs.glob("*.json"))
     assert main(["study", str(path)]) == 0              # released: it runs
+
+
+def test_scene_metrics_reduce_over_the_rows_that_have_a_value():
+    """coupling_residual is NaN at t = 0 and a partition NaN where nothing touches: their
+    :max/:min/:mean were NaN, and a study marked every run failed ('metric "coupling_residual:max"
+    is nan (not finite)') and --rerun-failed ran them all again (a user trial). The reductions skip
+    NaN rows; a column with none is NaN (that metric alone n/a); :first, :last and :rise are the rows'."""
+    from multiscale.io import History
+    from multiscale.studies.scene_problem import history_metrics
+    history = History()
+    for t, r in enumerate([math.nan, 2e-3, 5e-4]):
+        history.append(time=float(t), coupling_residual=r, partition_mean=math.nan, zones=np.ones(3))
+    got = history_metrics(history)
+    assert (got["coupling_residual:max"], got["coupling_residual:min"], got["coupling_residual"]) == (2e-3, 5e-4, 5e-4)
+    assert got["coupling_residual:mean"] == pytest.approx(1.25e-3) and math.isnan(got["coupling_residual:rise"])
+    assert math.isnan(got["partition_mean:max"]) and "zones:max" not in got
+
+
+def test_a_scene_run_is_timed_by_its_own_record(tmp_path, monkeypatch):
+    """A scene run's wall time is its provenance.json's, not its subprocess's: the start of Python
+    and DOLFINx took 10 of 18 s, a coarser grid looked slower than the reference and the cheapest
+    setting was the reference itself (a user trial)."""
+    import subprocess
+    from multiscale.io import History
+    from multiscale.studies import scene_problem
+    work = tmp_path / "run"
+
+    def ran(command, **options):         # the run's output, as multiscale.studies.scene_run writes it
+        history = History()
+        history.append(time=0.0, interface_force=100.0, newton_iterations=4.0)
+        history.write((work / "output").mkdir(parents=True) or work / "output" / "history.h5")
+        (work / "output" / "provenance.json").write_text(json.dumps({"total_wall_time_s": 7.34}))
+        return subprocess.CompletedProcess(command, 0, "", "")
+    monkeypatch.setattr(scene_problem.subprocess, "run", ran)
+    outcome = scene_problem.SceneProblem().run(scene_problem.SceneRun(ROOT / "demos" / "block_on_flat.toml"), work)
+    assert (outcome.wall_time, outcome.iterations, outcome.metrics["interface_force"]) == (7.34, 4, 100.0)
 
 
 def test_squeal_scene_metrics_from_the_mode_table(tmp_path):

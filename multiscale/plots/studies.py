@@ -24,8 +24,11 @@ matplotlib.use("Agg")          # PNG files only, no display
 
 def plot(study: Study, rows: list[Row], folder: Path) -> list[Path]:
     """PNGs: error vs wall time per metric (Pareto front; with many runs only the front is
-    labelled), and per knob: error (or metric) and wall time vs the knob."""
+    labelled), and per knob: error (or metric) and wall time vs the knob; the study's earlier PNGs
+    are removed first, so none is left beside a report that no longer draws it."""
     ok = [r for r in rows if r.ok]
+    for stale in [folder / f"{study.name}_error_vs_time.png"] + [_axis_path(study, axis, folder) for axis in study.axes]:
+        stale.unlink(missing_ok=True)    # (a report of failed runs sat beside the plots of the study before; a user trial)
     if not ok or not study.report.plots:
         return []
     out = []
@@ -95,6 +98,10 @@ def _plot_pareto(study, ok, folder):
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
+
+
+def _axis_path(study, axis, folder: Path) -> Path:
+    return folder / f"{study.name}_{axis[0].replace('.', '_')}.png"
 
 
 def _plain_log(axis) -> None:
@@ -181,7 +188,7 @@ def _plot_axis(study, ok, axis, folder):
     fig.suptitle(f"{study.name}: {' and '.join(study.metrics)} and wall time against {', '.join(axis)}"
                  + (f" (mean ± sample std over {', '.join(averaged)})" if averaged else ""))
     fig.tight_layout()
-    path = folder / f"{study.name}_{axis[0].replace('.', '_')}.png"
+    path = _axis_path(study, axis, folder)
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path

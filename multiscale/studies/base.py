@@ -20,6 +20,8 @@ class Outcome:
     metrics: dict                 # name -> float (SI units, see the problem's ``metrics``)
     iterations: int = 0           # solver iterations, summed over the run's solves
     converged: bool = True        # every solve reached its tolerance
+    wall_time: float | None = None   # s, the run's own time where the problem knows it better than
+    #                                  the worker's clock (a scene run: without its process's start-up)
 
 
 class Problem:

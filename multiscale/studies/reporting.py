@@ -81,7 +81,9 @@ def _code_line(rows) -> str:
 def _processes(study: Study) -> str:
     """How the runs ran: one thread, or a scene on its ranks."""
     ranks = study.options.ranks if study.problem == "scene" else 1
-    return "one thread" if ranks == 1 else f"{ranks} MPI ranks of one thread each"
+    how = "one thread" if ranks == 1 else f"{ranks} MPI ranks of one thread each"
+    return how + ("; a scene run's own time, its provenance.json's, without its process's start-up"
+                  if study.problem == "scene" else "")
 
 
 def _repeats(rows) -> str:
