@@ -25,11 +25,13 @@ the multiscale loop and the squeal analysis:
 """
 from __future__ import annotations
 
+import sys
 import warnings
 from dataclasses import replace
 
 import numpy as np
 
+from multiscale import io
 from multiscale.errors import InputError
 from multiscale.micro.conduction import SeriesKernel
 from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace
@@ -145,7 +147,13 @@ def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterfac
     yet computed: ``RoughInterface.update_laws``)."""
     check_rough_scene(scene)
     names, planes, grids, zones = list(scene.rough_interfaces), [], [], []
-    log = print if tm.comm.rank == 0 else None
+
+    def say(line: str) -> None:     # a step as a stage line (not with --quiet: it was said), a warning always
+        if "warning: " in line:
+            print(line, file=sys.stderr, flush=True)
+        else:
+            io.reporter().say(line)
+    log = say if tm.comm.rank == 0 else None
     for name in names:
         settings = scene.interface_settings(name)
         k = list(tm.interface.tags).index(name)
@@ -168,6 +176,5 @@ def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterfac
         if P_MAX_PLASTIC * hardness < p_max:
             p_max, why = P_MAX_PLASTIC * hardness, f"{P_MAX_PLASTIC:g} x the hardness"
     spec = LawSpec(kernel, p_max, n_points=m.law_points, tol=m.tol, E_star=E_star, hardness=hardness)
-    if log is not None:
-        log(f"laws: {m.law_points} nodes up to p_max = {p_max:.4g} Pa ({why})")
+    io.reporter().say(f"laws: {m.law_points} nodes up to p_max = {p_max:.4g} Pa ({why})")
     return RoughInterface(tm, names, planes, grids, zones, spec, MicroPool(spec, tm.comm, progress=progress))
