@@ -34,7 +34,7 @@ from multiscale.scene_rough import (measured_cover, micro_constants, nyquist, ow
 from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
-from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_phases, squeal_state,
+from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_phases, speed_range, squeal_state,
                                    thin_heated_layers)
 from multiscale.scene_stability import Stability, unresolved_band
 from multiscale.scene_vehicle import Vehicle
@@ -453,8 +453,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                                                scene.time.initial_temperature)
         if g is not None and g.motion == "rotation" and "thermal" in effects:
             warnings += convection_coverage(scene.boundary or (), scene.loading, end)
-    if g is not None and g.motion == "rotation":
-        warnings += plain_speeds(raw)
+            warnings += plain_speeds(raw, speed_range(scene.loading, end)[1])
     profile = scene.loading.load_profile if scene.loading is not None else None
     if profile is not None and not any(factor > 0 for _, factor in profile):
         warnings.append("loading.load_profile is 0 throughout: the load is released for the whole run (no "

@@ -112,12 +112,17 @@ def thin_heated_layers(ld, motion: str, end: float, spec, materials, T0: float) 
     return out
 
 
+def speed_range(ld, end: float) -> tuple[float, float]:
+    """The rotating body's lowest and highest speed [rad/s] over the run to ``end`` [s] (piecewise
+    linear between the cycle's knots: the extremes lie at knots or at 0 and ``end``)."""
+    speeds = [ld.angular_speed(t) for t in (0.0, end, *(t for t in ld.knots() if 0 < t < end))]
+    return min(speeds), max(speeds)
+
+
 def convection_coverage(boundaries, ld, end: float) -> list[str]:
     """A convection table h [W/(m^2 K)] against the rotating body's speed [rad/s] is held at its
-    ends: said where the run's speeds (piecewise linear between the cycle's knots, so their
-    extremes are at knots or at 0 and ``end`` [s]) leave it."""
-    speeds = [ld.angular_speed(t) for t in (0.0, end, *(t for t in ld.knots() if 0 < t < end))]
-    low, high = min(speeds), max(speeds)
+    ends: said where the run's speeds (``speed_range``) leave it."""
+    low, high = speed_range(ld, end)
     out = []
     for i, b in enumerate(boundaries, 1):
         if b is None or not isinstance(b.convection, tuple):

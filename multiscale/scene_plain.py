@@ -4,7 +4,7 @@
 ``PIXEL_LIMIT`` up (``pixel_size = 10`` is
 a 10 m pixel), and ``contains_hint`` adds to a geometry file's point that hits nothing the same
 numbers in the file's unit (``contains = [0, 105, 12]`` with ``unit = "mm"``), and
-``plain_speeds`` warns of a speed table's plain speeds, rad/s.
+``plain_speeds`` questions a convection table's plain speeds (rad/s) far beyond the run's.
 """
 from __future__ import annotations
 
@@ -71,20 +71,22 @@ def contains_hint(raw: dict, path: str, exc: InputError) -> str:
     return ""
 
 
-def plain_speeds(raw: dict) -> list[str]:
-    """Warnings of speed tables written in plain numbers other than 0: an h(speed) convection of
-    [[boundary]] and ``loading.speed_profile``. Plain speeds are rad/s, where such tables are most
-    often thought of in rpm (``[[1700, 110]]`` is h at 16 234 rpm; from the review list)."""
+PLAIN_REACH = 4.0    # a plain-number speed table reaching this many times the run's top speed is questioned
+
+
+def plain_speeds(raw: dict, top: float) -> list[str]:
+    """Warnings of h(speed) convection tables of [[boundary]] written in plain numbers (rad/s) that
+    reach beyond ``PLAIN_REACH`` times the run's largest speed ``top`` [rad/s]: such tables are most
+    often thought of in rpm, 9.55 times the number in rad/s ([[1700, 110]] meant h at 1700 rpm and
+    gave it at 16 234 rpm; from the review list). A table written as the run reads it (the resolved
+    scene's, in rad/s) spans its speeds and is not questioned."""
     out = []
     boundary = raw.get("boundary") if isinstance(raw.get("boundary"), list) else []
-    loading = raw.get("loading") if isinstance(raw.get("loading"), dict) else {}
-    tables = [(f"boundary[{i}].convection", b.get("convection"), 0) for i, b in enumerate(boundary, 1)
-              if isinstance(b, dict)] + [("loading.speed_profile", loading.get("speed_profile"), 1)]
-    for where, rows, column in tables:
-        speeds = [r[column] for r in (rows if isinstance(rows, list) else ())
-                  if isinstance(r, list) and len(r) > column and plain(r[column])]
-        if any(v != 0 for v in speeds):
-            top = max(speeds)
-            out.append(f'{where}: plain speeds are rad/s ({top:g} rad/s = {top * 30 / math.pi:.0f} rpm); give '
-                       f'a unit, e.g. "{top:g} rpm"')
+    for i, b in enumerate(boundary, 1):
+        rows = b.get("convection") if isinstance(b, dict) else None
+        speeds = [r[0] for r in (rows if isinstance(rows, list) else ()) if isinstance(r, list) and r and plain(r[0])]
+        if speeds and top > 0 and max(speeds) > PLAIN_REACH * top:
+            out.append(f"boundary[{i}].convection: plain speeds are rad/s: the table reaches {max(speeds):g} rad/s "
+                       f"({max(speeds) * 30 / math.pi:.0f} rpm), {max(speeds) / top:.3g} times the run's largest "
+                       f"speed ({top:.4g} rad/s); if meant in rpm, give the unit (\"{max(speeds):g} rpm\")")
     return out
