@@ -267,7 +267,7 @@ class CtrlCWatch:
     the default handler does not take (``StepStop``'s, an ignored SIGINT) are left alone: those a
     ``StepStop`` took are counted (``StepStop.taken``), since the watcher may read a signal's byte
     after the ``StepStop`` that took it put the default handler back (it then aborted a run while
-    its end was written: provenance.json left "running", no paraview.py; 1 in 6 quick Ctrl-Cs)."""
+    its end was written: provenance.json left "running", no open_in_paraview.py; 1 in 6 quick Ctrl-Cs)."""
 
     WAIT, STAGGER = 1.0, 2.5
 

@@ -84,7 +84,9 @@ WRITES = {"transient": ("displacement", "temperature", "von_mises", "contact_pre
 PROVENANCE = {"scene.toml": "the scene file as given",
               "scene_resolved.toml": "the scene with every default filled in, SI units",
               "provenance.json": "versions, command line, ranks, start and end time, wall time per stage"}
-SCRIPT = {"paraview.py": "pvpython script that opens the fields (pvpython paraview.py, or ParaView's Python shell)"}
+# (named paraview.py, it imported itself for the ParaView package: Python puts a script's folder first on its path)
+SCRIPT = {"open_in_paraview.py": "pvpython script that opens the fields (pvpython open_in_paraview.py, or ParaView's "
+                                  "Python shell)"}
 
 
 def analysis(scene) -> str:
@@ -213,7 +215,7 @@ def paraview_script(p: Plan) -> str:
     the preloaded bodies open but hidden."""
     files, squeal = p.field_files, p.analysis == "squeal"
     interface = OWN_FILES["interface"]
-    lines = ['"""Open these results in ParaView: pvpython paraview.py (a window), or paste into',
+    lines = ['"""Open these results in ParaView: pvpython open_in_paraview.py (a window), or paste into',
              "View > Python Shell. Each .xdmf holds one mesh with every field as a named array",
              "(unit in the name); the time slider steps through the output times. In the arrays'",
              f"names body 0 is {p.bodies[0]} and body 1 is {p.bodies[1]}.",

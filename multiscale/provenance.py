@@ -286,12 +286,13 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     ``earlier``: the parts of the run before this one (a resumed run: ``parts_of`` the folder
     before it wrote); the record's ``parts`` are those and this one, its ``start`` the first
     part's, its ``command``, ``ranks``, ``end`` and ``status`` this part's, its stage and total
-    wall times [s] the sums over the parts."""
+    wall times [s] the sums over the parts; each part names the code that ran it (``code``'s sha1)."""
     folder = Path(folder)
     given = scene.text if scene.source else \
         "# The scene came from text, not a file: here it is as resolved.\n" + resolved_toml(scene)
+    ran = code()                     # each part's own (a run resumed after a change of the code: a user trial)
     part = {"status": status, "command": list(sys.argv if command is None else command), "ranks": ranks,
-            "start": started, "end": None if status == RUNNING else now(),
+            "code": ran["sha1"], "start": started, "end": None if status == RUNNING else now(),
             "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()},
             "total_wall_time_s": None if status == RUNNING else round(wall_time, 3)}
     parts = [*earlier, part]
@@ -305,7 +306,7 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
               "stage_wall_time_s": {k: round(v, 3) for k, v in total.items()},
               "total_wall_time_s": round(sum(p["total_wall_time_s"] or 0.0 for p in parts), 3), "parts": parts,
               "process": process(),
-              "versions": versions(), "code": code(), "environment": environment(), "inputs": input_digests(scene),
+              "versions": versions(), "code": ran, "environment": environment(), "inputs": input_digests(scene),
               "files": sorted(plan(scene).files), "warnings": list(warnings)}
     texts = {"scene.toml": given, "scene_resolved.toml": resolved_toml(scene)}
     if status.startswith("failed"):              # (a run that ended writes its script after the record)
@@ -317,7 +318,8 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     return [folder / name for name in texts]
 
 
-PART = ("status", "command", "ranks", "start", "end", "stage_wall_time_s", "total_wall_time_s")   # a part's keys
+PART = ("status", "command", "ranks", "code", "start", "end", "stage_wall_time_s", "total_wall_time_s")   # a part's
+#                                                           keys ("code": the SHA-1 of the package's files, ``code``)
 
 
 def parts_of(folder: Path) -> list[dict]:

@@ -569,7 +569,7 @@ def test_resume_from_a_released_step_gives_the_straight_history(cycle, tmp_path)
 def test_a_loop_that_fails_keeps_the_history_of_its_steps(tmp_path, monkeypatch, free_communicators):
     """Step 2 fails (simulated): history.h5 holds the start and step 1 as the checkpoint does
     (before: written only at the end of the loop, so a killed or failed run had none to look at);
-    its record lists the files it wrote (it named paraview.py, never written) and the warnings of
+    its record lists the files it wrote (it named open_in_paraview.py, never written) and the warnings of
     the steps it wrote (a micro.p_max below the zone pressures: none were recorded; user trials).
     The failed run's model is closed (one rank): a second failed run in the process costs no MPI
     communicators (before: 58 of MPICH's 2048 each)."""
@@ -596,7 +596,7 @@ def test_a_loop_that_fails_keeps_the_history_of_its_steps(tmp_path, monkeypatch,
     record = json.loads((tmp_path / "failed" / "provenance.json").read_text())    # what it wrote
     assert record["status"] == "failed: ConvergenceError: step 2 fails (simulated)"
     assert [w for w in record["warnings"] if w.startswith("the zone pressures reached ")]   # of its steps: lost before
-    assert "history.h5" in record["files"] and "paraview.py" not in record["files"]
+    assert "history.h5" in record["files"] and "open_in_paraview.py" not in record["files"]
     assert all((tmp_path / "failed" / name).exists() for name in record["files"])
 
 

@@ -337,7 +337,7 @@ def test_multiscale_run_hands_stability_scenes_to_the_squeal_analysis(tmp_path, 
     monkeypatch.setattr(squeal, "run", lambda sc, **kw: seen.append((sc, kw)) or done)
     assert workflows.run(scene, overwrite=True, verbose=False) is done
     assert seen[0][0] is scene and seen[0][1]["overwrite"] is True
-    assert sorted(f.name for f in done.files) == ["paraview.py", "provenance.json", "scene.toml",
+    assert sorted(f.name for f in done.files) == ["open_in_paraview.py", "provenance.json", "scene.toml",
                                                   "scene_resolved.toml"]      # the provenance beside
     with pytest.raises(InputError, match="no checkpoints"):
         workflows.run(scene, resume=True)

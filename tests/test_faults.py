@@ -246,7 +246,7 @@ def interrupt(tmp_path, ranks: int, sent_signal: str = "SIGINT"):
 @pytest.mark.parametrize("ranks, sent_signal", [(1, "SIGINT"), (2, "SIGINT"), (1, "SIGTERM")])
 def test_ctrl_c_stops_the_run_after_its_step_with_the_results_written(tmp_path, ranks, sent_signal):
     """Ctrl-C during the steps: every rank stops after the same step, the history, its plot, the
-    fields of that step and paraview.py are written, and the job ends with exit code 130 and one
+    fields of that step and open_in_paraview.py are written, and the job ends with exit code 130 and one
     line saying where the results are (before: a Python traceback per rank, or PETSc's "error code
     101" when the signal came inside a Newton callback, and no plot); provenance.json says so.
     SIGTERM (a batch scheduler's time limit) does the same: it killed the run, its provenance left
@@ -269,7 +269,7 @@ def test_ctrl_c_stops_the_run_after_its_step_with_the_results_written(tmp_path, 
                      f"provenance.json says so); {launcher}{COMMAND} run {tmp_path / 'scene.toml'} --overwrite "
                      "starts again"]
     assert len(History.read(folder / "history.h5")) == done + 1
-    assert (folder / "history.png").stat().st_size > 0 and (folder / "paraview.py").exists()
+    assert (folder / "history.png").stat().st_size > 0 and (folder / "open_in_paraview.py").exists()
     import meshio
     with meshio.xdmf.TimeSeriesReader(str(folder / "block.xdmf")) as reader:
         reader.read_points_cells()
@@ -342,7 +342,7 @@ def test_the_watcher_leaves_a_ctrl_c_a_step_stop_took_even_when_it_reads_it_late
     """``CtrlCWatch`` reads a SIGINT's wake-up byte when its thread runs, maybe after the
     ``StepStop`` that took the signal put the default handler back: it then took the signal for
     one the main thread never met and aborted the run while its end was written (1 in 6 quick
-    multi-Ctrl-C tries: provenance.json left "running", no paraview.py). The byte is fed here by
+    multi-Ctrl-C tries: provenance.json left "running", no open_in_paraview.py). The byte is fed here by
     hand after the StepStop ended: left alone; a further SIGINT nobody took still ends the job."""
     import signal
     import threading
@@ -377,9 +377,9 @@ def test_the_watcher_leaves_a_ctrl_c_a_step_stop_took_even_when_it_reads_it_late
 @pytest.mark.parametrize("kind", ["transient", "multiscale"])
 def test_an_abandoned_step_leaves_the_plots_and_paraview_script_of_what_was_written(tmp_path, monkeypatch, kind):
     """Three Ctrl-C during step 2 abandon it (``StepStop``): history.png (and multiscale.png) are
-    drawn from history.h5 as written (t = 0 and step 1) and paraview.py opens the fields written,
+    drawn from history.h5 as written (t = 0 and step 1) and open_in_paraview.py opens the fields written,
     as after a stop at the end of a step (before: the run ended with neither history.png nor
-    paraview.py; the loop writes history.h5 alone)."""
+    open_in_paraview.py; the loop writes history.h5 alone)."""
     import json
     import signal
 
@@ -417,14 +417,14 @@ def test_an_abandoned_step_leaves_the_plots_and_paraview_script_of_what_was_writ
     for png, figure in plots:                    # the figure of the history written, nothing else
         figure(history, tmp_path / png, scene.name)
         assert (folder / png).read_bytes() == (tmp_path / png).read_bytes(), png
-    assert (folder / "paraview.py").read_text() == outputs.paraview_script(outputs.plan(scene))
+    assert (folder / "open_in_paraview.py").read_text() == outputs.paraview_script(outputs.plan(scene))
 
 
 def test_a_second_ctrl_c_while_the_run_stops_leaves_its_results_whole(tmp_path):
     """Two Ctrl-C a moment apart (the second once the first is acknowledged): the run still stops
-    after its step with every result of that step written: history, fields, plot, paraview.py and
+    after its step with every result of that step written: history, fields, plot, open_in_paraview.py and
     provenance.json agree (before: the second interrupted the writing: fields of t = 30.0 s beside a
-    history to 30.6 s, provenance "interrupted" without the step, no history.png nor paraview.py)."""
+    history to 30.6 s, provenance "interrupted" without the step, no history.png nor open_in_paraview.py)."""
     import json
     import signal
 
@@ -465,7 +465,7 @@ def test_a_second_ctrl_c_while_the_run_stops_leaves_its_results_whole(tmp_path):
     with meshio.xdmf.TimeSeriesReader(str(folder / "block.xdmf")) as reader:
         reader.read_points_cells()
         assert reader.read_data(reader.num_steps - 1)[0] == pytest.approx(done * 3 / 4000)   # the stop's fields
-    assert (folder / "history.png").stat().st_size > 0 and (folder / "paraview.py").exists()
+    assert (folder / "history.png").stat().st_size > 0 and (folder / "open_in_paraview.py").exists()
 
 
 # the mesh build of the cooling block held up: one rank in a collective operation that waits for

@@ -296,6 +296,8 @@ def test_a_resumed_run_says_the_heat_warnings_of_the_whole_run_once(tmp_path, mo
     assert last["status"] == record["status"] == "resumed and finished" and last["ranks"] == record["ranks"] == 1
     assert "restoring the checkpoint" in last["stage_wall_time_s"] and (record["start"], record["end"]) == (
         first["start"], last["end"])
+    assert first["code"] == last["code"] == record["code"]["sha1"]     # each part's code (one record's hash:
+    #                                                                    a resume after a change hid it; a user trial)
     assert record["total_wall_time_s"] == pytest.approx(first["total_wall_time_s"] + last["total_wall_time_s"],
                                                         abs=2e-3)
     for stage, seconds in record["stage_wall_time_s"].items():

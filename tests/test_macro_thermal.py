@@ -515,7 +515,7 @@ def test_energy_balance_of_a_stop(tmp_path, disc_c):
         text = text.replace('chi = "1e-5 m^2/s"\nalpha = "1e-5 1/K"', disc_c + 'alpha = "1e-5 1/K"', 1)
         assert "3000" in text
     result = run(loads(text), verbose=False)
-    assert "paraview.py" not in {f.name for f in result.files} | {f.name for f in (tmp_path / "stop").iterdir()}
+    assert "open_in_paraview.py" not in {f.name for f in result.files} | {f.name for f in (tmp_path / "stop").iterdir()}
     h = History.read(result.history_file)             # (fields = []: no script that opens nothing)
     final = {k: v[-1] for k, v in h.columns.items()}
     work = final["heat_total_pin"] + final["heat_total_disc"]

@@ -179,8 +179,8 @@ def test_provenance_and_paraview_script(case):
     else:
         assert {"meshing", "macro steps"} <= set(record["stage_wall_time_s"])
     assert record["start"] <= record["end"] and record["total_wall_time_s"] > 0
-    assert record["parts"] == [{k: record[k] for k in ("status", "command", "ranks", "start", "end",
-                                                       "stage_wall_time_s", "total_wall_time_s")}]   # not resumed
+    assert record["parts"] == [{"code": record["code"]["sha1"], **{k: record[k] for k in (
+        "status", "command", "ranks", "start", "end", "stage_wall_time_s", "total_wall_time_s")}}]   # not resumed
     assert record["files"] == sorted(p.files)          # what a later --overwrite deletes
     overrides = dict(record["overrides"])         # scene.toml alone is not this run (before: nothing said so)
     if p.analysis == "squeal":                    # run from its resolved scene, no overrides
@@ -196,8 +196,8 @@ def test_provenance_and_paraview_script(case):
     resolved = (p.folder / "scene_resolved.toml").read_text()
     again = loads(resolved, scene.source.parent, name=scene.name)
     assert resolved_toml(again).splitlines()[2:] == resolved.splitlines()[2:]
-    script = (p.folder / "paraview.py").read_text()
-    compile(script, "paraview.py", "exec")
+    script = (p.folder / "open_in_paraview.py").read_text()
+    compile(script, "open_in_paraview.py", "exec")
     for name in p.field_files:
         assert repr(name) in script
     assert "'temperature [K]'" in script if scene.has("thermal") else "'contact pressure [Pa]'" in script
@@ -239,7 +239,7 @@ def test_zone_results_say_where_each_value_is(case):
 
 
 class StubParaView:
-    """paraview.simple as far as paraview.py uses it, recording what the script opens, shows and
+    """paraview.simple as far as open_in_paraview.py uses it, recording what the script opens, shows and
     colours (``opened``: path -> reader; ``coloured``: (reader, array name))."""
 
     def __init__(self):
@@ -274,20 +274,20 @@ class StubParaView:
 
 
 def run_script(script: str, folder: Path, monkeypatch) -> StubParaView:
-    """Execute a paraview.py as if it lay in ``folder``, against ``StubParaView``."""
+    """Execute a open_in_paraview.py as if it lay in ``folder``, against ``StubParaView``."""
     stub = StubParaView()
     monkeypatch.setitem(sys.modules, "paraview", types.ModuleType("paraview"))
     monkeypatch.setitem(sys.modules, "paraview.simple", stub.module)
-    exec(compile(script, "paraview.py", "exec"), {"__file__": str(folder / "paraview.py"), "__name__": "pv"})
+    exec(compile(script, "open_in_paraview.py", "exec"), {"__file__": str(folder / "open_in_paraview.py"), "__name__": "pv"})
     return stub
 
 
 def test_the_paraview_script_opens_files_and_arrays_that_exist(case, monkeypatch):
-    """paraview.py, run against a stub of paraview.simple: every file it opens is in the folder and
+    """open_in_paraview.py, run against a stub of paraview.simple: every file it opens is in the folder and
     every array it colours or warps by is in that file."""
     import h5py
     _, p, _ = case
-    stub = run_script((p.folder / "paraview.py").read_text(), p.folder, monkeypatch)
+    stub = run_script((p.folder / "open_in_paraview.py").read_text(), p.folder, monkeypatch)
     assert sorted(Path(path).name for path in stub.opened) == sorted(
         list(p.field_files) + ([f"modes_{b}.bp" for b in p.bodies] if p.analysis == "squeal" else []))
     # the interface in a view of its own (on the bodies' faces it was hidden); squeal: the mode

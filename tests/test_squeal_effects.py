@@ -233,7 +233,7 @@ def test_scene_friction_sweep_writes_the_map(tmp_path, documented):
     names = {p.name for p in run.files}
     assert {"map.csv", "onsets.csv", "map.h5", "map.png", "map_tracks.png"} <= names
     # what check promised (and a later --overwrite deletes; before, the map's files were missing)
-    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(set(plan(scene).files) - {"paraview.py"})
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(set(plan(scene).files) - {"open_in_paraview.py"})
     smap = run.map
     np.testing.assert_allclose(smap.values, [0.0, 0.2, 0.4, 0.6])
     assert f"(common basis of {smap.basis_size})" in smap.summary() and smap.basis_size > 0
@@ -395,7 +395,7 @@ def test_scene_damping_and_stribeck_options(tmp_path, documented):
     assert run.case.modes.errors.max() < squeal.MODE_RESIDUAL           # measured 1.9e-3 (0.15 before)
     assert not [w for w in run.warnings if "relative residuals" in w]
     assert (tmp_path / "out" / "prestress.csv").exists()
-    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(set(plan(scene).files) - {"paraview.py"})
+    assert sorted(p.name for p in (tmp_path / "out").iterdir()) == sorted(set(plan(scene).files) - {"open_in_paraview.py"})
     assert np.all(np.abs(run.case.prestress.shift) < 0.01 * run.case.prestress.frequency)
     with open(tmp_path / "out" / "prestress.csv", newline="") as f:
         table = list(csv.DictReader(f))

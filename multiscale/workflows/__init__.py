@@ -38,7 +38,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     """Run a scene (``multiscale run``) with its workflow; only the multiscale loop resumes.
 
     Besides the analysis' results, the folder receives ``scene.toml``, ``scene_resolved.toml``,
-    ``provenance.json`` (also after a failure, once the run has written into the folder) and ``paraview.py``.
+    ``provenance.json`` (also after a failure, once the run has written into the folder) and ``open_in_paraview.py``.
     ``verbose``: stage lines and the summary on rank 0 (the warnings are printed in any case, the
     scene's first; ``result.warnings`` holds them all, for a script)."""
     if not all(hasattr(scene, a) for a in ("has", "effects", "output")):
@@ -105,8 +105,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
 
 
 def _write_script(folder: Path, scene) -> list[Path]:
-    """``paraview.py`` beside the results (rank 0), if they hold fields or mode shapes to open."""
-    p, path = outputs.plan(scene), Path(folder) / "paraview.py"
+    """``open_in_paraview.py`` beside the results (rank 0), if they hold fields or mode shapes to open."""
+    p, path = outputs.plan(scene), Path(folder) / "open_in_paraview.py"
     if path.name not in p.files:
         return []
     path.write_text(outputs.paraview_script(p))
@@ -117,7 +117,7 @@ def _abandoned(folder: Path, scene) -> None:
     """After a Ctrl-C that abandoned a step (the third, ``io.StepStop``) or came outside the steps
     of a run with a history (rank 0): with ``output.figures``, history.png (and a multiscale run's
     multiscale.png) drawn from history.h5 as written (the loop writes each step's row whole), and
-    paraview.py once a field file is written. The zone results of a multiscale run (zones.h5, wear
+    open_in_paraview.py once a field file is written. The zone results of a multiscale run (zones.h5, wear
     maps) need the state of its last step: they stay as they were."""
     kind, h5 = workflow(scene), Path(folder) / "history.h5"
     if kind == "squeal":
