@@ -94,6 +94,9 @@ def test_hertz_study_errors_match_an_independent_computation(hertz_study):
     with h5py.File(out / "results.h5", "r") as h5:
         np.testing.assert_allclose(h5["max_pressure_error"][...], [float(r["max_pressure_error"]) for r in rows])
         assert list(h5["grid"][...]) == list(GRIDS)
+        # units as history.h5's (they were in the report alone; a user trial); a relative error has none
+        assert (h5["max_pressure"].attrs["unit"], h5["contact_radius_reference"].attrs["unit"],
+                h5["wall_time"].attrs["unit"]) == ("Pa", "m", "s") and "unit" not in h5["max_pressure_error"].attrs
     # the report names the cheapest grid meeting each error, from the same errors
     worst = {int(r["grid"]): float(r["max_error"]) for r in rows}
     time = {int(r["grid"]): float(r["wall_time"]) for r in rows}

@@ -140,7 +140,8 @@ def _cell(value):
 
 
 def write_tables(study: Study, rows: list[Row]) -> tuple[Path, Path]:
-    """results.csv and results.h5 (one dataset per column, one row per run)."""
+    """results.csv and results.h5 (one dataset per column, one row per run; a metric's, its
+    reference's and the times' with their ``unit`` attribute, as history.h5's)."""
     cols = _columns(study, rows)
     study.folder.mkdir(parents=True, exist_ok=True)
     csv_path, h5_path = study.folder / "results.csv", study.folder / "results.h5"
@@ -149,12 +150,17 @@ def write_tables(study: Study, rows: list[Row]) -> tuple[Path, Path]:
         w.writerow(cols)
         for i in range(len(rows)):
             w.writerow([_csv(cols[c][i]) for c in cols])
+    units = {**{m: PROBLEMS[study.problem].metric_unit(m) for m in study.metrics},
+             **{f"{m}_reference": PROBLEMS[study.problem].metric_unit(m) for m in study.metrics},
+             "wall_time": "s", "cpu_time": "s", "peak_memory_mb": "MB"}    # (said by the report alone; a user trial)
     with h5py.File(h5_path, "w") as h5:
         for name, values in cols.items():
             if all(isinstance(v, (int, float, bool)) for v in values):
                 h5.create_dataset(name, data=np.asarray(values))
             else:
                 h5.create_dataset(name, data=[str(v) for v in values], dtype=h5py.string_dtype())
+            if units.get(name):
+                h5[name].attrs["unit"] = units[name]
         h5.attrs.update(study=study.name, problem=study.problem, source=str(study.source),
                         reference=reference_text(study), metrics=list(study.metrics), knobs=list(study.knobs))
     return csv_path, h5_path
