@@ -29,8 +29,8 @@ from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Sectio
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
 from multiscale.scene_plain import plain_speeds
-from multiscale.scene_rough import (measured_cover, micro_constants, nyquist, own_tables, penalty_range, perfect_contact,
-                                    rough_rules, roughness_over, thin_layer, zone_sizes)
+from multiscale.scene_rough import (measured_cover, micro_constants, nyquist, own_surface_tables, own_tables,
+                                    penalty_range, perfect_contact, rough_rules, roughness_over, thin_layer, zone_sizes)
 from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
@@ -121,9 +121,7 @@ class RoughnessSection(Section):
     file: missing", its keys unread; a user trial)."""
 
     def read(self, raw, path, ctx):
-        own = ctx.root.get("interfaces") if isinstance(ctx.root.get("interfaces"), dict) else {}
-        if path not in ctx.root and any(isinstance(t, dict) and isinstance(t.get("roughness"), dict)
-                                        and {"rms", "file"} & t["roughness"].keys() for t in own.values()):
+        if path not in ctx.root and any({"rms", "file"} & t.keys() for t in own_surface_tables(ctx.root)):
             return None
         return super().read(raw, path, ctx)
 
@@ -413,7 +411,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                 if given and name in scene.materials and scene.materials[name].k_w is not None:
                     problems.append(f"wear.{given[0]}: the rough body's material gives k_w "
                                     f"(materials.{name}.k_w): give one of them")
-        problems += [] if problems else [str(e) for e in rough_rules(scene)]
+        if not problems:
+            problems += [str(e) for e in rough_rules(scene)]
         if not problems:
             problems += (nyquist(scene) + thin_layer(scene) + measured_cover(scene, warnings)
                          + perfect_contact(scene, warnings) + own_tables(scene, warnings))

@@ -36,6 +36,12 @@ def roughness_over(base: dict, own: dict) -> dict:
     return {**{k: v for k, v in base.items() if k not in drop}, **own}
 
 
+def own_surface_tables(root: dict) -> list[dict]:
+    """The raw [interfaces.<name>.roughness] tables of a scene file ``root`` (those that are tables)."""
+    tables = root.get("interfaces") if isinstance(root.get("interfaces"), dict) else {}
+    return [t["roughness"] for t in tables.values() if isinstance(t, dict) and isinstance(t.get("roughness"), dict)]
+
+
 def rough_rules(scene) -> list[InputError]:
     """What every rough analysis needs (each an InputError naming the key): FFT-BEM laws, a rough
     interface, a surface for each (its own or [roughness]'s), the same materials on both sides of

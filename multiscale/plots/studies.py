@@ -27,7 +27,7 @@ def plot(study: Study, rows: list[Row], folder: Path) -> list[Path]:
     labelled), and per knob: error (or metric) and wall time vs the knob; the study's earlier PNGs
     are removed first, so none is left beside a report that no longer draws it."""
     ok = [r for r in rows if r.ok]
-    for stale in [folder / f"{study.name}_error_vs_time.png"] + [_axis_path(study, axis, folder) for axis in study.axes]:
+    for stale in [_pareto_path(study, folder)] + [_axis_path(study, axis, folder) for axis in study.axes]:
         stale.unlink(missing_ok=True)    # (a report of failed runs sat beside the plots of the study before; a user trial)
     if not ok or not study.report.plots:
         return []
@@ -94,10 +94,14 @@ def _plot_pareto(study, ok, folder):
         return None
     fig.suptitle(f"{study.name}: relative error against wall time (lower left is better)")
     fig.tight_layout()
-    path = folder / f"{study.name}_error_vs_time.png"
+    path = _pareto_path(study, folder)
     fig.savefig(path, dpi=100)
     plt.close(fig)
     return path
+
+
+def _pareto_path(study, folder: Path) -> Path:
+    return folder / f"{study.name}_error_vs_time.png"
 
 
 def _axis_path(study, axis, folder: Path) -> Path:
