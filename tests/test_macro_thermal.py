@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from scipy import integrate
 from scipy.integrate import solve_ivp
 from scipy.optimize import brentq
 
@@ -39,6 +40,11 @@ def test_kirchhoff_slab_of_constant_conductivity_is_linear():
     z = np.linspace(0, 0.01, 7)
     np.testing.assert_allclose(kirchhoff_slab(z, 0.01, 300, 600, ((0, 10.0), (1000, 10.0))), 300 + 3e4 * z, rtol=1e-12)
     assert float(kirchhoff_transform(600, ((300, 50.0), (600, 25.0)), 300)) == pytest.approx(37.5 * 300, rel=1e-14)
+    table = ((300.0, 50.0), (450.0, 30.0), (600.0, 25.0))          # against quadrature, beyond both ends too
+    T = np.array([250.0, 320.0, 450.0, 599.0, 700.0])
+    quad = [integrate.quad(lambda s: np.interp(s, *zip(*table)), 400.0, t, points=[300, 450, 600], epsabs=0,
+                           epsrel=1e-13)[0] for t in T]
+    np.testing.assert_allclose(kirchhoff_transform(T, table, 400.0), quad, rtol=1e-12)
 
 
 # ------------------------------------------------------------------ the solver, through scenes

@@ -123,13 +123,15 @@ def kirchhoff_transform(T, table, T_ref: float):
     if len(xs) < 2 or np.any(np.diff(xs) <= 0):
         raise InputError("table", table, "at least two rows with increasing temperatures")
 
-    def one(T):
-        lo, hi = sorted((T_ref, T))
-        grid = np.concatenate([[lo], xs[(xs > lo) & (xs < hi)], [hi]])
-        k = np.interp(grid, xs, ys)
-        integral = float(np.sum((k[1:] + k[:-1]) / 2 * np.diff(grid)))
-        return integral if T >= T_ref else -integral
-    return np.vectorize(one, otypes=[float])(np.asarray(T, dtype=float))
+    knots = np.concatenate([[0.0], np.cumsum((ys[1:] + ys[:-1]) / 2 * np.diff(xs))])
+
+    def primitive(T):            # ∫_{xs[0]}^{T} kappa ds, trapezoids exact on each linear piece
+        T = np.asarray(T, dtype=float)
+        at = np.clip(T, xs[0], xs[-1])
+        k = np.clip(np.searchsorted(xs, at, side="right") - 1, 0, len(xs) - 2)
+        inside = knots[k] + (at - xs[k]) * (ys[k] + np.interp(at, xs, ys)) / 2
+        return inside + np.minimum(T - xs[0], 0.0) * ys[0] + np.maximum(T - xs[-1], 0.0) * ys[-1]
+    return primitive(T) - primitive(T_ref)
 
 
 def kirchhoff_slab(z, length: float, T_low: float, T_high: float, table):
