@@ -328,10 +328,9 @@ class Thermal:
             T_n = ufl.variable(self.T_old[1])                   # kappa'(T) at T^n: see the module docstring
             slope = ufl.diff(self.conductivity[1].expression(T_n, self.T_ref), T_n)
             residual -= kappa * ufl.div(ufl.grad(T)) + slope * ufl.dot(ufl.grad(T), ufl.grad(T))
-        # tau is no polynomial (UFL estimated degree 8 with constant materials, 9 with tables: 45
-        # points a P2 cell, one weight negative): the enthalpy's rule (P2: degree 5, 15 points), exact
-        # for the Galerkin part e w.grad(r) with constant materials; at least degree 4 (P1: FFCx's
-        # degree-3 rule has a negative weight). The SUPG term moved by 4e-8 of the rise (two pads)
+        # tau is no polynomial (UFL estimated degree 8-9: 45 points a P2 cell, one weight negative):
+        # the enthalpy's rule (P2: degree 5, 15 points), exact for the Galerkin part e w.grad(r) with
+        # constant materials; at least degree 4 (P1: FFCx's degree-3 rule has a negative weight)
         dx = self._dx(1, max(self._enthalpy_degree(1), 4))
         return (-e * ufl.dot(w, ufl.grad(r)) + tau * ufl.dot(w, ufl.grad(r)) * residual) * dx
 
