@@ -274,7 +274,7 @@ class Thermal:
         return p1 * self.spaces[i].element.basix_element.degree
 
     def _enthalpy_degree(self, i: int) -> int:
-        """Quadrature degree of body i's terms with tabulated materials (``ENTHALPY_QUADRATURE``)."""
+        """Quadrature degree of body i's tabulated-material terms and of its transport (``ENTHALPY_QUADRATURE``)."""
         return ENTHALPY_QUADRATURE + 2 * (self.spaces[i].element.basix_element.degree - 1)
 
     def _rate(self, i: int):
