@@ -19,7 +19,6 @@ from mpi4py import MPI
 from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError, Interrupted, interrupted
 from multiscale.micro.wear import STEP_RMS, SUBSTEP_TOL
-from multiscale.plots.history import history_figure, multiscale_figure
 from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.model import interface_materials
@@ -123,6 +122,7 @@ def _abandoned(folder: Path, scene) -> None:
     if kind == "squeal":
         return
     if h5.is_file() and scene.output.figures:
+        from multiscale.plots.history import history_figure, multiscale_figure  # local: matplotlib only when a figure is drawn
         history = io.History.read(h5)
         history_figure(history, h5.with_name("history.png"), title=scene.name)
         if kind == "multiscale":

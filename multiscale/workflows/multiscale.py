@@ -40,7 +40,6 @@ from multiscale.macro.output import FieldOutput
 from multiscale.micro.heat_kernels import ThermalMaterial
 from multiscale.micro.laws import Conductance
 from multiscale.micro.post_analysis import Heating, PostAnalyses, PostAnalysis, grid_of
-from multiscale.plots.history import multiscale_figure, wear_map
 from multiscale.provenance import resolved_toml
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, heat_warnings_as_notes, \
     interface_forces, interface_materials, model_size, run_notes
@@ -293,6 +292,7 @@ def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: 
 
     def write():
         if plot:
+            from multiscale.plots.history import multiscale_figure  # local: matplotlib only when a figure is drawn
             multiscale_figure(history, plot, name)
         with h5py.File(zones, "w") as h5:
             h5.create_dataset("centre", data=np.array([z.centre for z in rough.zones])).attrs["unit"] = "m"   # (u, v)
@@ -309,7 +309,11 @@ def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: 
             h5.attrs["counts"] = np.array([g.counts for g in rough.grids])     # (interfaces, 2)
     offsets = np.cumsum([0] + [g.n_zones for g in rough.grids])
     faces = [rough.planes[k].uv(ms.tm.interface.triangles(n)) for k, n in enumerate(names)] if maps else []
-    jobs = [write] + [partial(wear_map, grid, depth[offsets[k]:offsets[k + 1]], path, f"{name}: {interface}", face)
+
+    def draw(*args):
+        from multiscale.plots.history import wear_map  # local: matplotlib only when a figure is drawn
+        return wear_map(*args)
+    jobs = [write] + [partial(draw, grid, depth[offsets[k]:offsets[k + 1]], path, f"{name}: {interface}", face)
                       for k, (grid, path, interface, face) in enumerate(zip(rough.grids, maps, names, faces))]
     io.on_ranks(comm, jobs, f"the zone results in {folder}")        # the wear maps spread over the ranks
     return plot, maps, zones

@@ -50,7 +50,6 @@ from multiscale.macro.modal import CLOSE, EnergyShares, RegionEnergy, StabilityR
 from multiscale.macro.output import write_modes, write_state
 from multiscale.macro.preload import Preload, linearise_system, preload
 from multiscale.macro.stability_map import StabilityMap
-from multiscale.plots.squeal import plot_energy, plot_pressure, plot_re_im
 from multiscale.workflows import squeal_map
 from multiscale.workflows.model import build_mechanics, build_mesh, drive, friction_coefficient, interface_forces, \
     model_size
@@ -310,9 +309,11 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         with io.stage("writing the preload"):
             files.extend(write_state(folder, mech, plan.body_fields + plan.interface_fields))
             pressure = mech.contact.facet_pressure()
-            files.extend(io.on_root(comm, lambda: [plot_pressure(tm.interface.midpoints, masks, pressure, scene.name,
-                                                                 folder / "pressure.png")]
-                                    if scene.output.figures else [], f"the figures in {folder}") or [])
+
+            def figure():
+                from multiscale.plots.squeal import plot_pressure  # local: matplotlib only when a figure is drawn
+                return [plot_pressure(tm.interface.midpoints, masks, pressure, scene.name, folder / "pressure.png")]
+            files.extend(io.on_root(comm, figure if scene.output.figures else list, f"the figures in {folder}") or [])
     case = analyse(scene, tm, degree=degree, on_preload=preloaded)
     with closed_on_error(case.mech, comm):       # a script going on after a failed run gets its communicators
         with io.stage("writing results"):
@@ -324,8 +325,10 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
             split = energy_split(tm)
 
             def figures():
-                out = [plot_re_im([case], folder / "re_im.png"),
-                       plot_energy(case, folder / "energy.png", split)] if scene.output.figures else []
+                out = []
+                if scene.output.figures:
+                    from multiscale.plots.squeal import plot_energy, plot_re_im  # local: matplotlib only when a figure is drawn
+                    out += [plot_re_im([case], folder / "re_im.png"), plot_energy(case, folder / "energy.png", split)]
                 if case.prestress is not None:
                     out.append(write_prestress_csv(case.prestress, folder / "prestress.csv"))
                 return out

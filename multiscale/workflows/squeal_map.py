@@ -40,7 +40,6 @@ from multiscale.macro.friction import set_friction
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.preload import linearise_system, preload
 from multiscale.macro.stability_map import MapBuilder, StabilityMap
-from multiscale.plots.squeal import plot_map, plot_tracks
 from multiscale.schema import FrozenMap
 from multiscale.scene_stability import SWEEP_PARAMETERS
 
@@ -176,8 +175,12 @@ def write(smap: StabilityMap, folder, comm=MPI.COMM_WORLD, figures: bool = True,
     track turns unstable"; a user trial) and, with ``figures``, its figures (rank 0 writes, the
     list is empty elsewhere; a failed write is an OutputError on every rank)."""
     folder = Path(folder)
-    return io.on_root(comm, lambda: [
-        smap.write_csv(folder / "map.csv"), *([smap.write_onsets_csv(folder / "onsets.csv")] if onsets else []),
-        smap.write_h5(folder / "map.h5")]
-        + ([plot_map(smap, folder / "map.png"), plot_tracks(smap, folder / "map_tracks.png")] if figures else []),
-        f"the stability map in {folder}") or []
+
+    def files():
+        out = [smap.write_csv(folder / "map.csv"), *([smap.write_onsets_csv(folder / "onsets.csv")] if onsets else []),
+               smap.write_h5(folder / "map.h5")]
+        if figures:
+            from multiscale.plots.squeal import plot_map, plot_tracks  # local: matplotlib only when a figure is drawn
+            out += [plot_map(smap, folder / "map.png"), plot_tracks(smap, folder / "map_tracks.png")]
+        return out
+    return io.on_root(comm, files, f"the stability map in {folder}") or []

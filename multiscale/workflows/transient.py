@@ -18,7 +18,6 @@ from multiscale import io, outputs
 from multiscale.errors import Interrupted
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.output import FieldOutput
-from multiscale.plots.history import history_figure
 from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, model_size, run_notes
 from multiscale.workflows.output import RunResult, prepare_folder
 from multiscale.workflows.strain import say_at_once
@@ -42,6 +41,7 @@ def write_history(history: io.History, folder: Path, name: str, comm, plot: bool
     def write():
         history.write(h5, {"scene": name, "ranks": comm.size})
         if plot:
+            from multiscale.plots.history import history_figure  # local: matplotlib only when a figure is drawn
             history_figure(history, png, title=name)
     io.on_root(comm, write, f"the history {h5}")
     return h5, png
