@@ -20,6 +20,7 @@ import h5py
 import numpy as np
 
 from multiscale import __version__
+from multiscale.arrays import unique_rows
 from multiscale.errors import InputError
 from multiscale.io import on_root, replacing
 
@@ -199,8 +200,7 @@ def peek(path, comm) -> dict:
 def _match(stored: np.ndarray, wanted: np.ndarray) -> np.ndarray:
     """Row of ``stored`` equal to each row of ``wanted`` (-1 where none)."""
     both = np.concatenate([stored, wanted])
-    _, inverse = np.unique(both, axis=0, return_inverse=True)
-    inverse = inverse.ravel()
+    inverse = unique_rows(both).inverse
     where = np.full(inverse.max(initial=-1) + 1, -1)
     where[inverse[:len(stored)]] = np.arange(len(stored))
     return where[inverse[len(stored):]]

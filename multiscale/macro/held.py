@@ -30,6 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from multiscale.arrays import unique_rows
 from multiscale.errors import InputError
 from multiscale.geometry import GeometrySpec, Rotation
 
@@ -96,8 +97,8 @@ class Parts:
         order = np.argsort(tags)
         tags, xyz = tags[order], xyz.reshape(-1, 3)[order]
         faces = np.sort(tets[:, [[1, 2, 3], [0, 2, 3], [0, 1, 3], [0, 1, 2]]].reshape(-1, 3), axis=1)
-        rows, face_of = np.unique(np.hstack([np.repeat(body, 4)[:, None], faces]), axis=0, return_inverse=True)
-        face_of, n = face_of.ravel(), len(tets)
+        distinct = unique_rows(np.hstack([np.repeat(body, 4)[:, None], faces]))
+        rows, face_of, n = distinct.values, distinct.inverse, len(tets)
         graph = scipy.sparse.coo_matrix((np.ones(face_of.size), (np.repeat(np.arange(n), 4), n + face_of)),
                                         shape=(n + len(rows),) * 2)
         n_parts, label = connected_components(graph, directed=False)
@@ -167,8 +168,9 @@ class Holding:
         """Nodes shared by parts of one body: their relative translation (weight: the squared size
         of the cells at the node)."""
         P = self.parts
-        keys = np.unique(np.stack([np.repeat(P.body, 4), P.index.ravel(), np.repeat(P.label, 4)], axis=1), axis=0)
-        _, first, count = np.unique(keys[:, :2], axis=0, return_index=True, return_counts=True)
+        keys = unique_rows(np.stack([np.repeat(P.body, 4), P.index.ravel(), np.repeat(P.label, 4)], axis=1)).values
+        nodes = unique_rows(keys[:, :2])
+        first, count = nodes.first, nodes.counts
         corner = P.xyz[P.index]
         volume = np.abs(np.einsum("ij,ij->i", corner[:, 1] - corner[:, 0],
                                   np.cross(corner[:, 2] - corner[:, 0], corner[:, 3] - corner[:, 0]))) / 6
@@ -203,7 +205,7 @@ class Holding:
             if not len(tri):
                 continue
             pair = np.stack([self.parts.of_triangles(0, tri), self.parts.of_triangles(1, tri)], axis=1)
-            for p, q in np.unique(pair[(pair >= 0).all(axis=1)], axis=0):
+            for p, q in unique_rows(pair[(pair >= 0).all(axis=1)]).values:
                 on = (pair == (p, q)).all(axis=1)
                 for k in range(3):      # each corner stands for a third of its triangle
                     self.hold(int(p), int(q), x[on, k], n[on], area[on] / 3, sliding)

@@ -36,6 +36,7 @@ from dolfinx import fem
 from dolfinx.io import VTXMeshPolicy, VTXWriter
 
 from multiscale import io
+from multiscale.arrays import unique_rows
 from multiscale.errors import InputError, OutputError
 from multiscale.macro.unloaded import Unloaded, UnloadedWarning
 from multiscale.outputs import FIELDS, MODE_ARRAYS, PART_ARRAY, array_name
@@ -80,8 +81,8 @@ class MeshLayout:
         node order -> XDMF/VTK order)."""
         nodes = np.concatenate([p[0] for p in parts])
         corners = np.concatenate([p[1] for p in parts])
-        unique, inverse = np.unique(np.vstack([nodes, corners.reshape(-1, 3)]), axis=0, return_inverse=True)
-        inverse = inverse.ravel()
+        distinct = unique_rows(np.vstack([nodes, corners.reshape(-1, 3)]))
+        unique, inverse = distinct.values, distinct.inverse
         if len(unique) != len(nodes):
             raise InputError("mesh", len(nodes), "nodes of the field mesh must have distinct coordinates")
         self.node_position = inverse[:len(nodes)]

@@ -11,6 +11,7 @@ import numpy as np
 from dolfinx import fem
 from dolfinx import mesh as dmesh
 
+from multiscale.arrays import unique_rows
 from multiscale.errors import InputError, check_positive
 from multiscale.macro.mesh import TwoBodyMesh
 
@@ -83,7 +84,7 @@ def settle(found: dict, boundaries, comm) -> dict:
         return rows[:, 0].astype(np.int64) * 64 + rows[:, 1]          # a (cell, local facet) row as one number
 
     empty = np.empty((0, 2), np.int32)
-    whole = {ki: np.unique(np.concatenate([r for _, r in parts] + [empty]), axis=0) for ki, parts in found.items()}
+    whole = {ki: unique_rows(np.concatenate([r for _, r in parts] + [empty])).values for ki, parts in found.items()}
     named = {ki: key(np.concatenate([r for free, r in parts if not free] + [empty])) for ki, parts in found.items()}
     out = {}
     for (k, i), rows in whole.items():
