@@ -652,6 +652,8 @@ plots = false
     assert 'warning: study: metric "interface_forc:last" not produced (did you mean "interface_force:last"?)' \
         in capsys.readouterr().err                    # when its first run ends, not in the report after the last
     out = tmp_path / "results" / "study"
+    for record in (out / "runs").glob("*.json"):      # strict JSON: its history's NaN columns are null
+        assert json.loads(record.read_text(), parse_constant=lambda c: pytest.fail(f"{c} in {record.name}"))["ran"]
     row = table(out / "results.csv")[0]
     assert row["status"] == "failed"
     assert ('metric "interface_forc:last" not produced (did you mean "interface_force:last"?) (fix the name: the '
@@ -666,6 +668,21 @@ plots = false
     assert float(row["interface_force:last"]) == pytest.approx(3e6 * 10e-3 * 6e-3, rel=1e-6)
     assert float(row["max_pressure:max"]) == pytest.approx(3e6, rel=1e-3)
     assert (out / "runs" / row["run"] / "output" / "history.h5").is_file()
+
+
+def test_records_are_strict_json_and_read_non_finite_numbers_back_as_nan(tmp_path):
+    """A scene's history columns of NaN were written as bare NaN, which is no JSON (jq refused the
+    records); they are null now, and NaN again when read: the run fails as before."""
+    from multiscale.studies.records import metric_problem, read_json, write_json
+    path = tmp_path / "record.json"
+    write_json(path, {"metrics": {"a": math.nan, "b": np.float32("inf"), "c": 1.5}, "wall_time": 0.25,
+                      "wall_times": [0.25, math.nan], "error": None})
+    strict = json.loads(path.read_text(), parse_constant=lambda c: pytest.fail(c))
+    assert strict["metrics"] == {"a": None, "b": None, "c": 1.5} and strict["wall_times"] == [0.25, None]
+    back = read_json(path)
+    assert math.isnan(back["metrics"]["a"]) and math.isnan(back["metrics"]["b"]) and back["metrics"]["c"] == 1.5
+    assert math.isnan(back["wall_times"][1]) and back["error"] is None and back["wall_time"] == 0.25
+    assert metric_problem(back["metrics"], ["c", "a"]) == 'metric "a" is nan (not finite)'
 
 
 def test_runs_are_shared_out_over_mpi_ranks(tmp_path):
@@ -989,7 +1006,7 @@ def _cmdline(proc: Path) -> bytes:
 
 
 def test_records_of_another_shape_are_run_again(hertz_study, tmp_path, capsys):
-    """Run records that are valid JSON of another shape (a list, a metric null, a wall time "x"):
+    """Run records that are valid JSON of another shape (a list, a metric "x", a wall time "x"):
     the study ended in an AttributeError, TypeError or ValueError traceback and wrote no table (a
     trial of odd files). A list or a wall time of text is taken as not done, like a torn file, and
     runs again; a metric that is no number fails that run, saying so (--rerun-failed reruns it)."""
@@ -1001,7 +1018,7 @@ def test_records_of_another_shape_are_run_again(hertz_study, tmp_path, capsys):
     shutil.copytree(out / "runs", runs)
     other = write(tmp_path, HERTZ.replace("[run]", f'[run]\nfolder = "{tmp_path}"') + "plots = false\n")
     study = load_study(other)
-    bad = [lambda r: [1, 2, 3], lambda r: {**r, "metrics": {k: None for k in r["metrics"]}},
+    bad = [lambda r: [1, 2, 3], lambda r: {**r, "metrics": {k: "x" for k in r["metrics"]}},
            lambda r: {**r, "wall_time": "x"}]
     for run, spoil in zip(study.runs, bad):
         p = runs / f"{run.key}.json"
@@ -1011,5 +1028,5 @@ def test_records_of_another_shape_are_run_again(hertz_study, tmp_path, capsys):
     assert "2 recorded before, 2 run now, 1 failed" in capsys.readouterr().out
     rows = table(tmp_path / "results.csv")
     assert [r["status"] for r in rows] == ["ok", "failed", "ok", "ok"]
-    assert rows[1]["message"] == 'metric "contact_radius" is None (not a number)'
+    assert rows[1]["message"] == 'metric "contact_radius" is \'x\' (not a number)'
 

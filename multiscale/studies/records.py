@@ -7,15 +7,20 @@ from __future__ import annotations
 import json
 import math
 import os
+from collections.abc import Mapping
 from pathlib import Path
+
+import numpy as np
 
 from multiscale.schema import FrozenMap, suggest
 from multiscale.studies.expand import Study, StudyRun
 
-__all__ = ["FAILED", "foreign_records", "json_default", "metric_problem", "read_records", "record_path", "write_json"]
+__all__ = ["FAILED", "NUMBERS", "foreign_records", "json_default", "metric_problem", "read_json", "read_records",
+           "record_path", "write_json"]
 
 FAILED = "failed"              # a record's status when the run did not produce its metrics
 MAX_LISTED = 12                # metrics named in the message of a run that lacks one
+NUMBERS = ("wall_time", "cpu_time", "peak_memory_mb", "base_memory_mb", "jit_time", "iterations", "repeat")
 
 
 def record_path(study: Study, run: StudyRun) -> Path:
@@ -46,8 +51,7 @@ def _well_formed(record) -> bool:
     whose times, memory and iterations are numbers (a record edited or written by hand may not be)."""
     if not isinstance(record, dict) or not isinstance(record.get("metrics", {}), dict):
         return False
-    return all(isinstance(record.get(k, 0), (int, float)) and not isinstance(record.get(k, 0), bool)
-               for k in ("wall_time", "cpu_time", "peak_memory_mb", "iterations", "repeat"))
+    return all(isinstance(record.get(k, 0), (int, float)) and not isinstance(record.get(k, 0), bool) for k in NUMBERS)
 
 
 def read_records(study: Study) -> dict:
@@ -59,7 +63,7 @@ def read_records(study: Study) -> dict:
         p = record_path(study, run)
         if p.is_file():
             try:
-                record = json.loads(p.read_text())
+                record = read_json(p)
             except ValueError:
                 continue                  # a torn file: treat the run as not done
             if not _well_formed(record):
@@ -82,10 +86,39 @@ def foreign_records(study: Study) -> int:
 
 
 def write_json(path: Path, data) -> None:
-    """Atomic write (a reader never sees half a record)."""
+    """Atomic write (a reader never sees half a record) of strict JSON: a number that is not finite
+    (a scene's history column of NaN) is written null, which ``read_json`` reads back as NaN
+    (``NaN`` itself is no JSON: jq and JavaScript refused the records; a user trial)."""
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    tmp.write_text(json.dumps(data, indent=1, sort_keys=True, default=json_default))
+    tmp.write_text(json.dumps(_strict(data), indent=1, sort_keys=True, default=json_default, allow_nan=False))
     os.replace(tmp, path)
+
+
+def read_json(path: Path):
+    """A record or cached reference written by ``write_json``: null in its number fields, its
+    metrics, reference values and wall times is NaN again (earlier records' bare NaN reads too)."""
+    data = json.loads(Path(path).read_text())
+    if isinstance(data, dict):
+        for key in NUMBERS:
+            if key in data and data[key] is None:
+                data[key] = math.nan
+        for key in ("metrics", "reference", "values"):
+            if isinstance(data.get(key), dict):
+                data[key] = {k: math.nan if v is None else v for k, v in data[key].items()}
+        if isinstance(data.get("wall_times"), list):
+            data["wall_times"] = [math.nan if v is None else v for v in data["wall_times"]]
+    return data
+
+
+def _strict(value):
+    """``value`` with every non-finite float (numpy's included) replaced by None, tables and lists walked."""
+    if isinstance(value, Mapping):
+        return {k: _strict(v) for k, v in value.items()}
+    if isinstance(value, (list, tuple)):
+        return [_strict(v) for v in value]
+    if isinstance(value, (float, np.floating)) and not math.isfinite(value):
+        return None
+    return value
 
 
 def json_default(value):

@@ -24,7 +24,7 @@ from multiscale.errors import MultiscaleError
 from multiscale.io import on_root
 from multiscale.studies.expand import Study, StudyRun
 from multiscale.studies.formatting import now
-from multiscale.studies.records import FAILED, json_default, read_records, record_path, write_json
+from multiscale.studies.records import FAILED, json_default, read_json, read_records, record_path, write_json
 
 __all__ = ["ExecStats", "execute", "world"]
 
@@ -94,7 +94,7 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
                 elif proc.returncode != 0 or not record_path(study, run).is_file():
                     _failed_record(study, run, _crash_message(study, run, proc.returncode))
                 del running[proc]
-                record = json.loads(record_path(study, run).read_text())
+                record = read_json(record_path(study, run))
                 failed += record.get("status") == FAILED
                 if record.get("ran") and "did you mean" in record.get("error", "") and not warned:
                     warned = True        # a misspelt metric: said at the first run, not after the last

@@ -30,7 +30,7 @@ from multiscale.provenance import code
 from multiscale.schema import Context
 from multiscale.studies.formatting import now
 from multiscale.studies.problems import problem as get_problem
-from multiscale.studies.records import FAILED, metric_problem, write_json
+from multiscale.studies.records import FAILED, metric_problem, read_json, write_json
 
 __all__ = ["JIT_SHARE", "run_task", "watch_driver"]
 
@@ -135,7 +135,7 @@ def _exact(problem, params, folder: Path) -> dict:
     ident = json.dumps(problem.exact_key(params), sort_keys=True)
     path = folder / f"{problem.name}-{hashlib.sha256(ident.encode()).hexdigest()[:16]}.json"
     if path.is_file():
-        return json.loads(path.read_text())["values"]
+        return read_json(path)["values"]
     values = {k: float(v) for k, v in problem.exact(params).items()}
     folder.mkdir(parents=True, exist_ok=True)
     write_json(path, {"params": json.loads(ident), "values": values})
