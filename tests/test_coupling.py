@@ -720,6 +720,26 @@ def test_plastic_pin_on_disc_caps_the_micro_pressure_and_keeps_archard(tmp_path)
     assert h["wear_volume"][-1] == pytest.approx(1e-14 * h["frictional_work"][-1], rel=0.01)
 
 
+def test_a_nominal_pressure_at_the_hardness_is_refused_before_the_laws(tmp_path, monkeypatch):
+    """A pressure on the load faces that puts the interface's nominal pressure at or above the
+    hardness (2 MPa on 2.4 cm²: 1.2 MPa over 4 cm²) failed only after the zone laws, minutes later
+    on a fine grid (a user trial): a perfectly plastic contact carries at most H on its real area.
+    It is refused once the mesh gives the areas, before any law (the scene's check does it for a
+    normal force, not at a load profile's peak, which counts here: 3 x 0.5 MPa)."""
+    from multiscale import pool
+    from multiscale.workflows import run
+    monkeypatch.setattr(pool.MicroPool, "laws", lambda *args, **kwargs: pytest.fail("zone laws computed"))
+    text = POD.format(folder=tmp_path / "hard").replace('"roughness", "wear"]', '"roughness", "wear", "plasticity"]')
+    text = text.replace("[materials.pin]", '[materials.pin]\nhardness = "1 MPa"', 1)
+    with pytest.raises(InputError, match=r"^materials.pin.hardness: 1e\+06 Pa at the initial temperature, at most the "
+                                         r"interfaces' nominal pressure \(the load over their area, at the load "
+                                         r"profile's largest in the run: 1.2e\+06 Pa\)"):
+        run(loads(text.replace('normal_force = "200 N"', 'pressure = "2 MPa"')), verbose=False)
+    peaked = text.replace("[loading]", '[loading]\nload_profile = [["0 s", 1], ["0.6 s", 3], ["1.2 s", 1], ["2 s", 9]]')
+    with pytest.raises(InputError, match=r"largest in the run: 1.5e\+06 Pa\)"):
+        run(loads(peaked), verbose=False)                    # (9 x after the run's end: not counted)
+
+
 def test_laws_failing_at_every_p_max_say_how_it_was_reached(tmp_path):
     """Zones close to full contact far below p_max: their laws fail at p_max and at each of its
     P_MAX_HALVINGS halvings; the error names the last p_max tried and how it came from the scene's

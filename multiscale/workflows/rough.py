@@ -173,6 +173,15 @@ def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterfac
     why = "micro.p_max" if m.p_max is not None else f"{P_MAX_FACTOR:g} x the nominal pressure {nominal:.4g} Pa"
     if scene.has("plasticity"):
         hardness = float(interface_hardness(scene)(scene.time.initial_temperature))
+        end, ld = scene.time.end or 0.0, scene.loading       # the load factor's largest in the run
+        peak = nominal * max(ld.factor(t) for t in [0.0, end, *(t for t in ld.knots() if t <= end)])
+        if peak >= hardness:   # as the scene's check for a normal force; a pressure or a load profile's
+            raise InputError(  # peak only now (the laws took minutes to fail: a user trial)
+                f"materials.{scene.softer_hardness}.hardness", None,
+                f"{hardness:.3g} Pa at the initial temperature, at most the interfaces' nominal pressure (the load "
+                f"over their area, at the load profile's largest in the run: {peak:.3g} Pa), so a zone would carry "
+                "the hardness or more (fully plastic), which the micro model refuses; raise the hardness or lower the "
+                "load")
         if P_MAX_PLASTIC * hardness < p_max:
             p_max, why = P_MAX_PLASTIC * hardness, f"{P_MAX_PLASTIC:g} x the hardness"
     spec = LawSpec(kernel, p_max, n_points=m.law_points, tol=m.tol, E_star=E_star, hardness=hardness)
