@@ -2,6 +2,7 @@
 import h5py
 import numpy as np
 import pytest
+from matplotlib.colors import to_hex
 
 from multiscale.io import History
 from multiscale.plots import history as plots
@@ -108,6 +109,32 @@ def test_each_bodys_heat_in_stored_and_lost_and_each_parts_stored_heat_are_drawn
     assert {line.get_label(): tuple(line.get_ydata()) for line in parts.get_lines()} == \
         {"pad": (0, 0.6, 1.2), "backplate": (0, 0.2, 0.4)}
     assert [t.get_text() for t in parts.get_legend().get_texts()] == ["pad", "backplate"]
+
+
+def test_a_body_or_part_has_one_colour_in_every_panel_of_both_figures(tmp_path, drawn):
+    """The pin-on-disc's pin (parts housing, pin, plate) beside the disc: each panel numbered its
+    curves' colours itself, so the pin was green among the temperatures, orange in the heat of each
+    body and in the stored heat of each part, and the micro temperature took the disc's blue (a
+    user trial). Now a name has one colour in both figures; the micro curve is black."""
+    history = History()
+    for t in (0.0, 1.0, 2.0):
+        history.append(time=t, interface_force=200.0, max_pressure=1e6, max_temperature_disc=300.0 + t,
+                       max_temperature_pin_part_housing=293.0 + t, max_temperature_pin_part_pin=299.0 + t,
+                       max_temperature_pin_part_plate=293.0, heat_total_disc=9 * t, heat_total_pin=t,
+                       stored_heat_pin_part_housing=0.1 * t, stored_heat_pin_part_pin=0.8 * t,
+                       stored_heat_pin_part_plate=0.0, micro_max_temperature=340.0 + t, max_zone_pressure=1e6)
+    plots.history_figure(history, tmp_path / "history.png")
+    plots.multiscale_figure(history, tmp_path / "multiscale.png")
+    seen = {}
+    for figure in drawn:
+        for ax in figure.axes:
+            for line in ax.get_lines():
+                name = line.get_label().removeprefix("macro ")
+                if ax.get_ylabel() in ("max temperature [°C]", "heat of each body [J]", "heat stored in each part [J]"):
+                    seen.setdefault(name, set()).add(to_hex(line.get_color()))
+    assert set(seen) == {"disc", "housing", "pin", "plate", "micro"}
+    assert all(len(c) == 1 for c in seen.values()), seen
+    assert len({c for cs in seen.values() for c in cs}) == 5 and seen["micro"] == {"#000000"}
 
 
 def test_nine_pads_have_distinct_curves_and_legends_inside_their_panels(tmp_path, drawn):

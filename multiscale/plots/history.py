@@ -69,16 +69,34 @@ def curve_pairs(keys) -> list | None:
     return None
 
 
-def curve_styles(keys) -> tuple[list[dict], list]:
+def colours(names) -> dict:
+    """A distinct colour per name, in order: tab10, tab20 beyond 10 names (tab10 repeats its
+    colours), turbo beyond 20."""
+    names = list(names)
+    cmap = colormaps["tab10" if len(names) <= 10 else "tab20" if len(names) <= 20 else "turbo"]
+    return {n: cmap(k if len(names) <= 20 else k / (len(names) - 1)) for k, n in enumerate(names)}
+
+
+def body_colours(columns) -> dict:
+    """One colour per body and part name of a history, for every panel of ``history_figure`` and
+    ``multiscale_figure``: in the order of the max-temperature panel's curves, then the other
+    bodies and parts (each panel numbered its own before: the pin was green, orange and orange in
+    three panels of one figure; a user trial)."""
+    names = [column_label(k) for k in temperature_columns(columns)]
+    names += [column_label(k) for k in columns if k.startswith("heat_total_")
+              or k.startswith("stored_heat_") and "_part_" in k]
+    return colours(dict.fromkeys(names))
+
+
+def curve_styles(keys, palette: dict | None = None) -> tuple[list[dict], list]:
     """The colour and line style of each column of a panel, and its legend's entries (a Line2D
     each): a colour per column, or for ``curve_pairs`` a colour and a line style by its two names,
-    each named once (9 pads on 2 bodies: 11 entries, and no two curves alike; tab10 repeats its
-    colours beyond 10)."""
+    each named once (9 pads on 2 bodies: 11 entries, and no two curves alike). The colours are
+    ``palette``'s where it names every curve (``body_colours``), else the panel's own."""
     pairs = curve_pairs(keys) if len(keys) > 1 else None
     names = list(dict.fromkeys(n for n, _ in pairs)) if pairs else [column_label(k) for k in keys]
     kinds = list(dict.fromkeys(k for _, k in pairs)) if pairs else []
-    cmap = colormaps["tab10" if len(names) <= 10 else "tab20" if len(names) <= 20 else "turbo"]
-    colour = {n: cmap(k if len(names) <= 20 else k / (len(names) - 1)) for k, n in enumerate(names)}
+    colour = palette if palette and all(n in palette for n in names) else colours(names)
     style = {b: BODY_STYLES[k % len(BODY_STYLES)] for k, b in enumerate(kinds)}
     if not pairs:
         return [{"color": colour[n], "ls": "-"} for n in names], []
@@ -110,8 +128,9 @@ def history_figure(history, path: Path, title: str = "") -> Path:
     axes = fig.subplots(rows, cols, squeeze=False).ravel()
     for ax in axes[len(groups):]:
         ax.set_visible(False)
+    palette = body_colours(history.columns)
     for ax, (label, keys, scale, shift) in zip(axes, groups):
-        styles, entries = curve_styles(keys)
+        styles, entries = curve_styles(keys, palette)
         for k, (key, style) in enumerate(zip(keys, styles)):    # each curve thinner than the one before:
             wide = (len(keys) - 1 - k) / max(len(keys) - 1, 1)   # one on another (equal pads) stays seen
             ax.plot(t, history[key] * scale + shift, marker="o", ms=3 + 3 * wide, lw=1.2 + 2.4 * wide,
@@ -173,10 +192,12 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
     nrow = -(-len(panels) // ncol)
     fig = Figure(figsize=(4.3 * ncol, 3.3 * nrow))
     axes = fig.subplots(nrow, ncol, squeeze=False)
-    t = history["time"]
+    t, palette = history["time"], body_colours(cols)
     for ax, (label, keys, scale, shift) in zip(axes.ravel(), panels):
-        for key, name in keys:
-            ax.plot(t, history[key] * scale + shift, "o-", ms=3, label=name)
+        for key, name in keys:     # the macro temperatures in history.png's colours, the micro one black
+            colour = {"color": palette[column_label(key)] if key in hot else "black"} \
+                if label.startswith("max temperature") else {}
+            ax.plot(t, history[key] * scale + shift, "o-", ms=3, label=name, **colour)
         if label.startswith("max contact pressure"):
             values = np.concatenate([np.asarray(history[k], dtype=float) for k, _ in keys])
             if (values > 0).any():     # log of the positive values (0 released or between zones)
