@@ -136,7 +136,8 @@ class MicroPool:
 
         t1 = time.perf_counter()
         nodes, failures = [], []
-        for batch in _progress([b for rank, b in plan if rank == comm.rank], self.progress and comm.rank == 0):
+        name = "zone laws" if spec.p_max == self.spec.p_max else f"zone laws up to p_max = {spec.p_max:.3g} Pa"
+        for batch in _progress([b for rank, b in plan if rank == comm.rank], self.progress and comm.rank == 0, name):
             key_of = {zid: key for zid, key, _, _ in batch}
             try:
                 n, f = zone_nodes([received[key[0]] for _, key, _, _ in batch], spec)
@@ -217,6 +218,8 @@ class MicroPool:
             self._cache.popitem(last=False)
 
 
-def _progress(items, show: bool):
-    """The active reporter's bar (one line under a terminal, inside the running stage's line)."""
-    return io.bar(items, "zone laws", unit="batch") if show else items
+def _progress(items, show: bool, name: str):
+    """The active reporter's bar (one line under a terminal, inside the running stage's line);
+    ``name`` says a halved p_max (the retry of failed laws printed a second "zone laws: 1/1
+    batches" line, as if the same were said twice; a user trial)."""
+    return io.bar(items, name, unit="batch") if show else items

@@ -2,6 +2,7 @@
 a flat macro interface with the micro model, law smoothness, zones, the serial pool."""
 import subprocess
 import sys
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -498,6 +499,26 @@ def test_pool_caches_unchanged_zones_and_matches_compute_laws(tiled):
         pool.laws([zones[0].with_heights(zones[0].surface.heights - k * 1e-9)] + zones[1:4])
         assert pool.stats.computed == 1 and pool.stats.cached == 3
     assert len(pool) == CACHE_CALLS * 4
+
+
+def test_the_pools_progress_line_names_a_halved_p_max(tiled):
+    """The retry of failed laws at p_max / 2 printed a second "zone laws: 1/1 batches" line, as if
+    one line were said twice (a user trial); now it names its p_max."""
+    import io as stdio
+
+    from mpi4py import MPI
+
+    from multiscale import io
+    from multiscale.pool import MicroPool
+    _, _, zones = tiled
+    spec = LawSpec(E, p_max=3e6, n_points=6)
+    out = stdio.StringIO()
+    with io.Reporter(MPI.COMM_SELF, stream=out):
+        pool = MicroPool(spec, comm=MPI.COMM_SELF, progress=True)
+        pool.laws(zones[:1])
+        pool.laws(zones[1:2], replace(spec, p_max=1.5e6))
+    lines = out.getvalue().splitlines()
+    assert [line.split(":")[0] for line in lines] == ["  zone laws", "  zone laws up to p_max = 1.5e+06 Pa"], lines
 
 
 def test_pool_worker_never_imports_dolfinx():
