@@ -1,7 +1,8 @@
 """The duty cycle against the analysis that runs it (``multiscale.scene``'s cross-checks): what a
 load or speed profile, a vehicle stop and a speed-dependent convection table leave out of the run
 [0, time.end], and what the squeal analysis, which linearises one state, ignores of a cycle.
-Warnings only: each returns one line per finding."""
+The checks return one warning line per finding; ``braking_phases`` and ``largest_load_factor``
+read the cycle over the run's knots (``run_knots``)."""
 from __future__ import annotations
 
 import math
@@ -39,6 +40,18 @@ def cycle_coverage(ld, end: float) -> list[str]:
     return out
 
 
+def run_knots(ld, end: float) -> list[float]:
+    """The times [s] of [0, ``end``] where the duty cycle may change slope, both ends included:
+    between them the load factor and the speed are linear."""
+    return sorted({0.0, end, *(t for t in ld.knots() if 0 < t < end)})
+
+
+def largest_load_factor(ld, end: float) -> float:
+    """The largest load factor of the run [0, ``end``] [s] (1 without a load profile): at a knot, the
+    factor being linear between them."""
+    return max(ld.factor(t) for t in run_knots(ld, end))
+
+
 def braking_phases(ld, motion: str, end: float) -> list[tuple[float, float]]:
     """Intervals [t0, t1] of [0, ``end``] [s] with frictional heat: loaded (load factor > 0) and
     sliding (the rotating body's speed, or ``sliding_speed`` of a translating one, > 0). Both are
@@ -47,7 +60,7 @@ def braking_phases(ld, motion: str, end: float) -> list[tuple[float, float]]:
     def heated(t):
         return ld.factor(t) * (ld.angular_speed(t) if motion == "rotation" else ld.sliding_speed or 0.0) > 0
 
-    ts = sorted({0.0, end, *(t for t in ld.knots() if 0 < t < end)})
+    ts = run_knots(ld, end)
     phases = []
     for a, b in zip(ts, ts[1:]):
         if heated(0.5 * (a + b)):

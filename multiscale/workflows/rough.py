@@ -43,6 +43,7 @@ from multiscale.micro.topography import TopographyWarning, condition, cover, rea
 from multiscale.micro.zones import ZoneGrid, cut_zones, generate_zones
 from multiscale.pool import MicroPool
 from multiscale.rough import RoughInterface, check_zone_size, interface_plane
+from multiscale.scene_cycle import largest_load_factor
 from multiscale.scene_rough import micro_key, rough_rules
 from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR, P_MAX_PLASTIC
 from multiscale.workflows.model import interface_forces, interface_materials
@@ -173,8 +174,7 @@ def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterfac
     why = "micro.p_max" if m.p_max is not None else f"{P_MAX_FACTOR:g} x the nominal pressure {nominal:.4g} Pa"
     if scene.has("plasticity"):
         hardness = float(interface_hardness(scene)(scene.time.initial_temperature))
-        end, ld = scene.time.end or 0.0, scene.loading       # the load factor's largest in the run
-        peak = nominal * max(ld.factor(t) for t in [0.0, end, *(t for t in ld.knots() if t <= end)])
+        peak = nominal * largest_load_factor(scene.loading, scene.time.end or 0.0)
         if peak >= hardness:   # as the scene's check for a normal force; a pressure or a load profile's
             raise InputError(  # peak only now (the laws took minutes to fail: a user trial)
                 f"materials.{scene.softer_hardness}.hardness", None,
