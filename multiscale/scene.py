@@ -34,8 +34,8 @@ from multiscale.scene_rough import (measured_cover, micro_constants, nyquist, ow
 from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
-from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_phases, speed_range, squeal_state,
-                                   thin_heated_layers)
+from multiscale.scene_cycle import (convection_coverage, cycle_coverage, largest_load_factor, short_phases, speed_range,
+                                   squeal_state, thin_heated_layers)
 from multiscale.scene_stability import Stability, unresolved_band
 from multiscale.scene_vehicle import Vehicle
 
@@ -498,19 +498,22 @@ def _hardness_checks(scene: Scene, g: Geometry, raw: dict, effects) -> list[str]
 
 def _plastic_everywhere(scene: Scene, g: Geometry) -> list[str]:
     """A hardness at the initial temperature at most the nominal pressure of the interfaces
-    (``loading.normal_force`` over their extents' boxes, which cover them: a lower bound), so
-    that some zone carries H or more, which the run refuses after its set-up (check said OK: a
-    materials engineer's trial)."""
+    (``loading.normal_force`` over their extents' boxes, which cover them: a lower bound; at the load
+    profile's largest factor in the run), so that some zone carries H or more, which the run refuses
+    after its set-up (check said OK: a materials engineer's trial; for a profile's peak, minutes
+    later: a user trial)."""
     force = getattr(scene.loading, "normal_force", None) if scene.loading is not None else None
     boxes = [g.spec.interface_extents.get(n) for n in g.spec.interfaces]
     soft = scene.softer_hardness
     if not force or soft is None or None in boxes:
         return []
-    nominal = force / sum(a * b for a, b in boxes)
+    factor = largest_load_factor(scene.loading, scene.time.end or 0.0)
+    nominal = factor * force / sum(a * b for a, b in boxes)
     H = scene.materials[soft].value("hardness", scene.time.initial_temperature)
+    peak = f" at the load profile's largest factor {factor:.3g}" if factor != 1 else ""
     return [f"materials.{soft}.hardness = {H:.3g} Pa at the initial temperature: at most the interfaces' nominal "
-            f"pressure (loading.normal_force over them: at least {nominal:.3g} Pa), so a zone would carry the hardness "
-            "or more (fully plastic), which the micro model refuses; raise the hardness or lower the load"] \
+            f"pressure (loading.normal_force over them{peak}: at least {nominal:.3g} Pa), so a zone would carry the "
+            "hardness or more (fully plastic), which the micro model refuses; raise the hardness or lower the load"] \
         if H <= nominal else []
 
 

@@ -725,7 +725,7 @@ def test_a_nominal_pressure_at_the_hardness_is_refused_before_the_laws(tmp_path,
     hardness (2 MPa on 2.4 cm²: 1.2 MPa over 4 cm²) failed only after the zone laws, minutes later
     on a fine grid (a user trial): a perfectly plastic contact carries at most H on its real area.
     It is refused once the mesh gives the areas, before any law (the scene's check does it for a
-    normal force, not at a load profile's peak, which counts here: 3 x 0.5 MPa)."""
+    normal force), at a load profile's peak too: 3 x 0.6 MPa."""
     from multiscale import pool
     from multiscale.workflows import run
     monkeypatch.setattr(pool.MicroPool, "laws", lambda *args, **kwargs: pytest.fail("zone laws computed"))
@@ -735,8 +735,9 @@ def test_a_nominal_pressure_at_the_hardness_is_refused_before_the_laws(tmp_path,
                                          r"interfaces' nominal pressure \(the load over their area, at the load "
                                          r"profile's largest in the run: 1.2e\+06 Pa\)"):
         run(loads(text.replace('normal_force = "200 N"', 'pressure = "2 MPa"')), verbose=False)
-    peaked = text.replace("[loading]", '[loading]\nload_profile = [["0 s", 1], ["0.6 s", 3], ["1.2 s", 1], ["2 s", 9]]')
-    with pytest.raises(InputError, match=r"largest in the run: 1.5e\+06 Pa\)"):
+    peaked = text.replace('normal_force = "200 N"', 'pressure = "1 MPa"').replace(
+        "[loading]", '[loading]\nload_profile = [["0 s", 1], ["0.6 s", 3], ["1.2 s", 1], ["2 s", 9]]')
+    with pytest.raises(InputError, match=r"largest in the run: 1.8e\+06 Pa\)"):
         run(loads(peaked), verbose=False)                    # (9 x after the run's end: not counted)
 
 

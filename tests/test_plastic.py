@@ -232,6 +232,18 @@ def test_scene_plasticity_needs_a_hardness_and_checks_its_table():
                                 "zone would carry the hardness or more (fully plastic), which the micro model refuses; "
                                 "raise the hardness or lower the load"]
     loads(text.replace("[materials.pin]", '[materials.pin]\nhardness = "0.55 MPa"\n', 1), "demos")   # a warning
+    # a load profile peaking at 1.5 within the run (0.75 MPa), and at 3 only after time.end (30 s)
+    soft = text.replace("[materials.pin]", '[materials.pin]\nhardness = "0.7 MPa"\n', 1)
+    with pytest.raises(SceneError) as e:
+        loads(soft.replace("ramp_steps = 2", 'ramp_steps = 2\nload_profile = [["0 s", 1], ["20 s", 1.5], ["30 s", 1.5]]'),
+              "demos")
+    assert e.value.problems == ["materials.pin.hardness = 7e+05 Pa at the initial temperature: at most the "
+                                "interfaces' nominal pressure (loading.normal_force over them at the load profile's "
+                                "largest factor 1.5: at least 7.5e+05 Pa), so a zone would carry the hardness or "
+                                "more (fully plastic), which the micro model refuses; raise the hardness or lower "
+                                "the load"]
+    loads(soft.replace("ramp_steps = 2", 'ramp_steps = 2\nload_profile = [["0 s", 1], ["30 s", 1], ["60 s", 3]]'),
+          "demos")
 
 
 def test_flash_softening_needs_plasticity_and_heating():

@@ -175,8 +175,8 @@ def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterfac
     if scene.has("plasticity"):
         hardness = float(interface_hardness(scene)(scene.time.initial_temperature))
         peak = nominal * largest_load_factor(scene.loading, scene.time.end or 0.0)
-        if peak >= hardness:   # as the scene's check for a normal force; a pressure or a load profile's
-            raise InputError(  # peak only now (the laws took minutes to fail: a user trial)
+        if peak >= hardness:   # as the scene's check over the interfaces' boxes for a normal force; a
+            raise InputError(  # pressure only now (the laws took minutes to fail: a user trial)
                 f"materials.{scene.softer_hardness}.hardness", None,
                 f"{hardness:.3g} Pa at the initial temperature, at most the interfaces' nominal pressure (the load "
                 f"over their area, at the load profile's largest in the run: {peak:.3g} Pa), so a zone would carry "
