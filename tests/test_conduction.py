@@ -9,6 +9,7 @@ from multiscale.micro.kernels import HalfSpace, Kernel, ThermalHalfSpace
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
 from multiscale.micro.surface import fractal_surface
 from multiscale.references.conduction import flux_tube_factor, holm_conductance, thermal_layer_compliance
+from multiscale.references.love import love_rectangle_mean
 
 K1, K2 = ThermalHalfSpace(10.0), ThermalHalfSpace(50.0)
 
@@ -60,7 +61,38 @@ def test_holm_constriction_of_a_circular_spot_with_grid_convergence():
     assert np.allclose(res.temperature_1[spot], 50 / 60, atol=1e-8)
     assert np.allclose(res.temperature_2[spot], 50 / 60, atol=1e-8)
     assert res.contact_temperature_1 == pytest.approx(50 / 60, abs=1e-8)
-    assert np.all(res.flux[~spot] == 0) and res.perfect_conductance == np.inf
+    assert np.all(res.flux[~spot] == 0)
+    # K_p: a uniform flux over the whole patch (a square of the spot's diameter) on the half-spaces
+    R_u = love_rectangle_mean(1e-4, 1e-4) * (1 / K1.kappa + 1 / K2.kappa) / (2 * np.pi)
+    assert 1 / res.perfect_conductance == pytest.approx(R_u, rel=5e-4)     # measured 1.5e-4
+
+
+def test_an_isolated_patch_follows_barbers_analogy():
+    """K_i of an isolated rough patch on half-spaces against the mechanics (Barber's analogy, the
+    thermal kernel 1/(kappa_s q) against the elastic 2/(E* q)): K_i = (2 kappa_s / E*) / (1/k - C_u),
+    k the incremental stiffness per area by central differences of the contact solver's approach,
+    C_u the mean compliance of a uniform pressure on the square (Love's closed form). Before, K_p was
+    that of an infinite interface (infinite here), so K_i = K_t: 3x low at 6 % contact, and on
+    layers an infinite K_i at 1 % (a user trial)."""
+    n, L, E_star = 128, 1e-4, 210e9 / (1 - 0.09) / 2
+    s = fractal_surface(n, L, hurst=0.8, k_min=2, k_max=32, rms=1e-7, seed=3)
+    mech = ContactSolver(HalfSpace.from_materials(210e9, 0.3, 210e9, 0.3), s.shape, s.dx, periodic=False)
+    heat = ConductionSolver(K1, K2, s.shape, s.dx, periodic=False)
+    kappa_s = 1 / (1 / K1.kappa + 1 / K2.kappa)
+    C_u = love_rectangle_mean(L / 2, L / 2) / (np.pi * E_star)               # m/Pa
+    for p in (1e7, 1e8):                                                      # 1 % and 6 % contact
+        r = mech.solve(s.heights, load=p, tol=1e-12)
+        lo, hi = (mech.solve(s.heights, approach=r.approach * (1 + e), tol=1e-12) for e in (-1e-4, 1e-4))
+        k = (hi.mean_pressure - lo.mean_pressure) / (2e-4 * r.approach)       # Pa/m
+        K_i = heat.solve(r.contact, tol=1e-12).interface_conductance
+        assert K_i == pytest.approx(2 * kappa_s / E_star / (1 / k - C_u), rel=5e-4)   # measured 1.5e-5, 5.4e-5
+    layered = ConductionSolver(LayeredThermal((1e-3,), (50.0,)), LayeredThermal((2e-3,), (20.0,)), s.shape, s.dx,
+                               periodic=False)
+    contact = mech.solve(s.heights, load=1e7).contact
+    res = layered.solve(contact)
+    assert np.isfinite(res.interface_conductance) and res.conductance < res.perfect_conductance
+    full = layered.solve(np.ones(s.shape, bool))               # uniform temperature beats a uniform flux (Thomson)
+    assert full.conductance > full.perfect_conductance and full.interface_conductance == np.inf
 
 
 def test_periodic_spots_match_the_flux_tube_constriction():

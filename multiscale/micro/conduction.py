@@ -9,7 +9,12 @@ contact, ``theta_2 − theta_1 = R phi_1`` (local resistance R [m² K/W], f = R 
 solved as the minimum of F = ½ phiᵀ(T + R)phi − phiᵀ Δθ (Eq. 5.11) on the contact points by
 conjugate gradients with FFT convolutions (Eqs. 5.10–5.11; the operator is symmetric positive
 definite there). K_t = mean(phi_1) / Δθ (Eq. 5.9), K_p = 1 / (F_1(0) + F_2(0)) and
-K_i = 1 / (1/K_t − 1/K_p).
+K_i = 1 / (1/K_t − 1/K_p). On an isolated patch K_p is the conductance of a uniform flux over the
+whole patch (mean temperature difference per flux: the bodies' spreading from the patch, and their
+bulk), as ``micro.laws.Conductance`` takes a zone's: 1/(F_1(0) + F_2(0)) there would leave the
+patch's own spreading resistance in K_i (K_i = K_t on half-spaces, bounded by the patch size
+instead of the roughness; on layers 1/K_t − 1/K_p < 0, an "infinite" K_i at 1 % contact: a user
+trial).
 
 Thermal kernels (``Kernel``: surface temperature [K] per surface flux [W/m²]): the q = 0 value
 F(0) [m² K/W] is the bulk resistance of a body of finite thickness with a fixed temperature at its
@@ -68,7 +73,7 @@ class ConductionResult:
     contact: np.ndarray                #: bool, contacting points, (..., ny, nx)
     conductance: np.ndarray            #: W/(m² K), K_t total (Eq. 5.9)
     interface_conductance: np.ndarray  #: W/(m² K), K_i = 1/(1/K_t − 1/K_p); inf for a perfect interface
-    perfect_conductance: float         #: W/(m² K), K_p = 1/(F_1(0) + F_2(0)); inf if a body is semi-infinite
+    perfect_conductance: float         #: W/(m² K), K_p: full contact under a uniform flux (``ConductionSolver``)
     contact_temperature_1: np.ndarray  #: K, T_s: mean of temperature_1 over the contact
     contact_temperature_2: np.ndarray  #: K, mean of temperature_2 over the contact (= T_s when R = 0)
     iterations: np.ndarray             #: CG iterations per patch
@@ -97,10 +102,21 @@ class ConductionSolver:
             raise InputError("kernel", self.kernels, "q = 0 value must be finite and >= 0")
         self.bulk = (f0[0], f0[1]) if min(f0) > 0 else None    # m² K/W each, None: semi-infinite
 
+    def uniform_resistance(self, masks) -> np.ndarray:
+        """R_u [m² K/W] of each mask (..., ny, nx): the mean over it of the temperature difference of
+        the two surfaces under a uniform unit flux on it (the series kernels' response)."""
+        masks = np.asarray(masks, dtype=float)
+        return np.sum(self.series(masks) * masks, axis=(-2, -1)) / masks.sum(axis=(-2, -1))
+
     @property
     def perfect_conductance(self) -> float:
-        """K_p [W/(m² K)] = 1/(F_1(0) + F_2(0)), the conductance of a perfect (full) contact."""
-        return np.inf if self.bulk is None else 1.0 / sum(self.bulk)
+        """K_p [W/(m² K)], the conductance of a perfect (full) contact under a uniform flux: periodic
+        1/(F_1(0) + F_2(0)) (inf if a body is semi-infinite), isolated 1/R_u of the whole patch
+        (``uniform_resistance``; e.g. 1/(0.4732 c (1/kappa_1 + 1/kappa_2)) for a square of side c
+        on half-spaces, Yovanovich)."""
+        if self.periodic:
+            return np.inf if self.bulk is None else 1.0 / sum(self.bulk)
+        return 1.0 / float(self.uniform_resistance(np.ones(self.shape)))
 
     def solve(self, contact, *, resistance=0.0, theta_1: float = 0.0, theta_2: float = 1.0,
               tol: float = 1e-10, max_iter: int | None = None, initial_flux=None,
@@ -145,7 +161,7 @@ class ConductionSolver:
         temp_1 = theta_1 + T1phi
         temp_2 = theta_2 - (Tphi - T1phi)
         K_t = phi.mean(axis=axes) / dtheta
-        K_p = self.perfect_conductance
+        K_p = self.perfect_conductance          # (isolated: 1/K_t <= 1/K_p in full contact, Thomson: K_i inf)
         with np.errstate(divide="ignore"):
             excess = 1.0 / K_t - 1.0 / K_p                    # interface resistance [m² K/W]
             K_i = np.where(excess > 1e-12 / np.maximum(K_t, 1e-300), 1.0 / excess, np.inf)

@@ -498,8 +498,7 @@ class Conductance(ExtraLaw):
         heat = solver.solve(result.contact, resistance=self.resistance, theta_1=0.0, theta_2=1.0, tol=self.tol)
         area = np.array([z.area for z in zones])
         K_t = heat.conductance * (s.size[0] * s.size[1]) / area
-        masks = np.stack([z.mask for z in zones]).astype(float)
-        R_zone = np.sum(solver.series(masks) * masks, axis=(-2, -1)) / masks.sum(axis=(-2, -1))
+        R_zone = solver.uniform_resistance(np.stack([z.mask for z in zones]))
         excess = 1.0 / K_t - R_zone
         if np.any(excess <= 0):
             raise InputError("p_max", result.mean_pressure.max(), "the zone's conductance exceeds its "
