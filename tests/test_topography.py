@@ -78,8 +78,12 @@ def test_plain_matrices_still_read_as_before(tmp_path):
     np.testing.assert_array_equal(m.heights, load_surface(tmp_path / "pad.npy", 2e-6, scale=1e-6,
                                                           detrend="none").heights)
     assert (m.dx, m.dy) == (2e-6, 2e-6)
-    with pytest.raises(InputError, match=r"^roughness\.pixel_size: pad\.npy is a plain height matrix"):
+    with pytest.raises(InputError, match=r'^roughness\.pixel_size: pad\.npy is a plain height matrix .* e\.g\. "0\.5 um"$'):
         read_topography(tmp_path / "pad.npy", prefix="roughness.")
+    # in Python the keyword takes metres: the example says so (it said "0.5 um", which the keyword refuses)
+    with pytest.raises(InputError, match=r"^pixel_size: pad\.npy .* e\.g\. pixel_size=0\.5e-6 \(metres\)$"):
+        read_topography(tmp_path / "pad.npy")
+    assert read_topography(tmp_path / "pad.npy", pixel_size=0.5e-6).dx == 0.5e-6
 
 
 @pytest.mark.filterwarnings("ignore::RuntimeWarning")

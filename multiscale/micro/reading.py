@@ -48,6 +48,13 @@ def option(prefix: str, key: str, value: str | None = None) -> str:
     return prefix + key if value is None else f"{prefix}{key} = {value}"
 
 
+def example(prefix: str, key: str, text: str, metres: str) -> str:
+    """An example value of option ``key`` as the caller writes it: ``text``, a quantity with its
+    unit, in a scene or on the command line; in Python (``prefix`` "") ``key=metres``, a number in
+    metres (a user trial passed the message's "0.5 um" to the keyword, which takes metres)."""
+    return f"{key}={metres} (metres)" if prefix == "" else text
+
+
 def formats() -> list[str]:
     """Name (extensions) of every format SurfaceTopography reads."""
     return [f"{r.name()} (.{', .'.join(r.file_extensions())})" for r in surface_topography().IO.readers
@@ -209,7 +216,7 @@ def _read(path: Path, channel, pair, height_unit: float | None, prefix: str) -> 
                              f"{path.name} is a plain height matrix: one channel, 0")
         if pair is None:
             raise InputError(option(prefix, "pixel_size"), None, f"{path.name} is a plain height matrix without units: "
-                             'give its pixel size, e.g. "0.5 um"')
+                             f"give its pixel size, e.g. {example(prefix, 'pixel_size', '\"0.5 um\"', '0.5e-6')}")
         try:
             h = read_matrix(path) * (1.0 if height_unit is None else height_unit)
         except InputError as exc:
@@ -233,7 +240,8 @@ def _read(path: Path, channel, pair, height_unit: float | None, prefix: str) -> 
     if ch.physical_sizes is None or factor is None:
         if pair is None:
             raise InputError(option(prefix, "pixel_size"), None, f"{path.name} gives no lateral "
-                             f"{'size' if ch.physical_sizes is None else 'unit'}: give its pixel size, e.g. \"0.5 um\"")
+                             f"{'size' if ch.physical_sizes is None else 'unit'}: give its pixel size, e.g. "
+                             f"{example(prefix, 'pixel_size', '\"0.5 um\"', '0.5e-6')}")
         dx, dy = pair
     else:
         dx, dy = (float(v) * factor for v in t.pixel_size)
@@ -247,8 +255,8 @@ def _read(path: Path, channel, pair, height_unit: float | None, prefix: str) -> 
                          f"({unit} = {factor:.4g} m)")
         factor = height_unit
     elif factor is None:
-        raise InputError(option(prefix, "height_unit"), None, f"{path.name} gives no height unit: give it, e.g. \"nm\" "
-                         "or \"1 um\"")
+        raise InputError(option(prefix, "height_unit"), None, f"{path.name} gives no height unit: give it, e.g. "
+                         f"{example(prefix, 'height_unit', '\"nm\" or \"1 um\"', '1e-9')}")
     h = np.ma.filled(np.ma.masked_invalid(np.ma.asarray(raw, dtype=float)), np.nan).T * factor
     notes += _height_range(h, path, prefix, f"{factor:.4g} m", f"channel {ch.index} (\"{ch.name}\")")
     h.flags.writeable = False
