@@ -44,7 +44,8 @@ def solver_statistic(name: str) -> bool:
 
 class History:
     """Time series: ``append(time=..., interface_force=..., ...)``, same keys every row; a value is a
-    scalar, or a 1-D array of fixed length (a per-zone quantity: its column is (rows, length))."""
+    scalar, or a 1-D array of fixed length (a per-zone quantity: its column is (rows, length)).
+    A column's unit is ``unit_of(name)``, as the file's ``unit`` attributes give it."""
 
     def __init__(self):
         self.columns: dict[str, list[float]] = {}
