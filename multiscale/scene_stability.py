@@ -115,8 +115,9 @@ class Stability:
     ``damping`` (loss factor eta), ``rayleigh_alpha`` / ``rayleigh_beta`` (alpha M + beta K) act on
     the whole system, mapped exactly from the undamped modes. Per-material damping, the friction
     slope (``friction_damping``) and the gyroscopic terms are solved as a full quadratic
-    eigenproblem (``method = "quadratic"``, viscous only) or by projection on the undamped modes up
-    to ``basis`` x the band's top (``"projection"``, needed for loss factors); ``"auto"`` picks.
+    eigenproblem (``method = "quadratic"``, viscous only, from 0 Hz up) or by projection on the
+    undamped modes up to ``basis`` x the band's top (``"projection"``, needed for loss factors and
+    for a band above 0 Hz or a target); ``"auto"`` picks.
     ``"subspace"``: projection on the real modes of the frictionless tangent and their static
     corrections, for models whose LU does not fit in memory (docs/squeal.md).
     ``prestress``: the initial-stress stiffness of the preload, its effect on every frequency

@@ -188,8 +188,8 @@ def test_a_loss_factor_on_a_part_of_the_model_is_projected_with_its_static_respo
     damping forces eta K_b phi of a basis mode load the part's boundary, which no mode below
     1.5 f_max balances. With the static responses (K - theta_t M)^-1 H phi of the right and
     (K^T - theta_t M)^-1 H psi of the left modes in the basis, the 8 modes below 2 kHz are within
-    1e-6 of the dense complex solve (measured 5.4e-9 with friction, 2.2e-7 without) and their
-    relative residuals below 5e-3 (2.9e-4, 7.8e-4). Without them: 4.2e-5 and 8.9e-5 off, residuals
+    1e-6 of the dense complex solve (measured 1.7e-11 with friction, 2.3e-7 without) and their
+    relative residuals below 5e-3 (3.9e-5, 7.8e-4). Without them: 4.2e-5 and 8.9e-5 off, residuals
     3.5e-2 and 8.1e-2 (on the demo brake 0.15 to 0.23, docs/squeal.md)."""
     K, M = chain(40)
     if friction:
@@ -203,6 +203,54 @@ def test_a_loss_factor_on_a_part_of_the_model_is_projected_with_its_static_respo
     assert len(r) == ref.size == 8 and r.method == "projection"
     np.testing.assert_allclose(r.eigenvalues, ref, rtol=1e-6)
     assert r.errors.max() < 5e-3
+
+
+@pytest.mark.parametrize("friction", [True, False])
+def test_viscous_damping_on_a_part_of_the_model_is_projected_with_its_static_responses(friction):
+    """Dashpots on the last 9 springs of the chain and a negative one at mass 35 (a falling friction
+    law at the interface: a mode grows at 5.6 1/s): the projection on the modes up to 1.5 f_max,
+    the left ones and the static responses (K - theta_t M)^-1 C phi, (K^T - theta_t M)^-1 C^T psi
+    gives the 8 modes below 2 kHz of the dense quadratic solve within 1e-7 (measured 1e-11 with
+    friction, 4.7e-9 without), residuals below 1e-3 (1.2e-5, 1.1e-4). Without the responses:
+    7.2e-7 and 1.3e-6 off, residuals 6.7e-3 (on the demo brake with a steep Stribeck law the
+    growth rates 0.14 1/s off against 3e-4, docs/squeal.md). The responses are of the order of
+    C/K (1e-7 s here): the basis judges their parts outside the modes against their own norms."""
+    K, M = chain(40)
+    if friction:
+        for i in range(0, 37, 3):
+            K[i, i + 2] += 0.6e6
+            K[i + 2, i] -= 0.3e6
+    C = segment_stiffness(40, 2.0, 30, 39)
+    C[35, 35] -= 3.0
+    r = damped.solve_system(damped.LinearSystem(petsc_mat(K), petsc_mat(M), petsc_mat(C)), f_max=2e3, basis=1.5,
+                            method="projection")
+    ref = companion_eigenvalues(K, C, M)
+    ref = ref[ref.imag / (2 * np.pi) <= 2e3]
+    assert len(r) == ref.size == 8 and ref.real.max() > 5.0
+    np.testing.assert_allclose(r.eigenvalues, ref, rtol=1e-7)
+    assert r.errors.max() < 1e-3
+
+
+def test_auto_projects_a_band_above_0_hz_that_the_quadratic_solver_cannot_reach():
+    """Viscous damping in a band from 1.2 to 2 kHz (the chain's modes 6 to 9): the real PEP
+    converges from 0 Hz up, so that 3 modes asked for lie below the band ("cover the band from
+    0 Hz"; a user trial on the demo brake with gyroscopic terms); "auto" takes the projection,
+    whose GNHEP shifts to the band: the band's 4 modes of the dense quadratic solve within 5e-6,
+    the lowest unstable as there. A target alone does the same; a band from 0 Hz keeps the PEP."""
+    K, M = chain(40)
+    C = segment_stiffness(40, 2.0, 30, 39)
+    C[35, 35] -= 3.0
+    system = damped.LinearSystem(petsc_mat(K), petsc_mat(M), petsc_mat(C))
+    ref = companion_eigenvalues(K, C, M)
+    ref = ref[(ref.imag / (2 * np.pi) >= 1.2e3) & (ref.imag / (2 * np.pi) <= 2e3)]
+    with pytest.raises(InputError, match="the quadratic solver finds the lowest modes first"):
+        damped.solve_system(system, f_min=1.2e3, f_max=2e3, n_modes=3, method="quadratic")
+    r = damped.solve_system(system, f_min=1.2e3, f_max=2e3)
+    assert r.method == "projection" and len(r) == ref.size == 4
+    np.testing.assert_allclose(r.eigenvalues, ref, rtol=5e-6)       # measured 9.5e-7: no modes below 800 Hz
+    assert np.array_equal(r.growth > 0, ref.real > 0) and ref[0].real > 3.0
+    assert damped.solve_system(system, f_max=2e3, n_modes=3, target=1.5e3).method == "projection"
+    assert damped.solve_system(system, f_max=2e3, n_modes=3).method == "pep"
 
 
 def test_hysteretic_damping_needs_the_projection():

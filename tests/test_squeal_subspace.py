@@ -99,7 +99,7 @@ def test_subspace_modes_match_the_full_nonsymmetric_solve(models):
     np.testing.assert_allclose(sub.frequency[near], ref.frequency, rtol=1e-3)       # measured 4.1e-4
     np.testing.assert_allclose(sub.growth[near], ref.growth, rtol=0, atol=10.0)    # 1/s; measured 5.3
     assert ref.unstable().sum() == sub.unstable().sum() == 1
-    assert sub.errors.max() < 0.1                # full-model relative residual; measured 0.039
+    assert sub.errors.max() < 0.1                # full-model relative residual; measured 0.041
     assert np.median(sub.errors) < 0.01          # measured 6.0e-3
     # the real modes alone (no static corrections) miss the friction coupling
     real = block_lanczos.symmetric_modes(system.K0, M, **damped.basis_band((0.0, F_MAX), 30, None, 1.5))

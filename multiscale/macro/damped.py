@@ -10,9 +10,11 @@ H += eta K. ``solve_system`` picks the method:
 
 - no C, no H: the GNHEP K phi = theta M phi and the exact map theta -> lambda of the
   proportional part (``eigen.solve_modes``): the undamped result, bit for bit;
-- ``"quadratic"`` (``"auto"`` with viscous damping only): SLEPc PEP on (K, C + alpha M + beta K,
-  M) over the whole model, exact;
-- ``"projection"`` (``"auto"`` with hysteretic terms, which the real PEP cannot take): the
+- ``"quadratic"`` (``"auto"`` with viscous damping only, in a band from 0 Hz): SLEPc PEP on
+  (K, C + alpha M + beta K, M) over the whole model, exact; in real arithmetic it converges from
+  the lowest frequency up, so that it cannot reach a band above 0 Hz or a target;
+- ``"projection"`` (``"auto"`` with hysteretic terms, which the real PEP cannot take, or a band
+  above 0 Hz or a target: the GNHEP of its basis shifts to them): the
   complex modes of the undamped, friction-coupled system (K, M) up to ``basis`` x f_max and,
   with friction (K not symmetric), those of (K^T, M), its left eigenvectors, span a real
   M-orthonormal basis V (``Subspace``); the reduced quadratic problem
@@ -25,20 +27,21 @@ H += eta K. ``solve_system`` picks the method:
   the wrong member (264.5 Hz unstable where a dense solve has 267.8 Hz; an adversarial test); with
   them every eigenvalue is within 2e-6 of the dense solve, at the cost of a second modal solve
   (without a second factorisation: ``eigen.shift_invert_modes(transpose_of=...)``).
-  With hysteretic terms H the basis also holds the static responses to their forces,
-  (K - theta_t M)^-1 H phi of the right and (K^T - theta_t M)^-1 H psi of the left modes in the
-  band (those of the modes above it, which only pad the basis, changed little), by the same
-  LU of K - theta_t M (modal truncation augmentation, Dickens, Nakagawa & Wittbrodt, Comput.
-  Struct. 62 (1997) 985): a loss factor of one part (the pad) loads the part's faces to its
-  neighbours with eta K_b phi, which no mode of the band balances. On the 20-mm demo brake (pad
-  loss factor 0.05, 10 modes) the relative residuals fell from 0.22 to 4e-3 and the eigenvalues'
-  error against the full complex solve from 7.5e-5 to 4e-8 (a basis of 3 x f_max without them:
-  0.22 and 5e-5; docs/squeal.md).
+  With damping terms the basis also holds the static responses to their forces,
+  (K - theta_t M)^-1 A phi of the right and (K^T - theta_t M)^-1 A^T psi of the left modes in the
+  band, A = H and A = C (those of the modes above it, which only pad the basis, changed little),
+  by the same LU of K - theta_t M (modal truncation augmentation, Dickens, Nakagawa & Wittbrodt,
+  Comput. Struct. 62 (1997) 985): a loss factor of one part (the pad) loads the part's faces to
+  its neighbours with eta K_b phi, the friction slope the interface with lambda C phi, which no
+  mode of the band balances. On the 20-mm demo brake (pad loss factor 0.05, 10 modes) the
+  relative residuals fell from 0.22 to 4e-3 and the eigenvalues' error against the full complex
+  solve from 7.5e-5 to 4e-8 (a basis of 3 x f_max without them: 0.22 and 5e-5); with a steep
+  Stribeck law (0.9 to 0.2 over 0.5 m/s, 20 modes) the growth rates' error against the PEP from
+  0.14 to 3e-4 1/s, the frequencies' from 2.6e-5 to 7e-8 (docs/squeal.md). A response joins the
+  basis with its part outside the modes' span, if that holds ``RESPONSE_KEEP`` of it (``Subspace``;
+  the responses to C phi are of the order of C/K ~ 1e-6 s: against the modes' scale they had all
+  been dropped as if dependent).
   Its accuracy is reported per mode: the relative residual of the full quadratic problem.
-  Damping spread like the mass or the stiffness is represented well; viscous damping localised at
-  the interface (the friction slope) is not: on the demo brake with a Stribeck law the growth rates of
-  the projection on 1.5 x f_max were off by up to 50 1/s against the PEP (10 1/s with 5 x f_max;
-  frequencies within 2e-5), hence the PEP by default.
 - ``"subspace"`` (any system that carries ``K0``; never picked by ``"auto"``): the same projection
   on a basis that needs no non-symmetric factorisation, for models whose LU does not fit in
   memory: the real modes of the frictionless, symmetric tangent (K0, M) up to ``basis`` x f_max
@@ -70,6 +73,7 @@ from multiscale.macro.eigen import (PAIR_RTOL, TWO_PI, Damping, ModalResult, by_
 from multiscale.macro.modal import mac_matrix, pair_modes
 
 METHODS = ("auto", "projection", "quadratic", "subspace")
+RESPONSE_KEEP = 1e-3   # a static response joins the basis with its part outside the modes' span above this share
 SYMMETRIC = 1e-12      # ||K - K^T|| <= this share of ||K|| (infinity norms): no left modes in the basis
 
 
@@ -99,14 +103,32 @@ def real_columns(X: np.ndarray) -> np.ndarray:
     return np.column_stack([X.real, X.imag]) if np.iscomplexobj(X) else X
 
 
+def unit_columns(vectors, M, comm) -> np.ndarray:
+    """The real columns of the blocks ``vectors`` (``real_columns``), each scaled to M-norm 1 (zero
+    columns left out)."""
+    X = np.hstack([real_columns(v) for v in vectors])
+    norms = np.sqrt(reduce_sum(np.einsum("ij,ij->j", X, mat_mult(M, X)), comm))
+    return X[:, norms > 0] / norms[norms > 0]
+
+
 class Subspace:
     """Real M-orthonormal basis V of the span of the real and imaginary parts of complex vectors
-    (e.g. ``ModalResult.modes`` of several cases), with its Gram matrix V^T V (for the MAC)."""
+    (e.g. ``ModalResult.modes`` of several cases), with its Gram matrix V^T V (for the MAC).
+    ``responses`` (static responses, ``static_responses``) add their parts outside the span of
+    ``vectors`` where these hold at least ``RESPONSE_KEEP`` of the response (M-norms): an LU
+    solve's round-off in the rest, amplified by the orthonormalisation, had made the lowest modes
+    of the 12-mm demo brake 100x less accurate (eigenvalues 7.8e-9 -> 6.4e-7 off)."""
 
-    def __init__(self, vectors, M, comm=None, drop: float = 1e-10):
-        X = np.hstack([real_columns(v) for v in vectors])
+    def __init__(self, vectors, M, comm=None, drop: float = 1e-10, responses=()):
         self.comm = comm
-        self.V = m_orthonormalise(X, [], [], M, comm, drop)[0]
+        V, MV = m_orthonormalise(unit_columns(vectors, M, comm), [], [], M, comm, drop)
+        if responses:
+            W = unit_columns(responses, M, comm)
+            W = W - V @ reduce_sum(MV.T @ W, comm)
+            new = np.sqrt(reduce_sum(np.einsum("ij,ij->j", W, mat_mult(M, W)), comm))
+            W = W[:, new >= RESPONSE_KEEP] / new[new >= RESPONSE_KEEP]
+            V = np.hstack([V, m_orthonormalise(W, [V], [MV], M, comm, RESPONSE_KEEP ** 2)[0]])
+        self.V = V
         self.gram = reduce_sum(self.V.T @ self.V, comm)
 
     @property
@@ -251,11 +273,12 @@ def basis_band(band, n_modes, target, basis: float) -> dict:
 
 
 def basis_modes(system: LinearSystem, *, band, n_modes, target, basis: float, left: bool = True,
-                **kw) -> tuple[ModalResult, list]:
+                **kw) -> tuple[ModalResult, list, list]:
     """The undamped modes of (K, M) in the projection basis' band (``basis_band``) and the vectors
-    that span the basis: those modes, with ``left`` and K not symmetric (friction) the modes of
-    (K^T, M), the left eigenvectors, and with hysteretic terms the static responses to their forces
-    of the modes in ``band`` (``hysteretic_corrections``; module docstring). One LU of
+    that span the basis (``Subspace(vectors, M, responses=responses)``): those modes, with ``left``
+    and K not symmetric (friction) the modes of (K^T, M), the left eigenvectors, and with damping
+    terms (H, C) the static responses to their forces of the modes in ``band``
+    (``static_responses``; module docstring). One LU of
     K - theta_t M serves them all, solved transposed for the left modes and their responses."""
     wanted = basis_band(band, n_modes, target, basis)
     with shift_invert_modes(system.K, system.M, **wanted, **kw) as (base, factors):
@@ -272,22 +295,21 @@ def basis_modes(system: LinearSystem, *, band, n_modes, target, basis: float, le
                     found.append(solve_modes(KT, system.M, **wanted, **kw, transpose_of=factors))
             finally:
                 KT.destroy()
-        vectors = [r.modes for r in found]
-        if system.H is not None:          # the modes of the band itself; those above it pad the basis
-            inside = [r.modes[:, (r.frequency >= band[0]) & (r.frequency <= band[1])] for r in found]
-            vectors += hysteretic_corrections(system.H, factors, *inside)
-    return base, vectors
+        inside = [r.modes[:, (r.frequency >= band[0]) & (r.frequency <= band[1])] for r in found]
+        responses = [x for A in (system.H, system.C) if A is not None    # of the modes of the band itself;
+                     for x in static_responses(A, factors, *inside)]    # those above it pad the basis
+    return base, [r.modes for r in found], responses
 
 
-def hysteretic_corrections(H: PETSc.Mat, factors: PETSc.KSP, right: np.ndarray,
-                           left: np.ndarray | None = None) -> list:
-    """Static responses to the hysteretic forces of the basis modes, (K - theta_t M)^-1 H phi of
-    the right modes phi and (K^T - theta_t M)^-1 H psi of the left modes psi (real and imaginary
-    parts), by the ``factors`` of K - theta_t M (modal truncation augmentation, Dickens, Nakagawa &
-    Wittbrodt, Comput. Struct. 62 (1997) 985; module docstring)."""
-    out = [block_solve(factors, mat_mult(H, real_columns(right)))]
+def static_responses(A: PETSc.Mat, factors: PETSc.KSP, right: np.ndarray, left: np.ndarray | None = None) -> list:
+    """Static responses to the damping forces A phi of the basis modes (A = H hysteretic or C
+    viscous), (K - theta_t M)^-1 A phi of the right modes phi and (K^T - theta_t M)^-1 A^T psi of
+    the left modes psi (real and imaginary parts), by the ``factors`` of K - theta_t M (modal
+    truncation augmentation, Dickens, Nakagawa & Wittbrodt, Comput. Struct. 62 (1997) 985;
+    module docstring)."""
+    out = [block_solve(factors, mat_mult(A, real_columns(right)))]
     if left is not None:
-        out.append(block_solve(factors, mat_mult(H, real_columns(left)), transpose=True))
+        out.append(block_solve(factors, mat_mult(A, real_columns(left), transpose=True), transpose=True))
     return out
 
 
@@ -307,7 +329,7 @@ def subspace_basis(system: LinearSystem, *, band, n_modes, target, basis: float,
         W = factors.solve(mat_mult(system.K, V) - mat_mult(system.K0, V))
     finally:
         factors.destroy()
-    return replace(base, modes=None), Subspace([V, W], system.M, matrix_comm(system.K))
+    return replace(base, modes=None), Subspace([V], system.M, matrix_comm(system.K), responses=[W])
 
 
 def solve_system(system: LinearSystem, *, f_max: float = 16e3, f_min: float = 0.0, n_modes: int | None = None,
@@ -322,8 +344,8 @@ def solve_system(system: LinearSystem, *, f_max: float = 16e3, f_min: float = 0.
                            damping=system.damping, **kw)
     t0 = time.perf_counter()
     band = (f_min, f_max)
-    if method == "auto":
-        method = "projection" if system.hysteretic else "quadratic"
+    if method == "auto":     # the real PEP converges from 0 Hz up (``solve_quadratic``): not to a band above it
+        method = "projection" if system.hysteretic or f_min > 0 or (target or 0.0) > 0 else "quadratic"
     if method == "quadratic":
         if system.hysteretic:
             raise InputError("stability.method", method, "the full quadratic solver takes viscous damping only; "
@@ -339,8 +361,8 @@ def solve_system(system: LinearSystem, *, f_max: float = 16e3, f_min: float = 0.
     if method == "subspace":
         base, sub = subspace_basis(system, band=band, n_modes=n_modes, target=target, basis=basis, **kw)
     else:
-        base, vectors = basis_modes(system, band=band, n_modes=n_modes, target=target, basis=basis, **kw)
-        sub = Subspace(vectors, system.M, matrix_comm(system.K))
+        base, vectors, responses = basis_modes(system, band=band, n_modes=n_modes, target=target, basis=basis, **kw)
+        sub = Subspace(vectors, system.M, matrix_comm(system.K), responses=responses)
     return solve_projected(system, sub, band=band, n_modes=n_modes, target=target, base=base, t0=t0)[0]
 
 

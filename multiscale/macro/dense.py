@@ -30,13 +30,14 @@ def from_dense(D: PETSc.Mat) -> np.ndarray:
     return X
 
 
-def mat_mult(A: PETSc.Mat, X: np.ndarray) -> np.ndarray:
-    """A @ X for real columns X (MatMatMult with a dense block)."""
+def mat_mult(A: PETSc.Mat, X: np.ndarray, transpose: bool = False) -> np.ndarray:
+    """A @ X (A^T @ X with ``transpose``: A square) for real columns X (MatMatMult,
+    MatTransposeMatMult with a dense block)."""
     if X.shape[1] == 0:
         return np.empty((A.getLocalSize()[0], 0))
     B = to_dense(X, A)
     try:
-        return from_dense(A.matMult(B))
+        return from_dense(A.transposeMatMult(B) if transpose else A.matMult(B))
     finally:
         B.destroy()
 

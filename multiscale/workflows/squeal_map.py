@@ -117,15 +117,16 @@ def stability_map(scene, tm, mech, options, load: float, rebuild: Callable) -> S
 def _common_basis(model: MapModel, builder: MapBuilder, st, options) -> int:
     """All points projected on the undamped modes of the first and last points (fixed preload)."""
     band, values, sw = tuple(st.band), list(st.sweep.values), st.sweep
-    bases = []
+    bases, responses = [], []
     for value in (values[0], values[-1]):
         lin = model.linearise(value)
-        bases += basis_modes(lin.system, band=band, n_modes=st.modes, target=st.target, basis=options.basis,
-                             left=lin.system.general)[1]      # the left modes for the damping's shifts
+        _, modes, static = basis_modes(lin.system, band=band, n_modes=st.modes, target=st.target,
+                                       basis=options.basis, left=lin.system.general)   # left: the damping's shifts
+        bases, responses = bases + modes, responses + static
         if value == values[0]:
             _free(lin)
-    sub = Subspace(bases, lin.system.M, matrix_comm(lin.system.K))
-    del bases
+    sub = Subspace(bases, lin.system.M, matrix_comm(lin.system.K), responses=responses)
+    del bases, responses
     results, reduced = [None] * len(values), [None] * len(values)
     for k in [len(values) - 1] + list(range(len(values) - 1)):
         if k != len(values) - 1:
