@@ -206,20 +206,24 @@ def test_modes_with_large_residuals_are_warned_about():
     """A run's modes with relative residuals above squeal.MODE_RESIDUAL are named in a warning with
     the key that widens the projection basis (before: no word; modes.csv of the coarse demo brake
     with a pad loss factor showed 0.15 for its first mode); without loss factors the exact
-    quadratic solver is named too."""
+    quadratic solver is named too, unless the band starts above 0 Hz or a target is set, which it
+    cannot reach."""
     lam = np.array([-28.8 + 4714.0j, -40.4 + 9688.0j, -1.1 + 9884.0j])
     modes = eigen.ModalResult(lam, -lam**2, np.zeros((1, 3)), np.array([0.22, 0.031, 1e-3]), (0.0, 16e3), 0.0, 1,
                               "projection", 0, 0, 0.0)
-    scene = NS(stability=NS(basis=1.5, damping=0.0, method="auto"))
+    scene = NS(stability=NS(basis=1.5, damping=0.0, method="auto", band=(0.0, 16e3), target=None))
     lossy = squeal.approximate_modes(scene, NS(modes=modes, terms=("material loss factors",)))
     assert lossy == ["modes 1 (750 Hz, 2.2e-01), 2 (1542 Hz, 3.1e-02) have relative residuals above 0.03: their "
                      "frequencies and growth rates are approximate (projected on the modes up to stability.basis x "
                      "f_max; a larger stability.basis, now 1.5, widens the basis)"]
     viscous = squeal.approximate_modes(scene, NS(modes=modes, terms=("friction slope",)))
-    subspace = NS(stability=NS(basis=1.5, damping=0.0, method="subspace"))     # a wider basis did not help it
+    subspace = NS(stability=NS(basis=1.5, damping=0.0, method="subspace", band=(0.0, 16e3), target=None))
     assert squeal.approximate_modes(subspace, NS(modes=modes, terms=("material loss factors",)))[0].endswith(
         "widens the basis; stability.method = \"projection\" adds the static responses to the loss factors' forces)")
     assert viscous[0].endswith('widens the basis; stability.method = "quadratic" solves viscous damping exactly)')
+    for band, target in (((1e3, 16e3), None), ((0.0, 16e3), 2e3)):   # out of the quadratic solver's reach
+        above = NS(stability=NS(basis=1.5, damping=0.0, method="auto", band=band, target=target))
+        assert squeal.approximate_modes(above, NS(modes=modes, terms=("friction slope",)))[0].endswith("widens the basis)")
     modes.errors[:] = 1e-3
     assert squeal.approximate_modes(scene, NS(modes=modes, terms=())) == []
 

@@ -248,7 +248,8 @@ def approximate_modes(scene, case: SquealCase) -> list[str]:
     if st.method == "subspace" and lossy:        # its basis has no static responses to H (docs/squeal.md)
         hint = '; stability.method = "projection" adds the static responses to the loss factors\' forces'
     else:
-        hint = "" if st.damping or lossy else '; stability.method = "quadratic" solves viscous damping exactly'
+        exact = not (st.damping or lossy or st.band[0] > 0 or st.target)   # the PEP reaches a band from 0 Hz only
+        hint = '; stability.method = "quadratic" solves viscous damping exactly' if exact else ""
     return [f"modes {named}{more} have relative residuals above {MODE_RESIDUAL:g}: their frequencies and growth "
             f"rates are approximate (projected on the modes up to stability.basis x f_max; a larger "
             f"stability.basis, now {st.basis:g}, widens the basis{hint})"]
