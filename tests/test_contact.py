@@ -158,8 +158,28 @@ def test_non_convergence_raises_with_history(rough):
     assert not partial.converged and partial.mean_pressure == pytest.approx(2e6)
 
 
+def test_a_zero_load_touches_at_the_highest_point(rough):
+    """Load 0 (a load sweep from 0; it was refused): no contact, no pressure or displacement, the
+    gap the depth below the highest point; in a batch the loaded patches are solved as alone,
+    with their hardness and initial pressure."""
+    solver = ContactSolver(E, rough.shape, rough.dx)
+    h = rough.heights[:3]
+    r = solver.solve(h[0], load=0.0)
+    assert r.area_fraction == r.mean_pressure == r.approach == 0 and r.converged and r.iterations == 0
+    assert not r.contact.any() and np.all(r.pressure == 0) and np.all(r.displacement == 0)
+    np.testing.assert_array_equal(r.gap, h[0].max() - h[0])
+    mixed = solver.solve(h, load=[0.0, 2e6, 0.0], hardness=[1e9, 5e6, 1e9], initial_pressure=np.full(h.shape, 1e3))
+    alone = solver.solve(h[1], load=2e6, hardness=5e6, initial_pressure=np.full(h.shape[1:], 1e3))
+    assert mixed.pressure.shape == h.shape and np.array_equal(mixed.mean_pressure, [0.0, 2e6, 0.0])
+    np.testing.assert_array_equal(mixed.pressure[1], alone.pressure)
+    np.testing.assert_array_equal(mixed.plastic[1], alone.plastic)
+    assert mixed.plastic_area_fraction[1] == alone.plastic_area_fraction > 0
+    np.testing.assert_array_equal(mixed.gap[2], h[2].max() - h[2])
+    assert solver.solve(h, load=0.0).area_fraction.tolist() == [0.0, 0.0, 0.0]
+
+
 @pytest.mark.parametrize("kwargs, name", [
-    (dict(load=-1.0), "load"), (dict(load=0.0), "load"), (dict(load=1e6, tol=0.0), "tol"),
+    (dict(load=-1.0), "load"), (dict(load=1e6, tol=0.0), "tol"),
     (dict(load=1e6, tol=-1e-3), "tol"), (dict(approach=-1e-6), "approach"),
     (dict(), "load/approach"), (dict(load=np.nan), "load"),
 ])

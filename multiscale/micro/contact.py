@@ -126,8 +126,9 @@ class ContactSolver:
     def solve(self, heights, *, load=None, approach=None, tol: float = 1e-8, max_iter: int = 5000,
               initial_pressure=None, partial: bool = False, method: str | None = None,
               hardness=None) -> ContactResult:
-        """Solve under load control (``load`` = mean pressure [Pa]) or displacement control
-        (``approach`` = delta [m]); scalars or arrays of the batch shape. ``heights`` [m]: an array
+        """Solve under load control (``load`` = mean pressure [Pa], >= 0: at 0 the patch is
+        untouched) or displacement control (``approach`` = delta [m]); scalars or arrays of the
+        batch shape. ``heights`` [m]: an array
         (..., ny, nx) or a ``Surface`` on the solver's grid (checked: shape, dx, dy, periodic). ``hardness`` H [Pa]
         (scalar or per patch, > 0; inf or None: elastic) bounds the pressure (p <= H, load < H):
         the result's ``plastic`` field is then the permanent deformation d - z - u on the cells at
@@ -164,8 +165,8 @@ class ContactSolver:
             raise InputError("heights", "array", "the height range overflows float64")
         if load is not None:
             target = _batch_values("load", load, batch)
-            if not np.all(np.isfinite(target)) or np.any(target <= 0):
-                raise InputError("load", load, "mean pressure must be finite and > 0")
+            if not np.all(np.isfinite(target)) or np.any(target < 0):
+                raise InputError("load", load, "mean pressure must be finite and >= 0")
             delta = None
         else:
             target = None
@@ -197,7 +198,33 @@ class ContactSolver:
             p0 = _batch_values("initial_pressure", initial_pressure, h.shape)
             if np.any(p0 < 0) or not np.all(np.isfinite(p0)):
                 raise InputError("initial_pressure", "array", "must be finite and >= 0")
+        if target is not None and np.any(target == 0):   # unloaded: touching at the highest point (a sweep from 0)
+            return self._unloaded(h, target, dict(tol=tol, max_iter=max_iter, initial_pressure=initial_pressure,
+                                                  partial=partial, method=method, hardness=hardness))
         return self._run_chunks(method, z, target, delta, tol, max_iter, p0, partial, upper=upper)
+
+    def _unloaded(self, h: np.ndarray, load: np.ndarray, options: dict) -> ContactResult:
+        """``solve`` under the loads ``load`` of which some are 0: those patches untouched (no
+        contact, pressure or displacement; the gap the depth below the highest point, approach 0),
+        the others solved as asked (with their hardness and initial pressure)."""
+        zero = load == 0
+        z = h.max(axis=(-2, -1), keepdims=True) - h
+        flat = np.zeros(h.shape)
+        result = ContactResult(flat, flat.copy(), np.broadcast_to(z, h.shape).copy(), flat != 0, np.zeros(load.shape),
+                               np.zeros(load.shape), np.zeros(load.shape), z.mean(axis=(-2, -1)).reshape(load.shape),
+                               np.zeros(load.shape), flat.copy(), np.zeros(load.shape, dtype=int),
+                               np.zeros(load.shape), np.ones(load.shape, dtype=bool))
+        if zero.all():
+            return result
+        p0, upper = options.pop("initial_pressure"), options.pop("hardness")
+        p0 = None if p0 is None else _batch_values("initial_pressure", p0, h.shape)[~zero]
+        upper = None if upper is None else _batch_values("hardness", upper, load.shape)[~zero]
+        loaded = self.solve(h[~zero], load=load[~zero], initial_pressure=p0, hardness=upper, **options)
+        for k, a in vars(loaded).items():
+            if isinstance(a, np.ndarray):
+                getattr(result, k)[~zero] = a
+        result.history = loaded.history
+        return result
 
     def _run_chunks(self, method, z, target, delta, tol, max_iter, p0, partial, fields=True, upper=None,
                     threads=None):
