@@ -152,6 +152,14 @@ class Stability:
             what = f"{path}.damping" if self.damping else f"materials.{lossy[0]}.loss_factor"
             return [f'{path}.method = "quadratic": takes viscous damping only; {what} (complex stiffness) '
                     'needs method = "projection"']
+        if self.method == "quadratic" and self.target:    # (a user trial got the lowest modes, the target unsaid)
+            return [f'{path}.target = {self.target:g} Hz: method = "quadratic" cannot shift to a frequency in real '
+                    'arithmetic (it finds the lowest modes first); use method = "auto", which projects on the modes '
+                    "around the target, or leave the target out"]
+        if self.method == "quadratic" and low > 0:
+            ctx.warnings.append(f'{path}.method = "quadratic" with a band from {low:g} Hz: it finds the lowest modes '
+                                f"first, {path}.modes of them from 0 Hz, and refuses a band they do not cover; "
+                                'method = "auto" projects on the band')
         if self.method == "subspace" and self.sweep is not None:
             return [f'{path}.method = "subspace": one big analysis, not a sweep (use "auto" with [{path}.sweep])']
         loading = ctx.root.get("loading") if isinstance(ctx.root.get("loading"), dict) else {}

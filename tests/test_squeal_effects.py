@@ -17,7 +17,7 @@ from mpi4py import MPI  # noqa: E402
 
 from meshes import disc_brake  # noqa: E402
 from multiscale import scene as scenes  # noqa: E402
-from multiscale.errors import InputError  # noqa: E402
+from multiscale.errors import InputError, SceneError  # noqa: E402
 from multiscale.geometry import Rotation, builder  # noqa: E402
 from multiscale.macro import damped, eigen  # noqa: E402
 from multiscale.macro import mesh as two_body  # noqa: E402
@@ -224,8 +224,31 @@ def test_modes_with_large_residuals_are_warned_about():
     for band, target in (((1e3, 16e3), None), ((0.0, 16e3), 2e3)):   # out of the quadratic solver's reach
         above = NS(stability=NS(basis=1.5, damping=0.0, method="auto", band=band, target=target))
         assert squeal.approximate_modes(above, NS(modes=modes, terms=("friction slope",)))[0].endswith("widens the basis)")
+    modes.errors[:] = [1e-3, 0.05, 1e-3]
+    assert squeal.approximate_modes(scene, NS(modes=modes, terms=("material loss factors",))) == [
+        "mode 2 (1542 Hz, 5.0e-02) has a relative residual above 0.03: its frequency and growth rate are approximate "
+        "(projected on the modes up to stability.basis x f_max; a larger stability.basis, now 1.5, widens the basis)"]
     modes.errors[:] = 1e-3
     assert squeal.approximate_modes(scene, NS(modes=modes, terms=())) == []
+
+
+def test_values_of_the_projected_problem_left_out_among_the_modes_are_said():
+    """A value that is no mode of the model (relative residual above damped.SPURIOUS) took a place
+    among the modes nearest the target: the run says it was left out (a user trial saw it reported
+    as an unstable squeal mode, 3524 Hz); one outside the modes' window displaced none, unsaid."""
+    lam = np.array([2.7 + 2915.5j, 28.7 + 2986.7j, 6.0 + 3542.6j, 15.2 + 3800.7j]) * 2 * np.pi
+    modes = eigen.ModalResult(lam, -lam**2, np.zeros((1, 4)), np.full(4, 1e-3), (0.0, 6e3), 3500.0, 1, "projection",
+                              0, 0, 0.0, spurious=(3524.3, 5931.0))
+    scene = NS(stability=NS(basis=1.5, damping=0.0, method="auto", band=(0.0, 6e3), target=3500.0, modes=4, sweep=None),
+               materials=None)
+    case = NS(modes=modes, terms=(), mech=NS(tm=NS(notes=())), facet_pressure=np.zeros(1),
+              preload=NS(normal_force={}))
+    said = squeal._left_out(scene, case, None)
+    assert said[0] == ("1 value(s) of the projected problem among the modes found (3524 Hz) had relative residuals "
+                       "above 0.5 in the full model: not modes of it, left out (a larger stability.basis, now 1.5, "
+                       "widens the basis)")
+    assert said[1].startswith("stability.modes = 4: the modes found span 2916 to 3801 Hz around stability.target = "
+                              "3500 Hz; the band below 2916 Hz, from 0 Hz, and above 4084 Hz")
 
 
 # ---------------------------------------------------------------- scene options and sweeps
@@ -536,7 +559,22 @@ def test_eigen_solver_errors_name_the_scene_keys(tmp_path):
     assert fields <= written and "modes.csv" not in written and "provenance.json" in written
 
 
-def test_a_band_cut_short_below_a_target_is_said(tmp_path):
+def test_the_quadratic_solver_is_not_asked_for_what_it_cannot_reach():
+    """method = "quadratic" converges from 0 Hz up (real arithmetic): with a target it returned the
+    lowest modes, the target unsaid (a user trial), so the scene refuses it; with a band above 0 Hz
+    check warns (the solve refuses a band its modes do not cover, test_stability)."""
+    base = {"stability.method": "quadratic", "stability.gyroscopic": True}
+    with pytest.raises(SceneError, match=r'stability.target = 3500 Hz: method = "quadratic" cannot shift to a '
+                                         r'frequency in real arithmetic .* use method = "auto"'):
+        scenes.load(DEMO, {**base, "stability.target": "3.5 kHz"})
+    scene = scenes.load(DEMO, {**base, "stability.band": ["2 kHz", "6 kHz"]})
+    assert [w for w in scene.warnings if "quadratic" in w] == [
+        'stability.method = "quadratic" with a band from 2000 Hz: it finds the lowest modes first, stability.modes '
+        'of them from 0 Hz, and refuses a band they do not cover; method = "auto" projects on the band']
+    assert not [w for w in scenes.load(DEMO, {**base, "stability.band": ["0 Hz", "6 kHz"]}).warnings if "quadratic" in w]
+
+
+def test_a_band_cut_short_below_a_target_is_said(tmp_path, capsys):
     """stability.target mid-band: the 6 modes nearest 8 kHz span 7.4-8.2 kHz and the band from 0 Hz
     below them was not searched (before: only 'the band above ... was not searched'; with the
     target at 15.5 kHz, 'above' though the search reached 17.9 kHz, and not a word on the 0-12.8 kHz
@@ -544,9 +582,11 @@ def test_a_band_cut_short_below_a_target_is_said(tmp_path):
     overrides = {**NO_FIGURES,
                  "geometry.mesh_size": "30 mm", "stability.modes": 6, "output.folder": str(tmp_path / "out"),
                  "stability.target": "8 kHz"}
-    run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
+    run = squeal.run(scenes.load(DEMO, overrides), degree=1)
     f = run.case.modes.frequency
     assert f.min() > 5e3 and len(run.warnings) == 1
+    # the console says which solver gave the modes (a user trial could not tell)
+    assert "\n  modes by the generalized eigenproblem K phi = theta M phi (exact)\n" in capsys.readouterr().out
     assert run.warnings[0].startswith(f"stability.modes = 6: the modes found span {f.min():.0f} to {f.max():.0f} Hz "
                                       "around stability.target = 8000 Hz; the band below ")
     assert "from 0 Hz, and above" in run.warnings[0] and run.warnings[0].endswith("move stability.target)")

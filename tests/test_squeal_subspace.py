@@ -104,7 +104,8 @@ def test_subspace_modes_match_the_full_nonsymmetric_solve(models):
     # the real modes alone (no static corrections) miss the friction coupling
     real = block_lanczos.symmetric_modes(system.K0, M, **damped.basis_band((0.0, F_MAX), 30, None, 1.5))
     plain = damped.solve_projected(system, damped.Subspace([real.modes], M), band=(0.0, F_MAX), n_modes=30)[0]
-    assert plain.errors.max() > 0.3                                          # measured 0.66
+    assert plain.errors.max() > 0.2 and len(plain.spurious) == 1  # measured 0.34, and a value (1097 Hz) with a
+    #                                               residual above damped.SPURIOUS (0.66) left out as no mode
 
 
 def test_subspace_needs_the_frictionless_tangent(models):

@@ -165,8 +165,12 @@ def test_a_mode_cap_on_the_quadratic_path_keeps_both_members_of_the_lock_in_pair
     assert len(q) == 22 and q.unstable().sum() == 1
     np.testing.assert_allclose(q.eigenvalues, ref[:22], rtol=1e-9)
     with pytest.raises(InputError, match=r"^stability.modes = 3: the quadratic solver finds the lowest modes first: "
-                                         r"its lowest reach 39.99\d+ Hz, below the band's 150 Hz"):   # (an open limit)
+                                         r"they reach 39.99\d+ Hz, 0 of them in the band from 150 Hz; cover the band "
+                                         r'from 0 Hz, or stability.method = "auto" projects on the band$'):
         eigen.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_min=150.0, f_max=1e3, n_modes=3)
+    # some of the band, fewer than asked: it returned them, and nothing said the band was cut (a user trial)
+    with pytest.raises(InputError, match=r"^stability.modes = 12: .* they reach 160 Hz, 6 of them in the band"):
+        eigen.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_min=100.0, f_max=1e3, n_modes=12)
 
 
 def test_overdamped_roots_are_not_potentially_unstable():

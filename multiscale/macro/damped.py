@@ -73,6 +73,7 @@ from multiscale.macro.eigen import (PAIR_RTOL, TWO_PI, Damping, ModalResult, by_
 from multiscale.macro.modal import mac_matrix, pair_modes
 
 METHODS = ("auto", "projection", "quadratic", "subspace")
+SPURIOUS = 0.5        # a projected eigenpair with a relative residual above this in the full model is no mode of it
 RESPONSE_KEEP = 1e-3   # a static response joins the basis with its part outside the modes' span above this share
 SYMMETRIC = 1e-12      # ||K - K^T|| <= this share of ||K|| (infinity norms): no left modes in the basis
 
@@ -255,11 +256,17 @@ def solve_projected(system: LinearSystem, sub: Subspace, *, band=(0.0, 16e3), n_
     target = band[0] if target is None else target
     red, AV = project(system, sub)
     lam, Q = red.eigenpairs()
+    inband = select(lam, band, None, target)
+    false = residuals(lam[inband], Q[:, inband], AV, system.damping, sub.comm) > SPURIOUS
+    lam, Q, spurious = lam[inband[~false]], Q[:, inband[~false]], lam[inband[false]].imag / TWO_PI
     keep = select(lam, band, n_modes, target)
     if keep.size == 0:
-        raise InputError("f_max", band, "no damped mode in this frequency band [Hz]; widen it")
-    return modal_result(lam[keep], Q[:, keep], sub, AV, system, band, target, system.K.getSize()[0], t0,
-                        base=base, expand=expand), red
+        raise InputError("f_max", band, "no damped mode in this frequency band [Hz]; widen it" +
+                         (f" ({spurious.size} values of the projected problem, not modes of the model: widen "
+                          "stability.basis)" if spurious.size else ""))
+    result = modal_result(lam[keep], Q[:, keep], sub, AV, system, band, target, system.K.getSize()[0], t0,
+                          base=base, expand=expand)
+    return replace(result, spurious=tuple(float(x) for x in spurious)), red
 
 
 def basis_band(band, n_modes, target, basis: float) -> dict:

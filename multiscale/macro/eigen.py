@@ -70,6 +70,8 @@ class ModalResult:
     comm: object = field(default=None, repr=False)   # mpi4py communicator of the modes (None: serial)
     gram: np.ndarray | None = field(default=None, repr=False)   # modes in reduced coordinates q of a
     #                                 basis V (``macro.damped.Subspace``): V^T V, for the MAC
+    spurious: tuple = ()        # projection: frequencies [Hz] of the band's reduced eigenvalues left out,
+    #                             their relative residual in the full model above ``damped.SPURIOUS``
 
     @property
     def frequency(self) -> np.ndarray:
@@ -456,9 +458,11 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
         if kept.size:                   # the other member of a lock-in pair the cap ends in (``PAIR_RTOL``)
             rest = rest[np.isclose(lam[rest].imag, lam[kept[-1]].imag, rtol=PAIR_RTOL, atol=0.0)]
         inband = np.concatenate([kept, rest])
-    if not inband.size and seen.size and seen.max() < f_min:   # (it said "widen it", nearest a spurious root)
-        raise InputError("stability.modes", n_modes, f"the quadratic solver finds the lowest modes first: its lowest "
-                         f"reach {seen.max():.6g} Hz, below the band's {f_min:g} Hz; cover the band from 0 Hz")
+    short = n_modes is not None and f_min > 0 and inband.size < n_modes and seen.size and seen.max() < f_max
+    if short or (not inband.size and seen.size and seen.max() < f_min):   # (it said "widen it", nearest a spurious
+        raise InputError("stability.modes", n_modes, f"the quadratic solver finds the lowest modes first: they "  # root)
+                         f"reach {seen.max():.6g} Hz, {inband.size} of them in the band from {f_min:g} Hz; cover the "
+                         'band from 0 Hz, or stability.method = "auto" projects on the band')
     order = inband[_sorted(lam[inband], (f_min, f_max), seen)]
     lam, vecs, errs = lam[order], vecs[:, order], errs[order]
     return ModalResult(lam, -lam ** 2, _normalise(vecs, M, comm), errs, (f_min, f_max), target, n,
