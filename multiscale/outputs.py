@@ -150,8 +150,9 @@ def plan(scene) -> Plan:
                 f"; {PART_ARRAY} ({parts[name]})" if name in parts else "")
             files[f"{name}.h5"] = f"data of {name}.xdmf"
     if kind == "squeal":
-        files["modes.csv"] = ("frequency, growth rate, damping ratio, unstable and potentially unstable flags, "
-                              "SLEPc residual and each component's strain-energy share of every mode")
+        files["modes.csv"] = ("frequency, growth rate, damping ratio (-sigma/|lambda|), unstable and potentially "
+                              "unstable flags, relative residual in the full model and each component's "
+                              "strain-energy share of every mode")
         files.update({f"modes_{b}.bp": f"mode shapes of {b} (VTX): real and imaginary parts, time = mode number"
                       for b in scene.bodies})
         files["pressure.png"] = "contact pressure on each interface at the preload"
