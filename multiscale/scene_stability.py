@@ -13,7 +13,8 @@ from multiscale.schema import Choice, Flag, Integer, ListOf, OneOf, Pair, Quanti
 @dataclass(frozen=True)
 class Stribeck:
     """[loading.stribeck]: friction falling with the slip speed v, mu(v) = kinetic + (static -
-    kinetic) exp(-(v / speed)^exponent) (exponent 1: the exponential static-to-kinetic decay law)."""
+    kinetic) exp(-(v / speed)^exponent) (exponent 1: the exponential static-to-kinetic decay law).
+    Not with a friction sweep ([stability.sweep] friction sets a constant mu at each point)."""
 
     static: float | None = key(Quantity("dimensionless", ge=0), required=True)
     kinetic: float | None = key(Quantity("dimensionless", ge=0), required=True)
