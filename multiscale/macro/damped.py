@@ -234,14 +234,14 @@ def residuals(lam: np.ndarray, Q: np.ndarray, AV: dict, damping: Damping | None,
     return norms(r) / np.maximum(sum(norms(t) for t in terms), np.finfo(float).tiny)
 
 
-def modal_result(lam, Q, sub: Subspace, AV: dict, system, band, target, n_dofs, t0, *, base=None,
+def modal_result(lam, Q, errs, sub: Subspace, band, target, n_dofs, t0, *, base=None,
                  expand: bool = True, method: str = "projection") -> ModalResult:
-    """ModalResult of reduced eigenpairs: full modes phi = V q (``expand``) normalised to
-    phi^H M phi = 1 with phi^T phi real positive, or the reduced q with the subspace's Gram matrix."""
+    """ModalResult of reduced eigenpairs (relative residuals ``errs``, ``residuals``): full modes
+    phi = V q (``expand``) normalised to phi^H M phi = 1 with phi^T phi real positive, or the
+    reduced q with the subspace's Gram matrix."""
     Q = Q / np.sqrt(np.maximum(np.einsum("ij,ij->j", Q.conj(), Q).real, np.finfo(float).tiny))   # V'MV = I
     sq = np.einsum("ij,ij->j", Q, sub.gram @ Q)
     Q = Q * np.exp(-0.5j * np.angle(sq))
-    errs = residuals(lam, Q, AV, system.damping, sub.comm) if AV else np.full(lam.size, np.nan)
     modes = sub.expand(Q) if expand else Q
     return ModalResult(lam, -lam**2, modes, errs, tuple(band), target, n_dofs, method,
                        base.iterations if base else 0, base.solves if base else 0, time.perf_counter() - t0,
@@ -257,14 +257,15 @@ def solve_projected(system: LinearSystem, sub: Subspace, *, band=(0.0, 16e3), n_
     red, AV = project(system, sub)
     lam, Q = red.eigenpairs()
     inband = select(lam, band, None, target)
-    false = residuals(lam[inband], Q[:, inband], AV, system.damping, sub.comm) > SPURIOUS
-    lam, Q, spurious = lam[inband[~false]], Q[:, inband[~false]], lam[inband[false]].imag / TWO_PI
+    errs = residuals(lam[inband], Q[:, inband], AV, system.damping, sub.comm)    # (scale and phase free)
+    false = errs > SPURIOUS
+    lam, Q, errs, spurious = lam[inband[~false]], Q[:, inband[~false]], errs[~false], lam[inband[false]].imag / TWO_PI
     keep = select(lam, band, n_modes, target)
     if keep.size == 0:
         raise InputError("f_max", band, "no damped mode in this frequency band [Hz]; widen it" +
                          (f" ({spurious.size} values of the projected problem, not modes of the model: widen "
                           "stability.basis)" if spurious.size else ""))
-    result = modal_result(lam[keep], Q[:, keep], sub, AV, system, band, target, system.K.getSize()[0], t0,
+    result = modal_result(lam[keep], Q[:, keep], errs[keep], sub, band, target, system.K.getSize()[0], t0,
                           base=base, expand=expand)
     return replace(result, spurious=tuple(float(x) for x in spurious)), red
 

@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 
@@ -108,7 +109,7 @@ class ConductionSolver:
         masks = np.asarray(masks, dtype=float)
         return np.sum(self.series(masks) * masks, axis=(-2, -1)) / masks.sum(axis=(-2, -1))
 
-    @property
+    @cached_property
     def perfect_conductance(self) -> float:
         """K_p [W/(m² K)], the conductance of a perfect (full) contact under a uniform flux: periodic
         1/(F_1(0) + F_2(0)) (inf if a body is semi-infinite), isolated 1/R_u of the whole patch

@@ -199,18 +199,17 @@ class ContactSolver:
             if np.any(p0 < 0) or not np.all(np.isfinite(p0)):
                 raise InputError("initial_pressure", "array", "must be finite and >= 0")
         if target is not None and np.any(target == 0):   # unloaded: touching at the highest point (a sweep from 0)
-            return self._unloaded(h, target, dict(tol=tol, max_iter=max_iter, initial_pressure=initial_pressure,
-                                                  partial=partial, method=method, hardness=hardness))
+            return self._unloaded(h, z, target, dict(tol=tol, max_iter=max_iter, initial_pressure=initial_pressure,
+                                                     partial=partial, method=method, hardness=hardness))
         return self._run_chunks(method, z, target, delta, tol, max_iter, p0, partial, upper=upper)
 
-    def _unloaded(self, h: np.ndarray, load: np.ndarray, options: dict) -> ContactResult:
+    def _unloaded(self, h: np.ndarray, z: np.ndarray, load: np.ndarray, options: dict) -> ContactResult:
         """``solve`` under the loads ``load`` of which some are 0: those patches untouched (no
-        contact, pressure or displacement; the gap the depth below the highest point, approach 0),
-        the others solved as asked (with their hardness and initial pressure)."""
+        contact, pressure or displacement; the gap the depth ``z`` below the highest point, approach
+        0), the others solved as asked (with their hardness and initial pressure)."""
         zero = load == 0
-        z = h.max(axis=(-2, -1), keepdims=True) - h
         flat = np.zeros(h.shape)
-        result = ContactResult(flat, flat.copy(), np.broadcast_to(z, h.shape).copy(), flat != 0, np.zeros(load.shape),
+        result = ContactResult(flat, flat.copy(), z.copy(), flat != 0, np.zeros(load.shape),
                                np.zeros(load.shape), np.zeros(load.shape), z.mean(axis=(-2, -1)).reshape(load.shape),
                                np.zeros(load.shape), flat.copy(), np.zeros(load.shape, dtype=int),
                                np.zeros(load.shape), np.ones(load.shape, dtype=bool))
