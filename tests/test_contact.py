@@ -170,7 +170,9 @@ def test_a_zero_load_touches_at_the_highest_point(rough):
     np.testing.assert_array_equal(r.gap, h[0].max() - h[0])
     mixed = solver.solve(h, load=[0.0, 2e6, 0.0], hardness=[1e9, 5e6, 1e9], initial_pressure=np.full(h.shape, 1e3))
     alone = solver.solve(h[1], load=2e6, hardness=5e6, initial_pressure=np.full(h.shape[1:], 1e3))
-    assert mixed.pressure.shape == h.shape and np.array_equal(mixed.mean_pressure, [0.0, 2e6, 0.0])
+    assert mixed.pressure.shape == h.shape and np.array_equal(mixed.mean_pressure[[0, 2]], [0.0, 0.0])
+    assert mixed.mean_pressure[1] == alone.mean_pressure == pytest.approx(2e6, rel=1e-12)   # (not 2e6 to the last
+    #                                                   bit in one fresh-clone CI run; not reproduced here)
     np.testing.assert_array_equal(mixed.pressure[1], alone.pressure)
     np.testing.assert_array_equal(mixed.plastic[1], alone.plastic)
     assert mixed.plastic_area_fraction[1] == alone.plastic_area_fraction > 0
