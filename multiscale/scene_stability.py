@@ -35,7 +35,8 @@ class Sweep:
     nominal analysis and projects every point on the undamped modes of the first and last points;
     ``"each"`` (pressure, roughness) preloads and solves every point. The modes are tracked by MAC
     (``mac``: the lowest MAC of a pair) and the onset of every unstable mode is bisected
-    (``onsets``); see ``multiscale.workflows.squeal_map``."""
+    (``onsets``); an "each" map narrows each onset's bracket by up to ``refine`` full analyses
+    (preload and eigen solve); see ``multiscale.workflows.squeal_map``."""
 
     friction: tuple | None = key(ListOf(Quantity("dimensionless", ge=0), min_len=2), absent=_OTHER)
     pressure: tuple | None = key(ListOf(Quantity("pressure", gt=0), min_len=2), absent=_OTHER)          # Pa
@@ -46,6 +47,7 @@ class Sweep:
                               "and rms")
     mac: float = key(Quantity("dimensionless", gt=0, le=1), default=0.5)
     onsets: bool = key(Flag(), default=True)
+    refine: int | None = key(Integer(ge=0), absent='3 with preload = "each"')
 
     rules = (OneOf(tuple(SWEEP_PARAMETERS), required=True),)
 
@@ -58,6 +60,11 @@ class Sweep:
     def preload_mode(self) -> str:
         """"once" (keep the nominal sliding state) or "each" (preload every point)."""
         return self.preload or ("once" if self.parameter in ("friction", "speed") else "each")
+
+    @property
+    def refine_steps(self) -> int:
+        """Full analyses that narrow each onset's bracket (0 with preload "once")."""
+        return 0 if self.preload_mode == "once" else 3 if self.refine is None else self.refine
 
     @property
     def values(self) -> tuple:
@@ -85,6 +92,9 @@ class Sweep:
             return [f"{where}: sweeps roughness.rms of a generated surface; the scene gives no roughness.rms"]
         if self.preload == "once" and name in ("pressure", "rms"):
             return [f'{path}.preload = "once": a {name} sweep changes the preloaded state; use "each"']
+        if self.refine is not None and self.preload_mode == "once":
+            return [f'{path}.refine: narrows the onsets of a preload = "each" map by full analyses; a "once" map '
+                    "bisects them on its common basis (set preload = \"each\" or remove refine)"]
         if name == "friction" and ("friction_curve" in loading or "stribeck" in loading):
             return [f"{where}: sets a constant friction; remove loading.friction_curve / loading.stribeck"]
         if name == "friction" and "friction" not in ctx.effects:     # (the map had friction, the analysis none)

@@ -1234,6 +1234,21 @@ def test_a_sweep_without_a_valid_parameter_is_a_problem_not_a_traceback(sweep, f
     assert all(p.startswith("stability.sweep") for p in info.value.problems), info.value.problems
 
 
+def test_an_each_map_refines_its_onsets_by_three_full_analyses_unless_told_and_a_once_map_cannot():
+    """``stability.sweep.refine``: full analyses per onset of a preload = "each" map (default 3);
+    a "once" map bisects on its common basis, so refine there is a problem, not ignored."""
+    text = (DEMOS / "brake_squeal.toml").read_text() + "\n[stability.sweep]\nfriction = [0.3, 0.5]\n"
+    assert loads(text, name="brake").stability.sweep.refine_steps == 0                 # "once"
+    each = text + 'preload = "each"\n'
+    assert loads(each, name="brake").stability.sweep.refine_steps == 3
+    assert loads(each + "refine = 5\n", name="brake").stability.sweep.refine_steps == 5
+    with pytest.raises(SceneError) as info:
+        loads(text + "refine = 2\n", name="brake")
+    assert info.value.problems == ['stability.sweep.refine: narrows the onsets of a preload = "each" map by full '
+                                   'analyses; a "once" map bisects them on its common basis (set preload = "each" '
+                                   "or remove refine)"]
+
+
 def test_a_friction_sweep_needs_the_friction_it_sweeps_and_says_it_overrides_the_pads_own():
     """A friction map of a scene without effect "friction" (its analysis frictionless, its map with
     mu: 1 unstable somewhere against 0) is refused; over an interface's own mu it is said that no

@@ -406,13 +406,78 @@ def test_a_band_of_instability_is_bisected_at_both_ends(tmp_path):
     assert smap.onsets[0].end == pytest.approx(0.5 + m, rel=1e-6)
     assert "; stable again at 0.6\n" in smap.summary() + "\n"
     row = smap.write_onsets_csv(tmp_path / "onsets.csv").read_text().splitlines()
-    assert row[0].endswith(",stable_again_friction_-") and float(row[1].split(",")[-1]) == pytest.approx(0.6)
+    assert row[0].endswith(",stable_again_friction_-,full_analyses") and row[1].endswith(",0")
+    assert float(row[1].split(",")[-2]) == pytest.approx(0.6)
     import h5py
     with h5py.File(smap.write_h5(tmp_path / "map.h5"), "r") as f:
         assert f["onsets/stable_again"][0] == pytest.approx(0.6) and f["onsets/stable_again"].attrs["unit"] == "-"
     ends = build_map("friction", "-", values[:4], [r for r, _ in points[:4]], [red for _, red in points[:4]],
                      (0.0, 1.0))
     assert np.isnan(ends.onsets[0].end) and "stable again" not in ends.summary()     # unstable to the end
+
+
+class NonlinearHoffmann:
+    """Stands in for ``squeal_map.MapModel``: the Hoffmann model at mu = 3 p (1 - p) of the swept
+    value p, so that K is not affine in p and the blend of two points is not the system between
+    them; records the values it linearises at and the states it is put back in."""
+
+    def __init__(self):
+        self.linearised, self.restored, self.p = [], [], None
+
+    def linearise(self, p):
+        from multiscale.macro.preload import Linearised
+        self.linearised.append(p)
+        self.p = p
+        K, M = hoffmann_matrices(3 * p * (1 - p), **HOFFMANN)
+        return Linearised(damped.LinearSystem(petsc_mat(K), petsc_mat(M)))
+
+    def state(self):
+        return self.p
+
+    def restore(self, state):
+        self.restored.append(state)
+
+
+def test_an_each_map_narrows_its_onsets_by_full_analyses(tmp_path):
+    """An "each" map bisects an onset on the blend of its two neighbouring points; with K not affine
+    in the swept value that is not the system between them (user trials: 8-9 % low on the demo
+    brake). Here mu = 3 p (1 - p) turns the Hoffmann pair unstable at p* = (1 - sqrt(1 - 4 mu_c / 3)) / 2
+    and stable again at 1 - p*; the blend of p = 0 and 0.5 puts the onset at 0.5 mu_c / 0.75, 57 %
+    high. Three full analyses per onset (``stability.sweep.refine``) bracket p* and 1 - p* between
+    full analyses and land within 1 % of them; the map's own points are unchanged and the model is
+    put back in each point's state after its refinement. Its progress is a line per point."""
+    import io as text
+    from types import SimpleNamespace as NS
+    from mpi4py import MPI
+    from multiscale import io
+    from multiscale.macro.stability_map import MapBuilder
+    from multiscale.workflows.squeal_map import KEEP, _per_point
+    onset = (1 - np.sqrt(1 - 4 * MU_C / 3)) / 2                # 0.2162
+    maps = {}
+    for refine in (0, 3):
+        model = NonlinearHoffmann()
+        st = NS(band=(0.0, 1.0), modes=None, target=None,
+                sweep=NS(values=(0.0, 0.5, 1.0), onsets=True, refine_steps=refine))
+        builder, out = MapBuilder("friction", "-", st.band), text.StringIO()
+        with io.Reporter(MPI.COMM_SELF, stream=out):
+            _per_point(model, builder, st, NS(method="auto", basis=1.5))
+        assert [line.split(",")[0] for line in out.getvalue().splitlines()] == [
+            f"  map points: {k}/3 points" for k in (1, 2, 3)]
+        maps[refine] = smap = builder.finish()
+        assert len(smap.onsets) == 1
+        assert model.linearised[:2] == [0.0, 0.5] and len(model.linearised) == 3 + 2 * refine
+        assert model.restored == [0.5, 1.0]
+    blend, full = maps[0].onsets[0], maps[3].onsets[0]
+    assert blend.value == pytest.approx(0.5 * MU_C / 0.75, rel=1e-3) and blend.analyses == 0
+    assert blend.end == pytest.approx(1 - 0.5 * MU_C / 0.75, rel=1e-3)
+    assert full.analyses == 3 and full.kind == "lock-in"
+    assert full.bracket[0] < onset < full.bracket[1]
+    assert full.bracket[1] - full.bracket[0] <= 0.5 * (1 - KEEP) ** 3
+    assert full.value == pytest.approx(onset, rel=1e-2) and full.end == pytest.approx(1 - onset, rel=1e-2)
+    np.testing.assert_array_equal(maps[3].growth, maps[0].growth)         # the points themselves
+    assert f"between full analyses at {full.bracket[0]:.6g} and {full.bracket[1]:.6g})" in maps[3].summary()
+    rows = maps[3].write_onsets_csv(tmp_path / "onsets.csv").read_text().splitlines()
+    assert rows[0].endswith(",full_analyses") and rows[1].endswith(",3")
 
 
 def hoffmann_spectator_points(values, spectator=4.0, coupling=0.1):

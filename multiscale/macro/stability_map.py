@@ -65,8 +65,10 @@ class Onset:
     frequency: float             # Hz, of the mode at the onset
     partner: int | None          # track nearest in frequency at the first unstable point
     kind: str                    # "lock-in", "mode coupling" (damped), "negative damping" or BELOW
-    bracket: tuple               # (stable value, unstable value) after the bisection
+    bracket: tuple               # (stable value, unstable value): of full analyses when ``analyses`` > 0,
+    #                              else the bisection's last on the blended systems
     end: float = np.nan          # value where the track is stable again (bisected; NaN: not in the sweep)
+    analyses: int = 0            # full analyses that narrowed the bracket (``MapBuilder.onset``'s ``refine``)
 
 
 @dataclass
@@ -116,8 +118,9 @@ class StabilityMap:
                 lines.append(f"    track {o.track}: unstable at the first value already ({o.frequency:.0f} Hz): "
                              f"its onset is below the sweep{again}")
                 continue
+            full = f", between full analyses at {o.bracket[0]:.6g} and {o.bracket[1]:.6g}" if o.analyses else ""
             lines.append(f"    track {o.track}: {o.kind} at {self.parameter} = {o.value:.6g} ({o.frequency:.0f} Hz"
-                         + (f", with track {o.partner})" if o.partner is not None else ")") + again)
+                         + (f", with track {o.partner}" if o.partner is not None else "") + full + ")" + again)
         return "\n".join(lines)
 
     def write_csv(self, path) -> Path:
@@ -143,10 +146,10 @@ class StabilityMap:
         with path.open("w", newline="") as f:
             w = csv.writer(f)
             w.writerow(["track", f"onset_{self.parameter}_{self.unit}", "frequency_Hz", "partner_track", "kind",
-                        "stable_value", "unstable_value", f"stable_again_{self.parameter}_{self.unit}"])
+                        "stable_value", "unstable_value", f"stable_again_{self.parameter}_{self.unit}", "full_analyses"])
             for o in self.onsets:
                 w.writerow([o.track, _number(o.value), f"{o.frequency:.6f}", "" if o.partner is None else o.partner,
-                            o.kind, _number(o.bracket[0]), _number(o.bracket[1]), _number(o.end)])
+                            o.kind, _number(o.bracket[0]), _number(o.bracket[1]), _number(o.end), o.analyses])
         return path
 
     def write_h5(self, path) -> Path:
@@ -166,7 +169,8 @@ class StabilityMap:
                       "kind": (np.array([o.kind for o in self.onsets], dtype=h5py.string_dtype()), "-"),
                       "stable_value": (np.array([o.bracket[0] for o in self.onsets], float), self.unit),
                       "unstable_value": (np.array([o.bracket[1] for o in self.onsets], float), self.unit),
-                      "stable_again": (np.array([o.end for o in self.onsets], float), self.unit)}
+                      "stable_again": (np.array([o.end for o in self.onsets], float), self.unit),
+                      "full_analyses": (np.array([o.analyses for o in self.onsets], int), "-")}
             for name, (data, unit) in onsets.items():
                 g[name] = data
                 g[name].attrs["unit"] = unit
@@ -181,9 +185,10 @@ def _unstable(lam: np.ndarray, rtol: float) -> np.ndarray:
     return lam.real > rtol * np.abs(lam)
 
 
-def _match(lam: np.ndarray, Q: np.ndarray, q_ref: np.ndarray, lam_ref: complex, gram) -> int:
-    """Index of the mode that best continues (q_ref, lam_ref): MAC less the relative eigenvalue jump."""
-    mac = mac_matrix(q_ref[:, None], Q, gram=gram)[0]
+def best_match(lam: np.ndarray, Q: np.ndarray, q_ref: np.ndarray, lam_ref: complex, gram=None, comm=None) -> int:
+    """Index of the mode (lam, Q) that best continues (q_ref, lam_ref): MAC less the relative
+    eigenvalue jump (``gram``: of reduced coordinates; else full vectors distributed over ``comm``)."""
+    mac = mac_matrix(q_ref[:, None], Q, comm=comm, gram=gram)[0]
     jump = np.minimum(np.abs(lam - lam_ref) / max(abs(lam_ref), np.finfo(float).tiny), 1.0)
     return int(np.argmax(mac - jump))
 
@@ -199,7 +204,7 @@ def bisect_onset(lo: ReducedSystem, hi: ReducedSystem, v_lo: float, v_hi: float,
     if check_lo:
         lam, Q = lo.eigenpairs()
         keep = select(lam, band, None, band[0])
-        if _unstable(lam[keep][_match(lam[keep], Q[:, keep], q_ref, lam_ref, gram)][None], rtol)[0]:
+        if _unstable(lam[keep][best_match(lam[keep], Q[:, keep], q_ref, lam_ref, gram)][None], rtol)[0]:
             return None
     a, b, f_b, gap = 0.0, 1.0, lam_ref.imag / TWO_PI, np.inf
     span = abs(v_hi - v_lo)
@@ -209,7 +214,7 @@ def bisect_onset(lo: ReducedSystem, hi: ReducedSystem, v_lo: float, v_hi: float,
         t = 0.5 * (a + b)
         lam, Q = lo.blend(hi, t).eigenpairs()
         keep = select(lam, band, None, band[0])
-        j = _match(lam[keep], Q[:, keep], q_ref, lam_ref, gram)
+        j = best_match(lam[keep], Q[:, keep], q_ref, lam_ref, gram)
         if _unstable(lam[keep][j:j + 1], rtol)[0]:
             f = lam[keep].imag / TWO_PI
             others = np.delete(np.arange(f.size), j)
@@ -278,16 +283,18 @@ class MapBuilder:
         return turned
 
     def onset(self, track: int, j: int, lo: ReducedSystem, hi: ReducedSystem, q_ref: np.ndarray,
-              gram) -> Onset | None:
+              gram, refine=None) -> Onset | None:
         """Bisect the onset of ``track`` (mode j of the last point, coordinates ``q_ref`` in the
         basis of ``lo`` and ``hi``, the reduced systems at the last two points) and record it; None
         when the mode continuing it at the previous point was unstable already (a new track that
-        continues an unstable one)."""
+        continues an unstable one). ``refine(found)``: narrows ``bisect_onset``'s result by full
+        analyses, returns it and the number of analyses."""
         r = self.prev
         found = bisect_onset(lo, hi, self.values[-2], self.values[-1], q_ref, r.eigenvalues[j], gram, self.band,
                              rtol=self.rtol, xtol=self.xtol, check_lo=track in self.new)
         if found is None:
             return None
+        found, analyses = refine(found) if refine is not None else (found, 0)
         value, freq, bracket, gap = found
         i, partner, kind = _nearest(r.frequency, j), None, "negative damping"
         if i is not None:
@@ -298,16 +305,19 @@ class MapBuilder:
                 kind = "lock-in"
             elif falling:
                 kind = "mode coupling"
-        found = Onset(int(track) + 1, value, freq, partner, kind, bracket)
+        found = Onset(int(track) + 1, value, freq, partner, kind, bracket, analyses=analyses)
         self.onsets.append(found)
         return found
 
-    def end(self, track: int, i: int, lo: ReducedSystem, hi: ReducedSystem, q_ref: np.ndarray, gram) -> None:
+    def end(self, track: int, i: int, lo: ReducedSystem, hi: ReducedSystem, q_ref: np.ndarray, gram,
+            refine=None) -> None:
         """Bisect where ``track`` (mode i of the point before the last, unstable there, coordinates
         ``q_ref`` in the basis of ``lo`` and ``hi``, the reduced systems at those two points) turns
-        stable again, from the stable end, and record it as the ``end`` of the track's last onset."""
-        value = bisect_onset(hi, lo, self.values[-1], self.values[-2], q_ref, self.before.eigenvalues[i], gram,
-                             self.band, rtol=self.rtol, xtol=self.xtol)[0]
+        stable again, from the stable end, and record it as the ``end`` of the track's last onset
+        (``refine`` as in ``onset``)."""
+        found = bisect_onset(hi, lo, self.values[-1], self.values[-2], q_ref, self.before.eigenvalues[i], gram,
+                             self.band, rtol=self.rtol, xtol=self.xtol)
+        value = (refine(found)[0] if refine is not None else found)[0]
         onset = next((o for o in reversed(self.onsets) if o.track == track + 1), None)
         if onset is not None:
             onset.end = value

@@ -298,12 +298,12 @@ def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
                    "analyses at those values, and an instability of a full analysis can be missing altogether "
                    "(demo brake: friction onset 0.109 against 0.062); stability.sweep.preload = \"each\" preloads "
                    "every point")
-    elif smap is not None and smap.onsets:
+    elif smap is not None and smap.onsets and not st.sweep.refine_steps:
         out.append("the stability map's onsets are bisected between its points on systems blended from the two "
-                   "neighbouring points' (stability.sweep.preload = \"each\"), not by full analyses: the bracket "
-                   "in onsets.csv is the blend's, and onsets were up to 9 % low against direct runs in trials "
-                   "(demo brake 4.3 kHz pair: 0.543 against 0.585-0.593); check an onset that matters with a "
-                   "direct run, or refine the sweep around it")
+                   "neighbouring points' (stability.sweep.refine = 0), not narrowed by full analyses: the bracket "
+                   "in onsets.csv is the blend's, and such onsets were up to 9 % low against direct runs in trials "
+                   "(demo brake 4.3 kHz pair: 0.543 against 0.585-0.593); stability.sweep.refine = 3 (the default) "
+                   "brackets each between full analyses")
     worst = float(np.nanmax(smap.residual)) if smap is not None and np.isfinite(smap.residual).any() else 0.0
     if worst > MAP_RESIDUAL:
         out.append(f"the stability map's modes have relative residuals up to {worst:.1e}: its frequencies and growth "
