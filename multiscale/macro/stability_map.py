@@ -146,7 +146,8 @@ class StabilityMap:
         with path.open("w", newline="") as f:
             w = csv.writer(f)
             w.writerow(["track", f"onset_{self.parameter}_{self.unit}", "frequency_Hz", "partner_track", "kind",
-                        "stable_value", "unstable_value", f"stable_again_{self.parameter}_{self.unit}", "full_analyses"])
+                        "stable_value", "unstable_value", f"stable_again_{self.parameter}_{self.unit}",
+                        "full_analyses"])
             for o in self.onsets:
                 w.writerow([o.track, _number(o.value), f"{o.frequency:.6f}", "" if o.partner is None else o.partner,
                             o.kind, _number(o.bracket[0]), _number(o.bracket[1]), _number(o.end), o.analyses])

@@ -198,25 +198,28 @@ def _refiner(model: MapModel, builder: MapBuilder, st, options, stable: MapPoint
     by MAC less the eigenvalue jump, stable or not), then bisected again on the new bracket's
     blend; returns the last bisection with the full analyses' bracket, and their number."""
     def refine(found):
-        s, u, jj, made = stable, unstable, j, []
+        s, u, jj, made = stable, unstable, j, []      # made: the analyses in the bracket (freed here)
         try:
             for _ in range(st.sweep.refine_steps):
                 t = min(max((found[0] - s.value) / (u.value - s.value), KEEP), 1.0 - KEEP)
                 mid = _point(model, s.value + t * (u.value - s.value), st, options)
                 made.append(mid)
-                k = best_match(mid.result.eigenvalues, mid.result.modes, u.result.modes[:, jj], u.result.eigenvalues[jj],
-                               comm=mid.result.comm)
+                k = best_match(mid.result.eigenvalues, mid.result.modes, u.result.modes[:, jj],
+                               u.result.eigenvalues[jj], comm=mid.result.comm)
                 if mid.result.unstable(builder.rtol)[k]:
                     u, jj = mid, k
                 else:
                     s = mid
+                for p in [p for p in made if p is not s and p is not u]:
+                    p.free()
+                    made.remove(p)
                 lo, hi, _, Q, gram = _union(s, u)
                 found = bisect_onset(lo, hi, s.value, u.value, Q[:, jj], u.result.eigenvalues[jj], gram,
                                      builder.band, rtol=builder.rtol, xtol=builder.xtol)
         finally:
             for p in made:
                 p.free()
-        return (found[0], found[1], (s.value, u.value), found[3]), len(made)
+        return (found[0], found[1], (s.value, u.value), found[3]), st.sweep.refine_steps
     return refine if st.sweep.refine_steps else None
 
 
