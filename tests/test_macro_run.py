@@ -329,6 +329,26 @@ def test_a_body_hotter_than_any_material_is_warned_about(tmp_path):
                      "of hot material or fade)"]
 
 
+def test_an_undershoot_is_weighed_against_the_rise_up_to_then(tmp_path):
+    """``workflows.UNDERSHOOT``: a railway drag's disc fell 5.6 K below its 20 degC start at t = 16 s,
+    12 % of its 45 K rise by then but 2.4 % of the run's 236 K: unsaid, only a material table's
+    lower end named it (a user trial). Now weighed against the rise up to then; an undershoot below
+    1 % of the run's rise (2.36 K) is still not worth a word, nor one within 5 % of the rise by then (2.25 K)."""
+    from multiscale.workflows import run_warnings
+    scene = loads(BLOCK.format(effects='"contact", "thermal"', folder=tmp_path / "out"))
+    T0 = scene.time.initial_temperature
+    for dip, late_rise, warned in ((5.63, 236.0, True), (2.0, 236.0, False), (2.0, 100.0, False)):
+        h = History()
+        for t, top, low in ((0.0, 0.0, 0.0), (16.0, 45.0, -dip), (240.0, late_rise, 0.0)):
+            h.append(time=t, max_temperature_block=T0 + top, min_temperature_block=T0 + low,
+                     max_temperature_flat=T0, min_temperature_flat=T0)
+        lines = [w for w in run_warnings(scene, h) if "undershoot" in w]
+        assert bool(lines) == warned, (dip, late_rise)
+        if warned:
+            assert lines[0].startswith(f"the temperature of body 'block' fell to {T0 - dip:.2f} K at t = 16 s, 5.63 K "
+                                       f"below the lowest imposed temperature ({T0:.2f} K) while it had risen by 45 K")
+
+
 def test_kept_heat_factors_give_the_factorised_answer(tmp_path, monkeypatch):
     """``thermal.KEPT_ITERATIONS``: a linear heat step solves by GMRES on LU factors of an earlier
     step's matrix (the interface terms change every step: it refactorised every step, 1.05 s of

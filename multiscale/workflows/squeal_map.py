@@ -192,24 +192,30 @@ KEEP = 0.2     # a refining analysis lies in the middle 60 % of its bracket: eac
 
 
 def _refiner(model: MapModel, builder: MapBuilder, st, options, stable: MapPoint, unstable: MapPoint, j: int):
-    """``MapBuilder.onset``'s ``refine`` for mode j of ``unstable``, stable at ``stable``: up to
+    """``MapBuilder.onset``'s ``refine`` for mode j of ``unstable``, stable at ``stable``:
     ``stability.sweep.refine`` full analyses, each at the blend's estimate (kept inside the middle
-    of the bracket) and replacing the bracket's end on its side (the mode that continues mode j,
-    by MAC less the eigenvalue jump, stable or not), then bisected again on the new bracket's
-    blend; returns the last bisection with the full analyses' bracket, and their number."""
+    60 % of the bracket; at its middle after two analyses that replaced the same end, as the blend
+    then errs to one side) and replacing the bracket's end on its side (the mode that continues
+    mode j, by MAC less the eigenvalue jump, stable or not), then bisected again on the new
+    bracket's blend; returns the last bisection with the full analyses' bracket, and their number."""
     def refine(found):
         s, u, jj, made = stable, unstable, j, []      # made: the analyses in the bracket (freed here)
+        moved = []                                     # the end each analysis replaced: "s" or "u"
         try:
             for _ in range(st.sweep.refine_steps):
                 t = min(max((found[0] - s.value) / (u.value - s.value), KEEP), 1.0 - KEEP)
+                if moved[-2:] in (["s", "s"], ["u", "u"]):
+                    t = 0.5              # the blend erred to one side twice: halve the bracket (Brent's guard)
                 mid = _point(model, s.value + t * (u.value - s.value), st, options)
                 made.append(mid)
                 k = best_match(mid.result.eigenvalues, mid.result.modes, u.result.modes[:, jj],
                                u.result.eigenvalues[jj], comm=mid.result.comm)
                 if mid.result.unstable(builder.rtol)[k]:
                     u, jj = mid, k
+                    moved.append("u")
                 else:
                     s = mid
+                    moved.append("s")
                 for p in [p for p in made if p is not s and p is not u]:
                     p.free()
                     made.remove(p)
