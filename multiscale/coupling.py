@@ -149,6 +149,7 @@ class MicroStep:
     law_reach: float = 0.0     # largest zone pressure over micro.p_max, the top of the laws (> 1: extrapolated)
     law_reach_halved: float = 0.0  # the same over the zones whose law failed, against their halved top
     wear_error: float = 0.0    # estimated error of the worn real contact area / that area, from the substeps
+    wear_substeps: int = 0     # the largest number of wear increments a rank took (wear.substeps, or more: stability)
 
 
 @dataclass
@@ -315,7 +316,7 @@ class Multiscale:
             self.rough.set_heights(ids, heights)
             self.rough.plastic[ids] += w
 
-    def wear(self, duration: float) -> tuple[float, float]:
+    def wear(self, duration: float) -> tuple[float, float, int]:
         """Wear of the zones of the last ``analyse`` over the last ``duration`` [s] (their topographies
         change; a wearing counter-face recedes along its track): the pressure fields of the last
         analysis slide over the interval's load-weighted sliding (``MacroModel.sliding``: none while
@@ -323,16 +324,18 @@ class Multiscale:
         [J], the macro steps' ``work_step``: the heat's pressures and quadrature, so that it is the
         frictional heat put in (the wear takes the pressure at the end of the interval); and the
         estimated error of the worn zones' real contact area, the zones' |errors| summed over that
-        area in twice the substeps (``PostAnalysis.wear``'s step doubling)."""
+        area in twice the substeps (``PostAnalysis.wear``'s step doubling); and the largest number of
+        increments a rank wore in (``wear.substeps``, or more where the stability asked for them)."""
         mine, res, load, remote, _ = self._last
         zones, m = self.rough.zones, self.model
         sliding = m.sliding(m.time - duration, m.time)
         res = io.collective(self.comm, lambda: self.post.wear([zones[i] for i in mine], res, load.reach[mine] * sliding,
                                                            remote))
-        volume, area, error = np.zeros(len(zones)), 0.0, 0.0
-        for ids, warm, heights, lost, w, worn, off in self.comm.allgather((
+        volume, area, error, substeps = np.zeros(len(zones)), 0.0, 0.0, 0
+        for ids, warm, heights, lost, w, worn, off, n in self.comm.allgather((
                 mine, res.worn_pressure, res.heights, res.counter_volume, res.plastic, res.worn_area_fraction,
-                res.wear_error)):
+                res.wear_error, int(np.max(res.wear_substeps, initial=0)))):
+            substeps = max(substeps, n)
             area += float((worn - off / 2) @ self.rough.covered_area[ids])     # in twice the substeps
             error += float(np.abs(off) @ self.rough.covered_area[ids])
             self.warm[ids] = warm
@@ -347,7 +350,7 @@ class Multiscale:
             iface.set_field(contact.initial_gap, self.datum_gap + self.counter_depth)
         work, self.interval_work = self.interval_work, 0.0                 # mu ∫ p |w| dA dt
         self.work += work
-        return work, error / area if area > 0 else 0.0
+        return work, error / area if area > 0 else 0.0, substeps
 
     def accept(self, micro: MicroStep) -> MicroStep:
         """The partitions (and exchanges) of the last ``analyse`` become the zones' (partition law);
@@ -481,7 +484,7 @@ class Multiscale:
         self.interval_work += self.model.work_step          # the last pass's
         t2 = _time.perf_counter()
         if wear:
-            micro.work, micro.wear_error = self.wear(s.dt * interval)
+            micro.work, micro.wear_error, micro.wear_substeps = self.wear(s.dt * interval)
         elif self.plastic:
             self.deform()
         self.accept(micro)
@@ -526,7 +529,8 @@ class Multiscale:
             row.update({f"wear_volume_{n}": v for n, v in self.rough.interface_sums(volume).items()})
             row.update(wear_volume=float(volume.sum()), wear_max_depth=float(depth.max()),
                        rms_height=self.rough.rms_height(heights),
-                       frictional_work=self.work, wear_substep_error=result.micro.wear_error)
+                       frictional_work=self.work, wear_substep_error=result.micro.wear_error,
+                       wear_substeps=result.micro.wear_substeps)
             if self.post.counter_rate is not None:
                 row.update(counter_wear_volume=self.counter_volume,
                            counter_wear_max_depth=float(self.counter_depth.max(initial=0.0)))

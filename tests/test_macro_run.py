@@ -332,12 +332,13 @@ def test_a_body_hotter_than_any_material_is_warned_about(tmp_path):
 def test_an_undershoot_is_weighed_against_the_rise_up_to_then(tmp_path):
     """``workflows.UNDERSHOOT``: a railway drag's disc fell 5.6 K below its 20 degC start at t = 16 s,
     12 % of its 45 K rise by then but 2.4 % of the run's 236 K: unsaid, only a material table's
-    lower end named it (a user trial). Now weighed against the rise up to then; an undershoot below
-    1 % of the run's rise (2.36 K) is still not worth a word, nor one within 5 % of the rise by then (2.25 K)."""
+    lower end named it (a user trial). Now weighed against the rise up to then (10 %: the demo
+    pin-on-disc's 0.126 K at t = 0.6 s, 5 % of its 2.51 K then, is not worth a word); an undershoot
+    below 1 % of the run's rise (2.36 K) is not either."""
     from multiscale.workflows import run_warnings
     scene = loads(BLOCK.format(effects='"contact", "thermal"', folder=tmp_path / "out"))
     T0 = scene.time.initial_temperature
-    for dip, late_rise, warned in ((5.63, 236.0, True), (2.0, 236.0, False), (2.0, 100.0, False)):
+    for dip, late_rise, warned in ((5.63, 236.0, True), (2.0, 236.0, False), (4.0, 100.0, False)):
         h = History()
         for t, top, low in ((0.0, 0.0, 0.0), (16.0, 45.0, -dip), (240.0, late_rise, 0.0)):
             h.append(time=t, max_temperature_block=T0 + top, min_temperature_block=T0 + low,

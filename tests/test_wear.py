@@ -99,6 +99,31 @@ def test_steps_that_wear_deeper_than_the_rms_height_are_warned_about():
         and "use more, at least 4" in run_in[16][1][0]
 
 
+def test_an_explicit_wear_increment_is_stable_up_to_the_grids_least_compliance():
+    """``stable_substeps``: an increment dh = c p (c = k_w mu ds) is forward Euler on
+    dh/ds = -k_w mu K h, stable for c below 2 / lambda_max(K) >= 2 least compliances of the grid
+    (``least_compliance``; a periodic half-space's, 2 / (E* q) at the Nyquist corner
+    q = pi sqrt(2) / dx). A 64^2 fractal patch at a mean pressure of 0.02 E* worn 40 least
+    compliances deep (0.36 of its RMS height in mean depth): increments of c <= 2 give the real area
+    of c = 0.25 within 0.5 %; c = 4 and 10 end far below it (measured 0.36 and 0.20 against 0.54)."""
+    from multiscale.micro.kernels import InfluenceOperator
+    from multiscale.micro.wear import STABLE, stable_substeps
+    patch = fractal_surface(64, 64e-6, hurst=0.8, k_min=2, k_max=16, rms=1e-6, seed=1)
+    operator = InfluenceOperator(HalfSpace(1e11), patch.shape, patch.dx)
+    least = operator.least_compliance
+    assert least == pytest.approx(np.sqrt(2) * patch.dx / (np.pi * 1e11), rel=1e-12)
+    total = 40 * least                                        # m/Pa: k_w mu S with mu = 1, S = 1 m
+    assert stable_substeps(operator, total) == int(np.ceil(40 / STABLE))
+    assert stable_substeps(operator, np.array([0.5 * least, 0.0])) == 1
+    area = {}
+    for steps in (4, 10, 20, 40, 160):                        # c = 10, 4, 2, 1, 0.25 least compliances
+        area[steps] = simulate_wear(patch, HalfSpace(1e11), load=2e9, mu=1.0, distance=1.0, steps=steps,
+                                    k_w=total).history.area_fraction[-1]
+    for steps in (20, 40):
+        assert area[steps] == pytest.approx(area[160], rel=5e-3)
+    assert area[10] < 0.8 * area[160] and area[4] < 0.5 * area[160]
+
+
 def test_uniform_wear_of_a_flat_is_not_a_coarse_step():
     """A periodic flat in full contact wears alike everywhere: exact at any step count, no warning
     (before: "a step wore up to 4.49e+296 times the RMS height", its RMS 0). A non-periodic flat

@@ -169,6 +169,9 @@ class InfluenceOperator:
     ``fft_shape``; ``inverse_spectrum`` its inverse where it is positive (0 elsewhere, e.g. at
     q = 0 of a periodic half-space): the FFT-based preconditioner M ≈ L⁻¹ of the contact solver.
     ``multiplier`` and ``inverse_multiplier`` include the 1/(Fy Fx) of the inverse FFT.
+    ``least_compliance`` [m/Pa]: the smallest positive value of ``spectrum``, a lower bound of the
+    eigenvalues of L on any set of cells (Cauchy interlacing; e.g. the stability bound of an
+    explicit wear step, ``micro.wear.stable_substeps``).
     """
 
     def __init__(self, kernel: Kernel, shape: tuple[int, int], dx: float, dy: float | None = None,
@@ -205,6 +208,7 @@ class InfluenceOperator:
         self.inverse_multiplier = self.inverse_spectrum / size
         self._workspaces: dict[tuple[int, ...], ConvolutionWorkspace] = {}
         self.self_influence = float(np.fft.irfft2(self.spectrum, s=self.fft_shape)[0, 0])
+        self.least_compliance = float(np.min(real[positive]))   # m/Pa: 1 / the stiffest mode's stiffness
 
     def workspace(self, batch: tuple[int, ...] = (), threads: int | None = None,
                   single: bool = False) -> "ConvolutionWorkspace":

@@ -21,8 +21,9 @@ area, sliding speed V and direction, macro surface temperatures of both bodies):
 3. optionally the thermal contact conductance h_c of the zone at that contact
    (``laws.Conductance``, the zone-scale spreading resistance taken out);
 4. Archard wear over the sliding distance s = V Δt (Eq. 3.10, dh = k_w(T) mu p ds, T the local
-   surface temperature of step 2): ``substeps`` increments, each followed by a load-controlled
-   re-solve of the worn patch warm-started from the previous pressure (§3.5.1). ``run`` does it
+   surface temperature of step 2): ``substeps`` increments (at least those that keep the explicit
+   increment stable, ``wear.stable_substeps``), each followed by a load-controlled re-solve of the
+   worn patch warm-started from the previous pressure (§3.5.1). ``run`` does it
    when given the sliding; ``wear`` does it later on a ``run`` made without (the coupled loop
    iterates steps 1–3 and wears once, at the converged state).
 
@@ -48,7 +49,7 @@ from multiscale.micro.kernels import Kernel
 from multiscale.micro.laws import Conductance
 from multiscale.micro.plasticity import Hardness
 from multiscale.micro.surface import Surface
-from multiscale.micro.wear import WearRate, wear_step
+from multiscale.micro.wear import WearRate, stable_substeps, wear_step
 from multiscale.micro.zones import Zone
 
 
@@ -120,6 +121,7 @@ class ZoneResult:
     worn_area_fraction: np.ndarray = None   # (B,): real contact area / zone area after the wear (None: no wear)
     wear_error: np.ndarray = None           # (B,): estimated error of that fraction from the wear substeps,
     #                                         signed (step doubling, ``PostAnalysis.wear``; 0 without wear)
+    wear_substeps: int = 0                  # the wear increments taken (``substeps``, or more for stability)
 
 
 class PostAnalysis:
@@ -253,8 +255,8 @@ class PostAnalysis:
 
     def wear(self, zones: list[Zone], result: ZoneResult, sliding, remote=None) -> ZoneResult:
         """Archard wear of the zones of ``result`` (``run`` of these zones without sliding) over
-        ``sliding`` [m] (B,) in ``substeps`` increments; remote (B, 2) [K] gives k_w's temperatures
-        without heating. Returns ``result`` with the worn heights, depth, volumes, pressures. The
+        ``sliding`` [m] (B,) in ``substeps`` increments, or the more that keep each stable
+        (``wear.stable_substeps``); remote (B, 2) [K] gives k_w's temperatures without heating. Returns ``result`` with the worn heights, depth, volumes, pressures. The
         explicit substeps' error is estimated by step doubling: the update is worn again, from the
         same start, in twice the substeps and discarded; ``wear_error`` = 2 (A_n - A_2n), the
         first-order Richardson estimate of the real area fraction's error (3 n contact solves
@@ -273,16 +275,20 @@ class PostAnalysis:
                 T, T1 = (value, T1) if field == "T" else (T, value)
         sliding = _per_zone("sliding", sliding, B)
         start = (heights, p, result.plastic, result.area_fraction)
+        n = self.substeps
+        if self.rate is not None:   # at least the increments that keep the explicit step stable
+            k_w = self.rate(T) if self.rate.depends_on_temperature else self.rate()
+            n = max(n, stable_substeps(self.solver.operator, np.max(k_w) * mu * sliding))
         heights, p, depth, counter, plastic, iterations, area = self._substeps(
-            zones, start, load, mu, sliding, T, T1, result.hardness, self.substeps)
+            zones, start, load, mu, sliding, T, T1, result.hardness, n)
         error = np.zeros(B)
         if self.rate is not None:   # step doubling: the same wear in twice the substeps, discarded
-            twice = self._substeps(zones, start, load, mu, sliding, T, T1, result.hardness, 2 * self.substeps)[-1]
+            twice = self._substeps(zones, start, load, mu, sliding, T, T1, result.hardness, 2 * n)[-1]
             error = 2.0 * (area - twice)       # Richardson, first order: A_n - A = 2 (A_n - A_2n)
         return replace(result, worn_pressure=p, heights=heights, depth=depth,
                        volume=depth.sum(axis=(-2, -1)) * self.dx * self.dy,
                        iterations=result.iterations + iterations, counter_volume=counter,
-                       plastic=plastic, worn_area_fraction=area, wear_error=error)
+                       plastic=plastic, worn_area_fraction=area, wear_error=error, wear_substeps=n)
 
     def _substeps(self, zones, start, load, mu, sliding, T, T1, hardness, n):
         """Wear from ``start`` = (heights, pressure, permanent deformation, real area fraction)

@@ -35,6 +35,25 @@ UNIFORM = 1e-12      # a step's depths equal to this share of the deepest: unifo
 ROUND_OFF_FLAT = 1e12   # a step's relief over this many RMS heights of its start: worn into a flat to round-off [-]
 
 
+STABLE = 1.0          # an explicit wear step's k_w mu ds over the least compliance of the grid, at most [-]
+
+
+def stable_substeps(operator, wear_per_pressure) -> int:
+    """Fewest explicit Archard increments (Eq. 3.10) of a sliding that keep each stable.
+
+    An increment lowers the heights by dh = c p with c = k_w mu ds [m/Pa] (``wear_per_pressure``,
+    the whole sliding's, any shape: its largest counts) and the pressure of the heights before it:
+    forward Euler on dh/ds = -k_w mu K h, K = L_C^-1 the stiffness of the contact set C. Its modes
+    are damped only for c lambda_max(K) < 2, and lambda_max(K) <= 1 / lambda_min(L) =
+    1 / ``operator.least_compliance`` (interlacing), the grid's stiffest wavelength: hence
+    ceil(c / (STABLE least_compliance)) increments. Beyond, the scheme amplifies grid-scale relief
+    and the worn topography is noise (a railway trial at c = 770 least compliances: the RMS height
+    3 -> 123 um; a 64^2 fractal patch worn 40 least compliances deep: real area 0.54-0.60 from
+    c <= 2, 0.36-0.40 at 4, 0.18-0.19 at 10)."""
+    c = float(np.max(wear_per_pressure, initial=0.0))
+    return max(1, int(np.ceil(c / (STABLE * operator.least_compliance))))
+
+
 class WearWarning(UserWarning):
     """Wear steps too coarse for the relief they wear (``simulate_wear``)."""
 
