@@ -215,6 +215,7 @@ class Multiscale:
         self.remote_difference = np.zeros(Z)          # K, T_rough − T_counter of the macro surfaces
         self._last = None                             # this rank's zones, their post-analysis, loading, remote
         self.law_increment = None                     # m, displacement change of the last solve after new laws
+        self.increments = post.substeps               # the most wear increments an update took (said as it grows)
 
     @property
     def partition_law(self) -> bool:
@@ -350,6 +351,11 @@ class Multiscale:
             iface.set_field(contact.initial_gap, self.datum_gap + self.counter_depth)
         work, self.interval_work = self.interval_work, 0.0                 # mu ∫ p |w| dA dt
         self.work += work
+        if substeps > self.increments:
+            self.increments = substeps
+            io.reporter().say(f"  wear updates in {substeps} increments (wear.substeps = {self.post.substeps}): each "
+                              "explicit increment k_w mu ds at most the zone grid's least compliance, for stability "
+                              "(micro.wear.stable_substeps; history column wear_substeps)")
         return work, error / area if area > 0 else 0.0, substeps
 
     def accept(self, micro: MicroStep) -> MicroStep:

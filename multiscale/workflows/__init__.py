@@ -231,12 +231,6 @@ def _coarse_wear(scene, history) -> list[str]:
     deeper = np.diff(history["wear_max_depth"]) / np.maximum(history["rms_height"][:-1], np.finfo(float).tiny) \
         / substeps[1:]
     out = []
-    if taken.max(initial=0) > asked:
-        row = int(np.argmax(taken))
-        out.append(f"the wear updates took up to {int(taken[row])} increments (at t = {history['time'][row]:g} s) "
-                   f"where wear.substeps asks {asked}: an explicit Archard increment k_w mu ds beyond the least "
-                   "compliance of the zone grid amplifies the grid-scale relief (micro.wear.stable_substeps); each "
-                   "increment is a contact solve of the zones, three with the substeps' error estimate")
     if deeper.size and deeper.max() > STEP_RMS:
         row = int(np.argmax(deeper)) + 1
         out.append(f"a wear increment deepened the wear by {deeper.max():.3g} times the RMS height (at t = "
