@@ -279,9 +279,10 @@ class Loading:
     run so that the friction moment about the axis is the torque times the load factor while sliding (a cycle
     of stops under a vehicle's torque; ``vehicle.mass`` does it for one stop). The speed of the rotating body:
     ``rotation_speed``, a ``speed_profile`` against time, or a ``vehicle`` stop or drag; a translating body
-    slides at ``sliding_speed``. Friction: a constant ``friction``,
-    or (squeal analysis only) mu against the slip speed: a table ``friction_curve`` or a ``stribeck`` law, taken
-    per interface facet at its steady slip speed; its slope enters the modal analysis as damping."""
+    slides at ``sliding_speed``. Friction: a constant ``friction`` (independent of the temperature:
+    no fade), or (squeal analysis only) mu against the slip speed: a table ``friction_curve`` or a
+    ``stribeck`` law, taken per interface facet at its steady slip speed; its slope enters the modal
+    analysis as damping."""
 
     normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)),                 # N
                                      absent="pressure, braking_torque or vehicle.mass gives the load")

@@ -208,7 +208,8 @@ def test_a_log_axis_of_pressures_ends_on_labelled_ticks(tmp_path, drawn):
     """The multiscale figure's pressure panel: facets at 12.6-15.1 MPa beside micro peaks of
     99 MPa had no labelled tick near the facets' curves (a user trial). Its limits are now the
     1, 2 or 5 x 10^k around the values, ticks labelled in plain numbers; a worn volume above
-    0.001 mm³ is in mm³."""
+    0.001 mm³ is in mm³. A released row (pressures 0) leaves a gap: its curves dropped off the
+    log axis (a user trial)."""
     assert plots.nice_range([12.6, 99.0]) == (10.0, 100.0)
     assert plots.nice_range([0.03, 0.7]) == (0.02, 1.0) and plots.nice_range([2.0, 5.0]) == (2.0, 5.0)
     assert plots.nice_range([5.0, 5.0]) == (2.0, 10.0)
@@ -220,6 +221,10 @@ def test_a_log_axis_of_pressures_ends_on_labelled_ticks(tmp_path, drawn):
     assert pressure.get_ylim() == pytest.approx((10.0, 100.0))
     assert {t.get_text() for t in pressure.get_yticklabels()} >= {"10", "20", "50", "100"}
     assert worn.get_ylabel() == "wear volume [mm³]"
+    history.append(time=2.0, max_pressure=0.0, micro_max_pressure=0.0, wear_volume=1.2e-11)     # released
+    plots.multiscale_figure(history, tmp_path / "m.png")
+    curves = [line.get_ydata() for line in drawn[-1].axes[0].get_lines()]
+    assert all(np.isnan(y[-1]) and np.isfinite(y[:2]).all() for y in curves)     # a gap (it dropped off the axis)
 
 
 def test_the_multiscale_figure_shows_the_real_contact_area_and_the_plastic_share(tmp_path, drawn):

@@ -197,7 +197,10 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
         for key, name in keys:     # the macro temperatures in history.png's colours, the micro one black
             colour = {"color": palette[column_label(key)] if key in hot else "black"} \
                 if label.startswith("max temperature") else {}
-            ax.plot(t, history[key] * scale + shift, "o-", ms=3, label=name, **colour)
+            y = np.asarray(history[key], dtype=float) * scale + shift
+            if label.startswith("max contact pressure"):    # released rows (0): a gap, not a drop off the log axis
+                y = np.where(y > 0, y, np.nan)
+            ax.plot(t, y, "o-", ms=3, label=name, **colour)
         if label.startswith("max contact pressure"):
             values = np.concatenate([np.asarray(history[k], dtype=float) for k, _ in keys])
             if (values > 0).any():     # log of the positive values (0 released or between zones)
