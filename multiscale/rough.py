@@ -44,6 +44,9 @@ P_MAX_HALVINGS = 4         # a zone whose law fails is retried with p_max / 2, .
 FULL_CONTACT = ("every zone's law stops below p_max / 16: at these pressures the roughness is stiffer than the "
                 "zones' own compliance resolves; more micro.zones (smaller zones) carry the laws further, and a "
                 "face this smooth tends to perfect contact (effects without \"roughness\", the interface's penalty)")
+WORN_FLAT = ("the failed zones have worn down up to {depth:.3g} times their initial RMS height: worn this far, "
+             "a face tends to perfect contact, which the zone laws do not reach (no p_max does); a lower k_w, or "
+             "the interface without \"roughness\" (perfect contact, the interface's penalty), models it")
 
 
 @dataclass(frozen=True)
@@ -257,9 +260,14 @@ class RoughInterface:
                 if level == P_MAX_HALVINGS:           # the messages name the last p_max: say how it came
                     full = len(exc.failures) == len(self.used) and all(STIFF in f.message
                                                                         for f in exc.failures)
+                    ids = [f.zone_id for f in exc.failures]
+                    rms = np.sqrt(np.mean((self.initial[ids] - self.initial[ids].mean(axis=(-2, -1), keepdims=True))
+                                          ** 2, axis=(-2, -1)))
+                    worn = float(np.max(self.wear_depth()[ids].max(axis=(-2, -1)) / np.maximum(rms, 1e-300)))
+                    notes = [FULL_CONTACT] * full + [WORN_FLAT.format(depth=worn)] * (worn > 1.0)
                     raise LawError([dataclasses.replace(f, message=f"{f.message}, reached by {level} halvings of "
                                                         f"micro.p_max = {self.spec.p_max:.3g} Pa") for f in exc.failures],
-                                   exc.result, FULL_CONTACT if full else "") from None
+                                   exc.result, "\n".join(notes)) from None
                 laws = exc.result
                 self.levels[[f.zone_id for f in exc.failures]] = level + 1
             computed += self.pool.stats.computed - self.pool.stats.failed
