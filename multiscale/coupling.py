@@ -330,8 +330,11 @@ class Multiscale:
         mine, res, load, remote, _ = self._last
         zones, m = self.rough.zones, self.model
         sliding = m.sliding(m.time - duration, m.time)
-        res = io.collective(self.comm, lambda: self.post.wear([zones[i] for i in mine], res, load.reach[mine] * sliding,
-                                                           remote))
+        slides = load.reach[mine] * sliding
+        increments = max(self.comm.allgather(io.collective(        # one count on every rank: the split's answer
+            self.comm, lambda: self.post.stable_increments([zones[i] for i in mine], res, slides, remote))))
+        res = io.collective(self.comm, lambda: self.post.wear([zones[i] for i in mine], res, slides, remote,
+                                                           increments))
         volume, area, error, substeps = np.zeros(len(zones)), 0.0, 0.0, 0
         for ids, warm, heights, lost, w, worn, off, n in self.comm.allgather((
                 mine, res.worn_pressure, res.heights, res.counter_volume, res.plastic, res.worn_area_fraction,

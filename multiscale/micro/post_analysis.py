@@ -253,32 +253,26 @@ class PostAnalysis:
             result = self.wear(zones, result, sliding, remote)
         return result
 
-    def wear(self, zones: list[Zone], result: ZoneResult, sliding, remote=None) -> ZoneResult:
+    def wear(self, zones: list[Zone], result: ZoneResult, sliding, remote=None,
+             increments: int | None = None) -> ZoneResult:
         """Archard wear of the zones of ``result`` (``run`` of these zones without sliding) over
-        ``sliding`` [m] (B,) in ``substeps`` increments, or the more that keep each stable
-        (``wear.stable_substeps``); remote (B, 2) [K] gives k_w's temperatures without heating. Returns ``result`` with the worn heights, depth, volumes, pressures. The
-        explicit substeps' error is estimated by step doubling: the update is worn again, from the
-        same start, in twice the substeps and discarded; ``wear_error`` = 2 (A_n - A_2n), the
-        first-order Richardson estimate of the real area fraction's error (3 n contact solves
-        instead of n: the test pin-on-disc's micro time 0.13 -> 0.16 s with 4 substeps)."""
+        ``sliding`` [m] (B,) in ``increments`` (default ``stable_increments``: ``substeps``, or the
+        more that keep each stable; pass one count agreed over the ranks of a batch split between
+        them, so that the answer does not depend on the split); remote (B, 2) [K] gives k_w's
+        temperatures without heating. Returns ``result`` with the worn heights, depth, volumes,
+        pressures. The explicit increments' error is estimated by step doubling: the update is worn
+        again, from the same start, in twice the increments and discarded; ``wear_error`` =
+        2 (A_n - A_2n), the first-order Richardson estimate of the real area fraction's error (3 n
+        contact solves instead of n: the test pin-on-disc's micro time 0.13 -> 0.16 s with 4)."""
         heights, p, load, mu = result.heights, result.pressure, result.load, result.mu
         B = len(zones)
         if B == 0:                 # a rank that holds no loaded zone
             return result
-        T, T1 = result.temperature, result.counter_temperature
-        for rate, field, col in ((self.rate, "T", 1), (self.counter_rate, "T1", 0)):
-            if rate is not None and rate.depends_on_temperature and (T if field == "T" else T1) is None:
-                if remote is None:
-                    raise InputError("remote", None, "a temperature-dependent wear rate needs temperatures")
-                value = np.broadcast_to(np.broadcast_to(np.asarray(remote, float), (B, 2))[:, col, None, None],
-                                        heights.shape)
-                T, T1 = (value, T1) if field == "T" else (T, value)
+        T, T1 = self._wear_temperatures(result, remote)
         sliding = _per_zone("sliding", sliding, B)
         start = (heights, p, result.plastic, result.area_fraction)
-        n = self.substeps
-        if self.rate is not None:   # at least the increments that keep the explicit step stable
-            k_w = self.rate(T) if self.rate.depends_on_temperature else self.rate()
-            n = max(n, stable_substeps(self.solver.operator, np.max(k_w) * mu * sliding))
+        n = self.stable_increments(zones, result, sliding, remote) if increments is None else \
+            check_count("increments", increments)
         heights, p, depth, counter, plastic, iterations, area = self._substeps(
             zones, start, load, mu, sliding, T, T1, result.hardness, n)
         error = np.zeros(B)
@@ -289,6 +283,32 @@ class PostAnalysis:
                        volume=depth.sum(axis=(-2, -1)) * self.dx * self.dy,
                        iterations=result.iterations + iterations, counter_volume=counter,
                        plastic=plastic, worn_area_fraction=area, wear_error=error, wear_substeps=n)
+
+    def stable_increments(self, zones: list[Zone], result: ZoneResult, sliding, remote=None) -> int:
+        """``substeps``, or the more increments that keep each explicit increment of the rough body's
+        wear of ``zones`` over ``sliding`` [m] (B,) stable (``wear.stable_substeps``, k_w at its
+        largest over the zones' temperatures, as ``wear`` takes them)."""
+        B = len(zones)
+        if self.rate is None or B == 0:
+            return self.substeps
+        T = self._wear_temperatures(result, remote)[0]
+        k_w = self.rate(T) if self.rate.depends_on_temperature else self.rate()
+        return max(self.substeps, stable_substeps(self.solver.operator,
+                                                  np.max(k_w) * result.mu * _per_zone("sliding", sliding, B)))
+
+    def _wear_temperatures(self, result: ZoneResult, remote):
+        """(rough body's, counter-face's) temperatures of k_w: the heating's fields, else the remote
+        temperatures spread over the zones, where a temperature-dependent rate needs them."""
+        T, T1 = result.temperature, result.counter_temperature
+        shape = result.heights.shape
+        for rate, field, col in ((self.rate, "T", 1), (self.counter_rate, "T1", 0)):
+            if rate is not None and rate.depends_on_temperature and (T if field == "T" else T1) is None:
+                if remote is None:
+                    raise InputError("remote", None, "a temperature-dependent wear rate needs temperatures")
+                value = np.broadcast_to(np.broadcast_to(np.asarray(remote, float), (shape[0], 2))[:, col, None, None],
+                                        shape)
+                T, T1 = (value, T1) if field == "T" else (T, value)
+        return T, T1
 
     def _substeps(self, zones, start, load, mu, sliding, T, T1, hardness, n):
         """Wear from ``start`` = (heights, pressure, permanent deformation, real area fraction)
@@ -429,13 +449,23 @@ class PostAnalyses:
                  for p, ids in groups]
         return _merged(parts, [ids for _, ids in groups], B)
 
-    def wear(self, zones: list[Zone], result: ZoneResult, sliding, remote=None) -> ZoneResult:
-        """``PostAnalysis.wear`` of each grid's zones."""
+    def stable_increments(self, zones: list[Zone], result: ZoneResult, sliding, remote=None) -> int:
+        """The most of each grid's ``PostAnalysis.stable_increments``: one count for all the zones."""
+        B = len(zones)
+        return max(p.stable_increments([zones[i] for i in ids], _result_part(result, ids, B), _part(sliding, ids, B),
+                                       _part(remote, ids, B)) for p, ids in self._groups(zones))
+
+    def wear(self, zones: list[Zone], result: ZoneResult, sliding, remote=None,
+             increments: int | None = None) -> ZoneResult:
+        """``PostAnalysis.wear`` of each grid's zones, in one count of increments (default
+        ``stable_increments``)."""
         B, groups = len(zones), self._groups(zones)
+        if increments is None:
+            increments = self.stable_increments(zones, result, sliding, remote)
         if len(groups) == 1:
-            return groups[0][0].wear(zones, result, sliding, remote)
+            return groups[0][0].wear(zones, result, sliding, remote, increments)
         parts = [p.wear([zones[i] for i in ids], _result_part(result, ids, B), _part(sliding, ids, B),
-                        _part(remote, ids, B)) for p, ids in groups]
+                        _part(remote, ids, B), increments) for p, ids in groups]
         return _merged(parts, [ids for _, ids in groups], B)
 
 
