@@ -284,8 +284,7 @@ def _undershoots(scene, history) -> list[str]:
         risen = np.maximum.accumulate(np.asarray(history[hot], float)) - floor     # K, the rise up to each row
         told = (below > UNDERSHOOT * risen) & (below > max(1e-3, NEGLIGIBLE * risen[-1]))
         if told.any():
-            share = np.divide(below, risen, out=np.full(below.shape, np.inf), where=risen > 0)
-            row = int(np.argmax(np.where(told, share, -np.inf)))
+            row = int(np.argmax(np.where(told, below, -np.inf)))       # the deepest of those told
             out.append(f"the temperature of body {body.name!r} fell to {floor - below[row]:.2f} K at t = "
                        f"{history['time'][row]:g} s, {below[row]:.3g} K below the lowest imposed temperature "
                        f"({floor:.2f} K) while it had risen by {risen[row]:.3g} K: an undershoot of the "
