@@ -1,70 +1,63 @@
-"""The multiscale loop: a macro model whose rough interface carries per-zone laws, the micro
-post-analysis of the zones, wear and checkpoints (thesis §1.4–1.5, ch. 7, Figs. 7.2–7.5).
+"""The multiscale loop: a macro model whose rough interface carries per-zone laws, the micro post-analysis of
+the zones, wear and checkpoints (thesis §1.4–1.5, ch. 7, Figs. 7.2–7.5).
 
 One macro step Δt (Fig. 7.2) runs:
 
-1. the macro transient over Δt in ``substeps`` thermo-mechanical sub-steps δt with the current
-   laws and partitions (Fig. 7.4; ``macro.model.MacroModel.macro_step``);
-2. per zone, the macro loading at the end of the step (``loading``): zone pressure P = (contact
-   force on the zone's facets) / (their area), the patch's results counted over it (``cover``),
-   the facet temperatures of both bodies, the sliding speed (force-weighted over the zone) and direction;
-3. the micro post-analysis of the loaded zones (Fig. 7.5, ``micro.post_analysis``): local pressure
-   under P, local surface temperatures, flash temperature and partition (steady sliding heating,
-   or with ``PostAnalysis.heating.transient_steps`` the transient heating over Δt, Table 7.1),
-   and, every ``wear_every`` steps (and at the last step), the Archard wear of the patch over the
-   load-weighted sliding of those steps with k_w(T) (and the counter-face's, spread over its wear
-   track: ``rough.track_depth``); the zones are spread over the MPI ranks and the worn topographies
-   shared;
-4. the laws of the zones whose topography changed are recomputed (``rough.RoughInterface``: the
-   others come from the pool's cache), the facet laws updated and the mechanics re-solved at the
-   same time (from the state plus the previous step's change by this solve, ``law_increment``, if
-   its residual is lower; where that fails, by ``macro.continuation``): the temperatures carry over.
+1. the macro transient over Δt in ``substeps`` thermo-mechanical sub-steps δt with the current laws and
+   partitions (Fig. 7.4; ``macro.model.MacroModel.macro_step``);
+2. per zone, the macro loading at the end of the step (``loading``): zone pressure P = (contact force on the
+   zone's facets) / (their area), the patch's results counted over it (``cover``), the facet temperatures of
+   both bodies, the sliding speed (force-weighted over the zone) and direction;
+3. the micro post-analysis of the loaded zones (Fig. 7.5, ``micro.post_analysis``): local pressure under P,
+   local surface temperatures, flash temperature and partition (steady sliding heating, or with
+   ``PostAnalysis.heating.transient_steps`` the transient heating over Δt, Table 7.1), and, every
+   ``wear_every`` steps (and at the last step), the Archard wear of the patch over the load-weighted sliding
+   of those steps with k_w(T) (and the counter-face's, spread over its wear track: ``rough.track_depth``); the
+   zones are spread over the MPI ranks and the worn topographies shared;
+4. the laws of the zones whose topography changed are recomputed (``rough.RoughInterface``: the others come
+   from the pool's cache), the facet laws updated and the mechanics re-solved at the same time (from the state
+   plus the previous step's change by this solve, ``law_increment``, if its residual is lower; where that
+   fails, by ``macro.continuation``): the temperatures carry over.
 
-Remote temperatures of the micro heating (``LoopSettings.remote``). "bulk": each body's own macro
-surface temperature at the zone (thesis §7.2.2, §6.5: the heat conducted from the hotter body
-through the contact spots is part of the heat into the rough body, whose share of the frictional
-heat may then leave [0, 1]). "rough": both at the rough body's (the partition then depends on the
-contact and the speed only); a departure from the thesis, the loop's behaviour before issue 19,
-kept as an option (and the scenes' default with an interface conductance, which conducts between
-the bulk temperatures itself): with the bulk temperatures the explicit coupling swings, a hotter
-rough body sending its heat back through the partition of the next step. The scenes' default is
-"bulk" with the implicit coupling (below).
+Remote temperatures of the micro heating (``LoopSettings.remote``). "bulk": each body's own macro surface
+temperature at the zone (thesis §7.2.2, §6.5: the heat conducted from the hotter body through the contact
+spots is part of the heat into the rough body, whose share of the frictional heat may then leave [0, 1]).
+"rough": both at the rough body's (the partition then depends on the contact and the speed only); a departure
+from the thesis, the loop's behaviour before issue 19, kept as an option (and the scenes' default with an
+interface conductance, which conducts between the bulk temperatures itself): with the bulk temperatures the
+explicit coupling swings, a hotter rough body sending its heat back through the partition of the next step.
+The scenes' default is "bulk" with the implicit coupling (below).
 
-Coupling of partitions and temperatures (``LoopSettings.coupling``); residual of a step: max over
-the loaded zones of |heat into the rough body by the post-analysis at the end of the step − the
-heat the macro model puts into it at that state| / mean zone frictional heat (``heat_residual``;
-a light zone's partition counts for the heat it moves). Schemes:
+Coupling of partitions and temperatures (``LoopSettings.coupling``); residual of a step: max over the loaded
+zones of |heat into the rough body by the post-analysis at the end of the step − the heat the macro model puts
+into it at that state| / mean zone frictional heat (``heat_residual``; a light zone's partition counts for the
+heat it moves). Schemes:
 
 - "explicit": the partitions of step n + 1 come from the post-analysis of step n (thesis Fig. 7.2).
-- "fixed-point" (thesis form, converged): the partitions p of step n solve p = G(p), G = the
-  post-analysis' partitions at the end of a macro step run with p: the step is restarted from its
-  initial state (``MacroModel.snapshot``/``restore``) with the next p of Anderson's acceleration
-  (``anderson``: a multisecant quasi-Newton on the per-zone partitions, residuals weighted by the
-  zones' heat, first step p + ``relaxation`` (G(p) − p)) until the residual is <= ``coupling_tol``;
-  wear is then done once, at the converged state. A scalar relaxation (Aitken's Δ²) does not do:
-  the zones' gains differ by orders of magnitude (a heavily loaded zone over-reacts, a light one
-  hardly) and one factor that tames the first stalls the others (measured on the coarse demo:
-  30 passes without reaching 1e-3).
-- "implicit" (bulk temperatures only): the micro problem is linear in the frictional heat and the
-  remote temperatures, so the post-analysis returns, per zone, the partition at equal remote
-  temperatures and the exchange G [W/K] (``PostAnalysis`` with ``Heating.conduction``); the macro
-  model splits the frictional heat with the first and conducts G (T_rough − T_counter) through the
-  interface conductance h_c = G / (facet area of the zone), inside its own backward-Euler heat
-  solve. This is a Newton step on the per-zone heat with the micro model's exact derivative, the
-  macro heat solve doing the rest: the micro heat at the end of the step is the macro one up to
-  the change of the contact during the step, in one pass. It departs from the thesis' form (which
-  keeps the thermal fields of the two bodies disconnected, Fig. 7.4, the conduction hidden in the
-  partition) to reach the same balance without its failure: in the thesis' form the conduction is
-  a multiple of the zone's frictional heat, so that a zone which barely touches at the
-  post-analysis (a partition of −2.3e4 measured at 1e-6 N on the coarse demo) and is pressed
-  harder at the next macro step (after the worn laws' re-solve) receives that multiple of a much
-  larger frictional heat (−74 W, the pin's whole share turned negative).
+- "fixed-point" (thesis form, converged): the partitions p of step n solve p = G(p), G = the post-analysis'
+  partitions at the end of a macro step run with p: the step is restarted from its initial state
+  (``MacroModel.snapshot``/``restore``) with the next p of Anderson's acceleration (``anderson``: a
+  multisecant quasi-Newton on the per-zone partitions, residuals weighted by the zones' heat, first step p +
+  ``relaxation`` (G(p) − p)) until the residual is <= ``coupling_tol``; wear is then done once, at the
+  converged state. A scalar relaxation (Aitken's Δ²) does not do: the zones' gains differ by orders of
+  magnitude (a heavily loaded zone over-reacts, a light one hardly) and one factor that tames the first stalls
+  the others (measured on the coarse demo: 30 passes without reaching 1e-3).
+- "implicit" (bulk temperatures only): the micro problem is linear in the frictional heat and the remote
+  temperatures, so the post-analysis returns, per zone, the partition at equal remote temperatures and the
+  exchange G [W/K] (``PostAnalysis`` with ``Heating.conduction``); the macro model splits the frictional heat
+  with the first and conducts G (T_rough − T_counter) through the interface conductance h_c = G / (facet area
+  of the zone), inside its own backward-Euler heat solve. This is a Newton step on the per-zone heat with the
+  micro model's exact derivative, the macro heat solve doing the rest: the micro heat at the end of the step
+  is the macro one up to the change of the contact during the step, in one pass. It departs from the thesis'
+  form (the conduction hidden in the partition) to reach the same balance without its failure
+  (docs/architecture.md, the decision on the coupling: a barely touching zone got a partition of −2.3e4 at
+  1e-6 N on the coarse demo, and the pin −74 W at the next step).
 
-The default (``scene_sections.COUPLING_DEFAULT``) was chosen by measurement (docs/accuracy/coupling.md).
-The initial laws are computed before the first solve; the rigid datum gap starts Newton close to
-equilibrium. ``save``/``restore`` write and read the whole state (``checkpoint``): a killed run
-continues to the same history (to solver tolerance: a resumed run recomputes its zone laws). This
-module reads no scene: ``multiscale.workflows.multiscale`` builds and runs it."""
+The default (``scene_sections.COUPLING_DEFAULT``) was chosen by measurement (docs/accuracy/coupling.md). The
+initial laws are computed before the first solve; the rigid datum gap starts Newton close to equilibrium.
+``save``/``restore`` write and read the whole state (``checkpoint``): a killed run continues to the same
+history (to solver tolerance: a resumed run recomputes its zone laws). This module reads no scene:
+``multiscale.workflows.multiscale`` builds and runs it."""
 from __future__ import annotations
 
 import json
@@ -149,7 +142,7 @@ class MicroStep:
     law_reach: float = 0.0     # largest zone pressure over micro.p_max, the top of the laws (> 1: extrapolated)
     law_reach_halved: float = 0.0  # the same over the zones whose law failed, against their halved top
     wear_error: float = 0.0    # estimated error of the worn real contact area / that area, from the substeps
-    wear_substeps: int = 0     # the largest number of wear increments a rank took (wear.substeps, or more: stability)
+    wear_substeps: int = 0     # wear increments of the update (wear.substeps, or more: stability)
 
 
 @dataclass
@@ -318,28 +311,23 @@ class Multiscale:
             self.rough.plastic[ids] += w
 
     def wear(self, duration: float) -> tuple[float, float, int]:
-        """Wear of the zones of the last ``analyse`` over the last ``duration`` [s] (their topographies
-        change; a wearing counter-face recedes along its track): the pressure fields of the last
-        analysis slide over the interval's load-weighted sliding (``MacroModel.sliding``: none while
-        released, exact for a stop or a release inside it). Returns the interval's frictional work
-        [J], the macro steps' ``work_step``: the heat's pressures and quadrature, so that it is the
-        frictional heat put in (the wear takes the pressure at the end of the interval); and the
-        estimated error of the worn zones' real contact area, the zones' |errors| summed over that
-        area in twice the substeps (``PostAnalysis.wear``'s step doubling); and the largest number of
-        increments a rank wore in (``wear.substeps``, or more where the stability asked for them)."""
+        """Wear of the zones of the last ``analyse`` over the last ``duration`` [s] (their topographies change; a
+        wearing counter-face recedes along its track): the pressure fields of the last analysis slide over the
+        interval's load-weighted sliding (``MacroModel.sliding``: none while released, exact for a stop or a release
+        inside it). Returns the interval's frictional work [J], the macro steps' ``work_step``: the heat's pressures
+        and quadrature, so that it is the frictional heat put in (the wear takes the pressure at the end of the
+        interval); and the estimated error of the worn zones' real contact area, the zones' |errors| summed over that
+        area in twice the substeps (``PostAnalysis.wear``'s step doubling); and the increments taken."""
         mine, res, load, remote, _ = self._last
         zones, m = self.rough.zones, self.model
         sliding = m.sliding(m.time - duration, m.time)
-        slides = load.reach[mine] * sliding
-        increments = max(self.comm.allgather(io.collective(        # one count on every rank: the split's answer
-            self.comm, lambda: self.post.stable_increments([zones[i] for i in mine], res, slides, remote))))
-        res = io.collective(self.comm, lambda: self.post.wear([zones[i] for i in mine], res, slides, remote,
-                                                           increments))
-        volume, area, error, substeps = np.zeros(len(zones)), 0.0, 0.0, 0
-        for ids, warm, heights, lost, w, worn, off, n in self.comm.allgather((
-                mine, res.worn_pressure, res.heights, res.counter_volume, res.plastic, res.worn_area_fraction,
-                res.wear_error, int(np.max(res.wear_substeps, initial=0)))):
-            substeps = max(substeps, n)
+        own, slides = [zones[i] for i in mine], load.reach[mine] * sliding
+        n = max(self.comm.allgather(io.collective(     # one count on every rank: the answer of any split
+            self.comm, lambda: self.post.stable_increments(own, res, slides, remote))))
+        res = io.collective(self.comm, lambda: self.post.wear(own, res, slides, remote, n))
+        volume, area, error = np.zeros(len(zones)), 0.0, 0.0
+        for ids, warm, heights, lost, w, worn, off in self.comm.allgather((mine, res.worn_pressure, res.heights,
+                res.counter_volume, res.plastic, res.worn_area_fraction, res.wear_error)):
             area += float((worn - off / 2) @ self.rough.covered_area[ids])     # in twice the substeps
             error += float(np.abs(off) @ self.rough.covered_area[ids])
             self.warm[ids] = warm
@@ -354,12 +342,11 @@ class Multiscale:
             iface.set_field(contact.initial_gap, self.datum_gap + self.counter_depth)
         work, self.interval_work = self.interval_work, 0.0                 # mu ∫ p |w| dA dt
         self.work += work
-        if substeps > self.increments:
-            self.increments = substeps
-            io.reporter().say(f"  wear updates in {substeps} increments (wear.substeps = {self.post.substeps}): each "
-                              "explicit increment k_w mu ds at most the zone grid's least compliance, for stability "
-                              "(micro.wear.stable_substeps; history column wear_substeps)")
-        return work, error / area if area > 0 else 0.0, substeps
+        if n > self.increments:
+            self.increments = n
+            io.reporter().say(f"  wear updates in {n} increments (wear.substeps = {self.post.substeps}), each stable: "
+                              "k_w mu ds at most the zone grid's least compliance (micro.wear.stable_substeps)")
+        return work, error / area if area > 0 else 0.0, n
 
     def accept(self, micro: MicroStep) -> MicroStep:
         """The partitions (and exchanges) of the last ``analyse`` become the zones' (partition law);

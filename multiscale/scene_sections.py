@@ -279,10 +279,9 @@ class Loading:
     run so that the friction moment about the axis is the torque times the load factor while sliding (a cycle
     of stops under a vehicle's torque; ``vehicle.mass`` does it for one stop). The speed of the rotating body:
     ``rotation_speed``, a ``speed_profile`` against time, or a ``vehicle`` stop or drag; a translating body
-    slides at ``sliding_speed``. Friction: a constant ``friction`` (independent of the temperature:
-    no fade), or (squeal analysis only) mu against the slip speed: a table ``friction_curve`` or a
-    ``stribeck`` law, taken per interface facet at its steady slip speed; its slope enters the modal
-    analysis as damping."""
+    slides at ``sliding_speed``. Friction: a constant ``friction`` (not of the temperature: no fade),
+    or (squeal analysis only) mu against the slip speed: a table ``friction_curve`` or a ``stribeck`` law, taken
+    per interface facet at its steady slip speed; its slope enters the modal analysis as damping."""
 
     normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)),                 # N
                                      absent="pressure, braking_torque or vehicle.mass gives the load")
@@ -543,9 +542,8 @@ class Wear:
     """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (``FIG_7_9_WEAR_RATE``:
     calibrated as ``FIG_7_9_CALIBRATION`` says). Every ``update_every`` macro steps (and at the last
     step, and a step ending at a stop) the zones wear over the sliding since, weighted by the load factor
-    (none while released), in ``substeps`` load-controlled increments, or the more that keep each
-    explicit increment stable (``micro.wear.stable_substeps``: k_w mu ds at most the least compliance
-    of the zone grid); a counter-face whose material gives ``k_w`` wears too."""
+    (none while released), in ``substeps`` load-controlled increments or the more that keep each stable
+    (``micro.wear.stable_substeps``); a counter-face whose material gives ``k_w`` wears too."""
 
     k_w: float | None = key(_WEAR_RATE, absent="k_w_table, else the rough material's k_w, else thesis Fig. 7.9")
     k_w_table: tuple | None = key(Curve(_TEMPERATURE, Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)), "temperature",

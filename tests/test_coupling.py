@@ -409,9 +409,8 @@ def test_the_wear_increments_are_as_many_as_their_stability_asks(tmp_path, capsy
     runs[1] = run(loads(POD.format(folder=tmp_path / "1"), overrides={**scene, "wear.substeps": 1})).history
     taken = runs[4]["wear_substeps"]
     said = [line for line in capsys.readouterr().out.splitlines() if line.startswith("  wear updates")]
-    assert said == [f"  wear updates in {int(taken[1])} increments (wear.substeps = 1): each explicit increment "
-                    "k_w mu ds at most the zone grid's least compliance, for stability (micro.wear.stable_substeps; "
-                    "history column wear_substeps)"]
+    assert said == [f"  wear updates in {int(taken[1])} increments (wear.substeps = 1), each stable: k_w mu ds at "
+                    "most the zone grid's least compliance (micro.wear.stable_substeps)"]
     assert taken[1] > 4 and list(runs[1]["wear_substeps"]) == list(taken)        # the bound, not the ask
     assert list(runs[32]["wear_substeps"][1:]) == [32, 32]
     for n in (1, 4):
