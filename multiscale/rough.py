@@ -261,9 +261,8 @@ class RoughInterface:
                     full = len(exc.failures) == len(self.used) and all(STIFF in f.message
                                                                         for f in exc.failures)
                     ids = [f.zone_id for f in exc.failures]
-                    rms = np.sqrt(np.mean((self.initial[ids] - self.initial[ids].mean(axis=(-2, -1), keepdims=True))
-                                          ** 2, axis=(-2, -1)))
-                    worn = float(np.max(self.wear_depth()[ids].max(axis=(-2, -1)) / np.maximum(rms, 1e-300)))
+                    rms = np.maximum(self.initial[ids].std(axis=(-2, -1)), 1e-300)     # m, each zone's at the start
+                    worn = float(np.max(self.wear_depth()[ids].max(axis=(-2, -1)) / rms))
                     notes = [FULL_CONTACT] * full + [WORN_FLAT.format(depth=worn)] * (worn > 1.0)
                     raise LawError([dataclasses.replace(f, message=f"{f.message}, reached by {level} halvings of "
                                                         f"micro.p_max = {self.spec.p_max:.3g} Pa") for f in exc.failures],

@@ -121,7 +121,6 @@ class ZoneResult:
     worn_area_fraction: np.ndarray = None   # (B,): real contact area / zone area after the wear (None: no wear)
     wear_error: np.ndarray = None           # (B,): estimated error of that fraction from the wear substeps,
     #                                         signed (step doubling, ``PostAnalysis.wear``; 0 without wear)
-    wear_substeps: int = 0                  # the wear increments taken (``substeps``, or more for stability)
 
 
 class PostAnalysis:
@@ -282,7 +281,7 @@ class PostAnalysis:
         return replace(result, worn_pressure=p, heights=heights, depth=depth,
                        volume=depth.sum(axis=(-2, -1)) * self.dx * self.dy,
                        iterations=result.iterations + iterations, counter_volume=counter,
-                       plastic=plastic, worn_area_fraction=area, wear_error=error, wear_substeps=n)
+                       plastic=plastic, worn_area_fraction=area, wear_error=error)
 
     def stable_increments(self, zones: list[Zone], result: ZoneResult, sliding, remote=None) -> int:
         """``substeps``, or the more increments that keep each explicit increment of the rough body's
