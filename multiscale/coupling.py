@@ -141,6 +141,7 @@ class MicroStep:
     real_area: np.ndarray = None  # m^2, per zone: real contact area over its facets (before wear; 0 unloaded)
     law_reach: float = 0.0     # largest zone pressure over micro.p_max, the top of the laws (> 1: extrapolated)
     law_reach_halved: float = 0.0  # the same over the zones whose law failed, against their halved top
+    near_perfect: int = 0      # zones loaded beyond their law's floor (nearly perfect contact)
     wear_error: float = 0.0    # estimated error of the worn real contact area / that area, from the substeps
     wear_substeps: int = 0     # wear increments of the update (wear.substeps, or more: stability)
 
@@ -187,8 +188,7 @@ class Multiscale:
     def __init__(self, model: MacroModel, rough: RoughInterface, post: PostAnalysis, settings: LoopSettings,
                  fingerprint: checkpoint.Fingerprint = checkpoint.Fingerprint()):
         self.model, self.rough, self.post, self.settings = model, rough, post, settings
-        self.tm, self.comm = model.tm, model.tm.comm
-        self.fingerprint = fingerprint
+        self.tm, self.comm, self.fingerprint = model.tm, model.tm.comm, fingerprint
         self.nominal = sum(settings.forces.values()) / self.tm.interface.areas.sum()
         Z = len(rough.zones)
         self.partition = np.broadcast_to(np.asarray(settings.partition, dtype=float), (Z,)).copy()
@@ -507,7 +507,7 @@ class Multiscale:
         row.update(zones_in_contact=micro.loaded * on, laws_computed=self.rough.laws_computed,
                    max_zone_pressure=micro.zone_pressure * on, micro_max_pressure=micro.max_pressure * on,
                    real_contact_area=float(micro.real_area.sum()) * on, law_reach=micro.law_reach * on,
-                   law_reach_halved=micro.law_reach_halved * on)
+                   law_reach_halved=micro.law_reach_halved * on, near_perfect_zones=micro.near_perfect * on)
         row.update({f"real_contact_area_{n}": a * on for n, a in self.rough.interface_sums(micro.real_area).items()})
         if self.post.heating is not None:           # released: no heat to share (NaN, as the flash)
             low, mean, high = micro.partition if on else (np.nan,) * 3

@@ -12,9 +12,10 @@ id. Zone coordinates (u, v) are those of the interface plane's frame (``interfac
 plane z = const, (u, v) = (x, y).
 
 ``update_laws`` computes the laws of the zones whose topography changed (the pool's cache keeps
-the others) and loads them into the facet law; a zone whose law fails (its roughness stiffer below
-p_max than the zone's own compliance resolves) is retried with p_max halved, up to
-``P_MAX_HALVINGS`` times (remembered for its later laws). ``datum_gap`` is the per-facet uniform
+the others) and loads them into the facet law; a zone whose law fails (no convergence, a pressure
+that stops growing) is retried with p_max halved, up to ``P_MAX_HALVINGS`` times (remembered for
+its later laws). Zones whose roughness adds less compliance than their laws resolve (worn flat,
+smooth) continue as nearly perfect contact (``micro.laws.resolved_gap``). ``datum_gap`` is the per-facet uniform
 initial gap at which the rigid rough bodies carry given forces, one bisection per interface: it
 starts Newton close to equilibrium.
 
@@ -36,17 +37,11 @@ from multiscale.errors import InputError
 from multiscale.geometry import Rotation, plane_frame
 from multiscale.macro.laws_ufl import FacetLaw, gap_at
 from multiscale.macro.mesh import TwoBodyMesh
-from multiscale.micro.laws import STIFF, LawError, LawSpec, ZoneLaws
+from multiscale.micro.laws import LawError, LawSpec, ZoneLaws
 from multiscale.micro.zones import Zone, ZoneGrid
 from multiscale.pool import MicroPool
 
 P_MAX_HALVINGS = 4         # a zone whose law fails is retried with p_max / 2, ... / 16
-FULL_CONTACT = ("every zone's law stops below p_max / 16: at these pressures the roughness is stiffer than the "
-                "zones' own compliance resolves; more micro.zones (smaller zones) carry the laws further, and a "
-                "face this smooth tends to perfect contact (effects without \"roughness\", the interface's penalty)")
-WORN_FLAT = ("the failed zones have worn down up to {depth:.3g} times their initial RMS height: worn this far, "
-             "a face tends to perfect contact, which the zone laws do not reach (no p_max does); a lower k_w, or "
-             "the interface without \"roughness\" (perfect contact, the interface's penalty), models it")
 
 
 @dataclass(frozen=True)
@@ -140,6 +135,7 @@ class RoughInterface:
     initial: np.ndarray = field(init=False)              # (Z, ny, nx) initial topographies [m]
     plastic: np.ndarray = field(init=False)              # (Z, ny, nx) accumulated permanent deformation [m]
     levels: np.ndarray = field(init=False)               # p_max halvings of each zone's law
+    floors: np.ndarray = field(init=False)               # Pa, where each zone's law reaches its floor (inf: not)
     covered_area: np.ndarray = field(init=False)         # m^2, area of the facets each zone holds
     used: np.ndarray = field(init=False)                 # ids of the zones holding a facet
     laws_computed: int = 0                               # laws computed by the last update
@@ -160,6 +156,7 @@ class RoughInterface:
         self.initial = np.stack([z.surface.heights for z in self.zones])
         self.plastic = np.zeros_like(self.initial)
         self.levels = np.zeros(len(self.zones), dtype=int)
+        self.floors = np.full(len(self.zones), np.inf)
         self.law = FacetLaw(self.tm, self.spec.n_points)
 
     @property
@@ -189,13 +186,15 @@ class RoughInterface:
         the facet law is extrapolated linearly)."""
         return self.spec.p_max / 2.0 ** self.levels
 
-    def law_reach(self, pressure: np.ndarray, ids) -> tuple[float, float]:
+    def law_reach(self, pressure: np.ndarray, ids) -> tuple[float, float, int]:
         """Largest ratio [-] of a zone's pressure (``pressure`` [Pa] per zone) to the top of its law
         among the zones ``ids``: over those with the full p_max, and over those whose law failed (a
-        halved top); 0 if none."""
+        halved top); 0 if none. And how many of them are loaded beyond their law's floor (nearly
+        perfect contact, ``micro.laws.resolved_gap``)."""
         reach = pressure[ids] / self.law_top[ids]
         halved = self.levels[ids] > 0
-        return float(reach[~halved].max(initial=0.0)), float(reach[halved].max(initial=0.0))
+        return (float(reach[~halved].max(initial=0.0)), float(reach[halved].max(initial=0.0)),
+                int(np.count_nonzero(pressure[ids] > self.floors[ids])))
 
     def zone_frames(self) -> tuple[np.ndarray, np.ndarray]:
         """Centre (Z, 3) [m] of every zone in space and the (Z, 2, 3) in-plane directions (e_u, e_v)
@@ -258,21 +257,17 @@ class RoughInterface:
                 laws = self.pool.laws(todo[comm.rank::comm.size], spec, gather="all")
             except LawError as exc:
                 if level == P_MAX_HALVINGS:           # the messages name the last p_max: say how it came
-                    full = len(exc.failures) == len(self.used) and all(STIFF in f.message
-                                                                        for f in exc.failures)
-                    ids = [f.zone_id for f in exc.failures]
-                    rms = np.maximum(self.initial[ids].std(axis=(-2, -1)), 1e-300)     # m, each zone's at the start
-                    worn = float(np.max(self.wear_depth()[ids].max(axis=(-2, -1)) / rms))
-                    notes = [FULL_CONTACT] * full + [WORN_FLAT.format(depth=worn)] * (worn > 1.0)
                     raise LawError([dataclasses.replace(f, message=f"{f.message}, reached by {level} halvings of "
                                                         f"micro.p_max = {self.spec.p_max:.3g} Pa") for f in exc.failures],
-                                   exc.result, "\n".join(notes)) from None
+                                   exc.result) from None
                 laws = exc.result
                 self.levels[[f.zone_id for f in exc.failures]] = level + 1
             computed += self.pool.stats.computed - self.pool.stats.failed
             nodes += laws.nodes if laws is not None else []
         self.law.set_laws(ZoneLaws(nodes, self.spec), self.zone_of_facet)
         self.laws_computed = computed
+        self.floors[:] = np.inf
+        self.floors[[nd.zone_id for nd in nodes]] = [nd.floored for nd in nodes]
         return computed
 
     def zone_of(self, name: str) -> np.ndarray:

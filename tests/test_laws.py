@@ -13,7 +13,8 @@ from multiscale.errors import InputError
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.law_tables import PressureGapLaw, PressureTable
-from multiscale.micro.laws import Conductance, ExtraLaw, HeatPartition, LawError, LawSpec, compute_laws
+from multiscale.micro.laws import (RESOLUTION, Conductance, ExtraLaw, HeatPartition, LawError, LawSpec, compute_laws,
+                                   resolved_gap)
 from multiscale.micro.surface import Surface, fractal_surface
 from multiscale.micro.zones import Zone, ZoneGrid, cut_triangles, cut_zones, generate_zones
 from multiscale.references.love import (love_rectangle, love_rectangle_mean, love_triangle, love_triangle_mean,
@@ -377,30 +378,65 @@ def test_triangular_zones_carry_the_micro_force(tiled):
 def test_failing_zones_are_named_and_the_others_survive(tiled):
     _, _, zones = tiled
     flat = Zone(99, Surface(np.zeros((32, 32)), zones[0].surface.dx, zones[0].surface.dy, periodic=False))
-    with pytest.raises(LawError) as info:
-        compute_laws([zones[0], flat, zones[1]], LawSpec(E, p_max=3e6, n_points=6))
-    assert [f.zone_id for f in info.value.failures] == [99]
-    assert "stops decreasing above p = " in info.value.failures[0].message
-    assert "at 100% real contact" in info.value.failures[0].message
-    assert sorted(info.value.result.ids) == [0, 1]
-    with pytest.raises(LawError) as info:
-        compute_laws(zones[:2], LawSpec(E, p_max=3e6, n_points=6, max_iter=2))
-    assert {f.zone_id for f in info.value.failures} == {0, 1}
+    with pytest.raises(LawError) as info:             # the rough zones need 11-15 iterations at the top nodes
+        compute_laws([zones[0], flat, zones[1]], LawSpec(E, p_max=3e6, n_points=6, max_iter=8))
+    assert [f.zone_id for f in info.value.failures] == [0, 1]
     assert info.value.failures[0].kind == "ContactConvergenceError"
+    assert info.value.result.ids.tolist() == [99]
+
+
+def test_a_law_falls_at_least_at_the_resolution_floor():
+    """``resolved_gap``: from first touch on, a node whose gap falls by less than RESOLUTION c per
+    pascal since the node before is lowered to that floor; the nodes before it are untouched, and
+    so is a later node that falls far enough; the pressure of the first lowered node is returned."""
+    c, top = 2e-13, 5e-6
+    p = np.array([1e5, 2e5, 4e5, 8e5, 1.6e6])
+    rate = np.array([3.0, 0.5, 0.05, -0.05, 0.2]) * c           # -dg/dp per interval (the 4th rises)
+    g = top - np.cumsum(rate * np.diff(p, prepend=0.0))
+    out, floored = resolved_gap(g, p, top, c)
+    assert floored == 4e5
+    np.testing.assert_array_equal(out[[0, 1, 4]], g[[0, 1, 4]])
+    falls = -np.diff(np.r_[top, out]) / np.diff(p, prepend=0.0)
+    np.testing.assert_allclose(falls[2:4], RESOLUTION * c, rtol=1e-9)
+    assert falls[4] > RESOLUTION * c
+    assert resolved_gap(g[:2], p[:2], top, c) == (pytest.approx(g[:2], rel=0, abs=0), np.inf)
+
+
+def test_a_zone_too_smooth_for_its_law_continues_as_nearly_perfect_contact(tiled):
+    """A flat isolated patch is stiffer than Love's uniform pressure (the flat punch of the next
+    test): its Love-corrected gap rises with p, and its law was refused (a worn-flat or smooth face
+    stopped the run). Its law now falls at the floor from first touch, p = (top − g)/(RESOLUTION c):
+    the macro model of the flat zone has the compliance (1 + RESOLUTION) c, Love's own plus the
+    floor, to 1e-8; the rough zones beside it keep their micro nodes exactly."""
+    _, _, zones = tiled
+    flat = Zone(99, Surface(np.zeros((32, 32)), zones[0].surface.dx, zones[0].surface.dy, periodic=False))
+    laws = compute_laws([zones[0], flat, zones[1]], LawSpec(E, p_max=3e6, n_points=6))
+    nodes = {nd.zone_id: nd for nd in laws.nodes}
+    nd = nodes[99]
+    c = nd.compliance
+    assert nd.floored == nd.pressure[0] and np.all(nd.area_fraction == 1.0)
+    np.testing.assert_allclose(nd.gap, nd.top - RESOLUTION * c * nd.pressure, rtol=0, atol=1e-12 * c * 3e6)
+    delta = np.geomspace(nd.pressure[0], nd.pressure[-1], 7) * (1 + RESOLUTION) * c     # (below the first node
+    p = flat_zone_pressure(lambda g: laws.pressure(g, np.full(np.shape(g), 99)), nd.top, c, delta)
+    np.testing.assert_allclose(p, delta / ((1 + RESOLUTION) * c), rtol=1e-8)      # K vanishes at first touch)
+    for rough in (nodes[0], nodes[1]):
+        assert rough.floored == np.inf
+        np.testing.assert_array_equal(rough.gap, rough.top - rough.approach + rough.compliance * rough.pressure)
 
 
 def test_a_flat_patch_in_full_contact_is_stiffer_than_loves_uniform_pressure():
-    """Why a smooth zone's law stops before full contact (``laws._monotone_problem``): a rigid flat
+    """Why a smooth zone's law needs a floor (``laws.resolved_gap``): a rigid flat
     pressed on a flat isolated square patch carries a flat punch's edge pressures, whose approach
-    per mean pressure is 0.93 of Love's mean displacement under the uniform pressure
+    per mean pressure is 0.92 of Love's mean displacement under the uniform pressure
     (``love_rectangle_mean``; 0.925 for a circle, Johnson 1985 §3.8: pi/2 against 16/(3 pi)), so the
-    roughness must add more than that 7 % of the zone's compliance for the Love-corrected gap to
-    fall. Within 1 % on 64 x 64 cells."""
+    roughness must add more than that 8 % of the zone's compliance for the Love-corrected gap to
+    fall (``RESOLUTION``). Within 1 % on 64 x 64 cells."""
     n, side = 64, 1e-3
     solver = ContactSolver(E, (n, n), side / n, periodic=False)
     punch = solver.solve(np.zeros((n, n)), load=1e6, tol=1e-10)
     uniform = love_rectangle_mean(side / 2, side / 2) * 1e6 / (np.pi * E.E_star)
     assert punch.approach / uniform == pytest.approx(0.927, rel=1e-2)
+    assert 1 - punch.approach / uniform == pytest.approx(RESOLUTION, abs=0.01)      # 0.922: 7.8 %
 
 
 @pytest.mark.parametrize("kwargs, name", [
@@ -464,6 +500,20 @@ def test_cut_triangles_assigns_every_cell_once():
 
 
 # --------------------------------------------------------------------------- pool (one process)
+class RefusesFlat(ExtraLaw):
+    """An extra law that raises for a flat patch (a zone failing inside a batch)."""
+
+    tables = {"refuses_flat": "hold"}
+
+    def key(self):
+        return ("refuses_flat",)
+
+    def values(self, result, zones):
+        if any(not z.surface.heights.any() for z in zones):
+            raise ValueError("a flat patch")
+        return {"refuses_flat": result.area_fraction}
+
+
 def test_pool_caches_unchanged_zones_and_matches_compute_laws(tiled):
     from mpi4py import MPI
 
@@ -481,14 +531,15 @@ def test_pool_caches_unchanged_zones_and_matches_compute_laws(tiled):
     assert pool.stats.computed == 1 and pool.stats.cached == 3
     assert again.nodes[0].top == pytest.approx(first.nodes[0].top - 2e-8, rel=1e-12)   # same datum, worn
     flat = Zone(99, Surface(np.zeros((32, 32)), zones[0].surface.dx, zones[0].surface.dy, periodic=False))
+    refusing = MicroPool(replace(spec, extras=(RefusesFlat(),)), comm=MPI.COMM_SELF)
     with pytest.raises(PoolError) as info:
-        pool.laws(zones[:2] + [flat])
+        refusing.laws(zones[:2] + [flat])
     assert [f.zone_id for f in info.value.failures] == [99] and len(info.value.result) == 2
     twin = Zone(98, flat.surface)     # one topography, solved once: both zones fail (before: 99 alone,
     with pytest.raises(PoolError) as info:                    # and 98 had no law and no failure)
-        pool.laws([flat, twin] + zones[:1])
+        refusing.laws([flat, twin] + zones[:1])
     assert [f.zone_id for f in info.value.failures] == [98, 99] and info.value.result.ids.tolist() == [0]
-    assert pool.stats.computed == pool.stats.failed == 1      # one solve (zone 0 was cached)
+    assert refusing.stats.computed == refusing.stats.failed == 1      # one solve (zone 0 was cached)
     small = MicroPool(spec, comm=MPI.COMM_SELF, cache_size=2)        # a call returns all it computed
     assert small.laws(zones[:4]).ids.tolist() == [0, 1, 2, 3] and len(small) == 2
     # zone 0 worn at every call, 1-3 unchanged: by default the pool keeps CACHE_CALLS x 4 laws, the

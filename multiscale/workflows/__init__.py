@@ -18,6 +18,7 @@ from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError, Interrupted, interrupted
+from multiscale.micro.laws import RESOLUTION
 from multiscale.micro.wear import STEP_RMS, SUBSTEP_TOL
 from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
@@ -192,20 +193,22 @@ def _wear_table_ends(scene, history) -> list[str]:
 def _law_reach(history) -> list[str]:
     """Zone pressures beyond the top of their laws (extrapolated linearly there): micro.p_max, or
     for a zone whose law stopped below it its halved top (raising p_max cannot help it; the demo's
-    worn zone at its last step)."""
-    reach, halved = (float(np.max(history[c])) if c in history.columns else 0.0
-                     for c in ("law_reach", "law_reach_halved"))
+    worn zone at its last step); and zones loaded beyond their law's floor (``resolved_gap``)."""
+    reach, halved, floored = (float(np.max(history[c])) if c in history.columns else 0.0
+                              for c in ("law_reach", "law_reach_halved", "near_perfect_zones"))
     out = []
     if reach > 1:
         out.append(f"the zone pressures reached {reach:.3g} times micro.p_max, the top of their laws: beyond it a "
-                   "law is extrapolated linearly, with the contact stiffness at the top; raise micro.p_max, unless "
-                   "the surface is in full contact near it (a nm-smooth face: perfect contact is the model it tends "
-                   "to)")
+                   "law is extrapolated linearly, with the contact stiffness at the top; raise micro.p_max")
     if halved > 1:
-        out.append(f"zones whose laws stopped below micro.p_max (their top halved: the roughness stiffer there than "
-                   f"the zone's own compliance resolves) were loaded to {halved:.3g} times that top: their laws are "
-                   "extrapolated linearly there, with the contact stiffness at the top; more micro.zones (smaller "
-                   "zones) carry the laws further, and a smooth or worn face tends to perfect contact")
+        out.append(f"zones whose laws failed at micro.p_max (their top halved: no convergence, or a pressure that "
+                   f"stopped growing) were loaded to {halved:.3g} times that top: their laws are extrapolated "
+                   "linearly there, with the contact stiffness at the top")
+    if floored > 0:
+        out.append(f"up to {floored:.0f} zones were loaded where their roughness adds less compliance than their "
+                   f"laws resolve ({RESOLUTION:.1%} of a zone's own, micro.laws.resolved_gap): there they are in "
+                   "nearly perfect contact, their laws at that floor (a smooth or worn-flat face; the column "
+                   "near_perfect_zones of the history says when)")
     return out
 
 

@@ -23,10 +23,6 @@ def zones():
     return cut_zones(s, (4, 4))[1]
 
 
-def flat_zone(zid, like):
-    return Zone(zid, Surface(np.zeros(like.shape), like.surface.dx, like.surface.dy, periodic=False))
-
-
 def test_laws_equal_one_process_and_are_shared_out(zones):
     pool = MicroPool(SPEC)
     mine = zones[comm.rank::comm.size]
@@ -75,25 +71,30 @@ class Fragile(ExtraLaw):
 
     tables = {"fragile": "hold"}
 
+    def __init__(self, zone_id: int):
+        self.zone_id = zone_id
+
     def key(self):
-        return ("fragile",)
+        return ("fragile", self.zone_id)
 
     def values(self, result, zones):
-        if any(z.id == 5 for z in zones):
-            raise RuntimeError("boom in zone 5")
+        if any(z.id == self.zone_id for z in zones):
+            raise RuntimeError(f"boom in zone {self.zone_id}")
         return {"fragile": result.area_fraction}
 
 
 def test_a_failing_zone_is_reported_on_every_rank_without_deadlock(zones):
-    pool = MicroPool(SPEC)
+    pool = MicroPool(LawSpec(E, p_max=3e6, n_points=8, extras=(Fragile(99),)))
     last = comm.size - 1
-    request = zones[comm.rank::comm.size] + ([flat_zone(99, zones[0])] if comm.rank == last else [])
+    s = zones[0].surface
+    odd = Zone(99, Surface(s.heights[::-1].copy(), s.dx, s.dy, periodic=False))     # a topography of its own
+    request = zones[comm.rank::comm.size] + ([odd] if comm.rank == last else [])
     with pytest.raises(PoolError) as info:
         pool.laws(request)
     assert [f.zone_id for f in info.value.failures] == [99]          # the same on every rank
-    assert "stops decreasing" in info.value.failures[0].message
+    assert "boom in zone 99" in info.value.failures[0].message
     assert info.value.result.ids.tolist() == [z.id for z in zones[comm.rank::comm.size]]
-    fragile = LawSpec(E, p_max=3e6, n_points=6, extras=(Fragile(),))
+    fragile = LawSpec(E, p_max=3e6, n_points=6, extras=(Fragile(5),))
     with pytest.raises(PoolError) as info:
         pool.laws(zones[comm.rank::comm.size], spec=fragile, gather="all")
     assert [(f.zone_id, f.kind) for f in info.value.failures] == [(5, "RuntimeError")]
