@@ -12,8 +12,9 @@ One macro step Δt (Fig. 7.2) runs:
    local surface temperatures, flash temperature and partition (steady sliding heating, or with
    ``PostAnalysis.heating.transient_steps`` the transient heating over Δt, Table 7.1), and, every
    ``wear_every`` steps (and at the last step), the Archard wear of the patch over the load-weighted sliding
-   of those steps with k_w(T) (and the counter-face's, spread over its wear track: ``rough.track_depth``); the
-   zones are spread over the MPI ranks and the worn topographies shared;
+   of those steps with k_w(T) (and the counter-face's, spread over its wear track: ``rough.track_depth``), in
+   increments raised until their step-doubling error is within ``micro.wear.WEAR_TOL``; the zones are spread
+   over the MPI ranks and the worn topographies shared;
 4. the laws of the zones whose topography changed are recomputed (``rough.RoughInterface``: the others come
    from the pool's cache), the facet laws updated and the mechanics re-solved at the same time (from the state
    plus the previous step's change by this solve, ``law_increment``, if its residual is lower; where that
@@ -22,11 +23,9 @@ One macro step Δt (Fig. 7.2) runs:
 Remote temperatures of the micro heating (``LoopSettings.remote``). "bulk": each body's own macro surface
 temperature at the zone (thesis §7.2.2, §6.5: the heat conducted from the hotter body through the contact
 spots is part of the heat into the rough body, whose share of the frictional heat may then leave [0, 1]).
-"rough": both at the rough body's (the partition then depends on the contact and the speed only); a departure
-from the thesis, the loop's behaviour before issue 19, kept as an option (and the scenes' default with an
-interface conductance, which conducts between the bulk temperatures itself): with the bulk temperatures the
-explicit coupling swings, a hotter rough body sending its heat back through the partition of the next step.
-The scenes' default is "bulk" with the implicit coupling (below).
+"rough": both at the rough body's (the partition then depends on the contact and the speed only); the loop's
+behaviour before issue 19, kept as an option (and the default with an interface conductance, which conducts
+between the bulk temperatures itself). The scenes' default is "bulk" with the implicit coupling (below).
 
 Coupling of partitions and temperatures (``LoopSettings.coupling``); residual of a step: max over the loaded
 zones of |heat into the rough body by the post-analysis at the end of the step − the heat the macro model puts
@@ -39,9 +38,7 @@ heat it moves). Schemes:
   (``MacroModel.snapshot``/``restore``) with the next p of Anderson's acceleration (``anderson``: a
   multisecant quasi-Newton on the per-zone partitions, residuals weighted by the zones' heat, first step p +
   ``relaxation`` (G(p) − p)) until the residual is <= ``coupling_tol``; wear is then done once, at the
-  converged state. A scalar relaxation (Aitken's Δ²) does not do: the zones' gains differ by orders of
-  magnitude (a heavily loaded zone over-reacts, a light one hardly) and one factor that tames the first stalls
-  the others (measured on the coarse demo: 30 passes without reaching 1e-3).
+  converged state. (A scalar relaxation stalls: the zones' gains differ by orders of magnitude.)
 - "implicit" (bulk temperatures only): the micro problem is linear in the frictional heat and the remote
   temperatures, so the post-analysis returns, per zone, the partition at equal remote temperatures and the
   exchange G [W/K] (``PostAnalysis`` with ``Heating.conduction``); the macro model splits the frictional heat
@@ -50,11 +47,10 @@ heat it moves). Schemes:
   micro model's exact derivative, the macro heat solve doing the rest: the micro heat at the end of the step
   is the macro one up to the change of the contact during the step, in one pass. It departs from the thesis'
   form (the conduction hidden in the partition) to reach the same balance without its failure
-  (docs/architecture.md, the decision on the coupling: a barely touching zone got a partition of −2.3e4 at
-  1e-6 N on the coarse demo, and the pin −74 W at the next step).
+  (docs/architecture.md, the decision on the coupling).
 
-The default (``scene_sections.COUPLING_DEFAULT``) was chosen by measurement (docs/accuracy/coupling.md). The
-initial laws are computed before the first solve; the rigid datum gap starts Newton close to equilibrium.
+The default (``scene_sections.COUPLING_DEFAULT``) was chosen by measurement (docs/accuracy/coupling.md); the
+rigid datum gap starts Newton close to equilibrium.
 ``save``/``restore`` write and read the whole state (``checkpoint``): a killed run continues to the same
 history (to solver tolerance: a resumed run recomputes its zone laws). This module reads no scene:
 ``multiscale.workflows.multiscale`` builds and runs it."""
@@ -73,6 +69,7 @@ from multiscale.macro.continuation import solve_on_new_laws
 from multiscale.macro.mechanics import SolveResult
 from multiscale.macro.model import MacroModel
 from multiscale.micro.post_analysis import PostAnalysis
+from multiscale.micro.wear import WEAR_TOL
 from multiscale.rough import RoughInterface
 
 LOADED = 1e-9              # zones below this fraction of the nominal pressure are unloaded
@@ -142,7 +139,7 @@ class MicroStep:
     law_reach: float = 0.0     # largest zone pressure over micro.p_max, the top of the laws (> 1: extrapolated)
     law_reach_halved: float = 0.0  # the same over the zones whose law failed, against their halved top
     near_perfect: int = 0      # zones loaded beyond their law's floor (nearly perfect contact)
-    wear_error: float = 0.0    # estimated error of the worn real contact area / that area, from the substeps
+    wear_error: float = 0.0    # estimated relative error of the worn depth, from the increments (step doubling)
     wear_substeps: int = 0     # wear increments of the update (wear.substeps, or more: stability)
 
 
@@ -201,8 +198,7 @@ class Multiscale:
         self.datum_gap = np.zeros(self.tm.interface.n_facets)   # m, uniform initial gap g_0 per facet
         self.counter_depth = np.zeros(self.tm.interface.n_facets)   # m, counter-face worn along its track
         self.counter_volume = 0.0                     # m^3, lost by the counter-face
-        self.exchange = np.zeros(Z)                   # W/K, conduction rough body -> counter-face (implicit)
-        self.proposed_exchange = np.zeros(Z)
+        self.exchange, self.proposed_exchange = np.zeros(Z), np.zeros(Z)   # W/K, rough body -> counter-face (implicit)
         self.micro_heat = np.full(Z, np.nan)          # W, Phi of the last post-analysis
         self.micro_heat_rough = np.full(Z, np.nan)    # W, heat into the rough body by it
         self.remote_difference = np.zeros(Z)          # K, T_rough − T_counter of the macro surfaces
@@ -314,39 +310,43 @@ class Multiscale:
         """Wear of the zones of the last ``analyse`` over the last ``duration`` [s] (their topographies change; a
         wearing counter-face recedes along its track): the pressure fields of the last analysis slide over the
         interval's load-weighted sliding (``MacroModel.sliding``: none while released, exact for a stop or a release
-        inside it). Returns the interval's frictional work [J], the macro steps' ``work_step``: the heat's pressures
-        and quadrature, so that it is the frictional heat put in (the wear takes the pressure at the end of the
-        interval); and the estimated error of the worn zones' real contact area, the zones' |errors| summed over that
-        area in twice the substeps (``PostAnalysis.wear``'s step doubling); and the increments taken."""
-        mine, res, load, remote, _ = self._last
-        zones, m = self.rough.zones, self.model
+        inside it), in increments raised from the fewest while the step-doubling estimate of the worn depth's error
+        is above ``WEAR_TOL`` (up to an explicit scheme's stable count). Returns the interval's frictional work [J]
+        (the macro steps' ``work_step``: the frictional heat put in), that estimate (the zones' relative errors
+        weighted by their worn volumes) and the increments taken."""
+        mine, start, load, remote, _ = self._last
+        zones, m, cover = self.rough.zones, self.model, self.rough.cover
         sliding = m.sliding(m.time - duration, m.time)
         own, slides = [zones[i] for i in mine], load.reach[mine] * sliding
-        n = max(self.comm.allgather(io.collective(     # one count on every rank: the answer of any split
-            self.comm, lambda: self.post.stable_increments(own, res, slides, remote))))
-        res = io.collective(self.comm, lambda: self.post.wear(own, res, slides, remote, n))
-        volume, area, error = np.zeros(len(zones)), 0.0, 0.0
-        for ids, warm, heights, lost, w, worn, off in self.comm.allgather((mine, res.worn_pressure, res.heights,
-                res.counter_volume, res.plastic, res.worn_area_fraction, res.wear_error)):
-            area += float((worn - off / 2) @ self.rough.covered_area[ids])     # in twice the substeps
-            error += float(np.abs(off) @ self.rough.covered_area[ids])
+        n, most = np.max(self.comm.allgather(io.collective(     # one count on every rank: the answer of any split
+            self.comm, lambda: self.post.increments(own, start, slides, remote))), axis=0)
+        while True:                                      # first order: n e / WEAR_TOL meets it, if it holds
+            res = io.collective(self.comm, lambda: self.post.wear(own, start, slides, remote, int(n)))
+            parts = self.comm.allgather((mine, res.worn_pressure, res.heights, res.counter_volume, res.plastic,
+                                         res.volume * cover[mine], res.wear_error))
+            total = sum(float(worn.sum()) for *_, worn, _ in parts)          # the depth errors weighted by volume
+            error = sum(float(worn @ off) for *_, worn, off in parts) / total if total > 0 else 0.0
+            if n >= most or error <= WEAR_TOL:
+                break
+            n = min(most, max(2 * n, int(np.ceil(n * error / WEAR_TOL))))
+        volume = np.zeros(len(zones))
+        for ids, warm, heights, lost, w, *_ in parts:
             self.warm[ids] = warm
             self.rough.set_heights(ids, heights)
             volume[ids] = lost * self.rough.cover[ids]
             if self.plastic:
                 self.rough.plastic[ids] += w
         if self.post.counter_rate is not None:
-            contact, iface = self.model.contact, self.tm.interface
             self.counter_depth += self.rough.track_depth(volume, m.facet_sliding_power())    # (its flux now: 0 at rest)
             self.counter_volume += volume.sum()
-            iface.set_field(contact.initial_gap, self.datum_gap + self.counter_depth)
+            self.tm.interface.set_field(self.model.contact.initial_gap, self.datum_gap + self.counter_depth)
         work, self.interval_work = self.interval_work, 0.0                 # mu ∫ p |w| dA dt
         self.work += work
         if n > self.increments:
             self.increments = n
-            io.reporter().say(f"  wear updates in {n} increments (wear.substeps = {self.post.substeps}), each stable: "
-                              "k_w mu ds at most the zone grid's least compliance (micro.wear.stable_substeps)")
-        return work, error / area if area > 0 else 0.0, n
+            io.reporter().say(f"  wear updates in {n} increments (wear.substeps = {self.post.substeps}), raised while "
+                              f"their step-doubling error exceeded {100 * WEAR_TOL:g} % of the worn depth (micro.wear.WEAR_TOL)")
+        return work, error, int(n)
 
     def accept(self, micro: MicroStep) -> MicroStep:
         """The partitions (and exchanges) of the last ``analyse`` become the zones' (partition law);

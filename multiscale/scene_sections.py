@@ -542,8 +542,8 @@ class Wear:
     """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (``FIG_7_9_WEAR_RATE``:
     calibrated as ``FIG_7_9_CALIBRATION`` says). Every ``update_every`` macro steps (and at the last
     step, and a step ending at a stop) the zones wear over the sliding since, weighted by the load factor
-    (none while released), in ``substeps`` load-controlled increments or the more that keep each stable
-    (``micro.wear.stable_substeps``); a counter-face whose material gives ``k_w`` wears too."""
+    (none while released), in at least ``substeps`` (and 2) implicit increments, raised while their error
+    estimate exceeds ``micro.wear.WEAR_TOL``; a counter-face whose material gives ``k_w`` wears too."""
 
     k_w: float | None = key(_WEAR_RATE, absent="k_w_table, else the rough material's k_w, else thesis Fig. 7.9")
     k_w_table: tuple | None = key(Curve(_TEMPERATURE, Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)), "temperature",

@@ -238,24 +238,20 @@ def test_the_sliding_power_leaves_the_speed_and_the_heating_as_they_were(tmp_pat
     assert unit == pytest.approx(c.facet_heat_power().sum() / (20.9 * 0.5), rel=1e-12)
 
 
-def test_a_wear_update_deeper_than_the_roughness_is_warned_about(tmp_path):
-    """``micro.wear.STEP_RMS``: a wear update that deepens the deepest wear by more than half the
-    RMS height before it per substep (a k_w of 1e-12 /Pa wore 9 RMS in one step of the demo, without
-    a word; found by an adversarial test) is warned about; the demo's 0.08 RMS per update is not.
-    0.9 RMS per substep is warned about (before, only above 1 RMS: the test pin-on-disc at 0.83 RMS
-    per substep ended at 49 % of the converged real contact area, silently); 0.45 is not."""
+def test_a_wear_update_its_increments_leave_off_is_warned_about(tmp_path):
+    """``micro.wear.SUBSTEP_TOL``: an update whose step-doubling estimate of the worn depth's error
+    stays above it (the loop raises the increments up to an explicit scheme's stable count) is
+    warned about, with the count that would meet it (first order); one within it is not."""
     from multiscale.workflows import run_warnings
     scene = loads(BLOCK.format(effects='"contact"', folder=tmp_path / "out"))
-    for per_step, warned in ((0.08e-5, False), (9e-5, True)):
+    for error, warned in ((0.049, False), (0.12, True)):
         h = History()
         for k in range(3):
-            h.append(time=1.2 * k, wear_max_depth=per_step * k, rms_height=1e-5)
-        lines = [w for w in run_warnings(scene, h) if "wear increment" in w]
+            h.append(time=1.2 * k, wear_substep_error=error * (k == 1), wear_substeps=8 * (k > 0))
+        lines = [w for w in run_warnings(scene, h) if "wear increments" in w]
         assert bool(lines) == warned
-    assert lines[0].startswith("a wear increment deepened the wear by 9 times the RMS height (at t = 1.2 s)")
-    for substeps, warned in ((10, True), (20, False)):                               # 0.9, 0.45 RMS per substep
-        finer = loads(BLOCK.format(effects='"contact"', folder=tmp_path / "out"), overrides={"wear.substeps": substeps})
-        assert bool([w for w in run_warnings(finer, h) if "wear increment" in w]) == warned
+    assert lines == ["the 8 wear increments of an update (at t = 1.2 s) left its worn depth an estimated 12 % off "
+                     "(against twice the increments); for 5 % set wear.substeps to about 20 (first order: fewer may do)"]
 
 
 def test_a_solve_starting_next_to_its_answer_converges(tmp_path):

@@ -19,7 +19,7 @@ from mpi4py import MPI
 from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError, Interrupted, interrupted
 from multiscale.micro.laws import RESOLUTION
-from multiscale.micro.wear import STEP_RMS, SUBSTEP_TOL
+from multiscale.micro.wear import SUBSTEP_TOL
 from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.model import interface_materials
@@ -217,36 +217,21 @@ NEGLIGIBLE = 0.01     # ... if it is also above this share of the whole run's ri
 
 
 def _coarse_wear(scene, history) -> list[str]:
-    """A wear increment (an update's deepening over its ``wear.substeps``) that deepened the
-    deepest wear by more than ``micro.wear.STEP_RMS`` times the RMS height before it: the explicit
-    Archard step wears the loaded asperities below the valleys and the worn laws depend on the step
-    count (``micro.wear.simulate_wear`` warns at the same depth; the demo's updates take 0.08 RMS,
-    a 1e-12 /Pa wear rate 9 RMS in one step; the test pin-on-disc at 1e-12 /Pa, 0.83 RMS per
-    substep, ended at 49 % of the real contact area of 32 substeps). And an update whose real
-    contact area the substeps leave more than ``micro.wear.SUBSTEP_TOL`` off by the step-doubling
-    estimate (``wear_substep_error``, ``PostAnalysis.wear``): 4 substeps of 0.27 RMS, below
-    STEP_RMS, left the test pin-on-disc's area 31 % below the converged one (estimate 72 %)."""
-    if "wear_max_depth" not in history.columns:
+    """A wear update whose worn depth its increments leave more than ``micro.wear.SUBSTEP_TOL`` off
+    by the step-doubling estimate (``wear_substep_error``, ``PostAnalysis.wear``): the loop raises
+    an update's increments to meet ``WEAR_TOL`` up to an explicit scheme's stable count, so this
+    is an update that count did not bring there. (Before the implicit increments: 4 explicit
+    substeps left the test pin-on-disc's real area 31 % below the converged one.)"""
+    if "wear_substep_error" not in history.columns:
         return []
-    asked = scene.wear.substeps if scene.wear is not None else 1
-    taken = np.asarray(history["wear_substeps"], float) if "wear_substeps" in history.columns else np.zeros(len(history))
-    substeps = np.maximum(taken, asked)               # per row (rows without an update: nothing deepened)
-    deeper = np.diff(history["wear_max_depth"]) / np.maximum(history["rms_height"][:-1], np.finfo(float).tiny) \
-        / substeps[1:]
-    out = []
-    if deeper.size and deeper.max() > STEP_RMS:
-        row = int(np.argmax(deeper)) + 1
-        out.append(f"a wear increment deepened the wear by {deeper.max():.3g} times the RMS height (at t = "
-                   f"{history['time'][row]:g} s): the explicit wear step is coarse for this wear rate and the results "
-                   "depend on it; use more wear.substeps or time.steps")
-    error = np.asarray(history["wear_substep_error"]) if "wear_substep_error" in history.columns else np.zeros(0)
-    if error.size and error.max() > SUBSTEP_TOL:
-        row = int(np.argmax(error))
-        need = int(np.ceil(substeps[row] * error.max() / SUBSTEP_TOL))
-        out.append(f"the wear.substeps ({int(substeps[row])}) left the real contact area of a wear update (at t = "
-                   f"{history['time'][row]:g} s) an estimated {100 * error.max():.3g} % off (against twice the "
-                   f"substeps); for {100 * SUBSTEP_TOL:g} % use about {need} (the step is first order: fewer may do)")
-    return out
+    error = np.asarray(history["wear_substep_error"], dtype=float)
+    if not error.size or error.max() <= SUBSTEP_TOL:
+        return []
+    row = int(np.argmax(error))
+    taken = int(history["wear_substeps"][row])
+    return [f"the {taken} wear increments of an update (at t = {history['time'][row]:g} s) left its worn depth an "
+            f"estimated {100 * error.max():.3g} % off (against twice the increments); for {100 * SUBSTEP_TOL:g} % "
+            f"set wear.substeps to about {int(np.ceil(taken * error.max() / SUBSTEP_TOL))} (first order: fewer may do)"]
 
 
 def _unloaded(scene, history) -> list[str]:
