@@ -15,9 +15,9 @@ plane z = const, (u, v) = (x, y).
 the others) and loads them into the facet law; a zone whose law fails (no convergence, a pressure
 that stops growing) is retried with p_max halved, up to ``P_MAX_HALVINGS`` times (remembered for
 its later laws). Zones whose roughness adds less compliance than their laws resolve (worn flat,
-smooth) continue as nearly perfect contact (``micro.laws.resolved_gap``). ``datum_gap`` is the per-facet uniform
-initial gap at which the rigid rough bodies carry given forces, one bisection per interface: it
-starts Newton close to equilibrium.
+smooth) continue as nearly perfect contact (``micro.laws.resolved_gap``). ``datum_gap`` is the
+per-facet uniform initial gap at which the rigid rough bodies carry given forces, one bisection per
+interface: it starts Newton close to equilibrium.
 
 ``track_depth`` spreads the volume the counter-face (a rotating body 1) loses in each zone over its
 circular wear track: the counter-face stays flat at the zone scale and its surface recedes by a

@@ -387,10 +387,11 @@ def resolved_gap(gap, pressure, top: float, compliance: float) -> tuple[np.ndarr
     pressure is 0.955, 0.927, 0.922, 0.918 of Love's uniform-pressure mean displacement on a square
     of 8², 32², 64², 256² cells (about 0.917 converged; 0.925 on a circle: pi/2 against 16/(3 pi),
     Johnson 1985 §3.8), so the Love-corrected gap of a patch close to full contact is too high by
-    up to 8 % of c p, and rises with p once the roughness adds less compliance than that. The zone law cannot resolve such compliance; where the nodes show less,
-    their gaps fall at the floor instead (−dg/dp = RESOLUTION c): the face continues as nearly
-    perfect contact, its extra compliance within the law's own uncertainty (before, such a law was
-    refused: a worn-flat or smooth face stopped the run)."""
+    up to 8 % of c p, and rises with p once the roughness adds less compliance than that. The zone
+    law cannot resolve such compliance; where the nodes show less, their gaps fall at the floor
+    instead (−dg/dp = RESOLUTION c): the face continues as nearly perfect contact, its extra
+    compliance within the law's own uncertainty (before, such a law was refused: a worn-flat or
+    smooth face stopped the run)."""
     gap, pressure = np.asarray(gap, dtype=float), np.asarray(pressure, dtype=float)
     floor, out, floored = RESOLUTION * compliance, gap.copy(), np.inf
     last_gap, last_p = top, 0.0
