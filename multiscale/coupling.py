@@ -140,7 +140,7 @@ class MicroStep:
     law_reach_halved: float = 0.0  # the same over the zones whose law failed, against their halved top
     near_perfect: int = 0      # zones loaded beyond their law's floor (nearly perfect contact)
     wear_error: float = 0.0    # estimated relative error of the worn depth, from the increments (step doubling)
-    wear_substeps: int = 0     # wear increments of the update (wear.substeps, or more: stability)
+    wear_substeps: int = 0     # wear increments of the update (wear.substeps, or more: WEAR_TOL, stability)
 
 
 @dataclass
@@ -333,7 +333,7 @@ class Multiscale:
         for ids, warm, heights, lost, w, *_ in parts:
             self.warm[ids] = warm
             self.rough.set_heights(ids, heights)
-            volume[ids] = lost * self.rough.cover[ids]
+            volume[ids] = lost * cover[ids]
             if self.plastic:
                 self.rough.plastic[ids] += w
         if self.post.counter_rate is not None:

@@ -251,7 +251,7 @@ def test_a_wear_update_its_increments_leave_off_is_warned_about(tmp_path):
         lines = [w for w in run_warnings(scene, h) if "wear increments" in w]
         assert bool(lines) == warned
     assert lines == ["the 8 wear increments of an update (at t = 1.2 s) left its worn depth an estimated 12 % off "
-                     "(against twice the increments); for 5 % set wear.substeps to about 20 (first order: fewer may do)"]
+                     "(against half the increments); for 5 % set wear.substeps to about 20 (first order: fewer may do)"]
 
 
 def test_a_solve_starting_next_to_its_answer_converges(tmp_path):

@@ -30,8 +30,8 @@ from multiscale.micro.surface import Surface, check_surface
 
 
 STEP_RMS = 0.5   # a simulate_wear step wearing deeper than this many RMS heights is warned about [-]
-SUBSTEP_TOL = 0.05   # a wear update whose real contact area the substeps leave this far off is warned about [-]
-WEAR_TOL = 0.005     # the coupled loop doubles a wear update's increments while their estimated error is above [-]
+SUBSTEP_TOL = 0.05   # a wear update whose worn depth its increments leave this far off is warned about [-]
+WEAR_TOL = 0.005     # the coupled loop raises a wear update's increments while their estimated error is above [-]
 UNIFORM = 1e-12      # a step's depths equal to this share of the deepest: uniform wear (full contact of a flat)
 ROUND_OFF_FLAT = 1e12   # a step's relief over this many RMS heights of its start: worn into a flat to round-off [-]
 

@@ -169,7 +169,7 @@ def run_warnings(scene, history) -> list[str]:
         for T, body in dict.fromkeys((hottest[name], coldest.get(name, hottest[name]))):   # the hottest, the coldest
             out += [f"materials.{name}.{phrase} (in body {body!r})"
                     for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
-    return (out + laws + _undershoots(scene, history) + _coarse_wear(scene, history) + _wear_table_ends(scene, history)
+    return (out + laws + _undershoots(scene, history) + _coarse_wear(history) + _wear_table_ends(scene, history)
             + _too_hot(scene, history) + _unloaded(scene, history)
             + (overloaded(scene, float(np.max(history["max_pressure"])), hottest)
                if "max_pressure" in history.columns else []))
@@ -216,7 +216,7 @@ UNDERSHOOT = 0.1      # a body's undershoot warned about: this share of its temp
 NEGLIGIBLE = 0.01     # ... if it is also above this share of the whole run's rise (and 1 mK) [-]
 
 
-def _coarse_wear(scene, history) -> list[str]:
+def _coarse_wear(history) -> list[str]:
     """A wear update whose worn depth its increments leave more than ``micro.wear.SUBSTEP_TOL`` off
     by the step-doubling estimate (``wear_substep_error``, ``PostAnalysis.wear``): the loop raises
     an update's increments to meet ``WEAR_TOL`` up to an explicit scheme's stable count, so this
@@ -230,7 +230,7 @@ def _coarse_wear(scene, history) -> list[str]:
     row = int(np.argmax(error))
     taken = int(history["wear_substeps"][row])
     return [f"the {taken} wear increments of an update (at t = {history['time'][row]:g} s) left its worn depth an "
-            f"estimated {100 * error.max():.3g} % off (against twice the increments); for {100 * SUBSTEP_TOL:g} % "
+            f"estimated {100 * error.max():.3g} % off (against half the increments); for {100 * SUBSTEP_TOL:g} % "
             f"set wear.substeps to about {int(np.ceil(taken * error.max() / SUBSTEP_TOL))} (first order: fewer may do)"]
 
 
