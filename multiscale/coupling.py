@@ -64,7 +64,9 @@ from pathlib import Path
 import numpy as np
 
 from multiscale import checkpoint, io
-from multiscale.errors import ConvergenceError, InputError
+from multiscale.anderson import anderson
+from multiscale.errors import ConvergenceError
+from multiscale.loop_settings import LoopSettings
 from multiscale.macro.continuation import solve_on_new_laws
 from multiscale.macro.mechanics import SolveResult
 from multiscale.macro.model import MacroModel
@@ -73,42 +75,7 @@ from multiscale.micro.wear import WEAR_TOL
 from multiscale.rough import RoughInterface
 
 LOADED = 1e-9              # zones below this fraction of the nominal pressure are unloaded
-REMOTE = ("rough", "bulk")
 ANDERSON_MEMORY = 8        # past passes the fixed point's acceleration uses
-COUPLING = ("explicit", "fixed-point", "implicit")
-
-
-@dataclass(frozen=True)
-class LoopSettings:
-    """Time and update rules of the loop."""
-
-    dt: float                     # s, macro step
-    substeps: int                 # thermo-mechanical sub-steps per macro step
-    initial_temperature: float    # K, also the temperature of zones without a heat problem
-    partition: float | np.ndarray  # share of the heat into the rough body, per zone, until the first heating (NaN: none)
-    partition_law: bool = False   # micro partition per zone (ch. 6) instead of the constant
-    wear: bool = False            # Archard wear of the zones
-    wear_every: int = 1           # macro steps per wear update
-    steps: int | None = None      # macro steps of the run: the last wears the rest of a wear interval
-    flash_softening: bool = False  # H(T) of each zone at its last micro flash temperature (plasticity)
-    forces: dict = field(default_factory=dict)   # N, per interface: the load it nominally carries
-    friction: np.ndarray | None = None            # mu of every zone (its interface's; None: the post-analysis')
-    remote: str = "rough"         # remote temperatures of the micro heating: "rough" or "bulk" (module docstring)
-    coupling: str = "explicit"    # "explicit", "fixed-point" or "implicit" (module docstring)
-    coupling_tol: float = 1e-3    # fixed point: max |G(p) - p| over the loaded zones
-    coupling_iterations: int = 30  # fixed point: passes before ConvergenceError
-    relaxation: float = 0.5       # fixed point: first relaxation factor
-
-    def __post_init__(self):
-        for name, allowed in (("remote", REMOTE), ("coupling", COUPLING)):
-            if getattr(self, name) not in allowed:
-                raise InputError(name, getattr(self, name), f"one of {', '.join(allowed)}")
-        if self.coupling == "implicit" and self.remote != "bulk":
-            raise InputError("coupling", self.coupling, 'the implicit coupling conducts between the bulk temperatures: '
-                             'remote = "bulk"')
-        if not (self.coupling_tol > 0 and self.coupling_iterations >= 1 and 0 < self.relaxation <= 1):
-            raise InputError("coupling", (self.coupling_tol, self.coupling_iterations, self.relaxation),
-                             "tolerance > 0, iterations >= 1, relaxation in (0, 1]")
 
 
 @dataclass
@@ -163,20 +130,6 @@ class Restored:
     step: int                  # last macro step done
     history: io.History
     fields_written: int        # last step whose fields were written (-1: none)
-
-
-def anderson(passes, weight, mixing: float) -> np.ndarray:
-    """The next partitions of Anderson's acceleration (Walker & Ni 2011, type II) of the fixed point
-    p = G(p): ``passes`` [(p_j, r_j = G(p_j) − p_j), ...], the last one current; the residuals
-    are compared weighted by ``weight`` (the zones' heat): p + m r − (ΔP + m ΔR) γ, γ minimising
-    |W (r − ΔR γ)|; with one pass, the relaxed step p + m r."""
-    p, r = passes[-1]
-    if len(passes) == 1:
-        return p + mixing * r
-    dP = np.column_stack([b[0] - a[0] for a, b in zip(passes, passes[1:])])
-    dR = np.column_stack([b[1] - a[1] for a, b in zip(passes, passes[1:])])
-    gamma = np.linalg.lstsq(weight[:, None] * dR, weight * r, rcond=None)[0]
-    return p + mixing * r - (dP + mixing * dR) @ gamma
 
 
 class Multiscale:

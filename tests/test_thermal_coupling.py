@@ -293,7 +293,7 @@ def test_scene_rules_of_the_thermal_coupling(tmp_path):
     from multiscale.scene_summary import summary
     assert any("calibrated" in line or "level set so that" in line
                for line in summary(loads(wear.replace('k_w = "1e-14 1/Pa"', "substeps = 1"))))
-    from multiscale.coupling import LoopSettings
+    from multiscale.loop_settings import LoopSettings
     with pytest.raises(InputError, match="bulk"):
         LoopSettings(1.0, 1, 293.15, 0.5, coupling="implicit")
 

@@ -32,9 +32,10 @@ import numpy as np
 from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs
-from multiscale.coupling import LoopSettings, Multiscale
+from multiscale.coupling import Multiscale
 from multiscale.errors import InputError, Interrupted
 from multiscale.geometry import MAX_CELLS, Rotation
+from multiscale.loop_settings import LoopSettings
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.output import FieldOutput
 from multiscale.micro.heat_kernels import ThermalMaterial
