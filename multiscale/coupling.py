@@ -4,7 +4,9 @@ the zones, wear and checkpoints (thesis §1.4–1.5, ch. 7, Figs. 7.2–7.5).
 One macro step Δt (Fig. 7.2) runs:
 
 1. the macro transient over Δt in ``substeps`` thermo-mechanical sub-steps δt with the current laws and
-   partitions (Fig. 7.4; ``macro.model.MacroModel.macro_step``);
+   partitions (Fig. 7.4; ``macro.model.MacroModel.macro_step``); a step that wears holds its Archard depth per
+   pressure k_w mu s in series with the laws (``ZoneLaws.in_series``, solved first): backward Euler, stable at
+   any Δt (the explicit update flip-flopped the facet pressures once a step's depth passed the laws' compliance);
 2. per zone, the macro loading at the end of the step (``loading``): zone pressure P = (contact force on the
    zone's facets) / (their area), the patch's results counted over it (``cover``), the facet temperatures of
    both bodies, the sliding speed (force-weighted over the zone) and direction;
@@ -259,6 +261,14 @@ class Multiscale:
             self.rough.set_heights(ids, heights)
             self.rough.plastic[ids] += w
 
+    def archard(self, m: int, n: int) -> np.ndarray:
+        """Archard's depth per pressure [m/Pa] of every zone over steps m + 1 ... n for the load at n's end
+        (``wear``'s sliding, ``MacroModel.sliding``), at the current temperatures."""
+        t0, t1 = (float(f"{k * self.settings.dt:.12g}") for k in (m, n))     # the model's times (step_time)
+        f, load = self.model.drive.factor(t1), self.loading()
+        sliding = self.model.drive.mean_sliding(t0, t1) * (t1 - t0) / f if f > 0 else 0.0
+        return self.post.archard_compliance(load.reach * sliding, load.temperature[:, 1], self.settings.friction)
+
     def wear(self, duration: float) -> tuple[float, float, int]:
         """Wear of the zones of the last ``analyse`` over the last ``duration`` [s] (their topographies change; a
         wearing counter-face recedes along its track): the pressure fields of the last analysis slide over the
@@ -411,8 +421,12 @@ class Multiscale:
         first = n - (n % s.wear_every or s.wear_every) + 1          # the wear interval holding step n
         interval = n - max([m for m in range(first, n) if self.stops(m)], default=first - 1)   # steps since the last wear
         wear = s.wear and self.post.wears and (n % s.wear_every == 0 or n == s.steps or self.stops(n))
+        t_series = _time.perf_counter()
+        if wear and (compliance := self.archard(n - interval, n)).any():   # its wear at the step's end pressure,
+            self.rough.wear_in_series(compliance)                         # in series with the laws (backward Euler)
+            self.solve_on_new_laws(None)
         state = self.model.snapshot() if self.iterating else None
-        residuals, passes, time_macro, time_micro = [], [], 0.0, 0.0
+        residuals, passes, time_macro, time_micro = [], [], _time.perf_counter() - t_series, 0.0
         while True:
             t0 = _time.perf_counter()
             heat = self.model.macro_step(s.dt, s.substeps)
@@ -445,13 +459,18 @@ class Multiscale:
             self.rough.update_laws()
         t4 = _time.perf_counter()
         if changed:
-            mech = self.model.mechanics
-            before = mech.displacements()
-            self.model.last_solve = solve_on_new_laws(mech, self.rough.law, self.law_increment, self.model.released)
-            self.law_increment = [u - x for u, x in zip(mech.displacements(), before)]
-            self.model.keep_torque(self.model.drive.factor(self.model.time))   # the worn laws moved the pressure
+            self.law_increment = self.solve_on_new_laws(self.law_increment)
         return StepResult(n, heat, micro, time_macro + _time.perf_counter() - t4, time_micro + t3 - t2, t4 - t3,
                           residuals)
+
+    def solve_on_new_laws(self, guess: list | None) -> list:
+        """The mechanics re-solved on the facet laws just set (``macro.continuation``; ``guess``: per-body
+        displacement increments to try first), the torque kept; returns the increments of this solve."""
+        mech = self.model.mechanics
+        before = mech.displacements()
+        self.model.last_solve = solve_on_new_laws(mech, self.rough.law, guess, self.model.released)
+        self.model.keep_torque(self.model.drive.factor(self.model.time))   # the new laws moved the pressure
+        return [u - x for u, x in zip(mech.displacements(), before)]
 
     def record(self, result: StepResult) -> dict:
         """One history row (units: ``io.UNITS``)."""

@@ -270,6 +270,12 @@ class RoughInterface:
         self.floors[[nd.zone_id for nd in nodes]] = [nd.floored for nd in nodes]
         return computed
 
+    def wear_in_series(self, compliance) -> None:
+        """The facet laws with each zone's compliance ``compliance`` [m/Pa] (one per zone id) in series
+        (``ZoneLaws.in_series``), until ``update_laws`` (collective)."""
+        laws = self.law.laws
+        self.law.set_laws(laws.in_series(np.asarray(compliance, dtype=float)[laws.ids]), self.zone_of_facet)
+
     def zone_of(self, name: str) -> np.ndarray:
         """Zone ids of rough interface ``name``."""
         k = self.names.index(name)

@@ -217,8 +217,9 @@ def test_transient_heating_with_remote_temperatures_tends_to_the_steady_one():
 
 def test_wear_sheds_load_from_the_most_loaded_zones(tmp_path):
     """Expansion off, a flat-topped k_w(T): the largest zone pressure falls at every wear step and
-    the load spreads over more zones (measured: 3.87 -> 2.78 MPa, 10 -> 14 zones over 5 steps; the
-    first two rows are before any wear). The wear volume grows at every step."""
+    the load spreads over more zones (measured: 5.25 -> 3.10 MPa, 9 -> 13 zones over 5 steps; the
+    first row is before any wear, the first step's end already under its own wear: backward Euler,
+    ``coupling``). The wear volume grows at every step."""
     from multiscale.workflows.multiscale import run
     extra = '[wear]\nk_w_table = [["20 degC", "5e-14 1/Pa"], ["40 degC", "3e-13 1/Pa"], ["2000 degC", "3e-13 1/Pa"]]\n' \
             "substeps = 2\n"
@@ -226,7 +227,7 @@ def test_wear_sheds_load_from_the_most_loaded_zones(tmp_path):
     text = text.replace("steps = 2", "steps = 5").replace('end = "1.2 s"', 'end = "3 s"')
     h = run(loads(text), verbose=False).history
     p, zones = h["max_zone_pressure"], h["zones_in_contact"]
-    assert p[1] == p[0] and np.all(np.diff(p[1:]) < 0), p
+    assert np.all(np.diff(p) < 0), p
     assert np.all(np.diff(zones) >= 0) and zones[-1] >= zones[0] + 3, zones
     assert p[-1] < 0.8 * p[0]
     assert np.all(np.diff(h["wear_volume"][1:]) > 0)

@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import time
 from abc import ABC, abstractmethod
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -432,6 +432,7 @@ class ZoneLaws:
         if np.any(np.diff(self.ids[order]) == 0):
             raise InputError("nodes", "zone ids", "each zone once")
         self._sorted_ids, self._order = self.ids[order], order
+        self.spec = spec
         self.mechanical = self._area = None
         self.extras: dict[str, PressureTable] = {}
         if not nodes:                      # e.g. a rank without interface facets
@@ -448,6 +449,18 @@ class ZoneLaws:
 
     def __len__(self) -> int:
         return len(self.ids)
+
+    def in_series(self, compliance) -> ZoneLaws:
+        """These laws with a compliance c [m/Pa] per zone (``ids`` order, >= 0) in series: at each
+        node the interpenetration d + c p for the same pressure (a node's gap lowered by c p; the
+        tables of the pressure, e.g. the area fraction, unchanged). With c Archard's depth per
+        pressure over a wear interval, the laws of the pressure at its end (``coupling``'s backward
+        Euler wear)."""
+        c = np.asarray(compliance, dtype=float)
+        if c.shape != self.ids.shape or not np.all(c >= 0):
+            raise InputError("compliance", c.shape, f"one compliance >= 0 [m/Pa] per zone ({len(self.ids)})")
+        return ZoneLaws([replace(nd, gap=nd.gap - k * nd.pressure) for nd, k in zip(self.nodes, c)],
+                        self.spec)
 
     def rows(self, zone_ids) -> np.ndarray:
         """Row of each zone id (raises for an unknown id)."""

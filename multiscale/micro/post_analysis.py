@@ -320,6 +320,15 @@ class PostAnalysis:
         least = np.min(C, axis=(-2, -1), where=touching, initial=np.inf)
         return C, np.where(touching.any(axis=(-2, -1)), least, 0.0)
 
+    def archard_compliance(self, sliding, temperature, mu=None) -> np.ndarray:
+        """The rough body's Archard depth per pressure k_w(T) mu s [m/Pa] of zones sliding ``sliding``
+        (B,) [m] at its temperatures ``temperature`` (B,) [K] (read by a k_w(T) only); ``mu`` (B,) or
+        the post-analysis' own; 0 without its wear."""
+        s = np.asarray(sliding, dtype=float)
+        if self.rate is None:
+            return np.zeros(s.shape)
+        return self.rate(np.asarray(temperature, dtype=float)) * (self.mu if mu is None else np.asarray(mu)) * s
+
     def _wear_temperatures(self, result: ZoneResult, remote):
         """(rough body's, counter-face's) temperatures of k_w: the heating's fields, else the remote
         temperatures spread over the zones, where a temperature-dependent rate needs them."""
