@@ -424,7 +424,7 @@ class Multiscale:
         t_series = _time.perf_counter()
         if wear and (compliance := self.archard(n - interval, n)).any():   # its wear at the step's end pressure,
             self.rough.wear_in_series(compliance)                         # in series with the laws (backward Euler)
-            self.solve_on_new_laws(None)
+            self.resolve(None)
         state = self.model.snapshot() if self.iterating else None
         residuals, passes, time_macro, time_micro = [], [], _time.perf_counter() - t_series, 0.0
         while True:
@@ -459,11 +459,11 @@ class Multiscale:
             self.rough.update_laws()
         t4 = _time.perf_counter()
         if changed:
-            self.law_increment = self.solve_on_new_laws(self.law_increment)
+            self.law_increment = self.resolve(self.law_increment)
         return StepResult(n, heat, micro, time_macro + _time.perf_counter() - t4, time_micro + t3 - t2, t4 - t3,
                           residuals)
 
-    def solve_on_new_laws(self, guess: list | None) -> list:
+    def resolve(self, guess: list | None) -> list:
         """The mechanics re-solved on the facet laws just set (``macro.continuation``; ``guess``: per-body
         displacement increments to try first), the torque kept; returns the increments of this solve."""
         mech = self.model.mechanics
