@@ -16,7 +16,8 @@ One macro step Δt (Fig. 7.2) runs:
    ``wear_every`` steps (and at the last step), the Archard wear of the patch over the load-weighted sliding
    of those steps with k_w(T) (and the counter-face's, spread over its wear track: ``rough.track_depth``), in
    increments raised until their step-doubling error is within ``micro.wear.WEAR_TOL``; the zones are spread
-   over the MPI ranks and the worn topographies shared;
+   over the MPI ranks and the worn topographies shared; a facet wears c (p − P) more than its zone's patch
+   (``form_depth``, c the step's series compliance, p its pressure: the series state's wear at the facet);
 4. the laws of the zones whose topography changed are recomputed (``rough.RoughInterface``: the others come
    from the pool's cache), the facet laws updated and the mechanics re-solved at the same time (from the state
    plus the previous step's change by this solve, ``law_increment``, if its residual is lower; where that
@@ -152,6 +153,8 @@ class Multiscale:
         self.interval_work = 0.0                      # J, that of the steps since the last wear
         self.datum_gap = np.zeros(self.tm.interface.n_facets)   # m, uniform initial gap g_0 per facet
         self.counter_depth = np.zeros(self.tm.interface.n_facets)   # m, counter-face worn along its track
+        self.form_depth = np.zeros(self.tm.interface.n_facets)   # m, the rough body's wear beyond its zone's mean
+        self.series = np.zeros(Z)                     # m/Pa, the wearing step's Archard depth per pressure (archard)
         self.counter_volume = 0.0                     # m^3, lost by the counter-face
         self.exchange, self.proposed_exchange = np.zeros(Z), np.zeros(Z)   # W/K, rough body -> counter-face (implicit)
         self.micro_heat = np.full(Z, np.nan)          # W, Phi of the last post-analysis
@@ -299,10 +302,13 @@ class Multiscale:
             volume[ids] = lost * cover[ids]
             if self.plastic:
                 self.rough.plastic[ids] += w
+        on = self.rough.zone_of_facet >= 0          # each facet's Archard depth at its own pressure, backward Euler:
+        zone_of = self.rough.zone_of_facet[on]      # the zone's topography took its mean, c P
+        self.form_depth[on] += self.series[zone_of] * (m.contact.facet_pressure()[on] - load.pressure[zone_of])
         if self.post.counter_rate is not None:
             self.counter_depth += self.rough.track_depth(volume, m.facet_sliding_power())    # (its flux now: 0 at rest)
             self.counter_volume += volume.sum()
-            self.tm.interface.set_field(self.model.contact.initial_gap, self.datum_gap + self.counter_depth)
+        self.set_gap()
         work, self.interval_work = self.interval_work, 0.0                 # mu ∫ p |w| dA dt
         self.work += work
         if n > self.increments:
@@ -310,6 +316,11 @@ class Multiscale:
             io.reporter().say(f"  wear updates in {n} increments (wear.substeps = {self.post.substeps}), raised while "
                               f"their step-doubling error exceeded {100 * WEAR_TOL:g} % of the worn depth (micro.wear.WEAR_TOL)")
         return work, error, int(n)
+
+    def set_gap(self) -> None:
+        """The facets' initial gap: the datum, opened by the counter-face's wear and by the rough body's
+        beyond its zones' means."""
+        self.tm.interface.set_field(self.model.contact.initial_gap, self.datum_gap + self.counter_depth + self.form_depth)
 
     def accept(self, micro: MicroStep) -> MicroStep:
         """The partitions (and exchanges) of the last ``analyse`` become the zones' (partition law);
@@ -376,7 +387,7 @@ class Multiscale:
         fields = {"contact_stiffness": lambda: rough.facet_stiffness(contact.facet_gap(), iface.values(contact.stiffness))
                   * (not self.model.released),
                   "partition": lambda: iface.values(contact.partition),
-                  "wear_depth": lambda: np.where(rough.zone_of_facet >= 0,
+                  "wear_depth": lambda: np.where(rough.zone_of_facet >= 0, self.form_depth +
                                                  rough.wear_depth().mean(axis=(-2, -1))[rough.zone_of_facet], 0.0)}
         if self.post.heating is not None:
             fields["flash_temperature"] = self.facet_flash
@@ -400,7 +411,7 @@ class Multiscale:
         self.rough.update_laws()
         t1 = _time.perf_counter()
         self.datum_gap = self.rough.datum_gap(self.settings.forces)
-        self.tm.interface.set_field(self.model.contact.initial_gap, self.datum_gap + self.counter_depth)
+        self.set_gap()
         self.model.start()
         t2 = _time.perf_counter()
         micro = self.micro_step()
@@ -422,8 +433,9 @@ class Multiscale:
         interval = n - max([m for m in range(first, n) if self.stops(m)], default=first - 1)   # steps since the last wear
         wear = s.wear and self.post.wears and (n % s.wear_every == 0 or n == s.steps or self.stops(n))
         t_series = _time.perf_counter()
-        if wear and (compliance := self.archard(n - interval, n)).any():   # its wear at the step's end pressure,
-            self.rough.wear_in_series(compliance)                         # in series with the laws (backward Euler)
+        self.series = self.archard(n - interval, n) if wear else np.zeros(len(self.rough.zones))
+        if self.series.any():                                   # its wear at the step's end pressure, in series
+            self.rough.wear_in_series(self.series)              # with the laws (backward Euler)
             self.resolve(None)
         state = self.model.snapshot() if self.iterating else None
         residuals, passes, time_macro, time_micro = [], [], _time.perf_counter() - t_series, 0.0
@@ -512,6 +524,7 @@ class Multiscale:
         arrays = {"heights": self.rough.heights(), "warm": self.warm, "partition": self.partition,
                   **({"plastic": self.rough.plastic} if self.plastic else {}),    # else zero: not stored
                   "conductance": self.conductance, "flash": self.flash, "counter_depth": self.counter_depth,
+                  "form_depth": self.form_depth,
                   "exchange": self.exchange, "levels": self.rough.levels, "heat_total": m.heat_total,
                   "interface_heat_total": m.interface_heat_total,
                   "heat_lost_recorded": m.heat_lost_recorded, "datum_gap": self.datum_gap,
@@ -538,6 +551,7 @@ class Multiscale:
         self.warm, self.partition = arrays["warm"], arrays["partition"]
         self.conductance, self.rough.levels = arrays["conductance"], arrays["levels"]
         self.datum_gap, self.flash, self.counter_depth = arrays["datum_gap"], arrays["flash"], arrays["counter_depth"]
+        self.form_depth = arrays["form_depth"]
         self.counter_volume = float(attrs["counter_volume"])
         m.heat_exchanged, m.heat_exchanged_total = (float(v) for v in attrs["heat_exchanged"])
         self.exchange = arrays["exchange"]
@@ -556,7 +570,7 @@ class Multiscale:
                 holder.notes = said + [n for n in holder.notes if n not in said]
         reason, its, force, max_p = attrs["solve"]
         m.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
-        self.tm.interface.set_field(m.contact.initial_gap, self.datum_gap + self.counter_depth)
+        self.set_gap()
         m.load, m.solved_speed = float(attrs["load"]), float(attrs["solved_speed"])
         for c, value in zip(self.model.drive_constants, attrs["constants"]):   # speed, engagement, load last solved
             c.value = value
