@@ -28,7 +28,7 @@ FORMAT = 7    # what a checkpoint holds; 2: P2 temperatures in a rotating body, 
 #               3: the drive's state (speed, engagement, load last solved) and the area-weighted effusivity partition;
 #               4: the law_reach_halved history column, quadratic cells in the field files beside it;
 #               5: min_temperature_<body>_in_<material> history columns; 6: wear_substeps, near_perfect_zones;
-#               7: form_depth (the rough body's wear at its facets beyond their zones' means)
+#               7: form_depth (the rough body's wear at its facets beyond their zones' means), the zones' rates
 
 
 def fingerprint(text: str) -> str:

@@ -147,6 +147,7 @@ class Multiscale:
         self.partition = np.broadcast_to(np.asarray(settings.partition, dtype=float), (Z,)).copy()
         self.proposed = np.full(Z, np.nan)            # partitions of the last post-analysis (NaN: unloaded)
         self.flash = np.full(Z, np.nan)               # K, flash temperature of each zone (NaN: unloaded)
+        self.rates = np.full(Z, np.nan)               # 1/Pa, k_w as the last analysis' wear takes it (NaN: unloaded)
         self.conductance = np.zeros(Z)
         self.warm = np.zeros(rough.initial.shape)     # previous local pressures (warm starts)
         self.work = 0.0                               # J, frictional work over the wear intervals
@@ -217,14 +218,15 @@ class Multiscale:
         parts = comm.allgather((mine, res.pressure, res.max_pressure, res.max_temperature,
                                 res.partition_equal if implicit else res.partition, res.conductance, res.heat * cover,
                                 res.heat_rough * cover, res.exchange * cover, remote[:, 1] - remote[:, 0],
-                                res.plastic_area_fraction, res.area_fraction * self.rough.covered_area[mine]))
-        for a in (self.proposed, self.flash, self.micro_heat, self.micro_heat_rough):
+                                res.plastic_area_fraction, res.area_fraction * self.rough.covered_area[mine],
+                                self.post.zone_rates(res, remote)))
+        for a in (self.proposed, self.flash, self.micro_heat, self.micro_heat_rough, self.rates):
             a[:] = np.nan
         self.proposed_exchange[:] = 0.0
         max_p, flow, real = [], [np.zeros(0)], np.zeros(len(zones))
-        for ids, warm, mp, mT, part, h_c, heat, rough, exchange, diff, fraction, area in parts:
+        for ids, warm, mp, mT, part, h_c, heat, rough, exchange, diff, fraction, area, rates in parts:
             flow.append(fraction)
-            real[ids] = area
+            real[ids], self.rates[ids] = area, rates
             self.warm[ids], self.proposed[ids], self.flash[ids] = warm, part, mT
             self.micro_heat[ids], self.micro_heat_rough[ids], self.remote_difference[ids] = heat, rough, diff
             if implicit:
@@ -266,11 +268,13 @@ class Multiscale:
 
     def archard(self, m: int, n: int) -> np.ndarray:
         """Archard's depth per pressure [m/Pa] of every zone over steps m + 1 ... n for the load at n's end
-        (``wear``'s sliding, ``MacroModel.sliding``), at the current temperatures."""
+        (``wear``'s sliding, ``MacroModel.sliding``), with k_w as the last analysis' wear took it
+        (``PostAnalysis.zone_rates``: its local temperatures), at the macro temperature elsewhere."""
         t0, t1 = (float(f"{k * self.settings.dt:.12g}") for k in (m, n))     # the model's times (step_time)
         f, load = self.model.drive.factor(t1), self.loading()
         sliding = self.model.drive.mean_sliding(t0, t1) * (t1 - t0) / f if f > 0 else 0.0
-        return self.post.archard_compliance(load.reach * sliding, load.temperature[:, 1], self.settings.friction)
+        return self.post.archard_compliance(load.reach * sliding, load.temperature[:, 1], self.settings.friction,
+                                            self.rates)
 
     def wear(self, duration: float) -> tuple[float, float, int]:
         """Wear of the zones of the last ``analyse`` over the last ``duration`` [s] (their topographies change; a
@@ -523,7 +527,7 @@ class Multiscale:
         m, last = self.model, self.model.last_solve
         arrays = {"heights": self.rough.heights(), "warm": self.warm, "partition": self.partition,
                   **({"plastic": self.rough.plastic} if self.plastic else {}),    # else zero: not stored
-                  "conductance": self.conductance, "flash": self.flash, "counter_depth": self.counter_depth,
+                  "conductance": self.conductance, "flash": self.flash, "rates": self.rates, "counter_depth": self.counter_depth,
                   "form_depth": self.form_depth,
                   "exchange": self.exchange, "levels": self.rough.levels, "heat_total": m.heat_total,
                   "interface_heat_total": m.interface_heat_total,
@@ -551,7 +555,7 @@ class Multiscale:
         self.warm, self.partition = arrays["warm"], arrays["partition"]
         self.conductance, self.rough.levels = arrays["conductance"], arrays["levels"]
         self.datum_gap, self.flash, self.counter_depth = arrays["datum_gap"], arrays["flash"], arrays["counter_depth"]
-        self.form_depth = arrays["form_depth"]
+        self.form_depth, self.rates = arrays["form_depth"], arrays["rates"]
         self.counter_volume = float(attrs["counter_volume"])
         m.heat_exchanged, m.heat_exchanged_total = (float(v) for v in attrs["heat_exchanged"])
         self.exchange = arrays["exchange"]

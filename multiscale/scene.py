@@ -64,8 +64,9 @@ EFFECTS: dict[str, Effect] = {
     "roughness": Effect("rough interface: per-zone homogenized laws from micro patches "
                         "([roughness], [micro])", ("contact",)),
     "layers": Effect("layered near-surface material in the micro models ([layers])", ("roughness",)),
-    "wear": Effect("Archard wear of the rough zones between macro steps ([wear]), and of a counter-face "
-                   "whose material gives k_w", ("roughness", "friction")),
+    "wear": Effect("Archard wear of the rough zones ([wear]; a step's wear held in series with the zone laws, "
+                   "the topographies worn after it), and of a counter-face whose material gives k_w",
+                   ("roughness", "friction")),
     "plasticity": Effect("elastic-perfectly-plastic asperities: micro pressures bounded by the hardness of the "
                          "softer body of each rough interface (materials.<name>.hardness, constant or H(T)); "
                          "yielded zones keep their permanent deformation", ("roughness",)),
