@@ -365,7 +365,9 @@ def test_a_failed_law_loaded_beyond_its_halved_top_is_not_told_to_raise_p_max():
     h.columns["law_reach"][1] = 1.5
     h.columns["near_perfect_zones"][0] = 3
     assert [w[:40] for w in run_warnings(scene, h)] == ["the zone pressures reached 1.5 times mic", warning[:40],
-                                                          f"up to 3 {NEAR_PERFECT}"[:40]]
+                                                          f"up to 3 zones were {NEAR_PERFECT}"[:40]]
+    h.columns["near_perfect_zones"][0] = 1                   # (it said "up to 1 zones were", a user trial)
+    assert run_warnings(scene, h)[-1].startswith(f"up to 1 zone was {NEAR_PERFECT}")
 
 
 def run_pod(folder, overrides: dict, text: str = POD):
@@ -816,7 +818,7 @@ def test_a_nominal_pressure_at_the_hardness_is_refused_before_the_laws(tmp_path,
         run(loads(peaked), verbose=False)                    # (9 x after the run's end: not counted)
 
 
-NEAR_PERFECT = "zones were loaded where their roughness adds less compliance than their laws resolve"
+NEAR_PERFECT = "loaded where the roughness adds less compliance than the zone laws resolve"
 
 
 def test_a_nm_smooth_face_runs_in_nearly_perfect_contact(tmp_path):
@@ -830,8 +832,9 @@ def test_a_nm_smooth_face_runs_in_nearly_perfect_contact(tmp_path):
     assert h["near_perfect_zones"][-1] >= 0.8 * h["zones_in_contact"][-1] > 0
     record = json.loads((tmp_path / "smooth" / "provenance.json").read_text())
     assert [w for w in record["warnings"] if NEAR_PERFECT in w] == [
-        f"up to {h['near_perfect_zones'].max():.0f} {NEAR_PERFECT} (8.0% of a zone's own, micro.laws.resolved_gap): "
-        "there they are in nearly perfect contact, their laws at that floor (a smooth or worn-flat face; the "
+        f"up to {h['near_perfect_zones'].max():.0f} zones were {NEAR_PERFECT} (8.0% of a zone's own, "
+        "micro.laws.resolved_gap): there the zones are in nearly perfect contact, their laws at that floor (a smooth "
+        "or worn-flat face; the "
         "column near_perfect_zones of the history says when)"]
     perfect = POD.replace(', "roughness", "wear"]', ']').replace("partition = 0.14", 'partition = 0.14\npenalty = "1e15 Pa/m"')
     perfect = perfect[:perfect.index("[roughness]")] + perfect[perfect.index("[output]"):]

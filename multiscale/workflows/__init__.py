@@ -205,9 +205,10 @@ def _law_reach(history) -> list[str]:
                    f"stopped growing) were loaded to {halved:.3g} times that top: their laws are extrapolated "
                    "linearly there, with the contact stiffness at the top")
     if floored > 0:
-        out.append(f"up to {floored:.0f} zones were loaded where their roughness adds less compliance than their "
-                   f"laws resolve ({RESOLUTION:.1%} of a zone's own, micro.laws.resolved_gap): there they are in "
-                   "nearly perfect contact, their laws at that floor (a smooth or worn-flat face; the column "
+        zones = "1 zone was" if floored == 1 else f"{floored:.0f} zones were"     # (it said "up to 1 zones")
+        out.append(f"up to {zones} loaded where the roughness adds less compliance than the zone laws resolve "
+                   f"({RESOLUTION:.1%} of a zone's own, micro.laws.resolved_gap): there the zones are in nearly "
+                   "perfect contact, their laws at that floor (a smooth or worn-flat face; the column "
                    "near_perfect_zones of the history says when)")
     return out
 
