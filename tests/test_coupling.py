@@ -186,7 +186,8 @@ def test_laws_that_leave_every_facet_open_are_reached_by_continuation(tmp_path):
     zones, 1 MPa) leave every facet open: the tangent is singular along the load, as worn laws left
     the coarse pin after its second wear update with k_w = 1e-12 /Pa, and the direct solve fails.
     ``solve_on_new_laws`` continues from the old laws' pressures to the exact answer: the block
-    moved rigidly by that shift toward the flat, the flat and the pressures as before."""
+    moved rigidly by that shift toward the flat, the flat and the pressures as before. That path is
+    linear in the continuation parameter, so the steps its secant predictor starts are solved."""
     from multiscale.macro.continuation import solve_on_new_laws
     from multiscale.workflows.multiscale import build
     patch = fractal_surface(16, 2.5e-3, 0.8, 1, 6, 2e-6, seed=5).heights
@@ -205,8 +206,17 @@ def test_laws_that_leave_every_facet_open_are_reached_by_continuation(tmp_path):
         mech.solve()
     for u, x in zip(mech.u, before):
         u.x.array[:] = x
+    solves, solve = [], mech.solve                   # (iterations, started from a prediction) of each converged solve
+
+    def logged(guess=None):
+        result = solve(guess=guess)
+        solves.append((result.iterations, guess is not None))
+        return result
+    mech.solve = logged
     result = solve_on_new_laws(mech, law)        # its iterations: the failed direct solve's and the continuation's
     assert result.converged and result.iterations > failed.value.result.iterations > 0
+    predicted = [its for its, guessed in solves if guessed]     # linear in lambda: the secant predictor is
+    assert predicted and max(predicted) == 0                    # its answer (the continuation's iterations: 24 -> 4)
     moved = (mech.u[0].x.array - before[0]).reshape(-1, 3)
     np.testing.assert_allclose(moved, np.tile([0.0, 0.0, -shift], (len(moved), 1)), rtol=0, atol=1e-9 * shift)
     np.testing.assert_allclose(mech.u[1].x.array, before[1], rtol=0, atol=1e-9 * shift)
@@ -217,7 +227,7 @@ def test_laws_that_leave_every_facet_open_are_reached_by_continuation(tmp_path):
                                                r"flattening: .*; released: solved at the last load, kept for the next "
                                                r"engagement\) failed: contact Newton did not converge at load "
                                                r"-1e\+06 Pa .*; continued from the pressures of the laws before, it "
-                                               r"stopped at 0 of the way \(its last step 0.5\): .*; smaller wear steps"):
+                                               r"stopped at 0 of the way \(its last step 0.0625\): .*; smaller wear steps"):
         solve_on_new_laws(mech, law, released=True)   # (as a wear update while released says)
     for u, x in zip(mech.u, before):
         u.x.array[:] = x
