@@ -23,7 +23,7 @@ from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, L
 
 # Plausible ranges (SI) are documented per key (``multiscale check --keys``); a value outside its
 # range is warned, not refused: foams, diamond, cryogenic tests exist, but 1e9 N on a pin is a typo.
-_MODULUS = Quantity("pressure", gt=0, plausible=(1e5, 1.2e12))           # rubber to diamond
+MODULUS = Quantity("pressure", gt=0, plausible=(1e5, 1.2e12))           # rubber to diamond
 _POISSON = Quantity("dimensionless", gt=-1, lt=0.5, plausible=(0.0, 0.5))
 _CONDUCTIVITY = Quantity("conductivity", gt=0, plausible=(0.01, 2500.0))  # foam to diamond
 HOTTEST = 2500.0     # K, the top of the plausible temperatures (molten iron), of inputs and results
@@ -33,7 +33,7 @@ _SPECIFIC_HEAT = Quantity("specific_heat", gt=0, plausible=(50.0, 5e3))
 _DIFFUSIVITY = Quantity("diffusivity", gt=0, plausible=(1e-8, 1.2e-3))
 _EXPANSION = Quantity("expansion", plausible=(-1e-5, 5e-4))
 _FRICTION = Quantity("dimensionless", ge=0, plausible=(0.0, 2.0))
-_ROUGHNESS = Quantity("length", gt=0, plausible=(1e-10, 1e-3))            # RMS height
+ROUGHNESS = Quantity("length", gt=0, plausible=(1e-10, 1e-3))            # RMS height
 _CONVECTION = Quantity("conductance", ge=0, plausible=(0.0, 1e4))         # still air to boiling water
 _ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0))  # up to ~24 000 rpm
 _WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # per frictional work (Eq. 3.10)
@@ -85,7 +85,7 @@ class Material:
     rate (effect "wear"). The squeal analysis reads the material damping: a structural loss factor eta
     (complex stiffness E (1 + i eta)) and Rayleigh alpha M + beta K (this material's mass, stiffness)."""
 
-    E: float | tuple = key(_property(_MODULUS, "E"), required=True)                          # Pa
+    E: float | tuple = key(_property(MODULUS, "E"), required=True)                          # Pa
     nu: float | tuple = key(_property(_POISSON, "nu"), required=True)
     rho: float | tuple | None = key(_property(_DENSITY, "rho"), needed_by=("stability",))  # kg/m^3
     kappa: float | tuple | None = key(_property(_CONDUCTIVITY, "kappa"), needed_by=("thermal",))  # W/(m K)
@@ -420,7 +420,7 @@ class Roughness:
     copies ("mirror", "tile": warned) or a surface from its PSD ("equivalent", ``seed``)."""
 
     body: str | None = key(Text(), absent="the stationary body, the only one allowed")
-    rms: float | None = key(_ROUGHNESS, absent="file gives the surface")                     # m
+    rms: float | None = key(ROUGHNESS, absent="file gives the surface")                     # m
     hurst: float | None = key(Quantity("dimensionless", gt=0, le=1, plausible=(0.1, 1.0)), absent=_WITH_RMS)
     k_min: tuple | None = key(Pair(Quantity("dimensionless", gt=0)), absent=_WITH_RMS)   # wavelengths, (x, y)
     k_max: tuple | None = key(Pair(Quantity("dimensionless", gt=0)), absent=_WITH_RMS)
@@ -585,7 +585,7 @@ class Layer:
     """One layer of [[layers.layer]] (top first): thickness, elastic constants, conductivity (conductance)."""
 
     thickness: float = key(Quantity("length", gt=0, plausible=(1e-9, 0.1)), required=True)  # m
-    E: float = key(_MODULUS, required=True)                                   # Pa
+    E: float = key(MODULUS, required=True)                                   # Pa
     nu: float = key(_POISSON, required=True)
     kappa: float | None = key(_CONDUCTIVITY, needed_by=("conductance",))      # W/(m K)
 

@@ -491,6 +491,9 @@ BAD = [   # (what, replacement applied to HERTZ, the message expected on stderr)
     ("unknown parameter", ("grid = [12", "gird = [12"),
      'sweep.gird: unknown parameter of problem "hertz" (did you mean "grid"?)'),
     ("empty sweep", ("grid = [12, 16, 24, 32]", "grid = []"), "sweep.grid = []: empty sweep: give at least one value"),
+    ("integer range of repeated values", ("grid = [12, 16, 24, 32]", "grid = {start = 12, stop = 13, num = 4}"),
+     "sweep.grid = {start = 12, stop = 13, num = 4}: its 4 values round to 2 different integers (12, 13): an "
+     "integer takes fewer values, or a wider range"),      # (ran 12 and 13, silently: a user trial)
     ("reference not in the sweep", ('kind = "analytic"', 'kind = "run"\nrun = {grid = 64}'),
      "reference.run = {grid = 64}: not in the sweep (swept grid: 12, 16, 24, 32)"),
     ("reference of an unswept parameter", ('kind = "analytic"', 'kind = "run"\nrun = {load = "1 N"}'),
@@ -516,6 +519,8 @@ BAD = [   # (what, replacement applied to HERTZ, the message expected on stderr)
     ("wrong unit", ('load = "10 N"', 'load = "10 mm"'),
      'fixed.load = "10 mm": expected a force (N, kN); the unit "mm" is a length'),
     ("no sweep", ("[sweep]\ngrid = [12, 16, 24, 32]", ""), "sweep: missing; required"),
+    ("misspelt sweep and metric", ("[sweep]", "[sweeps]", '"approach"]', '"aproach"]'),     # (the metric came a
+     'report\nerror: metrics item 3 ("aproach"): unknown metric of problem "hertz"'),     # pass later: a user trial)
 ]
 
 
@@ -649,16 +654,19 @@ loading.pressure = ["3 MPa"]
 plots = false
 """)
     assert main(["study", str(path)]) == 1
-    assert 'warning: study: metric "interface_forc:last" not produced (did you mean "interface_force:last"?)' \
+    assert 'warning: study: metric "interface_forc:last" (did you mean "interface_force:last"?) not produced' \
         in capsys.readouterr().err                    # when its first run ends, not in the report after the last
     out = tmp_path / "results" / "study"
     for record in (out / "runs").glob("*.json"):      # strict JSON: its history's NaN columns are null
         assert json.loads(record.read_text(), parse_constant=lambda c: pytest.fail(f"{c} in {record.name}"))["ran"]
     row = table(out / "results.csv")[0]
     assert row["status"] == "failed"
-    assert ('metric "interface_forc:last" not produced (did you mean "interface_force:last"?) (fix the name: the '
+    assert ('metric "interface_forc:last" (did you mean "interface_force:last"?) not produced (fix the name: the '
             'runs need not run again)' in row["message"])
     assert "in all: the run's record lists them)" in row["message"] and len(row["message"]) < 800    # not ~180 names
+    assert main(["study", str(path)]) == 1             # recorded: the reason is said again (it was "1 failed" alone)
+    assert ('\n  1 failed: metric "interface_forc:last" (did you mean "interface_force:last"?) not produced (fix '
+            "the name: the runs need not run again)\n") in capsys.readouterr().out
     path.write_text(path.read_text().replace("interface_forc:", "interface_force:"))
     capsys.readouterr()
     assert main(["study", str(path)]) == 0
@@ -668,6 +676,44 @@ plots = false
     assert float(row["interface_force:last"]) == pytest.approx(3e6 * 10e-3 * 6e-3, rel=1e-6)
     assert float(row["max_pressure:max"]) == pytest.approx(3e6, rel=1e-3)
     assert (out / "runs" / row["run"] / "output" / "history.h5").is_file()
+
+
+def test_every_misspelt_metric_is_named_at_once():
+    """Two misspelt metrics of a run: the message named the first only (a user trial met the
+    second after correcting the first)."""
+    from multiscale.studies.records import metric_problem
+    why = metric_problem({"interface_force:last": 1.0, "time:last": 2.0},
+                         ["max_temperature_block:last", "time:last", "interface_forc:last"])
+    assert why.startswith('metrics "max_temperature_block:last", "interface_forc:last" (did you mean '
+                          '"interface_force:last"?) not produced (fix the name: the runs need not run again)')
+
+
+def test_the_inputs_warnings_are_said_once_with_their_runs(tmp_path, capsys):
+    """Values outside their plausible range warn in a study as in a scene: on the console before
+    the runs and in the report, each once with the runs it concerns (before: a scene study at 1 Pa
+    said "0 failed" and its warnings stayed in each run's log; a micro study took "approach = 5" as
+    5 m without a word: a user trial)."""
+    swept = load_study(write(tmp_path, HERTZ.replace("grid = [12, 16, 24, 32]", 'E = ["1 Pa", "2 Pa", "4 GPa"]')
+                             .replace("[fixed]", "[fixed]\ngrid = 12")))
+    assert swept.warnings == ('E = "1 Pa": 1 Pa is outside the plausible range 100000 to 1.2e+12 Pa: check the value '
+                              'and its unit (run E = 1 Pa)', 'E = "2 Pa": 2 Pa is outside the plausible range 100000 '
+                              'to 1.2e+12 Pa: check the value and its unit (run E = 2 Pa)')
+    path = write(tmp_path, HERTZ.replace("grid = [12, 16, 24, 32]", "grid = [12, 16]")
+                 .replace('radius = "10 mm"', 'radius = "10 mm"\nE = 1').replace("processes = 2", "processes = 1"))
+    assert main(["study", str(path)]) == 0
+    line = "E = 1: 1 Pa is outside the plausible range 100000 to 1.2e+12 Pa: check the value and its unit (every run)"
+    assert f"warning: hertz: {line}" in capsys.readouterr().err
+    assert f"- {line}" in (tmp_path / "results" / "hertz" / "hertz.md").read_text()
+
+
+def test_the_study_package_leaves_its_worker_to_runpy():
+    """Importing the package imported ``multiscale.studies.worker``, which each run then executes
+    as ``python -m``: every run log began with runpy's RuntimeWarning (a user trial)."""
+    import subprocess
+    import sys
+    done = subprocess.run([sys.executable, "-c", "import sys, multiscale.studies; "
+                           "print('multiscale.studies.worker' in sys.modules)"], capture_output=True, text=True)
+    assert done.stdout.strip() == "False", done.stderr
 
 
 def test_records_are_strict_json_and_read_non_finite_numbers_back_as_nan(tmp_path):

@@ -1,7 +1,9 @@
 """``multiscale study``: several studies end to end (load all, run, tables, reports, index)."""
 from __future__ import annotations
 
+import collections
 import dataclasses
+import sys
 from pathlib import Path
 
 from multiscale.errors import SceneError
@@ -33,6 +35,9 @@ def run_studies(paths, *, rerun_failed: bool = False, report_folder=None, proces
     if processes is not None:
         studies = [dataclasses.replace(s, options=dataclasses.replace(s.options, processes=processes)) for s in studies]
     rank = comm.rank if comm is not None else 0
+    for study in studies if rank == 0 else ():
+        for line in study.warnings:
+            print(f"warning: {study.name}: {line}", file=sys.stderr)
     failed, summaries = 0, []
     for study in studies:
         stats = execute(study, rerun_failed=rerun_failed, progress=progress, comm=comm)
@@ -50,6 +55,9 @@ def run_studies(paths, *, rerun_failed: bool = False, report_folder=None, proces
                   f"\n{study.name}: {other} other record{'s' if other > 1 else ''} in {study.folder / 'runs'} (runs "
                   "not in this study: its file changed since they ran, or another study shares the folder): kept, "
                   "not in the tables" if other else ""))
+        reasons = collections.Counter(r.record.get("error", "").split("; available:")[0] for r in rows if not r.ok)
+        for why, n in reasons.most_common():          # (before: "2 failed" alone once the runs were recorded)
+            print(f"  {n} failed: {why}")
     if rank == 0 and report_folder is not None:
         index = write_index(summaries, Path(report_folder).resolve(), command)
         print(f"index {index}")

@@ -52,6 +52,7 @@ class Study:
     report: ReportOptions
     folder: Path
     report_folder: Path
+    warnings: tuple = ()              # the runs' inputs' warnings (implausible values, ...), one line each
 
     def _with_partners(self, names) -> tuple:
         return tuple(k for axis in self.axes if any(n in axis for n in names) for k in axis)
@@ -84,18 +85,19 @@ def load_study(path) -> Study:
     if f.problem in PROBLEMS and scene_problem != ("scene" in raw):
         ctx.problems.append("scene: missing; problem \"scene\" needs the base scene file" if scene_problem else
                             f"scene: only used with problem = \"scene\" (problem is \"{f.problem}\")")
-    if f.problem not in PROBLEMS or scene_problem and f.scene is None or f.sweep is None:
-        raise SceneError(ctx.problems)        # nothing to check the rest against; else every problem at once
-    problem = PROBLEMS[f.problem]
-    for i, name in enumerate(f.metrics or (), 1):
-        why = problem.check_metric(name, f.scene, dict(f.fixed))
+    known = f.problem in PROBLEMS and not (scene_problem and f.scene is None)
+    for i, name in enumerate(f.metrics or () if known else (), 1):     # (before: only once the sweep was right)
+        why = PROBLEMS[f.problem].check_metric(name, f.scene, dict(f.fixed))
         if why:
             ctx.problems.append(f"metrics item {i} ({show(name)}): {why}")
+    if not known or f.sweep is None:
+        raise SceneError(ctx.problems)        # nothing to check the rest against; else every problem at once
+    problem = PROBLEMS[f.problem]
     before = len(ctx.problems)
     knobs, values, lines, axes = _expand_groups(f, problem, ctx)
     name = f.name or path.stem
     extra = {"scene": f.scene, "ranks": f.run.ranks} if scene_problem else {}
-    runs = _runs(f, problem, knobs, values, extra, ctx) if len(ctx.problems) == before else ()
+    runs, warned = _runs(f, problem, knobs, values, extra, ctx) if len(ctx.problems) == before else ((), ())
     ref = f.reference      # checked against the runs when the schema found it whole
     if runs and f.metrics and ref is not None and ref.kind is not None and not ref.problems("reference", ctx):
         _check_reference(f, problem, knobs, axes, runs, ctx)
@@ -110,7 +112,7 @@ def load_study(path) -> Study:
     return Study(name=name, description=f.description, source=path.resolve(), problem=f.problem, scene=f.scene,
                  metrics=f.metrics, knobs=knobs, axes=axes, fixed=dict(f.fixed), sweep_text=tuple(lines), runs=runs,
                  reference=f.reference, options=f.run, report=f.report, folder=folder,
-                 report_folder=f.report.folder or folder)
+                 report_folder=f.report.folder or folder, warnings=warned)
 
 
 def parser_of(problem, name):
@@ -275,7 +277,12 @@ def _range(spec: dict, where, parser, ctx) -> list | None:
     if (parser is not None and isinstance(parser.parser, Integer)) or parser is None and all(
             isinstance(spec[k], int) and not isinstance(spec[k], bool) for k in ("start", "stop", "step") if k in spec) \
             and all(float(v).is_integer() for v in values):
-        values = list(dict.fromkeys(int(round(v)) for v in values))
+        whole = list(dict.fromkeys(int(round(v)) for v in values))
+        if len(whole) < len(values):           # {start = 1, stop = 2, num = 4} of a seed ran 1 and 2 (a user trial)
+            ctx.problems.append(f"{text}: its {len(values)} values round to {len(whole)} different integers "
+                                f"({', '.join(map(str, whole))}): an integer takes fewer values, or a wider range")
+            return None
+        values = whole
     elif kelvin:
         values = [f"{v:.12g} K" for v in values]
     elif isinstance(spec["start"], str):       # in the start's unit, shown so ("104.7 rpm", not 10.47)
@@ -325,9 +332,11 @@ def normalise(value, parser=None):
     return list(v) if isinstance(v, tuple) else v
 
 
-def _runs(f, problem, knobs, groups, extra, ctx) -> tuple:
-    """The runs of the product of the groups, each parsed by the problem and named by its hash."""
-    runs, seen = [], {}
+def _runs(f, problem, knobs, groups, extra, ctx) -> tuple[tuple, tuple]:
+    """The runs of the product of the groups, each parsed by the problem and named by its hash, and
+    the warnings of their inputs, each once with the runs it concerns (before: only in each run's
+    log, a scene study at 1 Pa reported "0 failed": a user trial)."""
+    runs, seen, warned = [], {}, {}
     for combo in itertools.product(*groups):
         swept = {k: v for part in combo for k, v in part.items()}
         raw = {**dict(f.fixed), **swept}
@@ -338,6 +347,8 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple:
         ctx.problems.extend(f"{line} (run {where})" for line in local.problems)
         if local.problems:
             continue
+        for line in local.warnings:
+            warned.setdefault(line, []).append(where)
         ident = json.dumps({"problem": f.problem, "params": problem.key(params)}, sort_keys=True)
         digest = hashlib.sha256(ident.encode()).hexdigest()[:16]
         if digest in seen:
@@ -345,7 +356,9 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple:
             continue
         seen[digest] = where
         runs.append(StudyRun(digest, label, raw, {k: value_text(swept[k]) for k in knobs}))
-    return tuple(runs)
+    lines = tuple(f"{line} ({'every run' if len(where) == len(runs) > 1 else 'run ' + '; '.join(where[:3])}"
+                  f"{f' and {len(where) - 3} more' if 3 < len(where) < len(runs) else ''})" for line, where in warned.items())
+    return tuple(runs), lines
 
 
 def reference_run(runs, label: dict, want: dict, axes) -> StudyRun | None:

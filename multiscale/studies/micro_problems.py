@@ -32,13 +32,13 @@ from multiscale.micro.wear import simulate_wear
 from multiscale.micro.zones import cut_zones
 from multiscale.references.hertz import sphere_on_flat
 from multiscale.references.love import love_rectangle, love_rectangle_mean
+from multiscale.scene_sections import MODULUS, ROUGHNESS
 from multiscale.schema import Choice, Flag, Integer, Pair, Quantity, key, read
 from multiscale.studies.base import Outcome, Problem, jsonable
 
 __all__ = ["MICRO_PROBLEMS", "MicroProblem", "SurfaceParams", "rough_surface"]
 
 _LENGTH = Quantity("length", gt=0)
-_MODULUS = Quantity("pressure", gt=0)
 _POISSON = Quantity("dimensionless", gt=-1, lt=0.5)
 _POSITIVE = Quantity("dimensionless", gt=0)
 
@@ -89,7 +89,7 @@ class SurfaceParams:
     hurst: float = key(Quantity("dimensionless", gt=0, le=1), default=0.8)
     k_min: tuple = key(Pair(_POSITIVE), default=(2.0, 2.0))
     k_max: tuple = key(Pair(_POSITIVE), default=(10.0, 10.0))
-    rms: float = key(_LENGTH, default=6e-6)                                    # m
+    rms: float = key(ROUGHNESS, default=6e-6)                                    # m
     seed: int = key(Integer(ge=0), default=1)
     source_n: int = key(Integer(ge=8), default=64)
 
@@ -133,7 +133,7 @@ class HertzParams:
     window: float = key(Quantity("dimensionless", gt=2), default=4.0)          # window side / a
     radius: float = key(_LENGTH, default=10e-3)                                # m, sphere radius R
     load: float = key(Quantity("force", gt=0), default=10.0)                   # N
-    E: float = key(_MODULUS, default=210e9)                                    # Pa
+    E: float = key(MODULUS, default=210e9)                                    # Pa
     nu: float = key(_POISSON, default=0.3)
     tol: float = key(Quantity("dimensionless", gt=0, lt=1), default=1e-8)
     max_iter: int = key(Integer(ge=1), default=5000)
@@ -175,10 +175,10 @@ class RoughContactParams(SurfaceParams):
     models of ch. 1 (circular/elliptic Hertz summits, with or without interaction)."""
 
     hurst: float = key(Quantity("dimensionless", gt=0, le=1), default=0.95)   # Table 1.1, set 1
-    rms: float = key(_LENGTH, default=4e-6)
-    E: float = key(_MODULUS, default=4e9)                                     # §1.3: E = 4 GPa
+    rms: float = key(ROUGHNESS, default=4e-6)
+    E: float = key(MODULUS, default=4e9)                                     # §1.3: E = 4 GPa
     nu: float = key(_POISSON, default=0.15)
-    approach: float = key(_LENGTH, default=5e-6)                              # m
+    approach: float = key(ROUGHNESS, default=5e-6)                              # m
     model: str = key(Choice(_MODELS), default="fft-bem")
     route: str = key(Choice(("energy", "kinematic")), default="energy")       # interacting models
     periodic: bool = key(Flag(), default=False)                                # FFT-BEM kernel
@@ -219,9 +219,9 @@ class WearParams(SurfaceParams):
     """Archard wear of a rough patch sliding ``distance`` in ``steps`` equal increments at a
     constant mean pressure (thesis §3.5.1, Table 3.1)."""
 
-    E: float = key(_MODULUS, default=4e9)                                     # solid S1 (worn)
+    E: float = key(MODULUS, default=4e9)                                     # solid S1 (worn)
     nu: float = key(_POISSON, default=0.15)
-    E2: float = key(_MODULUS, default=220e9)                                  # solid S2
+    E2: float = key(MODULUS, default=220e9)                                  # solid S2
     nu2: float = key(_POISSON, default=0.33)
     pressure: float = key(Quantity("pressure", gt=0), default=1e6)            # Pa
     mu: float = key(Quantity("dimensionless", ge=0), default=0.4)
@@ -255,13 +255,13 @@ class ConductanceParams(SurfaceParams):
     base, solid 2 homogeneous (Table 5.1); steady conduction at mean pressure ``pressure``."""
 
     thickness: float = key(_LENGTH, default=1e-3)                             # m, cube height
-    E1: float = key(_MODULUS, default=4e9)
+    E1: float = key(MODULUS, default=4e9)
     kappa1: float = key(Quantity("conductivity", gt=0), default=10.0)
     h: float = key(Quantity("length", ge=0), default=0.0)                     # m, top layer
-    E2: float = key(_MODULUS, default=4e9)
+    E2: float = key(MODULUS, default=4e9)
     kappa2: float = key(Quantity("conductivity", gt=0), default=10.0)
     nu1: float = key(_POISSON, default=0.15)
-    E_s: float = key(_MODULUS, default=220e9)                                 # solid 2 (Table 5.1)
+    E_s: float = key(MODULUS, default=220e9)                                 # solid 2 (Table 5.1)
     nu_s: float = key(_POISSON, default=0.33)
     kappa_s: float = key(Quantity("conductivity", gt=0), default=50.0)
     pressure: float = key(Quantity("pressure", gt=0), default=3e6)            # Pa
@@ -308,18 +308,18 @@ class HeatPartitionParams(SurfaceParams):
     ``ramp_time`` (Eq. 6.6; default constant), or the steady state (§6.5) at ``omega``."""
 
     hurst: float = key(Quantity("dimensionless", gt=0, le=1), default=0.59)   # §6.4.1
-    rms: float = key(_LENGTH, default=6.49e-6)
+    rms: float = key(ROUGHNESS, default=6.49e-6)
     n: int = key(Integer(ge=8), default=75)
-    E: float = key(_MODULUS, default=4e9)                                     # S2 (Table 6.3)
+    E: float = key(MODULUS, default=4e9)                                     # S2 (Table 6.3)
     nu: float = key(_POISSON, default=0.15)
-    E1: float = key(_MODULUS, default=220e9)                                  # S1
+    E1: float = key(MODULUS, default=220e9)                                  # S1
     nu1: float = key(_POISSON, default=0.33)
     kappa1: float = key(Quantity("conductivity", gt=0), default=50.0)
     chi1: float = key(Quantity("diffusivity", gt=0), default=1e-5)
     kappa2: float = key(Quantity("conductivity", gt=0), default=5.0)
     chi2: float = key(Quantity("diffusivity", gt=0), default=3.5e-6)
     radius: float = key(_LENGTH, default=0.1)                                 # m, patch centre from the axis
-    approach: float = key(_LENGTH, default=10e-6)                             # m
+    approach: float = key(ROUGHNESS, default=10e-6)                             # m
     pressure: float | None = key(Quantity("pressure", gt=0))                  # Pa: load control instead
     mu: float = key(Quantity("dimensionless", gt=0), default=0.4)
     omega: float = key(Quantity("angular_speed", gt=0), default=100.0)        # rad/s
@@ -377,12 +377,12 @@ class ZoneLawParams(SurfaceParams):
     at ``approach``; reference: FFT-BEM of the whole surface on ``reference_n`` (default n)."""
 
     hurst: float = key(Quantity("dimensionless", gt=0, le=1), default=0.95)   # §1.5, set 1
-    rms: float = key(_LENGTH, default=4e-6)
+    rms: float = key(ROUGHNESS, default=4e-6)
     n: int = key(Integer(ge=8), default=150)
-    E: float = key(_MODULUS, default=4e9)
+    E: float = key(MODULUS, default=4e9)
     nu: float = key(_POISSON, default=0.15)
     zones: tuple = key(Pair(Integer(ge=1), names="[nx, ny]"), default=(5, 5))
-    approach: float = key(_LENGTH, default=6e-6)                              # m, from the first touch
+    approach: float = key(ROUGHNESS, default=6e-6)                              # m, from the first touch
     p_max: float = key(Quantity("pressure", gt=0), default=50e6)              # Pa, top law node
     law_points: int = key(Integer(ge=4), default=20)
     love: str = key(Choice(("average", "centre")), default="average")

@@ -15,10 +15,11 @@ import numpy as np
 from multiscale.schema import FrozenMap, suggest
 from multiscale.studies.expand import Study, StudyRun
 
-__all__ = ["FAILED", "NUMBERS", "foreign_records", "json_default", "metric_problem", "read_json", "read_records",
-           "record_path", "write_json"]
+__all__ = ["FAILED", "JIT_SHARE", "NUMBERS", "foreign_records", "json_default", "metric_problem", "read_json",
+           "read_records", "record_path", "write_json"]
 
 FAILED = "failed"              # a record's status when the run did not produce its metrics
+JIT_SHARE = 0.05               # a first timing with more than this share in numba's compiler is timed again
 MAX_LISTED = 12                # metrics named in the message of a run that lacks one
 NUMBERS = ("wall_time", "cpu_time", "peak_memory_mb", "base_memory_mb", "jit_time", "iterations", "repeat")
 
@@ -29,15 +30,18 @@ def record_path(study: Study, run: StudyRun) -> Path:
 
 
 def metric_problem(metrics: dict, names) -> str | None:
-    """Why a run's ``metrics`` (name -> value) do not give the study's metric ``names``; None if they do."""
+    """Why a run's ``metrics`` (name -> value) do not give the study's metric ``names``; None if they do.
+    Names every metric missing (before: the first; a user trial's second misspelt one came a run later)."""
+    missing = {name: suggest(name, metrics) for name in names if name not in metrics}    # misspelt: fix them,
+    if missing:                                                                          # records are judged on read
+        available = sorted(metrics)           # a scene's history: ~180 names, in every failed run's line
+        shown = ", ".join(available[:MAX_LISTED]) + (f", ... ({len(available)} in all: the run's record lists them)"
+                                                     if len(available) > MAX_LISTED else "")
+        listed = ", ".join('"' + name + '"' + hint for name, hint in missing.items())
+        return (f"metric{'s' if len(missing) > 1 else ''} {listed} not produced"
+                + (" (fix the name: the runs need not run again)" if any(missing.values())
+                   else " (a run older than the metric: --rerun-failed recomputes it)") + f"; available: {shown}")
     for name in names:
-        if name not in metrics:
-            hint = suggest(name, metrics)     # a misspelt name: fix it, the records are judged on read
-            names = sorted(metrics)           # a scene's history: ~180 names, in every failed run's line
-            shown = ", ".join(names[:MAX_LISTED]) + (f", ... ({len(names)} in all: the run's record lists them)"
-                                                    if len(names) > MAX_LISTED else "")
-            return (f'metric "{name}" not produced' + (hint + " (fix the name: the runs need not run again)" if hint
-                    else " (a run older than the metric: --rerun-failed recomputes it)") + f"; available: {shown}")
         value = metrics[name]
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             return f'metric "{name}" is {value!r} (not a number)'

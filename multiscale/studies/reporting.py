@@ -11,8 +11,8 @@ import numpy as np
 from multiscale.studies.expand import Study
 from multiscale.studies.formatting import metric_heading, now, number_text, percent, value_text
 from multiscale.studies.problems import PROBLEMS
+from multiscale.studies.records import JIT_SHARE
 from multiscale.studies.results import Row, cheapest, reference_text, sample_std
-from multiscale.studies.worker import JIT_SHARE
 
 __all__ = ["report", "write_index"]
 
@@ -46,6 +46,8 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
               _code_line(rows),
               f"- Generated {now()} on a {os.cpu_count()}-core machine by `{command or 'multiscale study ' + study.source.name}`.",
               ""]
+    if study.warnings:
+        lines += ["Warnings of the runs' inputs:", ""] + [f"- {line}" for line in study.warnings] + [""]
     if study.reference is not None and ok:
         lines += _cheapest_table(study, rows)
     if study.averaged and ok:

@@ -107,6 +107,7 @@ class SceneProblem(Problem):
         except SceneError as exc:
             ctx.problems.extend(f"{path}: {line}" if path else line for line in exc.problems)
             return None
+        ctx.warnings.extend(loaded.warnings)
         own = Path(scene).resolve()
         return SceneRun(Path(scene), dict(raw), ranks, tuple(sorted(p for p in loaded.inputs if p != own)))
 

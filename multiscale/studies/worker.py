@@ -30,11 +30,9 @@ from multiscale.provenance import code
 from multiscale.schema import Context
 from multiscale.studies.formatting import now
 from multiscale.studies.problems import problem as get_problem
-from multiscale.studies.records import FAILED, metric_problem, read_json, write_json
+from multiscale.studies.records import FAILED, JIT_SHARE, metric_problem, read_json, write_json
 
-__all__ = ["JIT_SHARE", "run_task", "watch_driver"]
-
-JIT_SHARE = 0.05      # a first timing with more than this share in numba's compiler is timed again
+__all__ = ["run_task", "watch_driver"]
 
 
 def _peak_mb() -> float:
