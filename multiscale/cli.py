@@ -341,7 +341,7 @@ def _surface(args) -> int:
     stats = surface_statistics(done.surface)
     print("\n".join(done.report))
     print(f"statistics of the {'roughness' if done.waviness is not None else 'surface'}:")
-    print("\n".join(stats.table()))
+    print("\n".join(stats.table(filtered=done.waviness is not None)))
     if figure is None:        # a figure only where asked: nothing lands in the working folder
         if args.figure is None:
             print("figure: none written (--figure PATH.png draws the height map and the PSD with its fit)")

@@ -91,7 +91,9 @@ def test_a_fit_outside_the_self_affine_range_is_said_to_be_one():
     steep = dataclasses.replace(stats, power_law=dataclasses.replace(stats.power_law, hurst=1.107))
     assert next(r for r in steep.table() if "Hurst" in r).endswith(
         "; above 1, steeper than a self-affine surface's (a scene's hurst is at most 1): a form or waviness the "
-        "detrending left, e.g. (--cutoff takes it out)")
+        "detrending left (--cutoff takes it out)")
+    assert next(r for r in steep.table(filtered=True) if "Hurst" in r).endswith(     # given --cutoff "20 um",
+        "a waviness the filter left (a shorter --cutoff takes it out)")               # it advised --cutoff (a trial)
 
 
 def test_a_fit_that_misses_the_psd_says_h_is_only_a_slope():

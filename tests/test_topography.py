@@ -350,6 +350,8 @@ def test_a_truncated_file_gets_its_readers_diagnosis_and_no_log_of_its_bytes(tmp
     (tmp_path / "pad.plu").mkdir()
     with pytest.raises(InputError, match=r"'pad\.plu': a folder, not a file"):
         read_topography(tmp_path / "pad.plu")
+    with pytest.raises(InputError, match=r"= '\.': a folder, not a file"):      # its name was '' (a user trial)
+        read_topography(".")
     if SHARED is not None:
         (tmp_path / "cut.opd").write_bytes((SHARED / "opd-1.opd").read_bytes()[:3000])
         with caplog.at_level(logging.DEBUG), pytest.raises(InputError, match="as Wyko OPD, CorruptFile"):

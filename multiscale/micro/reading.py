@@ -187,7 +187,8 @@ def read_topography(path, channel: int | None = None, *, pixel_size=None, height
     except OSError as exc:                        # a name part over 255 bytes
         raise InputError(option(prefix, "file"), path.name[:60], f"cannot be used as a path ({exc.strerror})") from None
     if not found:
-        raise InputError(option(prefix, "file"), path.name, f"{'a folder, not a file' if folder else 'no such file'} "
+        raise InputError(option(prefix, "file"), path.name or str(path),    # (Path(".").name is '')
+                         f"{'a folder, not a file' if folder else 'no such file'} "
                          f"({path})")
     stat = path.stat()
     if stat.st_size == 0:     # some readers take it for a 0 x 0 map, then ask for its pixel size

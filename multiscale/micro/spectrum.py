@@ -433,8 +433,9 @@ class Statistics:
     spectrum: Spectrum
     power_law: PowerLaw | None       # None if the spectrum has too few bins to fit
 
-    def table(self) -> list[str]:
-        """The statistics as aligned text lines (``multiscale surface``)."""
+    def table(self, filtered: bool = False) -> list[str]:
+        """The statistics as aligned text lines (``multiscale surface``; ``filtered``: of a roughness
+        its ``--cutoff`` separated, whose advice is then a shorter cut-off)."""
         rows = [("Sq   RMS height", _length(self.Sq)), ("Sdq  RMS gradient", f"{self.Sdq:.4g}"),
                 ("Ssk  skewness", f"{self.Ssk:.4g}"), ("Sku  kurtosis", f"{self.Sku:.4g}"),
                 ("Nayak parameter m0 m4/m2^2", f"{self.nayak:.4g}"),
@@ -454,7 +455,8 @@ class Statistics:
                           "; the PSD is no power law there (misfit over a factor e, or under "
                           f"{FEW_BINS} bins): H is only its mean slope" if poor else
                           "; above 1, steeper than a self-affine surface's (a scene's hurst is at most 1): "
-                          "a form or waviness the detrending left, e.g. (--cutoff takes it out)" if fit.hurst > 1 else
+                          + ("a waviness the filter left (a shorter --cutoff takes it out)" if filtered else
+                             "a form or waviness the detrending left (--cutoff takes it out)") if fit.hurst > 1 else
                           "")),
                      ("long cut-off  2pi/q_r", _length(lr, 2) + ("  (to a PSD bin)" if rr else
                                                               "  (not resolved: >= this)")),
