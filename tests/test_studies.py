@@ -664,6 +664,7 @@ plots = false
     assert ('metric "interface_forc:last" (did you mean "interface_force:last"?) not produced (fix the name: the '
             'runs need not run again)' in row["message"])
     assert "in all: the run's record lists them)" in row["message"] and len(row["message"]) < 800    # not ~180 names
+    assert "best of" not in (out / "study.md").read_text()       # no run completed ("best of 0 repetition(s)")
     assert main(["study", str(path)]) == 1             # recorded: the reason is said again (it was "1 failed" alone)
     assert ('\n  1 failed: metric "interface_forc:last" (did you mean "interface_force:last"?) not produced (fix '
             "the name: the runs need not run again)\n") in capsys.readouterr().out
@@ -704,6 +705,20 @@ def test_the_inputs_warnings_are_said_once_with_their_runs(tmp_path, capsys):
     line = "E = 1: 1 Pa is outside the plausible range 100000 to 1.2e+12 Pa: check the value and its unit (every run)"
     assert f"warning: hertz: {line}" in capsys.readouterr().err
     assert f"- {line}" in (tmp_path / "results" / "hertz" / "hertz.md").read_text()
+
+
+def test_a_problem_of_every_run_is_said_once(tmp_path):
+    """A fixed value wrong with every swept one was said once per run (12 identical lines: a user trial)."""
+    with pytest.raises(SceneError) as info:
+        load_study(write(tmp_path, 'problem = "rough_contact"\nmetrics = ["mean_pressure"]\n[fixed]\nk_max = 40\n'
+                                   "[sweep]\nn = [128, 256, 512]\nseed = [1, 2]\n"))
+    assert info.value.problems == ["source_n = 64: must exceed 2 k_max = 80 (the surface must be resolved) (every run)"]
+    with pytest.raises(SceneError) as info:
+        load_study(write(tmp_path, 'problem = "rough_contact"\nmetrics = ["mean_pressure"]\n[fixed]\nk_max = 40\n'
+                                   "source_n = 128\n[sweep]\nn = [64, 72, 80, 128, 256]\n"))
+    assert info.value.problems == ["n = 64: must exceed 2 k_max = 80 (the surface must be resolved) (run n = 64)",
+                                   "n = 72: must exceed 2 k_max = 80 (the surface must be resolved) (run n = 72)",
+                                   "n = 80: must exceed 2 k_max = 80 (the surface must be resolved) (run n = 80)"]
 
 
 def test_the_study_package_leaves_its_worker_to_runpy():

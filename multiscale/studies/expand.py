@@ -334,21 +334,22 @@ def normalise(value, parser=None):
 
 def _runs(f, problem, knobs, groups, extra, ctx) -> tuple[tuple, tuple]:
     """The runs of the product of the groups, each parsed by the problem and named by its hash, and
-    the warnings of their inputs, each once with the runs it concerns (before: only in each run's
-    log, a scene study at 1 Pa reported "0 failed": a user trial)."""
-    runs, seen, warned = [], {}, {}
-    for combo in itertools.product(*groups):
+    the warnings of their inputs; the problems and warnings each once with the runs they concern
+    (before: the warnings only in each run's log, a scene study at 1 Pa reported "0 failed"; a
+    problem of the fixed values once per run, 12 times: a user trial)."""
+    runs, seen, wrong, warned, count = [], {}, {}, {}, 0
+    for count, combo in enumerate(itertools.product(*groups), 1):
         swept = {k: v for part in combo for k, v in part.items()}
         raw = {**dict(f.fixed), **swept}
         label = {k: normalise(swept[k], parser_of(problem, k)) for k in knobs}
         local = Context(directory=ctx.directory)
         params = problem.parse(raw, "", local, **extra)
         where = ", ".join(f"{k} = {value_text(swept[k])}" for k in knobs)
-        ctx.problems.extend(f"{line} (run {where})" for line in local.problems)
+        for lines, into in ((local.problems, wrong), (local.warnings, warned)):
+            for line in lines:
+                into.setdefault(line, []).append(where)
         if local.problems:
             continue
-        for line in local.warnings:
-            warned.setdefault(line, []).append(where)
         ident = json.dumps({"problem": f.problem, "params": problem.key(params)}, sort_keys=True)
         digest = hashlib.sha256(ident.encode()).hexdigest()[:16]
         if digest in seen:
@@ -356,9 +357,16 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple[tuple, tuple]:
             continue
         seen[digest] = where
         runs.append(StudyRun(digest, label, raw, {k: value_text(swept[k]) for k in knobs}))
-    lines = tuple(f"{line} ({'every run' if len(where) == len(runs) > 1 else 'run ' + '; '.join(where[:3])}"
-                  f"{f' and {len(where) - 3} more' if 3 < len(where) < len(runs) else ''})" for line, where in warned.items())
-    return tuple(runs), lines
+    ctx.problems.extend(_with_runs(wrong, count))
+    return tuple(runs), tuple(_with_runs(warned, count))
+
+
+def _with_runs(lines: dict, total: int) -> list[str]:
+    """Each of ``lines`` (line -> the runs it concerns, of ``total``) once, naming its runs: every
+    run, or up to three."""
+    return [f"{line} (" + ("every run" if len(where) == total > 1 else "run " + "; ".join(where[:3])
+                           + (f" and {len(where) - 3} more" if len(where) > 3 else "")) + ")"
+            for line, where in lines.items()]
 
 
 def reference_run(runs, label: dict, want: dict, axes) -> StudyRun | None:

@@ -26,6 +26,10 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
     problem = PROBLEMS[study.problem]
     ok = [r for r in rows if r.ok]
     failed = [r for r in rows if not r.ok]
+    timing = (f" Wall time: best of {_repeats(ok)} repetition(s) in a fresh process ({_processes(study)}; a run "
+              f"whose first timing spent over {JIT_SHARE:.0%} of it loading or compiling numba code is timed once "
+              "more); peak memory: the largest process's maximum resident set (interpreter and libraries included; "
+              "in brackets what the run added to the process's baseline).") if ok else ""   # ("best of 0 ...")
     lines = [f"# {study.report.title or study.name}", ""]
     if study.description:
         lines += [study.description, ""]
@@ -38,11 +42,7 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
               f"- Reference: {reference_text(study)}"
               + ("; error = |m − m_ref| / |m_ref|" if study.reference else ""),
               f"- Runs: {len(ok)} ok, {len(failed)} failed; {sum(r.record.get('wall_time', 0) for r in rows):.1f} s "
-              f"of run wall time in all (failed runs included). Wall time: best of {_repeats(ok)} "
-              f"repetition(s) in a fresh process ({_processes(study)}; a run whose first timing spent over "
-              f"{JIT_SHARE:.0%} of it loading or compiling numba code is timed once more); peak memory: the largest "
-              "process's maximum resident set (interpreter and libraries included; in brackets what the run added "
-              "to the process's baseline).",
+              f"of run wall time in all (failed runs included).{timing}",
               _code_line(rows),
               f"- Generated {now()} on a {os.cpu_count()}-core machine by `{command or 'multiscale study ' + study.source.name}`.",
               ""]
@@ -91,7 +91,7 @@ def _processes(study: Study) -> str:
 def _repeats(rows) -> str:
     """How many times the runs were timed, as their records say (a record timed more often than the
     study asks now is kept: '1-3')."""
-    counts = sorted({int(r.record.get("repeat", 1)) for r in rows}) or [0]
+    counts = sorted({int(r.record.get("repeat", 1)) for r in rows})
     return f"{counts[0]}" if len(counts) == 1 else f"{counts[0]}-{counts[-1]}"
 
 
