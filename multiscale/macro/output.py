@@ -353,13 +353,12 @@ class FieldOutput:
 
     def unloaded(self) -> list:
         """Per body, the displacement [m] written while released (and so the von Mises stress): the
-        bodies under their supports alone, without contact and load. 0 without thermal expansion
-        (exact: no load, zero supports, no body force); with it the thermo-elastic state of
-        ``unloaded.Unloaded`` (one linear solve; a part the supports leave free keeps the rigid
-        motion of the last loaded state), NaN with an ``UnloadedWarning`` if that fails (a
+        bodies under their supports alone, without contact and load: the thermo-elastic state of
+        ``unloaded.Unloaded`` (one linear solve; without thermal expansion no strain and no solve:
+        no load, zero supports, no body force), a part the supports leave free keeping the rigid
+        motion of the last loaded state (without expansion it was set to 0 too: a car brake's pads
+        jumped back in ParaView, a user trial), NaN with an ``UnloadedWarning`` if that fails (a
         mechanism beyond rigid motions). Collective."""
-        if self.mech.temperatures is None:
-            return [0.0] * len(self.mech.u)
         if self._unloaded is None:
             self._unloaded = Unloaded(self.mech)
         out = self._unloaded.solve()
