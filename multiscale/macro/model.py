@@ -301,7 +301,8 @@ class MacroModel:
         """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal
         boundary conditions, ``heat_lost_step_<body>`` is the heat lost since the previous record.
         ``friction_force`` (in all and per interface) sums the friction forces' magnitudes over the
-        facets, mu times the normal force where all slides: opposite pads do not cancel;
+        facets, mu times the normal force where all slides (less by the turn of the sliding direction
+        across a facet of a rotating body: 2.5e-5 on the car brake): opposite pads do not cancel;
         ``friction_moment`` [N m], with a rotating body 1, is the magnitude of their moment about its axis. With several
         interfaces and heat, ``interface_heat_row`` gives each one's heat and face temperatures."""
         on = not self.released
