@@ -676,6 +676,8 @@ plots = false
     assert float(row["loading.pressure"]) == 3e6
     assert float(row["interface_force:last"]) == pytest.approx(3e6 * 10e-3 * 6e-3, rel=1e-6)
     assert float(row["max_pressure:max"]) == pytest.approx(3e6, rel=1e-3)
+    with h5py.File(out / "results.h5") as h5:                   # the swept key's SI unit, from "3 MPa"
+        assert h5["loading.pressure"].attrs["unit"] == "Pa" and h5["interface_force:last"].attrs["unit"] == "N"
     assert (out / "runs" / row["run"] / "output" / "history.h5").is_file()
 
 
@@ -719,6 +721,38 @@ def test_a_problem_of_every_run_is_said_once(tmp_path):
     assert info.value.problems == ["n = 64: must exceed 2 k_max = 80 (the surface must be resolved) (run n = 64)",
                                    "n = 72: must exceed 2 k_max = 80 (the surface must be resolved) (run n = 72)",
                                    "n = 80: must exceed 2 k_max = 80 (the surface must be resolved) (run n = 80)"]
+
+
+def test_the_knobs_columns_carry_their_units(tmp_path):
+    """results.h5 gave the metrics and times a unit, the swept parameters none (a user trial): a
+    micro parameter's unit is its kind's, a scene key's that of the values as written."""
+    from multiscale.studies.results import knob_unit
+    study = load_study(write(tmp_path, HERTZ.replace("grid = [12, 16, 24, 32]", 'grid = [12, 16]\nE = ["1 GPa", 2e9]')))
+    assert (knob_unit(study, "grid"), knob_unit(study, "E")) == ("", "Pa")
+    (tmp_path / "scene.toml").write_text((ROOT / "demos" / "block_on_flat.toml").read_text())
+    scene = load_study(write(tmp_path, 'problem = "scene"\nscene = "scene.toml"\nmetrics = ["max_pressure"]\n[sweep]\n'
+                                       '"loading.pressure" = ["1 MPa", 2e6]\n"time.steps" = [1, 2]\n', "s.toml"))
+    assert (knob_unit(scene, "loading.pressure"), knob_unit(scene, "time.steps")) == ("Pa", "")
+
+
+def test_an_interrupted_study_writes_the_table_of_the_runs_that_ended(tmp_path, capsys, monkeypatch):
+    """Ctrl-C after the first run: results.csv holds it and names the others missing (it was written
+    only at the end, so an interrupted study had none: a user trial)."""
+    import dataclasses
+
+    from multiscale.studies import driver
+    real = driver.execute
+
+    def first_then_interrupted(study, **options):
+        real(dataclasses.replace(study, runs=study.runs[:1]), **options)
+        raise KeyboardInterrupt
+    monkeypatch.setattr(driver, "execute", first_then_interrupted)
+    path = write(tmp_path, HERTZ.replace("processes = 2", "processes = 1"))
+    assert main(["study", str(path)]) == 130
+    assert "hertz: the runs that ended are in " in capsys.readouterr().err
+    rows = table(tmp_path / "results" / "hertz" / "results.csv")
+    assert [r["status"] for r in rows] == ["ok", "missing", "missing", "missing"]
+    assert float(rows[0]["approach"]) > 0 and rows[1]["message"] == "not run"
 
 
 def test_the_study_package_leaves_its_worker_to_runpy():

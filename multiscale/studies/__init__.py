@@ -32,9 +32,11 @@ finished runs are never recomputed (``--rerun-failed`` retries the failed ones, 
 the others go on. A run that completed keeps every metric it produced and is judged by the study's
 metrics when read: a misspelt history metric, corrected, is read from the same run.
 
-Output: ``results.csv`` and ``results.h5`` (one row per run), PNGs of each metric's relative error
+Output: ``results.csv`` and ``results.h5`` (one row per run; in results.h5 a column's SI unit is
+its ``unit`` attribute, a swept parameter's included), PNGs of each metric's relative error
 |m − m_ref| / |m_ref| against wall time (Pareto front highlighted) and against each knob, and a
-Markdown report stating the cheapest setting meeting each stated error.
+Markdown report stating the cheapest setting meeting each stated error. Ctrl-C stops the runs
+under way and writes the tables of those that ended (the others with status ``missing``).
 
 Modules, in import order: ``spec`` (the file schema), ``problems`` (the registry; ``base``,
 ``micro_problems``, ``scene_problem``), ``expand`` (validation, runs), ``records`` (run records on

@@ -40,7 +40,14 @@ def run_studies(paths, *, rerun_failed: bool = False, report_folder=None, proces
             print(f"warning: {study.name}: {line}", file=sys.stderr)
     failed, summaries = 0, []
     for study in studies:
-        stats = execute(study, rerun_failed=rerun_failed, progress=progress, comm=comm)
+        try:
+            stats = execute(study, rerun_failed=rerun_failed, progress=progress, comm=comm)
+        except KeyboardInterrupt:       # Ctrl-C: the table of the runs that ended (it waited for the end before)
+            if rank == 0:
+                csv_path, _ = write_tables(study, collect(study))
+                print(f"{study.name}: the runs that ended are in {csv_path} (the others: status missing)",
+                      file=sys.stderr, flush=True)
+            raise
         if rank != 0:
             continue
         rows = collect(study)

@@ -11,10 +11,12 @@ from pathlib import Path
 import h5py
 import numpy as np
 
+from multiscale.schema import ListOf, Quantity
 from multiscale.studies.expand import Study, StudyRun, normalise, parser_of, reference_run
 from multiscale.studies.formatting import value_text
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.records import read_records
+from multiscale.units import KINDS, VALUE, parse_unit
 
 __all__ = ["Row", "Setting", "case_key", "cheapest", "collect", "pareto", "reference_text", "relative_error",
            "sample_std", "write_tables"]
@@ -151,6 +153,7 @@ def write_tables(study: Study, rows: list[Row]) -> tuple[Path, Path]:
         for i in range(len(rows)):
             w.writerow([_csv(cols[c][i]) for c in cols])
     units = {"wall_time": "s", "cpu_time": "s", "peak_memory_mb": "MB"}    # (said by the report alone; a user trial)
+    units.update((k, knob_unit(study, k)) for k in study.knobs)              # (none before: a user trial)
     for m in study.metrics:
         units[m] = units[f"{m}_reference"] = PROBLEMS[study.problem].metric_unit(m)
     with h5py.File(h5_path, "w") as h5:
@@ -164,6 +167,24 @@ def write_tables(study: Study, rows: list[Row]) -> tuple[Path, Path]:
         h5.attrs.update(study=study.name, problem=study.problem, source=str(study.source),
                         reference=reference_text(study), metrics=list(study.metrics), knobs=list(study.knobs))
     return csv_path, h5_path
+
+
+def knob_unit(study: Study, name: str) -> str:
+    """The SI unit of swept knob ``name``'s column: its kind's for a micro problem's parameter
+    ("-" dimensionless), else that of the unit its values were written in ("3 MPa": Pa); "" if not
+    known (a count, or bare numbers of a scene key)."""
+    spec = parser_of(PROBLEMS[study.problem], name)
+    parser = spec.parser if spec is not None else None
+    while isinstance(parser, ListOf):
+        parser = parser.item
+    if isinstance(parser, Quantity):
+        return parser.kind.si or "-"
+    for run in study.runs:
+        match = VALUE.match(run.raw[name]) if isinstance(run.raw.get(name), str) else None
+        if match and match.group(2):
+            dim = parse_unit(match.group(2))[2]
+            return next((k.si or "-" for k in KINDS.values() if k.dim == dim), "")
+    return ""
 
 
 def _csv(value):
