@@ -36,6 +36,7 @@ from multiscale.micro.surface import Surface, defined_sums, row_blocks
 MAX_UNDEFINED = 0.1       # default largest fraction of undefined points that is filled
 DETREND = {"none": None, "mean": "mean", "plane": "height", "poly2": "curvature"}   # -> SurfaceTopography
 COVER = ("measured", "mirror", "tile", "equivalent")
+TILTED = 0.5             # a map whose Sq a plane would halve (75 % of its variance a tilt) is said to be tilted
 MAX_CELLS = 1024          # cells per zone side taken from a measurement's own pixel size (no micro.grid)
 ALPHA = np.sqrt(np.log(2) / np.pi)     # ISO 16610-21/-61 Gaussian: 50 % transmission at the cut-off
 GRADIENT_KEPT = 0.5       # a micro grid resolving less of the measured RMS gradient is warned about
@@ -239,11 +240,12 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
         report.append(f"form removed: {names[detrend]} (SurfaceTopography detrend \"{DETREND[detrend]}\"): "
                       f"Sq {_um(before)} -> {_um(_defined_std(h))} um")
     undefined, notes = m.undefined, []
+    if detrend in ("none", "mean") and (flat := _defined_std(remove_form(m.heights, "plane"))) < TILTED * before:
+        share = 100 * (1 - (flat / before) ** 2)     # (--detrend none on plu-1 said nothing: a user trial)
+        notes.append(f"a tilt holds {share:.5g} % of the height variance: Sq {_um(before)} um with it, "
+                     f"{_um(flat)} um without ({option(prefix, 'detrend', 'plane')} removes it; the statistics keep it)")
     if despike is None:
-        notes = _outlier_notes(m, detrend, prefix, h)
-        for note in notes:
-            warnings.warn(note, TopographyWarning, stacklevel=2)
-        report += [f"warning: {note}" for note in notes]
+        notes += _outlier_notes(m, detrend, prefix, h)
     elif (found := find_outliers(h, despike)).count:
         h = h.copy() if h is m.heights else h
         h[found.rows, found.cols] = np.nan
@@ -254,6 +256,9 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
             raise InputError(option(prefix, "despike"), despike, f"{undefined} of {m.path.name}'s {h.size} points are "
                              f"undefined or outliers, more than {option(prefix, 'max_undefined')} = "
                              f"{100 * max_undefined:.3g} %")
+    for note in notes:
+        warnings.warn(note, TopographyWarning, stacklevel=2)
+    report += [f"warning: {note}" for note in notes]
     if undefined:
         frame = Surface(np.broadcast_to(0.0, m.shape), m.dx, m.dy, periodic=False)
         t = as_topography(frame, np.ma.masked_invalid(h)).interpolate_undefined_data("harmonic")
