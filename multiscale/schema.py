@@ -336,12 +336,12 @@ class Vector(ListOf):
 class FilePath:
     """A path relative to the scene file: an existing file, or a folder (need not exist) with ``folder``."""
 
-    def __init__(self, *, folder: bool = False):
-        self.folder = folder
+    def __init__(self, *, folder: bool = False, base: str = "the scene file"):
+        self.folder, self.base = folder, base
 
     def describe(self) -> str:
         what = "a folder path" if self.folder else "the path of an existing file"
-        return f"{what} (relative to the scene file)"
+        return f"{what} (relative to {self.base})"
 
     def __call__(self, raw, ctx):
         if not isinstance(raw, str) or not raw or "\x00" in raw:

@@ -755,6 +755,35 @@ def test_an_interrupted_study_writes_the_table_of_the_runs_that_ended(tmp_path, 
     assert float(rows[0]["approach"]) > 0 and rows[1]["message"] == "not run"
 
 
+def test_a_measured_surface_is_a_micro_study_problem(tmp_path, capsys):
+    """measured_contact: an instrument file swept in load (no micro patch from a measured file could
+    be run from a study or the command line: a user trial), the numbers of the Python path the
+    micro-patch tutorial shows to 1e-12, the file's bytes in the runs' keys."""
+    import shutil
+
+    from multiscale.checkpoint import file_digest
+    from multiscale.micro.contact import solve_contact
+    from multiscale.micro.topography import condition, read_topography
+    from multiscale.schema import Context
+    from multiscale.studies.problems import PROBLEMS
+    shutil.copy(ROOT / "tests" / "data" / "top-1.top", tmp_path / "afm.top")
+    path = write(tmp_path, 'problem = "measured_contact"\nmetrics = ["approach", "area_fraction"]\n[fixed]\n'
+                           'file = "afm.top"\n[sweep]\nload = ["1 MPa", "5 MPa"]\n[run]\nprocesses = 1\n'
+                           "[report]\nplots = false\n")
+    problem = PROBLEMS["measured_contact"]
+    for run in load_study(path).runs:                   # a file rewritten under its name: new runs
+        params = problem.parse(run.raw, "", Context(directory=tmp_path))
+        assert problem.key(params)["files"] == {"file": file_digest(tmp_path / "afm.top")}
+    assert main(["study", str(path)]) == 0
+    surface = condition(read_topography(tmp_path / "afm.top"), "plane").surface
+    with h5py.File(tmp_path / "results" / "study" / "results.h5") as h5:      # (results.csv: 10 digits)
+        assert list(h5["load"][()]) == [1e6, 5e6] and h5["approach"].attrs["unit"] == "m"
+        for k, load in enumerate(h5["load"][()]):
+            r = solve_contact(surface, kernel=HalfSpace.from_materials(4e9, 0.15), load=load)
+            assert h5["approach"][k] == pytest.approx(r.approach, rel=1e-12)
+            assert h5["area_fraction"][k] == pytest.approx(r.area_fraction, rel=1e-12) and r.area_fraction > 0
+
+
 def test_the_study_package_leaves_its_worker_to_runpy():
     """Importing the package imported ``multiscale.studies.worker``, which each run then executes
     as ``python -m``: every run log began with runpy's RuntimeWarning (a user trial)."""

@@ -16,24 +16,27 @@ discretisation alone. Physics lives in ``multiscale.micro``; this module only se
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass, replace
+from pathlib import Path
 
 import numpy as np
 
+from multiscale.checkpoint import file_digest
 from multiscale.micro.asperity import AsperityModel
 from multiscale.micro.conduction import ConductionSolver, SeriesKernel
-from multiscale.micro.contact import ContactSolver
+from multiscale.micro.contact import ContactSolver, solve_contact
 from multiscale.micro.heat_kernels import Rotation, SpeedProfile, ThermalMaterial
 from multiscale.micro.heating import SteadyHeating, TransientHeating
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.laws import LawSpec, compute_laws
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
 from multiscale.micro.surface import Surface, fractal_surface
+from multiscale.micro.topography import DETREND, condition, read_topography
 from multiscale.micro.wear import simulate_wear
 from multiscale.micro.zones import cut_zones
 from multiscale.references.hertz import sphere_on_flat
 from multiscale.references.love import love_rectangle, love_rectangle_mean
 from multiscale.scene_sections import MODULUS, ROUGHNESS
-from multiscale.schema import Choice, Flag, Integer, Pair, Quantity, key, read
+from multiscale.schema import Choice, FilePath, Flag, Integer, Pair, Quantity, key, read
 from multiscale.studies.base import Outcome, Problem, jsonable
 
 __all__ = ["MICRO_PROBLEMS", "MicroProblem", "SurfaceParams", "rough_surface"]
@@ -56,7 +59,10 @@ class MicroProblem(Problem):
         return read(self.params, raw, path, ctx)
 
     def key(self, params) -> dict:
-        return jsonable(asdict(params))
+        """The parameters, and the bytes of the files they name (a measured surface rewritten under
+        its name makes new runs, as a scene's files do)."""
+        files = {k: file_digest(v) for k, v in asdict(params).items() if isinstance(v, Path)}
+        return {**jsonable(asdict(params)), **({"files": files} if files else {})}
 
     def exact_key(self, params) -> dict:
         values = self.key(params)
@@ -210,6 +216,34 @@ def _rough_contact(p: RoughContactParams) -> Outcome:
     delta = p.approach - (float(surface.heights.max()) - model.z_max)
     r = model.solve(max(delta, 0.0), route=p.route, raster=False, **({"tol": p.tol} if p.tol else {}))
     return Outcome({"mean_pressure": r.mean_pressure, "area_fraction": r.area_fraction},
+                   int(r.iterations), bool(r.converged))
+
+
+# ----------------------------------------------------------------------------- measured contact
+@dataclass(frozen=True)
+class MeasuredContactParams:
+    """A measured topography (an instrument file, read and conditioned as ``multiscale surface``
+    does: ``detrend`` form removed, optionally filtered at ``cutoff``, undefined points filled; the
+    isolated patch it is, with its own pixel sizes) on an elastic half-space, pressed by a rigid
+    flat to the mean pressure ``load`` (FFT-BEM: ``solve_contact`` of the conditioned ``Surface``)."""
+
+    file: Path = key(FilePath(base="the study file"), required=True)
+    detrend: str = key(Choice(tuple(DETREND)), default="plane")
+    cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)))   # m, Gaussian λc
+    E: float = key(MODULUS, default=4e9)
+    nu: float = key(_POISSON, default=0.15)
+    load: float = key(Quantity("pressure", gt=0, plausible=(1e3, 5e9)), default=5e6)   # Pa, mean pressure
+    tol: float | None = key(Quantity("dimensionless", gt=0, lt=1))            # default: the solver's
+
+
+@_register(MeasuredContactParams, {"approach": "rigid approach from the first touch [m]",
+                                   "area_fraction": "real contact area / nominal area [-]"})
+def _measured_contact(p: MeasuredContactParams) -> Outcome:
+    """Contact of a measured topography at one mean pressure (FFT-BEM on its isolated patch)."""
+    surface = condition(read_topography(p.file), p.detrend, p.cutoff).surface
+    r = solve_contact(surface, kernel=HalfSpace.from_materials(p.E, p.nu), load=p.load,
+                      **({"tol": p.tol} if p.tol else {}))
+    return Outcome({"approach": float(r.approach), "area_fraction": float(r.area_fraction)},
                    int(r.iterations), bool(r.converged))
 
 
