@@ -92,6 +92,10 @@ def test_a_fit_outside_the_self_affine_range_is_said_to_be_one():
     assert next(r for r in steep.table() if "Hurst" in r).endswith(
         "; above 1, steeper than a self-affine surface's (a scene's hurst is at most 1): a form or waviness the "
         "detrending left (--cutoff takes it out)")
+    flat = dataclasses.replace(stats, power_law=dataclasses.replace(stats.power_law, hurst=0.005))   # opd-1's
+    assert next(r for r in flat.table() if "Hurst" in r).endswith(                  # (said nothing: a user trial)
+        "; below 0.1, a PSD nearly as flat as q^-2 (H = 0): instrument noise rather than self-affine roughness, "
+        "or its lowest end (a scene's hurst is plausibly 0.1 to 1)")
     assert next(r for r in steep.table(filtered=True) if "Hurst" in r).endswith(     # given --cutoff "20 um",
         "a waviness the filter left (a shorter --cutoff takes it out)")               # it advised --cutoff (a trial)
 

@@ -31,6 +31,7 @@ from multiscale.micro.surface import Surface, check_surface, find_asperities, ro
 
 POWER_FLOOR = 1e-24     # modes below this fraction of the largest C carry no power (FFT round-off: ~1e-32)
 HURST_RANGE = (0.0, 1.5)   # the power-law segment of a fit (a flat roll-off is no self-affine range)
+LOW_HURST = 0.1            # a fit below this is said to be near noise (a scene's hurst is plausibly 0.1 to 1)
 POOR_MISFIT = 1.0          # rms misfit in ln C above which a fit's H is said to be no more than a slope
 FEW_BINS = 5               # bins below which too
 
@@ -457,7 +458,9 @@ class Statistics:
                           "; above 1, steeper than a self-affine surface's (a scene's hurst is at most 1): "
                           + ("a waviness the filter left (a shorter --cutoff takes it out)" if filtered else
                              "a form or waviness the detrending left (--cutoff takes it out)") if fit.hurst > 1 else
-                          "")),
+                          f"; below {LOW_HURST:g}, a PSD nearly as flat as q^-2 (H = 0): instrument noise rather than "
+                          "self-affine roughness, or its lowest end (a scene's hurst is plausibly 0.1 to 1)"
+                          if fit.hurst < LOW_HURST else "")),     # (opd-1's H = 0.005 said nothing: a user trial)
                      ("long cut-off  2pi/q_r", _length(lr, 2) + ("  (to a PSD bin)" if rr else
                                                               "  (not resolved: >= this)")),
                      ("short cut-off 2pi/q_s", _length(ls, 2) + ("  (to a PSD bin)" if rs else
