@@ -1066,6 +1066,40 @@ def test_a_worker_whose_driver_is_gone_ends_its_process_group(tmp_path):
         _end(worker, ranks)
 
 
+def test_workers_holding_the_gil_end_with_their_driver(tmp_path):
+    """The end of the driver reaches a worker busy in a call that holds the GIL (numba compiling its
+    kernels for seconds under load: a watchdog thread waited for them, and the SIGKILL test failed
+    now and then). Two stand-in workers on one shared pipe, as `running._spawn` starts them, each
+    watch it and then hold the GIL in a regular expression that backtracks for minutes; the pipe's
+    write end closed, both are SIGKILLed within 10 s. A third, started after the driver's end, ends
+    at once."""
+    import os
+    import signal
+    import subprocess
+    import sys
+    read, write = os.pipe()
+    code = (f"import re, sys\nfrom multiscale.studies.worker import watch_driver\nwatch_driver({read})\n"
+            "print('watching', flush=True)\nre.match(r'(a+)+$', 'a' * 40 + 'b')\n")
+    start = lambda: subprocess.Popen([sys.executable, "-c", code], pass_fds=(read,), start_new_session=True,
+                                     stdout=subprocess.PIPE, text=True)
+    workers = [start(), start()]
+    try:
+        assert [w.stdout.readline() for w in workers] == ["watching\n"] * 2
+        os.close(write)                                         # the driver is gone
+        write = None
+        assert [w.wait(timeout=10) for w in workers] == [-signal.SIGKILL] * 2
+        workers.append(start())
+        assert workers[-1].wait(timeout=30) == -signal.SIGKILL
+    finally:
+        os.close(read)
+        if write is not None:
+            os.close(write)
+        for w in workers:
+            w.kill()
+            w.wait()
+            w.stdout.close()
+
+
 def _gone(pids, within: float) -> list:
     """The processes of ``pids`` still running after ``within`` seconds at most (polled)."""
     deadline = time.monotonic() + within

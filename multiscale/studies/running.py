@@ -191,8 +191,8 @@ class Termination:
 def _lifeline() -> tuple[int, int]:
     """A pipe (read end, write end) whose read end every worker gets (``_spawn``) and whose write
     end only this process holds and never writes to: the kernel closes it when the driver ends,
-    however it ends, and each worker's watchdog then reads end-of-file and kills the worker's
-    process group (``worker.watch_driver``). SIGKILL cannot be caught, so the driver cannot kill
+    however it ends, and each worker's process group is then killed (``worker.watch_driver``: by
+    the kernel on Linux, by a thread reading the end-of-file elsewhere). SIGKILL cannot be caught, so the driver cannot kill
     its workers then (they ran on, orphaned, each in a session of its own). Why a pipe: its
     end-of-file comes at once and cannot be missed, even when the driver died before the worker
     started watching; polling ``os.getppid()`` would wait a period and need the driver's pid;

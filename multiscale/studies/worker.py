@@ -9,6 +9,7 @@ timing spent more than ``JIT_SHARE`` of it there is timed once more (``jit_time`
 gone, ``watch_driver`` ends this worker and its process group."""
 from __future__ import annotations
 
+import fcntl
 import hashlib
 import json
 import os
@@ -51,32 +52,53 @@ def _cpu() -> float:
     return total
 
 
-def watch_driver(lifeline: int) -> threading.Thread:
-    """Start a daemon thread that ends this worker's process group as soon as the study's driver is
-    gone: ``lifeline`` is the read end of a pipe whose write end only the driver holds and never
-    writes to (``running._lifeline``), so a read returns end-of-file exactly when the kernel has
-    closed it, at the driver's end, a SIGKILL included (which the driver cannot catch to kill its
-    workers, as it does on SIGTERM and SIGHUP). The thread then sends SIGKILL to the group this
-    process leads (``running._spawn`` starts it in a session of its own): the worker and what it
-    started there, a scene run's ``python`` or ``mpiexec``, whose hydra proxy then ends the ranks
-    (it puts them in sessions of their own; they go when ``mpiexec`` does). Not the parent's death
+def watch_driver(lifeline: int) -> None:
+    """End this worker's process group as soon as the study's driver is gone: ``lifeline`` is the
+    read end of a pipe whose write end only the driver holds and never writes to
+    (``running._lifeline``), closed by the kernel at the driver's end, a SIGKILL included (which the
+    driver cannot catch to kill its workers, as it does on SIGTERM and SIGHUP). The group is the
+    one this process leads (``running._spawn`` starts it in a session of its own): the worker and
+    what it started there, a scene run's ``python`` or ``mpiexec``, whose hydra proxy then ends the
+    ranks (it puts them in sessions of their own; they go when ``mpiexec`` does). Outside a group
+    of its own (started by hand) the worker ends alone.
+
+    On Linux the kernel itself sends the SIGKILL when the pipe's writer closes: the pipe reopened
+    through /proc (an open file description of this worker's own, so that every worker on the
+    shared pipe is its owner) with ``O_ASYNC``, owner the group (``F_SETOWN``) and signal SIGKILL
+    (``F_SETSIG``). No thread waits, so a call that holds the GIL (numba compiling a kernel, for
+    seconds under load: the one test that failed now and then) cannot delay the end. Elsewhere a
+    daemon thread reads the pipe to its end-of-file and kills the group. Not the parent's death
     signal (Linux ``prctl(PR_SET_PDEATHSIG)``): it reaches this process only, not its children, and
     fires when the forking thread ends rather than the driver; not polling ``os.getppid()``: a
-    period of delay. Outside a group of its own (started by hand) the worker ends alone. A Python
-    thread needs the GIL: a call that holds it (none of the solvers' numba kernels do; a scene run
-    waits in ``subprocess``) delays the end until it returns."""
+    period of delay."""
+    owner = -os.getpid() if os.getpgrp() == os.getpid() else os.getpid()
+
+    def end():
+        if owner < 0:
+            os.killpg(-owner, signal.SIGKILL)
+        os.kill(os.getpid(), signal.SIGKILL)
+
+    if hasattr(fcntl, "F_SETSIG"):
+        fd = os.open(f"/proc/self/fd/{lifeline}", os.O_RDONLY | os.O_NONBLOCK)
+        fcntl.fcntl(fd, fcntl.F_SETOWN, owner)
+        fcntl.fcntl(fd, fcntl.F_SETSIG, signal.SIGKILL)
+        fcntl.fcntl(fd, fcntl.F_SETFL, fcntl.fcntl(fd, fcntl.F_GETFL) | os.O_ASYNC)
+        try:
+            gone = os.read(fd, 64) == b""     # the driver ended before the kernel watched for it
+        except BlockingIOError:
+            gone = False
+        if gone:
+            end()
+        return
+
     def watch():
         try:
             while os.read(lifeline, 64):      # the driver writes nothing: b"" is its end
                 pass
         except OSError:
             pass
-        if os.getpgrp() == os.getpid():
-            os.killpg(os.getpid(), signal.SIGKILL)
-        os.kill(os.getpid(), signal.SIGKILL)
-    thread = threading.Thread(target=watch, name="watch_driver", daemon=True)
-    thread.start()
-    return thread
+        end()
+    threading.Thread(target=watch, name="watch_driver", daemon=True).start()
 
 
 def run_task(task: dict) -> int:
