@@ -1068,8 +1068,8 @@ def test_a_worker_whose_driver_is_gone_ends_its_process_group(tmp_path):
 
 def test_workers_holding_the_gil_end_with_their_driver(tmp_path):
     """The end of the driver reaches a worker busy in a call that holds the GIL (numba compiling its
-    kernels for seconds under load: a watchdog thread waited for them, and the SIGKILL test failed
-    now and then). Two stand-in workers on one shared pipe, as `running._spawn` starts them, each
+    kernels for seconds under load: a watchdog thread waited for them, likely why the SIGKILL test
+    failed once at load 4.5). Two stand-in workers on one shared pipe, as `running._spawn` starts them, each
     watch it and then hold the GIL in a regular expression that backtracks for minutes; the pipe's
     write end closed, both are SIGKILLed within 10 s. A third, started after the driver's end, ends
     at once."""

@@ -66,7 +66,7 @@ def watch_driver(lifeline: int) -> None:
     through /proc (an open file description of this worker's own, so that every worker on the
     shared pipe is its owner) with ``O_ASYNC``, owner the group (``F_SETOWN``) and signal SIGKILL
     (``F_SETSIG``). No thread waits, so a call that holds the GIL (numba compiling a kernel, for
-    seconds under load: the one test that failed now and then) cannot delay the end. Elsewhere a
+    seconds under load, likely why a test failed once at load 4.5) cannot delay the end. Elsewhere a
     daemon thread reads the pipe to its end-of-file and kills the group. Not the parent's death
     signal (Linux ``prctl(PR_SET_PDEATHSIG)``): it reaches this process only, not its children, and
     fires when the forking thread ends rather than the driver; not polling ``os.getppid()``: a
