@@ -500,15 +500,17 @@ def test_the_wear_increments_are_raised_until_their_error_estimate_meets_the_tol
         assert not json.loads((tmp_path / str(n) / "provenance.json").read_text())["warnings"]
 
 
-def test_the_rms_height_weights_each_zone_by_the_area_it_covers():
-    """Zones of +1 and -1 um covering 3:1 of the face (an edge zone of a round face, pads of two
-    sizes): RMS sqrt(0.75) um about the area mean 0.5 um (before: 1 um, every zone alike); a zone
-    holding no facet counts for nothing."""
+def test_the_rms_height_is_each_zones_roughness_weighted_by_the_area_it_covers():
+    """Zones of +-1 and +-2 um checkerboards covering 3:1 of the face (an edge zone of a round face,
+    pads of two sizes), raised by 5 and -3 um (zones worn to different depths): RMS sqrt(7/4) um,
+    each zone about its own mean (before: the offsets counted, 3.7 um); a zone holding no facet
+    counts for nothing."""
     from types import SimpleNamespace
     from multiscale.rough import RoughInterface
-    heights = np.stack([np.full((4, 4), 1e-6), np.full((4, 4), -1e-6), np.full((4, 4), 9e-6)])
+    board = np.indices((4, 4)).sum(axis=0) % 2 * 2.0 - 1.0
+    heights = np.stack([5e-6 + 1e-6 * board, -3e-6 + 2e-6 * board, 9e-6 * board])
     rough = SimpleNamespace(covered_area=np.array([3.0, 1.0, 0.0]))
-    assert RoughInterface.rms_height(rough, heights) == pytest.approx(np.sqrt(0.75) * 1e-6, rel=1e-12)
+    assert RoughInterface.rms_height(rough, heights) == pytest.approx(np.sqrt(7 / 4) * 1e-6, rel=1e-12)
 
 
 def test_the_contact_stiffness_field_is_the_penalty_where_a_perfect_interface_touches():

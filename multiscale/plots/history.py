@@ -181,7 +181,7 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
                 ("partition_min", "min")], 100.0, 0),
               ("wear volume [mm³]" if volume == 1e9 else "wear volume [µm³]", [("wear_volume", None)], volume, 0),
               ("max wear depth [µm]", [("wear_max_depth", None)], 1e6, 0),
-              ("RMS of the worn surface [µm]", [("rms_height", None)], 1e6, 0),
+              ("RMS roughness of the worn zones [µm]", [("rms_height", None)], 1e6, 0),
               ("real contact area [mm²]" if area == 1e6 else "real contact area [µm²]",
                [("real_contact_area", "all interfaces" if len(areas) > 1 else None)]
                + [(k, k.removeprefix("real_contact_area_")) for k in areas], area, 0),
