@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from multiscale.units import KINDS, UnitError, to_si
+from multiscale.units import KINDS, UnitError, plausible_in, to_si
 
 __all__ = ["Bad", "Choice", "Context", "Curve", "Either", "FilePath", "Flag", "FrozenMap", "Integer", "ListOf", "Named",
            "OneOf", "OnlyWith", "Pair", "Quantity", "Requires", "Section", "TableOr", "Tables", "Text", "Vector",
@@ -148,7 +148,8 @@ class Quantity:
         if self.plausible is not None and not self.plausible[0] <= v <= self.plausible[1]:
             unit = f" {self.kind.si}" if self.kind.si else ""
             ctx.implausible.append(f"{v:g}{unit} is outside the plausible range {self.plausible[0]:g} to "
-                                   f"{self.plausible[1]:g}{unit}: check the value and its unit")
+                                   f"{self.plausible[1]:g}{unit}: check the value and its unit"
+                                   + plausible_in(raw, self.kind, *self.plausible))
         return v
 
 

@@ -20,7 +20,7 @@ import re
 from dataclasses import dataclass
 from fractions import Fraction
 
-__all__ = ["KINDS", "VALUE", "Kind", "UnitError", "parse_unit", "to_si"]
+__all__ = ["KINDS", "VALUE", "Kind", "UnitError", "parse_unit", "plausible_in", "to_si"]
 
 # Dimension exponents over the base units (m, kg, s, K, rad).
 _BASE = ("m", "kg", "s", "K", "rad")
@@ -131,7 +131,8 @@ def _lookup(name: str) -> tuple[Fraction, tuple[int, ...]]:
     if name in _NOT_READ:
         raise UnitError(f'unknown unit "{name}": {_NOT_READ[name]}')
     known = list(_UNITS) + [p + u for u, (_, _, pre) in _UNITS.items() if pre for p in "GMkmu"]
-    near = difflib.get_close_matches(name, known, n=1, cutoff=0.5)
+    split = next((f"{name[:i]} {name[i:]}" for i in range(1, len(name)) if {name[:i], name[i:]} <= set(known)), None)
+    near = [split] if split else difflib.get_close_matches(name, known, n=1, cutoff=0.5)   # "Nm": "N m", not "m"
     hint = f' (did you mean "{near[0]}"?)' if near else ""
     raise UnitError(f'unknown unit "{name}"{hint}')
 
@@ -275,12 +276,44 @@ def to_si(value, kind: str) -> float:
             if near is None:
                 raise
             raise UnitError(f'unknown unit "{match.group(2)}" (did you mean "{near}"?)') from None
+        if dim != spec.dim and not match.group(2):
+            raise UnitError(f'{expect}: a quoted number needs its unit, like "{match.group(1)} {spec.si}" (a '
+                            f'number without quotes is taken in {spec.si})')
         if dim != spec.dim:
-            raise UnitError(f"{expect}; the unit \"{match.group(2)}\" is {_a(describe(dim))}")
+            raise UnitError(f"{expect}; the unit \"{match.group(2)}\" is {_mismatch(dim, spec)}")
     try:
         return float(number * factor + offset)
     except OverflowError:
         raise UnitError("must be a finite number") from None
+
+
+def _mismatch(dim: tuple[int, ...], spec: Kind) -> str:
+    """What a unit of dimension ``dim`` is, against ``spec``'s: a kind's name, or this one's times or
+    per a kind ("mm^3/N" for a wear rate per frictional work: "that times a length"), or SI base units."""
+    name = describe(dim)
+    if any(kind.dim == dim for kind in KINDS.values()) or dim in _OTHER_NAMES:
+        return _a(name)
+    for sign, words in ((1, "that times {}"), (-1, "that per {}")):
+        off = tuple(sign * (d - e) for d, e in zip(dim, spec.dim))
+        if off in _OTHER_NAMES or any(kind.dim == off for kind in KINDS.values()):
+            return f"{words.format(_a(describe(off)))} ({name} in SI base units)"
+    return f"{name} in SI base units"
+
+
+def plausible_in(raw, spec: Kind, low: float, high: float) -> str:
+    """For a bare number ``raw`` (no unit, read in SI) outside [low, high]: the units among ``spec``'s
+    examples in which it would be inside, as a clause (' (as "2e-05 mm^3/(N m)" it would be
+    plausible)': k_w = 2e-5 meant in mm^3/(N m), user trial M); "" for none or a written unit."""
+    number, written = VALUE.match(raw).groups() if isinstance(raw, str) else (f"{raw:g}", "")
+    fits = []
+    for unit in ([] if written else [u.strip() for u in spec.examples.split(",")]):
+        try:
+            factor, offset, dim = parse_unit(unit)
+        except UnitError:
+            continue
+        if dim == spec.dim and factor != 1 and low <= float(_F(number) * factor + offset) <= high:
+            fits.append(f'"{number} {unit}"')
+    return f" (as {' or '.join(fits)} it would be plausible)" if fits else ""
 
 
 def _kind_unit(text: str, spec: Kind) -> str | None:

@@ -119,11 +119,27 @@ def test_unit_strings_to_si(text, kind, expected):
     ("0.1 kcal/(kg K)", "specific_heat", "1 cal = 4.184 J"),  # was: did you mean "kPa"
     ("5 ppm", "dimensionless", "ppm is not read"),             # was: did you mean "rpm"
     ("14 %", "resistance", 'the unit "%" is a dimensionless number'),
+    ("2e-5 mm^3/Nm", "wear_rate", 'unknown unit "Nm" (did you mean "N m"?)'),  # was: "m" (user trial M)
+    ("2 kNm", "torque", 'unknown unit "kNm" (did you mean "kN m"?)'),
+    ("2e-5 mm^3/N", "wear_rate", 'the unit "mm^3/N" is that times a length (m^2 kg^-1 s^2 in SI base units)'),
+    ("2e-5", "wear_rate", 'a quoted number needs its unit, like "2e-5 1/Pa"'),    # was: the unit "" is ...
 ])
 def test_unit_errors_say_what_is_expected(text, kind, fragment):
     with pytest.raises(UnitError, match=None) as info:
         to_si(text, kind)
     assert fragment in str(info.value)
+
+
+def test_a_bare_number_outside_the_plausible_range_is_shown_in_the_units_it_would_fit():
+    """k_w = 2e-5 (meant in mm^3/(N m)) was read as 2e-5 1/Pa with a warning to check the unit alone
+    (user trial M): the warning names the kind's units in which the number is plausible; none for a
+    number with its unit."""
+    from multiscale.schema import Context, Quantity, parse
+    rate = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))
+    ctx = Context(effects=frozenset())
+    assert parse(rate, 2e-5, "k_w", ctx) == 2e-5 and parse(rate, "2e-5 1/Pa", "k_w", ctx) == 2e-5
+    assert ctx.warnings[0].endswith('(as "2e-05 1/MPa" or "2e-05 mm^3/(N m)" it would be plausible)')
+    assert ctx.warnings[1].endswith("check the value and its unit")
 
 
 def test_good_scene_in_si(tmp_path):

@@ -704,7 +704,8 @@ def test_the_inputs_warnings_are_said_once_with_their_runs(tmp_path, capsys):
     path = write(tmp_path, HERTZ.replace("grid = [12, 16, 24, 32]", "grid = [12, 16]")
                  .replace('radius = "10 mm"', 'radius = "10 mm"\nE = 1').replace("processes = 2", "processes = 1"))
     assert main(["study", str(path)]) == 0
-    line = "E = 1: 1 Pa is outside the plausible range 100000 to 1.2e+12 Pa: check the value and its unit (every run)"
+    line = ('E = 1: 1 Pa is outside the plausible range 100000 to 1.2e+12 Pa: check the value and its unit (as "1 MPa" '
+            'or "1 GPa" or "1 bar" it would be plausible) (every run)')
     assert f"warning: hertz: {line}" in capsys.readouterr().err
     assert f"- {line}" in (tmp_path / "results" / "hertz" / "hertz.md").read_text()
 
@@ -725,14 +726,35 @@ def test_a_problem_of_every_run_is_said_once(tmp_path):
 
 def test_the_knobs_columns_carry_their_units(tmp_path):
     """results.h5 gave the metrics and times a unit, the swept parameters none (a user trial): a
-    micro parameter's unit is its kind's, a scene key's that of the values as written."""
+    micro parameter's unit is its kind's, a scene key's too (bare numbers of "wear.k_w" had none: user
+    trial M), else that of the values as written."""
     from multiscale.studies.results import knob_unit
     study = load_study(write(tmp_path, HERTZ.replace("grid = [12, 16, 24, 32]", 'grid = [12, 16]\nE = ["1 GPa", 2e9]')))
     assert (knob_unit(study, "grid"), knob_unit(study, "E")) == ("", "Pa")
     (tmp_path / "scene.toml").write_text((ROOT / "demos" / "block_on_flat.toml").read_text())
     scene = load_study(write(tmp_path, 'problem = "scene"\nscene = "scene.toml"\nmetrics = ["max_pressure"]\n[sweep]\n'
-                                       '"loading.pressure" = ["1 MPa", 2e6]\n"time.steps" = [1, 2]\n', "s.toml"))
-    assert (knob_unit(scene, "loading.pressure"), knob_unit(scene, "time.steps")) == ("Pa", "")
+                                       '"loading.pressure" = [1e6, 2e6]\n"time.steps" = [1, 2]\n"materials.block.nu" = [0.3, 0.25]\n'
+                                       '"geometry.length" = ["10 mm", 9e-3]\n', "s.toml"))
+    assert [knob_unit(scene, k) for k in ("loading.pressure", "time.steps", "materials.block.nu",
+                                          "geometry.length")] == ["Pa", "", "-", "m"]
+
+
+def test_a_scene_keys_bare_numbers_get_its_unit_on_the_axis(tmp_path, monkeypatch):
+    """A swept "wear.k_w" of bare numbers was plotted against "wear.k_w" without a unit (user trial
+    M): the scene key's SI unit, as results.h5 has it."""
+    import matplotlib.pyplot as plt
+
+    from multiscale.plots import studies as figures
+    made = []
+    subplots = plt.subplots
+    monkeypatch.setattr(figures.plt, "subplots", lambda *a, **k: made.append(subplots(*a, **k)) or made[-1])
+    monkeypatch.setattr(figures.plt, "close", lambda fig: None)
+    (tmp_path / "scene.toml").write_text((ROOT / "demos" / "block_on_flat.toml").read_text())
+    study = load_study(write(tmp_path, 'problem = "scene"\nscene = "scene.toml"\nmetrics = ["max_pressure"]\n'
+                                       '[sweep]\n"loading.pressure" = [1e6, 2e6]\n'))
+    rows = [Row(run, {"status": "ok", "wall_time": 1.0, "metrics": {"max_pressure": 1e6}}) for run in study.runs]
+    figures.plot(study, rows, tmp_path)
+    assert made[0][1][0][0].get_xlabel() == "loading.pressure [Pa]"
 
 
 def test_an_interrupted_study_writes_the_table_of_the_runs_that_ended(tmp_path, capsys, monkeypatch):
@@ -1113,13 +1135,33 @@ def _gone(pids, within: float) -> list:
 def _terminated(proc, workers):
     """SIGTERM ends the study ``proc`` with 143 and its ``workers`` with it (both killed in any case)."""
     import signal
+    import subprocess
     try:
         proc.send_signal(signal.SIGTERM)
-        assert proc.wait(timeout=30) == 128 + signal.SIGTERM
+        try:
+            code = proc.wait(timeout=30)
+        except subprocess.TimeoutExpired:        # once in a CI run at d7c81dd, not seen since: say where it hung
+            raise AssertionError(f"the driver did not end within 30 s of SIGTERM: {_states([proc.pid, *workers])}")
+        assert code == 128 + signal.SIGTERM
         time.sleep(0.5)
         assert [pid for pid in workers if _cmdline(Path(f"/proc/{pid}"))] == []
     finally:
         _end(proc, workers)
+
+
+def _states(pids) -> dict:
+    """Each process's state, kernel wait channel and signal masks (/proc), to say where one hung."""
+    out = {}
+    for pid in pids:
+        try:
+            status = Path(f"/proc/{pid}/status").read_text().splitlines()
+            wchan = Path(f"/proc/{pid}/wchan").read_text()
+        except OSError:
+            out[pid] = "gone"
+            continue
+        out[pid] = [line for line in status if line.startswith(("State", "SigPnd", "ShdPnd", "SigBlk", "SigIgn",
+                                                                 "SigCgt", "Threads"))] + [f"wchan {wchan}"]
+    return out
 
 
 def _slow_study(tmp_path, **popen):

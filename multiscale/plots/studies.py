@@ -12,10 +12,10 @@ import matplotlib.pyplot as plt
 import numpy as np
 from matplotlib.ticker import FuncFormatter, NullFormatter
 
-from multiscale.studies.expand import Study, StudyRun, parser_of
+from multiscale.studies.expand import Study, StudyRun
 from multiscale.studies.formatting import metric_heading, percent
 from multiscale.studies.problems import PROBLEMS
-from multiscale.studies.results import Row, case_key, pareto, sample_std
+from multiscale.studies.results import Row, case_key, knob_unit, pareto, sample_std
 
 __all__ = ["plot"]
 
@@ -121,10 +121,10 @@ def _plain_log(axis) -> None:
 
 
 def _axis_label(study, axis, raw) -> str:
-    """The knobs of an axis, with the SI unit of a micro parameter whose values ``raw`` (as the
-    study gave them) are bare numbers ("E [Pa]"; "E / nu" of a zipped axis read as a ratio: "E, nu")."""
-    parser = parser_of(PROBLEMS[study.problem], axis[0])
-    unit = getattr(getattr(getattr(parser, "parser", None), "kind", None), "si", "")
+    """The knobs of an axis, with the SI unit of a micro parameter or scene key (``knob_unit``) whose
+    values ``raw`` (as the study gave them) are bare numbers ("E [Pa]"; "E / nu" of a zipped axis
+    read as a ratio: "E, nu")."""
+    unit = knob_unit(study, axis[0])
     bare = all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in raw)
     return ", ".join(axis) + (f" [{unit}]" if unit and bare else "")
 

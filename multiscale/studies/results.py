@@ -11,7 +11,8 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from multiscale.schema import ListOf, Quantity
+from multiscale.scene import Scene
+from multiscale.schema import Either, ListOf, Named, Quantity, Section, TableOr, Tables, fields_of
 from multiscale.studies.expand import Study, StudyRun, normalise, parser_of, reference_run
 from multiscale.studies.formatting import value_text
 from multiscale.studies.problems import PROBLEMS
@@ -169,14 +170,31 @@ def write_tables(study: Study, rows: list[Row]) -> tuple[Path, Path]:
     return csv_path, h5_path
 
 
+def _key_spec(cls, dotted: str):
+    """The Spec of the dotted TOML key ``dotted`` of table class ``cls`` ("wear.k_w"; a named
+    table's name is any: "materials.pin.E"); None if there is no such key (or it is in an array
+    of tables)."""
+    parts = dotted.split(".")
+    while True:
+        spec = dict(fields_of(cls)).get(parts.pop(0))
+        if spec is None or not parts:
+            return spec
+        if isinstance(spec.parser, Named):
+            parts.pop(0)
+        if not parts or not isinstance(spec.parser, Section) or isinstance(spec.parser, Tables):
+            return None
+        cls = spec.parser.cls
+
+
 def knob_unit(study: Study, name: str) -> str:
-    """The SI unit of swept knob ``name``'s column: its kind's for a micro problem's parameter
-    ("-" dimensionless), else that of the unit its values were written in ("3 MPa": Pa); "" if not
-    known (a count, or bare numbers of a scene key)."""
-    spec = parser_of(PROBLEMS[study.problem], name)
+    """The SI unit of swept knob ``name``'s column: its kind's for a micro problem's parameter or a
+    scene key ("-" dimensionless; bare numbers of a scene key are in it, user trial M), else that
+    of the unit its values were written in ("3 MPa": Pa); "" if not known (a count)."""
+    spec = _key_spec(Scene, name) if study.problem == "scene" else parser_of(PROBLEMS[study.problem], name)
     parser = spec.parser if spec is not None else None
-    while isinstance(parser, ListOf):
-        parser = parser.item
+    while isinstance(parser, (ListOf, TableOr, Either)):
+        parser = parser.item if isinstance(parser, ListOf) else parser.value if isinstance(parser, TableOr) \
+            else next((p for p in parser.parsers if isinstance(p, Quantity)), None)
     if isinstance(parser, Quantity):
         return parser.kind.si or "-"
     for run in study.runs:
