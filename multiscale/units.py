@@ -235,13 +235,15 @@ def parse_unit(text: str) -> tuple[Fraction, Fraction, tuple[int, ...]]:
     return factor, _F(0), dim
 
 
+def _name(dim: tuple[int, ...]) -> str | None:
+    """The name of a dimension: a kind's, or another quantity's (energy, power, ...); None if none."""
+    return next((kind.name for kind in KINDS.values() if kind.dim == dim), _OTHER_NAMES.get(dim))
+
+
 def describe(dim: tuple[int, ...]) -> str:
     """A dimension in words: the kind's name if one matches, else base units (kg m^-1 s^-2)."""
-    for kind in KINDS.values():
-        if kind.dim == dim:
-            return kind.name
-    if dim in _OTHER_NAMES:
-        return _OTHER_NAMES[dim]
+    if _name(dim) is not None:
+        return _name(dim)
     parts = [b if p == 1 else f"{b}^{p}" for b, p in zip(_BASE, dim) if p]
     return " ".join(parts) or "dimensionless"
 
@@ -290,14 +292,13 @@ def to_si(value, kind: str) -> float:
 def _mismatch(dim: tuple[int, ...], spec: Kind) -> str:
     """What a unit of dimension ``dim`` is, against ``spec``'s: a kind's name, or this one's times or
     per a kind ("mm^3/N" for a wear rate per frictional work: "that times a length"), or SI base units."""
-    name = describe(dim)
-    if any(kind.dim == dim for kind in KINDS.values()) or dim in _OTHER_NAMES:
-        return _a(name)
-    for sign, words in ((1, "that times {}"), (-1, "that per {}")):
-        off = tuple(sign * (d - e) for d, e in zip(dim, spec.dim))
-        if off in _OTHER_NAMES or any(kind.dim == off for kind in KINDS.values()):
-            return f"{words.format(_a(describe(off)))} ({name} in SI base units)"
-    return f"{name} in SI base units"
+    if _name(dim) is not None:
+        return _a(_name(dim))
+    for sign, words in ((1, "that times"), (-1, "that per")):
+        off = _name(tuple(sign * (d - e) for d, e in zip(dim, spec.dim)))
+        if off is not None:
+            return f"{words} {_a(off)} ({describe(dim)} in SI base units)"
+    return f"{describe(dim)} in SI base units"
 
 
 def plausible_in(raw, spec: Kind, low: float, high: float) -> str:

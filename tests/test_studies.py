@@ -167,18 +167,23 @@ def test_runs_timed_fewer_times_than_asked_run_again_and_the_report_says_how_oft
     assert "**the runs were made by 2 versions of the package** (SHA-1 " in report.read_text()
 
 
-def test_the_error_figure_draws_the_pareto_front_of_each_case(tmp_path, monkeypatch):
-    """[report] cases are problems of their own (here two loads): the error-vs-time figure draws the
-    Pareto front of each (before: one front over all runs, which put a setting 17 % off at one
-    approach on the front for its 7 % at another; found by a user trial)."""
+@pytest.fixture
+def made(monkeypatch) -> list:
+    """The (figure, axes) of every ``plt.subplots`` of the study figures, kept open to be read."""
     import matplotlib.pyplot as plt
 
     from multiscale.plots import studies as figures
-    from multiscale.studies.results import case_key, collect
-    made = []
-    subplots = plt.subplots
+    made, subplots = [], plt.subplots
     monkeypatch.setattr(figures.plt, "subplots", lambda *a, **k: made.append(subplots(*a, **k)) or made[-1])
     monkeypatch.setattr(figures.plt, "close", lambda fig: None)
+    return made
+
+
+def test_the_error_figure_draws_the_pareto_front_of_each_case(tmp_path, made):
+    """[report] cases are problems of their own (here two loads): the error-vs-time figure draws the
+    Pareto front of each (before: one front over all runs, which put a setting 17 % off at one
+    approach on the front for its 7 % at another; found by a user trial)."""
+    from multiscale.studies.results import case_key, collect
     study = (HERTZ.replace("grid = [12, 16, 24, 32]", 'grid = [12, 16]\nload = ["5 N", "20 N"]')
              .replace('load = "10 N"\n', "").replace("[report]", '[report]\ncases = ["load"]'))
     path = write(tmp_path, study)
@@ -198,16 +203,10 @@ def test_the_error_figure_draws_the_pareto_front_of_each_case(tmp_path, monkeypa
 @pytest.mark.parametrize("dt, ticks, label", [('{start = "50 us", stop = "450 us", num = 3, log = true}',
                                                ["50 µs", "150 µs", "450 µs"], "dt"),
                                               ("[5e-05, 0.00015, 0.00045]", ["5e-05", "0.00015", "0.00045"], "dt [s]")])
-def test_a_knob_axis_is_labelled_as_the_study_wrote_it(tmp_path, monkeypatch, dt, ticks, label):
+def test_a_knob_axis_is_labelled_as_the_study_wrote_it(tmp_path, made, dt, ticks, label):
     """A range in rpm was ticked in rad/s without a unit (1000 rpm shown "104.7"; a user trial): the
     ticks are the values as written, in the range's unit; bare numbers get the SI unit on the axis."""
-    import matplotlib.pyplot as plt
-
     from multiscale.plots import studies as figures
-    made = []
-    subplots = plt.subplots
-    monkeypatch.setattr(figures.plt, "subplots", lambda *a, **k: made.append(subplots(*a, **k)) or made[-1])
-    monkeypatch.setattr(figures.plt, "close", lambda fig: None)
     study = load_study(write(tmp_path, f'problem = "heat_partition"\nmetrics = ["partition_1"]\n[sweep]\ndt = {dt}\n'))
     rows = [Row(run, {"status": "ok", "wall_time": 1.0, "metrics": {"partition_1": 0.5}}) for run in study.runs]
     figures.plot(study, rows, tmp_path)
@@ -739,16 +738,10 @@ def test_the_knobs_columns_carry_their_units(tmp_path):
                                           "geometry.length")] == ["Pa", "", "-", "m"]
 
 
-def test_a_scene_keys_bare_numbers_get_its_unit_on_the_axis(tmp_path, monkeypatch):
+def test_a_scene_keys_bare_numbers_get_its_unit_on_the_axis(tmp_path, made):
     """A swept "wear.k_w" of bare numbers was plotted against "wear.k_w" without a unit (user trial
     M): the scene key's SI unit, as results.h5 has it."""
-    import matplotlib.pyplot as plt
-
     from multiscale.plots import studies as figures
-    made = []
-    subplots = plt.subplots
-    monkeypatch.setattr(figures.plt, "subplots", lambda *a, **k: made.append(subplots(*a, **k)) or made[-1])
-    monkeypatch.setattr(figures.plt, "close", lambda fig: None)
     (tmp_path / "scene.toml").write_text((ROOT / "demos" / "block_on_flat.toml").read_text())
     study = load_study(write(tmp_path, 'problem = "scene"\nscene = "scene.toml"\nmetrics = ["max_pressure"]\n'
                                        '[sweep]\n"loading.pressure" = [1e6, 2e6]\n'))
