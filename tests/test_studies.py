@@ -235,6 +235,40 @@ def test_reference_from_a_stored_file_and_records_shared_by_studies(hertz_study,
     assert "stored result hertz.json" in (tmp_path / "stored.md").read_text()
 
 
+def test_a_reference_file_of_some_metrics_judges_those_and_tabulates_the_rest(hertz_study, tmp_path, capsys):
+    """A measurement of some metrics only (user trial M: a worn volume, no temperature) judges
+    those; the others are tabulated without an error (before: "no number for metric"). A key
+    like a misspelt metric, or no metric at all, is still refused."""
+    path, out = hertz_study
+    a = (3 * 10.0 * 10e-3 / (4 * 210e9 / (1 - 0.3**2))) ** (1 / 3)
+    ref = tmp_path / "some.json"
+    ref.write_text(json.dumps({"contact_radius": a, "max_pressure": 3 * 10.0 / (2 * np.pi * a * a)}))
+    text = (HERTZ.replace('kind = "analytic"', f'kind = "file"\nfile = "{ref.name}"')
+            .replace("[run]", f'[run]\nfolder = "{out}"').replace('name = "hertz"', 'name = "some"')
+            + f'folder = "{tmp_path / "report"}"\n')
+    assert main(["study", str(write(tmp_path, text))]) == 0
+    capsys.readouterr()
+    with h5py.File(out / "results.h5") as h5:
+        assert "approach" in h5 and "approach_error" not in h5 and "approach_reference" not in h5
+        errors = {m: h5[f"{m}_error"][...] for m in ("contact_radius", "max_pressure")}
+        np.testing.assert_allclose(h5["max_error"][...], np.maximum(*errors.values()), rtol=1e-12)
+    for row in table(out / "results.csv"):
+        exact = hertz_independent(int(row["grid"]))
+        assert float(row["max_pressure_error"]) == pytest.approx(exact["max_pressure"], rel=1e-6)
+        assert "approach_error" not in row and row["message"] == ""
+    md = (tmp_path / "report" / "some.md").read_text()
+    assert "stored result some.json (of contact_radius, max_pressure; approach tabulated without one)" in md
+    head = next(line for line in md.splitlines() if line.startswith("| grid |"))
+    assert head.count("| error |") == 2 and "approach" in head
+    assert (tmp_path / "report" / "some_error_vs_time.png").exists()
+    for given, message in (({"contact_radius": a, "aproach": 1e-6}, 'no number for metric "approach" (did you '
+                                                                    'mean "aproach"?)'),
+                           ({"radius": a}, 'no number for metric "contact_radius"')):
+        ref.write_text(json.dumps(given))
+        assert main(["study", str(write(tmp_path, text))]) == 2
+        assert message in capsys.readouterr().err
+
+
 def test_a_zone_law_sweep_over_the_grid_judges_each_grid_by_its_own_reference(tmp_path, capsys):
     """zone_laws without reference_n takes the whole surface on the run's own n as reference; the
     cached reference's key left n out, so a sweep over n judged every grid against the first one

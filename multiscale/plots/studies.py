@@ -32,7 +32,7 @@ def plot(study: Study, rows: list[Row], folder: Path) -> list[Path]:
     if not ok or not study.report.plots:
         return []
     out = []
-    if study.reference is not None:
+    if study.judged:
         out.append(_plot_pareto(study, ok, folder))
     for axis in study.axes:
         if axis[0] not in study.averaged:
@@ -52,11 +52,11 @@ def _plot_pareto(study, ok, folder):
     """Relative error vs wall time, one panel per metric, the Pareto front of each case of
     [report] cases in its colour (a case is a problem of its own: one front across them put a
     setting 17 % off at one load on the front for its 7 % at another; None if no error is positive)."""
-    n = len(study.metrics)
+    n = len(study.judged)
     fig, axes = plt.subplots(1, n, figsize=(5.2 * n, 4.3), squeeze=False)
     cases = list(dict.fromkeys(case_key(study, r) for r in ok))
     drawn = False
-    for ax, m in zip(axes[0], study.metrics):
+    for ax, m in zip(axes[0], study.judged):
         t = [r.record["wall_time"] for r in ok]
         e = [r.errors.get(m, math.nan) for r in ok]
         members = [[i for i, r in enumerate(ok) if case_key(study, r) == case and math.isfinite(e[i]) and e[i] > 0]
@@ -146,9 +146,7 @@ def _plot_axis(study, ok, axis, folder):
     lines = {}
     for r in ok:
         lines.setdefault(tuple(r.run.shown[k] for k in others), []).append(r)
-    with_ref = study.reference is not None
-    panels = ([("error", m) for m in study.metrics] if with_ref else [("value", m) for m in study.metrics]) \
-        + [("time", None)]
+    panels = [("error" if m in study.judged else "value", m) for m in study.metrics] + [("time", None)]
     fig, axes = plt.subplots(1, len(panels), figsize=(4.4 * len(panels), 3.9), squeeze=False)
     for ax, (kind, m) in zip(axes[0], panels):
         for c, (other, group) in enumerate(lines.items()):

@@ -17,7 +17,8 @@ reference::
     kind = "analytic"                 # the problem's exact values; "run" with run = {grid = 128}
                                       # (per run: the run with these values, others unchanged,
                                       # zip partners following);
-                                      # "file" with file = "ref.json" ({metric: value})
+                                      # "file" with file = "ref.json" ({metric: value};
+                                      # a metric without a value is tabulated, not judged)
     [run]                             # processes, timeout, repeat (best-of wall time), folder
     [report]                          # errors = ["1 %", "5 %"], cases (physical parameters, not
                                       # knobs), average_over (e.g. seeds), folder, title, plots

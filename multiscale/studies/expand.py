@@ -53,6 +53,12 @@ class Study:
     folder: Path
     report_folder: Path
     warnings: tuple = ()              # the runs' inputs' warnings (implausible values, ...), one line each
+    judged: tuple = ()                # the metrics with a reference value: their errors are computed
+
+    @property
+    def unjudged(self) -> tuple:
+        """Metrics tabulated without a reference value (a reference file that measured only some)."""
+        return tuple(m for m in self.metrics if m not in self.judged) if self.reference is not None else ()
 
     def _with_partners(self, names) -> tuple:
         return tuple(k for axis in self.axes if any(n in axis for n in names) for k in axis)
@@ -98,9 +104,9 @@ def load_study(path) -> Study:
     name = f.name or path.stem
     extra = {"scene": f.scene, "ranks": f.run.ranks} if scene_problem else {}
     runs, warned = _runs(f, problem, knobs, values, extra, ctx) if len(ctx.problems) == before else ((), ())
-    ref = f.reference      # checked against the runs when the schema found it whole
+    ref, judged = f.reference, ()      # checked against the runs when the schema found it whole
     if runs and f.metrics and ref is not None and ref.kind is not None and not ref.problems("reference", ctx):
-        _check_reference(f, problem, knobs, axes, runs, ctx)
+        judged = _check_reference(f, problem, knobs, axes, runs, ctx)
     for option in ("cases", "average_over"):
         for k in getattr(f.report, option):
             if k not in knobs:
@@ -112,7 +118,7 @@ def load_study(path) -> Study:
     return Study(name=name, description=f.description, source=path.resolve(), problem=f.problem, scene=f.scene,
                  metrics=f.metrics, knobs=knobs, axes=axes, fixed=dict(f.fixed), sweep_text=tuple(lines), runs=runs,
                  reference=f.reference, options=f.run, report=f.report, folder=folder,
-                 report_folder=f.report.folder or folder, warnings=warned)
+                 report_folder=f.report.folder or folder, warnings=warned, judged=judged)
 
 
 def parser_of(problem, name):
@@ -378,18 +384,22 @@ def reference_run(runs, label: dict, want: dict, axes) -> StudyRun | None:
     return hits[0] if len(hits) == 1 else None
 
 
-def _check_reference(f: StudyFile, problem, knobs, axes, runs, ctx):
+def _check_reference(f: StudyFile, problem, knobs, axes, runs, ctx) -> tuple:
+    """Problems of [reference] into ``ctx``; returns the metrics it gives values of (judged). A
+    metric without one is tabulated, not judged (a file that measured some of them: user trial M),
+    unless no metric has one, or the file has a key that looks like a misspelling of it."""
     ref = f.reference
     if ref.kind == "analytic":
         if not getattr(problem, "exact", None):
             ctx.problems.append(f'reference.kind = "analytic": problem "{f.problem}" has no analytic reference; '
                                 'use kind = "run" (a run of the sweep) or "file"')
-            return
-        missing = [m for m in f.metrics if m not in problem.exact_metrics]
-        if missing:
-            ctx.problems.append(f'reference.kind = "analytic": no analytic value of {", ".join(missing)} '
+            return ()
+        judged = tuple(m for m in f.metrics if m in problem.exact_metrics)
+        if not judged:
+            ctx.problems.append(f'reference.kind = "analytic": no analytic value of {", ".join(f.metrics)} '
                                 f'(the problem gives {", ".join(problem.exact_metrics)})')
-    elif ref.kind == "run":
+        return judged
+    if ref.kind == "run":
         for k in (k for k in ref.run if k not in knobs):
             ctx.problems.append(f"reference.run.{k}: not a swept parameter{suggest(k, knobs)}; swept: {', '.join(knobs)}")
         given = {k: v for k, v in ref.run.items() if k in knobs}     # the swept ones are checked too
@@ -399,25 +409,25 @@ def _check_reference(f: StudyFile, problem, knobs, axes, runs, ctx):
                 swept = "; ".join(f"{k}: {', '.join(dict.fromkeys(x.shown[k] for x in runs))}" for k in given)
                 ctx.problems.append(f"reference.run = {{{', '.join(f'{k} = {value_text(v)}' for k, v in given.items())}}}: "
                                     f"not in the sweep (swept {swept})")
-                return
-    else:
-        try:
-            values = json.loads(ref.file.read_text())
-        except (OSError, ValueError) as exc:
-            ctx.problems.append(f"reference.file = \"{ref.file}\": cannot read a JSON object ({exc})")
-            return
-        if not isinstance(values, dict):
-            ctx.problems.append(f"reference.file = \"{ref.file}\": must hold a JSON object {{metric: value}}")
-            return
-        for m in f.metrics:
-            if m in values and (not isinstance(values[m], (int, float)) or isinstance(values[m], bool)):
-                ctx.problems.append(f"reference.file = \"{ref.file}\": metric \"{m}\" is {values[m]!r}: give a "
-                                    "number in SI units (the metric's own unit)")
-            elif m in values and not (math.isfinite(values[m]) and values[m] != 0):
-                ctx.problems.append(f"reference.file = \"{ref.file}\": metric \"{m}\" is {values[m]!r}: errors are "
-                                    "relative to it; give a finite, nonzero number")
-            elif m not in values:
-                ctx.problems.append(f"reference.file = \"{ref.file}\": no number for metric \"{m}\""
-                                    f"{suggest(m, values)}")
-
-
+                break
+        return tuple(f.metrics)
+    try:
+        values = json.loads(ref.file.read_text())
+    except (OSError, ValueError) as exc:
+        ctx.problems.append(f"reference.file = \"{ref.file}\": cannot read a JSON object ({exc})")
+        return ()
+    if not isinstance(values, dict):
+        ctx.problems.append(f"reference.file = \"{ref.file}\": must hold a JSON object {{metric: value}}")
+        return ()
+    judged = tuple(m for m in f.metrics if m in values)
+    for m in f.metrics:
+        if m in values and (not isinstance(values[m], (int, float)) or isinstance(values[m], bool)):
+            ctx.problems.append(f"reference.file = \"{ref.file}\": metric \"{m}\" is {values[m]!r}: give a "
+                                "number in SI units (the metric's own unit)")
+        elif m in values and not (math.isfinite(values[m]) and values[m] != 0):
+            ctx.problems.append(f"reference.file = \"{ref.file}\": metric \"{m}\" is {values[m]!r}: errors are "
+                                "relative to it; give a finite, nonzero number")
+        elif m not in values and (not judged or suggest(m, [k for k in values if k not in f.metrics])):
+            ctx.problems.append(f"reference.file = \"{ref.file}\": no number for metric \"{m}\""
+                                f"{suggest(m, [k for k in values if k not in f.metrics])}")
+    return judged

@@ -111,7 +111,8 @@ def _cheapest_table(study, rows) -> list[str]:
     samples = (f" over every sample of {', '.join(study.averaged)} (its wall time their mean)"
                if study.averaged else "")
     lines = ["## What accuracy costs", "",
-             f"The cheapest setting (least wall time) whose worst error over the metrics{samples} meets each "
+             f"The cheapest setting (least wall time) whose worst error over the metrics"
+             f"{' with a reference' if study.unjudged else ''}{samples} meets each "
              "stated error; 'time / base' compares it with " + ("the reference run" if study.reference.kind == "run"
                                                                 else "the most expensive setting") + ".", "",
              "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
@@ -150,14 +151,14 @@ def _average_table(study, rows) -> list[str]:
 def _runs_table(study, rows) -> list[str]:
     head, unit = list(study.knobs), PROBLEMS[study.problem].metric_unit
     for m in study.metrics:
-        head += [metric_heading(m, unit(m))] + (["error"] if study.reference else [])
+        head += [metric_heading(m, unit(m))] + (["error"] if m in study.judged else [])
     head += ["wall time [s]", "peak memory [MB]", "iterations", "status"]
     lines = ["| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
     for r in rows:
         cells = [r.run.shown[k] for k in study.knobs]
         for m in study.metrics:
             cells.append(number_text(r.record.get("metrics", {}).get(m, math.nan)))
-            if study.reference:
+            if m in study.judged:
                 cells.append(percent(r.errors.get(m, math.nan)))
         rec = r.record
         status = rec.get("status", "")

@@ -107,7 +107,7 @@ def collect(study: Study) -> list[Row]:
                 row.note = "reference run failed"
             elif target is row:
                 row.note, row.is_reference = "reference run", True
-        for m in study.metrics:
+        for m in study.judged:
             if m in values:
                 row.reference[m] = float(values[m])
                 row.errors[m] = relative_error(row.record["metrics"][m], float(values[m]))
@@ -124,7 +124,7 @@ def _columns(study: Study, rows: list[Row]) -> dict:
         cols[k] = [_cell(r.run.label[k]) for r in rows]
     for m in study.metrics:
         cols[m] = [r.record.get("metrics", {}).get(m, math.nan) for r in rows]
-        if study.reference is not None:
+        if m in study.judged:
             cols[f"{m}_reference"] = [r.reference.get(m, math.nan) for r in rows]
             cols[f"{m}_error"] = [r.errors.get(m, math.nan) for r in rows]
     if study.reference is not None:
@@ -156,7 +156,8 @@ def write_tables(study: Study, rows: list[Row]) -> tuple[Path, Path]:
     units = {"wall_time": "s", "cpu_time": "s", "peak_memory_mb": "MB"}    # (said by the report alone; a user trial)
     units.update((k, knob_unit(study, k)) for k in study.knobs)              # (none before: a user trial)
     for m in study.metrics:
-        units[m] = units[f"{m}_reference"] = PROBLEMS[study.problem].metric_unit(m)
+        units[m] = PROBLEMS[study.problem].metric_unit(m)
+        units[f"{m}_reference"] = units[m] if m in study.judged else None
     with h5py.File(h5_path, "w") as h5:
         for name, values in cols.items():
             if all(isinstance(v, (int, float, bool)) for v in values):
@@ -214,11 +215,13 @@ def reference_text(study: Study) -> str:
     ref = study.reference
     if ref is None:
         return "none (a parametric study)"
+    alone = f" (of {', '.join(study.judged)}; {', '.join(study.unjudged)} tabulated without one)" \
+        if study.unjudged else ""
     if ref.kind == "analytic":
         doc = (PROBLEMS[study.problem].exact.__doc__ or "").strip().splitlines()
-        return "the problem's own reference" + (f": {doc[0].rstrip('.')}" if doc else "")
+        return "the problem's own reference" + (f": {doc[0].rstrip('.')}" if doc else "") + alone
     if ref.kind == "file":
-        return f"stored result {ref.file.name}"
+        return f"stored result {ref.file.name}{alone}"
     return "the run with " + ", ".join(f"{k} = {value_text(v)}" for k, v in ref.run.items()) + \
         (" (other parameters unchanged)" if len(ref.run) < len(study.knobs) else "")
 

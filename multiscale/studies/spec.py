@@ -55,11 +55,13 @@ def _flatten(raw: dict, prefix: str = "") -> dict:
 
 @dataclass(frozen=True)
 class Reference:
-    """What errors are measured against."""
+    """What errors are measured against. A metric the reference has no value of (a file of
+    measured values, or an analytic reference, that gives some metrics only) is tabulated without
+    an error; at least one metric needs a value."""
 
     kind: str | None = key(Choice(("analytic", "run", "file")), required=True)
     run: FrozenMap | None = key(_Values())          # kind "run": parameter values of the reference run
-    file: Path | None = key(FilePath())             # kind "file": JSON {metric: value}
+    file: Path | None = key(FilePath())             # kind "file": JSON {metric: value}, SI, some metrics or all
 
     def problems(self, path, ctx):
         needs = {"run": "run", "file": "file"}.get(self.kind)
