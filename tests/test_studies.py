@@ -569,6 +569,32 @@ def test_bad_study_files_give_clear_errors(tmp_path, capsys, what, change, messa
     assert "Traceback" not in err and not (tmp_path / "results").exists()
 
 
+def test_a_sweep_against_measured_values_finds_where_each_metric_meets_them(tmp_path):
+    """Calibration from a sweep (user trial M: which k_w gives the measured worn volume). A Hertz
+    contact on a grid that follows the contact radius is self-similar: its peak pressure is
+    c F^(1/3) exactly, so the log-log interpolation between loads must return the load whose
+    closed-form peak pressure was given, divided by the cube of the grid's error ratio."""
+    def p0(load):
+        a = (3 * load * 10e-3 / (4 * 210e9 / (1 - 0.3**2))) ** (1 / 3)
+        return 3 * load / (2 * np.pi * a * a)
+    (tmp_path / "measured.json").write_text(json.dumps({"max_pressure": p0(8.0), "contact_radius": 1.0}))
+    text = (HERTZ.replace('load = "10 N"', "grid = 16").replace("grid = [12, 16, 24, 32]", 'load = ["5 N", "10 N", "20 N"]')
+            .replace('kind = "analytic"', 'kind = "file"\nfile = "measured.json"').replace('"approach"]', ']')
+            + "plots = false\n")
+    assert main(["study", str(write(tmp_path, text))]) == 0
+    rows = {float(r["load"]): float(r["max_pressure"]) for r in table(tmp_path / "results" / "hertz" / "results.csv")}
+    assert sorted(rows) == [5.0, 10.0, 20.0]
+    ratio = rows[10.0] / p0(10.0)                    # the grid's error, the same at every load
+    assert rows[5.0] / p0(5.0) == pytest.approx(ratio, rel=1e-7)
+    md = (tmp_path / "results" / "hertz" / "hertz.md").read_text()
+    line = next(x for x in md.splitlines() if x.startswith("| max_pressure [Pa] | load |"))
+    found = float(line.split("|")[4].split()[0])
+    assert found == pytest.approx(8.0 / ratio**3, rel=1e-3) and abs(ratio**-3 - 1) > 3e-3   # 4 digits shown
+    assert "| 5 N … 10 N |" in line and "N (log-log)" in line
+    far = next(x for x in md.splitlines() if x.startswith("| contact_radius [m] | load |"))
+    assert "not in the swept range | 5 N … 20 N |" in far
+
+
 @pytest.mark.parametrize("values, message", [
     ('{"contact_radius": 0.0, "max_pressure": 1e9, "approach": 1e-6}', 'metric "contact_radius" is 0.0'),
     ('{"contact_radius": 1e-4, "max_pressure": NaN, "approach": 1e-6}', 'metric "max_pressure" is nan')])

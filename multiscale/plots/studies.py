@@ -181,7 +181,12 @@ def _plot_axis(study, ok, axis, folder):
             ax.xaxis.set_minor_formatter(NullFormatter())
         if numeric:
             ticks_at = sorted(set(raw))
-            ax.set_xticks(ticks_at, [shown_at[v] for v in ticks_at], rotation=30 if len(ticks_at) > 5 else 0)
+            at = np.log(ticks_at) if log_x else np.asarray(ticks_at, float)
+            labels, row = [shown_at[v] for v in ticks_at], 0
+            for k in range(1, len(at)):    # a value close to the last one's label (8.9e-15 by 1e-14) a line lower
+                row = 1 - row if at[k] - at[k - 1] < 0.12 * (at[-1] - at[0]) else 0
+                labels[k] = "\n" * row + labels[k]
+            ax.set_xticks(ticks_at, labels, rotation=30 if len(ticks_at) > 5 else 0)
         else:
             ax.set_xticks(range(len(values)), [ticks[v] for v in values], rotation=30, ha="right", fontsize=7)
         ax.grid(True, which="both", alpha=0.25)

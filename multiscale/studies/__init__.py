@@ -36,8 +36,11 @@ metrics when read: a misspelt history metric, corrected, is read from the same r
 Output: ``results.csv`` and ``results.h5`` (one row per run; in results.h5 a column's SI unit is
 its ``unit`` attribute, a swept parameter's included), PNGs of each metric's relative error
 |m − m_ref| / |m_ref| against wall time (Pareto front highlighted) and against each knob, and a
-Markdown report stating the cheapest setting meeting each stated error. Ctrl-C stops the runs
-under way and writes the tables of those that ended (the others with status ``missing``).
+Markdown report stating the cheapest setting meeting each stated error; against a reference file
+of measured values, also where along each swept knob each metric meets its measured value
+(calibration from a sweep: which k_w gives the measured worn volume; ``results.crossings``).
+Ctrl-C stops the runs under way and writes the tables of those that ended (the others with
+status ``missing``).
 
 Modules, in import order: ``spec`` (the file schema), ``problems`` (the registry; ``base``,
 ``micro_problems``, ``scene_problem``), ``expand`` (validation, runs), ``records`` (run records on

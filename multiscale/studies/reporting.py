@@ -12,7 +12,7 @@ from multiscale.studies.expand import Study
 from multiscale.studies.formatting import metric_heading, now, number_text, percent, value_text
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.records import JIT_SHARE
-from multiscale.studies.results import Row, cheapest, reference_text, sample_std
+from multiscale.studies.results import Row, cheapest, crossings, knob_unit, reference_text, sample_std
 
 __all__ = ["report", "write_index"]
 
@@ -50,6 +50,9 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
         lines += ["Warnings of the runs' inputs:", ""] + [f"- {line}" for line in study.warnings] + [""]
     if study.reference is not None and ok:
         lines += _cheapest_table(study, rows)
+    found = crossings(study, rows)
+    if found:
+        lines += _crossing_table(study, found)
     if study.averaged and ok:
         lines += _average_table(study, ok)
     lines += ["## Runs", ""] + _runs_table(study, rows)
@@ -127,6 +130,24 @@ def _cheapest_table(study, rows) -> list[str]:
             if g.is_reference:
                 cells[-1] += " (only the reference)"
         lines.append("| " + " | ".join([percent(c["error"]), *c["case"], *cells]) + " |")
+    return lines + [""]
+
+
+def _crossing_table(study, found) -> list[str]:
+    unit = PROBLEMS[study.problem].metric_unit
+    lines = ["## Where the metrics meet the reference", "",
+             f"Along each swept parameter, the other parameters held: the value at which a metric equals its "
+             f"value in {study.reference.file.name}, interpolated between the two runs around it (log-log where "
+             "both are positive: exact for a power law, as Archard's worn volume against k_w); run the value "
+             "found to check it.", "",
+             "| metric | parameter | held | value | between | metric there |", "|---|---|---|---|---|---|"]
+    for c in found:
+        u = knob_unit(study, c.knob)
+        value = "not in the swept range" if c.value is None else \
+            f"{c.value:.4g}" + (f" {u}" if u and u != "-" else "") + (" (log-log)" if c.log else " (linear)")
+        lines.append(f"| {metric_heading(c.metric, unit(c.metric))} | {c.knob} | "
+                     f"{', '.join(f'{k} = {v}' for k, v in c.held) or '–'} | {value} | {c.between[0]} … {c.between[1]} | "
+                     f"{number_text(c.span[0])} … {number_text(c.span[1])} |")
     return lines + [""]
 
 

@@ -19,8 +19,8 @@ from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.records import read_records
 from multiscale.units import KINDS, VALUE, parse_unit
 
-__all__ = ["Row", "Setting", "case_key", "cheapest", "collect", "pareto", "reference_text", "relative_error",
-           "sample_std", "write_tables"]
+__all__ = ["Crossing", "Row", "Setting", "case_key", "cheapest", "collect", "crossings", "pareto", "reference_text",
+           "relative_error", "sample_std", "write_tables"]
 
 
 @dataclass
@@ -250,6 +250,61 @@ def cheapest(study: Study, rows: list[Row]) -> list[dict]:
             out.append({"error": tol, "case": case, "setting": min(good, key=lambda g: g.wall_time, default=None),
                         "base": base})
     return sorted(out, key=lambda c: study.report.errors.index(c["error"]))
+
+
+@dataclass(frozen=True)
+class Crossing:
+    """Where a metric meets its measured value along one swept knob, the other knobs held."""
+
+    metric: str
+    knob: str
+    held: tuple            # (knob, value as shown) of the other knobs
+    value: float | None    # the knob's value [its SI unit] at which the metric equals the reference; None: not met
+    between: tuple         # the two swept values (as shown) around it; not met: the first and last swept
+    span: tuple            # the metric at ``between`` (mean over the averaged knobs); not met: its least and most
+    log: bool              # interpolated linearly in log(metric) against log(knob)
+
+
+def crossings(study: Study, rows: list[Row]) -> list[Crossing]:
+    """Calibration from a sweep against measured values (``reference.kind = "file"``): along each
+    numeric knob, for each setting of the other knobs and each judged metric, the knob values at
+    which the metric equals its reference, interpolated between neighbouring swept values where
+    metric − reference changes sign: in log-log when the knob's and the metric's values are
+    positive (exact for a power law: Archard's worn volume ∝ k_w), else linearly. The metric is
+    the mean over the averaged knobs; a setting with a failed run is left out. [] for other
+    references."""
+    if study.reference is None or study.reference.kind != "file":
+        return []
+    ok, out = [r for r in rows if r.ok], []
+    for axis in (a for a in study.axes if a[0] not in study.averaged):
+        knob, held = axis[0], [k for k in study.knobs if k not in axis and k not in study.averaged]
+        groups = {}
+        for r in rows:
+            groups.setdefault(tuple(r.run.shown[k] for k in held), []).append(r)
+        for setting, group in groups.items():
+            if any(not r.ok for r in group):
+                continue
+            xs = list({r.run.label[knob] for r in group})
+            if len(xs) < 2 or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in xs):
+                continue
+            xs.sort()
+            shown = {r.run.label[knob]: r.run.shown[knob] for r in group}
+            for m in study.judged:
+                ref = next(r.reference[m] for r in ok if m in r.reference)
+                y = [float(np.mean([r.record["metrics"][m] for r in group if r.run.label[knob] == x])) for x in xs]
+                log = min(xs) > 0 and min(y) > 0 and ref > 0
+                f = (lambda v: math.log(v)) if log else (lambda v: v)
+                found = [i for i in range(len(xs) - 1) if (y[i] - ref) * (y[i + 1] - ref) < 0 or y[i + 1] == ref
+                         or i == 0 and y[0] == ref]          # (a swept value that meets it: once)
+                for i in found:
+                    t = 0.0 if y[i] == ref else (f(ref) - f(y[i])) / (f(y[i + 1]) - f(y[i]))
+                    value = f(xs[i]) + t * (f(xs[i + 1]) - f(xs[i]))
+                    out.append(Crossing(m, knob, tuple(zip(held, setting)), math.exp(value) if log else value,
+                                        (shown[xs[i]], shown[xs[i + 1]]), (y[i], y[i + 1]), log))
+                if not found:
+                    out.append(Crossing(m, knob, tuple(zip(held, setting)), None, (shown[xs[0]], shown[xs[-1]]),
+                                        (min(y), max(y)), log))
+    return out
 
 
 def sample_std(values) -> float:
