@@ -512,8 +512,9 @@ class Multiscale:
             volume = self.rough.zone_wear_volume(depth)
             row.update({f"wear_volume_{n}": v for n, v in self.rough.interface_sums(volume).items()})
             row.update(wear_volume=float(volume.sum()), wear_max_depth=float(depth.max()),
-                       rms_height=self.rough.rms_height(heights),
-                       frictional_work=self.work, wear_substep_error=result.micro.wear_error,
+                       rms_height=self.rough.rms_height(heights), frictional_work=self.work,
+                       wear_rate_mean=float(volume.sum()) / self.work if self.work > 0 else np.nan,   # (user trial M)
+                       wear_substep_error=result.micro.wear_error,
                        wear_substeps=result.micro.wear_substeps)
             if self.post.counter_rate is not None:
                 row.update(counter_wear_volume=self.counter_volume,

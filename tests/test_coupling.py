@@ -15,7 +15,7 @@ pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 import ufl  # noqa: E402
 
 from multiscale.errors import ConvergenceError, InputError, SceneError  # noqa: E402
-from multiscale.io import History, solver_statistic  # noqa: E402
+from multiscale.io import History, solver_statistic, unit_of  # noqa: E402
 from multiscale.geometry import Support, builder  # noqa: E402
 from multiscale.macro import mesh  # noqa: E402
 from multiscale.macro.laws_ufl import FacetLaw  # noqa: E402
@@ -331,6 +331,8 @@ def test_rough_pin_on_disc_bookkeeping_and_outputs(straight):
     np.testing.assert_allclose(h["interface_force"], 200.0, rtol=1e-6)
     assert h["frictional_work"][-1] == pytest.approx(0.4 * 200 * 2 * np.pi * 200 / 60 * 0.09 * 1.2, rel=0.03)
     assert h["wear_volume"][-1] == pytest.approx(1e-14 * h["frictional_work"][-1], rel=5e-4)
+    assert np.isnan(h["wear_rate_mean"][0]) and unit_of("wear_rate_mean") == "1/Pa"    # no work yet
+    np.testing.assert_allclose(h["wear_rate_mean"][1:], 1e-14, rtol=5e-4)
     assert np.all(np.diff(h["wear_volume"]) > 0) and np.all(np.diff(h["rms_height"]) < 0)
     assert np.all((h["partition_min"] >= 0) & (h["partition_max"] <= 1))
     assert np.all(h["micro_max_pressure"] > h["max_pressure"])
