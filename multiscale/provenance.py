@@ -33,7 +33,7 @@ from multiscale.io import replacing
 from multiscale.outputs import plan
 from multiscale.schema import (Choice, Curve, Either, FilePath, ListOf, Named, OnlyWith, Quantity, Section, TableOr,
                                Tables, fields_of)
-from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE, Scene
+from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE, Scene, default_wear_rate
 from multiscale.scene_geometry import FileGeometry, LengthUnit, Points
 
 RUNNING = "running (or killed: no end was recorded)"      # status of a run's first record
@@ -163,8 +163,9 @@ def resolved_toml(scene: Scene) -> str:
     """The scene as TOML with every key the schema knows (see module docstring)."""
     head = ["# The scene as multiscale read it: every default filled in, SI units (unit in the comment).",
             f"# Read from {scene.source}" if scene.source else "# Read from text (no file)."]
-    head += [f"# warning: {w}" for w in scene.warnings]
     wear = scene.wear
+    filled = default_wear_rate(scene)          # the table is written out below, and said
+    head += [f"# warning: {w}" for w in scene.warnings if w not in filled]
     if "wear" in scene.effects and wear is not None and wear.k_w is None and wear.k_w_table is None \
             and not scene.rough_material_wears:       # the default k_w(T) table that runs, written out
         scene = dataclasses.replace(scene, wear=dataclasses.replace(wear, k_w_table=FIG_7_9_WEAR_RATE))

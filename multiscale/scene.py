@@ -40,7 +40,8 @@ from multiscale.scene_stability import Stability, unresolved_band
 from multiscale.scene_vehicle import Vehicle
 
 __all__ = ["COUPLING_DEFAULT", "EFFECTS", "FIG_7_9_CALIBRATION", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Boundary",
-           "Geometry", "Interface", "InterfaceSettings", "Loading", "Material", "Scene", "Vehicle", "load", "loads"]
+           "Geometry", "Interface", "InterfaceSettings", "Loading", "Material", "Scene", "Vehicle", "default_wear_rate",
+           "load", "loads"]
 
 
 # ------------------------------------------------------------------ effects
@@ -465,7 +466,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                      for phrase in scene.materials[name].beyond(T0).values()]
     if "wear" in effects and scene.wear is not None and g is not None and scene.materials is not None \
             and scene.time is not None and not scene.rough_material_wears:
-        warnings += scene.wear.held_ends(T0=scene.time.initial_temperature)
+        warnings += default_wear_rate(scene) + scene.wear.held_ends(T0=scene.time.initial_temperature)
     for i, b in enumerate(scene.boundary or (), 1):
         given = [k for k in Boundary.THERMAL if b is not None and getattr(b, k) is not None]
         if given and "thermal" not in effects:
@@ -474,6 +475,16 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         warnings.append('effects "friction" and "thermal" without "heat_partition": no frictional heat '
                         "enters the bodies")
     return ctx.warnings + warnings
+
+
+def default_wear_rate(scene: Scene) -> list[str]:
+    """The warning of a wear by the default k_w(T) table (user trial M calibrated on it unawares)."""
+    w = scene.wear
+    if "wear" not in scene.effects or w is None or w.k_w is not None or w.k_w_table is not None \
+            or scene.rough_material_wears:
+        return []
+    return ["wear: no k_w given (wear.k_w, wear.k_w_table or the rough material's k_w): the zones wear by the "
+            f"default k_w(T) table, the {FIG_7_9_CALIBRATION}"]
 
 
 def _hardness_checks(scene: Scene, g: Geometry, raw: dict, effects) -> list[str]:

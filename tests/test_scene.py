@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 from multiscale.errors import InputError, SceneError
-from multiscale.scene import EFFECTS, load, loads
+from multiscale.scene import EFFECTS, default_wear_rate, load, loads
 from multiscale.scene_summary import summary
 from multiscale.units import UnitError, to_si
 
@@ -204,7 +204,10 @@ def test_demo_scenes_validate():
     assert pod.warnings == ()
     for name in ("pin_on_disc", "pin_on_disc_thesis"):               # the multiscale versions
         rough = load(DEMOS / f"{name}.toml")
-        assert {"roughness", "wear"} <= rough.effects and rough.warnings == ()
+        assert {"roughness", "wear"} <= rough.effects and rough.warnings == tuple(default_wear_rate(rough))
+        assert rough.warnings[0].startswith("wear: no k_w given (wear.k_w, wear.k_w_table or the rough material's "
+                                            "k_w): the zones wear by the default k_w(T) table, the shape of thesis")
+        assert load(DEMOS / f"{name}.toml", overrides={"wear.k_w": "1e-14 1/Pa"}).warnings == ()   # (user trial M)
         assert rough.roughness.body == "pin" and rough.micro.partition_law
 
 
