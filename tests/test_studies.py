@@ -569,7 +569,7 @@ def test_bad_study_files_give_clear_errors(tmp_path, capsys, what, change, messa
     assert "Traceback" not in err and not (tmp_path / "results").exists()
 
 
-def test_a_sweep_against_measured_values_finds_where_each_metric_meets_them(tmp_path):
+def test_a_sweep_against_measured_values_finds_where_each_metric_meets_them(tmp_path, made):
     """Calibration from a sweep (user trial M: which k_w gives the measured worn volume). A Hertz
     contact on a grid that follows the contact radius is self-similar: its peak pressure is
     c F^(1/3) exactly, so the log-log interpolation between loads must return the load whose
@@ -579,8 +579,7 @@ def test_a_sweep_against_measured_values_finds_where_each_metric_meets_them(tmp_
         return 3 * load / (2 * np.pi * a * a)
     (tmp_path / "measured.json").write_text(json.dumps({"max_pressure": p0(8.0), "contact_radius": 1.0}))
     text = (HERTZ.replace('load = "10 N"', "grid = 16").replace("grid = [12, 16, 24, 32]", 'load = ["5 N", "10 N", "20 N"]')
-            .replace('kind = "analytic"', 'kind = "file"\nfile = "measured.json"').replace('"approach"]', ']')
-            + "plots = false\n")
+            .replace('kind = "analytic"', 'kind = "file"\nfile = "measured.json"').replace('"approach"]', ']'))
     assert main(["study", str(write(tmp_path, text))]) == 0
     rows = {float(r["load"]): float(r["max_pressure"]) for r in table(tmp_path / "results" / "hertz" / "results.csv")}
     assert sorted(rows) == [5.0, 10.0, 20.0]
@@ -593,6 +592,12 @@ def test_a_sweep_against_measured_values_finds_where_each_metric_meets_them(tmp_
     assert "| 5 N … 10 N |" in line and "N (log-log)" in line
     far = next(x for x in md.splitlines() if x.startswith("| contact_radius [m] | load |"))
     assert "not in the swept range | 5 N … 20 N |" in far
+    _, axes = made[-1]                          # against the load: the values, the measured one, where met
+    pressure = axes[0][1]
+    measured, = [line for line in pressure.get_lines() if line.get_label() == "measured"]
+    star, = [line for line in pressure.get_lines() if line.get_label() == "where the sweep meets it"]
+    assert measured.get_ydata()[0] == p0(8.0) and star.get_ydata()[0] == p0(8.0)
+    assert star.get_xdata()[0] == pytest.approx(8.0 / ratio**3, rel=1e-9)
 
 
 @pytest.mark.parametrize("values, message", [

@@ -15,7 +15,7 @@ from matplotlib.ticker import FuncFormatter, NullFormatter
 from multiscale.studies.expand import Study, StudyRun
 from multiscale.studies.formatting import metric_heading, percent
 from multiscale.studies.problems import PROBLEMS
-from multiscale.studies.results import Row, case_key, knob_unit, pareto, sample_std
+from multiscale.studies.results import Row, case_key, crossings, knob_unit, pareto, sample_std
 
 __all__ = ["plot"]
 
@@ -34,9 +34,10 @@ def plot(study: Study, rows: list[Row], folder: Path) -> list[Path]:
     out = []
     if study.judged:
         out.append(_plot_pareto(study, ok, folder))
+    found = crossings(study, rows)
     for axis in study.axes:
         if axis[0] not in study.averaged:
-            out.append(_plot_axis(study, ok, axis, folder))
+            out.append(_plot_axis(study, ok, axis, folder, found))
     return [p for p in out if p is not None]
 
 
@@ -129,9 +130,11 @@ def _axis_label(study, axis, raw) -> str:
     return ", ".join(axis) + (f" [{unit}]" if unit and bare else "")
 
 
-def _plot_axis(study, ok, axis, folder):
+def _plot_axis(study, ok, axis, folder, found):
     """Errors (or metric values) and wall time against one axis (a knob, or zipped knobs plotted
-    against the first), one line per setting of the other knobs (mean ± std over averaged ones)."""
+    against the first), one line per setting of the other knobs (mean ± std over averaged ones);
+    against measured values (a reference file) the metric itself, the measured value and where the
+    sweep meets it (``found``: ``results.crossings``)."""
     def point(r):
         return json.dumps([r.run.label[k] for k in axis])
     values = list(dict.fromkeys(point(r) for r in ok))
@@ -146,7 +149,8 @@ def _plot_axis(study, ok, axis, folder):
     lines = {}
     for r in ok:
         lines.setdefault(tuple(r.run.shown[k] for k in others), []).append(r)
-    panels = [("error" if m in study.judged else "value", m) for m in study.metrics] + [("time", None)]
+    measured = study.reference is not None and study.reference.kind == "file"
+    panels = [("error" if m in study.judged and not measured else "value", m) for m in study.metrics] + [("time", None)]
     fig, axes = plt.subplots(1, len(panels), figsize=(4.4 * len(panels), 3.9), squeeze=False)
     for ax, (kind, m) in zip(axes[0], panels):
         for c, (other, group) in enumerate(lines.items()):
@@ -171,6 +175,12 @@ def _plot_axis(study, ok, axis, folder):
                         ha="center", va="center")
             for tol in study.report.errors:
                 ax.axhline(tol, color="gray", ls="--", lw=0.8)
+        if kind == "value" and m in study.judged:        # calibration: the measured value, and where it is met
+            ref = next(r.reference[m] for r in ok if m in r.reference)
+            ax.axhline(ref, color="green", ls="--", lw=1, label="measured")
+            met = [c.value for c in found if c.knob == axis[0] and c.metric == m and c.value is not None]
+            ax.plot(met, [ref] * len(met), "*", color="green", ms=11, label="where the sweep meets it" if met else None)
+            ax.legend(fontsize=6)
         if kind == "time":
             ax.set_yscale("log")
         value = metric_heading(m, PROBLEMS[study.problem].metric_unit(m)) if kind == "value" else ""

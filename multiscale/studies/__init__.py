@@ -35,7 +35,8 @@ metrics when read: a misspelt history metric, corrected, is read from the same r
 
 Output: ``results.csv`` and ``results.h5`` (one row per run; in results.h5 a column's SI unit is
 its ``unit`` attribute, a swept parameter's included), PNGs of each metric's relative error
-|m − m_ref| / |m_ref| against wall time (Pareto front highlighted) and against each knob, and a
+|m − m_ref| / |m_ref| against wall time (Pareto front highlighted) and against each knob (against
+measured values: the metric, its measured value and where the sweep meets it), and a
 Markdown report stating the cheapest setting meeting each stated error; against a reference file
 of measured values, also where along each swept knob each metric meets its measured value
 (calibration from a sweep: which k_w gives the measured worn volume; ``results.crossings``).
