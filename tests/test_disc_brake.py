@@ -1,4 +1,5 @@
 """Disc-brake assembly (thesis §4.3.1): geometry, free-free disc modes, preload and complex modes."""
+import dataclasses
 from pathlib import Path
 from types import SimpleNamespace as NS
 
@@ -20,7 +21,7 @@ from multiscale.geometry import builder  # noqa: E402
 from multiscale.macro import eigen, modal  # noqa: E402
 from multiscale.macro import mesh as two_body  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
-from multiscale.macro.output import write_modes  # noqa: E402
+from multiscale.macro.output import orientation, write_modes  # noqa: E402
 from multiscale.rough import interface_plane  # noqa: E402
 from multiscale import scene as scenes  # noqa: E402
 from multiscale.workflows import squeal  # noqa: E402
@@ -263,6 +264,17 @@ def test_mode_shapes_are_written_to_vtx(tmp_path, brake, friction):
         for part, values in (("real", disc.real), ("imaginary", disc.imag)):
             stored = reader.read(f"mode shape {part} part [m/kg^0.5]", step_selection=[1, 1])
             assert np.abs(stored).max() == pytest.approx(np.abs(values).max(), rel=1e-12)
+    # the sign is the shape's, not the eigensolver's: the negated modes are written the same
+    flipped = dataclasses.replace(friction.modes, modes=-friction.modes.modes)
+    again = write_modes(tmp_path / "flipped", flipped, brake[1].u, ["pads", "disc"], modes=[1, 2])
+    with adios2.FileReader(str(files[1])) as one, adios2.FileReader(str(again[1])) as other:
+        for j in (0, 1):
+            name = "mode shape real part [m/kg^0.5]"
+            a, b = one.read(name, step_selection=[j, 1]), other.read(name, step_selection=[j, 1])
+            assert np.abs(a).max() > 0 and np.array_equal(a, b), j
+    sign = orientation(friction.modes.modes[:, :2], brake[1].u, [u.x.index_map.size_local * 3 for u in brake[1].u])
+    assert np.array_equal(orientation(-friction.modes.modes[:, :2], brake[1].u,
+                                      [u.x.index_map.size_local * 3 for u in brake[1].u]), -sign)
 
 
 # ---------------------------------------------------------------- rough pad interfaces

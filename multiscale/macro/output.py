@@ -34,6 +34,7 @@ import h5py
 import numpy as np
 from dolfinx import fem
 from dolfinx.io import VTXMeshPolicy, VTXWriter
+from mpi4py import MPI
 
 from multiscale import io
 from multiscale.arrays import unique_rows
@@ -383,7 +384,9 @@ def write_modes(folder: str | Path, result, functions: Sequence, names: Sequence
                 modes: Sequence[int] | None = None) -> list[Path]:
     """Mode shapes of ``result`` (``eigen.ModalResult``) to ``<folder>/modes_<name>.bp`` (VTX, one
     per body): arrays "mode shape real part" and "... imaginary part" [m/kg^0.5] on the space of
-    the displacement, "time" = mode number (1, 2, ...). Collective; returns the written paths.
+    the displacement, "time" = mode number (1, 2, ...), each mode's sign that of ``orientation``
+    (the eigensolver's is arbitrary: the same mode was written as +phi or -phi by runs on other
+    ranks). Collective; returns the written paths.
 
     ``functions`` are displacement Functions of the bodies in the block order of the matrices (the
     owned dofs of body 0, then of body 1, ... on each rank)."""
@@ -393,6 +396,7 @@ def write_modes(folder: str | Path, result, functions: Sequence, names: Sequence
     if sum(sizes) != result.modes.shape[0]:
         raise InputError("functions", len(functions), "must span the dof layout of the modes")
     offsets = np.concatenate([[0], np.cumsum(sizes)])
+    sign = orientation(result.modes, functions, sizes)
     files = []
     for k, (u, name) in enumerate(zip(functions, names)):
         V = u.function_space
@@ -400,10 +404,32 @@ def write_modes(folder: str | Path, result, functions: Sequence, names: Sequence
         out = folder / f"modes_{name}.bp"
         with VTXWriter(V.mesh.comm, out, list(parts), engine="BP4", mesh_policy=VTXMeshPolicy.reuse) as w:
             for j in sel:
-                block = result.modes[offsets[k]:offsets[k + 1], j - 1]
+                block = sign[j - 1] * result.modes[offsets[k]:offsets[k + 1], j - 1]
                 for f, values in zip(parts, (block.real, block.imag)):
                     f.x.array[:sizes[k]] = values
                     f.x.scatter_forward()
                 w.write(float(j))
         files.append(out)
     return files
+
+
+def orientation(modes: np.ndarray, functions: Sequence, sizes: Sequence[int]) -> np.ndarray:
+    """Per mode (column of ``modes``: owned dofs of the bodies' ``functions`` in block order, ``sizes``
+    each), the sign +-1 that makes sum Re(phi) w positive, w = sin(k . x / L + 1.1 c + 0.37) a
+    fixed weight of each dof's point x [m] and component c, L the bodies' largest extent: the same
+    sign on any partition and for a mirrored shape (collective)."""
+    weights, lo, hi = [], np.full(3, np.inf), np.full(3, -np.inf)
+    for u, n in zip(functions, sizes):
+        V = u.function_space
+        bs = V.dofmap.bs
+        x = V.tabulate_dof_coordinates()[:n // bs]
+        lo, hi = np.minimum(lo, x.min(axis=0, initial=np.inf)), np.maximum(hi, x.max(axis=0, initial=-np.inf))
+        weights.append((x, bs))
+    comm = functions[0].function_space.mesh.comm
+    extent = [comm.allreduce(float(h), op=MPI.MAX) - comm.allreduce(float(g), op=MPI.MIN) for g, h in zip(lo, hi)]
+    L = max(max(extent), np.finfo(float).tiny)      # (an array's allreduce with MAX fails on 2 ranks)
+    w = np.concatenate([np.sin((x @ np.array([7.31, 11.93, 5.17]) / L)[:, None] + 1.1 * np.arange(bs) + 0.37).ravel()
+                        for x, bs in weights])
+    total = comm.allreduce(w @ modes.real)
+    return np.where(total < 0, -1.0, 1.0)
+
