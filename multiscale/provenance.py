@@ -163,12 +163,10 @@ def resolved_toml(scene: Scene) -> str:
     """The scene as TOML with every key the schema knows (see module docstring)."""
     head = ["# The scene as multiscale read it: every default filled in, SI units (unit in the comment).",
             f"# Read from {scene.source}" if scene.source else "# Read from text (no file)."]
-    wear = scene.wear
-    filled = default_wear_rate(scene)          # the table is written out below, and said
+    filled = default_wear_rate(scene)          # the default k_w(T) table that runs: written out, and said
     head += [f"# warning: {w}" for w in scene.warnings if w not in filled]
-    if "wear" in scene.effects and wear is not None and wear.k_w is None and wear.k_w_table is None \
-            and not scene.rough_material_wears:       # the default k_w(T) table that runs, written out
-        scene = dataclasses.replace(scene, wear=dataclasses.replace(wear, k_w_table=FIG_7_9_WEAR_RATE))
+    if filled:
+        scene = dataclasses.replace(scene, wear=dataclasses.replace(scene.wear, k_w_table=FIG_7_9_WEAR_RATE))
     if scene.wear is not None and scene.wear.k_w_table == FIG_7_9_WEAR_RATE:
         head.append(f"# wear.k_w_table is the default table: {FIG_7_9_CALIBRATION}")
     return "\n".join(head + [""] + _emit(_table(Scene, scene))) + "\n"

@@ -419,7 +419,7 @@ def _check_reference(f: StudyFile, problem, knobs, axes, runs, ctx) -> tuple:
     if not isinstance(values, dict):
         ctx.problems.append(f"reference.file = \"{ref.file}\": must hold a JSON object {{metric: value}}")
         return ()
-    judged = tuple(m for m in f.metrics if m in values)
+    judged, others = tuple(m for m in f.metrics if m in values), [k for k in values if k not in f.metrics]
     for m in f.metrics:
         if m in values and (not isinstance(values[m], (int, float)) or isinstance(values[m], bool)):
             ctx.problems.append(f"reference.file = \"{ref.file}\": metric \"{m}\" is {values[m]!r}: give a "
@@ -427,7 +427,6 @@ def _check_reference(f: StudyFile, problem, knobs, axes, runs, ctx) -> tuple:
         elif m in values and not (math.isfinite(values[m]) and values[m] != 0):
             ctx.problems.append(f"reference.file = \"{ref.file}\": metric \"{m}\" is {values[m]!r}: errors are "
                                 "relative to it; give a finite, nonzero number")
-        elif m not in values and (not judged or suggest(m, [k for k in values if k not in f.metrics])):
-            ctx.problems.append(f"reference.file = \"{ref.file}\": no number for metric \"{m}\""
-                                f"{suggest(m, [k for k in values if k not in f.metrics])}")
+        elif m not in values and (not judged or suggest(m, others)):
+            ctx.problems.append(f"reference.file = \"{ref.file}\": no number for metric \"{m}\"{suggest(m, others)}")
     return judged
