@@ -24,7 +24,9 @@ a periodic patch, (2N)² zero-padded for an isolated one; "single": of which in 
 bccg's two pairs from 512²); "t/it [pairs]": time per iteration over the time of one
 (double) rfft2 + irfft2 pair of that grid (measured here); "to ref": relative
 L2 distance of the pressure to a tol = 1e-12 reference (bccg; pk at 1e-12 agrees with it to
-~1e-11); "vs pk": relative L2 between bccg and pk at tol 1e-8 (the discrete answer).
+~1e-11); "vs pk": relative L2 between bccg and pk at tol 1e-8 (the discrete answer). Batches:
+"cores" the one call's CPU time over its wall time (2 if each thread had a core throughout),
+"steal" the CPU seconds per second of the call the hypervisor gave to other guests (/proc/stat).
 
 Run: python benchmarks/bench_contact.py [--quick] [--sizes 256,512] [--skip-tamaas-above N]
 """
@@ -241,16 +243,21 @@ def batch(n_patches, n, reps, threads):
     h, dx = surface(n, seed=2, batch=(n_patches,))
     print(f"\nbatch of {n_patches} patches of {n}², MULTISCALE_THREADS={threads}")
     print(f"{'method':>7} {'one call [s]':>12} {'loop [s]':>9} {'speed-up':>8} {'loop 1 thr [s]':>14} "
-          f"{'speed-up':>8} {'its (max)':>9} {'max rel diff':>12}")
+          f"{'speed-up':>8} {'its (max)':>9} {'max rel diff':>12} {'cores':>5} {'steal':>6}")
     for m in ("bccg", "pk"):
         solver = ContactSolver(E, (n, n), dx, method=m)
         times = {"batch": [], "loop": [], "loop1": []}
+        cores, steal = [], []        # the one call's CPU time over its wall time; the VM's steal over it
 
         def timed(name, count, solve):
             fft.set_threads(count)
-            t0 = time.perf_counter()
+            s0, c0, t0 = steal_seconds(), time.process_time(), time.perf_counter()
             r = solve()
-            times[name].append(time.perf_counter() - t0)
+            wall = time.perf_counter() - t0
+            times[name].append(wall)
+            if name == "batch":
+                cores.append((time.process_time() - c0) / wall)
+                steal.append((steal_seconds() - s0) / wall)
             fft.set_threads(1)
             return r
 
@@ -267,7 +274,16 @@ def batch(n_patches, n, reps, threads):
             ratio1 = f"{stats.median([a / b for a, b in zip(t['loop1'], t['batch'])]):.2f}"
         diff = max(rel(rb.pressure[k], rl[k].pressure) for k in range(n_patches))
         print(f"{m:>7} {stats.median(t['batch']):12.3f} {stats.median(t['loop']):9.3f} {ratio:8.2f} {loop1:>14} "
-              f"{ratio1:>8} {int(rb.iterations.max()):9d} {diff:12.1e}", flush=True)
+              f"{ratio1:>8} {int(rb.iterations.max()):9d} {diff:12.1e} {stats.median(cores[1:]):5.2f} "
+              f"{stats.median(steal[1:]):6.2f}", flush=True)
+
+
+def steal_seconds() -> float:
+    """CPU time [s] the hypervisor gave to others while this VM's cores wanted it, summed over the
+    cores (/proc/stat's ``steal``; 0 where there is none)."""
+    with contextlib.suppress(OSError, IndexError, ValueError), open("/proc/stat") as fh:
+        return int(fh.readline().split()[8]) / os.sysconf("SC_CLK_TCK")
+    return 0.0
 
 
 def padding(sizes, reps):
