@@ -91,6 +91,7 @@ class ZoneLoading:
     angle: np.ndarray          # rad, its direction in the interface plane (from +x)
     temperature: np.ndarray    # K, (Z, 2): facet-mean surface temperatures (counter-face, rough body)
     reach: np.ndarray          # m per unit of body 1's sliding (rad or m): the zone's sliding distance
+    friction: np.ndarray | None  # -, mu: the zone's (its facets' area mean with a friction law); None: the post's
 
 
 @dataclass
@@ -182,11 +183,17 @@ class Multiscale:
         zone_of, areas = self.rough.zone_of_facet[rough], iface.areas[rough]
         pressure_area = model.contact.facet_pressure() * iface.areas          # N per facet
         force, area = (np.bincount(zone_of, f[rough], minlength=Z) for f in (pressure_area, iface.areas))
+
+        def mean(values, default):               # the zones' area means of a facet field, ``default`` without facets
+            total = np.bincount(zone_of, values[rough] * areas, minlength=Z)
+            return np.where(area > 0, total / np.where(area > 0, area, 1.0), default)
         T = np.full((Z, 2), self.settings.initial_temperature)
         if model.thermal is not None:
             for col, side in ((0, 1), (1, 0)):
-                total = np.bincount(zone_of, model.thermal.facet_temperature(side)[rough] * areas, minlength=Z)
-                T[:, col] = np.where(area > 0, total / np.where(area > 0, area, 1.0), T[:, col])
+                T[:, col] = mean(model.thermal.facet_temperature(side), T[:, col])
+        mu = self.settings.friction
+        if mu is not None and model.friction_law is not None:     # fade: mu of the facets' temperatures
+            mu = mean(iface.values(model.contact.friction), mu)
         reach, angle = self.rough.zone_sliding(self.tm.spec.motion, pressure_area)
         # the speed now; at a standstill the mean of the next step (these fields act on it), else of
         # the last (the zones' heating needs a speed; a restart from rest had no exchange for a step)
@@ -195,7 +202,7 @@ class Multiscale:
             speed = model.drive.mean_speed(model.time, model.time + dt) or \
                 model.drive.mean_speed(max(model.time - dt, 0.0), model.time)
         return ZoneLoading(force, self.rough.per_facet_area(force), reach * abs(speed),   # their mean pressure
-                           angle + (np.pi if speed < 0 else 0.0), T, reach)
+                           angle + (np.pi if speed < 0 else 0.0), T, reach, mu)
 
     def analyse(self) -> MicroStep:
         """Post-analysis (local contact, heating, conductance) of the loaded zones at the current
@@ -207,7 +214,7 @@ class Multiscale:
         mine = loaded[comm.rank::comm.size]
         T = load.temperature[mine]
         remote = np.column_stack([T[:, 0] if self.settings.remote == "bulk" else T[:, 1], T[:, 1]])
-        mu = None if self.settings.friction is None else self.settings.friction[mine]
+        mu = None if load.friction is None else load.friction[mine]
         res = io.collective(comm, lambda: self.post.run(
             [zones[i] for i in mine], load.pressure[mine], speed=load.speed[mine], angle=load.angle[mine],
             remote=remote, warm=self.warm[mine], mu=mu, duration=self.settings.dt,
@@ -273,8 +280,7 @@ class Multiscale:
         t0, t1 = (float(f"{k * self.settings.dt:.12g}") for k in (m, n))     # the model's times (step_time)
         f, load = self.model.drive.factor(t1), self.loading()
         sliding = self.model.drive.mean_sliding(t0, t1) * (t1 - t0) / f if f > 0 else 0.0
-        return self.post.archard_compliance(load.reach * sliding, load.temperature[:, 1], self.settings.friction,
-                                            self.rates)
+        return self.post.archard_compliance(load.reach * sliding, load.temperature[:, 1], load.friction, self.rates)
 
     def wear(self, duration: float) -> tuple[float, float, int]:
         """Wear of the zones of the last ``analyse`` over the last ``duration`` [s] (their topographies change; a
@@ -569,6 +575,7 @@ class Multiscale:
         self.interval_work = float(attrs.get("interval_work", 0.0))     # absent from older checkpoints
         if m.thermal is not None:
             m.thermal.time = m.time
+            m.update_friction()
         # the run's warnings before (not said again), then this session's own (set-up: the options)
         for holder, said in zip((m, m.thermal), json.loads(attrs.get("notes", "[[], []]"))):
             if holder is not None:

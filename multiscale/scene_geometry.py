@@ -250,8 +250,8 @@ class GeometrySection(Section):
         return f"a table with builder = {self.builders.describe()} and its parameters, or file = \"...\""
 
     def reference(self, path) -> list[str]:
-        lines = [f"  {'builder':<20} {self.builders.describe()}  [or file]",
-                 f"  {'max_cells':<20} integer >= 1, default {MAX_CELLS}: {MAX_CELLS_TEXT}"]
+        lines = [f"  {'builder':<20}  {self.builders.describe()}  [or file]",
+                 f"  {'max_cells':<20}  integer >= 1, default {MAX_CELLS}: {MAX_CELLS_TEXT}"]
         for name in self.builders.options:
             module = builder(name)
             lines.append(f"  builder = \"{name}\" parameters (SI defaults; 0 = the builder's fallback):")

@@ -91,12 +91,10 @@ class Material:
     kappa: float | tuple | None = key(_property(_CONDUCTIVITY, "kappa"), needed_by=("thermal",))  # W/(m K)
     c: float | tuple | None = key(_property(_SPECIFIC_HEAT, "c"), absent="with thermal: rho c = kappa/chi")  # J/(kg K)
     chi: float | tuple | None = key(_property(_DIFFUSIVITY, "chi"), absent="with thermal: kappa/(rho c)")    # m^2/s
-    alpha: float | tuple | None = key(_property(_EXPANSION, "alpha"), needed_by=("expansion",),
-                                      warn_unused=True)                                      # 1/K
+    alpha: float | tuple | None = key(_property(_EXPANSION, "alpha"), needed_by=("expansion",), warn_unused=True)  # 1/K
     k_w: float | tuple | None = key(_property(Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)), "k_w"),
                                     absent="rough body: wear.k_w's rate; counter-face: no wear")     # 1/Pa, Archard
-    hardness: float | tuple | None = key(_property(_HARDNESS, "hardness"),      # Pa, asperities' flow pressure
-                                         absent="with plasticity: the other side's")
+    hardness: float | tuple | None = key(_property(_HARDNESS, "hardness"), absent="with plasticity: the other side's")
     loss_factor: float | None = key(Quantity("dimensionless", ge=0), absent="0: no structural damping")
     damping_alpha: float | None = key(Quantity("rate", ge=0), absent="0: no alpha M damping")   # 1/s
     damping_beta: float | None = key(Quantity("time", ge=0), absent="0: no beta K damping")           # s
@@ -279,9 +277,9 @@ class Loading:
     run so that the friction moment about the axis is the torque times the load factor while sliding (a cycle
     of stops under a vehicle's torque; ``vehicle.mass`` does it for one stop). The speed of the rotating body:
     ``rotation_speed``, a ``speed_profile`` against time, or a ``vehicle`` stop or drag; a translating body
-    slides at ``sliding_speed``. Friction: a constant ``friction`` (not of the temperature: no fade),
-    or (squeal analysis only) mu against the slip speed: a table ``friction_curve`` or a ``stribeck`` law, taken
-    per interface facet at its steady slip speed; its slope enters the modal analysis as damping."""
+    slides at ``sliding_speed``. Friction: a constant ``friction``; ``friction_temperature``, mu against the
+    interface temperature (fade, effect "thermal": each facet's at the mean of its faces', a heat step late); or (the
+    squeal only) mu against the slip speed, ``friction_curve`` or ``stribeck``, per facet at its steady slip speed."""
 
     normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)),                 # N
                                      absent="pressure, braking_torque or vehicle.mass gives the load")
@@ -300,12 +298,14 @@ class Loading:
     vehicle: Vehicle | None = key(Section(Vehicle))
     sliding_speed: float | None = key(Quantity("speed", ge=0, plausible=(0.0, 200.0)), absent="at rest")  # m/s
     friction: float | None = key(_FRICTION, absent="friction_curve, stribeck or each interface's own friction")  # mu
+    friction_temperature: tuple | None = key(Curve(_TEMPERATURE, _FRICTION, "temperature", "mu", min_rows=2),
+                                             absent="friction: mu of no temperature")   # ((K, -), ...)
     ramp_steps: int = key(Integer(ge=1, le=10**4), default=1)   # load increments of the first mechanical solve
     friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), Quantity("dimensionless", ge=0), "slip speed",
                                              "mu", min_rows=2), absent="friction or stribeck gives mu")  # ((m/s, -),..)
     stribeck: Stribeck | None = key(Section(Stribeck))
 
-    FRICTION = ("friction", "friction_curve", "stribeck")     # one needed with effect friction: scene._cross_checks
+    FRICTION = ("friction", "friction_temperature", "friction_curve", "stribeck")   # one with effect friction
     rules = (OneOf(("normal_force", "pressure")), OneOf(FRICTION), OneOf(("rotation_speed", "speed_profile", "vehicle"),
              meaning="a vehicle is one stop or drag; several stops: speed and load profiles"))
 
@@ -313,7 +313,9 @@ class Loading:
         law = [k for k in self.FRICTION if getattr(self, k) is not None]
         if law and "friction" not in ctx.effects:
             ctx.warnings.append(f'{path}.{law[0]} is ignored: effect "friction" is not in effects')
-        elif law and law[0] != "friction" and "stability" not in ctx.effects:
+        elif law[:1] == ["friction_temperature"] and "thermal" not in ctx.effects:
+            return [f'{path}.friction_temperature: needs effect "thermal" (its temperatures); give {path}.friction']
+        elif law and law[0] not in self.FRICTION[:2] and "stability" not in ctx.effects:
             return [f"{path}.{law[0]}: a speed-dependent friction is read by the squeal analysis only "
                     f'(effect "stability"); give {path}.friction']
         if self.vehicle is not None and self.load_profile is not None:
@@ -556,9 +558,7 @@ class Wear:
     @property
     def rate(self):
         """k_w [1/Pa]: the constant, else the table ((temperatures [K]), (rates [1/Pa]))."""
-        if self.k_w is not None:
-            return self.k_w
-        return tuple(zip(*(self.k_w_table or FIG_7_9_WEAR_RATE)))
+        return self.k_w if self.k_w is not None else tuple(zip(*(self.k_w_table or FIG_7_9_WEAR_RATE)))
 
     def held_ends(self, T0: float | None = None, hottest: float | None = None) -> list[str]:
         """The k_w(T) table held at an end: below its first point at the initial temperature ``T0``

@@ -108,6 +108,9 @@ def _effect_line(scene: Scene, effect: str) -> str:
         if ld.friction_curve is not None:
             return "mu(slip speed) from friction_curve: " + ", ".join(f"{mu:g} at {v:g} m/s"
                                                                       for v, mu in ld.friction_curve)
+        if ld.friction_temperature is not None:
+            return "Coulomb, mu(interface temperature) from friction_temperature: " + ", ".join(
+                f"{mu:g} at {T - 273.15:g} degC" for T, mu in ld.friction_temperature)
         if ld.stribeck is not None:
             st = ld.stribeck
             return (f"Stribeck mu(v) = {st.kinetic:g} + ({st.static:g} - {st.kinetic:g}) exp(-(v / {st.speed:g} m/s)"

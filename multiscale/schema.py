@@ -594,7 +594,7 @@ def reference(cls, path: str = "") -> list[str]:
             shown = spec.parser.show_default(default) if hasattr(spec.parser, "show_default") else show(default)
             when = f"default {shown}" + ("" if when == "optional" else f"; {when}")
         when += f"; without it: {spec.absent}" if spec.absent and default is None else ""
-        lines.append(f"  {name:<20} {spec.parser.describe()}  [{when}]")
+        lines.append(f"  {name:<20}  {spec.parser.describe()}  [{when}]")
     for rule in getattr(cls, "rules", ()):
         lines.append(f"  rule: {rule.text()}")
     return lines + nested

@@ -11,7 +11,7 @@ from scipy.optimize import brentq
 
 from multiscale.errors import ClosedError, ConvergenceError, InputError
 from multiscale.references.thermal import (STEFAN_BOLTZMANN, kirchhoff_slab, kirchhoff_transform,
-                                           lumped_convective_cooling, lumped_cooling_linear_capacity,
+                                           lumped_convective_cooling, lumped_cooling_linear_capacity, lumped_frictional_fade,
                                            radiative_cooling, slab_convection)
 
 # ------------------------------------------------------------------ the closed forms themselves
@@ -33,6 +33,17 @@ def test_radiative_cooling_closed_form_against_ode_integration():
     times = [10.0, 100.0, 1000.0]
     ode = solve_ivp(lambda t, T: -K * (T**4 - 300.0**4), (0, 1000), [800.0], rtol=1e-12, atol=1e-10, t_eval=times)
     np.testing.assert_allclose(radiative_cooling(times, 800.0, 300.0, K), ode.y[0], rtol=1e-9)
+
+
+def test_lumped_frictional_fade_against_ode_integration():
+    """Two lumped bodies (14 % / 86 % of the heat) whose friction falls with their mean rise: the
+    closed form against the balance C_i dT_i/dt = a_i mu P integrated, mu = 0.4 - 0.004 u."""
+    C, a, P, times = np.array([8.0, 60.0]), np.array([0.14, 0.86]), 350.0, [1.0, 5.0, 20.0]
+    ode = solve_ivp(lambda t, T: a * (0.4 - 0.004 * T.mean()) * P / C, (0, 20), [0.0, 0.0], rtol=1e-12,
+                    atol=1e-12, t_eval=times)
+    mu, E = lumped_frictional_fade(times, 0.4, 0.004, P, a, C)
+    np.testing.assert_allclose(mu, 0.4 - 0.004 * ode.y.mean(axis=0), rtol=1e-9)
+    np.testing.assert_allclose(E, C @ ode.y, rtol=1e-9)
 
 
 def test_kirchhoff_slab_of_constant_conductivity_is_linear():
@@ -897,3 +908,73 @@ def test_a_run_that_fails_in_its_first_heat_step_keeps_its_start(tmp_path, monke
     assert len(h) == 1 and h["time"][0] == 0.0 and h["interface_force"][0] > 0
     assert json.loads((tmp_path / "stop" / "provenance.json").read_text())["status"].startswith(
         "failed: ConvergenceError: heat step at t = ")
+
+
+FADE = """
+name = "fade"
+effects = ["contact", "friction", "thermal", "heat_partition"]
+[geometry]
+builder = "pin_on_disc"
+mesh_size = "12 mm"
+holder_mesh_size = "6 mm"
+interface_mesh_size = "3 mm"
+track_mesh_size = "8 mm"
+[materials.disc]
+E = "220 GPa"
+nu = 0.3
+kappa = "1e4 W/(m K)"
+chi = "0.1 m^2/s"
+[materials.pin]
+E = "5 GPa"
+nu = 0.3
+kappa = "1e4 W/(m K)"
+chi = "0.1 m^2/s"
+[interface]
+penalty = "1e13 Pa/m"
+partition = 0.14
+[loading]
+normal_force = "200 N"
+rotation_speed = "200 rpm"
+{friction}
+[time]
+end = "4 s"
+steps = 40
+initial_temperature = "20 degC"
+"""
+
+
+def test_friction_of_the_temperature_fades_as_lumped_bodies_do():
+    """Brake fade (``loading.friction_temperature``): mu falling linearly from 0.4 at 20 degC to 0 at
+    120 degC, each facet's at the mean of its two faces' temperatures. Pin and disc conduct so well
+    (kappa 1e4 W/(m K), chi 0.1 m^2/s) that each is a lumped body, insulated, taking its share of the
+    heat (0.14 / 0.86): the friction coefficient (friction force over normal force) and the heat put
+    in follow ``lumped_frictional_fade`` (capacities from the stored heat at a 1 K rise, the power per
+    unit mu from the friction moment at the start) over 4 s, mu falling by a fifth: mu within 1 %
+    (measured 0.41 %: the facets run hotter than the bodies' means), the heat within 0.4 % (0.28 % after
+    the first step, all of it at mu0: the lag; 0.1 % at 4 s).
+    The fade is explicit (a step late: (1 - x)^n against exp(-n x)); without it mu stays 0.4, 25 %
+    above the closed form at 4 s."""
+    import warnings
+    table = 'friction_temperature = [["20 degC", 0.4], ["120 degC", 0.0]]'
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")           # the implausible kappa and chi are meant
+        scene = loads(FADE.format(friction=table))
+    model = build_model(scene)
+    model.start()
+    rows = [model.record()]
+    for _ in range(scene.time.steps):
+        model.macro_step(scene.time.dt)
+        rows.append(model.record())
+    t = np.array([r["time"] for r in rows])
+    mu = np.array([r["friction_coefficient"] for r in rows])
+    heat = np.array([r["heat_total_pin"] + r["heat_total_disc"] for r in rows])
+    th = model.thermal
+    for T in th.T:
+        T.x.array[:] = th.T_ref + 1.0
+    capacities = th.stored_heat()                                      # J/K
+    power = rows[0]["friction_moment"] / 0.4 * (200 * 2 * np.pi / 60)   # W per unit mu
+    model.close()
+    mu_ref, heat_ref = lumped_frictional_fade(t, 0.4, 0.004, power, (0.14, 0.86), capacities)
+    assert mu[-1] < 0.8 * 0.4                                            # a fifth of mu lost
+    np.testing.assert_allclose(mu, mu_ref, rtol=1e-2)
+    np.testing.assert_allclose(heat[1:], heat_ref[1:], rtol=4e-3)

@@ -780,7 +780,7 @@ def test_reference_lists_every_section_and_key():
     assert "friction" not in sections["[loading.vehicle]"] and "rule" not in sections["[loading.stribeck]"]
     assert "  rough " in sections["[interfaces.<name>]"] and "[interfaces.<name>.roughness]" in text
     # a CAD file's length unit: what no value means, as the user reads it (was "[default 1.0]", then "[optional]")
-    assert ('unit                 a length unit such as "m", "mm", "in"  [optional; without it: a STEP/IGES file\'s '
+    assert ('unit                  a length unit such as "m", "mm", "in"  [optional; without it: a STEP/IGES file\'s '
             'declared unit') in text
 
 
@@ -807,8 +807,9 @@ def test_loading_friction_is_needed_only_for_interfaces_without_their_own(tmp_pa
     text = (DEMOS / "brake_squeal.toml").read_text().replace("\nfriction = 0.4\n", "\n", 1)
     with pytest.raises(SceneError) as err:
         loads(text, DEMOS)
-    assert str(err.value).count("friction") == 3 and ('loading.friction or loading.friction_curve or '
-                                                      'loading.stribeck: missing; effect "friction" needs it') in str(err.value)
+    assert str(err.value).count("friction") == 4 and ('loading.friction or loading.friction_temperature or '
+                                                      'loading.friction_curve or loading.stribeck: missing; effect '
+                                                      '"friction" needs it') in str(err.value)
     with pytest.raises(SceneError, match=r'needs it for interfaces.outer_pad \(the others give their own friction\)'):
         loads(text, DEMOS, overrides={"interfaces.inner_pad.friction": 0.2})
     scene = loads(text, DEMOS, overrides={"interfaces.inner_pad.friction": 0.2, "interfaces.outer_pad.friction": 0.3})
@@ -969,8 +970,8 @@ def test_overrides_are_validated_like_the_file(tmp_path):
         loads(GOOD, tmp_path, overrides={"loading.frictoin": 0.2, "time.end": "-1 s"})
     assert info.value.problems == [
         'loading.frictoin: unknown key (did you mean "friction"?); allowed: normal_force, pressure, braking_torque, '
-        "faces, direction, load_profile, rotation_speed, speed_profile, vehicle, sliding_speed, friction, ramp_steps, "
-        "friction_curve, stribeck",
+        "faces, direction, load_profile, rotation_speed, speed_profile, vehicle, sliding_speed, friction, "
+        "friction_temperature, ramp_steps, friction_curve, stribeck",
         'time.end = "-1 s": must be > 0 s (got -1 s)']
     with pytest.raises(SceneError, match="cannot override, friction is not a table"):
         loads(GOOD, tmp_path, overrides={"loading.friction.x": 1})

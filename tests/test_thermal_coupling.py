@@ -333,3 +333,31 @@ def test_zone_heat_rates_are_at_the_true_speed_and_triangles_are_refused():
     triangle = cut_triangles(flat, np.array([[[0.0, 0.0], [1e-4, 0.0], [0.0, 1e-4]]]))[0]
     with pytest.raises(InputError, match=r"zones = \[0\]: the post-analysis takes rectangular zones"):
         PostAnalysis(HalfSpace(1e11), triangle.shape, s.dx, s.dy, mu=0.4).run([triangle], [5e6], speed=1.0)
+
+
+def test_zones_heat_with_the_friction_of_their_facets_temperatures(tmp_path):
+    """With ``loading.friction_temperature`` (fade) each zone's micro problem takes mu as its facets
+    have it: the area mean of mu at the mean of each facet's two face temperatures (here the pin at
+    330 K + 2 K/mm, the disc at 300 K: the two zones differ), computed afresh from the facet
+    temperatures; its heat is the constant-mu zone's times mu / 0.4 (the heat of a zone is linear in
+    mu: same pressure, speed and partition) to 1e-9. Before, every zone heated at one constant mu."""
+    from multiscale.workflows.multiscale import build
+    table = 'friction_temperature = [["20 degC", 0.4], ["120 degC", 0.2]]'
+    heats, mus = [], []
+    for k, text in enumerate((scene_text(tmp_path / "constant"),
+                              scene_text(tmp_path / "fade").replace("friction = 0.4", table))):
+        ms = build(loads(text))
+        ms.start()
+        hot_pin(ms)
+        ms.model.update_friction()
+        ms.micro_step()
+        iface, th, on = ms.tm.interface, ms.model.thermal, ms.rough.zone_of_facet
+        mu = np.interp(0.5 * (th.facet_temperature(0) + th.facet_temperature(1)), [293.15, 393.15], [0.4, 0.2])
+        expected = [(mu[on == z] * iface.areas[on == z]).sum() / iface.areas[on == z].sum() for z in range(2)]
+        load = ms.loading()
+        np.testing.assert_allclose(load.friction, [0.4, 0.4] if k == 0 else expected, rtol=1e-12)
+        heats.append(ms.micro_heat.copy())
+        mus.append(load.friction)
+        ms.model.close()
+    assert mus[1][0] != pytest.approx(mus[1][1], rel=1e-3) and np.all(mus[1] < 0.4)
+    np.testing.assert_allclose(heats[1], heats[0] * mus[1] / 0.4, rtol=1e-9)

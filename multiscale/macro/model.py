@@ -87,6 +87,8 @@ class MacroModel:
     solved_speed: float = 0.0                          # the speed of the last contact solve (friction on if > 0)
     load: float | None = None                          # N or Pa at factor 1 (the drive's, or scaled to its torque)
     partitions: dict = field(default_factory=dict)     # share of frictional heat into body 0 per interface [-]
+    # mu per interface facet against its temperature [K] (n_facets,) -> (n_facets,): fade, set after every heat step
+    friction_law: Callable[[np.ndarray], np.ndarray] | None = None
     notes: list = field(default_factory=list)          # what the run's warnings add (an unbalanced clamp, Mechanics.notes)
 
     @property
@@ -175,6 +177,7 @@ class MacroModel:
                 self.contact.engaged.value = self.drive.mean_factor(t0, t1) * scale
                 self.contact.heating.value = self.drive.mean_sliding(t0, t1) / speed * scale if speed else 0.0
                 done = self.thermal.step(delta)
+                self.update_friction()
                 heat += done.heat_in
                 facet_heat += done.facet_heat.sum(axis=1)
                 self.heat_exchanged += done.heat_exchanged
@@ -187,8 +190,8 @@ class MacroModel:
             # keeps the friction of the sliding that ended it (the pressure the step's wear and work take)
             speed = float(self.contact.speed.value)
             moving = speed or self.drive.mean_speed(start, start + (k + 1) * delta)
-            if factor > 0 and (self.mechanics.temperatures is not None or load != self.mechanics.load.value
-                               or (moving == 0.0) != (self.solved_speed == 0.0)):
+            if factor > 0 and (self.mechanics.temperatures is not None or self.friction_law is not None
+                               or load != self.mechanics.load.value or (moving == 0.0) != (self.solved_speed == 0.0)):
                 self.contact.speed.value = moving
                 self.last_solve = self.mechanics.solve(load)
                 self.solved_speed = moving
@@ -200,6 +203,13 @@ class MacroModel:
         self.interface_heat_total += self.interface_heat
         self.heat_exchanged_total += self.heat_exchanged
         return heat
+
+    def update_friction(self) -> None:
+        """With a ``friction_law``: each interface facet's mu at the mean of its two faces' temperatures,
+        for the solve and the heat steps that follow (explicit: the temperatures of the step's end)."""
+        if self.friction_law is not None and self.thermal is not None:
+            T = 0.5 * (self.thermal.facet_temperature(0) + self.thermal.facet_temperature(1))
+            self.tm.interface.set_field(self.contact.friction, self.friction_law(T))
 
     def start_sliding(self, speed: float, factor: float) -> None:
         """Solve the contact with friction at the sliding ``speed`` (rad/s or m/s; its sign the
@@ -296,6 +306,7 @@ class MacroModel:
         if self.thermal is not None:
             self.thermal.time = state["thermal_time"]
             self.thermal.lost_total, self.thermal.lost_step = state["lost_total"].copy(), state["lost_step"].copy()
+        self.update_friction()
 
     def record(self, heat_step=(0.0, 0.0)) -> dict:
         """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal
@@ -304,13 +315,17 @@ class MacroModel:
         facets, mu times the normal force where all slides (less by the turn of the sliding direction
         across a facet of a rotating body: 2.5e-5 on the car brake): opposite pads do not cancel;
         ``friction_moment`` [N m], with a rotating body 1, is the magnitude of their moment about its axis. With several
-        interfaces and heat, ``interface_heat_row`` gives each one's heat and face temperatures."""
+        interfaces and heat, ``interface_heat_row`` gives each one's heat and face temperatures. With a
+        ``friction_law``, ``friction_coefficient`` [-] is ``friction_force`` over ``interface_force``."""
         on = not self.released
         friction = np.linalg.norm(self.contact.facet_friction(), axis=1) * on     # N per facet, magnitudes
         row = {"time": self.time, "interface_force": self.last_solve.normal_force * on,
                "friction_force": float(friction.sum()),
                "max_pressure": self.last_solve.max_pressure * on,
                "newton_iterations": self.last_solve.iterations}
+        if self.friction_law is not None:               # fade: the friction over the normal force (NaN released)
+            normal = row["interface_force"]
+            row["friction_coefficient"] = row["friction_force"] / normal if normal > 0 else np.nan
         if isinstance(self.tm.spec.motion, Rotation):   # the braking torque: frictional heat power = it x omega
             row["friction_moment"] = abs(self.contact.friction_moment()) * on
         masks = self.tm.interface.masks()

@@ -9,7 +9,8 @@ The rules that more than one analysis follows live here once:
 - supports: the builder's, plus every [[boundary]] ``fix``; load faces and direction: [loading]
   ``faces``/``direction``, else the builder's;
 - friction coefficient of an interface: its [interfaces.<name>] ``friction``, else
-  ``loading.friction``, with effect ``friction``; else 0;
+  ``loading.friction``, else ``loading.friction_temperature`` at the initial temperature (and, with heat,
+  at each facet's temperature as the run goes: ``friction_law``), with effect ``friction``; else 0;
 - load: a fluid pressure -p n for builders that declare ``fluid_load`` and for geometry files (a
   normal force spread as the uniform pressure F / A, A the load faces' areas projected normal to
   each face's resultant, or of each of a face's flat parts facing opposite ways, ``load_face_areas``;
@@ -42,13 +43,30 @@ from multiscale.macro.load_faces import load_face_areas, load_face_forces
 from multiscale.macro.mechanics import REPEATABLE_REFRESH, Mechanics
 from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
+from multiscale.scene_sections import interpolate
 
 
 def friction_coefficient(scene, interface: str) -> float:
-    """mu [-] of an interface (its own, else ``loading.friction``) with effect "friction", else 0."""
+    """mu [-] of an interface (its own, else ``loading.friction``, else ``loading.friction_temperature`` at
+    the initial temperature) with effect "friction", else 0."""
     if not scene.has("friction"):
         return 0.0
-    return scene.interface_settings(interface).friction
+    mu, table = scene.interface_settings(interface).friction, scene.loading.friction_temperature
+    return interpolate(table, scene.time.initial_temperature) if mu is None and table is not None else mu
+
+
+def friction_law(scene, tm):
+    """With ``loading.friction_temperature`` and heat: mu per interface facet (n_facets,) against the facets'
+    temperatures [K] (the table's on the interfaces without a friction of their own; fade); else None."""
+    table = scene.loading.friction_temperature if scene.has("friction") and scene.has("thermal") else None
+    if table is None:
+        return None
+    follows = np.zeros(tm.interface.n_facets, dtype=bool)
+    for name, m in tm.interface.masks().items():
+        follows[m] = scene.interface_settings(name).friction is None
+    own = np.array([friction_coefficient(scene, name) for name in tm.interface.tags])[tm.interface.tag_index]
+    temperatures, mu = (np.array(column, dtype=float) for column in zip(*table))
+    return lambda T: np.where(follows, np.interp(T, temperatures, mu), own)
 
 
 def scene_spec(scene) -> GeometrySpec:
@@ -261,7 +279,7 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: b
             tm.interface.set_field(mech.contact.partition, share)
         if scene.has("conductance") and scene.interface.conductance is not None:   # else per facet later
             tm.interface.set_field(mech.contact.conductance, scene.interface.conductance)
-    return MacroModel(tm, mech, heat, drive(scene, tm), partitions=shares)
+    return MacroModel(tm, mech, heat, drive(scene, tm), partitions=shares, friction_law=friction_law(scene, tm))
 
 
 def run_notes(model: MacroModel) -> tuple:

@@ -154,7 +154,7 @@ def model_scene(scene):
     (the law sets the per-facet mu before the preload), the law's kinetic or mean mu (the first
     guess of the clamp force of a braking torque divides by it; 0 made it "braking needs friction")."""
     ld = scene.loading
-    if ld.friction is None and scene.has("friction"):
+    if ld.friction is None and ld.friction_temperature is None and scene.has("friction"):
         mu = ld.stribeck.kinetic if ld.stribeck is not None else float(np.mean([m for _, m in ld.friction_curve]))
         return dataclasses.replace(scene, loading=dataclasses.replace(ld, friction=mu))
     return scene
