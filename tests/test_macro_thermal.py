@@ -953,7 +953,8 @@ def test_friction_of_the_temperature_fades_as_lumped_bodies_do():
     (measured 0.41 %: the facets run hotter than the bodies' means), the heat within 0.4 % (0.28 % after
     the first step, all of it at mu0: the lag; 0.1 % at 4 s).
     The fade is explicit (a step late: (1 - x)^n against exp(-n x)); without it mu stays 0.4, 25 %
-    above the closed form at 4 s."""
+    above the closed form at 4 s. A table the run leaves (its ends below the initial temperature or
+    the bodies' largest) is said after the run; this one is not."""
     import warnings
     table = 'friction_temperature = [["20 degC", 0.4], ["120 degC", 0.0]]'
     with warnings.catch_warnings():
@@ -978,3 +979,41 @@ def test_friction_of_the_temperature_fades_as_lumped_bodies_do():
     assert mu[-1] < 0.8 * 0.4                                            # a fifth of mu lost
     np.testing.assert_allclose(mu, mu_ref, rtol=1e-2)
     np.testing.assert_allclose(heat[1:], heat_ref[1:], rtol=4e-3)
+    # a table the run left is said (mu held at its ends): the pin rose 28 K
+    from multiscale.workflows import run_warnings
+    history = History()
+    for r in rows:
+        history.append(**{k: r[k] for k in ("time", "max_temperature_pin", "max_temperature_disc")})
+    assert [w for w in run_warnings(scene, history) if "friction_temperature" in w] == []
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        short = loads(FADE.format(friction='friction_temperature = [["25 degC", 0.4], ["40 degC", 0.3]]'))
+    assert [w for w in run_warnings(short, history) if "friction_temperature" in w] == [
+        "loading.friction_temperature: the initial temperature, 20 degC, is below its first point, 25 degC: mu was "
+        "held at 0.4 below it",
+        f"loading.friction_temperature: the bodies reached {max(history['max_temperature_pin']) - 273.15:.4g} degC, "
+        "above its last point, 40 degC: where the interface was that hot, mu was held at 0.3"]
+
+
+def test_a_braking_torque_with_fade_raises_the_clamp_force_as_mu_falls():
+    """The lumped pin-on-disc of the fade test held at a braking torque of 5 N m instead of 200 N:
+    the friction moment stays the torque (within ``preload.TORQUE_TOL``) in every row while mu falls
+    from 0.4 by a sixth, so the clamp force rises as 1 / mu (its friction radius fixed: within 0.1 %)."""
+    import warnings
+    from multiscale.macro.preload import TORQUE_TOL
+    text = FADE.format(friction='friction_temperature = [["20 degC", 0.4], ["120 degC", 0.0]]')
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")           # the implausible kappa and chi are meant
+        scene = loads(text.replace('normal_force = "200 N"', 'braking_torque = "5 N m"'))
+    model = build_model(scene)
+    model.start()
+    rows = [model.record()]
+    for _ in range(scene.time.steps):
+        model.macro_step(scene.time.dt)
+        rows.append(model.record())
+    model.close()
+    moment, mu, force = (np.array([r[k] for r in rows]) for k in ("friction_moment", "friction_coefficient",
+                                                                      "interface_force"))
+    np.testing.assert_allclose(moment, 5.0, rtol=TORQUE_TOL)
+    assert mu[-1] < 0.85 * 0.4
+    np.testing.assert_allclose(force * mu, force[0] * mu[0], rtol=1e-3)

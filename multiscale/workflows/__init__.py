@@ -170,7 +170,7 @@ def run_warnings(scene, history) -> list[str]:
             out += [f"materials.{name}.{phrase} (in body {body!r})"
                     for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
     return (out + laws + _undershoots(scene, history) + _coarse_wear(history) + _wear_table_ends(scene, history)
-            + _too_hot(scene, history) + _unloaded(scene, history)
+            + _too_hot(scene, history) + _fade_table_ends(scene, history) + _unloaded(scene, history)
             + (overloaded(scene, float(np.max(history["max_pressure"])), hottest)
                if "max_pressure" in history.columns else []))
 
@@ -241,6 +241,21 @@ def _unloaded(scene, history) -> list[str]:
                      if f"interface_force_{n}" in history.columns})
 
 
+def _fade_table_ends(scene, history) -> list[str]:
+    """``loading.friction_temperature`` left by the run (mu held at its ends): the initial temperature
+    below its first point, or the bodies' largest temperature (the interface's at most) above its last."""
+    table = scene.loading.friction_temperature if scene.has("friction") and scene.has("thermal") else None
+    if table is None:
+        return []
+    T0, ((first, mu_first), (last, mu_last)) = scene.time.initial_temperature, (table[0], table[-1])
+    columns = [f"max_temperature_{b.name}" for b in scene.geometry.spec.bodies]
+    hottest = max((float(np.max(history[c])) for c in columns if c in history.columns), default=-np.inf)
+    return ([f"loading.friction_temperature: the initial temperature, {T0 - 273.15:.4g} degC, is below its first "
+             f"point, {first - 273.15:.4g} degC: mu was held at {mu_first:g} below it"] if T0 < first else []) + \
+        ([f"loading.friction_temperature: the bodies reached {hottest - 273.15:.4g} degC, above its last point, "
+          f"{last - 273.15:.4g} degC: where the interface was that hot, mu was held at {mu_last:g}"] if hottest > last else [])
+
+
 def _too_hot(scene, history) -> list[str]:
     """Bodies hotter than any plausible temperature (``scene_sections.HOTTEST``): the load, the
     partition or the materials are wrong for the case (a car pad reached 23 000 K without a word)."""
@@ -251,7 +266,8 @@ def _too_hot(scene, history) -> list[str]:
             row = int(np.argmax(history[column]))
             out.append(f"body {body.name!r} reached {float(history[column][row]):.4g} K at t = {history['time'][row]:g} s, "
                        f"above any plausible temperature ({HOTTEST:g} K: molten iron): check the load, the heat "
-                       "partition and the materials (the model has no melting, wear of hot material or fade)")
+                       "partition and the materials (the model has no melting or wear of hot material, and fade only "
+                       "with loading.friction_temperature)")
     return out
 
 
