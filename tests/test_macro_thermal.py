@@ -942,6 +942,27 @@ steps = 40
 initial_temperature = "20 degC"
 """
 
+FADE_TABLE = 'friction_temperature = [["20 degC", 0.4], ["120 degC", 0.0]]'
+
+
+def fade_scene(friction: str = FADE_TABLE, load: str = 'normal_force = "200 N"'):
+    """The lumped pin-on-disc (FADE) with its friction and load lines; its implausible kappa and chi are meant."""
+    import warnings
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        return loads(FADE.format(friction=friction).replace('normal_force = "200 N"', load))
+
+
+def recorded(scene):
+    """The model of ``scene`` after its steps and its history rows (the first at t = 0)."""
+    model = build_model(scene)
+    model.start()
+    rows = [model.record()]
+    for _ in range(scene.time.steps):
+        model.macro_step(scene.time.dt)
+        rows.append(model.record())
+    return model, rows
+
 
 def test_friction_of_the_temperature_fades_as_lumped_bodies_do():
     """Brake fade (``loading.friction_temperature``): mu falling linearly from 0.4 at 20 degC to 0 at
@@ -955,17 +976,8 @@ def test_friction_of_the_temperature_fades_as_lumped_bodies_do():
     The fade is explicit (a step late: (1 - x)^n against exp(-n x)); without it mu stays 0.4, 25 %
     above the closed form at 4 s. A table the run leaves (its ends below the initial temperature or
     the bodies' largest) is said after the run; this one is not."""
-    import warnings
-    table = 'friction_temperature = [["20 degC", 0.4], ["120 degC", 0.0]]'
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")           # the implausible kappa and chi are meant
-        scene = loads(FADE.format(friction=table))
-    model = build_model(scene)
-    model.start()
-    rows = [model.record()]
-    for _ in range(scene.time.steps):
-        model.macro_step(scene.time.dt)
-        rows.append(model.record())
+    scene = fade_scene()
+    model, rows = recorded(scene)
     t = np.array([r["time"] for r in rows])
     mu = np.array([r["friction_coefficient"] for r in rows])
     heat = np.array([r["heat_total_pin"] + r["heat_total_disc"] for r in rows])
@@ -985,9 +997,7 @@ def test_friction_of_the_temperature_fades_as_lumped_bodies_do():
     for r in rows:
         history.append(**{k: r[k] for k in ("time", "max_temperature_pin", "max_temperature_disc")})
     assert [w for w in run_warnings(scene, history) if "friction_temperature" in w] == []
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        short = loads(FADE.format(friction='friction_temperature = [["25 degC", 0.4], ["40 degC", 0.3]]'))
+    short = fade_scene('friction_temperature = [["25 degC", 0.4], ["40 degC", 0.3]]')
     assert [w for w in run_warnings(short, history) if "friction_temperature" in w] == [
         "loading.friction_temperature: the initial temperature, 20 degC, is below its first point, 25 degC: mu was "
         "held at 0.4 below it",
@@ -999,18 +1009,8 @@ def test_a_braking_torque_with_fade_raises_the_clamp_force_as_mu_falls():
     """The lumped pin-on-disc of the fade test held at a braking torque of 5 N m instead of 200 N:
     the friction moment stays the torque (within ``preload.TORQUE_TOL``) in every row while mu falls
     from 0.4 by a sixth, so the clamp force rises as 1 / mu (its friction radius fixed: within 0.1 %)."""
-    import warnings
     from multiscale.macro.preload import TORQUE_TOL
-    text = FADE.format(friction='friction_temperature = [["20 degC", 0.4], ["120 degC", 0.0]]')
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")           # the implausible kappa and chi are meant
-        scene = loads(text.replace('normal_force = "200 N"', 'braking_torque = "5 N m"'))
-    model = build_model(scene)
-    model.start()
-    rows = [model.record()]
-    for _ in range(scene.time.steps):
-        model.macro_step(scene.time.dt)
-        rows.append(model.record())
+    model, rows = recorded(fade_scene(load='braking_torque = "5 N m"'))
     model.close()
     moment, mu, force = (np.array([r[k] for r in rows]) for k in ("friction_moment", "friction_coefficient",
                                                                       "interface_force"))
