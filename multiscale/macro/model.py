@@ -316,16 +316,17 @@ class MacroModel:
         across a facet of a rotating body: 2.5e-5 on the car brake): opposite pads do not cancel;
         ``friction_moment`` [N m], with a rotating body 1, is the magnitude of their moment about its axis. With several
         interfaces and heat, ``interface_heat_row`` gives each one's heat and face temperatures. With a
-        ``friction_law``, ``friction_coefficient`` [-] is ``friction_force`` over ``interface_force``."""
+        ``friction_law``, ``friction_coefficient`` [-] is ``friction_force`` over ``interface_force`` (NaN
+        while released or at rest)."""
         on = not self.released
         friction = np.linalg.norm(self.contact.facet_friction(), axis=1) * on     # N per facet, magnitudes
         row = {"time": self.time, "interface_force": self.last_solve.normal_force * on,
                "friction_force": float(friction.sum()),
                "max_pressure": self.last_solve.max_pressure * on,
                "newton_iterations": self.last_solve.iterations}
-        if self.friction_law is not None:               # fade: the friction over the normal force (NaN released)
+        if self.friction_law is not None:               # fade: the friction over the normal force (NaN at rest)
             normal = row["interface_force"]
-            row["friction_coefficient"] = row["friction_force"] / normal if normal > 0 else np.nan
+            row["friction_coefficient"] = row["friction_force"] / normal if normal > 0 and self.solved_speed else np.nan
         if isinstance(self.tm.spec.motion, Rotation):   # the braking torque: frictional heat power = it x omega
             row["friction_moment"] = abs(self.contact.friction_moment()) * on
         masks = self.tm.interface.masks()
