@@ -248,3 +248,19 @@ def test_the_multiscale_figure_shows_the_real_contact_area_and_the_plastic_share
     (ax,) = [a for a in drawn[-1].axes if a.axison]
     assert ax.get_ylabel() == "real contact area [µm²]" and ax.get_lines()[0].get_ydata()[0] == pytest.approx(1070.0)
     assert drawn[-1]._suptitle.get_text() == "bof_x3p:\nboth scales of the multiscale loop against time"
+
+
+def test_a_run_with_fade_draws_its_friction_coefficient(tmp_path, drawn):
+    """``friction_coefficient`` (a run with ``loading.friction_temperature``) has a panel of its own,
+    its values as recorded (NaN at rest: a gap); a run without the column has no such panel."""
+    for fade in (True, False):
+        history = History()
+        for t, mu in ((0.0, 0.4), (1.0, 0.37), (2.0, float("nan"))):
+            history.append(time=t, interface_force=200.0, max_pressure=1e6, max_temperature_pin=300.0 + t,
+                           max_temperature_disc=298.0 + t, heat_total_pin=t, heat_total_disc=2 * t,
+                           **({"friction_coefficient": mu} if fade else {}))
+        plots.history_figure(history, tmp_path / "history.png")
+        axes = [ax for ax in drawn[-1].axes if ax.get_ylabel() == "friction coefficient [-]"]
+        assert len(axes) == fade
+        if fade:
+            np.testing.assert_allclose(axes[0].get_lines()[0].get_ydata(), [0.4, 0.37, np.nan])
