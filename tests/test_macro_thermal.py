@@ -1017,3 +1017,26 @@ def test_a_braking_torque_with_fade_raises_the_clamp_force_as_mu_falls():
     np.testing.assert_allclose(moment, 5.0, rtol=TORQUE_TOL)
     assert mu[-1] < 0.85 * 0.4
     np.testing.assert_allclose(force * mu, force[0] * mu[0], rtol=1e-3)
+
+
+def test_an_interface_with_its_own_friction_keeps_it_under_fade():
+    """``workflows.model.friction_law`` of the car brake with mu(T) in [loading] and the outer pad's
+    own friction 0.3: the inner pad's facets take the table at their temperatures (linear between
+    rows, held beyond), the outer pad's stay 0.3 whatever theirs; the first solve's mu is the
+    table's at the initial temperature (``friction_coefficient``)."""
+    from types import SimpleNamespace
+    from multiscale.workflows.model import friction_coefficient, friction_law
+    demos = Path(__file__).parents[1] / "demos"
+    if not (demos / "cad" / "car_brake.step").exists():
+        pytest.skip("demos/cad/car_brake.step not built (make demos/cad/car_brake.step)")
+    text = (demos / "car_brake_stop.toml").read_text().replace(
+        "friction = 0.4", 'friction_temperature = [["20 degC", 0.45], ["420 degC", 0.25]]')
+    scene = loads(text + "\n[interfaces.outer_pad]\nfriction = 0.3\n", demos)
+    masks = {"inner_pad": np.array([1, 1, 1, 0, 0], bool), "outer_pad": np.array([0, 0, 0, 1, 1], bool)}
+    tm = SimpleNamespace(interface=SimpleNamespace(n_facets=5, tags=("inner_pad", "outer_pad"),
+                                                   tag_index=np.array([0, 0, 0, 1, 1]), masks=lambda: masks))
+    law = friction_law(scene, tm)
+    T = np.array([273.15, 493.15, 1000.0, 273.15, 1000.0])          # 0 degC, 220 degC, beyond; the outer pad
+    np.testing.assert_allclose(law(T), [0.45, 0.35, 0.25, 0.3, 0.3], rtol=1e-14)
+    assert friction_coefficient(scene, "inner_pad") == pytest.approx(0.45 - 0.2 * (30.0 - 20.0) / 400.0)
+    assert friction_coefficient(scene, "outer_pad") == 0.3
