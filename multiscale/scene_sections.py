@@ -202,7 +202,7 @@ class InterfaceSettings:
     interface (its own surface, zones, laws); ``rough = false`` keeps it in perfect contact when
     the scene has effect "roughness"."""
 
-    friction: float | None = key(_FRICTION, absent="loading.friction, friction_curve or stribeck")   # mu
+    friction: float | None = key(_FRICTION, absent="loading.friction (or any of its rule's keys)")   # mu
     rough: bool = key(Flag(), default=True)                           # with effect "roughness"
     roughness: object = None          # Roughness of this interface (the merged [roughness] table)
     micro: object = None              # Micro of this interface (the merged [micro] table)
@@ -297,9 +297,9 @@ class Loading:
                                       absent="rotation_speed or vehicle gives the speed")   # ((s, rad/s), ...)
     vehicle: Vehicle | None = key(Section(Vehicle))
     sliding_speed: float | None = key(Quantity("speed", ge=0, plausible=(0.0, 200.0)), absent="at rest")  # m/s
-    friction: float | None = key(_FRICTION, absent="friction_curve, stribeck or each interface's own friction")  # mu
+    friction: float | None = key(_FRICTION, absent="another key of the rule below, or each interface's own")  # mu
     friction_temperature: tuple | None = key(Curve(_TEMPERATURE, _FRICTION, "temperature", "mu", min_rows=2),
-                                             absent="friction: mu of no temperature")   # ((K, -), ...)
+                                             absent="friction, constant (no fade)")   # ((K, -), ...)
     ramp_steps: int = key(Integer(ge=1, le=10**4), default=1)   # load increments of the first mechanical solve
     friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), Quantity("dimensionless", ge=0), "slip speed",
                                              "mu", min_rows=2), absent="friction or stribeck gives mu")  # ((m/s, -),..)
