@@ -250,10 +250,11 @@ def _fade_table_ends(scene, history) -> list[str]:
     T0, ((first, mu_first), (last, mu_last)) = scene.time.initial_temperature, (table[0], table[-1])
     columns = [f"max_temperature_{b.name}" for b in scene.geometry.spec.bodies]
     hottest = max((float(np.max(history[c])) for c in columns if c in history.columns), default=-np.inf)
-    return ([f"loading.friction_temperature: the initial temperature, {T0 - 273.15:.4g} degC, is below its first "
-             f"point, {first - 273.15:.4g} degC: mu was held at {mu_first:g} below it"] if T0 < first else []) + \
-        ([f"loading.friction_temperature: the bodies reached {hottest - 273.15:.4g} degC, above its last point, "
-          f"{last - 273.15:.4g} degC: where the interface was that hot, mu was held at {mu_last:g}"] if hottest > last else [])
+    low = f"the initial temperature, {T0 - 273.15:.4g} degC, is below its first point, {first - 273.15:.4g} degC: " \
+          f"mu was held at {mu_first:g} below it"
+    high = f"the bodies reached {hottest - 273.15:.4g} degC, above its last point, {last - 273.15:.4g} degC: where " \
+           f"the interface was that hot, mu was held at {mu_last:g}"
+    return [f"loading.friction_temperature: {text}" for text, left in ((low, T0 < first), (high, hottest > last)) if left]
 
 
 def _too_hot(scene, history) -> list[str]:
