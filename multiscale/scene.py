@@ -35,7 +35,7 @@ from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FI
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
 from multiscale.scene_cycle import (convection_coverage, cycle_coverage, largest_load_factor, short_phases, speed_range,
-                                   squeal_state, thin_heated_layers)
+                                   fade_coverage, squeal_state, thin_heated_layers)
 from multiscale.scene_stability import Stability, unresolved_band
 from multiscale.scene_vehicle import Vehicle
 
@@ -446,7 +446,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                                         (scene.time or Time()).initial_temperature)
     end = scene.time.end if scene.time is not None else None
     if scene.loading is not None and end is not None:
-        warnings += cycle_coverage(scene.loading, end)
+        warnings += cycle_coverage(scene.loading, end) + fade_coverage(scene.loading, scene.time.initial_temperature)
         if g is not None and {"friction", "thermal", "heat_partition"} <= effects:
             warnings += short_phases(scene.loading, g.motion, end, scene.time.dt)
             if scene.materials is not None:

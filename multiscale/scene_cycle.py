@@ -1,6 +1,7 @@
 """The duty cycle against the analysis that runs it (``multiscale.scene``'s cross-checks): what a
 load or speed profile, a vehicle stop and a speed-dependent convection table leave out of the run
-[0, time.end], and what the squeal analysis, which linearises one state, ignores of a cycle.
+[0, time.end] (and a fade table of the initial temperature), and what the squeal analysis, which
+linearises one state, ignores of a cycle.
 The checks return one warning line per finding; ``braking_phases`` and ``largest_load_factor``
 read the cycle over the run's knots (``run_knots``)."""
 from __future__ import annotations
@@ -38,6 +39,16 @@ def cycle_coverage(ld, end: float) -> list[str]:
                    f"braked {100 * (1 - (left / v.speed) ** 2):.0f} % of the kinetic energy; a longer time.end "
                    "brakes the rest" + (' (a deceleration in g is written "0.6 gn")' if v.deceleration < 1.0 else ""))
     return out
+
+
+def fade_coverage(ld, T0: float) -> list[str]:
+    """``friction_temperature`` (fade) held below its first point at the initial temperature T0 [K]
+    (its last point against the run's temperatures: ``workflows.run_warnings``, after the run)."""
+    table = ld.friction_temperature
+    if table is None or T0 >= table[0][0]:
+        return []
+    return [f"loading.friction_temperature: the initial temperature, {T0 - 273.15:.4g} degC, is below its first "
+            f"point, {table[0][0] - 273.15:.4g} degC: mu is held at {table[0][1]:g} below it"]
 
 
 def run_knots(ld, end: float) -> list[float]:

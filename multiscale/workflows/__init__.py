@@ -242,19 +242,16 @@ def _unloaded(scene, history) -> list[str]:
 
 
 def _fade_table_ends(scene, history) -> list[str]:
-    """``loading.friction_temperature`` left by the run (mu held at its ends): the initial temperature
-    below its first point, or the bodies' largest temperature (the interface's at most) above its last."""
+    """``loading.friction_temperature`` left by the run: the bodies' largest temperature (the
+    interface's at most) above its last point, where mu was held (below its first at the initial
+    temperature: the scene's warning, ``scene_cycle.fade_coverage``)."""
     table = scene.loading.friction_temperature if scene.has("friction") and scene.has("thermal") else None
-    if table is None:
-        return []
-    T0, ((first, mu_first), (last, mu_last)) = scene.time.initial_temperature, (table[0], table[-1])
     columns = [f"max_temperature_{b.name}" for b in scene.geometry.spec.bodies]
     hottest = max((float(np.max(history[c])) for c in columns if c in history.columns), default=-np.inf)
-    low = f"the initial temperature, {T0 - 273.15:.4g} degC, is below its first point, {first - 273.15:.4g} degC: " \
-          f"mu was held at {mu_first:g} below it"
-    high = f"the bodies reached {hottest - 273.15:.4g} degC, above its last point, {last - 273.15:.4g} degC: where " \
-           f"the interface was that hot, mu was held at {mu_last:g}"
-    return [f"loading.friction_temperature: {text}" for text, left in ((low, T0 < first), (high, hottest > last)) if left]
+    if table is None or hottest <= table[-1][0]:
+        return []
+    return [f"loading.friction_temperature: the bodies reached {hottest - 273.15:.4g} degC, above its last point, "
+            f"{table[-1][0] - 273.15:.4g} degC: where the interface was that hot, mu was held at {table[-1][1]:g}"]
 
 
 def _too_hot(scene, history) -> list[str]:
