@@ -1041,3 +1041,17 @@ def test_an_interface_with_its_own_friction_keeps_it_under_fade():
     np.testing.assert_allclose(law(T), [0.45, 0.35, 0.25, 0.3, 0.3], rtol=1e-14)
     assert friction_coefficient(scene, "inner_pad") == pytest.approx(0.45 - 0.2 * (30.0 - 20.0) / 400.0)
     assert friction_coefficient(scene, "outer_pad") == 0.3
+
+
+def test_a_braking_torque_whose_mu_fades_to_zero_is_refused_while_it_brakes():
+    """mu falling to 0 at 25 degC under a braking torque: once the facets pass it no clamp force
+    gives the torque, and the step stops with an InputError naming loading.friction_temperature
+    (before, the moment fell to 0 and the run went on, its torque unmet without a word)."""
+    scene = fade_scene('friction_temperature = [["20 degC", 0.4], ["25 degC", 0.0]]', 'braking_torque = "5 N m"')
+    model = build_model(scene)
+    model.start()
+    with pytest.raises(InputError, match=r"loading.friction_temperature.*mu fell to 0"):
+        for _ in range(scene.time.steps):
+            model.macro_step(scene.time.dt)
+    assert 0 < model.time < 4.0                     # in the run, not at its end
+    model.close()

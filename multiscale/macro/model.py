@@ -230,6 +230,10 @@ class MacroModel:
         load, solved = hold_moment(self.mechanics, self.load * factor, (self.drive.torque or 0.0) * factor)
         if solved is not None:                   # (only with a positive target: factor > 0)
             self.load, self.last_solve = load / factor, solved
+        if self.friction_law is not None and self.drive.torque and factor > 0 and float(self.contact.speed.value) \
+                and not abs(self.contact.friction_moment()) > 0:      # (collective: a global sum on every rank)
+            raise InputError("loading.friction_temperature", None, "mu fell to 0 at the interfaces' temperatures: "
+                             "no clamp force gives the braking torque (give mu > 0 up to the run's temperatures)")
 
     def interface_heat_row(self, masks: dict) -> dict:
         """Per interface (``masks``: its facets): the frictional heat generated on it [J] in the last
