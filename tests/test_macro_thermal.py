@@ -103,12 +103,16 @@ def block_scene(**kw):
     return loads(BLOCK.format(**values))
 
 
-def march(scene, steps=None):
-    """The model of a scene after ``steps`` macro steps (default: all)."""
+def march(scene, steps=None, rows=None):
+    """The model of a scene after ``steps`` macro steps (default: all); ``rows``, a list, gets its
+    history rows (the first at t = 0)."""
     model = build_model(scene)
     model.start()
-    for _ in range(scene.time.steps if steps is None else steps):
-        model.macro_step(scene.time.dt, scene.time.substeps)
+    for k in range(1 + (scene.time.steps if steps is None else steps)):
+        if k:
+            model.macro_step(scene.time.dt, scene.time.substeps)
+        if rows is not None:
+            rows.append(model.record())
     return model
 
 
@@ -953,17 +957,6 @@ def fade_scene(friction: str = FADE_TABLE, load: str = 'normal_force = "200 N"')
         return loads(FADE.format(friction=friction).replace('normal_force = "200 N"', load))
 
 
-def recorded(scene):
-    """The model of ``scene`` after its steps and its history rows (the first at t = 0)."""
-    model = build_model(scene)
-    model.start()
-    rows = [model.record()]
-    for _ in range(scene.time.steps):
-        model.macro_step(scene.time.dt)
-        rows.append(model.record())
-    return model, rows
-
-
 def test_friction_of_the_temperature_fades_as_lumped_bodies_do():
     """Brake fade (``loading.friction_temperature``): mu falling linearly from 0.4 at 20 degC to 0 at
     120 degC, each facet's at the mean of its two faces' temperatures. Pin and disc conduct so well
@@ -977,7 +970,8 @@ def test_friction_of_the_temperature_fades_as_lumped_bodies_do():
     above the closed form at 4 s. A table that leaves the run's temperatures is said: below the
     initial one when the scene is read, above the bodies' largest after the run; this one is not."""
     scene = fade_scene()
-    model, rows = recorded(scene)
+    rows = []
+    model = march(scene, rows=rows)
     t = np.array([r["time"] for r in rows])
     mu = np.array([r["friction_coefficient"] for r in rows])
     heat = np.array([r["heat_total_pin"] + r["heat_total_disc"] for r in rows])
@@ -1011,7 +1005,8 @@ def test_a_braking_torque_with_fade_raises_the_clamp_force_as_mu_falls():
     the friction moment stays the torque (within ``preload.TORQUE_TOL``) in every row while mu falls
     from 0.4 by a sixth, so the clamp force rises as 1 / mu (its friction radius fixed: within 0.1 %)."""
     from multiscale.macro.preload import TORQUE_TOL
-    model, rows = recorded(fade_scene(load='braking_torque = "5 N m"'))
+    rows = []
+    model = march(fade_scene(load='braking_torque = "5 N m"'), rows=rows)
     model.close()
     moment, mu, force = (np.array([r[k] for r in rows]) for k in ("friction_moment", "friction_coefficient",
                                                                       "interface_force"))

@@ -246,9 +246,11 @@ def _fade_table_ends(scene, history) -> list[str]:
     interface's at most) above its last point, where mu was held (below its first at the initial
     temperature: the scene's warning, ``scene_cycle.fade_coverage``)."""
     table = scene.loading.friction_temperature if scene.has("friction") and scene.has("thermal") else None
+    if table is None:
+        return []
     columns = [f"max_temperature_{b.name}" for b in scene.geometry.spec.bodies]
     hottest = max((float(np.max(history[c])) for c in columns if c in history.columns), default=-np.inf)
-    if table is None or hottest <= table[-1][0]:
+    if hottest <= table[-1][0]:
         return []
     return [f"loading.friction_temperature: the bodies reached {hottest - 273.15:.4g} degC, above its last point, "
             f"{table[-1][0] - 273.15:.4g} degC: where the interface was that hot, mu was held at {table[-1][1]:g}"]

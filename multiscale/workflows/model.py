@@ -55,16 +55,19 @@ def friction_coefficient(scene, interface: str) -> float:
     return interpolate(table, scene.time.initial_temperature) if mu is None and table is not None else mu
 
 
+def facet_friction(scene, tm) -> np.ndarray:
+    """mu [-] of every interface facet of ``tm`` (n_facets,): its interface's ``friction_coefficient``."""
+    return np.array([friction_coefficient(scene, name) for name in tm.interface.tags])[tm.interface.tag_index]
+
+
 def friction_law(scene, tm):
     """With ``loading.friction_temperature`` and heat: mu per interface facet (n_facets,) against the facets'
     temperatures [K] (the table's on the interfaces without a friction of their own; fade); else None."""
     table = scene.loading.friction_temperature if scene.has("friction") and scene.has("thermal") else None
     if table is None:
         return None
-    follows = np.zeros(tm.interface.n_facets, dtype=bool)
-    for name, m in tm.interface.masks().items():
-        follows[m] = scene.interface_settings(name).friction is None
-    own = np.array([friction_coefficient(scene, name) for name in tm.interface.tags])[tm.interface.tag_index]
+    follows = np.array([scene.interface_settings(name).friction is None for name in tm.interface.tags])
+    follows, own = follows[tm.interface.tag_index], facet_friction(scene, tm)
     temperatures, mu = (np.array(column, dtype=float) for column in zip(*table))
     return lambda T: np.where(follows, np.interp(T, temperatures, mu), own)
 
@@ -222,9 +225,7 @@ def build_mechanics(scene, tm, *, law=None, temperatures=None, degree: int = 1,
             if name not in scene.rough_interfaces:
                 perfect[m] = penalty
         law = SumLaw(law, PenaltyLaw(tm.interface.field("perfect_stiffness", perfect)))
-    mu = np.zeros(tm.interface.n_facets)
-    for name, m in masks.items():
-        mu[m] = friction_coefficient(scene, name)
+    mu = facet_friction(scene, tm)
     d = drive(scene, tm)
     lean = scene.stability is not None and scene.stability.method == "subspace"
     return Mechanics(tm, dict(scene.materials), stiffness=penalty, friction=mu, speed=d.speed(0.0), law=law,
