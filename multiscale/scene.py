@@ -35,7 +35,7 @@ from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FI
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
 from multiscale.scene_cycle import (convection_coverage, cycle_coverage, largest_load_factor, short_phases, speed_range,
-                                   fade_coverage, squeal_state, thin_heated_layers)
+                                   fade_coverage, fade_tables, squeal_state, thin_heated_layers)
 from multiscale.scene_stability import Stability, unresolved_band
 from multiscale.scene_vehicle import Vehicle
 
@@ -216,11 +216,12 @@ class Scene:
 
     def interface_settings(self, name: str) -> InterfaceSettings:
         """The settings of interface ``name``: its [interfaces.<name>] table, defaults filled
-        (friction from [loading], roughness and micro from [roughness] and [micro])."""
+        (friction or its fade table from [loading] unless it gives one, roughness and micro from
+        [roughness] and [micro])."""
         own = self.interfaces.get(name) or InterfaceSettings()
-        return dataclasses.replace(
-            own, friction=own.friction if own.friction is not None else self.loading.friction,
-            roughness=own.roughness or self.roughness, micro=own.micro or self.micro)
+        ld = self.loading if own.friction is None and own.friction_temperature is None else own
+        return dataclasses.replace(own, friction=ld.friction, friction_temperature=ld.friction_temperature,
+                                   roughness=own.roughness or self.roughness, micro=own.micro or self.micro)
 
     def roughness_key(self, name: str) -> str:
         """Where interface ``name``'s roughness is given: "interfaces.<name>.roughness" or "roughness"."""
@@ -392,7 +393,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                             "forces cancel: give loading.pressure (or loading.direction for a force along it)")
         if "friction" in effects and not any(k in loading for k in Loading.FRICTION):
             own = scene.interfaces or {}
-            bare = [n for n in g.spec.interfaces if getattr(own.get(n), "friction", None) is None]
+            bare = [n for n in g.spec.interfaces if getattr(own.get(n), "friction", None) is None
+                    and getattr(own.get(n), "friction_temperature", None) is None]
             if bare:
                 problems.append(f'{" or ".join("loading." + k for k in Loading.FRICTION)}: missing; effect "friction" '
                                 "needs it" + (f" for {', '.join(f'interfaces.{n}' for n in bare)} (the others give "
@@ -446,7 +448,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                                         (scene.time or Time()).initial_temperature)
     end = scene.time.end if scene.time is not None else None
     if scene.loading is not None and end is not None:
-        warnings += cycle_coverage(scene.loading, end) + fade_coverage(scene.loading, scene.time.initial_temperature)
+        warnings += cycle_coverage(scene.loading, end) + fade_coverage(fade_tables(scene.loading, scene.interfaces),
+                                                                        scene.time.initial_temperature)
         if g is not None and {"friction", "thermal", "heat_partition"} <= effects:
             warnings += short_phases(scene.loading, g.motion, end, scene.time.dt)
             if scene.materials is not None:

@@ -8,7 +8,7 @@ from __future__ import annotations
 
 import math
 
-from multiscale.scene_sections import interpolate
+from multiscale.curves import interpolate
 from multiscale.scene_vehicle import GRAVITY
 
 
@@ -41,14 +41,20 @@ def cycle_coverage(ld, end: float) -> list[str]:
     return out
 
 
-def fade_coverage(ld, T0: float) -> list[str]:
-    """``friction_temperature`` (fade) held below its first point at the initial temperature T0 [K]
-    (its last point against the run's temperatures: ``workflows.run_warnings``, after the run)."""
-    table = ld.friction_temperature
-    if table is None or T0 >= table[0][0]:
-        return []
-    return [f"loading.friction_temperature: the initial temperature, {T0 - 273.15:.4g} degC, is below its first "
-            f"point, {table[0][0] - 273.15:.4g} degC: mu is held at {table[0][1]:g} below it"]
+def fade_tables(ld, interfaces) -> dict[str, tuple]:
+    """The fade tables (``friction_temperature``) of [loading] and of the [interfaces.<name>]
+    (``interfaces``: name -> InterfaceSettings or None) by their keys."""
+    own = {f"interfaces.{n}.friction_temperature": s.friction_temperature for n, s in (interfaces or {}).items()
+           if s is not None and s.friction_temperature is not None}
+    return ({"loading.friction_temperature": ld.friction_temperature} if ld.friction_temperature else {}) | own
+
+
+def fade_coverage(tables: dict[str, tuple], T0: float) -> list[str]:
+    """Fade tables (``fade_tables``) held below their first point at the initial temperature T0 [K]
+    (their last point against the run's temperatures: ``workflows.run_warnings``, after the run)."""
+    return [f"{where}: the initial temperature, {T0 - 273.15:.4g} degC, is below its first point, "
+            f"{table[0][0] - 273.15:.4g} degC: mu is held at {table[0][1]:g} below it"
+            for where, table in tables.items() if T0 < table[0][0]]
 
 
 def run_knots(ld, end: float) -> list[float]:

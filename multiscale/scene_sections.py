@@ -11,6 +11,7 @@ import math
 from dataclasses import dataclass, replace
 from pathlib import Path
 
+from multiscale.curves import interpolate, mean, piecewise_mean
 from multiscale.errors import InputError
 from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_topography
@@ -33,6 +34,7 @@ _SPECIFIC_HEAT = Quantity("specific_heat", gt=0, plausible=(50.0, 5e3))
 _DIFFUSIVITY = Quantity("diffusivity", gt=0, plausible=(1e-8, 1.2e-3))
 _EXPANSION = Quantity("expansion", plausible=(-1e-5, 5e-4))
 _FRICTION = Quantity("dimensionless", ge=0, plausible=(0.0, 2.0))
+_FADE = Curve(_TEMPERATURE, _FRICTION, "temperature", "mu", min_rows=2)     # mu against the interface temperature
 ROUGHNESS = Quantity("length", gt=0, plausible=(1e-10, 1e-3))            # RMS height
 _CONVECTION = Quantity("conductance", ge=0, plausible=(0.0, 1e4))         # still air to boiling water
 _ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0))  # up to ~24 000 rpm
@@ -44,35 +46,6 @@ _WITH_RMS = "needed with rms (a generated surface)"
 def _property(value: Quantity, name: str) -> TableOr:
     """A material property: a constant, or a table [[temperature, value], ...] (>= 2 rows)."""
     return TableOr(value, Curve(_TEMPERATURE, value, "temperature", name, min_rows=2))
-
-
-def mean(table, x0: float, x1: float) -> float:
-    """Mean over [x0, x1] of the piecewise-linear ``interpolate(table, .)`` (exact)."""
-    if x1 <= x0:
-        return interpolate(table, x0)
-    xs = sorted({x0, x1, *(x for x, _ in table if x0 < x < x1)})
-    ys = [interpolate(table, x) for x in xs]
-    return sum(0.5 * (a + b) * (x1_ - x0_) for a, b, x0_, x1_ in zip(ys, ys[1:], xs, xs[1:])) / (x1 - x0)
-
-
-def piecewise_mean(fn, knots, x0: float, x1: float) -> float:
-    """Mean over [x0, x1] of ``fn``, a function that is quadratic (or linear) between its ``knots``:
-    Simpson's rule on each piece, exact for it. ``fn`` at x0 if the interval is empty."""
-    if x1 <= x0:
-        return fn(x0)
-    xs = sorted({x0, x1, *(x for x in knots if x0 < x < x1)})
-    return sum((b - a) * (fn(a) + 4.0 * fn(0.5 * (a + b)) + fn(b)) / 6.0 for a, b in zip(xs, xs[1:])) / (x1 - x0)
-
-
-def interpolate(table, x: float) -> float:
-    """Piecewise-linear interpolation of ((x, y), ...) rows at ``x``, held constant beyond the ends."""
-    xs, ys = zip(*table)
-    if x <= xs[0]:
-        return ys[0]
-    for (x0, y0), (x1, y1) in zip(table, table[1:]):
-        if x <= x1:
-            return y0 + (y1 - y0) * (x - x0) / (x1 - x0)
-    return ys[-1]
 
 
 # ------------------------------------------------------------------ materials and interfaces
@@ -200,12 +173,21 @@ class InterfaceSettings:
     """[interfaces.<name>]: one contact interface's own settings (names: the geometry's interfaces).
     ``roughness`` and ``micro`` override keys of the [roughness] and [micro] tables for this
     interface (its own surface, zones, laws); ``rough = false`` keeps it in perfect contact when
-    the scene has effect "roughness"."""
+    the scene has effect "roughness". Its own ``friction`` or ``friction_temperature`` (fade, as
+    [loading]'s) replaces [loading]'s friction, whichever key that gives."""
 
     friction: float | None = key(_FRICTION, absent="loading.friction (or any of its rule's keys)")   # mu
+    friction_temperature: tuple | None = key(_FADE, absent="loading's friction")     # ((K, -), ...)
     rough: bool = key(Flag(), default=True)                           # with effect "roughness"
     roughness: object = None          # Roughness of this interface (the merged [roughness] table)
     micro: object = None              # Micro of this interface (the merged [micro] table)
+
+    rules = (OneOf(("friction", "friction_temperature")),)
+
+    def problems(self, path, ctx):
+        if self.friction_temperature is not None and "thermal" not in ctx.effects:
+            return [f'{path}.friction_temperature: needs effect "thermal" (its temperatures); give {path}.friction']
+        return []
 
 
 _COMPONENTS = {"x": 0, "y": 1, "z": 2}
@@ -278,8 +260,9 @@ class Loading:
     of stops under a vehicle's torque; ``vehicle.mass`` does it for one stop). The speed of the rotating body:
     ``rotation_speed``, a ``speed_profile`` against time, or a ``vehicle`` stop or drag; a translating body
     slides at ``sliding_speed``. Friction: a constant ``friction``; ``friction_temperature``, mu against the
-    interface temperature (fade, effect "thermal": each facet's at the mean of its faces', a heat step late); or (the
-    squeal only) mu against the slip speed, ``friction_curve`` or ``stribeck``, per facet at its steady slip speed."""
+    interface temperature (fade, effect "thermal": each facet's at the mean of its faces', a heat step late); an
+    interface's own [interfaces.<name>] friction or table replaces them there; or (the squeal only) mu against
+    the slip speed, ``friction_curve`` or ``stribeck``, per facet at its steady slip speed."""
 
     normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)),                 # N
                                      absent="pressure, braking_torque or vehicle.mass gives the load")
@@ -298,8 +281,7 @@ class Loading:
     vehicle: Vehicle | None = key(Section(Vehicle))
     sliding_speed: float | None = key(Quantity("speed", ge=0, plausible=(0.0, 200.0)), absent="at rest")  # m/s
     friction: float | None = key(_FRICTION, absent="another key of the rule below, or each interface's own")  # mu
-    friction_temperature: tuple | None = key(Curve(_TEMPERATURE, _FRICTION, "temperature", "mu", min_rows=2),
-                                             absent="friction, constant (no fade)")   # ((K, -), ...)
+    friction_temperature: tuple | None = key(_FADE, absent="friction, constant (no fade)")   # ((K, -), ...)
     ramp_steps: int = key(Integer(ge=1, le=10**4), default=1)   # load increments of the first mechanical solve
     friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), Quantity("dimensionless", ge=0), "slip speed",
                                              "mu", min_rows=2), absent="friction or stribeck gives mu")  # ((m/s, -),..)

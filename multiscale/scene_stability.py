@@ -99,9 +99,10 @@ class Sweep:
             return [f"{where}: sets a constant friction; remove loading.friction_curve / loading.stribeck"]
         if name == "friction" and "friction" not in ctx.effects:     # (the map had friction, the analysis none)
             return [f'{where}: sweeps the friction of effect "friction", which the scene does not have']
-        own = [n for n, t in (ctx.root.get("interfaces") or {}).items() if isinstance(t, dict) and "friction" in t]
+        own = [f"interfaces.{n}.{k}" for n, t in (ctx.root.get("interfaces") or {}).items() if isinstance(t, dict)
+               for k in ("friction", "friction_temperature") if k in t]
         if name == "friction" and own:
-            given = ", ".join(f"interfaces.{n}.friction" for n in own)
+            given = ", ".join(own)
             ctx.warnings.append(f"{where}: sets every interface's friction, {given} too: no point of the map is "
                                 "the scene's analysis")
         if name == "pressure" and "pressure" not in loading:

@@ -71,7 +71,8 @@ def summary(scene: Scene) -> list[str]:
         if name in scene.interfaces or len(g.spec.interfaces) > 1:
             s = scene.interface_settings(name)
             kind = "rough" if name in (scene.rough_interfaces if scene.has("roughness") else ()) else "perfect contact"
-            mu = f", mu = {s.friction:g}" if scene.has("friction") and s.friction is not None else ""
+            mu = "" if not scene.has("friction") else f", mu = {s.friction:g}" if s.friction is not None else \
+                f", mu(T) {_fade(s.friction_temperature)}" if s.friction_temperature is not None else ""
             own, extra = scene.interfaces.get(name), []
             if kind == "rough" and own is not None:        # its own surface and zones (before: said nowhere)
                 extra += [f"its own surface: {_surface(s.roughness)}"] if own.roughness is not None else []
@@ -100,6 +101,18 @@ def summary(scene: Scene) -> list[str]:
     return lines
 
 
+def _fade(table) -> str:
+    """A fade table in words: "0.42 at 100 degC, 0.3 at 400 degC"."""
+    return ", ".join(f"{mu:g} at {T - 273.15:g} degC" for T, mu in table)
+
+
+def _own_friction(scene: Scene, name: str) -> str:
+    """" (its own on a, b)": the interfaces whose friction is not [loading]'s ``name`` key's."""
+    own = [n for n in scene.geometry.spec.interfaces
+           if getattr(scene.interface_settings(n), name) != getattr(scene.loading, name)]
+    return f" (its own on {', '.join(own)})" if own else ""
+
+
 def _effect_line(scene: Scene, effect: str) -> str:
     i, ld = scene.interface, scene.loading
     if effect == "contact":
@@ -109,16 +122,15 @@ def _effect_line(scene: Scene, effect: str) -> str:
             return "mu(slip speed) from friction_curve: " + ", ".join(f"{mu:g} at {v:g} m/s"
                                                                       for v, mu in ld.friction_curve)
         if ld.friction_temperature is not None:
-            return "Coulomb, mu(interface temperature) from friction_temperature: " + ", ".join(
-                f"{mu:g} at {T - 273.15:g} degC" for T, mu in ld.friction_temperature)
+            return "Coulomb, mu(interface temperature) from friction_temperature: " + _fade(ld.friction_temperature) \
+                + _own_friction(scene, "friction_temperature")
         if ld.stribeck is not None:
             st = ld.stribeck
             return (f"Stribeck mu(v) = {st.kinetic:g} + ({st.static:g} - {st.kinetic:g}) exp(-(v / {st.speed:g} m/s)"
                     f"^{st.exponent:g})")
         if ld.friction is None:
             return "Coulomb, mu per interface"
-        own = [n for n in scene.geometry.spec.interfaces if scene.interface_settings(n).friction != ld.friction]
-        return f"Coulomb, mu = {ld.friction:g}" + (f" (its own on {', '.join(own)})" if own else "")
+        return f"Coulomb, mu = {ld.friction:g}" + _own_friction(scene, "friction")
     if effect == "thermal":
         return f"transient conduction in {', '.join(scene.bodies)}"
     if effect == "heat_partition" and scene.has("roughness") and scene.micro.partition_law:

@@ -322,7 +322,7 @@ def test_a_body_hotter_than_any_material_is_warned_about(tmp_path):
         assert bool(lines) == warned
     assert lines == ["body 'block' reached 2.312e+04 K at t = 0.5 s, above any plausible temperature (2500 K: molten "
                      "iron): check the load, the heat partition and the materials (the model has no melting or "
-                     "wear of hot material, and fade only with loading.friction_temperature)"]
+                     "wear of hot material, and fade only with a friction_temperature table)"]
 
 
 def test_an_undershoot_is_weighed_against_the_rise_up_to_then(tmp_path):

@@ -639,6 +639,31 @@ def test_a_cycle_the_run_ends_before_is_warned_about(tmp_path):
                               "time.end = 2 s") and warning.endswith("brakes the rest")     # (not: written in gn)
 
 
+def test_an_interface_may_give_its_own_fade_table(tmp_path):
+    """[interfaces.<name>] friction_temperature: mu against its temperature for that interface alone,
+    replacing [loading]'s friction there (which is then not needed); one of friction and
+    friction_temperature per interface; it needs effect "thermal"; a table starting above the
+    initial temperature is warned about by its key; the summary says it (before: one table in
+    [loading] served every interface, and the key was refused)."""
+    pod = (DEMOS / "pin_on_disc_perfect.toml").read_text()
+    table = '[["100 degC", 0.5], ["300 degC", 0.3]]'
+    scene = loads(pod.replace("friction = 0.4\n", "") + f"\n[interfaces.interface]\nfriction_temperature = {table}\n",
+                  tmp_path)
+    s = scene.interface_settings("interface")
+    assert (s.friction, s.friction_temperature) == (None, ((373.15, 0.5), (573.15, 0.3)))
+    assert "interfaces.interface.friction_temperature: the initial temperature, 20 degC, is below its first point, " \
+        "100 degC: mu is held at 0.5 below it" in scene.warnings
+    assert "  interface interface: perfect contact, mu(T) 0.5 at 100 degC, 0.3 at 300 degC" in summary(scene)
+    kept = loads(pod + f"\n[interfaces.interface]\nfriction_temperature = {table}\n", tmp_path)
+    assert kept.loading.friction == 0.4 and kept.interface_settings("interface").friction is None
+    assert "    friction       Coulomb, mu = 0.4 (its own on interface)" in summary(kept)
+    with pytest.raises(SceneError, match=r"interfaces.interface.friction or interfaces.interface.friction_temperature: give only one"):
+        loads(pod + f"\n[interfaces.interface]\nfriction = 0.3\nfriction_temperature = {table}\n", tmp_path)
+    with pytest.raises(SceneError, match=r'interfaces.interface.friction_temperature: needs effect "thermal"'):
+        loads(pod.replace('"thermal", "heat_partition", "expansion"', '"expansion"')
+              + f"\n[interfaces.interface]\nfriction_temperature = {table}\n", tmp_path)
+
+
 def test_a_braking_phase_shorter_than_a_step_is_warned_about(tmp_path):
     """A step takes the mean frictional heat over its length: a brake application shorter than the
     step was spread over it silently (before), its temperatures too low (the coarse pin-on-disc's

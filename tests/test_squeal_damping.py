@@ -299,6 +299,26 @@ def test_friction_laws_values_and_slopes():
         TableFriction(((1.0, 0.5), (0.5, 0.4)))
 
 
+def test_an_interface_of_its_own_friction_keeps_it_constant_under_a_speed_law():
+    """``workflows.squeal.friction_laws`` with [loading]'s mu(v): the car brake's inner pad takes it,
+    the outer pad with its own fade table its mu at the initial temperature (30 degC: 0.4), constant
+    (before, only an own constant friction was kept)."""
+    from pathlib import Path
+    from types import SimpleNamespace
+
+    from multiscale.macro.friction import ConstantFriction
+    from multiscale.scene import loads
+    from multiscale.workflows.squeal import friction_laws
+    demos = Path(__file__).parents[1] / "demos"
+    if not (demos / "cad" / "car_brake.step").exists():
+        pytest.skip("demos/cad/car_brake.step not built (make demos/cad/car_brake.step)")
+    text = (demos / "car_brake_stop.toml").read_text().replace('"heat_partition"]', '"heat_partition", "stability"]')
+    text = text.replace("friction = 0.4", 'friction_curve = [["0 m/s", 0.5], ["10 m/s", 0.4]]') + "\n[stability]\nmodes = 4\n"
+    scene = loads(text + '[interfaces.outer_pad]\nfriction_temperature = [["10 degC", 0.5], ["50 degC", 0.3]]\n', demos)
+    laws = friction_laws(scene, SimpleNamespace(interface=SimpleNamespace(tags=("inner_pad", "outer_pad"))))
+    assert laws == {"inner_pad": TableFriction(((0.0, 0.5), (10.0, 0.4))), "outer_pad": ConstantFriction(0.4)}
+
+
 def test_belt_oscillator_negative_damping_onset():
     """m x'' + (c + N mu'(V)) x' + k x = 0: unstable below the belt speed where N mu'(V) = -c."""
     m, k, c, N = 1.0, 1e4, 0.5, 100.0

@@ -127,9 +127,6 @@ class MacroModel:
         self.load = self.drive.load
         factor = self.drive.factor(0.0) or 1.0
         self.last_solve = self.mechanics.ramp(self.load * factor, self.drive.ramp_steps)
-        if self.drive.torque is not None and self.speed(0.0) and not abs(self.contact.friction_moment()) > 0:
-            raise InputError("loading", None, f"the braking torque ({self.drive.torque:.6g} N m) needs a friction "
-                             "moment: give friction")
         self.keep_torque(factor)
         self.contact.engaged.value = float(self.drive.factor(0.0) > 0)
         self.solved_speed = float(self.contact.speed.value)
@@ -230,10 +227,6 @@ class MacroModel:
         load, solved = hold_moment(self.mechanics, self.load * factor, (self.drive.torque or 0.0) * factor)
         if solved is not None:                   # (only with a positive target: factor > 0)
             self.load, self.last_solve = load / factor, solved
-        if self.friction_law is not None and self.drive.torque and factor > 0 and float(self.contact.speed.value) \
-                and not abs(self.contact.friction_moment()) > 0:      # (collective: a global sum on every rank)
-            raise InputError("loading.friction_temperature", None, "mu fell to 0 at the interfaces' temperatures: "
-                             "no clamp force gives the braking torque (give mu > 0 up to the run's temperatures)")
 
     def interface_heat_row(self, masks: dict) -> dict:
         """Per interface (``masks``: its facets): the frictional heat generated on it [J] in the last

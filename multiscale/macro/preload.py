@@ -20,7 +20,7 @@ from dolfinx import fem
 from dolfinx.fem import petsc as fpetsc
 from petsc4py import PETSc
 
-from multiscale.errors import check_positive
+from multiscale.errors import InputError, check_positive
 from multiscale.macro.damped import LinearSystem
 from multiscale.macro.eigen import Damping
 from multiscale.macro.friction import friction_damping
@@ -54,10 +54,16 @@ def hold_moment(mech: Mechanics, load: float, target: float):
     """Scale ``load`` [N or Pa], the one ``mech`` solved last, until the friction moment about the
     rotation axis is ``target`` [N m] within ``TORQUE_TOL`` (secant steps, the moment being nearly
     linear in the load; at most ``TORQUE_SOLVES`` solves). Returns the load and the last
-    ``SolveResult`` (None: no solve was needed, or there is no moment: at rest, no friction)."""
+    ``SolveResult`` (None: no solve was needed, or at rest, where no friction acts). No moment
+    while sliding (mu 0 wherever the bodies touch: a friction of 0, a fade table falling to 0)
+    raises an InputError on every rank (the moment is a global sum)."""
     solved = None
     for _ in range(TORQUE_SOLVES if target > 0 else 0):
         moment = abs(mech.contact.friction_moment())
+        if not moment > 0 and float(mech.contact.speed.value):
+            raise InputError("loading", None, f"the braking torque ({target:.6g} N m) needs a friction moment, 0 "
+                             "while sliding: give friction (mu 0 wherever the bodies touch; with friction_temperature, "
+                             "at the interfaces' temperatures: give mu > 0 up to the run's temperatures)")
         if not moment > 0 or abs(moment - target) <= TORQUE_TOL * target:
             break
         load *= target / moment

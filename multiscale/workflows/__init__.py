@@ -20,6 +20,7 @@ from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError, Interrupted, interrupted
 from multiscale.micro.laws import RESOLUTION
 from multiscale.micro.wear import SUBSTEP_TOL
+from multiscale.scene_cycle import fade_tables
 from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.model import interface_materials
@@ -242,18 +243,15 @@ def _unloaded(scene, history) -> list[str]:
 
 
 def _fade_table_ends(scene, history) -> list[str]:
-    """``loading.friction_temperature`` left by the run: the bodies' largest temperature (the
-    interface's at most) above its last point, where mu was held (below its first at the initial
-    temperature: the scene's warning, ``scene_cycle.fade_coverage``)."""
-    table = scene.loading.friction_temperature if scene.has("friction") and scene.has("thermal") else None
-    if table is None:
-        return []
+    """Fade tables (``friction_temperature``) left by the run: the bodies' largest temperature (the
+    interfaces' at most) above a table's last point, where mu was held (below its first at the
+    initial temperature: the scene's warning, ``scene_cycle.fade_coverage``)."""
+    tables = fade_tables(scene.loading, scene.interfaces) if scene.has("friction") and scene.has("thermal") else {}
     columns = [f"max_temperature_{b.name}" for b in scene.geometry.spec.bodies]
-    hottest = max((float(np.max(history[c])) for c in columns if c in history.columns), default=-np.inf)
-    if hottest <= table[-1][0]:
-        return []
-    return [f"loading.friction_temperature: the bodies reached {hottest - 273.15:.4g} degC, above its last point, "
-            f"{table[-1][0] - 273.15:.4g} degC: where the interface was that hot, mu was held at {table[-1][1]:g}"]
+    hottest = max((float(np.max(history[c])) for c in columns if c in history.columns and tables), default=-np.inf)
+    return [f"{where}: the bodies reached {hottest - 273.15:.4g} degC, above its last point, "
+            f"{table[-1][0] - 273.15:.4g} degC: where the interface was that hot, mu was held at {table[-1][1]:g}"
+            for where, table in tables.items() if hottest > table[-1][0]]
 
 
 def _too_hot(scene, history) -> list[str]:
@@ -267,7 +265,7 @@ def _too_hot(scene, history) -> list[str]:
             out.append(f"body {body.name!r} reached {float(history[column][row]):.4g} K at t = {history['time'][row]:g} s, "
                        f"above any plausible temperature ({HOTTEST:g} K: molten iron): check the load, the heat "
                        "partition and the materials (the model has no melting or wear of hot material, and fade only "
-                       "with loading.friction_temperature)")
+                       "with a friction_temperature table)")
     return out
 
 

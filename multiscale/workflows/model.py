@@ -8,9 +8,9 @@ The rules that more than one analysis follows live here once:
 
 - supports: the builder's, plus every [[boundary]] ``fix``; load faces and direction: [loading]
   ``faces``/``direction``, else the builder's;
-- friction coefficient of an interface: its [interfaces.<name>] ``friction``, else
-  ``loading.friction``, else ``loading.friction_temperature`` at the initial temperature (and, with heat,
-  at each facet's temperature as the run goes: ``friction_law``), with effect ``friction``; else 0;
+- friction coefficient of an interface: its [interfaces.<name>] ``friction`` or ``friction_temperature``,
+  else [loading]'s; a fade table at the initial temperature (and, with heat, at each facet's temperature
+  as the run goes: ``friction_law``), with effect ``friction``; else 0;
 - load: a fluid pressure -p n for builders that declare ``fluid_load`` and for geometry files (a
   normal force spread as the uniform pressure F / A, A the load faces' areas projected normal to
   each face's resultant, or of each of a face's flat parts facing opposite ways, ``load_face_areas``;
@@ -43,16 +43,17 @@ from multiscale.macro.load_faces import load_face_areas, load_face_forces
 from multiscale.macro.mechanics import REPEATABLE_REFRESH, Mechanics
 from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
-from multiscale.scene_sections import interpolate
+from multiscale.curves import interpolate
 
 
 def friction_coefficient(scene, interface: str) -> float:
-    """mu [-] of an interface (its own, else ``loading.friction``, else ``loading.friction_temperature`` at
-    the initial temperature) with effect "friction", else 0."""
+    """mu [-] of an interface (``Scene.interface_settings``: its constant, else its fade table at the
+    initial temperature) with effect "friction", else 0."""
     if not scene.has("friction"):
         return 0.0
-    mu, table = scene.interface_settings(interface).friction, scene.loading.friction_temperature
-    return interpolate(table, scene.time.initial_temperature) if mu is None and table is not None else mu
+    s = scene.interface_settings(interface)
+    return interpolate(s.friction_temperature, scene.time.initial_temperature) if s.friction is None \
+        and s.friction_temperature is not None else s.friction
 
 
 def facet_friction(scene, tm) -> np.ndarray:
@@ -61,15 +62,21 @@ def facet_friction(scene, tm) -> np.ndarray:
 
 
 def friction_law(scene, tm):
-    """With ``loading.friction_temperature`` and heat: mu per interface facet (n_facets,) against the facets'
-    temperatures [K] (the table's on the interfaces without a friction of their own; fade); else None."""
-    table = scene.loading.friction_temperature if scene.has("friction") and scene.has("thermal") else None
-    if table is None:
+    """With heat and a fade table on any interface (its own or [loading]'s ``friction_temperature``): mu per
+    interface facet (n_facets,) against the facets' temperatures [K] (a constant mu where the interface has
+    one); else None."""
+    tables = [scene.interface_settings(name).friction_temperature for name in tm.interface.tags]
+    if not (scene.has("friction") and scene.has("thermal")) or all(t is None for t in tables):
         return None
-    follows = np.array([scene.interface_settings(name).friction is None for name in tm.interface.tags])
-    follows, own = follows[tm.interface.tag_index], facet_friction(scene, tm)
-    temperatures, mu = (np.array(column, dtype=float) for column in zip(*table))
-    return lambda T: np.where(follows, np.interp(T, temperatures, mu), own)
+    own, tag = facet_friction(scene, tm), tm.interface.tag_index
+    fades = [(tag == i, *(np.array(column, dtype=float) for column in zip(*t))) for i, t in enumerate(tables) if t]
+
+    def law(T: np.ndarray) -> np.ndarray:
+        mu = own.copy()
+        for on, temperatures, values in fades:
+            mu[on] = np.interp(T[on], temperatures, values)
+        return mu
+    return law
 
 
 def scene_spec(scene) -> GeometrySpec:

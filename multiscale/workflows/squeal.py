@@ -131,14 +131,16 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
 
 def friction_laws(scene, tm) -> dict | None:
     """mu(v) law of every interface when [loading] gives a ``friction_curve`` or ``stribeck``
-    (an interface's own constant ``friction`` stays constant); None with a constant friction."""
+    (an interface's own ``friction`` stays constant, its own fade table its mu at the initial
+    temperature); None with a constant friction."""
     ld = scene.loading
     if not scene.has("friction") or (ld.friction_curve is None and ld.stribeck is None):
         return None
     law = TableFriction(ld.friction_curve) if ld.friction_curve is not None else \
         StribeckFriction(ld.stribeck.static, ld.stribeck.kinetic, ld.stribeck.speed, ld.stribeck.exponent)
-    own = {n: scene.interfaces[n].friction for n in scene.interfaces if scene.interfaces[n] is not None}
-    return {n: ConstantFriction(own[n]) if own.get(n) is not None else law for n in tm.interface.tags}
+    own = {n for n, s in scene.interfaces.items()
+           if s is not None and (s.friction is not None or s.friction_temperature is not None)}
+    return {n: ConstantFriction(friction_coefficient(scene, n)) if n in own else law for n in tm.interface.tags}
 
 
 def squeal_options(scene, tm) -> SquealOptions:
