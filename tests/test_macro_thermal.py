@@ -949,12 +949,13 @@ initial_temperature = "20 degC"
 FADE_TABLE = 'friction_temperature = [["20 degC", 0.4], ["120 degC", 0.0]]'
 
 
-def fade_scene(friction: str = FADE_TABLE, load: str = 'normal_force = "200 N"'):
-    """The lumped pin-on-disc (FADE) with its friction and load lines; its implausible kappa and chi are meant."""
+def fade_scene(friction: str = FADE_TABLE, load: str = 'normal_force = "200 N"', speed='rotation_speed = "200 rpm"'):
+    """The lumped pin-on-disc (FADE) with its friction, load and speed lines; its implausible kappa and chi are meant."""
     import warnings
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
-        return loads(FADE.format(friction=friction).replace('normal_force = "200 N"', load))
+        return loads(FADE.format(friction=friction).replace('normal_force = "200 N"', load)
+                     .replace('rotation_speed = "200 rpm"', speed))
 
 
 def test_friction_of_the_temperature_fades_as_lumped_bodies_do():
@@ -1046,6 +1047,18 @@ def test_an_interface_with_its_own_friction_keeps_it_under_fade():
                  demos)
     np.testing.assert_allclose(friction_law(both, tm)(T), [0.45, 0.35, 0.25, 0.5, 0.3], rtol=1e-14)
     assert friction_law(loads((demos / "car_brake_stop.toml").read_text(), demos), tm) is None
+
+
+def test_the_friction_coefficient_is_not_a_number_once_the_disc_stopped():
+    """``friction_coefficient`` after a stop inside a step (200 rpm to 0 at 0.35 s, steps of 0.1 s):
+    NaN from the row at rest on, as the docs say (before: 0, the step's solve at its mean speed
+    counted as sliding), and mu of the table while it turned (above 0.39 at these temperatures)."""
+    scene = fade_scene(load='normal_force = "200 N"\nspeed_profile = [["0 s", "200 rpm"], ["0.35 s", "0 rpm"]]',
+                       speed="")
+    rows = []
+    march(scene, steps=6, rows=rows).close()
+    mu = np.array([r["friction_coefficient"] for r in rows])
+    assert np.all(mu[:4] > 0.39) and np.all(np.isnan(mu[4:]))
 
 
 def test_an_interface_fades_by_its_own_table_as_by_the_loadings():

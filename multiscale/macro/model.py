@@ -323,7 +323,8 @@ class MacroModel:
                "newton_iterations": self.last_solve.iterations}
         if self.friction_law is not None:               # fade: the friction over the normal force (NaN at rest)
             normal = row["interface_force"]
-            row["friction_coefficient"] = row["friction_force"] / normal if normal > 0 and self.solved_speed else np.nan
+            moving = float(self.contact.speed.value)      # (now: a stop inside the step solved at its speed)
+            row["friction_coefficient"] = row["friction_force"] / normal if normal > 0 and moving else np.nan
         if isinstance(self.tm.spec.motion, Rotation):   # the braking torque: frictional heat power = it x omega
             row["friction_moment"] = abs(self.contact.friction_moment()) * on
         masks = self.tm.interface.masks()
