@@ -15,7 +15,7 @@ from matplotlib.ticker import FuncFormatter, NullFormatter
 from multiscale.studies.expand import Study, StudyRun
 from multiscale.studies.formatting import metric_heading, percent
 from multiscale.studies.problems import PROBLEMS
-from multiscale.studies.results import Row, case_key, crossings, knob_unit, pareto, sample_std
+from multiscale.studies.results import Row, case_key, crossings, knob_unit, measured_value, pareto, sample_std
 
 __all__ = ["plot"]
 
@@ -176,7 +176,7 @@ def _plot_axis(study, ok, axis, folder, found):
             for tol in study.report.errors:
                 ax.axhline(tol, color="gray", ls="--", lw=0.8)
         if kind == "value" and m in study.judged:        # calibration: the measured value, and where it is met
-            ref = next(r.reference[m] for r in ok if m in r.reference)
+            ref = measured_value(ok, m)
             ax.axhline(ref, color="green", ls="--", lw=1, label="measured")
             met = [c.value for c in found if c.knob == axis[0] and c.metric == m and c.value is not None]
             ax.plot(met, [ref] * len(met), "*", color="green", ms=11, label="where the sweep meets it" if met else None)

@@ -265,6 +265,12 @@ class Crossing:
     log: bool              # interpolated linearly in log(metric) against log(knob)
 
 
+def measured_value(rows: list[Row], metric: str) -> float:
+    """The measured value of judged ``metric`` (a calibration's reference, the same in every run)
+    from the first successful row that has it."""
+    return next(r.reference[metric] for r in rows if r.ok and metric in r.reference)
+
+
 def crossings(study: Study, rows: list[Row]) -> list[Crossing]:
     """Calibration from a sweep against measured values (``reference.kind = "file"``): along each
     numeric knob, for each setting of the other knobs and each judged metric, the knob values at
@@ -275,7 +281,7 @@ def crossings(study: Study, rows: list[Row]) -> list[Crossing]:
     references."""
     if study.reference is None or study.reference.kind != "file":
         return []
-    ok, out = [r for r in rows if r.ok], []
+    out = []
     for axis in (a for a in study.axes if a[0] not in study.averaged):
         knob, held = axis[0], [k for k in study.knobs if k not in axis and k not in study.averaged]
         groups = {}
@@ -290,7 +296,7 @@ def crossings(study: Study, rows: list[Row]) -> list[Crossing]:
             xs.sort()
             shown = {r.run.label[knob]: r.run.shown[knob] for r in group}
             for m in study.judged:
-                ref = next(r.reference[m] for r in ok if m in r.reference)
+                ref = measured_value(rows, m)
                 y = [float(np.mean([r.record["metrics"][m] for r in group if r.run.label[knob] == x])) for x in xs]
                 log = min(xs) > 0 and min(y) > 0 and ref > 0
                 f = (lambda v: math.log(v)) if log else (lambda v: v)
