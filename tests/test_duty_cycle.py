@@ -279,17 +279,18 @@ def test_each_interface_has_its_own_friction_and_its_own_results(tmp_path):
     assert ratio["outer_pad"] == pytest.approx(0.4, rel=1e-3)           # magnitudes: all of the pad slides
 
 
-def heated_brake(folder, inner_friction: float = 0.4):
+def heated_brake(folder, inner_friction: float = 0.4, **overrides):
     """The 20 mm disc brake with heat: 50 rad/s, friction 0.4 (``inner_friction`` on the inner pad),
     30 % of the frictional heat into the pads, two 0.1 s steps, constant materials, no conductance
-    between the bodies and no expansion (a linear heat problem on a fixed pressure field)."""
+    between the bodies and no expansion (a linear heat problem on a fixed pressure field); more
+    ``overrides`` of dotted keys."""
     thermal = {f"materials.{m}.{k}": v for m in ("disc", "pad", "backplate", "piston", "caliper")
                for k, v in (("kappa", "1.5 W/(m K)" if m == "pad" else "40 W/(m K)"), ("c", "500 J/(kg K)"))}
     return load(ROOT / "demos" / "brake_squeal.toml", {
         **BRAKE, "output.folder": str(folder), "output.fields": [],
         "effects": ["contact", "friction", "thermal", "heat_partition"], "interface.partition": 0.3,
         "interfaces.inner_pad.friction": inner_friction, "loading.rotation_speed": "50 rad/s",
-        "time": {"end": "0.2 s", "steps": 2}, **thermal})
+        "time": {"end": "0.2 s", "steps": 2}, **thermal, **overrides})
 
 
 PADS = ("inner_pad", "outer_pad")
@@ -317,6 +318,31 @@ def test_each_pad_has_its_own_frictional_heat_and_face_temperatures(tmp_path):
     rise = {mu: h[mu]["face_mean_temperature_inner_pad_on_brake"][1:] - 293.15 for mu in h}
     assert np.all(rise[0.4] > 1.0)
     np.testing.assert_allclose(rise[0.2] / rise[0.4], 0.5, rtol=1e-2)
+
+
+def test_each_pad_reads_its_own_friction_coefficient_under_fade(tmp_path):
+    """With a fade table (here the outer pad's own; the inner pad at mu 0.4) the history has each
+    pad's ``friction_coefficient_<pad>``, its friction force over its normal force: the inner pad's
+    0.4, the outer pad's the mean of its facets' mu (the table at their temperatures) weighted by
+    their normal forces, within 1e-3 (a facet's friction is integrated before its magnitude is
+    taken: measured 1.3e-4 and 1.1e-4), below the table's 0.5 as its face heats (0.443 after 0.2 s);
+    ``friction_coefficient`` is the pads' together."""
+    from multiscale.workflows.model import build_model
+    table = [["20 degC", 0.5], ["120 degC", 0.3]]
+    model = build_model(heated_brake(tmp_path / "out", **{"interfaces.outer_pad.friction_temperature": table}))
+    model.start()
+    for _ in range(2):
+        row = model.record(model.macro_step(0.1))
+    masks, mu = model.tm.interface.masks(), model.tm.interface.values(model.contact.friction)
+    normal = model.contact.facet_normal_force()
+    model.close()
+    outer = masks["outer_pad"]
+    assert row["friction_coefficient_inner_pad"] == pytest.approx(0.4, rel=1e-3)
+    assert row["friction_coefficient_outer_pad"] == pytest.approx(mu[outer] @ normal[outer] / normal[outer].sum(),
+                                                                  rel=1e-3)
+    assert 0.3 < row["friction_coefficient_outer_pad"] < 0.49
+    both = sum(row[f"friction_force_{p}"] for p in PADS) / sum(row[f"interface_force_{p}"] for p in PADS)
+    assert row["friction_coefficient"] == pytest.approx(both, rel=1e-12)
 
 
 def test_a_pads_face_temperatures_are_those_of_its_facets(tmp_path):

@@ -251,8 +251,9 @@ def test_the_multiscale_figure_shows_the_real_contact_area_and_the_plastic_share
 
 
 def test_a_run_with_fade_draws_its_friction_coefficient(tmp_path, drawn):
-    """``friction_coefficient`` (a run with ``loading.friction_temperature``) has a panel of its own,
-    its values as recorded (NaN at rest: a gap); a run without the column has no such panel."""
+    """``friction_coefficient`` (a run with a ``friction_temperature`` table) has a panel of its own,
+    its values as recorded (NaN at rest: a gap); a run without the column has no such panel; with
+    several interfaces the panel also draws each one's ``friction_coefficient_<name>``."""
     for fade in (True, False):
         history = History()
         for t, mu in ((0.0, 0.4), (1.0, 0.37), (2.0, float("nan"))):
@@ -264,3 +265,13 @@ def test_a_run_with_fade_draws_its_friction_coefficient(tmp_path, drawn):
         assert len(axes) == fade
         if fade:
             np.testing.assert_allclose(axes[0].get_lines()[0].get_ydata(), [0.4, 0.37, np.nan])
+    pads = History()                    # several interfaces: each one's curve beside all of them together
+    for t, mu in ((0.0, 0.4), (1.0, 0.37)):
+        pads.append(time=t, interface_force=200.0, max_pressure=1e6, max_temperature_disc=298.0 + t,
+                    heat_total_disc=t, friction_coefficient=mu, friction_coefficient_inner_pad=mu + 0.01,
+                    friction_coefficient_outer_pad=mu - 0.01)
+    plots.history_figure(pads, tmp_path / "history.png")
+    (ax,) = [ax for ax in drawn[-1].axes if ax.get_ylabel() == "friction coefficient [-]"]
+    assert {line.get_label(): tuple(line.get_ydata()) for line in ax.get_lines()} == {
+        "all": pytest.approx((0.4, 0.37)), "inner pad": pytest.approx((0.41, 0.38)),
+        "outer pad": pytest.approx((0.39, 0.36))}

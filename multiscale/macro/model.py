@@ -314,17 +314,19 @@ class MacroModel:
         ``friction_moment`` [N m], with a rotating body 1, is the magnitude of their moment about its axis. With several
         interfaces and heat, ``interface_heat_row`` gives each one's heat and face temperatures. With a
         ``friction_law``, ``friction_coefficient`` [-] is ``friction_force`` over ``interface_force`` (NaN
-        while released or at rest)."""
+        while released or at rest), and with several interfaces each one's too."""
         on = not self.released
         friction = np.linalg.norm(self.contact.facet_friction(), axis=1) * on     # N per facet, magnitudes
         row = {"time": self.time, "interface_force": self.last_solve.normal_force * on,
                "friction_force": float(friction.sum()),
                "max_pressure": self.last_solve.max_pressure * on,
                "newton_iterations": self.last_solve.iterations}
-        if self.friction_law is not None:               # fade: the friction over the normal force (NaN at rest)
-            normal = row["interface_force"]
-            moving = float(self.contact.speed.value)      # (now: a stop inside the step solved at its speed)
-            row["friction_coefficient"] = row["friction_force"] / normal if normal > 0 and moving else np.nan
+        moving = float(self.contact.speed.value)          # (now: a stop inside the step solved at its speed)
+
+        def ratio(force: float, normal: float) -> float:  # mu as a dynamometer reads it; NaN at rest or released
+            return force / normal if normal > 0 and moving else np.nan
+        if self.friction_law is not None:               # fade: the friction over the normal force
+            row["friction_coefficient"] = ratio(row["friction_force"], row["interface_force"])
         if isinstance(self.tm.spec.motion, Rotation):   # the braking torque: frictional heat power = it x omega
             row["friction_moment"] = abs(self.contact.friction_moment()) * on
         masks = self.tm.interface.masks()
@@ -334,6 +336,9 @@ class MacroModel:
                 row[f"interface_force_{name}"] = float(p[m] @ self.tm.interface.areas[m])
                 row[f"friction_force_{name}"] = float(friction[m].sum())
                 row[f"max_pressure_{name}"] = float(p[m].max(initial=0.0))
+                if self.friction_law is not None:       # each pad's own (its own table, its temperatures)
+                    row[f"friction_coefficient_{name}"] = ratio(row[f"friction_force_{name}"],
+                                                                row[f"interface_force_{name}"])
             if self.thermal is not None:
                 row.update(self.interface_heat_row(masks))
         if self.thermal is not None:

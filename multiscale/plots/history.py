@@ -32,9 +32,11 @@ def column_label(key: str) -> str:
     max_temperature_pin_in_disc -> "pin, disc material" (the pin's cells of material disc),
     max_temperature_fixed_part_inner_pad -> "inner pad" (a part of body fixed),
     face_max_temperature_inner_pad_on_disc -> "inner pad on disc" (the disc's face of interface
-    inner_pad)."""
+    inner_pad), friction_coefficient_inner_pad -> "inner pad" (friction_coefficient: "all")."""
+    if key == "friction_coefficient":
+        return "all"
     for prefix in ("max_temperature_", "heat_total_", "stored_heat_", "heat_lost_total_", "frictional_heat_total_",
-                   "face_max_temperature_"):
+                   "face_max_temperature_", "friction_coefficient_"):
         key = key.removeprefix(prefix)
     key = key.partition("_part_")[2] or key
     body, within, material = key.partition("_in_")
@@ -113,7 +115,8 @@ def history_figure(history, path: Path, title: str = "") -> Path:
     heat = [prefix + b for b in bodies for prefix in HEAT_KINDS if prefix + b in history.columns]
     groups = [("interface force [N]", ["interface_force"], 1.0, 0.0),
               ("max contact pressure [MPa]", ["max_pressure"], 1e-6, 0.0),
-              ("friction coefficient [-]", ["friction_coefficient"], 1.0, 0.0),      # with fade
+              ("friction coefficient [-]", [k for k in history.columns if k.startswith("friction_coefficient")],
+               1.0, 0.0),                                                          # with fade (and per interface)
               ("max temperature [°C]", temperature_columns(history.columns), 1.0, -273.15),
               ("heat of each body [J]", heat, 1.0, 0.0),
               ("frictional heat per interface [J]",
