@@ -169,12 +169,12 @@ def test_a_unit_word_in_a_body_or_interface_name_does_not_set_the_unit(tmp_path)
     h = History()
     h.append(time=0.0, max_temperature_pressure_plate=300.0, frictional_heat_total_force_pad=1.0,
              face_mean_temperature_force_pad_on_pressure_plate=300.0, interface_force_heat_pad=5.0,
-             max_pressure_time_pad=1e6)
+             max_pressure_time_pad=1e6, friction_coefficient_pressure_pad=0.4)
     with h5py.File(h.write(tmp_path / "history.h5"), "r") as f:
         units = {key: f[key].attrs["unit"] for key in f}
     assert units == {"time": "s", "max_temperature_pressure_plate": "K", "frictional_heat_total_force_pad": "J",
                      "face_mean_temperature_force_pad_on_pressure_plate": "K", "interface_force_heat_pad": "N",
-                     "max_pressure_time_pad": "Pa"}
+                     "max_pressure_time_pad": "Pa", "friction_coefficient_pressure_pad": "-"}   # (was Pa)
 
 
 def test_the_wear_map_of_a_round_face_leaves_its_corners_blank(tmp_path, drawn):
