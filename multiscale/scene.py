@@ -35,7 +35,8 @@ from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FI
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
 from multiscale.scene_cycle import (convection_coverage, cycle_coverage, largest_load_factor, short_phases, speed_range,
-                                   fade_coverage, fade_tables, squeal_state, thin_heated_layers)
+                                   squeal_state, thin_heated_layers)
+from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks
 from multiscale.scene_stability import Stability, unresolved_band
 from multiscale.scene_vehicle import Vehicle
 
@@ -391,14 +392,10 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                 and not isinstance(g.params, FileGeometry):
             problems.append(f"loading.normal_force: {where} is loaded by a fluid pressure on its load faces, whose "
                             "forces cancel: give loading.pressure (or loading.direction for a force along it)")
-        if "friction" in effects and not any(k in loading for k in Loading.FRICTION):
-            own = scene.interfaces or {}
-            bare = [n for n in g.spec.interfaces if getattr(own.get(n), "friction", None) is None
-                    and getattr(own.get(n), "friction_temperature", None) is None]
-            if bare:
-                problems.append(f'{" or ".join("loading." + k for k in Loading.FRICTION)}: missing; effect "friction" '
-                                "needs it" + (f" for {', '.join(f'interfaces.{n}' for n in bare)} (the others give "
-                                              "their own friction)" if len(bare) < len(g.spec.interfaces) else ""))
+        if "friction" in effects:
+            more, unused = friction_checks(loading, scene.interfaces, g.spec.interfaces)
+            problems += more
+            warnings += unused
         problems += _surface_checks(scene, g, where, effects)
         problems += _symmetry_checks(scene, g, where, effects)
         given = raw.get("geometry") if isinstance(raw.get("geometry"), dict) else {}

@@ -1,6 +1,6 @@
 """The duty cycle against the analysis that runs it (``multiscale.scene``'s cross-checks): what a
 load or speed profile, a vehicle stop and a speed-dependent convection table leave out of the run
-[0, time.end] (and a fade table of the initial temperature), and what the squeal analysis, which
+[0, time.end], and what the squeal analysis, which
 linearises one state, ignores of a cycle.
 The checks return one warning line per finding; ``braking_phases`` and ``largest_load_factor``
 read the cycle over the run's knots (``run_knots``)."""
@@ -39,22 +39,6 @@ def cycle_coverage(ld, end: float) -> list[str]:
                    f"braked {100 * (1 - (left / v.speed) ** 2):.0f} % of the kinetic energy; a longer time.end "
                    "brakes the rest" + (' (a deceleration in g is written "0.6 gn")' if v.deceleration < 1.0 else ""))
     return out
-
-
-def fade_tables(ld, interfaces) -> dict[str, tuple]:
-    """The fade tables (``friction_temperature``) of [loading] and of the [interfaces.<name>]
-    (``interfaces``: name -> InterfaceSettings or None) by their keys."""
-    own = {f"interfaces.{n}.friction_temperature": s.friction_temperature for n, s in (interfaces or {}).items()
-           if s is not None and s.friction_temperature is not None}
-    return ({"loading.friction_temperature": ld.friction_temperature} if ld.friction_temperature else {}) | own
-
-
-def fade_coverage(tables: dict[str, tuple], T0: float) -> list[str]:
-    """Fade tables (``fade_tables``) held below their first point at the initial temperature T0 [K]
-    (their last point against the run's temperatures: ``workflows.run_warnings``, after the run)."""
-    return [f"{where}: the initial temperature, {T0 - 273.15:.4g} degC, is below its first point, "
-            f"{table[0][0] - 273.15:.4g} degC: mu is held at {table[0][1]:g} below it"
-            for where, table in tables.items() if T0 < table[0][0]]
 
 
 def run_knots(ld, end: float) -> list[float]:

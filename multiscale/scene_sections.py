@@ -15,6 +15,7 @@ from multiscale.curves import interpolate, mean, piecewise_mean
 from multiscale.errors import InputError
 from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_topography
+from multiscale.scene_friction import FRICTION
 from multiscale.scene_geometry import Direction, LengthUnit
 from multiscale.scene_plain import PixelSize
 from multiscale.scene_stability import Stribeck
@@ -287,17 +288,16 @@ class Loading:
                                              "mu", min_rows=2), absent="friction or stribeck gives mu")  # ((m/s, -),..)
     stribeck: Stribeck | None = key(Section(Stribeck))
 
-    FRICTION = ("friction", "friction_temperature", "friction_curve", "stribeck")   # one with effect friction
     rules = (OneOf(("normal_force", "pressure")), OneOf(FRICTION), OneOf(("rotation_speed", "speed_profile", "vehicle"),
              meaning="a vehicle is one stop or drag; several stops: speed and load profiles"))
 
     def problems(self, path, ctx):
-        law = [k for k in self.FRICTION if getattr(self, k) is not None]
+        law = [k for k in FRICTION if getattr(self, k) is not None]
         if law and "friction" not in ctx.effects:
             ctx.warnings.append(f'{path}.{law[0]} is ignored: effect "friction" is not in effects')
         elif law[:1] == ["friction_temperature"] and "thermal" not in ctx.effects:
             return [f'{path}.friction_temperature: needs effect "thermal" (its temperatures); give {path}.friction']
-        elif law and law[0] not in self.FRICTION[:2] and "stability" not in ctx.effects:
+        elif law and law[0] not in FRICTION[:2] and "stability" not in ctx.effects:
             return [f"{path}.{law[0]}: a speed-dependent friction is read by the squeal analysis only "
                     f'(effect "stability"); give {path}.friction']
         if self.vehicle is not None and self.load_profile is not None:

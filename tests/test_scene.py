@@ -657,6 +657,8 @@ def test_an_interface_may_give_its_own_fade_table(tmp_path):
     kept = loads(pod + f"\n[interfaces.interface]\nfriction_temperature = {table}\n", tmp_path)
     assert kept.loading.friction == 0.4 and kept.interface_settings("interface").friction is None
     assert "    friction       Coulomb, mu = 0.4 (its own on interface)" in summary(kept)
+    assert "loading.friction is unused: every interface gives its own friction (interfaces.interface)" in kept.warnings
+    assert not any("unused" in w for w in scene.warnings)
     with pytest.raises(SceneError, match=r"interfaces.interface.friction or interfaces.interface.friction_temperature: give only one"):
         loads(pod + f"\n[interfaces.interface]\nfriction = 0.3\nfriction_temperature = {table}\n", tmp_path)
     with pytest.raises(SceneError, match=r'interfaces.interface.friction_temperature: needs effect "thermal"'):
@@ -828,7 +830,8 @@ def test_friction_on_a_sliding_part_model_is_refused(tmp_path):
 
 def test_loading_friction_is_needed_only_for_interfaces_without_their_own(tmp_path):
     """With effect "friction" the scene-wide law is needed only by interfaces that give no friction
-    of their own (before: always, "loading.friction or ...: missing" with both pads' own mu)."""
+    of their own (before: always, "loading.friction or ...: missing" with both pads' own mu), and
+    is said unused when none takes it."""
     text = (DEMOS / "brake_squeal.toml").read_text().replace("\nfriction = 0.4\n", "\n", 1)
     with pytest.raises(SceneError) as err:
         loads(text, DEMOS)
@@ -842,6 +845,11 @@ def test_loading_friction_is_needed_only_for_interfaces_without_their_own(tmp_pa
     assert "Coulomb, mu per interface" in "\n".join(summary(scene))
     one = loads((DEMOS / "brake_squeal.toml").read_text(), DEMOS, overrides={"interfaces.inner_pad.friction": 0.3})
     assert "    friction       Coulomb, mu = 0.4 (its own on inner_pad)" in summary(one)   # (said mu = 0.4 alone)
+    assert not any("unused" in w for w in one.warnings)
+    every = loads((DEMOS / "brake_squeal.toml").read_text(), DEMOS,     # (said nothing: a sweep of it changed nothing)
+                  overrides={"interfaces.inner_pad.friction": 0.3, "interfaces.outer_pad.friction": 0.3})
+    assert "loading.friction is unused: every interface gives its own friction (interfaces.inner_pad, " \
+        "interfaces.outer_pad)" in every.warnings
 
 
 def test_perfect_contact_keys_with_rough_interfaces_are_needed_where_kept_and_said_ignored_otherwise():

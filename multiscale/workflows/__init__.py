@@ -20,7 +20,7 @@ from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError, Interrupted, interrupted
 from multiscale.micro.laws import RESOLUTION
 from multiscale.micro.wear import SUBSTEP_TOL
-from multiscale.scene_cycle import fade_tables
+from multiscale.scene_friction import fade_tables
 from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.model import interface_materials

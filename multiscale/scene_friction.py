@@ -1,0 +1,45 @@
+"""Friction across [loading] and [interfaces.<name>] (``multiscale.scene``'s checks): which
+interfaces need [loading]'s law and whether any takes it, the fade tables by their keys and their
+first points against the initial temperature (their last against the run's: ``workflows``)."""
+from __future__ import annotations
+
+FRICTION = ("friction", "friction_temperature", "friction_curve", "stribeck")   # [loading]'s laws, one at most
+
+
+def bare_interfaces(interfaces, names) -> list[str]:
+    """Of the interfaces ``names``, those without a friction of their own (``interfaces``: name ->
+    InterfaceSettings or None): they take [loading]'s."""
+    own = interfaces or {}
+    return [n for n in names if getattr(own.get(n), "friction", None) is None
+            and getattr(own.get(n), "friction_temperature", None) is None]
+
+
+def friction_checks(loading: dict, interfaces, names) -> tuple[list[str], list[str]]:
+    """(problems, warnings) of effect "friction" on interfaces ``names``: [loading] (its raw table)
+    gives no law while some interface has none of its own; it gives one that every interface
+    replaces by its own (unused: a sweep of it would change nothing)."""
+    given, bare = [k for k in FRICTION if k in loading], bare_interfaces(interfaces, names)
+    if not given and bare:
+        return [f'{" or ".join("loading." + k for k in FRICTION)}: missing; effect "friction" needs it'
+                + (f" for {', '.join(f'interfaces.{n}' for n in bare)} (the others give their own friction)"
+                   if len(bare) < len(names) else "")], []
+    if given and not bare and names:
+        return [], [f"loading.{given[0]} is unused: every interface gives its own friction (interfaces."
+                    f"{', interfaces.'.join(names)})"]
+    return [], []
+
+
+def fade_tables(ld, interfaces) -> dict[str, tuple]:
+    """The fade tables (``friction_temperature``) of [loading] and of the [interfaces.<name>]
+    (``interfaces``: name -> InterfaceSettings or None) by their keys."""
+    own = {f"interfaces.{n}.friction_temperature": s.friction_temperature for n, s in (interfaces or {}).items()
+           if s is not None and s.friction_temperature is not None}
+    return ({"loading.friction_temperature": ld.friction_temperature} if ld.friction_temperature else {}) | own
+
+
+def fade_coverage(tables: dict[str, tuple], T0: float) -> list[str]:
+    """Fade tables (``fade_tables``) held below their first point at the initial temperature T0 [K]
+    (their last point against the run's temperatures: ``workflows.run_warnings``, after the run)."""
+    return [f"{where}: the initial temperature, {T0 - 273.15:.4g} degC, is below its first point, "
+            f"{table[0][0] - 273.15:.4g} degC: mu is held at {table[0][1]:g} below it"
+            for where, table in tables.items() if T0 < table[0][0]]
