@@ -29,12 +29,14 @@ def friction_checks(loading: dict, interfaces, names) -> tuple[list[str], list[s
     return [], []
 
 
-def fade_tables(ld, interfaces) -> dict[str, tuple]:
-    """The fade tables (``friction_temperature``) of [loading] and of the [interfaces.<name>]
-    (``interfaces``: name -> InterfaceSettings or None) by their keys."""
+def fade_tables(ld, interfaces, names=None) -> dict[str, tuple]:
+    """The fade tables (``friction_temperature``) of the [interfaces.<name>] (``interfaces``: name ->
+    InterfaceSettings or None) and of [loading] if an interface of ``names`` takes it (None: not
+    known), by their keys."""
     own = {f"interfaces.{n}.friction_temperature": s.friction_temperature for n, s in (interfaces or {}).items()
            if s is not None and s.friction_temperature is not None}
-    return ({"loading.friction_temperature": ld.friction_temperature} if ld.friction_temperature else {}) | own
+    taken = ld.friction_temperature and (names is None or bare_interfaces(interfaces, names))
+    return ({"loading.friction_temperature": ld.friction_temperature} if taken else {}) | own
 
 
 def fade_coverage(tables: dict[str, tuple], T0: float) -> list[str]:

@@ -659,6 +659,10 @@ def test_an_interface_may_give_its_own_fade_table(tmp_path):
     assert "    friction       Coulomb, mu = 0.4 (its own on interface)" in summary(kept)
     assert "loading.friction is unused: every interface gives its own friction (interfaces.interface)" in kept.warnings
     assert not any("unused" in w for w in scene.warnings)
+    table_of_none = loads(pod.replace("friction = 0.4", f"friction_temperature = {table}")
+                          + "\n[interfaces.interface]\nfriction = 0.3\n", tmp_path)     # (said below its first point)
+    assert [w for w in table_of_none.warnings if "friction_temperature" in w] == [
+        "loading.friction_temperature is unused: every interface gives its own friction (interfaces.interface)"]
     with pytest.raises(SceneError, match=r"interfaces.interface.friction or interfaces.interface.friction_temperature: give only one"):
         loads(pod + f"\n[interfaces.interface]\nfriction = 0.3\nfriction_temperature = {table}\n", tmp_path)
     with pytest.raises(SceneError, match=r'interfaces.interface.friction_temperature: needs effect "thermal"'):

@@ -246,7 +246,8 @@ def _fade_table_ends(scene, history) -> list[str]:
     """Fade tables (``friction_temperature``) left by the run: the bodies' largest temperature (the
     interfaces' at most) above a table's last point, where mu was held (below its first at the
     initial temperature: the scene's warning, ``scene_cycle.fade_coverage``)."""
-    tables = fade_tables(scene.loading, scene.interfaces) if scene.has("friction") and scene.has("thermal") else {}
+    tables = fade_tables(scene.loading, scene.interfaces, scene.geometry.spec.interfaces) \
+        if scene.has("friction") and scene.has("thermal") else {}
     columns = [f"max_temperature_{b.name}" for b in scene.geometry.spec.bodies]
     hottest = max((float(np.max(history[c])) for c in columns if c in history.columns and tables), default=-np.inf)
     return [f"{where}: the bodies reached {hottest - 273.15:.4g} degC, above its last point, "
