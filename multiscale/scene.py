@@ -445,7 +445,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                                         (scene.time or Time()).initial_temperature)
     end = scene.time.end if scene.time is not None else None
     if scene.loading is not None and end is not None:
-        fades = fade_tables(scene.loading, scene.interfaces, g.spec.interfaces if g is not None else None)
+        fades = fade_tables(scene.loading, scene.interfaces, g.spec.interfaces if g is not None else None) \
+            if "friction" in effects else {}
         warnings += cycle_coverage(scene.loading, end) + fade_coverage(fades, scene.time.initial_temperature)
         if g is not None and {"friction", "thermal", "heat_partition"} <= effects:
             warnings += short_phases(scene.loading, g.motion, end, scene.time.dt)

@@ -186,7 +186,10 @@ class InterfaceSettings:
     rules = (OneOf(("friction", "friction_temperature")),)
 
     def problems(self, path, ctx):
-        if self.friction_temperature is not None and "thermal" not in ctx.effects:
+        given = [k for k in ("friction", "friction_temperature") if getattr(self, k) is not None]
+        if given and "friction" not in ctx.effects:           # (as [loading]'s)
+            ctx.warnings.append(f'{path}.{given[0]} is ignored: effect "friction" is not in effects')
+        elif self.friction_temperature is not None and "thermal" not in ctx.effects:
             return [f'{path}.friction_temperature: needs effect "thermal" (its temperatures); give {path}.friction']
         return []
 

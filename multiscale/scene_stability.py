@@ -99,7 +99,7 @@ class Sweep:
             return [f"{where}: sets a constant friction; remove loading.friction_curve / loading.stribeck"]
         if name == "friction" and "friction" not in ctx.effects:     # (the map had friction, the analysis none)
             return [f'{where}: sweeps the friction of effect "friction", which the scene does not have']
-        own = [f"interfaces.{n}.{k}" for n, t in (ctx.root.get("interfaces") or {}).items() if isinstance(t, dict)
+        own = [f"interfaces.{n}.{k}" for n, t in tables.items() if isinstance(t, dict)
                for k in ("friction", "friction_temperature") if k in t]
         if name == "friction" and own:
             given = ", ".join(own)

@@ -1086,7 +1086,7 @@ def test_a_braking_torque_whose_mu_fades_to_zero_is_refused_while_it_brakes():
     scene = fade_scene('friction_temperature = [["20 degC", 0.4], ["25 degC", 0.0]]', 'braking_torque = "5 N m"')
     model = build_model(scene)
     model.start()
-    with pytest.raises(InputError, match=r"braking torque .* needs a friction moment, 0 while sliding.*friction_temperature"):
+    with pytest.raises(InputError, match=r"braking torque .* needs a friction moment, 0 while sliding: mu is 0 .*friction_temperature"):
         for _ in range(scene.time.steps):
             model.macro_step(scene.time.dt)
     assert 0 < model.time < 4.0                     # in the run, not at its end

@@ -668,6 +668,35 @@ def test_an_interface_may_give_its_own_fade_table(tmp_path):
     with pytest.raises(SceneError, match=r'interfaces.interface.friction_temperature: needs effect "thermal"'):
         loads(pod.replace('"thermal", "heat_partition", "expansion"', '"expansion"')
               + f"\n[interfaces.interface]\nfriction_temperature = {table}\n", tmp_path)
+    frictionless = loads(pod.replace('"friction", ', "").replace('"heat_partition", ', "")
+                         + f"\n[interfaces.interface]\nfriction_temperature = {table}\n", tmp_path)
+    assert sorted(w for w in frictionless.warnings if "friction" in w) == [     # (before: "held at 0.5", as if it acted)
+        'interfaces.interface.friction_temperature is ignored: effect "friction" is not in effects',
+        'loading.friction is ignored: effect "friction" is not in effects']
+
+
+def test_a_pads_fade_table_is_said_left_by_the_run_where_its_own_faces_went_beyond_it():
+    """After the run (``workflows.run_warnings``) each fade table is held against the hottest face of
+    the interfaces it serves (``face_max_temperature_<pad>_on_<body>``), not the bodies' hottest: the
+    car brake's inner pad (its table to 300 degC) whose faces reached 250 degC while the disc under
+    the outer pad (600 degC) reached 450 degC is not warned about (before: "the bodies reached 450
+    degC"), the outer pad's table, [loading]'s here, is at 500 degC."""
+    from multiscale.io import History
+    from multiscale.workflows import run_warnings
+    if not (DEMOS / "cad" / "car_brake.step").exists():
+        pytest.skip("demos/cad/car_brake.step not built (make demos/cad/car_brake.step)")
+    text = (DEMOS / "car_brake_stop.toml").read_text().replace(
+        "friction = 0.4", 'friction_temperature = [["30 degC", 0.45], ["480 degC", 0.35]]')
+    scene = loads(text + '\n[interfaces.inner_pad]\nfriction_temperature = [["30 degC", 0.4], ["300 degC", 0.3]]\n',
+                  DEMOS)
+    history = History()
+    for T in (30.0, 250.0):
+        faces = {f"face_max_temperature_{pad}_on_{body}": 273.15 + (T if pad == "inner_pad" else 2 * T)
+                 for pad in ("inner_pad", "outer_pad") for body in ("disc", "fixed")}
+        history.append(time=T / 100, max_temperature_disc=273.15 + 1.8 * T, max_temperature_fixed=273.15 + T, **faces)
+    assert [w for w in run_warnings(scene, history) if "friction_temperature" in w] == [
+        "loading.friction_temperature: the faces of outer_pad reached 500 degC, above its last point, 480 degC: "
+        "where the interface was that hot, mu was held at 0.35"]
 
 
 def test_a_braking_phase_shorter_than_a_step_is_warned_about(tmp_path):

@@ -319,6 +319,23 @@ def test_an_interface_of_its_own_friction_keeps_it_constant_under_a_speed_law():
     assert laws == {"inner_pad": TableFriction(((0.0, 0.5), (10.0, 0.4))), "outer_pad": ConstantFriction(0.4)}
 
 
+def test_a_squeal_scene_of_the_pads_own_friction_alone_reads_as_given():
+    """``workflows.squeal.model_scene`` of the brake whose pads each give their friction and
+    [loading] none: the scene as it is (before: a TypeError, a placeholder mu taken from a
+    friction_curve that was not there, in every such squeal run); with a mu(v) law in [loading],
+    the placeholder is the law's kinetic mu."""
+    from pathlib import Path
+
+    from multiscale.scene import loads
+    from multiscale.workflows.squeal import model_scene
+    demos = Path(__file__).parents[1] / "demos"
+    text = (demos / "brake_squeal.toml").read_text().replace("\nfriction = 0.4\n", "\n", 1)
+    own = loads(text, demos, overrides={"interfaces.inner_pad.friction": 0.35, "interfaces.outer_pad.friction": 0.3})
+    assert model_scene(own) is own
+    law = loads(text, demos, overrides={"loading.stribeck": {"static": 0.5, "kinetic": 0.4, "speed": "1 m/s"}})
+    assert model_scene(law).loading.friction == 0.4
+
+
 def test_belt_oscillator_negative_damping_onset():
     """m x'' + (c + N mu'(V)) x' + k x = 0: unstable below the belt speed where N mu'(V) = -c."""
     m, k, c, N = 1.0, 1e4, 0.5, 100.0

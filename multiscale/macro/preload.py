@@ -55,15 +55,15 @@ def hold_moment(mech: Mechanics, load: float, target: float):
     rotation axis is ``target`` [N m] within ``TORQUE_TOL`` (secant steps, the moment being nearly
     linear in the load; at most ``TORQUE_SOLVES`` solves). Returns the load and the last
     ``SolveResult`` (None: no solve was needed, or at rest, where no friction acts). No moment
-    while sliding (mu 0 wherever the bodies touch: a friction of 0, a fade table falling to 0)
-    raises an InputError on every rank (the moment is a global sum)."""
+    while sliding (mu 0 wherever the bodies touch: a fade table or a mu(v) law falling to 0) raises
+    an InputError on every rank (the moment is a global sum)."""
     solved = None
     for _ in range(TORQUE_SOLVES if target > 0 else 0):
         moment = abs(mech.contact.friction_moment())
         if not moment > 0 and float(mech.contact.speed.value):
             raise InputError("loading", None, f"the braking torque ({target:.6g} N m) needs a friction moment, 0 "
-                             "while sliding: give friction (mu 0 wherever the bodies touch; with friction_temperature, "
-                             "at the interfaces' temperatures: give mu > 0 up to the run's temperatures)")
+                             "while sliding: mu is 0 wherever the bodies touch (a friction_temperature table at the "
+                             "interfaces' temperatures, or a mu(v) law at the slip speed): give mu > 0 there")
         if not moment > 0 or abs(moment - target) <= TORQUE_TOL * target:
             break
         load *= target / moment

@@ -20,7 +20,7 @@ from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError, Interrupted, interrupted
 from multiscale.micro.laws import RESOLUTION
 from multiscale.micro.wear import SUBSTEP_TOL
-from multiscale.scene_friction import fade_tables
+from multiscale.scene_friction import bare_interfaces, fade_tables
 from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.model import interface_materials
@@ -243,16 +243,25 @@ def _unloaded(scene, history) -> list[str]:
 
 
 def _fade_table_ends(scene, history) -> list[str]:
-    """Fade tables (``friction_temperature``) left by the run: the bodies' largest temperature (the
-    interfaces' at most) above a table's last point, where mu was held (below its first at the
-    initial temperature: the scene's warning, ``scene_cycle.fade_coverage``)."""
-    tables = fade_tables(scene.loading, scene.interfaces, scene.geometry.spec.interfaces) \
-        if scene.has("friction") and scene.has("thermal") else {}
-    columns = [f"max_temperature_{b.name}" for b in scene.geometry.spec.bodies]
-    hottest = max((float(np.max(history[c])) for c in columns if c in history.columns and tables), default=-np.inf)
-    return [f"{where}: the bodies reached {hottest - 273.15:.4g} degC, above its last point, "
-            f"{table[-1][0] - 273.15:.4g} degC: where the interface was that hot, mu was held at {table[-1][1]:g}"
-            for where, table in tables.items() if hottest > table[-1][0]]
+    """Fade tables (``friction_temperature``) left by the run: the hottest face of the interfaces a
+    table serves (``face_max_temperature_<name>_on_<body>``; with one interface, the bodies' largest
+    temperature, the interface's at most) above its last point, where mu was held (below its
+    first at the initial temperature: the scene's warning, ``scene_friction.fade_coverage``)."""
+    if not (scene.has("friction") and scene.has("thermal")):
+        return []
+    names, out = scene.geometry.spec.interfaces, []
+    for where, table in fade_tables(scene.loading, scene.interfaces, names).items():
+        served = [where.split(".")[1]] if where.startswith("interfaces.") else bare_interfaces(scene.interfaces, names)
+        faces = [k for k in history.columns if any(k.startswith(f"face_max_temperature_{n}_on_") for n in served)]
+        columns = faces or [c for c in (f"max_temperature_{b.name}" for b in scene.geometry.spec.bodies)
+                            if c in history.columns]
+        hottest = max((float(np.max(history[c])) for c in columns), default=-np.inf)
+        if hottest > table[-1][0]:
+            what = f"the faces of {', '.join(served)}" if faces else "the bodies"
+            out.append(f"{where}: {what} reached {hottest - 273.15:.4g} degC, above its last point, "
+                       f"{table[-1][0] - 273.15:.4g} degC: where the interface was that hot, mu was held at "
+                       f"{table[-1][1]:g}")
+    return out
 
 
 def _too_hot(scene, history) -> list[str]:

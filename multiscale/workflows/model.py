@@ -157,7 +157,7 @@ def drive(scene, tm) -> Drive:
         if moment <= 0:
             key = "loading.braking_torque" if ld.braking_torque is not None else "loading.vehicle.mass"
             raise InputError(key, ld.braking_torque or ld.vehicle.mass, 'braking needs friction (effect "friction" '
-                             "and loading.friction > 0)")
+                             "and mu > 0 at the initial temperature: [loading]'s or the interfaces' own)")
         force = len(radius) * torque / moment          # a first guess: the model scales it to the torque
     if force is not None and kind != "force":          # a force as a uniform pressure on the load faces
         area = sum(load_face_areas(tm, kind).values())  # with that resultant (a fluid's: projected areas)

@@ -152,11 +152,11 @@ def squeal_options(scene, tm) -> SquealOptions:
 
 
 def model_scene(scene):
-    """The scene the model factory reads: with a mu(v) law, a placeholder constant friction
+    """The scene the model factory reads: with a mu(v) law in [loading], a placeholder constant friction
     (the law sets the per-facet mu before the preload), the law's kinetic or mean mu (the first
     guess of the clamp force of a braking torque divides by it; 0 made it "braking needs friction")."""
     ld = scene.loading
-    if ld.friction is None and ld.friction_temperature is None and scene.has("friction"):
+    if (ld.friction_curve is not None or ld.stribeck is not None) and scene.has("friction"):
         mu = ld.stribeck.kinetic if ld.stribeck is not None else float(np.mean([m for _, m in ld.friction_curve]))
         return dataclasses.replace(scene, loading=dataclasses.replace(ld, friction=mu))
     return scene
