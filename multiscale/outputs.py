@@ -28,7 +28,7 @@ FIELDS = {"displacement": ("displacement", "m"), "temperature": ("temperature", 
           "heat_flux": ("frictional heat flux", "W/m^2"), "contact_stiffness": ("contact stiffness", "Pa/m"),
           "partition": ("heat partition into body 0", "-"), "wear_depth": ("wear depth", "m"),
           "flash_temperature": ("flash temperature", "K"), "counter_wear_depth": ("wear depth of body 1", "m"),
-          "interface": ("interface number", "-")}
+          "friction_coefficient": ("friction coefficient", "-"), "interface": ("interface number", "-")}
 
 
 def folder_problem(folder) -> str | None:
@@ -78,9 +78,9 @@ def step_time(t: float, dt: float) -> float:
 BODY_FIELDS = ("displacement", "temperature", "von_mises")
 # output fields each analysis writes (when the scene asks for them)
 WRITES = {"transient": ("displacement", "temperature", "von_mises", "contact_pressure", "heat_flux", "partition",
-                        "interface"),
+                        "friction_coefficient", "interface"),
           "multiscale": tuple(FIELDS),
-          "squeal": ("displacement", "von_mises", "contact_pressure", "interface")}
+          "squeal": ("displacement", "von_mises", "contact_pressure", "friction_coefficient", "interface")}
 PROVENANCE = {"scene.toml": "the scene file as given",
               "scene_resolved.toml": "the scene with every default filled in, SI units",
               "provenance.json": "versions, command line, ranks, start and end time, wall time per stage"}

@@ -242,7 +242,7 @@ class Boundary:
 # output field -> effects it needs
 OUTPUT_FIELDS: dict[str, tuple[str, ...]] = {
     "displacement": (), "von_mises": (), "contact_pressure": ("contact",),
-    "temperature": ("thermal",), "heat_flux": ("thermal", "friction"),
+    "temperature": ("thermal",), "heat_flux": ("thermal", "friction"), "friction_coefficient": ("friction",),
     "contact_stiffness": ("roughness",), "partition": ("heat_partition",), "wear_depth": ("wear",),
     "flash_temperature": ("roughness", "heat_partition"), "counter_wear_depth": ("wear",), "interface": (),
 }

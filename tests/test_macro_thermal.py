@@ -1061,6 +1061,29 @@ def test_the_friction_coefficient_is_not_a_number_once_the_disc_stopped():
     assert np.all(mu[:4] > 0.39) and np.all(np.isnan(mu[4:]))
 
 
+def test_the_interface_file_shows_each_facets_friction_coefficient(tmp_path):
+    """``friction coefficient [-]`` in interface.xdmf (output field ``friction_coefficient``): each
+    facet's mu as the model holds it, the table's at its temperature after 5 fading steps (matched
+    by facet midpoints, to round-off), not one value for the interface (the facets' temperatures
+    differ, so their mu do: spread over 6.6e-4 here, the bodies conducting so well)."""
+    import meshio
+    from multiscale.macro.output import FieldOutput
+    model = march(fade_scene(), steps=5)
+    mu = model.tm.interface.values(model.contact.friction)
+    midpoints = model.tm.interface.midpoints
+    out = FieldOutput(model, tmp_path, ["friction_coefficient"])
+    out.write()
+    model.close()
+    with meshio.xdmf.TimeSeriesReader(str(tmp_path / "interface.xdmf")) as reader:
+        points, cells = reader.read_points_cells()
+        _, _, data = reader.read_data(reader.num_steps - 1)
+    centres = points[cells[0].data].mean(axis=1)
+    order = [int(np.argmin(np.linalg.norm(midpoints - c, axis=1))) for c in centres]
+    assert len(set(order)) == len(mu)
+    np.testing.assert_allclose(data["friction coefficient [-]"][0], mu[order], rtol=1e-14)
+    assert np.ptp(mu) > 1e-4 and mu.max() < 0.4
+
+
 def test_an_interface_fades_by_its_own_table_as_by_the_loadings():
     """The lumped pin-on-disc's fade table given in [interfaces.interface] (beside a [loading]
     friction it replaces there) runs as the same table in [loading]: every history column within

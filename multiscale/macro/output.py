@@ -321,6 +321,7 @@ class FieldOutput:
                 body[i]["von_mises"] = f
         contact = mech.contact
         makers = {"contact_pressure": lambda: contact.facet_pressure() * (contact.engaged.value != 0.0),   # 0 released
+                  "friction_coefficient": lambda: tm.interface.values(contact.friction),   # its facets' own, fade
                   "interface": lambda: tm.interface.tag_index + 1.0}     # 1, 2, ... in the order of tm.interface.tags
         if th is not None:
             makers["heat_flux"] = contact.facet_heat_flux
