@@ -1016,6 +1016,28 @@ def test_a_braking_torque_with_fade_raises_the_clamp_force_as_mu_falls():
     np.testing.assert_allclose(force * mu, force[0] * mu[0], rtol=1e-3)
 
 
+def test_a_braking_torque_with_fade_does_its_work_in_the_first_step_after_a_dwell():
+    """The pin-on-disc (conducting as steel does, not lumped) held at 5 N m with mu falling from 0.4
+    at 20 degC to 0.2 at 60 degC, released from 1 s to 2 s while the disc turns on: every step's
+    heat is the torque's work, torque x the mean of load factor x speed x dt, within
+    ``preload.TORQUE_TOL`` (measured 1e-11). Before, the first loaded step after the release heated
+    with the pressure solved before it and the mu of the cooler interface after it (mu had risen
+    from 0.383 to 0.389 during the dwell): 2.6 % above the work."""
+    from multiscale.macro.preload import TORQUE_TOL
+    text = FADE.format(friction='friction_temperature = [["20 degC", 0.4], ["60 degC", 0.2]]').replace(
+        'normal_force = "200 N"', 'braking_torque = "5 N m"\nload_profile = [["0 s", 1], ["1 s", 1], ["1.01 s", 0], '
+        '["2 s", 0], ["2.01 s", 1], ["4 s", 1]]')
+    scene = loads(text.replace('kappa = "1e4 W/(m K)"', 'kappa = "35 W/(m K)"').replace('chi = "0.1 m^2/s"',
+                                                                                        'chi = "1e-5 m^2/s"'))
+    rows = []
+    march(scene, rows=rows).close()
+    ld, heat = scene.loading, [r["heat_total_pin"] + r["heat_total_disc"] for r in rows]
+    t = [r["time"] for r in rows]
+    work = np.array([ld.torque * ld.mean_sliding_factor(a, b) * (b - a) for a, b in zip(t, t[1:])])
+    np.testing.assert_allclose(np.diff(heat), work, rtol=TORQUE_TOL, atol=1e-9 * work.max())
+    assert work[20] > 0 and rows[21]["friction_coefficient"] > rows[10]["friction_coefficient"]   # mu rose in the dwell
+
+
 def test_an_interface_with_its_own_friction_keeps_it_under_fade():
     """``workflows.model.friction_law`` of the car brake with mu(T) in [loading] and the outer pad's
     own friction 0.3: the inner pad's facets take the table at their temperatures (linear between

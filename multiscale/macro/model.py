@@ -89,6 +89,7 @@ class MacroModel:
     partitions: dict = field(default_factory=dict)     # share of frictional heat into body 0 per interface [-]
     # mu per interface facet against its temperature [K] (n_facets,) -> (n_facets,): fade, set after every heat step
     friction_law: Callable[[np.ndarray], np.ndarray] | None = None
+    friction_stale: bool = False        # the law set mu after the last contact solve (a loaded slide solves first)
     notes: list = field(default_factory=list)          # what the run's warnings add (an unbalanced clamp, Mechanics.notes)
 
     @property
@@ -159,7 +160,10 @@ class MacroModel:
             t0, t1 = self.time, self.time + delta
             speed = self.drive.mean_speed(t0, t1)   # the mean speed of the step (transport, convection)
             self.contact.speed.value = speed
-            if speed and self.solved_speed == 0.0 and self.drive.mean_sliding(t0, t1):   # (released at t0 too)
+            # from rest, or with mu changed since the state was solved (fade through a release: the
+            # first loaded step after a dwell heated with the dwell's start's pressure and the new mu,
+            # 2.6 % above the torque's work on a test pin-on-disc)
+            if speed and (self.solved_speed == 0.0 or self.friction_stale) and self.drive.mean_sliding(t0, t1):
                 self.start_sliding(speed, float(self.mechanics.load.value) / self.load)
             # the frictional work of the substep with the pressure and the sliding its heat step takes
             slid = self.sliding(t0, t1)
@@ -191,7 +195,7 @@ class MacroModel:
                                or load != self.mechanics.load.value or (moving == 0.0) != (self.solved_speed == 0.0)):
                 self.contact.speed.value = moving
                 self.last_solve = self.mechanics.solve(load)
-                self.solved_speed = moving
+                self.solved_speed, self.friction_stale = moving, False
                 self.keep_torque(factor)
                 self.contact.speed.value = speed
         self.heat_total += heat
@@ -207,6 +211,7 @@ class MacroModel:
         if self.friction_law is not None and self.thermal is not None:
             T = 0.5 * (self.thermal.facet_temperature(0) + self.thermal.facet_temperature(1))
             self.tm.interface.set_field(self.contact.friction, self.friction_law(T))
+            self.friction_stale = True
 
     def start_sliding(self, speed: float, factor: float) -> None:
         """Solve the contact with friction at the sliding ``speed`` (rad/s or m/s; its sign the
@@ -216,7 +221,7 @@ class MacroModel:
         pin-on-disc restarting from a stop, 0 to 200 rpm over a 0.6 s step, 1.24e-3 off in the
         step's heat; a start released at rest, engaging within 10 ms, as much)."""
         self.last_solve = self.mechanics.solve()
-        self.solved_speed = speed
+        self.solved_speed, self.friction_stale = speed, False
         self.keep_torque(factor)
 
     def keep_torque(self, factor: float) -> None:
@@ -285,7 +290,7 @@ class MacroModel:
                  "heat_total": self.heat_total.copy(), "interface_heat_total": self.interface_heat_total.copy(),
                  "exchanged": self.heat_exchanged_total,
                  "last_solve": self.last_solve, "constants": [float(c.value) for c in self.drive_constants],
-                 "solved_speed": self.solved_speed, "load": self.load}
+                 "solved_speed": self.solved_speed, "load": self.load, "friction_stale": self.friction_stale}
         if self.thermal is not None:
             state.update(thermal_time=self.thermal.time, lost_total=self.thermal.lost_total.copy(),
                          lost_step=self.thermal.lost_step.copy())
@@ -304,6 +309,7 @@ class MacroModel:
             self.thermal.time = state["thermal_time"]
             self.thermal.lost_total, self.thermal.lost_step = state["lost_total"].copy(), state["lost_step"].copy()
         self.update_friction()
+        self.friction_stale = state["friction_stale"]      # (the snapshot's mu: that of its temperatures)
 
     def record(self, heat_step=(0.0, 0.0)) -> dict:
         """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal
