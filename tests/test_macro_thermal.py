@@ -998,7 +998,8 @@ def test_friction_of_the_temperature_fades_as_lumped_bodies_do():
         "held at 0.4 below it"]
     assert [w for w in run_warnings(short, history) if "friction_temperature" in w] == [
         f"loading.friction_temperature: the bodies reached {max(history['max_temperature_pin']) - 273.15:.4g} degC, "
-        "above its last point, 40 degC: where the interface was that hot, mu was held at 0.3"]
+        "above its last point, 40 degC: where the interface (the mean of its two faces) was that hot, mu was held "
+        "at 0.3"]
 
 
 def test_a_braking_torque_with_fade_raises_the_clamp_force_as_mu_falls():

@@ -695,8 +695,8 @@ def test_a_pads_fade_table_is_said_left_by_the_run_where_its_own_faces_went_beyo
                  for pad in ("inner_pad", "outer_pad") for body in ("disc", "fixed")}
         history.append(time=T / 100, max_temperature_disc=273.15 + 1.8 * T, max_temperature_fixed=273.15 + T, **faces)
     assert [w for w in run_warnings(scene, history) if "friction_temperature" in w] == [
-        "loading.friction_temperature: the faces of outer_pad reached 500 degC, above its last point, 480 degC: "
-        "where the interface was that hot, mu was held at 0.35"]
+        "loading.friction_temperature: the hottest face of outer_pad reached 500 degC, above its last point, "
+        "480 degC: where the interface (the mean of its two faces) was that hot, mu was held at 0.35"]
 
 
 def test_a_braking_phase_shorter_than_a_step_is_warned_about(tmp_path):

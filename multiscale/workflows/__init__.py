@@ -257,10 +257,10 @@ def _fade_table_ends(scene, history) -> list[str]:
                             if c in history.columns]
         hottest = max((float(np.max(history[c])) for c in columns), default=-np.inf)
         if hottest > table[-1][0]:
-            what = f"the faces of {', '.join(served)}" if faces else "the bodies"
+            what = f"the hottest face of {', '.join(served)}" if faces else "the bodies"
             out.append(f"{where}: {what} reached {hottest - 273.15:.4g} degC, above its last point, "
-                       f"{table[-1][0] - 273.15:.4g} degC: where the interface was that hot, mu was held at "
-                       f"{table[-1][1]:g}")
+                       f"{table[-1][0] - 273.15:.4g} degC: where the interface (the mean of its two faces) was that "
+                       f"hot, mu was held at {table[-1][1]:g}")
     return out
 
 
