@@ -492,6 +492,7 @@ class Multiscale:
         before = mech.displacements()
         self.model.last_solve = solve_on_new_laws(mech, self.rough.law, guess, self.model.released)
         self.model.keep_torque(self.model.drive.factor(self.model.time))   # the new laws moved the pressure
+        self.model.stale &= self.model.released
         return [u - x for u, x in zip(mech.displacements(), before)]
 
     def record(self, result: StepResult) -> dict:
@@ -544,7 +545,7 @@ class Multiscale:
         attrs = {"step": step, "time": m.time, "work": self.work, "interval_work": self.interval_work,
                  "counter_volume": self.counter_volume,
                  "heat_exchanged": [m.heat_exchanged, m.heat_exchanged_total], **self.fingerprint.attrs(), "load": m.load,
-                 "ranks": self.comm.size, "fields_written": -1, "solved_speed": m.solved_speed,
+                 "ranks": self.comm.size, "fields_written": -1, "solved_speed": m.solved_speed, "stale": m.stale,
                  "constants": [float(c.value) for c in self.model.drive_constants],
                  "solve": [last.reason, last.iterations, last.normal_force, last.max_pressure],
                  "notes": json.dumps([m.notes, m.thermal.notes if m.thermal is not None else []])}   # said once a run
@@ -583,7 +584,7 @@ class Multiscale:
         reason, its, force, max_p = attrs["solve"]
         m.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
         self.set_gap()
-        m.load, m.solved_speed = float(attrs["load"]), float(attrs["solved_speed"])
+        m.load, m.solved_speed, m.stale = float(attrs["load"]), float(attrs["solved_speed"]), bool(attrs.get("stale", 1))
         for c, value in zip(self.model.drive_constants, attrs["constants"]):   # speed, engagement, load last solved
             c.value = value
         self.rough.update_laws()

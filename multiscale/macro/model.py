@@ -89,7 +89,9 @@ class MacroModel:
     partitions: dict = field(default_factory=dict)     # share of frictional heat into body 0 per interface [-]
     # mu per interface facet against its temperature [K] (n_facets,) -> (n_facets,): fade, set after every heat step
     friction_law: Callable[[np.ndarray], np.ndarray] | None = None
-    friction_stale: bool = False        # the law set mu after the last contact solve (a loaded slide solves first)
+    # a heat step changed mu (a friction_law) or the thermal strain since the last contact solve: a loaded
+    # slide solves first (the first step of a stop after a dwell)
+    stale: bool = False
     notes: list = field(default_factory=list)          # what the run's warnings add (an unbalanced clamp, Mechanics.notes)
 
     @property
@@ -160,10 +162,9 @@ class MacroModel:
             t0, t1 = self.time, self.time + delta
             speed = self.drive.mean_speed(t0, t1)   # the mean speed of the step (transport, convection)
             self.contact.speed.value = speed
-            # from rest, or with mu changed since the state was solved (fade through a release: the
-            # first loaded step after a dwell heated with the dwell's start's pressure and the new mu,
-            # 2.6 % above the torque's work on a test pin-on-disc)
-            if speed and (self.solved_speed == 0.0 or self.friction_stale) and self.drive.mean_sliding(t0, t1):
+            # from rest, or ``stale`` (through a release under fade the first loaded step heated with the
+            # pressure of before the dwell and the new mu: 2.6 % above the torque's work on a test pin-on-disc)
+            if speed and (self.solved_speed == 0.0 or self.stale) and self.drive.mean_sliding(t0, t1):
                 self.start_sliding(speed, float(self.mechanics.load.value) / self.load)
             # the frictional work of the substep with the pressure and the sliding its heat step takes
             slid = self.sliding(t0, t1)
@@ -179,6 +180,7 @@ class MacroModel:
                 self.contact.heating.value = self.drive.mean_sliding(t0, t1) / speed * scale if speed else 0.0
                 done = self.thermal.step(delta)
                 self.update_friction()
+                self.stale = self.friction_law is not None or self.mechanics.temperatures is not None
                 heat += done.heat_in
                 facet_heat += done.facet_heat.sum(axis=1)
                 self.heat_exchanged += done.heat_exchanged
@@ -195,7 +197,7 @@ class MacroModel:
                                or load != self.mechanics.load.value or (moving == 0.0) != (self.solved_speed == 0.0)):
                 self.contact.speed.value = moving
                 self.last_solve = self.mechanics.solve(load)
-                self.solved_speed, self.friction_stale = moving, False
+                self.solved_speed, self.stale = moving, False
                 self.keep_torque(factor)
                 self.contact.speed.value = speed
         self.heat_total += heat
@@ -211,7 +213,6 @@ class MacroModel:
         if self.friction_law is not None and self.thermal is not None:
             T = 0.5 * (self.thermal.facet_temperature(0) + self.thermal.facet_temperature(1))
             self.tm.interface.set_field(self.contact.friction, self.friction_law(T))
-            self.friction_stale = True
 
     def start_sliding(self, speed: float, factor: float) -> None:
         """Solve the contact with friction at the sliding ``speed`` (rad/s or m/s; its sign the
@@ -221,7 +222,7 @@ class MacroModel:
         pin-on-disc restarting from a stop, 0 to 200 rpm over a 0.6 s step, 1.24e-3 off in the
         step's heat; a start released at rest, engaging within 10 ms, as much)."""
         self.last_solve = self.mechanics.solve()
-        self.solved_speed, self.friction_stale = speed, False
+        self.solved_speed, self.stale = speed, False
         self.keep_torque(factor)
 
     def keep_torque(self, factor: float) -> None:
@@ -290,7 +291,7 @@ class MacroModel:
                  "heat_total": self.heat_total.copy(), "interface_heat_total": self.interface_heat_total.copy(),
                  "exchanged": self.heat_exchanged_total,
                  "last_solve": self.last_solve, "constants": [float(c.value) for c in self.drive_constants],
-                 "solved_speed": self.solved_speed, "load": self.load, "friction_stale": self.friction_stale}
+                 "solved_speed": self.solved_speed, "load": self.load, "stale": self.stale}
         if self.thermal is not None:
             state.update(thermal_time=self.thermal.time, lost_total=self.thermal.lost_total.copy(),
                          lost_step=self.thermal.lost_step.copy())
@@ -309,7 +310,7 @@ class MacroModel:
             self.thermal.time = state["thermal_time"]
             self.thermal.lost_total, self.thermal.lost_step = state["lost_total"].copy(), state["lost_step"].copy()
         self.update_friction()
-        self.friction_stale = state["friction_stale"]      # (the snapshot's mu: that of its temperatures)
+        self.stale = state["stale"]                # (the snapshot's mu: that of its temperatures)
 
     def record(self, heat_step=(0.0, 0.0)) -> dict:
         """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal
