@@ -1,7 +1,6 @@
 """The duty cycle against the analysis that runs it (``multiscale.scene``'s cross-checks): what a
 load or speed profile, a vehicle stop and a speed-dependent convection table leave out of the run
-[0, time.end], and what the squeal analysis, which
-linearises one state, ignores of a cycle.
+[0, time.end], and what the squeal analysis, which linearises one state, ignores of a cycle.
 The checks return one warning line per finding; ``braking_phases`` and ``largest_load_factor``
 read the cycle over the run's knots (``run_knots``)."""
 from __future__ import annotations

@@ -14,6 +14,20 @@ def bare_interfaces(interfaces, names) -> list[str]:
             and getattr(own.get(n), "friction_temperature", None) is None]
 
 
+def law_problems(path: str, law: list[str], ctx) -> list[str]:
+    """The friction keys ``law`` given in table ``path`` ([loading] or [interfaces.<name>]; in
+    ``FRICTION`` order): ignored without effect "friction" (a warning in ``ctx``), else a fade table
+    needs effect "thermal" and a mu(v) law is the squeal analysis' (effect "stability")."""
+    if law and "friction" not in ctx.effects:
+        ctx.warnings.append(f'{path}.{law[0]} is ignored: effect "friction" is not in effects')
+    elif law[:1] == ["friction_temperature"] and "thermal" not in ctx.effects:
+        return [f'{path}.friction_temperature: needs effect "thermal" (its temperatures); give {path}.friction']
+    elif law and law[0] not in FRICTION[:2] and "stability" not in ctx.effects:
+        return [f"{path}.{law[0]}: a speed-dependent friction is read by the squeal analysis only "
+                f'(effect "stability"); give {path}.friction']
+    return []
+
+
 def friction_checks(loading: dict, interfaces, names) -> tuple[list[str], list[str]]:
     """(problems, warnings) of effect "friction" on interfaces ``names``: [loading] (its raw table)
     gives no law while some interface has none of its own; it gives one that every interface

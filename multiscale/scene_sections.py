@@ -15,7 +15,7 @@ from multiscale.curves import interpolate, mean, piecewise_mean
 from multiscale.errors import InputError
 from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.topography import COVER, DETREND, MAX_UNDEFINED, probe_topography
-from multiscale.scene_friction import FRICTION
+from multiscale.scene_friction import FRICTION, law_problems
 from multiscale.scene_geometry import Direction, LengthUnit
 from multiscale.scene_plain import PixelSize
 from multiscale.scene_stability import Stribeck
@@ -186,12 +186,7 @@ class InterfaceSettings:
     rules = (OneOf(("friction", "friction_temperature")),)
 
     def problems(self, path, ctx):
-        given = [k for k in ("friction", "friction_temperature") if getattr(self, k) is not None]
-        if given and "friction" not in ctx.effects:           # (as [loading]'s)
-            ctx.warnings.append(f'{path}.{given[0]} is ignored: effect "friction" is not in effects')
-        elif self.friction_temperature is not None and "thermal" not in ctx.effects:
-            return [f'{path}.friction_temperature: needs effect "thermal" (its temperatures); give {path}.friction']
-        return []
+        return law_problems(path, [k for k in FRICTION[:2] if getattr(self, k) is not None], ctx)   # as [loading]'s
 
 
 _COMPONENTS = {"x": 0, "y": 1, "z": 2}
@@ -295,14 +290,9 @@ class Loading:
              meaning="a vehicle is one stop or drag; several stops: speed and load profiles"))
 
     def problems(self, path, ctx):
-        law = [k for k in FRICTION if getattr(self, k) is not None]
-        if law and "friction" not in ctx.effects:
-            ctx.warnings.append(f'{path}.{law[0]} is ignored: effect "friction" is not in effects')
-        elif law[:1] == ["friction_temperature"] and "thermal" not in ctx.effects:
-            return [f'{path}.friction_temperature: needs effect "thermal" (its temperatures); give {path}.friction']
-        elif law and law[0] not in FRICTION[:2] and "stability" not in ctx.effects:
-            return [f"{path}.{law[0]}: a speed-dependent friction is read by the squeal analysis only "
-                    f'(effect "stability"); give {path}.friction']
+        wrong = law_problems(path, [k for k in FRICTION if getattr(self, k) is not None], ctx)
+        if wrong:
+            return wrong
         if self.vehicle is not None and self.load_profile is not None:
             ctx.warnings.append(f"{path}.load_profile with {path}.vehicle: the speed follows the vehicle's "
                                 "deceleration (or slope) whatever the load factor; a release does not stop it")
