@@ -90,7 +90,7 @@ class MacroModel:
     # mu per interface facet against its temperature [K] (n_facets,) -> (n_facets,): fade, set after every heat step
     friction_law: Callable[[np.ndarray], np.ndarray] | None = None
     # a heat step changed mu (a friction_law) or the thermal strain since the last contact solve: a loaded
-    # slide solves first (the first step of a stop after a dwell)
+    # substep solves after its heat step, and a loaded slide first (the first step of a stop after a dwell)
     stale: bool = False
     notes: list = field(default_factory=list)          # what the run's warnings add (an unbalanced clamp, Mechanics.notes)
 
@@ -193,8 +193,8 @@ class MacroModel:
             # keeps the friction of the sliding that ended it (the pressure the step's wear and work take)
             speed = float(self.contact.speed.value)
             moving = speed or self.drive.mean_speed(start, start + (k + 1) * delta)
-            if factor > 0 and (self.mechanics.temperatures is not None or self.friction_law is not None
-                               or load != self.mechanics.load.value or (moving == 0.0) != (self.solved_speed == 0.0)):
+            if factor > 0 and (self.stale or load != self.mechanics.load.value
+                               or (moving == 0.0) != (self.solved_speed == 0.0)):
                 self.contact.speed.value = moving
                 self.last_solve = self.mechanics.solve(load)
                 self.solved_speed, self.stale = moving, False
