@@ -18,6 +18,7 @@ import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
+from stat import S_ISDIR, S_ISREG
 from typing import Any
 
 from multiscale.units import KINDS, UnitError, plausible_in, to_si
@@ -349,14 +350,16 @@ class FilePath:
             raise Bad("holds a NUL character; a path cannot" if isinstance(raw, str) and raw else f"must be {self.describe()}")
         try:                             # (a name part over 255 bytes: "File name too long")
             path = (ctx.directory / Path(raw).expanduser()).resolve()
-            folder, file, exists = path.is_dir(), path.is_file(), path.exists()
+            mode = path.stat().st_mode   # one stat (is_dir, then exists, took a folder rank 0 made between as a file)
+        except (FileNotFoundError, NotADirectoryError):
+            mode = 0
         except OSError as exc:
             raise Bad(f"cannot be used as a path ({exc.strerror or exc})") from None
-        if self.folder and exists and not folder:
+        if self.folder and mode and not S_ISDIR(mode):
             raise Bad(f"exists and is not a folder ({path})")
-        if not self.folder and not file:
-            kind = "is a folder, not a file" if folder else "is no regular file (a FIFO, device or socket)" if exists \
-                else "no such file"
+        if not self.folder and not S_ISREG(mode):
+            kind = "is a folder, not a file" if S_ISDIR(mode) else "is no regular file (a FIFO, device or socket)" \
+                if mode else "no such file"
             raise Bad(f"{kind} ({path})")
         return path
 
@@ -466,10 +469,8 @@ class Requires:
             f" (with {', '.join(self.needed_by)})" if self.needed_by else "")
 
     def check(self, present, path, ctx):
-        if self.key not in present:
-            return []
         effect = _needing(self.needed_by, (), ctx.effects)
-        if self.needed_by and not effect:
+        if self.key not in present or self.needed_by and not effect:
             return []
         why = f' (effect "{effect}")' if effect else ""
         return [f"{path}.{k}: missing; needed with {path}.{self.key}{why}"
@@ -487,9 +488,8 @@ class OnlyWith:
         return f"{', '.join(self.keys)} only with {self.key}"
 
     def check(self, present, path, ctx):
-        if self.key in present:
-            return []
-        return [f"{path}.{k}: only used with {path}.{self.key}" for k in self.keys if k in present]
+        return [] if self.key in present else [f"{path}.{k}: only used with {path}.{self.key}"
+                                               for k in self.keys if k in present]
 
 
 # ---------------------------------------------------------------- the reader

@@ -699,6 +699,30 @@ def test_a_pads_fade_table_is_said_left_by_the_run_where_its_own_faces_went_beyo
         "480 degC: where the interface (the mean of its two faces) was that hot, mu was held at 0.35"]
 
 
+def test_an_output_folder_another_rank_makes_while_the_scene_is_read_is_a_folder(tmp_path, monkeypatch):
+    """``output.folder`` is checked by one stat: under MPI rank 0 may create the folder while another
+    rank still reads the scene. Here the folder appears right after the second look at it (the
+    first is ``Path.resolve``'s; as rank 0's run made it in CI, tests/mpi/test_thermal_mpi.py): it
+    reads as a folder to be. Before, is_dir (not yet) then exists (now) made it "exists and is not a
+    folder" on that rank alone."""
+    import pathlib
+    folder, real_stat, real_is_dir, looks = tmp_path / "late", pathlib.Path.stat, pathlib.Path.is_dir, []
+
+    def appearing(look):
+        def wrapped(self, *args, **kwargs):
+            try:
+                return look(self, *args, **kwargs)
+            finally:
+                looks.extend([None] if self == folder else [])
+                if len(looks) == 2 and not os.path.isdir(folder):     # (os: not the patched methods)
+                    os.mkdir(folder)
+        return wrapped
+    monkeypatch.setattr(pathlib.Path, "stat", appearing(real_stat))
+    monkeypatch.setattr(pathlib.Path, "is_dir", appearing(real_is_dir))
+    scene = loads(GOOD, tmp_path, overrides={"output.folder": str(folder)})
+    assert scene.output.folder == folder and os.path.isdir(folder)
+
+
 def test_a_braking_phase_shorter_than_a_step_is_warned_about(tmp_path):
     """A step takes the mean frictional heat over its length: a brake application shorter than the
     step was spread over it silently (before), its temperatures too low (the coarse pin-on-disc's
