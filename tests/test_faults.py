@@ -3,6 +3,7 @@ one rank. Each runs ``multiscale run`` under ``mpiexec -n 2`` in a subprocess an
 job ends within seconds, with one clear message and a non-zero exit code."""
 import os
 import re
+import signal
 import subprocess
 import sys
 import time
@@ -221,7 +222,6 @@ def interrupt(tmp_path, ranks: int, sent_signal: str = "SIGINT"):
     """``multiscale run`` of the cooling block in 4000 heat steps, sent SIGINT (Ctrl-C; under
     mpiexec to the launcher, which hands it to every rank), or ``sent_signal``, once the steps have
     begun."""
-    import signal
     scene = tmp_path / "scene.toml"
     scene.write_text(SCENE.format(folder=tmp_path / "out").replace("steps = 3\n", "steps = 4000\n")
                      .replace("[output]\n", "[output]\nevery = 1000\n"))
@@ -281,7 +281,6 @@ def test_ctrl_c_while_the_end_is_written_lets_it_finish(tmp_path, monkeypatch):
     and the run ends as finished (before: a KeyboardInterrupt inside the writing, MPI_Abort under
     mpiexec, provenance "interrupted" without a step; an adversarial docs audit)."""
     import json
-    import signal
 
     from multiscale.io import History
     from multiscale.scene import loads
@@ -305,7 +304,6 @@ def test_ctrl_c_while_the_end_is_written_lets_it_finish(tmp_path, monkeypatch):
 def python_sigint():
     """SIGINT taken by Python's handler during the test, as in a job started in the foreground (one
     started with ``&`` ignores it, and ``CtrlCWatch`` leaves an ignored SIGINT alone); put back after."""
-    import signal
     previous = signal.signal(signal.SIGINT, signal.default_int_handler)
     yield
     signal.signal(signal.SIGINT, previous)
@@ -316,7 +314,6 @@ def test_a_second_ctrl_c_is_held_and_a_third_abandons_the_step_but_not_a_write(p
     (the step ends with its results written), a third abandons the step in progress, naming the last
     step written, except inside ``writing()``, which it lets finish (before: the second raised
     wherever it came, inside the writing of a step's results too)."""
-    import signal
 
     from mpi4py import MPI
 
@@ -344,7 +341,6 @@ def test_the_watcher_leaves_a_ctrl_c_a_step_stop_took_even_when_it_reads_it_late
     one the main thread never met and aborted the run while its end was written (1 in 6 quick
     multi-Ctrl-C tries: provenance.json left "running", no open_in_paraview.py). The byte is fed here by
     hand after the StepStop ended: left alone; a further SIGINT nobody took still ends the job."""
-    import signal
     import threading
 
     from mpi4py import MPI
@@ -381,7 +377,6 @@ def test_an_abandoned_step_leaves_the_plots_and_paraview_script_of_what_was_writ
     as after a stop at the end of a step (before: the run ended with neither history.png nor
     open_in_paraview.py; the loop writes history.h5 alone)."""
     import json
-    import signal
 
     from test_coupling import POD
 
@@ -426,7 +421,6 @@ def test_a_second_ctrl_c_while_the_run_stops_leaves_its_results_whole(tmp_path):
     provenance.json agree (before: the second interrupted the writing: fields of t = 30.0 s beside a
     history to 30.6 s, provenance "interrupted" without the step, no history.png nor open_in_paraview.py)."""
     import json
-    import signal
 
     import h5py
     import meshio
@@ -495,7 +489,6 @@ def test_an_early_ctrl_c_ends_every_rank_at_once_with_one_line(tmp_path, waiting
     the one line saying what was written (before: 11 s, ended_together's 10 s and MPI_Abort, then
     MPICH's "Abort(130) ... MPI_Abort" line; with rank 0 waiting, no line of ours at all)."""
     import contextlib
-    import signal
     scene, driver = tmp_path / "scene.toml", tmp_path / "driver.py"
     scene.write_text(SCENE.format(folder=tmp_path / "out"))
     driver.write_text(HELD_UP)
@@ -596,3 +589,39 @@ def test_marking_a_checkpoint_is_all_or_nothing(tmp_path, monkeypatch):
     ckpt.mark(path, MPI.COMM_SELF, fields_written=3, finished=True)
     attrs, arrays = ckpt.load(path, MPI.COMM_SELF, {})
     assert (attrs["fields_written"], bool(attrs["finished"]), list(arrays["x"])) == (3, True, [0, 1, 2, 3])
+
+
+ONE_RANK_FAILS = """
+from mpi4py import MPI
+
+
+def test_fails_on_rank_1():
+    assert MPI.COMM_WORLD.rank == 0, "only rank 1 fails"
+    MPI.COMM_WORLD.barrier()                  # rank 0 waits here for a rank that left the test
+
+
+def test_never_reached():
+    MPI.COMM_WORLD.barrier()
+"""
+
+
+def test_a_test_failing_on_one_rank_ends_the_mpi_test_job(tmp_path):
+    """tests/mpi/conftest.py: a test failing on rank 1 alone, while rank 0 waits in a collective,
+    ends the ``mpiexec -n 2 pytest`` job within seconds, exit code 1, with the failure's report.
+    Without that conftest the job hangs (CI at 8a694ab: 38 minutes, until killed)."""
+    conftest = Path(__file__).with_name("mpi") / "conftest.py"
+    (tmp_path / "conftest.py").write_text(conftest.read_text())
+    (tmp_path / "test_one_rank.py").write_text(ONE_RANK_FAILS)
+    start = time.monotonic()
+    job = subprocess.Popen([str(MPIEXEC), "-n", "2", sys.executable, "-m", "pytest", "-q", "-p",
+                            "no:cacheprovider", "-o", "addopts=", str(tmp_path)], cwd=tmp_path,
+                           stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        out, err = job.communicate(timeout=60)
+    except subprocess.TimeoutExpired:
+        os.killpg(job.pid, signal.SIGKILL)      # the ranks too, not only mpiexec
+        raise
+    assert job.returncode == 1, err
+    assert "[rank 1] FAILED test_one_rank.py::test_fails_on_rank_1 (call)" in err
+    assert "only rank 1 fails" in err and "test_never_reached" not in out + err
+    assert time.monotonic() - start < 60
