@@ -20,7 +20,7 @@ OWN_FILES = {"interface": "interface.xdmf", "history": "history.h5", "zones": "z
              "checkpoint": CHECKPOINT, "map": "map.h5"}
 MODE_UNIT = "m/kg^0.5"     # mode shapes normalised to unit modal mass
 MODE_ARRAYS = tuple(f"mode shape {part} part [{MODE_UNIT}]" for part in ("real", "imaginary"))   # in modes_<body>.bp
-NAME = re.compile(r"[A-Za-z0-9_.-]+")    # a body, interface or material name that goes into file and column names
+NAME = re.compile(r"[A-Za-z0-9_-]+")    # a body, interface or material name: file and column names, scene keys
 
 # output field (scene key output.fields) -> (array name in the field files, unit)
 FIELDS = {"displacement": ("displacement", "m"), "temperature": ("temperature", "K"),
@@ -50,9 +50,10 @@ def folder_problem(folder) -> str | None:
 def name_problem(name: str, body: bool = False) -> str | None:
     """Why ``name`` cannot name a body (``body``: its fields go to ``<name>.xdmf`` and ``<name>.h5``),
     an interface or a material, which also name files (``wear_map_<interface>.png``) and history
-    columns (``max_temperature_<body>_in_<material>``: a "/" makes an HDF5 group of it); None if it can."""
+    columns (``max_temperature_<body>_in_<material>``: a "/" makes an HDF5 group of it) and is a part of
+    dotted scene keys (``interfaces.<name>.friction``: a "." would split it); None if it can."""
     if not NAME.fullmatch(name):
-        return "must be letters, digits, _ . - only (it names files and history columns)"
+        return "must be letters, digits, _ - only (it names files, history columns and scene keys)"
     if body and name in OWN_FILES:
         return f"is taken: the run writes {OWN_FILES[name]} of its own (name the body otherwise)"
     return None

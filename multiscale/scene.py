@@ -36,7 +36,7 @@ from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FI
                                        Micro, Output, Roughness, Time, Wear)
 from multiscale.scene_cycle import (convection_coverage, cycle_coverage, largest_load_factor, short_phases, speed_range,
                                    squeal_state, thin_heated_layers)
-from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks
+from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks, torque_problems
 from multiscale.scene_stability import Stability, unresolved_band
 from multiscale.scene_vehicle import Vehicle
 
@@ -289,7 +289,7 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
         raise toml_problem(source or "scene", exc, text) from None
     overrides = {dotted: _toml_value(value) for dotted, value in (overrides or {}).items()}
     for dotted, value in overrides.items():
-        *parents, last = dotted.split(".")
+        *parents, last = (part.strip().strip("\"'") for part in dotted.split("."))    # TOML's quoted parts too
         table = raw
         for part in parents:
             table = table.setdefault(part, {})
@@ -413,7 +413,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                     problems.append(f"wear.{given[0]}: the rough body's material gives k_w "
                                     f"(materials.{name}.k_w): give one of them")
         if not problems:
-            problems += [str(e) for e in rough_rules(scene)]
+            problems += [str(e) for e in rough_rules(scene)] + (torque_problems(scene, g.spec.interfaces)
+                                                                 if "friction" in effects else [])
         if not problems:
             problems += (nyquist(scene) + thin_layer(scene) + measured_cover(scene, warnings)
                          + perfect_contact(scene, warnings) + own_tables(scene, warnings))

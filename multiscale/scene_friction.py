@@ -1,7 +1,10 @@
 """Friction across [loading] and [interfaces.<name>] (``multiscale.scene``'s checks): which
 interfaces need [loading]'s law and whether any takes it, the fade tables by their keys and their
-first points against the initial temperature (their last against the run's: ``workflows``)."""
+first points against the initial temperature (their last against the run's: ``workflows``), mu at
+the start against a braking torque."""
 from __future__ import annotations
+
+from multiscale.curves import interpolate
 
 FRICTION = ("friction", "friction_temperature", "friction_curve", "stribeck")   # [loading]'s laws, one at most
 
@@ -24,7 +27,7 @@ def law_problems(path: str, law: list[str], ctx) -> list[str]:
         return [f'{path}.friction_temperature: needs effect "thermal" (its temperatures); give {path}.friction']
     elif law and law[0] not in FRICTION[:2] and "stability" not in ctx.effects:
         return [f"{path}.{law[0]}: a speed-dependent friction is read by the squeal analysis only "
-                f'(effect "stability"); give {path}.friction']
+                f'(effect "stability"); a run takes {path}.friction or {path}.friction_temperature']
     return []
 
 
@@ -59,3 +62,25 @@ def fade_coverage(tables: dict[str, tuple], T0: float) -> list[str]:
     return [f"{where}: the initial temperature, {T0 - 273.15:.4g} degC, is below its first point, "
             f"{table[0][0] - 273.15:.4g} degC: mu is held at {table[0][1]:g} below it"
             for where, table in tables.items() if T0 < table[0][0]]
+
+
+def initial_friction(settings, T0: float) -> float | None:
+    """mu [-] at the initial temperature T0 [K] of an interface's settings (``Scene.interface_settings``):
+    its constant, else its fade table's; None with a mu(v) law only (the squeal analysis')."""
+    if settings.friction is None and settings.friction_temperature is not None:
+        return interpolate(settings.friction_temperature, T0)
+    return settings.friction
+
+
+def torque_problems(scene, names) -> list[str]:
+    """A braking torque (or a vehicle's stop) on interfaces ``names`` that all start without friction
+    (mu 0 at the initial temperature): no clamp force gives it a friction moment (the run refused it
+    only after meshing, ``workflows.model.drive``)."""
+    ld, T0 = scene.loading, scene.time.initial_temperature
+    mus = [initial_friction(scene.interface_settings(n), T0) for n in names]
+    if ld.torque is None or not names or any(mu is None or mu > 0 for mu in mus):
+        return []
+    key = "loading.braking_torque" if ld.braking_torque is not None else "loading.vehicle"
+    return [f"{key}: braking at {ld.torque:.6g} N m needs friction, but mu is 0 at the initial temperature, "
+            f"{T0 - 273.15:.4g} degC, on every interface ({', '.join(names)}): give mu > 0 there "
+            "([loading]'s friction or table, or the interfaces' own)"]

@@ -523,10 +523,20 @@ def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_pa
               'loading.braking_torque: the clamp force follows from the friction moment: needs effect "friction"'),
              (torque.replace('braking_torque = "0.03 kN m"', 'braking_torque = "30 N"'),
               'loading.braking_torque = "30 N": expected a torque (N m, kN m); the unit "N" is a force')]
+    # mu 0 at the initial temperature everywhere: no clamp force holds the torque (check said OK, the
+    # run refused it after meshing; a user trial): a constant, [loading]'s table, the interface's own
+    zero = ("loading.braking_torque: braking at 30 N m needs friction, but mu is 0 at the initial temperature, "
+            "20 degC, on every interface (interface)")
+    fade = '[["20 degC", 0.0], ["200 degC", 0.4]]'
+    cases += [(torque.replace("friction = 0.4", "friction = 0.0"), zero),
+              (torque.replace("friction = 0.4", f"friction_temperature = {fade}"), zero),
+              (torque + f"\n[interfaces.interface]\nfriction_temperature = {fade}\n", zero)]
     for text, message in cases:
         with pytest.raises(SceneError) as info:
             loads(text, tmp_path)
         assert any(p.startswith(message) for p in info.value.problems), info.value.problems
+    assert loads(torque.replace("friction = 0.4", 'friction_temperature = [["20 degC", 0.4], ["300 degC", 0.0]]'),
+                 tmp_path).loading.torque == 30.0       # mu 0 only once hot: the run says so if it gets there
     block = GOOD.replace('pressure = "10 bar"', 'braking_torque = "30 N m"')
     with pytest.raises(SceneError) as info:
         loads(block, tmp_path)
@@ -570,9 +580,14 @@ def test_a_geometry_file_s_names_must_not_clash_with_the_results(tmp_path):
     with pytest.raises(SceneError) as info:
         loads(text.format(r="flat", b='"pad 1"', m="pad/1").replace("[materials.block]", '[materials."pad/1"]'),
               tmp_path)
-    assert {"geometry.bodies.pad 1: the name must be letters, digits, _ . - only (it names files and history columns)",
-            'geometry.bodies.pad 1.material = "pad/1": must be letters, digits, _ . - only (it names files and '
-            "history columns)"} <= set(info.value.problems)
+    rule = "must be letters, digits, _ - only (it names files, history columns and scene keys)"
+    assert {f"geometry.bodies.pad 1: the name {rule}", f'geometry.bodies.pad 1.material = "pad/1": {rule}'} \
+        <= set(info.value.problems)
+    # a "." split the name in dotted keys: --set interfaces.outer.pad.friction could not reach it, and
+    # the fade warning of interfaces.outer.pad.friction_temperature read the pad as "outer" (a user trial)
+    with pytest.raises(SceneError) as info:
+        loads(text.format(r="flat", b='"outer.pad"', m="block"), tmp_path)
+    assert f"geometry.bodies.outer.pad: the name {rule}" in info.value.problems
 
 
 def test_given_but_unused_keys_are_warnings_not_errors(tmp_path):
@@ -654,6 +669,9 @@ def test_an_interface_may_give_its_own_fade_table(tmp_path):
     assert "interfaces.interface.friction_temperature: the initial temperature, 20 degC, is below its first point, " \
         "100 degC: mu is held at 0.5 below it" in scene.warnings
     assert "  interface interface: perfect contact, mu(T) 0.5 at 100 degC, 0.3 at 300 degC" in summary(scene)
+    quoted = loads(pod, tmp_path, overrides={'interfaces."interface".friction_temperature': [["100 degC", 0.5],
+                                                                                            ["300 degC", 0.3]]})
+    assert quoted.interface_settings("interface").friction_temperature == s.friction_temperature   # TOML quoting
     kept = loads(pod + f"\n[interfaces.interface]\nfriction_temperature = {table}\n", tmp_path)
     assert kept.loading.friction == 0.4 and kept.interface_settings("interface").friction is None
     assert "    friction       Coulomb, mu = 0.4 (its own on interface)" in summary(kept)
@@ -663,6 +681,12 @@ def test_an_interface_may_give_its_own_fade_table(tmp_path):
                           + "\n[interfaces.interface]\nfriction = 0.3\n", tmp_path)     # (said below its first point)
     assert [w for w in table_of_none.warnings if "friction_temperature" in w] == [
         "loading.friction_temperature is unused: every interface gives its own friction (interfaces.interface)"]
+    with pytest.raises(SceneError) as info:     # (before: "give loading.friction", then said unused)
+        loads(pod.replace("friction = 0.4", 'friction_curve = [["0 m/s", 0.5], ["10 m/s", 0.4]]')
+              + "\n[interfaces.interface]\nfriction = 0.3\n", tmp_path)
+    assert info.value.problems == ['loading.friction_curve: a speed-dependent friction is read by the squeal analysis '
+                                   'only (effect "stability"); a run takes loading.friction or '
+                                   'loading.friction_temperature']
     with pytest.raises(SceneError, match=r"interfaces.interface.friction or interfaces.interface.friction_temperature: give only one"):
         loads(pod + f"\n[interfaces.interface]\nfriction = 0.3\nfriction_temperature = {table}\n", tmp_path)
     with pytest.raises(SceneError, match=r'interfaces.interface.friction_temperature: needs effect "thermal"'):

@@ -43,7 +43,7 @@ from multiscale.macro.load_faces import load_face_areas, load_face_forces
 from multiscale.macro.mechanics import REPEATABLE_REFRESH, Mechanics
 from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
-from multiscale.curves import interpolate
+from multiscale.scene_friction import initial_friction
 
 
 def friction_coefficient(scene, interface: str) -> float:
@@ -51,9 +51,7 @@ def friction_coefficient(scene, interface: str) -> float:
     initial temperature) with effect "friction", else 0."""
     if not scene.has("friction"):
         return 0.0
-    s = scene.interface_settings(interface)
-    return interpolate(s.friction_temperature, scene.time.initial_temperature) if s.friction is None \
-        and s.friction_temperature is not None else s.friction
+    return initial_friction(scene.interface_settings(interface), scene.time.initial_temperature)
 
 
 def facet_friction(scene, tm) -> np.ndarray:
@@ -155,8 +153,7 @@ def drive(scene, tm) -> Drive:
         radius = interface_radii(scene, tm)
         moment = sum(friction_coefficient(scene, n) * radius[n] for n in tm.interface.tags)
         if moment <= 0:
-            key = "loading.braking_torque" if ld.braking_torque is not None else "loading.vehicle.mass"
-            raise InputError(key, ld.braking_torque or ld.vehicle.mass, 'braking needs friction (effect "friction" '
+            raise InputError("loading", None, f"braking at {torque:.6g} N m needs friction (effect \"friction\" "
                              "and mu > 0 at the initial temperature: [loading]'s or the interfaces' own)")
         force = len(radius) * torque / moment          # a first guess: the model scales it to the torque
     if force is not None and kind != "force":          # a force as a uniform pressure on the load faces
