@@ -103,7 +103,7 @@ def test_hertz_study_errors_match_an_independent_computation(hertz_study):
     text = (out / "hertz.md").read_text()
     # the runs table names each metric's unit (from the problem's description of it)
     assert "| grid | contact_radius [m] | error | max_pressure [Pa] | error | approach [m] | error |" in text
-    assert f"4 ok, 0 failed; {sum(time.values()):.1f} s of run wall time in all (failed runs included)" in text
+    assert f"4 ok, 0 failed; {sum(time.values()):.3g} s of run wall time in all (failed runs included)" in text
     # the code that made the runs (a record is reused across code changes: the report says which)
     from multiscale.provenance import code
     assert f"- Code: package SHA-1 {code()['sha1'][:12]}" in text and {r["code"] for r in rows} == {code()["sha1"][:12]}

@@ -41,7 +41,7 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
                                          for m in study.metrics),
               f"- Reference: {reference_text(study)}"
               + ("; error = |m − m_ref| / |m_ref|" if study.reference else ""),
-              f"- Runs: {len(ok)} ok, {len(failed)} failed; {sum(r.record.get('wall_time', 0) for r in rows):.1f} s "
+              f"- Runs: {len(ok)} ok, {len(failed)} failed; {sum(r.record.get('wall_time', 0) for r in rows):.3g} s "
               f"of run wall time in all (failed runs included).{timing}",
               _code_line(rows),
               f"- Generated {now()} on a {os.cpu_count()}-core machine by `{command or 'multiscale study ' + study.source.name}`.",
