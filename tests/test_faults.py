@@ -612,7 +612,6 @@ def test_a_test_failing_on_one_rank_ends_the_mpi_test_job(tmp_path):
     conftest = Path(__file__).with_name("mpi") / "conftest.py"
     (tmp_path / "conftest.py").write_text(conftest.read_text())
     (tmp_path / "test_one_rank.py").write_text(ONE_RANK_FAILS)
-    start = time.monotonic()
     job = subprocess.Popen([str(MPIEXEC), "-n", "2", sys.executable, "-m", "pytest", "-q", "-p",
                             "no:cacheprovider", "-o", "addopts=", str(tmp_path)], cwd=tmp_path,
                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, start_new_session=True)
@@ -623,5 +622,4 @@ def test_a_test_failing_on_one_rank_ends_the_mpi_test_job(tmp_path):
         raise
     assert job.returncode == 1, err
     assert "[rank 1] FAILED test_one_rank.py::test_fails_on_rank_1 (call)" in err
-    assert "only rank 1 fails" in err and "test_never_reached" not in out + err
-    assert time.monotonic() - start < 60
+    assert "only rank 1 fails" in err and "passed" not in out      # ended there: no rank finished its run

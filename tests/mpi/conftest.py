@@ -3,9 +3,11 @@ job, with its report, instead of hanging it.
 
 A failure on one rank alone leaves the other rank waiting in a collective of that test for ever
 (CI at 8a694ab hung 38 minutes until killed). So a rank whose test fails prints the report and
-calls ``MPI.COMM_WORLD.Abort``. A test that hangs without failing (a deadlock) is ended by
-pyproject.toml's ``faulthandler_timeout``: the process dumps its threads' stacks and exits, and
-mpiexec ends the other ranks.
+calls ``MPI.COMM_WORLD.Abort``: the run stops at its first failure (as ``-x``), on one rank or
+all. A test that hangs without failing (a deadlock) is ended by pyproject.toml's
+``faulthandler_timeout``: the process dumps its threads' stacks and exits, and mpiexec ends the
+other ranks. A test skipped or xfailed on some ranks only would still desynchronise them: skip
+on every rank alike.
 """
 import sys
 
