@@ -235,7 +235,8 @@ def require_below(p: Mapping[str, float], given: Mapping | None, small: str, lar
 
 
 MAX_CELLS = 1_000_000        # default refusal limit of estimate_cells (geometry.max_cells, run --max-cells)
-OVER = 2.5     # the largest over-estimate of a trial's count times factor^3 (0.9-2.1x measured, CellEstimate)
+OVER = 2.5     # the largest over-estimate of a trial's count times factor^3 (tests: 0.9-2.1x; 1.1-1.5x from 20k cells)
+LARGEST_TRIAL = 1.5   # a trial refined on near the limit has at most about this times the limit's cells
 
 
 @dataclass(frozen=True)
@@ -271,8 +272,9 @@ def estimate_cells(module: ModuleType, params, target: int = 20_000, start: floa
     meshes from ``start`` times coarser, refined until one has ``target`` cells or is the real mesh
     (a trial the CAD kernel cannot mesh that coarse is skipped), or until the estimate is at most
     ``enough`` (an over-estimate below a limit settles the question). An estimate above ``enough``
-    but within ``OVER`` times it, from a trial of at most ``enough`` cells, is refined on towards
-    the real mesh, so that a mesh within the limit is not refused for the over-estimate (the car
+    but within ``OVER`` times it is refined on while the finer trial would have at most about
+    ``LARGEST_TRIAL`` times ``enough`` cells (by the same factor^3 rule: its real count is lower),
+    so that a mesh within the limit is not refused for the over-estimate (the car
     brake at 3 / 1.5 mm was estimated from a 25 000-cell trial at 1.32x its count, 429 315 cells;
     at 2.5 / 1.2 mm at 1.008M cells, above the default limit). The trials share one gmsh
     session on the calling rank: the builder runs once and later trials remesh its model (the same
@@ -297,13 +299,16 @@ def estimate_cells(module: ModuleType, params, target: int = 20_000, start: floa
             trial = _trial(module, params, factor)
             if trial and all(gmsh.model.getType(3, t) == "Discrete volume" for _, t in gmsh.model.getEntities(3)):
                 factor = 1.0           # a mesh read from a file: no size factor changes it
-            near = 0 < enough < trial * factor ** 3 <= OVER * enough and trial <= enough   # (refine on)
-            if factor == 1.0 or (trial >= target and not near) or 0 < trial * factor ** 3 <= enough:
-                estimate = CellEstimate(int(round(trial * factor ** 3)), trial, factor)
-                break
             grow = (target / trial) ** (1 / 3) if trial else 4.0     # a failed trial: its session is gone, skip ahead
-            factor = factor / max(2.0, min(grow, 8.0))
-            factor = 1.0 if factor < 1.25 else factor      # nearly the mesh: mesh it
+            finer = factor / max(2.0, min(grow, 8.0))
+            finer = 1.0 if finer < 1.25 else finer         # nearly the mesh: mesh it
+            cells = trial * factor ** 3
+            # near the limit, refine on while the finer trial (about cells / finer^3) stays small enough
+            near = 0 < enough < cells <= OVER * enough and cells / finer ** 3 <= LARGEST_TRIAL * enough
+            if factor == 1.0 or (trial >= target and not near) or 0 < cells <= enough:
+                estimate = CellEstimate(int(round(cells)), trial, factor)
+                break
+            factor = finer
         if keep and estimate.cells <= enough:
             if not estimate.exact:
                 _trial(module, params, 1.0)

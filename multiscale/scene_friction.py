@@ -26,8 +26,10 @@ def law_problems(path: str, law: list[str], ctx) -> list[str]:
     elif law[:1] == ["friction_temperature"] and "thermal" not in ctx.effects:
         return [f'{path}.friction_temperature: needs effect "thermal" (its temperatures); give {path}.friction']
     elif law and law[0] not in FRICTION[:2] and "stability" not in ctx.effects:
+        fade = f" or {path}.friction_temperature" if "thermal" in ctx.effects else ""
         return [f"{path}.{law[0]}: a speed-dependent friction is read by the squeal analysis only "
-                f'(effect "stability"); a run takes {path}.friction or {path}.friction_temperature']
+                f'(effect "stability"); a run takes {path}.friction{fade}'
+                + (" (or none, where every interface gives its own)" if path == "loading" else "")]
     return []
 
 
@@ -72,12 +74,22 @@ def initial_friction(settings, T0: float) -> float | None:
     return settings.friction
 
 
+def speed_law_guess(ld) -> float | None:
+    """The constant mu [-] standing for [loading]'s mu(v) law (``Loading``) until the squeal
+    preload sets each facet's (``workflows.squeal.model_scene``): its kinetic mu, or the mean of
+    its curve's; None without one."""
+    if ld.stribeck is not None:
+        return ld.stribeck.kinetic
+    return sum(mu for _, mu in ld.friction_curve) / len(ld.friction_curve) if ld.friction_curve else None
+
+
 def torque_problems(scene, names) -> list[str]:
     """A braking torque (or a vehicle's stop) on interfaces ``names`` that all start without friction
     (mu 0 at the initial temperature): no clamp force gives it a friction moment (the run refused it
     only after meshing, ``workflows.model.drive``)."""
     ld, T0 = scene.loading, scene.time.initial_temperature
     mus = [initial_friction(scene.interface_settings(n), T0) for n in names]
+    mus = [speed_law_guess(ld) if mu is None else mu for mu in mus]     # the squeal preload's first guess
     if ld.torque is None or not names or any(mu is None or mu > 0 for mu in mus):
         return []
     key = "loading.braking_torque" if ld.braking_torque is not None else "loading.vehicle"

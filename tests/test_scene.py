@@ -529,6 +529,9 @@ def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_pa
             "20 degC, on every interface (interface)")
     fade = '[["20 degC", 0.0], ["200 degC", 0.4]]'
     cases += [(torque.replace("friction = 0.4", "friction = 0.0"), zero),
+              ((DEMOS / "brake_squeal.toml").read_text().replace('pressure = "10 bar"', 'braking_torque = "300 N m"')
+               .replace("friction = 0.4", 'friction_curve = [["0 m/s", 0.0], ["10 m/s", 0.0]]'),   # the squeal's guess
+               "loading.braking_torque: braking at 300 N m needs friction, but mu is 0 at the initial temperature"),
               (torque.replace("friction = 0.4", f"friction_temperature = {fade}"), zero),
               (torque + f"\n[interfaces.interface]\nfriction_temperature = {fade}\n", zero)]
     for text, message in cases:
@@ -686,7 +689,7 @@ def test_an_interface_may_give_its_own_fade_table(tmp_path):
               + "\n[interfaces.interface]\nfriction = 0.3\n", tmp_path)
     assert info.value.problems == ['loading.friction_curve: a speed-dependent friction is read by the squeal analysis '
                                    'only (effect "stability"); a run takes loading.friction or '
-                                   'loading.friction_temperature']
+                                   'loading.friction_temperature (or none, where every interface gives its own)']
     with pytest.raises(SceneError, match=r"interfaces.interface.friction or interfaces.interface.friction_temperature: give only one"):
         loads(pod + f"\n[interfaces.interface]\nfriction = 0.3\nfriction_temperature = {table}\n", tmp_path)
     with pytest.raises(SceneError, match=r'interfaces.interface.friction_temperature: needs effect "thermal"'):

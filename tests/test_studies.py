@@ -17,6 +17,7 @@ from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.surface import fractal_surface
 from multiscale.studies import Row, load_study, pareto, relative_error
+from multiscale.studies.reporting import elapsed  # noqa: E402
 
 ROOT = Path(__file__).resolve().parents[1]
 GRIDS = (12, 16, 24, 32)
@@ -103,7 +104,8 @@ def test_hertz_study_errors_match_an_independent_computation(hertz_study):
     text = (out / "hertz.md").read_text()
     # the runs table names each metric's unit (from the problem's description of it)
     assert "| grid | contact_radius [m] | error | max_pressure [Pa] | error | approach [m] | error |" in text
-    assert f"4 ok, 0 failed; {sum(time.values()):.3g} s of run wall time in all (failed runs included)" in text
+    assert f"4 ok, 0 failed; {elapsed(sum(time.values()))} of run wall time in all (failed runs included)" in text
+    assert [elapsed(t) for t in (0.0217, 4.24, 4800.0)] == ["0.022 s", "4.2 s", "1 h 20 min"]    # (was "0.0 s")
     # the code that made the runs (a record is reused across code changes: the report says which)
     from multiscale.provenance import code
     assert f"- Code: package SHA-1 {code()['sha1'][:12]}" in text and {r["code"] for r in rows} == {code()["sha1"][:12]}

@@ -8,6 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
+from multiscale.io import duration
 from multiscale.studies.expand import Study
 from multiscale.studies.formatting import metric_heading, now, number_text, percent, value_text
 from multiscale.studies.problems import PROBLEMS
@@ -15,6 +16,11 @@ from multiscale.studies.records import JIT_SHARE
 from multiscale.studies.results import Row, cheapest, crossings, knob_unit, reference_text, sample_std
 
 __all__ = ["report", "write_index"]
+
+
+def elapsed(seconds: float) -> str:
+    """A run time for the report: "0.022 s", "4.2 s", "4 min 10 s" (``io.duration`` from 1 s on)."""
+    return f"{seconds:.2g} s" if seconds < 1 else duration(seconds)
 
 
 def report(study: Study, rows: list[Row], command: str = "") -> Path:
@@ -41,7 +47,7 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
                                          for m in study.metrics),
               f"- Reference: {reference_text(study)}"
               + ("; error = |m − m_ref| / |m_ref|" if study.reference else ""),
-              f"- Runs: {len(ok)} ok, {len(failed)} failed; {sum(r.record.get('wall_time', 0) for r in rows):.3g} s "
+              f"- Runs: {len(ok)} ok, {len(failed)} failed; {elapsed(sum(r.record.get('wall_time', 0) for r in rows))} "
               f"of run wall time in all (failed runs included).{timing}",
               _code_line(rows),
               f"- Generated {now()} on a {os.cpu_count()}-core machine by `{command or 'multiscale study ' + study.source.name}`.",

@@ -50,6 +50,7 @@ from multiscale.macro.modal import CLOSE, EnergyShares, RegionEnergy, StabilityR
 from multiscale.macro.output import write_modes, write_state
 from multiscale.macro.preload import Preload, linearise_system, preload
 from multiscale.macro.stability_map import StabilityMap
+from multiscale.scene_friction import speed_law_guess
 from multiscale.workflows import squeal_map
 from multiscale.workflows.model import build_mechanics, build_mesh, drive, friction_coefficient, interface_forces, \
     model_size
@@ -156,9 +157,8 @@ def model_scene(scene):
     (the law sets the per-facet mu before the preload), the law's kinetic or mean mu (the first
     guess of the clamp force of a braking torque divides by it; 0 made it "braking needs friction")."""
     ld = scene.loading
-    if (ld.friction_curve is not None or ld.stribeck is not None) and scene.has("friction"):
-        mu = ld.stribeck.kinetic if ld.stribeck is not None else float(np.mean([m for _, m in ld.friction_curve]))
-        return dataclasses.replace(scene, loading=dataclasses.replace(ld, friction=mu))
+    if (mu := speed_law_guess(ld)) is not None and scene.has("friction"):
+        return dataclasses.replace(scene, loading=dataclasses.replace(ld, friction=float(mu)))
     return scene
 
 
