@@ -36,6 +36,7 @@ from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FI
                                        Micro, Output, Roughness, Time, Wear)
 from multiscale.scene_cycle import (convection_coverage, cycle_coverage, largest_load_factor, short_phases, speed_range,
                                    squeal_state, thin_heated_layers)
+from multiscale.scene_keys import key_parts
 from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks, torque_problems
 from multiscale.scene_stability import Stability, unresolved_band
 from multiscale.scene_vehicle import Vehicle
@@ -289,7 +290,7 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
         raise toml_problem(source or "scene", exc, text) from None
     overrides = {dotted: _toml_value(value) for dotted, value in (overrides or {}).items()}
     for dotted, value in overrides.items():
-        *parents, last = (part.strip().strip("\"'") for part in dotted.split("."))    # TOML's quoted parts too
+        *parents, last = key_parts(dotted)
         table = raw
         for part in parents:
             table = table.setdefault(part, {})

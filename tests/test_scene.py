@@ -675,6 +675,9 @@ def test_an_interface_may_give_its_own_fade_table(tmp_path):
     quoted = loads(pod, tmp_path, overrides={'interfaces."interface".friction_temperature': [["100 degC", 0.5],
                                                                                             ["300 degC", 0.3]]})
     assert quoted.interface_settings("interface").friction_temperature == s.friction_temperature   # TOML quoting
+    from multiscale.scene_keys import key_parts
+    assert [key_parts(k) for k in ('a."b.c".d', '"loading.friction"', "loading.friction", 'a."b')] == [
+        ["a", "b.c", "d"], ["loading.friction"], ["loading", "friction"], ["a", '"b']]   # (stripping took the 2nd as 2)
     kept = loads(pod + f"\n[interfaces.interface]\nfriction_temperature = {table}\n", tmp_path)
     assert kept.loading.friction == 0.4 and kept.interface_settings("interface").friction is None
     assert "    friction       Coulomb, mu = 0.4 (its own on interface)" in summary(kept)

@@ -12,6 +12,7 @@ import h5py
 import numpy as np
 
 from multiscale.scene import Scene
+from multiscale.scene_keys import key_parts
 from multiscale.schema import Either, ListOf, Named, Quantity, Section, TableOr, Tables, fields_of
 from multiscale.studies.expand import Study, StudyRun, normalise, parser_of, reference_run
 from multiscale.studies.formatting import value_text
@@ -175,7 +176,7 @@ def _key_spec(cls, dotted: str):
     """The Spec of the dotted TOML key ``dotted`` of table class ``cls`` ("wear.k_w"; a named
     table's name is any: "materials.pin.E"); None if there is no such key (or it is in an array
     of tables)."""
-    parts = dotted.split(".")
+    parts = key_parts(dotted)
     while True:
         spec = dict(fields_of(cls)).get(parts.pop(0))
         if spec is None or not parts:
