@@ -88,10 +88,11 @@ def torque_problems(scene, names) -> list[str]:
     (mu 0 at the initial temperature): no clamp force gives it a friction moment (the run refused it
     only after meshing, ``workflows.model.drive``)."""
     ld, T0 = scene.loading, scene.time.initial_temperature
-    mus = [initial_friction(scene.interface_settings(n), T0) for n in names]
-    mus = [speed_law_guess(ld) if mu is None else mu for mu in mus]     # the squeal preload's first guess
-    if ld.torque is None or not names or any(mu is None or mu > 0 for mu in mus):
+    if ld.torque is None or not names:
         return []
+    mus = [initial_friction(scene.interface_settings(n), T0) for n in names]
+    if any(mu is None or mu > 0 for mu in (speed_law_guess(ld) if m is None else m for m in mus)):
+        return []            # (a mu(v) law counts with the squeal preload's first guess)
     key = "loading.braking_torque" if ld.braking_torque is not None else "loading.vehicle"
     return [f"{key}: braking at {ld.torque:.6g} N m needs friction, but mu is 0 at the initial temperature, "
             f"{T0 - 273.15:.4g} degC, on every interface ({', '.join(names)}): give mu > 0 there "
