@@ -29,12 +29,13 @@ from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Sectio
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
 from multiscale.scene_plain import plain_speeds
-from multiscale.scene_rough import (measured_cover, micro_constants, nyquist, own_surface_tables, own_tables,
-                                    penalty_range, perfect_contact, rough_rules, roughness_over, thin_layer, zone_sizes)
+from multiscale.scene_rough import (law_top, measured_cover, micro_constants, nyquist, own_surface_tables, own_tables,
+                                    penalty_range, perfect_contact, plastic_everywhere, rough_rules, roughness_over,
+                                    thin_layer, zone_sizes)
 from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
-from multiscale.scene_cycle import (convection_coverage, cycle_coverage, largest_load_factor, short_phases, speed_range,
+from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_phases, speed_range,
                                    squeal_state, thin_heated_layers)
 from multiscale.scene_keys import key_parts
 from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks, torque_problems
@@ -419,7 +420,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         if not problems:
             problems += (nyquist(scene) + thin_layer(scene) + measured_cover(scene, warnings)
                          + perfect_contact(scene, warnings) + own_tables(scene, warnings))
-            warnings += micro_constants(scene) + zone_sizes(scene)
+            warnings += micro_constants(scene) + zone_sizes(scene) + law_top(scene)
     if scene.output is not None and scene.output.fields is not None:
         for f in scene.output.fields:
             missing = [e for e in OUTPUT_FIELDS[f] if e not in effects]
@@ -507,29 +508,8 @@ def _hardness_checks(scene: Scene, g: Geometry, raw: dict, effects) -> list[str]
         if rough and sides and not given:
             problems.append(f'materials.{sides[0]}.hardness: missing; effect "plasticity" needs the hardness of '
                             f'the softer body of interface "{name}" ({" or ".join(sides)})')
-    problems += _plastic_everywhere(scene, g)
+    problems += plastic_everywhere(scene)
     return problems
-
-
-def _plastic_everywhere(scene: Scene, g: Geometry) -> list[str]:
-    """A hardness at the initial temperature at most the nominal pressure of the interfaces
-    (``loading.normal_force`` over their extents' boxes, which cover them: a lower bound; at the load
-    profile's largest factor in the run), so that some zone carries H or more, which the run refuses
-    after its set-up (check said OK: a materials engineer's trial; for a profile's peak, minutes
-    later: a user trial)."""
-    force = getattr(scene.loading, "normal_force", None) if scene.loading is not None else None
-    boxes = [g.spec.interface_extents.get(n) for n in g.spec.interfaces]
-    soft = scene.softer_hardness
-    if not force or soft is None or None in boxes:
-        return []
-    factor = largest_load_factor(scene.loading, scene.time.end or 0.0)
-    nominal = factor * force / sum(a * b for a, b in boxes)
-    H = scene.materials[soft].value("hardness", scene.time.initial_temperature)
-    peak = f" at the load profile's largest factor {factor:.3g}" if factor != 1 else ""
-    return [f"materials.{soft}.hardness = {H:.3g} Pa at the initial temperature: at most the interfaces' nominal "
-            f"pressure (loading.normal_force over them{peak}: at least {nominal:.3g} Pa), so a zone would carry the "
-            "hardness or more (fully plastic), which the micro model refuses; raise the hardness or lower the load"] \
-        if H <= nominal else []
 
 
 def _symmetry_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]:

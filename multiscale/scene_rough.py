@@ -13,7 +13,8 @@ from multiscale.micro.spectrum import power_spectrum
 from multiscale.micro.topography import (TopographyWarning, beyond_measurement, check_cutoff, check_resolved, coarse_grid,
                                          condition, covers, read_topography, zone_cells)
 from multiscale.micro.zones import THINNEST, ZoneGrid
-from multiscale.scene_sections import DEFAULT_GRID
+from multiscale.scene_cycle import largest_load_factor
+from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR
 
 FACET_AREA = 0.4   # median area of gmsh's interface triangles over h^2, h the size aimed at (0.37-0.43 on the demos)
 SHARED_MICRO = ("grid", "law_points", "model", "p_max", "tol", "partition_law", "heating", "heating_steps",
@@ -212,6 +213,50 @@ def micro_constants(scene) -> list[str]:
         out.append(f"layers: the micro contact yields at materials.{scene.softer_hardness}.hardness, layers or not (a "
                    "layer has no hardness of its own: a hard coating is capped at its substrate's; a user trial)")
     return out
+
+
+def nominal_pressure(scene) -> tuple[float, float] | None:
+    """(A lower bound of the interfaces' nominal pressure [Pa] at the load profile's largest factor,
+    that factor): ``loading.normal_force`` times the factor over the interfaces' extents' boxes,
+    which cover them; None without a normal force or a box (the run divides by the meshed areas)."""
+    force = getattr(scene.loading, "normal_force", None) if scene.loading is not None else None
+    spec = scene.geometry.spec if scene.geometry is not None else None
+    boxes = [spec.interface_extents.get(n) for n in spec.interfaces] if spec is not None else [None]
+    if not force or None in boxes:
+        return None
+    factor = largest_load_factor(scene.loading, scene.time.end or 0.0)
+    return factor * force / sum(a * b for a, b in boxes), factor
+
+
+def plastic_everywhere(scene) -> list[str]:
+    """A hardness at the initial temperature at most the interfaces' ``nominal_pressure``, so that
+    some zone carries H or more, which the run refuses after its set-up (check said OK: a materials
+    engineer's trial; for a profile's peak, minutes later: a user trial)."""
+    soft, bound = scene.softer_hardness, nominal_pressure(scene)
+    if soft is None or bound is None:
+        return []
+    (nominal, factor), H = bound, scene.materials[soft].value("hardness", scene.time.initial_temperature)
+    peak = f" at the load profile's largest factor {factor:.3g}" if factor != 1 else ""
+    return [f"materials.{soft}.hardness = {H:.3g} Pa at the initial temperature: at most the interfaces' nominal "
+            f"pressure (loading.normal_force over them{peak}: at least {nominal:.3g} Pa), so a zone would carry the "
+            "hardness or more (fully plastic), which the micro model refuses; raise the hardness or lower the load"] \
+        if H <= nominal else []
+
+
+def law_top(scene) -> list[str]:
+    """A warning of a ``micro.p_max`` at most the interfaces' ``nominal_pressure``: the zones then
+    press on average beyond the top of their laws, extrapolated linearly there (the run warned of it
+    only at its end; a user trial)."""
+    bound = nominal_pressure(scene) if scene.has("roughness") and scene.rough_interfaces else None
+    micro = scene.interface_settings(scene.rough_interfaces[0]).micro if bound is not None else None
+    if micro is None or micro.p_max is None or micro.p_max > bound[0]:
+        return []
+    peak = f" at the load profile's largest factor {bound[1]:.3g}" if bound[1] != 1 else ""
+    return [f"{micro_key(scene, scene.rough_interfaces[0])}.p_max = {micro.p_max:.3g} Pa, the top of the zone laws, "
+            f"is at most the interfaces' nominal pressure (loading.normal_force over them{peak}: at least "
+            f"{bound[0]:.3g} Pa): the zones will press beyond it on average, where a law is extrapolated linearly "
+            f"with the contact stiffness at its top; raise micro.p_max (without it: {P_MAX_FACTOR:g} x the nominal "
+            "pressure)"]
 
 
 def micro_key(scene, name: str) -> str:

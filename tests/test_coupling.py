@@ -348,6 +348,23 @@ def test_rough_pin_on_disc_bookkeeping_and_outputs(straight):
     assert not json.loads((result.folder / "provenance.json").read_text())["warnings"]
 
 
+TOP_WARNING = ("micro.p_max = {} Pa, the top of the zone laws, is at most the interfaces' nominal pressure "
+               "(loading.normal_force over them: at least {} Pa): the zones will press beyond it on average, where a "
+               "law is extrapolated linearly with the contact stiffness at its top; raise micro.p_max (without it: "
+               "20 x the nominal pressure)")
+
+
+def test_check_warns_of_a_law_top_below_the_nominal_pressure():
+    """micro.p_max at most the nominal pressure (200 N over the pin's 20 mm box: at least 0.5 MPa; the
+    round face's 0.64 MPa): every zone's law is extrapolated on average, which the run said only at its
+    end (a user trial); check says it now. Just above the bound: nothing (a lower bound)."""
+    text = (Path(__file__).parents[1] / "demos" / "pin_on_disc.toml").read_text()
+    assert 'p_max = "30 MPa"' in text
+    low = loads(text.replace('p_max = "30 MPa"', 'p_max = "0.45 MPa"'), "demos")
+    assert TOP_WARNING.format("4.5e+05", "5e+05") in low.warnings
+    assert not any("p_max" in w for w in loads(text.replace('p_max = "30 MPa"', 'p_max = "0.55 MPa"'), "demos").warnings)
+
+
 def test_zone_pressures_above_the_laws_are_warned_about(tmp_path):
     """micro.p_max below the zone pressures: the laws are extrapolated linearly above it, which the
     run says after its end (before: no word, with zone pressures 48 x the top of the laws)."""
@@ -355,7 +372,8 @@ def test_zone_pressures_above_the_laws_are_warned_about(tmp_path):
     assert h["law_reach"].max() == pytest.approx(h["max_zone_pressure"].max() / 0.2e6, rel=1e-12)
     assert h["law_reach"].max() > 2
     record = json.loads((tmp_path / "low" / "provenance.json").read_text())
-    assert record["warnings"] == [f"the zone pressures reached {h['law_reach'].max():.3g} times micro.p_max, the top "
+    assert record["warnings"] == [TOP_WARNING.format("2e+05", "5e+05"),        # said by check, before the run
+                                  f"the zone pressures reached {h['law_reach'].max():.3g} times micro.p_max, the top "
                                   "of their laws: beyond it a law is extrapolated linearly, with the contact stiffness "
                                   "at the top; raise micro.p_max"]
     assert h["law_reach_halved"].max() == 0.0          # no law failed
