@@ -289,6 +289,9 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise toml_problem(source or "scene", exc, text) from None
+    if "problem" in raw and "effects" not in raw:     # (answered with "did you mean" per key: a user trial)
+        raise SceneError([f"{source.name if source else name}: a study file (problem = ..., [sweep]), not a scene: "
+                          "give it to `multiscale study`"])
     overrides = {dotted: _toml_value(value) for dotted, value in (overrides or {}).items()}
     for dotted, value in overrides.items():
         *parents, last = key_parts(dotted)

@@ -1290,3 +1290,16 @@ def test_records_of_another_shape_are_run_again(hertz_study, tmp_path, capsys):
     assert [r["status"] for r in rows] == ["ok", "failed", "ok", "ok"]
     assert rows[1]["message"] == 'metric "contact_radius" is \'x\' (not a number)'
 
+
+
+def test_a_study_given_for_a_scene_and_a_scene_for_a_study_name_the_right_command(tmp_path, capsys):
+    """`check` of a study file and `study` of a scene file answered with a "did you mean" for each of
+    its keys (a user trial): now one line naming the command the file is for."""
+    path = write(tmp_path, HERTZ)
+    for command in ("check", "run"):
+        assert main([command, str(path)]) == 2
+        assert capsys.readouterr().err.startswith("error: study.toml: a study file (problem = ..., [sweep]), not a "
+                                                  "scene: give it to `multiscale study`\n")
+    assert main(["study", str(ROOT / "demos" / "block_on_flat.toml")]) == 2
+    assert capsys.readouterr().err == ("error: block_on_flat.toml: a scene file (effects = [...], [geometry]), not a "
+                                       "study: give it to `multiscale check` or `multiscale run`\n")

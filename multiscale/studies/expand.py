@@ -82,6 +82,9 @@ def load_study(path) -> Study:
         raw = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
         raise toml_problem(path, exc, text) from None
+    if "effects" in raw and "problem" not in raw:     # (answered with "did you mean" per key: a user trial)
+        raise SceneError([f"{path.name}: a scene file (effects = [...], [geometry]), not a study: give it to "
+                          "`multiscale check` or `multiscale run`"])
     ctx = Context(directory=path.resolve().parent)
     f = read(StudyFile, raw, "", ctx)
     if f.problem is not None and f.problem not in PROBLEMS:
