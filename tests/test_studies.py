@@ -819,7 +819,8 @@ def test_a_scene_keys_bare_numbers_get_its_unit_on_the_axis(tmp_path, made):
 
 def test_an_interrupted_study_writes_the_table_of_the_runs_that_ended(tmp_path, capsys, monkeypatch):
     """Ctrl-C after the first run: results.csv holds it and names the others missing (it was written
-    only at the end, so an interrupted study had none: a user trial)."""
+    only at the end, so an interrupted study had none: a user trial), and the report says so (it
+    was left as the previous sweep's, beside the new tables: a user trial)."""
     import dataclasses
 
     from multiscale.studies import driver
@@ -831,10 +832,14 @@ def test_an_interrupted_study_writes_the_table_of_the_runs_that_ended(tmp_path, 
     monkeypatch.setattr(driver, "execute", first_then_interrupted)
     path = write(tmp_path, HERTZ.replace("processes = 2", "processes = 1"))
     assert main(["study", str(path)]) == 130
-    assert "hertz: the runs that ended are in " in capsys.readouterr().err
+    md = tmp_path / "results" / "hertz" / "hertz.md"
+    assert f"hertz: the runs that ended are in {md.parent / 'results.csv'} and {md} " in capsys.readouterr().err
     rows = table(tmp_path / "results" / "hertz" / "results.csv")
     assert [r["status"] for r in rows] == ["ok", "missing", "missing", "missing"]
     assert float(rows[0]["approach"]) > 0 and rows[1]["message"] == "not run"
+    text = md.read_text()
+    assert "- Runs: 1 ok, 0 failed, **3 not run: the study was stopped before them** (run it again" in text
+    assert "Failed runs:" not in text
 
 
 def test_a_measured_surface_is_a_micro_study_problem(tmp_path, capsys):
@@ -864,6 +869,36 @@ def test_a_measured_surface_is_a_micro_study_problem(tmp_path, capsys):
             r = solve_contact(surface, kernel=HalfSpace.from_materials(4e9, 0.15), load=load)
             assert h5["approach"][k] == pytest.approx(r.approach, rel=1e-12)
             assert h5["area_fraction"][k] == pytest.approx(r.area_fraction, rel=1e-12) and r.area_fraction > 0
+
+
+def test_what_a_run_finds_is_said_by_the_study_its_report_and_table(tmp_path, capsys):
+    """Outliers of a measured file (a smooth map with 3 spikes, written as ISO 25178-71 SDF) are said
+    by ``multiscale surface`` and by a scene, but a measured_contact study kept them in its runs' logs
+    (a user trial): now the console names them once, the report once with its runs, results.csv per
+    run."""
+    from multiscale.micro.topography import TopographyWarning, condition, read_topography
+    rng = np.random.default_rng(0)
+    h = np.cumsum(np.cumsum(rng.normal(size=(48, 64)), 0), 1) * 1e-3      # um, smooth
+    h = h - h.mean()
+    h[10, 20] += 40 * h.std()
+    h[30, 40] -= 40 * h.std()
+    h[40, 10] += 40 * h.std()
+    head = ("aISO-1.0\nManufacID = test\nCreateDate = 010120260000\nModDate = 010120260000\nNumPoints = 64\n"
+            "NumProfiles = 48\nXscale = 1.0E-6\nYscale = 1.0E-6\nZscale = 1.0E-6\nZresolution = 1.0E-9\n"
+            "Compression = 0\nDataType = 7\nCheckType = 0\n*\n")
+    (tmp_path / "spiky.sdf").write_text(head + "\n".join(" ".join(f"{v:.6f}" for v in row) for row in h) + "\n*\n")
+    with pytest.warns(TopographyWarning):
+        notes = condition(read_topography(tmp_path / "spiky.sdf"), "plane").notes
+    assert len(notes) == 1 and notes[0].startswith("outliers in 'spiky.sdf': 3 points deviating")
+    path = write(tmp_path, 'problem = "measured_contact"\nmetrics = ["approach"]\n[fixed]\nfile = "spiky.sdf"\n'
+                           '[sweep]\nload = ["1 MPa", "2 MPa"]\n[run]\nprocesses = 1\n[report]\nplots = false\n')
+    assert main(["study", str(path)]) == 0
+    err, out = capsys.readouterr()[::-1]
+    assert err.count(notes[0]) == 1 and f"warning: study: run load = 1 MPa: {notes[0]}" in err
+    assert "  2 runs warned of what they found while running: in the report and the warnings column" in out
+    assert [r["warnings"] for r in table(tmp_path / "results" / "study" / "results.csv")] == [notes[0]] * 2
+    text = (tmp_path / "results" / "study" / "study.md").read_text()
+    assert text.count(notes[0]) == 1 and f"- {notes[0]} (load = 1 MPa; load = 2 MPa)" in text
 
 
 def test_the_study_package_leaves_its_worker_to_runpy():
@@ -953,7 +988,8 @@ def test_scene_metrics_reduce_over_the_rows_that_have_a_value():
 def test_a_scene_run_is_timed_by_its_own_record(tmp_path, monkeypatch):
     """A scene run's wall time is its provenance.json's, not its subprocess's: the start of Python
     and DOLFINx took 10 of 18 s, a coarser grid looked slower than the reference and the cheapest
-    setting was the reference itself (a user trial)."""
+    setting was the reference itself (a user trial). Its warnings beyond the scene's own are what it
+    found (a user trial: zone pressures beyond micro.p_max stayed in the run's log)."""
     import subprocess
     from multiscale.io import History
     from multiscale.studies import scene_problem
@@ -963,11 +999,14 @@ def test_a_scene_run_is_timed_by_its_own_record(tmp_path, monkeypatch):
         history = History()
         history.append(time=0.0, interface_force=100.0, newton_iterations=4.0)
         history.write((work / "output").mkdir(parents=True) or work / "output" / "history.h5")
-        (work / "output" / "provenance.json").write_text(json.dumps({"total_wall_time_s": 7.34}))
+        (work / "output" / "provenance.json").write_text(json.dumps({"total_wall_time_s": 7.34,
+                                                                     "warnings": ["the scene's", "the run's"]}))
         return subprocess.CompletedProcess(command, 0, "", "")
     monkeypatch.setattr(scene_problem.subprocess, "run", ran)
-    outcome = scene_problem.SceneProblem().run(scene_problem.SceneRun(ROOT / "demos" / "block_on_flat.toml"), work)
+    outcome = scene_problem.SceneProblem().run(scene_problem.SceneRun(ROOT / "demos" / "block_on_flat.toml",
+                                                                      warnings=("the scene's",)), work)
     assert (outcome.wall_time, outcome.iterations, outcome.metrics["interface_force"]) == (7.34, 4, 100.0)
+    assert outcome.warnings == ("the run's",)
 
 
 def test_squeal_scene_metrics_from_the_mode_table(tmp_path):

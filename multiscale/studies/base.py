@@ -22,6 +22,7 @@ class Outcome:
     converged: bool = True        # every solve reached its tolerance
     wall_time: float | None = None   # s, the run's own time where the problem knows it better than
     #                                  the worker's clock (a scene run: without its process's start-up)
+    warnings: tuple = ()          # what the run found, beyond its inputs' warnings (``Study.warnings``)
 
 
 class Problem:

@@ -42,10 +42,12 @@ def run_studies(paths, *, rerun_failed: bool = False, report_folder=None, proces
     for study in studies:
         try:
             stats = execute(study, rerun_failed=rerun_failed, progress=progress, comm=comm)
-        except KeyboardInterrupt:       # Ctrl-C: the table of the runs that ended (it waited for the end before)
-            if rank == 0:
-                csv_path, _ = write_tables(study, collect(study))
-                print(f"{study.name}: the runs that ended are in {csv_path} (the others: status missing)",
+        except KeyboardInterrupt:       # Ctrl-C: the tables and report of the runs that ended (it waited for the
+            if rank == 0:               # end before; then the old report stayed beside the new tables: a user trial)
+                rows = collect(study)
+                csv_path, _ = write_tables(study, rows)
+                md = report(study, rows, command)
+                print(f"{study.name}: the runs that ended are in {csv_path} and {md} (the others: status missing)",
                       file=sys.stderr, flush=True)
             raise
         if rank != 0:
@@ -65,6 +67,10 @@ def run_studies(paths, *, rerun_failed: bool = False, report_folder=None, proces
         reasons = collections.Counter(r.record.get("error", "").split("; available:")[0] for r in rows if not r.ok)
         for why, n in reasons.most_common():          # (before: "2 failed" alone once the runs were recorded)
             print(f"  {n} failed: {why}")
+        warned = sum(bool(r.record.get("warnings")) for r in rows)
+        if warned:                                    # (also of runs recorded before, not said as they ran)
+            print(f"  {warned} run{'s' if warned > 1 else ''} warned of what {'they' if warned > 1 else 'it'} found "
+                  "while running: in the report and the warnings column")
     if rank == 0 and report_folder is not None:
         index = write_index(summaries, Path(report_folder).resolve(), command)
         print(f"index {index}")

@@ -240,11 +240,12 @@ class MeasuredContactParams:
                                    "area_fraction": "real contact area / nominal area [-]"})
 def _measured_contact(p: MeasuredContactParams) -> Outcome:
     """Contact of a measured topography at one mean pressure (FFT-BEM on its isolated patch)."""
-    surface = condition(read_topography(p.file), p.detrend, p.cutoff).surface
-    r = solve_contact(surface, kernel=HalfSpace.from_materials(p.E, p.nu), load=p.load,
+    measured = read_topography(p.file)
+    conditioned = condition(measured, p.detrend, p.cutoff)
+    r = solve_contact(conditioned.surface, kernel=HalfSpace.from_materials(p.E, p.nu), load=p.load,
                       **({"tol": p.tol} if p.tol else {}))
     return Outcome({"approach": float(r.approach), "area_fraction": float(r.area_fraction)},
-                   int(r.iterations), bool(r.converged))
+                   int(r.iterations), bool(r.converged), warnings=measured.notes + conditioned.notes)
 
 
 # ----------------------------------------------------------------------------- wear steps

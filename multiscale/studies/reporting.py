@@ -13,7 +13,7 @@ from multiscale.studies.expand import Study
 from multiscale.studies.formatting import metric_heading, now, number_text, percent, value_text
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.records import JIT_SHARE
-from multiscale.studies.results import Row, cheapest, crossings, knob_unit, reference_text, sample_std
+from multiscale.studies.results import MISSING, Row, cheapest, crossings, knob_unit, reference_text, sample_std
 
 __all__ = ["report", "write_index"]
 
@@ -31,7 +31,8 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
     pngs = plot(study, rows, folder)
     problem = PROBLEMS[study.problem]
     ok = [r for r in rows if r.ok]
-    failed = [r for r in rows if not r.ok]
+    failed = [r for r in rows if not r.ok and r.record.get("status") != MISSING]
+    missing = len(rows) - len(ok) - len(failed)
     timing = (f" Wall time: best of {_repeats(ok)} repetition(s) in a fresh process ({_processes(study)}; a run "
               f"whose first timing spent over {JIT_SHARE:.0%} of it loading or compiling numba code is timed once "
               "more); peak memory: the largest process's maximum resident set (interpreter and libraries included; "
@@ -47,13 +48,16 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
                                          for m in study.metrics),
               f"- Reference: {reference_text(study)}"
               + ("; error = |m − m_ref| / |m_ref|" if study.reference else ""),
-              f"- Runs: {len(ok)} ok, {len(failed)} failed; {elapsed(sum(r.record.get('wall_time', 0) for r in rows))} "
+              f"- Runs: {len(ok)} ok, {len(failed)} failed"
+              + (f", **{missing} not run: the study was stopped before them** (run it again for them; the runs "
+                 "that ended are kept)" if missing else "") + f"; {elapsed(sum(r.record.get('wall_time', 0) for r in rows))} "
               f"of run wall time in all (failed runs included).{timing}",
               _code_line(rows),
               f"- Generated {now()} on a {os.cpu_count()}-core machine by `{command or 'multiscale study ' + study.source.name}`.",
               ""]
     if study.warnings:
         lines += ["Warnings of the runs' inputs:", ""] + [f"- {line}" for line in study.warnings] + [""]
+    lines += _found_warnings(rows)
     if study.reference is not None and ok:
         lines += _cheapest_table(study, rows)
     found = crossings(study, rows)
@@ -69,6 +73,22 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
     path = folder / f"{study.name}.md"
     path.write_text("\n".join(lines) + "\n")
     return path
+
+
+def _found_warnings(rows, shown: int = 3) -> list[str]:
+    """What the runs warned of while running (zone pressures beyond the laws' top, outliers of a
+    measured file), each warning once with the runs that gave it (the first ``shown`` of them)."""
+    found = {}
+    for r in rows:
+        for line in r.record.get("warnings", ()):
+            found.setdefault(line, []).append(_label_text(r) or r.run.key)
+    if not found:
+        return []
+    lines = ["Warnings of the runs (what they found while running; column `warnings` of results.csv):", ""]
+    for line, runs in found.items():
+        more = f" and {len(runs) - shown} more" if len(runs) > shown else ""
+        lines.append(f"- {line} ({'; '.join(runs[:shown])}{more})")
+    return lines + [""]
 
 
 def _code_line(rows) -> str:

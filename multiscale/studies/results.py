@@ -20,7 +20,7 @@ from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.records import read_records
 from multiscale.units import KINDS, VALUE, parse_unit
 
-__all__ = ["Crossing", "Row", "Setting", "case_key", "cheapest", "collect", "crossings", "pareto", "reference_text",
+__all__ = ["MISSING", "Crossing", "Row", "Setting", "case_key", "cheapest", "collect", "crossings", "pareto", "reference_text",
            "relative_error", "sample_std", "write_tables"]
 
 
@@ -76,6 +76,9 @@ class Setting:
         return max((r.record for r in self.rows), key=lambda rec: rec.get(name, -math.inf))
 
 
+MISSING = "missing"        # the status of a run without a record (a study stopped before it ran)
+
+
 def relative_error(value: float, ref: float) -> float:
     """|value − ref| / |ref|; against ref = 0, 0 for value = 0 and NaN (no relative error, shown
     "n/a") otherwise: |value| shown as a percentage read as 6e3 % for a growth rate of 60 1/s."""
@@ -87,7 +90,7 @@ def relative_error(value: float, ref: float) -> float:
 def collect(study: Study) -> list[Row]:
     """Rows of the recorded runs, with reference values and relative errors."""
     records = read_records(study)
-    rows = [Row(r, records.get(r.key, {"status": "missing", "error": "not run", "metrics": {}})) for r in study.runs]
+    rows = [Row(r, records.get(r.key, {"status": MISSING, "error": "not run", "metrics": {}})) for r in study.runs]
     ref = study.reference
     if ref is None:
         return rows
@@ -136,6 +139,7 @@ def _columns(study: Study, rows: list[Row]) -> dict:
     cols["converged"] = [bool(r.record.get("converged", False)) for r in rows]
     cols["code"] = [(r.record.get("code") or {}).get("sha1", "")[:12] for r in rows]    # the package that ran it
     cols["message"] = [r.record.get("error", "") or r.note for r in rows]
+    cols["warnings"] = ["; ".join(r.record.get("warnings", ())) for r in rows]    # what the run found
     return cols
 
 

@@ -67,7 +67,7 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
     start = time.perf_counter()
     rank, size = (comm.rank, comm.size) if comm is not None else (0, 1)
     lock = _claim(study, comm)
-    bar, failed, running, termination, lifeline, warned = None, 0, {}, None, None, False
+    bar, failed, running, termination, lifeline, warned, said = None, 0, {}, None, None, False, set()
     try:                                     # the lock is released whatever happens from here
         records = read_records(study)
         todo = [r for r in study.runs if not _done(records.get(r.key), rerun_failed, study.options.timeout)]
@@ -101,6 +101,10 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
                     tqdm.write(f"warning: {study.name}: {record['error'].split('; available:')[0]}; every run "
                                "will lack it: stop (Ctrl-C), correct the study's metrics and start again (finished "
                                "runs are kept)", file=sys.stderr)
+                for line in [w for w in dict.fromkeys(record.get("warnings", ())) if w not in said]:
+                    said.add(line)                        # each once, with the first run that found it
+                    tqdm.write(f"warning: {study.name}: run {', '.join(f'{k} = {v}' for k, v in run.shown.items())}: "
+                               f"{line}", file=sys.stderr)
                 log = study.folder / "runs" / f"{run.key}.log"
                 if log.is_file() and not log.stat().st_size:
                     log.unlink()

@@ -79,12 +79,14 @@ def _squeal(scene, fixed=None) -> bool:
 @dataclass(frozen=True)
 class SceneRun:
     """A macro scene with overrides (dotted scene paths -> raw values) and MPI ranks per run;
-    ``files``: the other files it reads (geometry, measured surfaces), whose bytes name the run."""
+    ``files``: the other files it reads (geometry, measured surfaces), whose bytes name the run;
+    ``warnings``: the scene's own (the study's, said before it runs)."""
 
     scene: Path
     overrides: dict = field(default_factory=dict)
     ranks: int = 1
     files: tuple = ()
+    warnings: tuple = ()
 
 
 class SceneProblem(Problem):
@@ -109,7 +111,8 @@ class SceneProblem(Problem):
             return None
         ctx.warnings.extend(loaded.warnings)
         own = Path(scene).resolve()
-        return SceneRun(Path(scene), dict(raw), ranks, tuple(sorted(p for p in loaded.inputs if p != own)))
+        return SceneRun(Path(scene), dict(raw), ranks, tuple(sorted(p for p in loaded.inputs if p != own)),
+                        tuple(loaded.warnings))
 
     def key(self, params: SceneRun) -> dict:
         """The scene's path and bytes, the overrides, the bytes of the files it reads (a CAD file
@@ -151,13 +154,16 @@ class SceneProblem(Problem):
         (Path(workdir) / "scene_run.log").write_text(done.stdout + done.stderr)
         if done.returncode != 0:
             raise RuntimeError(f"scene run failed (exit {done.returncode}): {failure_line(done.stderr or done.stdout)}")
-        own = json.loads((out / "provenance.json").read_text()).get("total_wall_time_s")   # (the process's start-
-        #   up, 10 of 18 s, made a coarser grid slower than the reference and the cheapest setting the reference)
+        record = json.loads((out / "provenance.json").read_text())
+        own = record.get("total_wall_time_s")     # (the process's start-up, 10 of 18 s, made a coarser grid
+        #                                           slower than the reference and the cheapest setting the reference)
+        found = tuple(w for w in record.get("warnings", ()) if w not in params.warnings)   # (only in its log before:
+        #                                           zone pressures beyond micro.p_max unseen in the study; a user trial)
         if (out / "modes.csv").exists():
-            return Outcome(squeal_metrics(out / "modes.csv"), 0, True, own)
+            return Outcome(squeal_metrics(out / "modes.csv"), 0, True, own, found)
         history = History.read(out / "history.h5")
         iterations = int(history["newton_iterations"].sum()) if "newton_iterations" in history.columns else 0
-        return Outcome(history_metrics(history), iterations, True, own)
+        return Outcome(history_metrics(history), iterations, True, own, found)
 
 
 def history_metrics(history: History) -> dict:

@@ -125,7 +125,7 @@ def run_task(task: dict) -> int:
         best = int(np.argmin(times))
         record.update(wall_time=times[best], wall_times=times, cpu_time=cpus[best], jit_time=jit[0],
                       peak_memory_mb=_peak_mb(), iterations=int(outcome.iterations),
-                      converged=bool(outcome.converged))
+                      converged=bool(outcome.converged), warnings=list(outcome.warnings))
         record["metrics"] = {k: float(v) for k, v in outcome.metrics.items()}
         if task["exact"]:
             record["reference"] = _exact(problem, params, Path(task["references"]))
