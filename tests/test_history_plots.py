@@ -275,3 +275,21 @@ def test_a_run_with_fade_draws_its_friction_coefficient(tmp_path, drawn):
     assert {line.get_label(): tuple(line.get_ydata()) for line in ax.get_lines()} == {
         "all": pytest.approx((0.4, 0.37)), "inner pad": pytest.approx((0.41, 0.38)),
         "outer pad": pytest.approx((0.39, 0.36))}
+
+
+def test_the_multiscale_figures_legends_cover_no_panel(tmp_path, drawn):
+    """The legends of multiscale.png lay over the curves (the pressures' and the partition's: a user
+    trial); they now stand above their panels, over none of the figure's axes."""
+    history = History()
+    for t in (0.0, 1.0, 2.0):
+        history.append(time=t, max_pressure=2e6, max_zone_pressure=1.3e6, micro_max_pressure=4.6e6 - 1e5 * t,
+                       max_temperature_disc=300.0 + t, max_temperature_pin=299.0 + 2 * t, micro_max_temperature=310.0,
+                       partition_max=0.09, partition_mean=0.04, partition_min=0.035, wear_volume=1e-12 * t)
+    plots.multiscale_figure(history, tmp_path / "multiscale.png")
+    figure = drawn[-1]
+    figure.canvas.draw()
+    legends = [ax.get_legend().get_window_extent() for ax in figure.axes if ax.get_legend() is not None]
+    assert len(legends) == 3
+    for box in legends:
+        for ax in figure.axes:
+            assert not box.overlaps(ax.get_window_extent()), ax.get_ylabel()

@@ -202,6 +202,28 @@ def test_the_error_figure_draws_the_pareto_front_of_each_case(tmp_path, made):
         assert len(steps) == 2
 
 
+@pytest.mark.parametrize("times, errors", [((4.1, 4.3, 4.5, 4.7), (0.018, 0.016, 0.014, 0.012)),
+                                           ((0.9, 2, 4, 8), (0.3, 0.1, 0.05, 0.011)),
+                                           ((1, 3, 30, 200), (0.8, 0.1, 0.02, 0.011))])
+def test_a_log_axis_of_the_error_figure_has_at_least_two_labels(tmp_path, made, times, errors):
+    """Wall times 4.1 ... 4.7 s: no decade, 2, 3 or 5 fell on the log axis, which had no tick label
+    at all (a user trial); each axis now has at least two, each where its number is."""
+    from multiscale.plots import studies as figures
+    study = load_study(write(tmp_path, HERTZ.replace('errors = ["1 %", "5 %"]', 'errors = ["1 %"]')))
+    rows = [Row(run, {"status": "ok", "wall_time": t, "metrics": {m: 1.0 for m in study.metrics}},
+                errors={m: e for m in study.judged}) for run, t, e in zip(study.runs, times, errors)]
+    figures.plot(study, rows, tmp_path)
+    fig, axes = made[0]
+    fig.canvas.draw()
+    for axis in (axes[0][0].xaxis, axes[0][0].yaxis):
+        lo, hi = axis.get_view_interval()
+        ticks = [(t.get_loc(), t.label1.get_text()) for t in axis.get_major_ticks() + axis.get_minor_ticks()
+                 if t.label1.get_text() and lo <= t.get_loc() <= hi]
+        assert len(ticks) >= 2, (axis.axis_name, ticks)
+        for at, text in ticks:
+            assert float(text) == pytest.approx(at, rel=5e-3)
+
+
 @pytest.mark.parametrize("dt, ticks, label", [('{start = "50 us", stop = "450 us", num = 3, log = true}',
                                                ["50 µs", "150 µs", "450 µs"], "dt"),
                                               ("[5e-05, 0.00015, 0.00045]", ["5e-05", "0.00015", "0.00045"], "dt [s]")])

@@ -220,8 +220,9 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
         ax.grid(alpha=0.3)
         if ax.get_yscale() == "linear":
             ax.ticklabel_format(axis="y", useOffset=False)
-        if any(name for _, name in keys):
-            ax.legend(fontsize=8)
+        if any(name for _, name in keys):     # above the panel, in two columns: inside, it hid the curves
+            ax.legend(fontsize=8, loc="lower left", bbox_to_anchor=(0.0, 1.02, 1.0, 0.1), mode="expand", ncol=2,
+                      borderaxespad=0.0)
     for ax in axes.ravel()[len(panels):]:
         ax.axis("off")
     fig.suptitle((f"{title}:" + ("\n" if ncol == 1 else " ") if title else "") +      # (one panel: cut off at

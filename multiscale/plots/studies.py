@@ -10,7 +10,7 @@ from pathlib import Path
 import matplotlib
 import matplotlib.pyplot as plt
 import numpy as np
-from matplotlib.ticker import FuncFormatter, NullFormatter
+from matplotlib.ticker import FuncFormatter, MaxNLocator, NullFormatter, NullLocator
 
 from multiscale.studies.expand import Study, StudyRun
 from multiscale.studies.formatting import metric_heading, percent
@@ -81,12 +81,13 @@ def _plot_pareto(study, ok, folder):
             ax.axvline(refs[len(refs) // 2], color="green", ls=":", label="reference run" + "s" * (len(refs) > 1))
         if any(fronts):
             ax.set(xscale="log", yscale="log")
-            for axis in (ax.xaxis, ax.yaxis):
-                _plain_log(axis)
         for tol in study.report.errors:
             ax.axhline(tol, color="gray", ls="--", lw=0.8)
             ax.annotate(percent(tol), (1, tol), xycoords=("axes fraction", "data"), fontsize=7, ha="right",
                         va="bottom", color="gray")
+        if any(fronts):                # (the tolerances' lines widen the view: ticks after them)
+            for axis in (ax.xaxis, ax.yaxis):
+                _plain_log(axis)
         ax.set(xlabel="wall time [s]", ylabel=f"relative error of {m}", title=f"error of {m} against cost")
         ax.grid(True, which="both", alpha=0.25)
         ax.legend(fontsize=7)
@@ -110,12 +111,20 @@ def _axis_path(study, axis, folder: Path) -> Path:
 
 
 def _plain_log(axis) -> None:
-    """Plain numbers on a log axis, "0.4" and not "4 x 10^-1" (those overlapped on short decades):
-    every decade, and 2, 3 and 5 times it on an axis that spans less than one."""
+    """Plain numbers on a log axis, "0.4" and not "4 x 10^-1" (those overlapped on short decades),
+    at least two of them: every decade on an axis spanning over two, and 2 and 5 times it over one,
+    and 3 times it too over a factor 4; on a shorter one (4.1 ... 4.8 s, where no such number falls:
+    the axis was bare, a user trial) about four evenly spaced values. Call it once the view is final."""
+    lo, hi = axis.get_view_interval()
+    if hi <= 4 * lo:
+        axis.set_major_locator(MaxNLocator(4))
+        axis.set_minor_locator(NullLocator())
+        axis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:.3g}"))
+        return
+    shown = (1,) if hi > 100 * lo else (1, 2, 5) if hi > 10 * lo else (1, 2, 3, 5)
+
     def label(x, _):
-        lo, hi = axis.get_view_interval()
         mantissa = x / 10 ** math.floor(math.log10(x) + 1e-9)
-        shown = (1,) if hi > 10 * lo else (1, 2, 3, 5)
         return f"{x:g}" if any(abs(mantissa - m) < 1e-6 for m in shown) else ""
     axis.set_major_formatter(FuncFormatter(label))
     axis.set_minor_formatter(FuncFormatter(label))
@@ -199,6 +208,8 @@ def _plot_axis(study, ok, axis, folder, found):
             ax.set_xticks(ticks_at, labels, rotation=30 if len(ticks_at) > 5 else 0)
         else:
             ax.set_xticks(range(len(values)), [ticks[v] for v in values], rotation=30, ha="right", fontsize=7)
+        if ax.get_yscale() == "log":
+            _plain_log(ax.yaxis)
         ax.grid(True, which="both", alpha=0.25)
         if others and len(lines) <= 8:
             ax.legend(fontsize=6)

@@ -37,7 +37,7 @@ def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -
     (complete bins as points, partial ones hollow) with the power-law fit between its cut-offs."""
     maps = [("roughness" if waviness is not None else "heights", surface)] + (
         [("waviness", waviness)] if waviness is not None else [])
-    fig = Figure(figsize=(4.6 * (len(maps) + 1), 4.0))
+    fig = Figure(figsize=(4.6 * (len(maps) + 1), 5.0))
     axes = fig.subplots(1, len(maps) + 1, squeeze=False)[0]
     for ax, (label, s) in zip(axes, maps):
         Lx, Ly = s.size
@@ -69,7 +69,7 @@ def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -
     ax.set_xlabel("wavevector q = 2π/λ [rad/m]")
     ax.set_ylabel("PSD C(q) [m⁴]")
     ax.grid(True, which="both", alpha=0.25)
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.16))   # below: it hid the short wavelengths
     ax.set_title(f"Sq = {stats.Sq * 1e6:.3g} µm, Sdq = {stats.Sdq:.3g}")
     fig.suptitle(title)
     fig.tight_layout()
