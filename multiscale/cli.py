@@ -334,8 +334,10 @@ def _surface(args) -> int:
                              "are available: crop or coarsen the map first")
         if cutoff is not None and plain(_number_or_text(args.cutoff)) and cutoff > min(measurement.size):
             Lx, Ly = measurement.size       # ISO cut-offs are given in mm: "--cutoff 0.8" was 0.8 m, silently
+            also = " (also longer)" if 1e-3 * cutoff > min(measurement.size) else ""     # (a user trial: said
             raise InputError("--cutoff", args.cutoff, f"{cutoff:g} m, longer than the measurement ({Lx * 1e3:.4g} x "
-                             f'{Ly * 1e3:.4g} mm); plain numbers are metres: did you mean "{args.cutoff} mm"?')
+                             f'{Ly * 1e3:.4g} mm); plain numbers are metres: did you mean "{args.cutoff} mm"{also}? '
+                             f'("{args.cutoff} m" filters at {cutoff:g} m all the same)')   # as if "0.8 m" were refused
         done = condition(measurement, args.detrend, cutoff, args.max_undefined, prefix=COMMAND_LINE,
                          despike=args.despike)      # errors and notes name the options as given here
     stats = surface_statistics(done.surface)

@@ -360,12 +360,17 @@ def measured_cover(scene, warnings_out: list) -> list[str]:
                     out.append(str(exc))
             cells = zone_cells(s.micro.grid, r.cover, size, s.micro.zones, (measured.dx, measured.dy), DEFAULT_GRID,
                                r.file.name)
+            cell = [L / (z * c) for L, z, c in zip(size, s.micro.zones, cells)]
+            if r.cutoff is not None:
+                try:
+                    check_cutoff(f"{prefix}cutoff", r.cutoff, *cell, grid=True)
+                except InputError as exc:
+                    out.append(str(exc))
             if r.cover == "equivalent":
                 check_resolved(measured.size, [z * c for z, c in zip(s.micro.zones, cells)], size, prefix=prefix)
             with warnings.catch_warnings():
                 warnings.simplefilter("ignore", TopographyWarning)
                 done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix=prefix, despike=r.despike)
-            cell = [L / (z * c) for L, z, c in zip(size, s.micro.zones, cells)]
             spectrum = power_spectrum(done.surface)       # one PSD for both checks
             beyond = beyond_measurement(done.surface, cell, prefix, spectrum) if r.cover == "equivalent" else None
             warnings_out += [w for w in [coarse_grid(done.surface, cell, prefix, spectrum), beyond]

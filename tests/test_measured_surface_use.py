@@ -76,9 +76,13 @@ def test_surface_command_prints_the_steps_and_surfacetopographys_sq(tmp_path, ca
     (["--channel", "2"], 'error: --channel = 2: top-1.top has the channels 0 "Default" (2-D)'),
     (["--cutoff", "3 kg"], 'error: --cutoff = \'3 kg\': expected a length'),
     (["--cutoff", "1 nm"], "error: --cutoff: λc = 0.001 um must span at least 2 pixels (0.004688 um): top-1.top's pixels"),
-    # ISO cut-offs are said in mm: "--cutoff 0.8" filtered at 0.8 m, "little is removed", and went on
+    # ISO cut-offs are said in mm: "--cutoff 0.8" filtered at 0.8 m, "little is removed", and went on; with a
+    # unit it is taken as meant (a user trial read the refusal as one of 0.8 m)
     (["--cutoff", "0.8"], "error: --cutoff = '0.8': 0.8 m, longer than the measurement (0.0006 x 0.0006 mm); plain "
-                          'numbers are metres: did you mean "0.8 mm"?'),
+                          'numbers are metres: did you mean "0.8 mm" (also longer)? ("0.8 m" filters at 0.8 m all '
+                          "the same)"),
+    (["--cutoff", "1e-6"], "error: --cutoff = '1e-6': 1e-06 m, longer than the measurement (0.0006 x 0.0006 mm); "
+                           'plain numbers are metres: did you mean "1e-6 mm"? ("1e-6 m" filters'),
 ])
 def test_surface_command_bad_options_are_one_line(capsys, args, message):
     assert main(["surface", str(TOP), "--figure", "none", *args]) == 2
@@ -123,12 +127,14 @@ def test_surface_command_lists_the_formats(capsys):
 
 
 def test_scene_reads_a_measured_file_with_its_options(tmp_path):
-    s = scene(tmp_path, f'file = "{TOP}"\nchannel = 0\ndetrend = "poly2"\ncutoff = "0.2 um"\ncover = "mirror"\n'
+    s = scene(tmp_path, f'file = "{TOP}"\nchannel = 0\ndetrend = "poly2"\ncutoff = "1 mm"\ncover = "mirror"\n'
                         'seed = 4\nmax_undefined = 0.2', GRID)   # ("equivalent" of 0.6 um on 10 mm: refused, flat)
-    r = s.roughness
+    r = s.roughness            # (a cut-off of 2 cells at least: 0.625 mm, longer than the 0.6 um map)
     assert (r.file, r.channel, r.detrend, r.cutoff, r.cover, r.seed, r.max_undefined) == (
-        TOP, 0, "poly2", pytest.approx(2e-7), "mirror", 4, 0.2)
-    assert r.pixel_size is None and r.height_unit is None and apart(s.warnings) == ()
+        TOP, 0, "poly2", pytest.approx(1e-3), "mirror", 4, 0.2)
+    assert r.pixel_size is None and r.height_unit is None
+    assert [w.split(":")[0] for w in apart(s.warnings)] == ["roughness.cutoff = 1000 um is longer than the measurement "
+                                                            "(0.6 x 0.6 um)"]
     assert [w for w in s.warnings if "resolve 0.0% of the measured RMS gradient" in w]
     over = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "tile"', GRID)
     assert apart(over.warnings) == ("roughness.pixel_size = 3e-09 x 3e-09 m overrides the file's 2.344e-09 x 2.344e-09 m",)
@@ -529,11 +535,29 @@ def test_a_missing_micro_grid_does_not_hide_that_the_measurement_does_not_cover_
 def test_a_cutoff_longer_than_the_measurement_is_warned_about(tmp_path):
     """cutoff = 8 mm on a 1.3 mm measurement passed check without a word (a user trial); top-1.top
     spans 0.6 um."""
-    s = scene(tmp_path, f'file = "{TOP}"\ncover = "tile"\ncutoff = "1 um"', GRID)
-    assert any(w.startswith("roughness.cutoff = 1 um is longer than the measurement (0.6") for w in s.warnings), \
+    s = scene(tmp_path, f'file = "{TOP}"\ncover = "tile"\ncutoff = "1 mm"', GRID)
+    assert any(w.startswith("roughness.cutoff = 1000 um is longer than the measurement (0.6") for w in s.warnings), \
         s.warnings
-    assert not any("longer than the measurement" in w for w in scene(
-        tmp_path, f'file = "{TOP}"\ncover = "tile"\ncutoff = "0.2 um"', GRID).warnings)
+
+
+@pytest.mark.parametrize("cover", ["tile", "equivalent"])
+def test_a_cutoff_shorter_than_two_micro_cells_is_refused(tmp_path, cover):
+    """The roughness a filter at λc leaves (wavelengths below about λc) is finer than micro cells
+    over λc / 2: the face's surface was nearly flat (a user trial: Sq 0.0003 of 0.0103 um) and check
+    warned only of the gradient the grid missed. The block's 10 mm face in 2 x 16 cells: 312.5 um;
+    a cut-off of 2 cells passes."""
+    wide = 'file = "{}"\ncover = "{}"\npixel_size = "4 um"\ncutoff = "{}"'     # 1 mm wide: "equivalent" resolves it
+    with pytest.raises(SceneError) as info:
+        scene(tmp_path, wide.format(TOP, cover, "600 um"), GRID)
+    assert info.value.problems == ["roughness.cutoff: λc = 600 um must span at least 2 cells of the micro grid (625 "
+                                   "um): the roughness the filter leaves is finer than the grid, whose surface would "
+                                   "be nearly flat; use a finer micro.grid or a longer cutoff"]
+    s = scene(tmp_path, wide.format(TOP, cover, "625 um"), GRID)
+    from multiscale.workflows import rough      # local: imports DOLFINx
+    short = dataclasses.replace(s.roughness, cutoff=600e-6)     # the run's own check (a face check did not know)
+    with pytest.raises(InputError, match=r"^roughness.cutoff: λc = 600 um must span at least 2 cells of the micro "
+                                         r"grid \(625 um\)"):
+        rough.measured_face(short, s.micro, (2, 2), np.array([10e-3, 10e-3]), seed=0)
 
 
 @pytest.mark.skipif(SHARED is None, reason="../shared/data/topographies not here")

@@ -39,7 +39,7 @@ from multiscale.micro.layered import LayeredElastic, LayeredThermal
 from multiscale.micro.laws import LawSpec
 from multiscale.micro.plasticity import Hardness
 from multiscale.micro.surface import Surface, fractal_surface
-from multiscale.micro.topography import TopographyWarning, condition, cover, read_topography, zone_cells
+from multiscale.micro.topography import TopographyWarning, check_cutoff, condition, cover, read_topography, zone_cells
 from multiscale.micro.zones import ZoneGrid, cut_zones, generate_zones
 from multiscale.pool import MicroPool
 from multiscale.rough import RoughInterface, check_zone_size, interface_plane
@@ -90,6 +90,8 @@ def measured_face(r, m, counts, size, seed: int, log=None, prefix: str = "roughn
         measured = read_topography(r.file, r.channel, pixel_size=r.pixel_size, height_unit=r.height_unit,
                                    prefix=prefix)      # the scene's read, kept (read_topography)
         cells = zone_cells(m.grid, r.cover, size, counts, (measured.dx, measured.dy), DEFAULT_GRID, r.file.name)
+        if r.cutoff is not None:                # as the scene's check, for a face whose extent it did not know
+            check_cutoff(f"{prefix}cutoff", r.cutoff, *(size / np.multiply(counts, cells)), grid=True)
         done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix=prefix, despike=r.despike)
         surface, lines = cover(done.surface, (counts[0] * cells[0], counts[1] * cells[1]), tuple(size), r.cover,
                                seed, prefix=prefix, warn=not warned)
