@@ -540,6 +540,14 @@ def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_pa
         assert any(p.startswith(message) for p in info.value.problems), info.value.problems
     assert loads(torque.replace("friction = 0.4", 'friction_temperature = [["20 degC", 0.4], ["300 degC", 0.0]]'),
                  tmp_path).loading.torque == 30.0       # mu 0 only once hot: the run says so if it gets there
+    # two pads: one at mu 0 is braked by the other; both at 0 are refused, named (a review)
+    pads = (DEMOS / "brake_squeal.toml").read_text().replace('pressure = "10 bar"', 'braking_torque = "300 N m"')
+    assert loads(pads, DEMOS, overrides={"interfaces.inner_pad.friction": 0.0}).loading.torque == 300.0
+    with pytest.raises(SceneError) as info:
+        loads(pads, DEMOS, overrides={"interfaces.inner_pad.friction": 0.0, "interfaces.outer_pad.friction": 0.0})
+    assert any(p.startswith("loading.braking_torque: braking at 300 N m needs friction, but mu is 0 at the initial "
+                            "temperature, 20 degC, on every interface (inner_pad, outer_pad)")
+               for p in info.value.problems), info.value.problems
     block = GOOD.replace('pressure = "10 bar"', 'braking_torque = "30 N m"')
     with pytest.raises(SceneError) as info:
         loads(block, tmp_path)
