@@ -29,9 +29,9 @@ from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Sectio
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
 from multiscale.scene_plain import plain_speeds
-from multiscale.scene_rough import (law_top, measured_cover, micro_constants, nyquist, own_surface_tables, own_tables,
-                                    penalty_range, perfect_contact, plastic_everywhere, rough_rules, roughness_over,
-                                    thin_layer, zone_sizes)
+from multiscale.scene_rough import (law_top_warnings, measured_cover, micro_constants, nyquist, own_surface_tables,
+                                    own_tables, penalty_range, perfect_contact, plastic_everywhere, rough_rules,
+                                    roughness_over, thin_layer, zone_sizes)
 from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
@@ -423,7 +423,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         if not problems:
             problems += (nyquist(scene) + thin_layer(scene) + measured_cover(scene, warnings)
                          + perfect_contact(scene, warnings) + own_tables(scene, warnings))
-            warnings += micro_constants(scene) + zone_sizes(scene) + law_top(scene)
+            warnings += micro_constants(scene) + zone_sizes(scene) + law_top_warnings(scene)
     if scene.output is not None and scene.output.fields is not None:
         for f in scene.output.fields:
             missing = [e for e in OUTPUT_FIELDS[f] if e not in effects]

@@ -14,7 +14,7 @@ from multiscale.micro.topography import (TopographyWarning, beyond_measurement, 
                                          condition, covers, read_topography, zone_cells)
 from multiscale.micro.zones import THINNEST, ZoneGrid
 from multiscale.scene_cycle import largest_load_factor
-from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR
+from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR, P_MAX_PLASTIC
 
 FACET_AREA = 0.4   # median area of gmsh's interface triangles over h^2, h the size aimed at (0.37-0.43 on the demos)
 SHARED_MICRO = ("grid", "law_points", "model", "p_max", "tol", "partition_law", "heating", "heating_steps",
@@ -243,20 +243,31 @@ def plastic_everywhere(scene) -> list[str]:
         if H <= nominal else []
 
 
-def law_top(scene) -> list[str]:
-    """A warning of a ``micro.p_max`` at most the interfaces' ``nominal_pressure``: the zones then
-    press on average beyond the top of their laws, extrapolated linearly there (the run warned of it
-    only at its end; a user trial)."""
+def law_top_warnings(scene) -> list[str]:
+    """A warning of zone laws whose top is at most the interfaces' ``nominal_pressure``: the zones
+    then press on average beyond it, where a law is extrapolated linearly (the run warned of it only
+    at its end; a user trial). The top is the run's (``workflows.rough``): ``micro.p_max`` (one for
+    every rough interface), else ``P_MAX_FACTOR`` x the nominal pressure at load factor 1, and with
+    plasticity at most ``P_MAX_PLASTIC`` x the softer body's hardness."""
     bound = nominal_pressure(scene) if scene.has("roughness") and scene.rough_interfaces else None
     micro = scene.interface_settings(scene.rough_interfaces[0]).micro if bound is not None else None
-    if micro is None or micro.p_max is None or micro.p_max > bound[0]:
+    if micro is None:
         return []
-    peak = f" at the load profile's largest factor {bound[1]:.3g}" if bound[1] != 1 else ""
-    return [f"{micro_key(scene, scene.rough_interfaces[0])}.p_max = {micro.p_max:.3g} Pa, the top of the zone laws, "
-            f"is at most the interfaces' nominal pressure (loading.normal_force over them{peak}: at least "
-            f"{bound[0]:.3g} Pa): the zones will press beyond it on average, where a law is extrapolated linearly "
-            f"with the contact stiffness at its top; raise micro.p_max (without it: {P_MAX_FACTOR:g} x the nominal "
-            "pressure)"]
+    (nominal, factor), soft = bound, scene.softer_hardness if scene.has("plasticity") else None
+    tops = {"micro.p_max": (micro.p_max, "raise micro.p_max")} if micro.p_max is not None else \
+        {f"{P_MAX_FACTOR:g} x the nominal pressure at load factor 1 (no micro.p_max)":
+         (P_MAX_FACTOR * nominal / factor, "give micro.p_max")}
+    if soft is not None:
+        H = scene.materials[soft].value("hardness", scene.time.initial_temperature)
+        tops[f"{P_MAX_PLASTIC:g} x materials.{soft}.hardness"] = (P_MAX_PLASTIC * H, "the zones are near fully "
+                                                                  "plastic: raise the hardness or lower the load")
+    what, (top, fix) = min(tops.items(), key=lambda item: item[1][0])
+    if top > nominal:
+        return []
+    peak = f" at the load profile's largest factor {factor:.3g}" if factor != 1 else ""
+    return [f"the zone laws' top, {what} = {top:.3g} Pa, is at most the interfaces' nominal pressure "
+            f"(loading.normal_force over them{peak}: at least {nominal:.3g} Pa): the zones will press beyond it on "
+            f"average, where a law is extrapolated linearly with the contact stiffness at its top; {fix}"]
 
 
 def micro_key(scene, name: str) -> str:
@@ -331,8 +342,9 @@ def measured_cover(scene, warnings_out: list) -> list[str]:
     wavelength the face's micro grid resolves: the run's refusals (``topography.covers``,
     ``topography.check_resolved``) before meshing, for the faces whose extent the geometry knows then
     (``GeometrySpec.interface_extents``; the others are refused after meshing), and a filter
-    ``cutoff`` spans 2 of its pixels (``topography.check_cutoff``); a grid too coarse for the measured
-    gradient is warned about (``topography.coarse_grid``, into ``warnings_out``)."""
+    ``cutoff`` spans 2 of its pixels and 2 micro cells (``topography.check_cutoff``); a grid too
+    coarse for the measured gradient is warned about (``topography.coarse_grid``, into
+    ``warnings_out``)."""
     out = []
     for name in scene.rough_interfaces:
         s, size = scene.interface_settings(name), scene.geometry.spec.interface_extents.get(name)
@@ -363,7 +375,7 @@ def measured_cover(scene, warnings_out: list) -> list[str]:
             cell = [L / (z * c) for L, z, c in zip(size, s.micro.zones, cells)]
             if r.cutoff is not None:
                 try:
-                    check_cutoff(f"{prefix}cutoff", r.cutoff, *cell, grid=True)
+                    check_cutoff(f"{prefix}cutoff", r.cutoff, *cell, measured=measured.size)
                 except InputError as exc:
                     out.append(str(exc))
             if r.cover == "equivalent":

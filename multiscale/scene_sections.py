@@ -409,7 +409,8 @@ class Roughness:
     height_unit: float | None = key(Either(Quantity("length", gt=0), LengthUnit()),   # m per height unit ("um")
                                     absent="the file's unit; metres for a plain height matrix")
     detrend: str = key(Choice(tuple(DETREND)), default="plane")               # form removal
-    cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)), absent="no filter")  # m, Gaussian λc
+    cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)), absent="no filter")  # m, Gaussian λc,
+    #                                                                    of 2 pixels and 2 micro cells at least
     max_undefined: float = key(Quantity("dimensionless", ge=0, le=1), default=MAX_UNDEFINED)
     despike: float | None = key(Quantity("dimensionless", gt=0), absent=f"outliers warned of (k = {DESPIKE:g}), kept")
     cover: str = key(Choice(COVER), default="measured")

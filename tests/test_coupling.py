@@ -348,21 +348,32 @@ def test_rough_pin_on_disc_bookkeeping_and_outputs(straight):
     assert not json.loads((result.folder / "provenance.json").read_text())["warnings"]
 
 
-TOP_WARNING = ("micro.p_max = {} Pa, the top of the zone laws, is at most the interfaces' nominal pressure "
-               "(loading.normal_force over them: at least {} Pa): the zones will press beyond it on average, where a "
-               "law is extrapolated linearly with the contact stiffness at its top; raise micro.p_max (without it: "
-               "20 x the nominal pressure)")
+TOP_WARNING = ("the zone laws' top, {} Pa, is at most the interfaces' nominal pressure (loading.normal_force over "
+               "them{}: at least {} Pa): the zones will press beyond it on average, where a law is extrapolated "
+               "linearly with the contact stiffness at its top; {}")
 
 
 def test_check_warns_of_a_law_top_below_the_nominal_pressure():
-    """micro.p_max at most the nominal pressure (200 N over the pin's 20 mm box: at least 0.5 MPa; the
-    round face's 0.64 MPa): every zone's law is extrapolated on average, which the run said only at its
-    end (a user trial); check says it now. Just above the bound: nothing (a lower bound)."""
+    """The laws' top at most the nominal pressure (200 N over the pin's 20 mm box: at least 0.5 MPa;
+    the round face's 0.64 MPa): every zone's law is extrapolated on average, which the run said only
+    at its end (a user trial); check says it now, of micro.p_max, of the default 20 x the nominal
+    pressure under a load profile peaking above 20, and of 0.9 x the hardness with plasticity (a
+    review). Just above the bound: nothing (a lower bound)."""
     text = (Path(__file__).parents[1] / "demos" / "pin_on_disc.toml").read_text()
-    assert 'p_max = "30 MPa"' in text
+    assert 'p_max = "30 MPa"' in text and "ramp_steps = 2" in text
     low = loads(text.replace('p_max = "30 MPa"', 'p_max = "0.45 MPa"'), "demos")
-    assert TOP_WARNING.format("4.5e+05", "5e+05") in low.warnings
-    assert not any("p_max" in w for w in loads(text.replace('p_max = "30 MPa"', 'p_max = "0.55 MPa"'), "demos").warnings)
+    assert TOP_WARNING.format("micro.p_max = 4.5e+05", "", "5e+05", "raise micro.p_max") in low.warnings
+    assert not any("laws' top" in w for w in loads(text.replace('p_max = "30 MPa"', 'p_max = "0.55 MPa"'),
+                                                   "demos").warnings)
+    peak = text.replace('p_max = "30 MPa"\n', "").replace(
+        "ramp_steps = 2", 'ramp_steps = 2\nload_profile = [["0 s", 1], ["10 s", 25], ["30 s", 25]]')
+    assert TOP_WARNING.format("20 x the nominal pressure at load factor 1 (no micro.p_max) = 1e+07",
+                              " at the load profile's largest factor 25", "1.25e+07", "give micro.p_max") \
+        in loads(peak, "demos").warnings
+    plastic = text.replace('"roughness", "wear"]', '"roughness", "wear", "plasticity"]').replace(
+        "[materials.pin]", '[materials.pin]\nhardness = "0.54 MPa"', 1)
+    assert TOP_WARNING.format("0.9 x materials.pin.hardness = 4.86e+05", "", "5e+05", "the zones are near fully "
+                              "plastic: raise the hardness or lower the load") in loads(plastic, "demos").warnings
 
 
 def test_zone_pressures_above_the_laws_are_warned_about(tmp_path):
@@ -372,7 +383,7 @@ def test_zone_pressures_above_the_laws_are_warned_about(tmp_path):
     assert h["law_reach"].max() == pytest.approx(h["max_zone_pressure"].max() / 0.2e6, rel=1e-12)
     assert h["law_reach"].max() > 2
     record = json.loads((tmp_path / "low" / "provenance.json").read_text())
-    assert record["warnings"] == [TOP_WARNING.format("2e+05", "5e+05"),        # said by check, before the run
+    assert record["warnings"] == [TOP_WARNING.format("micro.p_max = 2e+05", "", "5e+05", "raise micro.p_max"),
                                   f"the zone pressures reached {h['law_reach'].max():.3g} times micro.p_max, the top "
                                   "of their laws: beyond it a law is extrapolated linearly, with the contact stiffness "
                                   "at the top; raise micro.p_max"]

@@ -78,11 +78,10 @@ def test_surface_command_prints_the_steps_and_surfacetopographys_sq(tmp_path, ca
     (["--cutoff", "1 nm"], "error: --cutoff: λc = 0.001 um must span at least 2 pixels (0.004688 um): top-1.top's pixels"),
     # ISO cut-offs are said in mm: "--cutoff 0.8" filtered at 0.8 m, "little is removed", and went on; with a
     # unit it is taken as meant (a user trial read the refusal as one of 0.8 m)
-    (["--cutoff", "0.8"], "error: --cutoff = '0.8': 0.8 m, longer than the measurement (0.0006 x 0.0006 mm); plain "
-                          'numbers are metres: did you mean "0.8 mm" (also longer)? ("0.8 m" filters at 0.8 m all '
-                          "the same)"),
-    (["--cutoff", "1e-6"], "error: --cutoff = '1e-6': 1e-06 m, longer than the measurement (0.0006 x 0.0006 mm); "
-                           'plain numbers are metres: did you mean "1e-6 mm"? ("1e-6 m" filters'),
+    (["--cutoff", "0.8"], "error: --cutoff = '0.8': 0.8 m, longer than the measurement (0.6 x 0.6 um); plain "
+                          'numbers are metres: give it a unit (give "0.8 m" to filter at 0.8 m anyway)'),
+    (["--cutoff", "2e-4"], "error: --cutoff = '2e-4': 0.0002 m, longer than the measurement (0.6 x 0.6 um); plain "
+                           'numbers are metres: did you mean "2e-4 mm"? (give "2e-4 m" to filter'),
 ])
 def test_surface_command_bad_options_are_one_line(capsys, args, message):
     assert main(["surface", str(TOP), "--figure", "none", *args]) == 2
@@ -553,11 +552,18 @@ def test_a_cutoff_shorter_than_two_micro_cells_is_refused(tmp_path, cover):
                                    "um): the roughness the filter leaves is finer than the grid, whose surface would "
                                    "be nearly flat; use a finer micro.grid or a longer cutoff"]
     s = scene(tmp_path, wide.format(TOP, cover, "625 um"), GRID)
+    assert not any("longer than the measurement" in w for w in s.warnings)      # 625 um of a 1.024 mm map
     from multiscale.workflows import rough      # local: imports DOLFINx
     short = dataclasses.replace(s.roughness, cutoff=600e-6)     # the run's own check (a face check did not know)
     with pytest.raises(InputError, match=r"^roughness.cutoff: λc = 600 um must span at least 2 cells of the micro "
                                          r"grid \(625 um\)"):
         rough.measured_face(short, s.micro, (2, 2), np.array([10e-3, 10e-3]), seed=0)
+    # at the bound of a quotient (3 mm in 10 cells: 3.0000000000000003e-4 m) it passes (a review); where 2
+    # cells are longer than the map, a longer cut-off cannot help: the message says the grid only (a review)
+    topography.check_cutoff("cutoff", 600e-6, 3e-3 / 10, 3e-3 / 10, measured=(1e-3, 1e-3))
+    with pytest.raises(InputError, match=r"use a finer micro.grid: 2 of its cells are longer than the "
+                                         r"measurement \(0.5 x 0.5 mm\)$"):
+        topography.check_cutoff("cutoff", 0.4e-3, 312.5e-6, 312.5e-6, measured=(0.5e-3, 0.5e-3))
 
 
 @pytest.mark.skipif(SHARED is None, reason="../shared/data/topographies not here")

@@ -137,18 +137,22 @@ def gaussian_filter(surface: Surface, cutoff: float) -> Surface:
     return _gaussian(surface, cutoff, cutoff)
 
 
-def check_cutoff(name: str, cutoff: float, dx: float, dy: float, pixels: str = "", grid: bool = False) -> None:
+def check_cutoff(name: str, cutoff: float, dx: float, dy: float, pixels: str = "", measured=None) -> None:
     """Raise ``InputError`` (naming ``name``) unless λc = ``cutoff`` [m] spans at least 2 pixels of
-    dx x dy [m] (``pixels``: whose, for the message), or with ``grid`` 2 cells of dx x dy of the
-    micro grid: the roughness the filter leaves, wavelengths below about λc, is finer than a coarser
-    grid, whose surface would be nearly flat (a user trial: Sq 0.0003 of 0.0103 um; check warned
-    of the gradient the grid missed, not of the cut-off)."""
+    dx x dy [m] (``pixels``: whose, for the message; to 1e-9, the sizes being quotients), or with
+    ``measured`` (the measurement's size (mx, my) [m]) 2 of the micro grid's cells of dx x dy: the
+    roughness the filter leaves, wavelengths below about λc, is finer than a coarser grid, whose
+    surface would be nearly flat (a user trial: Sq 0.0003 of 0.0103 um; check warned of the
+    gradient the grid missed, not of the cut-off)."""
     check_positive(name, cutoff)
-    if cutoff < 2 * max(dx, dy) and grid:
+    short = cutoff < 2 * max(dx, dy) * (1 - 1e-9)
+    if short and measured is not None:
+        fix = "a finer micro.grid or a longer cutoff" if 2 * max(dx, dy) <= min(measured) else \
+            f"a finer micro.grid: 2 of its cells are longer than {_sized('the measurement', measured)}"
         raise InputError(name, None, f"λc = {cutoff * 1e6:.4g} um must span at least 2 cells of the micro grid "
                          f"({2e6 * max(dx, dy):.4g} um): the roughness the filter leaves is finer than the grid, whose "
-                         "surface would be nearly flat; use a finer micro.grid or a longer cutoff")
-    if cutoff < 2 * max(dx, dy):
+                         f"surface would be nearly flat; use {fix}")
+    if short:
         raise InputError(name, None, f"λc = {cutoff * 1e6:.4g} um must span at least 2 pixels "
                          f"({2e6 * max(dx, dy):.4g} um)" + (f": {pixels}'s pixels" if pixels else ""))
 

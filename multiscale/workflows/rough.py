@@ -91,7 +91,7 @@ def measured_face(r, m, counts, size, seed: int, log=None, prefix: str = "roughn
                                    prefix=prefix)      # the scene's read, kept (read_topography)
         cells = zone_cells(m.grid, r.cover, size, counts, (measured.dx, measured.dy), DEFAULT_GRID, r.file.name)
         if r.cutoff is not None:                # as the scene's check, for a face whose extent it did not know
-            check_cutoff(f"{prefix}cutoff", r.cutoff, *(size / np.multiply(counts, cells)), grid=True)
+            check_cutoff(f"{prefix}cutoff", r.cutoff, *(size / np.multiply(counts, cells)), measured=measured.size)
         done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix=prefix, despike=r.despike)
         surface, lines = cover(done.surface, (counts[0] * cells[0], counts[1] * cells[1]), tuple(size), r.cover,
                                seed, prefix=prefix, warn=not warned)
