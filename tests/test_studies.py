@@ -203,11 +203,13 @@ def test_the_error_figure_draws_the_pareto_front_of_each_case(tmp_path, made):
 
 
 @pytest.mark.parametrize("times, errors", [((4.1, 4.3, 4.5, 4.7), (0.018, 0.016, 0.014, 0.012)),
+                                           ((1000.2, 1000.9, 1001.6, 1002.3), (0.0104, 0.0103, 0.0102, 0.0101)),
                                            ((0.9, 2, 4, 8), (0.3, 0.1, 0.05, 0.011)),
                                            ((1, 3, 30, 200), (0.8, 0.1, 0.02, 0.011))])
 def test_a_log_axis_of_the_error_figure_has_at_least_two_labels(tmp_path, made, times, errors):
     """Wall times 4.1 ... 4.7 s: no decade, 2, 3 or 5 fell on the log axis, which had no tick label
-    at all (a user trial); each axis now has at least two, each where its number is."""
+    at all (a user trial); each axis now has at least two, distinct (1000.2 ... 1002.3 s read
+    "1e+03" each: a review), each where its number is."""
     from multiscale.plots import studies as figures
     study = load_study(write(tmp_path, HERTZ.replace('errors = ["1 %", "5 %"]', 'errors = ["1 %"]')))
     rows = [Row(run, {"status": "ok", "wall_time": t, "metrics": {m: 1.0 for m in study.metrics}},
@@ -219,7 +221,7 @@ def test_a_log_axis_of_the_error_figure_has_at_least_two_labels(tmp_path, made, 
         lo, hi = axis.get_view_interval()
         ticks = [(t.get_loc(), t.label1.get_text()) for t in axis.get_major_ticks() + axis.get_minor_ticks()
                  if t.label1.get_text() and lo <= t.get_loc() <= hi]
-        assert len(ticks) >= 2, (axis.axis_name, ticks)
+        assert len(ticks) >= 2 and len({text for _, text in ticks}) == len(ticks), (axis.axis_name, ticks)
         for at, text in ticks:
             assert float(text) == pytest.approx(at, rel=5e-3)
 
@@ -918,7 +920,7 @@ def test_what_a_run_finds_is_said_by_the_study_its_report_and_table(tmp_path, ca
     err, out = capsys.readouterr()[::-1]
     assert err.count(notes[0]) == 1 and f"warning: study: run load = 1 MPa: {notes[0]}" in err
     assert "  2 runs warned of what they found while running: in the report and the warnings column" in out
-    assert [r["warnings"] for r in table(tmp_path / "results" / "study" / "results.csv")] == [notes[0]] * 2
+    assert [json.loads(r["warnings"]) for r in table(tmp_path / "results" / "study" / "results.csv")] == [list(notes)] * 2
     text = (tmp_path / "results" / "study" / "study.md").read_text()
     assert text.count(notes[0]) == 1 and f"- {notes[0]} (load = 1 MPa; load = 2 MPa)" in text
 
@@ -1011,24 +1013,30 @@ def test_a_scene_run_is_timed_by_its_own_record(tmp_path, monkeypatch):
     """A scene run's wall time is its provenance.json's, not its subprocess's: the start of Python
     and DOLFINx took 10 of 18 s, a coarser grid looked slower than the reference and the cheapest
     setting was the reference itself (a user trial). Its warnings beyond the scene's own are what it
-    found (a user trial: zone pressures beyond micro.p_max stayed in the run's log)."""
+    found (a user trial: zone pressures beyond micro.p_max stayed in the run's log), a failed run's
+    too (a review: one that diverged beyond the laws' top kept only its error)."""
     import subprocess
     from multiscale.io import History
     from multiscale.studies import scene_problem
-    work = tmp_path / "run"
+    from multiscale.studies.base import RunFailed
+    work, code = tmp_path / "run", [0]
 
     def ran(command, **options):         # the run's output, as multiscale.studies.scene_run writes it
         history = History()
         history.append(time=0.0, interface_force=100.0, newton_iterations=4.0)
-        history.write((work / "output").mkdir(parents=True) or work / "output" / "history.h5")
+        history.write((work / "output").mkdir(parents=True, exist_ok=True) or work / "output" / "history.h5")
         (work / "output" / "provenance.json").write_text(json.dumps({"total_wall_time_s": 7.34,
                                                                      "warnings": ["the scene's", "the run's"]}))
-        return subprocess.CompletedProcess(command, 0, "", "")
+        return subprocess.CompletedProcess(command, code[0], "", "ConvergenceError: diverged\n")
     monkeypatch.setattr(scene_problem.subprocess, "run", ran)
-    outcome = scene_problem.SceneProblem().run(scene_problem.SceneRun(ROOT / "demos" / "block_on_flat.toml",
-                                                                      warnings=("the scene's",)), work)
+    run = scene_problem.SceneRun(ROOT / "demos" / "block_on_flat.toml", warnings=("the scene's",))
+    outcome = scene_problem.SceneProblem().run(run, work)
     assert (outcome.wall_time, outcome.iterations, outcome.metrics["interface_force"]) == (7.34, 4, 100.0)
     assert outcome.warnings == ("the run's",)
+    code[0] = 1
+    with pytest.raises(RunFailed, match=r"^scene run failed \(exit 1\): ConvergenceError: diverged$") as info:
+        scene_problem.SceneProblem().run(run, work)
+    assert info.value.warnings == ("the run's",)
 
 
 def test_squeal_scene_metrics_from_the_mode_table(tmp_path):
@@ -1329,7 +1337,8 @@ def _cmdline(proc: Path) -> bytes:
 def test_records_of_another_shape_are_run_again(hertz_study, tmp_path, capsys):
     """Run records that are valid JSON of another shape (a list, a metric "x", a wall time "x"):
     the study ended in an AttributeError, TypeError or ValueError traceback and wrote no table (a
-    trial of odd files). A list or a wall time of text is taken as not done, like a torn file, and
+    trial of odd files). A list, a wall time of text or warnings that are no list of texts (a review)
+    are taken as not done, like a torn file, and
     runs again; a metric that is no number fails that run, saying so (--rerun-failed reruns it)."""
     import shutil
 
@@ -1340,17 +1349,16 @@ def test_records_of_another_shape_are_run_again(hertz_study, tmp_path, capsys):
     other = write(tmp_path, HERTZ.replace("[run]", f'[run]\nfolder = "{tmp_path}"') + "plots = false\n")
     study = load_study(other)
     bad = [lambda r: [1, 2, 3], lambda r: {**r, "metrics": {k: "x" for k in r["metrics"]}},
-           lambda r: {**r, "wall_time": "x"}]
+           lambda r: {**r, "wall_time": "x"}, lambda r: {**r, "warnings": None}]       # (a review: warnings null)
     for run, spoil in zip(study.runs, bad):
         p = runs / f"{run.key}.json"
         p.write_text(json.dumps(spoil(json.loads(p.read_text()))))
     capsys.readouterr()
     assert main(["study", str(other)]) == 1
-    assert "2 recorded before, 2 run now, 1 failed" in capsys.readouterr().out
+    assert "1 recorded before, 3 run now, 1 failed" in capsys.readouterr().out
     rows = table(tmp_path / "results.csv")
     assert [r["status"] for r in rows] == ["ok", "failed", "ok", "ok"]
     assert rows[1]["message"] == 'metric "contact_radius" is \'x\' (not a number)'
-
 
 
 def test_a_study_given_for_a_scene_and_a_scene_for_a_study_name_the_right_command(tmp_path, capsys):

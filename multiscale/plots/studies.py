@@ -114,12 +114,20 @@ def _plain_log(axis) -> None:
     """Plain numbers on a log axis, "0.4" and not "4 x 10^-1" (those overlapped on short decades),
     at least two of them: every decade on an axis spanning over two, and 2 and 5 times it over one,
     and 3 times it too over a factor 4; on a shorter one (4.1 ... 4.8 s, where no such number falls:
-    the axis was bare, a user trial) about four evenly spaced values. Call it once the view is final."""
+    the axis was bare, a user trial) about four evenly spaced values, with the digits their step
+    needs (1000.5 ... 1002 s read "1e+03" each with 3; a review). Call it once the view is final."""
     lo, hi = axis.get_view_interval()
     if hi <= 4 * lo:
         axis.set_major_locator(MaxNLocator(4))
         axis.set_minor_locator(NullLocator())
-        axis.set_major_formatter(FuncFormatter(lambda x, _: f"{x:.3g}"))
+
+        def even(x, _):            # the fewest digits that write every tick exactly
+            ticks = axis.get_majorticklocs()
+            step = float(np.min(np.diff(ticks))) if len(ticks) > 1 else x
+            digits = next((d for d in range(1, 16) if all(abs(float(f"{t:.{d}g}") - t) < 1e-6 * step for t in ticks)),
+                          16)
+            return f"{x:.{digits}g}"
+        axis.set_major_formatter(FuncFormatter(even))
         return
     shown = (1,) if hi > 100 * lo else (1, 2, 5) if hi > 10 * lo else (1, 2, 3, 5)
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from multiscale.schema import Context, suggest
 
-__all__ = ["Outcome", "Problem", "jsonable"]
+__all__ = ["Outcome", "Problem", "RunFailed", "jsonable"]
 
 
 @dataclass
@@ -22,7 +22,16 @@ class Outcome:
     converged: bool = True        # every solve reached its tolerance
     wall_time: float | None = None   # s, the run's own time where the problem knows it better than
     #                                  the worker's clock (a scene run: without its process's start-up)
-    warnings: tuple = ()          # what the run found, beyond its inputs' warnings (``Study.warnings``)
+    warnings: tuple = ()          # what the run found that the study did not say before it ran (``Study.warnings``)
+
+
+class RunFailed(RuntimeError):
+    """A run that failed, with what it had found until then (``Outcome.warnings``: a scene run that
+    diverged after its zones pressed beyond the laws' top kept only its error; a review)."""
+
+    def __init__(self, message: str, warnings=()):
+        super().__init__(message)
+        self.warnings = tuple(warnings)
 
 
 class Problem:

@@ -46,8 +46,11 @@ def run_studies(paths, *, rerun_failed: bool = False, report_folder=None, proces
             if rank == 0:               # end before; then the old report stayed beside the new tables: a user trial)
                 rows = collect(study)
                 csv_path, _ = write_tables(study, rows)
-                md = report(study, rows, command)
-                print(f"{study.name}: the runs that ended are in {csv_path} and {md} (the others: status missing)",
+                try:                    # (an error of the report replaced the interrupt, its exit code 130: a review)
+                    md = f" and {report(study, rows, command)}"
+                except Exception as exc:      # the tables are written; the interrupt goes on
+                    md = f" (no report: {type(exc).__name__}: {exc})"
+                print(f"{study.name}: the runs that ended are in {csv_path}{md} (the others: status missing)",
                       file=sys.stderr, flush=True)
             raise
         if rank != 0:

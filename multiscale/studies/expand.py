@@ -31,6 +31,11 @@ class StudyRun:
     raw: dict         # fixed and swept raw values, as the problem parses them
     shown: dict       # swept knob -> the value as the study file wrote it (for tables and plots)
 
+    @property
+    def text(self) -> str:
+        """The run in messages and reports: "load = 1 MPa, grid = 64" (its key without knobs)."""
+        return ", ".join(f"{k} = {v}" for k, v in self.shown.items()) or self.key
+
 
 @dataclass(frozen=True)
 class Study:

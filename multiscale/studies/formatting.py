@@ -5,7 +5,7 @@ import math
 import re
 import time
 
-__all__ = ["metric_heading", "now", "number_text", "percent", "value_text"]
+__all__ = ["metric_heading", "now", "number_text", "percent", "value_text", "warning_kind"]
 
 
 # unit spellings of the study files -> their symbols in tables and plots
@@ -45,3 +45,12 @@ def percent(v: float) -> str:
 def now() -> str:
     """The local time, as records and reports show it."""
     return time.strftime("%Y-%m-%d %H:%M:%S")
+
+
+NUMBER = re.compile(r"[-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?")
+
+
+def warning_kind(line: str) -> str:
+    """A warning with its numbers as "#": the runs of a sweep warn alike with their own numbers
+    ("the zone pressures reached 4.3 times micro.p_max"), said and listed once as one kind."""
+    return NUMBER.sub("#", line)

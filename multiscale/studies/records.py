@@ -52,8 +52,11 @@ def metric_problem(metrics: dict, names) -> str | None:
 
 def _well_formed(record) -> bool:
     """Whether a record read back has the shape a run writes: a table whose metrics are a table and
-    whose times, memory and iterations are numbers (a record edited or written by hand may not be)."""
+    whose times, memory and iterations are numbers, whose warnings a list of texts (a record edited
+    or written by hand may not be)."""
     if not isinstance(record, dict) or not isinstance(record.get("metrics", {}), dict):
+        return False
+    if not (isinstance(record.get("warnings", []), list) and all(isinstance(w, str) for w in record.get("warnings", []))):
         return False
     return all(isinstance(record.get(k, 0), (int, float)) and not isinstance(record.get(k, 0), bool) for k in NUMBERS)
 

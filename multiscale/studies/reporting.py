@@ -10,7 +10,7 @@ import numpy as np
 
 from multiscale.io import duration
 from multiscale.studies.expand import Study
-from multiscale.studies.formatting import metric_heading, now, number_text, percent, value_text
+from multiscale.studies.formatting import metric_heading, now, number_text, percent, value_text, warning_kind
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.records import JIT_SHARE
 from multiscale.studies.results import MISSING, Row, cheapest, crossings, knob_unit, reference_text, sample_std
@@ -67,7 +67,7 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
         lines += _average_table(study, ok)
     lines += ["## Runs", ""] + _runs_table(study, rows)
     if failed:
-        lines += ["", "Failed runs:", ""] + [f"- {_label_text(r)}: {r.record.get('error', '')}" for r in failed]
+        lines += ["", "Failed runs:", ""] + [f"- {r.run.text}: {r.record.get('error', '')}" for r in failed]
     if pngs:
         lines += ["", "## Plots", ""] + [f"![{p.stem}]({p.name})" for p in pngs]
     path = folder / f"{study.name}.md"
@@ -77,17 +77,19 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
 
 def _found_warnings(rows, shown: int = 3) -> list[str]:
     """What the runs warned of while running (zone pressures beyond the laws' top, outliers of a
-    measured file), each warning once with the runs that gave it (the first ``shown`` of them)."""
+    measured file), each kind once (``warning_kind``: the runs' own numbers aside) as its first run
+    gave it, with the runs that gave it (the first ``shown`` of them)."""
     found = {}
     for r in rows:
         for line in r.record.get("warnings", ()):
-            found.setdefault(line, []).append(_label_text(r) or r.run.key)
+            found.setdefault(warning_kind(line), []).append((line, r.run.text))
     if not found:
         return []
     lines = ["Warnings of the runs (what they found while running; column `warnings` of results.csv):", ""]
-    for line, runs in found.items():
+    for runs in found.values():
         more = f" and {len(runs) - shown} more" if len(runs) > shown else ""
-        lines.append(f"- {line} ({'; '.join(runs[:shown])}{more})")
+        own = " (the numbers of the first; each run's in results.csv)" if len({t for t, _ in runs}) > 1 else ""
+        lines.append(f"- {runs[0][0]} ({'; '.join(r for _, r in runs[:shown])}{more}){own}")
     return lines + [""]
 
 
@@ -128,10 +130,6 @@ def _memory(record: dict) -> str:
     """Peak memory [MB] and, in brackets, what the run added to its process's baseline."""
     peak, base = record.get("peak_memory_mb", math.nan), record.get("base_memory_mb", math.nan)
     return "n/a" if not math.isfinite(peak) else f"{peak:.0f}" + (f" (+{peak - base:.0f})" if math.isfinite(base) else "")
-
-
-def _label_text(row: Row) -> str:
-    return ", ".join(f"{k} = {v}" for k, v in row.run.shown.items())
 
 
 def _cheapest_table(study, rows) -> list[str]:

@@ -23,7 +23,7 @@ from tqdm import tqdm
 from multiscale.errors import MultiscaleError
 from multiscale.io import on_root
 from multiscale.studies.expand import Study, StudyRun
-from multiscale.studies.formatting import now
+from multiscale.studies.formatting import now, warning_kind
 from multiscale.studies.records import FAILED, json_default, read_json, read_records, record_path, write_json
 
 __all__ = ["ExecStats", "execute", "world"]
@@ -101,10 +101,10 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
                     tqdm.write(f"warning: {study.name}: {record['error'].split('; available:')[0]}; every run "
                                "will lack it: stop (Ctrl-C), correct the study's metrics and start again (finished "
                                "runs are kept)", file=sys.stderr)
-                for line in [w for w in dict.fromkeys(record.get("warnings", ())) if w not in said]:
-                    said.add(line)                        # each once, with the first run that found it
-                    tqdm.write(f"warning: {study.name}: run {', '.join(f'{k} = {v}' for k, v in run.shown.items())}: "
-                               f"{line}", file=sys.stderr)
+                for line in record.get("warnings", ()) if rank == 0 else ():   # (the others: in the report)
+                    if warning_kind(line) not in said:    # each kind once, with the first run that found it
+                        said.add(warning_kind(line))
+                        tqdm.write(f"warning: {study.name}: run {run.text}: {line}", file=sys.stderr)
                 log = study.folder / "runs" / f"{run.key}.log"
                 if log.is_file() and not log.stat().st_size:
                     log.unlink()

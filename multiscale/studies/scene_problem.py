@@ -18,7 +18,7 @@ from multiscale.errors import MultiscaleError, SceneError
 from multiscale.io import History, unit_of
 from multiscale.scene import load
 from multiscale.schema import suggest
-from multiscale.studies.base import Outcome, Problem, jsonable, unit_in
+from multiscale.studies.base import Outcome, Problem, RunFailed, jsonable, unit_in
 
 __all__ = ["SQUEAL_METRICS", "SceneProblem", "SceneRun", "failure_line", "history_metrics", "squeal_metrics"]
 
@@ -150,15 +150,20 @@ class SceneProblem(Problem):
         if params.ranks > 1:
             mpiexec = Path(sys.executable).with_name("mpiexec")
             command = [str(mpiexec) if mpiexec.exists() else "mpiexec", "-n", str(params.ranks)] + command
+        (out / "provenance.json").unlink(missing_ok=True)      # a retried run's is not this one's
         done = subprocess.run(command, capture_output=True, text=True)
         (Path(workdir) / "scene_run.log").write_text(done.stdout + done.stderr)
-        if done.returncode != 0:
-            raise RuntimeError(f"scene run failed (exit {done.returncode}): {failure_line(done.stderr or done.stdout)}")
-        record = json.loads((out / "provenance.json").read_text())
-        own = record.get("total_wall_time_s")     # (the process's start-up, 10 of 18 s, made a coarser grid
-        #                                           slower than the reference and the cheapest setting the reference)
+        try:
+            record = json.loads((out / "provenance.json").read_text())
+        except (OSError, ValueError):                         # a run that failed before writing it
+            record = {}
         found = tuple(w for w in record.get("warnings", ()) if w not in params.warnings)   # (only in its log before:
         #                                           zone pressures beyond micro.p_max unseen in the study; a user trial)
+        if done.returncode != 0:
+            raise RunFailed(f"scene run failed (exit {done.returncode}): {failure_line(done.stderr or done.stdout)}",
+                            found)
+        own = record.get("total_wall_time_s")     # (the process's start-up, 10 of 18 s, made a coarser grid
+        #                                           slower than the reference and the cheapest setting the reference)
         if (out / "modes.csv").exists():
             return Outcome(squeal_metrics(out / "modes.csv"), 0, True, own, found)
         history = History.read(out / "history.h5")

@@ -134,7 +134,7 @@ def run_task(task: dict) -> int:
     except Exception as exc:       # recorded, never raised: the study goes on
         text = str(exc).strip().splitlines()
         record.update(status=FAILED, error=f"{type(exc).__name__}: {text[0] if text else ''}".strip(),
-                      traceback=traceback.format_exc())
+                      traceback=traceback.format_exc(), warnings=list(getattr(exc, "warnings", ())))
     record["finished"] = now()
     record.setdefault("peak_memory_mb", _peak_mb())
     write_json(Path(task["record"]), record)
