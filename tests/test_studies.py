@@ -1372,3 +1372,20 @@ def test_a_study_given_for_a_scene_and_a_scene_for_a_study_name_the_right_comman
     assert main(["study", str(ROOT / "demos" / "block_on_flat.toml")]) == 2
     assert capsys.readouterr().err == ("error: block_on_flat.toml: a scene file (effects = [...], [geometry]), not a "
                                        "study: give it to `multiscale check` or `multiscale run`\n")
+
+
+def test_warnings_that_differ_in_their_numbers_are_one_kind(tmp_path, capsys):
+    """The zone-pressure warning of each run of a sweep has its own number: a 30-run sweep said it
+    30 times (a review). One kind, said with its first run; the report lists the runs of each kind."""
+    from multiscale.studies.formatting import warning_kind
+    from multiscale.studies.reporting import report
+    assert warning_kind("reached 4.3 times p_max = 2e+05 Pa, -1.5e-3 and .5") == "reached # times p_max = # Pa, # and #"
+    study = load_study(write(tmp_path, HERTZ + "plots = false\n"))
+    said = ["the zone pressures reached {} times micro.p_max", "outliers in 'a.x3p'"]
+    rows = [Row(run, {"status": "ok", "wall_time": 1.0, "metrics": {m: 1.0 for m in study.metrics},
+                      "warnings": [said[0].format(k + 1.5)] + [said[1]] * (k == 2)})
+            for k, run in enumerate(study.runs)]
+    text = report(study, rows).read_text()
+    assert ("- the zone pressures reached 1.5 times micro.p_max (grid = 12; grid = 16; grid = 24 and 1 more) (the "
+            "numbers of the first; each run's in results.csv)") in text
+    assert "- outliers in 'a.x3p' (grid = 24)\n" in text and text.count("zone pressures") == 1
