@@ -789,8 +789,7 @@ def test_the_inputs_warnings_are_said_once_with_their_runs(tmp_path, capsys):
     swept = load_study(write(tmp_path, HERTZ.replace("grid = [12, 16, 24, 32]", 'E = ["1 Pa", "2 Pa", "4 GPa"]')
                              .replace("[fixed]", "[fixed]\ngrid = 12")))
     assert swept.warnings == ('E = "1 Pa": 1 Pa is outside the plausible range 100000 to 1.2e+12 Pa: check the value '
-                              'and its unit (run E = 1 Pa)', 'E = "2 Pa": 2 Pa is outside the plausible range 100000 '
-                              'to 1.2e+12 Pa: check the value and its unit (run E = 2 Pa)')
+                              'and its unit (the numbers of its first run) (run E = 1 Pa; E = 2 Pa)',)   # one kind
     path = write(tmp_path, HERTZ.replace("grid = [12, 16, 24, 32]", "grid = [12, 16]")
                  .replace('radius = "10 mm"', 'radius = "10 mm"\nE = 1').replace("processes = 2", "processes = 1"))
     assert main(["study", str(path)]) == 0
@@ -862,7 +861,7 @@ def test_an_interrupted_study_writes_the_table_of_the_runs_that_ended(tmp_path, 
     assert [r["status"] for r in rows] == ["ok", "missing", "missing", "missing"]
     assert float(rows[0]["approach"]) > 0 and rows[1]["message"] == "not run"
     text = md.read_text()
-    assert "- Runs: 1 ok, 0 failed, **3 not run: the study was stopped before them** (run it again" in text
+    assert "- Runs: 1 ok, 0 failed, **3 not run or cut off: the study was stopped** (run it again" in text
     assert "Failed runs:" not in text
 
 
@@ -923,6 +922,10 @@ def test_what_a_run_finds_is_said_by_the_study_its_report_and_table(tmp_path, ca
     assert [json.loads(r["warnings"]) for r in table(tmp_path / "results" / "study" / "results.csv")] == [list(notes)] * 2
     text = (tmp_path / "results" / "study" / "study.md").read_text()
     assert text.count(notes[0]) == 1 and f"- {notes[0]} (load = 1 MPa; load = 2 MPa)" in text
+    # the warning's advice, despike = 7, is a parameter of the problem (it was refused: a user trial)
+    path.write_text(path.read_text().replace('file = "spiky.sdf"', 'file = "spiky.sdf"\ndespike = 7'))
+    assert main(["study", str(path)]) == 0
+    assert [r["warnings"] for r in table(tmp_path / "results" / "study" / "results.csv")] == ["", ""]
 
 
 def test_the_study_package_leaves_its_worker_to_runpy():
@@ -1014,14 +1017,17 @@ def test_a_scene_run_is_timed_by_its_own_record(tmp_path, monkeypatch):
     and DOLFINx took 10 of 18 s, a coarser grid looked slower than the reference and the cheapest
     setting was the reference itself (a user trial). Its warnings beyond the scene's own are what it
     found (a user trial: zone pressures beyond micro.p_max stayed in the run's log), a failed run's
-    too (a review: one that diverged beyond the laws' top kept only its error)."""
+    too (a review: one that diverged beyond the laws' top kept only its error). Each run starts in an
+    empty output folder: what a run killed by Ctrl-C left there was refused by the next one's output
+    checks, and the study could not go on (a user trial)."""
     import subprocess
     from multiscale.io import History
     from multiscale.studies import scene_problem
     from multiscale.studies.base import RunFailed
-    work, code = tmp_path / "run", [0]
+    work, code, found = tmp_path / "run", [0], []
 
     def ran(command, **options):         # the run's output, as multiscale.studies.scene_run writes it
+        found.append(sorted(p.name for p in (work / "output").glob("*")))
         history = History()
         history.append(time=0.0, interface_force=100.0, newton_iterations=4.0)
         history.write((work / "output").mkdir(parents=True, exist_ok=True) or work / "output" / "history.h5")
@@ -1033,10 +1039,11 @@ def test_a_scene_run_is_timed_by_its_own_record(tmp_path, monkeypatch):
     outcome = scene_problem.SceneProblem().run(run, work)
     assert (outcome.wall_time, outcome.iterations, outcome.metrics["interface_force"]) == (7.34, 4, 100.0)
     assert outcome.warnings == ("the run's",)
+    (work / "output" / "checkpoint.h5").write_bytes(b"killed")       # a run stopped by Ctrl-C
     code[0] = 1
     with pytest.raises(RunFailed, match=r"^scene run failed \(exit 1\): ConvergenceError: diverged$") as info:
         scene_problem.SceneProblem().run(run, work)
-    assert info.value.warnings == ("the run's",)
+    assert info.value.warnings == ("the run's",) and found == [[], []]
 
 
 def test_squeal_scene_metrics_from_the_mode_table(tmp_path):
@@ -1389,3 +1396,24 @@ def test_warnings_that_differ_in_their_numbers_are_one_kind(tmp_path, capsys):
     assert ("- the zone pressures reached 1.5 times micro.p_max (grid = 12; grid = 16; grid = 24 and 1 more) (the "
             "numbers of the first; each run's in results.csv)") in text
     assert "- outliers in 'a.x3p' (grid = 24)\n" in text and text.count("zone pressures") == 1
+
+
+def test_a_study_stopped_before_its_reference_run_says_so(tmp_path, made):
+    """A study stopped before its reference run: the rows said "reference run failed", the figure
+    "error 0 in every run: equal to the reference" and the cost table "none of the runs" at every
+    error (a user trial). Now the reference run is "not run", and there is no error to judge."""
+    from multiscale.studies.records import record_path, write_json
+    from multiscale.studies.reporting import report
+    from multiscale.studies.results import collect
+    study = load_study(write(tmp_path, HERTZ.replace('kind = "analytic"', 'kind = "run"\nrun = {grid = 32}')))
+    (study.folder / "runs").mkdir(parents=True)
+    for run in study.runs[:2]:                               # grids 12 and 16 ended, 24 and 32 did not
+        write_json(record_path(study, run), {"key": run.key, "status": "ok", "wall_time": 1.0, "label": run.label,
+                                             "metrics": {m: 1.0 for m in study.metrics}})
+    rows = collect(study)
+    assert [(r.record["status"], r.note) for r in rows] == [("ok", "reference run not run")] * 2 + [("missing", "")] * 2
+    text = report(study, rows).read_text()
+    assert "## What accuracy costs\n\nNo run has an error to judge: reference run not run.\n" in text
+    assert "none of the runs" not in text and "**2 not run or cut off: the study was stopped**" in text
+    texts = [t.get_text() for fig, axes in made for ax in axes.ravel() for t in ax.texts]
+    assert "no error: the reference\nhas no value of it" in texts and not any("equal to the reference" in t for t in texts)

@@ -90,7 +90,8 @@ def _plot_pareto(study, ok, folder):
                 _plain_log(axis)
         ax.set(xlabel="wall time [s]", ylabel=f"relative error of {m}", title=f"error of {m} against cost")
         ax.grid(True, which="both", alpha=0.25)
-        ax.legend(fontsize=7)
+        if ax.get_legend_handles_labels()[0]:       # (else matplotlib warned "No artists with labels")
+            ax.legend(fontsize=7)
     if not drawn:
         plt.close(fig)
         return None
@@ -187,9 +188,10 @@ def _plot_axis(study, ok, axis, folder, found):
         if kind == "error":
             if any(np.isfinite(np.asarray(line.get_ydata(), float)).any() for line in ax.get_lines()):
                 ax.set_yscale("log")
-            else:            # a metric the knob does not change: no error to draw on a log axis (it raised)
-                ax.text(0.5, 0.5, "error 0 in every run:\nequal to the reference", transform=ax.transAxes,
-                        ha="center", va="center")
+            else:            # a metric the knob does not change: no error to draw on a log axis (it raised);
+                zero = any(r.errors.get(m) == 0 for r in ok)    # or no reference value (its run not run: a trial)
+                ax.text(0.5, 0.5, "error 0 in every run:\nequal to the reference" if zero else
+                        "no error: the reference\nhas no value of it", transform=ax.transAxes, ha="center", va="center")
             for tol in study.report.errors:
                 ax.axhline(tol, color="gray", ls="--", lw=0.8)
         if kind == "value" and m in study.judged:        # calibration: the measured value, and where it is met

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from multiscale.errors import SceneError, read_toml_text, toml_problem
 from multiscale.schema import Bad, Context, Integer, Quantity, fields_of, read, show, suggest
-from multiscale.studies.formatting import value_text
+from multiscale.studies.formatting import value_text, warning_kind
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.spec import RANGE_KEYS, ReportOptions, Reference, RunOptions, StudyFile, is_range
 from multiscale.units import KINDS, VALUE, UnitError, parse_unit
@@ -350,7 +350,9 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple[tuple, tuple]:
     """The runs of the product of the groups, each parsed by the problem and named by its hash, and
     the warnings of their inputs; the problems and warnings each once with the runs they concern
     (before: the warnings only in each run's log, a scene study at 1 Pa reported "0 failed"; a
-    problem of the fixed values once per run, 12 times: a user trial)."""
+    problem of the fixed values once per run, 12 times: a user trial); a warning whose runs differ in
+    its numbers only, once too (``formatting.warning_kind``: the p_max warning of each load of a
+    sweep; a user trial), as its first run gives it."""
     runs, seen, wrong, warned, count = [], {}, {}, {}, 0
     for count, combo in enumerate(itertools.product(*groups), 1):
         swept = {k: v for part in combo for k, v in part.items()}
@@ -359,9 +361,12 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple[tuple, tuple]:
         local = Context(directory=ctx.directory)
         params = problem.parse(raw, "", local, **extra)
         where = ", ".join(f"{k} = {value_text(swept[k])}" for k in knobs)
-        for lines, into in ((local.problems, wrong), (local.warnings, warned)):
-            for line in lines:
-                into.setdefault(line, []).append(where)
+        for line in local.problems:
+            wrong.setdefault(line, []).append(where)
+        for line in local.warnings:
+            lines, wheres = warned.setdefault(warning_kind(line), ([], {}))
+            lines.append(line)
+            wheres[where] = None
         if local.problems:
             continue
         ident = json.dumps({"problem": f.problem, "params": problem.key(params)}, sort_keys=True)
@@ -372,7 +377,9 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple[tuple, tuple]:
         seen[digest] = where
         runs.append(StudyRun(digest, label, raw, {k: value_text(swept[k]) for k in knobs}))
     ctx.problems.extend(_with_runs(wrong, count))
-    return tuple(runs), tuple(_with_runs(warned, count))
+    kinds = {lines[0] + (" (the numbers of its first run)" if len(set(lines)) > 1 else ""): list(wheres)
+             for lines, wheres in warned.values()}
+    return tuple(runs), tuple(_with_runs(kinds, count))
 
 
 def _with_runs(lines: dict, total: int) -> list[str]:

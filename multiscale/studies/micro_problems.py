@@ -29,6 +29,7 @@ from multiscale.micro.heating import SteadyHeating, TransientHeating
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.laws import LawSpec, compute_laws
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
+from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.surface import Surface, fractal_surface
 from multiscale.micro.topography import DETREND, condition, read_topography
 from multiscale.micro.wear import simulate_wear
@@ -224,12 +225,14 @@ def _rough_contact(p: RoughContactParams) -> Outcome:
 class MeasuredContactParams:
     """A measured topography (an instrument file, read and conditioned as ``multiscale surface``
     does: ``detrend`` form removed, optionally filtered at ``cutoff``, undefined points filled; the
-    isolated patch it is, with its own pixel sizes) on an elastic half-space, pressed by a rigid
-    flat to the mean pressure ``load`` (FFT-BEM: ``solve_contact`` of the conditioned ``Surface``)."""
+    isolated patch it is, with its own pixel sizes; outliers warned of, or removed at ``despike``)
+    on an elastic half-space, pressed by a rigid flat to the mean pressure ``load`` (FFT-BEM:
+    ``solve_contact`` of the conditioned ``Surface``)."""
 
     file: Path = key(FilePath(base="the study file"), required=True)
     detrend: str = key(Choice(tuple(DETREND)), default="plane")
     cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)))   # m, Gaussian λc
+    despike: float | None = key(Quantity("dimensionless", gt=0), absent=f"outliers warned of (k = {DESPIKE:g}), kept")
     E: float = key(MODULUS, default=4e9)
     nu: float = key(_POISSON, default=0.15)
     load: float = key(Quantity("pressure", gt=0, plausible=(1e3, 5e9)), default=5e6)   # Pa, mean pressure
@@ -241,7 +244,8 @@ class MeasuredContactParams:
 def _measured_contact(p: MeasuredContactParams) -> Outcome:
     """Contact of a measured topography at one mean pressure (FFT-BEM on its isolated patch)."""
     measured = read_topography(p.file)
-    conditioned = condition(measured, p.detrend, p.cutoff)
+    conditioned = condition(measured, p.detrend, p.cutoff, despike=p.despike)   # (the warning offered "despike",
+    #                                                                              which the study refused: a trial)
     r = solve_contact(conditioned.surface, kernel=HalfSpace.from_materials(p.E, p.nu), load=p.load,
                       **({"tol": p.tol} if p.tol else {}))
     return Outcome({"approach": float(r.approach), "area_fraction": float(r.area_fraction)},

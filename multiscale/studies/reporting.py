@@ -49,7 +49,7 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
               f"- Reference: {reference_text(study)}"
               + ("; error = |m − m_ref| / |m_ref|" if study.reference else ""),
               f"- Runs: {len(ok)} ok, {len(failed)} failed"
-              + (f", **{missing} not run: the study was stopped before them** (run it again for them; the runs "
+              + (f", **{missing} not run or cut off: the study was stopped** (run it again for them; the runs "
                  "that ended are kept)" if missing else "") + f"; {elapsed(sum(r.record.get('wall_time', 0) for r in rows))} "
               f"of run wall time in all (failed runs included).{timing}",
               _code_line(rows),
@@ -59,7 +59,7 @@ def report(study: Study, rows: list[Row], command: str = "") -> Path:
         lines += ["Warnings of the runs' inputs:", ""] + [f"- {line}" for line in study.warnings] + [""]
     lines += _found_warnings(rows)
     if study.reference is not None and ok:
-        lines += _cheapest_table(study, rows)
+        lines += _cheapest_table(study, rows, missing)
     found = crossings(study, rows)
     if found:
         lines += _crossing_table(study, found)
@@ -132,13 +132,19 @@ def _memory(record: dict) -> str:
     return "n/a" if not math.isfinite(peak) else f"{peak:.0f}" + (f" (+{peak - base:.0f})" if math.isfinite(base) else "")
 
 
-def _cheapest_table(study, rows) -> list[str]:
+def _cheapest_table(study, rows, missing: int = 0) -> list[str]:
+    """The cheapest setting meeting each stated error (``results.cheapest``), of the runs that ended
+    (``missing``: those a stopped study did not run); a reason where no run has an error."""
+    if not any(math.isfinite(r.max_error) for r in rows if r.ok):     # (the table said "none of the runs" for
+        why = next((r.note for r in rows if r.ok and r.note), "no reference value")   # every error: a user trial)
+        return ["## What accuracy costs", "", f"No run has an error to judge: {why}.", ""]
     knobs = [k for k in study.knobs if k not in study.cases]
     head = ["error ≤"] + list(study.cases) + knobs + ["wall time [s]", "peak memory [MB]", "worst error", "time / base"]
     samples = (f" over every sample of {', '.join(study.averaged)} (its wall time their mean)"
                if study.averaged else "")
     lines = ["## What accuracy costs", "",
-             f"The cheapest setting (least wall time) whose worst error over the metrics"
+             (f"Of the runs that ended ({missing} not run): t" if missing else "T") + "he cheapest setting (least "
+             f"wall time) whose worst error over the metrics"
              f"{' with a reference' if study.unjudged else ''}{samples} meets each "
              "stated error; 'time / base' compares it with " + ("the reference run" if study.reference.kind == "run"
                                                                 else "the most expensive setting") + ".", "",

@@ -108,7 +108,7 @@ def collect(study: Study) -> list[Row]:
             target = by_key[reference_run(study.runs, row.run.label, want, study.axes).key]
             values = target.record["metrics"] if target.ok else {}
             if not target.ok:
-                row.note = "reference run failed"
+                row.note = "reference run not run" if target.record.get("status") == MISSING else "reference run failed"
             elif target is row:
                 row.note, row.is_reference = "reference run", True
         for m in study.judged:

@@ -6,6 +6,7 @@ from __future__ import annotations
 import hashlib
 import json
 import re
+import shutil
 import subprocess
 import sys
 from dataclasses import dataclass, field
@@ -150,7 +151,9 @@ class SceneProblem(Problem):
         if params.ranks > 1:
             mpiexec = Path(sys.executable).with_name("mpiexec")
             command = [str(mpiexec) if mpiexec.exists() else "mpiexec", "-n", str(params.ranks)] + command
-        (out / "provenance.json").unlink(missing_ok=True)      # a retried run's is not this one's
+        shutil.rmtree(out, ignore_errors=True)   # a run killed or failed before (the study stopped by Ctrl-C, or
+        #   --rerun-failed) left files there that its output checks refused to overwrite: it never ran again (a
+        #   user trial); the study runs it anew, into a folder of its own
         done = subprocess.run(command, capture_output=True, text=True)
         (Path(workdir) / "scene_run.log").write_text(done.stdout + done.stderr)
         try:
