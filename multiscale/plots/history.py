@@ -175,9 +175,11 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
     areas = [k for k in cols if k.startswith("real_contact_area_")]          # one per rough interface
     area = 1e6 if np.nanmax(np.abs(cols.get("real_contact_area", [0.0])), initial=0.0) > 1e-8 else 1e12  # mm² or µm²
     volume = 1e9 if np.nanmax(np.abs(cols.get("wear_volume", [0.0])), initial=0.0) > 1e-12 else 1e18   # mm³ or µm³
-    panels = [("max contact pressure [MPa]", [("max_pressure", "macro, largest facet"),
-                                               ("max_zone_pressure", "macro, largest zone (mean)"),
-                                               ("micro_max_pressure", "micro, largest local")], 1e-6, 0),
+    after, before = (" (after wear)", " (before)") if "wear_volume" in cols else ("", "")   # a row's two states (a
+    panels = [("max contact pressure [MPa]", [("max_pressure", "macro facet" + after),       # zone above every facet
+                                               ("max_zone_pressure", "macro zone mean" + before),   # puzzled a user
+                                               ("micro_max_pressure", "micro local" + before)],     # trial: results.rst
+               1e-6, 0),                                                                           # "When in the step")
               ("max temperature [°C]", [(k, "macro " + column_label(k)) for k in hot]
                + [("micro_max_temperature", "micro")], 1.0, -273.15),
               ("zones' heat partition\ninto the rough body [%]",   # the coefficients of Fig. 7.12, not
