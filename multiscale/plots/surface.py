@@ -62,9 +62,10 @@ def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -
         q = np.geomspace(sp.q[0], sp.q[-1], 200)
         inside = q <= fit.q_s
         ax.loglog(q[inside], fit(q[inside]), "-", color="C1", label=f"fit: H = {fit.hurst:.2f}")
-        for value, resolved, name in ((fit.q_r, fit.resolved[0], "q_r"), (fit.q_s, fit.resolved[1], "q_s")):
-            ax.axvline(value, color="C1", ls="--" if resolved else ":", lw=1,
-                       label=f"{name} = {value:.3g} rad/m (λ = {2 * np.pi / value:.3g} m)"
+        for value, resolved, name, colour in ((fit.q_r, fit.resolved[0], "q_r", "C2"),
+                                              (fit.q_s, fit.resolved[1], "q_s", "C3")):   # (alike before: a trial)
+            ax.axvline(value, color=colour, ls="--" if resolved else ":", lw=1,
+                       label=f"{name} = {value:.3g} rad/m (λ = {2e6 * np.pi / value:.3g} µm)"   # µm, as the report
                        + ("" if resolved else " (end of data)"))
     ax.set_xlabel("wavevector q = 2π/λ [rad/m]")
     ax.set_ylabel("PSD C(q) [m⁴]")
