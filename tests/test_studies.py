@@ -1417,3 +1417,17 @@ def test_a_study_stopped_before_its_reference_run_says_so(tmp_path, made):
     assert "none of the runs" not in text and "**2 not run or cut off: the study was stopped**" in text
     texts = [t.get_text() for fig, axes in made for ax in axes.ravel() for t in ax.texts]
     assert "no error: the reference\nhas no value of it" in texts and not any("equal to the reference" in t for t in texts)
+
+
+def test_files_swept_without_being_cases_are_warned_of(tmp_path):
+    """Measured files swept beside a tolerance, without [report] cases: the cost table timed a
+    setting on one file against another file's reference run (a user trial)."""
+    import shutil
+    for name in ("a.top", "b.top"):
+        shutil.copy(ROOT / "tests" / "data" / "top-1.top", tmp_path / name)
+    text = ('problem = "measured_contact"\nmetrics = ["approach"]\n[[sweep]]\nfile = ["a.top", "b.top"]\n[[sweep]]\n'
+            'tol = [1e-3, 1e-6]\n[reference]\nkind = "run"\nrun = {tol = 1e-6}\n')
+    assert load_study(write(tmp_path, text)).warnings == (
+        'file is swept but not a [report] case: the cheapest settings compare runs on different files; give cases = '
+        '["file"] to judge each file by its own',)
+    assert load_study(write(tmp_path, text + '[report]\ncases = ["file"]\n')).warnings == ()

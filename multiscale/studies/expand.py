@@ -11,7 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from multiscale.errors import SceneError, read_toml_text, toml_problem
-from multiscale.schema import Bad, Context, Integer, Quantity, fields_of, read, show, suggest
+from multiscale.schema import Bad, Context, FilePath, Integer, Quantity, fields_of, read, show, suggest
 from multiscale.studies.formatting import value_text, warning_kind
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.spec import RANGE_KEYS, ReportOptions, Reference, RunOptions, StudyFile, is_range
@@ -122,6 +122,11 @@ def load_study(path) -> Study:
                                     f"swept: {', '.join(knobs)}")
     if ctx.problems:
         raise SceneError(list(dict.fromkeys(ctx.problems)))
+    files = [k for k in knobs if isinstance(getattr(parser_of(problem, k), "parser", None), FilePath)
+             and k not in f.report.cases]
+    if files and f.reference is not None:   # (a setting on one file was timed against another's reference run:
+        warned += (f"{files[0]} is swept but not a [report] case: the cheapest settings compare runs on different "
+                   f"files; give cases = [\"{files[0]}\"] to judge each file by its own",)   # a user trial)
     folder = f.run.folder or ctx.directory / "results" / name
     return Study(name=name, description=f.description, source=path.resolve(), problem=f.problem, scene=f.scene,
                  metrics=f.metrics, knobs=knobs, axes=axes, fixed=dict(f.fixed), sweep_text=tuple(lines), runs=runs,
