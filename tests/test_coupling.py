@@ -29,6 +29,7 @@ from multiscale.micro.surface import Surface, fractal_surface  # noqa: E402
 from multiscale.micro.zones import cut_zones  # noqa: E402
 from multiscale.references.love import love_rectangle_mean  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
+from multiscale.scene_summary import summary  # noqa: E402
 
 N_POINTS = 8          # nodes per law in every test here: the compiled forms are shared
 
@@ -370,6 +371,8 @@ def test_check_warns_of_a_law_top_below_the_nominal_pressure():
     assert TOP_WARNING.format("20 x the nominal pressure at load factor 1 (no micro.p_max) = 1e+07",
                               " at the load profile's largest factor 25", "1.25e+07", "give micro.p_max") \
         in loads(peak, "demos").warnings
+    assert "laws up to p_max 20 x the nominal pressure (at least 1e+07 Pa) (the run prints it)" in \
+        "\n".join(summary(loads(peak, "demos")))        # check says the number (a user trial)
     plastic = text.replace('"roughness", "wear"]', '"roughness", "wear", "plasticity"]').replace(
         "[materials.pin]", '[materials.pin]\nhardness = "0.54 MPa"', 1)
     assert TOP_WARNING.format("0.9 x materials.pin.hardness = 4.86e+05", "", "5e+05", "the zones are near fully "
