@@ -335,10 +335,10 @@ def _surface(args) -> int:
         if cutoff is not None and plain(_number_or_text(args.cutoff)) and cutoff > min(measurement.size):
             (Lx, Ly), unit = measurement.size, ("mm", 1e3) if min(measurement.size) >= 1e-3 else ("um", 1e6)
             fits = 2 * max(measurement.dx, measurement.dy) <= 1e-3 * cutoff <= min(measurement.size)
-            hint = f'did you mean "{args.cutoff} mm"?' if fits else "give it a unit"   # (suggested mm beyond the map)
+            hint = f'did you mean "{args.cutoff} mm"?' if fits else "give a unit"   # (suggested mm beyond the map)
             raise InputError("--cutoff", args.cutoff, f"{cutoff:g} m, longer than the measurement ({Lx * unit[1]:.4g} x "
-                             f"{Ly * unit[1]:.4g} {unit[0]}); plain numbers are metres: {hint} (give "
-                             f'"{args.cutoff} m" to filter at {cutoff:g} m anyway)')   # ISO's λc are in mm: "--cutoff
+                             f"{Ly * unit[1]:.4g} {unit[0]}); plain numbers are metres: {hint} "
+                             f'("{args.cutoff} m" filters at {cutoff:g} m anyway)')   # ISO's λc are in mm: "--cutoff
             #                                                0.8" was 0.8 m, silently; "0.8 m" is taken as meant
         done = condition(measurement, args.detrend, cutoff, args.max_undefined, prefix=COMMAND_LINE,
                          despike=args.despike)      # errors and notes name the options as given here

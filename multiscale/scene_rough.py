@@ -228,6 +228,13 @@ def nominal_pressure(scene) -> tuple[float, float] | None:
     return factor * force / sum(a * b for a, b in boxes), factor
 
 
+def default_p_max(scene) -> float | None:
+    """The laws' top without ``micro.p_max`` [Pa]: ``P_MAX_FACTOR`` x the nominal pressure at load
+    factor 1, from its lower bound (``nominal_pressure``); None where that is not known."""
+    bound = nominal_pressure(scene)
+    return P_MAX_FACTOR * bound[0] / bound[1] if bound is not None else None
+
+
 def plastic_everywhere(scene) -> list[str]:
     """A hardness at the initial temperature at most the interfaces' ``nominal_pressure``, so that
     some zone carries H or more, which the run refuses after its set-up (check said OK: a materials
@@ -256,7 +263,7 @@ def law_top_warnings(scene) -> list[str]:
     (nominal, factor), soft = bound, scene.softer_hardness if scene.has("plasticity") else None
     tops = {"micro.p_max": (micro.p_max, "raise micro.p_max")} if micro.p_max is not None else \
         {f"{P_MAX_FACTOR:g} x the nominal pressure at load factor 1 (no micro.p_max)":
-         (P_MAX_FACTOR * nominal / factor, "give micro.p_max")}
+         (default_p_max(scene), "give micro.p_max")}
     if soft is not None:
         H = scene.materials[soft].value("hardness", scene.time.initial_temperature)
         tops[f"{P_MAX_PLASTIC:g} x materials.{soft}.hardness"] = (P_MAX_PLASTIC * H, "the zones are near fully "

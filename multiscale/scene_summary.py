@@ -8,7 +8,7 @@ from multiscale.geometry import CellEstimate, estimate_cells
 from multiscale.outputs import analysis
 from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
-from multiscale.scene_rough import nominal_pressure, scene_surface_used
+from multiscale.scene_rough import default_p_max, scene_surface_used
 from multiscale.scene_sections import P_MAX_FACTOR, P_MAX_PLASTIC
 from multiscale.schema import reference as schema_reference
 
@@ -160,9 +160,9 @@ def _effect_line(scene: Scene, effect: str) -> str:
         measured_pixels = r.file is not None and r.cover != "equivalent"
         cells = f"{m.grid[0]} x {m.grid[1]} cells" if m.grid else \
             "the measurement's pixel size" if measured_pixels else "50 x 50 cells"
-        bound = nominal_pressure(scene) if m.p_max is None else None    # (its number unsaid before: a user trial)
+        least = default_p_max(scene) if m.p_max is None else None     # (its number unsaid before: a user trial)
         top = f"{m.p_max:g} Pa" if m.p_max is not None else f"{P_MAX_FACTOR:g} x the nominal pressure" + (
-            f" (at least {P_MAX_FACTOR * bound[0] / bound[1]:.3g} Pa)" if bound else "")
+            f" (at least {least:.3g} Pa)" if least is not None else "")
         if scene.has("plasticity"):
             top += f", at most {P_MAX_PLASTIC:g} x the hardness"     # (check said 3e7 Pa, the run used 9e6)
         top += "" if m.p_max is not None and not scene.has("plasticity") else " (the run prints it)"

@@ -292,7 +292,7 @@ def test_the_multiscale_figures_legends_cover_no_panel(tmp_path, drawn):
     assert len(legends) == 3
     pressures = next(ax for ax in figure.axes if ax.get_ylabel() == "max contact pressure [MPa]")
     assert [t.get_text() for t in pressures.get_legend().get_texts()] == [      # a row's two states (a zone
-        "macro facet (after wear)", "macro zone mean (before)", "micro local (before)"]  # above every facet: a trial)
+        "macro facet (after wear)", "macro zone mean (before wear)", "micro local (before wear)"]  # above every facet: a trial)
     for box in legends:
         for ax in figure.axes:
             assert not box.overlaps(ax.get_window_extent()), ax.get_ylabel()

@@ -79,9 +79,9 @@ def test_surface_command_prints_the_steps_and_surfacetopographys_sq(tmp_path, ca
     # ISO cut-offs are said in mm: "--cutoff 0.8" filtered at 0.8 m, "little is removed", and went on; with a
     # unit it is taken as meant (a user trial read the refusal as one of 0.8 m)
     (["--cutoff", "0.8"], "error: --cutoff = '0.8': 0.8 m, longer than the measurement (0.6 x 0.6 um); plain "
-                          'numbers are metres: give it a unit (give "0.8 m" to filter at 0.8 m anyway)'),
+                          'numbers are metres: give a unit ("0.8 m" filters at 0.8 m anyway)'),
     (["--cutoff", "2e-4"], "error: --cutoff = '2e-4': 0.0002 m, longer than the measurement (0.6 x 0.6 um); plain "
-                           'numbers are metres: did you mean "2e-4 mm"? (give "2e-4 m" to filter'),
+                           'numbers are metres: did you mean "2e-4 mm"? ("2e-4 m" filters'),
 ])
 def test_surface_command_bad_options_are_one_line(capsys, args, message):
     assert main(["surface", str(TOP), "--figure", "none", *args]) == 2

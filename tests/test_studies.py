@@ -789,7 +789,7 @@ def test_the_inputs_warnings_are_said_once_with_their_runs(tmp_path, capsys):
     swept = load_study(write(tmp_path, HERTZ.replace("grid = [12, 16, 24, 32]", 'E = ["1 Pa", "2 Pa", "4 GPa"]')
                              .replace("[fixed]", "[fixed]\ngrid = 12")))
     assert swept.warnings == ('E = "1 Pa": 1 Pa is outside the plausible range 100000 to 1.2e+12 Pa: check the value '
-                              'and its unit (the numbers of its first run) (run E = 1 Pa; E = 2 Pa)',)   # one kind
+                              'and its unit (run E = 1 Pa; E = 2 Pa; the numbers of E = 1 Pa)',)   # one kind
     path = write(tmp_path, HERTZ.replace("grid = [12, 16, 24, 32]", "grid = [12, 16]")
                  .replace('radius = "10 mm"', 'radius = "10 mm"\nE = 1').replace("processes = 2", "processes = 1"))
     assert main(["study", str(path)]) == 0
@@ -884,6 +884,7 @@ def test_a_measured_surface_is_a_micro_study_problem(tmp_path, capsys):
     for run in load_study(path).runs:                   # a file rewritten under its name: new runs
         params = problem.parse(run.raw, "", Context(directory=tmp_path))
         assert problem.key(params)["files"] == {"file": file_digest(tmp_path / "afm.top")}
+        assert "despike" not in problem.key(params)     # added later: the records before it stay valid (a review)
     assert main(["study", str(path)]) == 0
     surface = condition(read_topography(tmp_path / "afm.top"), "plane").surface
     with h5py.File(tmp_path / "results" / "study" / "results.h5") as h5:      # (results.csv: 10 digits)
@@ -1387,6 +1388,8 @@ def test_warnings_that_differ_in_their_numbers_are_one_kind(tmp_path, capsys):
     from multiscale.studies.formatting import warning_kind
     from multiscale.studies.reporting import report
     assert warning_kind("reached 4.3 times p_max = 2e+05 Pa, -1.5e-3 and .5") == "reached # times p_max = # Pa, # and #"
+    assert warning_kind("outliers in 'scan_01.sdf' of pad2") != warning_kind("outliers in 'scan_02.sdf' of pad2") \
+        != warning_kind("outliers in 'scan_02.sdf' of pad1")       # names keep their digits (a review)
     study = load_study(write(tmp_path, HERTZ + "plots = false\n"))
     said = ["the zone pressures reached {} times micro.p_max", "outliers in 'a.x3p'"]
     rows = [Row(run, {"status": "ok", "wall_time": 1.0, "metrics": {m: 1.0 for m in study.metrics},
@@ -1431,3 +1434,4 @@ def test_files_swept_without_being_cases_are_warned_of(tmp_path):
         'file is swept but not a [report] case: the cheapest settings compare runs on different files; give cases = '
         '["file"] to judge each file by its own',)
     assert load_study(write(tmp_path, text + '[report]\ncases = ["file"]\n')).warnings == ()
+    assert load_study(write(tmp_path, text + '[report]\naverage_over = ["file"]\n')).warnings == ()  # (a review)

@@ -175,7 +175,7 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
     areas = [k for k in cols if k.startswith("real_contact_area_")]          # one per rough interface
     area = 1e6 if np.nanmax(np.abs(cols.get("real_contact_area", [0.0])), initial=0.0) > 1e-8 else 1e12  # mm² or µm²
     volume = 1e9 if np.nanmax(np.abs(cols.get("wear_volume", [0.0])), initial=0.0) > 1e-12 else 1e18   # mm³ or µm³
-    after, before = (" (after wear)", " (before)") if "wear_volume" in cols else ("", "")   # a row's two states (a
+    after, before = (" (after wear)", " (before wear)") if "wear_volume" in cols else ("", "")   # a row's two states (a
     panels = [("max contact pressure [MPa]", [("max_pressure", "macro facet" + after),       # zone above every facet
                                                ("max_zone_pressure", "macro zone mean" + before),   # puzzled a user
                                                ("micro_max_pressure", "micro local" + before)],     # trial: results.rst

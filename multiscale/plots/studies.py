@@ -124,7 +124,7 @@ def _plain_log(axis) -> None:
 
         def even(x, _):            # the fewest digits that write every tick exactly
             ticks = axis.get_majorticklocs()
-            step = float(np.min(np.diff(ticks))) if len(ticks) > 1 else x
+            step = float(np.min(np.diff(ticks))) if len(ticks) > 1 else abs(x)
             digits = next((d for d in range(1, 16) if all(abs(float(f"{t:.{d}g}") - t) < 1e-6 * step for t in ticks)),
                           16)
             return f"{x:.{digits}g}"
@@ -189,9 +189,11 @@ def _plot_axis(study, ok, axis, folder, found):
             if any(np.isfinite(np.asarray(line.get_ydata(), float)).any() for line in ax.get_lines()):
                 ax.set_yscale("log")
             else:            # a metric the knob does not change: no error to draw on a log axis (it raised);
-                zero = any(r.errors.get(m) == 0 for r in ok)    # or no reference value (its run not run: a trial)
-                ax.text(0.5, 0.5, "error 0 in every run:\nequal to the reference" if zero else
-                        "no error: the reference\nhas no value of it", transform=ax.transAxes, ha="center", va="center")
+                zeros = sum(r.errors.get(m) == 0 for r in ok)   # or no reference value (its run not run: a trial)
+                ax.text(0.5, 0.5, "error 0 in every run:\nequal to the reference" if zeros == len(ok) else
+                        "no error: the reference\nhas no value of it" if not zeros else
+                        "error 0 where the reference\nhas a value, none elsewhere", transform=ax.transAxes,
+                        ha="center", va="center")
             for tol in study.report.errors:
                 ax.axhline(tol, color="gray", ls="--", lw=0.8)
         if kind == "value" and m in study.judged:        # calibration: the measured value, and where it is met

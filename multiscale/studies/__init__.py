@@ -41,10 +41,11 @@ Markdown report stating the cheapest setting meeting each stated error; against 
 of measured values, also where along each swept knob each metric meets its measured value
 (calibration from a sweep: which k_w gives the measured worn volume; ``results.crossings``).
 What a run found while running (a scene's zone pressures beyond the laws' top, a measured file's
-outliers: beyond its inputs' warnings, said before the runs) is said on the console once, with the
-first run that found it, listed in the report with its runs and in the ``warnings`` column. Ctrl-C
-stops the runs under way and writes the tables and the report of those that ended (the others with
-status ``missing``, "not run" in the report).
+outliers: beyond its inputs' warnings, said before the runs) is said on the console once per kind
+(warnings differing in their numbers only are one), with the first run that found it, listed in the
+report with its runs and in the ``warnings`` column (a JSON list). Ctrl-C stops the runs under way
+and writes the tables and the report of those that ended (the others with status ``missing``, "not
+run or cut off" in the report); run again, the study runs those anew.
 
 Modules, in import order: ``spec`` (the file schema), ``problems`` (the registry; ``base``,
 ``micro_problems``, ``scene_problem``), ``expand`` (validation, runs), ``records`` (run records on

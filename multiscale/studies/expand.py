@@ -122,11 +122,13 @@ def load_study(path) -> Study:
                                     f"swept: {', '.join(knobs)}")
     if ctx.problems:
         raise SceneError(list(dict.fromkeys(ctx.problems)))
-    files = [k for k in knobs if isinstance(getattr(parser_of(problem, k), "parser", None), FilePath)
-             and k not in f.report.cases]
+    files = [k for k in knobs if k not in f.report.cases and k not in f.report.average_over and (
+        isinstance(getattr(parser_of(problem, k), "parser", None), FilePath) or k.split(".")[-1] == "file")]
     if files and f.reference is not None:   # (a setting on one file was timed against another's reference run:
-        warned += (f"{files[0]} is swept but not a [report] case: the cheapest settings compare runs on different "
-                   f"files; give cases = [\"{files[0]}\"] to judge each file by its own",)   # a user trial)
+        one = len(files) == 1                                                                   # a user trial)
+        warned += (f"{', '.join(files)} {'is' if one else 'are'} swept but not {'a [report] case' if one else '[report] cases'}: "
+                   "the cheapest settings compare runs on different files; give cases = ["
+                   + ", ".join(f'"{k}"' for k in files) + "] to judge each file by its own",)
     folder = f.run.folder or ctx.directory / "results" / name
     return Study(name=name, description=f.description, source=path.resolve(), problem=f.problem, scene=f.scene,
                  metrics=f.metrics, knobs=knobs, axes=axes, fixed=dict(f.fixed), sweep_text=tuple(lines), runs=runs,
@@ -382,16 +384,18 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple[tuple, tuple]:
         seen[digest] = where
         runs.append(StudyRun(digest, label, raw, {k: value_text(swept[k]) for k in knobs}))
     ctx.problems.extend(_with_runs(wrong, count))
-    kinds = {lines[0] + (" (the numbers of its first run)" if len(set(lines)) > 1 else ""): list(wheres)
-             for lines, wheres in warned.values()}
-    return tuple(runs), tuple(_with_runs(kinds, count))
+    kinds = {lines[0]: list(wheres) for lines, wheres in warned.values()}
+    varied = {lines[0] for lines, _ in warned.values() if len(set(lines)) > 1}
+    return tuple(runs), tuple(_with_runs(kinds, count, varied))
 
 
-def _with_runs(lines: dict, total: int) -> list[str]:
+def _with_runs(lines: dict, total: int, varied=()) -> list[str]:
     """Each of ``lines`` (line -> the runs it concerns, of ``total``) once, naming its runs: every
-    run, or up to three."""
+    run, or up to three; of a line in ``varied`` (a kind whose runs differ in its numbers), whose
+    numbers it gives."""
     return [f"{line} (" + ("every run" if len(where) == total > 1 else "run " + "; ".join(where[:3])
-                           + (f" and {len(where) - 3} more" if len(where) > 3 else "")) + ")"
+                           + (f" and {len(where) - 3} more" if len(where) > 3 else ""))
+            + (f"; the numbers of {where[0]}" if line in varied else "") + ")"
             for line, where in lines.items()]
 
 

@@ -61,9 +61,11 @@ class MicroProblem(Problem):
 
     def key(self, params) -> dict:
         """The parameters, and the bytes of the files they name (a measured surface rewritten under
-        its name makes new runs, as a scene's files do)."""
-        files = {k: file_digest(v) for k, v in asdict(params).items() if isinstance(v, Path)}
-        return {**jsonable(asdict(params)), **({"files": files} if files else {})}
+        its name makes new runs, as a scene's files do); a parameter added since records were made
+        (the params' ``ADDED``) is left out while absent, so those records stay this run's."""
+        values = {k: v for k, v in asdict(params).items() if not (v is None and k in getattr(params, "ADDED", ()))}
+        files = {k: file_digest(v) for k, v in values.items() if isinstance(v, Path)}
+        return {**jsonable(values), **({"files": files} if files else {})}
 
     def exact_key(self, params) -> dict:
         values = self.key(params)
@@ -233,6 +235,8 @@ class MeasuredContactParams:
     detrend: str = key(Choice(tuple(DETREND)), default="plane")
     cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)))   # m, Gaussian λc
     despike: float | None = key(Quantity("dimensionless", gt=0), absent=f"outliers warned of (k = {DESPIKE:g}), kept")
+
+    ADDED = ("despike",)     # parameters added since records were made (``MicroProblem.key``)
     E: float = key(MODULUS, default=4e9)
     nu: float = key(_POISSON, default=0.15)
     load: float = key(Quantity("pressure", gt=0, plausible=(1e3, 5e9)), default=5e6)   # Pa, mean pressure

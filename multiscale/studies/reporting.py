@@ -13,7 +13,7 @@ from multiscale.studies.expand import Study
 from multiscale.studies.formatting import metric_heading, now, number_text, percent, value_text, warning_kind
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.records import JIT_SHARE
-from multiscale.studies.results import MISSING, Row, cheapest, crossings, knob_unit, reference_text, sample_std
+from multiscale.studies.results import MISSING, Row, case_key, cheapest, crossings, knob_unit, reference_text, sample_std
 
 __all__ = ["report", "write_index"]
 
@@ -134,10 +134,14 @@ def _memory(record: dict) -> str:
 
 def _cheapest_table(study, rows, missing: int = 0) -> list[str]:
     """The cheapest setting meeting each stated error (``results.cheapest``), of the runs that ended
-    (``missing``: those a stopped study did not run); a reason where no run has an error."""
-    if not any(math.isfinite(r.max_error) for r in rows if r.ok):     # (the table said "none of the runs" for
-        why = next((r.note for r in rows if r.ok and r.note), "no reference value")   # every error: a user trial)
-        return ["## What accuracy costs", "", f"No run has an error to judge: {why}.", ""]
+    (``missing``: those a stopped study did not run); the reason where a case's runs have no error
+    (it said "none of the runs" at every error, the reference run not run: a user trial)."""
+    judged = {case_key(study, r) for r in rows if r.ok and math.isfinite(r.max_error)}
+    why = {}
+    for r in (r for r in rows if r.ok):
+        why.setdefault(case_key(study, r), r.note or "a reference value of 0 has no relative error")
+    if not judged:
+        return ["## What accuracy costs", "", f"No run has an error to judge: {next(iter(why.values()), '')}.", ""]
     knobs = [k for k in study.knobs if k not in study.cases]
     head = ["error ≤"] + list(study.cases) + knobs + ["wall time [s]", "peak memory [MB]", "worst error", "time / base"]
     samples = (f" over every sample of {', '.join(study.averaged)} (its wall time their mean)"
@@ -152,7 +156,8 @@ def _cheapest_table(study, rows, missing: int = 0) -> list[str]:
     for c in cheapest(study, rows):
         g, base = c["setting"], c["base"]
         if g is None:
-            cells = ["none of the runs"] + [""] * (len(knobs) + 3)
+            cells = ["none of the runs" if c["case"] in judged else f"no error to judge: {why.get(c['case'], '')}"] \
+                + [""] * (len(knobs) + 3)
         else:
             speed = g.wall_time / base.wall_time if base else math.nan
             cells = [g.shown(study, k) for k in knobs] + [f"{g.wall_time:.3g}", _memory(g.record("peak_memory_mb")),

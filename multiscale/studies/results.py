@@ -139,7 +139,8 @@ def _columns(study: Study, rows: list[Row]) -> dict:
     cols["converged"] = [bool(r.record.get("converged", False)) for r in rows]
     cols["code"] = [(r.record.get("code") or {}).get("sha1", "")[:12] for r in rows]    # the package that ran it
     cols["message"] = [r.record.get("error", "") or r.note for r in rows]
-    cols["warnings"] = [json.dumps(r.record["warnings"]) if r.record.get("warnings") else "" for r in rows]   # what
+    cols["warnings"] = [json.dumps(r.record["warnings"], ensure_ascii=False) if r.record.get("warnings") else ""
+                        for r in rows]   # what
     #   the run found, a JSON list (its texts hold "; " themselves: a review)
     return cols
 
@@ -154,7 +155,7 @@ def write_tables(study: Study, rows: list[Row]) -> tuple[Path, Path]:
     cols = _columns(study, rows)
     study.folder.mkdir(parents=True, exist_ok=True)
     csv_path, h5_path = study.folder / "results.csv", study.folder / "results.h5"
-    with open(csv_path, "w", newline="") as fh:
+    with open(csv_path, "w", newline="", encoding="utf-8") as fh:
         w = csv.writer(fh)
         w.writerow(cols)
         for i in range(len(rows)):

@@ -29,6 +29,7 @@ import multiscale
 from multiscale.errors import SceneError
 from multiscale.provenance import code
 from multiscale.schema import Context
+from multiscale.studies.base import RunFailed
 from multiscale.studies.formatting import now
 from multiscale.studies.problems import problem as get_problem
 from multiscale.studies.records import FAILED, JIT_SHARE, metric_problem, read_json, write_json
@@ -133,7 +134,8 @@ def run_task(task: dict) -> int:
         record.update(ran=True, status=FAILED if why else "ok", error=why or "")
     except Exception as exc:       # recorded, never raised: the study goes on
         text = str(exc).strip().splitlines()
-        record.update(status=FAILED, error=f"{type(exc).__name__}: {text[0] if text else ''}".strip(),
+        named = "" if isinstance(exc, RunFailed) else f"{type(exc).__name__}: "     # (it names its own cause)
+        record.update(status=FAILED, error=f"{named}{text[0] if text else ''}".strip(),
                       traceback=traceback.format_exc(), warnings=list(getattr(exc, "warnings", ())))
     record["finished"] = now()
     record.setdefault("peak_memory_mb", _peak_mb())
