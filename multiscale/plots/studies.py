@@ -76,9 +76,11 @@ def _plot_pareto(study, ok, folder):
                         zorder=2, label=None if named else "Pareto front" + (" of each case" if len(cases) > 1 else ""))
                 drawn = named = True
         refs = sorted(r.record["wall_time"] for r in ok if r.is_reference)
-        if refs:
-            ax.axvspan(refs[0], refs[-1], color="green", alpha=0.15, lw=0)
-            ax.axvline(refs[len(refs) // 2], color="green", ls=":", label="reference run" + "s" * (len(refs) > 1))
+        if refs:                 # (the band was unexplained: a user trial)
+            ax.axvspan(refs[0], refs[-1], color="green", alpha=0.15, lw=0,
+                       label="reference runs' wall times" if len(refs) > 1 else None)
+            ax.axvline(refs[len(refs) // 2], color="green", ls=":",
+                       label="reference run" if len(refs) == 1 else "their median")
         if any(fronts):
             ax.set(xscale="log", yscale="log")
         for tol in study.report.errors:
