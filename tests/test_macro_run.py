@@ -94,9 +94,9 @@ def test_thermal_on_a_sliding_translating_flat_is_refused(tmp_path):
         at_rest.thermal.step(0.1)
 
 
-def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
+def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path, capsys):
     scene = loads(pin_on_disc(tmp_path / "pod"), overrides={"time.substeps": 2, "output.figures": True})
-    result = run(scene, verbose=False)
+    result = run(scene, verbose=True)
     h = History.read(result.history_file)
     assert len(h) == 3 and h["time"][-1] == pytest.approx(1.2)
     np.testing.assert_allclose(h["interface_force"], 200.0, rtol=1e-6)
@@ -108,6 +108,8 @@ def test_pin_on_disc_run_writes_history_plots_and_fields(tmp_path):
     share = h["heat_total_pin"][-1] / (h["heat_total_pin"][-1] + h["heat_total_disc"][-1])
     assert share == pytest.approx(e_pin * face / (e_pin * face + e_disc * track), rel=1e-9)
     assert 0.02 < share < 0.04
+    said = "".join(capsys.readouterr())        # the share the run uses, which check gives at equal areas only
+    assert f"heat partition into pin (effusivity, by area): interface {share:.4g}\n" in said   # (a user trial)
     # energy: what the fields store equals the frictional heat put in (adiabatic bodies)
     assert h["stored_heat_pin"][-1] == pytest.approx(h["heat_total_pin"][-1], rel=1e-6)
     assert h["stored_heat_disc"][-1] == pytest.approx(h["heat_total_disc"][-1], rel=1e-9)   # was 6e-4 off
@@ -385,6 +387,7 @@ def test_resume_of_a_scene_without_checkpoints_names_the_option_without_a_value(
     with pytest.raises(InputError) as info:
         run(loads(BLOCK.format(effects='"contact"', folder=tmp_path / "out")), resume=True, verbose=False)
     assert str(info.value).startswith("--resume: this scene has no checkpoints to resume from")
+    assert str(info.value).endswith(": run it again with --overwrite")          # the fix (a user trial)
 
 
 def test_the_run_summary_counts_its_records_in_english(tmp_path, capsys):

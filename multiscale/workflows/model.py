@@ -36,6 +36,7 @@ from mpi4py import MPI
 
 from multiscale.errors import InputError
 from multiscale.geometry import GeometrySpec, Rotation, Support
+from multiscale.io import reporter
 from multiscale.macro import mesh as two_body
 from multiscale.macro.interface import PenaltyLaw, SumLaw
 from multiscale.macro.kept_cells import SolverOptionWarning
@@ -282,6 +283,9 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: b
             for name, m in tm.interface.masks().items():
                 share[m] = shares[name]
             tm.interface.set_field(mech.contact.partition, share)
+            if scene.interface.partition == "effusivity":    # (check gives it at equal areas: the share the run
+                reporter().say(f"heat partition into {scene.bodies[0]} (effusivity, by area): " + ", ".join(   # used
+                    f"{n} {v:.4g}" for n, v in shares.items()))                      # was said nowhere: a user trial)
         if scene.has("conductance") and scene.interface.conductance is not None:   # else per facet later
             tm.interface.set_field(mech.contact.conductance, scene.interface.conductance)
     return MacroModel(tm, mech, heat, drive(scene, tm), partitions=shares, friction_law=friction_law(scene, tm))
