@@ -228,6 +228,12 @@ def nominal_pressure(scene) -> tuple[float, float] | None:
     return factor * force / sum(a * b for a, b in boxes), factor
 
 
+def _over_them(factor: float) -> str:
+    """How ``nominal_pressure`` was found, at load factor ``factor``, for the messages."""
+    return "loading.normal_force over them" + (f" at the load profile's largest factor {factor:.3g}"
+                                               if factor != 1 else "")
+
+
 def default_p_max(scene) -> float | None:
     """The laws' top without ``micro.p_max`` [Pa]: ``P_MAX_FACTOR`` x the nominal pressure at load
     factor 1, from its lower bound (``nominal_pressure``); None where that is not known."""
@@ -243,9 +249,8 @@ def plastic_everywhere(scene) -> list[str]:
     if soft is None or bound is None:
         return []
     (nominal, factor), H = bound, scene.materials[soft].value("hardness", scene.time.initial_temperature)
-    peak = f" at the load profile's largest factor {factor:.3g}" if factor != 1 else ""
     return [f"materials.{soft}.hardness = {H:.3g} Pa at the initial temperature: at most the interfaces' nominal "
-            f"pressure (loading.normal_force over them{peak}: at least {nominal:.3g} Pa), so a zone would carry the "
+            f"pressure ({_over_them(factor)}: at least {nominal:.3g} Pa), so a zone would carry the "
             "hardness or more (fully plastic), which the micro model refuses; raise the hardness or lower the load"] \
         if H <= nominal else []
 
@@ -271,9 +276,8 @@ def law_top_warnings(scene) -> list[str]:
     what, (top, fix) = min(tops.items(), key=lambda item: item[1][0])
     if top > nominal:
         return []
-    peak = f" at the load profile's largest factor {factor:.3g}" if factor != 1 else ""
     return [f"the zone laws' top, {what} = {top:.3g} Pa, is at most the interfaces' nominal pressure "
-            f"(loading.normal_force over them{peak}: at least {nominal:.3g} Pa): the zones will press beyond it on "
+            f"({_over_them(factor)}: at least {nominal:.3g} Pa): the zones will press beyond it on "
             f"average, where a law is extrapolated linearly with the contact stiffness at its top; {fix}"]
 
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 from multiscale.errors import SceneError, read_toml_text, toml_problem
 from multiscale.schema import Bad, Context, FilePath, Integer, Quantity, fields_of, read, show, suggest
-from multiscale.studies.formatting import value_text, warning_kind
+from multiscale.studies.formatting import by_kind, value_text
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.spec import RANGE_KEYS, ReportOptions, Reference, RunOptions, StudyFile, is_range
 from multiscale.units import KINDS, VALUE, UnitError, parse_unit
@@ -360,7 +360,7 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple[tuple, tuple]:
     problem of the fixed values once per run, 12 times: a user trial); a warning whose runs differ in
     its numbers only, once too (``formatting.warning_kind``: the p_max warning of each load of a
     sweep; a user trial), as its first run gives it."""
-    runs, seen, wrong, warned, count = [], {}, {}, {}, 0
+    runs, seen, wrong, warned, count = [], {}, {}, [], 0
     for count, combo in enumerate(itertools.product(*groups), 1):
         swept = {k: v for part in combo for k, v in part.items()}
         raw = {**dict(f.fixed), **swept}
@@ -370,10 +370,7 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple[tuple, tuple]:
         where = ", ".join(f"{k} = {value_text(swept[k])}" for k in knobs)
         for line in local.problems:
             wrong.setdefault(line, []).append(where)
-        for line in local.warnings:
-            lines, wheres = warned.setdefault(warning_kind(line), ([], {}))
-            lines.append(line)
-            wheres[where] = None
+        warned += [(line, where) for line in local.warnings]
         if local.problems:
             continue
         ident = json.dumps({"problem": f.problem, "params": problem.key(params)}, sort_keys=True)
@@ -384,9 +381,9 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple[tuple, tuple]:
         seen[digest] = where
         runs.append(StudyRun(digest, label, raw, {k: value_text(swept[k]) for k in knobs}))
     ctx.problems.extend(_with_runs(wrong, count))
-    kinds = {lines[0]: list(wheres) for lines, wheres in warned.values()}
-    varied = {lines[0] for lines, _ in warned.values() if len(set(lines)) > 1}
-    return tuple(runs), tuple(_with_runs(kinds, count, varied))
+    kinds = by_kind(warned)
+    return tuple(runs), tuple(_with_runs({line: where for line, where, _ in kinds}, count,
+                                         {line for line, _, varied in kinds if varied}))
 
 
 def _with_runs(lines: dict, total: int, varied=()) -> list[str]:

@@ -5,7 +5,7 @@ import math
 import re
 import time
 
-__all__ = ["metric_heading", "now", "number_text", "percent", "value_text", "warning_kind"]
+__all__ = ["by_kind", "metric_heading", "now", "number_text", "percent", "value_text", "warning_kind"]
 
 
 # unit spellings of the study files -> their symbols in tables and plots
@@ -54,3 +54,14 @@ def warning_kind(line: str) -> str:
     """A warning with its numbers as "#": the runs of a sweep warn alike with their own numbers
     ("the zone pressures reached 4.3 times micro.p_max"), said and listed once as one kind."""
     return NUMBER.sub("#", line)
+
+
+def by_kind(found) -> list[tuple[str, list, bool]]:
+    """(warning, run) pairs grouped by ``warning_kind``, in the order they first came: per kind its
+    first text, the runs that gave it (each once) and whether their texts differ (in numbers)."""
+    kinds = {}
+    for line, run in found:
+        lines, runs = kinds.setdefault(warning_kind(line), ([], {}))
+        lines.append(line)
+        runs[run] = None
+    return [(lines[0], list(runs), len(set(lines)) > 1) for lines, runs in kinds.values()]

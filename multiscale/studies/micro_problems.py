@@ -235,12 +235,12 @@ class MeasuredContactParams:
     detrend: str = key(Choice(tuple(DETREND)), default="plane")
     cutoff: float | None = key(Quantity("length", gt=0, plausible=(1e-7, 0.1)))   # m, Gaussian λc
     despike: float | None = key(Quantity("dimensionless", gt=0), absent=f"outliers warned of (k = {DESPIKE:g}), kept")
-
-    ADDED = ("despike",)     # parameters added since records were made (``MicroProblem.key``)
     E: float = key(MODULUS, default=4e9)
     nu: float = key(_POISSON, default=0.15)
     load: float = key(Quantity("pressure", gt=0, plausible=(1e3, 5e9)), default=5e6)   # Pa, mean pressure
     tol: float | None = key(Quantity("dimensionless", gt=0, lt=1))            # default: the solver's
+
+    ADDED = ("despike",)     # parameters added since records were made (``MicroProblem.key``)
 
 
 @_register(MeasuredContactParams, {"approach": "rigid approach from the first touch [m]",

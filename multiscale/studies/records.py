@@ -56,7 +56,7 @@ def _well_formed(record) -> bool:
     or written by hand may not be)."""
     if not isinstance(record, dict) or not isinstance(record.get("metrics", {}), dict):
         return False
-    if not (isinstance(record.get("warnings", []), list) and all(isinstance(w, str) for w in record.get("warnings", []))):
+    if not (isinstance(found := record.get("warnings", []), list) and all(isinstance(w, str) for w in found)):
         return False
     return all(isinstance(record.get(k, 0), (int, float)) and not isinstance(record.get(k, 0), bool) for k in NUMBERS)
 

@@ -10,7 +10,7 @@ import numpy as np
 
 from multiscale.io import duration
 from multiscale.studies.expand import Study
-from multiscale.studies.formatting import metric_heading, now, number_text, percent, value_text, warning_kind
+from multiscale.studies.formatting import by_kind, metric_heading, now, number_text, percent, value_text
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.records import JIT_SHARE
 from multiscale.studies.results import MISSING, Row, case_key, cheapest, crossings, knob_unit, reference_text, sample_std
@@ -79,17 +79,14 @@ def _found_warnings(rows, shown: int = 3) -> list[str]:
     """What the runs warned of while running (zone pressures beyond the laws' top, outliers of a
     measured file), each kind once (``warning_kind``: the runs' own numbers aside) as its first run
     gave it, with the runs that gave it (the first ``shown`` of them)."""
-    found = {}
-    for r in rows:
-        for line in r.record.get("warnings", ()):
-            found.setdefault(warning_kind(line), []).append((line, r.run.text))
+    found = by_kind((line, r.run.text) for r in rows for line in r.record.get("warnings", ()))
     if not found:
         return []
     lines = ["Warnings of the runs (what they found while running; column `warnings` of results.csv):", ""]
-    for runs in found.values():
+    for line, runs, varied in found:
         more = f" and {len(runs) - shown} more" if len(runs) > shown else ""
-        own = " (the numbers of the first; each run's in results.csv)" if len({t for t, _ in runs}) > 1 else ""
-        lines.append(f"- {runs[0][0]} ({'; '.join(r for _, r in runs[:shown])}{more}){own}")
+        own = " (the numbers of the first; each run's in results.csv)" if varied else ""
+        lines.append(f"- {line} ({'; '.join(runs[:shown])}{more}){own}")
     return lines + [""]
 
 

@@ -140,8 +140,7 @@ def _columns(study: Study, rows: list[Row]) -> dict:
     cols["code"] = [(r.record.get("code") or {}).get("sha1", "")[:12] for r in rows]    # the package that ran it
     cols["message"] = [r.record.get("error", "") or r.note for r in rows]
     cols["warnings"] = [json.dumps(r.record["warnings"], ensure_ascii=False) if r.record.get("warnings") else ""
-                        for r in rows]   # what
-    #   the run found, a JSON list (its texts hold "; " themselves: a review)
+                        for r in rows]   # what the run found, a JSON list (its texts hold "; " themselves: a review)
     return cols
 
 
