@@ -97,3 +97,19 @@ def models_closed():
     for ref in reversed(built):
         if (model := ref()) is not None:
             model.close()
+
+
+@pytest.fixture
+def keep_figures(monkeypatch):
+    """``keep(module)``: the matplotlib ``Figure`` objects that ``module`` (a ``multiscale.plots``
+    module) makes from then on, kept in the list returned, to be inspected."""
+    def keep(module) -> list:
+        figures = []
+
+        class Kept(module.Figure):
+            def __init__(self, *args, **kwargs):
+                super().__init__(*args, **kwargs)
+                figures.append(self)
+        monkeypatch.setattr(module, "Figure", Kept)
+        return figures
+    return keep

@@ -9,17 +9,9 @@ from multiscale.plots import history as plots
 
 
 @pytest.fixture
-def drawn(monkeypatch):
+def drawn(keep_figures):
     """The figures the plotting functions make, kept to be inspected."""
-    figures = []
-
-    class Kept(plots.Figure):
-        def __init__(self, *args, **kwargs):
-            super().__init__(*args, **kwargs)
-            figures.append(self)
-
-    monkeypatch.setattr(plots, "Figure", Kept)
-    return figures
+    return keep_figures(plots)
 
 
 def test_a_body_of_several_materials_has_one_visible_named_curve_per_material(tmp_path, drawn):

@@ -179,15 +179,9 @@ def test_the_figure_draws_a_strided_height_map_with_the_whole_maps_colour_range(
     assert labels[-1] == "wavevector q = 2π/λ [rad/m]"         # it said 1/m: 1/q read 2π too short (a trial)
 
 
-def test_the_surface_figures_legend_covers_neither_panel(tmp_path, monkeypatch):
+def test_the_surface_figures_legend_covers_neither_panel(tmp_path, keep_figures):
     """The PSD's legend lay over its short wavelengths (a user trial): it now stands below the panel."""
-    figures = []
-
-    class Kept(surface_plots.Figure):
-        def __init__(self, *args, **kwargs):
-            super().__init__(*args, **kwargs)
-            figures.append(self)
-    monkeypatch.setattr(surface_plots, "Figure", Kept)
+    figures = keep_figures(surface_plots)
     s = Surface(rough((200, 300), seed=2), 1e-6, 1e-6, periodic=False)
     surface_plots.surface_figure(s, surface_statistics(s), tmp_path / "f.png")
     (figure,) = figures

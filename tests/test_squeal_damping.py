@@ -634,17 +634,10 @@ def test_the_map_files_hold_the_map_and_say_it_in_documented_terms(tmp_path, doc
 
 
 @pytest.fixture
-def drawn(monkeypatch):
+def drawn(keep_figures):
     """The figures ``multiscale.plots.squeal`` makes, kept to be inspected."""
     from multiscale.plots import squeal as plots
-    figures = []
-
-    class Kept(plots.Figure):
-        def __init__(self, *args, **kwargs):
-            super().__init__(*args, **kwargs)
-            figures.append(self)
-    monkeypatch.setattr(plots, "Figure", Kept)
-    return figures
+    return keep_figures(plots)
 
 
 def test_a_track_of_one_point_is_seen_in_the_tracks_figure(tmp_path, drawn):
