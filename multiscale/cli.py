@@ -271,7 +271,9 @@ def _setting(text: str) -> tuple[str, object, str]:
                                          '"loading.normal_force=300 N"')
     try:
         read = tomllib.loads(f"value = {value}")["value"]
-    except tomllib.TOMLDecodeError:
+    except tomllib.TOMLDecodeError as exc:
+        if value.strip()[:1] in "[{\"'":            # meant as TOML: "[2,2" is an unclosed array, not a text
+            raise argparse.ArgumentTypeError(f"{text!r}: {value.strip()} is not a TOML value ({exc})") from None
         read = value.strip()
     return key.strip(), read, value
 

@@ -106,6 +106,7 @@ _UNITS: dict[str, tuple[Fraction, tuple[int, ...], bool]] = {
     "ksi": (1000 * _LBF / _F("0.0254") ** 2, _PRESSURE, False), "mph": (_F("0.44704"), _dim((L, 1), (T, -1)), False),
 }
 _ABSOLUTE = {"degC": _F("273.15"), "°C": _F("273.15")}   # offsets of a whole-unit absolute temperature
+_TYPED = {"°C": "degC"}          # a suggestion as a keyboard types it ("20 C": "degC", not "°C")
 _PREFIXES = {"G": _F(10**9), "M": _F(10**6), "k": _F(1000), "c": _F(1, 100), "m": _F(1, 1000),
              "u": _F(1, 10**6), "µ": _F(1, 10**6), "μ": _F(1, 10**6), "n": _F(1, 10**9),
              "p": _F(1, 10**12)}
@@ -133,7 +134,7 @@ def _lookup(name: str) -> tuple[Fraction, tuple[int, ...]]:
     known = list(_UNITS) + [p + u for u, (_, _, pre) in _UNITS.items() if pre for p in "GMkmu"]
     split = next((f"{name[:i]} {name[i:]}" for i in range(1, len(name)) if {name[:i], name[i:]} <= set(known)), None)
     near = [split] if split else difflib.get_close_matches(name, known, n=1, cutoff=0.5)   # "Nm": "N m", not "m"
-    hint = f' (did you mean "{near[0]}"?)' if near else ""
+    hint = f' (did you mean "{_TYPED.get(near[0], near[0])}"?)' if near else ""
     raise UnitError(f'unknown unit "{name}"{hint}')
 
 
@@ -323,7 +324,8 @@ def _kind_unit(text: str, spec: Kind) -> str | None:
     named = [u.strip() for u in spec.examples.split(",")] + \
         [p + u for u, (_, dim, pre) in _UNITS.items() if dim == spec.dim for p in ("", *("GMkmu" if pre else ""))]
     same = [u for u in named if u.lower() == text.lower()]
-    return same[0] if same else next(iter(difflib.get_close_matches(text, named, n=1, cutoff=0.5)), None)
+    near = same[0] if same else next(iter(difflib.get_close_matches(text, named, n=1, cutoff=0.5)), None)
+    return _TYPED.get(near, near)
 
 
 def _a(words: str) -> str:

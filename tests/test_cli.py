@@ -210,6 +210,9 @@ def test_set_gives_scene_keys_over_the_files_to_check_and_run(tmp_path, capsys, 
     with pytest.raises(SystemExit) as exit_:
         main(["check", path, "--set", "loading.pressure"])
     assert exit_.value.code == 2 and "KEY=VALUE" in capsys.readouterr().err
+    with pytest.raises(SystemExit) as exit_:     # meant as TOML (was read as the text "[2,2": a range error)
+        main(["check", path, "--set", "micro.zones=[2,2"])
+    assert exit_.value.code == 2 and "[2,2 is not a TOML value (Unclosed array" in capsys.readouterr().err
     handed = []
     module = types.ModuleType("multiscale.workflows")
     module.run = lambda scene, **kw: handed.append(scene)

@@ -121,6 +121,8 @@ def test_unit_strings_to_si(text, kind, expected):
     ("14 %", "resistance", 'the unit "%" is a dimensionless number'),
     ("2e-5 mm^3/Nm", "wear_rate", 'unknown unit "Nm" (did you mean "N m"?)'),  # was: "m" (user trial M)
     ("2 kNm", "torque", 'unknown unit "kNm" (did you mean "kN m"?)'),
+    ("20 C", "temperature", 'unknown unit "C" (did you mean "degC"?)'),       # was "°C", not on a keyboard
+    ("1e-5 1/C", "expansion", 'unknown unit "C" (did you mean "degC"?)'),
     ("2e-5 mm^3/N", "wear_rate", 'the unit "mm^3/N" is that times a length (m^2 kg^-1 s^2 in SI base units)'),
     ("2e-5", "wear_rate", 'a quoted number needs its unit, like "2e-5 1/Pa"'),    # was: the unit "" is ...
 ])
