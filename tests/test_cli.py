@@ -235,7 +235,7 @@ def test_run_refuses_to_overwrite_results(tmp_path, capsys, monkeypatch):
     (tmp_path / "out" / "history.h5").write_bytes(b"")
     assert main(["run", path]) == 2
     err = capsys.readouterr().err
-    assert f'error: output.folder = "{tmp_path / "out"}": already holds results (1 entry: history.h5)' in err
+    assert f'error: output.folder = "{tmp_path / "out"}": holds history.h5, named as this run\'s results but' in err
     assert "--overwrite" in err and "--resume" not in err and "Traceback" not in err
     fake_runner = []
     module = types.ModuleType("multiscale.workflows")
@@ -484,9 +484,19 @@ def test_overwrite_refuses_the_users_own_files_named_as_results(tmp_path, capsys
     (folder / "scene.toml").write_text("# mine")
     (folder / "history.h5").write_text("mine")
     scene = _scene_into(tmp_path, folder)
-    with pytest.raises(SceneError, match=r'holds history.h5, scene.toml, named as this run\'s results but not written '
-                                         r"by a run .*: --overwrite would replace them"):
-        prepare_folder(scene, overwrite=True, resume=False, comm=MPI.COMM_SELF)
+    for overwrite in (True, False):         # without --overwrite too (before: "already holds results")
+        with pytest.raises(SceneError, match=r'holds history.h5, scene.toml, named as this run\'s results but not '
+                                             r"written by a run .*: a run would write over them, --overwrite too"):
+            prepare_folder(scene, overwrite=overwrite, resume=False, comm=MPI.COMM_SELF)
+    (folder / "notes.txt").write_text("mine")
+    (folder / "history.h5").unlink()
+    (folder / "scene.toml").unlink()
+    with pytest.raises(SceneError, match=r"already holds 1 entry that no run wrote \(notes.txt\); use --overwrite to "
+                                         r"write beside them \(it deletes only what a run wrote"):
+        prepare_folder(scene, overwrite=False, resume=False, comm=MPI.COMM_SELF)
+    (folder / "notes.txt").unlink()
+    (folder / "scene.toml").write_text("# mine")
+    (folder / "history.h5").write_text("mine")
     assert (folder / "scene.toml").read_text() == "# mine" and (folder / "history.h5").read_text() == "mine"
     assert main(["check", str(scene.source)]) == 0
     assert "it refuses to write over history.h5, scene.toml, not written by a run" in capsys.readouterr().out

@@ -78,19 +78,22 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
     if taken:                        # this run would write over them: the scene of a run in its own folder
         raise SceneError(f'output.folder = "{folder}": holds {", ".join(taken)}, an input of the run before (a '
                          "scene run in its own folder); this run would write over it: choose another folder")
-    own = comm.bcast(provenance.unrecorded_results(scene, existing) if comm.rank == 0 and overwrite else [], root=0)
+    own = comm.bcast(provenance.unrecorded_results(scene, existing) if comm.rank == 0 and not resume else [], root=0)
     if own:
         raise SceneError(f'output.folder = "{folder}": holds {", ".join(own)}, named as this run\'s results but not '
-                         "written by a run (no record of it in provenance.json): --overwrite would replace them; move "
-                         "them or choose another folder")
+                         "written by a run (no record of it in provenance.json): a run would write over them, "
+                         "--overwrite too; move them or choose another folder")
     if existing and not (overwrite or resume):
         shown = ", ".join(existing[:3]) + (", ..." if len(existing) > 3 else "")
-        resumes = outputs.analysis(scene) == "multiscale"           # the only analysis with checkpoints
-        raise SceneError(f'output.folder = "{folder}": already holds results ({provenance.entries(len(existing))}: '
-                         f"{shown}); "
-                         + ("use --overwrite to replace them, --resume to continue the run (in Python: overwrite=True, "
-                            "resume=True), or choose another folder" if resumes else
-                            "use --overwrite to replace them (in Python: overwrite=True), or choose another folder"))
+        ran = comm.bcast(bool(set(existing) & set(provenance.results_of(folder))) if comm.rank == 0 else None, root=0)
+        resumes = ran and outputs.analysis(scene) == "multiscale"     # the only analysis with checkpoints
+        held = f"results ({provenance.entries(len(existing))}: {shown})" if ran else \
+            f"{provenance.entries(len(existing))} that no run wrote ({shown})"    # the user's own files: not "results"
+        advice = ("use --overwrite to replace them, --resume to continue the run (in Python: overwrite=True, "
+                  "resume=True)" if resumes else "use --overwrite to replace them (in Python: overwrite=True)" if ran
+                  else "use --overwrite to write beside them (it deletes only what a run wrote; in Python: "
+                  "overwrite=True)")
+        raise SceneError(f'output.folder = "{folder}": already holds {held}; {advice}, or choose another folder')
 
     def create():
         folder.mkdir(parents=True, exist_ok=True)
