@@ -261,7 +261,10 @@ class Loading:
     slides at ``sliding_speed``. Friction: a constant ``friction``; ``friction_temperature``, mu against the
     interface temperature (fade, effect "thermal": each facet's at the mean of its faces', a heat step late); an
     interface's own [interfaces.<name>] friction or table replaces them there; or (the squeal only) mu against
-    the slip speed, ``friction_curve`` or ``stribeck``, per facet at its steady slip speed."""
+    the slip speed, ``friction_curve`` or ``stribeck``, per facet at its steady slip speed. ``ramp_steps``: the
+    first contact solve (and the squeal's preload) applies the load in that many equal increments, 1/n, 2/n, ...,
+    1 of it, each from the last: more where one Newton solve from rest does not converge (a stiff penalty, a
+    contact that closes from a gap)."""
 
     normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)),                 # N
                                      absent="pressure, braking_torque or vehicle.mass gives the load")

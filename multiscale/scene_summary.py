@@ -42,6 +42,7 @@ def summary(scene: Scene) -> list[str]:
              f"  geometry  {source}, {g.motion} of {g.bodies[1]}" + (f"; {sizes}" if sizes else ""),
              *(f"            {line}" for line in g.spec.report),
              f"  bodies    {bodies}",
+             *(f"  material  {name}: {_material(m)}" for name, m in scene.materials.items()),
              f"  effects   {', '.join(e for e in EFFECTS if e in scene.effects)}"]
     for effect in EFFECTS:
         if scene.has(effect):
@@ -61,6 +62,10 @@ def summary(scene: Scene) -> list[str]:
         where = f" in all on {', '.join(ld.faces)}, shared by their areas"
     profile = f", load profile of {len(ld.load_profile)} points" if ld.load_profile else ""
     lines.append(f"  loading   {load_text}{where}, {motion}{profile}, {ld.ramp_steps} ramp step(s)")
+    if v is not None and ld.torque is not None and ld.braking_torque is None:   # (said nowhere before: a user trial)
+        force = "m a" if v.deceleration else f"m g sin(atan {v.slope:g})"
+        lines.append(f"            braking torque {ld.torque:.4g} N m at the {g.bodies[1]}: braking force {force} = "
+                     f"{v.braking_force:.4g} N x wheel radius")
     end = scene.time.end if scene.has("thermal") or scene.has("wear") else None
     if ld.torque is not None and end and g.motion == "rotation":     # the heat the run must account for
         work = ld.torque * ld.mean_sliding_factor(0.0, end) * end      # torque x load factor x angle, to time.end
@@ -99,6 +104,20 @@ def summary(scene: Scene) -> list[str]:
                      + (f"; it refuses to write over {', '.join(own)}, not written by a run" if own else ""))
     lines += [f"  warning   {w}" for w in scene.warnings]
     return lines
+
+
+MATERIAL_UNITS = {"E": (1e9, "GPa"), "nu": (1, ""), "rho": (1, "kg/m^3"), "kappa": (1, "W/(m K)"),
+                  "c": (1, "J/(kg K)"), "chi": (1, "m^2/s"), "alpha": (1, "1/K"), "k_w": (1, "1/Pa"),
+                  "hardness": (1e9, "GPa"), "loss_factor": (1, ""), "damping_alpha": (1, "1/s"),
+                  "damping_beta": (1, "s")}
+
+
+def _material(m) -> str:
+    """A material's given properties in words: "E 110 GPa, nu 0.26, kappa(T) 3 rows ..."."""
+    given = [(k, getattr(m, k)) for k in MATERIAL_UNITS if getattr(m, k) is not None]
+    return ", ".join(f"{k}(T) {len(v)} rows" if isinstance(v, tuple) else
+                     f"{k} {v / MATERIAL_UNITS[k][0]:.4g}" + (f" {MATERIAL_UNITS[k][1]}" if MATERIAL_UNITS[k][1] else "")
+                     for k, v in given)
 
 
 def _fade(table) -> str:
