@@ -562,7 +562,7 @@ def test_a_cutoff_shorter_than_two_micro_cells_is_refused(tmp_path, cover):
     # cells are longer than the map, a longer cut-off cannot help: the message says the grid only (a review)
     topography.check_cutoff("cutoff", 600e-6, 3e-3 / 10, 3e-3 / 10, measured=(1e-3, 1e-3))
     with pytest.raises(InputError, match=r"use a finer micro.grid: 2 of its cells are longer than the "
-                                         r"measurement \(0.5 x 0.5 mm\)$"):
+                                         r"measurement \(500 x 500 um\)$"):     # in um as the cells (a review)
         topography.check_cutoff("cutoff", 0.4e-3, 312.5e-6, 312.5e-6, measured=(0.5e-3, 0.5e-3))
 
 

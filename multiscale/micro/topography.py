@@ -148,7 +148,8 @@ def check_cutoff(name: str, cutoff: float, dx: float, dy: float, pixels: str = "
     short = cutoff < 2 * max(dx, dy) * (1 - 1e-9)
     if short and measured is not None:
         fix = "a finer micro.grid or a longer cutoff" if 2 * max(dx, dy) <= min(measured) else \
-            f"a finer micro.grid: 2 of its cells are longer than {_sized('the measurement', measured)}"
+            f"a finer micro.grid: 2 of its cells are longer than the measurement ({measured[0] * 1e6:.4g} x " \
+            f"{measured[1] * 1e6:.4g} um)"
         raise InputError(name, None, f"λc = {cutoff * 1e6:.4g} um must span at least 2 cells of the micro grid "
                          f"({2e6 * max(dx, dy):.4g} um): the roughness the filter leaves is finer than the grid, whose "
                          f"surface would be nearly flat; use {fix}")
