@@ -863,6 +863,12 @@ def test_an_interrupted_study_writes_the_table_of_the_runs_that_ended(tmp_path, 
     text = md.read_text()
     assert "- Runs: 1 ok, 0 failed, **3 not run or cut off: the study was stopped** (run it again" in text
     assert "Failed runs:" not in text
+    # into a report folder: its index of the reports written so far too (before: none on Ctrl-C, a review)
+    assert main(["study", str(path), "--report", str(tmp_path / "reports")]) == 130
+    index = tmp_path / "reports" / "README.md"
+    assert f"; index {index} " in capsys.readouterr().err
+    text = index.read_text()
+    assert "**Stopped during the study hertz**" in text and "## [" in text and "(hertz.md)" in text
 
 
 def test_a_measured_surface_is_a_micro_study_problem(tmp_path, capsys):

@@ -47,7 +47,11 @@ def run_studies(paths, *, rerun_failed: bool = False, report_folder=None, proces
                 rows = collect(study)
                 csv_path, _ = write_tables(study, rows)
                 try:                    # (an error of the report replaced the interrupt, its exit code 130: a review)
-                    md = f" and {report(study, rows, command)}"
+                    page = report(study, rows, command)
+                    md = f" and {page}"
+                    if report_folder is not None:     # the index too: the reports written so far (a review)
+                        index = write_index(summaries + [(study, rows, page)], study.report_folder, command, study.name)
+                        md += f"; index {index}"
                 except Exception as exc:      # the tables are written; the interrupt goes on
                     md = f" (no report: {type(exc).__name__}: {exc})"
                 print(f"{study.name}: the runs that ended are in {csv_path}{md} (the others: status missing)",

@@ -225,12 +225,16 @@ def _runs_table(study, rows) -> list[str]:
     return lines
 
 
-def write_index(summaries, folder: Path, command: str) -> Path:
-    """README.md of a report folder: per study, its cheapest settings at each stated error."""
+def write_index(summaries, folder: Path, command: str, stopped: str | None = None) -> Path:
+    """README.md of a report folder: per study, its cheapest settings at each stated error
+    (``stopped``: the study during which the command was stopped, the last of ``summaries``)."""
     lines = ["# What accuracy costs", "",
              f"Generated {now()} on a {os.cpu_count()}-core machine by `{command}`. Each study has its own "
              "page (tables of every run, plots of error against wall time with the Pareto front, and against "
              "each knob).", ""]
+    if stopped is not None:
+        lines += [f"**Stopped during the study {stopped}**: its page has the runs that ended; the studies after it "
+                  "did not run.", ""]
     for study, rows, md in summaries:
         lines += [f"## [{study.report.title or study.name}]({md.name})", ""]
         if study.description:
