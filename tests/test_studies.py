@@ -226,6 +226,26 @@ def test_a_log_axis_of_the_error_figure_has_at_least_two_labels(tmp_path, made, 
             assert float(text) == pytest.approx(at, rel=5e-3)
 
 
+def test_the_figures_mark_the_reference_run_and_label_only_what_they_draw(tmp_path, made):
+    """The reference run's error 0 has no place on a log axis: the knob figure marks its setting with
+    a line (it was missing: a user trial); a Pareto front's points are ringed, so that a front of one
+    point is seen under its legend entry (it drew nothing: a user trial)."""
+    from multiscale.plots import studies as figures
+    study = load_study(write(tmp_path, HERTZ.replace('kind = "analytic"', 'kind = "run"\nrun = {grid = 32}')))
+    for errors, front in (((0.05, 0.02, 0.01), 3), ((0.01, 0.02, 0.05), 1)):
+        made.clear()
+        rows = [Row(run, {"status": "ok", "wall_time": t, "metrics": {m: 1.0 for m in study.metrics}},
+                    errors={m: e for m in study.judged}, is_reference=e == 0)
+                for run, t, e in zip(study.runs, (1.0, 2.0, 3.0, 4.0), (*errors, 0.0))]
+        figures.plot(study, rows, tmp_path)
+        pareto_ax, knob_ax = made[0][1][0][0], made[1][1][0][0]
+        steps = [line for line in pareto_ax.get_lines() if line.get_drawstyle() == "steps-post"]
+        assert [len(line.get_xdata()) for line in steps] == [front] and steps[0].get_marker() == "o"
+        assert steps[0].get_label() == "Pareto front"
+        marks = [line for line in knob_ax.get_lines() if line.get_label() == "the reference (error 0)"]
+        assert len(marks) == 1 and list(marks[0].get_xdata()) == [32, 32]
+
+
 @pytest.mark.parametrize("dt, ticks, label", [('{start = "50 us", stop = "450 us", num = 3, log = true}',
                                                ["50 µs", "150 µs", "450 µs"], "dt"),
                                               ("[5e-05, 0.00015, 0.00045]", ["5e-05", "0.00015", "0.00045"], "dt [s]")])

@@ -71,9 +71,10 @@ def _plot_pareto(study, ok, folder):
             for i in (i for i in idx if i in labelled):
                 ax.annotate(_short(ok[i].run, study.cases), (t[i], e[i]), fontsize=6,
                             xytext=(3, 3), textcoords="offset points")
-            if front:
+            if front:                   # its points ringed: a front of one point drew nothing under its entry (a trial)
                 ax.step([t[i] for i in front], [e[i] for i in front], where="post", color=f"C{c}", lw=2, alpha=0.6,
-                        zorder=2, label=None if named else "Pareto front" + (" of each case" if len(cases) > 1 else ""))
+                        marker="o", ms=9, mfc="none", zorder=2,
+                        label=None if named else "Pareto front" + (" of each case" if len(cases) > 1 else ""))
                 drawn = named = True
         refs = sorted(r.record["wall_time"] for r in ok if r.is_reference)
         if refs:                 # (the band was unexplained: a user trial)
@@ -198,6 +199,11 @@ def _plot_axis(study, ok, axis, folder, found):
                         ha="center", va="center")
             for tol in study.report.errors:
                 ax.axhline(tol, color="gray", ls="--", lw=0.8)
+            at = sorted({xs[point(r)] for r in ok if r.is_reference})   # its error 0 has no place on a log axis
+            for k, x in enumerate(at):       # (it was missing from the plot: a user trial)
+                ax.axvline(x, color="green", ls=":", lw=1, label=None if k else "the reference (error 0)")
+            if at:
+                ax.legend(fontsize=6)
         if kind == "value" and m in study.judged:        # calibration: the measured value, and where it is met
             ref = measured_value(ok, m)
             ax.axhline(ref, color="green", ls="--", lw=1, label="measured")
@@ -207,7 +213,8 @@ def _plot_axis(study, ok, axis, folder, found):
         if kind == "time":
             ax.set_yscale("log")
         value = metric_heading(m, PROBLEMS[study.problem].metric_unit(m)) if kind == "value" else ""
-        ax.set(xlabel=_axis_label(study, axis, [r.run.raw[axis[0]] for r in ok]), ylabel={"error": f"relative error of {m}", "value": value, "time": "wall time [s]"}[kind],
+        ax.set(xlabel=_axis_label(study, axis, [r.run.raw[axis[0]] for r in ok]),
+               ylabel={"error": f"relative error of {m}", "value": value, "time": "wall time [s]"}[kind],
                title={"error": f"error of {m}", "value": m, "time": "wall time of a run"}[kind])
         if log_x:             # ticks at the swept values, no minor labels (they overlap on short decades)
             ax.set_xscale("log")
