@@ -106,6 +106,7 @@ _UNITS: dict[str, tuple[Fraction, tuple[int, ...], bool]] = {
     "ksi": (1000 * _LBF / _F("0.0254") ** 2, _PRESSURE, False), "mph": (_F("0.44704"), _dim((L, 1), (T, -1)), False),
 }
 _ABSOLUTE = {"degC": _F("273.15"), "°C": _F("273.15")}   # offsets of a whole-unit absolute temperature
+_SPELLED = {"kmh": "km/h", "kph": "km/h", "kmph": "km/h", "km/hr": "km/h", "G": "gn", "g0": "gn"}   # other spellings
 _TYPED = {"°C": "degC"}          # a suggestion as a keyboard types it ("20 C": "degC", not "°C")
 _PREFIXES = {"G": _F(10**9), "M": _F(10**6), "k": _F(1000), "c": _F(1, 100), "m": _F(1, 1000),
              "u": _F(1, 10**6), "µ": _F(1, 10**6), "μ": _F(1, 10**6), "n": _F(1, 10**9),
@@ -131,6 +132,9 @@ def _lookup(name: str) -> tuple[Fraction, tuple[int, ...]]:
             return _PREFIXES[name[0]] * base[0], base[1]
     if name in _NOT_READ:
         raise UnitError(f'unknown unit "{name}": {_NOT_READ[name]}')
+    spelled = _SPELLED.get(name, _SPELLED.get(name.lower()))
+    if spelled:                          # (by spelling alone "kmh" was "mph" and "G" "Gs": a user trial)
+        raise UnitError(f'unknown unit "{name}" (did you mean "{spelled}"?)')
     known = list(_UNITS) + [p + u for u, (_, _, pre) in _UNITS.items() if pre for p in "GMkmu"]
     split = next((f"{name[:i]} {name[i:]}" for i in range(1, len(name)) if {name[:i], name[i:]} <= set(known)), None)
     near = [split] if split else difflib.get_close_matches(name, known, n=1, cutoff=0.5)   # "Nm": "N m", not "m"
@@ -208,7 +212,9 @@ class _Parser:
             return _lookup(tok)
         if kind == "num" or (kind == "op" and tok.isdigit()):
             if self.i != 1 or _F(tok) != 1:      # only the 1 of "1/K": "0.4 5" is a typo, not 2.0
-                raise UnitError(f'a number ("{tok}") inside a unit: only "1/<unit>" may start with one')
+                before = self.tokens[self.i - 2] if self.i >= 2 else ("", "")
+                power = f' (a power is written with "^": "{before[1]}^{tok}")' if before[0] == "name" else ""
+                raise UnitError(f'a number ("{tok}") inside a unit: only "1/<unit>" may start with one{power}')
             return _F(tok), ONE
         if tok == "(":
             inner = self.expr()
@@ -283,7 +289,8 @@ def to_si(value, kind: str) -> float:
             raise UnitError(f'{expect}: a quoted number needs its unit, like "{match.group(1)} {spec.si}" (a '
                             f'number without quotes is taken in {spec.si})')
         if dim != spec.dim:
-            raise UnitError(f"{expect}; the unit \"{match.group(2)}\" is {_mismatch(dim, spec)}")
+            gravity = ' (standard gravity is "gn")' if match.group(2) == "g" and spec.name == "acceleration" else ""
+            raise UnitError(f"{expect}; the unit \"{match.group(2)}\" is {_mismatch(dim, spec)}{gravity}")
     try:
         return float(number * factor + offset)
     except OverflowError:
@@ -323,6 +330,9 @@ def _kind_unit(text: str, spec: Kind) -> str | None:
     (its examples first: "mpa" is MPa, "kn" kN), else the closest (difflib); None if none is close."""
     named = [u.strip() for u in spec.examples.split(",")] + \
         [p + u for u, (_, dim, pre) in _UNITS.items() if dim == spec.dim for p in ("", *("GMkmu" if pre else ""))]
+    spelled = _SPELLED.get(text, _SPELLED.get(text.lower()))
+    if spelled:
+        return spelled
     same = [u for u in named if u.lower() == text.lower()]
     near = same[0] if same else next(iter(difflib.get_close_matches(text, named, n=1, cutoff=0.5)), None)
     return _TYPED.get(near, near)

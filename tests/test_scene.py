@@ -123,6 +123,11 @@ def test_unit_strings_to_si(text, kind, expected):
     ("2 kNm", "torque", 'unknown unit "kNm" (did you mean "kN m"?)'),
     ("20 C", "temperature", 'unknown unit "C" (did you mean "degC"?)'),       # was "°C", not on a keyboard
     ("1e-5 1/C", "expansion", 'unknown unit "C" (did you mean "degC"?)'),
+    ("80 kmh", "speed", 'unknown unit "kmh" (did you mean "km/h"?)'),    # was "mph": 128.7 km/h (a user trial)
+    ("80 KMH", "speed", 'unknown unit "KMH" (did you mean "km/h"?)'),    # was "MHz"
+    ("0.5 G", "acceleration", 'unknown unit "G" (did you mean "gn"?)'),  # was "Gs", then refused as a time
+    ("0.5 g", "acceleration", 'the unit "g" is a mass (standard gravity is "gn")'),
+    ("7.2 g/cm3", "density", 'a power is written with "^": "cm^3"'),
     ("2e-5 mm^3/N", "wear_rate", 'the unit "mm^3/N" is that times a length (m^2 kg^-1 s^2 in SI base units)'),
     ("2e-5", "wear_rate", 'a quoted number needs its unit, like "2e-5 1/Pa"'),    # was: the unit "" is ...
 ])
