@@ -124,6 +124,11 @@ class Sweep:
 class Stability:
     """Complex eigenvalue analysis (§4.3): modes in a frequency band, shift target, damping.
 
+    ``modes``: how many complex modes to find in the ``band`` [low, high] (Hz), nearest the
+    ``target`` (default: the band's lower edge) first: all of the band's when it holds fewer; when it
+    holds more, those nearest the target, and the run warns which part of the band was not searched
+    (raise ``modes`` until that warning goes).
+
     ``damping`` (loss factor eta), ``rayleigh_alpha`` / ``rayleigh_beta`` (alpha M + beta K) act on
     the whole system, mapped exactly from the undamped modes. Per-material damping, the friction
     slope (``friction_damping``) and the gyroscopic terms are solved as a full quadratic

@@ -152,6 +152,11 @@ def _effect_line(scene: Scene, effect: str) -> str:
         return f"Coulomb, mu = {ld.friction:g}" + _own_friction(scene, "friction")
     if effect == "thermal":
         return f"transient conduction in {', '.join(scene.bodies)}"
+    if effect == "stability" and scene.stability is not None:   # (the band and count said nowhere: a user trial)
+        st = scene.stability
+        target = f"{st.target:g} Hz" if st.target is not None else "its lower edge"
+        return (f"complex eigenvalues at the sliding state: {st.modes} mode(s) in {st.band[0]:g} to {st.band[1]:g} Hz, "
+                f"nearest {target} first")
     if effect == "heat_partition" and scene.has("roughness") and scene.micro.partition_law:
         m = scene.micro
         heating = f"transient, N_t = {m.heating_steps}" if m.heating == "transient" else "steady"

@@ -951,6 +951,8 @@ def test_loading_friction_is_needed_only_for_interfaces_without_their_own(tmp_pa
     assert "Coulomb, mu per interface" in "\n".join(summary(scene))
     one = loads((DEMOS / "brake_squeal.toml").read_text(), DEMOS, overrides={"interfaces.inner_pad.friction": 0.3})
     assert "    friction       Coulomb, mu = 0.4 (its own on inner_pad)" in summary(one)   # (said mu = 0.4 alone)
+    assert ("    stability      complex eigenvalues at the sliding state: 100 mode(s) in 0 to 16000 Hz, nearest its "
+            "lower edge first") in summary(one)          # (the band and count were said nowhere: a user trial)
     assert not any("unused" in w for w in one.warnings)
     every = loads((DEMOS / "brake_squeal.toml").read_text(), DEMOS,     # (said nothing: a sweep of it changed nothing)
                   overrides={"interfaces.inner_pad.friction": 0.3, "interfaces.outer_pad.friction": 0.3})
