@@ -267,6 +267,20 @@ def test_a_run_with_fade_draws_its_friction_coefficient(tmp_path, drawn):
     assert {line.get_label(): tuple(line.get_ydata()) for line in ax.get_lines()} == {
         "all": pytest.approx((0.4, 0.37)), "inner pad": pytest.approx((0.41, 0.38)),
         "outer pad": pytest.approx((0.39, 0.36))}
+    # a pad has its part's colour in the friction panel too, all of them black (the "all" curve
+    # shifted the colours: orange was one pad there and another among the temperatures, a user trial)
+    parts = History()
+    for t, mu in ((0.0, 0.4), (1.0, 0.37)):
+        parts.append(time=t, interface_force=200.0, max_pressure=1e6, max_temperature_disc=298.0 + t,
+                     max_temperature_fixed_part_inner_pad=300.0 + t, max_temperature_fixed_part_outer_pad=301.0 + t,
+                     heat_total_disc=t, friction_coefficient=mu, friction_coefficient_inner_pad=mu + 0.01,
+                     friction_coefficient_outer_pad=mu - 0.01)
+    plots.history_figure(parts, tmp_path / "history.png")
+    colour = {}
+    for ax in drawn[-1].axes:
+        for line in ax.get_lines():
+            colour.setdefault(line.get_label(), set()).add(to_hex(line.get_color()))
+    assert colour["all"] == {"#000000"} and all(len(colour[n]) == 1 for n in ("inner pad", "outer pad", "disc"))
 
 
 def test_the_multiscale_figures_legends_cover_no_panel(tmp_path, drawn):

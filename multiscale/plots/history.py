@@ -82,12 +82,16 @@ def colours(names) -> dict:
 def body_colours(columns) -> dict:
     """One colour per body and part name of a history, for every panel of ``history_figure`` and
     ``multiscale_figure``: in the order of the max-temperature panel's curves, then the other
-    bodies and parts (each panel numbered its own before: the pin was green, orange and orange in
-    three panels of one figure; a user trial)."""
+    bodies and parts, then the interfaces (each panel numbered its own before: the pin was green,
+    orange and orange in three panels of one figure, and a pad orange in one panel and red in the
+    next; user trials)."""
     names = [column_label(k) for k in temperature_columns(columns)]
     names += [column_label(k) for k in columns if k.startswith("heat_total_")
               or k.startswith("stored_heat_") and "_part_" in k]
-    return colours(dict.fromkeys(names))
+    # the interfaces (a pad's own colour where it is named as its part), all of them together black
+    names += [column_label(k).rpartition(" on ")[0] or column_label(k) for k in columns
+              if k.startswith(("friction_coefficient_", "frictional_heat_total_", "face_max_temperature_"))]
+    return colours(dict.fromkeys(names)) | {"all": (0.0, 0.0, 0.0, 1.0)}
 
 
 def curve_styles(keys, palette: dict | None = None) -> tuple[list[dict], list]:
