@@ -562,8 +562,11 @@ def _surface_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]
         problems.append("loading.faces: missing; a geometry file needs the surfaces where the load acts "
                         f"(known: {', '.join(g.spec.faces) or 'none: name some in [geometry.surfaces]'})")
     for name in scene.interfaces:
-        if name not in g.spec.interfaces:
-            problems.append(f'interfaces.{name}: not an interface of {where}; interfaces: {", ".join(g.spec.interfaces)}')
+        if name not in g.spec.interfaces:      # a pad off the disc has none: its gap was not said (a user trial)
+            apart = [w.removeprefix("geometry.bodies: ") for w in g.spec.warnings
+                     if "share no face" in w and name in w.partition(" share no face")[0]]
+            problems.append(f'interfaces.{name}: not an interface of {where}; interfaces: {", ".join(g.spec.interfaces)}'
+                            + (f" ({apart[0]})" if apart else ""))
     ld = scene.loading
     direction = ld.direction if ld is not None and ld.direction is not None else \
         None if g.spec.fluid_load else g.spec.load_direction        # (a fluid load: along each face's normal)

@@ -1076,6 +1076,16 @@ def test_a_pad_off_the_disc_is_named_by_check(tmp_path, capsys):
     assert warnings == ["warning   geometry.bodies: pad_b share no face with disc, nor a body bonded to them (gap "
                         "0.001 m): no contact interface holds them, no friction or heat reaches them; a pad must "
                         "share a face with disc in the file"]
+    # the run's refusal of its free motion names that cause (it advised supports alone: a user trial)
+    from multiscale.workflows.model import build_mesh
+    with pytest.raises(InputError, match=r"could move as rigid bodies \(one of region 'pad_b' .*Its cause is likely "
+                                         r"what check warned: pad_b share no face with disc.*\(gap 0.001 m\)"):
+        build_mesh(loads(text, tmp_path))
+    # a table of its interface, which does not exist, says why (it hid the gap: a user trial)
+    path.write_text(text + "\n[interfaces.pad_b]\nfriction = 0.3\n")
+    assert main(["check", str(path)]) == 2
+    assert "error: interfaces.pad_b: not an interface of the geometry; interfaces: pad_a (pad_b share no face with " \
+        "disc, nor a body bonded to them (gap 0.001 m)" in capsys.readouterr().err
 
 
 ROUND_PIN_GEO = """SetFactory("OpenCASCADE");

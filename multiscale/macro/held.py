@@ -266,5 +266,10 @@ def check_held(model, spec: GeometrySpec, sliding: bool = False) -> None:
     holding.supports(spec)
     holding.interfaces(spec, sliding)
     error = holding.refusal({r.tag: r.name for b in spec.bodies for r in b.regions})
-    if error is not None:
-        raise error
+    if error is None:
+        return
+    apart = [w for w in spec.warnings if "share no face" in w and error.value in w.partition(" share no face")[0]]
+    if apart:                # its real cause, warned of at check (a user trial fixed the sides, as it advised)
+        raise InputError(error.name, error.value, f"{error.allowed}. Its cause is likely what check warned: "
+                         f"{apart[0].removeprefix('geometry.bodies: ')}")
+    raise error
