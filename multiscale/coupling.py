@@ -576,7 +576,6 @@ class Multiscale:
         self.interval_work = float(attrs.get("interval_work", 0.0))     # absent from older checkpoints
         if m.thermal is not None:
             m.thermal.time = m.time
-            m.update_friction()
         # the run's warnings before (not said again), then this session's own (set-up: the options)
         for holder, said in zip((m, m.thermal), json.loads(attrs.get("notes", "[[], []]"))):
             if holder is not None:
@@ -587,6 +586,7 @@ class Multiscale:
         m.load, m.solved_speed, m.stale = float(attrs["load"]), float(attrs["solved_speed"]), bool(attrs.get("stale", 1))
         for c, value in zip(self.model.drive_constants, attrs["constants"]):   # speed, engagement, load last solved
             c.value = value
+        m.update_friction()                     # fade and mu(v): at the temperatures and the speed last solved
         self.rough.update_laws()
         self.apply_zone_fields()
         history = io.History()

@@ -20,16 +20,11 @@ def bare_interfaces(interfaces, names) -> list[str]:
 def law_problems(path: str, law: list[str], ctx) -> list[str]:
     """The friction keys ``law`` given in table ``path`` ([loading] or [interfaces.<name>]; in
     ``FRICTION`` order): ignored without effect "friction" (a warning in ``ctx``), else a fade table
-    needs effect "thermal" and a mu(v) law is the squeal analysis' (effect "stability")."""
+    needs effect "thermal"."""
     if law and "friction" not in ctx.effects:
         ctx.warnings.append(f'{path}.{law[0]} is ignored: effect "friction" is not in effects')
     elif law[:1] == ["friction_temperature"] and "thermal" not in ctx.effects:
         return [f'{path}.friction_temperature: needs effect "thermal" (its temperatures); give {path}.friction']
-    elif law and law[0] not in FRICTION[:2] and "stability" not in ctx.effects:
-        fade = f" or {path}.friction_temperature" if "thermal" in ctx.effects else ""
-        return [f"{path}.{law[0]}: a speed-dependent friction is read by the squeal analysis only "
-                f'(effect "stability"); a run takes {path}.friction{fade}'
-                + (" (or none, where every interface gives its own)" if path == "loading" else "")]
     return []
 
 
@@ -68,16 +63,16 @@ def fade_coverage(tables: dict[str, tuple], T0: float) -> list[str]:
 
 def initial_friction(settings, T0: float) -> float | None:
     """mu [-] at the initial temperature T0 [K] of an interface's settings (``Scene.interface_settings``):
-    its constant, else its fade table's; None with a mu(v) law only (the squeal analysis')."""
+    its constant, else its fade table's; None with [loading]'s mu(v) law (``speed_law_guess``)."""
     if settings.friction is None and settings.friction_temperature is not None:
         return interpolate(settings.friction_temperature, T0)
     return settings.friction
 
 
 def speed_law_guess(ld) -> float | None:
-    """The constant mu [-] standing for [loading]'s mu(v) law (``Loading``) until the squeal
-    preload sets each facet's (``workflows.squeal.model_scene``): its kinetic mu, or the mean of
-    its curve's; None without one."""
+    """The constant mu [-] standing for [loading]'s mu(v) law (``Loading``) until the law sets each
+    facet's (a run's first solve, the squeal preload: ``workflows.model.friction_coefficient``): its
+    kinetic mu, or the mean of its curve's; None without one."""
     if ld.stribeck is not None:
         return ld.stribeck.kinetic
     return sum(mu for _, mu in ld.friction_curve) / len(ld.friction_curve) if ld.friction_curve else None

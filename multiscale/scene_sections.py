@@ -260,8 +260,9 @@ class Loading:
     ``rotation_speed``, a ``speed_profile`` against time, or a ``vehicle`` stop or drag; a translating body
     slides at ``sliding_speed``. Friction: a constant ``friction``; ``friction_temperature``, mu against the
     interface temperature (fade, effect "thermal": each facet's at the mean of its faces', a heat step late); an
-    interface's own [interfaces.<name>] friction or table replaces them there; or (the squeal only) mu against
-    the slip speed, ``friction_curve`` or ``stribeck``, per facet at its steady slip speed. ``ramp_steps``: the
+    interface's own [interfaces.<name>] friction or table replaces them there; or mu against the slip speed,
+    ``friction_curve`` or ``stribeck``, per facet at its slip speed (a run: at each contact solve's speed, the
+    heat of a step with the mu of its start; the squeal: at the steady slip speed). ``ramp_steps``: the
     first contact solve (and the squeal's preload) applies the load in that many equal increments, 1/n, 2/n, ...,
     1 of it, each from the last: more where one Newton solve from rest does not converge (a stiff penalty, a
     contact that closes from a gap)."""

@@ -29,24 +29,34 @@ def mean_pin_radius(n: int = 400) -> float:
     return float(np.hypot(90e-3 + s[:, None], s[None, :]).mean())
 
 
-@pytest.mark.parametrize("end, steps", [("2.4 s", 6), ("3 s", 2)])
-def test_a_vehicle_stop_brakes_the_mass_and_turns_its_energy_into_heat(tmp_path, end, steps):
+@pytest.mark.parametrize("end, steps, curve", [("2.4 s", 6, False), ("3 s", 2, False), ("2.4 s", 6, True)])
+def test_a_vehicle_stop_brakes_the_mass_and_turns_its_energy_into_heat(tmp_path, end, steps, curve):
     """The friction moment about the axis is the braking force at the tyre times the wheel radius
     (the clamp force is scaled to the pressure-weighted radius: the disc's bending shifts the
     pressure inwards, 2.5 % here, so it exceeds the guess from the pin's area-weighted radius);
     the speed falls linearly to 0 at v0/a; the frictional heat of the stop is the kinetic energy
     1/2 m v0^2, also when the stop ends inside a step (a heat step takes the exact means of the
     speed and of load factor x speed over it; before, the mean of the speeds at its ends: 1.125
-    times the energy with 2 steps over 3 s, 3 times with 1 step over 6 s)."""
+    times the energy with 2 steps over 3 s, 3 times with 1 step over 6 s). With mu rising as the disc
+    slows (``curve``: a friction_curve, mu 0.4 at the first guess's speed) the clamp force falls
+    with it and the heat is the energy all the same."""
     text = pod(tmp_path / "stop").replace('rotation_speed = "200 rpm"\n', "")
+    if curve:
+        text = text.replace("friction = 0.4", 'friction_curve = [["0 m/s", 0.5], ["1 m/s", 0.4]]')
     scene = loads(text.replace("normal_force = \"200 N\"\n", ""), overrides={
         "loading.vehicle": {"speed": f"{V0} m/s", "deceleration": f"{DECEL} m/s^2", "wheel_radius": f"{WHEEL} m",
                             "mass": f"{MASS} kg"}, "time.end": end, "time.steps": steps})
     h = run(scene, verbose=False).history
     guess = MASS * DECEL * WHEEL / (0.4 * mean_pin_radius())
     assert 1.0 < h["interface_force"][0] / guess < 1.05
-    # (at rest the contact is solved again without friction: the same load to round-off)
-    np.testing.assert_allclose(h["interface_force"], h["interface_force"][0], rtol=1e-10)
+    if curve:                 # 0.4 down to 1 m/s at the pin (3.33 m/s at the tyre, t = 1.33 s), then rising
+        mu = h["friction_coefficient"][h["time"] < 2.0 - 1e-9]           # rows at 0, 0.4, ... 1.6 s
+        slip = (V0 - DECEL * 1.6) / WHEEL * mean_pin_radius()
+        np.testing.assert_allclose(mu[:4], 0.4, rtol=1e-4)
+        assert mu[4] == pytest.approx(0.5 - 0.1 * slip, rel=0.01)      # 0.44
+        np.testing.assert_allclose(h["interface_force"][:5], h["interface_force"][0] * mu[0] / mu, rtol=0.01)
+    else:                     # (at rest the contact is solved again without friction: the same load to round-off)
+        np.testing.assert_allclose(h["interface_force"], h["interface_force"][0], rtol=1e-10)
     heat = h["heat_total_pin"][-1] + h["heat_total_disc"][-1]
     assert heat == pytest.approx(0.5 * MASS * V0**2, rel=1e-6)
     # the history's braking torque is m a R while sliding (every row before the stop), 0 without friction
@@ -343,6 +353,38 @@ def test_each_pad_reads_its_own_friction_coefficient_under_fade(tmp_path):
     assert 0.3 < row["friction_coefficient_outer_pad"] < 0.49
     both = sum(row[f"friction_force_{p}"] for p in PADS) / sum(row[f"interface_force_{p}"] for p in PADS)
     assert row["friction_coefficient"] == pytest.approx(both, rel=1e-12)
+
+
+def test_a_friction_falling_with_speed_sets_each_facets_mu_at_its_slip_speed(tmp_path):
+    """loading.friction_curve in a run (before: the squeal analysis' only): at every contact solve
+    each facet's mu is the law at its slip speed, here omega r on the pin's face, so a ramp of the
+    disc from 100 to 300 rpm lowers the dynamometer's mu (friction_force / interface_force) as the
+    law says: the law at each facet's midpoint radius weighted by the facets' normal forces, to 1e-3
+    (a facet's mean |w_t| against omega at its midpoint; its friction integrated before its
+    magnitude); at a constant speed mu stays and no solve is added."""
+    from multiscale.workflows.model import build_model
+    rows = [["0 m/s", 0.5], ["5 m/s", 0.3]]
+    text = pin_on_disc(tmp_path / "mu_v", effects=("contact", "friction")).replace('rotation_speed = "200 rpm"\n', "")
+    scene = loads(text.replace("friction = 0.4", f"friction_curve = {rows}".replace("'", '"')), overrides={
+        "loading.speed_profile": [["0 s", "100 rpm"], ["1.2 s", "300 rpm"], ["2.4 s", "300 rpm"]],
+        "time.end": "2.4 s", "time.steps": 4})
+    model = build_model(scene)
+    model.start()
+    iface = model.tm.interface
+    radius = np.hypot(iface.midpoints[:, 0], iface.midpoints[:, 1])
+    found = []
+    for k in range(4):
+        solves = model.last_solve
+        row = model.record(model.macro_step(0.6))
+        omega = (100 + 200 * min((k + 1) / 2, 1.0)) * np.pi / 30
+        normal = model.contact.facet_normal_force()
+        expected = np.interp(omega * radius, [0.0, 5.0], [0.5, 0.3]) @ normal / normal.sum()
+        assert row["friction_coefficient"] == pytest.approx(expected, rel=1e-3), k
+        found.append((row["friction_coefficient"], model.last_solve is solves))
+    model.close()
+    assert found[0][0] > found[1][0] == pytest.approx(found[2][0], rel=1e-12)    # 200, then 300 rpm and held
+    assert found[1][0] == pytest.approx(0.5 - 0.04 * 300 * np.pi / 30 * mean_pin_radius(), rel=0.01)
+    assert [same for _, same in found] == [False, False, True, True]    # no solve at a constant speed
 
 
 def test_a_pads_face_temperatures_are_those_of_its_facets(tmp_path):

@@ -1057,19 +1057,27 @@ def test_an_interface_with_its_own_friction_keeps_it_under_fade():
                                                    tag_index=np.array([0, 0, 0, 1, 1]), masks=lambda: masks))
     law = friction_law(scene, tm)
     T = np.array([273.15, 493.15, 1000.0, 273.15, 1000.0])          # 0 degC, 220 degC, beyond; the outer pad
-    np.testing.assert_allclose(law(T), [0.45, 0.35, 0.25, 0.3, 0.3], rtol=1e-14)
+    np.testing.assert_allclose(law(T, None), [0.45, 0.35, 0.25, 0.3, 0.3], rtol=1e-14)
     assert friction_coefficient(scene, "inner_pad") == pytest.approx(0.45 - 0.2 * (30.0 - 20.0) / 400.0)
     assert friction_coefficient(scene, "outer_pad") == 0.3
     # a table of the pad's own: the outer pad fades by its table, the inner keeps [loading]'s mu
     # (before, [interfaces.<name>] had no friction_temperature: one table served all interfaces)
     own = loads((demos / "car_brake_stop.toml").read_text() + '\n[interfaces.outer_pad]\nfriction_temperature = '
                 '[["120 degC", 0.5], ["320 degC", 0.3]]\n', demos)
-    np.testing.assert_allclose(friction_law(own, tm)(T), [0.4, 0.4, 0.4, 0.5, 0.3], rtol=1e-14)
+    np.testing.assert_allclose(friction_law(own, tm)(T, None), [0.4, 0.4, 0.4, 0.5, 0.3], rtol=1e-14)
     assert [friction_coefficient(own, n) for n in ("inner_pad", "outer_pad")] == [0.4, 0.5]
     both = loads(text + '\n[interfaces.outer_pad]\nfriction_temperature = [["120 degC", 0.5], ["320 degC", 0.3]]\n',
                  demos)
-    np.testing.assert_allclose(friction_law(both, tm)(T), [0.45, 0.35, 0.25, 0.5, 0.3], rtol=1e-14)
+    np.testing.assert_allclose(friction_law(both, tm)(T, None), [0.45, 0.35, 0.25, 0.5, 0.3], rtol=1e-14)
     assert friction_law(loads((demos / "car_brake_stop.toml").read_text(), demos), tm) is None
+    # [loading]'s mu(v) law: the inner pad's facets at their slip speeds, the outer pad's own 0.3
+    curve = loads((demos / "car_brake_stop.toml").read_text().replace(
+        "friction = 0.4", 'friction_curve = [["0 m/s", 0.5], ["10 m/s", 0.3]]')
+        + "\n[interfaces.outer_pad]\nfriction = 0.3\n", demos)
+    V = np.array([0.0, 5.0, 30.0, 5.0, 5.0])
+    np.testing.assert_allclose(friction_law(curve, tm)(None, V), [0.5, 0.4, 0.3, 0.3, 0.3], rtol=1e-14)
+    assert friction_law(curve, tm).reads_speed and not friction_law(both, tm).reads_speed
+    assert friction_coefficient(curve, "inner_pad") == pytest.approx(0.4)     # the curve's mean: a first guess
 
 
 def test_the_friction_coefficient_is_not_a_number_once_the_disc_stopped():

@@ -1,4 +1,5 @@
-"""Velocity-dependent friction mu(v_slip) and the damping of its slope (issue 20).
+"""Velocity-dependent friction mu(v_slip) and the damping of its slope (issue 20); the per-facet
+friction of a run (``FacetFriction``: fade tables and mu(v) laws as the run goes).
 
 A friction law gives mu and dmu/dv at a slip speed v [m/s]: ``ConstantFriction``,
 ``TableFriction`` (rows (v, mu), linear in between, constant beyond the ends) or
@@ -102,6 +103,32 @@ class StribeckFriction:
     @property
     def constant(self) -> bool:
         return self.static == self.kinetic
+
+
+@dataclass(frozen=True)
+class FacetFriction:
+    """mu of every interface facet as a run goes (``MacroModel.friction_law``): ``constant`` (n_facets,)
+    where an interface has a constant; on the facets of each ``fades`` entry (mask, temperatures [K],
+    mu) mu of the mean of its two faces' temperatures (a fade table, linear in between, held beyond its
+    ends); on those of each ``speeds`` entry (mask, law) the law's mu at the facet's slip speed [m/s]."""
+
+    constant: np.ndarray
+    fades: tuple = ()
+    speeds: tuple = ()
+
+    @property
+    def reads_speed(self) -> bool:
+        return bool(self.speeds)
+
+    def __call__(self, T: np.ndarray | None, V: np.ndarray | None) -> np.ndarray:
+        """mu [-] per facet at facet temperatures T [K] (None: no fade table) and slip speeds V
+        [m/s] (None: no speed law)."""
+        mu = self.constant.copy()
+        for on, temperatures, values in self.fades:
+            mu[on] = np.interp(T[on], temperatures, values)
+        for on, law in self.speeds:
+            mu[on] = law.value(V[on])
+        return mu
 
 
 def facet_slip_speed(mech: Mechanics) -> np.ndarray:

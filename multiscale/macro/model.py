@@ -22,6 +22,7 @@ import numpy as np
 from multiscale.outputs import step_time
 from multiscale.errors import InputError
 from multiscale.geometry import Rotation
+from multiscale.macro.friction import FacetFriction
 from multiscale.macro.load_faces import clamp_imbalance, load_face_forces
 from multiscale.macro.mechanics import Mechanics, SolveResult
 from multiscale.macro.mesh import TwoBodyMesh
@@ -87,8 +88,9 @@ class MacroModel:
     solved_speed: float = 0.0                          # the speed of the last contact solve (friction on if > 0)
     load: float | None = None                          # N or Pa at factor 1 (the drive's, or scaled to its torque)
     partitions: dict = field(default_factory=dict)     # share of frictional heat into body 0 per interface [-]
-    # mu per interface facet against its temperature [K] (n_facets,) -> (n_facets,): fade, set after every heat step
-    friction_law: Callable[[np.ndarray], np.ndarray] | None = None
+    # mu per interface facet against the facets' temperatures [K] and slip speeds [m/s] (``friction.FacetFriction``):
+    # set after every heat step (fade) and, with a mu(v) law, at the speed of every contact solve
+    friction_law: FacetFriction | None = None
     # a heat step changed mu (a friction_law) or the thermal strain since the last contact solve: a loaded
     # substep solves after its heat step, and a loaded slide first (the first step of a stop after a dwell)
     stale: bool = False
@@ -127,6 +129,7 @@ class MacroModel:
         a start in a released phase solves at the full load, factor 1, then releases); with a
         torque, the load is scaled to it and solved again (from rest: once sliding starts)."""
         self.contact.speed.value = self.speed(0.0)
+        self.update_friction(self.speed(0.0))
         self.load = self.drive.load
         factor = self.drive.factor(0.0) or 1.0
         self.last_solve = self.mechanics.ramp(self.load * factor, self.drive.ramp_steps)
@@ -179,8 +182,7 @@ class MacroModel:
                 self.contact.engaged.value = self.drive.mean_factor(t0, t1) * scale
                 self.contact.heating.value = self.drive.mean_sliding(t0, t1) / speed * scale if speed else 0.0
                 done = self.thermal.step(delta)
-                self.update_friction()
-                self.stale = self.friction_law is not None or self.mechanics.temperatures is not None
+                self.stale = self.update_friction() or self.mechanics.temperatures is not None
                 heat += done.heat_in
                 facet_heat += done.facet_heat.sum(axis=1)
                 self.heat_exchanged += done.heat_exchanged
@@ -193,6 +195,7 @@ class MacroModel:
             # keeps the friction of the sliding that ended it (the pressure the step's wear and work take)
             speed = float(self.contact.speed.value)
             moving = speed or self.drive.mean_speed(start, start + (k + 1) * delta)
+            self.stale = self.update_friction(moving) or self.stale     # mu(v) at the speed of the solve
             if factor > 0 and (self.stale or load != self.mechanics.load.value
                                or (moving == 0.0) != (self.solved_speed == 0.0)):
                 self.contact.speed.value = moving
@@ -207,12 +210,28 @@ class MacroModel:
         self.heat_exchanged_total += self.heat_exchanged
         return heat
 
-    def update_friction(self) -> None:
-        """With a ``friction_law``: each interface facet's mu at the mean of its two faces' temperatures,
-        for the solve and the heat steps that follow (explicit: the temperatures of the step's end)."""
-        if self.friction_law is not None and self.thermal is not None:
-            T = 0.5 * (self.thermal.facet_temperature(0) + self.thermal.facet_temperature(1))
-            self.tm.interface.set_field(self.contact.friction, self.friction_law(T))
+    def update_friction(self, speed: float | None = None) -> bool:
+        """With a ``friction_law``: each interface facet's mu at the mean of its two faces' temperatures
+        and (a mu(v) law) its slip speed at the sliding ``speed`` of the next solve (rad/s or m/s; None:
+        that of the last, ``solved_speed``), for the solve and the heat steps that follow (explicit in
+        the temperatures: those of the step's end); with a ``speed``, only if the law reads it.
+        Returns whether mu changed (collective)."""
+        law = self.friction_law
+        if law is None or (speed is not None and not law.reads_speed):
+            return False
+        T = None if self.thermal is None else \
+            0.5 * (self.thermal.facet_temperature(0) + self.thermal.facet_temperature(1))
+        V = None
+        if law.reads_speed:
+            now = float(self.contact.speed.value)
+            self.contact.speed.value = self.solved_speed if speed is None else speed
+            V = self.contact.facet_means("slip")
+            self.contact.speed.value = now
+        mu = law(T, V)
+        changed = not np.array_equal(mu, self.tm.interface.values(self.contact.friction))
+        if changed:
+            self.tm.interface.set_field(self.contact.friction, mu)
+        return changed
 
     def start_sliding(self, speed: float, factor: float) -> None:
         """Solve the contact with friction at the sliding ``speed`` (rad/s or m/s; its sign the
@@ -221,6 +240,7 @@ class MacroModel:
         frictional pressure (before, with the frictionless one of the solve at rest: the test
         pin-on-disc restarting from a stop, 0 to 200 rpm over a 0.6 s step, 1.24e-3 off in the
         step's heat; a start released at rest, engaging within 10 ms, as much)."""
+        self.update_friction(speed)
         self.last_solve = self.mechanics.solve()
         self.solved_speed, self.stale = speed, False
         self.keep_torque(factor)

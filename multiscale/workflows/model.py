@@ -10,7 +10,8 @@ The rules that more than one analysis follows live here once:
   ``faces``/``direction``, else the builder's;
 - friction coefficient of an interface: its [interfaces.<name>] ``friction`` or ``friction_temperature``,
   else [loading]'s; a fade table at the initial temperature (and, with heat, at each facet's temperature
-  as the run goes: ``friction_law``), with effect ``friction``; else 0;
+  as the run goes: ``friction_law``), a mu(v) law at each facet's slip speed as the run goes, with effect
+  ``friction``; else 0;
 - load: a fluid pressure -p n for builders that declare ``fluid_load`` and for geometry files (a
   normal force spread as the uniform pressure F / A, A the load faces' areas projected normal to
   each face's resultant, or of each of a face's flat parts facing opposite ways, ``load_face_areas``;
@@ -38,21 +39,32 @@ from multiscale.errors import InputError
 from multiscale.geometry import GeometrySpec, Rotation, Support
 from multiscale.io import reporter
 from multiscale.macro import mesh as two_body
+from multiscale.macro.friction import FacetFriction, StribeckFriction, TableFriction
 from multiscale.macro.interface import PenaltyLaw, SumLaw
 from multiscale.macro.kept_cells import SolverOptionWarning
 from multiscale.macro.load_faces import load_face_areas, load_face_forces
 from multiscale.macro.mechanics import REPEATABLE_REFRESH, Mechanics
 from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
-from multiscale.scene_friction import initial_friction
+from multiscale.scene_friction import bare_interfaces, initial_friction, speed_law_guess
 
 
 def friction_coefficient(scene, interface: str) -> float:
     """mu [-] of an interface (``Scene.interface_settings``: its constant, else its fade table at the
-    initial temperature) with effect "friction", else 0."""
+    initial temperature, else [loading]'s mu(v) law's kinetic or mean mu, a first guess until the law
+    sets each facet's) with effect "friction", else 0."""
     if not scene.has("friction"):
         return 0.0
-    return initial_friction(scene.interface_settings(interface), scene.time.initial_temperature)
+    mu = initial_friction(scene.interface_settings(interface), scene.time.initial_temperature)
+    return speed_law_guess(scene.loading) if mu is None else mu
+
+
+def speed_law(loading):
+    """[loading]'s mu(v) law (``friction_curve`` or ``stribeck``; ``macro.friction``), or None."""
+    if loading.friction_curve is not None:
+        return TableFriction(loading.friction_curve)
+    st = loading.stribeck
+    return None if st is None else StribeckFriction(st.static, st.kinetic, st.speed, st.exponent)
 
 
 def facet_friction(scene, tm) -> np.ndarray:
@@ -60,22 +72,20 @@ def facet_friction(scene, tm) -> np.ndarray:
     return np.array([friction_coefficient(scene, name) for name in tm.interface.tags])[tm.interface.tag_index]
 
 
-def friction_law(scene, tm):
-    """With heat and a fade table on any interface (its own or [loading]'s ``friction_temperature``): mu per
-    interface facet (n_facets,) against the facets' temperatures [K] (a constant mu where the interface has
-    one); else None."""
-    tables = [scene.interface_settings(name).friction_temperature for name in tm.interface.tags]
-    if not (scene.has("friction") and scene.has("thermal")) or all(t is None for t in tables):
+def friction_law(scene, tm) -> FacetFriction | None:
+    """mu per interface facet as the run goes (``FacetFriction``), with effect "friction" and a fade table
+    on any interface (its own or [loading]'s ``friction_temperature``, with heat) or [loading]'s mu(v) law
+    on any (those without a friction of their own); else None (mu constant on each interface)."""
+    if not scene.has("friction"):
         return None
-    own, tag = facet_friction(scene, tm), tm.interface.tag_index
-    fades = [(tag == i, *(np.array(column, dtype=float) for column in zip(*t))) for i, t in enumerate(tables) if t]
-
-    def law(T: np.ndarray) -> np.ndarray:
-        mu = own.copy()
-        for on, temperatures, values in fades:
-            mu[on] = np.interp(T[on], temperatures, values)
-        return mu
-    return law
+    tags, tag = tm.interface.tags, tm.interface.tag_index
+    tables = [scene.interface_settings(name).friction_temperature for name in tags] if scene.has("thermal") else []
+    fades = tuple((tag == i, *(np.array(column, dtype=float) for column in zip(*t)))
+                  for i, t in enumerate(tables) if t)
+    law = speed_law(scene.loading)
+    bare = bare_interfaces(scene.interfaces, tags) if law is not None else []
+    speeds = tuple((tag == i, law) for i, name in enumerate(tags) if name in bare)
+    return FacetFriction(facet_friction(scene, tm), fades, speeds) if fades or speeds else None
 
 
 def scene_spec(scene) -> GeometrySpec:

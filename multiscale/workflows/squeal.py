@@ -42,7 +42,7 @@ from multiscale import io, outputs
 from multiscale.errors import InputError
 from multiscale.macro.damped import SPURIOUS, PrestressEffect, prestress_effect, solve_system
 from multiscale.macro.eigen import Damping, ModalResult
-from multiscale.macro.friction import ConstantFriction, StribeckFriction, TableFriction, set_friction
+from multiscale.macro.friction import ConstantFriction, set_friction
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.mechanics import Mechanics
 from multiscale.macro.modal import CLOSE, EnergyShares, RegionEnergy, StabilityReport, stability_report, \
@@ -50,10 +50,10 @@ from multiscale.macro.modal import CLOSE, EnergyShares, RegionEnergy, StabilityR
 from multiscale.macro.output import write_modes, write_state
 from multiscale.macro.preload import Preload, linearise_system, preload
 from multiscale.macro.stability_map import StabilityMap
-from multiscale.scene_friction import speed_law_guess
+from multiscale.scene_friction import bare_interfaces, speed_law_guess
 from multiscale.workflows import squeal_map
 from multiscale.workflows.model import build_mechanics, build_mesh, drive, friction_coefficient, interface_forces, \
-    model_size
+    model_size, speed_law
 from multiscale.workflows.output import RunResult, prepare_folder
 from multiscale.workflows.rough import build_rough_interface
 from multiscale.workflows.strain import overloaded, unloaded
@@ -134,14 +134,11 @@ def friction_laws(scene, tm) -> dict | None:
     """mu(v) law of every interface when [loading] gives a ``friction_curve`` or ``stribeck``
     (an interface's own ``friction`` stays constant, its own fade table its mu at the initial
     temperature); None with a constant friction."""
-    ld = scene.loading
-    if not scene.has("friction") or (ld.friction_curve is None and ld.stribeck is None):
+    law = speed_law(scene.loading)
+    if not scene.has("friction") or law is None:
         return None
-    law = TableFriction(ld.friction_curve) if ld.friction_curve is not None else \
-        StribeckFriction(ld.stribeck.static, ld.stribeck.kinetic, ld.stribeck.speed, ld.stribeck.exponent)
-    own = {n for n, s in scene.interfaces.items()
-           if s is not None and (s.friction is not None or s.friction_temperature is not None)}
-    return {n: ConstantFriction(friction_coefficient(scene, n)) if n in own else law for n in tm.interface.tags}
+    bare = bare_interfaces(scene.interfaces, tm.interface.tags)
+    return {n: law if n in bare else ConstantFriction(friction_coefficient(scene, n)) for n in tm.interface.tags}
 
 
 def squeal_options(scene, tm) -> SquealOptions:
