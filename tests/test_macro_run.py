@@ -256,6 +256,31 @@ def test_a_wear_update_its_increments_leave_off_is_warned_about(tmp_path):
                      "(against half the increments); for 5 % set wear.substeps to about 20 (first order: fewer may do)"]
 
 
+def test_faces_of_an_interface_that_drift_apart_without_conductance_are_warned_of():
+    """A pad's face 110 K under the disc's (a user trial's three pads, no conductance) read as a
+    result: the run warns of faces whose mean temperatures drift more than ``APART`` of their rise
+    (and 10 K) apart, naming the interface, both temperatures and the effect that joins them; not
+    within that, and not with effect "conductance"."""
+    from multiscale.workflows import APART, run_warnings
+    demo = Path(__file__).resolve().parents[1] / "demos" / "car_brake_stop.toml"
+    scene = load(demo)
+    for pad, disc, warned in ((400.0, 420.0, False), (310.0, 315.0, False), (360.0, 420.0, True)):
+        h = History()
+        for t, k in ((0.0, 0.0), (1.0, 1.0)):
+            h.append(time=t, **{f"face_mean_temperature_{n}_on_{b}": 303.15 + k * (T - 303.15)
+                                for n in ("inner_pad", "outer_pad") for b, T in (("fixed", pad), ("disc", disc))})
+        lines = [w for w in run_warnings(scene, h) if "drifted" in w]
+        assert len(lines) == 2 * warned and (420.0 - 400.0) < APART * (420.0 - 303.15) < 420.0 - 360.0
+    assert lines[0] == ("interface inner_pad: its two faces' mean temperatures drifted 60 K apart (fixed 87 degC, disc "
+                        '147 degC at t = 1 s): without effect "conductance" nothing conducts across the interface and '
+                        "each face heats by its share of the frictional heat only (the partition, a mean over the "
+                        'face); where the faces in contact should meet, add effect "conductance" (interface.conductance)')
+    joined = load(demo, {"effects": ["contact", "friction", "thermal",
+                                                                       "heat_partition", "conductance"],
+                                                            "interface.conductance": "1e5 W/(m^2 K)"})
+    assert not [w for w in run_warnings(joined, h) if "drifted" in w]
+
+
 def test_a_solve_starting_next_to_its_answer_converges(tmp_path):
     """``mechanics.NEWTON_FLOOR``: the pin-on-disc solved at 867 N, then at loads 1e-3 N and 1 N
     higher, which start with residuals of 1.5e-4 and 0.15 near the round-off floor (~1.5e-12 of
