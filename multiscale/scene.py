@@ -297,9 +297,18 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
         *parents, last = key_parts(dotted)
         table = raw
         for part in parents:
-            table = table.setdefault(part, {})
-            if not isinstance(table, dict):
+            if isinstance(table, list):          # an entry of an array of tables: boundary[2] or boundary.2
+                if not (part.isdigit() and 1 <= int(part) <= len(table)):
+                    raise SceneError(f"{dotted}: cannot override, {part} is not one of the {len(table)} entries "
+                                     "(1, 2, ...: boundary[2].emissivity or boundary.2.emissivity)")
+                table = table[int(part) - 1]
+            else:
+                table = table.setdefault(part, {})
+            if not isinstance(table, (dict, list)):
                 raise SceneError(f"{dotted}: cannot override, {part} is not a table")
+        if isinstance(table, list):
+            raise SceneError(f"{dotted}: cannot override an array of tables whole; give a key of one of its "
+                             "entries (boundary[2].emissivity)")
         table[last] = value
     effects = raw.get("effects")
     active = frozenset(e for e in effects if isinstance(e, str) and e in EFFECTS) \

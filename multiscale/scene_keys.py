@@ -1,5 +1,6 @@
 """Dotted scene keys as TOML reads them (``--set``, a study's knobs): ``interfaces.inner_pad.friction``
-or with quoted parts, ``interfaces."inner_pad".friction``."""
+or with quoted parts, ``interfaces."inner_pad".friction``; an entry of an array of tables by its
+number from 1, ``boundary.2.emissivity`` or as messages name it, ``boundary[2].emissivity``."""
 from __future__ import annotations
 
 import tomllib
@@ -12,7 +13,11 @@ def key_parts(dotted: str) -> list[str]:
     try:
         table = tomllib.loads(f"{dotted} = 0")
     except tomllib.TOMLDecodeError:
-        return dotted.split(".")
+        parts = []
+        for part in dotted.split("."):       # "boundary[2]": ["boundary", "2"]
+            name, bracket, rest = part.partition("[")
+            parts += [name, rest[:-1]] if bracket and rest.endswith("]") else [part]
+        return parts
     parts = []
     while isinstance(table, dict) and len(table) == 1:
         (part, table), = table.items()

@@ -210,6 +210,12 @@ def test_set_gives_scene_keys_over_the_files_to_check_and_run(tmp_path, capsys, 
     with pytest.raises(SystemExit) as exit_:
         main(["check", path, "--set", "loading.pressure"])
     assert exit_.value.code == 2 and "KEY=VALUE" in capsys.readouterr().err
+    cooled = _write(tmp_path, COOLED.replace("../results/block_on_flat", "out"), "cooled.toml")
+    for key in ("boundary[1].convection", "boundary.1.convection"):      # an entry of [[boundary]] (a user trial:
+        assert main(["check", cooled, "--set", f"{key}=30"]) == 0          # "boundary is not a table")
+        assert "free:block: convection h = 30 W/(m^2 K)" in capsys.readouterr().out
+    assert main(["check", cooled, "--set", "boundary[2].convection=30"]) == 2
+    assert "boundary[2].convection: cannot override, 2 is not one of the 1 entries" in capsys.readouterr().err
     with pytest.raises(SystemExit) as exit_:     # meant as TOML (was read as the text "[2,2": a range error)
         main(["check", path, "--set", "micro.zones=[2,2"])
     assert exit_.value.code == 2 and "[2,2 is not a TOML value (Unclosed array" in capsys.readouterr().err
