@@ -168,7 +168,8 @@ def run_warnings(scene, history) -> list[str]:
     for name in hottest:
         known = scene.materials[name].beyond(T0)
         for T, body in dict.fromkeys((hottest[name], coldest.get(name, hottest[name]))):   # the hottest, the coldest
-            out += [f"materials.{name}.{phrase} (in body {body!r})"
+            why = ": an undershoot, below every imposed temperature (below)" if T < _floor(scene) else ""   # (a trial
+            out += [f"materials.{name}.{phrase} (in body {body!r}{why})"          # read it apart from the undershoot)
                     for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
     return (out + laws + _undershoots(scene, history) + _coarse_wear(history) + _wear_table_ends(scene, history)
             + _too_hot(scene, history) + _fade_table_ends(scene, history) + _unloaded(scene, history)
@@ -281,6 +282,12 @@ def _too_hot(scene, history) -> list[str]:
     return out
 
 
+def _floor(scene) -> float:
+    """The lowest temperature the scene imposes [K]: the initial one, ambients, fixed ones."""
+    return min([scene.time.initial_temperature] + [t for b in scene.boundary for t in (b.ambient, b.temperature)
+                                                   if t is not None])
+
+
 def _undershoots(scene, history) -> list[str]:
     """Bodies whose temperature fell below every temperature the scene imposes (the initial one,
     ambients, fixed ones; frictional heat only adds) by more than ``UNDERSHOOT`` of their rise up
@@ -288,9 +295,7 @@ def _undershoots(scene, history) -> list[str]:
     rise of the whole run, a 5.6 K undershoot at t = 16 s of a 240 s railway drag (12 % of the 45 K
     rise by then, 2.4 % of the run's 236 K) went unsaid, and only a material table's lower end
     named it (a user trial)."""
-    floor = min([scene.time.initial_temperature] + [t for b in scene.boundary for t in (b.ambient, b.temperature)
-                                                    if t is not None])
-    out = []
+    floor, out = _floor(scene), []
     for body in scene.geometry.spec.bodies:
         cold, hot = f"min_temperature_{body.name}", f"max_temperature_{body.name}"
         if cold not in history.columns:
