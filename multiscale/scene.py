@@ -582,10 +582,11 @@ def _surface_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]
     for i, b in enumerate(scene.boundary or (), 1):     # a support that holds a load face along the load
         held = [s for s in ((b.surfaces or ()) if b is not None and b.fix else ()) if s in (faces or g.spec.load_faces)]
         free = [c for c in range(3) if c not in (b.components if b is not None else ())]
-        if held and direction is not None and np.linalg.norm(np.asarray(direction, float)[free]) < 1e-9:
-            problems.append(f"boundary[{i}].fix = {list(b.fix)} on {', '.join(held)}, where the load pushes along "
-                            f"{list(direction)}: the support would take the load and the contact none; hold "
-                            "another face or leave that component free")
+        along = "normal to each face" if direction is None else f"along {list(direction)}"   # (a fixed bore loaded
+        if held and (not free if direction is None else np.linalg.norm(np.asarray(direction, float)[free]) < 1e-9):
+            problems.append(f"boundary[{i}].fix = {list(b.fix)} on {', '.join(held)}, where the load pushes {along}: "
+                            "the support would take the load and the contact none; hold another face or leave that "
+                            "component free")                              # normal to it said nothing: a user trial)
     if "roughness" in effects and scene.roughness is not None and scene.effects is not None and not problems:
         for name in scene.rough_interfaces:
             normal = g.spec.interface_normals.get(name, ())
