@@ -53,6 +53,13 @@ def assign_bodies(model, g, order: list[int], labels: dict) -> dict:
                                            f"body \"{owner[t]}\""))
             owner.setdefault(t, name)
         out[name] = sorted(set(tags))
+    points = [p for sel in g.bodies.values() if sel.volumes is None and sel.index is None for p in sel.contains]
+    missed = [p for p in problems if p.name.endswith(".contains") and "no volume of" in p.allowed]
+    if len(points) > 1 and len(missed) == len(points):    # every point missed: the unit, likely (said nothing
+        read = f"geometry.unit = {g.unit:g} m" if g.unit is not None else "the unit the file declares"
+        problems.append(InputError("geometry.unit", g.unit, f"no point of geometry.bodies lies in a volume of "
+                                   f"{g.file.name}, whose volumes span {_span(model, labels)} mm read in {read}: "
+                                   "is it the file's length unit?"))     # (said nothing when inside the box: a trial)
     left = [t for t in labels if t not in owner]
     if left and not problems:          # (a body that named nothing leaves its volumes over)
         centres = [np.round(model.occ.getCenterOfMass(3, t), 4).tolist() if model.occ.getEntities(3) else "" for t in left]
@@ -77,10 +84,19 @@ def curve_box(model, curves: list[int]) -> tuple[np.ndarray, np.ndarray]:
 def _outside(model, labels: dict, point, g) -> str:
     """Words for a point outside the box of every volume (``labels``' tags): where the volumes lie,
     in mm (a file in cm read in mm put every point of a scene outside, with no word of the unit)."""
-    faces = model.getBoundary([(3, t) for t in labels], combined=False, oriented=False)
-    low, high = curve_box(model, [c for _, c in model.getBoundary(faces, combined=False, oriented=False)])
+    low, high = _box(model, labels)
     if np.all(np.asarray(point) >= low) and np.all(np.asarray(point) <= high):
         return ""
-    span = ", ".join(f"{axis} {a * 1e3:.4g}..{b * 1e3:.4g}" for axis, a, b in zip("xyz", low, high))
     unit = f"geometry.unit = {g.unit:g} m: is it the file's?" if g.unit is not None else "is the file's unit right?"
-    return f"; it lies outside all of them, which span {span} mm ({unit})"
+    return f"; it lies outside all of them, which span {_span(model, labels)} mm ({unit})"
+
+
+def _box(model, labels: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The box of the volumes ``labels``' tags (``curve_box`` of their curves) [m]."""
+    faces = model.getBoundary([(3, t) for t in labels], combined=False, oriented=False)
+    return curve_box(model, [c for _, c in model.getBoundary(faces, combined=False, oriented=False)])
+
+
+def _span(model, labels: dict) -> str:
+    """The box of the volumes in words, "x -140..140, y ..." [mm]."""
+    return ", ".join(f"{axis} {a * 1e3:.4g}..{b * 1e3:.4g}" for axis, a, b in zip("xyz", *_box(model, labels)))

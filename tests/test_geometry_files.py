@@ -989,6 +989,12 @@ def test_a_point_in_plain_numbers_is_in_metres_and_a_miss_says_so(tmp_path, caps
     err = check(tmp_path, capsys, text.replace(backs, 'contains = [["0 mm", "80 mm", "18 mm"], [0, -80, 18.5]]'))
     assert err.endswith('passes through this point [m]; plain numbers are metres: did you mean ["0 mm", "-80 mm", '
                         '"18.5 mm"]?')
+    # every point inside the box of the volumes and in none of them: the unit, said once (a file in mm read in
+    # inches put every point of a brake in the disc's hole or beside the pads, with no word of the unit: a trial)
+    err = check(tmp_path, capsys, text.replace('unit = "mm"', 'unit = "in"'), count=4)
+    assert err.endswith("error: geometry.unit = 0.0254: no point of geometry.bodies lies in a volume of twopads.geo, "
+                        "whose volumes span x -2540..2540, y -2538..2538, z 0..457.2 mm read in geometry.unit = "
+                        "0.0254 m: is it the file's length unit?")
     err = check(tmp_path, capsys, text.replace('contains = ["0 mm", "60 mm", "5 mm"]', 'contains = ["0 mm", "60 m", 0]'))
     assert err.endswith("(geometry.unit = 0.001 m: is it the file's?)")   # not all plain numbers: no guess
     err = check(tmp_path, capsys, text.replace('contains = ["0 mm", "60 mm", "5 mm"]', 'contains = ["0 mm", "0 mm", '
