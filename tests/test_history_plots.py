@@ -276,11 +276,19 @@ def test_a_run_with_fade_draws_its_friction_coefficient(tmp_path, drawn):
                      heat_total_disc=t, friction_coefficient=mu, friction_coefficient_inner_pad=mu + 0.01,
                      friction_coefficient_outer_pad=mu - 0.01)
     plots.history_figure(parts, tmp_path / "history.png")
+    assert "braking torque [N m]" not in [ax.get_ylabel() for ax in drawn[-1].axes]     # no rotating body
     colour = {}
     for ax in drawn[-1].axes:
         for line in ax.get_lines():
             colour.setdefault(line.get_label(), set()).add(to_hex(line.get_color()))
     assert colour["all"] == {"#000000"} and all(len(colour[n]) == 1 for n in ("inner pad", "outer pad", "disc"))
+    torque = History()                  # a rotating body's braking torque has its panel (wanted there: a trial)
+    for t in (0.0, 1.0):
+        torque.append(time=t, interface_force=200.0, max_pressure=1e6, max_temperature_disc=298.0, heat_total_disc=t,
+                      friction_moment=30.0 - t)
+    plots.history_figure(torque, tmp_path / "history.png")
+    (ax,) = [ax for ax in drawn[-1].axes if ax.get_ylabel() == "braking torque [N m]"]
+    np.testing.assert_allclose(ax.get_lines()[0].get_ydata(), [30.0, 29.0])
 
 
 def test_the_multiscale_figures_legends_cover_no_panel(tmp_path, drawn):

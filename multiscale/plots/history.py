@@ -113,7 +113,8 @@ def curve_styles(keys, palette: dict | None = None) -> tuple[list[dict], list]:
 
 def history_figure(history, path: Path, title: str = "") -> Path:
     """PNG of the history: force, max pressure, max temperatures, heat per body (and the friction
-    coefficient with fade, per interface, max face temperatures, stored heat per part) vs time."""
+    coefficient with fade or mu(v), the braking torque of a rotating body, per interface, max face
+    temperatures, stored heat per part) vs time."""
     t = history["time"]
     bodies = [k.removeprefix("heat_total_") for k in history.columns if k.startswith("heat_total_")]
     heat = [prefix + b for b in bodies for prefix in HEAT_KINDS if prefix + b in history.columns]
@@ -121,6 +122,7 @@ def history_figure(history, path: Path, title: str = "") -> Path:
               ("max contact pressure [MPa]", ["max_pressure"], 1e-6, 0.0),
               ("friction coefficient [-]", [k for k in history.columns if k.startswith("friction_coefficient")],
                1.0, 0.0),                                                          # with fade (and per interface)
+              ("braking torque [N m]", ["friction_moment"], 1.0, 0.0),    # a rotating body's (wanted: a trial)
               ("max temperature [°C]", temperature_columns(history.columns), 1.0, -273.15),
               ("heat of each body [J]", heat, 1.0, 0.0),
               ("frictional heat per interface [J]",
