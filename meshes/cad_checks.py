@@ -10,6 +10,7 @@ from multiscale.geometry import thin_warning
 
 REVOLUTION = 1e-3           # the rotating body's centre of mass off its axis (of its extent), its axis of inertia (rad)
 EQUAL_MOMENTS = 0.01        # principal moments of inertia this close (of the largest) are those of a body of revolution
+OTHER = "; or, if it is not the body that turns, name the one that does (geometry.rotating)"   # (a pad named: a trial)
 
 
 def box_extent(boxes) -> float:
@@ -71,7 +72,8 @@ def check_revolution(g, volumes: list[tuple]) -> None:
     if not equal.any():
         raise InputError("geometry.rotating", g.rotating, f"the rotating body {g.rotating!r} {what.format('an axis')}, "
                          "but no axis of it is one: its principal moments of inertia differ by more than "
-                         f"{EQUAL_MOMENTS:.0%} ({', '.join(f'{m / moments[-1]:.3g}' for m in moments)} of the largest)")
+                         f"{EQUAL_MOMENTS:.0%} ({', '.join(f'{m / moments[-1]:.3g}' for m in moments)} of the largest)"
+                         f"{OTHER}")
     if not equal.all():              # the moment that differs from the two equal ones is about its axis
         axis = vectors[:, 2 if equal[0] else 0]
         axis = -axis if axis @ e < 0 else axis
@@ -83,4 +85,5 @@ def check_revolution(g, volumes: list[tuple]) -> None:
     if off > REVOLUTION * extent:
         raise InputError("geometry.centre", list(g.centre), f"the rotating body {g.rotating!r} "
                          f"{what.format('the axis through this point')}, but its centre of mass lies {off * 1e3:.3g} "
-                         f"mm from that axis, at {(np.round(c * 1e3, 2) + 0.0).tolist()} mm: give a point of its axis")
+                         f"mm from that axis, at {(np.round(c * 1e3, 2) + 0.0).tolist()} mm: give a point of its axis"
+                         f"{OTHER}")

@@ -758,7 +758,8 @@ def test_a_rotating_body_off_its_axis_is_refused_by_check(tmp_path, capsys):
         "error: geometry.centre = [0.002, 0.0, 0.0]: the rotating body 'disc' turns about the axis through this point, "
         "so it must be a body of revolution about it (or of n >= 3 equal sectors, as a vented disc): the run moves "
         "its material, and with it the sliding and the heat, round that axis, but its centre of mass lies 2 mm from "
-        "that axis, at [0.0, 0.0, 5.0] mm: give a point of its axis")
+        "that axis, at [0.0, 0.0, 5.0] mm: give a point of its axis; or, if it is not the body that turns, name the "
+        "one that does (geometry.rotating)")     # (a pad named rotating was advised on its axis only: a trial)
     tilted = text.replace('rotating = "disc"\n', 'rotating = "disc"\naxis = [0, 0.02, 1]\n')
     assert re.fullmatch(r"error: geometry.axis = \[0.0, 0.02, 1.0\]: the rotating body 'disc' turns about this axis, "
                         r".* but its own axis is 1.15 degrees off it, along \[0.0, 0.0, 1.0\]: give that axis",
