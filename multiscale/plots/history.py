@@ -187,7 +187,8 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
                                                ("micro_max_pressure", "micro local" + before)],     # trial: results.rst
                1e-6, 0),                                                                           # "When in the step")
               ("max temperature [°C]", [(k, "macro " + column_label(k)) for k in hot]
-               + [("micro_max_temperature", "micro")], 1.0, -273.15),
+               + [("micro_max_temperature", "micro: zone mean + local rise")], 1.0, -273.15),   # (below a macro
+                                                                                   # facet's max puzzled a user trial)
               ("zones' heat partition\ninto the rough body [%]",   # the coefficients of Fig. 7.12, not
                [("partition_max", "max"), ("partition_mean", "mean over zones"),    # weighted by the heat
                 ("partition_min", "min")], 100.0, 0),
