@@ -279,6 +279,8 @@ def test_faces_of_an_interface_that_drift_apart_without_conductance_are_warned_o
                                                                        "heat_partition", "conductance"],
                                                             "interface.conductance": "1e5 W/(m^2 K)"})
     assert not [w for w in run_warnings(joined, h) if "drifted" in w]
+    one_side = load(demo, {"interface.partition": 0.0})          # all the heat into the disc: the user's choice
+    assert not [w for w in run_warnings(one_side, h) if "drifted" in w]
 
 
 def test_a_solve_starting_next_to_its_answer_converges(tmp_path):

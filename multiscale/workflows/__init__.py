@@ -319,11 +319,12 @@ __all__ = ["RunResult", "run", "run_warnings", "workflow"]
 
 def _faces_apart(scene, history) -> list[str]:
     """Interfaces whose two faces' mean temperatures (``face_mean_temperature_<name>_on_<body>``)
-    drifted apart by more than ``APART`` of the faces' rise and 10 K, without effect "conductance":
+    drifted apart by more than ``APART`` of the faces' rise and 10 K, without effect "conductance" and
+    with a partition that heats both sides:
     nothing conducts across the interface, each face heats by its share of the frictional heat
     (docs/architecture.md, Known problems; a user trial read a pad face 110 K under the disc's for a
     result)."""
-    if scene.has("conductance"):
+    if scene.has("conductance") or scene.interface.partition in (0.0, 1.0):    # (all the heat into one side: chosen)
         return []
     T0, out = scene.time.initial_temperature, []
     body0, body1 = (b.name for b in scene.geometry.spec.bodies)
