@@ -287,17 +287,28 @@ def test_ctrl_c_while_the_end_is_written_lets_it_finish(tmp_path, monkeypatch):
     from multiscale.workflows import run, transient
     written = transient.write_history
 
-    def interrupted_write(history, folder, name, comm, plot=True):
+    titles = []
+
+    def interrupted_write(history, folder, name, comm, plot=True, title=None):
         if plot:                                     # the final write, after the steps
+            titles.append(title)
             os.kill(os.getpid(), signal.SIGINT)
             time.sleep(0.01)
-        return written(history, folder, name, comm, plot=plot)
+        return written(history, folder, name, comm, plot=plot, title=title)
     monkeypatch.setattr(transient, "write_history", interrupted_write)
     result = run(loads(SCENE.format(folder=tmp_path / "out")), verbose=False)
     folder = tmp_path / "out"
     assert json.loads((folder / "provenance.json").read_text())["status"] == "finished"
     assert len(History.read(folder / "history.h5")) == 4 and (folder / "history.png").stat().st_size > 0
-    assert result.history_file == folder / "history.h5"
+    assert result.history_file == folder / "history.h5" and titles == ["cooling_block"]
+    # stopped during the steps (after the first): the figure's title says so (it said nothing: a user trial)
+    from multiscale.errors import Interrupted
+    from multiscale.io import StepStop
+    monkeypatch.setattr(transient, "write_history", lambda *a, **k: titles.append(k.get("title")) or written(*a, **k))
+    monkeypatch.setattr(StepStop, "requested", lambda self: True)
+    with pytest.raises(Interrupted, match="after step 1 of 3"):
+        run(loads(SCENE.format(folder=tmp_path / "stopped")), verbose=False)
+    assert titles[-1] == "cooling_block (stopped after step 1 of 3)"
 
 
 @pytest.fixture
@@ -409,8 +420,8 @@ def test_an_abandoned_step_leaves_the_plots_and_paraview_script_of_what_was_writ
     assert len(history) == 2
     plots = [("history.png", history_figure)] + ([("multiscale.png", multiscale_figure)] if kind == "multiscale"
                                                  else [])
-    for png, figure in plots:                    # the figure of the history written, nothing else
-        figure(history, tmp_path / png, scene.name)
+    for png, figure in plots:                    # the figure of the history written, its title saying so
+        figure(history, tmp_path / png, f"{scene.name} (stopped at t = {history['time'][-1]:g} s)")
         assert (folder / png).read_bytes() == (tmp_path / png).read_bytes(), png
     assert (folder / "open_in_paraview.py").read_text() == outputs.paraview_script(outputs.plan(scene))
 

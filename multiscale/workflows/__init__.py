@@ -126,9 +126,10 @@ def _abandoned(folder: Path, scene) -> None:
     if h5.is_file() and scene.output.figures:
         from multiscale.plots.history import history_figure, multiscale_figure  # local: matplotlib only when a figure is drawn
         history = io.History.read(h5)
-        history_figure(history, h5.with_name("history.png"), title=scene.name)
+        title = f"{scene.name} (stopped at t = {history['time'][-1]:g} s)" if len(history) else scene.name
+        history_figure(history, h5.with_name("history.png"), title=title)
         if kind == "multiscale":
-            multiscale_figure(history, h5.with_name("multiscale.png"), scene.name)
+            multiscale_figure(history, h5.with_name("multiscale.png"), title)
     if any((Path(folder) / name).is_file() for name in outputs.plan(scene).field_files):
         _write_script(folder, scene)
 

@@ -48,7 +48,7 @@ from multiscale.workflows.output import prepare_folder
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
 from multiscale.workflows.strain import say_at_once
-from multiscale.workflows.transient import TransientResult, write_history
+from multiscale.workflows.transient import TransientResult, stopped_after, write_history
 
 CHECKPOINT = outputs.CHECKPOINT
 
@@ -213,8 +213,9 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                     if stopping:
                         break
             with io.stage("writing history and plots"), stop.writing(done):
-                h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures)
-                plot, maps, zones = write_zone_results(ms, folder, history, scene.name, comm, scene.output.figures)
+                title = scene.name + stopped_after(done, steps) * stopping
+                h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures, title=title)
+                plot, maps, zones = write_zone_results(ms, folder, history, title, comm, scene.output.figures)
         if done == steps:
             checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
         result = MultiscaleResult(folder, writer.files + [f for f in (h5, png, plot, zones, ckpt) if f] + maps,

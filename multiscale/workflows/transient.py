@@ -33,18 +33,24 @@ class TransientResult(RunResult):
     field_files: list           #: XDMF files
 
 
-def write_history(history: io.History, folder: Path, name: str, comm, plot: bool = True) -> tuple[Path, Path | None]:
-    """``history.h5`` and (with ``plot``) ``history.png``, else None (rank 0 writes; a failure is an
-    OutputError on every rank)."""
+def write_history(history: io.History, folder: Path, name: str, comm, plot: bool = True,
+                  title: str | None = None) -> tuple[Path, Path | None]:
+    """``history.h5`` and (with ``plot``) ``history.png`` titled ``title`` (default ``name``), else None
+    (rank 0 writes; a failure is an OutputError on every rank)."""
     h5, png = folder / "history.h5", folder / "history.png" if plot else None
 
     def write():
         history.write(h5, {"scene": name, "ranks": comm.size})
         if plot:
             from multiscale.plots.history import history_figure  # local: matplotlib only when a figure is drawn
-            history_figure(history, png, title=name)
+            history_figure(history, png, title=title or name)
     io.on_root(comm, write, f"the history {h5}")
     return h5, png
+
+
+def stopped_after(done: int, steps: int) -> str:
+    """The figures' title note of a run stopped by Ctrl-C (theirs said nothing of it: a user trial)."""
+    return f" (stopped after step {done} of {steps})"
 
 
 def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = True) -> TransientResult:
@@ -86,7 +92,8 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
                     if stopping:
                         break
             with io.stage("writing history and plots"), stop.writing(done):
-                h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures)
+                h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures,
+                                        title=scene.name + stopped_after(done, steps) * stopping)
         model.close()                    # on every rank in the same order (MUMPS' destruction communicates)
     if stopping:                     # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", run_notes(model))
