@@ -36,14 +36,17 @@ def overloaded(scene, p: float, hottest=None) -> list[str]:
 
 
 def say_at_once(scene, history, comm) -> None:
-    """``overloaded`` of the first contact solve's largest pressure (``history``'s last record, the
-    start's), said at once on rank 0 (stderr), for a run with steps to go: an impossible load (a
-    20 um pin under 200 N) was said only after the whole run. The run's warnings say it again, at
-    its largest pressure."""
-    if comm.rank == 0 and "max_pressure" in history.columns:
-        for line in overloaded(scene, float(history["max_pressure"][-1])):
-            print(f"warning: at the first contact solve, {line}; the run goes on (Ctrl-C stops it after a step, "
-                  "with its results written)", file=sys.stderr, flush=True)
+    """``overloaded`` of the first contact solve's largest pressure and ``unloaded`` of its interface
+    forces (``history``'s last record, the start's), said at once on rank 0 (stderr), for a run with
+    steps to go: an impossible load (a 20 um pin under 200 N), or a pad left out of the load faces (a
+    user trial), was said only after the whole run. The run's warnings say it again, over the run."""
+    if comm.rank != 0 or "max_pressure" not in history.columns:
+        return
+    forces = {n: abs(float(history[f"interface_force_{n}"][-1])) for n in scene.geometry.spec.interfaces
+              if f"interface_force_{n}" in history.columns}
+    for line in overloaded(scene, float(history["max_pressure"][-1])) + unloaded(forces):
+        print(f"warning: at the first contact solve, {line}; the run goes on (Ctrl-C stops it after a step, "
+              "with its results written)", file=sys.stderr, flush=True)
 
 
 def unloaded(forces: Mapping[str, float]) -> list[str]:
