@@ -387,6 +387,20 @@ def test_a_friction_falling_with_speed_sets_each_facets_mu_at_its_slip_speed(tmp
     assert [same for _, same in found] == [False, False, True, True]    # no solve at a constant speed
 
 
+def test_a_reload_after_a_dwell_of_two_steps_under_fade_heats_by_the_torques_work(tmp_path):
+    """A braking torque with fade, released for two heat steps in which mu changed in the first only:
+    the reload solves first (``MacroModel.stale`` kept through the dwell) and the heat is the torque's
+    work (before the fix, the reload took the pressure of before the dwell with the new mu: 27 % over
+    in that step, 4.4 % over the run; a review)."""
+    text = pod(tmp_path / "dwell").replace('normal_force = "200 N"\n', 'braking_torque = "7 N m"\n').replace(
+        "friction = 0.4", 'friction_temperature = [["23.5 degC", 0.4], ["24.5 degC", 0.1]]')
+    scene = loads(text, overrides={"time.end": "3 s", "time.steps": 10, "loading.load_profile": [
+        ["0 s", 1], ["0.6 s", 1], ["0.61 s", 0], ["1.8 s", 0], ["1.81 s", 1], ["3 s", 1]]})
+    h = run(scene, verbose=False).history
+    work = 7.0 * scene.loading.mean_sliding_factor(0.0, 3.0) * 3.0
+    assert h["heat_total_pin"][-1] + h["heat_total_disc"][-1] == pytest.approx(work, rel=1e-6)
+
+
 def test_a_pads_face_temperatures_are_those_of_its_facets(tmp_path):
     """``face_max_temperature_<pad>_on_<body>`` is the largest facet-mean temperature of the pad's
     facets (``Thermal.facet_temperature``), at most the body's largest nodal temperature;
