@@ -38,7 +38,7 @@ from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FI
 from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_phases, speed_range,
                                    squeal_state, thin_heated_layers)
 from multiscale.scene_keys import key_parts
-from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks, torque_problems
+from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks, speed_law_zeros, torque_problems
 from multiscale.scene_stability import Stability, unresolved_band
 from multiscale.scene_vehicle import Vehicle
 
@@ -432,7 +432,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         if not problems:
             problems += (nyquist(scene) + thin_layer(scene) + measured_cover(scene, warnings)
                          + perfect_contact(scene, warnings) + own_tables(scene, warnings))
-            warnings += micro_constants(scene) + zone_sizes(scene) + law_top_warnings(scene)
+            warnings += micro_constants(scene) + zone_sizes(scene) + law_top_warnings(scene) + (
+                speed_law_zeros(scene) if "friction" in effects else [])
     if scene.output is not None and scene.output.fields is not None:
         for f in scene.output.fields:
             missing = [e for e in OUTPUT_FIELDS[f] if e not in effects]

@@ -92,3 +92,23 @@ def torque_problems(scene, names) -> list[str]:
     return [f"{key}: braking at {ld.torque:.6g} N m needs friction, but mu is 0 at the initial temperature, "
             f"{T0 - 273.15:.4g} degC, on every interface ({', '.join(names)}): give mu > 0 there "
             "([loading]'s friction or table, or the interfaces' own)"]
+
+
+def speed_law_zeros(scene) -> list[str]:
+    """A braking torque (or a vehicle's stop) over [loading]'s mu(v) law where it gives mu 0: the run
+    stops where the facets slide at those speeds (its first solve, if there: check said OK to a curve
+    that was 0 at the stop's starting speed, a review)."""
+    ld = scene.loading
+    if ld is None or ld.torque is None:
+        return []
+    if ld.friction_curve is not None:
+        zero = [v for v, mu in ld.friction_curve if mu == 0]
+        where = f"at slip speeds of {', '.join(f'{v:g}' for v in zero)} m/s" if zero else ""
+        key = "loading.friction_curve"
+    else:
+        st = ld.stribeck
+        where = "" if st is None or (st.kinetic > 0 and st.static > 0) else \
+            "at rest" if st.static == 0 else "at high slip speeds (its kinetic mu)"
+        key = "loading.stribeck"
+    return [f"{key}: mu is 0 {where}: no clamp force gives the braking torque ({ld.torque:.6g} N m) where the "
+            "facets slide so, and the run stops there"] if where else []

@@ -8,6 +8,7 @@ from multiscale.geometry import CellEstimate, estimate_cells
 from multiscale.outputs import analysis
 from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
+from multiscale.scene_friction import FRICTION, bare_interfaces
 from multiscale.scene_rough import default_p_max, scene_surface_used
 from multiscale.scene_sections import P_MAX_FACTOR, P_MAX_PLASTIC
 from multiscale.schema import reference as schema_reference
@@ -126,9 +127,11 @@ def _fade(table) -> str:
 
 
 def _own_friction(scene: Scene, name: str) -> str:
-    """" (its own on a, b)": the interfaces whose friction is not [loading]'s ``name`` key's."""
-    own = [n for n in scene.geometry.spec.interfaces
-           if getattr(scene.interface_settings(n), name) != getattr(scene.loading, name)]
+    """" (its own on a, b)": the interfaces whose friction is not [loading]'s ``name`` key's (a mu(v)
+    law's: those with a friction of their own)."""
+    names = scene.geometry.spec.interfaces
+    own = [n for n in names if n not in bare_interfaces(scene.interfaces, names)] if name in FRICTION[2:] else \
+        [n for n in names if getattr(scene.interface_settings(n), name) != getattr(scene.loading, name)]
     return f" (its own on {', '.join(own)})" if own else ""
 
 
@@ -139,14 +142,15 @@ def _effect_line(scene: Scene, effect: str) -> str:
     if effect == "friction":
         if ld.friction_curve is not None:
             return "mu(slip speed) from friction_curve: " + ", ".join(f"{mu:g} at {v:g} m/s"
-                                                                      for v, mu in ld.friction_curve)
+                                                                      for v, mu in ld.friction_curve) \
+                + _own_friction(scene, "friction_curve")
         if ld.friction_temperature is not None:
             return "Coulomb, mu(interface temperature) from friction_temperature: " + _fade(ld.friction_temperature) \
                 + _own_friction(scene, "friction_temperature")
         if ld.stribeck is not None:
             st = ld.stribeck
             return (f"Stribeck mu(v) = {st.kinetic:g} + ({st.static:g} - {st.kinetic:g}) exp(-(v / {st.speed:g} m/s)"
-                    f"^{st.exponent:g})")
+                    f"^{st.exponent:g})" + _own_friction(scene, "stribeck"))
         if ld.friction is None:
             return "Coulomb, mu per interface"
         return f"Coulomb, mu = {ld.friction:g}" + _own_friction(scene, "friction")

@@ -710,6 +710,14 @@ def test_an_interface_may_give_its_own_fade_table(tmp_path):
                   + "\n[interfaces.interface]\nfriction = 0.3\n", tmp_path)    # a run reads mu(v) too now
     assert "loading.friction_curve is unused: every interface gives its own friction (interfaces.interface)" in \
         curve.warnings
+    assert "    friction       mu(slip speed) from friction_curve: 0.5 at 0 m/s, 0.4 at 10 m/s (its own on " \
+        "interface)" in summary(curve)           # (it did not say so: a review)
+    # a braking torque over a curve that gives mu 0 at some speed: warned at check (it said OK and the run
+    # stopped at its first solve: a review)
+    zero = loads(pod.replace("friction = 0.4", 'friction_curve = [["0 m/s", 0.6], ["1 m/s", 0], ["100 m/s", 0]]')
+                 .replace('normal_force = "200 N"', 'braking_torque = "30 N m"'), tmp_path)
+    assert "loading.friction_curve: mu is 0 at slip speeds of 1, 100 m/s: no clamp force gives the braking torque " \
+        "(30 N m) where the facets slide so, and the run stops there" in zero.warnings
     with pytest.raises(SceneError, match=r"interfaces.interface.friction or interfaces.interface.friction_temperature: give only one"):
         loads(pod + f"\n[interfaces.interface]\nfriction = 0.3\nfriction_temperature = {table}\n", tmp_path)
     with pytest.raises(SceneError, match=r'interfaces.interface.friction_temperature: needs effect "thermal"'):
