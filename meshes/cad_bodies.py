@@ -55,8 +55,9 @@ def assign_bodies(model, g, order: list[int], labels: dict) -> dict:
         out[name] = sorted(set(tags))
     points = [p for sel in g.bodies.values() if sel.volumes is None and sel.index is None for p in sel.contains]
     missed = [p for p in problems if p.name.endswith(".contains") and "no volume of" in p.allowed]
-    if len(points) > 1 and len(missed) == len(points):    # every point missed: the unit, likely (said nothing
-        read = f"geometry.unit = {g.unit:g} m" if g.unit is not None else "the unit the file declares"
+    inside = [p for p in missed if "outside all of them" not in p.allowed]      # (those outside say it themselves)
+    if len(points) > 1 and len(missed) == len(points) and inside:   # every point missed: the unit, likely (said nothing
+        read = f"geometry.unit = {g.unit:g} m" if g.unit is not None else "the file's own unit (no geometry.unit)"
         problems.append(InputError("geometry.unit", g.unit, f"no point of geometry.bodies lies in a volume of "
                                    f"{g.file.name}, whose volumes span {_span(model, labels)} mm read in {read}: "
                                    "is it the file's length unit?"))     # (said nothing when inside the box: a trial)

@@ -201,6 +201,19 @@ def resolve_parameters(defaults: Mapping[str, object], params: Mapping[str, obje
 THIN = 3.0      # element size over a body's thickness beyond which check warns (``thin_warning``)
 
 
+def loose_bodies(warnings) -> dict[str, str]:
+    """The bodies a file's builder found sharing no face with the rotating body (its "geometry.bodies:
+    ... share no face" warnings, ``meshes.from_file``), each with its warning's text (whole names: "pad"
+    is not "pad_b", a review)."""
+    out = {}
+    for w in warnings:
+        text = w.removeprefix("geometry.bodies: ")
+        group, found, _ = text.partition(" share no face")
+        if found and text != w:
+            out.update(dict.fromkeys(group.split(", "), text))
+    return out
+
+
 def thin_warning(bodies, how: str = "") -> list[str]:
     """The warning (a list of one, or none) of the bodies of ``bodies``, (name, thickness [m],
     element size [m]) each, meshed at elements more than ``THIN`` times as thick as they are (``how``

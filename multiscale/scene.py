@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from multiscale.errors import InputError, SceneError, read_toml_text, toml_problem
+from multiscale.geometry import loose_bodies
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show, suggest, unknown_keys)
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
@@ -573,10 +574,9 @@ def _surface_checks(scene: Scene, g: Geometry, where: str, effects) -> list[str]
                         f"(known: {', '.join(g.spec.faces) or 'none: name some in [geometry.surfaces]'})")
     for name in scene.interfaces:
         if name not in g.spec.interfaces:      # a pad off the disc has none: its gap was not said (a user trial)
-            apart = [w.removeprefix("geometry.bodies: ") for w in g.spec.warnings
-                     if "share no face" in w and name in w.partition(" share no face")[0]]
+            apart = loose_bodies(g.spec.warnings).get(name)
             problems.append(f'interfaces.{name}: not an interface of {where}; interfaces: {", ".join(g.spec.interfaces)}'
-                            + (f" ({apart[0]})" if apart else ""))
+                            + (f" ({apart})" if apart else ""))
     ld = scene.loading
     direction = ld.direction if ld is not None and ld.direction is not None else \
         None if g.spec.fluid_load else g.spec.load_direction        # (a fluid load: along each face's normal)

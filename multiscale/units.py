@@ -106,7 +106,7 @@ _UNITS: dict[str, tuple[Fraction, tuple[int, ...], bool]] = {
     "ksi": (1000 * _LBF / _F("0.0254") ** 2, _PRESSURE, False), "mph": (_F("0.44704"), _dim((L, 1), (T, -1)), False),
 }
 _ABSOLUTE = {"degC": _F("273.15"), "°C": _F("273.15")}   # offsets of a whole-unit absolute temperature
-_SPELLED = {"kmh": "km/h", "kph": "km/h", "kmph": "km/h", "km/hr": "km/h", "G": "gn", "g0": "gn"}   # other spellings
+_SPELLED = {"kmh": "km/h", "kph": "km/h", "kmph": "km/h", "G": "gn"}   # other spellings
 _TYPED = {"°C": "degC"}          # a suggestion as a keyboard types it ("20 C": "degC", not "°C")
 _PREFIXES = {"G": _F(10**9), "M": _F(10**6), "k": _F(1000), "c": _F(1, 100), "m": _F(1, 1000),
              "u": _F(1, 10**6), "µ": _F(1, 10**6), "μ": _F(1, 10**6), "n": _F(1, 10**9),
@@ -331,7 +331,7 @@ def _kind_unit(text: str, spec: Kind) -> str | None:
     named = [u.strip() for u in spec.examples.split(",")] + \
         [p + u for u, (_, dim, pre) in _UNITS.items() if dim == spec.dim for p in ("", *("GMkmu" if pre else ""))]
     spelled = _SPELLED.get(text, _SPELLED.get(text.lower()))
-    if spelled:
+    if spelled and parse_unit(spelled)[2] == spec.dim:     # ("200 G" for a pressure is GPa, not gn: a review)
         return spelled
     same = [u for u in named if u.lower() == text.lower()]
     near = same[0] if same else next(iter(difflib.get_close_matches(text, named, n=1, cutoff=0.5)), None)

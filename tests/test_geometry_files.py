@@ -1088,6 +1088,10 @@ def test_a_pad_off_the_disc_is_named_by_check(tmp_path, capsys):
     with pytest.raises(InputError, match=r"could move as rigid bodies \(one of region 'pad_b' .*Its cause is likely "
                                          r"what check warned: pad_b share no face with disc.*\(gap 0.001 m\)"):
         build_mesh(loads(text, tmp_path))
+    from multiscale.geometry import loose_bodies          # whole names: "pad" is not "pad_b" (a review)
+    assert loose_bodies(["geometry.bodies: pad_b, plate_b share no face with disc (gap 1 m)", "thin"]) == {
+        "pad_b": "pad_b, plate_b share no face with disc (gap 1 m)", "plate_b": "pad_b, plate_b share no face with "
+        "disc (gap 1 m)"}
     # a table of its interface, which does not exist, says why (it hid the gap: a user trial)
     path.write_text(text + "\n[interfaces.pad_b]\nfriction = 0.3\n")
     assert main(["check", str(path)]) == 2

@@ -471,5 +471,5 @@ def test_a_body_that_cools_below_a_tables_first_point_is_named(tmp_path):
                      max_temperature_disc=423.15, min_temperature_disc=273.15 + T)
         lines = [w for w in run_warnings(scene, h) if "materials.disc.kappa" in w]
         assert lines == (["materials.disc.kappa: at 60 degC, below its first point 100 degC, held at 50 there "
-                          "(in body 'disc': an undershoot, below every imposed temperature (below))"]
+                          "(in body 'disc': an undershoot, below every imposed temperature)"]
                          if warned else []), lines      # (no cooling here: said apart from it before, a user trial)

@@ -126,6 +126,8 @@ def test_unit_strings_to_si(text, kind, expected):
     ("80 kmh", "speed", 'unknown unit "kmh" (did you mean "km/h"?)'),    # was "mph": 128.7 km/h (a user trial)
     ("80 KMH", "speed", 'unknown unit "KMH" (did you mean "km/h"?)'),    # was "MHz"
     ("0.5 G", "acceleration", 'unknown unit "G" (did you mean "gn"?)'),  # was "Gs", then refused as a time
+    ("200 G", "pressure", 'unknown unit "G" (did you mean "GPa"?)'),    # gn only where it fits (a review)
+    ("7 kmh", "length", 'unknown unit "kmh" (did you mean "km"?)'),
     ("0.5 g", "acceleration", 'the unit "g" is a mass (standard gravity is "gn")'),
     ("7.2 g/cm3", "density", 'a power is written with "^": "cm^3"'),
     ("2e-5 mm^3/N", "wear_rate", 'the unit "mm^3/N" is that times a length (m^2 kg^-1 s^2 in SI base units)'),

@@ -32,7 +32,7 @@ import numpy as np
 
 from multiscale.arrays import unique_rows
 from multiscale.errors import InputError
-from multiscale.geometry import GeometrySpec, Rotation
+from multiscale.geometry import GeometrySpec, Rotation, loose_bodies
 
 MOTIONS = ("translation along x", "translation along y", "translation along z",
            "rotation about x", "rotation about y", "rotation about z")
@@ -268,8 +268,7 @@ def check_held(model, spec: GeometrySpec, sliding: bool = False) -> None:
     error = holding.refusal({r.tag: r.name for b in spec.bodies for r in b.regions})
     if error is None:
         return
-    apart = [w for w in spec.warnings if "share no face" in w and error.value in w.partition(" share no face")[0]]
+    apart = loose_bodies(spec.warnings).get(error.value)
     if apart:                # its real cause, warned of at check (a user trial fixed the sides, as it advised)
-        raise InputError(error.name, error.value, f"{error.allowed}. Its cause is likely what check warned: "
-                         f"{apart[0].removeprefix('geometry.bodies: ')}")
+        raise InputError(error.name, error.value, f"{error.allowed}. Its cause is likely what check warned: {apart}")
     raise error

@@ -202,7 +202,7 @@ def _plot_axis(study, ok, axis, folder, found):
             at = sorted({xs[point(r)] for r in ok if r.is_reference})   # its error 0 has no place on a log axis
             for k, x in enumerate(at):       # (it was missing from the plot: a user trial)
                 ax.axvline(x, color="green", ls=":", lw=1, label=None if k else "the reference (error 0)")
-            if at:
+            if at and len(lines) <= 8:     # (not a legend of many lines the panel leaves out below: a review)
                 ax.legend(fontsize=6)
         if kind == "value" and m in study.judged:        # calibration: the measured value, and where it is met
             ref = measured_value(ok, m)

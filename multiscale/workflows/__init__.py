@@ -169,7 +169,7 @@ def run_warnings(scene, history) -> list[str]:
     for name in hottest:
         known = scene.materials[name].beyond(T0)
         for T, body in dict.fromkeys((hottest[name], coldest.get(name, hottest[name]))):   # the hottest, the coldest
-            why = ": an undershoot, below every imposed temperature (below)" if T < _floor(scene) else ""   # (a trial
+            why = ": an undershoot, below every imposed temperature" if T < _floor(scene) else ""   # (a trial
             out += [f"materials.{name}.{phrase} (in body {body!r}{why})"          # read it apart from the undershoot)
                     for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
     return (out + laws + _undershoots(scene, history) + _coarse_wear(history) + _wear_table_ends(scene, history)
@@ -325,8 +325,8 @@ def _faces_apart(scene, history) -> list[str]:
     nothing conducts across the interface, each face heats by its share of the frictional heat
     (docs/architecture.md, Known problems; a user trial read a pad face 110 K under the disc's for a
     result)."""
-    if scene.has("conductance") or scene.interface.partition in (0.0, 1.0):    # (all the heat into one side: chosen)
-        return []
+    if scene.has("conductance") or scene.has("roughness") or scene.interface.partition in (0.0, 1.0):
+        return []          # (all the heat into one side: chosen; rough zones exchange heat by their laws: a review)
     T0, out = scene.time.initial_temperature, []
     body0, body1 = (b.name for b in scene.geometry.spec.bodies)
     for name in scene.geometry.spec.interfaces:
