@@ -71,10 +71,10 @@ def initial_friction(settings, T0: float) -> float | None:
 
 def speed_law_guess(ld) -> float | None:
     """The constant mu [-] standing for [loading]'s mu(v) law (``Loading``) until the law sets each
-    facet's (a run's first solve, the squeal preload: ``workflows.model.friction_coefficient``): its
-    kinetic mu, or the mean of its curve's; None without one."""
-    if ld.stribeck is not None:
-        return ld.stribeck.kinetic
+    facet's (a run's first solve, the squeal preload: ``workflows.model.friction_coefficient``): the
+    mean of its static and kinetic mu, or of its curve's; None without one."""
+    if ld.stribeck is not None:       # (its kinetic alone, 0, refused a law of mu 0.47-0.52 in a stop: a user trial)
+        return 0.5 * (ld.stribeck.static + ld.stribeck.kinetic)
     return sum(mu for _, mu in ld.friction_curve) / len(ld.friction_curve) if ld.friction_curve else None
 
 
@@ -110,5 +110,5 @@ def speed_law_zeros(scene) -> list[str]:
         where = "" if st is None or (st.kinetic > 0 and st.static > 0) else \
             "at rest" if st.static == 0 else "at high slip speeds (its kinetic mu)"
         key = "loading.stribeck"
-    return [f"{key}: mu is 0 {where}: no clamp force gives the braking torque ({ld.torque:.6g} N m) where the "
-            "facets slide so, and the run stops there"] if where else []
+    return [f"{key}: mu is 0 {where}: where the facets slide so, the clamp force that gives the braking torque "
+            f"({ld.torque:.6g} N m) grows without bound (the run stops where every facet has mu 0)"] if where else []

@@ -286,7 +286,7 @@ class Loading:
     friction: float | None = key(_FRICTION, absent="another key of the rule below, or each interface's own")  # mu
     friction_temperature: tuple | None = key(_FADE, absent="friction, constant (no fade)")   # ((K, -), ...)
     ramp_steps: int = key(Integer(ge=1, le=10**4), default=1)   # load increments of the first mechanical solve
-    friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), Quantity("dimensionless", ge=0), "slip speed",
+    friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), _FRICTION, "slip speed",
                                              "mu", min_rows=2), absent="friction or stribeck gives mu")  # ((m/s, -),..)
     stribeck: Stribeck | None = key(Section(Stribeck))
 

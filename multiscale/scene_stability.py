@@ -16,8 +16,8 @@ class Stribeck:
     kinetic) exp(-(v / speed)^exponent) (exponent 1: the exponential static-to-kinetic decay law).
     Not with a friction sweep ([stability.sweep] friction sets a constant mu at each point)."""
 
-    static: float | None = key(Quantity("dimensionless", ge=0), required=True)
-    kinetic: float | None = key(Quantity("dimensionless", ge=0), required=True)
+    static: float | None = key(Quantity("dimensionless", ge=0, plausible=(0.0, 2.0)), required=True)   # (52 passed:
+    kinetic: float | None = key(Quantity("dimensionless", ge=0, plausible=(0.0, 2.0)), required=True)  # a trial)
     speed: float | None = key(Quantity("speed", gt=0), required=True)            # m/s, Stribeck speed
     exponent: float = key(Quantity("dimensionless", gt=0), default=1.0)
 
