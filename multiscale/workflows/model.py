@@ -51,7 +51,7 @@ from multiscale.scene_friction import bare_interfaces, initial_friction, speed_l
 
 def friction_coefficient(scene, interface: str) -> float:
     """mu [-] of an interface (``Scene.interface_settings``: its constant, else its fade table at the
-    initial temperature, else [loading]'s mu(v) law's kinetic or mean mu, a first guess until the law
+    initial temperature, else [loading]'s mu(v) law's mean mu (speed_law_guess), a first guess until the law
     sets each facet's) with effect "friction", else 0."""
     if not scene.has("friction"):
         return 0.0

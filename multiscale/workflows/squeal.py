@@ -151,7 +151,7 @@ def squeal_options(scene, tm) -> SquealOptions:
 
 def model_scene(scene):
     """The scene the model factory reads: with a mu(v) law in [loading], a placeholder constant friction
-    (the law sets the per-facet mu before the preload), the law's kinetic or mean mu (the first
+    (the law sets the per-facet mu before the preload), the law's mean mu (speed_law_guess) (the first
     guess of the clamp force of a braking torque divides by it; 0 made it "braking needs friction")."""
     ld = scene.loading
     if (mu := speed_law_guess(ld)) is not None and scene.has("friction"):
