@@ -51,7 +51,12 @@ def _range(parser) -> str:
 
 
 def _cell(text: str) -> str:
-    return text.replace("|", "/").replace("*", "\\*").replace("`", "'") or " "
+    return _paragraph(text).replace("`", "'") or " "
+
+
+def _paragraph(text: str) -> str:
+    """A section's text as RST: its ``literals`` kept (they showed as ''literals'': a user trial)."""
+    return text.replace("|", "/").replace("*", "\\*")
 
 
 def _table_rows(cls, path: str, section_effects: tuple) -> tuple[list, list]:
@@ -90,7 +95,7 @@ def _doc(cls) -> str:
 
 def _tables(cls, path: str, effects: tuple, title: str, level: str = "-") -> list[str]:
     rows, subs = _table_rows(cls, path, effects)
-    lines = [title, level * len(title), "", _cell(_doc(cls)), ""] + (_list_table(rows) if rows else [])
+    lines = [title, level * len(title), "", _paragraph(_doc(cls)) or " ", ""] + (_list_table(rows) if rows else [])
     for where, parser, sub_effects, spec in subs:
         if isinstance(parser, GeometrySection):
             continue                      # its own section
@@ -120,7 +125,7 @@ def _geometry() -> list[str]:
     rows = [("``geometry.builder``", _cell(section.builders.describe()), " ", "required (or file)", " ", "any"),
             ("``geometry.max_cells``", _cell(f"{Integer(ge=1).describe()}: {MAX_CELLS_TEXT}"), "-", show(MAX_CELLS),
              " ", "any")]
-    lines = ["[geometry]", "-" * 10, "", _cell(" ".join(GeometrySection.__doc__.split())), ""] + _list_table(rows)
+    lines = ["[geometry]", "-" * 10, "", _paragraph(" ".join(GeometrySection.__doc__.split())), ""] + _list_table(rows)
     for name in section.builders.options:
         module = builder(name)
         title = f'builder = "{name}"'

@@ -41,6 +41,13 @@ def test_every_scene_key_appears_in_the_generated_reference():
     assert "``geometry.track_radius``" in text and "``materials.<name>.kappa``" in text
 
 
+def test_a_sections_text_keeps_its_literals_in_the_reference():
+    """A section's text in the generated reference keeps its ``literals`` (they rendered as
+    ''literals'': a user trial); table cells, where RST literals could break the table, do not."""
+    text = scene_rst()
+    assert "``friction_curve`` or ``stribeck``" in text and "''friction_curve''" not in text
+
+
 def test_check_keys_and_the_generated_reference_name_the_same_keys():
     """`multiscale check --keys` (scene_summary.reference) and the user guide's page list the same
     key names: the page lacked geometry.builder and geometry.max_cells. Each builder's text on the
