@@ -320,20 +320,20 @@ def test_an_interface_of_its_own_friction_keeps_it_constant_under_a_speed_law():
 
 
 def test_a_squeal_scene_of_the_pads_own_friction_alone_reads_as_given():
-    """``workflows.squeal.model_scene`` of the brake whose pads each give their friction and
-    [loading] none: the scene as it is (before: a TypeError, a placeholder mu taken from a
+    """``workflows.model.friction_coefficient`` of the brake whose pads each give their friction and
+    [loading] none: each pad's own (before: a TypeError, a placeholder mu taken from a
     friction_curve that was not there, in every such squeal run); with a mu(v) law in [loading],
-    the placeholder is the mean of the law's static and kinetic mu."""
+    the mean of the law's static and kinetic mu, the first guess the clamp force divides by."""
     from pathlib import Path
 
     from multiscale.scene import loads
-    from multiscale.workflows.squeal import model_scene
+    from multiscale.workflows.model import friction_coefficient
     demos = Path(__file__).parents[1] / "demos"
     text = (demos / "brake_squeal.toml").read_text().replace("\nfriction = 0.4\n", "\n", 1)
     own = loads(text, demos, overrides={"interfaces.inner_pad.friction": 0.35, "interfaces.outer_pad.friction": 0.3})
-    assert model_scene(own) is own
+    assert [friction_coefficient(own, n) for n in ("inner_pad", "outer_pad")] == [0.35, 0.3]
     law = loads(text, demos, overrides={"loading.stribeck": {"static": 0.5, "kinetic": 0.4, "speed": "1 m/s"}})
-    assert model_scene(law).loading.friction == pytest.approx(0.45)     # the mean of static and kinetic mu
+    assert friction_coefficient(law, "inner_pad") == pytest.approx(0.45)     # the mean of static and kinetic mu
 
 
 def test_belt_oscillator_negative_damping_onset():

@@ -29,7 +29,6 @@ With prestress also ``prestress.csv``; with a sweep the map's files (``workflows
 from __future__ import annotations
 
 import csv
-import dataclasses
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -50,7 +49,7 @@ from multiscale.macro.modal import CLOSE, EnergyShares, RegionEnergy, StabilityR
 from multiscale.macro.output import write_modes, write_state
 from multiscale.macro.preload import Preload, linearise_system, preload
 from multiscale.macro.stability_map import StabilityMap
-from multiscale.scene_friction import bare_interfaces, speed_law_guess
+from multiscale.scene_friction import bare_interfaces
 from multiscale.workflows import squeal_map
 from multiscale.workflows.model import build_mechanics, build_mesh, drive, friction_coefficient, interface_forces, \
     model_size, speed_law
@@ -149,28 +148,17 @@ def squeal_options(scene, tm) -> SquealOptions:
                          st.friction_damping, st.prestress, st.gyroscopic, st.method, st.basis)
 
 
-def model_scene(scene):
-    """The scene the model factory reads: with a mu(v) law in [loading], a placeholder constant friction
-    (the law sets the per-facet mu before the preload), the law's mean mu (speed_law_guess) (the first
-    guess of the clamp force of a braking torque divides by it; 0 made it "braking needs friction")."""
-    ld = scene.loading
-    if (mu := speed_law_guess(ld)) is not None and scene.has("friction"):
-        return dataclasses.replace(scene, loading=dataclasses.replace(ld, friction=float(mu)))
-    return scene
-
-
 def build_squeal_mechanics(scene, tm, *, degree: int = SQUEAL_DEGREE, prefix: str = "squeal_") -> Mechanics:
     """The mechanics of a scene's squeal analysis on ``tm`` (rough laws with effect roughness;
     the datum gap as Newton's start)."""
-    model = model_scene(scene)
-    rough = build_rough_interface(model, tm) if scene.has("roughness") else None
+    rough = build_rough_interface(scene, tm) if scene.has("roughness") else None
     if rough is not None:
         with io.stage("zone laws"):
             rough.update_laws()
     with io.stage("model set-up"):       # function spaces, forms compiled (cached after the first run)
-        mech = build_mechanics(model, tm, law=rough.law if rough else None, degree=degree, prefix=prefix)
+        mech = build_mechanics(scene, tm, law=rough.law if rough else None, degree=degree, prefix=prefix)
     if rough is not None:            # Newton starts at rest from the rigid datum gap
-        tm.interface.set_field(mech.contact.initial_gap, rough.datum_gap(interface_forces(model, tm)))
+        tm.interface.set_field(mech.contact.initial_gap, rough.datum_gap(interface_forces(scene, tm)))
     return mech
 
 
@@ -186,7 +174,7 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     io.reporter().say(model_size(tm, mech))
     try:
         with closed_on_error(mech, tm.comm):
-            d = drive(model_scene(scene), tm)
+            d = drive(scene, tm)
             return squeal_case(mech, dict(scene.materials), name, load=d.load, torque=d.torque,
                                steps=scene.loading.ramp_steps, band=tuple(st.band), n_modes=st.modes,
                                target=st.target, energy=energy, rtol=st.threshold, options=squeal_options(scene, tm),
