@@ -171,14 +171,17 @@ def test_runs_timed_fewer_times_than_asked_run_again_and_the_report_says_how_oft
 
 @pytest.fixture
 def made(monkeypatch) -> list:
-    """The (figure, axes) of every ``plt.subplots`` of the study figures, kept open to be read."""
+    """The (figure, axes) of every ``plt.subplots`` of the study figures, kept open to be read (closed
+    after the test)."""
     import matplotlib.pyplot as plt
 
     from multiscale.plots import studies as figures
-    made, subplots = [], plt.subplots
+    made, subplots, close = [], plt.subplots, plt.close
     monkeypatch.setattr(figures.plt, "subplots", lambda *a, **k: made.append(subplots(*a, **k)) or made[-1])
     monkeypatch.setattr(figures.plt, "close", lambda fig: None)
-    return made
+    yield made
+    for fig, _ in made:
+        close(fig)
 
 
 def test_the_error_figure_draws_the_pareto_front_of_each_case(tmp_path, made):

@@ -188,6 +188,7 @@ def _plot_axis(study, ok, axis, folder, found):
                 ax.errorbar(x, mean, yerr=std, marker="o", ms=4, color=f"C{c % 10}", capsize=3, label=label)
             else:
                 ax.plot(x, mean, "o-", ms=4, color=f"C{c % 10}", label=label)
+        curves = ax.get_lines() + ax.containers      # the swept lines (errorbar: a container)
         if kind == "error":
             if any(np.isfinite(np.asarray(line.get_ydata(), float)).any() for line in ax.get_lines()):
                 ax.set_yscale("log")
@@ -202,14 +203,11 @@ def _plot_axis(study, ok, axis, folder, found):
             at = sorted({xs[point(r)] for r in ok if r.is_reference})   # its error 0 has no place on a log axis
             for k, x in enumerate(at):       # (it was missing from the plot: a user trial)
                 ax.axvline(x, color="green", ls=":", lw=1, label=None if k else "the reference (error 0)")
-            if at and len(lines) <= 8:     # (not a legend of many lines the panel leaves out below: a review)
-                ax.legend(fontsize=6)
         if kind == "value" and m in study.judged:        # calibration: the measured value, and where it is met
             ref = measured_value(ok, m)
             ax.axhline(ref, color="green", ls="--", lw=1, label="measured")
             met = [c.value for c in found if c.knob == axis[0] and c.metric == m and c.value is not None]
             ax.plot(met, [ref] * len(met), "*", color="green", ms=11, label="where the sweep meets it" if met else None)
-            ax.legend(fontsize=6)
         if kind == "time":
             ax.set_yscale("log")
         value = metric_heading(m, PROBLEMS[study.problem].metric_unit(m)) if kind == "value" else ""
@@ -232,8 +230,9 @@ def _plot_axis(study, ok, axis, folder, found):
         if ax.get_yscale() == "log":
             _plain_log(ax.yaxis)
         ax.grid(True, which="both", alpha=0.25)
-        if others and len(lines) <= 8:
-            ax.legend(fontsize=6)
+        shown = [(h, t) for h, t in zip(*ax.get_legend_handles_labels()) if len(lines) <= 8 or h not in curves]
+        if shown:            # the reference and measured marks always; the lines' labels up to 8 of them
+            ax.legend(*zip(*shown), fontsize=6)
     fig.suptitle(f"{study.name}: {' and '.join(study.metrics)} and wall time against {', '.join(axis)}"
                  + (f" (mean ± sample std over {', '.join(averaged)})" if averaged else ""))
     fig.tight_layout()
