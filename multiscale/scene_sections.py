@@ -302,15 +302,14 @@ class Loading:
                                 "deceleration (or slope) whatever the load factor; a release does not stop it")
         given = [k for k in ("normal_force", "pressure") if getattr(self, k) is not None]
         by_mass = self.vehicle is not None and self.vehicle.mass is not None
-        if self.braking_torque is not None:
-            if given or by_mass:
-                return [f"{path}.braking_torque: give the torque or {path}.{(given or ['vehicle.mass'])[0]}, not both"]
-            if "friction" not in ctx.effects:
-                return [f'{path}.braking_torque: the clamp force follows from the friction moment: needs effect "friction"']
-            return []
+        if self.braking_torque is not None and (given or by_mass):
+            return [f"{path}.braking_torque: give the torque or {path}.{(given or ['vehicle.mass'])[0]}, not both"]
         if given and by_mass:
             return [f"{path}.{given[0]}: give the load or {path}.vehicle.mass, not both"]
-        if not given and not by_mass and "contact" in ctx.effects:
+        if (self.braking_torque is not None or by_mass) and "friction" not in ctx.effects:   # (a vehicle's: check
+            key = "braking_torque" if self.braking_torque is not None else "vehicle.mass"   # said OK: a user trial)
+            return [f'{path}.{key}: the clamp force follows from the friction moment: needs effect "friction"']
+        if self.braking_torque is None and not given and not by_mass and "contact" in ctx.effects:
             return [f"{path}.normal_force or {path}.pressure: missing; effect \"contact\" needs it "
                     f"(or {path}.braking_torque, {path}.vehicle.mass)"]
         return []

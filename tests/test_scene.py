@@ -534,6 +534,8 @@ def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_pa
               "loading.braking_torque: give the torque or loading.normal_force, not both"),
              (torque.replace('"friction", ', ""),
               'loading.braking_torque: the clamp force follows from the friction moment: needs effect "friction"'),
+             ((DEMOS / "car_brake_stop.toml").read_text().replace('"friction", ', ""),    # (check said OK: a trial)
+              'loading.vehicle.mass: the clamp force follows from the friction moment: needs effect "friction"'),
              (torque.replace('braking_torque = "0.03 kN m"', 'braking_torque = "30 N"'),
               'loading.braking_torque = "30 N": expected a torque (N m, kN m); the unit "N" is a force')]
     # mu 0 at the initial temperature everywhere: no clamp force holds the torque (check said OK, the
