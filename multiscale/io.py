@@ -24,7 +24,7 @@ from multiscale.errors import MultiscaleError, OutputError
 
 UNITS = {"time": "s", "force": "N", "pressure": "Pa", "temperature": "K", "heat": "J", "iterations": "-",
          "volume": "m^3", "depth": "m", "rms": "m", "work": "J", "area": "m^2", "moment": "N m", "wear_rate": "1/Pa",
-         "coefficient": "-"}
+         "coefficient": "-", "speed": "m/s"}
 
 
 def unit_of(name: str) -> str:

@@ -380,6 +380,9 @@ def test_a_friction_falling_with_speed_sets_each_facets_mu_at_its_slip_speed(tmp
         normal = model.contact.facet_normal_force()
         expected = np.interp(omega * radius, [0.0, 5.0], [0.5, 0.3]) @ normal / normal.sum()
         assert row["friction_coefficient"] == pytest.approx(expected, rel=1e-3), k
+        touching = radius[model.contact.facet_pressure() > 0]     # the slip speeds mu(v) read, in contact
+        assert (row["max_slip_speed"], row["min_slip_speed"]) == pytest.approx(
+            (omega * touching.max(), omega * touching.min()), rel=1e-3), k
         found.append((row["friction_coefficient"], model.last_solve is solves))
     model.close()
     assert found[0][0] > found[1][0] == pytest.approx(found[2][0], rel=1e-12)    # 200, then 300 rpm and held

@@ -256,6 +256,29 @@ def test_a_wear_update_its_increments_leave_off_is_warned_about(tmp_path):
                      "(against half the increments); for 5 % set wear.substeps to about 20 (first order: fewer may do)"]
 
 
+def test_slip_speeds_beyond_a_friction_curve_are_warned_of():
+    """A friction_curve holds mu at its end rows beyond them: slip speeds in contact
+    (``max_slip_speed``, ``min_slip_speed``) above its last row or below its first are warned of,
+    with the farthest speed, its time and the mu held (it was not said); NaN rows (released, at
+    rest) and speeds within the curve are not."""
+    from multiscale.workflows import run_warnings
+    demo = Path(__file__).resolve().parents[1] / "demos" / "car_brake_stop.toml"
+    scene = loads(demo.read_text().replace("friction = 0.4", 'friction_curve = [["1 m/s", 0.45], ["10 m/s", 0.35]]'),
+                  demo.parent)
+    h = History()
+    for t, high, low in ((0.0, 12.5, 9.0), (1.0, 11.0, 0.4), (2.0, 5.0, 0.2), (3.0, np.nan, np.nan)):
+        h.append(time=t, max_slip_speed=high, min_slip_speed=low)
+    assert [w for w in run_warnings(scene, h) if w.startswith("loading.friction_curve")] == [
+        "loading.friction_curve: the slip speed in contact reached 12.5 m/s at t = 0 s, above its last row, 10 m/s: "
+        "mu was held at 0.35 there (a curve over the run's slip speeds says what mu is)",
+        "loading.friction_curve: the slip speed in contact reached 0.2 m/s at t = 2 s, below its first row, 1 m/s: "
+        "mu was held at 0.45 there (a curve over the run's slip speeds says what mu is)"]
+    h = History()
+    for t in (0.0, 1.0):
+        h.append(time=t, max_slip_speed=9.5 if t else np.nan, min_slip_speed=1.0 if t else np.nan)
+    assert not [w for w in run_warnings(scene, h) if w.startswith("loading.friction_curve")]
+
+
 def test_faces_of_an_interface_that_drift_apart_without_conductance_are_warned_of():
     """A pad's face 110 K under the disc's (a user trial's three pads, no conductance) read as a
     result: the run warns of faces whose mean temperatures drift more than ``APART`` of their rise

@@ -113,7 +113,7 @@ def curve_styles(keys, palette: dict | None = None) -> tuple[list[dict], list]:
 
 def history_figure(history, path: Path, title: str = "") -> Path:
     """PNG of the history: force, max pressure, max temperatures, heat per body (and the friction
-    coefficient with fade or mu(v), the braking torque of a rotating body, per interface, max face
+    coefficient with fade or mu(v), the slip speeds with mu(v), the braking torque of a rotating body, per interface, max face
     temperatures, stored heat per part) vs time."""
     t = history["time"]
     bodies = [k.removeprefix("heat_total_") for k in history.columns if k.startswith("heat_total_")]
@@ -122,6 +122,7 @@ def history_figure(history, path: Path, title: str = "") -> Path:
               ("max contact pressure [MPa]", ["max_pressure"], 1e-6, 0.0),
               ("friction coefficient [-]", [k for k in history.columns if k.startswith("friction_coefficient")],
                1.0, 0.0),                                                          # with fade (and per interface)
+              ("slip speed in contact [m/s]", ["max_slip_speed", "min_slip_speed"], 1.0, 0.0),      # with mu(v)
               ("braking torque [N m]", ["friction_moment"], 1.0, 0.0),    # a rotating body's (wanted: a trial)
               ("max temperature [°C]", temperature_columns(history.columns), 1.0, -273.15),
               ("heat of each body [J]", heat, 1.0, 0.0),
@@ -156,6 +157,8 @@ def history_figure(history, path: Path, title: str = "") -> Path:
             handles = entries or ax.get_lines()
             ax.legend(handles=handles, fontsize="medium" if len(handles) <= LEGEND_ROWS else "x-small",
                       ncol=-(-len(handles) // LEGEND_ROWS))
+    for ax in axes[1:len(groups)]:       # one time axis (a panel's NaN rows, at rest, shortened its own)
+        ax.set_xlim(axes[0].get_xlim())
     fig.suptitle(f"{title}: interface force, contact pressure, temperatures and heat against time" if title else
                  "interface force, contact pressure, temperatures and heat against time")
     fig.tight_layout()

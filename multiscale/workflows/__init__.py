@@ -173,7 +173,8 @@ def run_warnings(scene, history) -> list[str]:
             out += [f"materials.{name}.{phrase} (in body {body!r}{why})"          # read it apart from the undershoot)
                     for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
     return (out + laws + _undershoots(scene, history) + _coarse_wear(history) + _wear_table_ends(scene, history)
-            + _too_hot(scene, history) + _fade_table_ends(scene, history) + _unloaded(scene, history)
+            + _too_hot(scene, history) + _fade_table_ends(scene, history) + _curve_ends(scene, history)
+            + _unloaded(scene, history)
             + _faces_apart(scene, history)
             + (overloaded(scene, float(np.max(history["max_pressure"])), hottest)
                if "max_pressure" in history.columns else []))
@@ -265,6 +266,24 @@ def _fade_table_ends(scene, history) -> list[str]:
             out.append(f"{where}: {what} reached {hottest - 273.15:.4g} degC, above its last point, "
                        f"{table[-1][0] - 273.15:.4g} degC: where the interface (the mean of its two faces) was that "
                        f"hot, mu was held at {table[-1][1]:g}")
+    return out
+
+
+def _curve_ends(scene, history) -> list[str]:
+    """[loading]'s ``friction_curve`` left by the slip speeds of the facets in contact
+    (``max_slip_speed``, ``min_slip_speed``), where mu was held at its end row (it was not said)."""
+    curve, out = scene.loading.friction_curve, []
+    if curve is None or "max_slip_speed" not in history.columns:
+        return []
+    for column, beyond, (v, mu), side in (("max_slip_speed", np.greater, curve[-1], "above its last"),
+                                          ("min_slip_speed", np.less, curve[0], "below its first")):
+        V = np.asarray(history[column], float)
+        left = np.flatnonzero(beyond(np.nan_to_num(V, nan=v), v))
+        if left.size:
+            row = left[np.argmax(np.abs(V[left] - v))]
+            out.append(f"loading.friction_curve: the slip speed in contact reached {V[row]:.4g} m/s at t = "
+                       f"{history['time'][row]:g} s, {side} row, {v:.4g} m/s: mu was held at {mu:g} there "
+                       "(a curve over the run's slip speeds says what mu is)")
     return out
 
 
