@@ -152,6 +152,10 @@ class FileGeometry:
             out.append(f"{path}.mesh_size: missing; needed to mesh a {self.file.suffix} file")
         elif self.kind == "mesh" and self.mesh_algorithm is not None:
             out.append(f"{path}.mesh_algorithm: not used with a {self.file.suffix} file (it is meshed already)")
+        elif self.kind != "mesh" and (fine := self.interface_mesh_size) is not None and fine >= self.mesh_size:
+            ctx.warnings.append(f"{path}.interface_mesh_size = {fine * 1e3:.4g} mm: not finer than mesh_size, "
+                                f"{self.mesh_size * 1e3:.4g} mm, so the interfaces are meshed at mesh_size (it only "
+                                "refines)")                                     # (it was silent: a user trial)
         if self.rotating not in self.bodies:
             out.append(f"{path}.rotating = \"{self.rotating}\": not a body; bodies: {', '.join(self.bodies)}")
         elif self.rotating == FIXED_BODY:

@@ -791,6 +791,11 @@ def test_elements_three_times_as_thick_as_a_body_are_warned_about(tmp_path):
                   if "as thick as" in w]
     assert warning.startswith("geometry.mesh_size: elements more than 3 times as thick as the bodies pad_a (about "
                               "4.44 mm, meshed at 15 mm), pad_b (about 4.44 mm, meshed at 15 mm) (thickness")
+    # an interface size coarser than mesh_size is not used, and said (it was silent: a user trial)
+    scene = loads(text, tmp_path, overrides={"geometry.interface_mesh_size": "20 mm"})
+    assert [w for w in scene.warnings if "as thick as" in w] == [warning]
+    assert ("geometry.interface_mesh_size = 20 mm: not finer than mesh_size, 15 mm, so the interfaces are meshed at "
+            "mesh_size (it only refines)") in scene.warnings
 
 
 def test_overlapping_parts_are_named_as_the_cause_of_an_unassigned_volume(tmp_path, capsys):
