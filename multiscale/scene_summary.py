@@ -5,7 +5,7 @@ import json
 import math
 
 from multiscale.geometry import CellEstimate, estimate_cells
-from multiscale.outputs import analysis
+from multiscale.outputs import CHECKPOINT, analysis
 from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
 from multiscale.scene_friction import FRICTION, bare_interfaces
@@ -101,7 +101,7 @@ def summary(scene: Scene) -> list[str]:
         own = unrecorded_results(scene, names)
         lines.append(f"  note      the output folder already holds {entries(len(names))}: run needs --overwrite "
                      f"(deletes the {earlier} the run before wrote)"
-                     + (" or --resume" if analysis(scene) == "multiscale" else "")
+                     + (" or --resume" if analysis(scene) == "multiscale" and CHECKPOINT in names else "")
                      + (f"; it refuses to write over {', '.join(own)}, not written by a run" if own else ""))
     lines += [f"  warning   {w}" for w in scene.warnings]
     return lines

@@ -257,6 +257,22 @@ def test_run_refuses_to_overwrite_results(tmp_path, capsys, monkeypatch):
     assert (tmp_path / "out" / "history.h5").exists()          # the CLI itself deletes nothing
 
 
+def test_check_offers_resume_only_where_a_checkpoint_is(tmp_path, capsys):
+    """A multiscale scene's output folder holding another file only: check's note asks for
+    --overwrite, not --resume (there is nothing to resume from: it offered it, a user trial); with
+    the run's checkpoint there, --resume too."""
+    demo = Path(__file__).resolve().parents[1] / "demos" / "pin_on_disc.toml"
+    out = tmp_path / "out"
+    out.mkdir()
+    (out / "notes.txt").write_text("mine\n")
+    for checkpoint in (False, True):
+        if checkpoint:
+            (out / "checkpoint.h5").write_bytes(b"")
+        assert main(["check", str(demo), "--set", f'output.folder="{out}"']) == 0
+        note = next(line for line in capsys.readouterr().out.splitlines() if "already holds" in line)
+        assert ("or --resume" in note) == checkpoint, note
+
+
 def test_heat_in_a_sliding_translating_body_is_refused_at_check(tmp_path, capsys):
     """The heat problem of a translating body runs only at rest: ``check`` says so (before: only
     ``run``, after meshing)."""
