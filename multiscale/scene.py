@@ -40,7 +40,7 @@ from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_p
                                    squeal_state, thin_heated_layers)
 from multiscale.scene_keys import key_parts
 from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks, speed_law_zeros, torque_problems
-from multiscale.scene_stability import Stability, unresolved_band
+from multiscale.scene_stability import Stability, undamped_falling_law, unresolved_band
 from multiscale.scene_vehicle import Vehicle
 
 __all__ = ["COUPLING_DEFAULT", "EFFECTS", "FIG_7_9_CALIBRATION", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Boundary",
@@ -459,7 +459,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         warnings += squeal_state(scene.loading, g.motion, "friction" in effects and not swept)
         if scene.stability is not None and scene.materials is not None:
             warnings += unresolved_band(scene.stability, g.resolved(), scene.materials, g.materials,
-                                        (scene.time or Time()).initial_temperature)
+                                        (scene.time or Time()).initial_temperature) + (undamped_falling_law(
+                scene.stability, scene.loading, scene.materials, g.materials) if "friction" in effects else [])
     end = scene.time.end if scene.time is not None else None
     if scene.loading is not None and end is not None:
         fades = fade_tables(scene.loading, scene.interfaces, g.spec.interfaces if g is not None else None) \

@@ -1519,3 +1519,23 @@ def test_a_squeal_band_beyond_what_the_mesh_resolves_is_warned_about():
     warned = [w for w in scene.warnings if w.startswith("stability.band: at its top")]
     assert len(warned) == 1 and f"pad ({wave * 1e3:.3g} mm)" in warned[0] and "elements (12 mm)" in warned[0]
 
+
+
+def test_a_falling_mu_v_law_in_an_undamped_squeal_analysis_is_warned_of():
+    """A Stribeck law (or a falling curve) with friction_damping and nothing damping the brake flags
+    nearly every mode moving the pads as unstable (9 of 10 car-brake modes, 1 with rayleigh_beta =
+    1e-7 s: a user trial): check says so; not with any damping, a rising curve or friction_damping
+    off."""
+    text = (DEMOS / "brake_squeal.toml").read_text()
+    stribeck = {"loading.stribeck": {"static": 0.5, "kinetic": 0.4, "speed": "1 m/s"}}
+
+    def warned(body, **overrides):
+        scene = loads(text.replace("friction = 0.4", body), DEMOS, overrides=overrides)
+        return [w for w in scene.warnings if w.startswith("stability.friction_damping: the mu(v) law falls")]
+    assert len(warned("", **stribeck)) == 1
+    assert len(warned('friction_curve = [["0 m/s", 0.4], ["5 m/s", 0.45], ["10 m/s", 0.42]]')) == 1
+    assert not warned('friction_curve = [["0 m/s", 0.4], ["10 m/s", 0.45]]')
+    assert not warned("friction = 0.4")
+    for damped in ({"stability.damping": 0.01}, {"stability.rayleigh_beta": "1e-7 s"},
+                   {"materials.pad.loss_factor": 0.05}, {"stability.friction_damping": False}):
+        assert not warned("", **stribeck, **damped), damped
