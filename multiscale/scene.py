@@ -307,9 +307,10 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
                 table = table.setdefault(part, {})
             if not isinstance(table, (dict, list)):
                 raise SceneError(f"{dotted}: cannot override, {part} is not a table")
-        if isinstance(table, list):
-            raise SceneError(f"{dotted}: cannot override an array of tables whole; give a key of one of its "
-                             "entries (boundary[2].emissivity)")
+        if isinstance(table, list):       # of tables, or plain (it was called one of tables: a review)
+            raise SceneError(f"{dotted}: cannot override " + ("an array of tables whole; give a key of one of its "
+                             "entries (boundary[2].emissivity)" if all(isinstance(e, dict) for e in table) else
+                             "one item of an array; give the whole array (geometry.axis = [0, 0, 1])"))
         table[last] = value
     effects = raw.get("effects")
     active = frozenset(e for e in effects if isinstance(e, str) and e in EFFECTS) \

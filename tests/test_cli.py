@@ -216,6 +216,10 @@ def test_set_gives_scene_keys_over_the_files_to_check_and_run(tmp_path, capsys, 
         assert "free:block: convection h = 30 W/(m^2 K)" in capsys.readouterr().out
     assert main(["check", cooled, "--set", "boundary[2].convection=30"]) == 2
     assert "boundary[2].convection: cannot override, 2 is not one of the 1 entries" in capsys.readouterr().err
+    assert main(["check", cooled, "--set", "boundary[1]=30"]) == 2
+    assert "boundary[1]: cannot override an array of tables whole; give a key" in capsys.readouterr().err
+    assert main(["check", cooled, "--set", "effects[2]=thermal"]) == 2     # a plain array (was: "of tables")
+    assert "effects[2]: cannot override one item of an array; give the whole array" in capsys.readouterr().err
     with pytest.raises(SystemExit) as exit_:     # meant as TOML (was read as the text "[2,2": a range error)
         main(["check", path, "--set", "micro.zones=[2,2"])
     assert exit_.value.code == 2 and "[2,2 is not a TOML value (Unclosed array" in capsys.readouterr().err
