@@ -3,11 +3,11 @@
 A table is a frozen dataclass whose fields carry a ``key(...)`` spec: how the TOML value is read
 (``Quantity("pressure", gt=0)``, ``Integer(ge=1)``, ``Choice(...)``, ``Section(Cls)`` ...), its
 default, and whether it is required always or only when some effect is on (``needed_by``).
-Class-level ``rules`` (``OneOf``, ``Requires``, ``OnlyWith``) relate keys of one table; an optional
-``problems(self, path, ctx)`` method checks the built table's consistency. ``read`` walks a raw table
-and collects EVERY problem as one line naming the path, the value and what is allowed, so a new
-section is added by declaring a dataclass, not by writing a code path.
-Paths are dotted (``materials.pin.E``); list items are numbered from 1 (``layers.layer[2].E``).
+Class-level ``rules`` (``OneOf``, ``Requires``, ``OnlyWith``) relate keys of one table (``ELSEWHERE``:
+where keys given there belong); ``problems(self, path, ctx)`` checks the built table. ``read`` walks a
+raw table and collects EVERY problem as one line naming the path, the value and what is allowed: a
+new section is a dataclass, not a code path. Paths are dotted (``materials.pin.E``), list items
+numbered from 1 (``layers.layer[2].E``).
 """
 from __future__ import annotations
 
@@ -493,21 +493,21 @@ class OnlyWith:
 
 
 # ---------------------------------------------------------------- the reader
-def unknown_keys(raw, allowed, path: str, ctx: Context, what: str = "key") -> set[str]:
-    """Report keys of ``raw`` not in ``allowed`` (with a "did you mean", also of a key that a plain
-    section has, given a level too high: ``--set ramp_steps=1``, a user trial); return the suggested
-    names, so that their "missing" problem is not reported a second time."""
+def unknown_keys(raw, allowed, path: str, ctx: Context, what: str = "key", elsewhere=()) -> set[str]:
+    """Report keys of ``raw`` not in ``allowed`` ("did you mean", also a plain section's key a level too high:
+    ``--set ramp_steps=1``; one of ``elsewhere``, {name: where it belongs}, with that); the suggested names."""
     prefix, typos = f"{path}." if path else "", set()
     inner = {s: dict(fields_of(p.parser.cls)) for s, p in (allowed.items() if isinstance(allowed, dict) else ())
              if isinstance(getattr(p, "parser", None), Section) and not isinstance(p.parser, (Tables, Named))
              and dataclasses.is_dataclass(p.parser.cls)} if set(raw) - set(allowed) else {}
     for name in raw:
-        if name not in allowed:
+        if name in elsewhere:
+            ctx.problems.append(f"{prefix}{name}: {elsewhere[name]}")
+        elif name not in allowed:
             hint = suggest(name, allowed) or next((f' (did you mean "{s}.{name}"?)' for s, keys in inner.items()
                                                    if name in keys), "")
             typos.update(hint.split('"')[1:2])
-            ctx.problems.append(f"{prefix}{name}: unknown {what}{hint}; "
-                                f"allowed: {', '.join(allowed) or 'none'}")
+            ctx.problems.append(f"{prefix}{name}: unknown {what}{hint}; allowed: {', '.join(allowed) or 'none'}")
     return typos
 
 
@@ -539,7 +539,7 @@ def read(cls, raw, path: str, ctx: Context):
         ctx.problems.append(f"{path} = {show(raw)}: must be a table [{path}]")
         return None
     before, specs, values = len(ctx.problems), dict(fields_of(cls)), {}
-    typos = unknown_keys(raw, specs, path, ctx)
+    typos = unknown_keys(raw, specs, path, ctx, elsewhere=getattr(cls, "ELSEWHERE", ()))
     for name, spec in specs.items():
         where = prefix + name
         effect = _needing(spec.needed_by, spec.unless, ctx.effects)

@@ -1539,3 +1539,17 @@ def test_a_falling_mu_v_law_in_an_undamped_squeal_analysis_is_warned_of():
     for damped in ({"stability.damping": 0.01}, {"stability.rayleigh_beta": "1e-7 s"},
                    {"materials.pad.loss_factor": 0.05}, {"stability.friction_damping": False}):
         assert not warned("", **stribeck, **damped), damped
+
+
+def test_an_interfaces_own_mu_v_law_is_refused_with_where_it_belongs():
+    """[interfaces.<pad>] friction_curve or stribeck: a mu(v) law is [loading]'s alone; the error
+    says so and what an interface may give (it was "unknown key (did you mean "friction"?)")."""
+    text = (DEMOS / "brake_squeal.toml").read_text()
+    for key, value in (("friction_curve", [["0 m/s", 0.5], ["10 m/s", 0.4]]),
+                       ("stribeck", {"static": 0.5, "kinetic": 0.4, "speed": "1 m/s"})):
+        with pytest.raises(SceneError) as info:
+            loads(text, DEMOS, overrides={f"interfaces.inner_pad.{key}": value})
+        assert info.value.problems == [
+            f"interfaces.inner_pad.{key}: a mu(v) law is [loading]'s, for every interface (loading.friction_curve or "
+            "[loading.stribeck]); an interface's own friction is a constant (friction) or a fade table "
+            "(friction_temperature)"]
