@@ -604,3 +604,26 @@ def test_a_history_of_released_rows_plots_without_a_warning(tmp_path):
         multiscale_figure(history, tmp_path / "released.png")
     assert [str(w.message) for w in caught] == []
     assert (tmp_path / "released.png").stat().st_size > 0
+
+
+def test_the_slip_speeds_recorded_are_those_the_speed_law_read(tmp_path):
+    """[loading]'s friction_curve on the outer pad, the inner pad's own constant mu: the history's
+    ``max_slip_speed`` and ``min_slip_speed`` are omega r over the outer pad's facets in contact alone,
+    to 1e-3 (before, over both pads': a review), which here span other radii than both pads' together."""
+    from multiscale.workflows.model import build_model
+    text = (ROOT / "demos" / "brake_squeal.toml").read_text().replace(
+        "friction = 0.4", 'friction_curve = [["0 m/s", 0.5], ["10 m/s", 0.4]]')
+    scene = loads(text, ROOT / "demos", overrides={
+        **BRAKE, "output.folder": str(tmp_path / "out"), "effects": ["contact", "friction"],
+        "interfaces.inner_pad.friction": 0.4, "loading.rotation_speed": "50 rad/s", "time": {"end": "0.1 s", "steps": 1}})
+    model = build_model(scene)
+    model.start()
+    row = model.record(model.macro_step(0.1))
+    iface = model.tm.interface
+    radius = np.hypot(iface.midpoints[:, 0], iface.midpoints[:, 1])
+    touching = model.contact.facet_pressure() > 0
+    outer = radius[touching & iface.masks()["outer_pad"]]
+    model.close()
+    assert (row["max_slip_speed"], row["min_slip_speed"]) == pytest.approx((50 * outer.max(), 50 * outer.min()), rel=1e-3)
+    both = radius[touching]
+    assert (both.max(), both.min()) != pytest.approx((outer.max(), outer.min()), rel=1e-3)    # the check bites

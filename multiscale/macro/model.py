@@ -344,7 +344,7 @@ class MacroModel:
         interfaces and heat, ``interface_heat_row`` gives each one's heat and face temperatures. With a
         ``friction_law``, ``friction_coefficient`` [-] is ``friction_force`` over ``interface_force`` (NaN
         while released or at rest), and with several interfaces each one's too; with a mu(v) law,
-        ``max_slip_speed`` and ``min_slip_speed`` [m/s] over the facets in contact (NaN as mu)."""
+        ``max_slip_speed`` and ``min_slip_speed`` [m/s] over its facets in contact (NaN as mu)."""
         on = not self.released
         friction = np.linalg.norm(self.contact.facet_friction(), axis=1) * on     # N per facet, magnitudes
         row = {"time": self.time, "interface_force": self.last_solve.normal_force * on,
@@ -358,7 +358,8 @@ class MacroModel:
         if self.friction_law is not None:               # fade: the friction over the normal force
             row["friction_coefficient"] = ratio(row["friction_force"], row["interface_force"])
         if self.friction_law is not None and self.friction_law.reads_speed:    # the slip speeds mu(v) read
-            V = self.contact.facet_means("slip")[self.contact.facet_pressure() > 0] if on and moving else []
+            read = np.logical_or.reduce([m for m, _ in self.friction_law.speeds]) & (self.contact.facet_pressure() > 0)
+            V = self.contact.facet_means("slip")[read] if on and moving else []
             row["max_slip_speed"], row["min_slip_speed"] = (float(V.max()), float(V.min())) if len(V) else (np.nan,) * 2
         if isinstance(self.tm.spec.motion, Rotation):   # the braking torque: frictional heat power = it x omega
             row["friction_moment"] = abs(self.contact.friction_moment()) * on
