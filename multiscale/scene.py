@@ -309,7 +309,7 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
                 raise SceneError(f"{dotted}: cannot override, {part} is not a table")
         if isinstance(table, list):       # of tables, or plain (it was called one of tables: a review)
             raise SceneError(f"{dotted}: cannot override " + ("an array of tables whole; give a key of one of its "
-                             "entries (boundary[2].emissivity)" if all(isinstance(e, dict) for e in table) else
+                             "entries (boundary[2].emissivity)" if table and all(isinstance(e, dict) for e in table) else
                              "one item of an array; give the whole array (geometry.axis = [0, 0, 1])"))
         table[last] = value
     effects = raw.get("effects")
@@ -461,7 +461,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         if scene.stability is not None and scene.materials is not None:
             warnings += unresolved_band(scene.stability, g.resolved(), scene.materials, g.materials,
                                         (scene.time or Time()).initial_temperature) + (undamped_falling_law(
-                scene.stability, scene.loading, scene.materials, g.materials) if "friction" in effects else [])
+                scene, g.materials, g.spec.interfaces) if "friction" in effects else [])
     end = scene.time.end if scene.time is not None else None
     if scene.loading is not None and end is not None:
         fades = fade_tables(scene.loading, scene.interfaces, g.spec.interfaces if g is not None else None) \

@@ -181,8 +181,9 @@ class InterfaceSettings:
     friction_temperature: tuple | None = key(_FADE, absent="loading's friction")     # ((K, -), ...)
     rough: bool = key(Flag(), default=True)                           # with effect "roughness"
     ELSEWHERE = dict.fromkeys(("friction_curve", "stribeck"), "a mu(v) law is [loading]'s, for every interface "
-                              "(loading.friction_curve or [loading.stribeck]); an interface's own friction is a "
-                              "constant (friction) or a fade table (friction_temperature)")   # (it was "unknown")
+                              "without a friction of its own (loading.friction_curve or [loading.stribeck]); an "
+                              "interface's own friction is a constant (friction) or a fade table "
+                              "(friction_temperature)")                                  # (it was "unknown")
     roughness: object = None          # Roughness of this interface (the merged [roughness] table)
     micro: object = None              # Micro of this interface (the merged [micro] table)
 

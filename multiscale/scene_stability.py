@@ -7,6 +7,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+from multiscale.scene_friction import bare_interfaces
 from multiscale.schema import Choice, Flag, Integer, ListOf, OneOf, Pair, Quantity, Section, key
 
 
@@ -207,20 +208,20 @@ def unresolved_band(stability, sizes: dict, materials, names, T0: float) -> list
             f"structure's; a geometry.mesh_size of {min(short.values()) / 2 * 1e3:.2g} mm or less, or a lower band"]
 
 
-def undamped_falling_law(stability, loading, materials, names) -> list[str]:
+def undamped_falling_law(scene, materials, interfaces) -> list[str]:
     """A warning if [loading]'s mu(v) law falls with the slip speed (a Stribeck law of static above
-    kinetic mu, a curve with a falling segment), ``stability.friction_damping`` turns its slope into
-    (negative) damping, and nothing damps the structure (no ``stability`` damping, no loss factor or
-    Rayleigh damping of the materials ``names``): that alone flags nearly every mode moving the pads
-    along the disc (9 of 10 car-brake modes; 1 of 10 with rayleigh_beta = 1e-7 s, as without the
-    slope: a user trial)."""
-    law = loading.stribeck
+    kinetic mu, a curve with a falling segment) on some of the ``interfaces`` (those without a
+    friction of their own), ``stability.friction_damping`` turns its slope into (negative) damping,
+    and nothing damps the structure (no ``stability`` damping, no loss factor or Rayleigh damping of
+    the ``materials``): that alone flags nearly every mode moving the pads along the disc (9 of 10
+    car-brake modes; 1 of 10 with rayleigh_beta = 1e-7 s, as without the slope: a user trial)."""
+    stability, loading, law = scene.stability, scene.loading, scene.loading.stribeck
     falls = law.static > law.kinetic if law is not None else \
         loading.friction_curve is not None and any(b[1] < a[1] for a, b in zip(loading.friction_curve,
                                                                                 loading.friction_curve[1:]))
     damped = stability.damping or stability.rayleigh_alpha or stability.rayleigh_beta or any(
-        getattr(materials[n], k) for n in names if n in materials for k in type(materials[n]).DAMPING)
-    if not (falls and stability.friction_damping) or damped:
+        getattr(m, k) for m in (scene.materials.get(n) for n in materials) if m is not None for k in m.DAMPING)
+    if not (falls and stability.friction_damping and bare_interfaces(scene.interfaces, interfaces)) or damped:
         return []
     return ["stability.friction_damping: the mu(v) law falls with the slip speed and nothing damps the structure, "
             "so its negative damping flags as unstable nearly every mode that moves the pads along the disc, "

@@ -534,7 +534,8 @@ def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_pa
               "loading.braking_torque: give the torque or loading.normal_force, not both"),
              (torque.replace('"friction", ', ""),
               'loading.braking_torque: the clamp force follows from the friction moment: needs effect "friction"'),
-             ((DEMOS / "car_brake_stop.toml").read_text().replace('"friction", ', ""),    # (check said OK: a trial)
+             ((DEMOS / "car_brake_stop.toml").read_text().replace('"friction", "thermal", "heat_partition"',
+                                                                  '"thermal"'),        # (check said OK: a trial)
               'loading.vehicle.mass: the clamp force follows from the friction moment: needs effect "friction"'),
              (torque.replace('braking_torque = "0.03 kN m"', 'braking_torque = "30 N"'),
               'loading.braking_torque = "30 N": expected a torque (N m, kN m); the unit "N" is a force')]
@@ -1524,8 +1525,8 @@ def test_a_squeal_band_beyond_what_the_mesh_resolves_is_warned_about():
 def test_a_falling_mu_v_law_in_an_undamped_squeal_analysis_is_warned_of():
     """A Stribeck law (or a falling curve) with friction_damping and nothing damping the brake flags
     nearly every mode moving the pads as unstable (9 of 10 car-brake modes, 1 with rayleigh_beta =
-    1e-7 s: a user trial): check says so; not with any damping, a rising curve or friction_damping
-    off."""
+    1e-7 s: a user trial): check says so; not with any damping, a rising curve, friction_damping
+    off, or every pad of a friction of its own (the law unread: a review)."""
     text = (DEMOS / "brake_squeal.toml").read_text()
     stribeck = {"loading.stribeck": {"static": 0.5, "kinetic": 0.4, "speed": "1 m/s"}}
 
@@ -1537,7 +1538,8 @@ def test_a_falling_mu_v_law_in_an_undamped_squeal_analysis_is_warned_of():
     assert not warned('friction_curve = [["0 m/s", 0.4], ["10 m/s", 0.45]]')
     assert not warned("friction = 0.4")
     for damped in ({"stability.damping": 0.01}, {"stability.rayleigh_beta": "1e-7 s"},
-                   {"materials.pad.loss_factor": 0.05}, {"stability.friction_damping": False}):
+                   {"materials.pad.loss_factor": 0.05}, {"stability.friction_damping": False},
+                   {"interfaces.inner_pad.friction": 0.4, "interfaces.outer_pad.friction": 0.4}):
         assert not warned("", **stribeck, **damped), damped
 
 
@@ -1550,6 +1552,6 @@ def test_an_interfaces_own_mu_v_law_is_refused_with_where_it_belongs():
         with pytest.raises(SceneError) as info:
             loads(text, DEMOS, overrides={f"interfaces.inner_pad.{key}": value})
         assert info.value.problems == [
-            f"interfaces.inner_pad.{key}: a mu(v) law is [loading]'s, for every interface (loading.friction_curve or "
-            "[loading.stribeck]); an interface's own friction is a constant (friction) or a fade table "
-            "(friction_temperature)"]
+            f"interfaces.inner_pad.{key}: a mu(v) law is [loading]'s, for every interface without a friction of its "
+            "own (loading.friction_curve or [loading.stribeck]); an interface's own friction is a constant (friction) "
+            "or a fade table (friction_temperature)"]
