@@ -176,11 +176,16 @@ def made(monkeypatch) -> list:
     import matplotlib.pyplot as plt
 
     from multiscale.plots import studies as figures
-    made, subplots, close = [], plt.subplots, plt.close
-    monkeypatch.setattr(figures.plt, "subplots", lambda *a, **k: made.append(subplots(*a, **k)) or made[-1])
+    made, every, subplots, close = [], [], plt.subplots, plt.close
+
+    def kept(*a, **k):
+        made.append(subplots(*a, **k))
+        every.append(made[-1][0])              # (a test may clear ``made``)
+        return made[-1]
+    monkeypatch.setattr(figures.plt, "subplots", kept)
     monkeypatch.setattr(figures.plt, "close", lambda fig: None)
     yield made
-    for fig, _ in made:
+    for fig in every:
         close(fig)
 
 
