@@ -854,6 +854,8 @@ def test_the_knobs_columns_carry_their_units(tmp_path):
                                        '"geometry.length" = ["10 mm", 9e-3]\n', "s.toml"))
     assert [knob_unit(scene, k) for k in ("loading.pressure", "time.steps", "materials.block.nu",
                                           "geometry.length")] == ["Pa", "", "-", "m"]
+    # an entry of an array of tables (it had none: a user trial)
+    assert [knob_unit(scene, k) for k in ("boundary[1].temperature", "boundary.2.emissivity")] == ["K", "-"]
 
 
 def test_a_scene_keys_bare_numbers_get_its_unit_on_the_axis(tmp_path, made):

@@ -179,16 +179,18 @@ def write_tables(study: Study, rows: list[Row]) -> tuple[Path, Path]:
 
 def _key_spec(cls, dotted: str):
     """The Spec of the dotted TOML key ``dotted`` of table class ``cls`` ("wear.k_w"; a named
-    table's name is any: "materials.pin.E"); None if there is no such key (or it is in an array
-    of tables)."""
+    table's name is any: "materials.pin.E"; an entry of an array of tables by its number:
+    "boundary[2].emissivity"); None if there is no such key."""
     parts = key_parts(dotted)
     while True:
         spec = dict(fields_of(cls)).get(parts.pop(0))
         if spec is None or not parts:
             return spec
-        if isinstance(spec.parser, Named):
-            parts.pop(0)
-        if not parts or not isinstance(spec.parser, Section) or isinstance(spec.parser, Tables):
+        if isinstance(spec.parser, Named) or (isinstance(spec.parser, Tables) and parts[0].isdigit()):
+            parts.pop(0)         # (a swept boundary[2].emissivity had no unit: a user trial)
+        elif isinstance(spec.parser, Tables):
+            return None
+        if not parts or not isinstance(spec.parser, Section):
             return None
         cls = spec.parser.cls
 
