@@ -265,9 +265,9 @@ def test_a_run_with_fade_draws_its_friction_coefficient(tmp_path, drawn):
     plots.history_figure(pads, tmp_path / "history.png")
     (ax,) = [ax for ax in drawn[-1].axes if ax.get_ylabel() == "friction coefficient [-]"]
     assert {line.get_label(): tuple(line.get_ydata()) for line in ax.get_lines()} == {
-        "all": pytest.approx((0.4, 0.37)), "inner pad": pytest.approx((0.41, 0.38)),
+        "all interfaces": pytest.approx((0.4, 0.37)), "inner pad": pytest.approx((0.41, 0.38)),
         "outer pad": pytest.approx((0.39, 0.36))}
-    # a pad has its part's colour in the friction panel too, all of them black (the "all" curve
+    # a pad has its part's colour in the friction panel too, all of them black (the "all interfaces" curve
     # shifted the colours: orange was one pad there and another among the temperatures, a user trial)
     parts = History()
     for t, mu in ((0.0, 0.4), (1.0, 0.37)):
@@ -281,7 +281,7 @@ def test_a_run_with_fade_draws_its_friction_coefficient(tmp_path, drawn):
     for ax in drawn[-1].axes:
         for line in ax.get_lines():
             colour.setdefault(line.get_label(), set()).add(to_hex(line.get_color()))
-    assert colour["all"] == {"#000000"} and all(len(colour[n]) == 1 for n in ("inner pad", "outer pad", "disc"))
+    assert colour["all interfaces"] == {"#000000"} and all(len(colour[n]) == 1 for n in ("inner pad", "outer pad", "disc"))
     torque = History()                  # a rotating body's braking torque has its panel (wanted there: a trial)
     for t in (0.0, 1.0):
         torque.append(time=t, interface_force=200.0, max_pressure=1e6, max_temperature_disc=298.0, heat_total_disc=t,

@@ -32,9 +32,10 @@ def column_label(key: str) -> str:
     max_temperature_pin_in_disc -> "pin, disc material" (the pin's cells of material disc),
     max_temperature_fixed_part_inner_pad -> "inner pad" (a part of body fixed),
     face_max_temperature_inner_pad_on_disc -> "inner pad on disc" (the disc's face of interface
-    inner_pad), friction_coefficient_inner_pad -> "inner pad" (friction_coefficient: "all")."""
+    inner_pad), friction_coefficient_inner_pad -> "inner pad" (friction_coefficient: "all interfaces",
+    as in multiscale.png: "all" clashed with an interface of that name)."""
     if key == "friction_coefficient":
-        return "all"
+        return "all interfaces"
     for prefix in ("max_temperature_", "heat_total_", "stored_heat_", "heat_lost_total_", "frictional_heat_total_",
                    "face_max_temperature_", "friction_coefficient_"):
         key = key.removeprefix(prefix)
@@ -91,7 +92,7 @@ def body_colours(columns) -> dict:
     # the interfaces (a pad's own colour where it is named as its part), all of them together black
     names += [column_label(k).rpartition(" on ")[0] or column_label(k) for k in columns
               if k.startswith(("friction_coefficient_", "frictional_heat_total_", "face_max_temperature_"))]
-    return colours(dict.fromkeys(names)) | {"all": (0.0, 0.0, 0.0, 1.0)}
+    return colours(dict.fromkeys(names)) | {"all interfaces": (0.0, 0.0, 0.0, 1.0)}
 
 
 def curve_styles(keys, palette: dict | None = None) -> tuple[list[dict], list]:
