@@ -89,6 +89,10 @@ def torque_problems(scene, names) -> list[str]:
     if any(mu is None or mu > 0 for mu in (speed_law_guess(ld) if m is None else m for m in mus)):
         return []            # (a mu(v) law counts with the squeal preload's first guess)
     key = "loading.braking_torque" if ld.braking_torque is not None else "loading.vehicle"
+    law = "friction_curve" if ld.friction_curve is not None else "stribeck" if ld.stribeck is not None else None
+    if law and all(mu is None for mu in mus):       # (it said "at the initial temperature": a user trial)
+        return [f"{key}: braking at {ld.torque:.6g} N m needs friction, but loading.{law} gives mu 0 at every slip "
+                "speed: give mu > 0 there"]
     return [f"{key}: braking at {ld.torque:.6g} N m needs friction, but mu is 0 at the initial temperature, "
             f"{T0 - 273.15:.4g} degC, on every interface ({', '.join(names)}): give mu > 0 there "
             "([loading]'s friction or table, or the interfaces' own)"]
@@ -112,3 +116,20 @@ def speed_law_zeros(scene) -> list[str]:
         key = "loading.stribeck"
     return [f"{key}: mu is 0 {where}: where the facets slide so, the clamp force that gives the braking torque "
             f"({ld.torque:.6g} N m) grows without bound (the run stops where every facet has mu 0)"] if where else []
+
+
+def curve_left(curve, fastest: tuple, slowest: tuple, when: str = "") -> list[str]:
+    """Warnings of slip speeds in contact beyond ``curve``'s rows (((v [m/s], mu), ...), held at its
+    end rows there): ``fastest`` and ``slowest`` are (v [m/s], where: " at t = 2 s" or ""), the
+    extremes over the run; a curve left on one side by every speed is said unused (it was said
+    as one speed out of range: a user trial). ``when``: what the speeds are of (" at the preload")."""
+    (v0, mu0), (v1, mu1) = curve[0], curve[-1]
+    if fastest[0] < v0 or slowest[0] > v1:
+        side, (v, mu) = ("below its first", (v0, mu0)) if fastest[0] < v0 else ("above its last", (v1, mu1))
+        return [f"loading.friction_curve: every slip speed in contact{when} ({slowest[0]:.4g} to {fastest[0]:.4g} "
+                f"m/s) is {side} row, {v:.4g} m/s: mu was held at {mu:g} throughout, the curve's slope unused (a "
+                "curve over the run's slip speeds says what mu is)"]
+    return [f"loading.friction_curve: the slip speed in contact{when} reached {s:.4g} m/s{at}, {side} row, "
+            f"{v:.4g} m/s: mu was held at {mu:g} there (a curve over the run's slip speeds says what mu is)"
+            for (s, at), beyond, side, (v, mu) in ((fastest, fastest[0] > v1, "above its last", (v1, mu1)),
+                                                 (slowest, slowest[0] < v0, "below its first", (v0, mu0))) if beyond]

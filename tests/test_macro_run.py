@@ -277,6 +277,12 @@ def test_slip_speeds_beyond_a_friction_curve_are_warned_of():
     for t in (0.0, 1.0):
         h.append(time=t, max_slip_speed=9.5 if t else np.nan, min_slip_speed=1.0 if t else np.nan)
     assert not [w for w in run_warnings(scene, h) if w.startswith("loading.friction_curve")]
+    h = History()              # a curve every speed left on one side: unused (it was one speed out: a user trial)
+    for t, high, low in ((0.0, 0.9, 0.6), (1.0, 0.5, 0.3)):
+        h.append(time=t, max_slip_speed=high, min_slip_speed=low)
+    assert [w for w in run_warnings(scene, h) if w.startswith("loading.friction_curve")] == [
+        "loading.friction_curve: every slip speed in contact (0.3 to 0.9 m/s) is below its first row, 1 m/s: mu was "
+        "held at 0.45 throughout, the curve's slope unused (a curve over the run's slip speeds says what mu is)"]
 
 
 def test_faces_of_an_interface_that_drift_apart_without_conductance_are_warned_of():

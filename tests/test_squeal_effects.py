@@ -243,7 +243,7 @@ def test_values_of_the_projected_problem_left_out_among_the_modes_are_said():
     scene = NS(stability=NS(basis=1.5, damping=0.0, method="auto", band=(0.0, 6e3), target=3500.0, modes=4, sweep=None),
                materials=None)
     case = NS(modes=modes, terms=(), mech=NS(tm=NS(notes=())), facet_pressure=np.zeros(1),
-              preload=NS(normal_force={}))
+              preload=NS(normal_force={}), slip_speed=None)
     said = squeal._left_out(scene, case, None)
     assert said[0] == ("1 value(s) of the projected problem among the modes found (3524 Hz) had relative residuals "
                        "above 0.5 in the full model: not modes of it, left out (a larger stability.basis, now 1.5, "
@@ -605,3 +605,21 @@ def test_a_band_cut_short_below_a_target_is_said(tmp_path, capsys):
     assert run.warnings[0].startswith(f"stability.modes = 6: the modes found span {f.min():.0f} to {f.max():.0f} Hz "
                                       "around stability.target = 8000 Hz; the band below ")
     assert "from 0 Hz, and above" in run.warnings[0] and run.warnings[0].endswith("move stability.target)")
+
+
+def test_a_friction_curve_the_preload_misses_is_said(tmp_path):
+    """A friction_curve from 2 m/s on pads sliding at 0.4-0.6 m/s (5 rad/s): mu is held at its first
+    row on every facet, its slope (the friction damping) 0, and the run says so (it was silent, while
+    a transient run warned: a user trial); the speeds are the preload's, omega r."""
+    text = DEMO.read_text().replace("friction = 0.4\n", 'friction_curve = [["2 m/s", 0.5], ["5 m/s", 0.4]]\n')
+    scene = scenes.loads(text, DEMO.parent, overrides={**NO_FIGURES, "geometry.mesh_size": "30 mm", "stability.modes": 6,
+                                                      "loading.rotation_speed": "5 rad/s",
+                                                      "output.folder": str(tmp_path / "out")})
+    run = squeal.run(scene, degree=1, verbose=False)
+    case = run.case
+    V = case.slip_speed[case.facet_pressure > 0]
+    (line,) = [w for w in run.warnings if w.startswith("loading.friction_curve")]
+    assert line == (f"loading.friction_curve: every slip speed in contact at the preload ({V.min():.4g} to {V.max():.4g} "
+                    "m/s) is below its first row, 2 m/s: mu was held at 0.5 throughout, the curve's slope unused (a "
+                    "curve over the run's slip speeds says what mu is)")
+    assert 0.3 < V.min() < V.max() < 0.7 and case.terms == ()        # no slope: no friction damping term

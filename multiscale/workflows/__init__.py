@@ -20,7 +20,7 @@ from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError, Interrupted, interrupted
 from multiscale.micro.laws import RESOLUTION
 from multiscale.micro.wear import SUBSTEP_TOL
-from multiscale.scene_friction import bare_interfaces, fade_tables
+from multiscale.scene_friction import bare_interfaces, curve_left, fade_tables
 from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.model import interface_materials
@@ -270,21 +270,20 @@ def _fade_table_ends(scene, history) -> list[str]:
 
 
 def _curve_ends(scene, history) -> list[str]:
-    """[loading]'s ``friction_curve`` left by the slip speeds of the facets in contact
-    (``max_slip_speed``, ``min_slip_speed``), where mu was held at its end row (it was not said)."""
-    curve, out = scene.loading.friction_curve, []
+    """[loading]'s ``friction_curve`` left by the slip speeds of the facets in contact that read it
+    (``max_slip_speed``, ``min_slip_speed``; ``scene_friction.curve_left``), where mu was held at its
+    end row (it was not said)."""
+    curve = scene.loading.friction_curve
     if curve is None or "max_slip_speed" not in history.columns:
         return []
-    for column, beyond, (v, mu), side in (("max_slip_speed", np.greater, curve[-1], "above its last"),
-                                          ("min_slip_speed", np.less, curve[0], "below its first")):
+    extremes = []
+    for column, pick in (("max_slip_speed", np.nanargmax), ("min_slip_speed", np.nanargmin)):
         V = np.asarray(history[column], float)
-        left = np.flatnonzero(beyond(np.nan_to_num(V, nan=v), v))
-        if left.size:
-            row = left[np.argmax(np.abs(V[left] - v))]
-            out.append(f"loading.friction_curve: the slip speed in contact reached {V[row]:.4g} m/s at t = "
-                       f"{history['time'][row]:g} s, {side} row, {v:.4g} m/s: mu was held at {mu:g} there "
-                       "(a curve over the run's slip speeds says what mu is)")
-    return out
+        if not np.isfinite(V).any():
+            return []                                  # never sliding in contact
+        row = int(pick(V))
+        extremes.append((float(V[row]), f" at t = {history['time'][row]:g} s"))
+    return curve_left(curve, *extremes)
 
 
 def _too_hot(scene, history) -> list[str]:

@@ -41,7 +41,7 @@ from multiscale import io, outputs
 from multiscale.errors import InputError
 from multiscale.macro.damped import SPURIOUS, PrestressEffect, prestress_effect, solve_system
 from multiscale.macro.eigen import Damping, ModalResult
-from multiscale.macro.friction import ConstantFriction, set_friction
+from multiscale.macro.friction import ConstantFriction, facet_slip_speed, set_friction
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.mechanics import Mechanics
 from multiscale.macro.modal import CLOSE, EnergyShares, RegionEnergy, StabilityReport, stability_report, \
@@ -49,7 +49,7 @@ from multiscale.macro.modal import CLOSE, EnergyShares, RegionEnergy, StabilityR
 from multiscale.macro.output import write_modes, write_state
 from multiscale.macro.preload import Preload, linearise_system, preload
 from multiscale.macro.stability_map import StabilityMap
-from multiscale.scene_friction import bare_interfaces
+from multiscale.scene_friction import bare_interfaces, curve_left
 from multiscale.workflows import squeal_map
 from multiscale.workflows.model import build_mechanics, build_mesh, drive, friction_coefficient, interface_forces, \
     model_size, speed_law
@@ -92,6 +92,7 @@ class SquealCase:
     mech: Mechanics | None = field(default=None, repr=False)   # the model (spaces of the modes; closed by ``run``)
     prestress: PrestressEffect | None = None    # the frequencies without the prestress stiffness
     terms: tuple = ()                           # parts of the linearised system beyond K and M
+    slip_speed: np.ndarray | None = None        # m/s, per facet: what the mu(v) laws read (with laws)
 
 
 def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "case", *, load: float = 1e6,
@@ -106,6 +107,7 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
     between the preload and the eigen solve (``run`` writes the preloaded state then)."""
     opt = options or SquealOptions()
     slope = set_friction(mech, opt.friction_laws)[1] if opt.friction_laws else None
+    slip = facet_slip_speed(mech) if opt.friction_laws else None
     with io.stage("preload"):
         pre = preload(mech, load, steps, reset=reset, torque=torque)
     if on_preload is not None:
@@ -126,7 +128,7 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
     with io.stage("strain energy per component"):
         shares = strain_energy_shares(modes, RegionEnergy(mech)) if energy else None
     return SquealCase(name, pre, modes, stability_report(modes, rtol, close_tol), shares,
-                      mech.contact.facet_pressure(), mech, effect, lin.terms)
+                      mech.contact.facet_pressure(), mech, effect, lin.terms, slip)
 
 
 def friction_laws(scene, tm) -> dict | None:
@@ -250,7 +252,7 @@ def approximate_modes(scene, case: SquealCase) -> list[str]:
 def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
     """Warnings: a band cut short by stability.modes, modes or a map whose modes are approximate, a
     contact pressure beyond small strains (at the preload, or at a map point's own preload), an
-    interface that the preload left without force; the mesh's (``TwoBodyMesh.notes``)."""
+    interface that the preload left without force, a friction_curve its slip speeds left; the mesh's (``TwoBodyMesh.notes``)."""
     st, out = scene.stability, [*case.mech.tm.notes, *approximate_modes(scene, case)]
     f = case.modes.frequency
     top = float(f.max(initial=0.0))
@@ -296,6 +298,13 @@ def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
         out.append(f"the stability map's modes have relative residuals up to {worst:.1e}: its frequencies and growth "
                    "rates are approximate, and a mode outside its basis is missed (stability.sweep.preload = \"each\" "
                    "solves every point in full)")
+    if case.slip_speed is not None and (curve := scene.loading.friction_curve) is not None:   # (a curve the
+        iface = case.mech.tm.interface                                   # preload missed was unsaid: a user trial)
+        masks = iface.masks()
+        read = np.logical_or.reduce([masks[n] for n in bare_interfaces(scene.interfaces, masks)] or [np.zeros(
+            iface.n_facets, bool)]) & (case.facet_pressure > 0)
+        V = case.slip_speed[read]
+        out += curve_left(curve, (float(V.max()), ""), (float(V.min()), ""), " at the preload") if V.size else []
     peak = max(float(case.facet_pressure.max(initial=0.0)), smap.max_pressure if smap is not None else 0.0)
     return out + overloaded(scene, peak) + unloaded({n: abs(f) for n, f in case.preload.normal_force.items()})
 
