@@ -547,7 +547,8 @@ def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_pa
     cases += [(torque.replace("friction = 0.4", "friction = 0.0"), zero),
               ((DEMOS / "brake_squeal.toml").read_text().replace('pressure = "10 bar"', 'braking_torque = "300 N m"')
                .replace("friction = 0.4", 'friction_curve = [["0 m/s", 0.0], ["10 m/s", 0.0]]'),   # the squeal's guess
-               "loading.braking_torque: braking at 300 N m needs friction, but mu is 0 at the initial temperature"),
+               "loading.braking_torque: braking at 300 N m needs friction, but loading.friction_curve gives mu 0 at "
+               "every slip speed: give mu > 0 there"),      # (not "at the initial temperature": a user trial)
               (torque.replace("friction = 0.4", f"friction_temperature = {fade}"), zero),
               (torque + f"\n[interfaces.interface]\nfriction_temperature = {fade}\n", zero)]
     for text, message in cases:
