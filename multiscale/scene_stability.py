@@ -22,6 +22,14 @@ class Stribeck:
     speed: float | None = key(Quantity("speed", gt=0), required=True)            # m/s, Stribeck speed
     exponent: float = key(Quantity("dimensionless", gt=0), default=1.0)
 
+    def problems(self, path, ctx):
+        if self.static <= self.kinetic:     # (a swapped pair passed unsaid: a user trial)
+            ctx.warnings.append(f"{path}: static mu {self.static:g} is not above kinetic mu {self.kinetic:g}: mu "
+                                + (f"is constant (loading.friction = {self.static:g} says so)" if self.static ==
+                                   self.kinetic else "rises with the slip speed (its slope damps a squeal analysis's "
+                                   "modes); static and kinetic swapped?"))
+        return []
+
 
 SWEEP_PARAMETERS = {"friction": "-", "pressure": "Pa", "speed": "rad/s", "rms": "m"}
 _OTHER = "another of friction, pressure, speed, rms is swept"

@@ -1556,3 +1556,18 @@ def test_an_interfaces_own_mu_v_law_is_refused_with_where_it_belongs():
             f"interfaces.inner_pad.{key}: a mu(v) law is [loading]'s, for every interface without a friction of its "
             "own (loading.friction_curve or [loading.stribeck]); an interface's own friction is a constant (friction) "
             "or a fade table (friction_temperature)"]
+
+
+def test_a_stribeck_law_that_does_not_fall_is_warned_of():
+    """static mu at or below kinetic mu (a swapped pair passed unsaid: a user trial): check warns that
+    mu rises (or is constant) with the slip speed; a falling law is not warned of."""
+    text = (DEMOS / "brake_squeal.toml").read_text().replace("\nfriction = 0.4\n", "\n", 1)
+
+    def said(static, kinetic):
+        scene = loads(text, DEMOS, overrides={"loading.stribeck": {"static": static, "kinetic": kinetic, "speed": "1 m/s"}})
+        return [w for w in scene.warnings if w.startswith("loading.stribeck:")]
+    assert said(0.3, 0.5) == ["loading.stribeck: static mu 0.3 is not above kinetic mu 0.5: mu rises with the slip "
+                              "speed (its slope damps a squeal analysis's modes); static and kinetic swapped?"]
+    assert said(0.4, 0.4) == ["loading.stribeck: static mu 0.4 is not above kinetic mu 0.4: mu is constant "
+                              "(loading.friction = 0.4 says so)"]
+    assert said(0.5, 0.3) == []
