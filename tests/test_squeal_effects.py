@@ -607,17 +607,20 @@ def test_a_band_cut_short_below_a_target_is_said(tmp_path, capsys):
     assert "from 0 Hz, and above" in run.warnings[0] and run.warnings[0].endswith("move stability.target)")
 
 
-def test_a_friction_curve_the_preload_misses_is_said(tmp_path):
+def test_a_friction_curve_the_preload_misses_is_said(tmp_path, capsys):
     """A friction_curve from 2 m/s on pads sliding at 0.4-0.6 m/s (5 rad/s): mu is held at its first
     row on every facet, its slope (the friction damping) 0, and the run says so (it was silent, while
-    a transient run warned: a user trial); the speeds are the preload's, omega r."""
+    a transient run warned: a user trial); the speeds are the preload's, omega r. Its summary gives
+    the preload's mu and slip speeds (they were only in interface.xdmf: the trial)."""
     text = DEMO.read_text().replace("friction = 0.4\n", 'friction_curve = [["2 m/s", 0.5], ["5 m/s", 0.4]]\n')
     scene = scenes.loads(text, DEMO.parent, overrides={**NO_FIGURES, "geometry.mesh_size": "30 mm", "stability.modes": 6,
                                                       "loading.rotation_speed": "5 rad/s",
                                                       "output.folder": str(tmp_path / "out")})
-    run = squeal.run(scene, degree=1, verbose=False)
+    run = squeal.run(scene, degree=1)
     case = run.case
     V = case.slip_speed[case.facet_pressure > 0]
+    assert (f"  friction: mu 0.5 on inner_pad, 0.5 on outer_pad (facet means) at slip speeds of {V.min():.3g} to "
+            f"{V.max():.3g} m/s\n") in capsys.readouterr().out
     (line,) = [w for w in run.warnings if w.startswith("loading.friction_curve")]
     assert line == (f"loading.friction_curve: every slip speed in contact at the preload ({V.min():.4g} to {V.max():.4g} "
                     "m/s) is below its first row, 2 m/s: mu was held at 0.5 throughout, the curve's slope unused (a "

@@ -371,6 +371,10 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
               f"{io.counted(comm.size, 'rank')}")
         print("  preload: " + ", ".join(f"{abs(f):.6g} N on {n}" for n, f in case.preload.normal_force.items())
               + " (normal contact force)")
+        touching = case.slip_speed[case.facet_pressure > 0] if case.slip_speed is not None else np.zeros(0)
+        if touching.size:            # a mu(v) law: the mu it gave (only in interface.xdmf before: a user trial)
+            print("  friction: mu " + ", ".join(f"{mu:.3g} on {n}" for n, mu in case.preload.friction.items())
+                  + f" (facet means) at slip speeds of {touching.min():.3g} to {touching.max():.3g} m/s")
         print(f"  modes by {SOLVERS[case.modes.method]}")
         if case.prestress is not None:
             shift = case.prestress.shift
