@@ -98,6 +98,27 @@ def torque_problems(scene, names) -> list[str]:
             "([loading]'s friction or table, or the interfaces' own)"]
 
 
+def zero_spans(curve) -> str:
+    """Where a friction curve (((v [m/s], mu), ...)) gives mu 0: "from 1 m/s up", "up to 2 m/s",
+    "from 1 to 5 m/s", "at 3 m/s" (linear between rows, held beyond the ends; it listed the rows: a
+    user trial), joined by "and"; "" if nowhere."""
+    spans, k = [], 0
+    while k < len(curve):
+        if curve[k][1] != 0:
+            k += 1
+            continue
+        j = k
+        while j + 1 < len(curve) and curve[j + 1][1] == 0:
+            j += 1
+        a, b = curve[k][0], curve[j][0]
+        first, last = k == 0, j == len(curve) - 1
+        spans.append("at every slip speed" if first and last else f"from {a:g} m/s up" if last else
+                     f"up to {b:g} m/s" if first and b > 0 else f"at {b:g} m/s" if first or j == k else
+                     f"from {a:g} to {b:g} m/s")
+        k = j + 1
+    return " and ".join(spans)
+
+
 def speed_law_zeros(scene) -> list[str]:
     """A braking torque (or a vehicle's stop) over [loading]'s mu(v) law where it gives mu 0: the run
     stops where the facets slide at those speeds (its first solve, if there: check said OK to a curve
@@ -106,9 +127,7 @@ def speed_law_zeros(scene) -> list[str]:
     if ld is None or ld.torque is None:
         return []
     if ld.friction_curve is not None:
-        zero = [v for v, mu in ld.friction_curve if mu == 0]
-        where = f"at slip speeds of {', '.join(f'{v:g}' for v in zero)} m/s" if zero else ""
-        key = "loading.friction_curve"
+        where, key = zero_spans(ld.friction_curve), "loading.friction_curve"
     else:
         st = ld.stribeck
         where = "" if st is None or (st.kinetic > 0 and st.static > 0) else \

@@ -722,7 +722,7 @@ def test_an_interface_may_give_its_own_fade_table(tmp_path):
     # stopped at its first solve: a review)
     zero = loads(pod.replace("friction = 0.4", 'friction_curve = [["0 m/s", 0.6], ["1 m/s", 0], ["100 m/s", 0]]')
                  .replace('normal_force = "200 N"', 'braking_torque = "30 N m"'), tmp_path)
-    assert "loading.friction_curve: mu is 0 at slip speeds of 1, 100 m/s: where the facets slide so, the clamp force " \
+    assert "loading.friction_curve: mu is 0 from 1 m/s up: where the facets slide so, the clamp force " \
         "that gives the braking torque (30 N m) grows without bound (the run stops where every facet has mu 0)" in \
         zero.warnings
     # a Stribeck law of kinetic mu 0 is mu > 0 at every finite speed: read (refused as "mu 0 at the initial
@@ -1571,3 +1571,16 @@ def test_a_stribeck_law_that_does_not_fall_is_warned_of():
     assert said(0.4, 0.4) == ["loading.stribeck: static mu 0.4 is not above kinetic mu 0.4: mu is constant "
                               "(loading.friction = 0.4 says so)"]
     assert said(0.5, 0.3) == []
+
+
+@pytest.mark.parametrize("curve, said", [
+    (((0, 0.6), (1, 0), (100, 0)), "from 1 m/s up"), (((0, 0), (1, 0.5)), "at 0 m/s"),
+    (((0.5, 0), (1, 0), (2, 0.5)), "up to 1 m/s"), (((0, 0.5), (1, 0), (2, 0), (3, 0.4)), "from 1 to 2 m/s"),
+    (((0, 0.5), (1, 0), (2, 0.4)), "at 1 m/s"), (((0, 0), (1, 0)), "at every slip speed"),
+    (((0, 0.4), (1, 0.5)), ""), (((0, 0), (1, 0.4), (2, 0)), "at 0 m/s and from 2 m/s up")])
+def test_where_a_friction_curve_gives_mu_0_is_said_as_spans(curve, said):
+    """``scene_friction.zero_spans``: mu 0 over spans of slip speed, the curve linear between its rows
+    and held beyond its ends (the warning listed the zero rows, "1, 100 m/s", for mu 0 from 1 m/s up:
+    a user trial)."""
+    from multiscale.scene_friction import zero_spans
+    assert zero_spans(curve) == said
