@@ -136,9 +136,9 @@ def facet_slip_speed(mech: Mechanics) -> np.ndarray:
     return mech.contact.facet_means("slip")
 
 
-def set_friction(mech: Mechanics, laws: dict) -> tuple[np.ndarray, np.ndarray]:
+def set_friction(mech: Mechanics, laws: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Set the per-facet friction coefficient mu(V) of every interface from ``laws`` {interface
-    name: law} at the facets' slip speeds V; returns the per-facet (mu, mu') [-, s/m]."""
+    name: law} at the facets' slip speeds V; returns the per-facet (mu, mu', V) [-, s/m, m/s]."""
     iface = mech.tm.interface
     V = facet_slip_speed(mech)
     mu, slope = np.zeros(iface.n_facets), np.zeros(iface.n_facets)
@@ -146,7 +146,7 @@ def set_friction(mech: Mechanics, laws: dict) -> tuple[np.ndarray, np.ndarray]:
         law = laws[name]
         mu[mask], slope[mask] = law.value(V[mask]), law.slope(V[mask])
     iface.set_field(mech.contact.friction, mu)
-    return mu, slope
+    return mu, slope, V
 
 
 def friction_damping(mech: Mechanics, slope: np.ndarray) -> PETSc.Mat:

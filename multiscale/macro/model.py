@@ -358,8 +358,10 @@ class MacroModel:
         if self.friction_law is not None:               # fade: the friction over the normal force
             row["friction_coefficient"] = ratio(row["friction_force"], row["interface_force"])
         if self.friction_law is not None and self.friction_law.reads_speed:    # the slip speeds mu(v) read
-            read = np.logical_or.reduce([m for m, _ in self.friction_law.speeds]) & (self.contact.facet_pressure() > 0)
-            V = self.contact.facet_means("slip")[read] if on and moving else []
+            V = []                      # (assembled only while loaded and sliding)
+            if on and moving:
+                read = np.logical_or.reduce([m for m, _ in self.friction_law.speeds])
+                V = self.contact.facet_means("slip")[read & (self.contact.facet_pressure() > 0)]
             row["max_slip_speed"], row["min_slip_speed"] = (float(V.max()), float(V.min())) if len(V) else (np.nan,) * 2
         if isinstance(self.tm.spec.motion, Rotation):   # the braking torque: frictional heat power = it x omega
             row["friction_moment"] = abs(self.contact.friction_moment()) * on

@@ -41,7 +41,7 @@ from multiscale import io, outputs
 from multiscale.errors import InputError
 from multiscale.macro.damped import SPURIOUS, PrestressEffect, prestress_effect, solve_system
 from multiscale.macro.eigen import Damping, ModalResult
-from multiscale.macro.friction import ConstantFriction, facet_slip_speed, set_friction
+from multiscale.macro.friction import ConstantFriction, set_friction
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.mechanics import Mechanics
 from multiscale.macro.modal import CLOSE, EnergyShares, RegionEnergy, StabilityReport, stability_report, \
@@ -106,8 +106,7 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
     proportional part, ``options`` the rest (``SquealOptions``). ``on_preload(mech)`` is called
     between the preload and the eigen solve (``run`` writes the preloaded state then)."""
     opt = options or SquealOptions()
-    slope = set_friction(mech, opt.friction_laws)[1] if opt.friction_laws else None
-    slip = facet_slip_speed(mech) if opt.friction_laws else None
+    _, slope, slip = set_friction(mech, opt.friction_laws) if opt.friction_laws else (None, None, None)
     with io.stage("preload"):
         pre = preload(mech, load, steps, reset=reset, torque=torque)
     if on_preload is not None:
