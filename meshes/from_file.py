@@ -78,6 +78,7 @@ class Found:
     areas: dict = field(default_factory=dict)        # name -> m^2
     normals: dict = field(default_factory=dict)      # name -> unit normal (fixed towards rotating), None if not planar
     extents: dict = field(default_factory=dict)      # planar interface -> size (u, v) [m] in its plane
+    sizes: dict = field(default_factory=dict)        # a .msh's interface -> mean edge of its triangles [m]
     surfaces: dict = field(default_factory=dict)     # name -> face tags
     extent: float = 0.0                              # m, largest side of the bounding box
     loose: list = field(default_factory=list)        # warnings: fixed bodies that touch no interface, thin ones
@@ -342,6 +343,9 @@ def _interfaces(model, g, found: Found, occ: bool) -> None:
         found.areas[name], found.normals[name] = _plane(model, faces, found.bodies[fixed], occ)
         if found.normals[name] is not None:
             found.extents[name] = plane_extent(found.normals[name], *_box(model, faces, g.kind == "mesh"))
+        if g.kind == "mesh":
+            tri = _nodes(model, faces)
+            found.sizes[name] = float(np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2).mean())
     if not found.interfaces:
         raise InputError("geometry.rotating", g.rotating, f"no fixed body of {g.file.name} touches it: no contact "
                          "interface (bodies must share a face; give [geometry.interfaces] to see the gaps)")
@@ -573,7 +577,7 @@ def _spec(g, found: Found) -> GeometrySpec:
         supports=(), load_faces=(), motion=Rotation(tuple(g.axis), tuple(g.centre)),
         length_scale=found.extent, fluid_load=True,
         interface_normals=dict(found.normals), interface_extents=dict(found.extents), report=tuple(report),
-        interface_sizes=dict.fromkeys(found.interfaces, min(g.mesh_size, g.interface_mesh_size or g.mesh_size))
-        if g.mesh_size is not None else {},
+        interface_sizes=found.sizes if g.kind == "mesh" else
+        dict.fromkeys(found.interfaces, min(g.mesh_size, g.interface_mesh_size or g.mesh_size)),
         warnings=tuple(found.loose),
         interface_regions={name: fixed for name, (fixed, _) in found.pairs.items()})

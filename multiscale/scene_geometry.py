@@ -150,9 +150,10 @@ class FileGeometry:
             out.append(f"{path}.file = \"{self.file.name}\": unknown type; allowed: {', '.join(FILE_TYPES)}")
         elif self.kind != "mesh" and self.mesh_size is None:
             out.append(f"{path}.mesh_size: missing; needed to mesh a {self.file.suffix} file")
-        elif self.kind == "mesh" and self.mesh_algorithm is not None:
-            out.append(f"{path}.mesh_algorithm: not used with a {self.file.suffix} file (it is meshed already)")
-        elif self.kind != "mesh" and (fine := self.interface_mesh_size) is not None and fine >= self.mesh_size:
+        elif self.kind == "mesh":
+            out += [f"{path}.{k}: not used with a {self.file.suffix} file (it is meshed already)"
+                    for k in ("mesh_size", "interface_mesh_size", "mesh_algorithm") if getattr(self, k) is not None]
+        elif (fine := self.interface_mesh_size) is not None and fine >= self.mesh_size:
             ctx.warnings.append(f"{path}.interface_mesh_size = {fine * 1e3:.4g} mm: not finer than mesh_size, "
                                 f"{self.mesh_size * 1e3:.4g} mm, so the interfaces are meshed at mesh_size (it only "
                                 "refines)")                                     # (it was silent: a user trial)

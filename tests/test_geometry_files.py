@@ -211,6 +211,21 @@ def test_a_mesh_file_is_counted_as_it_is(files, tmp_path):
     assert estimate.exact and estimate.cells == count > 1000
 
 
+def test_a_mesh_files_interface_element_size_is_its_own_and_mesh_sizes_are_refused(files, tmp_path, capsys):
+    """The checks that compare an interface's elements with a length (rough patches, heat
+    penetration) take a .msh file's own: the mean edge of its interface triangles, here within 10 %
+    of the 2.5 mm the builder meshed it at (measured 2.40 mm). mesh_size and interface_mesh_size
+    would not remesh it: refused, as mesh_algorithm is (they were taken as the interface's size
+    by those checks, and silently not used)."""
+    assert scene_for(files, "msh", tmp_path).geometry.spec.interface_sizes["pin"] == pytest.approx(2.5e-3, rel=0.1)
+    good = FILE.format(name="x", file=files / "pod.msh", extra="", folder=tmp_path / "out", surfaces="",
+                       **{b: f'volumes = ["{b}"]' for b in INSIDE})
+    err = check(tmp_path, capsys, good.replace('rotating = "disc"', 'rotating = "disc"\nmesh_size = "5 mm"\n'
+                                               'interface_mesh_size = "1 mm"'), count=2)
+    assert "geometry.mesh_size: not used with a .msh file (it is meshed already)" in err
+    assert "geometry.interface_mesh_size: not used with a .msh file (it is meshed already)" in err
+
+
 def test_cad_is_meshed_by_the_chosen_algorithm_and_a_failure_says_what_to_change(files, tmp_path, monkeypatch):
     """CAD takes HXT unless mesh_algorithm says otherwise; its coarse trial meshes take Delaunay,
     and the kept session's mesh is node for node that of the builder's own run. Were HXT to fail
@@ -1253,7 +1268,8 @@ def test_geometry_files_that_gmsh_cannot_take_are_refused_by_name(tmp_path):
                           r"OpenCASCADE cannot read it .*: is it a whole STEP file\?")}
     for name, (text, message) in cases.items():
         (tmp_path / name).write_text(text)
+        text = TWO_PADS if name != "old.msh" else TWO_PADS.replace('mesh_size = "15 mm"\ninterface_mesh_size = "5 mm"\n', "")
         with pytest.raises(SceneError, match=message):
-            loads(TWO_PADS.replace('"twopads.geo"', f'"{name}"').format(folder=tmp_path / "out"), tmp_path)
+            loads(text.replace('"twopads.geo"', f'"{name}"').format(folder=tmp_path / "out"), tmp_path)
     (tmp_path / "commented.geo").write_text(TWO_PADS_GEO + "\n// Exit;\n/* Exit; */\n")      # a comment passes
     loads(TWO_PADS.replace('"twopads.geo"', '"commented.geo"').format(folder=tmp_path / "out"), tmp_path)
