@@ -931,6 +931,20 @@ def test_a_measured_surface_is_a_micro_study_problem(tmp_path, capsys):
             assert h5["area_fraction"][k] == pytest.approx(r.area_fraction, rel=1e-12) and r.area_fraction > 0
 
 
+def test_an_asperity_model_beyond_its_range_is_said_by_the_run(tmp_path):
+    """A rough_contact run with an asperity model records the model's own notes (contacts that
+    overlap: ``AsperityResult.notes``) as what it found; the FFT-BEM run of the same patch none."""
+    from multiscale.schema import Context
+    from multiscale.studies.problems import PROBLEMS
+    problem = PROBLEMS["rough_contact"]
+    found = {}
+    for model in ("fft-bem", "circular"):
+        params = problem.parse({"n": 64, "model": model, "approach": "12 um"}, "", Context(directory=tmp_path))
+        found[model] = problem.run(params, tmp_path).warnings
+    assert found["fft-bem"] == () and len(found["circular"]) == 1
+    assert found["circular"][0].startswith("contacts holding") and "FFT-BEM" in found["circular"][0]
+
+
 def test_what_a_run_finds_is_said_by_the_study_its_report_and_table(tmp_path, capsys):
     """Outliers of a measured file (a smooth map with 3 spikes, written as ISO 25178-71 SDF) are said
     by ``multiscale surface`` and by a scene, but a measured_contact study kept them in its runs' logs

@@ -21,6 +21,7 @@ layered solid) is an ``asperity_laws.AsperityLaw``.
 from __future__ import annotations
 
 import time
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -34,6 +35,8 @@ from multiscale.micro.asperity_laws import AsperityLaw, check_table, hertz_law
 from multiscale.micro.surface import AsperityTable, Surface, find_asperities, statistics
 
 _SCREEN = 400           # more active candidates than this: screening pass with point forces only
+MAX_ITER = 2000         # minimiser iterations of a solve
+OVERLAP = 0.1           # share of the real area in overlapping contacts beyond which a result is warned of
 
 
 # ----------------------------------------------------------------------------- results
@@ -46,7 +49,9 @@ class AsperityResult:
     area: float                #: m², real contact area A (Eq. 1.8)
     mean_pressure: float       #: Pa, F / A0
     area_fraction: float       #: -, A / A0
-    mean_gap: float            #: m, g_n = (z_M − z̄) − delta (Eq. 1.9)
+    mean_gap: float            #: m, g_n = (z_M − z̄) − delta (Eq. 1.9): the flat's height above the mean plane of
+    #                            the undeformed surface (negative once below it), not the deformed mean gap of
+    #                            ``contact.ContactResult.mean_gap``
     kappa: float | None        #: -, (A/A0) E* sqrt(<|grad h|²>) / p_n (§1.3.2); None without contact/slope
     semi_axes: np.ndarray      #: m, (N, 2): major a and minor b of each contact (0, 0 out of contact)
     forces: np.ndarray         #: N, force of each asperity
@@ -64,6 +69,8 @@ class AsperityResult:
     converged: bool
     truncation: float          #: relative bound on the neglected part of each interaction sum
     wall_time: float           #: s
+    overlap: float = 0.0       #: -, share of ``area`` in contacts whose area-equivalent circles overlap another's
+    notes: tuple = ()          #: where the result leaves the models' range (separate contacts), warned of by ``solve``
 
 
 @dataclass
@@ -84,6 +91,10 @@ class AsperityCurve:
 
 class AsperityConvergenceError(ConvergenceError):
     """The asperity-model minimiser stopped above its tolerance."""
+
+
+class AsperityWarning(UserWarning):
+    """A result beyond the asperity models' range: contacts that overlap, a real area above the nominal."""
 
 
 # ----------------------------------------------------------------------------- model
@@ -139,15 +150,24 @@ class AsperityModel:
 
     # -- public ---------------------------------------------------------------------------
     def solve(self, delta: float, *, route: str = "energy", method: str | None = None, tol: float = 1e-6,
-              max_iter: int = 2000, partial: bool = False, raster: bool = True,
+              max_iter: int = MAX_ITER, partial: bool = False, raster: bool = True,
               initial=None) -> AsperityResult:
         """Contact state at rigid approach ``delta`` [m] >= 0.
 
         ``route``: "energy" (methods "l-bfgs-b" default, "tnc") or "kinematic" ("trf" default,
         "tnc", "l-bfgs-b"); ignored without interaction. ``tol``: bound on the complementarity
         residual (relative to delta). ``initial``: sizes [m] per asperity to start from.
-        Raises ``AsperityConvergenceError`` above ``tol`` unless ``partial``.
+        Raises ``AsperityConvergenceError`` above ``tol`` unless ``partial``. The models hold for
+        separate contacts (low loads): a result whose overlapping contacts hold more than ``OVERLAP``
+        of the real area, or whose real area exceeds the nominal one, is warned of
+        (``AsperityWarning``, ``AsperityResult.notes``).
         """
+        result = self._solve(delta, route, method, tol, max_iter, partial, raster, initial)
+        for note in result.notes:
+            warnings.warn(note, AsperityWarning, stacklevel=2)
+        return result
+
+    def _solve(self, delta, route, method, tol, max_iter, partial, raster, initial) -> AsperityResult:
         delta = _check_delta(delta)
         check_positive("tol", tol)
         max_iter = check_count("max_iter", max_iter)
@@ -217,8 +237,12 @@ class AsperityModel:
             init = None
             if prev is not None and prev.approach > 0:
                 init = prev.semi_axes[:, 0] * np.sqrt(delta / prev.approach)
-            prev = self.solve(delta, route=route, method=method, tol=tol, raster=raster, initial=init)
+            prev = self._solve(delta, route, method, tol, MAX_ITER, False, raster, init)
             results.append(prev)
+        beyond = [r for r in results if r.notes]
+        if beyond:                    # once: from where, and the last step's notes
+            warnings.warn(f"from approach {beyond[0].approach:.3g} m on: {'; '.join(results[-1].notes)}",
+                          AsperityWarning, stacklevel=2)
         kappa = np.array([np.nan if r.kappa is None else r.kappa for r in results])
         return AsperityCurve(
             approach=d, force=np.array([r.force for r in results]), area=np.array([r.area for r in results]),
@@ -304,12 +328,44 @@ class AsperityModel:
         pmap = None
         if raster and self.surface is not None:
             pmap = self._raster(a, P, on)
+        overlap = self._overlap(law.area(a[on], on), on) if len(on) > 1 else 0.0
+        notes = ()
+        if overlap > OVERLAP:
+            notes += (f"contacts holding {100 * overlap:.0f} % of the real area overlap another (A/A0 {frac:.3g} at "
+                      f"approach {delta:.3g} m): the asperity model assumes separate contacts, its area and force are "
+                      "unreliable here (over-estimated without interaction); the FFT-BEM (contact.solve_contact) "
+                      "holds at any load",)
+        if frac > 1.0:
+            notes += (f"real contact area {frac:.3g} times the nominal area at approach {delta:.3g} m: impossible, "
+                      "far beyond the asperity model's range",)
         return AsperityResult(
             approach=delta, force=F, area=A, mean_pressure=p_n, area_fraction=frac,
             mean_gap=(self.z_max - self.mean_height) - delta, kappa=kappa, semi_axes=axes, forces=P,
             contact=a > 0, pressure=pmap, n_contacts=len(on), absorbed=absorbed, interaction=self.interaction,
             truncation=self.truncation if (self.interaction and stats["route"] != "direct") else 0.0,
-            wall_time=time.perf_counter() - t0, **stats)
+            wall_time=time.perf_counter() - t0, overlap=overlap, notes=notes, **stats)
+
+    def _overlap(self, area: np.ndarray, on: np.ndarray) -> float:
+        """Share of the real area (``area`` [m²] of the contacts ``on``) in contacts whose
+        area-equivalent circles overlap another's (across a periodic surface's edges too)."""
+        t, r = self.table, np.sqrt(area / np.pi)
+        xy = np.column_stack([t.x[on], t.y[on]])
+        box = None
+        if self.surface is not None and self.surface.periodic:
+            box = np.array(self.surface.size)
+            xy = np.mod(xy, box)
+            xy[xy >= box] = 0.0                      # (a tiny negative coordinate rounds to the box's side)
+        pairs = cKDTree(xy, boxsize=box).query_pairs(2.0 * float(r.max()), output_type="ndarray")
+        if not len(pairs):
+            return 0.0
+        i, j = pairs.T
+        d = xy[i] - xy[j]
+        if box is not None:
+            d -= box * np.round(d / box)
+        hit = np.hypot(d[:, 0], d[:, 1]) < r[i] + r[j]
+        touched = np.zeros(len(on), dtype=bool)
+        touched[i[hit]] = touched[j[hit]] = True
+        return float(area[touched].sum() / area.sum())
 
     def _raster(self, a, P, on) -> np.ndarray:
         """Eq. 1.4 sampled at pixel centres, each contact scaled to carry exactly its force

@@ -15,13 +15,14 @@ discretisation alone. Physics lives in ``multiscale.micro``; this module only se
 """
 from __future__ import annotations
 
+import warnings
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 import numpy as np
 
 from multiscale.checkpoint import file_digest
-from multiscale.micro.asperity import AsperityModel
+from multiscale.micro.asperity import AsperityModel, AsperityWarning
 from multiscale.micro.conduction import ConductionSolver, SeriesKernel
 from multiscale.micro.contact import ContactSolver, solve_contact
 from multiscale.micro.heat_kernels import Rotation, SpeedProfile, ThermalMaterial
@@ -217,9 +218,11 @@ def _rough_contact(p: RoughContactParams) -> Outcome:
     model = AsperityModel.from_surface(surface, kernel, shape, interaction=interaction)
     # the same flat position: the asperity approach counts from the highest summit
     delta = p.approach - (float(surface.heights.max()) - model.z_max)
-    r = model.solve(max(delta, 0.0), route=p.route, raster=False, **({"tol": p.tol} if p.tol else {}))
+    with warnings.catch_warnings():               # said by the outcome, per run (``AsperityResult.notes``)
+        warnings.simplefilter("ignore", AsperityWarning)
+        r = model.solve(max(delta, 0.0), route=p.route, raster=False, **({"tol": p.tol} if p.tol else {}))
     return Outcome({"mean_pressure": r.mean_pressure, "area_fraction": r.area_fraction},
-                   int(r.iterations), bool(r.converged))
+                   int(r.iterations), bool(r.converged), warnings=r.notes)
 
 
 # ----------------------------------------------------------------------------- measured contact
