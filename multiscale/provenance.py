@@ -279,8 +279,8 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     ``scene_resolved.toml`` and ``provenance.json`` in ``folder``; call on rank 0. The record names
     the overrides given over the scene file (``scene.load``: a study's point), and lists
     every entry the run writes (``multiscale.outputs.plan``), so that ``results_of`` knows them
-    when the folder is overwritten (a failed run: those it wrote; its record named a script and
-    figures it never wrote); ``warnings``: the scene's and the run's (e.g. temperatures
+    when the folder is overwritten (a failed or interrupted run: those it wrote; its record named a
+    script and figures it never wrote, an interrupted squeal analysis its modes); ``warnings``: the scene's and the run's (e.g. temperatures
     beyond a material table); status ``RUNNING`` (written as the run begins) has no end time.
     ``earlier``: the parts of the run before this one (a resumed run: ``parts_of`` the folder
     before it wrote); the record's ``parts`` are those and this one, its ``start`` the first
@@ -308,7 +308,7 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
               "versions": versions(), "code": ran, "environment": environment(), "inputs": input_digests(scene),
               "files": sorted(plan(scene).files), "warnings": list(warnings)}
     texts = {"scene.toml": given, "scene_resolved.toml": resolved_toml(scene)}
-    if status.startswith("failed"):              # (a run that ended writes its script after the record)
+    if status.startswith(("failed", "interrupted")):     # (a finished run writes its script after the record)
         record["files"] = [n for n in record["files"] if n in texts or n == "provenance.json" or (folder / n).exists()]
     texts["provenance.json"] = json.dumps(record, indent=2, default=str) + "\n"
     for name, text in texts.items():              # each replaced whole: a killed run leaves the earlier one

@@ -308,6 +308,31 @@ def test_a_resumed_run_says_the_heat_warnings_of_the_whole_run_once(tmp_path, mo
     assert [w for w in said["interrupted"] if "too long for full Newton steps" in w] == notes
 
 
+def test_a_stopped_squeal_analysis_lists_only_the_files_it_wrote(tmp_path, monkeypatch):
+    """A squeal analysis stopped in its eigen solve keeps the preload's fields; its record listed the
+    mode files, figures and script it never wrote as well (a user audit: 16 files listed, 10 there)."""
+    from multiscale import io, outputs, workflows
+    from multiscale.workflows import squeal
+    folder = tmp_path / "out"
+    scene = loads((Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml").read_text().replace(
+        'folder = "../results/brake_squeal"', f'folder = "{folder}"'))
+    preload = outputs.plan(scene).field_files
+
+    def stopped_in_the_eigen_solve(scene, **kw):
+        io.reporter().folder = folder
+        folder.mkdir(exist_ok=True)
+        for name in preload:
+            (folder / name).write_text("")
+        raise KeyboardInterrupt("eigen solve: stopped after 1.5 s")
+    monkeypatch.setattr(squeal, "run", stopped_in_the_eigen_solve)
+    with pytest.raises(KeyboardInterrupt):
+        workflows.run(scene, verbose=False)
+    record = json.loads((folder / "provenance.json").read_text())
+    assert record["status"].startswith("interrupted") and "modes.csv" in outputs.plan(scene).files
+    assert sorted(record["files"]) == sorted(p.name for p in folder.iterdir()) == sorted(
+        [*preload, "provenance.json", "scene.toml", "scene_resolved.toml"])
+
+
 def test_a_ctrl_c_inside_a_petsc_solve_and_a_full_disk_keep_their_own_words(tmp_path, capsys, monkeypatch):
     """A third Ctrl-C met inside a PETSc solve comes out as PETSc's error 101 around it: the run's
     status was PETSc's stack ("interrupted error code 101 [0] SNESSolve() ..."), not the step

@@ -148,6 +148,12 @@ def test_field_files_hold_one_mesh_with_named_arrays_at_the_output_times(case):
             assert list(f["times"][...]) == expected_times and f["times"].attrs["unit"] == "s"
             for field in fields:
                 assert f[f"data/0/{field}"].attrs["unit"] == FIELDS[field][1]
+            # which part or interface a number is, in the file itself (a user audit: only in check's console)
+            named = {a: [n.decode() for n in f[f"names/{a}"][()]] for a in f.get("names", {})}
+            spec = scene.geometry.spec
+            assert named == ({PART_ARRAY: [r.name for b in spec.bodies if f"{b.name}.xdmf" == name for r in b.regions]}
+                             if name in parts else {array_name("interface"): list(spec.interfaces)}
+                             if "interface" in fields else {})
         text = (p.folder / name).read_text()
         assert text.count("<Grid ") == 1 + len(expected_times) and "Block" not in text
 

@@ -164,10 +164,14 @@ def layout_degree(functions) -> int:
 class SeriesFile:
     """One XDMF/HDF5 time series of one mesh (rank 0 writes; see module docstring); ``parts``: the
     cells' part numbers (``outputs.PART_ARRAY``, in the layout's cell order; None: one part), kept
-    once in ``/mesh/part`` and shown at every time."""
+    once in ``/mesh/part`` and shown at every time; ``names``: {array: the names of its numbers 1,
+    2, ...}, as string datasets ``/names/<array>`` (a reader finds which part or interface a number
+    is without the console of ``multiscale check``: a user audit)."""
 
-    def __init__(self, path: Path, layout: MeshLayout, parts: np.ndarray | None = None):
+    def __init__(self, path: Path, layout: MeshLayout, parts: np.ndarray | None = None,
+                 names: Mapping[str, Sequence[str]] | None = None):
         self.path, self.h5, self.layout, self.parts = Path(path), Path(path).with_suffix(".h5"), layout, parts
+        self.names = dict(names or {})
 
     def start(self, resume_at: float | None = None) -> None:
         """Create the files (rank 0), or with ``resume_at`` [s] continue those of a run resumed from
@@ -181,6 +185,8 @@ class SeriesFile:
                 f.create_dataset("times", data=np.zeros(0), maxshape=(None,)).attrs["unit"] = "s"
                 if self.parts is not None:
                     f.create_dataset("mesh/part", data=self.parts).attrs.update(name=PART_ARRAY, unit="-")
+                for array, names in self.names.items():
+                    f.create_dataset(f"names/{array}", data=list(names), dtype=h5py.string_dtype())
             self._mesh, self._grids = self._mesh_xml(self.parts is not None), []
             self._write_xml()
             return
@@ -265,16 +271,18 @@ class FieldWriter:
     (``{field: Function}``, the keys among ``io.FIELDS``); ``resume_at`` [s]: continue the existing
     files of a run resumed from a checkpoint at that time (``SeriesFile.start``). Collective: a file
     that cannot be written or continued is an ``OutputError`` on every rank. ``parts``: {name: DG0
-    function of its cells' part numbers} of the meshes of several parts (``SeriesFile``)."""
+    function of its cells' part numbers} of the meshes of several parts; ``names``: {name: {array:
+    names of its numbers}} (``SeriesFile``)."""
 
     def __init__(self, folder: Path, groups: Sequence[tuple], resume_at: float | None = None,
-                 parts: Mapping[str, fem.Function] | None = None):
+                 parts: Mapping[str, fem.Function] | None = None, names: Mapping[str, Mapping] | None = None):
         self.groups = []
         for name, mesh, functions in groups:
             if functions:
                 layout = MeshLayout(mesh, layout_degree(functions.values()))
                 numbers = layout.cell_values(parts[name]) if name in (parts or {}) else None
-                self.groups.append((SeriesFile(Path(folder) / f"{name}.xdmf", layout, numbers), dict(functions)))
+                self.groups.append((SeriesFile(Path(folder) / f"{name}.xdmf", layout, numbers,
+                                               (names or {}).get(name)), dict(functions)))
         self.files = [s.path for s, _ in self.groups]
         if self.groups:
             io.on_root(self.groups[0][0].layout.comm, lambda: [s.start(resume_at) for s, _ in self.groups],
@@ -333,7 +341,9 @@ class FieldOutput:
         groups.append(("interface", tm.interface.mesh, {f.name: f for f, _ in self.interface}))
         parts = {b.name: b.cell_field("part", {r.tag: float(k) for k, r in enumerate(b.spec.regions, 1)})
                  for b in tm.bodies if len(b.spec.regions) > 1}
-        self.writer = FieldWriter(folder, groups, resume_at=resume_at, parts=parts)
+        names = {b.name: {PART_ARRAY: [r.name for r in b.spec.regions]} for b in tm.bodies if b.name in parts}
+        names["interface"] = {array_name("interface"): list(tm.interface.tags)} if "interface" in fields else {}
+        self.writer = FieldWriter(folder, groups, resume_at=resume_at, parts=parts, names=names)
         self.files = self.writer.files
         self.body_fields = "displacement" in fields or bool(self.von_mises)   # a released state to write
         self._unloaded = None                   # its solver (``unloaded``), made on first use

@@ -69,6 +69,14 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             for line in notes if comm.rank == 0 else ():
                 print(f"warning: {line}", file=sys.stderr, flush=True)
             if reporter.folder is not None and comm.rank == 0:
+                try:                    # before the record, which lists the files there are
+                    if isinstance(exc, Interrupted):          # stopped after a step: its results are written
+                        _write_script(reporter.folder, scene)
+                    elif stopped:                             # a step abandoned: the plots of what was written
+                        _abandoned(reporter.folder, scene)
+                except Exception as lost:                     # not at the record's cost
+                    print(f"warning: the figures or the ParaView script of this run were not written ({lost})",
+                          file=sys.stderr, flush=True)
                 try:
                     provenance.write(reporter.folder, scene, ranks=comm.size, started=started,
                                      stages=reporter.times, wall_time=time.perf_counter() - start, analysis=kind,
@@ -76,10 +84,6 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                                      f"failed: {type(exc).__name__}: {exc}", earlier=earlier,
                                      warnings=[*scene.warnings, *(exc.warnings if isinstance(exc, Interrupted) else ()),
                                                *notes, *run_warnings(scene, _written_history(reporter.folder))])
-                    if isinstance(exc, Interrupted):          # stopped after a step: its results are written
-                        _write_script(reporter.folder, scene)
-                    elif stopped:                             # a step abandoned: the plots of what was written
-                        _abandoned(reporter.folder, scene)
                 except OSError as lost:                       # (a full disk): the error that stopped the run counts
                     print(f"warning: the record of this run was not written ({lost})", file=sys.stderr, flush=True)
             if stopped and stopped is not exc:
