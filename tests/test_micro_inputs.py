@@ -2,6 +2,8 @@
 NaN/inf, negative value, float count or seed raises ``InputError`` naming the argument, never a
 numpy/Python TypeError, ValueError or AttributeError, and never passes silently (a bool for a
 flag, a truncated float for a count). Each case below raised a raw error or was accepted before."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -175,6 +177,8 @@ CASES = [
     (lambda **k: generate_zones(**{**dict(grid=cut_zones(S, (2, 2))[0], n=8, hurst=0.8, k_min=1, k_max=3,
                                           rms=1e-6), **k}), dict(grid=(2, 2)), "grid"),
     (lambda **k: fft.set_threads(**k), dict(n="2"), "n"),
+    (lambda **k: Surface(**{**dict(heights=S.heights, dx=1e-6, dy=1e-6), **k}), dict(heights=S.heights > 0),
+     "heights"),                                      # (read as 1 m and 0 m: a user trial)
     # zone laws
     (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(kernel="steel"), "kernel"),
     (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(n_points=4.5), "n_points"),
@@ -271,3 +275,23 @@ def test_zones_of_two_grids_are_post_analysed_each_on_its_own():
             [zones[i] for i in ids], alone, np.full(2, 1e-3), remote[ids]).volume, rtol=1e-12)
     with pytest.raises(InputError, match="cells"):
         own[grid_of(a[0])].run([b[0]], [1e6], speed=1.0, remote=[[300.0, 300.0]])
+
+
+@pytest.mark.parametrize("text, threads, said", [("abc", 1, True), ("0", 1, True), ("-3", 1, True),
+                                                  ("2.5", 1, True), ("2", 2, False), (" 3 ", 3, False)])
+def test_the_threads_of_the_environment_are_a_whole_number_or_said(monkeypatch, recwarn, text, threads, said):
+    """MULTISCALE_THREADS=abc made the import a raw ValueError, 0 and -3 were 1 unsaid (a user trial)."""
+    monkeypatch.setenv("MULTISCALE_THREADS", text)
+    assert fft._environment_threads() == threads
+    assert [str(w.message) for w in recwarn] == ([f"MULTISCALE_THREADS = {text!r} is not a whole number of "
+                                                  "threads >= 1: FFTs take 1 thread"] if said else [])
+
+
+def test_a_measurement_given_for_heights_is_told_what_to_give():
+    """A Measurement as read, given to solve_contact, was only "must be an array of numbers" (a user trial)."""
+    from multiscale.micro.contact import solve_contact
+    from multiscale.micro.reading import Measurement
+    m = Measurement(S.heights, 1e-6, 1e-6, Path("afm.top"))
+    with pytest.raises(InputError, match=r"a measurement as read\? give its conditioned surface, "
+                                         r"topography.condition\(m\).surface"):
+        solve_contact(m, kernel=E, load=1e6)

@@ -445,7 +445,9 @@ def real_heights(heights) -> np.ndarray:
         given = np.asarray(heights)
         h = np.asarray(given, dtype=float) if given.dtype.kind not in "cb" else None
     except (TypeError, ValueError):
-        raise InputError("heights", heights, "must be an array of numbers") from None
+        hint = (" (a measurement as read? give its conditioned surface, topography.condition(m).surface)"
+                if hasattr(heights, "heights") else "")            # (it said no more: a user trial)
+        raise InputError("heights", heights, f"must be an array of numbers{hint}") from None
     if h is None:
         raise InputError("heights", "array", "must be real numbers [m] (not complex or bool)")
     return h

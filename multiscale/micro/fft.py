@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import os
 import threading
+import warnings
 import weakref
 from contextlib import contextmanager
 from pathlib import Path
@@ -40,7 +41,19 @@ try:  # pragma: no cover - depends on the installation
 except ImportError:  # pragma: no cover
     pyfftw = None
 
-_threads = max(1, int(os.environ.get("MULTISCALE_THREADS", "1")))
+
+def _environment_threads() -> int:
+    """Threads from ``MULTISCALE_THREADS``: a whole number >= 1, else 1 with a warning (it was a
+    raw ValueError at import for "abc", and 0 or -3 were 1 unsaid: a user trial)."""
+    text = os.environ.get("MULTISCALE_THREADS", "1")
+    if text.strip().isdigit() and int(text) >= 1:
+        return int(text)
+    warnings.warn(f"MULTISCALE_THREADS = {text!r} is not a whole number of threads >= 1: FFTs take 1 thread",
+                  stacklevel=2)
+    return 1
+
+
+_threads = _environment_threads()
 _plans: weakref.WeakSet = weakref.WeakSet()   # every RealFFT2 alive: they count their transforms
 _retired: dict = {}                            # (grid, single) -> [forward, inverse] of the plans collected since
 _planning = threading.Lock()                   # FFTW's planner is not thread-safe

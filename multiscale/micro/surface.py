@@ -26,6 +26,8 @@ class Surface:
     periodic: bool = True
 
     def __post_init__(self):
+        if np.asarray(self.heights).dtype.kind == "b":     # (read as 1 m and 0 m: a user trial)
+            raise InputError("heights", "array", "must be real numbers [m], not bool")
         h = check_field("heights", self.heights, min_ndim=2)
         if min(h.shape[-2:]) < 4:
             raise InputError("heights.shape", h.shape, "need a grid of at least 4 x 4 points")
