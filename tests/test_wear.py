@@ -173,6 +173,18 @@ def test_implicit_wear_increments_converge_to_the_explicit_ones_at_any_rate():
     assert errors[0] < 0.08 and errors[1] < 0.6 * errors[0] and errors[2] < 0.6 * errors[1]
 
 
+def test_an_absurd_wear_rate_is_said_as_coarse_steps_not_as_a_flat():
+    """k_w = 1 /Pa on a rough patch (rms 1 um) wears 1e7 m deep in a step: it was said to wear "a
+    relief into a surface flat to round-off", which the patch was not (a user trial). Now the
+    coarse-step warning, with the deepest wear and a question on the inputs."""
+    patch = fractal_surface(32, 1e-4, hurst=0.8, k_min=2, k_max=8, rms=1e-6, seed=4)
+    history, warned = _wear_runs(patch, (2,), contact=HalfSpace(2e11), load=5e7, mu=0.4, distance=0.1, k_w=1.0)[2]
+    deep = float(history.max_depth[-1])
+    assert deep > 1e5 and len(warned) == 1 and "flat to round-off" not in warned[0]
+    assert warned[0].startswith("simulate_wear: a step changed the relief by up to ")
+    assert warned[0].endswith(f"the deepest wear is {deep:.3g} m (are the wear rate and the sliding distance right?)")
+
+
 def test_uniform_wear_of_a_flat_is_not_a_coarse_step():
     """A periodic flat in full contact wears alike everywhere: exact at any step count, no warning
     (before: "a step wore up to 4.49e+296 times the RMS height", its RMS 0). A non-periodic flat

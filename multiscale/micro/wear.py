@@ -33,7 +33,7 @@ STEP_RMS = 0.5   # a simulate_wear step wearing deeper than this many RMS height
 SUBSTEP_TOL = 0.05   # a wear update whose worn depth its increments leave this far off is warned about [-]
 WEAR_TOL = 0.005     # the coupled loop raises a wear update's increments while their estimated error is above [-]
 UNIFORM = 1e-12      # a step's depths equal to this share of the deepest: uniform wear (full contact of a flat)
-ROUND_OFF_FLAT = 1e12   # a step's relief over this many RMS heights of its start: worn into a flat to round-off [-]
+ROUND_OFF_FLAT = 1e-12  # a surface whose RMS height is at most this share of its largest height is flat [-]
 
 
 STABLE = 1.0          # an explicit wear step's k_w mu ds over the least compliance of the grid, at most [-]
@@ -250,14 +250,19 @@ def simulate_wear(surface: Surface, contact: Kernel | ContactSolver, *, load, mu
     steps_iter = range(1, steps + 1)
     if progress:
         steps_iter = tqdm(steps_iter, desc="wear steps", unit="step")
-    overshoot = 0.0                          # largest step depth over the RMS height it started from
+    overshoot, from_flat = 0.0, False        # largest step relief over the RMS height it started from, and whether
+    #                                          that surface was flat to round-off (a flat punch)
     for j in [0, *steps_iter]:
         if j > 0:
             rms = np.std(current.heights, axis=(-2, -1))
             increment = wear_step(current, p, rate, mu, dS, T)
             worn, least = increment.depth.max(axis=(-2, -1)), increment.depth.min(axis=(-2, -1))
             relief = np.where(worn - least > UNIFORM * worn, worn - least, 0.0)    # uniform wear: exact
-            overshoot = max(overshoot, float(np.max(relief / np.maximum(rms, np.finfo(float).tiny))))
+            ratio = relief / np.maximum(rms, np.finfo(float).tiny)
+            if ratio.max() > overshoot:
+                k = np.unravel_index(np.argmax(ratio), ratio.shape)
+                overshoot = float(ratio[k])
+                from_flat = bool(rms[k] <= ROUND_OFF_FLAT * np.abs(current.heights[k]).max())
             current = increment.surface
             p = _solve_at_load(solver, current.heights, loads, p, rows, j, options)
         depth = h0 - current.heights
@@ -269,15 +274,17 @@ def simulate_wear(surface: Surface, contact: Kernel | ContactSolver, *, load, mu
         if j in law_steps:
             laws.append(_pressure_gap_law(solver, current.heights, law_loads, j, j * dS, options))
     history = WearHistory(sliding=np.arange(steps + 1) * dS, **rows)
-    if overshoot > ROUND_OFF_FLAT:
+    if overshoot > STEP_RMS and from_flat:
         warnings.warn(f"simulate_wear: a step wore a relief into a surface flat to round-off (e.g. a flat punch's "
                       f"edges), so the result depends on the step count (steps = {steps}): use more until the "
                       "result stops changing", WearWarning, stacklevel=2)
-    elif overshoot > STEP_RMS:
+    elif overshoot > STEP_RMS:                 # (an absurd k_w was said to wear into a flat surface: a user trial)
+        deep = float((h0 - current.heights).max())
         warnings.warn(f"simulate_wear: a step changed the relief by up to {overshoot:.3g} times the RMS height it "
                       f"started from (more than {STEP_RMS:g}), so the result depends on the step count (steps = "
-                      f"{steps}): use more, at least {int(np.ceil(steps * overshoot / (STEP_RMS / 2)))}, until the "
-                      "result stops changing", WearWarning, stacklevel=2)
+                      f"{steps}): use more, at least {int(min(np.ceil(steps * overshoot / (STEP_RMS / 2)), 1e15))}, "
+                      f"until the result stops changing; the deepest wear is {deep:.3g} m (are the wear rate and "
+                      "the sliding distance right?)", WearWarning, stacklevel=2)
     return WearResult(current, h0 - current.heights, p, history, laws, time.perf_counter() - t0)
 
 
