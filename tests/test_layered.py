@@ -291,3 +291,10 @@ def test_displacement_control_of_a_layer_on_a_rigid_base_reaches_full_contact(me
         assert by_approach.mean_pressure == pytest.approx(load, rel=1e-8)
         assert by_approach.area_fraction == by_load.area_fraction
     assert by_load.area_fraction == 1.0
+    # an incompressible layer on a rigid base has F(0) = 0 (no uniform compression): full contact has no
+    # finite load, refused at once (it ran 5000 iterations to an unexplained failure: a user trial)
+    incompressible = ContactSolver(LayeredElastic((2e-6,), (2e9,), (0.5,)), s.shape, s.dx, method=method)
+    assert incompressible.kernel.static_compliance == 0.0
+    with pytest.raises(InputError, match="full contact has no finite load: an incompressible layer on a rigid "
+                                         r"base, F\(0\) = 0"):
+        incompressible.solve(s.heights, approach=1.01 * (s.heights.max() - s.heights.mean()))

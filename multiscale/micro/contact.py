@@ -185,14 +185,17 @@ class ContactSolver:
             elif target is not None and np.any(target >= upper):
                 raise InputError("load", load, "mean pressure must be below the hardness (a fully plastic "
                                  "patch carries at most H)")
-        # an elastic periodic patch in full contact has no finite load, unless its kernel has a finite
-        # static compliance F(0) (a layer on a rigid base: the load is then (delta - mean z) / F(0))
-        if delta is not None and self.periodic and not np.isfinite(getattr(self.kernel, "static_compliance", np.inf)):
+        # an elastic periodic patch in full contact has no finite load, unless its kernel has a finite,
+        # positive static compliance F(0) (a layer on a rigid base: the load is then (delta - mean z) / F(0);
+        # an incompressible one has F(0) = 0: it ran its 5000 iterations to an unexplained failure, a user trial)
+        static = getattr(self.kernel, "static_compliance", np.inf)
+        if delta is not None and self.periodic and not (np.isfinite(static) and static > 0):
             unbounded = np.ones(batch, dtype=bool) if upper is None else np.broadcast_to(upper, batch) == np.inf
             if np.any(unbounded & (delta >= z.mean(axis=(-2, -1)))):
                 raise InputError("approach", approach, "a periodic elastic patch under displacement control "
-                                 "needs approach < max(h) - mean(h) (full contact has no finite load; with a "
-                                 "hardness it has)")
+                                 "needs approach < max(h) - mean(h) (full contact has no finite load"
+                                 + ("" if static else ": an incompressible layer on a rigid base, F(0) = 0")
+                                 + "; with a hardness it has)")
         p0 = None
         if initial_pressure is not None:
             p0 = _batch_values("initial_pressure", initial_pressure, h.shape)
