@@ -581,7 +581,15 @@ def test_the_micro_patch_tutorial_solves_a_measured_surface_as_the_isolated_patc
     out = capsys.readouterr().out
     quoted = re.search(r"this gives (\S+) % and\s+(\S+) nm", text)
     assert f"real contact area {quoted.group(1)} %, approach {quoted.group(2)} nm" in out
-    s = scope["s"]
+    s, r = scope["s"], scope["r"]
+    # what the approach holds (a user trial): the patch's mean indentation under a uniform 5 MPa, by Love's
+    # rectangle (measured 143.5 nm on the grid against 143.8 nm), and the mean gap, which does not depend on it
+    from multiscale.references.love import love_rectangle_mean
+    indent = float(re.search(r"Of that approach, (\S+) nm is the indentation", text).group(1)) * 1e-9
+    Lx, Ly = s.size
+    assert indent == pytest.approx(5e6 / (np.pi * HalfSpace.from_materials(4e9, 0.15).E_star)
+                                   * love_rectangle_mean(Lx / 2, Ly / 2), rel=0.005)
+    assert re.search(r"``r.mean_gap``, (\S+) nm", text).group(1) == f"{1e9 * r.mean_gap:.1f}"
     assert (s.periodic, s.dx != s.dy) == (False, True)
     bare = ContactSolver(HalfSpace.from_materials(4e9, 0.15), s.shape, s.dx).solve(s.heights, load=5e6)
     warned = re.search(r"gave (\S+) %\s+and (\S+) nm", text)
