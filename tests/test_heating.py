@@ -431,3 +431,23 @@ def test_non_convergence_raises_or_flags():
     assert info.value.result is not None and info.value.history
     r = sol.run(c.pressure, 0.4, max_iter=1, tol=1e-14, partial=True)
     assert not np.any(r.converged) and np.allclose(r.heat_1 + r.heat_2, r.heat, rtol=1e-12)
+
+
+def test_the_tables_memory_is_estimated_and_a_run_that_cannot_fit_is_refused(monkeypatch):
+    """``TransientHeating.memory`` is the tables' traced peak to 5 % (both bodies' spectra and their
+    build); 200 000 steps on 64² (99 GiB) were a raw MemoryError, or tens of GB asked for (a user
+    trial): refused at once beyond the machine's memory."""
+    import tracemalloc
+    b1, b2 = ThermalMaterial(50.0, 1.4e-5), ThermalMaterial(15.0, 5e-6)
+    motion = Translation(SpeedProfile.constant(1.0))
+    tracemalloc.start()
+    try:
+        TransientHeating((32, 32), 1e-3 / 32, b1, b2, motion, dt=1e-5, n_steps=300)
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert peak == pytest.approx(TransientHeating.memory((32, 32), 300), rel=0.05)
+    monkeypatch.setattr(heating, "_physical_memory", lambda: 2.0 ** 30)
+    with pytest.raises(InputError, match=r"n_steps = 20000: the pulse tables of 20000 steps on a 32 x 32 grid take "
+                                         r"about 2.52 GiB, more than this machine's 1 GiB"):
+        TransientHeating((32, 32), 1e-3 / 32, b1, b2, motion, dt=1e-5, n_steps=20000)
