@@ -479,16 +479,15 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
     return replace(tm, notes=_coverage_notes(tm, comm.bcast(coverage if comm.rank == 0 else None, root=0)))
 
 
-def _coverage(model, spec: GeometrySpec) -> dict:
-    """{interface: its meshed area / its faces' area} (gmsh, rank 0) of the interfaces whose faces
-    are OpenCASCADE's (the built-in kernel has no exact area: left out)."""
-    out = {}
-    for name, tag in spec.interfaces.items():
+def _coverage(model, spec: GeometrySpec) -> tuple[dict, dict]:
+    """({interface: its meshed area / its faces' area}, {load face: the same}) (gmsh, rank 0) of
+    those whose faces are OpenCASCADE's (the built-in kernel has no exact area: left out)."""
+    def ratio(tag: int) -> float | None:
         faces = model.getEntitiesForPhysicalGroup(2, tag)
         try:
             exact = sum(model.occ.getMass(2, int(f)) for f in faces)
         except Exception:          # gmsh raises a bare Exception for an entity OCC does not hold
-            continue
+            return None
         meshed = 0.0
         for f in faces:
             nodes, xyz, _ = model.mesh.getNodes(2, int(f), includeBoundary=True)
@@ -497,26 +496,38 @@ def _coverage(model, spec: GeometrySpec) -> dict:
                 tri = np.reshape(corners, (-1, model.mesh.getElementProperties(kind)[3]))[:, :3]
                 p = x[order[np.searchsorted(nodes, tri, sorter=order)]]
                 meshed += 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum()
-        if exact > 0:
-            out[name] = meshed / exact
-    return out
+        return meshed / exact if exact > 0 else None
+
+    def ratios(tags: dict) -> dict:
+        return {name: r for name, tag in tags.items() if (r := ratio(tag)) is not None}
+    return ratios(spec.interfaces), ratios({n: spec.faces[n] for n in spec.load_faces if n in spec.faces})
 
 
-def _coverage_notes(tm: TwoBodyMesh, coverage: dict) -> tuple:
-    """The note on the interfaces whose meshed area is more than ``COVERAGE_TOLERANCE`` off their
-    faces' (areas in mm^2 from the distributed mesh: the ratio is gmsh's, free of its units)."""
-    off = {n: r for n, r in coverage.items() if abs(r - 1) > COVERAGE_TOLERANCE}
-    if not off:
-        return ()
-    masks, areas, alike = tm.interface.masks(), tm.interface.areas, {}
-    for n, r in off.items():                     # equal pucks said once
-        mesh = areas[masks[n]].sum() * 1e6
-        alike.setdefault(f"{100 * (1 - r):.3g} % ({mesh:.4g} of {mesh / r:.4g} mm^2)", []).append(n)
-    said = [f"{', '.join(names[:3])}{f' and {len(names) - 3} more' * (len(names) > 3)}: {loss}"
-            f"{' each' * (len(names) > 1)}" for loss, names in alike.items()]
-    return (f"interface meshes cover less than their faces (negative: more): {'; '.join(said)}; their contact "
-            "pressures are that much higher under the same force (round edges meshed by straight ones): a finer "
-            "geometry.interface_mesh_size brings them closer, the loss falling with its square",)
+def _coverage_notes(tm: TwoBodyMesh, coverage: tuple[dict, dict]) -> tuple:
+    """The notes on the interfaces and the load faces whose meshed area is more than
+    ``COVERAGE_TOLERANCE`` off their faces' (areas in mm^2 from the distributed mesh: the ratio is
+    gmsh's, free of its units)."""
+    masks, notes = tm.interface.masks(), []
+    meshed = {**{n: tm.interface.areas[m].sum() for n, m in masks.items()},
+              **{f: tm.comm.allreduce(float(np.linalg.norm(tm.face_vector_areas(f), axis=1).sum()), op=MPI.SUM)
+                 for f in coverage[1]}}
+    for kind, ratios, effect in (
+            ("interface meshes", coverage[0], "their contact pressures are that much higher under the same force "
+             "(round edges meshed by straight ones): a finer geometry.interface_mesh_size brings them closer, the "
+             "loss falling with its square"),
+            ("load faces' meshes", coverage[1], "a pressure on them pushes with that much less force than on the "
+             "faces (round edges meshed by straight ones; a loading.normal_force is applied whole): a finer mesh "
+             "brings them closer")):
+        alike: dict = {}
+        for n, r in ratios.items():                  # equal pucks said once
+            if abs(r - 1) > COVERAGE_TOLERANCE:
+                mesh = meshed[n] * 1e6
+                alike.setdefault(f"{100 * (1 - r):.3g} % ({mesh:.4g} of {mesh / r:.4g} mm^2)", []).append(n)
+        said = [f"{', '.join(names[:3])}{f' and {len(names) - 3} more' * (len(names) > 3)}: {loss}"
+                f"{' each' * (len(names) > 1)}" for loss, names in alike.items()]
+        if said:
+            notes.append(f"{kind} cover less than their faces (negative: more): {'; '.join(said)}; {effect}")
+    return tuple(notes)
 
 
 def from_mesh(spec: GeometrySpec, parent: dmesh.Mesh, cell_tags: dmesh.MeshTags,
