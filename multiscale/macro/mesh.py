@@ -11,11 +11,8 @@ Per-facet data are keyed by a global facet index that does not depend on the num
 facets sorted lexicographically by their (rounded) midpoints. ``Interface.midpoints`` (global,
 every rank) tells which facet is which.
 
-``TwoBodyMesh.notes`` says what the run's warnings should: an interface whose mesh covers more
-than ``COVERAGE_TOLERANCE`` less (or more) than its OpenCASCADE faces, as round faces meshed by
-straight edges do (24 mm pucks at 8 mm elements: 6.5 % less, so 6.9 % more pressure under the
-same force; a user audit, 2026-12-01). A script scaled to metres is made of B-splines, whose
-OpenCASCADE areas are ~0.2 % coarse (``meshes/from_file.py``): its ratio is that good.
+``TwoBodyMesh.notes`` says what the run's warnings should: interfaces and load faces whose meshes
+cover less (or more) than their faces (``macro.coverage``).
 """
 from __future__ import annotations
 
@@ -32,9 +29,9 @@ from mpi4py import MPI
 
 from multiscale.errors import InputError, MultiscaleError
 from multiscale.geometry import BodySpec, GeometrySpec, check_cells, gmsh_session
+from multiscale.macro.coverage import coverage_notes, face_coverage
 from multiscale.macro.held import check_held
 
-COVERAGE_TOLERANCE = 0.01    # a meshed interface's area this share off its faces' is said (``TwoBodyMesh.notes``)
 
 INTERFACE_QUADRATURE = 2      # exact for P1 displacements times P1 tests on a facet
 
@@ -445,7 +442,7 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
     (``check_held``)."""
     spec = spec or builder.describe(params)
     name = getattr(builder, "NAME", builder.__name__)
-    error, coverage = None, {}
+    error, coverage = None, ({}, {})
     if comm.rank == 0:
         import gmsh   # rank 0 alone builds the geometry
         try:
@@ -456,7 +453,7 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
                 gmsh_session(builder)
                 builder.generate(gmsh.model, params)
             check_held(gmsh.model, spec, sliding)
-            coverage = _coverage(gmsh.model, spec)
+            coverage = face_coverage(gmsh.model, spec)
         except Exception as exc:  # re-raised on every rank below
             error = exc
     failed = comm.bcast(error if isinstance(error, MultiscaleError) else repr(error) if error is not None else None,
@@ -476,58 +473,7 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
         if comm.rank == 0 and gmsh.isInitialized():
             gmsh.finalize()
     tm = from_mesh(spec, data.mesh, data.cell_tags, data.facet_tags)
-    return replace(tm, notes=_coverage_notes(tm, comm.bcast(coverage if comm.rank == 0 else None, root=0)))
-
-
-def _coverage(model, spec: GeometrySpec) -> tuple[dict, dict]:
-    """({interface: its meshed area / its faces' area}, {load face: the same}) (gmsh, rank 0) of
-    those whose faces are OpenCASCADE's (the built-in kernel has no exact area: left out)."""
-    def ratio(tag: int) -> float | None:
-        faces = model.getEntitiesForPhysicalGroup(2, tag)
-        try:
-            exact = sum(model.occ.getMass(2, int(f)) for f in faces)
-        except Exception:          # gmsh raises a bare Exception for an entity OCC does not hold
-            return None
-        meshed = 0.0
-        for f in faces:
-            nodes, xyz, _ = model.mesh.getNodes(2, int(f), includeBoundary=True)
-            x, order = np.reshape(xyz, (-1, 3)), np.argsort(nodes)
-            for kind, _, corners in zip(*model.mesh.getElements(2, int(f))):
-                tri = np.reshape(corners, (-1, model.mesh.getElementProperties(kind)[3]))[:, :3]
-                p = x[order[np.searchsorted(nodes, tri, sorter=order)]]
-                meshed += 0.5 * np.linalg.norm(np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0]), axis=1).sum()
-        return meshed / exact if exact > 0 else None
-
-    def ratios(tags: dict) -> dict:
-        return {name: r for name, tag in tags.items() if (r := ratio(tag)) is not None}
-    return ratios(spec.interfaces), ratios({n: spec.faces[n] for n in spec.load_faces if n in spec.faces})
-
-
-def _coverage_notes(tm: TwoBodyMesh, coverage: tuple[dict, dict]) -> tuple:
-    """The notes on the interfaces and the load faces whose meshed area is more than
-    ``COVERAGE_TOLERANCE`` off their faces' (areas in mm^2 from the distributed mesh: the ratio is
-    gmsh's, free of its units)."""
-    masks, notes = tm.interface.masks(), []
-    meshed = {**{n: tm.interface.areas[m].sum() for n, m in masks.items()},
-              **{f: tm.comm.allreduce(float(np.linalg.norm(tm.face_vector_areas(f), axis=1).sum()), op=MPI.SUM)
-                 for f in coverage[1]}}
-    for kind, ratios, effect in (
-            ("interface meshes", coverage[0], "their contact pressures are that much higher under the same force "
-             "(round edges meshed by straight ones): a finer geometry.interface_mesh_size brings them closer, the "
-             "loss falling with its square"),
-            ("load faces' meshes", coverage[1], "a pressure on them pushes with that much less force than on the "
-             "faces (round edges meshed by straight ones; a loading.normal_force is applied whole): a finer mesh "
-             "brings them closer")):
-        alike: dict = {}
-        for n, r in ratios.items():                  # equal pucks said once
-            if abs(r - 1) > COVERAGE_TOLERANCE:
-                mesh = meshed[n] * 1e6
-                alike.setdefault(f"{100 * (1 - r):.3g} % ({mesh:.4g} of {mesh / r:.4g} mm^2)", []).append(n)
-        said = [f"{', '.join(names[:3])}{f' and {len(names) - 3} more' * (len(names) > 3)}: {loss}"
-                f"{' each' * (len(names) > 1)}" for loss, names in alike.items()]
-        if said:
-            notes.append(f"{kind} cover less than their faces (negative: more): {'; '.join(said)}; {effect}")
-    return tuple(notes)
+    return replace(tm, notes=coverage_notes(tm, comm.bcast(coverage if comm.rank == 0 else None, root=0)))
 
 
 def from_mesh(spec: GeometrySpec, parent: dmesh.Mesh, cell_tags: dmesh.MeshTags,
