@@ -495,8 +495,9 @@ def test_a_band_cut_short_by_the_number_of_modes_is_said(tmp_path):
                  "geometry.mesh_size": "30 mm", "stability.modes": 6, "output.folder": str(tmp_path / "out")}
     run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
     top = run.case.modes.frequency.max()
-    assert top < 8e3 and run.warnings == (f"stability.modes = 6: the modes found reach {top:.0f} Hz; the band above, "
-                                          "up to 16000 Hz, was not searched (raise stability.modes)",)
+    band = tuple(w for w in run.warnings if w.startswith("stability."))      # (the mesh's notes besides)
+    assert top < 8e3 and band == (f"stability.modes = 6: the modes found reach {top:.0f} Hz; the band above, "
+                                  "up to 16000 Hz, was not searched (raise stability.modes)",)
 
 
 def test_a_pressure_beyond_small_strains_is_warned_about_also_at_a_map_point(tmp_path):
@@ -599,12 +600,13 @@ def test_a_band_cut_short_below_a_target_is_said(tmp_path, capsys):
                  "stability.target": "8 kHz"}
     run = squeal.run(scenes.load(DEMO, overrides), degree=1)
     f = run.case.modes.frequency
-    assert f.min() > 5e3 and len(run.warnings) == 1
+    (band,) = [w for w in run.warnings if w.startswith("stability.")]      # (the mesh's notes besides)
+    assert f.min() > 5e3
     # the console says which solver gave the modes (a user trial could not tell)
     assert "\n  modes by the generalized eigenproblem K phi = theta M phi (exact)\n" in capsys.readouterr().out
-    assert run.warnings[0].startswith(f"stability.modes = 6: the modes found span {f.min():.0f} to {f.max():.0f} Hz "
-                                      "around stability.target = 8000 Hz; the band below ")
-    assert "from 0 Hz, and above" in run.warnings[0] and run.warnings[0].endswith("move stability.target)")
+    assert band.startswith(f"stability.modes = 6: the modes found span {f.min():.0f} to {f.max():.0f} Hz "
+                           "around stability.target = 8000 Hz; the band below ")
+    assert "from 0 Hz, and above" in band and band.endswith("move stability.target)")
 
 
 def test_a_friction_curve_the_preload_misses_is_said(tmp_path, capsys):
