@@ -73,7 +73,7 @@ def test_an_optional_key_without_default_says_what_its_absence_means():
                          "metres for .msh, .geo, .brep]")
     assert "| a STEP/IGES file's declared unit" in scene_rst().replace("\n     - ", " | ")
     assert [Sweep(**{p: (1.0, 2.0)}).preload_mode for p in ("friction", "speed", "pressure", "rms")] == \
-        ["once", "once", "each", "each"]
+        ["each", "once", "each", "each"]
 
 
 def test_every_optional_key_without_default_says_what_its_absence_means():

@@ -269,7 +269,8 @@ def test_values_of_the_projected_problem_left_out_among_the_modes_are_said():
 # ---------------------------------------------------------------- scene options and sweeps
 def test_scene_friction_sweep_writes_the_map(tmp_path, documented):
     overrides = {"geometry.mesh_size": "20 mm", "stability.modes": 30, "output.folder": str(tmp_path / "out"),
-                 "stability.sweep.friction": [0.0, 0.6], "stability.sweep.points": 4}
+                 "stability.sweep.friction": [0.0, 0.6], "stability.sweep.points": 4,
+                 "stability.sweep.preload": "once"}                  # (a friction map's default is "each")
     scene = scenes.load(DEMO, overrides)
     run = squeal.run(scene, degree=1, verbose=False)
     names = {p.name for p in run.files}
@@ -304,7 +305,8 @@ def test_a_mode_count_never_cuts_a_lock_in_pair_in_two(tmp_path):
     assert sorted(damped.select(lam, (0.0, 6e3), 1, 0.0)) == [0]
     overrides = {**NO_FIGURES,
                  "geometry.mesh_size": "20 mm", "stability.modes": 8, "stability.band": ["0 Hz", "3 kHz"],
-                 "output.folder": str(tmp_path / "out"), "stability.sweep.friction": [0.1, 0.6]}
+                 "output.folder": str(tmp_path / "out"), "stability.sweep.friction": [0.1, 0.6],
+                 "stability.sweep.preload": "once"}
     run = squeal.run(scenes.load(DEMO, overrides), verbose=False)          # quadratic elements, as the CLI
     assert run.case.modes.frequency.size == 9 and run.case.modes.unstable().sum() == 1
     assert run.map.unstable()[-1].sum() == 1                  # sigma = +79 1/s at mu = 0.6 (measured)
@@ -398,7 +400,7 @@ def test_the_instability_threshold_is_the_users(tmp_path):
     industrial practice leaves out)."""
     overrides = {**NO_FIGURES, "geometry.mesh_size": "20 mm", "stability.band": ["0 Hz", "9 kHz"],
                  "output.folder": str(tmp_path / "out"), "stability.threshold": 1e-2,
-                 "stability.sweep.friction": [0.35, 0.4]}
+                 "stability.sweep.friction": [0.35, 0.4], "stability.sweep.preload": "once"}
     run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)     # P1: the lock-in at 8507 Hz
     modes, report = run.case.modes, run.case.report
     ratio = -modes.growth / np.abs(modes.eigenvalues)

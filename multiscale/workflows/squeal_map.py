@@ -5,13 +5,14 @@ pressure, ``loading.pressure``), ``speed`` (of the rotating body: the slip speed
 the gyroscopic terms) or ``rms`` (R_q of the rough surfaces: the zone laws are rebuilt). Every
 point is linearised with the options of the nominal analysis, and
 
-- ``preload = "once"`` (default for friction and speed): the sliding state of the nominal
+- ``preload = "once"`` (default for speed): the sliding state of the nominal
   analysis is kept and only the operators change (as a friction change in a commercial
   complex-eigenvalue step). The linearised system is then smooth (affine for friction) in the
   parameter, and all points are projected on one basis: the undamped modes of (K, M) at the first
   and the last value, up to ``stability.basis`` x the band's top (``macro.damped.Subspace``);
-  onsets are bisected on the reduced systems. Fast: one factorisation per end point.
-- ``preload = "each"`` (default, and the only choice, for pressure and roughness): every point is
+  onsets are bisected on the reduced systems. Fast: one factorisation per end point; approximate
+  (docs/squeal.md: a friction map of the demo brake missed its strongest instability).
+- ``preload = "each"`` (default for friction, the only choice for pressure and roughness): every point is
   preloaded again from the previous state. The contact status of the penalty facets changes with
   the state, which one modal basis does not follow (frequency errors of ~0.5 % measured between
   the end points of a friction sweep), so every point is solved on its own (``solve_system``) and
