@@ -439,7 +439,10 @@ class Mechanics:
             if first is not result:       # the retries start afresh: the first attempt says more
                 cause += (f"; the first of its attempts: SNES reason {first.reason}, {first.iterations} iterations, "
                           f"residuals {['%.3g' % r for r in first.residuals[-4:]]}")
-            if result.reason == SNES_LINEAR_FAILED:
+            if pc is not None and mumps.status(pc) in mumps.MEMORY_ERRORS:   # (the rigid-body advice: a user trial)
+                cause += ("; the factors did not fit in memory: a coarser mesh (geometry.mesh_size), or more "
+                          "memory, the model's ranks spread over more machines (docs/performance.rst)")
+            elif result.reason == SNES_LINEAR_FAILED:
                 cause += f"; the linear solve failed, as it does when {free}"
             elif result.reason == PETSc.SNES.ConvergedReason.DIVERGED_DTOL:
                 cause += f"; the residual grew, as it can when {free}"

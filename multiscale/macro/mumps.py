@@ -19,6 +19,7 @@ from petsc4py import PETSc
 WORKSPACE_ERRORS = (-8, -9, -11, -14, -15, -17, -20)   # MUMPS INFOG(1): a workspace or buffer too small
 WORKSPACE_RETRIES = 4
 MEANINGS = {-10: "numerically singular", -13: "not enough memory", -19: "more memory than ICNTL(23) allows"}
+MEMORY_ERRORS = (-13, -19)    # MUMPS INFOG(1): the factors did not fit in memory
 
 
 def status(pc: PETSc.PC) -> int:
