@@ -1520,6 +1520,11 @@ def test_a_squeal_band_beyond_what_the_mesh_resolves_is_warned_about():
     wave = math.sqrt(pad.E / (2 * (1 + pad.nu) * pad.rho)) / 1.001e6
     warned = [w for w in scene.warnings if w.startswith("stability.band: at its top")]
     assert len(warned) == 1 and f"pad ({wave * 1e3:.3g} mm)" in warned[0] and "elements (12 mm)" in warned[0]
+    # a band of bare numbers read as Hz, [0, 6], failed only after the preload (a user trial): warned at once
+    low = load(demos / "brake_squeal.toml", {"stability.band": [0, 6]}).warnings
+    assert ('stability.band = [0, 6] Hz: ends below 100 Hz, where no squeal lies (1-16 kHz); a number without a '
+            'unit is Hz: "6 kHz"') in low
+    assert not any("ends below" in w for w in load(demos / "brake_squeal.toml", {"stability.band": [0, 6000]}).warnings)
 
 
 
