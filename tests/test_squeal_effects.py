@@ -2,6 +2,7 @@
 gyroscopic terms (spinning disc), per-material damping, friction-slope damping, scene sweeps."""
 import csv
 import dataclasses
+import re
 from pathlib import Path
 from types import SimpleNamespace as NS
 
@@ -605,7 +606,21 @@ def test_a_band_cut_short_below_a_target_is_said(tmp_path, capsys):
     (band,) = [w for w in run.warnings if w.startswith("stability.")]      # (the mesh's notes besides)
     assert f.min() > 5e3
     # the console says which solver gave the modes (a user trial could not tell)
-    assert "\n  modes by the generalized eigenproblem K phi = theta M phi (exact)\n" in capsys.readouterr().out
+    out = capsys.readouterr().out
+    assert "\n  modes by the generalized eigenproblem K phi = theta M phi (exact)\n" in out
+    # and the preload's braking torque (in no file and unsaid: a user trial), here against the sum of
+    # mu p A r over the facets of interface.h5 (centroid radii)
+    import h5py
+    with h5py.File(tmp_path / "out" / "interface.h5") as h5:
+        x, cells = h5["mesh/geometry"][()], h5["mesh/topology"][()]
+        p, mu = (h5[f"data/0/{k}"][()].ravel() for k in ("contact_pressure", "friction_coefficient"))
+    motion = run.case.mech.tm.spec.motion
+    axis, tri = np.asarray(motion.axis) / np.linalg.norm(motion.axis), x[cells]
+    arm = tri.mean(axis=1) - np.asarray(motion.centre)
+    radius = np.linalg.norm(arm - np.outer(arm @ axis, axis), axis=1)
+    area = 0.5 * np.linalg.norm(np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0]), axis=1)
+    assert float(re.search(r"; braking torque (\S+) N m\n", out).group(1)) == pytest.approx(
+        (mu * p * area * radius).sum(), rel=0.01)
     assert band.startswith(f"stability.modes = 6: the modes found span {f.min():.0f} to {f.max():.0f} Hz "
                            "around stability.target = 8000 Hz; the band below ")
     assert "from 0 Hz, and above" in band and band.endswith("move stability.target)")

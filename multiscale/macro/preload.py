@@ -21,6 +21,7 @@ from dolfinx.fem import petsc as fpetsc
 from petsc4py import PETSc
 
 from multiscale.errors import InputError, check_positive
+from multiscale.geometry import Rotation
 from multiscale.macro.damped import LinearSystem
 from multiscale.macro.eigen import Damping
 from multiscale.macro.friction import friction_damping
@@ -44,6 +45,7 @@ class Preload:
     iterations: int          # Newton iterations of the last load step
     residuals: list          # residual norms of the last load step
     time: float              # s, wall time
+    friction_moment: float | None = None   # N m, |moment| of the friction about body 1's axis (None: it translates)
 
 
 TORQUE_TOL = 1e-3    # relative error of the friction moment left by the load's scaling to a torque
@@ -92,9 +94,10 @@ def preload(mech: Mechanics, pressure: float, steps: int = 1, reset: bool = True
     normal = {name: float(facet_normal[m].sum()) for name, m in masks.items()}
     tangential = {name: facet_friction[m].sum(axis=0) for name, m in masks.items()}
     friction = {name: float(mu[m].mean()) for name, m in masks.items()}
+    moment = abs(c.friction_moment()) if isinstance(tm.spec.motion, Rotation) else None
     return Preload(float(pressure), friction, normal, tangential, loads,
                    solved.max_pressure, solved.iterations, list(solved.residuals),
-                   time.perf_counter() - t0)
+                   time.perf_counter() - t0, moment)
 
 
 def linearise(mech: Mechanics, materials: Mapping[str, object]):

@@ -368,8 +368,9 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
               + (f" ({', '.join(f'{f:.0f} Hz' for f in rep.frequency[rep.unstable - 1])})" if rep.unstable.size else "")
               + f", {rep.potentially_unstable.size} potentially unstable; {result.wall_time:.1f} s on "
               f"{io.counted(comm.size, 'rank')}")
+        moment = case.preload.friction_moment       # (in no file, and not said: a user trial)
         print("  preload: " + ", ".join(f"{abs(f):.6g} N on {n}" for n, f in case.preload.normal_force.items())
-              + " (normal contact force)")
+              + " (normal contact force)" + (f"; braking torque {moment:.6g} N m" if moment else ""))
         touching = case.slip_speed[case.facet_pressure > 0] if case.slip_speed is not None else np.zeros(0)
         if touching.size:            # a mu(v) law: the mu it gave (only in interface.xdmf before: a user trial)
             print("  friction: mu " + ", ".join(f"{mu:.3g} on {n}" for n, mu in case.preload.friction.items())
