@@ -66,6 +66,17 @@ def test_hoffmann_exactly_one_unstable_mode_above_mu_c(mu):
     assert list(rep.unstable) == [int(np.argmax(r.growth)) + 1]
 
 
+def test_a_mode_growing_without_oscillating_is_a_divergence():
+    """A negative stiffness (K = diag(-1, 4), M = I: lambda = +-1, +-2i) grows at sigma = 1 1/s at
+    0 Hz: unstable, and named a divergence, not flutter (a brake at mu = 2 listed two such modes
+    like its flutter modes: a user trial); the 1/pi Hz mode is neither."""
+    r = eigen.solve_modes(petsc_mat(np.diag([-1.0, 4.0])), petsc_mat(np.eye(2)), f_max=1.0)
+    rep = modal.stability_report(r)
+    np.testing.assert_allclose(r.eigenvalues, [1.0, 2.0j], atol=1e-12)
+    assert list(rep.unstable) == [1] and list(rep.divergent) == [1]
+    assert modal.stability_report(eigen.solve_modes(*hoffmann_model(0.8), f_max=1.0)).divergent.size == 0
+
+
 def test_hoffmann_just_below_mu_c_is_potentially_unstable():
     rep = modal.stability_report(eigen.solve_modes(*hoffmann_model(MU_C - 1e-4), f_max=1.0),
                               close_tol=0.05)

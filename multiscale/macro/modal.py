@@ -31,6 +31,13 @@ class StabilityReport:
     rtol: float                       # instability threshold on sigma / |lambda| [-]
     close_tol: float                  # relative frequency gap of a potentially unstable pair [-]
 
+    @property
+    def divergent(self) -> np.ndarray:
+        """The unstable modes that grow without oscillating (a real eigenvalue > 0, 0 Hz): a static
+        divergence of the state linearised about, not flutter (mode numbers, 1-based)."""
+        return self.unstable[self.frequency[self.unstable - 1] <= STATIC * max(float(self.frequency.max(initial=0.0)),
+                                                                                1.0)]
+
 
 @dataclass
 class EnergyShares:
@@ -53,6 +60,7 @@ class EnergyShares:
 
 
 CLOSE = 1e-3     # relative frequency gap of two stable modes that are "potentially unstable" (Fig. 4.14)
+STATIC = 1e-9    # a mode below this share of the highest frequency (or of 1 Hz) does not oscillate
 
 
 def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float = CLOSE) -> StabilityReport:

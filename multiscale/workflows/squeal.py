@@ -264,6 +264,12 @@ def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
     elif case.modes.method == "projection" and len(f):   # the modes nearest the target in frequency
         r = float(np.abs(f - t).max())
         floor, ceiling = max(t - r, 0.0), t + r
+    still = case.report.divergent
+    if still.size:                          # (listed as flutter: a user trial at mu = 2)
+        out.append(f"{io.counted(still.size, 'unstable mode')} at 0 Hz ("
+                   + ", ".join(f"mode {j}: sigma = {case.modes.growth[j - 1]:+.4g} 1/s" for j in still[:4])
+                   + "): a static divergence, not flutter: the sliding state the modes are linearised about is "
+                   "itself unstable (friction too high for the structure?), so its modes say little")
     spurious = [x for x in case.modes.spurious if floor <= x <= ceiling]   # (outside, they displaced no mode)
     if spurious:
         out.append(f"{len(spurious)} value(s) of the projected problem among the modes found "
