@@ -1434,12 +1434,12 @@ def test_an_each_map_refines_its_onsets_by_three_full_analyses_unless_told_and_a
     """``stability.sweep.refine``: full analyses per onset of a preload = "each" map (default 3);
     a "once" map bisects on its common basis, so refine there is a problem, not ignored."""
     text = (DEMOS / "brake_squeal.toml").read_text() + "\n[stability.sweep]\nfriction = [0.3, 0.5]\n"
-    assert loads(text, name="brake").stability.sweep.refine_steps == 0                 # "once"
-    each = text + 'preload = "each"\n'
-    assert loads(each, name="brake").stability.sweep.refine_steps == 3
-    assert loads(each + "refine = 5\n", name="brake").stability.sweep.refine_steps == 5
+    assert loads(text, name="brake").stability.sweep.refine_steps == 3                 # "each" (a friction map's default)
+    assert loads(text + "refine = 5\n", name="brake").stability.sweep.refine_steps == 5
+    once = text + 'preload = "once"\n'
+    assert loads(once, name="brake").stability.sweep.refine_steps == 0
     with pytest.raises(SceneError) as info:
-        loads(text + "refine = 2\n", name="brake")
+        loads(once + "refine = 2\n", name="brake")
     assert info.value.problems == ['stability.sweep.refine: narrows the onsets of a preload = "each" map by full '
                                    'analyses; a "once" map bisects them on its common basis (set preload = "each" '
                                    "or remove refine)"]

@@ -244,7 +244,7 @@ def test_values_of_the_projected_problem_left_out_among_the_modes_are_said():
     scene = NS(stability=NS(basis=1.5, damping=0.0, method="auto", band=(0.0, 6e3), target=3500.0, modes=4, sweep=None),
                materials=None)
     case = NS(modes=modes, terms=(), mech=NS(tm=NS(notes=())), facet_pressure=np.zeros(1),
-              preload=NS(normal_force={}), slip_speed=None)
+              preload=NS(normal_force={}), slip_speed=None, report=NS(divergent=np.zeros(0, dtype=int)))
     said = squeal._left_out(scene, case, None)
     assert said[0] == ("1 value(s) of the projected problem among the modes found (3524 Hz) had relative residuals "
                        "above 0.5 in the full model: not modes of it, left out (a larger stability.basis, now 1.5, "
