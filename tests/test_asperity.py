@@ -368,7 +368,7 @@ def test_asperity_results_beyond_the_models_range_are_warned_of():
         high = model.solve(5e-6)
     assert high.area_fraction > 1.0 and high.converged and len(caught) == 2
     assert re.match(r"real contact area 1\.\d+ times the nominal area .* impossible", str(caught[1].message))
-    with pytest.warns(AsperityWarning, match="^from approach 1e-06 m on: contacts holding") as caught:
+    with pytest.warns(AsperityWarning, match="^at approaches from 1e-06 m: contacts holding") as caught:
         model.curve([0.5e-6, 1e-6, 2e-6])
     assert len(caught) == 1                                # once for the whole curve
 @pytest.mark.filterwarnings("ignore::multiscale.micro.asperity.AsperityWarning")   # the thesis' loads overlap

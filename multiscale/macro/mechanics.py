@@ -441,7 +441,8 @@ class Mechanics:
                           f"residuals {['%.3g' % r for r in first.residuals[-4:]]}")
             if pc is not None and mumps.status(pc) in mumps.MEMORY_ERRORS:   # (the rigid-body advice: a user trial)
                 cause += ("; the factors did not fit in memory: a coarser mesh (geometry.mesh_size), or more "
-                          "memory, the model's ranks spread over more machines (docs/performance.rst)")
+                          "memory, the model's ranks spread over more machines (docs/performance.rst)"
+                          + (", or a higher cap mat_mumps_icntl_23" if mumps.status(pc) == -19 else ""))
             elif result.reason == SNES_LINEAR_FAILED:
                 cause += f"; the linear solve failed, as it does when {free}"
             elif result.reason == PETSc.SNES.ConvergedReason.DIVERGED_DTOL:

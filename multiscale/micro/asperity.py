@@ -240,8 +240,8 @@ class AsperityModel:
             prev = self._solve(delta, route, method, tol, MAX_ITER, False, raster, init)
             results.append(prev)
         beyond = [r for r in results if r.notes]
-        if beyond:                    # once: from where, and the last step's notes
-            warnings.warn(f"from approach {beyond[0].approach:.3g} m on: {'; '.join(results[-1].notes)}",
+        if beyond:                    # once: where first, and the notes of the last step that has them
+            warnings.warn(f"at approaches from {beyond[0].approach:.3g} m: {'; '.join(beyond[-1].notes)}",
                           AsperityWarning, stacklevel=2)
         kappa = np.array([np.nan if r.kappa is None else r.kappa for r in results])
         return AsperityCurve(

@@ -75,8 +75,8 @@ class ContactResult:
     #                            patch, the indentation of the whole loaded patch (143.5 of the 290 nm of
     #                            tutorial micro_patch's measured case), of a periodic one, that about a
     #                            displacement of mean zero
-    mean_gap: np.ndarray       #: m, mean separation between the flat and the deformed surface: unlike the
-    #                            approach, it does not depend on the patch's size or periodicity
+    mean_gap: np.ndarray       #: m, mean separation between the flat and the deformed surface: it depends
+    #                            much less on the patch than the approach (periodic against isolated 128²: 6 %)
     plastic_area_fraction: np.ndarray  #: cells at p = H (plastic flow) / all cells; 0 without a hardness
     plastic: np.ndarray | None  #: m, permanent (plastic) deformation, >= 0 into the solid: d - z - u at p = H
     iterations: np.ndarray     #: per patch

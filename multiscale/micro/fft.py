@@ -46,7 +46,7 @@ def _environment_threads() -> int:
     """Threads from ``MULTISCALE_THREADS``: a whole number >= 1, else 1 with a warning (it was a
     raw ValueError at import for "abc", and 0 or -3 were 1 unsaid: a user trial)."""
     text = os.environ.get("MULTISCALE_THREADS", "1")
-    if text.strip().isdigit() and int(text) >= 1:
+    if text.strip().isdecimal() and int(text) >= 1:
         return int(text)
     warnings.warn(f"MULTISCALE_THREADS = {text!r} is not a whole number of threads >= 1: FFTs take 1 thread",
                   stacklevel=2)

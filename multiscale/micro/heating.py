@@ -303,10 +303,12 @@ class TransientHeating:
     @staticmethod
     def memory(shape, n_steps: int) -> float:
         """Peak memory [bytes] of the tables for ``n_steps`` on a grid of ``shape`` (ny, nx): both
-        bodies' spectra and their build, 4 x 16 bytes per age and point of the padded half-spectrum
-        (traced: 106 MB for 200 steps on 64², 212 MB for 400)."""
-        ny, nx = shape
-        return 64.0 * n_steps * 2 * ny * (nx + 1)
+        bodies' spectra and their build, 4 x 16 bytes per age and point of the spectrum of the padded
+        grid, 2 my (mx + 1) for the 5-smooth sizes (my, mx) >= (ny, nx) (traced: 106 MB for 200 steps
+        on 64², 212 MB for 400). ``run`` adds 32 bytes per step and point for each pressure field
+        (its flux histories: half as much again for one field)."""
+        my, mx = (padded_size(int(n)) for n in shape)
+        return 64.0 * n_steps * 2 * my * (mx + 1)
 
     @staticmethod
     def _spectra(tables):

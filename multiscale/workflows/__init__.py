@@ -74,9 +74,9 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                         _write_script(reporter.folder, scene)
                     elif stopped:                             # a step abandoned: the plots of what was written
                         _abandoned(reporter.folder, scene)
-                except Exception as lost:                     # not at the record's cost
-                    print(f"warning: the figures or the ParaView script of this run were not written ({lost})",
-                          file=sys.stderr, flush=True)
+                except BaseException as lost:                 # not at the record's cost (a further Ctrl-C too)
+                    print(f"warning: the figures or the ParaView script of this run were not written "
+                          f"({type(lost).__name__}: {lost})", file=sys.stderr, flush=True)
                 try:
                     provenance.write(reporter.folder, scene, ranks=comm.size, started=started,
                                      stages=reporter.times, wall_time=time.perf_counter() - start, analysis=kind,
