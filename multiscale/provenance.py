@@ -280,7 +280,8 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     the overrides given over the scene file (``scene.load``: a study's point), and lists
     every entry the run writes (``multiscale.outputs.plan``), so that ``results_of`` knows them
     when the folder is overwritten (a failed or interrupted run: those it wrote; its record named a
-    script and figures it never wrote, an interrupted squeal analysis its modes); ``warnings``: the scene's and the run's (e.g. temperatures
+    script and figures it never wrote, an interrupted squeal analysis its modes); ``warnings``:
+    the scene's and the run's (e.g. temperatures
     beyond a material table); status ``RUNNING`` (written as the run begins) has no end time.
     ``earlier``: the parts of the run before this one (a resumed run: ``parts_of`` the folder
     before it wrote); the record's ``parts`` are those and this one, its ``start`` the first

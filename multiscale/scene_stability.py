@@ -45,7 +45,8 @@ class Sweep:
     (effect "roughness"). The listed values, or with ``points`` that many from the first to the
     last. ``preload = "once"`` (default for speed) keeps the sliding state of the nominal analysis
     and projects every point on the undamped modes of the first and last points (fast, approximate:
-    docs/squeal.md); ``"each"`` (friction, pressure, roughness) preloads and solves every point. The modes are tracked by MAC
+    docs/squeal.md); ``"each"`` (friction, pressure, roughness) preloads and solves every point.
+    The modes are tracked by MAC
     (``mac``: the lowest MAC of a pair) and the onset of every unstable mode is bisected
     (``onsets``); an "each" map narrows each onset's bracket by up to ``refine`` full analyses
     (preload and eigen solve); see ``multiscale.workflows.squeal_map``."""

@@ -284,6 +284,8 @@ def test_routes_and_methods_agree_on_a_fractal_surface():
     np.testing.assert_allclose(k.semi_axes[both, 0], e.semi_axes[both, 0], rtol=0.05)
     free = AsperityModel.from_surface(surf, SOLID, "elliptic", interaction=False).solve(delta)
     assert free.force > 1.2 * e.force and free.n_contacts > e.n_contacts   # interactions matter
+
+
 @pytest.mark.filterwarnings("ignore::multiscale.micro.asperity.AsperityWarning")   # the thesis' loads overlap
 def test_interaction_truncation_is_within_its_bound():
     """Near-field cut-off: the neglected part of each interaction sum stays below the bound
@@ -371,6 +373,8 @@ def test_asperity_results_beyond_the_models_range_are_warned_of():
     with pytest.warns(AsperityWarning, match="^at approaches from 1e-06 m: contacts holding") as caught:
         model.curve([0.5e-6, 1e-6, 2e-6])
     assert len(caught) == 1                                # once for the whole curve
+
+
 @pytest.mark.filterwarnings("ignore::multiscale.micro.asperity.AsperityWarning")   # the thesis' loads overlap
 def test_curve_is_monotone_and_separation_follows_eq_1_9():
     surf = thesis_surface("set1", 1, seed=3)

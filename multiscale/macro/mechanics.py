@@ -439,10 +439,11 @@ class Mechanics:
             if first is not result:       # the retries start afresh: the first attempt says more
                 cause += (f"; the first of its attempts: SNES reason {first.reason}, {first.iterations} iterations, "
                           f"residuals {['%.3g' % r for r in first.residuals[-4:]]}")
-            if pc is not None and mumps.status(pc) in mumps.MEMORY_ERRORS:   # (the rigid-body advice: a user trial)
+            code = 0 if pc is None else mumps.status(pc)
+            if code in mumps.MEMORY_ERRORS:      # (it gave the rigid-body advice: a user trial)
                 cause += ("; the factors did not fit in memory: a coarser mesh (geometry.mesh_size), or more "
                           "memory, the model's ranks spread over more machines (docs/performance.rst)"
-                          + (", or a higher cap mat_mumps_icntl_23" if mumps.status(pc) == -19 else ""))
+                          + (", or a higher cap mat_mumps_icntl_23" if code == -19 else ""))
             elif result.reason == SNES_LINEAR_FAILED:
                 cause += f"; the linear solve failed, as it does when {free}"
             elif result.reason == PETSc.SNES.ConvergedReason.DIVERGED_DTOL:

@@ -413,6 +413,7 @@ def write_modes(folder: str | Path, result, functions: Sequence, names: Sequence
     for k, (u, name) in enumerate(zip(functions, names)):
         V = u.function_space
         W, cells = owned_space(V)
+        into = np.arange(len(cells), dtype=np.int32)
         shape = fem.Function(V)
         parts = tuple(fem.Function(W, name=name) for name in MODE_ARRAYS)
         out = folder / f"modes_{name}.bp"
@@ -422,7 +423,7 @@ def write_modes(folder: str | Path, result, functions: Sequence, names: Sequence
                 for f, values in zip(parts, (block.real, block.imag)):
                     shape.x.array[:sizes[k]] = values
                     shape.x.scatter_forward()
-                    f.interpolate(shape, cells0=cells, cells1=np.arange(len(cells), dtype=np.int32))
+                    f.interpolate(shape, cells0=cells, cells1=into)
                 w.write(float(j))
         files.append(out)
     return files

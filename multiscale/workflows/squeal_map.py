@@ -12,7 +12,8 @@ point is linearised with the options of the nominal analysis, and
   and the last value, up to ``stability.basis`` x the band's top (``macro.damped.Subspace``);
   onsets are bisected on the reduced systems. Fast: one factorisation per end point; approximate
   (docs/squeal.md: a friction map of the demo brake missed its strongest instability).
-- ``preload = "each"`` (default for friction, the only choice for pressure and roughness): every point is
+- ``preload = "each"`` (default for friction, the only choice for pressure and roughness): every
+  point is
   preloaded again from the previous state. The contact status of the penalty facets changes with
   the state, which one modal basis does not follow (frequency errors of ~0.5 % measured between
   the end points of a friction sweep), so every point is solved on its own (``solve_system``) and
