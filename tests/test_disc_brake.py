@@ -113,6 +113,18 @@ def test_a_ventilated_disc_is_refused_by_the_heat_problem(tmp_path):
     build_model(scenes.loads(VENTED.replace("vanes = 12", "vanes = 0"), tmp_path), MPI.COMM_WORLD)
 
 
+def test_the_faceted_load_faces_are_said_only_under_a_given_pressure(tmp_path):
+    """A pressure on the faceted piston pushes with less than p pi r^2: said. A force (here from a
+    braking torque) is spread over the meshed faces and applied whole: nothing to say (the note
+    was said under a force too)."""
+    from multiscale.workflows.model import build_mesh
+    solid = VENTED.replace("vanes = 12", "vanes = 0")
+    def said(text):
+        return [n for n in build_mesh(scenes.loads(text, tmp_path)).notes if n.startswith("load faces' meshes")]
+    assert len(said(solid)) == 1
+    assert said(solid.replace('pressure = "10 bar"', 'braking_torque = "200 N m"')) == []
+
+
 # ---------------------------------------------------------------- free-free disc vs plate theory
 def kirchhoff_annulus(n, beta, nu):
     """Lowest lambda^2 = omega a^2 sqrt(rho h / D) of a free annular Kirchhoff plate, n nodal diameters.

@@ -53,8 +53,7 @@ def coverage_notes(tm, coverage: tuple[dict, dict]) -> tuple:
              "(round edges meshed by straight ones): a finer geometry.interface_mesh_size brings them closer, the "
              "loss falling with its square"),
             ("load faces' meshes", coverage[1], "a pressure on them pushes with that much less force than on the "
-             "faces (round edges meshed by straight ones; a loading.normal_force is applied whole): a finer mesh "
-             "brings them closer")):
+             "faces (round edges meshed by straight ones): a finer mesh brings them closer")):
         alike: dict = {}
         for n, r in ratios.items():                  # equal pucks said once
             if abs(r - 1) > COVERAGE_TOLERANCE:

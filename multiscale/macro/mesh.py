@@ -433,13 +433,14 @@ class FormCache:
 
 
 def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometrySpec | None = None,
-          max_cells: int | None = None, sliding: bool = False) -> TwoBodyMesh:
+          max_cells: int | None = None, sliding: bool = False, pressed: bool = True) -> TwoBodyMesh:
     """Run a gmsh builder (``multiscale.geometry``) on rank 0 and distribute the mesh (shared-facet
     ghosting); ``spec`` (default: the builder's ``describe``) tags bodies, faces and interfaces.
     With ``max_cells``, a mesh estimated larger is refused before meshing (``check_cells``: an
     InputError on every rank); the trial meshes and the mesh share one gmsh session (a CAD file is
     read once). ``sliding`` (friction): the interfaces do not hold body 1 in its motion
-    (``check_held``)."""
+    (``check_held``). ``pressed``: the load faces take a given pressure, whose force their faceting
+    lowers (said in ``notes``); a force spread over them is applied whole (False: not said)."""
     spec = spec or builder.describe(params)
     name = getattr(builder, "NAME", builder.__name__)
     error, coverage = None, ({}, {})
@@ -453,7 +454,7 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
                 gmsh_session(builder)
                 builder.generate(gmsh.model, params)
             check_held(gmsh.model, spec, sliding)
-            coverage = face_coverage(gmsh.model, spec)
+            coverage = face_coverage(gmsh.model, spec if pressed else replace(spec, load_faces=()))
         except Exception as exc:  # re-raised on every rank below
             error = exc
     failed = comm.bcast(error if isinstance(error, MultiscaleError) else repr(error) if error is not None else None,

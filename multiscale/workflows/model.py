@@ -198,7 +198,7 @@ def build_mesh(scene, comm=MPI.COMM_WORLD) -> two_body.TwoBodyMesh:
     g = scene.geometry
     params = g.params if g.builder == "file" else dict(g.params)
     tm = two_body.build(g.module(), params, comm, spec=scene_spec(scene), max_cells=g.max_cells,
-                        sliding=scene.has("friction"))
+                        sliding=scene.has("friction"), pressed=scene.loading.pressure is not None)
     motion = tm.spec.motion
     for name in tm.interface.tags if scene.has("friction") else ():
         c = tm.interface.crossing(name, motion)
