@@ -19,7 +19,8 @@ from pathlib import Path
 from multiscale import __version__
 from multiscale.errors import InputError, MultiscaleError, OutputError, SceneError
 from multiscale.geometry import too_many_cells
-from multiscale.io import CtrlCWatch, abort, ended_together, memory_available
+from multiscale.io import CtrlCWatch, abort, ended_together
+from multiscale.memory import memory_available
 from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.reading import COMMAND_LINE, TopographyWarning, formats, read_topography
 from multiscale.micro.spectrum import statistics_memory, surface_statistics

@@ -144,16 +144,6 @@ def collective(comm, call):
     return value
 
 
-def memory_available() -> float | None:
-    """Memory a process can take without swapping or the OOM killer [bytes]: Linux's MemAvailable
-    (/proc/meminfo); None where it cannot be read."""
-    try:
-        with open("/proc/meminfo") as f:
-            return next(float(line.split()[1]) * 1024 for line in f if line.startswith("MemAvailable:"))
-    except (OSError, StopIteration, ValueError, IndexError):
-        return None
-
-
 def counted(n: int, noun: str) -> str:
     """"1 record", "2 records": ``n`` and the noun, plural unless n is 1."""
     return f"{n} {noun}{'s' * (n != 1)}"

@@ -447,7 +447,8 @@ def test_the_tables_memory_is_estimated_and_a_run_that_cannot_fit_is_refused(mon
     finally:
         tracemalloc.stop()
     assert peak == pytest.approx(TransientHeating.memory((32, 32), 300), rel=0.05)
-    monkeypatch.setattr(heating, "_physical_memory", lambda: 2.0 ** 30)
+    monkeypatch.setattr(heating, "memory_limit", lambda: 2.0 ** 30)
     with pytest.raises(InputError, match=r"n_steps = 20000: the pulse tables of 20000 steps on a 32 x 32 grid take "
-                                         r"about 2.52 GiB, more than this machine's 1 GiB"):
+                                         r"about 2.52 GiB, more than the 1 GiB this process may use \(the machine's, "
+                                         r"or its container's or job's limit\)"):
         TransientHeating((32, 32), 1e-3 / 32, b1, b2, motion, dt=1e-5, n_steps=20000)

@@ -25,7 +25,6 @@ Phi_i/Phi may leave [0, 1].
 """
 from __future__ import annotations
 
-import os
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -33,6 +32,7 @@ from tqdm import tqdm
 
 from multiscale.errors import (ConvergenceError, InputError, check_count, check_field, check_flag, check_instance,
                                check_positive, check_real)
+from multiscale.memory import memory_limit
 from multiscale.micro.contact import ContactResult, ContactSolver
 from multiscale.micro.fft import RealFFT2
 from multiscale.micro.heat_kernels import Motion, ThermalMaterial, Translation, pulse_tables
@@ -256,14 +256,6 @@ def _remote_temperatures(value) -> tuple[float, float]:
     return float(th[0]), float(th[1])
 
 
-def _physical_memory() -> float:
-    """This machine's memory [bytes] (inf where the system does not say)."""
-    try:
-        return float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
-    except (ValueError, OSError, AttributeError):
-        return float("inf")
-
-
 def _partition(part, total):
     with np.errstate(divide="ignore", invalid="ignore"):
         return np.where(total != 0, part / np.where(total != 0, total, 1.0), np.nan)
@@ -286,11 +278,12 @@ class TransientHeating:
         self.shape, self.dx, self.dy = _check_grid(shape, dx, dy)
         self.dt = check_positive("dt", dt)
         self.n_steps = check_count("n_steps", n_steps)
-        need, have = self.memory(self.shape, self.n_steps), _physical_memory()
+        need, have = self.memory(self.shape, self.n_steps), memory_limit()
         if need > have:         # (200 000 steps on 64² was a raw MemoryError, or tens of GB asked: a user trial)
             raise InputError("n_steps", n_steps, f"the pulse tables of {n_steps} steps on a {self.shape[0]} x "
-                             f"{self.shape[1]} grid take about {need / 2**30:.3g} GiB, more than this machine's "
-                             f"{have / 2**30:.3g} GiB: fewer steps (a longer dt) or a coarser grid")
+                             f"{self.shape[1]} grid take about {need / 2**30:.3g} GiB, more than the "
+                             f"{have / 2**30:.3g} GiB this process may use (the machine's, or its container's or "
+                             "job's limit): fewer steps (a longer dt) or a coarser grid")
         _check_bodies(body1, body2)
         check_instance("motion", motion, Motion, "a Motion (Rotation or Translation)")
         self.body1, self.body2, self.motion = body1, body2, motion

@@ -1,0 +1,72 @@
+"""How much memory this process may use [bytes]: the machine's, or less where a container or a
+batch job (a cgroup's limit, v1 or v2: Docker, Kubernetes, Slurm) or ``ulimit -v`` sets less. A
+guard that compared with the machine's memory let a job ask for more than its container holds,
+to be ended by the OOM killer without a word (a review, 2026-12-04)."""
+from __future__ import annotations
+
+import os
+import resource
+from pathlib import Path
+
+CGROUP, OWN = Path("/sys/fs/cgroup"), Path("/proc/self/cgroup")    # the mount; this process's cgroups
+V2, V1 = ("memory.max", "memory.current"), ("memory.limit_in_bytes", "memory.usage_in_bytes")
+
+
+def _number(path: Path) -> float | None:
+    """A cgroup file's number [bytes]: inf for "max" or v1's page-rounded 2^63; None where absent."""
+    try:
+        text = path.read_text().split()[0]
+    except (OSError, IndexError):
+        return None
+    value = float("inf") if text == "max" else float(text) if text.isdecimal() else None
+    return float("inf") if value is not None and value >= 2 ** 62 else value
+
+
+def _limit_files() -> list[tuple[Path, Path]]:
+    """(limit, usage) files of the cgroups that may bound this process: the mount's root (a
+    container's own cgroup is its root) and the process's own (/proc/self/cgroup), v2 and v1."""
+    folders = [(CGROUP, V2), (CGROUP / "memory", V1)]
+    try:
+        lines = OWN.read_text().splitlines()
+    except OSError:
+        lines = []
+    for line in lines:
+        _, controllers, where = line.split(":", 2)
+        if controllers == "":
+            folders.append((CGROUP / where.lstrip("/"), V2))
+        elif "memory" in controllers.split(","):
+            folders.append((CGROUP / "memory" / where.lstrip("/"), V1))
+    return [(folder / cap, folder / used) for folder, (cap, used) in folders]
+
+
+def _cgroup_limits() -> tuple[float, float]:
+    """(the lowest cgroup memory limit, the least room under one: its limit less its usage)
+    [bytes]; (inf, inf) where none is set."""
+    limit = room = float("inf")
+    for cap_file, used_file in _limit_files():
+        if (cap := _number(cap_file)) is not None and cap < float("inf"):
+            limit, room = min(limit, cap), min(room, cap - (_number(used_file) or 0.0))
+    return limit, room
+
+
+def memory_limit() -> float:
+    """The most memory this process may hold [bytes]: the least of the machine's, a cgroup's limit
+    and ``ulimit -v`` (inf where none can be read)."""
+    try:
+        machine = float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+    except (ValueError, OSError, AttributeError):
+        machine = float("inf")
+    soft = resource.getrlimit(resource.RLIMIT_AS)[0]
+    return min(machine, _cgroup_limits()[0], float("inf") if soft == resource.RLIM_INFINITY else float(soft))
+
+
+def memory_available() -> float | None:
+    """Memory this process can take now without swapping or the OOM killer [bytes]: Linux's
+    MemAvailable (/proc/meminfo), or a cgroup's limit less its usage where that is less; None
+    where MemAvailable cannot be read (not Linux)."""
+    try:
+        with open("/proc/meminfo") as f:
+            free = next(float(line.split()[1]) * 1024 for line in f if line.startswith("MemAvailable:"))
+    except (OSError, StopIteration, ValueError, IndexError):
+        return None
+    return min(free, _cgroup_limits()[1])

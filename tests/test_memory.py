@@ -1,0 +1,49 @@
+"""The memory a process may use: the machine's, bounded by a container's or a job's cgroup (v1,
+v2) and by ``ulimit -v``, read from fake cgroup folders."""
+import os
+import resource
+
+import pytest
+
+from multiscale import memory
+
+MACHINE = float(os.sysconf("SC_PHYS_PAGES") * os.sysconf("SC_PAGE_SIZE"))
+GIB = 2.0 ** 30
+
+
+@pytest.fixture
+def cgroup(tmp_path, monkeypatch):
+    """A cgroup mount in tmp_path/sys, this process in /job.slice/step (v2) and /docker/abc (v1)."""
+    (tmp_path / "cgroup").write_text("4:memory:/docker/abc\n3:cpu,cpuacct:/elsewhere\n0::/job.slice/step\n")
+    monkeypatch.setattr(memory, "CGROUP", tmp_path / "sys")
+    monkeypatch.setattr(memory, "OWN", tmp_path / "cgroup")
+    return tmp_path / "sys"
+
+
+def write(folder, **files):
+    folder.mkdir(parents=True, exist_ok=True)
+    for name, text in files.items():
+        (folder / name.replace("_", ".", 1)).write_text(f"{text}\n")
+
+
+def test_without_limits_the_machine_is_the_limit(cgroup):
+    write(cgroup, memory_max="max")
+    write(cgroup / "memory", memory_limit_in_bytes=9223372036854771712)      # v1's "no limit"
+    assert memory.memory_limit() == MACHINE
+
+
+def test_a_jobs_cgroup_v2_limit_bounds_the_memory_and_its_usage_the_room_left(cgroup):
+    write(cgroup / "job.slice" / "step", memory_max=int(GIB), memory_current=int(0.25 * GIB))
+    assert memory.memory_limit() == min(MACHINE, GIB)
+    assert memory.memory_available() <= 0.75 * GIB
+
+
+def test_a_containers_cgroup_v1_limit_bounds_the_memory(cgroup):
+    write(cgroup / "memory" / "docker" / "abc", memory_limit_in_bytes=int(2 * GIB),
+          memory_usage_in_bytes=int(1.5 * GIB))
+    assert memory.memory_limit() == min(MACHINE, 2 * GIB) and memory.memory_available() <= 0.5 * GIB
+
+
+def test_ulimit_v_bounds_the_memory(cgroup, monkeypatch):
+    monkeypatch.setattr(resource, "getrlimit", lambda kind: (int(3 * GIB), resource.RLIM_INFINITY))
+    assert memory.memory_limit() == min(MACHINE, 3 * GIB)
