@@ -94,8 +94,7 @@ for name, surface in surfaces.items():
     for label, c in curves.items():
         print(f"  {label:30s} {c.wall_time:7.3f} s   F(top) = {c.force[-1]:8.3f} N   "
               f"A/A0(top) = {c.area_fraction[-1]:.4f}")
-    F_bem = bem.mean_pressure * np.prod(surface.size)
-    print(f"  {'FFT-BEM (isolated patch)':30s} {t_bem:7.3f} s   F(top) = {F_bem[-1]:8.3f} N   "
+    print(f"  {'FFT-BEM (isolated patch)':30s} {t_bem:7.3f} s   F(top) = {bem.force[-1]:8.3f} N   "
           f"A/A0(top) = {bem.area_fraction[-1]:.4f}")
 
 # ## Figure: one row per set, the four panels of Figs. 1.7 / 1.9 and the wall times

@@ -236,7 +236,7 @@ print(f"done in {time.perf_counter() - start:.1f} s")
 # rad/s and 4.5 ms: "almost 95 % of heat goes to S1" (§6.4.2.1, Fig. 6.24) and a maximal temperature
 # of 451 °C (Figs. 6.28–6.29). The heat generated is the friction power, Φ = μ F V with F = p̄ A0 and
 # V = ω R at the patch centre (up to the spread of ω r over the 1 mm patch).
-friction_power = MU * contact.mean_pressure * np.prod(surface.size) * 100.0 * np.hypot(*CENTRE)
+friction_power = MU * contact.force * 100.0 * np.hypot(*CENTRE)
 print(f"omega = 100 rad/s, 4.5 ms: p1 = {hot.partition_1[-1]:.3f} (thesis §6.4.2.1: about 0.95), T_max = "
       f"{max(hot.max_temperature_1[-1], hot.max_temperature_2[-1]):.0f} K (thesis: 451), heat {hot.heat[-1]:.3f} W "
       f"(mu p A0 omega R = {friction_power:.3f} W); A/A0 = {contact.area_fraction * 100:.2f} % (thesis: 1.48 %)")

@@ -70,6 +70,8 @@ class ContactResult:
     contact: np.ndarray        #: bool, p > 0
     area_fraction: np.ndarray  #: real contact area / nominal area
     mean_pressure: np.ndarray  #: Pa, total force / nominal area
+    force: np.ndarray          #: N, total normal force on the patch: mean_pressure x its nominal area ny nx dx dy
+    area: np.ndarray           #: m², real contact area: area_fraction x the nominal area
     approach: np.ndarray       #: m, rigid approach delta of the flat from first touch of the highest point;
     #                            it holds the mean elastic displacement, so it depends on the patch: of an isolated
     #                            patch, the indentation of the whole loaded patch (143.5 of the 290 nm of
@@ -217,8 +219,8 @@ class ContactSolver:
         0), the others solved as asked (with their hardness and initial pressure)."""
         zero = load == 0
         flat = np.zeros(h.shape)
-        result = ContactResult(flat, flat.copy(), z.copy(), flat != 0, np.zeros(load.shape),
-                               np.zeros(load.shape), np.zeros(load.shape), z.mean(axis=(-2, -1)).reshape(load.shape),
+        result = ContactResult(flat, flat.copy(), z.copy(), flat != 0, *(np.zeros(load.shape) for _ in range(5)),
+                               z.mean(axis=(-2, -1)).reshape(load.shape),
                                np.zeros(load.shape), flat.copy(), np.zeros(load.shape, dtype=int),
                                np.zeros(load.shape), np.ones(load.shape, dtype=bool))
         if zero.all():
@@ -331,12 +333,13 @@ class ContactSolver:
             part(0)
         length = max(len(h) for h in histories)
         history = [max(h[k] for h in histories if k < len(h)) for k in range(length)]
-        cells = batch + grid
+        cells, nominal = batch + grid, self.shape[0] * self.shape[1] * self.operator.dx * self.operator.dy
         result = ContactResult(
             pressure=p.reshape(cells), displacement=u.reshape(cells),
             gap=gap.reshape(cells) if fields else None, contact=(p > 0).reshape(cells) if fields else None,
             plastic=(np.zeros(cells) if plastic is None else plastic.reshape(cells)) if fields else None,
-            approach=out.pop("d").reshape(batch), history=history, **{k: v.reshape(batch) for k, v in out.items()})
+            approach=out.pop("d").reshape(batch), history=history, force=out["mean_pressure"].reshape(batch) * nominal,
+            area=out["area_fraction"].reshape(batch) * nominal, **{k: v.reshape(batch) for k, v in out.items()})
         if not np.all(result.converged) and not partial:
             raise ContactConvergenceError(
                 f"contact solver did not converge in {max_iter} iterations "
