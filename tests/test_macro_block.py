@@ -45,6 +45,15 @@ def test_a_solve_that_reaches_its_round_off_floor_stops_there(tm):
     assert np.abs(m.contact.facet_gap() / (-p0 / K_N) - 1).max() < 1e-6
 
 
+def test_a_newton_failure_at_absurd_friction_names_the_friction(tm):
+    """mu = 100: the block's sliding equilibrium is not found; the failure says why it may not
+    exist (a squeal run at mu = 5 failed after 30 iterations with no word of it: a user trial)."""
+    m = Mechanics(tm, MATERIALS, stiffness=K_N, friction=100.0, speed=1.0, load_kind="pressure", prefix="block_mu_")
+    with pytest.raises(ConvergenceError, match=r"the friction coefficient reaches 100, far above a dry sliding "
+                                               r"pair's .* a sliding equilibrium may not exist"):
+        m.ramp(1e6, 2)
+
+
 def test_per_facet_stiffness_field_roundtrip_and_effect(tm):
     iface = tm.interface
     assert iface.n_facets == len(iface.areas) and iface.areas.sum() == pytest.approx(1e-4, rel=1e-12)

@@ -94,6 +94,10 @@ FACTOR_PRECISION = "single"
 # beyond one per solve reach this count, not by measured times, so serial runs repeat bit for bit
 # (docs/architecture.md §8: the count the runs there were compared with).
 REPEATABLE_REFRESH = 20
+# A friction coefficient beyond which a failed Newton names it: dry sliding pairs stay below ~1 (brake
+# pads 0.3-0.6); far above, a sliding equilibrium may not exist (a squeal run at mu = 5 failed with no
+# word of it: a user trial; the block of the tests fails at mu = 100, solves at 20).
+HIGH_FRICTION = 1.0
 
 
 @dataclass
@@ -439,6 +443,12 @@ class Mechanics:
             if first is not result:       # the retries start afresh: the first attempt says more
                 cause += (f"; the first of its attempts: SNES reason {first.reason}, {first.iterations} iterations, "
                           f"residuals {['%.3g' % r for r in first.residuals[-4:]]}")
+            mu = self.tm.comm.allreduce(float(np.max(self.contact.friction.x.array, initial=0.0)), op=MPI.MAX)
+            if mu > HIGH_FRICTION:
+                cause += (f"; the friction coefficient reaches {mu:.3g}, far above a dry sliding pair's (brake pads "
+                          "0.3-0.6): with friction this high a sliding equilibrium may not exist (friction turns "
+                          "the tangent unstable, a static divergence: a squeal analysis names it as unstable modes "
+                          "at 0 Hz); check the friction given (loading.friction, the interfaces' own)")
             code = 0 if pc is None else mumps.status(pc)
             if code in mumps.MEMORY_ERRORS:      # (it gave the rigid-body advice: a user trial)
                 cause += ("; the factors did not fit in memory: a coarser mesh (geometry.mesh_size), or more "
