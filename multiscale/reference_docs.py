@@ -16,7 +16,7 @@ from multiscale.outputs import WRITES, array_name
 from multiscale.schema import (Curve, Either, Integer, ListOf, Named, Quantity, Section, TableOr, Tables, fields_of,
                                show)
 from multiscale.scene import EFFECTS, OUTPUT_FIELDS, Scene
-from multiscale.scene_geometry import MAX_CELLS_TEXT, FileGeometry, GeometrySection, parameter_kind
+from multiscale.scene_geometry import BUILDER_AXIS_TEXT, MAX_CELLS_TEXT, FileGeometry, GeometrySection, parameter_kind
 from multiscale.scene_sections import InterfaceSettings
 
 OWN_TABLES = ("Sub-tables ``[interfaces.<name>.roughness]`` and ``[interfaces.<name>.micro]`` take the keys of "
@@ -124,7 +124,8 @@ def _geometry() -> list[str]:
     section = GeometrySection()
     rows = [("``geometry.builder``", _cell(section.builders.describe()), " ", "required (or file)", " ", "any"),
             ("``geometry.max_cells``", _cell(f"{Integer(ge=1).describe()}: {MAX_CELLS_TEXT}"), "-", show(MAX_CELLS),
-             " ", "any")]
+             " ", "any"),
+            ("``geometry.axis``", _cell(f"[x, y, z]: {BUILDER_AXIS_TEXT}"), "-", " ", " ", "any")]
     lines = ["[geometry]", "-" * 10, "", _paragraph(" ".join(GeometrySection.__doc__.split())), ""] + _list_table(rows)
     for name in section.builders.options:
         module = builder(name)

@@ -232,6 +232,8 @@ class Geometry:
         return tuple(self.spec.faces) + tuple(f"free:{n}" for n in dict.fromkeys(self.bodies + self.regions))
 
 
+BUILDER_AXIS_TEXT = ("a rotating builder's axis (as it is) or its opposite, which turns the body the other way "
+                     "(a brake's reverse run); default the builder's")
 MAX_CELLS_TEXT = ("a mesh estimated larger (trial meshes before meshing) is refused; multiscale run --max-cells "
                   "overrides it")
 
@@ -256,7 +258,8 @@ class GeometrySection(Section):
 
     def reference(self, path) -> list[str]:
         lines = [f"  {'builder':<20}  {self.builders.describe()}  [or file]",
-                 f"  {'max_cells':<20}  integer >= 1, default {MAX_CELLS}: {MAX_CELLS_TEXT}"]
+                 f"  {'max_cells':<20}  integer >= 1, default {MAX_CELLS}: {MAX_CELLS_TEXT}",
+                 f"  {'axis':<20}  [x, y, z]: {BUILDER_AXIS_TEXT}"]
         for name in self.builders.options:
             module = builder(name)
             lines.append(f"  builder = \"{name}\" parameters (SI defaults; 0 = the builder's fallback):")
@@ -286,7 +289,8 @@ class GeometrySection(Section):
             ctx.problems.append(f"{path}.builder = {show(raw['builder'])}: {exc}")
             return None
         before = len(ctx.problems)
-        given = {k: v for k, v in raw.items() if k != "builder"}
+        given = {k: v for k, v in raw.items() if k not in ("builder", "axis")}
+        axis = parse(_DIRECTION, raw["axis"], f"{path}.axis", ctx) if "axis" in raw else None
         unknown_keys(given, module.DEFAULTS, path, ctx, f'parameter of builder "{name}"')
         params = {}
         for param, value in given.items():
@@ -298,7 +302,29 @@ class GeometrySection(Section):
                 params[param] = parse(parser, value, f"{path}.{param}", ctx)
         if len(ctx.problems) > before:
             return None
-        return self._describe(name, module, FrozenMap(params), params, ctx)
+        geometry = self._describe(name, module, FrozenMap(params), params, ctx)
+        return geometry if geometry is None or axis is None else self._turned(geometry, axis, path, ctx)
+
+    @staticmethod
+    def _turned(geometry, axis, path, ctx):
+        """A builder's geometry whose body turns about ``axis``: the builder's axis (as it is) or its
+        opposite (the other sense of rotation: a brake's forward and reverse runs); any other axis,
+        or a sliding body, is a problem."""
+        motion = geometry.spec.motion
+        if not isinstance(motion, Rotation):
+            ctx.problems.append(f'{path}.axis: not used by builder "{geometry.builder}", whose body slides')
+            return None
+        own = tuple(float(a) for a in motion.axis)
+        unit = tuple(float(a) / sum(b * b for b in axis) ** 0.5 for a in axis)
+        if max(abs(a - b) for a, b in zip(unit, own)) < 1e-9:
+            return geometry
+        if max(abs(a + b) for a, b in zip(unit, own)) < 1e-9:
+            spec = dataclasses.replace(geometry.spec, motion=dataclasses.replace(motion, axis=tuple(-a for a in own)))
+            return dataclasses.replace(geometry, spec=spec)
+        ctx.problems.append(f'{path}.axis = {list(axis)}: builder "{geometry.builder}" turns its body about '
+                            f"{list(own)}: give that axis or its opposite {[-a or 0.0 for a in own]} (the other "
+                            "sense of rotation)")
+        return None
 
     def _read_file(self, raw, path, ctx):
         before = len(ctx.problems)

@@ -38,7 +38,8 @@ _FRICTION = Quantity("dimensionless", ge=0, plausible=(0.0, 2.0))
 _FADE = Curve(_TEMPERATURE, _FRICTION, "temperature", "mu", min_rows=2)     # mu against the interface temperature
 ROUGHNESS = Quantity("length", gt=0, plausible=(1e-10, 1e-3))            # RMS height
 _CONVECTION = Quantity("conductance", ge=0, plausible=(0.0, 1e4))         # still air to boiling water
-_ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0))  # up to ~24 000 rpm
+_ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0),   # up to ~24 000 rpm
+                          outside="a speed about geometry.axis; to turn the other way, give the opposite axis")
 _WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # per frictional work (Eq. 3.10)
 _HARDNESS = Quantity("pressure", gt=0, plausible=(1e6, 1e11))            # soft polymer to diamond
 _WITH_RMS = "needed with rms (a generated surface)"

@@ -30,6 +30,11 @@ def _toml(value) -> str:
     return f"{value:g}" if isinstance(value, float) else json.dumps(value)
 
 
+def _axis(axis) -> str:
+    """An axis as given: "[0, 0, -1]"."""
+    return "[" + ", ".join(f"{float(a) + 0.0:g}" for a in axis) + "]"
+
+
 def summary(scene: Scene) -> list[str]:
     """A few lines: bodies, effects, loading, time, output — what a run would compute."""
     g, ld, t, o = scene.geometry, scene.loading, scene.time, scene.output
@@ -40,7 +45,9 @@ def summary(scene: Scene) -> list[str]:
     source = f"file {g.params.file.name}" if g.builder == "file" else g.builder
     lines = [f"scene {scene.name}" + (f" ({scene.source})" if scene.source else ""),
              *([f"  set       {', '.join(f'{k} = {_toml(v)}' for k, v in scene.overrides)}"] if scene.overrides else []),
-             f"  geometry  {source}, {g.motion} of {g.bodies[1]}" + (f"; {sizes}" if sizes else ""),
+             f"  geometry  {source}, {g.motion} of {g.bodies[1]}" + (f" about {_axis(g.spec.motion.axis)}"
+                                                                  if g.motion == "rotation" else "")
+             + (f"; {sizes}" if sizes else ""),
              *(f"            {line}" for line in g.spec.report),
              f"  bodies    {bodies}",
              *(f"  material  {name}: {_material(m)}" for name, m in scene.materials.items()),

@@ -104,11 +104,11 @@ def _a(words: str) -> str:
 class Quantity:
     """A physical quantity of a units.KINDS kind, converted to SI, with an optional range (outside
     it: a problem) and an optional ``plausible`` range (lo, hi) in SI (outside it: a warning, e.g. a
-    load of 1e9 N on a pin; the value is still used)."""
+    load of 1e9 N on a pin; the value is still used). ``outside``: said with a value out of range."""
 
-    def __init__(self, kind: str, *, gt=None, ge=None, lt=None, le=None, plausible=None):
+    def __init__(self, kind: str, *, gt=None, ge=None, lt=None, le=None, plausible=None, outside: str = ""):
         self.name, self.kind, self.gt, self.ge, self.lt, self.le = kind, KINDS[kind], gt, ge, lt, le
-        self.plausible = plausible
+        self.plausible, self.outside = plausible, outside
 
     def _range(self) -> str:
         unit = f" {self.kind.si}" if self.kind.si else ""
@@ -145,7 +145,7 @@ class Quantity:
               and (self.lt is None or v < self.lt) and (self.le is None or v <= self.le))
         if not ok:
             shown = "" if not isinstance(raw, str) else f" (got {v:g} {self.kind.si})".replace(" )", ")")
-            raise Bad(f"must be {self._range()}{shown}")
+            raise Bad(f"must be {self._range()}{shown}{': ' * bool(self.outside)}{self.outside}")
         if self.plausible is not None and not self.plausible[0] <= v <= self.plausible[1]:
             unit = f" {self.kind.si}" if self.kind.si else ""
             ctx.implausible.append(f"{v:g}{unit} is outside the plausible range {self.plausible[0]:g} to "
