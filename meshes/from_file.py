@@ -39,7 +39,8 @@ from meshes import cad_checks, cad_units
 from meshes.cad_bodies import assign_bodies, curve_box
 from meshes.foreign import refuse_foreign
 from multiscale.errors import InputError, InputErrors
-from multiscale.geometry import FIXED_BODY, BodySpec, GeometrySpec, Region, Rotation, add_group, plane_extent
+from multiscale.geometry import (FIXED_BODY, BodySpec, GeometrySpec, Region, Rotation, add_group, plane_extent,
+                                 start_gmsh)
 
 NAME = "file"
 DEFAULTS: dict = {}          # no numeric parameters: [geometry] of the scene is a FileGeometry
@@ -97,8 +98,7 @@ def _model():
     import gmsh   # only when a file is read: scenes with a builder never load gmsh
     started = not gmsh.isInitialized()
     if started:
-        gmsh.initialize(interruptible=False)
-        gmsh.option.setNumber("General.Terminal", 0)
+        start_gmsh()
     previous = gmsh.model.getCurrent() if not started else None
     gmsh.model.add("multiscale_file_inspection")
     try:

@@ -19,7 +19,7 @@ from pathlib import Path
 from multiscale import __version__
 from multiscale.errors import InputError, MultiscaleError, OutputError, SceneError
 from multiscale.geometry import too_many_cells
-from multiscale.io import CtrlCWatch, abort, ended_together
+from multiscale.io import CtrlCWatch, Outliving, abort, ended_together
 from multiscale.memory import memory_available
 from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.reading import COMMAND_LINE, TopographyWarning, formats, read_topography
@@ -106,6 +106,7 @@ LAUNCHERS = {"Open MPI": ("OMPI_COMM_WORLD_SIZE", "OMPI_COMM_WORLD_RANK"),
 
 
 SERIAL = ("info", "check", "surface")    # commands of one process: under a launcher its rank 0 alone runs them
+LONG = ("run", "study")     # commands whose results outlive their console (``io.Outliving``)
 
 
 def launched_rank(environ=None) -> int:
@@ -449,7 +450,11 @@ def main(argv: list[str] | None = None) -> int:
     if args.command in SERIAL and launched_rank() > 0:      # `mpiexec -n 4 multiscale check`: said once, not 4 times
         return 0
     try:
-        return int(args.func(args) or 0)
+        with contextlib.ExitStack() as steady:
+            if args.command in LONG:
+                steady.enter_context(contextlib.redirect_stdout(Outliving(sys.stdout)))
+                steady.enter_context(contextlib.redirect_stderr(Outliving(sys.stderr)))
+            return int(args.func(args) or 0)
     except SceneError as exc:
         for line in exc.problems:
             print(f"error: {line}", file=sys.stderr)

@@ -23,6 +23,8 @@ into body 0; the gap g_n = g_0 + (u_0 − u_1)·n is positive when open (thesis 
 """
 from __future__ import annotations
 
+import signal
+import threading
 from dataclasses import dataclass, field
 from functools import cache
 from importlib import import_module
@@ -269,12 +271,23 @@ class CellEstimate:
         return self.factor == 1.0
 
 
+def start_gmsh() -> None:
+    """``gmsh.initialize``, quiet, without its Ctrl-C handler, and with Python's SIGPIPE kept:
+    gmsh's initialisation sets it to the default, which killed a run piped into ``head`` or
+    ``less`` wherever it was (status 141, its files half written) instead of the BrokenPipeError
+    that ``io.Outliving`` takes."""
+    import gmsh   # local: this module stays importable without gmsh's library (scene reading)
+    gmsh.initialize(interruptible=False)
+    if threading.current_thread() is threading.main_thread() and hasattr(signal, "SIGPIPE"):
+        signal.signal(signal.SIGPIPE, signal.getsignal(signal.SIGPIPE))    # Python's own, as before
+    gmsh.option.setNumber("General.Terminal", 0)
+
+
 def gmsh_session(module: ModuleType) -> None:
     """Start gmsh for a run of the builder ``module`` on the calling rank: quiet, one thread (the
     same mesh on every run), an empty model; the caller ends it with ``gmsh.finalize()``."""
-    import gmsh   # local: this module stays importable without gmsh's library (scene reading)
-    gmsh.initialize(interruptible=False)
-    gmsh.option.setNumber("General.Terminal", 0)
+    import gmsh   # local: as in start_gmsh
+    start_gmsh()
     gmsh.option.setNumber("General.NumThreads", 1)
     gmsh.model.add(f"multiscale_{getattr(module, 'NAME', module.__name__)}")
 

@@ -149,6 +149,42 @@ def counted(n: int, noun: str) -> str:
     return f"{n} {noun}{'s' * (n != 1)}"
 
 
+class Outliving:
+    """A text stream (stdout, stderr) that outlives its reader: the first write or flush into a
+    closed pipe (BrokenPipeError) sends it, and its file descriptor, to /dev/null, and the run
+    goes on to write its results. A run piped into ``head`` or ``less`` was aborted by PETSc's
+    SIGPIPE handler, its files half written; ended alone, rank 0 would leave the others waiting."""
+
+    def __init__(self, stream):
+        self.stream = stream
+
+    def write(self, text: str) -> int:
+        try:
+            return self.stream.write(text)
+        except BrokenPipeError:
+            self._silence()
+            return len(text)
+
+    def flush(self) -> None:
+        try:
+            self.stream.flush()
+        except BrokenPipeError:
+            self._silence()
+
+    def _silence(self) -> None:
+        void = os.open(os.devnull, os.O_WRONLY)
+        try:
+            os.dup2(void, self.stream.fileno())     # its unflushed buffer, and C's writes, go there too
+        except (OSError, ValueError):               # (a stream without a descriptor)
+            pass
+        finally:
+            os.close(void)
+        self.stream = open(os.devnull, "w")
+
+    def __getattr__(self, name):
+        return getattr(self.stream, name)
+
+
 class StepStop:
     """Ctrl-C in a loop of steps (a context manager). The first SIGINT asks the loop to stop after
     its current step, when ``requested()`` (every rank together: one stops, all stop, at the same

@@ -137,6 +137,32 @@ def test_output_into_a_closed_pipe_ends_quietly(tmp_path, monkeypatch, capsys):
     assert "Traceback" not in capsys.readouterr().err
 
 
+def test_a_run_into_a_closed_pipe_goes_on_to_its_results(tmp_path, monkeypatch, capsys):
+    """`multiscale run SCENE | head`: the run went on after head left until its next line, where
+    gmsh's SIGPIPE (set to the default by its initialisation) killed it, no result written (PETSc's
+    handler aborted it otherwise). Now its console goes to /dev/null and the run ends as it would
+    (on the code before, this test kills pytest with status 141)."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+    folder = tmp_path / "out"
+    path = _write(tmp_path, BLOCK.replace("../results/block_on_flat", str(folder)))
+    read, write = os.pipe()
+    os.close(read)
+    saved = os.dup(1)
+    stream = open(os.dup(write), "w", buffering=1)
+    monkeypatch.setattr(sys, "stdout", stream)
+    try:
+        os.dup2(write, 1)
+        assert main(["run", path]) == 0
+    finally:
+        os.dup2(saved, 1)
+        os.close(saved)
+        os.close(write)
+        with contextlib.suppress(OSError):
+            stream.close()
+    assert json.loads((folder / "provenance.json").read_text())["status"] == "finished"
+    assert (folder / "interface.h5").is_file() and "Traceback" not in capsys.readouterr().err
+
+
 def test_check_good_scene_prints_summary(tmp_path, capsys):
     path = _write(tmp_path, BLOCK)
     assert main(["check", path]) == 0

@@ -23,6 +23,8 @@ except ImportError:  # pragma: no cover  (conda-forge FEniCSx)
     pass
 
 import os  # noqa: E402
+import signal  # noqa: E402
+import threading  # noqa: E402
 
 from mpi4py import MPI  # noqa: E402
 from threadpoolctl import threadpool_limits  # noqa: E402
@@ -34,6 +36,13 @@ if MPI.COMM_WORLD.size > 1 and not {"OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "
     threadpool_limits(1, user_api="blas")
 
 from petsc4py import PETSc  # noqa: E402
+
+# PETSc's initialisation takes SIGPIPE, which Python ignores (a write into a closed pipe raises
+# BrokenPipeError, on which the command line ends quietly with status 141): a run piped into
+# ``head``, or into a ``tee`` that died, was aborted by PETSc ("Caught signal number 13 Broken
+# Pipe", MPI_Abort) wherever it was, its files half written. Python's handling is restored.
+if threading.current_thread() is threading.main_thread() and hasattr(signal, "SIGPIPE"):
+    signal.signal(signal.SIGPIPE, signal.SIG_IGN)
 
 # PETSc (3.25; option -vec_mdot_use_gemv, on by default) computes VecMDot, the orthogonalisation
 # of (F)GMRES, by BLAS gemv over runs of vectors that happen to lie at one stride in memory and by
