@@ -30,7 +30,7 @@ from multiscale.outputs import summary as plan_summary
 from multiscale.provenance import versions
 from multiscale.scene import load
 from multiscale.scene_plain import pixel_problem, plain
-from multiscale.scene_summary import cells_line, reference, summary
+from multiscale.scene_summary import cells_line, memory_line, reference, summary
 from multiscale.units import UnitError, to_si
 
 DESCRIPTION = """Multi-scale thermo-mechanical simulation of frictional sliding contacts (disc brakes,
@@ -88,7 +88,12 @@ def _check(args) -> int:
             continue
         if args.cells:
             line, estimate = cells_line(scene)
-            print(line)
+            need, free = memory_line(scene, estimate.cells), memory_available()
+            print(f"{line}\n{need[0]}")
+            if free is not None and need[1] > free:    # (a ~1M-dof squeal was "OK": a user trial)
+                squeal = ', stability.method = "subspace"' if scene.has("stability") else ""
+                print(f"warning: more than the {free / 1e9:.2g} GB this machine has free: a coarser mesh{squeal} or "
+                      "ranks on more machines", file=sys.stderr)
             if estimate.cells > scene.geometry.max_cells:      # what run would refuse
                 print(f"error: {too_many_cells(estimate, scene.geometry.max_cells)}", file=sys.stderr)
                 print(f"{path}: 1 problem", file=sys.stderr)

@@ -70,3 +70,20 @@ def memory_available() -> float | None:
     except (OSError, StopIteration, ValueError, IndexError):
         return None
     return min(free, _cgroup_limits()[1])
+
+
+# Peak memory [bytes] of a run with n displacement dofs: ranks x BASE + SCALE (n / 1e5)^(4/3), the
+# factors' fill under nested dissection in 3-D (George 1973; MUMPS orders by METIS). Fitted to the
+# demo car brake run serially (peak RSS by /usr/bin/time -v, 2026-12-05, docs/performance.rst):
+# "squeal", quadratic tetrahedra, the default method, 35k-253k dofs, within 2.1 %; "transient",
+# linear, with heat (about twice as many temperature dofs), 18k-138k dofs, within 2.4 %. Other
+# shapes fill otherwise and larger models are extrapolated: an estimate, not a bound.
+RUN_MEMORY = {"squeal": (0.68e9, 1.97e9), "transient": (0.37e9, 1.55e9)}
+DOFS_PER_CELL = {"squeal": 5.0, "transient": 0.64}     # displacement dofs per tetrahedron (the larger meshes)
+
+
+def run_memory(dofs: float, kind: str, ranks: int = 1) -> float:
+    """The estimated peak memory [bytes] of a run of ``kind`` ("squeal" or "transient") with
+    ``dofs`` displacement dofs on ``ranks`` processes (``RUN_MEMORY``)."""
+    base, scale = RUN_MEMORY[kind]
+    return ranks * base + scale * (dofs / 1e5) ** (4 / 3)

@@ -5,6 +5,7 @@ import json
 import math
 
 from multiscale.geometry import CellEstimate, estimate_cells
+from multiscale.memory import DOFS_PER_CELL, run_memory
 from multiscale.outputs import CHECKPOINT, analysis
 from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
@@ -228,6 +229,16 @@ def cells_line(scene: Scene) -> tuple[str, CellEstimate]:
     verdict = "refused by run" if e.cells > g.max_cells else "within"
     return (f"  mesh      {'' if e.exact else 'about '}{e.cells:,} cells ({how}); {verdict} geometry.max_cells = "
             f"{g.max_cells:,}", e)
+
+
+def memory_line(scene: Scene, cells: int) -> tuple[str, float]:
+    """The estimated peak memory of a serial run of the scene's mesh of ``cells`` cells
+    (``memory.run_memory`` of ``DOFS_PER_CELL`` dofs a cell: an estimate), and that memory [bytes]."""
+    kind = "squeal" if scene.has("stability") else "transient"
+    dofs = DOFS_PER_CELL[kind] * cells
+    need = run_memory(dofs, kind)
+    return (f"  memory    about {need / 1e9:.2g} GB at the peak of a {kind} run (about {dofs:,.0f} displacement dofs; "
+            "an estimate from measured runs, docs/performance.rst)", need)
 
 
 def _rough_or_perfect(scene: Scene, rough: str, perfect: str, value: float) -> str:

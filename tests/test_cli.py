@@ -4,6 +4,7 @@ import contextlib
 import io
 import json
 import os
+import re
 import subprocess
 import sys
 import types
@@ -161,6 +162,20 @@ def test_a_run_into_a_closed_pipe_goes_on_to_its_results(tmp_path, monkeypatch, 
             stream.close()
     assert json.loads((folder / "provenance.json").read_text())["status"] == "finished"
     assert (folder / "interface.h5").is_file() and "Traceback" not in capsys.readouterr().err
+
+
+def test_a_run_larger_than_the_free_memory_is_warned_at_once(tmp_path, monkeypatch, capsys):
+    """Once the model is built, a run whose estimated peak (``memory.run_memory``) exceeds what the
+    machine has free says so before its solves (else the OOM killer ends it without a word)."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+    from multiscale.workflows import model
+    monkeypatch.setattr(model, "memory_available", lambda: 1e6)
+    path = _write(tmp_path, BLOCK.replace("../results/block_on_flat", str(tmp_path / "out")))
+    assert main(["run", path]) == 0
+    err = capsys.readouterr().err
+    assert re.search(r"warning: a transient run of [\d ]+ displacement dofs takes about [\d.]+ GB at its peak \(an "
+                     r"estimate from measured runs, docs/performance.rst\), more than the 0.001 GB this machine has "
+                     r"free: it may be killed", err), err
 
 
 def test_check_good_scene_prints_summary(tmp_path, capsys):

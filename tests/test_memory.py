@@ -47,3 +47,16 @@ def test_a_containers_cgroup_v1_limit_bounds_the_memory(cgroup):
 def test_ulimit_v_bounds_the_memory(cgroup, monkeypatch):
     monkeypatch.setattr(resource, "getrlimit", lambda kind: (int(3 * GIB), resource.RLIM_INFINITY))
     assert memory.memory_limit() == min(MACHINE, 3 * GIB)
+
+
+# Peak RSS of `multiscale run` on demos/car_brake_*.toml, serial, /usr/bin/time -v (2026-12-05;
+# docs/performance.rst): (displacement dofs, GB)
+SQUEAL = [(34_851, 1.162), (48_147, 1.431), (80_910, 2.116), (165_786, 4.609), (252_933, 7.425)]
+TRANSIENT = [(17_571, 0.513), (37_830, 0.792), (64_668, 1.265), (137_874, 2.747)]
+
+
+@pytest.mark.parametrize("kind, measured", [("squeal", SQUEAL), ("transient", TRANSIENT)])
+def test_the_run_memory_estimate_meets_the_measured_peaks(kind, measured):
+    for dofs, gb in measured:
+        assert memory.run_memory(dofs, kind) / 1e9 == pytest.approx(gb, rel=0.03)
+    assert memory.run_memory(1e5, kind, ranks=2) - memory.run_memory(1e5, kind) == memory.RUN_MEMORY[kind][0]

@@ -185,6 +185,24 @@ def test_the_limit_of_a_run_two_ranks(tmp_path):
     assert len(errors) == 1 and re.search(r"geometry.max_cells = 50: the mesh would have \d+ cells \(exact\)", errors[0])
 
 
+def test_check_cells_estimates_the_runs_memory_and_warns_beyond_the_free(tmp_path, capsys, monkeypatch):
+    """check --cells gives the memory a run of the mesh takes (a 3 mm CAD brake of ~1M dofs, some
+    40 GB, was checked "OK" without a word: a user trial), and warns beyond what the machine has
+    free; still OK: an estimate."""
+    from multiscale import cli
+    from multiscale.memory import DOFS_PER_CELL, run_memory
+    from test_faults import SCENE
+    path = tmp_path / "scene.toml"
+    path.write_text(SCENE.format(folder=tmp_path / "out"))
+    monkeypatch.setattr(cli, "memory_available", lambda: 1e6)
+    assert cli.main(["check", str(path), "--cells"]) == 0
+    captured = capsys.readouterr()
+    cells = int(next(x for x in captured.out.splitlines() if x.startswith("  mesh ")).split()[1].replace(",", ""))
+    need = run_memory(DOFS_PER_CELL["transient"] * cells, "transient")
+    assert f"  memory    about {need / 1e9:.2g} GB at the peak of a transient run (about " in captured.out
+    assert "warning: more than the 0.001 GB this machine has free: a coarser mesh or ranks" in captured.err
+
+
 def test_max_cells_in_the_scene_and_on_the_command_line(tmp_path, capsys):
     from multiscale.cli import main
     from multiscale.scene import loads

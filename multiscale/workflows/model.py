@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import sys
 import warnings
 from contextlib import contextmanager
 
@@ -46,6 +47,7 @@ from multiscale.macro.load_faces import load_face_areas, load_face_forces
 from multiscale.macro.mechanics import REPEATABLE_REFRESH, Mechanics
 from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
+from multiscale.memory import memory_available, run_memory
 from multiscale.scene_friction import bare_interfaces, initial_friction, speed_law_guess
 
 
@@ -213,16 +215,33 @@ def build_mesh(scene, comm=MPI.COMM_WORLD) -> two_body.TwoBodyMesh:
     return tm
 
 
-def model_size(tm, mechanics, thermal=None) -> str:
-    """The size of a model, a console line: its cells, displacement dofs and (with heat) temperature
-    dofs (collective: global counts)."""
-    def dofs(functions) -> str:
-        n = sum(f.function_space.dofmap.index_map.size_global * f.function_space.dofmap.index_map_bs
-                for f in functions)
+def say_model_size(tm, mechanics, thermal=None, kind: str = "transient") -> None:
+    """Say the size of a model, a console line: its cells, displacement dofs and (with heat)
+    temperature dofs; and warn (stderr, at once) when a run of ``kind`` ("transient" or "squeal")
+    of that size is estimated to need more memory than the machines of its ranks have free
+    (``memory.run_memory``; a squeal run of ~1M dofs was checked OK and would take ~40 GB: a user
+    trial). Collective: global counts."""
+    def count(functions) -> int:
+        return sum(f.function_space.dofmap.index_map.size_global * f.function_space.dofmap.index_map_bs
+                   for f in functions)
+
+    def spaced(n: int) -> str:
         return f"{n:,}".replace(",", " ")
-    cells = f"{tm.parent.topology.index_map(tm.parent.topology.dim).size_global:,}".replace(",", " ")
-    heat = f", {dofs(thermal.T)} temperature dofs" if thermal is not None else ""
-    return f"  model: {cells} cells, {dofs(mechanics.u)} displacement dofs{heat}"
+    n = count(mechanics.u)
+    heat = f", {spaced(count(thermal.T))} temperature dofs" if thermal is not None else ""
+    reporter().say(f"  model: {spaced(tm.parent.topology.index_map(tm.parent.topology.dim).size_global)} cells, "
+                   f"{spaced(n)} displacement dofs{heat}")
+    comm = tm.comm
+    hosts = comm.allgather(MPI.Get_processor_name())
+    free = comm.allgather(memory_available() if hosts.index(hosts[comm.rank]) == comm.rank else 0.0)
+    need, have = run_memory(n, kind, comm.size), (None if None in free else sum(free))
+    if comm.rank == 0 and have is not None and need > have:
+        machines = "this machine" if len(set(hosts)) == 1 else f"the {len(set(hosts))} machines of its ranks"
+        print(f"warning: a {kind} run of {spaced(n)} displacement dofs takes about {need / 1e9:.3g} GB at its peak (an "
+              f"estimate from measured runs, docs/performance.rst), more than the {have / 1e9:.3g} GB {machines} "
+              "has free: it may be killed without a word by the out-of-memory killer; a coarser mesh "
+              "(geometry.mesh_size)" + (', stability.method = "subspace"' if kind == "squeal" else "")
+              + " or ranks on more machines", file=sys.stderr, flush=True)
 
 
 def build_mechanics(scene, tm, *, law=None, temperatures=None, degree: int = 1,
