@@ -80,6 +80,7 @@ class Found:
     normals: dict = field(default_factory=dict)      # name -> unit normal (fixed towards rotating), None if not planar
     extents: dict = field(default_factory=dict)      # planar interface -> size (u, v) [m] in its plane
     sizes: dict = field(default_factory=dict)        # a .msh's interface -> mean edge of its triangles [m]
+    cell_size: float | None = None                   # a .msh's: its bodies' largest mean tetrahedron edge [m]
     surfaces: dict = field(default_factory=dict)     # name -> face tags
     extent: float = 0.0                              # m, largest side of the bounding box
     loose: list = field(default_factory=list)        # warnings: fixed bodies that touch no interface, thin ones
@@ -252,6 +253,8 @@ def _load(model, g) -> Found:
                   extent=extent, size_factor=_script_factor(model), unit=unit)
     _interfaces(model, g, found, occ)
     _surfaces(model, g, found, occ)
+    if g.kind == "mesh":
+        found.cell_size = max(_mean_edge(_simplices(model, 3, tags)) for tags in bodies.values())
     if occ and g.mesh_size is not None:
         found.loose += cad_checks.thin_bodies(model, g, found.bodies, found.volume, found.pairs)
     if occ:
@@ -344,8 +347,7 @@ def _interfaces(model, g, found: Found, occ: bool) -> None:
         if found.normals[name] is not None:
             found.extents[name] = plane_extent(found.normals[name], *_box(model, faces, g.kind == "mesh"))
         if g.kind == "mesh":
-            tri = _nodes(model, faces)
-            found.sizes[name] = float(np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2).mean())
+            found.sizes[name] = _mean_edge(_simplices(model, 2, faces))
     if not found.interfaces:
         raise InputError("geometry.rotating", g.rotating, f"no fixed body of {g.file.name} touches it: no contact "
                          "interface (bodies must share a face; give [geometry.interfaces] to see the gaps)")
@@ -377,15 +379,24 @@ def _gap(model, a: list[int], b: list[int], occ: bool) -> str:
     return f"{d:.4g} m" if d > 0 else "0 m: they overlap or touch at an edge, not along a shared face"
 
 
-def _nodes(model, faces: list[int]) -> tuple[np.ndarray, np.ndarray]:
-    """Triangles (n, 3, 3) [m] of the meshed faces (a .msh)."""
-    tris = []
-    for f in faces:
-        tags, coords, _ = model.mesh.getNodes(2, f, includeBoundary=True)
+def _simplices(model, dim: int, entities: list[int]) -> np.ndarray:
+    """The corners (n, dim + 1, 3) [m] of the meshed entities' triangles (dim 2) or tetrahedra
+    (dim 3) (a .msh; a quadratic element's corners only)."""
+    out = []
+    for e in entities:
+        tags, coords, _ = model.mesh.getNodes(dim, e, includeBoundary=True)
         x = dict(zip(tags, np.reshape(coords, (-1, 3))))
-        for etype, conn in zip(*model.mesh.getElements(2, f)[::2]):
-            tris.append(np.array([x[n] for n in conn]).reshape(-1, 3, 3)[:, :3])
-    return np.concatenate(tris)
+        for etype, conn in zip(*model.mesh.getElements(dim, e)[::2]):
+            per = model.mesh.getElementProperties(etype)[3]
+            out.append(np.array([x[n] for n in conn]).reshape(-1, per, 3)[:, :dim + 1])
+    return np.concatenate(out)
+
+
+def _mean_edge(simplices: np.ndarray) -> float:
+    """Mean edge length [m] of ``simplices`` (n, k, 3)."""
+    k = simplices.shape[1]
+    return float(np.mean([np.linalg.norm(simplices[:, i] - simplices[:, j], axis=1)
+                          for i in range(k) for j in range(i + 1, k)]))
 
 
 def _box(model, faces: list[int], mesh: bool) -> tuple[np.ndarray, np.ndarray]:
@@ -393,7 +404,7 @@ def _box(model, faces: list[int], mesh: bool) -> tuple[np.ndarray, np.ndarray]:
     run takes), else of their boundary curves (``curve_box``: a flat face's box is its boundary's;
     gmsh's boxes of OpenCASCADE shapes are larger by its tolerance, 1e-7 m)."""
     if mesh:
-        x = _nodes(model, faces).reshape(-1, 3)
+        x = _simplices(model, 2, faces).reshape(-1, 3)
         return x.min(axis=0), x.max(axis=0)
     return curve_box(model, [c for _, c in model.getBoundary([(2, f) for f in faces], combined=False, oriented=False)])
 
@@ -438,7 +449,7 @@ def _plane(model, faces: list[int], fixed: list[int], occ: bool):
             all(abs((p - points[0]) @ n) < 1e-9 * max(1.0, np.abs(points[0]).max()) for p in points)
         centre = np.asarray(model.occ.getCenterOfMass(3, fixed[0]))
     else:
-        tri = _nodes(model, faces)
+        tri = _simplices(model, 2, faces)
         cross = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
         area = 0.5 * np.linalg.norm(cross, axis=1).sum()
         pts = tri.reshape(-1, 3)
@@ -579,5 +590,5 @@ def _spec(g, found: Found) -> GeometrySpec:
         interface_normals=dict(found.normals), interface_extents=dict(found.extents), report=tuple(report),
         interface_sizes=found.sizes if g.kind == "mesh" else
         dict.fromkeys(found.interfaces, min(g.mesh_size, g.interface_mesh_size or g.mesh_size)),
-        warnings=tuple(found.loose),
+        warnings=tuple(found.loose), element_size=found.cell_size if g.kind == "mesh" else g.mesh_size,
         interface_regions={name: fixed for name, (fixed, _) in found.pairs.items()})

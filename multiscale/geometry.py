@@ -120,6 +120,8 @@ class GeometrySpec:
     #                                    known before meshing (absent: known from the mesh only)
     interface_sizes: Mapping[str, float] = field(default_factory=dict)   # interface -> element size [m]
     #                                    the mesher aims at on it (absent: unknown before meshing)
+    element_size: float | None = None    # m, a mesh file's: the largest of its bodies' mean tetrahedron
+    #                                    edges (a builder's or CAD's: its mesh_size)
 
     @property
     def materials(self) -> tuple[str, ...]:

@@ -459,7 +459,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
             scene.stability.sweep.parameter == "speed"
         warnings += squeal_state(scene.loading, g.motion, "friction" in effects and not swept)
         if scene.stability is not None and scene.materials is not None:
-            warnings += unresolved_band(scene.stability, g.resolved(), scene.materials, g.materials,
+            h = g.resolved().get("mesh_size") or g.spec.element_size
+            warnings += unresolved_band(scene.stability, h, scene.materials, g.materials,
                                         (scene.time or Time()).initial_temperature) + (undamped_falling_law(
                 scene, g.materials, g.spec.interfaces) if "friction" in effects else [])
     end = scene.time.end if scene.time is not None else None

@@ -202,13 +202,13 @@ class Stability:
         return []
 
 
-def unresolved_band(stability, sizes: dict, materials, names, T0: float) -> list[str]:
+def unresolved_band(stability, h: float | None, materials, names, T0: float) -> list[str]:
     """A warning if a material's (``names``: the geometry's) shear wavelength at the band's top,
-    sqrt(E / (2 (1 + nu) rho)) / f at ``T0`` [K], is shorter than one element of the mesh
-    (``sizes``: the geometry's resolved sizes [m]): modes there are the mesh's, not the structure's
-    (a 1 MHz band on a 12 mm brake gave 10 modes at residuals of 1e-17 without a word: an
-    adversarial trial)."""
-    h, top = sizes.get("mesh_size"), stability.band[1]
+    sqrt(E / (2 (1 + nu) rho)) / f at ``T0`` [K], is shorter than one element of the mesh (``h``
+    [m]: its mesh_size, a mesh file's own element size): modes there are the mesh's, not the
+    structure's (a 1 MHz band on a 12 mm brake gave 10 modes at residuals of 1e-17 without a word:
+    an adversarial trial; a .msh file's mesh was not checked)."""
+    top = stability.band[1]
     waves = {}
     for name in names:
         m = materials.get(name)
@@ -221,7 +221,8 @@ def unresolved_band(stability, sizes: dict, materials, names, T0: float) -> list
     return [f"stability.band: at its top ({top:.4g} Hz) the shear wavelengths in "
             + ", ".join(f"{name} ({wave * 1e3:.3g} mm)" for name, wave in short.items())
             + f" are shorter than the mesh's elements ({h * 1e3:.3g} mm): modes there are the mesh's, not the "
-            f"structure's; a geometry.mesh_size of {min(short.values()) / 2 * 1e3:.2g} mm or less, or a lower band"]
+            f"structure's; elements of {min(short.values()) / 2 * 1e3:.2g} mm or less (geometry.mesh_size), or a "
+            "lower band"]
 
 
 def undamped_falling_law(scene, materials, interfaces) -> list[str]:

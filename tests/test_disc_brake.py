@@ -134,7 +134,8 @@ def test_the_opposite_axis_turns_the_builders_disc_the_other_way(tmp_path):
     solid = VENTED.replace("vanes = 12", "vanes = 0")
     moments = []
     for axis in ("[0, 0, 1]", "[0, 0, -1]"):
-        scene = scenes.loads(solid.replace('builder = "disc_brake"', f'builder = "disc_brake"\naxis = {axis}'), tmp_path)
+        turned = solid.replace('builder = "disc_brake"', f'builder = "disc_brake"\naxis = {axis}')
+        scene = scenes.loads(turned, tmp_path)
         tm = build_mesh(scene)
         mech = Mechanics(tm, MATERIALS, stiffness=1e13, friction=0.4, speed=5.0, load_kind="fluid",
                          prefix=f"brake_axis{len(moments)}_")

@@ -226,6 +226,31 @@ def test_a_mesh_files_interface_element_size_is_its_own_and_mesh_sizes_are_refus
     assert "geometry.interface_mesh_size: not used with a .msh file (it is meshed already)" in err
 
 
+def test_a_mesh_files_element_size_checks_the_squeal_band(files, tmp_path):
+    """A .msh file's element size is its bodies' largest mean tetrahedron edge (here against meshio's
+    reading of the file); the squeal band's resolution is checked against it (a .msh brake had no
+    element size: the check was skipped)."""
+    import meshio
+    mesh = meshio.read(files / "pod.msh")
+    edges = {}
+    for block, tags in zip(mesh.cells, mesh.cell_data["gmsh:physical"]):
+        if block.type == "tetra":
+            x = mesh.points[block.data]
+            for tag in np.unique(tags):
+                t = x[tags == tag]
+                edges[tag] = np.mean([np.linalg.norm(t[:, i] - t[:, j], axis=1)
+                                      for i in range(4) for j in range(i + 1, 4)])
+    g = scene_for(files, "msh", tmp_path).geometry
+    assert g.spec.element_size == pytest.approx(max(edges.values()), rel=1e-9) and len(edges) == 4
+    text = FILE.format(name="x", file=files / "pod.msh", extra="", folder=tmp_path / "out", surfaces="",
+                       **{b: f'volumes = ["{b}"]' for b in INSIDE})
+    text = (text.replace(EFFECTS, 'effects = ["contact", "friction", "stability"]\n')
+            .replace('nu = 0.3\n', 'nu = 0.3\nrho = "7800 kg/m^3"\n')
+            + '[stability]\nmodes = 10\nband = ["0 Hz", "300 kHz"]\n')
+    (warned,) = [w for w in loads(text, tmp_path).warnings if w.startswith("stability.band: at its top")]
+    assert f"are shorter than the mesh's elements ({g.spec.element_size * 1e3:.3g} mm)" in warned
+
+
 def test_cad_is_meshed_by_the_chosen_algorithm_and_a_failure_says_what_to_change(files, tmp_path, monkeypatch):
     """CAD takes HXT unless mesh_algorithm says otherwise; its coarse trial meshes take Delaunay,
     and the kept session's mesh is node for node that of the builder's own run. Were HXT to fail
