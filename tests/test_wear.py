@@ -189,10 +189,14 @@ def test_uniform_wear_of_a_flat_is_not_a_coarse_step():
     """A periodic flat in full contact wears alike everywhere: exact at any step count, no warning
     (before: "a step wore up to 4.49e+296 times the RMS height", its RMS 0). A non-periodic flat
     punch wears its edges first, a relief from nothing that depends on the step count: warned,
-    without a ratio to a zero RMS."""
+    without a ratio to a zero RMS; so is a flat levelled to heights of round-off about 0 (1e-20 m:
+    it was asked whether the wear rate was right)."""
     runs = {periodic: _wear_runs(Surface(np.zeros((32, 32)), 1e-6, 1e-6, periodic=periodic), (4,),
                                  contact=HalfSpace(1e11), load=1e6, mu=0.4, distance=1e-3, k_w=1e-13)[4]
             for periodic in (True, False)}
+    levelled = Surface(1e-20 * np.random.default_rng(0).standard_normal((32, 32)), 1e-6, 1e-6, periodic=False)
+    assert _wear_runs(levelled, (4,), contact=HalfSpace(1e11), load=1e6, mu=0.4, distance=1e-3,
+                      k_w=1e-13)[4][1] == runs[False][1]
     history, warned = runs[True]
     assert history.max_depth[-1] == pytest.approx(1e-13 * 0.4 * 1e6 * 1e-3, rel=1e-12) and warned == []
     assert runs[False][1] == ["simulate_wear: a step wore a relief into a surface flat to round-off (e.g. a flat "

@@ -33,7 +33,8 @@ STEP_RMS = 0.5   # a simulate_wear step wearing deeper than this many RMS height
 SUBSTEP_TOL = 0.05   # a wear update whose worn depth its increments leave this far off is warned about [-]
 WEAR_TOL = 0.005     # the coupled loop raises a wear update's increments while their estimated error is above [-]
 UNIFORM = 1e-12      # a step's depths equal to this share of the deepest: uniform wear (full contact of a flat)
-ROUND_OFF_FLAT = 1e-12  # a surface whose RMS height is at most this share of its largest height is flat [-]
+ROUND_OFF_FLAT = 1e-12  # a surface whose RMS height is at most this share of its largest height, or of its
+#                        side, is flat [-] (a flat levelled to heights of round-off about 0: a review)
 
 
 STABLE = 1.0          # an explicit wear step's k_w mu ds over the least compliance of the grid, at most [-]
@@ -262,7 +263,7 @@ def simulate_wear(surface: Surface, contact: Kernel | ContactSolver, *, load, mu
             if ratio.max() > overshoot:
                 k = np.unravel_index(np.argmax(ratio), ratio.shape)
                 overshoot = float(ratio[k])
-                from_flat = bool(rms[k] <= ROUND_OFF_FLAT * np.abs(current.heights[k]).max())
+                from_flat = bool(rms[k] <= ROUND_OFF_FLAT * max(np.abs(current.heights[k]).max(), *surface.size))
             current = increment.surface
             p = _solve_at_load(solver, current.heights, loads, p, rows, j, options)
         depth = h0 - current.heights
