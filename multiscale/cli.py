@@ -21,6 +21,7 @@ from multiscale.errors import InputError, MultiscaleError, OutputError, SceneErr
 from multiscale.geometry import too_many_cells
 from multiscale.io import CtrlCWatch, Outliving, abort, ended_together
 from multiscale.memory import memory_available
+from multiscale.mode_pairs import pair, read_modes, report, write_pairs
 from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.reading import COMMAND_LINE, TopographyWarning, formats, read_topography
 from multiscale.micro.spectrum import statistics_memory, surface_statistics
@@ -110,7 +111,7 @@ LAUNCHERS = {"Open MPI": ("OMPI_COMM_WORLD_SIZE", "OMPI_COMM_WORLD_RANK"),
              "Slurm srun": ("SLURM_STEP_NUM_TASKS", "SLURM_PROCID")}
 
 
-SERIAL = ("info", "check", "surface")    # commands of one process: under a launcher its rank 0 alone runs them
+SERIAL = ("info", "check", "surface", "modes")    # commands of one process: under a launcher its rank 0 alone runs them
 LONG = ("run", "study")     # commands whose results outlive their console (``io.Outliving``)
 
 
@@ -317,6 +318,19 @@ def surface_memory(shape) -> float:
     return statistics_memory(shape) + 16.0 * shape[0] * shape[1]
 
 
+def _modes(args) -> int:
+    """Pair the modes of two squeal runs by MAC: a table, and the matrix as CSV or a figure."""
+    pairs = pair(read_modes(args.runs[0]), read_modes(args.runs[1]))
+    print("\n".join(report(pairs)))
+    if args.csv:
+        print(f"MAC matrix: {write_pairs(pairs, args.csv)}")
+    if args.figure:
+        from multiscale.plots.squeal import plot_mac    # local: matplotlib only when a figure is drawn
+        axes = (f"mode of B: {args.runs[1]}", f"mode of A: {args.runs[0]}")
+        print(f"figure: {plot_mac(pairs.mac, 'MAC', args.figure, axes)}")
+    return 0
+
+
 def _surface(args) -> int:
     """Read, condition and analyse a measured topography: the steps, the statistics, a figure."""
     if args.formats:
@@ -419,6 +433,14 @@ def build_parser() -> argparse.ArgumentParser:
     study.add_argument("--processes", type=_count, metavar="N", help="runs at a time (overrides [run] processes)")
     study.add_argument("--problems", action="store_true", help="list the problems, their parameters and metrics")
     study.set_defaults(func=_study)
+    modes = sub.add_parser("modes", help="pair the modes of two squeal runs of one mesh by MAC",
+                           description="Pair each mode of squeal run A with the mode of run B it resembles most "
+                           "(modal assurance criterion of the complex mode shapes in their results folders): "
+                           "forward against reverse rotation, with or without damping, serial against parallel.")
+    modes.add_argument("runs", nargs=2, metavar="RUN", help="results folders of the two runs (A, then B)")
+    modes.add_argument("--csv", metavar="FILE", help="write the MAC matrix (A's modes x B's) as CSV")
+    modes.add_argument("--figure", metavar="FILE", help="draw the MAC matrix (PNG, PDF, SVG)")
+    modes.set_defaults(func=_modes)
     surface = sub.add_parser("surface", help="measured topography: conditioning, statistics (Sq, Sdq, Ssk, Sku, "
                                              "Nayak, summits, PSD fit), a figure with --figure",
                              description="Read a measured topography (through SurfaceTopography), remove its form, "

@@ -298,6 +298,37 @@ def test_the_faceted_piston_face_is_said(brake, no_friction):
     assert 0.005 < loss < 0.02 and f"piston_back, caliper_bore: {100 * loss:.3g} % (" in note
 
 
+def test_the_modes_of_two_runs_are_paired_by_mac_from_their_files(tmp_path, brake, friction, no_friction):
+    """``multiscale modes A B`` reads the mode shapes back from the runs' VTX files and pairs them:
+    its MAC matrix is that of the modes in memory (modal.mac_matrix, 1e-9), a run against itself
+    pairs every mode with itself, and a run of another mesh is refused."""
+    import csv
+    import shutil
+    from multiscale.cli import main
+    from multiscale.mode_pairs import pair, read_modes
+    for name, case in (("a", friction), ("b", no_friction)):
+        folder = tmp_path / name
+        folder.mkdir()
+        write_modes(folder, case.modes, brake[1].u, ["pads", "disc"], modes=range(1, 13))
+        with open(folder / "modes.csv", "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(["mode", "frequency_Hz", "sigma_1_per_s"])
+            w.writerows([k + 1, lam.imag / (2 * np.pi), lam.real] for k, lam in enumerate(case.modes.eigenvalues))
+    pairs = pair(read_modes(tmp_path / "a"), read_modes(tmp_path / "b"))
+    mine = modal.mac_matrix(friction.modes.modes[:, :12], no_friction.modes.modes[:, :12])
+    np.testing.assert_allclose(pairs.mac, mine, atol=1e-9)
+    same = pair(read_modes(tmp_path / "a"), read_modes(tmp_path / "a"))
+    assert list(same.best) == list(range(12)) and np.allclose(np.diag(same.mac), 1, atol=1e-12)
+    assert main(["modes", str(tmp_path / "a"), str(tmp_path / "b"), "--csv", str(tmp_path / "mac.csv")]) == 0
+    assert (tmp_path / "mac.csv").read_text().count("\n") == 13
+    (tmp_path / "c").mkdir()
+    (tmp_path / "c" / "modes.csv").write_text((tmp_path / "a" / "modes.csv").read_text())
+    write_modes(tmp_path / "c", friction.modes, brake[1].u, ["pads", "disc"], modes=[1])
+    shutil.rmtree(tmp_path / "c" / "modes_disc.bp")                          # the pads alone: other nodes
+    with pytest.raises(InputError, match="MAC compares runs of one mesh"):
+        pair(read_modes(tmp_path / "a"), read_modes(tmp_path / "c"))
+
+
 def test_mode_shapes_are_written_to_vtx(tmp_path, brake, friction):
     adios2 = pytest.importorskip("adios2")
     files = write_modes(tmp_path, friction.modes, brake[1].u, ["pads", "disc"], modes=[1, 2])

@@ -114,14 +114,15 @@ def plot_unstable_bars(cases: Mapping, path) -> Path:
     return _save(fig, path)
 
 
-def plot_mac(mac: np.ndarray, title: str, path) -> Path:
-    """MAC matrix between two cases (Figs. 4.16–4.17)."""
+def plot_mac(mac: np.ndarray, title: str, path, labels: tuple[str, str] = ("mode (rough case)",
+                                                                            "mode (perfect contact)")) -> Path:
+    """MAC matrix between two cases (Figs. 4.16–4.17), ``labels`` of its columns' and rows' modes."""
     fig = Figure(figsize=(5.5, 4.8))
     ax = fig.subplots()
     art = ax.imshow(mac, origin="lower", vmin=0, vmax=1, cmap="viridis",
                     extent=(0.5, mac.shape[1] + 0.5, 0.5, mac.shape[0] + 0.5))
     fig.colorbar(art, ax=ax, label="MAC")
-    ax.set(title=title, xlabel="mode (rough case)", ylabel="mode (perfect contact)")
+    ax.set(title=title, xlabel=labels[0], ylabel=labels[1])
     return _save(fig, path)
 
 

@@ -17,6 +17,7 @@ from multiscale.macro import mesh as two_body  # noqa: E402
 from multiscale.macro import eigen, modal  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
 from multiscale.macro.output import orientation, write_modes  # noqa: E402
+from multiscale.mode_pairs import pair, read_modes  # noqa: E402
 from multiscale.references.stability import spring_chain, spring_chain_frequencies  # noqa: E402
 from multiscale.workflows.squeal import squeal_case  # noqa: E402
 
@@ -38,7 +39,8 @@ def test_two_ranks_reproduce_the_serial_squeal_analysis():
     comm = MPI.COMM_WORLD
     assert comm.size == 2
     par = case(comm, "squeal_mpi_par_")
-    ref = comm.bcast(None if comm.rank else _summary(case(MPI.COMM_SELF, "squeal_mpi_ser_")), root=0)
+    ser = None if comm.rank else case(MPI.COMM_SELF, "squeal_mpi_ser_")
+    ref = comm.bcast(None if comm.rank else _summary(ser), root=0)
     got = _summary(par)
     np.testing.assert_allclose(got["eigenvalues"], ref["eigenvalues"], rtol=1e-8, atol=1e-6)
     np.testing.assert_allclose(got["forces"], ref["forces"], rtol=1e-10)
@@ -68,6 +70,19 @@ def test_two_ranks_reproduce_the_serial_squeal_analysis():
             assert len(blocks) == 2 and len(centres) == count
             assert len(np.unique(np.round(centres / 1e-9), axis=0)) == count, path.name
             assert np.abs(real).max() == pytest.approx(top, rel=1e-12)
+    # `multiscale modes` reads a parallel run's files (each rank's block, its shared nodes once): its
+    # modes pair with the serial run's one to one
+    runs = [folder / "serial", folder / "parallel"]
+    if comm.rank == 0:
+        runs[0].mkdir(), runs[1].mkdir()
+        write_modes(runs[0], ser.modes, ser.mech.u, ["brake", "disc"], modes=range(1, 9))
+    write_modes(runs[1], par.modes, par.mech.u, ["brake", "disc"], modes=range(1, 9))
+    if comm.rank == 0:
+        for run, c in zip(runs, (ser, par)):
+            rows = [f"{k + 1},{lam.imag / (2 * np.pi)},{lam.real}" for k, lam in enumerate(c.modes.eigenvalues)]
+            (run / "modes.csv").write_text("\n".join(["mode,frequency_Hz,sigma_1_per_s", *rows]) + "\n")
+        pairs = pair(read_modes(runs[0]), read_modes(runs[1]))
+        assert list(pairs.best) == list(range(8)) and np.diag(pairs.mac).min() > 1 - 1e-9, np.diag(pairs.mac)
     comm.barrier()
 
 
