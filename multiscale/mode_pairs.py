@@ -41,7 +41,8 @@ class ModeSet:
 @dataclass
 class ModePairs:
     """Each mode of A with the mode of B of the largest MAC: ``best`` (index into B's modes),
-    ``mac`` (A's modes x B's), ``shift`` of the frequency [%] (f_B - f_A) / f_A."""
+    ``mac`` (A's modes x B's), ``shift`` of the frequency [%] (f_B - f_A) / f_A (NaN at f_A = 0:
+    a static divergence's mode)."""
 
     a: ModeSet
     b: ModeSet
@@ -102,7 +103,9 @@ def pair(a: ModeSet, b: ModeSet) -> ModePairs:
                          f"{len(b.points)} nodes, or at other places): MAC compares runs of one mesh")
     m = mac(a.shapes, b.shapes)
     best = np.argmax(m, axis=1)
-    return ModePairs(a, b, m, best, 100 * (b.frequency[best] - a.frequency) / a.frequency)
+    gap = b.frequency[best] - a.frequency
+    shift = np.divide(100 * gap, a.frequency, out=np.full(len(gap), np.nan), where=a.frequency != 0)
+    return ModePairs(a, b, m, best, shift)
 
 
 def report(pairs: ModePairs) -> list[str]:
