@@ -153,10 +153,12 @@ class Outliving:
     """A text stream (stdout, stderr) that outlives its reader: the first write or flush into a
     closed pipe (BrokenPipeError) sends it, and its file descriptor, to /dev/null, and the run
     goes on to write its results. A run piped into ``head`` or ``less`` was aborted by PETSc's
-    SIGPIPE handler, its files half written; ended alone, rank 0 would leave the others waiting."""
+    SIGPIPE handler, its files half written; ended alone, rank 0 would leave the others waiting.
+    A closed descriptor (``run >&-``: Python's stream is None) is /dev/null from the start (the
+    stage lines ended such a run at once)."""
 
     def __init__(self, stream):
-        self.stream = stream
+        self.stream = stream if stream is not None else open(os.devnull, "w")
 
     def write(self, text: str) -> int:
         try:

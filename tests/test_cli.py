@@ -162,6 +162,10 @@ def test_a_run_into_a_closed_pipe_goes_on_to_its_results(tmp_path, monkeypatch, 
             stream.close()
     assert json.loads((folder / "provenance.json").read_text())["status"] == "finished"
     assert (folder / "interface.h5").is_file() and "Traceback" not in capsys.readouterr().err
+    # closed descriptors (`run >&- 2>&-`: Python's streams are None) ended the run at its first stage line
+    monkeypatch.setattr(sys, "stdout", None)
+    monkeypatch.setattr(sys, "stderr", None)
+    assert main(["run", path, "--overwrite"]) == 0
 
 
 def test_a_run_larger_than_the_free_memory_is_warned_at_once(tmp_path, monkeypatch, capsys):
