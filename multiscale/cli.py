@@ -16,16 +16,18 @@ import tomllib
 import warnings
 from pathlib import Path
 
+from mpi4py import MPI
+
 from multiscale import __version__
 from multiscale.errors import InputError, MultiscaleError, OutputError, SceneError
 from multiscale.geometry import too_many_cells
 from multiscale.io import CtrlCWatch, Outliving, abort, ended_together
-from multiscale.memory import memory_available
-from multiscale.mode_pairs import pair, read_modes, report, write_pairs
+from multiscale.memory import memory_available, memory_limit
 from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.reading import COMMAND_LINE, TopographyWarning, formats, read_topography
 from multiscale.micro.spectrum import statistics_memory, surface_statistics
 from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition
+from multiscale.mode_pairs import pair, read_modes, report, write_pairs
 from multiscale.outputs import CHECKPOINT, analysis, folder_problem, plan
 from multiscale.outputs import summary as plan_summary
 from multiscale.provenance import versions
@@ -488,6 +490,14 @@ def main(argv: list[str] | None = None) -> int:
         return 2
     except MultiscaleError as exc:
         print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except MemoryError as exc:    # (a squeal run under ulimit -v ended in a traceback of numpy's allocation)
+        print(f"error: out of memory ({exc or 'MemoryError'}): more than the {memory_limit() / 1e9:.3g} GB this "
+              "process may use (the machine's, a container's or batch job's limit, ulimit -v); what a run wrote "
+              'stays, its provenance.json says it failed: a coarser mesh, stability.method = "subspace" for a '
+              "squeal run, or ranks on more machines (docs/performance.rst, Memory)", file=sys.stderr)
+        if MPI.COMM_WORLD.size > 1:      # the other ranks wait in a collective: ended with this one
+            abort(MPI.COMM_WORLD, 2)
         return 2
     except KeyboardInterrupt:     # Ctrl-C in a command without its own words (check --cells: a traceback)
         print(f"interrupted: multiscale {args.command}", file=sys.stderr)

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from multiscale import cli
 from multiscale.cli import main
 
 BLOCK = (Path(__file__).resolve().parents[1] / "demos" / "block_on_flat.toml").read_text()
@@ -238,6 +239,19 @@ def test_run_hands_the_scene_to_the_runner(tmp_path, fake_runner):
     path = _write(tmp_path, BLOCK.replace("../results/block_on_flat", "out"))
     assert main(["run", path]) == 0
     assert fake_runner == [("block_on_flat", False, False)]
+
+
+def test_a_run_out_of_memory_says_so_without_a_traceback(tmp_path, capsys, fake_runner, monkeypatch):
+    """A squeal run under `ulimit -v` ended in a traceback of numpy's allocation: now one error line
+    with the memory the process may use and what to change, status 2."""
+    def starved(scene, **kw):
+        raise MemoryError("Unable to allocate 33.3 MiB for an array")
+    monkeypatch.setattr(sys.modules["multiscale.workflows"], "run", starved)
+    monkeypatch.setattr(cli, "memory_limit", lambda: 3.07e9)
+    assert main(["run", _write(tmp_path, BLOCK.replace("../results/block_on_flat", "out"))]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: out of memory (Unable to allocate 33.3 MiB for an array): more than the 3.07 GB "
+                          "this process may use") and "Traceback" not in err
 
 
 def test_set_gives_scene_keys_over_the_files_to_check_and_run(tmp_path, capsys, monkeypatch):
