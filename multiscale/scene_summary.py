@@ -5,7 +5,7 @@ import json
 import math
 
 from multiscale.geometry import CellEstimate, estimate_cells
-from multiscale.memory import DOFS_PER_CELL, run_memory
+from multiscale.memory import DOFS_PER_CELL, RUN_MEMORY, run_memory
 from multiscale.outputs import CHECKPOINT, analysis
 from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
@@ -237,8 +237,9 @@ def memory_line(scene: Scene, cells: int) -> tuple[str, float]:
     kind = "squeal" if scene.has("stability") else "transient"
     dofs = DOFS_PER_CELL[kind] * cells
     need = run_memory(dofs, kind)
-    return (f"  memory    about {need / 1e9:.2g} GB at the peak of a {kind} run (about {dofs:,.0f} displacement dofs; "
-            "an estimate from measured runs, docs/performance.rst)", need)
+    return (f"  memory    about {need / 1e9:.2g} GB at the peak of a {kind} run on one rank, each more adding about "
+            f"{RUN_MEMORY[kind][0] / 1e9:.2g} GB (about {dofs:,.0f} displacement dofs; an estimate from measured "
+            "runs, docs/performance.rst)", need)
 
 
 def _rough_or_perfect(scene: Scene, rough: str, perfect: str, value: float) -> str:
