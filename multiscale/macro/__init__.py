@@ -42,7 +42,7 @@ from petsc4py import PETSc  # noqa: E402
 # ``head``, or into a ``tee`` that died, was aborted by PETSc ("Caught signal number 13 Broken
 # Pipe", MPI_Abort) wherever it was, its files half written. Python's handling is restored.
 if threading.current_thread() is threading.main_thread() and hasattr(signal, "SIGPIPE"):
-    signal.signal(signal.SIGPIPE, signal.SIG_IGN)
+    signal.signal(signal.SIGPIPE, signal.getsignal(signal.SIGPIPE))    # Python's own (as geometry.start_gmsh)
 
 # PETSc (3.25; option -vec_mdot_use_gemv, on by default) computes VecMDot, the orthogonalisation
 # of (F)GMRES, by BLAS gemv over runs of vectors that happen to lie at one stride in memory and by
