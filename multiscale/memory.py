@@ -24,7 +24,8 @@ def _number(path: Path) -> float | None:
 
 def _limit_files() -> list[tuple[Path, Path]]:
     """(limit, usage) files of the cgroups that may bound this process: the mount's root (a
-    container's own cgroup is its root) and the process's own (/proc/self/cgroup), v2 and v1."""
+    container's own cgroup is its root), the process's own (/proc/self/cgroup) and those between
+    (a Slurm job's limit is its job's, above its step's and task's), v2 and v1."""
     folders = [(CGROUP, V2), (CGROUP / "memory", V1)]
     try:
         lines = OWN.read_text().splitlines()
@@ -32,10 +33,10 @@ def _limit_files() -> list[tuple[Path, Path]]:
         lines = []
     for line in lines:
         _, controllers, where = line.split(":", 2)
-        if controllers == "":
-            folders.append((CGROUP / where.lstrip("/"), V2))
-        elif "memory" in controllers.split(","):
-            folders.append((CGROUP / "memory" / where.lstrip("/"), V1))
+        if controllers == "" or "memory" in controllers.split(","):
+            base, files = (CGROUP, V2) if controllers == "" else (CGROUP / "memory", V1)
+            parts = [p for p in where.split("/") if p]
+            folders += [(base.joinpath(*parts[:k]), files) for k in range(1, len(parts) + 1)]
     return [(folder / cap, folder / used) for folder, (cap, used) in folders]
 
 

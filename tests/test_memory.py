@@ -38,6 +38,13 @@ def test_a_jobs_cgroup_v2_limit_bounds_the_memory_and_its_usage_the_room_left(cg
     assert memory.memory_available() <= 0.75 * GIB
 
 
+def test_the_limit_of_a_cgroup_above_the_process_counts(cgroup):
+    """A Slurm job's limit sits on the job's cgroup, above the step's that holds the process."""
+    write(cgroup / "job.slice" / "step", memory_max="max")
+    write(cgroup / "job.slice", memory_max=int(1.5 * GIB))
+    assert memory.memory_limit() == min(MACHINE, 1.5 * GIB)
+
+
 def test_a_containers_cgroup_v1_limit_bounds_the_memory(cgroup):
     write(cgroup / "memory" / "docker" / "abc", memory_limit_in_bytes=int(2 * GIB),
           memory_usage_in_bytes=int(1.5 * GIB))
