@@ -22,7 +22,7 @@ from multiscale import __version__
 from multiscale.errors import InputError, MultiscaleError, OutputError, SceneError
 from multiscale.geometry import too_many_cells
 from multiscale.io import CtrlCWatch, Outliving, abort, ended_together
-from multiscale.memory import memory_available, memory_limit
+from multiscale.memory import memory_available, memory_limit, remedy
 from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.reading import COMMAND_LINE, TopographyWarning, formats, read_topography
 from multiscale.micro.spectrum import statistics_memory, surface_statistics
@@ -94,9 +94,8 @@ def _check(args) -> int:
             need, free = memory_line(scene, estimate.cells), memory_available()
             print(f"{line}\n{need[0]}")
             if free is not None and need[1] > free:    # (a ~1M-dof squeal was "OK": a user trial)
-                squeal = ', stability.method = "subspace"' if scene.has("stability") else ""
-                print(f"warning: more than the {free / 1e9:.2g} GB this machine has free: a coarser mesh{squeal} or "
-                      "ranks on more machines", file=sys.stderr)
+                print(f"warning: more than the {free / 1e9:.2g} GB this machine has free: "
+                      f"{remedy(scene.has('stability'))}", file=sys.stderr)
             if estimate.cells > scene.geometry.max_cells:      # what run would refuse
                 print(f"error: {too_many_cells(estimate, scene.geometry.max_cells)}", file=sys.stderr)
                 print(f"{path}: 1 problem", file=sys.stderr)
@@ -494,8 +493,7 @@ def main(argv: list[str] | None = None) -> int:
     except MemoryError as exc:    # (a squeal run under ulimit -v ended in a traceback of numpy's allocation)
         print(f"error: out of memory ({exc or 'MemoryError'}): more than the {memory_limit() / 1e9:.3g} GB this "
               "process may use (the machine's, a container's or batch job's limit, ulimit -v); what a run wrote "
-              'stays, its provenance.json says it failed: a coarser mesh, stability.method = "subspace" for a '
-              "squeal run, or ranks on more machines (docs/performance.rst, Memory)", file=sys.stderr)
+              f"stays, its provenance.json says it failed: {remedy(squeal=True)}", file=sys.stderr)
         if MPI.COMM_WORLD.size > 1:      # the other ranks wait in a collective: ended with this one
             abort(MPI.COMM_WORLD, 2)
         return 2

@@ -88,3 +88,9 @@ def run_memory(dofs: float, kind: str, ranks: int = 1) -> float:
     ``dofs`` displacement dofs on ``ranks`` processes (``RUN_MEMORY``)."""
     base, scale = RUN_MEMORY[kind]
     return ranks * base + scale * (dofs / 1e5) ** (4 / 3)
+
+
+def remedy(squeal: bool) -> str:
+    """What lowers a run's memory, as the messages that warn of it or report its lack say it."""
+    return "a coarser mesh (geometry.mesh_size)" + (', stability.method = "subspace" (a squeal run)' * squeal) + \
+        " or ranks on more machines (docs/performance.rst, Memory)"

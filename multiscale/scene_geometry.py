@@ -314,11 +314,12 @@ class GeometrySection(Section):
         if not isinstance(motion, Rotation):
             ctx.problems.append(f'{path}.axis: not used by builder "{geometry.builder}", whose body slides')
             return None
-        own = tuple(float(a) for a in motion.axis)
-        unit = tuple(float(a) / sum(b * b for b in axis) ** 0.5 for a in axis)
-        if max(abs(a - b) for a, b in zip(unit, own)) < 1e-9:
+        def unit(v):
+            return tuple(float(a) / sum(float(b) ** 2 for b in v) ** 0.5 for a in v)
+        own, given = unit(motion.axis), unit(axis)
+        if max(abs(a - b) for a, b in zip(given, own)) < 1e-9:
             return geometry
-        if max(abs(a + b) for a, b in zip(unit, own)) < 1e-9:
+        if max(abs(a + b) for a, b in zip(given, own)) < 1e-9:
             spec = dataclasses.replace(geometry.spec, motion=dataclasses.replace(motion, axis=tuple(-a for a in own)))
             return dataclasses.replace(geometry, spec=spec)
         ctx.problems.append(f'{path}.axis = {list(axis)}: builder "{geometry.builder}" turns its body about '

@@ -201,7 +201,8 @@ def test_check_cells_estimates_the_runs_memory_and_warns_beyond_the_free(tmp_pat
     need = run_memory(DOFS_PER_CELL["transient"] * cells, "transient")
     assert f"  memory    about {need / 1e9:.2g} GB at the peak of a transient run on one rank, each more adding " \
         "about 0.37 GB (about " in captured.out
-    assert "warning: more than the 0.001 GB this machine has free: a coarser mesh or ranks" in captured.err
+    assert "warning: more than the 0.001 GB this machine has free: a coarser mesh (geometry.mesh_size) or ranks " \
+        "on more machines" in captured.err
 
 
 def test_max_cells_in_the_scene_and_on_the_command_line(tmp_path, capsys):

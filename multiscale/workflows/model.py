@@ -47,7 +47,7 @@ from multiscale.macro.load_faces import load_face_areas, load_face_forces
 from multiscale.macro.mechanics import REPEATABLE_REFRESH, Mechanics
 from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
-from multiscale.memory import memory_available, run_memory
+from multiscale.memory import memory_available, remedy, run_memory
 from multiscale.scene_friction import bare_interfaces, initial_friction, speed_law_guess
 
 
@@ -239,9 +239,8 @@ def say_model_size(tm, mechanics, thermal=None, kind: str = "transient") -> None
         machines = "this machine" if len(set(hosts)) == 1 else f"the {len(set(hosts))} machines of its ranks"
         print(f"warning: a {kind} run of {spaced(n)} displacement dofs takes about {need / 1e9:.3g} GB at its peak (an "
               f"estimate from measured runs, docs/performance.rst), more than the {have / 1e9:.3g} GB {machines} "
-              "has free: it may be killed without a word by the out-of-memory killer; a coarser mesh "
-              "(geometry.mesh_size)" + (', stability.method = "subspace"' if kind == "squeal" else "")
-              + " or ranks on more machines", file=sys.stderr, flush=True)
+              f"has free: it may be killed without a word by the out-of-memory killer; {remedy(kind == 'squeal')}",
+              file=sys.stderr, flush=True)
 
 
 def build_mechanics(scene, tm, *, law=None, temperatures=None, degree: int = 1,
