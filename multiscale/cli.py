@@ -209,13 +209,14 @@ def _run(args) -> int:
 def _kept(scene, args, ranks: int = 1) -> str:
     """What a run interrupted by Ctrl-C leaves (``scene``: None if it was still being read), and the
     command that goes on (this environment's multiscale, under its mpiexec for ``ranks`` > 1: a user
-    trial's copy of the bare name failed where the environment was not activated); --resume is advised
+    trial's copy of the bare name failed where the environment was not activated; the scene's absolute
+    path: a job script's next step may start elsewhere); --resume is advised
     only with a checkpoint (before its first macro step ended it refused to resume), --overwrite
     when the folder holds files (a user trial was told to start again and refused)."""
     if scene is None:
         return "nothing was written"
     launcher = [MPIEXEC, "-n", str(ranks)] if ranks > 1 else []
-    command = shlex.join([*launcher, *COMMAND, "run", args.scene,
+    command = shlex.join([*launcher, *COMMAND, "run", os.path.abspath(args.scene),     # (from any folder)
                           *(f"--set={k}={text}" for k, _, text in args.settings)])
     folder = Path(scene.output.folder)
     written = folder.is_dir() and any(folder.iterdir())

@@ -348,10 +348,13 @@ def _part(record: dict) -> dict:
 
 def process(pid: int | None = None) -> dict:
     """The writing process: host name, pid and its start (clock ticks since boot, Linux's
-    /proc/<pid>/stat; None elsewhere): with the pid it names one process, a reused pid another."""
+    /proc/<pid>/stat; None elsewhere, and for a process that has ended but was not yet reaped, a
+    zombie: ``--resume`` right after a SIGKILL was refused for a moment): with the pid it names one
+    process, a reused pid another."""
     pid = os.getpid() if pid is None else int(pid)
     try:
-        started = int(Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[19])
+        fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
+        started = None if fields[0] in ("Z", "X") else int(fields[19])
     except (OSError, IndexError, ValueError):
         started = None
     return {"host": platform.node(), "pid": pid, "started": started}

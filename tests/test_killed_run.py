@@ -234,6 +234,9 @@ def test_a_run_stopped_before_its_first_step_is_not_advised_to_resume(tmp_path, 
     (folder / "provenance.json").write_text("{}")    # an interrupted run's record: the plain run is refused
     assert main(["run", str(path)]) == 130
     assert f"multiscale run {path} --overwrite starts again" in capsys.readouterr().err     # (a user trial)
+    monkeypatch.chdir(tmp_path)
+    assert main(["run", "scene.toml"]) == 130
+    assert f"multiscale run {path} --overwrite starts again" in capsys.readouterr().err     # from any folder
 
 
 def test_a_damaged_field_file_says_how_to_resume(base):

@@ -12,6 +12,7 @@ import json
 import os
 import subprocess
 import sys
+import time
 import types
 from dataclasses import replace
 from pathlib import Path
@@ -521,3 +522,80 @@ def test_a_run_refuses_a_folder_another_living_run_writes_into(tmp_path):
     record.update(process=provenance.process())                  # this process's own record
     (folder / "provenance.json").write_text(json.dumps(record))
     assert provenance.writer(folder) is None
+
+
+def _living_record(folder: Path, pid: int) -> None:
+    """A provenance.json in ``folder`` saying that process ``pid`` of this host runs there."""
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "provenance.json").write_text(json.dumps({"status": provenance.RUNNING,
+                                                         "process": provenance.process(pid)}))
+
+
+def test_two_runs_claiming_one_folder_at_once_one_is_refused(tmp_path):
+    """Two runs started at the same instant into one new folder both passed the record check, both
+    wrote, both failed (HDF5's "unable to lock file", a checkpoint's "No such file") and the second's
+    failed record replaced the first's (a user trial, 4 of 4 tries). The claim holds a lock on the
+    folder from its check to its record: a second claim waits for it, then finds the first run's
+    record and is refused, writing nothing."""
+    import threading
+    from mpi4py import MPI
+    from multiscale.errors import SceneError
+    from multiscale.workflows.output import exclusive, prepare_folder
+    folder = tmp_path / "results"
+    out = prepare_folder(load(DEMOS / "pin_on_disc_perfect.toml", {"output.folder": str(folder)}), False, False,
+                         MPI.COMM_WORLD)
+    other = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(60)"])
+    errors = []
+
+    def claim():
+        try:
+            out.claim()
+        except SceneError as exc:
+            errors.append(str(exc))
+    try:
+        with exclusive(folder):                  # the other run between its check and its record
+            second = threading.Thread(target=claim)
+            second.start()
+            second.join(0.5)
+            assert second.is_alive()             # waits for the lock
+            _living_record(folder, other.pid)
+        second.join(30)
+        assert not second.is_alive() and len(errors) == 1
+        assert f"another run writes into it (process {other.pid} on this host" in errors[0]
+        assert json.loads((folder / "provenance.json").read_text())["process"]["pid"] == other.pid
+    finally:
+        other.kill()
+        other.wait()
+
+
+def test_a_claim_refuses_results_that_appeared_since_the_run_prepared(tmp_path):
+    """A run that began and ended while this one meshed leaves results the folder check did not see:
+    the claim refuses them instead of writing over them without --overwrite."""
+    from mpi4py import MPI
+    from multiscale.errors import SceneError
+    from multiscale.workflows.output import prepare_folder
+    folder = tmp_path / "results"
+    out = prepare_folder(load(DEMOS / "pin_on_disc_perfect.toml", {"output.folder": str(folder)}), False, False,
+                         MPI.COMM_WORLD)
+    (folder / "history.csv").write_text("t\n")
+    with pytest.raises(SceneError, match=r"1 entry appeared in it while this run prepared \(history.csv\)"):
+        out.claim()
+    assert sorted(p.name for p in folder.iterdir()) == ["history.csv"]
+
+
+def test_a_killed_run_not_yet_reaped_frees_its_folder(tmp_path):
+    """``--resume`` right after a SIGKILL was refused for a moment: the killed process, a zombie until
+    its parent reaps it, still had its pid and start. A zombie writes nothing: its folder is free."""
+    short = subprocess.Popen([sys.executable, "-c", "import time; time.sleep(0.5)"])
+    _living_record(tmp_path, short.pid)
+    assert provenance.writer(tmp_path)["process"]["pid"] == short.pid
+    stat = Path(f"/proc/{short.pid}/stat")
+    for _ in range(300):                         # not reaped: no wait() before the check
+        if stat.read_text().rsplit(")", 1)[1].split()[0] == "Z":
+            break
+        time.sleep(0.05)
+    try:
+        assert stat.read_text().rsplit(")", 1)[1].split()[0] == "Z"
+        assert provenance.writer(tmp_path) is None
+    finally:
+        short.wait()

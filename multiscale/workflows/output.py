@@ -1,12 +1,15 @@
 """Where a run writes: the output-folder check (the only one) and the result every workflow returns."""
 from __future__ import annotations
 
+import fcntl
+import os
 import shutil
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from multiscale import io, outputs, provenance
-from multiscale.errors import InputError, OutputError, SceneError
+from multiscale.errors import InputError, SceneError
 
 
 @dataclass
@@ -34,25 +37,39 @@ class OutputFolder:
     comm: object
     replace: list          # names of earlier results that claim deletes (--overwrite)
     resume: bool = False
+    seen: list = field(default_factory=list)     # the entries the folder held at ``prepare_folder``
 
     def claim(self) -> Path:
         """Delete the earlier results (``--overwrite``: every entry the earlier run recorded writing,
         ``provenance.results_of``, so no stale field file, figure or checkpoint of another scene stays
         beside the new results; entries no run recorded, the user's own, stay with a message) and
         write the new run's provenance with status ``provenance.RUNNING`` (what a killed run leaves;
-        resumed, a part of that status after the earlier parts). Collective; once per run."""
+        resumed, a part of that status after the earlier parts). A ``SceneError`` on every rank, with
+        nothing written, when another run has since begun writing into the folder or has written
+        entries into it (``exclusive``: of two runs started at once, one). Collective; once per run."""
         scene, comm = self.scene, self.comm
 
         def start():
-            busy = busy_message(self.path)        # (one that began since ``prepare_folder``)
-            if busy:
-                raise OutputError(busy)
-            if self.replace:
-                clear(self.path, self.replace)
-            provenance.write(self.path, scene, ranks=comm.size, started=provenance.now(), stages={},
-                             wall_time=0.0, status=provenance.RUNNING, analysis=outputs.analysis(scene),
-                             warnings=scene.warnings, earlier=provenance.parts_of(self.path) if self.resume else ())
-        io.on_root(comm, start, f"into the output folder {self.path}")
+            with exclusive(self.path):            # the check and the record at once: no run between
+                busy = busy_message(self.path)    # (one that began since ``prepare_folder``)
+                if busy:
+                    return busy
+                appeared = sorted(set(scene.earlier_results()) - set(self.seen))
+                if appeared:                      # a run that began and ended since ``prepare_folder``
+                    shown = ", ".join(appeared[:3]) + (", ..." if len(appeared) > 3 else "")
+                    return (f'output.folder = "{self.path}": {provenance.entries(len(appeared))} appeared in '
+                            f"it while this run prepared ({shown}), written by another run: run again to see "
+                            "what it holds, or choose another folder")
+                if self.replace:
+                    clear(self.path, self.replace)
+                provenance.write(self.path, scene, ranks=comm.size, started=provenance.now(), stages={},
+                                 wall_time=0.0, status=provenance.RUNNING, analysis=outputs.analysis(scene),
+                                 warnings=scene.warnings,
+                                 earlier=provenance.parts_of(self.path) if self.resume else ())
+                return None
+        refused = comm.bcast(io.on_root(comm, start, f"into the output folder {self.path}"), root=0)
+        if refused:
+            raise SceneError(refused)
         io.reporter().folder = self.path        # where a failed run leaves its provenance
         return self.path
 
@@ -101,7 +118,25 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
         probe.write_bytes(b"")
         probe.unlink()
     io.on_root(comm, create, f"into the output folder {folder}")
-    return OutputFolder(folder, scene, comm, [] if resume else existing, resume)
+    return OutputFolder(folder, scene, comm, [] if resume else existing, resume, existing)
+
+
+@contextmanager
+def exclusive(folder: Path):
+    """Hold an exclusive advisory lock (``flock``) on the directory ``folder`` for the block, waiting
+    for another process's (rank 0). Two runs started at the same instant into one new folder both
+    passed the record check and both failed, the second's record over the first's (a user trial):
+    under the lock one of them finds the other's record. A file system without ``flock`` on
+    directories (some NFS mounts) gives no lock: the record check alone, as before."""
+    fd = os.open(folder, os.O_RDONLY | os.O_DIRECTORY)
+    try:
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX)
+        except OSError:
+            pass
+        yield
+    finally:
+        os.close(fd)                              # (releases the lock)
 
 
 def busy_message(folder: Path) -> str | None:
