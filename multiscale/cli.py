@@ -27,7 +27,7 @@ from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.reading import COMMAND_LINE, TopographyWarning, formats, read_topography
 from multiscale.micro.spectrum import statistics_memory, surface_statistics
 from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition
-from multiscale.mode_pairs import pair, read_modes, report, write_pairs
+from multiscale.mode_pairs import mirrored, pair, read_modes, report, write_pairs
 from multiscale.outputs import CHECKPOINT, analysis, folder_problem, plan
 from multiscale.outputs import summary as plan_summary
 from multiscale.provenance import versions
@@ -322,7 +322,8 @@ def surface_memory(shape) -> float:
 
 def _modes(args) -> int:
     """Pair the modes of two squeal runs by MAC: a table, and the matrix as CSV or a figure."""
-    pairs = pair(read_modes(args.runs[0]), read_modes(args.runs[1]))
+    b = read_modes(args.runs[1])
+    pairs = pair(read_modes(args.runs[0]), mirrored(b, args.mirror) if args.mirror else b, transfer=bool(args.mirror))
     print("\n".join(report(pairs)))
     if args.csv:
         print(f"MAC matrix: {write_pairs(pairs, args.csv)}")
@@ -440,6 +441,9 @@ def build_parser() -> argparse.ArgumentParser:
                            "(modal assurance criterion of the complex mode shapes in their results folders): "
                            "forward against reverse rotation, with or without damping, serial against parallel.")
     modes.add_argument("runs", nargs=2, metavar="RUN", help="results folders of the two runs (A, then B)")
+    modes.add_argument("--mirror", choices=("x", "y", "z"), help="compare B mirrored in the plane normal to this "
+                       "axis through the middle of its mesh (a reverse run of a brake symmetric about that plane; "
+                       "the built-in brake: x), its shapes taken at A's nodes from the nearest of its own")
     modes.add_argument("--csv", metavar="FILE", help="write the MAC matrix (A's modes x B's) as CSV")
     modes.add_argument("--figure", metavar="FILE", help="draw the MAC matrix (PNG, PDF, SVG)")
     modes.set_defaults(func=_modes)
