@@ -74,20 +74,24 @@ def memory_available() -> float | None:
 
 
 # Peak memory [bytes] of a run with n displacement dofs: ranks x BASE + SCALE (n / 1e5)^(4/3), the
-# factors' fill under nested dissection in 3-D (George 1973; MUMPS orders by METIS). Fitted to the
-# demo car brake run serially (peak RSS by /usr/bin/time -v, 2026-12-05, docs/performance.rst):
-# "squeal", quadratic tetrahedra, the default method, 35k-253k dofs, within 2.1 %; "transient",
-# linear, with heat (about twice as many temperature dofs), 18k-138k dofs, within 2.4 %. Other
+# factors' fill under nested dissection in 3-D (George 1973; MUMPS orders by METIS), and for a squeal
+# run MODE_MEMORY n m for m modes asked for (the eigensolver's subspace and the modes kept). Fitted
+# to runs measured serially (peak RSS by /usr/bin/time -v, 2026-12-05, docs/performance.rst):
+# "squeal", quadratic tetrahedra, the default method, the demo car brake (35k-253k dofs, 60 modes)
+# and the built-in brake (49k-106k dofs, 40 and 100 modes), within 7 %; "transient", linear, with
+# heat (about twice as many temperature dofs), the car brake, 18k-138k dofs, within 2.4 %. Other
 # shapes fill otherwise and larger models are extrapolated: an estimate, not a bound.
-RUN_MEMORY = {"squeal": (0.68e9, 1.97e9), "transient": (0.37e9, 1.55e9)}
+RUN_MEMORY = {"squeal": (0.56e9, 1.66e9), "transient": (0.37e9, 1.55e9)}
+MODE_MEMORY = 89.0       # bytes a displacement dof and a mode asked for (stability.modes)
 DOFS_PER_CELL = {"squeal": 5.0, "transient": 0.64}     # displacement dofs per tetrahedron (the larger meshes)
 
 
-def run_memory(dofs: float, kind: str, ranks: int = 1) -> float:
+def run_memory(dofs: float, kind: str, ranks: int = 1, modes: int = 0) -> float:
     """The estimated peak memory [bytes] of a run of ``kind`` ("squeal" or "transient") with
-    ``dofs`` displacement dofs on ``ranks`` processes (``RUN_MEMORY``)."""
+    ``dofs`` displacement dofs on ``ranks`` processes, a squeal run asking for ``modes`` modes
+    (``RUN_MEMORY``, ``MODE_MEMORY``)."""
     base, scale = RUN_MEMORY[kind]
-    return ranks * base + scale * (dofs / 1e5) ** (4 / 3)
+    return ranks * base + scale * (dofs / 1e5) ** (4 / 3) + MODE_MEMORY * dofs * modes
 
 
 def remedy(squeal: bool) -> str:

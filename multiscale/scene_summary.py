@@ -236,7 +236,7 @@ def memory_line(scene: Scene, cells: int) -> tuple[str, float]:
     (``memory.run_memory`` of ``DOFS_PER_CELL`` dofs a cell: an estimate), and that memory [bytes]."""
     kind = "squeal" if scene.has("stability") else "transient"
     dofs = DOFS_PER_CELL[kind] * cells
-    need = run_memory(dofs, kind)
+    need = run_memory(dofs, kind, modes=scene.stability.modes if kind == "squeal" else 0)
     return (f"  memory    about {need / 1e9:.2g} GB at the peak of a {kind} run on one rank, each more adding about "
             f"{RUN_MEMORY[kind][0] / 1e9:.2g} GB (about {dofs:,.0f} displacement dofs; an estimate from measured "
             "runs, docs/performance.rst)", need)

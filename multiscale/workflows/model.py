@@ -215,11 +215,11 @@ def build_mesh(scene, comm=MPI.COMM_WORLD) -> two_body.TwoBodyMesh:
     return tm
 
 
-def say_model_size(tm, mechanics, thermal=None, kind: str = "transient") -> None:
+def say_model_size(tm, mechanics, thermal=None, kind: str = "transient", modes: int = 0) -> None:
     """Say the size of a model, a console line: its cells, displacement dofs and (with heat)
     temperature dofs; and warn (stderr, at once) when a run of ``kind`` ("transient" or "squeal")
-    of that size is estimated to need more memory than the machines of its ranks have free
-    (``memory.run_memory``; a squeal run of ~1M dofs was checked OK and would take ~40 GB: a user
+    of that size (a squeal run asking for ``modes`` modes) is estimated to need more memory than the
+    machines of its ranks have free (``memory.run_memory``; a squeal run of ~1M dofs was checked OK and would take ~40 GB: a user
     trial). Collective: global counts."""
     def count(functions) -> int:
         return sum(f.function_space.dofmap.index_map.size_global * f.function_space.dofmap.index_map_bs
@@ -234,7 +234,7 @@ def say_model_size(tm, mechanics, thermal=None, kind: str = "transient") -> None
     comm = tm.comm
     hosts = comm.allgather(MPI.Get_processor_name())
     free = comm.allgather(memory_available() if hosts.index(hosts[comm.rank]) == comm.rank else 0.0)
-    need, have = run_memory(n, kind, comm.size), (None if None in free else sum(free))
+    need, have = run_memory(n, kind, comm.size, modes), (None if None in free else sum(free))
     if comm.rank == 0 and have is not None and need > have:
         machines = "this machine" if len(set(hosts)) == 1 else f"the {len(set(hosts))} machines of its ranks"
         print(f"warning: a {kind} run of {spaced(n)} displacement dofs takes about {need / 1e9:.3g} GB at its peak (an "

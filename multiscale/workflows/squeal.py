@@ -172,7 +172,7 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     name = name or scene.name
     prefix = "squeal_" + "".join(ch if ch.isalnum() else "_" for ch in name) + "_"
     mech = build_squeal_mechanics(scene, tm, degree=degree, prefix=prefix)
-    say_model_size(tm, mech, kind="squeal")
+    say_model_size(tm, mech, kind="squeal", modes=st.modes)
     try:
         with closed_on_error(mech, tm.comm):
             d = drive(scene, tm)
