@@ -19,7 +19,7 @@ from pathlib import Path
 from mpi4py import MPI
 
 from multiscale import __version__
-from multiscale.errors import InputError, MultiscaleError, OutputError, SceneError
+from multiscale.errors import InputError, MultiscaleError, OutputError, SceneError, behind
 from multiscale.geometry import too_many_cells
 from multiscale.io import CtrlCWatch, Outliving, abort, ended_together
 from multiscale.memory import memory_available, memory_limit, remedy
@@ -495,19 +495,22 @@ def main(argv: list[str] | None = None) -> int:
     except MultiscaleError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
-    except MemoryError as exc:    # (a squeal run under ulimit -v ended in a traceback of numpy's allocation)
-        print(f"error: out of memory ({exc or 'MemoryError'}): more than the {memory_limit() / 1e9:.3g} GB this "
-              "process may use (the machine's, a container's or batch job's limit, ulimit -v); what a run wrote "
-              f"stays, its provenance.json says it failed: {remedy(squeal=True)}", file=sys.stderr)
-        if MPI.COMM_WORLD.size > 1:      # the other ranks wait in a collective: ended with this one
-            abort(MPI.COMM_WORLD, 2)
-        return 2
     except KeyboardInterrupt:     # Ctrl-C in a command without its own words (check --cells: a traceback)
         print(f"interrupted: multiscale {args.command}", file=sys.stderr)
         return 130
     except BrokenPipeError:       # `multiscale surface FILE | head`: the reader left; no traceback
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())    # (nor at the interpreter's flush)
         return 141
+    except Exception as exc:      # (a squeal run under ulimit -v ended in a traceback of numpy's allocation)
+        lack = behind(exc, MemoryError)
+        if lack is None:
+            raise
+        print(f"error: out of memory ({lack or 'MemoryError'}): more than the {memory_limit() / 1e9:.3g} GB this "
+              "process may use (the machine's, a container's or batch job's limit, ulimit -v); what a run wrote "
+              f"stays, its provenance.json says it failed: {remedy(squeal=True)}", file=sys.stderr)
+        if MPI.COMM_WORLD.size > 1:      # the other ranks wait in a collective: ended with this one
+            abort(MPI.COMM_WORLD, 2)
+        return 2
 
 
 if __name__ == "__main__":  # pragma: no cover

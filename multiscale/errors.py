@@ -88,17 +88,22 @@ class Interrupted(KeyboardInterrupt):
         self.warnings = tuple(warnings)
 
 
-def interrupted(exc: BaseException) -> KeyboardInterrupt | None:
-    """The Ctrl-C behind ``exc``: ``exc`` if a ``KeyboardInterrupt``, or the one that caused it on
-    its way out of a library (petsc4py turns one raised in a callback of SNES into ``PETSc.Error``
-    101, whose text is PETSc's stack); None if there is none."""
+def behind(exc: BaseException | None, kind: type) -> BaseException | None:
+    """The exception of type ``kind`` behind ``exc``: ``exc`` itself, or the one that caused it on its
+    way out of a library (petsc4py turns one raised in a callback of SNES into ``PETSc.Error`` 101,
+    whose text is PETSc's stack); None if there is none."""
     seen = set()
     while exc is not None and id(exc) not in seen:
-        if isinstance(exc, KeyboardInterrupt):
+        if isinstance(exc, kind):
             return exc
         seen.add(id(exc))
         exc = exc.__cause__ or exc.__context__
     return None
+
+
+def interrupted(exc: BaseException) -> KeyboardInterrupt | None:
+    """The Ctrl-C behind ``exc`` (``behind``), None if there is none."""
+    return behind(exc, KeyboardInterrupt)
 
 
 MAX_TOML_BYTES = 16 * 2**20      # a scene or study file larger than this is not one

@@ -242,8 +242,9 @@ def test_run_hands_the_scene_to_the_runner(tmp_path, fake_runner):
 
 
 def test_a_run_out_of_memory_says_so_without_a_traceback(tmp_path, capsys, fake_runner, monkeypatch):
-    """A squeal run under `ulimit -v` ended in a traceback of numpy's allocation: now one error line
-    with the memory the process may use and what to change, status 2."""
+    """A squeal run under `ulimit -v` ended in a traceback of numpy's allocation, also inside PETSc's
+    callback (its error 101 caused by the MemoryError): now one error line with the memory the
+    process may use and what to change, status 2."""
     def starved(scene, **kw):
         raise MemoryError("Unable to allocate 33.3 MiB for an array")
     monkeypatch.setattr(sys.modules["multiscale.workflows"], "run", starved)
@@ -252,6 +253,18 @@ def test_a_run_out_of_memory_says_so_without_a_traceback(tmp_path, capsys, fake_
     err = capsys.readouterr().err
     assert err.startswith("error: out of memory (Unable to allocate 33.3 MiB for an array): more than the 3.07 GB "
                           "this process may use") and "Traceback" not in err
+
+    def starved_in_a_callback(scene, **kw):   # petsc4py's error 101 keeps the callback's MemoryError as its cause
+        raise RuntimeError("error code 101") from MemoryError("Unable to allocate 8.00 MiB for an array")
+    monkeypatch.setattr(sys.modules["multiscale.workflows"], "run", starved_in_a_callback)
+    assert main(["run", _write(tmp_path, BLOCK.replace("../results/block_on_flat", "out"))]) == 2
+    assert capsys.readouterr().err.startswith("error: out of memory (Unable to allocate 8.00 MiB for an array)")
+
+    def failed(scene, **kw):                  # any other error is not hidden
+        raise RuntimeError("error code 101")
+    monkeypatch.setattr(sys.modules["multiscale.workflows"], "run", failed)
+    with pytest.raises(RuntimeError, match="error code 101"):
+        main(["run", _write(tmp_path, BLOCK.replace("../results/block_on_flat", "out"))])
 
 
 def test_set_gives_scene_keys_over_the_files_to_check_and_run(tmp_path, capsys, monkeypatch):

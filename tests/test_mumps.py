@@ -105,3 +105,25 @@ def nearest_eigenvalues_against_dense() -> None:
 
 def test_slepc_shift_invert_on_the_indefinite_matrix():
     nearest_eigenvalues_against_dense()
+
+
+def test_factors_that_do_not_fit_in_memory_are_a_memory_error():
+    """A squeal run under ``ulimit -v`` whose shift-and-invert factors ran out of memory (MUMPS
+    INFOG(1) = -13) was told to choose another target. Factors over their cap (ICNTL(23) = 1 MB a
+    rank, INFOG(1) = -19) are a ``MemoryError`` naming MUMPS' status and the cap, through SLEPc's
+    shift-and-invert and the block Lanczos factors alike."""
+    import pytest
+    K, M = petsc(indefinite(shift=2.0)), petsc(sp.identity(2000, format="csr"))
+    options = PETSc.Options()
+    for prefix in ("capped_st_", "capped_"):
+        options[f"{prefix}mat_mumps_icntl_23"] = 1
+    try:
+        with pytest.raises(MemoryError, match=r"the factors of the shifted operator did not fit \[.*INFOG\(1\) = "
+                                              r"-19 .*\]; or raise the cap mat_mumps_icntl_23"):
+            eigen.solve_modes(K, M, target=math.sqrt(2.0) / (2 * math.pi), f_max=math.sqrt(2.05) / (2 * math.pi),
+                              n_modes=3, nev=3, options_prefix="capped_")
+        with pytest.raises(MemoryError, match=r"INFOG\(1\) = -19"):
+            ShiftInvert(K, M, shift=2.0, prefix="capped_")
+    finally:
+        for prefix in ("capped_st_", "capped_"):
+            options.delValue(f"{prefix}mat_mumps_icntl_23")

@@ -65,7 +65,10 @@ class ShiftInvert:
         except PETSc.Error as exc:
             failed = str(exc).strip()
         if failed:
-            self.destroy()
+            try:
+                mumps.check_memory(pc, "the shifted operator")
+            finally:
+                self.destroy()
             raise InputError("target", math.sqrt(max(self.shift, 0.0)) / TWO_PI,
                              f"K - (2 pi target)^2 M could not be factorised (singular at this shift? a free "
                              f"body needs a target > 0 away from an eigenvalue) [{failed}]")

@@ -204,6 +204,7 @@ def _set_up(solver, want: int, failure: tuple) -> None:
     except (PETSc.Error, SystemError) as exc:
         failed = mumps.describe(pc) or str(exc.__cause__ or exc).strip()
     if failed:
+        mumps.check_memory(pc, "the shifted operator")
         name, value, text = failure
         raise InputError(name, value, f"{text} [{failed}]")
 

@@ -77,6 +77,16 @@ def precision(prefix: str, value: str):
         options.delValue("pc_precision")
 
 
+def check_memory(pc: PETSc.PC, what: str) -> None:
+    """Raise ``MemoryError`` (on every rank: INFOG is global) when the PC's factorisation of ``what``
+    did not fit in memory (``MEMORY_ERRORS``): a squeal run under ``ulimit -v`` was told to choose
+    another shift target (a user trial)."""
+    code = status(pc)
+    if code in MEMORY_ERRORS:
+        cap = "; or raise the cap mat_mumps_icntl_23 (MB a rank)" if code == -19 else ""
+        raise MemoryError(f"the factors of {what} did not fit [{describe(pc)}]{cap}")
+
+
 def describe(pc: PETSc.PC) -> str:
     """Why the PC's factorisation failed ("" if it did not): PETSc's failed reason and MUMPS' INFOG(1)."""
     reason, code = pc.getFailedReason(), status(pc)
