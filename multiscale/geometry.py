@@ -274,14 +274,18 @@ class CellEstimate:
 
 
 def start_gmsh() -> None:
-    """``gmsh.initialize``, quiet, without its Ctrl-C handler, and with Python's SIGPIPE kept:
-    gmsh's initialisation sets it to the default, which killed a run piped into ``head`` or
-    ``less`` wherever it was (status 141, its files half written) instead of the BrokenPipeError
-    that ``io.Outliving`` takes."""
+    """``gmsh.initialize``, quiet, without its Ctrl-C handler, and with Python's handlers of SIGPIPE,
+    SIGTERM and SIGHUP kept: gmsh's initialisation sets them to the default, which killed a run
+    piped into ``head`` or ``less`` wherever it was (status 141, its files half written) instead of
+    the BrokenPipeError that ``io.Outliving`` takes, and a run sent SIGTERM (a scheduler's time
+    limit) or SIGHUP under ``nohup`` without a word (measured by sigaction, gmsh 4.x)."""
     import gmsh   # local: this module stays importable without gmsh's library (scene reading)
     gmsh.initialize(interruptible=False)
-    if threading.current_thread() is threading.main_thread() and hasattr(signal, "SIGPIPE"):
-        signal.signal(signal.SIGPIPE, signal.getsignal(signal.SIGPIPE))    # Python's own, as before
+    if threading.current_thread() is threading.main_thread():
+        for name in ("SIGPIPE", "SIGTERM", "SIGHUP"):
+            if hasattr(signal, name):
+                kind = getattr(signal, name)
+                signal.signal(kind, signal.getsignal(kind))       # Python's own, as before
     gmsh.option.setNumber("General.Terminal", 0)
 
 

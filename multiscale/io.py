@@ -187,6 +187,9 @@ class Outliving:
         return getattr(self.stream, name)
 
 
+TERMINATING = (signal.SIGTERM, signal.SIGHUP)     # signals that end a run as Ctrl-C does
+
+
 class StepStop:
     """Ctrl-C in a loop of steps (a context manager). The first SIGINT asks the loop to stop after
     its current step, when ``requested()`` (every rank together: one stops, all stop, at the same
@@ -199,14 +202,14 @@ class StepStop:
     ignored, as under ``nohup``) count as Ctrl-Cs: the first stops the run after its step (they
     killed it, its provenance left "running"). Without the main thread, nothing is installed."""
 
-    SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+    SIGNALS = (signal.SIGINT, *TERMINATING)
     FIRST = "\n{}: stopping after this step, with its results written ({})\n"
     AGAIN = {1: "Ctrl-C again is mpiexec's: it kills the job at once",
              0: "{} twice more abandons the step"}
     HELD = ("\nCtrl-C: still finishing the step and writing its results; Ctrl-C again abandons the step "
             "(the results written stay as they are)\n")
     WRITING = "\nCtrl-C: held until the results being written are complete\n"
-    taken = 0        # SIGINTs every StepStop of this process took (``CtrlCWatch`` counts them)
+    taken = 0        # signals every StepStop of this process took (``CtrlCWatch`` counts them)
 
     def __init__(self, comm, done: int = 0):
         self.comm, self.done, self.previous = comm, done, None
@@ -230,7 +233,7 @@ class StepStop:
 
     def _handle(self, signum, frame):
         self.count += 1
-        StepStop.taken += signum == signal.SIGINT
+        StepStop.taken += 1
         if self.count > 2 and not self.saving:
             raise KeyboardInterrupt(f"during step {self.done + 1}, abandoned: the results of step {self.done} "
                                     "are the last written")
@@ -286,6 +289,11 @@ def abort(comm, code: int, grace: float = 1.0, quiet: bool = False) -> None:
     comm.Abort(code)
 
 
+def _terminated(signum, frame):
+    """SIGTERM or SIGHUP outside a loop of steps (``CtrlCWatch``): a Ctrl-C that names it."""
+    raise KeyboardInterrupt(f"by {signal.Signals(signum).name}")
+
+
 class CtrlCWatch:
     """Ctrl-C outside a loop of steps, whatever each rank is doing (a context manager; the cli's).
     Python meets a SIGINT only between bytecodes of the main thread: a rank inside a long C call
@@ -293,8 +301,11 @@ class CtrlCWatch:
     left meets it late or never, while the ranks that left wait for it. This thread wakes at the
     signal itself (``signal.set_wakeup_fd``); if the main thread has not met the interrupt
     (``end``) within ``WAIT`` [s] (plus ``STAGGER`` [s] per rank: rank 0 first, the others only if
-    it cannot), it prints ``line()`` and ends every rank with ``code`` (``abort``, quiet). Signals
-    the default handler does not take (``StepStop``'s, an ignored SIGINT) are left alone: those a
+    it cannot), it prints ``line()`` and ends every rank with ``code`` (``abort``, quiet). SIGTERM
+    and SIGHUP (a scheduler's time limit, a closed terminal) are Ctrl-Cs too, ``KeyboardInterrupt``
+    "by SIGTERM" (before, outside the steps they ended the process without a word, its provenance
+    left "running"); ignored ones (``nohup``) stay ignored. Signals the watch's handlers do not
+    take (``StepStop``'s, an ignored SIGINT) are left alone: those a
     ``StepStop`` took are counted (``StepStop.taken``), since the watcher may read a signal's byte
     after the ``StepStop`` that took it put the default handler back (it then aborted a run while
     its end was written: provenance.json left "running", no open_in_paraview.py; 1 in 6 quick Ctrl-Cs)."""
@@ -304,10 +315,12 @@ class CtrlCWatch:
     def __init__(self, comm, line, code: int):
         self.comm, self.line, self.code = comm, line, code
         self.taken, self.pipe, self.previous, self.watcher = threading.Event(), None, None, None
-        self.lock, self.ending = threading.Lock(), False
+        self.lock, self.ending, self.ended = threading.Lock(), False, {}
 
     def __enter__(self):
         if threading.current_thread() is threading.main_thread():
+            self.ended = {s: signal.signal(s, _terminated) for s in TERMINATING
+                          if signal.getsignal(s) is not signal.SIG_IGN}
             self.pipe = os.pipe()
             os.set_blocking(self.pipe[1], False)
             self.previous = signal.set_wakeup_fd(self.pipe[1], warn_on_full_buffer=False)
@@ -317,6 +330,8 @@ class CtrlCWatch:
 
     def __exit__(self, *exc):
         if self.pipe is not None:
+            for s, handler in self.ended.items():
+                signal.signal(s, handler)
             signal.set_wakeup_fd(self.previous)
             self.taken.set()
             os.close(self.pipe[1])            # the watcher reads the end of the pipe and stops
@@ -340,11 +355,12 @@ class CtrlCWatch:
         abort(self.comm, self.code, quiet=True)
 
     def _watch(self, fd: int) -> None:
-        seen, ours = 0, StepStop.taken          # SIGINTs read here; those StepStops took before
+        seen, ours = 0, StepStop.taken          # signals read here; those StepStops took before
+        handlers = {signal.SIGINT: signal.default_int_handler, **{s: _terminated for s in self.ended}}
         try:
             while (data := os.read(fd, 64)) and not self.taken.is_set():
-                seen += data.count(signal.SIGINT)
-                if signal.SIGINT in data and signal.getsignal(signal.SIGINT) is signal.default_int_handler:
+                seen += sum(data.count(s) for s in handlers)
+                if any(s in data and signal.getsignal(s) is h for s, h in handlers.items()):
                     end = _time.monotonic() + self.WAIT + self.STAGGER * self.comm.rank
                     while not self.taken.wait(0.01) and StepStop.taken - ours < seen and _time.monotonic() < end:
                         pass

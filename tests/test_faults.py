@@ -554,6 +554,59 @@ def test_a_serial_run_ended_from_the_watcher_inside_gmsh_exits_with_its_code(tmp
     assert time.monotonic() - started < 60
 
 
+# the mesh build of the cooling block held up in Python (a sleep) or inside a C call (gmsh meshing a
+# fine box, where no Python signal handler runs)
+HELD_UP_SERIAL = """
+import os, sys, time
+from multiscale.cli import main
+from multiscale.workflows import transient
+
+def held_up(scene, comm):
+    print(f"held up: pid {os.getpid()}", flush=True)
+    if sys.argv[2] == "python":
+        time.sleep(120)
+    import gmsh
+    from multiscale.geometry import start_gmsh
+    start_gmsh()
+    gmsh.model.occ.addBox(0, 0, 0, 1, 1, 1)
+    gmsh.model.occ.synchronize()
+    gmsh.option.setNumber("Mesh.MeshSizeMax", 0.01)
+    gmsh.model.mesh.generate(3)
+
+transient.build_mesh = held_up
+sys.exit(main(["run", sys.argv[1], "--overwrite"]))
+"""
+
+
+@pytest.mark.parametrize("where", ["python", "gmsh"])
+def test_sigterm_before_the_steps_ends_the_run_with_one_line(tmp_path, where):
+    """SIGTERM (a batch scheduler's time limit) during a run's set-up ended it without a word (exit
+    -15) and its provenance said "running" (a user trial). It is a Ctrl-C now: in Python the run
+    stops with the line saying what was written, by SIGTERM; inside a C call (meshing, a
+    factorisation) the watcher ends it within seconds with that line. Exit code 130."""
+    scene, driver = tmp_path / "scene.toml", tmp_path / "driver.py"
+    scene.write_text(SCENE.format(folder=tmp_path / "out"))
+    driver.write_text(HELD_UP_SERIAL)
+    job = subprocess.Popen([sys.executable, str(driver), str(scene), where], stdout=subprocess.PIPE,
+                           stderr=subprocess.PIPE, text=True, start_new_session=True)
+    try:
+        for line in job.stdout:
+            if line.startswith("held up"):
+                break
+        time.sleep(1.0)                          # into the sleep, or into gmsh
+        sent = time.monotonic()
+        job.send_signal(signal.SIGTERM)
+        err = job.communicate(timeout=60)[1]
+        seconds = time.monotonic() - sent
+    finally:
+        if job.poll() is None:
+            os.killpg(job.pid, signal.SIGKILL)
+    assert job.returncode == 130 and seconds < 10, (job.returncode, seconds, err[-3000:])
+    said = "interrupted by SIGTERM" if where == "python" else "interrupted"
+    assert [line for line in err.splitlines() if line.strip()] == [
+        f"{said}: nothing was written; {COMMAND} run {scene} starts again"], err[-3000:]
+
+
 def test_an_interrupt_is_recognised_through_the_errors_it_caused():
     """petsc4py raises PETSc.Error(101) from a KeyboardInterrupt met in an SNES callback: that is a
     Ctrl-C too; an ordinary error is not, and a cycle of causes ends the search."""
