@@ -23,8 +23,6 @@ into body 0; the gap g_n = g_0 + (u_0 − u_1)·n is positive when open (thesis 
 """
 from __future__ import annotations
 
-import signal
-import threading
 from dataclasses import dataclass, field
 from functools import cache
 from importlib import import_module
@@ -35,6 +33,7 @@ from typing import Mapping, Sequence
 import numpy as np
 
 from multiscale.errors import InputError, check_positive
+from multiscale.signals import keep_python_handlers
 
 
 @dataclass(frozen=True)
@@ -275,17 +274,10 @@ class CellEstimate:
 
 def start_gmsh() -> None:
     """``gmsh.initialize``, quiet, without its Ctrl-C handler, and with Python's handlers of SIGPIPE,
-    SIGTERM and SIGHUP kept: gmsh's initialisation sets them to the default, which killed a run
-    piped into ``head`` or ``less`` wherever it was (status 141, its files half written) instead of
-    the BrokenPipeError that ``io.Outliving`` takes, and a run sent SIGTERM (a scheduler's time
-    limit) or SIGHUP under ``nohup`` without a word (measured by sigaction, gmsh 4.x)."""
+    SIGTERM and SIGHUP kept (``signals.keep_python_handlers``: gmsh sets them to the default)."""
     import gmsh   # local: this module stays importable without gmsh's library (scene reading)
     gmsh.initialize(interruptible=False)
-    if threading.current_thread() is threading.main_thread():
-        for name in ("SIGPIPE", "SIGTERM", "SIGHUP"):
-            if hasattr(signal, name):
-                kind = getattr(signal, name)
-                signal.signal(kind, signal.getsignal(kind))       # Python's own, as before
+    keep_python_handlers()
     gmsh.option.setNumber("General.Terminal", 0)
 
 

@@ -21,6 +21,7 @@ from mpi4py import MPI
 from tqdm import tqdm
 
 from multiscale.errors import MultiscaleError, OutputError
+from multiscale.signals import TERMINATING
 
 UNITS = {"time": "s", "force": "N", "pressure": "Pa", "temperature": "K", "heat": "J", "iterations": "-",
          "volume": "m^3", "depth": "m", "rms": "m", "work": "J", "area": "m^2", "moment": "N m", "wear_rate": "1/Pa",
@@ -185,9 +186,6 @@ class Outliving:
 
     def __getattr__(self, name):
         return getattr(self.stream, name)
-
-
-TERMINATING = (signal.SIGTERM, signal.SIGHUP)     # signals that end a run as Ctrl-C does
 
 
 class StepStop:

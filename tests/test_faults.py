@@ -607,6 +607,23 @@ def test_sigterm_before_the_steps_ends_the_run_with_one_line(tmp_path, where):
         f"{said}: nothing was written; {COMMAND} run {scene} starts again"], err[-3000:]
 
 
+KEPT_HANDLER = """
+import os, signal, sys
+signal.signal(signal.SIGTERM, lambda signum, frame: sys.exit(f"kept {signum}"))
+import multiscale.macro
+os.kill(os.getpid(), signal.SIGTERM)
+"""
+
+
+def test_petsc_leaves_python_its_sigterm_handler():
+    """PETSc's initialisation installs its own SIGTERM handler (MPI_Abort): the command line's watch,
+    set before the workflows import PETSc, lost it, and a 2-rank squeal run sent SIGTERM in its eigen
+    solve ended in "Caught signal number 15" and MPI_Abort (a trial). Importing the macro package
+    puts Python's handler back."""
+    done = subprocess.run([sys.executable, "-c", KEPT_HANDLER], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 1 and done.stderr.strip().endswith(f"kept {int(signal.SIGTERM)}"), done.stderr[-2000:]
+
+
 def test_an_interrupt_is_recognised_through_the_errors_it_caused():
     """petsc4py raises PETSc.Error(101) from a KeyboardInterrupt met in an SNES callback: that is a
     Ctrl-C too; an ordinary error is not, and a cycle of causes ends the search."""

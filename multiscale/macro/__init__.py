@@ -23,11 +23,11 @@ except ImportError:  # pragma: no cover  (conda-forge FEniCSx)
     pass
 
 import os  # noqa: E402
-import signal  # noqa: E402
-import threading  # noqa: E402
 
 from mpi4py import MPI  # noqa: E402
 from threadpoolctl import threadpool_limits  # noqa: E402
+
+from multiscale.signals import keep_python_handlers  # noqa: E402
 
 # One BLAS thread per MPI rank unless the user chose a number: OpenBLAS' threads otherwise spin on
 # the cores of the other ranks (dense block products of the modal analysis measured 21x slower with
@@ -40,9 +40,10 @@ from petsc4py import PETSc  # noqa: E402
 # PETSc's initialisation takes SIGPIPE, which Python ignores (a write into a closed pipe raises
 # BrokenPipeError, on which the command line ends quietly with status 141): a run piped into
 # ``head``, or into a ``tee`` that died, was aborted by PETSc ("Caught signal number 13 Broken
-# Pipe", MPI_Abort) wherever it was, its files half written. Python's handling is restored.
-if threading.current_thread() is threading.main_thread() and hasattr(signal, "SIGPIPE"):
-    signal.signal(signal.SIGPIPE, signal.getsignal(signal.SIGPIPE))    # Python's own (as geometry.start_gmsh)
+# Pipe", MPI_Abort) wherever it was, its files half written; and SIGTERM and SIGHUP, which the
+# command line takes as Ctrl-Cs (a 2-rank squeal run sent SIGTERM in its eigen solve was aborted
+# by PETSc, "Caught signal number 15", its provenance left "running"). Python's handling is restored.
+keep_python_handlers()
 
 # PETSc (3.25; option -vec_mdot_use_gemv, on by default) computes VecMDot, the orthogonalisation
 # of (F)GMRES, by BLAS gemv over runs of vectors that happen to lie at one stride in memory and by
