@@ -55,7 +55,7 @@ class ModePairs:
     mac: np.ndarray
     best: np.ndarray
     shift: np.ndarray
-    distance: np.ndarray = None  #: [m] from each node of A to B's nearest node (``transfer``), else None
+    distance: np.ndarray | None = None   #: [m] from each node of A to B's nearest node (``transfer``), else None
 
 
 def _read_part(path: Path) -> tuple[np.ndarray, dict]:
