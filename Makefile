@@ -57,11 +57,10 @@ docs: $(STAMP)
 # process must not run out of MPI communicators (MPICH's 2048; a model not closed keeps ~35-100):
 # the tests' conftest closes every model a module leaves open (docs/architecture.md, "Runs and
 # processes").
-# test_cli runs alone: one of its tests writes into a closed pipe, which ends the process (PETSc's
-# abort, exit code 15) once PETSc or gmsh has set SIGPIPE's handler. WITH: more targets beside.
+# WITH: more targets beside.
 JOBS ?= 2
 ALONE := duty_cycle squeal_effects killed_run coupling macro_thermal faults studies geometry_files architecture \
-	macro_run outputs mesh_size cli
+	macro_run outputs mesh_size
 ALONE_TESTS := $(ALONE:%=tests/test_%.py)
 QUICK_TESTS := $(filter-out $(ALONE_TESTS),$(sort $(wildcard tests/test_*.py)))
 ALONE_RUNS := $(ALONE_TESTS:tests/%.py=run-%)

@@ -624,6 +624,28 @@ def test_petsc_leaves_python_its_sigterm_handler():
     assert done.returncode == 1 and done.stderr.strip().endswith(f"kept {int(signal.SIGTERM)}"), done.stderr[-2000:]
 
 
+CLOSED_PIPE = """
+import os
+import multiscale.macro
+from multiscale.geometry import start_gmsh
+start_gmsh()
+read, write = os.pipe()
+os.close(read)
+try:
+    os.write(write, b"x")
+except BrokenPipeError:
+    print("raised")
+"""
+
+
+def test_a_python_session_with_petsc_and_gmsh_raises_on_a_closed_pipe():
+    """A write into a closed pipe in a session that had loaded PETSc printed "Caught signal number 13
+    Broken Pipe" and called MPI_Abort (exit code 15); after gmsh's initialisation it ended silently
+    (status 141). A notebook kernel died instead of raising; now it is Python's BrokenPipeError."""
+    done = subprocess.run([sys.executable, "-c", CLOSED_PIPE], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0 and done.stdout.strip() == "raised", (done.returncode, done.stderr[-2000:])
+
+
 def test_an_interrupt_is_recognised_through_the_errors_it_caused():
     """petsc4py raises PETSc.Error(101) from a KeyboardInterrupt met in an SNES callback: that is a
     Ctrl-C too; an ordinary error is not, and a cycle of causes ends the search."""
