@@ -47,8 +47,9 @@ def write(folder, text, name="study.toml"):
 
 
 def table(path):
+    """results.csv's rows keyed by column name (its header's units, "name [unit]", left off)."""
     with open(path, newline="") as fh:
-        return list(csv.DictReader(fh))
+        return [{k.split(" [")[0]: v for k, v in row.items()} for row in csv.DictReader(fh)]
 
 
 def hertz_independent(grid, load=10.0, R=10e-3, E=210e9, nu=0.3, window=4.0):
@@ -98,6 +99,10 @@ def test_hertz_study_errors_match_an_independent_computation(hertz_study):
         # units as history.h5's (they were in the report alone; a user trial); a relative error has none
         assert (h5["max_pressure"].attrs["unit"], h5["contact_radius_reference"].attrs["unit"],
                 h5["wall_time"].attrs["unit"]) == ("Pa", "m", "s") and "unit" not in h5["max_pressure_error"].attrs
+    # and in the CSV's header (results.h5 alone had them: a user trial)
+    header = (out / "results.csv").read_text().splitlines()[0].split(",")
+    assert {"grid", "max_pressure [Pa]", "contact_radius_reference [m]", "max_pressure_error",
+            "wall_time [s]", "peak_memory_mb [MB]"} <= set(header), header
     # the report names the cheapest grid meeting each error, from the same errors
     worst = {int(r["grid"]): float(r["max_error"]) for r in rows}
     time = {int(r["grid"]): float(r["wall_time"]) for r in rows}

@@ -33,8 +33,9 @@ finished runs are never recomputed (``--rerun-failed`` retries the failed ones, 
 the others go on. A run that completed keeps every metric it produced and is judged by the study's
 metrics when read: a misspelt history metric, corrected, is read from the same run.
 
-Output: ``results.csv`` and ``results.h5`` (one row per run; in results.h5 a column's SI unit is
-its ``unit`` attribute, a swept parameter's included), PNGs of each metric's relative error
+Output: ``results.csv`` and ``results.h5`` (one row per run; a column's SI unit, a swept
+parameter's included, is its ``unit`` attribute in results.h5 and in its header in results.csv,
+``wall_time [s]``), PNGs of each metric's relative error
 |m − m_ref| / |m_ref| against wall time (Pareto front highlighted) and against each knob (against
 measured values: the metric, its measured value and where the sweep meets it), and a
 Markdown report stating the cheapest setting meeting each stated error; against a reference file

@@ -148,22 +148,28 @@ def _cell(value):
     return json.dumps(value) if isinstance(value, list) else value
 
 
+def csv_header(name: str, unit: str | None) -> str:
+    """results.csv's header of column ``name``: "name [unit]" where its SI unit is known ("-"
+    dimensionless; the CSV had none, only results.h5: a user trial), else the name."""
+    return f"{name} [{unit}]" if unit else name
+
+
 def write_tables(study: Study, rows: list[Row]) -> tuple[Path, Path]:
     """results.csv and results.h5 (one dataset per column, one row per run; a metric's, its
     reference's and the times' with their ``unit`` attribute, as history.h5's)."""
     cols = _columns(study, rows)
     study.folder.mkdir(parents=True, exist_ok=True)
     csv_path, h5_path = study.folder / "results.csv", study.folder / "results.h5"
-    with open(csv_path, "w", newline="", encoding="utf-8") as fh:
-        w = csv.writer(fh)
-        w.writerow(cols)
-        for i in range(len(rows)):
-            w.writerow([_csv(cols[c][i]) for c in cols])
     units = {"wall_time": "s", "cpu_time": "s", "peak_memory_mb": "MB"}    # (said by the report alone; a user trial)
     units.update((k, knob_unit(study, k)) for k in study.knobs)              # (none before: a user trial)
     for m in study.metrics:
         units[m] = PROBLEMS[study.problem].metric_unit(m)
         units[f"{m}_reference"] = units[m] if m in study.judged else None
+    with open(csv_path, "w", newline="", encoding="utf-8") as fh:
+        w = csv.writer(fh)
+        w.writerow([csv_header(c, units.get(c)) for c in cols])
+        for i in range(len(rows)):
+            w.writerow([_csv(cols[c][i]) for c in cols])
     with h5py.File(h5_path, "w") as h5:
         for name, values in cols.items():
             if all(isinstance(v, (int, float, bool)) for v in values):
