@@ -91,7 +91,7 @@ def _check(args) -> int:
             continue
         if args.cells:
             line, estimate = cells_line(scene)
-            need, free = memory_line(scene, estimate.cells), memory_available()
+            need, free = memory_line(scene, estimate), memory_available()
             print(f"{line}\n{need[0]}")
             if free is not None and need[1] > free:    # (a ~1M-dof squeal was "OK": a user trial)
                 print(f"warning: more than the {free / 1e9:.2g} GB this machine has free: "

@@ -266,10 +266,50 @@ class CellEstimate:
     cells: int
     trial: int
     factor: float
+    nodes: int = 0     # the bodies' vertices, each body a mesh of its own (``mesh_counts``); 0: not counted
+    edges: int = 0     # the bodies' edges, likewise
 
     @property
     def exact(self) -> bool:
         return self.factor == 1.0
+
+
+def mesh_counts(model, bodies: Sequence[Sequence[int]]) -> tuple[int, int]:
+    """Vertices and edges of the tetrahedra of ``model``'s mesh, summed over ``bodies`` (each the
+    cell tags, 3-D physical groups, of one body) as the run's bodies are meshes of their own (a face
+    two bodies share counted in each); (0, 0) where a body has cells other than linear tetrahedra."""
+    nodes = edges = 0
+    for tags in bodies:
+        tets = []
+        for entity in (e for t in tags for e in model.getEntitiesForPhysicalGroup(3, t)):
+            types, _, node_tags = model.mesh.getElements(3, entity)
+            if any(kind != 4 for kind in types):
+                return 0, 0
+            tets += [np.asarray(n, dtype=np.int64).reshape(-1, 4) for n in node_tags]
+        if not tets:
+            continue
+        t = np.concatenate(tets)
+        pairs = np.sort(np.stack([t[:, [0, 0, 0, 1, 1, 2]].ravel(), t[:, [1, 2, 3, 2, 3, 3]].ravel()]), axis=0)
+        nodes += np.unique(t).size
+        edges += np.unique(pairs[0] * (int(t.max()) + 1) + pairs[1]).size
+    return nodes, edges
+
+
+def _extrapolated(counted: list[tuple[int, int, int]], cells: float) -> tuple[int, int]:
+    """Vertices and edges of a mesh of ``cells`` cells from trials' (cells, vertices, edges): as
+    a C + b C^(2/3) (volume and surface) through the last two, or in proportion to the last one's
+    cells when it alone is there or the fit is not increasing."""
+    c1, *last = counted[-1]
+    ratio = [round(x * cells / c1) for x in last]
+    if len(counted) < 2 or counted[-2][0] >= c1:
+        return tuple(ratio)
+    c0, *first = counted[-2]
+    out = []
+    for x0, x1, guess in zip(first, last, ratio):
+        a, b = np.linalg.solve([[c0, c0 ** (2 / 3)], [c1, c1 ** (2 / 3)]], [x0, x1])
+        out.append(round(a * cells + b * cells ** (2 / 3)) if a > 0 and a * cells + b * cells ** (2 / 3) >= x1
+                   else guess)
+    return tuple(out)
 
 
 def start_gmsh() -> None:
@@ -291,7 +331,8 @@ def gmsh_session(module: ModuleType) -> None:
 
 
 def estimate_cells(module: ModuleType, params, target: int = 20_000, start: float = 64.0,
-                   enough: int = 0, keep: bool = False, length_scale: float | None = None) -> CellEstimate:
+                   enough: int = 0, keep: bool = False, length_scale: float | None = None,
+                   bodies: Sequence[Sequence[int]] = ()) -> CellEstimate:
     """Estimate the cell count of ``module.generate(params)`` without meshing it at its size: trial
     meshes from ``start`` times coarser, refined until one has ``target`` cells or is the real mesh
     (a trial the CAD kernel cannot mesh that coarse is skipped), or until the estimate is at most
@@ -309,7 +350,11 @@ def estimate_cells(module: ModuleType, params, target: int = 20_000, start: floa
     most ``enough``, the session is left open holding the real mesh (factor 1) for the caller to
     read and end with ``gmsh.finalize()``; otherwise it is ended. With the geometry's
     ``length_scale`` [m], the first trial's elements are at least length_scale / 16 (a mesh size
-    of 12 um on a 300 mm brake made the first trial, 64 times coarser, mesh for minutes)."""
+    of 12 um on a 300 mm brake made the first trial, 64 times coarser, mesh for minutes). With
+    ``bodies`` (each body's cell tags), its vertices and edges too (``mesh_counts`` of the trials,
+    ``_extrapolated``; exact with the mesh; from trials, quadratic dofs a cell within 3 % of the
+    mesh's on the built-in brake and pin-on-disc, 7 % on the car brake at 5 / 3 mm: the cells'
+    over-estimate is the larger error)."""
     import gmsh   # local, as in gmsh_session
     if gmsh.isInitialized():
         raise RuntimeError("estimate_cells runs gmsh sessions of its own: call it before gmsh.initialize")
@@ -318,11 +363,14 @@ def estimate_cells(module: ModuleType, params, target: int = 20_000, start: floa
         if length_scale and hasattr(module, "parameters") else []
     if sizes:
         factor = max(factor, length_scale / (16 * min(sizes)))
+    counted = []      # (cells, vertices, edges) of the trials, with bodies
     try:
         while True:
             trial = _trial(module, params, factor)
             if trial and all(gmsh.model.getType(3, t) == "Discrete volume" for _, t in gmsh.model.getEntities(3)):
                 factor = 1.0           # a mesh read from a file: no size factor changes it
+            if trial and bodies:
+                counted.append((trial, *mesh_counts(gmsh.model, bodies)))
             grow = (target / trial) ** (1 / 3) if trial else 4.0     # a failed trial: its session is gone, skip ahead
             finer = factor / max(2.0, min(grow, 8.0))
             finer = 1.0 if finer < 1.25 else finer         # nearly the mesh: mesh it
@@ -330,7 +378,9 @@ def estimate_cells(module: ModuleType, params, target: int = 20_000, start: floa
             # near the limit, refine on while the finer trial (about cells / finer^3) stays small enough
             near = 0 < enough < cells <= OVER * enough and cells / finer ** 3 <= LARGEST_TRIAL * enough
             if factor == 1.0 or (trial >= target and not near) or 0 < cells <= enough:
-                estimate = CellEstimate(int(round(cells)), trial, factor)
+                known = counted and counted[-1][0] == trial and all(counted[-1])
+                estimate = CellEstimate(int(round(cells)), trial, factor,
+                                        *(_extrapolated(counted, cells) if known else ()))
                 break
             factor = finer
         if keep and estimate.cells <= enough:

@@ -222,20 +222,23 @@ def cells_line(scene: Scene) -> tuple[str, CellEstimate]:
     and the estimate."""
     g = scene.geometry
     params = g.params if g.builder == "file" else dict(g.params)
-    e = estimate_cells(g.module(), params, length_scale=g.spec.length_scale)
+    bodies = [[r.tag for r in b.regions] for b in g.spec.bodies]
+    e = estimate_cells(g.module(), params, length_scale=g.spec.length_scale, bodies=bodies)
     if not e.exact and e.cells > g.max_cells:          # the run's verdict: it refines near the limit
-        e = estimate_cells(g.module(), params, enough=g.max_cells, length_scale=g.spec.length_scale)
+        e = estimate_cells(g.module(), params, enough=g.max_cells, length_scale=g.spec.length_scale, bodies=bodies)
     how = "exact" if e.exact else f"from a trial mesh {e.factor:.3g}x coarser with {e.trial} cells"
     verdict = "refused by run" if e.cells > g.max_cells else "within"
     return (f"  mesh      {'' if e.exact else 'about '}{e.cells:,} cells ({how}); {verdict} geometry.max_cells = "
             f"{g.max_cells:,}", e)
 
 
-def memory_line(scene: Scene, cells: int) -> tuple[str, float]:
-    """The estimated peak memory of a serial run of the scene's mesh of ``cells`` cells
-    (``memory.run_memory`` of ``DOFS_PER_CELL`` dofs a cell: an estimate), and that memory [bytes]."""
+def memory_line(scene: Scene, mesh: CellEstimate) -> tuple[str, float]:
+    """The estimated peak memory of a serial run of the scene's estimated ``mesh`` (``memory.run_memory``
+    of its displacement dofs: quadratic for a squeal run, three a vertex and an edge, linear
+    otherwise, three a vertex; ``DOFS_PER_CELL`` a cell where its vertices were not counted), and
+    that memory [bytes]."""
     kind = "squeal" if scene.has("stability") else "transient"
-    dofs = DOFS_PER_CELL[kind] * cells
+    dofs = 3 * (mesh.nodes + mesh.edges * (kind == "squeal")) if mesh.nodes else DOFS_PER_CELL[kind] * mesh.cells
     need = run_memory(dofs, kind, modes=scene.stability.modes if kind == "squeal" else 0)
     return (f"  memory    about {need / 1e9:.2g} GB at the peak of a {kind} run on one rank, each more adding about "
             f"{RUN_MEMORY[kind][0] / 1e9:.2g} GB (about {dofs:,.0f} displacement dofs; an estimate from measured "

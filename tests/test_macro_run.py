@@ -12,6 +12,7 @@ import pytest
 pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
 from multiscale.errors import InputError, SceneError  # noqa: E402
+from multiscale.geometry import estimate_cells  # noqa: E402
 from multiscale.io import History, solver_statistic  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 from multiscale.workflows.model import build_model  # noqa: E402
@@ -481,6 +482,15 @@ def test_a_run_says_the_size_of_its_model(tmp_path, capsys):
         return f"{n:,}".replace(",", " ")
     assert len(said) == 1 and said[0].startswith(f"  model: {spaced(cells)} cells, {spaced(3 * vertices)} displacement dofs, ")
     assert said[0].endswith(" temperature dofs")
+    # check --cells counts the same bodies' vertices and edges (quadratic dofs: 3 a vertex and an edge)
+    edges = 0
+    for b in tm.bodies:
+        b.mesh.topology.create_entities(1)
+        edges += b.mesh.topology.index_map(1).size_global
+    g = scene.geometry
+    counted = estimate_cells(g.module(), dict(g.params), target=10**8,
+                             bodies=[[r.tag for r in b.regions] for b in g.spec.bodies])
+    assert (counted.cells, counted.nodes, counted.edges) == (cells, vertices, edges)
 
 
 def test_a_body_that_cools_below_a_tables_first_point_is_named(tmp_path):
