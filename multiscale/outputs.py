@@ -212,9 +212,11 @@ def script_name(file: str) -> str:
 def paraview_script(p: Plan) -> str:
     """A pvpython script that opens the results of ``p`` beside it: the bodies coloured by
     temperature (else displacement or von Mises stress), at the last output time with colour
-    ranges over every time; the interface by contact pressure in a view of its own (it lies on
-    the bodies' faces, where it would be hidden); for the squeal analysis the mode shapes, warped,
-    the preloaded bodies open but hidden."""
+    ranges over every time and every body coloured by the array (ParaView keeps one colour map
+    per array name, and each display's rescale over time replaces its range: the pin's 330 K
+    would have shown the top colour of the disc's 293-299 K); the interface by contact pressure
+    in a view of its own (it lies on the bodies' faces, where it would be hidden); for the squeal
+    analysis the mode shapes, warped, the preloaded bodies open but hidden."""
     files, squeal = p.field_files, p.analysis == "squeal"
     interface = OWN_FILES["interface"]
     lines = ['"""Open these results in ParaView: pvpython open_in_paraview.py (a window), or paste into',
@@ -224,7 +226,8 @@ def paraview_script(p: Plan) -> str:
              '"""', "import os", "from paraview.simple import *  # noqa: F401,F403", "",
              "# the folder of this script (the results folder where it was written, if run without a file)",
              f"here = os.path.dirname(os.path.abspath(__file__)) if '__file__' in globals() else {str(p.folder)!r}",
-             "view = GetActiveViewOrCreate('RenderView')", ""]
+             "view = GetActiveViewOrCreate('RenderView')",
+             "coloured = []   # (display, array): the colour ranges are set once every file is shown", ""]
     if interface in files:
         lines += ["# the interface lies on the bodies' faces: it gets a view of its own, right of theirs",
                   "layout = GetLayout(view)", "layout.SplitHorizontal(0, 0.5)",
@@ -241,8 +244,21 @@ def paraview_script(p: Plan) -> str:
             continue
         lines += [f"{var}_view = Show({var}, {where})",
                   f"ColorBy({var}_view, ({centre!r}, {array_name(shown)!r}))",
-                  f"{var}_view.RescaleTransferFunctionToDataRangeOverTime()   # the range of every output time",
-                  f"{var}_view.SetScalarBarVisibility({where}, True)", ""]
+                  f"{var}_view.SetScalarBarVisibility({where}, True)",
+                  f"coloured.append(({var}_view, {array_name(shown)!r}))", ""]
+    lines += ["# one colour map per array name, over every output time of every file coloured by it",
+              "# (each display's rescale replaces the map's range: the last file's alone would be kept)",
+              "ranges = {}",
+              "for display, array in coloured:",
+              "    display.RescaleTransferFunctionToDataRangeOverTime()",
+              "    points = list(GetColorTransferFunction(array).RGBPoints)   # x, r, g, b of each control point",
+              "    lo, hi = ranges.get(array, (points[0], points[-4]))",
+              "    ranges[array] = (min(lo, points[0]), max(hi, points[-4]))",
+              "for array, (lo, hi) in ranges.items():",
+              "    colours = GetColorTransferFunction(array)",
+              "    colours.AutomaticRescaleRangeMode = 'Never'   # kept when the time changes",
+              "    colours.RescaleTransferFunction(lo, hi)",
+              "    GetOpacityTransferFunction(array).RescaleTransferFunction(lo, hi)", ""]
     if squeal:
         lines += ["# mode shapes (VTX, ADIOS2 reader): time = mode number, see modes.csv for the frequencies"]
         for b in p.bodies:

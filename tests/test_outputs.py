@@ -245,17 +245,62 @@ def test_zone_results_say_where_each_value_is(case):
         np.testing.assert_allclose(position[:, 2], facets[:, 2].mean(), rtol=0, atol=1e-15)
 
 
+def data_range(path: Path, array: str) -> tuple[float, float]:
+    """The least and largest value of ``array`` of an XDMF file's HDF5 data over every time (a
+    vector's magnitude, as ParaView colours it)."""
+    import h5py
+    values = []
+    with h5py.File(path.with_suffix(".h5"), "r") as f:
+        for group in f["data"].values():
+            for d in group.values():
+                if d.attrs["name"] == array:
+                    v = d[...]
+                    values.append(np.linalg.norm(v, axis=1) if v.ndim == 2 and v.shape[1] > 1 else v.ravel())
+    v = np.concatenate(values)
+    return float(v.min()), float(v.max())
+
+
+class StubColourMap:
+    """A colour map of ParaView's (one per array name): ``RGBPoints`` x, r, g, b of each point."""
+
+    def __init__(self):
+        self.RGBPoints, self.AutomaticRescaleRangeMode = [0.0, 0, 0, 1, 1.0, 1, 0, 0], "Grow and update on 'Apply'"
+
+    def RescaleTransferFunction(self, lo, hi):
+        self.RGBPoints = [lo, 0, 0, 1, hi, 1, 0, 0]
+
+
+class StubDisplay:
+    def __init__(self, source, maps):
+        self.source, self.maps, self.array = source, maps, None
+
+    def SetScalarBarVisibility(self, view, on):
+        pass
+
+    def RescaleTransferFunctionToDataRangeOverTime(self):
+        """As ParaView does: the array's colour map set to this display's range alone (replaced;
+        a script run without its files: 0 to 1)."""
+        path = Path(self.source.path)
+        self.maps.setdefault(self.array, StubColourMap()).RescaleTransferFunction(
+            *(data_range(path, self.array) if path.with_suffix(".h5").exists() else (0.0, 1.0)))
+
+
 class StubParaView:
     """paraview.simple as far as open_in_paraview.py uses it, recording what the script opens, shows and
-    colours (``opened``: path -> reader; ``coloured``: (reader, array name))."""
+    colours (``opened``: path -> reader; ``coloured``: (reader, array name); ``maps``: array name ->
+    its colour map, ``opacities``: array name -> its opacity map's range)."""
 
     def __init__(self):
         self.view = types.SimpleNamespace(ResetCamera=lambda: None)
         self.face = types.SimpleNamespace(ResetCamera=lambda: None)            # the interface's own view
-        self.opened, self.coloured, self.shown, self.cells = {}, [], [], {}
+        self.opened, self.coloured, self.shown, self.cells, self.maps, self.opacities = {}, [], [], {}, {}, {}
         m = self.module = types.ModuleType("paraview.simple")
         m.__all__ = ["GetActiveViewOrCreate", "GetLayout", "CreateView", "GetAnimationScene", "Xdmf3ReaderS",
-                     "ADIOS2VTXReader", "WarpByVector", "Show", "ColorBy", "Render", "Interact"]
+                     "ADIOS2VTXReader", "WarpByVector", "Show", "ColorBy", "Render", "Interact",
+                     "GetColorTransferFunction", "GetOpacityTransferFunction"]
+        m.GetColorTransferFunction = lambda array: self.maps.setdefault(array, StubColourMap())
+        m.GetOpacityTransferFunction = lambda array: types.SimpleNamespace(
+            RescaleTransferFunction=lambda lo, hi: self.opacities.update({array: (lo, hi)}))
         m.GetActiveViewOrCreate = lambda kind: self.view
         m.GetLayout = lambda view: types.SimpleNamespace(SplitHorizontal=lambda cell, fraction: None,
                                                          AssignView=lambda cell, view: self.cells.update({cell: view}))
@@ -265,10 +310,9 @@ class StubParaView:
         m.Xdmf3ReaderS = lambda registrationName, FileName: self.open(FileName[0])
         m.ADIOS2VTXReader = lambda registrationName, FileName: self.open(FileName)
         m.WarpByVector = lambda Input, Vectors, ScaleFactor: self.coloured.append((Input, Vectors[1])) or Input
-        m.Show = lambda source, view: self.shown.append((source, view)) or types.SimpleNamespace(
-            source=source, SetScalarBarVisibility=lambda view, on: None,
-            RescaleTransferFunctionToDataRangeOverTime=lambda: None)
-        m.ColorBy = lambda shown, array: self.coloured.append((shown.source, array[1]))
+        m.Show = lambda source, view: self.shown.append((source, view)) or StubDisplay(source, self.maps)
+        m.ColorBy = lambda shown, array: self.coloured.append((shown.source, array[1])) or \
+            setattr(shown, "array", array[1])
         m.Render = m.Interact = lambda: None
 
     def shown_in(self, view) -> list[str]:
@@ -311,6 +355,19 @@ def test_the_paraview_script_opens_files_and_arrays_that_exist(case, monkeypatch
         else:
             with h5py.File(path.with_suffix(".h5"), "r") as f:
                 assert array in {d.attrs["name"] for d in f["data/0"].values()}
+    # one colour map per array name spans every file coloured by it over every time (each display's
+    # rescale replaced the last one's: the pin's 330 K would have had the disc's top colour)
+    by_array = {}
+    for source, array in stub.coloured:
+        if Path(source.path).suffix == ".xdmf":
+            by_array.setdefault(array, []).append(data_range(Path(source.path), array))
+    assert by_array and set(stub.opacities) == set(by_array)
+    assert p.analysis == "squeal" or max(len(r) for r in by_array.values()) == 2     # both bodies by one array
+    for array, ranges in by_array.items():
+        lo, hi = min(r[0] for r in ranges), max(r[1] for r in ranges)
+        points = stub.maps[array].RGBPoints
+        assert (points[0], points[-4]) == stub.opacities[array] == (lo, hi), array
+        assert stub.maps[array].AutomaticRescaleRangeMode == "Never"
 
 
 def test_a_body_named_like_a_name_of_the_script_keeps_the_script_working(tmp_path, monkeypatch):
