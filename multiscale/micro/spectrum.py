@@ -14,7 +14,7 @@ flat, or zero for a band-limited surface) and a short-wavelength cut-off q_s (th
 ``fit_power_law`` finds H, q_r and q_s of a measured spectrum (SurfaceTopography fits none).
 ``equivalent_surface`` draws a random surface with the measured PSD itself (not only its fit, and
 with its anisotropy) on any grid; ``surface_statistics`` gives Sq, Sdq, Ssk, Sku, Nayak's parameter, the summit
-density and both of the above.
+density, Sal, Str and the lay (``texture``) and both of the above.
 
 SurfaceTopography stores heights as [x, y]; here they are [y, x] (``multiscale.micro.surface``):
 ``as_topography`` transposes.
@@ -28,6 +28,7 @@ import scipy.fft
 
 from multiscale.errors import InputError, check_count, check_field, check_instance, check_positive
 from multiscale.micro.surface import Surface, check_surface, find_asperities, row_blocks, statistics
+from multiscale.micro.texture import Texture, texture
 
 POWER_FLOOR = 1e-24     # modes below this fraction of the largest C carry no power (FFT round-off: ~1e-32)
 HURST_RANGE = (0.0, 1.5)   # the power-law segment of a fit (a flat roll-off is no self-affine range)
@@ -433,6 +434,7 @@ class Statistics:
     summit_density_gaussian: float   # 1/m^2, Nayak (1971) for an isotropic Gaussian surface
     spectrum: Spectrum
     power_law: PowerLaw | None       # None if the spectrum has too few bins to fit
+    texture: Texture | None = None   # Sal, Str, lay (``texture.texture``); None if f_ACF never falls to 0.2
 
     def table(self, filtered: bool = False) -> list[str]:
         """The statistics as aligned text lines (``multiscale surface``; ``filtered``: of a roughness
@@ -442,6 +444,13 @@ class Statistics:
                 ("Nayak parameter m0 m4/m2^2", f"{self.nayak:.4g}"),
                 ("summit density", f"{self.summit_density * 1e-6:.4g} 1/mm^2 (Gaussian surface, Nayak: "
                                    f"{self.summit_density_gaussian * 1e-6:.4g} 1/mm^2)")]
+        t = self.texture
+        rows += [("Sal  autocorrelation length", _length(t.Sal) + f"  (fastest decay of f_ACF to {t.threshold:g})"),
+                 ("Str  texture aspect ratio", f"{t.Str:.3g}" + (
+                     "  (1 isotropic, towards 0 a lay)" if t.bounded else
+                     f"  (at most: f_ACF stays above {t.threshold:g} out to half the measurement along the lay)")),
+                 ("lay  longest correlation", f"{t.lay:.1f} deg from x towards y")] if t else \
+            [("Sal, Str", "no decay of f_ACF to 0.2 within half the measurement (a form or waviness left)")]
         fit = self.power_law
         if fit is None:
             rows.append(("PSD fit", "too few bins"))
@@ -500,6 +509,7 @@ def surface_statistics(surface: Surface, points_per_decade: int = 10) -> Statist
     """``Statistics`` of one patch (complete heights: fill undefined points first)."""
     if check_surface(surface).heights.ndim != 2:
         raise InputError("surface.heights", surface.heights.shape, "statistics of one 2-D patch at a time")
+    spatial = _texture(surface)          # first: its transforms' memory is free before the periodogram's
     m0, m3, m4_height, slope2 = _height_moments(surface)
     Sq = float(np.sqrt(m0))
     moments = statistics(surface)
@@ -515,7 +525,15 @@ def surface_statistics(surface: Surface, points_per_decade: int = 10) -> Statist
                       m0=float(moments.m0), m2=m2, m4=m4, nayak=float(moments.nayak),
                       summit_density=len(find_asperities(surface)) / inner,
                       summit_density_gaussian=m4 / (6 * np.pi * np.sqrt(3) * m2) if m2 > 0 else 0.0,
-                      spectrum=spectrum, power_law=fit)
+                      spectrum=spectrum, power_law=fit, texture=spatial)
+
+
+def _texture(surface: Surface) -> Texture | None:
+    """``texture.texture`` of the patch, None where its f_ACF does not decay to 0.2."""
+    try:
+        return texture(surface)
+    except InputError:
+        return None
 
 
 def _length(value: float, digits: int = 4) -> str:
