@@ -33,8 +33,9 @@ def colour_range(heights: np.ndarray) -> tuple[float, float]:
 
 
 def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -> Path:
-    """PNG: height map [µm] (and the waviness taken out, if given), then C(q) [m⁴] against q [rad/m]
-    (complete bins as points, partial ones hollow) with the power-law fit between its cut-offs."""
+    """PNG: height map [µm] (its texture aspect ratio and lay in the title; and the waviness taken
+    out, if given), then C(q) [m⁴] against q [rad/m] (complete bins as points, partial ones hollow)
+    with the power-law fit between its cut-offs."""
     maps = [("roughness" if waviness is not None else "heights", surface)] + (
         [("waviness", waviness)] if waviness is not None else [])
     fig = Figure(figsize=(4.6 * (len(maps) + 1), 5.0))
@@ -47,7 +48,8 @@ def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -
                           cmap="viridis", interpolation="nearest", vmin=lo * 1e6, vmax=hi * 1e6)
         ax.set_xlabel("x [mm]")
         ax.set_ylabel("y [mm]")
-        ax.set_title(label)
+        t = stats.texture if s is surface else None
+        ax.set_title(label if t is None else f"{label}: Str {'< ' * (not t.bounded)}{t.Str:.2g}, lay {t.lay:.0f}° from x")
         below, above = s.heights.min() < lo, s.heights.max() > hi
         fig.colorbar(image, ax=ax, shrink=0.85, extend={(0, 0): "neither", (1, 0): "min", (0, 1): "max",
                                                         (1, 1): "both"}[below, above],
