@@ -472,7 +472,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
             warnings += short_phases(scene.loading, g.motion, end, scene.time.dt)
             if scene.materials is not None:
                 warnings += thin_heated_layers(scene.loading, g.motion, end, g.spec, scene.materials,
-                                               scene.time.initial_temperature)
+                                               scene.time.initial_temperature, g.interface_size_key())
         if g is not None and g.motion == "rotation" and "thermal" in effects:
             warnings += convection_coverage(scene.boundary or (), scene.loading, end)
             warnings += plain_speeds(raw, speed_range(scene.loading, end)[1])

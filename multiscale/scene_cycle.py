@@ -91,7 +91,8 @@ def short_phases(ld, motion: str, end: float, dt: float) -> list[str]:
 RESOLVED = 0.9   # a braking's heat depth below this share of the interface's elements is warned about
 
 
-def thin_heated_layers(ld, motion: str, end: float, spec, materials, T0: float) -> list[str]:
+def thin_heated_layers(ld, motion: str, end: float, spec, materials, T0: float,
+                       size_key: str = "interface_mesh_size") -> list[str]:
     """The fixed body's materials along the interfaces (``spec``: the ``GeometrySpec``) into which
     the heat of the shortest braking phase t reaches less deep, sqrt(pi chi t) at the initial
     temperature ``T0`` [K], than the interface's elements (``GeometrySpec.interface_sizes`` [m]; its
@@ -102,7 +103,9 @@ def thin_heated_layers(ld, motion: str, end: float, spec, materials, T0: float) 
     sqrt(pi chi t)/h of it. The demo car pad's face rose 34 K at 0.96 s with 4 mm elements, 58 K
     with 2 mm, 103 K by the semi-infinite solid (a user trial). Elements between half the depth and
     the warning's bound still read low: the car pad's first-stop peak 509 °C with 2 mm, 529 °C with
-    1.5 mm (a user trial, 2026-12-03; the message says so)."""
+    1.5 mm (a user trial, 2026-12-03; the message says so). ``size_key``: the geometry key that sets
+    those elements (the built-in brake's is pad_mesh_size: interface_mesh_size was advised, which
+    its builder refuses; a user trial)."""
     phases = braking_phases(ld, motion, end)
     elements = {}                                   # material along an interface -> its largest size
     for n in spec.interfaces:
@@ -122,8 +125,8 @@ def thin_heated_layers(ld, motion: str, end: float, spec, materials, T0: float) 
             out.append(f"materials.{name}: the heat of the shortest braking ({t:.3g} s) reaches about sqrt(pi chi t) = "
                        f"{depth * 1e3:.2g} mm into it (chi {chi:.3g} m^2/s), less than the interface's elements "
                        f"({h * 1e3:.3g} mm): its surface temperatures come out low, about {depth / h:.0%} of the rise "
-                       f"by the phase's end (less before; 1-D estimate); an interface_mesh_size of "
-                       f"{depth / 2 * 1e3:.2g} mm or less resolves them (this warning stops at "
+                       f"by the phase's end (less before; 1-D estimate); geometry.{size_key} = "
+                       f"\"{depth / 2 * 1e3:.2g} mm\" or less resolves them (this warning stops at "
                        f"{depth / RESOLVED * 1e3:.2g} mm, where they still come out a few per cent low)")
     return out
 

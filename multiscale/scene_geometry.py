@@ -200,6 +200,12 @@ class Geometry:
         """The builder module (parameters, describe, generate)."""
         return builder(self.builder)
 
+    def interface_size_key(self) -> str:
+        """The geometry key that sets the interfaces' element size: a file's and most builders'
+        interface_mesh_size, the built-in brake's pad_mesh_size, else mesh_size."""
+        sizes = ("interface_mesh_size",) if self.builder == "file" else getattr(self.module(), "DEFAULTS", {})
+        return next((k for k in ("interface_mesh_size", "pad_mesh_size") if k in sizes), "mesh_size")
+
     def resolved(self) -> dict:
         """Every builder parameter [SI] (the mesh sizes of a file)."""
         if isinstance(self.params, FileGeometry):
