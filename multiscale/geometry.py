@@ -307,8 +307,8 @@ def _extrapolated(counted: list[tuple[int, int, int]], cells: float) -> tuple[in
     out = []
     for x0, x1, guess in zip(first, last, ratio):
         a, b = np.linalg.solve([[c0, c0 ** (2 / 3)], [c1, c1 ** (2 / 3)]], [x0, x1])
-        out.append(round(a * cells + b * cells ** (2 / 3)) if a > 0 and a * cells + b * cells ** (2 / 3) >= x1
-                   else guess)
+        fit = a * cells + b * cells ** (2 / 3)
+        out.append(round(fit) if a > 0 and fit >= x1 else guess)
     return tuple(out)
 
 

@@ -28,7 +28,7 @@ import scipy.fft
 
 from multiscale.errors import InputError, check_count, check_field, check_instance, check_positive
 from multiscale.micro.surface import Surface, check_surface, find_asperities, row_blocks, statistics
-from multiscale.micro.texture import Texture, texture
+from multiscale.micro.texture import DECAY, Texture, texture
 
 POWER_FLOOR = 1e-24     # modes below this fraction of the largest C carry no power (FFT round-off: ~1e-32)
 HURST_RANGE = (0.0, 1.5)   # the power-law segment of a fit (a flat roll-off is no self-affine range)
@@ -450,7 +450,7 @@ class Statistics:
                      "  (1 isotropic, towards 0 a lay)" if t.bounded else
                      f"  (at most: f_ACF stays above {t.threshold:g} out to half the measurement along the lay)")),
                  ("lay  longest correlation", f"{t.lay:.1f} deg from x towards y")] if t else \
-            [("Sal, Str", "no decay of f_ACF to 0.2 within half the measurement (a form or waviness left)")]
+            [("Sal, Str", f"no decay of f_ACF to {DECAY:g} within half the measurement (a form or waviness left)")]
         fit = self.power_law
         if fit is None:
             rows.append(("PSD fit", "too few bins"))
@@ -529,7 +529,7 @@ def surface_statistics(surface: Surface, points_per_decade: int = 10) -> Statist
 
 
 def _texture(surface: Surface) -> Texture | None:
-    """``texture.texture`` of the patch, None where its f_ACF does not decay to 0.2."""
+    """``texture.texture`` of the patch, None where its f_ACF does not decay to ``DECAY``."""
     try:
         return texture(surface)
     except InputError:

@@ -6,8 +6,7 @@ f_ACF(t) = Σ z(x) z(x + t) / Σ z² over the pairs of points t apart, z the hei
 circular on a periodic patch, over the overlapping points of a measured one (zero-padded FFTs,
 each lag normalised by its number of pairs, as SurfaceTopography's ``autocorrelation_from_area``
 does for its height-difference form), out to half the patch. That map holds only lags with
-non-negative components,
-which cannot tell a lay at 30° from one at 150°; hence this module. The decay to s (ISO's default
+non-negative components, which cannot tell a lay at 30° from one at 150°; hence this module. The decay to s (ISO's default
 0.2) is searched along rays from the origin (cubic spline interpolation, every 0.5°) out to half the
 patch along each axis, where a lag still has at least a quarter of the pairs.
 """
