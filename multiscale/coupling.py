@@ -32,8 +32,8 @@ between the bulk temperatures itself). The scenes' default is "bulk" with the im
 
 Coupling of partitions and temperatures (``LoopSettings.coupling``); residual of a step: max over the loaded
 zones of |heat into the rough body by the post-analysis at the end of the step − the heat the macro model puts
-into it at that state| / mean zone frictional heat (``heat_residual``; a light zone's partition counts for the
-heat it moves). Schemes:
+into it at that state| / mean zone frictional heat (or mean |heat into the rough body| nearly at rest;
+``heat_residual``; a light zone's partition counts for the heat it moves). Schemes:
 
 - "explicit": the partitions of step n + 1 come from the post-analysis of step n (thesis Fig. 7.2).
 - "fixed-point" (thesis form, converged): the partitions p of step n solve p = G(p), G = the post-analysis'
@@ -361,16 +361,17 @@ class Multiscale:
     def heat_residual(self) -> float:
         """The coupling residual: max over the loaded zones of |heat into the rough body by the last
         post-analysis − heat the macro model put into it at the same state (its partition of Phi,
-        minus the exchange G (T_rough − T_counter))| / the zones' mean Phi; 0 while released (no
-        contact, no heat: the zones' last loads are analysed, but nothing couples)."""
+        minus the exchange G (T_rough − T_counter))| / the zones' mean Phi, or mean |heat into the rough
+        body| if larger (near rest the conduction outweighs a vanishing Phi: 1.8e12 at a stop's end before);
+        0 while released (no contact, no heat: the zones' last loads are analysed, nothing couples)."""
         loaded = self._last[-1]
         if not len(loaded) or self.model.released:
             return 0.0
-        Q = self.micro_heat[loaded]
+        Q, into = self.micro_heat[loaded], self.micro_heat_rough[loaded]
         if not Q.mean() > 0:                    # no frictional heat (no sliding): nothing to couple
             return 0.0
         given = self.partition[loaded] * Q - self.exchange[loaded] * self.remote_difference[loaded]
-        return float(np.abs(self.micro_heat_rough[loaded] - given).max() / Q.mean())
+        return float(np.abs(into - given).max() / max(Q.mean(), np.abs(into).mean()))
 
     def zone_heat(self) -> np.ndarray:
         """Frictional heat rate Phi of each zone loaded in the last ``analyse`` over their mean (0 on the

@@ -28,6 +28,6 @@ def interpolate(table, x: float) -> float:
     if x <= xs[0]:
         return ys[0]
     for (x0, y0), (x1, y1) in zip(table, table[1:]):
-        if x <= x1:
-            return y0 + (y1 - y0) * (x - x0) / (x1 - x0)
+        if x <= x1:         # (the fraction first: exact at the knots, a stop's 0 rpm is 0, not 7e-15 rad/s)
+            return y0 + (y1 - y0) * ((x - x0) / (x1 - x0))
     return ys[-1]

@@ -82,8 +82,10 @@ def read_modes(folder: str | Path) -> ModeSet:
     """The modes of the squeal run whose results are in ``folder`` (InputError if it holds none)."""
     folder = Path(folder)
     table, parts = folder / "modes.csv", sorted(folder.glob("modes_*.bp"))
-    if not table.is_file() or not parts:
-        raise InputError("RUN", str(folder), "a squeal run's results folder (modes.csv and modes_<part>.bp)")
+    if not table.is_file() or not parts:        # (a missing folder was not said: a user trial)
+        found = "no such folder" if not folder.exists() else "not a folder" if not folder.is_dir() else \
+            f"it holds no {'modes.csv' if not table.is_file() else 'modes_<part>.bp'}"
+        raise InputError("RUN", str(folder), f"a squeal run's results folder (modes.csv and modes_<part>.bp); {found}")
     with open(table, newline="") as fh:
         rows = {int(r["mode"]): r for r in csv.DictReader(fh)}
     read = [_read_part(p) for p in parts]

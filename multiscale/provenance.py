@@ -58,7 +58,7 @@ def _value(parser, v):
     if isinstance(v, frozenset):
         return [e for e in EFFECTS if e in v], ""
     if isinstance(parser, Quantity):
-        if parser.kind.needs_unit:
+        if parser.kind.needs_unit or parser.kind.unit_advised:     # (a bare number would be refused, warned of)
             return f"{v!r} {parser.kind.si}", ""
         return float(v), parser.kind.si
     if isinstance(parser, Either):
@@ -85,7 +85,7 @@ def _value(parser, v):
 
 def _column_unit(parser, v) -> str:
     """The unit of a table column for its comment: a temperature's K (its values carry it), "-" if none."""
-    if isinstance(parser, Quantity) and parser.kind.needs_unit:
+    if isinstance(parser, Quantity) and (parser.kind.needs_unit or parser.kind.unit_advised):
         return parser.kind.si
     return _value(parser, v)[1] or "-"
 
@@ -387,6 +387,20 @@ def entries(n: int) -> str:
     return f"{n} entry" if n == 1 else f"{n} entries"
 
 
+def record_problem(folder: Path) -> str | None:
+    """Why ``folder``'s ``provenance.json`` cannot be read as a run's record ("not JSON: ..."), None if
+    it is absent or reads (a user trial's corrupted record: --resume lost the earlier parts without a
+    word, --overwrite called the results "not written by a run")."""
+    path = Path(folder) / "provenance.json"
+    if not path.is_file():
+        return None
+    try:
+        record = json.loads(path.read_text(encoding="utf-8"))
+    except (OSError, ValueError) as exc:
+        return f"{path} cannot be read ({exc})"
+    return None if isinstance(record, dict) else f"{path} is not a run's record (a JSON {type(record).__name__})"
+
+
 def _record_of(folder: Path) -> dict:
     """The earlier run's ``provenance.json`` in ``folder``, {} if none is readable."""
     try:
@@ -426,5 +440,6 @@ def unrecorded_results(scene, existing) -> list[str]:
     return [n for n in existing if n in planned and n not in recorded]
 
 
-__all__ = ["RUNNING", "inputs_in", "now", "parts_of", "process", "resolved_toml", "results_of", "unrecorded_results",
+__all__ = ["RUNNING", "inputs_in", "now", "parts_of", "process", "record_problem", "resolved_toml", "results_of",
+           "unrecorded_results",
            "versions", "write", "writer"]

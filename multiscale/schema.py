@@ -21,7 +21,7 @@ from pathlib import Path
 from stat import S_ISDIR, S_ISREG
 from typing import Any
 
-from multiscale.units import KINDS, UnitError, plausible_in, to_si
+from multiscale.units import KINDS, UnitError, plausible_in, to_si, unit_advice
 
 __all__ = ["Bad", "Choice", "Context", "Curve", "Either", "FilePath", "Flag", "FrozenMap", "Integer", "ListOf", "Named",
            "OneOf", "OnlyWith", "Pair", "Quantity", "Requires", "Section", "TableOr", "Tables", "Text", "Vector",
@@ -115,8 +115,7 @@ class Quantity:
         low = f"> {self.gt:g}" if self.gt is not None else f">= {self.ge:g}" if self.ge is not None else None
         high = f"< {self.lt:g}" if self.lt is not None else f"<= {self.le:g}" if self.le is not None else None
         if low and high:
-            lb = "(" if self.gt is not None else "["
-            rb = ")" if self.lt is not None else "]"
+            lb, rb = "(" if self.gt is not None else "[", ")" if self.lt is not None else "]"
             lo, hi = (self.gt if self.gt is not None else self.ge), (self.lt if self.lt is not None else self.le)
             return f"in {lb}{lo:g}, {hi:g}{rb}{unit}"
         return f"{low or high}{unit}" if (low or high) else ""
@@ -146,6 +145,7 @@ class Quantity:
         if not ok:
             shown = "" if not isinstance(raw, str) else f" (got {v:g} {self.kind.si})".replace(" )", ")")
             raise Bad(f"must be {self._range()}{shown}{': ' * bool(self.outside)}{self.outside}")
+        ctx.implausible.extend(unit_advice(raw, self.kind))
         if self.plausible is not None and not self.plausible[0] <= v <= self.plausible[1]:
             unit = f" {self.kind.si}" if self.kind.si else ""
             ctx.implausible.append(f"{v:g}{unit} is outside the plausible range {self.plausible[0]:g} to "

@@ -20,7 +20,7 @@ import re
 from dataclasses import dataclass
 from fractions import Fraction
 
-__all__ = ["KINDS", "VALUE", "Kind", "UnitError", "parse_unit", "plausible_in", "to_si"]
+__all__ = ["KINDS", "VALUE", "Kind", "UnitError", "parse_unit", "plausible_in", "to_si", "unit_advice"]
 
 # Dimension exponents over the base units (m, kg, s, K, rad).
 _BASE = ("m", "kg", "s", "K", "rad")
@@ -50,6 +50,7 @@ class Kind:
     si: str                   # SI unit the value is stored in
     examples: str             # accepted spellings, for messages
     needs_unit: bool = False  # bare numbers refused (temperatures: 20 would silently be 20 K)
+    unit_advised: bool = False  # bare numbers warned of (angular speeds: 300 is rad/s where rpm is meant)
 
 
 KINDS: dict[str, Kind] = {
@@ -63,7 +64,7 @@ KINDS: dict[str, Kind] = {
     "speed": Kind("speed", _dim((L, 1), (T, -1)), "m/s", "m/s, mm/s"),
     "acceleration": Kind("acceleration", _dim((L, 1), (T, -2)), "m/s^2", "m/s^2, gn"),
     "mass": Kind("mass", M, "kg", "kg, t"),
-    "angular_speed": Kind("angular speed", _dim((A, 1), (T, -1)), "rad/s", "rpm, rad/s"),
+    "angular_speed": Kind("angular speed", _dim((A, 1), (T, -1)), "rad/s", "rpm, rad/s", unit_advised=True),
     "force": Kind("force", _dim((M, 1), (L, 1), (T, -2)), "N", "N, kN"),
     "torque": Kind("torque", _dim((M, 1), (L, 2), (T, -2)), "N m", "N m, kN m"),
     "pressure": Kind("pressure or modulus", _dim((M, 1), (L, -1), (T, -2)), "Pa", "Pa, kPa, MPa, GPa, bar"),
@@ -255,6 +256,15 @@ def describe(dim: tuple[int, ...]) -> str:
     return " ".join(parts) or "dimensionless"
 
 
+def unit_advice(raw, kind: Kind) -> list[str]:
+    """What to say of a bare number ``raw`` of a kind whose bare numbers are warned of
+    (``Kind.unit_advised``: 300 is rad/s where rpm was meant, silently before: a user trial); else []."""
+    if not (kind.unit_advised and isinstance(raw, (int, float)) and not isinstance(raw, bool) and raw):
+        return []
+    return [f"a number without a unit is taken in {kind.si}, {raw:g} {kind.si} = {raw * 30 / math.pi:.4g} rpm; "
+            f'write "{raw:g} rpm" if that is meant, "{raw:g} {kind.si}" to say so']
+
+
 def to_si(value, kind: str) -> float:
     """A TOML value (number or "<number> <unit>") as a float in the SI unit of ``kind``.
 
@@ -290,7 +300,10 @@ def to_si(value, kind: str) -> float:
                             f'number without quotes is taken in {spec.si})')
         if dim != spec.dim:
             gravity = ' (standard gravity is "gn")' if match.group(2) == "g" and spec.name == "acceleration" else ""
-            raise UnitError(f"{expect}; the unit \"{match.group(2)}\" is {_mismatch(dim, spec)}{gravity}")
+            turns = (f': a turning speed is "{match.group(1)} rpm" (revolutions a minute) or "{match.group(1)} rad/s" '
+                     f'("{match.group(2)}" does not say revolutions or radians)' if dim == _dim((T, -1))
+                     and spec.dim == _dim((A, 1), (T, -1)) else "")
+            raise UnitError(f"{expect}; the unit \"{match.group(2)}\" is {_mismatch(dim, spec)}{gravity}{turns}")
     try:
         return float(number * factor + offset)
     except OverflowError:

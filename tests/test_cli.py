@@ -681,7 +681,10 @@ def test_overwrite_keeps_the_earlier_results_when_the_run_fails_before_writing(t
     assert record["status"] == "finished" and (folder / "block.xdmf").read_bytes() != b"x"
 
 
-def test_overwrite_without_a_record_deletes_nothing_and_resume_never_does(tmp_path):
+def test_overwrite_without_a_record_deletes_nothing_and_resume_never_does(tmp_path, capsys):
+    """Only what a run recorded writing is deleted; a record that cannot be read is said so (a user
+    trial's corrupted provenance.json: --overwrite called the results "not written by a run", and
+    --resume dropped the earlier parts' record without a word)."""
     from mpi4py import MPI
 
     from multiscale.errors import SceneError
@@ -698,8 +701,15 @@ def test_overwrite_without_a_record_deletes_nothing_and_resume_never_does(tmp_pa
     assert not (folder / "pad.xdmf").exists() and (tmp_path / "x").exists()     # only entries of the folder
     _earlier_run(tmp_path / "other", ["a.csv"])
     (tmp_path / "other" / "provenance.json").write_text("{not json")      # another program's record: not replaced
-    with pytest.raises(SceneError, match=r"holds provenance.json, named as this run's results but not written by a run"):
+    with pytest.raises(SceneError, match=r"holds provenance.json, named as this run's results; \S+/other/provenance"
+                                         r"\.json cannot be read \(Expecting property name .*\): which of them a run "
+                                         r"wrote is unknown: a run would write over them, --overwrite too"):
         prepare_folder(_scene_into(tmp_path, tmp_path / "other"), overwrite=True, resume=False, comm=MPI.COMM_SELF)
+    capsys.readouterr()
+    prepare_folder(_scene_into(tmp_path, tmp_path / "other"), overwrite=False, resume=True, comm=MPI.COMM_SELF)
+    err = capsys.readouterr().err
+    assert "provenance.json cannot be read (Expecting property name" in err
+    assert "the record of the run's earlier parts is lost; the new provenance.json records the resumed part only" in err
     (tmp_path / "other" / "provenance.json").unlink()
     stream = io.StringIO()
     with Reporter(MPI.COMM_SELF, stream=stream):

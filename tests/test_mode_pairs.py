@@ -36,6 +36,18 @@ def test_another_mesh_is_refused():
         pair(modes(range(4)), modes(range(4), points=POINTS + 1e-3))
 
 
+def test_a_folder_without_modes_is_said_for_what_it_is(tmp_path):
+    """`multiscale modes A B` with B a folder that does not exist said only what a results folder
+    holds (a user trial); now: no such folder, not a folder, or which file it lacks."""
+    from multiscale.mode_pairs import read_modes
+    (tmp_path / "file").write_text("")
+    (tmp_path / "run").mkdir()
+    (tmp_path / "run" / "modes.csv").write_text("")
+    for name, said in (("nowhere", "no such folder"), ("file", "not a folder"), ("run", "it holds no modes_<part>.bp")):
+        with pytest.raises(InputError, match=f"modes_<part>.bp\\); {said}"):
+            read_modes(tmp_path / name)
+
+
 def mirror_image(shapes, points, twin):
     """Shapes (3 n, m) of the mirror image in x of the field ``shapes`` on ``points``: the value at node
     i is the reflected value at node ``twin[i]``, the reflection of node i."""

@@ -106,6 +106,8 @@ def test_unit_strings_to_si(text, kind, expected):
     ("10 mpa", "pressure", 'unknown unit "mpa" (did you mean "MPa"?)'),       # not mPa (a user trial)
     ("200 kn", "force", 'unknown unit "kn" (did you mean "kN"?)'),            # not ks
     ("200 Hz", "angular_speed", 'expected an angular speed (rpm, rad/s); the unit "Hz" is a frequency'),
+    ("300 1/min", "angular_speed", 'the unit "1/min" is a frequency: a turning speed is "300 rpm" (revolutions a '
+                                   'minute) or "300 rad/s" ("1/min" does not say revolutions or radians)'),
     (20, "temperature", "a temperature needs its unit"),
     ("20", "temperature", "a temperature needs its unit"),
     ("fast", "speed", "write a number then a unit"),
@@ -183,6 +185,25 @@ def test_defaults_name_and_folder_from_the_file(tmp_path):
     assert scene.output.folder == tmp_path.resolve() / "results" / "my_case"
 
 
+def test_a_bare_angular_speed_is_rad_per_s_and_said_so(tmp_path):
+    """rotation_speed = 300 is 300 rad/s, as every bare number is SI, with a warning that gives it in
+    rpm (a user trial meant 300 rpm: silent before); in a profile too; with its unit, no warning;
+    the resolved scene writes it with its unit, so that running it says nothing."""
+    pytest.importorskip("meshes.pin_on_disc")
+    from multiscale.provenance import resolved_toml
+    text = (DEMOS / "pin_on_disc_perfect.toml").read_text()
+    bare = loads(text.replace('rotation_speed = "200 rpm"', "rotation_speed = 300"), tmp_path)
+    assert bare.loading.rotation_speed == 300.0
+    assert 'loading.rotation_speed = 300: a number without a unit is taken in rad/s, 300 rad/s = 2865 rpm; write ' \
+        '"300 rpm" if that is meant, "300 rad/s" to say so' in bare.warnings
+    profile = loads(text.replace('rotation_speed = "200 rpm"', 'speed_profile = [["0 s", 30], ["1 s", "0 rpm"]]'),
+                    tmp_path)
+    assert any("loading.speed_profile" in w and "30 rad/s = 286.5 rpm" in w for w in profile.warnings)
+    assert not any("without a unit" in w for w in loads(text, tmp_path).warnings)
+    again = loads(resolved_toml(bare), tmp_path)
+    assert again.loading.rotation_speed == 300.0 and not any("without a unit" in w for w in again.warnings)
+
+
 def test_speed_profile_interpolates(tmp_path):
     text = GOOD.replace('sliding_speed = "0 m/s"', "").replace('"block_on_flat"', '"block_on_flat"')
     with pytest.raises(SceneError) as info:         # block_on_flat slides: no rotation profile
@@ -200,6 +221,11 @@ def test_pin_on_disc_speed_profile(tmp_path):
     loading = loads(text, tmp_path).loading
     w0 = 2 * math.pi
     assert [loading.angular_speed(t) for t in (-1, 0, 2.5, 10, 20)] == pytest.approx([w0, w0, 0.75 * w0, 0, 0])
+    # a stop ends at rest exactly: 600 rpm to 0 in 3 s was 7.1e-15 rad/s at 3 s (the micro contacts of
+    # that instant slid, their frictional heat 1e-15 W, and the coupling residual was 1.8e12: a user trial)
+    stop = loads(text.replace('[[0, "60 rpm"], ["10 s", "0 rpm"]]', '[[0, "600 rpm"], ["3 s", "0 rpm"]]'),
+                 tmp_path).loading
+    assert stop.angular_speed(3.0) == 0.0 and stop.mean_angular_speed(3.0, 3.5) == 0.0
 
 
 def test_demo_scenes_validate():

@@ -361,3 +361,25 @@ def test_zones_heat_with_the_friction_of_their_facets_temperatures(tmp_path):
         ms.model.close()
     assert mus[1][0] != pytest.approx(mus[1][1], rel=1e-3) and np.all(mus[1] < 0.4)
     np.testing.assert_allclose(heats[1], heats[0] * mus[1] / 0.4, rtol=1e-9)
+
+
+def test_the_coupling_residual_near_rest_is_scaled_by_the_heat_the_contact_moves():
+    """Two loaded zones nearly at rest: frictional heat 1e-15 W, 0.014 W conducted into the rough
+    body that a partition in [0, 1] cannot give it. The residual is |mismatch| / mean |heat into the
+    rough body| (here 0.999...), not / mean Phi (1.4e13, the user trial's 1.8e12); sliding (Phi
+    dominating) it is / mean Phi as before; 0 without frictional heat."""
+    from types import SimpleNamespace
+
+    from multiscale.coupling import Multiscale
+
+    def residual(Q, into, partition):
+        zones = SimpleNamespace(_last=(None, None, None, None, np.arange(2)), model=SimpleNamespace(released=False),
+                                micro_heat=np.asarray(Q, float), micro_heat_rough=np.asarray(into, float),
+                                partition=np.asarray(partition, float), exchange=np.zeros(2),
+                                remote_difference=np.zeros(2))
+        return Multiscale.heat_residual(zones)
+
+    near_rest = residual([1e-15, 1e-15], [0.014, 0.014], [1.0, 1.0])
+    assert near_rest == pytest.approx((0.014 - 1e-15) / 0.014, rel=1e-12)
+    assert residual([60.0, 40.0], [0.09, 0.05], [0.0015, 0.0012]) == pytest.approx(0.002 / 50.0, rel=1e-9)
+    assert residual([0.0, 0.0], [0.01, 0.01], [0.5, 0.5]) == 0.0

@@ -4,6 +4,7 @@ from __future__ import annotations
 import fcntl
 import os
 import shutil
+import sys
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -96,10 +97,15 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
         raise SceneError(f'output.folder = "{folder}": holds {", ".join(taken)}, an input of the run before (a '
                          "scene run in its own folder); this run would write over it: choose another folder")
     own = comm.bcast(provenance.unrecorded_results(scene, existing) if comm.rank == 0 and not resume else [], root=0)
+    unreadable = comm.bcast(provenance.record_problem(folder) if comm.rank == 0 and existing else None, root=0)
     if own:
-        raise SceneError(f'output.folder = "{folder}": holds {", ".join(own)}, named as this run\'s results but not '
-                         "written by a run (no record of it in provenance.json): a run would write over them, "
-                         "--overwrite too; move them or choose another folder")
+        why = (f"; {unreadable}: which of them a run wrote is unknown" if unreadable else
+               " but not written by a run (no record of it in provenance.json)")
+        raise SceneError(f'output.folder = "{folder}": holds {", ".join(own)}, named as this run\'s results{why}: a '
+                         "run would write over them, --overwrite too; move them or choose another folder")
+    if resume and unreadable and comm.rank == 0:      # the checkpoint resumes; the record of the parts before is gone
+        print(f"warning: {unreadable}: the record of the run's earlier parts is lost; the new provenance.json "
+              "records the resumed part only", file=sys.stderr, flush=True)
     if existing and not (overwrite or resume):
         shown = ", ".join(existing[:3]) + (", ..." if len(existing) > 3 else "")
         ran = comm.bcast(bool(set(existing) & set(provenance.results_of(folder))) if comm.rank == 0 else None, root=0)
