@@ -143,6 +143,7 @@ def describe(params=None) -> GeometrySpec:
         interface_regions={"inner_pad": "pad_inner", "outer_pad": "pad_outer"},
         interface_extents=dict.fromkeys(("inner_pad", "outer_pad"), _pad_extent(p)),
         interface_sizes=dict.fromkeys(("inner_pad", "outer_pad"), p["pad_mesh_size"]),
+        load_areas=dict.fromkeys(("piston_back", "caliper_bore"), math.pi * p["piston_radius"] ** 2),
         warnings=tuple(thin_warning([("disc", p["cheek_thickness"] if p["vanes"] else p["disc_thickness"],
                                       p["mesh_size"]), ("pads", p["pad_thickness"], p["pad_mesh_size"]),
                                      ("backplates", p["backplate_thickness"], p["pad_mesh_size"])])),

@@ -88,6 +88,7 @@ def describe(params=None) -> GeometrySpec:
                                      ("plate", p["plate_thickness"], p["holder_mesh_size"])])),
         interface_extents={"interface": (p["pin_size"], p["pin_size"])},
         interface_sizes={"interface": p["interface_mesh_size"]},
+        load_areas={"plate_ends": 2 * p["plate_width"] * p["plate_thickness"]},   # (a pressure acts there)
     )
 
 

@@ -90,7 +90,12 @@ def _check(args) -> int:
             failed += 1
             continue
         if args.cells:
-            line, estimate = cells_line(scene)
+            try:                        # (meshes: a part nothing holds is what run refuses at meshing)
+                line, estimate = cells_line(scene)
+            except InputError as exc:
+                print(f"error: {exc}\n{path}: 1 problem", file=sys.stderr)
+                failed += 1
+                continue
             need, free = memory_line(scene, estimate), memory_available()
             print(f"{line}\n{need[0]}")
             if free is not None and need[1] > free:    # (a ~1M-dof squeal was "OK": a user trial)
@@ -405,7 +410,8 @@ def build_parser() -> argparse.ArgumentParser:
                            "or a summary of what a run computes and the files it writes.")
     check.add_argument("scenes", nargs="*", metavar="SCENE", help="scene TOML file(s)")
     check.add_argument("--keys", action="store_true", help="print the scene format: every section and key")
-    check.add_argument("--cells", action="store_true", help="estimate the mesh's cell count (trial meshes, seconds)")
+    check.add_argument("--cells", action="store_true", help="estimate the mesh's cell count and memory (trial meshes, seconds) and check that the supports "
+                       "hold every part, as run does at meshing")
     check.add_argument("--set", **SET)
     check.set_defaults(func=_check)
     run = sub.add_parser("run", help=f"run a scene (in parallel: {MPIEXEC} -n N multiscale run SCENE)",

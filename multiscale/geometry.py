@@ -119,6 +119,9 @@ class GeometrySpec:
     #                                    known before meshing (absent: known from the mesh only)
     interface_sizes: Mapping[str, float] = field(default_factory=dict)   # interface -> element size [m]
     #                                    the mesher aims at on it (absent: unknown before meshing)
+    load_areas: Mapping[str, float] = field(default_factory=dict)   # load face -> the area [m^2] whose
+    #                                    product with a pressure is its resultant, known before meshing (a
+    #                                    builder's; absent: known from the mesh only, ``load_face_areas``)
     element_size: float | None = None    # m, a mesh file's: the largest of its bodies' mean tetrahedron
     #                                    edges (a builder's or CAD's: its mesh_size)
 
@@ -332,7 +335,7 @@ def gmsh_session(module: ModuleType) -> None:
 
 def estimate_cells(module: ModuleType, params, target: int = 20_000, start: float = 64.0,
                    enough: int = 0, keep: bool = False, length_scale: float | None = None,
-                   bodies: Sequence[Sequence[int]] = ()) -> CellEstimate:
+                   bodies: Sequence[Sequence[int]] = (), inspect=None) -> CellEstimate:
     """Estimate the cell count of ``module.generate(params)`` without meshing it at its size: trial
     meshes from ``start`` times coarser, refined until one has ``target`` cells or is the real mesh
     (a trial the CAD kernel cannot mesh that coarse is skipped), or until the estimate is at most
@@ -354,7 +357,9 @@ def estimate_cells(module: ModuleType, params, target: int = 20_000, start: floa
     ``bodies`` (each body's cell tags), its vertices and edges too (``mesh_counts`` of the trials,
     ``_extrapolated``; exact with the mesh; from trials, quadratic dofs a cell within 3 % of the
     mesh's on the built-in brake and pin-on-disc, 7 % on the car brake at 5 / 3 mm: the cells'
-    over-estimate is the larger error)."""
+    over-estimate is the larger error). ``inspect(gmsh.model)`` is called on the mesh the estimate
+    comes from (the last trial's), its errors propagated (``check --cells`` runs ``held.check_held``
+    there: a part nothing holds was refused by the run alone, at meshing: a user trial)."""
     import gmsh   # local, as in gmsh_session
     if gmsh.isInitialized():
         raise RuntimeError("estimate_cells runs gmsh sessions of its own: call it before gmsh.initialize")
@@ -383,6 +388,8 @@ def estimate_cells(module: ModuleType, params, target: int = 20_000, start: floa
                                         *(_extrapolated(counted, cells) if known else ()))
                 break
             factor = finer
+        if inspect is not None and gmsh.isInitialized():
+            inspect(gmsh.model)
         if keep and estimate.cells <= enough:
             if not estimate.exact:
                 _trial(module, params, 1.0)

@@ -86,6 +86,20 @@ MODE_MEMORY = 89.0       # bytes a displacement dof and a mode asked for (stabil
 DOFS_PER_CELL = {"squeal": 5.0, "transient": 0.64}     # displacement dofs per tetrahedron (the larger meshes)
 
 
+# The multiscale loop's micro part [bytes], ranks x base + per_point x its zones' grid points, fitted to
+# peaks measured serially above the macro run's (/usr/bin/time -v, 2026-12-05, docs/performance.rst): the
+# rough pin-on-disc of 6 606 dofs (measured face, wear, partition law, 6 law points; 0.39 GB without its
+# roughness) at 3x3 zones of 16^2, 8x8 of 64^2 and 8x8 of 128^2 points, +0.147 / 0.458 / 1.352 GB, within 4 %.
+MICRO_MEMORY = (0.15e9, 1140.0)
+
+
+def micro_memory(points: float, ranks: int = 1) -> float:
+    """The estimated memory [bytes] the multiscale loop's zones of ``points`` grid points in all add to
+    the macro run's on ``ranks`` processes (``MICRO_MEMORY``; their points counted whole on each rank)."""
+    base, per_point = MICRO_MEMORY
+    return ranks * base + per_point * points
+
+
 def run_memory(dofs: float, kind: str, ranks: int = 1, modes: int = 0) -> float:
     """The estimated peak memory [bytes] of a run of ``kind`` ("squeal" or "transient") with
     ``dofs`` displacement dofs on ``ranks`` processes, a squeal run asking for ``modes`` modes

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from multiscale.errors import InputError, InputErrors
-from multiscale.geometry import FIXED_BODY, MAX_CELLS, GeometrySpec, Rotation, builder, builder_names
+from multiscale.geometry import FIXED_BODY, MAX_CELLS, GeometrySpec, Rotation, Support, builder, builder_names
 from multiscale.outputs import name_problem
 from multiscale.schema import (Bad, Choice, FilePath, FrozenMap, Integer, ListOf, Named, OneOf, Quantity,
                                Section, Text, Vector, key, parse, read, show, unknown_keys)
@@ -350,3 +350,15 @@ class GeometrySection(Section):
             ctx.problems += [str(e) + hint(e) for e in InputErrors.each(exc)]
             return None
         return Geometry(name, params, spec)
+
+
+def scene_spec(scene) -> GeometrySpec:
+    """The geometry's spec with the scene's supports, load faces and load direction."""
+    spec, ld = scene.geometry.spec, scene.loading
+    supports = spec.supports + tuple(Support(s, b.components) for b in scene.boundary if b.fix for s in b.surfaces)
+    changes = {"supports": supports}
+    if ld.faces:
+        changes["load_faces"] = tuple(ld.faces)
+    if ld.direction is not None:
+        changes.update(load_direction=tuple(ld.direction), fluid_load=False)
+    return dataclasses.replace(spec, **changes)

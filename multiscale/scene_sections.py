@@ -203,7 +203,7 @@ class Boundary:
     physical surfaces or [geometry.surfaces]; "free:<part or body>": its surfaces that touch nothing
     else, symmetry planes left out, a part's name before a body's). ``fix``: displacement components
     held at zero (with the interfaces' normals, friction holding nothing, they must hold every part
-    against its six rigid motions: ``macro.held``); ``convection`` h [W/(m^2 K)], constant or a table
+    against its six rigid motions: ``multiscale.held``); ``convection`` h [W/(m^2 K)], constant or a table
     against the rotating body's speed [rad/s], towards ``ambient``; ``emissivity``: radiation eps
     sigma (T^4 - T_ambient^4); ``temperature``: fixed. A face named in one entry takes its kinds of
     condition instead of a "free:" surface's of another; two of one kind on a face are refused otherwise."""
@@ -252,7 +252,9 @@ OUTPUT_FIELDS: dict[str, tuple[str, ...]] = {
 class Loading:
     """Normal load (force or pressure on the load faces), sliding speed, friction, duty cycle.
 
-    The load acts on ``faces``: on a geometry file's a pressure normal to each face, -p n (a force is spread as
+    The load acts on ``faces`` (a builder's own: a pin-on-disc's holder plate ends, a brake's piston back and
+    caliper bore, a block's top; not the contact: check and the run say a pressure's force on each): on a
+    geometry file's a pressure normal to each face, -p n (a force is spread as
     a uniform pressure whose resultants on the faces sum to it; a curved face counts with its projected area);
     with ``direction`` a traction along it whose resultant is the force, or the pressure itself.
     ``normal_force`` is the total over all the load faces: two faces of equal areas given 4000 N take 2000 N

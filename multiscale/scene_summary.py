@@ -5,13 +5,15 @@ import json
 import math
 
 from multiscale.geometry import CellEstimate, estimate_cells
-from multiscale.memory import DOFS_PER_CELL, RUN_MEMORY, run_memory
+from multiscale.held import check_held
+from multiscale.memory import DOFS_PER_CELL, MICRO_MEMORY, RUN_MEMORY, micro_memory, run_memory
 from multiscale.outputs import CHECKPOINT, analysis
 from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
 from multiscale.scene_friction import FRICTION, bare_interfaces
+from multiscale.scene_geometry import scene_spec
 from multiscale.scene_rough import default_p_max, scene_surface_used
-from multiscale.scene_sections import P_MAX_FACTOR, P_MAX_PLASTIC
+from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR, P_MAX_PLASTIC
 from multiscale.schema import reference as schema_reference
 
 
@@ -66,9 +68,7 @@ def summary(scene: Scene) -> list[str]:
               (f"a stop from {v.speed * 3.6:g} km/h in {v.stop_time:.3g} s" if v.deceleration else
                f"a drag at {v.speed * 3.6:g} km/h") + f" (wheel radius {v.wheel_radius * 1e3:g} mm)"
               if v is not None else f"{ld.sliding_speed:g} m/s" if ld.sliding_speed is not None else "no sliding")
-    where = f" on {', '.join(ld.faces)}" if ld.faces else ""
-    if ld.normal_force is not None and ld.faces and len(ld.faces) > 1:   # (read as each pad's clamp force)
-        where = f" in all on {', '.join(ld.faces)}, shared by their areas"
+    where = _load_faces(scene)
     profile = f", load profile of {len(ld.load_profile)} points" if ld.load_profile else ""
     lines.append(f"  loading   {load_text}{where}, {motion}{profile}, {ld.ramp_steps} ramp step(s)")
     if v is not None and ld.torque is not None and ld.braking_torque is None:   # (said nowhere before: a user trial)
@@ -119,6 +119,20 @@ MATERIAL_UNITS = {"E": (1e9, "GPa"), "nu": (1, ""), "rho": (1, "kg/m^3"), "kappa
                   "c": (1, "J/(kg K)"), "chi": (1, "m^2/s"), "alpha": (1, "1/K"), "k_w": (1, "1/Pa"),
                   "hardness": (1e9, "GPa"), "loss_factor": (1, ""), "damping_alpha": (1, "1/s"),
                   "damping_beta": (1, "s")}
+
+
+def _load_faces(scene: Scene) -> str:
+    """Where the load acts, for the loading line: the faces given, or the builder's; a pressure's
+    force on each where the builder knows their areas (a pin-on-disc's 0.375 MPa acts on the
+    holder plate's ends, 90 N, not on the pin's 400 mm^2: said nowhere before, a user trial)."""
+    ld, spec = scene.loading, scene.geometry.spec
+    faces = ld.faces or spec.load_faces
+    if ld.normal_force is not None and ld.faces and len(ld.faces) > 1:   # (read as each pad's clamp force)
+        return f" in all on {', '.join(ld.faces)}, shared by their areas"
+    if ld.pressure is None or not all(f in spec.load_areas for f in faces):
+        return f" on {', '.join(faces)}" if faces else ""
+    return " on " + ", ".join(f"{f} ({spec.load_areas[f] * 1e6:.4g} mm^2): {ld.pressure * spec.load_areas[f]:.4g} N"
+                              for f in faces)
 
 
 def _material(m) -> str:
@@ -219,11 +233,15 @@ def _effect_line(scene: Scene, effect: str) -> str:
 
 def cells_line(scene: Scene) -> tuple[str, CellEstimate]:
     """The mesh's estimated cell count against its limit (``check --cells``; runs gmsh trials),
-    and the estimate."""
+    and the estimate; an InputError if the trial mesh leaves a part free (``held.check_held``)."""
     g = scene.geometry
     params = g.params if g.builder == "file" else dict(g.params)
     bodies = [[r.tag for r in b.regions] for b in g.spec.bodies]
-    e = estimate_cells(g.module(), params, length_scale=g.spec.length_scale, bodies=bodies)
+    spec, sliding = scene_spec(scene), scene.has("friction")
+
+    def held(model):            # the run's check at meshing (an InputError naming a part nothing holds)
+        check_held(model, spec, sliding)
+    e = estimate_cells(g.module(), params, length_scale=g.spec.length_scale, bodies=bodies, inspect=held)
     if not e.exact and e.cells > g.max_cells:          # the run's verdict: it refines near the limit
         e = estimate_cells(g.module(), params, enough=g.max_cells, length_scale=g.spec.length_scale, bodies=bodies)
     how = "exact" if e.exact else f"from a trial mesh {e.factor:.3g}x coarser with {e.trial} cells"
@@ -235,14 +253,24 @@ def cells_line(scene: Scene) -> tuple[str, CellEstimate]:
 def memory_line(scene: Scene, mesh: CellEstimate) -> tuple[str, float]:
     """The estimated peak memory of a serial run of the scene's estimated ``mesh`` (``memory.run_memory``
     of its displacement dofs: quadratic for a squeal run, three a vertex and an edge, linear
-    otherwise, three a vertex; ``DOFS_PER_CELL`` a cell where its vertices were not counted), and
-    that memory [bytes]."""
+    otherwise, three a vertex; ``DOFS_PER_CELL`` a cell where its vertices were not counted; a
+    multiscale run adds its zones' ``memory.micro_memory``: it was left out, 0.41 GB said for
+    0.55-1.75 GB measured, a user trial), and that memory [bytes]."""
     kind = "squeal" if scene.has("stability") else "transient"
     dofs = 3 * (mesh.nodes + mesh.edges * (kind == "squeal")) if mesh.nodes else DOFS_PER_CELL[kind] * mesh.cells
-    need = run_memory(dofs, kind, modes=scene.stability.modes if kind == "squeal" else 0)
+    need, each = run_memory(dofs, kind, modes=scene.stability.modes if kind == "squeal" else 0), RUN_MEMORY[kind][0]
+    micro = ""
+    if scene.rough_interfaces and kind == "transient":
+        kind, m = "multiscale", scene.micro
+        if scene.roughness.file and not m.grid:
+            micro = "; its zones not counted: their grid is the measured file's pixels, give micro.grid"
+        else:
+            points = len(scene.rough_interfaces) * math.prod(m.zones) * math.prod(m.grid or DEFAULT_GRID)
+            need, each = need + micro_memory(points), each + MICRO_MEMORY[0]
+            micro = f"; its zones {points:,} grid points"
     return (f"  memory    about {need / 1e9:.2g} GB at the peak of a {kind} run on one rank, each more adding about "
-            f"{RUN_MEMORY[kind][0] / 1e9:.2g} GB (about {dofs:,.0f} displacement dofs; an estimate from measured "
-            "runs, docs/performance.rst)", need)
+            f"{each / 1e9:.2g} GB (about {dofs:,.0f} displacement dofs{micro}; an estimate from measured runs, "
+            "docs/performance.rst)", need)
 
 
 def _rough_or_perfect(scene: Scene, rough: str, perfect: str, value: float) -> str:

@@ -177,7 +177,9 @@ def test_a_run_larger_than_the_free_memory_is_warned_at_once(tmp_path, monkeypat
     monkeypatch.setattr(model, "memory_available", lambda: 1e6)
     path = _write(tmp_path, BLOCK.replace("../results/block_on_flat", str(tmp_path / "out")))
     assert main(["run", path]) == 0
-    err = capsys.readouterr().err
+    said = capsys.readouterr()
+    err = said.err
+    assert "  load: 1 MPa on block_top: 100 N\n" in said.out      # the meshed top's resultant, said once meshed
     assert re.search(r"warning: a transient run of [\d ]+ displacement dofs takes about [\d.]+ GB at its peak \(an "
                      r"estimate from measured runs, docs/performance.rst\), more than the 0.001 GB this machine has "
                      r"free: it may be killed", err), err
@@ -191,7 +193,8 @@ def test_check_good_scene_prints_summary(tmp_path, capsys):
     assert any(line.startswith("  bodies    block (block: block) | flat (flat: flat)") for line in out)
     assert any(line.startswith("  effects   contact") for line in out)
     assert any("penalty K_n = 1e+13 Pa/m" in line for line in out)
-    assert any(line.startswith("  loading   1 MPa") for line in out)
+    # the pressure's faces and force (the block's 10 x 10 mm top: 100 N; before, only "1 MPa")
+    assert any(line.startswith("  loading   1 MPa on block_top (100 mm^2): 100 N, ") for line in out)
     assert out[-1] == f"{path}: OK"
 
 

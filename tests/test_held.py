@@ -1,4 +1,4 @@
-"""Rigid motions nothing holds (multiscale/macro/held.py), found by adversarial tests of check_held."""
+"""Rigid motions nothing holds (multiscale/held.py), found by adversarial tests of check_held."""
 
 import pytest
 
@@ -205,3 +205,19 @@ def test_pads_free_to_slide_sideways_are_refused_before_solving(tmp_path):
         build_mesh(loads(text.replace(bore, 'surfaces = ["bore"]\nfix = ["x", "y"]'), tmp_path))  # all along z
     held = build_mesh(loads(text, tmp_path))
     assert held.interface is not None
+
+
+def test_check_cells_refuses_what_meshing_would(tmp_path, capsys):
+    """`check --cells` meshes (its trials): the pads without side supports are refused there as the run
+    refuses them at meshing, naming the pads' free motions (a user trial's scene was OK by check and
+    refused by run); the supported pads pass."""
+    from multiscale.cli import main
+    (tmp_path / "twopads.geo").write_text(TWO_PADS_GEO)
+    text = TWO_PADS.replace("{folder}", str(tmp_path / "out"))
+    (tmp_path / "free.toml").write_text(text.replace('[[boundary]]\nsurfaces = ["sides"]\nfix = ["x", "y"]\n', ""))
+    (tmp_path / "held.toml").write_text(text)
+    assert main(["check", str(tmp_path / "free.toml"), "--cells"]) == 2
+    err = capsys.readouterr().err
+    assert "error: geometry = 'pad_" in err and "could move as rigid bodies" in err and "1 problem" in err
+    assert main(["check", str(tmp_path / "held.toml"), "--cells"]) == 0
+    assert "held.toml: OK" in capsys.readouterr().out

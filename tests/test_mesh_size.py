@@ -248,6 +248,17 @@ def test_check_cells_estimates_the_runs_memory_and_warns_beyond_the_free(tmp_pat
         "about 0.37 GB (about " in captured.out
     assert "warning: more than the 0.001 GB this machine has free: a coarser mesh (geometry.mesh_size) or ranks " \
         "on more machines" in captured.err
+    # a multiscale run adds its zones' (before: the macro part alone, 0.41 GB for 0.55 to 1.75 GB measured)
+    from multiscale.memory import micro_memory
+    from test_coupling import POD
+    path.write_text(POD.format(folder=tmp_path / "rough"))
+    assert cli.main(["check", str(path), "--cells"]) == 0
+    out, scene = capsys.readouterr().out, load(path)
+    g = scene.geometry
+    mesh = estimate_cells(g.module(), dict(g.params), bodies=[[r.tag for r in b.regions] for b in g.spec.bodies])
+    need = run_memory(3 * mesh.nodes, "transient") + micro_memory(25 * 16**2)      # 5 x 5 zones of 16^2
+    assert f"  memory    about {need / 1e9:.2g} GB at the peak of a multiscale run on one rank, each more adding " \
+        "about 0.52 GB (about " in out and "; its zones 6,400 grid points; " in out
 
 
 def test_max_cells_in_the_scene_and_on_the_command_line(tmp_path, capsys):

@@ -228,6 +228,27 @@ def test_pin_on_disc_speed_profile(tmp_path):
     assert stop.angular_speed(3.0) == 0.0 and stop.mean_angular_speed(3.0, 3.5) == 0.0
 
 
+def test_check_says_where_a_pressure_acts_and_its_force(tmp_path):
+    """A pin-on-disc given loading.pressure = 0.375 MPa: check says it acts on the holder plate's
+    ends, 2 x 40 x 3 mm, 90 N (a user trial took it for the pin's nominal pressure, 150 N on its
+    400 mm^2, and check said only "0.375 MPa"); a force names the builder's load face; the disc
+    brake's line pressure gives p pi r^2 on the piston and the caliper's bore."""
+    pytest.importorskip("meshes.pin_on_disc")
+    from multiscale.scene_summary import summary
+
+    def loading(text):
+        return next(line for line in summary(loads(text, tmp_path)) if line.startswith("  loading   "))
+
+    text = (DEMOS / "pin_on_disc_perfect.toml").read_text()
+    assert loading(text.replace('normal_force = "200 N"', 'pressure = "0.375 MPa"')).startswith(
+        "  loading   0.375 MPa on plate_ends (240 mm^2): 90 N, 200 rpm")
+    assert loading(text).startswith("  loading   200 N on plate_ends, 200 rpm")
+    r = 0.023                                                        # m, the brake's piston radius
+    assert loading((DEMOS / "brake_squeal.toml").read_text()).startswith(
+        f"  loading   1 MPa on piston_back ({math.pi * r**2 * 1e6:.4g} mm^2): {1e6 * math.pi * r**2:.4g} N, "
+        f"caliper_bore ({math.pi * r**2 * 1e6:.4g} mm^2): {1e6 * math.pi * r**2:.4g} N, ")
+
+
 def test_demo_scenes_validate():
     pytest.importorskip("meshes.pin_on_disc")
     pod = load(DEMOS / "pin_on_disc_perfect.toml")
@@ -541,7 +562,7 @@ def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_pa
     lines = summary(loads(torque, tmp_path))
     # check states the work the run's frictional heat must add up to: T x 200 rpm x 30 s here,
     # 1/2 m v^2 for a vehicle stop that ends before time.end (20 kg from 36 km/h: 1 kJ)
-    at = next(k for k, line in enumerate(lines) if line.startswith("  loading   braking torque 30 N m, 200 rpm"))
+    at = next(k for k, line in enumerate(lines) if line.startswith("  loading   braking torque 30 N m on plate_ends, 200 rpm"))
     assert lines[at + 1] == (f"            braking work to time.end: {30 * 200 * math.pi / 30 * 30 / 1e3:.6g} kJ (the "
                              "frictional heat of the run)")
     stop = loads(pod.replace('rotation_speed = "200 rpm"\n', "").replace('normal_force = "200 N"\n', "")

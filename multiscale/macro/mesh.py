@@ -30,7 +30,7 @@ from mpi4py import MPI
 from multiscale.errors import InputError, MultiscaleError
 from multiscale.geometry import BodySpec, GeometrySpec, check_cells, gmsh_session
 from multiscale.macro.coverage import coverage_notes, face_coverage
-from multiscale.macro.held import check_held
+from multiscale.held import check_held
 
 
 INTERFACE_QUADRATURE = 2      # exact for P1 displacements times P1 tests on a facet

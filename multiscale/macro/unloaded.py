@@ -44,7 +44,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 from scipy.sparse.csgraph import connected_components
 
-from multiscale.macro.held import FREE, motion_rows
+from multiscale.held import FREE, motion_rows
 
 SHIFT = 1e-8       # P = K + SHIFT diag(K), the factorised operator of the refinement
 TOL = 1e-10        # the refinement stops at ||f − K u|| <= TOL ||f||

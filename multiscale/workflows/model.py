@@ -27,7 +27,6 @@ The rules that more than one analysis follows live here once:
 """
 from __future__ import annotations
 
-import dataclasses
 import itertools
 import sys
 import warnings
@@ -37,7 +36,7 @@ import numpy as np
 from mpi4py import MPI
 
 from multiscale.errors import InputError
-from multiscale.geometry import GeometrySpec, Rotation, Support
+from multiscale.geometry import Rotation
 from multiscale.io import reporter
 from multiscale.macro import mesh as two_body
 from multiscale.macro.friction import FacetFriction, StribeckFriction, TableFriction
@@ -47,8 +46,9 @@ from multiscale.macro.load_faces import load_face_areas, load_face_forces
 from multiscale.macro.mechanics import REPEATABLE_REFRESH, Mechanics
 from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
-from multiscale.memory import memory_available, remedy, run_memory
+from multiscale.memory import memory_available, micro_memory, remedy, run_memory
 from multiscale.scene_friction import bare_interfaces, initial_friction, speed_law_guess
+from multiscale.scene_geometry import scene_spec
 
 
 def friction_coefficient(scene, interface: str) -> float:
@@ -88,18 +88,6 @@ def friction_law(scene, tm) -> FacetFriction | None:
     bare = bare_interfaces(scene.interfaces, tags) if law is not None else []
     speeds = tuple((tag == i, law) for i, name in enumerate(tags) if name in bare)
     return FacetFriction(facet_friction(scene, tm), fades, speeds) if fades or speeds else None
-
-
-def scene_spec(scene) -> GeometrySpec:
-    """The geometry's spec with the scene's supports, load faces and load direction."""
-    spec, ld = scene.geometry.spec, scene.loading
-    supports = spec.supports + tuple(Support(s, b.components) for b in scene.boundary if b.fix for s in b.surfaces)
-    changes = {"supports": supports}
-    if ld.faces:
-        changes["load_faces"] = tuple(ld.faces)
-    if ld.direction is not None:
-        changes.update(load_direction=tuple(ld.direction), fluid_load=False)
-    return dataclasses.replace(spec, **changes)
 
 
 def load_kind(scene) -> str:
@@ -215,12 +203,24 @@ def build_mesh(scene, comm=MPI.COMM_WORLD) -> two_body.TwoBodyMesh:
     return tm
 
 
-def say_model_size(tm, mechanics, thermal=None, kind: str = "transient", modes: int = 0) -> None:
+def say_load(scene, tm) -> None:
+    """Say what a pressure load (``loading.pressure``) gives, a console line: its resultant [N] on each
+    load face of the mesh (a pin-on-disc's plate ends, a brake's piston: not the contact's nominal
+    pressure; said nowhere before, a user trial). Collective."""
+    if scene.loading.pressure is None:
+        return
+    forces = load_face_forces(tm, scene.loading.pressure, load_kind(scene))
+    reporter().say(f"  load: {scene.loading.pressure / 1e6:g} MPa on "
+                   + ", ".join(f"{face}: {force:.4g} N" for face, force in forces.items()))
+
+
+def say_model_size(tm, mechanics, thermal=None, kind: str = "transient", modes: int = 0, points: int = 0) -> None:
     """Say the size of a model, a console line: its cells, displacement dofs and (with heat)
     temperature dofs; and warn (stderr, at once) when a run of ``kind`` ("transient" or "squeal")
     of that size (a squeal run asking for ``modes`` modes) is estimated to need more memory than the
     machines of its ranks have free (``memory.run_memory``; a squeal run of ~1M dofs was checked OK and would take ~40 GB: a user
-    trial). Collective: global counts."""
+    trial), with a multiscale loop's zones of ``points`` grid points in all (``memory.micro_memory``).
+    Collective: global counts."""
     def count(functions) -> int:
         return sum(f.function_space.dofmap.index_map.size_global * f.function_space.dofmap.index_map_bs
                    for f in functions)
@@ -235,9 +235,11 @@ def say_model_size(tm, mechanics, thermal=None, kind: str = "transient", modes: 
     hosts = comm.allgather(MPI.Get_processor_name())
     free = comm.allgather(memory_available() if hosts.index(hosts[comm.rank]) == comm.rank else 0.0)
     need, have = run_memory(n, kind, comm.size, modes), (None if None in free else sum(free))
+    need += micro_memory(points, comm.size) if points else 0.0
     if comm.rank == 0 and have is not None and need > have:
         machines = "this machine" if len(set(hosts)) == 1 else f"the {len(set(hosts))} machines of its ranks"
-        print(f"warning: a {kind} run of {spaced(n)} displacement dofs takes about {need / 1e9:.3g} GB at its peak (an "
+        zones = f" and {spaced(points)} zone grid points" if points else ""
+        print(f"warning: a {kind} run of {spaced(n)} displacement dofs{zones} takes about {need / 1e9:.3g} GB at its peak (an "
               f"estimate from measured runs, docs/performance.rst), more than the {have / 1e9:.3g} GB {machines} "
               f"has free: it may be killed without a word by the out-of-memory killer; {remedy(kind == 'squeal')}",
               file=sys.stderr, flush=True)

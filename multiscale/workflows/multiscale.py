@@ -43,7 +43,7 @@ from multiscale.micro.laws import Conductance
 from multiscale.micro.post_analysis import Heating, PostAnalyses, PostAnalysis, grid_of
 from multiscale.provenance import resolved_toml
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, heat_warnings_as_notes, \
-    interface_forces, interface_materials, run_notes, say_model_size
+    interface_forces, interface_materials, run_notes, say_load, say_model_size
 from multiscale.workflows.output import prepare_folder
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
@@ -132,7 +132,8 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
         exchange = (scene.has("heat_partition") and scene.micro.partition_law
                     and scene.micro.coupling_scheme(scene.effects) == "implicit")
         model = build_model(scene, comm, law=rough.law, tm=tm, conductance=scene.has("conductance") or exchange)
-    say_model_size(tm, model.mechanics, model.thermal)
+    say_model_size(tm, model.mechanics, model.thermal, points=sum(z.surface.heights.size for z in rough.zones))
+    say_load(scene, tm)
     t, wear = scene.time, scene.has("wear")
     mu = np.concatenate([np.full(g.n_zones, friction_coefficient(scene, n)) for n, g in zip(rough.names, rough.grids)])
     shares = np.concatenate([np.full(g.n_zones, model.partitions[n]) for n, g in zip(rough.names, rough.grids)]) \

@@ -52,7 +52,7 @@ from multiscale.macro.stability_map import StabilityMap
 from multiscale.scene_friction import bare_interfaces, curve_left
 from multiscale.workflows import squeal_map
 from multiscale.workflows.model import build_mechanics, build_mesh, drive, friction_coefficient, interface_forces, \
-    say_model_size, speed_law
+    say_load, say_model_size, speed_law
 from multiscale.workflows.output import RunResult, prepare_folder
 from multiscale.workflows.rough import build_rough_interface
 from multiscale.workflows.strain import overloaded, unloaded
@@ -173,6 +173,7 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     prefix = "squeal_" + "".join(ch if ch.isalnum() else "_" for ch in name) + "_"
     mech = build_squeal_mechanics(scene, tm, degree=degree, prefix=prefix)
     say_model_size(tm, mech, kind="squeal", modes=st.modes)
+    say_load(scene, tm)
     try:
         with closed_on_error(mech, tm.comm):
             d = drive(scene, tm)

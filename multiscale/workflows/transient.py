@@ -18,7 +18,8 @@ from multiscale import io, outputs
 from multiscale.errors import Interrupted
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.output import FieldOutput
-from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, run_notes, say_model_size
+from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, run_notes, say_load, \
+    say_model_size
 from multiscale.workflows.output import RunResult, prepare_folder
 from multiscale.workflows.strain import say_at_once
 
@@ -64,6 +65,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
     with io.stage("model set-up"), heat_warnings_as_notes():
         model = build_model(scene, comm, tm=tm)
     say_model_size(tm, model.mechanics, model.thermal)
+    say_load(scene, tm)
     with closed_on_error(model, comm):           # a script going on after a failed run gets its communicators
         with io.stage("first contact solve"), heat_warnings_as_notes(model):
             model.start()
