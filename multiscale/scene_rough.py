@@ -11,7 +11,7 @@ import warnings
 from multiscale.errors import InputError
 from multiscale.micro.spectrum import power_spectrum
 from multiscale.micro.topography import (TopographyWarning, beyond_measurement, check_cutoff, check_resolved, coarse_grid,
-                                         condition, covers, read_topography, zone_cells)
+                                         condition, copy_notes, covers, read_topography, zone_cells)
 from multiscale.micro.zones import THINNEST, ZoneGrid
 from multiscale.scene_cycle import largest_load_factor
 from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR, P_MAX_PLASTIC
@@ -396,7 +396,8 @@ def measured_cover(scene, warnings_out: list) -> list[str]:
                 done = condition(measured, r.detrend, r.cutoff, r.max_undefined, prefix=prefix, despike=r.despike)
             spectrum = power_spectrum(done.surface)       # one PSD for both checks
             beyond = beyond_measurement(done.surface, cell, prefix, spectrum) if r.cover == "equivalent" else None
-            warnings_out += [w for w in [coarse_grid(done.surface, cell, prefix, spectrum), beyond]
+            copies = copy_notes(done.surface.size, (done.surface.dx, done.surface.dy), size, cell, r.cover, prefix)
+            warnings_out += [w for w in [coarse_grid(done.surface, cell, prefix, spectrum), beyond, *copies]
                              if w and w not in warnings_out]
         except InputError as exc:
             out.append(str(exc))

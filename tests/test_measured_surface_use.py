@@ -48,8 +48,33 @@ def scene(tmp_path, roughness, micro=""):
 
 def apart(found) -> tuple:
     """The scene's warnings but the micro grid's on the measured gradient (``topography.coarse_grid``:
-    top-1.top's 0.6 um measurement on the block's 10 mm face keeps none of it, and says so)."""
-    return tuple(w for w in found if "of the measured RMS gradient" not in w)
+    top-1.top's 0.6 um measurement on the block's 10 mm face keeps none of it, and says so) and
+    those of the copies that cover it (``topography.copy_notes``, tested on their own)."""
+    return tuple(w for w in found if "of the measured RMS gradient" not in w
+                 and not (w.startswith("roughness.cover") and ("pattern repeats" in w or "fewer than 4 cells" in w)))
+
+
+def test_check_says_what_the_copies_of_a_small_measurement_lose_as_the_run_does(tmp_path):
+    """top-1.top (0.77 um wide at the scene's 3 nm pixels) tiled or mirrored over the block's 10 mm
+    face: check warns, as the run's cover does (and before the run only the run did: a user
+    trial), that the pattern repeats and that it spans fewer than 4 cells of the micro grid; the
+    run's warnings are the same sentences."""
+    import warnings
+
+    from multiscale.micro.reading import read_topography
+    from multiscale.micro.topography import condition, cover
+    for method in ("tile", "mirror"):
+        s = scene(tmp_path, f'file = "{TOP}"\npixel_size = "3 nm"\ncover = "{method}"', GRID)
+        said = [w for w in s.warnings if w.startswith(f'roughness.cover = "{method}"')]
+        assert len(said) == 2 and "spans fewer than 4 cells of the micro grid" in said[0], said
+        assert "copies; wavelengths longer than" in said[1] and said[1].endswith("the pattern repeats")
+        if method == "mirror":    # (its 4-point periods tiled over 10 mm: 26k x 26k points, a minute)
+            continue
+        done = condition(read_topography(TOP, pixel_size=3e-9, prefix="roughness."), "plane", prefix="roughness.")
+        with warnings.catch_warnings(record=True):
+            warnings.simplefilter("always")
+            lines = cover(done.surface, (32, 32), (10e-3, 10e-3), method, prefix="roughness.")[1]   # 2 x 2 zones of 16^2
+        assert [line.removeprefix("warning: ") for line in lines if "roughness.cover" in line] == said
 
 
 def test_surface_command_prints_the_steps_and_surfacetopographys_sq(tmp_path, capsys):

@@ -358,15 +358,15 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
     - ``"equivalent"``: a statistically equivalent surface from its PSD
       (``spectrum.equivalent_surface``, ``seed``) over the whole size.
 
-    ``warn``: the grid's resolution of the gradient (``coarse_grid``) and the equivalent surface's
-    power beyond the measurement (``beyond_measurement``) checked (False: said already, e.g. by a
-    scene's check for a face whose extent its geometry knows). Returns the (non-periodic) surface
-    and report lines.
+    ``warn``: the grid's resolution of the gradient (``coarse_grid``), the equivalent surface's
+    power beyond the measurement (``beyond_measurement``) and the copies (``copy_notes``) checked
+    (False: said already, e.g. by a scene's check for a face whose extent its geometry knows).
+    Returns the (non-periodic) surface and report lines.
     """
     nx, ny = check_pair(f"{prefix}n", n, check_count)
     Lx, Ly = check_pair(f"{prefix}size", size, check_positive)
     short = not covers(surface.size, (Lx, Ly), method, prefix)
-    wide, target = _sized("the measurement", surface.size), _sized("the interface", (Lx, Ly))
+    target = _sized("the interface", (Lx, Ly))
     # one PSD for the checks and the equivalent surface, none for a cover neither takes
     spectrum = power_spectrum(surface) if warn or method == "equivalent" else None
     coarse = coarse_grid(surface, (Lx / nx, Ly / ny), prefix, spectrum) if warn else None
@@ -388,32 +388,21 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
                    f"{2 * max(surface.dx, surface.dy) * 1e6:.4g} um)"]
     filtered = False
     if short:
+        cell = (Lx / nx, Ly / ny)
+        counts, reps = copy_layout(surface.size, (surface.dx, surface.dy), (Lx, Ly), cell, method)
+        notes = copy_notes(surface.size, (surface.dx, surface.dy), (Lx, Ly), cell, method, prefix) if warn else []
         base = surface
         if method == "mirror":
             t = as_topography(surface).mirror_stitch()
             base = Surface(np.asarray(t.heights()).T, surface.dx, surface.dy, periodic=True)
-        cell = (Lx / nx, Ly / ny)
-        if base.dx < cell[0] * (1 - 1e-9) or base.dy < cell[1] * (1 - 1e-9):     # coarsen once, then copy
-            if base.periodic:         # mirror-stitched: whole periods, so that the copies meet without steps
-                counts = tuple(max(4, round(b / c)) for b, c in zip(base.size, cell))
-            else:                     # tiles of whole cells
-                counts = tuple(max(4, int(np.floor(b / c + 1e-9))) for b, c in zip(base.size, cell))
-            if min(b / c for b, c in zip(base.size, cell)) < 4:
-                few = (f"{prefix}cover = \"{method}\": {wide} spans fewer than 4 cells of the micro grid "
-                       f"({cell[0] * 1e6:.4g} x {cell[1] * 1e6:.4g} um) along an axis: its roughness is finer than "
-                       "the grid and the copies keep little of it; use \"equivalent\" or a finer micro.grid")
-                warnings.warn(few, TopographyWarning, stacklevel=2)
-                lines.append(f"warning: {few}")
+        if counts is not None:        # coarsened once (to whole cells, or whole periods), then copied
             base, note = resample(base, counts, None if base.periodic else (counts[0] * cell[0], counts[1] * cell[1]))
             lines.append(note)
             filtered = True           # the copies are sampled below, not filtered a second time
-        reps = (int(np.ceil(Ly / base.size[1])), int(np.ceil(Lx / base.size[0])))
         surface = Surface(np.tile(base.heights, reps), base.dx, base.dy, periodic=False)
-        message = (f"{prefix}cover = \"{method}\": {wide} is smaller than {target}: {reps[1]} x {reps[0]} "
-                   f"{'mirror-stitched ' if method == 'mirror' else ''}copies; wavelengths longer than "
-                   f"{max(base.size) * 1e3:.4g} mm are missing and the pattern repeats")
-        warnings.warn(message, TopographyWarning, stacklevel=2)
-        lines.append(f"warning: {message}")
+        for message in notes:
+            warnings.warn(message, TopographyWarning, stacklevel=2)
+            lines.append(f"warning: {message}")
     # the central Lx x Ly of it, on the target grid
     cx, cy = (surface.size[0] - Lx) / 2, (surface.size[1] - Ly) / 2
     c0, r0 = int(np.floor(cx / surface.dx + 1e-9)), int(np.floor(cy / surface.dy + 1e-9))
@@ -424,6 +413,44 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
     out, note = resample(crop, (nx, ny), (Lx, Ly), antialias=not filtered)
     lines.append(note)
     return Surface(out.heights - out.heights.mean(), out.dx, out.dy, periodic=False), lines
+
+
+def copy_layout(measured, pixel, size, cell, method: str) -> tuple[tuple | None, tuple[int, int]]:
+    """How ``cover`` copies a measurement of ``measured`` = (mx, my) [m] in pixels ``pixel`` [m] over a
+    face of ``size`` [m] in micro cells ``cell`` [m] (``method`` "mirror" or "tile"): the points
+    (nx, ny) the base (the measurement, or its mirror-stitched double) is coarsened to first, None if
+    its pixels are not finer than the cells (whole periods of the double, at least 4; whole cells of
+    a tile, at least 4), and the copies (rows, columns) of the base."""
+    base = tuple(2 * m for m in measured) if method == "mirror" else tuple(measured)
+    counts = None
+    if pixel[0] < cell[0] * (1 - 1e-9) or pixel[1] < cell[1] * (1 - 1e-9):
+        if method == "mirror":        # whole periods, so that the copies meet without steps
+            counts = tuple(max(4, round(b / c)) for b, c in zip(base, cell))
+        else:                         # tiles of whole cells
+            counts = tuple(max(4, int(np.floor(b / c + 1e-9))) for b, c in zip(base, cell))
+            base = (counts[0] * cell[0], counts[1] * cell[1])
+    return counts, (int(np.ceil(size[1] / base[1])), int(np.ceil(size[0] / base[0])))
+
+
+def copy_notes(measured, pixel, size, cell, method: str, prefix: str = "") -> list[str]:
+    """The warnings of ``cover``'s copies (``copy_layout``; [] if the measurement covers the face or
+    ``method`` takes no copies): the pattern repeats, and a measurement (or its mirror-stitched
+    double) spanning fewer than 4 cells keeps little of its roughness. ``multiscale check`` says them
+    for a face whose extent the geometry knows (it did not: a user trial's run did), a run with the
+    mesh's."""
+    if method not in ("mirror", "tile") or covers(measured, size, method, prefix):
+        return []
+    base = tuple(2 * m for m in measured) if method == "mirror" else tuple(measured)
+    counts, reps = copy_layout(measured, pixel, size, cell, method)
+    wide = _sized("the measurement", measured)
+    out = [f"{prefix}cover = \"{method}\": {wide} spans fewer than 4 cells of the micro grid ({cell[0] * 1e6:.4g} x "
+           f"{cell[1] * 1e6:.4g} um) along an axis: its roughness is finer than the grid and the copies keep little "
+           "of it; use \"equivalent\" or a finer micro.grid"] \
+        if counts is not None and min(b / c for b, c in zip(base, cell)) < 4 else []
+    period = max(base) if counts is None or method == "mirror" else max(n * c for n, c in zip(counts, cell))
+    return out + [f"{prefix}cover = \"{method}\": {wide} is smaller than {_sized('the interface', size)}: "
+                  f"{reps[1]} x {reps[0]} {'mirror-stitched ' if method == 'mirror' else ''}copies; wavelengths "
+                  f"longer than {period * 1e3:.4g} mm are missing and the pattern repeats"]
 
 
 def covers(measured, size, method: str = "measured", prefix: str = "") -> bool:
