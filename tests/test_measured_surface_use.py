@@ -58,7 +58,9 @@ def test_check_says_what_the_copies_of_a_small_measurement_lose_as_the_run_does(
     """top-1.top (0.77 um wide at the scene's 3 nm pixels) tiled or mirrored over the block's 10 mm
     face: check warns, as the run's cover does (and before the run only the run did: a user
     trial), that the pattern repeats and that it spans fewer than 4 cells of the micro grid; the
-    run's warnings are the same sentences."""
+    run's warnings are the same sentences. Mirrored, the run's cover samples the copies where they lie
+    (it tiled the 4-point periods over 10 mm: 26k x 26k points, 5 GB and a minute)."""
+    import tracemalloc
     import warnings
 
     from multiscale.micro.reading import read_topography
@@ -68,13 +70,15 @@ def test_check_says_what_the_copies_of_a_small_measurement_lose_as_the_run_does(
         said = [w for w in s.warnings if w.startswith(f'roughness.cover = "{method}"')]
         assert len(said) == 2 and "spans fewer than 4 cells of the micro grid" in said[0], said
         assert "copies; wavelengths longer than" in said[1] and said[1].endswith("the pattern repeats")
-        if method == "mirror":    # (its 4-point periods tiled over 10 mm: 26k x 26k points, a minute)
-            continue
         done = condition(read_topography(TOP, pixel_size=3e-9, prefix="roughness."), "plane", prefix="roughness.")
+        tracemalloc.start()
         with warnings.catch_warnings(record=True):
             warnings.simplefilter("always")
             lines = cover(done.surface, (32, 32), (10e-3, 10e-3), method, prefix="roughness.")[1]   # 2 x 2 zones of 16^2
+        peak = tracemalloc.get_traced_memory()[1]
+        tracemalloc.stop()
         assert [line.removeprefix("warning: ") for line in lines if "roughness.cover" in line] == said
+        assert peak < 50e6, peak        # (mirrored: 5.4 GB before)
 
 
 def test_surface_command_prints_the_steps_and_surfacetopographys_sq(tmp_path, capsys):

@@ -399,10 +399,18 @@ def cover(surface: Surface, n, size, method: str = "measured", seed=0, prefix: s
             base, note = resample(base, counts, None if base.periodic else (counts[0] * cell[0], counts[1] * cell[1]))
             lines.append(note)
             filtered = True           # the copies are sampled below, not filtered a second time
-        surface = Surface(np.tile(base.heights, reps), base.dx, base.dy, periodic=False)
         for message in notes:
             warnings.warn(message, TopographyWarning, stacklevel=2)
             lines.append(f"warning: {message}")
+        if base.periodic:   # mirror: its copies sampled where they lie, not tiled at its pixels (0.77 um tiled
+            #                 over 10 mm: 26k x 26k points, a minute; a user trial's measurement)
+            c0 = int(np.floor((reps[1] * base.size[0] - Lx) / 2 / base.dx + 1e-9))
+            r0 = int(np.floor((reps[0] * base.size[1] - Ly) / 2 / base.dy + 1e-9))
+            rolled = Surface(np.roll(base.heights, (-r0, -c0), axis=(0, 1)), base.dx, base.dy, periodic=True)
+            out, note = resample(rolled, (nx, ny), (Lx, Ly), antialias=not filtered)
+            lines += [f"cropped the central {Lx * 1e3:.4g} x {Ly * 1e3:.4g} mm", note]
+            return Surface(out.heights - out.heights.mean(), out.dx, out.dy, periodic=False), lines
+        surface = Surface(np.tile(base.heights, reps), base.dx, base.dy, periodic=False)
     # the central Lx x Ly of it, on the target grid
     cx, cy = (surface.size[0] - Lx) / 2, (surface.size[1] - Ly) / 2
     c0, r0 = int(np.floor(cx / surface.dx + 1e-9)), int(np.floor(cy / surface.dy + 1e-9))
