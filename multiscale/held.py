@@ -131,8 +131,11 @@ class Parts:
         return tri, x, n / np.maximum(2 * area, 1e-300)[:, None], area
 
     def where(self, p: int, names) -> str:
-        """Part p's region and the centre of its bounding box [mm]."""
-        return (f"{names.get(int(self.region[self.label == p][0]), '?')!r} around "
+        """Part p's region (its first cell's; the others it holds in parentheses) and the centre of its
+        bounding box [mm]."""
+        tags = self.region[self.label == p]
+        more = ", ".join(repr(names.get(int(t), "?")) for t in dict.fromkeys(tags.tolist()) if t != tags[0])
+        return (f"{names.get(int(tags[0]), '?')!r}{f' (with {more})' if more else ''} around "
                 f"{(np.round(self.centre[p] * 1e3, 1) + 0.0).tolist()} mm")
 
 
@@ -197,22 +200,28 @@ class Holding:
                         for k in range(3):      # each corner stands for a third of its triangle
                             self.hold(int(p), -1, x[at, k], np.tile(np.eye(3)[c], (at.sum(), 1)), area[at] / 3)
 
-    def interfaces(self, spec: GeometrySpec, sliding: bool) -> None:
+    def interfaces(self, spec: GeometrySpec, sliding: bool) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """The interfaces' normals, relative between the parts on both sides; ``sliding``: not
-        along body 1's motion."""
-        for tag in spec.interfaces.values():
+        along body 1's motion. Returns each interface's share of N and of ``lost``."""
+        shares = {}
+        for name, tag in spec.interfaces.items():
+            before, lost = self.N.copy(), self.lost.copy()
             tri, x, n, area = self.parts.triangles(tag)
-            if not len(tri):
-                continue
             pair = np.stack([self.parts.of_triangles(0, tri), self.parts.of_triangles(1, tri)], axis=1)
-            for p, q in unique_rows(pair[(pair >= 0).all(axis=1)]).values:
+            for p, q in unique_rows(pair[(pair >= 0).all(axis=1)]).values if len(tri) else ():
                 on = (pair == (p, q)).all(axis=1)
                 for k in range(3):      # each corner stands for a third of its triangle
                     self.hold(int(p), int(q), x[on, k], n[on], area[on] / 3, sliding)
+            shares[name] = (self.N - before, self.lost - lost)
+        return shares
 
-    def refusal(self, names) -> InputError | None:
-        """The error naming a part with a free motion and what it is (None: every part held)."""
-        N, P = self.N, self.parts
+    def free(self, names, without=None) -> tuple[str, str, bool] | None:
+        """What nothing holds: the region of the freest part, the parts and their free motions, and
+        whether they touch nothing at all (None: every part held). ``without``: an interface's share
+        of N and ``lost`` (``interfaces``) taken out."""
+        N, lost, P = self.N, self.lost, self.parts
+        if without is not None:
+            N, lost = N - without[0], lost - without[1]
         values, vectors = np.linalg.eigh(N)
         free = vectors[:, values <= FREE * max(values[-1], 0.0)]
         if not free.shape[1]:
@@ -224,50 +233,63 @@ class Holding:
         region = names.get(int(P.region[P.label == first][0]), "a part")
         if not np.diag(N)[block].any():
             untouched = sum(not np.diag(N)[6 * p:6 * p + 6].any() for p in loose)
-            return InputError("geometry", region,
-                              f"{untouched} part(s) touch no interface and no support (one of region "
-                              f"{P.where(first, names)}): they could move freely; remove them from the geometry "
-                              "or hold them ([[boundary]] fix)")
+            return region, (f"{untouched} part(s) touch no interface and no support (one of region "
+                            f"{P.where(first, names)})"), True
         own, alone = np.linalg.eigh(N[block, block])
         alone = alone[:, own <= FREE * values[-1]]       # its motions free while every other part stays
         if alone.shape[1]:
-            mode, others = np.sum(alone ** 2, axis=1), []
+            mode, together = np.sum(alone ** 2, axis=1), []
         else:                                            # it moves only together with others
             mode = free[:, np.argmax(np.sum(free[block] ** 2, axis=0))]
-            others = [names.get(int(P.region[P.label == p][0]), "?") for p in range(len(P))
-                      if p != first and np.sum(mode[6 * p:6 * p + 6] ** 2) > 1e-6]
+            together = [p for p in range(len(P)) if p != first and np.sum(mode[6 * p:6 * p + 6] ** 2) > 1e-6]
             mode = mode[block] ** 2
         motions = [m for m, s in zip(MOTIONS, mode) if s > 0.5 * mode.max()]
-        along = f", together with region(s) {', '.join(map(repr, others))}" if others else ""
-        if self.lost[first] > FREE * values[-1]:
+        region_of = [names.get(int(P.region[P.label == p][0]), "?") for p in range(len(P))]
+        along = f", together with region(s) {', '.join(repr(region_of[p]) for p in together)}" if together else ""
+        apart = [P.where(p, names) for p in loose if p != first and p not in together]
+        along += f"; also region(s) {', '.join(apart)}" if apart else ""   # (it named one of them: a user trial)
+        if lost[first] > FREE * values[-1]:
             along += "; the facets of its curved interfaces alone held its sliding along them"
         if first in self.joined:
             at = ", ".join(P.where(q, names) for q in sorted(self.joined[first]))
             along += f"; it shares only an edge or a vertex with the part(s) of {at}: a joint holds no turn about it"
+        return region, (f"{len(loose)} part(s) could move as rigid bodies (one of region {P.where(first, names)}: "
+                        f"{', '.join(motions)}{along})"), False
+
+    def refusal(self, names) -> InputError | None:
+        """The error naming the parts with a free motion and what it is (None: every part held)."""
+        found = self.free(names)
+        if found is None:
+            return None
+        region, what, untouched = found
+        if untouched:
+            return InputError("geometry", region, f"{what}: they could move freely; remove them from the geometry "
+                                                  "or hold them ([[boundary]] fix)")
         return InputError("geometry", region,
-                          f"{len(loose)} part(s) could move as rigid bodies (one of region {P.where(first, names)}: "
-                          f"{', '.join(motions)}{along}): nothing holds them there; a support holds the components "
-                          "it fixes on its face, an interface only along its normal, and friction does not hold: "
-                          "add a [[boundary]] fix that holds these motions (e.g. fix = [\"x\", \"y\"] on a pad's "
-                          "sides)")
+                          f"{what}: nothing holds them there; a support holds the components it fixes on its face, "
+                          "an interface only along its normal, and friction does not hold: add a [[boundary]] fix that "
+                          "holds these motions (e.g. fix = [\"x\", \"y\"] on a pad's sides)")
 
 
-def check_held(model, spec: GeometrySpec, sliding: bool = False) -> None:
+def check_held(model, spec: GeometrySpec, sliding: bool = False) -> dict[str, str]:
     """Every part of the meshed ``model`` (gmsh, linear or quadratic cells) is held against its six
     rigid motions by the joints, supports and interfaces of ``spec`` (module docstring); otherwise
     an InputError names a free part's region, a point and its free motions (a part touching
     nothing: that it touches nothing). ``sliding`` (friction): the interfaces hold no part, on
-    either side, in body 1's motion along them (``spec.motion``)."""
+    either side, in body 1's motion along them (``spec.motion``). Returns the interfaces that alone
+    hold a part, each with what would move without it (``sole_holds``)."""
     parts = Parts.of(model, spec)
     if parts is None:
-        return
+        return {}
     holding = Holding(parts, spec.motion)
     holding.joints()
     holding.supports(spec)
-    holding.interfaces(spec, sliding)
-    error = holding.refusal({r.tag: r.name for b in spec.bodies for r in b.regions})
+    shares = holding.interfaces(spec, sliding)
+    names = {r.tag: r.name for b in spec.bodies for r in b.regions}
+    error = holding.refusal(names)
     if error is None:
-        return
+        alone = {name: holding.free(names, share) for name, share in shares.items()}
+        return {name: f"without it {found[1]}" for name, found in alone.items() if found is not None}
     apart = loose_bodies(spec.warnings).get(error.value)
     if apart:                # its real cause, warned of at check (a user trial fixed the sides, as it advised)
         raise InputError(error.name, error.value, f"{error.allowed}. Its cause is likely what check warned: {apart}")

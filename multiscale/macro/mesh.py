@@ -293,6 +293,7 @@ class TwoBodyMesh:
     bodies: tuple[Body, Body]
     interface: Interface
     notes: tuple = ()                  # what the run's warnings add (module docstring)
+    sole_holds: dict = field(default_factory=dict)   # interface -> the parts only it holds (``held.check_held``)
     _bodies_dx: ufl.Measure = field(init=False, repr=False)
 
     def __post_init__(self):
@@ -443,7 +444,7 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
     lowers (said in ``notes``); a force spread over them is applied whole (False: not said)."""
     spec = spec or builder.describe(params)
     name = getattr(builder, "NAME", builder.__name__)
-    error, coverage = None, ({}, {})
+    error, coverage, alone = None, ({}, {}), {}
     if comm.rank == 0:
         import gmsh   # rank 0 alone builds the geometry
         try:
@@ -453,7 +454,7 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
             else:
                 gmsh_session(builder)
                 builder.generate(gmsh.model, params)
-            check_held(gmsh.model, spec, sliding)
+            alone = check_held(gmsh.model, spec, sliding)
             coverage = face_coverage(gmsh.model, spec if pressed else replace(spec, load_faces=()))
         except Exception as exc:  # re-raised on every rank below
             error = exc
@@ -474,7 +475,8 @@ def build(builder: ModuleType, params=None, comm=MPI.COMM_WORLD, spec: GeometryS
         if comm.rank == 0 and gmsh.isInitialized():
             gmsh.finalize()
     tm = from_mesh(spec, data.mesh, data.cell_tags, data.facet_tags)
-    return replace(tm, notes=coverage_notes(tm, comm.bcast(coverage if comm.rank == 0 else None, root=0)))
+    coverage, alone = comm.bcast((coverage, alone) if comm.rank == 0 else None, root=0)
+    return replace(tm, notes=coverage_notes(tm, coverage), sole_holds=alone)
 
 
 def from_mesh(spec: GeometrySpec, parent: dmesh.Mesh, cell_tags: dmesh.MeshTags,

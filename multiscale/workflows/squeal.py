@@ -55,7 +55,7 @@ from multiscale.workflows.model import build_mechanics, build_mesh, drive, frict
     say_load, say_model_size, speed_law
 from multiscale.workflows.output import RunResult, prepare_folder
 from multiscale.workflows.rough import build_rough_interface
-from multiscale.workflows.strain import overloaded, unloaded
+from multiscale.workflows.strain import idle_holder, overloaded, unloaded
 
 SQUEAL_DEGREE = 2     # quadratic tetrahedra: linear ones are far too stiff in bending (tests)
 MAP_RESIDUAL = 1e-3   # a stability map's modes with larger relative residuals are warned to be approximate
@@ -111,6 +111,9 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
         pre = preload(mech, load, steps, reset=reset, torque=torque)
     if on_preload is not None:
         on_preload(mech)
+    floating = idle_holder(mech.tm.sole_holds, {n: abs(f) for n, f in pre.normal_force.items()})
+    if floating is not None:       # before the eigen solve finds their rigid motions, or not
+        raise floating
     with io.stage("eigen solve"):
         lin = linearise_system(mech, materials, damping=damping or opt.damping,
                                slope=slope if opt.friction_damping else None, prestress=opt.prestress,
@@ -229,22 +232,25 @@ class SquealResult(RunResult):
 
 def approximate_modes(scene, case: SquealCase) -> list[str]:
     """A warning naming the modes whose relative residual of the full problem exceeds
-    ``MODE_RESIDUAL`` (a projected solve's modes; the exact solvers' are near round-off)."""
+    ``MODE_RESIDUAL`` (a projected solve's modes: approximate; an exact solver's: not converged)."""
     st, modes = scene.stability, case.modes
     bad = np.flatnonzero(modes.errors > MODE_RESIDUAL)
     if not bad.size:
         return []
     named = ", ".join(f"{j + 1} ({modes.frequency[j]:.0f} Hz, {modes.errors[j]:.1e})" for j in bad[:6])
     more = f" and {bad.size - 6} more" if bad.size > 6 else ""
+    which = f"modes {named}{more} have relative residuals above {MODE_RESIDUAL:g}: their frequencies and growth " \
+        "rates are" if bad.size > 1 else f"mode {named} has a relative residual above {MODE_RESIDUAL:g}: its " \
+        "frequency and growth rate are"
+    if modes.method != "projection":             # an exact solver's: no basis to widen (a user trial was told to)
+        return [f"{which} not converged, though solved by {SOLVERS[modes.method]}: a nearly singular system, e.g. "
+                "a part that only an unpressed contact holds"]
     lossy = "material loss factors" in case.terms
     if st.method == "subspace" and lossy:        # its basis has no static responses to H (docs/squeal.md)
         hint = '; stability.method = "projection" adds the static responses to the loss factors\' forces'
     else:
         exact = not (st.damping or lossy or st.band[0] > 0 or st.target)   # the PEP reaches a band from 0 Hz only
         hint = '; stability.method = "quadratic" solves viscous damping exactly' if exact else ""
-    which = f"modes {named}{more} have relative residuals above {MODE_RESIDUAL:g}: their frequencies and growth " \
-        "rates are" if bad.size > 1 else f"mode {named} has a relative residual above {MODE_RESIDUAL:g}: its " \
-        "frequency and growth rate are"
     return [f"{which} approximate (projected on the modes up to stability.basis x f_max; a larger "
             f"stability.basis, now {st.basis:g}, widens the basis{hint})"]
 

@@ -7,6 +7,8 @@ from __future__ import annotations
 import sys
 from collections.abc import Mapping
 
+from multiscale.errors import InputError
+
 STRAINED = 0.02   # a contact pressure above this share of the softer side's E is warned about
 UNLOADED = 1e-6   # an interface carrying less than this share of the largest one's force is warned about
 
@@ -56,3 +58,21 @@ def unloaded(forces: Mapping[str, float]) -> list[str]:
     top = max(forces.values(), default=0.0)
     return [f"interface {n} carried no force ({f:.3g} N at most, against {top:.3g} N): nothing presses it; check "
             "loading.faces and the supports" for n, f in forces.items() if top > 0 and f < UNLOADED * top]
+
+
+def idle_holder(sole_holds: Mapping[str, str], forces: Mapping[str, float]) -> InputError | None:
+    """The error if an interface that carried no force (``unloaded`` of ``forces`` [N]) is the only
+    thing that holds some parts (``sole_holds``: interface -> what moves without it, ``held.check_held``): a
+    contact that presses nothing holds them by round-off or not at all, so a tangent built there is
+    singular or not from run to run (a floating caliper loaded on the piston alone: 2 of 7 runs
+    gave a 0 Hz "unstable" mode; a user trial)."""
+    top = max(forces.values(), default=0.0)
+    for name, f in forces.items():
+        if name in sole_holds and top > 0 and f < UNLOADED * top:
+            return InputError("interface", name,
+                              f"it carried no force ({f:.3g} N, against {top:.3g} N), yet "
+                              f"{sole_holds[name]}: unpressed, it holds them by round-off or not at all, and their "
+                              "rigid motions would be modes of some runs and not of others; load what presses it "
+                              "(loading.faces: a floating caliper takes the fluid pressure on its bore too) or hold "
+                              "those parts ([[boundary]] fix)")
+    return None
