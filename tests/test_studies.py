@@ -563,6 +563,10 @@ metrics = ["max_pressure"]
     assert sorted({x["loading.friction"] for x in labels}) == pytest.approx([i / 10 for i in range(11)])
     assert sorted({x["time.steps"] for x in labels}) == [1, 3, 5, 7]
     assert all(isinstance(x["time.steps"], int) for x in labels)
+    log = scene.read_text().replace("{start = 1, stop = 7, num = 4}", "{start = 3, stop = 30, num = 3, log = true}")
+    labels = [r.label for r in load_study(write(tmp_path, log, "log_steps.toml")).runs]   # the scene's integer key:
+    assert sorted({x["time.steps"] for x in labels}) == [3, 9, 30]    # rounded (refused for 3.0000000000000004, 9.49:
+    assert all(isinstance(x["time.steps"], int) for x in labels)     # a user trial)
     one = {r.key for r in load_study(scene).runs}          # ranks name the runs (2 reused the times of 1)
     scene.write_text(scene.read_text() + "[run]\nranks = 2\n")
     assert not one & {r.key for r in load_study(scene).runs}
@@ -724,6 +728,11 @@ loading.friction = [0.3, 0.4]
                   '[fixed]\neffects = ["contact", "friction", "stability"]\n[sweep]\nloading.friction = [0.3, 0.4]\n')
     assert main(["study", str(fixed)]) == 2           # [fixed] makes it a squeal scene (it ran, then failed)
     assert 'metrics item 1 ("max_grwth"): unknown metric of a squeal scene' in capsys.readouterr().err
+    plain = write(tmp_path, f'problem = "scene"\nscene = "{tmp_path / "base.toml"}"\nmetrics = ["unstable_modes"]\n'
+                  '[sweep]\nloading.friction = [0.3, 0.4]\n')
+    assert main(["study", str(plain)]) == 2           # no squeal analysis: found after every run before (a trial)
+    assert ('metrics item 1 ("unstable_modes"): a squeal metric (of modes.csv), and this scene runs no squeal '
+            'analysis (effect "stability")') in capsys.readouterr().err
     folder = scene_study(tmp_path, "brake_squeal.toml", 'metrics = ["max_growth"]\n[fixed]\noutput.folder = "mine"\n'
                                                         "[sweep]\nloading.friction = [0.3, 0.4]\n")
     assert main(["study", str(folder)]) == 2           # (it was replaced by the run's own folder without a word)
@@ -1117,6 +1126,20 @@ def test_squeal_scene_metrics_from_the_mode_table(tmp_path):
     assert got["max_growth_frequency"] == pytest.approx(2500.0, rel=1e-9)
     assert got["lowest_unstable_frequency"] == pytest.approx(2500.0, rel=1e-9)
     assert got["min_damping_ratio"] == pytest.approx(-40.0 / abs(lam[1]), rel=1e-6)
+    # none grows: no frequency to name (it gave 0 Hz and a stable mode's 900 Hz, plotted: a user trial),
+    # and the run is not failed for it
+    from multiscale.studies.records import metric_problem
+    stable = ModalResult(lam.imag * 1j - 3.0, -lam**2, np.zeros((1, 4), complex), np.full(4, 1e-12), (0.0, 16e3),
+                         0.0, 10, "gnhep", 1, 1, 0.0)
+    got = squeal_metrics(stable.write_csv(tmp_path / "stable.csv"))
+    assert got["unstable_modes"] == 0 and got["max_growth"] == pytest.approx(-3.0, rel=1e-6)
+    assert np.isnan(got["max_growth_frequency"]) and np.isnan(got["lowest_unstable_frequency"])
+    from multiscale.studies.scene_problem import SceneProblem
+    undefined = SceneProblem.undefined
+    assert metric_problem(got, list(got), undefined) is None
+    assert metric_problem(got, ["lowest_unstable_frequency"]) == 'metric "lowest_unstable_frequency" is nan (not finite)'
+    assert metric_problem({**got, "max_growth": np.inf}, ["max_growth"], undefined) == \
+        'metric "max_growth" is inf (not finite)'
 
 
 def test_failed_scene_run_reports_its_exception_not_the_launchers_abort():

@@ -203,6 +203,9 @@ def _plot_axis(study, ok, axis, folder, found):
             at = sorted({xs[point(r)] for r in ok if r.is_reference})   # its error 0 has no place on a log axis
             for k, x in enumerate(at):       # (it was missing from the plot: a user trial)
                 ax.axvline(x, color="green", ls=":", lw=1, label=None if k else "the reference (error 0)")
+        if kind == "value" and not any(np.isfinite(np.asarray(line.get_ydata(), float)).any()
+                                       for line in ax.get_lines()):
+            ax.text(0.5, 0.5, "n/a in every run:\nwhat it measures is absent", transform=ax.transAxes, ha="center", va="center")
         if kind == "value" and m in study.judged:        # calibration: the measured value, and where it is met
             ref = measured_value(ok, m)
             ax.axhline(ref, color="green", ls="--", lw=1, label="measured")

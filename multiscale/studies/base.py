@@ -8,7 +8,7 @@ from pathlib import Path
 
 import numpy as np
 
-from multiscale.schema import Context, suggest
+from multiscale.schema import Context, fields_of, suggest
 
 __all__ = ["Outcome", "Problem", "RunFailed", "jsonable"]
 
@@ -41,6 +41,7 @@ class Problem:
     doc: str
     metrics: dict                 # name -> description with unit
     exact_metrics: tuple = ()     # metrics the analytic reference provides
+    undefined: frozenset = frozenset()   # metrics that are NaN where what they measure is absent
 
     def parse(self, raw: dict, path: str, ctx: Context, **options):
         """Validated parameters (problems appended to ``ctx``); ``options``: the scene problem's
@@ -54,6 +55,11 @@ class Problem:
     def run(self, params, workdir: Path) -> Outcome:
         """One run of validated ``params``; files it writes go under ``workdir``."""
         raise NotImplementedError
+
+    def knob_spec(self, name: str):
+        """The schema Spec of parameter ``name`` (None: unknown kind)."""
+        params = getattr(self, "params", None)
+        return dict(fields_of(params)).get(name) if params is not None else None
 
     def metric_unit(self, name: str) -> str:
         """The unit of metric ``name`` (``unit_in`` its description), "" if unknown."""

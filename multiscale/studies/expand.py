@@ -137,9 +137,8 @@ def load_study(path) -> Study:
 
 
 def parser_of(problem, name):
-    """The schema parser of a micro problem's parameter (None: unknown kind, e.g. scene keys)."""
-    params = getattr(problem, "params", None)
-    return dict(fields_of(params)).get(name) if params is not None else None
+    """The schema Spec of a problem's parameter (``Problem.knob_spec``; None: unknown kind)."""
+    return problem.knob_spec(name)
 
 
 def _names(problem) -> list | None:

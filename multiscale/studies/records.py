@@ -14,6 +14,7 @@ import numpy as np
 
 from multiscale.schema import FrozenMap, suggest
 from multiscale.studies.expand import Study, StudyRun
+from multiscale.studies.problems import PROBLEMS
 
 __all__ = ["FAILED", "JIT_SHARE", "NUMBERS", "foreign_records", "json_default", "metric_problem", "read_json",
            "read_records", "record_path", "write_json"]
@@ -29,9 +30,10 @@ def record_path(study: Study, run: StudyRun) -> Path:
     return study.folder / "runs" / f"{run.key}.json"
 
 
-def metric_problem(metrics: dict, names) -> str | None:
+def metric_problem(metrics: dict, names, undefined=frozenset()) -> str | None:
     """Why a run's ``metrics`` (name -> value) do not give the study's metric ``names``; None if they do.
-    Names every metric missing (before: the first; a user trial's second misspelt one came a run later)."""
+    Names every metric missing (before: the first; a user trial's second misspelt one came a run later).
+    A metric in ``undefined`` (``Problem.undefined``) may be NaN: what it measures is absent."""
     missing = {name: suggest(name, metrics) for name in names if name not in metrics}    # misspelt: fix them,
     if missing:                                                                          # records are judged on read
         available = sorted(metrics)           # a scene's history: ~180 names, in every failed run's line
@@ -45,7 +47,7 @@ def metric_problem(metrics: dict, names) -> str | None:
         value = metrics[name]
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             return f'metric "{name}" is {value!r} (not a number)'
-        if not math.isfinite(value):
+        if not math.isfinite(value) and not (name in undefined and math.isnan(value)):
             return f'metric "{name}" is {value} (not finite)'
     return None
 
@@ -78,7 +80,7 @@ def read_records(study: Study) -> dict:
             if record.get("ran") or record.get("status") == "ok":
                 if record.get("repeat", 1) < study.options.repeat:
                     continue
-                why = metric_problem(record.get("metrics", {}), study.metrics)
+                why = metric_problem(record.get("metrics", {}), study.metrics, PROBLEMS[study.problem].undefined)
                 record.update(status=FAILED if why else "ok", error=why or "")
             out[run.key] = record
     return out

@@ -11,13 +11,12 @@ from pathlib import Path
 import h5py
 import numpy as np
 
-from multiscale.scene import Scene
-from multiscale.scene_keys import key_parts
-from multiscale.schema import Either, ListOf, Named, Quantity, Section, TableOr, Tables, fields_of
+from multiscale.schema import Either, ListOf, Quantity, TableOr
 from multiscale.studies.expand import Study, StudyRun, normalise, parser_of, reference_run
 from multiscale.studies.formatting import value_text
 from multiscale.studies.problems import PROBLEMS
 from multiscale.studies.records import read_records
+from multiscale.studies.scene_problem import scene_key_spec
 from multiscale.units import KINDS, VALUE, parse_unit
 
 __all__ = ["MISSING", "Crossing", "Row", "Setting", "case_key", "cheapest", "collect", "crossings", "pareto", "reference_text",
@@ -183,29 +182,11 @@ def write_tables(study: Study, rows: list[Row]) -> tuple[Path, Path]:
     return csv_path, h5_path
 
 
-def _key_spec(cls, dotted: str):
-    """The Spec of the dotted TOML key ``dotted`` of table class ``cls`` ("wear.k_w"; a named
-    table's name is any: "materials.pin.E"; an entry of an array of tables by its number:
-    "boundary[2].emissivity"); None if there is no such key."""
-    parts = key_parts(dotted)
-    while True:
-        spec = dict(fields_of(cls)).get(parts.pop(0))
-        if spec is None or not parts:
-            return spec
-        if isinstance(spec.parser, Named) or (isinstance(spec.parser, Tables) and parts[0].isdigit()):
-            parts.pop(0)         # (a swept boundary[2].emissivity had no unit: a user trial)
-        elif isinstance(spec.parser, Tables):
-            return None
-        if not parts or not isinstance(spec.parser, Section):
-            return None
-        cls = spec.parser.cls
-
-
 def knob_unit(study: Study, name: str) -> str:
     """The SI unit of swept knob ``name``'s column: its kind's for a micro problem's parameter or a
     scene key ("-" dimensionless; bare numbers of a scene key are in it, user trial M), else that
     of the unit its values were written in ("3 MPa": Pa); "" if not known (a count)."""
-    spec = _key_spec(Scene, name) if study.problem == "scene" else parser_of(PROBLEMS[study.problem], name)
+    spec = scene_key_spec(name) if study.problem == "scene" else parser_of(PROBLEMS[study.problem], name)
     parser = spec.parser if spec is not None else None
     while isinstance(parser, (ListOf, TableOr, Either)):
         parser = parser.item if isinstance(parser, ListOf) else parser.value if isinstance(parser, TableOr) \

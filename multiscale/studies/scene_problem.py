@@ -17,11 +17,13 @@ import numpy as np
 from multiscale.checkpoint import file_digest
 from multiscale.errors import MultiscaleError, SceneError
 from multiscale.io import History, unit_of
-from multiscale.scene import load
-from multiscale.schema import suggest
+from multiscale.scene import Scene, load
+from multiscale.scene_keys import key_parts
+from multiscale.schema import Integer, Named, Section, Tables, fields_of, suggest
 from multiscale.studies.base import Outcome, Problem, RunFailed, jsonable, unit_in
 
-__all__ = ["SQUEAL_METRICS", "SceneProblem", "SceneRun", "failure_line", "history_metrics", "squeal_metrics"]
+__all__ = ["SQUEAL_METRICS", "SceneProblem", "SceneRun", "failure_line", "history_metrics", "scene_key_spec",
+           "squeal_metrics"]
 
 def _over_finite(f):
     """``f`` over the finite values of a history column, NaN if none: NaN marks a row without the
@@ -51,8 +53,9 @@ SQUEAL_METRICS = {
     "modes": "number of complex modes found in the band [-]",
     "unstable_modes": "modes flagged unstable in modes.csv: damping ratio below -stability.threshold [-]",
     "max_growth": "largest real part sigma of the eigenvalues [1/s]",
-    "max_growth_frequency": "frequency of the mode with the largest real part, the lowest of a tie [Hz]",
-    "lowest_unstable_frequency": "frequency of the lowest unstable mode, 0 if none [Hz]",
+    "max_growth_frequency": "frequency of the mode with the largest positive real part, the lowest of a tie; "
+                            "NaN (n/a) if no mode grows [Hz]",
+    "lowest_unstable_frequency": "frequency of the lowest unstable mode, NaN (n/a) if none [Hz]",
     "min_damping_ratio": "smallest damping ratio (negative: unstable) [-]",
 }
 
@@ -61,20 +64,38 @@ def squeal_metrics(modes_csv) -> dict:
     """``SQUEAL_METRICS`` of a squeal run's mode table (``ModalResult.write_csv``)."""
     table = np.genfromtxt(modes_csv, delimiter=",", names=True, ndmin=1)
     f, sigma, unstable = table["frequency_Hz"], table["sigma_1_per_s"], table["unstable"] > 0
-    k = int(np.argmax(sigma))
+    k = int(np.argmax(sigma))      # (0 Hz and a stable mode's frequency when none grew: a user trial)
     return {"modes": float(f.size), "unstable_modes": float(unstable.sum()), "max_growth": float(sigma[k]),
-            "max_growth_frequency": float(f[k]),
-            "lowest_unstable_frequency": float(f[unstable].min()) if unstable.any() else 0.0,
+            "max_growth_frequency": float(f[k]) if sigma[k] > 0 else np.nan,
+            "lowest_unstable_frequency": float(f[unstable].min()) if unstable.any() else np.nan,
             "min_damping_ratio": float(table["damping_ratio"].min())}
 
 
-def _squeal(scene, fixed=None) -> bool:
-    """Whether a scene file, with a study's ``fixed`` keys, runs the squeal analysis (False if it
-    cannot be read: said elsewhere)."""
+def scene_key_spec(dotted: str):
+    """The Spec of the dotted scene key ``dotted`` ("wear.k_w"; a named table's name is any:
+    "materials.pin.E"; an entry of an array of tables by its number: "boundary[2].emissivity");
+    None if the scene schema has no such key (a builder's parameters are the builder's)."""
+    parts, cls = key_parts(dotted), Scene
+    while True:
+        spec = dict(fields_of(cls)).get(parts.pop(0))
+        if spec is None or not parts:
+            return spec
+        if isinstance(spec.parser, Named) or (isinstance(spec.parser, Tables) and parts[0].isdigit()):
+            parts.pop(0)         # (a swept boundary[2].emissivity had no unit: a user trial)
+        elif isinstance(spec.parser, Tables):
+            return None
+        if not parts or not isinstance(spec.parser, Section):
+            return None
+        cls = spec.parser.cls
+
+
+def _squeal(scene, fixed=None) -> bool | None:
+    """Whether a scene file, with a study's ``fixed`` keys, runs the squeal analysis (None if it
+    cannot be read without the swept keys: said elsewhere)."""
     try:
         return load(scene, fixed or None).has("stability")
     except MultiscaleError:
-        return False
+        return None
 
 
 @dataclass(frozen=True)
@@ -103,6 +124,7 @@ class SceneProblem(Problem):
     doc = ("a macro scene run by the macro runner with overrides; metrics: HDF5 history columns, "
            "column[:last|first|max|min|mean|rise]; squeal scenes: " + ", ".join(SQUEAL_METRICS))
     metrics = {}
+    undefined = frozenset({"max_growth_frequency", "lowest_unstable_frequency"})
 
     def parse(self, raw, path, ctx, scene=None, ranks=1):
         try:
@@ -125,6 +147,12 @@ class SceneProblem(Problem):
                 "overrides": jsonable(params.overrides), **({"files": files} if files else {}),
                 **({"ranks": params.ranks} if params.ranks > 1 else {})}
 
+    def knob_spec(self, name: str):
+        """The Spec of a whole-number scene key (``time.steps``: a range's values rounded; 3.0000000000000004
+        was refused, a user trial); None for the others, which the scene reads."""
+        spec = scene_key_spec(name)
+        return spec if spec is not None and isinstance(spec.parser, Integer) else None
+
     def metric_unit(self, name: str) -> str:
         """A squeal metric's unit (``SQUEAL_METRICS``), else its history column's (``io.unit_of``)."""
         if name in SQUEAL_METRICS:
@@ -132,11 +160,15 @@ class SceneProblem(Problem):
         return unit_of(name.partition(":")[0])
 
     def check_metric(self, name, scene=None, fixed=None):
-        if scene is not None and _squeal(scene, fixed):    # its metrics are known before it runs (with [fixed]:
+        squeal = _squeal(scene, fixed) if scene is not None else None
+        if squeal:                                         # its metrics are known before it runs (with [fixed]:
             #                                                a base scene that [fixed] makes a squeal one was not)
             return None if name in SQUEAL_METRICS else \
                 f'unknown metric of a squeal scene{suggest(name, SQUEAL_METRICS)}; allowed: {", ".join(SQUEAL_METRICS)}'
         column, _, reducer = name.partition(":")
+        if squeal is False and name in SQUEAL_METRICS:    # (found after every run had failed for it: a user trial)
+            return ('a squeal metric (of modes.csv), and this scene runs no squeal analysis (effect "stability"): '
+                    "its metrics are history columns, optionally with :" + "|:".join(_REDUCERS))
         if not column or (reducer and reducer not in _REDUCERS):
             return (f"a history column, optionally with :{'|:'.join(_REDUCERS)} "
                     f"(e.g. max_temperature_pin:max)")

@@ -130,7 +130,7 @@ def run_task(task: dict) -> int:
         record["metrics"] = {k: float(v) for k, v in outcome.metrics.items()}
         if task["exact"]:
             record["reference"] = _exact(problem, params, Path(task["references"]))
-        why = metric_problem(record["metrics"], task["metrics"])
+        why = metric_problem(record["metrics"], task["metrics"], problem.undefined)
         record.update(ran=True, status=FAILED if why else "ok", error=why or "")
     except Exception as exc:       # recorded, never raised: the study goes on
         text = str(exc).strip().splitlines()
