@@ -327,6 +327,12 @@ def surface_memory(shape) -> float:
 
 def _modes(args) -> int:
     """Pair the modes of two squeal runs by MAC: a table, and the matrix as CSV or a figure."""
+    from multiscale.plots import figure_problem
+    if args.csv and (why := "a folder: give a file name" if Path(args.csv).is_dir() else
+                     f"no folder {Path(args.csv).parent}" if not Path(args.csv).parent.is_dir() else None):
+        raise InputError("--csv", args.csv, f"cannot write the table there: {why}")   # (after the work: a user trial)
+    if args.figure and (why := figure_problem(Path(args.figure))):
+        raise InputError("--figure", args.figure, f"cannot write the figure there: {why}")
     b = read_modes(args.runs[1])
     pairs = pair(read_modes(args.runs[0]), mirrored(b, args.mirror) if args.mirror else b, transfer=bool(args.mirror))
     print("\n".join(report(pairs)))
@@ -352,7 +358,7 @@ def _surface(args) -> int:
     unit = _length("--height-unit", args.height_unit, unit_name=True)
     figure = None if args.figure in (None, "none") else Path(args.figure)
     if figure is not None:
-        from multiscale.plots.surface import figure_problem   # local: matplotlib only when a figure is drawn
+        from multiscale.plots import figure_problem
         if why := figure_problem(figure):     # said before the analysis (minutes on a large file), not after
             raise InputError("--figure", args.figure, f"cannot write the figure there: {why}")
     with warnings.catch_warnings():

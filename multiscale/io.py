@@ -7,6 +7,7 @@ stage of a run on rank 0 (``stage``, ``bar``) and keeps the wall time of every s
 """
 from __future__ import annotations
 
+import difflib
 import os
 import signal
 import sys
@@ -61,7 +62,20 @@ class History:
                                                     else np.array(value, dtype=float))
 
     def __getitem__(self, key: str) -> np.ndarray:
+        if key not in self.columns:      # (an int key gave "KeyError: 0": a user trial)
+            close = difflib.get_close_matches(str(key), list(self.columns), n=3)
+            raise KeyError(f"no history column {key!r}" + (f"; did you mean {', '.join(map(repr, close))}?"
+                                                           if close else f"; {len(self.columns)} columns, e.g. "
+                                                           f"{', '.join(list(self.columns)[:3])}"))
         return np.asarray(self.columns[key])
+
+    def __contains__(self, key) -> bool:
+        """Whether ``key`` names a column (as a pandas DataFrame: ``in`` and iteration go over the
+        columns, ``len`` counts the rows)."""
+        return key in self.columns
+
+    def __iter__(self):
+        return iter(self.columns)
 
     def __len__(self) -> int:
         return len(next(iter(self.columns.values()), []))

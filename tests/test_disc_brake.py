@@ -1,5 +1,6 @@
 """Disc-brake assembly (thesis §4.3.1): geometry, free-free disc modes, preload and complex modes."""
 import dataclasses
+import re
 from pathlib import Path
 from types import SimpleNamespace as NS
 
@@ -298,7 +299,7 @@ def test_the_faceted_piston_face_is_said(brake, no_friction):
     assert 0.005 < loss < 0.02 and f"piston_back, caliper_bore: {100 * loss:.3g} % (" in note
 
 
-def test_the_modes_of_two_runs_are_paired_by_mac_from_their_files(tmp_path, brake, friction, no_friction):
+def test_the_modes_of_two_runs_are_paired_by_mac_from_their_files(tmp_path, capsys, brake, friction, no_friction):
     """``multiscale modes A B`` reads the mode shapes back from the runs' VTX files and pairs them:
     its MAC matrix is that of the modes in memory (modal.mac_matrix, 1e-9), a run against itself
     pairs every mode with itself, without friction mirrored too (the brake is symmetric about x = 0:
@@ -323,6 +324,14 @@ def test_the_modes_of_two_runs_are_paired_by_mac_from_their_files(tmp_path, brak
     assert list(same.best) == list(range(12)) and np.allclose(np.diag(same.mac), 1, atol=1e-12)
     assert main(["modes", str(tmp_path / "a"), str(tmp_path / "b"), "--csv", str(tmp_path / "mac.csv")]) == 0
     assert (tmp_path / "mac.csv").read_text().count("\n") == 13
+    capsys.readouterr()
+    for option, where, why in (("--figure", "m.txt", r"a figure is a .*, not \.txt"), ("--figure", "m", "a name without extension"),
+                               ("--figure", "nodir/m.png", "no folder"), ("--csv", ".", "a folder: give a file name"),
+                               ("--csv", "nodir/m.csv", "no folder")):    # said first (after the work: a user trial)
+        assert main(["modes", str(tmp_path / "a"), str(tmp_path / "b"), option, str(tmp_path / where)]) == 2
+        err = capsys.readouterr()
+        assert re.search(f"{option} = .*cannot write .* there: .*{why}", err.err) and "MAC" not in err.out
+    assert not (tmp_path / "nodir").exists() and not (tmp_path / "m").exists()
     mirrored = pair(read_modes(tmp_path / "b"), mirrored_modes(read_modes(tmp_path / "b"), "x"), transfer=True)
     assert list(mirrored.best) == list(range(12)) and np.median(np.diag(mirrored.mac)) > 0.95   # symmetric: 0.99
     assert main(["modes", str(tmp_path / "b"), str(tmp_path / "b"), "--mirror", "x"]) == 0

@@ -5,23 +5,10 @@ from __future__ import annotations
 from pathlib import Path
 
 import numpy as np
-from matplotlib.backend_bases import FigureCanvasBase
 from matplotlib.figure import Figure
 
 SHOWN = 1000      # height-map points per side drawn at most (a strided view; the figure has ~500 pixels a side)
 SPAN = (0.1, 99.9)   # percentiles of the whole map's heights that the colours span (beyond: the bar's arrows)
-
-
-def figure_problem(path: Path) -> str | None:
-    """Why ``surface_figure`` cannot write ``path`` (no such folder, a format matplotlib does not
-    write), or None."""
-    kinds = FigureCanvasBase.get_supported_filetypes()
-    if not path.parent.is_dir():
-        return f"no folder {path.parent}"
-    if path.suffix[1:].lower() not in kinds:     # none: matplotlib wrote PATH.png, not the PATH said
-        return (f"a figure is a .{', .'.join(sorted(kinds))} file (matplotlib), not "
-                f"{'.' + path.suffix[1:] if path.suffix else 'a name without extension'}")
-    return None
 
 
 def colour_range(heights: np.ndarray) -> tuple[float, float]:
