@@ -327,7 +327,7 @@ def surface_memory(shape) -> float:
 
 def _modes(args) -> int:
     """Pair the modes of two squeal runs by MAC: a table, and the matrix as CSV or a figure."""
-    from multiscale.plots import figure_problem
+    from multiscale.plots import figure_problem   # local: as the figures themselves, only where drawn
     if args.csv and (why := "a folder: give a file name" if Path(args.csv).is_dir() else
                      f"no folder {Path(args.csv).parent}" if not Path(args.csv).parent.is_dir() else None):
         raise InputError("--csv", args.csv, f"cannot write the table there: {why}")   # (after the work: a user trial)
@@ -358,7 +358,7 @@ def _surface(args) -> int:
     unit = _length("--height-unit", args.height_unit, unit_name=True)
     figure = None if args.figure in (None, "none") else Path(args.figure)
     if figure is not None:
-        from multiscale.plots import figure_problem
+        from multiscale.plots import figure_problem   # local: as the figures themselves, only where drawn
         if why := figure_problem(figure):     # said before the analysis (minutes on a large file), not after
             raise InputError("--figure", args.figure, f"cannot write the figure there: {why}")
     with warnings.catch_warnings():
