@@ -70,7 +70,8 @@ def _table_rows(cls, path: str, section_effects: tuple) -> tuple[list, list]:
             subs.append((where, spec.parser, effects, spec))
             continue
         default = defaults[name]
-        default = "required" if spec.required else show(default) if default is not None else spec.absent or (
+        shown = spec.parser.show_default if hasattr(spec.parser, "show_default") else show
+        default = "required" if spec.required else shown(default) if default is not None else spec.absent or (
             f"required with {' or '.join(spec.needed_by)}" if spec.needed_by else "none")
         needed = ", ".join(effects) + (f" (unless {', '.join(spec.unless)})" if spec.unless else "")
         rows.append((f"``{where}``", _cell(spec.parser.describe()), _cell(_unit(spec.parser)), _cell(default),

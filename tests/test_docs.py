@@ -129,6 +129,10 @@ def test_every_study_key_appears_in_the_generated_study_format():
     text = study_rst()
     for path in key_paths(StudyFile):
         assert f"``{path}``" in text, path
+    # in words, not Python's reprs; paths as they are read (a user trial read "FrozenMap({})", the
+    # dataclass signatures of [run] and [report], and "relative to the scene file")
+    assert "FrozenMap" not in text and "Options(" not in text and "the scene file" not in text
+    assert text.count("relative to the study file") == 4
 
 
 def test_the_micro_patch_tutorial_runs_and_gives_the_numbers_it_quotes(capsys):

@@ -10,6 +10,7 @@ from multiscale.schema import Bad, Choice, FilePath, Flag, FrozenMap, Integer, L
 __all__ = ["RANGE_KEYS", "ReportOptions", "Reference", "RunOptions", "StudyFile", "is_range"]
 
 RANGE_KEYS = ("start", "stop", "num", "step", "log")
+STUDY = "the study file"     # what a study's paths are relative to
 
 
 class _Values:
@@ -22,6 +23,10 @@ class _Values:
         if not isinstance(raw, dict):
             raise Bad(f"must be {self.describe()}")
         return FrozenMap(_flatten(raw))
+
+    @staticmethod
+    def show_default(value) -> str:
+        return "none" if not value else str(dict(value))      # (the reference showed "FrozenMap({})")
 
 
 class _Sweep:
@@ -61,7 +66,7 @@ class Reference:
 
     kind: str | None = key(Choice(("analytic", "run", "file")), required=True)
     run: FrozenMap | None = key(_Values())          # kind "run": parameter values of the reference run
-    file: Path | None = key(FilePath())             # kind "file": JSON {metric: value}, SI, some metrics or all
+    file: Path | None = key(FilePath(base=STUDY))   # kind "file": JSON {metric: value}, SI, some metrics or all
 
     def problems(self, path, ctx):
         needs = {"run": "run", "file": "file"}.get(self.kind)
@@ -75,19 +80,25 @@ class Reference:
 
 @dataclass(frozen=True)
 class RunOptions:
+    """How the runs run: how many at a time, each on how many MPI ranks, how long at most, timed
+    how often, and where their records go."""
+
     processes: int = key(Integer(ge=1), default=1)                  # runs at a time (per MPI rank)
     timeout: float | None = key(Quantity("time", gt=0))             # s per run; none by default
     repeat: int = key(Integer(ge=1), default=1)                     # wall time = best of repeats
     ranks: int = key(Integer(ge=1), default=1)                      # MPI ranks of each scene run
-    folder: Path | None = key(FilePath(folder=True))                # default results/<name>
+    folder: Path | None = key(FilePath(folder=True, base=STUDY), absent="results/<name> beside the study file")
 
 
 @dataclass(frozen=True)
 class ReportOptions:
+    """What the report shows: the error levels it marks, the swept knobs that are cases (each its
+    own cheapest setting) or averaged over, its folder, title and plots."""
+
     errors: tuple = key(ListOf(Quantity("dimensionless", gt=0), min_len=1, unique=True), default=(0.01, 0.05))
     cases: tuple = key(ListOf(Text(), unique=True), default=())         # swept physical parameters
     average_over: tuple = key(ListOf(Text(), unique=True), default=())  # e.g. seeds: mean ± std
-    folder: Path | None = key(FilePath(folder=True))                    # default: the run folder
+    folder: Path | None = key(FilePath(folder=True, base=STUDY), absent="the run folder ([run] folder)")
     title: str | None = key(Text())
     plots: bool = key(Flag(), default=True)                             # PNGs (matplotlib)
 
@@ -97,7 +108,7 @@ class StudyFile:
     name: str | None = key(Text(r"[A-Za-z0-9_.-]+", "a name of letters, digits, _ . -"))
     description: str = key(Text(), default="")
     problem: str | None = key(Text(), required=True)
-    scene: Path | None = key(FilePath())
+    scene: Path | None = key(FilePath(base=STUDY))
     metrics: tuple | None = key(ListOf(Text(), unique=True, min_len=1), required=True)
     fixed: FrozenMap = key(_Values(), default=FrozenMap())
     sweep: tuple | None = key(_Sweep(), required=True)
