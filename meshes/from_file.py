@@ -77,6 +77,7 @@ class Found:
     interfaces: dict = field(default_factory=dict)   # name -> face tags
     pairs: dict = field(default_factory=dict)        # name -> (fixed body, rotating body)
     areas: dict = field(default_factory=dict)        # name -> m^2
+    flat_areas: dict = field(default_factory=dict)   # named surface that is one plane -> m^2 (a load face's)
     normals: dict = field(default_factory=dict)      # name -> unit normal (fixed towards rotating), None if not planar
     extents: dict = field(default_factory=dict)      # planar interface -> size (u, v) [m] in its plane
     sizes: dict = field(default_factory=dict)        # a .msh's interface -> mean edge of its triangles [m]
@@ -253,6 +254,9 @@ def _load(model, g) -> Found:
                   extent=extent, size_factor=_script_factor(model), unit=unit)
     _interfaces(model, g, found, occ)
     _surfaces(model, g, found, occ)
+    for name, faces in found.surfaces.items() if occ or g.kind == "mesh" else ():   # (check said no pressure's
+        area, normal = _plane(model, faces, order[:1], occ)                     # force on a file's faces: a trial)
+        found.flat_areas.update({name: area} if normal is not None else {})
     if g.kind == "mesh":
         found.cell_size = max(_mean_edge(_simplices(model, 3, tags)) for tags in bodies.values())
     if occ and g.mesh_size is not None:
@@ -585,7 +589,7 @@ def _spec(g, found: Found) -> GeometrySpec:
                                                                        g.bodies[g.rotating].material),))),
         interfaces={n: 1001 + k for k, n in enumerate(found.interfaces)},
         faces={n: 2001 + k for k, n in enumerate(found.surfaces)},
-        supports=(), load_faces=(), motion=Rotation(tuple(g.axis), tuple(g.centre)),
+        supports=(), load_faces=(), motion=Rotation(tuple(g.axis), tuple(g.centre)), load_areas=found.flat_areas,
         length_scale=found.extent, fluid_load=True,
         interface_normals=dict(found.normals), interface_extents=dict(found.extents), report=tuple(report),
         interface_sizes=found.sizes if g.kind == "mesh" else

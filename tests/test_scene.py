@@ -247,6 +247,15 @@ def test_check_says_where_a_pressure_acts_and_its_force(tmp_path):
     assert loading((DEMOS / "brake_squeal.toml").read_text()).startswith(
         f"  loading   1 MPa on piston_back ({math.pi * r**2 * 1e6:.4g} mm^2): {1e6 * math.pi * r**2:.4g} N, "
         f"caliper_bore ({math.pi * r**2 * 1e6:.4g} mm^2): {1e6 * math.pi * r**2:.4g} N, ")
+    # a CAD file's flat faces: the STEP car brake's backplate backs, 72-degree sectors of 92-138 mm
+    # (demos/cad_models.py), 0.5 (72 pi / 180) (138^2 - 92^2) mm^2 each (check said "on piston, fingers": a trial)
+    stop = (DEMOS / "car_brake_stop.toml").read_text()
+    vehicle = stop[stop.index("[loading.vehicle]"):stop.index("[", stop.index("[loading.vehicle]") + 1)]
+    area = 0.5 * math.radians(72) * (138**2 - 92**2)
+    stop = stop.replace('file = "cad/', f'file = "{DEMOS / "cad"}/')
+    assert loading(stop.replace(vehicle, "").replace("friction = 0.4\n", 'friction = 0.4\npressure = "2 MPa"\n'
+                                                      'rotation_speed = "500 rpm"\n')).startswith(
+        f"  loading   2 MPa on piston ({area:.4g} mm^2): {2 * area:.4g} N, fingers ({area:.4g} mm^2): {2 * area:.4g} N, ")
 
 
 def test_demo_scenes_validate():
