@@ -271,6 +271,28 @@ class StepStop:
         return bool(self.comm.allreduce(self.asked, op=MPI.LOR))
 
 
+@contextmanager
+def holding_ctrl_c(what: str):
+    """A block that one Ctrl-C (SIGINT) does not interrupt: it is said on stderr (``what``: what is
+    being written) and the block goes on; another one abandons it (``KeyboardInterrupt``). Without
+    the main thread, nothing is installed."""
+    if threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    count = [0]
+
+    def hold(signum, frame):
+        count[0] += 1
+        if count[0] > 1:
+            raise KeyboardInterrupt(f"abandoned while writing {what}")
+        os.write(2, f"\nCtrl-C: still writing {what}; Ctrl-C again abandons it\n".encode())
+    previous = signal.signal(signal.SIGINT, hold)
+    try:
+        yield
+    finally:
+        signal.signal(signal.SIGINT, previous)
+
+
 def ended_together(comm, timeout: float = 10.0) -> bool:
     """Called by a rank that met an error: True if every rank of ``comm`` reaches this call within
     ``timeout`` [s] (the error was collective: each can end cleanly), False if not (another rank is

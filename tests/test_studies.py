@@ -884,7 +884,7 @@ def test_a_scene_keys_bare_numbers_get_its_unit_on_the_axis(tmp_path, made):
     assert made[0][1][0][0].get_xlabel() == "loading.pressure [Pa]"
 
 
-def test_an_interrupted_study_writes_the_table_of_the_runs_that_ended(tmp_path, capsys, monkeypatch):
+def test_an_interrupted_study_writes_the_table_of_the_runs_that_ended(tmp_path, capfd, monkeypatch):
     """Ctrl-C after the first run: results.csv holds it and names the others missing (it was written
     only at the end, so an interrupted study had none: a user trial), and the report says so (it
     was left as the previous sweep's, beside the new tables: a user trial)."""
@@ -900,19 +900,33 @@ def test_an_interrupted_study_writes_the_table_of_the_runs_that_ended(tmp_path, 
     path = write(tmp_path, HERTZ.replace("processes = 2", "processes = 1"))
     assert main(["study", str(path)]) == 130
     md = tmp_path / "results" / "hertz" / "hertz.md"
-    assert f"hertz: the runs that ended are in {md.parent / 'results.csv'} and {md} " in capsys.readouterr().err
+    assert f"hertz: the runs that ended are in {md.parent / 'results.csv'} and {md} " in capfd.readouterr().err
     rows = table(tmp_path / "results" / "hertz" / "results.csv")
     assert [r["status"] for r in rows] == ["ok", "missing", "missing", "missing"]
-    assert float(rows[0]["approach"]) > 0 and rows[1]["message"] == "not run"
+    assert float(rows[0]["approach"]) > 0 and rows[1]["message"] == "not run or cut off"
     text = md.read_text()
     assert "- Runs: 1 ok, 0 failed, **3 not run or cut off: the study was stopped** (run it again" in text
     assert "Failed runs:" not in text
     # into a report folder: its index of the reports written so far too (before: none on Ctrl-C, a review)
     assert main(["study", str(path), "--report", str(tmp_path / "reports")]) == 130
     index = tmp_path / "reports" / "README.md"
-    assert f"; index {index} " in capsys.readouterr().err
+    assert f"; index {index} " in capfd.readouterr().err
     text = index.read_text()
     assert "**Stopped during the study hertz**" in text and "## [" in text and "(hertz.md)" in text
+    # a second Ctrl-C while they are written is said and held (it left no report, unsaid: a user trial)
+    import os
+    import signal
+    real_collect = driver.collect
+
+    def collect_interrupted(study):
+        os.kill(os.getpid(), signal.SIGINT)
+        return real_collect(study)
+    monkeypatch.setattr(driver, "collect", collect_interrupted)
+    md.unlink()
+    assert main(["study", str(path)]) == 130
+    err = capfd.readouterr().err
+    assert "Ctrl-C: still writing the tables and report of the runs that ended; Ctrl-C again abandons it" in err
+    assert f"hertz: the runs that ended are in {md.parent / 'results.csv'} and {md} " in err and md.is_file()
 
 
 def test_a_measured_surface_is_a_micro_study_problem(tmp_path, capsys):

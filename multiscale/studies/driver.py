@@ -7,6 +7,7 @@ import sys
 from pathlib import Path
 
 from multiscale.errors import SceneError
+from multiscale.io import holding_ctrl_c
 from multiscale.studies.expand import load_study
 from multiscale.studies.records import foreign_records
 from multiscale.studies.reporting import report, write_index
@@ -44,18 +45,8 @@ def run_studies(paths, *, rerun_failed: bool = False, report_folder=None, proces
             stats = execute(study, rerun_failed=rerun_failed, progress=progress, comm=comm)
         except KeyboardInterrupt:       # Ctrl-C: the tables and report of the runs that ended (it waited for the
             if rank == 0:               # end before; then the old report stayed beside the new tables: a user trial)
-                rows = collect(study)
-                csv_path, _ = write_tables(study, rows)
-                try:                    # (an error of the report replaced the interrupt, its exit code 130: a review)
-                    page = report(study, rows, command)
-                    md = f" and {page}"
-                    if report_folder is not None:     # the index too: the reports written so far (a review)
-                        index = write_index(summaries + [(study, rows, page)], study.report_folder, command, study.name)
-                        md += f"; index {index}"
-                except Exception as exc:      # the tables are written; the interrupt goes on
-                    md = f" (no report: {type(exc).__name__}: {exc})"
-                print(f"{study.name}: the runs that ended are in {csv_path}{md} (the others: status missing)",
-                      file=sys.stderr, flush=True)
+                with holding_ctrl_c("the tables and report of the runs that ended"):   # (a second Ctrl-C
+                    _write_stopped(study, summaries, command, report_folder)         # left none, unsaid: a trial)
             raise
         if rank != 0:
             continue
@@ -82,3 +73,20 @@ def run_studies(paths, *, rerun_failed: bool = False, report_folder=None, proces
         index = write_index(summaries, Path(report_folder).resolve(), command)
         print(f"index {index}")
     return failed
+
+
+def _write_stopped(study, summaries: list, command: str, report_folder) -> None:
+    """The tables and report (and index, into ``report_folder``) of a study stopped by Ctrl-C: the
+    runs that ended, the others missing."""
+    rows = collect(study)
+    csv_path, _ = write_tables(study, rows)
+    try:                    # (an error of the report replaced the interrupt, its exit code 130: a review)
+        page = report(study, rows, command)
+        md = f" and {page}"
+        if report_folder is not None:     # the index too: the reports written so far (a review)
+            index = write_index(summaries + [(study, rows, page)], study.report_folder, command, study.name)
+            md += f"; index {index}"
+    except Exception as exc:      # the tables are written; the interrupt goes on
+        md = f" (no report: {type(exc).__name__}: {exc})"
+    print(f"{study.name}: the runs that ended are in {csv_path}{md} (the others: status missing)",
+          file=sys.stderr, flush=True)

@@ -89,7 +89,7 @@ def relative_error(value: float, ref: float) -> float:
 def collect(study: Study) -> list[Row]:
     """Rows of the recorded runs, with reference values and relative errors."""
     records = read_records(study)
-    rows = [Row(r, records.get(r.key, {"status": MISSING, "error": "not run", "metrics": {}})) for r in study.runs]
+    rows = [Row(r, records.get(r.key, {"status": MISSING, "error": "not run or cut off", "metrics": {}})) for r in study.runs]
     ref = study.reference
     if ref is None:
         return rows
