@@ -181,8 +181,15 @@ def _effect_line(scene: Scene, effect: str) -> str:
     if effect == "stability" and scene.stability is not None:   # (the band and count said nowhere: a user trial)
         st = scene.stability
         target = f"{st.target:g} Hz" if st.target is not None else "its lower edge"
-        return (f"complex eigenvalues at the sliding state: {st.modes} mode(s) in {st.band[0]:g} to {st.band[1]:g} Hz, "
-                f"nearest {target} first")
+        sw, line = st.sweep, (f"complex eigenvalues at the sliding state: {st.modes} mode(s) in {st.band[0]:g} to "
+                              f"{st.band[1]:g} Hz, nearest {target} first")
+        if sw is None or sw.parameter is None:
+            return line
+        each = sw.preload_mode == "each"        # what the map costs (said nowhere: 214 s for a 20 s analysis, a trial)
+        cost = (f"each point preloaded and solved: {len(sw.values) + 1} analyses"
+                + (f" and up to {sw.refine_steps} more per onset found" if sw.onsets and sw.refine_steps else "")
+                if each else "its points projected on the undamped modes of the first and last: 2 eigen solves more")
+        return f"{line}; then a stability map over {sw.parameter}, {len(sw.values)} points: {cost}"
     if effect == "heat_partition" and scene.has("roughness") and scene.micro.partition_law:
         m = scene.micro
         heating = f"transient, N_t = {m.heating_steps}" if m.heating == "transient" else "steady"

@@ -1043,6 +1043,13 @@ def test_loading_friction_is_needed_only_for_interfaces_without_their_own(tmp_pa
     assert "    friction       Coulomb, mu = 0.4 (its own on inner_pad)" in summary(one)   # (said mu = 0.4 alone)
     assert ("    stability      complex eigenvalues at the sliding state: 100 mode(s) in 0 to 16000 Hz, nearest its "
             "lower edge first") in summary(one)          # (the band and count were said nowhere: a user trial)
+    mapped = {"stability.sweep.friction": [0.1, 0.6], "stability.sweep.points": 6}   # its cost: said nowhere (a
+    line = "complex eigenvalues at the sliding state: 100 mode(s) in 0 to 16000 Hz, nearest its lower edge first; "
+    assert f"    stability      {line}then a stability map over friction, 6 points: each point preloaded and solved: " \
+        "7 analyses and up to 3 more per onset found" in summary(load(DEMOS / "brake_squeal.toml", mapped))  # trial: 214
+    assert f"    stability      {line}then a stability map over friction, 6 points: its points projected on the " \
+        "undamped modes of the first and last: 2 eigen solves more" in summary(     # s against 20 s for the analysis)
+            load(DEMOS / "brake_squeal.toml", {**mapped, "stability.sweep.preload": "once"}))
     assert not any("unused" in w for w in one.warnings)
     every = loads((DEMOS / "brake_squeal.toml").read_text(), DEMOS,     # (said nothing: a sweep of it changed nothing)
                   overrides={"interfaces.inner_pad.friction": 0.3, "interfaces.outer_pad.friction": 0.3})
