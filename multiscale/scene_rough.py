@@ -10,8 +10,9 @@ import warnings
 
 from multiscale.errors import InputError
 from multiscale.micro.spectrum import power_spectrum
-from multiscale.micro.topography import (TopographyWarning, beyond_measurement, check_cutoff, check_resolved, coarse_grid,
-                                         condition, copy_notes, covers, read_topography, zone_cells)
+from multiscale.micro.filters import check_cutoff
+from multiscale.micro.topography import (TopographyWarning, beyond_measurement, check_resolved, coarse_grid, condition,
+                                         copy_notes, covers, read_topography, zone_cells)
 from multiscale.micro.zones import THINNEST, ZoneGrid
 from multiscale.scene_cycle import largest_load_factor
 from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR, P_MAX_PLASTIC
@@ -353,7 +354,7 @@ def measured_cover(scene, warnings_out: list) -> list[str]:
     wavelength the face's micro grid resolves: the run's refusals (``topography.covers``,
     ``topography.check_resolved``) before meshing, for the faces whose extent the geometry knows then
     (``GeometrySpec.interface_extents``; the others are refused after meshing), and a filter
-    ``cutoff`` spans 2 of its pixels and 2 micro cells (``topography.check_cutoff``); a grid too
+    ``cutoff`` spans 2 of its pixels and 2 micro cells (``filters.check_cutoff``); a grid too
     coarse for the measured gradient is warned about (``topography.coarse_grid``, into
     ``warnings_out``)."""
     out = []

@@ -437,7 +437,8 @@ class Roughness:
             return []
         problems, notes = probe_topography(self.file, self.channel, pixel_size=self.pixel_size,
                                            height_unit=self.height_unit, max_undefined=self.max_undefined,
-                                           detrend=self.detrend, despike=self.despike, prefix=f"{path}.")
+                                           detrend=self.detrend, despike=self.despike, cutoff=self.cutoff,
+                                           prefix=f"{path}.")
         ctx.warnings.extend(notes)
         return problems
 

@@ -19,7 +19,7 @@ import SurfaceTopography as ST
 import multiscale.cli as cli
 from multiscale.cli import main
 from multiscale.errors import InputError, SceneError
-from multiscale.micro import reading, topography
+from multiscale.micro import filters, reading, topography
 from multiscale.micro.spectrum import statistics_memory, surface_statistics
 from multiscale.micro.surface import Surface
 from multiscale.micro.topography import condition, cover, read_topography
@@ -589,10 +589,10 @@ def test_a_cutoff_shorter_than_two_micro_cells_is_refused(tmp_path, cover):
         rough.measured_face(short, s.micro, (2, 2), np.array([10e-3, 10e-3]), seed=0)
     # at the bound of a quotient (3 mm in 10 cells: 3.0000000000000003e-4 m) it passes (a review); where 2
     # cells are longer than the map, a longer cut-off cannot help: the message says the grid only (a review)
-    topography.check_cutoff("cutoff", 600e-6, 3e-3 / 10, 3e-3 / 10, measured=(1e-3, 1e-3))
+    filters.check_cutoff("cutoff", 600e-6, 3e-3 / 10, 3e-3 / 10, measured=(1e-3, 1e-3))
     with pytest.raises(InputError, match=r"use a finer micro.grid: 2 of its cells are longer than the "
                                          r"measurement \(500 x 500 um\)$"):     # in um as the cells (a review)
-        topography.check_cutoff("cutoff", 0.4e-3, 312.5e-6, 312.5e-6, measured=(0.5e-3, 0.5e-3))
+        filters.check_cutoff("cutoff", 0.4e-3, 312.5e-6, 312.5e-6, measured=(0.5e-3, 0.5e-3))
 
 
 @pytest.mark.skipif(SHARED is None, reason="../shared/data/topographies not here")

@@ -114,6 +114,24 @@ def test_condition_warns_and_keeps_them_unless_despike_removes_them():
         condition(m, despike=7, max_undefined=1e-4)
 
 
+def test_before_a_waviness_filter_outliers_are_judged_against_the_roughness():
+    """``spiky`` (Sq 100 nm, pits and spikes of 18-40 Sq) on a waviness of 2 um amplitude and 200 um
+    wavelength: against the Sq of the heights (1.3 um) no point is an outlier, and the roughness
+    left by λc = 50 um kept them all (Sku 28 where the clean one has 3; sur-2.sur at λc = 0.5 mm
+    kept Sku 57: a user trial). With the cut-off they are judged against the roughness' Sq and
+    found, as on the flat map, and said to be so."""
+    x = np.arange(320) * 1e-6
+    wavy = spiky(0) + 2e-6 * np.sin(2 * np.pi * x / 200e-6)[None, :]
+    assert find_outliers(wavy).count == 0
+    with pytest.warns(TopographyWarning, match=r"outliers in 'spiky.npy': 9 points .* by more than 7 Sq \(Sq 12\d "
+                                               r"nm of the roughness at λc = 0.05 mm without them\)"):
+        condition(measurement(wavy), cutoff=50e-6)
+    removed = condition(measurement(wavy), despike=7, cutoff=50e-6)
+    assert "removed 9 outliers (despike = 7)" in removed.report[-3]
+    clean = surface_statistics(condition(measurement(gaussian(0) + wavy - spiky(0)), cutoff=50e-6).surface)
+    assert abs(surface_statistics(removed.surface).Sku - clean.Sku) < 0.2       # the map without them
+
+
 @pytest.mark.skipif(SHARED is None, reason="../shared/data/topographies not here")
 def test_sur2s_pits_are_found_and_without_them_its_ssk_and_sku_are_a_surfaces():
     """sur-2.sur: Ssk −15.6, Sku 787 from 100 points up to 1.2 um deep (Sq 17 nm); without them

@@ -13,12 +13,12 @@ import SurfaceTopography as ST
 from SurfaceTopography.Support.UnitConversion import get_unit_conversion_factor
 
 from multiscale.errors import InputError
-from multiscale.micro import spectrum, topography
+from multiscale.micro import filters, spectrum, topography
 from multiscale.micro.reading import formats
 from multiscale.micro.spectrum import surface_statistics
 from multiscale.micro.surface import Surface, fractal_surface, load_surface
-from multiscale.micro.topography import (Measurement, TopographyWarning, condition, cover,
-                                         gaussian_filter, gaussian_transmission, probe_topography,
+from multiscale.micro.filters import gaussian_filter, gaussian_transmission
+from multiscale.micro.topography import (Measurement, TopographyWarning, condition, cover, probe_topography,
                                          read_topography, resample)
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -236,7 +236,7 @@ def test_a_cutoff_longer_than_the_surface_filters_by_its_transmission(periodic, 
     surface = Surface(s.heights[:, : n - 28], d, d, periodic=False) if not periodic else s
     cutoff = 0.4 * min(surface.size)
     convolved = gaussian_filter(surface, cutoff).heights
-    monkeypatch.setattr(topography, "LONG_CUTOFF", 0.1)
+    monkeypatch.setattr(filters, "LONG_CUTOFF", 0.1)
     assert np.abs(gaussian_filter(surface, cutoff).heights - convolved).max() < 1e-6 * np.abs(surface.heights).max()
     x = np.arange(n) * d
     wave = np.tile(np.cos(2 * np.pi * x / (n * d)), (n, 1))

@@ -47,6 +47,7 @@ class Outliers:
     k: float
     sq: float
     shares: tuple[float, float]
+    sq_of: str = ""            # what the Sq is of, if not the heights ("the roughness at λc = 0.5 mm")
 
     @property
     def count(self) -> int:
@@ -66,7 +67,8 @@ class Outliers:
         """What they are: "points deviating from the median of ... (Sq 13.8 nm without them), up to -89 Sq"."""
         side = 2 * HALO + 1
         return (f"point{'s' if self.count != 1 else ''} deviating from the median of their {side} x {side} "
-                f"neighbourhood by more than {self.k:g} Sq (Sq {self.sq * 1e9:.3g} nm without them), up to "
+                f"neighbourhood by more than {self.k:g} Sq (Sq {self.sq * 1e9:.3g} nm{' ' * bool(self.sq_of)}{self.sq_of} "
+                f"without them), up to "
                 f"{self.largest / self.sq:+.3g} Sq ({self.largest * 1e9:+.4g} nm)")
 
     def gradient_share(self, heights: np.ndarray, dx: float, dy: float) -> float:
@@ -106,11 +108,14 @@ class Outliers:
                 f"{dominates}{slopes}; kept ({option} removes them and fills them as undefined points)")
 
 
-def find_outliers(heights: np.ndarray, k: float = DESPIKE) -> Outliers:
+def find_outliers(heights: np.ndarray, k: float = DESPIKE, scale: np.ndarray | None = None, sq_of: str = "") -> Outliers:
     """The outliers (module docstring) of ``heights`` [m] (ny, nx), NaN where undefined (never
-    outliers; left out of the medians), at ``k`` times the Sq of the other heights. In row blocks
-    with a halo of ``HALO`` rows: no temporaries of the map's size."""
-    count, mean, (squares, *absolute) = defined_sums(heights, (2, 3, 4))   # |h - mean|^2, ^3, ^4 summed
+    outliers; left out of the medians), at ``k`` times the Sq of the other heights, or of the other
+    points of ``scale`` [m] (the same map's roughness, when a waviness filter follows: its Sq and
+    moments are the statistics'; ``sq_of`` says so). In row blocks with a halo of ``HALO`` rows: no temporaries of the
+    map's size."""
+    of = heights if scale is None else scale
+    count, mean, (squares, *absolute) = defined_sums(of, (2, 3, 4))   # |h - mean|^2, ^3, ^4 summed
     sq = np.sqrt(squares / count)
     found = [[], [], []]        # candidates: rows, columns, deviations beyond k Sq / CLIP
     for rows in row_blocks(*heights.shape):
@@ -120,7 +125,7 @@ def find_outliers(heights: np.ndarray, k: float = DESPIKE) -> Outliers:
         for part, values in zip(found, (i + rows.start, j, d[i, j])):
             part.append(values)
     rows, cols, deviations = (np.concatenate(part) for part in found)
-    c = heights[rows, cols] - mean
+    c = of[rows, cols] - mean
     out = np.zeros(rows.size, dtype=bool)
     for _ in range(rows.size + 1):      # Sq without the outliers, to a fixed point (it only falls)
         n = count - out.sum()
@@ -130,7 +135,7 @@ def find_outliers(heights: np.ndarray, k: float = DESPIKE) -> Outliers:
         out = more
     shares = tuple(float(np.sum(np.abs(c[out]) ** n) / total) if total > 0 else 0.0
                    for n, total in zip((3, 4), absolute))
-    return Outliers(rows[out], cols[out], deviations[out], float(k), float(clean), shares)
+    return Outliers(rows[out], cols[out], deviations[out], float(k), float(clean), shares, sq_of)
 
 
 def _deviations(heights: np.ndarray, rows: slice) -> np.ndarray:

@@ -28,6 +28,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from multiscale.errors import InputError, check_count, check_instance, check_pair, check_positive, check_real
+from multiscale.micro.filters import check_cutoff, gaussian_filter, gaussian_per_axis, resolved, roughness_of
 from multiscale.micro.outliers import DESPIKE, find_outliers
 from multiscale.micro.reading import Measurement, TopographyWarning, option, read_topography
 from multiscale.micro.spectrum import Spectrum, as_topography, equivalent_surface, power_spectrum
@@ -38,7 +39,6 @@ DETREND = {"none": None, "mean": "mean", "plane": "height", "poly2": "curvature"
 COVER = ("measured", "mirror", "tile", "equivalent")
 TILTED = 0.5             # a map whose Sq a plane would halve (75 % of its variance a tilt) is said to be tilted
 MAX_CELLS = 1024          # cells per zone side taken from a measurement's own pixel size (no micro.grid)
-ALPHA = np.sqrt(np.log(2) / np.pi)     # ISO 16610-21/-61 Gaussian: 50 % transmission at the cut-off
 GRADIENT_KEPT = 0.5       # a micro grid resolving less of the measured RMS gradient is warned about
 LONG_POWER = 0.5          # an equivalent surface with more of its power beyond the measurement is warned about
 S_FILTER_PIXELS = 3.0     # anti-aliasing before coarsening: resolved to λs = 3 new pixels (21 % at the new Nyquist)
@@ -46,7 +46,7 @@ S_FILTER_PIXELS = 3.0     # anti-aliasing before coarsening: resolved to λs = 3
 
 def probe_topography(path, channel: int | None = None, *, pixel_size=None, height_unit=None,
                      max_undefined: float = MAX_UNDEFINED, detrend: str = "plane", despike: float | None = None,
-                     prefix: str = "") -> tuple[list[str], list[str]]:
+                     cutoff: float | None = None, prefix: str = "") -> tuple[list[str], list[str]]:
     """What ``read_topography`` and ``condition`` would refuse in a file, without filling or
     filtering it (``multiscale check``): (problems, notes), one line each; no problems for a usable
     file, the notes say what overrides the file and ``condition``'s warning of outliers."""
@@ -62,22 +62,33 @@ def probe_topography(path, channel: int | None = None, *, pixel_size=None, heigh
     if why is not None:
         return [str(InputError(option(prefix, "file"), m.path.name, why))], list(m.notes)
     searched = flattened if detrend == form else None         # the outlier search's heights, if these
-    return [], list(m.notes) + ([] if despike is not None else _outlier_notes(m, detrend, prefix, searched))
+    if cutoff is not None and not resolved(cutoff, m.dx, m.dy):   # refused in the scene's words (``check_cutoff``):
+        cutoff = None                                             # the outliers as if without it
+    return [], list(m.notes) + ([] if despike is not None else _outlier_notes(m, detrend, cutoff, prefix, searched))
 
 
-def _outlier_notes(m: Measurement, detrend: str, prefix: str, h: np.ndarray | None = None) -> list[str]:
+def _outlier_notes(m: Measurement, detrend: str, cutoff: float | None, prefix: str,
+                   h: np.ndarray | None = None) -> list[str]:
     """``condition``'s warning of outliers at the default threshold in ``m``'s heights with the form
-    ``detrend`` removed (``h`` [m]: those heights, if at hand): none or one line. Searched once per
-    ``Measurement`` (kept in ``m.found``; ``read_topography`` returns the same one while the file
-    is unchanged: ``multiscale run`` reads and searches a file once, not at the scene's check too)."""
-    if h is None and (detrend not in m.found or m.found[detrend].count):     # to search, or for the slopes
+    ``detrend`` removed (``h`` [m]: those heights, if at hand), judged against the roughness' Sq
+    with a ``cutoff`` (``filters.roughness_of``): none or one line. Searched once per ``Measurement`` (kept in
+    ``m.found``; ``read_topography`` returns the same one while the file is unchanged:
+    ``multiscale run`` reads and searches a file once, not at the scene's check too)."""
+    key = (detrend, cutoff)
+    if h is None and (key not in m.found or m.found[key].count):     # to search, or for the slopes
         h = m.heights if DETREND[detrend] is None else remove_form(m.heights, detrend)
-    if detrend not in m.found:
-        m.found[detrend] = find_outliers(h)
-    found = m.found[detrend]
+    if key not in m.found:
+        m.found[key] = _outliers(h, m, DESPIKE, cutoff)
+    found = m.found[key]
     if not found.count:
         return []
     return [found.note(m.path.name, option(prefix, "despike", f"{DESPIKE:g}"), found.gradient_share(h, m.dx, m.dy))]
+
+
+def _outliers(h: np.ndarray, m: Measurement, k: float, cutoff: float | None):
+    """``find_outliers`` of the heights ``h`` [m] of ``m`` at k Sq: of the roughness at λc = ``cutoff``
+    [m] when a waviness filter follows (``filters.roughness_of``)."""
+    return find_outliers(h, k, *(() if cutoff is None else roughness_of(h, m.dx, m.dy, cutoff)))
 
 
 def _form_only(m: Measurement, flattened: np.ndarray) -> str | None:
@@ -116,80 +127,6 @@ class Conditioned:
 
 
 FLAT = 1e-10        # a conditioned surface whose Sq is below this share of its largest height is flat
-LONG_CUTOFF = 0.5    # λc beyond this share of the surface's shorter side: filtered in Fourier space
-
-
-def gaussian_transmission(wavelength, cutoff: float) -> np.ndarray:
-    """Amplitude transmission of the ISO 16610-61 areal Gaussian filter's mean surface (waviness)
-    at a wavelength: exp(−π (α λc/λ)²), α = sqrt(ln 2/π) (50 % at λ = λc); the roughness keeps the
-    rest, 1 − that."""
-    return np.exp(-np.pi * (ALPHA * cutoff / np.asarray(wavelength, dtype=float)) ** 2)
-
-
-def gaussian_filter(surface: Surface, cutoff: float) -> Surface:
-    """The Gaussian mean surface (waviness) of ISO 16610-61 at the cut-off wavelength λc [m]:
-    convolution with s(x, y) = exp(−π (x² + y²)/(α λc)²)/(α λc)², truncated at ±λc (where it has
-    fallen to 7e-7 of its peak), so that a sinusoid of wavelength λ keeps
-    ``gaussian_transmission(λ, λc)`` of its amplitude. Edges:
-    periodic surfaces wrap, others are mirrored (one of the end-effect treatments of ISO 16610-28).
-    SurfaceTopography filters periodic topographies in Fourier space only, hence this one."""
-    check_cutoff("cutoff", cutoff, surface.dx, surface.dy)
-    return _gaussian(surface, cutoff, cutoff)
-
-
-def check_cutoff(name: str, cutoff: float, dx: float, dy: float, pixels: str = "", measured=None) -> None:
-    """Raise ``InputError`` (naming ``name``) unless λc = ``cutoff`` [m] spans at least 2 pixels of
-    dx x dy [m] (``pixels``: whose, for the message; to 1e-9, the sizes being quotients), or with
-    ``measured`` (the measurement's size (mx, my) [m]) 2 of the micro grid's cells of dx x dy: the
-    roughness the filter leaves, wavelengths below about λc, is finer than a coarser grid, whose
-    surface would be nearly flat (a user trial: Sq 0.0003 of 0.0103 um; check warned of the
-    gradient the grid missed, not of the cut-off)."""
-    check_positive(name, cutoff)
-    short = cutoff < 2 * max(dx, dy) * (1 - 1e-9)
-    if short and measured is not None:
-        fix = "a finer micro.grid or a longer cutoff" if 2 * max(dx, dy) <= min(measured) else \
-            f"a finer micro.grid: 2 of its cells are longer than the measurement ({measured[0] * 1e6:.4g} x " \
-            f"{measured[1] * 1e6:.4g} um)"
-        raise InputError(name, None, f"λc = {cutoff * 1e6:.4g} um must span at least 2 cells of the micro grid "
-                         f"({2e6 * max(dx, dy):.4g} um): the roughness the filter leaves is finer than the grid, whose "
-                         f"surface would be nearly flat; use {fix}")
-    if short:
-        raise InputError(name, None, f"λc = {cutoff * 1e6:.4g} um must span at least 2 pixels "
-                         f"({2e6 * max(dx, dy):.4g} um)" + (f": {pixels}'s pixels" if pixels else ""))
-
-
-def _gaussian(surface: Surface, cut_x: float, cut_y: float) -> Surface:
-    """``gaussian_filter`` with a cut-off per axis [m] (0: that axis unfiltered): the ISO filter
-    (cut_x = cut_y) or the anti-aliasing S-filter of ``resample`` (its new pixel per axis)."""
-    import scipy.ndimage  # ~0.4 s to import: only when a surface is filtered
-    h = surface.heights
-    ny, nx = h.shape[-2:]
-    if max(cut_x, cut_y) > LONG_CUTOFF * min(ny * surface.dy, nx * surface.dx):
-        return _fourier_filter(surface, cut_x, cut_y)
-    sigma = ALPHA * np.array([cut_y, cut_x]) / np.sqrt(2 * np.pi)      # exp(-π x²/(αλc)²) = exp(-x²/(2σ²))
-    axes = (h.ndim - 2, h.ndim - 1)
-    w = scipy.ndimage.gaussian_filter(h, sigma=(sigma[0] / surface.dy, sigma[1] / surface.dx), axes=axes,
-                                      mode="wrap" if surface.periodic else "mirror",
-                                      truncate=np.sqrt(2 * np.pi) / ALPHA)      # at ±λc
-    return Surface(w, surface.dx, surface.dy, periodic=surface.periodic)
-
-
-def _fourier_filter(surface: Surface, cut_x: float, cut_y: float) -> Surface:
-    """``_gaussian`` by its transmission in Fourier space, on the surface (periodic) or on its
-    whole-sample mirror image (period 2n - 2 along each axis, the convolution's "mirror" edges): the
-    cost does not grow with λc, whose kernel would be longer than the surface."""
-    h = surface.heights
-    ny, nx = h.shape[-2:]
-    if not surface.periodic:
-        h = np.concatenate([h, h[..., -2:0:-1, :]], axis=-2) if ny > 2 else h
-        h = np.concatenate([h, h[..., -2:0:-1]], axis=-1) if nx > 2 else h
-    qy = np.fft.fftfreq(h.shape[-2], d=surface.dy)[:, None]
-    qx = np.fft.rfftfreq(h.shape[-1], d=surface.dx)[None, :]
-    keep = np.exp(-np.pi * ALPHA ** 2 * ((cut_x * qx) ** 2 + (cut_y * qy) ** 2))   # gaussian_transmission per axis
-    w = np.fft.irfft2(np.fft.rfft2(h) * keep, s=h.shape[-2:])[..., :ny, :nx]
-    return Surface(w, surface.dx, surface.dy, periodic=surface.periodic)
-
-
 def _defined_std(h: np.ndarray) -> float:
     """Standard deviation [m] of the defined (not NaN) heights, in row blocks."""
     count, _, (squares,) = defined_sums(h)
@@ -257,8 +194,8 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
         notes.append(f"a tilt holds {share:.5g} % of the height variance: Sq {_um(before)} um with it, "
                      f"{_um(flat)} um without ({option(prefix, 'detrend', 'plane')} removes it; the statistics keep it)")
     if despike is None:
-        notes += _outlier_notes(m, detrend, prefix, h)
-    elif (found := find_outliers(h, despike)).count:
+        notes += _outlier_notes(m, detrend, cutoff, prefix, h)
+    elif (found := _outliers(h, m, despike, cutoff)).count:
         h = h.copy() if h is m.heights else h
         h[found.rows, found.cols] = np.nan
         undefined += found.count
@@ -326,7 +263,7 @@ def resample(surface: Surface, n, size=None, antialias: bool = True) -> tuple[Su
     cut_x = S_FILTER_PIXELS * np.sqrt(dx ** 2 - surface.dx ** 2) if antialias and dx > surface.dx * (1 + 1e-9) else 0.0
     cut_y = S_FILTER_PIXELS * np.sqrt(dy ** 2 - surface.dy ** 2) if antialias and dy > surface.dy * (1 + 1e-9) else 0.0
     if cut_x or cut_y:
-        source = _gaussian(surface, cut_x, cut_y)
+        source = gaussian_per_axis(surface, cut_x, cut_y)
         cuts = f"{cut_x * 1e6:.4g} um" if cut_x == cut_y else \
             f"{cut_x * 1e6:.4g} um along x, {cut_y * 1e6:.4g} um along y" if cut_x and cut_y else \
             f"{max(cut_x, cut_y) * 1e6:.4g} um along {'x' if cut_x else 'y'}"

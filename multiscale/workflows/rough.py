@@ -39,7 +39,8 @@ from multiscale.micro.layered import LayeredElastic, LayeredThermal
 from multiscale.micro.laws import LawSpec
 from multiscale.micro.plasticity import Hardness
 from multiscale.micro.surface import Surface, fractal_surface
-from multiscale.micro.topography import TopographyWarning, check_cutoff, condition, cover, read_topography, zone_cells
+from multiscale.micro.filters import check_cutoff
+from multiscale.micro.topography import TopographyWarning, condition, cover, read_topography, zone_cells
 from multiscale.micro.zones import ZoneGrid, cut_zones, generate_zones
 from multiscale.pool import MicroPool
 from multiscale.rough import RoughInterface, check_zone_size, interface_plane
