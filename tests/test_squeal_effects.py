@@ -473,6 +473,12 @@ def test_a_floating_caliper_pressed_on_the_piston_alone_is_refused_before_its_mo
                                          r"translation along z\)"):
         squeal.run(scene, degree=1, verbose=False)
     assert {"brake.xdmf", "interface.xdmf"} <= {p.name for p in (tmp_path / "out").iterdir()}   # the preload, kept
+    from multiscale.workflows import transient
+    static = scenes.load(DEMO, {**overrides, "loading.faces": ["piston_back"], "effects": ["contact", "friction"],
+                                "output.folder": str(tmp_path / "static")})
+    with pytest.raises(InputError, match=r"interface = 'outer_pad': it carried no force .* translation along z"):
+        transient.run(static, verbose=False)          # a braking run: refused after its first solve is written
+    assert {"brake.xdmf", "history.h5"} <= {p.name for p in (tmp_path / "static").iterdir()}
     run = squeal.run(scenes.load(DEMO, overrides), degree=1, overwrite=True, verbose=False)
     assert not [w for w in run.warnings if "carried no force" in w]
     assert run.case.modes.errors.max() < squeal.MODE_RESIDUAL

@@ -47,7 +47,7 @@ from multiscale.workflows.model import build_mesh, build_model, friction_coeffic
 from multiscale.workflows.output import prepare_folder
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
-from multiscale.workflows.strain import say_at_once
+from multiscale.workflows.strain import refuse_floating, say_at_once
 from multiscale.workflows.transient import TransientResult, stopped_after, write_history
 
 CHECKPOINT = outputs.CHECKPOINT
@@ -189,6 +189,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             out.claim()                      # --overwrite: the earlier results go now, not before a failed start
             ms.save(ckpt, 0, history)
             write_history(history, folder, scene.name, comm, plot=False)   # a run failing in step 1 keeps t = 0
+            refuse_floating(scene, ms.model.tm, history)
         ms.rough.pool.progress = False
         plan = outputs.plan(scene)
         writer = FieldOutput(ms.model, folder, plan.body_fields + plan.interface_fields, extra=ms.facet_fields(),

@@ -44,11 +44,24 @@ def say_at_once(scene, history, comm) -> None:
     user trial), was said only after the whole run. The run's warnings say it again, over the run."""
     if comm.rank != 0 or "max_pressure" not in history.columns:
         return
-    forces = {n: abs(float(history[f"interface_force_{n}"][-1])) for n in scene.geometry.spec.interfaces
-              if f"interface_force_{n}" in history.columns}
-    for line in overloaded(scene, float(history["max_pressure"][-1])) + unloaded(forces):
+    for line in overloaded(scene, float(history["max_pressure"][-1])) + unloaded(last_forces(scene, history)):
         print(f"warning: at the first contact solve, {line}; the run goes on (Ctrl-C stops it after a step, "
               "with its results written)", file=sys.stderr, flush=True)
+
+
+def last_forces(scene, history) -> dict[str, float]:
+    """The interfaces' normal forces [N] (magnitudes) of ``history``'s last record."""
+    return {n: abs(float(history[f"interface_force_{n}"][-1])) for n in scene.geometry.spec.interfaces
+            if f"interface_force_{n}" in history}
+
+
+def refuse_floating(scene, tm, history) -> None:
+    """``idle_holder``'s error at the first contact solve (``history``'s last record; its forces are
+    every rank's), raised on every rank: a part held by an unpressed contact alone has a position
+    that round-off decides, and its fields with it (the squeal analysis refuses it too)."""
+    error = idle_holder(tm.sole_holds, last_forces(scene, history))
+    if error is not None:
+        raise error
 
 
 def unloaded(forces: Mapping[str, float]) -> list[str]:

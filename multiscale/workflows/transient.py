@@ -21,7 +21,7 @@ from multiscale.macro.output import FieldOutput
 from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, run_notes, say_load, \
     say_model_size
 from multiscale.workflows.output import RunResult, prepare_folder
-from multiscale.workflows.strain import say_at_once
+from multiscale.workflows.strain import refuse_floating, say_at_once
 
 
 @dataclass
@@ -76,6 +76,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         history.append(**model.record())
         writer.write()
         write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
+        refuse_floating(scene, tm, history)
         steps = scene.time.steps if model.thermal is not None else 0
         if steps:
             say_at_once(scene, history, comm)
