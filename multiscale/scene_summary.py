@@ -74,7 +74,8 @@ def summary(scene: Scene) -> list[str]:
     if v is not None and ld.torque is not None and ld.braking_torque is None:   # (said nowhere before: a user trial)
         force = "m a" if v.deceleration else f"m g sin(atan {v.slope:g})"
         lines.append(f"            braking torque {ld.torque:.4g} N m at the {g.bodies[1]}: braking force {force} = "
-                     f"{v.braking_force:.4g} N x wheel radius")
+                     f"{v.braking_force:.4g} N x wheel radius; the clamp force that gives it (mu F r on each "
+                     "interface) is found and said by the run")
     end = scene.time.end if scene.has("thermal") or scene.has("wear") else None
     if ld.torque is not None and end and g.motion == "rotation":     # the heat the run must account for
         work = ld.torque * ld.mean_sliding_factor(0.0, end) * end      # torque x load factor x angle, to time.end

@@ -30,7 +30,7 @@ def mean_pin_radius(n: int = 400) -> float:
 
 
 @pytest.mark.parametrize("end, steps, curve", [("2.4 s", 6, False), ("3 s", 2, False), ("2.4 s", 6, True)])
-def test_a_vehicle_stop_brakes_the_mass_and_turns_its_energy_into_heat(tmp_path, end, steps, curve):
+def test_a_vehicle_stop_brakes_the_mass_and_turns_its_energy_into_heat(tmp_path, capsys, end, steps, curve):
     """The friction moment about the axis is the braking force at the tyre times the wheel radius
     (the clamp force is scaled to the pressure-weighted radius: the disc's bending shifts the
     pressure inwards, 2.5 % here, so it exceeds the guess from the pin's area-weighted radius);
@@ -46,9 +46,11 @@ def test_a_vehicle_stop_brakes_the_mass_and_turns_its_energy_into_heat(tmp_path,
     scene = loads(text.replace("normal_force = \"200 N\"\n", ""), overrides={
         "loading.vehicle": {"speed": f"{V0} m/s", "deceleration": f"{DECEL} m/s^2", "wheel_radius": f"{WHEEL} m",
                             "mass": f"{MASS} kg"}, "time.end": end, "time.steps": steps})
-    h = run(scene, verbose=False).history
+    h = run(scene).history
     guess = MASS * DECEL * WHEEL / (0.4 * mean_pin_radius())
     assert 1.0 < h["interface_force"][0] / guess < 1.05
+    assert f"  clamp: {h['interface_force'][0]:.4g} N on the interface at the start, for the braking torque " \
+        f"{MASS * DECEL * WHEEL:.4g} N m\n" in capsys.readouterr().out     # (said nowhere: a user trial)
     if curve:                 # 0.4 down to 1 m/s at the pin (3.33 m/s at the tyre, t = 1.33 s), then rising
         mu = h["friction_coefficient"][h["time"] < 2.0 - 1e-9]           # rows at 0, 0.4, ... 1.6 s
         slip = (V0 - DECEL * 1.6) / WHEEL * mean_pin_radius()

@@ -579,7 +579,8 @@ def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_pa
                    'mass = "20 kg"\n', tmp_path)
     assert "            braking work to time.end: 1 kJ (the frictional heat of the run)" in summary(stop)
     # the vehicle's torque itself: m a R = 20 kg x 1 m/s^2 x 0.3 m (said nowhere before: a user trial)
-    assert "            braking torque 6 N m at the disc: braking force m a = 20 N x wheel radius" in summary(stop)
+    assert ("            braking torque 6 N m at the disc: braking force m a = 20 N x wheel radius; the clamp force "
+            "that gives it (mu F r on each interface) is found and said by the run") in summary(stop)
     # and each material as read, in the summary's units (check did not echo them: a user trial)
     assert "  material  disc: E 220 GPa, nu 0.3, kappa 50 W/(m K), chi 1e-05 m^2/s, alpha 1e-05 1/K" in summary(stop)
     cold = loads(torque.replace('"heat_partition", ', ""), tmp_path)

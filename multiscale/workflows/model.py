@@ -214,6 +214,18 @@ def say_load(scene, tm) -> None:
                    + ", ".join(f"{face}: {force:.4g} N" for face, force in forces.items()))
 
 
+def say_clamp(scene, history) -> None:
+    """Say the clamp force that a braking torque (``loading.torque``: a vehicle's, or given) asked of
+    the first contact solve, a console line: the normal force on each interface (``history``'s last
+    record) and the torque; the run finds it (T = mu F r), check cannot (said nowhere: a user trial)."""
+    if scene.loading.torque is None:
+        return
+    each = {n: abs(float(history[f"interface_force_{n}"][-1])) for n in scene.geometry.spec.interfaces
+            if f"interface_force_{n}" in history} or {"the interface": abs(float(history["interface_force"][-1]))}
+    forces = ", ".join(f"{f:.4g} N on {n}" for n, f in each.items()) if max(each.values()) > 0 else "none (released)"
+    reporter().say(f"  clamp: {forces} at the start, for the braking torque {scene.loading.torque:.4g} N m")
+
+
 def say_model_size(tm, mechanics, thermal=None, kind: str = "transient", modes: int = 0, points: int = 0) -> None:
     """Say the size of a model, a console line: its cells, displacement dofs and (with heat)
     temperature dofs; and warn (stderr, at once) when a run of ``kind`` ("transient" or "squeal")

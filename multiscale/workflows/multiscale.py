@@ -43,7 +43,7 @@ from multiscale.micro.laws import Conductance
 from multiscale.micro.post_analysis import Heating, PostAnalyses, PostAnalysis, grid_of
 from multiscale.provenance import resolved_toml
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, heat_warnings_as_notes, \
-    interface_forces, interface_materials, run_notes, say_load, say_model_size
+    interface_forces, interface_materials, run_notes, say_clamp, say_load, say_model_size
 from multiscale.workflows.output import prepare_folder
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
@@ -190,6 +190,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             ms.save(ckpt, 0, history)
             write_history(history, folder, scene.name, comm, plot=False)   # a run failing in step 1 keeps t = 0
             refuse_floating(scene, ms.model.tm, history)
+            say_clamp(scene, history)
         ms.rough.pool.progress = False
         plan = outputs.plan(scene)
         writer = FieldOutput(ms.model, folder, plan.body_fields + plan.interface_fields, extra=ms.facet_fields(),

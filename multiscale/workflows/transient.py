@@ -18,8 +18,8 @@ from multiscale import io, outputs
 from multiscale.errors import Interrupted
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.output import FieldOutput
-from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, run_notes, say_load, \
-    say_model_size
+from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, run_notes, say_clamp, \
+    say_load, say_model_size
 from multiscale.workflows.output import RunResult, prepare_folder
 from multiscale.workflows.strain import refuse_floating, say_at_once
 
@@ -77,6 +77,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         writer.write()
         write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
         refuse_floating(scene, tm, history)
+        say_clamp(scene, history)
         steps = scene.time.steps if model.thermal is not None else 0
         if steps:
             say_at_once(scene, history, comm)
