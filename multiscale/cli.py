@@ -416,8 +416,8 @@ def build_parser() -> argparse.ArgumentParser:
                            "or a summary of what a run computes and the files it writes.")
     check.add_argument("scenes", nargs="*", metavar="SCENE", help="scene TOML file(s)")
     check.add_argument("--keys", action="store_true", help="print the scene format: every section and key")
-    check.add_argument("--cells", action="store_true", help="estimate the mesh's cell count and memory (trial meshes, seconds) and check that the supports "
-                       "hold every part, as run does at meshing")
+    check.add_argument("--cells", action="store_true", help="estimate the mesh's cell count and memory (trial "
+                       "meshes, seconds) and check that the supports hold every part, as run does at meshing")
     check.add_argument("--set", **SET)
     check.set_defaults(func=_check)
     run = sub.add_parser("run", help=f"run a scene (in parallel: {MPIEXEC} -n N multiscale run SCENE)",
