@@ -366,7 +366,7 @@ def copy_layout(measured, pixel, size, cell, method: str) -> tuple[tuple | None,
     (nx, ny) the base (the measurement, or its mirror-stitched double) is coarsened to first, None if
     its pixels are not finer than the cells (whole periods of the double, at least 4; whole cells of
     a tile, at least 4), and the copies (rows, columns) of the base."""
-    base = tuple(2 * m for m in measured) if method == "mirror" else tuple(measured)
+    base = _copied(measured, method)
     counts = None
     if pixel[0] < cell[0] * (1 - 1e-9) or pixel[1] < cell[1] * (1 - 1e-9):
         if method == "mirror":        # whole periods, so that the copies meet without steps
@@ -377,6 +377,11 @@ def copy_layout(measured, pixel, size, cell, method: str) -> tuple[tuple | None,
     return counts, (int(np.ceil(size[1] / base[1])), int(np.ceil(size[0] / base[0])))
 
 
+def _copied(measured, method: str) -> tuple:
+    """The size [m] of what ``cover`` copies: the measurement, or with "mirror" its mirror-stitched double."""
+    return tuple(2 * m for m in measured) if method == "mirror" else tuple(measured)
+
+
 def copy_notes(measured, pixel, size, cell, method: str, prefix: str = "") -> list[str]:
     """The warnings of ``cover``'s copies (``copy_layout``; [] if the measurement covers the face or
     ``method`` takes no copies): the pattern repeats, and a measurement (or its mirror-stitched
@@ -385,7 +390,7 @@ def copy_notes(measured, pixel, size, cell, method: str, prefix: str = "") -> li
     mesh's."""
     if method not in ("mirror", "tile") or covers(measured, size, method, prefix):
         return []
-    base = tuple(2 * m for m in measured) if method == "mirror" else tuple(measured)
+    base = _copied(measured, method)
     counts, reps = copy_layout(measured, pixel, size, cell, method)
     wide = _sized("the measurement", measured)
     out = [f"{prefix}cover = \"{method}\": {wide} spans fewer than 4 cells of the micro grid ({cell[0] * 1e6:.4g} x "
