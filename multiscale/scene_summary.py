@@ -269,11 +269,11 @@ def memory_line(scene: Scene, mesh: CellEstimate) -> tuple[str, float]:
     need, each = run_memory(dofs, kind, modes=scene.stability.modes if kind == "squeal" else 0), RUN_MEMORY[kind][0]
     micro = ""
     if scene.rough_interfaces and kind == "transient":
-        kind, m = "multiscale", scene.micro
-        if scene.roughness.file and not m.grid:
+        kind, own = "multiscale", [scene.interface_settings(n) for n in scene.rough_interfaces]
+        if any(s.roughness.file and not s.micro.grid for s in own):   # (of each interface: the shared ones were)
             micro = "; its zones not counted: their grid is the measured file's pixels, give micro.grid"
         else:
-            points = len(scene.rough_interfaces) * math.prod(m.zones) * math.prod(m.grid or DEFAULT_GRID)
+            points = sum(math.prod(s.micro.zones) * math.prod(s.micro.grid or DEFAULT_GRID) for s in own)
             need, each = need + micro_memory(points), each + MICRO_MEMORY[0]
             micro = f"; its zones {points:,} grid points"
     return (f"  memory    about {need / 1e9:.2g} GB at the peak of a {kind} run on one rank, each more adding about "

@@ -288,3 +288,19 @@ def test_max_cells_in_the_scene_and_on_the_command_line(tmp_path, capsys):
     with pytest.raises(SystemExit):
         main(["run", str(path), "--max-cells", "2.5"])
     assert "a whole number" in capsys.readouterr().err
+
+
+def test_a_multiscale_runs_memory_counts_each_interfaces_own_zones():
+    """Zones of each rough interface's own micro table: the brake's inner pad 3 x 3 zones, the outer
+    2 x 2, both 16^2 (before: the scene-wide 2 x 2 for both, 2 048 points for 3 328)."""
+    from multiscale.geometry import CellEstimate
+    from multiscale.memory import micro_memory, run_memory
+    from multiscale.scene import load
+    from multiscale.scene_summary import memory_line
+    scene = load(Path(__file__).resolve().parents[1] / "demos" / "brake_squeal.toml", {
+        "effects": ["contact", "friction", "roughness"], "roughness": {"rms": "3 um", "hurst": 0.8, "k_min": 1,
+                                                                    "k_max": 6},
+        "micro": {"zones": [2, 2], "grid": [16, 16]}, "interfaces.inner_pad.micro.zones": [3, 3]})
+    line, need = memory_line(scene, CellEstimate(1000, 1000, 1.0, nodes=500))
+    assert "its zones 3,328 grid points" in line
+    assert need == pytest.approx(run_memory(1500, "transient") + micro_memory(3328), rel=1e-12)
