@@ -1167,8 +1167,11 @@ multiscale.errors.ConvergenceError: step 18: the partitions did not converge in 
 Abort(1) on node 1 (rank 1 in comm 0): application called MPI_Abort(MPI_COMM_WORLD, 1) - process 1
 
 """
-    assert failure_line(log) == ("multiscale.errors.ConvergenceError: step 18: the partitions did not converge "
+    assert failure_line(log) == ("ConvergenceError: step 18: the partitions did not converge "
                                  "in 30 passes (residual 0.000359 > 1e-05)")
+    refused = "multiscale.errors.InputError: geometry.max_cells = 30000: the mesh would have 96245 cells (exact)"
+    assert failure_line(f"Traceback ...\n{refused}\n") == "geometry.max_cells = 30000: the mesh would have 96245 " \
+        "cells (exact)"          # as `multiscale run` says it (a user trial read the Python class path)
     assert failure_line("KeyboardInterrupt\nnothing\n") == "KeyboardInterrupt"
     assert failure_line("segfault in rank 0\n  \n") == "segfault in rank 0"
     assert failure_line("") == "no output"

@@ -43,10 +43,17 @@ _EXCEPTION = re.compile(r"^[A-Za-z_][\w.]*(Error|Exception|Interrupt)\b")
 
 def failure_line(output: str) -> str:
     """What a failed run says of its failure: the last line naming an exception (``ConvergenceError:
-    ...``; the launcher's abort lines of the other ranks come after it), else the last line."""
+    ...``; the launcher's abort lines of the other ranks come after it), else the last line; the
+    exception named without its module, a bad input (``InputError``, ``SceneError``) by its message
+    alone, as ``multiscale run`` says it (a user trial read "multiscale.errors.InputError: ...")."""
     lines = [line.strip() for line in output.splitlines() if line.strip()]
     named = [line for line in lines if _EXCEPTION.match(line)]
-    return (named or lines or ["no output"])[-1]
+    last = (named or lines or ["no output"])[-1]
+    kind, colon, message = last.partition(": ")
+    if not named or not colon:
+        return last
+    kind = kind.rpartition(".")[2]
+    return message if kind in ("InputError", "SceneError", "InputErrors") else f"{kind}: {message}"
 
 
 SQUEAL_METRICS = {
