@@ -444,7 +444,7 @@ def test_resume_of_a_scene_without_checkpoints_names_the_option_without_a_value(
     with pytest.raises(InputError) as info:
         run(loads(BLOCK.format(effects='"contact"', folder=tmp_path / "out")), resume=True, verbose=False)
     assert str(info.value).startswith("--resume: this scene has no checkpoints to resume from")
-    assert str(info.value).endswith(": run it again with --overwrite")          # the fix (a user trial)
+    assert str(info.value).endswith(": run it again with --overwrite (in Python: overwrite=True, not resume)")
 
 
 def test_the_run_summary_counts_its_records_in_english(tmp_path, capsys):

@@ -49,7 +49,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         why = ("the squeal analysis has no checkpoints to resume from" if kind == "squeal" else
                'this scene has no checkpoints to resume from (only the multiscale loop, effect "roughness", '
                "writes checkpoints)")
-        raise InputError("--resume", None, why + ": run it again with --overwrite")   # (no fix said: a user trial)
+        raise InputError("--resume", None, why + ": run it again with --overwrite (in Python: overwrite=True, "
+                                           "not resume)")   # (no fix said: a user trial; nor the API's)
     for line in scene.warnings if comm.rank == 0 else ():
         print(f"warning: {line}", file=sys.stderr, flush=True)
     ended = resume and checkpoint.peek(Path(scene.output.folder) / multiscale.CHECKPOINT, comm).get("finished")

@@ -163,7 +163,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     if resume and comm.bcast(ckpt.parent.is_dir() and not ckpt.is_file() if comm.rank == 0 else None, root=0):
         raise InputError("--resume", str(ckpt.parent), f"no {CHECKPOINT} in the output folder to resume from (no "
                          "macro step of a run ended there): run without --resume (with --overwrite if the folder "
-                         "holds results)")     # before the folder is claimed: it stays as it was
+                         "holds results; in Python: resume=False, overwrite=True)")     # before the folder is claimed: it stays as it was
     out = prepare_folder(scene, overwrite, resume, comm)
     folder = out.path
     stored = checkpoint.peek(ckpt, comm) if resume else {}
@@ -277,7 +277,7 @@ def finished(folder: Path, name: str, steps: int, comm, verbose: bool) -> Multis
     files += maps
     if verbose and comm.rank == 0:
         print(f"{name}: nothing to do, the run in {folder} has ended after {steps} step(s); "
-              "use --overwrite to run it again")
+              "use --overwrite to run it again (in Python: overwrite=True)")
     return MultiscaleResult(folder, files, 0.0, history, folder / "history.h5", png, fields, plot, maps,
                             folder / "zones.h5", steps)
 
