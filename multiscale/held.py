@@ -22,7 +22,8 @@ modes; a box touching another of its body along an edge turned about it (30 Newt
 forces 999.98-1001.33 N); a shaft turning in a bush, its end held along z alone, was held about its
 axis only by the facets of the cylinder, and friction turned it against them (SNES -6, residual
 stuck near 7.8); so did the bush around a held shaft. All are refused here, before the mesh is
-handed to DOLFINx.
+handed to DOLFINx. The interfaces that alone hold a part are returned (N without each one's rows):
+a run refuses such an interface if its contact carries no force (``workflows.strain.idle_holder``).
 """
 from __future__ import annotations
 
