@@ -27,8 +27,8 @@ import numpy as np
 from multiscale.errors import InputError, SceneError, read_toml_text, toml_problem
 from multiscale.geometry import loose_bodies
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
-                               read, reference, show, suggest, unknown_keys)
-from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection
+                               read, reference, show)
+from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection, material_problems
 from multiscale.scene_plain import plain_speeds
 from multiscale.scene_rough import (law_top_warnings, measured_cover, micro_constants, nyquist, own_surface_tables,
                                     own_tables, penalty_range, perfect_contact, plastic_everywhere, rough_rules,
@@ -357,18 +357,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
     g = scene.geometry
     where = f'builder "{g.builder}"' if g is not None and g.builder != "file" else "the geometry"
     if g is not None and scene.materials is not None:
-        missing = [m for m in g.materials if m not in scene.materials]
-        near = {name: suggest(name, missing) for name in scene.materials if name not in g.materials}
-        typos = unknown_keys({n: 0 for n, hint in near.items() if hint}, g.materials, "materials", ctx,
-                             f"material of {where}")
-        for name in (n for n, hint in near.items() if not hint):     # a library's spare tables: their problems
-            own = [p for p in problems if p.startswith((f"materials.{name}.", f"materials.{name}:"))]  # warned
-            problems[:] = [p for p in problems if p not in own]
-            warnings.append(f"materials.{name} is not used: {where} has the materials {', '.join(g.materials)}"
-                            + (f" (ignored with its problems: {', '.join(p.split(': ')[0] for p in own)})" if own else ""))
-        for name in g.materials:
-            if name not in scene.materials and name not in typos:
-                problems.append(f'materials.{name}: missing; {where} needs the materials {", ".join(g.materials)}')
+        warnings += material_problems(g, scene.materials, where, ctx)
     loading = raw.get("loading") if isinstance(raw.get("loading"), dict) else {}
     if g is not None:
         moving = ("rotation_speed", "speed_profile", "vehicle") if g.motion == "rotation" else ("sliding_speed",)

@@ -21,7 +21,7 @@ from multiscale.errors import InputError, InputErrors
 from multiscale.geometry import FIXED_BODY, MAX_CELLS, GeometrySpec, Rotation, Support, builder, builder_names
 from multiscale.outputs import name_problem
 from multiscale.schema import (Bad, Choice, FilePath, FrozenMap, Integer, ListOf, Named, OneOf, Quantity,
-                               Section, Text, Vector, key, parse, read, show, unknown_keys)
+                               Section, Text, Vector, key, parse, read, show, suggest, unknown_keys)
 from multiscale.schema import reference as schema_reference
 from multiscale.scene_plain import contains_hint
 from multiscale.units import UnitError, to_si
@@ -362,3 +362,37 @@ def scene_spec(scene) -> GeometrySpec:
     if ld.direction is not None:
         changes.update(load_direction=tuple(ld.direction), fluid_load=False)
     return dataclasses.replace(spec, **changes)
+
+
+def material_problems(g: Geometry, materials, where: str, ctx) -> list[str]:
+    """The [materials] tables ``materials`` against those the geometry ``g`` needs (``where``: its
+    name in messages): problems appended to ``ctx.problems``, the warnings returned. A name the
+    scene wrote on a body (``geometry.bodies.<body>.material``) with no table is that key's problem,
+    with the table it likely means (a misspelt "cast_iorn" was said of the right table, advising
+    the misspelling: a user trial); a builder's name missing is the table's, or a misspelt table's;
+    a spare table (a library's) is warned unused, its own problems with it."""
+    problems, warnings = ctx.problems, []
+    missing = [m for m in g.materials if m not in materials]
+    spare = [n for n in materials if n not in g.materials]
+    bodies = g.params.bodies if isinstance(g.params, FileGeometry) and g.params.bodies else {}
+    written = {}
+    for body, selection in bodies.items():
+        if selection is not None and selection.material in missing:
+            written.setdefault(selection.material, []).append(body)
+    meant = set()
+    for m, names in written.items():
+        hint = suggest(m, spare)
+        meant.update(hint.split('"')[1:2])
+        problems.extend(f'geometry.bodies.{b}.material = "{m}": no [materials.{m}] table{hint}; tables: '
+                        f'{", ".join(materials) or "none"}' for b in names)
+    missing = [m for m in missing if m not in written]
+    near = {name: suggest(name, missing) for name in spare if name not in meant}
+    typos = unknown_keys({n: 0 for n, hint in near.items() if hint}, g.materials, "materials", ctx, f"material of {where}")
+    for name in (n for n, hint in near.items() if not hint):     # a library's spare tables: their problems
+        own = [p for p in problems if p.startswith((f"materials.{name}.", f"materials.{name}:"))]  # warned
+        problems[:] = [p for p in problems if p not in own]
+        warnings.append(f"materials.{name} is not used: {where} has the materials {', '.join(g.materials)}"
+                        + (f" (ignored with its problems: {', '.join(p.split(': ')[0] for p in own)})" if own else ""))
+    problems.extend(f'materials.{name}: missing; {where} needs the materials {", ".join(g.materials)}'
+                    for name in missing if name not in typos)
+    return warnings

@@ -1355,6 +1355,14 @@ def test_a_material_the_geometry_does_not_use_is_a_warning_a_misspelt_one_a_prob
         loads(GOOD.replace("[materials.flat]", "[materials.flta]"), tmp_path)
     assert any(p.startswith('materials.flta: unknown material of builder "block_on_flat" (did you mean "flat"?)')
                for p in info.value.problems)
+    # a geometry file's body naming a material with no table: that key is the problem, with the table it
+    # likely means (it was said of the right table, advising the misspelling: a user trial)
+    stop = (DEMOS / "car_brake_stop.toml").read_text().replace('file = "cad/', f'file = "{DEMOS / "cad"}/')
+    assert stop.count('material = "cast_iron"') == 1
+    with pytest.raises(SceneError) as info:
+        loads(stop.replace('material = "cast_iron"', 'material = "cast_iorn"'), tmp_path)
+    assert info.value.problems == ['geometry.bodies.disc.material = "cast_iorn": no [materials.cast_iorn] table (did '
+                                   'you mean "cast_iron"?); tables: cast_iron, pad, steel']
 
 
 def test_an_unused_material_table_need_not_be_complete(tmp_path):
