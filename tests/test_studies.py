@@ -320,9 +320,11 @@ def test_a_reference_file_of_some_metrics_judges_those_and_tabulates_the_rest(he
     head = next(line for line in md.splitlines() if line.startswith("| grid |"))
     assert head.count("| error |") == 2 and "approach" in head
     assert (tmp_path / "report" / "some_error_vs_time.png").exists()
-    for given, message in (({"contact_radius": a, "aproach": 1e-6}, 'no number for metric "approach" (did you '
-                                                                    'mean "aproach"?)'),
-                           ({"radius": a}, 'no number for metric "contact_radius"')):
+    for given, message in (({"contact_radius": a, "aproach": 1e-6}, '"aproach" is no metric of the study (did you '
+                                                                    'mean "approach"?)'),    # (said of the metric)
+                           ({"radius": a}, '"radius" is no metric of the study (did you mean "contact_radius"?)'),
+                           ({"wear": a}, "holds no number for any metric of the study (contact_radius, max_pressure, "
+                                         "approach); it holds wear")):
         ref.write_text(json.dumps(given))
         assert main(["study", str(write(tmp_path, text))]) == 2
         assert message in capsys.readouterr().err
@@ -549,7 +551,7 @@ def test_a_range_with_whole_bounds_keeps_its_fractional_values(tmp_path):
     {start = 3, stop = 10, num = 50} of hertz's (real) window the eight 3 ... 10: whole bounds were
     taken for an integer range (a user trial). An integer parameter, or a scene key whose values
     are all whole, still gets integers."""
-    (tmp_path / "scene.toml").write_text((ROOT / "demos" / "block_on_flat.toml").read_text())
+    (tmp_path / "scene.toml").write_text((ROOT / "demos" / "pin_on_disc_perfect.toml").read_text())
     scene = write(tmp_path, """
 problem = "scene"
 scene = "scene.toml"
@@ -728,6 +730,14 @@ loading.friction = [0.3, 0.4]
                   '[fixed]\neffects = ["contact", "friction", "stability"]\n[sweep]\nloading.friction = [0.3, 0.4]\n')
     assert main(["study", str(fixed)]) == 2           # [fixed] makes it a squeal scene (it ran, then failed)
     assert 'metrics item 1 ("max_grwth"): unknown metric of a squeal scene' in capsys.readouterr().err
+    ignored = scene_study(tmp_path, "pin_on_disc_perfect.toml", 'metrics = ["wear_volume:last"]\n[sweep]\n'
+                          '"wear.k_w" = ["1e-14 1/Pa", "2e-14 1/Pa"]\n')
+    assert main(["study", str(ignored)]) == 2           # (it ran both alike, then advised --rerun-failed: a trial)
+    assert ('error: wear.k_w: the scene ignores it in every run ([wear] is ignored: effect "wear" is not in effects): '
+            "the runs would be alike") in capsys.readouterr().err
+    from multiscale.studies.records import metric_problem
+    assert "(the run does not write it: " in metric_problem({"time": 1.0}, ["wear_volume:last"], asked=["wear_volume:last"])
+    assert "(a run older than the metric: " in metric_problem({"time": 1.0}, ["wear_volume:last"], asked=["time"])
     plain = write(tmp_path, f'problem = "scene"\nscene = "{tmp_path / "base.toml"}"\nmetrics = ["unstable_modes"]\n'
                   '[sweep]\nloading.friction = [0.3, 0.4]\n')
     assert main(["study", str(plain)]) == 2           # no squeal analysis: found after every run before (a trial)

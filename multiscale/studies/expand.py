@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from multiscale.errors import SceneError, read_toml_text, toml_problem
+from multiscale.scene_keys import key_parts
 from multiscale.schema import Bad, Context, FilePath, Integer, Quantity, fields_of, read, show, suggest
 from multiscale.studies.formatting import by_kind, value_text
 from multiscale.studies.problems import PROBLEMS
@@ -380,9 +381,23 @@ def _runs(f, problem, knobs, groups, extra, ctx) -> tuple[tuple, tuple]:
         seen[digest] = where
         runs.append(StudyRun(digest, label, raw, {k: value_text(swept[k]) for k in knobs}))
     ctx.problems.extend(_with_runs(wrong, count))
+    for knob in knobs if runs else ():   # (a sweep of wear.k_w without effect "wear" ran alike runs: a user trial)
+        said = {where: line for line, where in warned if _ignores(line, knob)}
+        if len(said) == len(runs):
+            ctx.problems.append(f"{knob}: the scene ignores it in every run ({next(iter(said.values()))}): the "
+                                "runs would be alike; give what it needs ([fixed]) or sweep another key")
     kinds = by_kind(warned)
     return tuple(runs), tuple(_with_runs({line: where for line, where, _ in kinds}, count,
                                          {line for line, _, varied in kinds if varied}))
+
+
+def _ignores(line: str, knob: str) -> bool:
+    """Whether a scene's warning ``line`` says that the scene key ``knob`` is ignored: the key itself
+    or a table holding it ("[wear] is ignored: ...", "wear.k_w is ignored: ...")."""
+    what, said, _ = line.partition(" is ignored")
+    parts = key_parts(knob)
+    held = {".".join(parts[:i]) for i in range(1, len(parts) + 1)}
+    return bool(said) and what.strip("[]").replace("[", ".").replace("]", "") in held
 
 
 def _with_runs(lines: dict, total: int, varied=()) -> list[str]:
@@ -447,6 +462,10 @@ def _check_reference(f: StudyFile, problem, knobs, axes, runs, ctx) -> tuple:
         elif m in values and not (math.isfinite(values[m]) and values[m] != 0):
             ctx.problems.append(f"reference.file = \"{ref.file}\": metric \"{m}\" is {values[m]!r}: errors are "
                                 "relative to it; give a finite, nonzero number")
-        elif m not in values and (not judged or suggest(m, others)):
-            ctx.problems.append(f"reference.file = \"{ref.file}\": no number for metric \"{m}\"{suggest(m, others)}")
+    misspelt = {k: hint for k in others if (hint := suggest(k, f.metrics))}   # said of the file's key (it was of
+    for k, hint in misspelt.items():                                         # the metrics, the right one: a trial)
+        ctx.problems.append(f"reference.file = \"{ref.file}\": \"{k}\" is no metric of the study{hint}")
+    if not judged and not misspelt:
+        ctx.problems.append(f"reference.file = \"{ref.file}\": holds no number for any metric of the study "
+                            f"({', '.join(f.metrics)}); it holds {', '.join(map(str, values)) or 'nothing'}")
     return judged

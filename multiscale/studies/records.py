@@ -30,10 +30,12 @@ def record_path(study: Study, run: StudyRun) -> Path:
     return study.folder / "runs" / f"{run.key}.json"
 
 
-def metric_problem(metrics: dict, names, undefined=frozenset()) -> str | None:
+def metric_problem(metrics: dict, names, undefined=frozenset(), asked=()) -> str | None:
     """Why a run's ``metrics`` (name -> value) do not give the study's metric ``names``; None if they do.
     Names every metric missing (before: the first; a user trial's second misspelt one came a run later).
-    A metric in ``undefined`` (``Problem.undefined``) may be NaN: what it measures is absent."""
+    A metric in ``undefined`` (``Problem.undefined``) may be NaN: what it measures is absent. ``asked``:
+    the metrics the run was asked for when it ran; missing, they are not of a run older than the
+    metric (--rerun-failed was advised for them, and ran them alike: a user trial)."""
     missing = {name: suggest(name, metrics) for name in names if name not in metrics}    # misspelt: fix them,
     if missing:                                                                          # records are judged on read
         available = sorted(metrics)           # a scene's history: ~180 names, in every failed run's line
@@ -41,7 +43,9 @@ def metric_problem(metrics: dict, names, undefined=frozenset()) -> str | None:
                                                      if len(available) > MAX_LISTED else "")
         listed = ", ".join('"' + name + '"' + hint for name, hint in missing.items())
         return (f"metric{'s' if len(missing) > 1 else ''} {listed} not produced"
-                + (" (fix the name: the runs need not run again)" if any(missing.values())
+                + (" (fix the name: the runs need not run again)" if any(missing.values()) else
+                   " (the run does not write it: an effect or output it needs is not in the scene?)"
+                   if set(missing) <= set(asked)
                    else " (a run older than the metric: --rerun-failed recomputes it)") + f"; available: {shown}")
     for name in names:
         value = metrics[name]
@@ -80,7 +84,8 @@ def read_records(study: Study) -> dict:
             if record.get("ran") or record.get("status") == "ok":
                 if record.get("repeat", 1) < study.options.repeat:
                     continue
-                why = metric_problem(record.get("metrics", {}), study.metrics, PROBLEMS[study.problem].undefined)
+                why = metric_problem(record.get("metrics", {}), study.metrics, PROBLEMS[study.problem].undefined,
+                                     record["asked"] if isinstance(record.get("asked"), list) else ())
                 record.update(status=FAILED if why else "ok", error=why or "")
             out[run.key] = record
     return out

@@ -106,7 +106,8 @@ def run_task(task: dict) -> int:
     """One run in this (fresh) process: parse, run ``repeat`` times, write the record."""
     record = {"key": task["key"], "problem": task["problem"], "label": task["label"], "status": FAILED,
               "metrics": {}, "started": now(), "repeat": task["repeat"], "python": platform.python_version(),
-              "multiscale": multiscale.__version__, "code": code(), "cpus": os.cpu_count(), "rank": task["rank"]}
+              "multiscale": multiscale.__version__, "code": code(), "cpus": os.cpu_count(), "rank": task["rank"],
+              "asked": list(task["metrics"])}       # (``records.metric_problem``: a metric missing, asked, is no age)
     try:
         problem = get_problem(task["problem"])
         ctx = Context(directory=Path(task["directory"]))
@@ -130,7 +131,7 @@ def run_task(task: dict) -> int:
         record["metrics"] = {k: float(v) for k, v in outcome.metrics.items()}
         if task["exact"]:
             record["reference"] = _exact(problem, params, Path(task["references"]))
-        why = metric_problem(record["metrics"], task["metrics"], problem.undefined)
+        why = metric_problem(record["metrics"], task["metrics"], problem.undefined, task["metrics"])
         record.update(ran=True, status=FAILED if why else "ok", error=why or "")
     except Exception as exc:       # recorded, never raised: the study goes on
         text = str(exc).strip().splitlines()
