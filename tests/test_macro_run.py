@@ -402,7 +402,15 @@ def test_an_undershoot_is_weighed_against_the_rise_up_to_then(tmp_path):
         assert bool(lines) == warned, (dip, late_rise)
         if warned:
             assert lines[0].startswith(f"the temperature of body 'block' fell to {T0 - dip:.2f} K at t = 16 s, 5.63 K "
-                                       f"below the lowest imposed temperature ({T0:.2f} K) while it had risen by 45 K")
+                                       f"below the lowest imposed temperature ({T0:.2f} K) while it had risen by 45 K:")
+    # a deeper fall that is a smaller share of a larger rise: told too, as the lowest (only the row
+    # told was: 292.20 K at 1 s said, 290.91 K at 2 s unsaid; a user trial)
+    h = History()
+    for t, top, low in ((0.0, 0.0, 0.0), (16.0, 45.0, -5.63), (100.0, 236.0, -9.0), (240.0, 236.0, 0.0)):
+        h.append(time=t, max_temperature_block=T0 + top, min_temperature_block=T0 + low,
+                 max_temperature_flat=T0, min_temperature_flat=T0)
+    (line,) = [w for w in run_warnings(scene, h) if "undershoot" in w]
+    assert f"while it had risen by 45 K (its lowest: {T0 - 9:.2f} K at t = 100 s, after a rise of 236 K): " in line
 
 
 def test_kept_heat_factors_give_the_factorised_answer(tmp_path, monkeypatch):

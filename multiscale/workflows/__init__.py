@@ -328,10 +328,12 @@ def _undershoots(scene, history) -> list[str]:
         risen = np.maximum.accumulate(np.asarray(history[hot], float)) - floor     # K, the rise up to each row
         told = (below > UNDERSHOOT * risen) & (below > max(1e-3, NEGLIGIBLE * risen[-1]))
         if told.any():
-            row = int(np.argmax(np.where(told, below, -np.inf)))       # the deepest of those told
-            out.append(f"the temperature of body {body.name!r} fell to {floor - below[row]:.2f} K at t = "
+            row, deepest = int(np.argmax(np.where(told, below, -np.inf))), int(np.argmax(below))   # the deepest told
+            later = (f" (its lowest: {floor - below[deepest]:.2f} K at t = {history['time'][deepest]:g} s, after a "
+                     f"rise of {risen[deepest]:.3g} K)" if below[deepest] > below[row] else "")   # (the lowest was
+            out.append(f"the temperature of body {body.name!r} fell to {floor - below[row]:.2f} K at t = "   # unsaid: a trial)
                        f"{history['time'][row]:g} s, {below[row]:.3g} K below the lowest imposed temperature "
-                       f"({floor:.2f} K) while it had risen by {risen[row]:.3g} K: an undershoot of the "
+                       f"({floor:.2f} K) while it had risen by {risen[row]:.3g} K{later}: an undershoot of the "
                        "discretisation (a heated layer thinner than the elements; with a rotating body, its Eulerian "
                        "transport): temperatures near the rubbing surface are uncertain by at least as much; refine "
                        "the mesh across the thickness (docs/architecture.md, Known problems)")
