@@ -275,8 +275,10 @@ def test_covering_an_interface():
     twice = np.block([[s.heights, s.heights[:, ::-1]], [s.heights[::-1], s.heights[::-1, ::-1]]])
     tiles = np.tile(twice, (2, 3))[30:130, 20:220]                          # the central 200 x 100 cells
     np.testing.assert_allclose(mirrored.heights, tiles - tiles.mean(), atol=1e-20)
-    with pytest.warns(TopographyWarning, match="3 x 2 copies"):
+    with pytest.warns(TopographyWarning, match="3 x 2 copies; wavelengths longer than 0.04 mm are missing"):
         tiled, _ = cover(s, (100, 60), (100e-6, 60e-6), "tile")
+    with pytest.warns(TopographyWarning, match=r"wavelengths longer than 0\.035 mm along x and 0\.036 mm along y"):
+        cover(s, (10, 10), (70e-6, 90e-6), "tile")     # tiles of whole 7 x 9 um cells (one length said for both: a trial)
     assert tiled.shape == (60, 100) and not tiled.periodic
     with pytest.warns(TopographyWarning, match="13 x 7 mirror-stitched copies"):     # coarsened before copying
         coarse, lines = cover(s, (100, 50), (1e-3, 0.5e-3), "mirror")

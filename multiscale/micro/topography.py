@@ -397,10 +397,12 @@ def copy_notes(measured, pixel, size, cell, method: str, prefix: str = "") -> li
            f"{cell[1] * 1e6:.4g} um) along an axis: its roughness is finer than the grid and the copies keep little "
            "of it; use \"equivalent\" or a finer micro.grid"] \
         if counts is not None and min(b / c for b, c in zip(base, cell)) < 4 else []
-    period = max(base) if counts is None or method == "mirror" else max(n * c for n, c in zip(counts, cell))
+    period = base if counts is None or method == "mirror" else tuple(n * c for n, c in zip(counts, cell))
+    longer = f"{period[0] * 1e3:.4g} mm" if abs(period[0] - period[1]) <= 1e-9 * max(period) else \
+        f"{period[0] * 1e3:.4g} mm along x and {period[1] * 1e3:.4g} mm along y"   # (one said for both: a trial)
     return out + [f"{prefix}cover = \"{method}\": {wide} is smaller than {_sized('the interface', size)}: "
                   f"{reps[1]} x {reps[0]} {'mirror-stitched ' if method == 'mirror' else ''}copies; wavelengths "
-                  f"longer than {period * 1e3:.4g} mm are missing and the pattern repeats"]
+                  f"longer than {longer} are missing and the pattern repeats"]
 
 
 def covers(measured, size, method: str = "measured", prefix: str = "") -> bool:
