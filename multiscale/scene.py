@@ -28,7 +28,7 @@ from multiscale.errors import InputError, SceneError, read_toml_text, toml_probl
 from multiscale.geometry import loose_bodies
 from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Section, Tables, Text, fields_of, key,
                                read, reference, show)
-from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection, material_problems
+from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection, fluid_faces_left_out, material_problems
 from multiscale.scene_plain import plain_speeds
 from multiscale.scene_rough import (law_top_warnings, measured_cover, micro_constants, nyquist, own_surface_tables,
                                     own_tables, penalty_range, perfect_contact, plastic_everywhere, rough_rules,
@@ -358,6 +358,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
     where = f'builder "{g.builder}"' if g is not None and g.builder != "file" else "the geometry"
     if g is not None and scene.materials is not None:
         warnings += material_problems(g, scene.materials, where, ctx)
+    if g is not None and scene.loading is not None:
+        warnings += fluid_faces_left_out(g, scene.loading.faces, where)
     loading = raw.get("loading") if isinstance(raw.get("loading"), dict) else {}
     if g is not None:
         moving = ("rotation_speed", "speed_profile", "vehicle") if g.motion == "rotation" else ("sliding_speed",)

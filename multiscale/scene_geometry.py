@@ -396,3 +396,14 @@ def material_problems(g: Geometry, materials, where: str, ctx) -> list[str]:
     problems.extend(f'materials.{name}: missing; {where} needs the materials {", ".join(g.materials)}'
                     for name in missing if name not in typos)
     return warnings
+
+
+def fluid_faces_left_out(g: Geometry, faces, where: str) -> list[str]:
+    """The warning if ``faces`` (loading.faces) leave out some of a builder's fluid-loaded faces
+    (``GeometrySpec.fluid_load``): the fluid pushes on all of them, and a part whose face is left
+    out (the built-in brake's floating caliper, its bore) is held by an unpressed contact alone,
+    which the run refuses after its first solve (said only then: a user trial)."""
+    out = [f for f in g.spec.load_faces if f not in (faces or g.spec.load_faces)] if g.spec.fluid_load else []
+    return [f"loading.faces = {list(faces)}: leaves out {', '.join(out)}, where {where}'s fluid pressure acts too; "
+            "a part pressed only there (a floating caliper) is then held by no force, and the run stops after its "
+            "first solve"] if out else []

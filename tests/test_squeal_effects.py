@@ -467,6 +467,8 @@ def test_a_floating_caliper_pressed_on_the_piston_alone_is_refused_before_its_mo
     overrides = {**NO_FIGURES, "geometry.mesh_size": "20 mm", "stability.modes": 2,
                  "output.folder": str(tmp_path / "out")}
     scene = scenes.load(DEMO, {**overrides, "loading.faces": ["piston_back"]})
+    assert "loading.faces = ['piston_back']: leaves out caliper_bore, where builder \"disc_brake\"'s fluid pressure " \
+        "acts too; a part pressed only there (a floating caliper) is then held by no force" in scene.warnings[0]
     with pytest.raises(InputError, match=r"interface = 'outer_pad': it carried no force \(.* N, against 1\.6\de\+03 N\), "
                                          r"yet without it 1 part\(s\) could move as rigid bodies \(one of region "
                                          r"'pad_outer' \(with 'backplate_outer', 'caliper'\) around .* mm: "
