@@ -344,8 +344,11 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
                 from multiscale.plots.squeal import plot_pressure  # local: matplotlib only when a figure is drawn
                 return [plot_pressure(tm.interface.midpoints, masks, pressure, scene.name, folder / "pressure.png")]
             files.extend(io.on_root(comm, figure if scene.output.figures else list, f"the figures in {folder}") or [])
-    case = analyse(scene, tm, degree=degree, on_preload=preloaded)
-    with closed_on_error(case.mech, comm):       # a script going on after a failed run gets its communicators
+    replacing = bool(out.replace)     # --overwrite of earlier results: they stay until the modes are found (an
+    case = analyse(scene, tm, degree=degree, on_preload=None if replacing else preloaded)   # empty band deleted
+    with closed_on_error(case.mech, comm):       # them after the preload: a user trial)
+        if replacing:
+            preloaded(case.mech)
         with io.stage("writing results"):
             rep = case.report
             files += io.on_root(comm, lambda: [case.modes.write_csv(folder / "modes.csv", rep.rtol,
