@@ -33,7 +33,7 @@ from multiscale.outputs import summary as plan_summary
 from multiscale.provenance import versions
 from multiscale.scene import load
 from multiscale.scene_plain import pixel_problem, plain
-from multiscale.scene_summary import cells_line, memory_line, reference, summary
+from multiscale.scene_summary import cells_line, memory_line, modes_problem, reference, summary
 from multiscale.units import UnitError, to_si
 
 DESCRIPTION = """Multi-scale thermo-mechanical simulation of frictional sliding contacts (disc brakes,
@@ -94,6 +94,10 @@ def _check(args) -> int:
                 line, estimate = cells_line(scene)
             except InputError as exc:
                 print(f"error: {exc}\n{path}: 1 problem", file=sys.stderr)
+                failed += 1
+                continue
+            if (why := modes_problem(scene, estimate)) is not None:     # what run refuses after its preload
+                print(f"error: {why}\n{path}: 1 problem", file=sys.stderr)
                 failed += 1
                 continue
             need, free = memory_line(scene, estimate), memory_available()

@@ -258,6 +258,18 @@ def cells_line(scene: Scene) -> tuple[str, CellEstimate]:
             f"{g.max_cells:,}", e)
 
 
+def modes_problem(scene: Scene, mesh: CellEstimate) -> str | None:
+    """What the squeal run would refuse of ``stability.modes`` on the estimated ``mesh``: more modes
+    than its displacement dofs (quadratic: three a vertex and an edge; the run said it after meshing
+    and the preload, and check had estimated 440 GB for them: a user trial); None if nothing."""
+    modes = scene.stability.modes if scene.has("stability") else None
+    dofs = 3 * (mesh.nodes + mesh.edges)
+    if modes is None or not mesh.nodes or modes <= dofs:
+        return None
+    return (f"stability.modes = {modes}: more than the model's {'' if mesh.exact else 'about '}{dofs:,} displacement "
+            "dofs on this mesh: the run refuses it; ask fewer (a cap: the band's modes are found up to it)")
+
+
 def memory_line(scene: Scene, mesh: CellEstimate) -> tuple[str, float]:
     """The estimated peak memory of a serial run of the scene's estimated ``mesh`` (``memory.run_memory``
     of its displacement dofs: quadratic for a squeal run, three a vertex and an edge, linear

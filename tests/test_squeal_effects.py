@@ -493,6 +493,40 @@ def test_a_floating_caliper_pressed_on_the_piston_alone_is_refused_before_its_mo
     assert {p.name: p.stat().st_mtime_ns for p in (tmp_path / "out").iterdir()} == before
 
 
+def test_a_mode_cap_beyond_the_dofs_is_refused_by_check_and_before_the_preload(tmp_path, capsys):
+    """stability.modes = 100000 on the 20-mm brake (49 005 quadratic displacement dofs): the run said so
+    after meshing, a 438 GB memory warning and the preload; check --cells estimated 440 GB and said OK
+    (a user trial). Both refuse it now, check with the count it estimates, the run before its preload."""
+    from multiscale.cli import main
+    sets = ["--set", "geometry.mesh_size=20 mm", "--set", "stability.modes=100000",
+            "--set", f"output.folder={tmp_path / 'out'}"]
+    assert main(["check", str(DEMO), "--cells", *sets]) == 2
+    err = capsys.readouterr().err
+    assert "error: stability.modes = 100000: more than the model's 49,005 displacement dofs on this mesh" in err
+    scene = scenes.load(DEMO, {**NO_FIGURES, "geometry.mesh_size": "20 mm", "stability.modes": 100000,
+                               "output.folder": str(tmp_path / "out")})
+    with pytest.raises(InputError, match=r"^stability.modes = 100000: must not exceed the number of dofs \(49005\)"):
+        squeal.run(scene, verbose=False)
+    assert not (tmp_path / "out" / "brake.xdmf").exists()
+
+
+def test_a_large_mode_cap_asks_the_eigen_solver_for_the_band_not_for_the_cap(tmp_path, monkeypatch):
+    """stability.modes = 300 on a band that holds fewer: the first solve asks at most
+    ``eigen.FIRST_MODES`` pairs (it asked 301: 51.6 s for the 20-mm brake's 71 modes against 14.0 s;
+    a user trial), the same modes as a cap of 100."""
+    from multiscale.macro import eigen
+    asked, set_up = [], eigen._set_up
+    monkeypatch.setattr(eigen, "_set_up", lambda solver, want, failure: (asked.append(want),
+                                                                         set_up(solver, want, failure))[1])
+    runs = {}
+    for cap in (100, 300):
+        scene = scenes.load(DEMO, {**NO_FIGURES, "geometry.mesh_size": "20 mm", "stability.modes": cap,
+                                   "output.folder": str(tmp_path / f"cap{cap}")})
+        runs[cap] = squeal.run(scene, degree=1, verbose=False).case.modes
+    assert asked == [eigen.FIRST_MODES] * 2 and runs[300].eigenvalues.size < 100
+    np.testing.assert_array_equal(runs[300].eigenvalues, runs[100].eigenvalues)
+
+
 def test_scene_stribeck_friction_sets_mu_per_facet_and_its_slope_damping(tmp_path):
     text = DEMO.read_text().replace("friction = 0.4\n", "") + (
         '\n[loading.stribeck]\nstatic = 0.5\nkinetic = 0.35\nspeed = "1 m/s"\n')

@@ -175,6 +175,10 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     name = name or scene.name
     prefix = "squeal_" + "".join(ch if ch.isalnum() else "_" for ch in name) + "_"
     mech = build_squeal_mechanics(scene, tm, degree=degree, prefix=prefix)
+    dofs = sum(u.function_space.dofmap.index_map.size_global * u.function_space.dofmap.index_map_bs for u in mech.u)
+    if st.modes is not None and st.modes > dofs:     # (said after the preload, with a memory warning: a trial)
+        mech.close()
+        raise InputError("stability.modes", st.modes, f"must not exceed the number of dofs ({dofs})")
     say_model_size(tm, mech, kind="squeal", modes=st.modes)
     say_load(scene, tm)
     try:
