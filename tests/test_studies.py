@@ -916,6 +916,9 @@ def test_an_interrupted_study_writes_the_table_of_the_runs_that_ended(tmp_path, 
     assert float(rows[0]["approach"]) > 0 and rows[1]["message"] == "not run or cut off"
     text = md.read_text()
     assert "- Runs: 1 ok, 0 failed, **3 not run or cut off: the study was stopped** (run it again" in text
+    cells = [[c.strip() for c in line.strip("|").split("|")] for line in text.splitlines() if line.startswith("| ")]
+    head, missing = next(c for c in cells if c[0] == "grid"), next(c for c in cells if c[-1] == "missing")
+    assert missing[head.index("iterations")] == "n/a"   # a run without a count (it said nothing, 0 of a squeal run)
     assert "Failed runs:" not in text
     # into a report folder: its index of the reports written so far too (before: none on Ctrl-C, a review)
     assert main(["study", str(path), "--report", str(tmp_path / "reports")]) == 130

@@ -18,7 +18,7 @@ class Outcome:
     """What one run of a problem produced."""
 
     metrics: dict                 # name -> float (SI units, see the problem's ``metrics``)
-    iterations: int = 0           # solver iterations, summed over the run's solves
+    iterations: int = 0           # solver iterations, summed over the run's solves (-1: none to count)
     converged: bool = True        # every solve reached its tolerance
     wall_time: float | None = None   # s, the run's own time where the problem knows it better than
     #                                  the worker's clock (a scene run: without its process's start-up)

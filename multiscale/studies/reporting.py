@@ -123,6 +123,12 @@ def _repeats(rows) -> str:
     return f"{counts[0]}" if len(counts) == 1 else f"{counts[0]}-{counts[-1]}"
 
 
+def _iterations(record) -> str:
+    """A run's iteration count; "n/a" where it has none (-1: a squeal run's, a run not run)."""
+    n = record.get("iterations", -1)
+    return str(n) if isinstance(n, int) and n >= 0 else "n/a"
+
+
 def _memory(record: dict) -> str:
     """Peak memory [MB] and, in brackets, what the run added to its process's baseline."""
     peak, base = record.get("peak_memory_mb", math.nan), record.get("base_memory_mb", math.nan)
@@ -220,7 +226,7 @@ def _runs_table(study, rows) -> list[str]:
         if r.note:
             status += f" ({r.note})"
         cells += [number_text(float(rec.get("wall_time", math.nan))), _memory(rec),
-                  str(rec.get("iterations", "")), status]
+                  _iterations(rec), status]
         lines.append("| " + " | ".join(cells) + " |")
     return lines
 

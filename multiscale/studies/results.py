@@ -134,7 +134,7 @@ def _columns(study: Study, rows: list[Row]) -> dict:
         cols["max_error"] = [r.max_error for r in rows]
     for name in ("wall_time", "cpu_time", "peak_memory_mb"):
         cols[name] = [float(r.record.get(name, math.nan)) for r in rows]
-    cols["iterations"] = [int(r.record.get("iterations", -1)) for r in rows]
+    cols["iterations"] = [int(r.record.get("iterations", -1)) for r in rows]     # -1: none (a squeal run's)
     cols["converged"] = [bool(r.record.get("converged", False)) for r in rows]
     cols["code"] = [(r.record.get("code") or {}).get("sha1", "")[:12] for r in rows]    # the package that ran it
     cols["message"] = [r.record.get("error", "") or r.note for r in rows]

@@ -207,7 +207,7 @@ class SceneProblem(Problem):
         own = record.get("total_wall_time_s")     # (the process's start-up, 10 of 18 s, made a coarser grid
         #                                           slower than the reference and the cheapest setting the reference)
         if (out / "modes.csv").exists():
-            return Outcome(squeal_metrics(out / "modes.csv"), 0, True, own, found)
+            return Outcome(squeal_metrics(out / "modes.csv"), -1, True, own, found)   # (no count: n/a, not 0)
         history = History.read(out / "history.h5")
         iterations = int(history["newton_iterations"].sum()) if "newton_iterations" in history.columns else 0
         return Outcome(history_metrics(history), iterations, True, own, found)
