@@ -36,7 +36,8 @@ def surface_figure(surface, stats, path: Path, title: str = "", waviness=None) -
         ax.set_xlabel("x [mm]")
         ax.set_ylabel("y [mm]")
         t = stats.texture if s is surface else None
-        ax.set_title(label if t is None else f"{label}: Str {'< ' * (not t.bounded)}{t.Str:.2g}, lay {t.lay:.0f}° from x")
+        ax.set_title(label if t is None else f"{label}: Str {'< ' * (not t.bounded)}{t.Str:.2g},\nlay {t.lay:.0f}° from x")
+        #          (on two lines: one reached into the next panel, a user trial)
         below, above = s.heights.min() < lo, s.heights.max() > hi
         fig.colorbar(image, ax=ax, shrink=0.85, extend={(0, 0): "neither", (1, 0): "min", (0, 1): "max",
                                                         (1, 1): "both"}[below, above],
