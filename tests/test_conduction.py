@@ -18,6 +18,8 @@ class Slab(Kernel):
     """Test-only periodic kernel: a layer of thickness h on a base held at fixed temperature,
     F(q) = tanh(q h)/(kappa q), F(0) = h/kappa (independent of the package's layered kernels)."""
 
+    thermal = True      # temperature per heat flux (a kernel of one's own says which)
+
     def __init__(self, kappa, h):
         self.kappa, self.h = kappa, h
 

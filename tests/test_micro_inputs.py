@@ -10,7 +10,8 @@ import pytest
 from multiscale.errors import InputError
 from multiscale.micro import fft
 from multiscale.micro.asperity import AsperityModel
-from multiscale.micro.conduction import ConductionSolver, conductance_law
+from multiscale.micro.conduction import ConductionSolver, SeriesKernel, conductance_law
+from multiscale.micro.contact import ContactSolver
 from multiscale.micro.heat_kernels import Rotation, SpeedProfile, ThermalMaterial, Translation
 from multiscale.micro.heating import InterfaceLayer, SteadyHeating, TransientHeating, partition_law
 from multiscale.micro.kernels import HalfSpace, ThermalHalfSpace
@@ -179,6 +180,13 @@ CASES = [
     (lambda **k: fft.set_threads(**k), dict(n="2"), "n"),
     (lambda **k: Surface(**{**dict(heights=S.heights, dx=1e-6, dy=1e-6), **k}), dict(heights=S.heights > 0),
      "heights"),                                      # (read as 1 m and 0 m: a user trial)
+    # a kernel of the other kind: a thermal one taken as elastic put a patch in full contact, an elastic one
+    # taken as thermal gave K_t 18750 for 17046 W/(m^2 K), without a word (a user trial)
+    (lambda **k: ContactSolver(**{**dict(kernel=E, shape=(8, 8), dx=1e-5), **k}), dict(kernel=THERMAL[0]), "kernel"),
+    (lambda **k: ConductionSolver(**{**dict(kernel_1=THERMAL[0], kernel_2=THERMAL[1], shape=(8, 8), dx=1e-5), **k}),
+     dict(kernel_1=E), "kernel_1"),
+    (lambda **k: SeriesKernel(**{**dict(first=E, second=E), **k}), dict(second=THERMAL[1]), "second"),
+    (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(kernel=THERMAL[0]), "kernel"),
     # zone laws
     (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(kernel="steel"), "kernel"),
     (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(n_points=4.5), "n_points"),

@@ -35,7 +35,7 @@ import numpy as np
 from multiscale.errors import (ConvergenceError, InputError, check_count, check_field, check_flag, check_instance,
                                check_positive, check_real)
 from multiscale.micro.contact import ContactSolver
-from multiscale.micro.kernels import InfluenceOperator, Kernel
+from multiscale.micro.kernels import InfluenceOperator, Kernel, check_kernel
 from multiscale.micro.surface import Surface, check_surface
 
 
@@ -46,7 +46,13 @@ class SeriesKernel(Kernel):
     """
 
     def __init__(self, first: Kernel, second: Kernel):
-        self.first, self.second = first, second
+        check_instance("first", first, Kernel, "a Kernel")
+        self.first, self.second = first, check_kernel("second", second, first.thermal)   # of one kind: they add
+
+    @property
+    def thermal(self) -> bool:
+        """Of the two kernels' kind (the same)."""
+        return self.first.thermal
 
     def compliance(self, q):
         q = np.asarray(q, dtype=float)
@@ -93,7 +99,7 @@ class ConductionSolver:
     def __init__(self, kernel_1: Kernel, kernel_2: Kernel, shape, dx: float, dy: float | None = None,
                  periodic: bool = True):
         for name, kernel in (("kernel_1", kernel_1), ("kernel_2", kernel_2)):
-            check_instance(name, kernel, Kernel, "a thermal Kernel (e.g. ThermalHalfSpace(kappa))")
+            check_kernel(name, kernel, thermal=True)
         self.kernels = (kernel_1, kernel_2)
         self.series = InfluenceOperator(SeriesKernel(kernel_1, kernel_2), shape, dx, dy, periodic)
         self.body_1 = InfluenceOperator(kernel_1, shape, dx, dy, periodic)

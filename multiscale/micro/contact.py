@@ -40,7 +40,7 @@ import numpy as np
 from multiscale.errors import ConvergenceError, InputError, check_count, check_flag, check_positive, non_finite
 from multiscale.micro import bccg_solver, pk_solver
 from multiscale.micro.fft import get_threads
-from multiscale.micro.kernels import InfluenceOperator, Kernel
+from multiscale.micro.kernels import InfluenceOperator, Kernel, check_kernel
 from multiscale.micro.surface import Surface
 
 METHODS = ("bccg", "pk")
@@ -110,7 +110,7 @@ class ContactSolver:
 
     def __init__(self, kernel: Kernel, shape, dx: float, dy: float | None = None, periodic: bool = True,
                  method: str = "bccg"):
-        self.operator = InfluenceOperator(kernel, shape, dx, dy, periodic)
+        self.operator = InfluenceOperator(check_kernel("kernel", kernel, thermal=False), shape, dx, dy, periodic)
         self.kernel, self.shape, self.periodic = kernel, self.operator.shape, self.operator.periodic
         self.method = _method(method)
         self._scratch: dict[tuple, queue.SimpleQueue] = {}   # (method, chunk, threads) -> free buffers

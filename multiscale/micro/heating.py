@@ -36,7 +36,7 @@ from multiscale.memory import memory_limit
 from multiscale.micro.contact import ContactResult, ContactSolver
 from multiscale.micro.fft import RealFFT2
 from multiscale.micro.heat_kernels import Motion, ThermalMaterial, Translation, pulse_tables
-from multiscale.micro.kernels import Kernel, grid_shape, padded_size
+from multiscale.micro.kernels import Kernel, check_kernel, grid_shape, padded_size
 from multiscale.micro.masked_krylov import masked_solve
 from multiscale.micro.surface import Surface
 
@@ -528,7 +528,7 @@ def partition_law(source, body1: ThermalMaterial, body2: ThermalMaterial, speed,
         if elastic is None or pressures is None:
             raise InputError("elastic/pressures", (elastic, pressures),
                              "a Surface needs an elastic kernel and mean pressures")
-        check_instance("elastic", elastic, Kernel, "an elastic Kernel")
+        check_kernel("elastic", elastic, thermal=False)
         if source.heights.ndim != 2:
             raise InputError("source", source.heights.shape, "one patch (a 2-D height map)")
         loads = np.sort(np.atleast_1d(check_field("pressures", pressures)))

@@ -13,6 +13,7 @@ from __future__ import annotations
 import functools
 from abc import ABC, abstractmethod
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 import scipy.fft
@@ -27,9 +28,12 @@ class Kernel(ABC):
     """Linear surface response of a solid to a surface load distribution.
 
     Elastic kernels: normal displacement [m] per normal pressure [Pa]. Thermal kernels: surface
-    temperature rise [K] per surface heat flux [W/m²]. Responses are axisymmetric (isotropic
+    temperature rise [K] per surface heat flux [W/m²] (``thermal``: a kernel of one's own sets it
+    True; the solvers refuse a kernel of the other kind). Responses are axisymmetric (isotropic
     solids), so the Fourier transfer function depends on |k| only.
     """
+
+    thermal: ClassVar[bool] = False     # temperature per heat flux, not displacement per pressure
 
     @abstractmethod
     def compliance(self, q: np.ndarray) -> np.ndarray:
@@ -117,6 +121,7 @@ class ThermalHalfSpace(Kernel):
     """
 
     kappa: float
+    thermal: ClassVar[bool] = True
 
     def __post_init__(self):
         object.__setattr__(self, "kappa", check_positive("kappa", self.kappa))
@@ -189,6 +194,18 @@ def wavenumbers(ny: int, nx: int, dy: float, dx: float) -> np.ndarray:
     kx = 2 * np.pi * np.fft.rfftfreq(nx, dx)
     ky = 2 * np.pi * np.fft.fftfreq(ny, dy)
     return np.hypot(ky[:, None], kx[None, :])
+
+
+def check_kernel(name: str, kernel, thermal: bool) -> Kernel:
+    """``kernel`` if it is a ``Kernel`` of the kind asked (``thermal``: temperature per heat flux;
+    else displacement per pressure), else an InputError naming ``name``: a ThermalHalfSpace taken
+    for an elastic solid put a patch in full contact without a word (a user trial)."""
+    kind = ("a thermal Kernel (temperature rise per heat flux, e.g. ThermalHalfSpace(kappa))" if thermal else
+            "an elastic Kernel (displacement per pressure, e.g. HalfSpace(E_star))")
+    if not isinstance(kernel, Kernel) or kernel.thermal != thermal:
+        other = f"; this one is {'thermal' if kernel.thermal else 'elastic'}" if isinstance(kernel, Kernel) else ""
+        raise InputError(name, kernel, f"must be {kind}{other}")
+    return kernel
 
 
 class InfluenceOperator:

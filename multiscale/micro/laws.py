@@ -45,12 +45,12 @@ from dataclasses import dataclass, field, replace
 
 import numpy as np
 
-from multiscale.errors import ConvergenceError, InputError, check_count, check_instance, check_positive
+from multiscale.errors import ConvergenceError, InputError, check_count, check_positive
 from multiscale.micro.conduction import ConductionSolver
 from multiscale.micro.contact import ContactResult, ContactSolver
 from multiscale.micro.heat_kernels import ThermalMaterial
 from multiscale.micro.heating import InterfaceLayer, SteadyHeating
-from multiscale.micro.kernels import Kernel
+from multiscale.micro.kernels import Kernel, check_kernel
 from multiscale.micro.law_tables import LawValue, PressureGapLaw, PressureTable
 from multiscale.micro.zones import Zone
 
@@ -109,7 +109,7 @@ class LawSpec:
     hardness: float | None = None
 
     def __post_init__(self):
-        check_instance("kernel", self.kernel, Kernel, "the micro solids' Kernel (e.g. HalfSpace)")
+        check_kernel("kernel", self.kernel, thermal=False)
         check_positive("p_max", self.p_max)
         if self.hardness is not None and not check_positive("hardness", self.hardness) > self.p_max:
             raise InputError("p_max", self.p_max, f"the top node must lie below the hardness {self.hardness:.3g} Pa")

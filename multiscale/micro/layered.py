@@ -28,6 +28,7 @@ positive into the solid; ``compliance(q)`` is F(q) = w_z / p (thesis F11 = -q F,
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import ClassVar
 
 import numpy as np
 from scipy.interpolate import CubicSpline
@@ -428,6 +429,7 @@ class LayeredThermal(LayeredKernel):
     thickness: tuple
     kappa: tuple
     substrate_kappa: float = np.inf
+    thermal: ClassVar[bool] = True
 
     def __post_init__(self):
         h = _as_tuple("thickness", self.thickness)
