@@ -167,3 +167,11 @@ def test_the_surfaces_fed_to_the_solver_check_sizes_and_seeds(kwargs, name):
     assert info.value.name == name
     assert fractal_surface(16, 1e-3, 0.8, 2, 4, 1e-6, seed=np.int64(3), batch=3).heights.shape == (3, 16, 16)
     assert fractal_surface(16, 1e-3, 0.8, 2, 4, 1e-6, seed=np.random.SeedSequence([3, 1])).heights.shape == (16, 16)
+
+
+def test_an_initial_pressure_of_another_grid_names_the_heights_shape():
+    """It said "must broadcast to the batch's shape (64, 64), one value per patch" of a (32, 32)
+    start for one 64² patch, whose batch shape is () (a user trial)."""
+    h = fractal_surface(16, 1e-4, 0.8, 1, 4, 1e-7, seed=3).heights
+    with pytest.raises(InputError, match=r"must broadcast to the heights' shape \(16, 16\), one value per cell$"):
+        ContactSolver(E, (16, 16), 1e-4 / 16).solve(h, load=1e6, initial_pressure=np.ones((8, 8)))

@@ -187,6 +187,7 @@ CASES = [
      dict(kernel_1=E), "kernel_1"),
     (lambda **k: SeriesKernel(**{**dict(first=E, second=E), **k}), dict(second=THERMAL[1]), "second"),
     (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(kernel=THERMAL[0]), "kernel"),
+    (lambda **k: AsperityModel.from_surface(**{**dict(surface=S, solid=E), **k}), dict(solid=THERMAL[0]), "solid"),
     # zone laws
     (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(kernel="steel"), "kernel"),
     (lambda **k: LawSpec(**{**dict(kernel=E, p_max=1e6), **k}), dict(n_points=4.5), "n_points"),

@@ -3,14 +3,14 @@
 A rough surface is a set of paraboloidal summits (``AsperityTable`` from
 ``surface.find_asperities``) pressed by a rigid flat moved down by ``delta`` from the first touch of
 the highest summit. Summit k (height z_k) is asked to move ``delta_k = delta − (z_M − z_k)``
-(Eqs. 1.6, 2.20). The four models of the thesis are
+(Eqs. 1.6, 2.20). The four models of the thesis, numbered as in §1.3 (and ``demos/ch1_asperity_models.py``):
 
-1. circular, no interaction (Eqs. 1.6–1.9, F1 = A1 = 1, R = sqrt(R1 R2));
-2. elliptic, no interaction (Eqs. 1.1–1.8, F1(e), A1(e));
-3. circular with interaction (Eqs. 1.10–1.12; Ciavarella-type);
-4. elliptic with interaction (Eqs. 1.16–1.23).
+1. elliptic with interaction (Eqs. 1.16–1.23);
+2. circular with interaction (Eqs. 1.10–1.12; Ciavarella-type);
+3. elliptic, no interaction (Eqs. 1.1–1.8, F1(e), A1(e));
+4. circular, no interaction (Eqs. 1.6–1.9, F1 = A1 = 1, R = sqrt(R1 R2)).
 
-Models 3–4 add the surface displacement of every other contact at each summit (Eqs. 1.10, 1.23,
+Models 1–2 add the surface displacement of every other contact at each summit (Eqs. 1.10, 1.23,
 2.19) and are solved by the kinematic (Eq. 1.12) or the energy (§4.2.2) route of
 ``asperity_interaction``. A summit lying inside the (non-interacting) contact ellipse of a higher
 summit — twin peaks, ~1 % of the summits of a fractal surface — would make both problems ill-posed

@@ -36,7 +36,7 @@ from abc import ABC, abstractmethod
 import numpy as np
 
 from multiscale.errors import InputError, check_flag, check_positive
-from multiscale.micro.kernels import HalfSpace
+from multiscale.micro.kernels import HalfSpace, Kernel
 from multiscale.micro.surface import AsperityTable
 from multiscale.references.hertz import axis_ratio_squared, exterior_lambda, potential_integrals
 
@@ -249,9 +249,12 @@ class HertzElliptic(_HalfSpaceLaw):
 def hertz_law(table: AsperityTable, solid, shape: str = "elliptic", *, exact: bool = True) -> AsperityLaw:
     """Hertz law of the asperities of ``table`` on a homogeneous ``solid`` (``HalfSpace`` or E* [Pa]).
 
-    ``shape="circular"``: radius R = sqrt(R1 R2) (models 1 and 3); ``"elliptic"``: models 2 and 4.
+    ``shape="circular"``: radius R = sqrt(R1 R2) (models 2 and 4 of §1.3); ``"elliptic"``: models 1 and 3.
     """
     check_table(table)
+    if isinstance(solid, Kernel) and not isinstance(solid, HalfSpace):   # (it said "must be a real number": a trial)
+        raise InputError("solid", solid, "a HalfSpace or its E* [Pa] (the Hertz laws are of a homogeneous elastic "
+                                         "half-space; layered solids: layered_asperity.layered_law)")
     E_star = solid.E_star if isinstance(solid, HalfSpace) else check_positive("solid", solid)
     if not isinstance(shape, str) or shape not in ("circular", "elliptic"):
         raise InputError("shape", shape, "'circular' or 'elliptic'")

@@ -205,7 +205,7 @@ class ContactSolver:
                                  + "; with a hardness it has)")
         p0 = None
         if initial_pressure is not None:
-            p0 = _batch_values("initial_pressure", initial_pressure, h.shape)
+            p0 = _batch_values("initial_pressure", initial_pressure, h.shape, cells=True)
             if np.any(p0 < 0) or not np.all(np.isfinite(p0)):
                 raise InputError("initial_pressure", "array", "must be finite and >= 0")
         if target is not None and np.any(target == 0):   # unloaded: touching at the highest point (a sweep from 0)
@@ -226,7 +226,7 @@ class ContactSolver:
         if zero.all():
             return result
         p0, upper = options.pop("initial_pressure"), options.pop("hardness")
-        p0 = None if p0 is None else _batch_values("initial_pressure", p0, h.shape)[~zero]
+        p0 = None if p0 is None else _batch_values("initial_pressure", p0, h.shape, cells=True)[~zero]
         upper = None if upper is None else _batch_values("hardness", upper, load.shape)[~zero]
         loaded = self.solve(h[~zero], load=load[~zero], initial_pressure=p0, hardness=upper, **options)
         for k, a in vars(loaded).items():
@@ -478,14 +478,18 @@ def _writable(a: np.ndarray) -> np.ndarray:
     return a if a.flags.writeable else a.copy()
 
 
-def _batch_values(name: str, value, shape) -> np.ndarray:
-    """``value`` as a float array broadcast to ``shape``, else ``InputError`` naming it."""
+def _batch_values(name: str, value, shape, cells: bool = False) -> np.ndarray:
+    """``value`` as a float array broadcast to ``shape`` (the batch's, or with ``cells`` the
+    heights'), else ``InputError`` naming it."""
     a = np.asarray(value)
     if a.dtype.kind not in "iuf":
         raise InputError(name, value, "must be a number or an array of numbers")
     try:
         return np.broadcast_to(a.astype(float), shape)
     except ValueError:
+        if cells:                # (it said "the batch's shape (64, 64), one value per patch": a user trial)
+            raise InputError(name, f"array of shape {a.shape}", f"must broadcast to the heights' shape {shape}, one "
+                             "value per cell") from None
         sweep = " (a sweep on one patch: its heights broadcast to the values' shape, " \
                 "np.broadcast_to(h, (n, ny, nx)))" if not shape else ""
         raise InputError(name, f"array of shape {a.shape}", f"must broadcast to the batch's shape {shape}, one "
