@@ -15,6 +15,7 @@ pressure [Pa] positive in compression; sliding distance [m].
 """
 from __future__ import annotations
 
+import itertools
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -253,7 +254,7 @@ def simulate_wear(surface: Surface, contact: Kernel | ContactSolver, *, load, mu
         steps_iter = tqdm(steps_iter, desc="wear steps", unit="step")
     overshoot, from_flat = 0.0, False        # largest step relief over the RMS height it started from, and whether
     #                                          that surface was flat to round-off (a flat punch)
-    for j in [0, *steps_iter]:
+    for j in itertools.chain([0], steps_iter):       # (a list drew the bar before the steps: 150 000 step/s)
         if j > 0:
             rms = np.std(current.heights, axis=(-2, -1))
             increment = wear_step(current, p, rate, mu, dS, T)
