@@ -331,9 +331,8 @@ def surface_memory(shape) -> float:
 
 def _modes(args) -> int:
     """Pair the modes of two squeal runs by MAC: a table, and the matrix as CSV or a figure."""
-    from multiscale.plots import figure_problem   # local: as the figures themselves, only where drawn
-    if args.csv and (why := "a folder: give a file name" if Path(args.csv).is_dir() else
-                     f"no folder {Path(args.csv).parent}" if not Path(args.csv).parent.is_dir() else None):
+    from multiscale.plots import figure_problem, path_problem   # local: as the figures themselves, where drawn
+    if args.csv and (why := path_problem(Path(args.csv))):
         raise InputError("--csv", args.csv, f"cannot write the table there: {why}")   # (after the work: a user trial)
     if args.figure and (why := figure_problem(Path(args.figure))):
         raise InputError("--figure", args.figure, f"cannot write the figure there: {why}")

@@ -49,6 +49,7 @@ from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, 
 from multiscale.memory import memory_available, micro_memory, remedy, run_memory
 from multiscale.scene_friction import bare_interfaces, initial_friction, speed_law_guess
 from multiscale.scene_geometry import scene_spec
+from multiscale.workflows.strain import last_forces
 
 
 def friction_coefficient(scene, interface: str) -> float:
@@ -220,10 +221,16 @@ def say_clamp(scene, history) -> None:
     record) and the torque; the run finds it (T = mu F r), check cannot (said nowhere: a user trial)."""
     if scene.loading.torque is None:
         return
-    each = {n: abs(float(history[f"interface_force_{n}"][-1])) for n in scene.geometry.spec.interfaces
-            if f"interface_force_{n}" in history} or {"the interface": abs(float(history["interface_force"][-1]))}
+    each = last_forces(scene, history) or {"the interface": abs(float(history["interface_force"][-1]))}
     forces = ", ".join(f"{f:.4g} N on {n}" for n, f in each.items()) if max(each.values()) > 0 else "none (released)"
     reporter().say(f"  clamp: {forces} at the start, for the braking torque {scene.loading.torque:.4g} N m")
+
+
+def global_dofs(functions) -> int:
+    """The dofs of ``functions`` (DOLFINx Functions) over every rank (collective-free: the index maps
+    know their global sizes)."""
+    return sum(f.function_space.dofmap.index_map.size_global * f.function_space.dofmap.index_map_bs
+               for f in functions)
 
 
 def say_model_size(tm, mechanics, thermal=None, kind: str = "transient", modes: int = 0, points: int = 0) -> None:
@@ -233,14 +240,10 @@ def say_model_size(tm, mechanics, thermal=None, kind: str = "transient", modes: 
     machines of its ranks have free (``memory.run_memory``; a squeal run of ~1M dofs was checked OK and would take ~40 GB: a user
     trial), with a multiscale loop's zones of ``points`` grid points in all (``memory.micro_memory``).
     Collective: global counts."""
-    def count(functions) -> int:
-        return sum(f.function_space.dofmap.index_map.size_global * f.function_space.dofmap.index_map_bs
-                   for f in functions)
-
     def spaced(n: int) -> str:
         return f"{n:,}".replace(",", " ")
-    n = count(mechanics.u)
-    heat = f", {spaced(count(thermal.T))} temperature dofs" if thermal is not None else ""
+    n = global_dofs(mechanics.u)
+    heat = f", {spaced(global_dofs(thermal.T))} temperature dofs" if thermal is not None else ""
     reporter().say(f"  model: {spaced(tm.parent.topology.index_map(tm.parent.topology.dim).size_global)} cells, "
                    f"{spaced(n)} displacement dofs{heat}")
     comm = tm.comm

@@ -51,8 +51,8 @@ from multiscale.macro.preload import Preload, linearise_system, preload
 from multiscale.macro.stability_map import StabilityMap
 from multiscale.scene_friction import bare_interfaces, curve_left
 from multiscale.workflows import squeal_map
-from multiscale.workflows.model import build_mechanics, build_mesh, drive, friction_coefficient, interface_forces, \
-    say_load, say_model_size, speed_law
+from multiscale.workflows.model import build_mechanics, build_mesh, drive, friction_coefficient, global_dofs, \
+    interface_forces, say_load, say_model_size, speed_law
 from multiscale.workflows.output import RunResult, prepare_folder
 from multiscale.workflows.rough import build_rough_interface
 from multiscale.workflows.strain import idle_holder, overloaded, unloaded
@@ -175,7 +175,7 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     name = name or scene.name
     prefix = "squeal_" + "".join(ch if ch.isalnum() else "_" for ch in name) + "_"
     mech = build_squeal_mechanics(scene, tm, degree=degree, prefix=prefix)
-    dofs = sum(u.function_space.dofmap.index_map.size_global * u.function_space.dofmap.index_map_bs for u in mech.u)
+    dofs = global_dofs(mech.u)
     if st.modes is not None and st.modes > dofs:     # (said after the preload, with a memory warning: a trial)
         mech.close()
         raise InputError("stability.modes", st.modes, f"must not exceed the number of dofs ({dofs})")

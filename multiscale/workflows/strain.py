@@ -64,24 +64,31 @@ def refuse_floating(scene, tm, history) -> None:
         raise error
 
 
-def unloaded(forces: Mapping[str, float]) -> list[str]:
-    """The interfaces whose largest normal force [N] (``forces``, per interface) stayed below
-    ``UNLOADED`` times the largest one's: nothing presses them (a pad whose load face was put on the
-    disc ran at 7e-12 N beside two loaded pads, silently: an adversarial test)."""
+def idle(forces: Mapping[str, float]) -> tuple[dict[str, float], float]:
+    """The interfaces whose normal force [N] (``forces``, per interface) stayed below ``UNLOADED``
+    times the largest one's, and that largest force: nothing presses them."""
     top = max(forces.values(), default=0.0)
+    return {n: f for n, f in forces.items() if top > 0 and f < UNLOADED * top}, top
+
+
+def unloaded(forces: Mapping[str, float]) -> list[str]:
+    """The warnings of the interfaces ``idle`` finds in ``forces`` (their largest normal forces
+    [N]; a pad whose load face was put on the disc ran at 7e-12 N beside two loaded pads, silently:
+    an adversarial test)."""
+    none, top = idle(forces)
     return [f"interface {n} carried no force ({f:.3g} N at most, against {top:.3g} N): nothing presses it; check "
-            "loading.faces and the supports" for n, f in forces.items() if top > 0 and f < UNLOADED * top]
+            "loading.faces and the supports" for n, f in none.items()]
 
 
 def idle_holder(sole_holds: Mapping[str, str], forces: Mapping[str, float]) -> InputError | None:
-    """The error if an interface that carried no force (``unloaded`` of ``forces`` [N]) is the only
+    """The error if an interface that carried no force (``idle`` of ``forces`` [N]) is the only
     thing that holds some parts (``sole_holds``: interface -> what moves without it, ``held.check_held``): a
     contact that presses nothing holds them by round-off or not at all, so a tangent built there is
     singular or not from run to run (a floating caliper loaded on the piston alone: 2 of 7 runs
     gave a 0 Hz "unstable" mode; a user trial)."""
-    top = max(forces.values(), default=0.0)
-    for name, f in forces.items():
-        if name in sole_holds and top > 0 and f < UNLOADED * top:
+    none, top = idle(forces)
+    for name, f in none.items():
+        if name in sole_holds:
             return InputError("interface", name,
                               f"it carried no force ({f:.3g} N, against {top:.3g} N), yet "
                               f"{sole_holds[name]}: unpressed, it holds them by round-off or not at all, and their "
