@@ -88,14 +88,13 @@ def _fourier_filter(surface: Surface, cut_x: float, cut_y: float) -> Surface:
     return Surface(w, surface.dx, surface.dy, periodic=surface.periodic)
 
 
-
-def roughness_of(h: np.ndarray, dx: float, dy: float, cutoff: float) -> tuple[np.ndarray, str]:
+def roughness_of(h: np.ndarray, dx: float, dy: float, cutoff: float) -> np.ndarray:
     """``h`` [m] (pixels ``dx`` x ``dy`` [m]) minus its Gaussian mean surface at λc = ``cutoff`` [m],
-    the undefined points (NaN) left out of the means: the outliers of a map that is then filtered are judged against the Sq
-    of its roughness (against the Sq before the filter, 4.5 times the roughness' on sur-2.sur at
-    λc = 0.5 mm, its pits stayed: Sku 57; a user trial); and what it is, in words."""
+    the undefined points (NaN) left out of the means: the outliers of a map that is then filtered
+    are judged against the Sq of its roughness (against the Sq before the filter, 4.5 times the
+    roughness' on sur-2.sur at λc = 0.5 mm, its pits stayed: Sku 57; a user trial)."""
     defined = np.isfinite(h)
     means = [gaussian_filter(Surface(a, dx, dy, periodic=False), cutoff).heights
              for a in (np.where(defined, h, 0.0), defined.astype(float))]
     with np.errstate(invalid="ignore", divide="ignore"):
-        return np.where(defined, h - means[0] / means[1], np.nan), f"of the roughness at λc = {cutoff * 1e3:.4g} mm"
+        return np.where(defined, h - means[0] / means[1], np.nan)

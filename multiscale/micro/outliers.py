@@ -67,8 +67,8 @@ class Outliers:
         """What they are: "points deviating from the median of ... (Sq 13.8 nm without them), up to -89 Sq"."""
         side = 2 * HALO + 1
         return (f"point{'s' if self.count != 1 else ''} deviating from the median of their {side} x {side} "
-                f"neighbourhood by more than {self.k:g} Sq (Sq {self.sq * 1e9:.3g} nm{' ' * bool(self.sq_of)}{self.sq_of} "
-                f"without them), up to "
+                f"neighbourhood by more than {self.k:g} Sq (Sq {self.sq * 1e9:.3g} nm"
+                f"{f' {self.sq_of}' if self.sq_of else ''} without them), up to "
                 f"{self.largest / self.sq:+.3g} Sq ({self.largest * 1e9:+.4g} nm)")
 
     def gradient_share(self, heights: np.ndarray, dx: float, dy: float) -> float:
@@ -112,8 +112,8 @@ def find_outliers(heights: np.ndarray, k: float = DESPIKE, scale: np.ndarray | N
     """The outliers (module docstring) of ``heights`` [m] (ny, nx), NaN where undefined (never
     outliers; left out of the medians), at ``k`` times the Sq of the other heights, or of the other
     points of ``scale`` [m] (the same map's roughness, when a waviness filter follows: its Sq and
-    moments are the statistics'; ``sq_of`` says so). In row blocks with a halo of ``HALO`` rows: no temporaries of the
-    map's size."""
+    moments are the statistics'; ``sq_of`` says so). In row blocks with a halo of ``HALO`` rows: no
+    temporaries of the map's size."""
     of = heights if scale is None else scale
     count, mean, (squares, *absolute) = defined_sums(of, (2, 3, 4))   # |h - mean|^2, ^3, ^4 summed
     sq = np.sqrt(squares / count)

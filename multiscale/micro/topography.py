@@ -88,7 +88,9 @@ def _outlier_notes(m: Measurement, detrend: str, cutoff: float | None, prefix: s
 def _outliers(h: np.ndarray, m: Measurement, k: float, cutoff: float | None):
     """``find_outliers`` of the heights ``h`` [m] of ``m`` at k Sq: of the roughness at λc = ``cutoff``
     [m] when a waviness filter follows (``filters.roughness_of``)."""
-    return find_outliers(h, k, *(() if cutoff is None else roughness_of(h, m.dx, m.dy, cutoff)))
+    if cutoff is None:
+        return find_outliers(h, k)
+    return find_outliers(h, k, roughness_of(h, m.dx, m.dy, cutoff), f"of the roughness at λc = {cutoff * 1e3:.4g} mm")
 
 
 def _form_only(m: Measurement, flattened: np.ndarray) -> str | None:
