@@ -33,7 +33,7 @@ from multiscale.outputs import summary as plan_summary
 from multiscale.provenance import versions
 from multiscale.scene import load
 from multiscale.scene_plain import pixel_problem, plain
-from multiscale.scene_summary import cells_line, memory_line, modes_problem, reference, summary
+from multiscale.scene_summary import cells_line, memory_line, modes_problem, reference, summary, table_reference
 from multiscale.units import UnitError, to_si
 
 DESCRIPTION = """Multi-scale thermo-mechanical simulation of frictional sliding contacts (disc brakes,
@@ -67,8 +67,10 @@ def _info(args) -> int:
 
 def _check(args) -> int:
     """Validate scene files: a short summary for a good one, every problem of a bad one."""
-    if args.keys:
-        print("\n".join(reference()))
+    if args.keys is not None:
+        if args.keys.endswith(".toml"):             # check --keys SCENE: the format, then the scene
+            args.scenes, args.keys = [args.keys, *args.scenes], ""
+        print("\n".join(table_reference(args.keys) if args.keys else reference()))
     elif not args.scenes:
         raise MultiscaleError("multiscale check: give scene file(s), or --keys for the scene format")
     failed = 0
@@ -418,7 +420,8 @@ def build_parser() -> argparse.ArgumentParser:
                            description="Validate scene files without running them: every problem at once, "
                            "or a summary of what a run computes and the files it writes.")
     check.add_argument("scenes", nargs="*", metavar="SCENE", help="scene TOML file(s)")
-    check.add_argument("--keys", action="store_true", help="print the scene format: every section and key")
+    check.add_argument("--keys", nargs="?", const="", metavar="TABLE", help="print the scene format: every "
+                       "table and key; with a TABLE (e.g. loading, materials), that table with what its keys do")
     check.add_argument("--cells", action="store_true", help="estimate the mesh's cell count and memory (trial "
                        "meshes, seconds) and check that the supports hold every part, as run does at meshing")
     check.add_argument("--set", **SET)

@@ -445,7 +445,8 @@ def too_many_cells(estimate: CellEstimate, max_cells: int) -> InputError:
         f"about {estimate.cells:.3g} cells (a trial mesh {estimate.factor:.3g}x coarser has {estimate.trial})"
     return InputError("geometry.max_cells", max_cells,
                       f"the mesh would have {size}: coarsen the geometry's mesh sizes (geometry.mesh_size "
-                      "and the other *mesh_size), or allow it with geometry.max_cells or multiscale run --max-cells")
+                      "and the other *mesh_size), or allow it with the scene key geometry.max_cells (also "
+                      "multiscale run --max-cells)")
 
 
 # ---- gmsh helpers shared by the builders (model is ``gmsh.model``) ----------------------------

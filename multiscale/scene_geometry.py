@@ -252,8 +252,11 @@ def parameter_kind(module, name: str) -> str:
 
 
 class GeometrySection(Section):
-    """[geometry]: ``builder`` picks a registered builder, whose DEFAULTS are the allowed keys; or
-    ``file`` gives the user's geometry (``FileGeometry``)."""
+    """[geometry]: ``builder`` picks a built-in geometry (pin_on_disc, disc_brake, block_on_flat),
+    whose parameters (lengths in m, SI defaults below) are the allowed keys, ``mesh_size`` and the
+    other ``*_mesh_size`` the cell sizes; or ``file`` gives the user's own geometry (CAD or gmsh:
+    the keys under file = "..."). ``max_cells`` bounds the mesh, ``axis`` turns a rotating body the
+    other way."""
 
     def __init__(self):
         super().__init__(Geometry)

@@ -370,7 +370,12 @@ class Loading:
 
 @dataclass(frozen=True)
 class Time:
-    """Staggered time loop (Fig. 7.4): ``steps`` macro steps Δt over ``end``, each in ``substeps``."""
+    """Staggered time loop (Fig. 7.4): ``steps`` macro steps Δt = ``end``/``steps`` from t = 0 to
+    ``end``. Each macro step solves the heat conduction (backward Euler) in ``substeps`` heat steps
+    of Δt/``substeps``, the contact solved again after each where the load, the friction or the
+    expansion changed; a rough scene's zone laws, heat partition and wear are updated once per
+    macro step. ``initial_temperature``: every body's uniform temperature at t = 0, and the
+    reference of thermal expansion."""
 
     end: float | None = key(Quantity("time", gt=0, plausible=(1e-6, 1e6)), needed_by=("thermal", "wear"))  # s
     steps: int = key(Integer(ge=1, le=10**6), default=1)        # (1e9 steps: check's plan took ~30 min)
@@ -385,7 +390,12 @@ class Time:
 
 @dataclass(frozen=True)
 class Output:
-    """Where and what to write."""
+    """Where and what to write. ``folder``: the results folder (a relative path from the scene
+    file's folder; a run refuses a folder holding results unless --overwrite or --resume).
+    ``fields``: the fields of the ParaView files (XDMF), written at t = 0, every ``every`` macro
+    steps and at the end. ``figures``: the PNG figures (false: their data files only).
+    ``repeatable``: the macro Newton renews its factors by count instead of measured time, so that
+    serial runs repeat bit for bit (regression checks)."""
 
     folder: Path | None = key(FilePath(folder=True), absent="results/<name> next to the scene file")
     every: int = key(Integer(ge=1), default=1)            # write fields every n macro steps
@@ -569,7 +579,9 @@ class Wear:
 
 @dataclass(frozen=True)
 class Layer:
-    """One layer of [[layers.layer]] (top first): thickness, elastic constants, conductivity (conductance)."""
+    """One layer of [[layers.layer]] (top first), bonded to the next: its ``thickness``, Young's
+    modulus ``E`` and Poisson ratio ``nu`` (the micro contact's layered kernel, ch. 2), and its
+    conductivity ``kappa`` (effect "conductance": the layered conduction kernel, §5.3)."""
 
     thickness: float = key(Quantity("length", gt=0, plausible=(1e-9, 0.1)), required=True)  # m
     E: float = key(MODULUS, required=True)                                   # Pa

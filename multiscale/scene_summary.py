@@ -3,6 +3,7 @@ from __future__ import annotations
 
 import json
 import math
+import textwrap
 
 from multiscale.geometry import CellEstimate, estimate_cells
 from multiscale.held import check_held
@@ -11,9 +12,11 @@ from multiscale.outputs import CHECKPOINT, analysis
 from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
 from multiscale.scene_friction import FRICTION, bare_interfaces
-from multiscale.scene_geometry import scene_spec
+from multiscale.scene_geometry import GeometrySection, scene_spec
 from multiscale.scene_rough import default_p_max, scene_surface_used
 from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR, P_MAX_PLASTIC
+from multiscale.errors import InputError
+from multiscale.schema import Named, Section, fields_of, suggest
 from multiscale.schema import reference as schema_reference
 
 
@@ -23,9 +26,40 @@ def reference() -> list[str]:
                for name, e in EFFECTS.items()]
     fields = [f"  {name:<18} needs {', '.join(needs) or 'nothing'}" for name, needs in OUTPUT_FIELDS.items()]
     return (["Scene file (TOML). Values: SI numbers or unit strings (\"4 GPa\", \"200 rpm\", \"20 degC\").",
+             "What a table's keys do: multiscale check --keys TABLE (e.g. loading, materials, roughness).",
              "", "effects:"] + effects + ["", "output.fields:"] + fields + ["", "top level:"]
             + schema_reference(Scene))
 
+
+
+def tables(cls=Scene, path: str = "") -> dict:
+    """{dotted path of every table of the scene format ("loading.vehicle"): (its parser, that path,
+    the path its keys are shown under: "materials.<name>")}."""
+    out = {}
+    for name, spec in fields_of(cls):
+        if isinstance(spec.parser, Section):
+            where = f"{path}.{name}" if path else name
+            shown = where + (".<name>" if isinstance(spec.parser, Named) else "")
+            out[where] = (spec.parser, where, shown)
+            out.update(tables(spec.parser.cls, shown))
+    return out
+
+
+def table_reference(name: str) -> list[str]:
+    """One table of the scene format with what its keys do (``multiscale check --keys loading``):
+    its text (the dataclass' docstring, the scene reference page's), then its keys as ``reference``
+    lists them. ``name``: a dotted table path, brackets allowed ("[loading]"); InputError otherwise."""
+    known = tables()
+    key = name.strip().strip("[]").replace(".<name>", "")
+    if key not in known:
+        raise InputError("--keys", name, "not a table of the scene format" + suggest(key, known)
+                         + f"; the tables: {', '.join(known)}")
+    parser, where, shown = known[key]
+    doc = " ".join(((GeometrySection if isinstance(parser, GeometrySection) else parser.cls).__doc__ or "").split())
+    doc = doc.replace("``", "").removeprefix(f"[{shown}]: ")
+    text = textwrap.fill(doc, 100, initial_indent="  ", subsequent_indent="  ")
+    keys = parser.reference(where) if hasattr(parser, "reference") else schema_reference(parser.cls, shown)
+    return [f"[{shown}]", text, ""] + keys
 
 
 def _toml(value) -> str:

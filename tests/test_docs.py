@@ -9,7 +9,7 @@ import pytest
 from multiscale.reference_docs import key_paths, scene_rst, study_rst
 from multiscale.schema import Section, fields_of
 from multiscale.scene import EFFECTS, OUTPUT_FIELDS, Scene
-from multiscale.scene_summary import reference
+from multiscale.scene_summary import reference, table_reference, tables
 
 
 def _all_keys(cls, seen=None):
@@ -60,6 +60,27 @@ def test_check_keys_and_the_generated_reference_name_the_same_keys():
     assert "``geometry.builder``" in text and "``geometry.max_cells``" in text
     builders = re.findall(r'^builder = "\w+"\n~+\n\n(.*)$', text, re.M)
     assert len(builders) == 3 and all(b.endswith(".") for b in builders), builders
+
+
+def test_check_keys_of_a_table_says_what_its_keys_do(tmp_path, capsys):
+    """`check --keys TABLE` prints the table's text before its keys (check --keys gave a key's type
+    and range only, not what it does: a user trial); every table has a text; a misspelt table is
+    named with the nearest; `check --keys SCENE` still checks the scene after the format."""
+    from multiscale.cli import main
+    assert main(["check", "--keys", "loading"]) == 0
+    out = capsys.readouterr().out.splitlines()
+    assert out[0] == "[loading]" and "ramp_steps: the first contact solve" in " ".join(out[1:out.index("")])
+    assert any(re.match(r" +ramp_steps +an integer >= 1", line) for line in out)
+    for name in tables():
+        lines = table_reference(name)
+        assert len(lines[1].split()) >= 10 and lines[2] == "" and len(lines) > 3, name
+    assert table_reference("[materials.<name>]") == table_reference("materials")
+    assert main(["check", "--keys", "loadng"]) == 2
+    assert 'not a table of the scene format (did you mean "loading"?)' in capsys.readouterr().err
+    scene = tmp_path / "s.toml"
+    scene.write_text((Path(__file__).parents[1] / "demos" / "pin_on_disc.toml").read_text())
+    assert main(["check", "--keys", str(scene)]) == 0
+    assert capsys.readouterr().out.rstrip().endswith(f"{scene}: OK")
 
 
 def test_an_optional_key_without_default_says_what_its_absence_means():

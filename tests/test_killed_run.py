@@ -208,6 +208,26 @@ def test_field_times_after_the_checkpoint_are_dropped_and_written_once(base, tmp
     assert sorted(f.name for f in again.files) == sorted(f.name for f in result.files) == sorted(plan(scene).files)
 
 
+def test_a_stop_between_output_times_writes_its_fields_and_a_resume_drops_them(base, monkeypatch):
+    """Ctrl-C after step 1 of a run writing fields every 2 steps: ParaView's files hold the state at
+    the stop (they held only the output times: a user trial), and the resumed run drops it, ending
+    with the field times of an uninterrupted run."""
+    from multiscale.errors import Interrupted
+    from multiscale.io import StepStop
+    from multiscale.workflows.multiscale import run
+    folder = base / "every2" / "out"
+    scene = loads(scene_text(folder), overrides={"output.every": 2})
+    every = list(plan(scene).times)
+    assert every == [0.0, 1.2, 2.4]
+    with monkeypatch.context() as patch:
+        patch.setattr(StepStop, "requested", lambda self: True)
+        with pytest.raises(Interrupted, match="after step 1 of 4"):
+            run(scene, verbose=False)
+    assert all(t == [0.0, 0.6] for t in field_times(folder).values())
+    assert run(scene, resume=True, verbose=False).steps_done == 4
+    assert all(t == every for t in field_times(folder).values())
+
+
 def test_a_run_stopped_before_its_first_step_is_not_advised_to_resume(tmp_path, capsys, monkeypatch):
     """Ctrl-C before the first macro step ended (no checkpoint) advises running again, not --resume;
     a --resume there says why and leaves the folder as it was. Before: 'multiscale run --resume

@@ -425,7 +425,10 @@ class SteadyHeating:
     """Steady sliding contact with remote temperatures (§6.5), tables built once per (grid, speed).
 
     Body 1 slides at constant ``speed`` [m/s] along ``angle`` [rad from +x] (a ``Rotation`` is
-    replaced by the translation of its patch centre: far axis); body 2 is fixed.
+    replaced by the translation of its patch centre: far axis); body 2 is fixed. At ``speed`` 0
+    no frictional heat enters: ``solve`` gives the conduction between the remote temperatures
+    through the contact (``heat_1`` = −``heat_2``, Holm's constriction), and the partitions, Φ_1/Φ
+    with Φ = 0, are NaN: undefined (``partition_law`` refuses a speed of 0).
     """
 
     def __init__(self, shape, dx: float, body1: ThermalMaterial, body2: ThermalMaterial, speed: float,

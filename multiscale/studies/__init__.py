@@ -35,7 +35,8 @@ metrics when read: a misspelt history metric, corrected, is read from the same r
 
 Output: ``results.csv`` and ``results.h5`` (one row per run; a column's SI unit, a swept
 parameter's included, is its ``unit`` attribute in results.h5 and in its header in results.csv,
-``wall_time [s]``), PNGs of each metric's relative error
+``wall_time [s]``; ``iterations`` is −1 where there is nothing to count: a squeal run, a run that
+failed or did not run, whose ``converged`` is false), PNGs of each metric's relative error
 |m − m_ref| / |m_ref| against wall time (Pareto front highlighted) and against each knob (against
 measured values: the metric, its measured value and where the sweep meets it), and a
 Markdown report stating the cheapest setting meeting each stated error; against a reference file

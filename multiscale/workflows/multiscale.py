@@ -12,7 +12,9 @@ else the default table; the counter-face wears when its material gives ``k_w``;
 
 Every step writes a checkpoint (``checkpoint.h5``: macro fields, zone topographies, per-zone state,
 history), so that ``multiscale run --resume`` continues a killed run and ends with the same history
-as an uninterrupted one (to solver tolerance); then the fields of output steps. Results:
+as an uninterrupted one (to solver tolerance); then the fields of output steps (a run stopped by
+Ctrl-C writes those of its last step too, dropped when it is resumed, so that the resumed series
+has the times of an uninterrupted one). Results:
 ``history.h5`` and ``history.png`` (macro), ``multiscale.png`` (both scales: Figs. 7.12, 7.14–7.18),
 ``wear_map.png`` (Fig. 7.13), ``zones.h5`` (final per-zone state) and XDMF fields (the interface adds
 per-facet stiffness, partition, wear depth, flash temperature and the counter-face's wear depth).
@@ -193,9 +195,12 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             say_clamp(scene, history)
         ms.rough.pool.progress = False
         plan = outputs.plan(scene)
+        due = done % every == 0 or done == steps                # the step's fields belong to the series
+        # resumed: the files' times up to the checkpoint's, without the fields of a stop between output times
+        keep = ms.model.time if due else np.nextafter(ms.model.time, -np.inf)
         writer = FieldOutput(ms.model, folder, plan.body_fields + plan.interface_fields, extra=ms.facet_fields(),
-                             resume_at=ms.model.time if resume else None)
-        if written < done and (done % every == 0 or done == steps):
+                             resume_at=keep if resume else None)
+        if written < done and due:
             writer.write()
             ms.mark_fields(ckpt, done, comm)
         last = steps if stop_after is None else min(steps, stop_after)
@@ -210,8 +215,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                         ms.save(ckpt, n, history)
                         write_history(history, folder, scene.name, comm, plot=False)   # readable if the run is killed
                         done, stopping = n, stop.requested()
-                        if n % every == 0 or n == steps:      # not at a stop: a resumed run's field times stay those of
-                            writer.write()                    # an uninterrupted one
+                        if n % every == 0 or n == steps or stopping:   # a stop's are dropped when resumed
+                            writer.write()
                             ms.mark_fields(ckpt, n, comm)
                     if stopping:
                         break
