@@ -125,7 +125,8 @@ def thin_heated_layers(ld, motion: str, end: float, spec, materials, T0: float,
             out.append(f"materials.{name}: the heat of the shortest braking ({t:.3g} s) reaches about sqrt(pi chi t) = "
                        f"{depth * 1e3:.2g} mm into it (chi {chi:.3g} m^2/s), less than the interface's elements "
                        f"({h * 1e3:.3g} mm): its surface temperatures come out low, about {depth / h:.0%} of the rise "
-                       f"by the phase's end (less before; 1-D estimate); geometry.{size_key} = "
+                       f"by the phase's end (1-D, under a constant flux: less before, and less under a falling flux: "
+                       f"a user trial's pad read 70 % where this said 85 %); geometry.{size_key} = "
                        f"\"{depth / 2 * 1e3:.2g} mm\" or less resolves them (this warning stops at "
                        f"{depth / RESOLVED * 1e3:.2g} mm, where they still come out a few per cent low)")
     return out

@@ -268,7 +268,8 @@ def _effect_line(scene: Scene, effect: str) -> str:
             "k_w(T) table" if w.k_w_table is not None else "k_w of its material" if scene.rough_material_wears else
             f"k_w(T) default table: {FIG_7_9_CALIBRATION}")
         both = f"; the {scene.bodies[1]} wears too (k_w of its material)" if counter.k_w is not None else ""
-        return f"Archard every {w.update_every} step(s) in {w.substeps} increment(s){both}; {rate}"
+        return (f"Archard dh = k_w mu p ds every {w.update_every} step(s) in {w.substeps} increment(s){both}; "
+                f"{rate} (per frictional work: a specific wear rate K per load is k_w = K/mu)")
 
     return EFFECTS[effect].doc
 

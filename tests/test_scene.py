@@ -904,8 +904,9 @@ def test_a_heated_layer_thinner_than_the_interfaces_elements_is_warned_about(tmp
     warned = [w for w in loads(pod, tmp_path).warnings if "reaches about" in w]
     assert warned == ["materials.pin: the heat of the shortest braking (0.1 s) reaches about sqrt(pi chi t) = 1.6 mm "
                       "into it (chi 8.3e-06 m^2/s), less than the interface's elements (2.5 mm): its surface "
-                      "temperatures come out low, about 65% of the rise by the phase's end (less before; 1-D "
-                      "estimate); geometry.interface_mesh_size = \"0.81 mm\" or less resolves them (this warning "
+                      "temperatures come out low, about 65% of the rise by the phase's end (1-D, under a constant "
+                      "flux: less before, and less under a falling flux: a user trial's pad read 70 % where this said "
+                      "85 %); geometry.interface_mesh_size = \"0.81 mm\" or less resolves them (this warning "
                       "stops at 1.8 mm, where they still come out a few per cent low)"]
     finer = pod.replace('interface_mesh_size = "2.5 mm"', 'interface_mesh_size = "0.8 mm"')
     assert not [w for w in loads(finer, tmp_path).warnings if "reaches about" in w]

@@ -366,5 +366,7 @@ def _faces_apart(scene, history) -> list[str]:
                        f"{a[row] - 273.15:.0f} degC, {body1} {b[row] - 273.15:.0f} degC at t = {history['time'][row]:g} "
                        's): without effect "conductance" nothing conducts across the interface and each face heats '
                        "by its share of the frictional heat only (the partition, a mean over the face); where the "
-                       'faces in contact should meet, add effect "conductance" (interface.conductance)')
+                       'faces in contact should meet, add effect "conductance" (interface.conductance); a '
+                       "face whose interface elements are thicker than the heat's depth reads low too (a warning "
+                       "on its material says so before the run: refine the interface mesh first)")
     return out
