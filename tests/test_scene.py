@@ -1450,7 +1450,8 @@ def test_a_wear_table_left_by_the_run_is_warned_about(tmp_path):
         "largest micro temperature)"]
     assert not [w for w in loads(own.replace('"20 degC"', '"1 K"'), tmp_path).warnings if w.startswith("wear.")]
     from multiscale.scene_summary import summary
-    assert any(line.endswith("; k_w of its material") for line in summary(loads(own, tmp_path)))
+    assert any(line.endswith("; k_w of its material (per frictional work: a specific wear rate K per load is "
+                             "k_w = K/mu)") for line in summary(loads(own, tmp_path)))
 
 
 def test_a_penalty_softer_than_the_bodies_is_warned_about(tmp_path):
