@@ -34,7 +34,7 @@ $(STAMP): pyproject.toml
 	$(BIN)/python -m pip install -q --no-compile -e '.[fem,test,docs]'
 	@touch $(STAMP)
 
-demo: $(STAMP)
+demo: $(STAMP) demos/cad/car_brake.step
 	$(BIN)/mpiexec -n $(NP) $(BIN)/multiscale run demos/pin_on_disc.toml --overwrite
 
 # The user guide is built as one more job beside the test modules (WITH=docs), then tests/mpi runs.

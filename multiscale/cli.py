@@ -406,7 +406,8 @@ def _surface(args) -> int:
 SET = dict(type=_setting, action="append", default=[], dest="settings", metavar="KEY=VALUE",
            help='a scene key\'s value over the file\'s, repeatable: time.steps=40, "loading.normal_force=300 N", '
                 "micro.zones=[4,4], output.folder=runs/a (a value TOML does not read is text; paths from the "
-                "scene file's folder); provenance.json records them")
+                "scene file's folder; loading.pressure replaces the file's normal_force, and so on for every "
+                "pair of alternatives); provenance.json records them")
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -436,7 +437,8 @@ def build_parser() -> argparse.ArgumentParser:
     again.add_argument("--overwrite", action="store_true",
                        help="delete the results of the run before (the entries its provenance.json lists) and run again")
     again.add_argument("--resume", action="store_true", help="continue from the last checkpoint in the output folder "
-                       '(the multiscale loop, effect "roughness", writes them; other runs start again)')
+                       '(the multiscale loop, effect "roughness", writes them; the other analyses refuse it: '
+                       "run them again with --overwrite)")
     run.add_argument("--set", **SET)
     run.add_argument("--quiet", action="store_true", help="no stage lines or summary (warnings and errors only)")
     run.add_argument("--max-cells", type=_count, metavar="N", help="largest mesh (cells) the run may build; "

@@ -1217,6 +1217,26 @@ def test_overrides_are_validated_like_the_file(tmp_path):
         loads(GOOD, tmp_path, overrides={"loading.friction.x": 1})
 
 
+def test_an_override_replaces_the_files_alternative_to_it(tmp_path):
+    """A key given over a file replaces the file's alternatives of the same table (its OneOf rules):
+    ``--set loading.pressure=...`` on a scene giving normal_force, a friction curve over a constant
+    friction, a fixed temperature over a boundary's convection and emissivity (each was refused,
+    "give only one of them", and --set cannot remove a key: a user trial). Both given over the file
+    are still refused."""
+    pod = (DEMOS / "pin_on_disc.toml").read_text()
+    scene = loads(pod, tmp_path, overrides={"loading.pressure": "0.375 MPa"})
+    assert (scene.loading.pressure, scene.loading.normal_force) == (375e3, None)
+    curve = loads(pod, tmp_path, overrides={"loading.friction_curve": [["0 m/s", 0.45], ["30 m/s", 0.38]]})
+    assert (curve.loading.friction, curve.loading.friction_curve[1]) == (None, (30.0, 0.38))
+    car = (DEMOS / "car_brake_stop.toml").read_text()
+    fixed = loads(car, DEMOS, overrides={"boundary[1].temperature": "100 degC"})
+    assert (fixed.boundary[0].temperature, fixed.boundary[0].convection, fixed.boundary[0].emissivity) == \
+        (373.15, None, None)
+    with pytest.raises(SceneError, match=r"give only one of them \(got normal_force, pressure\)"):
+        loads(pod, tmp_path, overrides={"loading.pressure": "0.375 MPa", "loading.normal_force": "90 N"})
+    assert loads(pod, tmp_path, overrides={"micro.grid": [16, 16]}).loading.normal_force == 200.0   # no rule
+
+
 def test_overrides_from_a_python_loop_take_numpy_values_tuples_and_paths(tmp_path):
     """A sweep written in Python passes numpy scalars (np.arange, np.linspace), tuples and Paths;
     they are read as the TOML values they stand for (np.int64(6) for time.steps was refused as
