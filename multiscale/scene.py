@@ -38,7 +38,7 @@ from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FI
                                        Micro, Output, Roughness, Time, Wear)
 from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_phases, speed_range,
                                    squeal_state, thin_heated_layers)
-from multiscale.scene_keys import alternatives, key_parts
+from multiscale.scene_keys import key_parts, replaced
 from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks, speed_law_zeros, torque_problems
 from multiscale.scene_stability import Stability, undamped_falling_law, unresolved_band
 from multiscale.scene_vehicle import Vehicle
@@ -271,8 +271,8 @@ def load(path, overrides=None) -> Scene:
     ``overrides`` maps dotted key paths to raw values applied before validation (a study's sweep:
     ``{"loading.friction": 0.2, "geometry.mesh_size": "6 mm"}``); they are validated like the file
     (numpy scalars and arrays, tuples and paths are read as the TOML values they stand for). A key
-    replaces the file's alternatives to it (``loading.pressure`` its ``normal_force``), unless they
-    are given too."""
+    replaces the file's alternatives to it and the keys used only with those (``loading.pressure``
+    its ``normal_force``; ``roughness.file`` its ``rms``, ``hurst``, ...), unless they are given too."""
     if not isinstance(path, (str, os.PathLike)):
         raise InputError("path", path, "a scene file name (str or Path)")
     path = Path(path)
@@ -315,7 +315,7 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
                              "entries (boundary[2].emissivity)" if table and all(isinstance(e, dict) for e in table) else
                              "one item of an array; give the whole array (geometry.axis = [0, 0, 1])"))
         table[last] = value
-        for other in alternatives(Scene, [*parents, last]):    # the file's alternative goes, unless also given
+        for other in replaced(Scene, [*parents, last]):        # the file's alternative goes, unless also given
             if (*parents, other) not in given:
                 table.pop(other, None)
     effects = raw.get("effects")

@@ -1,13 +1,13 @@
 """Dotted scene keys as TOML reads them (``--set``, a study's knobs): ``interfaces.inner_pad.friction``
 or with quoted parts, ``interfaces."inner_pad".friction``; an entry of an array of tables by its
 number from 1, ``boundary.2.emissivity`` or as messages name it, ``boundary[2].emissivity``; the
-alternatives a key given over a file replaces (``alternatives``)."""
+keys a key given over a file replaces (``replaced``)."""
 from __future__ import annotations
 
 import dataclasses
 import tomllib
 
-from multiscale.schema import Named, OneOf, Section, Tables, fields_of
+from multiscale.schema import Named, OneOf, OnlyWith, Section, Tables, fields_of
 
 
 def key_parts(dotted: str) -> list[str]:
@@ -29,11 +29,13 @@ def key_parts(dotted: str) -> list[str]:
     return parts if table == 0 else dotted.split(".")
 
 
-def alternatives(cls, parts: list[str]) -> tuple[str, ...]:
-    """The keys of the same table that the key at ``parts`` (``key_parts``) excludes by a ``OneOf``
-    rule of the schema ``cls`` (``loading.pressure``: ``normal_force``), so that a key given over a
-    file replaces the file's alternative (``--set loading.pressure=...`` was refused, "give only one
-    of them", with no way to remove the file's normal_force: a user trial). () where none or unknown."""
+def replaced(cls, parts: list[str]) -> tuple[str, ...]:
+    """The keys of the same table that the key at ``parts`` (``key_parts``) replaces, by the rules of
+    the schema ``cls``: its alternatives (``OneOf``: ``loading.pressure`` replaces ``normal_force``)
+    and the keys used only with those (``OnlyWith``: ``roughness.file`` replaces ``rms`` and its
+    ``hurst``, ``k_min``, ...), so that a key given over a file replaces the file's (``--set
+    loading.pressure=...`` was refused, "give only one of them", and --set cannot remove a key: a
+    user trial). () where none or the table is unknown."""
     *tables, last = parts
     k = 0
     while k < len(tables) and dataclasses.is_dataclass(cls):
@@ -44,5 +46,6 @@ def alternatives(cls, parts: list[str]) -> tuple[str, ...]:
         k += 2 if isinstance(spec.parser, (Named, Tables)) else 1      # a table's name, an entry's number
     if k != len(tables) or not dataclasses.is_dataclass(cls):
         return ()
-    return tuple(other for rule in getattr(cls, "rules", ()) if isinstance(rule, OneOf) and last in rule.keys
-                 for other in rule.keys if other != last)
+    rules = getattr(cls, "rules", ())
+    others = [o for r in rules if isinstance(r, OneOf) and last in r.keys for o in r.keys if o != last]
+    return tuple(others + [k for r in rules if isinstance(r, OnlyWith) and r.key in others for k in r.keys])

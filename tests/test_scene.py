@@ -1235,6 +1235,10 @@ def test_an_override_replaces_the_files_alternative_to_it(tmp_path):
     with pytest.raises(SceneError, match=r"give only one of them \(got normal_force, pressure\)"):
         loads(pod, tmp_path, overrides={"loading.pressure": "0.375 MPa", "loading.normal_force": "90 N"})
     assert loads(pod, tmp_path, overrides={"micro.grid": [16, 16]}).loading.normal_force == 200.0   # no rule
+    measured = str(Path(__file__).parent / "data" / "sdf-1.sdf")
+    with pytest.raises(SceneError) as info:              # rms and its hurst, k_min, k_max, patch go with it:
+        loads(pod, tmp_path, overrides={"roughness.file": measured})     # the file itself is judged (too small)
+    assert len(info.value.problems) == 1 and info.value.problems[0].startswith("roughness.cover = 'measured'")
 
 
 def test_overrides_from_a_python_loop_take_numpy_values_tuples_and_paths(tmp_path):
