@@ -22,7 +22,7 @@ from multiscale import __version__
 from multiscale.errors import InputError, MultiscaleError, OutputError, SceneError, behind
 from multiscale.geometry import too_many_cells
 from multiscale.io import CtrlCWatch, Outliving, abort, ended_together
-from multiscale.memory import memory_available, memory_limit, remedy
+from multiscale.memory import SPREAD, memory_available, memory_limit, remedy
 from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.reading import COMMAND_LINE, TopographyWarning, formats, read_topography
 from multiscale.micro.spectrum import statistics_memory, surface_statistics
@@ -104,8 +104,8 @@ def _check(args) -> int:
                 continue
             need, free = memory_line(scene, estimate), memory_available()
             print(f"{line}\n{need[0]}")
-            if free is not None and need[1] > free:    # (a ~1M-dof squeal was "OK": a user trial)
-                print(f"warning: more than the {free / 1e9:.2g} GB this machine has free: "
+            if free is not None and SPREAD * need[1] > free:    # (a ~1M-dof squeal was "OK": a user trial)
+                print(f"warning: up to {SPREAD:g} times that is near or above the {free / 1e9:.2g} GB this machine has free: "
                       f"{remedy(scene.has('stability'))}", file=sys.stderr)
             if estimate.cells > scene.geometry.max_cells:      # what run would refuse
                 print(f"error: {too_many_cells(estimate, scene.geometry.max_cells)}", file=sys.stderr)

@@ -74,16 +74,24 @@ def memory_available() -> float | None:
 
 
 # Peak memory [bytes] of a run with n displacement dofs: ranks x BASE + SCALE (n / 1e5)^(4/3), the
-# factors' fill under nested dissection in 3-D (George 1973; MUMPS orders by METIS), and for a squeal
-# run MODE_MEMORY n m for m modes asked for (the eigensolver's subspace and the modes kept). Fitted
-# to runs measured serially (peak RSS by /usr/bin/time -v, 2026-12-05, docs/performance.rst):
-# "squeal", quadratic tetrahedra, the default method, the demo car brake (35k-253k dofs, 60 modes)
-# and the built-in brake (49k-106k dofs, 40 and 100 modes), within 7 %; "transient", linear, with
-# heat (about twice as many temperature dofs), the car brake, 18k-138k dofs, within 2.4 %. Other
-# shapes fill otherwise and larger models are extrapolated: an estimate, not a bound.
-RUN_MEMORY = {"squeal": (0.56e9, 1.66e9), "transient": (0.37e9, 1.55e9)}
+# factors' fill under nested dissection in 3-D (George 1973; MUMPS orders by METIS), for a squeal run
+# MODE_MEMORY n m for m modes asked for (the eigensolver's subspace and the modes kept), and for a
+# transient run with heat HEAT_MEMORY (n_T / 1e5)^(4/3) for n_T temperature dofs, twice that where the
+# heat problem is linear (constant properties, no radiation: macro.thermal keeps double-precision LU
+# factors, the Newton's are single). Fitted to runs measured serially (peak RSS by /usr/bin/time -v,
+# docs/performance.rst): "squeal" (2026-12-05), quadratic tetrahedra, the default method, the demo car
+# brake (35k-253k dofs, 60 modes) and the built-in brake (49k-106k dofs, 40 and 100 modes), within 7 %;
+# "transient" (2026-12-05, refitted after a user trial measured the thesis pin-on-disc at 1.5x the
+# estimate: its linear heat's factors are double), the car brake (nonlinear heat) and the perfect-contact
+# pin-on-disc (linear), 8k-60k dofs, each with and without heat, -12 % to +10 %: the pin-on-disc's
+# factors fill more than the car brake's at the same dofs. Other shapes fill otherwise and larger models
+# are extrapolated: an estimate, not a bound; a run warns when SPREAD times it exceeds the free memory.
+RUN_MEMORY = {"squeal": (0.56e9, 1.66e9), "transient": (0.33e9, 1.20e9)}
 MODE_MEMORY = 89.0       # bytes a displacement dof and a mode asked for (stability.modes)
+HEAT_MEMORY = 0.36e9     # bytes per (temperature dofs / 1e5)^(4/3), single-precision factors
+HEAT_DOFS = 1.7          # temperature dofs a displacement dof (P2 in the rotating body): 1.4-1.8 measured
 DOFS_PER_CELL = {"squeal": 5.0, "transient": 0.64}     # displacement dofs per tetrahedron (the larger meshes)
+SPREAD = 1.15            # the measured runs' largest under-estimate (12 %), with a margin
 
 
 # The multiscale loop's micro part [bytes], ranks x base + per_point x its zones' grid points, fitted to
@@ -100,12 +108,15 @@ def micro_memory(points: float, ranks: int = 1) -> float:
     return ranks * base + per_point * points
 
 
-def run_memory(dofs: float, kind: str, ranks: int = 1, modes: int = 0) -> float:
+def run_memory(dofs: float, kind: str, ranks: int = 1, modes: int = 0, heat_dofs: float = 0.0,
+               linear_heat: bool = False) -> float:
     """The estimated peak memory [bytes] of a run of ``kind`` ("squeal" or "transient") with
-    ``dofs`` displacement dofs on ``ranks`` processes, a squeal run asking for ``modes`` modes
-    (``RUN_MEMORY``, ``MODE_MEMORY``)."""
+    ``dofs`` displacement dofs on ``ranks`` processes, a squeal run asking for ``modes`` modes, a
+    transient one with ``heat_dofs`` temperature dofs, their problem linear or not (``RUN_MEMORY``,
+    ``MODE_MEMORY``, ``HEAT_MEMORY``)."""
     base, scale = RUN_MEMORY[kind]
-    return ranks * base + scale * (dofs / 1e5) ** (4 / 3) + MODE_MEMORY * dofs * modes
+    heat = HEAT_MEMORY * (2 if linear_heat else 1) * (heat_dofs / 1e5) ** (4 / 3)
+    return ranks * base + scale * (dofs / 1e5) ** (4 / 3) + MODE_MEMORY * dofs * modes + heat
 
 
 def remedy(squeal: bool) -> str:

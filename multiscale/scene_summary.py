@@ -7,7 +7,7 @@ import textwrap
 
 from multiscale.geometry import CellEstimate, estimate_cells
 from multiscale.held import check_held
-from multiscale.memory import DOFS_PER_CELL, MICRO_MEMORY, RUN_MEMORY, micro_memory, run_memory
+from multiscale.memory import DOFS_PER_CELL, HEAT_DOFS, MICRO_MEMORY, RUN_MEMORY, micro_memory, run_memory
 from multiscale.outputs import CHECKPOINT, analysis
 from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
@@ -305,15 +305,28 @@ def modes_problem(scene: Scene, mesh: CellEstimate) -> str | None:
             "dofs on this mesh: the run refuses it; ask fewer (a cap: the band's modes are found up to it)")
 
 
+def linear_heat(scene: Scene) -> bool:
+    """Whether a run's heat problem is linear, as ``macro.thermal`` decides it: no radiation, the
+    bodies' rho, c, kappa and chi constants, not tables (its LU factors are then double precision)."""
+    names = {r.material for b in scene.geometry.spec.bodies for r in b.regions}
+    return not any(b.emissivity is not None for b in scene.boundary) and not any(
+        isinstance(getattr(scene.materials[n], k), tuple) for n in names if n in scene.materials
+        for k in ("rho", "c", "kappa", "chi"))
+
+
 def memory_line(scene: Scene, mesh: CellEstimate) -> tuple[str, float]:
     """The estimated peak memory of a serial run of the scene's estimated ``mesh`` (``memory.run_memory``
     of its displacement dofs: quadratic for a squeal run, three a vertex and an edge, linear
-    otherwise, three a vertex; ``DOFS_PER_CELL`` a cell where its vertices were not counted; a
+    otherwise, three a vertex; ``DOFS_PER_CELL`` a cell where its vertices were not counted; with
+    heat ``HEAT_DOFS`` temperature dofs a displacement dof, their problem ``linear_heat`` or not; a
     multiscale run adds its zones' ``memory.micro_memory``: it was left out, 0.41 GB said for
     0.55-1.75 GB measured, a user trial), and that memory [bytes]."""
     kind = "squeal" if scene.has("stability") else "transient"
     dofs = 3 * (mesh.nodes + mesh.edges * (kind == "squeal")) if mesh.nodes else DOFS_PER_CELL[kind] * mesh.cells
-    need, each = run_memory(dofs, kind, modes=scene.stability.modes if kind == "squeal" else 0), RUN_MEMORY[kind][0]
+    heat = HEAT_DOFS * dofs if kind == "transient" and scene.has("thermal") else 0.0
+    need = run_memory(dofs, kind, modes=scene.stability.modes if kind == "squeal" else 0, heat_dofs=heat,
+                      linear_heat=linear_heat(scene))
+    each = RUN_MEMORY[kind][0]
     micro = ""
     if scene.rough_interfaces and kind == "transient":
         kind, own = "multiscale", [scene.interface_settings(n) for n in scene.rough_interfaces]

@@ -62,14 +62,29 @@ def test_ulimit_v_bounds_the_memory(cgroup, monkeypatch):
 SQUEAL = [(34_851, 60, 1.162), (48_147, 60, 1.431), (80_910, 60, 2.116), (165_786, 60, 4.609),
           (252_933, 60, 7.425), (49_005, 100, 1.603), (66_804, 40, 1.794), (66_804, 100, 2.143),
           (105_963, 40, 2.934), (105_963, 100, 3.490)]
-TRANSIENT = [(17_571, 0, 0.513), (37_830, 0, 0.792), (64_668, 0, 1.265), (137_874, 0, 2.747)]
+# Transient runs (2026-12-05, 2 steps; the pin-on-disc's heat 10 steps, its peak rises 4-7 % over the
+# first): (displacement dofs, temperature dofs, heat problem linear, GB). demos/car_brake_stop.toml at
+# 12/8, 7/4, 5/3 mm (nonlinear heat: radiation, tables), with effects contact, friction alone (no
+# temperature dofs) and with its heat; demos/pin_on_disc_perfect.toml at interface/track 2.5/6, 1.5/5,
+# 1/4 mm (linear heat: a user trial measured the 1 mm one at 1.5x the car-brake fit's estimate)
+TRANSIENT = [(7_875, 11_150, False, 0.398), (7_875, 0, False, 0.367), (28_407, 46_758, False, 0.657),
+             (28_407, 0, False, 0.552), (59_703, 108_283, False, 1.211), (59_703, 0, False, 0.902),
+             (10_296, 14_690, True, 0.433), (10_296, 0, False, 0.377), (19_584, 29_674, True, 0.635),
+             (19_584, 0, False, 0.484), (39_072, 63_733, True, 1.200), (39_072, 0, False, 0.767)]
 
 
-@pytest.mark.parametrize("kind, measured, within", [("squeal", SQUEAL, 0.07), ("transient", TRANSIENT, 0.03)])
-def test_the_run_memory_estimate_meets_the_measured_peaks(kind, measured, within):
-    for dofs, modes, gb in measured:
-        assert memory.run_memory(dofs, kind, modes=modes) / 1e9 == pytest.approx(gb, rel=within)
-    assert memory.run_memory(1e5, kind, ranks=2) - memory.run_memory(1e5, kind) == memory.RUN_MEMORY[kind][0]
+def test_the_squeal_memory_estimate_meets_the_measured_peaks():
+    for dofs, modes, gb in SQUEAL:
+        assert memory.run_memory(dofs, "squeal", modes=modes) / 1e9 == pytest.approx(gb, rel=0.07)
+
+
+def test_the_transient_memory_estimate_meets_the_measured_peaks():
+    """Within -12 % (the pin-on-disc's factors fill more than the car brake's at the same dofs) and
+    +10 %; a run warns at SPREAD times the estimate, which covers the lowest."""
+    ratios = [memory.run_memory(u, "transient", heat_dofs=t, linear_heat=lin) / 1e9 / gb for u, t, lin, gb in TRANSIENT]
+    assert 0.87 < min(ratios) and max(ratios) < 1.11 and memory.SPREAD * min(ratios) > 1.0
+    for kind in ("squeal", "transient"):
+        assert memory.run_memory(1e5, kind, ranks=2) - memory.run_memory(1e5, kind) == memory.RUN_MEMORY[kind][0]
 
 
 # Peak RSS of `multiscale run`, serial (2026-12-05, docs/performance.rst): the rough pin-on-disc of a

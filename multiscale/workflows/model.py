@@ -46,7 +46,7 @@ from multiscale.macro.load_faces import load_face_areas, load_face_forces
 from multiscale.macro.mechanics import REPEATABLE_REFRESH, Mechanics
 from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
-from multiscale.memory import memory_available, micro_memory, remedy, run_memory
+from multiscale.memory import SPREAD, memory_available, micro_memory, remedy, run_memory
 from multiscale.scene_friction import bare_interfaces, initial_friction, speed_law_guess
 from multiscale.scene_geometry import scene_spec
 from multiscale.workflows.strain import last_forces
@@ -236,26 +236,29 @@ def global_dofs(functions) -> int:
 def say_model_size(tm, mechanics, thermal=None, kind: str = "transient", modes: int = 0, points: int = 0) -> None:
     """Say the size of a model, a console line: its cells, displacement dofs and (with heat)
     temperature dofs; and warn (stderr, at once) when a run of ``kind`` ("transient" or "squeal")
-    of that size (a squeal run asking for ``modes`` modes) is estimated to need more memory than the
-    machines of its ranks have free (``memory.run_memory``; a squeal run of ~1M dofs was checked OK and would take ~40 GB: a user
+    of that size (a squeal run asking for ``modes`` modes) is estimated to need, ``SPREAD`` times, more
+    memory than the machines of its ranks have free (``memory.run_memory``, with ``thermal``'s
+    temperature dofs; a squeal run of ~1M dofs was checked OK and would take ~40 GB: a user
     trial), with a multiscale loop's zones of ``points`` grid points in all (``memory.micro_memory``).
     Collective: global counts."""
     def spaced(n: int) -> str:
         return f"{n:,}".replace(",", " ")
-    n = global_dofs(mechanics.u)
-    heat = f", {spaced(global_dofs(thermal.T))} temperature dofs" if thermal is not None else ""
+    n, n_T = global_dofs(mechanics.u), global_dofs(thermal.T) if thermal is not None else 0
+    heat = f", {spaced(n_T)} temperature dofs" if thermal is not None else ""
     reporter().say(f"  model: {spaced(tm.parent.topology.index_map(tm.parent.topology.dim).size_global)} cells, "
                    f"{spaced(n)} displacement dofs{heat}")
     comm = tm.comm
     hosts = comm.allgather(MPI.Get_processor_name())
     free = comm.allgather(memory_available() if hosts.index(hosts[comm.rank]) == comm.rank else 0.0)
-    need, have = run_memory(n, kind, comm.size, modes), (None if None in free else sum(free))
+    linear = thermal is not None and not thermal.nonlinear
+    need, have = run_memory(n, kind, comm.size, modes, n_T, linear), (None if None in free else sum(free))
     need += micro_memory(points, comm.size) if points else 0.0
-    if comm.rank == 0 and have is not None and need > have:
+    if comm.rank == 0 and have is not None and SPREAD * need > have:
         machines = "this machine" if len(set(hosts)) == 1 else f"the {len(set(hosts))} machines of its ranks"
         zones = f" and {spaced(points)} zone grid points" if points else ""
         print(f"warning: a {kind} run of {spaced(n)} displacement dofs{zones} takes about {need / 1e9:.3g} GB at its peak (an "
-              f"estimate from measured runs, docs/performance.rst), more than the {have / 1e9:.3g} GB {machines} "
+              f"estimate from measured runs, docs/performance.rst; up to {SPREAD:g} times that), near or above the "
+              f"{have / 1e9:.3g} GB {machines} "
               f"has free: it may be killed without a word by the out-of-memory killer; {remedy(kind == 'squeal')}",
               file=sys.stderr, flush=True)
 
