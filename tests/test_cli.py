@@ -455,6 +455,16 @@ def test_one_process_commands_under_a_launcher_speak_once(tmp_path, capsys, monk
         assert (said in err) if said else err == "", (rank, err)
 
 
+def test_info_under_mpiexec_ends(tmp_path):
+    """`mpiexec -n 2 multiscale info` hung: rank 0 imported DOLFINx, whose PETSc start is collective,
+    while rank 1 had ended (a user trial). Every rank now loads what rank 0 loads; it speaks once."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+    bin_ = Path(sys.executable).parent
+    done = subprocess.run([str(bin_ / "mpiexec"), "-n", "2", str(bin_ / "multiscale"), "info"], capture_output=True,
+                          text=True, timeout=120, start_new_session=True)
+    assert done.returncode == 0 and done.stdout.count("fft ") == 1 and " petsc " in done.stdout, done
+
+
 def test_the_time_left_leaves_out_the_first_step(monkeypatch):
     """A first step 10 s (set-up, compilation), the others 1 s: at 2 of 11 the time left is 9 s,
     not the mean rate's 49.5 s (a long-run trial's first step took 4.5 times the later ones)."""
