@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import json
 import os
 import shlex
 import sys
@@ -217,6 +218,14 @@ def _run(args) -> int:
     return 0
 
 
+def _finished(folder: Path) -> bool:
+    """Whether the results in ``folder`` are those of a run that finished (its provenance.json)."""
+    try:
+        return str(json.loads((folder / "provenance.json").read_text()).get("status", "")).endswith("finished")
+    except (OSError, ValueError, AttributeError):
+        return False
+
+
 def _kept(scene, args, ranks: int = 1) -> str:
     """What a run interrupted by Ctrl-C leaves (``scene``: None if it was still being read), and the
     command that goes on (this environment's multiscale, under its mpiexec for ``ranks`` > 1: a user
@@ -236,6 +245,8 @@ def _kept(scene, args, ranks: int = 1) -> str:
         return f"no macro step ended, there is nothing to resume; {again}"
     if not written:
         return f"nothing was written; {again}"
+    if args.overwrite and _finished(folder):     # stopped before it replaced them (it advised --resume: an MPI trial)
+        return f"the earlier results in {folder} stay as they were; {again}"
     how = f"{command} --resume continues from the last finished step" if analysis(scene) == "multiscale" else again
     return f"what was written stays in {folder} (its provenance.json says so); {how}"
 
@@ -244,7 +255,8 @@ def _study(args) -> int:
     """Run parametric studies; every problem of every study file is reported before anything runs."""
     from multiscale.studies import problems_text, run_studies  # local: loads the numba micro modules
     if args.problems:
-        print(problems_text())
+        if launched_rank() == 0:          # once under mpiexec (every rank printed it: an MPI trial)
+            print(problems_text())
         return 0
     if not args.studies:
         raise MultiscaleError("multiscale study: give study file(s), or --problems for the problems and their keys")
@@ -260,7 +272,10 @@ def _study(args) -> int:
                              processes=args.processes, command=command)
     except KeyboardInterrupt:                # Ctrl-C: the runs that ended are recorded, the others stopped
         if comm is None or comm.rank == 0:
-            print(f"interrupted: the runs that ended are recorded; {command} runs the others", file=sys.stderr,
+            launcher = [MPIEXEC, "-n", str(comm.size)] if comm is not None and comm.size > 1 else []   # (left
+            again = shlex.join([*launcher, *COMMAND, "study", *args.studies,                        # out: an MPI
+                                *(["--report", args.report] if args.report else [])])               # trial)
+            print(f"interrupted: the runs that ended are recorded; {again} runs the others", file=sys.stderr,
                   flush=True)
         return INTERRUPTED
     except MultiscaleError:                  # raised on every rank (running: collective): one speaks
@@ -288,8 +303,10 @@ def _setting(text: str) -> tuple[str, object, str]:
     (40, 0.3, false, [4, 4], "300 N") or else the text itself (300 N, runs/a), and the text."""
     key, equals, value = text.partition("=")
     if not equals or not key.strip() or not value.strip():
-        raise argparse.ArgumentTypeError(f"{text!r}: KEY=VALUE, a scene key and its value, e.g. time.steps=40 or "
-                                         '"loading.normal_force=300 N"')
+        lack = "no value after '=' (a key cannot be removed: one given replaces the file's alternatives to it); " \
+            if equals and key.strip() else ""          # (it said only KEY=VALUE: an MPI trial)
+        raise argparse.ArgumentTypeError(f"{text!r}: {lack}KEY=VALUE, a scene key and its value, e.g. time.steps=40 "
+                                         'or "loading.normal_force=300 N"')
     try:
         read = tomllib.loads(f"value = {value}")["value"]
     except tomllib.TOMLDecodeError as exc:

@@ -218,9 +218,9 @@ class StepStop:
     FIRST = "\n{}: stopping after this step, with its results written ({})\n"
     AGAIN = {1: "Ctrl-C again is mpiexec's: it kills the job at once",
              0: "{} twice more abandons the step"}
-    HELD = ("\nCtrl-C: still finishing the step and writing its results; Ctrl-C again abandons the step "
+    HELD = ("\n{0}: still finishing the step and writing its results; {0} again abandons the step "
             "(the results written stay as they are)\n")
-    WRITING = "\nCtrl-C: held until the results being written are complete\n"
+    WRITING = "\n{}: held until the results being written are complete\n"
     taken = 0        # signals every StepStop of this process took (``CtrlCWatch`` counts them)
 
     def __init__(self, comm, done: int = 0):
@@ -252,8 +252,8 @@ class StepStop:
         if self.comm.rank == 0:          # os.write, not print: the handler may run inside a write to stderr
             name = "Ctrl-C" if signum == signal.SIGINT else signal.Signals(signum).name
             again = self.AGAIN[self.comm.size > 1 and signum == signal.SIGINT].format(name)
-            os.write(2, (self.FIRST.format(name, again) if self.count == 1 else
-                         self.HELD if self.count == 2 else self.WRITING).encode())
+            os.write(2, (self.FIRST.format(name, again) if self.count == 1 else    # (a SIGTERM was called
+                         self.HELD.format(name) if self.count == 2 else self.WRITING.format(name)).encode())  # Ctrl-C)
 
     @contextmanager
     def writing(self, step: int):

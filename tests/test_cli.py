@@ -285,6 +285,9 @@ def test_set_gives_scene_keys_over_the_files_to_check_and_run(tmp_path, capsys, 
     with pytest.raises(SystemExit) as exit_:
         main(["check", path, "--set", "loading.pressure"])
     assert exit_.value.code == 2 and "KEY=VALUE" in capsys.readouterr().err
+    with pytest.raises(SystemExit):                                       # the value left out (an MPI trial)
+        main(["check", path, "--set", "output.folder="])
+    assert "'output.folder=': no value after '=' (a key cannot be removed" in capsys.readouterr().err
     cooled = _write(tmp_path, COOLED.replace("../results/block_on_flat", "out"), "cooled.toml")
     for key in ("boundary[1].convection", "boundary.1.convection"):      # an entry of [[boundary]] (a user trial:
         assert main(["check", cooled, "--set", f"{key}=30"]) == 0          # "boundary is not a table")
@@ -463,6 +466,21 @@ def test_info_under_mpiexec_ends(tmp_path):
     done = subprocess.run([str(bin_ / "mpiexec"), "-n", "2", str(bin_ / "multiscale"), "info"], capture_output=True,
                           text=True, timeout=120, start_new_session=True)
     assert done.returncode == 0 and done.stdout.count("fft ") == 1 and " petsc " in done.stdout, done
+
+
+def test_a_stopped_study_names_the_command_that_goes_on(tmp_path, capsys, monkeypatch):
+    """Ctrl-C of a study: the command that runs the others is this environment's (with --report);
+    under a launcher's rank > 0 ``study --problems`` prints nothing (every rank printed the list: an
+    MPI trial)."""
+    from multiscale import cli, studies
+    monkeypatch.setattr(studies, "run_studies", lambda *a, **k: (_ for _ in ()).throw(KeyboardInterrupt))
+    assert main(["study", "a.toml", "--report", "rep"]) == 130
+    err = capsys.readouterr().err
+    assert f"interrupted: the runs that ended are recorded; {cli.COMMAND[-1]} study a.toml --report rep runs the " \
+        "others" in err
+    monkeypatch.setenv("PMI_SIZE", "2")
+    monkeypatch.setenv("PMI_RANK", "1")
+    assert main(["study", "--problems"]) == 0 and capsys.readouterr().out == ""
 
 
 def test_the_time_left_leaves_out_the_first_step(monkeypatch):

@@ -346,6 +346,22 @@ def test_a_second_ctrl_c_is_held_and_a_third_abandons_the_step_but_not_a_write(p
     assert signal.getsignal(signal.SIGINT) is signal.default_int_handler      # restored
 
 
+def test_a_second_sigterm_is_named_as_itself(capfd):
+    """The second SIGTERM said "Ctrl-C: still finishing the step ...; Ctrl-C again abandons the step"
+    (an MPI trial): each line names the signal that came."""
+    from mpi4py import MPI
+
+    from multiscale.io import StepStop
+    with StepStop(MPI.COMM_SELF) as stop:
+        for _ in range(2):
+            os.kill(os.getpid(), signal.SIGTERM)
+            time.sleep(0.01)
+        assert stop.requested()
+    err = capfd.readouterr().err
+    assert "SIGTERM: stopping after this step" in err and "SIGTERM again abandons the step" in err
+    assert "Ctrl-C" not in err
+
+
 def test_the_watcher_leaves_a_ctrl_c_a_step_stop_took_even_when_it_reads_it_late(monkeypatch, python_sigint):
     """``CtrlCWatch`` reads a SIGINT's wake-up byte when its thread runs, maybe after the
     ``StepStop`` that took the signal put the default handler back: it then took the signal for

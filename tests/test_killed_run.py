@@ -257,6 +257,13 @@ def test_a_run_stopped_before_its_first_step_is_not_advised_to_resume(tmp_path, 
     monkeypatch.chdir(tmp_path)
     assert main(["run", "scene.toml"]) == 130
     assert f"multiscale run {path} --overwrite starts again" in capsys.readouterr().err     # from any folder
+    # --overwrite stopped before it replaced a finished run's results: they stay, no --resume advised
+    (folder / "provenance.json").write_text('{"status": "finished"}')     # (it said "--resume continues", which
+    (folder / "checkpoint.h5").write_bytes(b"")                           # then had nothing to do: an MPI trial)
+    assert main(["run", "scene.toml", "--overwrite"]) == 130
+    err = capsys.readouterr().err
+    assert f"the earlier results in {folder} stay as they were; " in err and "--resume" not in err
+    assert main(["run", "scene.toml"]) == 130 and "--resume continues" in capsys.readouterr().err   # without it
 
 
 def test_a_damaged_field_file_says_how_to_resume(base):

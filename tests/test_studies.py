@@ -1138,6 +1138,19 @@ def test_a_scene_run_is_timed_by_its_own_record(tmp_path, monkeypatch):
     assert info.value.warnings == ("the run's",) and found == [[], []]
 
 
+def test_a_scene_run_says_its_error_once(capsys):
+    """The study's scene subprocess says a MultiscaleError as one ``Kind: message`` line (by rank 0;
+    under mpiexec each rank wrote its traceback into the run's log: a user trial) and ends with 2,
+    as ``multiscale run`` does; ``failure_line`` reads it."""
+    from multiscale.studies.scene_problem import failure_line
+    from multiscale.studies.scene_run import main
+    task = json.dumps({"scene": str(ROOT / "demos" / "block_on_flat.toml"), "overrides": {"time.end": "-1 s"}})
+    assert main(task) == 2
+    err = capsys.readouterr().err
+    assert err == 'SceneError: time.end = "-1 s": must be > 0 s (got -1 s)\n' and "Traceback" not in err
+    assert failure_line(err) == 'time.end = "-1 s": must be > 0 s (got -1 s)'
+
+
 def test_squeal_scene_metrics_from_the_mode_table(tmp_path):
     """A squeal scene's study metrics, read back from modes.csv, equal those of the eigenvalues."""
     pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")

@@ -7,17 +7,27 @@ import json
 import os
 import sys
 
+from mpi4py import MPI
+
+from multiscale.errors import MultiscaleError
 from multiscale.scene import load
 
 __all__ = ["main"]
 
 
 def main(task: str) -> int:
-    """Run the scene of ``task`` (JSON); 0 on success, an exception otherwise."""
+    """Run the scene of ``task`` (JSON); 0 on success; 2 after a ``MultiscaleError``, raised on every
+    rank, said once by rank 0 as ``Kind: message`` (every rank printed its traceback into the run's
+    log: a user trial); any other exception as it is."""
     spec = json.loads(task)
-    scene = load(spec["scene"], overrides=spec["overrides"])
-    from multiscale.workflows import run  # DOLFINx: optional, and loaded only in this subprocess
-    run(scene, overwrite=True, verbose=False)
+    try:
+        scene = load(spec["scene"], overrides=spec["overrides"])
+        from multiscale.workflows import run  # DOLFINx: optional, and loaded only in this subprocess
+        run(scene, overwrite=True, verbose=False)
+    except MultiscaleError as exc:
+        if MPI.COMM_WORLD.rank == 0:
+            print(f"{type(exc).__name__}: {exc}", file=sys.stderr)
+        return 2
     return 0
 
 
