@@ -475,6 +475,9 @@ def test_failing_and_timed_out_runs_are_recorded_and_the_rest_completes(tmp_path
                          '[sweep]\ncombine = "zip"\ngrid = [12, 16, 24]\nmax_iter = [5000, 1, 5000]') + "plots = false\n"
     path = write(tmp_path, text)
     assert main(["study", str(path)]) == 1          # runs failed: exit 1, not a user error
+    failed = [line for line in capsys.readouterr().out.splitlines() if " failed: " in line]
+    assert len(failed) == 1 and failed[0].startswith("  1 failed: ContactConvergenceError: ")
+    assert failed[0].endswith("(grid = 16, max_iter = 1)")          # which run (it said none: an MPI trial)
     rows = table(tmp_path / "results" / "hertz" / "results.csv")
     assert [r["status"] for r in rows] == ["ok", "failed", "ok"]
     assert rows[1]["message"].startswith("ContactConvergenceError: ") and "1 iterations" in rows[1]["message"]
@@ -809,7 +812,7 @@ plots = false
     assert "best of" not in (out / "study.md").read_text()       # no run completed ("best of 0 repetition(s)")
     assert main(["study", str(path)]) == 1             # recorded: the reason is said again (it was "1 failed" alone)
     assert ('\n  1 failed: metric "interface_forc:last" (did you mean "interface_force:last"?) not produced (fix '
-            "the name: the runs need not run again)\n") in capsys.readouterr().out
+            "the name: the runs need not run again) (loading.pressure = 3 MPa)\n") in capsys.readouterr().out
     path.write_text(path.read_text().replace("interface_forc:", "interface_force:"))
     capsys.readouterr()
     assert main(["study", str(path)]) == 0

@@ -62,9 +62,12 @@ def run_studies(paths, *, rerun_failed: bool = False, report_folder=None, proces
                   f"\n{study.name}: {other} other record{'s' if other > 1 else ''} in {study.folder / 'runs'} (runs "
                   "not in this study: its file changed since they ran, or another study shares the folder): kept, "
                   "not in the tables" if other else ""))
-        reasons = collections.Counter(r.record.get("error", "").split("; available:")[0] for r in rows if not r.ok)
-        for why, n in reasons.most_common():          # (before: "2 failed" alone once the runs were recorded)
-            print(f"  {n} failed: {why}")
+        reasons = collections.defaultdict(list)       # (before: "2 failed" alone once the runs were recorded)
+        for r in rows:
+            if not r.ok:
+                reasons[r.record.get("error", "").split("; available:")[0]].append(r.run.text)
+        for why, runs in sorted(reasons.items(), key=lambda item: -len(item[1])):   # which runs (an MPI trial)
+            print(f"  {len(runs)} failed: {why} ({'; '.join(runs[:3])}{'; ...' if len(runs) > 3 else ''})")
         warned = sum(bool(r.record.get("warnings")) for r in rows)
         if warned:                                    # (also of runs recorded before, not said as they ran)
             print(f"  {warned} run{'s' if warned > 1 else ''} warned of what {'they' if warned > 1 else 'it'} found "
