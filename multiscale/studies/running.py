@@ -74,7 +74,8 @@ def execute(study: Study, *, rerun_failed: bool = False, progress: bool = True, 
         mine = todo[rank::size]
         if progress and rank == 0 and mine:      # under MPI the bar follows rank 0's share (it said 2/2 of 3)
             share = f" (rank 0's of {len(todo)})" if size > 1 else ""
-            bar = tqdm(total=len(mine), desc=study.name + share, unit="run")
+            bar = tqdm(total=len(mine), desc=study.name + share, unit="run", disable=None)   # none into a file
+            #                                          (its carriage returns filled a batch job's log: an MPI trial)
         queue = list(mine)
         termination = Termination()
         lifeline = _lifeline()
