@@ -92,6 +92,11 @@ HEAT_MEMORY = 0.36e9     # bytes per (temperature dofs / 1e5)^(4/3), single-prec
 HEAT_DOFS = 1.7          # temperature dofs a displacement dof (P2 in the rotating body): 1.4-1.8 measured
 DOFS_PER_CELL = {"squeal": 5.0, "transient": 0.64}     # displacement dofs per tetrahedron (the larger meshes)
 SPREAD = 1.15            # the measured runs' largest under-estimate (12 %), with a margin
+# A stability map's peak over its single analysis' (two points' systems and modes held at once, and a
+# point's refinement): the built-in brake at 20 mm, 30 modes to 8 kHz, 1.30 GB alone; a friction map
+# ("each") of 3 and 5 points 1.72 and 1.76 GB, a speed map ("once") of 3 points 1.50 GB (2026-12-05,
+# /usr/bin/time -v, serial; a user trial measured 1.35x where check said the single analysis' figure)
+MAP_MEMORY = {"each": 1.36, "once": 1.16}
 
 
 # The multiscale loop's micro part [bytes], ranks x base + per_point x its zones' grid points, fitted to
@@ -109,14 +114,16 @@ def micro_memory(points: float, ranks: int = 1) -> float:
 
 
 def run_memory(dofs: float, kind: str, ranks: int = 1, modes: int = 0, heat_dofs: float = 0.0,
-               linear_heat: bool = False) -> float:
+               linear_heat: bool = False, sweep: str | None = None) -> float:
     """The estimated peak memory [bytes] of a run of ``kind`` ("squeal" or "transient") with
-    ``dofs`` displacement dofs on ``ranks`` processes, a squeal run asking for ``modes`` modes, a
-    transient one with ``heat_dofs`` temperature dofs, their problem linear or not (``RUN_MEMORY``,
-    ``MODE_MEMORY``, ``HEAT_MEMORY``)."""
+    ``dofs`` displacement dofs on ``ranks`` processes, a squeal run asking for ``modes`` modes, and
+    with a stability map of preload ``sweep`` ("each", "once"), a transient one with ``heat_dofs``
+    temperature dofs, their problem linear or not (``RUN_MEMORY``, ``MODE_MEMORY``, ``MAP_MEMORY``,
+    ``HEAT_MEMORY``)."""
     base, scale = RUN_MEMORY[kind]
     heat = HEAT_MEMORY * (2 if linear_heat else 1) * (heat_dofs / 1e5) ** (4 / 3)
-    return ranks * base + scale * (dofs / 1e5) ** (4 / 3) + MODE_MEMORY * dofs * modes + heat
+    one = ranks * base + scale * (dofs / 1e5) ** (4 / 3) + MODE_MEMORY * dofs * modes + heat
+    return one * MAP_MEMORY.get(sweep, 1.0)
 
 
 def remedy(squeal: bool) -> str:

@@ -324,8 +324,9 @@ def memory_line(scene: Scene, mesh: CellEstimate) -> tuple[str, float]:
     kind = "squeal" if scene.has("stability") else "transient"
     dofs = 3 * (mesh.nodes + mesh.edges * (kind == "squeal")) if mesh.nodes else DOFS_PER_CELL[kind] * mesh.cells
     heat = HEAT_DOFS * dofs if kind == "transient" and scene.has("thermal") else 0.0
+    sweep = scene.stability.sweep.preload_mode if kind == "squeal" and scene.stability.sweep else None
     need = run_memory(dofs, kind, modes=scene.stability.modes if kind == "squeal" else 0, heat_dofs=heat,
-                      linear_heat=linear_heat(scene))
+                      linear_heat=linear_heat(scene), sweep=sweep)
     each = RUN_MEMORY[kind][0]
     micro = ""
     if scene.rough_interfaces and kind == "transient":
@@ -336,6 +337,7 @@ def memory_line(scene: Scene, mesh: CellEstimate) -> tuple[str, float]:
             points = sum(math.prod(s.micro.zones) * math.prod(s.micro.grid or DEFAULT_GRID) for s in own)
             need, each = need + micro_memory(points), each + MICRO_MEMORY[0]
             micro = f"; its zones {points:,} grid points"
+    kind += " map" * bool(sweep)
     return (f"  memory    about {need / 1e9:.2g} GB at the peak of a {kind} run on one rank, each more adding about "
             f"{each / 1e9:.2g} GB (about {dofs:,.0f} displacement dofs{micro}; an estimate from measured runs, "
             "docs/performance.rst)", need)

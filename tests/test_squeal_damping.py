@@ -500,8 +500,11 @@ def test_an_each_map_narrows_its_onsets_by_full_analyses(tmp_path):
         builder, out = MapBuilder("friction", "-", st.band), text.StringIO()
         with io.Reporter(MPI.COMM_SELF, stream=out):
             _per_point(model, builder, st, NS(method="auto", basis=1.5))
-        assert [line.split(",")[0] for line in out.getvalue().splitlines()] == [
-            f"  map points: {k}/3 points" for k in (1, 2, 3)]
+        def said(a, b):
+            return [f"  1 onset(s) between {a:g} and {b:g}: narrowed by up to 4 full analyses each"] * bool(refine)
+        assert [line.split(",")[0] for line in out.getvalue().splitlines()] == [    # (said: the bar's time left
+            "  map points: 1/3 points", *said(0, 0.5), "  map points: 2/3 points", *said(0.5, 1),   # leaves them
+            "  map points: 3/3 points"]                                                    # out: a user trial)
         maps[refine] = smap = builder.finish()
         assert len(smap.onsets) == 1
         assert model.linearised[:2] == [0.0, 0.5] and len(model.linearised) == 3 + 2 * refine

@@ -233,13 +233,15 @@ def global_dofs(functions) -> int:
                for f in functions)
 
 
-def say_model_size(tm, mechanics, thermal=None, kind: str = "transient", modes: int = 0, points: int = 0) -> None:
+def say_model_size(tm, mechanics, thermal=None, kind: str = "transient", modes: int = 0, points: int = 0,
+                   sweep: str | None = None) -> None:
     """Say the size of a model, a console line: its cells, displacement dofs and (with heat)
     temperature dofs; and warn (stderr, at once) when a run of ``kind`` ("transient" or "squeal")
     of that size (a squeal run asking for ``modes`` modes) is estimated to need, ``SPREAD`` times, more
     memory than the machines of its ranks have free (``memory.run_memory``, with ``thermal``'s
     temperature dofs; a squeal run of ~1M dofs was checked OK and would take ~40 GB: a user
-    trial), with a multiscale loop's zones of ``points`` grid points in all (``memory.micro_memory``).
+    trial), with a multiscale loop's zones of ``points`` grid points in all (``memory.micro_memory``)
+    or a stability map of preload ``sweep``.
     Collective: global counts."""
     def spaced(n: int) -> str:
         return f"{n:,}".replace(",", " ")
@@ -251,7 +253,7 @@ def say_model_size(tm, mechanics, thermal=None, kind: str = "transient", modes: 
     hosts = comm.allgather(MPI.Get_processor_name())
     free = comm.allgather(memory_available() if hosts.index(hosts[comm.rank]) == comm.rank else 0.0)
     linear = thermal is not None and not thermal.nonlinear
-    need, have = run_memory(n, kind, comm.size, modes, n_T, linear), (None if None in free else sum(free))
+    need, have = run_memory(n, kind, comm.size, modes, n_T, linear, sweep), (None if None in free else sum(free))
     need += micro_memory(points, comm.size) if points else 0.0
     if comm.rank == 0 and have is not None and SPREAD * need > have:
         machines = "this machine" if len(set(hosts)) == 1 else f"the {len(set(hosts))} machines of its ranks"

@@ -179,7 +179,7 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
     if st.modes is not None and st.modes > dofs:     # (said after the preload, with a memory warning: a trial)
         mech.close()
         raise InputError("stability.modes", st.modes, f"must not exceed the number of dofs ({dofs})")
-    say_model_size(tm, mech, kind="squeal", modes=st.modes)
+    say_model_size(tm, mech, kind="squeal", modes=st.modes, sweep=st.sweep.preload_mode if st.sweep else None)
     say_load(scene, tm)
     try:
         with closed_on_error(mech, tm.comm):
