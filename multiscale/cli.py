@@ -69,7 +69,7 @@ def _info(args) -> int:
 def _check(args) -> int:
     """Validate scene files: a short summary for a good one, every problem of a bad one."""
     if args.keys is not None:
-        if args.keys.endswith(".toml"):             # check --keys SCENE: the format, then the scene
+        if args.keys.lower().endswith(".toml"):     # check --keys SCENE: the format, then the scene
             args.scenes, args.keys = [args.keys, *args.scenes], ""
         print("\n".join(table_reference(args.keys) if args.keys else reference()))
     elif not args.scenes:

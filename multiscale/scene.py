@@ -296,7 +296,7 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
         raise SceneError([f"{source.name if source else name}: a study file (problem = ..., [sweep]), not a scene: "
                           "give it to `multiscale study`"])
     overrides = {dotted: _toml_value(value) for dotted, value in (overrides or {}).items()}
-    given = {tuple(key_parts(dotted)) for dotted in overrides}
+    given, dropped = {tuple(key_parts(dotted)) for dotted in overrides}, []
     for dotted, value in overrides.items():
         *parents, last = key_parts(dotted)
         table = raw
@@ -316,14 +316,15 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
                              "one item of an array; give the whole array (geometry.axis = [0, 0, 1])"))
         table[last] = value
         for other in replaced(Scene, [*parents, last]):        # the file's alternative goes, unless also given
-            if (*parents, other) not in given:
-                table.pop(other, None)
+            if not any(g[:len(parents) + 1] == (*parents, other) for g in given) and other in table:   # (a key of it
+                del table[other]                                        # too: it dropped loading.stribeck.kinetic)
+                dropped.append(f"{dotted} replaces the file's {'.'.join([*parents, other])}")
     effects = raw.get("effects")
     active = frozenset(e for e in effects if isinstance(e, str) and e in EFFECTS) \
         if isinstance(effects, list) else frozenset()      # the known effects decide what is needed
     ctx = Context(effects=active, directory=Path(directory).resolve(), root=raw)
     scene = read(Scene, raw, "", ctx)
-    warnings = _cross_checks(scene, raw, ctx)
+    warnings = dropped + _cross_checks(scene, raw, ctx)        # (said nowhere: a stop became a drag, a trial)
     if ctx.problems:
         raise SceneError(ctx.problems)
     name = scene.name or name

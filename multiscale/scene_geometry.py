@@ -75,7 +75,9 @@ class LengthUnit:
 
 @dataclass(frozen=True)
 class BodySelection:
-    """[geometry.bodies.<name>]: the volumes of one body and its material."""
+    """[geometry.bodies.<name>]: the volumes of one body, picked by ``volumes`` (physical names or
+    CAD labels), ``index`` (the file's volume numbers) or ``contains`` (points inside them), and its
+    ``material`` (a [materials.<name>])."""
 
     volumes: tuple | None = key(ListOf(Text(), unique=True, min_len=1),   # physical names or CAD labels
                                 absent="index or contains picks the volumes")
@@ -261,6 +263,7 @@ class GeometrySection(Section):
     def __init__(self):
         super().__init__(Geometry)
         self.builders = Choice(tuple(n for n in builder_names() if n != "file"))
+        self.key_schema = FileGeometry        # its keys' tables ([geometry.bodies.<name>], ...): --keys, --set
 
     def describe(self) -> str:
         return f"a table with builder = {self.builders.describe()} and its parameters, or file = \"...\""

@@ -42,7 +42,7 @@ def replaced(cls, parts: list[str]) -> tuple[str, ...]:
         spec = dict(fields_of(cls)).get(tables[k])
         if spec is None or not isinstance(spec.parser, Section):
             return ()
-        cls = spec.parser.cls
+        cls = getattr(spec.parser, "key_schema", spec.parser.cls)      # [geometry]: a geometry file's tables
         k += 2 if isinstance(spec.parser, (Named, Tables)) else 1      # a table's name, an entry's number
     if k != len(tables) or not dataclasses.is_dataclass(cls):
         return ()

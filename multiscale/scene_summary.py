@@ -7,7 +7,7 @@ import textwrap
 
 from multiscale.geometry import CellEstimate, estimate_cells
 from multiscale.held import check_held
-from multiscale.memory import DOFS_PER_CELL, HEAT_DOFS, MICRO_MEMORY, RUN_MEMORY, micro_memory, run_memory
+from multiscale.memory import DOFS_PER_CELL, HEAT_DOFS, MAP_MEMORY, MICRO_MEMORY, RUN_MEMORY, micro_memory, run_memory
 from multiscale.outputs import CHECKPOINT, analysis
 from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
@@ -41,7 +41,7 @@ def tables(cls=Scene, path: str = "") -> dict:
             where = f"{path}.{name}" if path else name
             shown = where + (".<name>" if isinstance(spec.parser, Named) else "")
             out[where] = (spec.parser, where, shown)
-            out.update(tables(spec.parser.cls, shown))
+            out.update(tables(getattr(spec.parser, "key_schema", spec.parser.cls), shown))
     return out
 
 
@@ -50,8 +50,11 @@ def table_reference(name: str) -> list[str]:
     its text (the dataclass' docstring, the scene reference page's), then its keys as ``reference``
     lists them. ``name``: a dotted table path, brackets allowed ("[loading]"); InputError otherwise."""
     known = tables()
-    key = name.strip().strip("[]").replace(".<name>", "")
+    key = name.strip().strip("[]").replace(".<name>", "").lower()
     if key not in known:
+        parent, _, leaf = key.rpartition(".")
+        if parent in known and leaf in dict(fields_of(known[parent][0].cls)):      # (a key: a trial was offered
+            raise InputError("--keys", name, f"a key of [{known[parent][2]}]: multiscale check --keys {parent}")  # a table)
         raise InputError("--keys", name, "not a table of the scene format" + suggest(key, known)
                          + f"; the tables: {', '.join(known)}")
     parser, where, shown = known[key]
@@ -325,9 +328,12 @@ def memory_line(scene: Scene, mesh: CellEstimate) -> tuple[str, float]:
     dofs = 3 * (mesh.nodes + mesh.edges * (kind == "squeal")) if mesh.nodes else DOFS_PER_CELL[kind] * mesh.cells
     heat = HEAT_DOFS * dofs if kind == "transient" and scene.has("thermal") else 0.0
     sweep = scene.stability.sweep.preload_mode if kind == "squeal" and scene.stability.sweep else None
+    linear = linear_heat(scene)
     need = run_memory(dofs, kind, modes=scene.stability.modes if kind == "squeal" else 0, heat_dofs=heat,
-                      linear_heat=linear_heat(scene), sweep=sweep)
-    each = RUN_MEMORY[kind][0]
+                      linear_heat=linear, sweep=sweep)
+    each = RUN_MEMORY[kind][0] * MAP_MEMORY.get(sweep, 1.0)
+    counted = f"{dofs:,.0f} displacement dofs" + (f", {heat:,.0f} temperature dofs" + (
+        " (a linear heat problem: double-precision factors)" if linear else "") if heat else "")
     micro = ""
     if scene.rough_interfaces and kind == "transient":
         kind, own = "multiscale", [scene.interface_settings(n) for n in scene.rough_interfaces]
@@ -339,7 +345,7 @@ def memory_line(scene: Scene, mesh: CellEstimate) -> tuple[str, float]:
             micro = f"; its zones {points:,} grid points"
     kind += " map" * bool(sweep)
     return (f"  memory    about {need / 1e9:.2g} GB at the peak of a {kind} run on one rank, each more adding about "
-            f"{each / 1e9:.2g} GB (about {dofs:,.0f} displacement dofs{micro}; an estimate from measured runs, "
+            f"{each / 1e9:.2g} GB (about {counted}{micro}; an estimate from measured runs, "
             "docs/performance.rst)", need)
 
 

@@ -74,7 +74,10 @@ def test_check_keys_of_a_table_says_what_its_keys_do(tmp_path, capsys):
     for name in tables():
         lines = table_reference(name)
         assert len(lines[1].split()) >= 10 and lines[2] == "" and len(lines) > 3, name
-    assert table_reference("[materials.<name>]") == table_reference("materials")
+    assert table_reference("[materials.<name>]") == table_reference("materials") == table_reference("MATERIALS")
+    assert table_reference("geometry.bodies")[0] == "[geometry.bodies.<name>]"       # a geometry file's tables too
+    assert main(["check", "--keys", "loading.friction"]) == 2                           # a key, not a table
+    assert "a key of [loading]: multiscale check --keys loading" in capsys.readouterr().err
     assert main(["check", "--keys", "loadng"]) == 2
     assert 'not a table of the scene format (did you mean "loading"?)' in capsys.readouterr().err
     scene = tmp_path / "s.toml"

@@ -1226,9 +1226,13 @@ def test_an_override_replaces_the_files_alternative_to_it(tmp_path):
     pod = (DEMOS / "pin_on_disc.toml").read_text()
     scene = loads(pod, tmp_path, overrides={"loading.pressure": "0.375 MPa"})
     assert (scene.loading.pressure, scene.loading.normal_force) == (375e3, None)
+    assert scene.warnings[0] == "loading.pressure replaces the file's loading.normal_force"     # said (a trial's
+    car = (DEMOS / "car_brake_stop.toml").read_text()                                           # stop became a drag)
+    with pytest.raises(SceneError, match=r"give only one of them"):     # a key of the alternative given too: kept,
+        loads(car, DEMOS, overrides={"loading.vehicle.speed": "50 km/h",   # whatever the order (it was dropped
+                                     "loading.rotation_speed": "10 rad/s"})    # when given first: an adversarial test)
     curve = loads(pod, tmp_path, overrides={"loading.friction_curve": [["0 m/s", 0.45], ["30 m/s", 0.38]]})
     assert (curve.loading.friction, curve.loading.friction_curve[1]) == (None, (30.0, 0.38))
-    car = (DEMOS / "car_brake_stop.toml").read_text()
     fixed = loads(car, DEMOS, overrides={"boundary[1].temperature": "100 degC"})
     assert (fixed.boundary[0].temperature, fixed.boundary[0].convection, fixed.boundary[0].emissivity) == \
         (373.15, None, None)
