@@ -93,7 +93,8 @@ def _column_unit(parser, v) -> str:
 def _table(cls, obj) -> dict:
     """{key: (value, comment) or sub-table dict or list of sub-table dicts} of a schema dataclass."""
     out = {}
-    unused = {k for rule in getattr(cls, "rules", ()) if isinstance(rule, OnlyWith) and getattr(obj, rule.key) is None
+    unused = {k for rule in getattr(cls, "rules", ()) if isinstance(rule, OnlyWith)
+              and all(getattr(obj, a) is None for a in rule.key)
               for k in rule.keys}            # defaults of keys allowed only with an absent one
     for name, spec in fields_of(cls):
         v = getattr(obj, name)

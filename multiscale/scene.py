@@ -318,7 +318,8 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
         for other in replaced(Scene, [*parents, last]):        # the file's alternative goes, unless also given
             if not any(g[:len(parents) + 1] == (*parents, other) for g in given) and other in table:   # (a key of it
                 del table[other]                                        # too: it dropped loading.stribeck.kinetic)
-                dropped.append(f"{dotted} replaces the file's {'.'.join([*parents, other])}")
+                name = "".join(f"[{p}]" if p.isdigit() else f".{p}" for p in [*parents, other]).lstrip(".")
+                dropped.append(f"{dotted} replaces the file's {name}")
     effects = raw.get("effects")
     active = frozenset(e for e in effects if isinstance(e, str) and e in EFFECTS) \
         if isinstance(effects, list) else frozenset()      # the known effects decide what is needed

@@ -218,7 +218,8 @@ class Boundary:
 
     THERMAL = ("convection", "emissivity", "temperature")
 
-    rules = (OneOf(("temperature", "convection")), OneOf(("temperature", "emissivity")))
+    rules = (OneOf(("temperature", "convection")), OneOf(("temperature", "emissivity")),
+             OnlyWith(("convection", "emissivity"), ("ambient",)))
 
     @property
     def components(self) -> tuple[int, ...]:
@@ -228,8 +229,6 @@ class Boundary:
     def problems(self, path, ctx):
         if not any(getattr(self, k) is not None for k in ("fix", "convection", "emissivity", "temperature")):
             return [f"{path}: give a condition: fix, convection, emissivity or temperature"]
-        if self.ambient is not None and self.convection is None and self.emissivity is None:
-            return [f"{path}.ambient: only used with {path}.convection or {path}.emissivity"]
         return []
 
     def h(self, speed: float) -> float:
@@ -436,8 +435,8 @@ class Roughness:
     cover: str = key(Choice(COVER), default="measured")
 
     rules = (OneOf(("rms", "file"), required=True, meaning="a generated fractal surface or a measured file"),
-             Requires("rms", ("hurst", "k_min", "k_max")), OnlyWith("rms", ("hurst", "k_min", "k_max", "patch")),
-             OnlyWith("file", ("channel", "pixel_size", "height_unit", "detrend", "cutoff", "max_undefined", "despike",
+             Requires("rms", ("hurst", "k_min", "k_max")), OnlyWith(("rms",), ("hurst", "k_min", "k_max", "patch")),
+             OnlyWith(("file",), ("channel", "pixel_size", "height_unit", "detrend", "cutoff", "max_undefined", "despike",
                                "cover")))
 
     def problems(self, path, ctx):

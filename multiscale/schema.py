@@ -479,17 +479,17 @@ class Requires:
 
 @dataclass(frozen=True)
 class OnlyWith:
-    """``keys`` make sense only together with ``key`` (e.g. a seed only for a generated surface)."""
+    """``keys`` make sense only together with one of ``key`` (e.g. hurst only for a generated surface, rms)."""
 
-    key: str
+    key: tuple[str, ...]
     keys: tuple[str, ...]
 
     def text(self) -> str:
-        return f"{', '.join(self.keys)} only with {self.key}"
+        return f"{', '.join(self.keys)} only with {' or '.join(self.key)}"
 
     def check(self, present, path, ctx):
-        return [] if self.key in present else [f"{path}.{k}: only used with {path}.{self.key}"
-                                               for k in self.keys if k in present]
+        return [] if present & set(self.key) else [f"{path}.{k}: only used with {' or '.join(f'{path}.{a}' for a in self.key)}"
+                                                   for k in self.keys if k in present]
 
 
 # ---------------------------------------------------------------- the reader

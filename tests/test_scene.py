@@ -1233,9 +1233,10 @@ def test_an_override_replaces_the_files_alternative_to_it(tmp_path):
                                      "loading.rotation_speed": "10 rad/s"})    # when given first: an adversarial test)
     curve = loads(pod, tmp_path, overrides={"loading.friction_curve": [["0 m/s", 0.45], ["30 m/s", 0.38]]})
     assert (curve.loading.friction, curve.loading.friction_curve[1]) == (None, (30.0, 0.38))
-    fixed = loads(car, DEMOS, overrides={"boundary[1].temperature": "100 degC"})
-    assert (fixed.boundary[0].temperature, fixed.boundary[0].convection, fixed.boundary[0].emissivity) == \
-        (373.15, None, None)
+    fixed = loads(car, DEMOS, overrides={"boundary[3].temperature": "100 degC"})     # the disc's free faces
+    disc = fixed.boundary[2]                      # and the ambient used only with what it replaced (refused)
+    assert (disc.temperature, disc.convection, disc.emissivity, disc.ambient) == (373.15, None, None, None)
+    assert "boundary[3].temperature replaces the file's boundary[3].ambient" in fixed.warnings
     with pytest.raises(SceneError, match=r"give only one of them \(got normal_force, pressure\)"):
         loads(pod, tmp_path, overrides={"loading.pressure": "0.375 MPa", "loading.normal_force": "90 N"})
     assert loads(pod, tmp_path, overrides={"micro.grid": [16, 16]}).loading.normal_force == 200.0   # no rule
