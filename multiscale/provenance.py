@@ -292,7 +292,8 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     given = scene.text if scene.source else \
         "# The scene came from text, not a file: here it is as resolved.\n" + resolved_toml(scene)
     ran = code()                     # each part's own (a run resumed after a change of the code: a user trial)
-    part = {"status": status, "command": list(sys.argv if command is None else command), "ranks": ranks,
+    part = {"status": status, "command": list(sys.argv if command is None else command), "directory": os.getcwd(),
+            "ranks": ranks,
             "code": ran["sha1"], "start": started, "end": None if status == RUNNING else now(),
             "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()},
             "total_wall_time_s": None if status == RUNNING else round(wall_time, 3)}
@@ -302,7 +303,8 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
         for k, v in p["stage_wall_time_s"].items():
             total[k] = total.get(k, 0.0) + v
     record = {"status": status, "analysis": analysis, "scene": str(scene.source or scene.name),
-              "overrides": {k: v for k, v in scene.overrides}, "command": part["command"], "ranks": ranks,
+              "overrides": {k: v for k, v in scene.overrides}, "command": part["command"],
+              "directory": part["directory"], "ranks": ranks,
               "start": parts[0]["start"], "end": part["end"],
               "stage_wall_time_s": {k: round(v, 3) for k, v in total.items()},
               "total_wall_time_s": round(sum(p["total_wall_time_s"] or 0.0 for p in parts), 3), "parts": parts,
@@ -319,7 +321,7 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     return [folder / name for name in texts]
 
 
-PART = ("status", "command", "ranks", "code", "start", "end", "stage_wall_time_s", "total_wall_time_s")   # a part's
+PART = ("status", "command", "directory", "ranks", "code", "start", "end", "stage_wall_time_s", "total_wall_time_s")   # a part's
 #                                                           keys ("code": the SHA-1 of the package's files, ``code``)
 
 

@@ -187,7 +187,8 @@ def test_provenance_and_paraview_script(case):
         assert {"meshing", "macro steps"} <= set(record["stage_wall_time_s"])
     assert record["start"] <= record["end"] and record["total_wall_time_s"] > 0
     assert record["parts"] == [{"code": record["code"]["sha1"], **{k: record[k] for k in (
-        "status", "command", "ranks", "start", "end", "stage_wall_time_s", "total_wall_time_s")}}]   # not resumed
+        "status", "command", "directory", "ranks", "start", "end", "stage_wall_time_s", "total_wall_time_s")}}]
+    assert record["directory"] == os.getcwd()     # the command's relative paths are from there (not said: a trial)
     assert record["files"] == sorted(p.files)          # what a later --overwrite deletes
     overrides = dict(record["overrides"])         # scene.toml alone is not this run (before: nothing said so)
     if p.analysis == "squeal":                    # run from its resolved scene, no overrides
