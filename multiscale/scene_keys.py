@@ -48,4 +48,5 @@ def replaced(cls, parts: list[str]) -> tuple[str, ...]:
         return ()
     rules = getattr(cls, "rules", ())
     others = [o for r in rules if isinstance(r, OneOf) and last in r.keys for o in r.keys if o != last]
-    return tuple(others + [k for r in rules if isinstance(r, OnlyWith) and set(r.key) <= set(others) for k in r.keys])
+    return tuple(others + [key for r in rules if isinstance(r, OnlyWith) and set(r.key) <= set(others)
+                           for key in r.keys])
