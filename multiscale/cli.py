@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import dataclasses
+import importlib.util
 import json
 import os
 import shlex
@@ -86,6 +87,9 @@ def _check(args) -> int:
             failed += 1
             continue
         print("\n".join(summary(scene) + plan_summary(plan(scene))))
+        if importlib.util.find_spec("dolfinx") is None:         # a micro-only install (said OK alone: a trial)
+            print("warning: multiscale run of this scene needs DOLFINx, not installed here: pip install -e "
+                  "'.[fem]'", file=sys.stderr)
         unwritable = folder_problem(scene.output.folder)          # what run would stop at
         if unwritable is not None:
             print(f'error: output.folder = "{scene.output.folder}": {unwritable}', file=sys.stderr)

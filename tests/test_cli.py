@@ -185,6 +185,16 @@ def test_a_run_larger_than_the_free_memory_is_warned_at_once(tmp_path, monkeypat
                      r"0.001 GB this machine has free: it may be killed", err), err
 
 
+def test_check_without_dolfinx_says_that_run_needs_it(tmp_path, capsys, monkeypatch):
+    """On a micro-only install check said OK alone; run then refused (a user trial)."""
+    import importlib.util
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "dolfinx" else real(name, *a))
+    assert main(["check", _write(tmp_path, BLOCK)]) == 0
+    assert "warning: multiscale run of this scene needs DOLFINx, not installed here: pip install -e '.[fem]'" in \
+        capsys.readouterr().err
+
+
 def test_check_good_scene_prints_summary(tmp_path, capsys):
     path = _write(tmp_path, BLOCK)
     assert main(["check", path]) == 0
@@ -574,6 +584,7 @@ def test_overwrite_deletes_what_the_run_before_wrote_and_keeps_the_rest(tmp_path
     from mpi4py import MPI
 
     from multiscale.io import Reporter
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")   # multiscale.workflows
     from multiscale.workflows.output import clear, prepare_folder
     folder = tmp_path / "out"
     _earlier_run(folder, ["pad.xdmf", "pad.h5", "modes_pad.bp", "history.h5", "wear_map_b.png"])
@@ -607,6 +618,7 @@ def test_overwrite_refuses_the_users_own_files_named_as_results(tmp_path, capsys
     from mpi4py import MPI
 
     from multiscale.errors import SceneError
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")   # multiscale.workflows
     from multiscale.workflows.output import prepare_folder
     folder = tmp_path / "out"
     folder.mkdir()
@@ -720,6 +732,7 @@ def test_overwrite_without_a_record_deletes_nothing_and_resume_never_does(tmp_pa
 
     from multiscale.errors import SceneError
     from multiscale.io import Reporter
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")   # multiscale.workflows
     from multiscale.workflows.output import prepare_folder
     folder = tmp_path / "out"
     _earlier_run(folder, ["pad.xdmf"])
@@ -759,6 +772,7 @@ def test_a_scene_in_its_own_output_folder_is_not_a_result(tmp_path, capsys):
 
     from multiscale.errors import SceneError
     from multiscale.scene import load
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")   # multiscale.workflows
     from multiscale.workflows.output import prepare_folder
     text = BLOCK.replace("../results/block_on_flat", ".") + "\n# the user's comment\n"
     path = _write(tmp_path, text)
@@ -812,8 +826,9 @@ def test_the_command_a_hint_repeats_is_the_one_launched():
     environment's console script, which runs the installed copy (a rank-consistency audit)."""
     import multiscale
     main_py = str(Path(multiscale.__file__).with_name("__main__.py"))
-    for argv0, expected in ((main_py, [sys.executable, "-m", "multiscale"]),
-                            (str(Path(sys.executable).with_name("multiscale")), [str(Path(sys.executable).with_name("multiscale"))])):
+    python = os.path.abspath(sys.executable)     # the child's, also where pytest was started as ../venv/bin/python
+    for argv0, expected in ((main_py, [python, "-m", "multiscale"]),
+                            (str(Path(python).with_name("multiscale")), [str(Path(python).with_name("multiscale"))])):
         code = f"import sys; sys.argv = [{argv0!r}]; import multiscale.cli as c; print(c.COMMAND)"
         out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
         assert out.strip() == str(expected)

@@ -200,6 +200,7 @@ def test_check_of_a_bad_file_runs_nothing_heavy(tmp_path):
 
 
 def test_zones_from_a_measured_file_for_every_cover(tmp_path):
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
     from multiscale.workflows import rough
 
     def make_zones(s, *args, cover=None, grid=None, **kwargs):       # cover, micro.grid: instead of the scene's
@@ -437,6 +438,7 @@ def test_a_measured_file_is_read_and_searched_for_outliers_once(tmp_path, monkey
     in one `multiscale run` (the scene's check of the file, its cover check, the zones): 5 s a search
     on a 4000² map. Now once; a changed file is read again, and one just written is not kept (file
     times are as coarse as a clock tick: its next change might keep them)."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
     from multiscale.workflows import rough      # local: imports DOLFINx
     calls = collections.Counter()
 
@@ -469,6 +471,7 @@ def test_a_measured_file_is_read_and_searched_for_outliers_once(tmp_path, monkey
 def test_an_interfaces_own_measured_file_is_named_by_its_key_and_read_once(tmp_path, monkeypatch):
     """With [interfaces.<name>.roughness] the zones' read and errors said "roughness." where the
     scene's check said "interfaces.<name>.roughness.", and the run read the file again."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
     from multiscale.workflows import rough      # local: imports DOLFINx
     reads = []
     monkeypatch.setattr(reading, "read_matrix", lambda path: reads.append(path) or np.load(path))
@@ -511,6 +514,7 @@ def test_a_micro_grid_too_coarse_for_the_measured_gradient_is_warned_about(tmp_p
     assert kept < topography.GRADIENT_KEPT and f"resolve {kept:.1%} of" in warned
     half = float(warned.split("cells of ")[1].split(" x")[0]) * 1e-6       # the cells it names
     assert topography.kept_gradient(measured, (half, half)) == pytest.approx(topography.GRADIENT_KEPT, rel=0.02)
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
     from multiscale.workflows import rough
     for said in (False, True):    # a run repeats it only where the scene's check could not (a face's extent unknown)
         lines = []                # before meshing); it said it twice, with 78.12 and 78.13 um cells
@@ -582,6 +586,7 @@ def test_a_cutoff_shorter_than_two_micro_cells_is_refused(tmp_path, cover):
                                    "be nearly flat; use a finer micro.grid or a longer cutoff"]
     s = scene(tmp_path, wide.format(TOP, cover, "625 um"), GRID)
     assert not any("longer than the measurement" in w for w in s.warnings)      # 625 um of a 1.024 mm map
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
     from multiscale.workflows import rough      # local: imports DOLFINx
     short = dataclasses.replace(s.roughness, cutoff=600e-6)     # the run's own check (a face check did not know)
     with pytest.raises(InputError, match=r"^roughness.cutoff: λc = 600 um must span at least 2 cells of the micro "

@@ -1141,6 +1141,21 @@ def test_a_scene_run_is_timed_by_its_own_record(tmp_path, monkeypatch):
     assert info.value.warnings == ("the run's",) and found == [[], []]
 
 
+def test_a_scene_study_without_dolfinx_is_refused_before_its_runs(tmp_path, monkeypatch):
+    """Without DOLFINx (a micro-only install) a scene study's runs each started and failed on
+    petsc4py (a user trial): it is refused once, before any run, saying what to install."""
+    import importlib.util
+    real = importlib.util.find_spec
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name, *a: None if name == "dolfinx" else real(name, *a))
+    path = scene_study(tmp_path, "block_on_flat.toml", 'metrics = ["interface_force:last"]\n[sweep]\n'
+                                                       '"loading.pressure" = ["1 MPa", "2 MPa"]')
+    with pytest.raises(SceneError) as info:
+        load_study(path)
+    assert [p for p in info.value.problems if "DOLFINx" in p] == [
+        "problem = \"scene\" runs each point with multiscale run, which needs DOLFINx: install it with pip install "
+        "-e '.[fem]' (every run)"]
+
+
 def test_a_scene_run_says_its_error_once(capsys):
     """The study's scene subprocess says a MultiscaleError as one ``Kind: message`` line (by rank 0;
     under mpiexec each rank wrote its traceback into the run's log: a user trial) and ends with 2,

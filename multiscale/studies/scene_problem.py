@@ -4,6 +4,7 @@ ranks > 1); metrics from its HDF5 history, or for a squeal scene from its table 
 from __future__ import annotations
 
 import hashlib
+import importlib.util
 import json
 import re
 import shutil
@@ -39,6 +40,10 @@ _REDUCERS = {"last": lambda v: v[-1], "first": lambda v: v[0], "max": _over_fini
              "min": _over_finite(np.min), "mean": _over_finite(np.mean), "rise": lambda v: v[-1] - v[0]}
 
 _EXCEPTION = re.compile(r"^[A-Za-z_][\w.]*(Error|Exception|Interrupt)\b")
+
+
+NO_DOLFINX = ("problem = \"scene\" runs each point with multiscale run, which needs DOLFINx: install it with "
+              "pip install -e '.[fem]'")
 
 
 def failure_line(output: str) -> str:
@@ -134,6 +139,8 @@ class SceneProblem(Problem):
     undefined = frozenset({"max_growth_frequency", "lowest_unstable_frequency"})
 
     def parse(self, raw, path, ctx, scene=None, ranks=1):
+        if importlib.util.find_spec("dolfinx") is None:
+            ctx.problems.append(NO_DOLFINX)       # (each run failed on petsc4py after starting: a user trial)
         try:
             loaded = load(scene, overrides=raw)
         except SceneError as exc:
