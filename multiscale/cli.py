@@ -10,7 +10,6 @@ import argparse
 import contextlib
 import dataclasses
 import importlib.util
-import json
 import os
 import shlex
 import sys
@@ -32,7 +31,7 @@ from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition
 from multiscale.mode_pairs import mirrored, pair, read_modes, report, write_pairs
 from multiscale.outputs import CHECKPOINT, analysis, folder_problem, plan
 from multiscale.outputs import summary as plan_summary
-from multiscale.provenance import versions
+from multiscale.provenance import finished, versions
 from multiscale.scene import load
 from multiscale.scene_plain import pixel_problem, plain
 from multiscale.scene_summary import cells_line, memory_line, modes_problem, reference, summary, table_reference
@@ -222,26 +221,22 @@ def _run(args) -> int:
     return 0
 
 
-def _finished(folder: Path) -> bool:
-    """Whether the results in ``folder`` are those of a run that finished (its provenance.json)."""
-    try:
-        return str(json.loads((folder / "provenance.json").read_text()).get("status", "")).endswith("finished")
-    except (OSError, ValueError, AttributeError):
-        return False
+def _command(ranks: int, *words: str) -> str:
+    """This environment's multiscale with ``words``, under its mpiexec for ``ranks`` > 1: the command
+    a hint repeats (a copy of the bare name failed where the environment was not activated)."""
+    return shlex.join([*([MPIEXEC, "-n", str(ranks)] if ranks > 1 else []), *COMMAND, *words])
 
 
 def _kept(scene, args, ranks: int = 1) -> str:
     """What a run interrupted by Ctrl-C leaves (``scene``: None if it was still being read), and the
-    command that goes on (this environment's multiscale, under its mpiexec for ``ranks`` > 1: a user
-    trial's copy of the bare name failed where the environment was not activated; the scene's absolute
-    path: a job script's next step may start elsewhere); --resume is advised
+    command that goes on (``_command``, with the scene's absolute path: a job script's next step may
+    start elsewhere); --resume is advised
     only with a checkpoint (before its first macro step ended it refused to resume), --overwrite
     when the folder holds files (a user trial was told to start again and refused)."""
     if scene is None:
         return "nothing was written"
-    launcher = [MPIEXEC, "-n", str(ranks)] if ranks > 1 else []
-    command = shlex.join([*launcher, *COMMAND, "run", os.path.abspath(args.scene),     # (from any folder)
-                          *(f"--set={k}={text}" for k, _, text in args.settings)])
+    command = _command(ranks, "run", os.path.abspath(args.scene),                    # (from any folder)
+                       *(f"--set={k}={text}" for k, _, text in args.settings))
     folder = Path(scene.output.folder)
     written = folder.is_dir() and any(folder.iterdir())
     again = f"{command}{' --overwrite' if written else ''} starts again"
@@ -249,7 +244,7 @@ def _kept(scene, args, ranks: int = 1) -> str:
         return f"no macro step ended, there is nothing to resume; {again}"
     if not written:
         return f"nothing was written; {again}"
-    if args.overwrite and _finished(folder):     # stopped before it replaced them (it advised --resume: an MPI trial)
+    if args.overwrite and finished(folder):     # stopped before it replaced them (it advised --resume: an MPI trial)
         return f"the earlier results in {folder} stay as they were; {again}"
     how = f"{command} --resume continues from the last finished step" if analysis(scene) == "multiscale" else again
     return f"what was written stays in {folder} (its provenance.json says so); {how}"
@@ -276,9 +271,8 @@ def _study(args) -> int:
                              processes=args.processes, command=command)
     except KeyboardInterrupt:                # Ctrl-C: the runs that ended are recorded, the others stopped
         if comm is None or comm.rank == 0:
-            launcher = [MPIEXEC, "-n", str(comm.size)] if comm is not None and comm.size > 1 else []   # (left
-            again = shlex.join([*launcher, *COMMAND, "study", *args.studies,                        # out: an MPI
-                                *(["--report", args.report] if args.report else [])])               # trial)
+            again = _command(comm.size if comm is not None else 1, "study", *args.studies,   # (mpiexec was
+                             *(["--report", args.report] if args.report else []))                 # left out: a trial)
             print(f"interrupted: the runs that ended are recorded; {again} runs the others", file=sys.stderr,
                   flush=True)
         return INTERRUPTED

@@ -413,6 +413,11 @@ def _record_of(folder: Path) -> dict:
     return record if isinstance(record, dict) else {}
 
 
+def finished(folder: Path) -> bool:
+    """Whether ``folder`` holds the results of a run that finished (its ``provenance.json``)."""
+    return str(_record_of(folder).get("status", "")).endswith("finished")
+
+
 def inputs_in(folder: Path) -> list[str]:
     """Names of the entries of ``folder`` that the earlier run there read as inputs (its scene file,
     when it ran in its own folder: recorded as the copy ``scene.toml`` too)."""
