@@ -208,7 +208,7 @@ class StepStop:
     step) is True. The second is held: the step ends and its results are written. A third abandons
     the step in progress (``KeyboardInterrupt`` naming the last step whose results are written),
     unless it comes inside ``writing()``, which no Ctrl-C interrupts: a step's results are written
-    whole or not at all. ``done``: the steps whose results are already written (a resumed run's).
+    whole or not at all (after the last step, ``writing(last=True)``: the run finishes). ``done``: the steps whose results are already written (a resumed run's).
     Under ``mpiexec`` the second Ctrl-C is the launcher's: it kills every rank (MPICH's hydra).
     SIGTERM and SIGHUP (a batch scheduler's time limit, ``timeout``, a closed terminal; unless
     ignored, as under ``nohup``) count as Ctrl-Cs: the first stops the run after its step (they
@@ -221,11 +221,12 @@ class StepStop:
     HELD = ("\n{0}: still finishing the step and writing its results; {0} again abandons the step "
             "(the results written stay as they are)\n")
     WRITING = "\n{}: held until the results being written are complete\n"
+    LAST = "\n{}: the steps are done; held until their results are written (the run finishes)\n"
     taken = 0        # signals every StepStop of this process took (``CtrlCWatch`` counts them)
 
     def __init__(self, comm, done: int = 0):
         self.comm, self.done, self.previous = comm, done, None
-        self.count, self.saving = 0, False
+        self.count, self.saving, self.last = 0, False, False
 
     @property
     def asked(self) -> bool:
@@ -252,14 +253,15 @@ class StepStop:
         if self.comm.rank == 0:          # os.write, not print: the handler may run inside a write to stderr
             name = "Ctrl-C" if signum == signal.SIGINT else signal.Signals(signum).name
             again = self.AGAIN[self.comm.size > 1 and signum == signal.SIGINT].format(name)
-            os.write(2, (self.FIRST.format(name, again) if self.count == 1 else    # (a SIGTERM was called
+            os.write(2, (self.LAST.format(name) if self.last else    # (it said "stopping after this step")
+                         self.FIRST.format(name, again) if self.count == 1 else    # (a SIGTERM was called
                          self.HELD.format(name) if self.count == 2 else self.WRITING.format(name)).encode())  # Ctrl-C)
 
     @contextmanager
-    def writing(self, step: int):
+    def writing(self, step: int, last: bool = False):
         """The block writing the results of ``step``: Ctrl-C does not interrupt it; once it ends,
-        they are the last written (``done``)."""
-        self.saving = True
+        they are the last written (``done``). ``last``: the run's final writing, after its steps."""
+        self.saving, self.last = True, last
         try:
             yield
         finally:

@@ -276,10 +276,12 @@ def test_ctrl_c_stops_the_run_after_its_step_with_the_results_written(tmp_path, 
         assert reader.read_data(reader.num_steps - 1)[0] == pytest.approx(done * 3 / 4000)   # the stop's fields
 
 
-def test_ctrl_c_while_the_end_is_written_lets_it_finish(tmp_path, monkeypatch):
+def test_ctrl_c_while_the_end_is_written_lets_it_finish(tmp_path, monkeypatch, capfd):
     """Ctrl-C after the last step, while the history and plots are written: the writing finishes
     and the run ends as finished (before: a KeyboardInterrupt inside the writing, MPI_Abort under
-    mpiexec, provenance "interrupted" without a step; an adversarial docs audit)."""
+    mpiexec, provenance "interrupted" without a step; an adversarial docs audit), and the console
+    says so (it said "stopping after this step": a user trial). Ctrl-C during the last step
+    finishes the run too (it ended "interrupted after step 3 of 3", exit 130)."""
     import json
 
     from multiscale.io import History
@@ -301,9 +303,24 @@ def test_ctrl_c_while_the_end_is_written_lets_it_finish(tmp_path, monkeypatch):
     assert json.loads((folder / "provenance.json").read_text())["status"] == "finished"
     assert len(History.read(folder / "history.h5")) == 4 and (folder / "history.png").stat().st_size > 0
     assert result.history_file == folder / "history.h5" and titles == ["cooling_block"]
+    err = capfd.readouterr().err
+    assert "Ctrl-C: the steps are done; held until their results are written" in err and "stopping" not in err
+    from multiscale.io import StepStop
+    from multiscale.macro.model import MacroModel as Model
+    step = Model.macro_step
+
+    def last_step_interrupted(self, *args):
+        if self.time > 1.5:                          # the third and last step (end 3 s)
+            os.kill(os.getpid(), signal.SIGINT)
+            time.sleep(0.01)
+        return step(self, *args)
+    monkeypatch.setattr(Model, "macro_step", last_step_interrupted)
+    result = run(loads(SCENE.format(folder=tmp_path / "last")), overwrite=True, verbose=False)
+    assert json.loads((tmp_path / "last" / "provenance.json").read_text())["status"] == "finished"
+    assert len(result.history) == 4 and "stopping after this step" in capfd.readouterr().err
+    monkeypatch.setattr(Model, "macro_step", step)
     # stopped during the steps (after the first): the figure's title says so (it said nothing: a user trial)
     from multiscale.errors import Interrupted
-    from multiscale.io import StepStop
     monkeypatch.setattr(transient, "write_history", lambda *a, **k: titles.append(k.get("title")) or written(*a, **k))
     monkeypatch.setattr(StepStop, "requested", lambda self: True)
     with pytest.raises(Interrupted, match="after step 1 of 3"):

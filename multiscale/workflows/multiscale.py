@@ -214,13 +214,13 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                         history.append(**ms.record(stepped))
                         ms.save(ckpt, n, history)
                         write_history(history, folder, scene.name, comm, plot=False)   # readable if the run is killed
-                        done, stopping = n, stop.requested()
+                        done, stopping = n, n < steps and stop.requested()   # (the last: it finishes)
                         if n % every == 0 or n == steps or stopping:   # a stop's are dropped when resumed
                             writer.write()
                             ms.mark_fields(ckpt, n, comm)
                     if stopping:
                         break
-            with io.stage("writing history and plots"), stop.writing(done):
+            with io.stage("writing history and plots"), stop.writing(done, last=not stopping):
                 title = scene.name + stopped_after(done, steps) * stopping
                 h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures, title=title)
                 plot, maps, zones = write_zone_results(ms, folder, history, title, comm, scene.output.figures)

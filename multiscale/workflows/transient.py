@@ -88,14 +88,14 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
                     heat = model.macro_step(scene.time.dt, scene.time.substeps)
                     with stop.writing(n):            # the step's fields and history, whole
                         history.append(**model.record(heat))
-                        done, stopping = n, stop.requested()
+                        done, stopping = n, n < steps and stop.requested()   # (the last: it finishes)
                         if n % scene.output.every == 0 or n == steps or stopping:
                             writer.write()
                         if n < steps:                # a killed run keeps the history of its steps
                             write_history(history, folder, scene.name, comm, plot=False)
                     if stopping:
                         break
-            with io.stage("writing history and plots"), stop.writing(done):
+            with io.stage("writing history and plots"), stop.writing(done, last=not stopping):
                 h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures,
                                         title=scene.name + stopped_after(done, steps) * stopping)
         model.close()                    # on every rank in the same order (MUMPS' destruction communicates)
