@@ -38,7 +38,7 @@ from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FI
                                        Micro, Output, Roughness, Time, Wear)
 from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_phases, speed_range,
                                    squeal_state, thin_heated_layers)
-from multiscale.scene_keys import key_parts, replaced
+from multiscale.scene_keys import key_parts, replaced, table_at
 from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks, speed_law_zeros, torque_problems
 from multiscale.scene_stability import Stability, undamped_falling_law, unresolved_band
 from multiscale.scene_vehicle import Vehicle
@@ -315,10 +315,11 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
                              "entries (boundary[2].emissivity)" if table and all(isinstance(e, dict) for e in table) else
                              "one item of an array; give the whole array (geometry.axis = [0, 0, 1])"))
         table[last] = value
-        for other in replaced(Scene, [*parents, last]):        # the file's alternative goes, unless also given
-            if not any(g[:len(parents) + 1] == (*parents, other) for g in given) and other in table:   # (a key of it
-                del table[other]                                        # too: it dropped loading.stribeck.kinetic)
-                name = "".join(f"[{p}]" if p.isdigit() else f".{p}" for p in [*parents, other]).lstrip(".")
+        for *where, other in replaced(Scene, [*parents, last]):   # the file's alternative goes, unless also given
+            holder = table_at(raw, where)
+            if not any(g[:len(where) + 1] == (*where, other) for g in given) and other in holder:   # (a key of it
+                del holder[other]                                       # too: it dropped loading.stribeck.kinetic)
+                name = "".join(f"[{p}]" if p.isdigit() else f".{p}" for p in [*where, other]).lstrip(".")
                 dropped.append(f"{dotted} replaces the file's {name}")
     effects = raw.get("effects")
     active = frozenset(e for e in effects if isinstance(e, str) and e in EFFECTS) \

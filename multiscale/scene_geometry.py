@@ -20,7 +20,7 @@ from pathlib import Path
 from multiscale.errors import InputError, InputErrors
 from multiscale.geometry import FIXED_BODY, MAX_CELLS, GeometrySpec, Rotation, Support, builder, builder_names
 from multiscale.outputs import name_problem
-from multiscale.schema import (Bad, Choice, FilePath, FrozenMap, Integer, ListOf, Named, OneOf, Quantity,
+from multiscale.schema import (Bad, Choice, FilePath, FrozenMap, Integer, ListOf, Named, OneOf, OnlyWith, Quantity,
                                Section, Text, Vector, key, parse, read, show, suggest, unknown_keys)
 from multiscale.schema import reference as schema_reference
 from multiscale.scene_plain import contains_hint
@@ -100,14 +100,10 @@ class SurfaceSelection:
     normal: tuple | None = key(_DIRECTION, absent="group or contains picks the faces")
     contains: tuple | None = key(Points(), absent="group or normal picks the faces")   # m, a point on each face
 
-    rules = (OneOf(("group", "normal", "contains"), required=True),)
+    rules = (OneOf(("group", "normal", "contains"), required=True), OnlyWith(("normal", "contains"), ("body",)))
 
     def problems(self, path, ctx):
-        if self.normal is not None and self.body is None:
-            return [f"{path}.body: missing; needed with {path}.normal"]
-        if self.group is not None and self.body is not None:
-            return [f"{path}.body: not used with {path}.group"]
-        return []
+        return [f"{path}.body: missing; needed with {path}.normal"] if self.normal is not None and self.body is None else []
 
 
 @dataclass(frozen=True)

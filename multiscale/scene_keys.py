@@ -29,24 +29,37 @@ def key_parts(dotted: str) -> list[str]:
     return parts if table == 0 else dotted.split(".")
 
 
-def replaced(cls, parts: list[str]) -> tuple[str, ...]:
-    """The keys of the same table that the key at ``parts`` (``key_parts``) replaces, by the rules of
-    the schema ``cls``: its alternatives (``OneOf``: ``loading.pressure`` replaces ``normal_force``)
-    and the keys used only with those (``OnlyWith``: ``roughness.file`` replaces ``rms`` and its
-    ``hurst``, ``k_min``, ...), so that a key given over a file replaces the file's (``--set
+def replaced(cls, parts: list[str]) -> tuple[tuple[str, ...], ...]:
+    """The keys (as table paths from the root) that the key at ``parts`` (``key_parts``) replaces, by
+    the rules of the schema ``cls`` on its way: the alternatives (``OneOf``: ``loading.pressure``
+    replaces ``normal_force``; a rule's key may lie in a sub-table, ``loading.vehicle.mass``, and a key
+    inside an alternative gives it, ``loading.vehicle.speed`` replaces ``rotation_speed``) and the
+    keys used only with those (``OnlyWith``: ``roughness.file`` replaces ``rms`` and its ``hurst``,
+    ``k_min``, ...), so that a key given over a file replaces the file's (``--set
     loading.pressure=...`` was refused, "give only one of them", and --set cannot remove a key: a
-    user trial). () where none or the table is unknown."""
-    *tables, last = parts
-    k = 0
-    while k < len(tables) and dataclasses.is_dataclass(cls):
-        spec = dict(fields_of(cls)).get(tables[k])
+    user trial). () where none or a table is unknown."""
+    out, k = [], 0
+    while dataclasses.is_dataclass(cls):
+        rest, rules = ".".join(parts[k:]), getattr(cls, "rules", ())
+        mine = [r for r in rules if isinstance(r, OneOf) and any(f"{rest}.".startswith(f"{o}.") for o in r.keys)]
+        others = [o for r in mine for o in r.keys if not f"{rest}.".startswith(f"{o}.")]
+        others += [key for r in rules if isinstance(r, OnlyWith) and set(r.key) <= set(others) for key in r.keys]
+        out += [(*parts[:k], *o.split(".")) for o in others]
+        spec = dict(fields_of(cls)).get(parts[k]) if k < len(parts) - 1 else None
         if spec is None or not isinstance(spec.parser, Section):
-            return ()
+            break
         cls = getattr(spec.parser, "key_schema", spec.parser.cls)      # [geometry]: a geometry file's tables
         k += 2 if isinstance(spec.parser, (Named, Tables)) else 1      # a table's name, an entry's number
-    if k != len(tables) or not dataclasses.is_dataclass(cls):
-        return ()
-    rules = getattr(cls, "rules", ())
-    others = [o for r in rules if isinstance(r, OneOf) and last in r.keys for o in r.keys if o != last]
-    return tuple(others + [key for r in rules if isinstance(r, OnlyWith) and set(r.key) <= set(others)
-                           for key in r.keys])
+    return tuple(out)
+
+
+def table_at(raw: dict, parts) -> dict:
+    """The table of the raw scene ``raw`` at the path ``parts`` (an array's entry by its number from
+    1); {} where there is none."""
+    table = raw
+    for part in parts:
+        if isinstance(table, list):
+            table = table[int(part) - 1] if part.isdigit() and 1 <= int(part) <= len(table) else {}
+        else:
+            table = table.get(part, {}) if isinstance(table, dict) else {}
+    return table if isinstance(table, dict) else {}

@@ -296,8 +296,10 @@ class Loading:
                                              "mu", min_rows=2), absent="friction or stribeck gives mu")  # ((m/s, -),..)
     stribeck: Stribeck | None = key(Section(Stribeck))
 
-    rules = (OneOf(("normal_force", "pressure")), OneOf(FRICTION), OneOf(("rotation_speed", "speed_profile", "vehicle"),
-             meaning="a vehicle is one stop or drag; several stops: speed and load profiles"))
+    rules = (OneOf(("normal_force", "pressure", "braking_torque", "vehicle.mass"),
+                   meaning="each gives the load (a torque or a vehicle's mass: the clamp force that brakes)"),
+             OneOf(FRICTION), OneOf(("rotation_speed", "speed_profile", "vehicle"),
+                                    meaning="a vehicle is one stop or drag; several stops: speed and load profiles"))
 
     def problems(self, path, ctx):
         wrong = law_problems(path, [k for k in FRICTION if getattr(self, k) is not None], ctx)
@@ -308,10 +310,6 @@ class Loading:
                                 "deceleration (or slope) whatever the load factor; a release does not stop it")
         given = [k for k in ("normal_force", "pressure") if getattr(self, k) is not None]
         by_mass = self.vehicle is not None and self.vehicle.mass is not None
-        if self.braking_torque is not None and (given or by_mass):
-            return [f"{path}.braking_torque: give the torque or {path}.{(given or ['vehicle.mass'])[0]}, not both"]
-        if given and by_mass:
-            return [f"{path}.{given[0]}: give the load or {path}.vehicle.mass, not both"]
         if (self.braking_torque is not None or by_mass) and "friction" not in ctx.effects:   # (a vehicle's: check
             key = "braking_torque" if self.braking_torque is not None else "vehicle.mass"   # said OK: a user trial)
             return [f'{path}.{key}: the clamp force follows from the friction moment: needs effect "friction"']

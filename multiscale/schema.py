@@ -110,7 +110,8 @@ class Quantity:
         self.name, self.kind, self.gt, self.ge, self.lt, self.le = kind, KINDS[kind], gt, ge, lt, le
         self.plausible, self.outside = plausible, outside
 
-    def _range(self) -> str:
+    def range_text(self) -> str:
+        """The allowed range with its unit (">= 0 Pa", "in (0, 1]"), or ""."""
         unit = f" {self.kind.si}" if self.kind.si else ""
         low = f"> {self.gt:g}" if self.gt is not None else f">= {self.ge:g}" if self.ge is not None else None
         high = f"< {self.lt:g}" if self.lt is not None else f"<= {self.le:g}" if self.le is not None else None
@@ -120,12 +121,8 @@ class Quantity:
             return f"in {lb}{lo:g}, {hi:g}{rb}{unit}"
         return f"{low or high}{unit}" if (low or high) else ""
 
-    def range_text(self) -> str:
-        """The allowed range with its unit (">= 0 Pa", "in (0, 1]"), or ""."""
-        return self._range()
-
     def describe(self) -> str:
-        rng = self._range()
+        rng = self.range_text()
         examples = f" ({self.kind.examples})" if self.kind.examples not in ("", self.kind.si) and self.kind.si else ""
         return f"{_a(self.kind.name)}{' ' + rng if rng else ''}{examples}{self._plausible()}"
 
@@ -144,7 +141,7 @@ class Quantity:
               and (self.lt is None or v < self.lt) and (self.le is None or v <= self.le))
         if not ok:
             shown = "" if not isinstance(raw, str) else f" (got {v:g} {self.kind.si})".replace(" )", ")")
-            raise Bad(f"must be {self._range()}{shown}{': ' * bool(self.outside)}{self.outside}")
+            raise Bad(f"must be {self.range_text()}{shown}{': ' * bool(self.outside)}{self.outside}")
         ctx.implausible.extend(unit_advice(raw, self.kind))
         if self.plausible is not None and not self.plausible[0] <= v <= self.plausible[1]:
             unit = f" {self.kind.si}" if self.kind.si else ""
@@ -433,7 +430,8 @@ def _needing(needed_by, unless, effects) -> str | None:
 
 @dataclass(frozen=True)
 class OneOf:
-    """At most one of ``keys`` (``meaning``: what they are); exactly one when required or needed_by."""
+    """At most one of ``keys`` (``vehicle.mass``: a sub-table's; ``meaning``: what they are); exactly one
+    when required or needed_by."""
 
     keys: tuple[str, ...]
     required: bool = False
@@ -564,6 +562,7 @@ def read(cls, raw, path: str, ctx: Context):
         elif (spec.required or effect) and missing:
             ctx.problems.append(f"{where}: missing; {why}: {spec.parser.describe()}")
     present, rules = {k for k in raw if k in specs}, getattr(cls, "rules", ())
+    present |= {f"{k}.{s}" for k in present if isinstance(raw[k], dict) for s in raw[k]}   # a sub-table's key
     clash = {k for r in rules if isinstance(r, OneOf) and len(present & set(r.keys)) > 1 for k in r.keys}
     for rule in (r for r in rules if getattr(r, "key", None) not in clash):   # alternatives given together:
         ctx.problems.extend(rule.check(present, path or "scene", ctx))        # one problem, not what each needs

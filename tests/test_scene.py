@@ -588,7 +588,9 @@ def test_a_braking_torque_gives_the_load_of_a_rotating_body_with_friction(tmp_pa
             in "\n".join(summary(cold)))
     assert to_si("957.6 N m", "torque") == pytest.approx(957.6) and to_si("1 kN*m", "torque") == 1e3
     cases = [(pod.replace('normal_force = "200 N"', 'normal_force = "200 N"\nbraking_torque = "30 N m"'),
-              "loading.braking_torque: give the torque or loading.normal_force, not both"),
+              "loading.normal_force or loading.pressure or loading.braking_torque or loading.vehicle.mass: give only one "
+              "of them: each gives the load (a torque or a vehicle's mass: the clamp force that brakes) (got normal_force, "
+              "braking_torque)"),
              (torque.replace('"friction", ', ""),
               'loading.braking_torque: the clamp force follows from the friction moment: needs effect "friction"'),
              ((DEMOS / "car_brake_stop.toml").read_text().replace('"friction", "thermal", "heat_partition"',
@@ -1237,9 +1239,25 @@ def test_an_override_replaces_the_files_alternative_to_it(tmp_path):
     disc = fixed.boundary[2]                      # and the ambient used only with what it replaced (refused)
     assert (disc.temperature, disc.convection, disc.emissivity, disc.ambient) == (373.15, None, None, None)
     assert "boundary[3].temperature replaces the file's boundary[3].ambient" in fixed.warnings
-    with pytest.raises(SceneError, match=r"give only one of them \(got normal_force, pressure\)"):
+    with pytest.raises(SceneError, match=r"give only one of them: .* \(got normal_force, pressure\)"):
         loads(pod, tmp_path, overrides={"loading.pressure": "0.375 MPa", "loading.normal_force": "90 N"})
     assert loads(pod, tmp_path, overrides={"micro.grid": [16, 16]}).loading.normal_force == 200.0   # no rule
+    # the load's alternatives, a sub-table's key among them (refused by name: a user trial)
+    held = loads(car, DEMOS, overrides={"loading.normal_force": "2 kN"})      # a stop at a fixed clamp force
+    assert (held.loading.normal_force, held.loading.vehicle.mass, held.loading.vehicle.speed) == (2000.0, None, 27.77777777777778)
+    assert "loading.normal_force replaces the file's loading.vehicle.mass" in held.warnings
+    torque = loads(pod, tmp_path, overrides={"loading.braking_torque": "3 N m"})
+    assert (torque.loading.braking_torque, torque.loading.normal_force) == (3.0, None)
+    stop = loads(pod, tmp_path, overrides={"loading.vehicle.mass": "300 kg", "loading.vehicle.speed": "1 m/s",
+                                            "loading.vehicle.wheel_radius": "0.3 m",
+                                            "loading.vehicle.deceleration": "2 m/s^2"})
+    assert (stop.loading.vehicle.mass, stop.loading.normal_force, stop.loading.rotation_speed) == (300.0, None, None)
+    assert {"loading.vehicle.mass replaces the file's loading.normal_force",   # a key inside an alternative gives it
+            "loading.vehicle.mass replaces the file's loading.rotation_speed"} <= set(stop.warnings)
+    with pytest.raises(SceneError) as info:           # a group replaces a selection's normal and its body
+        loads(car, DEMOS, overrides={"geometry.surfaces.piston.group": "piston_back"})   # (refused by name)
+    assert info.value.problems == ["geometry.surfaces.piston.group = 'piston_back': no physical surface of "
+                                   "car_brake.step has this name; known: none"]
     measured = str(Path(__file__).parent / "data" / "sdf-1.sdf")
     with pytest.raises(SceneError) as info:              # rms and its hurst, k_min, k_max, patch go with it:
         loads(pod, tmp_path, overrides={"roughness.file": measured})     # the file itself is judged (too small)
