@@ -202,6 +202,17 @@ def check_field(name: str, value, *, min_ndim: int = 0, nonnegative: bool = Fals
     return a
 
 
+def check_mask(name: str, value, *, min_ndim: int = 2) -> np.ndarray:
+    """``value`` as a bool array with at least ``min_ndim`` axes: bools, or numbers all 0 or 1, else
+    ``InputError`` (a gap or pressure field given as a contact mask was read as "non-zero: in
+    contact", its out-of-contact cells: a user trial)."""
+    a = check_field(name, value, min_ndim=min_ndim)
+    if not np.all((a == 0) | (a == 1)):
+        raise InputError(name, _summary(value), "must be a mask: True (or 1) where in contact, e.g. "
+                         "ContactResult.contact, not a gap or pressure field")
+    return a == 1
+
+
 def check_table(name: str, value, what: str) -> tuple[np.ndarray, np.ndarray]:
     """(temperatures [K], values) of a table given as two 1-D sequences of equal length >= 2 with
     finite, strictly increasing temperatures; InputError naming ``name`` (``what``: the allowed forms)."""

@@ -239,6 +239,12 @@ def test_bad_input_is_named():
         solver.solve(np.ones((8, 8), bool))              # semi-infinite bodies, full contact, R = 0
     with pytest.raises(InputError, match="contact.shape"):
         solver.solve(np.ones((4, 8), bool))
+    gap = np.where(mask, 0.0, 1e-7)              # a gap field for the mask: its zeros were taken as out of
+    with pytest.raises(InputError, match="must be a mask: True"):      # contact, a conductance 4e4x too high
+        solver.solve(gap)                        # (a user trial)
+    with pytest.raises(InputError, match="masks"):
+        solver.uniform_resistance(-2e6 * mask)
+    assert solver.solve(mask.astype(int)).conductance == solver.solve(mask).conductance     # 0/1 numbers are a mask
     surface = fractal_surface(16, 1e-3, 0.8, 2, 5, 6e-6)
     with pytest.raises(InputError, match="pressures"):
         conductance_law(surface, HalfSpace(4e9), (K1, K2), [1e6, -1e6])

@@ -33,7 +33,7 @@ from functools import cached_property
 import numpy as np
 
 from multiscale.errors import (ConvergenceError, InputError, check_count, check_field, check_flag, check_instance,
-                               check_positive, check_real)
+                               check_mask, check_positive, check_real)
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import InfluenceOperator, Kernel, check_kernel
 from multiscale.micro.surface import Surface, check_surface
@@ -112,7 +112,7 @@ class ConductionSolver:
     def uniform_resistance(self, masks) -> np.ndarray:
         """R_u [m² K/W] of each mask (..., ny, nx): the mean over it of the temperature difference of
         the two surfaces under a uniform unit flux on it (the series kernels' response)."""
-        masks = np.asarray(masks, dtype=float)
+        masks = check_mask("masks", masks).astype(float)
         return np.sum(self.series(masks) * masks, axis=(-2, -1)) / masks.sum(axis=(-2, -1))
 
     @cached_property
@@ -136,7 +136,7 @@ class ConductionSolver:
         initial_flux: warm start (W/m², restricted to the contact). Raises
         ``ConductionConvergenceError`` if not converged, unless ``partial``.
         """
-        mask = check_field("contact", contact, min_ndim=2) != 0
+        mask = check_mask("contact", contact)
         if mask.shape[-2:] != self.shape:
             raise InputError("contact.shape", mask.shape, f"last two axes must be {self.shape}")
         R = check_field("resistance", resistance, nonnegative=True)
