@@ -421,6 +421,14 @@ def test_errors_name_the_argument():
         InterfaceLayer(1e-6, n=2, generation="parabolic")
     with pytest.raises(InputError, match="speed"):
         partition_law(Surface(np.zeros((8, 8)), 1e-5, 1e-5), DISC, PIN, 0.0, [1e6], mu=0.4, elastic=ELASTIC)
+    # a rotating patch on or near the axis: no heat and NaN partitions, or one speed where the patch's
+    # points move at several times it in opposite directions (a user trial); 0.8 mm x 0.8 mm: 0.566 mm
+    with pytest.raises(InputError, match=r"^pressures = \[\]: one or more mean pressures > 0"):   # (blamed the
+        partition_law(Surface(np.zeros((8, 8)), 1e-5, 1e-5), DISC, PIN, 1.0, [], mu=0.4, elastic=ELASTIC)  # heights)
+    for centre in ((0.0, 0.0), (1e-4, 0.0), (0.0, -2.8e-3)):       # half-diagonal: refused within 2.83 mm
+        with pytest.raises(InputError, match=r"^motion.centre = .*within 5 x the patch's half-diagonal 0.000566 m"):
+            TransientHeating((8, 8), 1e-4, DISC, PIN, Rotation(centre, SpeedProfile.constant(10.0)), 1e-4, 2)
+    TransientHeating((8, 8), 1e-4, DISC, PIN, Rotation((0.0, -2.9e-3), SpeedProfile.constant(10.0)), 1e-4, 2)
 
 
 def test_non_convergence_raises_or_flags():

@@ -35,10 +35,12 @@ from multiscale.errors import (ConvergenceError, InputError, check_count, check_
 from multiscale.memory import memory_limit
 from multiscale.micro.contact import ContactResult, ContactSolver
 from multiscale.micro.fft import RealFFT2
-from multiscale.micro.heat_kernels import Motion, ThermalMaterial, Translation, pulse_tables
+from multiscale.micro.heat_kernels import Motion, Rotation, ThermalMaterial, Translation, pulse_tables
 from multiscale.micro.kernels import Kernel, check_kernel, grid_shape, padded_size
 from multiscale.micro.masked_krylov import masked_solve
 from multiscale.micro.surface import Surface
+
+FAR_AXIS = 0.2   # a rotating patch's half-diagonal at most this times its centre's radius (speeds within ±20 %)
 
 
 class HeatingConvergenceError(ConvergenceError):
@@ -286,6 +288,11 @@ class TransientHeating:
                              "job's limit): fewer steps (a longer dt) or a coarser grid")
         _check_bodies(body1, body2)
         check_instance("motion", motion, Motion, "a Motion (Rotation or Translation)")
+        reach = 0.5 * float(np.hypot(self.shape[0] * self.dy, self.shape[1] * self.dx))   # m, centre to corner
+        if isinstance(motion, Rotation) and reach > FAR_AXIS * motion.radius:   # (on the axis: no heat, NaN
+            raise InputError("motion.centre", motion.centre, f"{motion.radius:.3g} m from the axis, within "    # partitions:
+                             f"{1 / FAR_AXIS:g} x the patch's half-diagonal {reach:.3g} m: the patch moves with its "  # a user
+                             "centre's speed (far-axis approximation), whose error is of order that ratio")  # trial)
         self.body1, self.body2, self.motion = body1, body2, motion
         self._pad = _Padded(self.shape)
         self._tables2 = self._spectra(pulse_tables(self._pad.half, self.dx, self.dy, body2, self.dt, self.n_steps))
@@ -535,8 +542,8 @@ def partition_law(source, body1: ThermalMaterial, body2: ThermalMaterial, speed,
         if source.heights.ndim != 2:
             raise InputError("source", source.heights.shape, "one patch (a 2-D height map)")
         loads = np.sort(np.atleast_1d(check_field("pressures", pressures)))
-        if loads.ndim != 1 or not np.all(np.isfinite(loads)) or np.any(loads <= 0):
-            raise InputError("pressures", pressures, "mean pressures must be finite and > 0")
+        if loads.ndim != 1 or not loads.size or np.any(loads <= 0):    # (empty: "heights.shape ... no patch")
+            raise InputError("pressures", pressures, "one or more mean pressures > 0 [Pa] (a 1-D array)")
         h = np.broadcast_to(source.heights, loads.shape + source.shape)
         contact = ContactSolver(elastic, source.shape, source.dx, source.dy, source.periodic).solve(
             h, load=loads, tol=tol)
