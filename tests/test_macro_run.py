@@ -369,6 +369,18 @@ def test_a_material_table_is_judged_by_the_temperatures_of_its_own_cells(tmp_pat
         assert [w for w in lines if "materials.disc.kappa" in w] == (
             ["materials.disc.kappa: at 350 degC, above its last point 300 degC, held at 45 there (in body 'disc')"]
             if warned else []), lines
+    # a table the initial temperature is below already (said when read) is still judged at its top end
+    table = '[["30 degC", "50 W/(m K)"], ["40 degC", "45 W/(m K)"]]'                 # (it was not: a user trial)
+    scene = loads(pin_on_disc(tmp_path / "out").replace('kappa = "50 W/(m K)"', f"kappa = {table}"))
+    assert any("kappa: at 20 degC, below its first point 30 degC" in w for w in scene.warnings)
+    for disc, warned in ((25.0, False), (65.0, True)):
+        h = History()
+        for k, scale in enumerate((0.0, 1.0)):
+            h.append(time=0.6 * k, max_temperature_pin=293.15, max_temperature_pin_in_pin=293.15,
+                     max_temperature_pin_in_disc=293.15, max_temperature_disc=293.15 + scale * (disc - 20))
+        assert [w for w in run_warnings(scene, h) if "materials.disc.kappa" in w] == (
+            ["materials.disc.kappa: at 65 degC, above its last point 40 degC, held at 45 there (in body 'disc')"]
+            if warned else [])
 
 
 def test_a_body_hotter_than_any_material_is_warned_about(tmp_path):

@@ -172,11 +172,16 @@ def run_warnings(scene, history) -> list[str]:
     # k_w is read at the micro temperatures (``_wear_table_ends``), the strain's without expansion at T0
     unread = ("k_w",) + (() if scene.has("expansion") else Material.STRAIN)
     for name in hottest:
-        known = scene.materials[name].beyond(T0)
+        material = scene.materials[name]
+
+        def side(key, T, table_of=material):        # -1 below the table's first point, 1 above its last, 0 in it
+            table = getattr(table_of, key)
+            return (T > table[-1][0]) - (T < table[0][0])
         for T, body in dict.fromkeys((hottest[name], coldest.get(name, hottest[name]))):   # the hottest, the coldest
             why = ": an undershoot, below every imposed temperature" if T < _floor(scene) else ""   # (a trial
             out += [f"materials.{name}.{phrase} (in body {body!r}{why})"          # read it apart from the undershoot)
-                    for key, phrase in scene.materials[name].beyond(T).items() if key not in known and key not in unread]
+                    for key, phrase in material.beyond(T).items()   # a table T0 left at its other end too (a trial)
+                    if key not in unread and side(key, T) != side(key, T0)]
     return (out + laws + _undershoots(scene, history) + _coarse_wear(history) + _wear_table_ends(scene, history)
             + _too_hot(scene, history) + _fade_table_ends(scene, history) + _curve_ends(scene, history)
             + _unloaded(scene, history)
