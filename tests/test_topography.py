@@ -328,7 +328,8 @@ def test_a_flat_or_planar_matrix_has_no_roughness(tmp_path, heights):
 
 def test_heights_in_the_wrong_unit_are_warned_about_and_an_overflow_refused(tmp_path, capsys):
     """A matrix in um read as metres (Sq 2 m on a 20 mm pin ran to the end without a word): a
-    warning naming the file and height_unit, also in `multiscale check`; heights whose spread
+    warning naming the file and height_unit, also in `multiscale check`, and refused once its
+    conditioned Sq exceeds ``reading.TALLEST`` (the run went on with the warning); heights whose spread
     overflows (1e294) one InputError (before: Sq inf, then a ContactNonFiniteError in every zone)."""
     from multiscale.micro.topography import TopographyWarning, probe_topography
     h = fractal_surface(32, 32e-6, 0.8, 2, 8, 1e-6, seed=1).heights
@@ -337,6 +338,11 @@ def test_heights_in_the_wrong_unit_are_warned_about_and_an_overflow_refused(tmp_
                       r"one unit of the file = m\), far beyond a rough surface's: is roughness\.height_unit right\?"):
         read_topography(tmp_path / "um.npy", pixel_size=1e-6, prefix="roughness.")
     assert probe_topography(tmp_path / "um.npy", pixel_size=1e-6)[1][0].startswith("file = 'um.npy': heights up to")
+    from multiscale.micro.topography import condition        # its conditioned Sq beyond a measurement's: refused
+    with pytest.raises(InputError, match=r"^roughness\.file = 'um.npy': Sq 0\.[0-9]+ m after form removal and "
+                       r"outliers, beyond any roughness .*: is roughness\.height_unit right\?"):   # (it ran to
+        with pytest.warns(TopographyWarning):                                          # the end: a user trial)
+            condition(read_topography(tmp_path / "um.npy", pixel_size=1e-6, prefix="roughness."), prefix="roughness.")
     with warnings.catch_warnings():
         warnings.simplefilter("error", TopographyWarning)
         read_topography(tmp_path / "um.npy", pixel_size=1e-6, height_unit=1e-6)      # in its unit: no word

@@ -30,7 +30,7 @@ import numpy as np
 from multiscale.errors import InputError, check_count, check_instance, check_pair, check_positive, check_real
 from multiscale.micro.filters import check_cutoff, gaussian_filter, gaussian_per_axis, resolved, roughness_of
 from multiscale.micro.outliers import DESPIKE, find_outliers
-from multiscale.micro.reading import Measurement, TopographyWarning, option, read_topography
+from multiscale.micro.reading import TALLEST, Measurement, TopographyWarning, option, read_topography
 from multiscale.micro.spectrum import Spectrum, as_topography, equivalent_surface, power_spectrum
 from multiscale.micro.surface import Surface, defined_sums, row_blocks
 
@@ -230,9 +230,12 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
         report.append(f"waviness removed: Gaussian filter (ISO 16610-61) at λc = {cutoff * 1e3:.4g} mm{longer}: "
                       f"Sq waviness {_um(float(waviness.heights.std()))} um, roughness "
                       f"{_um(float(surface.heights.std()))} um")
-    scale = float(np.nanmax(np.abs(m.heights), initial=0.0))
-    if not surface.heights.std() > FLAT * scale:
-        raise InputError(option(prefix, "file"), m.path.name, _no_roughness(float(surface.heights.std()), scale))
+    scale, sq = float(np.nanmax(np.abs(m.heights), initial=0.0)), float(surface.heights.std())
+    if not sq > FLAT * scale:
+        raise InputError(option(prefix, "file"), m.path.name, _no_roughness(sq, scale))
+    if sq > TALLEST:          # (um read as m ran to the end: micro pressures 28x E*, exit 0; a user trial)
+        raise InputError(option(prefix, "file"), m.path.name, f"Sq {sq:.3g} m after form removal and outliers, "
+                         f"beyond any roughness (an instrument's z range is mm): is {option(prefix, 'height_unit')} right?")
     return Conditioned(surface, waviness, tuple(report), tuple(notes))
 
 
