@@ -5,7 +5,6 @@ import ast
 import multiprocessing
 import subprocess
 import sys
-from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 import pytest
@@ -189,9 +188,15 @@ ALONE = "import sys\nassert not [m for m in sys.modules if m.split('.')[0] in {p
 def test_every_module_imports_on_its_own_in_a_fresh_process():
     context = multiprocessing.get_context("forkserver")
     context.set_forkserver_preload(PRELOAD)
-    with ProcessPoolExecutor(2, mp_context=context, max_tasks_per_child=1) as pool:
-        done = {name: pool.submit(exec, ALONE.format(packages=PACKAGES, name=name), {}) for name in sorted(MODULES)}
-    failed = {name: repr(f.exception()) for name, f in done.items() if f.exception() is not None}
+    with context.Pool(2, maxtasksperchild=1) as pool:  # (not ProcessPoolExecutor's max_tasks_per_child: it can deadlock,
+        done = {name: pool.apply_async(exec, (ALONE.format(packages=PACKAGES, name=name), {}))   # CPython
+                for name in sorted(MODULES)}                                               # gh-115634, here 3.12.1)
+        failed = {}
+        for name, result in done.items():
+            try:
+                result.get(timeout=600)
+            except Exception as exc:             # (a child's failed import, re-raised here)
+                failed[name] = repr(exc)
     assert failed == {}
 
 
