@@ -603,6 +603,10 @@ def test_a_stop_and_a_restart_keep_every_result_finite(tmp_path):
     assert h["wear_volume"][2] == h["wear_volume"][1]
     assert h["heat_step_pin"][2] == h["heat_step_pin"][3] == 0.0 and h["wear_volume"][4] > h["wear_volume"][3]
     assert h["partition_mean"][3] != h["partition_mean"][2] and h["heat_exchanged_step"][4] != 0.0
+    for body in ("pin", "disc"):      # each body's balance by its own columns (history.png drew no conduction: a trial)
+        np.testing.assert_allclose(h[f"stored_heat_{body}"], h[f"heat_total_{body}"] + h[f"heat_conducted_total_{body}"],
+                                   rtol=1e-9, atol=1e-9 * h["heat_total_disc"][-1])
+    assert h["heat_conducted_total_disc"][-1] == -h["heat_conducted_total_pin"][-1] == h["heat_exchanged_total"][-1]
 
 def resumed_rtol(key: str, rtol: float = 1e-6) -> float:
     """Relative tolerance of history column ``key`` between a resumed run and the straight one

@@ -76,8 +76,9 @@ def test_the_pads_heat_and_face_temperatures_have_their_own_panels(tmp_path, dra
 
 
 def test_each_bodys_heat_in_stored_and_lost_and_each_parts_stored_heat_are_drawn(tmp_path, drawn):
-    """The heat of each body: into it (heat_total_<body>, solid), stored in it (stored_heat_<body>,
-    dashed) and lost by it (heat_lost_total_<body>, dotted), a colour per body, each named once
+    """The heat of each body: into it (heat_total_<body>, solid), conducted into it from the other
+    (heat_conducted_total_<body>, dashed), stored in it (stored_heat_<body>, dotted) and lost by it
+    (heat_lost_total_<body>, dash-dotted), a colour per body, each named once
     in the legend; a body of several parts has each part's stored heat in a panel of its own
     (before, only the heat into each body was drawn)."""
     history = History()
@@ -86,17 +87,20 @@ def test_each_bodys_heat_in_stored_and_lost_and_each_parts_stored_heat_are_drawn
                        max_temperature_disc=305.0 + t, heat_total_fixed=t, heat_total_disc=9 * t,
                        stored_heat_fixed=0.8 * t, stored_heat_disc=7 * t, heat_lost_total_fixed=0.2 * t,
                        heat_lost_total_disc=2 * t, stored_heat_fixed_part_pad=0.6 * t,
-                       stored_heat_fixed_part_backplate=0.2 * t)
+                       stored_heat_fixed_part_backplate=0.2 * t, heat_conducted_total_fixed=-0.1 * t,
+                       heat_conducted_total_disc=0.1 * t, heat_exchanged_total=0.1 * t)
     plots.history_figure(history, tmp_path / "history.png")
     axes = {ax.get_ylabel(): ax for ax in drawn[0].axes if ax.get_visible()}
     heat = axes["heat of each body [J]"]
     drawn_as = {(line.get_label(), line.get_linestyle()): tuple(line.get_ydata()) for line in heat.get_lines()}
-    assert drawn_as == {("fixed", "-"): (0, 1, 2), ("fixed", "--"): (0, 0.8, 1.6), ("fixed", ":"): (0, 0.2, 0.4),
-                        ("disc", "-"): (0, 9, 18), ("disc", "--"): (0, 7, 14), ("disc", ":"): (0, 2, 4)}
+    assert drawn_as == {("fixed", "-"): (0, 1, 2), ("fixed", "--"): (0, -0.1, -0.2), ("fixed", ":"): (0, 0.8, 1.6),
+                        ("fixed", "-."): (0, 0.2, 0.4), ("disc", "-"): (0, 9, 18), ("disc", "--"): (0, 0.1, 0.2),
+                        ("disc", ":"): (0, 7, 14), ("disc", "-."): (0, 2, 4)}   # (conducted: not drawn, a trial)
     colours = {line.get_label(): {str(other.get_color()) for other in heat.get_lines()
                                   if other.get_label() == line.get_label()} for line in heat.get_lines()}
     assert all(len(c) == 1 for c in colours.values()) and colours["fixed"] != colours["disc"]
-    assert [t.get_text() for t in heat.get_legend().get_texts()] == ["fixed", "disc", "into", "stored", "lost"]
+    assert [t.get_text() for t in heat.get_legend().get_texts()] == ["fixed", "disc", "into", "conducted in", "stored",
+                                                                     "lost"]
     parts = axes["heat stored in each part [J]"]
     assert {line.get_label(): tuple(line.get_ydata()) for line in parts.get_lines()} == \
         {"pad": (0, 0.6, 1.2), "backplate": (0, 0.2, 0.4)}

@@ -398,6 +398,8 @@ class MacroModel:
                 row[f"stored_heat_{body.name}"] = stored[i]
             if self.thermal.conductance:      # conducted through the interface conductance (body 0 -> 1)
                 row.update(heat_exchanged_step=self.heat_exchanged, heat_exchanged_total=self.heat_exchanged_total)
+                for i, body in enumerate(self.tm.bodies):       # each body's, by name (history.png draws it)
+                    row[f"heat_conducted_total_{body.name}"] = (2 * i - 1) * self.heat_exchanged_total
             if self.thermal.boundaries:       # heat lost through convection, radiation, fixed temperatures
                 lost = self.thermal.heat_lost
                 for i, body in enumerate(self.tm.bodies):

@@ -36,8 +36,8 @@ def column_label(key: str) -> str:
     as in multiscale.png: "all" clashed with an interface of that name)."""
     if key == "friction_coefficient":
         return "all interfaces"
-    for prefix in ("max_temperature_", "heat_total_", "stored_heat_", "heat_lost_total_", "frictional_heat_total_",
-                   "face_max_temperature_", "friction_coefficient_"):
+    for prefix in ("max_temperature_", "heat_total_", "heat_conducted_total_", "stored_heat_", "heat_lost_total_",
+                   "frictional_heat_total_", "face_max_temperature_", "friction_coefficient_"):
         key = key.removeprefix(prefix)
     key = key.partition("_part_")[2] or key
     body, within, material = key.partition("_in_")
@@ -56,14 +56,15 @@ def temperature_columns(columns) -> list[str]:
 
 
 # the heat of a body by what it is (heat_total_<body> etc.): its word in the legend, in this order
-HEAT_KINDS = {"heat_total_": "into", "stored_heat_": "stored", "heat_lost_total_": "lost"}
+HEAT_KINDS = {"heat_total_": "into", "heat_conducted_total_": "conducted in", "stored_heat_": "stored",
+              "heat_lost_total_": "lost"}
 
 
 def curve_pairs(keys) -> list | None:
     """(colour, line style) names of a panel's columns drawn by two properties, or None: faces
     (face_max_temperature_<interface>_on_<body>: a colour per interface, a style per body) or the
-    heat of bodies (heat_total_, stored_heat_, heat_lost_total_ <body>: a colour per body, a style
-    per kind, if there are several kinds)."""
+    heat of bodies (heat_total_, heat_conducted_total_, stored_heat_, heat_lost_total_ <body>: a colour
+    per body, a style per kind, if there are several kinds)."""
     if all(k.startswith("face_max_temperature_") for k in keys):
         return [(pad, f"on {body}") for pad, _, body in (column_label(k).rpartition(" on ") for k in keys)]
     kinds = [next((word for prefix, word in HEAT_KINDS.items() if k.startswith(prefix)), None) for k in keys]
