@@ -175,3 +175,33 @@ def test_an_initial_pressure_of_another_grid_names_the_heights_shape():
     h = fractal_surface(16, 1e-4, 0.8, 1, 4, 1e-7, seed=3).heights
     with pytest.raises(InputError, match=r"must broadcast to the heights' shape \(16, 16\), one value per cell$"):
         ContactSolver(E, (16, 16), 1e-4 / 16).solve(h, load=1e6, initial_pressure=np.ones((8, 8)))
+
+
+def test_a_solve_beyond_the_memory_is_refused_at_once(monkeypatch):
+    """``contact.BUILD_BYTES`` and its companions give at most the traced peak of a build and a solve (so a refusal is a
+    solve that could not fit), and a grid or batch beyond the process' memory is refused before
+    anything is built (an isolated 4096² solver built for 14 s before a raw MemoryError under a
+    3 GB limit: a user trial)."""
+    import tracemalloc
+
+    from multiscale.micro import contact
+    for periodic, batch in ((True, ()), (False, ()), (True, (8,))):
+        s = fractal_surface(256, 1e-3, 0.8, 2, 64, 1e-6, seed=1, batch=batch)
+        tracemalloc.start()
+        try:
+            ContactSolver(E, s.shape, s.dx, s.dy, periodic).solve(s.heights, load=1e6)
+            peak = tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+        patches = batch[0] if batch else 1
+        per_cell = contact.BUILD_BYTES[periodic] + contact.SCRATCH_BYTES + contact.RESULT_BYTES * patches
+        assert 256**2 * per_cell < peak < 2.5 * 256**2 * per_cell, (periodic, batch, peak)
+    monkeypatch.setattr(contact, "memory_limit", lambda: 2.0**31)
+    with pytest.raises(InputError, match=r"^shape = \(4096, 4096\): an isolated 4096 x 4096 patch takes at least "
+                                         r"5.38 GiB to solve, more than the 2 GiB this process may use"):
+        ContactSolver(E, (4096, 4096), 1e-7, periodic=False)
+    monkeypatch.setattr(contact, "memory_limit", lambda: 2.0**30)
+    solver = ContactSolver(E, (1024, 1024), 1e-7)          # a batch beyond it
+    with pytest.raises(InputError, match=r"^heights.shape = \(20, 1024, 1024\): a periodic 1024 x 1024 patch x 20 "
+                                         r"patches takes at least 1.11 GiB to solve, more than the 1 GiB"):
+        solver.solve(np.broadcast_to(0.0, (20, 1024, 1024)), load=1e6)

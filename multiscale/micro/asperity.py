@@ -49,9 +49,9 @@ class AsperityResult:
     area: float                #: m², real contact area A (Eq. 1.8)
     mean_pressure: float       #: Pa, F / A0
     area_fraction: float       #: -, A / A0
-    mean_gap: float            #: m, g_n = (z_M − z̄) − delta (Eq. 1.9): the flat's height above the mean plane of
-    #                            the undeformed surface (negative once below it), not the deformed mean gap of
-    #                            ``contact.ContactResult.mean_gap``
+    #: m, g_n = (z_M − z̄) − delta (Eq. 1.9): the flat's height above the mean plane of the undeformed
+    #: surface (negative once below it), not the deformed mean gap of ``contact.ContactResult.mean_gap``
+    mean_gap: float
     kappa: float | None        #: -, (A/A0) E* sqrt(<|grad h|²>) / p_n (§1.3.2); None without contact/slope
     semi_axes: np.ndarray      #: m, (N, 2): major a and minor b of each contact (0, 0 out of contact)
     forces: np.ndarray         #: N, force of each asperity
@@ -64,8 +64,9 @@ class AsperityResult:
     method: str                #: scipy minimiser
     iterations: int            #: minimiser iterations (all active-set passes)
     evaluations: int           #: interaction-sum evaluations
-    residual: float            #: max |min(P_k/P̄, gap_k/delta)| over candidates (route's own gap; P̄ the
-    #                            mean non-interacting force): the complementarity of Eq. 1.11
+    #: max |min(P_k/P̄, gap_k/delta)| over candidates (route's own gap; P̄ the mean non-interacting
+    #: force): the complementarity of Eq. 1.11
+    residual: float
     converged: bool
     truncation: float          #: relative bound on the neglected part of each interaction sum
     wall_time: float           #: s

@@ -40,7 +40,8 @@ import numpy as np
 from multiscale.errors import ConvergenceError, InputError, check_count, check_flag, check_positive, non_finite
 from multiscale.micro import bccg_solver, pk_solver
 from multiscale.micro.fft import get_threads
-from multiscale.micro.kernels import InfluenceOperator, Kernel, check_kernel
+from multiscale.memory import memory_limit
+from multiscale.micro.kernels import InfluenceOperator, Kernel, check_kernel, grid_shape
 from multiscale.micro.surface import Surface
 
 METHODS = ("bccg", "pk")
@@ -62,29 +63,42 @@ PERIODIC_LOCAL_START = 1e-3
 
 @dataclass
 class ContactResult:
-    """Solution of a (batch of) contact problem(s); per-patch arrays have the batch shape."""
+    """Solution of a (batch of) contact problem(s); per-patch arrays have the batch shape (...).
 
-    pressure: np.ndarray       #: Pa, (..., ny, nx)
-    displacement: np.ndarray   #: m, elastic normal displacement, positive into the solid
-    gap: np.ndarray            #: m, >= 0, zero on the contact
-    contact: np.ndarray        #: bool, p > 0
-    area_fraction: np.ndarray  #: real contact area / nominal area
-    mean_pressure: np.ndarray  #: Pa, total force / nominal area
-    force: np.ndarray          #: N, total normal force on the patch: mean_pressure x its nominal area ny nx dx dy
-    area: np.ndarray           #: m², real contact area: area_fraction x the nominal area
-    approach: np.ndarray       #: m, rigid approach delta of the flat from first touch of the highest point;
-    #                            it holds the mean elastic displacement, so it depends on the patch: of an isolated
-    #                            patch, the indentation of the whole loaded patch (143.5 of the 290 nm of
-    #                            tutorial micro_patch's measured case), of a periodic one, that about a
-    #                            displacement of mean zero
-    mean_gap: np.ndarray       #: m, mean separation between the flat and the deformed surface: it depends
-    #                            much less on the patch than the approach (periodic against isolated 128²: 6 %)
-    plastic_area_fraction: np.ndarray  #: cells at p = H (plastic flow) / all cells; 0 without a hardness
-    plastic: np.ndarray | None  #: m, permanent (plastic) deformation, >= 0 into the solid: d - z - u at p = H
-    iterations: np.ndarray     #: per patch
-    residual: np.ndarray       #: per patch, see ContactSolver.solve
-    converged: np.ndarray      #: bool per patch
-    history: list = field(default_factory=list, repr=False)  #: max residual per iteration
+    - ``pressure`` [Pa] (..., ny, nx), >= 0; ``contact`` (bool, p > 0) and ``gap`` [m] (>= 0, zero
+      on the contact) on the same grid; ``displacement`` [m], elastic normal displacement, positive
+      into the solid;
+    - ``area_fraction`` [-], real contact area / nominal area, and ``area`` [m²] = area_fraction x
+      the nominal area ny nx dx dy; ``mean_pressure`` [Pa], total force / nominal area, and
+      ``force`` [N] = mean_pressure x the nominal area;
+    - ``approach`` [m], rigid approach of the flat from first touch of the highest point. It holds
+      the mean elastic displacement, so it depends on the patch: of an isolated patch, the
+      indentation of the whole loaded patch (143.5 of the 290 nm of tutorial micro_patch's measured
+      case), of a periodic one, that about a displacement of mean zero;
+    - ``mean_gap`` [m], mean separation between the flat and the deformed surface: it depends much
+      less on the patch than the approach (periodic against isolated 128²: 6 %);
+    - ``plastic_area_fraction`` [-], cells at p = H (plastic flow) / all cells (0 without a
+      hardness); ``plastic`` [m], permanent deformation d - z - u at p = H, >= 0 into the solid
+      (None without a hardness);
+    - ``iterations``, ``residual`` (see ``ContactSolver.solve``) and ``converged`` (bool) per
+      patch; ``history``, the max residual over the patches per iteration."""
+
+    pressure: np.ndarray
+    displacement: np.ndarray
+    gap: np.ndarray
+    contact: np.ndarray
+    area_fraction: np.ndarray
+    mean_pressure: np.ndarray
+    force: np.ndarray
+    area: np.ndarray
+    approach: np.ndarray
+    mean_gap: np.ndarray
+    plastic_area_fraction: np.ndarray
+    plastic: np.ndarray | None
+    iterations: np.ndarray
+    residual: np.ndarray
+    converged: np.ndarray
+    history: list = field(default_factory=list, repr=False)
 
 
 class ContactConvergenceError(ConvergenceError):
@@ -94,6 +108,27 @@ class ContactConvergenceError(ConvergenceError):
 class ContactNonFiniteError(ContactConvergenceError):
     """The iteration produced non-finite numbers (the problem's scales overflow float64); the
     solver's buffers are cleared, so the next solve starts clean."""
+
+
+# the least memory of a solver [bytes per cell of the grid]: its build (kernel spectrum, plans;
+# periodic, isolated), each thread's scratch and each patch's result (tracemalloc peaks of build +
+# solve, one thread: periodic 200-210 a cell from 512² to 2048², isolated 490-560 from 256² to 2048²;
+# 8 x 256² periodic 615, 16 x 128² 2510 periodic and 2990 isolated)
+BUILD_BYTES = {True: 33, False: 194}
+SCRATCH_BYTES, RESULT_BYTES = 100, 50
+
+
+def _fits(name: str, shape, periodic: bool, patches: int) -> None:
+    """InputError naming ``name`` if a solver on the grid ``shape`` (periodic or not) solving
+    ``patches`` patches at once needs more memory than this process may use (``BUILD_BYTES``; an
+    isolated 4096² solver built for 14 s before a raw MemoryError under 3 GB: a user trial)."""
+    ny, nx = grid_shape(name, shape[-2:])
+    per_cell = BUILD_BYTES[bool(periodic)] + SCRATCH_BYTES * min(patches, get_threads()) + RESULT_BYTES * patches
+    need = float(ny * nx * per_cell)
+    if need > 2**30 and need > (have := memory_limit()):     # (the limit is read in 0.13 ms: not for small solves)
+        raise InputError(name, tuple(shape), f"{'a periodic' if periodic else 'an isolated'} {ny} x {nx} patch"
+                         f"{f' x {patches} patches' * (patches > 1)} takes at least {need / 2**30:.3g} GiB to solve, more "
+                         f"than the {have / 2**30:.3g} GiB this process may use: a coarser grid or fewer patches at once")
 
 
 class ContactSolver:
@@ -110,6 +145,7 @@ class ContactSolver:
 
     def __init__(self, kernel: Kernel, shape, dx: float, dy: float | None = None, periodic: bool = True,
                  method: str = "bccg"):
+        _fits("shape", shape, periodic is not False and periodic is not np.False_, 1)
         self.operator = InfluenceOperator(check_kernel("kernel", kernel, thermal=False), shape, dx, dy, periodic)
         self.kernel, self.shape, self.periodic = kernel, self.operator.shape, self.operator.periodic
         self.method = _method(method)
@@ -166,6 +202,7 @@ class ContactSolver:
         if (load is None) == (approach is None):
             raise InputError("load/approach", (load, approach), "give exactly one of them")
         batch = h.shape[:-2]
+        _fits("heights.shape", h.shape, self.periodic, int(np.prod(batch)))
         with np.errstate(over="ignore", invalid="ignore"):
             z = h.max(axis=(-2, -1), keepdims=True) - h        # depth below the highest point, >= 0
         if not np.all(np.isfinite(z)):
