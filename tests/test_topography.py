@@ -329,7 +329,7 @@ def test_a_flat_or_planar_matrix_has_no_roughness(tmp_path, heights):
 def test_heights_in_the_wrong_unit_are_warned_about_and_an_overflow_refused(tmp_path, capsys):
     """A matrix in um read as metres (Sq 2 m on a 20 mm pin ran to the end without a word): a
     warning naming the file and height_unit, also in `multiscale check`, and refused once its
-    conditioned Sq exceeds ``reading.TALLEST`` (the run went on with the warning); heights whose spread
+    conditioned Sq exceeds ``surface.TALLEST`` (the run went on with the warning); heights whose spread
     overflows (1e294) one InputError (before: Sq inf, then a ContactNonFiniteError in every zone)."""
     from multiscale.micro.topography import TopographyWarning, probe_topography
     h = fractal_surface(32, 32e-6, 0.8, 2, 8, 1e-6, seed=1).heights
@@ -351,6 +351,12 @@ def test_heights_in_the_wrong_unit_are_warned_about_and_an_overflow_refused(tmp_
                       r"the file = 1e-09 m\), far below a rough surface's: is height_unit right\?"):
         np.save(tmp_path / "m.npy", h)
         read_topography(tmp_path / "m.npy", pixel_size=1e-6, height_unit=1e-9)
+    # a pixel size in um given as m (a 126 x 94 m map without a word: a user trial), and in pm
+    with pytest.warns(TopographyWarning, match=r"file = 'um.npy': a map of 32 x 32 m \(pixels of 1 x 1 m\), wider "
+                      r"than any measurement's: is pixel_size in m\?"):
+        read_topography(tmp_path / "um.npy", pixel_size=1.0, height_unit=1e-6)
+    with pytest.warns(TopographyWarning, match=r"pixels finer than any measurement's: is pixel_size in m\?"):
+        read_topography(tmp_path / "um.npy", pixel_size=1e-12, height_unit=1e-6)
     np.save(tmp_path / "huge.npy", h * 1e300)
     with pytest.raises(InputError, match=r"file = 'huge.npy': heights up to .* m overflow"):
         read_topography(tmp_path / "huge.npy", pixel_size=1e-6)

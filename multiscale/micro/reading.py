@@ -19,10 +19,10 @@ import numpy as np
 
 from multiscale.errors import InputError, check_pair, check_positive
 from multiscale.micro.spectrum import surface_topography
-from multiscale.micro.surface import read_matrix
+from multiscale.micro.surface import TALLEST, read_matrix
 
 MATRIX_SUFFIXES = (".npy", ".txt", ".csv", ".asc")    # plain height matrices (no units in the file)
-TALLEST = 1e-2            # m: heights beyond are no roughness measurement (an instrument's z range is mm)
+WIDEST = 1.0              # m: maps wider are no roughness measurement (a profilometer's stage is 0.1 m)
 LOWEST = 1e-10            # m: heights all within it are none either (an atomic step; offsets and noise exceed it)
 UNDERFLOW = 1e-60         # m: heights all within it have powers (h^4 in Sku) that underflow: refused
 KEPT_BYTES = 2**30        # heights of the measurements kept for the next read (an 8000² map is 0.5 GB)
@@ -226,6 +226,7 @@ def _read(path: Path, channel, pair, height_unit: float | None, prefix: str) -> 
             raise InputError(option(prefix, "file"), path.name, "the height matrix holds infinite values (NaN marks an "
                              "undefined point)")
         notes = _height_range(h, path, prefix, "m" if height_unit is None else f"{height_unit:.4g} m")
+        notes += _lateral_range(h.shape, *pair, path, prefix)
         h.flags.writeable = False
         return Measurement(h, *pair, path, 0, "matrix", None, tuple(notes))
     ch = _channel(_reader(path, option(prefix, "file")), path, channel, prefix)
@@ -260,8 +261,20 @@ def _read(path: Path, channel, pair, height_unit: float | None, prefix: str) -> 
                          f"{example(prefix, 'height_unit', '\"nm\" or \"1 um\"', '1e-9')}")
     h = np.ma.filled(np.ma.masked_invalid(np.ma.asarray(raw, dtype=float)), np.nan).T * factor
     notes += _height_range(h, path, prefix, f"{factor:.4g} m", f"channel {ch.index} (\"{ch.name}\")")
+    notes += _lateral_range(h.shape, dx, dy, path, prefix)
     h.flags.writeable = False
     return Measurement(h, dx, dy, path, ch.index, str(ch.name), unit, tuple(notes))
+
+
+def _lateral_range(shape, dx: float, dy: float, path: Path, prefix: str) -> list[str]:
+    """A note if the map [m] is wider than ``WIDEST`` or its pixels finer than ``LOWEST`` (a pixel size
+    given in um as m made a 126 x 94 m map without a word: a user trial)."""
+    width, height = shape[1] * dx, shape[0] * dy
+    if max(width, height) <= WIDEST and min(dx, dy) >= LOWEST:
+        return []
+    return [f"{option(prefix, 'file')} = '{path.name}': a map of {width:.3g} x {height:.3g} m (pixels of {dx:.3g} x "
+            f"{dy:.3g} m), {'wider than' if max(width, height) > WIDEST else 'pixels finer than'} any measurement's: "
+            f"is {option(prefix, 'pixel_size')} in m?"]
 
 
 def _height_range(h: np.ndarray, path: Path, prefix: str, unit: str, what: str = "the height matrix") -> list[str]:
