@@ -314,3 +314,22 @@ def test_the_multiscale_figures_legends_cover_no_panel(tmp_path, drawn):
     for box in legends:
         for ax in figure.axes:
             assert not box.overlaps(ax.get_window_extent()), ax.get_ylabel()
+
+
+def test_a_runs_totals_are_its_headline_numbers():
+    """``workflows.output.totals``: the last console line of a run (a trial found only file paths
+    there): the rough interfaces' frictional work, else the heat into the bodies, each body's
+    highest temperature over the run (not its parts' or materials'), the worn volume in mm^3."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")      # workflows import it
+    from multiscale.workflows.output import totals
+    history = History()
+    for t, hot in ((0.0, 295.15), (1.0, 338.2), (2.0, 330.0)):
+        history.append(time=t, frictional_work=27.0 * t, max_temperature_pin=hot, max_temperature_pin_in_disc=300.0,
+                       max_temperature_pin_part_plate=299.0, max_temperature_disc=hot - 20, heat_total_pin=2.0 * t,
+                       wear_volume=1.5e-13 * t)
+    assert totals(history) == ("frictional work 54 J, hottest pin 65.05 degC, hottest disc 45.05 degC, "
+                               "wear volume 0.0003 mm^3")
+    heat = History()
+    for t in (0.0, 1.0):
+        heat.append(time=t, heat_total_pin=2.0 * t, heat_total_disc=40.0 * t)
+    assert totals(heat) == "frictional heat 42 J" and totals(History()) == ""

@@ -581,7 +581,8 @@ def test_a_pressure_beyond_small_strains_is_warned_about_also_at_a_map_point(tmp
     assert strained == [f"the contact pressure reached {run.map.max_pressure:.3g} Pa, "
                         f"{100 * run.map.max_pressure / 5e9:.2g} % of the softer side's E (5e+09 Pa): beyond the small "
                         "strains of the linear elastic model; check the load (a vehicle stop asks mu F r of the brake: "
-                        "a small mu needs a large clamp)"]
+                        "a small mu needs a large clamp) and E's unit (a bare number is Pa: 310000 for 310 GPa is "
+                        "310 kPa)"]
 
 
 def test_a_braking_torque_preloads_the_squeal_analysis_at_that_friction_moment(tmp_path):

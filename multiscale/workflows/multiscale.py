@@ -46,7 +46,7 @@ from multiscale.micro.post_analysis import Heating, PostAnalyses, PostAnalysis, 
 from multiscale.provenance import resolved_toml
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, heat_warnings_as_notes, \
     interface_forces, interface_materials, run_notes, say_clamp, say_load, say_model_size
-from multiscale.workflows.output import prepare_folder
+from multiscale.workflows.output import prepare_folder, totals
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
 from multiscale.workflows.strain import refuse_floating, say_at_once
@@ -238,6 +238,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         print(f"  ParaView: {', '.join(str(f) for f in result.field_files)}")
         plots = [str(p) for p in [png, plot] + maps if p]
         print(f"  history:  {h5}" + (f"  plots: {', '.join(plots)}" if plots else ""))
+        if headline := totals(history):
+            print(f"  totals:   {headline}")
     return result
 
 

@@ -26,6 +26,20 @@ class RunResult:
     warnings: tuple = field(default=(), kw_only=True)
 
 
+def totals(history) -> str:
+    """The run's headline numbers for its last console lines (a trial found only file paths there):
+    the frictional work [J] (the rough interfaces', else the frictional heat into the bodies), each
+    body's highest temperature [degC] over the run and the worn volume [mm^3]; "" without any."""
+    cols, last = history.columns, lambda key: float(history[key][-1])
+    heat = [k for k in cols if k.startswith("heat_total_")]
+    out = [f"frictional work {last('frictional_work'):.4g} J" if "frictional_work" in cols else
+           f"frictional heat {sum(last(k) for k in heat):.4g} J" if heat else ""]
+    bodies = [k for k in cols if k.startswith("max_temperature_") and "_part_" not in k and "_in_" not in k]
+    out += [f"hottest {k.removeprefix('max_temperature_')} {max(history[k]) - 273.15:.4g} degC" for k in bodies]
+    out += [f"wear volume {last('wear_volume') * 1e9:.4g} mm^3"] if "wear_volume" in cols else []
+    return ", ".join(o for o in out if o)
+
+
 @dataclass
 class OutputFolder:
     """A run's output folder, prepared (checked, created, writable) but not yet written into.

@@ -34,7 +34,8 @@ def overloaded(scene, p: float, hottest=None) -> list[str]:
                for n in spec.interfaces for m in spec.interface_materials(n))
     return [f"the contact pressure reached {p:.3g} Pa, {100 * p / soft:.2g} % of the softer side's E ({soft:.3g} Pa): "
             "beyond the small strains of the linear elastic model; check the load (a vehicle stop asks mu F r of "
-            "the brake: a small mu needs a large clamp)"] if p > STRAINED * soft else []
+            "the brake: a small mu needs a large clamp) and E's unit (a bare number is Pa: 310000 for 310 GPa "
+            "is 310 kPa)"] if p > STRAINED * soft else []
 
 
 def say_at_once(scene, history, comm) -> None:

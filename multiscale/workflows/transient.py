@@ -20,7 +20,7 @@ from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.output import FieldOutput
 from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, run_notes, say_clamp, \
     say_load, say_model_size
-from multiscale.workflows.output import RunResult, prepare_folder
+from multiscale.workflows.output import RunResult, prepare_folder, totals
 from multiscale.workflows.strain import refuse_floating, say_at_once
 
 
@@ -108,4 +108,6 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
               f"{io.counted(comm.size, 'rank')}")
         print(f"  ParaView: {', '.join(str(f) for f in writer.files)}")
         print(f"  history:  {h5}" + (f"  plot: {png}" if png else ""))
+        if headline := totals(history):
+            print(f"  totals:   {headline}")
     return result
