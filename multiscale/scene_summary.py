@@ -13,7 +13,7 @@ from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
 from multiscale.scene_friction import FRICTION, bare_interfaces
 from multiscale.scene_geometry import GeometrySection, scene_spec
-from multiscale.scene_rough import default_p_max, scene_surface_used
+from multiscale.scene_rough import default_p_max, nominal_pressure, scene_surface_used
 from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR, P_MAX_PLASTIC
 from multiscale.errors import InputError
 from multiscale.schema import Named, Section, fields_of, suggest
@@ -101,13 +101,18 @@ def summary(scene: Scene) -> list[str]:
                  f"braking torque {ld.braking_torque:g} N m" if ld.braking_torque is not None else
                  f"braking {v.mass:g} kg" if v is not None and v.mass is not None else "none")
     motion = (f"{ld.rotation_speed * 30 / math.pi:g} rpm" if ld.rotation_speed is not None else
-              f"speed profile of {len(ld.speed_profile)} points" if ld.speed_profile is not None else
+              f"speed profile of {len(ld.speed_profile)} points (up to {max(w for _, w in ld.speed_profile) * 30 / math.pi:.4g} "
+              "rpm)" if ld.speed_profile is not None else
               (f"a stop from {v.speed * 3.6:g} km/h in {v.stop_time:.3g} s" if v.deceleration else
                f"a drag at {v.speed * 3.6:g} km/h") + f" (wheel radius {v.wheel_radius * 1e3:g} mm)"
               if v is not None else f"{ld.sliding_speed:g} m/s" if ld.sliding_speed is not None else "no sliding")
     where = _load_faces(scene)
     profile = f", load profile of {len(ld.load_profile)} points" if ld.load_profile else ""
     lines.append(f"  loading   {load_text}{where}, {motion}{profile}, {ld.ramp_steps} ramp step(s)")
+    if (bound := nominal_pressure(scene)) is not None:      # (an engineer's first number: said nowhere, a trial)
+        at = f" at the load profile's largest factor {bound[1]:.3g}" if bound[1] != 1 else ""
+        lines.append(f"            nominal contact pressure {bound[0] / 1e6:.4g} MPa{at} (the force over the "
+                     "interfaces' extents; the run divides by their meshed areas)")
     if v is not None and ld.torque is not None and ld.braking_torque is None:   # (said nowhere before: a user trial)
         force = "m a" if v.deceleration else f"m g sin(atan {v.slope:g})"
         lines.append(f"            braking torque {ld.torque:.4g} N m at the {g.bodies[1]}: braking force {force} = "

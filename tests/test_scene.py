@@ -1107,7 +1107,7 @@ def test_an_interface_surface_of_its_own_replaces_the_scene_wide_one(tmp_path):
     [[interfaces]] crashed check), a rough body that moves is refused and tables no interface reads
     are warned about (they passed silently; user trials)."""
     np.save(tmp_path / "a.npy", np.random.default_rng(1).normal(size=(64, 64)))
-    np.save(tmp_path / "b.npy", np.random.default_rng(2).normal(size=(64, 64)))
+    np.save(tmp_path / "b.npy", 1e-6 * np.random.default_rng(2).normal(size=(64, 64)))   # in m
     rough = {"effects": ["contact", "friction", "roughness"], "micro": {"zones": [2, 2], "grid": [16, 16]},
              "roughness": {"rms": "5 um", "hurst": 0.8, "k_min": 1, "k_max": 6, "seed": 4}}
     measured = {"file": str(tmp_path / "a.npy"), "pixel_size": "20 um", "height_unit": "um", "cover": "tile"}
@@ -1440,7 +1440,7 @@ def test_a_contact_pressure_beyond_small_strains_is_warned_about(tmp_path):
     assert run_warnings(scene, h) == [
         "the contact pressure reached 1.84e+08 Pa, 6.1 % of the softer side's E (3e+09 Pa): beyond the small "
         "strains of the linear elastic model; check the load (a vehicle stop asks mu F r of the brake: a small "
-        "mu needs a large clamp)"]
+        "mu needs a large clamp) and E's unit (a bare number is Pa: 310000 for 310 GPa is 310 kPa)"]
     h = History()
     h.append(time=0.0, max_pressure=5e6)
     assert run_warnings(scene, h) == []
@@ -1460,7 +1460,7 @@ def test_a_contact_pressure_beyond_small_strains_of_a_softened_side_is_warned_ab
     assert run_warnings(loads(text, tmp_path), h) == [
         "the contact pressure reached 1e+06 Pa, 1e+02 % of the softer side's E (1e+06 Pa): beyond the small "
         "strains of the linear elastic model; check the load (a vehicle stop asks mu F r of the brake: a small "
-        "mu needs a large clamp)"]
+        "mu needs a large clamp) and E's unit (a bare number is Pa: 310000 for 310 GPa is 310 kPa)"]
     fixed = text.replace('"heat_partition", "expansion"]', '"heat_partition"]')     # E read at T0 only: 5 GPa
     assert run_warnings(loads(fixed, tmp_path), h) == []
 
