@@ -333,3 +333,16 @@ def test_a_runs_totals_are_its_headline_numbers():
     for t in (0.0, 1.0):
         heat.append(time=t, heat_total_pin=2.0 * t, heat_total_disc=40.0 * t)
     assert totals(heat) == "frictional heat 42 J" and totals(History()) == ""
+
+
+def test_the_speed_of_a_cycle_is_drawn(tmp_path, drawn):
+    """``angular_speed`` [rad/s] in rpm, ``sliding_speed`` [m/s] as it is: a cycle's speed was drawn
+    nowhere, so it had to be read off the torque (a user trial)."""
+    for column, label, factor in (("angular_speed", "rotation speed [rpm]", 30 / np.pi),
+                                  ("sliding_speed", "sliding speed [m/s]", 1.0)):
+        history = History()
+        for t, v in ((0.0, 80.0), (1.0, 40.0), (2.0, 0.0)):
+            history.append(time=t, interface_force=30.0, max_pressure=1e7, **{column: v})
+        plots.history_figure(history, tmp_path / "history.png")
+        axes = {ax.get_ylabel(): ax for ax in drawn[-1].axes if ax.get_visible()}
+        np.testing.assert_allclose(axes[label].get_lines()[0].get_ydata(), np.array([80.0, 40.0, 0.0]) * factor)

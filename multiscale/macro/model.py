@@ -344,7 +344,9 @@ class MacroModel:
         interfaces and heat, ``interface_heat_row`` gives each one's heat and face temperatures. With a
         ``friction_law``, ``friction_coefficient`` [-] is ``friction_force`` over ``interface_force`` (NaN
         while released or at rest), and with several interfaces each one's too; with a mu(v) law,
-        ``max_slip_speed`` and ``min_slip_speed`` [m/s] over its facets in contact (NaN as mu)."""
+        ``max_slip_speed`` and ``min_slip_speed`` [m/s] over its facets in contact (NaN as mu).
+        ``angular_speed`` [rad/s] of a rotating body 1 or ``sliding_speed`` [m/s] of a translating one,
+        at the row's time (a cycle's speed was drawn nowhere: a user trial)."""
         on = not self.released
         friction = np.linalg.norm(self.contact.facet_friction(), axis=1) * on     # N per facet, magnitudes
         row = {"time": self.time, "interface_force": self.last_solve.normal_force * on,
@@ -365,6 +367,7 @@ class MacroModel:
             row["max_slip_speed"], row["min_slip_speed"] = (float(V.max()), float(V.min())) if len(V) else (np.nan,) * 2
         if isinstance(self.tm.spec.motion, Rotation):   # the braking torque: frictional heat power = it x omega
             row["friction_moment"] = abs(self.contact.friction_moment()) * on
+        row["angular_speed" if isinstance(self.tm.spec.motion, Rotation) else "sliding_speed"] = self.speed(self.time)
         masks = self.tm.interface.masks()
         if len(masks) > 1:                        # per interface (a brake's pads, a disc's pucks)
             p = self.contact.facet_pressure() * on

@@ -114,7 +114,7 @@ def curve_styles(keys, palette: dict | None = None) -> tuple[list[dict], list]:
 
 
 def history_figure(history, path: Path, title: str = "") -> Path:
-    """PNG of the history: force, max pressure, max temperatures, heat per body (and the friction
+    """PNG of the history: force, max pressure, the speed, max temperatures, heat per body (and the friction
     coefficient with fade or mu(v), the slip speeds with mu(v), the braking torque of a rotating body, per interface, max face
     temperatures, stored heat per part) vs time."""
     t = history["time"]
@@ -124,6 +124,8 @@ def history_figure(history, path: Path, title: str = "") -> Path:
               ("max contact pressure [MPa]", ["max_pressure"], 1e-6, 0.0),
               ("friction coefficient [-]", [k for k in history.columns if k.startswith("friction_coefficient")],
                1.0, 0.0),                                                          # with fade (and per interface)
+              ("rotation speed [rpm]", ["angular_speed"], 30 / np.pi, 0.0),     # the cycle (drawn nowhere: a trial)
+              ("sliding speed [m/s]", ["sliding_speed"], 1.0, 0.0),
               ("slip speed in contact [m/s]", ["max_slip_speed", "min_slip_speed"], 1.0, 0.0),      # with mu(v)
               ("braking torque [N m]", ["friction_moment"], 1.0, 0.0),    # a rotating body's (wanted: a trial)
               ("max temperature [°C]", temperature_columns(history.columns), 1.0, -273.15),
