@@ -68,12 +68,12 @@ DEFAULTS: dict[str, float] = {
     "mesh_size": 0.012,              # m, element size in the disc and caliper
     "pad_mesh_size": 0.0,            # m, element size in pads, backplates, piston (0: mesh_size / 2)
 }
-CELL = {"disc": 1, "pad_inner": 2, "pad_outer": 3, "backplate_inner": 4, "backplate_outer": 5,
+CELL = {"disc": 1, "inner_pad": 2, "outer_pad": 3, "inner_backplate": 4, "outer_backplate": 5,
         "piston": 6, "caliper": 7}
 FACET = {"inner_pad": 10, "outer_pad": 11, "disc_mount": 12, "piston_back": 13, "caliper_bore": 14,
          "abutment_inner": 15, "abutment_outer": 16, "guide_pins": 17, "piston_wall": 18}
-MATERIALS = {"disc": "disc", "pad_inner": "pad", "pad_outer": "pad", "backplate_inner": "backplate",
-             "backplate_outer": "backplate", "piston": "piston", "caliper": "caliper"}   # region -> table
+MATERIALS = {"disc": "disc", "inner_pad": "pad", "outer_pad": "pad", "inner_backplate": "backplate",
+             "outer_backplate": "backplate", "piston": "piston", "caliper": "caliper"}   # region -> table
 COMPONENTS = tuple(CELL)            # strain-energy components (thesis Fig. 4.20)
 
 
@@ -140,7 +140,7 @@ def describe(params=None) -> GeometrySpec:
         motion=Rotation((0.0, 0.0, 1.0), (0.0, 0.0, 0.0)),
         length_scale=p["disc_outer_radius"],
         fluid_load=True,                          # the hydraulic pressure on piston and caliper bore
-        interface_regions={"inner_pad": "pad_inner", "outer_pad": "pad_outer"},
+        interface_regions={"inner_pad": "inner_pad", "outer_pad": "outer_pad"},
         interface_extents=dict.fromkeys(("inner_pad", "outer_pad"), _pad_extent(p)),
         interface_sizes=dict.fromkeys(("inner_pad", "outer_pad"), p["pad_mesh_size"]),
         load_areas=dict.fromkeys(("piston_back", "caliper_bore"), math.pi * p["piston_radius"] ** 2),
@@ -233,10 +233,10 @@ def generate(model, params=None) -> None:
     tp, tb, t = p["pad_thickness"], p["backplate_thickness"], p["disc_thickness"]
     parts = {
         "disc": _disc(occ, p, z),
-        "pad_inner": _sector(occ, -tp, tp, p["pad_inner_radius"], p["pad_outer_radius"], p["pad_angle"]),
-        "pad_outer": _sector(occ, t, tp, p["pad_inner_radius"], p["pad_outer_radius"], p["pad_angle"]),
-        "backplate_inner": _sector(occ, z["bp_in"], tb, r_bi, r_bo, p["backplate_angle"]),
-        "backplate_outer": _sector(occ, z["pad_out"], tb, r_bi, r_bo, p["backplate_angle"]),
+        "inner_pad": _sector(occ, -tp, tp, p["pad_inner_radius"], p["pad_outer_radius"], p["pad_angle"]),
+        "outer_pad": _sector(occ, t, tp, p["pad_inner_radius"], p["pad_outer_radius"], p["pad_angle"]),
+        "inner_backplate": _sector(occ, z["bp_in"], tb, r_bi, r_bo, p["backplate_angle"]),
+        "outer_backplate": _sector(occ, z["pad_out"], tb, r_bi, r_bo, p["backplate_angle"]),
         "piston": occ.addCylinder(0, yc, z["piston_back"], 0, 0, p["piston_length"], p["piston_radius"]),
         "caliper": _caliper(occ, p, z, yc),
     }

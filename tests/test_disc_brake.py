@@ -276,10 +276,10 @@ def test_friction_locks_in_a_pair_of_modes(no_friction, friction):
 def test_strain_energy_per_region_matches_an_assembled_disc_stiffness(brake, no_friction):
     tm, mech = brake
     shares = no_friction.energy
-    assert shares.names == ["pad_inner", "pad_outer", "backplate_inner", "backplate_outer", "piston",
+    assert shares.names == ["inner_pad", "outer_pad", "inner_backplate", "outer_backplate", "piston",
                             "caliper", "disc"]
     np.testing.assert_allclose(shares.share.sum(axis=1), 1.0, rtol=1e-12)
-    assert 0.0 <= shares.split("pad_inner", "pad_outer").min() <= shares.split("pad_inner", "pad_outer").max() <= 1
+    assert 0.0 <= shares.split("inner_pad", "outer_pad").min() <= shares.split("inner_pad", "outer_pad").max() <= 1
     du, v = ufl.TrialFunction(mech.spaces[1]), ufl.TestFunction(mech.spaces[1])
     a = ufl.derivative(ufl.inner(mech.stress(1), ufl.sym(ufl.grad(v))) * mech.dx(1), mech.u[1], du)
     K1 = fpetsc.assemble_matrix(fem.form(a, entity_maps=tm.entity_maps))

@@ -471,7 +471,7 @@ def test_a_floating_caliper_pressed_on_the_piston_alone_is_refused_before_its_mo
         "acts too; a part pressed only there (a floating caliper) is then held by no force" in scene.warnings[0]
     with pytest.raises(InputError, match=r"interface = 'outer_pad': it carried no force \(.* N, against 1\.6\de\+03 N\), "
                                          r"yet without it 1 part\(s\) could move as rigid bodies \(one of region "
-                                         r"'pad_outer' \(with 'backplate_outer', 'caliper'\) around .* mm: "
+                                         r"'outer_pad' \(with 'outer_backplate', 'caliper'\) around .* mm: "
                                          r"translation along z\)"):
         squeal.run(scene, degree=1, verbose=False)
     assert {"brake.xdmf", "interface.xdmf"} <= {p.name for p in (tmp_path / "out").iterdir()}   # the preload, kept
