@@ -38,7 +38,7 @@ from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FI
                                        Micro, Output, Roughness, Time, Wear)
 from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_phases, speed_range,
                                    squeal_state, thin_heated_layers)
-from multiscale.scene_keys import key_parts, replaced, table_at
+from multiscale.scene_keys import drop_replaced, given_paths, key_parts
 from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks, speed_law_zeros, torque_problems
 from multiscale.scene_stability import Stability, undamped_falling_law, unresolved_band
 from multiscale.scene_vehicle import Vehicle
@@ -87,6 +87,8 @@ class InterfacesSection(Named):
     of its own replacing the other's (``scene_rough.roughness_over``; the merged table is validated
     as a whole)."""
 
+    nested = {"roughness": Roughness, "micro": Micro}       # its sub-tables beside InterfaceSettings' keys
+
     def __init__(self):
         super().__init__(InterfaceSettings)
 
@@ -106,7 +108,7 @@ class InterfacesSection(Named):
                 ctx.problems.append(f"{where} = {show(table)}: must be a table [{where}]")
                 continue
             merged = {}
-            for section, cls in (("roughness", Roughness), ("micro", Micro)):
+            for section, cls in self.nested.items():
                 own = table.get(section)
                 if own is not None and not isinstance(own, dict):   # (a file's path was taken as {}: ignored)
                     ctx.problems.append(f"{where}.{section} = {show(own)}: must be a table [{where}.{section}]")
@@ -296,7 +298,7 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
         raise SceneError([f"{source.name if source else name}: a study file (problem = ..., [sweep]), not a scene: "
                           "give it to `multiscale study`"])
     overrides = {dotted: _toml_value(value) for dotted, value in (overrides or {}).items()}
-    given, dropped = {tuple(key_parts(dotted)) for dotted in overrides}, []
+    given, dropped = {p for dotted, value in overrides.items() for p in given_paths(key_parts(dotted), value)}, []
     for dotted, value in overrides.items():
         *parents, last = key_parts(dotted)
         table = raw
@@ -314,13 +316,9 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
             raise SceneError(f"{dotted}: cannot override " + ("an array of tables whole; give a key of one of its "
                              "entries (boundary[2].emissivity)" if table and all(isinstance(e, dict) for e in table) else
                              "one item of an array; give the whole array (geometry.axis = [0, 0, 1])"))
-        table[last] = value
-        for *where, other in replaced(Scene, [*parents, last]):   # the file's alternative goes, unless also given
-            holder = table_at(raw, where)
-            if not any(g[:len(where) + 1] == (*where, other) for g in given) and other in holder:   # (a key of it
-                del holder[other]                                       # too: it dropped loading.stribeck.kinetic)
-                name = "".join(f"[{p}]" if p.isdigit() else f".{p}" for p in [*where, other]).lstrip(".")
-                dropped.append(f"{dotted} replaces the file's {name}")
+        table[last] = value                 # the file's alternatives go, unless given too
+        dropped += [f"{dotted} replaces the file's {key}" for key in drop_replaced(Scene, raw, [*parents, last], value,
+                                                                                     given)]
     effects = raw.get("effects")
     active = frozenset(e for e in effects if isinstance(e, str) and e in EFFECTS) \
         if isinstance(effects, list) else frozenset()      # the known effects decide what is needed

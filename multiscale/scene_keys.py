@@ -38,16 +38,21 @@ def replaced(cls, parts: list[str]) -> tuple[tuple[str, ...], ...]:
     ``k_min``, ...), so that a key given over a file replaces the file's (``--set
     loading.pressure=...`` was refused, "give only one of them", and --set cannot remove a key: a
     user trial). () where none or a table is unknown."""
-    out, k = [], 0
+    out, k, nested = [], 0, {}
     while dataclasses.is_dataclass(cls):
         rest, rules = ".".join(parts[k:]), getattr(cls, "rules", ())
         mine = [r for r in rules if isinstance(r, OneOf) and any(f"{rest}.".startswith(f"{o}.") for o in r.keys)]
         others = [o for r in mine for o in r.keys if not f"{rest}.".startswith(f"{o}.")]
         others += [key for r in rules if isinstance(r, OnlyWith) and set(r.key) <= set(others) for key in r.keys]
         out += [(*parts[:k], *o.split(".")) for o in others]
-        spec = dict(fields_of(cls)).get(parts[k]) if k < len(parts) - 1 else None
+        part = parts[k] if k < len(parts) - 1 else None
+        if part in nested:                  # a table read beside the schema's keys ([interfaces.<name>.roughness])
+            cls, k, nested = nested[part], k + 1, {}
+            continue
+        spec = dict(fields_of(cls)).get(part)
         if spec is None or not isinstance(spec.parser, Section):
             break
+        nested = getattr(spec.parser, "nested", {})
         cls = getattr(spec.parser, "key_schema", spec.parser.cls)      # [geometry]: a geometry file's tables
         k += 2 if isinstance(spec.parser, (Named, Tables)) else 1      # a table's name, an entry's number
     return tuple(out)
@@ -63,3 +68,27 @@ def table_at(raw: dict, parts) -> dict:
         else:
             table = table.get(part, {}) if isinstance(table, dict) else {}
     return table if isinstance(table, dict) else {}
+
+
+def given_paths(parts, value) -> list[tuple]:
+    """The key paths that ``value`` given at the path ``parts`` gives: its own and, for a table given
+    whole, each of its keys' (recursively)."""
+    paths = [tuple(parts)]
+    for k, v in (value.items() if isinstance(value, dict) else ()):
+        paths += given_paths([*parts, k], v)
+    return paths
+
+
+def drop_replaced(cls, raw: dict, parts, value, given) -> list[str]:
+    """Deletes from the raw scene ``raw`` the keys that ``value`` given at ``parts`` replaces by the
+    schema ``cls`` (``replaced``; for a table given whole, what each of its keys replaces: a vehicle
+    with a mass replaces a force), except the keys given too (``given``: key paths, ``given_paths``);
+    returns the keys deleted, as messages name them (``boundary[3].ambient``)."""
+    dropped = []
+    for path in given_paths(parts, value):
+        for *where, other in replaced(cls, list(path)):
+            holder = table_at(raw, where)
+            if other in holder and not any(g[:len(where) + 1] == (*where, other) for g in given):   # (a key of
+                del holder[other]                                   # it given too: it dropped stribeck.kinetic)
+                dropped.append("".join(f"[{p}]" if p.isdigit() else f".{p}" for p in [*where, other]).lstrip("."))
+    return dropped

@@ -1254,6 +1254,21 @@ def test_an_override_replaces_the_files_alternative_to_it(tmp_path):
     assert (stop.loading.vehicle.mass, stop.loading.normal_force, stop.loading.rotation_speed) == (300.0, None, None)
     assert {"loading.vehicle.mass replaces the file's loading.normal_force",   # a key inside an alternative gives it
             "loading.vehicle.mass replaces the file's loading.rotation_speed"} <= set(stop.warnings)
+    # a table given whole gives each of its keys: a vehicle with a mass replaces the force, and a force given
+    vehicle = {"speed": "80 km/h", "deceleration": "0.5 gn", "wheel_radius": "300 mm", "mass": "500 kg"}   # too
+    whole = loads(pod, tmp_path, overrides={"loading.vehicle": vehicle})          # is refused in either order (it
+    assert (whole.loading.vehicle.mass, whole.loading.normal_force) == (500.0, None)     # dropped the user's mass
+    for ordered in ({"loading.vehicle": vehicle, "loading.normal_force": "3 kN"},     # or refused their vehicle:
+                    {"loading.normal_force": "3 kN", "loading.vehicle": vehicle}):    # an adversarial test)
+        with pytest.raises(SceneError, match=r"give only one of them: .* \(got normal_force, vehicle.mass\)"):
+            loads(pod, tmp_path, overrides=ordered)
+    own = pod + '\n[interfaces.interface.roughness]\nrms = "5 um"\nhurst = 0.7\nk_min = 1\nk_max = 16\n'
+    np.save(tmp_path / "pad.npy", 1e-6 * np.random.default_rng(3).normal(size=(64, 64)))      # 25.6 mm, in m
+    mine = loads(own, tmp_path, overrides={"interfaces.interface.roughness.file": str(tmp_path / "pad.npy"),
+                                           "interfaces.interface.roughness.pixel_size": "0.4 mm"})
+    assert mine.interface_settings("interface").roughness.file.name == "pad.npy"   # an interface's own surface
+    assert "interfaces.interface.roughness.file replaces the file's interfaces.interface.roughness.rms" in \
+        mine.warnings                                                          # (refused: "give only one of them")
     with pytest.raises(SceneError) as info:           # a group replaces a selection's normal and its body
         loads(car, DEMOS, overrides={"geometry.surfaces.piston.group": "piston_back"})   # (refused by name)
     assert info.value.problems == ["geometry.surfaces.piston.group = 'piston_back': no physical surface of "
