@@ -5,6 +5,7 @@ import ast
 import multiprocessing
 import subprocess
 import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -191,10 +192,12 @@ def test_every_module_imports_on_its_own_in_a_fresh_process():
     with context.Pool(2, maxtasksperchild=1) as pool:  # (not ProcessPoolExecutor's max_tasks_per_child: it can deadlock,
         done = {name: pool.apply_async(exec, (ALONE.format(packages=PACKAGES, name=name), {}))   # CPython
                 for name in sorted(MODULES)}                                               # gh-115634, here 3.12.1)
-        failed = {}
+        failed, deadline = {}, time.monotonic() + 600
         for name, result in done.items():
             try:
-                result.get(timeout=600)
+                result.get(timeout=max(deadline - time.monotonic(), 1.0))   # (a child that died: its task is lost)
+            except multiprocessing.TimeoutError:
+                failed[name] = "no answer: its child died or hung while importing it"
             except Exception as exc:             # (a child's failed import, re-raised here)
                 failed[name] = repr(exc)
     assert failed == {}

@@ -196,6 +196,9 @@ def test_a_solve_beyond_the_memory_is_refused_at_once(monkeypatch):
         patches = batch[0] if batch else 1
         per_cell = contact.BUILD_BYTES[periodic] + contact.SCRATCH_BYTES + contact.RESULT_BYTES * patches
         assert 256**2 * per_cell < peak < 2.5 * 256**2 * per_cell, (periodic, batch, peak)
+    for shape in (64, None, "64x64"):          # checked before the estimate (a raw TypeError: an adversarial test)
+        with pytest.raises(InputError, match="^shape.*must be a pair"):
+            ContactSolver(E, shape, 1e-7)
     monkeypatch.setattr(contact, "memory_limit", lambda: 2.0**31)
     with pytest.raises(InputError, match=r"^shape = \(4096, 4096\): an isolated 4096 x 4096 patch takes at least "
                                          r"5.38 GiB to solve, more than the 2 GiB this process may use"):

@@ -617,7 +617,7 @@ def resumed_rtol(key: str, rtol: float = 1e-6) -> float:
     "Repeatability")."""
     if key == "coupling_residual":
         return max(rtol, 1e-4)
-    return max(rtol, 1e-5) if key.startswith("heat_exchanged") else rtol
+    return max(rtol, 1e-5) if key.startswith(("heat_exchanged", "heat_conducted")) else rtol
 
 
 def test_a_coarse_wear_step_that_opens_the_contact_is_solved_with_backtracking(tmp_path, monkeypatch):

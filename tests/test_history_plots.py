@@ -333,6 +333,11 @@ def test_a_runs_totals_are_its_headline_numbers():
     for t in (0.0, 1.0):
         heat.append(time=t, heat_total_pin=2.0 * t, heat_total_disc=40.0 * t)
     assert totals(heat) == "frictional heat 42 J" and totals(History()) == ""
+    named = History()                             # bodies named with _in_ or _part_ (they were left out)
+    for t in (0.0, 1.0):
+        named.append(time=t, max_temperature_disc_in_front=300.0 + 10 * t, max_temperature_pad_part_a=310.0,
+                     max_temperature_pad_part_a_in_steel=305.0)
+    assert totals(named) == "hottest disc_in_front 36.85 degC, hottest pad_part_a 36.85 degC"
 
 
 def test_the_speed_of_a_cycle_is_drawn(tmp_path, drawn):

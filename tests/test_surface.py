@@ -145,7 +145,7 @@ def test_bad_surface_input(tmp_path):
     with pytest.warns(UserWarning, match=r"^rms = 6 m: beyond any roughness .*rms is in m"):   # 6 for 6 um (a
         fractal_surface(64, 1e-3, 0.8, 2, 10, 6.0)                                          # user trial)
     # a grid beyond the memory: refused at once (200 000²: a raw MemoryError for 149 GiB, a user trial)
-    with pytest.raises(InputError, match=r"^n = 200000: 200000 x 200000 points take about 1.79e\+03 GiB to "
+    with pytest.raises(InputError, match=r"^n = 200000: 200000 x 200000 points take about 1.08e\+03 GiB to "
                        r"generate, more than the .* GiB this process may use"):
         fractal_surface(200000, 1e-3, 0.8, 2, 10, 1e-6)
 

@@ -118,11 +118,12 @@ BUILD_BYTES = {True: 33, False: 194}
 SCRATCH_BYTES, RESULT_BYTES = 100, 50
 
 
-def _fits(name: str, shape, periodic: bool, patches: int) -> None:
-    """InputError naming ``name`` if a solver on the grid ``shape`` (periodic or not) solving
-    ``patches`` patches at once needs more memory than this process may use (``BUILD_BYTES``; an
-    isolated 4096² solver built for 14 s before a raw MemoryError under 3 GB: a user trial)."""
-    ny, nx = grid_shape(name, shape[-2:])
+def _fits(name: str, shape, grid, periodic: bool, patches: int) -> None:
+    """InputError naming ``name`` (given as ``shape``) if a solver on the grid ``grid`` (ny, nx;
+    periodic or not) solving ``patches`` patches at once needs more memory than this process may use
+    (``BUILD_BYTES``; an isolated 4096² solver built for 14 s before a raw MemoryError under 3 GB: a
+    user trial)."""
+    ny, nx = grid
     per_cell = BUILD_BYTES[bool(periodic)] + SCRATCH_BYTES * min(patches, get_threads()) + RESULT_BYTES * patches
     need = float(ny * nx * per_cell)
     if need > 2**30 and need > (have := memory_limit()):     # (the limit is read in 0.13 ms: not for small solves)
@@ -145,7 +146,7 @@ class ContactSolver:
 
     def __init__(self, kernel: Kernel, shape, dx: float, dy: float | None = None, periodic: bool = True,
                  method: str = "bccg"):
-        _fits("shape", shape, periodic is not False and periodic is not np.False_, 1)
+        _fits("shape", shape, grid_shape("shape", shape), periodic is not False and periodic is not np.False_, 1)
         self.operator = InfluenceOperator(check_kernel("kernel", kernel, thermal=False), shape, dx, dy, periodic)
         self.kernel, self.shape, self.periodic = kernel, self.operator.shape, self.operator.periodic
         self.method = _method(method)
@@ -202,7 +203,7 @@ class ContactSolver:
         if (load is None) == (approach is None):
             raise InputError("load/approach", (load, approach), "give exactly one of them")
         batch = h.shape[:-2]
-        _fits("heights.shape", h.shape, self.periodic, int(np.prod(batch)))
+        _fits("heights.shape", h.shape, self.shape, self.periodic, int(np.prod(batch)))
         with np.errstate(over="ignore", invalid="ignore"):
             z = h.max(axis=(-2, -1), keepdims=True) - h        # depth below the highest point, >= 0
         if not np.all(np.isfinite(z)):

@@ -34,7 +34,8 @@ def totals(history) -> str:
     heat = [k for k in cols if k.startswith("heat_total_")]
     out = [f"frictional work {last('frictional_work'):.4g} J" if "frictional_work" in cols else
            f"frictional heat {sum(last(k) for k in heat):.4g} J" if heat else ""]
-    bodies = [k for k in cols if k.startswith("max_temperature_") and "_part_" not in k and "_in_" not in k]
+    hot = [k for k in cols if k.startswith("max_temperature_")]       # a body's, not its parts' or materials'
+    bodies = [k for k in hot if not any(k.startswith(j + s) for j in hot for s in ("_in_", "_part_"))]
     out += [f"hottest {k.removeprefix('max_temperature_')} {max(history[k]) - 273.15:.4g} degC" for k in bodies]
     out += [f"wear volume {last('wear_volume') * 1e9:.4g} mm^3"] if "wear_volume" in cols else []
     return ", ".join(o for o in out if o)
