@@ -144,6 +144,8 @@ def describe(params=None) -> GeometrySpec:
         interface_extents=dict.fromkeys(("inner_pad", "outer_pad"), _pad_extent(p)),
         interface_sizes=dict.fromkeys(("inner_pad", "outer_pad"), p["pad_mesh_size"]),
         load_areas=dict.fromkeys(("piston_back", "caliper_bore"), math.pi * p["piston_radius"] ** 2),
+        report=(f"piston and bore discs of radius {p['piston_radius'] * 1e3:.4g} mm: a pressure's force is given "
+                "for pi r^2; their meshed polygons carry a little less (1.14 % with a 20 mm mesh), which the run says",),
         warnings=tuple(thin_warning([("disc", p["cheek_thickness"] if p["vanes"] else p["disc_thickness"],
                                       p["mesh_size"]), ("pads", p["pad_thickness"], p["pad_mesh_size"]),
                                      ("backplates", p["backplate_thickness"], p["pad_mesh_size"])])),
