@@ -282,8 +282,7 @@ def load(path, overrides=None) -> Scene:
     return loads(text, path.resolve().parent, name=path.stem, source=path.resolve(), overrides=overrides)
 
 
-def loads(text: str, directory=".", *, name: str = "scene", source: Path | None = None,
-          overrides=None) -> Scene:
+def loads(text: str, directory=".", *, name: str = "scene", source: Path | None = None, overrides=None) -> Scene:
     """Validate scene TOML text; relative paths are taken from ``directory``; ``name`` is the
     default scene name (the file stem for ``load``); ``overrides`` as in ``load``."""
     if not isinstance(text, str):
@@ -296,7 +295,7 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
         raise toml_problem(source or "scene", exc, text) from None
     if "problem" in raw and "effects" not in raw:     # (answered with "did you mean" per key: a user trial)
         raise SceneError([f"{source.name if source else name}: a study file (problem = ..., [sweep]), not a scene: "
-                          "give it to `multiscale study`"])
+                          "give it to `multiscale study` (Python: multiscale.studies.driver.run_studies)"])
     overrides = {dotted: _toml_value(value) for dotted, value in (overrides or {}).items()}
     given, dropped = {p for dotted, value in overrides.items() for p in given_paths(key_parts(dotted), value)}, []
     for dotted, value in overrides.items():
@@ -308,6 +307,9 @@ def loads(text: str, directory=".", *, name: str = "scene", source: Path | None 
                     raise SceneError(f"{dotted}: cannot override, {part} is not one of the {len(table)} entries "
                                      "(1, 2, ...: boundary[2].emissivity or boundary.2.emissivity)")
                 table = table[int(part) - 1]
+            elif part.isdigit() and not table:      # (an array the file has not: "must be an array", a trial)
+                raise SceneError(f"{dotted}: the file has no entry {part}; give the array whole: "
+                                 f"{'.'.join(parents[:parents.index(part)])} = [{{...}}]")
             else:
                 table = table.setdefault(part, {})
             if not isinstance(table, (dict, list)):

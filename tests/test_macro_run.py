@@ -173,7 +173,7 @@ def test_a_transient_run_that_fails_keeps_the_history_of_its_steps(tmp_path, mon
             np.testing.assert_allclose(values, full[key][:3], rtol=1e-7, atol=1e-12, err_msg=key)
 
 
-def test_a_load_that_a_support_takes_is_refused(tmp_path):
+def test_a_load_that_a_support_takes_is_refused(tmp_path, monkeypatch):
     """A load across the contact normal: the contact carries nothing of the 200 N, which the first
     solve says in an InputError (before: the run ended normally with zero contact force and no
     heat). The pin's plate held along the load is refused when the scene is read (the load face
@@ -181,6 +181,11 @@ def test_a_load_that_a_support_takes_is_refused(tmp_path):
     text = pin_on_disc(tmp_path / "out", effects=("contact", "friction"))
     scene = loads(text)             # (check refuses a builder's load along its contact plane: a file's is found here)
     scene = dataclasses.replace(scene, loading=dataclasses.replace(scene.loading, direction=(1.0, 0.0, 0.0)))
+    with pytest.raises(SceneError, match=r"^loading.direction = \[1.0, 0.0, 0.0\]: has no component towards the "
+                                         r"contact .*\(the scene as changed after it was read"):
+        run(scene, verbose=False)                # the run reads a changed scene again
+    import multiscale.workflows
+    monkeypatch.setattr(multiscale.workflows, "loads", lambda *args, **kwargs: None)   # past that: the first solve
     with pytest.raises(InputError, match=r"the contact carries .* of the 200 N applied: a support takes the load"):
         run(scene, verbose=False)
     with pytest.raises(SceneError, match=r"boundary\[1\]\.fix = \['z'\] on plate_ends, where the load pushes along"):
@@ -223,6 +228,16 @@ def test_the_python_entry_points_name_bad_arguments(tmp_path):
             load(path, bad)
     with pytest.raises(InputError, match="path = 3: a scene file name"):
         load(3)
+    # a scene changed by dataclasses.replace is checked again (a negative friction ran to "finished" with
+    # negative heat, a negative force failed as "contact Newton did not converge": a user trial)
+    import dataclasses
+    scene = load(path)
+    for change, said in (({"friction": -0.4}, "loading.friction = -0.4: must be >= 0"),
+                         ({"normal_force": -100.0}, "loading.normal_force = -100.0: must be > 0 N")):
+        changed = dataclasses.replace(scene, loading=dataclasses.replace(scene.loading, **change))
+        with pytest.raises(SceneError, match=f"^{said} \\(the scene as changed after it was read"):
+            run(changed, verbose=False)
+    assert not (tmp_path / "out").exists()                       # refused before anything is written
     with pytest.raises(InputError, match="text = .*: the scene's TOML text"):
         loads(path.read_bytes())
 

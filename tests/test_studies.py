@@ -1515,7 +1515,8 @@ def test_a_study_given_for_a_scene_and_a_scene_for_a_study_name_the_right_comman
     for command in ("check", "run"):
         assert main([command, str(path)]) == 2
         assert capsys.readouterr().err.startswith("error: study.toml: a study file (problem = ..., [sweep]), not a "
-                                                  "scene: give it to `multiscale study`\n")
+                                                  "scene: give it to `multiscale study` (Python: "
+                                                  "multiscale.studies.driver.run_studies)\n")
     assert main(["study", str(ROOT / "demos" / "block_on_flat.toml")]) == 2
     assert capsys.readouterr().err == ("error: block_on_flat.toml: a scene file (effects = [...], [geometry]), not a "
                                        "study: give it to `multiscale check` or `multiscale run`\n")

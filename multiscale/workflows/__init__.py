@@ -17,9 +17,10 @@ import numpy as np
 from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs, provenance
-from multiscale.errors import InputError, Interrupted, interrupted
+from multiscale.errors import InputError, Interrupted, SceneError, interrupted
 from multiscale.micro.laws import RESOLUTION
 from multiscale.micro.wear import SUBSTEP_TOL
+from multiscale.scene import loads
 from multiscale.scene_friction import bare_interfaces, curve_left, fade_tables
 from multiscale.scene_sections import HOTTEST, Material
 from multiscale.workflows import multiscale, squeal, transient
@@ -44,6 +45,11 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     scene's first; ``result.warnings`` holds them all, for a script)."""
     if not all(hasattr(scene, a) for a in ("has", "effects", "output")):
         raise InputError("scene", scene, "a validated scene: multiscale.scene.load(path) or loads(text)")
+    try:                    # read again: a script's dataclasses.replace skipped every check (a negative
+        loads(provenance.resolved_toml(scene), name=scene.name)    # friction ran to "finished": a user trial)
+    except SceneError as exc:
+        raise SceneError([f"{line} (the scene as changed after it was read: change it by overrides, "
+                          "multiscale.scene.load(path, overrides))" for line in exc.problems]) from None
     kind = workflow(scene)
     if resume and kind != "multiscale":
         why = ("the squeal analysis has no checkpoints to resume from" if kind == "squeal" else
