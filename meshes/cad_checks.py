@@ -1,6 +1,7 @@
 """Checks of the bodies of an OpenCASCADE geometry file (``meshes.from_file``) against the scene's
 [geometry]: the rotating body one of revolution about its axis (``check_revolution``, by the mass
-properties ``inertia``), bodies not much thinner than their elements (``thin_bodies``)."""
+properties ``inertia``), bodies not much thinner than their elements (``thin_bodies``), bodies
+that nearly touch the rotating one (``near_misses``)."""
 from __future__ import annotations
 
 import numpy as np
@@ -10,6 +11,7 @@ from multiscale.geometry import thin_warning
 
 REVOLUTION = 1e-3           # the rotating body's centre of mass off its axis (of its extent), its axis of inertia (rad)
 EQUAL_MOMENTS = 0.01        # principal moments of inertia this close (of the largest) are those of a body of revolution
+NEAR = 0.01                 # a body without an interface this close to the rotating one (of the model's extent)
 OTHER = "; or, if it is not the body that turns, name the one that does (geometry.rotating)"   # (a pad named: a trial)
 
 
@@ -45,6 +47,23 @@ def thin_bodies(model, g, bodies: dict, volume: dict, pairs: dict) -> list[str]:
         sized.append((name, thickness, min(g.interface_mesh_size, g.mesh_size) if name in touching and
                       g.interface_mesh_size else g.mesh_size))     # (a coarser interface size is not used)
     return thin_warning(sized, " (thickness 2 x volume / surface)")
+
+
+def near_misses(model, g, bodies: dict, pairs: dict, extent: float, named=()) -> list[str]:
+    """Warnings of the fixed bodies that share no face with the rotating one yet come within ``NEAR``
+    times the model's ``extent`` [m] of it: a pad drawn in its released position, 0.5 mm off the
+    disc, was left out without a word while its bonded neighbour took the whole clamp force (a CAD
+    trial). ``pairs``: the interfaces' (fixed, rotating) bodies; ``named``: bodies warned of already
+    (touching nothing, nor a body bonded to them)."""
+    touching = {fixed for fixed, _ in pairs.values()} | set(named)
+    out = []
+    for name in (n for n in bodies if n != g.rotating and n not in touching):
+        gap = min(model.occ.getDistance(3, s, 3, t)[0] for s in bodies[name] for t in bodies[g.rotating])
+        if 0 < gap < NEAR * extent:
+            out.append(f"geometry.bodies.{name} comes within {gap * 1e3:.3g} mm of {g.rotating} without sharing a "
+                       f"face with it: no contact interface there, no load or heat through it (a pad in its "
+                       f"released position? a pad must share a face with {g.rotating} in the file)")
+    return out
 
 
 def check_revolution(g, volumes: list[tuple]) -> None:

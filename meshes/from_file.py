@@ -39,8 +39,8 @@ from meshes import cad_checks, cad_units
 from meshes.cad_bodies import assign_bodies, curve_box
 from meshes.foreign import refuse_foreign
 from multiscale.errors import InputError, InputErrors
-from multiscale.geometry import (FIXED_BODY, BodySpec, GeometrySpec, Region, Rotation, add_group, plane_extent,
-                                 start_gmsh)
+from multiscale.geometry import (FIXED_BODY, BodySpec, GeometrySpec, Region, Rotation, add_group, loose_bodies,
+                                 plane_extent, start_gmsh)
 
 NAME = "file"
 DEFAULTS: dict = {}          # no numeric parameters: [geometry] of the scene is a FileGeometry
@@ -262,6 +262,8 @@ def _load(model, g) -> Found:
     if occ and g.mesh_size is not None:
         found.loose += cad_checks.thin_bodies(model, g, found.bodies, found.volume, found.pairs)
     if occ:
+        found.loose += cad_checks.near_misses(model, g, found.bodies, found.pairs, found.extent,
+                                              loose_bodies(found.loose))
         cad_checks.check_revolution(g, [inertia[v] for v in bodies[g.rotating]])
     return found
 
