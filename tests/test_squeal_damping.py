@@ -699,6 +699,16 @@ def test_the_squeal_figures_compare_like_with_like(tmp_path, drawn):
     assert len(bars) == 1 and bars[0].get_ylabel() == "contact pressure [MPa]"           # one colour bar
     np.testing.assert_array_equal(inner.collections[0].levels, outer.collections[0].levels)
     assert outer.collections[0].levels[-1] == pytest.approx(2.44)
+    r, t = np.meshgrid(np.linspace(0.088, 0.126, 5), np.linspace(-0.35, 0.35, 8))   # four pads of a brake in a
+    angles = [t.ravel() + c for c in (1.95, 1.19, -1.95, -1.19)]                      # row: no panel's labels
+    ring = np.column_stack([np.concatenate([r.ravel() * np.cos(a) for a in angles]),  # over its neighbour's
+                            np.concatenate([r.ravel() * np.sin(a) for a in angles]), np.zeros(160)])   # (a CAD
+    four = {f"pad_{k}": np.arange(160) // 40 == k for k in range(4)}                  # trial)
+    plots.plot_pressure(ring, four, np.linspace(0.0, 5e6, 160), "brake", tmp_path / "pressure.png")
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    renderer = FigureCanvasAgg(drawn[-1]).get_renderer()
+    boxes = [ax.get_tightbbox(renderer) for ax in drawn[-1].axes[:4]]
+    assert all(left.x1 <= right.x0 for left, right in zip(boxes, boxes[1:])), [(b.x0, b.x1) for b in boxes]
     energy = np.array([[1.0, 2.0, 3.0], [0.001, 0.002, 10.0], [0.5, 0.5, 3.0]])
     shares = EnergyShares(["inner", "outer", "disc"], energy, energy / energy.sum(axis=1, keepdims=True))
     class Modes(NS):

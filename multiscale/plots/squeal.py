@@ -32,15 +32,14 @@ def plot_pressure(midpoints: np.ndarray, masks: Mapping[str, np.ndarray], facet_
 
     ``midpoints`` and ``facet_pressure`` are global per interface facet; ``masks`` select each
     interface's facets."""
-    fig = Figure(figsize=(4.2 * len(masks) + 1.2, 3.8))
-    axes = fig.subplots(1, len(masks), squeeze=False)[0]
+    fig = Figure(figsize=(4.2 * len(masks) + 1.2, 3.8), layout="constrained")   # (tight_layout and then the
+    axes = fig.subplots(1, len(masks), squeeze=False)[0]                          # colorbar: labels overlapped)
     mid, p = midpoints, facet_pressure / 1e6
     levels = np.linspace(0.0, max(float(p.max(initial=0.0)), 1e-12), 21)    # one scale for every interface
     for ax, (iface, mask) in zip(axes, masks.items()):
         art = ax.tricontourf(mid[mask, 0] * 1e3, mid[mask, 1] * 1e3, p[mask], levels=levels, cmap="viridis")
         ax.set(title=iface, xlabel="x [mm]", ylabel="y [mm]", aspect="equal")
     fig.suptitle(f"{name}: contact pressure at the preload")
-    fig.tight_layout()
     fig.colorbar(art, ax=list(axes), label="contact pressure [MPa]", shrink=0.9, ticks=MaxNLocator(6))
     return _save(fig, path, tight=False)
 
