@@ -208,3 +208,19 @@ def test_a_solve_beyond_the_memory_is_refused_at_once(monkeypatch):
     with pytest.raises(InputError, match=r"^heights.shape = \(20, 1024, 1024\): a periodic 1024 x 1024 patch x 20 "
                                          r"patches takes at least 1.11 GiB to solve, more than the 1 GiB"):
         solver.solve(np.broadcast_to(0.0, (20, 1024, 1024)), load=1e6)
+
+
+def test_heights_in_another_unit_than_the_pixels_are_warned_about():
+    """Heights in um given as metres beside pixels in metres were solved as given (A/A0 0.00024
+    against 0.0012 in metres: an API trial): a warning by the median slope of the first patch
+    (``contact.STEEP``); a rough surface and a flat punch, whose rim is steep, say nothing."""
+    import warnings
+    s = fractal_surface(64, 1e-3, 0.8, 2, 16, 1e-6, seed=1)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        solve_contact(s, kernel=E, load=1e6)
+        x, y = np.meshgrid(np.arange(64) - 31.5, np.arange(64) - 31.5)
+        solve_contact(np.where(np.hypot(x, y) < 20, 0.0, -1e-3), 1e-6, E, load=1e6)   # 1 mm cliff on 1 um pixels
+    with pytest.warns(UserWarning, match=r"^heights: a median slope of [0-9.e+]+, beyond any rough surface's .*: "
+                                         r"are the heights and dx in m\?"):
+        solve_contact(s.heights * 1e6, s.dx, E, load=1e6)

@@ -142,8 +142,8 @@ def test_bad_surface_input(tmp_path):
         fractal_surface(64, 1e-3, 0.8, 2, 40, 1e-6)
     with pytest.raises(InputError, match="rms"):
         fractal_surface(64, 1e-3, 0.8, 2, 10, 0.0)
-    with pytest.warns(UserWarning, match=r"^rms = 6 m: beyond any roughness .*rms is in m"):   # 6 for 6 um (a
-        fractal_surface(64, 1e-3, 0.8, 2, 10, 6.0)                                          # user trial)
+    with pytest.warns(UserWarning, match=r"^rms = 6 m: taller than the patch is wide \(0.001 m\); rms is in m"):  # (a
+        fractal_surface(64, 1e-3, 0.8, 2, 10, 6.0)                                 # 6 for 6 um: a user trial)
     # a grid beyond the memory: refused at once (200 000²: a raw MemoryError for 149 GiB, a user trial)
     with pytest.raises(InputError, match=r"^n = 200000: 200000 x 200000 points take about 1.08e\+03 GiB to "
                        r"generate, more than the .* GiB this process may use"):

@@ -90,8 +90,8 @@ def fractal_surface(n, size, hurst: float, k_min, k_max, rms: float, seed: int =
         raise InputError("k_max", k_max, f"must exceed k_min = {k_min}")
     if kx_max > nx // 2 or ky_max > ny // 2:
         raise InputError("k_max", k_max, f"must not exceed the Nyquist index ({nx // 2}, {ny // 2})")
-    if check_positive("rms", rms) > TALLEST:          # (6 for 6 um: an rms slope of 1.6e5, a user trial)
-        warnings.warn(f"rms = {rms:g} m: beyond any roughness (heights beyond {TALLEST:g} m); rms is in m (6 um: "
+    if check_positive("rms", rms) > max(Lx, Ly):      # (6 for 6 um: an rms slope of 1.6e5, a user trial)
+        warnings.warn(f"rms = {rms:g} m: taller than the patch is wide ({max(Lx, Ly):g} m); rms is in m (6 um: "
                       "6e-6)", UserWarning, stacklevel=2)
     need, have = FRACTAL_BYTES * nx * ny * int(np.prod(batch)), memory_limit()
     if need > have:                                  # (200 000²: a raw MemoryError for 149 GiB, a user trial)
