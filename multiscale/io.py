@@ -208,7 +208,8 @@ class StepStop:
     step) is True. The second is held: the step ends and its results are written. A third abandons
     the step in progress (``KeyboardInterrupt`` naming the last step whose results are written),
     unless it comes inside ``writing()``, which no Ctrl-C interrupts: a step's results are written
-    whole or not at all (after the last step, ``writing(last=True)``: the run finishes). ``done``: the steps whose results are already written (a resumed run's).
+    whole or not at all (after the last step, ``writing(last=True)``: the run finishes). ``done``:
+    the steps whose results are already written (a resumed run's).
     Under ``mpiexec`` the second Ctrl-C is the launcher's: it kills every rank (MPICH's hydra).
     SIGTERM and SIGHUP (a batch scheduler's time limit, ``timeout``, a closed terminal; unless
     ignored, as under ``nohup``) count as Ctrl-Cs: the first stops the run after its step (they

@@ -184,6 +184,7 @@ def test_a_solve_beyond_the_memory_is_refused_at_once(monkeypatch):
     3 GB limit: a user trial)."""
     import tracemalloc
 
+    from multiscale import memory
     from multiscale.micro import contact
     for periodic, batch in ((True, ()), (False, ()), (True, (8,))):
         s = fractal_surface(256, 1e-3, 0.8, 2, 64, 1e-6, seed=1, batch=batch)
@@ -199,11 +200,11 @@ def test_a_solve_beyond_the_memory_is_refused_at_once(monkeypatch):
     for shape in (64, None, "64x64"):          # checked before the estimate (a raw TypeError: an adversarial test)
         with pytest.raises(InputError, match="^shape.*must be a pair"):
             ContactSolver(E, shape, 1e-7)
-    monkeypatch.setattr(contact, "memory_limit", lambda: 2.0**31)
+    monkeypatch.setattr(memory, "memory_limit", lambda: 2.0**31)
     with pytest.raises(InputError, match=r"^shape = \(4096, 4096\): an isolated 4096 x 4096 patch takes at least "
                                          r"5.38 GiB to solve, more than the 2 GiB this process may use"):
         ContactSolver(E, (4096, 4096), 1e-7, periodic=False)
-    monkeypatch.setattr(contact, "memory_limit", lambda: 2.0**30)
+    monkeypatch.setattr(memory, "memory_limit", lambda: 2.0**30)
     solver = ContactSolver(E, (1024, 1024), 1e-7)          # a batch beyond it
     with pytest.raises(InputError, match=r"^heights.shape = \(20, 1024, 1024\): a periodic 1024 x 1024 patch x 20 "
                                          r"patches takes at least 1.11 GiB to solve, more than the 1 GiB"):

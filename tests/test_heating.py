@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 from multiscale.errors import InputError
+from multiscale import memory
 from multiscale.micro import fft, heating
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.heat_kernels import (Rotation, SpeedProfile, ThermalMaterial, Translation,
@@ -455,7 +456,7 @@ def test_the_tables_memory_is_estimated_and_a_run_that_cannot_fit_is_refused(mon
     finally:
         tracemalloc.stop()
     assert peak == pytest.approx(TransientHeating.memory((32, 32), 300), rel=0.05)
-    monkeypatch.setattr(heating, "memory_limit", lambda: 2.0 ** 30)
+    monkeypatch.setattr(memory, "memory_limit", lambda: 2.0 ** 30)
     with pytest.raises(InputError, match=r"n_steps = 20000: the pulse tables of 20000 steps on a 32 x 32 grid take "
                                          r"about 2.52 GiB, more than the 1 GiB this process may use \(the machine's, "
                                          r"or its container's or job's limit\)"):

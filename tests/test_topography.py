@@ -329,7 +329,7 @@ def test_a_flat_or_planar_matrix_has_no_roughness(tmp_path, heights):
 def test_heights_in_the_wrong_unit_are_warned_about_and_an_overflow_refused(tmp_path, capsys):
     """A matrix in um read as metres (Sq 2 m on a 20 mm pin ran to the end without a word): a
     warning naming the file and height_unit, also in `multiscale check`, and refused once its
-    conditioned Sq exceeds ``surface.TALLEST`` (the run went on with the warning); heights whose spread
+    conditioned Sq exceeds ``reading.TALLEST`` (the run went on with the warning); heights whose spread
     overflows (1e294) one InputError (before: Sq inf, then a ContactNonFiniteError in every zone)."""
     from multiscale.micro.topography import TopographyWarning, probe_topography
     h = fractal_surface(32, 32e-6, 0.8, 2, 8, 1e-6, seed=1).heights

@@ -367,7 +367,9 @@ class MacroModel:
             row["max_slip_speed"], row["min_slip_speed"] = (float(V.max()), float(V.min())) if len(V) else (np.nan,) * 2
         if isinstance(self.tm.spec.motion, Rotation):   # the braking torque: frictional heat power = it x omega
             row["friction_moment"] = abs(self.contact.friction_moment()) * on
-        row["angular_speed" if isinstance(self.tm.spec.motion, Rotation) else "sliding_speed"] = self.speed(self.time)
+            row["angular_speed"] = self.speed(self.time)
+        else:
+            row["sliding_speed"] = self.speed(self.time)
         masks = self.tm.interface.masks()
         if len(masks) > 1:                        # per interface (a brake's pads, a disc's pucks)
             p = self.contact.facet_pressure() * on

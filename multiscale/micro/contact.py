@@ -40,7 +40,7 @@ import numpy as np
 
 from multiscale.errors import ConvergenceError, InputError, check_count, check_flag, check_positive, non_finite
 from multiscale.micro import bccg_solver, pk_solver
-from multiscale.memory import memory_limit
+from multiscale.memory import beyond_limit
 from multiscale.micro.fft import get_threads
 from multiscale.micro.kernels import InfluenceOperator, Kernel, check_kernel, grid_shape
 from multiscale.micro.surface import Surface
@@ -142,7 +142,7 @@ def _fits(name: str, shape, grid, periodic: bool, patches: int) -> None:
     ny, nx = grid
     per_cell = BUILD_BYTES[bool(periodic)] + SCRATCH_BYTES * min(patches, get_threads()) + RESULT_BYTES * patches
     need = float(ny * nx * per_cell)
-    if need > 2**30 and need > (have := memory_limit()):     # (the limit is read in 0.13 ms: not for small solves)
+    if have := beyond_limit(need):
         raise InputError(name, tuple(shape), f"{'a periodic' if periodic else 'an isolated'} {ny} x {nx} patch"
                          f"{f' x {patches} patches' * (patches > 1)} takes at least {need / 2**30:.3g} GiB to solve, more "
                          f"than the {have / 2**30:.3g} GiB this process may use: a coarser grid or fewer patches at once")

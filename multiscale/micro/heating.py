@@ -32,7 +32,7 @@ from tqdm import tqdm
 
 from multiscale.errors import (ConvergenceError, InputError, check_count, check_field, check_flag, check_instance,
                                check_positive, check_real)
-from multiscale.memory import memory_limit
+from multiscale.memory import beyond_limit
 from multiscale.micro.contact import ContactResult, ContactSolver
 from multiscale.micro.fft import RealFFT2
 from multiscale.micro.heat_kernels import Motion, Rotation, ThermalMaterial, Translation, pulse_tables
@@ -280,8 +280,8 @@ class TransientHeating:
         self.shape, self.dx, self.dy = _check_grid(shape, dx, dy)
         self.dt = check_positive("dt", dt)
         self.n_steps = check_count("n_steps", n_steps)
-        need, have = self.memory(self.shape, self.n_steps), memory_limit()
-        if need > have:         # (200 000 steps on 64² was a raw MemoryError, or tens of GB asked: a user trial)
+        need = self.memory(self.shape, self.n_steps)
+        if have := beyond_limit(need):     # (200 000 steps on 64² was a raw MemoryError, or tens of GB asked: a trial)
             raise InputError("n_steps", n_steps, f"the pulse tables of {n_steps} steps on a {self.shape[0]} x "
                              f"{self.shape[1]} grid take about {need / 2**30:.3g} GiB, more than the "
                              f"{have / 2**30:.3g} GiB this process may use (the machine's, or its container's or "

@@ -19,9 +19,10 @@ import numpy as np
 
 from multiscale.errors import InputError, check_pair, check_positive
 from multiscale.micro.spectrum import surface_topography
-from multiscale.micro.surface import TALLEST, read_matrix
+from multiscale.micro.surface import read_matrix
 
 MATRIX_SUFFIXES = (".npy", ".txt", ".csv", ".asc")    # plain height matrices (no units in the file)
+TALLEST = 1e-2            # m: heights beyond are no roughness measurement (an instrument's z range is mm)
 WIDEST = 1.0              # m: maps wider are no roughness measurement (a profilometer's stage is 0.1 m)
 LOWEST = 1e-10            # m: heights all within it are none either (an atomic step; offsets and noise exceed it)
 UNDERFLOW = 1e-60         # m: heights all within it have powers (h^4 in Sku) that underflow: refused

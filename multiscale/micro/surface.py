@@ -14,9 +14,8 @@ import numpy as np
 
 from multiscale.errors import (InputError, check_count, check_field, check_flag, check_instance, check_positive,
                                check_real)
-from multiscale.memory import memory_limit
+from multiscale.memory import beyond_limit
 
-TALLEST = 1e-2            # m: heights beyond are no roughness (an instrument's z range is mm)
 FRACTAL_BYTES = 29        # fractal_surface's least peak [bytes per point] (traced: 29-42 from 256² to 1024²)
 
 
@@ -93,8 +92,8 @@ def fractal_surface(n, size, hurst: float, k_min, k_max, rms: float, seed: int =
     if check_positive("rms", rms) > max(Lx, Ly):      # (6 for 6 um: an rms slope of 1.6e5, a user trial)
         warnings.warn(f"rms = {rms:g} m: taller than the patch is wide ({max(Lx, Ly):g} m); rms is in m (6 um: "
                       "6e-6)", UserWarning, stacklevel=2)
-    need, have = FRACTAL_BYTES * nx * ny * int(np.prod(batch)), memory_limit()
-    if need > have:                                  # (200 000²: a raw MemoryError for 149 GiB, a user trial)
+    need = FRACTAL_BYTES * nx * ny * int(np.prod(batch))
+    if have := beyond_limit(need):                   # (200 000²: a raw MemoryError for 149 GiB, a user trial)
         raise InputError("n", n, f"{nx} x {ny} points{f' x {int(np.prod(batch))} patches' * bool(batch)} take about "
                          f"{need / 2**30:.3g} GiB to generate, more than the {have / 2**30:.3g} GiB this process may "
                          "use: fewer points (a coarser grid or a smaller patch)")

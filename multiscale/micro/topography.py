@@ -30,9 +30,9 @@ import numpy as np
 from multiscale.errors import InputError, check_count, check_instance, check_pair, check_positive, check_real
 from multiscale.micro.filters import check_cutoff, gaussian_filter, gaussian_per_axis, resolved, roughness_of
 from multiscale.micro.outliers import DESPIKE, find_outliers
-from multiscale.micro.reading import Measurement, TopographyWarning, option, read_topography
+from multiscale.micro.reading import TALLEST, Measurement, TopographyWarning, option, read_topography
 from multiscale.micro.spectrum import Spectrum, as_topography, equivalent_surface, power_spectrum
-from multiscale.micro.surface import TALLEST, Surface, defined_sums, row_blocks
+from multiscale.micro.surface import Surface, defined_sums, row_blocks
 
 MAX_UNDEFINED = 0.1       # default largest fraction of undefined points that is filled
 DETREND = {"none": None, "mean": "mean", "plane": "height", "poly2": "curvature"}   # -> SurfaceTopography
