@@ -203,9 +203,9 @@ def test_the_wear_map_of_a_round_face_leaves_its_corners_blank(tmp_path, drawn):
 def test_a_log_axis_of_pressures_ends_on_labelled_ticks(tmp_path, drawn):
     """The multiscale figure's pressure panel: facets at 12.6-15.1 MPa beside micro peaks of
     99 MPa had no labelled tick near the facets' curves (a user trial). Its limits are now the
-    1, 2 or 5 x 10^k around the values, ticks labelled in plain numbers; a worn volume above
-    0.001 mm³ is in mm³. A released row (pressures 0) leaves a gap: its curves dropped off the
-    log axis (a user trial)."""
+    1, 2 or 5 x 10^k around the values, ticks labelled in plain numbers. A released row (pressures 0) leaves a gap: its curves dropped off the
+    log axis (a user trial). The worn volume is in mm³ however small (µm³ below 0.001 mm³ puzzled a
+    user trial: a tribologist reads mm³)."""
     assert plots.nice_range([12.6, 99.0]) == (10.0, 100.0)
     assert plots.nice_range([0.03, 0.7]) == (0.02, 1.0) and plots.nice_range([2.0, 5.0]) == (2.0, 5.0)
     assert plots.nice_range([5.0, 5.0]) == (2.0, 10.0)
@@ -221,6 +221,13 @@ def test_a_log_axis_of_pressures_ends_on_labelled_ticks(tmp_path, drawn):
     plots.multiscale_figure(history, tmp_path / "m.png")
     curves = [line.get_ydata() for line in drawn[-1].axes[0].get_lines()]
     assert all(np.isnan(y[-1]) and np.isfinite(y[:2]).all() for y in curves)     # a gap (it dropped off the axis)
+    small = History()
+    for t, volume in enumerate([0.0, 1.2e-15]):
+        small.append(time=float(t), max_pressure=1e6, wear_volume=volume)
+    plots.multiscale_figure(small, tmp_path / "m.png")
+    worn = drawn[-1].axes[1]
+    assert worn.get_ylabel() == "wear volume [mm³]"
+    assert worn.get_lines()[0].get_ydata()[-1] == pytest.approx(1.2e-6)
 
 
 def test_the_multiscale_figure_shows_the_real_contact_area_and_the_plastic_share(tmp_path, drawn):

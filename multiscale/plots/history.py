@@ -187,7 +187,6 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
     hot = temperature_columns(cols)
     areas = [k for k in cols if k.startswith("real_contact_area_")]          # one per rough interface
     area = 1e6 if np.nanmax(np.abs(cols.get("real_contact_area", [0.0])), initial=0.0) > 1e-8 else 1e12  # mm² or µm²
-    volume = 1e9 if np.nanmax(np.abs(cols.get("wear_volume", [0.0])), initial=0.0) > 1e-12 else 1e18   # mm³ or µm³
     after, before = (" (after wear)", " (before wear)") if "wear_volume" in cols else ("", "")   # a row's two states (a
     panels = [("max contact pressure [MPa]", [("max_pressure", "macro facet" + after),       # zone above every facet
                                                ("max_zone_pressure", "macro zone mean" + before),   # puzzled a user
@@ -199,7 +198,8 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
               ("zones' heat partition\ninto the rough body [%]",   # the coefficients of Fig. 7.12, not
                [("partition_max", "max"), ("partition_mean", "mean over zones"),    # weighted by the heat
                 ("partition_min", "min")], 100.0, 0),
-              ("wear volume [mm³]" if volume == 1e9 else "wear volume [µm³]", [("wear_volume", None)], volume, 0),
+              ("wear volume [mm³]", [("wear_volume", None)], 1e9, 0),     # a tribologist's unit, however small
+
               ("max wear depth [µm]", [("wear_max_depth", None)], 1e6, 0),
               ("RMS roughness of the worn zones [µm]", [("rms_height", None)], 1e6, 0),
               ("real contact area [mm²]" if area == 1e6 else "real contact area [µm²]",
