@@ -96,10 +96,6 @@ def suggest(name: str, options) -> str:
     return f' (did you mean "{near[0]}"?)' if near else ""
 
 
-def _a(words: str) -> str:
-    return ("an " if words[0] in "aeiou" else "a ") + words
-
-
 # ---------------------------------------------------------------- value parsers
 class Quantity:
     """A physical quantity of a units.KINDS kind, converted to SI, with an optional range (outside
@@ -124,7 +120,8 @@ class Quantity:
     def describe(self) -> str:
         rng = self.range_text()
         examples = f" ({self.kind.examples})" if self.kind.examples not in ("", self.kind.si) and self.kind.si else ""
-        return f"{_a(self.kind.name)}{' ' + rng if rng else ''}{examples}{self._plausible()}"
+        article = "an " if self.kind.name[0] in "aeiou" else "a "
+        return f"{article}{self.kind.name}{' ' + rng if rng else ''}{examples}{self._plausible()}"
 
     def _plausible(self) -> str:
         if self.plausible is None:
@@ -357,7 +354,9 @@ class FilePath:
         if not self.folder and not S_ISREG(mode):
             kind = "is a folder, not a file" if S_ISDIR(mode) else "is no regular file (a FIFO, device or socket)" \
                 if mode else "no such file"
-            raise Bad(f"{kind} ({path})")
+            maker = [] if mode else [s.name for s in sorted(ctx.directory.glob("*.py"))[:50]   # (the CAD demos' STEP)
+                                     if s.is_file() and path.name in s.read_text(errors="replace")]
+            raise Bad(f"{kind} ({path})" + (f"; {maker[0]} beside {self.base} names it: run it first?" if maker else ""))
         return path
 
 
