@@ -440,12 +440,14 @@ class Reporter:
     """Stage messages of a run: one line per stage on rank 0 (under a terminal the line shows the
     running stage, its progress bar, then its wall time), nothing with ``quiet``. ``times`` holds
     the wall time [s] of every stage (summed over repeats), for the provenance of the results.
-    Used as a context manager, it is the one that ``stage`` and ``bar`` report to."""
+    Used as a context manager, it is the one that ``stage`` and ``bar`` report to. Its ``warn`` lines
+    go to stderr on rank 0, with ``quiet`` too, unless ``warn`` is false."""
 
-    def __init__(self, comm=None, quiet: bool = False, stream=None):
+    def __init__(self, comm=None, quiet: bool = False, stream=None, warn: bool = True):
         self.comm = comm or MPI.COMM_WORLD
         self.stream = stream or sys.stdout
         self.show = not quiet and self.comm.rank == 0
+        self.warns = warn and self.comm.rank == 0
         self.tty = self.show and hasattr(self.stream, "isatty") and self.stream.isatty()
         self.times: dict[str, float] = {}
         self.depth = 0            # nested stages are timed, not printed
@@ -464,6 +466,11 @@ class Reporter:
         """A message line on rank 0 (not with ``quiet``)."""
         if self.show:
             print(text, file=self.stream, flush=True)
+
+    def warn(self, line: str) -> None:
+        """"warning: ``line``" on stderr (rank 0; not with ``warn`` false)."""
+        if self.warns:
+            print(f"warning: {line}", file=sys.stderr, flush=True)
 
     @contextmanager
     def stage(self, name: str):
@@ -530,7 +537,7 @@ def duration(seconds: float) -> str:
     return f"{s // 3600} h {s % 3600 // 60:02d} min"
 
 
-_SILENT = Reporter(MPI.COMM_SELF, quiet=True)
+_SILENT = Reporter(MPI.COMM_SELF, quiet=True)      # (its warnings are printed)
 
 
 def reporter() -> Reporter:

@@ -36,13 +36,13 @@ def workflow(scene) -> str:
 
 
 def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_WORLD,
-        verbose: bool = True) -> RunResult:
+        verbose: bool = True, warn: bool = True) -> RunResult:
     """Run a scene (``multiscale run``) with its workflow; only the multiscale loop resumes.
 
     Besides the analysis' results, the folder receives ``scene.toml``, ``scene_resolved.toml``,
     ``provenance.json`` (also after a failure, once the run has written into the folder) and ``open_in_paraview.py``.
-    ``verbose``: stage lines and the summary on rank 0 (the warnings are printed in any case, the
-    scene's first; ``result.warnings`` holds them all, for a script)."""
+    ``verbose``: stage lines and the summary on rank 0; ``warn``: the warnings on stderr (rank 0, the
+    scene's first; ``result.warnings`` and provenance.json hold them all, whatever ``warn``)."""
     if not all(hasattr(scene, a) for a in ("has", "effects", "output")):
         raise InputError("scene", scene, "a validated scene: multiscale.scene.load(path) or loads(text)")
     try:                    # read again: a script's dataclasses.replace skipped every check (a negative
@@ -57,13 +57,13 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                "writes checkpoints)")
         raise InputError("--resume", None, why + ": run it again with --overwrite (in Python: overwrite=True, "
                                            "not resume)")   # (no fix said: a user trial; nor the API's)
-    for line in scene.warnings if comm.rank == 0 else ():
-        print(f"warning: {line}", file=sys.stderr, flush=True)
     ended = resume and checkpoint.peek(Path(scene.output.folder) / multiscale.CHECKPOINT, comm).get("finished")
     # the parts of the run before this one (rank 0 writes the record): resumed, they stay in it
     earlier = provenance.parts_of(Path(scene.output.folder)) if resume and comm.rank == 0 else []
     started, start = provenance.now(), time.perf_counter()
-    with io.Reporter(comm, quiet=not verbose) as reporter:
+    with io.Reporter(comm, quiet=not verbose, warn=warn) as reporter:
+        for line in scene.warnings:
+            reporter.warn(line)
         try:
             if kind == "multiscale":
                 result = multiscale.run(scene, overwrite=overwrite, resume=resume, comm=comm, verbose=verbose)
@@ -73,8 +73,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         except BaseException as exc:
             stopped = interrupted(exc)
             notes = list(getattr(exc, "__notes__", ()))     # the run's warnings until it failed (model.heat_warnings_as_notes)
-            for line in notes if comm.rank == 0 else ():
-                print(f"warning: {line}", file=sys.stderr, flush=True)
+            for line in notes:
+                reporter.warn(line)
             if reporter.folder is not None and comm.rank == 0:
                 try:                    # before the record, which lists the files there are
                     if isinstance(exc, Interrupted):          # stopped after a step: its results are written
@@ -102,8 +102,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                          if (result.folder / name).is_file()]
         return result
     beyond = run_warnings(scene, getattr(result, "history", None)) + list(getattr(result, "warnings", ()))
-    for line in beyond if comm.rank == 0 else ():           # what the results leave out: also when quiet
-        print(f"warning: {line}", file=sys.stderr, flush=True)
+    for line in beyond:                                     # what the results leave out: also when quiet
+        reporter.warn(line)
 
     def write():
         files = provenance.write(result.folder, scene, ranks=comm.size, started=started, stages=reporter.times,

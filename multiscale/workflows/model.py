@@ -28,7 +28,6 @@ The rules that more than one analysis follows live here once:
 from __future__ import annotations
 
 import itertools
-import sys
 import warnings
 from contextlib import contextmanager
 
@@ -258,11 +257,10 @@ def say_model_size(tm, mechanics, thermal=None, kind: str = "transient", modes: 
     if comm.rank == 0 and have is not None and SPREAD * need > have:
         machines = "this machine" if len(set(hosts)) == 1 else f"the {len(set(hosts))} machines of its ranks"
         zones = f" and {spaced(points)} zone grid points" if points else ""
-        print(f"warning: a {kind} run of {spaced(n)} displacement dofs{zones} takes about {need / 1e9:.3g} GB at its peak (an "
-              f"estimate from measured runs, docs/performance.rst; up to {SPREAD:g} times that), near or above the "
-              f"{have / 1e9:.3g} GB {machines} "
-              f"has free: it may be killed without a word by the out-of-memory killer; {remedy(kind == 'squeal')}",
-              file=sys.stderr, flush=True)
+        reporter().warn(f"a {kind} run of {spaced(n)} displacement dofs{zones} takes about {need / 1e9:.3g} GB at its "
+                        f"peak (an estimate from measured runs, docs/performance.rst; up to {SPREAD:g} times that), "
+                        f"near or above the {have / 1e9:.3g} GB {machines} has free: it may be killed without a word "
+                        f"by the out-of-memory killer; {remedy(kind == 'squeal')}")
 
 
 def build_mechanics(scene, tm, *, law=None, temperatures=None, degree: int = 1,

@@ -4,7 +4,6 @@ from __future__ import annotations
 import fcntl
 import os
 import shutil
-import sys
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -119,8 +118,8 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
         raise SceneError(f'output.folder = "{folder}": holds {", ".join(own)}, named as this run\'s results{why}: a '
                          "run would write over them, --overwrite too; move them or choose another folder")
     if resume and unreadable and comm.rank == 0:      # the checkpoint resumes; the record of the parts before is gone
-        print(f"warning: {unreadable}: the record of the run's earlier parts is lost; the new provenance.json "
-              "records the resumed part only", file=sys.stderr, flush=True)
+        io.reporter().warn(f"{unreadable}: the record of the run's earlier parts is lost; the new provenance.json "
+                           "records the resumed part only")
     if existing and not (overwrite or resume):
         shown = ", ".join(existing[:3]) + (", ..." if len(existing) > 3 else "")
         ran = comm.bcast(bool(set(existing) & set(provenance.results_of(folder))) if comm.rank == 0 else None, root=0)

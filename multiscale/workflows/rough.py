@@ -25,7 +25,6 @@ the multiscale loop and the squeal analysis:
 """
 from __future__ import annotations
 
-import sys
 import warnings
 from dataclasses import replace
 
@@ -154,7 +153,7 @@ def build_rough_interface(scene, tm, *, progress: bool = False) -> RoughInterfac
 
     def say(line: str) -> None:     # a step as a stage line (not with --quiet: it was said), a warning always
         if "warning: " in line:
-            print(line, file=sys.stderr, flush=True)
+            io.reporter().warn(line.replace("warning: ", "", 1))
         else:
             io.reporter().say(line)
     log = say if tm.comm.rank == 0 else None

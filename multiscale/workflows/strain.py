@@ -4,9 +4,9 @@ others did. Read by the transient and multiscale runs from their history (``max_
 ``interface_force_<name>``) and by the squeal analysis from its preloads."""
 from __future__ import annotations
 
-import sys
 from collections.abc import Mapping
 
+from multiscale import io
 from multiscale.errors import InputError
 
 STRAINED = 0.02   # a contact pressure above this share of the softer side's E is warned about
@@ -46,8 +46,8 @@ def say_at_once(scene, history, comm) -> None:
     if comm.rank != 0 or "max_pressure" not in history.columns:
         return
     for line in overloaded(scene, float(history["max_pressure"][-1])) + unloaded(last_forces(scene, history)):
-        print(f"warning: at the first contact solve, {line}; the run goes on (Ctrl-C stops it after a step, "
-              "with its results written)", file=sys.stderr, flush=True)
+        io.reporter().warn(f"at the first contact solve, {line}; the run goes on (Ctrl-C stops it after a step, "
+                           "with its results written)")
 
 
 def last_forces(scene, history) -> dict[str, float]:
