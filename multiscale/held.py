@@ -272,16 +272,43 @@ class Holding:
                           "holds these motions (e.g. fix = [\"x\", \"y\"] on a pad's sides)")
 
 
+HELD_LOAD = 1e-6   # a load face whose load the supports' fixed components take but this share of is refused
+
+
+def check_load_free(parts: Parts, spec: GeometrySpec) -> None:
+    """InputError if the supports of a load face fix every component its load pushes along (a fluid
+    load's normal at each facet, else ``spec.load_direction``), to ``HELD_LOAD`` of its area: they
+    would take the load and the contact none. The scene refuses it for a given direction or all
+    components fixed; a fluid load needs the faces' normals (a trial fixed the abutments in x and y,
+    loaded by a pressure along their normals y: passed, and the pad carried no force)."""
+    fixed = {}
+    for sup in spec.supports:
+        fixed.setdefault(sup.face, set()).update(sup.components)
+    for face in spec.load_faces:
+        if face not in fixed or face not in spec.faces:
+            continue
+        free = [c for c in range(3) if c not in fixed[face]]
+        _, _, n, area = parts.triangles(spec.faces[face])
+        d = n if spec.fluid_load else np.broadcast_to(np.asarray(spec.load_direction, dtype=float), n.shape)
+        if area.sum() > 0 and area @ np.linalg.norm(d[:, free], axis=1) <= HELD_LOAD * area.sum():
+            along = "along its normals" if spec.fluid_load else f"along {list(spec.load_direction)}"
+            raise InputError("loading.faces", face, f"a load face whose supports fix {sorted('xyz'[c] for c in fixed[face])},"
+                             f" every component the load pushes {along}: they would take the load and the contact "
+                             "none; load another face, or fix another")
+
+
 def check_held(model, spec: GeometrySpec, sliding: bool = False) -> dict[str, str]:
     """Every part of the meshed ``model`` (gmsh, linear or quadratic cells) is held against its six
     rigid motions by the joints, supports and interfaces of ``spec`` (module docstring); otherwise
     an InputError names a free part's region, a point and its free motions (a part touching
     nothing: that it touches nothing). ``sliding`` (friction): the interfaces hold no part, on
     either side, in body 1's motion along them (``spec.motion``). Returns the interfaces that alone
-    hold a part, each with what would move without it (``sole_holds``)."""
+    hold a part, each with what would move without it (``sole_holds``). A load face its supports hold
+    along the load is refused first (``check_load_free``)."""
     parts = Parts.of(model, spec)
     if parts is None:
         return {}
+    check_load_free(parts, spec)
     holding = Holding(parts, spec.motion)
     holding.joints()
     holding.supports(spec)

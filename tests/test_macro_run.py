@@ -177,7 +177,8 @@ def test_a_load_that_a_support_takes_is_refused(tmp_path, monkeypatch):
     """A load across the contact normal: the contact carries nothing of the 200 N, which the first
     solve says in an InputError (before: the run ended normally with zero contact force and no
     heat). The pin's plate held along the load is refused when the scene is read (the load face
-    held along the load; before, after the first solve, and ``check`` said OK: a user trial)."""
+    held along the load; before, after the first solve, and ``check`` said OK: a user trial); past
+    that, meshing refuses it (``held.check_load_free``)."""
     text = pin_on_disc(tmp_path / "out", effects=("contact", "friction"))
     scene = loads(text)             # (check refuses a builder's load along its contact plane: a file's is found here)
     scene = dataclasses.replace(scene, loading=dataclasses.replace(scene.loading, direction=(1.0, 0.0, 0.0)))
@@ -185,7 +186,12 @@ def test_a_load_that_a_support_takes_is_refused(tmp_path, monkeypatch):
                                          r"contact .*\(the scene as changed after it was read"):
         run(scene, verbose=False)                # the run reads a changed scene again
     import multiscale.workflows
-    monkeypatch.setattr(multiscale.workflows, "loads", lambda *args, **kwargs: None)   # past that: the first solve
+    monkeypatch.setattr(multiscale.workflows, "loads", lambda *args, **kwargs: None)   # past that: the meshing
+    with pytest.raises(InputError, match=r"^loading.faces = 'plate_ends': a load face whose supports fix \['x', 'y'\], "
+                                         r"every component the load pushes along \[1.0, 0.0, 0.0\]"):
+        run(scene, verbose=False)
+    import multiscale.held
+    monkeypatch.setattr(multiscale.held, "check_load_free", lambda *args: None)     # past that: the first solve
     with pytest.raises(InputError, match=r"the contact carries .* of the 200 N applied: a support takes the load"):
         run(scene, verbose=False)
     with pytest.raises(SceneError, match=r"boundary\[1\]\.fix = \['z'\] on plate_ends, where the load pushes along"):
@@ -197,7 +203,8 @@ def test_temperatures_beyond_a_material_table_are_warned_about(tmp_path, capsys)
     it is warned about when the scene is read, a body hotter than its last point after the run
     (printed and kept in provenance.json). Before: no word of either. ``workflows.run`` prints
     both and returns them in ``result.warnings`` for a script (before, a script saw neither the
-    scene's warning, which only the command line printed, nor any in the result: a user trial)."""
+    scene's warning, which only the command line printed, nor any in the result: a user trial);
+    ``warn=False`` keeps them off stderr."""
     text = pin_on_disc(tmp_path / "pod").replace(
         'kappa = "35 W/(m K)"', 'kappa = [["20 degC", "35 W/(m K)"], ["20.5 degC", "35 W/(m K)"]]').replace(
         'alpha = "1e-5 1/K"', 'alpha = [["-50 degC", "1e-5 1/K"], ["0 degC", "1e-5 1/K"]]')
@@ -213,6 +220,9 @@ def test_temperatures_beyond_a_material_table_are_warned_about(tmp_path, capsys)
     assert list(result.warnings) == record["warnings"]
     assert [line for line in capsys.readouterr().err.splitlines() if "materials." in line] == \
         [f"warning: {line}" for line in record["warnings"]]
+    quiet = run(scene, verbose=False, warn=False, overwrite=True)   # a script's own report: not a line (before,
+    assert "warning" not in capsys.readouterr().err                # they went to stderr with verbose=False: a trial)
+    assert quiet.warnings == result.warnings
 
 
 def test_the_python_entry_points_name_bad_arguments(tmp_path):
