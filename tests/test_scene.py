@@ -650,12 +650,13 @@ def test_a_folder_given_as_a_file_is_said_to_be_a_folder(tmp_path):
 
 def test_a_missing_file_names_the_script_beside_the_scene_that_writes_it(tmp_path):
     """A CAD demo checked before its STEP file was made said "no such file" alone: a Python script
-    beside the scene that names the file is now named (the scene's comment said it, the message did
-    not; a user trial)."""
+    beside the scene whose line naming the file writes (saves, exports) it is now named (the scene's
+    comment said it, the message did not; a user trial), not one that reads it (a trial's own
+    reading script was named)."""
     text = GOOD.replace('builder = "block_on_flat"\nmesh_size = "2 mm"', 'file = "cad/brake.step"\nrotating = "flat"\n'
                         '[geometry.bodies.block]\nindex = [1]\nmaterial = "block"\n'
                         '[geometry.bodies.flat]\nindex = [2]\nmaterial = "flat"')
-    (tmp_path / "other.py").write_text("print('nothing here')\n")
+    (tmp_path / "other.py").write_text("print('nothing here')\nread('cad/brake.step')\n")   # reads it: not named
     with pytest.raises(SceneError) as info:
         loads(text, tmp_path)
     missing = f'geometry.file = "cad/brake.step": no such file ({tmp_path / "cad" / "brake.step"})'
@@ -663,7 +664,7 @@ def test_a_missing_file_names_the_script_beside_the_scene_that_writes_it(tmp_pat
     (tmp_path / "models.py").write_text("gmsh.write(str(OUT / 'brake.step'))\n")
     with pytest.raises(SceneError) as info:
         loads(text, tmp_path)
-    assert f"{missing}; models.py beside the scene file names it: run it first?" in info.value.problems
+    assert f"{missing}; models.py beside the scene file writes it: run it first?" in info.value.problems
 
 
 def test_a_geometry_file_s_names_must_not_clash_with_the_results(tmp_path):
