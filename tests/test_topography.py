@@ -330,7 +330,8 @@ def test_heights_in_the_wrong_unit_are_warned_about_and_an_overflow_refused(tmp_
     """A matrix in um read as metres (Sq 2 m on a 20 mm pin ran to the end without a word): a
     warning naming the file and height_unit, also in `multiscale check`, and refused once its
     conditioned Sq exceeds ``reading.TALLEST`` (the run went on with the warning); heights whose spread
-    overflows (1e294) one InputError (before: Sq inf, then a ContactNonFiniteError in every zone)."""
+    overflows (1e294) one InputError (before: Sq inf, then a ContactNonFiniteError in every zone); a
+    conditioned Sq below ``reading.LOWEST`` warned of."""
     from multiscale.micro.topography import TopographyWarning, probe_topography
     h = fractal_surface(32, 32e-6, 0.8, 2, 8, 1e-6, seed=1).heights
     np.save(tmp_path / "um.npy", h * 1e6)
@@ -360,6 +361,20 @@ def test_heights_in_the_wrong_unit_are_warned_about_and_an_overflow_refused(tmp_
     np.save(tmp_path / "huge.npy", h * 1e300)
     with pytest.raises(InputError, match=r"file = 'huge.npy': heights up to .* m overflow"):
         read_topography(tmp_path / "huge.npy", pixel_size=1e-6)
+    # um given as nm under a tilt and an offset (the raw heights' peak passed: Sq 0.018 nm without a word,
+    # a user trial): the conditioned Sq below an atomic step is warned of, in the report too
+    y, x = np.mgrid[:32, :32]
+    np.save(tmp_path / "tilted.npy", h * 1e4 + 5.0 + 0.3 * x)     # a 10 nm Sq in um, on a 5 um offset and a tilt
+    tilted = read_topography(tmp_path / "tilted.npy", pixel_size=1e-6, height_unit=1e-9, prefix="roughness.")
+    with pytest.warns(TopographyWarning, match=r"^roughness\.file = 'tilted\.npy': Sq [0-9.e-]+ m after form removal, "
+                      r"below an atomic step \(0\.1 nm\) and any measured roughness: is roughness\.height_unit right\?"):
+        low = condition(tilted, prefix="roughness.")
+    assert low.report[-1] == f"warning: {low.notes[-1]}"
+    assert probe_topography(tmp_path / "tilted.npy", pixel_size=1e-6, height_unit=1e-9)[1] == [   # check says it
+        low.notes[-1].replace("roughness.", "")]
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", TopographyWarning)                    # in its unit: no word
+        condition(read_topography(tmp_path / "tilted.npy", pixel_size=1e-6, height_unit=1e-6))
 
 
 def test_a_plain_matrix_has_one_channel(tmp_path):

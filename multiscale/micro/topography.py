@@ -30,7 +30,7 @@ import numpy as np
 from multiscale.errors import InputError, check_count, check_instance, check_pair, check_positive, check_real
 from multiscale.micro.filters import check_cutoff, gaussian_filter, gaussian_per_axis, resolved, roughness_of
 from multiscale.micro.outliers import DESPIKE, find_outliers
-from multiscale.micro.reading import TALLEST, Measurement, TopographyWarning, option, read_topography
+from multiscale.micro.reading import LOWEST, TALLEST, Measurement, TopographyWarning, option, read_topography
 from multiscale.micro.spectrum import Spectrum, as_topography, equivalent_surface, power_spectrum
 from multiscale.micro.surface import Surface, defined_sums, row_blocks
 
@@ -64,7 +64,9 @@ def probe_topography(path, channel: int | None = None, *, pixel_size=None, heigh
     searched = flattened if detrend == form else None         # the outlier search's heights, if these
     if cutoff is not None and not resolved(cutoff, m.dx, m.dy):   # refused in the scene's words (``check_cutoff``):
         cutoff = None                                             # the outliers as if without it
-    return [], list(m.notes) + ([] if despike is not None else _outlier_notes(m, detrend, cutoff, prefix, searched))
+    low = _too_smooth(float(np.nanstd(flattened)), m.path.name, prefix)
+    return [], list(m.notes) + ([] if despike is not None else _outlier_notes(m, detrend, cutoff, prefix, searched)) \
+        + ([low] if low else [])
 
 
 def _outlier_notes(m: Measurement, detrend: str, cutoff: float | None, prefix: str,
@@ -236,7 +238,21 @@ def condition(m: Measurement, detrend: str = "plane", cutoff: float | None = Non
     if sq > TALLEST:          # (um read as m ran to the end: micro pressures 28x E*, exit 0; a user trial)
         raise InputError(option(prefix, "file"), m.path.name, f"Sq {sq:.3g} m after form removal and outliers, "
                          f"beyond any roughness (an instrument's z range is mm): is {option(prefix, 'height_unit')} right?")
+    if (low := _too_smooth(sq, m.path.name, prefix)) is not None:
+        notes.append(low)
+        warnings.warn(low, TopographyWarning, stacklevel=2)
+        report.append(f"warning: {low}")
     return Conditioned(surface, waviness, tuple(report), tuple(notes))
+
+
+def _too_smooth(sq: float, name: str, prefix: str) -> str | None:
+    """A note if the Sq [m] left after form removal is below ``reading.LOWEST``, an atomic step: heights
+    in a smaller unit than the file's (um given as nm: Sq 0.018 nm passed without a word, the raw
+    heights' check seeing the tilt and offset; a user trial)."""
+    if sq >= LOWEST:
+        return None
+    return (f"{option(prefix, 'file')} = '{name}': Sq {sq:.3g} m after form removal, below an atomic step (0.1 nm) "
+            f"and any measured roughness: is {option(prefix, 'height_unit')} right?")
 
 
 def _um(value: float) -> str:
