@@ -408,7 +408,8 @@ class Roughness:
     cut-offs are wavelengths per patch: the whole face cut into zones, or each zone, ``patch``) or
     a measured ``file`` (issue 17; ``multiscale.micro.topography``): any format SurfaceTopography
     reads with its units and pixel sizes (``pixel_size``, ``height_unit`` override them, warned) or
-    a plain height matrix (.npy, .txt, .csv, .asc), conditioned (``detrend``, outliers warned of or
+    a plain height matrix (.npy, .txt, .csv, .asc; rows along y: (ny, nx), the transpose of
+    SurfaceTopography's ``heights()``), conditioned (``detrend``, outliers warned of or
     removed at ``despike``, undefined points filled up to ``max_undefined``, ``cutoff``), then
     ``cover``ing the face: itself ("measured": it must cover it; checked when the scene is read),
     copies ("mirror", "tile": warned) or a surface from its PSD ("equivalent", ``seed``)."""
