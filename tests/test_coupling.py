@@ -901,9 +901,10 @@ def test_a_nm_smooth_face_runs_in_nearly_perfect_contact(tmp_path):
     record = json.loads((tmp_path / "smooth" / "provenance.json").read_text())
     assert [w for w in record["warnings"] if NEAR_PERFECT in w] == [
         f"up to {h['near_perfect_zones'].max():.0f} zones were {NEAR_PERFECT} (8.0% of a zone's own, "
-        "micro.laws.resolved_gap): there the zones are in nearly perfect contact, their laws at that floor (a smooth "
-        "or worn-flat face; the "
-        "column near_perfect_zones of the history says when)"]
+        "micro.laws.resolved_gap): their laws' gaps fall at that floor, so their contact stiffness is a lower bound "
+        "(the interface nearly rigid beside the zone's own compliance), their real contact area, conductance and heat "
+        "partition those of the micro solves (a smooth or worn-flat face; the column near_perfect_zones of the history "
+        "says when)"]
     perfect = POD.replace(', "roughness", "wear"]', ']').replace("partition = 0.14", 'partition = 0.14\npenalty = "1e15 Pa/m"')
     perfect = perfect[:perfect.index("[roughness]")] + perfect[perfect.index("[output]"):]
     p = run_pod(tmp_path / "perfect", one, perfect)["max_pressure"][-1]

@@ -228,9 +228,10 @@ def _law_reach(history) -> list[str]:
     if floored > 0:
         zones = "1 zone was" if floored == 1 else f"{floored:.0f} zones were"     # (it said "up to 1 zones")
         out.append(f"up to {zones} loaded where the roughness adds less compliance than the zone laws resolve "
-                   f"({RESOLUTION:.1%} of a zone's own, micro.laws.resolved_gap): there the zones are in nearly "
-                   "perfect contact, their laws at that floor (a smooth or worn-flat face; the column "
-                   "near_perfect_zones of the history says when)")
+                   f"({RESOLUTION:.1%} of a zone's own, micro.laws.resolved_gap): their laws' gaps fall at that "
+                   "floor, so their contact stiffness is a lower bound (the interface nearly rigid beside the zone's "
+                   "own compliance), their real contact area, conductance and heat partition those of the micro "
+                   "solves (a smooth or worn-flat face; the column near_perfect_zones of the history says when)")
     return out
 
 
