@@ -19,6 +19,7 @@ from multiscale.scene_friction import FRICTION, law_problems
 from multiscale.scene_geometry import Direction, LengthUnit
 from multiscale.scene_plain import PixelSize
 from multiscale.scene_stability import Stribeck
+from multiscale.scene_values import ANGULAR_SPEED, LOAD_PRESSURE, MU, ROUGHNESS
 from multiscale.scene_vehicle import Vehicle
 from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, ListOf, OneOf, OnlyWith, Pair,
                                Quantity, Requires, Section, TableOr, Tables, Text, key)
@@ -34,12 +35,8 @@ _DENSITY = Quantity("density", gt=0, plausible=(100.0, 23e3))            # cork 
 _SPECIFIC_HEAT = Quantity("specific_heat", gt=0, plausible=(50.0, 5e3))
 _DIFFUSIVITY = Quantity("diffusivity", gt=0, plausible=(1e-8, 1.2e-3))
 _EXPANSION = Quantity("expansion", plausible=(-1e-5, 5e-4))
-_FRICTION = Quantity("dimensionless", ge=0, plausible=(0.0, 2.0))
-_FADE = Curve(_TEMPERATURE, _FRICTION, "temperature", "mu", min_rows=2)     # mu against the interface temperature
-ROUGHNESS = Quantity("length", gt=0, plausible=(1e-10, 1e-3))            # RMS height
+_FADE = Curve(_TEMPERATURE, MU, "temperature", "mu", min_rows=2)     # mu against the interface temperature
 _CONVECTION = Quantity("conductance", ge=0, plausible=(0.0, 1e4))         # still air to boiling water
-_ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0),   # up to ~24 000 rpm
-                          outside="a speed about geometry.axis; to turn the other way, give the opposite axis")
 _WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # per frictional work (Eq. 3.10)
 _HARDNESS = Quantity("pressure", gt=0, plausible=(1e6, 1e11))            # soft polymer to diamond
 _WITH_RMS = "needed with rms (a generated surface)"
@@ -178,7 +175,7 @@ class InterfaceSettings:
     the scene has effect "roughness". Its own ``friction`` or ``friction_temperature`` (fade, as
     [loading]'s) replaces [loading]'s friction, whichever key that gives."""
 
-    friction: float | None = key(_FRICTION, absent="loading.friction (or any of its rule's keys)")   # mu
+    friction: float | None = key(MU, absent="loading.friction (or any of its rule's keys)")   # mu
     friction_temperature: tuple | None = key(_FADE, absent="loading's friction")     # ((K, -), ...)
     rough: bool = key(Flag(), default=True)                           # with effect "roughness"
     ELSEWHERE = dict.fromkeys(("friction_curve", "stribeck"), "a mu(v) law is [loading]'s, for every interface "
@@ -275,7 +272,7 @@ class Loading:
 
     normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)),                 # N
                                      absent="pressure, braking_torque or vehicle.mass gives the load")
-    pressure: float | None = key(Quantity("pressure", gt=0, plausible=(1e3, 5e9)),                   # Pa
+    pressure: float | None = key(LOAD_PRESSURE,                   # Pa
                                  absent="normal_force, braking_torque or vehicle.mass gives the load")
     braking_torque: float | None = key(Quantity("torque", gt=0, plausible=(1e-3, 1e6)),              # N m
                                        absent="normal_force, pressure or vehicle.mass gives the load")
@@ -284,15 +281,15 @@ class Loading:
                                   absent="-p n on each face (disc_brake, files); else -z")
     load_profile: tuple | None = key(Curve(Quantity("time", ge=0), Quantity("dimensionless", ge=0, plausible=(
         0.0, 10.0)), "time", "factor"), absent="factor 1 throughout")   # ((s, -), ...): a factor of the load, not N
-    rotation_speed: float | None = key(_ANGULAR_SPEED, absent="speed_profile or vehicle; else at rest")  # rad/s
-    speed_profile: tuple | None = key(Curve(Quantity("time", ge=0), _ANGULAR_SPEED, "time", "speed"),
+    rotation_speed: float | None = key(ANGULAR_SPEED, absent="speed_profile or vehicle; else at rest")  # rad/s
+    speed_profile: tuple | None = key(Curve(Quantity("time", ge=0), ANGULAR_SPEED, "time", "speed"),
                                       absent="rotation_speed or vehicle gives the speed")   # ((s, rad/s), ...)
     vehicle: Vehicle | None = key(Section(Vehicle))
     sliding_speed: float | None = key(Quantity("speed", ge=0, plausible=(0.0, 200.0)), absent="at rest")  # m/s
-    friction: float | None = key(_FRICTION, absent="another key of the rule below, or each interface's own")  # mu
+    friction: float | None = key(MU, absent="another key of the rule below, or each interface's own")  # mu
     friction_temperature: tuple | None = key(_FADE, absent="friction, constant (no fade)")   # ((K, -), ...)
     ramp_steps: int = key(Integer(ge=1, le=10**4), default=1)   # load increments of the first mechanical solve
-    friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), _FRICTION, "slip speed",
+    friction_curve: tuple | None = key(Curve(Quantity("speed", ge=0), MU, "slip speed",
                                              "mu", min_rows=2), absent="friction or stribeck gives mu")  # ((m/s, -),..)
     stribeck: Stribeck | None = key(Section(Stribeck))
 

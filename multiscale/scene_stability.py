@@ -8,6 +8,7 @@ import math
 from dataclasses import dataclass
 
 from multiscale.scene_friction import bare_interfaces
+from multiscale.scene_values import ANGULAR_SPEED, LOAD_PRESSURE, MU, ROUGHNESS
 from multiscale.schema import Choice, Flag, Integer, ListOf, OneOf, Pair, Quantity, Section, key
 
 
@@ -17,8 +18,8 @@ class Stribeck:
     kinetic) exp(-(v / speed)^exponent) (exponent 1: the exponential static-to-kinetic decay law).
     Not with a friction sweep ([stability.sweep] friction sets a constant mu at each point)."""
 
-    static: float | None = key(Quantity("dimensionless", ge=0, plausible=(0.0, 2.0)), required=True)   # (52 passed:
-    kinetic: float | None = key(Quantity("dimensionless", ge=0, plausible=(0.0, 2.0)), required=True)  # a trial)
+    static: float | None = key(MU, required=True)      # (52 passed: a trial)
+    kinetic: float | None = key(MU, required=True)
     speed: float | None = key(Quantity("speed", gt=0), required=True)            # m/s, Stribeck speed
     exponent: float = key(Quantity("dimensionless", gt=0), default=1.0)
 
@@ -51,10 +52,10 @@ class Sweep:
     (``onsets``); an "each" map narrows each onset's bracket by up to ``refine`` full analyses
     (preload and eigen solve); see ``multiscale.workflows.squeal_map``."""
 
-    friction: tuple | None = key(ListOf(Quantity("dimensionless", ge=0), min_len=2), absent=_OTHER)
-    pressure: tuple | None = key(ListOf(Quantity("pressure", gt=0), min_len=2), absent=_OTHER)          # Pa
-    speed: tuple | None = key(ListOf(Quantity("angular_speed", ge=0), min_len=2), absent=_OTHER)       # rad/s
-    rms: tuple | None = key(ListOf(Quantity("length", gt=0), min_len=2), absent=_OTHER)                # m
+    friction: tuple | None = key(ListOf(MU, min_len=2), absent=_OTHER)       # each value read as loading's
+    pressure: tuple | None = key(ListOf(LOAD_PRESSURE, min_len=2), absent=_OTHER)     # Pa  (bare 10 and 20 Pa
+    speed: tuple | None = key(ListOf(ANGULAR_SPEED, min_len=2), absent=_OTHER)        # rad/s  passed unwarned:
+    rms: tuple | None = key(ListOf(ROUGHNESS, min_len=2), absent=_OTHER)              # m  a trial)
     points: int | None = key(Integer(ge=2), absent="the values listed")
     preload: str | None = key(Choice(("each", "once")), absent='"once" for speed, "each" for friction, pressure '
                               "and rms")

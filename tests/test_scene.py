@@ -1597,6 +1597,24 @@ def test_a_sweep_without_a_valid_parameter_is_a_problem_not_a_traceback(sweep, f
     assert all(p.startswith("stability.sweep") for p in info.value.problems), info.value.problems
 
 
+def test_a_sweep_s_values_are_judged_as_the_key_they_sweep():
+    """[stability.sweep] friction = [0.0, 40] and pressure = [10, 20] (bare: 10 and 20 Pa) passed
+    without a word where loading.friction = 40 and loading.pressure = 10 warn (a user trial); they
+    share the key's parser now (``scene_values``). A load face's pressure is plausible up to 2000 bar
+    (1e9 Pa, a 1.66 MN clamp on the demo brake, passed: its range was a modulus')."""
+    text = (DEMOS / "brake_squeal.toml").read_text()
+    warned = loads(text + "\n[stability.sweep]\nfriction = [0.0, 40]\n", name="brake").warnings
+    assert "stability.sweep.friction = [0.0, 40]: 40 is outside the plausible range 0 to 2: check the value and " \
+           "its unit" in warned
+    warned = loads(text + "\n[stability.sweep]\npressure = [10, 20]\n", name="brake").warnings
+    assert [w.split(": ")[1] for w in warned if w.startswith("stability.sweep.pressure = [10, 20]")] == [
+        "10 Pa is outside the plausible range 1000 to 2e+08 Pa", "20 Pa is outside the plausible range 1000 to 2e+08 Pa"]
+    assert not [w for w in loads(text + '\n[stability.sweep]\npressure = ["10 bar", "20 bar"]\n', name="brake").warnings
+                if "plausible" in w]
+    assert any("1e+09 Pa is outside the plausible range" in w
+               for w in loads(text.replace('pressure = "10 bar"', 'pressure = "10 kbar"'), name="brake").warnings)
+
+
 def test_an_each_map_refines_its_onsets_by_three_full_analyses_unless_told_and_a_once_map_cannot():
     """``stability.sweep.refine``: full analyses per onset of a preload = "each" map (default 3);
     a "once" map bisects on its common basis, so refine there is a problem, not ignored."""

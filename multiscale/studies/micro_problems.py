@@ -37,7 +37,8 @@ from multiscale.micro.wear import simulate_wear
 from multiscale.micro.zones import cut_zones
 from multiscale.references.hertz import sphere_on_flat
 from multiscale.references.love import love_rectangle, love_rectangle_mean
-from multiscale.scene_sections import MODULUS, ROUGHNESS
+from multiscale.scene_sections import MODULUS
+from multiscale.scene_values import ROUGHNESS
 from multiscale.schema import Choice, FilePath, Flag, Integer, Pair, Quantity, key, read
 from multiscale.studies.base import Outcome, Problem, jsonable
 
