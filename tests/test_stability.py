@@ -193,6 +193,22 @@ def test_overdamped_roots_are_not_potentially_unstable():
     np.testing.assert_array_equal(modal.stability_report(result).potentially_unstable, [4, 5])
 
 
+def test_the_stable_half_of_a_lock_in_pair_is_not_potentially_unstable():
+    """The car brake's modes 24-26: 9719.83 Hz stable, and a lock-in pair at 9728.99 Hz, sigma -/+2629
+    1/s. Mode 25, locked in already, was flagged potentially unstable with mode 24, 0.095 % away (an
+    NVH user trial); with the unstable half moved away (a pair of stable modes) both are flagged.
+    A pair split by 2e-5 (a loss factor) is locked in too."""
+    from types import SimpleNamespace
+
+    def flagged(f, sigma):
+        f, sigma = np.array(f), np.array(sigma)
+        result = SimpleNamespace(frequency=f, growth=sigma, unstable=lambda rtol: sigma > rtol * 2 * np.pi * f)
+        return modal.stability_report(result).potentially_unstable.tolist()
+    assert flagged([9575.97, 9719.83, 9728.99, 9728.99, 9783.96], [0, 0, -2629.3, 2629.3, 0]) == []
+    assert flagged([9575.97, 9719.83, 9728.99, 9728.99 * (1 + 2e-5), 9783.96], [0, 0, -2600, 2650, 0]) == []
+    assert flagged([9575.97, 9719.83, 9728.99, 9900.0], [0, 0, -1.0, 0]) == [2, 3]
+
+
 def test_a_mode_cap_on_a_reduced_damped_system_keeps_a_split_pair():
     """damped.select: a cap of 3 ending in a pair split by damping (2e-5 of its frequency) keeps
     both members (before: within 1e-8 only, so the unstable member went)."""
