@@ -36,11 +36,10 @@ from multiscale.scene_rough import (law_top_warnings, measured_cover, micro_cons
 from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
                                        Micro, Output, Roughness, Time, Wear)
-from multiscale.scene_cycle import (convection_coverage, cycle_coverage, short_phases, speed_range,
-                                   squeal_state, thin_heated_layers)
+from multiscale.scene_cycle import convection_coverage, cycle_coverage, short_phases, speed_range, thin_heated_layers
 from multiscale.scene_keys import drop_replaced, given_paths, key_parts
 from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks, speed_law_zeros, torque_problems
-from multiscale.scene_stability import Stability, undamped_falling_law, unresolved_band
+from multiscale.scene_stability import Stability, stability_warnings
 from multiscale.scene_vehicle import Vehicle
 
 __all__ = ["COUPLING_DEFAULT", "EFFECTS", "FIG_7_9_CALIBRATION", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Boundary",
@@ -455,14 +454,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
     if problems:            # what follows only warns, and reads values that a problem left unset
         return ctx.warnings + warnings
     if "stability" in effects and scene.loading is not None and g is not None:
-        swept = scene.stability is not None and scene.stability.sweep is not None and \
-            scene.stability.sweep.parameter == "speed"
-        warnings += squeal_state(scene.loading, g.motion, "friction" in effects and not swept)
-        if scene.stability is not None and scene.materials is not None:
-            h = g.resolved().get("mesh_size") or g.spec.element_size
-            warnings += unresolved_band(scene.stability, h, scene.materials, g.materials,
-                                        (scene.time or Time()).initial_temperature) + (undamped_falling_law(
-                scene, g.materials, g.spec.interfaces) if "friction" in effects else [])
+        warnings += stability_warnings(scene, g, effects, (scene.time or Time()).initial_temperature)
     end = scene.time.end if scene.time is not None else None
     if scene.loading is not None and end is not None:
         fades = fade_tables(scene.loading, scene.interfaces, g.spec.interfaces if g is not None else None) \

@@ -7,7 +7,8 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from multiscale.scene_friction import bare_interfaces
+from multiscale.scene_cycle import squeal_state
+from multiscale.scene_friction import bare_interfaces, initial_friction
 from multiscale.scene_values import ANGULAR_SPEED, LOAD_PRESSURE, MU, ROUGHNESS
 from multiscale.schema import Choice, Flag, Integer, ListOf, OneOf, Pair, Quantity, Section, key
 
@@ -247,3 +248,24 @@ def undamped_falling_law(scene, materials, interfaces) -> list[str]:
             "materials' loss_factor or damping_alpha/beta) to weigh it, or friction_damping = false to see the "
             "mode coupling alone"]
 
+
+def stability_warnings(scene, g, effects, T0: float) -> list[str]:
+    """What a squeal analysis of ``scene`` (geometry ``g``, initial temperature ``T0`` [K]) cannot
+    show: the state it linearises (``squeal_state``), no friction at all (effect "friction" missing,
+    or mu 0 on every interface and no friction sweep: nothing couples the modes, no flutter can be
+    found; it passed unsaid, an NVH user trial), a band the mesh does not resolve
+    (``unresolved_band``) and a falling mu(v) law left undamped (``undamped_falling_law``)."""
+    sweep = scene.stability.sweep if scene.stability is not None else None
+    swept = sweep.parameter if sweep is not None else None
+    friction = "friction" in effects
+    out = squeal_state(scene.loading, g.motion, friction and swept != "speed")
+    mu = [initial_friction(scene.interface_settings(n), T0) for n in g.spec.interfaces] if friction else []
+    if swept != "friction" and not any(m is None or m > 0 for m in mu):
+        why = "mu = 0 on every interface" if friction else 'no effect "friction"'
+        out.append(f"the squeal analysis has no friction ({why}): nothing couples the modes, so no friction-induced "
+                   "instability can be found")
+    if scene.stability is not None and scene.materials is not None:
+        h = g.resolved().get("mesh_size") or g.spec.element_size
+        out += unresolved_band(scene.stability, h, scene.materials, g.materials, T0)
+        out += undamped_falling_law(scene, g.materials, g.spec.interfaces) if friction else []
+    return out

@@ -1597,6 +1597,21 @@ def test_a_sweep_without_a_valid_parameter_is_a_problem_not_a_traceback(sweep, f
     assert all(p.startswith("stability.sweep") for p in info.value.problems), info.value.problems
 
 
+def test_a_squeal_analysis_without_friction_is_warned_of():
+    """loading.friction = 0, or no effect "friction", passed check without a word that no flutter
+    can be found (at rest it was said; an NVH user trial). A friction sweep from 0 is not warned."""
+    text = (DEMOS / "brake_squeal.toml").read_text()
+    said = "the squeal analysis has no friction ({}): nothing couples the modes, so no friction-induced instability " \
+           "can be found"
+    assert said.format("mu = 0 on every interface") in loads(text.replace("\nfriction = 0.4\n", "\nfriction = 0\n"),
+                                                             name="brake").warnings
+    assert said.format('no effect "friction"') in loads(text.replace('"friction", ', ""), name="brake").warnings
+    assert not [w for w in loads(text, name="brake").warnings if "no friction" in w]
+    swept = loads(text.replace("\nfriction = 0.4\n", "\nfriction = 0\n") + "\n[stability.sweep]\nfriction = [0, 0.6]\n",
+                  name="brake").warnings
+    assert not [w for w in swept if "no friction" in w]
+
+
 def test_a_sweep_s_values_are_judged_as_the_key_they_sweep():
     """[stability.sweep] friction = [0.0, 40] and pressure = [10, 20] (bare: 10 and 20 Pa) passed
     without a word where loading.friction = 40 and loading.pressure = 10 warn (a user trial); they
