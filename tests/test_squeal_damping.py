@@ -443,7 +443,7 @@ def test_a_band_of_instability_is_bisected_at_both_ends(tmp_path):
     assert smap.onsets[0].end == pytest.approx(0.5 + m, rel=1e-6)
     assert "; stable again at 0.6\n" in smap.summary() + "\n"
     row = smap.write_onsets_csv(tmp_path / "onsets.csv").read_text().splitlines()
-    assert row[0].endswith(",stable_again_friction_-,full_analyses") and row[1].endswith(",0")
+    assert row[0].endswith(",stable_again_friction,full_analyses") and row[1].endswith(",0")
     assert float(row[1].split(",")[-2]) == pytest.approx(0.6)
     import h5py
     with h5py.File(smap.write_h5(tmp_path / "map.h5"), "r") as f:
@@ -582,7 +582,7 @@ def check_map_files(folder, smap, documented) -> None:
     with open(folder / "map.csv", newline="") as f:
         rows = list(csv.reader(f))
     names += rows[0]
-    column = f"{smap.parameter}_{smap.unit}"
+    column = smap.column()
     bad = smap.unstable()
     assert len(rows) - 1 == int((smap.mode >= 0).sum())
     for row in (dict(zip(rows[0], r)) for r in rows[1:]):

@@ -629,7 +629,7 @@ def test_eigen_solver_errors_name_the_scene_keys(tmp_path):
         return sum(isinstance(o, Mechanics) for o in gc.get_objects())
     before = models()
     scene = scenes.load(DEMO, overrides)
-    with pytest.raises(InputError, match=r"^stability\.band = \(10\.0, 500\.0\): no eigenvalue in this frequency band"):
+    with pytest.raises(InputError, match=r"^stability\.band = \['10 Hz', '500 Hz'\]: no eigenvalue in this frequency band"):
         squeal.run(scene, degree=1, verbose=False)
     assert models() == before
     written = {p.name for p in (tmp_path / "out").iterdir()}

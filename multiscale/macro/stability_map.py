@@ -123,6 +123,13 @@ class StabilityMap:
                          + (f", with track {o.partner}" if o.partner is not None else "") + full + ")" + again)
         return "\n".join(lines)
 
+    def column(self) -> str:
+        """The swept value's column name: the parameter and its unit as modes.csv writes them
+        ("friction", "pressure_Pa", "speed_rad_per_s", "rms_m"; "friction_-" and "speed_rad/s" were
+        awkward in a table reader: an NVH user trial)."""
+        unit = self.unit.replace("/", "_per_")
+        return self.parameter if unit == "-" else f"{self.parameter}_{unit}"
+
     def write_csv(self, path) -> Path:
         """Mode-pairing table: point, value, track, mode, frequency, sigma, damping ratio,
         unstable, MAC with the previous point, residual."""
@@ -131,7 +138,7 @@ class StabilityMap:
         bad, zeta = self.unstable(), self.damping_ratio()
         with path.open("w", newline="") as f:
             w = csv.writer(f)
-            w.writerow(["point", f"{self.parameter}_{self.unit}", "track", "mode", "frequency_Hz", "sigma_1_per_s",
+            w.writerow(["point", self.column(), "track", "mode", "frequency_Hz", "sigma_1_per_s",
                         "damping_ratio", "unstable", "mac_previous", "residual"])
             for k, v in enumerate(self.values):
                 for t in np.nonzero(self.mode[k] >= 0)[0]:
@@ -145,8 +152,8 @@ class StabilityMap:
         path = Path(path)
         with path.open("w", newline="") as f:
             w = csv.writer(f)
-            w.writerow(["track", f"onset_{self.parameter}_{self.unit}", "frequency_Hz", "partner_track", "kind",
-                        "stable_value", "unstable_value", f"stable_again_{self.parameter}_{self.unit}",
+            w.writerow(["track", f"onset_{self.column()}", "frequency_Hz", "partner_track", "kind",
+                        "stable_value", "unstable_value", f"stable_again_{self.column()}",
                         "full_analyses"])
             for o in self.onsets:
                 w.writerow([o.track, _number(o.value), f"{o.frequency:.6f}", "" if o.partner is None else o.partner,

@@ -189,7 +189,8 @@ def analyse(scene, tm, *, name: str | None = None, energy: bool = True, degree: 
                                target=st.target, energy=energy, rtol=st.threshold, options=squeal_options(scene, tm),
                                on_preload=on_preload, close_tol=CLOSE if frictional(scene) else 0.0)
     except InputError as exc:        # the eigen solvers' arguments by their scene keys
-        keys = {"f_min": ("stability.band", st.band), "f_max": ("stability.band", st.band),
+        band = [f"{f:g} Hz" for f in st.band]          # (shown as "(100.0, 500.0)": an NVH user trial)
+        keys = {"f_min": ("stability.band", band), "f_max": ("stability.band", band),
                 "n_modes": ("stability.modes", st.modes)}
         if exc.name not in keys:
             raise
@@ -383,7 +384,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
                           warnings=tuple(_left_out(scene, case, smap)))   # what the results leave out or approximate
     if verbose and comm.rank == 0:
         rep = case.report
-        print(f"{scene.name}: {len(case.modes)} modes up to {case.modes.frequency.max():.0f} Hz, "
+        print(f"{scene.name}: {io.counted(len(case.modes), 'mode')} up to {case.modes.frequency.max():.0f} Hz, "
               f"{rep.unstable.size} unstable"
               + (f" ({', '.join(f'{f:.0f} Hz' for f in rep.frequency[rep.unstable - 1])})" if rep.unstable.size else "")
               + f", {rep.potentially_unstable.size} potentially unstable; {result.wall_time:.1f} s on "
