@@ -152,7 +152,7 @@ def plan(scene) -> Plan:
             files[f"{name}.h5"] = f"data of {name}.xdmf"
     if kind == "squeal":
         files["modes.csv"] = ("frequency, growth rate, damping ratio (-sigma/|lambda|), unstable and potentially "
-                              "unstable flags, relative residual in the full model and each component's "
+                              "unstable flags, flutter partner, relative residual in the full model and each component's "
                               "strain-energy share of every mode")
         files.update({f"modes_{b}.bp": f"mode shapes of {b} (VTX): real and imaginary parts, time = mode number"
                       for b in scene.bodies})

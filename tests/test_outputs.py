@@ -103,7 +103,8 @@ def test_check_names_every_column_of_modes_csv(case):
     if p.analysis != "squeal":
         pytest.skip("modes.csv: squeal analysis only")
     words = {"frequency_Hz": "frequency", "sigma_1_per_s": "growth rate", "damping_ratio": "damping ratio",
-             "unstable": "unstable", "potentially_unstable": "potentially unstable", "residual": "residual"}
+             "unstable": "unstable", "potentially_unstable": "potentially unstable", "flutter_partner": "flutter partner",
+             "residual": "residual"}
     words["energy_share_"] = "strain-energy share"
     rows = list(csv.DictReader((p.folder / "modes.csv").open()))
     shares = [k for k in rows[0] if k.startswith("energy_share_")]

@@ -316,15 +316,17 @@ def test_the_mode_table_writes_no_negative_zero(tmp_path):
 
 def test_the_mode_table_flags_unstable_and_potentially_unstable_modes(tmp_path):
     """Two stable modes 0.05 % apart are potentially unstable (``stability_report``), a mode with
-    sigma > 0 unstable; both flags are columns of modes.csv."""
+    sigma > 0 unstable; both flags are columns of modes.csv, and so is each flutter pair's other
+    half (``flutter_partner``: its pairs were found by equal frequencies alone, an NVH user trial)."""
     from multiscale.macro.modal import stability_report
-    lam = np.array([-1.0 + 2e3j, -1.0 + 2.001e3j, -1.0 + 3e3j, 5.0 + 4e3j])
-    modes = eigen.ModalResult(lam, np.abs(lam) ** 2, np.zeros((1, 4), complex), np.zeros(4), (0.0, 1e3), 0.0,
-                              4, "gnhep", 1, 1, 0.0)
+    lam = np.array([-1.0 + 2e3j, -1.0 + 2.001e3j, -1.0 + 3e3j, -5.0 + 4e3j, 5.0 + 4e3j])
+    modes = eigen.ModalResult(lam, np.abs(lam) ** 2, np.zeros((1, 5), complex), np.zeros(5), (0.0, 1e3), 0.0,
+                              5, "gnhep", 1, 1, 0.0)
     rep = stability_report(modes)
-    rows = list(csv.DictReader(modes.write_csv(tmp_path / "modes.csv", rep.rtol, rep.potentially_unstable).open()))
-    assert [(r["unstable"], r["potentially_unstable"]) for r in rows] == [("0", "1"), ("0", "1"), ("0", "0"),
-                                                                         ("1", "0")]
+    rows = list(csv.DictReader(modes.write_csv(tmp_path / "modes.csv", rep.rtol, rep.potentially_unstable,
+                                               partner=rep.flutter_partner).open()))
+    assert [(r["unstable"], r["potentially_unstable"], r["flutter_partner"]) for r in rows] == [
+        ("0", "1", ""), ("0", "1", ""), ("0", "0", ""), ("0", "0", "5"), ("1", "0", "4")]
 
 
 def test_without_friction_no_pair_is_potentially_unstable():

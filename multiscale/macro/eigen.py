@@ -99,9 +99,11 @@ class ModalResult:
     def __len__(self) -> int:
         return self.eigenvalues.size
 
-    def write_csv(self, path: str | Path, rtol: float = 1e-6, potentially_unstable=(), energy=None) -> Path:
+    def write_csv(self, path: str | Path, rtol: float = 1e-6, potentially_unstable=(), energy=None,
+                  partner=None) -> Path:
         """Mode table: number, frequency [Hz], sigma [1/s], damping ratio, unstable flag, potentially
-        unstable flag (mode numbers from 1, ``modal.StabilityReport``), residual; with ``energy``
+        unstable flag (mode numbers from 1, ``modal.StabilityReport``), the other half of a flutter
+        pair (``partner``: its number per mode, 0 none; empty), residual; with ``energy``
         (``modal.EnergyShares``) each component's share of the mode's strain energy."""
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
@@ -110,11 +112,12 @@ class ModalResult:
         with path.open("w", newline="") as f:
             w = csv.writer(f)
             w.writerow(["mode", "frequency_Hz", "sigma_1_per_s", "damping_ratio", "unstable", "potentially_unstable",
-                        "residual", *(f"energy_share_{n}" for n in names)])
-            for j, (fr, s, z, u, e, share) in enumerate(zip(self.frequency, self.growth, self.damping_ratio,
-                                                            self.unstable(rtol), self.errors, shares), start=1):
+                        "flutter_partner", "residual", *(f"energy_share_{n}" for n in names)])
+            pairs = np.zeros(len(self.frequency), int) if partner is None else partner
+            for j, (fr, s, z, u, p, e, share) in enumerate(zip(self.frequency, self.growth, self.damping_ratio,
+                                                               self.unstable(rtol), pairs, self.errors, shares), start=1):
                 w.writerow([j, f"{fr:.6f}", f"{s + 0.0:.6e}", f"{z + 0.0:.6e}", int(u), int(j in close),
-                            f"{e:.2e}", *(f"{v:.6f}" for v in share)])   # no -0
+                            p or "", f"{e:.2e}", *(f"{v:.6f}" for v in share)])   # no -0
         return path
 
 

@@ -30,6 +30,7 @@ class StabilityReport:
     growth: np.ndarray                # sigma [1/s] of all modes
     rtol: float                       # instability threshold on sigma / |lambda| [-]
     close_tol: float                  # relative frequency gap of a potentially unstable pair [-]
+    flutter_partner: np.ndarray       # per mode: the number of its flutter pair's other half (0: none)
 
     @property
     def divergent(self) -> np.ndarray:
@@ -73,13 +74,18 @@ def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float =
     (``close_tol`` 0: none, as without friction, where nothing couples two modes). Overdamped roots
     (0 Hz) do not oscillate and pair with nothing (five of them were flagged; a user trial); nor does
     the stable half of a lock-in pair, at the frequency of an unstable mode within ``LOCKED`` (it was
-    flagged beside a stable mode 0.095 % away: an NVH user trial).
+    flagged beside a stable mode 0.095 % away: an NVH user trial). ``flutter_partner`` pairs those
+    halves (found by equal frequencies alone before: an NVH user trial).
     """
     check_positive("rtol", rtol)
     check_positive("close_tol", close_tol, allow_zero=True)
     f = result.frequency
     bad = result.unstable(rtol)
-    close = np.zeros(f.size, bool)
+    close, partner = np.zeros(f.size, bool), np.zeros(f.size, int)
+    if f.size > 1:
+        halves = np.nonzero((np.diff(f) <= LOCKED * np.maximum(f[1:], np.finfo(float).tiny)) & (bad[1:] != bad[:-1])
+                            & (f[1:] > 0))[0]
+        partner[halves], partner[halves + 1] = halves + 2, halves + 1
     if f.size > 1 and close_tol > 0:
         scale = np.maximum(f[1:], np.finfo(float).tiny)
         gap, lock = np.diff(f) <= close_tol * scale, np.diff(f) <= LOCKED * scale
@@ -92,7 +98,7 @@ def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float =
         close[1:] |= pair
         close[:-1] |= pair
     number = np.arange(1, f.size + 1)
-    return StabilityReport(number[bad], number[close], f.copy(), result.growth.copy(), rtol, close_tol)
+    return StabilityReport(number[bad], number[close], f.copy(), result.growth.copy(), rtol, close_tol, partner)
 
 
 def _modes(x) -> np.ndarray:

@@ -357,7 +357,8 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         with io.stage("writing results"):
             rep = case.report
             files += io.on_root(comm, lambda: [case.modes.write_csv(folder / "modes.csv", rep.rtol,
-                                                                   rep.potentially_unstable, case.energy)],
+                                                                   rep.potentially_unstable, case.energy,
+                                                                   rep.flutter_partner)],
                                 f"{folder / 'modes.csv'}") or []
             files += write_modes(folder, case.modes, case.mech.u, [b.name for b in tm.bodies])
             split = energy_split(tm)
