@@ -238,15 +238,22 @@ def undamped_falling_law(scene, materials, interfaces) -> list[str]:
     falls = law.static > law.kinetic if law is not None else \
         loading.friction_curve is not None and any(b[1] < a[1] for a, b in zip(loading.friction_curve,
                                                                                 loading.friction_curve[1:]))
-    damped = stability.damping or stability.rayleigh_alpha or stability.rayleigh_beta or any(
-        getattr(m, k) for m in (scene.materials.get(n) for n in materials) if m is not None for k in m.DAMPING)
-    if not (falls and stability.friction_damping and bare_interfaces(scene.interfaces, interfaces)) or damped:
+    if not (falls and stability.friction_damping and bare_interfaces(scene.interfaces, interfaces)) or \
+            structurally_damped(scene, materials):
         return []
     return ["stability.friction_damping: the mu(v) law falls with the slip speed and nothing damps the structure, "
             "so its negative damping flags as unstable nearly every mode that moves the pads along the disc, "
             "however slightly: give the damping the brake has (stability.damping or rayleigh_alpha/beta, or the "
             "materials' loss_factor or damping_alpha/beta) to weigh it, or friction_damping = false to see the "
             "mode coupling alone"]
+
+
+def structurally_damped(scene, materials) -> bool:
+    """Whether anything damps the structure: [stability] damping or Rayleigh coefficients, or a loss
+    factor or Rayleigh damping of one of the ``materials`` (the geometry's material names)."""
+    st = scene.stability
+    return bool(st.damping or st.rayleigh_alpha or st.rayleigh_beta or any(
+        getattr(m, k) for m in (scene.materials.get(n) for n in materials) if m is not None for k in m.DAMPING))
 
 
 def stability_warnings(scene, g, effects, T0: float) -> list[str]:

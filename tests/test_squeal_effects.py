@@ -244,7 +244,8 @@ def test_values_of_the_projected_problem_left_out_among_the_modes_are_said():
     scene = NS(stability=NS(basis=1.5, damping=0.0, method="auto", band=(0.0, 6e3), target=3500.0, modes=4, sweep=None),
                materials=None)
     case = NS(modes=modes, terms=(), mech=NS(tm=NS(notes=())), facet_pressure=np.zeros(1),
-              preload=NS(normal_force={}), slip_speed=None, report=NS(divergent=np.zeros(0, dtype=int)))
+              preload=NS(normal_force={}), slip_speed=None,
+              report=NS(divergent=np.zeros(0, dtype=int), unstable=np.zeros(0, dtype=int)))
     said = squeal._left_out(scene, case, None)
     assert said[0] == ("1 value(s) of the projected problem among the modes found (3524 Hz) had relative residuals "
                        "above 0.5 in the full model: not modes of it, left out (a larger stability.basis, now 1.5, "
@@ -704,3 +705,22 @@ def test_a_friction_curve_the_preload_misses_is_said(tmp_path, capsys):
                     "m/s) is below its first row, 2 m/s: mu was held at 0.5 throughout, the curve's slope unused (a "
                     "curve over the run's slip speeds says what mu is)")
     assert 0.3 < V.min() < V.max() < 0.7 and case.terms == ()        # no slope: no friction damping term
+
+
+def test_marginal_instabilities_of_an_undamped_structure_are_said(tmp_path):
+    """The demo brake with gyroscopic terms at 5 rad/s: most of its unstable modes grow at damping
+    ratios of -1e-5 to -1e-4 that any damping removes (10 of 24 at 25 mm, said nowhere: an NVH user
+    trial; here, linear elements at 30 mm, all 9 of 24). The run says which."""
+    overrides = {**NO_FIGURES, "geometry.mesh_size": "30 mm", "stability.modes": 24, "stability.band": ["0 Hz", "6 kHz"],
+                 "stability.gyroscopic": True, "output.folder": str(tmp_path / "out")}
+    run = squeal.run(scenes.load(DEMO, overrides), degree=1, verbose=False)
+    zeta, bad = run.case.modes.damping_ratio, run.case.report.unstable
+    weak = bad[zeta[bad - 1] > -1e-4]
+    assert weak.size >= 3
+    (said,) = [w for w in run.warnings if "which a loss factor of 0.0002 would damp" in w]
+    assert said.startswith(f"{weak.size} of the {bad.size} unstable modes grow at damping ratios above -0.0001 (")
+    f = run.case.modes.frequency
+    assert all(f"{f[j - 1]:.0f} Hz" in said for j in weak[:6])
+    damped = squeal.run(scenes.load(DEMO, {**overrides, "stability.damping": 0.002}), degree=1, verbose=False,
+                        overwrite=True)
+    assert not [w for w in damped.warnings if "would damp" in w]          # a damped structure: its own to weigh

@@ -50,6 +50,7 @@ from multiscale.macro.output import write_modes, write_state
 from multiscale.macro.preload import Preload, linearise_system, preload
 from multiscale.macro.stability_map import StabilityMap
 from multiscale.scene_friction import bare_interfaces, curve_left
+from multiscale.scene_stability import structurally_damped
 from multiscale.workflows import squeal_map
 from multiscale.workflows.model import build_mechanics, build_mesh, drive, friction_coefficient, global_dofs, \
     interface_forces, say_load, say_model_size, speed_law
@@ -59,6 +60,7 @@ from multiscale.workflows.strain import idle_holder, overloaded, unloaded
 
 SQUEAL_DEGREE = 2     # quadratic tetrahedra: linear ones are far too stiff in bending (tests)
 MAP_RESIDUAL = 1e-3   # a stability map's modes with larger relative residuals are warned to be approximate
+WEAK = 1e-4           # unstable modes at damping ratios above -WEAK are warned marginal in an undamped structure
 SOLVERS = {"gnhep": "the generalized eigenproblem K phi = theta M phi (exact)",   # ModalResult.method, said
            "pep": "the full quadratic eigenproblem (SLEPc PEP, exact)",
            "projection": "projection on the undamped modes and static responses (approximate: the residual column)"}
@@ -263,7 +265,9 @@ def approximate_modes(scene, case: SquealCase) -> list[str]:
 def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
     """Warnings: a band cut short by stability.modes, modes or a map whose modes are approximate, a
     contact pressure beyond small strains (at the preload, or at a map point's own preload), an
-    interface that the preload left without force, a friction_curve its slip speeds left; the mesh's (``TwoBodyMesh.notes``)."""
+    interface that the preload left without force, a friction_curve its slip speeds left, unstable
+    modes that any damping would stabilise (``WEAK``) in an undamped structure; the mesh's
+    (``TwoBodyMesh.notes``)."""
     st, out = scene.stability, [*case.mech.tm.notes, *approximate_modes(scene, case)]
     f = case.modes.frequency
     top = float(f.max(initial=0.0))
@@ -322,6 +326,14 @@ def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
             iface.n_facets, bool)]) & (case.facet_pressure > 0)
         V = case.slip_speed[read]
         out += curve_left(curve, (float(V.max()), ""), (float(V.min()), ""), " at the preload") if V.size else []
+    # (gyroscopic terms at 48 rpm flagged 10 of 24 modes, most at damping ratios of -1e-5: an NVH trial)
+    weak = case.report.unstable[case.modes.damping_ratio[case.report.unstable - 1] > -WEAK]
+    if weak.size and not structurally_damped(scene, scene.geometry.materials):
+        out.append(f"{weak.size} of the {io.counted(case.report.unstable.size, 'unstable mode')} grow at damping "
+                   f"ratios above -{WEAK:g} ({', '.join(f'{f[j - 1]:.0f} Hz' for j in weak[:6])}), which a loss "
+                   f"factor of {2 * WEAK:g} would damp, and nothing damps this structure: give the damping the brake "
+                   "has (stability.damping, rayleigh_alpha/beta, the materials' loss_factor) to weigh them, or "
+                   f"stability.threshold = {WEAK:g} to leave them out")
     peak = max(float(case.facet_pressure.max(initial=0.0)), smap.max_pressure if smap is not None else 0.0)
     return out + overloaded(scene, peak) + unloaded({n: abs(f) for n, f in case.preload.normal_force.items()})
 
