@@ -377,6 +377,21 @@ def test_heights_in_the_wrong_unit_are_warned_about_and_an_overflow_refused(tmp_
         condition(read_topography(tmp_path / "tilted.npy", pixel_size=1e-6, height_unit=1e-6))
 
 
+def test_a_strip_of_a_few_points_across_is_warned_of(tmp_path):
+    """A 300 x 4 map (6.6 um wide) was read with full statistics and a PSD without a word (a user
+    trial): fewer than reading.NARROWEST points along a side are warned of; 16 are not."""
+    from multiscale.micro.topography import TopographyWarning
+    rng = np.random.default_rng(3)
+    np.save(tmp_path / "strip.npy", rng.normal(size=(4, 300)))
+    with pytest.warns(TopographyWarning, match=r"^file = 'strip.npy': a map of 300 x 4 points, fewer than 16 along a "
+                                               r"side: a strip"):
+        read_topography(tmp_path / "strip.npy", pixel_size=1e-6, height_unit=1e-6)
+    np.save(tmp_path / "square.npy", rng.normal(size=(16, 300)))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", TopographyWarning)
+        read_topography(tmp_path / "square.npy", pixel_size=1e-6, height_unit=1e-6)
+
+
 def test_a_plain_matrix_has_one_channel(tmp_path):
     """--channel 2 on a .npy is refused (before: silently read as channel 0); 0 reads it."""
     np.save(tmp_path / "rough.npy", fractal_surface(32, 32e-6, 0.8, 2, 8, 1e-6, seed=1).heights)

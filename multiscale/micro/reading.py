@@ -25,6 +25,7 @@ MATRIX_SUFFIXES = (".npy", ".txt", ".csv", ".asc")    # plain height matrices (n
 TALLEST = 1e-2            # m: heights beyond are no roughness measurement (an instrument's z range is mm)
 WIDEST = 1.0              # m: maps wider are no roughness measurement (a profilometer's stage is 0.1 m)
 LOWEST = 1e-10            # m: heights all within it are none either (an atomic step; offsets and noise exceed it)
+NARROWEST = 16            # points: a map with fewer along a side is warned of (a strip or line scan, not an areal map)
 UNDERFLOW = 1e-60         # m: heights all within it have powers (h^4 in Sku) that underflow: refused
 KEPT_BYTES = 2**30        # heights of the measurements kept for the next read (an 8000² map is 0.5 GB)
 SETTLED = 2.0             # s: a file modified more recently is not kept (file times are as coarse as a clock tick)
@@ -268,14 +269,19 @@ def _read(path: Path, channel, pair, height_unit: float | None, prefix: str) -> 
 
 
 def _lateral_range(shape, dx: float, dy: float, path: Path, prefix: str) -> list[str]:
-    """A note if the map [m] is wider than ``WIDEST`` or its pixels finer than ``LOWEST`` (a pixel size
-    given in um as m made a 126 x 94 m map without a word: a user trial)."""
+    """Notes if the map [m] is wider than ``WIDEST`` or its pixels finer than ``LOWEST`` (a pixel size
+    given in um as m made a 126 x 94 m map without a word: a user trial), or it has fewer than
+    ``NARROWEST`` points along a side (300 x 4 points passed with a full PSD: a user trial)."""
     width, height = shape[1] * dx, shape[0] * dy
-    if max(width, height) <= WIDEST and min(dx, dy) >= LOWEST:
-        return []
-    return [f"{option(prefix, 'file')} = '{path.name}': a map of {width:.3g} x {height:.3g} m (pixels of {dx:.3g} x "
-            f"{dy:.3g} m), {'wider than' if max(width, height) > WIDEST else 'pixels finer than'} any measurement's: "
-            f"is {option(prefix, 'pixel_size')} in m?"]
+    name = f"{option(prefix, 'file')} = '{path.name}'"
+    out = [] if max(width, height) <= WIDEST and min(dx, dy) >= LOWEST else [
+        f"{name}: a map of {width:.3g} x {height:.3g} m (pixels of {dx:.3g} x {dy:.3g} m), "
+        f"{'wider than' if max(width, height) > WIDEST else 'pixels finer than'} any measurement's: "
+        f"is {option(prefix, 'pixel_size')} in m?"]
+    if min(shape) < NARROWEST:
+        out.append(f"{name}: a map of {shape[1]} x {shape[0]} points, fewer than {NARROWEST} along a side: a strip, "
+                   "whose statistics and PSD across it rest on those few points")
+    return out
 
 
 def _height_range(h: np.ndarray, path: Path, prefix: str, unit: str, what: str = "the height matrix") -> list[str]:
