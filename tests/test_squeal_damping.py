@@ -725,6 +725,7 @@ def test_the_squeal_figures_compare_like_with_like(tmp_path, drawn):
     circled = [line for line in ax.get_lines() if line.get_markeredgecolor() == "r"]
     assert len(circled) == 1 and list(circled[0].get_xdata()) == [1500.0] and list(circled[0].get_ydata()) == [3.0]
     assert [t.get_text() for t in ax.get_legend().get_texts()] == ["brake", "unstable"]
+    assert [(t.get_text(), t.xy) for t in ax.texts] == [("1500 Hz", (1500.0, 3.0))]   # (unlabelled: an NVH trial)
 
 
 # ---------------------------------------------------------------- ties in the mode pairing

@@ -44,10 +44,14 @@ def plot_pressure(midpoints: np.ndarray, masks: Mapping[str, np.ndarray], facet_
     return _save(fig, path, tight=False)
 
 
+LABELLED = 8     # unstable modes labelled with their frequency per case in re_im.png (the fastest growing)
+
+
 def plot_re_im(cases: Sequence, path) -> Path:
     """Real part against imaginary part of the eigenvalues, one marker set per case (Fig. 4.13),
-    the unstable modes circled in red; ``cases`` have ``name``, ``modes`` (``ModalResult``) and
-    ``report`` (``StabilityReport``)."""
+    the unstable modes circled in red and labelled with their frequencies (the first ``LABELLED``
+    by growth; they were unlabelled: an NVH user trial); ``cases`` have ``name``, ``modes``
+    (``ModalResult``) and ``report`` (``StabilityReport``)."""
     fig = Figure(figsize=(8, 4.5))
     ax = fig.subplots()
     for c in cases:
@@ -55,6 +59,9 @@ def plot_re_im(cases: Sequence, path) -> Path:
         bad = np.asarray(c.report.unstable, dtype=int) - 1                   # mode numbers from 1
         ax.plot(c.modes.frequency[bad], c.modes.growth[bad], "o", ms=8, mfc="none", mec="r", mew=1.2,
                 label=f"{c.name}: unstable" if len(cases) > 1 else "unstable")
+        for j in bad[np.argsort(-c.modes.growth[bad])][:LABELLED]:
+            ax.annotate(f"{c.modes.frequency[j]:.0f} Hz", (c.modes.frequency[j], c.modes.growth[j]), fontsize=7,
+                        xytext=(5, 5), textcoords="offset points", color="r")
     ax.axhline(0.0, color="k", lw=0.5)
     ax.set(xlabel="imaginary part: frequency [Hz]", ylabel="real part sigma [1/s]",
            title="complex eigenvalues (sigma > 0: unstable)")
