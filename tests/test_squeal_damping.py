@@ -709,6 +709,14 @@ def test_the_squeal_figures_compare_like_with_like(tmp_path, drawn):
     renderer = FigureCanvasAgg(drawn[-1]).get_renderer()
     boxes = [ax.get_tightbbox(renderer) for ax in drawn[-1].axes[:4]]
     assert all(left.x1 <= right.x0 for left, right in zip(boxes, boxes[1:])), [(b.x0, b.x1) for b in boxes]
+    from multiscale.geometry import Rotation            # the disc's motion across each pad (an NVH user trial)
+    plots.plot_pressure(ring, four, np.linspace(0.0, 5e6, 160), "brake", tmp_path / "pressure.png",
+                        ("disc", Rotation().velocity(ring)))
+    for ax, mask in zip(drawn[-1].axes[:4], four.values()):
+        (arrow,) = [t for t in ax.texts if t.get_text() == ""]
+        c = ring[mask, :2].mean(axis=0) * 1e3
+        along = (np.asarray(arrow.xy) - np.asarray(arrow.xyann)) @ np.array([-c[1], c[0]])   # e_z x (x - 0)
+        assert along > 0 and [t.get_text() for t in ax.texts if t.get_text()] == ["disc slides"]
     energy = np.array([[1.0, 2.0, 3.0], [0.001, 0.002, 10.0], [0.5, 0.5, 3.0]])
     shares = EnergyShares(["inner", "outer", "disc"], energy, energy / energy.sum(axis=1, keepdims=True))
     class Modes(NS):

@@ -27,11 +27,13 @@ def _save(fig: Figure, path, tight: bool = True) -> Path:
 
 
 def plot_pressure(midpoints: np.ndarray, masks: Mapping[str, np.ndarray], facet_pressure: np.ndarray,
-                  name: str, path) -> Path:
+                  name: str, path, moving: tuple[str, np.ndarray] | None = None) -> Path:
     """Contact pressure [MPa] on each interface at the preloaded state (Fig. 4.12).
 
     ``midpoints`` and ``facet_pressure`` are global per interface facet; ``masks`` select each
-    interface's facets."""
+    interface's facets. ``moving``: the moving body's name and its velocity per facet (any scale):
+    an arrow across each interface shows where it slides, the leading edge where it enters (not
+    shown before: an NVH user trial)."""
     fig = Figure(figsize=(4.2 * len(masks) + 1.2, 3.8), layout="constrained")   # (tight_layout and then the
     axes = fig.subplots(1, len(masks), squeeze=False)[0]                          # colorbar: labels overlapped)
     mid, p = midpoints, facet_pressure / 1e6
@@ -39,6 +41,12 @@ def plot_pressure(midpoints: np.ndarray, masks: Mapping[str, np.ndarray], facet_
     for ax, (iface, mask) in zip(axes, masks.items()):
         art = ax.tricontourf(mid[mask, 0] * 1e3, mid[mask, 1] * 1e3, p[mask], levels=levels, cmap="viridis")
         ax.set(title=iface, xlabel="x [mm]", ylabel="y [mm]", aspect="equal")
+        d = moving[1][mask].mean(axis=0)[:2] if moving is not None and mask.any() else np.zeros(2)
+        if np.linalg.norm(d) > 0:
+            x = mid[mask, :2] * 1e3
+            c, half = x.mean(axis=0), 0.3 * float(np.ptp(x, axis=0).max()) * d / np.linalg.norm(d)
+            ax.annotate("", xy=c + half, xytext=c - half, arrowprops={"arrowstyle": "->", "color": "w", "lw": 1.5})
+            ax.text(*(c - half), f"{moving[0]} slides", color="w", fontsize=7, ha="center", va="top")
     fig.suptitle(f"{name}: contact pressure at the preload")
     fig.colorbar(art, ax=list(axes), label="contact pressure [MPa]", shrink=0.9, ticks=MaxNLocator(6))
     return _save(fig, path, tight=False)

@@ -359,7 +359,9 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
 
             def figure():
                 from multiscale.plots.squeal import plot_pressure  # local: matplotlib only when a figure is drawn
-                return [plot_pressure(tm.interface.midpoints, masks, pressure, scene.name, folder / "pressure.png")]
+                mid = tm.interface.midpoints
+                return [plot_pressure(mid, masks, pressure, scene.name, folder / "pressure.png",
+                                      (tm.bodies[1].name, tm.spec.motion.velocity(mid)))]
             files.extend(io.on_root(comm, figure if scene.output.figures else list, f"the figures in {folder}") or [])
     replacing = bool(out.replace)     # --overwrite of earlier results: they stay until the modes are found (an
     case = analyse(scene, tm, degree=degree, on_preload=None if replacing else preloaded)   # empty band deleted
