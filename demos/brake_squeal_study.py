@@ -79,7 +79,8 @@ if comm.rank == 0:
     masks, split = tm.interface.masks(), energy_split(tm)
     for name, case in cases.items():
         slug = name.replace(" ", "")
-        case.modes.write_csv(out / f"modes_{slug}.csv")
+        case.modes.write_csv(out / f"modes_{slug}.csv", case.report.rtol, case.report.potentially_unstable,
+                             partner=case.report.flutter_partner)
         plot_pressure(tm.interface.midpoints, masks, case.facet_pressure, name, out / f"fig4_12_pressure_{slug}.png")
         plot_energy(case, out / f"fig4_20_energy_{slug}.png", split)
     plot_re_im(list(cases.values()), out / "fig4_13_re_im.png")

@@ -441,13 +441,15 @@ class Reporter:
     running stage, its progress bar, then its wall time), nothing with ``quiet``. ``times`` holds
     the wall time [s] of every stage (summed over repeats), for the provenance of the results.
     Used as a context manager, it is the one that ``stage`` and ``bar`` report to. Its ``warn`` lines
-    go to stderr on rank 0, with ``quiet`` too, unless ``warn`` is false."""
+    go to stderr on rank 0, with ``quiet`` too, unless ``warn`` is false, and into ``said`` (every
+    rank's own) whatever ``warn``."""
 
     def __init__(self, comm=None, quiet: bool = False, stream=None, warn: bool = True):
         self.comm = comm or MPI.COMM_WORLD
         self.stream = stream or sys.stdout
         self.show = not quiet and self.comm.rank == 0
         self.warns = warn and self.comm.rank == 0
+        self.said: list[str] = []  # the warn lines, in order
         self.tty = self.show and hasattr(self.stream, "isatty") and self.stream.isatty()
         self.times: dict[str, float] = {}
         self.depth = 0            # nested stages are timed, not printed
@@ -468,7 +470,8 @@ class Reporter:
             print(text, file=self.stream, flush=True)
 
     def warn(self, line: str) -> None:
-        """"warning: ``line``" on stderr (rank 0; not with ``warn`` false)."""
+        """"warning: ``line``" on stderr (rank 0; not with ``warn`` false), kept in ``said``."""
+        self.said.append(line)
         if self.warns:
             print(f"warning: {line}", file=sys.stderr, flush=True)
 

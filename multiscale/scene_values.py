@@ -1,7 +1,8 @@
 """The value parsers several scene tables share, one plausible range each (``multiscale.schema``):
 a friction coefficient, a load face's pressure, an angular speed and an RMS roughness read the same
-in [loading], [interfaces.<name>], [stability.sweep] and the studies. A value outside its range is
-warned, not refused (``multiscale check --keys`` lists the ranges)."""
+in [loading], [interfaces.<name>], [loading.stribeck], [stability.sweep] and [roughness] (the RMS
+roughness in the studies' micro problems too). A value outside its range is warned, not refused
+(``multiscale check --keys`` lists the ranges)."""
 from __future__ import annotations
 
 from multiscale.schema import Quantity

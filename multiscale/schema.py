@@ -331,7 +331,7 @@ class Vector(ListOf):
 
 class FilePath:
     """A path relative to the scene file: an existing file, or a folder (need not exist) with ``folder``."""
-    WRITES = re.compile(r"writ|sav|export", re.IGNORECASE)   # a script's line naming a file it makes (its maker)
+    WRITES = r"\.(?:write|save\w*|export\w*|to_\w+)\s*\(.*(?<![\w.-]){}(?![\w.-])"   # a call writing the file
 
     def __init__(self, *, folder: bool = False, base: str = "the scene file"):
         self.folder, self.base = folder, base
@@ -355,8 +355,9 @@ class FilePath:
         if not self.folder and not S_ISREG(mode):
             kind = "is a folder, not a file" if S_ISDIR(mode) else "is no regular file (a FIFO, device or socket)" \
                 if mode else "no such file"
-            maker = [] if mode else [s.name for s in sorted(ctx.directory.glob("*.py"))[:50] if s.is_file() and any(
-                path.name in line and self.WRITES.search(line) for line in s.read_text(errors="replace").splitlines())]
+            made = re.compile(self.WRITES.format(re.escape(path.name)))     # (a reading line naming it, or a
+            maker = [] if mode else [s.name for s in sorted(ctx.directory.glob("*.py"))[:50]  # longer name, was
+                                     if s.is_file() and made.search(s.read_text(errors="replace"))]   # named: a review)
             raise Bad(f"{kind} ({path})" + (f"; {maker[0]} beside {self.base} writes it: run it first?" if maker else ""))
         return path
 

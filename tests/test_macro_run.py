@@ -198,7 +198,7 @@ def test_a_load_that_a_support_takes_is_refused(tmp_path, monkeypatch):
         loads(text.replace("[output]", '[[boundary]]\nsurfaces = ["plate_ends"]\nfix = ["z"]\n[output]'))
 
 
-def test_temperatures_beyond_a_material_table_are_warned_about(tmp_path, capsys):
+def test_temperatures_beyond_a_material_table_are_warned_about(tmp_path, capsys, monkeypatch):
     """A table is held constant beyond its ends (macro.materials): an initial temperature outside
     it is warned about when the scene is read, a body hotter than its last point after the run
     (printed and kept in provenance.json). Before: no word of either. ``workflows.run`` prints
@@ -223,6 +223,12 @@ def test_temperatures_beyond_a_material_table_are_warned_about(tmp_path, capsys)
     quiet = run(scene, verbose=False, warn=False, overwrite=True)   # a script's own report: not a line (before,
     assert "warning" not in capsys.readouterr().err                # they went to stderr with verbose=False: a trial)
     assert quiet.warnings == result.warnings
+    import multiscale.workflows.model                               # a warning said as the run goes (the memory
+    monkeypatch.setattr(multiscale.workflows.model, "memory_available", lambda: 1e3)   # estimate) is kept too
+    short = run(scene, verbose=False, warn=False, overwrite=True)   # (it was printed only: a review)
+    (memory,) = [w for w in short.warnings if "at its peak" in w]
+    assert memory.startswith("a transient run of ") and "warning" not in capsys.readouterr().err
+    assert memory in json.loads((short.folder / "provenance.json").read_text())["warnings"]
 
 
 def test_the_python_entry_points_name_bad_arguments(tmp_path):

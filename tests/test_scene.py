@@ -656,7 +656,8 @@ def test_a_missing_file_names_the_script_beside_the_scene_that_writes_it(tmp_pat
     text = GOOD.replace('builder = "block_on_flat"\nmesh_size = "2 mm"', 'file = "cad/brake.step"\nrotating = "flat"\n'
                         '[geometry.bodies.block]\nindex = [1]\nmaterial = "block"\n'
                         '[geometry.bodies.flat]\nindex = [2]\nmaterial = "flat"')
-    (tmp_path / "other.py").write_text("print('nothing here')\nread('cad/brake.step')\n")   # reads it: not named
+    (tmp_path / "other.py").write_text("read('cad/brake.step'); plt.savefig('a.png')\n"   # reads it, or another:
+                                       "gmsh.write('cad/old_brake.step')  # written by models.py\n")   # not named
     with pytest.raises(SceneError) as info:
         loads(text, tmp_path)
     missing = f'geometry.file = "cad/brake.step": no such file ({tmp_path / "cad" / "brake.step"})'
@@ -1601,12 +1602,13 @@ def test_a_squeal_analysis_without_friction_is_warned_of():
     """loading.friction = 0, or no effect "friction", passed check without a word that no flutter
     can be found (at rest it was said; an NVH user trial). A friction sweep from 0 is not warned."""
     text = (DEMOS / "brake_squeal.toml").read_text()
-    said = "the squeal analysis has no friction ({}): nothing couples the modes, so no friction-induced instability " \
-           "can be found"
+    said = "the squeal analysis has no friction ({}): no friction-induced instability can be found"
     assert said.format("mu = 0 on every interface") in loads(text.replace("\nfriction = 0.4\n", "\nfriction = 0\n"),
                                                              name="brake").warnings
     assert said.format('no effect "friction"') in loads(text.replace('"friction", ', ""), name="brake").warnings
     assert not [w for w in loads(text, name="brake").warnings if "no friction" in w]
+    curve = text.replace("\nfriction = 0.4\n", '\nfriction_curve = [["0 m/s", 0.0], ["10 m/s", 0.0]]\n')   # (a mu(v)
+    assert said.format("mu = 0 on every interface") in loads(curve, name="brake").warnings   # of 0: a review)
     swept = loads(text.replace("\nfriction = 0.4\n", "\nfriction = 0\n") + "\n[stability.sweep]\nfriction = [0, 0.6]\n",
                   name="brake").warnings
     assert not [w for w in swept if "no friction" in w]

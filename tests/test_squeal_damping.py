@@ -582,7 +582,7 @@ def check_map_files(folder, smap, documented) -> None:
     with open(folder / "map.csv", newline="") as f:
         rows = list(csv.reader(f))
     names += rows[0]
-    column = smap.column()
+    column = {"friction": "friction", "pressure": "pressure_Pa", "speed": "speed_rad_per_s", "rms": "rms_m"}[smap.parameter]
     bad = smap.unstable()
     assert len(rows) - 1 == int((smap.mode >= 0).sum())
     for row in (dict(zip(rows[0], r)) for r in rows[1:]):

@@ -207,6 +207,13 @@ def test_the_stable_half_of_a_lock_in_pair_is_not_potentially_unstable():
     assert flagged([9575.97, 9719.83, 9728.99, 9728.99, 9783.96], [0, 0, -2629.3, 2629.3, 0]) == []
     assert flagged([9575.97, 9719.83, 9728.99, 9728.99 * (1 + 2e-5), 9783.96], [0, 0, -2600, 2650, 0]) == []
     assert flagged([9575.97, 9719.83, 9728.99, 9900.0], [0, 0, -1.0, 0]) == [2, 3]
+    # pairs one to one, by opposite growth rates: a stable mode beside a pair, and a doublet's two pairs
+    # 2e-5 apart, were paired across by neighbours alone (partners [2 1 2], [2 1 2 3]: a review)
+    sigma = np.array([-5.0, 5.0, -0.5])
+    assert modal.flutter_pairs(np.array([1000.0, 1000.0, 1000.05]), sigma, sigma > 0).tolist() == [2, 1, 0]
+    f, sigma = np.array([1000.0, 1000.0, 1000.02, 1000.02]), np.array([-5.0, 5.0, -7.0, 7.0])
+    assert modal.flutter_pairs(f, sigma, sigma > 0).tolist() == [2, 1, 4, 3]
+    assert flagged([1000.0, 1000.0, 1000.05], [-5.0, 5.0, -0.5]) == []     # its neighbour, 5e-5 off, is no pair
 
 
 def test_a_mode_cap_on_a_reduced_damped_system_keeps_a_split_pair():

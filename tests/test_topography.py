@@ -372,6 +372,9 @@ def test_heights_in_the_wrong_unit_are_warned_about_and_an_overflow_refused(tmp_
     assert low.report[-1] == f"warning: {low.notes[-1]}"
     assert probe_topography(tmp_path / "tilted.npy", pixel_size=1e-6, height_unit=1e-9)[1] == [   # check says it
         low.notes[-1].replace("roughness.", "")]
+    np.save(tmp_path / "cap.npy", 1e-3 * (x - 16.0) ** 2 + 1e-3 * (y - 16.0) ** 2 + h * 30.0)   # a curved form: check
+    notes = probe_topography(tmp_path / "cap.npy", pixel_size=1e-6, height_unit=1e-6, detrend="poly2")[1]  # removes
+    assert [n for n in notes if "below an atomic step" in n]      # it as condition does (a plane did not: a review)
     with warnings.catch_warnings():
         warnings.simplefilter("error", TopographyWarning)                    # in its unit: no word
         condition(read_topography(tmp_path / "tilted.npy", pixel_size=1e-6, height_unit=1e-6))

@@ -66,6 +66,20 @@ LOCKED = 1e-4    # relative frequency gap of a stable mode to an unstable one: a
 STATIC = 1e-9    # a mode below this share of the highest frequency (or of 1 Hz) does not oscillate
 
 
+def flutter_pairs(f: np.ndarray, sigma: np.ndarray, bad: np.ndarray) -> np.ndarray:
+    """Per mode, the number (1-based) of the other half of its flutter pair, 0 for none: each unstable
+    mode (``bad``) taken in frequency order with the unused stable mode within ``LOCKED`` of its
+    frequency [Hz] whose growth rate ``sigma`` [1/s] is nearest its opposite (a doublet's two pairs,
+    or a stable mode beside a pair, were paired across by neighbours alone: a review)."""
+    partner = np.zeros(f.size, int)
+    for u in np.nonzero(bad & (f > 0))[0]:
+        near = np.nonzero(~bad & (partner == 0) & (np.abs(f - f[u]) <= LOCKED * f[u]))[0]
+        if near.size:
+            s = near[np.lexsort((np.abs(f[near] - f[u]), np.abs(sigma[near] + sigma[u])))[0]]
+            partner[u], partner[s] = s + 1, u + 1
+    return partner
+
+
 def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float = CLOSE) -> StabilityReport:
     """Unstable modes (sigma > rtol |lambda|) and potentially unstable ones (Fig. 4.14).
 
@@ -81,18 +95,10 @@ def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float =
     check_positive("close_tol", close_tol, allow_zero=True)
     f = result.frequency
     bad = result.unstable(rtol)
-    close, partner = np.zeros(f.size, bool), np.zeros(f.size, int)
-    if f.size > 1:
-        halves = np.nonzero((np.diff(f) <= LOCKED * np.maximum(f[1:], np.finfo(float).tiny)) & (bad[1:] != bad[:-1])
-                            & (f[1:] > 0))[0]
-        partner[halves], partner[halves + 1] = halves + 2, halves + 1
+    close, partner = np.zeros(f.size, bool), flutter_pairs(f, result.growth, bad)
     if f.size > 1 and close_tol > 0:
-        scale = np.maximum(f[1:], np.finfo(float).tiny)
-        gap, lock = np.diff(f) <= close_tol * scale, np.diff(f) <= LOCKED * scale
-        locked = np.zeros(f.size, bool)           # a stable mode locked in with an unstable neighbour
-        locked[1:] |= lock & bad[:-1]
-        locked[:-1] |= lock & bad[1:]
-        free = ~bad & ~locked
+        gap = np.diff(f) <= close_tol * np.maximum(f[1:], np.finfo(float).tiny)
+        free = ~bad & (partner == 0)              # not a stable half locked in with an unstable mode
         both_stable = free[1:] & free[:-1] & (f[:-1] > 0)
         pair = gap & both_stable
         close[1:] |= pair

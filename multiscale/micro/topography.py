@@ -64,7 +64,8 @@ def probe_topography(path, channel: int | None = None, *, pixel_size=None, heigh
     searched = flattened if detrend == form else None         # the outlier search's heights, if these
     if cutoff is not None and not resolved(cutoff, m.dx, m.dy):   # refused in the scene's words (``check_cutoff``):
         cutoff = None                                             # the outliers as if without it
-    low = _too_smooth(float(np.nanstd(flattened)), m.path.name, prefix)
+    rough = flattened if detrend != "poly2" else remove_form(m.heights, "poly2")   # condition's form (a curved
+    low = _too_smooth(float(np.nanstd(rough)), m.path.name, prefix)                # map passed: a review)
     return [], list(m.notes) + ([] if despike is not None else _outlier_notes(m, detrend, cutoff, prefix, searched)) \
         + ([low] if low else [])
 

@@ -9,7 +9,6 @@ provenance (``multiscale.provenance``) and a pvpython script (``multiscale.outpu
 """
 from __future__ import annotations
 
-import sys
 import time
 from pathlib import Path
 
@@ -72,6 +71,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                 result = module.run(scene, overwrite=overwrite, comm=comm, verbose=verbose)
         except BaseException as exc:
             stopped = interrupted(exc)
+            during = reporter.said[len(scene.warnings):]     # said as the run went (rank 0's: the record's)
             notes = list(getattr(exc, "__notes__", ()))     # the run's warnings until it failed (model.heat_warnings_as_notes)
             for line in notes:
                 reporter.warn(line)
@@ -82,17 +82,18 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                     elif stopped:                             # a step abandoned: the plots of what was written
                         _abandoned(reporter.folder, scene)
                 except BaseException as lost:                 # not at the record's cost (a further Ctrl-C too)
-                    print(f"warning: the figures or the ParaView script of this run were not written "
-                          f"({type(lost).__name__}: {lost})", file=sys.stderr, flush=True)
+                    reporter.warn(f"the figures or the ParaView script of this run were not written "
+                                  f"({type(lost).__name__}: {lost})")
                 try:
                     provenance.write(reporter.folder, scene, ranks=comm.size, started=started,
                                      stages=reporter.times, wall_time=time.perf_counter() - start, analysis=kind,
                                      status=f"interrupted {stopped}".strip() if stopped else
                                      f"failed: {type(exc).__name__}: {exc}", earlier=earlier,
-                                     warnings=[*scene.warnings, *(exc.warnings if isinstance(exc, Interrupted) else ()),
+                                     warnings=[*scene.warnings, *during,
+                                               *(exc.warnings if isinstance(exc, Interrupted) else ()),
                                                *notes, *run_warnings(scene, _written_history(reporter.folder))])
                 except OSError as lost:                       # (a full disk): the error that stopped the run counts
-                    print(f"warning: the record of this run was not written ({lost})", file=sys.stderr, flush=True)
+                    reporter.warn(f"the record of this run was not written ({lost})")
             if stopped and stopped is not exc:
                 raise stopped from None                       # not PETSc's error 101 around it
             raise
@@ -101,9 +102,13 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         result.files += [result.folder / name for name in [*outputs.PROVENANCE, *outputs.SCRIPT]
                          if (result.folder / name).is_file()]
         return result
+    # said as the run went (the memory estimate, the first contact solve's load: rank 0's), then what the
+    # results leave out (also when quiet); all in the record and the result (the first were lost: a review)
+    during = comm.bcast(reporter.said[len(scene.warnings):], root=0)
     beyond = run_warnings(scene, getattr(result, "history", None)) + list(getattr(result, "warnings", ()))
-    for line in beyond:                                     # what the results leave out: also when quiet
+    for line in beyond:
         reporter.warn(line)
+    beyond = during + beyond
 
     def write():
         files = provenance.write(result.folder, scene, ranks=comm.size, started=started, stages=reporter.times,

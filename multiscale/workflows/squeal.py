@@ -329,11 +329,14 @@ def _left_out(scene, case: SquealCase, smap: StabilityMap | None) -> list[str]:
     # (gyroscopic terms at 48 rpm flagged 10 of 24 modes, most at damping ratios of -1e-5: an NVH trial)
     weak = case.report.unstable[case.modes.damping_ratio[case.report.unstable - 1] > -WEAK]
     if weak.size and not structurally_damped(scene, scene.geometry.materials):
-        out.append(f"{weak.size} of the {io.counted(case.report.unstable.size, 'unstable mode')} grow at damping "
-                   f"ratios above -{WEAK:g} ({', '.join(f'{f[j - 1]:.0f} Hz' for j in weak[:6])}), which a loss "
-                   f"factor of {2 * WEAK:g} would damp, and nothing damps this structure: give the damping the brake "
-                   "has (stability.damping, rayleigh_alpha/beta, the materials' loss_factor) to weigh them, or "
-                   f"stability.threshold = {WEAK:g} to leave them out")
+        n = case.report.unstable.size
+        which = ("the unstable mode grows" if n == 1 else f"all {n} unstable modes grow" if weak.size == n else
+                 f"{weak.size} of the {n} unstable modes grow{'s' * (weak.size == 1)}")      # (grammar: a review)
+        them = "it" if weak.size == 1 else "them"
+        out.append(f"{which} at damping ratios above -{WEAK:g} ({', '.join(f'{f[j - 1]:.0f} Hz' for j in weak[:6])}), "
+                   f"which a loss factor of {2 * WEAK:g} would damp, and nothing damps this structure: give the damping "
+                   f"the brake has (stability.damping, rayleigh_alpha/beta, the materials' loss_factor) to weigh {them}, "
+                   f"or stability.threshold = {WEAK:g} to leave {them} out")
     peak = max(float(case.facet_pressure.max(initial=0.0)), smap.max_pressure if smap is not None else 0.0)
     return out + overloaded(scene, peak) + unloaded({n: abs(f) for n, f in case.preload.normal_force.items()})
 
