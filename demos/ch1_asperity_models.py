@@ -17,6 +17,14 @@
 # κ against the area fraction (iv), plus the wall time of each model's whole curve, so that the
 # accuracy–time trade-off is visible.
 #
+# Where we differ from the thesis (a user trial, 2026-12-06, default run): our Set-2 surface is
+# anisotropic in curvature (1.46 x along one axis) but its summits are no more eccentric than Set 1's
+# (mean eccentricity 0.79 against 0.80), so its elliptic and circular curves lie on top of each other,
+# where Fig. 1.9 finds the elliptic hypothesis "remarkable" for Set 2; the FFT-BEM reference gives
+# kappa 3.06 / 2.97 (Sets 1 / 2) at 1.5-5 % area where the thesis has about 2.2 (Bush et al. 2.51: the
+# 128² grid resolves the small contact spots coarsely, which raises kappa); the Nayak parameters are
+# 3.72 / 3.64 against the thesis' 2.6 / 3.
+#
 #     .venv/bin/python demos/ch1_asperity_models.py                     # the thesis' 1 mm patch
 #     .venv/bin/python demos/ch1_asperity_models.py --size 2 --seed 3   # 2 mm, same spectrum per mm
 #

@@ -11,10 +11,14 @@
 # 10, RMS 6 µm), E = 4 GPa, ν = 0.15 against a rigid flat, p = 1 MPa, μ = 0.4, S = 10 mm,
 # k_w = 1e-12 /Pa. We follow the real contact area (Fig. 3.3), the largest wear depth (Fig. 3.4) and
 # the worn volume (Fig. 3.9) for several N, the pressure–gap law of the worn surface (Fig. 3.10),
-# and the surfaces before and after (Figs. 3.5–3.6).
+# and the surfaces before and after (Figs. 3.5–3.6). Where we differ from the thesis: k_w = 1e-10
+# by default, not its 1e-12, which wears 4 nm on average over the 10 mm and cannot take the area
+# from 1 % to its 13 % (the mass balance below; at 1e-12, N = 200 and 300 give the same curves,
+# 0.61 % -> 0.99 %, and Fig. 3.3's message, that too few steps under-estimate the area, is not
+# seen: a user trial); S2 is rigid here, E = 220 GPa, ν = 0.33 in Table 3.1 (E* 1.7 % apart).
 #
-#     .venv/bin/python demos/ch3_wear.py                        # N = 200 and 300, thesis k_w
-#     .venv/bin/python demos/ch3_wear.py --steps 400 --kw 1e-10  # the regime where peaks wear flat
+#     .venv/bin/python demos/ch3_wear.py                  # N = 200, 300 and 400 at k_w = 1e-10
+#     .venv/bin/python demos/ch3_wear.py --kw 1e-12       # the thesis' k_w: 4 nm of mean wear
 
 import argparse
 import time
@@ -39,8 +43,8 @@ P, MU, S, KW = 1e6, 0.4, 10e-3, 1e-12
 
 parser = argparse.ArgumentParser(description="Wear of a rough surface under sliding (thesis §3.5)")
 parser.add_argument("--n", type=int, default=128, help="grid points per side")
-parser.add_argument("--steps", type=int, default=300, help="wear steps")
-parser.add_argument("--kw", type=float, default=KW, help="wear rate k_w [1/Pa] (thesis: 1e-12)")
+parser.add_argument("--steps", type=int, default=400, help="wear steps (besides 200 and 300)")
+parser.add_argument("--kw", type=float, default=100 * KW, help="wear rate k_w [1/Pa] (thesis: 1e-12; see the header)")
 add_out(parser, __file__)
 args = parser.parse_args()
 out = Path(args.out)
@@ -59,8 +63,8 @@ area = surface.size[0] * surface.size[1]
 #
 # Mass balance: summing Eq. 3.10 over the patch, the worn volume is k_w μ p A0 S whatever the pressure
 # field, so the mean wear depth is k_w μ p S = 4 nm for the thesis values, while wearing the peaks
-# flat down to 13 % real area (thesis §3.5.1) would take about 0.4 µm on a 6 µm RMS surface;
-# --kw 1e-10 shows that regime.
+# flat down to 13 % real area (thesis §3.5.1) would take about 0.4 µm on a 6 µm RMS surface:
+# k_w = 1e-10 (the default) shows that regime.
 law_steps = (0, args.steps // 4, args.steps // 2, args.steps)
 law_loads = np.linspace(0.25e6, 2e6, 8)
 runs = {}
@@ -132,8 +136,9 @@ print(f"wall time {time.perf_counter() - t0:.1f} s")
 # ## The numbers to check
 # The worn volume against Archard's law summed over the patch and the steps, W = k_w μ p A0 S
 # (thesis §3.4, Eq. 3.10): the ratio is 1 to round-off for every N. The initial real area: the thesis
-# starts from about 1 % (§3.5.1, Fig. 3.3); its 13 % after 10 mm is not reachable at k_w = 1e-12
-# (see the mass balance above).
+# starts from about 1 % (§3.5.1, Fig. 3.3); here 0.61 %. At k_w = 1e-10 (2026-12-06): 10.2 % after
+# 10 mm with N = 200, 15.5 % with N = 300 and 400 (Fig. 3.3: N = 200 under-estimates, N >= 300
+# converged, 13 %); at the thesis' 1e-12 not reachable (see the mass balance above).
 archard = args.kw * MU * P * area * S
 print(f"worn volume / (k_w mu p A0 S) = {h.volume[-1] / archard:.6f} after N = {args.steps} steps "
       f"(Archard, thesis Eq. 3.10: 1); initial A/A0 = {h.area_fraction[0] * 100:.2f} % (thesis: about 1 %)")

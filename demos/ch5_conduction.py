@@ -12,6 +12,13 @@
 # numbers at 3 MPa with Tables 5.4, 5.6 and 5.8, then sweep the local resistance (Fig. 5.25) and map
 # the surface temperatures of both bodies (Figs. 5.14–5.15).
 #
+# Where we differ from the thesis (a user trial, 2026-12-06): K_t at 3 MPa is 5-10 % below Tables
+# 5.4 / 5.6 / 5.8 (3.56 against 3.75, 2.78 against 3.10, 3.02 against 3.27 kW/(m² K)) on our own
+# fractal surface (its realisation is not the thesis'; Mikic's elastic conductance by hand, in
+# series with the layers, gives 3.50); at h = 100 um T_s is 0.91 against 0.87; the surface
+# temperatures span 0.30-0.83 (solid 1) and 0.83-0.94 (solid 2) against 0.53-0.83 and 0.83-0.90.
+# `--n` draws another surface of the same spectrum on that grid, not a refinement of this one.
+#
 #     .venv/bin/python demos/ch5_conduction.py                  # the thesis' 150 x 150 grid
 #     .venv/bin/python demos/ch5_conduction.py --n 100 --out results/ch5_conduction_100
 
