@@ -42,7 +42,8 @@ from demo_output import add_out
 matplotlib.use("Agg")  # PNG files only, no display
 
 parser = argparse.ArgumentParser(description="Contact of a rough two-layered solid (thesis ch. 2)")
-parser.add_argument("--n", type=int, default=128, help="grid points per side of the rough surface")
+parser.add_argument("--n", type=int, default=128,
+                    help="grid points per side of the rough surface (another n draws another surface of the spectrum)")
 add_out(parser, __file__)
 args = parser.parse_args()
 out = Path(args.out)

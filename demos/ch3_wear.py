@@ -42,7 +42,8 @@ matplotlib.use("Agg")  # PNG files only, no display
 P, MU, S, KW = 1e6, 0.4, 10e-3, 1e-12
 
 parser = argparse.ArgumentParser(description="Wear of a rough surface under sliding (thesis §3.5)")
-parser.add_argument("--n", type=int, default=128, help="grid points per side")
+parser.add_argument("--n", type=int, default=128,
+                    help="grid points per side (another n draws another surface of the spectrum)")
 parser.add_argument("--steps", type=int, default=400, help="wear steps (besides 200 and 300)")
 parser.add_argument("--kw", type=float, default=100 * KW, help="wear rate k_w [1/Pa] (thesis: 1e-12; see the header)")
 add_out(parser, __file__)

@@ -40,7 +40,8 @@ from demo_output import add_out
 matplotlib.use("Agg")  # PNG files only, no display
 
 parser = argparse.ArgumentParser(description="Thermal contact conductance of a rough two-layered solid")
-parser.add_argument("--n", type=int, default=150, help="grid points per side (thesis: 150)")
+parser.add_argument("--n", type=int, default=150,
+                    help="grid points per side (thesis: 150; another n draws another surface of the spectrum)")
 add_out(parser, __file__)
 args = parser.parse_args()
 out = Path(args.out)

@@ -29,7 +29,8 @@ from demo_output import add_out
 matplotlib.use("Agg")  # PNG files only, no display
 
 parser = argparse.ArgumentParser(description="A fractal surface pressed on a rigid flat by FFT-BEM")
-parser.add_argument("--n", type=int, default=256, help="grid points per side")
+parser.add_argument("--n", type=int, default=256,
+                    help="grid points per side (another n draws another surface of the spectrum)")
 add_out(parser, __file__)
 args = parser.parse_args()
 out = Path(args.out)
