@@ -469,9 +469,11 @@ class Reporter:
         if self.show:
             print(text, file=self.stream, flush=True)
 
-    def warn(self, line: str) -> None:
-        """"warning: ``line``" on stderr (rank 0; not with ``warn`` false), kept in ``said``."""
-        self.said.append(line)
+    def warn(self, line: str, keep: bool = True) -> None:
+        """"warning: ``line``" on stderr (rank 0; not with ``warn`` false), kept in ``said`` unless
+        ``keep`` is false (a line that the end of the run says again)."""
+        if keep:
+            self.said.append(line)
         if self.warns:
             print(f"warning: {line}", file=sys.stderr, flush=True)
 

@@ -47,7 +47,7 @@ def say_at_once(scene, history, comm) -> None:
         return
     for line in overloaded(scene, float(history["max_pressure"][-1])) + unloaded(last_forces(scene, history)):
         io.reporter().warn(f"at the first contact solve, {line}; the run goes on (Ctrl-C stops it after a step, "
-                           "with its results written)")
+                           "with its results written)", keep=False)       # (the run's end says it again)
 
 
 def last_forces(scene, history) -> dict[str, float]:
