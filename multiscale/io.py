@@ -470,9 +470,10 @@ class Reporter:
             print(text, file=self.stream, flush=True)
 
     def warn(self, line: str, keep: bool = True) -> None:
-        """"warning: ``line``" on stderr (rank 0; not with ``warn`` false), kept in ``said`` unless
-        ``keep`` is false (a line that the end of the run says again)."""
-        if keep:
+        """"warning: ``line``" on stderr (rank 0; not with ``warn`` false), kept in ``said`` while this
+        reporter is active unless ``keep`` is false (a line that the end of the run says again; the
+        silent reporter of no run keeps nothing)."""
+        if keep and self in _ACTIVE:
             self.said.append(line)
         if self.warns:
             print(f"warning: {line}", file=sys.stderr, flush=True)

@@ -272,8 +272,7 @@ class Loading:
 
     normal_force: float | None = key(Quantity("force", gt=0, plausible=(1e-3, 1e6)),                 # N
                                      absent="pressure, braking_torque or vehicle.mass gives the load")
-    pressure: float | None = key(LOAD_PRESSURE,                   # Pa
-                                 absent="normal_force, braking_torque or vehicle.mass gives the load")
+    pressure: float | None = key(LOAD_PRESSURE, absent="normal_force, braking_torque or vehicle.mass gives the load")
     braking_torque: float | None = key(Quantity("torque", gt=0, plausible=(1e-3, 1e6)),              # N m
                                        absent="normal_force, pressure or vehicle.mass gives the load")
     faces: tuple | None = key(ListOf(Text(), unique=True, min_len=1), absent="the builder's load faces (files: needed)")

@@ -61,11 +61,11 @@ def probe_topography(path, channel: int | None = None, *, pixel_size=None, heigh
     why = _too_many_undefined(m, max_undefined, prefix) or _form_only(m, flattened)
     if why is not None:
         return [str(InputError(option(prefix, "file"), m.path.name, why))], list(m.notes)
-    searched = flattened if detrend == form else None         # the outlier search's heights, if these
+    rough = flattened if detrend != "poly2" else remove_form(m.heights, "poly2")   # condition's form (a curved
+    searched = rough if detrend in (form, "poly2") else None      # map passed: a review); the outlier search's
     if cutoff is not None and not resolved(cutoff, m.dx, m.dy):   # refused in the scene's words (``check_cutoff``):
         cutoff = None                                             # the outliers as if without it
-    rough = flattened if detrend != "poly2" else remove_form(m.heights, "poly2")   # condition's form (a curved
-    low = _too_smooth(float(np.nanstd(rough)), m.path.name, prefix)                # map passed: a review)
+    low = _too_smooth(float(np.nanstd(rough)), m.path.name, prefix)
     return [], list(m.notes) + ([] if despike is not None else _outlier_notes(m, detrend, cutoff, prefix, searched)) \
         + ([low] if low else [])
 

@@ -199,7 +199,6 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
                [("partition_max", "max"), ("partition_mean", "mean over zones"),    # weighted by the heat
                 ("partition_min", "min")], 100.0, 0),
               ("wear volume [mm³]", [("wear_volume", None)], 1e9, 0),     # a tribologist's unit, however small
-
               ("max wear depth [µm]", [("wear_max_depth", None)], 1e6, 0),
               ("RMS roughness of the worn zones [µm]", [("rms_height", None)], 1e6, 0),
               ("real contact area [mm²]" if area == 1e6 else "real contact area [µm²]",
