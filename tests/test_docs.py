@@ -161,7 +161,8 @@ def test_every_study_key_appears_in_the_generated_study_format():
 
 def test_the_micro_patch_tutorial_runs_and_gives_the_numbers_it_quotes(capsys):
     """The tutorial's first code block, run as shown (256², seconds), prints the 256² numbers its
-    text quotes: area, approach and iterations (the first of each quoted triple)."""
+    text quotes: area, approach and iterations (the first of each quoted triple); then its
+    stiffness block the stiffness it quotes."""
     text = (Path(__file__).resolve().parents[1] / "docs" / "tutorials" / "micro_patch.rst").read_text()
     block = re.search(r"\.\. code-block:: python\n\n((?:    .*\n|\n)+)", text).group(1)
     scope = {}
@@ -174,6 +175,10 @@ def test_the_micro_patch_tutorial_runs_and_gives_the_numbers_it_quotes(capsys):
     assert 1e6 * r.approach == pytest.approx(approach, abs=5e-4)       # quoted to 1e-3 um
     assert 100 * r.area_fraction == pytest.approx(area, abs=5e-3)      # quoted to 0.01 %
     assert r.iterations == iterations
+    block = re.search(r"\.\. code-block:: python\n\n((?:    .*\n|\n)+)", text[text.index("contact_stiffness`:"):]).group(1)
+    exec("\n".join(line[4:] for line in block.splitlines()), scope)
+    stiffness = float(re.search(r"It gives (\S+) MPa/µm", text).group(1))
+    assert 1e-12 * scope["k"].stiffness == pytest.approx(stiffness, abs=5e-4)   # quoted to 1e-3 MPa/um
 
 
 def test_the_readme_names_every_tutorial_of_the_user_guide():

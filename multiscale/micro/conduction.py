@@ -36,6 +36,7 @@ from multiscale.errors import (ConvergenceError, InputError, check_count, check_
                                check_mask, check_positive, check_real)
 from multiscale.micro.contact import ContactSolver
 from multiscale.micro.kernels import InfluenceOperator, Kernel, check_kernel
+from multiscale.micro.masked_krylov import masked_cg
 from multiscale.micro.surface import Surface, check_surface
 
 
@@ -162,7 +163,16 @@ class ConductionSolver:
         if max_iter is None:
             max_iter = int(20 * np.sqrt(max(int(n_contact.max()), 1))) + 100
         max_iter = check_count("max_iter", max_iter)
-        phi, its, res, ok = self._cg(mask, R, dtheta, tol, max_iter, initial_flux)
+        if initial_flux is None:    # uniform flux of the 1-D (bulk + self-influence) estimate
+            initial_flux = dtheta / (self.series.self_influence + (sum(self.bulk) if self.bulk else 0.0) + R)
+        else:
+            try:
+                initial_flux = np.broadcast_to(initial_flux, mask.shape)
+            except ValueError:
+                raise InputError("initial_flux.shape", initial_flux.shape, f"must broadcast to {mask.shape}") from None
+        phi, its, res, ok = masked_cg(self.series, mask, dtheta, tol, max_iter, initial_flux, diagonal=R)
+        if not np.all(np.isfinite(phi)):
+            raise ConductionConvergenceError("conduction CG produced non-finite fluxes", [], None)
         T1phi = self.body_1(phi)
         Tphi = self.series(phi)
         temp_1 = theta_1 + T1phi
@@ -185,64 +195,6 @@ class ConductionSolver:
                 f"conduction CG did not converge in {max_iter} iterations (residual {res.max():.3e} > "
                 f"tol {tol:.1e} on {int(np.sum(~ok))} patch(es))", [float(res.max())], result)
         return result
-
-    def _cg(self, mask, R, dtheta, tol, max_iter, phi0):
-        """Conjugate gradients for (T + R) phi = Δθ on the mask, phi = 0 off it (Eqs. 5.10–5.12).
-
-        Vectors hold the contact points of all patches only (gathered); per-patch dot products
-        are segment sums, each patch is frozen once converged. Returns phi, iterations, relative
-        residual, converged."""
-        shape, batch = mask.shape, mask.shape[:-2]
-        B, N = int(np.prod(batch, dtype=int)), shape[-2] * shape[-1]
-        idx = np.flatnonzero(mask)
-        seg = idx // N                                   # patch of each contact point
-        Rc = np.ascontiguousarray(R).ravel()[idx]
-        work = np.zeros(shape)
-
-        def A(x):                                        # (T + R) x restricted to the contact
-            work.ravel()[idx] = x
-            out = self.series(work).ravel()[idx]
-            work.ravel()[idx] = 0.0
-            return out + Rc * x
-
-        def dot(x, y):
-            return np.bincount(seg, weights=x * y, minlength=B)
-
-        b = np.full(idx.size, dtheta)
-        if phi0 is not None:
-            try:
-                phi = np.broadcast_to(phi0, shape).ravel()[idx].copy()
-            except ValueError:
-                raise InputError("initial_flux.shape", phi0.shape, f"must broadcast to {shape}") from None
-        else:   # uniform flux of the 1-D (bulk + self-influence) estimate
-            phi = b / (self.series.self_influence + (sum(self.bulk) if self.bulk else 0.0) + Rc)
-        bnorm = np.sqrt(dot(b, b))
-        safe = np.where(bnorm > 0, bnorm, 1.0)
-        r = b - A(phi)
-        d = r.copy()
-        rr = dot(r, r)
-        active = np.sqrt(rr) / safe > tol
-        its = np.zeros(B, dtype=int)
-        for _ in range(max_iter):
-            if not active.any():
-                break
-            Ad = A(d)
-            dAd = dot(d, Ad)
-            alpha = np.where(active & (dAd > 0), rr / np.where(dAd > 0, dAd, 1.0), 0.0)[seg]
-            phi += alpha * d
-            r -= alpha * Ad
-            rr_new = dot(r, r)
-            d = r + np.where(active, rr_new / np.where(rr > 0, rr, 1.0), 0.0)[seg] * d
-            rr = np.where(active, rr_new, rr)
-            its += active
-            active &= np.sqrt(rr) / safe > tol
-        true = b - A(phi)
-        res = np.sqrt(dot(true, true)) / safe
-        if not np.all(np.isfinite(phi)):
-            raise ConductionConvergenceError("conduction CG produced non-finite fluxes", [], None)
-        out = np.zeros(shape)
-        out.ravel()[idx] = phi
-        return out, its.reshape(batch), res.reshape(batch), ~active.reshape(batch)
 
 
 @dataclass

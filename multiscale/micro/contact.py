@@ -82,7 +82,9 @@ class ContactResult:
       hardness); ``plastic`` [m], permanent deformation d - z - u at p = H, >= 0 into the solid
       (None without a hardness);
     - ``iterations``, ``residual`` (see ``ContactSolver.solve``) and ``converged`` (bool) per
-      patch; ``history``, the max residual over the patches per iteration."""
+      patch; ``history``, the max residual over the patches per iteration.
+
+    Its normal contact stiffness dp̄/dδ: ``micro.stiffness.contact_stiffness``."""
 
     pressure: np.ndarray
     displacement: np.ndarray

@@ -1,15 +1,71 @@
 """Krylov solves of a linear system restricted to a mask, batched over leading axes: A x = b on the
-cells of ``mask`` with x zero elsewhere, stopping per patch at |Ax − b| <= tol · scale (thesis
-§6.3.5, Eq. 6.21: the micro heat systems on the contacting cells, ``micro.heating``). ``apply`` maps
-a batch of fields to A x (e.g. an FFT convolution); the operator need not be symmetric.
+cells of ``mask`` with x zero elsewhere. ``apply`` maps a batch of fields to A x (e.g. an FFT
+convolution).
 
-``masked_solve`` runs ``bicgstab`` and hands the patches it leaves unconverged to ``cgls``, the
+``masked_cg``: conjugate gradients for a symmetric positive definite A (the conduction of a contact,
+thesis Eqs. 5.10–5.12, ``micro.conduction``; the incremental contact of a fixed contact set,
+``micro.stiffness``).
+
+``masked_solve``: any A, stopping per patch at |Ax − b| <= tol · scale (thesis §6.3.5, Eq. 6.21:
+the micro heat systems on the contacting cells, ``micro.heating``). It runs ``bicgstab`` and hands the patches it leaves unconverged to ``cgls``, the
 thesis' conjugate gradients on the normal equations (Eqs. 6.19–6.20), slower (its condition number
 is the square of the system's, two products per iteration) but without breakdowns.
 """
 from __future__ import annotations
 
 import numpy as np
+
+
+def masked_cg(apply, mask, b, tol, max_iter, x0, diagonal=0.0):
+    """Conjugate gradients for (A + D) x = b on the cells of ``mask`` (..., ny, nx), x zero
+    elsewhere, A + D symmetric positive definite there; D = diag(``diagonal``). ``b``, ``x0`` and
+    ``diagonal``: scalars or fields broadcastable to the mask. The vectors hold the mask's cells
+    only (gathered); per-patch dot products are segment sums, and a patch is frozen once its
+    recursive residual |r| <= tol |b|. Returns x (mask's shape), iterations, the true relative
+    residual |(A + D) x − b| / |b| on the mask and converged (the batch's shape)."""
+    shape, batch = mask.shape, mask.shape[:-2]
+    B, N = int(np.prod(batch, dtype=int)), shape[-2] * shape[-1]
+    idx = np.flatnonzero(mask)
+    seg = idx // N                                   # patch of each cell
+    gather = lambda a: np.ascontiguousarray(np.broadcast_to(a, shape)).ravel()[idx]
+    Dc, b = gather(diagonal), gather(b)
+    work = np.zeros(shape)
+
+    def A(x):                                        # (A + D) x restricted to the mask
+        work.ravel()[idx] = x
+        out = apply(work).ravel()[idx]
+        work.ravel()[idx] = 0.0
+        return out + Dc * x
+
+    def dot(x, y):
+        return np.bincount(seg, weights=x * y, minlength=B)
+
+    x = gather(x0).astype(float)
+    bnorm = np.sqrt(dot(b, b))
+    safe = np.where(bnorm > 0, bnorm, 1.0)
+    r = b - A(x)
+    d = r.copy()
+    rr = dot(r, r)
+    active = np.sqrt(rr) / safe > tol
+    its = np.zeros(B, dtype=int)
+    for _ in range(max_iter):
+        if not active.any():
+            break
+        Ad = A(d)
+        dAd = dot(d, Ad)
+        alpha = np.where(active & (dAd > 0), rr / np.where(dAd > 0, dAd, 1.0), 0.0)[seg]
+        x += alpha * d
+        r -= alpha * Ad
+        rr_new = dot(r, r)
+        d = r + np.where(active, rr_new / np.where(rr > 0, rr, 1.0), 0.0)[seg] * d
+        rr = np.where(active, rr_new, rr)
+        its += active
+        active &= np.sqrt(rr) / safe > tol
+    true = b - A(x)
+    res = np.sqrt(dot(true, true)) / safe
+    out = np.zeros(shape)
+    out.ravel()[idx] = x
+    return out, its.reshape(batch), res.reshape(batch), ~active.reshape(batch)
 
 
 def masked_solve(apply, apply_t, b, mask, scale, tol, max_iter, x0=None):
