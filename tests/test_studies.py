@@ -948,7 +948,8 @@ def test_an_interrupted_study_writes_the_table_of_the_runs_that_ended(tmp_path, 
 def test_a_measured_surface_is_a_micro_study_problem(tmp_path, capsys):
     """measured_contact: an instrument file swept in load (no micro patch from a measured file could
     be run from a study or the command line: a user trial), the numbers of the Python path the
-    micro-patch tutorial shows to 1e-12, the file's bytes in the runs' keys."""
+    micro-patch tutorial shows to 1e-12, its contact stiffness (rising with the load), the file's
+    bytes in the runs' keys."""
     import shutil
 
     from multiscale.checkpoint import file_digest
@@ -957,7 +958,7 @@ def test_a_measured_surface_is_a_micro_study_problem(tmp_path, capsys):
     from multiscale.schema import Context
     from multiscale.studies.problems import PROBLEMS
     shutil.copy(ROOT / "tests" / "data" / "top-1.top", tmp_path / "afm.top")
-    path = write(tmp_path, 'problem = "measured_contact"\nmetrics = ["approach", "area_fraction"]\n[fixed]\n'
+    path = write(tmp_path, 'problem = "measured_contact"\nmetrics = ["approach", "area_fraction", "stiffness"]\n[fixed]\n'
                            'file = "afm.top"\n[sweep]\nload = ["1 MPa", "5 MPa"]\n[run]\nprocesses = 1\n'
                            "[report]\nplots = false\n")
     problem = PROBLEMS["measured_contact"]
@@ -973,6 +974,7 @@ def test_a_measured_surface_is_a_micro_study_problem(tmp_path, capsys):
             r = solve_contact(surface, kernel=HalfSpace.from_materials(4e9, 0.15), load=load)
             assert h5["approach"][k] == pytest.approx(r.approach, rel=1e-12)
             assert h5["area_fraction"][k] == pytest.approx(r.area_fraction, rel=1e-12) and r.area_fraction > 0
+        assert h5["stiffness"].attrs["unit"] == "Pa/m" and 0 < h5["stiffness"][0] < h5["stiffness"][1]
 
 
 def test_an_asperity_model_beyond_its_range_is_said_by_the_run(tmp_path):

@@ -24,13 +24,14 @@ import numpy as np
 from multiscale.checkpoint import file_digest
 from multiscale.micro.asperity import AsperityModel, AsperityWarning
 from multiscale.micro.conduction import ConductionSolver, SeriesKernel
-from multiscale.micro.contact import ContactSolver, solve_contact
+from multiscale.micro.contact import ContactSolver
 from multiscale.micro.heat_kernels import Rotation, SpeedProfile, ThermalMaterial
 from multiscale.micro.heating import SteadyHeating, TransientHeating
 from multiscale.micro.kernels import HalfSpace
 from multiscale.micro.laws import LawSpec, compute_laws
 from multiscale.micro.layered import LayeredElastic, LayeredThermal
 from multiscale.micro.outliers import DESPIKE
+from multiscale.micro.stiffness import contact_stiffness
 from multiscale.micro.surface import Surface, fractal_surface
 from multiscale.micro.topography import DETREND, condition, read_topography
 from multiscale.micro.wear import simulate_wear
@@ -233,7 +234,7 @@ class MeasuredContactParams:
     does: ``detrend`` form removed, optionally filtered at ``cutoff``, undefined points filled; the
     isolated patch it is, with its own pixel sizes; outliers warned of, or removed at ``despike``)
     on an elastic half-space, pressed by a rigid flat to the mean pressure ``load`` (FFT-BEM:
-    ``solve_contact`` of the conditioned ``Surface``)."""
+    ``ContactSolver`` of the conditioned ``Surface``; its stiffness by ``contact_stiffness``)."""
 
     file: Path = key(FilePath(base="the study file"), required=True)
     detrend: str = key(Choice(tuple(DETREND)), default="plane")
@@ -248,15 +249,18 @@ class MeasuredContactParams:
 
 
 @_register(MeasuredContactParams, {"approach": "rigid approach from the first touch [m]",
-                                   "area_fraction": "real contact area / nominal area [-]"})
+                                   "area_fraction": "real contact area / nominal area [-]",
+                                   "stiffness": "normal contact stiffness d(mean pressure)/d(approach) [Pa/m]"})
 def _measured_contact(p: MeasuredContactParams) -> Outcome:
     """Contact of a measured topography at one mean pressure (FFT-BEM on its isolated patch)."""
     measured = read_topography(p.file)
     conditioned = condition(measured, p.detrend, p.cutoff, despike=p.despike)   # (the warning offered "despike",
     #                                                                              which the study refused: a trial)
-    r = solve_contact(conditioned.surface, kernel=HalfSpace.from_materials(p.E, p.nu), load=p.load,
-                      **({"tol": p.tol} if p.tol else {}))
-    return Outcome({"approach": float(r.approach), "area_fraction": float(r.area_fraction)},
+    s = conditioned.surface
+    solver = ContactSolver(HalfSpace.from_materials(p.E, p.nu), s.shape, s.dx, s.dy, s.periodic)
+    r = solver.solve(s, load=p.load, **({"tol": p.tol} if p.tol else {}))
+    return Outcome({"approach": float(r.approach), "area_fraction": float(r.area_fraction),
+                    "stiffness": float(contact_stiffness(solver, r).stiffness)},
                    int(r.iterations), bool(r.converged), warnings=measured.notes + conditioned.notes)
 
 
