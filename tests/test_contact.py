@@ -228,6 +228,8 @@ def test_a_surface_brings_its_own_grid_and_periodicity():
         ContactSolver(E, h.shape, 2 * dx, periodic=False).solve(s, load=load)
     with pytest.raises(InputError, match="a Surface gives its own pixel sizes and periodicity"):
         solve_contact(s, dx, E, load=load)
+    with pytest.raises(InputError, match=r"a Kernel given as the pixel size: name it, solve_contact\(heights, kernel="):
+        solve_contact(s, E, load=load)              # (it said that the kernel was missing: a trial)
     with pytest.raises(InputError, match=r"load = 'array of shape \(2,\)': must broadcast to the batch's shape "
                                          r"\(\), one value per patch \(a sweep on one patch"):
         solve_contact(h, dx, E, load=[load, 2 * load])

@@ -45,8 +45,8 @@ def differenced(solver, heights, result, hardness=None):
 
 
 def test_the_stiffness_is_the_derivative_of_the_solvers_load():
-    """Periodic rough patches at 0.04-3 % contact, an isolated sphere and a plastic patch: K
-    against a finite difference of the nonlinear solver (measured within 1.1e-8)."""
+    """Periodic rough patches at 0.04-3 % contact, an isolated sphere and a plastic patch, loading
+    and unloading: K against a finite difference of the nonlinear solver (measured within 1.1e-8)."""
     s = fractal_surface(128, 1e-4, 0.8, 2, 32, 1e-6, seed=3)
     solver = ContactSolver(STEEL, s.shape, s.dx, s.dy, True)
     h = np.broadcast_to(s.heights, (3, 128, 128))                                  # a batch
@@ -68,6 +68,16 @@ def test_the_stiffness_is_the_derivative_of_the_solvers_load():
     k = contact_stiffness(solver, r)
     assert same and k.stiffness == pytest.approx(fd, rel=1e-6)
     assert np.all(k.increment[r.plastic > 0] == 0)
+    # unloading: every contact cell elastic, as the elastic contact of the permanently deformed
+    # surface h - plastic at the same load (a user trial: 12x the loading stiffness at H = 2.5 p)
+    worn = s.heights - r.plastic
+    elastic = solver.solve(worn, load=5e7, tol=1e-12)
+    assert np.array_equal(elastic.contact, r.contact)
+    d = elastic.approach
+    lo, hi = (solver.solve(worn, approach=d * (1 - e), tol=1e-13) for e in (1e-8, 0.0))
+    unloading = contact_stiffness(solver, r, unloading=True)
+    assert unloading.stiffness == pytest.approx((hi.mean_pressure - lo.mean_pressure) / (1e-8 * d), rel=1e-6)
+    assert unloading.stiffness > 2 * k.stiffness and np.all(unloading.increment[r.contact] > 0)
 
 
 def test_barbers_analogy_with_the_conduction_of_the_same_contact():

@@ -560,8 +560,10 @@ def solve_contact(heights, dx: float | None = None, kernel: Kernel | None = None
     """One-call form of ``ContactSolver(kernel, heights.shape[-2:], dx, dy, periodic).solve(...)``:
     ``heights`` [m] an array (..., ny, nx) with ``dx`` (``periodic`` True unless given), or a
     ``Surface``, whose pixel sizes and periodicity are taken (``solve_contact(s, kernel=k, load=p)``)."""
+    if isinstance(dx, Kernel):           # solve_contact(s, k, ...): it said the kernel was missing (a trial)
+        raise InputError("dx", dx, "a Kernel given as the pixel size: name it, solve_contact(heights, kernel=k, ...)")
     if kernel is None:
-        raise InputError("kernel", None, "a Kernel (e.g. HalfSpace(E, nu)) is required")
+        raise InputError("kernel", None, "a Kernel (e.g. HalfSpace.from_materials(E, nu)) is required")
     if isinstance(heights, Surface):
         given = {"dx": dx, "dy": dy, "periodic": periodic}
         if any(v is not None for v in given.values()):

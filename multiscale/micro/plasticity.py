@@ -7,7 +7,8 @@ deformation. Carried forward, the patch's topography becomes h − w (heights po
 so that
 
 - unloading follows the elastic law of the deformed surface (stiffer than the loading curve: the
-  flattened summits carry the load on a larger area), and leaves the residual deformation w;
+  flattened summits carry the load on a larger area; ``stiffness.contact_stiffness(...,
+  unloading=True)``), and leaves the residual deformation w;
 - reloading up to the previous maximum load is that same elastic curve and meets the loading
   curve there (the deformed surface pressed to the previous maximum carries exactly the
   elastic-plastic pressure field: on the yielded cells u + z + w − d = 0 with p = H);
