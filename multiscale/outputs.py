@@ -14,6 +14,8 @@ import re
 from dataclasses import dataclass
 from pathlib import Path
 
+from multiscale.geometry import Rotation
+
 CHECKPOINT = "checkpoint.h5"      # a multiscale run's last macro step (``multiscale run --resume``)
 # files of a run named without a body: a body of that name would write its fields over them
 OWN_FILES = {"interface": "interface.xdmf", "history": "history.h5", "zones": "zones.h5",
@@ -151,9 +153,11 @@ def plan(scene) -> Plan:
                 f"; {PART_ARRAY} ({parts[name]})" if name in parts else "")
             files[f"{name}.h5"] = f"data of {name}.xdmf"
     if kind == "squeal":
+        rotating = isinstance(scene.geometry.spec.motion, Rotation)
         files["modes.csv"] = ("frequency, growth rate, damping ratio (-sigma/|lambda|), unstable and potentially "
                               "unstable flags, flutter partner, relative residual in the full model and each component's "
-                              "strain-energy share of every mode")
+                              "strain-energy share of every mode" + (f"; the nodal diameters and out-of-plane share of "
+                                                                     f"{scene.bodies[1]}'s motion" if rotating else ""))
         files.update({f"modes_{b}.bp": f"mode shapes of {b} (VTX): real and imaginary parts, time = mode number"
                       for b in scene.bodies})
         files["pressure.png"] = "contact pressure on each interface at the preload"

@@ -22,6 +22,7 @@ from multiscale.geometry import builder  # noqa: E402
 from multiscale.macro import eigen, modal  # noqa: E402
 from multiscale.macro import mesh as two_body  # noqa: E402
 from multiscale.macro.mechanics import Mechanics  # noqa: E402
+from multiscale.macro.nodal_diameters import nodal_diameters  # noqa: E402
 from multiscale.macro.output import orientation, write_modes  # noqa: E402
 from multiscale.rough import interface_plane  # noqa: E402
 from multiscale import scene as scenes  # noqa: E402
@@ -196,7 +197,10 @@ def free_disc_frequencies(h, thickness):
     M = fpetsc.assemble_matrix(fem.form(m.rho * ufl.inner(u, v) * ufl.dx))
     K.assemble(), M.assemble()
     # free-free: 6 rigid modes at 0 Hz; a small positive target keeps K - theta_t M regular
-    return eigen.solve_modes(K, M, f_min=20.0, f_max=2000.0, target=20.0, n_modes=5).frequency
+    modes = eigen.solve_modes(K, M, f_min=20.0, f_max=2000.0, target=20.0, n_modes=5)
+    n = V.dofmap.index_map.size_local
+    shapes = nodal_diameters(V.tabulate_dof_coordinates()[:n], modes.modes.reshape(n, 3, -1), (0, 0, 1), (0, 0, 0))
+    return modes.frequency, shapes
 
 
 def test_free_free_disc_bending_converges_to_plate_theory():
@@ -206,7 +210,7 @@ def test_free_free_disc_bending_converges_to_plate_theory():
     D = m.E * t**3 / (12 * (1 - m.nu**2))
     scale = np.sqrt(D / (m.rho * t)) / (2 * np.pi * a * a)
     f2, f3 = (kirchhoff_annulus(n, b / a, m.nu) * scale for n in (2, 3))
-    runs = [free_disc_frequencies(h, t) for h in (0.032, 0.02, 0.012)]
+    runs, shapes = zip(*(free_disc_frequencies(h, t) for h in (0.032, 0.02, 0.012)))
     doublet = np.array([r[:2].mean() for r in runs])          # two nodal diameters
     assert all(abs(r[1] / r[0] - 1) < 2e-3 for r in runs)      # split only by the mesh
     steps = np.abs(np.diff(doublet))
@@ -214,6 +218,9 @@ def test_free_free_disc_bending_converges_to_plate_theory():
     # thick-plate effects (shear, rotary inertia) lower the 3D values by ~1 % (h/a = 0.06)
     assert -0.025 < doublet[-1] / f2 - 1 < 0.0
     assert -0.03 < runs[-1][2:4].mean() / f3 - 1 < 0.0            # three nodal diameters
+    for shape in shapes:                                           # as macro.nodal_diameters names them
+        assert list(shape.nodal_diameters[:4]) == [2, 2, 3, 3]
+        assert np.all(shape.out_of_plane[:4] > 0.98) and np.all(shape.share[:4] > 0.9)   # measured 0.990, 0.96
 
 
 # ---------------------------------------------------------------- preload and complex modes
@@ -424,6 +431,13 @@ def test_scene_run_writes_results_and_matches_the_direct_analysis(tmp_path, fric
             "energy.png", "brake.xdmf", "disc.xdmf", "interface.xdmf"} <= names and all(p.exists() for p in run.files)
     # same mesh, materials, 10 bar, mu = 0.4 as the direct analysis of the fixtures
     np.testing.assert_allclose(run.case.modes.frequency, friction.modes.frequency[:20], rtol=1e-6)
+    # the disc's nodal diameters and out-of-plane share per mode (an NVH trial had the energy shares alone)
+    table = np.genfromtxt(run.folder / "modes.csv", delimiter=",", names=True)
+    disc = run.case.disc
+    assert list(table["nodal_diameters_disc"]) == list(disc.nodal_diameters)
+    np.testing.assert_allclose(table["out_of_plane_share_disc"], disc.out_of_plane, atol=5e-4)
+    np.testing.assert_allclose(table["nodal_diameter_share_disc"], disc.share, atol=5e-4)
+    assert np.all((disc.share > 0) & (disc.share <= 1)) and np.all((disc.out_of_plane >= 0) & (disc.out_of_plane <= 1))
     with pytest.raises(InputError, match="output.folder"):
         squeal.run(scene, degree=1, verbose=False)
 

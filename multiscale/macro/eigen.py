@@ -100,24 +100,33 @@ class ModalResult:
         return self.eigenvalues.size
 
     def write_csv(self, path: str | Path, rtol: float = 1e-6, potentially_unstable=(), energy=None,
-                  partner=None) -> Path:
+                  partner=None, disc=None, body: str = "") -> Path:
         """Mode table: number, frequency [Hz], sigma [1/s], damping ratio, unstable flag, potentially
         unstable flag (mode numbers from 1, ``modal.StabilityReport``), the other half of a flutter
         pair (``partner``: its number per mode, 0 none; empty), residual; with ``energy``
-        (``modal.EnergyShares``) each component's share of the mode's strain energy."""
+        (``modal.EnergyShares``) each component's share of the mode's strain energy; with ``disc``
+        (``nodal_diameters.DiscShapes`` of the rotating ``body``) its nodal diameters, their share
+        and the out-of-plane share of its motion."""
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         close = set(int(m) for m in potentially_unstable)
-        names, shares = ([], np.zeros((len(self.frequency), 0))) if energy is None else (energy.names, energy.share)
+        n_modes = len(self.frequency)
+        names, shares = ([], np.zeros((n_modes, 0))) if energy is None else (energy.names, energy.share)
+        shapes = np.zeros((n_modes, 0)) if disc is None else np.column_stack(
+            [disc.nodal_diameters, disc.share, disc.out_of_plane])
         with path.open("w", newline="") as f:
             w = csv.writer(f)
             w.writerow(["mode", "frequency_Hz", "sigma_1_per_s", "damping_ratio", "unstable", "potentially_unstable",
-                        "flutter_partner", "residual", *(f"energy_share_{n}" for n in names)])
-            pairs = np.zeros(len(self.frequency), int) if partner is None else partner
-            for j, (fr, s, z, u, p, e, share) in enumerate(zip(self.frequency, self.growth, self.damping_ratio,
-                                                               self.unstable(rtol), pairs, self.errors, shares), start=1):
+                        "flutter_partner", "residual", *(f"energy_share_{n}" for n in names),
+                        *([] if disc is None else [f"nodal_diameters_{body}", f"nodal_diameter_share_{body}",
+                                                   f"out_of_plane_share_{body}"])])
+            pairs = np.zeros(n_modes, int) if partner is None else partner
+            for j, (fr, s, z, u, p, e, share, shape) in enumerate(zip(
+                    self.frequency, self.growth, self.damping_ratio, self.unstable(rtol), pairs, self.errors, shares,
+                    shapes), start=1):
                 w.writerow([j, f"{fr:.6f}", f"{s + 0.0:.6e}", f"{z + 0.0:.6e}", int(u), int(j in close),
-                            p or "", f"{e:.2e}", *(f"{v:.6f}" for v in share)])   # no -0
+                            p or "", f"{e:.2e}", *(f"{v:.6f}" for v in share),      # no -0
+                            *([f"{int(shape[0])}", f"{shape[1]:.3f}", f"{shape[2]:.3f}"] if disc is not None else [])])
         return path
 
 

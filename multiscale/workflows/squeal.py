@@ -39,6 +39,7 @@ from mpi4py import MPI
 
 from multiscale import io, outputs
 from multiscale.errors import InputError
+from multiscale.geometry import Rotation
 from multiscale.macro.damped import SPURIOUS, PrestressEffect, prestress_effect, solve_system
 from multiscale.macro.eigen import Damping, ModalResult
 from multiscale.macro.friction import ConstantFriction, set_friction
@@ -46,6 +47,7 @@ from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.mechanics import Mechanics
 from multiscale.macro.modal import CLOSE, EnergyShares, RegionEnergy, StabilityReport, stability_report, \
     strain_energy_shares
+from multiscale.macro.nodal_diameters import DiscShapes, nodal_diameters
 from multiscale.macro.output import write_modes, write_state
 from multiscale.macro.preload import Preload, linearise_system, preload
 from multiscale.macro.stability_map import StabilityMap
@@ -95,6 +97,7 @@ class SquealCase:
     prestress: PrestressEffect | None = None    # the frequencies without the prestress stiffness
     terms: tuple = ()                           # parts of the linearised system beyond K and M
     slip_speed: np.ndarray | None = None        # m/s, per facet: what the mu(v) laws read (with laws)
+    disc: DiscShapes | None = None              # nodal diameters of the rotating body's motion (a rotation)
 
 
 def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "case", *, load: float = 1e6,
@@ -132,7 +135,29 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
     with io.stage("strain energy per component"):
         shares = strain_energy_shares(modes, RegionEnergy(mech)) if energy else None
     return SquealCase(name, pre, modes, stability_report(modes, rtol, close_tol), shares,
-                      mech.contact.facet_pressure(), mech, effect, lin.terms, slip)
+                      mech.contact.facet_pressure(), mech, effect, lin.terms, slip, disc_shapes(mech, modes))
+
+
+def mode_name(case: SquealCase, j: int) -> str:
+    """Mode ``j`` (1-based) by its frequency and, on a rotating body, its nodal diameters, e.g.
+    "4321 Hz: 5 ND out-of-plane" (the disc's motion mostly along its axis) or "in-plane"."""
+    name = f"{case.modes.frequency[j - 1]:.0f} Hz"
+    if case.disc is None:
+        return name
+    plane = "out-of-plane" if case.disc.out_of_plane[j - 1] >= 0.5 else "in-plane"
+    return f"{name}: {case.disc.nodal_diameters[j - 1]} ND {plane}"
+
+
+def disc_shapes(mech: Mechanics, modes: ModalResult) -> DiscShapes | None:
+    """``macro.nodal_diameters`` of the modes on the moving body (body 1) about its rotation axis;
+    None if it translates."""
+    motion = mech.tm.spec.motion
+    if not isinstance(motion, Rotation):
+        return None
+    before, own = (f.x.index_map.size_local * 3 for f in mech.u)
+    points = mech.spaces[1].tabulate_dof_coordinates()[:own // 3]
+    return nodal_diameters(points, modes.modes[before:before + own].reshape(own // 3, 3, -1), motion.axis,
+                           motion.centre, mech.tm.comm)
 
 
 def friction_laws(scene, tm) -> dict | None:
@@ -375,7 +400,8 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
             rep = case.report
             files += io.on_root(comm, lambda: [case.modes.write_csv(folder / "modes.csv", rep.rtol,
                                                                    rep.potentially_unstable, case.energy,
-                                                                   rep.flutter_partner)],
+                                                                   rep.flutter_partner, case.disc,
+                                                                   tm.bodies[1].name)],
                                 f"{folder / 'modes.csv'}") or []
             files += write_modes(folder, case.modes, case.mech.u, [b.name for b in tm.bodies])
             split = energy_split(tm)
@@ -404,7 +430,7 @@ def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = 
         rep = case.report
         print(f"{scene.name}: {io.counted(len(case.modes), 'mode')} up to {case.modes.frequency.max():.0f} Hz, "
               f"{rep.unstable.size} unstable"
-              + (f" ({', '.join(f'{f:.0f} Hz' for f in rep.frequency[rep.unstable - 1])})" if rep.unstable.size else "")
+              + (f" ({', '.join(mode_name(case, j) for j in rep.unstable)})" if rep.unstable.size else "")
               + f", {rep.potentially_unstable.size} potentially unstable; {result.wall_time:.1f} s on "
               f"{io.counted(comm.size, 'rank')}")
         moment = case.preload.friction_moment       # (in no file, and not said: a user trial)

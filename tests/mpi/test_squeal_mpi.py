@@ -1,4 +1,5 @@
-"""Squeal analysis on 2 ranks equals the serial one (preload forces, complex modes, MAC, energies)."""
+"""Squeal analysis on 2 ranks equals the serial one (preload forces, complex modes, MAC, energies,
+the disc's nodal diameters)."""
 import sys
 import tempfile
 from pathlib import Path
@@ -46,6 +47,8 @@ def test_two_ranks_reproduce_the_serial_squeal_analysis():
     np.testing.assert_allclose(got["forces"], ref["forces"], rtol=1e-10)
     np.testing.assert_allclose(got["energy"], ref["energy"], atol=1e-6)
     assert got["unstable"] == ref["unstable"]
+    assert got["nodal_diameters"] == ref["nodal_diameters"]           # the disc's, over the ranks' nodes
+    np.testing.assert_allclose(got["out_of_plane"], ref["out_of_plane"], atol=1e-6)
     # the written shapes' signs (``orientation``) are the partition's no more: a signed sum with another
     # weight agrees (the eigensolver's own signs differed in 6 of these 20 modes)
     np.testing.assert_allclose(got["signed"], ref["signed"], rtol=1e-5, atol=1e-9 * np.abs(ref["signed"]).max())
@@ -94,7 +97,8 @@ def _summary(c):
     weight = np.cos(x @ np.array([13.2, -32.4, 54.8]) + 0.7 * (np.arange(len(x)) % 3))
     signed = orientation(modes, u, sizes) * c.mech.tm.comm.allreduce(weight @ modes.real)
     return {"eigenvalues": c.modes.eigenvalues, "forces": list(c.preload.normal_force.values()),
-            "energy": c.energy.share, "unstable": c.report.unstable.tolist(), "signed": signed}
+            "energy": c.energy.share, "unstable": c.report.unstable.tolist(), "signed": signed,
+            "nodal_diameters": c.disc.nodal_diameters.tolist(), "out_of_plane": c.disc.out_of_plane}
 
 
 def test_the_quadratic_modes_with_a_rank_that_owns_no_row():
