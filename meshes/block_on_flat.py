@@ -55,6 +55,7 @@ def describe(params=None) -> GeometrySpec:
         length_scale=max(p["length"], p["width"], p["height"]),
         symmetry={"symmetry_x": (1.0, 0.0, 0.0), "symmetry_y": (0.0, 1.0, 0.0)},
         interface_extents={"interface": (p["length"], p["width"])},      # the block's footprint
+        interface_areas={"interface": p["length"] * p["width"]},
         load_areas={"block_top": p["length"] * p["width"]},
         interface_sizes={"interface": p["interface_mesh_size"]},
         report=(f"a quarter model of a {2e3 * p['length']:.4g} x {2e3 * p['width']:.4g} mm block (symmetry planes "

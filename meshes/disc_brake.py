@@ -142,6 +142,8 @@ def describe(params=None) -> GeometrySpec:
         fluid_load=True,                          # the hydraulic pressure on piston and caliper bore
         interface_regions={"inner_pad": "inner_pad", "outer_pad": "outer_pad"},
         interface_extents=dict.fromkeys(("inner_pad", "outer_pad"), _pad_extent(p)),
+        interface_areas=dict.fromkeys(("inner_pad", "outer_pad"),            # the annular sector
+                                      p["pad_angle"] / 2 * (p["pad_outer_radius"] ** 2 - p["pad_inner_radius"] ** 2)),
         interface_sizes=dict.fromkeys(("inner_pad", "outer_pad"), p["pad_mesh_size"]),
         load_areas=dict.fromkeys(("piston_back", "caliper_bore"), math.pi * p["piston_radius"] ** 2),
         report=(f"piston and bore discs of radius {p['piston_radius'] * 1e3:.4g} mm: a pressure's force is given "

@@ -87,6 +87,7 @@ def describe(params=None) -> GeometrySpec:
                                      ("pin", min(p["pin_size"], p["pin_height"]), p["holder_mesh_size"]),
                                      ("plate", p["plate_thickness"], p["holder_mesh_size"])])),
         interface_extents={"interface": (p["pin_size"], p["pin_size"])},
+        interface_areas={"interface": p["pin_size"] ** 2},
         interface_sizes={"interface": p["interface_mesh_size"]},
         load_areas={"plate_ends": 2 * p["plate_width"] * p["plate_thickness"]},   # (a pressure acts there)
     )

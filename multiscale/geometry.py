@@ -117,6 +117,8 @@ class GeometrySpec:
     interface_extents: Mapping[str, tuple] = field(default_factory=dict)   # planar interface -> size
     #                                    (u, v) [m] of its face in its plane's frame (``plane_extent``),
     #                                    known before meshing (absent: known from the mesh only)
+    interface_areas: Mapping[str, float] = field(default_factory=dict)   # interface -> its face's area
+    #                                    [m^2], known before meshing (absent: known from the mesh only)
     interface_sizes: Mapping[str, float] = field(default_factory=dict)   # interface -> element size [m]
     #                                    the mesher aims at on it (absent: unknown before meshing)
     load_areas: Mapping[str, float] = field(default_factory=dict)   # load face -> the area [m^2] whose

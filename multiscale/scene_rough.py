@@ -216,17 +216,28 @@ def micro_constants(scene) -> list[str]:
     return out
 
 
-def nominal_pressure(scene) -> tuple[float, float] | None:
+def nominal_pressure(scene, areas: bool = False) -> tuple[float, float] | None:
     """(A lower bound of the interfaces' nominal pressure [Pa] at the load profile's largest factor,
     that factor): ``loading.normal_force`` times the factor over the interfaces' extents' boxes,
-    which cover them; None without a normal force or a box (the run divides by the meshed areas)."""
+    which cover them; None without a normal force or a box (the run divides by the meshed areas).
+    With ``areas``, over the faces' own areas where the geometry knows them all (``contact_area``):
+    the pressure itself (a rotated pad's box was 1.8 times its area: a trial)."""
     force = getattr(scene.loading, "normal_force", None) if scene.loading is not None else None
     spec = scene.geometry.spec if scene.geometry is not None else None
     boxes = [spec.interface_extents.get(n) for n in spec.interfaces] if spec is not None else [None]
-    if not force or None in boxes:
+    area = contact_area(scene) if areas else None
+    if not force or (None in boxes and area is None):
         return None
     factor = largest_load_factor(scene.loading, scene.time.end or 0.0)
-    return factor * force / sum(a * b for a, b in boxes), factor
+    return factor * force / (area or sum(a * b for a, b in boxes)), factor
+
+
+def contact_area(scene) -> float | None:
+    """The interfaces' area [m^2] before meshing, where the geometry knows every face's
+    (``GeometrySpec.interface_areas``); None otherwise."""
+    spec = scene.geometry.spec if scene.geometry is not None else None
+    areas = [spec.interface_areas.get(n) for n in spec.interfaces] if spec is not None else [None]
+    return None if None in areas else float(sum(areas))
 
 
 def _over_them(factor: float) -> str:

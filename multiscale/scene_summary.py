@@ -13,7 +13,7 @@ from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
 from multiscale.scene_friction import FRICTION, bare_interfaces
 from multiscale.scene_geometry import GeometrySection, scene_spec
-from multiscale.scene_rough import default_p_max, nominal_pressure, scene_surface_used
+from multiscale.scene_rough import contact_area, default_p_max, nominal_pressure, scene_surface_used
 from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR, P_MAX_PLASTIC
 from multiscale.errors import InputError
 from multiscale.schema import Named, Section, fields_of, suggest
@@ -109,10 +109,13 @@ def summary(scene: Scene) -> list[str]:
     where = _load_faces(scene)
     profile = f", load profile of {len(ld.load_profile)} points" if ld.load_profile else ""
     lines.append(f"  loading   {load_text}{where}, {motion}{profile}, {ld.ramp_steps} ramp step(s)")
-    if (bound := nominal_pressure(scene)) is not None:      # (an engineer's first number: said nowhere, a trial)
+    if (bound := nominal_pressure(scene, areas=True)) is not None:   # (an engineer's first number: a trial)
         at = f" at the load profile's largest factor {bound[1]:.3g}" if bound[1] != 1 else ""
-        lines.append(f"            nominal contact pressure {bound[0] / 1e6:.4g} MPa{at} (the force over the "
-                     "interfaces' extents; the run divides by their meshed areas)")
+        area = contact_area(scene)
+        over = f"the force over the interfaces' {area * 1e6:.6g} mm^2" if area else \
+            "at least: the force over the boxes around the interfaces"      # (said as the pressure: a trial)
+        lines.append(f"            nominal contact pressure {bound[0] / 1e6:.4g} MPa{at} ({over}; the run divides "
+                     "by their meshed areas)")
     if v is not None and ld.torque is not None and ld.braking_torque is None:   # (said nowhere before: a user trial)
         force = "m a" if v.deceleration else f"m g sin(atan {v.slope:g})"
         lines.append(f"            braking torque {ld.torque:.4g} N m at the {g.bodies[1]}: braking force {force} = "

@@ -460,8 +460,12 @@ def test_multiscale_run_hands_stability_scenes_to_the_squeal_analysis(tmp_path, 
 
 def test_the_pads_extent_before_meshing_is_the_meshs(brake):
     """The extent of each pad's face in its plane that `check` compares a measured surface with
-    (``describe``, before meshing) is the one a run's zones cover (the mesh's), to 1e-9."""
-    extents = disc_brake.describe(COARSE).interface_extents
+    (``describe``, before meshing) is the one a run's zones cover (the mesh's), to 1e-9; its area,
+    over which check says the nominal pressure, the meshed facets' to the arcs' chords."""
+    spec = disc_brake.describe(COARSE)
+    masks = brake[0].interface.masks()
     for name in ("inner_pad", "outer_pad"):
         _, lo, hi = interface_plane(brake[0], name)
-        np.testing.assert_allclose(hi - lo, extents[name], rtol=1e-9)
+        np.testing.assert_allclose(hi - lo, spec.interface_extents[name], rtol=1e-9)
+        meshed = brake[0].interface.areas[masks[name]].sum()
+        assert meshed == pytest.approx(spec.interface_areas[name], rel=1e-3)   # the arcs' chords: 1.5e-4

@@ -18,6 +18,7 @@ from multiscale.errors import InputError, SceneError  # noqa: E402
 from multiscale.geometry import MAX_CELLS, check_cells, estimate_cells, gmsh_session  # noqa: E402
 from multiscale.provenance import resolved_toml  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
+from multiscale.scene_summary import summary  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 
 SIZES = {"mesh_size": 0.015, "holder_mesh_size": 0.006, "interface_mesh_size": 0.0025}
@@ -1104,9 +1105,14 @@ penalty = "1e13 Pa/m"
 faces = ["back"]
 normal_force = "100 N"
 """
-    spec = loads(text, tmp_path).geometry.spec
+    scene = loads(text, tmp_path)
+    spec = scene.geometry.spec
     assert spec.interface_extents.keys() == {"pad"}
     np.testing.assert_allclose(spec.interface_extents["pad"], (0.02, 0.03), rtol=1e-9)
+    # check's nominal pressure is the force over the face's area, 100 N / 600 mm^2 (over a box of a
+    # rotated pad it was 1.8 times too low, said as the pressure: a trial)
+    assert spec.interface_areas["pad"] == pytest.approx(6e-4, rel=1e-9)
+    assert "nominal contact pressure 0.1667 MPa (the force over the interfaces' 600 mm^2" in "\n".join(summary(scene))
 
 
 def test_a_pad_off_the_disc_is_named_by_check(tmp_path, capsys):
