@@ -358,3 +358,13 @@ def test_the_speed_of_a_cycle_is_drawn(tmp_path, drawn):
         plots.history_figure(history, tmp_path / "history.png")
         axes = {ax.get_ylabel(): ax for ax in drawn[-1].axes if ax.get_visible()}
         np.testing.assert_allclose(axes[label].get_lines()[0].get_ydata(), np.array([80.0, 40.0, 0.0]) * factor)
+
+
+def test_interface_names_ending_in_in_keep_their_names():
+    """A brake's pads named padA_in / padA_out (a trial): the face-temperature legend read
+    "padA, on fixed material" (the name split at "_in_" as a body's material)."""
+    assert plots.column_label("face_max_temperature_padA_in_on_fixed") == "padA in on fixed"
+    assert plots.column_label("face_max_temperature_inner_pad_on_disc") == "inner pad on disc"
+    assert plots.column_label("max_temperature_fixed_part_padA_in") == "padA in"
+    assert plots.column_label("max_temperature_pin_in_disc") == "pin, disc material"
+    assert plots.column_label("frictional_heat_total_padA_in") == "padA in"

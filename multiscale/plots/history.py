@@ -36,12 +36,17 @@ def column_label(key: str) -> str:
     as in multiscale.png: "all" clashed with an interface of that name)."""
     if key == "friction_coefficient":
         return "all interfaces"
+    face = key.startswith("face_max_temperature_")
     for prefix in ("max_temperature_", "heat_total_", "heat_conducted_total_", "stored_heat_", "heat_lost_total_",
                    "frictional_heat_total_", "face_max_temperature_", "friction_coefficient_"):
         key = key.removeprefix(prefix)
     key = key.partition("_part_")[2] or key
-    body, within, material = key.partition("_in_")
-    return body.replace("_", " ") + (f", {material.replace('_', ' ')} material" if within else "")
+    words = lambda name: name.replace("_", " ")
+    if face:                      # (split at "_in_" first: "padA_in_on_fixed" was "padA, on fixed material", a trial)
+        interface, _, body = key.rpartition("_on_")
+        return f"{words(interface)} on {words(body)}"
+    body, within, material = key.rpartition("_in_")
+    return f"{words(body)}, {words(material)} material" if within else words(key)
 
 
 def temperature_columns(columns) -> list[str]:
