@@ -592,9 +592,8 @@ def _spec(g, found: Found) -> GeometrySpec:
         interfaces={n: 1001 + k for k, n in enumerate(found.interfaces)},
         faces={n: 2001 + k for k, n in enumerate(found.surfaces)},
         supports=(), load_faces=(), motion=Rotation(tuple(g.axis), tuple(g.centre)), load_areas=found.flat_areas,
-        length_scale=found.extent, fluid_load=True,
+        length_scale=found.extent, fluid_load=True, interface_areas=dict(found.areas),
         interface_normals=dict(found.normals), interface_extents=dict(found.extents), report=tuple(report),
-        interface_areas=dict(found.areas),
         interface_sizes=found.sizes if g.kind == "mesh" else
         dict.fromkeys(found.interfaces, min(g.mesh_size, g.interface_mesh_size or g.mesh_size)),
         warnings=tuple(found.loose), element_size=found.cell_size if g.kind == "mesh" else g.mesh_size,
