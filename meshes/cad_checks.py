@@ -1,13 +1,13 @@
 """Checks of the bodies of an OpenCASCADE geometry file (``meshes.from_file``) against the scene's
 [geometry]: the rotating body one of revolution about its axis (``check_revolution``, by the mass
-properties ``inertia``), bodies not much thinner than their elements (``thin_bodies``), bodies
+properties ``inertia``; the share of its surface its rotation crosses, ``crossed_share``), bodies not much thinner than their elements (``thin_bodies``), bodies
 that nearly touch the rotating one (``near_misses``)."""
 from __future__ import annotations
 
 import numpy as np
 
 from multiscale.errors import InputError
-from multiscale.geometry import thin_warning
+from multiscale.geometry import CROSSES, thin_warning
 
 REVOLUTION = 1e-3           # the rotating body's centre of mass off its axis (of its extent), its axis of inertia (rad)
 EQUAL_MOMENTS = 0.01        # principal moments of inertia this close (of the largest) are those of a body of revolution
@@ -64,6 +64,34 @@ def near_misses(model, g, bodies: dict, pairs: dict, extent: float, named=()) ->
                        f"face with it: no contact interface there, no load or heat through it (a pad in its "
                        f"released position? a pad must share a face with {g.rotating} in the file)")
     return out
+
+
+def surface_samples(model, face: int, count: int) -> tuple[np.ndarray, np.ndarray]:
+    """Points and normals of a face's surface on a ``count`` x ``count`` grid of its parameter
+    range, from 0.1 to 0.9 of it along each parameter."""
+    lo, hi = (np.asarray(b, dtype=float) for b in model.getParametrizationBounds(2, face))
+    t = np.linspace(0.1, 0.9, count)
+    uv = np.array([[a, b] for a in lo[0] + t * (hi[0] - lo[0]) for b in lo[1] + t * (hi[1] - lo[1])]).ravel()
+    return np.reshape(model.getValue(2, face, uv), (-1, 3)), np.reshape(model.getNormal(face, uv), (-1, 3))
+
+
+def crossed_share(model, g, volumes) -> float:
+    """The share of the area of the rotating body's ``volumes`` (tags; the model in m) whose surface
+    its rotation crosses: a face is crossed where |w.n| > ``CROSSES`` |w| at most of a 5 x 5 grid
+    of its parametric points (w = e x (x - c); anywhere on its surface, even outside its trimmed
+    face: a plane normal to the axis or a coaxial cylinder is never crossed, a vane's side is).
+    Vanes, holes and slots are crossed; the heat problem needs none (``macro.thermal``)."""
+    e = np.asarray(g.axis, dtype=float) / np.linalg.norm(g.axis)
+    crossed = total = 0.0
+    for _, f in model.getBoundary([(3, v) for v in volumes], combined=True, oriented=False):
+        x, n = surface_samples(model, f, 5)
+        w = np.cross(e, x - np.asarray(g.centre, dtype=float))
+        speed = np.linalg.norm(w, axis=1)
+        cos = np.abs((w * n).sum(axis=1))[speed > 0] / speed[speed > 0]
+        area = model.occ.getMass(2, f)
+        total += area
+        crossed += area if cos.size and np.median(cos) > CROSSES else 0.0
+    return crossed / total if total > 0 else 0.0
 
 
 def check_revolution(g, volumes: list[tuple]) -> None:

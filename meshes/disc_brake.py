@@ -144,6 +144,7 @@ def describe(params=None) -> GeometrySpec:
         interface_extents=dict.fromkeys(("inner_pad", "outer_pad"), _pad_extent(p)),
         interface_areas=dict.fromkeys(("inner_pad", "outer_pad"),            # the annular sector
                                       p["pad_angle"] / 2 * (p["pad_outer_radius"] ** 2 - p["pad_inner_radius"] ** 2)),
+        crossed=_vane_share(p),
         interface_sizes=dict.fromkeys(("inner_pad", "outer_pad"), p["pad_mesh_size"]),
         load_areas=dict.fromkeys(("piston_back", "caliper_bore"), math.pi * p["piston_radius"] ** 2),
         report=(f"piston and bore discs of radius {p['piston_radius'] * 1e3:.4g} mm: a pressure's force is given "
@@ -152,6 +153,14 @@ def describe(params=None) -> GeometrySpec:
                                       p["mesh_size"]), ("pads", p["pad_thickness"], p["pad_mesh_size"]),
                                      ("backplates", p["backplate_thickness"], p["pad_mesh_size"])])),
     )
+
+
+def _vane_share(p) -> float:
+    """The share of the disc's surface that its rotation crosses: the vanes' sides over them and
+    the ring's four faces (cheeks outside and inside; the hat left out: an estimate), 0 solid."""
+    R, ri = p["disc_outer_radius"], p["ring_inner_radius"]
+    sides = 2 * p["vanes"] * (R - ri) * (p["disc_thickness"] - 2 * p["cheek_thickness"])
+    return sides / (sides + 4 * math.pi * (R * R - ri * ri))
 
 
 def _pad_extent(p) -> tuple[float, float]:

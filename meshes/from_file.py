@@ -87,6 +87,7 @@ class Found:
     loose: list = field(default_factory=list)        # warnings: fixed bodies that touch no interface, thin ones
     size_factor: float = 1.0                         # a script's own Mesh.MeshSizeFactor (SIZE_FACTOR)
     unit: tuple = (1.0, "")                          # m per unit of the file's numbers, where it comes from
+    crossed: float | None = None                     # OpenCASCADE: the rotating body's share crossed by its rotation
 
 
 def parameters(params) -> dict:
@@ -265,6 +266,7 @@ def _load(model, g) -> Found:
         found.loose += cad_checks.near_misses(model, g, found.bodies, found.pairs, found.extent,
                                               loose_bodies(found.loose))
         cad_checks.check_revolution(g, [inertia[v] for v in bodies[g.rotating]])
+        found.crossed = cad_checks.crossed_share(model, g, bodies[g.rotating])
     return found
 
 
@@ -429,11 +431,7 @@ def _coplanar(model, faces: list[int]) -> bool:
 def _flat(model, face: int):
     """(unit normal, a point) of a flat face, or None: normals and points sampled over the face's
     parameter range (a scaled CAD face is a B-spline surface, so its type says nothing)."""
-    lo, hi = (np.asarray(b, dtype=float) for b in model.getParametrizationBounds(2, face))
-    t = np.linspace(0.1, 0.9, 4)
-    uv = np.array([[a, b] for a in lo[0] + t * (hi[0] - lo[0]) for b in lo[1] + t * (hi[1] - lo[1])]).ravel()
-    n = np.reshape(model.getNormal(face, uv), (-1, 3))
-    x = np.reshape(model.getValue(2, face, uv), (-1, 3))
+    x, n = cad_checks.surface_samples(model, face, 4)
     n0 = n[0] / np.linalg.norm(n[0])
     size = max(np.ptp(x, axis=0).max(), np.finfo(float).tiny)
     if np.all(np.abs(n @ n0) / np.linalg.norm(n, axis=1) > 1 - 1e-9) and np.abs((x - x[0]) @ n0).max() <= 1e-9 * size:
@@ -592,7 +590,7 @@ def _spec(g, found: Found) -> GeometrySpec:
         interfaces={n: 1001 + k for k, n in enumerate(found.interfaces)},
         faces={n: 2001 + k for k, n in enumerate(found.surfaces)},
         supports=(), load_faces=(), motion=Rotation(tuple(g.axis), tuple(g.centre)), load_areas=found.flat_areas,
-        length_scale=found.extent, fluid_load=True, interface_areas=dict(found.areas),
+        length_scale=found.extent, fluid_load=True, interface_areas=dict(found.areas), crossed=found.crossed,
         interface_normals=dict(found.normals), interface_extents=dict(found.extents), report=tuple(report),
         interface_sizes=found.sizes if g.kind == "mesh" else
         dict.fromkeys(found.interfaces, min(g.mesh_size, g.interface_mesh_size or g.mesh_size)),

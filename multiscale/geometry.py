@@ -74,6 +74,9 @@ class Rotation:
         return np.cross(e, np.asarray(points, dtype=float) - np.asarray(self.centre, dtype=float))
 
 
+CROSSES = 0.5     # |w.n|/|w| above which a rotation w crosses a surface (vanes, holes: ``macro.mesh.crossing``)
+
+
 @dataclass(frozen=True)
 class Translation:
     """Rigid translation of body 1 along the unit vector ``direction``: w = v e [m/s]."""
@@ -119,6 +122,8 @@ class GeometrySpec:
     #                                    known before meshing (absent: known from the mesh only)
     interface_areas: Mapping[str, float] = field(default_factory=dict)   # interface -> its face's area
     #                                    [m^2], known before meshing (absent: known from the mesh only)
+    crossed: float | None = None       # share of the rotating body's surface area that its rotation crosses
+    #                                    (vanes, holes: > 0; a body of revolution: 0), None: known from the mesh only
     interface_sizes: Mapping[str, float] = field(default_factory=dict)   # interface -> element size [m]
     #                                    the mesher aims at on it (absent: unknown before meshing)
     load_areas: Mapping[str, float] = field(default_factory=dict)   # load face -> the area [m^2] whose

@@ -392,6 +392,11 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                                 f'"{g.bodies[0]}" (zones do not move)')
         if "contact" not in effects and not any("contact" in EFFECTS[e].requires for e in effects):
             problems.append(f'effects: {where} is a macro contact model: add effect "contact"')
+        if "thermal" in effects and g.motion == "rotation" and (g.spec.crossed or 0.0) > 0:   # (after meshing: a trial)
+            problems.append(f'effects: "thermal" solves the heat of {g.bodies[1]} in a fixed frame, which needs a body of '
+                            f"revolution, but its rotation crosses {100 * g.spec.crossed:.2g} % of its surface (vanes, holes, "
+                            f"slots): fill them{' (geometry.vanes = 0)' if 'vanes' in g.resolved() else ' in the geometry'}"
+                            ' or run without effect "thermal"')
         if "thermal" in effects and g.motion != "rotation" and (scene.loading is not None
                                                                and scene.loading.sliding_speed):
             problems.append(f'loading.sliding_speed = {scene.loading.sliding_speed:g} m/s: heat transport needs a '

@@ -28,7 +28,7 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from multiscale.errors import InputError, MultiscaleError
-from multiscale.geometry import BodySpec, GeometrySpec, check_cells, gmsh_session
+from multiscale.geometry import CROSSES, BodySpec, GeometrySpec, check_cells, gmsh_session
 from multiscale.macro.coverage import coverage_notes, face_coverage
 from multiscale.held import check_held
 
@@ -36,7 +36,6 @@ from multiscale.held import check_held
 INTERFACE_QUADRATURE = 2      # exact for P1 displacements times P1 tests on a facet
 
 
-CROSSES = 0.5     # |w.n|/|w| above which the rotation crosses a boundary facet (Body.crossing)
 
 
 @dataclass

@@ -300,7 +300,7 @@ class Thermal:
                                  f"(weighted by speed; e.g. at r = {r * 1e3:.1f} mm, point "
                                  f"{np.round(c.where * 1e3, 1).tolist()} mm: vanes, holes or slots). Its heat "
                                  "problem is solved in a fixed (Eulerian) frame, which needs a surface of "
-                                 "revolution: fill the holes and vanes of the geometry (e.g. geometry.vanes = 0) "
+                                 "revolution: fill the holes and vanes of the geometry (a built disc: geometry.vanes = 0) "
                                  "for the thermal effects, or run without effect \"thermal\"")
         speed = float(self.contact.speed.value)
         if not self.transport and speed != 0.0:
