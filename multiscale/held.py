@@ -257,8 +257,9 @@ class Holding:
         return region, (f"{len(loose)} part(s) could move as rigid bodies (one of region {P.where(first, names)}: "
                         f"{', '.join(motions)}{along})"), False
 
-    def refusal(self, names) -> InputError | None:
-        """The error naming the parts with a free motion and what it is (None: every part held)."""
+    def refusal(self, names, causes=None) -> InputError | None:
+        """The error naming the parts with a free motion and what it is (None: every part held); with
+        ``causes`` (region -> what check warned of it, ``geometry.loose_bodies``) that cause first."""
         found = self.free(names)
         if found is None:
             return None
@@ -266,6 +267,9 @@ class Holding:
         if untouched:
             return InputError("geometry", region, f"{what}: they could move freely; remove them from the geometry "
                                                   "or hold them ([[boundary]] fix)")
+        cause = (causes or {}).get(region)
+        if cause:                # its real cause, warned of at check (a user trial fixed the sides, as it advised;
+            return InputError("geometry", region, f"{what}, likely because {cause}")   # a later one saw z free)
         return InputError("geometry", region,
                           f"{what}: nothing holds them there; a support holds the components it fixes on its face, "
                           "an interface only along its normal, and friction does not hold: add a [[boundary]] fix that "
@@ -314,11 +318,8 @@ def check_held(model, spec: GeometrySpec, sliding: bool = False) -> dict[str, st
     holding.supports(spec)
     shares = holding.interfaces(spec, sliding)
     names = {r.tag: r.name for b in spec.bodies for r in b.regions}
-    error = holding.refusal(names)
+    error = holding.refusal(names, loose_bodies(spec.warnings))
     if error is None:
         alone = {name: holding.free(names, share) for name, share in shares.items()}
         return {name: f"without it {found[1]}" for name, found in alone.items() if found is not None}
-    apart = loose_bodies(spec.warnings).get(error.value)
-    if apart:                # its real cause, warned of at check (a user trial fixed the sides, as it advised)
-        raise InputError(error.name, error.value, f"{error.allowed}. Its cause is likely what check warned: {apart}")
     raise error
