@@ -175,7 +175,7 @@ def test_the_micro_patch_tutorial_runs_and_gives_the_numbers_it_quotes(capsys):
     assert 1e6 * r.approach == pytest.approx(approach, abs=5e-4)       # quoted to 1e-3 um
     assert 100 * r.area_fraction == pytest.approx(area, abs=5e-3)      # quoted to 0.01 %
     assert r.iterations == iterations
-    block = re.search(r"\.\. code-block:: python\n\n((?:    .*\n|\n)+)", text[text.index("contact_stiffness`:"):]).group(1)
+    block = re.search(r"\.\. code-block:: python\n\n((?:    .*\n|\n)+)", text[text.index("contact_stiffness`;"):]).group(1)
     exec("\n".join(line[4:] for line in block.splitlines()), scope)
     stiffness = float(re.search(r"It gives (\S+) MPa/µm", text).group(1))
     assert 1e-12 * scope["k"].stiffness == pytest.approx(stiffness, abs=5e-4)   # quoted to 1e-3 MPa/um

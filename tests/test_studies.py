@@ -958,7 +958,7 @@ def test_a_measured_surface_is_a_micro_study_problem(tmp_path, capsys):
     from multiscale.schema import Context
     from multiscale.studies.problems import PROBLEMS
     shutil.copy(ROOT / "tests" / "data" / "top-1.top", tmp_path / "afm.top")
-    path = write(tmp_path, 'problem = "measured_contact"\nmetrics = ["approach", "area_fraction", "stiffness"]\n[fixed]\n'
+    path = write(tmp_path, 'problem = "measured_contact"\nmetrics = ["approach", "area_fraction", "stiffness", "interface_stiffness"]\n[fixed]\n'
                            'file = "afm.top"\n[sweep]\nload = ["1 MPa", "5 MPa"]\n[run]\nprocesses = 1\n'
                            "[report]\nplots = false\n")
     problem = PROBLEMS["measured_contact"]
@@ -975,6 +975,7 @@ def test_a_measured_surface_is_a_micro_study_problem(tmp_path, capsys):
             assert h5["approach"][k] == pytest.approx(r.approach, rel=1e-12)
             assert h5["area_fraction"][k] == pytest.approx(r.area_fraction, rel=1e-12) and r.area_fraction > 0
         assert h5["stiffness"].attrs["unit"] == "Pa/m" and 0 < h5["stiffness"][0] < h5["stiffness"][1]
+        assert np.all(h5["interface_stiffness"][()] > h5["stiffness"][()])     # the patch's spreading out
 
 
 def test_an_asperity_model_beyond_its_range_is_said_by_the_run(tmp_path):

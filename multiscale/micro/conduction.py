@@ -170,7 +170,7 @@ class ConductionSolver:
                 initial_flux = np.broadcast_to(initial_flux, mask.shape)
             except ValueError:
                 raise InputError("initial_flux.shape", initial_flux.shape, f"must broadcast to {mask.shape}") from None
-        phi, its, res, ok = masked_cg(self.series, mask, dtheta, tol, max_iter, initial_flux, diagonal=R)
+        phi, its, res, ok = masked_cg(self.series, dtheta, mask, tol, max_iter, initial_flux, diagonal=R)
         if not np.all(np.isfinite(phi)):
             raise ConductionConvergenceError("conduction CG produced non-finite fluxes", [], None)
         T1phi = self.body_1(phi)

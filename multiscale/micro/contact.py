@@ -102,6 +102,7 @@ class ContactResult:
     residual: np.ndarray
     converged: np.ndarray
     history: list = field(default_factory=list, repr=False)
+    grid: tuple | None = field(default=None, repr=False)   # (dx, dy, periodic) of the solver that solved it
 
 
 class ContactConvergenceError(ConvergenceError):
@@ -172,6 +173,11 @@ class ContactSolver:
         self._coarse: ContactSolver | None = None             # the half-resolution solver of the nested start
         self._pool: ThreadPoolExecutor | None = None
         self._pool_threads = 0
+
+    @property
+    def grid(self) -> tuple:
+        """(dx, dy, periodic): what a ``ContactResult`` of this solver records of its grid."""
+        return self.operator.dx, self.operator.dy, self.periodic
 
     def _heights_of(self, surface: Surface) -> np.ndarray:
         """The heights of ``surface`` (m), refused unless it lies on this solver's grid: its shape,
@@ -281,7 +287,7 @@ class ContactSolver:
         result = ContactResult(flat, flat.copy(), z.copy(), flat != 0, *(np.zeros(load.shape) for _ in range(5)),
                                z.mean(axis=(-2, -1)).reshape(load.shape),
                                np.zeros(load.shape), flat.copy(), np.zeros(load.shape, dtype=int),
-                               np.zeros(load.shape), np.ones(load.shape, dtype=bool))
+                               np.zeros(load.shape), np.ones(load.shape, dtype=bool), grid=self.grid)
         if zero.all():
             return result
         p0, upper = options.pop("initial_pressure"), options.pop("hardness")
@@ -398,7 +404,8 @@ class ContactSolver:
             gap=gap.reshape(cells) if fields else None, contact=(p > 0).reshape(cells) if fields else None,
             plastic=(np.zeros(cells) if plastic is None else plastic.reshape(cells)) if fields else None,
             approach=out.pop("d").reshape(batch), history=history, force=out["mean_pressure"].reshape(batch) * nominal,
-            area=out["area_fraction"].reshape(batch) * nominal, **{k: v.reshape(batch) for k, v in out.items()})
+            area=out["area_fraction"].reshape(batch) * nominal, grid=self.grid,
+            **{k: v.reshape(batch) for k, v in out.items()})
         if not np.all(result.converged) and not partial:
             raise ContactConvergenceError(
                 f"contact solver did not converge in {max_iter} iterations "

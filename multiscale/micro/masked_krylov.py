@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 
 
-def masked_cg(apply, mask, b, tol, max_iter, x0, diagonal=0.0):
+def masked_cg(apply, b, mask, tol, max_iter, x0, diagonal=0.0):
     """Conjugate gradients for (A + D) x = b on the cells of ``mask`` (..., ny, nx), x zero
     elsewhere, A + D symmetric positive definite there; D = diag(``diagonal``). ``b``, ``x0`` and
     ``diagonal``: scalars or fields broadcastable to the mask. The vectors hold the mask's cells

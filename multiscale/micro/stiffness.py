@@ -17,8 +17,12 @@ difference, no resolution of its own beyond the grid's.
 K = d(mean pressure)/dδ [Pa/m] per nominal area (the patch's, as ``mean_pressure``). On a periodic
 patch of a half-space the mean gap falls as fast as the approach grows (dḡ = −dδ: the
 displacement has mean zero), so K = −dp̄/dḡ, Persson's contact stiffness; on a layer the approach
-includes the layer's bulk compression F(0) p̄. An isolated patch's approach holds
-its own spreading (``ContactResult.approach``): K is then that of the whole loaded patch.
+includes the layer's bulk compression F(0) p̄. An isolated patch's approach holds its own
+spreading (``ContactResult.approach``): K is then that of the whole loaded patch. The roughness'
+own stiffness, what a macro interface law adds to the bodies it joins, takes that compliance out:
+K_i = 1 / (1/K − C_u), C_u = mean(L 1) the patch's mean displacement under a uniform unit pressure
+(isolated: its spreading, Love's mean for a rectangle; a layer: F(0); a periodic half-space: 0, so
+K_i = K), as ``micro.laws`` does with Love's correction and ``micro.conduction`` with K_p.
 """
 from __future__ import annotations
 
@@ -41,11 +45,15 @@ class ContactStiffness:
 
     - ``stiffness`` [Pa/m], K = d(mean pressure)/dδ >= 0 (inf: a periodic half-space in full
       contact); ``total`` [N/m] = K x the nominal area, dF/dδ;
+    - ``interface`` [Pa/m], K_i = 1/(1/K − C_u), the roughness' own (module docstring; inf where
+      the patch is as stiff as a uniform pressure's, full contact), and ``uniform_compliance`` C_u [m/Pa];
     - ``increment`` [Pa/m] (..., ny, nx), dp/dδ: zero off the cells that take load;
     - ``iterations``, ``residual`` (|L dp − 1| / |1| on the contact cells) and ``converged``."""
 
     stiffness: np.ndarray
     total: np.ndarray
+    interface: np.ndarray
+    uniform_compliance: float
     increment: np.ndarray
     iterations: np.ndarray
     residual: np.ndarray
@@ -65,9 +73,9 @@ def contact_stiffness(solver: ContactSolver, result: ContactResult, *, unloading
     check_positive("tol", tol)
     check_flag("partial", partial)
     check_flag("unloading", unloading)
-    if result.pressure.shape[-2:] != solver.shape:
-        raise InputError("result.pressure.shape", result.pressure.shape,
-                         f"last two axes must be the solver's grid {solver.shape}")
+    if result.pressure.shape[-2:] != solver.shape or result.grid not in (None, solver.grid):
+        raise InputError("result", f"of a grid {result.pressure.shape[-2:]}, (dx, dy, periodic) = {result.grid}",
+                         f"the solver's grid {solver.shape}, {solver.grid}: give the solver that solved it")
     elastic = result.contact if unloading or result.plastic is None else result.contact & ~(result.plastic > 0)
     op = solver.operator
     axes = (-2, -1)
@@ -79,11 +87,17 @@ def contact_stiffness(solver: ContactSolver, result: ContactResult, *, unloading
     if max_iter is None:
         max_iter = int(20 * np.sqrt(max(int(cells.max(initial=0)), 1))) + 100
     max_iter = check_count("max_iter", max_iter)
-    dp, its, res, ok = masked_cg(op, mask, 1.0, tol, max_iter, 1.0 / op.self_influence)
+    dp, its, res, ok = masked_cg(op, 1.0, mask, tol, max_iter, 1.0 / op.self_influence)
     if not np.all(np.isfinite(dp)):
         raise StiffnessConvergenceError("stiffness CG produced non-finite pressures", [], None)
     stiffness = np.where(singular, np.inf, dp.mean(axis=axes))
-    out = ContactStiffness(stiffness, stiffness * (op.shape[0] * op.shape[1] * op.dx * op.dy), dp, its, res, ok)
+    uniform = float(op(np.ones(op.shape)).mean())        # m/Pa, C_u
+    with np.errstate(divide="ignore"):
+        excess = 1.0 / stiffness - uniform               # the roughness' compliance [m/Pa]
+        interface = np.where(excess > 1e-12 / np.maximum(stiffness, 1e-300), 1.0 / excess, np.inf)
+    interface = np.where(stiffness > 0, interface, 0.0)
+    out = ContactStiffness(stiffness, stiffness * (op.shape[0] * op.shape[1] * op.dx * op.dy), interface, uniform,
+                           dp, its, res, ok)
     if not np.all(ok) and not partial:
         raise StiffnessConvergenceError(
             f"stiffness CG did not converge in {max_iter} iterations (residual {res.max():.3e} > tol "

@@ -250,7 +250,10 @@ class MeasuredContactParams:
 
 @_register(MeasuredContactParams, {"approach": "rigid approach from the first touch [m]",
                                    "area_fraction": "real contact area / nominal area [-]",
-                                   "stiffness": "normal contact stiffness d(mean pressure)/d(approach) [Pa/m]"})
+                                   "stiffness": "normal contact stiffness d(mean pressure)/d(approach) of the "
+                                                "isolated patch, its own spreading included [Pa/m]",
+                                   "interface_stiffness": "the roughness' own normal stiffness, the patch's spreading "
+                                                          "taken out (what an interface law adds) [Pa/m]"})
 def _measured_contact(p: MeasuredContactParams) -> Outcome:
     """Contact of a measured topography at one mean pressure (FFT-BEM on its isolated patch)."""
     measured = read_topography(p.file)
@@ -259,8 +262,9 @@ def _measured_contact(p: MeasuredContactParams) -> Outcome:
     s = conditioned.surface
     solver = ContactSolver(HalfSpace.from_materials(p.E, p.nu), s.shape, s.dx, s.dy, s.periodic)
     r = solver.solve(s, load=p.load, **({"tol": p.tol} if p.tol else {}))
+    k = contact_stiffness(solver, r)
     return Outcome({"approach": float(r.approach), "area_fraction": float(r.area_fraction),
-                    "stiffness": float(contact_stiffness(solver, r).stiffness)},
+                    "stiffness": float(k.stiffness), "interface_stiffness": float(k.interface)},
                    int(r.iterations), bool(r.converged), warnings=measured.notes + conditioned.notes)
 
 
