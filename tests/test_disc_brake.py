@@ -232,6 +232,24 @@ def test_free_free_disc_bending_converges_to_plate_theory():
         assert np.all(shape.out_of_plane[:4] > 0.98) and np.all(shape.share[:4] > 0.9)   # measured 0.990, 0.96
 
 
+def test_nodal_diameters_on_a_mesh_finer_under_the_pads():
+    """Manufactured shapes (0, 1, 2, 5 ND) on the nodes of a disc meshed 7.5 times finer under the
+    pads: counted node by node, a uniform axial motion was 1 ND (a review); weighted by the nodes'
+    volumes (``squeal.node_volumes``, which sum to the disc's) each is its own, whole."""
+    tm = two_body.build(builder("disc_brake"), {"mesh_size": 0.03, "pad_mesh_size": 0.004})
+    V = fem.functionspace(tm.bodies[1].mesh, ("Lagrange", 2, (3,)))
+    n = V.dofmap.index_map.size_local
+    x = V.tabulate_dof_coordinates()[:n]
+    theta, ez = np.arctan2(x[:, 1], x[:, 0]), np.tile([0.0, 0.0, 1.0], (n, 1))
+    shapes = np.stack([ez, *(np.cos(k * theta + 0.3)[:, None] * ez for k in (1, 2, 5))], axis=2)
+    w = squeal.node_volumes(V)
+    volume = fem.assemble_scalar(fem.form(fem.Constant(V.mesh, 1.0) * ufl.dx(domain=V.mesh)))
+    assert w.sum() == pytest.approx(volume, rel=1e-12) and np.all(w > 0)
+    weighted = nodal_diameters(x, shapes, (0, 0, 1), (0, 0, 0), weights=w)
+    assert list(weighted.nodal_diameters) == [0, 1, 2, 5] and np.all(weighted.share > 0.99)
+    assert list(nodal_diameters(x, shapes, (0, 0, 1), (0, 0, 0)).nodal_diameters) != [0, 1, 2, 5]   # unweighted
+
+
 # ---------------------------------------------------------------- preload and complex modes
 @pytest.fixture(scope="module")
 def brake():

@@ -100,13 +100,15 @@ class ModalResult:
         return self.eigenvalues.size
 
     def write_csv(self, path: str | Path, rtol: float = 1e-6, potentially_unstable=(), energy=None,
-                  partner=None, disc=None, body: str = "") -> Path:
+                  partner=None, disc=None, body: str | None = None) -> Path:
         """Mode table: number, frequency [Hz], sigma [1/s], damping ratio, unstable flag, potentially
         unstable flag (mode numbers from 1, ``modal.StabilityReport``), the other half of a flutter
         pair (``partner``: its number per mode, 0 none; empty), residual; with ``energy``
         (``modal.EnergyShares``) each component's share of the mode's strain energy; with ``disc``
         (``nodal_diameters.DiscShapes`` of the rotating ``body``) its nodal diameters, their share
         and the out-of-plane share of its motion."""
+        if (disc is None) != (body is None):
+            raise InputError("body", body, "the rotating body's name with its disc shapes, none without")
         path = Path(path)
         path.parent.mkdir(parents=True, exist_ok=True)
         close = set(int(m) for m in potentially_unstable)

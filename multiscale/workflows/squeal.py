@@ -35,6 +35,8 @@ from pathlib import Path
 from typing import Mapping
 
 import numpy as np
+import ufl
+from dolfinx import fem, la
 from mpi4py import MPI
 
 from multiscale import io, outputs
@@ -139,10 +141,13 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
 
 
 def mode_name(case: SquealCase, j: int) -> str:
-    """Mode ``j`` (1-based) by its frequency and, on a rotating body, its nodal diameters, e.g.
-    "4321 Hz: 5 ND out-of-plane" (the disc's motion mostly along its axis) or "in-plane"."""
+    """Mode ``j`` (1-based) by its frequency and, on a rotating body whose motion one angular harmonic
+    holds at least half of, its nodal diameters, e.g. "4321 Hz: 5 ND out-of-plane" (the disc's
+    motion mostly along its axis) or "in-plane"."""
     name = f"{case.modes.frequency[j - 1]:.0f} Hz"
     if case.disc is None:
+        return name
+    if case.disc.share[j - 1] < 0.5:     # no one harmonic (or the disc does not move): no name (a review)
         return name
     plane = "out-of-plane" if case.disc.out_of_plane[j - 1] >= 0.5 else "in-plane"
     return f"{name}: {case.disc.nodal_diameters[j - 1]} ND {plane}"
@@ -155,9 +160,23 @@ def disc_shapes(mech: Mechanics, modes: ModalResult) -> DiscShapes | None:
     if not isinstance(motion, Rotation):
         return None
     before, own = (f.x.index_map.size_local * 3 for f in mech.u)
-    points = mech.spaces[1].tabulate_dof_coordinates()[:own // 3]
-    return nodal_diameters(points, modes.modes[before:before + own].reshape(own // 3, 3, -1), motion.axis,
-                           motion.centre, mech.tm.comm)
+    V = mech.spaces[1]
+    return nodal_diameters(V.tabulate_dof_coordinates()[:own // 3], modes.modes[before:before + own].reshape(
+        own // 3, 3, -1), motion.axis, motion.centre, mech.tm.comm, node_volumes(V))
+
+
+def node_volumes(V) -> np.ndarray:
+    """Each owned node's share of its body's volume [m^3]: every cell's volume split equally among
+    its nodes (positive, where a quadratic element's lumped mass is negative at its vertices)."""
+    msh, imap = V.mesh, V.dofmap.index_map
+    cells = msh.topology.index_map(msh.topology.dim).size_local
+    Q = fem.functionspace(msh, ("DG", 0))
+    volume = fem.assemble_vector(fem.form(ufl.TestFunction(Q) * ufl.dx)).array[Q.dofmap.list[:cells, 0]]
+    nodes = V.dofmap.list[:cells]
+    share = la.vector(imap, 1)
+    np.add.at(share.array, nodes.ravel(), np.repeat(volume / nodes.shape[1], nodes.shape[1]))
+    share.scatter_reverse(la.InsertMode.add)
+    return share.array[:imap.size_local].copy()
 
 
 def friction_laws(scene, tm) -> dict | None:
