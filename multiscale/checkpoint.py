@@ -22,7 +22,7 @@ import numpy as np
 from multiscale import __version__
 from multiscale.arrays import unique_rows
 from multiscale.errors import InputError
-from multiscale.io import on_root, replacing
+from multiscale.io import History, on_root, replacing
 
 FORMAT = 8    # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns;
 #               3: the drive's state (speed, engagement, load last solved) and the area-weighted effusivity partition;
@@ -79,6 +79,32 @@ def save(path, comm, *, attrs: dict, arrays: dict, functions: dict, scale: float
                 h5.create_dataset(name, data=value)
     on_root(comm, write, f"the checkpoint {path}")
     return path
+
+
+def save_step(path, comm, step: int, history: History, fingerprint: "Fingerprint", attrs: dict, arrays: dict,
+              model) -> Path:
+    """The checkpoint of a run after macro step ``step`` (collective): ``attrs`` and ``arrays`` (the
+    run's state), the history so far, the scene's ``fingerprint``, and the fields of ``model`` (a
+    ``macro.model.MacroModel``: its ``functions``, by coordinates at its mesh's length scale)."""
+    arrays = {**arrays, **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
+    attrs = {"step": step, **fingerprint.attrs(), "ranks": comm.size, "fields_written": -1, **attrs}
+    return save(path, comm, attrs=attrs, arrays=arrays, functions=model.functions, scale=model.tm.spec.length_scale)
+
+
+@dataclass
+class Restored:
+    """What a run resumes from: its last macro step, history and last step whose fields are written."""
+
+    step: int                  # last macro step done
+    history: History
+    fields_written: int        # last step whose fields were written (-1: none)
+
+
+def restored(attrs: dict, arrays: dict) -> Restored:
+    """The ``Restored`` of a checkpoint read by ``load`` (written by ``save_step``)."""
+    history = History()
+    history.columns = {k[len("history/"):]: list(v) for k, v in arrays.items() if k.startswith("history/")}
+    return Restored(int(attrs["step"]), history, int(attrs["fields_written"]))
 
 
 def load(path, comm, functions: dict) -> tuple[dict, dict]:

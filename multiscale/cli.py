@@ -29,7 +29,7 @@ from multiscale.micro.reading import COMMAND_LINE, TopographyWarning, formats, r
 from multiscale.micro.spectrum import statistics_memory, surface_statistics
 from multiscale.micro.topography import DETREND, MAX_UNDEFINED, condition
 from multiscale.mode_pairs import mirrored, pair, read_modes, report, write_pairs
-from multiscale.outputs import CHECKPOINT, analysis, folder_problem, plan
+from multiscale.outputs import CHECKPOINT, checkpointed, folder_problem, plan
 from multiscale.outputs import summary as plan_summary
 from multiscale.provenance import finished, versions
 from multiscale.scene import load
@@ -240,13 +240,13 @@ def _kept(scene, args, ranks: int = 1) -> str:
     folder = Path(scene.output.folder)
     written = folder.is_dir() and any(folder.iterdir())
     again = f"{command}{' --overwrite' if written else ''} starts again"
-    if analysis(scene) == "multiscale" and not (folder / CHECKPOINT).is_file():
+    if checkpointed(scene) and not (folder / CHECKPOINT).is_file():
         return f"no macro step ended, there is nothing to resume; {again}"
     if not written:
         return f"nothing was written; {again}"
     if args.overwrite and finished(folder):     # stopped before it replaced them (it advised --resume: an MPI trial)
         return f"the earlier results in {folder} stay as they were; {again}"
-    how = f"{command} --resume continues from the last finished step" if analysis(scene) == "multiscale" else again
+    how = f"{command} --resume continues from the last finished step" if checkpointed(scene) else again
     return f"what was written stays in {folder} (its provenance.json says so); {how}"
 
 
@@ -452,8 +452,8 @@ def build_parser() -> argparse.ArgumentParser:
     again.add_argument("--overwrite", action="store_true",
                        help="delete the results of the run before (the entries its provenance.json lists) and run again")
     again.add_argument("--resume", action="store_true", help="continue from the last checkpoint in the output folder "
-                       '(the multiscale loop, effect "roughness", writes them; the other analyses refuse it: '
-                       "run them again with --overwrite)")
+                       "(runs with macro steps write one after each: the multiscale loop and the thermal runs; the "
+                       "squeal analysis and a single contact solve refuse it: run them again with --overwrite)")
     run.add_argument("--set", **SET)
     run.add_argument("--quiet", action="store_true", help="no stage lines or summary (warnings and errors only)")
     run.add_argument("--max-cells", type=_count, metavar="N", help="largest mesh (cells) the run may build; "

@@ -59,7 +59,6 @@ history (to solver tolerance: a resumed run recomputes its zone laws). This modu
 ``multiscale.workflows.multiscale`` builds and runs it."""
 from __future__ import annotations
 
-import json
 import time as _time
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -71,7 +70,6 @@ from multiscale.anderson import anderson
 from multiscale.errors import ConvergenceError
 from multiscale.loop_settings import LoopSettings
 from multiscale.macro.continuation import solve_on_new_laws
-from multiscale.macro.mechanics import SolveResult
 from multiscale.macro.model import MacroModel
 from multiscale.micro.post_analysis import PostAnalysis
 from multiscale.micro.wear import WEAR_TOL
@@ -125,15 +123,6 @@ class StepResult:
     time_micro: float          # s, of the post-analysis
     time_laws: float           # s, of the law updates
     residuals: list = field(default_factory=list)   # max |G(p) - p| of each pass (empty: no partition law)
-
-
-@dataclass
-class Restored:
-    """State read back from a checkpoint."""
-
-    step: int                  # last macro step done
-    history: io.History
-    fields_written: int        # last step whose fields were written (-1: none)
 
 
 class Multiscale:
@@ -533,31 +522,21 @@ class Multiscale:
     # ---- checkpoints -----------------------------------------------------------------------
     def save(self, path: Path, step: int, history: io.History) -> None:
         """Checkpoint after macro step ``step`` (collective)."""
-        m, last = self.model, self.model.last_solve
+        model_attrs, model_arrays = self.model.checkpoint_state()
         arrays = {"heights": self.rough.heights(), "warm": self.warm, "partition": self.partition,
                   **({"plastic": self.rough.plastic} if self.plastic else {}),    # else zero: not stored
                   "conductance": self.conductance, "flash": self.flash, "rates": self.rates, "counter_depth": self.counter_depth,
-                  "form_depth": self.form_depth,
-                  "exchange": self.exchange, "levels": self.rough.levels, "heat_total": m.heat_total,
-                  "interface_heat_total": m.interface_heat_total,
-                  "heat_lost_recorded": m.heat_lost_recorded, "datum_gap": self.datum_gap,
-                  **({"lost_total": m.thermal.lost_total} if m.thermal is not None else {}),
-                  **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
-        attrs = {"step": step, "time": m.time, "work": self.work, "interval_work": self.interval_work,
-                 "counter_volume": self.counter_volume,
-                 "heat_exchanged": [m.heat_exchanged, m.heat_exchanged_total], **self.fingerprint.attrs(), "load": m.load,
-                 "ranks": self.comm.size, "fields_written": -1, "solved_speed": m.solved_speed, "stale": m.stale,
-                 "constants": [float(c.value) for c in self.model.drive_constants],
-                 "solve": [last.reason, last.iterations, last.normal_force, last.max_pressure],
-                 "notes": json.dumps([m.notes, m.thermal.notes if m.thermal is not None else []])}   # said once a run
-        checkpoint.save(path, self.comm, attrs=attrs, arrays=arrays, functions=self.model.functions,
-                        scale=self.tm.spec.length_scale)
+                  "form_depth": self.form_depth, "exchange": self.exchange, "levels": self.rough.levels,
+                  "datum_gap": self.datum_gap, **model_arrays}
+        attrs = {"work": self.work, "interval_work": self.interval_work, "counter_volume": self.counter_volume,
+                 **model_attrs}
+        checkpoint.save_step(path, self.comm, step, history, self.fingerprint, attrs, arrays, self.model)
 
-    def restore(self, path: Path) -> Restored:
+    def restore(self, path: Path) -> checkpoint.Restored:
         """State of the checkpoint ``path`` (collective)."""
         attrs, arrays = checkpoint.load(path, self.comm, self.model.functions)
         checkpoint.same_scene(attrs, self.fingerprint, path)
-        m = self.model
+        self.model.restore_checkpoint(attrs, arrays)
         self.rough.set_heights(range(len(arrays["heights"])), arrays["heights"])
         if self.plastic:
             self.rough.plastic = arrays["plastic"].copy()
@@ -566,35 +545,10 @@ class Multiscale:
         self.datum_gap, self.flash, self.counter_depth = arrays["datum_gap"], arrays["flash"], arrays["counter_depth"]
         self.form_depth, self.rates = arrays["form_depth"], arrays["rates"]
         self.counter_volume = float(attrs["counter_volume"])
-        m.heat_exchanged, m.heat_exchanged_total = (float(v) for v in attrs["heat_exchanged"])
         self.exchange = arrays["exchange"]
-        unknown = np.full(len(self.tm.interface.tags), np.nan)           # absent from older checkpoints
-        m.heat_total, m.interface_heat_total = arrays["heat_total"].copy(), arrays.get("interface_heat_total", unknown)
-        m.heat_lost_recorded = arrays["heat_lost_recorded"].copy()
-        if m.thermal is not None:
-            m.thermal.lost_total = arrays["lost_total"].copy()
-        m.time, self.work = float(attrs["time"]), float(attrs["work"])
+        self.work = float(attrs["work"])
         self.interval_work = float(attrs.get("interval_work", 0.0))     # absent from older checkpoints
-        if m.thermal is not None:
-            m.thermal.time = m.time
-        # the run's warnings before (not said again), then this session's own (set-up: the options)
-        for holder, said in zip((m, m.thermal), json.loads(attrs.get("notes", "[[], []]"))):
-            if holder is not None:
-                holder.notes = said + [n for n in holder.notes if n not in said]
-        reason, its, force, max_p = attrs["solve"]
-        m.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
         self.set_gap()
-        m.load, m.solved_speed, m.stale = float(attrs["load"]), float(attrs["solved_speed"]), bool(attrs.get("stale", 1))
-        for c, value in zip(self.model.drive_constants, attrs["constants"]):   # speed, engagement, load last solved
-            c.value = value
-        m.update_friction()                     # fade and mu(v): at the temperatures and the speed last solved
         self.rough.update_laws()
         self.apply_zone_fields()
-        history = io.History()
-        history.columns = {k[len("history/"):]: list(v) for k, v in arrays.items() if k.startswith("history/")}
-        return Restored(int(attrs["step"]), history, int(attrs["fields_written"]))
-
-    @staticmethod
-    def mark_fields(path: Path, step: int, comm) -> None:
-        """Record in the checkpoint that the fields of ``step`` are written (collective)."""
-        checkpoint.mark(path, comm, fields_written=step)
+        return checkpoint.restored(attrs, arrays)

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from multiscale.geometry import Rotation
 
-CHECKPOINT = "checkpoint.h5"      # a multiscale run's last macro step (``multiscale run --resume``)
+CHECKPOINT = "checkpoint.h5"      # a run's last macro step (``multiscale run --resume``, ``checkpointed``)
 # files of a run named without a body: a body of that name would write its fields over them
 OWN_FILES = {"interface": "interface.xdmf", "history": "history.h5", "zones": "zones.h5",
              "checkpoint": CHECKPOINT, "map": "map.h5"}
@@ -98,6 +98,13 @@ def analysis(scene) -> str:
     return "squeal" if scene.has("stability") else "multiscale" if scene.has("roughness") else "transient"
 
 
+def checkpointed(scene) -> bool:
+    """Whether a run of ``scene`` writes ``CHECKPOINT`` (``multiscale run --resume``): the multiscale
+    loop, and a transient run with macro steps (effect thermal); not the squeal analysis."""
+    kind = analysis(scene)
+    return kind == "multiscale" or (kind == "transient" and scene.has("thermal"))
+
+
 def output_times(scene) -> tuple[float, ...]:
     """Times [s] at which the fields are written: 0, then every ``output.every`` macro step and the
     last (squeal: the preload, 0)."""
@@ -175,8 +182,9 @@ def plan(scene) -> Plan:
     else:
         files["history.h5"] = "scalar history per step (forces, pressures, temperatures, heat), unit per dataset"
         files["history.png"] = "the history against time"
-    if kind == "multiscale":
+    if checkpointed(scene):
         files[CHECKPOINT] = "the last macro step's state (multiscale run --resume)"
+    if kind == "multiscale":
         files["multiscale.png"] = "both scales of the loop against time: pressures, temperatures, partition, wear"
         files["zones.h5"] = "final state of every zone: centre, wear depth and volume, partition, conductance"
         if scene.has("wear"):

@@ -87,10 +87,24 @@ def stopped(tmp_path_factory):
     return scene, folder / "checkpoint.h5"
 
 
+def flipped_data(path) -> bytes:
+    """The file's bytes with those of its largest dataset flipped: the HDF5 structure intact, its
+    data not (the file's last 4096 bytes held data once, HDF5 metadata since the attributes moved)."""
+    import h5py
+    sets = []
+    with h5py.File(path) as h5:
+        h5.visititems(lambda name, item: sets.append((item.id.get_storage_size(), item.id.get_offset()))
+                      if isinstance(item, h5py.Dataset) else None)
+    size, offset = max(sets)
+    b = bytearray(path.read_bytes())
+    b[offset:offset + size] = bytes(x ^ 0x5A for x in b[offset:offset + size])
+    return bytes(b)
+
+
 @pytest.mark.parametrize("damage, message", [
-    (lambda b: b[: len(b) // 2], "cannot be read"),             # truncated
-    (lambda b: b"", "cannot be read"),                           # empty
-    (lambda b: b[:-4096] + bytes(x ^ 0x5A for x in b[-4096:]), "corrupted"),   # damaged data
+    (lambda p: p.read_bytes()[: p.stat().st_size // 2], "cannot be read"),   # truncated
+    (lambda p: b"", "cannot be read"),                                      # empty
+    (flipped_data, "corrupted"),                                            # damaged data
 ])
 def test_a_damaged_checkpoint_is_one_clear_error(stopped, tmp_path, damage, message):
     import shutil
@@ -101,7 +115,7 @@ def test_a_damaged_checkpoint_is_one_clear_error(stopped, tmp_path, damage, mess
     folder = tmp_path / "copy"
     shutil.copytree(checkpoint.parent, folder)
     path = folder / "checkpoint.h5"
-    path.write_bytes(damage(path.read_bytes()))
+    path.write_bytes(damage(path))
     with pytest.raises(InputError, match=message):
         run(_with_folder(scene, folder), resume=True, verbose=False)
 
@@ -266,8 +280,11 @@ def test_ctrl_c_stops_the_run_after_its_step_with_the_results_written(tmp_path, 
     lines = [line for line in err.splitlines() if line.startswith("interrupted")]
     launcher = f"{MPIEXEC} -n {ranks} " if ranks > 1 else ""         # the command goes on as it ran (a user trial)
     assert lines == [f"interrupted after step {done} of 4000: what was written stays in {folder} (its "
-                     f"provenance.json says so); {launcher}{COMMAND} run {tmp_path / 'scene.toml'} --overwrite "
-                     "starts again"]
+                     f"provenance.json says so); {launcher}{COMMAND} run {tmp_path / 'scene.toml'} --resume "
+                     "continues from the last finished step"]        # (a thermal run had to start again: a trial)
+    import h5py
+    with h5py.File(folder / "checkpoint.h5") as h5:                  # what --resume continues from
+        assert h5.attrs["step"] == done
     assert len(History.read(folder / "history.h5")) == done + 1
     assert (folder / "history.png").stat().st_size > 0 and (folder / "open_in_paraview.py").exists()
     import meshio
@@ -555,7 +572,8 @@ def test_an_early_ctrl_c_ends_every_rank_at_once_with_one_line(tmp_path, waiting
                 os.kill(pid, signal.SIGKILL)
     assert job.returncode == 130 and seconds < 8, (seconds, err[-3000:])
     assert [line for line in err.splitlines() if line.strip()] == [
-        f"interrupted: nothing was written; {MPIEXEC} -n 2 {COMMAND} run {scene} starts again"], err[-3000:]
+        f"interrupted: no macro step ended, there is nothing to resume; {MPIEXEC} -n 2 {COMMAND} run {scene} "
+        "starts again"], err[-3000:]
     # (before: "what was written stays in ... (its provenance.json says so)" of a folder still empty)
 
 
@@ -637,7 +655,7 @@ def test_sigterm_before_the_steps_ends_the_run_with_one_line(tmp_path, where):
     assert job.returncode == 130 and seconds < 10, (job.returncode, seconds, err[-3000:])
     said = "interrupted by SIGTERM" if where == "python" else "interrupted"
     assert [line for line in err.splitlines() if line.strip()] == [
-        f"{said}: nothing was written; {COMMAND} run {scene} starts again"], err[-3000:]
+        f"{said}: no macro step ended, there is nothing to resume; {COMMAND} run {scene} starts again"], err[-3000:]
 
 
 KEPT_HANDLER = """

@@ -325,7 +325,7 @@ def test_a_rewritten_measured_file_changes_the_runs_fingerprint(tmp_path):
     unworn ones gave wear depths 12 % off; an adversarial test); the same bytes the same one."""
     pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
     from multiscale import checkpoint
-    from multiscale.workflows.multiscale import fingerprint
+    from multiscale.workflows.output import fingerprint
     heights = np.random.default_rng(1).normal(size=(64, 64))
     np.save(tmp_path / "pad.npy", heights)
     text = 'file = "pad.npy"\npixel_size = "10 um"\nheight_unit = "um"\ncover = "tile"'

@@ -14,6 +14,7 @@ plain objects (``multiscale.workflows.model.build_model`` makes one from a scene
 """
 from __future__ import annotations
 
+import json
 from dataclasses import dataclass, field
 from typing import Callable
 
@@ -333,6 +334,43 @@ class MacroModel:
             self.thermal.lost_total, self.thermal.lost_step = state["lost_total"].copy(), state["lost_step"].copy()
         self.update_friction()
         self.stale = state["stale"]                # (the snapshot's mu: that of its temperatures)
+
+    def checkpoint_state(self) -> tuple[dict, dict]:
+        """(attributes, arrays) of the state a checkpoint keeps beside the ``functions``: time, heat
+        counters, drive constants, the load and speed of the last solve, its statistics and the
+        warnings said so far (``restore_checkpoint`` reads them back)."""
+        last, thermal = self.last_solve, self.thermal
+        arrays = {"heat_total": self.heat_total, "interface_heat_total": self.interface_heat_total,
+                  "heat_lost_recorded": self.heat_lost_recorded,
+                  **({"lost_total": thermal.lost_total} if thermal is not None else {})}
+        attrs = {"time": self.time, "heat_exchanged": [self.heat_exchanged, self.heat_exchanged_total],
+                 "load": self.load, "solved_speed": self.solved_speed, "stale": self.stale,
+                 "constants": [float(c.value) for c in self.drive_constants],
+                 "solve": [last.reason, last.iterations, last.normal_force, last.max_pressure],
+                 "notes": json.dumps([self.notes, thermal.notes if thermal is not None else []])}   # said once a run
+        return attrs, arrays
+
+    def restore_checkpoint(self, attrs: dict, arrays: dict) -> None:
+        """Back to a ``checkpoint_state`` (the ``functions`` restored by the caller); mu at the
+        temperatures and the speed last solved. The run's warnings before are not said again."""
+        self.heat_exchanged, self.heat_exchanged_total = (float(v) for v in attrs["heat_exchanged"])
+        unknown = np.full(len(self.tm.interface.tags), np.nan)           # absent from older checkpoints
+        self.heat_total, self.interface_heat_total = arrays["heat_total"].copy(), arrays.get("interface_heat_total",
+                                                                                             unknown)
+        self.heat_lost_recorded = arrays["heat_lost_recorded"].copy()
+        self.time = float(attrs["time"])
+        if self.thermal is not None:
+            self.thermal.lost_total, self.thermal.time = arrays["lost_total"].copy(), self.time
+        for holder, said in zip((self, self.thermal), json.loads(attrs.get("notes", "[[], []]"))):
+            if holder is not None:
+                holder.notes = said + [n for n in holder.notes if n not in said]
+        reason, its, force, max_p = attrs["solve"]
+        self.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
+        self.load, self.solved_speed = float(attrs["load"]), float(attrs["solved_speed"])
+        self.stale = bool(attrs.get("stale", 1))
+        for c, value in zip(self.drive_constants, attrs["constants"]):   # speed, engagement, load last solved
+            c.value = value
+        self.update_friction()                  # fade and mu(v): at the temperatures and the speed last solved
 
     def record(self, heat_step=(0.0, 0.0)) -> dict:
         """One history row at the current state (units: see ``multiscale.io.UNITS``). With thermal

@@ -36,7 +36,8 @@ def workflow(scene) -> str:
 
 def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_WORLD,
         verbose: bool = True, warn: bool = True) -> RunResult:
-    """Run a scene (``multiscale run``) with its workflow; only the multiscale loop resumes.
+    """Run a scene (``multiscale run``) with its workflow; runs with macro steps resume
+    (``outputs.checkpointed``).
 
     Besides the analysis' results, the folder receives ``scene.toml``, ``scene_resolved.toml``,
     ``provenance.json`` (also after a failure, once the run has written into the folder) and ``open_in_paraview.py``.
@@ -50,13 +51,13 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         raise SceneError([f"{line} (the scene as changed after it was read: change it by overrides, "
                           "multiscale.scene.load(path, overrides))" for line in exc.problems]) from None
     kind = workflow(scene)
-    if resume and kind != "multiscale":
+    if resume and not outputs.checkpointed(scene):
         why = ("the squeal analysis has no checkpoints to resume from" if kind == "squeal" else
-               'this scene has no checkpoints to resume from (only the multiscale loop, effect "roughness", '
-               "writes checkpoints)")
+               'this scene has no checkpoints to resume from (one contact solve: runs with macro steps, effect '
+               '"thermal" or "roughness", write them)')
         raise InputError("--resume", None, why + ": run it again with --overwrite (in Python: overwrite=True, "
                                            "not resume)")   # (no fix said: a user trial; nor the API's)
-    ended = resume and checkpoint.peek(Path(scene.output.folder) / multiscale.CHECKPOINT, comm).get("finished")
+    ended = resume and checkpoint.peek(Path(scene.output.folder) / outputs.CHECKPOINT, comm).get("finished")
     # the parts of the run before this one (rank 0 writes the record): resumed, they stay in it
     earlier = provenance.parts_of(Path(scene.output.folder)) if resume and comm.rank == 0 else []
     started, start = provenance.now(), time.perf_counter()
@@ -64,11 +65,11 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         for line in scene.warnings:
             reporter.warn(line)
         try:
-            if kind == "multiscale":
-                result = multiscale.run(scene, overwrite=overwrite, resume=resume, comm=comm, verbose=verbose)
+            if kind == "squeal":
+                result = squeal.run(scene, overwrite=overwrite, comm=comm, verbose=verbose)
             else:
-                module = squeal if kind == "squeal" else transient
-                result = module.run(scene, overwrite=overwrite, comm=comm, verbose=verbose)
+                module = multiscale if kind == "multiscale" else transient
+                result = module.run(scene, overwrite=overwrite, resume=resume, comm=comm, verbose=verbose)
         except BaseException as exc:
             stopped = interrupted(exc)
             during = reporter.said[len(scene.warnings):]     # said as the run went (rank 0's: the record's)

@@ -22,9 +22,7 @@ per-facet stiffness, partition, wear depth, flash temperature and the counter-fa
 from __future__ import annotations
 
 import dataclasses
-import json
 import time as _time
-import tomllib
 from dataclasses import dataclass
 from functools import partial
 from pathlib import Path
@@ -36,19 +34,18 @@ from mpi4py import MPI
 from multiscale import checkpoint, io, outputs
 from multiscale.coupling import Multiscale
 from multiscale.errors import InputError, Interrupted
-from multiscale.geometry import MAX_CELLS, Rotation
+from multiscale.geometry import Rotation
 from multiscale.loop_settings import LoopSettings
 from multiscale.macro.kept_cells import closed_on_error
-from multiscale.macro.output import FieldOutput
 from multiscale.micro.heat_kernels import ThermalMaterial
 from multiscale.micro.laws import Conductance
 from multiscale.micro.post_analysis import Heating, PostAnalyses, PostAnalysis, grid_of
-from multiscale.provenance import resolved_toml
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, heat_warnings_as_notes, \
     interface_forces, interface_materials, run_notes, say_clamp, say_load, say_model_size
-from multiscale.workflows.output import prepare_folder, totals
+from multiscale.workflows.output import fingerprint, prepare_folder, totals
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
+from multiscale.workflows import stepping
 from multiscale.workflows.strain import refuse_floating, say_at_once
 from multiscale.workflows.transient import TransientResult, stopped_after, write_history
 
@@ -88,38 +85,6 @@ def post_analysis(scene, zone) -> PostAnalysis:
                         conductance=Conductance(*thermal_kernels(scene)) if scene.has("conductance") else None,
                         wear_rate=rate, counter_rate=counter_rate, substeps=scene.wear.substeps if wear else 1,
                         tol=m.tol, hardness=interface_hardness(scene) if scene.has("plasticity") else None)
-
-
-def fingerprint(scene) -> checkpoint.Fingerprint:
-    """What the results depend on: the scene (not the output section, ``name``, ``description`` or
-    ``geometry.max_cells``, a limit on the mesh: a long-run trial's resume was refused for a
-    changed description; effects sorted: a set's order changes between processes) and the bytes
-    of every file it reads (a measured surface rewritten under the same name was resumed into
-    wrong wear depths: the checkpoint holds the worn heights, the unworn ones are read again); its
-    inputs by name: every key of the resolved scene but those, and each file's SHA-1."""
-    s = dataclasses.replace(scene, output=None, source=None, overrides=(), warnings=(), name=None, description="",
-                            geometry=dataclasses.replace(scene.geometry, max_cells=MAX_CELLS),
-                            effects=tuple(sorted(scene.effects)))
-    source = scene.source.resolve() if scene.source is not None else None
-    files = {p: checkpoint.file_digest(p) for p in sorted(p for p in scene.inputs if p != source and p.is_file())}
-    resolved = tomllib.loads(resolved_toml(scene))
-    for key in ("output", "name", "description"):
-        resolved.pop(key, None)
-    resolved.get("geometry", {}).pop("max_cells", None)
-    inputs = {**_dotted(resolved), **{f"file {p}": digest for p, digest in files.items()}}
-    return checkpoint.Fingerprint(checkpoint.fingerprint(repr(s) + "".join(f"{p}:{d}" for p, d in files.items())),
-                                  inputs)
-
-
-def _dotted(table: dict, prefix: str = "") -> dict[str, str]:
-    """A TOML table's values by dotted key (arrays of tables as one value), as JSON."""
-    out = {}
-    for key, value in table.items():
-        if isinstance(value, dict):
-            out.update(_dotted(value, f"{prefix}{key}."))
-        else:
-            out[prefix + key] = json.dumps(value, default=str)
-    return out
 
 
 def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
@@ -162,16 +127,19 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     start = _time.perf_counter()
     io.abort_on_exception(comm)
     ckpt = Path(scene.output.folder) / CHECKPOINT
-    if resume and comm.bcast(ckpt.parent.is_dir() and not ckpt.is_file() if comm.rank == 0 else None, root=0):
-        raise InputError("--resume", str(ckpt.parent), f"no {CHECKPOINT} in the output folder to resume from (no "
-                         "macro step of a run ended there): run without --resume (with --overwrite if the folder "
-                         "holds results; in Python: resume=False, overwrite=True)")     # before the folder is claimed: it stays as it was
+    if resume:
+        stepping.refuse_without_checkpoint(ckpt.parent, comm)
     out = prepare_folder(scene, overwrite, resume, comm)
     folder = out.path
     stored = checkpoint.peek(ckpt, comm) if resume else {}
     if stored.get("finished"):
         checkpoint.same_scene(stored, fingerprint(scene), ckpt)
-        return finished(folder, scene.name, int(stored["step"]), comm, verbose)
+        history, fields, png = stepping.ended(folder, scene.name, int(stored["step"]), comm, verbose)
+        plot, maps = folder / "multiscale.png", sorted(folder.glob("wear_map*.png"))
+        plot = plot if plot.is_file() else None
+        files = fields + [f for f in (folder / "history.h5", png, plot, folder / "zones.h5", ckpt) if f] + maps
+        return MultiscaleResult(folder, files, 0.0, history, folder / "history.h5", png, fields, plot, maps,
+                                folder / "zones.h5", int(stored["step"]))
     if resume:
         out.claim()                          # a part of its own in the provenance, also if it is killed
     ms = build(scene, comm, progress=verbose and comm.rank == 0)
@@ -195,31 +163,15 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             say_clamp(scene, history)
         ms.rough.pool.progress = False
         plan = outputs.plan(scene)
-        due = done % every == 0 or done == steps                # the step's fields belong to the series
-        # resumed: the files' times up to the checkpoint's, without the fields of a stop between output times
-        keep = ms.model.time if due else np.nextafter(ms.model.time, -np.inf)
-        writer = FieldOutput(ms.model, folder, plan.body_fields + plan.interface_fields, extra=ms.facet_fields(),
-                             resume_at=keep if resume else None)
-        if written < done and due:
-            writer.write()
-            ms.mark_fields(ckpt, done, comm)
+        writer = stepping.field_output(ms.model, folder, plan.body_fields + plan.interface_fields, done=done,
+                                       steps=steps, every=every, written=written, resume=resume,
+                                       extra=ms.facet_fields(), ckpt=ckpt)
         last = steps if stop_after is None else min(steps, stop_after)
-        stopping = False
         # a Ctrl-C while the end is written lets it finish
         with io.StepStop(comm, done) as stop, heat_warnings_as_notes(ms.model):
-            with io.stage("macro steps"):
-                for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
-                    stepped = ms.step(n)
-                    with stop.writing(n):                     # the step's checkpoint, history and fields, whole
-                        history.append(**ms.record(stepped))
-                        ms.save(ckpt, n, history)
-                        write_history(history, folder, scene.name, comm, plot=False)   # readable if the run is killed
-                        done, stopping = n, n < steps and stop.requested()   # (the last: it finishes)
-                        if n % every == 0 or n == steps or stopping:   # a stop's are dropped when resumed
-                            writer.write()
-                            ms.mark_fields(ckpt, n, comm)
-                    if stopping:
-                        break
+            done, stopping = stepping.march(ms, stop, history, writer,
+                                            lambda: write_history(history, folder, scene.name, comm, plot=False),
+                                            ckpt, comm, done=done, last=last, steps=steps, every=every)
             with io.stage("writing history and plots"), stop.writing(done, last=not stopping):
                 title = scene.name + stopped_after(done, steps) * stopping
                 h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures, title=title)
@@ -272,21 +224,6 @@ def _wear_keys(scene) -> tuple[str, float]:
     """(the key of the rough body's wear rate, the total thickness of its layers [m] or 0)."""
     rate = f"materials.{scene.rough_material}.k_w" if scene.rough_material_wears else "wear.k_w"
     return rate, sum(x.thickness for x in scene.layers.layer) if scene.has("layers") else 0.0
-
-
-def finished(folder: Path, name: str, steps: int, comm, verbose: bool) -> MultiscaleResult:
-    """The results of a run that ended (``--resume`` of a finished run: nothing to do), from its files."""
-    history = io.History.read(folder / "history.h5")
-    fields = sorted(folder.glob("*.xdmf"))
-    maps = sorted(folder.glob("wear_map*.png"))
-    png, plot = [p if p.is_file() else None for p in (folder / "history.png", folder / "multiscale.png")]
-    files = fields + [f for f in (folder / "history.h5", png, plot, folder / "zones.h5", folder / CHECKPOINT) if f]
-    files += maps
-    if verbose and comm.rank == 0:
-        print(f"{name}: nothing to do, the run in {folder} has ended after {steps} step(s); "
-              "use --overwrite to run it again (in Python: overwrite=True)")
-    return MultiscaleResult(folder, files, 0.0, history, folder / "history.h5", png, fields, plot, maps,
-                            folder / "zones.h5", steps)
 
 
 def write_zone_results(ms: Multiscale, folder: Path, history: io.History, name: str, comm,

@@ -1,15 +1,20 @@
-"""Where a run writes: the output-folder check (the only one) and the result every workflow returns."""
+"""Where a run writes: the output-folder check (the only one), the result every workflow returns and
+the fingerprint its checkpoints hold."""
 from __future__ import annotations
 
+import dataclasses
 import fcntl
+import json
 import os
 import shutil
+import tomllib
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from multiscale import io, outputs, provenance
+from multiscale import checkpoint, io, outputs, provenance
 from multiscale.errors import InputError, SceneError
+from multiscale.geometry import MAX_CELLS
 
 
 @dataclass
@@ -185,3 +190,35 @@ def clear(folder: Path, existing: list[str]) -> None:
         why = "not written by the run before" if earlier else "no record of a run (provenance.json with its files)"
         io.reporter().say(f"--overwrite: {provenance.entries(len(kept))} of {folder} stay{'s' * (len(kept) == 1)} "
                           f"({why}): {shown}")
+
+
+def fingerprint(scene) -> checkpoint.Fingerprint:
+    """What the results depend on: the scene (not the output section, ``name``, ``description`` or
+    ``geometry.max_cells``, a limit on the mesh: a long-run trial's resume was refused for a
+    changed description; effects sorted: a set's order changes between processes) and the bytes
+    of every file it reads (a measured surface rewritten under the same name was resumed into
+    wrong wear depths: the checkpoint holds the worn heights, the unworn ones are read again); its
+    inputs by name: every key of the resolved scene but those, and each file's SHA-1."""
+    s = dataclasses.replace(scene, output=None, source=None, overrides=(), warnings=(), name=None, description="",
+                            geometry=dataclasses.replace(scene.geometry, max_cells=MAX_CELLS),
+                            effects=tuple(sorted(scene.effects)))
+    source = scene.source.resolve() if scene.source is not None else None
+    files = {p: checkpoint.file_digest(p) for p in sorted(p for p in scene.inputs if p != source and p.is_file())}
+    resolved = tomllib.loads(provenance.resolved_toml(scene))
+    for key in ("output", "name", "description"):
+        resolved.pop(key, None)
+    resolved.get("geometry", {}).pop("max_cells", None)
+    inputs = {**_dotted(resolved), **{f"file {p}": digest for p, digest in files.items()}}
+    return checkpoint.Fingerprint(checkpoint.fingerprint(repr(s) + "".join(f"{p}:{d}" for p, d in files.items())),
+                                  inputs)
+
+
+def _dotted(table: dict, prefix: str = "") -> dict[str, str]:
+    """A TOML table's values by dotted key (arrays of tables as one value), as JSON."""
+    out = {}
+    for key, value in table.items():
+        if isinstance(value, dict):
+            out.update(_dotted(value, f"{prefix}{key}."))
+        else:
+            out[prefix + key] = json.dumps(value, default=str)
+    return out

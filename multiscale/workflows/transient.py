@@ -4,23 +4,26 @@ without ``roughness`` or ``stability``.
 Builds the model (``workflows.model``), ramps the load, marches ``time.steps`` macro steps of
 ``time.substeps`` sub-steps (only with effect ``thermal``; otherwise the one contact solve), and
 writes ``history.h5``, ``history.png`` and the field files (``multiscale.outputs.plan``) into
-``output.folder``.
+``output.folder``; with steps, a checkpoint after each (``workflows.stepping``: ``--resume``).
 """
 from __future__ import annotations
 
+import dataclasses
 import time as _time
 from dataclasses import dataclass
 from pathlib import Path
 
 from mpi4py import MPI
 
-from multiscale import io, outputs
+from multiscale import checkpoint, io, outputs
 from multiscale.errors import Interrupted
 from multiscale.macro.kept_cells import closed_on_error
-from multiscale.macro.output import FieldOutput
+from multiscale.macro.model import MacroModel
+from multiscale.outputs import CHECKPOINT
+from multiscale.workflows import stepping
 from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, run_notes, say_clamp, \
     say_load, say_model_size
-from multiscale.workflows.output import RunResult, prepare_folder, totals
+from multiscale.workflows.output import RunResult, fingerprint, prepare_folder, totals
 from multiscale.workflows.strain import refuse_floating, say_at_once
 
 
@@ -54,55 +57,97 @@ def stopped_after(done: int, steps: int) -> str:
     return f" (stopped after step {done} of {steps})"
 
 
-def run(scene, *, overwrite: bool = False, comm=MPI.COMM_WORLD, verbose: bool = True) -> TransientResult:
-    """Run a perfect-contact scene (see module docstring)."""
+class Marching:
+    """A perfect-contact model as ``stepping.march`` drives it: its macro steps, history rows and
+    checkpoints (the model's state, ``MacroModel.checkpoint_state``)."""
+
+    def __init__(self, scene, model: MacroModel):
+        self.scene, self.model, self.fingerprint = scene, model, fingerprint(scene)
+
+    def step(self, n: int):
+        return self.model.macro_step(self.scene.time.dt, self.scene.time.substeps)
+
+    def record(self, heat) -> dict:
+        return self.model.record(heat)
+
+    def save(self, path: Path, step: int, history: io.History) -> None:
+        """Checkpoint after macro step ``step`` (collective)."""
+        attrs, arrays = self.model.checkpoint_state()
+        checkpoint.save_step(path, self.model.tm.comm, step, history, self.fingerprint, attrs, arrays, self.model)
+
+    def restore(self, path: Path) -> checkpoint.Restored:
+        """State of the checkpoint ``path`` (collective)."""
+        attrs, arrays = checkpoint.load(path, self.model.tm.comm, self.model.functions)
+        checkpoint.same_scene(attrs, self.fingerprint, path)
+        self.model.restore_checkpoint(attrs, arrays)
+        return checkpoint.restored(attrs, arrays)
+
+
+def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_WORLD, verbose: bool = True,
+        stop_after: int | None = None) -> TransientResult:
+    """Run a perfect-contact scene (see module docstring). ``resume`` continues from
+    ``checkpoint.h5`` in the output folder (``workflows.stepping``); ``stop_after`` ends the run
+    after that macro step's checkpoint (as if it had been killed then; for tests)."""
     start = _time.perf_counter()
     io.abort_on_exception(comm)
-    out = prepare_folder(scene, overwrite, False, comm)
+    ckpt = Path(scene.output.folder) / CHECKPOINT
+    if resume:
+        stepping.refuse_without_checkpoint(ckpt.parent, comm)
+    out = prepare_folder(scene, overwrite, resume, comm)
     folder = out.path
+    stored = checkpoint.peek(ckpt, comm) if resume else {}
+    if stored.get("finished"):
+        checkpoint.same_scene(stored, fingerprint(scene), ckpt)
+        history, fields, png = stepping.ended(folder, scene.name, int(stored["step"]), comm, verbose)
+        return TransientResult(folder, fields + [f for f in (folder / "history.h5", png, ckpt) if f], 0.0, history,
+                               folder / "history.h5", png, fields)
+    if resume:
+        out.claim()                          # a part of its own in the provenance, also if it is killed
     with io.stage("meshing"):
         tm = build_mesh(scene, comm)
     with io.stage("model set-up"), heat_warnings_as_notes():
         model = build_model(scene, comm, tm=tm)
     say_model_size(tm, model.mechanics, model.thermal)
     say_load(scene, tm)
+    marching = Marching(scene, model)
     with closed_on_error(model, comm):           # a script going on after a failed run gets its communicators
-        with io.stage("first contact solve"), heat_warnings_as_notes(model):
-            model.start()
-        out.claim()                          # --overwrite: the earlier results go now, not before a failed start
-        plan = outputs.plan(scene)
-        writer = FieldOutput(model, folder, plan.body_fields + plan.interface_fields)
-        history = io.History()
-        history.append(**model.record())
-        writer.write()
-        write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
-        refuse_floating(scene, tm, history)
-        say_clamp(scene, history)
         steps = scene.time.steps if model.thermal is not None else 0
-        if steps:
-            say_at_once(scene, history, comm)
-        done, stopping = 0, False
-        with io.StepStop(comm) as stop, heat_warnings_as_notes(model):   # a Ctrl-C while the end is written lets it finish
-            with io.stage("macro steps"):
-                for n in io.bar(range(1, steps + 1), "macro steps"):
-                    heat = model.macro_step(scene.time.dt, scene.time.substeps)
-                    with stop.writing(n):            # the step's fields and history, whole
-                        history.append(**model.record(heat))
-                        done, stopping = n, n < steps and stop.requested()   # (the last: it finishes)
-                        if n % scene.output.every == 0 or n == steps or stopping:
-                            writer.write()
-                        if n < steps:                # a killed run keeps the history of its steps
-                            write_history(history, folder, scene.name, comm, plot=False)
-                    if stopping:
-                        break
+        if resume:
+            with io.stage("restoring the checkpoint"):
+                done, history, written = dataclasses.astuple(marching.restore(ckpt))
+        else:
+            with io.stage("first contact solve"), heat_warnings_as_notes(model):
+                model.start()
+            out.claim()                          # --overwrite: the earlier results go now, not before a failed start
+            done, history, written = 0, io.History(), -1
+            history.append(**model.record())
+            if steps:
+                marching.save(ckpt, 0, history)
+            write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
+            refuse_floating(scene, tm, history)
+            say_clamp(scene, history)
+            if steps:
+                say_at_once(scene, history, comm)
+        plan = outputs.plan(scene)
+        writer = stepping.field_output(model, folder, plan.body_fields + plan.interface_fields, done=done,
+                                       steps=steps, every=scene.output.every, written=written, resume=resume,
+                                       ckpt=ckpt if steps else None)
+        last = steps if stop_after is None else min(steps, stop_after)
+        with io.StepStop(comm, done) as stop, heat_warnings_as_notes(model):   # a Ctrl-C while the end is written lets it finish
+            done, stopping = stepping.march(marching, stop, history, writer,
+                                            lambda: write_history(history, folder, scene.name, comm, plot=False),
+                                            ckpt, comm, done=done, last=last, steps=steps, every=scene.output.every)
             with io.stage("writing history and plots"), stop.writing(done, last=not stopping):
                 h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures,
                                         title=scene.name + stopped_after(done, steps) * stopping)
+        if steps and done == steps:
+            checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
         model.close()                    # on every rank in the same order (MUMPS' destruction communicates)
     if stopping:                     # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", run_notes(model))
-    result = TransientResult(folder, writer.files + [f for f in (h5, png) if f], _time.perf_counter() - start, history,
-                             h5, png, writer.files, warnings=run_notes(model))
+    kept = [ckpt] if steps else []
+    result = TransientResult(folder, writer.files + [f for f in (h5, png) if f] + kept, _time.perf_counter() - start,
+                             history, h5, png, writer.files, warnings=run_notes(model))
     if verbose and comm.rank == 0:
         print(f"{scene.name}: {io.counted(len(history), 'record')} in {result.wall_time:.1f} s on "
               f"{io.counted(comm.size, 'rank')}")

@@ -1,0 +1,78 @@
+"""The macro steps of a time-marching run (``workflows.transient``, ``workflows.multiscale``) and
+their checkpoints, so that ``multiscale run --resume`` continues a stopped or killed run.
+
+Every step writes, as one whole that a Ctrl-C waits for (``io.StepStop.writing``): its history row,
+its checkpoint (``checkpoint.h5``: the step, the history, the model's fields and state; the run's
+own ``save``), the history file (readable if the run is killed next) and, at output times (and at a
+stop), its fields, marked in the checkpoint as written. A resumed run starts from the checkpoint's
+step: the field files keep their times up to it (``FieldOutput(resume_at=...)``: those of a step
+whose checkpoint was not written are dropped, and the fields of a stop between output times too),
+so that a run stopped and resumed, any number of times, writes what the straight run writes.
+"""
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from multiscale import checkpoint, io
+from multiscale.errors import InputError
+from multiscale.macro.output import FieldOutput
+from multiscale.outputs import CHECKPOINT
+
+
+def refuse_without_checkpoint(folder: Path, comm) -> None:
+    """InputError (every rank) for ``--resume`` into a folder that holds no checkpoint; before the
+    folder is claimed, so that it stays as it was."""
+    if comm.bcast(folder.is_dir() and not (folder / CHECKPOINT).is_file() if comm.rank == 0 else None, root=0):
+        raise InputError("--resume", str(folder), f"no {CHECKPOINT} in the output folder to resume from (no "
+                         "macro step of a run ended there): run without --resume (with --overwrite if the folder "
+                         "holds results; in Python: resume=False, overwrite=True)")
+
+
+def field_output(model, folder: Path, names, *, done: int, steps: int, every: int, written: int, resume: bool,
+                 extra=None, ckpt: Path | None = None) -> FieldOutput:
+    """The run's field files from step ``done`` on (resumed: kept up to the checkpoint's time, without
+    the fields of a stop between output times; those of step ``done`` written if they are due and
+    the checkpoint ``ckpt`` (None: none) says they are not: ``written`` < ``done``)."""
+    due = done % every == 0 or done == steps                # the step's fields belong to the series
+    keep = model.time if due else np.nextafter(model.time, -np.inf)
+    writer = FieldOutput(model, folder, names, extra=extra, resume_at=keep if resume else None)
+    if written < done and due:
+        writer.write()
+        if ckpt is not None:
+            checkpoint.mark(ckpt, model.tm.comm, fields_written=done)
+    return writer
+
+
+def march(run, stop: io.StepStop, history: io.History, writer: FieldOutput, write_history, ckpt: Path, comm, *,
+          done: int, last: int, steps: int, every: int) -> tuple[int, bool]:
+    """Macro steps ``done`` + 1 ... ``last`` of ``steps`` (module docstring): ``run`` has
+    ``step(n)`` (its result goes to ``record``), ``record(stepped)`` (a history row) and
+    ``save(ckpt, n, history)`` (the checkpoint); ``write_history()`` writes the history file.
+    Returns the last step done and whether a Ctrl-C stops the run there (decided by every rank)."""
+    stopping = False
+    with io.stage("macro steps"):
+        for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
+            stepped = run.step(n)
+            with stop.writing(n):                     # the step's checkpoint, history and fields, whole
+                history.append(**run.record(stepped))
+                run.save(ckpt, n, history)
+                write_history()                       # readable if the run is killed
+                done, stopping = n, n < steps and stop.requested()   # (the last: it finishes)
+                if n % every == 0 or n == steps or stopping:   # a stop's are dropped when resumed
+                    writer.write()
+                    checkpoint.mark(ckpt, comm, fields_written=n)
+            if stopping:
+                break
+    return done, stopping
+
+
+def ended(folder: Path, name: str, steps: int, comm, verbose: bool) -> tuple[io.History, list, Path | None]:
+    """A run that ended (``--resume`` of a finished run: nothing to do): its history, field files
+    and history.png (None if not drawn), from its folder."""
+    if verbose and comm.rank == 0:
+        print(f"{name}: nothing to do, the run in {folder} has ended after {steps} step(s); "
+              "use --overwrite to run it again (in Python: overwrite=True)")
+    png = folder / "history.png"
+    return io.History.read(folder / "history.h5"), sorted(folder.glob("*.xdmf")), png if png.is_file() else None
