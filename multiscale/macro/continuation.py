@@ -27,6 +27,8 @@ from __future__ import annotations
 
 import dataclasses
 
+import numpy as np
+
 from multiscale.errors import ConvergenceError
 from multiscale.macro.laws_ufl import FacetLaw
 from multiscale.macro.mechanics import Mechanics, SolveResult
@@ -52,6 +54,7 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None,
         law.shift(offset)
         result = mech.solve()
         iterations += result.iterations
+        step, smallest = first_steps(law.depths(mech.contact.facet_gap(), offset), offset)
         rate = None                 # m per unit of lambda: the secant of the last two converged states
         while done < 1.0:
             target, kept = min(1.0, done + step), mech.displacements()
@@ -60,7 +63,7 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None,
                 result = mech.solve(guess=None if rate is None else [(target - done) * r for r in rate])
             except ConvergenceError:
                 mech.set_displacements(kept)
-                if step / 2 < SMALLEST_STEP:
+                if step / 2 < smallest:
                     raise
                 step /= 2
                 continue
@@ -75,3 +78,18 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None,
             f"the way (its last step {step:.3g}): {exc}; smaller wear steps change the laws less at an update "
             "(more wear.substeps or time.steps, or a lower k_w)", exc.history, exc.result) from exc
     return dataclasses.replace(result, iterations=iterations)
+
+
+def first_steps(depth, offset) -> tuple[float, float]:
+    """The first and the smallest step of lambda: ``FIRST_STEP`` and ``SMALLEST_STEP``, or less where a
+    step of lambda would open the facets that carry at lambda = 0 (``depth`` [m]: their interpenetration
+    of the shifted laws, ``offset`` [m]: their shifts; a shift s moves a facet by d lambda s): a fraction
+    of the median depth per unit shift over the shifted facets in contact. Worn-flat laws rise from 0
+    to their pressure within nm (a light load's run-in: all facets open at lambda = 1/64, the pin then
+    free along the load; a trial)."""
+    depth, offset = np.asarray(depth, dtype=float), np.asarray(offset, dtype=float)
+    carrying = (offset > 0) & (depth > 0)
+    if not carrying.any():
+        return FIRST_STEP, SMALLEST_STEP
+    reach = float(np.median(depth[carrying] / offset[carrying]))    # lambda that opens half of them
+    return min(FIRST_STEP, reach / 2), min(SMALLEST_STEP, reach / 16)

@@ -196,6 +196,12 @@ class FacetLaw:
         carrying = gap_at(lambda g: self.laws.pressure(g, zones).pressure, target, top, top - mechanical.gap[rows, -1])
         return np.where(target > 0, gap - carrying, 0.0)
 
+    def depths(self, gap, offset) -> np.ndarray:
+        """Per-facet interpenetration [m] of the laws shifted by ``offset`` at the gaps ``gap``:
+        g_open + s − g (> 0 in contact; global facet order)."""
+        rows = self.laws.rows(self._lawful(self.laws, self.zone_of_facet))
+        return self.laws.mechanical.g_open[rows] + np.asarray(offset, dtype=float) - np.asarray(gap, dtype=float)
+
     def evaluate(self, gap) -> tuple[np.ndarray, np.ndarray]:
         """Per-facet (p_n [Pa], K_n [Pa/m]) of the numpy laws (scaled) at per-facet gaps [m]
         (0 on facets without a law)."""
