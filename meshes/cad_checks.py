@@ -76,21 +76,23 @@ def surface_samples(model, face: int, count: int) -> tuple[np.ndarray, np.ndarra
 
 
 def crossed_share(model, g, volumes) -> float:
-    """The share of the area of the rotating body's ``volumes`` (tags; the model in m) whose surface
-    its rotation crosses: a face is crossed where |w.n| > ``CROSSES`` |w| at most of a 5 x 5 grid
-    of its parametric points (w = e x (x - c); anywhere on its surface, even outside its trimmed
-    face: a plane normal to the axis or a coaxial cylinder is never crossed, a vane's side is).
-    Vanes, holes and slots are crossed; the heat problem needs none (``macro.thermal``)."""
+    """The share of the rotating body's surface (its ``volumes``' boundary; the model in m) that its
+    rotation crosses, weighted by the speed as the run's check of its mesh weighs it
+    (``macro.mesh.crossing``): |w.n| > ``CROSSES`` |w| (w = e x (x - c)) at the points of a 5 x 5
+    grid of each face's parameters, each face's points standing for its area. A plane normal to the
+    axis or a coaxial cylinder is never crossed; vanes, holes, slots and the flats of a square bore
+    are (a face judged whole, by its median, missed the flats: a review). The heat problem needs
+    none (``macro.thermal``)."""
     e = np.asarray(g.axis, dtype=float) / np.linalg.norm(g.axis)
     crossed = total = 0.0
     for _, f in model.getBoundary([(3, v) for v in volumes], combined=True, oriented=False):
         x, n = surface_samples(model, f, 5)
         w = np.cross(e, x - np.asarray(g.centre, dtype=float))
         speed = np.linalg.norm(w, axis=1)
-        cos = np.abs((w * n).sum(axis=1))[speed > 0] / speed[speed > 0]
+        cos = np.abs((w * n).sum(axis=1)) / np.maximum(speed * np.linalg.norm(n, axis=1), np.finfo(float).tiny)
         area = model.occ.getMass(2, f)
-        total += area
-        crossed += area if cos.size and np.median(cos) > CROSSES else 0.0
+        total += area * speed.mean()
+        crossed += area * np.mean(speed * (cos > CROSSES))
     return crossed / total if total > 0 else 0.0
 
 

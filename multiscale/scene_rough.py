@@ -216,16 +216,16 @@ def micro_constants(scene) -> list[str]:
     return out
 
 
-def nominal_pressure(scene, areas: bool = False) -> tuple[float, float] | None:
-    """(A lower bound of the interfaces' nominal pressure [Pa] at the load profile's largest factor,
-    that factor): ``loading.normal_force`` times the factor over the interfaces' extents' boxes,
-    which cover them; None without a normal force or a box (the run divides by the meshed areas).
-    With ``areas``, over the faces' own areas where the geometry knows them all (``contact_area``):
-    the pressure itself (a rotated pad's box was 1.8 times its area: a trial)."""
+def nominal_pressure(scene) -> tuple[float, float] | None:
+    """(The interfaces' nominal pressure [Pa] at the load profile's largest factor, that factor):
+    ``loading.normal_force`` times the factor over the faces' areas where the geometry knows them all
+    (``contact_area``), else over their extents' boxes, which cover them: a lower bound (a rotated
+    pad's box was 1.8 times its area: a trial); None without a normal force or a box. The run
+    divides by the meshed areas."""
     force = getattr(scene.loading, "normal_force", None) if scene.loading is not None else None
     spec = scene.geometry.spec if scene.geometry is not None else None
     boxes = [spec.interface_extents.get(n) for n in spec.interfaces] if spec is not None else [None]
-    area = contact_area(scene) if areas else None
+    area = contact_area(scene)
     if not force or (None in boxes and area is None):
         return None
     factor = largest_load_factor(scene.loading, scene.time.end or 0.0)
@@ -240,15 +240,16 @@ def contact_area(scene) -> float | None:
     return None if None in areas else float(sum(areas))
 
 
-def _over_them(factor: float) -> str:
-    """How ``nominal_pressure`` was found, at load factor ``factor``, for the messages."""
+def _over_them(scene, factor: float, nominal: float) -> str:
+    """How ``nominal_pressure`` was found, at load factor ``factor``, and its value, for the messages."""
     return "loading.normal_force over them" + (f" at the load profile's largest factor {factor:.3g}"
-                                               if factor != 1 else "")
+                                               if factor != 1 else "") + \
+        (f": {nominal:.3g} Pa" if contact_area(scene) else f": at least {nominal:.3g} Pa")
 
 
 def default_p_max(scene) -> float | None:
     """The laws' top without ``micro.p_max`` [Pa]: ``P_MAX_FACTOR`` x the nominal pressure at load
-    factor 1, from its lower bound (``nominal_pressure``); None where that is not known."""
+    factor 1 (``nominal_pressure``); None where that is not known."""
     bound = nominal_pressure(scene)
     return P_MAX_FACTOR * bound[0] / bound[1] if bound is not None else None
 
@@ -262,7 +263,7 @@ def plastic_everywhere(scene) -> list[str]:
         return []
     (nominal, factor), H = bound, scene.materials[soft].value("hardness", scene.time.initial_temperature)
     return [f"materials.{soft}.hardness = {H:.3g} Pa at the initial temperature: at most the interfaces' nominal "
-            f"pressure ({_over_them(factor)}: at least {nominal:.3g} Pa), so a zone would carry the "
+            f"pressure ({_over_them(scene, factor, nominal)}), so a zone would carry the "
             "hardness or more (fully plastic), which the micro model refuses; raise the hardness or lower the load"] \
         if H <= nominal else []
 
@@ -289,7 +290,7 @@ def law_top_warnings(scene) -> list[str]:
     if top > nominal:
         return []
     return [f"the zone laws' top, {what} = {top:.3g} Pa, is at most the interfaces' nominal pressure "
-            f"({_over_them(factor)}: at least {nominal:.3g} Pa): the zones will press beyond it on "
+            f"({_over_them(scene, factor, nominal)}): the zones will press beyond it on "
             f"average, where a law is extrapolated linearly with the contact stiffness at its top; {fix}"]
 
 

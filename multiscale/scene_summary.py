@@ -109,7 +109,7 @@ def summary(scene: Scene) -> list[str]:
     where = _load_faces(scene)
     profile = f", load profile of {len(ld.load_profile)} points" if ld.load_profile else ""
     lines.append(f"  loading   {load_text}{where}, {motion}{profile}, {ld.ramp_steps} ramp step(s)")
-    if (bound := nominal_pressure(scene, areas=True)) is not None:   # (an engineer's first number: a trial)
+    if (bound := nominal_pressure(scene)) is not None:      # (an engineer's first number: said nowhere, a trial)
         at = f" at the load profile's largest factor {bound[1]:.3g}" if bound[1] != 1 else ""
         area = contact_area(scene)
         over = f"the force over the interfaces' {area * 1e6:.6g} mm^2" if area else \
@@ -264,8 +264,9 @@ def _effect_line(scene: Scene, effect: str) -> str:
         cells = f"{m.grid[0]} x {m.grid[1]} cells" if m.grid else \
             "the measurement's pixel size" if measured_pixels else "50 x 50 cells"
         least = default_p_max(scene) if m.p_max is None else None     # (its number unsaid before: a user trial)
+        about = "" if contact_area(scene) else "at least "              # (over the faces' boxes: a lower bound)
         top = f"{m.p_max:g} Pa" if m.p_max is not None else f"{P_MAX_FACTOR:g} x the nominal pressure" + (
-            f" (at least {least:.3g} Pa)" if least is not None else "")
+            f" ({about}{least:.3g} Pa)" if least is not None else "")
         if scene.has("plasticity"):
             top += f", at most {P_MAX_PLASTIC:g} x the hardness"     # (check said 3e7 Pa, the run used 9e6)
         top += "" if m.p_max is not None and not scene.has("plasticity") else " (the run prints it)"

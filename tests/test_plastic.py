@@ -223,12 +223,12 @@ def test_scene_plasticity_needs_a_hardness_and_checks_its_table():
     assert len(e.value.problems) == 1 and e.value.problems[0].startswith("materials.pin.hardness = 0")
     scene = loads(text.replace("[materials.pin]", '[materials.pin]\nhardness = "300 MPa"\n', 1), "demos")
     assert scene.has("plasticity") and scene.materials["pin"].hardness == 3e8
-    # below the nominal pressure (200 N over the pin's 20 mm box: at least 0.5 MPa; the round face's is 0.64
-    # MPa): the run refused it after its set-up naming a fully plastic zone, check said OK (a materials trial)
+    # below the nominal pressure (200 N over the pin's 20 x 20 mm face: 0.5 MPa): the run refused it after its
+    # set-up naming a fully plastic zone, check said OK (a materials trial)
     with pytest.raises(SceneError) as e:
         loads(text.replace("[materials.pin]", '[materials.pin]\nhardness = "0.45 MPa"\n', 1), "demos")
     assert e.value.problems == ["materials.pin.hardness = 4.5e+05 Pa at the initial temperature: at most the "
-                                "interfaces' nominal pressure (loading.normal_force over them: at least 5e+05 Pa), so a "
+                                "interfaces' nominal pressure (loading.normal_force over them: 5e+05 Pa), so a "
                                 "zone would carry the hardness or more (fully plastic), which the micro model refuses; "
                                 "raise the hardness or lower the load"]
     loads(text.replace("[materials.pin]", '[materials.pin]\nhardness = "0.55 MPa"\n', 1), "demos")   # a warning
@@ -239,7 +239,7 @@ def test_scene_plasticity_needs_a_hardness_and_checks_its_table():
               "demos")
     assert e.value.problems == ["materials.pin.hardness = 7e+05 Pa at the initial temperature: at most the "
                                 "interfaces' nominal pressure (loading.normal_force over them at the load profile's "
-                                "largest factor 1.5: at least 7.5e+05 Pa), so a zone would carry the hardness or "
+                                "largest factor 1.5: 7.5e+05 Pa), so a zone would carry the hardness or "
                                 "more (fully plastic), which the micro model refuses; raise the hardness or lower "
                                 "the load"]
     loads(soft.replace("ramp_steps = 2", 'ramp_steps = 2\nload_profile = [["0 s", 1], ["30 s", 1], ["60 s", 3]]'),
