@@ -4,6 +4,7 @@ import csv
 import hashlib
 import json
 import math
+import re
 import time
 from pathlib import Path
 
@@ -778,6 +779,13 @@ def test_shipped_study_files_are_valid():
     for f in files:
         study = load_study(f)
         assert study.runs and all(k in study.knobs for k in study.report.cases)
+    # the study tutorial's calibration is the shipped file, its reference beside it (a tribologist
+    # looked for the file it named: it was not there)
+    text = (ROOT / "docs" / "tutorials" / "study.rst").read_text()
+    shown = re.search(r'\n((?:    .*\n|\n)*?    name = "k_w_calibration"\n(?:    .*\n|\n)+)', text).group(1)
+    calibration = ROOT / "studies" / "macro" / "k_w_calibration.toml"
+    assert "\n".join(line[4:] for line in shown.splitlines()).strip() == calibration.read_text().strip()
+    assert json.loads((calibration.parent / "measured.json").read_text()) == {"wear_volume:last": 3.8e-11}
 
 
 def test_scene_problem_errors_are_user_errors(tmp_path):
