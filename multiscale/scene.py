@@ -31,7 +31,8 @@ from multiscale.schema import (Choice, Context, FrozenMap, ListOf, Named, Sectio
 from multiscale.scene_geometry import FileGeometry, Geometry, GeometrySection, fluid_faces_left_out, material_problems
 from multiscale.scene_plain import plain_speeds
 from multiscale.scene_rough import (law_top_warnings, measured_cover, micro_constants, nyquist, own_surface_tables,
-                                    own_tables, penalty_range, perfect_contact, plastic_everywhere, rough_rules,
+                                    own_tables, penalty_range, perfect_contact, plastic_everywhere, pressure_range,
+                                    rough_rules,
                                     roughness_over, thin_layer, zone_sizes)
 from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
                                        OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
@@ -424,7 +425,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                      if key.endswith("mesh_size") and isinstance(given.get(key), (int, float))
                      and size > g.spec.length_scale]
         problems += _hardness_checks(scene, g, raw, effects)
-        warnings += penalty_range(scene, g.spec, effects) + list(g.spec.warnings)
+        warnings += penalty_range(scene, g.spec, effects) + list(g.spec.warnings) + pressure_range(scene)
         if "wear" in effects and scene.wear is not None and scene.materials is not None and not problems:
             rough = {scene.geometry.spec.interface_materials(n)[0] for n in scene.geometry.spec.interfaces}
             given = [k for k in ("k_w", "k_w_table") if getattr(scene.wear, k) is not None]

@@ -16,6 +16,7 @@ from multiscale.micro.topography import (TopographyWarning, beyond_measurement, 
 from multiscale.micro.zones import THINNEST, ZoneGrid
 from multiscale.scene_cycle import largest_load_factor
 from multiscale.scene_sections import DEFAULT_GRID, P_MAX_FACTOR, P_MAX_PLASTIC
+from multiscale.scene_values import LOAD_PRESSURE
 
 FACET_AREA = 0.4   # median area of gmsh's interface triangles over h^2, h the size aimed at (0.37-0.43 on the demos)
 SHARED_MICRO = ("grid", "law_points", "model", "p_max", "tol", "partition_law", "heating", "heating_steps",
@@ -230,6 +231,21 @@ def nominal_pressure(scene) -> tuple[float, float] | None:
         return None
     factor = largest_load_factor(scene.loading, scene.time.end or 0.0)
     return factor * force / (area or sum(a * b for a, b in boxes)), factor
+
+
+def pressure_range(scene) -> list[str]:
+    """A warning where ``loading.normal_force`` puts the interfaces' ``nominal_pressure`` outside
+    the plausible range of a pressure on a load face (``scene_values.LOAD_PRESSURE``): a force in
+    the wrong unit, or a face of the wrong size (50 kN on a 6 mm pin: 1389 MPa, said by check as a
+    number and warned of only when given as a pressure; a tribologist's trial)."""
+    nominal = nominal_pressure(scene)
+    lo, hi = LOAD_PRESSURE.plausible
+    if nominal is None or lo <= nominal[0] <= hi:
+        return []
+    at = f" at the load profile's largest factor {nominal[1]:.3g}" if nominal[1] != 1 else ""
+    return [f"loading.normal_force = {scene.loading.normal_force:g} N is a nominal contact pressure of "
+            f"{'at least ' if contact_area(scene) is None else ''}{nominal[0]:.4g} Pa on the interfaces{at}, "
+            f"outside {lo:g} to {hi:g} Pa: is the force in N and the geometry in m?"]
 
 
 def contact_area(scene) -> float | None:

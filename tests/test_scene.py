@@ -1791,3 +1791,16 @@ def test_where_a_friction_curve_gives_mu_0_is_said_as_spans(curve, said):
     a user trial)."""
     from multiscale.scene_friction import zero_spans
     assert zero_spans(curve) == said
+
+
+def test_a_force_that_is_an_implausible_pressure_is_warned_of():
+    """50 kN on the 20 x 20 mm pin is 125 MPa: plausible; 50 MN is not, nor 200 N on a pin of 20 um
+    (a unit slip): a pressure given as such was warned of, the same given as a force was not (a
+    tribologist's trial: 1389 MPa said by check as a number only)."""
+    said = lambda scene: [w for w in scene.warnings if "is a nominal contact pressure" in w]
+    assert said(load(DEMOS / "pin_on_disc_perfect.toml", {"loading.normal_force": "50 kN"})) == []
+    assert said(load(DEMOS / "pin_on_disc_perfect.toml", {"loading.normal_force": "50 MN"})) == [
+        "loading.normal_force = 5e+07 N is a nominal contact pressure of 1.25e+11 Pa on the interfaces, outside "
+        "1000 to 2e+08 Pa: is the force in N and the geometry in m?"]
+    assert len(said(load(DEMOS / "pin_on_disc_perfect.toml", {"geometry.pin_size": "20 um",
+                                                               "geometry.housing_size": "30 um"}))) == 1
