@@ -66,10 +66,14 @@ def rough_rules(scene) -> list[InputError]:
         out.append(InputError("interfaces", sorted(scene.rough_interfaces), "the rough interfaces must have the same "
                               f"materials on both sides (one micro solid); found {sorted(pairs)}"))
     for name in scene.rough_interfaces:
-        m = scene.interface_settings(name).micro
-        out += [InputError(f"interfaces.{name}.micro.{key}", getattr(m, key), f"must be the same on every interface "
-                           f"(micro.{key} = {getattr(scene.micro, key)}); only zones may differ")
-                for key in SHARED_MICRO if getattr(m, key) != getattr(scene.micro, key)]
+        s = scene.interface_settings(name)
+        out += [InputError(f"interfaces.{name}.micro.{key}", getattr(s.micro, key), f"must be the same on every "
+                           f"interface (micro.{key} = {getattr(scene.micro, key)}); only zones may differ")
+                for key in SHARED_MICRO if getattr(s.micro, key) != getattr(scene.micro, key)]
+        size = scene.geometry.spec.interface_extents.get(name)     # (0.8 for 0.8 um ran to a rigid-body
+        if s.roughness.rms is not None and size is not None and s.roughness.rms > max(size):   # error: a trial)
+            out.append(InputError(f"{scene.roughness_key(name)}.rms", s.roughness.rms, f"an RMS height [m] below "
+                                  f"the interface's width ({max(size):g} m): 0.8 um is 8e-7 or \"0.8 um\""))
     return out
 
 
@@ -238,9 +242,12 @@ def pressure_range(scene) -> list[str]:
     the plausible range of a pressure on a load face (``scene_values.LOAD_PRESSURE``): a force in
     the wrong unit, or a face of the wrong size (50 kN on a 6 mm pin: 1389 MPa, said by check as a
     number and warned of only when given as a pressure; a tribologist's trial)."""
-    nominal = nominal_pressure(scene)
+    try:
+        nominal = nominal_pressure(scene)
+    except (AttributeError, TypeError):          # a partial scene (a refused vehicle speed): reported elsewhere
+        return []
     lo, hi = LOAD_PRESSURE.plausible
-    if nominal is None or lo <= nominal[0] <= hi:
+    if nominal is None or nominal[0] == 0 or lo <= nominal[0] <= hi:   # (0: released throughout, warned of)
         return []
     at = f" at the load profile's largest factor {nominal[1]:.3g}" if nominal[1] != 1 else ""
     return [f"loading.normal_force = {scene.loading.normal_force:g} N is a nominal contact pressure of "

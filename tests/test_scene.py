@@ -1804,3 +1804,13 @@ def test_a_force_that_is_an_implausible_pressure_is_warned_of():
         "1000 to 2e+08 Pa: is the force in N and the geometry in m?"]
     assert len(said(load(DEMOS / "pin_on_disc_perfect.toml", {"geometry.pin_size": "20 um",
                                                                "geometry.housing_size": "30 um"}))) == 1
+
+
+def test_an_rms_height_taller_than_the_interface_is_refused():
+    """roughness.rms = 0.8 (for 0.8 um) passed check with a plausibility warning, then the run printed
+    Python's raw warnings of the micro solves and stopped at a rigid-body error (a trial)."""
+    with pytest.raises(SceneError) as e:
+        load(DEMOS / "pin_on_disc.toml", {"roughness.rms": 0.8})
+    assert e.value.problems == ['roughness.rms = 0.8: an RMS height [m] below the interface\'s width (0.02 m): '
+                                '0.8 um is 8e-7 or "0.8 um"']
+    load(DEMOS / "pin_on_disc.toml", {"roughness.rms": "0.8 um"})
