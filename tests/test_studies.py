@@ -1586,3 +1586,21 @@ def test_files_swept_without_being_cases_are_warned_of(tmp_path):
         '["file"] to judge each file by its own',)
     assert load_study(write(tmp_path, text + '[report]\ncases = ["file"]\n')).warnings == ()
     assert load_study(write(tmp_path, text + '[report]\naverage_over = ["file"]\n')).warnings == ()  # (a review)
+
+
+def test_the_figure_against_a_knob_wraps_its_panels_and_draws_power_laws_straight(tmp_path, made):
+    """Three metrics and the wall time against a load swept over two decades: 2 rows of 3 panels (a
+    study of 9 metrics drew one row 4400 px wide); a metric proportional to the load on log-log axes (on a log x axis and a
+    linear y one, a linear wear looked exponential: a tribologist's trial), a constant one linear."""
+    from multiscale.plots import studies as figures
+    text = (HERTZ.replace('load = "10 N"', "grid = 16").replace("grid = [12, 16, 24, 32]", 'load = ["1 N", "10 N", "100 N"]')
+            .replace('[reference]\nkind = "analytic"\n', "").replace('errors = ["1 %", "5 %"]', ""))
+    study = load_study(write(tmp_path, text))
+    rows = [Row(run, {"status": "ok", "wall_time": 1.0 + k, "metrics": {
+        "contact_radius": 1.0, "max_pressure": float(run.label["load"]), "approach": 2.0}})
+        for k, run in enumerate(study.runs)]
+    figures.plot(study, rows, tmp_path)
+    fig, axes = next((f, a) for f, a in made if a.size > 1)
+    assert axes.shape == (2, 3) and [ax.get_visible() for ax in axes[1]] == [True, False, False]
+    assert axes[0][1].get_title() == "max_pressure" and axes[0][1].get_yscale() == "log"
+    assert axes[0][0].get_yscale() == "linear" and axes[0][1].get_xscale() == "log"

@@ -22,6 +22,9 @@ __all__ = ["plot"]
 matplotlib.use("Agg")          # PNG files only, no display
 
 
+COLUMNS = 3        # panels per row of a figure against one axis
+
+
 def plot(study: Study, rows: list[Row], folder: Path) -> list[Path]:
     """PNGs: error vs wall time per metric (Pareto front; with many runs only the front is
     labelled), and per knob: error (or metric) and wall time vs the knob; the study's earlier PNGs
@@ -106,6 +109,13 @@ def _plot_pareto(study, ok, folder):
     return path
 
 
+def _spans_decades(ax) -> bool:
+    """Whether the lines of ``ax`` are positive and span more than a factor 5: a log axis for them."""
+    y = np.concatenate([np.asarray(line.get_ydata(), float) for line in ax.get_lines()] or [np.zeros(0)])
+    y = y[np.isfinite(y)]
+    return y.size > 1 and y.min() > 0 and y.max() / y.min() > 5
+
+
 def _pareto_path(study, folder: Path) -> Path:
     return folder / f"{study.name}_error_vs_time.png"
 
@@ -172,8 +182,13 @@ def _plot_axis(study, ok, axis, folder, found):
         lines.setdefault(tuple(r.run.shown[k] for k in others), []).append(r)
     measured = study.reference is not None and study.reference.kind == "file"
     panels = [("error" if m in study.judged and not measured else "value", m) for m in study.metrics] + [("time", None)]
-    fig, axes = plt.subplots(1, len(panels), figsize=(4.4 * len(panels), 3.9), squeeze=False)
-    for ax, (kind, m) in zip(axes[0], panels):
+    columns = min(COLUMNS, len(panels))        # (all in one row: 4400 px wide for 9 metrics, a trial)
+    fig, axes = plt.subplots(-(-len(panels) // columns), columns, figsize=(4.4 * columns,
+                                                                         3.9 * -(-len(panels) // columns)),
+                             squeeze=False)
+    for ax in axes.ravel()[len(panels):]:
+        ax.set_visible(False)
+    for ax, (kind, m) in zip(axes.ravel(), panels):
         for c, (other, group) in enumerate(lines.items()):
             pts = {}
             for r in group:
@@ -211,8 +226,8 @@ def _plot_axis(study, ok, axis, folder, found):
             ax.axhline(ref, color="green", ls="--", lw=1, label="measured")
             met = [c.value for c in found if c.knob == axis[0] and c.metric == m and c.value is not None]
             ax.plot(met, [ref] * len(met), "*", color="green", ms=11, label="where the sweep meets it" if met else None)
-        if kind == "time":
-            ax.set_yscale("log")
+        if kind == "time" or (kind == "value" and log_x and _spans_decades(ax)):   # a power law straight (a linear
+            ax.set_yscale("log")                                                   # law looked exponential: a trial)
         value = metric_heading(m, PROBLEMS[study.problem].metric_unit(m)) if kind == "value" else ""
         ax.set(xlabel=_axis_label(study, axis, [r.run.raw[axis[0]] for r in ok]),
                ylabel={"error": f"relative error of {m}", "value": value, "time": "wall time [s]"}[kind],
