@@ -123,15 +123,16 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             history.append(**model.record())
             if steps:
                 marching.save(ckpt, 0, history)
+        plan = outputs.plan(scene)
+        writer = stepping.field_output(model, folder, plan.body_fields + plan.interface_fields, done=done,
+                                       steps=steps, every=scene.output.every, written=written, resume=resume,
+                                       ckpt=ckpt if steps else None)     # (the first solve's fields: also those
+        if not resume:                                                    # of a run refused next)
             write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
             refuse_floating(scene, tm, history)
             say_clamp(scene, history)
             if steps:
                 say_at_once(scene, history, comm)
-        plan = outputs.plan(scene)
-        writer = stepping.field_output(model, folder, plan.body_fields + plan.interface_fields, done=done,
-                                       steps=steps, every=scene.output.every, written=written, resume=resume,
-                                       ckpt=ckpt if steps else None)
         last = steps if stop_after is None else min(steps, stop_after)
         with io.StepStop(comm, done) as stop, heat_warnings_as_notes(model):   # a Ctrl-C while the end is written lets it finish
             done, stopping = stepping.march(marching, stop, history, writer,
