@@ -92,8 +92,9 @@ def parameters(params=None) -> dict:
         ("pad_outer_radius", p["pad_outer_radius"] <= p["disc_outer_radius"]
          and p["pad_outer_radius"] > p["pad_inner_radius"],
          "pad_inner_radius < pad_outer_radius <= disc_outer_radius"),
-        ("backplate_angle", p["pad_angle"] < p["backplate_angle"] < math.pi,
-         "pad_angle < backplate_angle < pi"),
+        ("pad_angle", p["pad_angle"] < p["backplate_angle"],     # (55 for 55 deg blamed backplate_angle: a trial)
+         f"must be below backplate_angle ({p['backplate_angle']:.4g} rad); a bare number is in radians: \"40 deg\""),
+        ("backplate_angle", p["backplate_angle"] < math.pi, "pad_angle < backplate_angle < pi (rad: \"70 deg\")"),
         ("piston_radius", _piston_fits(p), "the piston must lie inside the backplate"),
         ("cheek_thickness", p["vanes"] == 0 or 2 * p["cheek_thickness"] < p["disc_thickness"],
          "two cheeks must be thinner than the disc"),

@@ -44,6 +44,9 @@ def test_parameters_are_checked_and_named():
         disc_brake.parameters({"pad_outer_radius": 0.2})
     with pytest.raises(InputError, match="geometry.colour"):
         disc_brake.parameters({"colour": 1.0})
+    with pytest.raises(InputError, match=r'geometry.pad_angle = 55.0: must be below backplate_angle \(1.2 rad\); a '
+                                         r'bare number is in radians: "40 deg"'):     # (it blamed backplate_angle)
+        disc_brake.parameters({"pad_angle": 55.0})
     spec = disc_brake.describe()
     assert spec.materials == ("pad", "backplate", "piston", "caliper", "disc")
     assert set(spec.interfaces) == {"inner_pad", "outer_pad"}
@@ -231,6 +234,21 @@ def test_free_free_disc_bending_converges_to_plate_theory():
     for shape in shapes:                                           # as macro.nodal_diameters names them
         assert list(shape.nodal_diameters[:4]) == [2, 2, 3, 3]
         assert np.all(shape.out_of_plane[:4] > 0.98) and np.all(shape.share[:4] > 0.9)   # measured 0.990, 0.96
+
+
+def test_a_mode_is_named_by_the_disc_where_the_disc_moves():
+    """The console's name of an unstable mode: "3413 Hz: 2 ND in-plane" where the disc holds the
+    mode; a pad's mode where the disc holds 8.8 % of the strain energy was named by the disc's
+    harmonics too (an NVH trial), and one no harmonic holds half of is not."""
+    from multiscale.macro.modal import EnergyShares
+    from multiscale.macro.nodal_diameters import DiscShapes
+    shares = np.array([[0.2, 0.8], [0.912, 0.088], [0.2, 0.8]])
+    case = NS(modes=NS(frequency=np.array([3413.2, 9729.0, 5000.0])),
+              disc=DiscShapes(np.array([2, 2, 4]), np.array([0.87, 0.9, 0.3]), np.array([0.09, 0.1, 0.9]),
+                              np.array([3, 2, 4])),
+              energy=EnergyShares(["inner_pad", "disc"], shares, shares),
+              mech=NS(tm=NS(bodies=[None, NS(spec=NS(regions=[NS(name="disc")]))])))
+    assert [squeal.mode_name(case, j) for j in (1, 2, 3)] == ["3413 Hz: 2 ND in-plane", "9729 Hz", "5000 Hz"]
 
 
 def test_nodal_diameters_on_a_mesh_finer_under_the_pads():
@@ -463,6 +481,7 @@ def test_scene_run_writes_results_and_matches_the_direct_analysis(tmp_path, fric
     table = np.genfromtxt(run.folder / "modes.csv", delimiter=",", names=True)
     disc = run.case.disc
     assert list(table["nodal_diameters_disc"]) == list(disc.nodal_diameters)
+    assert list(table["out_of_plane_nodal_diameters_disc"]) == list(disc.axial_nodal_diameters)
     np.testing.assert_allclose(table["out_of_plane_share_disc"], disc.out_of_plane, atol=5e-4)
     np.testing.assert_allclose(table["nodal_diameter_share_disc"], disc.share, atol=5e-4)
     assert np.all((disc.share > 0) & (disc.share <= 1)) and np.all((disc.out_of_plane >= 0) & (disc.out_of_plane <= 1))

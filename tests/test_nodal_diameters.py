@@ -34,6 +34,10 @@ def test_manufactured_shapes_are_named_by_their_nodal_diameters():
     motion = np.stack(shapes, axis=2)
     d = nodal_diameters(points, motion, 3 * AXIS, CENTRE + 2 * AXIS)   # any length, any point of the axis
     assert list(d.nodal_diameters) == [3, 5, 4, 0, 2]
+    assert list(d.axial_nodal_diameters)[::2] == [3, 4, 2]        # (the in-plane ones have no axial motion)
+    inplane = np.cos(5 * theta)[:, None] * er + 0.2 * np.cos(3 * theta)[:, None] * ez   # radial 5 ND, axial 3 ND
+    both = nodal_diameters(points, inplane[:, :, None], AXIS, CENTRE)
+    assert (both.nodal_diameters[0], both.axial_nodal_diameters[0]) == (5, 3) and both.out_of_plane[0] < 0.1
     bending, radial = np.sum(np.cos(2 * theta) ** 2), 0.01 * np.sum(np.sin(7 * theta) ** 2)
     np.testing.assert_allclose(d.out_of_plane, [1, 0, 1, 0, bending / (bending + radial)], atol=1e-12)
     assert np.all(d.share > 0.95)                                      # measured 0.988-1 (even spread: Parseval)

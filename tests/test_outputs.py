@@ -109,7 +109,8 @@ def test_check_names_every_column_of_modes_csv(case):
     rows = list(csv.DictReader((p.folder / "modes.csv").open()))
     shares = [k for k in rows[0] if k.startswith("energy_share_")]
     disc = scene.bodies[1]                    # the rotating body's motion: nodal diameters, out-of-plane share
-    shapes = [f"nodal_diameters_{disc}", f"nodal_diameter_share_{disc}", f"out_of_plane_share_{disc}"]
+    shapes = [f"nodal_diameters_{disc}", f"nodal_diameter_share_{disc}", f"out_of_plane_share_{disc}",
+              f"out_of_plane_nodal_diameters_{disc}"]
     words.update({"nodal_diameter": "nodal diameters", "out_of_plane": "out-of-plane share"})
     assert set(rows[0]) == {"mode", *words, *shares, *shapes} - {"energy_share_", "nodal_diameter", "out_of_plane"}
     assert len(shares) >= 2

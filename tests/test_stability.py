@@ -214,6 +214,13 @@ def test_the_stable_half_of_a_lock_in_pair_is_not_potentially_unstable():
     f, sigma = np.array([1000.0, 1000.0, 1000.02, 1000.02]), np.array([-5.0, 5.0, -7.0, 7.0])
     assert modal.flutter_pairs(f, sigma, sigma > 0).tolist() == [2, 1, 4, 3]
     assert flagged([1000.0, 1000.0, 1000.05], [-5.0, 5.0, -0.5]) == []     # its neighbour, 5e-5 off, is no pair
+    # a loss factor of 0.01 split the car brake's pairs beyond 1e-4 (4810 Hz by 0.56 Hz, sigma 201 1/s): both
+    # halves unpaired, the stable one of 9731 Hz (-2935 1/s) flagged with its neighbour (an NVH trial)
+    f, sigma = np.array([4809.50, 4810.06, 9719.83, 9730.2, 9731.9]), np.array([201.3, -221.0, -3.0, 2900.0, -2935.0])
+    assert modal.flutter_pairs(f, sigma, sigma > 0).tolist() == [2, 1, 0, 5, 4]
+    assert flagged(f, sigma) == []
+    assert modal.flutter_pairs(np.array([4755.0, 4846.0]), np.array([-1.0, 1.0]), np.array([False, True])).tolist() \
+        == [0, 0]                                               # a doublet 91 Hz apart at 1 1/s: no pair
 
 
 def test_a_mode_cap_on_a_reduced_damped_system_keeps_a_split_pair():

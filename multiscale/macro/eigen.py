@@ -105,8 +105,8 @@ class ModalResult:
         unstable flag (mode numbers from 1, ``modal.StabilityReport``), the other half of a flutter
         pair (``partner``: its number per mode, 0 none; empty), residual; with ``energy``
         (``modal.EnergyShares``) each component's share of the mode's strain energy; with ``disc``
-        (``nodal_diameters.DiscShapes`` of the rotating ``body``) its nodal diameters, their share
-        and the out-of-plane share of its motion."""
+        (``nodal_diameters.DiscShapes`` of the rotating ``body``) its nodal diameters, their share,
+        the out-of-plane share of its motion and the nodal diameters of its axial motion."""
         if (disc is None) != (body is None):
             raise InputError("body", body, "the rotating body's name with its disc shapes, none without")
         path = Path(path)
@@ -115,20 +115,22 @@ class ModalResult:
         n_modes = len(self.frequency)
         names, shares = ([], np.zeros((n_modes, 0))) if energy is None else (energy.names, energy.share)
         shapes = np.zeros((n_modes, 0)) if disc is None else np.column_stack(
-            [disc.nodal_diameters, disc.share, disc.out_of_plane])
+            [disc.nodal_diameters, disc.share, disc.out_of_plane, disc.axial_nodal_diameters])
         with path.open("w", newline="") as f:
             w = csv.writer(f)
             w.writerow(["mode", "frequency_Hz", "sigma_1_per_s", "damping_ratio", "unstable", "potentially_unstable",
                         "flutter_partner", "residual", *(f"energy_share_{n}" for n in names),
                         *([] if disc is None else [f"nodal_diameters_{body}", f"nodal_diameter_share_{body}",
-                                                   f"out_of_plane_share_{body}"])])
+                                                   f"out_of_plane_share_{body}",
+                                                   f"out_of_plane_nodal_diameters_{body}"])])
             pairs = np.zeros(n_modes, int) if partner is None else partner
             for j, (fr, s, z, u, p, e, share, shape) in enumerate(zip(
                     self.frequency, self.growth, self.damping_ratio, self.unstable(rtol), pairs, self.errors, shares,
                     shapes), start=1):
                 w.writerow([j, f"{fr:.6f}", f"{s + 0.0:.6e}", f"{z + 0.0:.6e}", int(u), int(j in close),
                             p or "", f"{e:.2e}", *(f"{v:.6f}" for v in share),      # no -0
-                            *([f"{int(shape[0])}", f"{shape[1]:.3f}", f"{shape[2]:.3f}"] if disc is not None else [])])
+                            *([f"{int(shape[0])}", f"{shape[1]:.3f}", f"{shape[2]:.3f}", f"{int(shape[3])}"]
+                              if disc is not None else [])])
         return path
 
 

@@ -64,16 +64,26 @@ CLOSE = 1e-3     # relative frequency gap of two stable modes that are "potentia
 LOCKED = 1e-4    # relative frequency gap of a stable mode to an unstable one: a lock-in pair's halves (equal
                  # frequencies; split by 2e-5 by a pad's loss factor, ``damped.select``)
 STATIC = 1e-9    # a mode below this share of the highest frequency (or of 1 Hz) does not oscillate
+SPLIT = 1 / (4 * np.pi)   # a lock-in pair split by damping (~ eta sigma / 2 pi) lies within this x sigma [Hz]
+
+
+def locked_window(frequency: float, sigma: float) -> float:
+    """How far [Hz] the stable half of a lock-in pair may lie from its unstable half at ``frequency``
+    [Hz] growing at ``sigma`` [1/s]: ``LOCKED`` of the frequency without damping (the halves share
+    it), and ``SPLIT`` sigma with it: a loss factor eta splits the pair by the order of eta sigma / 2 pi (the
+    car brake at eta = 0.01: 0.56 Hz at 4810 Hz, 1.2e-4 of it, sigma 201 1/s; both halves were left
+    unpaired and the stable one flagged potentially unstable: an NVH trial)."""
+    return max(LOCKED * frequency, SPLIT * abs(sigma))
 
 
 def flutter_pairs(f: np.ndarray, sigma: np.ndarray, bad: np.ndarray) -> np.ndarray:
     """Per mode, the number (1-based) of the other half of its flutter pair, 0 for none: each unstable
-    mode (``bad``) taken in frequency order with the unused stable mode within ``LOCKED`` of its
+    mode (``bad``) taken in frequency order with the unused stable mode within ``locked_window`` of its
     frequency [Hz] whose growth rate ``sigma`` [1/s] is nearest its opposite (a doublet's two pairs,
     or a stable mode beside a pair, were paired across by neighbours alone: a review)."""
     partner = np.zeros(f.size, int)
     for u in np.nonzero(bad & (f > 0))[0]:
-        near = np.nonzero(~bad & (partner == 0) & (np.abs(f - f[u]) <= LOCKED * f[u]))[0]
+        near = np.nonzero(~bad & (partner == 0) & (np.abs(f - f[u]) <= locked_window(f[u], sigma[u])))[0]
         if near.size:
             s = near[np.lexsort((np.abs(f[near] - f[u]), np.abs(sigma[near] + sigma[u])))[0]]
             partner[u], partner[s] = s + 1, u + 1
@@ -87,8 +97,8 @@ def stability_report(result: ModalResult, rtol: float = 1e-6, close_tol: float =
     ``close_tol`` relative frequency: the pair is close to coalescence but not yet locked in
     (``close_tol`` 0: none, as without friction, where nothing couples two modes). Overdamped roots
     (0 Hz) do not oscillate and pair with nothing (five of them were flagged; a user trial); nor does
-    the stable half of a lock-in pair, at the frequency of an unstable mode within ``LOCKED`` (it was
-    flagged beside a stable mode 0.095 % away: an NVH user trial). ``flutter_partner`` pairs those
+    the stable half of a lock-in pair, at the frequency of an unstable mode within ``locked_window`` (it
+    was flagged beside a stable mode 0.095 % away: an NVH user trial). ``flutter_partner`` pairs those
     halves (found by equal frequencies alone before: an NVH user trial).
     """
     check_positive("rtol", rtol)

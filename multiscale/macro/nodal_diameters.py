@@ -12,7 +12,9 @@ harmonic n in a ring of weight W is (|Σ w_k a_k e^{−inθ_k}|² + |Σ w_k a_k 
 n = 0), its share of Σ w_k |a_k|² (Parseval, for a ring's volume spread evenly in θ); the mode's
 nodal diameters are the harmonic with the most power over all rings and components, its ``share``
 that power's share of the motion (near 1 on an axisymmetric disc; lower where the hat, bolts or
-pads break the symmetry, or the mesh is too coarse to resolve n), ``out_of_plane`` the axial share.
+pads break the symmetry, or the mesh is too coarse to resolve n), ``out_of_plane`` the axial share,
+``axial_nodal_diameters`` the harmonic of the axial component alone (an in-plane mode's axial part,
+what radiates and what a test measures, can have other nodal diameters than its radial one).
 """
 from __future__ import annotations
 
@@ -34,6 +36,7 @@ class DiscShapes:
     nodal_diameters: np.ndarray   # the angular harmonic n with the most power [-], int
     share: np.ndarray             # that harmonic's share of the motion [-]
     out_of_plane: np.ndarray      # share of the motion along the rotation axis [-] (1: bending, 0: in-plane)
+    axial_nodal_diameters: np.ndarray   # the harmonic of the axial motion alone (what radiates) [-], int
 
 
 def nodal_diameters(points, motion, axis, centre, comm=None, weights=None) -> DiscShapes:
@@ -87,4 +90,6 @@ def nodal_diameters(points, motion, axis, centre, comm=None, weights=None) -> Di
     per_n = power.sum(axis=(0, 1))                                                     # (N_MAX + 1, modes)
     motion_sq = np.maximum(total.sum(axis=0), np.finfo(float).tiny)
     n = np.argmax(per_n, axis=0)
-    return DiscShapes(n, np.minimum(per_n[n, np.arange(per_n.shape[1])] / motion_sq, 1.0), total[0] / motion_sq)
+    axial = np.argmax(power[:, 0].sum(axis=0), axis=0)                                 # (an in-plane mode's axial
+    return DiscShapes(n, np.minimum(per_n[n, np.arange(per_n.shape[1])] / motion_sq, 1.0), total[0] / motion_sq,
+                      axial)                                                           # part: an NVH trial)

@@ -69,6 +69,7 @@ SOLVERS = {"gnhep": "the generalized eigenproblem K phi = theta M phi (exact)", 
            "pep": "the full quadratic eigenproblem (SLEPc PEP, exact)",
            "projection": "projection on the undamped modes and static responses (approximate: the residual column)"}
 MODE_RESIDUAL = 3e-2  # the analysis' modes with larger relative residuals are warned to be approximate
+DISC_SHARE = 0.25     # a mode is named by the disc's nodal diameters where the disc holds this share of its energy
 
 
 @dataclass(frozen=True)
@@ -141,14 +142,19 @@ def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "c
 
 
 def mode_name(case: SquealCase, j: int) -> str:
-    """Mode ``j`` (1-based) by its frequency and, on a rotating body whose motion one angular harmonic
-    holds at least half of, its nodal diameters, e.g. "4321 Hz: 5 ND out-of-plane" (the disc's
-    motion mostly along its axis) or "in-plane"."""
+    """Mode ``j`` (1-based) by its frequency and, on a rotating body that holds at least ``DISC_SHARE``
+    of the mode's strain energy and whose motion one angular harmonic holds at least half of, its
+    nodal diameters, e.g. "4321 Hz: 5 ND out-of-plane" (the disc's motion mostly along its axis) or
+    "in-plane"."""
     name = f"{case.modes.frequency[j - 1]:.0f} Hz"
     if case.disc is None:
         return name
     if case.disc.share[j - 1] < 0.5:     # no one harmonic (or the disc does not move): no name (a review)
         return name
+    if case.energy is not None:          # a pad's mode, the disc holding 8.8 % of its strain energy, was
+        disc = [r.name for r in case.mech.tm.bodies[1].spec.regions]             # named by it (an NVH trial)
+        if sum(case.energy.share[j - 1, case.energy.names.index(r)] for r in disc) < DISC_SHARE:
+            return name
     plane = "out-of-plane" if case.disc.out_of_plane[j - 1] >= 0.5 else "in-plane"
     return f"{name}: {case.disc.nodal_diameters[j - 1]} ND {plane}"
 
