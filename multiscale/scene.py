@@ -395,7 +395,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
             problems.append(f'effects: {where} is a macro contact model: add effect "contact"')
         if "thermal" in effects and g.motion == "rotation" and (g.spec.crossed or 0.0) > 0:   # (after meshing: a trial)
             problems.append(f'effects: "thermal" solves the heat of {g.bodies[1]} in a fixed frame, which needs a body of '
-                            f"revolution, but its rotation crosses {100 * g.spec.crossed:.2g} % of its surface (vanes, holes, "
+                            f"revolution, but its rotation crosses about {100 * g.spec.crossed:.2g} % of its surface (vanes, holes, "
                             f"slots): fill them{' (geometry.vanes = 0)' if 'vanes' in g.resolved() else ' in the geometry'}"
                             ' or run without effect "thermal"')
         if "thermal" in effects and g.motion != "rotation" and (scene.loading is not None

@@ -8,7 +8,7 @@ import textwrap
 from multiscale.geometry import CellEstimate, estimate_cells
 from multiscale.held import check_held
 from multiscale.memory import DOFS_PER_CELL, HEAT_DOFS, MAP_MEMORY, MICRO_MEMORY, RUN_MEMORY, micro_memory, run_memory
-from multiscale.outputs import CHECKPOINT, analysis
+from multiscale.outputs import CHECKPOINT, checkpointed
 from multiscale.provenance import entries, results_of, unrecorded_results
 from multiscale.scene import EFFECTS, FIG_7_9_CALIBRATION, OUTPUT_FIELDS, Scene
 from multiscale.scene_friction import FRICTION, bare_interfaces
@@ -155,7 +155,7 @@ def summary(scene: Scene) -> list[str]:
         own = unrecorded_results(scene, names)
         lines.append(f"  note      the output folder already holds {entries(len(names))}: run needs --overwrite "
                      f"(deletes the {earlier} the run before wrote)"
-                     + (" or --resume" if analysis(scene) == "multiscale" and CHECKPOINT in names else "")
+                     + (" or --resume" if checkpointed(scene) and CHECKPOINT in names else "")
                      + (f"; it refuses to write over {', '.join(own)}, not written by a run" if own else ""))
     lines += [f"  warning   {w}" for w in scene.warnings]
     return lines

@@ -823,7 +823,7 @@ def test_a_rotating_body_with_holes_is_refused_by_check_for_its_heat(tmp_path, c
         holes + "BooleanDifference(3) = { Volume{1}; Delete; }{ Volume{2, 10:15}; Delete; };"))
     text = TWO_PADS.replace("{folder}", str(tmp_path / "out"))
     assert re.fullmatch(r'error: effects: "thermal" solves the heat of disc in a fixed frame, which needs a body of '
-                        r"revolution, but its rotation crosses 1.2 % of its surface \(vanes, holes, slots\): fill them "
+                        r"revolution, but its rotation crosses about 1.2 % of its surface \(vanes, holes, slots\): fill them "
                         r'in the geometry or run without effect "thermal"', check(tmp_path, capsys, text))
     from multiscale.geometry import Rotation
     from multiscale.workflows.model import build_mesh

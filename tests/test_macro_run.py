@@ -17,6 +17,7 @@ from multiscale.io import History, solver_statistic  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 from multiscale.workflows.model import build_model  # noqa: E402
 from multiscale.scene import load, loads  # noqa: E402
+from multiscale.scene_summary import summary  # noqa: E402
 
 BLOCK = """
 name = "block"
@@ -157,6 +158,9 @@ def test_a_stopped_thermal_run_resumes_to_the_straight_results(tmp_path):
         run(scene, resume=True, verbose=False)
     transient.run(scene, verbose=False, stop_after=2)
     assert len(History.read(tmp_path / "resumed" / "history.h5")) == 3
+    with pytest.raises(SceneError, match=r"use --overwrite to replace them, --resume to continue the run"):
+        run(scene, verbose=False)                        # (it offered --overwrite alone: a review)
+    assert re.search(r"run needs --overwrite \(deletes the \d+ the run before wrote\) or --resume", "\n".join(summary(scene)))
     resumed = run(loads(text, overrides={**settings, "output.folder": resumed_folder}), resume=True, verbose=False)
     a, b = straight.history, resumed.history
     assert set(a.columns) == set(b.columns) and len(b) == 5

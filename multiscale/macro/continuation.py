@@ -34,6 +34,7 @@ from multiscale.macro.laws_ufl import FacetLaw
 from multiscale.macro.mechanics import Mechanics, SolveResult
 
 FIRST_STEP, SMALLEST_STEP = 1 / 16, 1 / 64
+LEAST_STEP = 1 / 4096      # below this no step: a stuck continuation gives up after at most 12 halvings
 
 
 def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None, released: bool = False) -> SolveResult:
@@ -48,13 +49,14 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None,
     except ConvergenceError as exc:
         direct = exc
     mech.set_displacements(start)
-    offset = law.carried_offsets(mech.contact.facet_gap())
-    done, step, iterations = 0.0, FIRST_STEP, direct.result.iterations if direct.result is not None else 0
-    try:
+    gap = mech.contact.facet_gap()
+    offset = law.carried_offsets(gap)
+    step, smallest = first_steps(law.depths(gap, offset), offset)   # (at the gaps the offsets carry: after the
+    done, iterations = 0.0, direct.result.iterations if direct.result is not None else 0   # solve the facets' mean
+    try:                                                     # gaps carried nothing by the laws: a review)
         law.shift(offset)
         result = mech.solve()
         iterations += result.iterations
-        step, smallest = first_steps(law.depths(mech.contact.facet_gap(), offset), offset)
         rate = None                 # m per unit of lambda: the secant of the last two converged states
         while done < 1.0:
             target, kept = min(1.0, done + step), mech.displacements()
@@ -76,7 +78,8 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None,
             f"did{'; released: solved at the last load, kept for the next engagement' if released else ''}) failed: "
             f"{direct}; continued from the pressures of the laws before, it stopped at {done:.3g} of "
             f"the way (its last step {step:.3g}): {exc}; smaller wear steps change the laws less at an update "
-            "(more wear.substeps or time.steps, or a lower k_w)", exc.history, exc.result) from exc
+            "(more time.steps, or a lower k_w; wear.substeps divide the micro wear, not the update)",
+            exc.history, exc.result) from exc
     return dataclasses.replace(result, iterations=iterations)
 
 
@@ -84,7 +87,8 @@ def first_steps(depth, offset) -> tuple[float, float]:
     """The first and the smallest step of lambda: ``FIRST_STEP`` and ``SMALLEST_STEP``, or less where a
     step of lambda would open the facets that carry at lambda = 0 (``depth`` [m]: their interpenetration
     of the shifted laws, ``offset`` [m]: their shifts; a shift s moves a facet by d lambda s): a fraction
-    of the median depth per unit shift over the shifted facets in contact. Worn-flat laws rise from 0
+    of the median depth per unit shift over the shifted facets in contact, at the gaps the offsets were
+    taken at (``LEAST_STEP`` at least). Worn-flat laws rise from 0
     to their pressure within nm (a light load's run-in: all facets open at lambda = 1/64, the pin then
     free along the load; a trial)."""
     depth, offset = np.asarray(depth, dtype=float), np.asarray(offset, dtype=float)
@@ -92,4 +96,4 @@ def first_steps(depth, offset) -> tuple[float, float]:
     if not carrying.any():
         return FIRST_STEP, SMALLEST_STEP
     reach = float(np.median(depth[carrying] / offset[carrying]))    # lambda that opens half of them
-    return min(FIRST_STEP, reach / 2), min(SMALLEST_STEP, reach / 16)
+    return min(FIRST_STEP, reach / 2), max(min(SMALLEST_STEP, reach / 16), LEAST_STEP)

@@ -201,7 +201,8 @@ class SeriesFile:
                           "--overwrite") from None
         if shape != self.layout.geometry.shape:
             raise OutputError(f"{self.h5} holds another mesh than this run's (resume with the same scene)")
-        keep = int(np.count_nonzero(times <= resume_at))
+        keep = int(np.argmin(np.append(times <= resume_at, False)))     # the leading run of such times (a junk
+        #                                                                     time after them counted before: a review)
         self._grids = grids[:keep]
         if keep < len(times):
             with h5py.File(self.h5, "a") as f:

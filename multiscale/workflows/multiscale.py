@@ -42,14 +42,13 @@ from multiscale.micro.laws import Conductance
 from multiscale.micro.post_analysis import Heating, PostAnalyses, PostAnalysis, grid_of
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, heat_warnings_as_notes, \
     interface_forces, interface_materials, run_notes, say_clamp, say_load, say_model_size
-from multiscale.workflows.output import fingerprint, prepare_folder, totals
+from multiscale.workflows.output import fingerprint, totals
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
 from multiscale.workflows import stepping
 from multiscale.workflows.strain import refuse_floating, say_at_once
 from multiscale.workflows.transient import TransientResult, stopped_after, write_history
 
-CHECKPOINT = outputs.CHECKPOINT
 
 
 @dataclass
@@ -126,22 +125,15 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     """
     start = _time.perf_counter()
     io.abort_on_exception(comm)
-    ckpt = Path(scene.output.folder) / CHECKPOINT
-    if resume:
-        stepping.refuse_without_checkpoint(ckpt.parent, comm)
-    out = prepare_folder(scene, overwrite, resume, comm)
+    out, ckpt, stored = stepping.open_run(scene, overwrite, resume, comm)
     folder = out.path
-    stored = checkpoint.peek(ckpt, comm) if resume else {}
     if stored.get("finished"):
-        checkpoint.same_scene(stored, fingerprint(scene), ckpt)
         history, fields, png = stepping.ended(folder, scene.name, int(stored["step"]), comm, verbose)
         plot, maps = folder / "multiscale.png", sorted(folder.glob("wear_map*.png"))
         plot = plot if plot.is_file() else None
         files = fields + [f for f in (folder / "history.h5", png, plot, folder / "zones.h5", ckpt) if f] + maps
         return MultiscaleResult(folder, files, 0.0, history, folder / "history.h5", png, fields, plot, maps,
                                 folder / "zones.h5", int(stored["step"]))
-    if resume:
-        out.claim()                          # a part of its own in the provenance, also if it is killed
     ms = build(scene, comm, progress=verbose and comm.rank == 0)
     with closed_on_error(ms.model, comm):        # a script going on after a failed run gets its communicators
         steps = scene.time.steps if (ms.model.thermal is not None or scene.has("wear")) else 0
@@ -157,10 +149,10 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             if steps:
                 say_at_once(scene, history, comm)
             out.claim()                      # --overwrite: the earlier results go now, not before a failed start
-            ms.save(ckpt, 0, history)
             write_history(history, folder, scene.name, comm, plot=False)   # a run failing in step 1 keeps t = 0
             refuse_floating(scene, ms.model.tm, history)
             say_clamp(scene, history)
+            ms.save(ckpt, 0, history)        # after the refusal: a refused run leaves nothing to resume (a review)
         ms.rough.pool.progress = False
         plan = outputs.plan(scene)
         writer = stepping.field_output(ms.model, folder, plan.body_fields + plan.interface_fields, done=done,

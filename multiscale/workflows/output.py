@@ -128,7 +128,7 @@ def prepare_folder(scene, overwrite: bool, resume: bool, comm) -> OutputFolder:
     if existing and not (overwrite or resume):
         shown = ", ".join(existing[:3]) + (", ..." if len(existing) > 3 else "")
         ran = comm.bcast(bool(set(existing) & set(provenance.results_of(folder))) if comm.rank == 0 else None, root=0)
-        resumes = ran and outputs.analysis(scene) == "multiscale"     # the only analysis with checkpoints
+        resumes = ran and outputs.checkpointed(scene)                  # the analyses with checkpoints
         held = f"results ({provenance.entries(len(existing))}: {shown})" if ran else \
             f"{provenance.entries(len(existing))} that no run wrote ({shown})"    # the user's own files: not "results"
         advice = ("use --overwrite to replace them, --resume to continue the run (in Python: overwrite=True, "

@@ -19,15 +19,27 @@ from multiscale import checkpoint, io
 from multiscale.errors import InputError
 from multiscale.macro.output import FieldOutput
 from multiscale.outputs import CHECKPOINT
+from multiscale.workflows.output import OutputFolder, fingerprint, prepare_folder
 
 
-def refuse_without_checkpoint(folder: Path, comm) -> None:
-    """InputError (every rank) for ``--resume`` into a folder that holds no checkpoint; before the
-    folder is claimed, so that it stays as it was."""
-    if comm.bcast(folder.is_dir() and not (folder / CHECKPOINT).is_file() if comm.rank == 0 else None, root=0):
+def open_run(scene, overwrite: bool, resume: bool, comm) -> tuple[OutputFolder, Path, dict]:
+    """The output folder of a time-marching run (``workflows.output.prepare_folder``), its checkpoint's
+    path, and (``resume``) the checkpoint's attributes, {} otherwise: ``--resume`` into a folder
+    without a checkpoint is refused before the folder is touched, and that of a finished run is
+    checked against the scene (``finished`` in the attributes: nothing left to do); collective."""
+    folder = Path(scene.output.folder)
+    if resume and comm.bcast(folder.is_dir() and not (folder / CHECKPOINT).is_file() if comm.rank == 0 else None,
+                             root=0):
         raise InputError("--resume", str(folder), f"no {CHECKPOINT} in the output folder to resume from (no "
                          "macro step of a run ended there): run without --resume (with --overwrite if the folder "
                          "holds results; in Python: resume=False, overwrite=True)")
+    out = prepare_folder(scene, overwrite, resume, comm)
+    stored = checkpoint.peek(out.path / CHECKPOINT, comm) if resume else {}
+    if stored.get("finished"):
+        checkpoint.same_scene(stored, fingerprint(scene), out.path / CHECKPOINT)
+    elif resume:
+        out.claim()                          # a part of its own in the provenance, also if it is killed
+    return out, out.path / CHECKPOINT, stored
 
 
 def field_output(model, folder: Path, names, *, done: int, steps: int, every: int, written: int, resume: bool,

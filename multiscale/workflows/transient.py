@@ -19,11 +19,10 @@ from multiscale import checkpoint, io, outputs
 from multiscale.errors import Interrupted
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.model import MacroModel
-from multiscale.outputs import CHECKPOINT
 from multiscale.workflows import stepping
 from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, run_notes, say_clamp, \
     say_load, say_model_size
-from multiscale.workflows.output import RunResult, fingerprint, prepare_folder, totals
+from multiscale.workflows.output import RunResult, fingerprint, totals
 from multiscale.workflows.strain import refuse_floating, say_at_once
 
 
@@ -90,19 +89,12 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     after that macro step's checkpoint (as if it had been killed then; for tests)."""
     start = _time.perf_counter()
     io.abort_on_exception(comm)
-    ckpt = Path(scene.output.folder) / CHECKPOINT
-    if resume:
-        stepping.refuse_without_checkpoint(ckpt.parent, comm)
-    out = prepare_folder(scene, overwrite, resume, comm)
+    out, ckpt, stored = stepping.open_run(scene, overwrite, resume, comm)
     folder = out.path
-    stored = checkpoint.peek(ckpt, comm) if resume else {}
     if stored.get("finished"):
-        checkpoint.same_scene(stored, fingerprint(scene), ckpt)
         history, fields, png = stepping.ended(folder, scene.name, int(stored["step"]), comm, verbose)
         return TransientResult(folder, fields + [f for f in (folder / "history.h5", png, ckpt) if f], 0.0, history,
                                folder / "history.h5", png, fields)
-    if resume:
-        out.claim()                          # a part of its own in the provenance, also if it is killed
     with io.stage("meshing"):
         tm = build_mesh(scene, comm)
     with io.stage("model set-up"), heat_warnings_as_notes():
@@ -121,17 +113,17 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             out.claim()                          # --overwrite: the earlier results go now, not before a failed start
             done, history, written = 0, io.History(), -1
             history.append(**model.record())
-            if steps:
-                marching.save(ckpt, 0, history)
         plan = outputs.plan(scene)
         writer = stepping.field_output(model, folder, plan.body_fields + plan.interface_fields, done=done,
                                        steps=steps, every=scene.output.every, written=written, resume=resume,
-                                       ckpt=ckpt if steps else None)     # (the first solve's fields: also those
-        if not resume:                                                    # of a run refused next)
+                                       ckpt=ckpt if steps and resume else None)   # (the first solve's fields: also
+        if not resume:                                                              # those of a run refused next)
             write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
             refuse_floating(scene, tm, history)
             say_clamp(scene, history)
-            if steps:
+            if steps:                        # after the refusal: a refused run leaves nothing to resume (a review)
+                marching.save(ckpt, 0, history)
+                checkpoint.mark(ckpt, comm, fields_written=0)
                 say_at_once(scene, history, comm)
         last = steps if stop_after is None else min(steps, stop_after)
         with io.StepStop(comm, done) as stop, heat_warnings_as_notes(model):   # a Ctrl-C while the end is written lets it finish
