@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 
 from multiscale.errors import InputError
-from multiscale.geometry import CROSSES, thin_warning
+from multiscale.geometry import CROSSES, Rotation, crossed, thin_warning
 
 REVOLUTION = 1e-3           # the rotating body's centre of mass off its axis (of its extent), its axis of inertia (rad)
 EQUAL_MOMENTS = 0.01        # principal moments of inertia this close (of the largest) are those of a body of revolution
@@ -83,17 +83,13 @@ def crossed_share(model, g, volumes) -> float:
     axis or a coaxial cylinder is never crossed; vanes, holes, slots and the flats of a square bore
     are (a face judged whole, by its median, missed the flats: a review). The heat problem needs
     none (``macro.thermal``)."""
-    e = np.asarray(g.axis, dtype=float) / np.linalg.norm(g.axis)
-    crossed = total = 0.0
+    motion, across, total = Rotation(tuple(g.axis), tuple(g.centre)), 0.0, 0.0
     for _, f in model.getBoundary([(3, v) for v in volumes], combined=True, oriented=False):
         x, n = surface_samples(model, f, 5)
-        w = np.cross(e, x - np.asarray(g.centre, dtype=float))
-        speed = np.linalg.norm(w, axis=1)
-        cos = np.abs((w * n).sum(axis=1)) / np.maximum(speed * np.linalg.norm(n, axis=1), np.finfo(float).tiny)
-        area = model.occ.getMass(2, f)
-        total += area * speed.mean()
-        crossed += area * np.mean(speed * (cos > CROSSES))
-    return crossed / total if total > 0 else 0.0
+        cos, weight = crossed(x, n, np.full(len(x), model.occ.getMass(2, f) / len(x)), motion)
+        total += weight.sum()
+        across += weight[cos > CROSSES].sum()
+    return across / total if total > 0 else 0.0
 
 
 def check_revolution(g, volumes: list[tuple]) -> None:

@@ -77,6 +77,18 @@ class Rotation:
 CROSSES = 0.5     # |w.n|/|w| above which a rotation w crosses a surface (vanes, holes: ``macro.mesh.crossing``)
 
 
+def crossed(points, normals, weights, motion) -> tuple[np.ndarray, np.ndarray]:
+    """Where the rigid ``motion`` crosses a surface sampled at ``points`` (n, 3) [m] with ``normals``
+    (any length) standing for ``weights`` (n,) of it (areas): per point |w.n| / (|w| |n|) (0 where w
+    = 0; crossed above ``CROSSES``) and the weight times the speed |w|, the weight of its share
+    (``macro.mesh.crossing`` on a mesh, ``meshes.cad_checks.crossed_share`` on CAD faces)."""
+    w = motion.velocity(points)
+    n = np.asarray(normals, dtype=float)
+    speed = np.linalg.norm(w, axis=1)
+    cos = np.abs((w * n).sum(axis=1)) / np.maximum(speed * np.linalg.norm(n, axis=1), np.finfo(float).tiny)
+    return cos, np.asarray(weights, dtype=float) * speed
+
+
 @dataclass(frozen=True)
 class Translation:
     """Rigid translation of body 1 along the unit vector ``direction``: w = v e [m/s]."""

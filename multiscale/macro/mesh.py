@@ -28,7 +28,7 @@ from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
 from multiscale.errors import InputError, MultiscaleError
-from multiscale.geometry import CROSSES, BodySpec, GeometrySpec, check_cells, gmsh_session
+from multiscale.geometry import CROSSES, BodySpec, GeometrySpec, check_cells, crossed, gmsh_session
 from multiscale.macro.coverage import coverage_notes, face_coverage
 from multiscale.held import check_held
 
@@ -66,13 +66,9 @@ def crossing(triangles: np.ndarray, motion, comm) -> Crossing:
     ``motion`` crosses: |w.n| > ``CROSSES`` |w| at a triangle's centroid (collective)."""
     x = np.asarray(triangles, dtype=float).reshape(-1, 3, 3)
     n = vector_areas(x)
-    area = np.linalg.norm(n, axis=1)
     mid = x.mean(axis=1)
-    w = motion.velocity(mid)
-    speed = np.linalg.norm(w, axis=1)
-    cos = np.abs((w * n).sum(axis=1)) / np.maximum(speed * area, np.finfo(float).tiny)
-    crossed = cos > CROSSES
-    sums = comm.allreduce(np.array([(area * speed)[crossed].sum(), (area * speed).sum()]), op=MPI.SUM)
+    cos, weight = crossed(mid, n, np.linalg.norm(n, axis=1), motion)
+    sums = comm.allreduce(np.array([weight[cos > CROSSES].sum(), weight.sum()]), op=MPI.SUM)
     k = int(np.argmax(cos)) if len(cos) else -1
     worst, where = max(comm.allgather((cos[k], tuple(mid[k])) if k >= 0 else (-1.0, (np.nan,) * 3)))
     return Crossing(float(sums[0] / sums[1]) if sums[1] > 0 else 0.0, float(worst), np.array(where))
