@@ -24,12 +24,13 @@ from multiscale.arrays import unique_rows
 from multiscale.errors import InputError
 from multiscale.io import History, on_root, replacing
 
-FORMAT = 8    # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns;
+FORMAT = 9    # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns;
 #               3: the drive's state (speed, engagement, load last solved) and the area-weighted effusivity partition;
 #               4: the law_reach_halved history column, quadratic cells in the field files beside it;
 #               5: min_temperature_<body>_in_<material> history columns; 6: wear_substeps, near_perfect_zones;
 #               7: form_depth (the rough body's wear at its facets beyond their zones' means), the zones' rates;
-#               8: max_slip_speed, min_slip_speed history columns (a mu(v) law)
+#               8: max_slip_speed, min_slip_speed history columns (a mu(v) law); 9: no fields_written (a step's
+#               fields are written before its checkpoint, ``workflows.stepping``)
 
 
 def fingerprint(text: str) -> str:
@@ -87,24 +88,23 @@ def save_step(path, comm, step: int, history: History, fingerprint: "Fingerprint
     run's state), the history so far, the scene's ``fingerprint``, and the fields of ``model`` (a
     ``macro.model.MacroModel``: its ``functions``, by coordinates at its mesh's length scale)."""
     arrays = {**arrays, **{f"history/{k}": np.asarray(v) for k, v in history.columns.items()}}
-    attrs = {"step": step, **fingerprint.attrs(), "ranks": comm.size, "fields_written": -1, **attrs}
+    attrs = {"step": step, **fingerprint.attrs(), "ranks": comm.size, **attrs}
     return save(path, comm, attrs=attrs, arrays=arrays, functions=model.functions, scale=model.tm.spec.length_scale)
 
 
 @dataclass
 class Restored:
-    """What a run resumes from: its last macro step, history and last step whose fields are written."""
+    """What a run resumes from: its last macro step and history."""
 
     step: int                  # last macro step done
     history: History
-    fields_written: int        # last step whose fields were written (-1: none)
 
 
 def restored(attrs: dict, arrays: dict) -> Restored:
     """The ``Restored`` of a checkpoint read by ``load`` (written by ``save_step``)."""
     history = History()
     history.columns = {k[len("history/"):]: list(v) for k, v in arrays.items() if k.startswith("history/")}
-    return Restored(int(attrs["step"]), history, int(attrs["fields_written"]))
+    return Restored(int(attrs["step"]), history)
 
 
 def load(path, comm, functions: dict) -> tuple[dict, dict]:
@@ -144,8 +144,7 @@ def load(path, comm, functions: dict) -> tuple[dict, dict]:
 
 
 def mark(path, comm, **attrs) -> None:
-    """Set scalar attributes of the checkpoint ``path`` (e.g. the last step whose fields are
-    written, or that the run finished); outside the checksum, which covers the data (collective).
+    """Set scalar attributes of the checkpoint ``path`` (e.g. that the run finished); outside the checksum, which covers the data (collective).
     All or nothing: a copy is marked and replaces the checkpoint (HDF5 edits in place are not
     crash-safe: a run killed while its only checkpoint was being edited could lose it)."""
     path = Path(path)

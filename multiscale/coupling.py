@@ -521,7 +521,7 @@ class Multiscale:
 
     # ---- checkpoints -----------------------------------------------------------------------
     def save(self, path: Path, step: int, history: io.History) -> None:
-        """Checkpoint after macro step ``step`` (collective)."""
+        """Checkpoint after macro step ``step`` (collective; ``checkpoint.save_step``)."""
         model_attrs, model_arrays = self.model.checkpoint_state()
         arrays = {"heights": self.rough.heights(), "warm": self.warm, "partition": self.partition,
                   **({"plastic": self.rough.plastic} if self.plastic else {}),    # else zero: not stored

@@ -129,12 +129,13 @@ def ranks_of(pid: int) -> list[int]:
     return out
 
 
-def fields_written(ckpt: Path) -> int:
-    """The last step whose fields the running job wrote (-1: none yet); read from a copy of the
-    checkpoint's bytes, so that no HDF5 lock is taken on the file the job rewrites."""
+def checkpoint_step(ckpt: Path) -> int:
+    """The step of the running job's checkpoint (-1: none yet; its fields are written before it);
+    read from a copy of the checkpoint's bytes, so that no HDF5 lock is taken on the file the job
+    rewrites."""
     try:
         with h5py.File(BytesIO(ckpt.read_bytes()), "r") as f:
-            return int(f.attrs["fields_written"])
+            return int(f.attrs["step"])
     except (OSError, KeyError, ValueError):
         return -1
 
@@ -152,7 +153,7 @@ def test_killed_mid_run_and_resumed_writes_the_uninterrupted_results(base, tmp_p
                            stderr=subprocess.PIPE, text=True, start_new_session=True)
     try:
         deadline = time.monotonic() + 300
-        while time.monotonic() < deadline and job.poll() is None and fields_written(ckpt) < 2:
+        while time.monotonic() < deadline and job.poll() is None and checkpoint_step(ckpt) < 2:
             time.sleep(0.05)                    # after step 2's checkpoint and fields: computing step 3
         victims = ranks_of(job.pid)[-1:] if ranks > 1 else [job.pid]
         assert victims and job.poll() is None, "the run was to be killed mid-run; it ended"

@@ -140,11 +140,11 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         every = scene.output.every
         if resume:
             with io.stage("restoring the checkpoint"):
-                done, history, written = dataclasses.astuple(ms.restore(ckpt))
+                done, history = dataclasses.astuple(ms.restore(ckpt))
         else:
             with io.stage("zone laws and first solve"), heat_warnings_as_notes(ms.model):
                 first = ms.start()
-            done, history, written = 0, io.History(), -1
+            done, history = 0, io.History()
             history.append(**ms.record(first))
             if steps:
                 say_at_once(scene, history, comm)
@@ -152,18 +152,18 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             write_history(history, folder, scene.name, comm, plot=False)   # a run failing in step 1 keeps t = 0
             refuse_floating(scene, ms.model.tm, history)
             say_clamp(scene, history)
-            ms.save(ckpt, 0, history)        # after the refusal: a refused run leaves nothing to resume (a review)
         ms.rough.pool.progress = False
         plan = outputs.plan(scene)
         writer = stepping.field_output(ms.model, folder, plan.body_fields + plan.interface_fields, done=done,
-                                       steps=steps, every=every, written=written, resume=resume,
-                                       extra=ms.facet_fields(), ckpt=ckpt)
+                                       steps=steps, every=every, resume=resume, extra=ms.facet_fields())
+        if not resume:                       # after the refusal: a refused run leaves nothing to resume (a review)
+            ms.save(ckpt, 0, history)
         last = steps if stop_after is None else min(steps, stop_after)
         # a Ctrl-C while the end is written lets it finish
         with io.StepStop(comm, done) as stop, heat_warnings_as_notes(ms.model):
             done, stopping = stepping.march(ms, stop, history, writer,
                                             lambda: write_history(history, folder, scene.name, comm, plot=False),
-                                            ckpt, comm, done=done, last=last, steps=steps, every=every)
+                                            ckpt, done=done, last=last, steps=steps, every=every)
             with io.stage("writing history and plots"), stop.writing(done, last=not stopping):
                 title = scene.name + stopped_after(done, steps) * stopping
                 h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures, title=title)

@@ -2,9 +2,9 @@
 their checkpoints, so that ``multiscale run --resume`` continues a stopped or killed run.
 
 Every step writes, as one whole that a Ctrl-C waits for (``io.StepStop.writing``): its history row,
-its checkpoint (``checkpoint.h5``: the step, the history, the model's fields and state; the run's
-own ``save``), the history file (readable if the run is killed next) and, at output times (and at a
-stop), its fields, marked in the checkpoint as written. A resumed run starts from the checkpoint's
+at output times (and at a stop) its fields, its checkpoint (``checkpoint.h5``: the step, the history,
+the model's fields and state; the run's own ``save``) and the history file (readable if the run is
+killed next): a checkpoint's step has its fields written if they are due. A resumed run starts from the checkpoint's
 step: the field files keep their times up to it (``FieldOutput(resume_at=...)``: those of a step
 whose checkpoint was not written are dropped, and the fields of a stop between output times too),
 so that a run stopped and resumed, any number of times, writes what the straight run writes.
@@ -42,22 +42,20 @@ def open_run(scene, overwrite: bool, resume: bool, comm) -> tuple[OutputFolder, 
     return out, out.path / CHECKPOINT, stored
 
 
-def field_output(model, folder: Path, names, *, done: int, steps: int, every: int, written: int, resume: bool,
-                 extra=None, ckpt: Path | None = None) -> FieldOutput:
-    """The run's field files from step ``done`` on (resumed: kept up to the checkpoint's time, without
-    the fields of a stop between output times; those of step ``done`` written if they are due and
-    the checkpoint ``ckpt`` (None: none) says they are not: ``written`` < ``done``)."""
+def field_output(model, folder: Path, names, *, done: int, steps: int, every: int, resume: bool,
+                 extra=None) -> FieldOutput:
+    """The run's field files: a new run's, with the fields of its start (step ``done`` = 0, written
+    before its first checkpoint); a resumed run's, kept up to its checkpoint's step ``done`` (whose
+    due fields were written before it), without the fields of a stop between output times."""
     due = done % every == 0 or done == steps                # the step's fields belong to the series
     keep = model.time if due else np.nextafter(model.time, -np.inf)
     writer = FieldOutput(model, folder, names, extra=extra, resume_at=keep if resume else None)
-    if written < done and due:
+    if not resume:
         writer.write()
-        if ckpt is not None:
-            checkpoint.mark(ckpt, model.tm.comm, fields_written=done)
     return writer
 
 
-def march(run, stop: io.StepStop, history: io.History, writer: FieldOutput, write_history, ckpt: Path, comm, *,
+def march(run, stop: io.StepStop, history: io.History, writer: FieldOutput, write_history, ckpt: Path, *,
           done: int, last: int, steps: int, every: int) -> tuple[int, bool]:
     """Macro steps ``done`` + 1 ... ``last`` of ``steps`` (module docstring): ``run`` has
     ``step(n)`` (its result goes to ``record``), ``record(stepped)`` (a history row) and
@@ -67,14 +65,14 @@ def march(run, stop: io.StepStop, history: io.History, writer: FieldOutput, writ
     with io.stage("macro steps"):
         for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
             stepped = run.step(n)
-            with stop.writing(n):                     # the step's checkpoint, history and fields, whole
+            with stop.writing(n):                     # the step's fields, checkpoint and history, whole
                 history.append(**run.record(stepped))
+                done, stopping = n, n < steps and stop.requested()   # (the last: it finishes)
+                due = n % every == 0 or n == steps or stopping       # a stop's are dropped when resumed
+                if due:
+                    writer.write()                    # before the checkpoint: killed between, they are dropped
                 run.save(ckpt, n, history)
                 write_history()                       # readable if the run is killed
-                done, stopping = n, n < steps and stop.requested()   # (the last: it finishes)
-                if n % every == 0 or n == steps or stopping:   # a stop's are dropped when resumed
-                    writer.write()
-                    checkpoint.mark(ckpt, comm, fields_written=n)
             if stopping:
                 break
     return done, stopping

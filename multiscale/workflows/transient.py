@@ -70,7 +70,7 @@ class Marching:
         return self.model.record(heat)
 
     def save(self, path: Path, step: int, history: io.History) -> None:
-        """Checkpoint after macro step ``step`` (collective)."""
+        """Checkpoint after macro step ``step`` (collective; ``checkpoint.save_step``)."""
         attrs, arrays = self.model.checkpoint_state()
         checkpoint.save_step(path, self.model.tm.comm, step, history, self.fingerprint, attrs, arrays, self.model)
 
@@ -106,30 +106,28 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         steps = scene.time.steps if model.thermal is not None else 0
         if resume:
             with io.stage("restoring the checkpoint"):
-                done, history, written = dataclasses.astuple(marching.restore(ckpt))
+                done, history = dataclasses.astuple(marching.restore(ckpt))
         else:
             with io.stage("first contact solve"), heat_warnings_as_notes(model):
                 model.start()
             out.claim()                          # --overwrite: the earlier results go now, not before a failed start
-            done, history, written = 0, io.History(), -1
+            done, history = 0, io.History()
             history.append(**model.record())
         plan = outputs.plan(scene)
         writer = stepping.field_output(model, folder, plan.body_fields + plan.interface_fields, done=done,
-                                       steps=steps, every=scene.output.every, written=written, resume=resume,
-                                       ckpt=ckpt if steps and resume else None)   # (the first solve's fields: also
-        if not resume:                                                              # those of a run refused next)
+                                       steps=steps, every=scene.output.every, resume=resume)
+        if not resume:                       # (the first solve's fields are written: also those of a run refused next)
             write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
             refuse_floating(scene, tm, history)
             say_clamp(scene, history)
             if steps:                        # after the refusal: a refused run leaves nothing to resume (a review)
                 marching.save(ckpt, 0, history)
-                checkpoint.mark(ckpt, comm, fields_written=0)
                 say_at_once(scene, history, comm)
         last = steps if stop_after is None else min(steps, stop_after)
         with io.StepStop(comm, done) as stop, heat_warnings_as_notes(model):   # a Ctrl-C while the end is written lets it finish
             done, stopping = stepping.march(marching, stop, history, writer,
                                             lambda: write_history(history, folder, scene.name, comm, plot=False),
-                                            ckpt, comm, done=done, last=last, steps=steps, every=scene.output.every)
+                                            ckpt, done=done, last=last, steps=steps, every=scene.output.every)
             with io.stage("writing history and plots"), stop.writing(done, last=not stopping):
                 h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures,
                                         title=scene.name + stopped_after(done, steps) * stopping)
