@@ -107,11 +107,12 @@ def restored(attrs: dict, arrays: dict) -> Restored:
     return Restored(int(attrs["step"]), history)
 
 
-def load(path, comm, functions: dict) -> tuple[dict, dict]:
+def load(path, comm, functions: dict, fingerprint: "Fingerprint | None" = None) -> tuple[dict, dict]:
     """Read a checkpoint: sets ``functions`` (name -> Function, matched by dof coordinates) and
-    returns (attrs, arrays). Raises InputError (on every rank: each reads the whole file) if the
-    file is unreadable, truncated or corrupted (its checksum), of another ``FORMAT``, or a
-    function's dofs are not in it."""
+    returns (attrs, arrays). Raises InputError on every rank (each reads the whole file) if the
+    file is unreadable, truncated or corrupted (its checksum), of another ``FORMAT``, not of the
+    scene whose ``fingerprint`` is given (``same_scene``; None: not checked), or a function's dofs
+    are not in it (on any rank: the mesh changed)."""
     data = {}
     try:
         with h5py.File(path, "r") as h5:
@@ -129,16 +130,18 @@ def load(path, comm, functions: dict) -> tuple[dict, dict]:
     if int(attrs.get("format", 1)) != FORMAT:
         raise InputError("--resume", str(path), f"written by another version of multiscale (checkpoint format "
                          f"{int(attrs.get('format', 1))}, this one reads {FORMAT}); start again with --overwrite")
+    if fingerprint is not None:
+        same_scene(attrs, fingerprint, path)
     arrays = {name[len("arrays/"):]: value for name, value in data.items() if name.startswith("arrays/")}
+    tables = {name: _dof_table(f, scale) for name, f in functions.items()}
+    index = {name: _match(stored[name][0], keys) for name, (keys, _) in tables.items()}
+    unknown = comm.allgather([name for name, i in index.items() if np.any(i < 0)])   # (one rank's: all raise)
+    if any(unknown):
+        raise InputError("--resume", str(path), f"the mesh changed: field {sorted(set(sum(unknown, [])))[0]!r} "
+                         "has dofs the checkpoint does not know")
     for name, f in functions.items():
-        keys, values = _dof_table(f, scale)
-        index = _match(stored[name][0], keys)
-        if np.any(index < 0):
-            raise InputError("--resume", str(path), f"the mesh changed: field {name!r} has dofs the "
-                             "checkpoint does not know")
-        bs = values.shape[1]
-        owned = stored[name][1][index]
-        f.x.array.reshape(-1, bs)[:len(keys)] = owned
+        keys, values = tables[name]
+        f.x.array.reshape(-1, values.shape[1])[:len(keys)] = stored[name][1][index[name]]
         f.x.scatter_forward()
     return attrs, arrays
 

@@ -534,8 +534,7 @@ class Multiscale:
 
     def restore(self, path: Path) -> checkpoint.Restored:
         """State of the checkpoint ``path`` (collective)."""
-        attrs, arrays = checkpoint.load(path, self.comm, self.model.functions)
-        checkpoint.same_scene(attrs, self.fingerprint, path)
+        attrs, arrays = checkpoint.load(path, self.comm, self.model.functions, self.fingerprint)
         self.model.restore_checkpoint(attrs, arrays)
         self.rough.set_heights(range(len(arrays["heights"])), arrays["heights"])
         if self.plastic:
@@ -547,7 +546,7 @@ class Multiscale:
         self.counter_volume = float(attrs["counter_volume"])
         self.exchange = arrays["exchange"]
         self.work = float(attrs["work"])
-        self.interval_work = float(attrs.get("interval_work", 0.0))     # absent from older checkpoints
+        self.interval_work = float(attrs["interval_work"])
         self.set_gap()
         self.rough.update_laws()
         self.apply_zone_fields()

@@ -307,33 +307,18 @@ class MacroModel:
         """The contact's speed, engagement and heating constants and the mechanics' load."""
         return [*(getattr(self.contact, k) for k in ("speed", "engaged", "heating")), self.mechanics.load]
 
-    def snapshot(self) -> dict:
-        """The state a step starts from (fields, time, heat counters, drive constants, the speed and
-        load of the last solve: a pass of a fixed point that solved at a start or a stop is undone)."""
-        state = {"arrays": [f.x.array.copy() for f in self.functions.values()], "time": self.time,
-                 "heat_total": self.heat_total.copy(), "interface_heat_total": self.interface_heat_total.copy(),
-                 "exchanged": self.heat_exchanged_total,
-                 "last_solve": self.last_solve, "constants": [float(c.value) for c in self.drive_constants],
-                 "solved_speed": self.solved_speed, "load": self.load, "stale": self.stale}
-        if self.thermal is not None:
-            state.update(thermal_time=self.thermal.time, lost_total=self.thermal.lost_total.copy(),
-                         lost_step=self.thermal.lost_step.copy())
-        return state
+    def snapshot(self) -> tuple[dict, dict, list]:
+        """The state a step starts from, in memory (a pass of a fixed point that solved at a start or
+        a stop is undone): ``checkpoint_state`` and the values of the ``functions``."""
+        attrs, arrays = self.checkpoint_state()
+        return attrs, {k: v.copy() for k, v in arrays.items()}, [f.x.array.copy() for f in self.functions.values()]
 
-    def restore(self, state: dict) -> None:
+    def restore(self, state: tuple[dict, dict, list]) -> None:
         """Back to a ``snapshot``."""
-        for f, values in zip(self.functions.values(), state["arrays"]):
-            f.x.array[:] = values
-        for c, value in zip(self.drive_constants, state["constants"]):
-            c.value = value
-        self.time, self.heat_total, self.last_solve = state["time"], state["heat_total"].copy(), state["last_solve"]
-        self.heat_exchanged_total, self.interface_heat_total = state["exchanged"], state["interface_heat_total"].copy()
-        self.solved_speed, self.load = state["solved_speed"], state["load"]
-        if self.thermal is not None:
-            self.thermal.time = state["thermal_time"]
-            self.thermal.lost_total, self.thermal.lost_step = state["lost_total"].copy(), state["lost_step"].copy()
-        self.update_friction()
-        self.stale = state["stale"]                # (the snapshot's mu: that of its temperatures)
+        attrs, arrays, values = state
+        for f, array in zip(self.functions.values(), values):
+            f.x.array[:] = array
+        self.restore_checkpoint(attrs, arrays)
 
     def checkpoint_state(self) -> tuple[dict, dict]:
         """(attributes, arrays) of the state a checkpoint keeps beside the ``functions``: time, heat
@@ -354,20 +339,18 @@ class MacroModel:
         """Back to a ``checkpoint_state`` (the ``functions`` restored by the caller); mu at the
         temperatures and the speed last solved. The run's warnings before are not said again."""
         self.heat_exchanged, self.heat_exchanged_total = (float(v) for v in attrs["heat_exchanged"])
-        unknown = np.full(len(self.tm.interface.tags), np.nan)           # absent from older checkpoints
-        self.heat_total, self.interface_heat_total = arrays["heat_total"].copy(), arrays.get("interface_heat_total",
-                                                                                             unknown)
+        self.heat_total, self.interface_heat_total = arrays["heat_total"].copy(), arrays["interface_heat_total"].copy()
         self.heat_lost_recorded = arrays["heat_lost_recorded"].copy()
         self.time = float(attrs["time"])
         if self.thermal is not None:
             self.thermal.lost_total, self.thermal.time = arrays["lost_total"].copy(), self.time
-        for holder, said in zip((self, self.thermal), json.loads(attrs.get("notes", "[[], []]"))):
+        for holder, said in zip((self, self.thermal), json.loads(attrs["notes"])):
             if holder is not None:
                 holder.notes = said + [n for n in holder.notes if n not in said]
         reason, its, force, max_p = attrs["solve"]
         self.last_solve = SolveResult(True, int(reason), int(its), [], float(force), float(max_p))
         self.load, self.solved_speed = float(attrs["load"]), float(attrs["solved_speed"])
-        self.stale = bool(attrs.get("stale", 1))
+        self.stale = bool(attrs["stale"])
         for c, value in zip(self.drive_constants, attrs["constants"]):   # speed, engagement, load last solved
             c.value = value
         self.update_friction()                  # fade and mu(v): at the temperatures and the speed last solved

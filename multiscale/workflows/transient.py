@@ -76,8 +76,7 @@ class Marching:
 
     def restore(self, path: Path) -> checkpoint.Restored:
         """State of the checkpoint ``path`` (collective)."""
-        attrs, arrays = checkpoint.load(path, self.model.tm.comm, self.model.functions)
-        checkpoint.same_scene(attrs, self.fingerprint, path)
+        attrs, arrays = checkpoint.load(path, self.model.tm.comm, self.model.functions, self.fingerprint)
         self.model.restore_checkpoint(attrs, arrays)
         return checkpoint.restored(attrs, arrays)
 

@@ -47,3 +47,27 @@ def test_a_field_mesh_refused_on_rank_0_is_refused_on_every_rank():
     with pytest.raises(MultiscaleError, match="distinct coordinates"):
         MeshLayout(twice)
     comm.Barrier()
+
+
+def test_a_checkpoint_that_one_rank_cannot_match_is_refused_on_every_rank(tmp_path_factory):
+    """``checkpoint.load`` of a checkpoint whose dofs the last rank's part of the mesh does not hold
+    (its nodes moved there alone) raises on every rank: the test was each rank's, and the other
+    waited for ever in the scatter that followed (a review, 2026-12-06)."""
+    pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+    import numpy as np
+    from dolfinx import fem, mesh
+
+    from multiscale import checkpoint
+    from multiscale.errors import InputError
+    path = comm.bcast(tmp_path_factory.mktemp("ckpt") / "checkpoint.h5" if comm.rank == 0 else None, root=0)
+    square = mesh.create_unit_square(comm, 4, 4)
+    f = fem.Function(fem.functionspace(square, ("Lagrange", 1)))
+    f.x.array[:] = 1.0
+    checkpoint.save(path, comm, attrs={"step": 1}, arrays={}, functions={"u": f})
+    attrs, _ = checkpoint.load(path, comm, {"u": f})          # the same mesh: read back
+    assert attrs["step"] == 1 and np.all(f.x.array == 1.0)
+    if comm.rank == comm.size - 1:
+        square.geometry.x[:, 0] += 0.5
+    with pytest.raises(InputError, match="the mesh changed: field 'u' has dofs the checkpoint does not know"):
+        checkpoint.load(path, comm, {"u": f})
+    comm.Barrier()                      # both ranks got here: no rank is left waiting
