@@ -6,12 +6,14 @@ INFOG(1). The 2-rank LU of the same matrix: tests/mpi/test_factor_mpi.py."""
 import math
 
 import numpy as np
+import pytest
 import scipy.sparse as sp
 
 import multiscale.macro  # noqa: F401,I001  (DOLFINx's prerequisites before petsc4py)
 from mpi4py import MPI
 from petsc4py import PETSc
 
+from multiscale.errors import ConvergenceError
 from multiscale.macro import eigen, mumps
 from multiscale.macro.block_lanczos import ShiftInvert
 
@@ -76,6 +78,21 @@ def test_singular_matrix_is_named_by_mumps_status():
     pc = direct(petsc(A.tocsr()), "lu")
     assert mumps.factorise(pc) == (None, 0)                   # not a workspace error: no retry
     assert "INFOG(1) = -10 (numerically singular)" in mumps.describe(pc)
+
+
+def test_a_direct_solver_of_a_singular_matrix_is_a_convergence_error():
+    """``mumps.direct_solver`` (the centrifugal preload's and the unloaded state's LU) names the
+    failure: a KSP on the singular matrix solved to inf without a word (a review, 2026-12-06); the
+    indefinite one, after its workspace retry, solves to 1e-8."""
+    A = indefinite(200).tolil()
+    A[5, :] = 0.0
+    A[:, 5] = 0.0
+    with pytest.raises(ConvergenceError, match=r"the test matrix could not be factorised \[.*numerically singular"):
+        mumps.direct_solver(petsc(A.tocsr()), "the test matrix")
+    A = petsc(indefinite())
+    ksp = mumps.direct_solver(A, "the indefinite matrix")
+    assert residual(A, ksp.getPC()) <= 1e-8
+    ksp.destroy()
 
 
 def test_block_lanczos_factors_survive_a_workspace_error():

@@ -16,6 +16,8 @@ from contextlib import contextmanager
 
 from petsc4py import PETSc
 
+from multiscale.errors import ConvergenceError
+
 WORKSPACE_ERRORS = (-8, -9, -11, -14, -15, -17, -20)   # MUMPS INFOG(1): a workspace or buffer too small
 WORKSPACE_RETRIES = 4
 MEANINGS = {-10: "numerically singular", -13: "not enough memory", -19: "more memory than ICNTL(23) allows"}
@@ -48,6 +50,32 @@ def factorise(pc: PETSc.PC, workspace: int | None = None) -> tuple[int | None, i
         _set_margin(pc, workspace)
         _set_up(pc)
     return workspace, WORKSPACE_RETRIES
+
+
+def direct_solver(A: PETSc.Mat, what: str) -> PETSc.KSP:
+    """A KSP applying the LU factors of ``A`` (``preonly``; MUMPS when PETSc has it), factorised at
+    once by ``factorise``. A failed factorisation raises ``MemoryError`` (``check_memory``) or
+    ``ConvergenceError`` naming ``what`` and ``describe``'s reason, on every rank (MUMPS' status
+    is global); before, a singular matrix gave inf and NaN solutions, said by nobody (a review)."""
+    ksp = PETSc.KSP().create(A.getComm())
+    ksp.setOperators(A)
+    ksp.setType("preonly")
+    pc = ksp.getPC()
+    pc.setType("lu")
+    if PETSc.Sys.hasExternalPackage("mumps"):
+        pc.setFactorSolverType("mumps")
+    try:
+        factorise(pc)
+        failed = describe(pc)
+    except PETSc.Error as exc:
+        failed = str(exc).strip()
+    if failed:
+        try:
+            check_memory(pc, what)
+        finally:
+            ksp.destroy()
+        raise ConvergenceError(f"{what} could not be factorised [{failed}]")
+    return ksp
 
 
 def _set_up(pc: PETSc.PC) -> None:

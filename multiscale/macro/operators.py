@@ -37,10 +37,9 @@ from petsc4py import PETSc
 
 from multiscale.errors import InputError
 from multiscale.geometry import Rotation
+from multiscale.macro import mumps
 from multiscale.macro.materials import body_fields
 from multiscale.macro.mechanics import Mechanics
-
-DAMPING_PROPERTIES = ("damping_alpha", "damping_beta", "loss_factor")
 
 
 # ---------------------------------------------------------------- UFL pieces
@@ -166,7 +165,8 @@ def rotation_matrices(mech: Mechanics, materials: Mapping[str, object], omega: f
 
 def centrifugal_displacement(mech: Mechanics, materials: Mapping[str, object], omega: float, K: PETSc.Mat) -> list:
     """Displacement increments (one Function per body) under the centrifugal body force
-    rho Omega^2 r e_r of the rotating body, solved with the tangent ``K`` (linear about the preload)."""
+    rho Omega^2 r e_r of the rotating body, solved with the tangent ``K`` (linear about the preload);
+    ``ConvergenceError`` on every rank if ``K`` cannot be factorised (``mumps.direct_solver``)."""
     motion = _rotation(mech)
     rho = body_fields(mech.tm, materials, "rho", mech.reference_temperature)[1]
     axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
@@ -180,13 +180,7 @@ def centrifugal_displacement(mech: Mechanics, materials: Mapping[str, object], o
     b.ghostUpdate(addv=PETSc.InsertMode.ADD, mode=PETSc.ScatterMode.REVERSE)
     fpetsc.set_bc(b, fem.bcs_by_block(fem.extract_function_spaces(forms), mech.bcs))
     x = b.duplicate()
-    ksp = PETSc.KSP().create(K.getComm())
-    ksp.setOperators(K)
-    ksp.setType("preonly")
-    pc = ksp.getPC()
-    pc.setType("lu")
-    if PETSc.Sys.hasExternalPackage("mumps"):
-        pc.setFactorSolverType("mumps")
+    ksp = mumps.direct_solver(K, "the stiffness of the centrifugal preload")
     ksp.solve(b, x)
     ksp.destroy()
     out = [fem.Function(V) for V in mech.spaces]

@@ -45,6 +45,7 @@ from petsc4py import PETSc
 from scipy.sparse.csgraph import connected_components
 
 from multiscale.held import FREE, motion_rows
+from multiscale.macro import mumps
 
 SHIFT = 1e-8       # P = K + SHIFT diag(K), the factorised operator of the refinement
 TOL = 1e-10        # the refinement stops at ||f − K u|| <= TOL ||f||
@@ -152,7 +153,8 @@ class Unloaded:
     def solve(self) -> list[np.ndarray] | None:
         """Per body, the displacement [m] (arrays of the ``u`` layout) of the unloaded state, with
         the free motions of the current displacements (the last loaded state, kept); None if the
-        refinement did not reach ``TOL`` (a mechanism). Collective."""
+        refinement did not reach ``TOL`` (a mechanism); ``ConvergenceError`` if the shifted
+        stiffness cannot be factorised. Collective."""
         mech = self.mech
         K, r = mech.cell_system()
         modes = self.free_motions(r)
@@ -162,12 +164,7 @@ class Unloaded:
         d = K.getDiagonal()
         d.scale(SHIFT)
         P.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
-        ksp = PETSc.KSP().create(K.getComm())
-        ksp.setOperators(P)
-        ksp.setType("preonly")
-        ksp.getPC().setType("lu")
-        if PETSc.Sys.hasExternalPackage("mumps"):
-            ksp.getPC().setFactorSolverType("mumps")
+        ksp = mumps.direct_solver(P, "the shifted stiffness of the unloaded state")
         u, du = f.duplicate(), f.duplicate()
         u.set(0.0)
         self._project(f)                # round-off of r . f = 0
