@@ -352,12 +352,17 @@ class Multiscale:
         post-analysis − heat the macro model put into it at the same state (its partition of Phi,
         minus the exchange G (T_rough − T_counter))| / the zones' mean Phi, or mean |heat into the rough
         body| if larger (near rest the conduction outweighs a vanishing Phi: 1.8e12 at a stop's end before);
-        0 while released (no contact, no heat: the zones' last loads are analysed, nothing couples)."""
+        0 while released (no contact, no heat: the zones' last loads are analysed, nothing couples).
+        A heat that is not finite is a ``ConvergenceError`` (it was a residual of 0: converged)."""
         loaded = self._last[-1]
         if not len(loaded) or self.model.released:
             return 0.0
         Q, into = self.micro_heat[loaded], self.micro_heat_rough[loaded]
-        if not Q.mean() > 0:                    # no frictional heat (no sliding): nothing to couple
+        if not (np.isfinite(Q).all() and np.isfinite(into).all()):
+            bad = np.asarray(loaded)[~(np.isfinite(Q) & np.isfinite(into))]
+            raise ConvergenceError(f"the post-analysis gave a heat rate that is not finite in {io.counted(len(bad), 'zone')} "
+                                   f"(the first: {bad[:5].tolist()}): the coupling cannot be checked")
+        if Q.mean() <= 0.0:                     # no frictional heat (no sliding): nothing to couple
             return 0.0
         given = self.partition[loaded] * Q - self.exchange[loaded] * self.remote_difference[loaded]
         return float(np.abs(into - given).max() / max(Q.mean(), np.abs(into).mean()))

@@ -1085,3 +1085,19 @@ def test_a_layer_too_thin_for_the_micro_cells_is_refused_by_check():
                                          r"cells of interface interface"):
         loads(text)
     loads(text.replace('"100 nm"', '"10 um"'))
+
+
+def test_a_heat_rate_that_is_not_finite_is_a_convergence_error_not_a_converged_residual():
+    """The coupling residual of a post-analysis that gave NaN for a loaded zone: before, the NaN
+    mean passed the "no heat" test and the residual was 0, converged (a review, 2026-12-06)."""
+    from types import SimpleNamespace
+    from multiscale.coupling import Multiscale
+    loop = SimpleNamespace(_last=[np.array([0, 1])], model=SimpleNamespace(released=False),
+                           micro_heat=np.array([1.0, np.nan, 2.0]), micro_heat_rough=np.array([0.5, 0.4, 0.1]),
+                           partition=np.full(3, 0.5), exchange=np.zeros(3), remote_difference=np.zeros(3))
+    with pytest.raises(ConvergenceError, match=r"not finite in 1 zone \(the first: \[1\]\)"):
+        Multiscale.heat_residual(loop)
+    loop.micro_heat[1] = 3.0                                   # finite: |0.4 - 1.5| / 2
+    assert Multiscale.heat_residual(loop) == pytest.approx(1.1 / 2.0, rel=1e-12)
+    loop.micro_heat[:] = 0.0                                   # no sliding: nothing to couple
+    assert Multiscale.heat_residual(loop) == 0.0
