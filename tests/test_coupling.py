@@ -693,6 +693,7 @@ def test_a_light_load_wears_its_summits_flat_and_the_solve_follows(tmp_path, k_w
     assert first_steps([1e-8, 2e-8], [1e-6, 1e-6]) == pytest.approx((0.015 / 2, 0.015 / 16), rel=1e-12)
     assert first_steps([1e-7], [1e-9]) == (FIRST_STEP, SMALLEST_STEP) == first_steps([-1e-9], [1e-6])
     assert first_steps([1e-13], [1e-6])[1] == LEAST_STEP       # a stuck continuation gives up in 12 halvings
+    assert first_steps([1e-9], [1e-3]) == (LEAST_STEP, LEAST_STEP)   # (the first was 5e-7: no halving, a review)
     from multiscale.workflows import run
     result = run(loads(BRASS.format(folder=tmp_path / "brass"), overrides={"wear.k_w": k_w}), verbose=False)
     h = History.read(result.history_file)

@@ -88,7 +88,7 @@ def first_steps(depth, offset) -> tuple[float, float]:
     step of lambda would open the facets that carry at lambda = 0 (``depth`` [m]: their interpenetration
     of the shifted laws, ``offset`` [m]: their shifts; a shift s moves a facet by d lambda s): a fraction
     of the median depth per unit shift over the shifted facets in contact, at the gaps the offsets were
-    taken at (``LEAST_STEP`` at least). Worn-flat laws rise from 0
+    taken at (``LEAST_STEP`` at least, and the first step not below the smallest). Worn-flat laws rise from 0
     to their pressure within nm (a light load's run-in: all facets open at lambda = 1/64, the pin then
     free along the load; a trial)."""
     depth, offset = np.asarray(depth, dtype=float), np.asarray(offset, dtype=float)
@@ -96,4 +96,5 @@ def first_steps(depth, offset) -> tuple[float, float]:
     if not carrying.any():
         return FIRST_STEP, SMALLEST_STEP
     reach = float(np.median(depth[carrying] / offset[carrying]))    # lambda that opens half of them
-    return min(FIRST_STEP, reach / 2), max(min(SMALLEST_STEP, reach / 16), LEAST_STEP)
+    smallest = max(min(SMALLEST_STEP, reach / 16), LEAST_STEP)
+    return max(min(FIRST_STEP, reach / 2), smallest), smallest
