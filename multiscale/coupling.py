@@ -16,8 +16,10 @@ One macro step Δt (Fig. 7.2) runs:
    ``wear_every`` steps (and at the last step), the Archard wear of the patch over the load-weighted sliding
    of those steps with k_w(T) (and the counter-face's, spread over its wear track: ``rough.track_depth``), in
    increments raised until their step-doubling error is within ``micro.wear.WEAR_TOL``; the zones are spread
-   over the MPI ranks and the worn topographies shared; a facet wears c (p − P) more than its zone's patch
-   (``form_depth``, c the step's series compliance, p its pressure: the series state's wear at the facet);
+   over the MPI ranks and the worn topographies shared; a facet wears D (p − P) / P more than its zone's patch
+   (``form_depth``, D the patch's mean worn depth, p the facet's pressure: Archard's at the facet, never
+   negative; c (p − P) with the step's series compliance c, D / P where the micro wear took c, left
+   facets unloaded with less depth than before, down to −0.12 um on a brake pad: a user trial);
 4. the laws of the zones whose topography changed are recomputed (``rough.RoughInterface``: the others come
    from the pool's cache), the facet laws updated and the mechanics re-solved at the same time (from the state
    plus the previous step's change by this solve, ``law_increment``, if its residual is lower; where that
@@ -294,7 +296,7 @@ class Multiscale:
             if n >= most or error <= WEAR_TOL:
                 break
             n = min(most, max(2 * n, int(np.ceil(n * error / WEAR_TOL))))
-        volume = np.zeros(len(zones))
+        volume, before = np.zeros(len(zones)), self.rough.wear_depth().mean(axis=(-2, -1))
         for ids, warm, heights, lost, w, *_ in parts:
             self.warm[ids] = warm
             self.rough.set_heights(ids, heights)
@@ -302,8 +304,9 @@ class Multiscale:
             if self.plastic:
                 self.rough.plastic[ids] += w
         on = self.rough.zone_of_facet >= 0          # each facet's Archard depth at its own pressure, backward Euler:
-        zone_of = self.rough.zone_of_facet[on]      # the zone's topography took its mean, c P
-        self.form_depth[on] += self.series[zone_of] * (m.contact.facet_pressure()[on] - load.pressure[zone_of])
+        zone_of = self.rough.zone_of_facet[on]      # the zone's topography took its mean D, the facet D p / P
+        gained, P = (self.rough.wear_depth().mean(axis=(-2, -1)) - before)[zone_of], load.pressure[zone_of]
+        self.form_depth[on] += gained * np.divide(m.contact.facet_pressure()[on] - P, P, out=np.zeros(P.shape), where=P > 0)
         if self.post.counter_rate is not None:
             self.counter_depth += self.rough.track_depth(volume, m.facet_sliding_power())    # (its flux now: 0 at rest)
             self.counter_volume += volume.sum()
@@ -392,8 +395,8 @@ class Multiscale:
         fields = {"contact_stiffness": lambda: rough.facet_stiffness(contact.facet_gap(), iface.values(contact.stiffness))
                   * (not self.model.released),
                   "partition": lambda: iface.values(contact.partition),
-                  "wear_depth": lambda: np.where(rough.zone_of_facet >= 0, self.form_depth +
-                                                 rough.wear_depth().mean(axis=(-2, -1))[rough.zone_of_facet], 0.0)}
+                  "wear_depth": lambda: np.where(rough.zone_of_facet >= 0, np.maximum(self.form_depth +   # (round-off)
+                                                 rough.wear_depth().mean(axis=(-2, -1))[rough.zone_of_facet], 0.0), 0.0)}
         if self.post.heating is not None:
             fields["flash_temperature"] = self.facet_flash
         if self.settings.wear:      # zero where body 1 does not wear (no k_w of its material)

@@ -466,9 +466,10 @@ def test_the_steps_series_compliance_is_the_depth_per_pressure_its_wear_takes(tm
     of the step in series with its laws (``Multiscale.archard``); the micro wear that follows finds
     its sliding on its own (``PostAnalysis``). Their worn volumes agree: sum over the zones of c x
     the zone force the micro analysis took = the step's worn volume, within 1e-4 (2.1e-5 and
-    1.0e-5 measured: the macro zone force against the micro patch's). A facet wears c (p - P) beyond
-    its zone's patch (``form_depth``): zero over each zone, so the facets' wear depth field
-    integrates to the worn volume."""
+    1.0e-5 measured: the macro zone force against the micro patch's). A facet wears D (p - P) / P
+    beyond its zone's patch, D the patch's mean worn depth (``form_depth``): zero over each zone, so
+    the facets' wear depth field integrates to the worn volume, and never negative (with c (p - P)
+    an unloaded facet lost depth where the micro wear took less than c P: a user trial)."""
     from multiscale.coupling import Multiscale
     predicted, init, loops = series_predictions(monkeypatch), Multiscale.__init__, []
 
@@ -488,6 +489,7 @@ def test_the_steps_series_compliance_is_the_depth_per_pressure_its_wear_takes(tm
     assert np.abs(form).max() > 1e-3 * h["wear_max_depth"][-1]
     assert np.abs(per_zone).max() < 1e-12 * (areas * np.abs(form)).sum()
     assert areas @ ms.facet_fields()["wear_depth"]() == pytest.approx(h["wear_volume"][-1], rel=1e-9)
+    assert ms.facet_fields()["wear_depth"]().min() >= 0.0
 
 
 def test_the_series_compliance_takes_k_w_at_the_temperatures_the_micro_wear_takes(tmp_path, monkeypatch):
