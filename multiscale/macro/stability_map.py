@@ -330,6 +330,18 @@ class MapBuilder:
         if onset is not None:
             onset.end = value
 
+    def track(self, values: Sequence[float], results: Sequence[ModalResult], reduced: Sequence[ReducedSystem],
+              onsets: bool = True) -> None:
+        """``add`` the points ``values`` with their ``results`` (reduced coordinates of one basis,
+        ``ModalResult.gram``) and, with ``onsets``, bisect every onset and end on the ``reduced``
+        systems of the two points around it."""
+        for k, (value, result) in enumerate(zip(values, results)):
+            for track, j in self.add(value, result):
+                if onsets:
+                    self.onset(track, j, reduced[k - 1], reduced[k], result.modes[:, j], result.gram)
+            for track, i, _ in self.calmed if onsets else ():
+                self.end(track, i, reduced[k - 1], reduced[k], results[k - 1].modes[:, i], result.gram)
+
     def finish(self, *, basis_size: int = 0, time: float = 0.0, max_pressure: float = 0.0) -> StabilityMap:
         P, T = len(self.values), self.n_tracks
         out = {name: np.full((P, T), np.nan) for name in ("frequency", "growth", "mac", "residual")}
@@ -345,22 +357,16 @@ class MapBuilder:
 
 
 def build_map(parameter: str, unit: str, values: Sequence[float], results: Sequence[ModalResult],
-              reduced: Sequence[ReducedSystem], band, *, mac_min: float = 0.5, rtol: float = 1e-6,
-              xtol: float = 1e-4, onsets: bool = True, basis_size: int = 0, time: float = 0.0,
+              reduced: Sequence[ReducedSystem], band, *, mac_min: float = 0.5, xtol: float = 1e-4,
               subspace: bool = True) -> StabilityMap:
-    """Track the modes of ``results`` (reduced coordinates of one basis, ``ModalResult.gram``)
-    over ``values`` and bisect the onsets on ``reduced`` (module docstring). ``xtol`` is relative
+    """The map of the points ``values`` with their ``results`` and ``reduced`` systems of one basis
+    (``MapBuilder.track``, as a "common" sweep runs it; module docstring). ``xtol`` is relative
     to the step between the two bracketing values; ``subspace`` False: pairs by the single MAC only."""
     if len(values) != len(results) or len(results) != len(reduced) or len(values) < 2:
         raise InputError("stability.sweep", len(values), "at least two points, one result and system each")
-    builder = MapBuilder(parameter, unit, band, mac_min=mac_min, rtol=rtol, xtol=xtol, subspace=subspace)
-    for k, (value, result) in enumerate(zip(values, results)):
-        for track, j in builder.add(value, result):
-            if onsets:
-                builder.onset(track, j, reduced[k - 1], reduced[k], result.modes[:, j], result.gram)
-        for track, i, _ in builder.calmed if onsets else ():
-            builder.end(track, i, reduced[k - 1], reduced[k], results[k - 1].modes[:, i], result.gram)
-    return builder.finish(basis_size=basis_size, time=time)
+    builder = MapBuilder(parameter, unit, band, mac_min=mac_min, xtol=xtol, subspace=subspace)
+    builder.track(values, results, reduced)
+    return builder.finish()
 
 
 def _nearest(frequency, j: int) -> int | None:

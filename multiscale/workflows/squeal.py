@@ -105,25 +105,23 @@ class SquealCase:
 
 def squeal_case(mech: Mechanics, materials: Mapping[str, object], name: str = "case", *, load: float = 1e6,
                 steps: int = 1, band=(0.0, 16e3), n_modes: int | None = None,
-                target: float | None = None, damping: Damping | None = None, energy: bool = True,
-                rtol: float = 1e-6, close_tol: float = CLOSE, options: SquealOptions | None = None,
-                reset: bool = True, torque: float | None = None, on_preload=None) -> SquealCase:
-    """Preload ``mech`` from rest (``reset``) to ``load`` [Pa or N] in ``steps`` (with ``torque``
-    [N m] a first guess, scaled to that friction moment: ``preload``), linearise and extract the
-    complex modes in ``band`` [Hz] (§4.3.1, two steps); ``damping`` (or ``options.damping``) is the
-    proportional part, ``options`` the rest (``SquealOptions``). ``on_preload(mech)`` is called
+                target: float | None = None, energy: bool = True, rtol: float = 1e-6, close_tol: float = CLOSE,
+                options: SquealOptions | None = None, torque: float | None = None, on_preload=None) -> SquealCase:
+    """Preload ``mech`` from rest to ``load`` [Pa or N] in ``steps`` (with ``torque`` [N m] a first
+    guess, scaled to that friction moment: ``preload``), linearise and extract the complex modes in
+    ``band`` [Hz] (§4.3.1, two steps); ``options`` (``SquealOptions``) the damping and the rest. ``on_preload(mech)`` is called
     between the preload and the eigen solve (``run`` writes the preloaded state then)."""
     opt = options or SquealOptions()
     _, slope, slip = set_friction(mech, opt.friction_laws) if opt.friction_laws else (None, None, None)
     with io.stage("preload"):
-        pre = preload(mech, load, steps, reset=reset, torque=torque)
+        pre = preload(mech, load, steps, torque=torque)
     if on_preload is not None:
         on_preload(mech)
     floating = idle_holder(mech.tm.sole_holds, {n: abs(f) for n, f in pre.normal_force.items()})
     if floating is not None:       # before the eigen solve finds their rigid motions, or not
         raise floating
     with io.stage("eigen solve"):
-        lin = linearise_system(mech, materials, damping=damping or opt.damping,
+        lin = linearise_system(mech, materials, damping=opt.damping,
                                slope=slope if opt.friction_damping else None, prestress=opt.prestress,
                                gyroscopic=opt.gyroscopic, material=opt.material_damping)
         if opt.method == "subspace":       # the memory-lean path: no Newton factors next to the modes'

@@ -149,12 +149,7 @@ def _common_basis(model: MapModel, builder: MapBuilder, st, options) -> int:
         results[k], reduced[k] = solve_projected(lin.system, sub, band=band, n_modes=st.modes, target=st.target,
                                                  expand=False)
         _free(lin)
-    for k, (value, result) in enumerate(zip(values, results)):
-        for track, j in builder.add(value, result):
-            if sw.onsets:
-                builder.onset(track, j, reduced[k - 1], reduced[k], result.modes[:, j], result.gram)
-        for track, i, _ in builder.calmed if sw.onsets else ():
-            builder.end(track, i, reduced[k - 1], reduced[k], results[k - 1].modes[:, i], result.gram)
+    builder.track(values, results, reduced, onsets=sw.onsets)
     return sub.size
 
 
