@@ -55,10 +55,6 @@ class Plane:
         """Plane coordinates (..., 2) [m] of points x (..., 3)."""
         return (np.asarray(x, dtype=float) - self.origin) @ self.frame[:2].T
 
-    def to_plane(self, vectors) -> np.ndarray:
-        """Components (..., 2) of 3-vectors along (e_u, e_v)."""
-        return np.asarray(vectors, dtype=float) @ self.frame[:2].T
-
 
 def interface_plane(tm: TwoBodyMesh, name: str) -> tuple[Plane, np.ndarray, np.ndarray]:
     """The plane of interface ``name`` and the lower and upper corners (u, v) [m] of its facets'

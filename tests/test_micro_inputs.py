@@ -21,7 +21,7 @@ from multiscale.micro.layered_asperity import LayeredAsperity, layered_law
 from multiscale.micro.plasticity import Hardness
 from multiscale.micro.post_analysis import Heating, PostAnalysis
 from multiscale.micro.spectrum import fit_power_law, power_spectrum, surface_statistics
-from multiscale.micro.surface import Surface, find_asperities, fractal_surface, load_surface, statistics
+from multiscale.micro.surface import Surface, find_asperities, fractal_surface, statistics
 from multiscale.micro.wear import simulate_wear, wear_step
 from multiscale.micro.zones import cut_zones, generate_zones
 
@@ -160,7 +160,6 @@ CASES = [
      dict(hurst="0.8"), "hurst"),
     (lambda **k: fractal_surface(**{**dict(n=16, size=1e-3, hurst=0.8, k_min=2, k_max=4, rms=1e-6), **k}),
      dict(size=(1e-3, 1e-3, 1e-3)), "size"),
-    (lambda **k: load_surface(**{**dict(path="x.npy", dx=1e-6), **k}), dict(path=None), "path"),
     (lambda **k: LayeredElastic(**{**dict(thickness=(1e-6,), E=(1e9,), nu=(0.3,)), **k}), dict(E=("a",)), "E"),
     (lambda **k: LayeredElastic(**{**dict(thickness=(1e-6,), E=(1e9,), nu=(0.3,)), **k}), dict(substrate_nu="x"),
      "substrate_nu"),

@@ -3,7 +3,9 @@ import numpy as np
 import pytest
 
 from multiscale.errors import InputError
-from multiscale.micro.surface import Surface, find_asperities, fractal_surface, load_surface, refine, statistics
+from multiscale.micro.reading import read_topography
+from multiscale.micro.surface import Surface, find_asperities, fractal_surface, refine, statistics
+from multiscale.micro.topography import remove_form
 
 
 def test_same_seed_same_surface_and_rms():
@@ -96,29 +98,30 @@ def test_summits_are_strict_8_neighbour_maxima():
 
 
 def test_import_npy_txt_csv(tmp_path):
+    """Plain height matrices (``read_topography`` with a pixel size) read exactly; the plane removed
+    (``topography.remove_form``) leaves heights orthogonal to 1, x and y."""
     rng = np.random.default_rng(0)
-    h = rng.normal(size=(10, 12))
+    h = rng.normal(size=(16, 18))
     np.save(tmp_path / "s.npy", h)
     np.savetxt(tmp_path / "s.txt", h)
     np.savetxt(tmp_path / "s.csv", h, delimiter=",")
     for name in ("s.npy", "s.txt", "s.csv"):
-        s = load_surface(tmp_path / name, 2e-6, scale=1e-6, detrend="none")
-        np.testing.assert_allclose(s.heights, h * 1e-6, rtol=1e-12)
-        assert s.dx == s.dy == 2e-6 and not s.periodic
-    tilted = h + 3.0 * np.arange(12)[None, :] - 2.0 * np.arange(10)[:, None]
-    np.save(tmp_path / "t.npy", tilted)
-    flat = load_surface(tmp_path / "t.npy", 1e-6).heights
-    Y, X = np.mgrid[:10, :12]
-    A = np.column_stack([np.ones(120), X.ravel(), Y.ravel()])
+        m = read_topography(tmp_path / name, pixel_size=2e-6, height_unit=1e-6)
+        np.testing.assert_allclose(m.heights, h * 1e-6, rtol=1e-12)
+        assert m.dx == m.dy == 2e-6
+    tilted = h + 3.0 * np.arange(18)[None, :] - 2.0 * np.arange(16)[:, None]
+    flat = remove_form(tilted, "plane")
+    Y, X = np.mgrid[:16, :18]
+    A = np.column_stack([np.ones(h.size), X.ravel(), Y.ravel()])
     assert np.abs(A.T @ flat.ravel()).max() < 1e-9          # plane removed
 
 
 def test_bad_surface_input(tmp_path):
-    with pytest.raises(InputError, match="path"):
-        load_surface(tmp_path / "missing.npy", 1e-6)
+    with pytest.raises(InputError, match="no such file"):
+        read_topography(tmp_path / "missing.npy", pixel_size=1e-6)
     (tmp_path / "bad.csv").write_text("1,2,x\n3,4,5\n")
-    with pytest.raises(InputError, match="path"):
-        load_surface(tmp_path / "bad.csv", 1e-6)
+    with pytest.raises(InputError, match="could not read a height matrix"):
+        read_topography(tmp_path / "bad.csv", pixel_size=1e-6)
     # an empty file, a row, complex or boolean values: one clear error (before: a ZeroDivisionError
     # later, a read row, the imaginary part dropped with numpy's ComplexWarning)
     (tmp_path / "empty.txt").write_text("# no data\n")
@@ -128,12 +131,12 @@ def test_bad_surface_input(tmp_path):
     np.save(tmp_path / "mask.npy", np.ones((8, 8), bool))
     (tmp_path / "empty.npy").write_bytes(b"")          # numpy's EOFError came through as a traceback
     for name, why in [("empty.txt", r"the height matrix has 1 x 0 points: a height map of at least 4 x 4"),
-                      ("empty.npy", "could not read a height matrix"),
+                      ("empty.npy", r"the file is empty \(0 bytes\)"),
                       ("row.npy", r"has 9 x 1 points: a height map of at least 4 x 4 points is needed"),
                       ("small.npy", r"has 9 x 3 points: a height map of at least 4 x 4 points is needed"),
                       ("complex.npy", "real numbers, not complex128"), ("mask.npy", "real numbers, not bool")]:
         with pytest.raises(InputError, match=why):
-            load_surface(tmp_path / name, 1e-6)
+            read_topography(tmp_path / name, pixel_size=1e-6)
     with pytest.raises(InputError, match="dx"):
         Surface(np.zeros((8, 8)), -1.0, 1.0)
     with pytest.raises(InputError, match="hurst"):

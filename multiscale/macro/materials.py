@@ -174,10 +174,10 @@ def body_fields(tm: TwoBodyMesh, materials: Mapping[str, object], name: str,
 
 
 def body_expressions(tm: TwoBodyMesh, materials: Mapping[str, object], name: str,
-                     temperatures: Sequence | None, reference: float, of=None) -> list:
+                     temperatures: Sequence | None, reference: float) -> list:
     """Per body: the property as a DG0 field, or as a UFL expression of the body's temperature
     (``temperatures[i]``) where a region has a table; without temperatures tables are taken at
     ``reference`` [K]."""
-    props = body_properties(tm, materials, name, of)
+    props = body_properties(tm, materials, name)
     return [p.expression(None if temperatures is None else temperatures[i], reference)
             for i, p in enumerate(props)]

@@ -386,10 +386,10 @@ class FieldOutput:
         return out
 
 
-def write_state(folder: Path, mechanics, fields, time: float = 0.0) -> list[Path]:
-    """The ``fields`` of one mechanical state (e.g. the squeal preload) at ``time``; the files."""
+def write_state(folder: Path, mechanics, fields) -> list[Path]:
+    """The ``fields`` of one mechanical state (e.g. the squeal preload), at time 0; the files."""
     out = FieldOutput(None, folder, fields, mechanics=mechanics)
-    out.write(time)
+    out.write(0.0)
     return out.files
 
 

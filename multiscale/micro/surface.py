@@ -202,31 +202,6 @@ def read_matrix(path) -> np.ndarray:
     return h
 
 
-def load_surface(path, dx: float, dy: float | None = None, *, scale: float = 1.0,
-                 detrend: str = "plane") -> Surface:
-    """Measured topography from .npy or a .txt/.csv matrix (rows ↔ y) with pixel size dx (dy) [m].
-
-    ``scale`` converts the file's height unit to metres (1e-6 for µm). ``detrend`` removes the
-    least-squares 'plane', the 'mean', or 'none'. The result is not periodic (undefined points:
-    ``topography.read_topography`` fills them).
-    """
-    if not isinstance(detrend, str):
-        raise InputError("detrend", detrend, "one of 'plane', 'mean', 'none'")
-    h = read_matrix(path) * check_positive("scale", scale)
-    if not np.all(np.isfinite(h)):
-        raise InputError("path", str(path), "height matrix contains NaN/inf (fill missing points first)")
-    if detrend == "plane":
-        ny, nx = h.shape
-        Y, X = np.mgrid[:ny, :nx]
-        A = np.column_stack([np.ones(h.size), X.ravel(), Y.ravel()])
-        h = h - (A @ np.linalg.lstsq(A, h.ravel(), rcond=None)[0]).reshape(h.shape)
-    elif detrend == "mean":
-        h = h - h.mean()
-    elif detrend != "none":
-        raise InputError("detrend", detrend, "one of 'plane', 'mean', 'none'")
-    return Surface(h, dx, dy if dy is not None else dx, periodic=False)
-
-
 @dataclass(frozen=True)
 class SurfaceStats:
     """Roughness statistics (per patch for batches). Profile moments are x/y averages."""

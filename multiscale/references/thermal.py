@@ -26,16 +26,15 @@ def lumped_convective_cooling(time, T_initial: float, ambient: float, h: float, 
     return ambient + (T_initial - ambient) * np.exp(-rate * np.asarray(time, dtype=float))
 
 
-def lumped_frictional_fade(time, mu0: float, slope: float, power: float, shares, capacities, weights=None):
+def lumped_frictional_fade(time, mu0: float, slope: float, power: float, shares, capacities):
     """(mu(t), E(t)) of lumped bodies, insulated, heated by a sliding contact whose friction falls
     linearly with their temperatures (brake fade): mu = mu0 − slope u, u = sum_i w_i (T_i − T_0) the
-    weighted mean rise (``weights`` w_i, default equal; the contact's temperature), body i taking the
+    mean rise (w_i = 1/n: the contact's temperature, the mean of its two faces'), body i taking the
     share a_i of the frictional power mu P [W] (``power`` P per unit mu) into its capacity C_i [J/K].
     Then du/dt = K mu P, K = sum_i w_i a_i / C_i, so mu = mu0 exp(−slope K P t) and the heat put in
     E = (mu0 − mu) / (slope K) [J] (derived here from the lumped balance C_i dT_i/dt = a_i mu P)."""
     a, C = np.asarray(shares, dtype=float), np.asarray(capacities, dtype=float)
-    w = np.full(a.shape, 1.0 / a.size) if weights is None else np.asarray(weights, dtype=float)
-    K = float(np.sum(w * a / C))
+    K = float(np.mean(a / C))
     rate = check_positive("slope", slope) * check_positive("K", K) * check_positive("power", power)
     mu = mu0 * np.exp(-rate * np.asarray(time, dtype=float))
     return mu, (mu0 - mu) / (slope * K)
