@@ -963,8 +963,10 @@ def test_friction_of_the_temperature_fades_as_lumped_bodies_do():
     120 degC, each facet's at the mean of its two faces' temperatures. Pin and disc conduct so well
     (kappa 1e4 W/(m K), chi 0.1 m^2/s) that each is a lumped body, insulated, taking its share of the
     heat (0.14 / 0.86): the friction coefficient (friction force over normal force) and the heat put
-    in follow ``lumped_frictional_fade`` (capacities from the stored heat at a 1 K rise, the power per
-    unit mu from the friction moment at the start) over 4 s, mu falling by a fifth: mu within 1 %
+    in follow ``lumped_frictional_fade`` (capacities rho c V, V the bodies' meshed volumes, not the
+    model's stored heat, a review; the power per unit mu from the friction moment at the start: its
+    arm is 88.0 mm, not the 90.0 mm of the pin's centre: the pressure under the pin is not uniform,
+    2.2 % of the power) over 4 s, mu falling by a fifth: mu within 1 %
     (measured 0.41 %: the facets run hotter than the bodies' means), the heat within 0.4 % (0.28 % after
     the first step, all of it at mu0: the lag; 0.1 % at 4 s).
     The fade is explicit (a step late: (1 - x)^n against exp(-n x)); without it mu stays 0.4, 25 %
@@ -976,12 +978,13 @@ def test_friction_of_the_temperature_fades_as_lumped_bodies_do():
     t = np.array([r["time"] for r in rows])
     mu = np.array([r["friction_coefficient"] for r in rows])
     heat = np.array([r["heat_total_pin"] + r["heat_total_disc"] for r in rows])
-    th = model.thermal
-    for T in th.T:
-        T.x.array[:] = th.T_ref + 1.0
-    capacities = th.stored_heat()                                      # J/K
-    power = rows[0]["friction_moment"] / 0.4 * (200 * 2 * np.pi / 60)   # W per unit mu
+    import ufl
+    from dolfinx import fem
+    volumes = [model.tm.comm.allreduce(fem.assemble_scalar(fem.form(1.0 * ufl.dx(domain=T.function_space.mesh))))
+               for T in model.thermal.T]
+    capacities = 1e4 / 0.1 * np.array(volumes)                            # J/K: rho c = kappa / chi
     model.close()
+    power = rows[0]["friction_moment"] / 0.4 * (200 * 2 * np.pi / 60)   # W per unit mu
     mu_ref, heat_ref = lumped_frictional_fade(t, 0.4, 0.004, power, (0.14, 0.86), capacities)
     assert mu[-1] < 0.8 * 0.4                                            # a fifth of mu lost
     np.testing.assert_allclose(mu, mu_ref, rtol=1e-2)
