@@ -171,7 +171,7 @@ def test_a_mode_cap_on_the_quadratic_path_keeps_both_members_of_the_lock_in_pair
     np.testing.assert_allclose(q.eigenvalues, ref[:20], rtol=1e-9)
     C[28, 29], C[29, 28] = 0.05, -0.05               # a gyroscopic term splits the pair's frequency by 4e-5
     ref = dense_quadratic(K, C, M)                  # (the brake's: 1.3e-5; the cap kept only its stable member)
-    assert 1e-5 < ref[21].imag / ref[20].imag - 1 < eigen.PAIR_RTOL and ref[21].real > 0 > ref[20].real
+    assert 1e-5 < ref[21].imag / ref[20].imag - 1 < eigen.LOCKED and ref[21].real > 0 > ref[20].real
     q = eigen.solve_quadratic(petsc_mat(K), petsc_mat(C), petsc_mat(M), f_max=1e3, n_modes=21, target=100.0)
     assert len(q) == 22 and q.unstable().sum() == 1
     np.testing.assert_allclose(q.eigenvalues, ref[:22], rtol=1e-9)
@@ -230,6 +230,12 @@ def test_a_mode_cap_on_a_reduced_damped_system_keeps_a_split_pair():
     lam = np.array([-1 + 100j, -1 + 200j, -5 + 300j, 5 + 300.006j]) * 2 * np.pi
     np.testing.assert_array_equal(select(lam, (0.0, 1e3), 3, 0.0), [0, 1, 2, 3])
     np.testing.assert_array_equal(select(lam, (0.0, 1e3), 2, 0.0), [0, 1])
+    # split by 1.2e-4 of its frequency (the car brake at eta = 0.01: 0.56 Hz at 4810 Hz, sigma +-201
+    # 1/s): kept whole by the cap of the projected and of the quadratic solves (before: 1e-4 only)
+    lam = np.array([-3 + 2000j * 2 * np.pi, -201 + 4810j * 2 * np.pi, 201 + 4810.56j * 2 * np.pi])
+    np.testing.assert_array_equal(select(lam, (0.0, 1e4), 2, 0.0), [0, 1, 2])
+    np.testing.assert_array_equal(eigen.capped(lam, np.array([0, 1, 2]), 2), [0, 1, 2])
+    assert eigen.capped(lam, np.array([0, 1, 2]), 1).tolist() == [0]
 
 
 def test_proportional_damping_mapping_matches_companion_form_and_pep():

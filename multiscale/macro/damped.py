@@ -68,7 +68,7 @@ from petsc4py import PETSc
 from multiscale.errors import InputError
 from multiscale.macro.block_lanczos import ShiftInvert, m_orthonormalise, symmetric_modes
 from multiscale.macro.dense import block_solve, mat_mult
-from multiscale.macro.eigen import (PAIR_RTOL, TWO_PI, Damping, ModalResult, by_frequency, lambda_from_theta,
+from multiscale.macro.eigen import (TWO_PI, Damping, ModalResult, by_frequency, capped, lambda_from_theta,
                                     matrix_comm, reduce_sum, shift_invert_modes, solve_modes, solve_quadratic)
 from multiscale.macro.modal import mac_matrix, pair_modes
 
@@ -197,15 +197,12 @@ class ReducedSystem:
 
 
 def select(lam: np.ndarray, band, n_modes: int | None, target: float) -> np.ndarray:
-    """Indices of the eigenvalues in the band (the ``n_modes`` nearest ``target`` [Hz], and those as
-    near as the last to ``PAIR_RTOL`` of its frequency: a lock-in pair, sigma +-, split by damping,
-    is never cut in two), by frequency."""
+    """Indices of the eigenvalues in the band (the ``n_modes`` nearest ``target`` [Hz], with the
+    other half of a lock-in pair the cap ends in: ``eigen.capped``), by frequency."""
     f = lam.imag / TWO_PI
     idx = np.nonzero((f >= band[0]) & (f <= band[1]))[0]
     if n_modes is not None and idx.size > n_modes:
-        gap = np.abs(f[idx] - target)
-        cut = np.sort(gap)[n_modes - 1]
-        idx = idx[gap <= cut + PAIR_RTOL * (cut + abs(target))]
+        idx = capped(lam, idx[np.argsort(np.abs(f[idx] - target), kind="stable")], n_modes)
     return idx[by_frequency(lam[idx])]
 
 

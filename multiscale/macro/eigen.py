@@ -39,15 +39,38 @@ from multiscale.macro import mumps
 from multiscale.macro.dense import mat_mult
 
 TWO_PI = 2.0 * math.pi
-# Modes this close in frequency (relative) to the last one a mode cap keeps are kept with it: the
-# members of a lock-in pair, sigma +-, are one frequency without damping, but gyroscopic or damping
-# terms split them (0.034 Hz at 2680 Hz, 1.3e-5: the cap kept the stable member and dropped the
-# unstable one, sigma +64 1/s; a user trial). A doublet kept beyond the cap costs nothing.
-PAIR_RTOL = 1e-4
+LOCKED = 1e-4    # relative frequency gap of a stable mode to an unstable one: a lock-in pair's halves (equal
+                 # frequencies; split by 2e-5 by a pad's loss factor, ``damped.select``)
+SPLIT = 1 / (4 * np.pi)   # a lock-in pair split by damping (~ eta sigma / 2 pi) lies within this x sigma [Hz]
 # The first shift-and-invert solve asks at most this many pairs of a mode cap; more are asked only
 # if the band holds more (a cap of 300 on the 20-mm brake's band of 71 modes took 51.6 s, asked at
 # once, for 14.0 s at a cap of 100; a user trial).
 FIRST_MODES = 101
+
+
+def locked_window(frequency: float, sigma: float) -> float:
+    """How far [Hz] the stable half of a lock-in pair may lie from its unstable half at ``frequency``
+    [Hz] growing at ``sigma`` [1/s]: ``LOCKED`` of the frequency without damping (the halves share
+    it), and ``SPLIT`` sigma with it: a loss factor eta splits the pair by the order of eta sigma / 2 pi (the
+    car brake at eta = 0.01: 0.56 Hz at 4810 Hz, 1.2e-4 of it, sigma 201 1/s; both halves were left
+    unpaired and the stable one flagged potentially unstable: an NVH trial)."""
+    return max(LOCKED * frequency, SPLIT * abs(sigma))
+
+
+def capped(lam: np.ndarray, ranked: np.ndarray, n_modes: int) -> np.ndarray:
+    """The first ``n_modes`` of ``ranked`` (indices of eigenvalues ``lam`` [1/s], nearest the target
+    first) and the others within ``locked_window`` of the last one's frequency: a lock-in pair,
+    sigma +-, is never cut in two, also where gyroscopic or damping terms split it (0.034 Hz at
+    2680 Hz, 1.3e-5: a cap kept the stable member and dropped the unstable one, sigma +64 1/s, a
+    user trial; a loss factor 1.2e-4, beyond the 1e-4 the cap allowed, a review). A doublet kept
+    beyond the cap costs nothing."""
+    kept, rest = ranked[:n_modes], ranked[n_modes:]
+    if not kept.size:
+        return kept
+    f, last = lam.imag / TWO_PI, kept[-1]
+    near = [i for i in rest if abs(f[i] - f[last]) <= locked_window(abs(f[last]), max(abs(lam[i].real),
+                                                                                        abs(lam[last].real)))]
+    return np.concatenate([kept, np.asarray(near, dtype=kept.dtype)])
 
 
 @dataclass
@@ -474,11 +497,7 @@ def solve_quadratic(K, C, M, *, f_max: float = 16e3, f_min: float = 0.0, n_modes
     seen = lam.imag / TWO_PI
     inband = np.nonzero((seen >= f_min) & (seen <= f_max) & _carry_mass(vecs, M, comm))[0]
     if n_modes is not None:             # the n_modes nearest the shift, as they converge
-        ranked = inband[np.argsort(np.abs(lam[inband] - s), kind="stable")]
-        kept, rest = ranked[:int(n_modes)], ranked[int(n_modes):]
-        if kept.size:                   # the other member of a lock-in pair the cap ends in (``PAIR_RTOL``)
-            rest = rest[np.isclose(lam[rest].imag, lam[kept[-1]].imag, rtol=PAIR_RTOL, atol=0.0)]
-        inband = np.concatenate([kept, rest])
+        inband = capped(lam, inband[np.argsort(np.abs(lam[inband] - s), kind="stable")], int(n_modes))
     short = n_modes is not None and f_min > 0 and inband.size < n_modes and seen.size and seen.max() < f_max
     if short or (not inband.size and seen.size and seen.max() < f_min):   # (it said "widen it", nearest a spurious
         raise InputError("stability.modes", n_modes, f"the quadratic solver finds the lowest modes first: they "  # root)

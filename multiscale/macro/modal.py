@@ -17,7 +17,7 @@ from dolfinx import fem, la
 from scipy.optimize import linear_sum_assignment
 
 from multiscale.errors import InputError, check_positive
-from multiscale.macro.eigen import ModalResult, mat_apply, matrix_comm, reduce_sum
+from multiscale.macro.eigen import ModalResult, locked_window, mat_apply, matrix_comm, reduce_sum
 
 
 @dataclass
@@ -61,19 +61,7 @@ class EnergyShares:
 
 
 CLOSE = 1e-3     # relative frequency gap of two stable modes that are "potentially unstable" (Fig. 4.14)
-LOCKED = 1e-4    # relative frequency gap of a stable mode to an unstable one: a lock-in pair's halves (equal
-                 # frequencies; split by 2e-5 by a pad's loss factor, ``damped.select``)
 STATIC = 1e-9    # a mode below this share of the highest frequency (or of 1 Hz) does not oscillate
-SPLIT = 1 / (4 * np.pi)   # a lock-in pair split by damping (~ eta sigma / 2 pi) lies within this x sigma [Hz]
-
-
-def locked_window(frequency: float, sigma: float) -> float:
-    """How far [Hz] the stable half of a lock-in pair may lie from its unstable half at ``frequency``
-    [Hz] growing at ``sigma`` [1/s]: ``LOCKED`` of the frequency without damping (the halves share
-    it), and ``SPLIT`` sigma with it: a loss factor eta splits the pair by the order of eta sigma / 2 pi (the
-    car brake at eta = 0.01: 0.56 Hz at 4810 Hz, 1.2e-4 of it, sigma 201 1/s; both halves were left
-    unpaired and the stable one flagged potentially unstable: an NVH trial)."""
-    return max(LOCKED * frequency, SPLIT * abs(sigma))
 
 
 def flutter_pairs(f: np.ndarray, sigma: np.ndarray, bad: np.ndarray) -> np.ndarray:
