@@ -262,7 +262,8 @@ class Loading:
     of stops under a vehicle's torque; ``vehicle.mass`` does it for one stop). The speed of the rotating body:
     ``rotation_speed``, a ``speed_profile`` against time, or a ``vehicle`` stop or drag; a translating body
     slides at ``sliding_speed``. Friction: a constant ``friction``; ``friction_temperature``, mu against the
-    interface temperature (fade, effect "thermal": each facet's at the mean of its faces', a heat step late); an
+    interface temperature (fade, effect "thermal": each facet's at the mean of its faces' macro temperatures,
+    without the micro flash rise, a heat step late); an
     interface's own [interfaces.<name>] friction or table replaces them there; or mu against the slip speed,
     ``friction_curve`` or ``stribeck``, per facet at its slip speed (a run: at each contact solve's speed, the
     heat of a step with the mu of its start; the squeal: at the steady slip speed). ``ramp_steps``: the
@@ -533,7 +534,9 @@ FIG_7_9_WEAR_RATE = ((293.15, 8.2e-15), (373.15, 1.09e-14), (473.15, 2.04e-14), 
 @dataclass(frozen=True)
 class Wear:
     """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (``FIG_7_9_WEAR_RATE``:
-    calibrated as ``FIG_7_9_CALIBRATION`` says). Every ``update_every`` macro steps (and at the last
+    calibrated as ``FIG_7_9_CALIBRATION`` says) at the rough surface's local temperature, cell by cell
+    in each micro patch (its face's macro temperature plus the flash rise; without heating the face's
+    macro temperature), not a thermocouple's below the surface. Every ``update_every`` macro steps (and at the last
     step, and a step ending at a stop) the zones wear over the sliding since, weighted by the load factor
     (none while released), in at least ``substeps`` (and 2) implicit increments, raised while their error
     estimate exceeds ``micro.wear.WEAR_TOL``; a counter-face whose material gives ``k_w`` wears too."""

@@ -51,6 +51,7 @@ class Kind:
     examples: str             # accepted spellings, for messages
     needs_unit: bool = False  # bare numbers refused (temperatures: 20 would silently be 20 K)
     unit_advised: bool = False  # bare numbers warned of (angular speeds: 300 is rad/s where rpm is meant)
+    advice: str = ""          # said with the units a bare number would be plausible in
 
 
 KINDS: dict[str, Kind] = {
@@ -82,7 +83,9 @@ KINDS: dict[str, Kind] = {
     "resistance": Kind("thermal contact resistance per area", _dim((M, -1), (T, 3), (TH, 1)), "m^2 K/W",
                        "m^2 K/W"),
     "wear_rate": Kind("wear rate per frictional work (dh = k_w mu p ds: a specific wear rate K per normal load "
-                      "is k_w = K/mu)", _dim((M, -1), (L, 1), (T, 2)), "1/Pa", "1/Pa, 1/MPa, m^2/N, mm^3/(N m)"),
+                      "is k_w = K/mu)", _dim((M, -1), (L, 1), (T, 2)), "1/Pa", "1/Pa, 1/MPa, m^2/N, mm^3/(N m)",
+                      advice="per frictional work: a specific wear rate K = V/(F s) per normal load, as tribometers "
+                             "give it in mm^3/(N m), is k_w = K/mu"),
 }
 
 _FORCE, _PRESSURE = KINDS["force"].dim, KINDS["pressure"].dim
@@ -325,7 +328,8 @@ def _mismatch(dim: tuple[int, ...], spec: Kind) -> str:
 def plausible_in(raw, spec: Kind, low: float, high: float) -> str:
     """For a bare number ``raw`` (no unit, read in SI) outside [low, high]: the units among ``spec``'s
     examples in which it would be inside, as a clause (' (as "2e-05 mm^3/(N m)" it would be
-    plausible)': k_w = 2e-5 meant in mm^3/(N m), user trial M); "" for none or a written unit."""
+    plausible)': k_w = 2e-5 meant in mm^3/(N m), user trial M; with the kind's ``advice``: a pad
+    developer took that unit for K's, a trial); "" for none or a written unit."""
     number, written = VALUE.match(raw).groups() if isinstance(raw, str) else (f"{raw:g}", "")
     fits = []
     for unit in ([] if written else [u.strip() for u in spec.examples.split(",")]):
@@ -335,7 +339,8 @@ def plausible_in(raw, spec: Kind, low: float, high: float) -> str:
             continue
         if dim == spec.dim and factor != 1 and low <= float(_F(number) * factor + offset) <= high:
             fits.append(f'"{number} {unit}"')
-    return f" (as {' or '.join(fits)} it would be plausible)" if fits else ""
+    advice = f"; {spec.advice}" if spec.advice else ""
+    return f" (as {' or '.join(fits)} it would be plausible{advice})" if fits else ""
 
 
 def _kind_unit(text: str, spec: Kind) -> str | None:

@@ -149,7 +149,9 @@ def test_a_bare_number_outside_the_plausible_range_is_shown_in_the_units_it_woul
     rate = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))
     ctx = Context(effects=frozenset())
     assert parse(rate, 2e-5, "k_w", ctx) == 2e-5 and parse(rate, "2e-5 1/Pa", "k_w", ctx) == 2e-5
-    assert ctx.warnings[0].endswith('(as "2e-05 1/MPa" or "2e-05 mm^3/(N m)" it would be plausible)')
+    assert ctx.warnings[0].endswith('(as "2e-05 1/MPa" or "2e-05 mm^3/(N m)" it would be plausible; per frictional '
+                                    'work: a specific wear rate K = V/(F s) per normal load, as tribometers give it '
+                                    'in mm^3/(N m), is k_w = K/mu)')
     assert ctx.warnings[1].endswith("check the value and its unit")
 
 
