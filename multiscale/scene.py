@@ -34,14 +34,14 @@ from multiscale.scene_rough import (law_top_warnings, measured_cover, micro_cons
                                     own_tables, penalty_range, perfect_contact, plastic_everywhere, pressure_range,
                                     rough_rules,
                                     roughness_over, thin_layer, zone_sizes)
-from multiscale.scene_sections import (COUPLING_DEFAULT, FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE,
-                                       OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers, Loading, Material,
-                                       Micro, Output, Roughness, Time, Wear)
+from multiscale.scene_sections import (COUPLING_DEFAULT, OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers,
+                                       Loading, Material, Micro, Output, Roughness, Time)
 from multiscale.scene_cycle import convection_coverage, cycle_coverage, short_phases, speed_range, thin_heated_layers
 from multiscale.scene_keys import drop_replaced, given_paths, key_parts
 from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks, speed_law_zeros, torque_problems
 from multiscale.scene_stability import Stability, stability_warnings
 from multiscale.scene_vehicle import Vehicle
+from multiscale.scene_wear import FIG_7_9_CALIBRATION, FIG_7_9_WEAR_RATE, Wear
 
 __all__ = ["COUPLING_DEFAULT", "EFFECTS", "FIG_7_9_CALIBRATION", "FIG_7_9_WEAR_RATE", "OUTPUT_FIELDS", "Boundary",
            "Geometry", "Interface", "InterfaceSettings", "Loading", "Material", "Scene", "Vehicle", "default_wear_rate",
@@ -499,10 +499,10 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
 def default_wear_rate(scene: Scene) -> list[str]:
     """The warning of a wear by the default k_w(T) table (user trial M calibrated on it unawares)."""
     w = scene.wear
-    if "wear" not in scene.effects or w is None or w.k_w is not None or w.k_w_table is not None \
-            or scene.rough_material_wears:
+    if "wear" not in scene.effects or w is None or w.given is not None or scene.rough_material_wears:
         return []
-    return ["wear: no k_w given (wear.k_w, wear.k_w_table or the rough material's k_w): the zones wear by the "
+    return ["wear: no k_w given (wear.k_w, wear.k_w_table, a specific_rate or the rough material's k_w): the zones "
+            "wear by the "
             f"default k_w(T) table, the {FIG_7_9_CALIBRATION}"]
 
 

@@ -19,7 +19,7 @@ from multiscale.scene_friction import FRICTION, law_problems
 from multiscale.scene_geometry import Direction, LengthUnit
 from multiscale.scene_plain import PixelSize
 from multiscale.scene_stability import Stribeck
-from multiscale.scene_values import ANGULAR_SPEED, LOAD_PRESSURE, MU, ROUGHNESS
+from multiscale.scene_values import ANGULAR_SPEED, LOAD_PRESSURE, MU, ROUGHNESS, TEMPERATURE
 from multiscale.scene_vehicle import Vehicle
 from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, ListOf, OneOf, OnlyWith, Pair,
                                Quantity, Requires, Section, TableOr, Tables, Text, key)
@@ -29,22 +29,19 @@ from multiscale.schema import (Choice, Curve, Either, FilePath, Flag, Integer, L
 MODULUS = Quantity("pressure", gt=0, plausible=(1e5, 1.2e12))           # rubber to diamond
 _POISSON = Quantity("dimensionless", gt=-1, lt=0.5, plausible=(0.0, 0.5))
 _CONDUCTIVITY = Quantity("conductivity", gt=0, plausible=(0.01, 2500.0))  # foam to diamond
-HOTTEST = 2500.0     # K, the top of the plausible temperatures (molten iron), of inputs and results
-_TEMPERATURE = Quantity("temperature", gt=0, plausible=(20.0, HOTTEST))    # cryogenic to molten iron
 _DENSITY = Quantity("density", gt=0, plausible=(100.0, 23e3))            # cork to osmium
 _SPECIFIC_HEAT = Quantity("specific_heat", gt=0, plausible=(50.0, 5e3))
 _DIFFUSIVITY = Quantity("diffusivity", gt=0, plausible=(1e-8, 1.2e-3))
 _EXPANSION = Quantity("expansion", plausible=(-1e-5, 5e-4))
-_FADE = Curve(_TEMPERATURE, MU, "temperature", "mu", min_rows=2)     # mu against the interface temperature
+_FADE = Curve(TEMPERATURE, MU, "temperature", "mu", min_rows=2)     # mu against the interface temperature
 _CONVECTION = Quantity("conductance", ge=0, plausible=(0.0, 1e4))         # still air to boiling water
-_WEAR_RATE = Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9))         # per frictional work (Eq. 3.10)
 _HARDNESS = Quantity("pressure", gt=0, plausible=(1e6, 1e11))            # soft polymer to diamond
 _WITH_RMS = "needed with rms (a generated surface)"
 
 
 def _property(value: Quantity, name: str) -> TableOr:
     """A material property: a constant, or a table [[temperature, value], ...] (>= 2 rows)."""
-    return TableOr(value, Curve(_TEMPERATURE, value, "temperature", name, min_rows=2))
+    return TableOr(value, Curve(TEMPERATURE, value, "temperature", name, min_rows=2))
 
 
 # ------------------------------------------------------------------ materials and interfaces
@@ -210,8 +207,8 @@ class Boundary:
     convection: float | tuple | None = key(TableOr(_CONVECTION, Curve(
         Quantity("angular_speed", ge=0), _CONVECTION, "speed", "h", min_rows=2)), absent="no convection")
     emissivity: float | None = key(Quantity("dimensionless", gt=0, le=1), absent="no radiation")
-    ambient: float | None = key(_TEMPERATURE, absent="time.initial_temperature")            # K
-    temperature: float | None = key(_TEMPERATURE, absent="not fixed (no condition at all: insulated)")   # K
+    ambient: float | None = key(TEMPERATURE, absent="time.initial_temperature")            # K
+    temperature: float | None = key(TEMPERATURE, absent="not fixed (no condition at all: insulated)")   # K
 
     THERMAL = ("convection", "emissivity", "temperature")
 
@@ -374,7 +371,7 @@ class Time:
     end: float | None = key(Quantity("time", gt=0, plausible=(1e-6, 1e6)), needed_by=("thermal", "wear"))  # s
     steps: int = key(Integer(ge=1, le=10**6), default=1)        # (1e9 steps: check's plan took ~30 min)
     substeps: int = key(Integer(ge=1, le=10**4), default=1)
-    initial_temperature: float = key(_TEMPERATURE, default=293.15)  # K
+    initial_temperature: float = key(TEMPERATURE, default=293.15)  # K
 
     @property
     def dt(self) -> float | None:
@@ -515,63 +512,6 @@ class Micro:
     def coupling_scheme(self, effects) -> str:
         """``coupling``, or its default for the remote temperatures (``COUPLING_DEFAULT``)."""
         return self.coupling or COUPLING_DEFAULT[self.remote(effects)]
-
-
-# Default k_w(T) [(K, 1/Pa)]: the shape of thesis Fig. 7.9 (sintered pad material, [Mann 2017]):
-# slowly rising up to 200 degC, steeply above. The figure's numbers are not in the text; the level
-# is set so that the ch. 7 run (demos/pin_on_disc_thesis.toml, zones at 20-60 degC) wears the
-# volume of §7.3.2 (3.8e7 um^3 in 30 s of 200 N at 1.9 m/s with mu = 0.4: V / (mu F s) = 8.4e-15
-# 1/Pa on average). Calibrated on that one volume of a pin below 100 degC: below 100 degC it is
-# nearly flat (the worn volume then grows linearly with the sliding), above it is the figure's
-# shape only. ``multiscale check`` says so. (Until 2026-11-29 the level was 0.74 of this: 6e-15 at
-# 20 degC, and the ch. 7 run wore 2.8e7 um^3; found by an adversarial test.)
-FIG_7_9_CALIBRATION = ("shape of thesis Fig. 7.9 (its numbers are not in the text); level set so that "
-                       "k_w mu F s gives the thesis' ch. 7 worn volume (3.8e7 um^3 in 30 s at 200 N, "
-                       "1.9 m/s, mu 0.4: 8.4e-15 1/Pa on average over the ch. 7 zones); give your material's k_w")
-FIG_7_9_WEAR_RATE = ((293.15, 8.2e-15), (373.15, 1.09e-14), (473.15, 2.04e-14), (573.15, 8.2e-14), (673.15, 2.7e-13))
-
-
-@dataclass(frozen=True)
-class Wear:
-    """Archard wear dh = k_w mu p ds (Eq. 3.10), k_w constant or a table k_w(T) (``FIG_7_9_WEAR_RATE``:
-    calibrated as ``FIG_7_9_CALIBRATION`` says) at the rough surface's local temperature, cell by cell
-    in each micro patch (its face's macro temperature plus the flash rise; without heating the face's
-    macro temperature), not a thermocouple's below the surface. Every ``update_every`` macro steps (and at the last
-    step, and a step ending at a stop) the zones wear over the sliding since, weighted by the load factor
-    (none while released), in at least ``substeps`` (and 2) implicit increments, raised while their error
-    estimate exceeds ``micro.wear.WEAR_TOL``; a counter-face whose material gives ``k_w`` wears too."""
-
-    k_w: float | None = key(_WEAR_RATE, absent="k_w_table, else the rough material's k_w, else thesis Fig. 7.9")
-    k_w_table: tuple | None = key(Curve(_TEMPERATURE, Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)), "temperature",
-                                        "k_w"), absent="k_w, else the rough material's k_w, else thesis Fig. 7.9")
-    update_every: int = key(Integer(ge=1), default=1)                         # macro steps per update
-    substeps: int = key(Integer(ge=1), default=1)                             # wear increments per update
-
-    rules = (OneOf(("k_w", "k_w_table")),)
-
-    @property
-    def rate(self):
-        """k_w [1/Pa]: the constant, else the table ((temperatures [K]), (rates [1/Pa]))."""
-        return self.k_w if self.k_w is not None else tuple(zip(*(self.k_w_table or FIG_7_9_WEAR_RATE)))
-
-    def held_ends(self, T0: float | None = None, hottest: float | None = None) -> list[str]:
-        """The k_w(T) table held at an end: below its first point at the initial temperature ``T0``
-        (check), above its last at ``hottest`` [K] (the largest micro temperature, after a run); []
-        with a constant k_w (a run at 1 K or 3000 K wore at the end values without a word)."""
-        if self.k_w is not None:
-            return []
-        temperatures, rates = self.rate
-        table = "wear.k_w_table" if self.k_w_table else "wear.k_w_table (absent: thesis Fig. 7.9)"
-        out = []
-        for T, where, end, rate, side, beyond in (
-                (T0, "the initial temperature", temperatures[0], rates[0], "below its first",
-                 T0 is not None and T0 < temperatures[0]),
-                (hottest, "the rough surface's largest micro temperature", temperatures[-1], rates[-1],
-                 "above its last", hottest is not None and hottest > temperatures[-1])):
-            if beyond:
-                out.append(f"{table}: {where}, {T - 273.15:.4g} degC, is {side} point {end - 273.15:.4g} degC: the "
-                           f"zones wear with k_w held at {rate:.3g} 1/Pa there")
-        return out
 
 
 @dataclass(frozen=True)

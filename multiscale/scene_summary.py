@@ -276,12 +276,14 @@ def _effect_line(scene: Scene, effect: str) -> str:
         w = scene.wear
         counter = scene.materials[scene.geometry.spec.interface_materials(
             scene.rough_interfaces[0] if scene.rough_interfaces else None)[1]]
-        rate = f"k_w = {w.k_w:g} 1/Pa" if w.k_w is not None else (
-            "k_w(T) table" if w.k_w_table is not None else "k_w of its material" if scene.rough_material_wears else
-            f"k_w(T) default table: {FIG_7_9_CALIBRATION}")
+        named = {"k_w": "k_w = {:g} 1/Pa", "k_w_table": "k_w(T) table", "specific_rate": "k = {:g} 1/Pa",
+                 "specific_rate_table": "k(T) table"}
+        rate = "k_w of its material" if scene.rough_material_wears else named[w.given].format(w.rate) if w.given \
+            else f"k_w(T) default table: {FIG_7_9_CALIBRATION}"
         both = f"; the {scene.bodies[1]} wears too (k_w of its material)" if counter.k_w is not None else ""
-        return (f"Archard dh = k_w mu p ds every {w.update_every} step(s) in {w.substeps} increment(s){both}; "
-                f"{rate} (per frictional work: a specific wear rate K per load is k_w = K/mu)")
+        law = "k p ds" if w.per_load and not scene.rough_material_wears else "k_w mu p ds"
+        return (f"Archard dh = {law} every {w.update_every} step(s) in {w.substeps} increment(s){both}; "
+                f"{rate} (k_w per frictional work, k per normal load: a specific wear rate k is k_w = k/mu)")
 
     return EFFECTS[effect].doc
 

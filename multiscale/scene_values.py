@@ -7,6 +7,8 @@ from __future__ import annotations
 
 from multiscale.schema import Quantity
 
+HOTTEST = 2500.0     # K, the top of the plausible temperatures (molten iron), of inputs and results
+TEMPERATURE = Quantity("temperature", gt=0, plausible=(20.0, HOTTEST))    # cryogenic to molten iron
 MU = Quantity("dimensionless", ge=0, plausible=(0.0, 2.0))        # a friction coefficient
 LOAD_PRESSURE = Quantity("pressure", gt=0, plausible=(1e3, 2e8))        # on load faces: 0.01 to 2000 bar
 ANGULAR_SPEED = Quantity("angular_speed", ge=0, plausible=(0.0, 2500.0),   # up to ~24 000 rpm

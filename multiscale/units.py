@@ -84,8 +84,10 @@ KINDS: dict[str, Kind] = {
                        "m^2 K/W"),
     "wear_rate": Kind("wear rate per frictional work (dh = k_w mu p ds: a specific wear rate K per normal load "
                       "is k_w = K/mu)", _dim((M, -1), (L, 1), (T, 2)), "1/Pa", "1/Pa, 1/MPa, m^2/N, mm^3/(N m)",
-                      advice="per frictional work: a specific wear rate K = V/(F s) per normal load, as tribometers "
-                             "give it in mm^3/(N m), is k_w = K/mu"),
+                      advice="per frictional work: a specific wear rate k = V/(F s) per normal load, as tribometers "
+                             "give it in mm^3/(N m), is k_w = k/mu, or wear.specific_rate itself"),
+    "specific_wear_rate": Kind("specific wear rate per normal load and sliding distance (k = V/(F s): dh = k p ds)",
+                               _dim((M, -1), (L, 1), (T, 2)), "1/Pa", "mm^3/(N m), m^3/(N m), 1/Pa"),
 }
 
 _FORCE, _PRESSURE = KINDS["force"].dim, KINDS["pressure"].dim

@@ -418,6 +418,21 @@ def run_pod(folder, overrides: dict, text: str = POD):
     return run(loads(text.format(folder=folder), overrides=overrides), verbose=False).history
 
 
+def test_a_specific_wear_rate_per_normal_load_wears_as_k_w_times_mu(straight, tmp_path):
+    """``wear.specific_rate`` k = V/(F s), a tribometer's (a pad developer divided it by mu by hand;
+    check's hint even offered its unit for k_w): the rough pin at mu 0.4 with k = 4e-15 1/Pa wears
+    what k_w = 1e-14 1/Pa wears (to the coupled solves' tolerance), and check says which law."""
+    from multiscale.scene_summary import summary
+    overrides = {"wear.specific_rate": "4e-6 mm^3/(N m)"}          # replaces the file's k_w (one of the rule)
+    scene = loads(POD.format(folder=tmp_path / "k"), overrides=overrides)
+    assert (scene.wear.given, scene.wear.per_load, scene.wear.rate) == ("specific_rate", True, pytest.approx(4e-15))
+    assert any("Archard dh = k p ds every 1 step(s)" in line and "k = 4e-15 1/Pa" in line for line in summary(scene))
+    h, before = run_pod(tmp_path / "k", overrides), History.read(straight[1].history_file)
+    np.testing.assert_allclose(h["wear_volume"], before["wear_volume"], rtol=1e-6)
+    with pytest.raises(SceneError, match=r"give only one of them \(got k_w, specific_rate\)"):
+        loads(POD.format(folder="x").replace('k_w = "1e-14 1/Pa"', 'k_w = "1e-14 1/Pa"\nspecific_rate = 4e-15'))
+
+
 def test_the_zones_wear_with_the_loaded_sliding_and_at_the_last_step(straight, cycle, tmp_path):
     """Archard wear and the frictional work follow the sliding weighted by the load factor: released
     after 0.6 s (within 10 ms), step 2 works and wears 1/120 of step 1 (before: the end-of-step

@@ -121,8 +121,8 @@ def test_the_absence_texts_say_what_the_code_does(tmp_path):
     boundary's ambient and convection, an interface's friction, the load factor and the speed, the
     micro grid, remote temperatures and coupling, and the wear rate."""
     from multiscale.scene import loads
-    from multiscale.scene_sections import (DEFAULT_GRID, FIG_7_9_WEAR_RATE, Boundary, InterfaceSettings, Loading,
-                                           Micro, Output, Wear)
+    from multiscale.scene_sections import DEFAULT_GRID, Boundary, InterfaceSettings, Loading, Micro, Output
+    from multiscale.scene_wear import FIG_7_9_WEAR_RATE, Wear
     text = (Path(__file__).parents[1] / "demos" / "block_on_flat.toml").read_text()
     text = text.replace('folder = "../results/block_on_flat"', "")
     scene = loads(text, tmp_path, name="x")
@@ -142,6 +142,7 @@ def test_the_absence_texts_say_what_the_code_does(tmp_path):
     assert _absent(Micro, "remote_temperatures") == '"bulk"; "rough" with effect conductance'
     assert [Micro().coupling_scheme(e) for e in (set(), {"conductance"})] == ["implicit", "explicit"]
     assert _absent(Wear, "k_w").endswith("else thesis Fig. 7.9") and Wear().rate == tuple(zip(*FIG_7_9_WEAR_RATE))
+    assert (Wear().given, Wear(specific_rate=1e-14).per_load, Wear(k_w=1e-14).per_load) == (None, True, False)
 
 
 def _absent(cls, name: str) -> str:

@@ -150,8 +150,8 @@ def test_a_bare_number_outside_the_plausible_range_is_shown_in_the_units_it_woul
     ctx = Context(effects=frozenset())
     assert parse(rate, 2e-5, "k_w", ctx) == 2e-5 and parse(rate, "2e-5 1/Pa", "k_w", ctx) == 2e-5
     assert ctx.warnings[0].endswith('(as "2e-05 1/MPa" or "2e-05 mm^3/(N m)" it would be plausible; per frictional '
-                                    'work: a specific wear rate K = V/(F s) per normal load, as tribometers give it '
-                                    'in mm^3/(N m), is k_w = K/mu)')
+                                    'work: a specific wear rate k = V/(F s) per normal load, as tribometers give it '
+                                    'in mm^3/(N m), is k_w = k/mu, or wear.specific_rate itself)')
     assert ctx.warnings[1].endswith("check the value and its unit")
 
 
@@ -272,8 +272,9 @@ def test_demo_scenes_validate():
     for name in ("pin_on_disc", "pin_on_disc_thesis"):               # the multiscale versions
         rough = load(DEMOS / f"{name}.toml")
         assert {"roughness", "wear"} <= rough.effects and rough.warnings == tuple(default_wear_rate(rough))
-        assert rough.warnings[0].startswith("wear: no k_w given (wear.k_w, wear.k_w_table or the rough material's "
-                                            "k_w): the zones wear by the default k_w(T) table, the shape of thesis")
+        assert rough.warnings[0].startswith("wear: no k_w given (wear.k_w, wear.k_w_table, a specific_rate or the rough "
+                                            "material's k_w): the zones wear by the default k_w(T) table, the shape of "
+                                            "thesis")
         assert load(DEMOS / f"{name}.toml", overrides={"wear.k_w": "1e-14 1/Pa"}).warnings == ()   # (user trial M)
         assert rough.roughness.body == "pin" and rough.micro.partition_law
 
@@ -436,7 +437,7 @@ def test_measured_surface_path_is_relative_to_the_scene(tmp_path):
     ('model = "fft-bem"', 'model = "bem"', 'micro.model = "bem": unknown (did you mean "fft-bem"?)'),
     ('model = "fft-bem"', "partition_law = true", 'micro.partition_law = true: needs effect "heat_partition"'),
     ('["200 degC", "3e-14 1/Pa"]', '["10 degC", "3e-14 1/Pa"]', "temperature must increase strictly"),
-    ("update_every = 2", 'k_w = "1e-12 1/Pa"', "wear.k_w or wear.k_w_table: give only one of them"),
+    ("update_every = 2", 'k_w = "1e-12 1/Pa"', "wear.k_w or wear.k_w_table or wear.specific_rate or wear.specific_rate_table: give only one of them"),
     ('E = "2 GPa"', 'E = "2 GW"', 'layers.layer[2].E = "2 GW": expected a pressure or modulus'),
     ('thickness = "10 um"\n', "", "layers.layer[1].thickness: missing; required: a length > 0 m"),
     ("modes = 100", "modes = 0", "stability.modes = 0: must be an integer >= 1"),
@@ -1534,8 +1535,8 @@ def test_a_wear_table_left_by_the_run_is_warned_about(tmp_path):
         "largest micro temperature)"]
     assert not [w for w in loads(own.replace('"20 degC"', '"1 K"'), tmp_path).warnings if w.startswith("wear.")]
     from multiscale.scene_summary import summary
-    assert any(line.endswith("; k_w of its material (per frictional work: a specific wear rate K per load is "
-                             "k_w = K/mu)") for line in summary(loads(own, tmp_path)))
+    assert any(line.endswith("; k_w of its material (k_w per frictional work, k per normal load: a specific wear "
+                             "rate k is k_w = k/mu)") for line in summary(loads(own, tmp_path)))
 
 
 def test_a_penalty_softer_than_the_bodies_is_warned_about(tmp_path):

@@ -310,3 +310,23 @@ def test_a_wear_rate_says_what_it_is():
     assert repr(WearRate(1e-14)) == "WearRate(1e-14 1/Pa)"
     assert repr(WearRate(([300.0, 500.0], [1e-14, 5e-14]))) == "WearRate(table of 2 points, 300-500: 1e-14-5e-14 1/Pa)"
     assert repr(WearRate(np.exp)) == "WearRate(exp)"
+
+
+def test_a_specific_wear_rate_per_normal_load_wears_k_p_s_whatever_mu():
+    """``PostAnalysis(per_load=True)``: a specific wear rate k = V/(F s) (a tribometer's) wears
+    dh = k p ds, mu out of it (a pad developer divided by mu by hand, a function of the temperature
+    where mu fades): two zones at mu 0.2 and 0.5 lose k P A s each (Archard, to round-off), and
+    at mu 0.5 the same heights as a rate per frictional work k_w = k / 0.5."""
+    from multiscale.micro.post_analysis import PostAnalysis
+    from multiscale.micro.zones import Zone
+    s = fractal_surface(32, 32e-6, hurst=0.8, k_min=2, k_max=8, rms=1e-6, seed=3)
+    s = Surface(s.heights, s.dx, s.dy, periodic=False)
+    E, k, P = HalfSpace(1e11), 1e-14, 5e8
+    zones, run = [Zone(0, s), Zone(1, s)], dict(speed=np.ones(2), sliding=np.full(2, 2.0))
+    per_load = PostAnalysis(E, s.shape, s.dx, s.dy, mu=0.3, wear_rate=k, per_load=True, tol=1e-10)
+    r = per_load.run(zones, np.full(2, P), mu=np.array([0.2, 0.5]), **run)
+    np.testing.assert_allclose(r.volume, k * P * s.size[0] * s.size[1] * 2.0, rtol=1e-10)
+    assert per_load.archard_compliance(np.array([2.0]), np.array([300.0]), mu=np.array([0.5]))[0] == 2.0 * k
+    work = PostAnalysis(E, s.shape, s.dx, s.dy, mu=0.5, wear_rate=k / 0.5, tol=1e-10)
+    w = work.run(zones[1:], np.array([P]), speed=np.ones(1), sliding=np.full(1, 2.0))
+    np.testing.assert_allclose(w.heights[0], r.heights[1], rtol=0, atol=1e-12 * np.ptp(s.heights))

@@ -20,7 +20,8 @@ area, sliding speed V and direction, macro surface temperatures of both bodies):
    rates are scaled back to the true speed (mu p V is linear in it; the partition is unchanged);
 3. optionally the thermal contact conductance h_c of the zone at that contact
    (``laws.Conductance``, the zone-scale spreading resistance taken out);
-4. Archard wear over the sliding distance s = V Δt (Eq. 3.10, dh = k_w(T) mu p ds, T the local
+4. Archard wear over the sliding distance s = V Δt (Eq. 3.10, dh = k_w(T) mu p ds, or k(T) p ds by a
+   specific wear rate per normal load, ``per_load``; T the local
    surface temperature of step 2): ``substeps`` increments, each a load-controlled solve of the
    worn patch warm-started from the previous pressure (§3.5.1), linearly implicit: the depth of
    the pressure after the increment acts as a Winkler layer in that solve (stable at any wear
@@ -135,7 +136,9 @@ class PostAnalysis:
     temperature: k_w is then taken at the macro temperature of the rough body); ``conductance``: a
     ``laws.Conductance`` or None; ``wear_rate``: anything ``WearRate`` accepts (temperatures in K),
     or None for no wear; ``counter_rate``: the same for the counter-face (None: it does not wear);
-    ``substeps``: wear increments per step; ``tol``: contact tolerance; ``hardness``: a
+    ``per_load``: ``wear_rate`` is a specific wear rate k per normal load (dh = k p ds: mu out of
+    the rough body's wear, not of the counter-face's); ``substeps``: wear increments per step;
+    ``tol``: contact tolerance; ``hardness``: a
     ``plasticity.Hardness`` (H, or H(T) at the rough body's remote temperature of each zone) for
     elastic-perfectly-plastic asperities, whose permanent deformation goes into the returned
     heights (before wear; the wear re-solves are bounded too), or None (elastic).
@@ -143,7 +146,7 @@ class PostAnalysis:
 
     def __init__(self, kernel: Kernel, shape, dx: float, dy: float, *, mu: float, heating: Heating | None = None,
                  conductance: Conductance | None = None, wear_rate=None, counter_rate=None, substeps: int = 1,
-                 tol: float = 1e-8, max_iter: int = 5000, hardness: Hardness | None = None):
+                 tol: float = 1e-8, max_iter: int = 5000, hardness: Hardness | None = None, per_load: bool = False):
         self.solver = ContactSolver(kernel, shape, dx, dy, periodic=False)
         self.shape, self.dx, self.dy = tuple(shape), float(dx), float(dy)
         self.mu = check_positive("mu", mu, allow_zero=True)
@@ -159,6 +162,7 @@ class PostAnalysis:
                                     or heating.transient_steps < 0):
             raise InputError("transient_steps", heating.transient_steps, "0 (steady) or an integer >= 1")
         self.rate = WearRate(wear_rate) if wear_rate is not None else None
+        self.per_load = bool(per_load)
         self.counter_rate = WearRate(counter_rate) if counter_rate is not None else None
         self.substeps, self.tol = check_count("substeps", substeps), check_positive("tol", tol)
         self.max_iter = check_count("max_iter", max_iter)
@@ -315,7 +319,7 @@ class PostAnalysis:
         touches; 0 for a constant k_w)."""
         T = self._wear_temperatures(result, remote)[0]
         k_w = self.rate(T) if self.rate.depends_on_temperature else self.rate()
-        C = np.broadcast_to(k_w * (result.mu * sliding)[:, None, None], result.pressure.shape)
+        C = np.broadcast_to(k_w * (self._wear_mu(result.mu) * sliding)[:, None, None], result.pressure.shape)
         touching = result.pressure > 0
         least = np.min(C, axis=(-2, -1), where=touching, initial=np.inf)
         return C, np.where(touching.any(axis=(-2, -1)), least, 0.0)
@@ -331,7 +335,11 @@ class PostAnalysis:
         k_w = self.rate(np.asarray(temperature, dtype=float))
         if rates is not None:
             k_w = np.where(np.isfinite(rates), rates, k_w)
-        return k_w * (self.mu if mu is None else np.asarray(mu)) * s
+        return k_w * self._wear_mu(self.mu if mu is None else np.asarray(mu)) * s
+
+    def _wear_mu(self, mu):
+        """The factor mu of the rough body's dh = k_w mu p ds: 1 for a rate ``per_load``."""
+        return np.ones_like(mu, dtype=float) if self.per_load else mu
 
     def zone_rates(self, result: ZoneResult, remote=None) -> np.ndarray:
         """Each zone's k_w [1/Pa] as its wear takes it: k_w(T) at its cells' temperatures (those of

@@ -21,7 +21,8 @@ from multiscale.micro.laws import RESOLUTION
 from multiscale.micro.wear import SUBSTEP_TOL
 from multiscale.scene import loads
 from multiscale.scene_friction import bare_interfaces, curve_left, fade_tables
-from multiscale.scene_sections import HOTTEST, Material
+from multiscale.scene_sections import Material
+from multiscale.scene_values import HOTTEST
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.model import interface_materials
 from multiscale.workflows.output import RunResult
@@ -310,7 +311,7 @@ def _curve_ends(scene, history) -> list[str]:
 
 
 def _too_hot(scene, history) -> list[str]:
-    """Bodies hotter than any plausible temperature (``scene_sections.HOTTEST``): the load, the
+    """Bodies hotter than any plausible temperature (``scene_values.HOTTEST``): the load, the
     partition or the materials are wrong for the case (a car pad reached 23 000 K without a word)."""
     out = []
     for body in scene.geometry.spec.bodies:

@@ -83,6 +83,7 @@ def post_analysis(scene, zone) -> PostAnalysis:
                         heating=heating,
                         conductance=Conductance(*thermal_kernels(scene)) if scene.has("conductance") else None,
                         wear_rate=rate, counter_rate=counter_rate, substeps=scene.wear.substeps if wear else 1,
+                        per_load=wear and scene.wear.per_load and not scene.rough_material_wears,
                         tol=m.tol, hardness=interface_hardness(scene) if scene.has("plasticity") else None)
 
 
@@ -214,7 +215,7 @@ def worn_through(ms: Multiscale, rate: str = "wear.k_w", layers: float = 0.0) ->
 
 def _wear_keys(scene) -> tuple[str, float]:
     """(the key of the rough body's wear rate, the total thickness of its layers [m] or 0)."""
-    rate = f"materials.{scene.rough_material}.k_w" if scene.rough_material_wears else "wear.k_w"
+    rate = f"materials.{scene.rough_material}.k_w" if scene.rough_material_wears else f"wear.{scene.wear.given or 'k_w'}"
     return rate, sum(x.thickness for x in scene.layers.layer) if scene.has("layers") else 0.0
 
 
