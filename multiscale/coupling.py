@@ -361,13 +361,15 @@ class Multiscale:
         if not len(loaded) or self.model.released:
             return 0.0
         Q, into = self.micro_heat[loaded], self.micro_heat_rough[loaded]
-        if not (np.isfinite(Q).all() and np.isfinite(into).all()):
-            bad = np.asarray(loaded)[~(np.isfinite(Q) & np.isfinite(into))]
+        with np.errstate(invalid="ignore", over="ignore"):     # (what is not finite is said next)
+            given = np.where(Q > 0, self.partition[loaded] * Q, 0.0) - self.exchange[loaded] * self.remote_difference[loaded]
+        finite = np.isfinite(Q) & np.isfinite(into) & np.isfinite(given)
+        if not finite.all():
+            bad = np.asarray(loaded)[~finite]
             raise ConvergenceError(f"the post-analysis gave a heat rate that is not finite in {io.counted(len(bad), 'zone')} "
                                    f"(the first: {bad[:5].tolist()}): the coupling cannot be checked")
         if Q.mean() <= 0.0:                     # no frictional heat (no sliding): nothing to couple
             return 0.0
-        given = self.partition[loaded] * Q - self.exchange[loaded] * self.remote_difference[loaded]
         return float(np.abs(into - given).max() / max(Q.mean(), np.abs(into).mean()))
 
     def zone_heat(self) -> np.ndarray:

@@ -504,7 +504,8 @@ def test_the_steps_series_compliance_is_the_depth_per_pressure_its_wear_takes(tm
     assert np.abs(form).max() > 1e-3 * h["wear_max_depth"][-1]
     assert np.abs(per_zone).max() < 1e-12 * (areas * np.abs(form)).sum()
     assert areas @ ms.facet_fields()["wear_depth"]() == pytest.approx(h["wear_volume"][-1], rel=1e-9)
-    assert ms.facet_fields()["wear_depth"]().min() >= 0.0
+    facet = form[on] + ms.rough.wear_depth().mean(axis=(-2, -1))[zone_of[on]]      # (the field clips round-off)
+    assert facet.min() >= -1e-9 * facet.max()                                      # (it was -3.3e-14: 1.5e-6 of it)
 
 
 def test_the_series_compliance_takes_k_w_at_the_temperatures_the_micro_wear_takes(tmp_path, monkeypatch):
@@ -709,8 +710,8 @@ def test_a_light_load_wears_its_summits_flat_and_the_solve_follows(tmp_path, k_w
     assert first_steps([1e-7, 2e-7, 3e-7, 0.0], [1e-6, 1e-6, 1e-6, 0.0]) == (FIRST_STEP, 0.2 / 16)   # the median
     assert first_steps([1e-8, 2e-8], [1e-6, 1e-6]) == pytest.approx((0.015 / 2, 0.015 / 16), rel=1e-12)
     assert first_steps([1e-7], [1e-9]) == (FIRST_STEP, SMALLEST_STEP) == first_steps([-1e-9], [1e-6])
-    assert first_steps([1e-13], [1e-6])[1] == LEAST_STEP       # a stuck continuation gives up in 12 halvings
-    assert first_steps([1e-9], [1e-3]) == (LEAST_STEP, LEAST_STEP)   # (the first was 5e-7: no halving, a review)
+    assert first_steps([3e-9], [1e-6]) == (1.5e-3, LEAST_STEP)      # a stuck continuation gives up in 12 halvings
+    assert first_steps([1e-9], [1e-3]) == pytest.approx((5e-7, 5e-7 / 4), rel=1e-12)   # (smallest 2.4e-4: no halving)
     from multiscale.workflows import run
     result = run(loads(BRASS.format(folder=tmp_path / "brass"), overrides={"wear.k_w": k_w}), verbose=False)
     h = History.read(result.history_file)
@@ -1119,3 +1120,6 @@ def test_a_heat_rate_that_is_not_finite_is_a_convergence_error_not_a_converged_r
     assert Multiscale.heat_residual(loop) == pytest.approx(1.1 / 2.0, rel=1e-12)
     loop.micro_heat[:] = 0.0                                   # no sliding: nothing to couple
     assert Multiscale.heat_residual(loop) == 0.0
+    loop.micro_heat[1], loop.exchange[0] = 3.0, np.inf          # an exchange that is not finite: said too
+    with pytest.raises(ConvergenceError, match=r"not finite in 1 zone \(the first: \[0\]\)"):
+        Multiscale.heat_residual(loop)

@@ -236,6 +236,13 @@ def test_a_mode_cap_on_a_reduced_damped_system_keeps_a_split_pair():
     np.testing.assert_array_equal(select(lam, (0.0, 1e4), 2, 0.0), [0, 1, 2])
     np.testing.assert_array_equal(eigen.capped(lam, np.array([0, 1, 2]), 2), [0, 1, 2])
     assert eigen.capped(lam, np.array([0, 1, 2]), 1).tolist() == [0]
+    # stable modes are no pair: a heavily damped band (sigma -2000 1/s) keeps its cap (a review)
+    lam = -2000 + 2j * np.pi * np.array([10000.0, 10100.0, 10150.0])
+    assert eigen.capped(lam, np.array([0, 1, 2]), 1).tolist() == [0]
+    # a pair split by 0.15 Hz at 1000 Hz, the cap's target at 10 kHz: kept by the old floor, 1e-4 of
+    # the distance to the target and the target
+    lam = np.array([-1 + 1000j * 2 * np.pi, 1 + 1000.15j * 2 * np.pi, -1 + 500j * 2 * np.pi, -1 + 2e3j * 2 * np.pi])
+    assert sorted(select(lam, (0.0, 2e4), 2, 1e4)) == [0, 1, 3]
 
 
 def test_proportional_damping_mapping_matches_companion_form_and_pep():

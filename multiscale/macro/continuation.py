@@ -34,7 +34,7 @@ from multiscale.macro.laws_ufl import FacetLaw
 from multiscale.macro.mechanics import Mechanics, SolveResult
 
 FIRST_STEP, SMALLEST_STEP = 1 / 16, 1 / 64
-LEAST_STEP = 1 / 4096      # below this no step: a stuck continuation gives up after at most 12 halvings
+LEAST_STEP = 1 / 4096      # the smallest step at least (unless the first is below 4x it): a stuck continuation gives up
 
 
 def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None, released: bool = False) -> SolveResult:
@@ -88,7 +88,9 @@ def first_steps(depth, offset) -> tuple[float, float]:
     step of lambda would open the facets that carry at lambda = 0 (``depth`` [m]: their interpenetration
     of the shifted laws, ``offset`` [m]: their shifts; a shift s moves a facet by d lambda s): a fraction
     of the median depth per unit shift over the shifted facets in contact, at the gaps the offsets were
-    taken at (``LEAST_STEP`` at least, and the first step not below the smallest). Worn-flat laws rise from 0
+    taken at (``LEAST_STEP`` at least, unless a quarter of the first step is less: a failed first
+    step is halved twice before the continuation gives up; below the smallest it gave up at once,
+    a review). Worn-flat laws rise from 0
     to their pressure within nm (a light load's run-in: all facets open at lambda = 1/64, the pin then
     free along the load; a trial)."""
     depth, offset = np.asarray(depth, dtype=float), np.asarray(offset, dtype=float)
@@ -96,5 +98,5 @@ def first_steps(depth, offset) -> tuple[float, float]:
     if not carrying.any():
         return FIRST_STEP, SMALLEST_STEP
     reach = float(np.median(depth[carrying] / offset[carrying]))    # lambda that opens half of them
-    smallest = max(min(SMALLEST_STEP, reach / 16), LEAST_STEP)
-    return max(min(FIRST_STEP, reach / 2), smallest), smallest
+    first = min(FIRST_STEP, reach / 2)
+    return first, min(max(min(SMALLEST_STEP, reach / 16), LEAST_STEP), first / 4)

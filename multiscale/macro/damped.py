@@ -68,7 +68,7 @@ from petsc4py import PETSc
 from multiscale.errors import InputError
 from multiscale.macro.block_lanczos import ShiftInvert, m_orthonormalise, symmetric_modes
 from multiscale.macro.dense import block_solve, mat_mult
-from multiscale.macro.eigen import (TWO_PI, Damping, ModalResult, by_frequency, capped, lambda_from_theta,
+from multiscale.macro.eigen import (LOCKED, TWO_PI, Damping, ModalResult, by_frequency, capped, lambda_from_theta,
                                     matrix_comm, reduce_sum, shift_invert_modes, solve_modes, solve_quadratic)
 from multiscale.macro.modal import mac_matrix, pair_modes
 
@@ -198,11 +198,13 @@ class ReducedSystem:
 
 def select(lam: np.ndarray, band, n_modes: int | None, target: float) -> np.ndarray:
     """Indices of the eigenvalues in the band (the ``n_modes`` nearest ``target`` [Hz], with the
-    other half of a lock-in pair the cap ends in: ``eigen.capped``), by frequency."""
+    other half of a lock-in pair the cap ends in: ``eigen.capped``, within ``LOCKED`` of the last
+    one's distance to the target at least), by frequency."""
     f = lam.imag / TWO_PI
     idx = np.nonzero((f >= band[0]) & (f <= band[1]))[0]
     if n_modes is not None and idx.size > n_modes:
-        idx = capped(lam, idx[np.argsort(np.abs(f[idx] - target), kind="stable")], n_modes)
+        ranked = idx[np.argsort(np.abs(f[idx] - target), kind="stable")]
+        idx = capped(lam, ranked, n_modes, LOCKED * (abs(f[ranked[n_modes - 1]] - target) + abs(target)))
     return idx[by_frequency(lam[idx])]
 
 

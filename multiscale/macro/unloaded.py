@@ -44,6 +44,7 @@ from mpi4py import MPI
 from petsc4py import PETSc
 from scipy.sparse.csgraph import connected_components
 
+from multiscale.errors import ConvergenceError
 from multiscale.held import FREE, motion_rows
 from multiscale.macro import mumps
 
@@ -153,8 +154,8 @@ class Unloaded:
     def solve(self) -> list[np.ndarray] | None:
         """Per body, the displacement [m] (arrays of the ``u`` layout) of the unloaded state, with
         the free motions of the current displacements (the last loaded state, kept); None if the
-        refinement did not reach ``TOL`` (a mechanism); ``ConvergenceError`` if the shifted
-        stiffness cannot be factorised. Collective."""
+        refinement did not reach ``TOL`` (a mechanism) or the shifted stiffness could not be
+        factorised (``mumps.direct_solver``: the output writes NaN, the run goes on). Collective."""
         mech = self.mech
         K, r = mech.cell_system()
         modes = self.free_motions(r)
@@ -164,7 +165,12 @@ class Unloaded:
         d = K.getDiagonal()
         d.scale(SHIFT)
         P.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
-        ksp = mumps.direct_solver(P, "the shifted stiffness of the unloaded state")
+        try:
+            ksp = mumps.direct_solver(P, "the shifted stiffness of the unloaded state")
+        except ConvergenceError:
+            for v in (P, d, f, r):
+                v.destroy()
+            return None
         u, du = f.duplicate(), f.duplicate()
         u.set(0.0)
         self._project(f)                # round-off of r . f = 0

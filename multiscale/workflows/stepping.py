@@ -2,9 +2,10 @@
 their checkpoints, so that ``multiscale run --resume`` continues a stopped or killed run.
 
 Every step writes, as one whole that a Ctrl-C waits for (``io.StepStop.writing``): its history row,
-at output times (and at a stop) its fields, its checkpoint (``checkpoint.h5``: the step, the history,
-the model's fields and state; the run's own ``save``) and the history file (readable if the run is
-killed next): a checkpoint's step has its fields written if they are due. A resumed run starts from the checkpoint's
+at output times its fields, its checkpoint (``checkpoint.h5``: the step, the history, the model's
+fields and state; the run's own ``save``), the history file (readable if the run is killed next)
+and, at a stop between output times, its fields: a checkpoint's step has its fields written if they
+are due. A resumed run starts from the checkpoint's
 step: the field files keep their times up to it (``FieldOutput(resume_at=...)``: those of a step
 whose checkpoint was not written are dropped, and the fields of a stop between output times too),
 so that a run stopped and resumed, any number of times, writes what the straight run writes.
@@ -67,12 +68,14 @@ def march(run, stop: io.StepStop, history: io.History, writer: FieldOutput, writ
             stepped = run.step(n)
             with stop.writing(n):                     # the step's fields, checkpoint and history, whole
                 history.append(**run.record(stepped))
-                done, stopping = n, n < steps and stop.requested()   # (the last: it finishes)
-                due = n % every == 0 or n == steps or stopping       # a stop's are dropped when resumed
+                due = n % every == 0 or n == steps
                 if due:
                     writer.write()                    # before the checkpoint: killed between, they are dropped
                 run.save(ckpt, n, history)
                 write_history()                       # readable if the run is killed
+                done, stopping = n, n < steps and stop.requested()   # (the last: it finishes)
+                if stopping and not due:
+                    writer.write()                    # the stop's, dropped when resumed
             if stopping:
                 break
     return done, stopping
