@@ -661,6 +661,13 @@ def test_a_sweep_against_measured_values_finds_where_each_metric_meets_them(tmp_
     assert "| 5 N … 10 N |" in line and "N (log-log)" in line
     far = next(x for x in md.splitlines() if x.startswith("| contact_radius [m] | load |"))
     assert "not in the swept range | 5 N … 20 N |" in far
+    # a zip group: its first knob with the others alongside (a trial's zip of two pad formulations,
+    # whose tables were interpolated as if along the first key alone)
+    zipped = text.replace('radius = "10 mm"\n', "", 1).replace('load = ["5 N", "10 N", "20 N"]', 'combine = "zip"\nload = ["5 N", "10 N", "20 N"]\n'
+                                                           'radius = ["10 mm", "10 mm", "10 mm"]')
+    assert main(["study", str(write(tmp_path, zipped.replace('name = "hertz"', 'name = "zipped"')))]) == 0
+    md = (tmp_path / "results" / "zipped" / "zipped.md").read_text()
+    assert "| max_pressure [Pa] | load (with radius alongside) |" in md
     _, axes = made[-1]                          # against the load: the values, the measured one, where met
     pressure = axes[0][1]
     measured, = [line for line in pressure.get_lines() if line.get_label() == "measured"]
@@ -1604,3 +1611,22 @@ def test_the_figure_against_a_knob_wraps_its_panels_and_draws_power_laws_straigh
     assert axes.shape == (2, 3) and [ax.get_visible() for ax in axes[1]] == [True, False, False]
     assert axes[0][1].get_title() == "max_pressure" and axes[0][1].get_yscale() == "log"
     assert axes[0][0].get_yscale() == "linear" and axes[0][1].get_xscale() == "log"
+
+
+def test_a_zip_group_holding_a_table_is_not_interpolated():
+    """``results.crossings`` along a zip group: the first knob with its partners alongside where all
+    are numbers; a group holding a table (a trial's two pad formulations: E and a fade table
+    zipped) has no value between its runs, so no crossing is offered."""
+    from types import SimpleNamespace as NS
+    from multiscale.studies.results import crossings
+
+    def row(label, volume):
+        return NS(ok=True, run=NS(label=label, shown={k: str(v) for k, v in label.items()}),
+                  record={"metrics": {"wear_volume": volume}}, reference={"wear_volume": 2.0})
+    study = NS(reference=NS(kind="file"), axes=(("E", "table"),), averaged=(), knobs=("E", "table"),
+               judged=("wear_volume",))
+    numbers = [row({"E": 1.0, "table": 10.0}, 1.0), row({"E": 4.0, "table": 20.0}, 4.0)]
+    (c,) = crossings(study, numbers)
+    assert (c.knob, c.partners, c.log) == ("E", ("table",), True) and c.value == pytest.approx(2.0, rel=1e-12)
+    tables = [row({"E": 1.0, "table": ((293.15, 0.4),)}, 1.0), row({"E": 4.0, "table": ((293.15, 0.3),)}, 4.0)]
+    assert crossings(study, tables) == []

@@ -183,7 +183,8 @@ def _crossing_table(study, found) -> list[str]:
         u = knob_unit(study, c.knob)
         value = "not in the swept range" if c.value is None else \
             f"{c.value:.4g}" + (f" {u}" if u and u != "-" else "") + (" (log-log)" if c.log else " (linear)")
-        lines.append(f"| {metric_heading(c.metric, unit(c.metric))} | {c.knob} | "
+        along = c.knob + (f" (with {', '.join(c.partners)} alongside)" if c.partners else "")
+        lines.append(f"| {metric_heading(c.metric, unit(c.metric))} | {along} | "
                      f"{', '.join(f'{k} = {v}' for k, v in c.held) or '–'} | {value} | {c.between[0]} … {c.between[1]} | "
                      f"{number_text(c.span[0])} … {number_text(c.span[1])} |")
     return lines + [""]

@@ -258,6 +258,7 @@ class Crossing:
     between: tuple         # the two swept values (as shown) around it; not met: the first and last swept
     span: tuple            # the metric at ``between`` (mean over the averaged knobs); not met: its least and most
     log: bool              # interpolated linearly in log(metric) against log(knob)
+    partners: tuple = ()   # the knobs of its zip group, varied alongside
 
 
 def measured_value(rows: list[Row], metric: str) -> float:
@@ -271,9 +272,11 @@ def crossings(study: Study, rows: list[Row]) -> list[Crossing]:
     numeric knob, for each setting of the other knobs and each judged metric, the knob values at
     which the metric equals its reference, interpolated between neighbouring swept values where
     metric − reference changes sign: in log-log when the knob's and the metric's values are
-    positive (exact for a power law: Archard's worn volume ∝ k_w), else linearly. The metric is
-    the mean over the averaged knobs; a setting with a failed run is left out. [] for other
-    references."""
+    positive (exact for a power law: Archard's worn volume ∝ k_w), else linearly. Along a zip
+    group, its first knob with the others varied alongside (``Crossing.partners``), and
+    only where all of them are numbers (a zip of two pad formulations' tables was interpolated
+    along its first key: a trial). The metric is the mean over the averaged knobs; a setting with
+    a failed run is left out. [] for other references."""
     if study.reference is None or study.reference.kind != "file":
         return []
     out = []
@@ -286,7 +289,8 @@ def crossings(study: Study, rows: list[Row]) -> list[Crossing]:
             if any(not r.ok for r in group):
                 continue
             xs = list({r.run.label[knob] for r in group})
-            if len(xs) < 2 or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in xs):
+            if len(xs) < 2 or not all(isinstance(r.run.label[k], (int, float)) and not isinstance(r.run.label[k], bool)
+                                      for r in group for k in axis):
                 continue
             xs.sort()
             shown = {r.run.label[knob]: r.run.shown[knob] for r in group}
@@ -301,10 +305,10 @@ def crossings(study: Study, rows: list[Row]) -> list[Crossing]:
                     t = 0.0 if y[i] == ref else (f(ref) - f(y[i])) / (f(y[i + 1]) - f(y[i]))
                     value = f(xs[i]) + t * (f(xs[i + 1]) - f(xs[i]))
                     out.append(Crossing(m, knob, tuple(zip(held, setting)), math.exp(value) if log else value,
-                                        (shown[xs[i]], shown[xs[i + 1]]), (y[i], y[i + 1]), log))
+                                        (shown[xs[i]], shown[xs[i + 1]]), (y[i], y[i + 1]), log, axis[1:]))
                 if not found:
                     out.append(Crossing(m, knob, tuple(zip(held, setting)), None, (shown[xs[0]], shown[xs[-1]]),
-                                        (min(y), max(y)), log))
+                                        (min(y), max(y)), log, axis[1:]))
     return out
 
 
