@@ -428,10 +428,9 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
         warnings += penalty_range(scene, g.spec, effects) + list(g.spec.warnings) + pressure_range(scene)
         if "wear" in effects and scene.wear is not None and scene.materials is not None and not problems:
             rough = {scene.geometry.spec.interface_materials(n)[0] for n in scene.geometry.spec.interfaces}
-            given = [k for k in ("k_w", "k_w_table") if getattr(scene.wear, k) is not None]
-            for name in sorted(rough):
-                if given and name in scene.materials and scene.materials[name].k_w is not None:
-                    problems.append(f"wear.{given[0]}: the rough body's material gives k_w "
+            for name in sorted(rough):      # (a specific_rate too: the material's k_w won silently, a review)
+                if scene.wear.given and name in scene.materials and scene.materials[name].k_w is not None:
+                    problems.append(f"wear.{scene.wear.given}: the rough body's material gives k_w "
                                     f"(materials.{name}.k_w): give one of them")
         if not problems:
             problems += [str(e) for e in rough_rules(scene)] + (torque_problems(scene, g.spec.interfaces)

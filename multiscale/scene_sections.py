@@ -62,7 +62,7 @@ class Material:
     chi: float | tuple | None = key(_property(_DIFFUSIVITY, "chi"), absent="with thermal: kappa/(rho c)")    # m^2/s
     alpha: float | tuple | None = key(_property(_EXPANSION, "alpha"), needed_by=("expansion",), warn_unused=True)  # 1/K
     k_w: float | tuple | None = key(_property(Quantity("wear_rate", ge=0, plausible=(0.0, 1e-9)), "k_w"),
-                                    absent="rough body: wear.k_w's rate; counter-face: no wear")     # 1/Pa, Archard
+                                    absent="rough body: [wear]'s rate; counter-face: no wear")     # 1/Pa, Archard
     hardness: float | tuple | None = key(_property(_HARDNESS, "hardness"), absent="with plasticity: the other side's")
     loss_factor: float | None = key(Quantity("dimensionless", ge=0), absent="0: no structural damping")
     damping_alpha: float | None = key(Quantity("rate", ge=0), absent="0: no alpha M damping")   # 1/s

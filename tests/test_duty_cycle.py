@@ -190,18 +190,28 @@ def test_a_released_phase_writes_the_unloaded_bodies(tmp_path, expansion):
             np.testing.assert_allclose(fields[3][2], fields[1][2], rtol=1e-6, atol=1e-6 * fields[1][2].max())
 
 
-def test_an_unloaded_state_that_does_not_converge_is_written_nan(tmp_path, monkeypatch):
-    """If the released bodies' state cannot be solved (here forced: a tolerance of 0; in earnest a
-    mechanism beyond rigid motions) the run goes on: an ``UnloadedWarning``, displacement and von
-    Mises stress NaN at the released time, the loaded state again after it."""
+@pytest.mark.parametrize("how", ["tolerance", "factorisation"])
+def test_an_unloaded_state_that_does_not_converge_is_written_nan(tmp_path, monkeypatch, how):
+    """If the released bodies' state cannot be solved (here forced: a tolerance of 0, or a failed
+    factorisation of the shifted stiffness; in earnest a mechanism beyond rigid motions) the run goes
+    on: an ``UnloadedWarning`` that says why, displacement and von Mises stress NaN at the released
+    time, the loaded state again after it."""
+    from multiscale.errors import ConvergenceError
     from multiscale.macro import unloaded
-    monkeypatch.setattr(unloaded, "TOL", 0.0)
+
+    def fail(A, what):
+        raise ConvergenceError(f"{what} could not be factorised [PC failed reason 3]")
+    if how == "tolerance":
+        monkeypatch.setattr(unloaded, "TOL", 0.0)
+    else:
+        monkeypatch.setattr(unloaded.mumps, "direct_solver", fail)
     folder = tmp_path / "failed"
     scene = loads(pin_on_disc(folder, effects=("contact", "friction", "thermal", "heat_partition", "expansion"),
                               partition="0.14"), overrides={
         "loading.load_profile": [["0 s", 1.0], ["0.6 s", 1.0], ["0.61 s", 0.0], ["1.2 s", 0.0], ["1.21 s", 1.0]],
         "time.end": "1.8 s", "time.steps": 3})
-    with pytest.warns(unloaded.UnloadedWarning, match="written NaN"):
+    why = "did not converge" if how == "tolerance" else "the shifted stiffness of the unloaded state could not be"
+    with pytest.warns(unloaded.UnloadedWarning, match=f"thermo-elastic state: {why}.*written NaN"):
         run(scene, verbose=False)
     fields = body_fields(folder / "pin.xdmf")
     assert np.isnan(fields[2][1]).all() and np.isnan(fields[2][2]).all()

@@ -240,9 +240,14 @@ def test_a_mode_cap_on_a_reduced_damped_system_keeps_a_split_pair():
     lam = -2000 + 2j * np.pi * np.array([10000.0, 10100.0, 10150.0])
     assert eigen.capped(lam, np.array([0, 1, 2]), 1).tolist() == [0]
     # a pair split by 0.15 Hz at 1000 Hz, the cap's target at 10 kHz: kept by the old floor, 1e-4 of
-    # the distance to the target and the target
+    # the distance to the target and the target; and a tie on the other side of the target
     lam = np.array([-1 + 1000j * 2 * np.pi, 1 + 1000.15j * 2 * np.pi, -1 + 500j * 2 * np.pi, -1 + 2e3j * 2 * np.pi])
     assert sorted(select(lam, (0.0, 2e4), 2, 1e4)) == [0, 1, 3]
+    assert sorted(select(2j * np.pi * np.array([990.0, 1010.0, 500.0]), (0.0, 2e4), 1, 1e3)) == [0, 1]
+    # damped near its onset, the unstable half grows at 6 1/s, split 0.56 Hz from its stable half
+    # (sigma -396): the window takes the larger |sigma| (0.48 Hz at the growth alone cut the pair)
+    lam = np.array([-396 + 4810.56j * 2 * np.pi, 6 + 4810j * 2 * np.pi, -1 + 3000j * 2 * np.pi])
+    assert sorted(eigen.capped(lam, np.array([2, 0, 1]), 2).tolist()) == [0, 1, 2]
 
 
 def test_proportional_damping_mapping_matches_companion_form_and_pep():

@@ -34,7 +34,7 @@ from multiscale.macro.laws_ufl import FacetLaw
 from multiscale.macro.mechanics import Mechanics, SolveResult
 
 FIRST_STEP, SMALLEST_STEP = 1 / 16, 1 / 64
-LEAST_STEP = 1 / 4096      # the smallest step at least (unless the first is below 4x it): a stuck continuation gives up
+LEAST_STEP = 1 / 4096      # the smallest step once one converged (a first step below 4x it halves twice)
 
 
 def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None, released: bool = False) -> SolveResult:
@@ -71,6 +71,7 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None,
                 continue
             rate = [(u - x) / (target - done) for u, x in zip(mech.displacements(), kept)]
             done, step, iterations = target, 2 * step, iterations + result.iterations
+            smallest = max(smallest, LEAST_STEP)     # (a stuck point later gives up in at most 12 halvings)
     except ConvergenceError as exc:
         law.shift(None)
         raise ConvergenceError(
@@ -78,7 +79,7 @@ def solve_on_new_laws(mech: Mechanics, law: FacetLaw, guess: list | None = None,
             f"did{'; released: solved at the last load, kept for the next engagement' if released else ''}) failed: "
             f"{direct}; continued from the pressures of the laws before, it stopped at {done:.3g} of "
             f"the way (its last step {step:.3g}): {exc}; smaller wear steps change the laws less at an update "
-            "(more time.steps, or a lower k_w; wear.substeps divide the micro wear, not the update)",
+            "(more time.steps, or a lower wear rate; wear.substeps divide the micro wear, not the update)",
             exc.history, exc.result) from exc
     return dataclasses.replace(result, iterations=iterations)
 
@@ -89,8 +90,8 @@ def first_steps(depth, offset) -> tuple[float, float]:
     of the shifted laws, ``offset`` [m]: their shifts; a shift s moves a facet by d lambda s): a fraction
     of the median depth per unit shift over the shifted facets in contact, at the gaps the offsets were
     taken at (``LEAST_STEP`` at least, unless a quarter of the first step is less: a failed first
-    step is halved twice before the continuation gives up; below the smallest it gave up at once,
-    a review). Worn-flat laws rise from 0
+    step is halved twice before the continuation gives up, below the smallest it gave up at once,
+    a review; ``LEAST_STEP`` again once a step converged). Worn-flat laws rise from 0
     to their pressure within nm (a light load's run-in: all facets open at lambda = 1/64, the pin then
     free along the load; a trial)."""
     depth, offset = np.asarray(depth, dtype=float), np.asarray(offset, dtype=float)

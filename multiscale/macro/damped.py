@@ -198,13 +198,14 @@ class ReducedSystem:
 
 def select(lam: np.ndarray, band, n_modes: int | None, target: float) -> np.ndarray:
     """Indices of the eigenvalues in the band (the ``n_modes`` nearest ``target`` [Hz], with the
-    other half of a lock-in pair the cap ends in: ``eigen.capped``, within ``LOCKED`` of the last
-    one's distance to the target at least), by frequency."""
+    other half of a lock-in pair the cap ends in: ``eigen.capped``; and any as near the target as
+    the last, to ``LOCKED`` of that distance and the target), by frequency."""
     f = lam.imag / TWO_PI
     idx = np.nonzero((f >= band[0]) & (f <= band[1]))[0]
     if n_modes is not None and idx.size > n_modes:
-        ranked = idx[np.argsort(np.abs(f[idx] - target), kind="stable")]
-        idx = capped(lam, ranked, n_modes, LOCKED * (abs(f[ranked[n_modes - 1]] - target) + abs(target)))
+        gap = np.abs(f[idx] - target)
+        ranked, cut = idx[np.argsort(gap, kind="stable")], np.sort(gap)[n_modes - 1]
+        idx = np.union1d(capped(lam, ranked, n_modes), idx[gap <= cut + LOCKED * (cut + abs(target))])
     return idx[by_frequency(lam[idx])]
 
 

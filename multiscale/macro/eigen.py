@@ -57,10 +57,11 @@ def locked_window(frequency: float, sigma: float) -> float:
     return max(LOCKED * frequency, SPLIT * abs(sigma))
 
 
-def capped(lam: np.ndarray, ranked: np.ndarray, n_modes: int, floor: float = 0.0) -> np.ndarray:
+def capped(lam: np.ndarray, ranked: np.ndarray, n_modes: int) -> np.ndarray:
     """The first ``n_modes`` of ``ranked`` (indices of eigenvalues ``lam`` [1/s], nearest the target
-    first) and the others within ``locked_window`` of the last one's frequency (at the growth rate
-    of the unstable one of the two; ``floor`` [Hz] at least): a lock-in pair, sigma +-, is never
+    first) and the others within ``locked_window`` of the last one's frequency (at the larger |sigma|
+    of the two where one is unstable: damping lowers the unstable half's growth, not the split;
+    at ``LOCKED`` of the frequency where both are stable): a lock-in pair, sigma +-, is never
     cut in two, also where gyroscopic or damping terms split it (0.034 Hz at 2680 Hz, 1.3e-5: a cap
     kept the stable member and dropped the unstable one, sigma +64 1/s, a user trial; a loss
     factor 1.2e-4, beyond the 1e-4 the cap allowed, a review). A doublet kept beyond the cap costs
@@ -69,8 +70,9 @@ def capped(lam: np.ndarray, ranked: np.ndarray, n_modes: int, floor: float = 0.0
     if not kept.size:
         return kept
     f, last = lam.imag / TWO_PI, kept[-1]
-    near = [i for i in rest if abs(f[i] - f[last]) <= max(floor, locked_window(abs(f[last]), max(
-        lam[i].real, lam[last].real, 0.0)))]
+    def split(i):                                   # [1/s]: the growth rates' share of the window
+        return max(abs(lam[i].real), abs(lam[last].real)) if max(lam[i].real, lam[last].real) > 0 else 0.0
+    near = [i for i in rest if abs(f[i] - f[last]) <= locked_window(abs(f[last]), split(i))]
     return np.concatenate([kept, np.asarray(near, dtype=kept.dtype)])
 
 

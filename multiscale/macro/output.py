@@ -378,10 +378,10 @@ class FieldOutput:
         out = self._unloaded.solve()
         if out is None:
             if self.tm.comm.rank == 0:
-                warnings.warn(UnloadedWarning(
-                    "the released bodies' thermo-elastic state did not converge (a part held by neither "
-                    "supports nor rigid motions alone: two parts joined at an edge or a vertex?): their "
-                    "displacement and von Mises stress are written NaN"), stacklevel=2)
+                why = self._unloaded.failure or ("did not converge (a part held by neither supports nor rigid "
+                                                 "motions alone: two parts joined at an edge or a vertex?)")
+                warnings.warn(UnloadedWarning(f"the released bodies' thermo-elastic state: {why}: their "
+                                              "displacement and von Mises stress are written NaN"), stacklevel=2)
             return [np.nan] * len(self.mech.u)
         return out
 

@@ -92,6 +92,7 @@ class Unloaded:
         self.mech = mechanics
         self._modes: list | None = None      # orthonormal free motions (block vectors)
         self.passes = 0                       # refinement passes of the last solve
+        self.failure = ""                     # why the last solve gave None: a failed factorisation's reason
 
     def free_motions(self, template: PETSc.Vec) -> list:
         """Orthonormal block vectors (of ``template``'s layout) spanning the rigid motions of the
@@ -155,7 +156,8 @@ class Unloaded:
         """Per body, the displacement [m] (arrays of the ``u`` layout) of the unloaded state, with
         the free motions of the current displacements (the last loaded state, kept); None if the
         refinement did not reach ``TOL`` (a mechanism) or the shifted stiffness could not be
-        factorised (``mumps.direct_solver``: the output writes NaN, the run goes on). Collective."""
+        factorised (``mumps.direct_solver``, its reason in ``failure``: the output writes NaN, the
+        run goes on). Collective."""
         mech = self.mech
         K, r = mech.cell_system()
         modes = self.free_motions(r)
@@ -167,10 +169,12 @@ class Unloaded:
         P.setDiagonal(d, addv=PETSc.InsertMode.ADD_VALUES)
         try:
             ksp = mumps.direct_solver(P, "the shifted stiffness of the unloaded state")
-        except ConvergenceError:
+        except ConvergenceError as exc:
             for v in (P, d, f, r):
                 v.destroy()
+            self.failure = str(exc)
             return None
+        self.failure = ""
         u, du = f.duplicate(), f.duplicate()
         u.set(0.0)
         self._project(f)                # round-off of r . f = 0

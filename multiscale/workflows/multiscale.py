@@ -215,7 +215,8 @@ def worn_through(ms: Multiscale, rate: str = "wear.k_w", layers: float = 0.0) ->
 
 def _wear_keys(scene) -> tuple[str, float]:
     """(the key of the rough body's wear rate, the total thickness of its layers [m] or 0)."""
-    rate = f"materials.{scene.rough_material}.k_w" if scene.rough_material_wears else f"wear.{scene.wear.given or 'k_w'}"
+    given = scene.wear.given if scene.wear is not None else None            # (no [wear]: no wear)
+    rate = f"materials.{scene.rough_material}.k_w" if scene.rough_material_wears else f"wear.{given or 'k_w'}"
     return rate, sum(x.thickness for x in scene.layers.layer) if scene.has("layers") else 0.0
 
 
