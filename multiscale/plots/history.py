@@ -204,7 +204,8 @@ def multiscale_figure(history, path: Path, title: str = "") -> Path:
                [("partition_max", "max"), ("partition_mean", "mean over zones"),    # weighted by the heat
                 ("partition_min", "min")], 100.0, 0),
               ("wear volume [mm³]", [("wear_volume", None)], 1e9, 0),     # a tribologist's unit, however small
-              ("max wear depth [µm]", [("wear_max_depth", None)], 1e6, 0),
+              ("max wear depth [µm]", [("wear_max_depth", "micro: a patch's deepest cell")], 1e6, 0),   # (read as
+                                                                  # the pad's deepest facet: a user trial)
               ("RMS roughness of the worn zones [µm]", [("rms_height", None)], 1e6, 0),
               ("real contact area [mm²]" if area == 1e6 else "real contact area [µm²]",
                [("real_contact_area", "all interfaces" if len(areas) > 1 else None)]
