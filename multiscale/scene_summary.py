@@ -276,10 +276,10 @@ def _effect_line(scene: Scene, effect: str) -> str:
         w = scene.wear
         counter = scene.materials[scene.geometry.spec.interface_materials(
             scene.rough_interfaces[0] if scene.rough_interfaces else None)[1]]
-        named = {"k_w": "k_w = {:g} 1/Pa", "k_w_table": "k_w(T) table", "specific_rate": "k = {:g} 1/Pa",
-                 "specific_rate_table": "k(T) table"}
-        rate = "k_w of its material" if scene.rough_material_wears else named[w.given].format(w.rate) if w.given \
-            else f"k_w(T) default table: {FIG_7_9_CALIBRATION}"
+        named = {"k_w": "k_w = {:g} 1/Pa", "k_w_table": "k_w(T) table", "specific_rate": "k = {:g} 1/Pa ({:.4g} "
+                 "mm^3/(N m))", "specific_rate_table": "k(T) table"}        # (a tribologist's unit too: a trial)
+        rate = "k_w of its material" if scene.rough_material_wears else named[w.given].format(w.rate, w.rate * 1e9) \
+            if w.given else f"k_w(T) default table: {FIG_7_9_CALIBRATION}"
         both = f"; the {scene.bodies[1]} wears too (k_w of its material)" if counter.k_w is not None else ""
         law = "k p ds" if w.per_load and not scene.rough_material_wears else "k_w mu p ds"
         return (f"Archard dh = {law} every {w.update_every} step(s) in {w.substeps} increment(s){both}; "

@@ -426,7 +426,8 @@ def test_a_specific_wear_rate_per_normal_load_wears_as_k_w_times_mu(straight, tm
     overrides = {"wear.specific_rate": "4e-6 mm^3/(N m)"}          # replaces the file's k_w (one of the rule)
     scene = loads(POD.format(folder=tmp_path / "k"), overrides=overrides)
     assert (scene.wear.given, scene.wear.per_load, scene.wear.rate) == ("specific_rate", True, pytest.approx(4e-15))
-    assert any("Archard dh = k p ds every 1 step(s)" in line and "k = 4e-15 1/Pa" in line for line in summary(scene))
+    assert any("Archard dh = k p ds every 1 step(s)" in line and "k = 4e-15 1/Pa (4e-06 mm^3/(N m))" in line
+               for line in summary(scene))
     h, before = run_pod(tmp_path / "k", overrides), History.read(straight[1].history_file)
     np.testing.assert_allclose(h["wear_volume"], before["wear_volume"], rtol=1e-6)
     with pytest.raises(SceneError, match=r"give only one of them \(got k_w, specific_rate\)"):
