@@ -47,8 +47,10 @@ into it at that state| / mean zone frictional heat (or mean |heat into the rough
 - "implicit" (bulk temperatures only): the micro problem is linear in the frictional heat and the remote
   temperatures, so the post-analysis returns, per zone, the partition at equal remote temperatures and the
   exchange G [W/K] (``PostAnalysis`` with ``Heating.conduction``); the macro model splits the frictional heat
-  with the first and conducts G (T_rough − T_counter) through the interface conductance h_c = G / (facet area
-  of the zone), inside its own backward-Euler heat solve. This is a Newton step on the per-zone heat with the
+  with the first and conducts G (T_rough − T_counter) through the interface conductance h_c = G_i / (facet
+  area of the zone), G_i = 1/(1/G − 1/G_full) (``post_analysis.interface_exchange``: G without the zone's own
+  bulk spreading, which the macro model resolves: G_full the zone's exchange in full contact; with G itself a
+  zone in nearly full contact conducted only its bulk's conductance), inside its own backward-Euler heat solve. This is a Newton step on the per-zone heat with the
   micro model's exact derivative, the macro heat solve doing the rest: the micro heat at the end of the step
   is the macro one up to the change of the contact during the step, in one pass. It departs from the thesis'
   form (the conduction hidden in the partition) to reach the same balance without its failure
@@ -73,7 +75,7 @@ from multiscale.errors import ConvergenceError
 from multiscale.loop_settings import LoopSettings
 from multiscale.macro.continuation import solve_on_new_laws
 from multiscale.macro.model import MacroModel
-from multiscale.micro.post_analysis import PostAnalysis
+from multiscale.micro.post_analysis import PostAnalysis, interface_exchange
 from multiscale.micro.wear import WEAR_TOL
 from multiscale.rough import RoughInterface
 
@@ -150,6 +152,7 @@ class Multiscale:
         self.series = np.zeros(Z)                     # m/Pa, the wearing step's Archard depth per pressure (archard)
         self.counter_volume = 0.0                     # m^3, lost by the counter-face
         self.exchange, self.proposed_exchange = np.zeros(Z), np.zeros(Z)   # W/K, rough body -> counter-face (implicit)
+        self.exchange_full, self.proposed_full = np.full(Z, np.nan), np.full(Z, np.nan)   # W/K, in full contact
         self.micro_heat = np.full(Z, np.nan)          # W, Phi of the last post-analysis
         self.micro_heat_rough = np.full(Z, np.nan)    # W, heat into the rough body by it
         self.remote_difference = np.zeros(Z)          # K, T_rough − T_counter of the macro surfaces
@@ -215,20 +218,21 @@ class Multiscale:
         cover = self.rough.cover[mine]              # the patches' heat and area over their facets'
         parts = comm.allgather((mine, res.pressure, res.max_pressure, res.max_temperature,
                                 res.partition_equal if implicit else res.partition, res.conductance, res.heat * cover,
-                                res.heat_rough * cover, res.exchange * cover, remote[:, 1] - remote[:, 0],
+                                res.heat_rough * cover, res.exchange * cover, res.exchange_full * cover,
+                                remote[:, 1] - remote[:, 0],
                                 res.plastic_area_fraction, res.area_fraction * self.rough.covered_area[mine],
                                 self.post.zone_rates(res, remote)))
         for a in (self.proposed, self.flash, self.micro_heat, self.micro_heat_rough, self.rates):
             a[:] = np.nan
-        self.proposed_exchange[:] = 0.0
+        self.proposed_exchange[:], self.proposed_full[:] = 0.0, np.nan
         max_p, flow, real = [], [np.zeros(0)], np.zeros(len(zones))
-        for ids, warm, mp, mT, part, h_c, heat, rough, exchange, diff, fraction, area, rates in parts:
+        for ids, warm, mp, mT, part, h_c, heat, rough, exchange, full, diff, fraction, area, rates in parts:
             flow.append(fraction)
             real[ids], self.rates[ids] = area, rates
             self.warm[ids], self.proposed[ids], self.flash[ids] = warm, part, mT
             self.micro_heat[ids], self.micro_heat_rough[ids], self.remote_difference[ids] = heat, rough, diff
             if implicit:
-                self.proposed_exchange[ids] = exchange
+                self.proposed_exchange[ids], self.proposed_full[ids] = exchange, full
             if self.post.conductance is not None:
                 self.conductance[ids] = h_c
             max_p.append(mp)
@@ -332,8 +336,8 @@ class Multiscale:
             proposed = self.proposed[loaded]
             self.partition[loaded] = np.where(np.isfinite(proposed), proposed, self.partition[loaded])
         if self.settings.coupling == "implicit":
-            self.exchange[:] = 0.0
-            self.exchange[loaded] = self.proposed_exchange[loaded]
+            self.exchange[:], self.exchange_full[:] = 0.0, np.nan
+            self.exchange[loaded], self.exchange_full[loaded] = self.proposed_exchange[loaded], self.proposed_full[loaded]
         heated = loaded if self.settings.friction is None else loaded[self.settings.friction[loaded] > 0]
         used = self.partition[heated] if len(heated) else np.full(1, np.nan)     # (without friction, no heat)
         micro.partition = (float(used.min()), float(used.mean()), float(used.max()))
@@ -385,8 +389,8 @@ class Multiscale:
         rough = zone_of >= 0                       # the other interfaces keep their scene values
         if self.partition_law:
             iface.set_field(contact.partition, np.where(rough, self.partition[zone_of], iface.values(contact.partition)))
-        if self.settings.coupling == "implicit":   # the exchange G of each zone over its facets
-            self.conductance = self.rough.per_facet_area(self.exchange)
+        if self.settings.coupling == "implicit":   # the exchange G of each zone over its facets, its bulk's out
+            self.conductance = self.rough.per_facet_area(interface_exchange(self.exchange, self.exchange_full))
         if self.post.conductance is not None or self.settings.coupling == "implicit":
             iface.set_field(contact.conductance,
                             np.where(rough, self.conductance[zone_of], iface.values(contact.conductance)))
@@ -536,7 +540,8 @@ class Multiscale:
         arrays = {"heights": self.rough.heights(), "warm": self.warm, "partition": self.partition,
                   **({"plastic": self.rough.plastic} if self.plastic else {}),    # else zero: not stored
                   "conductance": self.conductance, "flash": self.flash, "rates": self.rates, "counter_depth": self.counter_depth,
-                  "form_depth": self.form_depth, "exchange": self.exchange, "levels": self.rough.levels,
+                  "form_depth": self.form_depth, "exchange": self.exchange, "exchange_full": self.exchange_full,
+                  "levels": self.rough.levels,
                   "datum_gap": self.datum_gap, **model_arrays}
         attrs = {"work": self.work, "interval_work": self.interval_work, "counter_volume": self.counter_volume,
                  **model_attrs}
@@ -554,7 +559,7 @@ class Multiscale:
         self.datum_gap, self.flash, self.counter_depth = arrays["datum_gap"], arrays["flash"], arrays["counter_depth"]
         self.form_depth, self.rates = arrays["form_depth"], arrays["rates"]
         self.counter_volume = float(attrs["counter_volume"])
-        self.exchange = arrays["exchange"]
+        self.exchange, self.exchange_full = arrays["exchange"], arrays["exchange_full"]
         self.work = float(attrs["work"])
         self.interval_work = float(attrs["interval_work"])
         self.set_gap()

@@ -131,12 +131,14 @@ def test_two_zones_with_bulk_temperatures_converge_to_the_direct_micro_solution(
     # implicit: one pass, the same balance (the pin's heat = share at equal temperatures minus G dT)
     # to the distribution of the conduction over a zone's facets (uniform per area here, with the
     # frictional heat in the fixed point: the end temperatures differ by 0.4 K of 56-71 K, the
-    # pin's heat by 0.4 % and 0.16 % of the zones' heat, measured)
+    # pin's heat by 0.4 % and 0.16 % of the zones' heat, measured) and to the zones' own bulk
+    # spreading, which the implicit interface conductance no longer counts twice (2026-12-06,
+    # ``interface_exchange``; the fixed point keeps the thesis' form): 0.37 % and 1.1 % since
     imp, result, _, _ = two_zones["implicit"]
     assert len(result.residuals) == 1 and result.residuals[0] < 1e-6
     Q = ms.micro_heat[loaded]
     np.testing.assert_allclose(imp.micro_heat_rough[loaded], ms.micro_heat_rough[loaded], atol=0, rtol=0.05)
-    assert np.all(np.abs(imp.micro_heat_rough[loaded] - ms.micro_heat_rough[loaded]) < 6e-3 * Q)
+    assert np.all(np.abs(imp.micro_heat_rough[loaded] - ms.micro_heat_rough[loaded]) < 1.5e-2 * Q)
     assert np.all(imp.exchange[loaded] > 0) and np.all(imp.conductance[loaded] > 0)
     # explicit: the partition of the step came from the hot start, the end state disagrees
     _, result, _, _ = two_zones["explicit"]
@@ -386,3 +388,35 @@ def test_the_coupling_residual_near_rest_is_scaled_by_the_heat_the_contact_moves
     assert near_rest == pytest.approx((0.014 - 1e-15) / 0.014, rel=1e-12)
     assert residual([60.0, 40.0], [0.09, 0.05], [0.0015, 0.0012]) == pytest.approx(0.002 / 50.0, rel=1e-9)
     assert residual([0.0, 0.0], [0.01, 0.01], [0.5, 0.5]) == 0.0
+
+
+def test_the_exchange_without_the_zones_own_spreading_is_the_interface_conductance():
+    """The implicit coupling's exchange G (the isolated patch, remote temperatures at infinity) holds
+    the zone's own bulk spreading, which the macro model conducts itself: a zone in nearly full
+    contact conducted only its bulk's conductance (a trial's brake pads: 84 W/(m^2 K), 100-180 K
+    between the faces). ``exchange_full``, the zone in full contact by the same heating model: at a
+    slow speed that of an isothermal square on two half-spaces, 2 pi 0.3607 / (c (1/kappa_1 +
+    1/kappa_2)) (the unit square plate's capacitance, 0.3607 x 4 pi eps_0: F. H. Read, COMPEL 23,
+    572, 2004) within 2 % (0.85 % measured at 64^2 cells; the uniform-flux mean, 0.4732, is 7 %
+    below); G itself, the conduction solver's patch conductance (``laws.Conductance``) within 1 %
+    (0.3 %); ``interface_exchange`` 1/(1/G - 1/G_full): G where the spots constrict, 1e3 G_full at
+    most in full contact."""
+    from multiscale.micro.kernels import ThermalHalfSpace
+    from multiscale.micro.laws import Conductance
+    from multiscale.micro.post_analysis import SPREAD_CAP, interface_exchange
+    from multiscale.micro.zones import Zone
+    c, pad, disc = 0.02, ThermalMaterial(1.5, 7.5e-7), ThermalMaterial(54.0, 1.5e-5)
+    s = fractal_surface(64, c, hurst=0.8, k_min=2, k_max=16, rms=2e-6, seed=1)
+    s = Surface(s.heights, s.dx, s.dy, periodic=False)
+    post = PostAnalysis(HalfSpace(5e9), s.shape, s.dx, s.dy, mu=0.4, heating=Heating(disc, pad, conduction=True),
+                        tol=1e-10)
+    r = post.run([Zone(0, s)], np.array([1e5]), speed=np.array([1e-5]), remote=np.array([[300.0, 300.0]]))
+    assert r.exchange_full[0] / c**2 == pytest.approx(2 * np.pi * 0.3607 / (c * (1 / 1.5 + 1 / 54.0)), rel=0.02)
+    contact = ContactSolver(HalfSpace(5e9), s.shape, s.dx, s.dy, periodic=False).solve(
+        s.heights[None], load=np.array([1e5]), tol=1e-10)
+    K_t = Conductance(ThermalHalfSpace(54.0), ThermalHalfSpace(1.5), tol=1e-10).values(contact, [Zone(0, s)])
+    assert r.exchange[0] / c**2 == pytest.approx(float(K_t["patch_conductance"][0]), rel=0.01)
+    assert r.area_fraction[0] < 0.05 and 1.3 < interface_exchange(r.exchange, r.exchange_full)[0] / r.exchange[0] < 1.6
+    full = r.exchange_full[0]
+    np.testing.assert_allclose(interface_exchange([0.5 * full, full, 1.0], [full, full, np.nan]),
+                               [full, SPREAD_CAP * full, 1.0], rtol=1e-12)

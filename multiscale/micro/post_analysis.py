@@ -122,6 +122,7 @@ class ZoneResult:
     plastic_area_fraction: np.ndarray = None  # (B,): cells at the hardness / zone cells at the macro load (0 if elastic)
     plastic: np.ndarray = None              # m, (B, ny, nx): permanent deformation of this step, >= 0 (0 if elastic)
     hardness: np.ndarray | None = None      # Pa, (B,): the hardness of each zone's solves (None: elastic)
+    exchange_full: np.ndarray = None        # W/K, (B,): G of the zone in full contact, its own bulk's (NaN without)
     worn_area_fraction: np.ndarray = None   # (B,): real contact area / zone area after the wear (None: no wear)
     wear_error: np.ndarray = None           # (B,): estimated relative L2 error of the worn depth field
     #                                         (step doubling, ``PostAnalysis.wear``; 0 without wear)
@@ -167,6 +168,7 @@ class PostAnalysis:
         self.substeps, self.tol = check_count("substeps", substeps), check_positive("tol", tol)
         self.max_iter = check_count("max_iter", max_iter)
         self._heaters: dict[tuple, SteadyHeating | TransientHeating] = {}
+        self._full: dict[tuple, float] = {}           # W/K: ``_full_exchange`` by mask, speed, direction, step
 
     @property
     def wears(self) -> bool:
@@ -227,7 +229,7 @@ class PostAnalysis:
                                  "(materials.<name>.hardness) or lower the load")
         r = self._solve(zones, H, load, _warm(warm, H.shape), hard)
         T = T1 = None
-        max_T, partition, heat, heat_rough, exchange, equal = (nan.copy() for _ in range(6))
+        max_T, partition, heat, heat_rough, exchange, equal, full = (nan.copy() for _ in range(7))
         if self.heating is not None:
             if remote is None:
                 raise InputError("remote", None, "heating needs the remote temperatures of both bodies")
@@ -242,6 +244,7 @@ class PostAnalysis:
                     warmer = remote[b] + np.array([0.0, 1.0])      # the rough body 1 K warmer
                     exchange[b] = heat_rough[b] - self._heat(r.pressure[b], speed[b], angle[b], mu[b], warmer,
                                                              duration)[-1]
+                    full[b] = self._full_exchange(zones[b], speed[b], angle[b], mu[b], remote[b], duration)
             with np.errstate(divide="ignore", invalid="ignore"):
                 partition = heat_rough / heat
                 if self.heating.conduction:
@@ -254,7 +257,8 @@ class PostAnalysis:
         result = ZoneResult(r.pressure, r.pressure, H - r.plastic, np.zeros(H.shape), np.zeros(B),
                             r.pressure.max(axis=(-2, -1)), np.asarray(r.area_fraction, dtype=float), max_T, partition,
                             h_c, np.asarray(r.iterations).copy(), load, mu, T, T1, np.zeros(B), heat, heat_rough,
-                            exchange, equal, np.asarray(r.plastic_area_fraction, dtype=float), r.plastic.copy(), hard)
+                            exchange, equal, np.asarray(r.plastic_area_fraction, dtype=float), r.plastic.copy(), hard,
+                            exchange_full=full)
         if sliding is not None and self.wears:
             result = self.wear(zones, result, sliding, remote)
         return result
@@ -422,6 +426,21 @@ class PostAnalysis:
         return (h.temperature_1[-1], h.temperature_2[-1], h.max_temperature_2.max(), scale * float(h.heat.mean()),
                 scale * float(h.heat_2.mean()))
 
+    def _full_exchange(self, zone: Zone, speed, angle, mu, remote, duration) -> float:
+        """The exchange G [W/K] of ``zone`` in full contact (every cell of its mask): its two bodies'
+        own spreading at the zone's scale, which the macro model resolves itself
+        (``interface_exchange``); the same heating model's at the rounded speed and direction, kept
+        per mask, speed, direction and step (whichever zone asks first: a resumed run the same; the
+        problem is linear: the frictional heat cancels in the difference)."""
+        v, a = (float(x) for x in self.heating.rounded(speed, angle))
+        key = (zone.mask.tobytes(), v, a, duration)
+        if key not in self._full:
+            touching = zone.mask.astype(float)                     # 1 Pa on every cell of the zone
+            warmer = np.asarray(remote, float) + np.array([0.0, 1.0])
+            self._full[key] = self._heat(touching, v, a, mu, remote, duration)[-1] - \
+                self._heat(touching, v, a, mu, warmer, duration)[-1]
+        return self._full[key]
+
     def _solve(self, zones, heights, load, warm, hardness=None, solver: ContactSolver | None = None):
         """Load-controlled contact of the batch (on ``solver``, default this grid's); patches that do
         not converge within ``WARM_ITERATIONS`` from the warm start (warm starts converge in tens of
@@ -459,6 +478,21 @@ class PostAnalysis:
                 if not n else TransientHeating(self.shape, self.dx, h.moving, h.fixed, Translation.steady(*key[:2]),
                                                key[2] / n, n, self.dy)
         return self._heaters[key]
+
+
+SPREAD_CAP = 1e3    # the interface exchange at most this x the zone's own bulk's (in full contact: infinite)
+
+
+def interface_exchange(exchange, full) -> np.ndarray:
+    """The exchange G [W/K] of zones without their own bulks' spreading at the zone's scale, which the
+    macro model conducts itself: 1/(1/G − 1/G_full), G_full the zone's in full contact
+    (``ZoneResult.exchange_full``), as ``laws.Conductance`` takes R_zone out of K_t (the analogue of
+    Eq. 1.31 for the gap); at most ``SPREAD_CAP`` G_full; G where G_full is not known (with G a
+    trial's brake pads at 94-98 % real area conducted 84 W/(m^2 K), their bulk's, 100-180 K apart)."""
+    G, full = np.asarray(exchange, dtype=float), np.asarray(full, dtype=float)
+    known = np.isfinite(full) & (full > 0)
+    share = np.where(known, G / np.where(known, full, 1.0), 0.0)
+    return G / np.maximum(1.0 - share, 1.0 / SPREAD_CAP)
 
 
 def _per_zone(name, value, B, each=()) -> np.ndarray:
