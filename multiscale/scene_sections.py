@@ -469,8 +469,8 @@ class Micro:
     effect "conductance" h_c conducts between the bodies already) or "bulk" (each body's own: §7.2.2,
     §6.5); ``coupling`` of partitions and temperatures "explicit" (from the previous step),
     "fixed-point" (iterated within the step to ``coupling_tol`` in at most ``coupling_iterations``
-    passes) or "implicit" (bulk only: the partition at equal temperatures and the zone's exchange G
-    as an interface conductance); defaults: ``remote``, ``coupling_scheme``."""
+    passes) or "implicit" (bulk only: the partition at equal temperatures and the zone's exchange G,
+    its own bulk's spreading out, as an interface conductance); defaults: ``remote``, ``coupling_scheme``."""
 
     zones: tuple | None = key(Pair(Integer(ge=1)), required=True)             # (nx, ny) zones
     grid: tuple | None = key(Pair(Integer(ge=8)),                             # (nx, ny) per zone
