@@ -33,9 +33,10 @@ behaviour before issue 19, kept as an option (and the default with an interface 
 between the bulk temperatures itself). The scenes' default is "bulk" with the implicit coupling (below).
 
 Coupling of partitions and temperatures (``LoopSettings.coupling``); residual of a step: max over the loaded
-zones of |heat into the rough body by the post-analysis at the end of the step − the heat the macro model puts
-into it at that state| / mean zone frictional heat (or mean |heat into the rough body| nearly at rest;
-``heat_residual``; a light zone's partition counts for the heat it moves). Schemes:
+zones of |heat into the rough body by the post-analysis at the end of the step − the heat the zone's partition
+and exchange G put into it at that state| / mean zone frictional heat (or mean |heat into the rough body|
+nearly at rest; ``heat_residual``; a light zone's partition counts for the heat it moves; the implicit
+scheme's macro model conducts G_i, not G: the residual checks the micro model's own split). Schemes:
 
 - "explicit": the partitions of step n + 1 come from the post-analysis of step n (thesis Fig. 7.2).
 - "fixed-point" (thesis form, converged): the partitions p of step n solve p = G(p), G = the post-analysis'
@@ -50,11 +51,12 @@ into it at that state| / mean zone frictional heat (or mean |heat into the rough
   with the first and conducts G (T_rough − T_counter) through the interface conductance h_c = G_i / (facet
   area of the zone), G_i = 1/(1/G − 1/G_full) (``post_analysis.interface_exchange``: G without the zone's own
   bulk spreading, which the macro model resolves: G_full the zone's exchange in full contact; with G itself a
-  zone in nearly full contact conducted only its bulk's conductance), inside its own backward-Euler heat solve. This is a Newton step on the per-zone heat with the
-  micro model's exact derivative, the macro heat solve doing the rest: the micro heat at the end of the step
-  is the macro one up to the change of the contact during the step, in one pass. It departs from the thesis'
-  form (the conduction hidden in the partition) to reach the same balance without its failure
-  (docs/architecture.md, the decision on the coupling).
+  zone in nearly full contact conducted only its bulk's conductance), inside its own backward-Euler heat solve.
+  With G itself this was a Newton step on the per-zone heat with the micro model's exact derivative (the micro
+  heat at the end of the step the macro one up to the change of the contact during the step, in one pass);
+  with G_i the macro model resolves the zone-scale spreading the micro patch holds too, so the two differ by
+  (G_i − G) times the faces' difference, by design. It departs from the thesis' form (the conduction hidden
+  in the partition) without its failure (docs/architecture.md, the decision on the coupling; §7 on G_i).
 
 The default (``scene_sections.COUPLING_DEFAULT``) was chosen by measurement (docs/accuracy/coupling.md); the
 rigid datum gap starts Newton close to equilibrium.
@@ -356,8 +358,9 @@ class Multiscale:
 
     def heat_residual(self) -> float:
         """The coupling residual: max over the loaded zones of |heat into the rough body by the last
-        post-analysis − heat the macro model put into it at the same state (its partition of Phi,
-        minus the exchange G (T_rough − T_counter))| / the zones' mean Phi, or mean |heat into the rough
+        post-analysis − heat the zone's partition of Phi and exchange put into it at the same state
+        (minus G (T_rough − T_counter), the micro model's own G, not the macro's G_i: module docstring)|
+        / the zones' mean Phi, or mean |heat into the rough
         body| if larger (near rest the conduction outweighs a vanishing Phi: 1.8e12 at a stop's end before);
         0 while released (no contact, no heat: the zones' last loads are analysed, nothing couples).
         A heat that is not finite is a ``ConvergenceError`` (it was a residual of 0: converged)."""

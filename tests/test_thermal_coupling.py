@@ -418,5 +418,14 @@ def test_the_exchange_without_the_zones_own_spreading_is_the_interface_conductan
     assert r.exchange[0] / c**2 == pytest.approx(float(K_t["patch_conductance"][0]), rel=0.01)
     assert r.area_fraction[0] < 0.05 and 1.3 < interface_exchange(r.exchange, r.exchange_full)[0] / r.exchange[0] < 1.6
     full = r.exchange_full[0]
-    np.testing.assert_allclose(interface_exchange([0.5 * full, full, 1.0], [full, full, np.nan]),
-                               [full, SPREAD_CAP * full, 1.0], rtol=1e-12)
+    np.testing.assert_allclose(interface_exchange([0.5 * full, full, 2 * full, 1.0], [full, full, full, np.nan]),
+                               [full, SPREAD_CAP * full, SPREAD_CAP * full, 1.0], rtol=1e-12)
+    # G and G_full at one speed scaling (a review: G at the zone's speed, G_full at the rounded one,
+    # off by up to 0.5 %, capped at full contact by the rounding alone): full contact gives the cap
+    speeds = np.array([9.97, 10.0, 10.03])                  # across a rounding bin of the heating tables
+    touching = PostAnalysis(HalfSpace(5e9), s.shape, s.dx, s.dy, mu=0.4, heating=Heating(disc, pad, conduction=True),
+                            tol=1e-10)
+    flat = Surface(np.zeros(s.shape), s.dx, s.dy, periodic=False)
+    for v in speeds:
+        f = touching.run([Zone(0, flat)], np.array([1e6]), speed=np.array([v]), remote=np.array([[300.0, 300.0]]))
+        assert f.area_fraction[0] == 1.0 and f.exchange[0] == pytest.approx(f.exchange_full[0], rel=1e-6)

@@ -167,8 +167,7 @@ class PostAnalysis:
         self.counter_rate = WearRate(counter_rate) if counter_rate is not None else None
         self.substeps, self.tol = check_count("substeps", substeps), check_positive("tol", tol)
         self.max_iter = check_count("max_iter", max_iter)
-        self._heaters: dict[tuple, SteadyHeating | TransientHeating] = {}
-        self._full: dict[tuple, float] = {}           # W/K: ``_full_exchange`` by mask, speed, direction, step
+        self._heaters, self._full = {}, {}      # heaters, and G_full [W/K] (``_full_exchange``), by their keys
 
     @property
     def wears(self) -> bool:
@@ -427,19 +426,20 @@ class PostAnalysis:
                 scale * float(h.heat_2.mean()))
 
     def _full_exchange(self, zone: Zone, speed, angle, mu, remote, duration) -> float:
-        """The exchange G [W/K] of ``zone`` in full contact (every cell of its mask): its two bodies'
-        own spreading at the zone's scale, which the macro model resolves itself
-        (``interface_exchange``); the same heating model's at the rounded speed and direction, kept
-        per mask, speed, direction and step (whichever zone asks first: a resumed run the same; the
-        problem is linear: the frictional heat cancels in the difference)."""
+        """The exchange G [W/K] of ``zone`` in full contact (every cell of its mask): its bodies' own
+        spreading, which the macro model resolves (``interface_exchange``); kept per mask, rounded
+        speed and direction and step (linear: the frictional heat cancels), scaled to ``speed`` as
+        ``_heat`` scales G (G / G_full was off by the rounding, up to 0.5 %: a review)."""
         v, a = (float(x) for x in self.heating.rounded(speed, angle))
-        key = (zone.mask.tobytes(), v, a, duration)
+        key = (hash(zone.mask.tobytes()), v, a, duration)
         if key not in self._full:
+            if len(self._full) >= 4096:
+                self._full.pop(next(iter(self._full)))
             touching = zone.mask.astype(float)                     # 1 Pa on every cell of the zone
             warmer = np.asarray(remote, float) + np.array([0.0, 1.0])
             self._full[key] = self._heat(touching, v, a, mu, remote, duration)[-1] - \
                 self._heat(touching, v, a, mu, warmer, duration)[-1]
-        return self._full[key]
+        return self._full[key] * speed / v
 
     def _solve(self, zones, heights, load, warm, hardness=None, solver: ContactSolver | None = None):
         """Load-controlled contact of the batch (on ``solver``, default this grid's); patches that do
@@ -484,15 +484,15 @@ SPREAD_CAP = 1e3    # the interface exchange at most this x the zone's own bulk'
 
 
 def interface_exchange(exchange, full) -> np.ndarray:
-    """The exchange G [W/K] of zones without their own bulks' spreading at the zone's scale, which the
-    macro model conducts itself: 1/(1/G − 1/G_full), G_full the zone's in full contact
-    (``ZoneResult.exchange_full``), as ``laws.Conductance`` takes R_zone out of K_t (the analogue of
-    Eq. 1.31 for the gap); at most ``SPREAD_CAP`` G_full; G where G_full is not known (with G a
-    trial's brake pads at 94-98 % real area conducted 84 W/(m^2 K), their bulk's, 100-180 K apart)."""
+    """The exchange G [W/K] of zones without their own bulks' spreading, which the macro model conducts
+    itself: 1/(1/G − 1/G_full), G_full the zone's in full contact (``ZoneResult.exchange_full``), as
+    ``laws.Conductance`` takes R_zone out of K_t (Eq. 1.31's analogue); at most ``SPREAD_CAP`` G_full;
+    G where G_full is not known (with G, a trial's pads at 94-98 % real area were 100-180 K apart)."""
     G, full = np.asarray(exchange, dtype=float), np.asarray(full, dtype=float)
     known = np.isfinite(full) & (full > 0)
     share = np.where(known, G / np.where(known, full, 1.0), 0.0)
-    return G / np.maximum(1.0 - share, 1.0 / SPREAD_CAP)
+    capped = np.minimum(G / np.maximum(1.0 - share, 1.0 / SPREAD_CAP), SPREAD_CAP * np.where(known, full, 0.0))
+    return np.where(known, capped, G)
 
 
 def _per_zone(name, value, B, each=()) -> np.ndarray:
