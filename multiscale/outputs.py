@@ -105,6 +105,11 @@ def checkpointed(scene) -> bool:
     return kind == "multiscale" or (kind == "transient" and scene.has("thermal"))
 
 
+def field_step(n: int, every: int, steps: int) -> bool:
+    """Whether macro step ``n`` of ``steps`` writes its fields: every ``every`` steps (0 too) and the last."""
+    return n % every == 0 or n == steps
+
+
 def output_times(scene) -> tuple[float, ...]:
     """Times [s] at which the fields are written: 0, then every ``output.every`` macro step and the
     last (squeal: the preload, 0)."""
@@ -114,7 +119,7 @@ def output_times(scene) -> tuple[float, ...]:
     times, now = [0.0], 0.0
     for n in range(1, steps + 1):
         now = step_time(now, t.dt)
-        if n % scene.output.every == 0 or n == steps:
+        if field_step(n, scene.output.every, steps):
             times.append(now)
     return tuple(times)
 

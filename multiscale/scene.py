@@ -501,8 +501,7 @@ def default_wear_rate(scene: Scene) -> list[str]:
     if "wear" not in scene.effects or w is None or w.given is not None or scene.rough_material_wears:
         return []
     return ["wear: no k_w given (wear.k_w, wear.k_w_table, a specific_rate or the rough material's k_w): the zones "
-            "wear by the "
-            f"default k_w(T) table, the {FIG_7_9_CALIBRATION}"]
+            f"wear by the default k_w(T) table, the {FIG_7_9_CALIBRATION}"]
 
 
 def _hardness_checks(scene: Scene, g: Geometry, raw: dict, effects) -> list[str]:

@@ -204,7 +204,8 @@ def select(lam: np.ndarray, band, n_modes: int | None, target: float) -> np.ndar
     idx = np.nonzero((f >= band[0]) & (f <= band[1]))[0]
     if n_modes is not None and idx.size > n_modes:
         gap = np.abs(f[idx] - target)
-        ranked, cut = idx[np.argsort(gap, kind="stable")], np.sort(gap)[n_modes - 1]
+        order = np.argsort(gap, kind="stable")
+        ranked, cut = idx[order], gap[order[n_modes - 1]]
         idx = np.union1d(capped(lam, ranked, n_modes), idx[gap <= cut + LOCKED * (cut + abs(target))])
     return idx[by_frequency(lam[idx])]
 

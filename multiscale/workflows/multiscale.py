@@ -50,7 +50,6 @@ from multiscale.workflows.strain import refuse_floating, say_at_once
 from multiscale.workflows.transient import TransientResult, stopped_after, write_history
 
 
-
 @dataclass
 class MultiscaleResult(TransientResult):
     """``TransientResult`` plus the multiscale plots and the final per-zone state."""

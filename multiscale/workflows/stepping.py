@@ -19,7 +19,7 @@ import numpy as np
 from multiscale import checkpoint, io
 from multiscale.errors import InputError
 from multiscale.macro.output import FieldOutput
-from multiscale.outputs import CHECKPOINT
+from multiscale.outputs import CHECKPOINT, field_step
 from multiscale.workflows.output import OutputFolder, fingerprint, prepare_folder
 
 
@@ -48,7 +48,7 @@ def field_output(model, folder: Path, names, *, done: int, steps: int, every: in
     """The run's field files: a new run's, with the fields of its start (step ``done`` = 0, written
     before its first checkpoint); a resumed run's, kept up to its checkpoint's step ``done`` (whose
     due fields were written before it), without the fields of a stop between output times."""
-    due = done % every == 0 or done == steps                # the step's fields belong to the series
+    due = field_step(done, every, steps)                    # the step's fields belong to the series
     keep = model.time if due else np.nextafter(model.time, -np.inf)
     writer = FieldOutput(model, folder, names, extra=extra, resume_at=keep if resume else None)
     if not resume:
@@ -68,7 +68,7 @@ def march(run, stop: io.StepStop, history: io.History, writer: FieldOutput, writ
             stepped = run.step(n)
             with stop.writing(n):                     # the step's fields, checkpoint and history, whole
                 history.append(**run.record(stepped))
-                due = n % every == 0 or n == steps
+                due = field_step(n, every, steps)
                 if due:
                     writer.write()                    # before the checkpoint: killed between, they are dropped
                 run.save(ckpt, n, history)
