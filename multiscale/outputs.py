@@ -185,7 +185,9 @@ def plan(scene) -> Plan:
                           "every mode, coloured by the swept value",
                           "map_tracks.png": "frequency and growth rate of each tracked mode against the swept value"})
     else:
-        files["history.h5"] = "scalar history per step (forces, pressures, temperatures, heat), unit per dataset"
+        probes = ", ".join(scene.output.probes) if scene.has("thermal") else ""
+        files["history.h5"] = ("scalar history per step (forces, pressures, temperatures, heat), unit per dataset"
+                               + (f"; the probes' temperatures ({probes})" if probes else ""))
         files["history.png"] = "the history against time"
     if checkpointed(scene):
         files[CHECKPOINT] = "the last macro step's state (multiscale run --resume)"

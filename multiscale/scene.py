@@ -34,8 +34,9 @@ from multiscale.scene_rough import (law_top_warnings, measured_cover, micro_cons
                                     own_tables, penalty_range, perfect_contact, plastic_everywhere, pressure_range,
                                     rough_rules,
                                     roughness_over, thin_layer, zone_sizes)
-from multiscale.scene_sections import (COUPLING_DEFAULT, OUTPUT_FIELDS, Boundary, Interface, InterfaceSettings, Layers,
-                                       Loading, Material, Micro, Output, Roughness, Time)
+from multiscale.scene_output import OUTPUT_FIELDS, Output, output_problems
+from multiscale.scene_sections import (COUPLING_DEFAULT, Boundary, Interface, InterfaceSettings, Layers, Loading,
+                                       Material, Micro, Roughness, Time)
 from multiscale.scene_cycle import convection_coverage, cycle_coverage, short_phases, speed_range, thin_heated_layers
 from multiscale.scene_keys import drop_replaced, given_paths, key_parts
 from multiscale.scene_friction import fade_coverage, fade_tables, friction_checks, speed_law_zeros, torque_problems
@@ -440,11 +441,11 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                          + perfect_contact(scene, warnings) + own_tables(scene, warnings))
             warnings += micro_constants(scene) + zone_sizes(scene) + law_top_warnings(scene) + (
                 speed_law_zeros(scene) if "friction" in effects else [])
-    if scene.output is not None and scene.output.fields is not None:
-        for f in scene.output.fields:
-            missing = [e for e in OUTPUT_FIELDS[f] if e not in effects]
-            if missing:
-                problems.append(f'output.fields: "{f}" needs effect "{missing[0]}" (not in effects)')
+    if scene.output is not None:
+        more, unused = output_problems(scene.output, g.bodies if g is not None else None,
+                                       g is not None and g.motion == "rotation", effects)
+        problems += more
+        warnings += unused
     for section, spec in fields_of(Scene):
         if section in raw and spec.needed_by and not any(e in effects for e in spec.needed_by):
             warnings.append(f'[{section}] is ignored: effect "{spec.needed_by[0]}" is not in effects')

@@ -39,7 +39,7 @@ class Direction(Vector):
         return value
 
 
-_POINT = Vector(Quantity("length"))
+POINT = Vector(Quantity("length"))
 _DIRECTION = Direction(Quantity("dimensionless"))
 # plausible builder parameters by kind (SI; warned outside): lengths of a tribometer or brake part
 _PLAUSIBLE = {"length": (1e-5, 10.0), "angle": (0.0, 6.2832)}
@@ -52,12 +52,12 @@ class Points:
     """One point [x, y, z] or a list of points, as a tuple of points."""
 
     def describe(self) -> str:
-        return f"a point {_POINT.describe()}, or a list of such points"
+        return f"a point {POINT.describe()}, or a list of such points"
 
     def __call__(self, raw, ctx):
         if isinstance(raw, list) and raw and all(isinstance(r, list) for r in raw):
-            return tuple(_POINT(r, ctx) for r in raw)
-        return (_POINT(raw, ctx),)
+            return tuple(POINT(r, ctx) for r in raw)
+        return (POINT(raw, ctx),)
 
 
 class LengthUnit:
@@ -132,7 +132,7 @@ class FileGeometry:
                                      "choice")                     # gmsh's 3-D mesher
     rotating: str | None = key(Text(), required=True)          # the body that rotates, one of revolution about
     axis: tuple = key(_DIRECTION, default=(0.0, 0.0, 1.0))     # its axis (or of n >= 3 equal sectors: checked on
-    centre: tuple = key(_POINT, default=(0.0, 0.0, 0.0))       # CAD, meshes.from_file); m, a point on the axis
+    centre: tuple = key(POINT, default=(0.0, 0.0, 0.0))       # CAD, meshes.from_file); m, a point on the axis
     bodies: FrozenMap | None = key(Named(BodySelection), required=True)
     surfaces: FrozenMap = key(Named(SurfaceSelection), default=FrozenMap())
     interfaces: FrozenMap = key(Named(ContactPair), default=FrozenMap())

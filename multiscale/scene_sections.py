@@ -2,8 +2,8 @@
 
 Materials (constants or temperature tables), the interface defaults and per-interface settings,
 boundary conditions (supports, convection, radiation, fixed temperatures), the loading and its duty
-cycle (load and speed against time, a braking torque; a vehicle stop or drag: ``scene_vehicle``), time,
-output, and the sections of the multiscale loop (roughness, micro, wear, layers); the squeal analysis' in
+cycle (load and speed against time, a braking torque; a vehicle stop or drag: ``scene_vehicle``), time
+(the output in ``scene_output``), and the sections of the multiscale loop (roughness, micro, wear, layers); the squeal analysis' in
 ``scene_stability``. Values are SI numbers or unit strings (``multiscale.units``)."""
 from __future__ import annotations
 
@@ -231,16 +231,7 @@ class Boundary:
             return 0.0
         return interpolate(self.convection, speed) if isinstance(self.convection, tuple) else self.convection
 
-# ------------------------------------------------------------------ loading, time, output
-# output field -> effects it needs
-OUTPUT_FIELDS: dict[str, tuple[str, ...]] = {
-    "displacement": (), "von_mises": (), "contact_pressure": ("contact",),
-    "temperature": ("thermal",), "heat_flux": ("thermal", "friction"), "friction_coefficient": ("friction",),
-    "contact_stiffness": ("roughness",), "partition": ("heat_partition",), "wear_depth": ("wear",),
-    "flash_temperature": ("roughness", "heat_partition"), "counter_wear_depth": ("wear",), "interface": (),
-}
-
-
+# ------------------------------------------------------------------ loading, time
 @dataclass(frozen=True)
 class Loading:
     """Normal load (force or pressure on the load faces), sliding speed, friction, duty cycle.
@@ -377,22 +368,6 @@ class Time:
     def dt(self) -> float | None:
         """Macro time step Δt [s] (None without an end time)."""
         return None if self.end is None else self.end / self.steps
-
-
-@dataclass(frozen=True)
-class Output:
-    """Where and what to write. ``folder``: the results folder (a relative path from the scene
-    file's folder; a run refuses a folder holding results unless --overwrite or --resume).
-    ``fields``: the fields of the ParaView files (XDMF), written at t = 0, every ``every`` macro
-    steps and at the end. ``figures``: the PNG figures (false: their data files only).
-    ``repeatable``: the macro Newton renews its factors by count instead of measured time, so that
-    serial runs repeat bit for bit (regression checks)."""
-
-    folder: Path | None = key(FilePath(folder=True), absent="results/<name> next to the scene file")
-    every: int = key(Integer(ge=1), default=1)            # write fields every n macro steps
-    fields: tuple = key(ListOf(Choice(OUTPUT_FIELDS), unique=True), absent="every field the effects produce")
-    figures: bool = key(Flag(), default=True)           # the PNG figures (false: their tables and fields only)
-    repeatable: bool = key(Flag(), default=False)       # Newton factors renewed by count, not time: repeat bit for bit
 
 
 # ------------------------------------------------------------------ later effects (validated only)

@@ -121,7 +121,8 @@ def test_the_absence_texts_say_what_the_code_does(tmp_path):
     boundary's ambient and convection, an interface's friction, the load factor and the speed, the
     micro grid, remote temperatures and coupling, and the wear rate."""
     from multiscale.scene import loads
-    from multiscale.scene_sections import DEFAULT_GRID, Boundary, InterfaceSettings, Loading, Micro, Output
+    from multiscale.scene_output import Output, Probe
+    from multiscale.scene_sections import DEFAULT_GRID, Boundary, InterfaceSettings, Loading, Micro
     from multiscale.scene_wear import FIG_7_9_WEAR_RATE, Wear
     text = (Path(__file__).parents[1] / "demos" / "block_on_flat.toml").read_text()
     text = text.replace('folder = "../results/block_on_flat"', "")
@@ -130,6 +131,7 @@ def test_the_absence_texts_say_what_the_code_does(tmp_path):
     assert scene.output.folder == tmp_path.resolve() / "results" / "block_on_flat"
     assert _absent(Output, "fields") == "every field the effects produce"
     assert scene.output.fields == ("displacement", "von_mises", "contact_pressure", "interface")
+    assert _absent(Probe, "body").startswith("the body holding the point")   # macro.probes: bodies [0, 1] searched
     assert _absent(Boundary, "ambient") == "time.initial_temperature"       # read in workflows.model
     assert Boundary(surfaces=("a",), fix=("z",)).h(10.0) == 0.0 and _absent(Boundary, "convection") == "no convection"
     assert _absent(InterfaceSettings, "friction").startswith("loading.friction")

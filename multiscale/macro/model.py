@@ -28,6 +28,7 @@ from multiscale.macro.load_faces import clamp_imbalance, load_face_forces
 from multiscale.macro.mechanics import Mechanics, SolveResult
 from multiscale.macro.mesh import TwoBodyMesh
 from multiscale.macro.preload import hold_moment
+from multiscale.macro.probes import Probes
 from multiscale.macro.thermal import Thermal
 
 
@@ -96,6 +97,7 @@ class MacroModel:
     # substep solves after its heat step, and a loaded slide first (the first step of a stop after a dwell)
     stale: bool = False
     notes: list = field(default_factory=list)          # what the run's warnings add (an unbalanced clamp, Mechanics.notes)
+    probes: Probes | None = None                       # thermocouples: ``probe_temperature_<name>`` columns
 
     @property
     def contact(self):
@@ -367,7 +369,8 @@ class MacroModel:
         while released or at rest), and with several interfaces each one's too; with a mu(v) law,
         ``max_slip_speed`` and ``min_slip_speed`` [m/s] over its facets in contact (NaN as mu).
         ``angular_speed`` [rad/s] of a rotating body 1 or ``sliding_speed`` [m/s] of a translating one,
-        at the row's time (a cycle's speed was drawn nowhere: a user trial)."""
+        at the row's time (a cycle's speed was drawn nowhere: a user trial). With ``probes``,
+        ``probe_temperature_<name>`` [K], each thermocouple's reading (``macro.probes``)."""
         on = not self.released
         friction = np.linalg.norm(self.contact.facet_friction(), axis=1) * on     # N per facet, magnitudes
         row = {"time": self.time, "interface_force": self.last_solve.normal_force * on,
@@ -422,6 +425,8 @@ class MacroModel:
                 row[f"heat_step_{body.name}"] = heat_step[i]
                 row[f"heat_total_{body.name}"] = self.heat_total[i]
                 row[f"stored_heat_{body.name}"] = stored[i]
+            if self.probes is not None:
+                row.update({f"probe_temperature_{name}": T for name, T in self.probes.temperatures().items()})
             if self.thermal.conductance:      # conducted through the interface conductance (body 0 -> 1)
                 row.update(heat_exchanged_step=self.heat_exchanged, heat_exchanged_total=self.heat_exchanged_total)
                 for i, body in enumerate(self.tm.bodies):       # each body's, by name (history.png draws it)

@@ -36,6 +36,8 @@ def column_label(key: str) -> str:
     as in multiscale.png: "all" clashed with an interface of that name)."""
     if key == "friction_coefficient":
         return "all interfaces"
+    if key.startswith("probe_temperature_"):          # a probe's own name, whole
+        return key.removeprefix("probe_temperature_").replace("_", " ")
     face = key.startswith("face_max_temperature_")
     for prefix in ("max_temperature_", "heat_total_", "heat_conducted_total_", "stored_heat_", "heat_lost_total_",
                    "frictional_heat_total_", "face_max_temperature_", "friction_coefficient_"):
@@ -120,8 +122,8 @@ def curve_styles(keys, palette: dict | None = None) -> tuple[list[dict], list]:
 
 def history_figure(history, path: Path, title: str = "") -> Path:
     """PNG of the history: force, max pressure, the speed, max temperatures, heat per body (and the friction
-    coefficient with fade or mu(v), the slip speeds with mu(v), the braking torque of a rotating body, per interface, max face
-    temperatures, stored heat per part) vs time."""
+    coefficient with fade or mu(v), the slip speeds with mu(v), the braking torque of a rotating body, the probes'
+    temperatures, per interface, max face temperatures, stored heat per part) vs time."""
     t = history["time"]
     bodies = [k.removeprefix("heat_total_") for k in history.columns if k.startswith("heat_total_")]
     heat = [prefix + b for b in bodies for prefix in HEAT_KINDS if prefix + b in history.columns]
@@ -134,6 +136,8 @@ def history_figure(history, path: Path, title: str = "") -> Path:
               ("slip speed in contact [m/s]", ["max_slip_speed", "min_slip_speed"], 1.0, 0.0),      # with mu(v)
               ("braking torque [N m]", ["friction_moment"], 1.0, 0.0),    # a rotating body's (wanted: a trial)
               ("max temperature [°C]", temperature_columns(history.columns), 1.0, -273.15),
+              ("probe temperature [°C]", [k for k in history.columns if k.startswith("probe_temperature_")],
+               1.0, -273.15),                                                     # thermocouples (output.probes)
               ("heat of each body [J]", heat, 1.0, 0.0),
               ("frictional heat per interface [J]",
                [k for k in history.columns if k.startswith("frictional_heat_total_")], 1.0, 0.0),

@@ -44,6 +44,7 @@ from multiscale.macro.kept_cells import SolverOptionWarning
 from multiscale.macro.load_faces import load_face_areas, load_face_forces
 from multiscale.macro.mechanics import REPEATABLE_REFRESH, Mechanics
 from multiscale.macro.model import Drive, MacroModel
+from multiscale.macro.probes import Probes, ProbeSpec
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
 from multiscale.memory import SPREAD, memory_available, micro_memory, remedy, run_memory
 from multiscale.scene_friction import bare_interfaces, initial_friction, speed_law_guess
@@ -336,7 +337,27 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: b
                     f"{n} {v:.4g}" for n, v in shares.items()))                      # was said nowhere: a user trial)
         if scene.has("conductance") and scene.interface.conductance is not None:   # else per facet later
             tm.interface.set_field(mech.contact.conductance, scene.interface.conductance)
-    return MacroModel(tm, mech, heat, drive(scene, tm), partitions=shares, friction_law=friction_law(scene, tm))
+    return MacroModel(tm, mech, heat, drive(scene, tm), partitions=shares, friction_law=friction_law(scene, tm),
+                      probes=probes(scene, tm, T) if T is not None and scene.output.probes else None)
+
+
+def probes(scene, tm, temperatures) -> Probes:
+    """The scene's thermocouples (``output.probes``) on the temperature functions; says where each
+    one reads (its body and part, its distance from the interface; in the rotating body whether it
+    turns with it or stays in place)."""
+    motion = tm.spec.motion
+    specs = [ProbeSpec(name, p.point, scene.bodies.index(p.body) if p.body is not None else None, p.turns)
+             for name, p in scene.output.probes.items()]
+    found = Probes(tm, temperatures, specs, motion if isinstance(motion, Rotation) else None)
+    for where, spec in zip(found.located, specs):
+        body = tm.bodies[where.body]
+        part = f", part {where.part}" if len(body.spec.regions) > 1 else ""
+        moving = (" (turning with it: its circle's mean)" if spec.turns else " (fixed in space: a rubbing thermocouple "
+                  "or pyrometer; output.probes.<name>.turns for one embedded in it)") if where.body == 1 and \
+            isinstance(motion, Rotation) else ""
+        track = "the interfaces' track" if where.body == 1 and isinstance(motion, Rotation) else "the interface"
+        reporter().say(f"probe {where.name}: in {body.name}{part}{moving}, {where.depth * 1e3:.3g} mm from {track}")
+    return found
 
 
 def run_notes(model: MacroModel) -> tuple:

@@ -1,5 +1,6 @@
 """Thermal boundary conditions on two MPI ranks give the serial history (convection, radiation, a fixed
-temperature and its reaction, kappa(T) and c(T); run: mpiexec -n 2 python -m pytest tests/mpi)."""
+temperature and its reaction, kappa(T) and c(T), the probes' readings; run: mpiexec -n 2 python -m
+pytest tests/mpi)."""
 import numpy as np
 import pytest
 
@@ -50,6 +51,13 @@ temperature = "350 K"
 [output]
 folder = "{folder}"
 fields = []
+[output.probes.in_block]
+point = ["3 mm", "4 mm", "2.5 mm"]
+[output.probes.in_flat]
+point = ["6 mm", "2 mm", "-1 mm"]
+[output.probes.flat_face]
+point = ["5 mm", "5 mm", "0 mm"]
+body = "flat"
 """
 
 
@@ -63,6 +71,7 @@ def test_two_ranks_give_the_serial_thermal_history(tmp_path):
         serial = run(loads(SCENE.format(folder=f"{base}/serial")), comm=MPI.COMM_SELF, verbose=False).history
     serial = world.bcast(serial.columns if serial is not None else None, root=0)
     assert set(serial) == set(parallel.columns) and "heat_lost_total_flat" in serial
+    assert {"probe_temperature_in_block", "probe_temperature_in_flat", "probe_temperature_flat_face"} <= set(serial)
     for key in (k for k in serial if not solver_statistic(k)):
         np.testing.assert_allclose(parallel[key], serial[key], rtol=1e-8, atol=1e-8, err_msg=key)
     # energy: stored + lost = 0 in the stack (no frictional heat), to round-off
@@ -87,3 +96,16 @@ def test_runs_one_after_another_free_their_models(tmp_path, free_communicators):
         gc.collect()
         free.append(free_communicators())
     assert world.allgather(free[2] - free[1]) == [0, 0], free
+
+
+def test_a_probe_outside_the_bodies_is_refused_on_every_rank(tmp_path):
+    """Where a point lies is decided from every rank's cells: each rank raises the same error (none
+    waits for another in a collective)."""
+    from multiscale.errors import InputError
+    from multiscale.workflows.model import build_model
+    base = MPI.COMM_WORLD.bcast(str(tmp_path), root=0)
+    scene = loads(SCENE.format(folder=f"{base}/out"), overrides={"output.probes.in_flat.point": ["6 mm", "2 mm", "-9 mm"]})
+    with pytest.raises(InputError, match=r"output.probes.in_flat.point: \[6.0, 2.0, -9.0\] mm is in neither 'block' "
+                                         r"nor 'flat' \('block' spans \[0.0, 0.0, 0.0\] to \[10.0, 10.0, 5.0\] mm; "
+                                         r"'flat' spans \[0.0, 0.0, -5.0\] to"):
+        build_model(scene)
