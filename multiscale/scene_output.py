@@ -55,8 +55,9 @@ def output_problems(output: Output, bodies: tuple | None, rotating: bool, effect
     None: unknown), whether the moving one ``rotating``, and the active ``effects``."""
     problems = [f'output.fields: "{f}" needs effect "{missing[0]}" (not in effects)' for f in output.fields or ()
                 if (missing := [e for e in OUTPUT_FIELDS[f] if e not in effects])]
-    if output.probes and "thermal" not in effects:
-        return problems, ['output.probes is ignored: effect "thermal" is not in effects']
+    if output.probes and ("thermal" not in effects or "stability" in effects):
+        return problems, ['output.probes is ignored: ' + ('effect "thermal" is not in effects' if "thermal" not in
+                                                          effects else "the squeal analysis writes no history")]
     for name, p in output.probes.items():
         where = f"output.probes.{name}"
         if problem := name_problem(name):

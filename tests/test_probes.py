@@ -1,6 +1,8 @@
 """Temperature probes (``multiscale.macro.probes``, scene key output.probes): a thermocouple reads the
 temperature field at its point, a turning one the mean round its circle, and a point outside its
 body is refused with where the bodies are."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -10,7 +12,7 @@ from multiscale.errors import InputError, SceneError  # noqa: E402
 from multiscale.macro.probes import RING, Probes, ProbeSpec, ring  # noqa: E402
 from multiscale.geometry import Rotation  # noqa: E402
 from multiscale.references.thermal import slab_convection  # noqa: E402
-from multiscale.scene import loads  # noqa: E402
+from multiscale.scene import load, loads  # noqa: E402
 from multiscale.workflows import run  # noqa: E402
 from multiscale.workflows.model import build_model  # noqa: E402
 
@@ -105,7 +107,8 @@ def test_a_probe_in_a_cooling_column_follows_the_series(tmp_path, capsys):
 
 def test_the_scene_checks_the_probes():
     """A probe's body must be one of the geometry's, only the rotating body's probe turns, its name
-    names a history column, and without effect "thermal" the probes are ignored with a warning."""
+    names a history column, and without effect "thermal" or in a squeal analysis the probes are
+    ignored with a warning."""
     probe = '[output.probes.{name}]\npoint = ["1 mm", "1 mm", "1 mm"]\n{more}\n'
     text = BLOCK.format(effects="{effects}", geometry='mesh_size = "2.5 mm"', block=STEEL, flat=STEEL, interface="",
                         pressure="1 MPa", end=1.0, steps=1, T0=400.0, boundary="[output]\n{probes}")
@@ -119,3 +122,7 @@ def test_the_scene_checks_the_probes():
                                 "history columns and scene keys)"]
     scene = loads(text.format(effects='["contact"]', probes=probe.format(name="a", more="")))
     assert 'output.probes is ignored: effect "thermal" is not in effects' in scene.warnings
+    squeal = load(Path(__file__).parents[1] / "demos" / "car_brake_squeal.toml", overrides={
+        "effects": ["contact", "friction", "stability", "thermal"], "time.end": "1 s",
+        "output.probes.a.point": ["0 mm", "115 mm", "26 mm"]})
+    assert "output.probes is ignored: the squeal analysis writes no history" in squeal.warnings
