@@ -521,13 +521,19 @@ def test_builder_bodies_thinner_than_their_elements_are_warned_about():
 def test_check_says_what_the_builders_sizes_mean():
     """pin_size is the square's side (read as a diameter: 27 % more area), and block_on_flat is a
     quarter model whose forces are the quarter's (its 100 N carried 400 N of the whole block): said
-    only in a demo's comment and the builders' docstrings (a lab-geometry trial)."""
+    only in a demo's comment and the builders' docstrings (a lab-geometry trial). A generated surface cut
+    per zone changes with the zone count: check says so (a brake trial)."""
     lines = summary(load(DEMOS / "block_on_flat.toml"))
     assert "            a quarter model of a 20 x 20 mm block (symmetry planes x = 0, y = 0): its load, forces, areas, " \
            "heats and worn volumes are the quarter's, a quarter of the whole block's" in lines
     lines = summary(load(DEMOS / "pin_on_disc.toml", overrides={"geometry.pin_size": "10 mm"}))
     assert "            a square pin of side pin_size = 10 mm at track_radius = 90 mm on a disc of 12.5 to 107.5 mm, " \
            "10 mm thick" in lines
+    rough = next(line for line in lines if line.startswith("    roughness"))
+    assert "RMS 10.35 um, H 0.6;" in rough                      # patch "face": the face's wavelengths
+    zoned = summary(load(DEMOS / "railway_drag.toml"))           # patch "zone": micro.zones changes the surface
+    assert 'RMS 3 um, H 0.8, wavelengths k_min..k_max per zone (patch = "zone": micro.zones changes the surface);' \
+        in next(line for line in zoned if line.startswith("    roughness"))
     text = (DEMOS / "car_brake_stop.toml").read_text().replace(
         '[loading.vehicle]\nspeed = "100 km/h"\ndeceleration = "0.6 gn"\nwheel_radius = "310 mm"\nmass = "525 kg"',
         'normal_force = "5000 N"\nrotation_speed = "800 rpm"\n#')
