@@ -29,6 +29,7 @@ from pathlib import Path
 import multiscale
 from multiscale import __version__
 from multiscale.checkpoint import file_digest
+from multiscale.geometry import Rotation
 from multiscale.io import replacing
 from multiscale.outputs import plan
 from multiscale.schema import (Choice, Curve, Either, FilePath, ListOf, Named, OnlyWith, Quantity, Section, TableOr,
@@ -121,7 +122,10 @@ def _section(name, parser, v) -> dict:
         if isinstance(v.params, FileGeometry):
             return {**_table(FileGeometry, v.params), **limit}
         params = {k: (x if isinstance(x, int) else float(x), "") for k, x in v.resolved().items()}
-        return {"builder": (v.builder, ""), **params, **limit}
+        motion = v.spec.motion       # the axis as turned (geometry.axis) and every part's material
+        axis = {"axis": ([float(a) for a in motion.axis], "")} if isinstance(motion, Rotation) else {}
+        materials = {"materials": {r.name: (r.material, "") for b in v.spec.bodies for r in b.regions}}
+        return {"builder": (v.builder, ""), **params, **axis, **limit, **materials}
     if name == "interfaces":
         out = {}
         for n, s in v.items():

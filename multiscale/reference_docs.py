@@ -16,7 +16,8 @@ from multiscale.outputs import WRITES, array_name
 from multiscale.schema import (Curve, Either, Integer, ListOf, Named, Quantity, Section, TableOr, Tables, fields_of,
                                show)
 from multiscale.scene import EFFECTS, OUTPUT_FIELDS, Scene
-from multiscale.scene_geometry import BUILDER_AXIS_TEXT, MAX_CELLS_TEXT, FileGeometry, GeometrySection, parameter_kind
+from multiscale.scene_geometry import (BUILDER_AXIS_TEXT, BUILDER_MATERIALS_TEXT, MAX_CELLS_TEXT, FileGeometry,
+                                       GeometrySection, parameter_kind)
 from multiscale.scene_sections import InterfaceSettings
 
 OWN_TABLES = ("Sub-tables ``[interfaces.<name>.roughness]`` and ``[interfaces.<name>.micro]`` take the keys of "
@@ -126,7 +127,8 @@ def _geometry() -> list[str]:
     rows = [("``geometry.builder``", _cell(section.builders.describe()), " ", "required (or file)", " ", "any"),
             ("``geometry.max_cells``", _cell(f"{Integer(ge=1).describe()}: {MAX_CELLS_TEXT}"), "-", show(MAX_CELLS),
              " ", "any"),
-            ("``geometry.axis``", _cell(f"[x, y, z]: {BUILDER_AXIS_TEXT}"), "-", " ", " ", "any")]
+            ("``geometry.axis``", _cell(f"[x, y, z]: {BUILDER_AXIS_TEXT}"), "-", " ", " ", "any"),
+            ("``geometry.materials``", _cell(BUILDER_MATERIALS_TEXT), "-", " ", " ", "any")]
     lines = ["[geometry]", "-" * 10, "", _paragraph(" ".join(GeometrySection.__doc__.split())), ""] + _list_table(rows)
     for name in section.builders.options:
         module = builder(name)
@@ -189,7 +191,7 @@ def key_paths(cls=Scene, path: str = "") -> list[str]:
         where = f"{path}.{name}" if path else name
         parser = spec.parser
         if isinstance(parser, GeometrySection):
-            out += ["geometry.builder", "geometry.max_cells"]
+            out += ["geometry.builder", "geometry.max_cells", "geometry.materials"]
             out += [f"geometry.{k}" for b in parser.builders.options for k in builder(b).DEFAULTS]
             out += key_paths(FileGeometry, "geometry")
         elif where == "interfaces":

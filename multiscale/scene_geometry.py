@@ -238,6 +238,8 @@ class Geometry:
 
 BUILDER_AXIS_TEXT = ("a rotating builder's axis (as it is) or its opposite, which turns the body the other way "
                      "(a brake's reverse run); default the builder's")
+BUILDER_MATERIALS_TEXT = ('a table of part = "material" (a builder\'s parts: pin, housing, plate, disc, ...): those '
+                          "parts take that [materials.<name>] table; default the builder's own material names")
 MAX_CELLS_TEXT = ("a mesh estimated larger (trial meshes before meshing) is refused; multiscale run --max-cells "
                   "overrides it")
 
@@ -254,7 +256,7 @@ class GeometrySection(Section):
     whose parameters (lengths in m, SI defaults below) are the allowed keys, ``mesh_size`` and the
     other ``*_mesh_size`` the cell sizes; or ``file`` gives the user's own geometry (CAD or gmsh:
     the keys under file = "..."). ``max_cells`` bounds the mesh, ``axis`` turns a rotating body the
-    other way."""
+    other way, ``materials`` gives a builder's parts other materials than its own."""
 
     def __init__(self):
         super().__init__(Geometry)
@@ -267,7 +269,8 @@ class GeometrySection(Section):
     def reference(self, path) -> list[str]:
         lines = [f"  {'builder':<20}  {self.builders.describe()}  [or file]",
                  f"  {'max_cells':<20}  integer >= 1, default {MAX_CELLS}: {MAX_CELLS_TEXT}",
-                 f"  {'axis':<20}  [x, y, z]: {BUILDER_AXIS_TEXT}"]
+                 f"  {'axis':<20}  [x, y, z]: {BUILDER_AXIS_TEXT}",
+                 f"  {'materials':<20}  {BUILDER_MATERIALS_TEXT}"]
         for name in self.builders.options:
             module = builder(name)
             lines.append(f"  builder = \"{name}\" parameters (SI defaults; 0 = the builder's fallback):")
@@ -297,7 +300,7 @@ class GeometrySection(Section):
             ctx.problems.append(f"{path}.builder = {show(raw['builder'])}: {exc}")
             return None
         before = len(ctx.problems)
-        given = {k: v for k, v in raw.items() if k not in ("builder", "axis")}
+        given = {k: v for k, v in raw.items() if k not in ("builder", "axis", "materials")}
         axis = parse(_DIRECTION, raw["axis"], f"{path}.axis", ctx) if "axis" in raw else None
         unknown_keys(given, module.DEFAULTS, path, ctx, f'parameter of builder "{name}"')
         params = {}
@@ -311,7 +314,30 @@ class GeometrySection(Section):
         if len(ctx.problems) > before:
             return None
         geometry = self._describe(name, module, FrozenMap(params), params, ctx)
+        if geometry is not None and "materials" in raw:
+            geometry = self._materials(geometry, raw["materials"], f"{path}.materials", ctx)
         return geometry if geometry is None or axis is None else self._turned(geometry, axis, path, ctx)
+
+    @staticmethod
+    def _materials(geometry, raw, where, ctx):
+        """A builder's geometry whose parts take the materials ``raw`` gives ({part: material name}; the
+        others keep the builder's): a pin-on-disc's housing and plate took the disc's material, with
+        no key to give them their own (a trial)."""
+        parts = geometry.regions
+        if not isinstance(raw, dict) or not all(isinstance(v, str) for v in raw.values()):
+            ctx.problems.append(f'{where} = {show(raw)}: must be a table of part = "material" '
+                                f'(parts: {", ".join(parts)})')
+            return None
+        bad = [f'{where}.{k}: not a part of builder "{geometry.builder}"; parts: {", ".join(parts)}'
+               for k in raw if k not in parts]
+        bad += [f'{where}.{k} = "{m}": the name {problem}' for k, m in raw.items() if (problem := name_problem(m))]
+        if bad:
+            ctx.problems.extend(bad)
+            return None
+        spec = geometry.spec
+        bodies = tuple(dataclasses.replace(b, regions=tuple(dataclasses.replace(r, material=raw.get(r.name, r.material))
+                                                            for r in b.regions)) for b in spec.bodies)
+        return dataclasses.replace(geometry, spec=dataclasses.replace(spec, bodies=bodies))
 
     @staticmethod
     def _turned(geometry, axis, path, ctx):
