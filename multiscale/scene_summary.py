@@ -278,10 +278,14 @@ def _effect_line(scene: Scene, effect: str) -> str:
             scene.rough_interfaces[0] if scene.rough_interfaces else None)[1]]
         named = {"k_w": "k_w = {:g} 1/Pa", "k_w_table": "k_w(T) table", "specific_rate": "k = {:g} 1/Pa ({:.4g} "
                  "mm^3/(N m))", "specific_rate_table": "k(T) table"}        # (a tribologist's unit too: a trial)
-        rate = "k_w of its material" if scene.rough_material_wears else named[w.given].format(w.rate, w.rate * 1e9) \
-            if w.given else f"k_w(T) default table: {FIG_7_9_CALIBRATION}"
+        constant = w.given in ("k_w", "specific_rate")           # (a table's format took rate * 1e9: check failed)
+        rate = "k_w of its material" if scene.rough_material_wears else named[w.given].format(
+            *((w.rate, w.rate * 1e9) if constant else ())) if w.given else f"k_w(T) default table: {FIG_7_9_CALIBRATION}"
         both = f"; the {scene.bodies[1]} wears too (k_w of its material)" if counter.k_w is not None else ""
         law = "k p ds" if w.per_load and not scene.rough_material_wears else "k_w mu p ds"
+        if not constant or scene.rough_material_wears:                         # a table (or the material's)
+            law += (", a table's T each face's macro temperature" if w.temperature == "macro" else
+                    ", a table's T the rough surface's local one, macro + flash") + " (wear.temperature),"
         return (f"Archard dh = {law} every {w.update_every} step(s) in {w.substeps} increment(s){both}; "
                 f"{rate} (k_w per frictional work, k per normal load: a specific wear rate k is k_w = k/mu)")
 

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from multiscale.schema import Curve, Integer, OneOf, Quantity, key
+from multiscale.schema import Choice, Curve, Integer, OneOf, Quantity, key
 from multiscale.scene_values import TEMPERATURE
 
 # Default k_w(T) [(K, 1/Pa)]: the shape of thesis Fig. 7.9 (sintered pad material, [Mann 2017]):
@@ -32,8 +32,9 @@ class Wear:
     calibrated as ``FIG_7_9_CALIBRATION`` says), or dh = k p ds by a specific wear rate k = V/(F s) per
     normal load (``specific_rate``, or a table k(T): a tribometer's, the same whatever mu, also where
     it fades), at the rough surface's local temperature, cell by cell in each micro patch (its face's
-    macro temperature plus the flash rise; without heating the face's macro temperature), not a
-    thermocouple's below the surface. Every ``update_every`` macro steps (and at the last
+    macro temperature plus the flash rise; without heating the face's macro temperature), or with
+    ``temperature = "macro"`` at each face's macro temperature (a dynamometer's k(T) and mu(T) were
+    measured against one temperature: a fade table reads the mean of the two faces'). Every ``update_every`` macro steps (and at the last
     step, and a step ending at a stop) the zones wear over the sliding since, weighted by the load factor
     (none while released), in at least ``substeps`` (and 2) implicit increments, raised while their error
     estimate exceeds ``micro.wear.WEAR_TOL``; a counter-face whose material gives ``k_w`` wears too."""
@@ -42,6 +43,7 @@ class Wear:
     k_w_table: tuple | None = key(Curve(TEMPERATURE, _PER_WORK, "temperature", "k_w"), absent=_RULE)
     specific_rate: float | None = key(Quantity("specific_wear_rate", gt=0, plausible=(1e-20, 1e-9)), absent=_RULE)
     specific_rate_table: tuple | None = key(Curve(TEMPERATURE, _PER_LOAD, "temperature", "k"), absent=_RULE)
+    temperature: str = key(Choice(("surface", "macro")), default="surface")   # what a k_w(T) or k(T) reads
     update_every: int = key(Integer(ge=1), default=1)                         # macro steps per update
     substeps: int = key(Integer(ge=1), default=1)                             # wear increments per update
 
@@ -65,6 +67,12 @@ class Wear:
         return value if value is not None else \
             tuple(zip(*(self.k_w_table or self.specific_rate_table or FIG_7_9_WEAR_RATE)))
 
+    @property
+    def read(self) -> str:
+        """The largest temperature a k_w(T) reads, in words (a run's warnings)."""
+        return "body's largest macro temperature" if self.temperature == "macro" else \
+            "surface's largest micro temperature"
+
     def held_ends(self, T0: float | None = None, hottest: float | None = None) -> list[str]:
         """The k_w(T) (or k(T)) table held at an end: below its first point at the initial temperature
         ``T0`` (check), above its last at ``hottest`` [K] (the largest micro temperature, after a run);
@@ -78,7 +86,7 @@ class Wear:
         for T, where, end, rate, side, beyond in (
                 (T0, "the initial temperature", temperatures[0], rates[0], "below its first",
                  T0 is not None and T0 < temperatures[0]),
-                (hottest, "the rough surface's largest micro temperature", temperatures[-1], rates[-1],
+                (hottest, f"the rough {self.read}", temperatures[-1], rates[-1],
                  "above its last", hottest is not None and hottest > temperatures[-1])):
             if beyond:
                 out.append(f"{table}: {where}, {T - 273.15:.4g} degC, is {side} point {end - 273.15:.4g} degC: the "

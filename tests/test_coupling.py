@@ -248,6 +248,48 @@ def test_gap_at_inverts_decreasing_pressures_and_refuses_one_bounded_below_its_t
         gap_at(lambda g: np.minimum(stiffness * np.maximum(top - g, 0), 5e5), target, np.full(3, top), np.full(3, top))
 
 
+def test_a_wear_table_at_the_macro_temperature_reads_the_faces_not_the_flash():
+    """``PostAnalysis(wear_at_macro=True)`` (scene: wear.temperature = "macro"): a k_w(T) table reads
+    each zone's remote (macro) temperature of the rough body, not the heated surface's: the zone wears
+    k_w(T_macro) mu P A s to round-off (a constant rate over its patch) and ``zone_rates`` is that
+    k_w; the surface's local temperatures (the default) read otherwise: the flash of a rough body
+    10 K above the counter-face, and the contact between a rough body 25 K above it and it. A
+    dynamometer's k(T) and mu(T) are measured against one temperature (a brake trial: the micro
+    surface read 317-327 degC where the fade table read 210 degC)."""
+    s = fractal_surface(24, 1e-3, 0.8, 1, 6, 2e-6, seed=2)
+    _, zones = cut_zones(Surface(s.heights, s.dx, s.dy, periodic=False), (2, 1))
+    kernel = HalfSpace.from_materials(5e9, 0.3, 220e9, 0.3)
+    heating = Heating(ThermalMaterial(50, 1e-5), ThermalMaterial(35, 8.3e-6))
+    P, v, mu, table = np.array([1e6, 3e6]), np.array([1.9, 1.7]), 0.4, ([300.0, 400.0], [1e-14, 5e-14])
+    remote = np.array([[300.0, 310.0], [305.0, 330.0]])                # (counter-face, rough body) [K]
+    at = {}
+    for macro in (True, False):
+        post = PostAnalysis(kernel, zones[0].shape, s.dx, s.dy, mu=mu, heating=heating, wear_rate=table,
+                            wear_at_macro=macro)
+        r = post.run(zones, P, speed=v, angle=np.pi / 2, remote=remote, sliding=v * 0.6)
+        at[macro] = post.zone_rates(r, remote)
+    k_w = np.interp(remote[:, 1], *table)
+    np.testing.assert_allclose(at[True], k_w, rtol=1e-12)
+    area = np.array([z.area for z in zones])
+    post = PostAnalysis(kernel, zones[0].shape, s.dx, s.dy, mu=mu, heating=heating, wear_rate=table,
+                        wear_at_macro=True)
+    r = post.run(zones, P, speed=v, angle=np.pi / 2, remote=remote, sliding=v * 0.6)
+    np.testing.assert_allclose(r.volume, k_w * mu * P * area * v * 0.6, rtol=1e-10)
+    assert at[False][0] > 1.005 * at[True][0] and at[False][1] < 0.95 * at[True][1]     # +0.6 %, -11 % measured
+    from multiscale.scene_summary import summary
+    from multiscale.workflows.multiscale import post_analysis
+    for read in ("surface", "macro"):                         # the scene key reaches the post-analysis, check says it
+        scene = loads(POD.format(folder="out"), overrides={"wear.temperature": read, "wear.k_w_table": [
+            ["20 degC", "1e-14 1/Pa"], ["200 degC", "5e-14 1/Pa"]]})
+        assert post_analysis(scene, zones[0]).wear_at_macro == (read == "macro")
+        line = next(x for x in summary(scene) if x.startswith("    wear"))
+        assert ("a table's T each face's macro temperature" in line) == (read == "macro")
+    per_load = loads(POD.format(folder="out"), overrides={"wear.specific_rate_table": [   # check failed on a table
+        ["20 degC", "4e-15 1/Pa"], ["200 degC", "2e-14 1/Pa"]]})                          # (until 2026-12-06)
+    assert any(x.startswith("    wear           Archard dh = k p ds, a table's T the rough surface's local one")
+               and "k(T) table" in x for x in summary(per_load))
+
+
 def test_post_analysis_wears_exactly_archard_volume():
     """Constant k_w: a zone's worn volume is k_w mu P A s to round-off, whatever the substeps; the
     partition into the rough body lies in [0, 1] and matches the steady solver alone."""

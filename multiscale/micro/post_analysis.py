@@ -20,9 +20,9 @@ area, sliding speed V and direction, macro surface temperatures of both bodies):
    rates are scaled back to the true speed (mu p V is linear in it; the partition is unchanged);
 3. optionally the thermal contact conductance h_c of the zone at that contact
    (``laws.Conductance``, the zone-scale spreading resistance taken out);
-4. Archard wear over the sliding distance s = V Δt (Eq. 3.10, dh = k_w(T) mu p ds, or k(T) p ds by a
-   specific wear rate per normal load, ``per_load``; T the local
-   surface temperature of step 2): ``substeps`` increments, each a load-controlled solve of the
+4. Archard wear over the sliding distance s = V Δt (Eq. 3.10, dh = k_w(T) mu p ds, or k(T) p ds by a specific
+   wear rate, ``per_load``; T the local surface temperature of step 2, or with ``wear_at_macro`` the
+   remote one): ``substeps`` increments, each a load-controlled solve of the
    worn patch warm-started from the previous pressure (§3.5.1), linearly implicit: the depth of
    the pressure after the increment acts as a Winkler layer in that solve (stable at any wear
    rate, where the explicit increments of the thesis amplify grid-scale relief beyond
@@ -55,7 +55,6 @@ from multiscale.micro.plasticity import Hardness
 from multiscale.micro.surface import Surface
 from multiscale.micro.wear import WearRate, stable_substeps, wear_step
 from multiscale.micro.zones import Zone
-
 
 WARM_ITERATIONS = 300     # a warm-started local solve that needs more starts again from uniform
 
@@ -138,16 +137,17 @@ class PostAnalysis:
     ``laws.Conductance`` or None; ``wear_rate``: anything ``WearRate`` accepts (temperatures in K),
     or None for no wear; ``counter_rate``: the same for the counter-face (None: it does not wear);
     ``per_load``: ``wear_rate`` is a specific wear rate k per normal load (dh = k p ds: mu out of
-    the rough body's wear, not of the counter-face's); ``substeps``: wear increments per step;
-    ``tol``: contact tolerance; ``hardness``: a
-    ``plasticity.Hardness`` (H, or H(T) at the rough body's remote temperature of each zone) for
-    elastic-perfectly-plastic asperities, whose permanent deformation goes into the returned
-    heights (before wear; the wear re-solves are bounded too), or None (elastic).
-    """
+    the rough body's wear, not of the counter-face's); ``wear_at_macro``: the wear rates' tables read
+    each body's remote (macro) temperature, not its local surface's with heating (the temperature a
+    dynamometer's k(T) and mu(T) were measured against); ``substeps``: wear increments per step;
+    ``tol``: contact tolerance; ``hardness``: a ``plasticity.Hardness`` (H, or H(T) at the rough
+    body's remote temperature of each zone) for elastic-perfectly-plastic asperities, whose permanent
+    deformation goes into the returned heights (before wear; the wear re-solves too), or None."""
 
     def __init__(self, kernel: Kernel, shape, dx: float, dy: float, *, mu: float, heating: Heating | None = None,
                  conductance: Conductance | None = None, wear_rate=None, counter_rate=None, substeps: int = 1,
-                 tol: float = 1e-8, max_iter: int = 5000, hardness: Hardness | None = None, per_load: bool = False):
+                 tol: float = 1e-8, max_iter: int = 5000, hardness: Hardness | None = None, per_load: bool = False,
+                 wear_at_macro: bool = False):
         self.solver = ContactSolver(kernel, shape, dx, dy, periodic=False)
         self.shape, self.dx, self.dy = tuple(shape), float(dx), float(dy)
         self.mu = check_positive("mu", mu, allow_zero=True)
@@ -163,7 +163,7 @@ class PostAnalysis:
                                     or heating.transient_steps < 0):
             raise InputError("transient_steps", heating.transient_steps, "0 (steady) or an integer >= 1")
         self.rate = WearRate(wear_rate) if wear_rate is not None else None
-        self.per_load = bool(per_load)
+        self.per_load, self.wear_at_macro = bool(per_load), bool(wear_at_macro)
         self.counter_rate = WearRate(counter_rate) if counter_rate is not None else None
         self.substeps, self.tol = check_count("substeps", substeps), check_positive("tol", tol)
         self.max_iter = check_count("max_iter", max_iter)
@@ -358,9 +358,9 @@ class PostAnalysis:
         return np.divide((k_w * p).sum(axis=(-2, -1)), total, out=np.full(total.shape, np.nan), where=total > 0)
 
     def _wear_temperatures(self, result: ZoneResult, remote):
-        """(rough body's, counter-face's) temperatures of k_w: the heating's fields, else the remote
-        temperatures spread over the zones, where a temperature-dependent rate needs them."""
-        T, T1 = result.temperature, result.counter_temperature
+        """(rough body's, counter-face's) temperatures of k_w: the heating's fields (not ``wear_at_macro``),
+        else the remote temperatures spread over the zones, where a temperature-dependent rate needs them."""
+        T, T1 = (None, None) if self.wear_at_macro else (result.temperature, result.counter_temperature)
         shape = result.heights.shape
         for rate, field, col in ((self.rate, "T", 1), (self.counter_rate, "T1", 0)):
             if rate is not None and rate.depends_on_temperature and (T if field == "T" else T1) is None:

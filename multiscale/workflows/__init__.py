@@ -204,17 +204,20 @@ def run_warnings(scene, history) -> list[str]:
 
 
 def _wear_table_ends(scene, history) -> list[str]:
-    """``Wear.held_ends`` at the rough surface's largest micro temperature (``micro_max_temperature``;
-    the initial temperature is the scene's warning), or the rough material's k_w table left there
+    """``Wear.held_ends`` at the largest temperature the wear read (the rough surface's micro one,
+    ``micro_max_temperature``, or with ``wear.temperature = "macro"`` the rough body's; the initial
+    temperature is the scene's warning), or the rough material's k_w table left there
     (``Material.beyond``; it was not said)."""
-    if not scene.has("wear") or "micro_max_temperature" not in history.columns:
+    column = f"max_temperature_{scene.bodies[0]}" if scene.has("wear") and scene.wear.temperature == "macro" \
+        else "micro_max_temperature"
+    if not scene.has("wear") or column not in history.columns:
         return []
-    micro = np.asarray(history["micro_max_temperature"], dtype=float)
-    hottest = float(np.max(micro, initial=-np.inf, where=np.isfinite(micro)))
+    read = np.asarray(history[column], dtype=float)
+    hottest = float(np.max(read, initial=-np.inf, where=np.isfinite(read)))
     if scene.rough_material_wears:
         name = scene.rough_material
         phrase = scene.materials[name].beyond(hottest).get("k_w")
-        return [f"materials.{name}.{phrase} (the rough surface's largest micro temperature)"] if phrase else []
+        return [f"materials.{name}.{phrase} (the rough {scene.wear.read})"] if phrase else []
     return scene.wear.held_ends(hottest=hottest)
 
 

@@ -83,6 +83,7 @@ def post_analysis(scene, zone) -> PostAnalysis:
                         conductance=Conductance(*thermal_kernels(scene)) if scene.has("conductance") else None,
                         wear_rate=rate, counter_rate=counter_rate, substeps=scene.wear.substeps if wear else 1,
                         per_load=wear and scene.wear.per_load and not scene.rough_material_wears,
+                        wear_at_macro=wear and scene.wear.temperature == "macro",
                         tol=m.tol, hardness=interface_hardness(scene) if scene.has("plasticity") else None)
 
 
