@@ -81,7 +81,7 @@ def step_time(t: float, dt: float) -> float:
 BODY_FIELDS = ("displacement", "temperature", "von_mises")
 # output fields each analysis writes (when the scene asks for them)
 WRITES = {"transient": ("displacement", "temperature", "von_mises", "contact_pressure", "heat_flux", "partition",
-                        "friction_coefficient", "interface"),
+                        "friction_coefficient", "interface", "wear_depth", "counter_wear_depth"),
           "multiscale": tuple(FIELDS),
           "squeal": ("displacement", "von_mises", "contact_pressure", "friction_coefficient", "interface")}
 PROVENANCE = {"scene.toml": "the scene file as given",
@@ -100,9 +100,9 @@ def analysis(scene) -> str:
 
 def checkpointed(scene) -> bool:
     """Whether a run of ``scene`` writes ``CHECKPOINT`` (``multiscale run --resume``): the multiscale
-    loop, and a transient run with macro steps (effect thermal); not the squeal analysis."""
+    loop, and a transient run with macro steps (effect thermal or wear); not the squeal analysis."""
     kind = analysis(scene)
-    return kind == "multiscale" or (kind == "transient" and scene.has("thermal"))
+    return kind == "multiscale" or (kind == "transient" and (scene.has("thermal") or scene.has("wear")))
 
 
 def field_step(n: int, every: int, steps: int) -> bool:
@@ -114,7 +114,7 @@ def output_times(scene) -> tuple[float, ...]:
     """Times [s] at which the fields are written: 0, then every ``output.every`` macro step and the
     last (squeal: the preload, 0)."""
     kind, t = analysis(scene), scene.time
-    marching = scene.has("thermal") or (kind == "multiscale" and scene.has("wear"))
+    marching = scene.has("thermal") or scene.has("wear")
     steps = t.steps if kind != "squeal" and marching else 0
     times, now = [0.0], 0.0
     for n in range(1, steps + 1):

@@ -35,6 +35,7 @@ import numpy as np
 
 from multiscale.errors import InputError
 from multiscale.geometry import Rotation, plane_frame
+from multiscale.macro.facet_wear import track_spread
 from multiscale.macro.laws_ufl import FacetLaw, gap_at
 from multiscale.macro.mesh import TwoBodyMesh
 from multiscale.micro.laws import LawError, LawSpec, ZoneLaws
@@ -75,18 +76,6 @@ def interface_plane(tm: TwoBodyMesh, name: str) -> tuple[Plane, np.ndarray, np.n
     corners = plane.uv(np.array([[a, b, c] for a in (lo3[0], hi3[0]) for b in (lo3[1], hi3[1])
                                  for c in (lo3[2], hi3[2])]))
     return plane, corners.min(axis=0), corners.max(axis=0)
-
-
-def track_spread(radius, source_radius, volume, half: float) -> np.ndarray:
-    """Depth [m] at ``radius`` [m] of the volumes ``volume`` [m^3] lost at ``source_radius`` spread
-    around their circles: Σ_f V_f K(r − r_f) / (2 π r), K the hat of half-width ``half`` [m] and unit
-    integral (the depth integrated over the track, ∫ depth 2 π r dr, is Σ V_f)."""
-    r, src, v = (np.asarray(a, dtype=float) for a in (radius, source_radius, volume))
-    out = np.empty(r.size)
-    for i in range(0, r.size, 256):                                    # rows in blocks: memory O(256 n)
-        hat = np.clip(1.0 - np.abs(r[i:i + 256, None] - src[None, :]) / half, 0.0, None) / half
-        out[i:i + 256] = hat @ v / (2 * np.pi * r[i:i + 256])
-    return out
 
 
 def check_zone_size(grid, areas, name: str, key: str) -> None:

@@ -70,9 +70,9 @@ EFFECTS: dict[str, Effect] = {
     "roughness": Effect("rough interface: per-zone homogenized laws from micro patches "
                         "([roughness], [micro])", ("contact",)),
     "layers": Effect("layered near-surface material in the micro models ([layers])", ("roughness",)),
-    "wear": Effect("Archard wear of the rough zones ([wear]; a step's wear held in series with the zone laws, "
-                   "the topographies worn after it), and of a counter-face whose material gives k_w",
-                   ("roughness", "friction")),
+    "wear": Effect("Archard wear ([wear]) of the rough zones (a step's wear held in series with the zone laws, the "
+                   "topographies worn after it) or, in perfect contact, of the interface facets (their gaps opened), "
+                   "and of a counter-face whose material gives k_w", ("friction",)),
     "plasticity": Effect("elastic-perfectly-plastic asperities: micro pressures bounded by the hardness of the "
                          "softer body of each rough interface (materials.<name>.hardness, constant or H(T)); "
                          "yielded zones keep their permanent deformation", ("roughness",)),
@@ -244,10 +244,10 @@ class Scene:
 
     @property
     def rough_material(self) -> str | None:
-        """The rough body's material at the first rough interface (one pair over them all,
-        ``scene_rough.rough_rules``), None without a rough interface."""
-        rough = self.rough_interfaces
-        return self.geometry.spec.interface_materials(rough[0])[0] if rough else None
+        """The worn body's material: at the first rough interface (one pair over them all,
+        ``scene_rough.rough_rules``), or with wear in perfect contact at the first interface; else None."""
+        worn = self.rough_interfaces or (tuple(self.geometry.spec.interfaces) if self.has("wear") else ())
+        return self.geometry.spec.interface_materials(worn[0])[0] if worn else None
 
     @property
     def rough_material_wears(self) -> bool:

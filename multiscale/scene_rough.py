@@ -111,6 +111,12 @@ def perfect_contact(scene, warnings_out: list) -> list[str]:
 STIFF_PENALTY = 1e4   # a penalty above this many times E*/h is warned about (ill-conditioned tangent)
 
 
+def contact_modulus(sides) -> float:
+    """E* [Pa] of two materials (constants: ``Material.at``): 1/E* = (1 - nu_0^2)/E_0 + (1 - nu_1^2)/E_1
+    (Johnson 1985, Eq. 4.22)."""
+    return 1.0 / sum((1.0 - m.nu ** 2) / m.E for m in sides)
+
+
 def penalty_range(scene, spec, effects) -> list[str]:
     """A perfect-contact penalty K_n [Pa/m] below E*/h on an interface of ``spec`` (the
     ``GeometrySpec``) in perfect contact, E* the contact modulus of its two materials at the initial
@@ -133,8 +139,8 @@ def penalty_range(scene, spec, effects) -> list[str]:
         try:
             if name in scene.rough_interfaces or h is None:
                 continue
-            sides = [scene.materials[m].at(scene.time.initial_temperature) for m in spec.interface_materials(name)]
-            modulus = 1.0 / sum((1.0 - m.nu ** 2) / m.E for m in sides)
+            modulus = contact_modulus([scene.materials[m].at(scene.time.initial_temperature)
+                                       for m in spec.interface_materials(name)])
         except (AttributeError, KeyError, StopIteration, TypeError):   # a partial scene: reported elsewhere
             continue
         if K < modulus / h:

@@ -286,7 +286,9 @@ def _effect_line(scene: Scene, effect: str) -> str:
         if not constant or scene.rough_material_wears:                         # a table (or the material's)
             law += (", a table's T each face's macro temperature" if w.temperature == "macro" else
                     ", a table's T the rough surface's local one, macro + flash") + " (wear.temperature),"
-        return (f"Archard dh = {law} every {w.update_every} step(s) in {w.substeps} increment(s){both}; "
+        increments = f"in {w.substeps} increment(s)" if scene.has("roughness") else \
+            "per interface facet (perfect contact: its gap opens), in the increments that keep it stable"
+        return (f"Archard dh = {law} every {w.update_every} step(s) {increments}{both}; "
                 f"{rate} (k_w per frictional work, k per normal load: a specific wear rate k is k_w = k/mu)")
 
     return EFFECTS[effect].doc

@@ -37,7 +37,9 @@ class Wear:
     measured against one temperature: a fade table reads the mean of the two faces'). Every ``update_every`` macro steps (and at the last
     step, and a step ending at a stop) the zones wear over the sliding since, weighted by the load factor
     (none while released), in at least ``substeps`` (and 2) implicit increments, raised while their error
-    estimate exceeds ``micro.wear.WEAR_TOL``; a counter-face whose material gives ``k_w`` wears too."""
+    estimate exceeds ``micro.wear.WEAR_TOL``; a counter-face whose material gives ``k_w`` wears too.
+    Without effect "roughness" the interface facets wear (``macro.facet_wear``: at their face
+    temperatures, their gaps opened, in the increments that keep the explicit update stable)."""
 
     k_w: float | None = key(Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9)), absent=_RULE)
     k_w_table: tuple | None = key(Curve(TEMPERATURE, _PER_WORK, "temperature", "k_w"), absent=_RULE)
@@ -48,6 +50,12 @@ class Wear:
     substeps: int = key(Integer(ge=1), default=1)                             # wear increments per update
 
     rules = (OneOf(("k_w", "k_w_table", "specific_rate", "specific_rate_table")),)
+
+    def problems(self, path, ctx):
+        if "roughness" not in ctx.effects and self.substeps != 1:      # (perfect contact: macro.facet_wear)
+            ctx.warnings.append(f"{path}.substeps is ignored in perfect contact: the facets' wear takes the "
+                                "increments that keep it stable")
+        return []
 
     @property
     def given(self) -> str | None:

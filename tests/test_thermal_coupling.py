@@ -16,7 +16,7 @@ from multiscale.micro.kernels import HalfSpace  # noqa: E402
 from multiscale.micro.post_analysis import Heating, PostAnalysis  # noqa: E402
 from multiscale.micro.surface import Surface, fractal_surface  # noqa: E402
 from multiscale.micro.zones import cut_zones  # noqa: E402
-from multiscale.rough import track_spread  # noqa: E402
+from multiscale.macro.facet_wear import track_spread  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
 from test_coupling import POD  # noqa: E402
 

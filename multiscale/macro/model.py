@@ -98,6 +98,9 @@ class MacroModel:
     stale: bool = False
     notes: list = field(default_factory=list)          # what the run's warnings add (an unbalanced clamp, Mechanics.notes)
     probes: Probes | None = None                       # thermocouples: ``probe_temperature_<name>`` columns
+    # per facet since the last wear update (``facet_wear.FacetWear`` sets it; None: not summed): the frictional work
+    # mu p |w| ds dA [J], p |w| ds dA [N m] and the load-weighted sliding ds of body 1 [rad or m]
+    exposure: np.ndarray | None = None
 
     @property
     def contact(self):
@@ -175,7 +178,12 @@ class MacroModel:
             # the frictional work of the substep with the pressure and the sliding its heat step takes
             slid = self.sliding(t0, t1)
             if slid:                                # (at rest or released: no work, no assembly)
-                self.work_step += self.sliding_power() * slid
+                power = self.facet_sliding_power()
+                self.work_step += power.sum() * slid
+                if self.exposure is not None:       # (mu = 0: no work, no load counted)
+                    mu = self.tm.interface.values(self.contact.friction)
+                    self.exposure += slid * np.stack([power, np.divide(power, mu, out=np.zeros(mu.shape), where=mu > 0),
+                                                      np.ones(mu.shape)])
             if self.thermal is not None:
                 # the pressure was solved at the load factor of the step's start: the conductance
                 # scales with the mean factor over the step (a release inside it, a load ramp), the

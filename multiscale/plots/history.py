@@ -39,8 +39,10 @@ def column_label(key: str) -> str:
     if key.startswith("probe_temperature_"):          # a probe's own name, whole
         return key.removeprefix("probe_temperature_").replace("_", " ")
     face = key.startswith("face_max_temperature_")
+    if key in ("wear_max_depth", "counter_wear_max_depth"):
+        return "body 1's track" if key.startswith("counter") else "body 0"
     for prefix in ("max_temperature_", "heat_total_", "heat_conducted_total_", "stored_heat_", "heat_lost_total_",
-                   "frictional_heat_total_", "face_max_temperature_", "friction_coefficient_"):
+                   "frictional_heat_total_", "face_max_temperature_", "friction_coefficient_", "wear_volume_"):
         key = key.removeprefix(prefix)
     key = key.partition("_part_")[2] or key
     words = lambda name: name.replace("_", " ")
@@ -123,7 +125,7 @@ def curve_styles(keys, palette: dict | None = None) -> tuple[list[dict], list]:
 def history_figure(history, path: Path, title: str = "") -> Path:
     """PNG of the history: force, max pressure, the speed, max temperatures, heat per body (and the friction
     coefficient with fade or mu(v), the slip speeds with mu(v), the braking torque of a rotating body, the probes'
-    temperatures, per interface, max face temperatures, stored heat per part) vs time."""
+    temperatures, per interface, max face temperatures, stored heat per part, the worn volume and depth) vs time."""
     t = history["time"]
     bodies = [k.removeprefix("heat_total_") for k in history.columns if k.startswith("heat_total_")]
     heat = [prefix + b for b in bodies for prefix in HEAT_KINDS if prefix + b in history.columns]
@@ -144,7 +146,11 @@ def history_figure(history, path: Path, title: str = "") -> Path:
               ("max face temperature [°C]", [k for k in history.columns if k.startswith("face_max_temperature_")],
                1.0, -273.15),
               ("heat stored in each part [J]",
-               [k for k in history.columns if k.startswith("stored_heat_") and "_part_" in k], 1.0, 0.0)]
+               [k for k in history.columns if k.startswith("stored_heat_") and "_part_" in k], 1.0, 0.0),
+              ("wear volume [mm³]", [k for k in history.columns if k.startswith("wear_volume_")]
+               or [k for k in ("wear_volume",) if k in history.columns], 1e9, 0.0),             # (its interfaces')
+              ("max wear depth [µm]", [k for k in ("wear_max_depth", "counter_wear_max_depth") if k in history.columns],
+               1e6, 0.0)]
     groups = [g for g in groups if g[1] and all(k in history.columns for k in g[1])]
     rows = 1 if len(groups) <= 4 else 2
     cols = -(-len(groups) // rows)

@@ -38,6 +38,7 @@ from multiscale.errors import InputError
 from multiscale.geometry import Rotation
 from multiscale.io import reporter
 from multiscale.macro import mesh as two_body
+from multiscale.macro.facet_wear import FacetRate, FacetWear
 from multiscale.macro.friction import FacetFriction, StribeckFriction, TableFriction
 from multiscale.macro.interface import PenaltyLaw, SumLaw
 from multiscale.macro.kept_cells import SolverOptionWarning
@@ -47,8 +48,10 @@ from multiscale.macro.model import Drive, MacroModel
 from multiscale.macro.probes import Probes, ProbeSpec
 from multiscale.macro.thermal import HeatStepWarning, Thermal, ThermalBoundary, temperature_functions
 from multiscale.memory import SPREAD, memory_available, micro_memory, remedy, run_memory
+from multiscale.micro.wear import WearRate
 from multiscale.scene_friction import bare_interfaces, initial_friction, speed_law_guess
 from multiscale.scene_geometry import scene_spec
+from multiscale.scene_rough import contact_modulus
 from multiscale.workflows.strain import last_forces
 
 
@@ -339,6 +342,26 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: b
             tm.interface.set_field(mech.contact.conductance, scene.interface.conductance)
     return MacroModel(tm, mech, heat, drive(scene, tm), partitions=shares, friction_law=friction_law(scene, tm),
                       probes=probes(scene, tm, T) if T is not None and scene.output.probes else None)
+
+
+def facet_wear(scene, model: MacroModel) -> FacetWear:
+    """The Archard wear of the interface facets in perfect contact (effect "wear" without
+    "roughness"): body 0 on each interface by its material's k_w, else by [wear]'s rate (k_w, k per
+    normal load, their tables, the default table); body 1 whose material gives k_w (the first
+    interface's) wears its tracks. Each facet's contact stiffness is bounded by K_n in series with E*/sqrt(A_f) (E*
+    of the interface's materials at the initial temperature): the update's stable increments."""
+    tm, penalty = model.tm, scene.interface.penalty
+    rates, stiffness = [], np.zeros(tm.interface.n_facets)
+    counter = {scene.geometry.spec.interface_materials(name)[1] for name in tm.interface.tags}
+    for name, mask in tm.interface.masks().items():
+        worn = scene.materials[scene.geometry.spec.interface_materials(name)[0]]
+        rates.append(FacetRate(mask, WearRate(worn.wear_rate), False) if worn.k_w is not None else
+                     FacetRate(mask, WearRate(scene.wear.rate), scene.wear.per_load))
+        modulus = contact_modulus(interface_materials(scene, name))
+        stiffness[mask] = 1.0 / (1.0 / penalty + np.sqrt(tm.interface.areas[mask]) / modulus)
+    wearing = [m for m in sorted(counter) if scene.materials[m].k_w is not None]
+    return FacetWear(model, rates, stiffness, WearRate(scene.materials[wearing[0]].wear_rate) if wearing else None,
+                     temperature=scene.time.initial_temperature)
 
 
 def probes(scene, tm, temperatures) -> Probes:

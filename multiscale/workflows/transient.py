@@ -2,7 +2,8 @@
 without ``roughness`` or ``stability``.
 
 Builds the model (``workflows.model``), ramps the load, marches ``time.steps`` macro steps of
-``time.substeps`` sub-steps (only with effect ``thermal``; otherwise the one contact solve), and
+``time.substeps`` sub-steps (only with effect ``thermal`` or ``wear``: the facets' Archard wear,
+``macro.facet_wear``; otherwise the one contact solve), and
 writes ``history.h5``, ``history.png`` and the field files (``multiscale.outputs.plan``) into
 ``output.folder``; with steps, a checkpoint after each (``workflows.stepping``: ``--resume``).
 """
@@ -17,11 +18,12 @@ from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs
 from multiscale.errors import Interrupted
+from multiscale.macro.facet_wear import FacetWear
 from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.model import MacroModel
 from multiscale.workflows import stepping
-from multiscale.workflows.model import build_mesh, build_model, heat_warnings_as_notes, run_notes, say_clamp, \
-    say_load, say_model_size
+from multiscale.workflows.model import build_mesh, build_model, facet_wear, heat_warnings_as_notes, run_notes, \
+    say_clamp, say_load, say_model_size
 from multiscale.workflows.output import RunResult, fingerprint, totals
 from multiscale.workflows.strain import refuse_floating, say_at_once
 
@@ -57,28 +59,43 @@ def stopped_after(done: int, steps: int) -> str:
 
 
 class Marching:
-    """A perfect-contact model as ``stepping.march`` drives it: its macro steps, history rows and
-    checkpoints (the model's state, ``MacroModel.checkpoint_state``)."""
+    """A perfect-contact model as ``stepping.march`` drives it: its macro steps (with ``wear``, the
+    facets' Archard wear every ``wear.update_every`` steps and at the last), history rows and
+    checkpoints (the model's state, ``MacroModel.checkpoint_state``, and the wear's)."""
 
-    def __init__(self, scene, model: MacroModel):
-        self.scene, self.model, self.fingerprint = scene, model, fingerprint(scene)
+    def __init__(self, scene, model: MacroModel, wear: FacetWear | None = None):
+        self.scene, self.model, self.wear, self.fingerprint = scene, model, wear, fingerprint(scene)
 
     def step(self, n: int):
-        return self.model.macro_step(self.scene.time.dt, self.scene.time.substeps)
+        heat = self.model.macro_step(self.scene.time.dt, self.scene.time.substeps)
+        if self.wear is not None and (n % self.scene.wear.update_every == 0 or n == self.scene.time.steps):
+            self.wear.update()
+        return heat
 
     def record(self, heat) -> dict:
-        return self.model.record(heat)
+        return {**self.model.record(heat), **(self.wear.row() if self.wear is not None else {})}
 
     def save(self, path: Path, step: int, history: io.History) -> None:
         """Checkpoint after macro step ``step`` (collective; ``checkpoint.save_step``)."""
         attrs, arrays = self.model.checkpoint_state()
+        if self.wear is not None:
+            more, worn = self.wear.state()
+            attrs, arrays = {**attrs, **more}, {**arrays, **worn}
         checkpoint.save_step(path, self.model.tm.comm, step, history, self.fingerprint, attrs, arrays, self.model)
 
     def restore(self, path: Path) -> checkpoint.Restored:
         """State of the checkpoint ``path`` (collective)."""
         attrs, arrays = checkpoint.load(path, self.model.tm.comm, self.model.functions, self.fingerprint)
         self.model.restore_checkpoint(attrs, arrays)
+        if self.wear is not None:
+            self.wear.restore(attrs, arrays)
         return checkpoint.restored(attrs, arrays)
+
+
+def wear_fields(wear: FacetWear) -> dict:
+    """The interface fields of the facets' wear: ``wear_depth`` of body 0 and ``counter_wear_depth`` of
+    body 1 [m] (0 where it does not wear)."""
+    return {"wear_depth": lambda: wear.depth.copy(), "counter_wear_depth": lambda: wear.counter_depth.copy()}
 
 
 def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_WORLD, verbose: bool = True,
@@ -100,9 +117,10 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         model = build_model(scene, comm, tm=tm)
     say_model_size(tm, model.mechanics, model.thermal)
     say_load(scene, tm)
-    marching = Marching(scene, model)
+    wear = facet_wear(scene, model) if scene.has("wear") else None
+    marching = Marching(scene, model, wear)
     with closed_on_error(model, comm):           # a script going on after a failed run gets its communicators
-        steps = scene.time.steps if model.thermal is not None else 0
+        steps = scene.time.steps if model.thermal is not None or wear is not None else 0
         if resume:
             with io.stage("restoring the checkpoint"):
                 done, history = dataclasses.astuple(marching.restore(ckpt))
@@ -111,10 +129,11 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                 model.start()
             out.claim()                          # --overwrite: the earlier results go now, not before a failed start
             done, history = 0, io.History()
-            history.append(**model.record())
+            history.append(**marching.record((0.0, 0.0)))
         plan = outputs.plan(scene)
         writer = stepping.field_output(model, folder, plan.body_fields + plan.interface_fields, done=done,
-                                       steps=steps, every=scene.output.every, resume=resume)
+                                       steps=steps, every=scene.output.every, resume=resume,
+                                       extra=wear_fields(wear) if wear is not None else None)
         if not resume:                       # (the first solve's fields are written: also those of a run refused next)
             write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
             refuse_floating(scene, tm, history)

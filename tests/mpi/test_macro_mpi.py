@@ -131,3 +131,16 @@ def test_interface_midpoints_do_not_depend_on_the_ranks(tmp_path):
     world = build_mesh(s, MPI.COMM_WORLD).interface
     alone = build_mesh(s, MPI.COMM_SELF).interface
     np.testing.assert_array_equal(world.midpoints, alone.midpoints)
+
+
+def test_two_ranks_give_the_serial_facet_wear(tmp_path):
+    """Wear in perfect contact (``macro.facet_wear``: global per-facet arrays, a re-solve after each
+    update) and a wearing disc on two ranks: the serial history."""
+    def wearing(folder):
+        text = pin_on_disc(folder, name="wear_mpi", effects=("contact", "friction", "wear")).replace(
+            "partition = ", "# partition = ") + '\n[wear]\nk_w = "3e-13 1/Pa"\n'
+        return loads(text, overrides={"time.steps": 3, "time.end": "9 s", "materials.disc.k_w": "1e-14 1/Pa"})
+    parallel, serial = histories(wearing, MPI.COMM_WORLD.bcast(str(tmp_path), root=0))
+    assert serial["wear_substeps"][-1] >= 2 and serial["counter_wear_volume"][-1] > 0
+    for key in (k for k in serial if not solver_statistic(k)):
+        np.testing.assert_allclose(parallel[key], serial[key], rtol=1e-8, atol=1e-15, err_msg=key)
