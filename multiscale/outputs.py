@@ -15,8 +15,10 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from multiscale.geometry import Rotation
+from multiscale.scene_cycle import braking_phases, cycle_keys
 
 CHECKPOINT = "checkpoint.h5"      # a run's last macro step (``multiscale run --resume``, ``checkpointed``)
+APPLICATIONS = "applications.csv"     # a duty cycle's braking applications (``per_application``)
 # files of a run named without a body: a body of that name would write its fields over them
 OWN_FILES = {"interface": "interface.xdmf", "history": "history.h5", "zones": "zones.h5",
              "checkpoint": CHECKPOINT, "map": "map.h5"}
@@ -101,8 +103,22 @@ def analysis(scene) -> str:
 def checkpointed(scene) -> bool:
     """Whether a run of ``scene`` writes ``CHECKPOINT`` (``multiscale run --resume``): the multiscale
     loop, and a transient run with macro steps (effect thermal or wear); not the squeal analysis."""
-    kind = analysis(scene)
-    return kind == "multiscale" or (kind == "transient" and (scene.has("thermal") or scene.has("wear")))
+    return analysis(scene) == "multiscale" or marching(scene)
+
+
+def marching(scene) -> bool:
+    """Whether a run of ``scene`` takes macro steps (``time.steps``): with effect thermal or wear; not
+    the squeal analysis (else: the one contact solve)."""
+    return analysis(scene) != "squeal" and (scene.has("thermal") or scene.has("wear"))
+
+
+def per_application(scene) -> bool:
+    """Whether a run of ``scene`` writes ``APPLICATIONS`` (``multiscale.applications``): one with
+    macro steps and friction whose [loading] is a duty cycle (``scene_cycle.cycle_keys``) with a
+    braking phase before ``time.end``."""
+    ld = scene.loading
+    return (marching(scene) and scene.has("friction") and ld is not None and bool(cycle_keys(ld))
+            and bool(braking_phases(ld, scene.geometry.motion, scene.time.end)))
 
 
 def field_step(n: int, every: int, steps: int) -> bool:
@@ -113,9 +129,8 @@ def field_step(n: int, every: int, steps: int) -> bool:
 def output_times(scene) -> tuple[float, ...]:
     """Times [s] at which the fields are written: 0, then every ``output.every`` macro step and the
     last (squeal: the preload, 0)."""
-    kind, t = analysis(scene), scene.time
-    marching = scene.has("thermal") or scene.has("wear")
-    steps = t.steps if kind != "squeal" and marching else 0
+    t = scene.time
+    steps = t.steps if marching(scene) else 0
     times, now = [0.0], 0.0
     for n in range(1, steps + 1):
         now = step_time(now, t.dt)
@@ -189,6 +204,16 @@ def plan(scene) -> Plan:
         files["history.h5"] = ("scalar history per step (forces, pressures, temperatures, heat), unit per dataset"
                                + (f"; the probes' temperatures ({probes})" if probes else ""))
         files["history.png"] = "the history against time"
+    if per_application(scene):
+        rotating, bodies = scene.geometry.motion == "rotation", scene.bodies
+        files[APPLICATIONS] = ", ".join(
+            ["one row per braking application of the cycle (the last one partial if the run stopped inside it): "
+             "start and end time, speeds at both, duration, frictional energy, mean friction coefficient"]
+            + ["mean and peak braking torque"] * rotating
+            + [f"peak temperature of {bodies[0]} and {bodies[1]}"] * scene.has("thermal")
+            + ["worn volume"] * scene.has("wear")
+            + ["per interface its energy, mean friction coefficient and what else the history has of it"]
+            * (len(scene.geometry.spec.interfaces) > 1)) + " (SI, units in the header)"
     if checkpointed(scene):
         files[CHECKPOINT] = "the last macro step's state (multiscale run --resume)"
     if kind == "multiscale":

@@ -2,7 +2,7 @@
 load or speed profile, a vehicle stop and a speed-dependent convection table leave out of the run
 [0, time.end], and what the squeal analysis, which linearises one state, ignores of a cycle.
 The checks return one warning line per finding; ``braking_phases`` and ``largest_load_factor``
-read the cycle over the run's knots (``run_knots``)."""
+read the cycle over the run's knots (``run_knots``), ``loaded_sliding`` integrates it."""
 from __future__ import annotations
 
 import math
@@ -52,13 +52,36 @@ def largest_load_factor(ld, end: float) -> float:
     return max(ld.factor(t) for t in run_knots(ld, end))
 
 
+def cycle_keys(ld) -> list[str]:
+    """The keys that make [loading] a duty cycle: a load or a speed profile, a vehicle that slows
+    (a stop; a drag keeps its speed)."""
+    keys = [f"loading.{k}" for k in ("load_profile", "speed_profile") if getattr(ld, k) is not None]
+    return keys + (["loading.vehicle"] if ld.vehicle is not None and not ld.steady_speed else [])
+
+
+def speed(ld, motion: str, t: float) -> float:
+    """Body 1's speed at ``t`` [s]: rotating (``motion`` "rotation"), its angular speed [rad/s];
+    translating, ``sliding_speed`` [m/s] (0 at rest)."""
+    return ld.angular_speed(t) if motion == "rotation" else ld.sliding_speed or 0.0
+
+
+def loaded_sliding(ld, motion: str, t0: float, t1: float) -> float:
+    """The integral of load factor x ``speed`` over [t0, t1] [s] (rad or m; 0 if t1 <= t0): the
+    sliding that frictional heat and wear follow, exact for the piecewise-linear cycle."""
+    if t1 <= t0:
+        return 0.0
+    if motion == "rotation":
+        return ld.mean_sliding_factor(t0, t1) * (t1 - t0)
+    return ld.mean_factor(t0, t1) * (ld.sliding_speed or 0.0) * (t1 - t0)
+
+
 def braking_phases(ld, motion: str, end: float) -> list[tuple[float, float]]:
     """Intervals [t0, t1] of [0, ``end``] [s] with frictional heat: loaded (load factor > 0) and
     sliding (the rotating body's speed, or ``sliding_speed`` of a translating one, > 0). Both are
     piecewise linear and non-negative between the cycle's knots, so a piece is heated when their
     product is positive at its midpoint."""
     def heated(t):
-        return ld.factor(t) * (ld.angular_speed(t) if motion == "rotation" else ld.sliding_speed or 0.0) > 0
+        return ld.factor(t) * speed(ld, motion, t) > 0
 
     ts = run_knots(ld, end)
     phases = []
@@ -162,13 +185,11 @@ def squeal_state(ld, motion: str, friction: bool) -> list[str]:
     """The squeal analysis linearises one sliding state, the full load at the speed at t = 0: a duty
     cycle's rest is ignored, and at rest the preload has no friction (a speed profile from 0 rpm
     gave 0 unstable modes of the demo brake where 5 rad/s gives 4, silently: an adversarial test)."""
-    cycle = [f"loading.{k}" for k in ("load_profile", "speed_profile") if getattr(ld, k) is not None]
-    cycle += ["loading.vehicle"] if ld.vehicle is not None and not ld.steady_speed else []
-    speed = ld.angular_speed(0.0) if motion == "rotation" else ld.sliding_speed or 0.0
+    cycle, start = cycle_keys(ld), speed(ld, motion, 0.0)
     unit = "rad/s" if motion == "rotation" else "m/s"
     out = [f"{', '.join(cycle)}: the squeal analysis is of one state, the full load at the speed at t = 0 "
-           f"({speed:g} {unit}); the rest of the cycle is ignored"] if cycle else []
-    if friction and speed == 0.0:
+           f"({start:g} {unit}); the rest of the cycle is ignored"] if cycle else []
+    if friction and start == 0.0:
         out.append(f"the squeal analysis is at rest (speed 0 {unit} at t = 0): the preload has no friction, so no "
                    "friction-induced instability can be found; give the speed of the sliding state to analyse")
     return out

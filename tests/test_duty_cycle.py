@@ -87,22 +87,32 @@ def test_a_vehicle_stop_with_thermal_expansion_keeps_the_torque(tmp_path):
     assert np.ptp(h["interface_force"]) > 10 * TORQUE_TOL * h["interface_force"][0]
 
 
+# a cycle under a braking torque (``torque_cycle``): at rest and released, speeding up, braked to half
+# speed, released while coasting, braked to rest (s, rad/s and s, load factor)
+TORQUE, W0 = MASS * DECEL * WHEEL, V0 / WHEEL           # 30 N m, 33.3 rad/s
+CYCLE_SPEED = [(0.0, 0.0), (0.25, W0), (1.25, W0 / 2), (1.75, W0 / 2), (2.75, 0.0)]
+CYCLE_LOAD = [(0.0, 0.0), (0.25, 0.0), (0.26, 1.0), (1.25, 1.0), (1.26, 0.0), (1.75, 0.0), (1.76, 1.0)]
+
+
+def torque_cycle(folder):
+    """The scene of ``pod`` under ``TORQUE`` with the profiles ``CYCLE_SPEED`` and ``CYCLE_LOAD``, 11 steps
+    to 2.75 s (two applications: [0.25, 1.26] and [1.75, 2.75] s)."""
+    text = pod(folder).replace('rotation_speed = "200 rpm"\n', "").replace('normal_force = "200 N"\n', "")
+    return loads(text, overrides={
+        "loading.braking_torque": f"{TORQUE} N m", "loading.load_profile": [[f"{t} s", f] for t, f in CYCLE_LOAD],
+        "loading.speed_profile": [[f"{t} s", f"{w} rad/s"] for t, w in CYCLE_SPEED], "time.end": "2.75 s",
+        "time.steps": 11})
+
+
 def test_a_cycle_under_a_braking_torque_holds_the_moment_and_turns_its_work_into_heat(tmp_path):
     """loading.braking_torque T with speed and load profiles (a cycle the vehicle section cannot
-    write: at rest and released, speeding up, braked to half speed, released while coasting,
-    braked to rest): the clamp force is scaled so that the friction moment is T while braked and
+    write, ``torque_cycle``): the clamp force is scaled so that the friction moment is T while braked and
     sliding (0 released or at rest), from rest once sliding starts, and the frictional heat is
     T times the integral of load factor x angular speed (trapezoids on 1 us, independent of the
     run's exact means). Before, a cycle took a fixed clamp force (docs/tutorials/braking_cycle.rst)."""
     from multiscale.macro.preload import TORQUE_TOL
-    torque, w0 = MASS * DECEL * WHEEL, V0 / WHEEL           # 30 N m, 33.3 rad/s
-    speed = [(0.0, 0.0), (0.25, w0), (1.25, w0 / 2), (1.75, w0 / 2), (2.75, 0.0)]
-    load = [(0.0, 0.0), (0.25, 0.0), (0.26, 1.0), (1.25, 1.0), (1.26, 0.0), (1.75, 0.0), (1.76, 1.0)]
-    text = pod(tmp_path / "cycle").replace('rotation_speed = "200 rpm"\n', "").replace('normal_force = "200 N"\n', "")
-    scene = loads(text, overrides={
-        "loading.braking_torque": f"{torque} N m", "loading.load_profile": [[f"{t} s", f] for t, f in load],
-        "loading.speed_profile": [[f"{t} s", f"{w} rad/s"] for t, w in speed], "time.end": "2.75 s", "time.steps": 11})
-    h = run(scene, verbose=False).history
+    torque, speed, load = TORQUE, CYCLE_SPEED, CYCLE_LOAD
+    h = run(torque_cycle(tmp_path / "cycle"), verbose=False).history
     t = np.linspace(0.0, 2.75, 2_750_001)
     power = np.interp(t, *zip(*load)) * np.interp(t, *zip(*speed))
     work = torque * np.sum(0.5 * (power[1:] + power[:-1]) * np.diff(t))

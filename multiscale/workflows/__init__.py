@@ -5,7 +5,8 @@ output-folder check, ``RunResult``) and one workflow per analysis: ``transient``
 with perfect contact), ``multiscale`` (the multiscale loop, effect ``roughness``) and ``squeal``
 (complex eigenvalues, effect ``stability``). ``run`` dispatches a scene to its workflow, prints one
 line per stage on rank 0 (``multiscale.io.Reporter``) and completes the results folder with its
-provenance (``multiscale.provenance``) and a pvpython script (``multiscale.outputs``).
+provenance (``multiscale.provenance``), a pvpython script (``multiscale.outputs``) and, for a duty
+cycle, its braking applications (``multiscale.applications``).
 """
 from __future__ import annotations
 
@@ -16,6 +17,7 @@ import numpy as np
 from mpi4py import MPI
 
 from multiscale import checkpoint, io, outputs, provenance
+from multiscale.applications import summary
 from multiscale.errors import InputError, Interrupted, SceneError, interrupted
 from multiscale.micro.laws import RESOLUTION
 from multiscale.micro.wear import SUBSTEP_TOL
@@ -25,7 +27,7 @@ from multiscale.scene_sections import Material
 from multiscale.scene_values import HOTTEST
 from multiscale.workflows import multiscale, squeal, transient
 from multiscale.workflows.model import interface_materials
-from multiscale.workflows.output import RunResult
+from multiscale.workflows.output import RunResult, write_applications
 from multiscale.workflows.strain import overloaded, unloaded
 
 
@@ -41,7 +43,9 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     (``outputs.checkpointed``).
 
     Besides the analysis' results, the folder receives ``scene.toml``, ``scene_resolved.toml``,
-    ``provenance.json`` (also after a failure, once the run has written into the folder) and ``open_in_paraview.py``.
+    ``provenance.json`` (also after a failure, once the run has written into the folder), ``open_in_paraview.py``
+    and, for a duty cycle (``outputs.per_application``), ``applications.csv`` (also after a Ctrl-C: the
+    applications of the history written), its table in the summary.
     ``verbose``: stage lines and the summary on rank 0; ``warn``: the warnings on stderr (rank 0, the
     scene's first; ``result.warnings`` and provenance.json hold them all, whatever ``warn``)."""
     if not all(hasattr(scene, a) for a in ("has", "effects", "output")):
@@ -83,9 +87,13 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                         _write_script(reporter.folder, scene)
                     elif stopped:                             # a step abandoned: the plots of what was written
                         _abandoned(reporter.folder, scene)
+                    if stopped and outputs.per_application(scene):     # the applications it completed
+                        written = _written_history(reporter.folder)
+                        if written is not None:
+                            write_applications(scene, written, reporter.folder)
                 except BaseException as lost:                 # not at the record's cost (a further Ctrl-C too)
-                    reporter.warn(f"the figures or the ParaView script of this run were not written "
-                                  f"({type(lost).__name__}: {lost})")
+                    reporter.warn(f"the figures, {outputs.APPLICATIONS} or the ParaView script of this run were not "
+                                  f"written ({type(lost).__name__}: {lost})")
                 try:
                     provenance.write(reporter.folder, scene, ranks=comm.size, started=started,
                                      stages=reporter.times, wall_time=time.perf_counter() - start, analysis=kind,
@@ -101,9 +109,11 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             raise
     result.files += [f.with_suffix(".h5") for f in result.files if f.suffix == ".xdmf"]   # their data
     if ended:                 # --resume of a finished run: nothing to do, its provenance stays as it was
-        result.files += [result.folder / name for name in [*outputs.PROVENANCE, *outputs.SCRIPT]
+        result.files += [result.folder / name for name in [*outputs.PROVENANCE, *outputs.SCRIPT, outputs.APPLICATIONS]
                          if (result.folder / name).is_file()]
         return result
+    if outputs.per_application(scene):
+        _applications(scene, result, comm, verbose)
     # said as the run went (the memory estimate, the first contact solve's load: rank 0's), then what the
     # results leave out (also when quiet); all in the record and the result (the first were lost: a review)
     during = comm.bcast(reporter.said[len(scene.warnings):], root=0)
@@ -121,6 +131,17 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     result.files += comm.bcast(io.on_root(comm, write, f"the provenance into {result.folder}"), root=0)
     result.warnings = (*scene.warnings, *beyond)
     return result
+
+
+def _applications(scene, result, comm, verbose: bool) -> None:
+    """``applications.csv`` of a finished run (rank 0 writes it: ``workflows.output.write_applications``),
+    in ``result.files``, and its table in the run's summary (``verbose``)."""
+    apps = io.on_root(comm, lambda: write_applications(scene, result.history, result.folder),
+                      f"{outputs.APPLICATIONS} into {result.folder}")
+    if comm.bcast(bool(apps), root=0):
+        result.files.append(result.folder / outputs.APPLICATIONS)
+    if verbose and apps:                   # (rank 0's)
+        print("\n".join(summary(apps, scene.geometry.motion)))
 
 
 def _write_script(folder: Path, scene) -> list[Path]:

@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from multiscale import checkpoint, io, outputs, provenance
+from multiscale.applications import applications, hottest_columns, write_csv
 from multiscale.errors import InputError, SceneError
 from multiscale.geometry import MAX_CELLS
 
@@ -38,11 +39,22 @@ def totals(history) -> str:
     heat = [k for k in cols if k.startswith("heat_total_")]
     out = [f"frictional work {last('frictional_work'):.4g} J" if "frictional_work" in cols else
            f"frictional heat {sum(last(k) for k in heat):.4g} J" if heat else ""]
-    hot = [k for k in cols if k.startswith("max_temperature_")]       # a body's, not its parts' or materials'
-    bodies = [k for k in hot if not any(k.startswith(j + s) for j in hot for s in ("_in_", "_part_"))]
-    out += [f"hottest {k.removeprefix('max_temperature_')} {max(history[k]) - 273.15:.4g} degC" for k in bodies]
+    out += [f"hottest {k.removeprefix('max_temperature_')} {max(history[k]) - 273.15:.4g} degC"
+            for k in hottest_columns(cols)]
     out += [f"wear volume {last('wear_volume') * 1e9:.4g} mm^3"] if "wear_volume" in cols else []
     return ", ".join(o for o in out if o)
+
+
+def write_applications(scene, history, folder: Path) -> list:
+    """``applications.csv`` in ``folder``: the braking applications of ``scene``'s cycle that ``history``
+    reached (``multiscale.applications``; call on rank 0, for a scene of ``outputs.per_application``);
+    none reached, no file. Returns them."""
+    motion = scene.geometry.motion
+    apps = applications(history, scene.loading, motion, scene.time.end)
+    if apps:
+        with io.replacing(Path(folder) / outputs.APPLICATIONS) as part:
+            write_csv(apps, motion, part)
+    return apps
 
 
 @dataclass
