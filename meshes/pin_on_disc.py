@@ -7,7 +7,8 @@ steel pin-housing (a sleeve) and its top is bonded, like the housing, to a thin 
 along the sliding direction y. The plate's extremities (faces y = ±plate_length/2) carry the normal
 load along −z and are held laterally (x, y), as on the bench; the disc's bore is clamped. Body 0 is
 pin + housing + plate (regions with materials "pin", "disc", "disc": the holder parts are steel,
-Table 7.2 "other components"; a scene's ``geometry.materials`` gives them others), body 1 the disc. The thesis does not give the disc, pin, housing
+Table 7.2 "other components"; a scene's ``geometry.part_materials``
+gives them others), body 1 the disc. The thesis does not give the disc, pin, housing
 and plate thicknesses: the defaults below are plausible bench values.
 
 At (track_radius, 0) the disc moves along +y, so the leading edge of the pin (where disc material

@@ -123,8 +123,8 @@ def _section(name, parser, v) -> dict:
             return {**_table(FileGeometry, v.params), **limit}
         params = {k: (x if isinstance(x, int) else float(x), "") for k, x in v.resolved().items()}
         motion = v.spec.motion       # the axis as turned (geometry.axis) and every part's material
-        axis = {"axis": ([float(a) for a in motion.axis], "")} if isinstance(motion, Rotation) else {}
-        materials = {"materials": {r.name: (r.material, "") for b in v.spec.bodies for r in b.regions}}
+        axis = {"axis": ([float(a) + 0.0 for a in motion.axis], "")} if isinstance(motion, Rotation) else {}   # not -0
+        materials = {"part_materials": {r.name: (r.material, "") for b in v.spec.bodies for r in b.regions}}
         return {"builder": (v.builder, ""), **params, **axis, **limit, **materials}
     if name == "interfaces":
         out = {}

@@ -128,7 +128,7 @@ def _geometry() -> list[str]:
             ("``geometry.max_cells``", _cell(f"{Integer(ge=1).describe()}: {MAX_CELLS_TEXT}"), "-", show(MAX_CELLS),
              " ", "any"),
             ("``geometry.axis``", _cell(f"[x, y, z]: {BUILDER_AXIS_TEXT}"), "-", " ", " ", "any"),
-            ("``geometry.materials``", _cell(BUILDER_MATERIALS_TEXT), "-", " ", " ", "any")]
+            ("``geometry.part_materials``", _cell(BUILDER_MATERIALS_TEXT), "-", " ", " ", "any")]
     lines = ["[geometry]", "-" * 10, "", _paragraph(" ".join(GeometrySection.__doc__.split())), ""] + _list_table(rows)
     for name in section.builders.options:
         module = builder(name)
@@ -191,7 +191,7 @@ def key_paths(cls=Scene, path: str = "") -> list[str]:
         where = f"{path}.{name}" if path else name
         parser = spec.parser
         if isinstance(parser, GeometrySection):
-            out += ["geometry.builder", "geometry.max_cells", "geometry.materials"]
+            out += ["geometry.builder", "geometry.max_cells", "geometry.part_materials"]
             out += [f"geometry.{k}" for b in parser.builders.options for k in builder(b).DEFAULTS]
             out += key_paths(FileGeometry, "geometry")
         elif where == "interfaces":

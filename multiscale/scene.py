@@ -442,8 +442,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
             warnings += micro_constants(scene) + zone_sizes(scene) + law_top_warnings(scene) + (
                 speed_law_zeros(scene) if "friction" in effects else [])
     if scene.output is not None:
-        more, unused = output_problems(scene.output, g.bodies if g is not None else None,
-                                       g is not None and g.motion == "rotation", effects)
+        more, unused = output_problems(scene.output, g.bodies if g is not None else None, {} if g is None else {
+            r.name: b.name for b in g.spec.bodies for r in b.regions}, g is not None and g.motion == "rotation", effects)
         problems += more
         warnings += unused
     for section, spec in fields_of(Scene):

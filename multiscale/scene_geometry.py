@@ -256,7 +256,7 @@ class GeometrySection(Section):
     whose parameters (lengths in m, SI defaults below) are the allowed keys, ``mesh_size`` and the
     other ``*_mesh_size`` the cell sizes; or ``file`` gives the user's own geometry (CAD or gmsh:
     the keys under file = "..."). ``max_cells`` bounds the mesh, ``axis`` turns a rotating body the
-    other way, ``materials`` gives a builder's parts other materials than its own."""
+    other way, ``part_materials`` gives a builder's parts other materials than its own."""
 
     def __init__(self):
         super().__init__(Geometry)
@@ -270,7 +270,7 @@ class GeometrySection(Section):
         lines = [f"  {'builder':<20}  {self.builders.describe()}  [or file]",
                  f"  {'max_cells':<20}  integer >= 1, default {MAX_CELLS}: {MAX_CELLS_TEXT}",
                  f"  {'axis':<20}  [x, y, z]: {BUILDER_AXIS_TEXT}",
-                 f"  {'materials':<20}  {BUILDER_MATERIALS_TEXT}"]
+                 f"  {'part_materials':<20}  {BUILDER_MATERIALS_TEXT}"]
         for name in self.builders.options:
             module = builder(name)
             lines.append(f"  builder = \"{name}\" parameters (SI defaults; 0 = the builder's fallback):")
@@ -300,7 +300,7 @@ class GeometrySection(Section):
             ctx.problems.append(f"{path}.builder = {show(raw['builder'])}: {exc}")
             return None
         before = len(ctx.problems)
-        given = {k: v for k, v in raw.items() if k not in ("builder", "axis", "materials")}
+        given = {k: v for k, v in raw.items() if k not in ("builder", "axis", "part_materials")}
         axis = parse(_DIRECTION, raw["axis"], f"{path}.axis", ctx) if "axis" in raw else None
         unknown_keys(given, module.DEFAULTS, path, ctx, f'parameter of builder "{name}"')
         params = {}
@@ -314,8 +314,8 @@ class GeometrySection(Section):
         if len(ctx.problems) > before:
             return None
         geometry = self._describe(name, module, FrozenMap(params), params, ctx)
-        if geometry is not None and "materials" in raw:
-            geometry = self._materials(geometry, raw["materials"], f"{path}.materials", ctx)
+        if geometry is not None and "part_materials" in raw:
+            geometry = self._materials(geometry, raw["part_materials"], f"{path}.part_materials", ctx)
         return geometry if geometry is None or axis is None else self._turned(geometry, axis, path, ctx)
 
     @staticmethod

@@ -25,11 +25,11 @@ class Probe:
     column ``probe_temperature_<name>`` (with effect "thermal"). The rotating body's heat is solved in
     a fixed frame: there a probe stays at its place in space (a rubbing thermocouple, a pyrometer's
     spot) unless it ``turns`` with the body (a thermocouple embedded in the disc): the mean round its
-    circle about the axis (``multiscale.macro.probes``). The run says each probe's body, part and
-    distance from the interface."""
+    circle about the axis (``multiscale.macro.probes``). ``body`` may name a part of a body (a pad,
+    not its backplate). The run says each probe's body, part and distance from the interface."""
 
     point: tuple | None = key(POINT, required=True)        # m, [x, y, z]
-    body: str | None = key(Text(), absent="the body holding the point (on the interface: give it)")
+    body: str | None = key(Text(), absent="the body holding the point (on the interface: give it); or a part")
     turns: bool = key(Flag(), default=False)                # embedded in the rotating body, turning with it
 
 
@@ -50,9 +50,11 @@ class Output:
     probes: FrozenMap = key(Named(Probe), default=FrozenMap())
 
 
-def output_problems(output: Output, bodies: tuple | None, rotating: bool, effects) -> tuple[list[str], list[str]]:
+def output_problems(output: Output, bodies: tuple | None, parts: dict, rotating: bool,
+                    effects) -> tuple[list[str], list[str]]:
     """(problems, warnings) of ``output`` against the geometry's ``bodies`` (stationary, moving;
-    None: unknown), whether the moving one ``rotating``, and the active ``effects``."""
+    None: unknown) and ``parts`` (their regions: part name -> body name), whether the moving one
+    ``rotating``, and the active ``effects``."""
     problems = [f'output.fields: "{f}" needs effect "{missing[0]}" (not in effects)' for f in output.fields or ()
                 if (missing := [e for e in OUTPUT_FIELDS[f] if e not in effects])]
     if output.probes and ("thermal" not in effects or "stability" in effects):
@@ -64,10 +66,11 @@ def output_problems(output: Output, bodies: tuple | None, rotating: bool, effect
             problems.append(f"{where}: the name {problem}")
         if p is None or bodies is None:
             continue
-        if p.body is not None and p.body not in bodies:
-            problems.append(f'{where}.body = "{p.body}": not a body; allowed: {", ".join(bodies)}')
+        owner = {**parts, **{b: b for b in bodies}}
+        if p.body is not None and p.body not in owner:
+            problems.append(f'{where}.body = "{p.body}": not a body or a part; allowed: {", ".join(owner)}')
         elif p.turns and not rotating:
             problems.append(f"{where}.turns: the geometry has no rotating body to turn with")
-        elif p.turns and p.body not in (None, bodies[1]):
+        elif p.turns and owner.get(p.body, bodies[1]) != bodies[1]:
             problems.append(f'{where}.turns: only a probe of the rotating body "{bodies[1]}" turns')
     return problems, []

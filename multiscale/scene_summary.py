@@ -380,6 +380,7 @@ def _surface(r) -> str:
     """A rough surface in words: generated (RMS, H; with patch "zone" its wavelengths per zone, which
     micro.zones changes: a trial's real area 0.0081 against 0.0057 m^2 at 2 x 2 and 4 x 4 zones) or
     measured (file, cover)."""
-    per_zone = ", wavelengths k_min..k_max per zone (patch = \"zone\": micro.zones changes the surface)"
-    return f"RMS {r.rms * 1e6:g} um, H {r.hurst:g}" + (per_zone if r.patch == "zone" else "") if r.rms is not None else \
+    per_zone = f", wavelengths from 1/{list(r.k_min)} to 1/{list(r.k_max)} of a zone (patch = \"zone\": micro.zones " \
+        "changes the surface)" if r.rms is not None and r.patch == "zone" else ""
+    return f"RMS {r.rms * 1e6:g} um, H {r.hurst:g}{per_zone}" if r.rms is not None else \
         f"file {r.file.name} ({r.cover}" + (f", seed {r.seed})" if r.cover == "equivalent" else ")")

@@ -532,7 +532,8 @@ def test_check_says_what_the_builders_sizes_mean():
     rough = next(line for line in lines if line.startswith("    roughness"))
     assert "RMS 10.35 um, H 0.6;" in rough                      # patch "face": the face's wavelengths
     zoned = summary(load(DEMOS / "railway_drag.toml"))           # patch "zone": micro.zones changes the surface
-    assert 'RMS 3 um, H 0.8, wavelengths k_min..k_max per zone (patch = "zone": micro.zones changes the surface);' \
+    assert 'RMS 3 um, H 0.8, wavelengths from 1/[1.0, 1.0] to 1/[8.0, 8.0] of a zone (patch = "zone": micro.zones ' \
+        'changes the surface);' \
         in next(line for line in zoned if line.startswith("    roughness"))
     text = (DEMOS / "car_brake_stop.toml").read_text().replace(
         '[loading.vehicle]\nspeed = "100 km/h"\ndeceleration = "0.6 gn"\nwheel_radius = "310 mm"\nmass = "525 kg"',
@@ -1826,13 +1827,13 @@ def test_an_rms_height_taller_than_the_interface_is_refused():
 
 
 def test_a_builders_parts_take_the_materials_the_scene_gives():
-    """geometry.materials gives a builder's parts other materials: the pin-on-disc's housing and plate
+    """geometry.part_materials gives a builder's parts other materials: the pin-on-disc's housing and plate
     took the disc's, with no key to give them their own (a trial). Unknown parts and a material
     without its table are refused; the resolved scene writes every part's material and the axis as
     turned, and reads back to the same geometry (the reversed axis of a builder was left out)."""
     from multiscale.provenance import resolved_toml
     steel = {"E": "210 GPa", "nu": 0.3, "kappa": "45 W/(m K)", "chi": "1.2e-5 m^2/s", "alpha": "1.2e-5 1/K"}
-    given = {"geometry.materials": {"housing": "steel", "plate": "steel"}, "materials.steel": steel}
+    given = {"geometry.part_materials": {"housing": "steel", "plate": "steel"}, "materials.steel": steel}
     scene = load(DEMOS / "pin_on_disc_perfect.toml", overrides=given)
     assert [(r.name, r.material) for r in scene.geometry.spec.bodies[0].regions] == [
         ("pin", "pin"), ("housing", "steel"), ("plate", "steel")]
@@ -1840,13 +1841,14 @@ def test_a_builders_parts_take_the_materials_the_scene_gives():
     again = loads(resolved_toml(scene), DEMOS)
     assert again.geometry.spec == scene.geometry.spec and again.materials == scene.materials
     with pytest.raises(SceneError) as err:
-        load(DEMOS / "pin_on_disc_perfect.toml", overrides={"geometry.materials": {"sleeve": "steel", "plate": "st/eel"}})
+        load(DEMOS / "pin_on_disc_perfect.toml",
+             overrides={"geometry.part_materials": {"sleeve": "steel", "plate": "st/eel"}})
     assert err.value.problems == [
-        'geometry.materials.sleeve: not a part of builder "pin_on_disc"; parts: pin, housing, plate, disc',
-        'geometry.materials.plate = "st/eel": the name must be letters, digits, _ - only (it names files, history '
+        'geometry.part_materials.sleeve: not a part of builder "pin_on_disc"; parts: pin, housing, plate, disc',
+        'geometry.part_materials.plate = "st/eel": the name must be letters, digits, _ - only (it names files, history '
         'columns and scene keys)']
     with pytest.raises(SceneError, match=r"materials\.steel"):
-        load(DEMOS / "pin_on_disc_perfect.toml", overrides={"geometry.materials": {"plate": "steel"}})
+        load(DEMOS / "pin_on_disc_perfect.toml", overrides={"geometry.part_materials": {"plate": "steel"}})
     reverse = load(DEMOS / "brake_squeal.toml", overrides={"geometry.axis": [0, 0, -1]})
     assert loads(resolved_toml(reverse), DEMOS).geometry.spec.motion.axis == (0.0, 0.0, -1.0) != \
         load(DEMOS / "brake_squeal.toml").geometry.spec.motion.axis

@@ -23,7 +23,7 @@ import numpy as np
 
 import dolfinx
 import ufl
-from dolfinx import fem, la
+from dolfinx import fem, geometry, la
 from dolfinx import mesh as dmesh
 from mpi4py import MPI
 
@@ -234,6 +234,18 @@ class Interface:
         self.comm.Allreduce(x.min(axis=0) if len(x) else np.full(x.shape[1], np.inf), lo, op=MPI.MIN)
         self.comm.Allreduce(x.max(axis=0) if len(x) else np.full(x.shape[1], -np.inf), hi, op=MPI.MAX)
         return lo, hi
+
+    def distance(self, points) -> float:
+        """The least distance [m] from ``points`` (n, 3) [m] to a facet of the interfaces (collective)."""
+        m, tdim = self.mesh, self.mesh.topology.dim
+        owned = np.arange(len(self.owned_index), dtype=np.int32)
+        d = np.inf
+        if len(owned):
+            points = np.asarray(points, dtype=float)
+            near = geometry.compute_closest_entity(geometry.bb_tree(m, tdim, entities=owned),
+                                                   geometry.create_midpoint_tree(m, tdim, owned), m, points)
+            d = float(np.sqrt(geometry.squared_distance(m, tdim, near, points).min()))
+        return self.comm.allreduce(d, op=MPI.MIN)
 
     def _owned_dofs(self, space=None) -> np.ndarray:
         n = len(self.owned_index)

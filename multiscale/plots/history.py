@@ -161,10 +161,11 @@ def history_figure(history, path: Path, title: str = "") -> Path:
     palette = body_colours(history.columns)
     for ax, (label, keys, scale, shift) in zip(axes, groups):
         styles, entries = curve_styles(keys, palette)
+        named = len(keys) > 1 or keys[0].startswith("probe_temperature_")     # (a probe's name: said only there)
         for k, (key, style) in enumerate(zip(keys, styles)):    # each curve thinner than the one before:
             wide = (len(keys) - 1 - k) / max(len(keys) - 1, 1)   # one on another (equal pads) stays seen
             ax.plot(t, history[key] * scale + shift, marker="o", ms=3 + 3 * wide, lw=1.2 + 2.4 * wide,
-                    label=column_label(key) if len(keys) > 1 else None, **style)
+                    label=column_label(key) if named else None, **style)
         ax.set_xlabel("time [s]")
         ax.set_ylabel(label)
         ax.grid(alpha=0.3)
@@ -172,7 +173,7 @@ def history_figure(history, path: Path, title: str = "") -> Path:
         if np.ptp(values) <= 1e-6 * np.abs(values).max(initial=0.0):     # constant to round-off
             centre = values.mean()
             ax.set_ylim(centre - 0.05 * abs(centre) - 1e-30, centre + 0.05 * abs(centre) + 1e-30)
-        if len(keys) > 1:
+        if named:
             handles = entries or ax.get_lines()
             ax.legend(handles=handles, fontsize="medium" if len(handles) <= LEGEND_ROWS else "x-small",
                       ncol=-(-len(handles) // LEGEND_ROWS))

@@ -323,6 +323,7 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: b
     if T is not None:
         for f in T:
             f.x.array[:] = t.initial_temperature
+    found = probes(scene, tm, T) if T is not None and scene.output.probes else None   # (refused: nothing to free)
     mech = build_mechanics(scene, tm, law=law, temperatures=T if scene.has("expansion") else None)
     heat, shares = None, {}
     if T is not None:
@@ -341,7 +342,7 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: b
         if scene.has("conductance") and scene.interface.conductance is not None:   # else per facet later
             tm.interface.set_field(mech.contact.conductance, scene.interface.conductance)
     return MacroModel(tm, mech, heat, drive(scene, tm), partitions=shares, friction_law=friction_law(scene, tm),
-                      probes=probes(scene, tm, T) if T is not None and scene.output.probes else None)
+                      probes=found)
 
 
 def facet_wear(scene, model: MacroModel) -> FacetWear:
@@ -366,20 +367,27 @@ def facet_wear(scene, model: MacroModel) -> FacetWear:
 
 def probes(scene, tm, temperatures) -> Probes:
     """The scene's thermocouples (``output.probes``) on the temperature functions; says where each
-    one reads (its body and part, its distance from the interface; in the rotating body whether it
-    turns with it or stays in place)."""
-    motion = tm.spec.motion
-    specs = [ProbeSpec(name, p.point, scene.bodies.index(p.body) if p.body is not None else None, p.turns)
-             for name, p in scene.output.probes.items()]
-    found = Probes(tm, temperatures, specs, motion if isinstance(motion, Rotation) else None)
+    one reads (its body and part, its distance from the interface, how far outside the meshed
+    surface; in the rotating body whether it turns with it or stays in place). A probe's ``body``
+    may name a part of a body (a pad against its backplate)."""
+    motion, specs = tm.spec.motion, []
+    parts = {r.name: i for i, b in enumerate(scene.geometry.spec.bodies) for r in b.regions}
+    for name, p in scene.output.probes.items():
+        body = scene.bodies.index(p.body) if p.body in scene.bodies else parts.get(p.body)
+        part = p.body if p.body is not None and p.body not in scene.bodies else None
+        specs.append(ProbeSpec(name, p.point, body, p.turns, part))
+    rotating = isinstance(motion, Rotation)
+    found = Probes(tm, temperatures, specs, motion if rotating else None)
     for where, spec in zip(found.located, specs):
-        body = tm.bodies[where.body]
-        part = f", part {where.part}" if len(body.spec.regions) > 1 else ""
-        moving = (" (turning with it: its circle's mean)" if spec.turns else " (fixed in space: a rubbing thermocouple "
-                  "or pyrometer; output.probes.<name>.turns for one embedded in it)") if where.body == 1 and \
-            isinstance(motion, Rotation) else ""
-        track = "the interfaces' track" if where.body == 1 and isinstance(motion, Rotation) else "the interface"
-        reporter().say(f"probe {where.name}: in {body.name}{part}{moving}, {where.depth * 1e3:.3g} mm from {track}")
+        body, turning = tm.bodies[where.body], where.body == 1 and rotating
+        said = [f"probe {where.name}: in {body.name}" + (f", part {where.part}" if len(body.spec.regions) > 1 else "")]
+        if turning:
+            said.append("turning with it: its circle's mean" if spec.turns else "fixed in space: a rubbing "
+                        "thermocouple or pyrometer; output.probes.<name>.turns for one embedded in it")
+        said.append(f"{where.depth * 1e3:.3g} mm from " + ("the interfaces' track" if turning else "the interface"))
+        if where.outside > 0:
+            said.append(f"{where.outside * 1e6:.3g} um outside the meshed surface, read in the closest cell")
+        reporter().say(", ".join(said))
     return found
 
 

@@ -205,7 +205,9 @@ def clear(folder: Path, existing: list[str]) -> None:
 
 
 def fingerprint(scene) -> checkpoint.Fingerprint:
-    """What the results depend on: the scene (not the output section, ``name``, ``description`` or
+    """What the results depend on: the scene (not the output section but its probes, whose history
+    columns a resumed run continues: one added failed in the history's first row, one moved mixed
+    two places in a column, a review; not ``name``, ``description`` or
     ``geometry.max_cells``, a limit on the mesh: a long-run trial's resume was refused for a
     changed description; effects sorted: a set's order changes between processes) and the bytes
     of every file it reads (a measured surface rewritten under the same name was resumed into
@@ -217,12 +219,14 @@ def fingerprint(scene) -> checkpoint.Fingerprint:
     source = scene.source.resolve() if scene.source is not None else None
     files = {p: checkpoint.file_digest(p) for p in sorted(p for p in scene.inputs if p != source and p.is_file())}
     resolved = tomllib.loads(provenance.resolved_toml(scene))
+    probes = {"output": {"probes": resolved.get("output", {}).get("probes", {})}}
     for key in ("output", "name", "description"):
         resolved.pop(key, None)
     resolved.get("geometry", {}).pop("max_cells", None)
-    inputs = {**_dotted(resolved), **{f"file {p}": digest for p, digest in files.items()}}
-    return checkpoint.Fingerprint(checkpoint.fingerprint(repr(s) + "".join(f"{p}:{d}" for p, d in files.items())),
-                                  inputs)
+    inputs = {**_dotted(resolved), **_dotted(probes), **{f"file {p}": digest for p, digest in files.items()}}
+    text = repr(s) + (repr(scene.output.probes) if scene.output.probes else "") + \
+        "".join(f"{p}:{d}" for p, d in files.items())
+    return checkpoint.Fingerprint(checkpoint.fingerprint(text), inputs)
 
 
 def _dotted(table: dict, prefix: str = "") -> dict[str, str]:

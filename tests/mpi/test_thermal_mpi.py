@@ -106,6 +106,6 @@ def test_a_probe_outside_the_bodies_is_refused_on_every_rank(tmp_path):
     base = MPI.COMM_WORLD.bcast(str(tmp_path), root=0)
     scene = loads(SCENE.format(folder=f"{base}/out"), overrides={"output.probes.in_flat.point": ["6 mm", "2 mm", "-9 mm"]})
     with pytest.raises(InputError, match=r"output.probes.in_flat.point: \[6.0, 2.0, -9.0\] mm is in neither 'block' "
-                                         r"nor 'flat' \('block' spans \[0.0, 0.0, 0.0\] to \[10.0, 10.0, 5.0\] mm; "
+                                         r"nor 'flat': 4 mm outside its meshed surface \('block' spans \[0.0, 0.0, 0.0\] to \[10.0, 10.0, 5.0\] mm; "
                                          r"'flat' spans \[0.0, 0.0, -5.0\] to"):
         build_model(scene)
