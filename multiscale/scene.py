@@ -431,7 +431,7 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
             rough = {scene.geometry.spec.interface_materials(n)[0] for n in scene.geometry.spec.interfaces}
             for name in sorted(rough):      # (a specific_rate too: the material's k_w won silently, a review)
                 if scene.wear.given and name in scene.materials and scene.materials[name].k_w is not None:
-                    problems.append(f"wear.{scene.wear.given}: the rough body's material gives k_w "
+                    problems.append(f"wear.{scene.wear.given}: the worn body's material gives k_w "
                                     f"(materials.{name}.k_w): give one of them")
         if not problems:
             problems += [str(e) for e in rough_rules(scene)] + (torque_problems(scene, g.spec.interfaces)
@@ -485,7 +485,8 @@ def _cross_checks(scene: Scene, raw: dict, ctx: Context) -> list[str]:
                      for phrase in scene.materials[name].beyond(T0).values()]
     if "wear" in effects and scene.wear is not None and g is not None and scene.materials is not None \
             and scene.time is not None and not scene.rough_material_wears:
-        warnings += default_wear_rate(scene) + scene.wear.held_ends(T0=scene.time.initial_temperature)
+        warnings += default_wear_rate(scene) + scene.wear.held_ends(T0=scene.time.initial_temperature,
+                                                                    rough=scene.has("roughness"))
     for i, b in enumerate(scene.boundary or (), 1):
         given = [k for k in Boundary.THERMAL if b is not None and getattr(b, k) is not None]
         if given and "thermal" not in effects:

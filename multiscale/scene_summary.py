@@ -284,8 +284,9 @@ def _effect_line(scene: Scene, effect: str) -> str:
         both = f"; the {scene.bodies[1]} wears too (k_w of its material)" if counter.k_w is not None else ""
         law = "k p ds" if w.per_load and not scene.rough_material_wears else "k_w mu p ds"
         if not constant or scene.rough_material_wears:                         # a table (or the material's)
-            law += (", a table's T each face's macro temperature" if w.temperature == "macro" else
-                    ", a table's T the rough surface's local one, macro + flash") + " (wear.temperature),"
+            law += (", a table's T each face's macro temperature" if w.temperature == "macro" or not
+                    scene.has("roughness") else ", a table's T the rough surface's local one, macro + flash") + \
+                " (wear.temperature),"
         increments = f"in {w.substeps} increment(s)" if scene.has("roughness") else \
             "per interface facet (perfect contact: its gap opens), in the increments that keep it stable"
         return (f"Archard dh = {law} every {w.update_every} step(s) {increments}{both}; "

@@ -75,16 +75,17 @@ class Wear:
         return value if value is not None else \
             tuple(zip(*(self.k_w_table or self.specific_rate_table or FIG_7_9_WEAR_RATE)))
 
-    @property
-    def read(self) -> str:
-        """The largest temperature a k_w(T) reads, in words (a run's warnings)."""
-        return "body's largest macro temperature" if self.temperature == "macro" else \
-            "surface's largest micro temperature"
+    def read(self, rough: bool = True) -> str:
+        """The largest temperature a k_w(T) reads, in words (a run's warnings): the rough surface's
+        micro one, or the worn body's macro one (``temperature = "macro"``, or in perfect contact)."""
+        return "the rough surface's largest micro temperature" if rough and self.temperature == "surface" else \
+            "the worn body's largest macro temperature"
 
-    def held_ends(self, T0: float | None = None, hottest: float | None = None) -> list[str]:
+    def held_ends(self, T0: float | None = None, hottest: float | None = None, rough: bool = True) -> list[str]:
         """The k_w(T) (or k(T)) table held at an end: below its first point at the initial temperature
-        ``T0`` (check), above its last at ``hottest`` [K] (the largest micro temperature, after a run);
-        [] with a constant rate (a run at 1 K or 3000 K wore at the end values without a word)."""
+        ``T0`` (check), above its last at ``hottest`` [K] (the largest temperature it read, ``read``,
+        after a run; ``rough``: the zones wear, else the facets in perfect contact); [] with a constant
+        rate (a run at 1 K or 3000 K wore at the end values without a word)."""
         if self.given in ("k_w", "specific_rate"):
             return []
         temperatures, rates = self.rate
@@ -94,9 +95,9 @@ class Wear:
         for T, where, end, rate, side, beyond in (
                 (T0, "the initial temperature", temperatures[0], rates[0], "below its first",
                  T0 is not None and T0 < temperatures[0]),
-                (hottest, f"the rough {self.read}", temperatures[-1], rates[-1],
+                (hottest, self.read(rough), temperatures[-1], rates[-1],
                  "above its last", hottest is not None and hottest > temperatures[-1])):
             if beyond:
                 out.append(f"{table}: {where}, {T - 273.15:.4g} degC, is {side} point {end - 273.15:.4g} degC: the "
-                           f"zones wear with {name} held at {rate:.3g} 1/Pa there")
+                           f"{'zones' if rough else 'facets'} wear with {name} held at {rate:.3g} 1/Pa there")
         return out

@@ -7,7 +7,7 @@ import pytest
 
 pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
 
-from multiscale.errors import SceneError  # noqa: E402
+from multiscale.errors import InputError, SceneError  # noqa: E402
 from multiscale.io import History, solver_statistic  # noqa: E402
 from multiscale.outputs import plan  # noqa: E402
 from multiscale.scene import loads  # noqa: E402
@@ -31,7 +31,7 @@ def test_the_facets_wear_archards_volume_of_the_work_and_of_the_load(tmp_path):
     same work, spread round its track. The work is the friction moment's: mu F r_eff omega t within
     its variation over the run (0.2 %)."""
     h = run(scene(tmp_path / "w", **{"materials.disc.k_w": "2e-14 1/Pa"}), verbose=False).history
-    assert list(h["wear_substeps"][1:]) == [1, 1, 1]
+    assert list(h["wear_substeps"]) == [0, 1, 1, 1] and h["wear_implicit_updates"][-1] == 0   # c K_n = 0.9 / 3
     work = h["frictional_work"]
     np.testing.assert_allclose(h["wear_volume"], 1e-14 * work, rtol=1e-12, atol=0)
     np.testing.assert_allclose(h["counter_wear_volume"], 2e-14 * work, rtol=1e-12, atol=0)
@@ -45,17 +45,18 @@ def test_the_facets_wear_archards_volume_of_the_work_and_of_the_load(tmp_path):
 def test_a_worn_in_pin_carries_its_load_as_one_over_the_radius(tmp_path):
     """Archard wear at k_w mu p omega r settles where every point wears alike (the worn face recedes
     as a whole): p r uniform, p = C / r. The coarse pin (20 mm at 80-100 mm, 2.5 mm facets), k_w =
-    3e-13 /Pa, 120 s at 200 rpm (17 um worn): its mean pressure in five bands of radius follows
-    1/r within 3 % (measured 2.3 %; at the start 0.84 to 0.43 MPa inside out, against 1/r's
-    0.55 to 0.46), the peak of the fresh pin's edge worn from 2.5 to 0.56 MPa. Five increments an
-    update (c K about 1.6 / ``STABLE``): the volume is k_w times the work within 0.2 %, each
-    increment on the pressure re-solved after the last."""
+    3e-13 /Pa, 120 s at 200 rpm in 40 steps (17 um worn): its mean pressure in five bands of radius
+    follows 1/r within 5 % (measured 3.9 %; at the start 0.84 to 0.43 MPa inside out, against 1/r's
+    0.55 to 0.46), the peak of the fresh pin's edge worn from 2.5 to 0.74 MPa. Every update is
+    linearly implicit (c K_n about 27, ``STABLE`` 0.5: the explicit update, taken with an elastic
+    estimate of the stiffness, failed in a stiffer case; a review): the volume is k_w times the
+    work within 0.2 % (its pressure is the step's end's, the work's the step's)."""
     import meshio
     h = run(scene(tmp_path / "in", steps=40, end="120 s", wear='k_w = "3e-13 1/Pa"',
                   **{"output.every": 40, "output.fields": ["contact_pressure", "wear_depth"]}), verbose=False).history
-    assert h["max_pressure"][0] > 2e6 and h["max_pressure"][-1] < 0.6e6
+    assert h["max_pressure"][0] > 2e6 and h["max_pressure"][-1] < 0.8e6
     assert h["wear_volume"][-1] == pytest.approx(3e-13 * h["frictional_work"][-1], rel=2e-3)
-    assert set(h["wear_substeps"][1:]) == {5}       # c K = 3e-13 x 0.4 x 62.8 rad x 90 mm x ~2.3e12 Pa/m over STABLE
+    assert h["wear_implicit_updates"][-1] == 40 and list(h["wear_substeps"]) == [0] + [1] * 40
     series = meshio.xdmf.TimeSeriesReader(str(tmp_path / "in" / "interface.xdmf"))
     points, cells = series.read_points_cells()
     middle = points[cells[0].data].mean(axis=1)
@@ -66,7 +67,34 @@ def test_a_worn_in_pin_carries_its_load_as_one_over_the_radius(tmp_path):
     band = np.digitize(radius, edges) - 1
     mean = np.array([p[band == b] @ area[band == b] / area[band == b].sum() for b in range(5)])
     r = 0.5 * (edges[1:] + edges[:-1])
-    np.testing.assert_allclose(mean * r / np.mean(mean * r), 1.0, atol=0.03)
+    np.testing.assert_allclose(mean * r / np.mean(mean * r), 1.0, atol=0.05)
+
+
+def test_a_stiff_penalty_a_release_and_a_pad_without_its_rate(tmp_path):
+    """K_n = 1e14 Pa/m with k_w = 1e-13 /Pa (c K_n about 9: the explicit update, with an elastic
+    estimate of the stiffness, failed its contact Newton there; a review) runs linearly implicit,
+    worn volume k_w x work within 0.2 %. An update falling in a release (update_every = 3 over a
+    release from 4.5 to 8 s) wears from the exposure, k_w x work to round-off (it lost 89 % of it,
+    re-reading the pressure of the opened gaps; a review). A worn body whose material gives no k_w
+    beside one that does is refused unless [wear] gives a rate (the thesis' sintered table wore it)."""
+    stiff = run(scene(tmp_path / "s", wear='k_w = "1e-13 1/Pa"', **{"interface.penalty": "1e14 Pa/m"}),
+                verbose=False).history
+    assert stiff["wear_implicit_updates"][-1] == 3
+    assert stiff["wear_volume"][-1] == pytest.approx(1e-13 * stiff["frictional_work"][-1], rel=2e-3)
+    cycle = {"wear.update_every": 3, "time.steps": 3, "time.end": "9 s",
+             "loading.load_profile": [["0 s", 1.0], ["4.5 s", 1.0], ["4.51 s", 0.0], ["9 s", 0.0]]}
+    released = run(scene(tmp_path / "r", wear='k_w = "3e-13 1/Pa"', **cycle), verbose=False).history
+    assert released["interface_force"][-1] == 0.0 and released["frictional_work"][-1] > 0
+    assert released["wear_volume"][-1] == pytest.approx(3e-13 * released["frictional_work"][-1], rel=1e-12)
+    from pathlib import Path
+    from multiscale.scene import load
+    from multiscale.workflows.model import build_model, facet_wear
+    pads = load(Path(__file__).parents[1] / "demos" / "brake_squeal.toml", overrides={
+        "effects": list(WEAR), "time.end": "1 s", "loading.rotation_speed": "100 rpm",
+        "geometry.part_materials": {"outer_pad": "pad2"},
+        "materials.pad2": {"E": "5 GPa", "nu": 0.25, "rho": "2500 kg/m^3", "k_w": "1e-14 1/Pa"}})
+    with pytest.raises(InputError, match=r"wear: a rate for interface\(s\) inner_pad, whose worn material gives no k_w"):
+        facet_wear(pads, build_model(pads))
 
 
 def test_a_resumed_wearing_run_is_the_straight_one(tmp_path):
@@ -85,10 +113,19 @@ def test_a_resumed_wearing_run_is_the_straight_one(tmp_path):
 
 def test_the_scene_takes_wear_in_perfect_contact(tmp_path):
     """Wear needs no roughness: the run marches, checkpoints and writes the worn depths of both bodies;
-    it needs friction."""
+    a table reads the faces' macro temperatures (check says so; its end is warned of at the worn
+    body's hottest); it needs friction."""
     s = scene(tmp_path / "s")
     p = plan(s)
     assert "checkpoint.h5" in p.files and {"wear_depth", "counter_wear_depth"} <= set(p.interface_fields)
     assert len(p.times) == 4
+    from multiscale.scene_summary import summary
+    from multiscale.workflows import run_warnings
+    table = scene(tmp_path / "t", wear='k_w_table = [["20 degC", "1e-14 1/Pa"], ["22 degC", "2e-14 1/Pa"]]')
+    assert "a table's T each face's macro temperature" in next(x for x in summary(table) if x.startswith("    wear"))
+    h = History()
+    h.append(time=0.0, max_temperature_pin=298.2)           # a review: the pin at 25 degC, a table to 22, unsaid
+    assert run_warnings(table, h) == ["wear.k_w_table: the worn body's largest macro temperature, 25.05 degC, is "
+                                      "above its last point 22 degC: the facets wear with k_w held at 2e-14 1/Pa there"]
     with pytest.raises(SceneError, match='effects: "wear" needs effect "friction" too'):
         loads(pin_on_disc(tmp_path / "x", effects=("contact", "wear")))

@@ -79,7 +79,7 @@ def test_scene_without_thermal_builds_no_heat_problem(tmp_path):
     assert model.mechanics.temperatures is None             # no thermal strain either
     result = run(scene, verbose=False)
     assert set(result.history.columns) == {"time", "interface_force", "friction_force", "max_pressure",
-                                           "newton_iterations", "sliding_speed"}
+                                           "newton_iterations", "sliding_speed", "frictional_work_step"}
     assert result.history["max_pressure"][-1] == pytest.approx(1e6, rel=1e-6)
     assert [f.name for f in result.field_files] == ["block.xdmf", "flat.xdmf", "interface.xdmf"]
 

@@ -283,7 +283,7 @@ def test_scene_rules_of_the_thermal_coupling(tmp_path):
     wear = text.replace('"roughness"]', '"roughness", "wear"]') + '[wear]\nk_w = "1e-14 1/Pa"\n'
     with pytest.raises(SceneError, match="give one of them"):
         loads(wear.replace('alpha = "5e-6 1/K"', 'alpha = "5e-6 1/K"\nk_w = "1e-14 1/Pa"'))
-    with pytest.raises(SceneError, match=r"wear.specific_rate: the rough body's material gives k_w \(materials.pin.k_w\)"):
+    with pytest.raises(SceneError, match=r"wear.specific_rate: the worn body's material gives k_w \(materials.pin.k_w\)"):
         loads(wear.replace('k_w = "1e-14 1/Pa"\n', 'specific_rate = "4e-15 1/Pa"\n').replace(
             'alpha = "5e-6 1/K"', 'alpha = "5e-6 1/K"\nk_w = "1e-14 1/Pa"'))     # (the material's won silently)
     scene = loads(text.replace('alpha = "5e-6 1/K"', 'alpha = "5e-6 1/K"\nk_w = [["20 degC", 1e-14], ["200 degC", 2e-14]]'))

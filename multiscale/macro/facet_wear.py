@@ -6,20 +6,25 @@ normal load (``per_load``), dh_f = k_f L_f / A_f (L_f = p_f ds_f A_f [N m]), ove
 the last update: ``MacroModel.exposure`` sums them as the heat and the frictional work are summed,
 each substep's pressure over its load-weighted sliding, ds_f = |w_f| ds (|w_f| the facet's speed
 per unit of body 1's: its distance from the axis of a rotation, 1 for a translation). k_f is the
-rate of the facet's interface at the facet's face temperature (a table; without heat the initial
-temperature). The worn depth opens the facet's initial gap, and the next contact solve
-redistributes the pressure (towards p |w| uniform: the steady state of a face that wears all over,
-its profile receding as a whole). A rotating body 1 whose material gives k_w loses k_w,1(T_1) W_f
-per facet (per frictional work), spread round the circle of the facet's radius over its face
-(``track_spread``): its track recedes.
+rate of the facet's interface at the facet's face temperature at the update (a table; without heat
+the initial temperature). The worn depth opens the facet's initial gap and the contact is solved
+on the worn gaps: the pressure redistributes (towards p |w| uniform: the steady state of a face
+that wears all over, its profile receding as a whole). A rotating body 1 whose material gives k_w
+loses k_w,1(T_1) W_f per facet (per frictional work), spread round the circle of the facet's radius
+over its face (``track_spread``; a face in a plane normal to the axis): its track recedes, from the
+exposure.
 
-Explicit in the pressure: an update's depth per pressure c_f = k_f mu_f ds_f [m/Pa] (k_f ds_f per
-load) times the facet's contact stiffness K_f [Pa/m] must stay below 2 (a facet pressed alone: p =
-K_f x its closure, dh = c_f p). ``FacetWear`` estimates K_f = 1/(1/K_n + sqrt(A_f)/E*), the penalty
-in series with the bodies' stiffness over the facet (a bound of a facet's share of the assembled
-stiffness), and takes an update whose S = max c_f K_f exceeds ``STABLE`` in n = ceil(S / STABLE)
-increments, each with the pressure re-solved after the last. The contact is solved on the worn
-gaps after an update (n solves in all), the drive's braking torque kept.
+Stability. The depth per pressure of an update, c_f = k_f mu_f ds_f [m/Pa] (k_f ds_f per load),
+against the facets' contact stiffness: a depth constant over a facet is a pattern the displacement
+(linear over each element) cannot follow facet by facet, so only the penalty K_n resists it (a
+review measured the facet Jacobian: its largest eigenvalue times c within 1.2 % of c K_n, 3.4 to
+24 times an elastic estimate, and the explicit update failed where c K_n exceeded 2). An update
+with max c_f K_n <= ``STABLE`` wears explicitly from the exposure (its volume k W, the heat's
+work, to round-off) and solves once; a larger one is linearly implicit (backward Euler, stable at
+any c; the thesis' micro wear takes the same way, ``micro.post_analysis``): the contact is solved
+with each facet's penalty K_n / (1 + K_n c_f), so that dh_f = c_f p_f at the pressure found,
+then the facets wear by it and the contact is solved again with K_n (two solves). Released, an
+update wears from the exposure and the next loaded step solves.
 """
 from __future__ import annotations
 
@@ -49,8 +54,9 @@ def track_spread(radius, source_radius, volume, half: float) -> np.ndarray:
 
 @dataclass(frozen=True)
 class FacetRate:
-    """The wear rate of body 0 on one interface: its facets (``mask``, global), k [1/Pa] (a
-    ``WearRate``: constant or against the face temperature [K]) and whether it is per normal load."""
+    """The wear rate of a body on one interface: its facets (``mask``, global), k [1/Pa] (a
+    ``WearRate``: constant or against the face temperature [K]) and whether it is per normal load
+    (body 0's only: body 1 wears per frictional work)."""
 
     mask: np.ndarray
     rate: WearRate
@@ -60,21 +66,20 @@ class FacetRate:
 class FacetWear:
     """The worn depths of a ``MacroModel``'s interface facets (see module docstring): ``depth`` of
     body 0 and ``counter_depth`` of body 1 [m] per facet (global arrays), ``volume`` [m^3] lost per
-    interface and ``counter_volume`` [m^3] since the start, ``work`` [J] of the updates. ``stiffness``
-    [Pa/m] per facet bounds its contact stiffness (stability); ``counter_rate`` the rotating body
-    1's k_w (None: it does not wear); ``temperature`` [K] where no heat is solved."""
+    interface and ``counter_volume`` [m^3] since the start, ``work`` [J] of the updates, ``implicit``
+    the updates taken linearly implicit. ``counter_rates``: body 1's k_w on the facets it gives
+    (``FacetRate``; none: it does not wear); ``temperature`` [K] where no heat is solved."""
 
-    def __init__(self, model, rates: Sequence[FacetRate], stiffness: np.ndarray, counter_rate: WearRate | None = None,
+    def __init__(self, model, rates: Sequence[FacetRate], counter_rates: Sequence[FacetRate] = (),
                  temperature: float = 293.15):
         iface, motion = model.tm.interface, model.tm.spec.motion
-        if counter_rate is not None and not isinstance(motion, Rotation):
-            raise InputError("counter_rate", counter_rate, "a rotating body 1: its wear spreads round a circular track")
-        self.model, self.rates, self.counter_rate = model, tuple(rates), counter_rate
-        self.stiffness, self.temperature = np.asarray(stiffness, dtype=float), float(temperature)
+        self.model, self.rates, self.counter_rates = model, tuple(rates), tuple(counter_rates)
+        self.temperature = float(temperature)
         n = iface.n_facets
         self.depth, self.counter_depth = np.zeros(n), np.zeros(n)
-        self.volume, self.counter_volume, self.work, self.increments = np.zeros(len(iface.tags)), 0.0, 0.0, 1
+        self.volume, self.counter_volume, self.work, self.implicit = np.zeros(len(iface.tags)), 0.0, 0.0, 0
         self.datum = iface.values(model.contact.initial_gap)
+        self.reach, self.faces = np.ones(n), np.zeros(n, dtype=int)
         if isinstance(motion, Rotation):
             axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
             arm = iface.midpoints - np.asarray(motion.centre, float)
@@ -82,49 +87,53 @@ class FacetWear:
             self.reach = np.linalg.norm(arm - np.outer(along, axis), axis=1)        # m per rad
             scale = model.tm.spec.length_scale                                      # faces of one axial position
             self.faces = np.unique(np.round(along / scale, 6), return_inverse=True)[1]
-        else:
-            self.reach, self.faces = np.ones(n), np.zeros(n, dtype=int)
-        model.exposure = np.zeros((3, n))
+        for r in self.counter_rates:
+            flat = not isinstance(motion, Rotation) or len(np.unique(self.faces[r.mask])) == 1
+            if not flat:
+                raise InputError("counter-face wear", r.rate, "a rotating body 1 whose worn faces lie in planes "
+                                 "normal to its axis (its wear spreads round a circular track on them)")
+        model.exposure, model.exposure_sliding = np.zeros((2, n)), 0.0
 
-    def update(self) -> tuple[np.ndarray, float, int]:
+    def update(self) -> tuple[np.ndarray, float]:
         """Wear over the model's ``exposure`` since the last update, then the exposure restarts and
-        the contact is solved on the worn gaps (collective: the same on every rank).
-        Returns the volume [m^3] body 0 lost per interface, the frictional work [J] and the
-        increments taken."""
+        the contact is solved on the worn gaps (collective: the same on every rank). Returns the
+        volume [m^3] body 0 lost per interface and the frictional work [J]."""
         m, iface = self.model, self.model.tm.interface
-        work, load, slid = m.exposure
-        m.exposure = np.zeros_like(m.exposure)
-        if not slid.any():
-            return np.zeros(len(iface.tags)), 0.0, 0
+        (work, load), slid = m.exposure, m.exposure_sliding
+        m.exposure, m.exposure_sliding = np.zeros_like(m.exposure), 0.0
+        if not slid:
+            return np.zeros(len(iface.tags)), 0.0
         T0, T1 = (m.thermal.facet_temperature(0), m.thermal.facet_temperature(1)) if m.thermal is not None else \
             (np.full(iface.n_facets, self.temperature),) * 2
-        k, per_load = np.zeros(iface.n_facets), np.zeros(iface.n_facets, dtype=bool)
+        k, per_load, k1 = np.zeros(iface.n_facets), np.zeros(iface.n_facets, dtype=bool), np.zeros(iface.n_facets)
         for r in self.rates:
             k[r.mask], per_load[r.mask] = np.broadcast_to(r.rate(T0[r.mask]), (int(r.mask.sum()),)), r.per_load
-        mu = iface.values(m.contact.friction)
-        k1 = np.broadcast_to(self.counter_rate(T1), k.shape) if self.counter_rate is not None else np.zeros(k.shape)
+        for r in self.counter_rates:
+            k1[r.mask] = np.broadcast_to(r.rate(T1[r.mask]), (int(r.mask.sum()),))
+        mu, K = iface.values(m.contact.friction), iface.values(m.contact.stiffness)
         per_pressure = k * np.where(per_load, 1.0, mu) * slid * self.reach      # m/Pa per facet
-        n = max(1, int(np.ceil((per_pressure * self.stiffness).max() / STABLE)))
-        for i in range(n):
-            if n == 1:                         # the exposure's own pressures: volume = k x work exactly
-                self._wear(k * np.where(per_load, load, work) / iface.areas, k1 * work)
-            else:                              # each increment at the pressure re-solved after the last
-                p = m.contact.facet_pressure()
-                self._wear(per_pressure * p / n, k1 * mu * p * slid * self.reach * iface.areas / n)
-            self._solve()
-        if not m.released:
-            m.keep_torque(m.drive.factor(m.time))          # the worn faces moved the friction moment
+        if m.released or (per_pressure * K).max() <= STABLE:     # the exposure's own pressures: k x work exactly
+            self._wear(k * np.where(per_load, load, work) / iface.areas, k1 * work)
+        else:                                                     # backward Euler: dh = c p at the pressure found
+            iface.set_field(m.contact.stiffness, K / (1.0 + K * per_pressure))
+            try:
+                self._solve()
+                pressure = m.contact.facet_pressure()
+            finally:
+                iface.set_field(m.contact.stiffness, K)
+            self._wear(per_pressure * pressure, k1 * work)
+            self.implicit += 1
+        self._solve()
         done = float(work.sum())
         self.work += done
-        self.increments = max(self.increments, n)
         gained = np.bincount(iface.tag_index, self.depth * iface.areas, minlength=len(iface.tags)) - self.volume
         self.volume += gained
-        return gained, done, n
+        return gained, done
 
     def _solve(self) -> None:
-        """The contact solved again on the worn gaps (at the speed of the last solve: a stop keeps the
-        friction that ended it), so that the state recorded and written is the worn one; released,
-        the next loaded step solves it (``MacroModel.stale``)."""
+        """The contact solved on the worn gaps at the speed of the last solve (a stop keeps the
+        friction that ended it), the drive's braking torque kept, so that the state recorded and
+        written is the worn one; released, the next loaded step solves (``MacroModel.stale``)."""
         m = self.model
         if m.released:
             m.stale = True
@@ -133,6 +142,7 @@ class FacetWear:
         m.contact.speed.value = m.solved_speed
         try:
             m.last_solve = m.mechanics.solve()
+            m.keep_torque(m.drive.factor(m.time))           # the worn faces moved the friction moment
         finally:
             m.contact.speed.value = now
 
@@ -149,32 +159,33 @@ class FacetWear:
             self.counter_volume += float(lost.sum())
         iface.set_field(self.model.contact.initial_gap, self.datum + self.depth + self.counter_depth)
 
-    def row(self) -> dict:
+    def row(self, updated: bool) -> dict:
         """History columns: ``wear_volume`` [m^3] (and per interface with several), ``wear_max_depth``
         [m], ``frictional_work`` [J] and ``wear_rate_mean`` [1/Pa] (volume / work) since the start,
-        ``wear_substeps`` (the most increments an update took); with a wearing body 1
-        ``counter_wear_volume`` [m^3] and ``counter_wear_max_depth`` [m]."""
+        ``wear_substeps`` (1 in a row with an update, ``updated``, else 0: the rough loop's increments),
+        ``wear_implicit_updates`` (so far); with a wearing body 1 ``counter_wear_volume`` [m^3] and
+        ``counter_wear_max_depth`` [m]."""
         tags = list(self.model.tm.interface.tags)
         row = {"wear_volume": float(self.volume.sum()), "wear_max_depth": float(self.depth.max(initial=0.0)),
-               "frictional_work": self.work, "wear_substeps": self.increments,
+               "frictional_work": self.work, "wear_substeps": int(updated), "wear_implicit_updates": self.implicit,
                "wear_rate_mean": float(self.volume.sum()) / self.work if self.work > 0 else np.nan}
         if len(tags) > 1:
             row.update({f"wear_volume_{name}": float(v) for name, v in zip(tags, self.volume)})
-        if self.counter_rate is not None:
+        if self.counter_rates:
             row.update(counter_wear_volume=self.counter_volume,
                        counter_wear_max_depth=float(self.counter_depth.max(initial=0.0)))
         return row
 
     def state(self) -> tuple[dict, dict]:
         """(attributes, arrays) a checkpoint keeps (``restore`` reads them back)."""
-        return ({"wear": [self.work, self.counter_volume, self.increments]},
+        return ({"wear": [self.work, self.counter_volume, self.implicit, self.model.exposure_sliding]},
                 {"wear_depth": self.depth, "counter_depth": self.counter_depth, "wear_volume": self.volume,
                  "exposure": self.model.exposure})
 
     def restore(self, attrs: dict, arrays: dict) -> None:
         """Back to a ``state``; the facets' gaps follow."""
-        self.work, self.counter_volume, increments = (float(v) for v in attrs["wear"])
-        self.increments = int(increments)
+        self.work, self.counter_volume, implicit, self.model.exposure_sliding = (float(v) for v in attrs["wear"])
+        self.implicit = int(implicit)
         self.depth, self.counter_depth = arrays["wear_depth"].copy(), arrays["counter_depth"].copy()
         self.volume, self.model.exposure = arrays["wear_volume"].copy(), arrays["exposure"].copy()
         self.model.tm.interface.set_field(self.model.contact.initial_gap, self.datum + self.depth + self.counter_depth)

@@ -98,9 +98,10 @@ class MacroModel:
     stale: bool = False
     notes: list = field(default_factory=list)          # what the run's warnings add (an unbalanced clamp, Mechanics.notes)
     probes: Probes | None = None                       # thermocouples: ``probe_temperature_<name>`` columns
-    # per facet since the last wear update (``facet_wear.FacetWear`` sets it; None: not summed): the frictional work
-    # mu p |w| ds dA [J], p |w| ds dA [N m] and the load-weighted sliding ds of body 1 [rad or m]
+    # since the last wear update (``facet_wear.FacetWear`` sets them; None: not summed): per facet the frictional
+    # work mu p |w| ds dA [J] and p |w| ds dA [N m], and body 1's load-weighted sliding ds [rad or m]
     exposure: np.ndarray | None = None
+    exposure_sliding: float = 0.0
 
     @property
     def contact(self):
@@ -182,8 +183,8 @@ class MacroModel:
                 self.work_step += power.sum() * slid
                 if self.exposure is not None:       # (mu = 0: no work, no load counted)
                     mu = self.tm.interface.values(self.contact.friction)
-                    self.exposure += slid * np.stack([power, np.divide(power, mu, out=np.zeros(mu.shape), where=mu > 0),
-                                                      np.ones(mu.shape)])
+                    self.exposure += slid * np.stack([power, np.divide(power, mu, out=np.zeros(mu.shape), where=mu > 0)])
+                    self.exposure_sliding += slid
             if self.thermal is not None:
                 # the pressure was solved at the load factor of the step's start: the conductance
                 # scales with the mean factor over the step (a release inside it, a load ramp), the
@@ -376,13 +377,14 @@ class MacroModel:
         ``friction_law``, ``friction_coefficient`` [-] is ``friction_force`` over ``interface_force`` (NaN
         while released or at rest), and with several interfaces each one's too; with a mu(v) law,
         ``max_slip_speed`` and ``min_slip_speed`` [m/s] over its facets in contact (NaN as mu).
+        ``frictional_work_step`` [J]: the last step's frictional work (``work_step``, the heat's quadrature).
         ``angular_speed`` [rad/s] of a rotating body 1 or ``sliding_speed`` [m/s] of a translating one,
         at the row's time (a cycle's speed was drawn nowhere: a user trial). With ``probes``,
         ``probe_temperature_<name>`` [K], each thermocouple's reading (``macro.probes``)."""
         on = not self.released
         friction = np.linalg.norm(self.contact.facet_friction(), axis=1) * on     # N per facet, magnitudes
         row = {"time": self.time, "interface_force": self.last_solve.normal_force * on,
-               "friction_force": float(friction.sum()),
+               "friction_force": float(friction.sum()), "frictional_work_step": self.work_step,
                "max_pressure": self.last_solve.max_pressure * on,
                "newton_iterations": self.last_solve.iterations}
         moving = float(self.contact.speed.value)          # (now: a stop inside the step solved at its speed)

@@ -226,20 +226,23 @@ def run_warnings(scene, history) -> list[str]:
 
 def _wear_table_ends(scene, history) -> list[str]:
     """``Wear.held_ends`` at the largest temperature the wear read (the rough surface's micro one,
-    ``micro_max_temperature``, or with ``wear.temperature = "macro"`` the rough body's; the initial
-    temperature is the scene's warning), or the rough material's k_w table left there
-    (``Material.beyond``; it was not said)."""
-    column = f"max_temperature_{scene.bodies[0]}" if scene.has("wear") and scene.wear.temperature == "macro" \
-        else "micro_max_temperature"
-    if not scene.has("wear") or column not in history.columns:
+    ``micro_max_temperature``, or with ``wear.temperature = "macro"`` and in perfect contact the worn
+    body's; the initial temperature is the scene's warning), or the worn material's k_w table left
+    there (``Material.beyond``; it was not said)."""
+    if not scene.has("wear"):
+        return []
+    rough = scene.has("roughness")
+    column = "micro_max_temperature" if rough and scene.wear.temperature == "surface" else \
+        f"max_temperature_{scene.bodies[0]}"
+    if column not in history.columns:
         return []
     read = np.asarray(history[column], dtype=float)
     hottest = float(np.max(read, initial=-np.inf, where=np.isfinite(read)))
     if scene.rough_material_wears:
         name = scene.rough_material
         phrase = scene.materials[name].beyond(hottest).get("k_w")
-        return [f"materials.{name}.{phrase} (the rough {scene.wear.read})"] if phrase else []
-    return scene.wear.held_ends(hottest=hottest)
+        return [f"materials.{name}.{phrase} ({scene.wear.read(rough)})"] if phrase else []
+    return scene.wear.held_ends(hottest=hottest, rough=rough)
 
 
 def _law_reach(history) -> list[str]:

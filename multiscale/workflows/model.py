@@ -51,7 +51,6 @@ from multiscale.memory import SPREAD, memory_available, micro_memory, remedy, ru
 from multiscale.micro.wear import WearRate
 from multiscale.scene_friction import bare_interfaces, initial_friction, speed_law_guess
 from multiscale.scene_geometry import scene_spec
-from multiscale.scene_rough import contact_modulus
 from multiscale.workflows.strain import last_forces
 
 
@@ -348,21 +347,23 @@ def build_model(scene, comm=MPI.COMM_WORLD, *, law=None, tm=None, conductance: b
 def facet_wear(scene, model: MacroModel) -> FacetWear:
     """The Archard wear of the interface facets in perfect contact (effect "wear" without
     "roughness"): body 0 on each interface by its material's k_w, else by [wear]'s rate (k_w, k per
-    normal load, their tables, the default table); body 1 whose material gives k_w (the first
-    interface's) wears its tracks. Each facet's contact stiffness is bounded by K_n in series with E*/sqrt(A_f) (E*
-    of the interface's materials at the initial temperature): the update's stable increments."""
-    tm, penalty = model.tm, scene.interface.penalty
-    rates, stiffness = [], np.zeros(tm.interface.n_facets)
-    counter = {scene.geometry.spec.interface_materials(name)[1] for name in tm.interface.tags}
-    for name, mask in tm.interface.masks().items():
-        worn = scene.materials[scene.geometry.spec.interface_materials(name)[0]]
-        rates.append(FacetRate(mask, WearRate(worn.wear_rate), False) if worn.k_w is not None else
+    normal load, their tables, the default table: refused where another interface's material gives
+    its own, a pad of no rate of its own worn by the thesis' sintered table unsaid: a review); body 1
+    on each interface whose material gives k_w, along its track."""
+    spec, rates, counter, own = scene.geometry.spec, [], [], []
+    for name, mask in model.tm.interface.masks().items():
+        worn, other = (scene.materials[m] for m in spec.interface_materials(name))
+        own.append(worn.k_w is not None)
+        rates.append(FacetRate(mask, WearRate(worn.wear_rate)) if worn.k_w is not None else
                      FacetRate(mask, WearRate(scene.wear.rate), scene.wear.per_load))
-        modulus = contact_modulus(interface_materials(scene, name))
-        stiffness[mask] = 1.0 / (1.0 / penalty + np.sqrt(tm.interface.areas[mask]) / modulus)
-    wearing = [m for m in sorted(counter) if scene.materials[m].k_w is not None]
-    return FacetWear(model, rates, stiffness, WearRate(scene.materials[wearing[0]].wear_rate) if wearing else None,
-                     temperature=scene.time.initial_temperature)
+        if other.k_w is not None:
+            counter.append(FacetRate(mask, WearRate(other.wear_rate)))
+    if any(own) and not all(own) and scene.wear.given is None:
+        bare = [n for n, given in zip(model.tm.interface.tags, own) if not given]
+        raise InputError("wear", None, f"a rate for interface(s) {', '.join(bare)}, whose worn material gives no "
+                         "k_w while another interface's does: give wear.k_w (or wear.specific_rate, a table) or that "
+                         "material's k_w (else the thesis' default k_w(T) table would wear it)")
+    return FacetWear(model, rates, counter, temperature=scene.time.initial_temperature)
 
 
 def probes(scene, tm, temperatures) -> Probes:

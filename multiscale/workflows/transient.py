@@ -65,15 +65,17 @@ class Marching:
 
     def __init__(self, scene, model: MacroModel, wear: FacetWear | None = None):
         self.scene, self.model, self.wear, self.fingerprint = scene, model, wear, fingerprint(scene)
+        self.updated = False                  # the last step updated the wear
 
     def step(self, n: int):
         heat = self.model.macro_step(self.scene.time.dt, self.scene.time.substeps)
-        if self.wear is not None and (n % self.scene.wear.update_every == 0 or n == self.scene.time.steps):
+        self.updated = self.wear is not None and (n % self.scene.wear.update_every == 0 or n == self.scene.time.steps)
+        if self.updated:
             self.wear.update()
         return heat
 
     def record(self, heat) -> dict:
-        return {**self.model.record(heat), **(self.wear.row() if self.wear is not None else {})}
+        return {**self.model.record(heat), **(self.wear.row(self.updated) if self.wear is not None else {})}
 
     def save(self, path: Path, step: int, history: io.History) -> None:
         """Checkpoint after macro step ``step`` (collective; ``checkpoint.save_step``)."""
