@@ -288,7 +288,7 @@ def _effect_line(scene: Scene, effect: str) -> str:
                     scene.has("roughness") else ", a table's T the rough surface's local one, macro + flash") + \
                 " (wear.temperature),"
         increments = f"in {w.substeps} increment(s)" if scene.has("roughness") else \
-            "per interface facet (perfect contact: its gap opens), in the increments that keep it stable"
+            "per interface facet (perfect contact: its gap opens), linearly implicit where it would not be stable"
         return (f"Archard dh = {law} every {w.update_every} step(s) {increments}{both}; "
                 f"{rate} (k_w per frictional work, k per normal load: a specific wear rate k is k_w = k/mu)")
 

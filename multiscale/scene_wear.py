@@ -39,7 +39,8 @@ class Wear:
     (none while released), in at least ``substeps`` (and 2) implicit increments, raised while their error
     estimate exceeds ``micro.wear.WEAR_TOL``; a counter-face whose material gives ``k_w`` wears too.
     Without effect "roughness" the interface facets wear (``macro.facet_wear``: at their face
-    temperatures, their gaps opened, in the increments that keep the explicit update stable)."""
+    temperatures, their gaps opened; an update linearly implicit where an explicit one would not be
+    stable)."""
 
     k_w: float | None = key(Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9)), absent=_RULE)
     k_w_table: tuple | None = key(Curve(TEMPERATURE, _PER_WORK, "temperature", "k_w"), absent=_RULE)
@@ -54,7 +55,7 @@ class Wear:
     def problems(self, path, ctx):
         if "roughness" not in ctx.effects and self.substeps != 1:      # (perfect contact: macro.facet_wear)
             ctx.warnings.append(f"{path}.substeps is ignored in perfect contact: the facets' wear takes the "
-                                "increments that keep it stable")
+                                "update explicit, or linearly implicit where that would not be stable")
         return []
 
     @property

@@ -46,15 +46,16 @@ def test_a_worn_in_pin_carries_its_load_as_one_over_the_radius(tmp_path):
     """Archard wear at k_w mu p omega r settles where every point wears alike (the worn face recedes
     as a whole): p r uniform, p = C / r. The coarse pin (20 mm at 80-100 mm, 2.5 mm facets), k_w =
     3e-13 /Pa, 120 s at 200 rpm in 40 steps (17 um worn): its mean pressure in five bands of radius
-    follows 1/r within 5 % (measured 3.9 %; at the start 0.84 to 0.43 MPa inside out, against 1/r's
-    0.55 to 0.46), the peak of the fresh pin's edge worn from 2.5 to 0.74 MPa. Every update is
-    linearly implicit (c K_n about 27, ``STABLE`` 0.5: the explicit update, taken with an elastic
-    estimate of the stiffness, failed in a stiffer case; a review): the volume is k_w times the
-    work within 0.2 % (its pressure is the step's end's, the work's the step's)."""
+    follows 1/r within 2 % (measured 0.43 %; 3.9 % without the updates' corrections; at the start
+    0.84 to 0.43 MPa inside out, against 1/r's 0.55 to 0.46), the peak of the fresh pin's edge worn
+    from 2.5 to 0.61 MPa. Every update is linearly implicit (c K_n about 27, ``STABLE`` 0.5: the
+    explicit update, taken with an elastic estimate of the stiffness, failed in a stiffer case; a
+    review): the volume is k_w times the work within 0.2 % (its pressure is the step's end's, the
+    work's the step's)."""
     import meshio
     h = run(scene(tmp_path / "in", steps=40, end="120 s", wear='k_w = "3e-13 1/Pa"',
                   **{"output.every": 40, "output.fields": ["contact_pressure", "wear_depth"]}), verbose=False).history
-    assert h["max_pressure"][0] > 2e6 and h["max_pressure"][-1] < 0.8e6
+    assert h["max_pressure"][0] > 2e6 and h["max_pressure"][-1] < 0.65e6
     assert h["wear_volume"][-1] == pytest.approx(3e-13 * h["frictional_work"][-1], rel=2e-3)
     assert h["wear_implicit_updates"][-1] == 40 and list(h["wear_substeps"]) == [0] + [1] * 40
     series = meshio.xdmf.TimeSeriesReader(str(tmp_path / "in" / "interface.xdmf"))
@@ -67,7 +68,7 @@ def test_a_worn_in_pin_carries_its_load_as_one_over_the_radius(tmp_path):
     band = np.digitize(radius, edges) - 1
     mean = np.array([p[band == b] @ area[band == b] / area[band == b].sum() for b in range(5)])
     r = 0.5 * (edges[1:] + edges[:-1])
-    np.testing.assert_allclose(mean * r / np.mean(mean * r), 1.0, atol=0.05)
+    np.testing.assert_allclose(mean * r / np.mean(mean * r), 1.0, atol=0.02)
 
 
 def test_a_stiff_penalty_a_release_and_a_pad_without_its_rate(tmp_path):
@@ -75,7 +76,10 @@ def test_a_stiff_penalty_a_release_and_a_pad_without_its_rate(tmp_path):
     estimate of the stiffness, failed its contact Newton there; a review) runs linearly implicit,
     worn volume k_w x work within 0.2 %. An update falling in a release (update_every = 3 over a
     release from 4.5 to 8 s) wears from the exposure, k_w x work to round-off (it lost 89 % of it,
-    re-reading the pressure of the opened gaps; a review). A worn body whose material gives no k_w
+    re-reading the pressure of the opened gaps; a review); one that would be implicit, released
+    with a loaded step to come, waits for it (worn explicitly, the re-engaging Newton failed). A
+    load ramp from 0.1 to 1 in the first step wears k_w x work within 0.5 % an update (10 times
+    it: the implicit depth per pressure took the ramp's sliding at the full load). A worn body whose material gives no k_w
     beside one that does is refused unless [wear] gives a rate (the thesis' sintered table wore it)."""
     stiff = run(scene(tmp_path / "s", wear='k_w = "1e-13 1/Pa"', **{"interface.penalty": "1e14 Pa/m"}),
                 verbose=False).history
@@ -86,6 +90,14 @@ def test_a_stiff_penalty_a_release_and_a_pad_without_its_rate(tmp_path):
     released = run(scene(tmp_path / "r", wear='k_w = "3e-13 1/Pa"', **cycle), verbose=False).history
     assert released["interface_force"][-1] == 0.0 and released["frictional_work"][-1] > 0
     assert released["wear_volume"][-1] == pytest.approx(3e-13 * released["frictional_work"][-1], rel=1e-12)
+    again = {"time.steps": 3, "time.end": "9 s", "loading.load_profile": [   # released at the update, loaded again
+        ["0 s", 1.0], ["2.9 s", 1.0], ["2.91 s", 0.0], ["5.99 s", 0.0], ["6 s", 1.0]]}
+    back = run(scene(tmp_path / "b", wear='k_w = "3e-13 1/Pa"', **again), verbose=False).history   # (Newton failed)
+    assert list(back["wear_substeps"]) == [0, 0, 1, 1] and back["wear_implicit_updates"][-1] == 2
+    assert back["wear_volume"][-1] == pytest.approx(3e-13 * back["frictional_work"][-1], rel=5e-3)
+    ramp = run(scene(tmp_path / "p", wear='k_w = "1e-13 1/Pa"', **{"loading.load_profile": [["0 s", 0.1], ["3 s", 1.0]],
+                                                                  "interface.penalty": "1e14 Pa/m"}), verbose=False).history
+    np.testing.assert_allclose(np.diff(ramp["wear_volume"]) / np.diff(ramp["frictional_work"]), 1e-13, rtol=5e-3)
     from pathlib import Path
     from multiscale.scene import load
     from multiscale.workflows.model import build_model, facet_wear

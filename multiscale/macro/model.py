@@ -99,9 +99,11 @@ class MacroModel:
     notes: list = field(default_factory=list)          # what the run's warnings add (an unbalanced clamp, Mechanics.notes)
     probes: Probes | None = None                       # thermocouples: ``probe_temperature_<name>`` columns
     # since the last wear update (``facet_wear.FacetWear`` sets them; None: not summed): per facet the frictional
-    # work mu p |w| ds dA [J] and p |w| ds dA [N m], and body 1's load-weighted sliding ds [rad or m]
+    # work mu p |w| ds dA [J] and p |w| ds dA [N m], and body 1's load-weighted sliding ds [rad or m] times the load
+    # each substep's pressure was solved at [N or Pa] (over the load now: the sliding of the pressure now)
     exposure: np.ndarray | None = None
     exposure_sliding: float = 0.0
+    facet_reach: np.ndarray | None = None              # |w| per facet at unit speed of body 1 [m per rad, or 1]
 
     @property
     def contact(self):
@@ -181,10 +183,12 @@ class MacroModel:
             if slid:                                # (at rest or released: no work, no assembly)
                 power = self.facet_sliding_power()
                 self.work_step += power.sum() * slid
-                if self.exposure is not None:       # (mu = 0: no work, no load counted)
+                if self.exposure is not None:       # (p |w| dA as the work integrates it; where mu = 0, at the midpoint)
                     mu = self.tm.interface.values(self.contact.friction)
-                    self.exposure += slid * np.stack([power, np.divide(power, mu, out=np.zeros(mu.shape), where=mu > 0)])
-                    self.exposure_sliding += slid
+                    load = np.divide(power, mu, out=self.contact.facet_pressure() * self.tm.interface.areas
+                                     * self.facet_reach, where=mu > 0)
+                    self.exposure += slid * np.stack([power, load])
+                    self.exposure_sliding += slid * float(self.mechanics.load.value)
             if self.thermal is not None:
                 # the pressure was solved at the load factor of the step's start: the conductance
                 # scales with the mean factor over the step (a release inside it, a load ramp), the

@@ -69,9 +69,11 @@ class Marching:
 
     def step(self, n: int):
         heat = self.model.macro_step(self.scene.time.dt, self.scene.time.substeps)
-        self.updated = self.wear is not None and (n % self.scene.wear.update_every == 0 or n == self.scene.time.steps)
+        last = n == self.scene.time.steps
+        self.updated = self.wear is not None and (n % self.scene.wear.update_every == 0 or last or self.wear.pending)
         if self.updated:
-            self.wear.update()
+            self.wear.update(last)
+            self.updated = not self.wear.pending
         return heat
 
     def record(self, heat) -> dict:
