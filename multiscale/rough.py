@@ -328,9 +328,7 @@ class RoughInterface:
         share = np.where(total[zone_of] > 0, w / np.where(total[zone_of] > 0, total[zone_of], 1.0),
                          areas / np.where(area[zone_of] > 0, area[zone_of], 1.0))
         lost = np.where(rough, np.asarray(volume, dtype=float)[zone_of] * share, 0.0)        # m^3 per facet
-        axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
-        arm = iface.midpoints - np.asarray(motion.centre, float)
-        radius = np.linalg.norm(arm - np.outer(arm @ axis, axis), axis=1)
+        radius = np.linalg.norm(motion.velocity(iface.midpoints), axis=1)       # |e x (x - c)|: the distance from the axis
         half = np.sqrt(2.0 * np.median(areas[rough]))                  # the side of a typical facet
         depth = np.zeros(len(areas))
         masks = iface.masks()

@@ -89,11 +89,9 @@ class FacetWear:
         self.datum = iface.values(model.contact.initial_gap)
         self.reach, self.faces = np.ones(n), np.zeros(n, dtype=int)
         if isinstance(motion, Rotation):
-            axis = np.asarray(motion.axis, float) / np.linalg.norm(motion.axis)
-            arm = iface.midpoints - np.asarray(motion.centre, float)
-            along = arm @ axis
-            self.reach = np.linalg.norm(arm - np.outer(along, axis), axis=1)        # m per rad
-            scale = model.tm.spec.length_scale                                      # faces of one axial position
+            self.reach = np.linalg.norm(motion.velocity(iface.midpoints), axis=1)     # m per rad: the radius
+            along = (iface.midpoints - np.asarray(motion.centre, float)) @ np.asarray(motion.axis, float)
+            scale = model.tm.spec.length_scale * np.linalg.norm(motion.axis)       # faces of one axial position
             self.faces = np.unique(np.round(along / scale, 6), return_inverse=True)[1]
         for r in self.counter_rates:
             flat = not isinstance(motion, Rotation) or len(np.unique(self.faces[r.mask])) == 1
@@ -141,7 +139,8 @@ class FacetWear:
         self._wear(worn, k1 * work)
         self._solve()
         for _ in range(CORRECTIONS if implicit else 0):   # the facets' mean pressures back to the ones found
-            self._wear(np.divide(m.contact.facet_pressure() - found, K, out=np.zeros(K.shape), where=K > 0), 0.0 * work)
+            self._wear(np.divide(m.contact.facet_pressure() - found, K, out=np.zeros(K.shape), where=K > 0),
+                       np.zeros(K.shape))
             self._solve()
         m.exposure, m.exposure_sliding = np.zeros_like(m.exposure), 0.0
         self.implicit += implicit
@@ -178,7 +177,11 @@ class FacetWear:
                 on = self.faces == face
                 self.counter_depth[on] += track_spread(self.reach[on], self.reach[on], lost[on], half)
             self.counter_volume += float(lost.sum())
-        iface.set_field(self.model.contact.initial_gap, self.datum + self.depth + self.counter_depth)
+        self._set_gap()
+
+    def _set_gap(self) -> None:
+        """The facets' initial gap: the datum opened by both bodies' worn depths."""
+        self.model.tm.interface.set_field(self.model.contact.initial_gap, self.datum + self.depth + self.counter_depth)
 
     def row(self, updated: bool) -> dict:
         """History columns: ``wear_volume`` [m^3] (and per interface with several), ``wear_max_depth``
@@ -209,4 +212,4 @@ class FacetWear:
         self.implicit, self.pending = int(implicit), bool(pending)
         self.depth, self.counter_depth = arrays["wear_depth"].copy(), arrays["counter_depth"].copy()
         self.volume, self.model.exposure = arrays["wear_volume"].copy(), arrays["exposure"].copy()
-        self.model.tm.interface.set_field(self.model.contact.initial_gap, self.datum + self.depth + self.counter_depth)
+        self._set_gap()

@@ -185,8 +185,10 @@ class MacroModel:
                 self.work_step += power.sum() * slid
                 if self.exposure is not None:       # (p |w| dA as the work integrates it; where mu = 0, at the midpoint)
                     mu = self.tm.interface.values(self.contact.friction)
-                    load = np.divide(power, mu, out=self.contact.facet_pressure() * self.tm.interface.areas
-                                     * self.facet_reach, where=mu > 0)
+                    load = np.divide(power, mu, out=np.zeros(mu.shape), where=mu > 0)
+                    if not (mu > 0).all():          # (an assembly: only where a facet has no friction)
+                        load = np.where(mu > 0, load, self.contact.facet_pressure() * self.tm.interface.areas
+                                        * self.facet_reach)
                     self.exposure += slid * np.stack([power, load])
                     self.exposure_sliding += slid * float(self.mechanics.load.value)
             if self.thermal is not None:

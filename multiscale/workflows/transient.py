@@ -124,7 +124,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     wear = facet_wear(scene, model) if scene.has("wear") else None
     marching = Marching(scene, model, wear)
     with closed_on_error(model, comm):           # a script going on after a failed run gets its communicators
-        steps = scene.time.steps if model.thermal is not None or wear is not None else 0
+        steps = scene.time.steps if outputs.marching(scene) else 0
         if resume:
             with io.stage("restoring the checkpoint"):
                 done, history = dataclasses.astuple(marching.restore(ckpt))
