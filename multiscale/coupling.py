@@ -77,6 +77,7 @@ from multiscale.errors import ConvergenceError
 from multiscale.loop_settings import LoopSettings
 from multiscale.macro.continuation import solve_on_new_laws
 from multiscale.macro.model import MacroModel
+from multiscale.macro.thickness import WearLimit
 from multiscale.micro.post_analysis import PostAnalysis, interface_exchange
 from multiscale.micro.wear import WEAR_TOL
 from multiscale.rough import RoughInterface
@@ -161,6 +162,7 @@ class Multiscale:
         self._last = None                             # this rank's zones, their post-analysis, loading, remote
         self.law_increment = None                     # m, displacement change of the last solve after new laws
         self.increments = post.substeps               # the most wear increments an update took (said as it grows)
+        self.limit = WearLimit(self.tm) if settings.wear else None   # the worn depths against the rough body's
 
     @property
     def partition_law(self) -> bool:
@@ -404,13 +406,22 @@ class Multiscale:
         fields = {"contact_stiffness": lambda: rough.facet_stiffness(contact.facet_gap(), iface.values(contact.stiffness))
                   * (not self.model.released),
                   "partition": lambda: iface.values(contact.partition),
-                  "wear_depth": lambda: np.where(rough.zone_of_facet >= 0, np.maximum(self.form_depth +   # (round-off)
-                                                 rough.wear_depth().mean(axis=(-2, -1))[rough.zone_of_facet], 0.0), 0.0)}
+                  "wear_depth": self.facet_wear_depth}
         if self.post.heating is not None:
             fields["flash_temperature"] = self.facet_flash
         if self.settings.wear:      # zero where body 1 does not wear (no k_w of its material)
             fields["counter_wear_depth"] = lambda: self.counter_depth.copy()
         return fields
+
+    def facet_wear_depth(self) -> np.ndarray:
+        """The rough body's worn depth [m] per facet: its zone's mean and the form beyond it (0 off the zones)."""
+        zone_of = self.rough.zone_of_facet
+        return np.where(zone_of >= 0, np.maximum(self.form_depth + self.rough.wear_depth().mean(axis=(-2, -1))[zone_of],
+                                                 0.0), 0.0)              # (round-off)
+
+    def worn_through(self) -> str | None:
+        """What the rough body wore through (``WearLimit.through``), or None (collective)."""
+        return self.limit.through(self.facet_wear_depth()) if self.limit is not None else None
 
     def facet_flash(self) -> np.ndarray:
         """Flash temperature [K] per facet: its zone's, or the rough body's macro surface
@@ -529,7 +540,7 @@ class Multiscale:
                        rms_height=self.rough.rms_height(heights), frictional_work=self.work,
                        wear_rate_mean=float(volume.sum()) / self.work if self.work > 0 else np.nan,   # (user trial M)
                        wear_substep_error=result.micro.wear_error,
-                       wear_substeps=result.micro.wear_substeps)
+                       wear_substeps=result.micro.wear_substeps, **self.limit.row(self.facet_wear_depth()))
             if self.post.counter_rate is not None:
                 row.update(counter_wear_volume=self.counter_volume,
                            counter_wear_max_depth=float(self.counter_depth.max(initial=0.0)))

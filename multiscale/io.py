@@ -26,7 +26,7 @@ from multiscale.signals import TERMINATING
 
 UNITS = {"time": "s", "force": "N", "pressure": "Pa", "temperature": "K", "heat": "J", "iterations": "-",
          "volume": "m^3", "depth": "m", "rms": "m", "work": "J", "area": "m^2", "moment": "N m", "wear_rate": "1/Pa",
-         "coefficient": "-", "speed": "m/s", "angular_speed": "rad/s"}
+         "coefficient": "-", "speed": "m/s", "angular_speed": "rad/s", "remaining": "m"}
 
 
 def unit_of(name: str) -> str:

@@ -549,6 +549,8 @@ def test_the_steps_series_compliance_is_the_depth_per_pressure_its_wear_takes(tm
     assert areas @ ms.facet_fields()["wear_depth"]() == pytest.approx(h["wear_volume"][-1], rel=1e-9)
     facet = form[on] + ms.rough.wear_depth().mean(axis=(-2, -1))[zone_of[on]]      # (the field clips round-off)
     assert facet.min() >= -1e-9 * facet.max()                                      # (it was -3.3e-14: 1.5e-6 of it)
+    np.testing.assert_allclose(ms.limit.thickness.value, 15e-3, rtol=1e-12)        # the pin's length behind each facet
+    assert h["wear_remaining_min"][-1] == pytest.approx(15e-3 - ms.facet_wear_depth().max(), rel=1e-12)
 
 
 def test_the_series_compliance_takes_k_w_at_the_temperatures_the_micro_wear_takes(tmp_path, monkeypatch):

@@ -123,6 +123,24 @@ def test_a_resumed_wearing_run_is_the_straight_one(tmp_path):
         np.testing.assert_allclose(resumed[key], straight[key], rtol=1e-9, atol=1e-15, err_msg=key)
 
 
+def test_a_pin_worn_through_ends_the_run_with_its_results(tmp_path):
+    """k_w = 1e-8 /Pa wears the coarse pin (15 mm long behind every facet) 11.3 mm deep at its
+    deepest facet in the first 3 s step and 22.6 mm in the second: the run ends after step 2 of 4,
+    said, with that step's history row, fields and checkpoint (marked finished: --resume has nothing
+    to do); ``wear_remaining_min`` is the length less the deepest wear."""
+    s = scene(tmp_path / "t", steps=4, end="12 s", wear='k_w = "1e-8 1/Pa"', **{"output.every": 4})
+    r = run(s, verbose=False)
+    h = r.history
+    assert list(h["time"]) == [0.0, 3.0, 6.0]
+    np.testing.assert_allclose(h["wear_remaining_min"], 15e-3 - h["wear_max_depth"], rtol=1e-12)
+    assert h["wear_remaining_min"][1] > 0 > h["wear_remaining_min"][2]
+    (note,) = [w for w in r.warnings if "worn through" in w]
+    assert note.startswith("pin worn through: 22.58 mm worn of its 15 mm at (") and "the run ended after step 2 of 4" in note
+    import meshio
+    assert meshio.xdmf.TimeSeriesReader(str(tmp_path / "t" / "interface.xdmf")).num_steps == 2    # t = 0 and the end
+    assert run(s, resume=True, verbose=False).history["time"][-1] == 6.0                       # nothing to do
+
+
 def test_the_scene_takes_wear_in_perfect_contact(tmp_path):
     """Wear needs no roughness: the run marches, checkpoints and writes the worn depths of both bodies;
     a table reads the faces' macro temperatures (check says so; its end is warned of at the worn

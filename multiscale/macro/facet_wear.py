@@ -42,6 +42,7 @@ import numpy as np
 
 from multiscale.errors import InputError
 from multiscale.geometry import Rotation
+from multiscale.macro.thickness import WearLimit
 from multiscale.micro.wear import WearRate
 
 STABLE = 0.5        # the largest c_f K_n of an explicit update (explicit Archard: oscillation above 1, growth above 2)
@@ -100,6 +101,7 @@ class FacetWear:
                                  "normal to its axis (its wear spreads round a circular track on them)")
         model.exposure, model.exposure_sliding, model.facet_reach = np.zeros((2, n)), 0.0, self.reach
         self.pending = False              # a released update waiting for the next loaded step
+        self.limit = WearLimit(model.tm)  # the worn depths against the thickness behind the facets
 
     def update(self, last: bool = False) -> tuple[np.ndarray, float]:
         """Wear over the model's ``exposure`` since the last update, then the exposure restarts and
@@ -187,18 +189,23 @@ class FacetWear:
         """History columns: ``wear_volume`` [m^3] (and per interface with several), ``wear_max_depth``
         [m], ``frictional_work`` [J] and ``wear_rate_mean`` [1/Pa] (volume / work) since the start,
         ``wear_substeps`` (1 in a row with an update, ``updated``, else 0: the rough loop's increments),
-        ``wear_implicit_updates`` (so far); with a wearing body 1 ``counter_wear_volume`` [m^3] and
-        ``counter_wear_max_depth`` [m]."""
+        ``wear_implicit_updates`` (so far), ``wear_remaining_min`` [m] (``WearLimit``); with a wearing
+        body 1 ``counter_wear_volume`` [m^3] and ``counter_wear_max_depth`` [m]."""
         tags = list(self.model.tm.interface.tags)
         row = {"wear_volume": float(self.volume.sum()), "wear_max_depth": float(self.depth.max(initial=0.0)),
                "frictional_work": self.work, "wear_substeps": int(updated), "wear_implicit_updates": self.implicit,
-               "wear_rate_mean": float(self.volume.sum()) / self.work if self.work > 0 else np.nan}
+               "wear_rate_mean": float(self.volume.sum()) / self.work if self.work > 0 else np.nan,
+               **self.limit.row(self.depth)}
         if len(tags) > 1:
             row.update({f"wear_volume_{name}": float(v) for name, v in zip(tags, self.volume)})
         if self.counter_rates:
             row.update(counter_wear_volume=self.counter_volume,
                        counter_wear_max_depth=float(self.counter_depth.max(initial=0.0)))
         return row
+
+    def worn_through(self) -> str | None:
+        """What body 0 wore through (``WearLimit.through``), or None (collective)."""
+        return self.limit.through(self.depth)
 
     def state(self) -> tuple[dict, dict]:
         """(attributes, arrays) a checkpoint keeps (``restore`` reads them back)."""

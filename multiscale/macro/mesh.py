@@ -135,16 +135,6 @@ class Body:
         facets = facets[facets < m.topology.index_map(tdim - 1).size_local]       # owned: each once
         return crossing(m.geometry.x[dmesh.entities_to_geometry(m, tdim - 1, facets)], motion, m.comm)
 
-    def extent(self, regions, direction) -> float:
-        """Extent [m] along the unit vector ``direction`` of the cells of region tags ``regions``
-        (0 if none; collective)."""
-        cells = np.flatnonzero(np.isin(self.region_tags, list(regions))).astype(np.int32)
-        g = self.mesh.geometry
-        a = g.x[g.dofmaps[0][cells]].reshape(-1, 3) @ np.asarray(direction, dtype=float)
-        lo = self.mesh.comm.allreduce(a.min(initial=np.inf), op=MPI.MIN)
-        hi = self.mesh.comm.allreduce(a.max(initial=-np.inf), op=MPI.MAX)
-        return max(hi - lo, 0.0) if np.isfinite(lo) else 0.0
-
     def has_face(self, tag: int) -> bool:
         """True if the face ``tag`` belongs to this body (on any rank)."""
         return bool(self.mesh.comm.allreduce(len(self.facet_tags.find(tag)), op=MPI.SUM))

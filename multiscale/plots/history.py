@@ -150,7 +150,9 @@ def history_figure(history, path: Path, title: str = "") -> Path:
               ("wear volume [mm³]", [k for k in history.columns if k.startswith("wear_volume_")]
                or [k for k in ("wear_volume",) if k in history.columns], 1e9, 0.0),             # (its interfaces')
               ("max wear depth [µm]", [k for k in ("wear_max_depth", "counter_wear_max_depth") if k in history.columns],
-               1e6, 0.0)]
+               1e6, 0.0),
+              ("least material left\nbehind a facet [mm]", [k for k in ("wear_remaining_min",) if k in history.columns],
+               1e3, 0.0)]
     groups = [g for g in groups if g[1] and all(k in history.columns for k in g[1])]
     rows = 1 if len(groups) <= 4 else 2
     cols = -(-len(groups) // rows)

@@ -47,7 +47,7 @@ from multiscale.workflows.rough import (build_rough_interface, check_rough_scene
                                         thermal_kernels)
 from multiscale.workflows import stepping
 from multiscale.workflows.strain import refuse_floating, say_at_once
-from multiscale.workflows.transient import TransientResult, stopped_after, write_history
+from multiscale.workflows.transient import TransientResult, write_history
 
 
 @dataclass
@@ -162,18 +162,19 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         last = steps if stop_after is None else min(steps, stop_after)
         # a Ctrl-C while the end is written lets it finish
         with io.StepStop(comm, done) as stop, heat_warnings_as_notes(ms.model):
-            done, stopping = stepping.march(ms, stop, history, writer,
+            done, stopping, through = stepping.march(ms, stop, history, writer,
                                             lambda: write_history(history, folder, scene.name, comm, plot=False),
                                             ckpt, done=done, last=last, steps=steps, every=every)
             with io.stage("writing history and plots"), stop.writing(done, last=not stopping):
-                title = scene.name + stopped_after(done, steps) * stopping
+                title = scene.name + stepping.stopped_after(done, steps, stopping, through)
                 h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures, title=title)
                 plot, maps, zones = write_zone_results(ms, folder, history, title, comm, scene.output.figures)
-        if done == steps:
+        if done == steps or through:
             checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
         result = MultiscaleResult(folder, writer.files + [f for f in (h5, png, plot, zones, ckpt) if f] + maps,
                                   _time.perf_counter() - start, history, h5, png, writer.files, plot, maps, zones,
-                                  done, warnings=run_notes(ms.model) + worn_through(ms, *_wear_keys(scene)))
+                                  done, warnings=run_notes(ms.model) + through_layers(ms, *_wear_keys(scene)) +
+                                  ((stepping.worn_note(through, done, steps),) if through else ()))
         ms.model.close()          # on every rank in the same order (MUMPS' destruction communicates)
     if stopping:                 # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", result.warnings)
@@ -188,25 +189,18 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     return result
 
 
-def worn_through(ms: Multiscale, rate: str = "wear.k_w", layers: float = 0.0) -> tuple:
-    """Rough interfaces whose deepest wear exceeds the extent of the material it wears along the
-    interface's normal (its regions beside the interface), or the ``layers`` [m] on it (their
-    total thickness): the body or its coating is worn through, which the model does not follow
-    (the zones' topographies wear, the macro geometry and the micro kernel do not; an adversarial
-    trial's wear rate took a 15 mm pin 73 mm deep, a materials trial's a 2 um coating 15.6 um).
-    ``rate``: the key of the wear rate, for the message. Collective."""
-    rough, tm = ms.rough, ms.model.tm
+def through_layers(ms: Multiscale, rate: str = "wear.k_w", layers: float = 0.0) -> tuple:
+    """Rough interfaces whose deepest wear exceeds the ``layers`` [m] on them (their total thickness):
+    the coating is worn through, which the micro kernel does not follow (a materials trial's wear
+    rate took a 2 um coating 15.6 um). The body itself worn through ends the run (``Multiscale.
+    worn_through``: an adversarial trial's wear rate took a 15 mm pin 73 mm deep). ``rate``: the key
+    of the wear rate, for the message."""
+    rough = ms.rough
     depth = rough.wear_depth().max(axis=(-2, -1), initial=0.0)
     out = []
-    for k, name in enumerate(rough.names):
+    for name in rough.names:
         deepest = float(depth[rough.zone_of(name)].max(initial=0.0))
-        extent = tm.bodies[0].extent(tm.interface.plus_regions[name], rough.planes[k].frame[2])
-        if deepest > extent > 0:
-            out.append(f"the wear on interface {name!r} reached {deepest * 1e3:.3g} mm deep, more than the "
-                       f"{extent * 1e3:.3g} mm of the material it wears along the contact normal: worn through, "
-                       "which the model does not follow (the zones' topographies wear, the macro geometry does not); "
-                       f"check the wear rate ({rate}) and the duration")
-        elif deepest > layers > 0:
+        if deepest > layers > 0:
             out.append(f"the wear on interface {name!r} reached {deepest * 1e6:.3g} um deep, through its layers "
                        f"({layers * 1e6:.3g} um): the micro contact keeps them (its kernel is the layered one), so "
                        f"the worn zones' laws are those of a coating that is gone; check the wear rate ({rate})")

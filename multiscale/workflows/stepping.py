@@ -57,18 +57,21 @@ def field_output(model, folder: Path, names, *, done: int, steps: int, every: in
 
 
 def march(run, stop: io.StepStop, history: io.History, writer: FieldOutput, write_history, ckpt: Path, *,
-          done: int, last: int, steps: int, every: int) -> tuple[int, bool]:
+          done: int, last: int, steps: int, every: int) -> tuple[int, bool, str | None]:
     """Macro steps ``done`` + 1 ... ``last`` of ``steps`` (module docstring): ``run`` has
-    ``step(n)`` (its result goes to ``record``), ``record(stepped)`` (a history row) and
-    ``save(ckpt, n, history)`` (the checkpoint); ``write_history()`` writes the history file.
-    Returns the last step done and whether a Ctrl-C stops the run there (decided by every rank)."""
-    stopping = False
+    ``step(n)`` (its result goes to ``record``), ``record(stepped)`` (a history row),
+    ``save(ckpt, n, history)`` (the checkpoint) and ``worn_through()`` (what wore through, or None:
+    the run ends after that step, its fields written); ``write_history()`` writes the history file.
+    Returns the last step done, whether a Ctrl-C stops the run there and what wore through (decided
+    by every rank)."""
+    stopping, through = False, None
     with io.stage("macro steps"):
         for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
             stepped = run.step(n)
+            through = run.worn_through()
             with stop.writing(n):                     # the step's fields, checkpoint and history, whole
                 history.append(**run.record(stepped))
-                due = field_step(n, every, steps)
+                due = field_step(n, every, steps) or through is not None
                 if due:
                     writer.write()                    # before the checkpoint: killed between, they are dropped
                 run.save(ckpt, n, history)
@@ -76,9 +79,9 @@ def march(run, stop: io.StepStop, history: io.History, writer: FieldOutput, writ
                 done, stopping = n, n < steps and stop.requested()   # (the last: it finishes)
                 if stopping and not due:
                     writer.write()                    # the stop's, dropped when resumed
-            if stopping:
+            if stopping or through:
                 break
-    return done, stopping
+    return done, stopping, through
 
 
 def ended(folder: Path, name: str, steps: int, comm, verbose: bool) -> tuple[io.History, list, Path | None]:
@@ -89,3 +92,16 @@ def ended(folder: Path, name: str, steps: int, comm, verbose: bool) -> tuple[io.
               "use --overwrite to run it again (in Python: overwrite=True)")
     png = folder / "history.png"
     return io.History.read(folder / "history.h5"), sorted(folder.glob("*.xdmf")), png if png.is_file() else None
+
+
+def stopped_after(done: int, steps: int, stopping: bool, through: str | None = None) -> str:
+    """The figures' title note of a run stopped by Ctrl-C (theirs said nothing of it: a user trial) or
+    ended by a part worn ``through`` (``march``); "" otherwise."""
+    return f" (stopped after step {done} of {steps})" if stopping else \
+        f" (worn through at step {done} of {steps})" if through else ""
+
+
+def worn_note(through: str, done: int, steps: int) -> str:
+    """The warning of a run that ended at step ``done`` of ``steps`` because a part wore ``through``."""
+    return (f"{through}: the run ended after step {done} of {steps}, its results written (the model keeps the "
+            "bodies' shapes: beyond it, what lies behind the worn part, a pad's backplate, would rub unseen)")

@@ -53,11 +53,6 @@ def write_history(history: io.History, folder: Path, name: str, comm, plot: bool
     return h5, png
 
 
-def stopped_after(done: int, steps: int) -> str:
-    """The figures' title note of a run stopped by Ctrl-C (theirs said nothing of it: a user trial)."""
-    return f" (stopped after step {done} of {steps})"
-
-
 class Marching:
     """A perfect-contact model as ``stepping.march`` drives it: its macro steps (with ``wear``, the
     facets' Archard wear every ``wear.update_every`` steps and at the last), history rows and
@@ -78,6 +73,9 @@ class Marching:
 
     def record(self, heat) -> dict:
         return {**self.model.record(heat), **(self.wear.row(self.updated) if self.wear is not None else {})}
+
+    def worn_through(self) -> str | None:
+        return self.wear.worn_through() if self.wear is not None else None
 
     def save(self, path: Path, step: int, history: io.History) -> None:
         """Checkpoint after macro step ``step`` (collective; ``checkpoint.save_step``)."""
@@ -147,20 +145,21 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                 say_at_once(scene, history, comm)
         last = steps if stop_after is None else min(steps, stop_after)
         with io.StepStop(comm, done) as stop, heat_warnings_as_notes(model):   # a Ctrl-C while the end is written lets it finish
-            done, stopping = stepping.march(marching, stop, history, writer,
+            done, stopping, through = stepping.march(marching, stop, history, writer,
                                             lambda: write_history(history, folder, scene.name, comm, plot=False),
                                             ckpt, done=done, last=last, steps=steps, every=scene.output.every)
             with io.stage("writing history and plots"), stop.writing(done, last=not stopping):
                 h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures,
-                                        title=scene.name + stopped_after(done, steps) * stopping)
-        if steps and done == steps:
+                                        title=scene.name + stepping.stopped_after(done, steps, stopping, through))
+        if steps and (done == steps or through):
             checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
         model.close()                    # on every rank in the same order (MUMPS' destruction communicates)
     if stopping:                     # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", run_notes(model))
     kept = [ckpt] if steps else []
     result = TransientResult(folder, writer.files + [f for f in (h5, png) if f] + kept, _time.perf_counter() - start,
-                             history, h5, png, writer.files, warnings=run_notes(model))
+                             history, h5, png, writer.files,
+                             warnings=run_notes(model) + ((stepping.worn_note(through, done, steps),) if through else ()))
     if verbose and comm.rank == 0:
         print(f"{scene.name}: {io.counted(len(history), 'record')} in {result.wall_time:.1f} s on "
               f"{io.counted(comm.size, 'rank')}")

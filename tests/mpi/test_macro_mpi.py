@@ -144,3 +144,16 @@ def test_two_ranks_give_the_serial_facet_wear(tmp_path):
     assert serial["wear_implicit_updates"][-1] >= 2 and serial["counter_wear_volume"][-1] > 0
     for key in (k for k in serial if not solver_statistic(k)):
         np.testing.assert_allclose(parallel[key], serial[key], rtol=1e-8, atol=1e-15, err_msg=key)
+
+
+def test_a_pin_worn_through_ends_the_run_on_both_ranks(tmp_path):
+    """The thickness behind the facets (rays cut by each rank's share, ``macro.thickness``) and the
+    decision to end (rank 0's, broadcast): the pin worn through at step 2 of 4 on two ranks as on one."""
+    def through(folder):
+        text = pin_on_disc(folder, name="through_mpi", effects=("contact", "friction", "wear")).replace(
+            "partition = ", "# partition = ") + '\n[wear]\nk_w = "1e-8 1/Pa"\n'
+        return loads(text, overrides={"time.steps": 4, "time.end": "12 s"})
+    parallel, serial = histories(through, MPI.COMM_WORLD.bcast(str(tmp_path), root=0))
+    assert list(parallel["time"]) == list(serial["time"]) == [0.0, 3.0, 6.0]
+    np.testing.assert_allclose(parallel["wear_remaining_min"], serial["wear_remaining_min"], rtol=1e-8)
+    assert serial["wear_remaining_min"][0] == pytest.approx(15e-3, rel=1e-12) and serial["wear_remaining_min"][-1] < 0

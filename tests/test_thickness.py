@@ -1,0 +1,70 @@
+"""The material behind each interface facet (``multiscale.macro.thickness``): the boundary of a set of
+tetrahedra, rays cut with it, the thickness of a meshed block, and the message of a part worn
+through."""
+import numpy as np
+import pytest
+
+from multiscale.macro.thickness import part_boundaries, ray_exit
+
+
+def sloped_box(n: int = 4):
+    """The unit cube in n^3 cubes of 6 tetrahedra each (Kuhn), its top lifted to z = 1 + x / 2
+    (z -> z (1 + x / 2): every face of the top stays in that plane): (tets (6 n^3, 4, 3), the
+    z-index of each tetrahedron's cube)."""
+    paths = [(0, 1, 2), (0, 2, 1), (1, 0, 2), (1, 2, 0), (2, 0, 1), (2, 1, 0)]
+    tets, layer = [], []
+    for i, j, k in np.ndindex(n, n, n):
+        for path in paths:
+            corner, tet = np.array([i, j, k], float), [np.array([i, j, k], float)]
+            for axis in path:
+                corner = corner.copy()
+                corner[axis] += 1
+                tet.append(corner)
+            tets.append(np.array(tet) / n)
+            layer.append(k)
+    tets = np.array(tets)
+    tets[..., 2] *= 1 + tets[..., 0] / 2
+    return tets, np.array(layer)
+
+
+def test_rays_leave_a_sloped_box_through_its_top_and_a_part_through_the_face_it_shares():
+    """From the midpoints of the bottom's triangles straight up: the top lies at 1 + x / 2 (to
+    round-off); the lower half of the cells (a part bonded to the upper) ends at its shared face,
+    (1 + x / 2) / 2. The boundary's normals point into the cells: +z on the bottom."""
+    tets, layer = sloped_box()
+    tri, normal = part_boundaries(tets)
+    assert len(tri) == 6 * 2 * 16                                     # two triangles a square, 16 squares a side
+    bottom = np.all(tri[:, :, 2] == 0, axis=1)
+    assert bottom.sum() == 32
+    np.testing.assert_allclose(normal[bottom], np.tile([0.0, 0.0, 1.0], (32, 1)), atol=1e-15)
+    start = tri[bottom].mean(axis=1)
+    top = 1 + start[:, 0] / 2
+    np.testing.assert_allclose(ray_exit(start, normal[bottom], tri, 1e-12), top, rtol=1e-13)
+    low_tri, low_normal = part_boundaries(tets[layer < 2])
+    assert len(low_tri) == 2 * 32 + 4 * 2 * 8                         # bottom, shared face, four sides of 2 x 4 squares
+    np.testing.assert_allclose(ray_exit(start, normal[bottom], low_tri, 1e-12), top / 2, rtol=1e-13)
+    sideways = ray_exit(np.array([[0.5, 0.5, 0.25]]), np.array([[-1.0, 0.0, 0.0]]), low_tri, 1e-12)
+    assert sideways == pytest.approx([0.5], rel=1e-13)
+    assert ray_exit(start[:1], -normal[bottom][:1], tri, 1e-12) == [np.inf]     # out of the box: nothing
+
+
+dolfinx = pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
+
+
+def test_the_block_keeps_five_millimetres_behind_every_facet_until_worn_through():
+    """The block on the flat (10 x 10 x 5 mm, 2.5 mm cells): 5 mm behind each interface facet; worn
+    4 mm it keeps 1 mm, worn 6 mm at one facet it is through there (named, with the place)."""
+    from multiscale.geometry import builder
+    from multiscale.macro import mesh
+    from multiscale.macro.thickness import WearLimit
+    tm = mesh.build(builder("block_on_flat"), {"mesh_size": 2.5e-3})
+    limit = WearLimit(tm)
+    n = tm.interface.n_facets
+    np.testing.assert_allclose(limit.thickness.value, 5e-3, rtol=1e-12)
+    assert set(limit.thickness.part) == {0} and limit.thickness.names == (tm.bodies[0].spec.regions[0].name,)
+    depth = np.full(n, 4e-3)
+    assert limit.row(depth)["wear_remaining_min"] == pytest.approx(1e-3, rel=1e-10) and limit.through(depth) is None
+    depth[7] = 6e-3
+    where = ", ".join(f"{1e3 * x:.4g}" for x in tm.interface.midpoints[7])
+    assert limit.through(depth) == (f"{limit.thickness.names[0]} worn through: 6 mm worn of its 5 mm at ({where}) mm, "
+                                    "1 facet(s) through")
