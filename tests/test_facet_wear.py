@@ -123,6 +123,24 @@ def test_a_resumed_wearing_run_is_the_straight_one(tmp_path):
         np.testing.assert_allclose(resumed[key], straight[key], rtol=1e-9, atol=1e-15, err_msg=key)
 
 
+def test_a_table_reads_the_temperatures_of_the_whole_interval(tmp_path):
+    """k_w(T) linear over the heating pin's faces (1e-18 to 1e-16 /Pa from 20 to 120 degC; the face
+    20 -> 25 degC in 9 s): one update after three steps wears what three updates wear, within 1e-5
+    (measured 1.3e-6: the wear's own feedback on the pressure), as the exposure weights each
+    substep's face temperatures by its work. Read at the update, the one update wore 14 % more (the
+    whole interval at its end's temperature)."""
+    from test_macro_run import pin_on_disc
+    table = 'k_w_table = [["20 degC", "1e-18 1/Pa"], ["120 degC", "1e-16 1/Pa"]]'
+    volumes = []
+    for every in (1, 3):
+        text = pin_on_disc(tmp_path / f"u{every}", effects=("contact", "friction", "thermal", "heat_partition", "wear"))
+        h = run(loads(text + f"\n[wear]\n{table}\nupdate_every = {every}\n",
+                      overrides={"time.steps": 3, "time.end": "9 s"}), verbose=False).history
+        assert h["max_temperature_pin"][-1] > 298.0
+        volumes.append(h["wear_volume"][-1])
+    assert volumes[1] == pytest.approx(volumes[0], rel=1e-5)
+
+
 def test_a_pin_worn_through_ends_the_run_with_its_results(tmp_path):
     """k_w = 1e-8 /Pa wears the coarse pin (15 mm long behind every facet) 11.3 mm deep at its
     deepest facet in the first 3 s step and 22.6 mm in the second: the run ends after step 2 of 4,

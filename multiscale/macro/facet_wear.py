@@ -6,8 +6,10 @@ normal load (``per_load``), dh_f = k_f L_f / A_f (L_f = p_f ds_f A_f [N m]), ove
 the last update: ``MacroModel.exposure`` sums them as the heat and the frictional work are summed,
 each substep's pressure over its load-weighted sliding, ds_f = |w_f| ds (|w_f| the facet's speed
 per unit of body 1's: its distance from the axis of a rotation, 1 for a translation). k_f is the
-rate of the facet's interface at the facet's face temperature at the update (a table; without heat
-the initial temperature). The worn depth opens the facet's initial gap and the contact is solved
+rate of the facet's interface at the facet's face temperature (a table) averaged over the interval,
+weighted by the facet's work (its load for a rate per load), each substep's the mean of its start
+and end (``MacroModel.exposure``; read at the update, a table gave a cooled interval the rate of its
+end); without heat the initial temperature. The worn depth opens the facet's initial gap and the contact is solved
 on the worn gaps: the pressure redistributes (towards p |w| uniform: the steady state of a face
 that wears all over, its profile receding as a whole). A rotating body 1 whose material gives k_w
 loses k_w,1(T_1) W_f per facet (per frictional work), spread round the circle of the facet's radius
@@ -99,7 +101,7 @@ class FacetWear:
             if not flat:
                 raise InputError("counter-face wear", r.rate, "a rotating body 1 whose worn faces lie in planes "
                                  "normal to its axis (its wear spreads round a circular track on them)")
-        model.exposure, model.exposure_sliding, model.facet_reach = np.zeros((2, n)), 0.0, self.reach
+        model.exposure, model.exposure_sliding, model.facet_reach = np.zeros((5, n)), 0.0, self.reach
         self.pending = False              # a released update waiting for the next loaded step
         self.limit = WearLimit(model.tm)  # the worn depths against the thickness behind the facets
 
@@ -109,16 +111,21 @@ class FacetWear:
         update that would be implicit waits (``pending``) for the next loaded step, unless it is the
         ``last``. Returns the volume [m^3] body 0 lost per interface and the frictional work [J]."""
         m, iface = self.model, self.model.tm.interface
-        (work, load), solved = m.exposure, float(m.mechanics.load.value)
+        (work, load, *weighted), solved = m.exposure, float(m.mechanics.load.value)
         slid = m.exposure_sliding / solved if solved else 0.0     # the sliding of the pressure solved now
         none = np.zeros(len(iface.tags)), 0.0
         if not m.exposure_sliding:
             return none
-        T0, T1 = (m.thermal.facet_temperature(0), m.thermal.facet_temperature(1)) if m.thermal is not None else \
-            (np.full(iface.n_facets, self.temperature),) * 2
         k, per_load, k1 = np.zeros(iface.n_facets), np.zeros(iface.n_facets, dtype=bool), np.zeros(iface.n_facets)
         for r in self.rates:
-            k[r.mask], per_load[r.mask] = np.broadcast_to(r.rate(T0[r.mask]), (int(r.mask.sum()),)), r.per_load
+            per_load[r.mask] = r.per_load
+        T0, T1 = np.full((2, iface.n_facets), self.temperature) if m.thermal is None else m.face_temperatures()[1:]
+        if m.thermal is not None:                 # weighted by the exposure (now's where a facet had none)
+            for T, (sum_T, weight) in zip((T0, T1), ((np.where(per_load, weighted[1], weighted[0]),
+                                                      np.where(per_load, load, work)), (weighted[2], work))):
+                np.divide(sum_T, weight, out=T, where=weight > 0)
+        for r in self.rates:
+            k[r.mask] = np.broadcast_to(r.rate(T0[r.mask]), (int(r.mask.sum()),))
         for r in self.counter_rates:
             k1[r.mask] = np.broadcast_to(r.rate(T1[r.mask]), (int(r.mask.sum()),))
         mu, K = iface.values(m.contact.friction), iface.values(m.contact.stiffness)

@@ -99,8 +99,10 @@ class MacroModel:
     notes: list = field(default_factory=list)          # what the run's warnings add (an unbalanced clamp, Mechanics.notes)
     probes: Probes | None = None                       # thermocouples: ``probe_temperature_<name>`` columns
     # since the last wear update (``facet_wear.FacetWear`` sets them; None: not summed): per facet the frictional
-    # work mu p |w| ds dA [J] and p |w| ds dA [N m], and body 1's load-weighted sliding ds [rad or m] times the load
-    # each substep's pressure was solved at [N or Pa] (over the load now: the sliding of the pressure now)
+    # work W = mu p |w| ds dA [J], L = p |w| ds dA [N m], and W T_0, L T_0, W T_1 (T_i body i's face temperature
+    # [K], each substep's the mean of its start and end: the wear's tables read at their weighted means; zero
+    # without heat), and body 1's load-weighted sliding ds [rad or m] times the load each substep's pressure
+    # was solved at [N or Pa] (over the load now: the sliding of the pressure now)
     exposure: np.ndarray | None = None
     exposure_sliding: float = 0.0
     facet_reach: np.ndarray | None = None              # |w| per facet at unit speed of body 1 [m per rad, or 1]
@@ -159,6 +161,14 @@ class MacroModel:
         self.notes = [*self.tm.notes, *mech.notes, *([clamp] if clamp is not None else [])]
         return self.last_solve
 
+    def face_temperatures(self) -> np.ndarray:
+        """(T_0, T_0, T_1) per interface facet [K], the faces' mean temperatures of body 0 and 1 (zeros
+        without heat): the weights of the exposure's rows W, L, W."""
+        if self.thermal is None:
+            return np.zeros((3, self.tm.interface.n_facets))
+        T0 = self.thermal.facet_temperature(0)
+        return np.stack([T0, T0, self.thermal.facet_temperature(1)])
+
     def macro_step(self, dt: float, substeps: int = 1) -> np.ndarray:
         """Advance by one macro step dt [s] in ``substeps`` (Fig. 7.4); returns the heat [J] put
         into each body during the step. ``work_step`` [J] is the step's frictional work mu ∫ p |w| dA
@@ -189,7 +199,8 @@ class MacroModel:
                     if not (mu > 0).all():          # (an assembly: only where a facet has no friction)
                         load = np.where(mu > 0, load, self.contact.facet_pressure() * self.tm.interface.areas
                                         * self.facet_reach)
-                    self.exposure += slid * np.stack([power, load])
+                    exposed = slid * np.stack([power, load, power])
+                    self.exposure += np.concatenate([exposed[:2], 0.5 * exposed * self.face_temperatures()])
                     self.exposure_sliding += slid * float(self.mechanics.load.value)
             if self.thermal is not None:
                 # the pressure was solved at the load factor of the step's start: the conductance
@@ -200,6 +211,8 @@ class MacroModel:
                 self.contact.engaged.value = self.drive.mean_factor(t0, t1) * scale
                 self.contact.heating.value = self.drive.mean_sliding(t0, t1) / speed * scale if speed else 0.0
                 done = self.thermal.step(delta)
+                if slid and self.exposure is not None:      # (the substep's end: its mean temperatures)
+                    self.exposure[2:] += 0.5 * exposed * self.face_temperatures()
                 # (kept if set before: a reload after a dwell of two steps skipped its solve, 27 % off: a review)
                 self.stale = self.update_friction() or self.stale or self.mechanics.temperatures is not None
                 heat += done.heat_in
