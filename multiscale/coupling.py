@@ -162,7 +162,7 @@ class Multiscale:
         self._last = None                             # this rank's zones, their post-analysis, loading, remote
         self.law_increment = None                     # m, displacement change of the last solve after new laws
         self.increments = post.substeps               # the most wear increments an update took (said as it grows)
-        self.limit = WearLimit(self.tm) if settings.wear else None   # the worn depths against the rough body's
+        self.limit = WearLimit(self.tm, settings.wear_limit) if settings.wear else None   # against the rough body
 
     @property
     def partition_law(self) -> bool:

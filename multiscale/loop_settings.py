@@ -22,6 +22,7 @@ class LoopSettings:
     partition_law: bool = False   # micro partition per zone (ch. 6) instead of the constant
     wear: bool = False            # Archard wear of the zones
     wear_every: int = 1           # macro steps per wear update
+    wear_limit: float = 0.0       # m, material kept behind a worn facet: the run ends below it (0: worn through)
     steps: int | None = None      # macro steps of the run: the last wears the rest of a wear interval
     flash_softening: bool = False  # H(T) of each zone at its last micro flash temperature (plasticity)
     forces: dict = field(default_factory=dict)   # N, per interface: the load it nominally carries

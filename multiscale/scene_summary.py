@@ -289,8 +289,10 @@ def _effect_line(scene: Scene, effect: str) -> str:
                 " (wear.temperature),"
         increments = f"in {w.substeps} increment(s)" if scene.has("roughness") else \
             "per interface facet (perfect contact: its gap opens), linearly implicit where it would not be stable"
+        end = f"{w.limit * 1e3:.4g} mm are left behind a facet" if w.limit else "a worn part is worn through"
         return (f"Archard dh = {law} every {w.update_every} step(s) {increments}{both}; "
-                f"{rate} (k_w per frictional work, k per normal load: a specific wear rate k is k_w = k/mu)")
+                f"{rate} (k_w per frictional work, k per normal load: a specific wear rate k is k_w = k/mu); "
+                f"the run ends once {end} (wear.limit)")
 
     return EFFECTS[effect].doc
 

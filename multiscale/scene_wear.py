@@ -40,7 +40,9 @@ class Wear:
     estimate exceeds ``micro.wear.WEAR_TOL``; a counter-face whose material gives ``k_w`` wears too.
     Without effect "roughness" the interface facets wear (``macro.facet_wear``: at their face
     temperatures, their gaps opened; an update linearly implicit where an explicit one would not be
-    stable)."""
+    stable). The run ends after the step that leaves less than ``limit`` [m] of a worn part behind a
+    facet (``macro.thickness``: a car pad's wear limit, some 2-3 mm of friction material; 0: worn
+    through)."""
 
     k_w: float | None = key(Quantity("wear_rate", gt=0, plausible=(1e-20, 1e-9)), absent=_RULE)
     k_w_table: tuple | None = key(Curve(TEMPERATURE, _PER_WORK, "temperature", "k_w"), absent=_RULE)
@@ -49,6 +51,7 @@ class Wear:
     temperature: str = key(Choice(("surface", "macro")), default="surface")   # what a k_w(T) or k(T) reads
     update_every: int = key(Integer(ge=1), default=1)                         # macro steps per update
     substeps: int = key(Integer(ge=1), default=1)                             # wear increments per update
+    limit: float = key(Quantity("length", ge=0), default=0.0)   # material kept behind a worn face: the run ends below it
 
     rules = (OneOf(("k_w", "k_w_table", "specific_rate", "specific_rate_table")),)
 

@@ -144,8 +144,10 @@ def test_a_table_reads_the_temperatures_of_the_whole_interval(tmp_path):
 def test_a_pin_worn_through_ends_the_run_with_its_results(tmp_path):
     """k_w = 1e-8 /Pa wears the coarse pin (15 mm long behind every facet) 11.3 mm deep at its
     deepest facet in the first 3 s step and 22.6 mm in the second: the run ends after step 2 of 4,
-    said, with that step's history row, fields and checkpoint (marked finished: --resume has nothing
-    to do); ``wear_remaining_min`` is the length less the deepest wear."""
+    said, with that step's history row, fields and checkpoint (--resume steps no further);
+    ``wear_remaining_min`` is the length less the deepest wear. With ``wear.limit`` = 5 mm it ends
+    after step 1 (3.7 mm left), and resumed without the limit (not part of the checkpoint's
+    fingerprint) it goes on to the straight run's end."""
     s = scene(tmp_path / "t", steps=4, end="12 s", wear='k_w = "1e-8 1/Pa"', **{"output.every": 4})
     r = run(s, verbose=False)
     h = r.history
@@ -156,7 +158,14 @@ def test_a_pin_worn_through_ends_the_run_with_its_results(tmp_path):
     assert note.startswith("pin worn through: 22.58 mm worn of its 15 mm at (") and "the run ended after step 2 of 4" in note
     import meshio
     assert meshio.xdmf.TimeSeriesReader(str(tmp_path / "t" / "interface.xdmf")).num_steps == 2    # t = 0 and the end
-    assert run(s, resume=True, verbose=False).history["time"][-1] == 6.0                       # nothing to do
+    assert list(run(s, resume=True, verbose=False).history["time"]) == [0.0, 3.0, 6.0]          # no step further
+    kept = scene(tmp_path / "k", steps=4, end="12 s", wear='k_w = "1e-8 1/Pa"\nlimit = "5 mm"', **{"output.every": 4})
+    r = run(kept, verbose=False)
+    assert list(r.history["time"]) == [0.0, 3.0]
+    assert any(w.startswith("pin at its wear limit: 11.29 mm worn of its 15 mm at (") for w in r.warnings)
+    on = run(scene(tmp_path / "k", steps=4, end="12 s", wear='k_w = "1e-8 1/Pa"', **{"output.every": 4}),
+             resume=True, verbose=False).history
+    np.testing.assert_allclose(on["wear_remaining_min"], h["wear_remaining_min"], rtol=1e-8)
 
 
 def test_the_scene_takes_wear_in_perfect_contact(tmp_path):

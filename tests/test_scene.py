@@ -1543,7 +1543,8 @@ def test_a_wear_table_left_by_the_run_is_warned_about(tmp_path):
     assert not [w for w in loads(own.replace('"20 degC"', '"1 K"'), tmp_path).warnings if w.startswith("wear.")]
     from multiscale.scene_summary import summary
     assert any(line.endswith("; k_w of its material (k_w per frictional work, k per normal load: a specific wear "
-                             "rate k is k_w = k/mu)") for line in summary(loads(own, tmp_path)))
+                             "rate k is k_w = k/mu); the run ends once a worn part is worn through (wear.limit)")
+               for line in summary(loads(own, tmp_path)))
 
 
 def test_a_penalty_softer_than_the_bodies_is_warned_about(tmp_path):

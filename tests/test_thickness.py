@@ -53,9 +53,11 @@ dolfinx = pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not instal
 
 def test_the_block_keeps_five_millimetres_behind_every_facet_until_worn_through():
     """The block on the flat (10 x 10 x 5 mm, 2.5 mm cells): 5 mm behind each interface facet; worn
-    4 mm it keeps 1 mm, worn 6 mm at one facet it is through there (named, with the place)."""
+    4 mm it keeps 1 mm, worn 6 mm at one facet it is through there (named, with the place); with a
+    wear limit of 1.5 mm, 3.6 mm worn reaches it, 3.4 mm does not; a limit of 5 mm is refused."""
     from multiscale.geometry import builder
     from multiscale.macro import mesh
+    from multiscale.errors import InputError
     from multiscale.macro.thickness import WearLimit
     tm = mesh.build(builder("block_on_flat"), {"mesh_size": 2.5e-3})
     limit = WearLimit(tm)
@@ -66,5 +68,14 @@ def test_the_block_keeps_five_millimetres_behind_every_facet_until_worn_through(
     assert limit.row(depth)["wear_remaining_min"] == pytest.approx(1e-3, rel=1e-10) and limit.through(depth) is None
     depth[7] = 6e-3
     where = ", ".join(f"{1e3 * x:.4g}" for x in tm.interface.midpoints[7])
-    assert limit.through(depth) == (f"{limit.thickness.names[0]} worn through: 6 mm worn of its 5 mm at ({where}) mm, "
-                                    "1 facet(s) through")
+    name = limit.thickness.names[0]
+    assert limit.through(depth).startswith(f"{name} worn through: 6 mm worn of its 5 mm at ({where}) mm, 1 facet(s) through")
+    keep = WearLimit(tm, 1.5e-3)                                     # a wear limit: 1.5 mm to keep
+    assert keep.through(np.full(n, 3.4e-3)) is None
+    depth[:] = 3.4e-3
+    depth[:3] = 3.6e-3
+    assert keep.through(depth).startswith(f"{name} at its wear limit: 3.6 mm worn of its 5 mm at (")
+    assert keep.through(depth).endswith("1.4 mm left (wear.limit 1.5 mm), 3 facet(s) at it")
+    with pytest.raises(InputError, match=f'wear.limit = "5 mm": less than the thinnest part behind an interface facet: '
+                                         f"{name}, 5 mm"):
+        WearLimit(tm, 5e-3)

@@ -79,10 +79,11 @@ class FacetWear:
     body 0 and ``counter_depth`` of body 1 [m] per facet (global arrays), ``volume`` [m^3] lost per
     interface and ``counter_volume`` [m^3] since the start, ``work`` [J] of the updates, ``implicit``
     the updates taken linearly implicit. ``counter_rates``: body 1's k_w on the facets it gives
-    (``FacetRate``; none: it does not wear); ``temperature`` [K] where no heat is solved."""
+    (``FacetRate``; none: it does not wear); ``temperature`` [K] where no heat is solved; ``limit`` [m]
+    the material to keep behind a facet (``WearLimit``)."""
 
     def __init__(self, model, rates: Sequence[FacetRate], counter_rates: Sequence[FacetRate] = (),
-                 temperature: float = 293.15):
+                 temperature: float = 293.15, limit: float = 0.0):
         iface, motion = model.tm.interface, model.tm.spec.motion
         self.model, self.rates, self.counter_rates = model, tuple(rates), tuple(counter_rates)
         self.temperature = float(temperature)
@@ -103,7 +104,7 @@ class FacetWear:
                                  "normal to its axis (its wear spreads round a circular track on them)")
         model.exposure, model.exposure_sliding, model.facet_reach = np.zeros((5, n)), 0.0, self.reach
         self.pending = False              # a released update waiting for the next loaded step
-        self.limit = WearLimit(model.tm)  # the worn depths against the thickness behind the facets
+        self.limit = WearLimit(model.tm, limit)   # the worn depths against the thickness behind the facets
 
     def update(self, last: bool = False) -> tuple[np.ndarray, float]:
         """Wear over the model's ``exposure`` since the last update, then the exposure restarts and

@@ -20,6 +20,8 @@ import numpy as np
 from numba import njit
 from scipy.spatial import cKDTree
 
+from multiscale.errors import InputError
+
 MATCH = 1e-9         # a facet's midpoint on a part's boundary triangle, relative to the length scale
 
 
@@ -112,10 +114,17 @@ def facet_thickness(tm) -> Thickness:
 class WearLimit:
     """Worn depths [m] per facet (global) held against the ``facet_thickness`` of ``tm``'s interface:
     ``remaining`` [m] per facet, the history's ``wear_remaining_min`` [m] and the message of a part
-    worn through (None while every facet keeps material). Collective to build and to ask ``through``."""
+    worn to ``keep`` [m] behind a facet, or through (``keep`` 0; None while every facet keeps more).
+    Collective to build and to ask ``through``; ``keep`` not below the thinnest part is refused."""
 
-    def __init__(self, tm):
+    def __init__(self, tm, keep: float = 0.0):
         self.thickness, self.midpoints, self.comm = facet_thickness(tm), tm.interface.midpoints, tm.comm
+        self.keep = float(keep)
+        thinnest = int(np.argmin(self.thickness.value)) if len(self.thickness.value) else None
+        if thinnest is not None and self.keep >= self.thickness.value[thinnest] and self.keep > 0:
+            name = self.thickness.names[self.thickness.part[thinnest]]
+            raise InputError(f'wear.limit = "{1e3 * self.keep:.4g} mm"', None, "less than the thinnest part behind "
+                             f"an interface facet: {name}, {self.thickness.value[thinnest] * 1e3:.4g} mm")
 
     def remaining(self, depth: np.ndarray) -> np.ndarray:
         return self.thickness.value - depth
@@ -130,9 +139,15 @@ class WearLimit:
 
     def _through(self, depth: np.ndarray) -> str | None:
         left = self.remaining(depth)
-        if not len(left) or left.min() > 0:
+        if not len(left) or left.min() > self.keep:
             return None
         f = int(np.argmin(left))
         where = ", ".join(f"{1e3 * x:.4g}" for x in self.midpoints[f])
-        return (f"{self.thickness.names[self.thickness.part[f]]} worn through: {1e3 * depth[f]:.4g} mm worn of its "
-                f"{1e3 * self.thickness.value[f]:.4g} mm at ({where}) mm, {int((left <= 0).sum())} facet(s) through")
+        name, worn, of = self.thickness.names[self.thickness.part[f]], 1e3 * depth[f], 1e3 * self.thickness.value[f]
+        if self.keep:
+            return (f"{name} at its wear limit: {worn:.4g} mm worn of its {of:.4g} mm at ({where}) mm, "
+                    f"{1e3 * left[f]:.4g} mm left (wear.limit {1e3 * self.keep:.4g} mm), "
+                    f"{int((left <= self.keep).sum())} facet(s) at it")
+        return (f"{name} worn through: {worn:.4g} mm worn of its {of:.4g} mm at ({where}) mm, "
+                f"{int((left <= 0).sum())} facet(s) through (the model keeps the bodies' shapes: beyond it, what "
+                "lies behind the worn part, a pad's backplate, would rub unseen)")

@@ -363,7 +363,7 @@ def facet_wear(scene, model: MacroModel) -> FacetWear:
         raise InputError("wear", None, f"a rate for interface(s) {', '.join(bare)}, whose worn material gives no "
                          "k_w while another interface's does: give wear.k_w (or wear.specific_rate, a table) or that "
                          "material's k_w (else the thesis' default k_w(T) table would wear it)")
-    return FacetWear(model, rates, counter, temperature=scene.time.initial_temperature)
+    return FacetWear(model, rates, counter, temperature=scene.time.initial_temperature, limit=scene.wear.limit)
 
 
 def probes(scene, tm, temperatures) -> Probes:

@@ -108,6 +108,7 @@ def build(scene, comm=MPI.COMM_WORLD, progress: bool = False) -> Multiscale:
     settings = LoopSettings(dt=t.dt, substeps=t.substeps, initial_temperature=t.initial_temperature, partition=shares,
                             partition_law=scene.micro.partition_law, wear=wear,
                             wear_every=scene.wear.update_every if wear else 1, steps=t.steps,
+                            wear_limit=scene.wear.limit if wear else 0.0,
                             flash_softening=scene.micro.flash_softening,
                             forces=interface_forces(scene, tm), friction=mu,
                             remote=scene.micro.remote(scene.effects), coupling=scene.micro.coupling_scheme(scene.effects),
@@ -169,7 +170,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
                 title = scene.name + stepping.stopped_after(done, steps, stopping, through)
                 h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures, title=title)
                 plot, maps, zones = write_zone_results(ms, folder, history, title, comm, scene.output.figures)
-        if done == steps or through:
+        if done == steps:
             checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
         result = MultiscaleResult(folder, writer.files + [f for f in (h5, png, plot, zones, ckpt) if f] + maps,
                                   _time.perf_counter() - start, history, h5, png, writer.files, plot, maps, zones,

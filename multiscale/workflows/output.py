@@ -209,12 +209,13 @@ def fingerprint(scene) -> checkpoint.Fingerprint:
     columns a resumed run continues: one added failed in the history's first row, one moved mixed
     two places in a column, a review; not ``name``, ``description`` or
     ``geometry.max_cells``, a limit on the mesh: a long-run trial's resume was refused for a
-    changed description; effects sorted: a set's order changes between processes) and the bytes
+    changed description; nor ``wear.limit``, which ends a run and may be lowered to resume it; effects sorted: a set's order changes between processes) and the bytes
     of every file it reads (a measured surface rewritten under the same name was resumed into
     wrong wear depths: the checkpoint holds the worn heights, the unworn ones are read again); its
     inputs by name: every key of the resolved scene but those, and each file's SHA-1."""
     s = dataclasses.replace(scene, output=None, source=None, overrides=(), warnings=(), name=None, description="",
                             geometry=dataclasses.replace(scene.geometry, max_cells=MAX_CELLS),
+                            wear=dataclasses.replace(scene.wear, limit=0.0) if scene.wear is not None else None,
                             effects=tuple(sorted(scene.effects)))
     source = scene.source.resolve() if scene.source is not None else None
     files = {p: checkpoint.file_digest(p) for p in sorted(p for p in scene.inputs if p != source and p.is_file())}
@@ -223,6 +224,7 @@ def fingerprint(scene) -> checkpoint.Fingerprint:
     for key in ("output", "name", "description"):
         resolved.pop(key, None)
     resolved.get("geometry", {}).pop("max_cells", None)
+    resolved.get("wear", {}).pop("limit", None)
     inputs = {**_dotted(resolved), **_dotted(probes), **{f"file {p}": digest for p, digest in files.items()}}
     text = repr(s) + (repr(scene.output.probes) if scene.output.probes else "") + \
         "".join(f"{p}:{d}" for p, d in files.items())

@@ -64,7 +64,9 @@ def march(run, stop: io.StepStop, history: io.History, writer: FieldOutput, writ
     the run ends after that step, its fields written); ``write_history()`` writes the history file.
     Returns the last step done, whether a Ctrl-C stops the run there and what wore through (decided
     by every rank)."""
-    stopping, through = False, None
+    stopping, through = False, run.worn_through()      # resumed where wear ended it: no step further
+    if through:
+        return done, stopping, through
     with io.stage("macro steps"):
         for n in io.bar(range(done + 1, last + 1), "macro steps", initial=done, total=steps):
             stepped = run.step(n)
@@ -96,12 +98,12 @@ def ended(folder: Path, name: str, steps: int, comm, verbose: bool) -> tuple[io.
 
 def stopped_after(done: int, steps: int, stopping: bool, through: str | None = None) -> str:
     """The figures' title note of a run stopped by Ctrl-C (theirs said nothing of it: a user trial) or
-    ended by a part worn ``through`` (``march``); "" otherwise."""
+    ended by a part worn ``through`` or to its wear limit (``march``); "" otherwise."""
     return f" (stopped after step {done} of {steps})" if stopping else \
-        f" (worn through at step {done} of {steps})" if through else ""
+        f" (ended by wear at step {done} of {steps})" if through else ""
 
 
 def worn_note(through: str, done: int, steps: int) -> str:
-    """The warning of a run that ended at step ``done`` of ``steps`` because a part wore ``through``."""
-    return (f"{through}: the run ended after step {done} of {steps}, its results written (the model keeps the "
-            "bodies' shapes: beyond it, what lies behind the worn part, a pad's backplate, would rub unseen)")
+    """The warning of a run that ended at step ``done`` of ``steps`` because a part wore ``through`` (or
+    to its wear limit)."""
+    return f"{through}; the run ended after step {done} of {steps}, its results written"

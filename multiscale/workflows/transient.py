@@ -151,7 +151,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
             with io.stage("writing history and plots"), stop.writing(done, last=not stopping):
                 h5, png = write_history(history, folder, scene.name, comm, plot=scene.output.figures,
                                         title=scene.name + stepping.stopped_after(done, steps, stopping, through))
-        if steps and (done == steps or through):
+        if steps and done == steps:
             checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
         model.close()                    # on every rank in the same order (MUMPS' destruction communicates)
     if stopping:                     # decided by every rank together
