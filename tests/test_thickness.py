@@ -79,3 +79,24 @@ def test_the_block_keeps_five_millimetres_behind_every_facet_until_worn_through(
     with pytest.raises(InputError, match=f'wear.limit = "5 mm": less than the thinnest part behind an interface facet: '
                                          f"{name}, 5 mm"):
         WearLimit(tm, 5e-3)
+
+
+def test_each_pad_of_a_brake_keeps_its_friction_material_behind_it():
+    """The demo brake (tests' coarse mesh of demos/brake_squeal.toml): each pad's 11 mm of friction
+    material to its backplate (a part of its own) behind every facet; with two interfaces the
+    history has each one's least material left, and the worn pad names itself."""
+    from pathlib import Path
+    from multiscale.macro.thickness import WearLimit
+    from multiscale.scene import load
+    from multiscale.workflows.model import build_mesh
+    tm = build_mesh(load(Path(__file__).parents[1] / "demos" / "brake_squeal.toml"))
+    limit = WearLimit(tm)
+    assert limit.thickness.names == ("inner_pad", "outer_pad")
+    np.testing.assert_allclose(limit.thickness.value, 11e-3, rtol=1e-12)
+    masks = tm.interface.masks()
+    depth = np.where(masks["outer_pad"], 2e-3, 1e-3)
+    depth[np.flatnonzero(masks["outer_pad"])[0]] = 12e-3
+    row = limit.row(depth)
+    assert row["wear_remaining_min_inner_pad"] == pytest.approx(10e-3, rel=1e-12)
+    assert row["wear_remaining_min_outer_pad"] == row["wear_remaining_min"] == pytest.approx(-1e-3, rel=1e-9)
+    assert limit.through(depth).startswith("outer_pad worn through: 12 mm worn of its 11 mm at (")

@@ -113,12 +113,13 @@ def facet_thickness(tm) -> Thickness:
 
 class WearLimit:
     """Worn depths [m] per facet (global) held against the ``facet_thickness`` of ``tm``'s interface:
-    ``remaining`` [m] per facet, the history's ``wear_remaining_min`` [m] and the message of a part
+    ``remaining`` [m] per facet, the history's ``wear_remaining_min`` [m] (``row``) and the message of a part
     worn to ``keep`` [m] behind a facet, or through (``keep`` 0; None while every facet keeps more).
     Collective to build and to ask ``through``; ``keep`` not below the thinnest part is refused."""
 
     def __init__(self, tm, keep: float = 0.0):
         self.thickness, self.midpoints, self.comm = facet_thickness(tm), tm.interface.midpoints, tm.comm
+        self.masks = tm.interface.masks() if len(tm.interface.tags) > 1 else {}
         self.keep = float(keep)
         thinnest = int(np.argmin(self.thickness.value)) if len(self.thickness.value) else None
         if thinnest is not None and self.keep >= self.thickness.value[thinnest] and self.keep > 0:
@@ -130,7 +131,10 @@ class WearLimit:
         return self.thickness.value - depth
 
     def row(self, depth: np.ndarray) -> dict:
-        return {"wear_remaining_min": float(self.remaining(depth).min(initial=np.inf))}
+        """``wear_remaining_min`` [m], and per interface ``wear_remaining_min_<name>`` with several."""
+        left = self.remaining(depth)
+        return {"wear_remaining_min": float(left.min(initial=np.inf)),
+                **{f"wear_remaining_min_{name}": float(left[on].min(initial=np.inf)) for name, on in self.masks.items()}}
 
     def through(self, depth: np.ndarray) -> str | None:
         """What wore through (the part, where, its depth against its thickness), or None: rank 0's

@@ -42,7 +42,8 @@ def column_label(key: str) -> str:
     if key in ("wear_max_depth", "counter_wear_max_depth"):
         return "body 1's track" if key.startswith("counter") else "body 0"
     for prefix in ("max_temperature_", "heat_total_", "heat_conducted_total_", "stored_heat_", "heat_lost_total_",
-                   "frictional_heat_total_", "face_max_temperature_", "friction_coefficient_", "wear_volume_"):
+                   "frictional_heat_total_", "face_max_temperature_", "friction_coefficient_", "wear_volume_",
+                   "wear_remaining_min_"):
         key = key.removeprefix(prefix)
     key = key.partition("_part_")[2] or key
     words = lambda name: name.replace("_", " ")
@@ -151,8 +152,9 @@ def history_figure(history, path: Path, title: str = "") -> Path:
                or [k for k in ("wear_volume",) if k in history.columns], 1e9, 0.0),             # (its interfaces')
               ("max wear depth [µm]", [k for k in ("wear_max_depth", "counter_wear_max_depth") if k in history.columns],
                1e6, 0.0),
-              ("least material left\nbehind a facet [mm]", [k for k in ("wear_remaining_min",) if k in history.columns],
-               1e3, 0.0)]
+              ("least material left\nbehind a facet [mm]", [k for k in history.columns
+                                                              if k.startswith("wear_remaining_min_")]
+               or [k for k in ("wear_remaining_min",) if k in history.columns], 1e3, 0.0)]    # (its interfaces')
     groups = [g for g in groups if g[1] and all(k in history.columns for k in g[1])]
     rows = 1 if len(groups) <= 4 else 2
     cols = -(-len(groups) // rows)
