@@ -186,3 +186,49 @@ def test_the_scene_takes_wear_in_perfect_contact(tmp_path):
                                       "above its last point 22 degC: the facets wear with k_w held at 2e-14 1/Pa there"]
     with pytest.raises(SceneError, match='effects: "wear" needs effect "friction" too'):
         loads(pin_on_disc(tmp_path / "x", effects=("contact", "wear")))
+
+
+def test_a_failed_update_is_undone(tmp_path, monkeypatch):
+    """A contact solve failing inside an implicit update (its third) raises, with the worn depths,
+    the facets' gaps, the exposure and the displacements as they were before it: a caller that goes
+    on (a smaller step, other settings) starts from a consistent state: the update then wears what
+    it wears in a model where nothing failed, to the solver's tolerance (its Newton refreshes its
+    factors on timed decisions: round-off apart)."""
+    from multiscale.errors import ConvergenceError
+    from multiscale.macro.facet_wear import FacetWear
+    from multiscale.workflows.model import build_model, facet_wear
+    s = scene(tmp_path / "f", wear='k_w = "3e-13 1/Pa"')
+    model = build_model(s)
+    wear = facet_wear(s, model)
+    model.start()
+    model.macro_step(3.0)
+    iface = model.tm.interface
+    gap, exposure = iface.values(model.contact.initial_gap), model.exposure.copy()
+    u = [x.copy() for x in model.mechanics.displacements()]
+    solve, calls = FacetWear._solve, []
+
+    def failing(self):
+        calls.append(1)
+        if len(calls) == 3:
+            raise ConvergenceError("a test's failed solve")
+        solve(self)
+    monkeypatch.setattr(FacetWear, "_solve", failing)
+    with pytest.raises(ConvergenceError, match="a test's failed solve"):
+        wear.update()
+    assert not wear.depth.any() and wear.implicit == 0 and wear.volume.sum() == 0.0
+    np.testing.assert_array_equal(iface.values(model.contact.initial_gap), gap)
+    np.testing.assert_array_equal(model.exposure, exposure)
+    for x, y in zip(model.mechanics.displacements(), u):
+        np.testing.assert_array_equal(x, y)
+    monkeypatch.setattr(FacetWear, "_solve", solve)
+    volume, work = wear.update()
+    model.close()
+    straight = build_model(s)                  # the same update, never failed
+    again = facet_wear(s, straight)
+    straight.start()
+    straight.macro_step(3.0)
+    expected, expected_work = again.update()
+    straight.close()
+    assert wear.implicit == again.implicit == 1 and work == pytest.approx(expected_work, rel=1e-9)
+    np.testing.assert_allclose(volume, expected, rtol=1e-9)
+    np.testing.assert_allclose(wear.depth, again.depth, rtol=1e-9, atol=1e-9 * again.depth.max())

@@ -32,7 +32,8 @@ not amplifies the within-facet variation by 1 + K_n c; without them the worn-in 
 pressure followed 1/r within 3.9 %, with them 0.4 %). Its volume is k W within 0.2-0.7 %; its
 transient converges like dt^0.5 (a review: 1.4 times closer per halving, pre-asymptotic). Released,
 an update that would be implicit waits for the next loaded step (an explicit one there made the
-re-engaging contact Newton fail), unless it is the run's last. The counter-face's track wears
+re-engaging contact Newton fail), unless it is the run's last. An update whose solve fails is
+undone (the model's state and the wear's as before it) before the error goes on. The counter-face's track wears
 explicitly (its depth per pressure is its pad's times the share of the circle the pads cover).
 """
 from __future__ import annotations
@@ -136,22 +137,14 @@ class FacetWear:
         if self.pending:                          # re-engaging on an explicit wear of this size failed (a review)
             return none
         implicit = not (explicit or m.released)
-        if not implicit:                          # the exposure's own pressures: k x work exactly
-            worn = k * np.where(per_load, load, work) / iface.areas
-        else:                                     # backward Euler: dh = c p at the pressure found
-            iface.set_field(m.contact.stiffness, K / (1.0 + K * per_pressure))
-            try:
-                self._solve()
-                found = m.contact.facet_pressure()
-            finally:
-                iface.set_field(m.contact.stiffness, K)
-            worn = per_pressure * found
-        self._wear(worn, k1 * work)
-        self._solve()
-        for _ in range(CORRECTIONS if implicit else 0):   # the facets' mean pressures back to the ones found
-            self._wear(np.divide(m.contact.facet_pressure() - found, K, out=np.zeros(K.shape), where=K > 0),
-                       np.zeros(K.shape))
-            self._solve()
+        before, (attrs, arrays) = m.snapshot(), self.state()
+        before_wear = attrs, {name: a.copy() for name, a in arrays.items()}
+        try:
+            self._wear_and_solve(implicit, k * np.where(per_load, load, work) / iface.areas, per_pressure, k1 * work)
+        except BaseException:                     # a failed solve: the update undone, for a caller going on
+            m.restore(before)
+            self.restore(*before_wear)
+            raise
         m.exposure, m.exposure_sliding = np.zeros_like(m.exposure), 0.0
         self.implicit += implicit
         done = float(work.sum())
@@ -159,6 +152,27 @@ class FacetWear:
         gained = np.bincount(iface.tag_index, self.depth * iface.areas, minlength=len(iface.tags)) - self.volume
         self.volume += gained
         return gained, done
+
+    def _wear_and_solve(self, implicit: bool, explicit: np.ndarray, per_pressure: np.ndarray, lost: np.ndarray) -> None:
+        """Wear by the ``explicit`` depths [m] per facet, or (``implicit``) by ``per_pressure`` [m/Pa]
+        times the pressures of a solve with the penalty K_n / (1 + K_n c) and the ``CORRECTIONS``;
+        body 1 loses the volumes ``lost`` [m^3]; the contact solved on the worn gaps."""
+        m, iface = self.model, self.model.tm.interface
+        K, worn = iface.values(m.contact.stiffness), explicit
+        if implicit:                              # backward Euler: dh = c p at the pressure found
+            iface.set_field(m.contact.stiffness, K / (1.0 + K * per_pressure))
+            try:
+                self._solve()
+                found = m.contact.facet_pressure()
+            finally:
+                iface.set_field(m.contact.stiffness, K)
+            worn = per_pressure * found
+        self._wear(worn, lost)
+        self._solve()
+        for _ in range(CORRECTIONS if implicit else 0):   # the facets' mean pressures back to the ones found
+            self._wear(np.divide(m.contact.facet_pressure() - found, K, out=np.zeros(K.shape), where=K > 0),
+                       np.zeros(K.shape))
+            self._solve()
 
     def _solve(self) -> None:
         """The contact solved on the worn gaps at the speed of the last solve (a stop keeps the
