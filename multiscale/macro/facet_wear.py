@@ -92,9 +92,8 @@ class FacetWear:
         self.depth, self.counter_depth = np.zeros(n), np.zeros(n)
         self.volume, self.counter_volume, self.work, self.implicit = np.zeros(len(iface.tags)), 0.0, 0.0, 0
         self.datum = iface.values(model.contact.initial_gap)
-        self.reach, self.faces = np.ones(n), np.zeros(n, dtype=int)
+        self.reach, self.faces = model.facet_reach, np.zeros(n, dtype=int)
         if isinstance(motion, Rotation):
-            self.reach = np.linalg.norm(motion.velocity(iface.midpoints), axis=1)     # m per rad: the radius
             along = (iface.midpoints - np.asarray(motion.centre, float)) @ np.asarray(motion.axis, float)
             scale = model.tm.spec.length_scale * np.linalg.norm(motion.axis)       # faces of one axial position
             self.faces = np.unique(np.round(along / scale, 6), return_inverse=True)[1]
@@ -103,7 +102,7 @@ class FacetWear:
             if not flat:
                 raise InputError("counter-face wear", r.rate, "a rotating body 1 whose worn faces lie in planes "
                                  "normal to its axis (its wear spreads round a circular track on them)")
-        model.exposure, model.exposure_sliding, model.facet_reach = np.zeros((5, n)), 0.0, self.reach
+        model.exposure, model.exposure_sliding = np.zeros((5, n)), 0.0
         self.pending = False              # a released update waiting for the next loaded step
         self.limit = WearLimit(model.tm, limit)   # the worn depths against the thickness behind the facets
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Callable
 
 import numpy as np
@@ -105,7 +106,6 @@ class MacroModel:
     # was solved at [N or Pa] (over the load now: the sliding of the pressure now)
     exposure: np.ndarray | None = None
     exposure_sliding: float = 0.0
-    facet_reach: np.ndarray | None = None              # |w| per facet at unit speed of body 1 [m per rad, or 1]
 
     @property
     def contact(self):
@@ -160,6 +160,12 @@ class MacroModel:
         clamp = clamp_imbalance(self.tm, float(mech.load.value)) if mech.load_kind == "fluid" else None
         self.notes = [*self.tm.notes, *mech.notes, *([clamp] if clamp is not None else [])]
         return self.last_solve
+
+    @cached_property
+    def facet_reach(self) -> np.ndarray:
+        """|w| per interface facet (global) at unit speed of body 1 [m per rad: its distance from the
+        axis of a rotation; 1 for a translation]."""
+        return np.linalg.norm(self.tm.spec.motion.velocity(self.tm.interface.midpoints), axis=1)
 
     def face_temperatures(self) -> np.ndarray:
         """(T_0, T_0, T_1) per interface facet [K], the faces' mean temperatures of body 0 and 1 (zeros
