@@ -74,6 +74,15 @@ def crossing(triangles: np.ndarray, motion, comm) -> Crossing:
     return Crossing(float(sums[0] / sums[1]) if sums[1] > 0 else 0.0, float(worst), np.array(where))
 
 
+def bounds(x: np.ndarray, comm) -> tuple[np.ndarray, np.ndarray]:
+    """Lower and upper corners of the points ``x`` (n, d) of every rank (collective; inf and -inf
+    where no rank has one)."""
+    lo, hi = np.empty(x.shape[1]), np.empty(x.shape[1])
+    comm.Allreduce(x.min(axis=0, initial=np.inf), lo, op=MPI.MIN)
+    comm.Allreduce(x.max(axis=0, initial=-np.inf), hi, op=MPI.MAX)
+    return lo, hi
+
+
 def swept_area(lo, hi) -> float:
     """Area [m^2] of the surface of revolution over the (radius r, axial position a) box ``lo``,
     ``hi`` of what sweeps it (``Interface.box`` about the axis): the frustum pi (r_lo + r_hi)
@@ -134,6 +143,10 @@ class Body:
         facets = dmesh.exterior_facet_indices(m.topology)
         facets = facets[facets < m.topology.index_map(tdim - 1).size_local]       # owned: each once
         return crossing(m.geometry.x[dmesh.entities_to_geometry(m, tdim - 1, facets)], motion, m.comm)
+
+    def box(self) -> tuple[np.ndarray, np.ndarray]:
+        """Lower and upper corners (3-vectors) [m] of the body's nodes (collective)."""
+        return bounds(self.mesh.geometry.x, self.mesh.comm)
 
     def has_face(self, tag: int) -> bool:
         """True if the face ``tag`` belongs to this body (on any rank)."""
@@ -220,10 +233,7 @@ class Interface:
             e, x = np.asarray(axis, dtype=float) / np.linalg.norm(axis), x - np.asarray(centre, dtype=float)
             a = x @ e
             x = np.column_stack([np.linalg.norm(x - np.outer(a, e), axis=1), a])
-        lo, hi = np.empty(x.shape[1]), np.empty(x.shape[1])
-        self.comm.Allreduce(x.min(axis=0) if len(x) else np.full(x.shape[1], np.inf), lo, op=MPI.MIN)
-        self.comm.Allreduce(x.max(axis=0) if len(x) else np.full(x.shape[1], -np.inf), hi, op=MPI.MAX)
-        return lo, hi
+        return bounds(x, self.comm)
 
     def distance(self, points) -> float:
         """The least distance [m] from ``points`` (n, 3) [m] to a facet of the interfaces (collective)."""

@@ -177,9 +177,7 @@ class Probes:
         """The bounding boxes [mm] of ``bodies``, for an error message (collective)."""
         out = []
         for i in bodies:
-            x, lo, hi = self.tm.bodies[i].mesh.geometry.x, np.empty(3), np.empty(3)
-            self.comm.Allreduce(x.min(axis=0, initial=np.inf), lo, op=MPI.MIN)
-            self.comm.Allreduce(x.max(axis=0, initial=-np.inf), hi, op=MPI.MAX)
+            lo, hi = self.tm.bodies[i].box()
             out.append(f"{self.tm.bodies[i].name!r} spans {np.round(lo * 1e3, 3).tolist()} to "
                        f"{np.round(hi * 1e3, 3).tolist()} mm")
         return "; ".join(out)
