@@ -30,7 +30,9 @@ def sloped_box(n: int = 4):
 def test_rays_leave_a_sloped_box_through_its_top_and_a_part_through_the_face_it_shares():
     """From the midpoints of the bottom's triangles straight up: the top lies at 1 + x / 2 (to
     round-off); the lower half of the cells (a part bonded to the upper) ends at its shared face,
-    (1 + x / 2) / 2. The boundary's normals point into the cells: +z on the bottom."""
+    (1 + x / 2) / 2. The boundary's normals point into the cells: +z on the bottom. A ray leaves
+    through a face that looks back at it (a side wall met at 53 degrees), not one it grazes (at 73
+    degrees: no exit); one through an edge two triangles share meets them."""
     tets, layer = sloped_box()
     tri, normal = part_boundaries(tets)
     assert len(tri) == 6 * 2 * 16                                     # two triangles a square, 16 squares a side
@@ -39,13 +41,18 @@ def test_rays_leave_a_sloped_box_through_its_top_and_a_part_through_the_face_it_
     np.testing.assert_allclose(normal[bottom], np.tile([0.0, 0.0, 1.0], (32, 1)), atol=1e-15)
     start = tri[bottom].mean(axis=1)
     top = 1 + start[:, 0] / 2
-    np.testing.assert_allclose(ray_exit(start, normal[bottom], tri, 1e-12), top, rtol=1e-13)
+    np.testing.assert_allclose(ray_exit(start, normal[bottom], tri, normal, 1e-12), top, rtol=1e-13)
     low_tri, low_normal = part_boundaries(tets[layer < 2])
     assert len(low_tri) == 2 * 32 + 4 * 2 * 8                         # bottom, shared face, four sides of 2 x 4 squares
-    np.testing.assert_allclose(ray_exit(start, normal[bottom], low_tri, 1e-12), top / 2, rtol=1e-13)
-    sideways = ray_exit(np.array([[0.5, 0.5, 0.25]]), np.array([[-1.0, 0.0, 0.0]]), low_tri, 1e-12)
+    np.testing.assert_allclose(ray_exit(start, normal[bottom], low_tri, low_normal, 1e-12), top / 2, rtol=1e-13)
+    sideways = ray_exit(np.array([[0.5, 0.5, 0.25]]), np.array([[-1.0, 0.0, 0.0]]), low_tri, low_normal, 1e-12)
     assert sideways == pytest.approx([0.5], rel=1e-13)
-    assert ray_exit(start[:1], -normal[bottom][:1], tri, 1e-12) == [np.inf]     # out of the box: nothing
+    assert ray_exit(start[:1], -normal[bottom][:1], tri, normal, 1e-12) == [np.inf]     # out of the box: nothing
+    steep, grazing = np.array([[0.8, 0.0, 0.6]]), np.array([[0.3, 0.0, 0.954]]) / np.hypot(0.3, 0.954)
+    assert ray_exit(np.array([[0.9, 0.5, 0.01]]), steep, tri, normal, 1e-12) == pytest.approx([0.125], rel=1e-12)
+    assert ray_exit(np.array([[0.9, 0.5, 0.01]]), grazing, tri, normal, 1e-12) == [np.inf]   # a side wall grazed
+    through_edge = np.array([[0.125, 0.125, 0.0]])                   # on an edge two of the top's triangles share
+    assert ray_exit(through_edge, np.array([[0.0, 0.0, 1.0]]), tri, normal, 1e-12) == pytest.approx([1.0625])
 
 
 dolfinx = pytest.importorskip("dolfinx_solver", reason="DOLFINx wheel not installed")
@@ -69,13 +76,14 @@ def test_the_block_keeps_five_millimetres_behind_every_facet_until_worn_through(
     depth[7] = 6e-3
     where = ", ".join(f"{1e3 * x:.4g}" for x in tm.interface.midpoints[7])
     name = limit.thickness.names[0]
-    assert limit.through(depth).startswith(f"{name} worn through: 6 mm worn of its 5 mm at ({where}) mm, 1 facet(s) through")
+    assert limit.through(depth).startswith(f"{name} worn through: 6 mm worn of its 5 mm at ({where}) mm, 1 of its "
+                                           "facets through (the model keeps")
     keep = WearLimit(tm, 1.5e-3)                                     # a wear limit: 1.5 mm to keep
     assert keep.through(np.full(n, 3.4e-3)) is None
     depth[:] = 3.4e-3
     depth[:3] = 3.6e-3
     assert keep.through(depth).startswith(f"{name} at its wear limit: 3.6 mm worn of its 5 mm at (")
-    assert keep.through(depth).endswith("1.4 mm left (wear.limit 1.5 mm), 3 facet(s) at it")
+    assert keep.through(depth).endswith("1.4 mm left (wear.limit 1.5 mm), 3 of its facets at it")
     with pytest.raises(InputError, match=f'wear.limit = "5 mm": less than the thinnest part behind an interface facet: '
                                          f"{name}, 5 mm"):
         WearLimit(tm, 5e-3)
@@ -100,3 +108,71 @@ def test_each_pad_of_a_brake_keeps_its_friction_material_behind_it():
     assert row["wear_remaining_min_inner_pad"] == pytest.approx(10e-3, rel=1e-12)
     assert row["wear_remaining_min_outer_pad"] == row["wear_remaining_min"] == pytest.approx(-1e-3, rel=1e-9)
     assert limit.through(depth).startswith("outer_pad worn through: 12 mm worn of its 11 mm at (")
+    depth[np.flatnonzero(masks["inner_pad"])[:2]] = 11.5e-3
+    assert ", 1 of its facets through; inner_pad too (the model keeps" in limit.through(depth)
+
+
+def test_a_shoe_on_a_rim_is_as_thick_as_its_back_says(tmp_path):
+    """A 20 mm block cut by a wheel's rim (r = 50 mm; its back at y = 60 mm): behind every facet of
+    its curved face from 10 mm (the crown) to 11.3 mm (along the facet's normal, 10.8 mm where it
+    reaches the back's edge), or no limit where the ray leaves through a side wall it grazes (from
+    |x| = 8.3 mm, 17 % of the facets: their material does not end there). A review found 2.3 mm behind the edge facets, 0.5 mm on a finer mesh, and a
+    run ended "worn through"."""
+    import gmsh
+    from multiscale.macro.thickness import facet_thickness
+    from multiscale.scene import loads
+    from multiscale.workflows.model import build_mesh
+    gmsh.initialize()
+    gmsh.option.setNumber("General.Terminal", 0)
+    try:
+        gmsh.model.add("rim")
+        gmsh.model.occ.addCylinder(0, 0, 0, 0, 0, 0.02, 0.05)
+        shoe = gmsh.model.occ.addBox(-0.01, 0.04, 0, 0.02, 0.02, 0.02)
+        gmsh.model.occ.cut([(3, shoe)], [(3, 1)], removeTool=False)
+        gmsh.model.occ.synchronize()
+        gmsh.write(str(tmp_path / "rim.step"))
+    finally:
+        gmsh.finalize()
+    scene = loads(f"""
+effects = ["contact", "friction"]
+[geometry]
+file = "{tmp_path / 'rim.step'}"
+unit = "m"
+mesh_size = "5 mm"
+interface_mesh_size = "1 mm"
+rotating = "wheel"
+[geometry.bodies.wheel]
+contains = [0, 0, 0.01]
+material = "steel"
+[geometry.bodies.shoe]
+contains = [0, 0.055, 0.01]
+material = "steel"
+[geometry.surfaces.back]
+body = "shoe"
+normal = [0, 1, 0]
+[geometry.surfaces.bore]
+body = "wheel"
+contains = [0, 0.01, 0]
+[materials.steel]
+E = "200 GPa"
+nu = 0.3
+[interface]
+penalty = "1e13 Pa/m"
+[loading]
+normal_force = "100 N"
+faces = ["back"]
+rotation_speed = "100 rpm"
+friction = 0.4
+[[boundary]]
+surfaces = ["back"]
+fix = ["x", "z"]
+[[boundary]]
+surfaces = ["bore"]
+fix = ["x", "y", "z"]
+[output]
+folder = "{tmp_path / 'out'}"
+""")
+    thick = facet_thickness(build_mesh(scene))
+    finite = thick.value[np.isfinite(thick.value)]
+    assert (thick.part == 0).all() and len(finite) > 0.8 * len(thick.value)    # |x| > 8.3 mm: out by a side
+    assert finite.min() > 9.99e-3 and finite.max() < 11.3e-3

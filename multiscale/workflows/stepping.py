@@ -78,7 +78,7 @@ def march(run, stop: io.StepStop, history: io.History, writer: FieldOutput, writ
                     writer.write()                    # before the checkpoint: killed between, they are dropped
                 run.save(ckpt, n, history)
                 write_history()                       # readable if the run is killed
-                done, stopping = n, n < steps and stop.requested()   # (the last: it finishes)
+                done, stopping = n, n < steps and not through and stop.requested()   # (the last, or worn: it ends)
                 if stopping and not due:
                     writer.write()                    # the stop's, dropped when resumed
             if stopping or through:
