@@ -4,6 +4,7 @@ input is one clear line with exit code 2, nothing written."""
 
 import re
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -515,9 +516,9 @@ def test_a_script_that_would_mesh_other_elements_than_linear_tetrahedra_is_refus
     finally:
         gmsh.finalize()
 
-def test_a_rough_interface_must_be_planar(tmp_path, capsys):
-    """A fixed block pressed on the curved rim of a rotating wheel: fine in perfect contact, refused
-    as a rough interface (check, before anything runs)."""
+def rim_step(folder: Path) -> Path:
+    """rim.step in ``folder``: a wheel (r = 50 mm, 20 mm wide, m) and a 20 x 20 x 20 mm block cut
+    by its rim (a shoe, its back at y = 60 mm)."""
     gmsh.initialize()
     gmsh.option.setNumber("General.Terminal", 0)
     try:
@@ -526,9 +527,16 @@ def test_a_rough_interface_must_be_planar(tmp_path, capsys):
         shoe = gmsh.model.occ.addBox(-0.01, 0.04, 0, 0.02, 0.02, 0.02)
         gmsh.model.occ.cut([(3, shoe)], [(3, 1)], removeTool=False)
         gmsh.model.occ.synchronize()
-        gmsh.write(str(tmp_path / "rim.step"))
+        gmsh.write(str(folder / "rim.step"))
     finally:
         gmsh.finalize()
+    return folder / "rim.step"
+
+
+def test_a_rough_interface_must_be_planar(tmp_path, capsys):
+    """A fixed block pressed on the curved rim of a rotating wheel: fine in perfect contact, refused
+    as a rough interface (check, before anything runs)."""
+    rim_step(tmp_path)
     text = f"""
 effects = ["contact", "roughness"]
 [geometry]

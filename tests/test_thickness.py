@@ -118,25 +118,14 @@ def test_a_shoe_on_a_rim_is_as_thick_as_its_back_says(tmp_path):
     reaches the back's edge), or no limit where the ray leaves through a side wall it grazes (from
     |x| = 8.3 mm, 17 % of the facets: their material does not end there). A review found 2.3 mm behind the edge facets, 0.5 mm on a finer mesh, and a
     run ended "worn through"."""
-    import gmsh
     from multiscale.macro.thickness import facet_thickness
     from multiscale.scene import loads
     from multiscale.workflows.model import build_mesh
-    gmsh.initialize()
-    gmsh.option.setNumber("General.Terminal", 0)
-    try:
-        gmsh.model.add("rim")
-        gmsh.model.occ.addCylinder(0, 0, 0, 0, 0, 0.02, 0.05)
-        shoe = gmsh.model.occ.addBox(-0.01, 0.04, 0, 0.02, 0.02, 0.02)
-        gmsh.model.occ.cut([(3, shoe)], [(3, 1)], removeTool=False)
-        gmsh.model.occ.synchronize()
-        gmsh.write(str(tmp_path / "rim.step"))
-    finally:
-        gmsh.finalize()
+    from test_geometry_files import rim_step
     scene = loads(f"""
 effects = ["contact", "friction"]
 [geometry]
-file = "{tmp_path / 'rim.step'}"
+file = "{rim_step(tmp_path)}"
 unit = "m"
 mesh_size = "5 mm"
 interface_mesh_size = "1 mm"
