@@ -32,7 +32,7 @@ FORMAT = 12   # what a checkpoint holds; 2: P2 temperatures in a rotating body, 
 #               8: max_slip_speed, min_slip_speed history columns (a mu(v) law); 9: no fields_written (a step's
 #               fields are written before its checkpoint, ``workflows.stepping``); 10: the zones' exchange_full;
 #               11: the facets' wear in perfect contact (exposure per facet, its sliding x load, pending);
-#               12: the exposure's temperature-weighted rows
+#               12: the exposure's rows rated at each substep's temperatures
 
 
 def fingerprint(text: str) -> str:

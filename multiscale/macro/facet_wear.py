@@ -3,13 +3,11 @@
 Each facet f of body 0's face (a pad, a pin) loses the depth dh_f = k_f W_f / A_f (Eq. 3.10,
 dh = k_w mu p ds: W_f = mu_f p_f ds_f A_f its frictional work [J]) or, with a specific wear rate per
 normal load (``per_load``), dh_f = k_f L_f / A_f (L_f = p_f ds_f A_f [N m]), over the interval since
-the last update: ``MacroModel.exposure`` sums them as the heat and the frictional work are summed,
+the last update: an ``Exposure`` (the model's) sums them as the heat and the frictional work are summed,
 each substep's pressure over its load-weighted sliding, ds_f = |w_f| ds (|w_f| the facet's speed
-per unit of body 1's: its distance from the axis of a rotation, 1 for a translation). k_f is the
-rate of the facet's interface at the facet's face temperature (a table) averaged over the interval,
-weighted by the facet's work (its load for a rate per load), each substep's the mean of its start
-and end (``MacroModel.exposure``; read at the update, a table gave a cooled interval the rate of its
-end); without heat the initial temperature. The worn depth opens the facet's initial gap and the contact is solved
+per unit of body 1's: its distance from the axis of a rotation, 1 for a translation), each
+substep's at its own rate k_f, the rate of the facet's interface at the facet's face temperature (a
+table; ``Exposure``); without heat at the initial temperature. The worn depth opens the facet's initial gap and the contact is solved
 on the worn gaps: the pressure redistributes (towards p |w| uniform: the steady state of a face
 that wears all over, its profile receding as a whole). A rotating body 1 whose material gives k_w
 loses k_w,1(T_1) W_f per facet (per frictional work), spread round the circle of the facet's radius
@@ -64,6 +62,52 @@ def track_spread(radius, source_radius, volume, half: float) -> np.ndarray:
     return out
 
 
+class Exposure:
+    """What the facets' wear sums between updates (global arrays per facet): the frictional work
+    ``work`` W = mu p |w| ds dA [J] and ``load`` L = p |w| ds dA [N m] of each loaded substep
+    (``MacroModel.macro_step`` adds them), the volumes at each substep's own rates, ``volume`` = Σ
+    k_0 W (Σ k_0 L where the rate is per load, ``per_load``) and ``counter_volume`` = Σ k_1 W [m^3],
+    k_i at body i's face temperatures (``rates``: (T_0, T_1) or None -> (k_0, k_1) [1/Pa]) as the
+    mean of the substep's start's and end's rates (its heat step's), and ``sliding``, body 1's
+    load-weighted sliding [rad or m] times the load each substep's pressure was solved at [N or Pa].
+    (A table read at the interval's work-weighted mean temperature wore 6-25 % off where it bends:
+    a review.)"""
+
+    def __init__(self, n: int, rates, per_load: np.ndarray):
+        self.rates, self.per_load = rates, per_load
+        self.sums, self.sliding, self._last = np.zeros((4, n)), 0.0, (np.zeros(n), np.zeros(n))
+
+    work = property(lambda self: self.sums[0])
+    load = property(lambda self: self.sums[1])
+    volume = property(lambda self: self.sums[2])
+    counter_volume = property(lambda self: self.sums[3])
+
+    def add(self, work: np.ndarray, load: np.ndarray, sliding: float, temperatures) -> None:
+        """A substep's ``work`` [J], ``load`` [N m] and ``sliding`` [rad N or m Pa], rated at the faces'
+        ``temperatures`` at its start (with heat; its ``end`` adds the other half) or throughout (None)."""
+        self.sums[:2] += work, load
+        self.sliding += sliding
+        self._last = work, load
+        self._rate(temperatures, 1.0 if temperatures is None else 0.5)
+
+    def end(self, temperatures) -> None:
+        """The last substep's rate at its end's face ``temperatures`` (T_0, T_1) [K]."""
+        self._rate(temperatures, 0.5)
+
+    def _rate(self, temperatures, share: float) -> None:
+        (k0, k1), (work, load) = self.rates(temperatures), self._last
+        self.sums[2:] += share * k0 * np.where(self.per_load, load, work), share * k1 * work
+
+    def mean_rate(self, temperatures) -> np.ndarray:
+        """Body 0's rate [1/Pa] per facet over the interval, its volume over its work (its load per
+        load), at the faces' ``temperatures`` now where it had none."""
+        weight = np.where(self.per_load, self.load, self.work)
+        return np.divide(self.volume, weight, out=self.rates(temperatures)[0], where=weight > 0)
+
+    def clear(self) -> None:
+        self.sums[:], self.sliding = 0.0, 0.0
+
+
 @dataclass(frozen=True)
 class FacetRate:
     """The wear rate of a body on one interface: its facets (``mask``, global), k [1/Pa] (a
@@ -102,7 +146,10 @@ class FacetWear:
             if not flat:
                 raise InputError("counter-face wear", r.rate, "a rotating body 1 whose worn faces lie in planes "
                                  "normal to its axis (its wear spreads round a circular track on them)")
-        model.exposure, model.exposure_sliding = np.zeros((5, n)), 0.0
+        per_load = np.zeros(n, dtype=bool)
+        for r in self.rates:
+            per_load[r.mask] = r.per_load
+        model.exposure = Exposure(n, self.rate_at, per_load)
         self.pending = False              # a released update waiting for the next loaded step
         self.limit = WearLimit(model.tm, limit)   # the worn depths against the thickness behind the facets
 
@@ -112,25 +159,13 @@ class FacetWear:
         update that would be implicit waits (``pending``) for the next loaded step, unless it is the
         ``last``. Returns the volume [m^3] body 0 lost per interface and the frictional work [J]."""
         m, iface = self.model, self.model.tm.interface
-        (work, load, *weighted), solved = m.exposure, float(m.mechanics.load.value)
-        slid = m.exposure_sliding / solved if solved else 0.0     # the sliding of the pressure solved now
+        e, solved = m.exposure, float(m.mechanics.load.value)
+        slid = e.sliding / solved if solved else 0.0     # the sliding of the pressure solved now
         none = np.zeros(len(iface.tags)), 0.0
-        if not m.exposure_sliding:
+        if not e.sliding:
             return none
-        k, per_load, k1 = np.zeros(iface.n_facets), np.zeros(iface.n_facets, dtype=bool), np.zeros(iface.n_facets)
-        for r in self.rates:
-            per_load[r.mask] = r.per_load
-        T0, T1 = np.full((2, iface.n_facets), self.temperature) if m.thermal is None else m.face_temperatures()[1:]
-        if m.thermal is not None:                 # weighted by the exposure (now's where a facet had none)
-            for T, (sum_T, weight) in zip((T0, T1), ((np.where(per_load, weighted[1], weighted[0]),
-                                                      np.where(per_load, load, work)), (weighted[2], work))):
-                np.divide(sum_T, weight, out=T, where=weight > 0)
-        for r in self.rates:
-            k[r.mask] = np.broadcast_to(r.rate(T0[r.mask]), (int(r.mask.sum()),))
-        for r in self.counter_rates:
-            k1[r.mask] = np.broadcast_to(r.rate(T1[r.mask]), (int(r.mask.sum()),))
         mu, K = iface.values(m.contact.friction), iface.values(m.contact.stiffness)
-        per_pressure = k * np.where(per_load, 1.0, mu) * slid * self.reach      # m/Pa per facet
+        per_pressure = e.mean_rate(m.face_temperatures()) * np.where(e.per_load, 1.0, mu) * slid * self.reach  # m/Pa
         explicit = (per_pressure * K).max() <= STABLE
         self.pending = m.released and not explicit and not last
         if self.pending:                          # re-engaging on an explicit wear of this size failed (a review)
@@ -139,15 +174,15 @@ class FacetWear:
         before, (attrs, arrays) = m.snapshot(), self.state()
         before_wear = attrs, {name: a.copy() for name, a in arrays.items()}
         try:
-            self._wear_and_solve(implicit, k * np.where(per_load, load, work) / iface.areas, per_pressure, k1 * work)
+            self._wear_and_solve(implicit, e.volume / iface.areas, per_pressure, e.counter_volume.copy())
         except BaseException:                     # a failed solve: the update undone, for a caller going on
             m.restore(before)
             self.restore(*before_wear)
             raise
-        m.exposure, m.exposure_sliding = np.zeros_like(m.exposure), 0.0
         self.implicit += implicit
-        done = float(work.sum())
+        done = float(e.work.sum())
         self.work += done
+        e.clear()
         gained = np.bincount(iface.tag_index, self.depth * iface.areas, minlength=len(iface.tags)) - self.volume
         self.volume += gained
         return gained, done
@@ -224,20 +259,32 @@ class FacetWear:
                        counter_wear_max_depth=float(self.counter_depth.max(initial=0.0)))
         return row
 
+    def rate_at(self, temperatures) -> tuple[np.ndarray, np.ndarray]:
+        """(k_0, k_1) per facet [1/Pa]: body 0's rate (per frictional work, or per load where its rate
+        is) and body 1's k_w (0 where it does not wear) at the faces' ``temperatures`` (T_0, T_1) [K]
+        (None: ``temperature``)."""
+        n = self.model.tm.interface.n_facets
+        T = np.full((2, n), self.temperature) if temperatures is None else temperatures
+        k = np.zeros((2, n))
+        for side, rates in enumerate((self.rates, self.counter_rates)):
+            for r in rates:
+                k[side, r.mask] = np.broadcast_to(r.rate(T[side][r.mask]), (int(r.mask.sum()),))
+        return k[0], k[1]
+
     def worn_through(self) -> str | None:
         """What body 0 wore through (``WearLimit.through``), or None (collective)."""
         return self.limit.through(self.depth)
 
     def state(self) -> tuple[dict, dict]:
         """(attributes, arrays) a checkpoint keeps (``restore`` reads them back)."""
-        return ({"wear": [self.work, self.counter_volume, self.implicit, self.model.exposure_sliding, self.pending]},
+        return ({"wear": [self.work, self.counter_volume, self.implicit, self.model.exposure.sliding, self.pending]},
                 {"wear_depth": self.depth, "counter_depth": self.counter_depth, "wear_volume": self.volume,
-                 "exposure": self.model.exposure})
+                 "exposure": self.model.exposure.sums})
 
     def restore(self, attrs: dict, arrays: dict) -> None:
         """Back to a ``state``; the facets' gaps follow."""
-        self.work, self.counter_volume, implicit, self.model.exposure_sliding, pending = (float(v) for v in attrs["wear"])
+        self.work, self.counter_volume, implicit, self.model.exposure.sliding, pending = (float(v) for v in attrs["wear"])
         self.implicit, self.pending = int(implicit), bool(pending)
         self.depth, self.counter_depth = arrays["wear_depth"].copy(), arrays["counter_depth"].copy()
-        self.volume, self.model.exposure = arrays["wear_volume"].copy(), arrays["exposure"].copy()
+        self.volume, self.model.exposure.sums[:] = arrays["wear_volume"].copy(), arrays["exposure"]
         self._set_gap()

@@ -99,13 +99,9 @@ class MacroModel:
     stale: bool = False
     notes: list = field(default_factory=list)          # what the run's warnings add (an unbalanced clamp, Mechanics.notes)
     probes: Probes | None = None                       # thermocouples: ``probe_temperature_<name>`` columns
-    # since the last wear update (``facet_wear.FacetWear`` sets them; None: not summed): per facet the frictional
-    # work W = mu p |w| ds dA [J], L = p |w| ds dA [N m], and W T_0, L T_0, W T_1 (T_i body i's face temperature
-    # [K], each substep's the mean of its start and end: the wear's tables read at their weighted means; zero
-    # without heat), and body 1's load-weighted sliding ds [rad or m] times the load each substep's pressure
-    # was solved at [N or Pa] (over the load now: the sliding of the pressure now)
-    exposure: np.ndarray | None = None
-    exposure_sliding: float = 0.0
+    # what the facets' wear sums since its last update (a ``facet_wear.Exposure``, which ``FacetWear`` sets; None:
+    # not summed): each loaded substep's work and load per facet, rated at its faces' temperatures
+    exposure: object | None = None
 
     @property
     def contact(self):
@@ -167,13 +163,10 @@ class MacroModel:
         axis of a rotation; 1 for a translation]."""
         return np.linalg.norm(self.tm.spec.motion.velocity(self.tm.interface.midpoints), axis=1)
 
-    def face_temperatures(self) -> np.ndarray:
-        """(T_0, T_0, T_1) per interface facet [K], the faces' mean temperatures of body 0 and 1 (zeros
-        without heat): the weights of the exposure's rows W, L, W."""
-        if self.thermal is None:
-            return np.zeros((3, self.tm.interface.n_facets))
-        T0 = self.thermal.facet_temperature(0)
-        return np.stack([T0, T0, self.thermal.facet_temperature(1)])
+    def face_temperatures(self) -> tuple[np.ndarray, np.ndarray] | None:
+        """(T_0, T_1) per interface facet [K], the mean temperatures of body 0's and body 1's faces;
+        None without heat."""
+        return None if self.thermal is None else (self.thermal.facet_temperature(0), self.thermal.facet_temperature(1))
 
     def macro_step(self, dt: float, substeps: int = 1) -> np.ndarray:
         """Advance by one macro step dt [s] in ``substeps`` (Fig. 7.4); returns the heat [J] put
@@ -205,9 +198,8 @@ class MacroModel:
                     if not (mu > 0).all():          # (an assembly: only where a facet has no friction)
                         load = np.where(mu > 0, load, self.contact.facet_pressure() * self.tm.interface.areas
                                         * self.facet_reach)
-                    exposed = slid * np.stack([power, load, power])
-                    self.exposure += np.concatenate([exposed[:2], 0.5 * exposed * self.face_temperatures()])
-                    self.exposure_sliding += slid * float(self.mechanics.load.value)
+                    self.exposure.add(slid * power, slid * load, slid * float(self.mechanics.load.value),
+                                      self.face_temperatures())
             if self.thermal is not None:
                 # the pressure was solved at the load factor of the step's start: the conductance
                 # scales with the mean factor over the step (a release inside it, a load ramp), the
@@ -217,8 +209,8 @@ class MacroModel:
                 self.contact.engaged.value = self.drive.mean_factor(t0, t1) * scale
                 self.contact.heating.value = self.drive.mean_sliding(t0, t1) / speed * scale if speed else 0.0
                 done = self.thermal.step(delta)
-                if slid and self.exposure is not None:      # (the substep's end: its mean temperatures)
-                    self.exposure[2:] += 0.5 * exposed * self.face_temperatures()
+                if slid and self.exposure is not None:      # (the substep's end: its rates' mean)
+                    self.exposure.end(self.face_temperatures())
                 # (kept if set before: a reload after a dwell of two steps skipped its solve, 27 % off: a review)
                 self.stale = self.update_friction() or self.stale or self.mechanics.temperatures is not None
                 heat += done.heat_in
