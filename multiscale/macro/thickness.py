@@ -37,7 +37,7 @@ def ray_exit(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray,
     """Least distance t > ``skip`` [m] along each unit ray (origins, directions: (m, 3) [m]) to a
     triangle of ``triangles`` (k, 3, 3) [m] whose unit inward normal (``normals``, (k, 3)) n has
     n·d <= -``FACING``; inf where a ray meets none (Möller–Trumbore, ``EDGE`` slack; every pair
-    tested, compiled: some 5e7 pairs a second, a car brake's 22 648 facets of 1 mm in 4.9 s)."""
+    tested, compiled: the car brake's 22 648 facets of 1 mm in 1.1 s, 5714 of 2 mm in 0.37 s)."""
     out = np.full(len(origins), np.inf)
     e1, e2 = triangles[:, 1] - triangles[:, 0], triangles[:, 2] - triangles[:, 0]
     floor = 1e-12 * np.sqrt((e1 * e1).sum(axis=1) * (e2 * e2).sum(axis=1))
