@@ -149,7 +149,8 @@ def test_a_table_reads_the_temperatures_of_the_whole_interval(tmp_path):
 def test_a_pin_worn_through_ends_the_run_with_its_results(tmp_path):
     """k_w = 1e-8 /Pa wears the coarse pin (15 mm long behind every facet) 11.3 mm deep at its
     deepest facet in the first 3 s step and 22.6 mm in the second: the run ends after step 2 of 4,
-    said, with that step's history row, fields and checkpoint (--resume steps no further);
+    said, with that step's history row, fields and checkpoint (--resume steps no further and keeps
+    that step's fields; its provenance says how it ended);
     ``wear_remaining_min`` is the length less the deepest wear. With ``wear.limit`` = 5 mm it ends
     after step 1 (3.7 mm left), and resumed without the limit (not part of the checkpoint's
     fingerprint) it goes on to the straight run's end."""
@@ -163,11 +164,16 @@ def test_a_pin_worn_through_ends_the_run_with_its_results(tmp_path):
     assert note.startswith("pin worn through: 22.58 mm worn of its 15 mm at (") and "the run ended after step 2 of 4" in note
     import meshio
     assert meshio.xdmf.TimeSeriesReader(str(tmp_path / "t" / "interface.xdmf")).num_steps == 2    # t = 0 and the end
-    assert list(run(s, resume=True, verbose=False).history["time"]) == [0.0, 3.0, 6.0]          # no step further
+    again = run(s, resume=True, verbose=False)
+    assert list(again.history["time"]) == [0.0, 3.0, 6.0] and again.ended == "ended by wear after step 2 of 4"
+    assert meshio.xdmf.TimeSeriesReader(str(tmp_path / "t" / "interface.xdmf")).num_steps == 2    # kept (a review)
+    import json
+    from multiscale.workflows import run as run_scene
     kept = scene(tmp_path / "k", steps=4, end="12 s", wear='k_w = "1e-8 1/Pa"\nlimit = "5 mm"', **{"output.every": 4})
-    r = run(kept, verbose=False)
+    r = run_scene(kept, verbose=False)
     assert list(r.history["time"]) == [0.0, 3.0]
     assert any(w.startswith("pin at its wear limit: 11.29 mm worn of its 15 mm at (") for w in r.warnings)
+    assert json.loads((tmp_path / "k" / "provenance.json").read_text())["status"] == "ended by wear after step 1 of 4"
     on = run(scene(tmp_path / "k", steps=4, end="12 s", wear='k_w = "1e-8 1/Pa"', **{"output.every": 4}),
              resume=True, verbose=False).history
     np.testing.assert_allclose(on["wear_remaining_min"], h["wear_remaining_min"], rtol=1e-8)

@@ -84,8 +84,11 @@ def test_the_block_keeps_five_millimetres_behind_every_facet_until_worn_through(
     depth[:3] = 3.6e-3
     assert keep.through(depth).startswith(f"{name} at its wear limit: 3.6 mm worn of its 5 mm at (")
     assert keep.through(depth).endswith("1.4 mm left (wear.limit 1.5 mm), 3 of its facets at it")
-    with pytest.raises(InputError, match=f'wear.limit = "5 mm": less than the thinnest part behind an interface facet: '
-                                         f"{name}, 5 mm"):
+    depth[0] = 5.5e-3                                                # beyond the limit and through
+    assert keep.through(depth).startswith(f"{name} worn through: 5.5 mm worn of its 5 mm at (")
+    assert ", 1 of its facets through, wear.limit 1.5 mm (the model keeps" in keep.through(depth)
+    with pytest.raises(InputError, match=rf'wear.limit = "5 mm": must be less than the thinnest part behind an interface '
+                                         rf"facet \({name}, 5 mm\)"):
         WearLimit(tm, 5e-3)
 
 

@@ -167,12 +167,12 @@ class FacetWear:
         mu, K = iface.values(m.contact.friction), iface.values(m.contact.stiffness)
         per_pressure = e.mean_rate(m.face_temperatures()) * np.where(e.per_load, 1.0, mu) * slid * self.reach  # m/Pa
         explicit = (per_pressure * K).max() <= STABLE
+        before, (attrs, arrays) = m.snapshot(), self.state()         # (pending too: as it was)
+        before_wear = attrs, {name: a.copy() for name, a in arrays.items()}
         self.pending = m.released and not explicit and not last
         if self.pending:                          # re-engaging on an explicit wear of this size failed (a review)
             return none
         implicit = not (explicit or m.released)
-        before, (attrs, arrays) = m.snapshot(), self.state()
-        before_wear = attrs, {name: a.copy() for name, a in arrays.items()}
         try:
             self._wear_and_solve(implicit, e.volume / iface.areas, per_pressure, e.counter_volume.copy())
         except BaseException:                     # a failed solve: the update undone, for a caller going on

@@ -134,8 +134,8 @@ class WearLimit:
         thinnest = int(np.argmin(self.thickness.value)) if len(self.thickness.value) else None
         if thinnest is not None and self.keep >= self.thickness.value[thinnest] and self.keep > 0:
             name = self.thickness.names[self.thickness.part[thinnest]]
-            raise InputError(f'wear.limit = "{1e3 * self.keep:.4g} mm"', None, "less than the thinnest part behind "
-                             f"an interface facet: {name}, {self.thickness.value[thinnest] * 1e3:.4g} mm")
+            raise InputError(f'wear.limit = "{1e3 * self.keep:.4g} mm"', None, "must be less than the thinnest part "
+                             f"behind an interface facet ({name}, {self.thickness.value[thinnest] * 1e3:.4g} mm)")
 
     def remaining(self, depth: np.ndarray) -> np.ndarray:
         return self.thickness.value - depth
@@ -156,15 +156,16 @@ class WearLimit:
         if not len(left) or left.min() > self.keep:
             return None
         f, part, names = int(np.argmin(left)), self.thickness.part, self.thickness.names
-        at = left <= self.keep
+        through = left[f] <= 0                     # (beyond a wear limit too)
+        at = left <= (0.0 if through else self.keep)
         where = ", ".join(f"{1e3 * x:.4g}" for x in self.midpoints[f])
         name, worn, of = names[part[f]], 1e3 * depth[f], 1e3 * self.thickness.value[f]
         count = f"{int((at & (part == part[f])).sum())} of its facets"
-        others = ", ".join(sorted({names[p] for p in part[at] if p != part[f]}))
-        also = f"; {others} too" if others else ""
-        if self.keep:
+        also = "".join(f"; {other} too" for other in sorted({names[p] for p in part[at] if p != part[f]}))
+        limit = f"wear.limit {1e3 * self.keep:.4g} mm"
+        if not through:
             return (f"{name} at its wear limit: {worn:.4g} mm worn of its {of:.4g} mm at ({where}) mm, "
-                    f"{1e3 * left[f]:.4g} mm left (wear.limit {1e3 * self.keep:.4g} mm), {count} at it{also}")
-        return (f"{name} worn through: {worn:.4g} mm worn of its {of:.4g} mm at ({where}) mm, {count} through{also} "
-                "(the model keeps the bodies' shapes: beyond it, what lies behind the worn part, a pad's backplate, "
-                "would rub unseen)")
+                    f"{1e3 * left[f]:.4g} mm left ({limit}), {count} at it{also}")
+        return (f"{name} worn through: {worn:.4g} mm worn of its {of:.4g} mm at ({where}) mm, {count} through{also}"
+                f"{', ' + limit if self.keep else ''} (the model keeps the bodies' shapes: beyond it, what lies behind "
+                "the worn part, a pad's backplate, would rub unseen)")

@@ -125,7 +125,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     def write():
         files = provenance.write(result.folder, scene, ranks=comm.size, started=started, stages=reporter.times,
                                  wall_time=time.perf_counter() - start, analysis=kind,
-                                 status="resumed and finished" if resume else "finished", earlier=earlier,
+                                 status=("resumed and " if resume else "") + (result.ended or "finished"),
+                                 earlier=earlier,
                                  warnings=[*scene.warnings, *beyond])
         return files + _write_script(result.folder, scene)
     result.files += comm.bcast(io.on_root(comm, write, f"the provenance into {result.folder}"), root=0)

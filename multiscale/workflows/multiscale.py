@@ -157,7 +157,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         ms.rough.pool.progress = False
         plan = outputs.plan(scene)
         writer = stepping.field_output(ms.model, folder, plan.body_fields + plan.interface_fields, done=done,
-                                       steps=steps, every=every, resume=resume, extra=ms.facet_fields())
+                                       steps=steps, every=every, resume=resume, extra=ms.facet_fields(),
+                                       worn=resume and ms.worn_through() is not None)
         if not resume:                       # after the refusal: a refused run leaves nothing to resume (a review)
             ms.save(ckpt, 0, history)
         last = steps if stop_after is None else min(steps, stop_after)
@@ -175,7 +176,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         result = MultiscaleResult(folder, writer.files + [f for f in (h5, png, plot, zones, ckpt) if f] + maps,
                                   _time.perf_counter() - start, history, h5, png, writer.files, plot, maps, zones,
                                   done, warnings=run_notes(ms.model) + through_layers(ms, *_wear_keys(scene)) +
-                                  ((stepping.worn_note(through, done, steps),) if through else ()))
+                                  ((stepping.worn_note(through, done, steps),) if through else ()),
+                                  ended=stepping.ended_by(through, done, steps))
         ms.model.close()          # on every rank in the same order (MUMPS' destruction communicates)
     if stopping:                 # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", result.warnings)

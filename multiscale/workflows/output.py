@@ -29,6 +29,7 @@ class RunResult:
     files: list            #: written paths
     wall_time: float       #: s
     warnings: tuple = field(default=(), kw_only=True)
+    ended: str = field(default="", kw_only=True)   #: why it ended before its last step ("" if it did not)
 
 
 def totals(history) -> str:

@@ -44,11 +44,12 @@ def open_run(scene, overwrite: bool, resume: bool, comm) -> tuple[OutputFolder, 
 
 
 def field_output(model, folder: Path, names, *, done: int, steps: int, every: int, resume: bool,
-                 extra=None) -> FieldOutput:
+                 extra=None, worn: bool = False) -> FieldOutput:
     """The run's field files: a new run's, with the fields of its start (step ``done`` = 0, written
     before its first checkpoint); a resumed run's, kept up to its checkpoint's step ``done`` (whose
-    due fields were written before it), without the fields of a stop between output times."""
-    due = field_step(done, every, steps)                    # the step's fields belong to the series
+    due fields were written before it), without the fields of a stop between output times, but with
+    those of a step where wear ended the run, if it still does (``worn``: ``march`` steps no further)."""
+    due = field_step(done, every, steps) or worn           # the step's fields belong to the series
     keep = model.time if due else np.nextafter(model.time, -np.inf)
     writer = FieldOutput(model, folder, names, extra=extra, resume_at=keep if resume else None)
     if not resume:
@@ -101,6 +102,11 @@ def stopped_after(done: int, steps: int, stopping: bool, through: str | None = N
     ended by a part worn ``through`` or to its wear limit (``march``); "" otherwise."""
     return f" (stopped after step {done} of {steps})" if stopping else \
         f" (ended by wear at step {done} of {steps})" if through else ""
+
+
+def ended_by(through: str | None, done: int, steps: int) -> str:
+    """A run's provenance status when a part wore ``through`` (or to its limit), else ""."""
+    return f"ended by wear after step {done} of {steps}" if through else ""
 
 
 def worn_note(through: str, done: int, steps: int) -> str:

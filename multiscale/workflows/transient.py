@@ -135,7 +135,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         plan = outputs.plan(scene)
         writer = stepping.field_output(model, folder, plan.body_fields + plan.interface_fields, done=done,
                                        steps=steps, every=scene.output.every, resume=resume,
-                                       extra=wear_fields(wear) if wear is not None else None)
+                                       extra=wear_fields(wear) if wear is not None else None,
+                                       worn=resume and marching.worn_through() is not None)
         if not resume:                       # (the first solve's fields are written: also those of a run refused next)
             write_history(history, folder, scene.name, comm, plot=False)   # a run failing in its first step keeps t = 0
             refuse_floating(scene, tm, history)
@@ -159,7 +160,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
     kept = [ckpt] if steps else []
     result = TransientResult(folder, writer.files + [f for f in (h5, png) if f] + kept, _time.perf_counter() - start,
                              history, h5, png, writer.files,
-                             warnings=run_notes(model) + ((stepping.worn_note(through, done, steps),) if through else ()))
+                             warnings=run_notes(model) + ((stepping.worn_note(through, done, steps),) if through else ()),
+                             ended=stepping.ended_by(through, done, steps))
     if verbose and comm.rank == 0:
         print(f"{scene.name}: {io.counted(len(history), 'record')} in {result.wall_time:.1f} s on "
               f"{io.counted(comm.size, 'rank')}")
