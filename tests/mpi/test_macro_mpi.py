@@ -155,5 +155,6 @@ def test_a_pin_worn_through_ends_the_run_on_both_ranks(tmp_path):
         return loads(text, overrides={"time.steps": 4, "time.end": "12 s"})
     parallel, serial = histories(through, MPI.COMM_WORLD.bcast(str(tmp_path), root=0))
     assert list(parallel["time"]) == list(serial["time"]) == [0.0, 3.0, 6.0]
-    np.testing.assert_allclose(parallel["wear_remaining_min"], serial["wear_remaining_min"], rtol=1e-8)
+    # (11 mm worn in a step by implicit updates: the solvers' tolerances on 1 and 2 ranks reach 1.2e-8 of it)
+    np.testing.assert_allclose(parallel["wear_remaining_min"], serial["wear_remaining_min"], rtol=1e-6)
     assert serial["wear_remaining_min"][0] == pytest.approx(15e-3, rel=1e-12) and serial["wear_remaining_min"][-1] < 0
