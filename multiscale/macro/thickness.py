@@ -10,7 +10,8 @@ J. Graphics Tools 2(1), 21–28), only with those whose inward normal n has n·d
 the ray's direction d: a side wall that a ray near the edge of a curved face grazes is not where
 the material behind it ends (a review: a shoe on a wheel's rim, 10 mm thick, was said to be
 2.3 mm behind its edge facets, and 0.5 mm on a finer mesh, and its run ended "worn through"). A
-ray that leaves through no such triangle gives an infinite thickness (no limit at that facet).
+facet whose ray leaves through no such triangle (it grazed a side wall only) takes its least
+distance to one (``nearest_facing``: at most the distance along any ray to it).
 
 ``WearLimit`` compares a run's worn depths [m] per facet with these thicknesses: the history column
 ``wear_remaining_min`` and, at zero, the part worn through (the run ends after writing that step:
@@ -66,6 +67,42 @@ def ray_exit(origins: np.ndarray, directions: np.ndarray, triangles: np.ndarray,
     return out
 
 
+@njit(cache=True, nogil=True)
+def nearest_facing(points: np.ndarray, directions: np.ndarray, triangles: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Least distance [m] from each of ``points`` (m, 3) [m] to a triangle of ``triangles`` (k, 3, 3)
+    whose unit inward normal n has n·d <= -``FACING`` for the point's unit ``directions`` d (inf if
+    none): the closest point on a triangle by Ericson's regions (2005, Real-Time Collision
+    Detection, §5.1.5)."""
+    out = np.full(len(points), np.inf)
+    for i in range(len(points)):
+        p, d = points[i], directions[i]
+        for j in range(len(triangles)):
+            if normals[j] @ d > -FACING:
+                continue
+            a, b, c = triangles[j, 0], triangles[j, 1], triangles[j, 2]
+            ab, ac, ap = b - a, c - a, p - a
+            d1, d2 = ab @ ap, ac @ ap
+            bp, cp = p - b, p - c
+            d3, d4, d5, d6 = ab @ bp, ac @ bp, ab @ cp, ac @ cp
+            va, vb, vc = d3 * d6 - d5 * d4, d5 * d2 - d1 * d6, d1 * d4 - d3 * d2
+            if d1 <= 0 and d2 <= 0:
+                q = a                                            # vertex regions
+            elif d3 >= 0 and d4 <= d3:
+                q = b
+            elif d6 >= 0 and d5 <= d6:
+                q = c
+            elif vc <= 0 and d1 >= 0 and d3 <= 0:
+                q = a + d1 / (d1 - d3) * ab                      # edge regions
+            elif vb <= 0 and d2 >= 0 and d6 <= 0:
+                q = a + d2 / (d2 - d6) * ac
+            elif va <= 0 and d4 - d3 >= 0 and d5 - d6 >= 0:
+                q = b + (d4 - d3) / ((d4 - d3) + (d5 - d6)) * (c - b)
+            else:
+                q = a + (vb * ab + vc * ac) / (va + vb + vc)      # the face
+            out[i] = min(out[i], np.sqrt((p - q) @ (p - q)))
+    return out
+
+
 def part_boundaries(tets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The boundary of a set of tetrahedra (n, 4, 3) [m]: its triangles (k, 3, 3) and their unit
     normals (k, 3) pointing into the set (towards each triangle's tetrahedron)."""
@@ -115,6 +152,8 @@ def facet_thickness(tm) -> Thickness:
         on = np.isfinite(d)
         rays = share[on]
         value[rays] = ray_exit(iface.midpoints[rays], normal[j[on]], tri, normal, MATCH * tm.spec.length_scale)
+        missed = np.isinf(value[rays])                   # its ray grazed a side wall only: the nearest back face
+        value[rays[missed]] = nearest_facing(iface.midpoints[rays[missed]], normal[j[on]][missed], tri, normal)
         part[rays] = names.index(next(r.name for r in body.spec.regions if r.tag == tag))
     value = np.concatenate(comm.allgather(value[share]))
     part = np.concatenate(comm.allgather(part[share]))
