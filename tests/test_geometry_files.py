@@ -533,17 +533,17 @@ def rim_step(folder: Path) -> Path:
     return folder / "rim.step"
 
 
-def test_a_rough_interface_must_be_planar(tmp_path, capsys):
-    """A fixed block pressed on the curved rim of a rotating wheel: fine in perfect contact, refused
-    as a rough interface (check, before anything runs)."""
-    rim_step(tmp_path)
-    text = f"""
-effects = ["contact", "roughness"]
+def rim_scene(folder: Path, effects: str, geometry: str = "") -> str:
+    """A scene of ``rim_step`` (written into ``folder``): the wheel turning, the shoe of steel pressed
+    by 100 N on its back; ``effects`` and more [geometry] keys as TOML; [loading] last, to go on."""
+    return f"""
+effects = {effects}
 [geometry]
-file = "{tmp_path / 'rim.step'}"
+file = "{rim_step(folder)}"
 unit = "m"
 mesh_size = "5 mm"
 rotating = "wheel"
+{geometry}
 [geometry.bodies.wheel]
 contains = [0, 0, 0.01]
 material = "steel"
@@ -559,6 +559,13 @@ nu = 0.3
 [loading]
 normal_force = "100 N"
 faces = ["back"]
+"""
+
+
+def test_a_rough_interface_must_be_planar(tmp_path, capsys):
+    """A fixed block pressed on the curved rim of a rotating wheel: fine in perfect contact, refused
+    as a rough interface (check, before anything runs)."""
+    text = rim_scene(tmp_path, '["contact", "roughness"]') + """
 [roughness]
 rms = "1 um"
 hurst = 0.8

@@ -128,37 +128,15 @@ def test_a_shoe_on_a_rim_is_as_thick_as_its_back_says(tmp_path):
     from multiscale.macro.thickness import facet_thickness
     from multiscale.scene import loads
     from multiscale.workflows.model import build_mesh
-    from test_geometry_files import rim_step
-    scene = loads(f"""
-effects = ["contact", "friction"]
-[geometry]
-file = "{rim_step(tmp_path)}"
-unit = "m"
-mesh_size = "5 mm"
-interface_mesh_size = "1 mm"
-rotating = "wheel"
-[geometry.bodies.wheel]
-contains = [0, 0, 0.01]
-material = "steel"
-[geometry.bodies.shoe]
-contains = [0, 0.055, 0.01]
-material = "steel"
-[geometry.surfaces.back]
-body = "shoe"
-normal = [0, 1, 0]
+    from test_geometry_files import rim_scene
+    scene = loads(rim_scene(tmp_path, '["contact", "friction"]', 'interface_mesh_size = "1 mm"') + f"""
+rotation_speed = "100 rpm"
+friction = 0.4
 [geometry.surfaces.bore]
 body = "wheel"
 contains = [0, 0.01, 0]
-[materials.steel]
-E = "200 GPa"
-nu = 0.3
 [interface]
 penalty = "1e13 Pa/m"
-[loading]
-normal_force = "100 N"
-faces = ["back"]
-rotation_speed = "100 rpm"
-friction = 0.4
 [[boundary]]
 surfaces = ["back"]
 fix = ["x", "z"]
