@@ -28,10 +28,10 @@ with T = T_fix on fixed-temperature surfaces and ∂T/∂n = 0 (insulated) on ev
 q_i come from ``ContactInterface.heat_residuals``: the frictional flux mu p_n |w| split by the
 per-facet partition p_1, and with ``conductance`` an exchange h_c (T_0 − T_1). Boundary fluxes are
 positive out of the body: convection h [W/(m^2 K)] towards the ambient T_a (Newton's law of cooling,
-h constant or a function of the rotating body's speed, taken at the start of each step), grey-body
-radiation to surroundings at T_a with emissivity eps and sigma = 5.670374419e-8 W/(m^2 K^4)
-(Incropera & DeWitt, Fundamentals of Heat and Mass Transfer, §1.2.3). With constant materials and
-no radiation the step is one linear solve, its matrix's cell part (storage, conduction,
+h constant or a function of the rotating body's speed, taken at the step's mean speed as the
+transport is: ``MacroModel.macro_step``), grey-body radiation to surroundings at T_a with
+emissivity eps and sigma = 5.670374419e-8 W/(m^2 K^4) (Incropera & DeWitt, Fundamentals of Heat
+and Mass Transfer, §1.2.3). With constant materials and no radiation the step is one linear solve, its matrix's cell part (storage, conduction,
 transport) kept between steps while dt and the speed stay (``kept_cells.KeptCells``), by GMRES to
 1e-12 of the step's residual on the LU factors of an earlier step's matrix, refactorised after a
 solve of more than ``KEPT_ITERATIONS`` iterations (the interface terms change every step; ch. 7's
