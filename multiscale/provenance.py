@@ -23,6 +23,7 @@ import math
 import os
 import platform
 import sys
+import tomllib
 from importlib import metadata
 from pathlib import Path
 
@@ -289,7 +290,8 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     the scene's and the run's (e.g. temperatures
     beyond a material table); status ``RUNNING`` (written as the run begins) has no end time.
     ``earlier``: the parts of the run before this one (a resumed run: ``parts_of`` the folder
-    before it wrote); the record's ``parts`` are those and this one, its ``start`` the first
+    before it wrote); the record's ``parts`` are those and this one (each with the scene's keys it
+    ran with that a resume may change, ``free``), its ``start`` the first
     part's, its ``command``, ``ranks``, ``end`` and ``status`` this part's, its stage and total
     wall times [s] the sums over the parts; each part names the code that ran it (``code``'s sha1)."""
     folder = Path(folder)
@@ -300,7 +302,8 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
             "ranks": ranks,
             "code": ran["sha1"], "start": started, "end": None if status == RUNNING else now(),
             "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()},
-            "total_wall_time_s": None if status == RUNNING else round(wall_time, 3)}
+            "total_wall_time_s": None if status == RUNNING else round(wall_time, 3),
+            "free": free(tomllib.loads(resolved_toml(scene)))}
     parts = [*earlier, part]
     total: dict[str, float] = {}
     for p in parts:
@@ -325,8 +328,35 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     return [folder / name for name in texts]
 
 
-PART = ("status", "command", "directory", "ranks", "code", "start", "end", "stage_wall_time_s", "total_wall_time_s")   # a part's
-#                                                           keys ("code": the SHA-1 of the package's files, ``code``)
+PART = ("status", "command", "directory", "ranks", "code", "start", "end", "stage_wall_time_s", "total_wall_time_s",
+        "free")   # a part's keys ("code": the SHA-1 of the package's files, ``code``; "free": ``free``'s keys as it ran)
+
+
+def dotted(table: dict, prefix: str = "") -> dict:
+    """A TOML table's values by dotted key (arrays of tables as one value)."""
+    out = {}
+    for key, value in table.items():
+        if isinstance(value, dict):
+            out.update(dotted(value, f"{prefix}{key}."))
+        else:
+            out[prefix + key] = value
+    return out
+
+
+def free(resolved: dict) -> dict:
+    """Takes out of a resolved scene (``resolved_toml`` read back) the keys a resumed run may change,
+    which the checkpoint's fingerprint leaves out (``workflows.output.fingerprint``), and returns them
+    by dotted key: ``name``, ``description``, ``geometry.max_cells`` (a limit on the mesh),
+    ``wear.limit`` (it ends a run and may be lowered to resume it) and ``output`` but its probes
+    (whose history columns a resumed run continues). Each part of a run's record keeps its own."""
+    out = {k: resolved.pop(k) for k in ("name", "description") if k in resolved}
+    for section, key in (("geometry", "max_cells"), ("wear", "limit")):
+        if key in resolved.get(section, {}):
+            out[f"{section}.{key}"] = resolved[section].pop(key)
+    output = resolved.pop("output", {})
+    if "probes" in output:
+        resolved["output"] = {"probes": output.pop("probes")}
+    return dotted({**out, **({"output": output} if output else {})})
 
 
 def parts_of(folder: Path) -> list[dict]:

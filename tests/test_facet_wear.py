@@ -153,7 +153,7 @@ def test_a_pin_worn_through_ends_the_run_with_its_results(tmp_path):
     that step's fields; its provenance says how it ended);
     ``wear_remaining_min`` is the length less the deepest wear. With ``wear.limit`` = 5 mm it ends
     after step 1 (3.7 mm left), and resumed without the limit (not part of the checkpoint's
-    fingerprint) it goes on to the straight run's end."""
+    fingerprint) it goes on to the straight run's end; each part's record keeps its limit."""
     s = scene(tmp_path / "t", steps=4, end="12 s", wear='k_w = "1e-8 1/Pa"', **{"output.every": 4})
     r = run(s, verbose=False)
     h = r.history
@@ -177,6 +177,8 @@ def test_a_pin_worn_through_ends_the_run_with_its_results(tmp_path):
     on = run(scene(tmp_path / "k", steps=4, end="12 s", wear='k_w = "1e-8 1/Pa"', **{"output.every": 4}),
              resume=True, verbose=False).history
     np.testing.assert_allclose(on["wear_remaining_min"], h["wear_remaining_min"], rtol=1e-6)   # (solver tolerances)
+    parts = json.loads((tmp_path / "k" / "provenance.json").read_text())["parts"]     # each part's own limit
+    assert [p["free"]["wear.limit"] for p in parts] == [0.005, 0.0]
 
 
 def test_the_scene_takes_wear_in_perfect_contact(tmp_path):

@@ -13,6 +13,7 @@ import os
 import subprocess
 import sys
 import time
+import tomllib
 import types
 from dataclasses import replace
 from pathlib import Path
@@ -193,7 +194,9 @@ def test_provenance_and_paraview_script(case):
         assert {"meshing", "macro steps"} <= set(record["stage_wall_time_s"])
     assert record["start"] <= record["end"] and record["total_wall_time_s"] > 0
     assert record["parts"] == [{"code": record["code"]["sha1"], **{k: record[k] for k in (
-        "status", "command", "directory", "ranks", "start", "end", "stage_wall_time_s", "total_wall_time_s")}}]
+        "status", "command", "directory", "ranks", "start", "end", "stage_wall_time_s", "total_wall_time_s")},
+        "free": provenance.free(tomllib.loads(resolved_toml(scene)))}]
+    assert "output.folder" in record["parts"][0]["free"]      # (keys a resume may change, as this part ran them)
     assert record["directory"] == os.getcwd()     # the command's relative paths are from there (not said: a trial)
     assert record["files"] == sorted(p.files)          # what a later --overwrite deletes
     overrides = dict(record["overrides"])         # scene.toml alone is not this run (before: nothing said so)

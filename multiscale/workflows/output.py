@@ -206,12 +206,12 @@ def clear(folder: Path, existing: list[str]) -> None:
 
 
 def fingerprint(scene) -> checkpoint.Fingerprint:
-    """What the results depend on: the scene (not the output section but its probes, whose history
-    columns a resumed run continues: one added failed in the history's first row, one moved mixed
-    two places in a column, a review; not ``name``, ``description`` or
-    ``geometry.max_cells``, a limit on the mesh: a long-run trial's resume was refused for a
-    changed description; nor ``wear.limit``, which ends a run and may be lowered to resume it; effects sorted: a set's order changes between processes) and the bytes
-    of every file it reads (a measured surface rewritten under the same name was resumed into
+    """What the results depend on: the scene but the keys a resume may change (``provenance.free``:
+    the output section but its probes, whose history columns a resumed run continues: one added
+    failed in the history's first row, one moved mixed two places in a column, a review; ``name``,
+    ``description`` and ``geometry.max_cells``: a long-run trial's resume was refused for a changed
+    description; ``wear.limit``, which ends a run and may be lowered to resume it; effects sorted:
+    a set's order changes between processes) and the bytes of every file it reads (a measured surface rewritten under the same name was resumed into
     wrong wear depths: the checkpoint holds the worn heights, the unworn ones are read again); its
     inputs by name: every key of the resolved scene but those, and each file's SHA-1."""
     s = dataclasses.replace(scene, output=None, source=None, overrides=(), warnings=(), name=None, description="",
@@ -221,23 +221,10 @@ def fingerprint(scene) -> checkpoint.Fingerprint:
     source = scene.source.resolve() if scene.source is not None else None
     files = {p: checkpoint.file_digest(p) for p in sorted(p for p in scene.inputs if p != source and p.is_file())}
     resolved = tomllib.loads(provenance.resolved_toml(scene))
-    probes = {"output": {"probes": resolved.get("output", {}).get("probes", {})}}
-    for key in ("output", "name", "description"):
-        resolved.pop(key, None)
-    resolved.get("geometry", {}).pop("max_cells", None)
-    resolved.get("wear", {}).pop("limit", None)
-    inputs = {**_dotted(resolved), **_dotted(probes), **{f"file {p}": digest for p, digest in files.items()}}
+    provenance.free(resolved)
+    inputs = {**{k: json.dumps(v, default=str) for k, v in provenance.dotted(resolved).items()},
+              **{f"file {p}": digest for p, digest in files.items()}}
     text = repr(s) + (repr(scene.output.probes) if scene.output.probes else "") + \
         "".join(f"{p}:{d}" for p, d in files.items())
     return checkpoint.Fingerprint(checkpoint.fingerprint(text), inputs)
 
-
-def _dotted(table: dict, prefix: str = "") -> dict[str, str]:
-    """A TOML table's values by dotted key (arrays of tables as one value), as JSON."""
-    out = {}
-    for key, value in table.items():
-        if isinstance(value, dict):
-            out.update(_dotted(value, f"{prefix}{key}."))
-        else:
-            out[prefix + key] = json.dumps(value, default=str)
-    return out
