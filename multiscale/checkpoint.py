@@ -24,7 +24,7 @@ from multiscale.arrays import unique_rows
 from multiscale.errors import InputError
 from multiscale.io import History, on_root, replacing
 
-FORMAT = 13   # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns;
+FORMAT = 14   # what a checkpoint holds; 2: P2 temperatures in a rotating body, min_temperature_* history columns;
 #               3: the drive's state (speed, engagement, load last solved) and the area-weighted effusivity partition;
 #               4: the law_reach_halved history column, quadratic cells in the field files beside it;
 #               5: min_temperature_<body>_in_<material> history columns; 6: wear_substeps, near_perfect_zones;
@@ -32,7 +32,8 @@ FORMAT = 13   # what a checkpoint holds; 2: P2 temperatures in a rotating body, 
 #               8: max_slip_speed, min_slip_speed history columns (a mu(v) law); 9: no fields_written (a step's
 #               fields are written before its checkpoint, ``workflows.stepping``); 10: the zones' exchange_full;
 #               11: the facets' wear in perfect contact (exposure per facet, its sliding x load, pending);
-#               12: the exposure's temperature-weighted rows; 13: its rows rated at each substep's temperatures
+#               12: the exposure's temperature-weighted rows; 13: its rows rated at each substep's temperatures;
+#               14: no pending facet wear (a released implicit update solves at the held load)
 
 
 def fingerprint(text: str) -> str:

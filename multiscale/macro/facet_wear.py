@@ -29,8 +29,11 @@ back to p (dh_f += (p_now - p_f) / K_n: a depth constant over a facet against a 
 not amplifies the within-facet variation by 1 + K_n c; without them the worn-in pin's recorded
 pressure followed 1/r within 3.9 %, with them 0.4 %). Its volume is k W within 0.2-0.7 %; its
 transient converges like dt^0.5 (a review: 1.4 times closer per halving, pre-asymptotic). Released,
-an update that would be implicit waits for the next loaded step (an explicit one there made the
-re-engaging contact Newton fail), unless it is the run's last. An update whose solve fails is
+an update that would be implicit is solved at the load the contact was released from (its last
+solve's), and the model is released again from that worn state (an explicit one there made the
+re-engaging contact Newton fail, as did the released state's displacement on the worn gaps; waiting for the next loaded step put the wear, the work and a
+``wear.limit`` off by the dwell: a user trial's run stopped a stop late), unless it is the run's
+last: nothing re-engages, and it wears from the exposure (k W). An update whose solve fails is
 undone (the model's state and the wear's as before it) before the error goes on. The counter-face's
 track wears from the exposure (k_1 W) while its depth per pressure at a facet, c_1 = k_1 mu ds times
 ``coverage`` (the depth a unit depth over every facet spreads to round the circles: the share of its
@@ -164,7 +167,6 @@ class FacetWear:
         for r in self.rates:
             per_load[r.mask] = r.per_load
         model.exposure = Exposure(n, self.rate_at, per_load)
-        self.pending = False              # a released update waiting for the next loaded step
         self.limit = WearLimit(model.tm, limit)   # the worn depths against the thickness behind the facets
         self.coverage = np.zeros(n)       # [-] (module docstring; a translating body 1's track is uniform: none)
         if self.counter_rates and isinstance(motion, Rotation):
@@ -173,8 +175,9 @@ class FacetWear:
     def update(self, last: bool = False) -> tuple[np.ndarray, float]:
         """Wear over the model's ``exposure`` since the last update, then the exposure restarts and
         the contact is solved on the worn gaps (collective: the same on every rank). Released, an
-        update that would be implicit waits (``pending``) for the next loaded step, unless it is the
-        ``last``. Returns the volume [m^3] body 0 lost per interface and the frictional work [J]."""
+        update that would be implicit is solved at the load of the last solve, then the model is
+        released again from that worn state, unless it is the run's ``last`` (module
+        docstring). Returns the volume [m^3] body 0 lost per interface and the frictional work [J]."""
         m, iface = self.model, self.model.tm.interface
         e, solved = m.exposure, float(m.mechanics.load.value)
         slid = e.sliding / solved if solved else 0.0     # the sliding of the pressure solved now
@@ -187,19 +190,21 @@ class FacetWear:
         counter = k1 * mu * slid * self.reach                                          # m/Pa: body 1's volume / area
         track = (counter * self.coverage * K).max() > TRACK_STABLE                     # its track implicit too
         explicit = (per_pressure * K).max() <= STABLE and not track
-        before, (attrs, arrays) = m.snapshot(), self.state()         # (pending too: as it was)
+        before, (attrs, arrays) = m.snapshot(), self.state()
         before_wear = attrs, {name: a.copy() for name, a in arrays.items()}
-        self.pending = m.released and not explicit and not last
-        if self.pending:                          # re-engaging on an explicit wear of this size failed (a review)
-            return none
-        implicit = not (explicit or m.released)
+        implicit = not explicit and not (m.released and last)
+        held = m.released and implicit            # re-engaging on an explicit wear of this size failed (a review)
         try:
+            if held:                              # at the load it was released from
+                m.contact.engaged.value = 1.0
             self._wear_and_solve(implicit, e.volume / iface.areas, e.counter_volume.copy(), per_pressure,
                                  counter if track else None)
         except BaseException:                     # a failed solve: the update undone, for a caller going on
             m.restore(before)
             self.restore(*before_wear)
             raise
+        if held:                                  # released again; the next loaded step solves from the worn state
+            m.contact.engaged.value, m.stale = 0.0, True
         self.implicit += implicit
         done = float(e.work.sum())
         self.work += done
@@ -309,14 +314,14 @@ class FacetWear:
 
     def state(self) -> tuple[dict, dict]:
         """(attributes, arrays) a checkpoint keeps (``restore`` reads them back)."""
-        return ({"wear": [self.work, self.counter_volume, self.implicit, self.model.exposure.sliding, self.pending]},
+        return ({"wear": [self.work, self.counter_volume, self.implicit, self.model.exposure.sliding]},
                 {"wear_depth": self.depth, "counter_depth": self.counter_depth, "wear_volume": self.volume,
                  "exposure": self.model.exposure.sums})
 
     def restore(self, attrs: dict, arrays: dict) -> None:
         """Back to a ``state``; the facets' gaps follow."""
-        self.work, self.counter_volume, implicit, self.model.exposure.sliding, pending = (float(v) for v in attrs["wear"])
-        self.implicit, self.pending = int(implicit), bool(pending)
+        self.work, self.counter_volume, implicit, self.model.exposure.sliding = (float(v) for v in attrs["wear"])
+        self.implicit = int(implicit)
         self.depth, self.counter_depth = arrays["wear_depth"].copy(), arrays["counter_depth"].copy()
         self.volume, self.model.exposure.sums[:] = arrays["wear_volume"].copy(), arrays["exposure"]
         self._set_gap()

@@ -65,10 +65,10 @@ class Marching:
     def step(self, n: int):
         heat = self.model.macro_step(self.scene.time.dt, self.scene.time.substeps)
         last = n == self.scene.time.steps
-        self.updated = self.wear is not None and (n % self.scene.wear.update_every == 0 or last or self.wear.pending)
+        self.updated = self.wear is not None and (n % self.scene.wear.update_every == 0 or last) \
+            and bool(self.model.exposure.sliding)      # (a dwell's rows: no update)
         if self.updated:
             self.wear.update(last)
-            self.updated = not self.wear.pending
         return heat
 
     def record(self, heat) -> dict:
