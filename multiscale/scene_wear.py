@@ -51,7 +51,8 @@ class Wear:
     temperature: str = key(Choice(("surface", "macro")), default="surface")   # what a k_w(T) or k(T) reads
     update_every: int = key(Integer(ge=1), default=1)                         # macro steps per update
     substeps: int = key(Integer(ge=1), default=1)                             # wear increments per update
-    limit: float = key(Quantity("length", ge=0), default=0.0)   # material kept behind a worn face: the run ends below it
+    # material kept behind a worn face: the run ends below it (plausibly a pad's few mm: a bare 2 is 2 m, a trial)
+    limit: float = key(Quantity("length", ge=0, plausible=(0.0, 0.05)), default=0.0)
 
     rules = (OneOf(("k_w", "k_w_table", "specific_rate", "specific_rate_table")),)
 

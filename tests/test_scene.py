@@ -1515,7 +1515,7 @@ def test_a_wear_table_left_by_the_run_is_warned_about(tmp_path):
     run started at 1 K, or whose micro temperatures reached 2769 degC, wore at the end values
     without a word (material tables are warned about). The initial temperature's end is the
     scene's warning, so that check says it before the run (it said it only after; a user trial).
-    A constant k_w has no ends."""
+    A constant k_w has no ends. A ``wear.limit`` beyond 5 cm is warned of (a bare 2 is 2 m)."""
     from multiscale.io import History
     from multiscale.workflows import run_warnings
     text = (DEMOS / "pin_on_disc.toml").read_text()
@@ -1545,6 +1545,9 @@ def test_a_wear_table_left_by_the_run_is_warned_about(tmp_path):
     assert any(line.endswith("; k_w of its material (k_w per frictional work, k per normal load: a specific wear "
                              "rate k is k_w = k/mu); the run ends once a worn part is worn through (wear.limit)")
                for line in summary(loads(own, tmp_path)))
+    metres = loads(own.replace("substeps = 2", "substeps = 2\nlimit = 2"), tmp_path)      # a bare 2 is 2 m (a trial)
+    assert "wear.limit = 2: 2 m is outside the plausible range 0 to 0.05 m: check the value and its unit" \
+        " (as \"2 mm\" or \"2 um\" it would be plausible)" in metres.warnings
 
 
 def test_a_penalty_softer_than_the_bodies_is_warned_about(tmp_path):
