@@ -26,7 +26,8 @@ class Probe:
     a fixed frame: there a probe stays at its place in space (a rubbing thermocouple, a pyrometer's
     spot) unless it ``turns`` with the body (a thermocouple embedded in the disc): the mean round its
     circle about the axis (``multiscale.macro.probes``). ``body`` may name a part of a body (a pad,
-    not its backplate). The run says each probe's body, part and distance from the interface."""
+    not its backplate). The run says each probe's body, part and distance from the interface, and
+    at its end each probe that a worn face reached (the bodies keep their shapes: it read on)."""
 
     point: tuple | None = key(POINT, required=True)        # m, [x, y, z]
     body: str | None = key(Text(), absent="the body holding the point (on the interface: give it); or a part")

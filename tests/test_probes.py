@@ -27,7 +27,8 @@ def test_a_probe_reads_the_field_at_its_point():
     """A field linear in space (exact in P1): each probe reads it to round-off, inside a body, on its
     outer face and 1e-9 m outside it (``TOUCH``: said in ``located``); on the interface (z = 0, the
     block on the flat) only with its body named, and each body's own field there. Points outside
-    are refused all together, with how far out they are."""
+    are refused all together, with how far out they are. Those a worn face reached are named
+    (``worn``: a trial's thermocouple 2 mm into a pad worn 4.5 mm read on)."""
     model = build_model(block_scene())
     T = model.thermal.T
     T[0].interpolate(linear)
@@ -44,6 +45,13 @@ def test_a_probe_reads_the_field_at_its_point():
     assert got["face1"] == pytest.approx(linear((3e-3, 3e-3, 0.0)) + 50.0, abs=1e-9)
     assert [(w.body, round(w.depth * 1e3, 9)) for w in probes.located[:2]] == [(0, 1.7), (0, 5.0)]
     assert [w.outside for w in probes.located[1:3]] == [0.0, pytest.approx(1e-9, rel=1e-6)]
+    n = model.tm.interface.n_facets                            # the block worn 2 mm deep, the flat not
+    assert probes.worn((np.full(n, 2e-3), np.zeros(n))) == [
+        "probe inside: 1.7 mm from the interface, where block wore 2 mm: it read material worn away (the bodies "
+        "keep their shapes)", "probe face0: 0 mm from the interface, where block wore 2 mm: it read material worn "
+        "away (the bodies keep their shapes)"]
+    below = np.linalg.norm(model.tm.interface.midpoints[probes.located[0].facet, :2] - [2e-3, 3e-3])
+    assert below == np.linalg.norm(model.tm.interface.midpoints[:, :2] - [2e-3, 3e-3], axis=1).min()
     with pytest.raises(InputError, match=r"output.probes.edge.point: \[3.0, 3.0, 0.0\] mm lies on the faces of both "
                                          r"'block' and 'flat': give output.probes.edge.body"):
         Probes(model.tm, T, [ProbeSpec("edge", (3e-3, 3e-3, 0.0))])

@@ -25,6 +25,7 @@ from typing import Sequence
 import numpy as np
 from dolfinx import fem, geometry
 from mpi4py import MPI
+from scipy.spatial import cKDTree
 
 from multiscale.errors import InputError, InputErrors
 
@@ -49,14 +50,16 @@ class ProbeSpec:
 class Located:
     """Where a probe reads: its body's index, the name of the region (part) at its point, its
     distance [m] from the nearest interface facet (how deep below the friction face it sits; in the
-    rotating body from the track the interfaces sweep: the least over its circle) and how far [m]
-    outside the meshed body it lies (0 inside; ``TOUCH``)."""
+    rotating body from the track the interfaces sweep: the least over its circle), how far [m]
+    outside the meshed body it lies (0 inside; ``TOUCH``) and ``facet``, the interface facet (global
+    index) whose midpoint is nearest (to its circle's points in the rotating body)."""
 
     name: str
     body: int
     part: str
     depth: float
     outside: float
+    facet: int
 
 
 def ring(point, rotation, n: int = RING) -> np.ndarray:
@@ -121,8 +124,24 @@ class Probes:
         self.reads[i].append((k, points[mine], cells[mine]))
         swept = ring(s.point, rotation) if i == 1 and rotation is not None else points    # the track it passes
         depth = tm.interface.distance(swept)
+        near, facet = cKDTree(tm.interface.midpoints).query(swept)
         return Located(s.name, i, self._part(tm.bodies[i], owner[0], cells[0]),
-                       0.0 if depth < 1e-9 * tm.spec.length_scale else depth, float(gaps.max()))
+                       0.0 if depth < 1e-9 * tm.spec.length_scale else depth, float(gaps.max()),
+                       int(facet[np.argmin(near)]))
+
+    def worn(self, depths) -> list[str]:
+        """The probes in material worn away: each whose facet's worn depth [m] (``depths``: per body,
+        global arrays per facet) is positive and reaches its depth below the face.
+        The bodies keep their shapes, so such a probe reads on in material that is gone (a user
+        trial's thermocouple 2 mm into a pad worn 4.5 mm deep)."""
+        out = []
+        for where in self.located:
+            worn = depths[where.body]
+            if worn[where.facet] > 0 and worn[where.facet] >= where.depth:
+                out.append(f"probe {where.name}: {where.depth * 1e3:.3g} mm from the interface, where "
+                           f"{where.part} wore {worn[where.facet] * 1e3:.3g} mm: it read "
+                           "material worn away (the bodies keep their shapes)")
+        return out
 
     def temperatures(self) -> dict[str, float]:
         """{probe name: its temperature [K]} now, the same on every rank (collective)."""

@@ -176,6 +176,8 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         result = MultiscaleResult(folder, writer.files + [f for f in (h5, png, plot, zones, ckpt) if f] + maps,
                                   _time.perf_counter() - start, history, h5, png, writer.files, plot, maps, zones,
                                   done, warnings=run_notes(ms.model) + through_layers(ms, *_wear_keys(scene)) +
+                                  (tuple(ms.model.probes.worn((ms.facet_wear_depth(), ms.counter_depth)))
+                                   if ms.model.probes is not None else ()) +
                                   ((stepping.worn_note(through, done, steps),) if through else ()),
                                   ended=stepping.ended_by(through, done, steps))
         ms.model.close()          # on every rank in the same order (MUMPS' destruction communicates)

@@ -155,12 +155,14 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         if steps and done == steps:
             checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
         model.close()                    # on every rank in the same order (MUMPS' destruction communicates)
+    notes = run_notes(model) + (tuple(model.probes.worn((wear.depth, wear.counter_depth)))
+                                if wear is not None and model.probes is not None else ())
     if stopping:                     # decided by every rank together
-        raise Interrupted(f"after step {done} of {steps}", run_notes(model))
+        raise Interrupted(f"after step {done} of {steps}", notes)
     kept = [ckpt] if steps else []
     result = TransientResult(folder, writer.files + [f for f in (h5, png) if f] + kept, _time.perf_counter() - start,
                              history, h5, png, writer.files,
-                             warnings=run_notes(model) + ((stepping.worn_note(through, done, steps),) if through else ()),
+                             warnings=notes + ((stepping.worn_note(through, done, steps),) if through else ()),
                              ended=stepping.ended_by(through, done, steps))
     if verbose and comm.rank == 0:
         print(f"{scene.name}: {io.counted(len(history), 'record')} in {result.wall_time:.1f} s on "
