@@ -22,7 +22,7 @@ from mpi4py import MPI
 from multiscale import __version__
 from multiscale.errors import InputError, MultiscaleError, OutputError, SceneError, behind
 from multiscale.geometry import too_many_cells
-from multiscale.io import CtrlCWatch, Outliving, abort, ended_together
+from multiscale.io import CtrlCWatch, Outliving, abort, ended_together, reason
 from multiscale.memory import SPREAD, memory_available, memory_limit, remedy
 from multiscale.micro.outliers import DESPIKE
 from multiscale.micro.reading import COMMAND_LINE, TopographyWarning, formats, read_topography
@@ -281,7 +281,7 @@ def _study(args) -> int:
             raise
         return 2
     except OSError as exc:                   # a results or report folder that cannot be written
-        raise OutputError(f"cannot write {exc.filename}: {exc.strerror or exc}") from None
+        raise OutputError(f"cannot write {exc.filename}: {reason(exc)}") from None
     return 1 if failed else 0
 
 

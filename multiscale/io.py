@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import difflib
 import os
+import re
 import signal
 import sys
 import threading
@@ -125,6 +126,15 @@ def on_root(comm, write, what: str):
     return value[0] if value else None
 
 
+def reason(exc: OSError) -> str:
+    """An ``OSError``'s reason in a line: the system's, also out of HDF5's long text (h5py: "Can't close
+    file (file write failed: time = ..., errno = 28, error message = 'No space left on device', ...)",
+    which a full disk printed over two lines: an MPI review)."""
+    text = exc.strerror or str(exc)
+    found = re.search(r"error message = '([^']*)'", text)
+    return found.group(1) if found else " ".join(text.split())
+
+
 def on_ranks(comm, jobs, what: str) -> None:
     """Run the callables ``jobs`` spread over the ranks (job k on rank k mod size: files any rank
     can write alone, e.g. figures from data every rank holds) and make a failure collective: an
@@ -134,7 +144,7 @@ def on_ranks(comm, jobs, what: str) -> None:
         try:
             job()
         except OSError as exc:
-            failure = f"cannot write {what}: {exc.strerror or exc}"
+            failure = f"cannot write {what}: {reason(exc)}"
             break
     failures = [f for f in comm.allgather(failure) if f]
     if failures:

@@ -21,12 +21,20 @@ def test_jobs_are_spread_over_the_ranks_and_each_runs_once():
 
 
 def test_a_failure_on_one_rank_is_an_output_error_on_every_rank():
-    """Job 1 (rank 1 on two ranks, rank 0 alone) meets a full disk: every rank raises."""
+    """Job 1 (rank 1 on two ranks, rank 0 alone) meets a full disk: every rank raises, with the
+    system's reason (HDF5's long text cut to it)."""
     def full():
         raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC))
     with pytest.raises(OutputError, match="cannot write the wear maps: No space left on device"):
         io.on_ranks(comm, [lambda: None, full, lambda: None], "the wear maps")
     comm.Barrier()                      # both ranks got here: no rank is left waiting
+
+    def hdf5():                         # h5py's text of a full disk: its reason alone (it took two lines)
+        raise OSError("Can't close file (file write failed: time = Sun Dec  6 14:19:02 2026\n, filename = "
+                      "'checkpoint.h5', file descriptor = 5, errno = 28, error message = 'No space left on device', "
+                      "buf = 0x5a1, total write size = 8)")
+    with pytest.raises(OutputError, match=r"^cannot write the checkpoint: No space left on device$"):
+        io.on_ranks(comm, [lambda: None, hdf5, lambda: None], "the checkpoint")
 
 
 def test_a_field_mesh_refused_on_rank_0_is_refused_on_every_rank():
