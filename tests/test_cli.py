@@ -284,7 +284,7 @@ def test_set_gives_scene_keys_over_the_files_to_check_and_run(tmp_path, capsys, 
     """``--set KEY=VALUE``: a value TOML reads (a number, a list, a quoted string) or else the text;
     check judges and summarises the scene with them, run hands it on with them (recorded in its
     overrides, which provenance.json lists); a bad key is the scene's error, a setting without "="
-    the command line's."""
+    the command line's; a key given twice takes the last, said."""
     path = _write(tmp_path, BLOCK.replace("../results/block_on_flat", "out"))
     assert main(["check", path, "--set", "loading.pressure=2 MPa", "--set", "interface.penalty=2e13"]) == 0
     out = capsys.readouterr().out
@@ -292,6 +292,10 @@ def test_set_gives_scene_keys_over_the_files_to_check_and_run(tmp_path, capsys, 
     assert out.splitlines()[1] == '  set       loading.pressure = "2 MPa", interface.penalty = 2e+13'
     assert main(["check", path, "--set", "loading.pressur=2"]) == 2
     assert 'error: loading.pressur: unknown key (did you mean "pressure"?)' in capsys.readouterr().err
+    assert main(["check", path, "--set", "loading.pressure=2 MPa", "--set", "loading.pressure=3 MPa"]) == 0
+    twice = capsys.readouterr()                                           # (kept silently: a user trial)
+    assert "warning: --set loading.pressure given 2 times (2 MPa, 3 MPa): the last is taken" in twice.err
+    assert "  loading   3 MPa" in twice.out
     with pytest.raises(SystemExit) as exit_:
         main(["check", path, "--set", "loading.pressure"])
     assert exit_.value.code == 2 and "KEY=VALUE" in capsys.readouterr().err
