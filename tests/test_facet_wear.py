@@ -42,6 +42,23 @@ def test_the_facets_wear_archards_volume_of_the_work_and_of_the_load(tmp_path):
     np.testing.assert_allclose(per_load["wear_volume"], 4e-15 * per_load["frictional_work"] / 0.4, rtol=1e-12)
 
 
+def test_an_implicit_update_under_fade_wears_at_the_sliding_s_friction(tmp_path):
+    """With a fade table (mu 0.4 at 20 degC to 0.1 at 23 degC) an implicit update's depth per pressure
+    takes the mu of the sliding it wears for, the exposure's work over its load: k_w x work within 1 %
+    whether the update falls at the release (the pin hot, mu 0.1) or after a dwell. With the mu at
+    the update it wore 45 % and 10 % short (a review)."""
+    from test_macro_run import THERMAL
+    text = pin_on_disc(tmp_path / "f", effects=THERMAL + ("wear",)) + '\n[wear]\nk_w = "3e-13 1/Pa"\n'
+    for every in (1, 3):
+        h = run(loads(text, overrides={"time.steps": 6, "time.end": "18 s", "wear.update_every": every,
+                                       "loading.load_profile": [["0 s", 1.0], ["2.9 s", 1.0], ["2.91 s", 0.0],
+                                                                ["14.99 s", 0.0], ["15 s", 1.0]],
+                                       "loading.friction_temperature": [["20 degC", 0.4], ["23 degC", 0.1]]}),
+                resume=False, overwrite=True, verbose=False).history
+        assert h["wear_implicit_updates"][-1] == 2
+        assert h["wear_volume"][-1] == pytest.approx(3e-13 * h["frictional_work"][-1], rel=1e-2), every
+
+
 def test_a_worn_in_pin_carries_its_load_as_one_over_the_radius(tmp_path):
     """Archard wear at k_w mu p omega r settles where every point wears alike (the worn face recedes
     as a whole): p r uniform, p = C / r. The coarse pin (20 mm at 80-100 mm, 2.5 mm facets), k_w =

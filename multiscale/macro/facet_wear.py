@@ -16,7 +16,9 @@ exposure.
 
 Stability. The depth per pressure of an update, c_f = k_f mu_f ds_f [m/Pa] (k_f ds_f per load; ds
 the sliding of the pressure solved now: the exposure's load-weighted sliding times its loads over
-the load now), against the facets' contact stiffness: a depth constant over a facet is a pattern
+the load now; mu_f the sliding's, the exposure's work over its load, W_f / L_f: with a fade table
+the mu at the update, read after a stop's heating or a dwell's cooling, wore 10-45 % off k W, a
+review), against the facets' contact stiffness: a depth constant over a facet is a pattern
 the displacement (linear over each element) cannot follow facet by facet, so only the penalty K_n
 resists it (a review measured the facet Jacobian: its largest eigenvalue times c within 1.2 % of
 c K_n, 3.4 to 24 times an elastic estimate, and the explicit update failed where c K_n exceeded 2).
@@ -184,7 +186,8 @@ class FacetWear:
         none = np.zeros(len(iface.tags)), 0.0
         if not e.sliding:
             return none
-        mu, K = iface.values(m.contact.friction), iface.values(m.contact.stiffness)
+        K = iface.values(m.contact.stiffness)     # mu: the sliding's, W / L (with fade, mu now was 45 % off: a review)
+        mu = np.divide(e.work, e.load, out=iface.values(m.contact.friction), where=e.load > 0)
         k0, k1 = e.mean_rates(m.face_temperatures())
         per_pressure = k0 * np.where(e.per_load, 1.0, mu) * slid * self.reach          # m/Pa: body 0's depth
         counter = k1 * mu * slid * self.reach                                          # m/Pa: body 1's volume / area

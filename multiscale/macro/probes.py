@@ -131,13 +131,14 @@ class Probes:
 
     def worn(self, depths) -> list[str]:
         """The probes in material worn away: each whose facet's worn depth [m] (``depths``: per body,
-        global arrays per facet) is positive and reaches its depth below the face.
+        global arrays per facet) reaches its depth below the face (not one on the face: it reads the
+        face, which the model keeps where it was; a review found a pyrometer's spot named at 0.14 um).
         The bodies keep their shapes, so such a probe reads on in material that is gone (a user
         trial's thermocouple 2 mm into a pad worn 4.5 mm deep)."""
         out = []
         for where in self.located:
             worn = depths[where.body]
-            if worn[where.facet] > 0 and worn[where.facet] >= where.depth:
+            if where.depth > 0 and worn[where.facet] >= where.depth:
                 out.append(f"probe {where.name}: {where.depth * 1e3:.3g} mm from the interface, where "
                            f"{where.part} wore {worn[where.facet] * 1e3:.3g} mm: it read "
                            "material worn away (the bodies keep their shapes)")
