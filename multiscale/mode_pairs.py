@@ -5,7 +5,7 @@ it resembles most. For what an NVH engineer compares: forward against reverse ro
 mesh of the pads' friction, damping or not, serial against parallel (Allemang 2003, "The modal
 assurance criterion, twenty years of use and abuse", Sound and Vibration 37(8)).
 
-The shapes are the nodal displacements [m/kg^0.5] as the files hold them (no mass weighting, as a
+The shapes are the nodal displacements [1/kg^0.5] as the files hold them (no mass weighting, as a
 test correlation takes them). Nodes are matched by their coordinates, part by part, so runs on any
 number of ranks compare (a parallel run's files hold the nodes its ranks share once per rank);
 runs on different meshes are refused. A reverse run of a brake symmetric about a plane through its
@@ -23,7 +23,7 @@ import numpy as np
 
 from multiscale.errors import InputError
 
-SHAPE = "mode shape {} part [m/kg^0.5]"
+SHAPE = "mode shape {} part [1/kg^0.5]"
 SAME_POINT = 1e-9        # nodes this share of the mesh's extent apart are one node
 PAIRED = 0.9             # a pair whose MAC is below this is said to be weak
 AXES = "xyz"
@@ -32,7 +32,7 @@ AXES = "xyz"
 @dataclass
 class ModeSet:
     """The modes of one run: number (1, 2, ... as in modes.csv), frequency [Hz], growth rate
-    sigma [1/s] (> 0 grows), the nodes (n, 3) [m] and shapes (3 n, modes) [m/kg^0.5] of its parts."""
+    sigma [1/s] (> 0 grows), the nodes (n, 3) [m] and shapes (3 n, modes) [1/kg^0.5] of its parts."""
 
     folder: Path
     numbers: np.ndarray

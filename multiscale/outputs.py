@@ -22,7 +22,7 @@ APPLICATIONS = "applications.csv"     # a duty cycle's braking applications (``p
 # files of a run named without a body: a body of that name would write its fields over them
 OWN_FILES = {"interface": "interface.xdmf", "history": "history.h5", "zones": "zones.h5",
              "checkpoint": CHECKPOINT, "map": "map.h5"}
-MODE_UNIT = "m/kg^0.5"     # mode shapes normalised to unit modal mass
+MODE_UNIT = "1/kg^0.5"     # mode shapes normalised to unit modal mass, phi^H M phi = 1 with M in kg
 MODE_ARRAYS = tuple(f"mode shape {part} part [{MODE_UNIT}]" for part in ("real", "imaginary"))   # in modes_<body>.bp
 NAME = re.compile(r"[A-Za-z0-9_-]+")    # a body, interface or material name: file and column names, scene keys
 

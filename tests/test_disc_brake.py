@@ -404,14 +404,14 @@ def test_mode_shapes_are_written_to_vtx(tmp_path, brake, friction):
     disc = friction.modes.modes[n0:, 1]                     # mode 2 on the disc (its dofs, serial)
     with adios2.FileReader(str(files[1])) as reader:
         for part, values in (("real", disc.real), ("imaginary", disc.imag)):
-            stored = reader.read(f"mode shape {part} part [m/kg^0.5]", step_selection=[1, 1])
+            stored = reader.read(f"mode shape {part} part [1/kg^0.5]", step_selection=[1, 1])
             assert np.abs(stored).max() == pytest.approx(np.abs(values).max(), rel=1e-12)
     # the sign is the shape's, not the eigensolver's: the negated modes are written the same
     flipped = dataclasses.replace(friction.modes, modes=-friction.modes.modes)
     again = write_modes(tmp_path / "flipped", flipped, brake[1].u, ["pads", "disc"], modes=[1, 2])
     with adios2.FileReader(str(files[1])) as one, adios2.FileReader(str(again[1])) as other:
         for j in (0, 1):
-            name = "mode shape real part [m/kg^0.5]"
+            name = "mode shape real part [1/kg^0.5]"
             a, b = one.read(name, step_selection=[j, 1]), other.read(name, step_selection=[j, 1])
             assert np.abs(a).max() > 0 and np.array_equal(a, b), j
     sign = orientation(friction.modes.modes[:, :2], brake[1].u, [u.x.index_map.size_local * 3 for u in brake[1].u])

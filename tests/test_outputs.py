@@ -175,7 +175,7 @@ def test_mode_shapes_read_back_from_vtx(case):
     for body in p.bodies:
         with adios2.FileReader(str(p.folder / f"modes_{body}.bp")) as reader:
             variables = reader.available_variables()
-            assert {"mode shape real part [m/kg^0.5]", "mode shape imaginary part [m/kg^0.5]"} <= set(variables)
+            assert {"mode shape real part [1/kg^0.5]", "mode shape imaginary part [1/kg^0.5]"} <= set(variables)
             assert int(variables["step"]["AvailableStepsCount"]) == n
             steps = reader.read("step", step_selection=[0, n])
             np.testing.assert_array_equal(steps, np.arange(1, n + 1))

@@ -396,7 +396,7 @@ def write_state(folder: Path, mechanics, fields) -> list[Path]:
 def write_modes(folder: str | Path, result, functions: Sequence, names: Sequence[str],
                 modes: Sequence[int] | None = None) -> list[Path]:
     """Mode shapes of ``result`` (``eigen.ModalResult``) to ``<folder>/modes_<name>.bp`` (VTX, one
-    per body): arrays "mode shape real part" and "... imaginary part" [m/kg^0.5] on the space of
+    per body): arrays "mode shape real part" and "... imaginary part" [1/kg^0.5] on the space of
     the displacement, "time" = mode number (1, 2, ...), each mode's sign that of ``orientation``
     (the eigensolver's is arbitrary: the same mode was written as +phi or -phi by runs on other
     ranks), on each rank's owned cells (``owned_space``). Collective; returns the written paths.

@@ -69,7 +69,7 @@ def test_two_ranks_reproduce_the_serial_squeal_analysis():
                     conn = [stream.read("connectivity", block_id=b).ravel() for b in blocks]   # (n, n nodes) a cell
                     centres = np.concatenate([stream.read("geometry", block_id=b).reshape(-1, 3)[
                         c.reshape(-1, int(c[0]) + 1)[:, 1:5]].mean(axis=1) for b, c in zip(blocks, conn)])
-                    real = np.concatenate([stream.read("mode shape real part [m/kg^0.5]", block_id=b) for b in blocks])
+                    real = np.concatenate([stream.read("mode shape real part [1/kg^0.5]", block_id=b) for b in blocks])
             assert len(blocks) == 2 and len(centres) == count
             assert len(np.unique(np.round(centres / 1e-9), axis=0)) == count, path.name
             assert np.abs(real).max() == pytest.approx(top, rel=1e-12)
