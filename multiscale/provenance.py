@@ -294,16 +294,16 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     ran with that a resume may change, ``free``), its ``start`` the first
     part's, its ``command``, ``ranks``, ``end`` and ``status`` this part's, its stage and total
     wall times [s] the sums over the parts; each part names the code that ran it (``code``'s sha1)."""
-    folder = Path(folder)
+    folder, resolved = Path(folder), resolved_toml(scene)
     given = scene.text if scene.source else \
-        "# The scene came from text, not a file: here it is as resolved.\n" + resolved_toml(scene)
+        "# The scene came from text, not a file: here it is as resolved.\n" + resolved
     ran = code()                     # each part's own (a run resumed after a change of the code: a user trial)
     part = {"status": status, "command": list(sys.argv if command is None else command), "directory": os.getcwd(),
             "ranks": ranks,
             "code": ran["sha1"], "start": started, "end": None if status == RUNNING else now(),
             "stage_wall_time_s": {k: round(v, 3) for k, v in stages.items()},
             "total_wall_time_s": None if status == RUNNING else round(wall_time, 3),
-            "free": free(tomllib.loads(resolved_toml(scene)))}
+            "free": free(tomllib.loads(resolved))}
     parts = [*earlier, part]
     total: dict[str, float] = {}
     for p in parts:
@@ -318,7 +318,7 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
               "process": process(),
               "versions": versions(), "code": ran, "environment": environment(), "inputs": input_digests(scene),
               "files": sorted(plan(scene).files), "warnings": list(warnings)}
-    texts = {"scene.toml": given, "scene_resolved.toml": resolved_toml(scene)}
+    texts = {"scene.toml": given, "scene_resolved.toml": resolved}
     if status.startswith(("failed", "interrupted")):     # (a finished run writes its script after the record)
         record["files"] = [n for n in record["files"] if n in texts or n == "provenance.json" or (folder / n).exists()]
     texts["provenance.json"] = json.dumps(record, indent=2, default=str) + "\n"
@@ -328,8 +328,9 @@ def write(folder: Path, scene: Scene, *, ranks: int, started: str, stages: dict,
     return [folder / name for name in texts]
 
 
+# a part's keys ("code": the SHA-1 of the package's files, ``code``; "free": ``free``'s keys as it ran)
 PART = ("status", "command", "directory", "ranks", "code", "start", "end", "stage_wall_time_s", "total_wall_time_s",
-        "free")   # a part's keys ("code": the SHA-1 of the package's files, ``code``; "free": ``free``'s keys as it ran)
+        "free")
 
 
 def dotted(table: dict, prefix: str = "") -> dict:

@@ -33,8 +33,9 @@ pressure followed 1/r within 3.9 %, with them 0.4 %). Its volume is k W within 0
 transient converges like dt^0.5 (a review: 1.4 times closer per halving, pre-asymptotic). Released,
 an update that would be implicit is solved at the load the contact was released from (its last
 solve's), and the model is released again from that worn state (an explicit one there made the
-re-engaging contact Newton fail, as did the released state's displacement on the worn gaps; waiting for the next loaded step put the wear, the work and a
-``wear.limit`` off by the dwell: a user trial's run stopped a stop late), unless it is the run's
+re-engaging contact Newton fail, as did the released state's displacement on the worn gaps;
+waiting for the next loaded step put the wear, the work and a ``wear.limit`` off by the dwell: a
+user trial's run stopped a stop late), unless it is the run's
 last: nothing re-engages, and it wears from the exposure (k W). An update whose solve fails is
 undone (the model's state and the wear's as before it) before the error goes on. The counter-face's
 track wears from the exposure (k_1 W) while its depth per pressure at a facet, c_1 = k_1 mu ds times

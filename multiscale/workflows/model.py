@@ -392,6 +392,12 @@ def probes(scene, tm, temperatures) -> Probes:
     return found
 
 
+def worn_probes(model: MacroModel, depths) -> tuple:
+    """The model's probes that a worn face reached (``Probes.worn``: ``depths`` [m] per body, global
+    arrays per facet); none without probes."""
+    return tuple(model.probes.worn(depths)) if model.probes is not None else ()
+
+
 def run_notes(model: MacroModel) -> tuple:
     """What a run of the model adds to its warnings: the model's notes (``MacroModel.notes``) and
     the heat's (``Thermal.notes``)."""

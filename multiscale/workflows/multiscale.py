@@ -41,7 +41,7 @@ from multiscale.micro.heat_kernels import ThermalMaterial
 from multiscale.micro.laws import Conductance
 from multiscale.micro.post_analysis import Heating, PostAnalyses, PostAnalysis, grid_of
 from multiscale.workflows.model import build_mesh, build_model, friction_coefficient, heat_warnings_as_notes, \
-    interface_forces, interface_materials, run_notes, say_clamp, say_load, say_model_size
+    interface_forces, interface_materials, run_notes, say_clamp, say_load, say_model_size, worn_probes
 from multiscale.workflows.output import fingerprint, totals
 from multiscale.workflows.rough import (build_rough_interface, check_rough_scene, contact_kernel, interface_hardness,
                                         thermal_kernels)
@@ -176,8 +176,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         result = MultiscaleResult(folder, writer.files + [f for f in (h5, png, plot, zones, ckpt) if f] + maps,
                                   _time.perf_counter() - start, history, h5, png, writer.files, plot, maps, zones,
                                   done, warnings=run_notes(ms.model) + through_layers(ms, *_wear_keys(scene)) +
-                                  (tuple(ms.model.probes.worn((ms.facet_wear_depth(), ms.counter_depth)))
-                                   if ms.model.probes is not None else ()) +
+                                  worn_probes(ms.model, (ms.facet_wear_depth(), ms.counter_depth)) +
                                   ((stepping.worn_note(through, done, steps),) if through else ()),
                                   ended=stepping.ended_by(through, done, steps))
         ms.model.close()          # on every rank in the same order (MUMPS' destruction communicates)

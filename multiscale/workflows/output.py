@@ -211,8 +211,8 @@ def fingerprint(scene) -> checkpoint.Fingerprint:
     failed in the history's first row, one moved mixed two places in a column, a review; ``name``,
     ``description`` and ``geometry.max_cells``: a long-run trial's resume was refused for a changed
     description; ``wear.limit``, which ends a run and may be lowered to resume it; effects sorted:
-    a set's order changes between processes) and the bytes of every file it reads (a measured surface rewritten under the same name was resumed into
-    wrong wear depths: the checkpoint holds the worn heights, the unworn ones are read again); its
+    a set's order changes between processes) and the bytes of every file it reads (a measured
+    surface rewritten under the same name was resumed into wrong wear depths: the checkpoint holds the worn heights, the unworn ones are read again); its
     inputs by name: every key of the resolved scene but those, and each file's SHA-1."""
     s = dataclasses.replace(scene, output=None, source=None, overrides=(), warnings=(), name=None, description="",
                             geometry=dataclasses.replace(scene.geometry, max_cells=MAX_CELLS),

@@ -23,7 +23,7 @@ from multiscale.macro.kept_cells import closed_on_error
 from multiscale.macro.model import MacroModel
 from multiscale.workflows import stepping
 from multiscale.workflows.model import build_mesh, build_model, facet_wear, heat_warnings_as_notes, run_notes, \
-    say_clamp, say_load, say_model_size
+    say_clamp, say_load, say_model_size, worn_probes
 from multiscale.workflows.output import RunResult, fingerprint, totals
 from multiscale.workflows.strain import refuse_floating, say_at_once
 
@@ -155,8 +155,7 @@ def run(scene, *, overwrite: bool = False, resume: bool = False, comm=MPI.COMM_W
         if steps and done == steps:
             checkpoint.mark(ckpt, comm, finished=True)      # --resume: nothing left to do
         model.close()                    # on every rank in the same order (MUMPS' destruction communicates)
-    notes = run_notes(model) + (tuple(model.probes.worn((wear.depth, wear.counter_depth)))
-                                if wear is not None and model.probes is not None else ())
+    notes = run_notes(model) + (worn_probes(model, (wear.depth, wear.counter_depth)) if wear is not None else ())
     if stopping:                     # decided by every rank together
         raise Interrupted(f"after step {done} of {steps}", notes)
     kept = [ckpt] if steps else []
